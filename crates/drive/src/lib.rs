@@ -1,0 +1,287 @@
+//! The drive product: the SC6-class double-axis drive as seen on the bus.
+//!
+//! - [`DEVICE`]: the device description (identity, SyncManagers, FMMUs, PDO maps,
+//!   DC op modes), the one source the SII image, the stack's checks and later
+//!   the ESI XML and object dictionary derive from.
+//! - [`DriveObjects`]: the few objects a master reads during start-up, until the
+//!   object dictionary arrives (replace it then).
+#![no_std]
+#![cfg_attr(
+    not(test),
+    deny(
+        clippy::unwrap_used,
+        clippy::expect_used,
+        clippy::panic,
+        clippy::indexing_slicing
+    )
+)]
+#![deny(missing_docs)]
+
+use ecat::desc::coe_details;
+use ecat::{
+    DataType, DcOpMode, Device, FmmuUsage, Identity, MailboxSm, ObjectAccess, Pdo, PdoEntry, ProcessSm,
+    SdoAbort,
+};
+use esc::sii::mailbox_protocol;
+use esc::AlState;
+
+/// STOBER's EtherCAT vendor ID (E-005).
+pub const VENDOR_ID: u32 = 0xB9;
+/// Product code = nominal power in 0.1 kW (E-005). The SC6A062's nominal power
+/// is not in the seeds or the spec; assumed 1.5 kW (2 × 0.75 kW) until checked
+/// against the SC6 manual.
+pub const PRODUCT_CODE: u32 = 15;
+/// Software build number, reported as revision 1018h:03 (E-005, E-008).
+pub const SOFTWARE_BUILD: u32 = 1;
+/// Serial number placeholder; the real value is E52[2], from the device's
+/// production data (E-005).
+pub const SERIAL: u32 = 0;
+/// Device type 1000h: profile 402, servo drive (E-004).
+pub const DEVICE_TYPE: u32 = 0x0002_0192;
+/// Device name (1008h, E50).
+pub const DEVICE_NAME: &str = "SC6";
+/// Entries per PDO mapping object (spec §5.1: sub 0 is always 24).
+pub const MAPPING_ENTRIES: u8 = 24;
+/// Offset of axis B's CiA 402 objects (E-015).
+pub const AXIS_B_CIA402: u16 = 0x0800;
+/// Offset of axis B's manufacturer objects (E-010).
+pub const AXIS_B_MANUFACTURER: u16 = 0x8000;
+
+/// CoE index of manufacturer parameter `group` (A = 0 … Z = 25), `line`, axis A
+/// window (spec §2.6, E-009).
+pub const fn parameter_index(group: u16, line: u16) -> u16 {
+    0x2000 + group * 0x200 + line
+}
+
+/// Axis-A RxPDO entries (spec §5.4, 23 bytes).
+const RX_A: [PdoEntry; 8] = [
+    PdoEntry::new(0x6040, 0, DataType::U16, "Controlword"),
+    PdoEntry::new(0x6060, 0, DataType::I8, "Modes of operation"),
+    PdoEntry::new(0x607A, 0, DataType::I32, "Target position"),
+    PdoEntry::new(0x60FF, 0, DataType::I32, "Target velocity"),
+    PdoEntry::new(0x60B1, 0, DataType::I32, "Velocity offset"),
+    PdoEntry::new(0x60B2, 0, DataType::I16, "Torque offset"),
+    PdoEntry::new(0x6071, 0, DataType::I16, "Target torque"),
+    PdoEntry::new(0x60FE, 1, DataType::U32, "Digital outputs"),
+];
+
+/// Axis-A TxPDO entries (spec §5.4, 29 bytes).
+const TX_A: [PdoEntry; 10] = [
+    PdoEntry::new(0x6041, 0, DataType::U16, "Statusword"),
+    PdoEntry::new(0x6061, 0, DataType::I8, "Modes of operation display"),
+    PdoEntry::new(0x6064, 0, DataType::I32, "Position actual value"),
+    PdoEntry::new(0x606C, 0, DataType::I32, "Velocity actual value"),
+    PdoEntry::new(0x6077, 0, DataType::I16, "Torque actual value"),
+    PdoEntry::new(0x60F4, 0, DataType::I32, "Following error actual value"),
+    PdoEntry::new(0x60FD, 0, DataType::U32, "Digital inputs"),
+    PdoEntry::new(0x60E4, 1, DataType::I32, "Additional position actual value"),
+    PdoEntry::new(parameter_index(4, 201), 0, DataType::U16, "E201 Status word 2"),
+    PdoEntry::new(
+        parameter_index(0, 67),
+        0,
+        DataType::U16,
+        "A67 Status word user-defined",
+    ),
+];
+
+/// The same entries for axis B: CiA 402 objects +800h, manufacturer +8000h.
+const fn axis_b<const N: usize>(a: [PdoEntry; N]) -> [PdoEntry; N] {
+    let mut b = a;
+    let mut i = 0;
+    while i < N {
+        // N is the array's length: compile-time evaluation, no run-time index.
+        #[allow(clippy::indexing_slicing)]
+        let e = &mut b[i];
+        e.index += if e.index >= 0x6000 {
+            AXIS_B_CIA402
+        } else {
+            AXIS_B_MANUFACTURER
+        };
+        i += 1;
+    }
+    b
+}
+
+static RX_A_ENTRIES: [PdoEntry; 8] = RX_A;
+static RX_B_ENTRIES: [PdoEntry; 8] = axis_b(RX_A);
+static TX_A_ENTRIES: [PdoEntry; 10] = TX_A;
+static TX_B_ENTRIES: [PdoEntry; 10] = axis_b(TX_A);
+
+static RX_PDOS: [Pdo; 2] = [
+    Pdo {
+        index: 0x1600,
+        name: "RxPDO axis A",
+        entries: &RX_A_ENTRIES,
+    },
+    Pdo {
+        index: 0x1601,
+        name: "RxPDO axis B",
+        entries: &RX_B_ENTRIES,
+    },
+];
+
+static TX_PDOS: [Pdo; 2] = [
+    Pdo {
+        index: 0x1A00,
+        name: "TxPDO axis A",
+        entries: &TX_A_ENTRIES,
+    },
+    Pdo {
+        index: 0x1A01,
+        name: "TxPDO axis B",
+        entries: &TX_B_ENTRIES,
+    },
+];
+
+static DC_MODES: [DcOpMode; 3] = [
+    DcOpMode {
+        name: "FreeRun",
+        description: "Free run",
+        assign_activate: 0,
+        cycle_time_ns: 0,
+        shift_ns: 0,
+        sync0_cycle_factor: 0,
+    },
+    DcOpMode {
+        name: "SM-Synchron",
+        description: "SM-synchronous",
+        assign_activate: 0,
+        cycle_time_ns: 0,
+        shift_ns: 0,
+        sync0_cycle_factor: 0,
+    },
+    DcOpMode {
+        name: "DC",
+        description: "DC enabled (SYNC0)",
+        assign_activate: 0x0300,
+        cycle_time_ns: 0,
+        shift_ns: 0,
+        sync0_cycle_factor: 1,
+    },
+];
+
+/// The drive as seen on the bus (SC6A062, double axis).
+pub static DEVICE: Device = Device {
+    identity: Identity {
+        vendor_id: VENDOR_ID,
+        product_code: PRODUCT_CODE,
+        revision: SOFTWARE_BUILD,
+        serial: SERIAL,
+    },
+    device_type: DEVICE_TYPE,
+    name: DEVICE_NAME,
+    order_code: "SC6A062",
+    group: "Drives",
+    mailbox_out: MailboxSm {
+        start: 0x1000,
+        length: 256,
+        control: 0x26,
+    },
+    mailbox_in: MailboxSm {
+        start: 0x1100,
+        length: 256,
+        control: 0x22,
+    },
+    outputs: ProcessSm {
+        start: 0x1200,
+        control: 0x64,
+    },
+    inputs: ProcessSm {
+        start: 0x1A00,
+        control: 0x20,
+    },
+    // ethercrab needs an outputs and an inputs FMMU
+    fmmus: &[
+        FmmuUsage::Outputs,
+        FmmuUsage::Inputs,
+        FmmuUsage::MailboxStatus,
+        FmmuUsage::Unused,
+    ],
+    mailbox_protocols: mailbox_protocol::COE | mailbox_protocol::EOE,
+    coe_details: coe_details::SDO,
+    ports: 2,
+    process_ram_end: 0x3000,
+    dc_modes: &DC_MODES,
+    rx_pdos: &RX_PDOS,
+    tx_pdos: &TX_PDOS,
+    rx_assign: &[0x1600],
+    tx_assign: &[0x1A00],
+};
+
+/// The start-up objects of [`DEVICE`] (1000h, 1008h, 1018h, 1C00h, 1C12h,
+/// 1C13h, 1600h–1603h, 1A00h–1A03h), read-only. Replaced by the object
+/// dictionary later.
+#[derive(Debug, Default, Clone, Copy)]
+pub struct DriveObjects;
+
+impl DriveObjects {
+    /// The start-up objects.
+    pub const fn new() -> Self {
+        Self
+    }
+}
+
+fn put(buf: &mut [u8], data: &[u8]) -> Result<usize, SdoAbort> {
+    buf.get_mut(..data.len())
+        .ok_or(SdoAbort::OUT_OF_MEMORY)?
+        .copy_from_slice(data);
+    Ok(data.len())
+}
+
+fn sub_of<T: Copy>(list: &[T], sub: u8) -> Option<T> {
+    list.get(usize::from(sub).checked_sub(1)?).copied()
+}
+
+impl ObjectAccess for DriveObjects {
+    fn read(&mut self, index: u16, sub: u8, buf: &mut [u8]) -> Result<usize, SdoAbort> {
+        let d = &DEVICE;
+        let u8v = |v: u8| [v];
+        match (index, sub) {
+            (0x1000, 0) => put(buf, &d.device_type.to_le_bytes()),
+            (0x1008, 0) => put(buf, d.name.as_bytes()),
+            (0x1018, 0) => put(buf, &u8v(4)),
+            (0x1018, 1..=4) => {
+                let id = &d.identity;
+                let v = [id.vendor_id, id.product_code, id.revision, id.serial];
+                let v = sub_of(&v, sub).ok_or(SdoAbort::NO_SUBINDEX)?;
+                put(buf, &v.to_le_bytes())
+            }
+            (0x1C00, 0) => put(buf, &u8v(4)),
+            (0x1C00, 1..=4) => put(buf, &u8v(sub)),
+            // Sub 0 reports the number of assigned PDOs (1 by default), not the
+            // spec's constant 4 (E-054): ethercrab reads subs 1..=sub0 and then
+            // each PDO's mapping, and an unused assignment 0 would send it to
+            // object 0000h.
+            (0x1C12 | 0x1C13, _) => {
+                let list = if index == 0x1C12 { d.rx_assign } else { d.tx_assign };
+                match sub {
+                    0 => put(buf, &u8v(list.len() as u8)),
+                    1..=4 => put(buf, &sub_of(list, sub).unwrap_or(0).to_le_bytes()),
+                    _ => Err(SdoAbort::NO_SUBINDEX),
+                }
+            }
+            (0x1600..=0x1603 | 0x1A00..=0x1A03, _) => {
+                let entries = d.pdo(index).map(|p| p.entries).unwrap_or(&[]);
+                match sub {
+                    0 => put(buf, &u8v(MAPPING_ENTRIES)),
+                    1..=MAPPING_ENTRIES => {
+                        let v = sub_of(entries, sub).map_or(0, |e| e.mapping_value());
+                        put(buf, &v.to_le_bytes())
+                    }
+                    _ => Err(SdoAbort::NO_SUBINDEX),
+                }
+            }
+            (0x1000 | 0x1008 | 0x1018 | 0x1C00, _) => Err(SdoAbort::NO_SUBINDEX),
+            _ => Err(SdoAbort::NO_OBJECT),
+        }
+    }
+
+    fn write(&mut self, index: u16, sub: u8, _: &[u8], _: AlState) -> Result<(), SdoAbort> {
+        let mut probe = [0u8; 64];
+        self.read(index, sub, &mut probe)?;
+        Err(SdoAbort::READ_ONLY)
+    }
+}
+
+#[cfg(test)]
+mod tests;

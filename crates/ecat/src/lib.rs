@@ -1,0 +1,36 @@
+//! EtherCAT slave stack, sans-IO.
+//!
+//! - [`desc`]: the device description a product declares once (`static`): identity,
+//!   SyncManagers, FMMUs, PDO maps, DC op modes.
+//! - [`sii`]: the SII EEPROM image generated from it, and a checked category reader.
+//! - [`esm`]: the EtherCAT state machine rules and SyncManager checks (spec §3–4).
+//! - [`mailbox`]: the mailbox header and error replies; [`coe`]: CoE SDO
+//!   expedited/normal transfers over [`ObjectAccess`].
+//! - [`Slave`]: all of it composed; the application calls
+//!   [`Slave::poll`]`(pdi, app, now_ns)` with the ESC behind an [`esc::Pdi`].
+#![no_std]
+#![cfg_attr(
+    not(test),
+    deny(
+        clippy::unwrap_used,
+        clippy::expect_used,
+        clippy::panic,
+        clippy::indexing_slicing
+    )
+)]
+#![deny(missing_docs)]
+
+pub mod coe;
+pub mod desc;
+pub mod esm;
+pub mod mailbox;
+pub mod sii;
+mod slave;
+
+pub use coe::{ObjectAccess, SdoAbort};
+pub use desc::{DataType, DcOpMode, Device, FmmuUsage, Identity, MailboxSm, Pdo, PdoEntry, ProcessSm};
+pub use sii::{build_sii, SiiError};
+pub use slave::{Slave, StateChange};
+
+#[cfg(test)]
+mod tests;

@@ -1,0 +1,577 @@
+//! Slave tests against a fake ESC: plain memory, AL control read clears AL event
+//! bit 0, reading the last byte of SM0/SM2 clears their event bit, writing the
+//! last byte of SM1 sets its MAILBOX_FULL status bit.
+
+extern crate std;
+use std::vec::Vec;
+
+use crate::coe::{ObjectAccess, SdoAbort};
+use crate::desc::*;
+use crate::{Slave, StateChange};
+use esc::regs::{self, al_event};
+use esc::sii::mailbox_protocol;
+use esc::sm::{activate, pdi_control, status};
+use esc::{AlState, AlStatusCode, Pdi};
+
+static RX_ENTRIES: [PdoEntry; 2] = [
+    PdoEntry::new(0x7000, 1, DataType::U16, "Out word"),
+    PdoEntry::new(0x7000, 2, DataType::U8, "Out byte"),
+];
+static TX_ENTRIES: [PdoEntry; 1] = [PdoEntry::new(0x6000, 1, DataType::U32, "In dword")];
+static RX: [Pdo; 1] = [Pdo {
+    index: 0x1600,
+    name: "Outputs",
+    entries: &RX_ENTRIES,
+}];
+static TX: [Pdo; 1] = [Pdo {
+    index: 0x1A00,
+    name: "Inputs",
+    entries: &TX_ENTRIES,
+}];
+static DEV: Device = Device {
+    identity: Identity {
+        vendor_id: 0xB9,
+        product_code: 1,
+        revision: 1,
+        serial: 0,
+    },
+    device_type: 0x0002_0192,
+    name: "Test",
+    order_code: "T",
+    group: "Drives",
+    mailbox_out: MailboxSm {
+        start: 0x1000,
+        length: 128,
+        control: 0x26,
+    },
+    mailbox_in: MailboxSm {
+        start: 0x1080,
+        length: 128,
+        control: 0x22,
+    },
+    outputs: ProcessSm {
+        start: 0x1100,
+        control: 0x64,
+    },
+    inputs: ProcessSm {
+        start: 0x1180,
+        control: 0x20,
+    },
+    fmmus: &[FmmuUsage::Outputs, FmmuUsage::Inputs, FmmuUsage::MailboxStatus],
+    mailbox_protocols: mailbox_protocol::COE | mailbox_protocol::EOE,
+    coe_details: coe_details::SDO,
+    ports: 2,
+    process_ram_end: 0x3000,
+    dc_modes: &[],
+    rx_pdos: &RX,
+    tx_pdos: &TX,
+    rx_assign: &[0x1600],
+    tx_assign: &[0x1A00],
+};
+
+struct Fake {
+    mem: [u8; 0x3000],
+    /// Addresses of PDI writes to AL status / AL status code, in order.
+    status_writes: Vec<u16>,
+}
+
+impl Fake {
+    fn new() -> Self {
+        let mut f = Fake {
+            mem: [0; 0x3000],
+            status_writes: Vec::new(),
+        };
+        // the master's SII-conformant configuration
+        f.set_sm(0, 0x1000, 128, 0x26);
+        f.set_sm(1, 0x1080, 128, 0x22);
+        f.set_sm(2, 0x1100, 3, 0x64);
+        f.set_sm(3, 0x1180, 4, 0x20);
+        f
+    }
+    fn set_sm(&mut self, n: u8, start: u16, len: u16, control: u8) {
+        let a = regs::sm(n) as usize;
+        self.mem[a..a + 2].copy_from_slice(&start.to_le_bytes());
+        self.mem[a + 2..a + 4].copy_from_slice(&len.to_le_bytes());
+        self.mem[a + 4] = control;
+        self.mem[a + 6] = activate::ENABLE;
+    }
+    fn sm(&self, n: u8) -> (usize, usize) {
+        let a = regs::sm(n) as usize;
+        let start = u16::from_le_bytes([self.mem[a], self.mem[a + 1]]) as usize;
+        let len = u16::from_le_bytes([self.mem[a + 2], self.mem[a + 3]]) as usize;
+        (start, len)
+    }
+    fn u16(&self, a: u16) -> u16 {
+        u16::from_le_bytes([self.mem[a as usize], self.mem[a as usize + 1]])
+    }
+    fn events(&self) -> u32 {
+        let a = regs::AL_EVENT_REQUEST as usize;
+        u32::from_le_bytes(self.mem[a..a + 4].try_into().unwrap())
+    }
+    fn set_events(&mut self, e: u32) {
+        let a = regs::AL_EVENT_REQUEST as usize;
+        self.mem[a..a + 4].copy_from_slice(&e.to_le_bytes());
+    }
+    fn request(&mut self, ctrl: u16) {
+        let a = regs::AL_CONTROL as usize;
+        self.mem[a..a + 2].copy_from_slice(&ctrl.to_le_bytes());
+        self.set_events(self.events() | al_event::AL_CONTROL);
+    }
+    fn status(&self) -> u16 {
+        self.u16(regs::AL_STATUS)
+    }
+    fn code(&self) -> u16 {
+        self.u16(regs::AL_STATUS_CODE)
+    }
+    fn sm1_full(&self) -> bool {
+        self.mem[regs::sm(1) as usize + 5] & status::MAILBOX_FULL != 0
+    }
+    /// The master writes a mailbox request into SM0.
+    fn mbx_write(&mut self, req: &[u8]) {
+        let (start, len) = self.sm(0);
+        self.mem[start..start + len].fill(0);
+        self.mem[start..start + req.len()].copy_from_slice(req);
+        self.set_events(self.events() | al_event::sm(0));
+    }
+    /// The master reads SM1 (if full).
+    fn mbx_read(&mut self) -> Option<Vec<u8>> {
+        if !self.sm1_full() {
+            return None;
+        }
+        let (start, len) = self.sm(1);
+        self.mem[regs::sm(1) as usize + 5] &= !status::MAILBOX_FULL;
+        Some(self.mem[start..start + len].to_vec())
+    }
+}
+
+impl Pdi for Fake {
+    type Error = core::convert::Infallible;
+    fn read(&mut self, addr: u16, buf: &mut [u8]) -> Result<(), Self::Error> {
+        let (a, end) = (addr as usize, addr as usize + buf.len());
+        buf.copy_from_slice(&self.mem[a..end]);
+        if (a..end).contains(&(regs::AL_CONTROL as usize)) {
+            self.set_events(self.events() & !al_event::AL_CONTROL);
+        }
+        for n in [0u8, 2] {
+            let (s, l) = self.sm(n);
+            if l > 0 && (a..end).contains(&(s + l - 1)) {
+                self.set_events(self.events() & !al_event::sm(n));
+            }
+        }
+        Ok(())
+    }
+    fn write(&mut self, addr: u16, data: &[u8]) -> Result<(), Self::Error> {
+        let (a, end) = (addr as usize, addr as usize + data.len());
+        self.mem[a..end].copy_from_slice(data);
+        for r in [regs::AL_STATUS, regs::AL_STATUS_CODE] {
+            if (a..end).contains(&(r as usize)) {
+                self.status_writes.push(r);
+            }
+        }
+        let (s, l) = self.sm(1);
+        if l > 0 && (a..end).contains(&(s + l - 1)) {
+            self.mem[regs::sm(1) as usize + 5] |= status::MAILBOX_FULL;
+        }
+        Ok(())
+    }
+}
+
+/// 0x1000:0 = "Test", 0x2000:0 u16 writable.
+struct App {
+    value: u16,
+}
+
+impl ObjectAccess for App {
+    fn read(&mut self, index: u16, sub: u8, buf: &mut [u8]) -> Result<usize, SdoAbort> {
+        let v = self.value.to_le_bytes();
+        let data: &[u8] = match (index, sub) {
+            (0x1008, 0) => b"Test",
+            (0x2000, 0) => &v,
+            _ => return Err(SdoAbort::NO_OBJECT),
+        };
+        buf.get_mut(..data.len())
+            .ok_or(SdoAbort::OUT_OF_MEMORY)?
+            .copy_from_slice(data);
+        Ok(data.len())
+    }
+    fn write(&mut self, index: u16, _: u8, data: &[u8], _: AlState) -> Result<(), SdoAbort> {
+        match (index, data) {
+            (0x2000, &[a, b]) => {
+                self.value = u16::from_le_bytes([a, b]);
+                Ok(())
+            }
+            _ => Err(SdoAbort::READ_ONLY),
+        }
+    }
+}
+
+struct Rig {
+    esc: Fake,
+    slave: Slave,
+    app: App,
+    t: u64,
+}
+
+impl Rig {
+    fn new() -> Self {
+        let mut r = Rig {
+            esc: Fake::new(),
+            slave: Slave::new(&DEV),
+            app: App { value: 0 },
+            t: 0,
+        };
+        r.poll();
+        r
+    }
+    fn poll(&mut self) -> Option<StateChange> {
+        self.t += 1_000_000;
+        let Ok(c) = self.slave.poll(&mut self.esc, &mut self.app, self.t);
+        c
+    }
+    /// Requests `ctrl` and returns (AL status, AL status code) after one poll.
+    fn req(&mut self, ctrl: u16) -> (u16, u16) {
+        self.esc.request(ctrl);
+        self.poll();
+        (self.esc.status(), self.esc.code())
+    }
+    fn goto(&mut self, state: AlState) {
+        let path: &[u16] = match state {
+            AlState::Init => &[],
+            AlState::PreOp => &[2],
+            AlState::SafeOp => &[2, 4],
+            AlState::Op => &[2, 4, 8],
+            AlState::Bootstrap => unreachable!(),
+        };
+        for &s in path {
+            assert_eq!(self.req(s), (s, 0));
+        }
+        assert_eq!(self.slave.state(), state);
+    }
+    /// Sends an SDO upload request with `counter` and returns the response (if any).
+    fn upload(&mut self, index: u16, sub: u8, counter: u8) -> Option<Vec<u8>> {
+        let [i0, i1] = index.to_le_bytes();
+        self.esc.mbx_write(&[
+            10,
+            0,
+            0,
+            0,
+            0,
+            0x03 | (counter << 4),
+            0x00,
+            0x20,
+            0x40,
+            i0,
+            i1,
+            sub,
+            0,
+            0,
+            0,
+            0,
+        ]);
+        self.poll();
+        self.esc.mbx_read()
+    }
+}
+
+const STATES: [AlState; 4] = [AlState::Init, AlState::PreOp, AlState::SafeOp, AlState::Op];
+
+#[test]
+fn e021_e022_e023_transition_matrix() {
+    for from in STATES {
+        for requested in 0u16..16 {
+            let mut r = Rig::new();
+            r.goto(from);
+            let (status, code) = r.req(requested);
+            let legal = match (from.code(), requested) {
+                (f, q) if f as u16 == q => Some(q),
+                (1, 2) | (2, 4) | (4, 8) => Some(requested),
+                (_, 1 | 2 | 4) if (requested as u8) < from.code() => Some(requested),
+                _ => None,
+            };
+            let want = match (legal, requested) {
+                (Some(q), _) => (q, 0),
+                (None, 3) => (u16::from(from.code()) | 0x10, 0x0013),
+                (None, 1 | 2 | 4 | 8) => (u16::from(from.code()) | 0x10, 0x0011),
+                (None, _) => (u16::from(from.code()) | 0x10, 0x0012),
+            };
+            assert_eq!((status, code), want, "{from:?} -> {requested}");
+        }
+    }
+}
+
+#[test]
+fn e043_status_code_written_before_status() {
+    let mut r = Rig::new();
+    r.esc.status_writes.clear();
+    r.req(4);
+    assert_eq!(r.esc.status_writes, [regs::AL_STATUS_CODE, regs::AL_STATUS]);
+}
+
+#[test]
+fn e041_error_needs_acknowledge() {
+    let mut r = Rig::new();
+    assert_eq!(r.req(8), (0x11, 0x0011));
+    assert!(r.slave.error());
+    // without ack: ignored, even a valid request
+    assert_eq!(r.req(2), (0x11, 0x0011));
+    assert_eq!(r.slave.state(), AlState::Init);
+    // with ack: error cleared and request processed
+    assert_eq!(r.req(0x12), (2, 0));
+    assert_eq!(r.slave.al_status_code(), AlStatusCode::NO_ERROR);
+}
+
+#[test]
+fn e021_poll_reports_state_changes() {
+    let mut r = Rig::new();
+    r.esc.request(2);
+    let c = r.poll().unwrap();
+    assert_eq!(
+        (c.from, c.to, c.code),
+        (AlState::Init, AlState::PreOp, AlStatusCode(0))
+    );
+    r.esc.request(2);
+    assert_eq!(r.poll(), None);
+    r.esc.request(8);
+    let c = r.poll().unwrap();
+    assert_eq!((c.from, c.to, c.code.0), (AlState::PreOp, AlState::PreOp, 0x11));
+    assert_eq!(
+        std::format!("{c}"),
+        "PreOp: request 8 refused, AL status code 0x0011"
+    );
+}
+
+#[test]
+fn e025_invalid_mailbox_sm_stays_init() {
+    let cases: [(u8, u16, u16, u8, bool); 7] = [
+        (0, 0x1004, 128, 0x26, true),  // wrong start
+        (0, 0x1000, 256, 0x26, true),  // longer than the SII's
+        (0, 0x1000, 8, 0x26, true),    // too short
+        (0, 0x1000, 128, 0x22, true),  // wrong direction
+        (1, 0x1080, 128, 0x20, true),  // buffered mode
+        (1, 0x1080, 128, 0x22, false), // not enabled
+        (1, 0x1080, 128, 0x27, true),  // reserved direction
+    ];
+    for (n, start, len, control, enable) in cases {
+        let mut r = Rig::new();
+        r.esc.set_sm(n, start, len, control);
+        if !enable {
+            r.esc.mem[regs::sm(n) as usize + 6] = 0;
+        }
+        assert_eq!(r.req(2), (0x11, 0x0016), "SM{n} {start:#x} {len} {control:#x}");
+        assert_eq!(r.slave.state(), AlState::Init);
+    }
+    // a shorter, still sane mailbox is accepted
+    let mut r = Rig::new();
+    r.esc.set_sm(1, 0x1080, 64, 0x22);
+    assert_eq!(r.req(2), (2, 0));
+}
+
+#[test]
+fn e028_e045_process_sm_checks() {
+    let cases: [(u8, u16, u16, u8, u16); 9] = [
+        (2, 0x1100, 4, 0x64, 0x001D), // RxPDO length mismatch
+        (2, 0x1100, 3, 0x66, 0x001D), // mailbox mode
+        (2, 0x1100, 3, 0x60, 0x001D), // MasterRead direction
+        (2, 0x0F00, 3, 0x64, 0x001D), // outside process RAM
+        (2, 0x2FFC, 3, 0x64, 0x001D), // 3 buffers run past the RAM end
+        (3, 0x1180, 2, 0x20, 0x001E), // TxPDO length mismatch
+        (3, 0x1180, 4, 0x24, 0x001E), // MasterWrite direction
+        (2, 0x1100, 3, 0x65, 0x0017), // reserved mode bits
+        (3, 0x1104, 4, 0x20, 0x0017), // SM3 overlaps SM2's three buffers
+    ];
+    for (n, start, len, control, code) in cases {
+        let mut r = Rig::new();
+        r.goto(AlState::PreOp);
+        r.esc.set_sm(n, start, len, control);
+        assert_eq!(r.req(4), (0x12, code), "SM{n} {start:#x} {len} {control:#x}");
+        assert_eq!(r.slave.state(), AlState::PreOp);
+    }
+    // SM2 overlapping the read mailbox
+    let mut r = Rig::new();
+    r.goto(AlState::PreOp);
+    r.esc.set_sm(2, 0x10F0, 3, 0x64);
+    assert_eq!(r.req(4), (0x12, 0x0017));
+    // SM2 disabled while outputs are assigned
+    let mut r = Rig::new();
+    r.goto(AlState::PreOp);
+    r.esc.mem[regs::sm(2) as usize + 6] = 0;
+    assert_eq!(r.req(4), (0x12, 0x001D));
+}
+
+#[test]
+fn e032_e034_e035_process_data_by_state() {
+    let mut r = Rig::new();
+    r.goto(AlState::PreOp);
+    r.slave.inputs_mut().copy_from_slice(&[1, 2, 3, 4]);
+    r.poll();
+    assert_eq!(&r.esc.mem[0x1180..0x1184], &[0, 0, 0, 0], "no inputs in Pre-Op");
+    r.goto_from_preop_safeop();
+    assert_eq!(&r.esc.mem[0x1180..0x1184], &[1, 2, 3, 4], "inputs in Safe-Op");
+    // outputs received in Safe-Op are ignored
+    r.esc.mem[0x1100..0x1103].copy_from_slice(&[9, 8, 7]);
+    r.esc.set_events(al_event::sm(2));
+    r.poll();
+    assert_eq!(r.slave.outputs(), &[0, 0, 0]);
+    assert_eq!(r.slave.outputs_received(), 1);
+    assert_eq!(r.req(8), (8, 0));
+    assert_eq!(r.slave.outputs(), &[0, 0, 0], "Safe-Op data not carried into Op");
+    r.esc.mem[0x1100..0x1103].copy_from_slice(&[5, 6, 7]);
+    r.esc.set_events(al_event::sm(2));
+    r.poll();
+    assert_eq!(r.slave.outputs(), &[5, 6, 7], "outputs applied in Op");
+    assert_eq!(r.esc.events() & al_event::sm(2), 0, "whole SM2 area read");
+    r.slave.inputs_mut()[0] = 42;
+    r.poll();
+    assert_eq!(r.esc.mem[0x1180], 42);
+    assert_eq!(r.req(4), (4, 0));
+    assert_eq!(r.slave.outputs(), &[0, 0, 0], "O->S falls back to defaults");
+    assert_eq!(r.req(2), (2, 0));
+    r.slave.inputs_mut()[0] = 43;
+    r.poll();
+    assert_eq!(r.esc.mem[0x1180], 42, "S->P stops inputs");
+}
+
+impl Rig {
+    fn goto_from_preop_safeop(&mut self) {
+        assert_eq!(self.req(4), (4, 0));
+    }
+}
+
+#[test]
+fn e027_sdo_upload_and_download_through_mailbox() {
+    let mut r = Rig::new();
+    r.goto(AlState::PreOp);
+    let resp = r.upload(0x1008, 0, 1).unwrap();
+    assert_eq!(resp.len(), 128);
+    // header: length 10, CoE, counter 1
+    assert_eq!(&resp[..6], &[10, 0, 0, 0, 0, 0x13]);
+    assert_eq!(
+        &resp[6..16],
+        &[0x00, 0x30, 0x43, 0x08, 0x10, 0x00, b'T', b'e', b's', b't']
+    );
+    assert!(resp[16..].iter().all(|&b| b == 0));
+    // expedited download 2 bytes
+    r.esc.mbx_write(&[
+        10, 0, 0, 0, 0, 0x23, 0x00, 0x20, 0x2B, 0x00, 0x20, 0x00, 0x34, 0x12, 0, 0,
+    ]);
+    r.poll();
+    let resp = r.esc.mbx_read().unwrap();
+    assert_eq!(
+        &resp[..16],
+        &[10, 0, 0, 0, 0, 0x23, 0x00, 0x30, 0x60, 0x00, 0x20, 0x00, 0, 0, 0, 0]
+    );
+    assert_eq!(r.app.value, 0x1234);
+}
+
+#[test]
+fn e037_no_mailbox_in_init() {
+    let mut r = Rig::new();
+    assert!(r.upload(0x1008, 0, 1).is_none());
+    assert_ne!(r.esc.events() & al_event::sm(0), 0, "SM0 not read in Init");
+    // P->I drops the mailbox again
+    r.goto(AlState::PreOp);
+    assert!(r.upload(0x1008, 0, 2).is_some());
+    assert_eq!(r.req(1), (1, 0));
+    assert!(r.upload(0x1008, 0, 3).is_none());
+}
+
+#[test]
+fn mailbox_counter_cycles_and_duplicates_are_dropped() {
+    let mut r = Rig::new();
+    r.goto(AlState::PreOp);
+    let mut counters = Vec::new();
+    for i in 0..9u8 {
+        let resp = r.upload(0x1008, 0, i % 7 + 1).unwrap();
+        counters.push(resp[5] >> 4);
+    }
+    assert_eq!(counters, [1, 2, 3, 4, 5, 6, 7, 1, 2]);
+    // same counter again (request repeated by the master): no reply
+    assert!(r.upload(0x1008, 0, 2).is_none());
+    // counter 0 is never a duplicate
+    assert!(r.upload(0x1008, 0, 0).is_some());
+    assert!(r.upload(0x1008, 0, 0).is_some());
+}
+
+#[test]
+fn mailbox_error_replies() {
+    let mut r = Rig::new();
+    r.goto(AlState::PreOp);
+    // EoE is not handled yet: unsupported protocol
+    r.esc.mbx_write(&[4, 0, 0, 0, 0, 0x12, 0, 0, 0, 0]);
+    r.poll();
+    let resp = r.esc.mbx_read().unwrap();
+    assert_eq!(&resp[..10], &[4, 0, 0, 0, 0, 0x10, 0x01, 0x00, 0x02, 0x00]);
+    // length beyond the mailbox: invalid size
+    r.esc.mbx_write(&[200, 0, 0, 0, 0, 0x23, 0, 0, 0, 0]);
+    r.poll();
+    let resp = r.esc.mbx_read().unwrap();
+    assert_eq!(&resp[..10], &[4, 0, 0, 0, 0, 0x20, 0x01, 0x00, 0x08, 0x00]);
+    // CoE frame too short for an SDO: size too short
+    r.esc.mbx_write(&[4, 0, 0, 0, 0, 0x33, 0x00, 0x20, 0x40, 0x00]);
+    r.poll();
+    let resp = r.esc.mbx_read().unwrap();
+    assert_eq!(&resp[6..10], &[0x01, 0x00, 0x06, 0x00]);
+}
+
+#[test]
+fn mailbox_waits_for_sm1_empty_and_holds_next_request() {
+    let mut r = Rig::new();
+    r.goto(AlState::PreOp);
+    r.esc.mbx_write(&[
+        10, 0, 0, 0, 0, 0x13, 0x00, 0x20, 0x40, 0x00, 0x20, 0x00, 0, 0, 0, 0,
+    ]);
+    r.poll();
+    assert!(r.esc.sm1_full());
+    // the master has not read SM1 yet: the next response stays pending
+    r.esc.mbx_write(&[
+        10, 0, 0, 0, 0, 0x23, 0x00, 0x20, 0x40, 0x08, 0x10, 0x00, 0, 0, 0, 0,
+    ]);
+    r.poll();
+    let first = r.esc.mbx_read().unwrap();
+    assert_eq!(first[5] >> 4, 1);
+    assert_eq!(&first[9..11], &[0x00, 0x20]);
+    r.poll();
+    let second = r.esc.mbx_read().unwrap();
+    assert_eq!(second[5] >> 4, 2);
+    assert_eq!(&second[9..11], &[0x08, 0x10]);
+    // a third request held back while a response is pending is served later
+    r.esc.mbx_write(&[
+        10, 0, 0, 0, 0, 0x33, 0x00, 0x20, 0x40, 0x00, 0x20, 0x00, 0, 0, 0, 0,
+    ]);
+    r.esc.mem[regs::sm(1) as usize + 5] |= status::MAILBOX_FULL;
+    r.poll(); // response pending, SM1 "full"
+    r.esc.mbx_write(&[
+        10, 0, 0, 0, 0, 0x43, 0x00, 0x20, 0x40, 0x08, 0x10, 0x00, 0, 0, 0, 0,
+    ]);
+    r.poll();
+    assert_ne!(
+        r.esc.events() & al_event::sm(0),
+        0,
+        "SM0 left full while a response is pending"
+    );
+    assert_eq!(r.esc.mbx_read().unwrap()[5] >> 4, 2, "stale content");
+    r.poll();
+    assert_eq!(r.esc.mbx_read().unwrap()[5] >> 4, 3);
+    r.poll();
+    assert_eq!(r.esc.mbx_read().unwrap()[5] >> 4, 4);
+}
+
+#[test]
+fn mailbox_repeat_rewrites_last_response() {
+    let mut r = Rig::new();
+    r.goto(AlState::PreOp);
+    let first = r.upload(0x1008, 0, 1).unwrap();
+    // the master lost it and toggles the repeat bit
+    r.esc.mem[regs::sm(1) as usize + 6] ^= activate::REPEAT;
+    r.poll();
+    assert_eq!(r.esc.mbx_read().unwrap(), first);
+    assert_ne!(r.esc.mem[regs::sm(1) as usize + 7] & pdi_control::REPEAT_ACK, 0);
+    // no further repeat: nothing new
+    r.poll();
+    assert!(r.esc.mbx_read().is_none());
+    // toggling back is a second repeat request
+    r.esc.mem[regs::sm(1) as usize + 6] ^= activate::REPEAT;
+    r.poll();
+    assert_eq!(r.esc.mbx_read().unwrap(), first);
+    assert_eq!(r.esc.mem[regs::sm(1) as usize + 7] & pdi_control::REPEAT_ACK, 0);
+}

@@ -1,0 +1,90 @@
+//! The in-process link between a real EtherCAT master (`ethercrab`) and the
+//! simulated line: every frame the master sends goes through
+//! [`Simulation::exchange`] and comes straight back, no network, no root.
+
+use crate::sim::Simulation;
+use core::cell::RefCell;
+use core::future::Future;
+use core::pin::Pin;
+use core::sync::atomic::{AtomicU64, Ordering};
+use core::task::{Context, Poll};
+use ethercrab::{PduRx, PduTx};
+
+/// Longest Ethernet frame the link carries.
+const MAX_FRAME: usize = 1536;
+
+/// A future that moves frames between ethercrab's PDU loop and the simulation.
+/// It never completes: race it against the master's work
+/// (`futures_lite::future::or`).
+pub struct InProcessLink<'a> {
+    tx: PduTx<'a>,
+    rx: PduRx<'a>,
+    sim: &'a RefCell<Simulation>,
+    clock: &'a AtomicU64,
+}
+
+impl<'a> InProcessLink<'a> {
+    /// Connects the master's PDU loop halves to `sim`; `clock` is updated with the
+    /// simulated time after every frame (hand `|| clock.load(..)` to ethercrab as its time source).
+    pub fn new(tx: PduTx<'a>, rx: PduRx<'a>, sim: &'a RefCell<Simulation>, clock: &'a AtomicU64) -> Self {
+        Self { tx, rx, sim, clock }
+    }
+}
+
+impl Future for InProcessLink<'_> {
+    type Output = ();
+
+    fn poll(mut self: Pin<&mut Self>, cx: &mut Context<'_>) -> Poll<()> {
+        self.tx.replace_waker(cx.waker());
+        while let Some(frame) = self.tx.next_sendable_frame() {
+            let mut buf = [0u8; MAX_FRAME];
+            let mut len = 0;
+            let sent = frame.send_blocking(|bytes| {
+                len = bytes.len().min(MAX_FRAME);
+                buf[..len].copy_from_slice(&bytes[..len]);
+                Ok(len)
+            });
+            if sent.is_err() {
+                continue;
+            }
+            let now = {
+                let mut sim = self.sim.borrow_mut();
+                sim.exchange(&mut buf[..len]);
+                sim.now_ns()
+            };
+            self.clock.store(now, Ordering::Relaxed);
+            // A frame the master no longer waits for (timed out) is dropped by ethercrab.
+            let _ = self.rx.receive_frame(&buf[..len]);
+        }
+        Poll::Pending
+    }
+}
+
+/// Frames in flight the in-process master can hold.
+pub const MAX_FRAMES: usize = 16;
+/// Largest PDU payload of one frame.
+pub const MAX_PDU_DATA: usize = ethercrab::PduStorage::element_size(1100);
+
+/// Runs `body` with an ethercrab [`MainDevice`](ethercrab::MainDevice) wired to
+/// `sim` in-process, on the current thread, and returns its result. The
+/// master's time source is the simulated clock (`clock` in the closure; hand
+/// `|| clock.load(Ordering::Relaxed)` to `init_single_group`).
+pub fn run<T, F>(sim: &RefCell<Simulation>, timeouts: ethercrab::Timeouts, body: F) -> T
+where
+    F: for<'a> AsyncFnOnce(&'a ethercrab::MainDevice<'a>, &'a AtomicU64) -> T,
+{
+    let storage = ethercrab::PduStorage::<MAX_FRAMES, MAX_PDU_DATA>::new();
+    let Ok((tx, rx, pdu_loop)) = storage.try_split() else {
+        unreachable!("a fresh PduStorage splits once")
+    };
+    let clock = AtomicU64::new(sim.borrow().now_ns());
+    let md = ethercrab::MainDevice::new(pdu_loop, timeouts, ethercrab::MainDeviceConfig::default());
+    let link = InProcessLink::new(tx, rx, sim, &clock);
+    futures_lite::future::block_on(futures_lite::future::or(
+        async {
+            link.await;
+            unreachable!("the in-process link never completes")
+        },
+        body(&md, &clock),
+    ))
+}

@@ -1,0 +1,113 @@
+//! E-002: the simulated line answers a real master over raw Ethernet.
+//!
+//! Builds a private network namespace with one end of a veth pair, runs
+//! `hil-sim serve` inside it, and drives it with ethercrab's std transport from
+//! the other end. Needs root (CI runs as root); skipped with a message otherwise.
+#![allow(clippy::unwrap_used, clippy::expect_used, clippy::panic)]
+
+use ethercrab::{MainDevice, MainDeviceConfig, PduStorage, Timeouts};
+use std::process::{Child, Command, Stdio};
+use std::time::Duration;
+
+struct Netns {
+    ns: String,
+    host_if: String,
+    server: Option<Child>,
+}
+
+fn ip(args: &[&str]) {
+    let st = Command::new("ip").args(args).status().expect("run ip");
+    assert!(st.success(), "ip {args:?} failed");
+}
+
+impl Netns {
+    fn new() -> Self {
+        let id = std::process::id() % 100_000;
+        let ns = format!("hilsim{id}");
+        let host_if = format!("hs{id}a");
+        let sim_if = format!("hs{id}b");
+        let _ = Command::new("ip")
+            .args(["netns", "del", &ns])
+            .stderr(Stdio::null())
+            .status();
+        ip(&["netns", "add", &ns]);
+        ip(&["link", "add", &host_if, "type", "veth", "peer", "name", &sim_if]);
+        ip(&["link", "set", &sim_if, "netns", &ns]);
+        ip(&["link", "set", &host_if, "up"]);
+        ip(&["-n", &ns, "link", "set", &sim_if, "up"]);
+        let server = Command::new("ip")
+            .args([
+                "netns",
+                "exec",
+                &ns,
+                env!("CARGO_BIN_EXE_hil-sim"),
+                "serve",
+                "--iface",
+                &sim_if,
+            ])
+            .args(["--slaves", "2", "--seconds", "60"])
+            .stdout(Stdio::inherit())
+            .spawn()
+            .expect("spawn hil-sim serve");
+        std::thread::sleep(Duration::from_millis(300));
+        Self {
+            ns,
+            host_if,
+            server: Some(server),
+        }
+    }
+}
+
+impl Drop for Netns {
+    fn drop(&mut self) {
+        if let Some(mut s) = self.server.take() {
+            let _ = s.kill();
+            let _ = s.wait();
+        }
+        let _ = Command::new("ip")
+            .args(["link", "del", &self.host_if])
+            .stderr(Stdio::null())
+            .status();
+        let _ = Command::new("ip").args(["netns", "del", &self.ns]).status();
+    }
+}
+
+#[test]
+fn e002_raw_ethernet_veth_master_reaches_op() {
+    // SAFETY: geteuid has no preconditions.
+    #[allow(unsafe_code)]
+    let root = unsafe { libc::geteuid() } == 0;
+    if !root {
+        eprintln!("e002_raw_ethernet_veth: skipped, needs root for network namespaces and raw sockets");
+        return;
+    }
+    let net = Netns::new();
+    let storage: &'static PduStorage<16, { PduStorage::element_size(1100) }> =
+        Box::leak(Box::new(PduStorage::new()));
+    let (tx, rx, pdu_loop) = storage.try_split().expect("split");
+    let task = ethercrab::std::tx_rx_task(&net.host_if, tx, rx).expect("raw socket on the veth end");
+    std::thread::spawn(move || futures_lite::future::block_on(task));
+    let md = MainDevice::new(pdu_loop, Timeouts::default(), MainDeviceConfig::default());
+    futures_lite::future::block_on(async {
+        let group = md
+            .init_single_group::<4, 256>(ethercrab::std::ethercat_now)
+            .await
+            .expect("init over veth");
+        assert_eq!(group.len(), 2, "two simulated drives on the line");
+        for sd in group.iter(&md) {
+            assert_eq!(sd.identity().vendor_id, 0xB9);
+        }
+        let group = group.into_op(&md).await.expect("PRE-OP -> OP over veth");
+        for _ in 0..20 {
+            group.tx_rx(&md).await.expect("cycle");
+        }
+        for sd in group.iter(&md) {
+            let (state, _) = sd.status().await.expect("status");
+            assert_eq!(state, ethercrab::SubDeviceState::Op);
+        }
+        let group = group.into_safe_op(&md).await.expect("OP -> SAFE-OP");
+        let group = group.into_pre_op(&md).await.expect("SAFE-OP -> PRE-OP");
+        group.into_init(&md).await.expect("PRE-OP -> INIT").len()
+    });
+    drop(net);
+}
