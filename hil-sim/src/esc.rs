@@ -867,22 +867,16 @@ fn physical_kind(cmd: Command) -> Kind {
     }
 }
 
-/// DL status (0x0110) bits.
+/// DL status bits, named as the simulated ESC uses them.
 mod dl {
-    /// PDI operational: EEPROM loaded with a correct checksum.
-    pub const PDI_OPERATIONAL: u16 = 1 << 0;
-    /// PDI watchdog status: 1 = reloaded, 0 = expired.
-    pub const PDI_WATCHDOG: u16 = 1 << 1;
-    /// Physical link on port 0.
-    pub const LINK0: u16 = 1 << 4;
-    /// Port 1 closed (loop).
-    pub const LOOP1: u16 = 1 << 10;
-    /// Communication on port 0.
-    pub const COMM0: u16 = 1 << 9;
-    /// Port 2 closed.
-    pub const LOOP2: u16 = 1 << 12;
-    /// Port 3 closed.
-    pub const LOOP3: u16 = 1 << 14;
+    use ::esc::regs::dl_status;
+    pub const PDI_OPERATIONAL: u16 = dl_status::PDI_OPERATIONAL;
+    pub const PDI_WATCHDOG: u16 = dl_status::PDI_WATCHDOG;
+    pub const LINK0: u16 = dl_status::link(0);
+    pub const LOOP1: u16 = dl_status::loop_closed(1);
+    pub const COMM0: u16 = dl_status::communication(0);
+    pub const LOOP2: u16 = dl_status::loop_closed(2);
+    pub const LOOP3: u16 = dl_status::loop_closed(3);
 }
 
 /// Whether a plain (non-SyncManager) byte at `a` takes writes from `side`.

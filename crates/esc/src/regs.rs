@@ -138,6 +138,28 @@ pub mod al_event {
     }
 }
 
+/// Bits of the DL status register (0x0110, u16).
+pub mod dl_status {
+    /// PDI operational: EEPROM loaded with a correct checksum.
+    pub const PDI_OPERATIONAL: u16 = 1 << 0;
+    /// PDI watchdog status: 1 = reloaded, 0 = expired.
+    pub const PDI_WATCHDOG: u16 = 1 << 1;
+    /// Enhanced link detection active.
+    pub const ENHANCED_LINK_DETECTION: u16 = 1 << 2;
+    /// Physical link on port `n` (0..3).
+    pub const fn link(n: u8) -> u16 {
+        1 << (4 + n as u16)
+    }
+    /// Loop closed on port `n` (0..3): the port forwards back, nothing behind it.
+    pub const fn loop_closed(n: u8) -> u16 {
+        1 << (8 + 2 * n as u16)
+    }
+    /// Stable communication on port `n` (0..3).
+    pub const fn communication(n: u8) -> u16 {
+        1 << (9 + 2 * n as u16)
+    }
+}
+
 /// Distributed-clock registers (0x0900–0x09FF).
 pub mod dc {
     /// Receive time port 0 (u32), latched by a write to it.

@@ -1,0 +1,248 @@
+//! The bus through a real master: ethercrab drives the simulated ESC in-process
+//! (no root, no network), the slave stack runs its real code in simulated time.
+#![allow(
+    clippy::unwrap_used,
+    clippy::expect_used,
+    clippy::panic,
+    clippy::indexing_slicing
+)]
+
+use drive_tests::{al_status, init, line, request, with_master, write_sm};
+use ecat::sii;
+use esc::{AlState, AlStatusCode};
+
+const INIT: u16 = 1;
+const PREOP: u16 = 2;
+const BOOT: u16 = 3;
+const SAFEOP: u16 = 4;
+const OP: u16 = 8;
+const ERR: u16 = 0x10;
+const ACK: u16 = 0x10;
+
+fn changes(sim: &hil_sim::sim::Simulation, i: usize) -> Vec<(AlState, AlState, u16)> {
+    sim.drives()[i]
+        .state_log
+        .iter()
+        .map(|(_, c)| (c.from, c.to, c.code.0))
+        .collect()
+}
+
+#[test]
+fn e021_master_walks_init_preop_safeop_op_and_back() {
+    let sim = line(1);
+    with_master(&sim, async |md, clock| {
+        let group = init(md, clock).await;
+        assert_eq!(group.len(), 1);
+        let group = group.into_op(md).await.expect("PRE-OP -> OP");
+        assert_eq!(al_status(&group.subdevice(md, 0).unwrap()).await, (OP, 0));
+        for _ in 0..10 {
+            group.tx_rx(md).await.expect("cycle");
+        }
+        let group = group.into_safe_op(md).await.expect("OP -> SAFE-OP");
+        let group = group.into_pre_op(md).await.expect("SAFE-OP -> PRE-OP");
+        group.into_init(md).await.expect("PRE-OP -> INIT");
+    });
+    assert_eq!(sim.borrow().drives()[0].esc.al_status(), INIT);
+    use AlState::*;
+    assert_eq!(
+        changes(&sim.borrow(), 0),
+        [
+            (Init, PreOp, 0),
+            (PreOp, SafeOp, 0),
+            (SafeOp, Op, 0),
+            (Op, SafeOp, 0),
+            (SafeOp, PreOp, 0),
+            (PreOp, Init, 0)
+        ]
+    );
+}
+
+#[test]
+fn e005_slave_count_addresses_identity_and_name_from_sii() {
+    let sim = line(2);
+    with_master(&sim, async |md, clock| {
+        let group = init(md, clock).await;
+        assert_eq!(group.len(), 2, "BRD counts both slaves");
+        let addrs: Vec<u16> = group.iter(md).map(|s| s.configured_address()).collect();
+        assert_eq!(addrs, [0x1000, 0x1001]);
+        for sd in group.iter(md) {
+            let id = sd.identity();
+            assert_eq!(id.vendor_id, 0xB9, "E-005 vendor ID");
+            assert_eq!(id.product_id, drive::PRODUCT_CODE);
+            assert_eq!(id.revision, drive::SOFTWARE_BUILD);
+            assert_eq!(id.serial, drive::SERIAL);
+            assert_eq!(sd.name(), drive::DEVICE.order_code);
+        }
+        // the configured addresses really are in the ESCs
+        for i in 0..2 {
+            let sd = group.subdevice(md, i).unwrap();
+            let a: u16 = sd.register_read(esc::regs::STATION_ADDRESS).await.unwrap();
+            assert_eq!(a, 0x1000 + i as u16);
+        }
+    });
+}
+
+#[test]
+fn e003_sii_read_by_master_has_syncmanagers_and_protocols() {
+    let sim = line(1);
+    let image = with_master(&sim, async |md, clock| {
+        let group = init(md, clock).await;
+        let sd = group.iter(md).next().unwrap();
+        let size = sd.eeprom_size(md).await.expect("eeprom size");
+        let mut buf = vec![0u8; size];
+        let n = sd.eeprom_read_raw(md, 0, &mut buf).await.expect("eeprom read");
+        buf.truncate(n);
+        buf
+    });
+    assert_eq!(sii::sii_word(&image, esc::sii::word::VENDOR_ID), Some(0xB9));
+    let protocols = sii::sii_word(&image, esc::sii::word::MAILBOX_PROTOCOL).unwrap();
+    assert_eq!(
+        protocols,
+        esc::sii::mailbox_protocol::COE | esc::sii::mailbox_protocol::EOE,
+        "E-003: CoE and EoE only"
+    );
+    let sms = sii::find_category(&image, esc::sii::category::SYNC_MANAGER).expect("SM category");
+    let sms: Vec<&[u8]> = sii::records(sms, 8).collect();
+    assert_eq!(sms.len(), 4);
+    let start = |r: &[u8]| u16::from_le_bytes([r[0], r[1]]);
+    assert_eq!(
+        (start(sms[0]), sms[0][4], sms[0][7]),
+        (0x1000, 0x26, 1),
+        "SM0 mailbox out"
+    );
+    assert_eq!(
+        (start(sms[1]), sms[1][4], sms[1][7]),
+        (0x1100, 0x22, 2),
+        "SM1 mailbox in"
+    );
+    assert_eq!(
+        (start(sms[2]), sms[2][4], sms[2][7]),
+        (0x1200, 0x64, 3),
+        "SM2 outputs"
+    );
+    assert_eq!(
+        (start(sms[3]), sms[3][4], sms[3][7]),
+        (0x1A00, 0x20, 4),
+        "SM3 inputs"
+    );
+    // the master read the same image the ESC was loaded with
+    assert_eq!(&image[..], &sim.borrow().drives()[0].esc.sii()[..image.len()]);
+}
+
+#[test]
+fn e022_bootstrap_refused_with_0013_and_acknowledged() {
+    let sim = line(1);
+    with_master(&sim, async |md, clock| {
+        let group = init(md, clock).await;
+        request(&group.subdevice(md, 0).unwrap(), BOOT).await;
+        assert_eq!(
+            al_status(&group.subdevice(md, 0).unwrap()).await,
+            (PREOP | ERR, 0x0013)
+        );
+        // a request without acknowledge is ignored while the error is shown
+        request(&group.subdevice(md, 0).unwrap(), INIT).await;
+        assert_eq!(
+            al_status(&group.subdevice(md, 0).unwrap()).await,
+            (PREOP | ERR, 0x0013)
+        );
+        // acknowledge clears the indication and the request is carried out
+        request(&group.subdevice(md, 0).unwrap(), PREOP | ACK).await;
+        assert_eq!(al_status(&group.subdevice(md, 0).unwrap()).await, (PREOP, 0));
+    });
+}
+
+#[test]
+fn e023_impossible_transition_0011_and_unknown_state_0012() {
+    let sim = line(1);
+    with_master(&sim, async |md, clock| {
+        let group = init(md, clock).await;
+        request(&group.subdevice(md, 0).unwrap(), OP).await; // PRE-OP -> OP skips SAFE-OP
+        assert_eq!(
+            al_status(&group.subdevice(md, 0).unwrap()).await,
+            (PREOP | ERR, 0x0011)
+        );
+        request(&group.subdevice(md, 0).unwrap(), 5 | ACK).await;
+        assert_eq!(
+            al_status(&group.subdevice(md, 0).unwrap()).await,
+            (PREOP | ERR, 0x0012)
+        );
+        request(&group.subdevice(md, 0).unwrap(), INIT | ACK).await;
+        assert_eq!(al_status(&group.subdevice(md, 0).unwrap()).await, (INIT, 0));
+        request(&group.subdevice(md, 0).unwrap(), SAFEOP).await; // INIT -> SAFE-OP
+        assert_eq!(
+            al_status(&group.subdevice(md, 0).unwrap()).await,
+            (INIT | ERR, 0x0011)
+        );
+    });
+}
+
+#[test]
+fn e025_invalid_mailbox_sm_stays_init_with_0016() {
+    let sim = line(1);
+    with_master(&sim, async |md, clock| {
+        let group = init(md, clock).await;
+        request(&group.subdevice(md, 0).unwrap(), INIT).await;
+        assert_eq!(al_status(&group.subdevice(md, 0).unwrap()).await, (INIT, 0));
+        let sd = group.subdevice(md, 0).unwrap();
+        // SM0 moved away from the SII's start address
+        sd.register_write(esc::regs::sm(0), 0x1800u16).await.unwrap();
+        request(&group.subdevice(md, 0).unwrap(), PREOP).await;
+        assert_eq!(
+            al_status(&group.subdevice(md, 0).unwrap()).await,
+            (INIT | ERR, AlStatusCode::INVALID_MAILBOX_CONFIG.0)
+        );
+        // repaired and acknowledged: the mailbox starts
+        sd.register_write(esc::regs::sm(0), 0x1000u16).await.unwrap();
+        request(&group.subdevice(md, 0).unwrap(), PREOP | ACK).await;
+        assert_eq!(al_status(&group.subdevice(md, 0).unwrap()).await, (PREOP, 0));
+    });
+}
+
+#[test]
+fn e028_e045_sm2_sm3_length_checked_on_preop_to_safeop() {
+    let rx = drive::DEVICE.output_bytes() as u16;
+    let tx = drive::DEVICE.input_bytes() as u16;
+    assert_eq!(
+        (rx, tx),
+        (23, 29),
+        "standard maps: RxPDO 23 bytes, TxPDO 29 bytes"
+    );
+    let sim = line(1);
+    with_master(&sim, async |md, clock| {
+        let group = init(md, clock).await;
+        // SM2 one byte short: invalid output configuration
+        write_sm(&group.subdevice(md, 0).unwrap(), 2, 0x1200, rx - 1, 0x64).await;
+        write_sm(&group.subdevice(md, 0).unwrap(), 3, 0x1A00, tx, 0x20).await;
+        request(&group.subdevice(md, 0).unwrap(), SAFEOP).await;
+        assert_eq!(
+            al_status(&group.subdevice(md, 0).unwrap()).await,
+            (PREOP | ERR, AlStatusCode::INVALID_OUTPUT_CONFIG.0)
+        );
+        // SM2 right, SM3 one byte long: invalid input configuration
+        write_sm(&group.subdevice(md, 0).unwrap(), 2, 0x1200, rx, 0x64).await;
+        write_sm(&group.subdevice(md, 0).unwrap(), 3, 0x1A00, tx + 1, 0x20).await;
+        request(&group.subdevice(md, 0).unwrap(), SAFEOP | ACK).await;
+        assert_eq!(
+            al_status(&group.subdevice(md, 0).unwrap()).await,
+            (PREOP | ERR, AlStatusCode::INVALID_INPUT_CONFIG.0)
+        );
+        // both right: SAFE-OP
+        write_sm(&group.subdevice(md, 0).unwrap(), 3, 0x1A00, tx, 0x20).await;
+        request(&group.subdevice(md, 0).unwrap(), SAFEOP | ACK).await;
+        assert_eq!(al_status(&group.subdevice(md, 0).unwrap()).await, (SAFEOP, 0));
+    });
+}
+
+#[test]
+fn e037_back_to_init_stops_mailbox() {
+    let sim = line(1);
+    with_master(&sim, async |md, clock| {
+        let group = init(md, clock).await;
+        let sd = group.subdevice(md, 0).unwrap();
+        let dt: u32 = sd.sdo_read(0x1000, 0).await.expect("1000h in PRE-OP");
+        assert_eq!(dt, drive::DEVICE_TYPE, "E-004");
+        request(&sd, INIT).await;
+        assert_eq!(al_status(&sd).await, (INIT, 0));
+        assert!(sd.sdo_read::<u32>(0x1000, 0).await.is_err(), "no mailbox in INIT");
+    });
+}
