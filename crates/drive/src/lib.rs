@@ -18,12 +18,8 @@
 #![deny(missing_docs)]
 
 use ecat::desc::coe_details;
-use ecat::{
-    DataType, DcOpMode, Device, FmmuUsage, Identity, MailboxSm, ObjectAccess, Pdo, PdoEntry, ProcessSm,
-    SdoAbort,
-};
+use ecat::{DataType, DcOpMode, Device, FmmuUsage, Identity, MailboxSm, Pdo, PdoEntry, ProcessSm, SdoAbort};
 use esc::sii::mailbox_protocol;
-use esc::AlState;
 
 /// STOBER's EtherCAT vendor ID (E-005).
 pub const VENDOR_ID: u32 = 0xB9;
@@ -232,8 +228,23 @@ fn sub_of<T: Copy>(list: &[T], sub: u8) -> Option<T> {
     list.get(usize::from(sub).checked_sub(1)?).copied()
 }
 
-impl ObjectAccess for DriveObjects {
-    fn read(&mut self, index: u16, sub: u8, buf: &mut [u8]) -> Result<usize, SdoAbort> {
+impl od::Dictionary for DriveObjects {
+    /// No metadata yet: SDO Info and complete access arrive with the object dictionary.
+    fn object(&self, _index: u16) -> Option<&'static od::ObjectInfo> {
+        None
+    }
+
+    fn next_object(&self, _after: Option<u16>) -> Option<&'static od::ObjectInfo> {
+        None
+    }
+
+    fn read(
+        &mut self,
+        index: u16,
+        sub: u8,
+        buf: &mut [u8],
+        _state: od::CommState,
+    ) -> Result<usize, SdoAbort> {
         let d = &DEVICE;
         let u8v = |v: u8| [v];
         match (index, sub) {
@@ -276,9 +287,9 @@ impl ObjectAccess for DriveObjects {
         }
     }
 
-    fn write(&mut self, index: u16, sub: u8, _: &[u8], _: AlState) -> Result<(), SdoAbort> {
+    fn write(&mut self, index: u16, sub: u8, _: &[u8], state: od::CommState) -> Result<(), SdoAbort> {
         let mut probe = [0u8; 64];
-        self.read(index, sub, &mut probe)?;
+        self.read(index, sub, &mut probe, state)?;
         Err(SdoAbort::READ_ONLY)
     }
 }

@@ -1,6 +1,7 @@
 use super::*;
 use ecat::sii::{build_sii, categories, find_category, records, sii_string, sii_word, EEPROM_BYTES};
 use esc::sii::{category, config_checksum, word};
+use od::Dictionary as _;
 
 fn image() -> ([u8; EEPROM_BYTES], usize) {
     let mut img = [0u8; EEPROM_BYTES];
@@ -120,7 +121,7 @@ fn dc_category_has_three_op_modes() {
 
 fn read(index: u16, sub: u8) -> Result<heapless::Vec<u8, 64>, SdoAbort> {
     let mut buf = [0u8; 64];
-    let n = DriveObjects.read(index, sub, &mut buf)?;
+    let n = DriveObjects.read(index, sub, &mut buf, od::CommState::PreOp)?;
     Ok(heapless::Vec::from_slice(&buf[..n]).unwrap())
 }
 
@@ -202,11 +203,11 @@ fn e048_e050_mapping_objects() {
 #[test]
 fn writes_are_refused_read_only() {
     assert_eq!(
-        DriveObjects.write(0x1C12, 1, &[0, 0x16], AlState::PreOp),
+        DriveObjects.write(0x1C12, 1, &[0, 0x16], od::CommState::PreOp),
         Err(SdoAbort::READ_ONLY)
     );
     assert_eq!(
-        DriveObjects.write(0x5000, 0, &[0], AlState::PreOp),
+        DriveObjects.write(0x5000, 0, &[0], od::CommState::PreOp),
         Err(SdoAbort::NO_OBJECT)
     );
 }

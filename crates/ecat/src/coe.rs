@@ -1,8 +1,8 @@
 //! CAN application protocol over EtherCAT: CoE header, SDO expedited/normal
 //! initiate transfers, abort (spec §6.1–6.2, §6.5).
 //!
-//! Objects are read and written through [`ObjectAccess`], which the application
-//! (today `drive::DriveObjects`, later the object dictionary) implements.
+//! Objects are read and written through [`od::Dictionary`], which the drive's
+//! object dictionary implements.
 
 use crate::mailbox::MailboxError;
 use esc::AlState;
@@ -12,75 +12,7 @@ pub const COE_HEADER_LEN: usize = 2;
 /// Length of an SDO initiate/abort frame after the CoE header.
 pub const SDO_LEN: usize = 8;
 
-/// SDO abort code (CiA 301, spec §6.5).
-#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash)]
-pub struct SdoAbort(pub u32);
-
-impl SdoAbort {
-    /// 0503 0000h Toggle bit not alternated.
-    pub const TOGGLE_BIT: Self = Self(0x0503_0000);
-    /// 0504 0000h SDO protocol timed out.
-    pub const TIMEOUT: Self = Self(0x0504_0000);
-    /// 0504 0001h Command specifier invalid or unknown.
-    pub const INVALID_COMMAND: Self = Self(0x0504_0001);
-    /// 0504 0005h Out of memory.
-    pub const OUT_OF_MEMORY: Self = Self(0x0504_0005);
-    /// 0601 0000h Unsupported access to an object.
-    pub const UNSUPPORTED_ACCESS: Self = Self(0x0601_0000);
-    /// 0601 0001h Read of a write-only object.
-    pub const WRITE_ONLY: Self = Self(0x0601_0001);
-    /// 0601 0002h Write of a read-only object.
-    pub const READ_ONLY: Self = Self(0x0601_0002);
-    /// 0602 0000h Object does not exist in the object dictionary.
-    pub const NO_OBJECT: Self = Self(0x0602_0000);
-    /// 0604 0041h Object cannot be mapped into a PDO.
-    pub const NOT_MAPPABLE: Self = Self(0x0604_0041);
-    /// 0604 0042h Number/length of mapped objects exceeds the PDO length.
-    pub const PDO_LENGTH: Self = Self(0x0604_0042);
-    /// 0604 0043h General parameter incompatibility.
-    pub const PARAMETER_INCOMPATIBLE: Self = Self(0x0604_0043);
-    /// 0604 0047h General internal device incompatibility.
-    pub const DEVICE_INCOMPATIBLE: Self = Self(0x0604_0047);
-    /// 0606 0000h Access failed due to a hardware error.
-    pub const HARDWARE_ERROR: Self = Self(0x0606_0000);
-    /// 0607 0010h Data type / parameter length does not match.
-    pub const TYPE_MISMATCH: Self = Self(0x0607_0010);
-    /// 0607 0012h Data type mismatch, length too high.
-    pub const LENGTH_TOO_HIGH: Self = Self(0x0607_0012);
-    /// 0607 0013h Data type mismatch, length too low.
-    pub const LENGTH_TOO_LOW: Self = Self(0x0607_0013);
-    /// 0609 0011h Subindex does not exist.
-    pub const NO_SUBINDEX: Self = Self(0x0609_0011);
-    /// 0609 0030h Invalid value (write).
-    pub const INVALID_VALUE: Self = Self(0x0609_0030);
-    /// 0609 0031h Value too high.
-    pub const VALUE_TOO_HIGH: Self = Self(0x0609_0031);
-    /// 0609 0032h Value too low.
-    pub const VALUE_TOO_LOW: Self = Self(0x0609_0032);
-    /// 0609 0036h Maximum value below minimum value.
-    pub const MAX_BELOW_MIN: Self = Self(0x0609_0036);
-    /// 0800 0000h General error.
-    pub const GENERAL: Self = Self(0x0800_0000);
-    /// 0800 0020h Data cannot be transferred or stored.
-    pub const TRANSFER: Self = Self(0x0800_0020);
-    /// 0800 0021h ... because of local control.
-    pub const LOCAL_CONTROL: Self = Self(0x0800_0021);
-    /// 0800 0022h ... because of the present device state.
-    pub const DEVICE_STATE: Self = Self(0x0800_0022);
-    /// 0800 0023h Object dictionary not present / dynamic generation failed.
-    pub const NO_DICTIONARY: Self = Self(0x0800_0023);
-}
-
-/// Object access the CoE server delegates to the application.
-pub trait ObjectAccess {
-    /// Reads object `index`:`sub` into `buf`, returning the byte count. When the
-    /// value does not fit `buf`, return [`SdoAbort::OUT_OF_MEMORY`].
-    fn read(&mut self, index: u16, sub: u8, buf: &mut [u8]) -> Result<usize, SdoAbort>;
-
-    /// Writes `data` to object `index`:`sub`; `state` is the current ESM state
-    /// (for objects writable only in some states).
-    fn write(&mut self, index: u16, sub: u8, data: &[u8], state: AlState) -> Result<(), SdoAbort>;
-}
+pub use od::{CommState, Dictionary, SdoAbort};
 
 /// CoE services (CoE header bits 12..15).
 pub mod service {
@@ -219,7 +151,7 @@ impl<'a> SdoRequest<'a> {
 /// the response's mailbox data into `out` (capacity = SM1 length − 6).
 /// Returns the response length, `None` when nothing is to be sent, or the
 /// mailbox error to reply with.
-pub fn handle<A: ObjectAccess>(
+pub fn handle<A: Dictionary>(
     req: &[u8],
     out: &mut [u8],
     app: &mut A,
@@ -245,8 +177,9 @@ pub fn handle<A: ObjectAccess>(
             ..
         } => Err((index, sub, SdoAbort::UNSUPPORTED_ACCESS)),
         SdoRequest::Unsupported { index, sub } => Err((index, sub, SdoAbort::INVALID_COMMAND)),
-        SdoRequest::Upload { index, sub, .. } => upload(out, app, index, sub),
-        SdoRequest::Download { index, sub, data, .. } => match app.write(index, sub, data, state) {
+        SdoRequest::Upload { index, sub, .. } => upload(out, app, index, sub, comm_state(state)),
+        SdoRequest::Download { index, sub, data, .. } => match app.write(index, sub, data, comm_state(state))
+        {
             Ok(()) => sdo_frame(out, service::SDO_RESPONSE, 0x60, index, sub, [0; 4]),
             Err(e) => Err((index, sub, e)),
         },
@@ -262,6 +195,16 @@ pub fn handle<A: ObjectAccess>(
 }
 
 type Failure = (u16, u8, SdoAbort);
+
+/// The access state of an ESM state (Bootstrap has no CoE; treated as Init).
+pub fn comm_state(state: AlState) -> CommState {
+    match state {
+        AlState::Init | AlState::Bootstrap => CommState::Init,
+        AlState::PreOp => CommState::PreOp,
+        AlState::SafeOp => CommState::SafeOp,
+        AlState::Op => CommState::Op,
+    }
+}
 
 /// Writes CoE header + 8-byte SDO frame into `out`; returns 10.
 fn sdo_frame(
@@ -284,10 +227,16 @@ fn sdo_frame(
 
 /// Upload: expedited response for 1..4 bytes, normal initiate response with the
 /// complete data otherwise (it must fit the mailbox).
-fn upload<A: ObjectAccess>(out: &mut [u8], app: &mut A, index: u16, sub: u8) -> Result<usize, Failure> {
+fn upload<A: Dictionary>(
+    out: &mut [u8],
+    app: &mut A,
+    index: u16,
+    sub: u8,
+    state: CommState,
+) -> Result<usize, Failure> {
     const DATA: usize = COE_HEADER_LEN + SDO_LEN;
     let buf = out.get_mut(DATA..).ok_or((index, sub, SdoAbort::OUT_OF_MEMORY))?;
-    let n = app.read(index, sub, buf).map_err(|e| (index, sub, e))?;
+    let n = app.read(index, sub, buf, state).map_err(|e| (index, sub, e))?;
     if n > buf.len() {
         return Err((index, sub, SdoAbort::OUT_OF_MEMORY));
     }
@@ -322,8 +271,14 @@ mod tests {
         written: Option<(u16, u8, heapless::Vec<u8, 8>)>,
     }
 
-    impl ObjectAccess for Objs {
-        fn read(&mut self, index: u16, sub: u8, buf: &mut [u8]) -> Result<usize, SdoAbort> {
+    impl Dictionary for Objs {
+        fn object(&self, _: u16) -> Option<&'static od::ObjectInfo> {
+            None
+        }
+        fn next_object(&self, _: Option<u16>) -> Option<&'static od::ObjectInfo> {
+            None
+        }
+        fn read(&mut self, index: u16, sub: u8, buf: &mut [u8], _: CommState) -> Result<usize, SdoAbort> {
             let data: &[u8] = match (index, sub) {
                 (0x2000, 0) => &[0x34, 0x12],
                 (0x2001, 0) => b"abcdef",
@@ -335,7 +290,7 @@ mod tests {
             dst.copy_from_slice(data);
             Ok(data.len())
         }
-        fn write(&mut self, index: u16, sub: u8, data: &[u8], _: AlState) -> Result<(), SdoAbort> {
+        fn write(&mut self, index: u16, sub: u8, data: &[u8], _: CommState) -> Result<(), SdoAbort> {
             if index != 0x2003 {
                 return Err(SdoAbort::READ_ONLY);
             }

@@ -63,59 +63,7 @@ impl FmmuUsage {
     }
 }
 
-/// CoE data types usable in PDO entries (ETG.1000.6 Table 64).
-#[derive(Debug, Clone, Copy, PartialEq, Eq)]
-pub enum DataType {
-    /// BOOLEAN, 1 bit.
-    Bool,
-    /// INTEGER8.
-    I8,
-    /// INTEGER16.
-    I16,
-    /// INTEGER32.
-    I32,
-    /// UNSIGNED8.
-    U8,
-    /// UNSIGNED16.
-    U16,
-    /// UNSIGNED32.
-    U32,
-    /// REAL32.
-    F32,
-    /// INTEGER64.
-    I64,
-    /// UNSIGNED64.
-    U64,
-}
-
-impl DataType {
-    /// The CoE data type index (also the SII entry's data type byte).
-    pub const fn code(self) -> u16 {
-        match self {
-            DataType::Bool => 0x0001,
-            DataType::I8 => 0x0002,
-            DataType::I16 => 0x0003,
-            DataType::I32 => 0x0004,
-            DataType::U8 => 0x0005,
-            DataType::U16 => 0x0006,
-            DataType::U32 => 0x0007,
-            DataType::F32 => 0x0008,
-            DataType::I64 => 0x0015,
-            DataType::U64 => 0x001B,
-        }
-    }
-
-    /// Size in bits.
-    pub const fn bits(self) -> u8 {
-        match self {
-            DataType::Bool => 1,
-            DataType::I8 | DataType::U8 => 8,
-            DataType::I16 | DataType::U16 => 16,
-            DataType::I32 | DataType::U32 | DataType::F32 => 32,
-            DataType::I64 | DataType::U64 => 64,
-        }
-    }
-}
+pub use od::DataType;
 
 /// One entry of a PDO mapping.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
@@ -141,9 +89,14 @@ impl PdoEntry {
         }
     }
 
-    /// Bit length.
+    /// Bit length (PDO entries are at most 64 bits; longer types saturate at 255).
     pub const fn bits(&self) -> u8 {
-        self.data_type.bits()
+        let b = self.data_type.bits();
+        if b > 255 {
+            255
+        } else {
+            b as u8
+        }
     }
 
     /// The CoE mapping value `index << 16 | sub << 8 | bits` (mapping objects 16xxh/1Axxh).

@@ -5,7 +5,7 @@
 //! - [`sii`]: the SII EEPROM image generated from it, and a checked category reader.
 //! - [`esm`]: the EtherCAT state machine rules and SyncManager checks (spec §3–4).
 //! - [`mailbox`]: the mailbox header and error replies; [`coe`]: CoE SDO
-//!   expedited/normal transfers over [`ObjectAccess`].
+//!   expedited/normal transfers over [`od::Dictionary`].
 //! - [`Slave`]: all of it composed; the application calls
 //!   [`Slave::poll`]`(pdi, app, now_ns)` with the ESC behind an [`esc::Pdi`].
 #![no_std]
@@ -27,7 +27,7 @@ pub mod mailbox;
 pub mod sii;
 mod slave;
 
-pub use coe::{ObjectAccess, SdoAbort};
+pub use coe::{CommState, Dictionary, SdoAbort};
 pub use desc::{DataType, DcOpMode, Device, FmmuUsage, Identity, MailboxSm, Pdo, PdoEntry, ProcessSm};
 pub use sii::{build_sii, SiiError};
 pub use slave::{Slave, StateChange};

@@ -1,6 +1,6 @@
 //! The slave: ESM + mailbox + CoE dispatch + process data, driven by `poll`.
 
-use crate::coe::{self, ObjectAccess};
+use crate::coe::{self, Dictionary};
 use crate::desc::Device;
 use crate::esm::{self, MAX_MAILBOX_LEN, MAX_PDO_BYTES};
 use crate::mailbox::{next_counter, MailboxError, MailboxHeader, MailboxType, HEADER_LEN};
@@ -150,7 +150,7 @@ impl Slave {
     /// One step of the stack: AL control requests, mailbox, process data.
     /// Returns the processed AL control request when it changed the state or was
     /// refused.
-    pub fn poll<P: Pdi, A: ObjectAccess>(
+    pub fn poll<P: Pdi, A: Dictionary>(
         &mut self,
         pdi: &mut P,
         app: &mut A,
@@ -285,7 +285,7 @@ impl Slave {
         m.counter = 0;
     }
 
-    fn poll_mailbox<P: Pdi, A: ObjectAccess>(
+    fn poll_mailbox<P: Pdi, A: Dictionary>(
         &mut self,
         pdi: &mut P,
         app: &mut A,
@@ -330,7 +330,7 @@ impl Slave {
     }
 
     /// Handles the request in `mbx.rx`; a response goes to `mbx.tx` and is pending.
-    fn handle_request<A: ObjectAccess>(&mut self, app: &mut A) {
+    fn handle_request<A: Dictionary>(&mut self, app: &mut A) {
         let state = self.state;
         let m = &mut self.mbx;
         let rx = m.rx.get(..m.rx_len).unwrap_or_default();

@@ -5,7 +5,7 @@
 extern crate std;
 use std::vec::Vec;
 
-use crate::coe::{ObjectAccess, SdoAbort};
+use crate::coe::{CommState, Dictionary, SdoAbort};
 use crate::desc::*;
 use crate::{Slave, StateChange};
 use esc::regs::{self, al_event};
@@ -181,8 +181,14 @@ struct App {
     value: u16,
 }
 
-impl ObjectAccess for App {
-    fn read(&mut self, index: u16, sub: u8, buf: &mut [u8]) -> Result<usize, SdoAbort> {
+impl Dictionary for App {
+    fn object(&self, _: u16) -> Option<&'static od::ObjectInfo> {
+        None
+    }
+    fn next_object(&self, _: Option<u16>) -> Option<&'static od::ObjectInfo> {
+        None
+    }
+    fn read(&mut self, index: u16, sub: u8, buf: &mut [u8], _: CommState) -> Result<usize, SdoAbort> {
         let v = self.value.to_le_bytes();
         let data: &[u8] = match (index, sub) {
             (0x1008, 0) => b"Test",
@@ -194,7 +200,7 @@ impl ObjectAccess for App {
             .copy_from_slice(data);
         Ok(data.len())
     }
-    fn write(&mut self, index: u16, _: u8, data: &[u8], _: AlState) -> Result<(), SdoAbort> {
+    fn write(&mut self, index: u16, _: u8, data: &[u8], _: CommState) -> Result<(), SdoAbort> {
         match (index, data) {
             (0x2000, &[a, b]) => {
                 self.value = u16::from_le_bytes([a, b]);
