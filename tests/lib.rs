@@ -86,3 +86,77 @@ pub async fn write_sm<S>(sd: &SubDeviceRef<'_, S>, n: u8, start: u16, len: u16, 
         && sd.register_write(base + 6, a).await.is_ok();
     assert!(ok, "write SM{n}");
 }
+
+/// Length of the drive's mailboxes (SM0 and SM1), bytes.
+pub const MAILBOX_LEN: usize = 256;
+
+/// A raw mailbox client: builds mailbox frames from the spec's byte layouts
+/// and moves them through SM0/SM1 with plain register reads and writes of a
+/// real master. ethercrab itself only sends expedited SDO downloads; this is
+/// how the tests send segmented, normal and complete-access transfers, SDO
+/// Info requests and malformed mailboxes.
+pub struct RawMailbox {
+    counter: u8,
+}
+
+impl Default for RawMailbox {
+    fn default() -> Self {
+        Self::new()
+    }
+}
+
+impl RawMailbox {
+    /// Counter starts at 1 and cycles 1..7 (ETG.1000.4 §5.6).
+    pub fn new() -> Self {
+        Self { counter: 0 }
+    }
+
+    /// Sends one mailbox message (`kind` 3 = CoE, ...) and returns the
+    /// response's mailbox data (after the 6-byte header) and its type, or
+    /// `None` when no response arrives within 50 reads.
+    pub async fn exchange<S>(
+        &mut self,
+        sd: &SubDeviceRef<'_, S>,
+        kind: u8,
+        data: &[u8],
+    ) -> Option<(u8, Vec<u8>)> {
+        self.counter = self.counter % 7 + 1;
+        let mut frame = [0u8; MAILBOX_LEN];
+        let len = data.len().min(MAILBOX_LEN - 6);
+        frame[0..2].copy_from_slice(&(len as u16).to_le_bytes());
+        frame[5] = (kind & 0x0F) | (self.counter << 4);
+        frame[6..6 + len].copy_from_slice(&data[..len]);
+        self.send_raw(sd, frame).await;
+        self.receive(sd).await
+    }
+
+    /// Writes a whole, possibly malformed, SM0 buffer.
+    pub async fn send_raw<S>(&mut self, sd: &SubDeviceRef<'_, S>, frame: [u8; MAILBOX_LEN]) {
+        let ok = sd.register_write(0x1000u16, frame).await.is_ok();
+        assert!(ok, "write SM0 mailbox");
+    }
+
+    /// Waits for SM1 to fill and reads the response.
+    pub async fn receive<S>(&mut self, sd: &SubDeviceRef<'_, S>) -> Option<(u8, Vec<u8>)> {
+        for _ in 0..50 {
+            let status: u8 = sd.register_read(esc::regs::sm(1) + 5).await.ok()?;
+            if status & esc::sm::status::MAILBOX_FULL != 0 {
+                let buf: [u8; MAILBOX_LEN] = sd.register_read(0x1100u16).await.ok()?;
+                let len = usize::from(u16::from_le_bytes([buf[0], buf[1]])).min(MAILBOX_LEN - 6);
+                return Some((buf[5] & 0x0F, buf[6..6 + len].to_vec()));
+            }
+        }
+        None
+    }
+
+    /// An SDO request (CoE service 2): CoE header then the 8-byte SDO part and
+    /// optional extra data; returns the CoE response (header included).
+    pub async fn sdo<S>(&mut self, sd: &SubDeviceRef<'_, S>, sdo: &[u8]) -> Vec<u8> {
+        let mut req = vec![0x00, 0x20]; // number 0, service 2 (SDO request)
+        req.extend_from_slice(sdo);
+        match self.exchange(sd, 3, &req).await {
+            Some((3, resp)) => resp,
+            other => panic!("no CoE response: {other:?}"),
+        }
+    }
+}

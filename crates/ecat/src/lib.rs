@@ -4,8 +4,10 @@
 //!   SyncManagers, FMMUs, PDO maps, DC op modes.
 //! - [`sii`]: the SII EEPROM image generated from it, and a checked category reader.
 //! - [`esm`]: the EtherCAT state machine rules and SyncManager checks (spec §3–4).
-//! - [`mailbox`]: the mailbox header and error replies; [`coe`]: CoE SDO
-//!   expedited/normal transfers over [`od::Dictionary`].
+//! - [`mailbox`]: the mailbox header and error replies; [`coe`]: the CoE server
+//!   ([`CoeServer`]: SDO expedited/normal/segmented transfers, complete access,
+//!   abort, timeout) over [`od::Dictionary`]; [`sdo_info`]: the SDO Information
+//!   service.
 //! - [`Slave`]: all of it composed; the application calls
 //!   [`Slave::poll`]`(pdi, app, now_ns)` with the ESC behind an [`esc::Pdi`].
 #![no_std]
@@ -22,12 +24,15 @@
 
 pub mod coe;
 pub mod desc;
+pub mod diag;
+pub mod emcy;
 pub mod esm;
 pub mod mailbox;
+pub mod sdo_info;
 pub mod sii;
 mod slave;
 
-pub use coe::{CommState, Dictionary, SdoAbort};
+pub use coe::{CoeConfig, CoeServer, CommState, Dictionary, SdoAbort};
 pub use desc::{DataType, DcOpMode, Device, FmmuUsage, Identity, MailboxSm, Pdo, PdoEntry, ProcessSm};
 pub use sii::{build_sii, SiiError};
 pub use slave::{Slave, StateChange};

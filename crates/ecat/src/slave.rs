@@ -1,6 +1,6 @@
 //! The slave: ESM + mailbox + CoE dispatch + process data, driven by `poll`.
 
-use crate::coe::{self, Dictionary};
+use crate::coe::{CoeConfig, CoeServer, Dictionary};
 use crate::desc::Device;
 use crate::esm::{self, MAX_MAILBOX_LEN, MAX_PDO_BYTES};
 use crate::mailbox::{next_counter, MailboxError, MailboxHeader, MailboxType, HEADER_LEN};
@@ -57,6 +57,34 @@ struct Mailbox {
     counter: u8,
 }
 
+impl Mailbox {
+    /// Completes the response whose `len` data bytes are in `tx` after the
+    /// header: zero fill, next counter, header; the response is pending.
+    fn queue(&mut self, kind: MailboxType, len: usize) {
+        if let Some(rest) = self
+            .tx
+            .get_mut(..self.tx_len)
+            .and_then(|t| t.get_mut(HEADER_LEN.saturating_add(len)..))
+        {
+            rest.fill(0);
+        }
+        self.counter = next_counter(self.counter);
+        let header = MailboxHeader {
+            length: len as u16,
+            address: 0,
+            channel: 0,
+            priority: 0,
+            kind,
+            counter: self.counter,
+        };
+        if let Some(head) = self.tx.get_mut(..HEADER_LEN) {
+            head.copy_from_slice(&header.to_bytes());
+        }
+        self.tx_valid = true;
+        self.pending = true;
+    }
+}
+
 /// The EtherCAT slave stack (sans-IO). See the crate documentation.
 pub struct Slave {
     desc: &'static Device,
@@ -65,6 +93,8 @@ pub struct Slave {
     code: AlStatusCode,
     started: bool,
     mbx: Mailbox,
+    /// CoE server: SDO transfers and SDO Info fragments spanning mailbox messages.
+    coe: CoeServer,
     out_len: usize,
     in_len: usize,
     out_start: u16,
@@ -95,6 +125,7 @@ impl Slave {
                 last_counter: 0,
                 counter: 0,
             },
+            coe: CoeServer::new(CoeConfig::from_details(desc.coe_details)),
             out_len: desc.output_bytes().min(MAX_PDO_BYTES),
             in_len: desc.input_bytes().min(MAX_PDO_BYTES),
             out_start: desc.outputs.start,
@@ -167,7 +198,7 @@ impl Slave {
             None
         };
         if esm::mailbox_on(self.state) {
-            self.poll_mailbox(pdi, app, events)?;
+            self.poll_mailbox(pdi, app, events, now_ns)?;
         }
         if esm::process_data_on(self.state) {
             self.process_data(pdi, events)?;
@@ -259,6 +290,7 @@ impl Slave {
         if to == AlState::Init {
             self.mbx.pending = false;
             self.mbx.tx_valid = false;
+            self.coe.reset();
         }
         Ok(Ok(()))
     }
@@ -283,6 +315,7 @@ impl Slave {
         m.pending = false;
         m.last_counter = 0;
         m.counter = 0;
+        self.coe.reset();
     }
 
     fn poll_mailbox<P: Pdi, A: Dictionary>(
@@ -290,6 +323,7 @@ impl Slave {
         pdi: &mut P,
         app: &mut A,
         events: u32,
+        now_ns: u64,
     ) -> Result<(), P::Error> {
         let sm1 = pdi.read_sm(1)?;
         let mut full = sm1.status & status::MAILBOX_FULL != 0;
@@ -312,8 +346,13 @@ impl Slave {
             let m = &mut self.mbx;
             if let Some(rx) = m.rx.get_mut(..m.rx_len) {
                 pdi.read(m.rx_start, rx)?;
-                self.handle_request(app);
+                self.handle_request(app, now_ns);
             }
+        }
+        self.coe.tick(now_ns);
+        // the next SDO Info fragment once the previous response has left
+        if !self.mbx.pending && self.coe.has_fragments() {
+            self.next_fragment(app);
         }
         if self.mbx.pending && !full {
             self.write_response(pdi)?;
@@ -330,14 +369,11 @@ impl Slave {
     }
 
     /// Handles the request in `mbx.rx`; a response goes to `mbx.tx` and is pending.
-    fn handle_request<A: Dictionary>(&mut self, app: &mut A) {
+    fn handle_request<A: Dictionary>(&mut self, app: &mut A, now_ns: u64) {
         let state = self.state;
         let m = &mut self.mbx;
         let rx = m.rx.get(..m.rx_len).unwrap_or_default();
-        let Some((head, body)) =
-            m.tx.get_mut(..m.tx_len)
-                .and_then(|t| t.split_at_mut_checked(HEADER_LEN))
-        else {
+        let Some(body) = m.tx.get_mut(HEADER_LEN..m.tx_len) else {
             return;
         };
         let reply = match MailboxHeader::check(rx) {
@@ -347,9 +383,10 @@ impl Slave {
                 m.last_counter = h.counter;
                 let payload = h.payload(rx).unwrap_or_default();
                 match h.kind {
-                    MailboxType::Coe => {
-                        coe::handle(payload, body, app, state).map(|n| n.map(|n| (MailboxType::Coe, n)))
-                    }
+                    MailboxType::Coe => self
+                        .coe
+                        .handle(payload, body, app, state, now_ns)
+                        .map(|n| n.map(|n| (MailboxType::Coe, n))),
                     _ => Err(MailboxError::UNSUPPORTED_PROTOCOL),
                 }
             }
@@ -366,21 +403,19 @@ impl Slave {
                 (MailboxType::Error, data.len())
             }
         };
-        if let Some(rest) = body.get_mut(len..) {
-            rest.fill(0);
-        }
-        m.counter = next_counter(m.counter);
-        let header = MailboxHeader {
-            length: len as u16,
-            address: 0,
-            channel: 0,
-            priority: 0,
-            kind,
-            counter: m.counter,
+        m.queue(kind, len);
+    }
+
+    /// Puts the next SDO Info fragment into `mbx.tx` (pending).
+    fn next_fragment<A: Dictionary>(&mut self, app: &mut A) {
+        let m = &mut self.mbx;
+        let Some(body) = m.tx.get_mut(HEADER_LEN..m.tx_len) else {
+            self.coe.reset();
+            return;
         };
-        head.copy_from_slice(&header.to_bytes());
-        m.tx_valid = true;
-        m.pending = true;
+        if let Some(len) = self.coe.next_fragment(body, app) {
+            m.queue(MailboxType::Coe, len);
+        }
     }
 
     fn process_data<P: Pdi>(&mut self, pdi: &mut P, events: u32) -> Result<(), P::Error> {

@@ -28,7 +28,7 @@ static TX: [Pdo; 1] = [Pdo {
     name: "Inputs",
     entries: &TX_ENTRIES,
 }];
-static DEV: Device = Device {
+const DEV_DESC: Device = Device {
     identity: Identity {
         vendor_id: 0xB9,
         product_code: 1,
@@ -67,6 +67,40 @@ static DEV: Device = Device {
     tx_pdos: &TX,
     rx_assign: &[0x1600],
     tx_assign: &[0x1A00],
+};
+static DEV: Device = DEV_DESC;
+/// The same device with SDO Information.
+static DEV_INFO: Device = Device {
+    coe_details: coe_details::SDO | coe_details::SDO_INFO,
+    ..DEV_DESC
+};
+
+static MANY_ENTRIES: [od::EntryInfo; 1] = [od::EntryInfo {
+    sub: 0,
+    name: "Many",
+    data_type: DataType::U8,
+    access: od::Access::RO,
+    min: None,
+    max: None,
+    default: 0,
+    unit: "",
+    persistent: false,
+}];
+const MANY_N: usize = 150;
+/// Objects 3000h..3095h, for SDO Info lists longer than one mailbox.
+static MANY: [od::ObjectInfo; MANY_N] = {
+    let mut a = [od::ObjectInfo {
+        index: 0x3000,
+        name: "Many",
+        code: od::ObjectCode::Var,
+        entries: &MANY_ENTRIES,
+    }; MANY_N];
+    let mut i = 0;
+    while i < MANY_N {
+        a[i].index = 0x3000 + i as u16;
+        i += 1;
+    }
+    a
 };
 
 struct Fake {
@@ -182,11 +216,11 @@ struct App {
 }
 
 impl Dictionary for App {
-    fn object(&self, _: u16) -> Option<&'static od::ObjectInfo> {
-        None
+    fn object(&self, index: u16) -> Option<&'static od::ObjectInfo> {
+        MANY.iter().find(|o| o.index == index)
     }
-    fn next_object(&self, _: Option<u16>) -> Option<&'static od::ObjectInfo> {
-        None
+    fn next_object(&self, after: Option<u16>) -> Option<&'static od::ObjectInfo> {
+        MANY.iter().find(|o| after.is_none_or(|a| o.index > a))
     }
     fn read(&mut self, index: u16, sub: u8, buf: &mut [u8], _: CommState) -> Result<usize, SdoAbort> {
         let v = self.value.to_le_bytes();
@@ -220,9 +254,12 @@ struct Rig {
 
 impl Rig {
     fn new() -> Self {
+        Self::with(&DEV)
+    }
+    fn with(dev: &'static Device) -> Self {
         let mut r = Rig {
             esc: Fake::new(),
-            slave: Slave::new(&DEV),
+            slave: Slave::new(dev),
             app: App { value: 0 },
             t: 0,
         };
@@ -580,4 +617,60 @@ fn mailbox_repeat_rewrites_last_response() {
     r.poll();
     assert_eq!(r.esc.mbx_read().unwrap(), first);
     assert_eq!(r.esc.mem[regs::sm(1) as usize + 7] & pdi_control::REPEAT_ACK, 0);
+}
+
+#[test]
+fn e080_od_list_fragments_through_the_mailbox() {
+    let mut r = Rig::with(&DEV_INFO);
+    r.goto(AlState::PreOp);
+    // Get OD List, all objects: 2 + 2 * 150 bytes, 116 per fragment (SM1 128) -> 3 fragments
+    r.esc.mbx_write(&[
+        8, 0, 0, 0, 0, 0x13, 0x00, 0x80, 0x01, 0x00, 0x00, 0x00, 0x01, 0x00,
+    ]);
+    r.poll();
+    let mut indices = Vec::new();
+    let mut frames = Vec::new();
+    for _ in 0..3 {
+        let resp = r.esc.mbx_read().expect("a fragment");
+        // the master has not read yet: nothing new is written
+        frames.push(resp);
+        r.poll();
+    }
+    for (i, f) in frames.iter().enumerate() {
+        let len = u16::from_le_bytes([f[0], f[1]]) as usize;
+        assert_eq!(f[5], 0x03 | ((i as u8 + 1) << 4), "CoE, counters 1, 2, 3");
+        assert_eq!(&f[6..8], &[0x00, 0x80]);
+        let left = 2 - i as u16;
+        assert_eq!(f[8], if left > 0 { 0x82 } else { 0x02 });
+        assert_eq!(u16::from_le_bytes([f[10], f[11]]), left);
+        let data = &f[12..6 + len];
+        let data = if i == 0 {
+            assert_eq!(&data[..2], &[1, 0]);
+            &data[2..]
+        } else {
+            data
+        };
+        indices.extend(data.chunks(2).map(|c| u16::from_le_bytes([c[0], c[1]])));
+    }
+    assert_eq!(
+        indices,
+        (0..MANY_N as u16).map(|i| 0x3000 + i).collect::<Vec<_>>()
+    );
+    assert!(r.esc.mbx_read().is_none(), "no fourth fragment");
+    // the next request is served normally
+    let resp = r.upload(0x1008, 0, 2).unwrap();
+    assert_eq!(&resp[6..9], &[0x00, 0x30, 0x43]);
+}
+
+#[test]
+fn e079_no_sdo_info_without_the_coe_detail() {
+    let mut r = Rig::new();
+    r.goto(AlState::PreOp);
+    r.esc.mbx_write(&[
+        8, 0, 0, 0, 0, 0x13, 0x00, 0x80, 0x01, 0x00, 0x00, 0x00, 0x01, 0x00,
+    ]);
+    r.poll();
+    let resp = r.esc.mbx_read().unwrap();
+    // mailbox error: service not supported
+    assert_eq!(&resp[..10], &[4, 0, 0, 0, 0, 0x10, 0x01, 0x00, 0x04, 0x00]);
 }

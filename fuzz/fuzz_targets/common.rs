@@ -1,0 +1,43 @@
+//! Frame building shared by the fuzz targets: real EtherCAT frames into the
+//! simulated line, exactly as a master would send them.
+
+use hil_sim::sim::Simulation;
+
+/// One datagram frame: Ethernet + EtherCAT header + datagram + WKC.
+pub fn frame(cmd: u8, adp: u16, ado: u16, data: &[u8]) -> Vec<u8> {
+    let mut f = vec![0xFF; 6];
+    f.extend_from_slice(&[0x10; 6]);
+    f.extend_from_slice(&0x88A4u16.to_be_bytes());
+    let len = data.len().min(1400);
+    f.extend_from_slice(&((10 + len + 2) as u16 | 0x1000).to_le_bytes());
+    f.push(cmd);
+    f.push(0);
+    f.extend_from_slice(&adp.to_le_bytes());
+    f.extend_from_slice(&ado.to_le_bytes());
+    f.extend_from_slice(&(len as u16).to_le_bytes());
+    f.extend_from_slice(&0u16.to_le_bytes());
+    f.extend_from_slice(&data[..len]);
+    f.extend_from_slice(&0u16.to_le_bytes());
+    f
+}
+
+/// APWR (auto-increment write) to the first slave.
+pub fn apwr(sim: &mut Simulation, ado: u16, data: &[u8]) {
+    let mut f = frame(2, 0, ado, data);
+    sim.exchange(&mut f);
+}
+
+/// A one-slave line brought to PRE-OP the way a master does it: station
+/// address, mailbox SyncManagers from the SII defaults, AL control = 2.
+pub fn preop_line() -> Simulation {
+    let mut sim = Simulation::new(1);
+    apwr(&mut sim, esc::regs::STATION_ADDRESS, &0x1000u16.to_le_bytes());
+    let sm0 = esc::SyncManager { start: 0x1000, length: 256, control: 0x26, status: 0, activate: 1, pdi_control: 0 };
+    let sm1 = esc::SyncManager { start: 0x1100, length: 256, control: 0x22, status: 0, activate: 1, pdi_control: 0 };
+    let mut both = sm0.to_bytes().to_vec();
+    both.extend_from_slice(&sm1.to_bytes());
+    apwr(&mut sim, esc::regs::sm(0), &both);
+    apwr(&mut sim, esc::regs::AL_CONTROL, &2u16.to_le_bytes());
+    sim.advance_to(sim.now_ns() + 1_000_000);
+    sim
+}

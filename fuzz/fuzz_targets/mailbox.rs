@@ -1,0 +1,23 @@
+//! Arbitrary bytes as mailbox requests (mailbox header, CoE, SDO, SDO Info, ...)
+//! into SM0 of a drive in PRE-OP, each answer read back from SM1: the slave
+//! stack must never panic, whatever the master writes.
+#![no_main]
+
+#[path = "common.rs"]
+mod common;
+
+use libfuzzer_sys::fuzz_target;
+
+fuzz_target!(|data: &[u8]| {
+    let mut sim = common::preop_line();
+    for chunk in data.chunks(256) {
+        let mut buf = [0u8; 256];
+        buf[..chunk.len()].copy_from_slice(chunk);
+        let mut w = common::frame(5, 0x1000, 0x1000, &buf); // FPWR into SM0
+        sim.exchange(&mut w);
+        let t = sim.now_ns() + 200_000;
+        sim.advance_to(t);
+        let mut r = common::frame(4, 0x1000, 0x1100, &[0u8; 256]); // FPRD of SM1
+        sim.exchange(&mut r);
+    }
+});
