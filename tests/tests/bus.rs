@@ -246,3 +246,32 @@ fn e037_back_to_init_stops_mailbox() {
         assert!(sd.sdo_read::<u32>(0x1000, 0).await.is_err(), "no mailbox in INIT");
     });
 }
+
+#[test]
+fn e028_e092_failed_preop_to_safeop_sends_emcy_a000_with_diag_code() {
+    let sim = line(1);
+    with_master(&sim, async |md, clock| {
+        let group = init(md, clock).await;
+        let sd = group.subdevice(md, 0).unwrap();
+        // SM3 one byte short: PDO length not correct on SM3 -> diag code 4*3 + 2 = Eh
+        write_sm(&sd, 2, 0x1200, 23, 0x64).await;
+        write_sm(&sd, 3, 0x1A00, 28, 0x20).await;
+        request(&sd, SAFEOP).await;
+        assert_eq!(
+            al_status(&sd).await,
+            (PREOP | ERR, AlStatusCode::INVALID_INPUT_CONFIG.0)
+        );
+        let mut mbx = drive_tests::RawMailbox::new();
+        let (kind, data) = mbx.receive(&sd).await.expect("an EMCY in the mailbox");
+        assert_eq!(kind, 3, "CoE");
+        assert_eq!(
+            u16::from_le_bytes([data[0], data[1]]) >> 12,
+            1,
+            "CoE service 1: emergency"
+        );
+        let emcy = &data[2..10];
+        assert_eq!(u16::from_le_bytes([emcy[0], emcy[1]]), 0xA000, "error code A000h");
+        assert_eq!(emcy[2], 2, "error register = ESM state Pre-Op");
+        assert_eq!(emcy[3], 0x0E, "diag code: SM3, PDO length not correct");
+    });
+}

@@ -3,8 +3,16 @@
 //! - [`DEVICE`]: the device description (identity, SyncManagers, FMMUs, PDO maps,
 //!   DC op modes), the one source the SII image, the stack's checks and later
 //!   the ESI XML and object dictionary derive from.
-//! - [`DriveObjects`]: the few objects a master reads during start-up, until the
-//!   object dictionary arrives (replace it then).
+//! - [`objects`]: the object dictionary, declared once (communication area,
+//!   manufacturer parameters, CiA 402 objects of both axes) with its RAM image
+//!   layout, computed at compile time.
+//! - [`DriveObjects`]: the values and the CoE access rules; implements
+//!   [`od::Dictionary`] for the CoE server. Live values come from the runtime
+//!   ([`DriveObjects::set`], [`LiveValues`]); saving and restoring go through
+//!   [`DriveObjects::persistent_image`], [`DriveObjects::load_persistent`] and
+//!   [`Requests`].
+//! - [`doc`]: the object-dictionary reference (`docs/object-dictionary.md`)
+//!   generated from the declaration.
 #![no_std]
 #![cfg_attr(
     not(test),
@@ -18,7 +26,16 @@
 #![deny(missing_docs)]
 
 use ecat::desc::coe_details;
-use ecat::{DataType, DcOpMode, Device, FmmuUsage, Identity, MailboxSm, Pdo, PdoEntry, ProcessSm, SdoAbort};
+use ecat::{DataType, DcOpMode, Device, FmmuUsage, Identity, MailboxSm, Pdo, PdoEntry, ProcessSm};
+
+pub mod dictionary;
+pub mod doc;
+pub mod objects;
+
+pub use dictionary::{
+    revision, DriveObjects, ImageError, LiveValues, NoLive, Requests, Template, WithLive, LOAD_SIGNATURE,
+    PERSISTENT_IMAGE_BYTES, SAVE_SIGNATURE,
+};
 use esc::sii::mailbox_protocol;
 
 /// STOBER's EtherCAT vendor ID (E-005).
@@ -27,8 +44,14 @@ pub const VENDOR_ID: u32 = 0xB9;
 /// is not in the seeds or the spec; assumed 1.5 kW (2 × 0.75 kW) until checked
 /// against the SC6 manual.
 pub const PRODUCT_CODE: u32 = 15;
-/// Software build number, reported as revision 1018h:03 (E-005, E-008).
+/// Revision number 1018h:03 with the default template "EtherCAT Rx SDO
+/// Info", also in the SII (E-005, E-008): software build number << 1 | 1
+/// (bit 0 = template, see [`revision`]); build 0 for now.
 pub const SOFTWARE_BUILD: u32 = 1;
+/// Hardware version 1009h (E52[1]).
+pub const HARDWARE_VERSION: &str = "HW 1";
+/// Software version 100Ah (E52[3]).
+pub const SOFTWARE_VERSION: &str = env!("CARGO_PKG_VERSION");
 /// Serial number placeholder; the real value is E52[2], from the device's
 /// production data (E-005).
 pub const SERIAL: u32 = 0;
@@ -36,7 +59,7 @@ pub const SERIAL: u32 = 0;
 pub const DEVICE_TYPE: u32 = 0x0002_0192;
 /// Device name (1008h, E50).
 pub const DEVICE_NAME: &str = "SC6";
-/// Entries per PDO mapping object (spec §5.1: sub 0 is always 24).
+/// Entries per PDO mapping object (spec §5.1).
 pub const MAPPING_ENTRIES: u8 = 24;
 /// Offset of axis B's CiA 402 objects (E-015).
 pub const AXIS_B_CIA402: u16 = 0x0800;
@@ -49,8 +72,8 @@ pub const fn parameter_index(group: u16, line: u16) -> u16 {
     0x2000 + group * 0x200 + line
 }
 
-/// Axis-A RxPDO entries (spec §5.4, 23 bytes).
-const RX_A: [PdoEntry; 8] = [
+/// Axis-A RxPDO entries (spec §5.4, 23 bytes): the default of 1600h.
+pub(crate) const RX_A: [PdoEntry; 8] = [
     PdoEntry::new(0x6040, 0, DataType::U16, "Controlword"),
     PdoEntry::new(0x6060, 0, DataType::I8, "Modes of operation"),
     PdoEntry::new(0x607A, 0, DataType::I32, "Target position"),
@@ -61,8 +84,8 @@ const RX_A: [PdoEntry; 8] = [
     PdoEntry::new(0x60FE, 1, DataType::U32, "Digital outputs"),
 ];
 
-/// Axis-A TxPDO entries (spec §5.4, 29 bytes).
-const TX_A: [PdoEntry; 10] = [
+/// Axis-A TxPDO entries (spec §5.4, 29 bytes): the default of 1A00h.
+pub(crate) const TX_A: [PdoEntry; 10] = [
     PdoEntry::new(0x6041, 0, DataType::U16, "Statusword"),
     PdoEntry::new(0x6061, 0, DataType::I8, "Modes of operation display"),
     PdoEntry::new(0x6064, 0, DataType::I32, "Position actual value"),
@@ -98,10 +121,15 @@ const fn axis_b<const N: usize>(a: [PdoEntry; N]) -> [PdoEntry; N] {
     b
 }
 
+/// Axis-B RxPDO entries: the default of 1601h.
+pub(crate) const RX_B: [PdoEntry; 8] = axis_b(RX_A);
+/// Axis-B TxPDO entries: the default of 1A01h.
+pub(crate) const TX_B: [PdoEntry; 10] = axis_b(TX_A);
+
 static RX_A_ENTRIES: [PdoEntry; 8] = RX_A;
-static RX_B_ENTRIES: [PdoEntry; 8] = axis_b(RX_A);
+static RX_B_ENTRIES: [PdoEntry; 8] = RX_B;
 static TX_A_ENTRIES: [PdoEntry; 10] = TX_A;
-static TX_B_ENTRIES: [PdoEntry; 10] = axis_b(TX_A);
+static TX_B_ENTRIES: [PdoEntry; 10] = TX_B;
 
 static RX_PDOS: [Pdo; 2] = [
     Pdo {
@@ -204,95 +232,9 @@ pub static DEVICE: Device = Device {
     tx_assign: &[0x1A00],
 };
 
-/// The start-up objects of [`DEVICE`] (1000h, 1008h, 1018h, 1C00h, 1C12h,
-/// 1C13h, 1600h–1603h, 1A00h–1A03h), read-only. Replaced by the object
-/// dictionary later.
-#[derive(Debug, Default, Clone, Copy)]
-pub struct DriveObjects;
-
-impl DriveObjects {
-    /// The start-up objects.
-    pub const fn new() -> Self {
-        Self
-    }
-}
-
-fn put(buf: &mut [u8], data: &[u8]) -> Result<usize, SdoAbort> {
-    buf.get_mut(..data.len())
-        .ok_or(SdoAbort::OUT_OF_MEMORY)?
-        .copy_from_slice(data);
-    Ok(data.len())
-}
-
-fn sub_of<T: Copy>(list: &[T], sub: u8) -> Option<T> {
-    list.get(usize::from(sub).checked_sub(1)?).copied()
-}
-
-impl od::Dictionary for DriveObjects {
-    /// No metadata yet: SDO Info and complete access arrive with the object dictionary.
-    fn object(&self, _index: u16) -> Option<&'static od::ObjectInfo> {
-        None
-    }
-
-    fn next_object(&self, _after: Option<u16>) -> Option<&'static od::ObjectInfo> {
-        None
-    }
-
-    fn read(
-        &mut self,
-        index: u16,
-        sub: u8,
-        buf: &mut [u8],
-        _state: od::CommState,
-    ) -> Result<usize, SdoAbort> {
-        let d = &DEVICE;
-        let u8v = |v: u8| [v];
-        match (index, sub) {
-            (0x1000, 0) => put(buf, &d.device_type.to_le_bytes()),
-            (0x1008, 0) => put(buf, d.name.as_bytes()),
-            (0x1018, 0) => put(buf, &u8v(4)),
-            (0x1018, 1..=4) => {
-                let id = &d.identity;
-                let v = [id.vendor_id, id.product_code, id.revision, id.serial];
-                let v = sub_of(&v, sub).ok_or(SdoAbort::NO_SUBINDEX)?;
-                put(buf, &v.to_le_bytes())
-            }
-            (0x1C00, 0) => put(buf, &u8v(4)),
-            (0x1C00, 1..=4) => put(buf, &u8v(sub)),
-            // Sub 0 reports the number of assigned PDOs (1 by default), not the
-            // spec's constant 4 (E-054): ethercrab reads subs 1..=sub0 and then
-            // each PDO's mapping, and an unused assignment 0 would send it to
-            // object 0000h.
-            (0x1C12 | 0x1C13, _) => {
-                let list = if index == 0x1C12 { d.rx_assign } else { d.tx_assign };
-                match sub {
-                    0 => put(buf, &u8v(list.len() as u8)),
-                    1..=4 => put(buf, &sub_of(list, sub).unwrap_or(0).to_le_bytes()),
-                    _ => Err(SdoAbort::NO_SUBINDEX),
-                }
-            }
-            (0x1600..=0x1603 | 0x1A00..=0x1A03, _) => {
-                let entries = d.pdo(index).map(|p| p.entries).unwrap_or(&[]);
-                match sub {
-                    0 => put(buf, &u8v(MAPPING_ENTRIES)),
-                    1..=MAPPING_ENTRIES => {
-                        let v = sub_of(entries, sub).map_or(0, |e| e.mapping_value());
-                        put(buf, &v.to_le_bytes())
-                    }
-                    _ => Err(SdoAbort::NO_SUBINDEX),
-                }
-            }
-            (0x1000 | 0x1008 | 0x1018 | 0x1C00, _) => Err(SdoAbort::NO_SUBINDEX),
-            _ => Err(SdoAbort::NO_OBJECT),
-        }
-    }
-
-    fn write(&mut self, index: u16, sub: u8, _: &[u8], state: od::CommState) -> Result<(), SdoAbort> {
-        let mut probe = [0u8; 64];
-        self.read(index, sub, &mut probe, state)?;
-        Err(SdoAbort::READ_ONLY)
-    }
-}
-
+#[cfg(test)]
+extern crate std;
 #[cfg(test)]
 mod tests;
+#[cfg(test)]
+mod tests_od;

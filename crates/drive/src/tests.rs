@@ -1,7 +1,7 @@
 use super::*;
 use ecat::sii::{build_sii, categories, find_category, records, sii_string, sii_word, EEPROM_BYTES};
 use esc::sii::{category, config_checksum, word};
-use od::Dictionary as _;
+use od::{Dictionary as _, SdoAbort};
 
 fn image() -> ([u8; EEPROM_BYTES], usize) {
     let mut img = [0u8; EEPROM_BYTES];
@@ -121,7 +121,7 @@ fn dc_category_has_three_op_modes() {
 
 fn read(index: u16, sub: u8) -> Result<heapless::Vec<u8, 64>, SdoAbort> {
     let mut buf = [0u8; 64];
-    let n = DriveObjects.read(index, sub, &mut buf, od::CommState::PreOp)?;
+    let n = DriveObjects::new().read(index, sub, &mut buf, od::CommState::PreOp)?;
     Ok(heapless::Vec::from_slice(&buf[..n]).unwrap())
 }
 
@@ -165,7 +165,7 @@ fn ethercrab_bits(assign: u16) -> u32 {
         assert_eq!(pdo.len(), 2);
         let pdo = u16::from_le_bytes([pdo[0], pdo[1]]);
         let m = read(pdo, 0).unwrap();
-        assert_eq!(m.as_slice(), &[24]);
+        assert_eq!(m.len(), 1);
         for s in 1..=m[0] {
             let v = read(pdo, s).unwrap();
             assert_eq!(v.len(), 4);
@@ -192,8 +192,11 @@ fn e048_e050_mapping_objects() {
     assert_eq!(read_u32(0x1600, 9), 0);
     assert_eq!(read_u32(0x1A00, 9), 0x28C9_0010);
     assert_eq!(read_u32(0x1A01, 10), 0xA043_0010);
+    // sub 0 = number of mapped entries (decision, see docs/conformance.md)
+    assert_eq!(read(0x1600, 0).unwrap().as_slice(), &[8]);
+    assert_eq!(read(0x1A01, 0).unwrap().as_slice(), &[10]);
     for pdo in [0x1602, 0x1603, 0x1A02, 0x1A03] {
-        assert_eq!(read(pdo, 0).unwrap().as_slice(), &[24]);
+        assert_eq!(read(pdo, 0).unwrap().as_slice(), &[0]);
         assert_eq!(read_u32(pdo, 24), 0);
     }
     assert_eq!(read(0x1600, 25), Err(SdoAbort::NO_SUBINDEX));
@@ -201,13 +204,14 @@ fn e048_e050_mapping_objects() {
 }
 
 #[test]
-fn writes_are_refused_read_only() {
+fn writes_to_missing_and_read_only_objects() {
+    let mut d = DriveObjects::new();
     assert_eq!(
-        DriveObjects.write(0x1C12, 1, &[0, 0x16], od::CommState::PreOp),
+        d.write(0x1018, 1, &[0; 4], od::CommState::PreOp),
         Err(SdoAbort::READ_ONLY)
     );
     assert_eq!(
-        DriveObjects.write(0x5000, 0, &[0], od::CommState::PreOp),
+        d.write(0x5000, 0, &[0], od::CommState::PreOp),
         Err(SdoAbort::NO_OBJECT)
     );
 }

@@ -3,6 +3,7 @@
 //! applies them to the ESC.
 
 use crate::desc::{Device, MailboxSm};
+use crate::emcy::SmFault;
 use esc::{regs, AlState, AlStatusCode, SmDirection, SmMode, SyncManager};
 
 /// Smallest mailbox SyncManager length accepted: header + CoE header + SDO frame.
@@ -78,44 +79,82 @@ fn overlap(a: Option<(u32, u32)>, b: Option<(u32, u32)>) -> bool {
     matches!((a, b), (Some((a0, a1)), Some((b0, b1))) if a0 < b1 && b0 < a1)
 }
 
-fn process_sm_ok(sm: &SyncManager, bytes: usize, dir: SmDirection, ram_end: u32) -> bool {
-    if bytes == 0 {
-        return sm.length == 0 || !sm.enabled();
-    }
-    let end = u32::from(sm.start) + sm.occupied_len();
-    bytes <= MAX_PDO_BYTES
-        && sm.enabled()
-        && usize::from(sm.length) == bytes
-        && sm.control().mode() == SmMode::Buffered
-        && sm.control().direction() == dir
-        && sm.start >= regs::PROCESS_RAM
-        && end <= ram_end
+/// Why a process-data SyncManager was refused, for the AL status code and the
+/// diag code of the state-transition EMCY (spec §8.4).
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub struct SmRefusal {
+    /// AL status code (0017h, 001Dh or 001Eh).
+    pub code: AlStatusCode,
+    /// The SyncManager at fault (2 or 3).
+    pub sm: u8,
+    /// What is wrong with it.
+    pub fault: SmFault,
 }
 
-/// P→S check (E-028, E-045): `sms` are SM0..SM3 as configured by the master.
+fn process_sm_fault(sm: &SyncManager, bytes: usize, dir: SmDirection, ram_end: u32) -> Option<SmFault> {
+    if bytes == 0 {
+        return (sm.length != 0 && sm.enabled()).then_some(SmFault::Length);
+    }
+    let end = u32::from(sm.start) + sm.occupied_len();
+    if sm.start < regs::PROCESS_RAM || end > ram_end {
+        Some(SmFault::Address)
+    } else if bytes > MAX_PDO_BYTES || usize::from(sm.length) != bytes {
+        Some(SmFault::Length)
+    } else if !sm.enabled() || sm.control().mode() != SmMode::Buffered || sm.control().direction() != dir {
+        Some(SmFault::Settings)
+    } else {
+        None
+    }
+}
+
+/// P→S check (E-028, E-045): `sms` are SM0..SM3 as configured by the master,
+/// `rx_bytes`/`tx_bytes` the lengths of the assigned RxPDOs/TxPDOs.
 /// Reserved mode/direction bits or overlapping areas: 0017h; SM2 (outputs,
-/// three-buffer, MasterWrite, length = assigned RxPDO bytes, inside process RAM):
+/// three-buffer, MasterWrite, length = RxPDO bytes, inside process RAM):
 /// 001Dh; SM3 (inputs, likewise): 001Eh.
-pub fn check_process_sms(desc: &Device, sms: &[SyncManager; 4]) -> Result<(), AlStatusCode> {
+pub fn check_process_sms(
+    desc: &Device,
+    sms: &[SyncManager; 4],
+    rx_bytes: usize,
+    tx_bytes: usize,
+) -> Result<(), SmRefusal> {
     let [sm0, sm1, sm2, sm3] = sms;
-    for sm in [sm2, sm3] {
+    for (n, sm) in [(2, sm2), (3, sm3)] {
         let c = sm.control();
         let reserved =
             matches!(c.mode(), SmMode::Reserved(_)) || matches!(c.direction(), SmDirection::Reserved(_));
         if area(sm).is_some() && reserved {
-            return Err(AlStatusCode::INVALID_SM_CONFIG);
+            return Err(SmRefusal {
+                code: AlStatusCode::INVALID_SM_CONFIG,
+                sm: n,
+                fault: SmFault::Settings,
+            });
         }
     }
     let (a0, a1, a2, a3) = (area(sm0), area(sm1), area(sm2), area(sm3));
-    if overlap(a2, a3) || [a0, a1].iter().any(|&m| overlap(m, a2) || overlap(m, a3)) {
-        return Err(AlStatusCode::INVALID_SM_CONFIG);
+    for (n, a, other) in [(2, a2, a3), (3, a3, a2)] {
+        if overlap(a, other) || overlap(a0, a) || overlap(a1, a) {
+            return Err(SmRefusal {
+                code: AlStatusCode::INVALID_SM_CONFIG,
+                sm: n,
+                fault: SmFault::Address2,
+            });
+        }
     }
     let ram_end = desc.process_ram_end;
-    if !process_sm_ok(sm2, desc.output_bytes(), SmDirection::MasterWrite, ram_end) {
-        return Err(AlStatusCode::INVALID_OUTPUT_CONFIG);
+    if let Some(fault) = process_sm_fault(sm2, rx_bytes, SmDirection::MasterWrite, ram_end) {
+        return Err(SmRefusal {
+            code: AlStatusCode::INVALID_OUTPUT_CONFIG,
+            sm: 2,
+            fault,
+        });
     }
-    if !process_sm_ok(sm3, desc.input_bytes(), SmDirection::MasterRead, ram_end) {
-        return Err(AlStatusCode::INVALID_INPUT_CONFIG);
+    if let Some(fault) = process_sm_fault(sm3, tx_bytes, SmDirection::MasterRead, ram_end) {
+        return Err(SmRefusal {
+            code: AlStatusCode::INVALID_INPUT_CONFIG,
+            sm: 3,
+            fault,
+        });
     }
     Ok(())
 }

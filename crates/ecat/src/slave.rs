@@ -1,7 +1,8 @@
 //! The slave: ESM + mailbox + CoE dispatch + process data, driven by `poll`.
 
-use crate::coe::{CoeConfig, CoeServer, Dictionary};
+use crate::coe::{service, CoeConfig, CoeHeader, CoeServer, Dictionary, COE_HEADER_LEN};
 use crate::desc::Device;
+use crate::emcy::{self, Emcy, EmcyQueue};
 use crate::esm::{self, MAX_MAILBOX_LEN, MAX_PDO_BYTES};
 use crate::mailbox::{next_counter, MailboxError, MailboxHeader, MailboxType, HEADER_LEN};
 use esc::regs::{self, al_event};
@@ -37,6 +38,9 @@ impl core::fmt::Display for StateChange {
 }
 
 static ZEROS: [u8; MAX_PDO_BYTES] = [0; MAX_PDO_BYTES];
+
+/// Emergencies the slave holds while the mailbox is busy (the oldest is dropped beyond).
+pub const EMCY_QUEUE: usize = 8;
 
 /// Mailbox state: the SM areas as configured at I→P, the request buffer and the
 /// last (or pending) response.
@@ -95,6 +99,10 @@ pub struct Slave {
     mbx: Mailbox,
     /// CoE server: SDO transfers and SDO Info fragments spanning mailbox messages.
     coe: CoeServer,
+    /// Emergencies waiting for a free SM1 (sent before the next response).
+    emcy: EmcyQueue<EMCY_QUEUE>,
+    /// Lengths of the assigned RxPDOs and TxPDOs (bytes), from the dictionary.
+    pdo_bytes: (usize, usize),
     out_len: usize,
     in_len: usize,
     out_start: u16,
@@ -126,6 +134,8 @@ impl Slave {
                 counter: 0,
             },
             coe: CoeServer::new(CoeConfig::from_details(desc.coe_details)),
+            emcy: EmcyQueue::new(),
+            pdo_bytes: (desc.output_bytes(), desc.input_bytes()),
             out_len: desc.output_bytes().min(MAX_PDO_BYTES),
             in_len: desc.input_bytes().min(MAX_PDO_BYTES),
             out_start: desc.outputs.start,
@@ -149,6 +159,17 @@ impl Slave {
     /// Current AL status code (0 = no error).
     pub fn al_status_code(&self) -> AlStatusCode {
         self.code
+    }
+
+    /// Queues an emergency (device fault, fault cleared, EoE error); it is sent
+    /// through the mailbox from Pre-Op on, before the next SDO response.
+    pub fn emergency(&mut self, e: Emcy) {
+        self.emcy.push(e);
+    }
+
+    /// Emergencies waiting to be sent.
+    pub fn emergencies_pending(&self) -> usize {
+        self.emcy.len()
     }
 
     /// Whether the AL status error indication is set.
@@ -192,6 +213,9 @@ impl Slave {
             self.started = true;
         }
         let events = pdi.al_event()?;
+        if let Some(bytes) = app.process_data_bytes() {
+            self.pdo_bytes = bytes;
+        }
         let change = if events & al_event::AL_CONTROL != 0 {
             self.al_control(pdi, now_ns)?
         } else {
@@ -267,8 +291,18 @@ impl Slave {
             }
             (AlState::PreOp, AlState::SafeOp) => {
                 let sms = [pdi.read_sm(0)?, pdi.read_sm(1)?, pdi.read_sm(2)?, pdi.read_sm(3)?];
-                if let Err(code) = esm::check_process_sms(self.desc, &sms) {
-                    return Ok(Err(code));
+                let (rx, tx) = self.pdo_bytes;
+                if let Err(refusal) = esm::check_process_sms(self.desc, &sms, rx, tx) {
+                    // E-028: EMCY A000h, error register = ESM state (Pre-Op = 2),
+                    // diag code 4·SM + fault (spec §8.4)
+                    let diag = emcy::diag_code(refusal.sm, refusal.fault);
+                    self.emcy.push(Emcy::state_transition(
+                        emcy::code::PREOP_TO_SAFEOP,
+                        2,
+                        diag,
+                        [0; 4],
+                    ));
+                    return Ok(Err(refusal.code));
                 }
                 if let Err(code) = self.check_watchdog(pdi)? {
                     return Ok(Err(code));
@@ -350,6 +384,12 @@ impl Slave {
             }
         }
         self.coe.tick(now_ns);
+        // emergencies go out first once SM1 is free (E-094: through the mailbox)
+        if !self.mbx.pending {
+            if let Some(e) = self.emcy.pop() {
+                self.queue_emcy(&e);
+            }
+        }
         // the next SDO Info fragment once the previous response has left
         if !self.mbx.pending && self.coe.has_fragments() {
             self.next_fragment(app);
@@ -404,6 +444,25 @@ impl Slave {
             }
         };
         m.queue(kind, len);
+    }
+
+    /// Puts an EMCY (CoE service 1) into `mbx.tx` (pending).
+    fn queue_emcy(&mut self, e: &Emcy) {
+        let m = &mut self.mbx;
+        let coe = CoeHeader {
+            number: 0,
+            service: service::EMERGENCY,
+        }
+        .to_bytes();
+        let Some(body) =
+            m.tx.get_mut(HEADER_LEN..HEADER_LEN + COE_HEADER_LEN + emcy::EMCY_LEN)
+        else {
+            return;
+        };
+        for (dst, src) in body.iter_mut().zip(coe.into_iter().chain(e.to_bytes())) {
+            *dst = src;
+        }
+        m.queue(MailboxType::Coe, COE_HEADER_LEN + emcy::EMCY_LEN);
     }
 
     /// Puts the next SDO Info fragment into `mbx.tx` (pending).

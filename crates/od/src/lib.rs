@@ -165,9 +165,97 @@ pub struct EntryInfo {
 }
 
 impl EntryInfo {
+    /// An entry without range, default 0, no unit, not persistent.
+    pub const fn new(sub: u8, name: &'static str, data_type: DataType, access: Access) -> Self {
+        Self {
+            sub,
+            name,
+            data_type,
+            access,
+            min: None,
+            max: None,
+            default: 0,
+            unit: "",
+            persistent: false,
+        }
+    }
+
+    /// With the accepted range `min..=max`.
+    pub const fn range(mut self, min: i64, max: i64) -> Self {
+        self.min = Some(min);
+        self.max = Some(max);
+        self
+    }
+
+    /// With the default value `value`.
+    pub const fn default_value(mut self, value: i64) -> Self {
+        self.default = value;
+        self
+    }
+
+    /// With the unit `unit`.
+    pub const fn unit(mut self, unit: &'static str) -> Self {
+        self.unit = unit;
+        self
+    }
+
+    /// Persistent: saved by "save values" and restored at start-up.
+    pub const fn saved(mut self) -> Self {
+        self.persistent = true;
+        self
+    }
+
+    /// RxPDO-mappable.
+    pub const fn rx(mut self) -> Self {
+        self.access = self.access.with(Access::RXPDO);
+        self
+    }
+
+    /// TxPDO-mappable.
+    pub const fn tx(mut self) -> Self {
+        self.access = self.access.with(Access::TXPDO);
+        self
+    }
+
+    /// The same entry at subindex `sub`.
+    pub const fn at(mut self, sub: u8) -> Self {
+        self.sub = sub;
+        self
+    }
+
     /// Size in bits.
     pub const fn bit_len(&self) -> u16 {
         self.data_type.bits()
+    }
+
+    /// Lowest accepted value: the declared minimum, else the type's.
+    pub const fn lowest(&self) -> i64 {
+        match self.min {
+            Some(m) => m,
+            None => self.data_type.min_value(),
+        }
+    }
+
+    /// Highest accepted value: the declared maximum, else the type's.
+    pub const fn highest(&self) -> i64 {
+        match self.max {
+            Some(m) => m,
+            None => self.data_type.max_value(),
+        }
+    }
+
+    /// Checks a decoded integer value against the range: 0609 0032h below,
+    /// 0609 0031h above. REAL32 and strings are not range-checked.
+    pub const fn check_range(&self, value: i64) -> Result<(), SdoAbort> {
+        if !self.data_type.is_integer() {
+            Ok(())
+        } else if value < self.lowest() {
+            Err(SdoAbort::VALUE_TOO_LOW)
+        } else if value > self.highest() {
+            Err(SdoAbort::VALUE_TOO_HIGH)
+        } else {
+            Ok(())
+        }
     }
 }
 
@@ -214,4 +302,18 @@ pub trait Dictionary {
 
     /// Writes `data` to `index`:`sub`.
     fn write(&mut self, index: u16, sub: u8, data: &[u8], state: CommState) -> Result<(), SdoAbort>;
+
+    /// The lengths in bytes of the currently mapped process data: (RxPDO =
+    /// outputs = SM2, TxPDO = inputs = SM3), the sums of the entries of the
+    /// PDOs assigned in 1C12h/1C13h. `None`: the dictionary has no PDO
+    /// objects (the stack then uses its device description).
+    fn process_data_bytes(&self) -> Option<(usize, usize)> {
+        None
+    }
+
+    /// Is the SDO Information service available? (Spec §7: only with the
+    /// "EtherCAT Rx SDO Info" template.)
+    fn sdo_info_enabled(&self) -> bool {
+        true
+    }
 }

@@ -1,0 +1,682 @@
+//! [`DriveObjects`]: the values of the declaration in [`crate::objects`] and
+//! the CoE access rules (spec §6.5 abort codes, §5 PDO mapping/assignment,
+//! §2.4 visibility, §2.5 save/restore).
+//!
+//! Subindex numbering: the bus side ([`od::Dictionary`]) uses the active
+//! [`Template`]; the runtime side ([`DriveObjects::get`], [`DriveObjects::set`],
+//! [`LiveValues`]) always uses the "EtherCAT Rx SDO Info" numbering
+//! (element + 1 for manufacturer arrays), so it does not change with the
+//! template.
+
+use crate::objects::{self, enumeration, find, Object, Value, IMAGE_BYTES, INITIAL_IMAGE, OBJECTS, OFFSETS};
+use crate::{parameter_index, MAPPING_ENTRIES, SOFTWARE_BUILD};
+use od::{CommState, DataType, Dictionary, EntryInfo, ObjectInfo, SdoAbort};
+
+/// Signature written to 1010h:01 to save ("save", CiA 301).
+pub const SAVE_SIGNATURE: u32 = 0x6576_6173;
+/// Signature written to 1011h:01 to restore defaults ("load", CiA 301).
+pub const LOAD_SIGNATURE: u32 = 0x6461_6F6C;
+/// Longest PDO in bits: 24 entries of 32 bits (spec §5.3, inference).
+pub const MAX_PDO_BITS: u32 = MAPPING_ENTRIES as u32 * 32;
+
+/// The subindex template of manufacturer arrays and records (spec §2.6).
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum Template {
+    /// "EtherCAT Rx": subindex = element number; no SDO Info.
+    Rx,
+    /// "EtherCAT Rx SDO Info": subindex = element number + 1 (default).
+    SdoInfo,
+}
+
+/// Revision number 1018h:03 in `template` (E-008): the software build
+/// number shifted left by one, bit 0 = 1 for "EtherCAT Rx SDO Info".
+/// [`SOFTWARE_BUILD`] is the revision of the default template.
+pub const fn revision(template: Template) -> u32 {
+    (SOFTWARE_BUILD & !1)
+        | match template {
+            Template::Rx => 0,
+            Template::SdoInfo => 1,
+        }
+}
+const _: () = assert!(
+    SOFTWARE_BUILD & 1 == 1,
+    "SOFTWARE_BUILD is the SDO-Info template revision"
+);
+
+/// Requests for the runtime, set by bus writes, cleared by
+/// [`DriveObjects::take_requests`].
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
+pub struct Requests {
+    /// Save the persistent values ([`DriveObjects::persistent_image`]):
+    /// 1010h:01 = "save" or A00[0] = 1.
+    pub save: bool,
+    /// Restart the device: A09[0] = 1.
+    pub restart: bool,
+    /// 1011h:01 = "load" restored the defaults in RAM (the stored image is
+    /// unchanged until the next save).
+    pub defaults_restored: bool,
+}
+
+/// Why a persistent image was refused.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum ImageError {
+    /// The output buffer is shorter than [`PERSISTENT_IMAGE_BYTES`].
+    BufferTooSmall,
+    /// Wrong length, magic or template byte.
+    Malformed,
+    /// Saved by another declaration (layout hash differs).
+    ForeignLayout,
+}
+
+const IMAGE_MAGIC: [u8; 4] = *b"DOD1";
+const IMAGE_HEADER: usize = 12;
+/// Size of a persistent image: 12-byte header (magic "DOD1", layout hash
+/// u32, payload length u16, template u8, 0) + the persistent values.
+pub const PERSISTENT_IMAGE_BYTES: usize = IMAGE_HEADER + objects::PERSISTENT_BYTES;
+
+/// Values owned by other parts of the firmware ([`Value::Live`] objects):
+/// the statusword, actual values, error register, diagnosis history, ESM
+/// state… A provider answers what it owns and returns `None` for the rest,
+/// which the dictionary then answers from its RAM image (where the runtime
+/// may also push values with [`DriveObjects::set`]). Indices and subindices
+/// use the "EtherCAT Rx SDO Info" numbering.
+pub trait LiveValues {
+    /// Reads `index`:`sub` into `buf`: `Some(byte count or abort)` if owned.
+    fn read(&mut self, index: u16, sub: u8, buf: &mut [u8]) -> Option<Result<usize, SdoAbort>> {
+        let _ = (index, sub, buf);
+        None
+    }
+
+    /// A checked write (access, size, range) to a live entry, before the
+    /// dictionary stores it in its RAM image; an error refuses the write.
+    fn write(&mut self, index: u16, sub: u8, data: &[u8]) -> Result<(), SdoAbort> {
+        let _ = (index, sub, data);
+        Ok(())
+    }
+}
+
+/// No live-value provider: live entries answer from the RAM image.
+#[derive(Debug, Default, Clone, Copy)]
+pub struct NoLive;
+impl LiveValues for NoLive {}
+
+/// An entry: object position in [`OBJECTS`], entry position in its
+/// "EtherCAT Rx SDO Info" entries.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+struct Loc {
+    obj: usize,
+    pos: usize,
+}
+
+impl Loc {
+    fn object(self) -> Result<&'static Object, SdoAbort> {
+        OBJECTS.get(self.obj).ok_or(SdoAbort::NO_OBJECT)
+    }
+
+    fn entry(self) -> Result<&'static EntryInfo, SdoAbort> {
+        self.object()?
+            .info
+            .entries
+            .get(self.pos)
+            .ok_or(SdoAbort::NO_SUBINDEX)
+    }
+
+    /// Byte range of the entry in the RAM image.
+    fn slot(self) -> Result<core::ops::Range<usize>, SdoAbort> {
+        let o = self.object()?;
+        let base = usize::from(*OFFSETS.get(self.obj).ok_or(SdoAbort::NO_OBJECT)?);
+        let before: usize = o
+            .info
+            .entries
+            .iter()
+            .take(self.pos)
+            .map(|e| e.data_type.bytes())
+            .sum();
+        let at = base + before;
+        Ok(at..at + self.entry()?.data_type.bytes())
+    }
+}
+
+/// The entry `index`:`sub` in "EtherCAT Rx SDO Info" numbering, visible or not.
+fn canonical(index: u16, sub: u8) -> Result<Loc, SdoAbort> {
+    let (obj, o) = find(index).ok_or(SdoAbort::NO_OBJECT)?;
+    let pos = o
+        .info
+        .entries
+        .iter()
+        .position(|e| e.sub == sub)
+        .ok_or(SdoAbort::NO_SUBINDEX)?;
+    Ok(Loc { obj, pos })
+}
+
+/// Where the value of `loc` lives: the entry itself or, for mirrors and
+/// aliases, the target entry.
+fn follow(loc: Loc) -> Result<Loc, SdoAbort> {
+    match loc.object()?.value {
+        Value::Mirror { index, sub0 } if loc.pos > 0 || sub0 => {
+            let (obj, _) = find(index).ok_or(SdoAbort::NO_OBJECT)?;
+            Ok(Loc { obj, pos: loc.pos })
+        }
+        Value::Alias(list) => match list.get(loc.pos) {
+            Some(&(index, sub)) if index != 0 => canonical(index, sub),
+            _ => Ok(loc),
+        },
+        _ => Ok(loc),
+    }
+}
+
+/// Does `loc` have a slot in the RAM image?
+fn in_ram(loc: Loc) -> Result<bool, SdoAbort> {
+    Ok(matches!(loc.object()?.value, Value::Ram | Value::Live))
+}
+
+fn put(buf: &mut [u8], data: &[u8]) -> Result<usize, SdoAbort> {
+    buf.get_mut(..data.len())
+        .ok_or(SdoAbort::OUT_OF_MEMORY)?
+        .copy_from_slice(data);
+    Ok(data.len())
+}
+
+/// The drive's object dictionary: the RAM image of every value, the active
+/// template and the requests for the runtime. Implements [`od::Dictionary`]
+/// (live entries from the RAM image; see [`DriveObjects::with_live`]).
+#[derive(Debug, Clone, PartialEq, Eq)]
+pub struct DriveObjects {
+    image: [u8; IMAGE_BYTES],
+    template: Template,
+    requests: Requests,
+}
+
+impl Default for DriveObjects {
+    fn default() -> Self {
+        Self::new()
+    }
+}
+
+/// [`DriveObjects`] with a [`LiveValues`] provider, as the CoE server sees it.
+#[derive(Debug)]
+pub struct WithLive<'a, L: LiveValues> {
+    /// The dictionary.
+    pub objects: &'a mut DriveObjects,
+    /// The provider of live values.
+    pub live: &'a mut L,
+}
+
+impl DriveObjects {
+    /// Every value at its default, template "EtherCAT Rx SDO Info".
+    pub const fn new() -> Self {
+        Self {
+            image: INITIAL_IMAGE,
+            template: Template::SdoInfo,
+            requests: Requests {
+                save: false,
+                restart: false,
+                defaults_restored: false,
+            },
+        }
+    }
+
+    /// This dictionary with `live` answering the live entries.
+    pub fn with_live<'a, L: LiveValues>(&'a mut self, live: &'a mut L) -> WithLive<'a, L> {
+        WithLive { objects: self, live }
+    }
+
+    /// The active subindex template.
+    pub fn template(&self) -> Template {
+        self.template
+    }
+
+    /// Switches the subindex template (a configuration setting of the
+    /// device; it changes 1018h:03, the addressing of manufacturer arrays and
+    /// the availability of SDO Info at once; the SII/ESI must follow).
+    pub fn set_template(&mut self, template: Template) {
+        self.template = template;
+    }
+
+    /// The requests set since the last call, cleared.
+    pub fn take_requests(&mut self) -> Requests {
+        core::mem::take(&mut self.requests)
+    }
+
+    /// The requests set since the last [`take_requests`](Self::take_requests).
+    pub fn requests(&self) -> Requests {
+        self.requests
+    }
+
+    /// The access level of CoE accesses, A10[2] (E-017).
+    pub fn access_level(&self) -> u8 {
+        self.get(parameter_index(0, 10), 3).map_or(0, |v| v as u8)
+    }
+
+    fn visible(&self, o: &Object) -> bool {
+        o.level <= self.access_level()
+    }
+
+    fn sdo_info(&self) -> bool {
+        self.template == Template::SdoInfo
+    }
+
+    /// The visible entry `index`:`sub` in the active template.
+    fn locate(&self, index: u16, sub: u8) -> Result<Loc, SdoAbort> {
+        let (obj, o) = find(index).ok_or(SdoAbort::NO_OBJECT)?;
+        if !self.visible(o) {
+            return Err(SdoAbort::NO_OBJECT);
+        }
+        let rx_view = !self.sdo_info() && o.rx.is_some();
+        let view = o.view(self.sdo_info());
+        let p = view
+            .entries
+            .iter()
+            .position(|e| e.sub == sub)
+            .ok_or(SdoAbort::NO_SUBINDEX)?;
+        Ok(Loc {
+            obj,
+            pos: if rx_view { p + 1 } else { p },
+        })
+    }
+
+    fn ram(&self, loc: Loc) -> Result<&[u8], SdoAbort> {
+        self.image.get(loc.slot()?).ok_or(SdoAbort::GENERAL)
+    }
+
+    /// The value of a target entry (after [`follow`]) from RAM or declaration.
+    fn read_loc(&self, loc: Loc, buf: &mut [u8]) -> Result<usize, SdoAbort> {
+        let o = loc.object()?;
+        let e = loc.entry()?;
+        match o.value {
+            Value::Ram | Value::Live => {
+                let raw = self.ram(loc)?;
+                let len = match e.data_type {
+                    DataType::VisibleString(_) => raw.iter().position(|&b| b == 0).unwrap_or(raw.len()),
+                    _ => raw.len(),
+                };
+                put(buf, raw.get(..len).ok_or(SdoAbort::GENERAL)?)
+            }
+            Value::Text(s) => put(buf, s.as_bytes()),
+            Value::Identity if e.sub == 3 => e.data_type.encode(i64::from(revision(self.template)), buf),
+            _ if e.data_type.is_string() => Ok(0),
+            _ => e.data_type.encode(e.default, buf),
+        }
+    }
+
+    /// The integer value of `index`:`sub` ("EtherCAT Rx SDO Info" numbering,
+    /// aliases followed; live entries as last set in the RAM image).
+    pub fn get(&self, index: u16, sub: u8) -> Result<i64, SdoAbort> {
+        let loc = follow(canonical(index, sub)?)?;
+        let t = loc.entry()?.data_type;
+        let mut buf = [0u8; 8];
+        let n = self.read_loc(loc, &mut buf)?;
+        t.decode(buf.get(..n).ok_or(SdoAbort::GENERAL)?)
+    }
+
+    /// Sets `index`:`sub` from the runtime (statusword, actual values, ESM
+    /// state, …): no access, state or level check, only the type's bounds.
+    /// "EtherCAT Rx SDO Info" numbering; entries without a RAM slot
+    /// (constants) answer 0601 0002h.
+    pub fn set(&mut self, index: u16, sub: u8, value: i64) -> Result<(), SdoAbort> {
+        let loc = follow(canonical(index, sub)?)?;
+        let t = loc.entry()?.data_type;
+        if !t.is_integer() && t != DataType::F32 {
+            return Err(SdoAbort::TYPE_MISMATCH);
+        }
+        if t.is_integer() && (value < t.min_value() || value > t.max_value()) {
+            return Err(if value < t.min_value() {
+                SdoAbort::VALUE_TOO_LOW
+            } else {
+                SdoAbort::VALUE_TOO_HIGH
+            });
+        }
+        let mut raw = [0u8; 8];
+        let n = t.encode(value, &mut raw)?;
+        self.set_bytes(index, sub, raw.get(..n).ok_or(SdoAbort::GENERAL)?)
+    }
+
+    /// Sets `index`:`sub` from raw little-endian bytes or string bytes (e.g.
+    /// the A257 texts), like [`set`](Self::set); strings shorter than the
+    /// entry are padded with 0.
+    pub fn set_bytes(&mut self, index: u16, sub: u8, data: &[u8]) -> Result<(), SdoAbort> {
+        let loc = follow(canonical(index, sub)?)?;
+        if !in_ram(loc)? {
+            return Err(SdoAbort::READ_ONLY);
+        }
+        loc.entry()?.data_type.check_len(data.len())?;
+        self.store(loc, data)
+    }
+
+    fn store(&mut self, loc: Loc, data: &[u8]) -> Result<(), SdoAbort> {
+        let slot = self.image.get_mut(loc.slot()?).ok_or(SdoAbort::GENERAL)?;
+        slot.fill(0);
+        slot.get_mut(..data.len())
+            .ok_or(SdoAbort::LENGTH_TOO_HIGH)?
+            .copy_from_slice(data);
+        Ok(())
+    }
+
+    fn read_with<L: LiveValues>(
+        &self,
+        live: &mut L,
+        index: u16,
+        sub: u8,
+        buf: &mut [u8],
+    ) -> Result<usize, SdoAbort> {
+        let loc = self.locate(index, sub)?;
+        if !loc.entry()?.access.readable() {
+            return Err(SdoAbort::WRITE_ONLY);
+        }
+        let target = follow(loc)?;
+        let o = target.object()?;
+        if o.value == Value::Live {
+            if let Some(r) = live.read(o.info.index, target.entry()?.sub, buf) {
+                return r;
+            }
+        }
+        self.read_loc(target, buf)
+    }
+
+    fn write_with<L: LiveValues>(
+        &mut self,
+        live: &mut L,
+        index: u16,
+        sub: u8,
+        data: &[u8],
+        state: CommState,
+    ) -> Result<(), SdoAbort> {
+        let loc = self.locate(index, sub)?;
+        let access = loc.entry()?.access;
+        if !access.writable() {
+            return Err(SdoAbort::READ_ONLY);
+        }
+        if !access.writable_in(state.access_bit()) {
+            return Err(SdoAbort::DEVICE_STATE);
+        }
+        let target = follow(loc)?;
+        let (o, e) = (target.object()?, target.entry()?);
+        e.data_type.check_len(data.len())?;
+        let value = if e.data_type.is_string() {
+            None
+        } else {
+            Some(e.data_type.decode(data)?)
+        };
+        if let Some(v) = value {
+            self.check_consistency(o, e, v)?;
+            e.check_range(v)?;
+            if let Some(list) = enumeration(o.info.index, e.sub) {
+                if !list.contains(&v) {
+                    return Err(SdoAbort::INVALID_VALUE);
+                }
+            }
+        }
+        if o.value == Value::Live {
+            live.write(o.info.index, e.sub, data)?;
+        }
+        match (o.value, o.info.index) {
+            (Value::Command, 0x1010) => self.requests.save = true,
+            (Value::Command, _) => {
+                self.restore_defaults();
+                self.requests.defaults_restored = true;
+            }
+            _ => {
+                self.store(target, data)?;
+                self.side_effects(o.info.index, e.sub, value);
+            }
+        }
+        Ok(())
+    }
+
+    /// Object-specific checks of a write of `v` to entry `e` of `o`, before
+    /// the range check: PDO mapping (§5.3), PDO assignment, command
+    /// signatures.
+    fn check_consistency(&self, o: &Object, e: &EntryInfo, v: i64) -> Result<(), SdoAbort> {
+        let index = o.info.index;
+        match (index, o.value) {
+            (0x1010, Value::Command) if v != i64::from(SAVE_SIGNATURE) => Err(SdoAbort::TRANSFER),
+            (0x1011, Value::Command) if v != i64::from(LOAD_SIGNATURE) => Err(SdoAbort::TRANSFER),
+            (0x1600..=0x1603 | 0x1A00..=0x1A03, _) => {
+                let rx = index < 0x1A00;
+                if e.sub == 0 {
+                    // the count is checked against the entries (CiA 301 step d)
+                    let n = u8::try_from(v).map_err(|_| SdoAbort::PDO_LENGTH)?;
+                    if n > MAPPING_ENTRIES {
+                        return Err(SdoAbort::PDO_LENGTH);
+                    }
+                    let mut bits = 0;
+                    for s in 1..=n {
+                        bits += self.mapped_bits(self.get(index, s)? as u32, rx)?;
+                    }
+                    if bits > MAX_PDO_BITS {
+                        return Err(SdoAbort::PDO_LENGTH);
+                    }
+                    Ok(())
+                } else if self.get(index, 0)? != 0 {
+                    // entries change only while sub 0 = 0 (CiA 301 step b)
+                    Err(SdoAbort::DEVICE_STATE)
+                } else {
+                    self.mapped_bits(v as u32, rx).map(|_| ())
+                }
+            }
+            (0x1C12 | 0x1C13, _) => {
+                let pdos = if index == 0x1C12 {
+                    0x1600..=0x1603
+                } else {
+                    0x1A00..=0x1A03
+                };
+                if e.sub == 0 {
+                    if v > 4 {
+                        return Err(SdoAbort::VALUE_TOO_HIGH);
+                    }
+                    for s in 1..=(v as u8) {
+                        let pdo = self.get(index, s)?;
+                        let twice = (1..s).any(|t| self.get(index, t).ok() == Some(pdo));
+                        if !pdos.contains(&pdo) || twice {
+                            return Err(SdoAbort::PARAMETER_INCOMPATIBLE);
+                        }
+                    }
+                    Ok(())
+                } else if self.get(index, 0)? != 0 {
+                    Err(SdoAbort::DEVICE_STATE)
+                } else if v != 0 && !pdos.contains(&v) {
+                    Err(SdoAbort::PARAMETER_INCOMPATIBLE)
+                } else {
+                    Ok(())
+                }
+            }
+            _ => Ok(()),
+        }
+    }
+
+    /// Bits of mapping entry `m` (index << 16 | sub << 8 | bits) in a PDO of
+    /// direction `rx`: index 0 is a gap of `bits`; otherwise the entry must
+    /// exist, be visible and mappable in that direction (0604 0041h) and
+    /// have that bit length (0604 0043h).
+    fn mapped_bits(&self, m: u32, rx: bool) -> Result<u32, SdoAbort> {
+        let (index, sub, bits) = ((m >> 16) as u16, (m >> 8) as u8, m & 0xFF);
+        if index == 0 {
+            return Ok(bits);
+        }
+        let e = self
+            .locate(index, sub)
+            .and_then(Loc::entry)
+            .map_err(|_| SdoAbort::NOT_MAPPABLE)?;
+        let mappable = if rx {
+            e.access.rx_mappable()
+        } else {
+            e.access.tx_mappable()
+        };
+        if !mappable {
+            Err(SdoAbort::NOT_MAPPABLE)
+        } else if u32::from(e.bit_len()) != bits {
+            Err(SdoAbort::PARAMETER_INCOMPATIBLE)
+        } else {
+            Ok(bits)
+        }
+    }
+
+    /// Actions started by a write: A00[0] = 1 save, A09[0] = 1 restart.
+    fn side_effects(&mut self, index: u16, sub: u8, value: Option<i64>) {
+        match (index, sub, value) {
+            (0x2000, 1, Some(1)) => self.requests.save = true,
+            (0x2009, 1, Some(1)) => self.requests.restart = true,
+            _ => {}
+        }
+    }
+
+    /// The byte ranges of the persistent values, in declaration order.
+    fn persistent_slots() -> impl Iterator<Item = core::ops::Range<usize>> {
+        OBJECTS.iter().enumerate().flat_map(|(obj, o)| {
+            let ram = matches!(o.value, Value::Ram | Value::Live);
+            o.info
+                .entries
+                .iter()
+                .enumerate()
+                .filter(move |(_, e)| ram && e.persistent)
+                .filter_map(move |(pos, _)| Loc { obj, pos }.slot().ok())
+        })
+    }
+
+    /// Writes the persistent values into `out` (header + values, see
+    /// [`PERSISTENT_IMAGE_BYTES`]) for the non-volatile store; returns the
+    /// byte count.
+    pub fn persistent_image(&self, out: &mut [u8]) -> Result<usize, ImageError> {
+        let out = out
+            .get_mut(..PERSISTENT_IMAGE_BYTES)
+            .ok_or(ImageError::BufferTooSmall)?;
+        let (header, mut payload) = out.split_at_mut(IMAGE_HEADER);
+        let len = (objects::PERSISTENT_BYTES as u16).to_le_bytes();
+        let hash = objects::LAYOUT_HASH.to_le_bytes();
+        let [m0, m1, m2, m3] = IMAGE_MAGIC;
+        let [h0, h1, h2, h3] = hash;
+        let t = u8::from(self.template == Template::SdoInfo);
+        header.copy_from_slice(&[m0, m1, m2, m3, h0, h1, h2, h3, len[0], len[1], t, 0]);
+        for slot in Self::persistent_slots() {
+            let n = slot.len();
+            let src = self.image.get(slot).ok_or(ImageError::Malformed)?;
+            let (dst, rest) = payload.split_at_mut(n.min(payload.len()));
+            dst.copy_from_slice(src.get(..dst.len()).ok_or(ImageError::Malformed)?);
+            payload = rest;
+        }
+        Ok(PERSISTENT_IMAGE_BYTES)
+    }
+
+    /// Loads an image made by [`persistent_image`](Self::persistent_image) of
+    /// the same declaration; anything else is refused and changes nothing.
+    pub fn load_persistent(&mut self, data: &[u8]) -> Result<(), ImageError> {
+        if data.len() != PERSISTENT_IMAGE_BYTES {
+            return Err(ImageError::Malformed);
+        }
+        let (header, mut payload) = data.split_at(IMAGE_HEADER);
+        let template = match header {
+            [m0, m1, m2, m3, _, _, _, _, l0, l1, t, 0]
+                if [*m0, *m1, *m2, *m3] == IMAGE_MAGIC
+                    && usize::from(u16::from_le_bytes([*l0, *l1])) == objects::PERSISTENT_BYTES =>
+            {
+                match t {
+                    0 => Template::Rx,
+                    1 => Template::SdoInfo,
+                    _ => return Err(ImageError::Malformed),
+                }
+            }
+            _ => return Err(ImageError::Malformed),
+        };
+        if header.get(4..8) != Some(&objects::LAYOUT_HASH.to_le_bytes()[..]) {
+            return Err(ImageError::ForeignLayout);
+        }
+        for slot in Self::persistent_slots() {
+            let (src, rest) = payload.split_at(slot.len().min(payload.len()));
+            if let Some(dst) = self.image.get_mut(slot) {
+                dst.copy_from_slice(src);
+            }
+            payload = rest;
+        }
+        self.template = template;
+        Ok(())
+    }
+
+    /// Sets every persistent value back to its default in RAM (1011h, CiA
+    /// 301 "restore default parameters"; the stored image changes with the
+    /// next save). Live and set-point values are untouched.
+    pub fn restore_defaults(&mut self) {
+        for slot in Self::persistent_slots() {
+            if let (Some(dst), Some(src)) = (self.image.get_mut(slot.clone()), INITIAL_IMAGE.get(slot)) {
+                dst.copy_from_slice(src);
+            }
+        }
+    }
+
+    /// The PDOs assigned in `assign` (1C12h or 1C13h), in order.
+    pub fn assigned_pdos(&self, assign: u16) -> impl Iterator<Item = u16> + '_ {
+        let n = self.get(assign, 0).unwrap_or(0).clamp(0, 4) as u8;
+        (1..=n).filter_map(move |s| self.get(assign, s).ok().map(|v| v as u16))
+    }
+
+    /// The mapping entries (index << 16 | sub << 8 | bits) of PDO `pdo`.
+    pub fn mapping(&self, pdo: u16) -> impl Iterator<Item = u32> + '_ {
+        let n = self.get(pdo, 0).unwrap_or(0).clamp(0, i64::from(MAPPING_ENTRIES)) as u8;
+        (1..=n).filter_map(move |s| self.get(pdo, s).ok().map(|v| v as u32))
+    }
+
+    fn sm_bytes(&self, assign: u16) -> usize {
+        let bits: u32 = self
+            .assigned_pdos(assign)
+            .flat_map(|pdo| self.mapping(pdo))
+            .map(|m| m & 0xFF)
+            .sum();
+        (bits as usize).div_ceil(8)
+    }
+
+    fn object_info(&self, o: &'static Object) -> Option<&'static ObjectInfo> {
+        self.visible(o).then(|| o.view(self.sdo_info()))
+    }
+}
+
+impl Dictionary for DriveObjects {
+    fn object(&self, index: u16) -> Option<&'static ObjectInfo> {
+        find(index).and_then(|(_, o)| self.object_info(o))
+    }
+
+    fn next_object(&self, after: Option<u16>) -> Option<&'static ObjectInfo> {
+        let start = after.map_or(0, |a| OBJECTS.partition_point(|o| o.info.index <= a));
+        OBJECTS.get(start..)?.iter().find_map(|o| self.object_info(o))
+    }
+
+    fn read(&mut self, index: u16, sub: u8, buf: &mut [u8], _state: CommState) -> Result<usize, SdoAbort> {
+        self.read_with(&mut NoLive, index, sub, buf)
+    }
+
+    fn write(&mut self, index: u16, sub: u8, data: &[u8], state: CommState) -> Result<(), SdoAbort> {
+        self.write_with(&mut NoLive, index, sub, data, state)
+    }
+
+    fn process_data_bytes(&self) -> Option<(usize, usize)> {
+        Some((self.sm_bytes(0x1C12), self.sm_bytes(0x1C13)))
+    }
+
+    fn sdo_info_enabled(&self) -> bool {
+        self.sdo_info()
+    }
+}
+
+impl<L: LiveValues> Dictionary for WithLive<'_, L> {
+    fn object(&self, index: u16) -> Option<&'static ObjectInfo> {
+        self.objects.object(index)
+    }
+
+    fn next_object(&self, after: Option<u16>) -> Option<&'static ObjectInfo> {
+        self.objects.next_object(after)
+    }
+
+    fn read(&mut self, index: u16, sub: u8, buf: &mut [u8], _state: CommState) -> Result<usize, SdoAbort> {
+        self.objects.read_with(self.live, index, sub, buf)
+    }
+
+    fn write(&mut self, index: u16, sub: u8, data: &[u8], state: CommState) -> Result<(), SdoAbort> {
+        self.objects.write_with(self.live, index, sub, data, state)
+    }
+
+    fn process_data_bytes(&self) -> Option<(usize, usize)> {
+        self.objects.process_data_bytes()
+    }
+
+    fn sdo_info_enabled(&self) -> bool {
+        self.objects.sdo_info_enabled()
+    }
+}

@@ -1,0 +1,530 @@
+//! Manufacturer parameters at 2000h + group·200h + line (spec §2.6, E-009);
+//! per-axis parameters also at +8000h (E-010), derived in [`super::OBJECTS`].
+//!
+//! Simple parameters use sub 0 in both templates (E-011); arrays and records
+//! are declared by their elements (subindex = element number, template
+//! "EtherCAT Rx", E-012) and get the "EtherCAT Rx SDO Info" view (element +
+//! 1, E-013) derived. The parameters are those of spec §20 that are reachable
+//! over CoE (lines < 512) and the ones the stack needs; where the spec gives
+//! no type or range, the note says what was assumed. Levels: the access level
+//! (A10[2]) needed to see a parameter (E-016).
+
+use super::{comm, repeat, Object, Value};
+use crate::{parameter_index, DEVICE_NAME, HARDWARE_VERSION, SOFTWARE_VERSION};
+use od::DataType::{Bool, VisibleString, I32, U16, U32, U8};
+use od::{Access, DataType, EntryInfo, ObjectCode::*, ObjectInfo};
+
+const RO: Access = Access::RO;
+const RW: Access = Access::RW;
+const RW_PREOP: Access = Access::RW_PREOP;
+const fn e(sub: u8, name: &'static str, t: DataType, a: Access) -> EntryInfo {
+    EntryInfo::new(sub, name, t, a)
+}
+/// Group A parameter `line`.
+const fn a(line: u16) -> u16 {
+    parameter_index(0, line)
+}
+/// Group E parameter `line`.
+const fn e_(line: u16) -> u16 {
+    parameter_index(4, line)
+}
+
+/// An action parameter (A00, A09, A37, A287): [0] start, [1] progress, [2] result.
+const ACTION: &[EntryInfo] = &[
+    e(0, "Start", U8, RW).range(0, 1),
+    e(1, "Progress", U8, RO).unit("%"),
+    e(2, "Result", U8, RO),
+];
+
+/// Elements `1..=N` of `entries` renumbered from 0 (a mirror of a standard
+/// object as a manufacturer array, e.g. A264 = 1C32h:01…).
+const fn elements_of<const N: usize>(entries: &[EntryInfo]) -> [EntryInfo; N] {
+    let mut out = [e(0, "", U8, RO); N];
+    let mut i = 0;
+    while i < N {
+        // i + 1 < entries.len() or compile error (compile-time evaluation)
+        #[allow(clippy::indexing_slicing)]
+        {
+            out[i] = entries[i + 1].at(i as u8);
+        }
+        i += 1;
+    }
+    out
+}
+
+const MAPPING_RX_VIEW: [EntryInfo; 24] = repeat(e(0, "", U32, RW_PREOP).saved(), 0, &comm::APP_OBJECT);
+const MAPPING_RX_VIEW_RO: [EntryInfo; 24] = repeat(e(0, "", U32, RO), 0, &comm::APP_OBJECT);
+const ASSIGN_RX_VIEW: [EntryInfo; 4] = repeat(
+    e(0, "", U16, RW_PREOP).saved(),
+    0,
+    &[
+        "Assigned PDO 1",
+        "Assigned PDO 2",
+        "Assigned PDO 3",
+        "Assigned PDO 4",
+    ],
+);
+
+/// A parameter mirroring a standard array entry by entry, sub 0 included
+/// (A225 ≡ 1600h: A225[e] = 1600h:e+1, A225:00 = 1600h:00 in the SDO Info
+/// template).
+macro_rules! mirror {
+    ($index:expr, $name:expr, $target:expr, $entries:expr, $rx:expr, $note:expr) => {{
+        const RX: &ObjectInfo = &ObjectInfo {
+            index: $index,
+            name: $name,
+            code: Array,
+            entries: $rx,
+        };
+        Object::new(
+            $index,
+            $name,
+            Array,
+            &$entries,
+            Value::Mirror {
+                index: $target,
+                sub0: true,
+            },
+        )
+        .rx_view(RX, RX)
+        .level(2)
+        .note($note)
+    }};
+}
+
+const fn string(s: &str) -> DataType {
+    VisibleString(s.len() as u16)
+}
+
+/// Global and axis-A manufacturer parameters, sorted by index.
+pub const PARAMS: [Object; 54] = [
+    param_array!(a(0), "Save values", Record, Value::Ram, from ACTION)
+        .note("A00; [0] = 1 requests saving (E-018); progress/result set by the store"),
+    param_array!(a(9), "Restart", Record, Value::Ram, from ACTION)
+        .level(1)
+        .note("A09; [0] = 1 requests a restart"),
+    param_array!(
+        a(10),
+        "Access level",
+        Array,
+        Value::Ram,
+        [
+            e(0, "Operating unit", U8, RW)
+                .range(0, 3)
+                .default_value(2)
+                .saved(),
+            e(1, "DS6", U8, RW).range(0, 3).default_value(2).saved(),
+            e(2, "CANopen and EtherCAT", U8, RW)
+                .range(0, 3)
+                .default_value(2)
+                .saved(),
+            e(3, "PROFINET", U8, RW).range(0, 3).default_value(2).saved(),
+        ]
+    )
+    .note("A10; [2] applies to CoE (E-017); element meanings of [1]/[3] assumed"),
+    Object::var(
+        a(29),
+        Value::Ram,
+        entries![e(0, "Quick stop on fault", U8, RW).range(0, 1).saved()],
+    )
+    .axis()
+    .level(1)
+    .note("A29; drive-based fault reaction: 0 inactive, 1 active"),
+    param_array!(a(37), "Reset memorised values", Record, Value::Ram, from ACTION)
+        .level(1)
+        .note("A37; action"),
+    Object::var(
+        a(67),
+        Value::Live,
+        entries![e(0, "Status word user-defined", U16, RO).tx()],
+    )
+    .axis()
+    .note("A67; bits from the sources in A66"),
+    Object::var(
+        a(69),
+        Value::Live,
+        entries![e(0, "Status word for actions", U16, RO).tx()],
+    )
+    .axis()
+    .level(1)
+    .note("A69; layout not in the spec (§22)"),
+    Object::var(
+        a(75),
+        Value::Ram,
+        entries![e(0, "Control byte for actions", U8, RW).rx()],
+    )
+    .axis()
+    .level(1)
+    .note("A75; bit 0 execute, bits 1–4 action selector (assumed, §14)"),
+    Object::var(
+        a(149),
+        Value::Ram,
+        entries![e(0, "Cycle sequence", U8, RW).range(0, 1).saved()],
+    )
+    .level(2)
+    .note("A149; 0 Rx→app→Tx, 1 Rx→Tx→app"),
+    Object::var(
+        a(150),
+        Value::Ram,
+        entries![e(0, "Cycle time", U16, RW).default_value(1000).unit("µs").saved()],
+    )
+    .level(1)
+    .note("A150; 250, 500, 1000, 2000, 4000, 8000 µs (type assumed UINT16 in µs)"),
+    Object::var(
+        a(166),
+        Value::Ram,
+        entries![e(0, "IP address reference", U8, RW)
+            .range(0, 2)
+            .default_value(2)
+            .saved()],
+    )
+    .level(2)
+    .note("A166; 2 = DHCP + DS6 (other codes assumed)"),
+    Object::var(a(175), Value::Ram, entries![e(0, "Gateway", U32, RW).saved()])
+        .level(2)
+        .note("A175; IPv4 address as DWORD (assumed)"),
+    param_array!(
+        a(199),
+        "SNTP settings",
+        Record,
+        Value::Ram,
+        [
+            e(0, "Active", U8, RW).range(0, 1).saved(),
+            e(1, "Server 1", U32, RW).saved(),
+            e(2, "Server 2", U32, RW).saved(),
+        ]
+    )
+    .level(2)
+    .note("A199; elements assumed (spec §10: two servers)"),
+    param_array!(
+        a(213),
+        "Fieldbus scaling",
+        Array,
+        Value::Ram,
+        [
+            e(0, "Process data", U8, RW).range(0, 1).default_value(1).saved(),
+            e(1, "Parameter channel", U8, RW)
+                .range(0, 1)
+                .default_value(1)
+                .saved(),
+        ]
+    )
+    .level(2)
+    .note("A213; 1 = native (default), 0 = integer with decimal places; element roles assumed"),
+    mirror!(
+        0x20E1,
+        "RxPDO 1 mapping",
+        0x1600,
+        comm::MAP_1600,
+        &MAPPING_RX_VIEW,
+        "A225 = 1600h"
+    ),
+    mirror!(
+        0x20E2,
+        "RxPDO 2 mapping",
+        0x1601,
+        comm::MAP_1601,
+        &MAPPING_RX_VIEW,
+        "A226 = 1601h"
+    ),
+    mirror!(
+        0x20E3,
+        "RxPDO 3 mapping",
+        0x1602,
+        comm::MAP_1602,
+        &MAPPING_RX_VIEW,
+        "A227 = 1602h"
+    ),
+    mirror!(
+        0x20E4,
+        "RxPDO 4 mapping",
+        0x1603,
+        comm::MAP_1603,
+        &MAPPING_RX_VIEW_RO,
+        "A228 = 1603h (FSoE)"
+    ),
+    mirror!(
+        0x20E9,
+        "TxPDO 1 mapping",
+        0x1A00,
+        comm::MAP_1A00,
+        &MAPPING_RX_VIEW,
+        "A233 = 1A00h"
+    ),
+    mirror!(
+        0x20EA,
+        "TxPDO 2 mapping",
+        0x1A01,
+        comm::MAP_1A01,
+        &MAPPING_RX_VIEW,
+        "A234 = 1A01h"
+    ),
+    mirror!(
+        0x20EB,
+        "TxPDO 3 mapping",
+        0x1A02,
+        comm::MAP_1A02,
+        &MAPPING_RX_VIEW,
+        "A235 = 1A02h"
+    ),
+    mirror!(
+        0x20EC,
+        "TxPDO 4 mapping",
+        0x1A03,
+        comm::MAP_1A03,
+        &MAPPING_RX_VIEW_RO,
+        "A236 = 1A03h (FSoE)"
+    ),
+    Object::var(
+        a(250),
+        Value::Alias(&[(0x10F3, 4)]),
+        entries![e(0, "New diagnosis messages available", Bool, RO).tx()],
+    )
+    .note("A250 = 10F3h:04"),
+    mirror!(
+        0x20FC,
+        "PDO assignment SM2",
+        0x1C12,
+        comm::ASSIGN_1C12,
+        &ASSIGN_RX_VIEW,
+        "A252 = 1C12h"
+    ),
+    mirror!(
+        0x20FD,
+        "PDO assignment SM3",
+        0x1C13,
+        comm::ASSIGN_1C13,
+        &ASSIGN_RX_VIEW,
+        "A253 = 1C13h"
+    ),
+    Object::var(
+        a(254),
+        Value::Live,
+        entries![e(0, "EtherCAT station alias", U16, RO)],
+    )
+    .level(1)
+    .note("A254; from the SII at Init→PreOp"),
+    Object::var(
+        a(255),
+        Value::Live,
+        entries![e(0, "EtherCAT device state", U8, RO)],
+    )
+    .note("A255; 1/2/4/8 = Init/PreOp/SafeOp/Op, +16 with error"),
+    Object::var(a(256), Value::Live, entries![e(0, "EtherCAT address", U16, RO)])
+        .level(1)
+        .note("A256; station address"),
+    param_array!(
+        a(257),
+        "EtherCAT diagnosis",
+        Array,
+        Value::Live,
+        [
+            e(0, "Error and links", VisibleString(16), RO),
+            e(1, "Link-lost counters", VisibleString(16), RO),
+            e(2, "Data-error counters", VisibleString(16), RO),
+            e(3, "AL status", VisibleString(16), RO),
+        ]
+    )
+    .note("A257; texts (spec §13.5)"),
+    Object::var(
+        a(258),
+        Value::Ram,
+        entries![e(0, "PDO timeout", U16, RW).unit("ms").saved()],
+    )
+    .level(1)
+    .note("A258; 0/65535 off, 65532–65534 special (spec §13.1)"),
+    param_array!(
+        a(259),
+        "EtherCAT SM watchdog",
+        Record,
+        Value::Live,
+        [
+            e(0, "Tolerated failure time", U16, RO).unit("ms"),
+            e(1, "State", U8, RO),
+            e(2, "Times triggered", U16, RO),
+        ]
+    )
+    .level(1)
+    .note("A259"),
+    param_array!(
+        a(261),
+        "Sync diagnostics",
+        Record,
+        Value::Live,
+        [
+            e(0, "Error code", U8, RO),
+            e(1, "Data to SYNC0", I32, RO).unit("µs"),
+            e(2, "Error counter", U32, RO),
+            e(3, "Reserved", U32, RO),
+        ]
+    )
+    .level(2)
+    .note("A261; element types assumed"),
+    param_array!(
+        a(264),
+        "Output SyncManager parameter",
+        Record,
+        Value::Mirror {
+            index: 0x1C32,
+            sub0: false
+        },
+        from & elements_of::<10>(&comm::SM_OUTPUT)
+    )
+    .level(2)
+    .note("A264 = 1C32h:01…20h"),
+    param_array!(
+        a(265),
+        "Input SyncManager parameter",
+        Record,
+        Value::Mirror {
+            index: 0x1C33,
+            sub0: false
+        },
+        from & elements_of::<10>(&comm::SM_INPUT)
+    )
+    .level(2)
+    .note("A265 = 1C33h:01…20h"),
+    param_array!(
+        a(268),
+        "SDO Info object selection",
+        Record,
+        Value::Ram,
+        [
+            e(0, "Index area", U8, RW).range(0, 2).default_value(2).saved(),
+            e(1, "Manufacturer groups", U32, RW)
+                .default_value(0x03FF_FFFF)
+                .saved(),
+        ]
+    )
+    .level(2)
+    .note("A268; encoding assumed (0 standard, 1 manufacturer, 2 all; bit per group A…Z); not applied yet"),
+    param_array!(a(287), "DC-Sync optimization", Record, Value::Ram, from ACTION)
+        .level(2)
+        .note("A287; action, results not stored (spec §22)"),
+    Object::var(
+        a(290),
+        Value::Ram,
+        entries![e(0, "PLL control", U8, RW).range(0, 1).default_value(1).saved()],
+    )
+    .level(2)
+    .note("A290; 1 = active"),
+    Object::var(
+        a(291),
+        Value::Ram,
+        entries![e(0, "PLC cycle time", U32, RW)
+            .default_value(1000)
+            .unit("µs")
+            .saved()],
+    )
+    .level(2)
+    .note("A291"),
+    Object::var(
+        a(292),
+        Value::Ram,
+        entries![e(0, "PLL phase offset", I32, RW)
+            .range(-8000, 8000)
+            .unit("µs")
+            .saved()],
+    )
+    .level(2)
+    .note("A292; unit µs assumed, at most one A150 cycle"),
+    Object::var(a(293), Value::Ram, entries![e(0, "PLL gain", U16, RW).saved()])
+        .level(3)
+        .note("A293; meaning unclear (spec §11.6), service level"),
+    Object::var(
+        a(296),
+        Value::Live,
+        entries![e(0, "Measured sync cycle time", U32, RO).unit("µs")],
+    )
+    .level(2)
+    .note("A296"),
+    Object::var(a(298), Value::Live, entries![e(0, "PLL status word", U16, RO)])
+        .level(2)
+        .note("A298; bits spec §11.6"),
+    Object::var(
+        a(310),
+        Value::Ram,
+        entries![e(0, "Decimal places velocity", U8, RW).range(0, 9).saved()],
+    )
+    .axis()
+    .level(2)
+    .note("A310; CiA 402 scaling (A213)"),
+    Object::var(
+        a(311),
+        Value::Ram,
+        entries![e(0, "Decimal places acceleration", U8, RW).range(0, 9).saved()],
+    )
+    .axis()
+    .level(2)
+    .note("A311"),
+    Object::var(e_(43), Value::Live, entries![e(0, "Event cause", U8, RO)]).note("E43; EMCY byte 5"),
+    Object::var(e_(48), Value::Live, entries![e(0, "Device state", U8, RO)])
+        .axis()
+        .note("E48; 2 ready to switch on, 4 enabled, 7 quick stop"),
+    Object::var(
+        e_(50),
+        Value::Alias(&[(0x1008, 0)]),
+        entries![e(0, "Device name", string(DEVICE_NAME), RO)],
+    )
+    .note("E50 = 1008h"),
+    param_array!(
+        e_(52),
+        "Device identification",
+        Record,
+        Value::Alias(&[(0, 0), (0, 0), (0x1009, 0), (0x1018, 4), (0x100A, 0)]),
+        [
+            e(0, "Identification", U32, RO),
+            e(1, "Hardware version", string(HARDWARE_VERSION), RO),
+            e(2, "Serial number", U32, RO),
+            e(3, "Software version", string(SOFTWARE_VERSION), RO),
+        ]
+    )
+    .note("E52; [1] = 1009h, [2] = 1018h:04, [3] = 100Ah; [0] not described (0)"),
+    param_array!(
+        e_(59),
+        "Projected fieldbus identification",
+        Array,
+        Value::Live,
+        [
+            e(0, "Element 0", U16, RO),
+            e(1, "Element 1", U16, RO),
+            e(2, "Fieldbus", U16, RO),
+        ]
+    )
+    .level(1)
+    .note("E59; [2] compared with E52[3] (Event 52 cause 15); type assumed"),
+    Object::var(
+        e_(72),
+        Value::Ram,
+        entries![e(0, "User configuration identification", VisibleString(16), RW).saved()],
+    )
+    .level(1)
+    .note("E72; ESI module name, STR16"),
+    Object::var(e_(82), Value::Live, entries![e(0, "Event type", U8, RO)]).note("E82; EMCY byte 4"),
+    Object::var(
+        e_(191),
+        Value::Live,
+        entries![e(0, "Real-time task utilisation", U8, RO).unit("%")],
+    )
+    .level(2)
+    .note("E191"),
+    param_array!(
+        e_(200),
+        "Status words",
+        Array,
+        Value::Live,
+        [
+            e(0, "Status word 1", U16, RO),
+            e(1, "Status word 1 (element 1)", U16, RO),
+        ]
+    )
+    .axis()
+    .note("E200; content not in the sources, declared for the addressing example E-014"),
+    Object::var(
+        e_(201),
+        Value::Live,
+        entries![e(0, "Status word 2", U16, RO).tx()],
+    )
+    .axis()
+    .note("E201; content not described"),
+];
