@@ -73,12 +73,25 @@ pub fn run<T, F>(sim: &RefCell<Simulation>, timeouts: ethercrab::Timeouts, body:
 where
     F: for<'a> AsyncFnOnce(&'a ethercrab::MainDevice<'a>, &'a AtomicU64) -> T,
 {
+    run_with(sim, timeouts, ethercrab::MainDeviceConfig::default(), body)
+}
+
+/// [`run`] with a master configuration (e.g. fewer DC static-sync frames in tests).
+pub fn run_with<T, F>(
+    sim: &RefCell<Simulation>,
+    timeouts: ethercrab::Timeouts,
+    config: ethercrab::MainDeviceConfig,
+    body: F,
+) -> T
+where
+    F: for<'a> AsyncFnOnce(&'a ethercrab::MainDevice<'a>, &'a AtomicU64) -> T,
+{
     let storage = ethercrab::PduStorage::<MAX_FRAMES, MAX_PDU_DATA>::new();
     let Ok((tx, rx, pdu_loop)) = storage.try_split() else {
         unreachable!("a fresh PduStorage splits once")
     };
     let clock = AtomicU64::new(sim.borrow().now_ns());
-    let md = ethercrab::MainDevice::new(pdu_loop, timeouts, ethercrab::MainDeviceConfig::default());
+    let md = ethercrab::MainDevice::new(pdu_loop, timeouts, config);
     let link = InProcessLink::new(tx, rx, sim, &clock);
     futures_lite::future::block_on(futures_lite::future::or(
         async {

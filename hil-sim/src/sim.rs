@@ -18,37 +18,57 @@ const BYTE_NS: u64 = 80;
 /// Preamble, FCS and inter-frame gap, bytes.
 const FRAME_OVERHEAD: u64 = 8 + 4 + 12;
 
-/// One simulated drive: ESC + slave stack + objects.
+/// The simulated non-volatile memory of a drive: two 4 KiB sectors (one per slot).
+pub type SimFlash = store::RamFlash<4096, 2>;
+
+/// One simulated drive: ESC + the drive's runtime (slave stack, objects, store).
 pub struct SimDrive {
     /// The simulated ESC (what the master sees).
     pub esc: Esc,
-    /// The slave firmware's EtherCAT stack.
-    pub slave: ecat::Slave,
-    /// The drive's objects served over CoE.
-    pub objects: drive::DriveObjects,
+    /// The drive firmware's communication runtime.
+    pub drive: drive::runtime::Drive<SimFlash>,
     /// State changes with their simulated time, oldest first.
     pub state_log: Vec<(u64, ecat::StateChange)>,
 }
 
+/// The SII image generated from [`drive::DEVICE`].
+fn sii_image() -> ([u8; ecat::sii::EEPROM_BYTES], usize) {
+    let mut sii = [0u8; ecat::sii::EEPROM_BYTES];
+    let len = ecat::build_sii(&drive::DEVICE, &mut sii).unwrap_or(0);
+    (sii, len)
+}
+
 impl SimDrive {
-    /// A drive powered on with the SII image generated from [`drive::DEVICE`].
+    /// A drive powered on with empty non-volatile memory.
     pub fn new() -> Self {
-        let mut sii = [0u8; 4096];
-        let len = ecat::build_sii(&drive::DEVICE, &mut sii).unwrap_or(0);
+        Self::power_on(SimFlash::new())
+    }
+
+    /// A drive powered on with the given non-volatile memory.
+    pub fn power_on(flash: SimFlash) -> Self {
+        let (sii, len) = sii_image();
         let esc = Esc::new(EscConfig::default(), sii.get(..len).unwrap_or(&[]));
         Self {
             esc,
-            slave: ecat::Slave::new(&drive::DEVICE),
-            objects: drive::DriveObjects::new(),
+            drive: drive::runtime::Drive::new(flash),
             state_log: Vec::new(),
         }
+    }
+
+    /// Switches the drive off and on again: RAM values and ESC state are lost,
+    /// the non-volatile memory stays.
+    pub fn power_cycle(&mut self) {
+        let flash = std::mem::replace(self, Self::power_on(SimFlash::new()))
+            .drive
+            .into_flash();
+        *self = Self::power_on(flash);
     }
 
     /// Runs the slave firmware once at `now_ns`.
     pub fn poll(&mut self, now_ns: u64) {
         self.esc.tick(now_ns);
         let mut pdi = self.esc.pdi();
-        if let Ok(Some(change)) = self.slave.poll(&mut pdi, &mut self.objects, now_ns) {
+        if let Ok(Some(change)) = self.drive.poll(&mut pdi, now_ns) {
             self.state_log.push((now_ns, change));
         }
     }

@@ -31,6 +31,7 @@ use ecat::{DataType, DcOpMode, Device, FmmuUsage, Identity, MailboxSm, Pdo, PdoE
 pub mod dictionary;
 pub mod doc;
 pub mod objects;
+pub mod runtime;
 
 pub use dictionary::{
     revision, DriveObjects, ImageError, LiveValues, NoLive, Requests, Template, WithLive, LOAD_SIGNATURE,
@@ -222,7 +223,11 @@ pub static DEVICE: Device = Device {
         FmmuUsage::Unused,
     ],
     mailbox_protocols: mailbox_protocol::COE | mailbox_protocol::EOE,
-    coe_details: coe_details::SDO,
+    coe_details: coe_details::SDO
+        | coe_details::SDO_INFO
+        | coe_details::PDO_ASSIGN
+        | coe_details::PDO_CONFIG
+        | coe_details::SDO_COMPLETE_ACCESS,
     ports: 2,
     process_ram_end: 0x3000,
     dc_modes: &DC_MODES,

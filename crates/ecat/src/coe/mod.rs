@@ -265,7 +265,10 @@ impl CoeServer {
                     }
                 }
             }
-            service::SDO_INFO if self.config.sdo_info => sdo_info::handle(body, out, dict, &mut self.od_list),
+            // E-079: only with the CoE detail and the "EtherCAT Rx SDO Info" template
+            service::SDO_INFO if self.config.sdo_info && dict.sdo_info_enabled() => {
+                sdo_info::handle(body, out, dict, &mut self.od_list)
+            }
             _ => Err(MailboxError::SERVICE_NOT_SUPPORTED),
         }
     }

@@ -1,0 +1,107 @@
+//! Save values and power loss through the real master (E-018, E-020): written
+//! values live in RAM until "save values"; a save cut short by a power loss
+//! leaves the previous set intact.
+#![allow(
+    clippy::unwrap_used,
+    clippy::expect_used,
+    clippy::panic,
+    clippy::indexing_slicing
+)]
+
+use drive_tests::{init, line, with_master};
+use hil_sim::sim::Simulation;
+use std::cell::RefCell;
+
+/// A258 PDO timeout (ms): a saved UINT16 parameter, writable in every state.
+const A258: u16 = drive::parameter_index(0, 258);
+/// A00 Save values: [0] start = sub 1, [2] result = sub 3 (SDO-Info template).
+const A00: u16 = drive::parameter_index(0, 0);
+const SAVE: u32 = u32::from_le_bytes(*b"save");
+
+fn read_a258(sim: &RefCell<Simulation>) -> u16 {
+    with_master(sim, async |md, clock| {
+        let group = init(md, clock).await;
+        let sd = group.subdevice(md, 0).unwrap();
+        sd.sdo_read::<u16>(A258, 0).await.expect("read A258")
+    })
+}
+
+fn write_a258(sim: &RefCell<Simulation>, v: u16, save: Option<(u16, u8, u32)>) {
+    with_master(sim, async |md, clock| {
+        let group = init(md, clock).await;
+        let sd = group.subdevice(md, 0).unwrap();
+        sd.sdo_write(A258, 0, v).await.expect("write A258");
+        if let Some((index, sub, value)) = save {
+            if index == A00 {
+                sd.sdo_write(index, sub, value as u8).await.expect("A00[0] = 1");
+            } else {
+                sd.sdo_write(index, sub, value).await.expect("1010h:01 = save");
+            }
+        }
+    })
+}
+
+fn power_cycle(sim: &RefCell<Simulation>) {
+    sim.borrow_mut().drives_mut()[0].power_cycle();
+}
+
+#[test]
+fn e018_written_values_stay_in_ram_until_saved() {
+    let sim = line(1);
+    let default = read_a258(&sim);
+    write_a258(&sim, default.wrapping_add(7), None);
+    assert_eq!(read_a258(&sim), default.wrapping_add(7), "written value in RAM");
+    power_cycle(&sim);
+    assert_eq!(read_a258(&sim), default, "not saved: lost at power-off");
+
+    // 1010h:01 = "save"
+    write_a258(&sim, 1234, Some((0x1010, 1, SAVE)));
+    power_cycle(&sim);
+    assert_eq!(read_a258(&sim), 1234, "saved through 1010h survives power-off");
+
+    // A00[0] = 1 (Save values), result in A00[2]
+    write_a258(&sim, 4321, Some((A00, 1, 1)));
+    let result = with_master(&sim, async |md, clock| {
+        let group = init(md, clock).await;
+        let sd = group.subdevice(md, 0).unwrap();
+        sd.sdo_read::<u8>(A00, 3).await.expect("A00[2]")
+    });
+    assert_eq!(i64::from(result), drive::runtime::save_result::OK);
+    power_cycle(&sim);
+    assert_eq!(read_a258(&sim), 4321, "saved through A00 survives power-off");
+}
+
+#[test]
+fn e020_power_cut_at_every_step_of_a_save_keeps_a_usable_set() {
+    // how many flash operations one save takes
+    let sim = line(1);
+    write_a258(&sim, 111, Some((0x1010, 1, SAVE)));
+    let before = sim.borrow_mut().drives_mut()[0].drive.flash_mut().ops();
+    write_a258(&sim, 112, Some((0x1010, 1, SAVE)));
+    let per_save = sim.borrow_mut().drives_mut()[0].drive.flash_mut().ops() - before;
+    assert!(per_save >= 2, "a save erases and writes");
+
+    for cut in 0..per_save {
+        let sim = line(1);
+        write_a258(&sim, 500, Some((0x1010, 1, SAVE)));
+        // power fails during the next save, after `cut` flash operations
+        sim.borrow_mut().drives_mut()[0].drive.flash_mut().cut_after(cut);
+        write_a258(&sim, 600, Some((0x1010, 1, SAVE)));
+        sim.borrow_mut().drives_mut()[0].drive.flash_mut().power_on();
+        power_cycle(&sim);
+        assert_eq!(
+            sim.borrow().drives()[0].drive.startup(),
+            drive::runtime::Startup::Loaded,
+            "cut {cut}"
+        );
+        assert_eq!(
+            read_a258(&sim),
+            500,
+            "cut after {cut} of {per_save} operations: the previous set"
+        );
+        // and the store still works
+        write_a258(&sim, 700, Some((0x1010, 1, SAVE)));
+        power_cycle(&sim);
+        assert_eq!(read_a258(&sim), 700, "saving works again after cut {cut}");
+    }
+}
