@@ -164,7 +164,7 @@ fn serve(args: &[String]) -> Result<(), String> {
             break;
         }
         // The simulation is paced by the wall clock.
-        sim.advance_to(u64::try_from(elapsed.as_nanos()).unwrap_or(u64::MAX));
+        sim.catch_up(u64::try_from(elapsed.as_nanos()).unwrap_or(u64::MAX));
         if let Some(n) = sock
             .recv(&mut buf, Duration::from_millis(1))
             .map_err(|e| e.to_string())?

@@ -2,7 +2,7 @@
 //! simulated line: every frame the master sends goes through
 //! [`Simulation::exchange`] and comes straight back, no network, no root.
 
-use crate::sim::Simulation;
+use crate::sim::{Node, SimDrive, Simulation};
 use core::cell::RefCell;
 use core::future::Future;
 use core::pin::Pin;
@@ -16,22 +16,22 @@ const MAX_FRAME: usize = 1536;
 /// A future that moves frames between ethercrab's PDU loop and the simulation.
 /// It never completes: race it against the master's work
 /// (`futures_lite::future::or`).
-pub struct InProcessLink<'a> {
+pub struct InProcessLink<'a, N: Node = SimDrive> {
     tx: PduTx<'a>,
     rx: PduRx<'a>,
-    sim: &'a RefCell<Simulation>,
+    sim: &'a RefCell<Simulation<N>>,
     clock: &'a AtomicU64,
 }
 
-impl<'a> InProcessLink<'a> {
+impl<'a, N: Node> InProcessLink<'a, N> {
     /// Connects the master's PDU loop halves to `sim`; `clock` is updated with the
     /// simulated time after every frame (hand `|| clock.load(..)` to ethercrab as its time source).
-    pub fn new(tx: PduTx<'a>, rx: PduRx<'a>, sim: &'a RefCell<Simulation>, clock: &'a AtomicU64) -> Self {
+    pub fn new(tx: PduTx<'a>, rx: PduRx<'a>, sim: &'a RefCell<Simulation<N>>, clock: &'a AtomicU64) -> Self {
         Self { tx, rx, sim, clock }
     }
 }
 
-impl Future for InProcessLink<'_> {
+impl<N: Node> Future for InProcessLink<'_, N> {
     type Output = ();
 
     fn poll(mut self: Pin<&mut Self>, cx: &mut Context<'_>) -> Poll<()> {
@@ -69,7 +69,7 @@ pub const MAX_PDU_DATA: usize = ethercrab::PduStorage::element_size(1100);
 /// `sim` in-process, on the current thread, and returns its result. The
 /// master's time source is the simulated clock (`clock` in the closure; hand
 /// `|| clock.load(Ordering::Relaxed)` to `init_single_group`).
-pub fn run<T, F>(sim: &RefCell<Simulation>, timeouts: ethercrab::Timeouts, body: F) -> T
+pub fn run<N: Node, T, F>(sim: &RefCell<Simulation<N>>, timeouts: ethercrab::Timeouts, body: F) -> T
 where
     F: for<'a> AsyncFnOnce(&'a ethercrab::MainDevice<'a>, &'a AtomicU64) -> T,
 {
@@ -77,8 +77,8 @@ where
 }
 
 /// [`run`] with a master configuration (e.g. fewer DC static-sync frames in tests).
-pub fn run_with<T, F>(
-    sim: &RefCell<Simulation>,
+pub fn run_with<N: Node, T, F>(
+    sim: &RefCell<Simulation<N>>,
     timeouts: ethercrab::Timeouts,
     config: ethercrab::MainDeviceConfig,
     body: F,

@@ -80,20 +80,45 @@ impl Default for SimDrive {
     }
 }
 
-/// A line of simulated drives and the simulated clock.
-pub struct Simulation {
-    drives: Vec<SimDrive>,
+/// One slave on the simulated line: its ESC and the firmware behind the PDI.
+/// [`SimDrive`] is the drive; tests and benchmarks may plug in other slaves.
+pub trait Node {
+    /// The node's simulated ESC.
+    fn esc_mut(&mut self) -> &mut Esc;
+    /// Runs the node's firmware once at `now_ns`.
+    fn poll(&mut self, now_ns: u64);
+}
+
+impl Node for SimDrive {
+    fn esc_mut(&mut self) -> &mut Esc {
+        &mut self.esc
+    }
+    fn poll(&mut self, now_ns: u64) {
+        SimDrive::poll(self, now_ns);
+    }
+}
+
+/// A line of simulated slaves (drives by default) and the simulated clock.
+pub struct Simulation<N: Node = SimDrive> {
+    drives: Vec<N>,
     now_ns: u64,
     last_poll_ns: u64,
     frames: u64,
     pcap: Option<PcapWriter<BufWriter<File>>>,
 }
 
-impl Simulation {
+impl Simulation<SimDrive> {
     /// `n` drives in a line, time 0.
     pub fn new(n: usize) -> Self {
+        Self::with_nodes((0..n).map(|_| SimDrive::new()).collect())
+    }
+}
+
+impl<N: Node> Simulation<N> {
+    /// A line of the given nodes, position 0 first, time 0.
+    pub fn with_nodes(nodes: Vec<N>) -> Self {
         Self {
-            drives: (0..n).map(|_| SimDrive::new()).collect(),
+            drives: nodes,
             now_ns: 0,
             last_poll_ns: 0,
             frames: 0,
@@ -118,12 +143,12 @@ impl Simulation {
     }
 
     /// The drives, position 0 first.
-    pub fn drives(&self) -> &[SimDrive] {
+    pub fn drives(&self) -> &[N] {
         &self.drives
     }
 
     /// Mutable access to the drives (tests inject faults this way).
-    pub fn drives_mut(&mut self) -> &mut [SimDrive] {
+    pub fn drives_mut(&mut self) -> &mut [N] {
         &mut self.drives
     }
 
@@ -138,7 +163,7 @@ impl Simulation {
         }
         let n = self.drives.len() as u64;
         self.now_ns += (frame.len() as u64 + FRAME_OVERHEAD) * BYTE_NS + n * SLAVE_DELAY_NS;
-        let mut escs: Vec<&mut Esc> = self.drives.iter_mut().map(|d| &mut d.esc).collect();
+        let mut escs: Vec<&mut Esc> = self.drives.iter_mut().map(|d| d.esc_mut()).collect();
         let _ = process_frame(&mut escs, frame, t_out);
         if let Some(p) = self.pcap.as_mut() {
             let _ = p.frame(self.now_ns, frame);
@@ -155,6 +180,16 @@ impl Simulation {
             if self.now_ns >= self.last_poll_ns + POLL_PERIOD_NS {
                 self.poll_all();
             }
+        }
+    }
+
+    /// Moves the clock to `t_ns` and runs the slaves' firmware once, however
+    /// far behind the simulation is: for wall-clock pacing (`hil-sim serve`),
+    /// where simulating every poll period of a long gap would starve the frames.
+    pub fn catch_up(&mut self, t_ns: u64) {
+        if t_ns > self.now_ns {
+            self.now_ns = t_ns;
+            self.poll_all();
         }
     }
 

@@ -310,6 +310,10 @@ impl Slave {
                 let [_, _, sm2, sm3] = sms;
                 self.out_start = sm2.start;
                 self.in_start = sm3.start;
+                // the process image follows the mapping checked above (E-019: a remap
+                // takes effect at the next P→S)
+                self.out_len = rx.min(MAX_PDO_BYTES);
+                self.in_len = tx.min(MAX_PDO_BYTES);
                 self.rx_frames = 0;
             }
             (AlState::SafeOp, AlState::Op) => {
