@@ -37,14 +37,18 @@ def items():
 
 def tests():
     found = {}
-    pat = re.compile(r"fn\s+([cep])(\d{3})_(\w+)")
+    # a test may name several items: fn e028_e045_..., fn e063_e064_e071_...
+    pat = re.compile(r"fn\s+((?:[cep]\d{3}_)+)(\w*)")
+    item = re.compile(r"([cep])(\d{3})_")
     for d in ("crates", "hil-sim", "tests", "firmware/src"):
         for f in sorted((top / d).rglob("*.rs")):
             if "target" in f.parts:
                 continue
             for m in pat.finditer(f.read_text()):
-                key = f"{m.group(1).upper()}-{m.group(2)}"
-                found.setdefault(key, []).append(f"{m.group(1)}{m.group(2)}_{m.group(3)}")
+                name = m.group(1) + m.group(2)
+                for i in item.finditer(m.group(1)):
+                    key = f"{i.group(1).upper()}-{i.group(2)}"
+                    found.setdefault(key, []).append(name)
     return found
 
 

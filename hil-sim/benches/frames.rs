@@ -40,7 +40,7 @@ fn main() {
 
     let sim = RefCell::new(hil_sim::sim::Simulation::new(2));
     let (wall, frames, sim_ns, pdi_bytes) =
-        hil_sim::master::run(&sim, ethercrab::Timeouts::default(), async |md, clock| {
+        hil_sim::master::run(&sim, hil_sim::master::in_process_timeouts(), async |md, clock| {
             let group = md
                 .init_single_group::<2, 256>(|| clock.load(Ordering::Relaxed))
                 .await

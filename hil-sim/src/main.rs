@@ -6,7 +6,6 @@
 //! - `hil-sim serve --iface IF [--slaves N] [--axes 1|2] [--pcap FILE] [--seconds S]`:
 //!   the simulated line answers EtherCAT frames on a raw Ethernet interface.
 
-use ethercrab::Timeouts;
 use hil_sim::sim::Simulation;
 use std::cell::RefCell;
 use std::path::PathBuf;
@@ -69,7 +68,7 @@ fn demo(args: &[String]) -> Result<(), String> {
     }
     println!("hil-sim demo: ethercrab (in-process) -> simulated ESC -> drive firmware stack");
     let mut printed = Vec::new();
-    let result = hil_sim::master::run(&sim, Timeouts::default(), async |md, clock| {
+    let result = hil_sim::master::run(&sim, hil_sim::master::in_process_timeouts(), async |md, clock| {
         let group = md
             .init_single_group::<4, 256>(|| clock.load(Ordering::Relaxed))
             .await

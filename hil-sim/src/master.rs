@@ -60,6 +60,21 @@ impl<N: Node> Future for InProcessLink<'_, N> {
     }
 }
 
+/// Timeouts for an in-process master. ethercrab measures them on the wall
+/// clock, but the simulated line answers every frame at once, so they only
+/// fire when the host is loaded or the slave really stays silent: generous.
+pub fn in_process_timeouts() -> ethercrab::Timeouts {
+    use std::time::Duration;
+    ethercrab::Timeouts {
+        state_transition: Duration::from_secs(2),
+        pdu: Duration::from_secs(1),
+        eeprom: Duration::from_secs(1),
+        wait_loop_delay: Duration::ZERO,
+        mailbox_echo: Duration::from_secs(1),
+        mailbox_response: Duration::from_millis(500),
+    }
+}
+
 /// Frames in flight the in-process master can hold.
 pub const MAX_FRAMES: usize = 16;
 /// Largest PDU payload of one frame.

@@ -87,7 +87,13 @@ fn e002_raw_ethernet_veth_master_reaches_op() {
     let (tx, rx, pdu_loop) = storage.try_split().expect("split");
     let task = ethercrab::std::tx_rx_task(&net.host_if, tx, rx).expect("raw socket on the veth end");
     std::thread::spawn(move || futures_lite::future::block_on(task));
-    let md = MainDevice::new(pdu_loop, Timeouts::default(), MainDeviceConfig::default());
+    // a debug-build simulator behind a raw socket on a loaded CI machine: roomy timeouts
+    let timeouts = Timeouts {
+        pdu: std::time::Duration::from_millis(500),
+        eeprom: std::time::Duration::from_millis(500),
+        ..Timeouts::default()
+    };
+    let md = MainDevice::new(pdu_loop, timeouts, MainDeviceConfig::default());
     futures_lite::future::block_on(async {
         let group = md
             .init_single_group::<4, 256>(ethercrab::std::ethercat_now)

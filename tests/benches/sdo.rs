@@ -5,13 +5,13 @@
 //!
 //! The drive's dictionary has no object of 4 KiB, so the benchmark slave
 //! serves the drive's objects plus one 4 KiB OCTET_STRING at 5FFFh. The
-//! upload is driven with raw mailbox frames ([`drive_tests::RawMailbox`]):
+//! upload is driven with raw mailbox frames ([`drive_tests::CoeClient`]):
 //! ethercrab 0.7.1's `sdo_read` cannot decode an upload-segment response
 //! (its `CoeCommand` has no value for scs = 0).
 #![allow(clippy::unwrap_used, clippy::expect_used, clippy::indexing_slicing)]
 
 use drive::DriveObjects;
-use drive_tests::RawMailbox;
+use drive_tests::CoeClient;
 use hil_sim::esc::{Esc, EscConfig};
 use hil_sim::sim::{Node, Simulation};
 use od::{Access, CommState, DataType, Dictionary, EntryInfo, ObjectCode, ObjectInfo, SdoAbort};
@@ -82,34 +82,6 @@ impl Node for BenchNode {
     }
 }
 
-/// Segmented upload of 5FFFh:00 with the frames of spec §6.3.
-async fn upload<S>(mbx: &mut RawMailbox, sd: &ethercrab::SubDeviceRef<'_, S>) -> Vec<u8> {
-    let [i0, i1] = BIG.to_le_bytes();
-    let init = mbx.sdo(sd, &[0x40, i0, i1, 0, 0, 0, 0, 0]).await;
-    assert_eq!(init[2] & 0xE3, 0x41, "normal initiate upload response with size");
-    let size = u32::from_le_bytes(init[6..10].try_into().unwrap()) as usize;
-    let mut data = init[10..].to_vec();
-    let mut toggle = 0u8;
-    while data.len() < size {
-        let seg = mbx.sdo(sd, &[0x60 | toggle, 0, 0, 0, 0, 0, 0, 0]).await;
-        let cmd = seg[2];
-        assert_eq!(cmd & 0xF0, toggle, "upload segment response, toggle echoed");
-        let body = &seg[3..];
-        let used = if body.len() == 7 {
-            7 - usize::from((cmd >> 1) & 7)
-        } else {
-            body.len()
-        };
-        data.extend_from_slice(&body[..used]);
-        if cmd & 1 != 0 {
-            break;
-        }
-        toggle ^= 0x10;
-    }
-    data.truncate(size);
-    data
-}
-
 fn main() {
     let args: Vec<String> = std::env::args().collect();
     let reads: usize = args
@@ -130,15 +102,18 @@ fn main() {
         dc_static_sync_iterations: 100,
         ..Default::default()
     };
-    let (wall, sim_ns, frames) =
-        hil_sim::master::run_with(&sim, ethercrab::Timeouts::default(), config, async |md, clock| {
+    let (wall, sim_ns, frames) = hil_sim::master::run_with(
+        &sim,
+        hil_sim::master::in_process_timeouts(),
+        config,
+        async |md, clock| {
             let group = md
                 .init_single_group::<2, 64>(|| clock.load(Ordering::Relaxed))
                 .await
                 .expect("init");
             let sd = group.subdevice(md, 0).expect("slave");
-            let mut mbx = RawMailbox::new();
-            let first = upload(&mut mbx, &sd).await;
+            let mut coe = CoeClient::new();
+            let first = coe.upload(&sd, BIG, 0).await.expect("4 KiB upload");
             assert!(first.iter().enumerate().all(|(i, &b)| b == i as u8), "content");
             let (t0, f0) = {
                 let s = sim.borrow();
@@ -146,12 +121,13 @@ fn main() {
             };
             let start = Instant::now();
             for _ in 0..reads {
-                assert_eq!(upload(&mut mbx, &sd).await.len(), BIG_LEN);
+                assert_eq!(coe.upload(&sd, BIG, 0).await.expect("4 KiB upload").len(), BIG_LEN);
             }
             let wall = start.elapsed();
             let s = sim.borrow();
             (wall, s.now_ns() - t0, s.frames() - f0)
-        });
+        },
+    );
     let bytes = (reads * BIG_LEN) as f64;
     println!("segmented SDO upload of a {BIG_LEN}-byte object, {reads} uploads, mailbox 256 bytes");
     println!("{:<34} {:>14}", "frames per upload", frames as f64 / reads as f64);

@@ -18,12 +18,13 @@
 //!
 //! Download order (CiA 301 for mapping/assignment objects): when subindex 0 is
 //! writable, it is written to 0 first, then entries 1..=n, then subindex 0 to
-//! n. Before anything is written the whole value is checked: length, access
-//! rights in the present state, and the integer ranges of the metadata. A
-//! refusal by the dictionary after that (e.g. a PDO-mapping consistency check)
-//! aborts with its code; entries written until then stay written, and when the
-//! sequence had started with subindex 0 = 0, subindex 0 stays 0 (an empty,
-//! consistent object).
+//! n, whether the download starts at subindex 0 or at subindex 1 (then n is
+//! the number of entries the data holds). Before anything is written the whole
+//! value is checked: length, access rights in the present state, and the
+//! integer ranges of the metadata. A refusal by the dictionary after that
+//! (e.g. a PDO-mapping consistency check) aborts with its code; entries written
+//! until then stay written, and when the sequence had started with subindex 0
+//! = 0, subindex 0 stays 0 (an empty, consistent object).
 
 use od::{CommState, DataType, Dictionary, EntryInfo, ObjectCode, ObjectInfo, SdoAbort};
 
@@ -146,7 +147,9 @@ pub fn download<D: Dictionary>(
     if pos != body.len() {
         return Err(SdoAbort::LENGTH_TOO_HIGH);
     }
-    let order_sub0 = sub == 0 && sub0_writable;
+    // from subindex 1 too (ethercrab's complete access starts there): the
+    // entries of a mapping/assignment object change only while sub 0 = 0
+    let order_sub0 = sub0_writable;
     if order_sub0 {
         dict.write(index, 0, &[0], state)?;
     }

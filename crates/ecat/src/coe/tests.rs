@@ -682,13 +682,20 @@ fn e078_complete_access_download_writes_sub0_zero_entries_then_count() {
             (0x1C12, 0, vec![3]),
         ]
     );
-    // expedited complete access from sub 1 (as ethercrab sends it): entries only
+    // expedited complete access from sub 1 (as ethercrab sends it): the same
+    // order, sub 0 = the number of entries in the data (the drive's dictionary
+    // refuses entries while sub 0 != 0)
     t.dict.writes.clear();
     let r = t.sdo(&[0x33, 0x12, 0x1C, 0x01, 0x10, 0x1A, 0x11, 0x1A]);
     assert_eq!(resp(&r)[0], 0x60);
     assert_eq!(
         t.dict.writes,
-        vec![(0x1C12, 1, vec![0x10, 0x1A]), (0x1C12, 2, vec![0x11, 0x1A])]
+        vec![
+            (0x1C12, 0, vec![0]),
+            (0x1C12, 1, vec![0x10, 0x1A]),
+            (0x1C12, 2, vec![0x11, 0x1A]),
+            (0x1C12, 0, vec![2]),
+        ]
     );
 }
 
