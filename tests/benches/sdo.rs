@@ -121,7 +121,10 @@ fn main() {
             };
             let start = Instant::now();
             for _ in 0..reads {
-                assert_eq!(coe.upload(&sd, BIG, 0).await.expect("4 KiB upload").len(), BIG_LEN);
+                assert_eq!(
+                    coe.upload(&sd, BIG, 0).await.expect("4 KiB upload").len(),
+                    BIG_LEN
+                );
             }
             let wall = start.elapsed();
             let s = sim.borrow();

@@ -275,3 +275,33 @@ fn e028_e092_failed_preop_to_safeop_sends_emcy_a000_with_diag_code() {
         assert_eq!(emcy[3], 0x0E, "diag code: SM3, PDO length not correct");
     });
 }
+
+#[test]
+fn e144_e146_refused_transition_lands_in_the_diagnosis_history() {
+    let sim = line(1);
+    with_master(&sim, async |md, clock| {
+        let group = init(md, clock).await;
+        let sd = group.subdevice(md, 0).unwrap();
+        let fresh: u8 = sd.sdo_read(0x10F3, 4).await.expect("10F3h:04");
+        assert_eq!(fresh, 0, "no new messages after power-on (E-145)");
+        request(&sd, BOOT).await; // refused with 0013h
+        assert_eq!(al_status(&sd).await, (PREOP | ERR, 0x0013));
+        let new: u8 = sd.sdo_read(0x10F3, 4).await.expect("10F3h:04");
+        assert_eq!(new, 1, "new message available");
+        let newest: u8 = sd.sdo_read(0x10F3, 2).await.expect("10F3h:02");
+        assert_eq!(newest, 6, "the first message sits at subindex 6");
+        let mut coe = drive_tests::CoeClient::new();
+        let msg = coe.upload(&sd, 0x10F3, 6).await.expect("10F3h:06");
+        let code = u32::from_le_bytes(msg[0..4].try_into().unwrap());
+        assert_eq!(
+            code,
+            drive::runtime::DIAG_AL_STATUS | 0x0013,
+            "diag code carries the AL status code"
+        );
+        assert_eq!(u16::from_le_bytes([msg[4], msg[5]]) & 0x0F, 2, "type: error");
+        // acknowledging it clears the new-message flag (E-146)
+        sd.sdo_write(0x10F3, 3, 6u8).await.expect("acknowledge");
+        let after: u8 = sd.sdo_read(0x10F3, 4).await.expect("10F3h:04");
+        assert_eq!(after, 0);
+    });
+}

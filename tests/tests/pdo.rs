@@ -288,3 +288,38 @@ fn e048_e049_slave_process_image_follows_a_remapped_layout() {
         assert_eq!(slave.inputs_mut().len(), 2, "TxPDO: statusword");
     });
 }
+
+/// The mode-specific maps (cia402.md §6.5.1 ip, §6.5.6 vl) written by a master's
+/// startup list in Pre-Op, then OP with the new process image.
+#[test]
+fn e048_e049_ip_and_vl_maps_from_a_startup_list_reach_op() {
+    for (layout, bytes) in [(drive::PdoLayout::Ip, 7usize), (drive::PdoLayout::Vl, 5)] {
+        let sim = drive_tests::line(1);
+        drive_tests::with_master(&sim, async |md, clock| {
+            let group = drive_tests::init(md, clock).await;
+            let sd = group.subdevice(md, 0).unwrap();
+            let (rx, tx) = layout.entries();
+            for (pdo, entries) in [(0x1600u16, rx), (0x1A00, tx)] {
+                sd.sdo_write(pdo, 0, 0u8).await.expect("sub 0 = 0");
+                for (sub, e) in (1u8..).zip(entries) {
+                    sd.sdo_write(pdo, sub, e.mapping_value()).await.expect("entry");
+                }
+                sd.sdo_write(pdo, 0, entries.len() as u8)
+                    .await
+                    .expect("sub 0 = n");
+            }
+            let group = group.into_op(md).await.expect("OP with the mode map");
+            let sd = group.subdevice(md, 0).unwrap();
+            assert_eq!(sd.io_raw().outputs().len(), bytes, "{layout:?} RxPDO");
+            assert_eq!(sd.io_raw().inputs().len(), bytes, "{layout:?} TxPDO");
+            for _ in 0..5 {
+                group.tx_rx(md).await.expect("cycle");
+            }
+        });
+        // the drive side computes the same layout from its own declaration
+        let mut objects = drive::DriveObjects::new();
+        objects.apply_map(layout).expect("apply_map");
+        use od::Dictionary as _;
+        assert_eq!(objects.process_data_bytes(), Some((bytes, bytes)));
+    }
+}

@@ -602,6 +602,22 @@ impl DriveObjects {
         }
     }
 
+    /// Puts `layout` into 1600h/1A00h (axis A), as a startup list in Pre-Op
+    /// would: sub 0 = 0, the entries, sub 0 = n (CiA 301 order), through the
+    /// same checks as a bus write. Takes effect at the next Pre-Op → Safe-Op.
+    pub fn apply_map(&mut self, layout: crate::PdoLayout) -> Result<(), SdoAbort> {
+        let (rx, tx) = layout.entries();
+        for (pdo, entries) in [(0x1600u16, rx), (0x1A00, tx)] {
+            self.write(pdo, 0, &[0], CommState::PreOp)?;
+            for (sub, e) in (1u8..).zip(entries) {
+                self.write(pdo, sub, &e.mapping_value().to_le_bytes(), CommState::PreOp)?;
+            }
+            let n = u8::try_from(entries.len()).map_err(|_| SdoAbort::PDO_LENGTH)?;
+            self.write(pdo, 0, &[n], CommState::PreOp)?;
+        }
+        Ok(())
+    }
+
     /// The PDOs assigned in `assign` (1C12h or 1C13h), in order.
     pub fn assigned_pdos(&self, assign: u16) -> impl Iterator<Item = u16> + '_ {
         let n = self.get(assign, 0).unwrap_or(0).clamp(0, 4) as u8;

@@ -104,6 +104,55 @@ pub(crate) const TX_A: [PdoEntry; 10] = [
     ),
 ];
 
+/// The mode-specific maps of cia402.md §6.5.1 and §6.5.6: ip and vl cannot use
+/// the standard maps. A master (startup list) or the commissioning side writes
+/// them into 1600h/1A00h in Pre-Op ([`DriveObjects::apply_map`]).
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum PdoLayout {
+    /// RxPDO 23 bytes, TxPDO 29 bytes (spec §5.4).
+    Standard,
+    /// Interpolated position (ip, 7): 6040h, 6060h, 60C1h:01 / 6041h, 6061h, 6064h; 7 bytes each.
+    Ip,
+    /// Velocity mode (vl, 2): 6040h, 6060h, 6042h / 6041h, 6061h, 6044h; 5 bytes each.
+    Vl,
+}
+
+/// ip RxPDO (7 bytes).
+pub const IP_RX: [PdoEntry; 3] = [
+    PdoEntry::new(0x6040, 0, DataType::U16, "Controlword"),
+    PdoEntry::new(0x6060, 0, DataType::I8, "Modes of operation"),
+    PdoEntry::new(0x60C1, 1, DataType::I32, "Interpolation data record 1"),
+];
+/// ip TxPDO (7 bytes).
+pub const IP_TX: [PdoEntry; 3] = [
+    PdoEntry::new(0x6041, 0, DataType::U16, "Statusword"),
+    PdoEntry::new(0x6061, 0, DataType::I8, "Modes of operation display"),
+    PdoEntry::new(0x6064, 0, DataType::I32, "Position actual value"),
+];
+/// vl RxPDO (5 bytes).
+pub const VL_RX: [PdoEntry; 3] = [
+    PdoEntry::new(0x6040, 0, DataType::U16, "Controlword"),
+    PdoEntry::new(0x6060, 0, DataType::I8, "Modes of operation"),
+    PdoEntry::new(0x6042, 0, DataType::I16, "vl target velocity"),
+];
+/// vl TxPDO (5 bytes).
+pub const VL_TX: [PdoEntry; 3] = [
+    PdoEntry::new(0x6041, 0, DataType::U16, "Statusword"),
+    PdoEntry::new(0x6061, 0, DataType::I8, "Modes of operation display"),
+    PdoEntry::new(0x6044, 0, DataType::I16, "vl velocity actual value"),
+];
+
+impl PdoLayout {
+    /// The RxPDO and TxPDO entries of axis A.
+    pub const fn entries(self) -> (&'static [PdoEntry], &'static [PdoEntry]) {
+        match self {
+            PdoLayout::Standard => (&RX_A, &TX_A),
+            PdoLayout::Ip => (&IP_RX, &IP_TX),
+            PdoLayout::Vl => (&VL_RX, &VL_TX),
+        }
+    }
+}
+
 /// The same entries for axis B: CiA 402 objects +800h, manufacturer +8000h.
 const fn axis_b<const N: usize>(a: [PdoEntry; N]) -> [PdoEntry; N] {
     let mut b = a;

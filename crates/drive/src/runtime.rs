@@ -8,11 +8,13 @@
 //! persistent image through [`store::ParamStore`]; at construction the newest
 //! saved image is loaded (E-018, E-020).
 
-use crate::dictionary::{DriveObjects, PERSISTENT_IMAGE_BYTES};
+use crate::dictionary::{DriveObjects, LiveValues, PERSISTENT_IMAGE_BYTES};
 use crate::objects::LAYOUT_HASH;
 use crate::DEVICE;
+use ecat::diag::{DiagHistory, DiagMessage, DiagType};
 use ecat::{Slave, StateChange};
 use esc::{regs, AlStatusCode, Pdi, PdiExt};
+use od::SdoAbort;
 use store::{Flash, ParamStore, StoreError};
 
 /// A00 "Save values": [0] start (sub 1), [1] progress (sub 2), [2] result (sub 3),
@@ -32,6 +34,29 @@ pub mod save_result {
     pub const FAILED: i64 = 1;
 }
 
+/// Diag code of a refused ESM transition: this prefix | AL status code (our
+/// choice; the message texts belong in the ESI).
+pub const DIAG_AL_STATUS: u32 = 0xE000_0000;
+
+/// The live objects the runtime owns: 10F3h from the diagnosis history.
+struct Live<'a> {
+    diag: &'a mut DiagHistory,
+}
+
+impl LiveValues for Live<'_> {
+    fn read(&mut self, index: u16, sub: u8, buf: &mut [u8]) -> Option<Result<usize, SdoAbort>> {
+        (index == 0x10F3).then(|| self.diag.read(sub, buf))
+    }
+
+    fn write(&mut self, index: u16, sub: u8, data: &[u8]) -> Result<(), SdoAbort> {
+        if index == 0x10F3 {
+            self.diag.write(sub, data)
+        } else {
+            Ok(())
+        }
+    }
+}
+
 /// What happened to the saved parameters at start-up.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
 pub enum Startup {
@@ -48,6 +73,8 @@ pub struct Drive<F: Flash> {
     /// The object dictionary (values in RAM).
     pub objects: DriveObjects,
     store: ParamStore<F>,
+    /// Diagnosis history 10F3h (volatile, E-145).
+    pub diag: DiagHistory,
     startup: Startup,
     last_code: AlStatusCode,
 }
@@ -71,6 +98,7 @@ impl<F: Flash> Drive<F> {
             slave: Slave::new(&DEVICE),
             objects,
             store,
+            diag: DiagHistory::new(),
             startup,
             last_code: AlStatusCode(0xFFFF),
         };
@@ -96,7 +124,15 @@ impl<F: Flash> Drive<F> {
     /// Runs the slave stack once at `now_ns`, then the live objects and the
     /// dictionary's requests.
     pub fn poll<P: Pdi>(&mut self, pdi: &mut P, now_ns: u64) -> Result<Option<StateChange>, P::Error> {
-        let change = self.slave.poll(pdi, &mut self.objects, now_ns)?;
+        let mut live = Live { diag: &mut self.diag };
+        let change = self
+            .slave
+            .poll(pdi, &mut self.objects.with_live(&mut live), now_ns)?;
+        if let Some(c) = change.filter(|c| c.code != AlStatusCode::NO_ERROR) {
+            // a refused state change is an error message in the history (E-144)
+            let msg = DiagMessage::new(DIAG_AL_STATUS | u32::from(c.code.0), DiagType::Error, c.code.0);
+            self.diag.push(msg, now_ns);
+        }
         if change.is_some() {
             // A254/A256 as the ESC has them after the master's configuration
             let alias = pdi.read_u16(regs::STATION_ALIAS)?;
@@ -110,6 +146,19 @@ impl<F: Flash> Drive<F> {
             self.save();
         }
         Ok(change)
+    }
+
+    /// Reads an object as the bus sees it (live values included), without the bus.
+    pub fn read_object(
+        &mut self,
+        index: u16,
+        sub: u8,
+        buf: &mut [u8],
+        state: od::CommState,
+    ) -> Result<usize, SdoAbort> {
+        use od::Dictionary as _;
+        let mut live = Live { diag: &mut self.diag };
+        self.objects.with_live(&mut live).read(index, sub, buf, state)
     }
 
     /// Writes the persistent values to the store (A00 / 1010h "save").
