@@ -9,6 +9,7 @@
 
 pub mod esc;
 pub mod frame;
+pub mod motor;
 
 #[cfg(feature = "std")]
 pub mod master;

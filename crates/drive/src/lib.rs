@@ -31,6 +31,7 @@ use ecat::{DataType, DcOpMode, Device, FmmuUsage, Identity, MailboxSm, Pdo, PdoE
 pub mod dictionary;
 pub mod doc;
 pub mod objects;
+pub mod pdo_image;
 pub mod runtime;
 
 pub use dictionary::{

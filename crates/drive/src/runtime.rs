@@ -7,13 +7,27 @@
 //! and serves the dictionary's requests: "save values" (A00, 1010h) writes the
 //! persistent image through [`store::ParamStore`]; at construction the newest
 //! saved image is loaded (E-018, E-020).
+//!
+//! Process data (E-032…E-035) goes through a [`PdoImage`] compiled from the
+//! mapping at every change into Safe-Op: in Safe-Op and Op the TxPDO image is
+//! filled from the objects every poll (before the slave stack copies it to
+//! SM3); in Op every new RxPDO frame is decoded into the objects; on leaving
+//! Op the RxPDO-mapped objects fall back to their "internal defaults": the
+//! defaults declared in the dictionary for set-points (controlword 0, target
+//! values 0, digital outputs 0), and for RxPDO-mapped parameters (persistent
+//! entries, e.g. 6060h modes of operation = A541) the value they had when Op
+//! was entered (the saved or SDO-configured parameter, else the declared
+//! default), so the master's process data never changes a parameter for good.
+//! Below Op the RxPDO objects keep those defaults (or what an SDO write put
+//! there): RxPDO content is never evaluated outside Op.
 
 use crate::dictionary::{DriveObjects, LiveValues, PERSISTENT_IMAGE_BYTES};
 use crate::objects::LAYOUT_HASH;
+use crate::pdo_image::{PdoImage, PdoImageError};
 use crate::DEVICE;
 use ecat::diag::{DiagHistory, DiagMessage, DiagType};
 use ecat::{Slave, StateChange};
-use esc::{regs, AlStatusCode, Pdi, PdiExt};
+use esc::{regs, AlState, AlStatusCode, Pdi, PdiExt};
 use od::SdoAbort;
 use store::{Flash, ParamStore, StoreError};
 
@@ -77,6 +91,14 @@ pub struct Drive<F: Flash> {
     pub diag: DiagHistory,
     startup: Startup,
     last_code: AlStatusCode,
+    /// The process images of the mapping in force (compiled at P→S).
+    pdo: PdoImage,
+    /// Why the last compilation failed (the image is then empty).
+    pdo_error: Option<PdoImageError>,
+    /// The slave's state after the previous poll.
+    last_state: AlState,
+    /// `Slave::outputs_received` after the previous poll.
+    last_rx_frames: u32,
 }
 
 impl<F: Flash> Drive<F> {
@@ -101,7 +123,12 @@ impl<F: Flash> Drive<F> {
             diag: DiagHistory::new(),
             startup,
             last_code: AlStatusCode(0xFFFF),
+            pdo: PdoImage::EMPTY,
+            pdo_error: None,
+            last_state: AlState::Init,
+            last_rx_frames: 0,
         };
+        drive.compile_pdo_image();
         drive.update_live();
         drive
     }
@@ -121,13 +148,34 @@ impl<F: Flash> Drive<F> {
         self.store.into_inner()
     }
 
-    /// Runs the slave stack once at `now_ns`, then the live objects and the
-    /// dictionary's requests.
+    /// The process images in force (compiled at the last change into Safe-Op).
+    pub fn pdo_image(&self) -> &PdoImage {
+        &self.pdo
+    }
+
+    /// Why the last compilation of the mapping failed, if it did (the
+    /// process images are then empty: nothing decoded, zeros sent).
+    pub fn pdo_image_error(&self) -> Option<PdoImageError> {
+        self.pdo_error
+    }
+
+    /// Compiles the current mapping into [`Self::pdo_image`].
+    fn compile_pdo_image(&mut self) {
+        (self.pdo, self.pdo_error) = match PdoImage::compile(&self.objects) {
+            Ok(image) => (image, None),
+            Err(e) => (PdoImage::EMPTY, Some(e)),
+        };
+    }
+
+    /// Runs the slave stack once at `now_ns`, then process data, the live
+    /// objects and the dictionary's requests.
     pub fn poll<P: Pdi>(&mut self, pdi: &mut P, now_ns: u64) -> Result<Option<StateChange>, P::Error> {
+        self.process_inputs();
         let mut live = Live { diag: &mut self.diag };
         let change = self
             .slave
             .poll(pdi, &mut self.objects.with_live(&mut live), now_ns)?;
+        self.process_outputs();
         if let Some(c) = change.filter(|c| c.code != AlStatusCode::NO_ERROR) {
             // a refused state change is an error message in the history (E-144)
             let msg = DiagMessage::new(DIAG_AL_STATUS | u32::from(c.code.0), DiagType::Error, c.code.0);
@@ -146,6 +194,43 @@ impl<F: Flash> Drive<F> {
             self.save();
         }
         Ok(change)
+    }
+
+    /// State changes and the RxPDO: on leaving Op the RxPDO objects fall back
+    /// to their defaults (E-035); on entering Safe-Op the mapping is compiled
+    /// (E-019); on entering Op the RxPDO-mapped parameters are captured as
+    /// their fallbacks; in Op each new SM2 frame is decoded (E-034). Safe-Op frames
+    /// are counted by the slave but never decoded (E-032).
+    fn process_outputs(&mut self) {
+        let state = self.slave.state();
+        if state != self.last_state {
+            if self.last_state == AlState::Op {
+                self.pdo.restore_rx_defaults(&mut self.objects);
+            }
+            if state == AlState::SafeOp {
+                self.compile_pdo_image();
+            }
+            if state == AlState::Op {
+                self.pdo.capture_fallbacks(&self.objects);
+            }
+            self.last_state = state;
+        }
+        let frames = self.slave.outputs_received();
+        if state == AlState::Op && frames != self.last_rx_frames {
+            self.pdo.apply_outputs(self.slave.outputs(), &mut self.objects);
+        }
+        self.last_rx_frames = frames;
+    }
+
+    /// In Safe-Op and Op the TxPDO image follows the objects (E-032, E-034).
+    /// Runs before the slave's poll, which copies the image to SM3 at once:
+    /// a value set between two polls is on the bus after the next poll.
+    fn process_inputs(&mut self) {
+        if matches!(self.slave.state(), AlState::SafeOp | AlState::Op) {
+            // 10F3h:04 (A250) is answered live; the image needs its value in RAM
+            let _ = self.objects.set(0x10F3, 4, i64::from(self.diag.new_messages()));
+            self.pdo.fill_inputs(&self.objects, self.slave.inputs_mut());
+        }
     }
 
     /// Reads an object as the bus sees it (live values included), without the bus.

@@ -29,10 +29,15 @@
 )]
 #![deny(missing_docs)]
 
+pub mod cascade;
 pub mod cycle;
+pub mod homing;
 pub mod interp;
+pub mod limits;
 pub mod profile;
 pub mod scaling;
+pub mod touch_probe;
+pub mod windows;
 
 pub use cycle::{CycleError, CycleRatio};
 pub use interp::{

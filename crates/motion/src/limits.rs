@@ -1,0 +1,966 @@
+//! Limit switches, direction lock and the 31-bit computing limit (spec §7,
+//! §8, §13; C-091 – C-106).
+//!
+//! [`Limits`] evaluates once per control cycle:
+//!
+//! - **hardware limit switches** I441/I442 (sources I101/I102): reaching one
+//!   from the permitted range raises event 53 cause 1/2 at once (fault), the
+//!   position of the edge is stored and that direction stays locked until
+//!   the axis is back at or behind the stored position with the switch
+//!   inactive ("passable" switches, C-097); both switches hit at once is
+//!   event 53 cause 7 (wiring);
+//! - **software limit switches** 607Dh:01/:02 (A570), only when referenced,
+//!   on a limited axis and not referencing (C-099, C-100): beyond the limit
+//!   the direction is locked (released with the I22 hysteresis, C-103); more
+//!   than I22 beyond it raises event 53 cause 3/4 (C-101), or, in jog with
+//!   velocity control, a quick stop at the limit instead (C-091);
+//! - **permitted direction** I04 on endless axes (C-105);
+//! - the **31-bit computing limit**: the commanded position, summed without
+//!   wrap-around, must stay within the `i32` range (±2^31 increments);
+//!   beyond it event 53 cause 5 (C-106).
+//!
+//! The output is the direction lock (I196) with its cause (I90/I91), a stop
+//! request with its ramp, and the events. Positions are increments.
+
+use crate::Event;
+
+/// Event 53 "Limit switch".
+pub const LIMIT_SWITCH_EVENT: u16 = 53;
+
+/// The causes of event 53 (spec §13).
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum LimitCause {
+    /// 1: hardware limit switch positive.
+    HardwarePositive = 1,
+    /// 2: hardware limit switch negative.
+    HardwareNegative = 2,
+    /// 3: software limit switch positive.
+    SoftwarePositive = 3,
+    /// 4: software limit switch negative.
+    SoftwareNegative = 4,
+    /// 5: ±31-bit computing limit reached.
+    ComputingLimit = 5,
+    /// 7: both limit switches not connected.
+    BothSwitches = 7,
+}
+
+impl LimitCause {
+    /// The event 53 with this cause.
+    pub const fn event(self) -> Event {
+        Event {
+            number: LIMIT_SWITCH_EVENT,
+            cause: self as u8,
+        }
+    }
+}
+
+/// I90 denial cause (spec §8.3, C-102).
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum DenialCause {
+    /// 1: illegal direction (I04 on endless axes).
+    IllegalDirection = 1,
+    /// 2: software limit switch positive.
+    SoftwarePositive = 2,
+    /// 3: software limit switch negative.
+    SoftwareNegative = 3,
+    /// 10: position not within the circular (modulo) length.
+    OutsideModuloLength = 10,
+    /// 11: hardware limit switch positive.
+    HardwarePositive = 11,
+    /// 12: hardware limit switch negative.
+    HardwareNegative = 12,
+}
+
+impl DenialCause {
+    /// The I90 value.
+    pub const fn code(self) -> u8 {
+        self as u8
+    }
+
+    /// The E80 operating state shown for this limitation: 20 "limit switch"
+    /// or 15 "illegal direction" (C-107).
+    pub const fn e80(self) -> u8 {
+        match self {
+            DenialCause::IllegalDirection | DenialCause::OutsideModuloLength => 15,
+            _ => 20,
+        }
+    }
+}
+
+/// A direction of motion.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum Direction {
+    /// Increasing positions.
+    Positive,
+    /// Decreasing positions.
+    Negative,
+}
+
+/// I196 direction blocking: which directions are locked.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
+pub struct DirectionLock {
+    /// Motion in the positive direction is refused.
+    pub positive: bool,
+    /// Motion in the negative direction is refused.
+    pub negative: bool,
+}
+
+impl DirectionLock {
+    /// `true` if motion in `direction` is allowed.
+    pub const fn permits(&self, direction: Direction) -> bool {
+        match direction {
+            Direction::Positive => !self.positive,
+            Direction::Negative => !self.negative,
+        }
+    }
+
+    /// `true` if any direction is locked.
+    pub const fn any(&self) -> bool {
+        self.positive || self.negative
+    }
+
+    /// A velocity set-point (increments/s) with the locked direction removed:
+    /// 0 instead of a velocity into a locked direction (csv, pv, jog).
+    pub fn filter_velocity(&self, velocity_inc_per_s: f32) -> f32 {
+        if (velocity_inc_per_s > 0.0 && self.positive) || (velocity_inc_per_s < 0.0 && self.negative) {
+            0.0
+        } else {
+            velocity_inc_per_s
+        }
+    }
+
+    /// A torque set-point (N·m) with the locked direction removed (cst, pt).
+    pub fn filter_torque(&self, torque_nm: f32) -> f32 {
+        self.filter_velocity(torque_nm)
+    }
+
+    /// `true` if a move from `from_inc` to `to_inc` (wrap-around distance)
+    /// goes into a locked direction; a zero-length move is always allowed.
+    pub fn refuses_move(&self, from_inc: i32, to_inc: i32) -> bool {
+        let d = to_inc.wrapping_sub(from_inc);
+        (d > 0 && self.positive) || (d < 0 && self.negative)
+    }
+}
+
+/// Electrical polarity of the hardware limit switch signals.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum SwitchPolarity {
+    /// 0 = switch hit (NC contact, broken wire counts as hit; spec §8.1).
+    LowActive,
+    /// 1 = switch hit.
+    HighActive,
+}
+
+/// Reaction to reaching a software limit.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum SoftLimitReaction {
+    /// Event 53 cause 3/4 (fault) more than I22 beyond the limit (C-101).
+    Fault,
+    /// Quick stop on reaching the limit, no fault (jog with I26 = 0, C-091).
+    QuickStop,
+}
+
+/// I04 permitted direction of an endless axis.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum PermittedDirection {
+    /// Both directions.
+    Both,
+    /// Positive direction only.
+    PositiveOnly,
+    /// Negative direction only.
+    NegativeOnly,
+}
+
+/// The ramp a [`StopRequest`] asks for.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum StopRamp {
+    /// Fault: the device control's fault reaction (605Eh) stops the axis.
+    FaultReaction,
+    /// Quick stop ramp (6085h), no fault.
+    QuickStop,
+}
+
+/// A request to stop the axis, with its ramp and the direction that caused it.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub struct StopRequest {
+    /// Ramp to use.
+    pub ramp: StopRamp,
+    /// Direction of the limit that was reached.
+    pub direction: Direction,
+}
+
+/// Configuration of [`Limits`].
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub struct LimitConfig {
+    /// I101 positive limit switch source set (0 = switch not evaluated).
+    pub positive_switch: bool,
+    /// I102 negative limit switch source set.
+    pub negative_switch: bool,
+    /// Polarity of I441/I442.
+    pub switch_polarity: SwitchPolarity,
+    /// 607Dh:01 (`A570[0]`) lowest allowed position, increments.
+    pub software_min_inc: i32,
+    /// 607Dh:02 (`A570[1]`) highest allowed position, increments; equal to
+    /// the minimum (or below it) disables the software limits.
+    pub software_max_inc: i32,
+    /// I22 position window, increments: fault distance and lock hysteresis.
+    pub window_inc: u32,
+    /// I00 = 1: endless (modulo) axis — no software limits, no computing
+    /// limit, I04 applies.
+    pub endless_axis: bool,
+    /// I04 permitted direction (endless axes only).
+    pub permitted_direction: PermittedDirection,
+    /// Reaction at a software limit.
+    pub soft_limit_reaction: SoftLimitReaction,
+}
+
+impl Default for LimitConfig {
+    /// No switches, software limits off, I22 = 2 912 increments, limited
+    /// axis, low-active switches, fault reaction.
+    fn default() -> Self {
+        Self {
+            positive_switch: false,
+            negative_switch: false,
+            switch_polarity: SwitchPolarity::LowActive,
+            software_min_inc: 0,
+            software_max_inc: 0,
+            window_inc: crate::INCREMENTS_PER_REVOLUTION / 360,
+            endless_axis: false,
+            permitted_direction: PermittedDirection::Both,
+            soft_limit_reaction: SoftLimitReaction::Fault,
+        }
+    }
+}
+
+impl LimitConfig {
+    /// The software limits act (configuration side of C-099/C-100): a
+    /// limited axis with min < max.
+    pub const fn software_limits_configured(&self) -> bool {
+        !self.endless_axis && self.software_min_inc < self.software_max_inc
+    }
+}
+
+/// One cycle's inputs of [`Limits`].
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub struct LimitInput {
+    /// Actual position 6064h, increments.
+    pub actual_position_inc: i32,
+    /// Position set-point of this cycle, increments (computing limit).
+    pub position_setpoint_inc: i32,
+    /// I441 positive limit switch signal level (electrical, before polarity).
+    pub positive_switch_signal: bool,
+    /// I442 negative limit switch signal level.
+    pub negative_switch_signal: bool,
+    /// The axis is referenced.
+    pub referenced: bool,
+    /// Referencing (homing) is running: switches and software limits are not
+    /// limits (§9.3), and the switch memory is cleared.
+    pub referencing: bool,
+}
+
+/// One cycle's result of [`Limits`].
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub struct LimitStatus {
+    /// I196: the locked directions.
+    pub lock: DirectionLock,
+    /// I90 cause of the lock (I91 = `is_some()`); hardware before software
+    /// before illegal direction.
+    pub denial: Option<DenialCause>,
+    /// Event raised this cycle (53 with its cause).
+    pub event: Option<Event>,
+    /// Stop requested this cycle.
+    pub stop: Option<StopRequest>,
+}
+
+/// The position where the 31-bit computing limit trips: outside
+/// `i32::MIN ..= i32::MAX` (±2^31 increments).
+const COMPUTING_MIN: i64 = i32::MIN as i64;
+const COMPUTING_MAX: i64 = i32::MAX as i64;
+
+/// Limit-switch evaluation of one axis.
+#[derive(Debug, Clone)]
+pub struct Limits {
+    config: LimitConfig,
+    /// Passable-switch memory: position where the switch edge was seen.
+    positive_memory: Option<i32>,
+    negative_memory: Option<i32>,
+    /// Switch hit in the last cycle (edge detection).
+    positive_hit: bool,
+    negative_hit: bool,
+    both_hit: bool,
+    /// Software-limit direction locks (with hysteresis).
+    soft_positive_lock: bool,
+    soft_negative_lock: bool,
+    /// Software-limit fault raised (re-armed when the lock releases).
+    soft_positive_fault: bool,
+    soft_negative_fault: bool,
+    /// Commanded position summed without wrap-around.
+    unwrapped_setpoint: i64,
+    last_setpoint: i32,
+    computing_fault: bool,
+}
+
+impl Limits {
+    /// Limits with `config` and the set-point at `position_inc` (restart:
+    /// empty switch memory).
+    pub const fn new(config: LimitConfig, position_inc: i32) -> Self {
+        Self {
+            config,
+            positive_memory: None,
+            negative_memory: None,
+            positive_hit: false,
+            negative_hit: false,
+            both_hit: false,
+            soft_positive_lock: false,
+            soft_negative_lock: false,
+            soft_positive_fault: false,
+            soft_negative_fault: false,
+            unwrapped_setpoint: position_inc as i64,
+            last_setpoint: position_inc,
+            computing_fault: false,
+        }
+    }
+
+    /// The configuration.
+    pub const fn config(&self) -> &LimitConfig {
+        &self.config
+    }
+
+    /// Replaces the configuration (e.g. 607Dh written); keeps the state.
+    pub fn set_config(&mut self, config: LimitConfig) {
+        self.config = config;
+    }
+
+    /// Stored positions of the passable-switch memory (positive, negative).
+    pub const fn switch_memory(&self) -> (Option<i32>, Option<i32>) {
+        (self.positive_memory, self.negative_memory)
+    }
+
+    /// I52 "Delete limit switch memory": clears each switch's memory (and
+    /// the cause-7 latch) while that switch's signal is inactive (C-098).
+    /// Returns `true` if everything was cleared.
+    pub fn clear_switch_memory(&mut self) -> bool {
+        if !self.positive_hit {
+            self.positive_memory = None;
+        }
+        if !self.negative_hit {
+            self.negative_memory = None;
+        }
+        if !(self.positive_hit && self.negative_hit) {
+            self.both_hit = false;
+        }
+        self.positive_memory.is_none() && self.negative_memory.is_none()
+    }
+
+    /// Referencing finished or the reference was deleted (I452): clears the
+    /// switch memory (C-098) and restarts the computing limit at the new
+    /// position set-point `position_inc`.
+    pub fn reference_changed(&mut self, position_inc: i32) {
+        self.positive_memory = None;
+        self.negative_memory = None;
+        self.restart_computing_limit(position_inc);
+    }
+
+    /// Restarts the summed commanded position at `position_inc` (e.g. after
+    /// a preset), clearing the computing-limit latch.
+    pub fn restart_computing_limit(&mut self, position_inc: i32) {
+        self.unwrapped_setpoint = i64::from(position_inc);
+        self.last_setpoint = position_inc;
+        self.computing_fault = false;
+    }
+
+    /// The commanded position summed without wrap-around, increments.
+    pub const fn unwrapped_setpoint_inc(&self) -> i64 {
+        self.unwrapped_setpoint
+    }
+
+    /// `true` if a relative move of `distance_inc` from the present
+    /// set-point would pass the 31-bit computing limit (check before taking
+    /// over a pp/jog target, C-106). Endless axes never do.
+    pub fn relative_move_exceeds_computing_limit(&self, distance_inc: i64) -> bool {
+        if self.config.endless_axis {
+            return false;
+        }
+        let target = self.unwrapped_setpoint.saturating_add(distance_inc);
+        !(COMPUTING_MIN..=COMPUTING_MAX).contains(&target)
+    }
+
+    /// Jog with position control (I26 = 1, C-092): `target_inc` clamped into
+    /// the software-limit range, so the profile stops at the limit and never
+    /// passes it. Unchanged when the software limits do not act.
+    pub fn clamp_target(&self, target_inc: i32, referenced: bool) -> i32 {
+        if referenced && self.config.software_limits_configured() {
+            target_inc.clamp(self.config.software_min_inc, self.config.software_max_inc)
+        } else {
+            target_inc
+        }
+    }
+
+    /// Evaluates one control cycle.
+    pub fn update(&mut self, input: &LimitInput) -> LimitStatus {
+        let mut event = None;
+        let mut stop = None;
+        let mut lock = DirectionLock::default();
+        let mut denial = None;
+        let actual = input.actual_position_inc;
+
+        // --- Computing limit (C-106) ---
+        let step = input.position_setpoint_inc.wrapping_sub(self.last_setpoint);
+        self.last_setpoint = input.position_setpoint_inc;
+        self.unwrapped_setpoint = self.unwrapped_setpoint.saturating_add(i64::from(step));
+        if !self.config.endless_axis {
+            let outside = !(COMPUTING_MIN..=COMPUTING_MAX).contains(&self.unwrapped_setpoint);
+            if outside && !self.computing_fault {
+                self.computing_fault = true;
+                event = Some(LimitCause::ComputingLimit.event());
+                stop = Some(StopRequest {
+                    ramp: StopRamp::FaultReaction,
+                    direction: if self.unwrapped_setpoint > 0 {
+                        Direction::Positive
+                    } else {
+                        Direction::Negative
+                    },
+                });
+            } else if !outside {
+                self.computing_fault = false;
+            }
+            if self.computing_fault {
+                if self.unwrapped_setpoint > 0 {
+                    lock.positive = true;
+                } else {
+                    lock.negative = true;
+                }
+            }
+        }
+
+        // --- Hardware limit switches (C-093 – C-098) ---
+        let level_hit = |signal: bool| match self.config.switch_polarity {
+            SwitchPolarity::LowActive => !signal,
+            SwitchPolarity::HighActive => signal,
+        };
+        let pos_hit = self.config.positive_switch && level_hit(input.positive_switch_signal);
+        let neg_hit = self.config.negative_switch && level_hit(input.negative_switch_signal);
+        if input.referencing {
+            // §9.3: not limit switches while referencing; referencing clears
+            // the memory.
+            self.positive_memory = None;
+            self.negative_memory = None;
+            self.both_hit = false;
+        } else if pos_hit && neg_hit {
+            if !self.both_hit {
+                self.both_hit = true;
+                event = event.or(Some(LimitCause::BothSwitches.event()));
+                stop = stop.or(Some(StopRequest {
+                    ramp: StopRamp::FaultReaction,
+                    direction: Direction::Positive,
+                }));
+            }
+        } else {
+            if pos_hit && !self.positive_hit && self.positive_memory.is_none() {
+                self.positive_memory = Some(actual);
+                event = event.or(Some(LimitCause::HardwarePositive.event()));
+                stop = stop.or(Some(StopRequest {
+                    ramp: StopRamp::FaultReaction,
+                    direction: Direction::Positive,
+                }));
+            }
+            if neg_hit && !self.negative_hit && self.negative_memory.is_none() {
+                self.negative_memory = Some(actual);
+                event = event.or(Some(LimitCause::HardwareNegative.event()));
+                stop = stop.or(Some(StopRequest {
+                    ramp: StopRamp::FaultReaction,
+                    direction: Direction::Negative,
+                }));
+            }
+            // Passable switch: the memory clears only with the switch
+            // inactive and the axis back at or behind the stored position.
+            if let Some(p) = self.positive_memory {
+                if !pos_hit && actual.wrapping_sub(p) <= 0 {
+                    self.positive_memory = None;
+                }
+            }
+            if let Some(p) = self.negative_memory {
+                if !neg_hit && actual.wrapping_sub(p) >= 0 {
+                    self.negative_memory = None;
+                }
+            }
+        }
+        self.positive_hit = pos_hit;
+        self.negative_hit = neg_hit;
+        if !input.referencing {
+            if self.both_hit {
+                lock.positive = true;
+                lock.negative = true;
+            }
+            if pos_hit || self.positive_memory.is_some() {
+                lock.positive = true;
+                denial = denial.or(Some(DenialCause::HardwarePositive));
+            }
+            if neg_hit || self.negative_memory.is_some() {
+                lock.negative = true;
+                denial = denial.or(Some(DenialCause::HardwareNegative));
+            }
+        }
+
+        // --- Software limit switches (C-099 – C-103, C-091) ---
+        let soft_active = input.referenced && !input.referencing && self.config.software_limits_configured();
+        if soft_active {
+            let a = i64::from(actual);
+            let max = i64::from(self.config.software_max_inc);
+            let min = i64::from(self.config.software_min_inc);
+            let w = i64::from(self.config.window_inc);
+            // Positive side.
+            if a > max {
+                if !self.soft_positive_lock && self.config.soft_limit_reaction == SoftLimitReaction::QuickStop
+                {
+                    stop = stop.or(Some(StopRequest {
+                        ramp: StopRamp::QuickStop,
+                        direction: Direction::Positive,
+                    }));
+                }
+                self.soft_positive_lock = true;
+            } else if a < max - w {
+                self.soft_positive_lock = false;
+                self.soft_positive_fault = false;
+            }
+            if self.config.soft_limit_reaction == SoftLimitReaction::Fault
+                && a > max + w
+                && !self.soft_positive_fault
+            {
+                self.soft_positive_fault = true;
+                event = event.or(Some(LimitCause::SoftwarePositive.event()));
+                stop = stop.or(Some(StopRequest {
+                    ramp: StopRamp::FaultReaction,
+                    direction: Direction::Positive,
+                }));
+            }
+            // Negative side.
+            if a < min {
+                if !self.soft_negative_lock && self.config.soft_limit_reaction == SoftLimitReaction::QuickStop
+                {
+                    stop = stop.or(Some(StopRequest {
+                        ramp: StopRamp::QuickStop,
+                        direction: Direction::Negative,
+                    }));
+                }
+                self.soft_negative_lock = true;
+            } else if a > min + w {
+                self.soft_negative_lock = false;
+                self.soft_negative_fault = false;
+            }
+            if self.config.soft_limit_reaction == SoftLimitReaction::Fault
+                && a < min - w
+                && !self.soft_negative_fault
+            {
+                self.soft_negative_fault = true;
+                event = event.or(Some(LimitCause::SoftwareNegative.event()));
+                stop = stop.or(Some(StopRequest {
+                    ramp: StopRamp::FaultReaction,
+                    direction: Direction::Negative,
+                }));
+            }
+            if self.soft_positive_lock {
+                lock.positive = true;
+                denial = denial.or(Some(DenialCause::SoftwarePositive));
+            }
+            if self.soft_negative_lock {
+                lock.negative = true;
+                denial = denial.or(Some(DenialCause::SoftwareNegative));
+            }
+        } else {
+            self.soft_positive_lock = false;
+            self.soft_negative_lock = false;
+            self.soft_positive_fault = false;
+            self.soft_negative_fault = false;
+        }
+
+        // --- I04 permitted direction on endless axes (C-105) ---
+        if self.config.endless_axis {
+            match self.config.permitted_direction {
+                PermittedDirection::Both => {}
+                PermittedDirection::PositiveOnly => {
+                    lock.negative = true;
+                    denial = denial.or(Some(DenialCause::IllegalDirection));
+                }
+                PermittedDirection::NegativeOnly => {
+                    lock.positive = true;
+                    denial = denial.or(Some(DenialCause::IllegalDirection));
+                }
+            }
+        }
+
+        LimitStatus {
+            lock,
+            denial,
+            event,
+            stop,
+        }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn hw_config() -> LimitConfig {
+        LimitConfig {
+            positive_switch: true,
+            negative_switch: true,
+            ..LimitConfig::default()
+        }
+    }
+
+    fn sw_config() -> LimitConfig {
+        LimitConfig {
+            software_min_inc: -10_000,
+            software_max_inc: 10_000,
+            window_inc: 100,
+            ..LimitConfig::default()
+        }
+    }
+
+    /// Low-active inputs: `true` = switch hit.
+    fn hw(actual: i32, pos_hit: bool, neg_hit: bool) -> LimitInput {
+        LimitInput {
+            actual_position_inc: actual,
+            position_setpoint_inc: actual,
+            positive_switch_signal: !pos_hit,
+            negative_switch_signal: !neg_hit,
+            referenced: true,
+            referencing: false,
+        }
+    }
+
+    fn at(actual: i32) -> LimitInput {
+        hw(actual, false, false)
+    }
+
+    #[test]
+    fn c093_switches_without_source_are_ignored_and_low_active() {
+        let mut l = Limits::new(LimitConfig::default(), 0);
+        // Sources not set: both signals 0 mean nothing.
+        let s = l.update(&hw(0, true, true));
+        assert_eq!(s.event, None);
+        assert!(!s.lock.any());
+        // Sources set, signals high (NC contacts closed): no hit.
+        let mut l = Limits::new(hw_config(), 0);
+        let s = l.update(&hw(0, false, false));
+        assert_eq!(s.event, None);
+        assert!(!s.lock.any());
+        // High-active configuration: a high signal is a hit.
+        let mut l = Limits::new(
+            LimitConfig {
+                switch_polarity: SwitchPolarity::HighActive,
+                ..hw_config()
+            },
+            0,
+        );
+        let mut input = at(0);
+        input.positive_switch_signal = true;
+        input.negative_switch_signal = false;
+        assert_eq!(l.update(&input).event, Some(LimitCause::HardwarePositive.event()));
+    }
+
+    #[test]
+    fn c094_hardware_limit_positive_faults_on_the_edge() {
+        let mut l = Limits::new(hw_config(), 0);
+        assert_eq!(l.update(&at(900)).event, None);
+        let s = l.update(&hw(1000, true, false));
+        assert_eq!(s.event, Some(Event { number: 53, cause: 1 }));
+        assert_eq!(
+            s.stop,
+            Some(StopRequest {
+                ramp: StopRamp::FaultReaction,
+                direction: Direction::Positive
+            })
+        );
+        // Only once, while staying on the switch.
+        let s = l.update(&hw(1050, true, false));
+        assert_eq!(s.event, None);
+        assert!(s.lock.positive && !s.lock.negative);
+    }
+
+    #[test]
+    fn c094_hardware_limit_negative_faults_on_the_edge() {
+        let mut l = Limits::new(hw_config(), 0);
+        l.update(&at(-900));
+        let s = l.update(&hw(-1000, false, true));
+        assert_eq!(s.event, Some(Event { number: 53, cause: 2 }));
+        assert_eq!(s.denial, Some(DenialCause::HardwareNegative));
+        assert_eq!(s.denial.unwrap().code(), 12);
+    }
+
+    #[test]
+    fn c095_hardware_limit_locks_direction_and_allows_moving_away() {
+        let mut l = Limits::new(hw_config(), 0);
+        l.update(&at(0));
+        let s = l.update(&hw(1000, true, false));
+        assert!(!s.lock.permits(Direction::Positive));
+        assert!(s.lock.permits(Direction::Negative));
+        assert_eq!(s.denial, Some(DenialCause::HardwarePositive));
+        assert_eq!(s.denial.unwrap().code(), 11);
+        assert_eq!(s.denial.unwrap().e80(), 20);
+        assert_eq!(s.lock.filter_velocity(5000.0), 0.0);
+        assert_eq!(s.lock.filter_velocity(-5000.0), -5000.0);
+        assert_eq!(s.lock.filter_torque(1.0), 0.0);
+        assert!(s.lock.refuses_move(1000, 2000));
+        assert!(!s.lock.refuses_move(1000, 0));
+        // Moving away, off the switch and behind the stored position: free,
+        // and the fault can trigger again.
+        let s = l.update(&at(990));
+        assert!(!s.lock.any());
+        assert_eq!(s.denial, None);
+        let s = l.update(&hw(1000, true, false));
+        assert_eq!(s.event, Some(LimitCause::HardwarePositive.event()));
+    }
+
+    #[test]
+    fn c096_both_switches_hit_is_cause_7_acknowledged_with_i52() {
+        let mut l = Limits::new(hw_config(), 0);
+        let s = l.update(&hw(0, true, true));
+        assert_eq!(s.event, Some(Event { number: 53, cause: 7 }));
+        assert!(s.lock.positive && s.lock.negative);
+        assert_eq!(l.update(&hw(0, true, true)).event, None);
+        // I52 only works once the signals are back.
+        l.clear_switch_memory();
+        assert!(l.update(&hw(0, true, true)).lock.positive);
+        let s = l.update(&at(0));
+        assert!(s.lock.positive, "latched until I52");
+        assert!(l.clear_switch_memory());
+        assert!(!l.update(&at(0)).lock.any());
+    }
+
+    #[test]
+    fn c097_passable_switch_clears_only_behind_the_stored_position() {
+        // Cam 100 … 120, seen at 100, physically left at 101 on the way back.
+        let mut l = Limits::new(hw_config(), 0);
+        l.update(&at(99));
+        let s = l.update(&hw(100, true, false));
+        assert_eq!(s.event, Some(LimitCause::HardwarePositive.event()));
+        assert_eq!(l.switch_memory().0, Some(100));
+        // Overtravel across the cam: signal gone, still locked, no new fault.
+        let s = l.update(&hw(110, true, false));
+        assert!(s.lock.positive && s.event.is_none());
+        let s = l.update(&at(125));
+        assert!(s.lock.positive, "beyond the cam the memory keeps the lock");
+        // Back through the cam: no new event.
+        let s = l.update(&hw(115, true, false));
+        assert_eq!(s.event, None);
+        // Signal inactive at 101, but not yet behind 100.
+        let s = l.update(&at(101));
+        assert!(s.lock.positive);
+        let s = l.update(&at(100));
+        assert!(!s.lock.positive, "cleared at the stored position");
+        assert_eq!(l.switch_memory().0, None);
+    }
+
+    #[test]
+    fn c098_switch_memory_cleared_by_i52_referencing_and_restart() {
+        let mut l = Limits::new(hw_config(), 0);
+        l.update(&at(0));
+        l.update(&hw(100, true, false));
+        l.update(&at(150));
+        // I52 refused while the signal is active …
+        l.update(&hw(150, true, false));
+        assert!(!l.clear_switch_memory());
+        // … accepted once it is inactive, even beyond the stored position.
+        l.update(&at(150));
+        assert!(l.clear_switch_memory());
+        assert!(!l.update(&at(150)).lock.any());
+        // Referencing clears it and ignores the switches.
+        l.update(&hw(160, true, false));
+        let mut input = hw(170, true, false);
+        input.referencing = true;
+        let s = l.update(&input);
+        assert!(!s.lock.any() && s.event.is_none());
+        assert_eq!(l.switch_memory(), (None, None));
+        // Deleting the reference clears it too.
+        l.update(&at(0));
+        l.update(&hw(100, false, true));
+        assert!(l.switch_memory().1.is_some());
+        l.reference_changed(100);
+        assert_eq!(l.switch_memory(), (None, None));
+        // Restart: a new instance has no memory.
+        assert_eq!(Limits::new(hw_config(), 0).switch_memory(), (None, None));
+    }
+
+    #[test]
+    fn c099_software_limits_only_when_referenced_and_limited() {
+        let mut l = Limits::new(sw_config(), 0);
+        let mut input = at(20_000);
+        input.referenced = false;
+        let s = l.update(&input);
+        assert!(s.event.is_none() && !s.lock.any());
+        input.referenced = true;
+        input.referencing = true;
+        let s = l.update(&input);
+        assert!(s.event.is_none() && !s.lock.any());
+        let mut l = Limits::new(
+            LimitConfig {
+                endless_axis: true,
+                ..sw_config()
+            },
+            0,
+        );
+        let s = l.update(&at(20_000));
+        assert!(s.event.is_none() && !s.lock.any());
+    }
+
+    #[test]
+    fn c100_software_limits_disabled_when_min_equals_max() {
+        let mut l = Limits::new(
+            LimitConfig {
+                software_min_inc: 5000,
+                software_max_inc: 5000,
+                ..sw_config()
+            },
+            0,
+        );
+        for p in [-1_000_000, 0, 5000, 1_000_000] {
+            let s = l.update(&at(p));
+            assert!(s.event.is_none() && !s.lock.any(), "at {p}");
+        }
+    }
+
+    #[test]
+    fn c101_software_limit_positive_fault_beyond_window() {
+        let mut l = Limits::new(sw_config(), 0);
+        let s = l.update(&at(10_050));
+        assert!(s.event.is_none(), "within I22 beyond the limit: no fault");
+        assert!(s.lock.positive);
+        let s = l.update(&at(10_101));
+        assert_eq!(s.event, Some(Event { number: 53, cause: 3 }));
+        assert_eq!(s.stop.unwrap().ramp, StopRamp::FaultReaction);
+        assert_eq!(l.update(&at(10_200)).event, None, "only once");
+    }
+
+    #[test]
+    fn c101_software_limit_negative_fault_beyond_window() {
+        let mut l = Limits::new(sw_config(), 0);
+        assert!(l.update(&at(-10_100)).event.is_none());
+        let s = l.update(&at(-10_101));
+        assert_eq!(s.event, Some(Event { number: 53, cause: 4 }));
+        assert_eq!(s.denial, Some(DenialCause::SoftwareNegative));
+    }
+
+    #[test]
+    fn c102_software_limit_blocks_positive_direction() {
+        let mut l = Limits::new(sw_config(), 0);
+        assert!(!l.update(&at(10_000)).lock.any(), "at the limit: not yet beyond");
+        let s = l.update(&at(10_001));
+        assert!(!s.lock.permits(Direction::Positive));
+        assert!(s.lock.permits(Direction::Negative));
+        assert_eq!(s.denial, Some(DenialCause::SoftwarePositive));
+        assert_eq!(s.denial.unwrap().code(), 2);
+        assert!(s.lock.refuses_move(10_001, 10_002));
+        assert!(!s.lock.refuses_move(10_001, 0));
+    }
+
+    #[test]
+    fn c103_software_lock_releases_with_hysteresis() {
+        let mut l = Limits::new(sw_config(), 0);
+        assert!(l.update(&at(10_001)).lock.positive);
+        assert!(l.update(&at(9_950)).lock.positive, "inside, but not by I22");
+        assert!(l.update(&at(9_900)).lock.positive, "exactly limit − I22");
+        assert!(!l.update(&at(9_899)).lock.positive);
+        assert!(l.update(&at(-10_001)).lock.negative);
+        assert!(l.update(&at(-9_900)).lock.negative);
+        assert!(!l.update(&at(-9_899)).lock.negative);
+    }
+
+    #[test]
+    fn c091_jog_velocity_control_quick_stops_at_software_limit() {
+        let mut l = Limits::new(
+            LimitConfig {
+                soft_limit_reaction: SoftLimitReaction::QuickStop,
+                ..sw_config()
+            },
+            0,
+        );
+        let s = l.update(&at(10_001));
+        assert_eq!(
+            s.stop,
+            Some(StopRequest {
+                ramp: StopRamp::QuickStop,
+                direction: Direction::Positive
+            })
+        );
+        assert_eq!(s.event, None);
+        assert!(s.lock.positive);
+        // Stops a little past the limit: no fault even beyond I22.
+        let s = l.update(&at(10_500));
+        assert_eq!(s.event, None);
+        assert_eq!(s.stop, None);
+        assert!(s.lock.positive);
+    }
+
+    #[test]
+    fn c092_jog_position_control_target_clamped_to_limits() {
+        let l = Limits::new(sw_config(), 0);
+        assert_eq!(l.clamp_target(50_000, true), 10_000);
+        assert_eq!(l.clamp_target(-50_000, true), -10_000);
+        assert_eq!(l.clamp_target(500, true), 500);
+        assert_eq!(l.clamp_target(50_000, false), 50_000);
+    }
+
+    #[test]
+    fn c105_endless_axis_permitted_direction() {
+        let mut l = Limits::new(
+            LimitConfig {
+                endless_axis: true,
+                permitted_direction: PermittedDirection::PositiveOnly,
+                ..sw_config()
+            },
+            0,
+        );
+        let s = l.update(&at(1_000_000));
+        assert!(s.lock.negative && !s.lock.positive);
+        assert_eq!(s.denial, Some(DenialCause::IllegalDirection));
+        assert_eq!(s.denial.unwrap().e80(), 15);
+        assert_eq!(s.event, None);
+    }
+
+    #[test]
+    fn c106_computing_limit_trips_beyond_31_bits() {
+        let mut l = Limits::new(LimitConfig::default(), 0);
+        // Chained moves summing to i32::MAX: fine.
+        let mut p: i32 = 0;
+        for _ in 0..2047 {
+            p = p.wrapping_add(1 << 20);
+            let mut input = at(p);
+            input.position_setpoint_inc = p;
+            assert_eq!(l.update(&input).event, None);
+        }
+        p = p.wrapping_add((1 << 20) - 1);
+        let mut input = at(p);
+        input.position_setpoint_inc = p;
+        assert_eq!(l.update(&input).event, None);
+        assert_eq!(l.unwrapped_setpoint_inc(), i64::from(i32::MAX));
+        assert!(l.relative_move_exceeds_computing_limit(1));
+        assert!(!l.relative_move_exceeds_computing_limit(-1));
+        // One more increment wraps the i32 set-point: event 53 cause 5.
+        p = p.wrapping_add(1);
+        input.position_setpoint_inc = p;
+        let s = l.update(&input);
+        assert_eq!(s.event, Some(Event { number: 53, cause: 5 }));
+        assert_eq!(s.stop.unwrap().ramp, StopRamp::FaultReaction);
+        assert!(s.lock.positive && !s.lock.negative);
+        assert_eq!(l.update(&input).event, None, "only once");
+        // Back inside: the lock goes.
+        p = p.wrapping_sub(10);
+        input.position_setpoint_inc = p;
+        assert!(!l.update(&input).lock.any());
+        // Endless axes wrap by design.
+        let mut e = Limits::new(
+            LimitConfig {
+                endless_axis: true,
+                ..LimitConfig::default()
+            },
+            i32::MAX,
+        );
+        let mut input = at(i32::MIN);
+        input.position_setpoint_inc = i32::MIN;
+        assert_eq!(e.update(&input).event, None);
+        assert!(!e.relative_move_exceeds_computing_limit(i64::MAX));
+    }
+}
