@@ -16,6 +16,8 @@ pub mod master;
 #[cfg(feature = "std")]
 pub mod pcap;
 #[cfg(feature = "std")]
+pub mod plot;
+#[cfg(feature = "std")]
 pub mod raw;
 #[cfg(feature = "std")]
 pub mod sim;

@@ -4,7 +4,9 @@
 
 use crate::esc::{Esc, EscConfig};
 use crate::frame::process_frame;
+use crate::motor::{Input, Motor, MotorOutputs};
 use crate::pcap::PcapWriter;
+use drive::axis::{AxisIo, IndexLatch, ProbeEdge};
 use std::fs::File;
 use std::io::{self, BufWriter};
 use std::path::Path;
@@ -21,7 +23,33 @@ const FRAME_OVERHEAD: u64 = 8 + 4 + 12;
 /// The simulated non-volatile memory of a drive: two 4 KiB sectors (one per slot).
 pub type SimFlash = store::RamFlash<4096, 2>;
 
-/// One simulated drive: ESC + the drive's runtime (slave stack, objects, store).
+/// Control cycle of the simulated drive (A150 default), ns.
+pub const CONTROL_CYCLE_NS: u64 = 1_000_000;
+
+/// The conditions of one axis that are not the motor's: additional enable
+/// (A60), supply, STO. "Ready" by default in the simulator, so a master alone
+/// can enable the drive; tests switch them off to check each refusal.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub struct AxisConditions {
+    /// Additional enable A60 active.
+    pub additional_enable: bool,
+    /// DC-link supply present.
+    pub supply_ok: bool,
+    /// Safe torque off active.
+    pub sto_active: bool,
+}
+
+impl AxisConditions {
+    /// Everything ready.
+    pub const READY: Self = Self {
+        additional_enable: true,
+        supply_ok: true,
+        sto_active: false,
+    };
+}
+
+/// One simulated drive: ESC + the drive's runtime (slave stack, objects,
+/// store) + a motor and load per axis, stepped once per control cycle.
 pub struct SimDrive {
     /// The simulated ESC (what the master sees).
     pub esc: Esc,
@@ -29,6 +57,14 @@ pub struct SimDrive {
     pub drive: drive::runtime::Drive<SimFlash>,
     /// State changes with their simulated time, oldest first.
     pub state_log: Vec<(u64, ecat::StateChange)>,
+    /// Motor and load of axis A and B.
+    pub motors: [Motor; 2],
+    /// A60, supply and STO per axis.
+    pub conditions: [AxisConditions; 2],
+    /// Control cycle, ns.
+    pub cycle_ns: u64,
+    feedback: [Option<MotorOutputs>; 2],
+    next_cycle_ns: u64,
 }
 
 /// The SII image generated from [`drive::DEVICE`].
@@ -38,8 +74,48 @@ fn sii_image() -> ([u8; ecat::sii::EEPROM_BYTES], usize) {
     (sii, len)
 }
 
+/// What the axis runtime reads from the motor's last step.
+fn axis_io(out: Option<&MotorOutputs>, motor: &Motor, c: AxisConditions) -> AxisIo {
+    let mut io = AxisIo::ready(0);
+    io.additional_enable = c.additional_enable;
+    io.supply_ok = c.supply_ok;
+    io.sto_active = c.sto_active;
+    let Some(out) = out else {
+        io.position_inc = motor.position_inc_i64() as i32;
+        return io;
+    };
+    io.position_inc = out.position_inc;
+    let sw = motor.switches();
+    // electrical level -> "switch actuated" (normally closed contacts read low when hit)
+    let hit = |which: Input| out.inputs.get(which) != sw.get(which).is_active_low();
+    io.limit_positive = hit(Input::PositiveLimit);
+    io.limit_negative = hit(Input::NegativeLimit);
+    io.reference = hit(Input::Reference);
+    io.index = out.index.map(|i| IndexLatch {
+        position_inc: i.position_inc,
+        time_ns: out.step_start_ns + i.time_offset_ns,
+    });
+    let probes = out.edges.iter().filter_map(|e| {
+        let input = match e.input {
+            Input::Probe1 => 1,
+            Input::Probe2 => 2,
+            _ => return None,
+        };
+        Some(ProbeEdge {
+            input,
+            rising: e.rising,
+            time_ns: out.step_start_ns + e.time_offset_ns,
+            position_inc: Some(e.position_inc),
+        })
+    });
+    for (slot, edge) in io.probe_edges.iter_mut().zip(probes) {
+        *slot = Some(edge);
+    }
+    io
+}
+
 impl SimDrive {
-    /// A drive powered on with empty non-volatile memory.
+    /// A drive powered on with empty non-volatile memory and default servo motors.
     pub fn new() -> Self {
         Self::power_on(SimFlash::new())
     }
@@ -52,11 +128,16 @@ impl SimDrive {
             esc,
             drive: drive::runtime::Drive::new(flash),
             state_log: Vec::new(),
+            motors: [Motor::default_servo(), Motor::default_servo()],
+            conditions: [AxisConditions::READY; 2],
+            cycle_ns: CONTROL_CYCLE_NS,
+            feedback: [None, None],
+            next_cycle_ns: CONTROL_CYCLE_NS,
         }
     }
 
-    /// Switches the drive off and on again: RAM values and ESC state are lost,
-    /// the non-volatile memory stays.
+    /// Switches the drive off and on again: RAM values, ESC state and motor
+    /// motion are lost, the non-volatile memory stays.
     pub fn power_cycle(&mut self) {
         let flash = std::mem::replace(self, Self::power_on(SimFlash::new()))
             .drive
@@ -64,9 +145,28 @@ impl SimDrive {
         *self = Self::power_on(flash);
     }
 
-    /// Runs the slave firmware once at `now_ns`.
+    /// Runs the drive firmware up to `now_ns`: every control cycle that is due
+    /// (axis runtime, then one motor step with the commanded torque), then the
+    /// communication stack once.
     pub fn poll(&mut self, now_ns: u64) {
         self.esc.tick(now_ns);
+        while self.next_cycle_ns <= now_ns {
+            let t = self.next_cycle_ns;
+            let io = [
+                axis_io(self.feedback[0].as_ref(), &self.motors[0], self.conditions[0]),
+                axis_io(self.feedback[1].as_ref(), &self.motors[1], self.conditions[1]),
+            ];
+            let cmd = self.drive.control_cycle(t, &io);
+            for ((motor, fb), c) in self.motors.iter_mut().zip(self.feedback.iter_mut()).zip(cmd) {
+                let torque = if c.power_stage {
+                    f64::from(c.torque_nm)
+                } else {
+                    0.0
+                };
+                *fb = Some(motor.step(torque, !c.brake_release, self.cycle_ns));
+            }
+            self.next_cycle_ns += self.cycle_ns;
+        }
         let mut pdi = self.esc.pdi();
         if let Ok(Some(change)) = self.drive.poll(&mut pdi, now_ns) {
             self.state_log.push((now_ns, change));

@@ -244,15 +244,25 @@ fn e048_e034_a_remapped_layout_is_decoded_and_encoded_as_mapped() {
         }
         sd.outputs_raw_mut()
             .copy_from_slice(&[0x78, 0x56, 0x34, 0x12, 0x07, 0x00]);
-        set(&sim, 0x606C, 0, -1);
-        set(&sim, 0x6041, 0, 0x1637);
+        // the axis runtime owns 606Ch and 6041h now: the TxPDO must carry what it wrote
         for _ in 0..3 {
             group.tx_rx(md).await.expect("cycle");
         }
         assert_eq!(get(&sim, 0x60FF, 0), 0x1234_5678, "target velocity @0");
         assert_eq!(get(&sim, 0x6040, 0), 7, "controlword @4");
         assert_eq!(get(&sim, 0x607A, 0), default_of(0x607A, 0), "unmapped: untouched");
-        assert_eq!(sd.io_raw().inputs(), &[0xFF, 0xFF, 0xFF, 0xFF, 0x37, 0x16]);
+        let mut expected = (get(&sim, 0x606C, 0) as i32).to_le_bytes().to_vec();
+        expected.extend_from_slice(&(get(&sim, 0x6041, 0) as u16).to_le_bytes());
+        assert_eq!(
+            sd.io_raw().inputs(),
+            &expected[..],
+            "velocity actual @0, statusword @4"
+        );
+        assert_eq!(
+            get(&sim, 0x6041, 0) & 0x6F,
+            0x40,
+            "statusword: switch on disabled"
+        );
         assert_eq!(al_status(&sd).await, (OP, 0));
     });
 }

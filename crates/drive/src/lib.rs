@@ -28,6 +28,7 @@
 use ecat::desc::coe_details;
 use ecat::{DataType, DcOpMode, Device, FmmuUsage, Identity, MailboxSm, Pdo, PdoEntry, ProcessSm};
 
+pub mod axis;
 pub mod dictionary;
 pub mod doc;
 pub mod objects;

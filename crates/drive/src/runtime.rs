@@ -21,6 +21,7 @@
 //! Below Op the RxPDO objects keep those defaults (or what an SDO write put
 //! there): RxPDO content is never evaluated outside Op.
 
+use crate::axis::{Axis, AxisCommand, AxisIo};
 use crate::dictionary::{DriveObjects, LiveValues, PERSISTENT_IMAGE_BYTES};
 use crate::objects::LAYOUT_HASH;
 use crate::pdo_image::{PdoImage, PdoImageError};
@@ -99,6 +100,11 @@ pub struct Drive<F: Flash> {
     last_state: AlState,
     /// `Slave::outputs_received` after the previous poll.
     last_rx_frames: u32,
+    /// The two axes (A, B), stepped by [`Drive::control_cycle`].
+    pub axes: [Axis; 2],
+    /// `Slave::outputs_received` at the previous control cycle (new
+    /// cyclic set-points).
+    ctl_rx_frames: u32,
 }
 
 impl<F: Flash> Drive<F> {
@@ -127,6 +133,8 @@ impl<F: Flash> Drive<F> {
             pdo_error: None,
             last_state: AlState::Init,
             last_rx_frames: 0,
+            axes: [Axis::new(0), Axis::new(1)],
+            ctl_rx_frames: 0,
         };
         drive.compile_pdo_image();
         drive.update_live();
@@ -231,6 +239,48 @@ impl<F: Flash> Drive<F> {
             let _ = self.objects.set(0x10F3, 4, i64::from(self.diag.new_messages()));
             self.pdo.fill_inputs(&self.objects, self.slave.inputs_mut());
         }
+    }
+
+    /// One control cycle (A150) of both axes at `now_ns` with the hardware
+    /// inputs `io`; returns the power-stage commands. Call it once per
+    /// control cycle (SYNC0 / the control timer), independent of
+    /// [`poll`](Self::poll): the set-points are the objects as the last poll
+    /// left them, the actual values written here go out with the next poll.
+    ///
+    /// A new cyclic set-point (csp/csv/ip) is taken when an RxPDO frame
+    /// arrived in Op since the last control cycle; outside Op (set-points
+    /// written by SDO or directly) every cycle carries one. Use
+    /// [`control_cycle_with`](Self::control_cycle_with) to say it explicitly.
+    pub fn control_cycle(&mut self, now_ns: u64, io: &[AxisIo; 2]) -> [AxisCommand; 2] {
+        let frames = self.slave.outputs_received();
+        let new = self.slave.state() != AlState::Op || frames != self.ctl_rx_frames;
+        self.ctl_rx_frames = frames;
+        self.control_cycle_with(now_ns, io, [new, new])
+    }
+
+    /// [`control_cycle`](Self::control_cycle) with the "new set-point" flag
+    /// of each axis given by the caller (e.g. a per-cycle RxPDO flag of the
+    /// board). Queues the axes' EMCYs (fault on T13, fault cleared on T15)
+    /// and keeps 1001h (error register) at the OR of both axes' faults.
+    pub fn control_cycle_with(
+        &mut self,
+        now_ns: u64,
+        io: &[AxisIo; 2],
+        new_setpoint: [bool; 2],
+    ) -> [AxisCommand; 2] {
+        let mut commands = [AxisCommand::OFF; 2];
+        let mut register = 0u8;
+        let axes = self.axes.iter_mut().zip(io).zip(new_setpoint);
+        for (((axis, io), new), command) in axes.zip(commands.iter_mut()) {
+            let report = axis.cycle(&mut self.objects, io, now_ns, new);
+            if let Some(e) = report.emcy {
+                self.slave.emergency(e);
+            }
+            register |= axis.error_register();
+            *command = report.command;
+        }
+        let _ = self.objects.set(0x1001, 0, i64::from(register));
+        commands
     }
 
     /// Reads an object as the bus sees it (live values included), without the bus.

@@ -1,0 +1,206 @@
+//! One control cycle's view of an axis' set-point and configuration objects
+//! (read from [`DriveObjects`] at the axis' window) and the actual values
+//! written back.
+//!
+//! Every read falls back to the declared default's meaning when an object is
+//! missing or unreadable, so a dictionary change never stops the control
+//! cycle. Units are the objects' (increments, inc/s, inc/s², inc/s³, 0.1 % of
+//! the rated torque, ms, µs).
+
+use crate::dictionary::DriveObjects;
+use crate::{parameter_index, AXIS_B_CIA402, AXIS_B_MANUFACTURER};
+
+/// 1 rev = 2^20 increments (6092h default feed).
+const REV: i64 = 1 << 20;
+
+/// A150 application cycle time (µs, global).
+pub(crate) const A150: u16 = parameter_index(0, 150);
+/// A291 PLC cycle time (µs, global), the copy of 60C2h (C-114).
+pub(crate) const A291: u16 = parameter_index(0, 291);
+/// E48 device state (per axis).
+pub(crate) const E48: u16 = parameter_index(4, 48);
+
+/// The object window of one axis: CiA 402 objects at +800h, per-axis
+/// manufacturer parameters at +8000h for axis B.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub(crate) struct Window {
+    /// 0 = axis A, 1 = axis B.
+    pub axis: u8,
+}
+
+impl Window {
+    /// The axis' index of CiA 402 object `index` (axis-A numbering).
+    pub const fn cia402(self, index: u16) -> u16 {
+        if self.axis == 0 {
+            index
+        } else {
+            index.wrapping_add(AXIS_B_CIA402)
+        }
+    }
+
+    /// The axis' index of per-axis manufacturer parameter `index` (axis-A
+    /// numbering).
+    pub const fn manufacturer(self, index: u16) -> u16 {
+        if self.axis == 0 {
+            index
+        } else {
+            index.wrapping_add(AXIS_B_MANUFACTURER)
+        }
+    }
+
+    /// CiA 402 entry `index`:`sub` of this axis, or `default`.
+    pub fn get(self, od: &DriveObjects, index: u16, sub: u8, default: i64) -> i64 {
+        od.get(self.cia402(index), sub).unwrap_or(default)
+    }
+
+    /// Writes CiA 402 entry `index`:`sub` of this axis (clamped to the
+    /// entry's type by the caller; errors are ignored: a missing actual
+    /// value object must not stop the control cycle).
+    pub fn put(self, od: &mut DriveObjects, index: u16, sub: u8, value: i64) {
+        let _ = od.set(self.cia402(index), sub, value);
+    }
+}
+
+/// The objects the control cycle reads, one snapshot per cycle.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub(crate) struct Snapshot {
+    /// 6040h controlword.
+    pub controlword: u16,
+    /// 6060h modes of operation.
+    pub mode: i8,
+    /// 607Ah target position, inc.
+    pub target_position: i32,
+    /// 60C1h:01 ip set-point, inc.
+    pub ip_setpoint: i32,
+    /// 60FFh target velocity, inc/s.
+    pub target_velocity: i32,
+    /// 6071h target torque, 0.1 %.
+    pub target_torque: i16,
+    /// 60B1h velocity offset, inc/s.
+    pub velocity_offset: i32,
+    /// 60B2h torque offset, 0.1 %.
+    pub torque_offset: i16,
+    /// 6072h max torque, 0.1 %.
+    pub max_torque: u16,
+    /// 6087h torque slope, 0.1 %/s (0 = step).
+    pub torque_slope: u32,
+    /// 6081h profile velocity, inc/s.
+    pub profile_velocity: u32,
+    /// 607Fh max profile velocity, inc/s.
+    pub max_profile_velocity: u32,
+    /// 6083h profile acceleration, inc/s².
+    pub acceleration: u32,
+    /// 6084h profile deceleration, inc/s².
+    pub deceleration: u32,
+    /// 6085h quick stop deceleration, inc/s².
+    pub quick_stop_deceleration: u32,
+    /// 60A4h:01 profile jerk, inc/s³ (0 = no jerk limit).
+    pub jerk: u32,
+    /// 60F2h positioning option code.
+    pub positioning_option: u16,
+    /// 605Ah quick stop option code.
+    pub quick_stop_option: i16,
+    /// 605Eh fault reaction option code.
+    pub fault_reaction_option: i16,
+    /// 6065h following error window, inc (`u32::MAX` = off).
+    pub following_error_window: u32,
+    /// 6066h following error time out, ms.
+    pub following_error_timeout_ms: u16,
+    /// 607Dh:01 / :02 software position limits, inc.
+    pub software_min: i32,
+    /// 607Dh:02.
+    pub software_max: i32,
+    /// 607Eh polarity (bit 7: position polarity).
+    pub polarity: u8,
+    /// 6098h homing method.
+    pub homing_method: i8,
+    /// 6099h:01 speed during search for switch, inc/s.
+    pub homing_fast: u32,
+    /// 6099h:02 speed during search for zero, inc/s.
+    pub homing_slow: u32,
+    /// 609Ah homing acceleration, inc/s².
+    pub homing_acceleration: u32,
+    /// 607Ch home offset, inc.
+    pub home_offset: i32,
+    /// 60B8h touch probe function.
+    pub probe_function: u16,
+    /// 60D0h:01 / :02 touch probe sources (1 = input 1, 2 = input 2).
+    pub probe_source: [i16; 2],
+    /// 6042h vl target velocity, rpm.
+    pub vl_target: i16,
+    /// 6046h:01 / :02 vl velocity min / max amount, rpm.
+    pub vl_min: u32,
+    /// 6046h:02.
+    pub vl_max: u32,
+    /// 6048h vl acceleration: delta speed (rpm), delta time (s).
+    pub vl_acceleration: (u32, u16),
+    /// 6049h vl deceleration.
+    pub vl_deceleration: (u32, u16),
+    /// 604Ah vl quick stop.
+    pub vl_quick_stop: (u32, u16),
+    /// A150 application (control) cycle, µs.
+    pub control_cycle_us: u16,
+    /// 60C2h:01 interpolation time period value.
+    pub period_value: u8,
+    /// 60C2h:02 interpolation time index.
+    pub period_index: i8,
+}
+
+fn sat<T: TryFrom<i64> + Copy>(v: i64, lo: T, hi: T) -> T {
+    T::try_from(v).unwrap_or(if v < 0 { lo } else { hi })
+}
+
+impl Snapshot {
+    /// Reads the snapshot of axis `w`.
+    pub fn read(od: &DriveObjects, w: Window) -> Self {
+        let i32_ = |index: u16, sub: u8, d: i64| sat(w.get(od, index, sub, d), i32::MIN, i32::MAX);
+        let u32_ = |index: u16, sub: u8, d: i64| sat(w.get(od, index, sub, d), 0u32, u32::MAX);
+        let u16_ = |index: u16, sub: u8, d: i64| sat(w.get(od, index, sub, d), 0u16, u16::MAX);
+        let i16_ = |index: u16, sub: u8, d: i64| sat(w.get(od, index, sub, d), i16::MIN, i16::MAX);
+        let i8_ = |index: u16, sub: u8, d: i64| sat(w.get(od, index, sub, d), i8::MIN, i8::MAX);
+        let u8_ = |index: u16, sub: u8, d: i64| sat(w.get(od, index, sub, d), 0u8, u8::MAX);
+        let ramp = |index: u16| (u32_(index, 1, 3000), u16_(index, 2, 1));
+        Snapshot {
+            controlword: u16_(0x6040, 0, 0),
+            mode: i8_(0x6060, 0, 8),
+            target_position: i32_(0x607A, 0, 0),
+            ip_setpoint: i32_(0x60C1, 1, 0),
+            target_velocity: i32_(0x60FF, 0, 0),
+            target_torque: i16_(0x6071, 0, 0),
+            velocity_offset: i32_(0x60B1, 0, 0),
+            torque_offset: i16_(0x60B2, 0, 0),
+            max_torque: u16_(0x6072, 0, 3000),
+            torque_slope: u32_(0x6087, 0, 0),
+            profile_velocity: u32_(0x6081, 0, 10 * REV),
+            max_profile_velocity: u32_(0x607F, 0, 50 * REV),
+            acceleration: u32_(0x6083, 0, 100 * REV),
+            deceleration: u32_(0x6084, 0, 100 * REV),
+            quick_stop_deceleration: u32_(0x6085, 0, 1000 * REV),
+            jerk: u32_(0x60A4, 1, 0),
+            positioning_option: u16_(0x60F2, 0, 0),
+            quick_stop_option: i16_(0x605A, 0, 2),
+            fault_reaction_option: i16_(0x605E, 0, 2),
+            following_error_window: u32_(0x6065, 0, i64::from(u32::MAX)),
+            following_error_timeout_ms: u16_(0x6066, 0, 10),
+            software_min: i32_(0x607D, 1, 0),
+            software_max: i32_(0x607D, 2, 0),
+            polarity: u8_(0x607E, 0, 0),
+            homing_method: i8_(0x6098, 0, 35),
+            homing_fast: u32_(0x6099, 1, 2 * REV),
+            homing_slow: u32_(0x6099, 2, REV / 4),
+            homing_acceleration: u32_(0x609A, 0, 100 * REV),
+            home_offset: i32_(0x607C, 0, 0),
+            probe_function: u16_(0x60B8, 0, 0),
+            probe_source: [i16_(0x60D0, 1, 1), i16_(0x60D0, 2, 2)],
+            vl_target: i16_(0x6042, 0, 0),
+            vl_min: u32_(0x6046, 1, 0),
+            vl_max: u32_(0x6046, 2, 3000),
+            vl_acceleration: ramp(0x6048),
+            vl_deceleration: ramp(0x6049),
+            vl_quick_stop: ramp(0x604A),
+            control_cycle_us: sat(od.get(A150, 0).unwrap_or(1000), 0u16, u16::MAX),
+            period_value: u8_(0x60C2, 1, 1),
+            period_index: i8_(0x60C2, 2, -3),
+        }
+    }
+}

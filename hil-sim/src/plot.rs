@@ -1,0 +1,132 @@
+//! Time traces of a simulated run and their SVG plot: set and actual
+//! position, velocity, torque and following error over time.
+
+use plotters::prelude::*;
+use std::path::Path;
+
+/// One axis' signals sampled once per master cycle.
+#[derive(Debug, Default, Clone)]
+pub struct Trace {
+    /// Simulated time, ms.
+    pub t_ms: Vec<f64>,
+    /// Position set-point (607Ah), revolutions.
+    pub set_rev: Vec<f64>,
+    /// Position actual value (6064h), revolutions.
+    pub act_rev: Vec<f64>,
+    /// Velocity actual value (606Ch), rpm.
+    pub vel_rpm: Vec<f64>,
+    /// Torque actual value (6077h), % of rated torque.
+    pub torque_pct: Vec<f64>,
+    /// Following error (60F4h), increments.
+    pub ferr_inc: Vec<f64>,
+}
+
+/// One line of a panel: values, colour, legend.
+type Line<'a> = (&'a [f64], RGBColor, &'static str);
+
+/// Increments per revolution (2^20).
+const INC_PER_REV: f64 = 1_048_576.0;
+
+impl Trace {
+    /// Appends one sample: positions and following error in increments,
+    /// velocity in increments per second, torque in 0.1 % of rated torque.
+    pub fn push(
+        &mut self,
+        t_ns: u64,
+        set_inc: i32,
+        act_inc: i32,
+        vel_inc_s: i32,
+        torque_permille: i16,
+        ferr_inc: i32,
+    ) {
+        self.t_ms.push(t_ns as f64 / 1e6);
+        self.set_rev.push(f64::from(set_inc) / INC_PER_REV);
+        self.act_rev.push(f64::from(act_inc) / INC_PER_REV);
+        self.vel_rpm.push(f64::from(vel_inc_s) / INC_PER_REV * 60.0);
+        self.torque_pct.push(f64::from(torque_permille) / 10.0);
+        self.ferr_inc.push(f64::from(ferr_inc));
+    }
+
+    /// Number of samples.
+    pub fn len(&self) -> usize {
+        self.t_ms.len()
+    }
+
+    /// No samples yet.
+    pub fn is_empty(&self) -> bool {
+        self.t_ms.is_empty()
+    }
+
+    /// Maximum and RMS of |following error| in increments.
+    pub fn following_error_stats(&self) -> (f64, f64) {
+        let n = self.ferr_inc.len().max(1) as f64;
+        let max = self.ferr_inc.iter().fold(0.0f64, |m, v| m.max(v.abs()));
+        let rms = (self.ferr_inc.iter().map(|v| v * v).sum::<f64>() / n).sqrt();
+        (max, rms)
+    }
+
+    /// Writes a four-panel SVG plot to `path`.
+    pub fn write_svg(&self, path: &Path, title: &str) -> Result<(), String> {
+        let root = SVGBackend::new(path, (1100, 1000)).into_drawing_area();
+        root.fill(&WHITE).map_err(|e| e.to_string())?;
+        let root = root
+            .titled(title, ("sans-serif", 22))
+            .map_err(|e| e.to_string())?;
+        let panels = root.split_evenly((4, 1));
+        let t_end = self.t_ms.last().copied().unwrap_or(1.0).max(1e-3);
+        let t0 = self.t_ms.first().copied().unwrap_or(0.0);
+        let series: [(&str, Vec<Line>); 4] = [
+            (
+                "position [rev]",
+                vec![
+                    (&self.set_rev, BLUE, "set 607Ah"),
+                    (&self.act_rev, RED, "actual 6064h"),
+                ],
+            ),
+            ("velocity [rpm]", vec![(&self.vel_rpm, GREEN, "actual 606Ch")]),
+            (
+                "torque [% rated]",
+                vec![(&self.torque_pct, MAGENTA, "actual 6077h")],
+            ),
+            ("following error [inc]", vec![(&self.ferr_inc, BLACK, "60F4h")]),
+        ];
+        for (area, (label, lines)) in panels.iter().zip(series.iter()) {
+            let (lo, hi) = lines
+                .iter()
+                .flat_map(|(v, _, _)| v.iter())
+                .fold((f64::MAX, f64::MIN), |(lo, hi), &v| (lo.min(v), hi.max(v)));
+            let (lo, hi) = if lo > hi { (-1.0, 1.0) } else { (lo, hi) };
+            let pad = ((hi - lo) * 0.08).max(1e-9);
+            let mut chart = ChartBuilder::on(area)
+                .margin(8)
+                .x_label_area_size(30)
+                .y_label_area_size(70)
+                .build_cartesian_2d(t0..t_end, (lo - pad)..(hi + pad))
+                .map_err(|e| e.to_string())?;
+            chart
+                .configure_mesh()
+                .x_desc("time [ms]")
+                .y_desc(*label)
+                .draw()
+                .map_err(|e| e.to_string())?;
+            for (values, color, name) in lines {
+                let color = *color;
+                chart
+                    .draw_series(LineSeries::new(
+                        self.t_ms.iter().copied().zip(values.iter().copied()),
+                        color,
+                    ))
+                    .map_err(|e| e.to_string())?
+                    .label(*name)
+                    .legend(move |(x, y)| PathElement::new(vec![(x, y), (x + 18, y)], color));
+            }
+            chart
+                .configure_series_labels()
+                .background_style(WHITE.mix(0.8))
+                .border_style(BLACK)
+                .draw()
+                .map_err(|e| e.to_string())?;
+        }
+        root.present().map_err(|e| e.to_string())
+    }
+}
