@@ -537,3 +537,251 @@ impl CoeClient {
         })
     }
 }
+
+// ---------------------------------------------------------------------------
+// Cyclic process data with the default PDO layout (tests/tests/motion.rs)
+// ---------------------------------------------------------------------------
+
+/// A group in Op as [`init`] + `into_op` leave it.
+pub type OpGroup = ethercrab::SubDeviceGroup<
+    8,
+    512,
+    ethercrab::DefaultLock,
+    ethercrab::subdevice_group::Op,
+    ethercrab::subdevice_group::NoDc,
+>;
+
+/// One master cycle of the simulated line, ns (the drive's A150 default).
+pub const MASTER_CYCLE_NS: u64 = hil_sim::sim::CONTROL_CYCLE_NS;
+
+/// Standard RxPDO length (C-130): 6040h, 6060h, 607Ah, 60FFh, 60B1h, 60B2h, 6071h, 60FEh:01.
+pub const RXPDO_LEN: usize = 23;
+/// Standard TxPDO length (C-131).
+pub const TXPDO_LEN: usize = 29;
+
+/// The standard TxPDO of axis A as the master received it (C-131 offsets).
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
+pub struct TxPdo {
+    /// 6041h statusword @0.
+    pub statusword: u16,
+    /// 6061h modes of operation display @2.
+    pub mode_display: i8,
+    /// 6064h position actual value @3, inc.
+    pub position: i32,
+    /// 606Ch velocity actual value @7, inc/s.
+    pub velocity: i32,
+    /// 6077h torque actual value @11, 0.1 % of 6076h.
+    pub torque: i16,
+    /// 60F4h following error actual value @13, inc.
+    pub following_error: i32,
+    /// 60FDh digital inputs @17.
+    pub digital_inputs: u32,
+    /// 60E4h:01 additional position actual value @21, inc.
+    pub additional_position: i32,
+    /// E201 @25.
+    pub e201: u16,
+    /// A67 user statusword @27.
+    pub a67: u16,
+}
+
+impl TxPdo {
+    /// Decodes the 29-byte standard TxPDO.
+    pub fn decode(b: &[u8]) -> Self {
+        assert_eq!(b.len(), TXPDO_LEN, "standard TxPDO length");
+        let u16_ = |o: usize| u16::from_le_bytes([b[o], b[o + 1]]);
+        let i32_ = |o: usize| i32::from_le_bytes([b[o], b[o + 1], b[o + 2], b[o + 3]]);
+        Self {
+            statusword: u16_(0),
+            mode_display: b[2] as i8,
+            position: i32_(3),
+            velocity: i32_(7),
+            torque: u16_(11) as i16,
+            following_error: i32_(13),
+            digital_inputs: i32_(17) as u32,
+            additional_position: i32_(21),
+            e201: u16_(25),
+            a67: u16_(27),
+        }
+    }
+
+    /// Statusword bits 0–6 with the CiA 402 state mask 0x6F (bit 4 voltage
+    /// enabled is not part of the state).
+    pub fn state(&self) -> u16 {
+        self.statusword & 0x6F
+    }
+
+    /// Statusword bit `n`.
+    pub fn bit(&self, n: u8) -> bool {
+        self.statusword & (1 << n) != 0
+    }
+}
+
+/// Statusword patterns (& 0x6F) of the CiA 402 states (C-018).
+pub mod sw {
+    /// Switch on disabled.
+    pub const SOD: u16 = 0x0040;
+    /// Ready to switch on.
+    pub const RTSO: u16 = 0x0021;
+    /// Switched on.
+    pub const SO: u16 = 0x0023;
+    /// Operation enabled.
+    pub const OE: u16 = 0x0027;
+    /// Quick stop active.
+    pub const QSA: u16 = 0x0007;
+    /// Fault reaction active.
+    pub const FRA: u16 = 0x000F;
+    /// Fault.
+    pub const FAULT: u16 = 0x0008;
+}
+
+/// A master running the standard process data of one drive in Op: each
+/// [`cycle`](Self::cycle) writes the outputs, lets the simulated line run one
+/// master cycle (1 ms: the drive's control cycle and polls), then exchanges
+/// the process data (one LRW) and decodes the drive's TxPDO.
+pub struct Cyclic<'a> {
+    /// The master.
+    pub md: &'a MainDevice<'a>,
+    /// The group in Op.
+    pub group: &'a OpGroup,
+    /// The simulated line.
+    pub sim: &'a RefCell<Simulation>,
+    /// Position of the drive in the group.
+    pub slave: usize,
+    /// The RxPDO image sent every cycle.
+    pub out: [u8; RXPDO_LEN],
+    /// The last TxPDO received.
+    pub tx: TxPdo,
+    /// Master cycles run so far.
+    pub cycles: u64,
+}
+
+impl<'a> Cyclic<'a> {
+    /// A master on drive `slave` of `group`; the outputs start all zero
+    /// (controlword 0, mode 0).
+    pub fn new(
+        md: &'a MainDevice<'a>,
+        group: &'a OpGroup,
+        sim: &'a RefCell<Simulation>,
+        slave: usize,
+    ) -> Self {
+        let sd = group.subdevice(md, slave).expect("subdevice");
+        let io = sd.io_raw();
+        assert_eq!(io.outputs().len(), RXPDO_LEN, "standard RxPDO length");
+        assert_eq!(io.inputs().len(), TXPDO_LEN, "standard TxPDO length");
+        Self {
+            md,
+            group,
+            sim,
+            slave,
+            out: [0; RXPDO_LEN],
+            tx: TxPdo::default(),
+            cycles: 0,
+        }
+    }
+
+    fn put(&mut self, offset: usize, bytes: &[u8]) {
+        self.out[offset..offset + bytes.len()].copy_from_slice(bytes);
+    }
+
+    /// 6040h controlword @0.
+    pub fn set_controlword(&mut self, cw: u16) {
+        self.put(0, &cw.to_le_bytes());
+    }
+
+    /// The controlword being sent.
+    pub fn controlword(&self) -> u16 {
+        u16::from_le_bytes([self.out[0], self.out[1]])
+    }
+
+    /// 6060h modes of operation @2.
+    pub fn set_mode(&mut self, mode: i8) {
+        self.out[2] = mode as u8;
+    }
+
+    /// 607Ah target position @3, inc.
+    pub fn set_target_position(&mut self, p: i32) {
+        self.put(3, &p.to_le_bytes());
+    }
+
+    /// 60FFh target velocity @7, inc/s.
+    pub fn set_target_velocity(&mut self, v: i32) {
+        self.put(7, &v.to_le_bytes());
+    }
+
+    /// 60B1h velocity offset @11, inc/s.
+    pub fn set_velocity_offset(&mut self, v: i32) {
+        self.put(11, &v.to_le_bytes());
+    }
+
+    /// 60B2h torque offset @15, 0.1 %.
+    pub fn set_torque_offset(&mut self, t: i16) {
+        self.put(15, &t.to_le_bytes());
+    }
+
+    /// 6071h target torque @17, 0.1 %.
+    pub fn set_target_torque(&mut self, t: i16) {
+        self.put(17, &t.to_le_bytes());
+    }
+
+    /// One master cycle; returns the TxPDO received.
+    pub async fn cycle(&mut self) -> TxPdo {
+        let sd = self.group.subdevice(self.md, self.slave).expect("subdevice");
+        sd.outputs_raw_mut().copy_from_slice(&self.out);
+        {
+            let mut sim = self.sim.borrow_mut();
+            let t = sim.now_ns() + MASTER_CYCLE_NS;
+            sim.advance_to(t);
+        }
+        let r = self.group.tx_rx(self.md).await.expect("process data cycle");
+        assert_eq!(r.working_counter, 3, "outputs written and inputs read");
+        self.tx = TxPdo::decode(sd.io_raw().inputs());
+        self.cycles += 1;
+        self.tx
+    }
+
+    /// `n` master cycles; returns the last TxPDO.
+    pub async fn run(&mut self, n: usize) -> TxPdo {
+        for _ in 0..n {
+            self.cycle().await;
+        }
+        self.tx
+    }
+
+    /// Runs up to `max` cycles until `pred` holds for the TxPDO; returns the
+    /// number of cycles it took, `None` if it never held.
+    pub async fn run_until(&mut self, max: usize, mut pred: impl FnMut(&TxPdo) -> bool) -> Option<usize> {
+        for k in 1..=max {
+            let tx = self.cycle().await;
+            if pred(&tx) {
+                return Some(k);
+            }
+        }
+        None
+    }
+
+    /// Sends `cw` until the statusword state (& 0x6F) is `state`, at most
+    /// `max` cycles; panics otherwise.
+    pub async fn command(&mut self, cw: u16, state: u16, max: usize) -> TxPdo {
+        self.set_controlword(cw);
+        let ok = self.run_until(max, |t| t.state() == state).await;
+        assert!(
+            ok.is_some(),
+            "controlword {cw:#06x}: statusword {:#06x}, expected state {state:#06x}",
+            self.tx.statusword
+        );
+        self.tx
+    }
+
+    /// Shutdown (6), switch on (7), enable operation (15), each until its
+    /// state shows in the TxPDO.
+    pub async fn enable(&mut self) -> TxPdo {
+        self.command(0x0006, sw::RTSO, 20).await;
+        self.command(0x0007, sw::SO, 20).await;
+        self.command(0x000F, sw::OE, 20).await
+    }
+
+    /// Simulated time, ns.
+    pub fn now_ns(&self) -> u64 {
+        self.sim.borrow().now_ns()
+    }
+}

@@ -37,10 +37,10 @@ fn main() {
     let mut motors = [Motor::default_servo(), Motor::default_servo()];
     let mut pos = [0i32; 2];
     let mut now = 0u64;
-    let mut step = |drive: &mut drive::runtime::Drive<SimFlash>,
-                    motors: &mut [Motor; 2],
-                    pos: &mut [i32; 2],
-                    now: &mut u64| {
+    let step = |drive: &mut drive::runtime::Drive<SimFlash>,
+                motors: &mut [Motor; 2],
+                pos: &mut [i32; 2],
+                now: &mut u64| {
         *now += CONTROL_CYCLE_NS;
         let io = [AxisIo::ready(pos[0]), AxisIo::ready(pos[1])];
         let t0 = Instant::now();
