@@ -24,7 +24,8 @@ pub fn with_master<T>(
     sim: &RefCell<Simulation>,
     body: impl for<'a> AsyncFnOnce(&'a MainDevice<'a>, &'a AtomicU64) -> T,
 ) -> T {
-    // 100 instead of 10 000 DC static-sync frames: the simulated clocks do not drift yet
+    // 100 instead of 10 000 DC static-sync frames: the simulated clocks run without drift
+    // unless a test sets one (hil-sim/tests/dc.rs uses the full static sync)
     let config = ethercrab::MainDeviceConfig {
         dc_static_sync_iterations: 100,
         ..Default::default()

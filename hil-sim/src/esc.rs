@@ -38,8 +38,11 @@
 )]
 #![deny(missing_docs)]
 
+mod dc;
 mod eeprom;
 mod sm;
+
+pub use dc::{LineTiming, SyncPulses, MAX_CORRECTION_PPT, MAX_DRIFT_PPB};
 
 use ::esc::{
     regs::{self, al_event},
@@ -48,6 +51,7 @@ use ::esc::{
 use core::convert::Infallible;
 
 use crate::frame::{Command, Datagram};
+use dc::DcState;
 use sm::SmState;
 
 /// Size of the memory image: registers 0x0000–0x0FFF plus 8 KiB process RAM.
@@ -92,6 +96,11 @@ pub struct EscConfig {
     /// Simulated duration of an SII EEPROM command; 0 completes immediately
     /// (BUSY is then never seen).
     pub sii_busy_ns: u64,
+    /// Drift of the ESC's oscillator, ppb (+: the local clock runs fast),
+    /// clamped to ±[`MAX_DRIFT_PPB`].
+    pub clock_drift_ppb: i32,
+    /// Local time at simulation time 0, ns.
+    pub clock_offset_ns: u64,
 }
 
 impl EscConfig {
@@ -107,6 +116,8 @@ impl EscConfig {
         features: 0,
         dc_supported: true,
         sii_busy_ns: 0,
+        clock_drift_ppb: 0,
+        clock_offset_ns: 0,
     };
 }
 
@@ -205,6 +216,8 @@ pub struct Esc {
     pd_wd_trigger: Option<u64>,
     /// Last retrigger of the PDI watchdog (None: not running / expired).
     pdi_wd_trigger: Option<u64>,
+    /// Distributed clocks: local clock, drift-control loop, cyclic unit.
+    dc: DcState,
 }
 
 impl core::fmt::Debug for Esc {
@@ -237,6 +250,7 @@ impl Esc {
             sii_pending: None,
             pd_wd_trigger: None,
             pdi_wd_trigger: None,
+            dc: DcState::new(config.clock_drift_ppb, config.clock_offset_ns),
         };
         for (dst, src) in esc.sii.iter_mut().zip(sii) {
             *dst = *src;
@@ -263,6 +277,10 @@ impl Esc {
         esc.set_u16(regs::WATCHDOG_DIVIDER, DEFAULT_WATCHDOG_DIVIDER);
         esc.set_u16(regs::WATCHDOG_TIME_PDI, DEFAULT_WATCHDOG_TIME);
         esc.set_u16(regs::WATCHDOG_TIME_PD, DEFAULT_WATCHDOG_TIME);
+        // ET1100 defaults of the drift-control loop
+        esc.set_u16(regs::dc::SPEED_COUNTER_START, 0x1000);
+        esc.set_u8(regs::dc::FILTER_DEPTH_TIME, 0x04);
+        esc.set_u8(regs::dc::FILTER_DEPTH_SPEED, 0x0C);
         esc.load_sii_config();
         esc
     }
@@ -334,11 +352,11 @@ impl Esc {
 
     /// Reads physical memory without side effects (tests, CLI): no SyncManager
     /// buffer mapping, no event clearing. Not-present addresses read 0; the
-    /// DC system time (0x0910) is computed as on a real read.
+    /// DC system time (0x0910) is computed as on a real read (at the ESC's time).
     pub fn read_reg(&self, addr: u16, buf: &mut [u8]) {
         for (i, b) in buf.iter_mut().enumerate() {
             let a = u32::from(addr) + i as u32;
-            *b = self.computed(a).unwrap_or_else(|| self.raw(a));
+            *b = self.computed(a, self.now_ns).unwrap_or_else(|| self.raw(a));
         }
     }
 
@@ -377,8 +395,9 @@ impl Esc {
     // ------------------------------------------------------------------- time
 
     /// Advances the ESC's time to `now_ns` (never backwards): completes a
-    /// pending SII command and checks the process-data and PDI watchdogs.
-    /// [`Esc::process_datagram`] calls it too.
+    /// pending SII command, checks the process-data and PDI watchdogs and
+    /// generates the SYNC pulses that are due. [`Esc::process_datagram`] calls
+    /// it too.
     pub fn tick(&mut self, now_ns: u64) {
         self.now_ns = self.now_ns.max(now_ns);
         let now = self.now_ns;
@@ -407,6 +426,7 @@ impl Esc {
                 self.set_u8(regs::WATCHDOG_COUNTER_PDI, c);
             }
         }
+        self.dc_tick(now);
     }
 
     /// Watchdog period in ns for the time register at `reg`; `None` when the time is 0 (disabled).
@@ -436,9 +456,12 @@ impl Esc {
     // ------------------------------------------------------------- datagrams
 
     /// Processes one datagram as it passes this ESC: addressing, memory access
-    /// with all side effects, working counter, ADP auto-increment.
+    /// with all side effects, working counter, ADP auto-increment. `now_ns` is
+    /// the time the frame entered the line; DC registers use the frame's
+    /// arrival at this ESC (see [`Esc::set_line_timing`]).
     pub fn process_datagram(&mut self, dg: &mut Datagram<'_>, now_ns: u64) {
         self.tick(now_ns);
+        self.dc.ecat_time = self.now_ns.saturating_add(self.dc.line.arrival_ns);
         let adp = dg.adp();
         let ado = u32::from(dg.ado());
         let cmd = dg.command();
@@ -497,11 +520,20 @@ impl Esc {
     }
 
     /// ARMW/FRMW: the addressed slave reads, every other slave writes; +1 either way.
+    /// A write that includes 0x0910 (the system time) feeds the drift-control loop.
     fn read_multiple_write(&mut self, addressed: bool, ado: u32, data: &mut [u8]) -> u16 {
         if addressed {
             Kind::Read.wkc(self.access(Side::Ecat, ado, data, Op::Read))
         } else {
-            Kind::Write.wkc(self.access(Side::Ecat, ado, data, Op::Write))
+            let wkc = Kind::Write.wkc(self.access(Side::Ecat, ado, data, Op::Write));
+            let st = u32::from(regs::dc::SYSTEM_TIME);
+            if let Some(off) = st.checked_sub(ado) {
+                let off = off as usize;
+                if let Some(w) = data.get(off..data.len().min(off.saturating_add(8))) {
+                    self.dc_system_time_written(w);
+                }
+            }
+            wkc
         }
     }
 
@@ -572,15 +604,9 @@ impl Esc {
         }
     }
 
-    /// Bytes computed on read: the DC system time (local time + offset).
-    fn computed(&self, a: u32) -> Option<u8> {
-        let st = u32::from(regs::dc::SYSTEM_TIME);
-        if self.config.dc_supported && (st..st + 8).contains(&a) {
-            let offset = self.get_u64(regs::dc::SYSTEM_TIME_OFFSET);
-            let t = self.now_ns.wrapping_add(offset).to_le_bytes();
-            return t.get((a - st) as usize).copied();
-        }
-        None
+    /// Bytes computed on read at time `t`: the DC system time (local time + offset).
+    fn computed(&self, a: u32, t: u64) -> Option<u8> {
+        self.dc_computed(a, t)
     }
 
     /// One access from `side` at `addr` with all ESC side effects.
@@ -627,6 +653,10 @@ impl Esc {
 
         // Data phase, byte by byte.
         let present = self.present_end();
+        let t_read = match side {
+            Side::Ecat => self.dc.ecat_time,
+            Side::Pdi => self.now_ns,
+        };
         for (i, byte) in data.iter_mut().enumerate() {
             let a = addr + i as u32;
             let incoming = *byte;
@@ -650,7 +680,7 @@ impl Esc {
             let value = if a >= present || !rd {
                 0
             } else {
-                self.computed(a).unwrap_or_else(|| self.raw(phys))
+                self.computed(a, t_read).unwrap_or_else(|| self.raw(phys))
             };
             if op.reads() {
                 if op.ors() {
@@ -710,8 +740,11 @@ impl Esc {
                 if touches(regs::dc::RECEIVE_TIME_PORT0, regs::dc::RECEIVE_TIME_PORT0 + 3) {
                     self.dc_latch_receive_times();
                 }
-                if touches(regs::dc::SYSTEM_TIME, regs::dc::SYSTEM_TIME + 7) {
-                    self.dc_system_time_written();
+                if touches(regs::dc::SPEED_COUNTER_START, regs::dc::SPEED_COUNTER_START + 1) {
+                    self.dc_loop_reset();
+                }
+                if touches(regs::dc::ACTIVATION, regs::dc::ACTIVATION) {
+                    self.dc_activation_written();
                 }
                 for reg in [regs::WATCHDOG_COUNTER_PD, regs::WATCHDOG_COUNTER_PDI] {
                     if touches(reg, reg) {
@@ -730,6 +763,7 @@ impl Esc {
                     if touches(regs::WATCHDOG_STATUS_PD, regs::WATCHDOG_STATUS_PD + 1) {
                         self.clear_al_event(al_event::WATCHDOG_PD);
                     }
+                    self.dc_pdi_read(|r| touches(r, r));
                 }
                 if op.writes() {
                     for n in 0..self.config.sm_count {
@@ -781,27 +815,6 @@ impl Esc {
         let e = self.get_u16(regs::ECAT_EVENT_REQUEST) & !bits;
         self.set_u16(regs::ECAT_EVENT_REQUEST, e);
     }
-
-    // -------------------------------------------------------------------- DC
-
-    /// A write to receive time port 0 latches the local time into all ports'
-    /// receive times and the processing unit's receive time.
-    fn dc_latch_receive_times(&mut self) {
-        if !self.config.dc_supported {
-            return;
-        }
-        let now = self.now_ns;
-        // Port 1 sees the frame again after the downstream loop; the
-        // simulation has no cable delay yet (hook for the full DC model).
-        self.set_u32(regs::dc::RECEIVE_TIME_PORT0, now as u32);
-        self.set_u32(regs::dc::RECEIVE_TIME_PORT1, now as u32);
-        self.set_u64(regs::dc::RECEIVE_TIME_PU, now);
-    }
-
-    /// ECAT write of the system time (ARMW/FRMW from the reference clock):
-    /// on a real ESC this feeds the drift-control loop. The simulation has one
-    /// perfect clock, so nothing happens yet (hook for the full DC model).
-    fn dc_system_time_written(&mut self) {}
 
     // ---------------------------------------------------------------- memory
 
@@ -898,6 +911,8 @@ fn writable(side: Side, a: u32) -> bool {
             0x0502..=0x0503 => false,
             // DC receive times (latched by a write), system time, receive time PU
             0x0900..=0x091F => false,
+            // DC system time difference, speed counter difference, cyclic unit status
+            0x092C..=0x092F | 0x0932..=0x0933 | 0x0984 | 0x098E..=0x098F | 0x0998..=0x099F => false,
             _ if (sm_lo..sm_hi).contains(&a) => !matches!((a - sm_lo) % 8, 5 | 7),
             _ => true,
         },

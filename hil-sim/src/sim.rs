@@ -2,19 +2,22 @@
 //! with the real slave stack (`ecat`) and the drive's objects (`drive`) behind
 //! its PDI. Frames from any master go through [`Simulation::exchange`].
 
-use crate::esc::{Esc, EscConfig};
+use crate::esc::{Esc, EscConfig, LineTiming};
 use crate::frame::process_frame;
 use crate::motor::{Input, Motor, MotorOutputs};
 use crate::pcap::PcapWriter;
 use drive::axis::{AxisIo, IndexLatch, ProbeEdge};
+use std::collections::VecDeque;
 use std::fs::File;
 use std::io::{self, BufWriter};
 use std::path::Path;
 
 /// Local poll period of the slave firmware between frames (the mailbox/ESM task), ns.
 pub const POLL_PERIOD_NS: u64 = 100_000;
-/// Forwarding delay of one slave, ns.
+/// Forwarding delay of one slave, ns (out and back: half of it each way).
 const SLAVE_DELAY_NS: u64 = 500;
+/// SYNC0 pulses kept in [`SimDrive::sync0_log`].
+pub const SYNC0_LOG_LEN: usize = 64;
 /// One byte on the wire at 100 Mbit/s, ns.
 const BYTE_NS: u64 = 80;
 /// Preamble, FCS and inter-frame gap, bytes.
@@ -63,8 +66,23 @@ pub struct SimDrive {
     pub conditions: [AxisConditions; 2],
     /// Control cycle, ns.
     pub cycle_ns: u64,
+    /// The last [`SYNC0_LOG_LEN`] SYNC0 pulses the ESC delivered, oldest first.
+    pub sync0_log: VecDeque<Sync0Stamp>,
     feedback: [Option<MotorOutputs>; 2],
     next_cycle_ns: u64,
+}
+
+/// One SYNC0 pulse as the drive saw it.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub struct Sync0Stamp {
+    /// Simulation time of the pulse, ns.
+    pub now_ns: u64,
+    /// The ESC's local time at the pulse, ns.
+    pub local_ns: u64,
+    /// The ESC's DC system time of the pulse (start time + k · cycle), ns.
+    pub system_ns: u64,
+    /// Pulses since the previous stamp (1 unless pulses were missed).
+    pub pulses: u32,
 }
 
 /// The SII image generated from [`drive::DEVICE`].
@@ -131,6 +149,7 @@ impl SimDrive {
             motors: [Motor::default_servo(), Motor::default_servo()],
             conditions: [AxisConditions::READY; 2],
             cycle_ns: CONTROL_CYCLE_NS,
+            sync0_log: VecDeque::with_capacity(SYNC0_LOG_LEN),
             feedback: [None, None],
             next_cycle_ns: CONTROL_CYCLE_NS,
         }
@@ -138,11 +157,43 @@ impl SimDrive {
 
     /// Switches the drive off and on again: RAM values, ESC state and motor
     /// motion are lost, the non-volatile memory stays.
+    ///
+    /// The oscillator (drift and offset, see [`SimDrive::set_clock`]) is the
+    /// same hardware and keeps running.
     pub fn power_cycle(&mut self) {
-        let flash = std::mem::replace(self, Self::power_on(SimFlash::new()))
-            .drive
-            .into_flash();
-        *self = Self::power_on(flash);
+        let old = std::mem::replace(self, Self::power_on(SimFlash::new()));
+        let (drift, offset) = (old.esc.config().clock_drift_ppb, old.esc.config().clock_offset_ns);
+        *self = Self::power_on(old.drive.into_flash());
+        self.esc.set_clock(drift, offset);
+    }
+
+    /// Sets the drive's oscillator: drift in ppm (+: runs fast) and the ESC's
+    /// local time at simulation time 0, ns. Call it before the first frame.
+    pub fn set_clock(&mut self, drift_ppm: f64, offset_ns: u64) {
+        let ppb = (drift_ppm * 1000.0).round();
+        let ppb = ppb.clamp(f64::from(i32::MIN), f64::from(i32::MAX)) as i32;
+        self.esc.set_clock(ppb, offset_ns);
+    }
+
+    /// SYNC0 hook: records the pulse in [`SimDrive::sync0_log`] and
+    /// acknowledges it (reads 0x098E through the PDI, as the firmware's SYNC0
+    /// interrupt does). The control cycle does not run on SYNC0 yet.
+    pub fn on_sync0(&mut self, now_ns: u64) {
+        let p = self.esc.take_sync0_events(now_ns);
+        if p.count == 0 {
+            return;
+        }
+        let mut status = [0u8; 1];
+        let _ = ::esc::Pdi::read(&mut self.esc, ::esc::regs::dc::SYNC0_STATUS, &mut status);
+        if self.sync0_log.len() >= SYNC0_LOG_LEN {
+            self.sync0_log.pop_front();
+        }
+        self.sync0_log.push_back(Sync0Stamp {
+            now_ns: p.last_now_ns,
+            local_ns: self.esc.local_ns(p.last_now_ns),
+            system_ns: p.last_system_ns,
+            pulses: p.count,
+        });
     }
 
     /// Runs the drive firmware up to `now_ns`: every control cycle that is due
@@ -187,6 +238,11 @@ pub trait Node {
     fn esc_mut(&mut self) -> &mut Esc;
     /// Runs the node's firmware once at `now_ns`.
     fn poll(&mut self, now_ns: u64);
+    /// The ESC raised SYNC0 at `now_ns` (the simulation stops at each edge and
+    /// calls this after advancing the ESC to it). Default: nothing.
+    fn on_sync0(&mut self, now_ns: u64) {
+        let _ = now_ns;
+    }
 }
 
 impl Node for SimDrive {
@@ -195,6 +251,32 @@ impl Node for SimDrive {
     }
     fn poll(&mut self, now_ns: u64) {
         SimDrive::poll(self, now_ns);
+    }
+    fn on_sync0(&mut self, now_ns: u64) {
+        SimDrive::on_sync0(self, now_ns);
+    }
+}
+
+/// Seeded frame-arrival jitter: xorshift64, uniform in ±`max_ns`.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+struct Jitter {
+    max_ns: u64,
+    state: u64,
+}
+
+impl Jitter {
+    /// The next jitter value, ns, in `-max_ns..=max_ns`.
+    fn next(&mut self) -> i64 {
+        if self.max_ns == 0 {
+            return 0;
+        }
+        let mut x = self.state;
+        x ^= x << 13;
+        x ^= x >> 7;
+        x ^= x << 17;
+        self.state = x;
+        let span = self.max_ns.saturating_mul(2).saturating_add(1);
+        (x % span) as i64 - self.max_ns as i64
     }
 }
 
@@ -205,6 +287,7 @@ pub struct Simulation<N: Node = SimDrive> {
     last_poll_ns: u64,
     frames: u64,
     pcap: Option<PcapWriter<BufWriter<File>>>,
+    jitter: Jitter,
 }
 
 impl Simulation<SimDrive> {
@@ -223,7 +306,23 @@ impl<N: Node> Simulation<N> {
             last_poll_ns: 0,
             frames: 0,
             pcap: None,
+            jitter: Jitter { max_ns: 0, state: 1 },
         }
+    }
+
+    /// Frame-arrival jitter: every frame reaches the line `max_ns + u` after
+    /// the master sent it, `u` uniform in `-max_ns..=max_ns` from a xorshift
+    /// generator seeded with `seed` (deterministic; 0 = no jitter, the default).
+    pub fn set_frame_jitter(&mut self, max_ns: u64, seed: u64) {
+        // splitmix64 of the seed: nearby seeds give unrelated sequences, never state 0
+        let mut z = seed.wrapping_add(0x9E37_79B9_7F4A_7C15);
+        z = (z ^ (z >> 30)).wrapping_mul(0xBF58_476D_1CE4_E5B9);
+        z = (z ^ (z >> 27)).wrapping_mul(0x94D0_49BB_1331_11EB);
+        z ^= z >> 31;
+        self.jitter = Jitter {
+            max_ns: max_ns.min(i64::MAX as u64 / 4),
+            state: z.max(1),
+        };
     }
 
     /// Records every frame, both directions, to a pcap file at `path`.
@@ -253,18 +352,35 @@ impl<N: Node> Simulation<N> {
     }
 
     /// Passes one frame from the master through the line and back (in place),
-    /// advancing the clock by its time on the wire, then lets every slave's
-    /// firmware run once. Non-EtherCAT frames come back unchanged.
+    /// advancing the clock by its time on the wire (plus the frame-arrival
+    /// jitter, [`Simulation::set_frame_jitter`]), then lets every slave's
+    /// firmware run once. SYNC0 edges before the frame's arrival and during
+    /// its round trip are delivered at their times. Non-EtherCAT frames come
+    /// back unchanged.
     pub fn exchange(&mut self, frame: &mut [u8]) {
         self.frames += 1;
         let t_out = self.now_ns;
         if let Some(p) = self.pcap.as_mut() {
             let _ = p.frame(t_out, frame);
         }
+        let j = self.jitter.next();
+        let t_arr = t_out.saturating_add(self.jitter.max_ns).saturating_add_signed(j);
+        self.deliver_sync0(t_arr);
+        self.now_ns = self.now_ns.max(t_arr);
         let n = self.drives.len() as u64;
-        self.now_ns += (frame.len() as u64 + FRAME_OVERHEAD) * BYTE_NS + n * SLAVE_DELAY_NS;
+        let wire = (frame.len() as u64 + FRAME_OVERHEAD) * BYTE_NS + n * SLAVE_DELAY_NS;
+        let hop = SLAVE_DELAY_NS / 2;
         let mut escs: Vec<&mut Esc> = self.drives.iter_mut().map(|d| d.esc_mut()).collect();
-        let _ = process_frame(&mut escs, frame, t_out);
+        for (k, esc) in (0u64..).zip(escs.iter_mut()) {
+            esc.set_line_timing(LineTiming {
+                arrival_ns: k * hop,
+                loop_ns: 2 * n.saturating_sub(k + 1) * hop,
+            });
+        }
+        let _ = process_frame(&mut escs, frame, t_arr);
+        let t_back = t_arr.saturating_add(wire);
+        self.deliver_sync0(t_back);
+        self.now_ns = self.now_ns.max(t_back);
         if let Some(p) = self.pcap.as_mut() {
             let _ = p.frame(self.now_ns, frame);
         }
@@ -272,10 +388,11 @@ impl<N: Node> Simulation<N> {
     }
 
     /// Advances the clock to `t_ns` (no frames), running the slaves' firmware
-    /// every [`POLL_PERIOD_NS`].
+    /// every [`POLL_PERIOD_NS`] and delivering SYNC0 edges at their times.
     pub fn advance_to(&mut self, t_ns: u64) {
         while self.now_ns < t_ns {
             let next = (self.last_poll_ns + POLL_PERIOD_NS).min(t_ns).max(self.now_ns);
+            self.deliver_sync0(next);
             self.now_ns = next;
             if self.now_ns >= self.last_poll_ns + POLL_PERIOD_NS {
                 self.poll_all();
@@ -286,10 +403,40 @@ impl<N: Node> Simulation<N> {
     /// Moves the clock to `t_ns` and runs the slaves' firmware once, however
     /// far behind the simulation is: for wall-clock pacing (`hil-sim serve`),
     /// where simulating every poll period of a long gap would starve the frames.
+    /// SYNC0 edges in the gap are still delivered one by one.
     pub fn catch_up(&mut self, t_ns: u64) {
         if t_ns > self.now_ns {
+            self.deliver_sync0(t_ns);
             self.now_ns = t_ns;
             self.poll_all();
+        }
+    }
+
+    /// Delivers every SYNC0 edge up to and including `t_ns` in time order
+    /// (position order for edges at the same time): the clock moves to the
+    /// edge, the node's ESC is advanced to it and [`Node::on_sync0`] runs.
+    fn deliver_sync0(&mut self, t_ns: u64) {
+        // bounded: a pathological SYNC0 cycle cannot hang the simulation
+        for _ in 0..1_000_000 {
+            let mut best: Option<(u64, usize)> = None;
+            for (i, d) in self.drives.iter_mut().enumerate() {
+                if let Some(e) = d.esc_mut().next_sync0_at() {
+                    if e <= t_ns && best.is_none_or(|(b, _)| e < b) {
+                        best = Some((e, i));
+                    }
+                }
+            }
+            let Some((e, i)) = best else { return };
+            self.now_ns = self.now_ns.max(e);
+            let now = self.now_ns;
+            let Some(d) = self.drives.get_mut(i) else { return };
+            let before = d.esc_mut().sync0_total();
+            d.esc_mut().tick(now);
+            if d.esc_mut().sync0_total() == before {
+                // no pulse fired (cannot happen: the edge time is exact); stop
+                return;
+            }
+            d.on_sync0(now);
         }
     }
 
@@ -307,5 +454,120 @@ impl<N: Node> Simulation<N> {
             Some(p) => p.flush(),
             None => Ok(()),
         }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::frame::testutil::{build, phys, pos};
+    use crate::frame::Command;
+    use ::esc::regs::dc;
+
+    /// Sends one datagram through the simulation.
+    fn send(sim: &mut Simulation, cmd: Command, addr: u32, data: &[u8]) {
+        let mut f = build(&[(cmd, addr, data)]);
+        sim.exchange(&mut f);
+    }
+
+    /// Starts SYNC0 at every slave at system time `start` with `cycle`.
+    fn start_sync0(sim: &mut Simulation, start: u64, cycle: u32) {
+        let n = sim.drives().len() as u16;
+        for p in 0..n {
+            send(
+                sim,
+                Command::Apwr,
+                phys(pos(p), dc::START_TIME),
+                &start.to_le_bytes(),
+            );
+            send(
+                sim,
+                Command::Apwr,
+                phys(pos(p), dc::SYNC0_CYCLE),
+                &cycle.to_le_bytes(),
+            );
+            send(sim, Command::Apwr, phys(pos(p), dc::ACTIVATION), &[0x03]);
+        }
+    }
+
+    #[test]
+    fn frame_jitter_is_seeded_deterministic_and_bounded() {
+        let run = |max: u64, seed: u64| {
+            let mut sim = Simulation::with_nodes(Vec::<SimDrive>::new());
+            sim.set_frame_jitter(max, seed);
+            let mut times = Vec::new();
+            for _ in 0..200 {
+                let t0 = sim.now_ns();
+                send(&mut sim, Command::Brd, phys(0, 0), &[0; 2]);
+                times.push(sim.now_ns() - t0);
+            }
+            times
+        };
+        let a = run(5_000, 42);
+        assert_eq!(a, run(5_000, 42), "same seed, same jitter");
+        assert_ne!(a, run(5_000, 43), "another seed");
+        let wire = run(0, 42)[0];
+        assert!(run(0, 7).iter().all(|&t| t == wire), "no jitter by default");
+        assert!(
+            a.iter().all(|&t| (wire..=wire + 10_000).contains(&t)),
+            "±5 µs around 5 µs"
+        );
+        let spread = a.iter().max().unwrap() - a.iter().min().unwrap();
+        assert!(spread > 8_000, "uses the range: {spread}");
+    }
+
+    #[test]
+    fn sync0_is_delivered_at_each_edge_in_time_order() {
+        let mut sim = Simulation::new(2);
+        sim.drives_mut()[0].set_clock(50.0, 1_000);
+        sim.drives_mut()[1].set_clock(-80.0, 7_777_777);
+        start_sync0(&mut sim, 2_000_000, 250_000);
+        // the second drive's system time is ahead (its local clock is): no offsets written
+        sim.advance_to(20_000_000);
+        for (i, d) in sim.drives().iter().enumerate() {
+            let log: Vec<_> = d.sync0_log.iter().copied().collect();
+            assert!(log.len() >= 40, "drive {i}: {} pulses", log.len());
+            for w in log.windows(2) {
+                assert_eq!(w[1].system_ns - w[0].system_ns, 250_000, "exact in system time");
+                assert_eq!(w[1].pulses, 1, "each edge delivered");
+            }
+            for s in &log {
+                assert!(d.esc.system_time_ns(s.now_ns) >= s.system_ns);
+                assert!(d.esc.system_time_ns(s.now_ns - 1) < s.system_ns, "at the edge");
+                assert_eq!(s.local_ns, d.esc.local_ns(s.now_ns));
+            }
+            assert_eq!(
+                d.esc.al_event_request() & ::esc::regs::al_event::SYNC0,
+                0,
+                "acknowledged"
+            );
+        }
+        // with frames in between: still every edge, never late
+        let before = sim.drives()[0].sync0_log.back().copied().unwrap();
+        let t0 = sim.now_ns();
+        for _ in 0..100 {
+            send(&mut sim, Command::Brd, phys(0, 0), &[0; 64]);
+        }
+        sim.advance_to(sim.now_ns() + 1_000_000);
+        let log = &sim.drives()[0].sync0_log;
+        let after: Vec<_> = log.iter().filter(|s| s.system_ns > before.system_ns).collect();
+        let expected = (sim.now_ns() - t0) / 250_000;
+        assert!(
+            after.len() as u64 >= expected,
+            "{} pulses in {} ns",
+            after.len(),
+            sim.now_ns() - t0
+        );
+        assert!(after.iter().all(|s| s.pulses == 1));
+        assert_eq!(after[0].system_ns, before.system_ns + 250_000);
+    }
+
+    #[test]
+    fn power_cycle_keeps_the_oscillator() {
+        let mut d = SimDrive::new();
+        d.set_clock(-25.0, 42);
+        d.power_cycle();
+        assert_eq!(d.esc.config().clock_drift_ppb, -25_000);
+        assert_eq!(d.esc.local_ns(1_000_000_000), 42 + 1_000_000_000 - 25_000);
     }
 }

@@ -715,7 +715,7 @@ async fn receive_emcy<S>(mbx: &mut RawMailbox, sd: &ethercrab::SubDeviceRef<'_, 
 }
 
 #[test]
-fn c016_c017_following_error_fault_emcy_and_reset() {
+fn c016_c017_e007_e087_e088_following_error_fault_emcy_and_reset() {
     let sim = line(1);
     // a rigid end stop at +0.5 rev blocks the motor
     with_drive(&sim, |d| {
