@@ -28,6 +28,11 @@ pub type SimFlash = store::RamFlash<4096, 2>;
 
 /// Control cycle of the simulated drive (A150 default), ns.
 pub const CONTROL_CYCLE_NS: u64 = 1_000_000;
+/// Control-cycle starts kept in [`SimDrive::cycle_log`].
+pub const CYCLE_LOG_LEN: usize = 256;
+/// Tick frequency of the simulated control-cycle timer, Hz.
+const TIMER_HZ: u64 = drive::runtime::TIMER_HZ as u64;
+const NS_PER_S: u128 = 1_000_000_000;
 
 /// The conditions of one axis that are not the motor's: additional enable
 /// (A60), supply, STO. "Ready" by default in the simulator, so a master alone
@@ -53,6 +58,22 @@ impl AxisConditions {
 
 /// One simulated drive: ESC + the drive's runtime (slave stack, objects,
 /// store) + a motor and load per axis, stepped once per control cycle.
+///
+/// # Control-cycle timing
+///
+/// The MCU's control-cycle timer counts ticks of [`drive::runtime::TIMER_HZ`]
+/// of the MCU's local time. The MCU runs from the same crystal as the ESC
+/// ([`SimDrive::set_clock`]: `local(t) = offset + t · (1 + drift)`), but
+/// its timer is *not* corrected by the ESC's drift-control loop: that loop
+/// only trims the ESC's DC clock. So the PLL sees the oscillator's full
+/// drift against the DC system time and trims it, and aligns the phase.
+///
+/// - Without SYNC0: a free-running [`CONTROL_CYCLE_NS`] cycle in simulation
+///   time, run when [`SimDrive::poll`] finds it due (as before DC-Sync).
+/// - From the first SYNC0 pulse the PLL runs ([`drive::runtime::Drive::pll`]):
+///   the next start is the PLL's `start + period_ticks`, converted to
+///   simulation time through the MCU clock; [`Node::next_timer_at`] makes
+///   the [`Simulation`] stop at each start, so cycles run at their exact time.
 pub struct SimDrive {
     /// The simulated ESC (what the master sees).
     pub esc: Esc,
@@ -68,8 +89,29 @@ pub struct SimDrive {
     pub cycle_ns: u64,
     /// The last [`SYNC0_LOG_LEN`] SYNC0 pulses the ESC delivered, oldest first.
     pub sync0_log: VecDeque<Sync0Stamp>,
+    /// The last [`CYCLE_LOG_LEN`] control-cycle starts under the PLL, oldest first.
+    pub cycle_log: VecDeque<CycleStamp>,
     feedback: [Option<MotorOutputs>; 2],
     next_cycle_ns: u64,
+    /// Next start of the PLL-driven timer, ticks of the MCU clock (`None`: free-running).
+    next_tick: Option<u64>,
+    /// SM2 event pending after the last poll (a new one means a new RxPDO frame).
+    sm2_event: bool,
+}
+
+/// One control-cycle start under the PLL.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub struct CycleStamp {
+    /// Simulation time of the start, ns.
+    pub now_ns: u64,
+    /// The MCU's local time of the start, ns.
+    pub local_ns: u64,
+    /// The ESC's DC system time at the start, ns.
+    pub system_ns: u64,
+    /// Position in the SYNC0 cycle (0 = the aligned cycle).
+    pub index: u32,
+    /// The PLL was phase locked after this start.
+    pub locked: bool,
 }
 
 /// One SYNC0 pulse as the drive saw it.
@@ -150,8 +192,11 @@ impl SimDrive {
             conditions: [AxisConditions::READY; 2],
             cycle_ns: CONTROL_CYCLE_NS,
             sync0_log: VecDeque::with_capacity(SYNC0_LOG_LEN),
+            cycle_log: VecDeque::with_capacity(CYCLE_LOG_LEN),
             feedback: [None, None],
             next_cycle_ns: CONTROL_CYCLE_NS,
+            next_tick: None,
+            sm2_event: false,
         }
     }
 
@@ -175,9 +220,68 @@ impl SimDrive {
         self.esc.set_clock(ppb, offset_ns);
     }
 
-    /// SYNC0 hook: records the pulse in [`SimDrive::sync0_log`] and
+    /// The MCU's local time at simulation time `now_ns` (the ESC's crystal
+    /// without the DC drift correction), ns.
+    pub fn mcu_local_ns(&self, now_ns: u64) -> u64 {
+        let c = self.esc.config();
+        let drift = i128::from(now_ns) * i128::from(c.clock_drift_ppb) / 1_000_000_000;
+        let t = i128::from(c.clock_offset_ns) + i128::from(now_ns) + drift;
+        u64::try_from(t.max(0)).unwrap_or(u64::MAX)
+    }
+
+    /// The first simulation time at which the MCU's local time reaches `local_ns`.
+    fn mcu_now_for(&self, local_ns: u64) -> u64 {
+        let c = self.esc.config();
+        let rel = i128::from(local_ns) - i128::from(c.clock_offset_ns);
+        if rel <= 0 {
+            return 0;
+        }
+        let den = 1_000_000_000 + i128::from(c.clock_drift_ppb);
+        let mut t = u64::try_from(rel * 1_000_000_000 / den.max(1)).unwrap_or(u64::MAX);
+        while self.mcu_local_ns(t) < local_ns {
+            t = t.saturating_add(1);
+        }
+        while t > 0 && self.mcu_local_ns(t - 1) >= local_ns {
+            t -= 1;
+        }
+        t
+    }
+
+    /// Local time of timer tick `tick`, ns (rounded up: the tick is reached then).
+    fn tick_local_ns(tick: u64) -> u64 {
+        let ns = (u128::from(tick) * NS_PER_S).div_ceil(u128::from(TIMER_HZ));
+        u64::try_from(ns).unwrap_or(u64::MAX)
+    }
+
+    /// Simulation time of the next control-cycle start.
+    pub fn next_cycle_at(&self) -> u64 {
+        match self.next_tick {
+            Some(tick) => self.mcu_now_for(Self::tick_local_ns(tick)),
+            None => self.next_cycle_ns,
+        }
+    }
+
+    /// Follows the PLL's presence: the timer switches to the PLL's periods
+    /// (continuing from the free-running phase) or back to free-running.
+    fn follow_pll(&mut self) {
+        match (self.drive.pll().is_some(), self.next_tick) {
+            (true, None) => {
+                let local = u128::from(self.mcu_local_ns(self.next_cycle_ns));
+                let tick = (local * u128::from(TIMER_HZ)).div_ceil(NS_PER_S);
+                self.next_tick = Some(u64::try_from(tick).unwrap_or(u64::MAX));
+            }
+            (false, Some(_)) => {
+                self.next_cycle_ns = self.next_cycle_at();
+                self.next_tick = None;
+            }
+            _ => {}
+        }
+    }
+
+    /// SYNC0 hook: records the pulse in [`SimDrive::sync0_log`],
     /// acknowledges it (reads 0x098E through the PDI, as the firmware's SYNC0
-    /// interrupt does). The control cycle does not run on SYNC0 yet.
+    /// interrupt does) and hands the MCU's local time of the edge to the
+    /// drive's PLL (built at the first pulse).
     pub fn on_sync0(&mut self, now_ns: u64) {
         let p = self.esc.take_sync0_events(now_ns);
         if p.count == 0 {
@@ -194,6 +298,76 @@ impl SimDrive {
             system_ns: p.last_system_ns,
             pulses: p.count,
         });
+        let local = self.mcu_local_ns(p.last_now_ns);
+        let mut pdi = self.esc.pdi();
+        let _ = self.drive.on_sync0(&mut pdi, local);
+        self.follow_pll();
+    }
+
+    /// A frame passed the ESC at `arrival_ns`: when it completed an SM2
+    /// (RxPDO) buffer, the drive's SM2 event tells the PLL (`A261[1]`, `[2]`).
+    pub fn on_frame(&mut self, arrival_ns: u64) {
+        let event = self.esc.al_event_request() & ::esc::regs::al_event::sm(2) != 0;
+        if event && !self.sm2_event {
+            let local = self.mcu_local_ns(arrival_ns);
+            let _ = self.drive.on_frame(local);
+        }
+        self.sm2_event = event;
+    }
+
+    /// Runs every control cycle due at `now_ns`, each at its own start time.
+    pub fn run_due_cycles(&mut self, now_ns: u64) {
+        // bounded: a broken timer cannot hang the simulation
+        for _ in 0..1_000_000 {
+            let t = self.next_cycle_at();
+            if t > now_ns {
+                return;
+            }
+            self.run_cycle(t);
+        }
+    }
+
+    /// One control cycle starting at `t`: the PLL's command (when it runs)
+    /// programs the next start; then the axes and one motor step.
+    fn run_cycle(&mut self, t: u64) {
+        match self.next_tick {
+            Some(tick) => {
+                let local = Self::tick_local_ns(tick);
+                match self.drive.cycle_start(local) {
+                    Some(cmd) => {
+                        self.next_tick = Some(tick.saturating_add(u64::from(cmd.period_ticks.max(1))));
+                        if self.cycle_log.len() >= CYCLE_LOG_LEN {
+                            self.cycle_log.pop_front();
+                        }
+                        self.cycle_log.push_back(CycleStamp {
+                            now_ns: t,
+                            local_ns: local,
+                            system_ns: self.esc.system_time_ns(t),
+                            index: cmd.index,
+                            locked: self.drive.pll().is_some_and(|p| p.is_locked()),
+                        });
+                    }
+                    None => {
+                        self.next_tick = None;
+                        self.next_cycle_ns = t.saturating_add(self.cycle_ns);
+                    }
+                }
+            }
+            None => self.next_cycle_ns = t.saturating_add(self.cycle_ns),
+        }
+        let io = [
+            axis_io(self.feedback[0].as_ref(), &self.motors[0], self.conditions[0]),
+            axis_io(self.feedback[1].as_ref(), &self.motors[1], self.conditions[1]),
+        ];
+        let cmd = self.drive.control_cycle(t, &io);
+        for ((motor, fb), c) in self.motors.iter_mut().zip(self.feedback.iter_mut()).zip(cmd) {
+            let torque = if c.power_stage {
+                f64::from(c.torque_nm)
+            } else {
+                0.0
+            };
+            *fb = Some(motor.step(torque, !c.brake_release, self.cycle_ns));
+        }
     }
 
     /// Runs the drive firmware up to `now_ns`: every control cycle that is due
@@ -201,27 +375,13 @@ impl SimDrive {
     /// communication stack once.
     pub fn poll(&mut self, now_ns: u64) {
         self.esc.tick(now_ns);
-        while self.next_cycle_ns <= now_ns {
-            let t = self.next_cycle_ns;
-            let io = [
-                axis_io(self.feedback[0].as_ref(), &self.motors[0], self.conditions[0]),
-                axis_io(self.feedback[1].as_ref(), &self.motors[1], self.conditions[1]),
-            ];
-            let cmd = self.drive.control_cycle(t, &io);
-            for ((motor, fb), c) in self.motors.iter_mut().zip(self.feedback.iter_mut()).zip(cmd) {
-                let torque = if c.power_stage {
-                    f64::from(c.torque_nm)
-                } else {
-                    0.0
-                };
-                *fb = Some(motor.step(torque, !c.brake_release, self.cycle_ns));
-            }
-            self.next_cycle_ns += self.cycle_ns;
-        }
+        self.run_due_cycles(now_ns);
         let mut pdi = self.esc.pdi();
         if let Ok(Some(change)) = self.drive.poll(&mut pdi, now_ns) {
             self.state_log.push((now_ns, change));
         }
+        self.sm2_event = self.esc.al_event_request() & ::esc::regs::al_event::sm(2) != 0;
+        self.follow_pll();
     }
 }
 
@@ -243,6 +403,21 @@ pub trait Node {
     fn on_sync0(&mut self, now_ns: u64) {
         let _ = now_ns;
     }
+    /// Simulation time of the node's next timer interrupt that must run at
+    /// its exact time (the simulation stops there and calls
+    /// [`Node::on_timer`]). Default: none.
+    fn next_timer_at(&self) -> Option<u64> {
+        None
+    }
+    /// The timer of [`Node::next_timer_at`] is due at `now_ns`. Default: nothing.
+    fn on_timer(&mut self, now_ns: u64) {
+        let _ = now_ns;
+    }
+    /// A frame passed the node's ESC, arriving there at `arrival_ns`.
+    /// Default: nothing.
+    fn on_frame(&mut self, arrival_ns: u64) {
+        let _ = arrival_ns;
+    }
 }
 
 impl Node for SimDrive {
@@ -254,6 +429,15 @@ impl Node for SimDrive {
     }
     fn on_sync0(&mut self, now_ns: u64) {
         SimDrive::on_sync0(self, now_ns);
+    }
+    fn next_timer_at(&self) -> Option<u64> {
+        self.next_tick.map(|_| self.next_cycle_at())
+    }
+    fn on_timer(&mut self, now_ns: u64) {
+        self.run_due_cycles(now_ns);
+    }
+    fn on_frame(&mut self, arrival_ns: u64) {
+        SimDrive::on_frame(self, arrival_ns);
     }
 }
 
@@ -365,7 +549,7 @@ impl<N: Node> Simulation<N> {
         }
         let j = self.jitter.next();
         let t_arr = t_out.saturating_add(self.jitter.max_ns).saturating_add_signed(j);
-        self.deliver_sync0(t_arr);
+        self.deliver_events(t_arr);
         self.now_ns = self.now_ns.max(t_arr);
         let n = self.drives.len() as u64;
         let wire = (frame.len() as u64 + FRAME_OVERHEAD) * BYTE_NS + n * SLAVE_DELAY_NS;
@@ -378,8 +562,12 @@ impl<N: Node> Simulation<N> {
             });
         }
         let _ = process_frame(&mut escs, frame, t_arr);
+        drop(escs);
+        for (k, d) in (0u64..).zip(self.drives.iter_mut()) {
+            d.on_frame(t_arr.saturating_add(k * hop));
+        }
         let t_back = t_arr.saturating_add(wire);
-        self.deliver_sync0(t_back);
+        self.deliver_events(t_back);
         self.now_ns = self.now_ns.max(t_back);
         if let Some(p) = self.pcap.as_mut() {
             let _ = p.frame(self.now_ns, frame);
@@ -392,7 +580,7 @@ impl<N: Node> Simulation<N> {
     pub fn advance_to(&mut self, t_ns: u64) {
         while self.now_ns < t_ns {
             let next = (self.last_poll_ns + POLL_PERIOD_NS).min(t_ns).max(self.now_ns);
-            self.deliver_sync0(next);
+            self.deliver_events(next);
             self.now_ns = next;
             if self.now_ns >= self.last_poll_ns + POLL_PERIOD_NS {
                 self.poll_all();
@@ -406,30 +594,43 @@ impl<N: Node> Simulation<N> {
     /// SYNC0 edges in the gap are still delivered one by one.
     pub fn catch_up(&mut self, t_ns: u64) {
         if t_ns > self.now_ns {
-            self.deliver_sync0(t_ns);
+            self.deliver_events(t_ns);
             self.now_ns = t_ns;
             self.poll_all();
         }
     }
 
-    /// Delivers every SYNC0 edge up to and including `t_ns` in time order
-    /// (position order for edges at the same time): the clock moves to the
-    /// edge, the node's ESC is advanced to it and [`Node::on_sync0`] runs.
-    fn deliver_sync0(&mut self, t_ns: u64) {
+    /// Delivers every SYNC0 edge and node timer ([`Node::next_timer_at`]) up
+    /// to and including `t_ns` in time order (SYNC0 before a timer, then
+    /// position order, for events at the same time): the clock moves to the
+    /// event; for an edge the node's ESC is advanced to it and
+    /// [`Node::on_sync0`] runs, for a timer [`Node::on_timer`].
+    fn deliver_events(&mut self, t_ns: u64) {
         // bounded: a pathological SYNC0 cycle cannot hang the simulation
         for _ in 0..1_000_000 {
-            let mut best: Option<(u64, usize)> = None;
+            // (time, 0 = SYNC0 / 1 = timer, node)
+            let mut best: Option<(u64, u8, usize)> = None;
             for (i, d) in self.drives.iter_mut().enumerate() {
-                if let Some(e) = d.esc_mut().next_sync0_at() {
-                    if e <= t_ns && best.is_none_or(|(b, _)| e < b) {
-                        best = Some((e, i));
+                let sync0 = d.esc_mut().next_sync0_at().map(|e| (e, 0u8, i));
+                let timer = d.next_timer_at().map(|e| (e, 1u8, i));
+                for ev in [sync0, timer].into_iter().flatten() {
+                    if ev.0 <= t_ns && best.is_none_or(|b| ev < b) {
+                        best = Some(ev);
                     }
                 }
             }
-            let Some((e, i)) = best else { return };
+            let Some((e, kind, i)) = best else { return };
             self.now_ns = self.now_ns.max(e);
             let now = self.now_ns;
             let Some(d) = self.drives.get_mut(i) else { return };
+            if kind == 1 {
+                d.on_timer(now);
+                if d.next_timer_at().is_some_and(|n| n <= e) {
+                    // the timer did not move on (cannot happen); stop
+                    return;
+                }
+                continue;
+            }
             let before = d.esc_mut().sync0_total();
             d.esc_mut().tick(now);
             if d.esc_mut().sync0_total() == before {

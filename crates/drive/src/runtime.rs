@@ -20,6 +20,15 @@
 //! default), so the master's process data never changes a parameter for good.
 //! Below Op the RxPDO objects keep those defaults (or what an SDO write put
 //! there): RxPDO content is never evaluated outside Op.
+//!
+//! DC-Sync (E-107…E-118): the drive owns one [`dcsync::Pll`] while SYNC0
+//! pulses arrive. The firmware's SYNC0 interrupt calls [`Drive::on_sync0`]
+//! (the PLL is built at the first pulse from the ESC's SYNC0 cycle 0x09A0
+//! and A150/A292/A149/A290; a configuration the PLL refuses leaves it off
+//! and is kept in [`Drive::sync_error`]), the control-cycle timer interrupt
+//! calls [`Drive::cycle_start`] and programs the next start from the
+//! returned period, the SM2 event calls [`Drive::on_frame`]. A296, A298 and
+//! A261 follow the PLL. Going back to Init drops the PLL.
 
 use crate::axis::{Axis, AxisCommand, AxisIo};
 use crate::dictionary::{DriveObjects, LiveValues, PERSISTENT_IMAGE_BYTES};
@@ -32,6 +41,10 @@ use esc::{regs, AlState, AlStatusCode, Pdi, PdiExt};
 use od::SdoAbort;
 use store::{Flash, ParamStore, StoreError};
 
+/// The DC-Sync crate (PLL, A298/A261 types), re-exported for the firmware and tests.
+pub use dcsync;
+pub use dcsync::{CycleCommand, FrameTiming, Pll, SyncError};
+
 /// A00 "Save values": [0] start (sub 1), [1] progress (sub 2), [2] result (sub 3),
 /// in the SDO-Info numbering the runtime always uses.
 const A00: u16 = crate::parameter_index(0, 0);
@@ -40,6 +53,20 @@ const A254: u16 = crate::parameter_index(0, 254);
 const A255: u16 = crate::parameter_index(0, 255);
 const A256: u16 = crate::parameter_index(0, 256);
 const A257: u16 = crate::parameter_index(0, 257);
+/// A149 cycle sequence, A150 cycle time (µs).
+const A149: u16 = crate::parameter_index(0, 149);
+const A150: u16 = crate::parameter_index(0, 150);
+/// A261 sync diagnostics: `[k]` is sub `k + 1`.
+const A261: u16 = crate::parameter_index(0, 261);
+/// A290 PLL control, A292 phase offset (µs), A296 measured cycle (µs), A298 status.
+const A290: u16 = crate::parameter_index(0, 290);
+const A292: u16 = crate::parameter_index(0, 292);
+const A296: u16 = crate::parameter_index(0, 296);
+const A298: u16 = crate::parameter_index(0, 298);
+
+/// Tick frequency of the control-cycle timer the PLL trims, Hz (the
+/// reference board's CCU4 at 144 MHz; the simulator models the same).
+pub const TIMER_HZ: u32 = 144_000_000;
 
 /// Result of the last save, as A00[2] shows it.
 pub mod save_result {
@@ -105,6 +132,10 @@ pub struct Drive<F: Flash> {
     /// `Slave::outputs_received` at the previous control cycle (new
     /// cyclic set-points).
     ctl_rx_frames: u32,
+    /// The DC-Sync PLL while SYNC0 runs (built at the first pulse).
+    pll: Option<Pll>,
+    /// Why the PLL could not be built for the last SYNC0 configuration.
+    sync_error: Option<SyncError>,
 }
 
 impl<F: Flash> Drive<F> {
@@ -135,6 +166,8 @@ impl<F: Flash> Drive<F> {
             last_rx_frames: 0,
             axes: [Axis::new(0), Axis::new(1)],
             ctl_rx_frames: 0,
+            pll: None,
+            sync_error: None,
         };
         drive.compile_pdo_image();
         drive.update_live();
@@ -218,6 +251,11 @@ impl<F: Flash> Drive<F> {
             if state == AlState::SafeOp {
                 self.compile_pdo_image();
             }
+            if state == AlState::Init {
+                self.pll = None;
+                self.sync_error = None;
+                self.update_sync_live();
+            }
             if state == AlState::Op {
                 self.pdo.capture_fallbacks(&self.objects);
             }
@@ -281,6 +319,128 @@ impl<F: Flash> Drive<F> {
         }
         let _ = self.objects.set(0x1001, 0, i64::from(register));
         commands
+    }
+
+    /// The DC-Sync PLL, while SYNC0 runs.
+    pub fn pll(&self) -> Option<&Pll> {
+        self.pll.as_ref()
+    }
+
+    /// The DC-Sync PLL, mutable (e.g. to acknowledge its fault).
+    pub fn pll_mut(&mut self) -> Option<&mut Pll> {
+        self.pll.as_mut()
+    }
+
+    /// Why the PLL refused the SYNC0 configuration last seen (`None` while
+    /// it runs or before any SYNC0).
+    pub fn sync_error(&self) -> Option<SyncError> {
+        self.sync_error
+    }
+
+    /// The PLL configuration from the ESC's SYNC0 cycle and the objects
+    /// (A150, A292, A149, A290; µs in the objects).
+    fn pll_config(&self, sync0_cycle_ns: u32) -> dcsync::Config {
+        let get = |index| self.objects.get(index, 0).unwrap_or(0);
+        let a150_ns = u32::try_from(get(A150).saturating_mul(1000)).unwrap_or(0);
+        let mut cfg = dcsync::Config::new(sync0_cycle_ns, a150_ns, TIMER_HZ);
+        cfg.a292_ns = i32::try_from(get(A292).saturating_mul(1000)).unwrap_or(0);
+        cfg.sequence = u8::try_from(get(A149))
+            .ok()
+            .and_then(dcsync::CycleSequence::from_a149)
+            .unwrap_or_default();
+        cfg.enabled = self.objects.get(A290, 0).map_or(true, |v| v == 1);
+        cfg
+    }
+
+    /// SYNC0 interrupt at local time `t_local_ns` (the timer's time base).
+    /// Builds the PLL at the first pulse, or again when the SYNC0 cycle
+    /// (0x09A0, read through `pdi`) changed; a refused configuration leaves
+    /// the PLL off ([`Drive::sync_error`], `A261[0]`).
+    pub fn on_sync0<P: Pdi>(&mut self, pdi: &mut P, t_local_ns: u64) -> Result<(), P::Error> {
+        let cycle = pdi.read_u32(regs::dc::SYNC0_CYCLE)?;
+        let current = self.pll.as_ref().map(|p| p.config().sync0_cycle_ns);
+        if current != Some(cycle) {
+            match Pll::new(self.pll_config(cycle)) {
+                Ok(pll) => {
+                    self.pll = Some(pll);
+                    self.sync_error = None;
+                }
+                Err(e) => {
+                    self.pll = None;
+                    self.sync_error = Some(e);
+                }
+            }
+        }
+        if let Some(pll) = self.pll.as_mut() {
+            pll.on_sync0(t_local_ns);
+        }
+        self.update_sync_live();
+        Ok(())
+    }
+
+    /// Control-cycle timer interrupt at the programmed local start
+    /// `t_local_ns`: applies changed A292/A149/A290 and asks the PLL for
+    /// this cycle's length (program the next start at `start +
+    /// period_ticks`). `None` without a PLL (free-running A150 timer).
+    pub fn cycle_start(&mut self, t_local_ns: u64) -> Option<CycleCommand> {
+        let wanted = self.pll.as_ref().map(|p| *p.config())?;
+        let cfg = self.pll_config(wanted.sync0_cycle_ns);
+        let pll = self.pll.as_mut()?;
+        if cfg.a292_ns != wanted.a292_ns {
+            pll.set_phase_offset(cfg.a292_ns);
+        }
+        if cfg.sequence != wanted.sequence {
+            pll.set_sequence(cfg.sequence);
+        }
+        if cfg.enabled != wanted.enabled {
+            pll.set_enabled(cfg.enabled);
+        }
+        let cmd = pll.on_cycle_start(t_local_ns);
+        self.update_sync_live();
+        Some(cmd)
+    }
+
+    /// The master's process data (SM2) arrived at local time `t_local_ns`:
+    /// `A261[1]`, `[2]`. `None` without a PLL or before the first SYNC0.
+    pub fn on_frame(&mut self, t_local_ns: u64) -> Option<FrameTiming> {
+        let timing = self.pll.as_mut()?.on_frame(t_local_ns);
+        self.update_sync_live();
+        timing
+    }
+
+    /// A296, A298 and A261 from the PLL (A261[0] also from a refused
+    /// configuration; everything 0 without SYNC0).
+    fn update_sync_live(&mut self) {
+        let (status, diag, measured) = match &self.pll {
+            Some(p) => (
+                p.status().0,
+                p.diagnostics(),
+                p.measured_sync0_cycle_ns().unwrap_or(0),
+            ),
+            None => {
+                let mut d = dcsync::SyncDiagnostics::default();
+                if let Some(e) = self.sync_error {
+                    d.code = e.diag_code();
+                }
+                let status = if self.sync_error.is_some() {
+                    dcsync::PllStatus::ERROR
+                } else {
+                    0
+                };
+                (status, d, 0)
+            }
+        };
+        let _ = self.objects.set(A298, 0, i64::from(status));
+        // µs, rounded to nearest
+        let _ = self
+            .objects
+            .set(A296, 0, i64::from(measured.saturating_add(500) / 1000));
+        let [code, data_us, late, phase] = diag.elements();
+        let _ = self.objects.set(A261, 1, i64::from(code));
+        let _ = self.objects.set(A261, 2, i64::from(data_us));
+        let _ = self.objects.set(A261, 3, i64::from(late));
+        // `[3]` is declared U32: the phase error's two's complement
+        let _ = self.objects.set(A261, 4, i64::from(phase as u32));
     }
 
     /// Reads an object as the bus sees it (live values included), without the bus.

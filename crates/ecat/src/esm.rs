@@ -158,3 +158,176 @@ pub fn check_process_sms(
     }
     Ok(())
 }
+
+/// `1C32h:01` synchronisation types (ETG.1020).
+pub mod sync_type {
+    /// Free run: not synchronised.
+    pub const FREE_RUN: u16 = 0;
+    /// Synchronous with the SM2 event.
+    pub const SM2: u16 = 1;
+    /// DC SYNC0.
+    pub const DC_SYNC0: u16 = 2;
+}
+
+/// The synchronisation mode the master chose (spec §11.1), decided at P→S.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
+pub enum SyncMode {
+    /// Free run (`1C32h:01` = 0): needs SM2 in 3-buffer mode (0029h).
+    FreeRun,
+    /// SM-synchronous (`1C32h:01` = 1, the SM2 event). Also the mode assumed
+    /// when the application has no `1C32h` (no mode-specific check then).
+    #[default]
+    SmSync,
+    /// DC SYNC0: 0x0981 has cyclic operation and SYNC0 active, or `1C32h:01` = 2.
+    DcSync0,
+}
+
+impl SyncMode {
+    /// The `1C32h:01` value of the mode.
+    pub const fn sync_type(self) -> u16 {
+        match self {
+            Self::FreeRun => sync_type::FREE_RUN,
+            Self::SmSync => sync_type::SM2,
+            Self::DcSync0 => sync_type::DC_SYNC0,
+        }
+    }
+}
+
+/// 0x0981 bits 0 (cyclic operation) and 1 (SYNC0 active).
+pub const DC_ACTIVATION_SYNC0: u8 = 0x03;
+
+/// The sync mode from the ESC's DC activation register (0x0981) and
+/// `1C32h:01` (`None`: the application has no such entry). DC wins when
+/// the master activated SYNC0 (ethercrab writes 0x0981 without touching
+/// `1C32h`). A sync type this device does not support (3 = DC SYNC1 and
+/// above, spec §11.9: `1C32h:04` = 0007h) is refused with 0030h.
+pub fn sync_mode(dc_activation: u8, sync_type: Option<u16>) -> Result<SyncMode, AlStatusCode> {
+    if dc_activation & DC_ACTIVATION_SYNC0 == DC_ACTIVATION_SYNC0 {
+        return Ok(SyncMode::DcSync0);
+    }
+    match sync_type {
+        None | Some(sync_type::SM2) => Ok(SyncMode::SmSync),
+        Some(sync_type::FREE_RUN) => Ok(SyncMode::FreeRun),
+        Some(sync_type::DC_SYNC0) => Ok(SyncMode::DcSync0),
+        Some(_) => Err(AlStatusCode::INVALID_DC_SYNC_CONFIG),
+    }
+}
+
+/// E-030: in free run the outputs need SM2 in 3-buffer mode; an SM2 that
+/// carries outputs in 1-buffer (mailbox) mode is refused with 0029h. Other
+/// SM2 faults are left to [`check_process_sms`] (001Dh). Run before it, so
+/// the more specific code wins.
+pub fn check_free_run(mode: SyncMode, sm2: &SyncManager, rx_bytes: usize) -> Result<(), AlStatusCode> {
+    if mode == SyncMode::FreeRun && rx_bytes > 0 && sm2.enabled() && sm2.control().mode() == SmMode::Mailbox {
+        Err(AlStatusCode::FREERUN_NEEDS_3BUFFER)
+    } else {
+        Ok(())
+    }
+}
+
+/// A258 values with a special meaning (spec §13.1).
+pub mod a258 {
+    /// Monitoring off (as is 0).
+    pub const OFF: u16 = 65535;
+    /// Largest plain timeout, ms.
+    pub const MAX_MS: u16 = 65531;
+    /// A single lost packet is tolerated.
+    pub const ONE_LOST: u16 = 65532;
+    /// Up to 3 consecutive lost packets are tolerated.
+    pub const THREE_LOST: u16 = 65533;
+    /// SyncManager watchdog mode: the tolerance is the master's SM watchdog (A259).
+    pub const SM_WATCHDOG: u16 = 65534;
+}
+
+/// The ESC's process-data watchdog as the master configured it (0x0400,
+/// 0x0420, SM2's watchdog trigger bit).
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub struct EscWatchdog {
+    /// Watchdog divider (0x0400): one unit is (divider + 2) × 40 ns.
+    pub divider: u16,
+    /// Process-data watchdog time (0x0420) in units; 0 = disabled.
+    pub pd_time: u16,
+    /// SM2 retriggers the watchdog (SM control bit 6).
+    pub sm2_trigger: bool,
+}
+
+impl EscWatchdog {
+    /// The watchdog time in ns, `None` when disabled (time 0 or no SM2 trigger).
+    pub fn time_ns(&self) -> Option<u64> {
+        (self.pd_time != 0 && self.sm2_trigger)
+            .then(|| u64::from(self.pd_time) * (u64::from(self.divider) + 2) * 40)
+    }
+}
+
+/// How the RxPDO reception is monitored in Op (A258, spec §13.1).
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum PdoMonitor {
+    /// No new RxPDO for longer than this (ns) is a PDO timeout.
+    Timeout(u64),
+    /// A258 = 65534: the ESC's SM watchdog decides (AL event 6, 0x0440 bit
+    /// 0); the tolerance (ns) is the watchdog time (A259[0]).
+    EscWatchdog(u64),
+}
+
+impl PdoMonitor {
+    /// The tolerated time without RxPDO, ns.
+    pub const fn tolerance_ns(&self) -> u64 {
+        match *self {
+            Self::Timeout(t) | Self::EscWatchdog(t) => t,
+        }
+    }
+}
+
+/// The monitoring A258 asks for, with `cycle_ns` the process-data cycle
+/// (SYNC0 cycle in DC mode, else `1C32h:02`) and the ESC's watchdog.
+/// 0/65535: off. 1…65531: that many ms. 65532 / 65533: one / three lost
+/// packets tolerated, i.e. a gap of 2 / 4 cycles passes, plus half a cycle
+/// for jitter. 65534: the ESC's SM watchdog (off when the master disabled it).
+pub fn pdo_monitor(a258: u16, cycle_ns: u32, wd: &EscWatchdog) -> Option<PdoMonitor> {
+    let cycle = u64::from(cycle_ns);
+    match a258 {
+        0 | a258::OFF => None,
+        1..=a258::MAX_MS => Some(PdoMonitor::Timeout(u64::from(a258) * 1_000_000)),
+        a258::ONE_LOST => Some(PdoMonitor::Timeout(2 * cycle + cycle / 2)),
+        a258::THREE_LOST => Some(PdoMonitor::Timeout(4 * cycle + cycle / 2)),
+        _ => wd.time_ns().map(PdoMonitor::EscWatchdog),
+    }
+}
+
+/// Longest watchdog tolerance A259[0] can show (u16 ms).
+pub const MAX_WATCHDOG_NS: u64 = 65_535 * 1_000_000;
+
+/// P→S check of the SM watchdog settings (E-031, AL 001Fh). Invalid:
+/// - a running process-data watchdog (time ≠ 0) with divider 0 (a 80 ns
+///   unit: no master means that);
+/// - with A258 = 65534 (the drive relies on the master's SM watchdog, spec
+///   §13.2): the watchdog disabled (time 0 or SM2 without its trigger bit
+///   while outputs are mapped), shorter than one process-data cycle
+///   (`cycle_ns`: it would fire between two frames) or longer than A259[0]
+///   can show (65535 ms).
+pub fn check_watchdog(
+    a258: u16,
+    wd: &EscWatchdog,
+    cycle_ns: u32,
+    rx_bytes: usize,
+) -> Result<(), AlStatusCode> {
+    let invalid = Err(AlStatusCode::INVALID_WATCHDOG_CONFIG);
+    if wd.pd_time != 0 && wd.divider == 0 {
+        return invalid;
+    }
+    if a258 == a258::SM_WATCHDOG && rx_bytes > 0 {
+        match wd.time_ns() {
+            None => return invalid,
+            Some(t) if t < u64::from(cycle_ns) || t > MAX_WATCHDOG_NS => return invalid,
+            Some(_) => {}
+        }
+    }
+    Ok(())
+}
+
+/// RxPDO frames in a row, each within the tolerance of the previous one,
+/// that make the reception "stable and regular" for S→O (E-033).
+pub const STEADY_FRAMES: u32 = 3;
+/// How long an S→O request waits for stable RxPDO before it is refused
+/// (spec §3.3), ns.
+pub const STEADY_WAIT_NS: u64 = 200_000_000;

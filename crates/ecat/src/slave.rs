@@ -1,9 +1,9 @@
 //! The slave: ESM + mailbox + CoE dispatch + process data, driven by `poll`.
 
-use crate::coe::{service, CoeConfig, CoeHeader, CoeServer, Dictionary, COE_HEADER_LEN};
+use crate::coe::{service, CoeConfig, CoeHeader, CoeServer, CommState, Dictionary, COE_HEADER_LEN};
 use crate::desc::Device;
 use crate::emcy::{self, Emcy, EmcyQueue};
-use crate::esm::{self, MAX_MAILBOX_LEN, MAX_PDO_BYTES};
+use crate::esm::{self, EscWatchdog, PdoMonitor, SyncMode, MAX_MAILBOX_LEN, MAX_PDO_BYTES};
 use crate::mailbox::{next_counter, MailboxError, MailboxHeader, MailboxType, HEADER_LEN};
 use esc::regs::{self, al_event};
 use esc::sm::{activate, pdi_control, status};
@@ -20,12 +20,21 @@ pub struct StateChange {
     pub requested: u8,
     /// The AL status code (0 on success).
     pub code: AlStatusCode,
+    /// The slave left the state on its own (PDO timeout / SM watchdog, E-038:
+    /// A257 Er3, red LED single flash); `requested` is then the state it left.
+    pub unsolicited: bool,
 }
 
 impl core::fmt::Display for StateChange {
     /// `Init -> PreOp`, or `PreOp: request 8 refused, AL status code 0x0011`.
     fn fmt(&self, f: &mut core::fmt::Formatter<'_>) -> core::fmt::Result {
-        if self.code == AlStatusCode::NO_ERROR {
+        if self.unsolicited {
+            write!(
+                f,
+                "{:?} -> {:?} (unsolicited, AL status code {:#06x})",
+                self.from, self.to, self.code.0
+            )
+        } else if self.code == AlStatusCode::NO_ERROR {
             write!(f, "{:?} -> {:?}", self.from, self.to)
         } else {
             write!(
@@ -41,6 +50,46 @@ static ZEROS: [u8; MAX_PDO_BYTES] = [0; MAX_PDO_BYTES];
 
 /// Emergencies the slave holds while the mailbox is busy (the oldest is dropped beyond).
 pub const EMCY_QUEUE: usize = 8;
+
+/// A150 (drive cycle, U16 µs; spec §12): parameter 2000h + 150.
+pub const A150_INDEX: u16 = 0x2096;
+/// A258 (PDO timeout, U16 ms; spec §13.1): parameter 2000h + 258.
+pub const A258_INDEX: u16 = 0x2102;
+/// Output / input SyncManager parameter objects (spec §11.9).
+pub const SM_OUTPUT_PARAMETER: u16 = 0x1C32;
+/// Input SyncManager parameter object.
+pub const SM_INPUT_PARAMETER: u16 = 0x1C33;
+/// A150 when the application has none, µs.
+const DEFAULT_A150_US: u32 = 1000;
+/// Event 52 "Communication", cause 6 "EtherCAT PDO-Timeout" (spec §13.1, §13.4).
+const E82_COMMUNICATION: u8 = 52;
+const E43_PDO_TIMEOUT: u8 = 6;
+
+/// The synchronisation the slave accepted at the last P→S (spec §11), and
+/// the RxPDO monitoring (A258/A259, spec §13.1–13.2): what `1C32h`/`1C33h`,
+/// A259 and A257 show.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
+pub struct SyncStatus {
+    /// Mode accepted at P→S.
+    pub mode: SyncMode,
+    /// Process-data cycle, ns: the SYNC0 cycle in DC mode, else `1C32h:02`
+    /// (A150 when that is 0).
+    pub cycle_ns: u32,
+    /// Drive cycles per SYNC0 cycle (DC), 1 otherwise.
+    pub k: u32,
+    /// Why the last P→S refused the DC configuration (for `A261[0]`).
+    pub sync_error: Option<dcsync::SyncError>,
+    /// The RxPDO monitoring in force (set at S→O from A258).
+    pub monitor: Option<PdoMonitor>,
+    /// A259[1]: the PDO timeout / SM watchdog triggered (until the master's
+    /// next acknowledged request).
+    pub triggered: bool,
+    /// A259[2]: how often it triggered.
+    pub trigger_count: u16,
+    /// The last state change was unsolicited (E-038, A257 Er3) until the
+    /// master's next acknowledged request.
+    pub unsolicited: bool,
+}
 
 /// Mailbox state: the SM areas as configured at I→P, the request buffer and the
 /// last (or pending) response.
@@ -110,6 +159,15 @@ pub struct Slave {
     inputs: [u8; MAX_PDO_BYTES],
     outputs: [u8; MAX_PDO_BYTES],
     rx_frames: u32,
+    /// Times of the last [`esm::STEADY_FRAMES`] RxPDO frames (newest first).
+    rx_times: [u64; esm::STEADY_FRAMES as usize],
+    /// Frames recorded in `rx_times` (saturating).
+    rx_seen: u32,
+    /// An S→O request waiting for stable RxPDO since this time (E-033).
+    pending_op: Option<u64>,
+    /// When Op was last entered (start of the PDO timeout).
+    op_entry_ns: u64,
+    sync: SyncStatus,
 }
 
 impl Slave {
@@ -143,7 +201,26 @@ impl Slave {
             inputs: [0; MAX_PDO_BYTES],
             outputs: [0; MAX_PDO_BYTES],
             rx_frames: 0,
+            rx_times: [0; esm::STEADY_FRAMES as usize],
+            rx_seen: 0,
+            pending_op: None,
+            op_entry_ns: 0,
+            sync: SyncStatus {
+                k: 1,
+                ..SyncStatus::default()
+            },
         }
+    }
+
+    /// The synchronisation and RxPDO monitoring state (1C32h/1C33h, A259,
+    /// A257 Er3/Er4).
+    pub fn sync_status(&self) -> &SyncStatus {
+        &self.sync
+    }
+
+    /// Whether an S→O request waits for stable RxPDO (E-033).
+    pub fn op_pending(&self) -> bool {
+        self.pending_op.is_some()
     }
 
     /// The device description.
@@ -216,8 +293,8 @@ impl Slave {
         if let Some(bytes) = app.process_data_bytes() {
             self.pdo_bytes = bytes;
         }
-        let change = if events & al_event::AL_CONTROL != 0 {
-            self.al_control(pdi, now_ns)?
+        let mut change = if events & al_event::AL_CONTROL != 0 {
+            self.al_control(pdi, app, now_ns)?
         } else {
             None
         };
@@ -225,9 +302,132 @@ impl Slave {
             self.poll_mailbox(pdi, app, events, now_ns)?;
         }
         if esm::process_data_on(self.state) {
-            self.process_data(pdi, events)?;
+            self.process_data(pdi, events, now_ns)?;
+        }
+        if change.is_none() {
+            change = self.pending_op(pdi, app, now_ns)?;
+        }
+        if change.is_none() && self.state == AlState::Op {
+            change = self.monitor_rxpdo(pdi, events, now_ns)?;
         }
         Ok(change)
+    }
+
+    /// E-033: answers a waiting S→O request once the RxPDO is steady, or
+    /// refuses it after [`esm::STEADY_WAIT_NS`].
+    fn pending_op<P: Pdi, A: Dictionary>(
+        &mut self,
+        pdi: &mut P,
+        app: &mut A,
+        now_ns: u64,
+    ) -> Result<Option<StateChange>, P::Error> {
+        let Some(since) = self.pending_op else {
+            return Ok(None);
+        };
+        if self.state != AlState::SafeOp {
+            self.pending_op = None;
+            return Ok(None);
+        }
+        let result = if self.outputs_steady(now_ns) {
+            self.transition(pdi, app, AlState::SafeOp, AlState::Op, now_ns)?
+        } else if now_ns.wrapping_sub(since) > esm::STEADY_WAIT_NS {
+            // Not stable within 200 ms: refused. The spec names no AL code
+            // (§3.3: 001Bh or 002Bh); 001Bh "SM watchdog" is the one §4 ties to
+            // "no RxPDO received, or not within the tolerated time". A257 Er6
+            // ("regular process data missing") is not modelled here: A257 is
+            // the runtime's, it can tell this refusal by the code and `from`.
+            Err(AlStatusCode::SM_WATCHDOG)
+        } else {
+            return Ok(None);
+        };
+        self.pending_op = None;
+        match result {
+            Ok(()) => {
+                self.state = AlState::Op;
+                self.error = false;
+                self.code = AlStatusCode::NO_ERROR;
+            }
+            Err(code) => {
+                self.error = true;
+                self.code = code;
+            }
+        }
+        self.write_status(pdi)?;
+        Ok(Some(StateChange {
+            from: AlState::SafeOp,
+            to: self.state,
+            requested: AlState::Op.code(),
+            code: self.code,
+            unsolicited: false,
+        }))
+    }
+
+    /// Whether the RxPDO is "stable and regular" for S→O (E-033): with
+    /// monitoring on (A258), the last [`esm::STEADY_FRAMES`] frames each
+    /// within the tolerance of the previous one and the newest within the
+    /// tolerance of `now_ns`. With monitoring off nothing is required: the
+    /// drive would never notice missing frames in Op either, and masters
+    /// that request Op before their cyclic task runs (ethercrab's `into_op`)
+    /// still get there.
+    fn outputs_steady(&self, now_ns: u64) -> bool {
+        let Some(m) = self.sync.monitor else {
+            return true;
+        };
+        let tol = m.tolerance_ns();
+        if self.rx_seen < esm::STEADY_FRAMES {
+            return false;
+        }
+        let mut newer = now_ns;
+        for &t in &self.rx_times {
+            if newer.wrapping_sub(t) > tol {
+                return false;
+            }
+            newer = t;
+        }
+        true
+    }
+
+    /// In Op (E-044, E-126…E-128): a PDO timeout or an expired SM watchdog
+    /// leaves Op for Safe-Op with the error indication, AL 001Bh, EMCY 7500h
+    /// (event 52, cause 6) and an unsolicited state change (E-038). Only in
+    /// Op, so a master leaving Op on purpose never triggers it.
+    fn monitor_rxpdo<P: Pdi>(
+        &mut self,
+        pdi: &mut P,
+        events: u32,
+        now_ns: u64,
+    ) -> Result<Option<StateChange>, P::Error> {
+        let expired = match self.sync.monitor {
+            None => false,
+            Some(PdoMonitor::Timeout(t)) => {
+                let newest = self.rx_times.first().copied().filter(|_| self.rx_seen > 0);
+                let last = newest.map_or(self.op_entry_ns, |t| t.max(self.op_entry_ns));
+                now_ns.wrapping_sub(last) > t
+            }
+            Some(PdoMonitor::EscWatchdog(_)) => {
+                // the event is cleared by reading 0x0440; bit 0 = 0: expired
+                events & al_event::WATCHDOG_PD != 0 && pdi.read_u16(regs::WATCHDOG_STATUS_PD)? & 1 == 0
+            }
+        };
+        if !expired {
+            return Ok(None);
+        }
+        self.state = AlState::SafeOp;
+        self.error = true;
+        self.code = AlStatusCode::SM_WATCHDOG;
+        self.sync.triggered = true;
+        self.sync.trigger_count = self.sync.trigger_count.saturating_add(1);
+        self.sync.unsolicited = true;
+        self.emcy
+            .push(Emcy::for_event(E82_COMMUNICATION, E43_PDO_TIMEOUT, 0));
+        self.write_status(pdi)?;
+        Ok(Some(StateChange {
+            from: AlState::Op,
+            to: AlState::SafeOp,
+            requested: AlState::Op.code(),
+            code: self.code,
+            unsolicited: true,
+        }))
     }
 
     fn write_status<P: Pdi>(&self, pdi: &mut P) -> Result<(), P::Error> {
@@ -240,17 +440,41 @@ impl Slave {
         pdi.write_u16(regs::AL_STATUS, status.raw())
     }
 
-    fn al_control<P: Pdi>(&mut self, pdi: &mut P, now_ns: u64) -> Result<Option<StateChange>, P::Error> {
+    fn al_control<P: Pdi, A: Dictionary>(
+        &mut self,
+        pdi: &mut P,
+        app: &mut A,
+        now_ns: u64,
+    ) -> Result<Option<StateChange>, P::Error> {
         let ctrl = AlControl::from_raw(pdi.read_u16(regs::AL_CONTROL)?);
         if self.error && !ctrl.ack {
             // ETG.1000.6: a request without acknowledge leaves an error indication as it is
             return Ok(None);
         }
+        // any processed request replaces a waiting S→O and ends the
+        // "unsolicited" / "triggered" indications
+        self.pending_op = None;
+        self.sync.unsolicited = false;
+        self.sync.triggered = false;
         let from = self.state;
         let result = match esm::target(from, ctrl.requested) {
             Err(code) => Err(code),
             Ok(None) => Ok(from),
-            Ok(Some(to)) => self.transition(pdi, from, to, now_ns)?.map(|()| to),
+            Ok(Some(AlState::Op)) if from == AlState::SafeOp => {
+                self.sync.monitor = self.pdo_monitor(pdi, app)?;
+                if !self.outputs_steady(now_ns) {
+                    // E-033: wait (up to 200 ms) for stable RxPDO; the status
+                    // stays Safe-Op without error meanwhile
+                    self.pending_op = Some(now_ns);
+                    self.error = false;
+                    self.code = AlStatusCode::NO_ERROR;
+                    self.write_status(pdi)?;
+                    return Ok(None);
+                }
+                self.transition(pdi, app, from, AlState::Op, now_ns)?
+                    .map(|()| AlState::Op)
+            }
+            Ok(Some(to)) => self.transition(pdi, app, from, to, now_ns)?.map(|()| to),
         };
         match result {
             Ok(to) => {
@@ -269,14 +493,16 @@ impl Slave {
             to: self.state,
             requested: ctrl.requested,
             code: self.code,
+            unsolicited: false,
         };
         Ok((from != self.state || self.error).then_some(change))
     }
 
     /// Checks and actions of one ESM transition; the outer `Result` is the PDI's.
-    fn transition<P: Pdi>(
+    fn transition<P: Pdi, A: Dictionary>(
         &mut self,
         pdi: &mut P,
+        app: &mut A,
         from: AlState,
         to: AlState,
         now_ns: u64,
@@ -292,6 +518,17 @@ impl Slave {
             (AlState::PreOp, AlState::SafeOp) => {
                 let sms = [pdi.read_sm(0)?, pdi.read_sm(1)?, pdi.read_sm(2)?, pdi.read_sm(3)?];
                 let (rx, tx) = self.pdo_bytes;
+                // E-029/E-030: the sync mode the master chose
+                let activation = pdi.read_u8(regs::dc::ACTIVATION)?;
+                let sync_type = read_uint(app, SM_OUTPUT_PARAMETER, 1).and_then(|v| u16::try_from(v).ok());
+                let mode = match esm::sync_mode(activation, sync_type) {
+                    Ok(mode) => mode,
+                    Err(code) => return Ok(Err(code)),
+                };
+                let [_, _, sm2, _] = &sms;
+                if let Err(code) = esm::check_free_run(mode, sm2, rx) {
+                    return Ok(Err(code));
+                }
                 if let Err(refusal) = esm::check_process_sms(self.desc, &sms, rx, tx) {
                     // E-028: EMCY A000h, error register = ESM state (Pre-Op = 2),
                     // diag code 4·SM + fault (spec §8.4)
@@ -304,8 +541,42 @@ impl Slave {
                     ));
                     return Ok(Err(refusal.code));
                 }
-                if let Err(code) = self.check_watchdog(pdi)? {
+                let a150_ns = read_uint(app, A150_INDEX, 0)
+                    .unwrap_or(DEFAULT_A150_US)
+                    .saturating_mul(1000);
+                let (cycle_ns, k) = match mode {
+                    SyncMode::DcSync0 => {
+                        let sync0 = pdi.read_u32(regs::dc::SYNC0_CYCLE)?;
+                        let sm2_cycle = read_uint(app, SM_OUTPUT_PARAMETER, 2).unwrap_or(0);
+                        let sm3_cycle = read_uint(app, SM_INPUT_PARAMETER, 2).unwrap_or(0);
+                        match dcsync::validate(sync0, a150_ns, sm2_cycle, sm3_cycle) {
+                            Ok(k) => (sync0, k),
+                            Err(e) => {
+                                self.sync.sync_error = Some(e);
+                                return Ok(Err(AlStatusCode(e.al_status_code())));
+                            }
+                        }
+                    }
+                    _ => {
+                        let c = read_uint(app, SM_OUTPUT_PARAMETER, 2).unwrap_or(0);
+                        (if c == 0 { a150_ns } else { c }, 1)
+                    }
+                };
+                if let Err(code) = self.check_watchdog(pdi, app, sm2, cycle_ns, rx)? {
                     return Ok(Err(code));
+                }
+                self.sync.mode = mode;
+                self.sync.cycle_ns = cycle_ns;
+                self.sync.k = k;
+                self.sync.sync_error = None;
+                self.sync.monitor = None;
+                if mode == SyncMode::DcSync0 {
+                    // 1C32h/1C33h:01/:02 show what runs (the master may only
+                    // have written 0x0981); ignored if the application refuses
+                    for index in [SM_OUTPUT_PARAMETER, SM_INPUT_PARAMETER] {
+                        let _ = app.write(index, 1, &mode.sync_type().to_le_bytes(), CommState::PreOp);
+                        let _ = app.write(index, 2, &cycle_ns.to_le_bytes(), CommState::PreOp);
+                    }
                 }
                 let [_, _, sm2, sm3] = sms;
                 self.out_start = sm2.start;
@@ -315,12 +586,17 @@ impl Slave {
                 self.out_len = rx.min(MAX_PDO_BYTES);
                 self.in_len = tx.min(MAX_PDO_BYTES);
                 self.rx_frames = 0;
+                self.rx_seen = 0;
             }
             (AlState::SafeOp, AlState::Op) => {
-                if let Err(code) = self.check_outputs_steady(now_ns) {
-                    return Ok(Err(code));
-                }
+                // the steadiness (E-033) was checked by the caller
                 self.outputs.fill(0);
+                // the PDO timeout runs from the entry into Op at the earliest
+                self.op_entry_ns = now_ns;
+                if let Some(PdoMonitor::EscWatchdog(_)) = self.sync.monitor {
+                    // clears an SM watchdog event left over from Safe-Op
+                    let _ = pdi.read_u16(regs::WATCHDOG_STATUS_PD)?;
+                }
             }
             // downward transitions always succeed
             _ => {}
@@ -333,14 +609,42 @@ impl Slave {
         Ok(Ok(()))
     }
 
-    /// P→S hook for the SM watchdog settings (E-031, AL 001Fh); accepts all for now.
-    fn check_watchdog<P: Pdi>(&mut self, _pdi: &mut P) -> Result<Result<(), AlStatusCode>, P::Error> {
-        Ok(Ok(()))
+    /// The ESC's process-data watchdog as the master set it up.
+    fn esc_watchdog<P: Pdi>(pdi: &mut P, sm2: &SyncManager) -> Result<EscWatchdog, P::Error> {
+        Ok(EscWatchdog {
+            divider: pdi.read_u16(regs::WATCHDOG_DIVIDER)?,
+            pd_time: pdi.read_u16(regs::WATCHDOG_TIME_PD)?,
+            sm2_trigger: sm2.control().watchdog(),
+        })
     }
 
-    /// S→O hook for "steady process data" (E-033); accepts for now.
-    fn check_outputs_steady(&self, _now_ns: u64) -> Result<(), AlStatusCode> {
-        Ok(())
+    /// P→S: the SM watchdog settings against A258 (E-031, AL 001Fh; see
+    /// [`esm::check_watchdog`]).
+    fn check_watchdog<P: Pdi, A: Dictionary>(
+        &mut self,
+        pdi: &mut P,
+        app: &mut A,
+        sm2: &SyncManager,
+        cycle_ns: u32,
+        rx_bytes: usize,
+    ) -> Result<Result<(), AlStatusCode>, P::Error> {
+        let wd = Self::esc_watchdog(pdi, sm2)?;
+        let a258 = read_a258(app);
+        Ok(esm::check_watchdog(a258, &wd, cycle_ns, rx_bytes))
+    }
+
+    /// The RxPDO monitoring A258 asks for now (read at each S→O request).
+    fn pdo_monitor<P: Pdi, A: Dictionary>(
+        &mut self,
+        pdi: &mut P,
+        app: &mut A,
+    ) -> Result<Option<PdoMonitor>, P::Error> {
+        if self.out_len == 0 {
+            return Ok(None);
+        }
+        let sm2 = pdi.read_sm(2)?;
+        let wd = Self::esc_watchdog(pdi, &sm2)?;
+        Ok(esm::pdo_monitor(read_a258(app), self.sync.cycle_ns, &wd))
     }
 
     fn start_mailbox(&mut self, sm0: &SyncManager, sm1: &SyncManager) {
@@ -481,12 +785,17 @@ impl Slave {
         }
     }
 
-    fn process_data<P: Pdi>(&mut self, pdi: &mut P, events: u32) -> Result<(), P::Error> {
+    fn process_data<P: Pdi>(&mut self, pdi: &mut P, events: u32, now_ns: u64) -> Result<(), P::Error> {
         if self.out_len > 0 && events & al_event::sm(2) != 0 {
             if let Some(out) = self.outputs.get_mut(..self.out_len) {
                 // one read of the whole area: the ESC releases the buffer on its last byte
                 pdi.read(self.out_start, out)?;
                 self.rx_frames = self.rx_frames.wrapping_add(1);
+                self.rx_times.rotate_right(1);
+                if let Some(newest) = self.rx_times.first_mut() {
+                    *newest = now_ns;
+                }
+                self.rx_seen = self.rx_seen.saturating_add(1);
             }
         }
         if self.in_len > 0 {
@@ -496,4 +805,20 @@ impl Slave {
         }
         Ok(())
     }
+}
+
+/// Reads an unsigned entry of up to 4 bytes (little-endian) through the
+/// dictionary; `None` if it is missing or unreadable.
+fn read_uint<A: Dictionary>(app: &mut A, index: u16, sub: u8) -> Option<u32> {
+    let mut buf = [0u8; 4];
+    let n = app.read(index, sub, &mut buf, CommState::PreOp).ok()?;
+    let bytes = buf.get(..n)?;
+    Some(bytes.iter().rev().fold(0u32, |v, &b| (v << 8) | u32::from(b)))
+}
+
+/// A258 (0 = monitoring off when the application has none).
+fn read_a258<A: Dictionary>(app: &mut A) -> u16 {
+    read_uint(app, A258_INDEX, 0)
+        .and_then(|v| u16::try_from(v).ok())
+        .unwrap_or(0)
 }

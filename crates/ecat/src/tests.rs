@@ -674,3 +674,118 @@ fn e079_no_sdo_info_without_the_coe_detail() {
     // mailbox error: service not supported
     assert_eq!(&resp[..10], &[4, 0, 0, 0, 0, 0x10, 0x01, 0x00, 0x04, 0x00]);
 }
+
+#[test]
+fn e029_e030_sync_mode_and_free_run_check() {
+    use crate::esm::{check_free_run, sync_mode, SyncMode};
+    assert_eq!(sync_mode(0x03, Some(0)), Ok(SyncMode::DcSync0), "0x0981 wins");
+    assert_eq!(
+        sync_mode(0x01, Some(0)),
+        Ok(SyncMode::FreeRun),
+        "cyclic unit without SYNC0"
+    );
+    assert_eq!(sync_mode(0, Some(1)), Ok(SyncMode::SmSync));
+    assert_eq!(sync_mode(0, Some(2)), Ok(SyncMode::DcSync0));
+    assert_eq!(sync_mode(0, None), Ok(SyncMode::SmSync));
+    assert_eq!(sync_mode(0, Some(3)), Err(AlStatusCode::INVALID_DC_SYNC_CONFIG));
+    let sm = |control| esc::SyncManager {
+        start: 0x1100,
+        length: 3,
+        control,
+        status: 0,
+        activate: activate::ENABLE,
+        pdi_control: 0,
+    };
+    assert_eq!(
+        check_free_run(SyncMode::FreeRun, &sm(0x66), 3),
+        Err(AlStatusCode::FREERUN_NEEDS_3BUFFER)
+    );
+    assert_eq!(check_free_run(SyncMode::FreeRun, &sm(0x64), 3), Ok(()));
+    assert_eq!(check_free_run(SyncMode::SmSync, &sm(0x66), 3), Ok(()));
+    assert_eq!(
+        check_free_run(SyncMode::FreeRun, &sm(0x66), 0),
+        Ok(()),
+        "no outputs"
+    );
+}
+
+#[test]
+fn e031_e126_e127_watchdog_check_and_pdo_monitor() {
+    use crate::esm::{check_watchdog, pdo_monitor, EscWatchdog, PdoMonitor};
+    let wd = EscWatchdog {
+        divider: 2498,
+        pd_time: 1000,
+        sm2_trigger: true,
+    };
+    let bad = Err(AlStatusCode::INVALID_WATCHDOG_CONFIG);
+    assert_eq!(wd.time_ns(), Some(100_000_000));
+    assert_eq!(check_watchdog(0, &wd, 1_000_000, 23), Ok(()));
+    assert_eq!(
+        check_watchdog(0, &EscWatchdog { divider: 0, ..wd }, 1_000_000, 23),
+        bad
+    );
+    assert_eq!(
+        check_watchdog(0, &EscWatchdog { pd_time: 0, ..wd }, 1_000_000, 23),
+        Ok(())
+    );
+    assert_eq!(
+        check_watchdog(65534, &EscWatchdog { pd_time: 0, ..wd }, 1_000_000, 23),
+        bad
+    );
+    let no_trigger = EscWatchdog {
+        sm2_trigger: false,
+        ..wd
+    };
+    assert_eq!(check_watchdog(65534, &no_trigger, 1_000_000, 23), bad);
+    assert_eq!(
+        check_watchdog(65534, &EscWatchdog { pd_time: 5, ..wd }, 1_000_000, 23),
+        bad
+    );
+    assert_eq!(check_watchdog(65534, &wd, 1_000_000, 23), Ok(()));
+    assert_eq!(
+        check_watchdog(65534, &EscWatchdog { pd_time: 0, ..wd }, 1_000_000, 0),
+        Ok(())
+    );
+
+    assert_eq!(pdo_monitor(0, 1_000_000, &wd), None);
+    assert_eq!(pdo_monitor(65535, 1_000_000, &wd), None);
+    assert_eq!(
+        pdo_monitor(1, 1_000_000, &wd),
+        Some(PdoMonitor::Timeout(1_000_000))
+    );
+    assert_eq!(
+        pdo_monitor(65531, 1_000_000, &wd),
+        Some(PdoMonitor::Timeout(65_531_000_000))
+    );
+    assert_eq!(
+        pdo_monitor(65532, 1_000_000, &wd),
+        Some(PdoMonitor::Timeout(2_500_000))
+    );
+    assert_eq!(
+        pdo_monitor(65533, 1_000_000, &wd),
+        Some(PdoMonitor::Timeout(4_500_000))
+    );
+    assert_eq!(
+        pdo_monitor(65534, 1_000_000, &wd),
+        Some(PdoMonitor::EscWatchdog(100_000_000))
+    );
+    assert_eq!(
+        pdo_monitor(65534, 1_000_000, &EscWatchdog { pd_time: 0, ..wd }),
+        None
+    );
+}
+
+#[test]
+fn e038_unsolicited_change_displays() {
+    let c = StateChange {
+        from: AlState::Op,
+        to: AlState::SafeOp,
+        requested: 8,
+        code: AlStatusCode::SM_WATCHDOG,
+        unsolicited: true,
+    };
+    assert_eq!(
+        std::format!("{c}"),
+        "Op -> SafeOp (unsolicited, AL status code 0x001b)"
+    );
+}

@@ -1,0 +1,301 @@
+//! Synchronisation and RxPDO monitoring through a real master (spec §3.3,
+//! §11, §13.1–13.4): the P→S checks of the sync mode (DC SYNC0 cycle vs
+//! A150, free run needs a 3-buffer SM2, SM watchdog settings), the S→O wait
+//! for stable RxPDO and the PDO timeout in Op.
+#![allow(
+    clippy::unwrap_used,
+    clippy::expect_used,
+    clippy::panic,
+    clippy::indexing_slicing
+)]
+
+use drive_tests::{al_status, init, line, request, with_master, write_sm, CoeClient};
+use esc::regs::{self, dc};
+use esc::AlStatusCode;
+use ethercrab::{MainDevice, SubDeviceGroup};
+use hil_sim::sim::Simulation;
+use std::cell::RefCell;
+
+const PREOP: u16 = 2;
+const SAFEOP: u16 = 4;
+const OP: u16 = 8;
+const ERR: u16 = 0x10;
+const ACK: u16 = 0x10;
+
+/// A258 PDO timeout (ms), parameter 2000h + 258.
+const A258: u16 = 0x2102;
+/// SM2 as the drive's SII describes it.
+const SM2_START: u16 = 0x1200;
+const SM2_LEN: u16 = 23;
+const SM2_CONTROL: u8 = 0x64;
+
+fn set(sim: &RefCell<Simulation>, index: u16, sub: u8, value: i64) {
+    sim.borrow_mut().drives_mut()[0]
+        .drive
+        .objects
+        .set(index, sub, value)
+        .unwrap_or_else(|e| panic!("{index:04X}h:{sub}: {e:?}"));
+}
+
+fn advance(sim: &RefCell<Simulation>, ns: u64) {
+    let mut s = sim.borrow_mut();
+    let t = s.now_ns() + ns;
+    s.advance_to(t);
+}
+
+/// `n` process-data cycles of 1 ms (the master writes the RxPDO).
+async fn cycles<S: ethercrab::subdevice_group::HasPdi>(
+    md: &MainDevice<'_>,
+    group: &SubDeviceGroup<8, 512, ethercrab::DefaultLock, S>,
+    sim: &RefCell<Simulation>,
+    n: usize,
+) {
+    for _ in 0..n {
+        advance(sim, 1_000_000);
+        group.tx_rx(md).await.expect("process data cycle");
+    }
+}
+
+/// SYNC0 configured with plain register writes, as a master's DC set-up does.
+async fn start_sync0<S>(sd: &ethercrab::SubDeviceRef<'_, S>, cycle_ns: u32) {
+    let now: u64 = sd.register_read(dc::SYSTEM_TIME).await.unwrap();
+    sd.register_write(dc::SYNC0_CYCLE, cycle_ns).await.unwrap();
+    sd.register_write(dc::START_TIME, now + 1_000_000).await.unwrap();
+    sd.register_write(dc::ACTIVATION, 0x03u8).await.unwrap();
+}
+
+async fn stop_sync0<S>(sd: &ethercrab::SubDeviceRef<'_, S>) {
+    sd.register_write(dc::ACTIVATION, 0x00u8).await.unwrap();
+}
+
+fn u32_of(d: &[u8]) -> u32 {
+    let mut b = [0u8; 4];
+    b[..d.len()].copy_from_slice(d);
+    u32::from_le_bytes(b)
+}
+
+#[test]
+fn e029_sync0_cycle_not_a_multiple_of_a150_or_above_8ms_refused() {
+    let sim = line(1);
+    with_master(&sim, async |md, clock| {
+        let group = init(md, clock).await;
+        // the master's SM set-up, then back to Pre-Op for the DC configuration
+        let group = group.into_safe_op(md).await.expect("SAFE-OP");
+        let group = group.into_pre_op(md).await.expect("PRE-OP");
+        let sd = group.subdevice(md, 0).unwrap();
+        let mut c = CoeClient::new();
+
+        // 1C32h:01 = 2 (DC SYNC0) without SYNC0 active: 0030h
+        c.download(&sd, 0x1C32, 1, &2u16.to_le_bytes()).await.unwrap();
+        request(&sd, SAFEOP).await;
+        assert_eq!(
+            al_status(&sd).await,
+            (PREOP | ERR, AlStatusCode::INVALID_DC_SYNC_CONFIG.0),
+            "DC selected, SYNC0 inactive"
+        );
+        c.download(&sd, 0x1C32, 1, &0u16.to_le_bytes()).await.unwrap();
+
+        // A150 = 1 ms (default): 1.5 ms is not a multiple, 10 ms is above 8 ms
+        for bad in [1_500_000u32, 10_000_000] {
+            start_sync0(&sd, bad).await;
+            request(&sd, SAFEOP | ACK).await;
+            assert_eq!(
+                al_status(&sd).await,
+                (PREOP | ERR, 0x0036),
+                "SYNC0 {bad} ns: DC SYNC0 cycle time"
+            );
+            stop_sync0(&sd).await;
+        }
+        // 2 ms = 2 × A150: accepted; 1C32h/1C33h show DC SYNC0 and the cycle
+        start_sync0(&sd, 2_000_000).await;
+        request(&sd, SAFEOP | ACK).await;
+        assert_eq!(al_status(&sd).await, (SAFEOP, 0), "SYNC0 2 ms");
+        for index in [0x1C32, 0x1C33] {
+            let st = c.upload(&sd, index, 1).await.unwrap();
+            assert_eq!(u32_of(&st), 2, "{index:04X}h:01 sync type DC SYNC0");
+            let cy = c.upload(&sd, index, 2).await.unwrap();
+            assert_eq!(u32_of(&cy), 2_000_000, "{index:04X}h:02 cycle time");
+        }
+        let supported = c.upload(&sd, 0x1C32, 4).await.unwrap();
+        assert_eq!(u32_of(&supported), 0x0007, "free run, SM2, DC SYNC0");
+        let min = c.upload(&sd, 0x1C32, 5).await.unwrap();
+        assert_eq!(u32_of(&min), 250_000, "minimum cycle 250 µs");
+    });
+}
+
+#[test]
+fn e030_free_run_without_3_buffer_sm2_refused_with_0029() {
+    let sim = line(1);
+    with_master(&sim, async |md, clock| {
+        let group = init(md, clock).await;
+        let group = group.into_safe_op(md).await.expect("SAFE-OP");
+        let group = group.into_pre_op(md).await.expect("PRE-OP");
+        let sd = group.subdevice(md, 0).unwrap();
+        let mut c = CoeClient::new();
+        let one_buffer = (SM2_CONTROL & !0x03) | 0x02;
+
+        // 1C32h:01 = 0 (free run, the default) with SM2 in 1-buffer mode
+        write_sm(&sd, 2, SM2_START, SM2_LEN, one_buffer).await;
+        request(&sd, SAFEOP).await;
+        assert_eq!(
+            al_status(&sd).await,
+            (PREOP | ERR, AlStatusCode::FREERUN_NEEDS_3BUFFER.0)
+        );
+        // SM-synchronous: the device still needs its 3-buffer SM2 (001Dh)
+        c.download(&sd, 0x1C32, 1, &1u16.to_le_bytes()).await.unwrap();
+        request(&sd, SAFEOP | ACK).await;
+        assert_eq!(
+            al_status(&sd).await,
+            (PREOP | ERR, AlStatusCode::INVALID_OUTPUT_CONFIG.0)
+        );
+        // free run with 3 buffers: fine
+        c.download(&sd, 0x1C32, 1, &0u16.to_le_bytes()).await.unwrap();
+        write_sm(&sd, 2, SM2_START, SM2_LEN, SM2_CONTROL).await;
+        request(&sd, SAFEOP | ACK).await;
+        assert_eq!(al_status(&sd).await, (SAFEOP, 0));
+    });
+}
+
+#[test]
+fn e031_invalid_sm_watchdog_settings_refused_with_001f() {
+    let sim = line(1);
+    with_master(&sim, async |md, clock| {
+        let group = init(md, clock).await;
+        let group = group.into_safe_op(md).await.expect("SAFE-OP");
+        let group = group.into_pre_op(md).await.expect("PRE-OP");
+        let sd = group.subdevice(md, 0).unwrap();
+        let code = AlStatusCode::INVALID_WATCHDOG_CONFIG.0;
+
+        // divider 0 with the watchdog running
+        let divider: u16 = sd.register_read(regs::WATCHDOG_DIVIDER).await.unwrap();
+        sd.register_write(regs::WATCHDOG_DIVIDER, 0u16).await.unwrap();
+        request(&sd, SAFEOP).await;
+        assert_eq!(al_status(&sd).await, (PREOP | ERR, code), "divider 0");
+        sd.register_write(regs::WATCHDOG_DIVIDER, divider).await.unwrap();
+
+        // A258 = 65534 relies on the master's SM watchdog
+        set(&sim, A258, 0, 65534);
+        sd.register_write(regs::WATCHDOG_TIME_PD, 0u16).await.unwrap();
+        request(&sd, SAFEOP | ACK).await;
+        assert_eq!(al_status(&sd).await, (PREOP | ERR, code), "SM watchdog off");
+        // 5 × 100 µs is shorter than the 1 ms cycle
+        sd.register_write(regs::WATCHDOG_TIME_PD, 5u16).await.unwrap();
+        request(&sd, SAFEOP | ACK).await;
+        assert_eq!(al_status(&sd).await, (PREOP | ERR, code), "shorter than a cycle");
+        // 100 ms: valid
+        sd.register_write(regs::WATCHDOG_TIME_PD, 1000u16).await.unwrap();
+        request(&sd, SAFEOP | ACK).await;
+        assert_eq!(al_status(&sd).await, (SAFEOP, 0));
+    });
+}
+
+#[test]
+fn e033_safeop_to_op_waits_for_steady_rxpdo_and_refuses_after_200ms() {
+    let sim = line(1);
+    with_master(&sim, async |md, clock| {
+        set(&sim, A258, 0, 50);
+        let group = init(md, clock).await;
+        let group = group.into_safe_op(md).await.expect("SAFE-OP");
+        let sd = group.subdevice(md, 0).unwrap();
+
+        // no process data: the request waits (Safe-Op, no error)…
+        request(&sd, OP).await;
+        assert_eq!(al_status(&sd).await, (SAFEOP, 0), "pending");
+        advance(&sim, 100_000_000);
+        assert_eq!(al_status(&sd).await, (SAFEOP, 0), "still pending at 100 ms");
+        // …and is refused after 200 ms
+        advance(&sim, 150_000_000);
+        assert_eq!(
+            al_status(&sd).await,
+            (SAFEOP | ERR, AlStatusCode::SM_WATCHDOG.0),
+            "no RxPDO within 200 ms"
+        );
+
+        // a waiting request is granted once the RxPDO runs
+        request(&sd, OP | ACK).await;
+        assert_eq!(al_status(&sd).await, (SAFEOP, 0), "pending again");
+        cycles(md, &group, &sim, 5).await;
+        assert_eq!(al_status(&sd).await, (OP, 0), "steady RxPDO: Op");
+    });
+}
+
+#[test]
+fn e044_e126_e128_op_without_rxpdo_longer_than_a258_falls_to_safeop() {
+    let sim = line(1);
+    with_master(&sim, async |md, clock| {
+        set(&sim, A258, 0, 50);
+        let group = init(md, clock).await;
+        let group = group.into_safe_op(md).await.expect("SAFE-OP");
+        cycles(md, &group, &sim, 5).await;
+        // process data just ran: ethercrab's into_op gets Op at once
+        let group = group.into_op(md).await.expect("OP");
+        let sd = group.subdevice(md, 0).unwrap();
+        cycles(md, &group, &sim, 20).await;
+        assert_eq!(al_status(&sd).await, (OP, 0), "RxPDO every 1 ms");
+
+        // 40 ms without RxPDO: still within A258
+        advance(&sim, 40_000_000);
+        assert_eq!(al_status(&sd).await, (OP, 0));
+        cycles(md, &group, &sim, 1).await;
+        // 60 ms without: PDO timeout
+        advance(&sim, 60_000_000);
+        assert_eq!(
+            al_status(&sd).await,
+            (SAFEOP | ERR, AlStatusCode::SM_WATCHDOG.0),
+            "PDO timeout"
+        );
+        // EMCY 7500h, error register 10h, event 52 cause 6
+        let mut c = CoeClient::new();
+        c.upload(&sd, 0x1000, 0).await.unwrap();
+        let emcy = c.emergencies.first().expect("EMCY");
+        assert_eq!(u16::from_le_bytes([emcy[0], emcy[1]]), 0x7500);
+        assert_eq!((emcy[2], emcy[3], emcy[4]), (0x10, 52, 6));
+        // an unsolicited state change (E-038)
+        let log = sim.borrow().drives()[0].state_log.clone();
+        let (_, last) = log.last().unwrap();
+        assert!(last.unsolicited, "{last}");
+        assert_eq!((last.from, last.to), (esc::AlState::Op, esc::AlState::SafeOp));
+        let status = *sim.borrow().drives()[0].drive.slave.sync_status();
+        assert!(status.triggered && status.trigger_count == 1 && status.unsolicited);
+    });
+}
+
+#[test]
+fn e128_master_leaving_op_does_not_trigger_the_pdo_timeout() {
+    let sim = line(1);
+    with_master(&sim, async |md, clock| {
+        set(&sim, A258, 0, 50);
+        let group = init(md, clock).await;
+        let group = group.into_safe_op(md).await.expect("SAFE-OP");
+        cycles(md, &group, &sim, 5).await;
+        let group = group.into_op(md).await.expect("OP");
+        cycles(md, &group, &sim, 5).await;
+        let group = group.into_safe_op(md).await.expect("back to SAFE-OP");
+        let sd = group.subdevice(md, 0).unwrap();
+        advance(&sim, 200_000_000);
+        assert_eq!(al_status(&sd).await, (SAFEOP, 0), "no timeout outside Op");
+    });
+}
+
+#[test]
+fn e127_sm_watchdog_mode_uses_the_escs_watchdog() {
+    let sim = line(1);
+    with_master(&sim, async |md, clock| {
+        set(&sim, A258, 0, 65534);
+        let group = init(md, clock).await;
+        let group = group.into_safe_op(md).await.expect("SAFE-OP");
+        cycles(md, &group, &sim, 5).await;
+        let group = group.into_op(md).await.expect("OP");
+        let sd = group.subdevice(md, 0).unwrap();
+        cycles(md, &group, &sim, 5).await;
+        // the ESC's default SM watchdog: 1000 × 100 µs
+        advance(&sim, 90_000_000);
+        assert_eq!(al_status(&sd).await, (OP, 0));
+        advance(&sim, 20_000_000);
+        assert_eq!(
+            al_status(&sd).await,
+            (SAFEOP | ERR, AlStatusCode::SM_WATCHDOG.0),
+            "SM watchdog expired"
+        );
+    });
+}
