@@ -347,7 +347,7 @@ fn serve(args: &[String]) -> Result<(), String> {
         sim.record_pcap(&PathBuf::from(&p))
             .map_err(|e| format!("{p}: {e}"))?;
     }
-    println!("hil-sim serve: {slaves} simulated drive(s) with {axes} axis/axes on {iface}");
+    println!("hil-sim serve: {slaves} simulated double-axis drive(s) on {iface} (--axes {axes}: a single-axis variant is not modelled yet)");
     let start = Instant::now();
     let mut printed = Vec::new();
     let mut buf = [0u8; 1600];

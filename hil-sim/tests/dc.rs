@@ -115,7 +115,9 @@ fn run_sync0(sim: &RefCell<Simulation>, cycles: usize) -> (i64, i64) {
                 DcConfiguration {
                     start_delay: Duration::from_millis(20),
                     sync0_period: Duration::from_nanos(SYNC0_NS),
-                    sync0_shift: Duration::from_nanos(SYNC0_NS / 4),
+                    // frames 250 µs before SYNC0: after it they would be late
+                    // (E-118) and the drive would refuse Op with 0033h
+                    sync0_shift: Duration::from_nanos(SYNC0_NS - SYNC0_NS / 4),
                 },
             )
             .await

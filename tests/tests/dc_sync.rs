@@ -383,3 +383,175 @@ fn e116_a_sync0_cycle_the_pll_cannot_run_is_refused() {
     assert_eq!(a261_0, 3, "A261[0] = 3: not a multiple of 250 µs");
     assert!(d.cycle_log.is_empty(), "the control cycle stays free-running");
 }
+
+/// AL status bits / requests used by the DC supervision test.
+const SAFEOP: u16 = 4;
+const OP: u16 = 8;
+const ERR_ACK: u16 = 0x10;
+
+/// Runs `n` `tx_rx_dc` cycles, the clock advanced as ethercrab computes it;
+/// calls `probe` after each with the cycle number, whether the group is in
+/// OP, and the simulation.
+async fn dc_cycles<'a>(
+    md: &'a MainDevice<'a>,
+    group: &SubDeviceGroup<
+        8,
+        512,
+        ethercrab::DefaultLock,
+        ethercrab::subdevice_group::Op,
+        ethercrab::subdevice_group::HasDc,
+    >,
+    sim: &RefCell<Simulation>,
+    n: usize,
+    mut probe: impl FnMut(usize, bool, &Simulation),
+) {
+    for i in 0..n {
+        let r = group.tx_rx_dc(md).await.expect("DC cycle");
+        probe(i, r.all_op(), &sim.borrow());
+        let wait = r.extra.next_cycle_wait.as_nanos() as u64;
+        let mut s = sim.borrow_mut();
+        let t = s.now_ns() + wait;
+        s.advance_to(t);
+    }
+}
+
+/// E-046, E-131, E-038 (spec §3.3 "S→O / in O: SYNC0 present, PLL locked",
+/// §13.4): in DC mode Safe-Op → Op waits (no error) while the PLL has no
+/// SYNC0 (002Dh) or is not locked (0032h) and is granted once it is locked;
+/// SYNC0 switched off in Op (0x0981 = 0) drops to Safe-Op with the error
+/// indication, AL 0034h (SYNC0 timeout), EMCY 7500h / 10h / event 52 cause
+/// 7 and an unsolicited state change; acknowledge + SYNC0 back: Op again.
+#[test]
+fn e046_e131_e038_dc_op_waits_for_pll_lock_and_sync0_loss_drops_to_safeop() {
+    use drive::runtime::dcsync::al;
+    use drive_tests::{al_status, request, CoeClient};
+    use esc::AlStatusCode;
+    let sim = line();
+    with_master(&sim, async |md, clock| {
+        let mut group = init(md, clock).await;
+        for mut sd in group.iter_mut(md) {
+            sd.set_dc_sync(DcSync::Sync0);
+        }
+        let group = group
+            .into_pre_op_pdi(md)
+            .await
+            .expect("PRE-OP with PDI")
+            .configure_dc_sync(
+                md,
+                DcConfiguration {
+                    start_delay: Duration::from_millis(20),
+                    sync0_period: Duration::from_nanos(SYNC0_NS),
+                    sync0_shift: Duration::from_nanos(SYNC0_NS - FRAME_LEAD_NS),
+                },
+            )
+            .await
+            .expect("DC configuration")
+            .request_into_op(md)
+            .await
+            .expect("request OP");
+
+        // S→O waits for the lock: Safe-Op without error, 002Dh then 0032h
+        let mut waiting = Vec::new();
+        let mut first_op = None;
+        dc_cycles(md, &group, &sim, 150, |i, all_op, s| {
+            for d in s.drives() {
+                let slave = &d.drive.slave;
+                if slave.state() == esc::AlState::SafeOp {
+                    assert!(!slave.error(), "cycle {i}: no error while waiting");
+                    assert!(slave.op_pending(), "cycle {i}: S→O pending");
+                    let ready = d.drive.sync_state().ready;
+                    if !waiting.contains(&ready) {
+                        waiting.push(ready);
+                    }
+                }
+            }
+            if all_op && first_op.is_none() {
+                first_op = Some(i);
+                for d in s.drives() {
+                    assert!(
+                        d.drive.pll().is_some_and(|p| p.is_locked()),
+                        "Op only once locked"
+                    );
+                }
+            }
+        })
+        .await;
+        println!("S→O waited {first_op:?} cycles: {waiting:?}");
+        assert!(first_op.is_some(), "the group reached OP");
+        assert!(
+            waiting.contains(&Err(AlStatusCode(al::NO_SYNC))),
+            "002Dh before SYNC0"
+        );
+        assert!(
+            waiting.contains(&Err(AlStatusCode(al::PLL_ERROR))),
+            "0032h before the lock"
+        );
+
+        // SYNC0 off in Op: Safe-Op + error, 0034h
+        for sd in group.iter(md) {
+            sd.register_write(esc::regs::dc::ACTIVATION, 0u8)
+                .await
+                .expect("0x0981");
+        }
+        dc_cycles(md, &group, &sim, 20, |_, _, _| {}).await;
+        for i in 0..2 {
+            let sd = group.subdevice(md, i).expect("drive");
+            assert_eq!(
+                al_status(&sd).await,
+                (SAFEOP | 0x10, al::DC_SYNC_TIMEOUT),
+                "drive {i}: SYNC0 timeout"
+            );
+            let mut c = CoeClient::new();
+            c.upload(&sd, 0x1000, 0).await.expect("1000h");
+            let emcy = c.emergencies.first().expect("EMCY");
+            println!("drive {i}: EMCY {emcy:02x?}");
+            assert_eq!(u16::from_le_bytes([emcy[0], emcy[1]]), 0x7500);
+            assert_eq!(
+                (emcy[2], emcy[3], emcy[4]),
+                (0x10, 52, 7),
+                "register 10h, event 52 cause 7"
+            );
+            let s = sim.borrow();
+            let (_, last) = s.drives()[i].state_log.last().copied().expect("state change");
+            println!("drive {i}: {last}");
+            assert!(last.unsolicited, "E-038: {last}");
+            assert_eq!((last.from, last.to), (esc::AlState::Op, esc::AlState::SafeOp));
+            assert_eq!(last.code, AlStatusCode(al::DC_SYNC_TIMEOUT));
+            assert!(s.drives()[i].drive.slave.sync_status().unsolicited);
+            assert_eq!(
+                s.drives()[i].drive.pll().and_then(|p| p.fault()),
+                Some(SyncFault::Sync0Timeout)
+            );
+        }
+        // without acknowledge a request is ignored
+        let sd0 = group.subdevice(md, 0).expect("drive");
+        request(&sd0, OP).await;
+        assert_eq!(al_status(&sd0).await.0, SAFEOP | 0x10, "no acknowledge: ignored");
+
+        // SYNC0 back (on the same grid: 0x0990 holds the next pulse) and
+        // acknowledge + Op: the PLL fault is cleared, Op once locked again
+        for sd in group.iter(md) {
+            sd.register_write(esc::regs::dc::ACTIVATION, 0x03u8)
+                .await
+                .expect("0x0981");
+            request(&sd, OP | ERR_ACK).await;
+        }
+        let mut back = None;
+        dc_cycles(md, &group, &sim, 150, |i, all_op, _| {
+            if all_op && back.is_none() {
+                back = Some(i);
+            }
+        })
+        .await;
+        println!("Op again after {back:?} cycles");
+        assert!(back.is_some(), "Op again after acknowledge");
+        for i in 0..2 {
+            let sd = group.subdevice(md, i).expect("drive");
+            assert_eq!(al_status(&sd).await, (OP, 0), "drive {i}");
+            let s = sim.borrow();
+            let pll = s.drives()[i].drive.pll().expect("PLL");
+            assert_eq!(pll.fault(), None, "acknowledge cleared the PLL fault");
+            assert!(pll.is_locked());
+        }
+    });
+}

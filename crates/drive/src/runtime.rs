@@ -29,6 +29,14 @@
 //! calls [`Drive::cycle_start`] and programs the next start from the
 //! returned period, the SM2 event calls [`Drive::on_frame`]. A296, A298 and
 //! A261 follow the PLL. Going back to Init drops the PLL.
+//!
+//! The slave stack learns the synchronisation state through
+//! [`ecat::Slave::set_sync_state`], set from the PLL before each slave poll
+//! while the mode accepted at P→S is DC SYNC0 and the PLL is enabled (A290 =
+//! 1): Safe-Op → Op waits for the lock (002Dh without SYNC0, 0032h not
+//! locked), a latched PLL fault in Op drops to Safe-Op with its AL code and
+//! EMCY 7500h cause 7 (spec §3.3, §13.4). The master's error acknowledge
+//! clears the PLL fault.
 
 use crate::axis::{Axis, AxisCommand, AxisIo};
 use crate::dictionary::{DriveObjects, LiveValues, PERSISTENT_IMAGE_BYTES};
@@ -36,6 +44,7 @@ use crate::objects::LAYOUT_HASH;
 use crate::pdo_image::{PdoImage, PdoImageError};
 use crate::DEVICE;
 use ecat::diag::{DiagHistory, DiagMessage, DiagType};
+use ecat::esm::{SyncMode, SyncState};
 use ecat::{Slave, StateChange};
 use esc::{regs, AlState, AlStatusCode, Pdi, PdiExt};
 use od::SdoAbort;
@@ -212,10 +221,19 @@ impl<F: Flash> Drive<F> {
     /// objects and the dictionary's requests.
     pub fn poll<P: Pdi>(&mut self, pdi: &mut P, now_ns: u64) -> Result<Option<StateChange>, P::Error> {
         self.process_inputs();
+        self.slave.set_sync_state(self.sync_state());
         let mut live = Live { diag: &mut self.diag };
         let change = self
             .slave
             .poll(pdi, &mut self.objects.with_live(&mut live), now_ns)?;
+        if self.slave.take_error_ack() {
+            // the master acknowledged the error: a latched PLL fault goes
+            // (a new one latches again at the next occurrence)
+            if let Some(pll) = self.pll.as_mut() {
+                pll.clear_fault();
+            }
+            self.update_sync_live();
+        }
         self.process_outputs();
         if let Some(c) = change.filter(|c| c.code != AlStatusCode::NO_ERROR) {
             // a refused state change is an error message in the history (E-144)
@@ -335,6 +353,33 @@ impl<F: Flash> Drive<F> {
     /// it runs or before any SYNC0).
     pub fn sync_error(&self) -> Option<SyncError> {
         self.sync_error
+    }
+
+    /// What the slave stack is told about the synchronisation (see
+    /// [`Slave::set_sync_state`]): supervised in DC SYNC0 mode with the PLL
+    /// not deactivated (A290 ≠ 1 leaves the drive unsynchronised on purpose).
+    /// Without a PLL (no SYNC0 yet, or a configuration it refused) S→O waits
+    /// with 002Dh (or the refusal's code).
+    pub fn sync_state(&self) -> SyncState {
+        if self.slave.sync_status().mode != SyncMode::DcSync0 {
+            return SyncState::NONE;
+        }
+        let code = |f: dcsync::SyncFault| AlStatusCode(f.al_status_code());
+        match &self.pll {
+            Some(p) if p.state() == dcsync::PllState::Disabled => SyncState::NONE,
+            Some(p) => SyncState {
+                required: true,
+                ready: p.ready_for_op().map_err(code),
+                fault: p.fault().map(code),
+            },
+            None => SyncState {
+                required: true,
+                ready: Err(self.sync_error.map_or(AlStatusCode(dcsync::al::NO_SYNC), |e| {
+                    AlStatusCode(e.al_status_code())
+                })),
+                fault: None,
+            },
+        }
     }
 
     /// The PLL configuration from the ESC's SYNC0 cycle and the objects

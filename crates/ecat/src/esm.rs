@@ -331,3 +331,60 @@ pub const STEADY_FRAMES: u32 = 3;
 /// How long an S→O request waits for stable RxPDO before it is refused
 /// (spec §3.3), ns.
 pub const STEADY_WAIT_NS: u64 = 200_000_000;
+
+/// Event 52 "Communication" (spec §13.4): the causes (`E43`) this stack
+/// raises, in one place. The EMCY is 7500h, error register 10h, `E82` = 52,
+/// `E43` = the cause ([`crate::emcy::Emcy::for_event`]); the drive's reaction
+/// (A29 / A540, E-129) is the application's.
+///
+/// | Cause | Raised by | When |
+/// |---|---|---|
+/// | [`PDO_TIMEOUT`] (6) | [`crate::Slave`] in Op | no RxPDO for longer than A258, or the ESC's SM watchdog (A258 = 65534) expired (AL 001Bh) |
+/// | [`SYNC`] (7) | [`crate::Slave`] in Op, DC mode | the application reports a synchronisation fault through [`crate::Slave::set_sync_state`]: SYNC0 timeout (0034h), late frames (0033h), lost lock (0032h) (E-131; the spec's cell merges synchronisation and connection errors, uncertain) |
+/// | [`WRONG_FIRMWARE`] (15) | not raised | the projected fieldbus identification E59[2] ≠ the firmware's E52[3] (E-130): this firmware has no E59/E52 to compare |
+pub mod event52 {
+    /// `E82` of the event.
+    pub const EVENT: u8 = 52;
+    /// Cause 6: EtherCAT PDO timeout (process data missing).
+    pub const PDO_TIMEOUT: u8 = 6;
+    /// Cause 7: synchronisation (or connection) error; the value
+    /// `dcsync::EVENT52_CAUSE_SYNC` the PLL reports.
+    pub const SYNC: u8 = dcsync::EVENT52_CAUSE_SYNC;
+    /// Cause 15: wrong firmware for the application (not detected here).
+    pub const WRONG_FIRMWARE: u8 = 15;
+}
+
+/// What the application tells the slave about its synchronisation (the
+/// DC-Sync PLL, which the slave does not own) before each
+/// [`crate::Slave::poll`], through [`crate::Slave::set_sync_state`].
+/// Only used while the mode accepted at P→S is [`SyncMode::DcSync0`].
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub struct SyncState {
+    /// The application supervises the synchronisation (DC mode with its
+    /// PLL enabled); `false`: no sync check at S→O, no sync fault in Op.
+    pub required: bool,
+    /// Whether Safe-Op → Op may go ahead (PLL locked, no latched fault);
+    /// otherwise the AL code to refuse with (002Dh no SYNC0, 0032h not
+    /// locked, or the latched fault's code).
+    pub ready: Result<(), AlStatusCode>,
+    /// A latched synchronisation fault (0032h lost lock, 0033h late frames,
+    /// 0034h SYNC0 timeout, 001Ah): in Op it drops to Safe-Op with this code
+    /// and EMCY 7500h cause [`event52::SYNC`]. The application clears it when
+    /// the master acknowledges the error ([`crate::Slave::take_error_ack`]).
+    pub fault: Option<AlStatusCode>,
+}
+
+impl SyncState {
+    /// Not supervised (free run, SM-Sync, PLL disabled): no sync checks.
+    pub const NONE: Self = Self {
+        required: false,
+        ready: Ok(()),
+        fault: None,
+    };
+}
+
+impl Default for SyncState {
+    fn default() -> Self {
+        Self::NONE
+    }
+}

@@ -3,7 +3,9 @@
 use crate::coe::{service, CoeConfig, CoeHeader, CoeServer, CommState, Dictionary, COE_HEADER_LEN};
 use crate::desc::Device;
 use crate::emcy::{self, Emcy, EmcyQueue};
-use crate::esm::{self, EscWatchdog, PdoMonitor, SyncMode, MAX_MAILBOX_LEN, MAX_PDO_BYTES};
+use crate::esm::{
+    self, event52, EscWatchdog, PdoMonitor, SyncMode, SyncState, MAX_MAILBOX_LEN, MAX_PDO_BYTES,
+};
 use crate::mailbox::{next_counter, MailboxError, MailboxHeader, MailboxType, HEADER_LEN};
 use esc::regs::{self, al_event};
 use esc::sm::{activate, pdi_control, status};
@@ -20,7 +22,8 @@ pub struct StateChange {
     pub requested: u8,
     /// The AL status code (0 on success).
     pub code: AlStatusCode,
-    /// The slave left the state on its own (PDO timeout / SM watchdog, E-038:
+    /// The slave left the state on its own (PDO timeout / SM watchdog / sync
+    /// fault, E-038:
     /// A257 Er3, red LED single flash); `requested` is then the state it left.
     pub unsolicited: bool,
 }
@@ -61,9 +64,6 @@ pub const SM_OUTPUT_PARAMETER: u16 = 0x1C32;
 pub const SM_INPUT_PARAMETER: u16 = 0x1C33;
 /// A150 when the application has none, µs.
 const DEFAULT_A150_US: u32 = 1000;
-/// Event 52 "Communication", cause 6 "EtherCAT PDO-Timeout" (spec §13.1, §13.4).
-const E82_COMMUNICATION: u8 = 52;
-const E43_PDO_TIMEOUT: u8 = 6;
 
 /// The synchronisation the slave accepted at the last P→S (spec §11), and
 /// the RxPDO monitoring (A258/A259, spec §13.1–13.2): what `1C32h`/`1C33h`,
@@ -168,6 +168,11 @@ pub struct Slave {
     /// When Op was last entered (start of the PDO timeout).
     op_entry_ns: u64,
     sync: SyncStatus,
+    /// The application's synchronisation state (DC-Sync PLL), set before each poll.
+    sync_state: SyncState,
+    /// The master acknowledged an error indication since the last
+    /// [`Slave::take_error_ack`].
+    error_acked: bool,
 }
 
 impl Slave {
@@ -209,6 +214,8 @@ impl Slave {
                 k: 1,
                 ..SyncStatus::default()
             },
+            sync_state: SyncState::NONE,
+            error_acked: false,
         }
     }
 
@@ -218,7 +225,31 @@ impl Slave {
         &self.sync
     }
 
-    /// Whether an S→O request waits for stable RxPDO (E-033).
+    /// The application's synchronisation state (its DC-Sync PLL), to be set
+    /// before each [`poll`](Self::poll). Used only while the mode accepted at
+    /// P→S is DC SYNC0 and `state.required`: S→O then waits (up to 200 ms,
+    /// like the steady-RxPDO wait) for `state.ready` and is refused with its
+    /// code; in Op `state.fault` drops to Safe-Op with that code, EMCY 7500h
+    /// (event 52 cause 7) and an unsolicited state change (spec §3.3, E-046,
+    /// E-131, E-038).
+    pub fn set_sync_state(&mut self, state: SyncState) {
+        self.sync_state = state;
+    }
+
+    /// The synchronisation state last set by the application.
+    pub fn sync_state(&self) -> &SyncState {
+        &self.sync_state
+    }
+
+    /// Whether the master acknowledged an error indication (AL control with
+    /// the acknowledge bit while the error was set) since the last call; the
+    /// application then clears its latched faults (e.g. `Pll::clear_fault`).
+    pub fn take_error_ack(&mut self) -> bool {
+        core::mem::take(&mut self.error_acked)
+    }
+
+    /// Whether an S→O request waits for stable RxPDO (E-033) or for the
+    /// synchronisation (DC mode).
     pub fn op_pending(&self) -> bool {
         self.pending_op.is_some()
     }
@@ -310,11 +341,16 @@ impl Slave {
         if change.is_none() && self.state == AlState::Op {
             change = self.monitor_rxpdo(pdi, events, now_ns)?;
         }
+        if change.is_none() && self.state == AlState::Op {
+            change = self.monitor_sync(pdi)?;
+        }
         Ok(change)
     }
 
-    /// E-033: answers a waiting S→O request once the RxPDO is steady, or
-    /// refuses it after [`esm::STEADY_WAIT_NS`].
+    /// E-033: answers a waiting S→O request once the RxPDO is steady and
+    /// (DC mode) the synchronisation ready, or refuses it after
+    /// [`esm::STEADY_WAIT_NS`] (with the synchronisation's code when that is
+    /// what is missing).
     fn pending_op<P: Pdi, A: Dictionary>(
         &mut self,
         pdi: &mut P,
@@ -328,15 +364,21 @@ impl Slave {
             self.pending_op = None;
             return Ok(None);
         }
-        let result = if self.outputs_steady(now_ns) {
+        let sync = self.sync_ready();
+        let result = if self.outputs_steady(now_ns) && sync.is_ok() {
             self.transition(pdi, app, AlState::SafeOp, AlState::Op, now_ns)?
         } else if now_ns.wrapping_sub(since) > esm::STEADY_WAIT_NS {
-            // Not stable within 200 ms: refused. The spec names no AL code
-            // (§3.3: 001Bh or 002Bh); 001Bh "SM watchdog" is the one §4 ties to
-            // "no RxPDO received, or not within the tolerated time". A257 Er6
-            // ("regular process data missing") is not modelled here: A257 is
-            // the runtime's, it can tell this refusal by the code and `from`.
-            Err(AlStatusCode::SM_WATCHDOG)
+            // spec §3.3 "S→O: SYNC0 present, PLL locked": 002Dh / 0032h / …
+            if let Err(code) = sync {
+                Err(code)
+            } else {
+                // Not stable within 200 ms: refused. The spec names no AL code
+                // (§3.3: 001Bh or 002Bh); 001Bh "SM watchdog" is the one §4 ties to
+                // "no RxPDO received, or not within the tolerated time". A257 Er6
+                // ("regular process data missing") is not modelled here: A257 is
+                // the runtime's, it can tell this refusal by the code and `from`.
+                Err(AlStatusCode::SM_WATCHDOG)
+            }
         } else {
             return Ok(None);
         };
@@ -419,13 +461,56 @@ impl Slave {
         self.sync.trigger_count = self.sync.trigger_count.saturating_add(1);
         self.sync.unsolicited = true;
         self.emcy
-            .push(Emcy::for_event(E82_COMMUNICATION, E43_PDO_TIMEOUT, 0));
+            .push(Emcy::for_event(event52::EVENT, event52::PDO_TIMEOUT, 0));
         self.write_status(pdi)?;
         Ok(Some(StateChange {
             from: AlState::Op,
             to: AlState::SafeOp,
             requested: AlState::Op.code(),
             code: self.code,
+            unsolicited: true,
+        }))
+    }
+
+    /// The synchronisation is supervised: DC SYNC0 accepted at P→S and the
+    /// application says it checks it ([`SyncState::required`]).
+    fn sync_supervised(&self) -> bool {
+        self.sync.mode == SyncMode::DcSync0 && self.sync_state.required
+    }
+
+    /// S→O condition of the synchronisation (spec §3.3): `Ok` when not
+    /// supervised.
+    fn sync_ready(&self) -> Result<(), AlStatusCode> {
+        if self.sync_supervised() {
+            self.sync_state.ready
+        } else {
+            Ok(())
+        }
+    }
+
+    /// In Op in DC mode (spec §3.3, E-046, E-131): a synchronisation fault
+    /// the application reports (SYNC0 timeout 0034h, late frames 0033h, lost
+    /// lock 0032h) leaves Op for Safe-Op with the error indication and that
+    /// code, EMCY 7500h (event 52, cause 7) and an unsolicited state change
+    /// (E-038). Not an RxPDO monitoring trigger: A259 is left alone.
+    fn monitor_sync<P: Pdi>(&mut self, pdi: &mut P) -> Result<Option<StateChange>, P::Error> {
+        if !self.sync_supervised() {
+            return Ok(None);
+        }
+        let Some(code) = self.sync_state.fault else {
+            return Ok(None);
+        };
+        self.state = AlState::SafeOp;
+        self.error = true;
+        self.code = code;
+        self.sync.unsolicited = true;
+        self.emcy.push(Emcy::for_event(event52::EVENT, event52::SYNC, 0));
+        self.write_status(pdi)?;
+        Ok(Some(StateChange {
+            from: AlState::Op,
+            to: AlState::SafeOp,
+            requested: AlState::Op.code(),
+            code,
             unsolicited: true,
         }))
     }
@@ -451,6 +536,9 @@ impl Slave {
             // ETG.1000.6: a request without acknowledge leaves an error indication as it is
             return Ok(None);
         }
+        if self.error && ctrl.ack {
+            self.error_acked = true;
+        }
         // any processed request replaces a waiting S→O and ends the
         // "unsolicited" / "triggered" indications
         self.pending_op = None;
@@ -462,9 +550,10 @@ impl Slave {
             Ok(None) => Ok(from),
             Ok(Some(AlState::Op)) if from == AlState::SafeOp => {
                 self.sync.monitor = self.pdo_monitor(pdi, app)?;
-                if !self.outputs_steady(now_ns) {
-                    // E-033: wait (up to 200 ms) for stable RxPDO; the status
-                    // stays Safe-Op without error meanwhile
+                if !self.outputs_steady(now_ns) || self.sync_ready().is_err() {
+                    // E-033: wait (up to 200 ms) for stable RxPDO and, in DC
+                    // mode, for the PLL lock; the status stays Safe-Op
+                    // without error meanwhile
                     self.pending_op = Some(now_ns);
                     self.error = false;
                     self.code = AlStatusCode::NO_ERROR;

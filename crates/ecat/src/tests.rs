@@ -789,3 +789,100 @@ fn e038_unsolicited_change_displays() {
         "Op -> SafeOp (unsolicited, AL status code 0x001b)"
     );
 }
+
+#[test]
+fn e046_e131_e038_dc_sync_state_gates_op_and_faults_in_op() {
+    use crate::esm::{SyncMode, SyncState};
+    let waiting = |code: u16| SyncState {
+        required: true,
+        ready: Err(AlStatusCode(code)),
+        fault: None,
+    };
+    let locked = SyncState {
+        required: true,
+        ready: Ok(()),
+        fault: None,
+    };
+
+    // SM-Sync: the sync state is not consulted
+    let mut r = Rig::new();
+    r.slave.set_sync_state(waiting(0x002D));
+    r.goto(AlState::Op);
+
+    // DC SYNC0 (0x0981 = 3, 1 ms = A150)
+    let mut r = Rig::new();
+    r.esc.mem[regs::dc::ACTIVATION as usize] = 0x03;
+    let c0 = regs::dc::SYNC0_CYCLE as usize;
+    r.esc.mem[c0..c0 + 4].copy_from_slice(&1_000_000u32.to_le_bytes());
+    r.goto(AlState::SafeOp);
+    assert_eq!(r.slave.sync_status().mode, SyncMode::DcSync0);
+    // S→O waits (no error) while there is no SYNC0 / no lock …
+    r.slave.set_sync_state(waiting(0x002D));
+    assert_eq!(r.req(8), (4, 0));
+    assert!(r.slave.op_pending());
+    r.slave.set_sync_state(waiting(0x0032));
+    r.poll();
+    assert_eq!((r.esc.status(), r.esc.code()), (4, 0));
+    // … and is granted once locked
+    r.slave.set_sync_state(locked);
+    let c = r.poll().expect("granted");
+    assert_eq!((c.to, c.unsolicited), (AlState::Op, false));
+    assert_eq!(r.esc.status(), 8);
+
+    // a sync fault in Op: Safe-Op + error + its code, EMCY 7500h cause 7, unsolicited
+    r.slave.set_sync_state(SyncState {
+        required: true,
+        ready: Err(AlStatusCode(0x0034)),
+        fault: Some(AlStatusCode(0x0034)),
+    });
+    let c = r.poll().expect("dropped");
+    assert!(c.unsolicited);
+    assert_eq!(
+        (c.from, c.to, c.code),
+        (AlState::Op, AlState::SafeOp, AlStatusCode(0x0034))
+    );
+    assert_eq!((r.esc.status(), r.esc.code()), (0x14, 0x0034));
+    assert!(r.slave.sync_status().unsolicited);
+    assert!(!r.slave.sync_status().triggered, "not a PDO timeout (A259)");
+    r.poll();
+    let emcy = r.esc.mbx_read().expect("EMCY");
+    assert_eq!(&emcy[8..13], &[0x00, 0x75, 0x10, 52, 7]);
+    // no second drop while in Safe-Op; a request without acknowledge is ignored
+    assert_eq!(r.poll(), None);
+    assert_eq!(r.req(8), (0x14, 0x0034));
+    assert!(!r.slave.take_error_ack());
+    // acknowledge + Op: waits for the application to clear the fault and relock
+    assert_eq!(r.req(0x18), (4, 0));
+    assert!(r.slave.take_error_ack());
+    assert!(!r.slave.take_error_ack(), "reported once");
+    assert!(r.slave.op_pending());
+    r.slave.set_sync_state(locked);
+    r.poll();
+    assert_eq!(r.esc.status(), 8);
+
+    // no lock within 200 ms: refused with the sync code
+    assert_eq!(r.req(4), (4, 0));
+    r.slave.set_sync_state(waiting(0x0032));
+    assert_eq!(r.req(8), (4, 0));
+    for _ in 0..200 {
+        r.poll();
+    }
+    assert_eq!((r.esc.status(), r.esc.code()), (4, 0), "still waiting at 200 ms");
+    r.poll();
+    assert_eq!(
+        (r.esc.status(), r.esc.code()),
+        (0x14, 0x0032),
+        "refused after 200 ms"
+    );
+}
+
+#[test]
+fn e129_e131_event52_causes() {
+    use crate::esm::event52;
+    assert_eq!(event52::EVENT, 52);
+    assert_eq!(event52::PDO_TIMEOUT, 6);
+    assert_eq!(event52::SYNC, 7);
+    assert_eq!(event52::WRONG_FIRMWARE, 15);
+    let e = crate::emcy::Emcy::for_event(event52::EVENT, event52::SYNC, 0).to_bytes();
+    assert_eq!(&e[..5], &[0x00, 0x75, 0x10, 52, 7]);
+}
