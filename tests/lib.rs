@@ -786,3 +786,167 @@ impl<'a> Cyclic<'a> {
         self.sim.borrow().now_ns()
     }
 }
+
+// ---------------------------------------------------------------------------
+// Cyclic process data with a remapped layout (tests/tests/motion_more.rs)
+// ---------------------------------------------------------------------------
+
+/// Writes the mode map `layout` of axis A into 1600h/1A00h by SDO (Pre-Op),
+/// the CiA 301 sequence a master's start-up list uses.
+pub async fn map_layout<S>(sd: &SubDeviceRef<'_, S>, layout: drive::PdoLayout)
+where
+    S: std::ops::Deref<Target = ethercrab::SubDevice>,
+{
+    let (rx, tx) = layout.entries();
+    for (pdo, entries) in [(0x1600u16, rx), (0x1A00, tx)] {
+        sd.sdo_write(pdo, 0, 0u8).await.expect("sub 0 = 0");
+        for (sub, e) in (1u8..).zip(entries) {
+            sd.sdo_write(pdo, sub, e.mapping_value()).await.expect("entry");
+        }
+        sd.sdo_write(pdo, 0, entries.len() as u8)
+            .await
+            .expect("sub 0 = n");
+    }
+}
+
+/// A master running any process image of one drive in Op as raw bytes (the
+/// ip and vl maps): like [`Cyclic`], without the standard layout. The
+/// controlword sits at byte 0 and 6060h at byte 2 of the RxPDO, the
+/// statusword at byte 0 of the TxPDO in every map.
+pub struct RawCyclic<'a> {
+    /// The master.
+    pub md: &'a MainDevice<'a>,
+    /// The group in Op.
+    pub group: &'a OpGroup,
+    /// The simulated line.
+    pub sim: &'a RefCell<Simulation>,
+    /// Position of the drive in the group.
+    pub slave: usize,
+    /// The RxPDO image sent every cycle.
+    pub out: Vec<u8>,
+    /// The last TxPDO received.
+    pub inputs: Vec<u8>,
+    /// Master cycles run so far.
+    pub cycles: u64,
+}
+
+impl<'a> RawCyclic<'a> {
+    /// A master on drive `slave` of `group` with the lengths ethercrab
+    /// configured; the outputs start all zero.
+    pub fn new(
+        md: &'a MainDevice<'a>,
+        group: &'a OpGroup,
+        sim: &'a RefCell<Simulation>,
+        slave: usize,
+    ) -> Self {
+        let sd = group.subdevice(md, slave).expect("subdevice");
+        let io = sd.io_raw();
+        let (o, i) = (io.outputs().len(), io.inputs().len());
+        Self {
+            md,
+            group,
+            sim,
+            slave,
+            out: vec![0; o],
+            inputs: vec![0; i],
+            cycles: 0,
+        }
+    }
+
+    /// Writes `bytes` into the RxPDO at `offset`.
+    pub fn put(&mut self, offset: usize, bytes: &[u8]) {
+        self.out[offset..offset + bytes.len()].copy_from_slice(bytes);
+    }
+
+    /// 6040h controlword @0.
+    pub fn set_controlword(&mut self, cw: u16) {
+        self.put(0, &cw.to_le_bytes());
+    }
+
+    /// 6060h modes of operation @2.
+    pub fn set_mode(&mut self, mode: i8) {
+        self.out[2] = mode as u8;
+    }
+
+    /// TxPDO u16 at `o`.
+    pub fn u16_at(&self, o: usize) -> u16 {
+        u16::from_le_bytes([self.inputs[o], self.inputs[o + 1]])
+    }
+
+    /// TxPDO i16 at `o`.
+    pub fn i16_at(&self, o: usize) -> i16 {
+        self.u16_at(o) as i16
+    }
+
+    /// TxPDO i32 at `o`.
+    pub fn i32_at(&self, o: usize) -> i32 {
+        i32::from_le_bytes(self.inputs[o..o + 4].try_into().expect("4 bytes"))
+    }
+
+    /// 6041h statusword @0.
+    pub fn statusword(&self) -> u16 {
+        self.u16_at(0)
+    }
+
+    /// Statusword & 0x6F.
+    pub fn state(&self) -> u16 {
+        self.statusword() & 0x6F
+    }
+
+    /// Statusword bit `n`.
+    pub fn bit(&self, n: u8) -> bool {
+        self.statusword() & (1 << n) != 0
+    }
+
+    /// 6061h @2.
+    pub fn mode_display(&self) -> i8 {
+        self.inputs[2] as i8
+    }
+
+    /// One master cycle (see [`Cyclic::cycle`]).
+    pub async fn cycle(&mut self) {
+        let sd = self.group.subdevice(self.md, self.slave).expect("subdevice");
+        sd.outputs_raw_mut().copy_from_slice(&self.out);
+        {
+            let mut sim = self.sim.borrow_mut();
+            let t = sim.now_ns() + MASTER_CYCLE_NS;
+            sim.advance_to(t);
+        }
+        let r = self.group.tx_rx(self.md).await.expect("process data cycle");
+        assert_eq!(r.working_counter, 3, "outputs written and inputs read");
+        self.inputs.copy_from_slice(sd.io_raw().inputs());
+        self.cycles += 1;
+    }
+
+    /// `n` master cycles.
+    pub async fn run(&mut self, n: usize) {
+        for _ in 0..n {
+            self.cycle().await;
+        }
+    }
+
+    /// Runs up to `max` cycles until `pred` holds; returns the cycles it took.
+    pub async fn run_until(&mut self, max: usize, mut pred: impl FnMut(&Self) -> bool) -> Option<usize> {
+        for k in 1..=max {
+            self.cycle().await;
+            if pred(self) {
+                return Some(k);
+            }
+        }
+        None
+    }
+
+    /// Shutdown, switch on, enable operation (the bits in `extra` added to
+    /// enable operation), each until its state shows.
+    pub async fn enable(&mut self, extra: u16) {
+        for (cw, state) in [(0x0006, sw::RTSO), (0x0007, sw::SO), (0x000F | extra, sw::OE)] {
+            self.set_controlword(cw);
+            let ok = self.run_until(20, |c| c.state() == state).await;
+            assert!(
+                ok.is_some(),
+                "controlword {cw:#06x}: statusword {:#06x}",
+                self.statusword()
+            );
+        }
+    }
+}

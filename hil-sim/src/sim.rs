@@ -112,6 +112,10 @@ pub struct CycleStamp {
     pub index: u32,
     /// The PLL was phase locked after this start.
     pub locked: bool,
+    /// The cycle read the RxPDO (the aligned cycle).
+    pub rx: bool,
+    /// The cycle wrote the TxPDO (the aligned cycle).
+    pub tx: bool,
 }
 
 /// One SYNC0 pulse as the drive saw it.
@@ -328,8 +332,11 @@ impl SimDrive {
     }
 
     /// One control cycle starting at `t`: the PLL's command (when it runs)
-    /// programs the next start; then the axes and one motor step.
+    /// programs the next start and gives the cycle's steps (Rx, application,
+    /// Tx in the A149 order, Rx/Tx in the aligned cycle only:
+    /// [`drive::runtime::Drive::sync_cycle`]); then one motor step.
     fn run_cycle(&mut self, t: u64) {
+        let mut command = None;
         match self.next_tick {
             Some(tick) => {
                 let local = Self::tick_local_ns(tick);
@@ -345,7 +352,10 @@ impl SimDrive {
                             system_ns: self.esc.system_time_ns(t),
                             index: cmd.index,
                             locked: self.drive.pll().is_some_and(|p| p.is_locked()),
+                            rx: cmd.rx,
+                            tx: cmd.tx,
                         });
+                        command = Some(cmd);
                     }
                     None => {
                         self.next_tick = None;
@@ -359,7 +369,10 @@ impl SimDrive {
             axis_io(self.feedback[0].as_ref(), &self.motors[0], self.conditions[0]),
             axis_io(self.feedback[1].as_ref(), &self.motors[1], self.conditions[1]),
         ];
-        let cmd = self.drive.control_cycle(t, &io);
+        let cmd = match command {
+            Some(c) => self.drive.sync_cycle(&c, t, &io),
+            None => self.drive.control_cycle(t, &io),
+        };
         for ((motor, fb), c) in self.motors.iter_mut().zip(self.feedback.iter_mut()).zip(cmd) {
             let torque = if c.power_stage {
                 f64::from(c.torque_nm)

@@ -555,3 +555,277 @@ fn e046_e131_e038_dc_op_waits_for_pll_lock_and_sync0_loss_drops_to_safeop() {
         }
     });
 }
+
+const A149: u16 = drive::parameter_index(0, 149);
+const A150: u16 = drive::parameter_index(0, 150);
+const A287: u16 = drive::parameter_index(0, 287);
+
+/// Brings the line to OP with DC (SYNC0 every `sync0_ns`, frames
+/// [`FRAME_LEAD_NS`] before SYNC0, A292 = [`A292_US`]) after `pre_op` ran in
+/// Pre-Op, runs `n` cycles (see [`dc_cycles`]), then `body`.
+fn dc_op<T>(
+    sim: &RefCell<Simulation>,
+    sync0_ns: u64,
+    pre_op: impl for<'a> AsyncFn(&'a Sd<'a>),
+    n: usize,
+    body: impl for<'a> AsyncFnOnce(
+        &'a MainDevice<'a>,
+        &'a SubDeviceGroup<
+            8,
+            512,
+            ethercrab::DefaultLock,
+            ethercrab::subdevice_group::Op,
+            ethercrab::subdevice_group::HasDc,
+        >,
+    ) -> T,
+) -> T {
+    with_master(sim, async |md, clock| {
+        let mut group = init(md, clock).await;
+        for mut sd in group.iter_mut(md) {
+            sd.set_dc_sync(DcSync::Sync0);
+        }
+        let group = group.into_pre_op_pdi(md).await.expect("PRE-OP with PDI");
+        for sd in group.iter(md) {
+            sd.sdo_write(A292, 0, A292_US).await.expect("A292");
+            pre_op(&sd).await;
+        }
+        let group = group
+            .configure_dc_sync(
+                md,
+                DcConfiguration {
+                    start_delay: Duration::from_millis(20),
+                    sync0_period: Duration::from_nanos(sync0_ns),
+                    sync0_shift: Duration::from_nanos(sync0_ns - FRAME_LEAD_NS),
+                },
+            )
+            .await
+            .expect("DC configuration")
+            .request_into_op(md)
+            .await
+            .expect("request OP");
+        let mut op = None;
+        dc_cycles(md, &group, sim, n, |i, all_op, _| {
+            if all_op && op.is_none() {
+                op = Some(i);
+            }
+        })
+        .await;
+        assert!(op.is_some(), "the group reached OP");
+        body(md, &group).await
+    })
+}
+
+/// E-120, E-121, E-123, E-124 (spec §11.8): A287[0] = 1 (sub 1) in Pre-Op
+/// fails at once with 2 ("not executable"); in Op with DC SYNC0 it runs over
+/// ≥ 1000 × A150, A287[1] (progress) rises by SDO, then A287[2] is 7 or 8
+/// with a proposed A292 range min ≤ max (A287[3], [4]) around the A292 in
+/// force, and A287[0] is back to 0.
+#[test]
+fn e120_e123_e124_a287_optimisation_through_the_master() {
+    let sim = line();
+    let pre_op = async |sd: &Sd<'_>| {
+        sd.sdo_write(A287, 1, 1u8).await.expect("A287[0] in Pre-Op");
+        let mut result = 0u8;
+        for _ in 0..10 {
+            result = sd.sdo_read(A287, 3).await.expect("A287[2]");
+            if result != 0 {
+                break;
+            }
+        }
+        let start: u8 = sd.sdo_read(A287, 1).await.expect("A287[0]");
+        println!("A287 in Pre-Op: result {result}, start {start}");
+        assert_eq!(result, 2, "E-121: not executable in Pre-Op");
+        assert_eq!(start, 0, "A287[0] back to 0");
+    };
+    let (progress, seen) = dc_op(&sim, SYNC0_NS, pre_op, 150, async |md, group| {
+        for sd in group.iter(md) {
+            sd.sdo_write(A287, 1, 1u8).await.expect("A287[0] = 1");
+        }
+        let mut progress: Vec<u8> = Vec::new();
+        let mut done = false;
+        for _ in 0..30 {
+            dc_cycles(md, group, &sim, 50, |_, _, _| {}).await;
+            let sd = group.subdevice(md, 0).expect("drive");
+            let p: u8 = sd.sdo_read(A287, 2).await.expect("A287[1]");
+            progress.push(p);
+            let r: u8 = sd.sdo_read(A287, 3).await.expect("A287[2]");
+            if r >= 2 {
+                done = true;
+                break;
+            }
+        }
+        assert!(done, "finished: progress {progress:?}");
+        let mut seen = Vec::new();
+        for i in 0..2 {
+            let sd = group.subdevice(md, i).expect("drive");
+            let mut v = [0i64; 8];
+            for (k, slot) in v.iter_mut().enumerate() {
+                *slot = match k {
+                    0..=2 => i64::from(sd.sdo_read::<u8>(A287, k as u8 + 1).await.expect("A287")),
+                    _ => i64::from(sd.sdo_read::<i32>(A287, k as u8 + 1).await.expect("A287")),
+                };
+            }
+            seen.push(v);
+        }
+        (progress, seen)
+    });
+    println!("A287[1] progress of drive 0 by SDO: {progress:?}");
+    assert!(
+        progress.iter().any(|&p| p > 0 && p < 100),
+        "E-124: progress during the measurement"
+    );
+    assert!(progress.windows(2).all(|w| w[0] <= w[1]), "progress never falls");
+    let s = sim.borrow();
+    for (i, v) in seen.iter().enumerate() {
+        println!(
+            "drive {i}: A287 = {v:?} ([0] start, [1] %, [2] result, [3]/[4] A292 min/max µs, [5] EoF→SYNC0, \
+             [6] frame, [7] SYNC0→Rx)"
+        );
+        assert_eq!(v[0], 0, "drive {i}: A287[0] back to 0");
+        assert_eq!(v[1], 100, "drive {i}: progress 100 %");
+        assert!(matches!(v[2], 7 | 8), "E-123: drive {i}: result {}", v[2]);
+        assert!(v[3] <= v[4], "drive {i}: min ≤ max");
+        if v[2] == 7 {
+            assert!(
+                (v[3]..=v[4]).contains(&i64::from(A292_US)),
+                "drive {i}: 7 = A292 in range"
+            );
+        }
+        assert!((-1000..1000).contains(&v[3]) && (-1000..1000).contains(&v[4]));
+        let out = s.drives()[i].drive.optimizer().outcome().expect("outcome");
+        assert!(out.result.is_success());
+        // frames ≈ 100 µs before SYNC0; the SDO reads in between delay some
+        assert!((-500..=110).contains(&v[5]), "drive {i}: EoF → SYNC0 {} µs", v[5]);
+        assert!((0..500).contains(&v[6]), "drive {i}: frame window {} µs", v[6]);
+    }
+}
+
+/// Position actual value 6064h of axis A: the drive's object and its bytes in
+/// the TxPDO image the drive's Tx step wrote (what the next frame carries).
+fn actual_and_txpdo(d: &mut hil_sim::sim::SimDrive) -> (i64, i64) {
+    let obj = d.drive.objects.get(0x6064, 0).expect("6064h");
+    let e = *d
+        .drive
+        .pdo_image()
+        .tx()
+        .entries()
+        .iter()
+        .find(|e| e.index == 0x6064)
+        .expect("6064h mapped");
+    let at = usize::from(e.bit_offset / 8);
+    let img = d.drive.slave.inputs_mut();
+    let tx = i32::from_le_bytes(img[at..at + 4].try_into().unwrap());
+    (obj, i64::from(tx))
+}
+
+/// E-111 (spec §11.5): the motor of axis A moves by a new position every
+/// cycle. With A149 = 0 (Rx → app → Tx) the TxPDO written by a cycle carries
+/// the actual position the application computed in that same cycle; with
+/// A149 = 1 (Rx → Tx → app) it carries the previous cycle's.
+#[test]
+fn e111_a149_orders_rx_app_tx() {
+    for a149 in [0u8, 1] {
+        let sim = line();
+        let pre_op = async |sd: &Sd<'_>| {
+            sd.sdo_write(A149, 0, a149).await.expect("A149");
+        };
+        let (same, differ, master_lag) = dc_op(&sim, SYNC0_NS, pre_op, 150, async |md, group| {
+            let (mut same, mut differ) = (0, 0);
+            let mut images = Vec::new();
+            let mut master = Vec::new();
+            for i in 0..40i64 {
+                sim.borrow_mut().drives_mut()[0].motors[0].set_position_inc(100_000 * (i + 1));
+                dc_cycles(md, group, &sim, 1, |_, _, _| {}).await;
+                let (obj, tx) = actual_and_txpdo(&mut sim.borrow_mut().drives_mut()[0]);
+                if i >= 5 {
+                    if obj == tx {
+                        same += 1;
+                    } else {
+                        differ += 1;
+                    }
+                }
+                images.push(tx);
+                let sd = group.subdevice(md, 0).expect("drive");
+                let inputs = sd.inputs_raw();
+                let at = usize::from(
+                    sim.borrow().drives()[0]
+                        .drive
+                        .pdo_image()
+                        .tx()
+                        .entries()
+                        .iter()
+                        .find(|e| e.index == 0x6064)
+                        .expect("6064h")
+                        .bit_offset
+                        / 8,
+                );
+                master.push(i64::from(i32::from_le_bytes(
+                    inputs[at..at + 4].try_into().unwrap(),
+                )));
+            }
+            // the frame after a probe carries the image seen at the probe
+            let lag = (0..3usize).find(|&l| (10..39).all(|i| master[i + l] == images[i]));
+            (same, differ, lag)
+        });
+        println!(
+            "A149 = {a149}: TxPDO = this cycle's 6064h in {same} cycles, another in {differ}; \
+             master sees the image {master_lag:?} frame(s) later"
+        );
+        if a149 == 0 {
+            assert_eq!(differ, 0, "A149 = 0: Tx after the application");
+        } else {
+            assert_eq!(same, 0, "A149 = 1: Tx before the application");
+        }
+        assert!(master_lag.is_some(), "the image written by Tx goes on the bus");
+    }
+}
+
+/// E-112 (spec §11.3, §11.4): SYNC0 = 2 ms with A150 = 1 ms (k = 2): P→S
+/// accepted, the PLL locks, two control cycles per SYNC0 of which only one
+/// (index 0, at SYNC0 − A292) is aligned and runs Rx/Tx.
+#[test]
+fn e112_sync0_twice_a150() {
+    const SYNC0_2MS: u64 = 2_000_000;
+    let sim = line();
+    let pre_op = async |sd: &Sd<'_>| {
+        sd.sdo_write(A150, 0, 1000u16).await.expect("A150");
+    };
+    let a296 = dc_op(&sim, SYNC0_2MS, pre_op, 200, async |md, group| {
+        let sd = group.subdevice(md, 0).expect("drive");
+        let v: u32 = sd.sdo_read(A296, 0).await.expect("A296");
+        v
+    });
+    assert_eq!(a296, 2000, "A296: the 2 ms SYNC0 cycle");
+    let s = sim.borrow();
+    for (i, d) in s.drives().iter().enumerate() {
+        let pll = d.drive.pll().expect("PLL");
+        assert_eq!(pll.k(), 2, "drive {i}: k = 2");
+        assert!(pll.is_locked(), "drive {i} locked");
+        assert_eq!(d.drive.slave.state(), esc::AlState::Op);
+        let log: Vec<_> = d.cycle_log.iter().filter(|c| c.locked).collect();
+        assert!(log.len() >= 100, "drive {i}: {} locked cycles", log.len());
+        for w in log.windows(2) {
+            let dt = w[1].system_ns - w[0].system_ns;
+            assert!(dt.abs_diff(1_000_000) <= 1_000, "drive {i}: cycle {dt} ns");
+            assert_ne!(w[0].index, w[1].index, "indices alternate");
+        }
+        for c in &log {
+            assert_eq!((c.rx, c.tx), (c.index == 0, c.index == 0), "Rx/Tx only aligned");
+            if c.index == 0 {
+                let target = -i64::from(A292_US) * 1000;
+                let p = SYNC0_2MS as i64;
+                let e = (c.system_ns as i64 - target).rem_euclid(p);
+                let e = if e >= p / 2 { e - p } else { e };
+                assert!(e.abs() <= 1_000, "drive {i}: aligned at SYNC0 − A292: {e} ns");
+            }
+        }
+        let aligned = log.iter().filter(|c| c.index == 0).count();
+        println!(
+            "drive {i}: k = 2, {} locked cycles in the log, {aligned} aligned",
+            log.len()
+        );
+    }
+}
+
+/// A drive in the Pre-Op group as the master holds it.
+type Sd<'a> = ethercrab::SubDeviceRef<'a, ethercrab::SubDevicePdi<'a, 512, ethercrab::DefaultLock>>;

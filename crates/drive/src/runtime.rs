@@ -52,7 +52,7 @@ use store::{Flash, ParamStore, StoreError};
 
 /// The DC-Sync crate (PLL, A298/A261 types), re-exported for the firmware and tests.
 pub use dcsync;
-pub use dcsync::{CycleCommand, FrameTiming, Pll, SyncError};
+pub use dcsync::{CycleCommand, FrameTiming, Pll, Step, SyncError};
 
 /// A00 "Save values": [0] start (sub 1), [1] progress (sub 2), [2] result (sub 3),
 /// in the SDO-Info numbering the runtime always uses.
@@ -69,6 +69,12 @@ const A150: u16 = crate::parameter_index(0, 150);
 const A261: u16 = crate::parameter_index(0, 261);
 /// A290 PLL control, A292 phase offset (µs), A296 measured cycle (µs), A298 status.
 const A290: u16 = crate::parameter_index(0, 290);
+/// A287 DC-Sync optimisation: [0] start, [1] progress, [2] result, [3]/[4]
+/// proposed A292 min/max, [5] end of frame → SYNC0, [6] frame duration,
+/// [7] SYNC0 → Rx (µs); `[k]` is sub `k + 1`.
+const A287: u16 = crate::parameter_index(0, 287);
+/// A291 PLC cycle time (µs).
+const A291: u16 = crate::parameter_index(0, 291);
 const A292: u16 = crate::parameter_index(0, 292);
 const A296: u16 = crate::parameter_index(0, 296);
 const A298: u16 = crate::parameter_index(0, 298);
@@ -76,6 +82,10 @@ const A298: u16 = crate::parameter_index(0, 298);
 /// Tick frequency of the control-cycle timer the PLL trims, Hz (the
 /// reference board's CCU4 at 144 MHz; the simulator models the same).
 pub const TIMER_HZ: u32 = 144_000_000;
+
+/// Distance the A287 measurement keeps between the drive's Rx/Tx and the
+/// master's frame when it proposes the A292 range, ns (our choice).
+pub const OPTIMIZE_GUARD_NS: u32 = 5_000;
 
 /// Result of the last save, as A00[2] shows it.
 pub mod save_result {
@@ -145,6 +155,16 @@ pub struct Drive<F: Flash> {
     pll: Option<Pll>,
     /// Why the PLL could not be built for the last SYNC0 configuration.
     sync_error: Option<SyncError>,
+    /// The A287 measurement.
+    optimizer: dcsync::Optimizer,
+    /// Arrival of the last SM2 frame relative to SYNC0 (local ns), not yet
+    /// given to the A287 measurement.
+    frame_rel_sync0_ns: Option<i64>,
+    /// Rx and Tx of the aligned cycle after its start, ns (for A287).
+    step_offsets_ns: (u32, u32),
+    /// The control cycle ([`Drive::sync_cycle`]) runs Rx and Tx: the poll
+    /// leaves the process images alone.
+    cycle_pdo: bool,
 }
 
 impl<F: Flash> Drive<F> {
@@ -177,6 +197,10 @@ impl<F: Flash> Drive<F> {
             ctl_rx_frames: 0,
             pll: None,
             sync_error: None,
+            optimizer: dcsync::Optimizer::new(),
+            frame_rel_sync0_ns: None,
+            step_offsets_ns: (0, 0),
+            cycle_pdo: false,
         };
         drive.compile_pdo_image();
         drive.update_live();
@@ -220,7 +244,9 @@ impl<F: Flash> Drive<F> {
     /// Runs the slave stack once at `now_ns`, then process data, the live
     /// objects and the dictionary's requests.
     pub fn poll<P: Pdi>(&mut self, pdi: &mut P, now_ns: u64) -> Result<Option<StateChange>, P::Error> {
-        self.process_inputs();
+        if !self.cycle_owns_pdo() {
+            self.process_inputs();
+        }
         self.slave.set_sync_state(self.sync_state());
         let mut live = Live { diag: &mut self.diag };
         let change = self
@@ -248,6 +274,7 @@ impl<F: Flash> Drive<F> {
             let _ = self.objects.set(A256, 0, i64::from(address));
         }
         self.update_live();
+        self.update_optimizer();
         let requests = self.objects.take_requests();
         if requests.save {
             self.save();
@@ -272,6 +299,7 @@ impl<F: Flash> Drive<F> {
             if state == AlState::Init {
                 self.pll = None;
                 self.sync_error = None;
+                self.cycle_pdo = false;
                 self.update_sync_live();
             }
             if state == AlState::Op {
@@ -279,11 +307,27 @@ impl<F: Flash> Drive<F> {
             }
             self.last_state = state;
         }
+        if !self.cycle_owns_pdo() {
+            self.read_outputs();
+        }
+    }
+
+    /// Rx: decodes a new RxPDO frame (read from SM2 by the last poll) into
+    /// the objects, in Op only. Returns whether there was one.
+    fn read_outputs(&mut self) -> bool {
         let frames = self.slave.outputs_received();
-        if state == AlState::Op && frames != self.last_rx_frames {
+        let new = self.slave.state() == AlState::Op && frames != self.last_rx_frames;
+        if new {
             self.pdo.apply_outputs(self.slave.outputs(), &mut self.objects);
         }
         self.last_rx_frames = frames;
+        new
+    }
+
+    /// Whether the control cycle runs Rx and Tx ([`Drive::sync_cycle`]
+    /// under the PLL) rather than every poll.
+    fn cycle_owns_pdo(&self) -> bool {
+        self.cycle_pdo && self.pll.is_some()
     }
 
     /// In Safe-Op and Op the TxPDO image follows the objects (E-032, E-034).
@@ -337,6 +381,132 @@ impl<F: Flash> Drive<F> {
         }
         let _ = self.objects.set(0x1001, 0, i64::from(register));
         commands
+    }
+
+    /// One control cycle under the PLL (E-111, E-112), started by
+    /// [`cycle_start`](Self::cycle_start) which returned `cmd`: runs
+    /// [`CycleCommand::steps`] in their A149 order — Rx (decode the RxPDO
+    /// frame the last poll read from SM2; Op only), the application
+    /// ([`control_cycle_with`](Self::control_cycle_with)), Tx (encode the
+    /// TxPDO image the next poll copies to SM3; Safe-Op and Op) — with Rx and
+    /// Tx only in the aligned cycle (`index == 0`): A149 = 0 sends this
+    /// cycle's actual values, A149 = 1 those of the previous cycle. From the
+    /// first call on the poll no longer decodes or encodes the process data
+    /// itself (until the PLL goes). A new set-point is flagged when Rx
+    /// decoded a new frame (outside Op every cycle, as in
+    /// [`control_cycle`](Self::control_cycle)).
+    pub fn sync_cycle(&mut self, cmd: &CycleCommand, now_ns: u64, io: &[AxisIo; 2]) -> [AxisCommand; 2] {
+        self.cycle_pdo = self.pll.is_some();
+        let mut commands = [AxisCommand::OFF; 2];
+        let mut new = self.slave.state() != AlState::Op;
+        for step in cmd.steps().into_iter().flatten() {
+            match step {
+                Step::ReadOutputs => {
+                    new |= self.read_outputs();
+                    self.ctl_rx_frames = self.slave.outputs_received();
+                }
+                Step::Application => commands = self.control_cycle_with(now_ns, io, [new, new]),
+                Step::WriteInputs => self.process_inputs(),
+            }
+        }
+        commands
+    }
+
+    /// Where the aligned cycle does Rx and Tx after its start, ns (the
+    /// firmware's measured step times; 0 and 0 until set): what the A287
+    /// measurement records for Rx and Tx.
+    pub fn set_step_offsets(&mut self, rx_after_start_ns: u32, tx_after_start_ns: u32) {
+        self.step_offsets_ns = (rx_after_start_ns, tx_after_start_ns);
+    }
+
+    /// The A287 measurement (its outcome once finished).
+    pub fn optimizer(&self) -> &dcsync::Optimizer {
+        &self.optimizer
+    }
+
+    /// A287: `[0]` = 1 written (by SDO) starts the measurement when none
+    /// runs (result 2 at once when not in Safe-Op/Op with DC SYNC0 and a
+    /// running PLL, or the master cycle ≠ A291); a measurement running when
+    /// the drive leaves Safe-Op/Op or the PLL goes ends with 2. `[1]`, `[2]`
+    /// and the results follow the measurement; `[0]` goes back to 0 when it
+    /// is finished.
+    fn update_optimizer(&mut self) {
+        let start = self.objects.get(A287, 1).is_ok_and(|v| v == 1);
+        let usable = matches!(self.slave.state(), AlState::SafeOp | AlState::Op)
+            && self.slave.sync_status().mode == SyncMode::DcSync0
+            && self.pll.is_some();
+        if (start && !self.optimizer.is_running()) || (self.optimizer.is_running() && !usable) {
+            let req = self.optimize_request(usable);
+            self.optimizer.start(req);
+            self.frame_rel_sync0_ns = None;
+        }
+        self.update_optimizer_live();
+    }
+
+    /// The A287 preconditions as they are now.
+    fn optimize_request(&self, usable: bool) -> dcsync::OptimizeRequest {
+        let get = |index| self.objects.get(index, 0).unwrap_or(0);
+        let ns = |us: i64| u32::try_from(us.saturating_mul(1000)).unwrap_or(0);
+        let pll = self.pll.as_ref();
+        dcsync::OptimizeRequest {
+            safe_op_or_op: matches!(self.slave.state(), AlState::SafeOp | AlState::Op),
+            dc_sync: usable,
+            master_cycle_ns: pll.and_then(|p| p.measured_sync0_cycle_ns()).unwrap_or(0),
+            a291_ns: ns(get(A291)),
+            sync0_cycle_ns: pll.map_or(0, |p| p.config().sync0_cycle_ns),
+            a150_ns: ns(get(A150)),
+            a292_ns: i32::try_from(get(A292).saturating_mul(1000)).unwrap_or(0),
+            guard_ns: OPTIMIZE_GUARD_NS,
+        }
+    }
+
+    /// A287[0..7] from the measurement.
+    fn update_optimizer_live(&mut self) {
+        let o = &self.optimizer;
+        let (progress, result) = (o.progress_percent(), o.result_code());
+        let _ = self.objects.set(A287, 2, i64::from(progress));
+        let _ = self.objects.set(A287, 3, i64::from(result));
+        if let Some(out) = o.outcome() {
+            let _ = self.objects.set(A287, 1, 0);
+            // the µs range inside the ns range (rounded inwards)
+            let (mut lo, mut hi) = (
+                out.a292_min_ns.div_euclid(1000) + i64::from(out.a292_min_ns.rem_euclid(1000) != 0),
+                out.a292_max_ns.div_euclid(1000),
+            );
+            if lo > hi {
+                let mid = (out.a292_min_ns + out.a292_max_ns).div_euclid(2000);
+                (lo, hi) = (mid, mid);
+            }
+            let us = |ns: i64| ns.div_euclid(1000);
+            let _ = self.objects.set(A287, 4, lo);
+            let _ = self.objects.set(A287, 5, hi);
+            let _ = self.objects.set(A287, 6, us(out.end_of_frame_to_sync_ns));
+            let _ = self.objects.set(A287, 7, us(out.frame_duration_ns));
+            let _ = self.objects.set(A287, 8, us(out.sync_to_rx_ns));
+        }
+    }
+
+    /// One A287 sample for the aligned cycle starting at `t_local_ns`: the
+    /// last frame's arrival (start = end: the SM2 event gives one time), the
+    /// cycle start and the Rx/Tx offsets, all relative to SYNC0.
+    fn record_optimizer_sample(&mut self, t_local_ns: u64) {
+        if !self.optimizer.is_running() {
+            return;
+        }
+        let Some(pll) = self.pll.as_ref() else { return };
+        let (Some(frame), Some(start)) = (self.frame_rel_sync0_ns.take(), pll.relative_to_sync0(t_local_ns))
+        else {
+            return;
+        };
+        let (rx, tx) = self.step_offsets_ns;
+        self.optimizer.record(&dcsync::FrameSample {
+            sof_ns: frame,
+            eof_ns: frame,
+            cycle_start_ns: start,
+            rx_after_start_ns: rx,
+            tx_after_start_ns: tx,
+        });
+        self.update_optimizer_live();
     }
 
     /// The DC-Sync PLL, while SYNC0 runs.
@@ -441,6 +611,9 @@ impl<F: Flash> Drive<F> {
             pll.set_enabled(cfg.enabled);
         }
         let cmd = pll.on_cycle_start(t_local_ns);
+        if cmd.index == 0 {
+            self.record_optimizer_sample(t_local_ns);
+        }
         self.update_sync_live();
         Some(cmd)
     }
@@ -449,6 +622,9 @@ impl<F: Flash> Drive<F> {
     /// `A261[1]`, `[2]`. `None` without a PLL or before the first SYNC0.
     pub fn on_frame(&mut self, t_local_ns: u64) -> Option<FrameTiming> {
         let timing = self.pll.as_mut()?.on_frame(t_local_ns);
+        if let Some(t) = timing {
+            self.frame_rel_sync0_ns = Some(t.rel_sync0_ns);
+        }
         self.update_sync_live();
         timing
     }

@@ -81,7 +81,9 @@ use motion::cascade::{Cascade, CascadeConfig, CascadeInput, CascadeOutput, Contr
 use motion::cycle::{application_cycle_ns, interpolation_period_ns};
 use motion::homing::{Homing, HomingConfig, HomingInput, SwitchInput};
 use motion::interp::from_i425;
-use motion::limits::{DirectionLock, LimitConfig, LimitInput, Limits, StopRamp, SwitchPolarity};
+use motion::limits::{
+    DirectionLock, LimitConfig, LimitInput, Limits, SoftLimitReaction, StopRamp, SwitchPolarity,
+};
 use motion::touch_probe::{interpolate_position, Edge, PositionSample, TouchProbe, TriggerSignal};
 use motion::windows::{
     is_standstill, ms_to_ns, FollowingErrorConfig, FollowingErrorMonitor, PositionWindowConfig,
@@ -690,11 +692,19 @@ impl Axis {
             window_inc_per_s: p.velocity_window_inc_per_s,
             time_ns: p.velocity_window_time_ns,
         });
+        // C-091: jog under velocity control (I26 = 0) quick-stops at a
+        // software limit instead of faulting
+        let soft_limit_reaction = if self.running == Some(Mode::Jog) && !p.jog_position_control {
+            SoftLimitReaction::QuickStop
+        } else {
+            p.limits.soft_limit_reaction
+        };
         self.limits.set_config(LimitConfig {
             software_min_inc: o.software_min,
             software_max_inc: o.software_max,
             window_inc: p.position_window_inc,
             switch_polarity: SwitchPolarity::HighActive,
+            soft_limit_reaction,
             ..p.limits
         });
     }

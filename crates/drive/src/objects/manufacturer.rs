@@ -36,6 +36,20 @@ const ACTION: &[EntryInfo] = &[
     e(2, "Result", U8, RO),
 ];
 
+/// A287 DC-Sync optimisation: the action elements, then the measurement's
+/// results (spec §11.8: proposed A292 range, end of frame → SYNC0, frame
+/// duration, SYNC0 → Rx), µs.
+const A287_ELEMENTS: &[EntryInfo] = &[
+    e(0, "Start", U8, RW).range(0, 1),
+    e(1, "Progress", U8, RO).unit("%"),
+    e(2, "Result", U8, RO),
+    e(3, "A292 minimum", I32, RO).unit("µs"),
+    e(4, "A292 maximum", I32, RO).unit("µs"),
+    e(5, "End of frame to SYNC0", I32, RO).unit("µs"),
+    e(6, "Frame duration", I32, RO).unit("µs"),
+    e(7, "SYNC0 to Rx", I32, RO).unit("µs"),
+];
+
 /// Elements `1..=N` of `entries` renumbered from 0 (a mirror of a standard
 /// object as a manufacturer array, e.g. A264 = 1C32h:01…).
 const fn elements_of<const N: usize>(entries: &[EntryInfo]) -> [EntryInfo; N] {
@@ -398,9 +412,9 @@ pub const PARAMS: [Object; 54] = [
     )
     .level(2)
     .note("A268; encoding assumed (0 standard, 1 manufacturer, 2 all; bit per group A…Z); not applied yet"),
-    param_array!(a(287), "DC-Sync optimization", Record, Value::Ram, from ACTION)
+    param_array!(a(287), "DC-Sync optimization", Record, Value::Ram, from A287_ELEMENTS)
         .level(2)
-        .note("A287; action, results not stored (spec §22)"),
+        .note("A287; action, results not stored (spec §22); [3]..[7] measurement results (our choice, spec §11.8 leaves their place open)"),
     Object::var(
         a(290),
         Value::Ram,
