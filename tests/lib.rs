@@ -14,6 +14,29 @@ pub fn timeouts() -> Timeouts {
     hil_sim::master::in_process_timeouts()
 }
 
+/// AL control/status values the tests write and expect (ETG.1000.6).
+pub mod al {
+    /// Init.
+    pub const INIT: u16 = 1;
+    /// Pre-Operational.
+    pub const PREOP: u16 = 2;
+    /// Bootstrap.
+    pub const BOOT: u16 = 3;
+    /// Safe-Operational.
+    pub const SAFEOP: u16 = 4;
+    /// Operational.
+    pub const OP: u16 = 8;
+    /// AL status: error indication.
+    pub const ERR: u16 = 0x10;
+    /// AL control: error acknowledge.
+    pub const ACK: u16 = 0x10;
+}
+
+/// One revolution in increments (2^20, 6092h default feed, C-108).
+pub const REV: i32 = 1 << 20;
+/// [`REV`] as a float.
+pub const REV_F: f64 = REV as f64;
+
 /// A line of `n` simulated drives.
 pub fn line(n: usize) -> RefCell<Simulation> {
     RefCell::new(Simulation::new(n))

@@ -7,17 +7,10 @@
     clippy::indexing_slicing
 )]
 
+use drive_tests::al::{ACK, BOOT, ERR, INIT, OP, PREOP, SAFEOP};
 use drive_tests::{al_status, init, line, request, with_master, write_sm};
 use ecat::sii;
 use esc::{AlState, AlStatusCode};
-
-const INIT: u16 = 1;
-const PREOP: u16 = 2;
-const BOOT: u16 = 3;
-const SAFEOP: u16 = 4;
-const OP: u16 = 8;
-const ERR: u16 = 0x10;
-const ACK: u16 = 0x10;
 
 fn changes(sim: &hil_sim::sim::Simulation, i: usize) -> Vec<(AlState, AlState, u16)> {
     sim.drives()[i]

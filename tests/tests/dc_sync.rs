@@ -13,6 +13,7 @@
 
 use drive::runtime::dcsync;
 use drive::runtime::dcsync::{PllStatus, SyncFault};
+use drive_tests::al::{OP, SAFEOP};
 use ethercrab::subdevice_group::DcConfiguration;
 use ethercrab::{DcSync, MainDevice, MainDeviceConfig, SubDeviceGroup};
 use hil_sim::sim::Simulation;
@@ -31,6 +32,16 @@ const A292_US: i32 = -100;
 /// Frames arrive 100 µs before SYNC0 (ethercrab sends at SYNC0 + shift).
 const FRAME_LEAD_NS: u64 = 100_000;
 const A261: u16 = drive::parameter_index(0, 261);
+
+/// SYNC0 every `sync0_ns`, starting 20 ms out, frames arriving
+/// [`FRAME_LEAD_NS`] before each SYNC0.
+fn dc_config(sync0_ns: u64) -> DcConfiguration {
+    DcConfiguration {
+        start_delay: Duration::from_millis(20),
+        sync0_period: Duration::from_nanos(sync0_ns),
+        sync0_shift: Duration::from_nanos(sync0_ns - FRAME_LEAD_NS),
+    }
+}
 const A292: u16 = drive::parameter_index(0, 292);
 const A296: u16 = drive::parameter_index(0, 296);
 const A298: u16 = drive::parameter_index(0, 298);
@@ -98,14 +109,7 @@ fn run(
             sd.sdo_write(A292, 0, A292_US).await.expect("A292");
         }
         let group = group
-            .configure_dc_sync(
-                md,
-                DcConfiguration {
-                    start_delay: Duration::from_millis(20),
-                    sync0_period: Duration::from_nanos(SYNC0_NS),
-                    sync0_shift: Duration::from_nanos(SYNC0_NS - FRAME_LEAD_NS),
-                },
-            )
+            .configure_dc_sync(md, dc_config(SYNC0_NS))
             .await
             .expect("DC configuration")
             .request_into_op(md)
@@ -384,9 +388,6 @@ fn e116_a_sync0_cycle_the_pll_cannot_run_is_refused() {
     assert!(d.cycle_log.is_empty(), "the control cycle stays free-running");
 }
 
-/// AL status bits / requests used by the DC supervision test.
-const SAFEOP: u16 = 4;
-const OP: u16 = 8;
 const ERR_ACK: u16 = 0x10;
 
 /// Runs `n` `tx_rx_dc` cycles, the clock advanced as ethercrab computes it;
@@ -436,14 +437,7 @@ fn e046_e131_e038_dc_op_waits_for_pll_lock_and_sync0_loss_drops_to_safeop() {
             .into_pre_op_pdi(md)
             .await
             .expect("PRE-OP with PDI")
-            .configure_dc_sync(
-                md,
-                DcConfiguration {
-                    start_delay: Duration::from_millis(20),
-                    sync0_period: Duration::from_nanos(SYNC0_NS),
-                    sync0_shift: Duration::from_nanos(SYNC0_NS - FRAME_LEAD_NS),
-                },
-            )
+            .configure_dc_sync(md, dc_config(SYNC0_NS))
             .await
             .expect("DC configuration")
             .request_into_op(md)
@@ -590,14 +584,7 @@ fn dc_op<T>(
             pre_op(&sd).await;
         }
         let group = group
-            .configure_dc_sync(
-                md,
-                DcConfiguration {
-                    start_delay: Duration::from_millis(20),
-                    sync0_period: Duration::from_nanos(sync0_ns),
-                    sync0_shift: Duration::from_nanos(sync0_ns - FRAME_LEAD_NS),
-                },
-            )
+            .configure_dc_sync(md, dc_config(sync0_ns))
             .await
             .expect("DC configuration")
             .request_into_op(md)

@@ -11,13 +11,10 @@
 )]
 
 use drive_tests::{init, line, sw, with_master, CoeClient, Cyclic, RawMailbox, TxPdo};
+use drive_tests::{REV, REV_F};
 use hil_sim::motor::PositionInput;
 use hil_sim::sim::{AxisConditions, Simulation};
 use std::cell::RefCell;
-
-/// 1 revolution, increments (6092h default feed, C-108).
-const REV: i32 = 1 << 20;
-const REV_F: f64 = REV as f64;
 
 /// Axis B's CiA 402 objects (C-134).
 const B: u16 = 0x800;

@@ -10,13 +10,10 @@
 )]
 
 use drive_tests::{init, line, map_layout, sw, with_master, Cyclic, RawCyclic, TxPdo};
+use drive_tests::{REV, REV_F};
 use hil_sim::motor::{PositionInput, Switches};
 use hil_sim::sim::Simulation;
 use std::cell::RefCell;
-
-/// 1 revolution, increments.
-const REV: i32 = 1 << 20;
-const REV_F: f64 = REV as f64;
 
 const CW_ENABLED: u16 = 0x000F;
 const CW_BIT4: u16 = 1 << 4;

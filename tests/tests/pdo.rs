@@ -9,15 +9,10 @@
     clippy::indexing_slicing
 )]
 
+use drive_tests::al::{ACK, ERR, OP, PREOP, SAFEOP};
 use drive_tests::{al_status, init, line, request, with_master, write_sm, CoeClient};
 use ecat::SdoAbort;
 use esc::AlStatusCode;
-
-const PREOP: u16 = 2;
-const SAFEOP: u16 = 4;
-const OP: u16 = 8;
-const ERR: u16 = 0x10;
-const ACK: u16 = 0x10;
 
 /// Mapping entry: index << 16 | sub << 8 | bit length.
 const fn m(index: u16, sub: u8, bits: u8) -> u32 {

@@ -10,12 +10,10 @@
 )]
 
 use drive::DriveObjects;
+use drive_tests::al::{OP, SAFEOP};
 use drive_tests::{al_status, init, line, with_master};
 use hil_sim::sim::Simulation;
 use std::cell::RefCell;
-
-const SAFEOP: u16 = 4;
-const OP: u16 = 8;
 
 /// Mapping entry: index << 16 | sub << 8 | bit length.
 const fn m(index: u16, sub: u8, bits: u8) -> u32 {

@@ -9,18 +9,13 @@
     clippy::indexing_slicing
 )]
 
+use drive_tests::al::{ACK, ERR, OP, PREOP, SAFEOP};
 use drive_tests::{al_status, init, line, request, with_master, write_sm, CoeClient};
 use esc::regs::{self, dc};
 use esc::AlStatusCode;
 use ethercrab::{MainDevice, SubDeviceGroup};
 use hil_sim::sim::Simulation;
 use std::cell::RefCell;
-
-const PREOP: u16 = 2;
-const SAFEOP: u16 = 4;
-const OP: u16 = 8;
-const ERR: u16 = 0x10;
-const ACK: u16 = 0x10;
 
 /// A258 PDO timeout (ms), parameter 2000h + 258.
 const A258: u16 = 0x2102;
