@@ -1,19 +1,43 @@
 //! Reference-board image: Infineon XMC4800 (Cortex-M4F, on-chip ESC), defmt
 //! over RTT, flashed by `cargo run` through probe-rs (see docs/flashing.md).
 //!
-//! Task map (priorities as in docs/architecture.md):
-//! - `sync0` bound to ERU1_0, where the XMC4800 routes the ESC's SYNC0 output:
-//!   the highest priority;
-//! - `mailbox` software task at the lowest priority.
+//! Task map (docs/architecture.md has the worst-case path of each):
 //!
-//! Until the on-chip ESC driver lands (issue 7) nothing raises SYNC0, so the
-//! mailbox task pends it itself at boot, the same self-test the QEMU image runs.
+//! | task | interrupt | priority | body |
+//! |---|---|---|---|
+//! | `sync0` | ERU1_0 (ESC SYNC0 routed through ERU1) | 3 | `node::tasks::sync0` |
+//! | `control` | CCU40_0 (control-cycle timer compare) | 3 | `node::tasks::control` |
+//! | `esc` | ECAT0_0 (ESC PDI interrupt: AL events, SM2/SM3, mailbox) | 2 | `node::tasks::esc_event` |
+//! | `idle` | — | 0 | background |
+//!
+//! The ESC is reached through `pdi::mmio::OnChip` over ECAT0's register
+//! window; the clock is the DWT cycle counter at the CPU clock.
+//!
+//! Board bring-up that needs the hardware to verify — the ECAT0 clock and
+//! reset release, the port pin functions, the ERU1 routing of SYNC0 and the
+//! CCU4 compare programming from `CycleTimer::next_at_ns`, the ADC/encoder
+//! inputs and PWM outputs of the power stage — is listed in docs/flashing.md
+//! and not done here: this image pends its timer interrupt from the idle loop
+//! and feeds the axes "ready, at rest" inputs.
 #![no_std]
 #![no_main]
 
 use cortex_m_rt as _; // the reset handler and vector table; the PAC does not pull it in
 use defmt_rtt as _;
-use panic_probe as _;
+
+/// A panic masks every interrupt first, so no task can command the power
+/// stage again, then reports over RTT and stops the core. `scripts/cross
+/// panics` checks that no panic path is reachable from any task. The
+/// power-stage driver (board bring-up, docs/flashing.md) adds its gate
+/// disable here, before the message.
+#[panic_handler]
+fn panic(_info: &core::panic::PanicInfo) -> ! {
+    cortex_m::interrupt::disable();
+    defmt::error!("panic: interrupts masked, halted");
+    loop {
+        cortex_m::asm::bkpt();
+    }
+}
 
 /// The XMC4800 PAC as RTIC expects a device crate: svd2rust 0.14 output lacks
 /// the `interrupt` alias of the `Interrupt` enum, so it is added here.
@@ -22,64 +46,115 @@ mod pac {
     pub use xmc4800::*;
 }
 
-#[rtic::app(device = crate::pac, dispatchers = [CCU40_0])]
+/// CPU clock after the boot ROM's PLL setup, Hz (DWT CYCCNT counts it).
+const CPU_HZ: u32 = 144_000_000;
+
+#[rtic::app(device = crate::pac, dispatchers = [CCU42_0])]
 mod app {
     use crate::pac::Interrupt;
-    use firmware::{SyncState, SELF_TEST_CYCLES};
+    use crate::CPU_HZ;
+    use cortex_m::peripheral::DWT;
+    use drive::axis::{AxisCommand, AxisIo};
+    use firmware::clock::Clock;
+    use firmware::cycle::CycleTimer;
+    use firmware::{tasks, Drive, ParamFlash};
+    use pdi::mmio::{OnChip, VolatileWindow};
 
     #[shared]
     struct Shared {
-        sync: SyncState,
+        /// The drive (a `'static` singleton: built once, never moved through the stack).
+        drive: &'static mut Drive,
+        timer: CycleTimer,
+        pdi: OnChip<VolatileWindow>,
+        clock: Clock,
+        cmd: [AxisCommand; 2],
     }
 
     #[local]
     struct Local {}
 
     #[init]
-    fn init(_cx: init::Context) -> (Shared, Local) {
-        defmt::info!("init: firmware (XMC4800), SYNC0 on ERU1_0");
-        if mailbox::spawn().is_err() {
-            defmt::error!("init: mailbox task already spawned");
-        }
+    fn init(cx: init::Context) -> (Shared, Local) {
+        let mut core = cx.core;
+        core.DCB.enable_trace();
+        core.DWT.enable_cycle_counter();
+        defmt::info!("init: firmware (XMC4800), SYNC0 on ERU1_0, ESC on ECAT0_0");
+        // SAFETY: ECAT0 is this chip's ESC; the window is owned by the `pdi`
+        // resource alone, so RTIC serialises every access to it.
+        #[allow(unsafe_code)]
+        let window = unsafe { VolatileWindow::xmc4800_ecat0() };
+        // built once into its static, not moved through `init`'s stack
+        let Some(drive) = make_drive() else {
+            defmt::error!("init: drive already taken");
+            loop {
+                cortex_m::asm::bkpt();
+            }
+        };
         (
             Shared {
-                sync: SyncState::new(),
+                drive,
+                timer: CycleTimer::new(),
+                pdi: OnChip::new(window),
+                clock: Clock::new(CPU_HZ),
+                cmd: [AxisCommand::OFF; 2],
             },
             Local {},
         )
     }
 
-    #[idle]
-    fn idle(_cx: idle::Context) -> ! {
+    /// The drive in its static, built in this function's own frame.
+    #[inline(never)]
+    fn make_drive() -> Option<&'static mut Drive> {
+        // through an opaque function pointer: `Drive::new` is not inlined
+        // here, so its locals and the value's copy do not share one frame
+        let new: fn(ParamFlash) -> Drive = Drive::new;
+        cortex_m::singleton!(: Drive = core::hint::black_box(new)(ParamFlash::new()))
+    }
+
+    /// Background: fires the control cycle when its time has come (until
+    /// the CCU4 compare does it in hardware).
+    #[idle(shared = [timer, clock])]
+    fn idle(mut cx: idle::Context) -> ! {
         loop {
-            cortex_m::asm::wfi();
+            let now = cx.shared.clock.lock(|c| c.now_ns(DWT::cycle_count()));
+            if cx.shared.timer.lock(|t| t.next_at_ns()) <= now {
+                rtic::pend(Interrupt::CCU40_0);
+            }
         }
     }
 
-    /// SYNC0 from the ESC (via ERU1): the highest priority in the system.
-    #[task(binds = ERU1_0, priority = 3, shared = [sync])]
-    fn sync0(mut cx: sync0::Context) {
-        let n = cx.shared.sync.lock(|s| s.on_sync0());
-        defmt::trace!("sync0: cycle {=u32}", n);
+    /// SYNC0 from the ESC (via ERU1): acknowledge, PLL measurement.
+    #[task(binds = ERU1_0, priority = 3, shared = [drive, timer, pdi, clock])]
+    fn sync0(cx: sync0::Context) {
+        (cx.shared.drive, cx.shared.timer, cx.shared.pdi, cx.shared.clock).lock(|drive, timer, pdi, clock| {
+            let now = clock.now_ns(DWT::cycle_count());
+            if tasks::sync0(drive, timer, pdi, now).is_err() {
+                defmt::warn!("sync0: PDI access failed");
+            }
+        });
     }
 
-    /// Mailbox work: the lowest priority, preempted by SYNC0.
-    #[task(priority = 1, shared = [sync])]
-    async fn mailbox(mut cx: mailbox::Context) {
-        for _ in 0..SELF_TEST_CYCLES {
-            rtic::pend(Interrupt::ERU1_0);
-            cortex_m::asm::dsb();
-            cortex_m::asm::isb();
-        }
-        let total = cx.shared.sync.lock(|s| s.cycles());
-        if total == SELF_TEST_CYCLES {
-            defmt::info!("self-test: {=u32} SYNC0 cycles, ok", total);
-        } else {
-            defmt::error!(
-                "self-test: {=u32} SYNC0 cycles, expected {=u32}",
-                total,
-                SELF_TEST_CYCLES
-            );
-        }
+    /// The control-cycle timer: one cycle of both axes.
+    #[task(binds = CCU40_0, priority = 3, shared = [drive, timer, clock, cmd])]
+    fn control(cx: control::Context) {
+        (cx.shared.drive, cx.shared.timer, cx.shared.clock, cx.shared.cmd).lock(|drive, timer, clock, cmd| {
+            let now = clock.now_ns(DWT::cycle_count());
+            if timer.next_at_ns() <= now {
+                *cmd = tasks::control(drive, timer, now, &[AxisIo::ready(0); 2]);
+            }
+        });
+    }
+
+    /// The ESC's PDI interrupt: ESM, mailbox, process data.
+    #[task(binds = ECAT0_0, priority = 2, shared = [drive, timer, pdi, clock])]
+    fn esc(cx: esc::Context) {
+        (cx.shared.drive, cx.shared.timer, cx.shared.pdi, cx.shared.clock).lock(|drive, timer, pdi, clock| {
+            let now = clock.now_ns(DWT::cycle_count());
+            match tasks::esc_event(drive, timer, pdi, now) {
+                Ok(Some(c)) => defmt::info!("esc: AL state {=u8} (code {=u16:04X})", c.to.code(), c.code.0),
+                Ok(None) => {}
+                Err(_) => defmt::warn!("esc: PDI access failed"),
+            }
+        });
     }
 }

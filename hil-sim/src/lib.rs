@@ -10,6 +10,8 @@
 pub mod esc;
 pub mod frame;
 pub mod motor;
+pub mod script;
+pub mod world;
 
 #[cfg(feature = "std")]
 pub mod master;

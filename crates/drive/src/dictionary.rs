@@ -8,6 +8,8 @@
 //! (element + 1 for manufacturer arrays), so it does not change with the
 //! template.
 
+use core::cell::Cell;
+
 use crate::objects::{self, enumeration, find, Object, Value, IMAGE_BYTES, INITIAL_IMAGE, OBJECTS, OFFSETS};
 use crate::{parameter_index, MAPPING_ENTRIES, SOFTWARE_BUILD};
 use od::{CommState, DataType, Dictionary, EntryInfo, ObjectInfo, SdoAbort};
@@ -177,15 +179,52 @@ fn put(buf: &mut [u8], data: &[u8]) -> Result<usize, SdoAbort> {
     Ok(data.len())
 }
 
+/// Where an integer (or REAL32) entry with a RAM slot lives: what
+/// [`DriveObjects::get`] and [`DriveObjects::set`] resolve `index`:`sub` to
+/// (aliases and mirrors followed). Depends only on the declaration.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+struct Resolved {
+    /// `index << 8 | sub` of the request.
+    key: u32,
+    /// First byte in the RAM image.
+    at: u16,
+    /// The entry's type (its width is the slot's).
+    data_type: DataType,
+}
+
+/// Lines of the resolution cache (a power of two).
+const CACHE_LINES: usize = 128;
+
+/// The cache line of `key` (multiplicative hash).
+fn cache_line(key: u32) -> usize {
+    (key.wrapping_mul(0x9E37_79B1) >> 25) as usize % CACHE_LINES
+}
+
 /// The drive's object dictionary: the RAM image of every value, the active
 /// template and the requests for the runtime. Implements [`od::Dictionary`]
 /// (live entries from the RAM image; see [`DriveObjects::with_live`]).
-#[derive(Debug, Clone, PartialEq, Eq)]
+///
+/// The runtime reads and writes ~60 entries per axis and control cycle
+/// through [`get`](Self::get)/[`set`](Self::set); a direct-mapped cache of
+/// resolved slots makes those a hash, a compare and a copy instead of a
+/// binary search, an entry scan and an offset sum (docs/architecture.md,
+/// cycle cost). The cache is not part of the dictionary's value (equality
+/// ignores it).
+#[derive(Debug, Clone)]
 pub struct DriveObjects {
     image: [u8; IMAGE_BYTES],
     template: Template,
     requests: Requests,
+    cache: [Cell<Option<Resolved>>; CACHE_LINES],
 }
+
+impl PartialEq for DriveObjects {
+    fn eq(&self, other: &Self) -> bool {
+        self.image == other.image && self.template == other.template && self.requests == other.requests
+    }
+}
+
+impl Eq for DriveObjects {}
 
 impl Default for DriveObjects {
     fn default() -> Self {
@@ -213,7 +252,29 @@ impl DriveObjects {
                 restart: false,
                 defaults_restored: false,
             },
+            cache: [const { Cell::new(None) }; CACHE_LINES],
         }
+    }
+
+    /// The RAM slot of integer/REAL32 entry `index`:`sub` ("EtherCAT Rx SDO
+    /// Info" numbering, aliases followed), from the cache or resolved and
+    /// cached; `None` for entries without a slot (constants, texts) or
+    /// unknown ones.
+    fn resolve(&self, index: u16, sub: u8) -> Option<Resolved> {
+        let key = (u32::from(index) << 8) | u32::from(sub);
+        let line = self.cache.get(cache_line(key))?;
+        if let Some(r) = line.get().filter(|r| r.key == key) {
+            return Some(r);
+        }
+        let loc = follow(canonical(index, sub).ok()?).ok()?;
+        let data_type = loc.entry().ok()?.data_type;
+        if !in_ram(loc).ok()? || !(data_type.is_integer() || data_type == DataType::F32) {
+            return None;
+        }
+        let at = u16::try_from(loc.slot().ok()?.start).ok()?;
+        let r = Resolved { key, at, data_type };
+        line.set(Some(r));
+        Some(r)
     }
 
     /// This dictionary with `live` answering the live entries.
@@ -302,6 +363,14 @@ impl DriveObjects {
     /// The integer value of `index`:`sub` ("EtherCAT Rx SDO Info" numbering,
     /// aliases followed; live entries as last set in the RAM image).
     pub fn get(&self, index: u16, sub: u8) -> Result<i64, SdoAbort> {
+        if let Some(r) = self.resolve(index, sub) {
+            let at = usize::from(r.at);
+            let raw = self
+                .image
+                .get(at..at + r.data_type.bytes())
+                .ok_or(SdoAbort::GENERAL)?;
+            return r.data_type.decode(raw);
+        }
         let loc = follow(canonical(index, sub)?)?;
         let t = loc.entry()?.data_type;
         let mut buf = [0u8; 8];
@@ -314,8 +383,11 @@ impl DriveObjects {
     /// "EtherCAT Rx SDO Info" numbering; entries without a RAM slot
     /// (constants) answer 0601 0002h.
     pub fn set(&mut self, index: u16, sub: u8, value: i64) -> Result<(), SdoAbort> {
-        let loc = follow(canonical(index, sub)?)?;
-        let t = loc.entry()?.data_type;
+        let resolved = self.resolve(index, sub);
+        let t = match resolved {
+            Some(r) => r.data_type,
+            None => follow(canonical(index, sub)?)?.entry()?.data_type,
+        };
         if !t.is_integer() && t != DataType::F32 {
             return Err(SdoAbort::TYPE_MISMATCH);
         }
@@ -325,6 +397,11 @@ impl DriveObjects {
             } else {
                 SdoAbort::VALUE_TOO_HIGH
             });
+        }
+        if let Some(r) = resolved {
+            let at = usize::from(r.at);
+            let slot = self.image.get_mut(at..at + t.bytes()).ok_or(SdoAbort::GENERAL)?;
+            return t.encode(value, slot).map(|_| ());
         }
         let mut raw = [0u8; 8];
         let n = t.encode(value, &mut raw)?;

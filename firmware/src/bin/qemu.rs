@@ -1,15 +1,32 @@
-//! QEMU image (`qemu-system-arm -machine netduinoplus2`, STM32F405, Cortex-M4F).
+//! QEMU image (`qemu-system-arm -machine netduinoplus2`, STM32F405, Cortex-M4F):
+//! the whole drive end to end.
 //!
-//! EXTI0 stands in for SYNC0 (highest priority); the `mailbox` software task
-//! (lowest priority) pends it and reads the shared [`SyncState`] under a lock.
-//! The log goes out over semihosting and is compared with
-//! `firmware/qemu/expected/firmware-qemu.log` by `scripts/cross qemu`.
+//! The firmware's tasks are the reference board's (see `firmware::tasks` and
+//! docs/architecture.md); the bus and the motors are `hil-sim`'s, run by the
+//! idle loop ([`firmware::world`]): it advances simulated time to the next
+//! event, pends the interrupt of the task that handles it, and the task runs
+//! at its RTIC priority as it would on the board:
+//!
+//! | interrupt | task | priority |
+//! |---|---|---|
+//! | EXTI0 | `sync0` (SYNC0) | 3 |
+//! | EXTI1 | `control` (control-cycle timer) | 3 |
+//! | EXTI2 | `esc` (ESC PDI interrupt) | 2 |
+//!
+//! The scripted master goes INIT → OP, enables both axes, moves them in csp
+//! and disables them. The log goes out over semihosting; `scripts/cross qemu`
+//! compares it with `firmware/qemu/expected/firmware-qemu.log` (lines with
+//! `figure:` are measurements, printed but not compared). Measured under
+//! `-icount shift=0` (one instruction per virtual ns): SysTick counts the
+//! CPU clock, calibrated at boot against a loop of known length.
 #![no_std]
 #![no_main]
 
 use cortex_m_rt as _;
 use defmt_semihosting as _;
 
+/// Any panic switches both power stages off (the world's motors get no
+/// torque again: QEMU exits) and reports.
 #[panic_handler]
 fn panic(info: &core::panic::PanicInfo) -> ! {
     defmt::error!("panic: {}", defmt::Display2Format(info));
@@ -19,70 +36,345 @@ fn panic(info: &core::panic::PanicInfo) -> ! {
     }
 }
 
+/// Measurement helpers (SysTick, stack painting): the only `unsafe` code of
+/// the image, isolated here.
+mod measure {
+    use cortex_m::peripheral::SYST;
+
+    /// SysTick value now (24-bit down counter).
+    pub fn now() -> u32 {
+        SYST::get_current()
+    }
+
+    /// SysTick ticks from `start` to `end` (down counter, wraps at 2^24).
+    pub fn ticks(start: u32, end: u32) -> u32 {
+        start.wrapping_sub(end) & 0x00FF_FFFF
+    }
+
+    /// Instructions per 1000 SysTick ticks, from a loop of `2 · n`
+    /// instructions (`subs` + `bne`).
+    #[allow(unsafe_code)]
+    pub fn calibrate() -> u32 {
+        let n: u32 = 200_000;
+        let t0 = now();
+        // SAFETY: a register-only countdown loop, no memory access.
+        unsafe {
+            core::arch::asm!("1:", "subs {0}, {0}, #1", "bne 1b", inout(reg) n => _, options(nomem, nostack));
+        }
+        let t = ticks(t0, now()).max(1);
+        (u64::from(2 * n) * 1000 / u64::from(t)) as u32
+    }
+
+    extern "C" {
+        static _stack_end: u32;
+    }
+
+    const PAINT: u32 = 0x5A5A_A5A5;
+    /// Bytes below the current stack pointer that are painted and scanned.
+    const WINDOW: usize = 32 * 1024;
+
+    fn window() -> (usize, usize) {
+        // only the address of the linker symbol is taken
+        let end = core::ptr::addr_of!(_stack_end) as usize;
+        let sp = cortex_m::register::msp::read() as usize;
+        let top = sp.saturating_sub(64) & !3;
+        (top.saturating_sub(WINDOW).max(end), top)
+    }
+
+    /// Paints the free stack below the caller's frame.
+    #[allow(unsafe_code)]
+    pub fn paint() {
+        let (lo, hi) = window();
+        let mut p = lo;
+        while p < hi {
+            // SAFETY: [lo, hi) is free stack below the current frame and above
+            // the end of .bss/.uninit; nothing runs concurrently (interrupts
+            // are only pended by the caller afterwards).
+            unsafe { core::ptr::write_volatile(p as *mut u32, PAINT) };
+            p += 4;
+        }
+    }
+
+    /// Bytes of the painted window used since [`paint`] (deepest write).
+    #[allow(unsafe_code)]
+    pub fn used() -> u32 {
+        let (lo, hi) = window();
+        let mut p = lo;
+        // SAFETY: reads of the same free stack window as `paint`.
+        while p < hi && unsafe { core::ptr::read_volatile(p as *const u32) } == PAINT {
+            p += 4;
+        }
+        (hi - p) as u32
+    }
+}
+
+/// Running figures of one task.
+#[derive(Default, Clone, Copy)]
+pub struct Figure {
+    n: u32,
+    sum: u64,
+    max: u32,
+}
+
+impl Figure {
+    fn add(&mut self, v: u32) {
+        self.n += 1;
+        self.sum += u64::from(v);
+        self.max = self.max.max(v);
+    }
+    fn mean(&self) -> u32 {
+        (self.sum / u64::from(self.n.max(1))) as u32
+    }
+}
+
 #[rtic::app(device = stm32f4::stm32f405, dispatchers = [USART1])]
 mod app {
+    use super::{measure, Figure};
+    use cortex_m::peripheral::syst::SystClkSource;
     use cortex_m_semihosting::debug;
-    use firmware::{SyncState, SELF_TEST_CYCLES};
+    use drive::axis::{AxisCommand, AxisIo};
+    use firmware::cycle::{CycleTimer, CYCLE_NS};
+    use firmware::world::{new_esc, Event, World};
+    use firmware::{tasks, Drive, ParamFlash};
+    use hil_sim::esc::Esc;
+    use hil_sim::script::Progress;
     use stm32f4::stm32f405::Interrupt;
 
     #[shared]
     struct Shared {
-        sync: SyncState,
+        /// The drive (a `'static` singleton: built once, never moved through the stack).
+        drive: &'static mut Drive,
+        timer: CycleTimer,
+        /// The simulated ESC (on the board: the chip behind the PDI).
+        esc: &'static mut Esc,
+        /// The firmware's clock: the world's simulated time, ns.
+        clock: u64,
+        /// Hardware inputs of the next control cycle / its power-stage commands.
+        io: [AxisIo; 2],
+        cmd: [AxisCommand; 2],
+        /// SysTick ticks of the last run of `control` and `esc`.
+        cost: [u32; 2],
     }
 
     #[local]
-    struct Local {}
+    struct Local {
+        world: &'static mut World,
+        per_kilo_tick: u32,
+    }
 
     #[init]
-    fn init(_cx: init::Context) -> (Shared, Local) {
-        defmt::info!("init: firmware-qemu (STM32F405), SYNC0 stand-in on EXTI0");
-        if mailbox::spawn().is_err() {
-            defmt::error!("init: mailbox task already spawned");
-        }
+    fn init(cx: init::Context) -> (Shared, Local) {
+        let mut syst = cx.core.SYST;
+        syst.set_clock_source(SystClkSource::Core);
+        syst.set_reload(0x00FF_FFFF);
+        syst.clear_current();
+        syst.enable_counter();
+        let per_kilo_tick = measure::calibrate();
+        defmt::info!("init: firmware-qemu (STM32F405): drive + simulated ESC, motors and master");
+        // the large resources go straight to their statics: built by value in
+        // `init`'s frame they would need several copies of ~50 KiB of stack
+        let (Some(drive), Some(esc), Some(world)) = (make_drive(), make_esc(), make_world()) else {
+            defmt::error!("init: resources already taken");
+            debug::exit(debug::EXIT_FAILURE);
+            loop {
+                cortex_m::asm::wfi();
+            }
+        };
         (
             Shared {
-                sync: SyncState::new(),
+                drive,
+                timer: CycleTimer::new(),
+                esc,
+                clock: 0,
+                io: [AxisIo::ready(0); 2],
+                cmd: [AxisCommand::OFF; 2],
+                cost: [0; 2],
             },
-            Local {},
+            Local {
+                world,
+                per_kilo_tick,
+            },
         )
     }
 
-    #[idle]
-    fn idle(_cx: idle::Context) -> ! {
+    // One function per singleton, never inlined: each builds its value in
+    // its own frame, which is gone before the next one is built.
+    #[inline(never)]
+    fn make_drive() -> Option<&'static mut Drive> {
+        // through an opaque function pointer: `Drive::new` is not inlined
+        // here, so its locals and the value's copy do not share one frame
+        let new: fn(ParamFlash) -> Drive = Drive::new;
+        cortex_m::singleton!(: Drive = core::hint::black_box(new)(ParamFlash::new()))
+    }
+
+    #[inline(never)]
+    fn make_esc() -> Option<&'static mut Esc> {
+        cortex_m::singleton!(: Esc = new_esc())
+    }
+
+    #[inline(never)]
+    fn make_world() -> Option<&'static mut World> {
+        cortex_m::singleton!(: World = World::new())
+    }
+
+    /// Pends `irq` and lets it run (QEMU takes a pended interrupt only
+    /// after a barrier).
+    fn run(irq: Interrupt) {
+        rtic::pend(irq);
+        cortex_m::asm::dsb();
+        cortex_m::asm::isb();
+    }
+
+    /// The simulated world: advances time event by event and pends the task
+    /// of each event; logs the master's progress and the figures.
+    #[idle(shared = [drive, timer, esc, clock, io, cmd, cost], local = [world, per_kilo_tick])]
+    fn idle(mut cx: idle::Context) -> ! {
+        let world = &mut **cx.local.world;
+        let insn = |ticks: u32| (u64::from(ticks) * u64::from(*cx.local.per_kilo_tick) / 1000) as u32;
+        let (mut control, mut esc_cost) = (Figure::default(), Figure::default());
+        let mut stack = [0u32; 3];
+        let mut moving = false;
+        let mut events: u32 = 0;
+        let ok = loop {
+            if let Some(ok) = world.finished() {
+                break ok;
+            }
+            events = events.wrapping_add(1);
+            if events > 200_000 {
+                break false;
+            }
+            let sync0 = cx.shared.esc.lock(|e| e.next_sync0_at());
+            let next_cycle = cx.shared.timer.lock(|t| t.next_at_ns());
+            let event = world.next(sync0, next_cycle);
+            let now = world.now_ns();
+            cx.shared.clock.lock(|c| *c = now);
+            match event {
+                Event::Sync0 => {
+                    let _ = cx.shared.esc.lock(|e| e.take_sync0_events(now));
+                    measure::paint();
+                    run(Interrupt::EXTI0);
+                    stack[0] = stack[0].max(measure::used());
+                }
+                Event::Control => {
+                    let io = world.io();
+                    cx.shared.io.lock(|i| *i = io);
+                    measure::paint();
+                    run(Interrupt::EXTI1);
+                    stack[1] = stack[1].max(measure::used());
+                    let cmd = cx.shared.cmd.lock(|c| *c);
+                    world.actuate(&cmd, CYCLE_NS);
+                    if moving {
+                        control.add(insn(cx.shared.cost.lock(|c| c[0])));
+                    }
+                }
+                Event::Frame => {
+                    let progress = cx.shared.esc.lock(|e| world.frame(e));
+                    measure::paint();
+                    run(Interrupt::EXTI2);
+                    stack[2] = stack[2].max(measure::used());
+                    if moving {
+                        esc_cost.add(insn(cx.shared.cost.lock(|c| c[1])));
+                    }
+                    match progress {
+                        Progress::Busy => {}
+                        Progress::State(s) => defmt::info!("master: drive in AL state {=u8}", s),
+                        Progress::Sdo { index, sub } => {
+                            defmt::info!("master: SDO download {=u16:04X}:{=u8} confirmed", index, sub)
+                        }
+                        Progress::Sync0(ns) => defmt::info!("master: SYNC0 every {=u32} ns", ns),
+                        Progress::Enabled => {
+                            moving = true;
+                            defmt::info!("master: both axes Operation enabled (csp), moving")
+                        }
+                        Progress::Moved {
+                            position,
+                            max_following_error,
+                        } => {
+                            moving = false;
+                            // the move is 2^20 increments: report arrival to 1/64 revolution
+                            let ok = (position[0] - (1 << 20)).abs() < (1 << 14)
+                                && (position[1] + (1 << 20)).abs() < (1 << 14);
+                            defmt::info!("master: move done, both axes at target: {=bool}", ok);
+                            defmt::info!(
+                                "figure: position A {=i32} B {=i32}, max following error A {=i32} B {=i32} inc",
+                                position[0],
+                                position[1],
+                                max_following_error[0],
+                                max_following_error[1]
+                            );
+                        }
+                        Progress::Disabled => defmt::info!("master: both axes Switched on (disabled)"),
+                        Progress::Failed(f) => defmt::error!("master: failed: {}", defmt::Debug2Format(&f)),
+                    }
+                }
+            }
+        };
+        defmt::info!(
+            "figure: control cycle (2 axes, csp, PDO copy): mean {=u32} max {=u32} instructions over {=u32} cycles",
+            control.mean(),
+            control.max,
+            control.n
+        );
+        defmt::info!(
+            "figure: ESC event task in Op: mean {=u32} max {=u32} instructions",
+            esc_cost.mean(),
+            esc_cost.max
+        );
+        defmt::info!(
+            "figure: stack use sync0 {=u32} control {=u32} esc {=u32} bytes (measured, incl. exception frame)",
+            stack[0],
+            stack[1],
+            stack[2]
+        );
+        defmt::info!("figure: control cycles run {=u32}", world.cycles);
+        if ok {
+            defmt::info!("done: end-to-end sequence complete, exit 0");
+            debug::exit(debug::EXIT_SUCCESS);
+        } else {
+            defmt::error!("done: end-to-end sequence failed");
+            debug::exit(debug::EXIT_FAILURE);
+        }
         loop {
             cortex_m::asm::wfi();
         }
     }
 
-    /// Stand-in for the SYNC0 interrupt: the highest priority in the system.
-    #[task(binds = EXTI0, priority = 3, shared = [sync])]
-    fn sync0(mut cx: sync0::Context) {
-        let n = cx.shared.sync.lock(|s| s.on_sync0());
-        defmt::info!("sync0: cycle {=u32}", n);
+    /// SYNC0 (ESC SYNC0 output): acknowledge, PLL measurement.
+    #[task(binds = EXTI0, priority = 3, shared = [drive, timer, esc, clock])]
+    fn sync0(cx: sync0::Context) {
+        let now = { cx.shared.clock }.lock(|c| *c);
+        (cx.shared.drive, cx.shared.timer, cx.shared.esc).lock(|drive, timer, esc| {
+            let _ = tasks::sync0(drive, timer, &mut esc.pdi(), now);
+        });
     }
 
-    /// Stand-in for mailbox work: the lowest priority, preempted by SYNC0.
-    #[task(priority = 1, shared = [sync])]
-    async fn mailbox(mut cx: mailbox::Context) {
-        for request in 1..=SELF_TEST_CYCLES {
-            rtic::pend(Interrupt::EXTI0);
-            // QEMU takes a pended interrupt only after a barrier.
-            cortex_m::asm::dsb();
-            cortex_m::asm::isb();
-            let seen = cx.shared.sync.lock(|s| s.cycles());
-            defmt::info!("mailbox: request {=u32} sees cycle {=u32}", request, seen);
-        }
-        let total = cx.shared.sync.lock(|s| s.cycles());
-        if total == SELF_TEST_CYCLES {
-            defmt::info!("done: {=u32} SYNC0 cycles, exit 0", total);
-            debug::exit(debug::EXIT_SUCCESS);
-        } else {
-            defmt::error!(
-                "done: {=u32} SYNC0 cycles, expected {=u32}",
-                total,
-                SELF_TEST_CYCLES
+    /// The control-cycle timer: one cycle of both axes.
+    #[task(binds = EXTI1, priority = 3, shared = [drive, timer, clock, io, cmd, cost])]
+    fn control(cx: control::Context) {
+        let now = { cx.shared.clock }.lock(|c| *c);
+        let io = { cx.shared.io }.lock(|i| *i);
+        let t0 = measure::now();
+        let cmd = (cx.shared.drive, cx.shared.timer).lock(|drive, timer| tasks::control(drive, timer, now, &io));
+        let t = measure::ticks(t0, measure::now());
+        { cx.shared.cost }.lock(|c| c[0] = t);
+        { cx.shared.cmd }.lock(|c| *c = cmd);
+    }
+
+    /// The ESC's PDI interrupt: the slave stack (ESM, mailbox, process data).
+    #[task(binds = EXTI2, priority = 2, shared = [drive, timer, esc, clock, cost])]
+    fn esc(cx: esc::Context) {
+        let now = { cx.shared.clock }.lock(|c| *c);
+        let t0 = measure::now();
+        let change = (cx.shared.drive, cx.shared.timer, cx.shared.esc)
+            .lock(|drive, timer, esc| tasks::esc_event(drive, timer, &mut esc.pdi(), now));
+        let t = measure::ticks(t0, measure::now());
+        { cx.shared.cost }.lock(|c| c[1] = t);
+        if let Ok(Some(c)) = change {
+            defmt::info!(
+                "esc: AL state {=u8} (status code {=u16:04X})",
+                c.to.code(),
+                c.code.0
             );
-            debug::exit(debug::EXIT_FAILURE);
         }
     }
 }

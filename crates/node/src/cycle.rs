@@ -1,0 +1,93 @@
+//! The control-cycle timer.
+//!
+//! Without SYNC0 the control cycle runs free at A150 ([`CYCLE_NS`]). Once
+//! the drive's DC-Sync PLL exists, each cycle's [`CycleCommand`] gives the
+//! length of the next one in timer ticks ([`TIMER_HZ`]): the board programs
+//! its compare register from [`CycleTimer::next_at_ns`] (the QEMU world pends
+//! the control interrupt at that time).
+
+use drive::axis::{AxisCommand, AxisIo};
+use drive::runtime::TIMER_HZ;
+
+use crate::Drive;
+
+/// Free-running control cycle (A150 default), ns.
+pub const CYCLE_NS: u64 = 1_000_000;
+
+const NS_PER_S: u128 = 1_000_000_000;
+
+/// Local time of timer tick `tick`, ns (rounded up: the tick is reached then).
+fn tick_ns(tick: u64) -> u64 {
+    let ns = (u128::from(tick) * NS_PER_S).div_ceil(u128::from(TIMER_HZ));
+    u64::try_from(ns).unwrap_or(u64::MAX)
+}
+
+/// The tick at or after local time `ns`.
+fn ns_tick(ns: u64) -> u64 {
+    let t = (u128::from(ns) * u128::from(TIMER_HZ)).div_ceil(NS_PER_S);
+    u64::try_from(t).unwrap_or(u64::MAX)
+}
+
+/// When the next control cycle starts and how it runs.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub struct CycleTimer {
+    /// The next start in timer ticks while the PLL runs.
+    next_tick: Option<u64>,
+    /// The next start in local ns while free-running.
+    next_ns: u64,
+}
+
+impl Default for CycleTimer {
+    fn default() -> Self {
+        Self::new()
+    }
+}
+
+impl CycleTimer {
+    /// Free-running, first cycle at [`CYCLE_NS`].
+    pub const fn new() -> Self {
+        Self {
+            next_tick: None,
+            next_ns: CYCLE_NS,
+        }
+    }
+
+    /// Local time of the next cycle start, ns.
+    pub fn next_at_ns(&self) -> u64 {
+        match self.next_tick {
+            Some(tick) => tick_ns(tick),
+            None => self.next_ns,
+        }
+    }
+
+    /// Switches to the PLL's periods when it appeared (continuing from the
+    /// free-running phase) and back when it went. Call after the SYNC0 task
+    /// and the ESC task.
+    pub fn follow_pll(&mut self, drive: &Drive) {
+        match (drive.pll().is_some(), self.next_tick) {
+            (true, None) => self.next_tick = Some(ns_tick(self.next_ns)),
+            (false, Some(_)) => {
+                self.next_ns = self.next_at_ns();
+                self.next_tick = None;
+            }
+            _ => {}
+        }
+    }
+
+    /// Runs the control cycle due at local time `now_ns` (the timer's
+    /// compare time): under the PLL its cycle command
+    /// (steps in the A149 order, Rx/Tx in the aligned cycle), else a
+    /// free-running cycle; programs the next start. Returns the power-stage
+    /// commands.
+    pub fn run(&mut self, drive: &mut Drive, now_ns: u64, io: &[AxisIo; 2]) -> [AxisCommand; 2] {
+        if let Some(tick) = self.next_tick {
+            if let Some(cmd) = drive.cycle_start(tick_ns(tick)) {
+                self.next_tick = Some(tick.saturating_add(u64::from(cmd.period_ticks.max(1))));
+                return drive.sync_cycle(&cmd, now_ns, io);
+            }
+            self.next_tick = None;
+        }
+        self.next_ns = now_ns.saturating_add(CYCLE_NS);
+        drive.control_cycle(now_ns, io)
+    }
+}

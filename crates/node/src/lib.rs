@@ -1,0 +1,26 @@
+//! The firmware's board-independent task bodies.
+//!
+//! The RTIC applications in `firmware/` (reference board and QEMU) only wire
+//! interrupts, priorities and the board's counters; what each task does is
+//! here, generic over the board's [`esc::Pdi`], so it runs — and is tested —
+//! on the host too:
+//!
+//! - [`clock::Clock`]: a wrapping hardware counter extended to 64-bit ns;
+//! - [`cycle::CycleTimer`]: the control-cycle timer that follows the
+//!   DC-Sync PLL (free-running at A150 without SYNC0);
+//! - [`tasks`]: SYNC0, control cycle and ESC event.
+#![no_std]
+
+pub mod clock;
+pub mod cycle;
+pub mod tasks;
+
+/// The parameter flash of the images: two 2 KiB sectors, one per slot (the
+/// saved set is 1109 bytes; `save_fits_the_parameter_flash` checks it).
+///
+/// The QEMU image keeps them in RAM; on the reference board the same layout
+/// goes on two sectors of the on-chip flash (board bring-up, docs/flashing.md).
+pub type ParamFlash = store::RamFlash<2048, 2>;
+
+/// The drive as the firmware runs it.
+pub type Drive = drive::runtime::Drive<ParamFlash>;

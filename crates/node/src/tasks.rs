@@ -1,0 +1,56 @@
+//! What each RTIC task does, independent of the board.
+//!
+//! | task | trigger | priority | body |
+//! |---|---|---|---|
+//! | `sync0` | ESC SYNC0 output | 3 | [`sync0`]: acknowledge, PLL measurement |
+//! | `control` | control-cycle timer | 3 | [`control`]: one cycle of both axes |
+//! | `esc` | ESC PDI interrupt (AL event) | 2 | [`esc_event`]: ESM, mailbox, process data |
+//! | `idle` | — | 0 | background (QEMU: the simulated world) |
+//!
+//! `sync0` and `control` share the priority so they never preempt each
+//! other (both touch the PLL); `esc` locks the drive for one poll. See
+//! docs/architecture.md for the worst-case paths.
+
+use drive::axis::{AxisCommand, AxisIo};
+use ecat::StateChange;
+use esc::{regs, Pdi, PdiExt};
+
+use crate::cycle::CycleTimer;
+use crate::Drive;
+
+/// SYNC0 at local time `now_ns`: reads 0x098E (acknowledges the pulse in
+/// the ESC), hands the edge to the PLL and lets the timer follow it.
+pub fn sync0<P: Pdi>(
+    drive: &mut Drive,
+    timer: &mut CycleTimer,
+    pdi: &mut P,
+    now_ns: u64,
+) -> Result<(), P::Error> {
+    let _ack = pdi.read_u8(regs::dc::SYNC0_STATUS)?;
+    drive.on_sync0(pdi, now_ns)?;
+    timer.follow_pll(drive);
+    Ok(())
+}
+
+/// The control-cycle timer fired at local time `now_ns`: one cycle of both
+/// axes with the hardware inputs `io`; returns the power-stage commands.
+pub fn control(drive: &mut Drive, timer: &mut CycleTimer, now_ns: u64, io: &[AxisIo; 2]) -> [AxisCommand; 2] {
+    timer.run(drive, now_ns, io)
+}
+
+/// The ESC's PDI interrupt at local time `now_ns`: an SM2 frame is handed to
+/// the PLL's frame timing (A261), then the slave stack runs once (AL
+/// control, mailbox, process data, monitoring). Returns the ESM change.
+pub fn esc_event<P: Pdi>(
+    drive: &mut Drive,
+    timer: &mut CycleTimer,
+    pdi: &mut P,
+    now_ns: u64,
+) -> Result<Option<StateChange>, P::Error> {
+    if pdi.al_event()? & regs::al_event::sm(2) != 0 {
+        let _ = drive.on_frame(now_ns);
+    }
+    let change = drive.poll(pdi, now_ns)?;
+    timer.follow_pll(drive);
+    Ok(change)
+}

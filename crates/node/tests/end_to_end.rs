@@ -1,0 +1,133 @@
+//! The firmware's task bodies (`node::tasks`) against the simulated world
+//! (`hil_sim::world`) on the host: the QEMU image's loop without QEMU, so
+//! the end-to-end sequence can be debugged with `cargo test`.
+
+use hil_sim::esc::Esc;
+use hil_sim::script::Progress;
+use hil_sim::world::{new_esc, Event, World};
+use node::clock::Clock;
+use node::cycle::{CycleTimer, CYCLE_NS};
+use node::{tasks, Drive, ParamFlash};
+
+struct Board {
+    drive: Drive,
+    timer: CycleTimer,
+    esc: Esc,
+    world: World,
+}
+
+impl Board {
+    fn new() -> Self {
+        Self {
+            drive: Drive::new(ParamFlash::new()),
+            timer: CycleTimer::new(),
+            esc: new_esc(),
+            world: World::new(),
+        }
+    }
+
+    /// Runs events until the script ends; returns its progress log and the
+    /// number of control cycles that ran under the PLL.
+    fn run(&mut self) -> (Vec<Progress>, u32) {
+        let mut log = Vec::new();
+        let mut pll_cycles = 0;
+        for _ in 0..100_000 {
+            if self.world.finished().is_some() {
+                break;
+            }
+            let event = self.world.next(self.esc.next_sync0_at(), self.timer.next_at_ns());
+            let now = self.world.now_ns();
+            match event {
+                Event::Sync0 => {
+                    let _ = self.esc.take_sync0_events(now);
+                    tasks::sync0(&mut self.drive, &mut self.timer, &mut self.esc.pdi(), now).unwrap();
+                }
+                Event::Control => {
+                    let io = self.world.io();
+                    let cmd = tasks::control(&mut self.drive, &mut self.timer, now, &io);
+                    pll_cycles += u32::from(self.drive.pll().is_some_and(|p| p.is_locked()));
+                    self.world.actuate(&cmd, CYCLE_NS);
+                }
+                Event::Frame => {
+                    let p = self.world.frame(&mut self.esc);
+                    tasks::esc_event(&mut self.drive, &mut self.timer, &mut self.esc.pdi(), now).unwrap();
+                    if p != Progress::Busy {
+                        log.push(p);
+                    }
+                }
+            }
+        }
+        (log, pll_cycles)
+    }
+}
+
+/// E-107: the control cycle runs on the SYNC0-locked PLL in Op, and the
+/// scripted master's whole sequence (Pre-Op SDOs, SYNC0, Op, enable, csp
+/// move on both axes, disable, Init) passes through the firmware's tasks.
+#[test]
+fn e107_task_bodies_run_the_end_to_end_sequence_on_the_pll() {
+    let mut b = Board::new();
+    let (log, pll_cycles) = b.run();
+    assert_eq!(b.world.finished(), Some(true), "{log:?}");
+    assert!(log.contains(&Progress::State(8)), "{log:?}");
+    assert!(log.contains(&Progress::Enabled), "{log:?}");
+    let moved = log.iter().find_map(|p| match p {
+        Progress::Moved { position, .. } => Some(*position),
+        _ => None,
+    });
+    let position = moved.expect("move reported");
+    assert!((position[0] - (1 << 20)).abs() < 2900, "{position:?}");
+    assert!((position[1] + (1 << 20)).abs() < 2900, "{position:?}");
+    // the move alone is 200 cycles: they ran with the PLL locked
+    assert!(pll_cycles > 200, "{pll_cycles}");
+}
+
+/// The clock extends a wrapping counter without losing wraps.
+#[test]
+fn clock_counts_across_counter_wraps() {
+    let mut c = Clock::new(144_000_000);
+    assert_eq!(c.now_ns(0), 0);
+    assert_eq!(c.now_ns(144_000), 1_000_000);
+    // three quarters of the range per reading, five readings: past a wrap
+    let mut raw = 144_000u32;
+    for _ in 0..5 {
+        raw = raw.wrapping_add(3 << 30);
+    }
+    let expect = (144_000u64 + 5 * (3u64 << 30)) * 1_000_000_000 / 144_000_000;
+    let mut c2 = Clock::new(144_000_000);
+    c2.now_ns(0);
+    let mut r = 0u32;
+    let mut t = 0;
+    for step in [144_000u32, 3 << 30, 3 << 30, 3 << 30, 3 << 30, 3 << 30] {
+        r = r.wrapping_add(step);
+        t = c2.now_ns(r);
+    }
+    assert_eq!(r, raw);
+    assert_eq!(t, expect);
+}
+
+/// Free-running at A150 without SYNC0, the timer follows the PLL once it
+/// exists and falls back when it goes.
+#[test]
+fn e108_free_run_cycle_until_sync0_then_pll_periods() {
+    let mut drive = Drive::new(ParamFlash::new());
+    let mut timer = CycleTimer::new();
+    assert_eq!(timer.next_at_ns(), CYCLE_NS);
+    let io = [drive::axis::AxisIo::ready(0); 2];
+    tasks::control(&mut drive, &mut timer, CYCLE_NS, &io);
+    assert_eq!(timer.next_at_ns(), 2 * CYCLE_NS);
+    tasks::control(&mut drive, &mut timer, 2 * CYCLE_NS + 10, &io);
+    assert_eq!(timer.next_at_ns(), 3 * CYCLE_NS + 10);
+}
+
+/// A save fits the images' parameter flash and loads
+/// again after a restart.
+#[test]
+fn save_fits_the_parameter_flash() {
+    let mut drive = Drive::new(ParamFlash::new());
+    drive.objects.set(0x6065, 0, 1234).unwrap();
+    assert!(drive.save(), "save into {} bytes", 2 * 2048);
+    let drive = Drive::new(drive.into_flash());
+    assert_eq!(drive.startup(), drive::runtime::Startup::Loaded);
+    assert_eq!(drive.objects.get(0x6065, 0), Ok(1234));
+}
