@@ -123,6 +123,8 @@ pub const MAILBOX_LEN: usize = 256;
 /// Info requests and malformed mailboxes.
 pub struct RawMailbox {
     counter: u8,
+    /// Send the next message with counter 0 (see [`CoeClient::hand_over`]).
+    zero_next: bool,
 }
 
 impl Default for RawMailbox {
@@ -134,7 +136,10 @@ impl Default for RawMailbox {
 impl RawMailbox {
     /// Counter starts at 1 and cycles 1..7 (ETG.1000.4 §5.6).
     pub fn new() -> Self {
-        Self { counter: 0 }
+        Self {
+            counter: 0,
+            zero_next: false,
+        }
     }
 
     /// Sends one mailbox message (`kind` 3 = CoE, ...) and returns the
@@ -146,7 +151,11 @@ impl RawMailbox {
         kind: u8,
         data: &[u8],
     ) -> Option<(u8, Vec<u8>)> {
-        self.counter = self.counter % 7 + 1;
+        self.counter = if std::mem::take(&mut self.zero_next) {
+            0
+        } else {
+            self.counter % 7 + 1
+        };
         let mut frame = [0u8; MAILBOX_LEN];
         let len = data.len().min(MAILBOX_LEN - 6);
         frame[0..2].copy_from_slice(&(len as u16).to_le_bytes());
@@ -292,6 +301,19 @@ impl CoeClient {
             }
         }
         panic!("no reply to CoE request {coe:02x?}")
+    }
+
+    /// Leaves the mailbox to another master (ethercrab) without a counter
+    /// collision: one SDO upload of 1000h with counter 0, which resets the
+    /// drive's repeat detection (ETG.1000.4), so whatever counter the other
+    /// master sends next is new. Without it ethercrab's next request is
+    /// dropped as a repeat whenever its counter equals this client's last.
+    pub async fn hand_over<S>(&mut self, sd: &SubDeviceRef<'_, S>) {
+        self.mbx.zero_next = true;
+        let reply = self
+            .request(sd, &[0x00, 0x20, 0x40, 0x00, 0x10, 0x00, 0, 0, 0, 0])
+            .await;
+        assert_eq!(reply[2] >> 5, 2, "1000h upload: {reply:02x?}");
     }
 
     /// Sends one CoE message that gets no reply (an SDO abort request).

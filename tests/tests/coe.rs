@@ -214,6 +214,7 @@ fn e063_e064_e076_writable_entries_take_range_ends_and_default_preop_only_refuse
 
         // Safe-Op, then Op: entries writable in every state take their default,
         // Pre-Op-only entries answer 0800 0022h and keep their value
+        c.hand_over(&sd).await;
         let group = group.into_safe_op(md).await.expect("PRE-OP -> SAFE-OP");
         let sd = group.subdevice(md, 0).unwrap();
         let (accepted, refused) = state_writes(&sim, &sd, &mut c, SAFEOP).await;

@@ -728,3 +728,83 @@ fn c124_c127_touch_probe_single_shot_falling_only_and_rearm() {
         );
     });
 }
+
+#[test]
+fn c125_c126_touch_probe_example_1_continuous_both_edges() {
+    let sim = line(1);
+    // probe input 1 toggles at four positions: ↑p1 ↓p2 ↑p3 ↓p4
+    let marks: Vec<i64> = [2, 4, 6, 8]
+        .iter()
+        .map(|k| i64::from(REV) * k / 20 + 97 * k)
+        .collect();
+    with_drive(&sim, |d| {
+        d.motors[0].switches_mut().probe1 = PositionInput::toggles(false, &marks).unwrap();
+    });
+    with_master(&sim, async |md, clock| {
+        let group = init(md, clock).await.into_op(md).await.expect("OP");
+        let sd = group.subdevice(md, 0).unwrap();
+        // example 1: enabled (bit 0), continuous (bit 1), rising (bit 4) and falling (bit 5)
+        sd.sdo_write(0x60B8, 0, 0x0033u16).await.unwrap();
+        let mut m = Cyclic::new(md, &group, &sim, 0);
+        m.set_mode(9);
+        m.run(3).await;
+        m.enable().await;
+        m.set_target_velocity(REV / 2);
+        // past p2: the first pair is stored, both status bits on
+        m.run_until(3000, |t| i64::from(t.position) > marks[1] + i64::from(REV / 40))
+            .await
+            .expect("past p2");
+        let status: u16 = sd.sdo_read(0x60B9, 0).await.unwrap();
+        let rising: i32 = sd.sdo_read(0x60BA, 0).await.unwrap();
+        let falling: i32 = sd.sdo_read(0x60BB, 0).await.unwrap();
+        println!("example 1 after p2: 60B9h {status:#06x}, 60BAh {rising}, 60BBh {falling}");
+        assert_eq!(
+            status & 0x07,
+            0x07,
+            "enabled, rising and falling stored: {status:#06x}"
+        );
+        assert!((i64::from(rising) - marks[0]).abs() <= 1, "p1: {rising}");
+        assert!((i64::from(falling) - marks[1]).abs() <= 1, "p2: {falling}");
+        // past p4: every edge overwrote its value (continuous, C-125)
+        m.run_until(3000, |t| i64::from(t.position) > marks[3] + i64::from(REV / 40))
+            .await
+            .expect("past p4");
+        m.set_target_velocity(0);
+        m.run(100).await;
+        let status: u16 = sd.sdo_read(0x60B9, 0).await.unwrap();
+        let rising: i32 = sd.sdo_read(0x60BA, 0).await.unwrap();
+        let falling: i32 = sd.sdo_read(0x60BB, 0).await.unwrap();
+        println!(
+            "example 1 after p4: 60B9h {status:#06x}, 60BAh {rising} (p3 {}), 60BBh {falling} (p4 {})",
+            marks[2], marks[3]
+        );
+        assert_eq!(status & 0x07, 0x07, "still both stored: {status:#06x}");
+        assert!(
+            (i64::from(rising) - marks[2]).abs() <= 1,
+            "overwritten by p3: {rising}"
+        );
+        assert!(
+            (i64::from(falling) - marks[3]).abs() <= 1,
+            "overwritten by p4: {falling}"
+        );
+        // disabling clears the status bits, the values stay (C-126)
+        sd.sdo_write(0x60B8, 0, 0x0032u16).await.unwrap();
+        m.run(3).await;
+        let status: u16 = sd.sdo_read(0x60B9, 0).await.unwrap();
+        assert_eq!(status & 0x00FF, 0, "probe 1 status cleared: {status:#06x}");
+        let kept_r: i32 = sd.sdo_read(0x60BA, 0).await.unwrap();
+        let kept_f: i32 = sd.sdo_read(0x60BB, 0).await.unwrap();
+        assert_eq!((kept_r, kept_f), (rising, falling), "60BAh/60BBh kept");
+        // disabled: passing the edges again stores nothing
+        m.set_target_velocity(-REV / 2);
+        m.run_until(3000, |t| i64::from(t.position) < marks[0] - i64::from(REV / 40))
+            .await
+            .expect("back below p1");
+        m.set_target_velocity(0);
+        m.run(100).await;
+        let status: u16 = sd.sdo_read(0x60B9, 0).await.unwrap();
+        let still: i32 = sd.sdo_read(0x60BA, 0).await.unwrap();
+        assert_eq!(status & 0x07, 0, "nothing latched while disabled: {status:#06x}");
+        assert_eq!(still, rising, "60BAh unchanged while disabled");
+    });
+}

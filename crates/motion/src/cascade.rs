@@ -249,7 +249,8 @@ impl Cascade {
         self.config = config;
         self.integral_nm = self
             .integral_nm
-            .clamp(-config.torque_limit_negative_nm, config.torque_limit_positive_nm);
+            .max(-config.torque_limit_negative_nm)
+            .min(config.torque_limit_positive_nm);
         Ok(())
     }
 
@@ -299,7 +300,7 @@ impl Cascade {
                     finite_or_zero(input.velocity_inc_per_s)
                 };
                 let vmax = cfg.max_velocity_inc_per_s;
-                let command = raw_command.clamp(-vmax, vmax);
+                let command = raw_command.max(-vmax).min(vmax);
                 velocity_limited = command != raw_command;
 
                 let error_rad_per_s = (command - actual_velocity) * RAD_PER_INCREMENT;
@@ -318,7 +319,7 @@ impl Cascade {
                     let winds_up = (unsaturated >= lim_pos && increment > 0.0)
                         || (unsaturated <= -lim_neg && increment < 0.0);
                     if !winds_up {
-                        self.integral_nm = (self.integral_nm + increment).clamp(-lim_neg, lim_pos);
+                        self.integral_nm = (self.integral_nm + increment).max(-lim_neg).min(lim_pos);
                     }
                 } else {
                     self.integral_nm = 0.0;
@@ -347,7 +348,7 @@ impl Cascade {
             }
         };
 
-        let torque = torque_unlimited.clamp(-lim_neg, lim_pos);
+        let torque = torque_unlimited.max(-lim_neg).min(lim_pos);
         let torque_limited = torque != torque_unlimited;
         if input.entry == ControlEntry::Torque {
             // Track the output so a later switch to the velocity entry starts

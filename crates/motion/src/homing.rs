@@ -1086,7 +1086,7 @@ mod tests {
         fn follow(&mut self, out: &HomingOutput) {
             let sp = i64::from(out.position.wrapping_sub(self.offset));
             let p0 = self.raw;
-            let p1 = sp.clamp(self.stops.0, self.stops.1);
+            let p1 = sp.max(self.stops.0).min(self.stops.1);
             self.edges = [self.neg.edge(p0, p1), self.pos.edge(p0, p1), self.rs.edge(p0, p1)];
             self.index = self.index_between(p0, p1);
             self.torque = (sp - p1).abs() >= 50;

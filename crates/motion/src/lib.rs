@@ -63,4 +63,8 @@ impl Event {
     /// Event 78 "Cyclical position limit", cause 3 "Overrun of max.
     /// extrapolation period I423" (spec §10.1, C-117).
     pub const EXTRAPOLATION_OVERRUN: Event = Event { number: 78, cause: 3 };
+    /// Event 78 "Cyclical position limit", cause 4 "excessive set value
+    /// jump" (set-value monitoring, spec §13, C-148; the spec gives no
+    /// number, the cause is ours).
+    pub const SET_VALUE_JUMP: Event = Event { number: 78, cause: 4 };
 }

@@ -390,7 +390,9 @@ impl Limits {
     /// passes it. Unchanged when the software limits do not act.
     pub fn clamp_target(&self, target_inc: i32, referenced: bool) -> i32 {
         if referenced && self.config.software_limits_configured() {
-            target_inc.clamp(self.config.software_min_inc, self.config.software_max_inc)
+            target_inc
+                .max(self.config.software_min_inc)
+                .min(self.config.software_max_inc)
         } else {
             target_inc
         }

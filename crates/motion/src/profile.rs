@@ -521,7 +521,7 @@ impl ProfileGenerator {
             return Err(ProfileError::TargetVelocity);
         }
         let l = Lim::from(limits);
-        let vt = f64::from(target_velocity).clamp(-l.v, l.v);
+        let vt = f64::from(target_velocity).max(-l.v).min(l.v);
         let (base, frac, v, a) = self.current();
         let mut p = Plan::new(1.0, v, a);
         p.ramp_to(vt, l.acc, l.dec, l.jerk);

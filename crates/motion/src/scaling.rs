@@ -47,11 +47,12 @@ pub const fn polarity_inverted(polarity_607e: u8) -> bool {
 
 /// Rounds num/den to the nearest integer, half away from zero (den > 0).
 fn div_round(num: i128, den: i128) -> i128 {
+    // a zero denominator (no scaling configured) gives 0, not a panic
     let half = den / 2;
     if num >= 0 {
-        (num + half) / den
+        (num + half).checked_div(den).unwrap_or(0)
     } else {
-        -((-num + half) / den)
+        -(-num + half).checked_div(den).unwrap_or(0)
     }
 }
 
@@ -109,8 +110,19 @@ impl AxisScaling {
         }
     }
 
+    /// Whether user units equal increments (num = den, polarity normal): the
+    /// conversions are then the identity, without the 128-bit division
+    /// (a few hundred instructions on a Cortex-M each).
+    fn is_identity(&self) -> bool {
+        let (num, den) = self.ratio();
+        !self.inverted && num == den
+    }
+
     /// Increments → user units (rounded to the nearest unit).
     pub fn to_user(&self, increments: i64) -> Result<i64, ScalingError> {
+        if self.is_identity() {
+            return Ok(increments);
+        }
         let (num, den) = self.ratio();
         let u = div_round(self.sign() * i128::from(increments) * num, den);
         i64::try_from(u).map_err(|_| ScalingError::Overflow)
@@ -118,6 +130,9 @@ impl AxisScaling {
 
     /// User units → increments (rounded to the nearest increment).
     pub fn to_increments(&self, user: i64) -> Result<i64, ScalingError> {
+        if self.is_identity() {
+            return Ok(user);
+        }
         let (num, den) = self.ratio();
         let inc = div_round(self.sign() * i128::from(user) * den, num);
         i64::try_from(inc).map_err(|_| ScalingError::Overflow)
@@ -178,13 +193,18 @@ impl ModuloAxis {
 
     /// `position` wrapped into 0 … length − 1.
     pub const fn wrap(&self, position: i64) -> i64 {
-        position.rem_euclid(self.length)
+        match position.checked_rem_euclid(self.length) {
+            Some(p) => p,
+            None => position,
+        }
     }
 
     /// Distance to travel from `from` to the modulo position `to` (both taken
     /// modulo the length) in the given direction.
     pub fn distance(&self, from: i64, to: i64, direction: ModuloDirection) -> i64 {
-        let d = (i128::from(to) - i128::from(from)).rem_euclid(i128::from(self.length));
+        let d = (i128::from(to) - i128::from(from))
+            .checked_rem_euclid(i128::from(self.length))
+            .unwrap_or(0);
         // 0 ≤ d < length ≤ i64::MAX.
         let d = d as i64;
         match direction {

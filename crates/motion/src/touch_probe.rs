@@ -83,7 +83,7 @@ pub fn interpolate_position(previous: PositionSample, current: PositionSample, e
     if current.time_ns <= previous.time_ns {
         return current.position_inc;
     }
-    let t = edge_time_ns.clamp(previous.time_ns, current.time_ns);
+    let t = edge_time_ns.max(previous.time_ns).min(current.time_ns);
     let span = i128::from(current.time_ns - previous.time_ns);
     let elapsed = i128::from(t - previous.time_ns);
     let delta = i128::from(current.position_inc.wrapping_sub(previous.position_inc));

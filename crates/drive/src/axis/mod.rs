@@ -45,10 +45,17 @@
 //! when the caller says one arrived; 60C2h over A150 gives their ratio N
 //! (60C2h is copied into A291, C-114; an invalid ratio falls back to N = 1).
 //!
-//! Homing uses `motion::homing` (in work by its author): the seam is
-//! [`Axis`]'s `run_homing` (config from 6098h/6099h/609Ah/607Ch and
-//! [`AxisParams`], inputs from [`AxisIo`]), the reference event shifts the
-//! position offset.
+//! Homing uses `motion::homing`: the seam is [`Axis`]'s `run_homing`
+//! (config from 6098h/6099h/609Ah/607Ch and [`AxisParams`], inputs from
+//! [`AxisIo`], with the latched index pulse and, when the hardware has them,
+//! the latched switch changes [`AxisIo::switch_edges`]); the reference event
+//! shifts the position offset.
+//!
+//! pp, pv and vl apply the velocity override A340 (C-030). The switch
+//! signals come from the inputs or, with I101/I102/I103 = 2, from I210
+//! (C-104); E80 shows a limitation (C-107), A67 is assembled from the
+//! sources in A66 (C-143), E47/E49 name the causes of Switch on disabled
+//! (C-015), I46 = 5 makes the encoder position the reference (C-112).
 //!
 //! # Coordinates
 //!
@@ -62,7 +69,8 @@
 //!
 //! Following error (6065h/6066h with [`AxisParams::following_error_fault`]),
 //! limit switches (event 53), the extrapolation overrun of the interpolators
-//! (event 78 cause 3) raise a fault in the device control; on T13 the axis
+//! (event 78 cause 3) and an excessive set-value jump of the master (event 78
+//! cause 4, C-148) raise a fault in the device control; on T13 the axis
 //! returns the EMCY ([`Emcy::for_event`]) and sets 603Fh and its error
 //! register, on T15 it returns [`Emcy::fault_cleared`].
 
@@ -82,8 +90,9 @@ use motion::cycle::{application_cycle_ns, interpolation_period_ns};
 use motion::homing::{Homing, HomingConfig, HomingInput, SwitchInput};
 use motion::interp::from_i425;
 use motion::limits::{
-    DirectionLock, LimitConfig, LimitInput, Limits, SoftLimitReaction, StopRamp, SwitchPolarity,
+    DenialCause, DirectionLock, LimitConfig, LimitInput, Limits, SoftLimitReaction, StopRamp, SwitchPolarity,
 };
+use motion::scaling::{AxisScaling, ModuloAxis, ModuloDirection};
 use motion::touch_probe::{interpolate_position, Edge, PositionSample, TouchProbe, TriggerSignal};
 use motion::windows::{
     is_standstill, ms_to_ns, FollowingErrorConfig, FollowingErrorMonitor, PositionWindowConfig,
@@ -93,7 +102,10 @@ use motion::{
     CycleRatio, Event, FineInterpolator, InterpolatorConfig, MasterSetpoint, PositionTarget,
     ProfileGenerator, ProfileLimits, SetMode, VelocityInterpolator, INCREMENTS_PER_REVOLUTION,
 };
-use snapshot::{Snapshot, Window, A291, E48};
+use snapshot::{Snapshot, Window, A291, A67, E47, E48, E49, E80};
+
+/// The permitted direction of an endless axis (I04), for [`AxisParams::limits`].
+pub use motion::limits::PermittedDirection;
 
 /// Increments per revolution as `f32`.
 const REV: f32 = INCREMENTS_PER_REVOLUTION as f32;
@@ -125,6 +137,29 @@ pub struct ProbeEdge {
     pub position_inc: Option<i32>,
 }
 
+/// A limit or reference switch input.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum SwitchId {
+    /// Positive hardware limit switch (I441).
+    PositiveLimit,
+    /// Negative hardware limit switch (I442).
+    NegativeLimit,
+    /// Reference (home) switch.
+    Reference,
+}
+
+/// A change of a limit or reference switch latched by the hardware in this
+/// cycle (time-stamped input, spec §12): homing takes its reference from the
+/// latched position instead of the position of the cycle that sees the new
+/// level.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub struct SwitchEdge {
+    /// Which switch changed.
+    pub switch: SwitchId,
+    /// Encoder position at the change, increments (motor coordinates).
+    pub position_inc: i32,
+}
+
 /// What the hardware (board driver or simulated motor) reports for one axis
 /// at the start of a control cycle.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
@@ -144,6 +179,9 @@ pub struct AxisIo {
     pub reference: bool,
     /// Touch-probe input edges since the last cycle (up to 4).
     pub probe_edges: [Option<ProbeEdge>; 4],
+    /// Limit/reference switch changes latched since the last cycle (up to
+    /// 4; none: homing uses the position of the cycle that sees the level).
+    pub switch_edges: [Option<SwitchEdge>; 4],
     /// Additional enable A60 active.
     pub additional_enable: bool,
     /// Supply and DC link present.
@@ -163,6 +201,7 @@ impl AxisIo {
             limit_negative: false,
             reference: false,
             probe_edges: [None; 4],
+            switch_edges: [None; 4],
             additional_enable: true,
             supply_ok: true,
             sto_active: false,
@@ -209,7 +248,9 @@ pub struct AxisParams {
     /// 6076h rated torque, N·m (motor data); 0.1 % torque objects refer to it.
     pub rated_torque_nm: f32,
     /// Cascade gains and limits. The torque limits are replaced by 6072h, the
-    /// speed feedforward weight is applied by the interpolator (I25 below).
+    /// speed feedforward weight is applied by the interpolator (I25 below);
+    /// the inertia (motor data) turns the generators' acceleration into
+    /// torque feedforward.
     pub cascade: CascadeConfig,
     /// I25 speed feedforward of ip/csp, % (0 … 100).
     pub feedforward_percent: f32,
@@ -234,6 +275,10 @@ pub struct AxisParams {
     pub limits: LimitConfig,
     /// C-050: absolute pp moves need a referenced axis.
     pub absolute_needs_reference: bool,
+    /// C-148 set-value monitoring: a cyclic position set-point further from
+    /// the previous one than twice 607Fh over the time between them trips
+    /// event 78 cause 4 "excessive set value jump".
+    pub set_value_monitoring: bool,
     /// I12 jog velocity, inc/s.
     pub jog_velocity: f32,
     /// I13 jog acceleration, inc/s².
@@ -265,14 +310,18 @@ pub struct AxisParams {
 }
 
 impl Default for AxisParams {
-    /// Rated torque 1.3 N·m, the cascade defaults, I25 = 100 %, I425 = 0,
+    /// Rated torque 1.3 N·m, the cascade defaults with an inertia of 1e-4
+    /// kg·m² (the simulated servo), I25 = 100 %, I425 = 0,
     /// I423 = 10 ms, C40 = 0.1 rev/s, I22 = 1/360 rev, following error as
     /// bit 13 only, no limit switches, jog 1 rev/s with 10 rev/s², I26 = 1,
     /// no jerk limits, stops settle 10 ms.
     fn default() -> Self {
         Self {
             rated_torque_nm: 1.3,
-            cascade: CascadeConfig::DEFAULT,
+            cascade: CascadeConfig {
+                inertia_kg_m2: 1.0e-4,
+                ..CascadeConfig::DEFAULT
+            },
             feedforward_percent: 100.0,
             interpolation_i425: 0,
             max_extrapolation_ns: 10_000_000,
@@ -283,6 +332,7 @@ impl Default for AxisParams {
             following_error_fault: false,
             limits: LimitConfig::default(),
             absolute_needs_reference: true,
+            set_value_monitoring: true,
             jog_velocity: REV,
             jog_acceleration: 10.0 * REV,
             jog_deceleration: 10.0 * REV,
@@ -397,6 +447,26 @@ pub struct Axis {
     error_register: u8,
     /// vl demand (6043h), inc/s.
     vl_demand: f32,
+    /// I90 cause of this cycle's direction lock (E80).
+    denial: Option<DenialCause>,
+    /// I46 = 5 with I02 = 0: the encoder position is the reference (C-112).
+    retained: bool,
+    /// The pp target being approached (override re-plans, C-030).
+    pp_target: Option<i32>,
+    /// The A340 override the pp move was planned with, %.
+    pp_override: u16,
+    /// Last cyclic position set-point of the master (C-148) and the time
+    /// since it arrived, ns.
+    last_master_sp: Option<i32>,
+    sp_age_ns: u64,
+    /// 6091h/6092h of this cycle (C-109).
+    scaling: AxisScaling,
+    /// 10^A310 with A213 = 0, else 1 (C-142).
+    velocity_decimals: f32,
+    /// Endless axis (I00 = 1) with 607Bh:02 > 0, user units (C-111).
+    modulo: Option<ModuloAxis>,
+    /// The last cyclic set-point of an endless axis as sent (user units).
+    last_master_user: Option<i64>,
 }
 
 impl Axis {
@@ -451,6 +521,16 @@ impl Axis {
             error_code: 0,
             error_register: 0,
             vl_demand: 0.0,
+            denial: None,
+            retained: false,
+            pp_target: None,
+            pp_override: 100,
+            last_master_sp: None,
+            sp_age_ns: 0,
+            scaling: AxisScaling::INCREMENTAL,
+            velocity_decimals: 1.0,
+            modulo: None,
+            last_master_user: None,
         }
     }
 
@@ -501,9 +581,10 @@ impl Axis {
         self.shift_coordinates(shift);
     }
 
-    /// The axis is referenced (homing done since power-on).
+    /// The axis is referenced: homing done since power-on, or reference
+    /// retaining I46 = 5 (direct absolute) on the motor encoder (C-112).
     pub fn is_referenced(&self) -> bool {
-        self.homing.is_referenced()
+        self.homing.is_referenced() || self.retained
     }
 
     /// 603Fh error code of the fault being handled (0 = none).
@@ -538,10 +619,20 @@ impl Axis {
         now_ns: u64,
         new_setpoint: bool,
     ) -> AxisReport {
-        let o = Snapshot::read(od, self.window);
+        let raw = Snapshot::read(od, self.window);
+        // C-109: user units at the objects, increments inside
+        self.scaling = raw.scaling();
+        self.velocity_decimals = raw.decimal_factors().0 as f32;
+        let o = raw.to_increments(&self.scaling);
+        self.modulo = if self.params.limits.endless_axis && o.modulo_length > 0 {
+            ModuloAxis::new(i64::from(o.modulo_length)).ok()
+        } else {
+            None
+        };
         let dt_ns =
             application_cycle_ns(u32::from(o.control_cycle_us).saturating_mul(1000)).unwrap_or(1_000_000);
         self.configure(od, &o, dt_ns);
+        let io = &sourced(io, &o);
 
         let mut actual = self.feedback(io, o.polarity, dt_ns, now_ns);
         let i199 = is_standstill(self.velocity, self.params.velocity_window_inc_per_s);
@@ -553,10 +644,11 @@ impl Axis {
             position_setpoint_inc: self.sp_pos,
             positive_switch_signal: io.limit_positive,
             negative_switch_signal: io.limit_negative,
-            referenced: self.homing.is_referenced(),
+            referenced: self.is_referenced(),
             referencing: homing_active && self.homing.is_referencing(),
         });
         self.lock = status.lock;
+        self.denial = status.denial;
         if let Some(ev) = status.event {
             self.raise(ev);
         }
@@ -609,6 +701,8 @@ impl Axis {
 
         self.prev_cw = o.controlword;
         self.write_back(od, &out, bits, actual, torque, fe);
+        self.user_statusword(od, &o);
+        self.switch_on_disabled_causes(od, &out, io, o.controlword);
         self.digital_inputs(od, io);
 
         let sign = if o.polarity & 0x80 != 0 { -1.0 } else { 1.0 };
@@ -694,6 +788,7 @@ impl Axis {
         });
         // C-091: jog under velocity control (I26 = 0) quick-stops at a
         // software limit instead of faulting
+        self.retained = o.i46 == 5 && o.i02 == 0;
         let soft_limit_reaction = if self.running == Some(Mode::Jog) && !p.jog_position_control {
             SoftLimitReaction::QuickStop
         } else {
@@ -705,6 +800,9 @@ impl Axis {
             window_inc: p.position_window_inc,
             switch_polarity: SwitchPolarity::HighActive,
             soft_limit_reaction,
+            // I101/I102 (C-104) switch the evaluation on as well
+            positive_switch: p.limits.positive_switch || o.switch_source[0] != 0,
+            negative_switch: p.limits.negative_switch || o.switch_source[1] != 0,
             ..p.limits
         });
     }
@@ -904,10 +1002,11 @@ impl Axis {
         }
     }
 
+    /// The pp limits: 6081h × A340 (C-030), capped by 607Fh.
     fn profile_limits(&self, o: &Snapshot) -> ProfileLimits {
         let cap = o.max_profile_velocity as f32;
         ProfileLimits {
-            velocity: (o.profile_velocity as f32).min(cap),
+            velocity: (o.profile_velocity as f32 * override_factor(o)).min(cap),
             acceleration: o.acceleration as f32,
             deceleration: o.deceleration as f32,
             jerk: jerk(o.jerk),
@@ -981,6 +1080,10 @@ impl Axis {
         self.velocity_window.reset();
         // a bit 4 already set is no edge (pp, homing)
         self.prev_cw = o.controlword;
+        self.pp_target = None;
+        self.last_master_sp = None;
+        self.last_master_user = None;
+        self.sp_age_ns = 0;
         match mode {
             Mode::CyclicPosition | Mode::InterpolatedPosition => {
                 if let Some(i) = self.interp.as_mut() {
@@ -996,6 +1099,14 @@ impl Axis {
                 self.pt_torque = self.last_out.map_or(0.0, |c| c.torque_nm);
             }
             Mode::Homing => self.homing.activate(actual),
+            Mode::ProfilePosition => {
+                // entered while moving (from pv, vl, jog): no target yet, so
+                // brake with 6084h instead of cruising on
+                self.profile.take_over(self.sp_pos, self.sp_vel);
+                if self.sp_vel != 0.0 {
+                    let _ = self.profile.stop(o.deceleration as f32, jerk(o.jerk));
+                }
+            }
             _ => self.profile.take_over(self.sp_pos, self.sp_vel),
         }
     }
@@ -1060,17 +1171,57 @@ impl Axis {
         let ip = mode == Mode::InterpolatedPosition;
         let enabled = !ip || o.controlword & CW_MODE_BIT4 != 0;
         let torque = self.per_mille(i32::from(o.torque_offset));
-        let Some(interp) = self.interp.as_mut() else {
-            return Demand::hold(self.sp_pos);
-        };
         if !enabled {
-            interp.start(self.sp_pos);
+            if let Some(interp) = self.interp.as_mut() {
+                interp.start(self.sp_pos);
+            }
+            self.last_master_sp = None;
+            self.last_master_user = None;
             return Demand {
                 torque,
                 ..Demand::hold(self.sp_pos)
             };
         }
-        let target = if ip { o.ip_setpoint } else { o.target_position };
+        let target = match self.modulo {
+            // C-111: the master sends wrapped positions; unwrapped the short way
+            Some(m) if new_setpoint => {
+                let sent = i64::from(if ip {
+                    o.ip_setpoint_user
+                } else {
+                    o.target_position_user
+                });
+                let (base, base_user) = match (self.last_master_sp, self.last_master_user) {
+                    (Some(b), Some(u)) => (b, u),
+                    _ => (self.sp_pos, self.user_position(self.sp_pos)),
+                };
+                self.last_master_user = Some(m.wrap(sent));
+                base.wrapping_add(self.increments(m.distance(base_user, sent, ModuloDirection::Shortest)))
+            }
+            Some(_) => self.last_master_sp.unwrap_or(self.sp_pos),
+            None if ip => o.ip_setpoint,
+            None => o.target_position,
+        };
+        // C-148: set-value monitoring of the master's steps
+        let master_ns = self.ratio.map_or(0, |r| u64::from(r.master_ns()));
+        self.sp_age_ns = self
+            .sp_age_ns
+            .saturating_add(u64::from(self.ratio.map_or(0, |r| r.control_ns())));
+        if new_setpoint {
+            let from = self.last_master_sp.unwrap_or(self.sp_pos);
+            let step = target.wrapping_sub(from).unsigned_abs() as f32;
+            let elapsed_s = self.sp_age_ns.max(master_ns) as f32 * 1e-9;
+            let allowed =
+                2.0 * o.max_profile_velocity as f32 * elapsed_s + self.params.position_window_inc as f32;
+            self.last_master_sp = Some(target);
+            self.sp_age_ns = 0;
+            if self.params.set_value_monitoring && step > allowed {
+                self.raise(Event::SET_VALUE_JUMP);
+                return Demand::hold(self.sp_pos);
+            }
+        }
+        let Some(interp) = self.interp.as_mut() else {
+            return Demand::hold(self.sp_pos);
+        };
         let sp = new_setpoint.then_some(MasterSetpoint {
             position: target,
             velocity_offset: o.velocity_offset as f32,
@@ -1129,6 +1280,7 @@ impl Axis {
         if halt && !self.halting {
             let _ = self.profile.stop(o.deceleration as f32, jerk(o.jerk));
             self.halting = true;
+            self.pp_target = None;
         } else if !halt && self.halting {
             self.halting = false;
         }
@@ -1138,8 +1290,28 @@ impl Axis {
         if !bit4 {
             self.pp_ack = false;
         }
+        // C-030: a changed override re-plans the running move (0 % pauses it)
+        if o.override_percent != self.pp_override && !self.halting {
+            self.pp_override = o.override_percent;
+            if let Some(t) = self.pp_target {
+                let _ = if o.override_percent == 0 {
+                    self.profile.stop(o.deceleration as f32, jerk(o.jerk))
+                } else {
+                    self.profile
+                        .move_to(
+                            PositionTarget::Absolute(t),
+                            self.profile_limits(o),
+                            SetMode::Immediate,
+                        )
+                        .map(|_| ())
+                };
+            }
+        }
         let s = self.profile.step(dt_ns);
-        let target = self.profile.target();
+        let target = self.pp_target.unwrap_or(self.profile.target());
+        if s.done && s.position == target {
+            self.pp_target = None;
+        }
         let reached = if self.halting {
             s.done
         } else {
@@ -1166,7 +1338,28 @@ impl Axis {
         let cw = o.controlword;
         let d = o.target_position;
         let (target, resolved, relative) = if cw & CW_MODE_BIT6 == 0 {
-            (PositionTarget::Absolute(d), d, false)
+            match self.modulo {
+                // C-111: a position within the revolution length, reached the
+                // way 60F2h bits 7..6 say (01 negative, 10 positive, else the
+                // shorter way); outside the length the move is refused (I90 = 10)
+                Some(m) => {
+                    let t = i64::from(o.target_position_user);
+                    if t < 0 || t >= m.length() {
+                        return;
+                    }
+                    let dir = match (o.positioning_option >> 6) & 0b11 {
+                        0b01 => ModuloDirection::Negative,
+                        0b10 => ModuloDirection::Positive,
+                        _ => ModuloDirection::Shortest,
+                    };
+                    let from = self.user_position(self.sp_pos);
+                    let p = self
+                        .sp_pos
+                        .wrapping_add(self.increments(m.distance(from, t, dir)));
+                    (PositionTarget::Absolute(p), p, false)
+                }
+                None => (PositionTarget::Absolute(d), d, false),
+            }
         } else if o.positioning_option & 0b11 == 0b10 {
             (
                 PositionTarget::Relative { distance: d, actual },
@@ -1176,11 +1369,11 @@ impl Axis {
         } else {
             (
                 PositionTarget::Additive(d),
-                self.profile.target().wrapping_add(d),
+                self.pp_target.unwrap_or(self.profile.target()).wrapping_add(d),
                 true,
             )
         };
-        let refused = (!relative && self.params.absolute_needs_reference && !self.homing.is_referenced())
+        let refused = (!relative && self.params.absolute_needs_reference && !self.is_referenced())
             || (relative && self.limits.relative_move_exceeds_computing_limit(i64::from(d)))
             || self.lock.refuses_move(self.sp_pos, resolved);
         if refused {
@@ -1191,14 +1384,27 @@ impl Axis {
         } else {
             SetMode::WhenStandstill
         };
+        if o.override_percent == 0 {
+            // paused by the override: taken over, started when A340 > 0
+            self.pp_target = Some(resolved);
+            self.pp_override = 0;
+            self.pp_ack = true;
+            self.in_position.reset();
+            return;
+        }
         if let Ok(true) = self.profile.move_to(target, self.profile_limits(o), mode) {
+            self.pp_target = Some(self.profile.target());
+            self.pp_override = o.override_percent;
             self.pp_ack = true;
             self.in_position.reset();
         }
     }
 
     fn profile_velocity(&mut self, o: &Snapshot, halt: bool, now_ns: u64, dt_ns: u32) -> Demand {
-        let target = self.lock.filter_velocity(o.target_velocity as f32);
+        // C-030: 60FFh × A340
+        let target = self
+            .lock
+            .filter_velocity(o.target_velocity as f32 * override_factor(o));
         if halt {
             if !self.halting {
                 let _ = self.profile.stop(o.deceleration as f32, jerk(o.jerk));
@@ -1244,7 +1450,7 @@ impl Axis {
         let max = self.per_mille(i32::from(o.max_torque));
         let target = self
             .lock
-            .filter_torque(self.per_mille(i32::from(o.target_torque)).clamp(-max, max));
+            .filter_torque(self.per_mille(i32::from(o.target_torque)).max(-max).min(max));
         let slope = self.per_mille(i32::try_from(o.torque_slope).unwrap_or(i32::MAX)) * dt_ns as f32 * 1e-9;
         let diff = target - self.pt_torque;
         self.pt_torque = if o.torque_slope == 0 || diff.abs() <= slope {
@@ -1268,7 +1474,7 @@ impl Axis {
         let cw = o.controlword;
         let max = o.vl_max as f32;
         let min = o.vl_min as f32;
-        let mut rpm = f32::from(o.vl_target).clamp(-max, max);
+        let mut rpm = (f32::from(o.vl_target) * override_factor(o)).max(-max).min(max);
         if rpm != 0.0 && rpm.abs() < min {
             rpm = min.copysign(rpm);
         }
@@ -1315,12 +1521,30 @@ impl Axis {
             max_search_distance: 0,
             limit_as_reference: p.homing_limit_as_reference,
         };
-        let switch = |active: bool| SwitchInput { active, edge: None };
+        // the latest latched change of each switch in this cycle, user coordinates
+        let edge = |id: SwitchId| {
+            io.switch_edges
+                .iter()
+                .flatten()
+                .rfind(|e| e.switch == id)
+                .map(|e| self.to_user(e.position_inc, o.polarity))
+        };
+        let switch = |active: bool, id: SwitchId| SwitchInput {
+            active,
+            edge: edge(id),
+        };
+        let limits = self.limits.config();
         let input = HomingInput {
             actual_position: *actual,
-            negative_limit: switch(p.limits.negative_switch && io.limit_negative),
-            positive_limit: switch(p.limits.positive_switch && io.limit_positive),
-            reference_switch: switch(io.reference),
+            negative_limit: switch(
+                limits.negative_switch && io.limit_negative,
+                SwitchId::NegativeLimit,
+            ),
+            positive_limit: switch(
+                limits.positive_switch && io.limit_positive,
+                SwitchId::PositiveLimit,
+            ),
+            reference_switch: switch(io.reference, SwitchId::Reference),
             index: io.index.map(|i| self.to_user(i.position_inc, o.polarity)),
             torque_limit: self.last_out.is_some_and(|c| c.torque_limited),
             standstill: i199,
@@ -1356,7 +1580,7 @@ impl Axis {
             deceleration: p.jog_deceleration,
             jerk: p.jog_jerk,
         };
-        let referenced = self.homing.is_referenced();
+        let referenced = self.is_referenced();
         let soft = referenced && self.limits.config().software_limits_configured();
         let target = self.lock.filter_velocity(dir * p.jog_velocity);
         if self.commanded_velocity != Some(target) {
@@ -1469,22 +1693,34 @@ impl Axis {
             sw |= bits & SW_INTERNAL_LIMIT;
         }
         w.put(od, 0x6041, 0, i64::from(sw));
+        let e80 = match self.denial {
+            Some(DenialCause::IllegalDirection) => 15,
+            Some(
+                DenialCause::HardwarePositive
+                | DenialCause::HardwareNegative
+                | DenialCause::SoftwarePositive
+                | DenialCause::SoftwareNegative,
+            ) => 20,
+            _ => 0,
+        };
+        let _ = od.set(w.manufacturer(E80), 0, e80);
         w.put(od, 0x6061, 0, i64::from(out.mode_display));
-        w.put(od, 0x6064, 0, i64::from(actual));
-        w.put(od, 0x606C, 0, i64::from(round_i32(self.velocity)));
+        w.put(od, 0x6064, 0, self.user_position(actual));
+        let v = self.scaling.velocity_to_user(self.velocity) * self.velocity_decimals;
+        w.put(od, 0x606C, 0, i64::from(round_i32(v)));
         let rated = self.params.rated_torque_nm;
         let per_mille = if rated > 0.0 { torque / rated * 1000.0 } else { 0.0 };
         let t = i64::from(round_i32(per_mille)).clamp(i64::from(i16::MIN), i64::from(i16::MAX));
         w.put(od, 0x6077, 0, t);
         w.put(od, 0x6078, 0, t);
         w.put(od, 0x6076, 0, i64::from(round_i32(rated * 1000.0).max(0)));
-        w.put(od, 0x60F4, 0, i64::from(fe));
+        w.put(od, 0x60F4, 0, self.user(fe));
         w.put(od, 0x60B9, 0, i64::from(self.probe.status()));
-        w.put(od, 0x60BA, 0, i64::from(self.probe.value_60ba()));
-        w.put(od, 0x60BB, 0, i64::from(self.probe.value_60bb()));
-        w.put(od, 0x60BC, 0, i64::from(self.probe.value_60bc()));
-        w.put(od, 0x60BD, 0, i64::from(self.probe.value_60bd()));
-        w.put(od, 0x60E4, 1, i64::from(actual));
+        w.put(od, 0x60BA, 0, self.user_position(self.probe.value_60ba()));
+        w.put(od, 0x60BB, 0, self.user_position(self.probe.value_60bb()));
+        w.put(od, 0x60BC, 0, self.user_position(self.probe.value_60bc()));
+        w.put(od, 0x60BD, 0, self.user_position(self.probe.value_60bd()));
+        w.put(od, 0x60E4, 1, self.user_position(actual));
         w.put(
             od,
             0x6043,
@@ -1498,6 +1734,79 @@ impl Axis {
             i64::from(round_i32(self.velocity / RPM_TO_INC_PER_S)).clamp(-32768, 32767),
         );
         let _ = od.set(w.manufacturer(E48), 0, i64::from(e48(out.state)));
+    }
+
+    /// A position (or distance) in increments as the objects show it: user
+    /// units of 6091h/6092h (C-109), wrapped to 32 bits like the counter.
+    fn user(&self, increments: i32) -> i64 {
+        let u = self
+            .scaling
+            .to_user(i64::from(increments))
+            .unwrap_or(i64::from(increments));
+        i64::from(u as i32)
+    }
+
+    /// A position in increments as the objects show it: user units,
+    /// wrapped into 0 … 607Bh:02 − 1 on an endless axis (C-111).
+    fn user_position(&self, increments: i32) -> i64 {
+        match self.modulo {
+            Some(m) => m.wrap(
+                self.scaling
+                    .to_user(i64::from(increments))
+                    .unwrap_or(i64::from(increments)),
+            ),
+            None => self.user(increments),
+        }
+    }
+
+    /// Increments of a distance in user units (saturating).
+    fn increments(&self, user: i64) -> i32 {
+        let v = self.scaling.to_increments(user).unwrap_or(user);
+        i32::try_from(v).unwrap_or(if v < 0 { i32::MIN } else { i32::MAX })
+    }
+
+    /// E47 (first cause) and E49 (all causes) of Switch on disabled
+    /// (C-015): STO, supply, additional enable A60, and the controlword
+    /// (no Shutdown command). Both 0 outside Switch on disabled.
+    fn switch_on_disabled_causes(&self, od: &mut DriveObjects, out: &Outputs, io: &AxisIo, cw: u16) {
+        let mut causes = 0u8;
+        if out.state == State::SwitchOnDisabled {
+            // Shutdown = xxxx x110 (bit 7 clear): anything else keeps SOD
+            let shutdown = cw & 0x0087 == 0x0006;
+            for (bit, present) in [
+                (0, io.sto_active),
+                (1, !io.supply_ok),
+                (2, !io.additional_enable),
+                (3, !shutdown),
+            ] {
+                if present {
+                    causes |= 1 << bit;
+                }
+            }
+        }
+        let first = if causes == 0 {
+            0
+        } else {
+            causes.trailing_zeros() as u8 + 1
+        };
+        let _ = od.set(self.window.manufacturer(E47), 0, i64::from(first));
+        let _ = od.set(self.window.manufacturer(E49), 0, i64::from(causes));
+    }
+
+    /// A67 from the sources in A66 (C-143): bit k is bit `b` of the entry
+    /// `index`:`sub` that element k names (index << 16 | sub << 8 | b;
+    /// 0 or an unreadable entry: the bit is 0).
+    fn user_statusword(&self, od: &mut DriveObjects, o: &Snapshot) {
+        let mut a67 = 0u16;
+        for (k, &src) in o.a66.iter().enumerate() {
+            let index = (src >> 16) as u16;
+            let sub = (src >> 8) as u8;
+            let bit = src & 0xFF;
+            if src != 0 && bit < 64 && od.get(index, sub).is_ok_and(|v| (v >> bit) & 1 != 0) {
+                a67 |= 1 << k;
+            }
+        }
+        let _ = od.set(self.window.manufacturer(A67), 0, i64::from(a67));
     }
 
     /// The switch levels in 60FDh (bit 0 negative limit, bit 1 positive
@@ -1514,20 +1823,60 @@ impl Axis {
 pub const GAIN_REFERENCE_CYCLE_NS: u32 = 250_000;
 
 /// The gains of `c` for a control cycle of `dt_ns`: above
-/// [`GAIN_REFERENCE_CYCLE_NS`] the position gain Kv and the velocity gain Kp
-/// shrink by reference / cycle and the integral time Ti grows by the
-/// inverse, so the loop keeps its phase margin with the longer dead time
-/// (the default A150 is 1 ms: Kv 25 /s, Kp 0.015 N·m·s/rad, Ti 32 ms).
+/// [`GAIN_REFERENCE_CYCLE_NS`] the velocity gain Kp shrinks by r =
+/// reference / cycle and the integral time Ti grows by 1/r, so the velocity
+/// loop keeps its phase margin with the longer dead time; the position gain
+/// Kv shrinks only by √r (the position loop is slower than the velocity loop
+/// by more than √r still) to keep the stiffness against friction (the
+/// default A150 is 1 ms: Kv 50 /s, Kp 0.015 N·m·s/rad, Ti 32 ms).
 pub fn scaled_gains(c: &CascadeConfig, dt_ns: u32) -> CascadeConfig {
     if dt_ns <= GAIN_REFERENCE_CYCLE_NS {
         return *c;
     }
-    let f = GAIN_REFERENCE_CYCLE_NS as f32 / dt_ns as f32;
+    let r = GAIN_REFERENCE_CYCLE_NS as f32 / dt_ns as f32;
     CascadeConfig {
-        position_gain_per_s: c.position_gain_per_s * f,
-        velocity_gain_nm_per_rad_per_s: c.velocity_gain_nm_per_rad_per_s * f,
-        velocity_integral_time_ns: (c.velocity_integral_time_ns as f32 / f) as u32,
+        position_gain_per_s: c.position_gain_per_s * sqrt(r),
+        velocity_gain_nm_per_rad_per_s: c.velocity_gain_nm_per_rad_per_s * r,
+        velocity_integral_time_ns: (c.velocity_integral_time_ns as f32 / r) as u32,
         ..*c
+    }
+}
+
+/// The A340 velocity override as a factor (C-030).
+fn override_factor(o: &Snapshot) -> f32 {
+    f32::from(o.override_percent) * 0.01
+}
+
+/// The switch signals after their sources (C-104): I101/I102/I103 = 2 take
+/// them from I210 bits 0/1/2 (1 = actuated), 0 turns the reference switch
+/// off; the limit switches with source 0 stay as wired (their evaluation is
+/// off unless [`AxisParams::limits`] switches it on).
+fn sourced(io: &AxisIo, o: &Snapshot) -> AxisIo {
+    let bit = |n: u16| o.i210 & (1 << n) != 0;
+    let [pos, neg, reference] = o.switch_source;
+    // latched edges belong to the hardware inputs only
+    let mut switch_edges = io.switch_edges;
+    for slot in &mut switch_edges {
+        let hardware = match slot.map(|e| e.switch) {
+            Some(SwitchId::PositiveLimit) => pos != 2,
+            Some(SwitchId::NegativeLimit) => neg != 2,
+            Some(SwitchId::Reference) => reference == 1,
+            None => true,
+        };
+        if !hardware {
+            *slot = None;
+        }
+    }
+    AxisIo {
+        switch_edges,
+        limit_positive: if pos == 2 { bit(0) } else { io.limit_positive },
+        limit_negative: if neg == 2 { bit(1) } else { io.limit_negative },
+        reference: match reference {
+            0 => false,
+            2 => bit(2),
+            _ => io.reference,
+        },
+        ..*io
     }
 }
 
@@ -1571,4 +1920,17 @@ pub const fn e48(state: State) -> u8 {
         State::FaultReactionActive => 6,
         State::QuickStopActive => 7,
     }
+}
+
+/// Square root without `std` (Newton steps from a bit-level first guess);
+/// `x` ≤ 0 or not finite gives 0.
+fn sqrt(x: f32) -> f32 {
+    if !(x.is_finite() && x > 0.0) {
+        return 0.0;
+    }
+    let mut r = f32::from_bits((x.to_bits() >> 1) + 0x1FC0_0000);
+    for _ in 0..4 {
+        r = 0.5 * (r + x / r);
+    }
+    r
 }

@@ -9,6 +9,7 @@
 
 use crate::dictionary::DriveObjects;
 use crate::{parameter_index, AXIS_B_CIA402, AXIS_B_MANUFACTURER};
+use motion::scaling::AxisScaling;
 
 /// 1 rev = 2^20 increments (6092h default feed).
 const REV: i64 = 1 << 20;
@@ -17,8 +18,31 @@ const REV: i64 = 1 << 20;
 pub(crate) const A150: u16 = parameter_index(0, 150);
 /// A291 PLC cycle time (µs, global), the copy of 60C2h (C-114).
 pub(crate) const A291: u16 = parameter_index(0, 291);
+/// E47 / E49 causes of Switch on disabled (per axis).
+pub(crate) const E47: u16 = parameter_index(4, 47);
+pub(crate) const E49: u16 = parameter_index(4, 49);
 /// E48 device state (per axis).
 pub(crate) const E48: u16 = parameter_index(4, 48);
+/// A66 sources of the user status word (per axis, 16 elements).
+pub(crate) const A66: u16 = parameter_index(0, 66);
+/// A67 user-defined status word (per axis).
+pub(crate) const A67: u16 = parameter_index(0, 67);
+/// A340 velocity override, % (per axis).
+pub(crate) const A340: u16 = parameter_index(0, 340);
+/// E80 operating condition (per axis).
+pub(crate) const E80: u16 = parameter_index(4, 80);
+/// A213 fieldbus scaling (global; [0] process data: 1 native, 0 decimals).
+pub(crate) const A213: u16 = parameter_index(0, 213);
+/// A310 / A311 decimal places of velocities / accelerations (per axis).
+pub(crate) const A310: u16 = parameter_index(0, 310);
+/// I02 position encoder (per axis).
+pub(crate) const I02: u16 = parameter_index(8, 2);
+/// I46 reference retaining (per axis).
+pub(crate) const I46: u16 = parameter_index(8, 46);
+/// I101 / I102 / I103 sources of +LS, −LS and the reference switch.
+pub(crate) const I101: u16 = parameter_index(8, 101);
+/// I210 application control word (switch signals from the fieldbus).
+pub(crate) const I210: u16 = parameter_index(8, 210);
 
 /// The object window of one axis: CiA 402 objects at +800h, per-axis
 /// manufacturer parameters at +8000h for axis B.
@@ -46,6 +70,12 @@ impl Window {
         } else {
             index.wrapping_add(AXIS_B_MANUFACTURER)
         }
+    }
+
+    /// Per-axis manufacturer entry `index`:`sub` ("SDO Info" numbering) of
+    /// this axis, or `default`.
+    pub fn param(self, od: &DriveObjects, index: u16, sub: u8, default: i64) -> i64 {
+        od.get(self.manufacturer(index), sub).unwrap_or(default)
     }
 
     /// CiA 402 entry `index`:`sub` of this axis, or `default`.
@@ -144,6 +174,32 @@ pub(crate) struct Snapshot {
     pub period_value: u8,
     /// 60C2h:02 interpolation time index.
     pub period_index: i8,
+    /// A340 velocity override, % (pp, vl, pv).
+    pub override_percent: u16,
+    /// A66 sources of the A67 bits (index << 16 | sub << 8 | bit, 0 = none).
+    pub a66: [u32; 16],
+    /// I02 position encoder (0 = motor encoder).
+    pub i02: u8,
+    /// I46 reference retaining (5 = direct absolute).
+    pub i46: u8,
+    /// I101, I102, I103: 0 off, 1 input, 2 parameter I210.
+    pub switch_source: [u8; 3],
+    /// I210 application control word.
+    pub i210: u16,
+    /// 6091h:01/:02 gear ratio (motor, shaft revolutions).
+    pub gear: (u32, u32),
+    /// 6092h:01/:02 feed constant (feed, shaft revolutions).
+    pub feed: (u32, u32),
+    /// 607Bh:02 revolution length of an endless axis, user units (C-111).
+    pub modulo_length: i32,
+    /// 607Ah and 60C1h:01 as sent, user units (not converted by
+    /// [`Snapshot::to_increments`]; endless axes unwrap them).
+    pub target_position_user: i32,
+    /// 60C1h:01 as sent.
+    pub ip_setpoint_user: i32,
+    /// Decimal places of velocities (A310) and of accelerations and jerk
+    /// (A311) when A213[0] = 0 "integer with decimal places"; (0, 0) native.
+    pub decimals: (u8, u8),
 }
 
 fn sat<T: TryFrom<i64> + Copy>(v: i64, lo: T, hi: T) -> T {
@@ -201,6 +257,88 @@ impl Snapshot {
             control_cycle_us: sat(od.get(A150, 0).unwrap_or(1000), 0u16, u16::MAX),
             period_value: u8_(0x60C2, 1, 1),
             period_index: i8_(0x60C2, 2, -3),
+            override_percent: sat(w.param(od, A340, 0, 100), 0u16, u16::MAX),
+            a66: core::array::from_fn(|k| sat(w.param(od, A66, k as u8 + 1, 0), 0u32, u32::MAX)),
+            i02: sat(w.param(od, I02, 0, 0), 0u8, u8::MAX),
+            i46: sat(w.param(od, I46, 0, 0), 0u8, u8::MAX),
+            switch_source: [
+                sat(w.param(od, I101, 0, 0), 0u8, u8::MAX),
+                sat(w.param(od, I101 + 1, 0, 0), 0u8, u8::MAX),
+                sat(w.param(od, I101 + 2, 0, 1), 0u8, u8::MAX),
+            ],
+            i210: sat(w.param(od, I210, 0, 0), 0u16, u16::MAX),
+            gear: (u32_(0x6091, 1, 1), u32_(0x6091, 2, 1)),
+            feed: (u32_(0x6092, 1, REV), u32_(0x6092, 2, 1)),
+            modulo_length: i32_(0x607B, 2, 0),
+            target_position_user: i32_(0x607A, 0, 0),
+            ip_setpoint_user: i32_(0x60C1, 1, 0),
+            decimals: if od.get(A213, 1).unwrap_or(1) == 0 {
+                (
+                    sat(w.param(od, A310, 0, 0), 0u8, 9),
+                    sat(w.param(od, A310 + 1, 0, 0), 0u8, 9),
+                )
+            } else {
+                (0, 0)
+            },
+        }
+    }
+
+    /// The scaling of 6091h/6092h (polarity is applied separately); the
+    /// increments themselves when a factor is 0.
+    pub fn scaling(&self) -> AxisScaling {
+        AxisScaling::new(self.gear.0, self.gear.1, self.feed.0, self.feed.1, 0)
+            .unwrap_or(AxisScaling::INCREMENTAL)
+    }
+
+    /// 10^A310 and 10^A311 (C-142): velocity / acceleration objects count
+    /// in user units / 10^decimals; 1 in native scaling.
+    pub fn decimal_factors(&self) -> (f64, f64) {
+        let p = |d: u8| (0..d).fold(1.0f64, |f, _| f * 10.0);
+        (p(self.decimals.0), p(self.decimals.1))
+    }
+
+    /// The snapshot with every position, velocity, acceleration and jerk
+    /// object turned from user units (6091h/6092h, C-109; decimals A310/A311
+    /// with A213 = 0, C-142) into increments, the unit the axis works in.
+    pub fn to_increments(self, s: &AxisScaling) -> Self {
+        if *s == AxisScaling::INCREMENTAL && self.decimals == (0, 0) {
+            return self;
+        }
+        let (fv, fa) = self.decimal_factors();
+        let pos = |u: i32| {
+            s.to_increments(i64::from(u))
+                .map_or(if u < 0 { i32::MIN } else { i32::MAX }, |v| v as i32)
+        };
+        let k = s.user_per_increment().abs();
+        // half away from zero; the casts saturate
+        let round = |x: f64| if x >= 0.0 { x + 0.5 } else { x - 0.5 };
+        let rate = |u: i32| round(f64::from(u) / (k * fv)) as i32;
+        let vel = |u: u32| round(f64::from(u) / (k * fv)) as u32;
+        let acc = |u: u32| round(f64::from(u) / (k * fa)) as u32;
+        let mag = |u: u32| round(f64::from(u) / k) as u32;
+        Snapshot {
+            target_position: pos(self.target_position),
+            ip_setpoint: pos(self.ip_setpoint),
+            software_min: pos(self.software_min),
+            software_max: pos(self.software_max),
+            home_offset: pos(self.home_offset),
+            target_velocity: rate(self.target_velocity),
+            velocity_offset: rate(self.velocity_offset),
+            profile_velocity: vel(self.profile_velocity),
+            max_profile_velocity: vel(self.max_profile_velocity),
+            acceleration: acc(self.acceleration),
+            deceleration: acc(self.deceleration),
+            quick_stop_deceleration: acc(self.quick_stop_deceleration),
+            jerk: acc(self.jerk),
+            homing_fast: vel(self.homing_fast),
+            homing_slow: vel(self.homing_slow),
+            homing_acceleration: acc(self.homing_acceleration),
+            following_error_window: if self.following_error_window == u32::MAX {
+                u32::MAX
+            } else {
+                mag(self.following_error_window)
+            },
+            ..self
         }
     }
 }

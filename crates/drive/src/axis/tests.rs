@@ -738,3 +738,53 @@ fn c094_c095_hardware_limit_switch_faults_and_locks_the_direction() {
     assert!(rig.velocity(0) < -(REV_I as i32) / 2);
     assert_eq!(rig.state(0), State::OperationEnabled);
 }
+
+/// Method 19 on a reference switch from X on (motor increments), with or
+/// without the hardware's latched edge; returns the error of the edge's
+/// reading against 607Ch.
+fn method_19_edge_error(latched: bool) -> i64 {
+    const X: i32 = 300_000;
+    let mut rig = Rig::new();
+    rig.set(0, 0x6098, 0, 19);
+    rig.set(0, 0x607C, 0, 0);
+    rig.set(0, 0x6060, 0, 6);
+    rig.enable(0);
+    rig.controlword(0, 0x1F);
+    let mut last = rig.motors[0].position_inc();
+    let mut done = false;
+    for _ in 0..10_000 {
+        let now = rig.motors[0].position_inc();
+        rig.io[0].reference = now >= X;
+        rig.io[0].switch_edges = [None; 4];
+        if latched && (last >= X) != (now >= X) {
+            rig.io[0].switch_edges[0] = Some(SwitchEdge {
+                switch: SwitchId::Reference,
+                position_inc: X,
+            });
+        }
+        last = now;
+        rig.cycle();
+        if rig.sw(0) & 0x1400 == 0x1400 {
+            done = true;
+            break;
+        }
+    }
+    assert!(done, "homing done: {:#06x}", rig.sw(0));
+    rig.controlword(0, 0x0F);
+    rig.run(50);
+    // the switch edge X (motor increments) reads, in 6064h:
+    i64::from(rig.position(0)) - i64::from(rig.motors[0].position_inc() - X)
+}
+
+#[test]
+fn c071_homing_takes_the_latched_switch_edge() {
+    let level = method_19_edge_error(false);
+    let latched = method_19_edge_error(true);
+    // creep 6099h:02 = 0.25 rev/s: one cycle is 262 increments
+    assert!(
+        level.abs() <= 2 * 262,
+        "level only: within two creep steps: {level}"
+    );
+    assert!(latched.abs() <= 2, "latched edge: exact: {latched}");
+    assert!(latched.abs() < level.abs(), "{latched} vs {level}");
+}

@@ -28,6 +28,17 @@ const fn a(line: u16) -> u16 {
 const fn e_(line: u16) -> u16 {
     parameter_index(4, line)
 }
+/// Group I parameter `line`.
+const fn i_(line: u16) -> u16 {
+    parameter_index(8, line)
+}
+
+/// A66: the sources of the 16 bits of A67, one per element (C-143).
+const A66_ELEMENTS: [EntryInfo; 16] = repeat(
+    e(0, "", U32, RW).saved(),
+    0,
+    &numbered!("Source bit "; "0" "1" "2" "3" "4" "5" "6" "7" "8" "9" "10" "11" "12" "13" "14" "15"),
+);
 
 /// An action parameter (A00, A09, A37, A287): [0] start, [1] progress, [2] result.
 const ACTION: &[EntryInfo] = &[
@@ -111,7 +122,7 @@ const fn string(s: &str) -> DataType {
 }
 
 /// Global and axis-A manufacturer parameters, sorted by index.
-pub const PARAMS: [Object; 54] = [
+pub const PARAMS: [Object; 65] = [
     param_array!(a(0), "Save values", Record, Value::Ram, from ACTION)
         .note("A00; [0] = 1 requests saving (E-018); progress/result set by the store"),
     param_array!(a(9), "Restart", Record, Value::Ram, from ACTION)
@@ -147,6 +158,9 @@ pub const PARAMS: [Object; 54] = [
     param_array!(a(37), "Reset memorised values", Record, Value::Ram, from ACTION)
         .level(1)
         .note("A37; action"),
+    param_array!(a(66), "Sources user status word", Array, Value::Ram, from &A66_ELEMENTS)
+        .axis()
+        .note("A66; element = index << 16 | subindex << 8 | bit of the source (0 = bit stays 0); ours, the spec gives no encoding"),
     Object::var(
         a(67),
         Value::Live,
@@ -471,10 +485,35 @@ pub const PARAMS: [Object; 54] = [
     .axis()
     .level(2)
     .note("A311"),
+    Object::var(
+        a(340),
+        Value::Ram,
+        entries![e(0, "Velocity override", U16, RW)
+            .range(0, 200)
+            .default_value(100)
+            .unit("%")
+            .rx()],
+    )
+    .axis()
+    .note("A340; pp, vl, pv (C-030); range 0–200 % assumed"),
     Object::var(e_(43), Value::Live, entries![e(0, "Event cause", U8, RO)]).note("E43; EMCY byte 5"),
+    Object::var(
+        e_(47),
+        Value::Live,
+        entries![e(0, "Cause of switch on disabled", U8, RO)],
+    )
+    .axis()
+    .note("E47; first cause: 0 none, 1 STO, 2 supply, 3 additional enable A60, 4 controlword (encoding ours, C-015)"),
     Object::var(e_(48), Value::Live, entries![e(0, "Device state", U8, RO)])
         .axis()
         .note("E48; 2 ready to switch on, 4 enabled, 7 quick stop"),
+    Object::var(
+        e_(49),
+        Value::Live,
+        entries![e(0, "Causes of switch on disabled", U8, RO)],
+    )
+    .axis()
+    .note("E49; all causes: bit 0 STO, 1 supply, 2 A60, 3 controlword (encoding ours, C-015)"),
     Object::var(
         e_(50),
         Value::Alias(&[(0x1008, 0)]),
@@ -514,6 +553,9 @@ pub const PARAMS: [Object; 54] = [
     )
     .level(1)
     .note("E72; ESI module name, STR16"),
+    Object::var(e_(80), Value::Live, entries![e(0, "Operating condition", U8, RO).tx()])
+        .axis()
+        .note("E80; 0 none, 15 illegal direction, 20 limit switch (C-107); other codes not modelled"),
     Object::var(e_(82), Value::Live, entries![e(0, "Event type", U8, RO)]).note("E82; EMCY byte 4"),
     Object::var(
         e_(191),
@@ -541,4 +583,54 @@ pub const PARAMS: [Object; 54] = [
     )
     .axis()
     .note("E201; content not described"),
+    Object::var(
+        i_(2),
+        Value::Ram,
+        entries![e(0, "Position encoder", U8, RW).range(0, 0).saved()],
+    )
+    .axis()
+    .level(1)
+    .note("I02; 0 = motor encoder, the only encoder of this hardware model (C-113)"),
+    Object::var(
+        i_(46),
+        Value::Ram,
+        entries![e(0, "Reference retaining", U8, RW).range(0, 5).saved()],
+    )
+    .axis()
+    .level(1)
+    .note("I46; 5 = direct absolute (C-112); 0–4 = not referenced after power-on"),
+    Object::var(
+        i_(101),
+        Value::Ram,
+        entries![e(0, "Source positive limit switch", U8, RW).range(0, 2).saved()],
+    )
+    .axis()
+    .level(1)
+    .note("I101; 0 off, 1 input, 2 parameter I210 bit 0 (C-104)"),
+    Object::var(
+        i_(102),
+        Value::Ram,
+        entries![e(0, "Source negative limit switch", U8, RW).range(0, 2).saved()],
+    )
+    .axis()
+    .level(1)
+    .note("I102; 0 off, 1 input, 2 parameter I210 bit 1 (C-104)"),
+    Object::var(
+        i_(103),
+        Value::Ram,
+        entries![e(0, "Source reference switch", U8, RW)
+            .range(0, 2)
+            .default_value(1)
+            .saved()],
+    )
+    .axis()
+    .level(1)
+    .note("I103; 0 off, 1 input, 2 parameter I210 bit 2"),
+    Object::var(
+        i_(210),
+        Value::Ram,
+        entries![e(0, "Application control word", U16, RW).rx()],
+    )
+    .axis()
+    .note("I210; bit 0 +LS, bit 1 −LS, bit 2 reference switch (1 = actuated; bit layout ours)"),
 ];
