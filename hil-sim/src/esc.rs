@@ -218,7 +218,14 @@ pub struct Esc {
     pdi_wd_trigger: Option<u64>,
     /// Distributed clocks: local clock, drift-control loop, cyclic unit.
     dc: DcState,
+    /// Time of the last frame that passed the ESC (port 0 receives every
+    /// frame; port 1 forwards it when it has a link).
+    last_frame_ns: Option<u64>,
 }
+
+/// How long a port counts as active after a frame (the LA_EC LED
+/// flickers), ns: two flicker periods (ETG.1300), our choice.
+pub const ACTIVITY_WINDOW_NS: u64 = 100_000_000;
 
 impl core::fmt::Debug for Esc {
     fn fmt(&self, f: &mut core::fmt::Formatter<'_>) -> core::fmt::Result {
@@ -246,6 +253,7 @@ impl Esc {
             mem: [0; MEM_SIZE],
             sii: [0xFF; SII_MAX_BYTES],
             sm: [SmState::default(); MAX_SM],
+            last_frame_ns: None,
             now_ns: 0,
             sii_pending: None,
             pd_wd_trigger: None,
@@ -382,9 +390,40 @@ impl Esc {
         let link_bit = 1u16 << (4 + port);
         let loop_bit = 1u16 << (8 + 2 * port);
         let comm_bit = 1u16 << (9 + 2 * port);
-        let mut s = self.get_u16(regs::DL_STATUS) & !(link_bit | loop_bit | comm_bit);
+        let before = self.get_u16(regs::DL_STATUS);
+        if before & link_bit != 0 && !link {
+            // a lost link counts in 0x0310 + port (saturating, E-137)
+            let a = regs::LOST_LINK_COUNTER + u16::from(port);
+            self.set_u8(a, self.get_u8(a).saturating_add(1));
+        }
+        let mut s = before & !(link_bit | loop_bit | comm_bit);
         s |= if link { link_bit | comm_bit } else { loop_bit };
         self.set_u16(regs::DL_STATUS, s);
+    }
+
+    /// Counts a receive error on `port` (0..3) in its RX error counter
+    /// (0x0300 + 2·port: `invalid_frame` = the invalid-frame counter, else
+    /// 0x0301 + 2·port, the physical-layer RX error counter), saturating, as
+    /// an ESC does for a corrupted frame (E-138 fault injection).
+    pub fn inject_rx_error(&mut self, port: u8, invalid_frame: bool) {
+        if port > 3 {
+            return;
+        }
+        let a = regs::RX_ERROR_COUNTER + 2 * u16::from(port) + u16::from(!invalid_frame);
+        self.set_u8(a, self.get_u8(a).saturating_add(1));
+    }
+
+    /// Whether `port` (0 or 1) carried a frame within [`ACTIVITY_WINDOW_NS`]
+    /// before `now_ns` (what the ESC's LA_EC LED outputs show, E-134).
+    pub fn port_activity(&self, port: u8, now_ns: u64) -> bool {
+        let link = match port {
+            0 => true,
+            1..=3 => self.get_u16(regs::DL_STATUS) & (1 << (4 + port)) != 0,
+            _ => false,
+        };
+        link && self
+            .last_frame_ns
+            .is_some_and(|t| now_ns.saturating_sub(t) < ACTIVITY_WINDOW_NS)
     }
 
     /// A PDI handle (implements [`::esc::Pdi`]); [`Esc`] implements it too.
@@ -461,6 +500,7 @@ impl Esc {
     /// arrival at this ESC (see [`Esc::set_line_timing`]).
     pub fn process_datagram(&mut self, dg: &mut Datagram<'_>, now_ns: u64) {
         self.tick(now_ns);
+        self.last_frame_ns = Some(self.now_ns);
         self.dc.ecat_time = self.now_ns.saturating_add(self.dc.line.arrival_ns);
         let adp = dg.adp();
         let ado = u32::from(dg.ado());

@@ -398,6 +398,25 @@ impl SimDrive {
     }
 }
 
+impl SimDrive {
+    /// What motor `axis` (0 = A, 1 = B) did in the last control cycle
+    /// (torque applied, brake applied, …), `None` before the first cycle.
+    pub fn motor_outputs(&self, axis: usize) -> Option<&MotorOutputs> {
+        self.feedback.get(axis).and_then(Option::as_ref)
+    }
+
+    /// The drive's four EtherCAT LEDs at `now_ns` (E-132…E-134): the
+    /// firmware's patterns ([`drive::runtime::Drive::leds`]) with the port
+    /// activity the simulated ESC saw.
+    pub fn leds(&self, now_ns: u64) -> drive::runtime::Leds {
+        let activity = [
+            self.esc.port_activity(0, now_ns),
+            self.esc.port_activity(1, now_ns),
+        ];
+        self.drive.leds(activity)
+    }
+}
+
 impl Default for SimDrive {
     fn default() -> Self {
         Self::new()

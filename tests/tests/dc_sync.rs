@@ -43,6 +43,7 @@ fn dc_config(sync0_ns: u64) -> DcConfiguration {
     }
 }
 const A292: u16 = drive::parameter_index(0, 292);
+const A264: u16 = drive::parameter_index(0, 264);
 const A296: u16 = drive::parameter_index(0, 296);
 const A298: u16 = drive::parameter_index(0, 298);
 
@@ -88,6 +89,10 @@ struct Seen {
     a298: u16,
     a261_late: u32,
     a296_us: u32,
+    /// 1C32h:0B / 1C33h:0B SM-event missed counters, A264[7] (their mirror).
+    sm_missed: [u16; 3],
+    /// 1C32h:20 sync error, A264[9].
+    sync_error: [u8; 2],
 }
 
 /// Configures A292 by SDO, DC with SYNC0 every [`SYNC0_NS`], requests OP and
@@ -140,12 +145,23 @@ fn run(
             a298: 0,
             a261_late: 0,
             a296_us: 0,
+            sm_missed: [0; 3],
+            sync_error: [0; 2],
         }; 2];
         for (i, s) in seen.iter_mut().enumerate() {
             let sd = group.subdevice(md, i).expect("drive");
             s.a298 = sd.sdo_read(A298, 0).await.expect("A298");
             s.a261_late = sd.sdo_read(A261, 3).await.expect("A261[2]");
             s.a296_us = sd.sdo_read(A296, 0).await.expect("A296");
+            s.sm_missed = [
+                sd.sdo_read(0x1C32, 0x0B).await.expect("1C32h:0B"),
+                sd.sdo_read(0x1C33, 0x0B).await.expect("1C33h:0B"),
+                sd.sdo_read(A264, 8).await.expect("A264[7]"),
+            ];
+            s.sync_error = [
+                sd.sdo_read(0x1C32, 0x20).await.expect("1C32h:20"),
+                sd.sdo_read(A264, 10).await.expect("A264[9]"),
+            ];
         }
         seen
     })
@@ -268,7 +284,7 @@ fn e113_pll_stays_locked_with_5us_frame_jitter() {
 }
 
 #[test]
-fn e114_loss_of_sync0_loses_the_lock_and_reports_a_pll_fault() {
+fn e114_e119_loss_of_sync0_loses_the_lock_and_reports_a_pll_fault() {
     let sim = line();
     let mut locked_before = [false; 2];
     let seen = run(&sim, 330, Inject::StopSync0(300), |i, s| {
@@ -293,6 +309,7 @@ fn e114_loss_of_sync0_loses_the_lock_and_reports_a_pll_fault() {
         assert!(locked_before[i], "drive {i} locked before SYNC0 stopped");
         assert!(!pll.is_locked());
         assert_eq!(pll.fault(), Some(SyncFault::Sync0Timeout));
+        assert_eq!(seen.sync_error, [1, 1], "E-119: 1C32h:20 and A264[9]");
         let st = PllStatus(seen.a298);
         assert!(
             st.contains(PllStatus::ERROR),
@@ -313,7 +330,7 @@ fn e114_loss_of_sync0_loses_the_lock_and_reports_a_pll_fault() {
 }
 
 #[test]
-fn e117_e118_a_late_frame_counts_in_a261() {
+fn e117_e118_e119_a_late_frame_counts_in_a261_and_1c32h() {
     let sim = line();
     let mut before = [(0u32, None); 2];
     let seen = run(&sim, 330, Inject::LateFrame(300), |i, s| {
@@ -335,6 +352,10 @@ fn e117_e118_a_late_frame_counts_in_a261() {
             pll.fault()
         );
         assert_eq!(seen.a261_late, before[i].0 + 1, "drive {i}: one late frame");
+        // E-119: 1C32h/1C33h:0B count it too, A264[7] mirrors 1C32h:0B
+        let late = seen.a261_late as u16;
+        assert_eq!(seen.sm_missed, [late; 3], "drive {i}: SM-event missed");
+        assert_eq!(seen.sync_error, [0, 0], "drive {i}: no sync error");
         assert!(pll.is_locked(), "SYNC0 is not moved by a frame");
         assert_eq!(pll.fault(), before[i].1, "one late frame is no sync I/O fault");
     }
@@ -423,7 +444,7 @@ async fn dc_cycles<'a>(
 /// indication, AL 0034h (SYNC0 timeout), EMCY 7500h / 10h / event 52 cause
 /// 7 and an unsolicited state change; acknowledge + SYNC0 back: Op again.
 #[test]
-fn e046_e131_e038_dc_op_waits_for_pll_lock_and_sync0_loss_drops_to_safeop() {
+fn e046_e131_e129_e038_dc_op_waits_for_pll_lock_and_sync0_loss_drops_to_safeop() {
     use drive::runtime::dcsync::al;
     use drive_tests::{al_status, request, CoeClient};
     use esc::AlStatusCode;
@@ -505,7 +526,33 @@ fn e046_e131_e038_dc_op_waits_for_pll_lock_and_sync0_loss_drops_to_safeop() {
                 (0x10, 52, 7),
                 "register 10h, event 52 cause 7"
             );
+            // E-129/E-131: both axes react (Fault, 603Fh 7500h, E43 = 7)
+            // with no second EMCY for the event
+            c.upload(&sd, 0x1000, 0).await.expect("1000h");
+            let n = c.emergencies.iter().filter(|e| e[0..2] == [0x00, 0x75]).count();
+            assert_eq!(n, 1, "one EMCY 7500h: {:02x?}", c.emergencies);
+            // E-038: A257[0] Er3 "unsolicited state change", ERR single flash
+            let a257 = c
+                .upload(&sd, drive::parameter_index(0, 257), 1)
+                .await
+                .expect("A257[0]");
+            assert!(a257.starts_with(b"Er3 "), "A257[0] {a257:02x?}");
             let s = sim.borrow();
+            assert_eq!(
+                s.drives()[i].leds(s.now_ns()).err,
+                ecat::led::Pattern::SingleFlash
+            );
+            let d = &s.drives()[i].drive;
+            for axis in &d.axes {
+                let state = d.objects.get(axis.cia402_index(0x6041), 0).unwrap() & 0x6F;
+                assert!(
+                    state == 0x08 || state == 0x0F,
+                    "axis {}: {state:#x}",
+                    axis.index()
+                );
+                assert_eq!(axis.error_code(), 0x7500);
+            }
+            assert_eq!(d.objects.get(drive::parameter_index(4, 43), 0), Ok(7), "E43");
             let (_, last) = s.drives()[i].state_log.last().copied().expect("state change");
             println!("drive {i}: {last}");
             assert!(last.unsolicited, "E-038: {last}");
@@ -816,3 +863,213 @@ fn e112_sync0_twice_a150() {
 
 /// A drive in the Pre-Op group as the master holds it.
 type Sd<'a> = ethercrab::SubDeviceRef<'a, ethercrab::SubDevicePdi<'a, 512, ethercrab::DefaultLock>>;
+
+/// E-109 (spec §11.3): A292 = −1500 µs written by the master with A150 =
+/// 1 ms is limited to one drive cycle: the aligned cycle starts just under
+/// one A150 after SYNC0 and the PLL locks there.
+#[test]
+fn e109_a292_beyond_one_a150_is_limited_to_one_cycle_through_the_master() {
+    let sim = line();
+    let pre_op = async |sd: &Sd<'_>| {
+        sd.sdo_write(A292, 0, -1500i32).await.expect("A292");
+    };
+    dc_op(&sim, SYNC0_NS, pre_op, 400, async |_, _| {});
+    let s = sim.borrow();
+    for (i, d) in s.drives().iter().enumerate() {
+        let pll = d.drive.pll().expect("PLL");
+        assert_eq!(
+            d.drive.objects.get(A292, 0),
+            Ok(-1500),
+            "the object keeps the value"
+        );
+        assert_eq!(pll.phase_offset_ns(), -999_999, "drive {i}: limited to one A150");
+        assert!(pll.is_locked(), "drive {i} locked");
+        let target = 999_999i64;
+        let p = SYNC0_NS as i64;
+        let errors: Vec<i64> = d
+            .cycle_log
+            .iter()
+            .filter(|c| c.locked)
+            .map(|c| {
+                let e = (c.system_ns as i64 - target).rem_euclid(p);
+                if e >= p / 2 {
+                    e - p
+                } else {
+                    e
+                }
+            })
+            .collect();
+        let worst = errors.iter().map(|e| e.abs()).max().unwrap_or(i64::MAX);
+        println!(
+            "drive {i}: A292 −1500 µs → {} ns, worst {worst} ns",
+            pll.phase_offset_ns()
+        );
+        assert!(errors.len() >= 100 && worst <= 1_000, "drive {i}: {worst} ns");
+    }
+}
+
+/// E-115 (spec §11.6) through the master: bits 0/1 when the PLL uses at
+/// least half of its ±500 ppm range (drive 0 is the DC reference at 0 ppm;
+/// drive 1 at +300 ppm lengthens its cycle, drive 2 at −300 ppm shortens
+/// it), bit 2 while it stretches cycles to align, bit 4 when A296 > A291
+/// (60C2h = 500 µs is copied into A291), bit 5 when A290 ≠ 1.
+#[test]
+fn e115_a298_bits_through_the_master() {
+    let mut line3 = Simulation::new(3);
+    for (d, drift) in line3.drives_mut().iter_mut().zip([0.0, 300.0, -300.0]) {
+        d.set_clock(drift, 1_234_567);
+    }
+    let sim = RefCell::new(line3);
+    let mut ever = [0u16; 3];
+    run(&sim, 600, Inject::Nothing, |_, s| {
+        for (i, d) in s.drives().iter().enumerate() {
+            ever[i] |= d.drive.objects.get(A298, 0).unwrap() as u16;
+        }
+    });
+    let s = sim.borrow();
+    let a298: Vec<u16> = s
+        .drives()
+        .iter()
+        .map(|d| d.drive.objects.get(A298, 0).unwrap() as u16)
+        .collect();
+    println!("A298 at 0 / +300 / −300 ppm: {a298:04x?}, seen {ever:04x?}");
+    let locked = PllStatus::PHASE_LOCKED | PllStatus::SYNC0_PRESENT;
+    let engaged = PllStatus::ENGAGED_SLOWER | PllStatus::ENGAGED_FASTER;
+    assert!(PllStatus(a298[0]).contains(locked));
+    assert_eq!(a298[0] & engaged, 0, "the reference sees no drift");
+    assert!(PllStatus(a298[1]).contains(locked | PllStatus::ENGAGED_SLOWER));
+    assert!(PllStatus(a298[2]).contains(locked | PllStatus::ENGAGED_FASTER));
+    for (i, a) in a298.iter().enumerate() {
+        let not = PllStatus::MAX_RANGE | PllStatus::SYNC_CYCLE_TOO_LONG | PllStatus::DEACTIVATED;
+        assert_eq!(a & not, 0, "drive {i}: {a:#06x}");
+        assert_ne!(
+            ever[i] & PllStatus::CYCLE_EXTENDED,
+            0,
+            "drive {i}: stretched while aligning"
+        );
+    }
+    drop(s);
+
+    // 60C2h = 5 × 10⁻⁴ s: A291 = 500 µs < A296 = 1000 µs; then A290 = 0
+    let sim = line();
+    let pre_op = async |sd: &Sd<'_>| {
+        sd.sdo_write(0x60C2, 1, 5u8).await.expect("60C2h:01");
+        sd.sdo_write(0x60C2, 2, -4i8).await.expect("60C2h:02");
+    };
+    let (bit4, bit5): (u16, u16) = dc_op(&sim, SYNC0_NS, pre_op, 200, async |md, group| {
+        let sd = group.subdevice(md, 0).expect("drive");
+        let a291: u32 = sd
+            .sdo_read(drive::parameter_index(0, 291), 0)
+            .await
+            .expect("A291");
+        assert_eq!(a291, 500, "60C2h copied into A291");
+        let bit4 = sd.sdo_read(A298, 0).await.expect("A298");
+        sd.sdo_write(drive::parameter_index(0, 290), 0, 0u8)
+            .await
+            .expect("A290");
+        dc_cycles(md, group, &sim, 5, |_, _, _| {}).await;
+        (bit4, sd.sdo_read(A298, 0).await.expect("A298"))
+    });
+    println!("A298 with A291 = 500 µs: {bit4:#06x}; then A290 = 0: {bit5:#06x}");
+    assert!(PllStatus(bit4).contains(PllStatus::SYNC_CYCLE_TOO_LONG | PllStatus::PHASE_LOCKED));
+    assert_eq!(bit4 & PllStatus::DEACTIVATED, 0);
+    assert!(PllStatus(bit5).contains(PllStatus::DEACTIVATED));
+}
+
+/// Runs one A287 measurement on both drives of `group`,
+/// calling `each` with the cycle number and the simulation after every
+/// cycle; returns drive 0's A287[2], [3], [4] (result, A292 min/max µs) as
+/// the dictionary holds them.
+async fn a287_measurement<'a>(
+    md: &'a MainDevice<'a>,
+    group: &SubDeviceGroup<
+        8,
+        512,
+        ethercrab::DefaultLock,
+        ethercrab::subdevice_group::Op,
+        ethercrab::subdevice_group::HasDc,
+    >,
+    sim: &RefCell<Simulation>,
+    mut each: impl FnMut(usize, &mut Simulation),
+) -> (i64, i64, i64) {
+    // started in the dictionary, not by SDO: mailbox traffic would delay the
+    // next frames and look like master jitter (the SDO start is tested above)
+    for d in sim.borrow_mut().drives_mut() {
+        d.drive.objects.set(A287, 1, 1).expect("A287[0] = 1");
+    }
+    for k in 0..1500 {
+        dc_cycles(md, group, sim, 1, |_, _, _| {}).await;
+        let mut s = sim.borrow_mut();
+        each(k, &mut s);
+        if s.drives()[0].drive.objects.get(A287, 3).unwrap() >= 2 {
+            break;
+        }
+    }
+    let s = sim.borrow();
+    let get = |sub| s.drives()[0].drive.objects.get(A287, sub).unwrap();
+    (get(3), get(4), get(5))
+}
+
+/// E-121, E-122, E-123 (spec §11.8) through the master, with the drive's
+/// measured Rx/Tx offsets ([`drive::runtime::Drive::set_step_offsets`]) and
+/// the frame jitter injected: Rx…Tx over 995 µs of the 1 ms cycle leaves no
+/// room for the frame (5: application runtime); Rx/Tx moving by 30 µs from
+/// cycle to cycle (4: drive jitter); ±20 µs frame jitter (3: master jitter);
+/// each failure proposes min = max = the A292 in force. A291 ≠ the master
+/// cycle (60C2h = 2 ms) and SM-Sync (no DC) give 2 at once.
+#[test]
+fn e121_e122_e123_a287_failures_through_the_master() {
+    let sim = line();
+    let results = dc_op(
+        &sim,
+        SYNC0_NS,
+        async |_| {},
+        150,
+        async |md, group| {
+            let offsets = |s: &mut Simulation, rx: u32, tx: u32| {
+                for d in s.drives_mut() {
+                    d.drive.set_step_offsets(rx, tx);
+                }
+            };
+            let runtime = a287_measurement(md, group, &sim, |_, s| offsets(s, 0, 995_000)).await;
+            let jitter = a287_measurement(md, group, &sim, |k, s| {
+                let j = if k % 2 == 0 { 0 } else { 30_000 };
+                offsets(s, j, 960_000 + j);
+            })
+            .await;
+            let master = a287_measurement(md, group, &sim, |k, s| {
+                if k == 0 {
+                    s.set_frame_jitter(20_000, 0xE122);
+                }
+                offsets(s, 0, 985_000);
+            })
+            .await;
+            sim.borrow_mut().set_frame_jitter(0, 0);
+            // A291 ≠ the master cycle: 60C2h = 2 ms is copied into A291
+            let sd = group.subdevice(md, 0).expect("drive");
+            sd.sdo_write(0x60C2, 1, 2u8).await.expect("60C2h:01");
+            sd.sdo_write(0x60C2, 2, -3i8).await.expect("60C2h:02");
+            dc_cycles(md, group, &sim, 3, |_, _, _| {}).await;
+            let a291 = a287_measurement(md, group, &sim, |_, _| {}).await;
+            [runtime, jitter, master, a291]
+        },
+    );
+    println!(
+        "A287 (result, min, max): runtime {:?}, drive jitter {:?}, frame jitter {:?}, A291 {:?}",
+        results[0], results[1], results[2], results[3]
+    );
+    let a292 = i64::from(A292_US);
+    for (r, want) in results.iter().zip([5, 4, 3, 2]) {
+        assert_eq!(*r, (want, a292, a292), "result {want}: min = max = A292");
+    }
+
+    // SM-Sync (no DC): not executable
+    let sim = RefCell::new(Simulation::new(1));
+    let result: u8 = with_master(&sim, async |md, clock| {
+        let group = init(md, clock).await.into_op(md).await.expect("OP");
+        let sd = group.subdevice(md, 0).expect("drive");
+        sd.sdo_write(A287, 1, 1u8).await.expect("A287[0]");
+        sd.sdo_read(A287, 3).await.expect("A287[2]")
+    });
+    assert_eq!(result, 2, "E-121: DC not used");
+}

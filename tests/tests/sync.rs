@@ -294,3 +294,51 @@ fn e127_sm_watchdog_mode_uses_the_escs_watchdog() {
         );
     });
 }
+
+/// E-110 (spec §9.5.1, §11.2): in SM-Sync (`1C32h:01` = 1) the PLL locks
+/// the control cycle to the SM2 event; A292 = −200 µs starts the drive's
+/// cycle 200 µs after the process data arrived.
+#[test]
+fn e110_a292_applies_to_the_sm2_event_in_sm_sync() {
+    let sim = line(1);
+    let sends = with_master(&sim, async |md, clock| {
+        let group = init(md, clock).await;
+        let sd = group.subdevice(md, 0).unwrap();
+        sd.sdo_write(0x1C32, 1, 1u16).await.unwrap();
+        sd.sdo_write(drive::parameter_index(0, 292), 0, -200i32)
+            .await
+            .unwrap();
+        let group = group.into_safe_op(md).await.expect("SAFE-OP");
+        let sd = group.subdevice(md, 0).unwrap();
+        assert_eq!(
+            sim.borrow().drives()[0].drive.slave.sync_status().mode,
+            ecat::esm::SyncMode::SmSync
+        );
+        let mut sends = Vec::new();
+        // a master cycle of exactly 1 ms (the PLL's range is ±500 ppm)
+        let t0 = sim.borrow().now_ns();
+        for k in 1..=300u64 {
+            sim.borrow_mut().advance_to(t0 + k * 1_000_000);
+            sends.push(sim.borrow().now_ns());
+            group.tx_rx(md).await.expect("process data cycle");
+        }
+        assert_eq!(al_status(&sd).await, (SAFEOP, 0));
+        sends
+    });
+    let s = sim.borrow();
+    let d = &s.drives()[0];
+    let pll = d.drive.pll().expect("the PLL follows the SM2 event");
+    assert!(pll.is_locked(), "locked to the SM2 event");
+    assert_eq!(pll.phase_offset_ns(), -200_000);
+    let locked: Vec<_> = d.cycle_log.iter().filter(|c| c.locked).collect();
+    assert!(locked.len() >= 100, "{} locked cycles", locked.len());
+    let mut worst = 0;
+    for c in &locked {
+        // the frame this cycle follows: the last one sent before it
+        let sent = sends.iter().rev().find(|&&t| t <= c.now_ns).unwrap();
+        let after = c.now_ns as i64 - *sent as i64;
+        worst = worst.max((after - 200_000).abs());
+    }
+    println!("SM-Sync, A292 = −200 µs: cycle start − SM2 event within ±{worst} ns");
+    assert!(worst <= 1_000, "{worst} ns");
+}

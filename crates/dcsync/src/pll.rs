@@ -416,7 +416,7 @@ impl Pll {
     pub fn set_phase_offset(&mut self, a292_ns: i32) {
         self.cfg.a292_ns = a292_ns;
         let lim = i64::from(self.cfg.a150_ns).saturating_sub(1);
-        self.a292_ns = i64::from(a292_ns).clamp(-lim, lim);
+        self.a292_ns = i64::from(a292_ns).max(-lim).min(lim);
     }
 
     /// Changes the cycle sequence A149 (takes effect at the next cycle).
@@ -529,7 +529,7 @@ impl Pll {
         let mut period_q = (a150 << Q) + self.corr_q / k;
         self.stretching = false;
         if self.stretch_ns != 0 {
-            let chunk = self.stretch_ns.clamp(-(a150 / 4), a150);
+            let chunk = self.stretch_ns.max(-(a150 / 4)).min(a150);
             self.stretch_ns -= chunk;
             period_q += chunk << Q;
             self.stretching = chunk > 0;
@@ -542,7 +542,11 @@ impl Pll {
         let aligned = index == 0;
         CycleCommand {
             period_ticks: u32::try_from(ticks).unwrap_or(u32::MAX),
-            period_local_ns: u32::try_from(ticks * NS_PER_S / hz).unwrap_or(u32::MAX),
+            period_local_ns: ticks
+                .checked_mul(NS_PER_S)
+                .and_then(|t| t.checked_div(hz))
+                .and_then(|t| u32::try_from(t).ok())
+                .unwrap_or(u32::MAX),
             index,
             rx: aligned,
             tx: aligned,
@@ -605,7 +609,7 @@ impl Pll {
         let quarter = i64::from(self.cfg.a150_ns) / 4;
         // Delay wanted for the aligned cycle, in [−A150/4, est − A150/4).
         let c = (-e + quarter).rem_euclid(est) - quarter;
-        let j = ((c + quarter) / p).clamp(0, k - 1);
+        let j = ((c + quarter) / p).max(0).min(k - 1);
         self.stretch_ns = c - j * p;
         self.lock_count = 0;
         if j == 0 {
@@ -646,7 +650,7 @@ impl Pll {
         let integ = -i64::from(t.ki_q16).saturating_mul(e);
         let windup = (self.sat > 0 && integ > 0) || (self.sat < 0 && integ < 0);
         if !windup {
-            self.freq_q = self.freq_q.saturating_add(integ).clamp(-range, range);
+            self.freq_q = self.freq_q.saturating_add(integ).max(-range).min(range);
         }
         let u = self.freq_q.saturating_sub(i64::from(t.kp_q16).saturating_mul(e));
         self.sat = if u > range {
@@ -656,7 +660,7 @@ impl Pll {
         } else {
             0
         };
-        self.corr_q = u.clamp(-range, range);
+        self.corr_q = u.max(-range).min(range);
         None
     }
 

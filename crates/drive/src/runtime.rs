@@ -36,7 +36,18 @@
 //! 1): Safe-Op → Op waits for the lock (002Dh without SYNC0, 0032h not
 //! locked), a latched PLL fault in Op drops to Safe-Op with its AL code and
 //! EMCY 7500h cause 7 (spec §3.3, §13.4). The master's error acknowledge
-//! clears the PLL fault.
+//! clears the PLL fault. In SM-Sync the SM2 event drives the PLL instead
+//! of SYNC0 (E-110, [`Drive::on_frame`]).
+//!
+//! Event 52 "Communication" (E-128…E-131): when the slave leaves Op for a
+//! PDO timeout (cause 6) or a sync fault (cause 7), or the projected
+//! fieldbus identification does not match (cause 15), both axes run the
+//! fault reaction of 605Eh (A540) and end in Fault ([`Drive::raise_event52`]),
+//! with one EMCY for the event.
+//!
+//! Diagnosis (E-132…E-139): A257[0..2] from the ESC's DL status and error
+//! counters (read every poll), A257[3] from the AL status code, and the
+//! four LEDs as patterns of `ecat::led` ([`Drive::leds`]).
 
 use crate::axis::{Axis, AxisCommand, AxisIo};
 use crate::dictionary::{DriveObjects, LiveValues, PERSISTENT_IMAGE_BYTES};
@@ -44,7 +55,9 @@ use crate::objects::LAYOUT_HASH;
 use crate::pdo_image::{PdoImage, PdoImageError};
 use crate::DEVICE;
 use ecat::diag::{DiagHistory, DiagMessage, DiagType};
-use ecat::esm::{SyncMode, SyncState};
+use ecat::emcy::Emcy;
+use ecat::esm::{event52, SyncMode, SyncState};
+use ecat::led::Pattern;
 use ecat::{Slave, StateChange};
 use esc::{regs, AlState, AlStatusCode, Pdi, PdiExt};
 use od::SdoAbort;
@@ -78,6 +91,30 @@ const A291: u16 = crate::parameter_index(0, 291);
 const A292: u16 = crate::parameter_index(0, 292);
 const A296: u16 = crate::parameter_index(0, 296);
 const A298: u16 = crate::parameter_index(0, 298);
+
+/// E43 event cause, E59 projected fieldbus identification, E82 event type.
+const E43: u16 = crate::parameter_index(4, 43);
+const E59: u16 = crate::parameter_index(4, 59);
+const E82: u16 = crate::parameter_index(4, 82);
+
+/// This firmware's fieldbus identification (EtherCAT), compared with the
+/// projected one (E59[2], [`Drive::set_projected_fieldbus`]) for event 52
+/// cause 15 (E-130). The code is our choice: the sources give no values.
+pub const FIELDBUS_ID: u16 = 1;
+
+/// Versions of the EtherCAT diagnosis parameters as this firmware lays
+/// them out (E-139, spec §13.6, the S edition): (line of group A, version).
+/// A255 V3: 17/18/20/24 error states; A257 V2: four texts, `[0]` without
+/// `StX`, `[3]` "AL xxxx"; A287 V3: action with progress and result.
+pub const PARAMETER_VERSIONS: [(u16, u8); 7] = [
+    (254, 0),
+    (255, 3),
+    (256, 1),
+    (257, 2),
+    (259, 1),
+    (261, 1),
+    (287, 3),
+];
 
 /// Tick frequency of the control-cycle timer the PLL trims, Hz (the
 /// reference board's CCU4 at 144 MHz; the simulator models the same).
@@ -165,29 +202,73 @@ pub struct Drive<F: Flash> {
     /// The control cycle ([`Drive::sync_cycle`]) runs Rx and Tx: the poll
     /// leaves the process images alone.
     cycle_pdo: bool,
+    /// Per axis: an event 52 was injected whose EMCY is already queued, so
+    /// the axis' own EMCY at T13 is dropped (one EMCY per event, E-087).
+    event52_emcy_sent: [bool; 2],
+    /// The projected fieldbus identification (E59[2]).
+    projected_fieldbus: u16,
+    /// Event 52 cause 15 was raised for the present mismatch.
+    wrong_firmware: bool,
+    /// The ESC's port and error registers as the last poll read them.
+    ports: PortDiag,
+    /// A257 Er9 (SM1, mailbox Tx) or Er10 (SM0, mailbox Rx) for the last
+    /// refused I→P (AL 0016h).
+    mailbox_er: u8,
+    /// The PLL follows the SM2 event (SM-Sync, E-110), not SYNC0.
+    pll_from_sm: bool,
+}
+
+/// The ESC's link and error registers (A257[0..2], the link LEDs).
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
+struct PortDiag {
+    /// DL status 0x0110.
+    dl_status: u16,
+    /// Lost-link counters 0x0310, ports 0 and 1.
+    lost: [u8; 2],
+    /// Invalid-frame + RX-error counters 0x0300…, ports 0 and 1.
+    rx_errors: [u16; 2],
+    /// The texts were written at least once.
+    shown: bool,
+    /// The Er code shown.
+    er: u8,
+}
+
+/// The four EtherCAT LEDs (spec §13.3) as patterns ([`Drive::leds`]).
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub struct Leds {
+    /// Green RUN: the ESM state (E-133).
+    pub run: Pattern,
+    /// Red ERR: the error indication (E-132).
+    pub err: Pattern,
+    /// Green LA_EC IN (X200, port 0) and OUT (X201, port 1) (E-134).
+    pub ports: [Pattern; 2],
+}
+
+impl Leds {
+    /// Whether each LED is lit at `t_ns`: RUN, ERR, IN, OUT.
+    pub const fn lit(&self, t_ns: u64) -> [bool; 4] {
+        let [p0, p1] = self.ports;
+        [
+            self.run.is_on(t_ns),
+            self.err.is_on(t_ns),
+            p0.is_on(t_ns),
+            p1.is_on(t_ns),
+        ]
+    }
 }
 
 impl<F: Flash> Drive<F> {
     /// Powers the drive on: defaults, then the newest saved set from `flash`.
     pub fn new(flash: F) -> Self {
-        let mut store = ParamStore::new(flash);
-        let mut objects = DriveObjects::new();
-        let mut image = [0u8; PERSISTENT_IMAGE_BYTES];
-        let startup = match store.load(LAYOUT_HASH, &mut image) {
-            Ok(n) => match image.get(..n).map(|img| objects.load_persistent(img)) {
-                Some(Ok(())) => Startup::Loaded,
-                _ => Startup::Defaults,
-            },
-            Err(
-                StoreError::NoData | StoreError::LayoutMismatch | StoreError::TooLarge | StoreError::Flash(_),
-            ) => Startup::Defaults,
-        };
+        // Built in place (the value goes straight to the caller's slot) and
+        // loaded afterwards: a drive assembled from large locals needed
+        // several copies of itself on the stack (docs/architecture.md).
         let mut drive = Self {
             slave: Slave::new(&DEVICE),
-            objects,
-            store,
+            objects: DriveObjects::new(),
+            store: ParamStore::new(flash),
             diag: DiagHistory::new(),
-            startup,
+            startup: Startup::Defaults,
             last_code: AlStatusCode(0xFFFF),
             pdo: PdoImage::EMPTY,
             pdo_error: None,
@@ -201,10 +282,32 @@ impl<F: Flash> Drive<F> {
             frame_rel_sync0_ns: None,
             step_offsets_ns: (0, 0),
             cycle_pdo: false,
+            event52_emcy_sent: [false; 2],
+            projected_fieldbus: FIELDBUS_ID,
+            wrong_firmware: false,
+            ports: PortDiag::default(),
+            mailbox_er: 0,
+            pll_from_sm: false,
         };
+        drive.startup = drive.load_saved();
         drive.compile_pdo_image();
         drive.update_live();
         drive
+    }
+
+    /// Loads the saved parameter set into the dictionary (defaults stay when
+    /// there is none, it is from another layout or does not load).
+    fn load_saved(&mut self) -> Startup {
+        let mut image = [0u8; PERSISTENT_IMAGE_BYTES];
+        match self.store.load(LAYOUT_HASH, &mut image) {
+            Ok(n) => match image.get(..n).map(|img| self.objects.load_persistent(img)) {
+                Some(Ok(())) => Startup::Loaded,
+                _ => Startup::Defaults,
+            },
+            Err(
+                StoreError::NoData | StoreError::LayoutMismatch | StoreError::TooLarge | StoreError::Flash(_),
+            ) => Startup::Defaults,
+        }
     }
 
     /// Whether the saved set was loaded at power-on.
@@ -261,6 +364,20 @@ impl<F: Flash> Drive<F> {
             self.update_sync_live();
         }
         self.process_outputs();
+        if let Some(cause) = self.slave.take_event52() {
+            // the slave left Op and queued EMCY 7500h: the axes' reaction only
+            self.raise_event52(cause, false);
+        }
+        self.check_fieldbus_identification();
+        if change.is_some_and(|c| c.code == AlStatusCode::INVALID_MAILBOX_CONFIG) {
+            let sm0 = pdi.read_sm(0)?;
+            self.mailbox_er = if ecat::esm::mailbox_sm_ok_alone(self.slave.device(), 0, &sm0) {
+                9
+            } else {
+                10
+            };
+        }
+        self.read_ports(pdi)?;
         if let Some(c) = change.filter(|c| c.code != AlStatusCode::NO_ERROR) {
             // a refused state change is an error message in the history (E-144)
             let msg = DiagMessage::new(DIAG_AL_STATUS | u32::from(c.code.0), DiagType::Error, c.code.0);
@@ -296,7 +413,8 @@ impl<F: Flash> Drive<F> {
             if state == AlState::SafeOp {
                 self.compile_pdo_image();
             }
-            if state == AlState::Init {
+            if state == AlState::Init || (self.pll_from_sm && state == AlState::PreOp) {
+                self.pll_from_sm = false;
                 self.pll = None;
                 self.sync_error = None;
                 self.cycle_pdo = false;
@@ -371,10 +489,21 @@ impl<F: Flash> Drive<F> {
         let mut commands = [AxisCommand::OFF; 2];
         let mut register = 0u8;
         let axes = self.axes.iter_mut().zip(io).zip(new_setpoint);
-        for (((axis, io), new), command) in axes.zip(commands.iter_mut()) {
+        let sent = self.event52_emcy_sent.iter_mut();
+        for ((((axis, io), new), command), sent) in axes.zip(commands.iter_mut()).zip(sent) {
             let report = axis.cycle(&mut self.objects, io, now_ns, new);
-            if let Some(e) = report.emcy {
+            let mut emcy = report.emcy;
+            if report.transition.is_some_and(|t| t.number == 13) {
+                // the event 52 EMCY is already queued (once for the device)
+                if core::mem::take(sent) && emcy.is_some_and(|e| is_event52(&e)) {
+                    emcy = None;
+                }
+            }
+            if let Some(e) = emcy {
                 self.slave.emergency(e);
+                let [e82, e43, ..] = e.data;
+                let _ = self.objects.set(E82, 0, i64::from(e82));
+                let _ = self.objects.set(E43, 0, i64::from(e43));
             }
             register |= axis.error_register();
             *command = report.command;
@@ -410,6 +539,136 @@ impl<F: Flash> Drive<F> {
             }
         }
         commands
+    }
+
+    /// Event 52 "Communication" with `cause` (E-129…E-131, spec §13.4): both
+    /// axes take T13 in their next control cycle and run the fault reaction
+    /// of 605Eh (A540: 0 = power unit off at once, brake engages; 1–4 = stop
+    /// on the slow-down / quick-stop ramp with the brake released, then
+    /// off), ending in Fault with 603Fh = 7500h; a fault reset (controlword
+    /// bit 7 edge) clears it. One EMCY 7500h / 10h / 52 / cause for the
+    /// device (axis byte 0): queued here when `queue_emcy`, else the slave
+    /// already did; the axes' own T13 EMCY for it is dropped. E82/E43 show
+    /// the event.
+    pub fn raise_event52(&mut self, cause: u8, queue_emcy: bool) {
+        let emcy = Emcy::for_event(event52::EVENT, cause, 0);
+        if queue_emcy {
+            self.slave.emergency(emcy);
+        }
+        let event = motion::Event {
+            number: u16::from(event52::EVENT),
+            cause,
+        };
+        for (axis, sent) in self.axes.iter_mut().zip(self.event52_emcy_sent.iter_mut()) {
+            axis.raise_event(event);
+            *sent = true;
+        }
+        let _ = self.objects.set(E82, 0, i64::from(event52::EVENT));
+        let _ = self.objects.set(E43, 0, i64::from(cause));
+    }
+
+    /// The projected fieldbus identification (E59[2]; from the drive's
+    /// configuration project, which the firmware or board support passes
+    /// in). A value other than [`FIELDBUS_ID`] raises event 52 cause 15 at
+    /// the next poll (E-130).
+    pub fn set_projected_fieldbus(&mut self, id: u16) {
+        self.projected_fieldbus = id;
+    }
+
+    /// E-130: E59[2] against this firmware's fieldbus identification; a
+    /// mismatch raises event 52 cause 15 once when it appears (a fault
+    /// reset then clears the fault, the mismatch stays visible in E59[2]).
+    fn check_fieldbus_identification(&mut self) {
+        let _ = self.objects.set(E59, 3, i64::from(self.projected_fieldbus));
+        let mismatch = self.projected_fieldbus != FIELDBUS_ID;
+        if mismatch && !self.wrong_firmware {
+            self.raise_event52(event52::WRONG_FIRMWARE, true);
+        }
+        self.wrong_firmware = mismatch;
+    }
+
+    /// The EtherCAT LEDs now: RUN and ERR from the ESM (E-132, E-133), the
+    /// port LEDs from the link state the last poll read from the ESC and
+    /// `activity` per port (frames seen lately: on the board the ESC's LED
+    /// outputs, in the simulator the ESC's frame log) (E-134).
+    pub fn leds(&self, activity: [bool; 2]) -> Leds {
+        let link = |n: u8| self.ports.dl_status & regs::dl_status::link(n) != 0;
+        let [a0, a1] = activity;
+        Leds {
+            run: self.slave.run_led(),
+            err: self.slave.err_led(),
+            ports: [ecat::led::link(link(0), a0), ecat::led::link(link(1), a1)],
+        }
+    }
+
+    /// A257 Er code (spec §13.5) of the slave's present indication.
+    fn er_code(&self) -> u8 {
+        let s = &self.slave;
+        if !s.error() {
+            return 0;
+        }
+        let code = s.al_status_code();
+        if s.sync_status().unsolicited {
+            return if code == AlStatusCode::SM_WATCHDOG { 4 } else { 3 };
+        }
+        match code {
+            AlStatusCode::SM_WATCHDOG => 6,
+            AlStatusCode::INVALID_INPUT_CONFIG => 7,
+            AlStatusCode::INVALID_OUTPUT_CONFIG => 8,
+            AlStatusCode::INVALID_MAILBOX_CONFIG => self.mailbox_er,
+            AlStatusCode::INVALID_SM_CONFIG => 2,
+            _ => 11,
+        }
+    }
+
+    /// Reads the ESC's DL status, lost-link and RX-error counters and
+    /// updates A257[0..2] when something changed (E-136…E-138).
+    fn read_ports<P: Pdi>(&mut self, pdi: &mut P) -> Result<(), P::Error> {
+        let mut rx = [0u8; 4];
+        pdi.read(regs::RX_ERROR_COUNTER, &mut rx)?;
+        let mut lost = [0u8; 2];
+        pdi.read(regs::LOST_LINK_COUNTER, &mut lost)?;
+        let [f0, e0, f1, e1] = rx;
+        let now = PortDiag {
+            dl_status: pdi.read_u16(regs::DL_STATUS)?,
+            lost,
+            rx_errors: [u16::from(f0) + u16::from(e0), u16::from(f1) + u16::from(e1)],
+            shown: true,
+            er: self.er_code(),
+        };
+        if now != self.ports {
+            self.ports = now;
+            self.update_a257_texts();
+        }
+        Ok(())
+    }
+
+    /// A257[0] "ErX L0X L1X", [1] "L0 xx L1 xx", [2] "R0 xxxx R1 xxxx".
+    fn update_a257_texts(&mut self) {
+        let p = self.ports;
+        let link = |n: u8| u8::from(p.dl_status & regs::dl_status::link(n) != 0);
+        let mut t = Text::new();
+        t.put(b"Er");
+        t.dec(p.er);
+        t.put(b" L0");
+        t.dec(link(0));
+        t.put(b" L1");
+        t.dec(link(1));
+        let _ = self.objects.set_bytes(A257, 1, t.bytes());
+        let [l0, l1] = p.lost;
+        let mut t = Text::new();
+        t.put(b"L0 ");
+        t.hex(u16::from(l0), 2);
+        t.put(b" L1 ");
+        t.hex(u16::from(l1), 2);
+        let _ = self.objects.set_bytes(A257, 2, t.bytes());
+        let [r0, r1] = p.rx_errors;
+        let mut t = Text::new();
+        t.put(b"R0 ");
+        t.hex(r0, 4);
+        t.put(b" R1 ");
+        t.hex(r1, 4);
+        let _ = self.objects.set_bytes(A257, 3, t.bytes());
     }
 
     /// Where the aligned cycle does Rx and Tx after its start, ns (the
@@ -574,7 +833,8 @@ impl<F: Flash> Drive<F> {
     pub fn on_sync0<P: Pdi>(&mut self, pdi: &mut P, t_local_ns: u64) -> Result<(), P::Error> {
         let cycle = pdi.read_u32(regs::dc::SYNC0_CYCLE)?;
         let current = self.pll.as_ref().map(|p| p.config().sync0_cycle_ns);
-        if current != Some(cycle) {
+        if current != Some(cycle) || self.pll_from_sm {
+            self.pll_from_sm = false;
             match Pll::new(self.pll_config(cycle)) {
                 Ok(pll) => {
                     self.pll = Some(pll);
@@ -620,13 +880,48 @@ impl<F: Flash> Drive<F> {
 
     /// The master's process data (SM2) arrived at local time `t_local_ns`:
     /// `A261[1]`, `[2]`. `None` without a PLL or before the first SYNC0.
+    ///
+    /// In SM-Sync (`1C32h:01` = 1 accepted at P→S, Safe-Op and Op) the SM2
+    /// event is the synchronisation signal instead (E-110, spec §9.5.1): the
+    /// PLL is built at the first event with the process-data cycle
+    /// (`1C32h:02`, else A150) and locks the control cycle to event − A292
+    /// like to SYNC0 − A292; it goes when the drive leaves Safe-Op/Op.
     pub fn on_frame(&mut self, t_local_ns: u64) -> Option<FrameTiming> {
+        if self.slave.sync_status().mode == SyncMode::SmSync
+            && matches!(self.slave.state(), AlState::SafeOp | AlState::Op)
+        {
+            self.on_sm_event(t_local_ns);
+            return None;
+        }
         let timing = self.pll.as_mut()?.on_frame(t_local_ns);
         if let Some(t) = timing {
             self.frame_rel_sync0_ns = Some(t.rel_sync0_ns);
         }
         self.update_sync_live();
         timing
+    }
+
+    /// SM-Sync: the SM2 event at `t_local_ns` as the PLL's sync pulse.
+    fn on_sm_event(&mut self, t_local_ns: u64) {
+        let cycle = self.slave.sync_status().cycle_ns;
+        let current = self.pll.as_ref().map(|p| p.config().sync0_cycle_ns);
+        if current != Some(cycle) || !self.pll_from_sm {
+            match Pll::new(self.pll_config(cycle)) {
+                Ok(pll) => {
+                    self.pll = Some(pll);
+                    self.sync_error = None;
+                }
+                Err(e) => {
+                    self.pll = None;
+                    self.sync_error = Some(e);
+                }
+            }
+            self.pll_from_sm = true;
+        }
+        if let Some(pll) = self.pll.as_mut() {
+            pll.on_sync0(t_local_ns);
+        }
+        self.update_sync_live();
     }
 
     /// A296, A298 and A261 from the PLL (A261[0] also from a refused
@@ -651,17 +946,34 @@ impl<F: Flash> Drive<F> {
                 (status, d, 0)
             }
         };
-        let _ = self.objects.set(A298, 0, i64::from(status));
         // µs, rounded to nearest
-        let _ = self
-            .objects
-            .set(A296, 0, i64::from(measured.saturating_add(500) / 1000));
+        let measured_us = i64::from(measured.saturating_add(500) / 1000);
+        // bit 4: A296 > A291 (spec §11.6; the PLL itself compares with the
+        // SYNC0 cycle it was configured for)
+        let a291_us = self.objects.get(A291, 0).unwrap_or(0);
+        let status = if measured_us > 0 && a291_us > 0 && measured_us > a291_us {
+            status | dcsync::PllStatus::SYNC_CYCLE_TOO_LONG
+        } else {
+            status
+        };
+        let _ = self.objects.set(A298, 0, i64::from(status));
+        let _ = self.objects.set(A296, 0, measured_us);
         let [code, data_us, late, phase] = diag.elements();
         let _ = self.objects.set(A261, 1, i64::from(code));
         let _ = self.objects.set(A261, 2, i64::from(data_us));
         let _ = self.objects.set(A261, 3, i64::from(late));
         // `[3]` is declared U32: the phase error's two's complement
         let _ = self.objects.set(A261, 4, i64::from(phase as u32));
+        // 1C32h/1C33h (mirrored in A264/A265, E-119): :0B SM-event missed
+        // = the late frames of A261[2], :20 sync error = a PLL fault or a
+        // refused SYNC0 configuration
+        let fault = self.pll.as_ref().is_some_and(|p| p.fault().is_some()) || self.sync_error.is_some();
+        for index in [0x1C32, 0x1C33] {
+            let _ = self
+                .objects
+                .set(index, 0x0B, i64::from(late.clamp(0, i32::from(u16::MAX))));
+            let _ = self.objects.set(index, 0x20, i64::from(fault));
+        }
     }
 
     /// Reads an object as the bus sees it (live values included), without the bus.
@@ -707,15 +1019,69 @@ impl<F: Flash> Drive<F> {
         let code = self.slave.al_status_code();
         if code != self.last_code {
             self.last_code = code;
-            let mut text = *b"AL 0000";
-            for (i, slot) in text.iter_mut().skip(3).enumerate() {
-                let nibble = (code.0 >> (12 - 4 * i)) & 0xF;
-                *slot = b"0123456789ABCDEF"
-                    .get(usize::from(nibble))
-                    .copied()
-                    .unwrap_or(b'?');
-            }
-            let _ = self.objects.set_bytes(A257, 4, &text);
+            let mut t = Text::new();
+            t.put(b"AL ");
+            t.hex(code.0, 4);
+            let _ = self.objects.set_bytes(A257, 4, t.bytes());
         }
+        if self.ports.shown && self.er_code() != self.ports.er {
+            self.ports.er = self.er_code();
+            self.update_a257_texts();
+        }
+    }
+}
+
+/// Whether `e` is the EMCY of event 52 (7500h, E82 = 52).
+fn is_event52(e: &Emcy) -> bool {
+    let [e82, ..] = e.data;
+    e.code == 0x7500 && e82 == event52::EVENT
+}
+
+/// A short diagnosis text (A257) built without the heap.
+struct Text {
+    buf: [u8; 16],
+    len: usize,
+}
+
+impl Text {
+    const fn new() -> Self {
+        Self { buf: [0; 16], len: 0 }
+    }
+
+    fn push(&mut self, b: u8) {
+        if let Some(slot) = self.buf.get_mut(self.len) {
+            *slot = b;
+            self.len += 1;
+        }
+    }
+
+    fn put(&mut self, s: &[u8]) {
+        for &b in s {
+            self.push(b);
+        }
+    }
+
+    /// `v` in decimal, no leading zeros.
+    fn dec(&mut self, v: u8) {
+        if v >= 100 {
+            self.push(b'0' + v / 100);
+        }
+        if v >= 10 {
+            self.push(b'0' + (v / 10) % 10);
+        }
+        self.push(b'0' + v % 10);
+    }
+
+    /// The low `digits` hex digits of `v`, upper case, leading zeros.
+    fn hex(&mut self, v: u16, digits: u32) {
+        for i in (0..digits).rev() {
+            let nibble = (u32::from(v) >> (4 * i)) & 0xF;
+            let c = b"0123456789ABCDEF".get(nibble as usize).copied().unwrap_or(b'?');
+            self.push(c);
+        }
+    }
+
+    fn bytes(&self) -> &[u8] {
+        self.buf.get(..self.len).unwrap_or_default()
     }
 }

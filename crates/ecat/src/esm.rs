@@ -67,6 +67,17 @@ pub fn check_mailbox_sms(desc: &Device, sm0: &SyncManager, sm1: &SyncManager) ->
     }
 }
 
+/// Whether mailbox SyncManager `n` (0 = master → slave, "mailbox Rx"; 1 =
+/// slave → master, "mailbox Tx") alone passes the I→P check of
+/// [`check_mailbox_sms`]: which one failed (A257 Er10 / Er9).
+pub fn mailbox_sm_ok_alone(desc: &Device, n: u8, sm: &SyncManager) -> bool {
+    match n {
+        0 => mailbox_sm_ok(sm, &desc.mailbox_out, SmDirection::MasterWrite),
+        1 => mailbox_sm_ok(sm, &desc.mailbox_in, SmDirection::MasterRead),
+        _ => false,
+    }
+}
+
 /// The memory an active SyncManager occupies, as a half-open range.
 fn area(sm: &SyncManager) -> Option<(u32, u32)> {
     (sm.enabled() && sm.length > 0).then(|| {
@@ -341,7 +352,7 @@ pub const STEADY_WAIT_NS: u64 = 200_000_000;
 /// |---|---|---|
 /// | [`PDO_TIMEOUT`] (6) | [`crate::Slave`] in Op | no RxPDO for longer than A258, or the ESC's SM watchdog (A258 = 65534) expired (AL 001Bh) |
 /// | [`SYNC`] (7) | [`crate::Slave`] in Op, DC mode | the application reports a synchronisation fault through [`crate::Slave::set_sync_state`]: SYNC0 timeout (0034h), late frames (0033h), lost lock (0032h) (E-131; the spec's cell merges synchronisation and connection errors, uncertain) |
-/// | [`WRONG_FIRMWARE`] (15) | not raised | the projected fieldbus identification E59[2] ≠ the firmware's E52[3] (E-130): this firmware has no E59/E52 to compare |
+/// | [`WRONG_FIRMWARE`] (15) | the application (`drive::runtime`) | the projected fieldbus identification E59[2] ≠ the firmware's (E-130) |
 pub mod event52 {
     /// `E82` of the event.
     pub const EVENT: u8 = 52;
@@ -350,7 +361,8 @@ pub mod event52 {
     /// Cause 7: synchronisation (or connection) error; the value
     /// `dcsync::EVENT52_CAUSE_SYNC` the PLL reports.
     pub const SYNC: u8 = dcsync::EVENT52_CAUSE_SYNC;
-    /// Cause 15: wrong firmware for the application (not detected here).
+    /// Cause 15: wrong firmware for the application (detected by the
+    /// application, which queues the EMCY itself).
     pub const WRONG_FIRMWARE: u8 = 15;
 }
 

@@ -4,6 +4,7 @@
 //!   SyncManagers, FMMUs, PDO maps, DC op modes.
 //! - [`sii`]: the SII EEPROM image generated from it, and a checked category reader.
 //! - [`esm`]: the EtherCAT state machine rules and SyncManager checks (spec §3–4).
+//! - [`led`]: the RUN/ERR/link indicators (ETG.1300) as pure functions of state and time.
 //! - [`mailbox`]: the mailbox header and error replies; [`coe`]: the CoE server
 //!   ([`CoeServer`]: SDO expedited/normal/segmented transfers, complete access,
 //!   abort, timeout) over [`od::Dictionary`]; [`sdo_info`]: the SDO Information
@@ -27,6 +28,7 @@ pub mod desc;
 pub mod diag;
 pub mod emcy;
 pub mod esm;
+pub mod led;
 pub mod mailbox;
 pub mod sdo_info;
 pub mod sii;

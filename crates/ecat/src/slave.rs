@@ -173,6 +173,9 @@ pub struct Slave {
     /// The master acknowledged an error indication since the last
     /// [`Slave::take_error_ack`].
     error_acked: bool,
+    /// Cause of the event 52 the slave raised since the last
+    /// [`Slave::take_event52`].
+    event52: Option<u8>,
 }
 
 impl Slave {
@@ -216,6 +219,7 @@ impl Slave {
             },
             sync_state: SyncState::NONE,
             error_acked: false,
+            event52: None,
         }
     }
 
@@ -246,6 +250,24 @@ impl Slave {
     /// application then clears its latched faults (e.g. `Pll::clear_fault`).
     pub fn take_error_ack(&mut self) -> bool {
         core::mem::take(&mut self.error_acked)
+    }
+
+    /// The cause (`E43`) of the event 52 "Communication" the slave raised
+    /// since the last call ([`event52::PDO_TIMEOUT`] or [`event52::SYNC`],
+    /// with Op left for Safe-Op and EMCY 7500h queued): the application runs
+    /// its fault reaction (A540, E-129) without a second EMCY.
+    pub fn take_event52(&mut self) -> Option<u8> {
+        self.event52.take()
+    }
+
+    /// The RUN LED's pattern now (E-133, [`crate::led::run`]).
+    pub fn run_led(&self) -> crate::led::Pattern {
+        crate::led::run(self.state)
+    }
+
+    /// The ERR LED's pattern now (E-132, [`crate::led::err`]).
+    pub fn err_led(&self) -> crate::led::Pattern {
+        crate::led::err(self.error, self.sync.unsolicited, self.code)
     }
 
     /// Whether an S→O request waits for stable RxPDO (E-033) or for the
@@ -462,6 +484,7 @@ impl Slave {
         self.sync.unsolicited = true;
         self.emcy
             .push(Emcy::for_event(event52::EVENT, event52::PDO_TIMEOUT, 0));
+        self.event52 = Some(event52::PDO_TIMEOUT);
         self.write_status(pdi)?;
         Ok(Some(StateChange {
             from: AlState::Op,
@@ -505,6 +528,7 @@ impl Slave {
         self.code = code;
         self.sync.unsolicited = true;
         self.emcy.push(Emcy::for_event(event52::EVENT, event52::SYNC, 0));
+        self.event52 = Some(event52::SYNC);
         self.write_status(pdi)?;
         Ok(Some(StateChange {
             from: AlState::Op,

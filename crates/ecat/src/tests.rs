@@ -835,12 +835,20 @@ fn e046_e131_e038_dc_sync_state_gates_op_and_faults_in_op() {
         ready: Err(AlStatusCode(0x0034)),
         fault: Some(AlStatusCode(0x0034)),
     });
+    assert_eq!(r.slave.run_led(), crate::led::Pattern::On);
+    assert_eq!(r.slave.err_led(), crate::led::Pattern::Off);
+    assert_eq!(r.slave.take_event52(), None, "nothing raised in Op yet");
     let c = r.poll().expect("dropped");
     assert!(c.unsolicited);
     assert_eq!(
         (c.from, c.to, c.code),
         (AlState::Op, AlState::SafeOp, AlStatusCode(0x0034))
     );
+    // the application learns the cause once (its fault reaction, E-129)
+    assert_eq!(r.slave.take_event52(), Some(7));
+    assert_eq!(r.slave.take_event52(), None);
+    assert_eq!(r.slave.run_led(), crate::led::Pattern::SingleFlash);
+    assert_eq!(r.slave.err_led(), crate::led::Pattern::SingleFlash, "unsolicited");
     assert_eq!((r.esc.status(), r.esc.code()), (0x14, 0x0034));
     assert!(r.slave.sync_status().unsolicited);
     assert!(!r.slave.sync_status().triggered, "not a PDO timeout (A259)");
@@ -877,7 +885,7 @@ fn e046_e131_e038_dc_sync_state_gates_op_and_faults_in_op() {
 }
 
 #[test]
-fn e129_e131_event52_causes() {
+fn e089_e131_event52_cause_codes() {
     use crate::esm::event52;
     assert_eq!(event52::EVENT, 52);
     assert_eq!(event52::PDO_TIMEOUT, 6);

@@ -341,10 +341,14 @@ impl CoeServer {
         if size.is_some_and(|s| end > s) {
             return Err((index, sub, SdoAbort::TYPE_MISMATCH));
         }
-        self.buf
+        let dst = self
+            .buf
             .get_mut(self.len..end)
-            .ok_or((index, sub, SdoAbort::OUT_OF_MEMORY))?
-            .copy_from_slice(data);
+            .ok_or((index, sub, SdoAbort::OUT_OF_MEMORY))?;
+        // equal lengths unless `end` saturated (then the range fails above)
+        for (d, s) in dst.iter_mut().zip(data) {
+            *d = *s;
+        }
         self.len = end;
         let cmd = 0x20 | if toggle { 0x10 } else { 0 };
         if last {
