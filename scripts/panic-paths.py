@@ -9,8 +9,8 @@ the vector table. Any `core::panicking::*` function, `slice_index_fail`,
 the panic handler itself (`rust_begin_unwind`) is reachable only through
 them, so an image without reachable panic paths has none except the handler.
 
-Prints each reachable panic function with one shortest call chain from an
-entry point. Exit status 1 when there is one (with --check), else 0.
+Prints each reachable call site (the function that calls a panic function)
+with one shortest call chain from an entry point. Exit status 1 when there is one (with --check), else 0.
 
 Limits: calls through function pointers (trait objects, `blx reg`) are not
 followed; the core crates use generics, not `dyn`, on the bus paths.
@@ -99,14 +99,28 @@ def main():
             if g not in parent:
                 parent[g] = f
                 queue.append(g)
-    found = sorted(f for f in parent if PANIC.search(f) and parent[f] is not None)
-    print(f"panic-paths: {len(entries)} entry points, {len(parent)} reachable functions, {len(found)} reachable panic functions")
-    for f in found:
+    # every reachable function that calls a panic function directly: one line each
+    sites = sorted(
+        (f, p)
+        for f in parent
+        if not PANIC.search(f) and not any(a.search(f) for a in allow)
+        for p in sorted(calls.get(f, ()))
+        if PANIC.search(p)
+    )
+    allowed = sorted(f for f in parent if any(a.search(f) for a in allow))
+    found = sorted({p for _, p in sites})
+    print(
+        f"panic-paths: {len(entries)} entry points, {len(parent)} reachable functions, "
+        f"{len(sites)} reachable call sites of {len(found)} panic functions"
+    )
+    for f in allowed:
+        print(f"  allowed: {f[:100]}")
+    for f, p in sites:
         chain = [f]
         while parent[chain[-1]] is not None:
             chain.append(parent[chain[-1]])
-        print("  " + " <- ".join(c[:80] for c in chain))
-    if args.check and found:
+        print(f"  {p[:60]} <- " + " <- ".join(c[:80] for c in chain))
+    if args.check and sites:
         sys.exit(1)
 
 

@@ -104,11 +104,18 @@ mod app {
 
     /// The drive in its static, built in this function's own frame.
     #[inline(never)]
+    #[allow(unsafe_code)]
     fn make_drive() -> Option<&'static mut Drive> {
-        // through an opaque function pointer: `Drive::new` is not inlined
-        // here, so its locals and the value's copy do not share one frame
-        let new: fn(ParamFlash) -> Drive = Drive::new;
-        cortex_m::singleton!(: Drive = core::hint::black_box(new)(ParamFlash::new()))
+        static mut DRIVE: core::mem::MaybeUninit<Drive> = core::mem::MaybeUninit::uninit();
+        static TAKEN: core::sync::atomic::AtomicBool = core::sync::atomic::AtomicBool::new(false);
+        if TAKEN.swap(true, core::sync::atomic::Ordering::AcqRel) {
+            return None;
+        }
+        // SAFETY: the flag hands out the static once; `write` lets the drive
+        // be built in place (no copy of ~30 KiB through this frame, which
+        // `cortex_m::singleton!` makes).
+        let slot = unsafe { &mut *core::ptr::addr_of_mut!(DRIVE) };
+        Some(slot.write(Drive::new(ParamFlash::new())))
     }
 
     /// Background: fires the control cycle when its time has come (until
@@ -126,35 +133,43 @@ mod app {
     /// SYNC0 from the ESC (via ERU1): acknowledge, PLL measurement.
     #[task(binds = ERU1_0, priority = 3, shared = [drive, timer, pdi, clock])]
     fn sync0(cx: sync0::Context) {
-        (cx.shared.drive, cx.shared.timer, cx.shared.pdi, cx.shared.clock).lock(|drive, timer, pdi, clock| {
-            let now = clock.now_ns(DWT::cycle_count());
-            if tasks::sync0(drive, timer, pdi, now).is_err() {
-                defmt::warn!("sync0: PDI access failed");
-            }
-        });
+        (cx.shared.drive, cx.shared.timer, cx.shared.pdi, cx.shared.clock).lock(
+            |drive, timer, pdi, clock| {
+                let now = clock.now_ns(DWT::cycle_count());
+                if tasks::sync0(drive, timer, pdi, now).is_err() {
+                    defmt::warn!("sync0: PDI access failed");
+                }
+            },
+        );
     }
 
     /// The control-cycle timer: one cycle of both axes.
     #[task(binds = CCU40_0, priority = 3, shared = [drive, timer, clock, cmd])]
     fn control(cx: control::Context) {
-        (cx.shared.drive, cx.shared.timer, cx.shared.clock, cx.shared.cmd).lock(|drive, timer, clock, cmd| {
-            let now = clock.now_ns(DWT::cycle_count());
-            if timer.next_at_ns() <= now {
-                *cmd = tasks::control(drive, timer, now, &[AxisIo::ready(0); 2]);
-            }
-        });
+        (cx.shared.drive, cx.shared.timer, cx.shared.clock, cx.shared.cmd).lock(
+            |drive, timer, clock, cmd| {
+                let now = clock.now_ns(DWT::cycle_count());
+                if timer.next_at_ns() <= now {
+                    *cmd = tasks::control(drive, timer, now, &[AxisIo::ready(0); 2]);
+                }
+            },
+        );
     }
 
     /// The ESC's PDI interrupt: ESM, mailbox, process data.
     #[task(binds = ECAT0_0, priority = 2, shared = [drive, timer, pdi, clock])]
     fn esc(cx: esc::Context) {
-        (cx.shared.drive, cx.shared.timer, cx.shared.pdi, cx.shared.clock).lock(|drive, timer, pdi, clock| {
-            let now = clock.now_ns(DWT::cycle_count());
-            match tasks::esc_event(drive, timer, pdi, now) {
-                Ok(Some(c)) => defmt::info!("esc: AL state {=u8} (code {=u16:04X})", c.to.code(), c.code.0),
-                Ok(None) => {}
-                Err(_) => defmt::warn!("esc: PDI access failed"),
-            }
-        });
+        (cx.shared.drive, cx.shared.timer, cx.shared.pdi, cx.shared.clock).lock(
+            |drive, timer, pdi, clock| {
+                let now = clock.now_ns(DWT::cycle_count());
+                match tasks::esc_event(drive, timer, pdi, now) {
+                    Ok(Some(c)) => {
+                        defmt::info!("esc: AL state {=u8} (code {=u16:04X})", c.to.code(), c.code.0)
+                    }
+                    Ok(None) => {}
+                    Err(_) => defmt::warn!("esc: PDI access failed"),
+                }
+            },
+        );
     }
 }

@@ -22,10 +22,10 @@ impl Link for SimLink<'_> {
     }
 }
 
-/// E-108/C-145 through the scripted master: Pre-Op SDOs, DC SYNC0, Op,
+/// E-107 (DC-Sync selected by the master) through the scripted master: Pre-Op SDOs, DC SYNC0, Op,
 /// enable, a csp move on both axes, disable and back to Init.
 #[test]
-fn e108_scripted_master_runs_csp_on_both_axes_with_sync0() {
+fn e107_scripted_master_selects_dc_sync_and_runs_csp_on_both_axes() {
     let mut sim = Simulation::new(1);
     let mut script = Script::new();
     let mut log = Vec::new();

@@ -8,7 +8,7 @@
 //! (element + 1 for manufacturer arrays), so it does not change with the
 //! template.
 
-use core::cell::Cell;
+use core::sync::atomic::{AtomicU32, Ordering};
 
 use crate::objects::{self, enumeration, find, Object, Value, IMAGE_BYTES, INITIAL_IMAGE, OBJECTS, OFFSETS};
 use crate::{parameter_index, MAPPING_ENTRIES, SOFTWARE_BUILD};
@@ -179,25 +179,174 @@ fn put(buf: &mut [u8], data: &[u8]) -> Result<usize, SdoAbort> {
     Ok(data.len())
 }
 
-/// Where an integer (or REAL32) entry with a RAM slot lives: what
-/// [`DriveObjects::get`] and [`DriveObjects::set`] resolve `index`:`sub` to
-/// (aliases and mirrors followed). Depends only on the declaration.
+/// Where an integer/REAL32 entry's value lives.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+enum Place {
+    /// A slot in the RAM image starting at this byte.
+    Ram(u16),
+    /// A constant (the declared default as its type reads it), ≤ 32 bits.
+    Const(i64),
+}
+
+/// What [`DriveObjects::get`] and [`DriveObjects::set`] resolve
+/// `index`:`sub` to (aliases and mirrors followed). Depends only on the
+/// declaration.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
 struct Resolved {
-    /// `index << 8 | sub` of the request.
+    /// `index << 8 | sub` of the request (24 bits).
     key: u32,
-    /// First byte in the RAM image.
-    at: u16,
+    place: Place,
     /// The entry's type (its width is the slot's).
     data_type: DataType,
 }
 
-/// Lines of the resolution cache (a power of two).
-const CACHE_LINES: usize = 128;
+/// The scalar types a cache slot can hold, by code (0 = empty slot).
+const CACHED_TYPES: [DataType; 10] = [
+    DataType::Bool,
+    DataType::I8,
+    DataType::I16,
+    DataType::I32,
+    DataType::U8,
+    DataType::U16,
+    DataType::U32,
+    DataType::F32,
+    DataType::I64,
+    DataType::U64,
+];
 
-/// The cache line of `key` (multiplicative hash).
-fn cache_line(key: u32) -> usize {
-    (key.wrapping_mul(0x9E37_79B1) >> 25) as usize % CACHE_LINES
+/// Type-code flag of a constant.
+const CONST_FLAG: u32 = 0x80;
+
+impl Resolved {
+    /// Packed into two words: key (24 bits) | constant flag | type code
+    /// (1..=10; the word is never 0 or [`BUSY`]), then the RAM offset or the
+    /// constant's 32 bits.
+    fn pack(self) -> Option<(u32, u32)> {
+        let code = CACHED_TYPES.iter().position(|&t| t == self.data_type)? as u32 + 1;
+        match self.place {
+            Place::Ram(at) => Some(((self.key << 8) | code, u32::from(at))),
+            Place::Const(v) => {
+                let bits = match self.data_type {
+                    DataType::I8 | DataType::I16 | DataType::I32 => i32::try_from(v).ok()? as u32,
+                    DataType::I64 | DataType::U64 => return None,
+                    _ => u32::try_from(v).ok()?,
+                };
+                Some(((self.key << 8) | CONST_FLAG | code, bits))
+            }
+        }
+    }
+
+    fn unpack(key: u32, word: u32, value: u32) -> Option<Self> {
+        let data_type = *CACHED_TYPES.get(((word & 0x7F) as usize).checked_sub(1)?)?;
+        let place = if word & CONST_FLAG == 0 {
+            Place::Ram(u16::try_from(value).ok()?)
+        } else if matches!(data_type, DataType::I8 | DataType::I16 | DataType::I32) {
+            Place::Const(i64::from(value as i32))
+        } else {
+            Place::Const(i64::from(value))
+        };
+        Some(Self {
+            key,
+            place,
+            data_type,
+        })
+    }
+}
+
+/// Slots of the resolution cache (a power of two), two words each: key and
+/// type code, then the RAM offset or constant. Open addressing, no eviction; the runtime
+/// touches ~250 distinct entries. The cache is a memo of the (constant)
+/// declaration, shared by every [`DriveObjects`] and every task: a slot is
+/// claimed with a compare-and-swap to [`BUSY`], its offset written, then its
+/// key published (release); readers take a slot only with its key (acquire).
+const CACHE_SLOTS: usize = 512;
+/// Probes before a lookup gives up on the cache (the entry is then resolved
+/// without being cached).
+const MAX_PROBES: usize = 16;
+/// A slot being filled.
+const BUSY: u32 = u32::MAX;
+
+static CACHE_KEYS: [AtomicU32; CACHE_SLOTS] = [const { AtomicU32::new(0) }; CACHE_SLOTS];
+static CACHE_AT: [AtomicU32; CACHE_SLOTS] = [const { AtomicU32::new(0) }; CACHE_SLOTS];
+
+/// The home slot of `key` (multiplicative hash, top 9 bits).
+fn home_slot(key: u32) -> usize {
+    (key.wrapping_mul(0x9E37_79B1) >> 23) as usize % CACHE_SLOTS
+}
+
+/// Where integer/REAL32 entry `index`:`sub` ("EtherCAT Rx SDO Info"
+/// numbering, aliases followed) lives, from the cache or resolved and
+/// cached; `None` for entries that are neither in RAM nor constant.
+fn resolve(index: u16, sub: u8) -> Option<Resolved> {
+    let key = (u32::from(index) << 8) | u32::from(sub);
+    let mut at = home_slot(key);
+    for _ in 0..MAX_PROBES {
+        let (k, a) = (CACHE_KEYS.get(at)?, CACHE_AT.get(at)?);
+        match k.load(Ordering::Acquire) {
+            0 => {
+                let r = lookup(key)?;
+                if let Some((word, value)) = r.pack() {
+                    if k.compare_exchange(0, BUSY, Ordering::AcqRel, Ordering::Relaxed)
+                        .is_ok()
+                    {
+                        a.store(value, Ordering::Relaxed);
+                        k.store(word, Ordering::Release);
+                    }
+                }
+                return Some(r);
+            }
+            BUSY => return lookup(key),
+            word if word >> 8 == key => return Resolved::unpack(key, word, a.load(Ordering::Relaxed)),
+            _ => at = (at + 1) % CACHE_SLOTS,
+        }
+    }
+    lookup(key)
+}
+
+/// Resolves `key` from the declaration: `None` for entries that are not
+/// an integer/REAL32 in RAM or a constant (strings, 1018h, commands, unknown).
+fn lookup(key: u32) -> Option<Resolved> {
+    let (index, sub) = ((key >> 8) as u16, key as u8);
+    let loc = follow(canonical(index, sub).ok()?).ok()?;
+    let e = loc.entry().ok()?;
+    let data_type = e.data_type;
+    if !CACHED_TYPES.contains(&data_type) {
+        return None;
+    }
+    let place = match loc.object().ok()?.value {
+        Value::Ram | Value::Live => Place::Ram(u16::try_from(loc.slot().ok()?.start).ok()?),
+        Value::Const => {
+            let mut raw = [0u8; 8];
+            let n = data_type.encode(e.default, &mut raw).ok()?;
+            Place::Const(data_type.decode(raw.get(..n)?).ok()?)
+        }
+        _ => return None,
+    };
+    Some(Resolved {
+        key,
+        place,
+        data_type,
+    })
+}
+
+/// Reads `N` bytes at `at`.
+fn bytes_at<const N: usize>(image: &[u8], at: usize) -> Option<[u8; N]> {
+    image.get(at..at + N)?.try_into().ok()
+}
+
+/// The value of type `t` at `at` in `image` (the common widths without the
+/// generic decoder's copy and shifts).
+fn load(image: &[u8], at: usize, t: DataType) -> Result<i64, SdoAbort> {
+    let v = match t {
+        DataType::Bool | DataType::U8 => bytes_at::<1>(image, at).map(|[b]| i64::from(b)),
+        DataType::I8 => bytes_at::<1>(image, at).map(|[b]| i64::from(b as i8)),
+        DataType::U16 => bytes_at(image, at).map(|b| i64::from(u16::from_le_bytes(b))),
+        DataType::I16 => bytes_at(image, at).map(|b| i64::from(i16::from_le_bytes(b))),
+        DataType::U32 => bytes_at(image, at).map(|b| i64::from(u32::from_le_bytes(b))),
+        DataType::I32 => bytes_at(image, at).map(|b| i64::from(i32::from_le_bytes(b))),
+        _ => return t.decode(image.get(at..at + t.bytes()).ok_or(SdoAbort::GENERAL)?),
+    };
+    v.ok_or(SdoAbort::GENERAL)
 }
 
 /// The drive's object dictionary: the RAM image of every value, the active
@@ -205,26 +354,16 @@ fn cache_line(key: u32) -> usize {
 /// (live entries from the RAM image; see [`DriveObjects::with_live`]).
 ///
 /// The runtime reads and writes ~60 entries per axis and control cycle
-/// through [`get`](Self::get)/[`set`](Self::set); a direct-mapped cache of
-/// resolved slots makes those a hash, a compare and a copy instead of a
-/// binary search, an entry scan and an offset sum (docs/architecture.md,
-/// cycle cost). The cache is not part of the dictionary's value (equality
-/// ignores it).
-#[derive(Debug, Clone)]
+/// through [`get`](Self::get)/[`set`](Self::set); a shared cache of
+/// resolved RAM slots (open addressing, filled on first use) makes those a
+/// hash, a compare and a load instead of a binary search, an entry scan and
+/// an offset sum (docs/architecture.md, cycle cost).
+#[derive(Debug, Clone, PartialEq, Eq)]
 pub struct DriveObjects {
     image: [u8; IMAGE_BYTES],
     template: Template,
     requests: Requests,
-    cache: [Cell<Option<Resolved>>; CACHE_LINES],
 }
-
-impl PartialEq for DriveObjects {
-    fn eq(&self, other: &Self) -> bool {
-        self.image == other.image && self.template == other.template && self.requests == other.requests
-    }
-}
-
-impl Eq for DriveObjects {}
 
 impl Default for DriveObjects {
     fn default() -> Self {
@@ -252,29 +391,7 @@ impl DriveObjects {
                 restart: false,
                 defaults_restored: false,
             },
-            cache: [const { Cell::new(None) }; CACHE_LINES],
         }
-    }
-
-    /// The RAM slot of integer/REAL32 entry `index`:`sub` ("EtherCAT Rx SDO
-    /// Info" numbering, aliases followed), from the cache or resolved and
-    /// cached; `None` for entries without a slot (constants, texts) or
-    /// unknown ones.
-    fn resolve(&self, index: u16, sub: u8) -> Option<Resolved> {
-        let key = (u32::from(index) << 8) | u32::from(sub);
-        let line = self.cache.get(cache_line(key))?;
-        if let Some(r) = line.get().filter(|r| r.key == key) {
-            return Some(r);
-        }
-        let loc = follow(canonical(index, sub).ok()?).ok()?;
-        let data_type = loc.entry().ok()?.data_type;
-        if !in_ram(loc).ok()? || !(data_type.is_integer() || data_type == DataType::F32) {
-            return None;
-        }
-        let at = u16::try_from(loc.slot().ok()?.start).ok()?;
-        let r = Resolved { key, at, data_type };
-        line.set(Some(r));
-        Some(r)
     }
 
     /// This dictionary with `live` answering the live entries.
@@ -363,13 +480,11 @@ impl DriveObjects {
     /// The integer value of `index`:`sub` ("EtherCAT Rx SDO Info" numbering,
     /// aliases followed; live entries as last set in the RAM image).
     pub fn get(&self, index: u16, sub: u8) -> Result<i64, SdoAbort> {
-        if let Some(r) = self.resolve(index, sub) {
-            let at = usize::from(r.at);
-            let raw = self
-                .image
-                .get(at..at + r.data_type.bytes())
-                .ok_or(SdoAbort::GENERAL)?;
-            return r.data_type.decode(raw);
+        if let Some(r) = resolve(index, sub) {
+            return match r.place {
+                Place::Ram(at) => load(&self.image, usize::from(at), r.data_type),
+                Place::Const(v) => Ok(v),
+            };
         }
         let loc = follow(canonical(index, sub)?)?;
         let t = loc.entry()?.data_type;
@@ -383,7 +498,7 @@ impl DriveObjects {
     /// "EtherCAT Rx SDO Info" numbering; entries without a RAM slot
     /// (constants) answer 0601 0002h.
     pub fn set(&mut self, index: u16, sub: u8, value: i64) -> Result<(), SdoAbort> {
-        let resolved = self.resolve(index, sub);
+        let resolved = resolve(index, sub);
         let t = match resolved {
             Some(r) => r.data_type,
             None => follow(canonical(index, sub)?)?.entry()?.data_type,
@@ -399,7 +514,10 @@ impl DriveObjects {
             });
         }
         if let Some(r) = resolved {
-            let at = usize::from(r.at);
+            let Place::Ram(at) = r.place else {
+                return Err(SdoAbort::READ_ONLY);
+            };
+            let at = usize::from(at);
             let slot = self.image.get_mut(at..at + t.bytes()).ok_or(SdoAbort::GENERAL)?;
             return t.encode(value, slot).map(|_| ());
         }
@@ -660,7 +778,10 @@ impl DriveObjects {
         for slot in Self::persistent_slots() {
             let (src, rest) = payload.split_at(slot.len().min(payload.len()));
             if let Some(dst) = self.image.get_mut(slot) {
-                dst.copy_from_slice(src);
+                // equal lengths after the size check above; zip keeps it panic-free
+                for (d, s) in dst.iter_mut().zip(src) {
+                    *d = *s;
+                }
             }
             payload = rest;
         }
@@ -674,7 +795,9 @@ impl DriveObjects {
     pub fn restore_defaults(&mut self) {
         for slot in Self::persistent_slots() {
             if let (Some(dst), Some(src)) = (self.image.get_mut(slot.clone()), INITIAL_IMAGE.get(slot)) {
-                dst.copy_from_slice(src);
+                for (d, s) in dst.iter_mut().zip(src) {
+                    *d = *s;
+                }
             }
         }
     }

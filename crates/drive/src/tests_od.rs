@@ -709,3 +709,39 @@ fn ram_image_layout() {
     }
     let _ = rd(&mut d, 0x1000, 0);
 }
+
+/// The resolution cache of `get`/`set` answers exactly what the SDO path
+/// reads, for every readable integer entry, on the first (resolving) and
+/// the second (cached) access, and after a `set` through the cache.
+#[test]
+fn e016_cached_get_equals_the_sdo_read_of_every_entry() {
+    let mut d = DriveObjects::new();
+    let mut checked = 0;
+    for o in OBJECTS.iter() {
+        for e in o.info.entries {
+            if !(e.data_type.is_integer() || e.data_type == od::DataType::F32) {
+                continue;
+            }
+            let mut buf = [0u8; 8];
+            let Ok(n) = d.read(o.info.index, e.sub, &mut buf, CommState::PreOp) else {
+                continue;
+            };
+            let Ok(sdo) = e.data_type.decode(&buf[..n]) else {
+                continue;
+            };
+            let first = d.get(o.info.index, e.sub);
+            let second = d.get(o.info.index, e.sub);
+            assert_eq!(first, Ok(sdo), "{:04X}:{}", o.info.index, e.sub);
+            assert_eq!(second, Ok(sdo), "{:04X}:{} cached", o.info.index, e.sub);
+            checked += 1;
+        }
+    }
+    assert!(checked > 300, "{checked} entries");
+    // a set through the cache lands where the SDO path reads
+    d.set(0x6065, 0, 4321).unwrap();
+    let mut buf = [0u8; 4];
+    assert_eq!(d.read(0x6065, 0, &mut buf, CommState::PreOp), Ok(4));
+    assert_eq!(u32::from_le_bytes(buf), 4321);
+    // constants stay read-only through the cache
+    assert_eq!(d.set(0x1000, 0, 1), Err(SdoAbort::READ_ONLY));
+}

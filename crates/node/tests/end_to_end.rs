@@ -88,28 +88,23 @@ fn clock_counts_across_counter_wraps() {
     let mut c = Clock::new(144_000_000);
     assert_eq!(c.now_ns(0), 0);
     assert_eq!(c.now_ns(144_000), 1_000_000);
-    // three quarters of the range per reading, five readings: past a wrap
+    // five readings three quarters of the counter range apart: past three wraps
     let mut raw = 144_000u32;
+    let mut t = 0;
     for _ in 0..5 {
         raw = raw.wrapping_add(3 << 30);
+        t = c.now_ns(raw);
     }
-    let expect = (144_000u64 + 5 * (3u64 << 30)) * 1_000_000_000 / 144_000_000;
-    let mut c2 = Clock::new(144_000_000);
-    c2.now_ns(0);
-    let mut r = 0u32;
-    let mut t = 0;
-    for step in [144_000u32, 3 << 30, 3 << 30, 3 << 30, 3 << 30, 3 << 30] {
-        r = r.wrapping_add(step);
-        t = c2.now_ns(r);
-    }
-    assert_eq!(r, raw);
-    assert_eq!(t, expect);
+    let ticks = 144_000u64 + 5 * (3u64 << 30);
+    assert!(ticks > 3 * (1u64 << 32));
+    assert_eq!(t, ticks * 1_000_000_000 / 144_000_000);
 }
 
-/// Free-running at A150 without SYNC0, the timer follows the PLL once it
-/// exists and falls back when it goes.
+/// E-107 free run: without SYNC0 the control cycle runs at A150, the next
+/// start counted from the actual start (the PLL following is checked by the
+/// end-to-end test above).
 #[test]
-fn e108_free_run_cycle_until_sync0_then_pll_periods() {
+fn e107_free_run_cycle_at_a150_without_sync0() {
     let mut drive = Drive::new(ParamFlash::new());
     let mut timer = CycleTimer::new();
     assert_eq!(timer.next_at_ns(), CYCLE_NS);

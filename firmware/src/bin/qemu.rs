@@ -190,21 +190,25 @@ mod app {
                 cmd: [AxisCommand::OFF; 2],
                 cost: [0; 2],
             },
-            Local {
-                world,
-                per_kilo_tick,
-            },
+            Local { world, per_kilo_tick },
         )
     }
 
     // One function per singleton, never inlined: each builds its value in
     // its own frame, which is gone before the next one is built.
     #[inline(never)]
+    #[allow(unsafe_code)]
     fn make_drive() -> Option<&'static mut Drive> {
-        // through an opaque function pointer: `Drive::new` is not inlined
-        // here, so its locals and the value's copy do not share one frame
-        let new: fn(ParamFlash) -> Drive = Drive::new;
-        cortex_m::singleton!(: Drive = core::hint::black_box(new)(ParamFlash::new()))
+        static mut DRIVE: core::mem::MaybeUninit<Drive> = core::mem::MaybeUninit::uninit();
+        static TAKEN: core::sync::atomic::AtomicBool = core::sync::atomic::AtomicBool::new(false);
+        if TAKEN.swap(true, core::sync::atomic::Ordering::AcqRel) {
+            return None;
+        }
+        // SAFETY: the flag hands out the static once; `write` lets the drive
+        // be built in place (no copy of ~30 KiB through this frame, which
+        // `cortex_m::singleton!` makes).
+        let slot = unsafe { &mut *core::ptr::addr_of_mut!(DRIVE) };
+        Some(slot.write(Drive::new(ParamFlash::new())))
     }
 
     #[inline(never)]
@@ -354,7 +358,8 @@ mod app {
         let now = { cx.shared.clock }.lock(|c| *c);
         let io = { cx.shared.io }.lock(|i| *i);
         let t0 = measure::now();
-        let cmd = (cx.shared.drive, cx.shared.timer).lock(|drive, timer| tasks::control(drive, timer, now, &io));
+        let cmd =
+            (cx.shared.drive, cx.shared.timer).lock(|drive, timer| tasks::control(drive, timer, now, &io));
         let t = measure::ticks(t0, measure::now());
         { cx.shared.cost }.lock(|c| c[0] = t);
         { cx.shared.cmd }.lock(|c| *c = cmd);
