@@ -6,7 +6,7 @@ use crate::esc::{Esc, EscConfig, LineTiming};
 use crate::frame::process_frame;
 use crate::motor::{Input, Motor, MotorOutputs};
 use crate::pcap::PcapWriter;
-use drive::axis::{AxisIo, IndexLatch, ProbeEdge};
+use drive::axis::{AxisIo, IndexLatch, ProbeEdge, SwitchEdge, SwitchId};
 use std::collections::VecDeque;
 use std::fs::File;
 use std::io::{self, BufWriter};
@@ -173,6 +173,22 @@ fn axis_io(out: Option<&MotorOutputs>, motor: &Motor, c: AxisConditions) -> Axis
         })
     });
     for (slot, edge) in io.probe_edges.iter_mut().zip(probes) {
+        *slot = Some(edge);
+    }
+    // limit and reference switch changes, latched where the motor crossed them
+    let switches = out.edges.iter().filter_map(|e| {
+        let switch = match e.input {
+            Input::PositiveLimit => SwitchId::PositiveLimit,
+            Input::NegativeLimit => SwitchId::NegativeLimit,
+            Input::Reference => SwitchId::Reference,
+            _ => return None,
+        };
+        Some(SwitchEdge {
+            switch,
+            position_inc: e.position_inc,
+        })
+    });
+    for (slot, edge) in io.switch_edges.iter_mut().zip(switches) {
         *slot = Some(edge);
     }
     io

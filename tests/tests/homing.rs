@@ -33,9 +33,11 @@ const NEG_LS: i64 = -2 * R;
 const POS_LS: i64 = 2 * R;
 /// Tolerance of an index reference (exact hardware latch), increments.
 const INDEX_TOL: i64 = 4;
-/// Tolerance of a switch-edge reference: the level is seen once per cycle,
-/// the creep (6099h:02 = 0.25 rev/s) moves 262 increments per 1 ms cycle.
-const EDGE_TOL: i64 = 2 * (R / 4 / 1000);
+/// Tolerance of a switch-edge reference: the simulator latches the switch
+/// change where the motor crossed it (`AxisIo::switch_edges`), so the
+/// reference is exact to a few increments, not one creep step (the creep,
+/// 6099h:02 = 0.25 rev/s, moves 262 increments per 1 ms cycle).
+const EDGE_TOL: i64 = 4;
 
 /// First index pulse strictly above / below `x` (plant increments).
 fn index_above(x: i64) -> i64 {
