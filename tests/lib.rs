@@ -1,6 +1,8 @@
 //! Helpers shared by the end-to-end tests in `tests/tests/`: a real EtherCAT
 //! master (ethercrab) talks to the simulated line in-process, in simulated time.
 
+pub mod axis;
+
 use ethercrab::{MainDevice, SubDeviceGroup, SubDeviceRef, Timeouts};
 use hil_sim::sim::Simulation;
 use std::cell::RefCell;

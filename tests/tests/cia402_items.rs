@@ -13,17 +13,9 @@
 )]
 
 use drive::parameter_index;
-use drive_tests::{init, line, sw, with_master, Cyclic, TxPdo};
+use drive_tests::axis::*;
+use drive_tests::{init, line, sw, with_master, Cyclic};
 use drive_tests::{REV, REV_F};
-use hil_sim::sim::Simulation;
-use std::cell::RefCell;
-
-const CW_ENABLED: u16 = 0x000F;
-const CW_BIT4: u16 = 1 << 4;
-const CW_BIT5: u16 = 1 << 5;
-const CW_BIT6: u16 = 1 << 6;
-const CW_FAULT_RESET: u16 = 1 << 7;
-const CW_HALT: u16 = 1 << 8;
 
 const A66: u16 = parameter_index(0, 66);
 const A340: u16 = parameter_index(0, 340);
@@ -33,29 +25,6 @@ const I46: u16 = parameter_index(8, 46);
 const I101: u16 = parameter_index(8, 101);
 const I102: u16 = parameter_index(8, 102);
 const I210: u16 = parameter_index(8, 210);
-
-fn with_drive(sim: &RefCell<Simulation>, f: impl FnOnce(&mut hil_sim::sim::SimDrive)) {
-    f(&mut sim.borrow_mut().drives_mut()[0]);
-}
-
-/// Motor A's encoder position, increments (the plant).
-fn motor_position(sim: &RefCell<Simulation>) -> i64 {
-    sim.borrow().drives()[0].motors[0].position_inc_i64()
-}
-
-/// Method 37 through the PDO: the present position reads 607Ch (0).
-async fn home_here(m: &mut Cyclic<'_>) -> TxPdo {
-    m.set_mode(6);
-    m.set_controlword(CW_ENABLED);
-    m.run(3).await;
-    m.set_controlword(CW_ENABLED | CW_BIT4);
-    let done = m
-        .run_until(50, |t| t.mode_display == 6 && t.bit(12) && t.bit(10))
-        .await;
-    assert!(done.is_some(), "method 37: {:#06x}", m.tx.statusword);
-    m.set_controlword(CW_ENABLED);
-    m.run(2).await
-}
 
 /// A bit-4 edge in pp with `bits`; returns whether bit 12 acknowledged it
 /// within 5 cycles (bit 4 is taken back afterwards).
@@ -90,14 +59,14 @@ fn c028_mode_0_generates_no_motion() {
         m.run(3).await;
         let tx = m.enable().await;
         assert_eq!(tx.mode_display, 0, "6061h shows mode 0");
-        let p0 = motor_position(&sim);
+        let p0 = motor_position(&sim, 0);
         // every set-point of every mode and all mode bits: nothing moves
         m.set_target_position(3 * REV);
         m.set_target_velocity(2 * REV);
         m.set_target_torque(300);
         m.set_controlword(CW_ENABLED | CW_BIT4 | CW_BIT5 | CW_BIT6);
         let tx = m.run(300).await;
-        let moved = motor_position(&sim) - p0;
+        let moved = motor_position(&sim, 0) - p0;
         println!("mode 0: moved {moved} inc, 6077h {}", tx.torque);
         assert_eq!(tx.state(), sw::OE);
         assert!(moved.abs() < 50, "no motion in mode 0: {moved}");
@@ -106,7 +75,7 @@ fn c028_mode_0_generates_no_motion() {
         m.set_controlword(CW_ENABLED);
         m.set_mode(9);
         m.run(300).await;
-        assert!(motor_position(&sim) - p0 > i64::from(REV) / 4, "csv moves");
+        assert!(motor_position(&sim, 0) - p0 > i64::from(REV) / 4, "csv moves");
     });
 }
 
@@ -153,13 +122,13 @@ fn c029_running_move_is_replaced_but_not_during_a_stop() {
         assert!(qs.is_some(), "quick stop active: {:#06x}", m.tx.statusword);
         m.run(30).await;
         assert_eq!(m.tx.state(), sw::QSA, "605Ah = 6 stays in Quick stop active");
-        let at = motor_position(&sim);
+        let at = motor_position(&sim, 0);
         m.set_target_position(3 * REV);
         m.set_controlword(0x000B | CW_BIT5 | CW_BIT6);
         m.run(2).await;
         m.set_controlword(0x000B | CW_BIT4 | CW_BIT5 | CW_BIT6);
         let tx = m.run(300).await;
-        let moved = motor_position(&sim) - at;
+        let moved = motor_position(&sim, 0) - at;
         assert!(
             !tx.bit(12),
             "no set-point acknowledge while stopped: {:#06x}",
@@ -351,7 +320,7 @@ fn c042_c050_setpoint_acknowledge_only_for_accepted_targets() {
         m.set_mode(1);
         m.run(3).await;
         m.enable().await;
-        let p0 = motor_position(&sim);
+        let p0 = motor_position(&sim, 0);
         // not referenced: an absolute target is refused, no acknowledge, no motion (C-050)
         assert!(
             !pp_edge(&mut m, REV, 0).await,
@@ -359,7 +328,7 @@ fn c042_c050_setpoint_acknowledge_only_for_accepted_targets() {
             m.tx.statusword
         );
         m.run(300).await;
-        assert!((motor_position(&sim) - p0).abs() < 100, "no motion");
+        assert!((motor_position(&sim, 0) - p0).abs() < 100, "no motion");
         // a relative one is accepted and acknowledged (C-042)
         assert!(pp_edge(&mut m, REV, CW_BIT6).await, "relative taken");
         m.run(100).await;
@@ -370,7 +339,7 @@ fn c042_c050_setpoint_acknowledge_only_for_accepted_targets() {
             m.tx.statusword
         );
         settle(&mut m, 3000).await.expect("arrives");
-        let end = motor_position(&sim) - p0;
+        let end = motor_position(&sim, 0) - p0;
         assert!(
             (end - i64::from(REV)).abs() < i64::from(REV / 300),
             "one move only: {end}"
@@ -570,7 +539,7 @@ fn c112_direct_absolute_encoder_position_without_homing() {
             "at 2 rev: {}",
             m.tx.position
         );
-        assert!((motor_position(&sim) - 2 * i64::from(REV)).abs() < i64::from(REV / 300));
+        assert!((motor_position(&sim, 0) - 2 * i64::from(REV)).abs() < i64::from(REV / 300));
     });
 }
 
@@ -597,7 +566,7 @@ fn c113_the_motor_encoder_closes_the_position_loop() {
             m.cycle().await;
         }
         m.run(200).await;
-        let enc = motor_position(&sim);
+        let enc = motor_position(&sim, 0);
         println!(
             "csp +1 rev: 6064h {}, motor encoder {enc}, set {p}, 60F4h {}",
             m.tx.position, m.tx.following_error
@@ -687,9 +656,9 @@ fn c148_set_value_jump_trips_the_monitor() {
         assert_eq!(code, 0x8612, "603Fh of event 78");
         // the axis did not jump: it never reached the new set-point
         assert!(
-            (motor_position(&sim) - i64::from(p)).abs() < i64::from(REV / 20),
+            (motor_position(&sim, 0) - i64::from(p)).abs() < i64::from(REV / 20),
             "stayed near {p}: {}",
-            motor_position(&sim)
+            motor_position(&sim, 0)
         );
         // monitoring off (AxisParams): the same jump is followed
         with_drive(&sim, |d| {
@@ -817,13 +786,13 @@ fn c109_gear_and_feed_scale_positions_and_velocities_through_the_master() {
         m.run(300).await;
         // pp absolute: referenced here (607Ch = 0), then to 90° of the shaft = 0.5 motor rev
         home_here(&mut m).await;
-        let p0 = motor_position(&sim);
+        let p0 = motor_position(&sim, 0);
         m.set_mode(1);
         m.run(5).await;
         assert!(pp_edge(&mut m, 90_000, 0).await, "taken");
         settle(&mut m, 5000).await.expect("arrives");
         m.run(50).await;
-        let moved = motor_position(&sim) - p0;
+        let moved = motor_position(&sim, 0) - p0;
         println!("pp to 90 000: 6064h {}, motor moved {moved} inc", m.tx.position);
         assert!((m.tx.position - 90_000).abs() <= 100, "6064h {}", m.tx.position);
         assert!(
@@ -854,7 +823,7 @@ fn c111_endless_axis_wraps_at_607b_through_the_master() {
         m.enable().await;
         // csv 1 rev/s for 1.6 s: 6064h stays in 0 … L − 1 and wraps once
         m.set_target_velocity(L);
-        let p0 = motor_position(&sim);
+        let p0 = motor_position(&sim, 0);
         let (mut lo, mut hi, mut wraps, mut last) = (i32::MAX, i32::MIN, 0, m.tx.position);
         for _ in 0..1600 {
             let t = m.cycle().await;
@@ -867,7 +836,7 @@ fn c111_endless_axis_wraps_at_607b_through_the_master() {
         }
         m.set_target_velocity(0);
         m.run(300).await;
-        let turned = motor_position(&sim) - p0;
+        let turned = motor_position(&sim, 0) - p0;
         println!("endless csv: 6064h {lo} … {hi}, {wraps} wrap(s), motor turned {turned} inc");
         assert!(
             lo >= 0 && hi < L,
@@ -883,11 +852,11 @@ fn c111_endless_axis_wraps_at_607b_through_the_master() {
         home_here(&mut m).await;
         m.set_mode(1);
         m.run(5).await;
-        let p1 = motor_position(&sim);
+        let p1 = motor_position(&sim, 0);
         assert!(pp_edge(&mut m, 270_000, 0).await, "taken");
         settle(&mut m, 5000).await.expect("arrives");
         m.run(30).await;
-        let d1 = motor_position(&sim) - p1;
+        let d1 = motor_position(&sim, 0) - p1;
         println!("pp 270 000 shortest: moved {d1} inc, 6064h {}", m.tx.position);
         assert!(
             (d1 + i64::from(REV) / 4).abs() < i64::from(REV / 300),
@@ -896,11 +865,11 @@ fn c111_endless_axis_wraps_at_607b_through_the_master() {
         assert!((m.tx.position - 270_000).abs() < 500, "6064h {}", m.tx.position);
         // 60F2h bits 7..6 = 10: positive only, 90° is +180° from 270°
         sd.sdo_write(0x60F2, 0, 0x0080u16).await.unwrap();
-        let p2 = motor_position(&sim);
+        let p2 = motor_position(&sim, 0);
         assert!(pp_edge(&mut m, 90_000, 0).await, "taken");
         settle(&mut m, 5000).await.expect("arrives");
         m.run(30).await;
-        let d2 = motor_position(&sim) - p2;
+        let d2 = motor_position(&sim, 0) - p2;
         assert!(
             (d2 - i64::from(REV) / 2).abs() < i64::from(REV / 300),
             "+180°: {d2}"
@@ -917,7 +886,7 @@ fn c111_endless_axis_wraps_at_607b_through_the_master() {
         let mut sp = m.tx.position;
         m.set_target_position(sp);
         m.run(20).await;
-        let p3 = motor_position(&sim);
+        let p3 = motor_position(&sim, 0);
         let target_total = 100_000; // +100°
         for _ in 0..(target_total / 500) {
             sp = (sp + 500) % L;
@@ -925,7 +894,7 @@ fn c111_endless_axis_wraps_at_607b_through_the_master() {
             m.cycle().await;
         }
         m.run(100).await;
-        let d3 = motor_position(&sim) - p3;
+        let d3 = motor_position(&sim, 0) - p3;
         println!("csp across the wrap: moved {d3} inc, 6064h {}", m.tx.position);
         assert!(m.tx.position < L / 4, "wrapped past 0: {}", m.tx.position);
         assert_eq!(

@@ -13,14 +13,11 @@
     clippy::indexing_slicing
 )]
 
+use drive_tests::axis::*;
 use drive_tests::{init, line, sw, with_master, Cyclic};
 use drive_tests::{REV, REV_F};
 use hil_sim::motor::{PositionInput, Switches};
 use std::cell::RefCell;
-
-const CW_ENABLED: u16 = 0x000F;
-const CW_START: u16 = 1 << 4;
-const CW_HALT: u16 = 1 << 8;
 
 /// One revolution, increments, as i64.
 const R: i64 = REV as i64;
@@ -143,7 +140,7 @@ fn home(case: Case) -> Run {
             case.method,
             tx.statusword
         );
-        m.set_controlword(CW_ENABLED | CW_START);
+        m.set_controlword(CW_ENABLED | CW_BIT4);
         let t0 = m.now_ns();
         let (mut min, mut max) = (case.start, case.start);
         let mut done = false;
@@ -453,7 +450,7 @@ fn c086_limit_switch_as_reference_switch() {
         m.set_mode(6);
         m.run(3).await;
         m.enable().await;
-        m.set_controlword(CW_ENABLED | CW_START);
+        m.set_controlword(CW_ENABLED | CW_BIT4);
         let done = m
             .run_until(10_000, |t| {
                 t.state() != sw::OE || (t.bit(12) && t.bit(10)) || t.bit(13)
@@ -499,10 +496,10 @@ fn c059_halt_interrupts_homing_then_restart_completes() {
         m.set_mode(6);
         m.run(3).await;
         m.enable().await;
-        m.set_controlword(CW_ENABLED | CW_START);
+        m.set_controlword(CW_ENABLED | CW_BIT4);
         m.run_until(2000, |t| t.velocity > REV).await.expect("searching");
         // halt (bit 8): the axis brakes, 000 while braking, then 001 interrupted at standstill
-        m.set_controlword(CW_ENABLED | CW_START | CW_HALT);
+        m.set_controlword(CW_ENABLED | CW_BIT4 | CW_HALT);
         let stopped = m.run_until(2000, |t| t.bit(10) && !t.bit(12) && !t.bit(13)).await;
         assert!(stopped.is_some(), "interrupted = 001: {:#06x}", m.tx.statusword);
         m.run(30).await;
@@ -517,7 +514,7 @@ fn c059_halt_interrupts_homing_then_restart_completes() {
         // a new edge of bit 4 without halt restarts and completes
         m.set_controlword(CW_ENABLED);
         m.run(2).await;
-        m.set_controlword(CW_ENABLED | CW_START);
+        m.set_controlword(CW_ENABLED | CW_BIT4);
         let done = m.run_until(10_000, |t| t.bit(12) && t.bit(10)).await;
         assert!(done.is_some(), "restarted and done: {:#06x}", m.tx.statusword);
     });

@@ -10,7 +10,8 @@
     clippy::indexing_slicing
 )]
 
-use drive_tests::{init, line, sw, with_master, CoeClient, Cyclic, RawMailbox, TxPdo};
+use drive_tests::axis::*;
+use drive_tests::{init, line, sw, with_master, CoeClient, Cyclic, RawMailbox};
 use drive_tests::{REV, REV_F};
 use hil_sim::motor::PositionInput;
 use hil_sim::sim::{AxisConditions, Simulation};
@@ -18,15 +19,6 @@ use std::cell::RefCell;
 
 /// Axis B's CiA 402 objects (C-134).
 const B: u16 = 0x800;
-
-fn with_drive(sim: &RefCell<Simulation>, f: impl FnOnce(&mut hil_sim::sim::SimDrive)) {
-    f(&mut sim.borrow_mut().drives_mut()[0]);
-}
-
-/// Motor A's encoder position, increments (the plant, for cross-checks).
-fn motor_position(sim: &RefCell<Simulation>, axis: usize) -> i64 {
-    sim.borrow().drives()[0].motors[axis].position_inc_i64()
-}
 
 /// Motor velocity, rev/s (the plant).
 fn motor_velocity_rev_s(sim: &RefCell<Simulation>, axis: usize) -> f64 {
@@ -315,38 +307,13 @@ fn c038_c039_cst_torque_with_and_without_speed_limit() {
 // Drive-based modes (C-041 … C-056) and homing (C-058 … C-078)
 // ---------------------------------------------------------------------------
 
-/// Controlword bits.
-const CW_ENABLED: u16 = 0x000F;
-const CW_NEW_SETPOINT: u16 = 1 << 4;
-const CW_IMMEDIATE: u16 = 1 << 5;
-const CW_RELATIVE: u16 = 1 << 6;
-
-/// Homing with method 37 (reference here, no motion) through the process data:
-/// mode 6, a 0→1 edge of bit 4; returns the TxPDO once bits 12 and 10 are set.
-async fn home_here(m: &mut Cyclic<'_>) -> TxPdo {
-    m.set_mode(6);
-    m.set_controlword(CW_ENABLED);
-    m.run(3).await;
-    m.set_controlword(CW_ENABLED | CW_NEW_SETPOINT);
-    let done = m
-        .run_until(50, |t| t.mode_display == 6 && t.bit(12) && t.bit(10))
-        .await;
-    assert!(
-        done.is_some(),
-        "method 37 homes at once: {:#06x}",
-        m.tx.statusword
-    );
-    m.set_controlword(CW_ENABLED);
-    m.run(2).await
-}
-
 /// Starts a pp move (bit 4 edge with `bits`) and checks the set-point
 /// handshake: bit 12 acknowledges, then clears when bit 4 is taken back.
 async fn pp_start(m: &mut Cyclic<'_>, target: i32, bits: u16) {
     m.set_target_position(target);
     m.set_controlword(CW_ENABLED | bits);
     m.run(1).await;
-    m.set_controlword(CW_ENABLED | bits | CW_NEW_SETPOINT);
+    m.set_controlword(CW_ENABLED | bits | CW_BIT4);
     let ack = m.run_until(5, |t| t.bit(12)).await;
     assert!(
         ack.is_some(),
@@ -380,7 +347,7 @@ fn c041_c048_pp_moves_to_target_and_sets_target_reached() {
 
         // C-050: an absolute move is refused before the axis is referenced
         m.set_target_position(3 * REV);
-        m.set_controlword(CW_ENABLED | CW_NEW_SETPOINT);
+        m.set_controlword(CW_ENABLED | CW_BIT4);
         let tx = m.run(50).await;
         assert!(
             !tx.bit(12),
@@ -441,13 +408,13 @@ fn c041_c048_pp_moves_to_target_and_sets_target_reached() {
         pp_start(&mut m, 0, 0).await;
         m.run(200).await;
         assert!(m.tx.velocity < -REV, "moving back: {}", m.tx.velocity);
-        pp_start(&mut m, REV, CW_IMMEDIATE).await;
+        pp_start(&mut m, REV, CW_BIT5).await;
         m.run_until(1500, |t| t.bit(10)).await.expect("reached 1 rev");
         let min_pos = m.tx.position;
         assert!((REV - min_pos).abs() <= REV / 360, "at 1 rev: {min_pos}");
 
         // relative (bit 6, 60F2h = 0: to the last target) +0.5 rev (C-046)
-        pp_start(&mut m, REV / 2, CW_RELATIVE).await;
+        pp_start(&mut m, REV / 2, CW_BIT6).await;
         m.run_until(1500, |t| t.bit(10)).await.expect("reached 1.5 rev");
         let tx = m.tx;
         assert!(
@@ -559,7 +526,7 @@ fn c058_c059_c071_homing_method_19_on_a_reference_switch() {
         m.set_mode(6);
         m.run(3).await;
         m.enable().await;
-        m.set_controlword(CW_ENABLED | CW_NEW_SETPOINT);
+        m.set_controlword(CW_ENABLED | CW_BIT4);
         let t0 = m.now_ns();
         let mut saw_switch = false;
         let mut peak = 0i32;
@@ -959,7 +926,7 @@ fn c071_homing_method_19_started_on_the_switch() {
             "on the switch: 60FDh {:#x}",
             tx.digital_inputs
         );
-        m.set_controlword(CW_ENABLED | CW_NEW_SETPOINT);
+        m.set_controlword(CW_ENABLED | CW_BIT4);
         let mut max_pos = 0;
         m.run_until(3000, |t| {
             max_pos = max_pos.max(t.position);

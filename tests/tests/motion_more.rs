@@ -9,45 +9,16 @@
     clippy::indexing_slicing
 )]
 
-use drive_tests::{init, line, map_layout, sw, with_master, Cyclic, RawCyclic, TxPdo};
+use drive_tests::axis::*;
+use drive_tests::{init, line, map_layout, sw, with_master, Cyclic, RawCyclic};
 use drive_tests::{REV, REV_F};
 use hil_sim::motor::{PositionInput, Switches};
 use hil_sim::sim::Simulation;
 use std::cell::RefCell;
 
-const CW_ENABLED: u16 = 0x000F;
-const CW_BIT4: u16 = 1 << 4;
-const CW_BIT5: u16 = 1 << 5;
-const CW_BIT6: u16 = 1 << 6;
-const CW_FAULT_RESET: u16 = 1 << 7;
-
-fn with_drive(sim: &RefCell<Simulation>, f: impl FnOnce(&mut hil_sim::sim::SimDrive)) {
-    f(&mut sim.borrow_mut().drives_mut()[0]);
-}
-
-/// Motor A's encoder position, increments (the plant).
-fn motor_position(sim: &RefCell<Simulation>) -> i64 {
-    sim.borrow().drives()[0].motors[0].position_inc_i64()
-}
-
 /// 603Fh of event 53 (limit switch).
 fn event_53() -> Option<u16> {
     ecat::emcy::fault_code_for_event(53).map(|(c, _)| c)
-}
-
-/// Homing method 37 (reference here) through the standard PDO: the axis is
-/// referenced at its present position, which then reads 607Ch = 0.
-async fn home_here(m: &mut Cyclic<'_>) -> TxPdo {
-    m.set_mode(6);
-    m.set_controlword(CW_ENABLED);
-    m.run(3).await;
-    m.set_controlword(CW_ENABLED | CW_BIT4);
-    let done = m
-        .run_until(50, |t| t.mode_display == 6 && t.bit(12) && t.bit(10))
-        .await;
-    assert!(done.is_some(), "method 37: {:#06x}", m.tx.statusword);
-    m.set_controlword(CW_ENABLED);
-    m.run(2).await
 }
 
 // ---------------------------------------------------------------------------
@@ -89,7 +60,7 @@ fn c031_c032_c033_c034_ip_follows_60c1_only_while_bit_4() {
         assert!((pos(&m) - start).abs() < REV / 100, "holds: 6064h {}", pos(&m));
         assert!(!m.bit(12), "bit 12 still 0: {:#06x}", m.statusword());
         assert!(
-            motor_position(&sim).abs() < i64::from(REV / 100),
+            motor_position(&sim, 0).abs() < i64::from(REV / 100),
             "the motor stands"
         );
 
@@ -532,7 +503,7 @@ fn c093_c094_c095_hardware_limit_switch_faults_and_locks_the_direction() {
         assert_eq!(m.tx.state(), sw::OE, "inside the range: {:#06x}", m.tx.statusword);
         m.set_target_velocity(2 * REV);
         let code = fault_and_reset(&mut m, "positive switch").await;
-        let at = motor_position(&sim);
+        let at = motor_position(&sim, 0);
         println!(
             "HW limit +: 603Fh {code:#06x}, stopped at {:.3} rev",
             at as f64 / REV_F
@@ -546,7 +517,7 @@ fn c093_c094_c095_hardware_limit_switch_faults_and_locks_the_direction() {
         // enabled again on the switch: positive direction refused (C-095)
         m.set_target_velocity(REV);
         m.run(300).await;
-        let now = motor_position(&sim);
+        let now = motor_position(&sim, 0);
         println!(
             "on the switch, +1 rev/s: moved {} inc, {:#06x}",
             now - at,
@@ -558,7 +529,7 @@ fn c093_c094_c095_hardware_limit_switch_faults_and_locks_the_direction() {
         // away from the switch: allowed
         m.set_target_velocity(-REV);
         m.run(500).await;
-        assert!(motor_position(&sim) < plus - i64::from(REV / 4), "moves away");
+        assert!(motor_position(&sim, 0) < plus - i64::from(REV / 4), "moves away");
         assert_eq!(m.tx.state(), sw::OE);
         m.set_target_velocity(0);
         m.run(200).await;

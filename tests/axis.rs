@@ -1,0 +1,47 @@
+//! Axis-level helpers of the motion tests (`motion.rs`, `motion_more.rs`,
+//! `cia402_items.rs`, `homing.rs`): controlword bits, the simulated plant,
+//! homing in place.
+
+use crate::{Cyclic, TxPdo};
+use hil_sim::sim::{SimDrive, Simulation};
+use std::cell::RefCell;
+
+/// Controlword "Enable operation" (bits 0..3).
+pub const CW_ENABLED: u16 = 0x000F;
+/// Bit 4: new set-point (pp), homing start (hm).
+pub const CW_BIT4: u16 = 1 << 4;
+/// Bit 5: change set immediately (pp).
+pub const CW_BIT5: u16 = 1 << 5;
+/// Bit 6: relative (pp).
+pub const CW_BIT6: u16 = 1 << 6;
+/// Bit 7: fault reset.
+pub const CW_FAULT_RESET: u16 = 1 << 7;
+/// Bit 8: halt.
+pub const CW_HALT: u16 = 1 << 8;
+
+/// Runs `f` on the first drive of the line (conditions, motors, faults).
+pub fn with_drive(sim: &RefCell<Simulation>, f: impl FnOnce(&mut SimDrive)) {
+    f(&mut sim.borrow_mut().drives_mut()[0]);
+}
+
+/// Encoder position of motor `axis` of the first drive, increments (the
+/// plant, for cross-checks).
+pub fn motor_position(sim: &RefCell<Simulation>, axis: usize) -> i64 {
+    sim.borrow().drives()[0].motors[axis].position_inc_i64()
+}
+
+/// Homing method 37 (reference here, no motion) through the standard PDO:
+/// mode 6, a 0→1 edge of bit 4; returns the TxPDO once bits 12 and 10 are
+/// set. The present position then reads 607Ch.
+pub async fn home_here(m: &mut Cyclic<'_>) -> TxPdo {
+    m.set_mode(6);
+    m.set_controlword(CW_ENABLED);
+    m.run(3).await;
+    m.set_controlword(CW_ENABLED | CW_BIT4);
+    let done = m
+        .run_until(50, |t| t.mode_display == 6 && t.bit(12) && t.bit(10))
+        .await;
+    assert!(done.is_some(), "method 37: {:#06x}", m.tx.statusword);
+    m.set_controlword(CW_ENABLED);
+    m.run(2).await
+}
