@@ -997,3 +997,239 @@ impl<'a> RawCyclic<'a> {
         }
     }
 }
+
+// ---------------------------------------------------------------------------
+// FoE firmware update (tests/tests/foe.rs): a drive with firmware slots and
+// an FoE client over `RawMailbox` (ethercrab 0.7.1 has no FoE)
+// ---------------------------------------------------------------------------
+
+/// The firmware flash of [`FwNode`]: 2 × 66 sectors of 4 KiB (a slot takes a
+/// 256 KiB image), NOR in RAM, on the heap.
+pub struct FwFlash(pub Box<drive::boot::RamFlash<4096, 132>>);
+
+impl FwFlash {
+    /// An erased flash.
+    pub fn new() -> Self {
+        Self(Box::new(drive::boot::RamFlash::new()))
+    }
+}
+
+impl Default for FwFlash {
+    fn default() -> Self {
+        Self::new()
+    }
+}
+
+impl drive::boot::Flash for FwFlash {
+    const SECTOR: usize = 4096;
+    const SECTORS: usize = 132;
+    const WRITE: usize = 8;
+    fn read(&mut self, addr: u32, buf: &mut [u8]) -> Result<(), drive::boot::FlashError> {
+        drive::boot::Flash::read(&mut *self.0, addr, buf)
+    }
+    fn erase(&mut self, sector: u32) -> Result<(), drive::boot::FlashError> {
+        drive::boot::Flash::erase(&mut *self.0, sector)
+    }
+    fn write(&mut self, addr: u32, data: &[u8]) -> Result<(), drive::boot::FlashError> {
+        drive::boot::Flash::write(&mut *self.0, addr, data)
+    }
+}
+
+/// The firmware slots of a [`FwNode`].
+pub type FwSlots = drive::boot::BootSlots<FwFlash>;
+
+/// An image file as the master downloads it: header (length, CRC-32,
+/// `version`) and a body of `len` bytes derived from `version`.
+pub fn firmware_file(version: u32, len: usize) -> Vec<u8> {
+    let body: Vec<u8> = (0..len)
+        .map(|i| {
+            (i as u32)
+                .wrapping_mul(2_654_435_761)
+                .wrapping_add(version)
+                .to_le_bytes()[3]
+        })
+        .collect();
+    let mut f = drive::boot::ImageHeader::for_body(&body, version)
+        .to_bytes()
+        .to_vec();
+    f.extend_from_slice(&body);
+    f
+}
+
+/// A drive with firmware slots behind a simulated ESC (communication only:
+/// no motors). [`FwNode::power_cycle`] runs the boot decision again.
+pub struct FwNode {
+    /// The simulated ESC.
+    pub esc: hil_sim::esc::Esc,
+    /// The drive runtime with its firmware slots.
+    pub drive: drive::runtime::Drive<hil_sim::sim::SimFlash, FwFlash>,
+    /// What the last boot started.
+    pub boot: Option<drive::boot::Decision>,
+}
+
+impl FwNode {
+    /// Powers on with `param` (parameter flash) and `fw` (firmware flash):
+    /// the boot decision, then the drive.
+    pub fn power_on(param: hil_sim::sim::SimFlash, fw: FwFlash) -> Self {
+        let mut slots = FwSlots::new(fw);
+        let boot = slots.boot().expect("boot: read the slots");
+        let mut sii = [0u8; ecat::sii::EEPROM_BYTES];
+        let n = ecat::build_sii(&drive::DEVICE, &mut sii).expect("SII");
+        Self {
+            esc: hil_sim::esc::Esc::new(hil_sim::esc::EscConfig::default(), &sii[..n]),
+            drive: drive::runtime::Drive::with_boot(param, Some(slots)),
+            boot,
+        }
+    }
+
+    /// A drive whose slot A holds a confirmed image of `factory_len` body
+    /// bytes, version 1 (the firmware it was delivered with).
+    pub fn factory(factory_len: usize) -> Self {
+        let mut slots = FwSlots::new(FwFlash::new());
+        slots.boot().expect("boot");
+        slots.begin().expect("begin");
+        slots.write(&firmware_file(1, factory_len)).expect("write");
+        slots.finish().expect("finish");
+        let mut slots = FwSlots::new(slots.into_inner());
+        slots.boot().expect("boot");
+        slots.confirm().expect("confirm");
+        Self::power_on(hil_sim::sim::SimFlash::new(), slots.into_inner())
+    }
+
+    /// Switches off and on: only the flashes stay; the boot decides anew.
+    pub fn power_cycle(&mut self) {
+        let old = std::mem::replace(
+            self,
+            Self {
+                esc: hil_sim::esc::Esc::new(hil_sim::esc::EscConfig::default(), &[]),
+                drive: drive::runtime::Drive::with_boot(hil_sim::sim::SimFlash::new(), None),
+                boot: None,
+            },
+        );
+        let (param, fw) = old.drive.into_flashes();
+        *self = Self::power_on(param, fw.expect("firmware flash"));
+    }
+
+    /// The firmware slots.
+    pub fn slots(&mut self) -> &mut FwSlots {
+        self.drive.boot_slots_mut().expect("slots")
+    }
+}
+
+impl hil_sim::sim::Node for FwNode {
+    fn esc_mut(&mut self) -> &mut hil_sim::esc::Esc {
+        &mut self.esc
+    }
+    fn poll(&mut self, now_ns: u64) {
+        self.esc.tick(now_ns);
+        let _ = self.drive.poll(&mut self.esc.pdi(), now_ns);
+    }
+}
+
+/// [`with_master`] for a line of any node type.
+pub fn with_master_on<N: hil_sim::sim::Node, T>(
+    sim: &RefCell<Simulation<N>>,
+    body: impl for<'a> AsyncFnOnce(&'a MainDevice<'a>, &'a AtomicU64) -> T,
+) -> T {
+    let config = ethercrab::MainDeviceConfig {
+        dc_static_sync_iterations: 100,
+        ..Default::default()
+    };
+    hil_sim::master::run_with(sim, timeouts(), config, body)
+}
+
+/// An FoE reply as the client sees it.
+#[derive(Debug, Clone, PartialEq, Eq)]
+pub enum FoeReply {
+    /// ACK with the packet number.
+    Ack(u32),
+    /// ERROR with the code.
+    Error(u32),
+    /// BUSY (done, entire).
+    Busy(u16, u16),
+    /// Something else: mailbox type and data.
+    Other(u8, Vec<u8>),
+    /// No reply.
+    None,
+}
+
+/// An FoE client (ETG.1000.6 §5.8) over [`RawMailbox`]: write requests and
+/// data packets of `MAILBOX_LEN − 12` bytes.
+#[derive(Default)]
+pub struct FoeClient {
+    mbx: RawMailbox,
+    /// BUSY replies seen.
+    pub busy: u32,
+}
+
+impl FoeClient {
+    /// Data bytes per full DATA packet.
+    pub const SEGMENT: usize = MAILBOX_LEN - 12;
+
+    /// A fresh client.
+    pub fn new() -> Self {
+        Self::default()
+    }
+
+    /// Sends one FoE message: opcode, the 32-bit field, then `data`.
+    pub async fn send<S>(&mut self, sd: &SubDeviceRef<'_, S>, op: u8, field: u32, data: &[u8]) -> FoeReply {
+        let mut req = vec![op, 0];
+        req.extend_from_slice(&field.to_le_bytes());
+        req.extend_from_slice(data);
+        match self.mbx.exchange(sd, 4, &req).await {
+            Some((4, r)) if r.len() >= 6 => {
+                let field = u32::from_le_bytes([r[2], r[3], r[4], r[5]]);
+                match r[0] {
+                    4 => FoeReply::Ack(field),
+                    5 => FoeReply::Error(field),
+                    6 => FoeReply::Busy(field as u16, (field >> 16) as u16),
+                    _ => FoeReply::Other(4, r),
+                }
+            }
+            Some((kind, r)) => FoeReply::Other(kind, r),
+            None => FoeReply::None,
+        }
+    }
+
+    /// Write request for `name`.
+    pub async fn write_request<S>(&mut self, sd: &SubDeviceRef<'_, S>, name: &str) -> FoeReply {
+        self.send(sd, 2, 0, name.as_bytes()).await
+    }
+
+    /// DATA packet `n` (a BUSY reply is retried with the same packet).
+    pub async fn data<S>(&mut self, sd: &SubDeviceRef<'_, S>, n: u32, data: &[u8]) -> FoeReply {
+        loop {
+            match self.send(sd, 3, n, data).await {
+                FoeReply::Busy(..) => self.busy += 1,
+                r => return r,
+            }
+        }
+    }
+
+    /// Writes the whole file: write request, DATA packets 1, 2, … (an empty
+    /// last one when the length is a multiple of [`Self::SEGMENT`]). Returns
+    /// the packets sent, or the first reply that is not the expected ACK.
+    pub async fn write_file<S>(
+        &mut self,
+        sd: &SubDeviceRef<'_, S>,
+        name: &str,
+        file: &[u8],
+    ) -> Result<u32, FoeReply> {
+        match self.write_request(sd, name).await {
+            FoeReply::Ack(0) => {}
+            r => return Err(r),
+        }
+        let mut chunks: Vec<&[u8]> = file.chunks(Self::SEGMENT).collect();
+        if file.len() % Self::SEGMENT == 0 {
+            chunks.push(&[]);
+        }
+        for (i, c) in chunks.iter().enumerate() {
+            let n = i as u32 + 1;
+            match self.data(sd, n, c).await {
+                FoeReply::Ack(a) if a == n => {}
+                r => return Err(r),
+            }
+        }
+        Ok(chunks.len() as u32)
+    }
+}

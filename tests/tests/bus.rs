@@ -91,8 +91,8 @@ fn e003_sii_read_by_master_has_syncmanagers_and_protocols() {
     let protocols = sii::sii_word(&image, esc::sii::word::MAILBOX_PROTOCOL).unwrap();
     assert_eq!(
         protocols,
-        esc::sii::mailbox_protocol::COE | esc::sii::mailbox_protocol::EOE,
-        "E-003: CoE and EoE only"
+        esc::sii::mailbox_protocol::COE | esc::sii::mailbox_protocol::EOE | esc::sii::mailbox_protocol::FOE,
+        "E-003: CoE and EoE, and FoE for the firmware download (issue 8)"
     );
     let sms = sii::find_category(&image, esc::sii::category::SYNC_MANAGER).expect("SM category");
     let sms: Vec<&[u8]> = sii::records(sms, 8).collect();
@@ -123,20 +123,23 @@ fn e003_sii_read_by_master_has_syncmanagers_and_protocols() {
 }
 
 #[test]
-fn e022_bootstrap_refused_with_0013_and_acknowledged() {
+/// The drive declares FoE (issue 8), so Bootstrap exists, but only through
+/// Init: from Pre-Op it is an invalid change (0011h). Devices without FoE keep
+/// refusing it with 0013h (E-022, `e021_e022_e023_transition_matrix`).
+fn e022_bootstrap_from_preop_refused_with_0011_and_acknowledged() {
     let sim = line(1);
     with_master(&sim, async |md, clock| {
         let group = init(md, clock).await;
         request(&group.subdevice(md, 0).unwrap(), BOOT).await;
         assert_eq!(
             al_status(&group.subdevice(md, 0).unwrap()).await,
-            (PREOP | ERR, 0x0013)
+            (PREOP | ERR, 0x0011)
         );
         // a request without acknowledge is ignored while the error is shown
         request(&group.subdevice(md, 0).unwrap(), INIT).await;
         assert_eq!(
             al_status(&group.subdevice(md, 0).unwrap()).await,
-            (PREOP | ERR, 0x0013)
+            (PREOP | ERR, 0x0011)
         );
         // acknowledge clears the indication and the request is carried out
         request(&group.subdevice(md, 0).unwrap(), PREOP | ACK).await;
@@ -277,8 +280,8 @@ fn e144_e146_refused_transition_lands_in_the_diagnosis_history() {
         let sd = group.subdevice(md, 0).unwrap();
         let fresh: u8 = sd.sdo_read(0x10F3, 4).await.expect("10F3h:04");
         assert_eq!(fresh, 0, "no new messages after power-on (E-145)");
-        request(&sd, BOOT).await; // refused with 0013h
-        assert_eq!(al_status(&sd).await, (PREOP | ERR, 0x0013));
+        request(&sd, BOOT).await; // refused with 0011h (Bootstrap only from Init)
+        assert_eq!(al_status(&sd).await, (PREOP | ERR, 0x0011));
         let new: u8 = sd.sdo_read(0x10F3, 4).await.expect("10F3h:04");
         assert_eq!(new, 1, "new message available");
         let newest: u8 = sd.sdo_read(0x10F3, 2).await.expect("10F3h:02");
@@ -288,7 +291,7 @@ fn e144_e146_refused_transition_lands_in_the_diagnosis_history() {
         let code = u32::from_le_bytes(msg[0..4].try_into().unwrap());
         assert_eq!(
             code,
-            drive::runtime::DIAG_AL_STATUS | 0x0013,
+            drive::runtime::DIAG_AL_STATUS | 0x0011,
             "diag code carries the AL status code"
         );
         assert_eq!(u16::from_le_bytes([msg[4], msg[5]]) & 0x0F, 2, "type: error");

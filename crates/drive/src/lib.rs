@@ -41,6 +41,10 @@ pub use dictionary::{
 };
 use esc::sii::mailbox_protocol;
 
+/// The firmware slots crate (A/B images, boot decision), re-exported for the
+/// firmware, the simulator and the tests.
+pub use boot;
+
 /// STOBER's EtherCAT vendor ID (E-005).
 pub const VENDOR_ID: u32 = 0xB9;
 /// Product code = nominal power in 0.1 kW (E-005). The SC6A062's nominal power
@@ -210,6 +214,15 @@ static TX_PDOS: [Pdo; 2] = [
 ];
 
 static DC_MODES: [DcOpMode; 3] = [
+    // first = the default the master's configuration tool offers (E-108)
+    DcOpMode {
+        name: "DC",
+        description: "DC enabled (SYNC0)",
+        assign_activate: 0x0300,
+        cycle_time_ns: 0,
+        shift_ns: 0,
+        sync0_cycle_factor: 1,
+    },
     DcOpMode {
         name: "FreeRun",
         description: "Free run",
@@ -225,14 +238,6 @@ static DC_MODES: [DcOpMode; 3] = [
         cycle_time_ns: 0,
         shift_ns: 0,
         sync0_cycle_factor: 0,
-    },
-    DcOpMode {
-        name: "DC",
-        description: "DC enabled (SYNC0)",
-        assign_activate: 0x0300,
-        cycle_time_ns: 0,
-        shift_ns: 0,
-        sync0_cycle_factor: 1,
     },
 ];
 
@@ -273,7 +278,9 @@ pub static DEVICE: Device = Device {
         FmmuUsage::MailboxStatus,
         FmmuUsage::Unused,
     ],
-    mailbox_protocols: mailbox_protocol::COE | mailbox_protocol::EOE,
+    // FoE: the firmware download in Bootstrap (issue 8, `runtime::Drive` with
+    // `boot::BootSlots`)
+    mailbox_protocols: mailbox_protocol::COE | mailbox_protocol::EOE | mailbox_protocol::FOE,
     coe_details: coe_details::SDO
         | coe_details::SDO_INFO
         | coe_details::PDO_ASSIGN

@@ -45,6 +45,14 @@
 //! fault reaction of 605Eh (A540) and end in Fault ([`Drive::raise_event52`]),
 //! with one EMCY for the event.
 //!
+//! Firmware update (issue 8): a drive built with [`Drive::with_boot`] holds
+//! the firmware slots ([`boot::BootSlots`]) and passes FoE writes in
+//! Bootstrap through to them ([`FirmwareFoe`]): a file named
+//! `firmware…` ([`FIRMWARE_FILE`]) goes into the inactive slot, is
+//! CRC-checked at its end and marked pending; the next boot tries it and
+//! the running image confirms itself with [`Drive::confirm_firmware`].
+//! [`Drive::new`] has no slots: FoE writes are refused (8002h).
+//!
 //! Diagnosis (E-132…E-139): A257[0..2] from the ESC's DL status and error
 //! counters (read every poll), A257[3] from the AL status code, and the
 //! four LEDs as patterns of `ecat::led` ([`Drive::leds`]).
@@ -54,9 +62,11 @@ use crate::dictionary::{DriveObjects, LiveValues, PERSISTENT_IMAGE_BYTES};
 use crate::objects::LAYOUT_HASH;
 use crate::pdo_image::{PdoImage, PdoImageError};
 use crate::DEVICE;
+use boot::{BootSlots, NoFlash, UpdateError};
 use ecat::diag::{DiagHistory, DiagMessage, DiagType};
 use ecat::emcy::Emcy;
 use ecat::esm::{event52, SyncMode, SyncState};
+use ecat::foe::{Accept, FoeError, FoeHandler};
 use ecat::led::Pattern;
 use ecat::{Slave, StateChange};
 use esc::{regs, AlState, AlStatusCode, Pdi, PdiExt};
@@ -164,13 +174,68 @@ pub enum Startup {
     Defaults,
 }
 
-/// One drive on the bus: slave stack + object dictionary + parameter store.
-pub struct Drive<F: Flash> {
+/// FoE file names (prefix) of the firmware image; other names: 8001h.
+pub const FIRMWARE_FILE: &[u8] = b"firmware";
+
+/// The FoE handler of the drive: firmware images into the boot slots.
+pub struct FirmwareFoe<'a, B: Flash> {
+    slots: Option<&'a mut BootSlots<B>>,
+}
+
+impl<'a, B: Flash> FirmwareFoe<'a, B> {
+    /// The handler over `slots` (`None`: every write is refused with 8002h).
+    pub fn new(slots: Option<&'a mut BootSlots<B>>) -> Self {
+        Self { slots }
+    }
+}
+
+/// The FoE error code of an update error (docs/conformance.md, decisions).
+pub fn foe_error(e: UpdateError) -> FoeError {
+    match e {
+        UpdateError::NotStarted | UpdateError::BadHeader => FoeError::ILLEGAL,
+        UpdateError::Unconfirmed => FoeError::ACCESS_DENIED,
+        UpdateError::TooLarge => FoeError::DISK_FULL,
+        UpdateError::Incomplete | UpdateError::Crc => FoeError::CHECKSUM,
+        UpdateError::Flash(_) => FoeError::PROGRAM_ERROR,
+    }
+}
+
+impl<B: Flash> FoeHandler for FirmwareFoe<'_, B> {
+    fn begin_write(&mut self, name: &[u8], _password: u32) -> Result<(), FoeError> {
+        if !name.starts_with(FIRMWARE_FILE) {
+            return Err(FoeError::NOT_FOUND);
+        }
+        let slots = self.slots.as_deref_mut().ok_or(FoeError::ACCESS_DENIED)?;
+        slots.begin().map(|_| ()).map_err(foe_error)
+    }
+
+    fn write(&mut self, data: &[u8]) -> Result<Accept, FoeError> {
+        let slots = self.slots.as_deref_mut().ok_or(FoeError::ILLEGAL)?;
+        slots.write(data).map(|()| Accept::Done).map_err(foe_error)
+    }
+
+    fn end_write(&mut self) -> Result<(), FoeError> {
+        let slots = self.slots.as_deref_mut().ok_or(FoeError::ILLEGAL)?;
+        slots.finish().map(|_| ()).map_err(foe_error)
+    }
+
+    fn abort(&mut self) {
+        if let Some(slots) = self.slots.as_deref_mut() {
+            slots.abort();
+        }
+    }
+}
+
+/// One drive on the bus: slave stack + object dictionary + parameter store
+/// (+ the firmware slots on flash `B`, see [`Drive::with_boot`]).
+pub struct Drive<F: Flash, B: Flash = NoFlash> {
     /// The EtherCAT slave stack.
     pub slave: Slave,
     /// The object dictionary (values in RAM).
     pub objects: DriveObjects,
     store: ParamStore<F>,
+    /// The firmware slots (FoE firmware update), if the drive has them.
+    boot: Option<BootSlots<B>>,
     /// Diagnosis history 10F3h (volatile, E-145).
     pub diag: DiagHistory,
     startup: Startup,
@@ -259,7 +324,19 @@ impl Leds {
 
 impl<F: Flash> Drive<F> {
     /// Powers the drive on: defaults, then the newest saved set from `flash`.
+    /// No firmware slots: FoE writes are refused.
+    #[inline(always)]
     pub fn new(flash: F) -> Self {
+        Self::with_boot(flash, None)
+    }
+}
+
+impl<F: Flash, B: Flash> Drive<F, B> {
+    /// Powers the drive on with the firmware slots `boot` (as the boot left
+    /// them: [`BootSlots::boot`] ran and chose the running slot): FoE
+    /// firmware downloads in Bootstrap go into the inactive slot.
+    #[inline(always)]
+    pub fn with_boot(flash: F, boot: Option<BootSlots<B>>) -> Self {
         // Built in place (the value goes straight to the caller's slot) and
         // loaded afterwards: a drive assembled from large locals needed
         // several copies of itself on the stack (docs/architecture.md).
@@ -267,6 +344,7 @@ impl<F: Flash> Drive<F> {
             slave: Slave::new(&DEVICE),
             objects: DriveObjects::new(),
             store: ParamStore::new(flash),
+            boot,
             diag: DiagHistory::new(),
             startup: Startup::Defaults,
             last_code: AlStatusCode(0xFFFF),
@@ -325,6 +403,29 @@ impl<F: Flash> Drive<F> {
         self.store.into_inner()
     }
 
+    /// Powers off: gives the parameter flash and the firmware slots' flash back.
+    pub fn into_flashes(self) -> (F, Option<B>) {
+        (self.store.into_inner(), self.boot.map(BootSlots::into_inner))
+    }
+
+    /// The firmware slots, if the drive has them.
+    pub fn boot_slots(&self) -> Option<&BootSlots<B>> {
+        self.boot.as_ref()
+    }
+
+    /// The firmware slots, mutable (tests, fault injection).
+    pub fn boot_slots_mut(&mut self) -> Option<&mut BootSlots<B>> {
+        self.boot.as_mut()
+    }
+
+    /// The running firmware confirms itself after a successful start: a
+    /// trial image (first start after an update) is kept from now on instead
+    /// of being rolled back at the next boot. `false` when the drive has no
+    /// slots or the flash failed.
+    pub fn confirm_firmware(&mut self) -> bool {
+        self.boot.as_mut().is_some_and(|b| b.confirm().is_ok())
+    }
+
     /// The process images in force (compiled at the last change into Safe-Op).
     pub fn pdo_image(&self) -> &PdoImage {
         &self.pdo
@@ -352,9 +453,10 @@ impl<F: Flash> Drive<F> {
         }
         self.slave.set_sync_state(self.sync_state());
         let mut live = Live { diag: &mut self.diag };
-        let change = self
-            .slave
-            .poll(pdi, &mut self.objects.with_live(&mut live), now_ns)?;
+        let mut foe = FirmwareFoe::new(self.boot.as_mut());
+        let change =
+            self.slave
+                .poll_with_foe(pdi, &mut self.objects.with_live(&mut live), &mut foe, now_ns)?;
         if self.slave.take_error_ack() {
             // the master acknowledged the error: a latched PLL fault goes
             // (a new one latches again at the next occurrence)

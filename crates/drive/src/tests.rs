@@ -43,12 +43,12 @@ fn e003_mailbox_and_protocols_in_sii() {
         assert_eq!(sii_word(&img, base + 2), Some(0x1100));
         assert_eq!(sii_word(&img, base + 3), Some(256));
     }
-    // exactly CoE and EoE
-    assert_eq!(sii_word(&img, word::MAILBOX_PROTOCOL), Some(0x0006));
+    // CoE and EoE (E-003), and FoE for the firmware download (issue 8)
+    assert_eq!(sii_word(&img, word::MAILBOX_PROTOCOL), Some(0x000E));
     let general = find_category(&img, category::GENERAL).unwrap();
     assert_eq!(general[5] & 1, 1, "CoE SDO");
     assert_eq!(general[7], 1, "EoE");
-    assert_eq!(general[6], 0, "no FoE");
+    assert_eq!(general[6], 1, "FoE");
 }
 
 #[test]
@@ -106,16 +106,19 @@ fn e015_axis_b_pdo_entries_offset() {
     assert_eq!(RX_B_ENTRIES[0].index, 0x6840);
 }
 
+/// E-108: the SII's DC category has three op modes, "DC enabled (SYNC0)"
+/// (assign-activate 0300h) first, the default a configuration tool offers.
 #[test]
-fn dc_category_has_three_op_modes() {
+fn e108_dc_category_lists_sync0_first_of_three_op_modes() {
     let (img, _) = image();
     let dc = find_category(&img, category::DC).unwrap();
     let modes: heapless::Vec<&[u8], 3> = records(dc, 24).collect();
     assert_eq!(modes.len(), 3);
-    assert_eq!(u16_at(modes[0], 14), 0);
-    assert_eq!(u16_at(modes[2], 14), 0x0300);
+    assert_eq!(u16_at(modes[0], 14), 0x0300);
+    assert_eq!(u16_at(modes[1], 14), 0);
+    assert_eq!(u16_at(modes[2], 14), 0);
     let strings = find_category(&img, category::STRINGS).unwrap();
-    assert_eq!(sii_string(strings, modes[2][18]), Some(&b"DC"[..]));
+    assert_eq!(sii_string(strings, modes[0][18]), Some(&b"DC"[..]));
     assert!(categories(&img).any(|c| c.kind == category::DC));
 }
 

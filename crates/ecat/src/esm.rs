@@ -17,10 +17,23 @@ pub const MAX_PDO_BYTES: usize = 384;
 /// `Ok(None)` = stay (the requested state is the current one), `Ok(Some(to))` =
 /// a transition of the ESM (upward ones still need their checks), `Err(code)` =
 /// refused (0011h invalid change, 0012h unknown state, 0013h bootstrap).
+///
+/// Bootstrap follows [`target_with_boot`] with `boot = false`: a device
+/// without FoE refuses it with 0013h.
 pub fn target(from: AlState, requested: u8) -> Result<Option<AlState>, AlStatusCode> {
+    target_with_boot(from, requested, false)
+}
+
+/// [`target`] for a device that may support Bootstrap (`boot`: it declares FoE,
+/// the firmware download, issue 8). With `boot`: Init → Boot and Boot → Init are
+/// transitions; every other change into or out of Boot (P/S/O → B, B → P/S/O) is
+/// refused with 0011h, as any other invalid change (ETG.1000.6: Boot is entered
+/// and left through Init only). Without `boot`: Boot is refused with 0013h from
+/// any state.
+pub fn target_with_boot(from: AlState, requested: u8, boot: bool) -> Result<Option<AlState>, AlStatusCode> {
     use AlState::*;
     let to = AlState::from_code(requested).ok_or(AlStatusCode::UNKNOWN_STATE)?;
-    if to == Bootstrap {
+    if to == Bootstrap && !boot {
         return Err(AlStatusCode::BOOTSTRAP_NOT_SUPPORTED);
     }
     if to == from {
@@ -31,13 +44,18 @@ pub fn target(from: AlState, requested: u8) -> Result<Option<AlState>, AlStatusC
         (Init, PreOp) | (PreOp, SafeOp) | (SafeOp, Op) => Ok(Some(to)),
         // downward: always
         (Op, SafeOp | PreOp | Init) | (SafeOp, PreOp | Init) | (PreOp, Init) => Ok(Some(to)),
+        // Bootstrap (only with `boot`, see above): through Init only
+        (Init, Bootstrap) | (Bootstrap, Init) => Ok(Some(to)),
         _ => Err(AlStatusCode::INVALID_STATE_CHANGE),
     }
 }
 
-/// Whether the mailbox runs in `state` (Pre-Op and up).
+/// Whether the mailbox runs in `state` (Pre-Op and up, and Bootstrap).
 pub fn mailbox_on(state: AlState) -> bool {
-    matches!(state, AlState::PreOp | AlState::SafeOp | AlState::Op)
+    matches!(
+        state,
+        AlState::PreOp | AlState::SafeOp | AlState::Op | AlState::Bootstrap
+    )
 }
 
 /// Whether process data runs in `state` (Safe-Op and Op).
@@ -398,5 +416,43 @@ impl SyncState {
 impl Default for SyncState {
     fn default() -> Self {
         Self::NONE
+    }
+}
+
+#[cfg(test)]
+mod boot_tests {
+    use super::*;
+
+    const ALL: [AlState; 5] = [
+        AlState::Init,
+        AlState::PreOp,
+        AlState::Bootstrap,
+        AlState::SafeOp,
+        AlState::Op,
+    ];
+
+    #[test]
+    fn e022_e023_bootstrap_through_init_only_with_foe() {
+        use AlState::*;
+        for from in ALL {
+            for to in ALL {
+                let with = target_with_boot(from, to.code(), true);
+                let want = match (from, to) {
+                    _ if from == to => Ok(None),
+                    (Init, Bootstrap) | (Bootstrap, Init) => Ok(Some(to)),
+                    (Bootstrap, _) | (_, Bootstrap) => Err(AlStatusCode::INVALID_STATE_CHANGE),
+                    _ => target(from, to.code()),
+                };
+                assert_eq!(with, want, "{from:?} -> {to:?} with FoE");
+            }
+            // without FoE: 0013h from everywhere, as before
+            assert_eq!(
+                target(from, 3),
+                Err(AlStatusCode::BOOTSTRAP_NOT_SUPPORTED),
+                "{from:?} -> Boot without FoE"
+            );
+        }
+        assert!(mailbox_on(Bootstrap));
+        assert!(!process_data_on(Bootstrap));
     }
 }

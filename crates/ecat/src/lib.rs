@@ -8,7 +8,9 @@
 //! - [`mailbox`]: the mailbox header and error replies; [`coe`]: the CoE server
 //!   ([`CoeServer`]: SDO expedited/normal/segmented transfers, complete access,
 //!   abort, timeout) over [`od::Dictionary`]; [`sdo_info`]: the SDO Information
-//!   service.
+//!   service; [`foe`]: the FoE server ([`FoeServer`]: file download in Bootstrap
+//!   for the firmware update, packet numbers, busy, errors, timeout) over the
+//!   application's [`FoeHandler`].
 //! - [`Slave`]: all of it composed; the application calls
 //!   [`Slave::poll`]`(pdi, app, now_ns)` with the ESC behind an [`esc::Pdi`].
 #![no_std]
@@ -28,6 +30,7 @@ pub mod desc;
 pub mod diag;
 pub mod emcy;
 pub mod esm;
+pub mod foe;
 pub mod led;
 pub mod mailbox;
 pub mod sdo_info;
@@ -36,6 +39,7 @@ mod slave;
 
 pub use coe::{CoeConfig, CoeServer, CommState, Dictionary, SdoAbort};
 pub use desc::{DataType, DcOpMode, Device, FmmuUsage, Identity, MailboxSm, Pdo, PdoEntry, ProcessSm};
+pub use foe::{FoeError, FoeHandler, FoeServer};
 pub use sii::{build_sii, SiiError};
 pub use slave::{Slave, StateChange};
 

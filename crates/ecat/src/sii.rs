@@ -171,7 +171,8 @@ pub fn build_sii(desc: &Device, out: &mut [u8]) -> Result<usize, SiiError> {
         let group = strings.idx(desc.group);
         w.bytes(&[group, 0, strings.idx(desc.order_code), strings.idx(desc.name), 0])?;
         w.u8(desc.coe_details)?;
-        w.u8(0)?; // FoE details
+        // FoE details: 1 = FoE supported (the firmware download, issue 8)
+        w.u8(u8::from(desc.mailbox_protocols & mailbox_protocol::FOE != 0))?;
         let eoe = desc.mailbox_protocols & mailbox_protocol::EOE != 0;
         w.u8(u8::from(eoe))?;
         w.bytes(&[0, 0, 0, 0])?; // SoE channels, DS402 channels, SysmanClass, flags

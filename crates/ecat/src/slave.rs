@@ -6,6 +6,7 @@ use crate::emcy::{self, Emcy, EmcyQueue};
 use crate::esm::{
     self, event52, EscWatchdog, PdoMonitor, SyncMode, SyncState, MAX_MAILBOX_LEN, MAX_PDO_BYTES,
 };
+use crate::foe::{FoeHandler, FoeServer, NoFiles, FOE_HEADER_LEN};
 use crate::mailbox::{next_counter, MailboxError, MailboxHeader, MailboxType, HEADER_LEN};
 use esc::regs::{self, al_event};
 use esc::sm::{activate, pdi_control, status};
@@ -148,6 +149,8 @@ pub struct Slave {
     mbx: Mailbox,
     /// CoE server: SDO transfers and SDO Info fragments spanning mailbox messages.
     coe: CoeServer,
+    /// FoE server: the file download in Bootstrap (devices that declare FoE).
+    foe: FoeServer,
     /// Emergencies waiting for a free SM1 (sent before the next response).
     emcy: EmcyQueue<EMCY_QUEUE>,
     /// Lengths of the assigned RxPDOs and TxPDOs (bytes), from the dictionary.
@@ -200,6 +203,7 @@ impl Slave {
                 counter: 0,
             },
             coe: CoeServer::new(CoeConfig::from_details(desc.coe_details)),
+            foe: FoeServer::new(),
             emcy: EmcyQueue::new(),
             pdo_bytes: (desc.output_bytes(), desc.input_bytes()),
             out_len: desc.output_bytes().min(MAX_PDO_BYTES),
@@ -329,13 +333,39 @@ impl Slave {
         self.rx_frames
     }
 
+    /// Whether the device declares FoE (SII mailbox protocols): it then supports
+    /// the Bootstrap state for the firmware download.
+    pub fn foe_supported(&self) -> bool {
+        self.desc.mailbox_protocols & esc::sii::mailbox_protocol::FOE != 0
+    }
+
+    /// The FoE server (transfer state, timeouts).
+    pub fn foe(&self) -> &FoeServer {
+        &self.foe
+    }
+
     /// One step of the stack: AL control requests, mailbox, process data.
     /// Returns the processed AL control request when it changed the state or was
-    /// refused.
+    /// refused. FoE requests are refused ([`NoFiles`]); see
+    /// [`poll_with_foe`](Self::poll_with_foe).
     pub fn poll<P: Pdi, A: Dictionary>(
         &mut self,
         pdi: &mut P,
         app: &mut A,
+        now_ns: u64,
+    ) -> Result<Option<StateChange>, P::Error> {
+        self.poll_with_foe(pdi, app, &mut NoFiles, now_ns)
+    }
+
+    /// [`poll`](Self::poll) with the application's FoE file handler (the
+    /// firmware slots): FoE writes in Bootstrap go to `foe`; a transfer in
+    /// progress ends when the slave leaves Bootstrap or after
+    /// [`crate::foe::FOE_TIMEOUT_NS`] without a packet.
+    pub fn poll_with_foe<P: Pdi, A: Dictionary, H: FoeHandler>(
+        &mut self,
+        pdi: &mut P,
+        app: &mut A,
+        foe: &mut H,
         now_ns: u64,
     ) -> Result<Option<StateChange>, P::Error> {
         if !self.started {
@@ -351,8 +381,11 @@ impl Slave {
         } else {
             None
         };
+        if self.state != AlState::Bootstrap {
+            self.foe.reset(foe);
+        }
         if esm::mailbox_on(self.state) {
-            self.poll_mailbox(pdi, app, events, now_ns)?;
+            self.poll_mailbox(pdi, app, foe, events, now_ns)?;
         }
         if esm::process_data_on(self.state) {
             self.process_data(pdi, events, now_ns)?;
@@ -569,7 +602,7 @@ impl Slave {
         self.sync.unsolicited = false;
         self.sync.triggered = false;
         let from = self.state;
-        let result = match esm::target(from, ctrl.requested) {
+        let result = match esm::target_with_boot(from, ctrl.requested, self.foe_supported()) {
             Err(code) => Err(code),
             Ok(None) => Ok(from),
             Ok(Some(AlState::Op)) if from == AlState::SafeOp => {
@@ -621,7 +654,8 @@ impl Slave {
         now_ns: u64,
     ) -> Result<Result<(), AlStatusCode>, P::Error> {
         match (from, to) {
-            (AlState::Init, AlState::PreOp) => {
+            (AlState::Init, AlState::PreOp | AlState::Bootstrap) => {
+                // the bootstrap mailbox is the standard one (the SII says so)
                 let (sm0, sm1) = (pdi.read_sm(0)?, pdi.read_sm(1)?);
                 if let Err(code) = esm::check_mailbox_sms(self.desc, &sm0, &sm1) {
                     return Ok(Err(code));
@@ -773,10 +807,11 @@ impl Slave {
         self.coe.reset();
     }
 
-    fn poll_mailbox<P: Pdi, A: Dictionary>(
+    fn poll_mailbox<P: Pdi, A: Dictionary, H: FoeHandler>(
         &mut self,
         pdi: &mut P,
         app: &mut A,
+        foe: &mut H,
         events: u32,
         now_ns: u64,
     ) -> Result<(), P::Error> {
@@ -801,12 +836,14 @@ impl Slave {
             let m = &mut self.mbx;
             if let Some(rx) = m.rx.get_mut(..m.rx_len) {
                 pdi.read(m.rx_start, rx)?;
-                self.handle_request(app, now_ns);
+                self.handle_request(app, foe, now_ns);
             }
         }
         self.coe.tick(now_ns);
-        // emergencies go out first once SM1 is free (E-094: through the mailbox)
-        if !self.mbx.pending {
+        self.foe.tick(foe, now_ns);
+        // emergencies go out first once SM1 is free (E-094: through the mailbox);
+        // not in Bootstrap (FoE only), they wait
+        if !self.mbx.pending && self.state != AlState::Bootstrap {
             if let Some(e) = self.emcy.pop() {
                 self.queue_emcy(&e);
             }
@@ -830,8 +867,10 @@ impl Slave {
     }
 
     /// Handles the request in `mbx.rx`; a response goes to `mbx.tx` and is pending.
-    fn handle_request<A: Dictionary>(&mut self, app: &mut A, now_ns: u64) {
+    fn handle_request<A: Dictionary, H: FoeHandler>(&mut self, app: &mut A, foe: &mut H, now_ns: u64) {
         let state = self.state;
+        let boot = state == AlState::Bootstrap;
+        let foe_on = self.foe_supported();
         let m = &mut self.mbx;
         let rx = m.rx.get(..m.rx_len).unwrap_or_default();
         let Some(body) = m.tx.get_mut(HEADER_LEN..m.tx_len) else {
@@ -844,7 +883,14 @@ impl Slave {
                 m.last_counter = h.counter;
                 let payload = h.payload(rx).unwrap_or_default();
                 match h.kind {
-                    MailboxType::Coe => self
+                    // Bootstrap: FoE only
+                    MailboxType::Foe if foe_on => {
+                        let max_data = m.rx_len.saturating_sub(HEADER_LEN + FOE_HEADER_LEN);
+                        self.foe
+                            .handle(payload, body, foe, boot, max_data, now_ns)
+                            .map(|n| n.map(|n| (MailboxType::Foe, n)))
+                    }
+                    MailboxType::Coe if !boot => self
                         .coe
                         .handle(payload, body, app, state, now_ns)
                         .map(|n| n.map(|n| (MailboxType::Coe, n))),

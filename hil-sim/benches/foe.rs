@@ -1,0 +1,190 @@
+//! FoE firmware download throughput: a 256 KiB image through the whole chain
+//! (ethercrab in-process -> simulated ESC -> slave stack FoE server -> the
+//! drive's firmware slots on a simulated NOR flash), in simulated time.
+//!
+//! `cargo bench -p hil-sim --bench foe [-- --runs N]`
+//!
+//! ethercrab 0.7.1 has no FoE: the packets are written into SM0 and read
+//! from SM1 with plain register accesses (one write, SM1 status polls, one
+//! read per packet), as `drive_tests::FoeClient` does. Mailbox 256 bytes:
+//! 244 data bytes per packet.
+#![allow(
+    clippy::unwrap_used,
+    clippy::expect_used,
+    clippy::indexing_slicing,
+    clippy::panic
+)]
+
+use drive::boot::{BootSlots, Flash, FlashError, ImageHeader, RamFlash, IMAGE_HEADER_LEN};
+use drive::runtime::Drive;
+use ethercrab::SubDeviceRef;
+use hil_sim::esc::{Esc, EscConfig};
+use hil_sim::sim::{Node, SimFlash, Simulation};
+use std::cell::RefCell;
+use std::sync::atomic::Ordering;
+use std::time::Instant;
+
+const FILE_LEN: usize = 256 * 1024;
+const MAILBOX_LEN: usize = 256;
+const SEGMENT: usize = MAILBOX_LEN - 12;
+
+/// 2 × 66 sectors of 4 KiB, on the heap.
+struct FwFlash(Box<RamFlash<4096, 132>>);
+
+impl Flash for FwFlash {
+    const SECTOR: usize = 4096;
+    const SECTORS: usize = 132;
+    const WRITE: usize = 8;
+    fn read(&mut self, addr: u32, buf: &mut [u8]) -> Result<(), FlashError> {
+        self.0.read(addr, buf)
+    }
+    fn erase(&mut self, sector: u32) -> Result<(), FlashError> {
+        self.0.erase(sector)
+    }
+    fn write(&mut self, addr: u32, data: &[u8]) -> Result<(), FlashError> {
+        self.0.write(addr, data)
+    }
+}
+
+struct FwNode {
+    esc: Esc,
+    drive: Drive<SimFlash, FwFlash>,
+}
+
+impl Node for FwNode {
+    fn esc_mut(&mut self) -> &mut Esc {
+        &mut self.esc
+    }
+    fn poll(&mut self, now_ns: u64) {
+        self.esc.tick(now_ns);
+        let _ = self.drive.poll(&mut self.esc.pdi(), now_ns);
+    }
+}
+
+struct Mbx {
+    counter: u8,
+}
+
+impl Mbx {
+    /// One FoE request, its reply (opcode, 32-bit field).
+    async fn foe<S>(&mut self, sd: &SubDeviceRef<'_, S>, op: u8, field: u32, data: &[u8]) -> (u8, u32) {
+        self.counter = self.counter % 7 + 1;
+        let mut frame = [0u8; MAILBOX_LEN];
+        let len = 6 + data.len();
+        frame[0..2].copy_from_slice(&(len as u16).to_le_bytes());
+        frame[5] = 4 | (self.counter << 4);
+        frame[6] = op;
+        frame[8..12].copy_from_slice(&field.to_le_bytes());
+        frame[12..12 + data.len()].copy_from_slice(data);
+        sd.register_write(0x1000u16, frame).await.expect("SM0");
+        for _ in 0..50 {
+            let status: u8 = sd.register_read(esc::regs::sm(1) + 5).await.expect("SM1 status");
+            if status & esc::sm::status::MAILBOX_FULL != 0 {
+                let r: [u8; MAILBOX_LEN] = sd.register_read(0x1100u16).await.expect("SM1");
+                assert_eq!(r[5] & 0x0F, 4, "FoE reply");
+                return (r[6], u32::from_le_bytes([r[8], r[9], r[10], r[11]]));
+            }
+        }
+        panic!("no FoE reply");
+    }
+}
+
+fn file(version: u32) -> Vec<u8> {
+    let body: Vec<u8> = (0..FILE_LEN - IMAGE_HEADER_LEN)
+        .map(|i| {
+            (i as u32)
+                .wrapping_mul(2_654_435_761)
+                .wrapping_add(version)
+                .to_le_bytes()[3]
+        })
+        .collect();
+    let mut f = ImageHeader::for_body(&body, version).to_bytes().to_vec();
+    f.extend_from_slice(&body);
+    f
+}
+
+fn main() {
+    let args: Vec<String> = std::env::args().collect();
+    let runs: usize = args
+        .iter()
+        .position(|a| a == "--runs")
+        .and_then(|i| args.get(i + 1))
+        .and_then(|s| s.parse().ok())
+        .unwrap_or(3);
+    let mut sii = [0u8; ecat::sii::EEPROM_BYTES];
+    let n = ecat::build_sii(&drive::DEVICE, &mut sii).expect("SII");
+    let mut slots = BootSlots::new(FwFlash(Box::new(RamFlash::new())));
+    slots.boot().expect("boot");
+    let node = FwNode {
+        esc: Esc::new(EscConfig::default(), &sii[..n]),
+        drive: Drive::with_boot(SimFlash::new(), Some(slots)),
+    };
+    let sim = RefCell::new(Simulation::with_nodes(vec![node]));
+    let image = file(2);
+    let config = ethercrab::MainDeviceConfig {
+        dc_static_sync_iterations: 100,
+        ..Default::default()
+    };
+    let results = hil_sim::master::run_with(
+        &sim,
+        hil_sim::master::in_process_timeouts(),
+        config,
+        async |md, clock| {
+            let group = md
+                .init_single_group::<2, 64>(|| clock.load(Ordering::Relaxed))
+                .await
+                .expect("init");
+            let sd = group.subdevice(md, 0).expect("slave");
+            for state in [1u16, 3] {
+                sd.register_write(esc::regs::AL_CONTROL, state)
+                    .await
+                    .expect("AL control");
+                let _: u16 = sd.register_read(esc::regs::AL_STATUS).await.expect("AL status");
+            }
+            let st: u16 = sd.register_read(esc::regs::AL_STATUS).await.expect("AL status");
+            assert_eq!(st, 3, "Bootstrap");
+            let mut mbx = Mbx { counter: 0 };
+            let mut results = Vec::new();
+            for _ in 0..runs {
+                let (t0, f0) = {
+                    let s = sim.borrow();
+                    (s.now_ns(), s.frames())
+                };
+                let start = Instant::now();
+                assert_eq!(mbx.foe(&sd, 2, 0, b"firmware.efw").await, (4, 0), "WRQ acked");
+                let mut chunks: Vec<&[u8]> = image.chunks(SEGMENT).collect();
+                if image.len() % SEGMENT == 0 {
+                    chunks.push(&[]);
+                }
+                for (i, c) in chunks.iter().enumerate() {
+                    let k = i as u32 + 1;
+                    assert_eq!(mbx.foe(&sd, 3, k, c).await, (4, k), "packet {k}");
+                }
+                let wall = start.elapsed();
+                let s = sim.borrow();
+                results.push((wall, s.now_ns() - t0, s.frames() - f0, chunks.len()));
+            }
+            results
+        },
+    );
+    {
+        let mut s = sim.borrow_mut();
+        let slots = s.drives_mut()[0].drive.boot_slots_mut().expect("slots");
+        let state = slots.state(slots.inactive()).expect("state");
+        assert!(
+            matches!(state, drive::boot::SlotState::Pending { .. }),
+            "{state:?}"
+        );
+    }
+    println!("FoE download of a {FILE_LEN}-byte image file, mailbox {MAILBOX_LEN} bytes ({SEGMENT} data bytes per packet), {runs} runs");
+    for (i, (wall, sim_ns, frames, packets)) in results.iter().enumerate() {
+        println!(
+            "run {}: {packets} packets, {frames} frames, {:.1} ms simulated, {:.0} KiB/s simulated time, {:.0} KiB/s wall clock ({:.0} ms)",
+            i + 1,
+            *sim_ns as f64 / 1e6,
+            FILE_LEN as f64 / 1024.0 / (*sim_ns as f64 / 1e9),
+            FILE_LEN as f64 / 1024.0 / wall.as_secs_f64(),
+            wall.as_secs_f64() * 1e3,
+        );
+    }
+}

@@ -1,0 +1,284 @@
+//! FoE firmware update through a real master's frames (issue 8): Bootstrap
+//! through Init only, the download of an image into the inactive slot, its
+//! CRC check, the switch at the next power-on, confirmation and rollback, a
+//! cut connection, FoE errors. ethercrab has no FoE: the FoE packets go
+//! through [`drive_tests::RawMailbox`] ([`FoeClient`]).
+#![allow(
+    clippy::unwrap_used,
+    clippy::expect_used,
+    clippy::panic,
+    clippy::indexing_slicing
+)]
+
+use drive::boot::{Slot, SlotState};
+use drive_tests::al::{ACK, BOOT, ERR, INIT, PREOP};
+use drive_tests::{
+    al_status, firmware_file, init, request, with_master_on, FoeClient, FoeReply, FwNode, RawMailbox,
+};
+use ecat::foe::{FoeError, FOE_TIMEOUT_NS};
+use ecat::mailbox::MailboxError;
+use ethercrab::{MainDevice, SubDeviceRef};
+use hil_sim::sim::Simulation;
+use std::cell::RefCell;
+
+/// The image file the tests download: 256 KiB in all (header + body).
+const IMAGE_FILE_LEN: usize = 256 * 1024;
+/// Body of the factory image in slot A.
+const FACTORY_LEN: usize = 20_000;
+
+fn line() -> RefCell<Simulation<FwNode>> {
+    RefCell::new(Simulation::with_nodes(vec![FwNode::factory(FACTORY_LEN)]))
+}
+
+fn node(sim: &RefCell<Simulation<FwNode>>) -> std::cell::RefMut<'_, FwNode> {
+    std::cell::RefMut::map(sim.borrow_mut(), |s| &mut s.drives_mut()[0])
+}
+
+/// Pre-Op (ethercrab's init) → Init → Bootstrap.
+async fn to_boot<S>(sd: &SubDeviceRef<'_, S>) {
+    request(sd, INIT).await;
+    assert_eq!(al_status(sd).await, (INIT, 0));
+    request(sd, BOOT).await;
+    assert_eq!(al_status(sd).await, (BOOT, 0), "Init -> Bootstrap");
+}
+
+/// Runs `body` against the first drive in Bootstrap.
+fn in_boot<T>(
+    sim: &RefCell<Simulation<FwNode>>,
+    body: impl for<'a> AsyncFnOnce(&'a MainDevice<'a>, SubDeviceRef<'a, &'a ethercrab::SubDevice>) -> T,
+) -> T {
+    with_master_on(sim, async |md, clock| {
+        let group = init(md, clock).await;
+        let sd = group.subdevice(md, 0).unwrap();
+        to_boot(&sd).await;
+        let r = body(md, sd).await;
+        // back to Init (what a master does after the download)
+        request(&group.subdevice(md, 0).unwrap(), INIT).await;
+        r
+    })
+}
+
+fn power_cycle(sim: &RefCell<Simulation<FwNode>>) {
+    node(sim).power_cycle();
+}
+
+#[test]
+fn e022_e023_bootstrap_only_through_init_when_foe_is_declared() {
+    let sim = line();
+    with_master_on(&sim, async |md, clock| {
+        let group = init(md, clock).await;
+        let sd = group.subdevice(md, 0).unwrap();
+        // Pre-Op -> Bootstrap: an invalid change (0011h), not "not supported"
+        request(&sd, BOOT).await;
+        assert_eq!(al_status(&sd).await, (PREOP | ERR, 0x0011));
+        request(&sd, INIT | ACK).await;
+        assert_eq!(al_status(&sd).await, (INIT, 0));
+        request(&sd, BOOT).await;
+        assert_eq!(al_status(&sd).await, (BOOT, 0), "Init -> Bootstrap");
+        // Bootstrap -> Pre-Op (and up): only through Init
+        for to in [PREOP, 4, 8] {
+            request(&sd, to).await;
+            assert_eq!(al_status(&sd).await, (BOOT | ERR, 0x0011), "Boot -> {to}");
+            request(&sd, BOOT | ACK).await;
+            assert_eq!(al_status(&sd).await, (BOOT, 0));
+        }
+        // in Bootstrap the mailbox carries FoE only: CoE gets 0002h
+        let mut mbx = RawMailbox::new();
+        let resp = mbx
+            .exchange(&sd, 3, &[0x00, 0x20, 0x40, 0x00, 0x10, 0, 0, 0, 0, 0])
+            .await
+            .expect("a reply");
+        assert_eq!(resp.0, 0, "mailbox error");
+        assert_eq!(
+            u16::from_le_bytes([resp.1[2], resp.1[3]]),
+            MailboxError::UNSUPPORTED_PROTOCOL.0
+        );
+        request(&sd, INIT).await;
+        assert_eq!(al_status(&sd).await, (INIT, 0), "Bootstrap -> Init");
+        request(&sd, PREOP).await;
+        assert_eq!(al_status(&sd).await, (PREOP, 0));
+    });
+}
+
+#[test]
+fn foe_256k_image_switches_on_next_power_cycle_and_confirms() {
+    let sim = line();
+    assert_eq!(node(&sim).boot.map(|d| d.slot), Some(Slot::A));
+    let file = firmware_file(2, IMAGE_FILE_LEN - drive::boot::IMAGE_HEADER_LEN);
+    assert_eq!(file.len(), IMAGE_FILE_LEN);
+    let packets = in_boot(&sim, async |_, sd| {
+        FoeClient::new()
+            .write_file(&sd, "firmware.efw", &file)
+            .await
+            .expect("download accepted")
+    });
+    assert_eq!(packets as usize, IMAGE_FILE_LEN / FoeClient::SEGMENT + 1);
+    {
+        let mut n = node(&sim);
+        assert_eq!(n.slots().active(), Some(Slot::A), "still running A");
+        assert_eq!(n.slots().state(Slot::B).unwrap(), SlotState::Pending { seq: 2 });
+        assert_eq!(n.slots().header(Slot::B).unwrap().map(|h| h.version), Some(2));
+    }
+    // the next power-on starts B on trial; it confirms itself
+    power_cycle(&sim);
+    {
+        let mut n = node(&sim);
+        let d = n.boot.expect("a slot starts");
+        assert_eq!((d.slot, d.trial), (Slot::B, true));
+        assert!(n.drive.confirm_firmware());
+        assert_eq!(n.slots().state(Slot::B).unwrap(), SlotState::Confirmed { seq: 2 });
+    }
+    power_cycle(&sim);
+    let d = node(&sim).boot.expect("a slot starts");
+    assert_eq!((d.slot, d.trial, d.rolled_back), (Slot::B, false, None));
+    // the updated drive still works on the bus
+    with_master_on(&sim, async |md, clock| {
+        let group = init(md, clock).await;
+        let sd = group.subdevice(md, 0).unwrap();
+        assert_eq!(al_status(&sd).await, (PREOP, 0));
+    });
+}
+
+#[test]
+fn foe_unconfirmed_image_rolls_back_at_the_next_boot() {
+    let sim = line();
+    let file = firmware_file(2, 5000);
+    in_boot(&sim, async |_, sd| {
+        FoeClient::new().write_file(&sd, "firmware", &file).await.unwrap();
+    });
+    power_cycle(&sim);
+    assert_eq!(node(&sim).boot.map(|d| (d.slot, d.trial)), Some((Slot::B, true)));
+    // no confirmation (the new image did not come up): back to A
+    power_cycle(&sim);
+    let d = node(&sim).boot.unwrap();
+    assert_eq!((d.slot, d.trial, d.rolled_back), (Slot::A, false, Some(Slot::B)));
+}
+
+#[test]
+fn foe_corrupt_image_is_rejected_and_the_old_slot_stays_active() {
+    let sim = line();
+    let mut file = firmware_file(2, 30_000);
+    file[12_345] ^= 0x01; // one bit of the body: the CRC no longer matches
+    let r = in_boot(&sim, async |_, sd| {
+        FoeClient::new().write_file(&sd, "firmware.efw", &file).await
+    });
+    assert_eq!(
+        r,
+        Err(FoeReply::Error(FoeError::CHECKSUM.0)),
+        "800Ch on the last packet"
+    );
+    assert_eq!(node(&sim).slots().state(Slot::B).unwrap(), SlotState::Empty);
+    power_cycle(&sim);
+    let d = node(&sim).boot.unwrap();
+    assert_eq!((d.slot, d.trial), (Slot::A, false));
+    // a file that is not an image at all: 8004h at the header
+    let r = in_boot(&sim, async |_, sd| {
+        FoeClient::new()
+            .write_file(&sd, "firmware.efw", &[0x55; 1000])
+            .await
+    });
+    assert_eq!(r, Err(FoeReply::Error(FoeError::ILLEGAL.0)));
+}
+
+#[test]
+fn foe_cut_connection_times_out_and_the_slot_is_not_pending() {
+    let sim = line();
+    let file = firmware_file(2, 100_000);
+    in_boot(&sim, async |_, sd| {
+        let mut foe = FoeClient::new();
+        assert_eq!(foe.write_request(&sd, "firmware.efw").await, FoeReply::Ack(0));
+        for (i, c) in file.chunks(FoeClient::SEGMENT).take(100).enumerate() {
+            assert_eq!(foe.data(&sd, i as u32 + 1, c).await, FoeReply::Ack(i as u32 + 1));
+        }
+        // the cable is cut: no packet for longer than the timeout
+        let t = sim.borrow().now_ns();
+        sim.borrow_mut().advance_to(t + FOE_TIMEOUT_NS + 1_000_000);
+        {
+            let mut n = node(&sim);
+            assert_eq!(n.drive.slave.foe().timeouts(), 1, "transfer dropped");
+            assert!(!n.drive.slave.foe().busy());
+            assert!(!n.slots().downloading());
+        }
+        // the master comes back and continues: no transfer any more
+        assert_eq!(
+            foe.data(
+                &sd,
+                101,
+                &file[100 * FoeClient::SEGMENT..101 * FoeClient::SEGMENT]
+            )
+            .await,
+            FoeReply::Error(FoeError::ILLEGAL.0)
+        );
+    });
+    assert_eq!(node(&sim).slots().state(Slot::B).unwrap(), SlotState::Empty);
+    power_cycle(&sim);
+    let d = node(&sim).boot.unwrap();
+    assert_eq!((d.slot, d.trial), (Slot::A, false), "the old image runs");
+}
+
+#[test]
+fn foe_write_outside_bootstrap_is_refused_with_8008() {
+    let sim = line();
+    with_master_on(&sim, async |md, clock| {
+        let group = init(md, clock).await;
+        let sd = group.subdevice(md, 0).unwrap();
+        assert_eq!(al_status(&sd).await, (PREOP, 0));
+        let mut foe = FoeClient::new();
+        assert_eq!(
+            foe.write_request(&sd, "firmware.efw").await,
+            FoeReply::Error(FoeError::BOOTSTRAP_ONLY.0)
+        );
+        // and no DATA without a write request
+        assert_eq!(
+            foe.data(&sd, 1, &[0; 10]).await,
+            FoeReply::Error(FoeError::ILLEGAL.0)
+        );
+        // read requests: nothing to read
+        assert_eq!(
+            foe.send(&sd, 1, 0, b"firmware.efw").await,
+            FoeReply::Error(FoeError::NOT_FOUND.0)
+        );
+    });
+    assert!(!node(&sim).slots().downloading());
+    assert_eq!(node(&sim).slots().state(Slot::B).unwrap(), SlotState::Empty);
+}
+
+#[test]
+fn foe_wrong_packet_number_gets_8005_and_ends_the_transfer() {
+    let sim = line();
+    let file = firmware_file(2, 3000);
+    in_boot(&sim, async |_, sd| {
+        let mut foe = FoeClient::new();
+        let seg = FoeClient::SEGMENT;
+        assert_eq!(foe.write_request(&sd, "firmware.efw").await, FoeReply::Ack(0));
+        assert_eq!(foe.data(&sd, 1, &file[..seg]).await, FoeReply::Ack(1));
+        // packet 3 instead of 2
+        assert_eq!(
+            foe.data(&sd, 3, &file[seg..2 * seg]).await,
+            FoeReply::Error(FoeError::PACKET_NUMBER.0)
+        );
+        // the transfer is over: the right number now is too late
+        assert_eq!(
+            foe.data(&sd, 2, &file[seg..2 * seg]).await,
+            FoeReply::Error(FoeError::ILLEGAL.0)
+        );
+        // the same packet again (a repeat) is also a wrong number
+        assert_eq!(foe.write_request(&sd, "firmware.efw").await, FoeReply::Ack(0));
+        assert_eq!(foe.data(&sd, 1, &file[..seg]).await, FoeReply::Ack(1));
+        assert_eq!(
+            foe.data(&sd, 1, &file[..seg]).await,
+            FoeReply::Error(FoeError::PACKET_NUMBER.0)
+        );
+        // other file names are not found
+        assert_eq!(
+            foe.write_request(&sd, "parameters.bin").await,
+            FoeReply::Error(FoeError::NOT_FOUND.0)
+        );
+        // a complete download still works afterwards
+        assert_eq!(foe.write_file(&sd, "firmware.efw", &file).await, Ok(13));
+    });
+    assert_eq!(
+        node(&sim).slots().state(Slot::B).unwrap(),
+        SlotState::Pending { seq: 2 }
+    );
+}
