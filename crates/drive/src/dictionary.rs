@@ -198,6 +198,8 @@ struct Resolved {
     place: Place,
     /// The entry's type (its width is the slot's).
     data_type: DataType,
+    /// A write to it is a configuration change ([`is_config`]).
+    config: bool,
 }
 
 /// The scalar types a cache slot can hold, by code (0 = empty slot).
@@ -216,6 +218,38 @@ const CACHED_TYPES: [DataType; 10] = [
 
 /// Type-code flag of a constant.
 const CONST_FLAG: u32 = 0x80;
+/// Type-code flag of a configuration entry.
+const CONFIG_FLAG: u32 = 0x40;
+
+/// Set-points the control cycle reads every cycle (axis-A indices; axis B
+/// at +800h / +8000h): writes to them are not configuration changes.
+const CYCLIC_SETPOINTS: [u16; 11] = [
+    0x6040,
+    0x6060,
+    0x607A,
+    0x60C1,
+    0x60FF,
+    0x6071,
+    0x60B1,
+    0x60B2,
+    0x6042,
+    0x60B8,
+    parameter_index(8, 210),
+];
+
+/// Whether a changed value of object `o` is a configuration change
+/// ([`DriveObjects::config_generation`]): RAM values (parameters and
+/// set-points) except the cyclic set-points; live values (actual values,
+/// diagnosis, fed by the runtime) never are.
+fn is_config(o: &Object) -> bool {
+    let index = o.info.index;
+    let a = match index {
+        0x6800..=0x6FFF => index - crate::AXIS_B_CIA402,
+        0xA000..=0xFFFF => index.wrapping_sub(crate::AXIS_B_MANUFACTURER),
+        _ => index,
+    };
+    o.value == Value::Ram && !CYCLIC_SETPOINTS.contains(&a)
+}
 
 impl Resolved {
     /// Packed into two words: key (24 bits) | constant flag | type code
@@ -223,6 +257,7 @@ impl Resolved {
     /// constant's 32 bits.
     fn pack(self) -> Option<(u32, u32)> {
         let code = CACHED_TYPES.iter().position(|&t| t == self.data_type)? as u32 + 1;
+        let code = code | if self.config { CONFIG_FLAG } else { 0 };
         match self.place {
             Place::Ram(at) => Some(((self.key << 8) | code, u32::from(at))),
             Place::Const(v) => {
@@ -237,7 +272,8 @@ impl Resolved {
     }
 
     fn unpack(key: u32, word: u32, value: u32) -> Option<Self> {
-        let data_type = *CACHED_TYPES.get(((word & 0x7F) as usize).checked_sub(1)?)?;
+        let data_type = *CACHED_TYPES.get(((word & 0x3F) as usize).checked_sub(1)?)?;
+        let config = word & CONFIG_FLAG != 0;
         let place = if word & CONST_FLAG == 0 {
             Place::Ram(u16::try_from(value).ok()?)
         } else if matches!(data_type, DataType::I8 | DataType::I16 | DataType::I32) {
@@ -249,6 +285,7 @@ impl Resolved {
             key,
             place,
             data_type,
+            config,
         })
     }
 }
@@ -313,7 +350,8 @@ fn lookup(key: u32) -> Option<Resolved> {
     if !CACHED_TYPES.contains(&data_type) {
         return None;
     }
-    let place = match loc.object().ok()?.value {
+    let o = loc.object().ok()?;
+    let place = match o.value {
         Value::Ram | Value::Live => Place::Ram(u16::try_from(loc.slot().ok()?.start).ok()?),
         Value::Const => {
             let mut raw = [0u8; 8];
@@ -326,6 +364,7 @@ fn lookup(key: u32) -> Option<Resolved> {
         key,
         place,
         data_type,
+        config: is_config(o),
     })
 }
 
@@ -358,12 +397,24 @@ fn load(image: &[u8], at: usize, t: DataType) -> Result<i64, SdoAbort> {
 /// resolved RAM slots (open addressing, filled on first use) makes those a
 /// hash, a compare and a load instead of a binary search, an entry scan and
 /// an offset sum (docs/architecture.md, cycle cost).
-#[derive(Debug, Clone, PartialEq, Eq)]
+#[derive(Debug, Clone)]
 pub struct DriveObjects {
     image: [u8; IMAGE_BYTES],
     template: Template,
     requests: Requests,
+    /// Counts configuration changes ([`Self::config_generation`]).
+    config_generation: u32,
 }
+
+/// Equal dictionaries hold the same values and template; how they got
+/// there (the configuration generation) does not count.
+impl PartialEq for DriveObjects {
+    fn eq(&self, other: &Self) -> bool {
+        self.image == other.image && self.template == other.template && self.requests == other.requests
+    }
+}
+
+impl Eq for DriveObjects {}
 
 impl Default for DriveObjects {
     fn default() -> Self {
@@ -391,7 +442,21 @@ impl DriveObjects {
                 restart: false,
                 defaults_restored: false,
             },
+            config_generation: 0,
         }
+    }
+
+    /// A counter that changes whenever a configuration value may have
+    /// changed: a changed RAM value other than a cyclic set-point (6040h,
+    /// 6060h, 607Ah, 60C1h, 60FFh, 6071h, 60B1h, 60B2h, 6042h, 60B8h, I210 of
+    /// either axis), a load, a restore or a template switch. Live values never
+    /// change it. The axes re-read their configuration only when it moved.
+    pub fn config_generation(&self) -> u32 {
+        self.config_generation
+    }
+
+    fn config_changed(&mut self) {
+        self.config_generation = self.config_generation.wrapping_add(1);
     }
 
     /// This dictionary with `live` answering the live entries.
@@ -409,6 +474,7 @@ impl DriveObjects {
     /// the availability of SDO Info at once; the SII/ESI must follow).
     pub fn set_template(&mut self, template: Template) {
         self.template = template;
+        self.config_changed();
     }
 
     /// The requests set since the last call, cleared.
@@ -519,7 +585,18 @@ impl DriveObjects {
             };
             let at = usize::from(at);
             let slot = self.image.get_mut(at..at + t.bytes()).ok_or(SdoAbort::GENERAL)?;
-            return t.encode(value, slot).map(|_| ());
+            let mut new = [0u8; 8];
+            let n = t.encode(value, &mut new)?;
+            let new = new.get(..n).ok_or(SdoAbort::GENERAL)?;
+            if slot != new {
+                for (d, s) in slot.iter_mut().zip(new) {
+                    *d = *s;
+                }
+                if r.config {
+                    self.config_changed();
+                }
+            }
+            return Ok(());
         }
         let mut raw = [0u8; 8];
         let n = t.encode(value, &mut raw)?;
@@ -530,6 +607,28 @@ impl DriveObjects {
     /// the A257 texts), like [`set`](Self::set); strings shorter than the
     /// entry are padded with 0.
     pub fn set_bytes(&mut self, index: u16, sub: u8, data: &[u8]) -> Result<(), SdoAbort> {
+        if let Some(Resolved {
+            place: Place::Ram(at),
+            data_type,
+            config,
+            ..
+        }) = resolve(index, sub)
+        {
+            // a scalar of its full width: straight into its slot
+            if data.len() == data_type.bytes() {
+                let at = usize::from(at);
+                let slot = self.image.get_mut(at..at + data.len()).ok_or(SdoAbort::GENERAL)?;
+                if slot != data {
+                    for (d, s) in slot.iter_mut().zip(data) {
+                        *d = *s;
+                    }
+                    if config {
+                        self.config_changed();
+                    }
+                }
+                return Ok(());
+            }
+        }
         let loc = follow(canonical(index, sub)?)?;
         if !in_ram(loc)? {
             return Err(SdoAbort::READ_ONLY);
@@ -539,11 +638,20 @@ impl DriveObjects {
     }
 
     fn store(&mut self, loc: Loc, data: &[u8]) -> Result<(), SdoAbort> {
+        let config = is_config(loc.object()?);
         let slot = self.image.get_mut(loc.slot()?).ok_or(SdoAbort::GENERAL)?;
-        slot.fill(0);
-        slot.get_mut(..data.len())
-            .ok_or(SdoAbort::LENGTH_TOO_HIGH)?
-            .copy_from_slice(data);
+        if data.len() > slot.len() {
+            return Err(SdoAbort::LENGTH_TOO_HIGH);
+        }
+        let mut changed = false;
+        for (k, d) in slot.iter_mut().enumerate() {
+            let v = data.get(k).copied().unwrap_or(0);
+            changed |= *d != v;
+            *d = v;
+        }
+        if changed && config {
+            self.config_changed();
+        }
         Ok(())
     }
 
@@ -786,6 +894,7 @@ impl DriveObjects {
             payload = rest;
         }
         self.template = template;
+        self.config_changed();
         Ok(())
     }
 
@@ -800,6 +909,7 @@ impl DriveObjects {
                 }
             }
         }
+        self.config_changed();
     }
 
     /// Puts `layout` into 1600h/1A00h (axis A), as a startup list in Pre-Op

@@ -411,6 +411,10 @@ pub struct Axis {
     offset: i32,
     /// Last encoder reading (motor coordinates) for the velocity filter.
     last_raw: Option<i32>,
+    /// The last snapshot and the dictionary's configuration generation it
+    /// was read at: while the generation stands, only the cyclic set-points
+    /// are read again (docs/architecture.md, cycle cost).
+    snapshot: Option<(u32, Snapshot)>,
     /// Filtered actual velocity, inc/s (user coordinates).
     velocity: f32,
     /// Last cycle's actual position sample (user coordinates).
@@ -502,6 +506,7 @@ impl Axis {
             homing: Homing::new(0),
             offset: 0,
             last_raw: None,
+            snapshot: None,
             velocity: 0.0,
             last_sample: None,
             sp_pos: 0,
@@ -619,7 +624,15 @@ impl Axis {
         now_ns: u64,
         new_setpoint: bool,
     ) -> AxisReport {
-        let raw = Snapshot::read(od, self.window);
+        let generation = od.config_generation();
+        let raw = match self.snapshot {
+            Some((g, mut cached)) if g == generation => {
+                cached.refresh_setpoints(od, self.window);
+                cached
+            }
+            _ => Snapshot::read(od, self.window),
+        };
+        self.snapshot = Some((generation, raw));
         // C-109: user units at the objects, increments inside
         self.scaling = raw.scaling();
         self.velocity_decimals = raw.decimal_factors().0 as f32;

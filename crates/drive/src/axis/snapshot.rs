@@ -207,6 +207,28 @@ fn sat<T: TryFrom<i64> + Copy>(v: i64, lo: T, hi: T) -> T {
 }
 
 impl Snapshot {
+    /// Reads the cyclic set-points of axis `w` again (the objects of
+    /// `CYCLIC_SETPOINTS` in the dictionary, whose writes do not move its
+    /// configuration generation); the rest of the snapshot is kept.
+    pub fn refresh_setpoints(&mut self, od: &DriveObjects, w: Window) {
+        let i32_ = |index: u16, sub: u8, d: i64| sat(w.get(od, index, sub, d), i32::MIN, i32::MAX);
+        let u16_ = |index: u16, sub: u8, d: i64| sat(w.get(od, index, sub, d), 0u16, u16::MAX);
+        let i16_ = |index: u16, sub: u8, d: i64| sat(w.get(od, index, sub, d), i16::MIN, i16::MAX);
+        self.controlword = u16_(0x6040, 0, 0);
+        self.mode = sat(w.get(od, 0x6060, 0, 8), i8::MIN, i8::MAX);
+        self.target_position = i32_(0x607A, 0, 0);
+        self.target_position_user = self.target_position;
+        self.ip_setpoint = i32_(0x60C1, 1, 0);
+        self.ip_setpoint_user = self.ip_setpoint;
+        self.target_velocity = i32_(0x60FF, 0, 0);
+        self.target_torque = i16_(0x6071, 0, 0);
+        self.velocity_offset = i32_(0x60B1, 0, 0);
+        self.torque_offset = i16_(0x60B2, 0, 0);
+        self.probe_function = u16_(0x60B8, 0, 0);
+        self.vl_target = i16_(0x6042, 0, 0);
+        self.i210 = sat(w.param(od, I210, 0, 0), 0u16, u16::MAX);
+    }
+
     /// Reads the snapshot of axis `w`.
     pub fn read(od: &DriveObjects, w: Window) -> Self {
         let i32_ = |index: u16, sub: u8, d: i64| sat(w.get(od, index, sub, d), i32::MIN, i32::MAX);

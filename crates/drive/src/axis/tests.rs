@@ -788,3 +788,50 @@ fn c071_homing_takes_the_latched_switch_edge() {
     assert!(latched.abs() <= 2, "latched edge: exact: {latched}");
     assert!(latched.abs() < level.abs(), "{latched} vs {level}");
 }
+
+/// The cycle keeps its configuration while the dictionary's configuration
+/// generation stands and reads only the cyclic set-points again: for a write
+/// of a changed value to every scalar entry of the dictionary, either the
+/// generation moves or the refreshed snapshot equals a fresh read (both
+/// axes). A Live object feeding the snapshot, or a set-point missing from the
+/// refresh, fails here.
+#[test]
+fn cached_snapshot_equals_a_fresh_read_after_any_write() {
+    use crate::axis::snapshot::{Snapshot, Window};
+    use crate::objects::OBJECTS;
+    let mut checked = 0;
+    for o in OBJECTS.iter() {
+        for e in o.info.entries {
+            if !e.data_type.is_integer() {
+                continue;
+            }
+            let mut od = DriveObjects::new();
+            let windows = [Window { axis: 0 }, Window { axis: 1 }];
+            let before = windows.map(|w| Snapshot::read(&od, w));
+            let g0 = od.config_generation();
+            let Ok(v) = od.get(o.info.index, e.sub) else {
+                continue;
+            };
+            let v = if v < e.data_type.max_value() { v + 1 } else { v - 1 };
+            if od.set(o.info.index, e.sub, v).is_err() {
+                continue;
+            }
+            checked += 1;
+            if od.config_generation() != g0 {
+                continue;
+            }
+            for (w, mut cached) in windows.into_iter().zip(before) {
+                cached.refresh_setpoints(&od, w);
+                assert_eq!(
+                    cached,
+                    Snapshot::read(&od, w),
+                    "{:04X}:{} axis {}",
+                    o.info.index,
+                    e.sub,
+                    w.axis
+                );
+            }
+        }
+    }
+    assert!(checked > 300, "{checked} writes");
+}
