@@ -20,62 +20,11 @@ usage: panic-paths.py ELF [--objdump TOOL] [--check] [--allow REGEX]...
 import argparse
 import collections
 import re
-import shutil
-import subprocess
 import sys
 
+from elfgraph import parse, vector_entries
+
 PANIC = re.compile(r"core::panicking::|slice_index_fail|unwrap_failed|expect_failed|len_mismatch_fail")
-
-
-def objdump_tool(explicit):
-    if explicit:
-        return explicit
-    for t in ("llvm-objdump-22", "llvm-objdump", "arm-none-eabi-objdump"):
-        if shutil.which(t):
-            return t
-    sys.exit("panic-paths: no objdump found (llvm-objdump or binutils-arm-none-eabi)")
-
-
-def strip_hash(name):
-    return re.sub(r"::h[0-9a-f]{16}$", "", name)
-
-
-def graph(elf, tool):
-    out = subprocess.run([tool, "-d", "-C", "--no-show-raw-insn", elf], capture_output=True, text=True, check=True).stdout
-    calls = collections.defaultdict(set)
-    addr_of = {}
-    cur = None
-    for line in out.splitlines():
-        m = re.match(r"^([0-9a-f]+) <(.*)>:$", line)
-        if m:
-            cur = strip_hash(m.group(2))
-            addr_of[int(m.group(1), 16) & ~1] = cur
-            continue
-        m = re.search(r"\s(bl|blx|b|b\.w|beq|bne|bcs|bcc|bhi|bls|bge|blt|bgt|ble|bmi|bpl|bvs|bvc|beq\.w|bne\.w|bhi\.w|bls\.w|bcs\.w|bcc\.w|bge\.w|blt\.w|bgt\.w|ble\.w|bmi\.w|bpl\.w)\s+0x[0-9a-f]+ <([^>+]*)(\+0x[0-9a-f]+)?>", line)
-        if m and cur is not None:
-            target = strip_hash(m.group(2))
-            if target != cur:
-                calls[cur].add(target)
-    return calls, addr_of
-
-
-def vector_entries(elf, addr_of):
-    """Function names in the vector table (reset + handlers)."""
-    tool = shutil.which("llvm-readelf-22") or shutil.which("llvm-readelf") or shutil.which("readelf")
-    hexdump = subprocess.run([objdump_tool(None), "-s", "-j", ".vector_table", elf], capture_output=True, text=True).stdout
-    words = []
-    for line in hexdump.splitlines():
-        m = re.match(r"^\s*[0-9a-f]+ ((?:[0-9a-f]{8} ?){1,4})", line)
-        if m:
-            for w in m.group(1).split():
-                words.append(int.from_bytes(bytes.fromhex(w), "little"))
-    names = set()
-    for w in words[1:]:  # word 0 is the initial stack pointer
-        name = addr_of.get(w & ~1)
-        if name:
-            names.add(name)
-    _ = tool
-    return names
 
 
 def main():
@@ -85,8 +34,8 @@ def main():
     ap.add_argument("--check", action="store_true")
     ap.add_argument("--allow", action="append", default=[], help="regex of caller functions whose panic paths are accepted")
     args = ap.parse_args()
-    calls, addr_of = graph(args.elf, objdump_tool(args.objdump))
-    entries = vector_entries(args.elf, addr_of)
+    calls, _frames, addr_of = parse(args.elf, args.objdump)
+    entries = vector_entries(args.elf, addr_of, args.objdump)
     allow = [re.compile(a) for a in args.allow]
     # breadth-first from the entries, remembering one parent per function
     parent = {e: None for e in entries}

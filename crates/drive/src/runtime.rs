@@ -439,10 +439,18 @@ impl<F: Flash, B: Flash> Drive<F, B> {
 
     /// Compiles the current mapping into [`Self::pdo_image`].
     fn compile_pdo_image(&mut self) {
-        (self.pdo, self.pdo_error) = match PdoImage::compile(&self.objects) {
-            Ok(image) => (image, None),
-            Err(e) => (PdoImage::EMPTY, Some(e)),
-        };
+        // field by field: a (image, error) tuple cost several copies of the
+        // image on the ESC task's stack
+        match PdoImage::compile(&self.objects) {
+            Ok(image) => {
+                self.pdo = image;
+                self.pdo_error = None;
+            }
+            Err(e) => {
+                self.pdo = PdoImage::EMPTY;
+                self.pdo_error = Some(e);
+            }
+        }
     }
 
     /// Runs the slave stack once at `now_ns`, then process data, the live
