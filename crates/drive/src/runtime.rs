@@ -231,6 +231,9 @@ impl<B: Flash> FoeHandler for FirmwareFoe<'_, B> {
 pub struct Drive<F: Flash, B: Flash = NoFlash> {
     /// The EtherCAT slave stack.
     pub slave: Slave,
+    /// The EoE interface (E-095): counts the Ethernet frames the master
+    /// tunnels to the drive until an IP stack is bound to it.
+    pub eoe: ecat::eoe::FrameCounter,
     /// The object dictionary (values in RAM).
     pub objects: DriveObjects,
     store: ParamStore<F>,
@@ -342,6 +345,11 @@ impl<F: Flash, B: Flash> Drive<F, B> {
         // several copies of itself on the stack (docs/architecture.md).
         let mut drive = Self {
             slave: Slave::new(&DEVICE),
+            eoe: ecat::eoe::FrameCounter {
+                frames: 0,
+                last_len: 0,
+                last_hash: 0,
+            },
             objects: DriveObjects::new(),
             store: ParamStore::new(flash),
             boot,
@@ -462,9 +470,13 @@ impl<F: Flash, B: Flash> Drive<F, B> {
         self.slave.set_sync_state(self.sync_state());
         let mut live = Live { diag: &mut self.diag };
         let mut foe = FirmwareFoe::new(self.boot.as_mut());
-        let change =
-            self.slave
-                .poll_with_foe(pdi, &mut self.objects.with_live(&mut live), &mut foe, now_ns)?;
+        let change = self.slave.poll_with_eoe(
+            pdi,
+            &mut self.objects.with_live(&mut live),
+            &mut foe,
+            &mut self.eoe,
+            now_ns,
+        )?;
         if self.slave.take_error_ack() {
             // the master acknowledged the error: a latched PLL fault goes
             // (a new one latches again at the next occurrence)

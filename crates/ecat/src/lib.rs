@@ -10,9 +10,12 @@
 //!   abort, timeout) over [`od::Dictionary`]; [`sdo_info`]: the SDO Information
 //!   service; [`foe`]: the FoE server ([`FoeServer`]: file download in Bootstrap
 //!   for the firmware update, packet numbers, busy, errors, timeout) over the
-//!   application's [`FoeHandler`].
+//!   application's [`FoeHandler`]; [`eoe`]: Ethernet over EtherCAT ([`eoe::EoeServer`]:
+//!   fragment reassembly and fragmentation, set IP parameter, EMCY FFF0h) towards the
+//!   application's [`eoe::EthernetPort`].
 //! - [`Slave`]: all of it composed; the application calls
-//!   [`Slave::poll`]`(pdi, app, now_ns)` with the ESC behind an [`esc::Pdi`].
+//!   [`Slave::poll`]`(pdi, app, now_ns)`
+//!   (or [`Slave::poll_with_eoe`] with the FoE handler and the Ethernet port) with the ESC behind an [`esc::Pdi`].
 #![no_std]
 #![cfg_attr(
     not(test),
@@ -29,6 +32,7 @@ pub mod coe;
 pub mod desc;
 pub mod diag;
 pub mod emcy;
+pub mod eoe;
 pub mod esm;
 pub mod foe;
 pub mod led;

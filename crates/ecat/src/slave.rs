@@ -3,6 +3,7 @@
 use crate::coe::{service, CoeConfig, CoeHeader, CoeServer, CommState, Dictionary, COE_HEADER_LEN};
 use crate::desc::Device;
 use crate::emcy::{self, Emcy, EmcyQueue};
+use crate::eoe::{EoeServer, EthernetPort, NoEthernet};
 use crate::esm::{
     self, event52, EscWatchdog, PdoMonitor, SyncMode, SyncState, MAX_MAILBOX_LEN, MAX_PDO_BYTES,
 };
@@ -151,6 +152,8 @@ pub struct Slave {
     coe: CoeServer,
     /// FoE server: the file download in Bootstrap (devices that declare FoE).
     foe: FoeServer,
+    /// EoE server: Ethernet frames and IP parameters (Pre-Op, Safe-Op, Op).
+    eoe: EoeServer,
     /// Emergencies waiting for a free SM1 (sent before the next response).
     emcy: EmcyQueue<EMCY_QUEUE>,
     /// Lengths of the assigned RxPDOs and TxPDOs (bytes), from the dictionary.
@@ -204,6 +207,7 @@ impl Slave {
             },
             coe: CoeServer::new(CoeConfig::from_details(desc.coe_details)),
             foe: FoeServer::new(),
+            eoe: EoeServer::new(),
             emcy: EmcyQueue::new(),
             pdo_bytes: (desc.output_bytes(), desc.input_bytes()),
             out_len: desc.output_bytes().min(MAX_PDO_BYTES),
@@ -344,6 +348,16 @@ impl Slave {
         &self.foe
     }
 
+    /// Whether the device declares EoE (SII mailbox protocols).
+    pub fn eoe_supported(&self) -> bool {
+        self.desc.mailbox_protocols & esc::sii::mailbox_protocol::EOE != 0
+    }
+
+    /// The EoE server: the IP parameters the master set, counters.
+    pub fn eoe(&self) -> &EoeServer {
+        &self.eoe
+    }
+
     /// One step of the stack: AL control requests, mailbox, process data.
     /// Returns the processed AL control request when it changed the state or was
     /// refused. FoE requests are refused ([`NoFiles`]); see
@@ -368,6 +382,23 @@ impl Slave {
         foe: &mut H,
         now_ns: u64,
     ) -> Result<Option<StateChange>, P::Error> {
+        self.poll_with_eoe(pdi, app, foe, &mut NoEthernet, now_ns)
+    }
+
+    /// [`poll_with_foe`](Self::poll_with_foe) with the application's
+    /// Ethernet interface (devices that declare EoE, from Pre-Op on, E-095):
+    /// complete frames tunnelled by the master go to `eth.receive`, frames
+    /// from `eth.transmit` go out in fragments, one per mailbox message, when
+    /// SM1 is free; set-IP-parameter requests are answered here (E-096,
+    /// E-097, EMCY FFF0h on refusal, E-093).
+    pub fn poll_with_eoe<P: Pdi, A: Dictionary, H: FoeHandler, E: EthernetPort>(
+        &mut self,
+        pdi: &mut P,
+        app: &mut A,
+        foe: &mut H,
+        eth: &mut E,
+        now_ns: u64,
+    ) -> Result<Option<StateChange>, P::Error> {
         if !self.started {
             self.write_status(pdi)?;
             self.started = true;
@@ -384,8 +415,11 @@ impl Slave {
         if self.state != AlState::Bootstrap {
             self.foe.reset(foe);
         }
+        if !eoe_on(self.state) {
+            self.eoe.reset();
+        }
         if esm::mailbox_on(self.state) {
-            self.poll_mailbox(pdi, app, foe, events, now_ns)?;
+            self.poll_mailbox(pdi, app, foe, eth, events, now_ns)?;
         }
         if esm::process_data_on(self.state) {
             self.process_data(pdi, events, now_ns)?;
@@ -807,11 +841,12 @@ impl Slave {
         self.coe.reset();
     }
 
-    fn poll_mailbox<P: Pdi, A: Dictionary, H: FoeHandler>(
+    fn poll_mailbox<P: Pdi, A: Dictionary, H: FoeHandler, E: EthernetPort>(
         &mut self,
         pdi: &mut P,
         app: &mut A,
         foe: &mut H,
+        eth: &mut E,
         events: u32,
         now_ns: u64,
     ) -> Result<(), P::Error> {
@@ -836,7 +871,10 @@ impl Slave {
             let m = &mut self.mbx;
             if let Some(rx) = m.rx.get_mut(..m.rx_len) {
                 pdi.read(m.rx_start, rx)?;
-                self.handle_request(app, foe, now_ns);
+                self.handle_request(app, foe, eth, now_ns);
+                if let Some(e) = self.eoe.take_emcy() {
+                    self.emcy.push(e);
+                }
             }
         }
         self.coe.tick(now_ns);
@@ -851,6 +889,15 @@ impl Slave {
         // the next SDO Info fragment once the previous response has left
         if !self.mbx.pending && self.coe.has_fragments() {
             self.next_fragment(app);
+        }
+        // then the next outgoing EoE fragment (E-095)
+        if !self.mbx.pending && eoe_on(self.state) && self.eoe_supported() {
+            let m = &mut self.mbx;
+            if let Some(body) = m.tx.get_mut(HEADER_LEN..m.tx_len) {
+                if let Some(len) = self.eoe.next_fragment(body, eth) {
+                    m.queue(MailboxType::Eoe, len);
+                }
+            }
         }
         if self.mbx.pending && !full {
             self.write_response(pdi)?;
@@ -867,10 +914,17 @@ impl Slave {
     }
 
     /// Handles the request in `mbx.rx`; a response goes to `mbx.tx` and is pending.
-    fn handle_request<A: Dictionary, H: FoeHandler>(&mut self, app: &mut A, foe: &mut H, now_ns: u64) {
+    fn handle_request<A: Dictionary, H: FoeHandler, E: EthernetPort>(
+        &mut self,
+        app: &mut A,
+        foe: &mut H,
+        eth: &mut E,
+        now_ns: u64,
+    ) {
         let state = self.state;
         let boot = state == AlState::Bootstrap;
         let foe_on = self.foe_supported();
+        let eoe = self.eoe_supported() && eoe_on(state);
         let m = &mut self.mbx;
         let rx = m.rx.get(..m.rx_len).unwrap_or_default();
         let Some(body) = m.tx.get_mut(HEADER_LEN..m.tx_len) else {
@@ -894,6 +948,11 @@ impl Slave {
                         .coe
                         .handle(payload, body, app, state, now_ns)
                         .map(|n| n.map(|n| (MailboxType::Coe, n))),
+                    // E-095: Pre-Op, Safe-Op and Op
+                    MailboxType::Eoe if eoe => self
+                        .eoe
+                        .handle(payload, body, eth)
+                        .map(|n| n.map(|n| (MailboxType::Eoe, n))),
                     _ => Err(MailboxError::UNSUPPORTED_PROTOCOL),
                 }
             }
@@ -964,6 +1023,11 @@ impl Slave {
         }
         Ok(())
     }
+}
+
+/// E-095: EoE runs in Pre-Op, Safe-Op and Op (not in Init or Bootstrap).
+fn eoe_on(state: AlState) -> bool {
+    matches!(state, AlState::PreOp | AlState::SafeOp | AlState::Op)
 }
 
 /// Reads an unsigned entry of up to 4 bytes (little-endian) through the
