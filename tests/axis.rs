@@ -30,6 +30,17 @@ pub fn motor_position(sim: &RefCell<Simulation>, axis: usize) -> i64 {
     sim.borrow().drives()[0].motors[axis].position_inc_i64()
 }
 
+/// The speed limit of the torque modes (G472/G475) of axis A, rev/s, set
+/// through the axis parameters.
+pub fn torque_mode_speed_limit(sim: &RefCell<Simulation>, rev_s: f32) {
+    with_drive(sim, |d| {
+        let c = &mut d.drive.axes[0].params_mut().cascade;
+        let v = rev_s * crate::REV as f32;
+        c.torque_mode_velocity_limit_positive_inc_per_s = v;
+        c.torque_mode_velocity_limit_negative_inc_per_s = v;
+    });
+}
+
 /// Homing method 37 (reference here, no motion) through the standard PDO:
 /// mode 6, a 0→1 edge of bit 4; returns the TxPDO once bits 12 and 10 are
 /// set. The present position then reads 607Ch.
@@ -44,4 +55,16 @@ pub async fn home_here(m: &mut Cyclic<'_>) -> TxPdo {
     assert!(done.is_some(), "method 37: {:#06x}", m.tx.statusword);
     m.set_controlword(CW_ENABLED);
     m.run(2).await
+}
+
+/// Touch probe 1 as the master reads it by SDO: 60B9h (status), 60BAh
+/// (position at the rising edge), 60BBh (at the falling edge).
+pub async fn probe1<S>(sd: &ethercrab::SubDeviceRef<'_, S>) -> (u16, i32, i32)
+where
+    S: std::ops::Deref<Target = ethercrab::SubDevice>,
+{
+    let status: u16 = sd.sdo_read(0x60B9, 0).await.expect("60B9h");
+    let rising: i32 = sd.sdo_read(0x60BA, 0).await.expect("60BAh");
+    let falling: i32 = sd.sdo_read(0x60BB, 0).await.expect("60BBh");
+    (status, rising, falling)
 }

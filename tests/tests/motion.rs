@@ -240,15 +240,6 @@ fn c037_csv_reaches_target_velocity() {
     });
 }
 
-/// G472/G475 through the axis parameters, rev/s.
-fn torque_mode_speed_limit(sim: &RefCell<Simulation>, rev_s: f32) {
-    with_drive(sim, |d| {
-        let c = &mut d.drive.axes[0].params_mut().cascade;
-        c.torque_mode_velocity_limit_positive_inc_per_s = rev_s * REV as f32;
-        c.torque_mode_velocity_limit_negative_inc_per_s = rev_s * REV as f32;
-    });
-}
-
 #[test]
 fn c038_c039_cst_torque_with_and_without_speed_limit() {
     let sim = line(1);
@@ -883,9 +874,7 @@ fn c121_c122_c123_touch_probe_latches_the_edges_of_input_1() {
             .expect("past the probe window");
         m.set_target_velocity(0);
         m.run(50).await;
-        let status: u16 = sd.sdo_read(0x60B9, 0).await.unwrap();
-        let pos: i32 = sd.sdo_read(0x60BA, 0).await.unwrap();
-        let neg: i32 = sd.sdo_read(0x60BB, 0).await.unwrap();
+        let (status, pos, neg) = probe1(&sd).await;
         println!("touch probe 1: 60B9h {status:#06x}, 60BAh {pos} (edge {rise}), 60BBh {neg} (edge {fall})");
         assert_eq!(
             status & 0x07,

@@ -13,8 +13,6 @@ use drive_tests::axis::*;
 use drive_tests::{init, line, map_layout, sw, with_master, Cyclic, RawCyclic};
 use drive_tests::{REV, REV_F};
 use hil_sim::motor::{PositionInput, Switches};
-use hil_sim::sim::Simulation;
-use std::cell::RefCell;
 
 /// 603Fh of event 53 (limit switch).
 fn event_53() -> Option<u16> {
@@ -189,15 +187,6 @@ fn c051_c052_c053_c054_vl_bits_4_5_6_ramp_and_limit() {
 // ---------------------------------------------------------------------------
 // pt (4) (C-057)
 // ---------------------------------------------------------------------------
-
-/// G472/G475 through the axis parameters, rev/s.
-fn torque_mode_speed_limit(sim: &RefCell<Simulation>, rev_s: f32) {
-    with_drive(sim, |d| {
-        let c = &mut d.drive.axes[0].params_mut().cascade;
-        c.torque_mode_velocity_limit_positive_inc_per_s = rev_s * REV as f32;
-        c.torque_mode_velocity_limit_negative_inc_per_s = rev_s * REV as f32;
-    });
-}
 
 #[test]
 fn c057_pt_ramps_6071_with_6087_limited_by_6072_and_g472() {
@@ -646,9 +635,7 @@ fn c124_c127_touch_probe_single_shot_falling_only_and_rearm() {
             .expect("past p4");
         m.set_target_velocity(0);
         m.run(100).await;
-        let status: u16 = sd.sdo_read(0x60B9, 0).await.unwrap();
-        let rising: i32 = sd.sdo_read(0x60BA, 0).await.unwrap();
-        let falling: i32 = sd.sdo_read(0x60BB, 0).await.unwrap();
+        let (status, rising, falling) = probe1(&sd).await;
         println!(
             "example 2: 60B9h {status:#06x}, 60BAh {rising}, 60BBh {falling} (p2 {})",
             marks[1]
@@ -681,9 +668,7 @@ fn c124_c127_touch_probe_single_shot_falling_only_and_rearm() {
             .expect("past p6");
         m.set_target_velocity(0);
         m.run(100).await;
-        let status: u16 = sd.sdo_read(0x60B9, 0).await.unwrap();
-        let rising: i32 = sd.sdo_read(0x60BA, 0).await.unwrap();
-        let falling: i32 = sd.sdo_read(0x60BB, 0).await.unwrap();
+        let (status, rising, falling) = probe1(&sd).await;
         println!(
             "example 3: 60B9h {status:#06x}, 60BAh {rising} (p5 {}), 60BBh {falling} (p6 {})",
             marks[4], marks[5]
@@ -725,9 +710,7 @@ fn c125_c126_touch_probe_example_1_continuous_both_edges() {
         m.run_until(3000, |t| i64::from(t.position) > marks[1] + i64::from(REV / 40))
             .await
             .expect("past p2");
-        let status: u16 = sd.sdo_read(0x60B9, 0).await.unwrap();
-        let rising: i32 = sd.sdo_read(0x60BA, 0).await.unwrap();
-        let falling: i32 = sd.sdo_read(0x60BB, 0).await.unwrap();
+        let (status, rising, falling) = probe1(&sd).await;
         println!("example 1 after p2: 60B9h {status:#06x}, 60BAh {rising}, 60BBh {falling}");
         assert_eq!(
             status & 0x07,
@@ -742,9 +725,7 @@ fn c125_c126_touch_probe_example_1_continuous_both_edges() {
             .expect("past p4");
         m.set_target_velocity(0);
         m.run(100).await;
-        let status: u16 = sd.sdo_read(0x60B9, 0).await.unwrap();
-        let rising: i32 = sd.sdo_read(0x60BA, 0).await.unwrap();
-        let falling: i32 = sd.sdo_read(0x60BB, 0).await.unwrap();
+        let (status, rising, falling) = probe1(&sd).await;
         println!(
             "example 1 after p4: 60B9h {status:#06x}, 60BAh {rising} (p3 {}), 60BBh {falling} (p4 {})",
             marks[2], marks[3]
