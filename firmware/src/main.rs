@@ -8,6 +8,7 @@
 //! | `sync0` | ERU1_0 (ESC SYNC0 routed through ERU1) | 3 | `node::tasks::sync0` |
 //! | `control` | CCU40_0 (control-cycle timer compare) | 3 | `node::tasks::control` |
 //! | `esc` | ECAT0_0 (ESC PDI interrupt: AL events, SM2/SM3, mailbox) | 2 | `node::tasks::esc_event` |
+//! | `mailbox` | software task (dispatcher CCU42_0), spawned by `esc` | 1 | `node::tasks::mailbox` |
 //! | `idle` | — | 0 | background |
 //!
 //! The ESC is reached through `pdi::mmio::OnChip` over ECAT0's register
@@ -115,7 +116,9 @@ mod app {
         // be built in place (no copy of ~30 KiB through this frame, which
         // `cortex_m::singleton!` makes).
         let slot = unsafe { &mut *core::ptr::addr_of_mut!(DRIVE) };
-        Some(slot.write(Drive::new(ParamFlash::new())))
+        let drive = slot.write(Drive::unstarted(ParamFlash::new(), None));
+        drive.start();
+        Some(drive)
     }
 
     /// Background: fires the control cycle when its time has come (until
@@ -156,9 +159,11 @@ mod app {
         );
     }
 
-    /// The ESC's PDI interrupt: ESM, mailbox, process data.
+    /// The ESC's PDI interrupt: ESM, process data; the mailbox below it.
     #[task(binds = ECAT0_0, priority = 2, shared = [drive, timer, pdi, clock])]
     fn esc(cx: esc::Context) {
+        // already spawned: that run serves the mailbox
+        let _ = mailbox::spawn();
         (cx.shared.drive, cx.shared.timer, cx.shared.pdi, cx.shared.clock).lock(
             |drive, timer, pdi, clock| {
                 let now = clock.now_ns(DWT::cycle_count());
@@ -171,5 +176,17 @@ mod app {
                 }
             },
         );
+    }
+
+    /// The mailbox (CoE, EoE, FoE, EMCY, save) below the ESC task: the
+    /// drive is locked for one request.
+    #[task(priority = 1, shared = [drive, pdi, clock])]
+    async fn mailbox(cx: mailbox::Context) {
+        (cx.shared.drive, cx.shared.pdi, cx.shared.clock).lock(|drive, pdi, clock| {
+            let now = clock.now_ns(DWT::cycle_count());
+            if tasks::mailbox(drive, pdi, now).is_err() {
+                defmt::warn!("mailbox: PDI access failed");
+            }
+        });
     }
 }

@@ -373,6 +373,21 @@ fn bytes_at<const N: usize>(image: &[u8], at: usize) -> Option<[u8; N]> {
     image.get(at..at + N)?.try_into().ok()
 }
 
+/// Writes `N` bytes at `at`; `false` (nothing written) outside `image`.
+#[inline]
+fn put_at<const N: usize>(image: &mut [u8], at: usize, bytes: [u8; N]) -> bool {
+    match image
+        .get_mut(at..at + N)
+        .and_then(|s| <&mut [u8; N]>::try_from(s).ok())
+    {
+        Some(dst) => {
+            *dst = bytes;
+            true
+        }
+        None => false,
+    }
+}
+
 /// The value of type `t` at `at` in `image` (the common widths without the
 /// generic decoder's copy and shifts).
 fn load(image: &[u8], at: usize, t: DataType) -> Result<i64, SdoAbort> {
@@ -386,6 +401,103 @@ fn load(image: &[u8], at: usize, t: DataType) -> Result<i64, SdoAbort> {
         _ => return t.decode(image.get(at..at + t.bytes()).ok_or(SdoAbort::GENERAL)?),
     };
     v.ok_or(SdoAbort::GENERAL)
+}
+
+/// A resolved integer entry in the RAM image: the handle the control cycle
+/// and the process-data copy use for the entries they touch every cycle
+/// (resolved once, then a load or store of one to eight bytes). It depends
+/// only on the declaration, so it stays valid for every [`DriveObjects`].
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub struct Slot {
+    /// Byte offset in the RAM image.
+    at: u16,
+    /// The entry's type.
+    kind: SlotType,
+    /// A changed value is a configuration change.
+    config: bool,
+}
+
+/// The types a [`Slot`] holds (one byte, so a slot is four).
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+enum SlotType {
+    Bool,
+    U8,
+    I8,
+    U16,
+    I16,
+    U32,
+    I32,
+    U64,
+    I64,
+}
+
+impl SlotType {
+    const fn of(t: DataType) -> Option<Self> {
+        Some(match t {
+            DataType::Bool => Self::Bool,
+            DataType::U8 => Self::U8,
+            DataType::I8 => Self::I8,
+            DataType::U16 => Self::U16,
+            DataType::I16 => Self::I16,
+            DataType::U32 => Self::U32,
+            DataType::I32 => Self::I32,
+            DataType::U64 => Self::U64,
+            DataType::I64 => Self::I64,
+            _ => return None,
+        })
+    }
+
+    /// The type's value range.
+    const fn range(self) -> (i64, i64) {
+        match self {
+            Self::Bool => (0, 1),
+            Self::U8 => (0, u8::MAX as i64),
+            Self::I8 => (i8::MIN as i64, i8::MAX as i64),
+            Self::U16 => (0, u16::MAX as i64),
+            Self::I16 => (i16::MIN as i64, i16::MAX as i64),
+            Self::U32 => (0, u32::MAX as i64),
+            Self::I32 => (i32::MIN as i64, i32::MAX as i64),
+            Self::U64 => (0, i64::MAX),
+            Self::I64 => (i64::MIN, i64::MAX),
+        }
+    }
+
+    /// Width in bytes.
+    const fn bytes(self) -> usize {
+        match self {
+            Self::Bool | Self::U8 | Self::I8 => 1,
+            Self::U16 | Self::I16 => 2,
+            Self::U32 | Self::I32 => 4,
+            Self::U64 | Self::I64 => 8,
+        }
+    }
+
+    const fn data_type(self) -> DataType {
+        match self {
+            Self::Bool => DataType::Bool,
+            Self::U8 => DataType::U8,
+            Self::I8 => DataType::I8,
+            Self::U16 => DataType::U16,
+            Self::I16 => DataType::I16,
+            Self::U32 => DataType::U32,
+            Self::I32 => DataType::I32,
+            Self::U64 => DataType::U64,
+            Self::I64 => DataType::I64,
+        }
+    }
+}
+
+impl Slot {
+    /// Width of the value in bytes.
+    #[inline]
+    pub fn bytes(self) -> usize {
+        self.kind.bytes()
+    }
+
+    /// The entry's type.
+    pub fn data_type(self) -> DataType {
+        self.kind.data_type()
+    }
 }
 
 /// The drive's object dictionary: the RAM image of every value, the active
@@ -557,6 +669,88 @@ impl DriveObjects {
         let mut buf = [0u8; 8];
         let n = self.read_loc(loc, &mut buf)?;
         t.decode(buf.get(..n).ok_or(SdoAbort::GENERAL)?)
+    }
+
+    /// The [`Slot`] of integer entry `index`:`sub` ("EtherCAT Rx SDO Info"
+    /// numbering, aliases followed) when its value is in RAM; `None` for
+    /// constants, strings, REAL32 and unknown entries.
+    pub fn slot(&self, index: u16, sub: u8) -> Option<Slot> {
+        let r = resolve(index, sub)?;
+        let Place::Ram(at) = r.place else {
+            return None;
+        };
+        let kind = SlotType::of(r.data_type)?;
+        let fits = usize::from(at) + r.data_type.bytes() <= IMAGE_BYTES;
+        fits.then_some(Slot {
+            at,
+            kind,
+            config: r.config,
+        })
+    }
+
+    /// The value in `slot` (as [`get`](Self::get) reads it).
+    #[inline]
+    pub fn load_slot(&self, slot: Slot) -> i64 {
+        let (img, at) = (&self.image, usize::from(slot.at));
+        let v = match slot.kind {
+            SlotType::Bool | SlotType::U8 => bytes_at::<1>(img, at).map(|[b]| i64::from(b)),
+            SlotType::I8 => bytes_at::<1>(img, at).map(|[b]| i64::from(b as i8)),
+            SlotType::U16 => bytes_at(img, at).map(|b| i64::from(u16::from_le_bytes(b))),
+            SlotType::I16 => bytes_at(img, at).map(|b| i64::from(i16::from_le_bytes(b))),
+            SlotType::U32 => bytes_at(img, at).map(|b| i64::from(u32::from_le_bytes(b))),
+            SlotType::I32 => bytes_at(img, at).map(|b| i64::from(i32::from_le_bytes(b))),
+            SlotType::U64 => bytes_at(img, at).map(|b| u64::from_le_bytes(b) as i64),
+            SlotType::I64 => bytes_at(img, at).map(i64::from_le_bytes),
+        };
+        v.unwrap_or(0)
+    }
+
+    /// Stores `value` in `slot` (as [`set`](Self::set): a value outside the
+    /// type's range changes nothing and returns `false`).
+    #[inline]
+    pub fn store_slot(&mut self, slot: Slot, value: i64) -> bool {
+        let (lo, hi) = slot.kind.range();
+        if value < lo || value > hi {
+            return false;
+        }
+        if slot.config && self.load_slot(slot) != value {
+            self.config_changed();
+        }
+        let (img, at) = (&mut self.image, usize::from(slot.at));
+        match slot.kind {
+            SlotType::Bool | SlotType::U8 | SlotType::I8 => put_at(img, at, [value as u8]),
+            SlotType::U16 | SlotType::I16 => put_at(img, at, (value as u16).to_le_bytes()),
+            SlotType::U32 | SlotType::I32 => put_at(img, at, (value as u32).to_le_bytes()),
+            SlotType::U64 | SlotType::I64 => put_at(img, at, value.to_le_bytes()),
+        }
+    }
+
+    /// The raw little-endian bytes of `slot`.
+    pub fn slot_bytes(&self, slot: Slot) -> &[u8] {
+        let at = usize::from(slot.at);
+        self.image.get(at..at + slot.bytes()).unwrap_or_default()
+    }
+
+    /// Stores raw little-endian bytes of the slot's full width (a process
+    /// data copy); another length changes nothing and returns `false`.
+    pub fn store_slot_bytes(&mut self, slot: Slot, data: &[u8]) -> bool {
+        let at = usize::from(slot.at);
+        let Some(dst) = self.image.get_mut(at..at + data.len()) else {
+            return false;
+        };
+        if data.len() != slot.bytes() {
+            return false;
+        }
+        if slot.config {
+            if dst == data {
+                return true;
+            }
+            self.config_generation = self.config_generation.wrapping_add(1);
+        }
+        for (d, s) in dst.iter_mut().zip(data) {
+            *d = *s;
+        }
+        true
     }
 
     /// Sets `index`:`sub` from the runtime (statusword, actual values, ESM

@@ -36,8 +36,8 @@ pub mod pdo_image;
 pub mod runtime;
 
 pub use dictionary::{
-    revision, DriveObjects, ImageError, LiveValues, NoLive, Requests, Template, WithLive, LOAD_SIGNATURE,
-    PERSISTENT_IMAGE_BYTES, SAVE_SIGNATURE,
+    revision, DriveObjects, ImageError, LiveValues, NoLive, Requests, Slot, Template, WithLive,
+    LOAD_SIGNATURE, PERSISTENT_IMAGE_BYTES, SAVE_SIGNATURE,
 };
 use esc::sii::mailbox_protocol;
 

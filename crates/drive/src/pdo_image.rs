@@ -33,7 +33,7 @@
 //! runtime ("EtherCAT Rx SDO Info") numbering of [`DriveObjects::get`] and
 //! [`DriveObjects::set_bytes`].
 
-use crate::dictionary::{DriveObjects, Template};
+use crate::dictionary::{DriveObjects, Slot, Template};
 use crate::objects::find;
 use crate::MAPPING_ENTRIES;
 use od::{Access, DataType, EntryInfo};
@@ -66,6 +66,9 @@ pub struct ImageEntry {
     /// declared default, for persistent entries the value captured by
     /// [`PdoImage::capture_fallbacks`].
     pub fallback: i64,
+    /// The entry's RAM slot when it is an integer of exactly `bits` at a
+    /// byte boundary: copied as bytes without a dictionary lookup.
+    pub slot: Option<Slot>,
 }
 
 impl ImageEntry {
@@ -76,6 +79,7 @@ impl ImageEntry {
         sub: 0,
         info: &UNUSED,
         fallback: 0,
+        slot: None,
     };
 
     /// Byte offset of the entry in the image (of its first bit).
@@ -145,14 +149,20 @@ impl Channel {
                 if info.bit_len() != u16::from(bits) {
                     return Err(bad(EntryFault::BitLength));
                 }
-                let entry = ImageEntry {
+                let mut entry = ImageEntry {
                     bit_offset: u16::try_from(at).map_err(|_| PdoImageError::TooLong { pdo })?,
                     bits,
                     index,
                     sub: info.sub,
                     info,
                     fallback: info.default,
+                    slot: None,
                 };
+                if entry.byte_aligned() {
+                    entry.slot = objects
+                        .slot(index, info.sub)
+                        .filter(|s| s.bytes() * 8 == usize::from(bits));
+                }
                 if !entry.byte_aligned() && bits > 64 {
                     return Err(bad(EntryFault::Unaligned));
                 }
@@ -262,7 +272,12 @@ impl PdoImage {
     pub fn apply_outputs(&self, rx_bytes: &[u8], objects: &mut DriveObjects) -> usize {
         let mut written = 0;
         for e in self.rx.entries() {
-            let ok = if e.byte_aligned() {
+            let ok = if let Some(slot) = e.slot {
+                let at = e.byte_offset();
+                rx_bytes
+                    .get(at..at + slot.bytes())
+                    .is_some_and(|raw| objects.store_slot_bytes(slot, raw))
+            } else if e.byte_aligned() {
                 let at = e.byte_offset();
                 rx_bytes
                     .get(at..at + usize::from(e.bits / 8))
@@ -286,6 +301,16 @@ impl PdoImage {
     pub fn fill_inputs(&self, objects: &DriveObjects, tx_bytes: &mut [u8]) {
         tx_bytes.fill(0);
         for e in self.tx.entries() {
+            if let Some(slot) = e.slot {
+                let at = e.byte_offset();
+                let src = objects.slot_bytes(slot);
+                if let Some(dst) = tx_bytes.get_mut(at..at + src.len()) {
+                    for (d, s) in dst.iter_mut().zip(src) {
+                        *d = *s;
+                    }
+                }
+                continue;
+            }
             let Ok(value) = objects.get(e.index, e.sub) else {
                 continue;
             };
@@ -504,6 +529,47 @@ mod tests {
         let mut short = [0u8; 5];
         img.fill_inputs(&objects, &mut short);
         assert_eq!(short, [0x37, 0x02, 0xFF, 0, 0]);
+    }
+
+    /// E-034/E-032: the direct slot copy of byte-aligned integer entries
+    /// decodes and encodes exactly what the copy through the dictionary
+    /// does, on every layout, and it is the path the default layouts take.
+    #[test]
+    fn e034_slot_copy_equals_the_dictionary_copy() {
+        for layout in [PdoLayout::Standard, PdoLayout::Ip, PdoLayout::Vl] {
+            let mut objects = DriveObjects::new();
+            objects.apply_map(layout).unwrap();
+            let img = PdoImage::compile(&objects).unwrap();
+            let mut slow = img.clone();
+            for e in slow.rx.entries.iter_mut().chain(slow.tx.entries.iter_mut()) {
+                e.slot = None;
+            }
+            let with_slots = img
+                .rx
+                .entries()
+                .iter()
+                .chain(img.tx.entries())
+                .filter(|e| e.slot.is_some());
+            assert_eq!(
+                with_slots.count(),
+                img.rx.entries().len() + img.tx.entries().len(),
+                "{layout:?}"
+            );
+            let rx: Vec<u8> = (0..img.rx.bytes()).map(|i| (i * 37 + 201) as u8).collect();
+            let (mut a, mut b) = (objects.clone(), objects.clone());
+            assert_eq!(img.apply_outputs(&rx, &mut a), slow.apply_outputs(&rx, &mut b));
+            assert_eq!(a, b, "{layout:?}");
+            a.set(0x6041, 0, 0x1637).unwrap();
+            a.set(0x6064, 0, -123_456).unwrap();
+            a.set(0x6044, 0, -77).unwrap();
+            let (mut fast_tx, mut slow_tx) = (
+                std::vec![0x55u8; img.tx.bytes()],
+                std::vec![0xAAu8; img.tx.bytes()],
+            );
+            img.fill_inputs(&a, &mut fast_tx);
+            slow.fill_inputs(&a, &mut slow_tx);
+            assert_eq!(fast_tx, slow_tx, "{layout:?}");
+        }
     }
 
     #[test]

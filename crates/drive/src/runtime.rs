@@ -58,7 +58,7 @@
 //! four LEDs as patterns of `ecat::led` ([`Drive::leds`]).
 
 use crate::axis::{Axis, AxisCommand, AxisIo};
-use crate::dictionary::{DriveObjects, LiveValues, PERSISTENT_IMAGE_BYTES};
+use crate::dictionary::{DriveObjects, LiveValues, Slot, PERSISTENT_IMAGE_BYTES};
 use crate::objects::LAYOUT_HASH;
 use crate::pdo_image::{PdoImage, PdoImageError};
 use crate::DEVICE;
@@ -226,6 +226,104 @@ impl<B: Flash> FoeHandler for FirmwareFoe<'_, B> {
     }
 }
 
+/// The entries the runtime reads or writes in every control cycle, SYNC0
+/// and frame event, resolved once (a load or store each instead of a
+/// dictionary lookup; docs/architecture.md, cycle cost). `None`: not an
+/// integer in RAM (reads give the default, writes are dropped).
+#[derive(Debug, Clone, Copy)]
+struct RuntimeSlots {
+    a149: Option<Slot>,
+    a150: Option<Slot>,
+    a290: Option<Slot>,
+    a291: Option<Slot>,
+    a292: Option<Slot>,
+    a296: Option<Slot>,
+    a298: Option<Slot>,
+    a261: [Option<Slot>; 4],
+    /// 1C32h:0B, 1C33h:0B SM-event missed.
+    sm_missed: [Option<Slot>; 2],
+    /// 1C32h:20, 1C33h:20 sync error.
+    sync_error: [Option<Slot>; 2],
+    /// 1001h error register.
+    error_register: Option<Slot>,
+    /// 10F3h:04 (A250) new messages.
+    new_messages: Option<Slot>,
+}
+
+impl RuntimeSlots {
+    const NONE: Self = Self {
+        a149: None,
+        a150: None,
+        a290: None,
+        a291: None,
+        a292: None,
+        a296: None,
+        a298: None,
+        a261: [None; 4],
+        sm_missed: [None; 2],
+        sync_error: [None; 2],
+        error_register: None,
+        new_messages: None,
+    };
+
+    fn resolve(od: &DriveObjects) -> Self {
+        let s = |index: u16, sub: u8| od.slot(index, sub);
+        Self {
+            a149: s(A149, 0),
+            a150: s(A150, 0),
+            a290: s(A290, 0),
+            a291: s(A291, 0),
+            a292: s(A292, 0),
+            a296: s(A296, 0),
+            a298: s(A298, 0),
+            a261: [s(A261, 1), s(A261, 2), s(A261, 3), s(A261, 4)],
+            sm_missed: [s(0x1C32, 0x0B), s(0x1C33, 0x0B)],
+            sync_error: [s(0x1C32, 0x20), s(0x1C33, 0x20)],
+            error_register: s(0x1001, 0),
+            new_messages: s(0x10F3, 4),
+        }
+    }
+
+    /// Every slot, for the completeness test.
+    #[cfg(test)]
+    fn all(&self) -> [Option<Slot>; 17] {
+        let [r0, r1, r2, r3] = self.a261;
+        let [m0, m1] = self.sm_missed;
+        let [e0, e1] = self.sync_error;
+        [
+            self.a149,
+            self.a150,
+            self.a290,
+            self.a291,
+            self.a292,
+            self.a296,
+            self.a298,
+            r0,
+            r1,
+            r2,
+            r3,
+            m0,
+            m1,
+            e0,
+            e1,
+            self.error_register,
+            self.new_messages,
+        ]
+    }
+}
+
+/// The value in `slot`, or `default` without one.
+fn read_slot(od: &DriveObjects, slot: Option<Slot>, default: i64) -> i64 {
+    slot.map_or(default, |s| od.load_slot(s))
+}
+
+/// Stores `value` in `slot` (dropped without one or out of range).
+fn write_slot(od: &mut DriveObjects, slot: Option<Slot>, value: i64) {
+    if let Some(s) = slot {
+        od.store_slot(s, value);
+    }
+}
+
 /// One drive on the bus: slave stack + object dictionary + parameter store
 /// (+ the firmware slots on flash `B`, see [`Drive::with_boot`]).
 pub struct Drive<F: Flash, B: Flash = NoFlash> {
@@ -258,6 +356,8 @@ pub struct Drive<F: Flash, B: Flash = NoFlash> {
     ctl_rx_frames: u32,
     /// The DC-Sync PLL while SYNC0 runs (built at the first pulse).
     pll: Option<Pll>,
+    /// The entries of the cyclic paths.
+    slots: RuntimeSlots,
     /// Why the PLL could not be built for the last SYNC0 configuration.
     sync_error: Option<SyncError>,
     /// The A287 measurement.
@@ -340,10 +440,19 @@ impl<F: Flash, B: Flash> Drive<F, B> {
     /// firmware downloads in Bootstrap go into the inactive slot.
     #[inline(always)]
     pub fn with_boot(flash: F, boot: Option<BootSlots<B>>) -> Self {
-        // Built in place (the value goes straight to the caller's slot) and
-        // loaded afterwards: a drive assembled from large locals needed
-        // several copies of itself on the stack (docs/architecture.md).
-        let mut drive = Self {
+        let mut drive = Self::unstarted(flash, boot);
+        drive.start();
+        drive
+    }
+
+    /// The drive before [`start`](Self::start): every part at its power-on
+    /// value, nothing loaded. A plain value, so a firmware can write it
+    /// straight into its static (`MaybeUninit::write`) and start it there:
+    /// a drive assembled and loaded in one function needed several copies
+    /// of itself on the stack (docs/architecture.md).
+    #[inline(always)]
+    pub fn unstarted(flash: F, boot: Option<BootSlots<B>>) -> Self {
+        Self {
             slave: Slave::new(&DEVICE),
             eoe: ecat::eoe::FrameCounter {
                 frames: 0,
@@ -363,6 +472,7 @@ impl<F: Flash, B: Flash> Drive<F, B> {
             axes: [Axis::new(0), Axis::new(1)],
             ctl_rx_frames: 0,
             pll: None,
+            slots: RuntimeSlots::NONE,
             sync_error: None,
             optimizer: dcsync::Optimizer::new(),
             frame_rel_sync0_ns: None,
@@ -374,11 +484,17 @@ impl<F: Flash, B: Flash> Drive<F, B> {
             ports: PortDiag::default(),
             mailbox_er: 0,
             pll_from_sm: false,
-        };
-        drive.startup = drive.load_saved();
-        drive.compile_pdo_image();
-        drive.update_live();
-        drive
+        }
+    }
+
+    /// Power-on of an [`unstarted`](Self::unstarted) drive: resolves the
+    /// cyclic entries, loads the newest saved set, compiles the process
+    /// images and fills the live values.
+    pub fn start(&mut self) {
+        self.slots = RuntimeSlots::resolve(&self.objects);
+        self.startup = self.load_saved();
+        self.compile_pdo_image();
+        self.update_live();
     }
 
     /// Loads the saved parameter set into the dictionary (defaults stay when
@@ -464,19 +580,68 @@ impl<F: Flash, B: Flash> Drive<F, B> {
     /// Runs the slave stack once at `now_ns`, then process data, the live
     /// objects and the dictionary's requests.
     pub fn poll<P: Pdi>(&mut self, pdi: &mut P, now_ns: u64) -> Result<Option<StateChange>, P::Error> {
-        if !self.cycle_owns_pdo() {
-            self.process_inputs();
-        }
-        self.slave.set_sync_state(self.sync_state());
+        let change = self.poll_parts(pdi, now_ns, true)?;
+        self.serve_requests();
+        Ok(change)
+    }
+
+    /// The ESC-event part of [`poll`](Self::poll) for the priority-2 task:
+    /// AL control, process data, monitoring, live values; the mailbox
+    /// waits for [`poll_mailbox`](Self::poll_mailbox).
+    pub fn poll_esc<P: Pdi>(&mut self, pdi: &mut P, now_ns: u64) -> Result<Option<StateChange>, P::Error> {
+        self.poll_parts(pdi, now_ns, false)
+    }
+
+    /// The mailbox part of [`poll`](Self::poll) for the low-priority task:
+    /// one CoE/EoE/FoE request answered, queued EMCYs and EoE fragments
+    /// sent, then the dictionary's requests (A00/1010h save) served.
+    pub fn poll_mailbox<P: Pdi>(&mut self, pdi: &mut P, now_ns: u64) -> Result<(), P::Error> {
+        self.update_live();
         let mut live = Live { diag: &mut self.diag };
         let mut foe = FirmwareFoe::new(self.boot.as_mut());
-        let change = self.slave.poll_with_eoe(
+        self.slave.poll_mailbox_only(
             pdi,
             &mut self.objects.with_live(&mut live),
             &mut foe,
             &mut self.eoe,
             now_ns,
         )?;
+        self.serve_requests();
+        Ok(())
+    }
+
+    /// The dictionary's requests: a save (A00, 1010h) writes the store.
+    fn serve_requests(&mut self) {
+        let requests = self.objects.take_requests();
+        if requests.save {
+            self.save();
+        }
+    }
+
+    fn poll_parts<P: Pdi>(
+        &mut self,
+        pdi: &mut P,
+        now_ns: u64,
+        mailbox: bool,
+    ) -> Result<Option<StateChange>, P::Error> {
+        if !self.cycle_owns_pdo() {
+            self.process_inputs();
+        }
+        self.slave.set_sync_state(self.sync_state());
+        let mut live = Live { diag: &mut self.diag };
+        let mut foe = FirmwareFoe::new(self.boot.as_mut());
+        let change = if mailbox {
+            self.slave.poll_with_eoe(
+                pdi,
+                &mut self.objects.with_live(&mut live),
+                &mut foe,
+                &mut self.eoe,
+                now_ns,
+            )?
+        } else {
+            self.slave
+                .poll_esc(pdi, &mut self.objects.with_live(&mut live), now_ns)?
+        };
         if self.slave.take_error_ack() {
             // the master acknowledged the error: a latched PLL fault goes
             // (a new one latches again at the next occurrence)
@@ -514,10 +679,6 @@ impl<F: Flash, B: Flash> Drive<F, B> {
         }
         self.update_live();
         self.update_optimizer();
-        let requests = self.objects.take_requests();
-        if requests.save {
-            self.save();
-        }
         Ok(change)
     }
 
@@ -576,7 +737,11 @@ impl<F: Flash, B: Flash> Drive<F, B> {
     fn process_inputs(&mut self) {
         if matches!(self.slave.state(), AlState::SafeOp | AlState::Op) {
             // 10F3h:04 (A250) is answered live; the image needs its value in RAM
-            let _ = self.objects.set(0x10F3, 4, i64::from(self.diag.new_messages()));
+            write_slot(
+                &mut self.objects,
+                self.slots.new_messages,
+                i64::from(self.diag.new_messages()),
+            );
             self.pdo.fill_inputs(&self.objects, self.slave.inputs_mut());
         }
     }
@@ -630,7 +795,7 @@ impl<F: Flash, B: Flash> Drive<F, B> {
             register |= axis.error_register();
             *command = report.command;
         }
-        let _ = self.objects.set(0x1001, 0, i64::from(register));
+        write_slot(&mut self.objects, self.slots.error_register, i64::from(register));
         commands
     }
 
@@ -936,15 +1101,15 @@ impl<F: Flash, B: Flash> Drive<F, B> {
     /// The PLL configuration from the ESC's SYNC0 cycle and the objects
     /// (A150, A292, A149, A290; µs in the objects).
     fn pll_config(&self, sync0_cycle_ns: u32) -> dcsync::Config {
-        let get = |index| self.objects.get(index, 0).unwrap_or(0);
-        let a150_ns = u32::try_from(get(A150).saturating_mul(1000)).unwrap_or(0);
+        let get = |slot| read_slot(&self.objects, slot, 0);
+        let a150_ns = u32::try_from(get(self.slots.a150).saturating_mul(1000)).unwrap_or(0);
         let mut cfg = dcsync::Config::new(sync0_cycle_ns, a150_ns, TIMER_HZ);
-        cfg.a292_ns = i32::try_from(get(A292).saturating_mul(1000)).unwrap_or(0);
-        cfg.sequence = u8::try_from(get(A149))
+        cfg.a292_ns = i32::try_from(get(self.slots.a292).saturating_mul(1000)).unwrap_or(0);
+        cfg.sequence = u8::try_from(get(self.slots.a149))
             .ok()
             .and_then(dcsync::CycleSequence::from_a149)
             .unwrap_or_default();
-        cfg.enabled = self.objects.get(A290, 0).map_or(true, |v| v == 1);
+        cfg.enabled = read_slot(&self.objects, self.slots.a290, 1) == 1;
         cfg
     }
 
@@ -1072,29 +1237,32 @@ impl<F: Flash, B: Flash> Drive<F, B> {
         let measured_us = i64::from(measured.saturating_add(500) / 1000);
         // bit 4: A296 > A291 (spec §11.6; the PLL itself compares with the
         // SYNC0 cycle it was configured for)
-        let a291_us = self.objects.get(A291, 0).unwrap_or(0);
+        let a291_us = read_slot(&self.objects, self.slots.a291, 0);
         let status = if measured_us > 0 && a291_us > 0 && measured_us > a291_us {
             status | dcsync::PllStatus::SYNC_CYCLE_TOO_LONG
         } else {
             status
         };
-        let _ = self.objects.set(A298, 0, i64::from(status));
-        let _ = self.objects.set(A296, 0, measured_us);
+        let (od, slots) = (&mut self.objects, &self.slots);
+        write_slot(od, slots.a298, i64::from(status));
+        write_slot(od, slots.a296, measured_us);
         let [code, data_us, late, phase] = diag.elements();
-        let _ = self.objects.set(A261, 1, i64::from(code));
-        let _ = self.objects.set(A261, 2, i64::from(data_us));
-        let _ = self.objects.set(A261, 3, i64::from(late));
         // `[3]` is declared U32: the phase error's two's complement
-        let _ = self.objects.set(A261, 4, i64::from(phase as u32));
+        let a261 = [code, data_us, late].map(i64::from);
+        for (slot, v) in slots
+            .a261
+            .into_iter()
+            .zip(a261.into_iter().chain([i64::from(phase as u32)]))
+        {
+            write_slot(od, slot, v);
+        }
         // 1C32h/1C33h (mirrored in A264/A265, E-119): :0B SM-event missed
         // = the late frames of A261[2], :20 sync error = a PLL fault or a
         // refused SYNC0 configuration
         let fault = self.pll.as_ref().is_some_and(|p| p.fault().is_some()) || self.sync_error.is_some();
-        for index in [0x1C32, 0x1C33] {
-            let _ = self
-                .objects
-                .set(index, 0x0B, i64::from(late.clamp(0, i32::from(u16::MAX))));
-            let _ = self.objects.set(index, 0x20, i64::from(fault));
+        for (missed, error) in slots.sm_missed.into_iter().zip(slots.sync_error) {
+            write_slot(od, missed, i64::from(late.clamp(0, i32::from(u16::MAX))));
+            write_slot(od, error, i64::from(fault));
         }
     }
 
@@ -1205,5 +1373,21 @@ impl Text {
 
     fn bytes(&self) -> &[u8] {
         self.buf.get(..self.len).unwrap_or_default()
+    }
+}
+
+#[cfg(test)]
+mod slot_tests {
+    use super::*;
+
+    /// Every entry the cyclic paths write has a RAM slot (a missing one
+    /// would drop A261, 1C32h or 1001h silently), and no two share one.
+    #[test]
+    fn runtime_slots_resolve_every_entry() {
+        let all = RuntimeSlots::resolve(&DriveObjects::new()).all();
+        for (k, s) in all.iter().enumerate() {
+            assert!(s.is_some(), "slot {k} missing");
+            assert!(!all[..k].contains(s), "slot {k} shared");
+        }
     }
 }

@@ -745,3 +745,49 @@ fn e016_cached_get_equals_the_sdo_read_of_every_entry() {
     // constants stay read-only through the cache
     assert_eq!(d.set(0x1000, 0, 1), Err(SdoAbort::READ_ONLY));
 }
+
+/// A [`Slot`] reads and writes exactly what `get`/`set` do, for every
+/// integer entry in RAM: the same value, the same refusal of an
+/// out-of-range value, the same configuration-generation change.
+#[test]
+fn slot_access_equals_get_and_set() {
+    let mut checked = 0;
+    for o in OBJECTS.iter() {
+        for e in o.info.entries {
+            let od = DriveObjects::new();
+            let Some(slot) = od.slot(o.info.index, e.sub) else {
+                continue;
+            };
+            assert_eq!(Ok(od.load_slot(slot)), od.get(o.info.index, e.sub));
+            let t = e.data_type;
+            let v = od.load_slot(slot);
+            let candidates = [
+                if v < t.max_value() { v + 1 } else { v - 1 },
+                t.max_value().saturating_add(1),
+                t.min_value().saturating_sub(1),
+            ];
+            for value in candidates {
+                let (mut by_set, mut by_slot) = (od.clone(), od.clone());
+                let ok = by_set.set(o.info.index, e.sub, value).is_ok();
+                assert_eq!(
+                    by_slot.store_slot(slot, value),
+                    ok,
+                    "{:04X}:{}",
+                    o.info.index,
+                    e.sub
+                );
+                assert_eq!(by_set, by_slot);
+                assert_eq!(
+                    by_set.config_generation() == od.config_generation(),
+                    by_slot.config_generation() == od.config_generation(),
+                    "{:04X}:{} generation",
+                    o.info.index,
+                    e.sub
+                );
+                assert_eq!(by_slot.slot_bytes(slot).len(), t.bytes());
+            }
+            checked += 1;
+        }
+    }
+    assert!(checked > 300, "{checked} slots");
+}

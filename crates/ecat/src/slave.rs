@@ -399,6 +399,48 @@ impl Slave {
         eth: &mut E,
         now_ns: u64,
     ) -> Result<Option<StateChange>, P::Error> {
+        let (events, change) = self.poll_al_control(pdi, app, now_ns)?;
+        self.mailbox_step(pdi, app, foe, eth, events, now_ns)?;
+        self.poll_process_data(pdi, app, events, change, now_ns)
+    }
+
+    /// The ESC-event part of [`poll_with_eoe`](Self::poll_with_eoe) for a
+    /// high-priority task: AL control, process data and its monitoring,
+    /// without the mailbox. Run [`poll_mailbox_only`](Self::poll_mailbox_only)
+    /// at a lower priority to serve the mailbox.
+    pub fn poll_esc<P: Pdi, A: Dictionary>(
+        &mut self,
+        pdi: &mut P,
+        app: &mut A,
+        now_ns: u64,
+    ) -> Result<Option<StateChange>, P::Error> {
+        let (events, change) = self.poll_al_control(pdi, app, now_ns)?;
+        self.poll_process_data(pdi, app, events, change, now_ns)
+    }
+
+    /// The mailbox part of [`poll_with_eoe`](Self::poll_with_eoe) for a
+    /// low-priority task: one request from SM0 (CoE, EoE, FoE) answered
+    /// into SM1, the EMCY queue, SDO Info fragments, outgoing EoE fragments
+    /// and the FoE timeout. Nothing happens outside the mailbox states.
+    pub fn poll_mailbox_only<P: Pdi, A: Dictionary, H: FoeHandler, E: EthernetPort>(
+        &mut self,
+        pdi: &mut P,
+        app: &mut A,
+        foe: &mut H,
+        eth: &mut E,
+        now_ns: u64,
+    ) -> Result<(), P::Error> {
+        let events = pdi.al_event()?;
+        self.mailbox_step(pdi, app, foe, eth, events, now_ns)
+    }
+
+    /// The AL event request register and the AL control request it carries.
+    fn poll_al_control<P: Pdi, A: Dictionary>(
+        &mut self,
+        pdi: &mut P,
+        app: &mut A,
+        now_ns: u64,
+    ) -> Result<(u32, Option<StateChange>), P::Error> {
         if !self.started {
             self.write_status(pdi)?;
             self.started = true;
@@ -407,20 +449,43 @@ impl Slave {
         if let Some(bytes) = app.process_data_bytes() {
             self.pdo_bytes = bytes;
         }
-        let mut change = if events & al_event::AL_CONTROL != 0 {
+        let change = if events & al_event::AL_CONTROL != 0 {
             self.al_control(pdi, app, now_ns)?
         } else {
             None
         };
-        if self.state != AlState::Bootstrap {
-            self.foe.reset(foe);
-        }
         if !eoe_on(self.state) {
             self.eoe.reset();
+        }
+        Ok((events, change))
+    }
+
+    fn mailbox_step<P: Pdi, A: Dictionary, H: FoeHandler, E: EthernetPort>(
+        &mut self,
+        pdi: &mut P,
+        app: &mut A,
+        foe: &mut H,
+        eth: &mut E,
+        events: u32,
+        now_ns: u64,
+    ) -> Result<(), P::Error> {
+        if self.state != AlState::Bootstrap {
+            self.foe.reset(foe);
         }
         if esm::mailbox_on(self.state) {
             self.poll_mailbox(pdi, app, foe, eth, events, now_ns)?;
         }
+        Ok(())
+    }
+
+    fn poll_process_data<P: Pdi, A: Dictionary>(
+        &mut self,
+        pdi: &mut P,
+        app: &mut A,
+        events: u32,
+        mut change: Option<StateChange>,
+        now_ns: u64,
+    ) -> Result<Option<StateChange>, P::Error> {
         if esm::process_data_on(self.state) {
             self.process_data(pdi, events, now_ns)?;
         }

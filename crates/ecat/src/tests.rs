@@ -1099,3 +1099,49 @@ fn e095_eoe_unsupported_without_the_sii_protocol() {
     let resp = r.eoe(&mut port, &set_ip_request([10, 0, 0, 7]), 1).unwrap();
     assert_eq!(&resp[..10], &[4, 0, 0, 0, 0, 0x10, 0x01, 0x00, 0x02, 0x00]);
 }
+
+/// E-027/E-037 with the stack split over two tasks: `poll_esc` (AL control,
+/// process data) never touches the mailbox, `poll_mailbox_only` serves it,
+/// and together they answer like `poll`.
+#[test]
+fn e027_e037_mailbox_served_by_its_own_task() {
+    let mut r = Rig::new();
+    let split = |r: &mut Rig, mailbox: bool| {
+        r.t += 1_000_000;
+        let Ok(c) = r.slave.poll_esc(&mut r.esc, &mut r.app, r.t);
+        if mailbox {
+            let Ok(()) = r.slave.poll_mailbox_only(
+                &mut r.esc,
+                &mut r.app,
+                &mut crate::foe::NoFiles,
+                &mut crate::eoe::NoEthernet,
+                r.t,
+            );
+        }
+        c
+    };
+    // AL control through the ESC part alone
+    r.esc.request(2);
+    let c = split(&mut r, false);
+    assert_eq!(c.map(|c| c.to), Some(AlState::PreOp));
+    assert_eq!(r.esc.status(), 2);
+    // a request waits in SM0 while only the ESC part runs
+    r.esc
+        .mbx_write(&[10, 0, 0, 0, 0, 0x13, 0x00, 0x20, 0x40, 0x08, 0x10, 0, 0, 0, 0, 0]);
+    for _ in 0..3 {
+        split(&mut r, false);
+        assert!(r.esc.mbx_read().is_none());
+        assert_ne!(r.esc.events() & al_event::sm(0), 0, "SM0 read by the ESC part");
+    }
+    // the mailbox part answers it
+    split(&mut r, true);
+    let resp = r.esc.mbx_read().unwrap();
+    assert_eq!(&resp[6..12], &[0x00, 0x30, 0x43, 0x08, 0x10, 0x00]);
+    // back in Init the mailbox part serves nothing (E-037)
+    r.esc.request(1);
+    split(&mut r, true);
+    r.esc
+        .mbx_write(&[10, 0, 0, 0, 0, 0x23, 0x00, 0x20, 0x40, 0x08, 0x10, 0, 0, 0, 0, 0]);
+    split(&mut r, true);
+    assert!(r.esc.mbx_read().is_none());
+}

@@ -37,6 +37,9 @@ pub struct AxisScaling {
     feed_shaft_revs: u32,
     /// 607Eh bit 7: position polarity inverted.
     inverted: bool,
+    /// User units are increments (computed once: the conversions then skip
+    /// the 128-bit and double-precision arithmetic).
+    identity: bool,
 }
 
 /// 607Eh bit 7 (position polarity) is the only polarity bit with a function
@@ -65,6 +68,7 @@ impl AxisScaling {
         feed: INCREMENTS_PER_REVOLUTION,
         feed_shaft_revs: 1,
         inverted: false,
+        identity: true,
     };
 
     /// Scaling from 6091h:01/02 (motor, shaft revolutions), 6092h:01/02
@@ -79,13 +83,17 @@ impl AxisScaling {
         if gear_motor_revs == 0 || gear_shaft_revs == 0 || feed == 0 || feed_shaft_revs == 0 {
             return Err(ScalingError::Zero);
         }
-        Ok(Self {
+        let mut s = Self {
             gear_motor_revs,
             gear_shaft_revs,
             feed,
             feed_shaft_revs,
             inverted: polarity_inverted(polarity_607e),
-        })
+            identity: false,
+        };
+        let (num, den) = s.ratio();
+        s.identity = !s.inverted && num == den;
+        Ok(s)
     }
 
     /// Polarity inverted (607Eh bit 7).
@@ -114,8 +122,7 @@ impl AxisScaling {
     /// conversions are then the identity, without the 128-bit division
     /// (a few hundred instructions on a Cortex-M each).
     fn is_identity(&self) -> bool {
-        let (num, den) = self.ratio();
-        !self.inverted && num == den
+        self.identity
     }
 
     /// Increments → user units (rounded to the nearest unit).
@@ -147,12 +154,18 @@ impl AxisScaling {
     /// Velocity (or acceleration, jerk) in increments/s (/s², /s³) → user
     /// units/s (/s², /s³).
     pub fn velocity_to_user(&self, increments_per_s: f32) -> f32 {
+        if self.is_identity() {
+            return increments_per_s;
+        }
         (f64::from(increments_per_s) * self.user_per_increment()) as f32
     }
 
     /// Velocity (or acceleration, jerk) in user units/s (/s², /s³) →
     /// increments/s (/s², /s³).
     pub fn velocity_to_increments(&self, user_per_s: f32) -> f32 {
+        if self.is_identity() {
+            return user_per_s;
+        }
         (f64::from(user_per_s) / self.user_per_increment()) as f32
     }
 }

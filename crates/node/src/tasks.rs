@@ -4,12 +4,14 @@
 //! |---|---|---|---|
 //! | `sync0` | ESC SYNC0 output | 3 | [`sync0`]: acknowledge, PLL measurement |
 //! | `control` | control-cycle timer | 3 | [`control`]: one cycle of both axes |
-//! | `esc` | ESC PDI interrupt (AL event) | 2 | [`esc_event`]: ESM, mailbox, process data |
+//! | `esc` | ESC PDI interrupt (AL event) | 2 | [`esc_event`]: ESM, process data, monitoring |
+//! | `mailbox` | spawned by `esc` | 1 | [`mailbox`]: one CoE/EoE/FoE request, EMCY, save |
 //! | `idle` | — | 0 | background (QEMU: the simulated world) |
 //!
 //! `sync0` and `control` share the priority so they never preempt each
-//! other (both touch the PLL); `esc` locks the drive for one poll. See
-//! docs/architecture.md for the worst-case paths.
+//! other (both touch the PLL); `esc` locks the drive for one poll without
+//! the mailbox, `mailbox` for one request. See docs/architecture.md for the
+//! worst-case paths.
 
 use drive::axis::{AxisCommand, AxisIo};
 use ecat::StateChange;
@@ -40,7 +42,8 @@ pub fn control(drive: &mut Drive, timer: &mut CycleTimer, now_ns: u64, io: &[Axi
 
 /// The ESC's PDI interrupt at local time `now_ns`: an SM2 frame is handed to
 /// the PLL's frame timing (A261), then the slave stack runs once (AL
-/// control, mailbox, process data, monitoring). Returns the ESM change.
+/// control, process data, monitoring; the mailbox is the [`mailbox`]
+/// task's). Returns the ESM change.
 pub fn esc_event<P: Pdi>(
     drive: &mut Drive,
     timer: &mut CycleTimer,
@@ -50,7 +53,14 @@ pub fn esc_event<P: Pdi>(
     if pdi.al_event()? & regs::al_event::sm(2) != 0 {
         let _ = drive.on_frame(now_ns);
     }
-    let change = drive.poll(pdi, now_ns)?;
+    let change = drive.poll_esc(pdi, now_ns)?;
     timer.follow_pll(drive);
     Ok(change)
+}
+
+/// The mailbox task at local time `now_ns` (spawned by the ESC task, runs
+/// below it): one mailbox request from SM0 answered into SM1, queued EMCYs
+/// and EoE fragments sent, a requested save written.
+pub fn mailbox<P: Pdi>(drive: &mut Drive, pdi: &mut P, now_ns: u64) -> Result<(), P::Error> {
+    drive.poll_mailbox(pdi, now_ns)
 }

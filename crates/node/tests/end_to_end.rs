@@ -51,6 +51,8 @@ impl Board {
                 Event::Frame => {
                     let p = self.world.frame(&mut self.esc);
                     tasks::esc_event(&mut self.drive, &mut self.timer, &mut self.esc.pdi(), now).unwrap();
+                    // the mailbox task runs after the ESC task returns (priority 1)
+                    tasks::mailbox(&mut self.drive, &mut self.esc.pdi(), now).unwrap();
                     if p != Progress::Busy {
                         log.push(p);
                     }

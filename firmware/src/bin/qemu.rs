@@ -12,6 +12,7 @@
 //! | EXTI0 | `sync0` (SYNC0) | 3 |
 //! | EXTI1 | `control` (control-cycle timer) | 3 |
 //! | EXTI2 | `esc` (ESC PDI interrupt) | 2 |
+//! | USART1 (dispatcher) | `mailbox` (spawned by `esc`) | 1 |
 //!
 //! The scripted master goes INIT → OP, enables both axes, moves them in csp
 //! and disables them. The log goes out over semihosting; `scripts/cross qemu`
@@ -208,7 +209,9 @@ mod app {
         // be built in place (no copy of ~30 KiB through this frame, which
         // `cortex_m::singleton!` makes).
         let slot = unsafe { &mut *core::ptr::addr_of_mut!(DRIVE) };
-        Some(slot.write(Drive::new(ParamFlash::new())))
+        let drive = slot.write(Drive::unstarted(ParamFlash::new(), None));
+        drive.start();
+        Some(drive)
     }
 
     #[inline(never)]
@@ -368,6 +371,8 @@ mod app {
     /// The ESC's PDI interrupt: the slave stack (ESM, mailbox, process data).
     #[task(binds = EXTI2, priority = 2, shared = [drive, timer, esc, clock, cost])]
     fn esc(cx: esc::Context) {
+        // already spawned: that run serves the mailbox
+        let _ = mailbox::spawn();
         let now = { cx.shared.clock }.lock(|c| *c);
         let t0 = measure::now();
         let change = (cx.shared.drive, cx.shared.timer, cx.shared.esc)
@@ -381,5 +386,14 @@ mod app {
                 c.code.0
             );
         }
+    }
+
+    /// The mailbox (CoE, EoE, FoE, EMCY, save) below the ESC task.
+    #[task(priority = 1, shared = [drive, esc, clock])]
+    async fn mailbox(cx: mailbox::Context) {
+        let now = { cx.shared.clock }.lock(|c| *c);
+        (cx.shared.drive, cx.shared.esc).lock(|drive, esc| {
+            let _ = tasks::mailbox(drive, &mut esc.pdi(), now);
+        });
     }
 }

@@ -102,7 +102,7 @@ use motion::{
     CycleRatio, Event, FineInterpolator, InterpolatorConfig, MasterSetpoint, PositionTarget,
     ProfileGenerator, ProfileLimits, SetMode, VelocityInterpolator, INCREMENTS_PER_REVOLUTION,
 };
-use snapshot::{Snapshot, Window, A291, A67, E47, E48, E49, E80};
+use snapshot::{write, CyclicSlots, Snapshot, Window, A291};
 
 /// The permitted direction of an endless axis (I04), for [`AxisParams::limits`].
 pub use motion::limits::PermittedDirection;
@@ -415,6 +415,8 @@ pub struct Axis {
     /// was read at: while the generation stands, only the cyclic set-points
     /// are read again (docs/architecture.md, cycle cost).
     snapshot: Option<(u32, Snapshot)>,
+    /// The entries read and written every cycle, resolved at the first.
+    slots: Option<CyclicSlots>,
     /// Filtered actual velocity, inc/s (user coordinates).
     velocity: f32,
     /// Last cycle's actual position sample (user coordinates).
@@ -507,6 +509,7 @@ impl Axis {
             offset: 0,
             last_raw: None,
             snapshot: None,
+            slots: None,
             velocity: 0.0,
             last_sample: None,
             sp_pos: 0,
@@ -625,17 +628,23 @@ impl Axis {
         new_setpoint: bool,
     ) -> AxisReport {
         let generation = od.config_generation();
-        let raw = match self.snapshot {
-            Some((g, mut cached)) if g == generation => {
-                cached.refresh_setpoints(od, self.window);
-                cached
+        let slots = *self
+            .slots
+            .get_or_insert_with(|| CyclicSlots::resolve(od, self.window));
+        let raw = match &mut self.snapshot {
+            Some((g, cached)) if *g == generation => {
+                cached.refresh_setpoints(od, &slots);
+                *cached
             }
-            _ => Snapshot::read(od, self.window),
+            _ => {
+                let fresh = Snapshot::read(od, self.window);
+                // C-109: user units at the objects, increments inside
+                self.scaling = fresh.scaling();
+                self.velocity_decimals = fresh.decimal_factors().0 as f32;
+                self.snapshot = Some((generation, fresh));
+                fresh
+            }
         };
-        self.snapshot = Some((generation, raw));
-        // C-109: user units at the objects, increments inside
-        self.scaling = raw.scaling();
-        self.velocity_decimals = raw.decimal_factors().0 as f32;
         let o = raw.to_increments(&self.scaling);
         self.modulo = if self.params.limits.endless_axis && o.modulo_length > 0 {
             ModuloAxis::new(i64::from(o.modulo_length)).ok()
@@ -713,10 +722,10 @@ impl Axis {
         let (torque, bits, fe) = self.control(demand, actual, now_ns, dt_ns);
 
         self.prev_cw = o.controlword;
-        self.write_back(od, &out, bits, actual, torque, fe);
-        self.user_statusword(od, &o);
-        self.switch_on_disabled_causes(od, &out, io, o.controlword);
-        self.digital_inputs(od, io);
+        self.write_back(od, &slots, &out, (bits, actual, torque, fe));
+        self.user_statusword(od, &slots, &o);
+        self.switch_on_disabled_causes(od, &slots, &out, io, o.controlword);
+        self.digital_inputs(od, &slots, io);
 
         let sign = if o.polarity & 0x80 != 0 { -1.0 } else { 1.0 };
         AxisReport {
@@ -1686,13 +1695,10 @@ impl Axis {
     fn write_back(
         &mut self,
         od: &mut DriveObjects,
+        c: &CyclicSlots,
         out: &Outputs,
-        bits: u16,
-        actual: i32,
-        torque: f32,
-        fe: i32,
+        (bits, actual, torque, fe): (u16, i32, f32, i32),
     ) {
-        let w = self.window;
         let mut sw =
             out.statusword & !(SW_TARGET_REACHED | SW_MODE_BIT12 | SW_MODE_BIT13 | SW_INTERNAL_LIMIT);
         let enabled = out.state == State::OperationEnabled;
@@ -1705,7 +1711,7 @@ impl Axis {
         if out.drive_function {
             sw |= bits & SW_INTERNAL_LIMIT;
         }
-        w.put(od, 0x6041, 0, i64::from(sw));
+        write(od, c.statusword, i64::from(sw));
         let e80 = match self.denial {
             Some(DenialCause::IllegalDirection) => 15,
             Some(
@@ -1716,37 +1722,35 @@ impl Axis {
             ) => 20,
             _ => 0,
         };
-        let _ = od.set(w.manufacturer(E80), 0, e80);
-        w.put(od, 0x6061, 0, i64::from(out.mode_display));
-        w.put(od, 0x6064, 0, self.user_position(actual));
+        write(od, c.e80, e80);
+        write(od, c.mode_display, i64::from(out.mode_display));
+        write(od, c.position, self.user_position(actual));
         let v = self.scaling.velocity_to_user(self.velocity) * self.velocity_decimals;
-        w.put(od, 0x606C, 0, i64::from(round_i32(v)));
+        write(od, c.velocity, i64::from(round_i32(v)));
         let rated = self.params.rated_torque_nm;
         let per_mille = if rated > 0.0 { torque / rated * 1000.0 } else { 0.0 };
         let t = i64::from(round_i32(per_mille)).clamp(i64::from(i16::MIN), i64::from(i16::MAX));
-        w.put(od, 0x6077, 0, t);
-        w.put(od, 0x6078, 0, t);
-        w.put(od, 0x6076, 0, i64::from(round_i32(rated * 1000.0).max(0)));
-        w.put(od, 0x60F4, 0, self.user(fe));
-        w.put(od, 0x60B9, 0, i64::from(self.probe.status()));
-        w.put(od, 0x60BA, 0, self.user_position(self.probe.value_60ba()));
-        w.put(od, 0x60BB, 0, self.user_position(self.probe.value_60bb()));
-        w.put(od, 0x60BC, 0, self.user_position(self.probe.value_60bc()));
-        w.put(od, 0x60BD, 0, self.user_position(self.probe.value_60bd()));
-        w.put(od, 0x60E4, 1, self.user_position(actual));
-        w.put(
+        write(od, c.torque, t);
+        write(od, c.current, t);
+        write(od, c.rated_current, i64::from(round_i32(rated * 1000.0).max(0)));
+        write(od, c.following_error, self.user(fe));
+        write(od, c.probe_status, i64::from(self.probe.status()));
+        write(od, c.probe_values[0], self.user_position(self.probe.value_60ba()));
+        write(od, c.probe_values[1], self.user_position(self.probe.value_60bb()));
+        write(od, c.probe_values[2], self.user_position(self.probe.value_60bc()));
+        write(od, c.probe_values[3], self.user_position(self.probe.value_60bd()));
+        write(od, c.additional_position, self.user_position(actual));
+        write(
             od,
-            0x6043,
-            0,
+            c.vl_demand,
             i64::from(round_i32(self.vl_demand / RPM_TO_INC_PER_S)).clamp(-32768, 32767),
         );
-        w.put(
+        write(
             od,
-            0x6044,
-            0,
+            c.vl_actual,
             i64::from(round_i32(self.velocity / RPM_TO_INC_PER_S)).clamp(-32768, 32767),
         );
-        let _ = od.set(w.manufacturer(E48), 0, i64::from(e48(out.state)));
+        write(od, c.e48, i64::from(e48(out.state)));
     }
 
     /// A position (or distance) in increments as the objects show it: user
@@ -1781,7 +1785,14 @@ impl Axis {
     /// E47 (first cause) and E49 (all causes) of Switch on disabled
     /// (C-015): STO, supply, additional enable A60, and the controlword
     /// (no Shutdown command). Both 0 outside Switch on disabled.
-    fn switch_on_disabled_causes(&self, od: &mut DriveObjects, out: &Outputs, io: &AxisIo, cw: u16) {
+    fn switch_on_disabled_causes(
+        &self,
+        od: &mut DriveObjects,
+        c: &CyclicSlots,
+        out: &Outputs,
+        io: &AxisIo,
+        cw: u16,
+    ) {
         let mut causes = 0u8;
         if out.state == State::SwitchOnDisabled {
             // Shutdown = xxxx x110 (bit 7 clear): anything else keeps SOD
@@ -1802,14 +1813,14 @@ impl Axis {
         } else {
             causes.trailing_zeros() as u8 + 1
         };
-        let _ = od.set(self.window.manufacturer(E47), 0, i64::from(first));
-        let _ = od.set(self.window.manufacturer(E49), 0, i64::from(causes));
+        write(od, c.e47, i64::from(first));
+        write(od, c.e49, i64::from(causes));
     }
 
     /// A67 from the sources in A66 (C-143): bit k is bit `b` of the entry
     /// `index`:`sub` that element k names (index << 16 | sub << 8 | b;
     /// 0 or an unreadable entry: the bit is 0).
-    fn user_statusword(&self, od: &mut DriveObjects, o: &Snapshot) {
+    fn user_statusword(&self, od: &mut DriveObjects, c: &CyclicSlots, o: &Snapshot) {
         let mut a67 = 0u16;
         for (k, &src) in o.a66.iter().enumerate() {
             let index = (src >> 16) as u16;
@@ -1819,15 +1830,15 @@ impl Axis {
                 a67 |= 1 << k;
             }
         }
-        let _ = od.set(self.window.manufacturer(A67), 0, i64::from(a67));
+        write(od, c.a67, i64::from(a67));
     }
 
     /// The switch levels in 60FDh (bit 0 negative limit, bit 1 positive
     /// limit, bit 2 home switch, CiA 402).
-    fn digital_inputs(&self, od: &mut DriveObjects, io: &AxisIo) {
+    fn digital_inputs(&self, od: &mut DriveObjects, c: &CyclicSlots, io: &AxisIo) {
         let bits =
             u32::from(io.limit_negative) | u32::from(io.limit_positive) << 1 | u32::from(io.reference) << 2;
-        self.window.put(od, 0x60FD, 0, i64::from(bits));
+        write(od, c.digital_inputs, i64::from(bits));
     }
 }
 

@@ -7,7 +7,7 @@
 //! cycle. Units are the objects' (increments, inc/s, inc/s², inc/s³, 0.1 % of
 //! the rated torque, ms, µs).
 
-use crate::dictionary::DriveObjects;
+use crate::dictionary::{DriveObjects, Slot};
 use crate::{parameter_index, AXIS_B_CIA402, AXIS_B_MANUFACTURER};
 use motion::scaling::AxisScaling;
 
@@ -88,6 +88,138 @@ impl Window {
     /// value object must not stop the control cycle).
     pub fn put(self, od: &mut DriveObjects, index: u16, sub: u8, value: i64) {
         let _ = od.set(self.cia402(index), sub, value);
+    }
+}
+
+/// The entries one axis reads (set-points) and writes (actual values) in
+/// every control cycle, resolved once: a load or store each instead of a
+/// dictionary lookup (docs/architecture.md, cycle cost). `None`: the entry
+/// is not an integer in RAM (reads give the default, writes are dropped).
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub(crate) struct CyclicSlots {
+    pub controlword: Option<Slot>,
+    pub mode: Option<Slot>,
+    pub target_position: Option<Slot>,
+    pub ip_setpoint: Option<Slot>,
+    pub target_velocity: Option<Slot>,
+    pub target_torque: Option<Slot>,
+    pub velocity_offset: Option<Slot>,
+    pub torque_offset: Option<Slot>,
+    pub probe_function: Option<Slot>,
+    pub vl_target: Option<Slot>,
+    pub i210: Option<Slot>,
+    pub statusword: Option<Slot>,
+    pub mode_display: Option<Slot>,
+    pub position: Option<Slot>,
+    pub velocity: Option<Slot>,
+    pub torque: Option<Slot>,
+    pub current: Option<Slot>,
+    pub rated_current: Option<Slot>,
+    pub following_error: Option<Slot>,
+    pub probe_status: Option<Slot>,
+    pub probe_values: [Option<Slot>; 4],
+    pub additional_position: Option<Slot>,
+    pub vl_demand: Option<Slot>,
+    pub vl_actual: Option<Slot>,
+    pub digital_inputs: Option<Slot>,
+    pub e80: Option<Slot>,
+    pub e48: Option<Slot>,
+    pub e47: Option<Slot>,
+    pub e49: Option<Slot>,
+    pub a67: Option<Slot>,
+}
+
+impl CyclicSlots {
+    /// The slots of axis `w`.
+    pub fn resolve(od: &DriveObjects, w: Window) -> Self {
+        let c = |index: u16, sub: u8| od.slot(w.cia402(index), sub);
+        let m = |index: u16| od.slot(w.manufacturer(index), 0);
+        Self {
+            controlword: c(0x6040, 0),
+            mode: c(0x6060, 0),
+            target_position: c(0x607A, 0),
+            ip_setpoint: c(0x60C1, 1),
+            target_velocity: c(0x60FF, 0),
+            target_torque: c(0x6071, 0),
+            velocity_offset: c(0x60B1, 0),
+            torque_offset: c(0x60B2, 0),
+            probe_function: c(0x60B8, 0),
+            vl_target: c(0x6042, 0),
+            i210: m(I210),
+            statusword: c(0x6041, 0),
+            mode_display: c(0x6061, 0),
+            position: c(0x6064, 0),
+            velocity: c(0x606C, 0),
+            torque: c(0x6077, 0),
+            current: c(0x6078, 0),
+            rated_current: c(0x6076, 0),
+            following_error: c(0x60F4, 0),
+            probe_status: c(0x60B9, 0),
+            probe_values: [c(0x60BA, 0), c(0x60BB, 0), c(0x60BC, 0), c(0x60BD, 0)],
+            additional_position: c(0x60E4, 1),
+            vl_demand: c(0x6043, 0),
+            vl_actual: c(0x6044, 0),
+            digital_inputs: c(0x60FD, 0),
+            e80: m(E80),
+            e48: m(E48),
+            e47: m(E47),
+            e49: m(E49),
+            a67: m(A67),
+        }
+    }
+
+    /// Every slot, for the completeness test.
+    #[cfg(test)]
+    pub fn all(&self) -> [Option<Slot>; 33] {
+        let [p0, p1, p2, p3] = self.probe_values;
+        [
+            self.controlword,
+            self.mode,
+            self.target_position,
+            self.ip_setpoint,
+            self.target_velocity,
+            self.target_torque,
+            self.velocity_offset,
+            self.torque_offset,
+            self.probe_function,
+            self.vl_target,
+            self.i210,
+            self.statusword,
+            self.mode_display,
+            self.position,
+            self.velocity,
+            self.torque,
+            self.current,
+            self.rated_current,
+            self.following_error,
+            self.probe_status,
+            p0,
+            p1,
+            p2,
+            p3,
+            self.additional_position,
+            self.vl_demand,
+            self.vl_actual,
+            self.digital_inputs,
+            self.e80,
+            self.e48,
+            self.e47,
+            self.e49,
+            self.a67,
+        ]
+    }
+}
+
+/// The value in `slot`, or `default` without one.
+pub(crate) fn read(od: &DriveObjects, slot: Option<Slot>, default: i64) -> i64 {
+    slot.map_or(default, |s| od.load_slot(s))
+}
+
+/// Stores `value` in `slot` (dropped without one or out of the type's
+/// range: an actual value must never stop the control cycle).
+pub(crate) fn write(od: &mut DriveObjects, slot: Option<Slot>, value: i64) {
+    if let Some(s) = slot {
+        od.store_slot(s, value);
     }
 }
 
@@ -210,23 +342,23 @@ impl Snapshot {
     /// Reads the cyclic set-points of axis `w` again (the objects of
     /// `CYCLIC_SETPOINTS` in the dictionary, whose writes do not move its
     /// configuration generation); the rest of the snapshot is kept.
-    pub fn refresh_setpoints(&mut self, od: &DriveObjects, w: Window) {
-        let i32_ = |index: u16, sub: u8, d: i64| sat(w.get(od, index, sub, d), i32::MIN, i32::MAX);
-        let u16_ = |index: u16, sub: u8, d: i64| sat(w.get(od, index, sub, d), 0u16, u16::MAX);
-        let i16_ = |index: u16, sub: u8, d: i64| sat(w.get(od, index, sub, d), i16::MIN, i16::MAX);
-        self.controlword = u16_(0x6040, 0, 0);
-        self.mode = sat(w.get(od, 0x6060, 0, 8), i8::MIN, i8::MAX);
-        self.target_position = i32_(0x607A, 0, 0);
+    pub fn refresh_setpoints(&mut self, od: &DriveObjects, c: &CyclicSlots) {
+        let i32_ = |s: Option<Slot>, d: i64| sat(read(od, s, d), i32::MIN, i32::MAX);
+        let u16_ = |s: Option<Slot>, d: i64| sat(read(od, s, d), 0u16, u16::MAX);
+        let i16_ = |s: Option<Slot>, d: i64| sat(read(od, s, d), i16::MIN, i16::MAX);
+        self.controlword = u16_(c.controlword, 0);
+        self.mode = sat(read(od, c.mode, 8), i8::MIN, i8::MAX);
+        self.target_position = i32_(c.target_position, 0);
         self.target_position_user = self.target_position;
-        self.ip_setpoint = i32_(0x60C1, 1, 0);
+        self.ip_setpoint = i32_(c.ip_setpoint, 0);
         self.ip_setpoint_user = self.ip_setpoint;
-        self.target_velocity = i32_(0x60FF, 0, 0);
-        self.target_torque = i16_(0x6071, 0, 0);
-        self.velocity_offset = i32_(0x60B1, 0, 0);
-        self.torque_offset = i16_(0x60B2, 0, 0);
-        self.probe_function = u16_(0x60B8, 0, 0);
-        self.vl_target = i16_(0x6042, 0, 0);
-        self.i210 = sat(w.param(od, I210, 0, 0), 0u16, u16::MAX);
+        self.target_velocity = i32_(c.target_velocity, 0);
+        self.target_torque = i16_(c.target_torque, 0);
+        self.velocity_offset = i32_(c.velocity_offset, 0);
+        self.torque_offset = i16_(c.torque_offset, 0);
+        self.probe_function = u16_(c.probe_function, 0);
+        self.vl_target = i16_(c.vl_target, 0);
+        self.i210 = u16_(c.i210, 0);
     }
 
     /// Reads the snapshot of axis `w`.

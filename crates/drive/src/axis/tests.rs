@@ -3,6 +3,7 @@
 //! `DriveObjects::set`, as the PDO/SDO side would.
 
 use super::*;
+use crate::axis::snapshot::E48;
 use crate::runtime::Drive;
 use store::RamFlash;
 
@@ -797,7 +798,7 @@ fn c071_homing_takes_the_latched_switch_edge() {
 /// refresh, fails here.
 #[test]
 fn cached_snapshot_equals_a_fresh_read_after_any_write() {
-    use crate::axis::snapshot::{Snapshot, Window};
+    use crate::axis::snapshot::{CyclicSlots, Snapshot, Window};
     use crate::objects::OBJECTS;
     let mut checked = 0;
     for o in OBJECTS.iter() {
@@ -821,7 +822,7 @@ fn cached_snapshot_equals_a_fresh_read_after_any_write() {
                 continue;
             }
             for (w, mut cached) in windows.into_iter().zip(before) {
-                cached.refresh_setpoints(&od, w);
+                cached.refresh_setpoints(&od, &CyclicSlots::resolve(&od, w));
                 assert_eq!(
                     cached,
                     Snapshot::read(&od, w),
@@ -834,4 +835,21 @@ fn cached_snapshot_equals_a_fresh_read_after_any_write() {
         }
     }
     assert!(checked > 300, "{checked} writes");
+}
+
+/// Every entry the control cycle reads or writes each cycle has a RAM slot
+/// on both axes (a missing one would silently read the default or drop an
+/// actual value), and no two share one.
+#[test]
+fn cyclic_slots_resolve_every_entry_on_both_axes() {
+    use crate::axis::snapshot::{CyclicSlots, Window};
+    let od = DriveObjects::new();
+    let a = CyclicSlots::resolve(&od, Window { axis: 0 }).all();
+    let b = CyclicSlots::resolve(&od, Window { axis: 1 }).all();
+    let mut seen = std::vec::Vec::new();
+    for (k, s) in a.iter().chain(b.iter()).enumerate() {
+        let s = s.unwrap_or_else(|| panic!("slot {k} missing"));
+        assert!(!seen.contains(&s), "slot {k} shared");
+        seen.push(s);
+    }
 }
