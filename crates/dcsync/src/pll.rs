@@ -296,11 +296,43 @@ pub struct FrameTiming {
 const Q: u32 = 16;
 const NS_PER_S: i128 = 1_000_000_000;
 
-/// `d` wrapped into [−p/2, p/2) (p ≥ 1).
+/// `d` wrapped into [−p/2, p/2) (p ≥ 1). In 64 bits (a Cortex-M divides
+/// them in a library call of ~100 instructions, 128 bits take several
+/// hundred); 128 only where `d + p/2` would overflow.
 pub(crate) fn wrap_signed(d: i64, p: i64) -> i64 {
-    let p = i128::from(p.max(1));
-    let w = (i128::from(d) + p / 2).rem_euclid(p) - p / 2;
-    i64::try_from(w).unwrap_or(0)
+    let p = p.max(1);
+    match d.checked_add(p / 2) {
+        Some(x) => x.rem_euclid(p) - p / 2,
+        None => {
+            let p = i128::from(p);
+            let w = (i128::from(d) + p / 2).rem_euclid(p) - p / 2;
+            i64::try_from(w).unwrap_or(0)
+        }
+    }
+}
+
+/// Greatest common divisor (Euclid), `gcd(0, b) = b`.
+const fn gcd(mut a: u64, mut b: u64) -> u64 {
+    while b != 0 {
+        let r = a % b;
+        a = b;
+        b = r;
+    }
+    a
+}
+
+/// `a · b / c` truncated toward zero, in 64 bits when `a · b` fits, else
+/// 128 (`c` ≠ 0; a quotient beyond 64 bits saturates).
+fn mul_div(a: i64, b: i64, c: i64) -> i64 {
+    match a.checked_mul(b) {
+        Some(x) => x.checked_div(c).unwrap_or(0),
+        None => {
+            let q = (i128::from(a) * i128::from(b))
+                .checked_div(i128::from(c))
+                .unwrap_or(0);
+            i64::try_from(q).unwrap_or(if q < 0 { i64::MIN } else { i64::MAX })
+        }
+    }
 }
 
 /// The PLL. See the module documentation.
@@ -329,8 +361,16 @@ pub struct Pll {
     /// Phase still to be stretched (+) or shortened (−), local ns.
     stretch_ns: i64,
     stretching: bool,
-    /// Sub-tick remainder of the issued periods, units of 1/(1e9·2^16) tick.
-    carry: i128,
+    /// Sub-tick remainder of the issued periods, units of
+    /// 1/(`ns_den`·2^16) tick.
+    carry: i64,
+    /// Timer ticks per ns as the reduced fraction `tick_num / ns_den`
+    /// (timer_hz / 1e9 divided by their gcd: 144 MHz → 18/125), so the
+    /// period conversion stays in 64 bits.
+    tick_num: i64,
+    ns_den: i64,
+    /// ± the PLL's range (Tuning::range_ppm of the set cycle), local ns, Q16.
+    range_q: i64,
     next_index: u32,
     lock_count: u32,
     freq_locked: bool,
@@ -351,6 +391,8 @@ impl Pll {
         let k = validate(cfg.sync0_cycle_ns, cfg.a150_ns, 0, 0)?;
         let mut cfg = cfg;
         cfg.timer_hz = cfg.timer_hz.max(1);
+        let g = gcd(u64::from(cfg.timer_hz), NS_PER_S as u64).max(1);
+        let range = i128::from(cfg.sync0_cycle_ns) * i128::from(cfg.tuning.range_ppm) / 1_000_000;
         let mut pll = Self {
             cfg,
             k,
@@ -375,6 +417,9 @@ impl Pll {
             stretch_ns: 0,
             stretching: false,
             carry: 0,
+            tick_num: (u64::from(cfg.timer_hz) / g) as i64,
+            ns_den: (NS_PER_S as u64 / g) as i64,
+            range_q: i64::try_from(range << Q).unwrap_or(i64::MAX),
             next_index: 0,
             lock_count: 0,
             freq_locked: false,
@@ -452,8 +497,7 @@ impl Pll {
     }
 
     fn range_q(&self) -> i64 {
-        let r = i128::from(self.nominal_ns) * i128::from(self.cfg.tuning.range_ppm) / 1_000_000;
-        i64::try_from(r << Q).unwrap_or(i64::MAX)
+        self.range_q
     }
 
     /// SYNC0 interrupt: `t_local_ns` = local time the SYNC0 edge was seen.
@@ -534,19 +578,29 @@ impl Pll {
             period_q += chunk << Q;
             self.stretching = chunk > 0;
         }
-        let hz = i128::from(self.cfg.timer_hz);
-        let den = NS_PER_S << Q;
-        let x = i128::from(period_q.max(0)) * hz + self.carry;
-        let ticks = x / den;
-        self.carry = x - ticks * den;
+        // ticks = period · timer_hz / 1e9 with the sub-tick remainder carried
+        let den = self.ns_den << Q;
+        let p = period_q.max(0);
+        let ticks = match p
+            .checked_mul(self.tick_num)
+            .and_then(|x| x.checked_add(self.carry))
+        {
+            Some(x) => {
+                let t = x.checked_div(den).unwrap_or(0);
+                self.carry = x - t * den;
+                t
+            }
+            None => {
+                let x = i128::from(p) * i128::from(self.tick_num) + i128::from(self.carry);
+                let t = x.checked_div(i128::from(den)).unwrap_or(0);
+                self.carry = i64::try_from(x - t * i128::from(den)).unwrap_or(0);
+                i64::try_from(t).unwrap_or(i64::MAX)
+            }
+        };
         let aligned = index == 0;
         CycleCommand {
             period_ticks: u32::try_from(ticks).unwrap_or(u32::MAX),
-            period_local_ns: ticks
-                .checked_mul(NS_PER_S)
-                .and_then(|t| t.checked_div(hz))
-                .and_then(|t| u32::try_from(t).ok())
-                .unwrap_or(u32::MAX),
+            period_local_ns: u32::try_from(mul_div(ticks, self.ns_den, self.tick_num)).unwrap_or(u32::MAX),
             index,
             rx: aligned,
             tx: aligned,
@@ -557,9 +611,9 @@ impl Pll {
     /// Phase error of an aligned cycle starting at `t`, local ns, against
     /// the SYNC0 edge nearest to its target.
     fn phase_error(&self, t: u64, s: u64, est: i64) -> i64 {
-        let offset = i128::from(self.a292_ns) * i128::from(est) / i128::from(self.nominal_ns.max(1));
-        let d = i128::from(t.wrapping_sub(s) as i64) + offset;
-        wrap_signed(i64::try_from(d).unwrap_or(0), est)
+        let offset = mul_div(self.a292_ns, est, self.nominal_ns.max(1));
+        let d = (t.wrapping_sub(s) as i64).saturating_add(offset);
+        wrap_signed(d, est)
     }
 
     /// Runs at an aligned cycle start; returns a new index for this cycle
@@ -823,5 +877,60 @@ impl Pll {
             return Err(SyncFault::PllError);
         }
         Ok(())
+    }
+}
+
+#[cfg(test)]
+mod arith_tests {
+    use super::*;
+
+    /// The 64-bit `wrap_signed` equals the 128-bit reference everywhere,
+    /// the overflow edges included.
+    #[test]
+    fn e111_wrap_signed_matches_128_bit_reference() {
+        let reference = |d: i64, p: i64| {
+            let p = i128::from(p.max(1));
+            i64::try_from((i128::from(d) + p / 2).rem_euclid(p) - p / 2).unwrap()
+        };
+        for &d in &[
+            0,
+            1,
+            -1,
+            499_999,
+            500_000,
+            -500_001,
+            7_123_456_789,
+            i64::MAX,
+            i64::MIN,
+            i64::MAX - 3,
+        ] {
+            for &p in &[1, 2, 3, 1_000_000, 999_983, i64::MAX] {
+                assert_eq!(wrap_signed(d, p), reference(d, p), "{d} {p}");
+            }
+        }
+    }
+
+    /// E-111: the cycle lengths issued in timer ticks add up exactly (the
+    /// sub-tick carry) for a timer whose ratio to 1 GHz reduces (144 MHz)
+    /// and for one whose does not (a prime), over 10,000 cycles.
+    #[test]
+    fn e111_cycle_ticks_carry_exactly() {
+        for hz in [144_000_000u32, 99_999_989] {
+            let mut pll = Pll::new(Config::new(1_000_000, 1_000_000, hz)).unwrap();
+            let n = 10_000u64;
+            let total: u64 = (0..n)
+                .map(|i| u64::from(pll.on_cycle_start(i * 1_000_000).period_ticks))
+                .sum();
+            // nominal 1 ms per cycle, no SYNC0: the exact tick count of 10 s
+            assert_eq!(total, u64::from(hz) * 10, "{hz} Hz");
+            let c = pll.on_cycle_start(n * 1_000_000);
+            // the local length of the issued ticks: within one tick
+            let tick_ns = 1_000_000_000 / hz + 1;
+            assert!(
+                c.period_local_ns.abs_diff(1_000_000) <= tick_ns,
+                "{hz} Hz: {}",
+                c.period_local_ns
+            );
+        }
     }
 }

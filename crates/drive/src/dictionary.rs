@@ -373,6 +373,16 @@ fn bytes_at<const N: usize>(image: &[u8], at: usize) -> Option<[u8; N]> {
     image.get(at..at + N)?.try_into().ok()
 }
 
+/// Copies `N` bytes from `src` at `from` to `dst` at `to`; `false`
+/// (nothing copied) when either range is outside its slice.
+#[inline(always)]
+fn copy_bytes<const N: usize>(src: &[u8], from: usize, dst: &mut [u8], to: usize) -> bool {
+    match bytes_at::<N>(src, from) {
+        Some(b) => put_at(dst, to, b),
+        None => false,
+    }
+}
+
 /// Writes `N` bytes at `at`; `false` (nothing written) outside `image`.
 #[inline]
 fn put_at<const N: usize>(image: &mut [u8], at: usize, bytes: [u8; N]) -> bool {
@@ -689,7 +699,7 @@ impl DriveObjects {
     }
 
     /// The value in `slot` (as [`get`](Self::get) reads it).
-    #[inline]
+    #[inline(always)]
     pub fn load_slot(&self, slot: Slot) -> i64 {
         let (img, at) = (&self.image, usize::from(slot.at));
         let v = match slot.kind {
@@ -707,7 +717,7 @@ impl DriveObjects {
 
     /// Stores `value` in `slot` (as [`set`](Self::set): a value outside the
     /// type's range changes nothing and returns `false`).
-    #[inline]
+    #[inline(always)]
     pub fn store_slot(&mut self, slot: Slot, value: i64) -> bool {
         let (lo, hi) = slot.kind.range();
         if value < lo || value > hi {
@@ -725,32 +735,41 @@ impl DriveObjects {
         }
     }
 
-    /// The raw little-endian bytes of `slot`.
-    pub fn slot_bytes(&self, slot: Slot) -> &[u8] {
-        let at = usize::from(slot.at);
-        self.image.get(at..at + slot.bytes()).unwrap_or_default()
+    /// Copies the raw little-endian bytes of `slot` to `dst` at `at`
+    /// (the TxPDO copy); `false` when they do not fit there.
+    #[inline(always)]
+    pub fn copy_slot_to(&self, slot: Slot, dst: &mut [u8], at: usize) -> bool {
+        let from = usize::from(slot.at);
+        match slot.kind.bytes() {
+            1 => copy_bytes::<1>(&self.image, from, dst, at),
+            2 => copy_bytes::<2>(&self.image, from, dst, at),
+            4 => copy_bytes::<4>(&self.image, from, dst, at),
+            _ => copy_bytes::<8>(&self.image, from, dst, at),
+        }
     }
 
-    /// Stores raw little-endian bytes of the slot's full width (a process
-    /// data copy); another length changes nothing and returns `false`.
-    pub fn store_slot_bytes(&mut self, slot: Slot, data: &[u8]) -> bool {
-        let at = usize::from(slot.at);
-        let Some(dst) = self.image.get_mut(at..at + data.len()) else {
+    /// Stores the slot's width of raw little-endian bytes from `src` at
+    /// `at` (the RxPDO copy); `false` (nothing changed) when `src` is too
+    /// short.
+    #[inline(always)]
+    pub fn copy_slot_from(&mut self, slot: Slot, src: &[u8], at: usize) -> bool {
+        let n = slot.kind.bytes();
+        let Some(data) = src.get(at..at + n) else {
             return false;
         };
-        if data.len() != slot.bytes() {
-            return false;
-        }
+        let to = usize::from(slot.at);
         if slot.config {
-            if dst == data {
+            if self.image.get(to..to + n) == Some(data) {
                 return true;
             }
-            self.config_generation = self.config_generation.wrapping_add(1);
+            self.config_changed();
         }
-        for (d, s) in dst.iter_mut().zip(data) {
-            *d = *s;
+        match n {
+            1 => copy_bytes::<1>(src, at, &mut self.image, to),
+            2 => copy_bytes::<2>(src, at, &mut self.image, to),
+            4 => copy_bytes::<4>(src, at, &mut self.image, to),
+            _ => copy_bytes::<8>(src, at, &mut self.image, to),
         }
-        true
     }
 
     /// Sets `index`:`sub` from the runtime (statusword, actual values, ESM

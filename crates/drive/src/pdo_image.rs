@@ -273,10 +273,7 @@ impl PdoImage {
         let mut written = 0;
         for e in self.rx.entries() {
             let ok = if let Some(slot) = e.slot {
-                let at = e.byte_offset();
-                rx_bytes
-                    .get(at..at + slot.bytes())
-                    .is_some_and(|raw| objects.store_slot_bytes(slot, raw))
+                objects.copy_slot_from(slot, rx_bytes, e.byte_offset())
             } else if e.byte_aligned() {
                 let at = e.byte_offset();
                 rx_bytes
@@ -302,13 +299,7 @@ impl PdoImage {
         tx_bytes.fill(0);
         for e in self.tx.entries() {
             if let Some(slot) = e.slot {
-                let at = e.byte_offset();
-                let src = objects.slot_bytes(slot);
-                if let Some(dst) = tx_bytes.get_mut(at..at + src.len()) {
-                    for (d, s) in dst.iter_mut().zip(src) {
-                        *d = *s;
-                    }
-                }
+                objects.copy_slot_to(slot, tx_bytes, e.byte_offset());
                 continue;
             }
             let Ok(value) = objects.get(e.index, e.sub) else {

@@ -313,11 +313,13 @@ impl RuntimeSlots {
 }
 
 /// The value in `slot`, or `default` without one.
+#[inline(always)]
 fn read_slot(od: &DriveObjects, slot: Option<Slot>, default: i64) -> i64 {
     slot.map_or(default, |s| od.load_slot(s))
 }
 
 /// Stores `value` in `slot` (dropped without one or out of range).
+#[inline(always)]
 fn write_slot(od: &mut DriveObjects, slot: Option<Slot>, value: i64) {
     if let Some(s) = slot {
         od.store_slot(s, value);

@@ -784,7 +784,16 @@ fn slot_access_equals_get_and_set() {
                     o.info.index,
                     e.sub
                 );
-                assert_eq!(by_slot.slot_bytes(slot).len(), t.bytes());
+                let mut raw = [0u8; 9];
+                assert!(by_slot.copy_slot_to(slot, &mut raw, 1));
+                assert_eq!(
+                    raw[1..=t.bytes()],
+                    by_set.get(o.info.index, e.sub).unwrap().to_le_bytes()[..t.bytes()]
+                );
+                assert!(
+                    !by_slot.copy_slot_to(slot, &mut raw, 9 - t.bytes() + 1),
+                    "past the end"
+                );
             }
             checked += 1;
         }

@@ -14,18 +14,40 @@ use crate::Drive;
 /// Free-running control cycle (A150 default), ns.
 pub const CYCLE_NS: u64 = 1_000_000;
 
-const NS_PER_S: u128 = 1_000_000_000;
+const NS_PER_S: u64 = 1_000_000_000;
+
+/// Greatest common divisor (Euclid).
+const fn gcd(mut a: u64, mut b: u64) -> u64 {
+    while b != 0 {
+        let r = a % b;
+        a = b;
+        b = r;
+    }
+    a
+}
+
+/// Timer ticks per ns as a reduced fraction (144 MHz: 18/125), so the
+/// conversions stay in 64 bits for centuries of uptime.
+const G: u64 = gcd(TIMER_HZ as u64, NS_PER_S);
+const TICK_NUM: u64 = TIMER_HZ as u64 / G;
+const NS_DEN: u64 = NS_PER_S / G;
+
+/// `a · b / c` rounded up, in 64 bits when `a · b` fits (else 128).
+fn mul_div_ceil(a: u64, b: u64, c: u64) -> u64 {
+    match a.checked_mul(b) {
+        Some(x) => x.div_ceil(c),
+        None => u64::try_from((u128::from(a) * u128::from(b)).div_ceil(u128::from(c))).unwrap_or(u64::MAX),
+    }
+}
 
 /// Local time of timer tick `tick`, ns (rounded up: the tick is reached then).
 fn tick_ns(tick: u64) -> u64 {
-    let ns = (u128::from(tick) * NS_PER_S).div_ceil(u128::from(TIMER_HZ));
-    u64::try_from(ns).unwrap_or(u64::MAX)
+    mul_div_ceil(tick, NS_DEN, TICK_NUM)
 }
 
 /// The tick at or after local time `ns`.
 fn ns_tick(ns: u64) -> u64 {
-    let t = (u128::from(ns) * u128::from(TIMER_HZ)).div_ceil(NS_PER_S);
-    u64::try_from(t).unwrap_or(u64::MAX)
+    mul_div_ceil(ns, TICK_NUM, NS_DEN)
 }
 
 /// When the next control cycle starts and how it runs.
@@ -89,5 +111,34 @@ impl CycleTimer {
         }
         self.next_ns = now_ns.saturating_add(CYCLE_NS);
         drive.control_cycle(now_ns, io)
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// E-111: the 64-bit tick conversions equal the exact 128-bit ones,
+    /// from 0 to centuries of uptime and at the overflow edge.
+    #[test]
+    fn e111_tick_conversions_match_128_bit_reference() {
+        let hz = u128::from(TIMER_HZ);
+        let ns = u128::from(NS_PER_S);
+        for &v in &[
+            0u64,
+            1,
+            7,
+            143_999,
+            1_000_000,
+            123_456_789_012,
+            1 << 40,
+            1 << 60,
+            u64::MAX / 200,
+        ] {
+            let t = u64::try_from((u128::from(v) * ns).div_ceil(hz)).unwrap_or(u64::MAX);
+            assert_eq!(tick_ns(v), t, "tick {v}");
+            let n = u64::try_from((u128::from(v) * hz).div_ceil(ns)).unwrap_or(u64::MAX);
+            assert_eq!(ns_tick(v), n, "ns {v}");
+        }
     }
 }

@@ -102,7 +102,7 @@ use motion::{
     CycleRatio, Event, FineInterpolator, InterpolatorConfig, MasterSetpoint, PositionTarget,
     ProfileGenerator, ProfileLimits, SetMode, VelocityInterpolator, INCREMENTS_PER_REVOLUTION,
 };
-use snapshot::{write, CyclicSlots, Snapshot, Window, A291};
+use snapshot::{write, CyclicSlots, Snapshot, Window};
 
 /// The permitted direction of an endless axis (I04), for [`AxisParams::limits`].
 pub use motion::limits::PermittedDirection;
@@ -417,6 +417,10 @@ pub struct Axis {
     snapshot: Option<(u32, Snapshot)>,
     /// The entries read and written every cycle, resolved at the first.
     slots: Option<CyclicSlots>,
+    /// What [`Self::configure`] last ran for: the configuration generation,
+    /// the cycle and the mode class (homing, jog, other); it runs again
+    /// only when one of them (or the parameters) changed.
+    configured: Option<(u32, u32, u8)>,
     /// Filtered actual velocity, inc/s (user coordinates).
     velocity: f32,
     /// Last cycle's actual position sample (user coordinates).
@@ -496,6 +500,7 @@ impl Axis {
             interp: None,
             vinterp: None,
             interp_key: None,
+            configured: None,
             profile: ProfileGenerator::new(0),
             cascade: Cascade::new(params.cascade, 0)
                 .or_else(|_| Cascade::new(CascadeConfig::DEFAULT, 0))
@@ -565,6 +570,7 @@ impl Axis {
 
     /// The parameters not in the dictionary, to change (next cycle).
     pub fn params_mut(&mut self) -> &mut AxisParams {
+        self.configured = None;
         &mut self.params
     }
 
@@ -653,7 +659,15 @@ impl Axis {
         };
         let dt_ns =
             application_cycle_ns(u32::from(o.control_cycle_us).saturating_mul(1000)).unwrap_or(1_000_000);
-        self.configure(od, &o, dt_ns);
+        let class = match self.running {
+            Some(Mode::Homing) => 1,
+            Some(Mode::Jog) => 2,
+            _ => 0,
+        };
+        if self.configured != Some((generation, dt_ns, class)) {
+            self.configure(od, &slots, &o, dt_ns);
+            self.configured = Some((generation, dt_ns, class));
+        }
         let io = &sourced(io, &o);
 
         let mut actual = self.feedback(io, o.polarity, dt_ns, now_ns);
@@ -740,7 +754,7 @@ impl Axis {
     }
 
     /// Applies the configuration objects and parameters.
-    fn configure(&mut self, od: &mut DriveObjects, o: &Snapshot, dt_ns: u32) {
+    fn configure(&mut self, od: &mut DriveObjects, slots: &CyclicSlots, o: &Snapshot, dt_ns: u32) {
         let p = self.params;
         let opts = self.dc.options_mut();
         if let Ok(q) = QuickStopOption::try_from(o.quick_stop_option) {
@@ -755,9 +769,7 @@ impl Axis {
         let master_ns = interpolation_period_ns(o.period_value, o.period_index).unwrap_or(dt_ns);
         if self.window.axis == 0 {
             let us = i64::from(master_ns / 1000);
-            if od.get(A291, 0).ok() != Some(us) {
-                let _ = od.set(A291, 0, us);
-            }
+            write(od, slots.a291, us);
         }
         let ratio = CycleRatio::new(master_ns, dt_ns)
             .or_else(|_| CycleRatio::new(dt_ns, dt_ns))

@@ -127,6 +127,8 @@ pub(crate) struct CyclicSlots {
     pub e47: Option<Slot>,
     pub e49: Option<Slot>,
     pub a67: Option<Slot>,
+    /// A291 (global): the copy of 60C2h.
+    pub a291: Option<Slot>,
 }
 
 impl CyclicSlots {
@@ -165,12 +167,13 @@ impl CyclicSlots {
             e47: m(E47),
             e49: m(E49),
             a67: m(A67),
+            a291: od.slot(A291, 0),
         }
     }
 
     /// Every slot, for the completeness test.
     #[cfg(test)]
-    pub fn all(&self) -> [Option<Slot>; 33] {
+    pub fn all(&self) -> [Option<Slot>; 34] {
         let [p0, p1, p2, p3] = self.probe_values;
         [
             self.controlword,
@@ -206,17 +209,20 @@ impl CyclicSlots {
             self.e47,
             self.e49,
             self.a67,
+            self.a291,
         ]
     }
 }
 
 /// The value in `slot`, or `default` without one.
+#[inline(always)]
 pub(crate) fn read(od: &DriveObjects, slot: Option<Slot>, default: i64) -> i64 {
     slot.map_or(default, |s| od.load_slot(s))
 }
 
 /// Stores `value` in `slot` (dropped without one or out of the type's
 /// range: an actual value must never stop the control cycle).
+#[inline(always)]
 pub(crate) fn write(od: &mut DriveObjects, slot: Option<Slot>, value: i64) {
     if let Some(s) = slot {
         od.store_slot(s, value);
