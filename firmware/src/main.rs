@@ -8,7 +8,7 @@
 //! | `sync0` | ERU1_0 (ESC SYNC0 routed through ERU1) | 3 | `node::tasks::sync0` |
 //! | `control` | CCU40_0 (control-cycle timer compare) | 3 | `node::tasks::control` |
 //! | `esc` | ECAT0_0 (ESC PDI interrupt: AL events, SM2/SM3, mailbox) | 2 | `node::tasks::esc_event` |
-//! | `mailbox` | software task (dispatcher CCU42_0), spawned by `esc` | 1 | `node::tasks::mailbox` |
+//! | `mailbox` | CCU42_0 (a spare interrupt, pended by `esc`) | 1 | `node::tasks::mailbox` |
 //! | `idle` | — | 0 | background |
 //!
 //! The ESC is reached through `pdi::mmio::OnChip` over ECAT0's register
@@ -27,14 +27,14 @@ use cortex_m_rt as _; // the reset handler and vector table; the PAC does not pu
 use defmt_rtt as _;
 
 /// A panic masks every interrupt first, so no task can command the power
-/// stage again, then reports over RTT and stops the core. `scripts/cross
-/// panics` checks that no panic path is reachable from any task. The
-/// power-stage driver (board bring-up, docs/flashing.md) adds its gate
-/// disable here, before the message.
+/// stage again, switches the power stage off (gate enable low), then
+/// reports over RTT and stops the core. `scripts/cross panics` checks that
+/// no panic path is reachable from any task.
 #[panic_handler]
 fn panic(_info: &core::panic::PanicInfo) -> ! {
     cortex_m::interrupt::disable();
-    defmt::error!("panic: interrupts masked, halted");
+    power::set(false);
+    defmt::error!("panic: interrupts masked, power stage off, halted");
     loop {
         cortex_m::asm::bkpt();
     }
@@ -47,10 +47,37 @@ mod pac {
     pub use xmc4800::*;
 }
 
+/// The power stage's gate-driver enable: P5.9, push-pull, active high
+/// (docs/flashing.md, wiring). Low from `init` until a control cycle
+/// commands an axis' power stage on; the panic handler drives it low.
+mod power {
+    /// Port 5 (only its output-modification register, whose set/reset
+    /// writes are atomic, and at `init` its pin 8–11 control register).
+    #[allow(unsafe_code)]
+    fn port() -> &'static xmc4800::port5::RegisterBlock {
+        // SAFETY: PORT5 is a fixed peripheral address; OMR writes touch only
+        // the bits written (no read-modify-write race with other users).
+        unsafe { &*xmc4800::PORT5::ptr() }
+    }
+
+    /// P5.9 as a push-pull output, low.
+    pub fn init() {
+        port().omr().write(|w| w.pr9().set_bit());
+        port().iocr8().modify(|_, w| w.pc9().value9());
+    }
+
+    /// Gate enable high (`on`) or low.
+    pub fn set(on: bool) {
+        port()
+            .omr()
+            .write(|w| if on { w.ps9().set_bit() } else { w.pr9().set_bit() });
+    }
+}
+
 /// CPU clock after the boot ROM's PLL setup, Hz (DWT CYCCNT counts it).
 const CPU_HZ: u32 = 144_000_000;
 
-#[rtic::app(device = crate::pac, dispatchers = [CCU42_0])]
+#[rtic::app(device = crate::pac)]
 mod app {
     use crate::pac::Interrupt;
     use crate::CPU_HZ;
@@ -79,6 +106,7 @@ mod app {
         let mut core = cx.core;
         core.DCB.enable_trace();
         core.DWT.enable_cycle_counter();
+        crate::power::init();
         defmt::info!("init: firmware (XMC4800), SYNC0 on ERU1_0, ESC on ECAT0_0");
         // SAFETY: ECAT0 is this chip's ESC; the window is owned by the `pdi`
         // resource alone, so RTIC serialises every access to it.
@@ -154,6 +182,7 @@ mod app {
                 let now = clock.now_ns(DWT::cycle_count());
                 if timer.next_at_ns() <= now {
                     *cmd = tasks::control(drive, timer, now, &[AxisIo::ready(0); 2]);
+                    crate::power::set(cmd.iter().any(|c| c.power_stage));
                 }
             },
         );
@@ -162,8 +191,8 @@ mod app {
     /// The ESC's PDI interrupt: ESM, process data; the mailbox below it.
     #[task(binds = ECAT0_0, priority = 2, shared = [drive, timer, pdi, clock])]
     fn esc(cx: esc::Context) {
-        // already spawned: that run serves the mailbox
-        let _ = mailbox::spawn();
+        // a pended mailbox task runs once more after this one
+        rtic::pend(Interrupt::CCU42_0);
         (cx.shared.drive, cx.shared.timer, cx.shared.pdi, cx.shared.clock).lock(
             |drive, timer, pdi, clock| {
                 let now = clock.now_ns(DWT::cycle_count());
@@ -179,9 +208,11 @@ mod app {
     }
 
     /// The mailbox (CoE, EoE, FoE, EMCY, save) below the ESC task: the
-    /// drive is locked for one request.
-    #[task(priority = 1, shared = [drive, pdi, clock])]
-    async fn mailbox(cx: mailbox::Context) {
+    /// drive is locked for one request. A hardware task on a spare
+    /// interrupt, not an async software task: an `async fn` carries a
+    /// "resumed after completion" panic path.
+    #[task(binds = CCU42_0, priority = 1, shared = [drive, pdi, clock])]
+    fn mailbox(cx: mailbox::Context) {
         (cx.shared.drive, cx.shared.pdi, cx.shared.clock).lock(|drive, pdi, clock| {
             let now = clock.now_ns(DWT::cycle_count());
             if tasks::mailbox(drive, pdi, now).is_err() {

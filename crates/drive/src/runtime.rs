@@ -1159,11 +1159,18 @@ impl<F: Flash, B: Flash> Drive<F, B> {
         if cfg.enabled != wanted.enabled {
             pll.set_enabled(cfg.enabled);
         }
+        let before = (pll.status(), pll.fault());
         let cmd = pll.on_cycle_start(t_local_ns);
+        let changed = (pll.status(), pll.fault()) != before;
         if cmd.index == 0 {
             self.record_optimizer_sample(t_local_ns);
         }
-        self.update_sync_live();
+        // A298 and the sync-error flags at once when they change here; the
+        // phase error of A261[3] follows with the next SYNC0 (on_sync0), so
+        // the control cycle does not rewrite the diagnostics every cycle
+        if changed {
+            self.update_sync_live();
+        }
         Some(cmd)
     }
 

@@ -82,6 +82,18 @@ fn e107_task_bodies_run_the_end_to_end_sequence_on_the_pll() {
     assert!((position[1] + (1 << 20)).abs() < 2900, "{position:?}");
     // the move alone is 200 cycles: they ran with the PLL locked
     assert!(pll_cycles > 200, "{pll_cycles}");
+    // every entry of the script's mapping was copied through its slot
+    let img = b.drive.pdo_image();
+    let slow: Vec<(u16, u8)> = img
+        .rx()
+        .entries()
+        .iter()
+        .chain(img.tx().entries())
+        .filter(|e| e.slot.is_none())
+        .map(|e| (e.index, e.sub))
+        .collect();
+    assert!(!img.tx().entries().is_empty());
+    assert!(slow.is_empty(), "{slow:04X?}");
 }
 
 /// The clock extends a wrapping counter without losing wraps.

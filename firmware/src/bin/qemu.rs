@@ -12,7 +12,7 @@
 //! | EXTI0 | `sync0` (SYNC0) | 3 |
 //! | EXTI1 | `control` (control-cycle timer) | 3 |
 //! | EXTI2 | `esc` (ESC PDI interrupt) | 2 |
-//! | USART1 (dispatcher) | `mailbox` (spawned by `esc`) | 1 |
+//! | USART1 | `mailbox` (pended by `esc`) | 1 |
 //!
 //! The scripted master goes INIT → OP, enables both axes, moves them in csp
 //! and disables them. The log goes out over semihosting; `scripts/cross qemu`
@@ -128,7 +128,7 @@ impl Figure {
     }
 }
 
-#[rtic::app(device = stm32f4::stm32f405, dispatchers = [USART1])]
+#[rtic::app(device = stm32f4::stm32f405)]
 mod app {
     use super::{measure, Figure};
     use cortex_m::peripheral::syst::SystClkSource;
@@ -371,8 +371,8 @@ mod app {
     /// The ESC's PDI interrupt: the slave stack (ESM, mailbox, process data).
     #[task(binds = EXTI2, priority = 2, shared = [drive, timer, esc, clock, cost])]
     fn esc(cx: esc::Context) {
-        // already spawned: that run serves the mailbox
-        let _ = mailbox::spawn();
+        // a pended mailbox task runs once more after this one
+        rtic::pend(Interrupt::USART1);
         let now = { cx.shared.clock }.lock(|c| *c);
         let t0 = measure::now();
         let change = (cx.shared.drive, cx.shared.timer, cx.shared.esc)
@@ -389,8 +389,8 @@ mod app {
     }
 
     /// The mailbox (CoE, EoE, FoE, EMCY, save) below the ESC task.
-    #[task(priority = 1, shared = [drive, esc, clock])]
-    async fn mailbox(cx: mailbox::Context) {
+    #[task(binds = USART1, priority = 1, shared = [drive, esc, clock])]
+    fn mailbox(cx: mailbox::Context) {
         let now = { cx.shared.clock }.lock(|c| *c);
         (cx.shared.drive, cx.shared.esc).lock(|drive, esc| {
             let _ = tasks::mailbox(drive, &mut esc.pdi(), now);

@@ -651,7 +651,15 @@ impl Axis {
                 fresh
             }
         };
-        let o = raw.to_increments(&self.scaling);
+        // one copy of the snapshot per cycle: converted only when user
+        // units are not increments
+        let converted;
+        let o = if raw.in_increments(&self.scaling) {
+            &raw
+        } else {
+            converted = raw.to_increments(&self.scaling);
+            &converted
+        };
         self.modulo = if self.params.limits.endless_axis && o.modulo_length > 0 {
             ModuloAxis::new(i64::from(o.modulo_length)).ok()
         } else {
@@ -665,10 +673,10 @@ impl Axis {
             _ => 0,
         };
         if self.configured != Some((generation, dt_ns, class)) {
-            self.configure(od, &slots, &o, dt_ns);
+            self.configure(od, &slots, o, dt_ns);
             self.configured = Some((generation, dt_ns, class));
         }
-        let io = &sourced(io, &o);
+        let io = &sourced(io, o);
 
         let mut actual = self.feedback(io, o.polarity, dt_ns, now_ns);
         let i199 = is_standstill(self.velocity, self.params.velocity_window_inc_per_s);
@@ -690,7 +698,7 @@ impl Axis {
         }
         if let Some(stop) = status.stop {
             if stop.ramp == StopRamp::QuickStop {
-                self.local_quick_stop(&o);
+                self.local_quick_stop(o);
             }
         }
 
@@ -717,7 +725,7 @@ impl Axis {
             sto_active: io.sto_active,
             standstill: i199 && stop_done,
             fault_present: false,
-            motion_command: self.motion_command(&o),
+            motion_command: self.motion_command(o),
             brake_override: false,
             target_reached: false,
             mode_bit12: false,
@@ -730,14 +738,14 @@ impl Axis {
         let out = self.dc.step(&inputs, now_ns);
         let emcy = self.on_transition(out.transition, od);
 
-        self.touch_probe(&o, io, actual, now_ns);
+        self.touch_probe(o, io, actual, now_ns);
 
-        let demand = self.motion(&o, &out, io, &mut actual, i199, now_ns, dt_ns, new_setpoint);
+        let demand = self.motion(o, &out, io, &mut actual, i199, now_ns, dt_ns, new_setpoint);
         let (torque, bits, fe) = self.control(demand, actual, now_ns, dt_ns);
 
         self.prev_cw = o.controlword;
         self.write_back(od, &slots, &out, (bits, actual, torque, fe));
-        self.user_statusword(od, &slots, &o);
+        self.user_statusword(od, &slots, o);
         self.switch_on_disabled_causes(od, &slots, &out, io, o.controlword);
         self.digital_inputs(od, &slots, io);
 

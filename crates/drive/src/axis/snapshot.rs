@@ -457,11 +457,17 @@ impl Snapshot {
         (p(self.decimals.0), p(self.decimals.1))
     }
 
+    /// Whether the objects are in increments already (identity scaling, no
+    /// decimals): [`to_increments`](Self::to_increments) changes nothing.
+    pub fn in_increments(&self, s: &AxisScaling) -> bool {
+        *s == AxisScaling::INCREMENTAL && self.decimals == (0, 0)
+    }
+
     /// The snapshot with every position, velocity, acceleration and jerk
     /// object turned from user units (6091h/6092h, C-109; decimals A310/A311
     /// with A213 = 0, C-142) into increments, the unit the axis works in.
     pub fn to_increments(self, s: &AxisScaling) -> Self {
-        if *s == AxisScaling::INCREMENTAL && self.decimals == (0, 0) {
+        if self.in_increments(s) {
             return self;
         }
         let (fv, fa) = self.decimal_factors();
