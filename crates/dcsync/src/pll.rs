@@ -301,6 +301,9 @@ const NS_PER_S: i128 = 1_000_000_000;
 /// hundred); 128 only where `d + p/2` would overflow.
 pub(crate) fn wrap_signed(d: i64, p: i64) -> i64 {
     let p = p.max(1);
+    if d >= -(p / 2) && d < p - p / 2 {
+        return d; // already inside: no division (the usual phase error)
+    }
     match d.checked_add(p / 2) {
         Some(x) => x.rem_euclid(p) - p / 2,
         None => {
@@ -324,6 +327,15 @@ const fn gcd(mut a: u64, mut b: u64) -> u64 {
 /// `a · b / c` truncated toward zero, in 64 bits when `a · b` fits, else
 /// 128 (`c` ≠ 0; a quotient beyond 64 bits saturates).
 fn mul_div(a: i64, b: i64, c: i64) -> i64 {
+    if a == 0 {
+        return 0;
+    }
+    // a Cortex-M divides 32 bits in hardware, 64 in a library call
+    if let (Ok(a), Ok(b), Ok(c)) = (u32::try_from(a), u32::try_from(b), u32::try_from(c)) {
+        if let Some(x) = a.checked_mul(b) {
+            return i64::from(x.checked_div(c).unwrap_or(0));
+        }
+    }
     match a.checked_mul(b) {
         Some(x) => x.checked_div(c).unwrap_or(0),
         None => {
@@ -570,7 +582,7 @@ impl Pll {
 
         let a150 = i64::from(self.cfg.a150_ns);
         let k = i64::from(self.k.max(1));
-        let mut period_q = (a150 << Q) + self.corr_q / k;
+        let mut period_q = (a150 << Q) + if k == 1 { self.corr_q } else { self.corr_q / k };
         self.stretching = false;
         if self.stretch_ns != 0 {
             let chunk = self.stretch_ns.max(-(a150 / 4)).min(a150);
