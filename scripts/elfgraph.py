@@ -53,13 +53,21 @@ def parse(elf, objdump=None):
     frames = collections.Counter()
     addr_of = {}
     cur = None
+    in_data = False
     for line in out.splitlines():
         m = re.match(r"^([0-9a-f]+) <(.*)>:$", line)
         if m:
-            cur = strip_hash(m.group(2))
+            name = m.group(2)
+            if re.match(r"^\$[adt](\.\d+)?$", name):
+                # ARM mapping symbols mark code ($t, $a) and literal pools ($d)
+                # inside a function: the function goes on
+                in_data = name.startswith("$d")
+                continue
+            cur = strip_hash(name)
+            in_data = False
             addr_of[int(m.group(1), 16) & ~1] = cur
             continue
-        if cur is None:
+        if cur is None or in_data:
             continue
         m = BRANCH.search(line)
         if m:
