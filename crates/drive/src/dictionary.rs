@@ -735,6 +735,58 @@ impl DriveObjects {
         }
     }
 
+    /// Stores a 16-bit value: straight into a 16-bit slot of the same
+    /// signedness that is not a configuration entry (the actual values),
+    /// else through [`store_slot`](Self::store_slot).
+    #[inline(always)]
+    pub fn store_slot_u16(&mut self, slot: Slot, value: u16) {
+        if slot.kind == SlotType::U16 && !slot.config {
+            put_at(&mut self.image, usize::from(slot.at), value.to_le_bytes());
+        } else {
+            self.store_slot(slot, i64::from(value));
+        }
+    }
+
+    /// [`store_slot_u16`](Self::store_slot_u16) for INTEGER16.
+    #[inline(always)]
+    pub fn store_slot_i16(&mut self, slot: Slot, value: i16) {
+        if slot.kind == SlotType::I16 && !slot.config {
+            put_at(&mut self.image, usize::from(slot.at), value.to_le_bytes());
+        } else {
+            self.store_slot(slot, i64::from(value));
+        }
+    }
+
+    /// [`store_slot_u16`](Self::store_slot_u16) for INTEGER32.
+    #[inline(always)]
+    pub fn store_slot_i32(&mut self, slot: Slot, value: i32) {
+        if slot.kind == SlotType::I32 && !slot.config {
+            put_at(&mut self.image, usize::from(slot.at), value.to_le_bytes());
+        } else {
+            self.store_slot(slot, i64::from(value));
+        }
+    }
+
+    /// [`store_slot_u16`](Self::store_slot_u16) for INTEGER8.
+    #[inline(always)]
+    pub fn store_slot_i8(&mut self, slot: Slot, value: i8) {
+        if slot.kind == SlotType::I8 && !slot.config {
+            put_at(&mut self.image, usize::from(slot.at), value.to_le_bytes());
+        } else {
+            self.store_slot(slot, i64::from(value));
+        }
+    }
+
+    /// [`store_slot_u16`](Self::store_slot_u16) for UNSIGNED8.
+    #[inline(always)]
+    pub fn store_slot_u8(&mut self, slot: Slot, value: u8) {
+        if slot.kind == SlotType::U8 && !slot.config {
+            put_at(&mut self.image, usize::from(slot.at), [value]);
+        } else {
+            self.store_slot(slot, i64::from(value));
+        }
+    }
+
     /// Copies the raw little-endian bytes of `slot` to `dst` at `at`
     /// (the TxPDO copy); `false` when they do not fit there.
     #[inline(always)]

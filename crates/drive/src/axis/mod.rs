@@ -102,7 +102,7 @@ use motion::{
     CycleRatio, Event, FineInterpolator, InterpolatorConfig, MasterSetpoint, PositionTarget,
     ProfileGenerator, ProfileLimits, SetMode, VelocityInterpolator, INCREMENTS_PER_REVOLUTION,
 };
-use snapshot::{write, CyclicSlots, Snapshot, Window};
+use snapshot::{write, write_typed, Actual, CyclicSlots, Snapshot, Window};
 
 /// The permitted direction of an endless axis (I04), for [`AxisParams::limits`].
 pub use motion::limits::PermittedDirection;
@@ -1731,7 +1731,7 @@ impl Axis {
         if out.drive_function {
             sw |= bits & SW_INTERNAL_LIMIT;
         }
-        write(od, c.statusword, i64::from(sw));
+        write_typed(od, c.statusword, Actual::U16(sw));
         let e80 = match self.denial {
             Some(DenialCause::IllegalDirection) => 15,
             Some(
@@ -1740,26 +1740,27 @@ impl Axis {
                 | DenialCause::SoftwarePositive
                 | DenialCause::SoftwareNegative,
             ) => 20,
-            _ => 0,
+            _ => 0u8,
         };
-        write(od, c.e80, e80);
-        write(od, c.mode_display, i64::from(out.mode_display));
-        write(od, c.position, self.user_position(actual));
+        write_typed(od, c.e80, Actual::U8(e80));
+        write_typed(od, c.mode_display, Actual::I8(out.mode_display));
+        let position = self.user_position(actual);
+        write(od, c.position, position);
         let v = self.scaling.velocity_to_user(self.velocity) * self.velocity_decimals;
-        write(od, c.velocity, i64::from(round_i32(v)));
+        write_typed(od, c.velocity, Actual::I32(round_i32(v)));
         let rated = self.params.rated_torque_nm;
         let per_mille = if rated > 0.0 { torque / rated * 1000.0 } else { 0.0 };
-        let t = i64::from(round_i32(per_mille)).clamp(i64::from(i16::MIN), i64::from(i16::MAX));
-        write(od, c.torque, t);
-        write(od, c.current, t);
+        let t = round_i32(per_mille).clamp(i32::from(i16::MIN), i32::from(i16::MAX)) as i16;
+        write_typed(od, c.torque, Actual::I16(t));
+        write_typed(od, c.current, Actual::I16(t));
         write(od, c.rated_current, i64::from(round_i32(rated * 1000.0).max(0)));
         write(od, c.following_error, self.user(fe));
-        write(od, c.probe_status, i64::from(self.probe.status()));
+        write_typed(od, c.probe_status, Actual::U16(self.probe.status()));
         write(od, c.probe_values[0], self.user_position(self.probe.value_60ba()));
         write(od, c.probe_values[1], self.user_position(self.probe.value_60bb()));
         write(od, c.probe_values[2], self.user_position(self.probe.value_60bc()));
         write(od, c.probe_values[3], self.user_position(self.probe.value_60bd()));
-        write(od, c.additional_position, self.user_position(actual));
+        write(od, c.additional_position, position);
         write(
             od,
             c.vl_demand,
@@ -1770,7 +1771,7 @@ impl Axis {
             c.vl_actual,
             i64::from(round_i32(self.velocity / RPM_TO_INC_PER_S)).clamp(-32768, 32767),
         );
-        write(od, c.e48, i64::from(e48(out.state)));
+        write_typed(od, c.e48, Actual::U8(e48(out.state)));
     }
 
     /// A position (or distance) in increments as the objects show it: user
@@ -1785,6 +1786,7 @@ impl Axis {
 
     /// A position in increments as the objects show it: user units,
     /// wrapped into 0 … 607Bh:02 − 1 on an endless axis (C-111).
+    #[inline]
     fn user_position(&self, increments: i32) -> i64 {
         match self.modulo {
             Some(m) => m.wrap(

@@ -220,6 +220,30 @@ pub(crate) fn read(od: &DriveObjects, slot: Option<Slot>, default: i64) -> i64 {
     slot.map_or(default, |s| od.load_slot(s))
 }
 
+/// A typed actual value for [`write_typed`].
+pub(crate) enum Actual {
+    I8(i8),
+    U8(u8),
+    U16(u16),
+    I16(i16),
+    I32(i32),
+}
+
+/// Stores a typed actual value in `slot` (dropped without one): one
+/// compare and a store when the slot has the value's type.
+#[inline(always)]
+pub(crate) fn write_typed(od: &mut DriveObjects, slot: Option<Slot>, value: Actual) {
+    if let Some(s) = slot {
+        match value {
+            Actual::I8(v) => od.store_slot_i8(s, v),
+            Actual::U8(v) => od.store_slot_u8(s, v),
+            Actual::U16(v) => od.store_slot_u16(s, v),
+            Actual::I16(v) => od.store_slot_i16(s, v),
+            Actual::I32(v) => od.store_slot_i32(s, v),
+        }
+    }
+}
+
 /// Stores `value` in `slot` (dropped without one or out of the type's
 /// range: an actual value must never stop the control cycle).
 #[inline(always)]

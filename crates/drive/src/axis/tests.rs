@@ -856,3 +856,28 @@ fn cyclic_slots_resolve_every_entry_on_both_axes() {
         seen.push(s);
     }
 }
+
+/// The actual values written with a typed store have that type in the
+/// dictionary (else every store takes the generic path).
+#[test]
+fn typed_actual_value_slots_have_their_types() {
+    use crate::axis::snapshot::{CyclicSlots, Window};
+    use od::DataType::{I16, I32, I8, U16, U8};
+    let od = DriveObjects::new();
+    for axis in 0..2 {
+        let c = CyclicSlots::resolve(&od, Window { axis });
+        let typed = [
+            (c.statusword, U16),
+            (c.mode_display, I8),
+            (c.velocity, I32),
+            (c.torque, I16),
+            (c.current, I16),
+            (c.probe_status, U16),
+            (c.e80, U8),
+            (c.e48, U8),
+        ];
+        for (k, (slot, t)) in typed.into_iter().enumerate() {
+            assert_eq!(slot.map(|s| s.data_type()), Some(t), "axis {axis} entry {k}");
+        }
+    }
+}
