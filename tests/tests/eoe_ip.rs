@@ -109,6 +109,35 @@ fn e096_e095_ping_and_parameters_over_udp() {
     assert_eq!(d.drive.slave.eoe().params().ip, Some(DRIVE_IP));
 }
 
+#[test]
+fn e099_refused_eoe_configuration_shows_er10() {
+    let sim = sim_with_net();
+    with_master(&sim, async |md, clock| {
+        let group = init(md, clock).await;
+        let sd = group.subdevice(md, 0).unwrap();
+        let mut host = HostNet::new(HOST_MAC, &[(HOST_IP, 24)], clock.load(Ordering::Relaxed));
+        assert_eq!(set_ip(&mut host, &sd, clock).await, vec![0x03, 0x01, 0x00, 0x00]);
+        let er = |t: &str| t.split(' ').nth(1).unwrap_or_default().to_string();
+        assert_eq!(er(&ask(&mut host, &sd, clock, "R A257[0]").await), "Er0");
+        // the subnet's broadcast address: refused (0001h), the old address stays
+        let bad = set_ip_request([10, 0, 0, 255], MASK, HOST_IP);
+        assert!(host.tunnel.request(&sd, &bad).await);
+        let mut resp = None;
+        for _ in 0..STEPS {
+            host.step(&sd, clock).await;
+            if let Some(r) = host.tunnel.responses.pop_front() {
+                resp = Some(r);
+                break;
+            }
+        }
+        assert_eq!(resp, Some(vec![0x03, 0x01, 0x01, 0x00]));
+        assert_eq!(er(&ask(&mut host, &sd, clock, "R A257[0]").await), "Er10");
+        // an accepted configuration clears it
+        assert_eq!(set_ip(&mut host, &sd, clock).await, vec![0x03, 0x01, 0x00, 0x00]);
+        assert_eq!(er(&ask(&mut host, &sd, clock, "R A257[0]").await), "Er0");
+    });
+}
+
 /// A drive without motors or control cycles, with its IP stack: six
 /// simulated hours stay cheap (the 1 ms motor steps would be 21.6 million).
 struct NetNode {

@@ -737,7 +737,9 @@ impl<F: Flash, B: Flash> Drive<F, B> {
     fn er_code(&self) -> u8 {
         let s = &self.slave;
         if !s.error() {
-            return 0;
+            // E-099: a refused EoE IP configuration (EMCY FFF0h sent) shows
+            // Er10 until an accepted one replaces it
+            return if s.eoe().address_error() { 10 } else { 0 };
         }
         let code = s.al_status_code();
         if s.sync_status().unsolicited {

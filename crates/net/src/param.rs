@@ -325,7 +325,7 @@ mod tests {
     }
 
     #[test]
-    fn e009_coordinates_map_to_coe_addresses() {
+    fn e009_e010_e012_e013_coordinates_map_to_coe_addresses() {
         let c = Coordinate::parse("A150").unwrap();
         assert_eq!(c.address(true), Some((0x2096, 0)));
         let c = Coordinate::parse("A199[1]").unwrap();
@@ -393,6 +393,18 @@ mod tests {
         // a string
         assert_eq!(ask(&mut d, "R E50", pre), "OK SC6");
         assert_eq!(ask(&mut d, "W E50 XY", pre), "ERR 06010002");
+        // global parameters only in the axis-A window
+        assert_eq!(ask(&mut d, "R 2.A150", pre), "ERR 06020000");
+        // the state rule: A225 (= 1600h) is writable in Pre-Op only, and the
+        // answer is the abort an SDO download gets
+        let sdo = d
+            .write(0x20E1, 1, &0x6040_0010u32.to_le_bytes(), CommState::Op)
+            .unwrap_err();
+        assert_eq!(
+            ask(&mut d, "W A225[0] 0x60400010", CommState::Op),
+            std::format!("ERR {:08X}", sdo.0)
+        );
+        assert_eq!(sdo, SdoAbort::DEVICE_STATE);
         // an answer buffer too small
         assert_eq!(handle(b"R A150", &mut [0u8; 4], &mut d, pre), 0);
     }

@@ -402,7 +402,7 @@ mod tests {
     }
 
     #[test]
-    fn e106_same_server_every_5_to_6_hours_next_only_on_failure() {
+    fn e103_e106_same_server_every_5_to_6_hours_next_only_on_failure() {
         let mut c = SntpClient::new(7);
         let base = (NTP_UNIX_OFFSET_S + 1_700_000_000) * 1_000_000_000;
         let mut t = c.next_request_us();
