@@ -69,8 +69,12 @@ pub struct SntpConfig {
 }
 
 impl SntpConfig {
+    /// Server `i` if it is a unicast address (0.0.0.0 = none; broadcast
+    /// and multicast are not servers).
     fn server(&self, i: usize) -> Option<Ipv4> {
-        self.servers.get(i).copied().filter(|s| *s != [0; 4])
+        self.servers.get(i).copied().filter(|&[a, b, c, d]| {
+            [a, b, c, d] != [0; 4] && [a, b, c, d] != [255; 4] && !(224..=239).contains(&a)
+        })
     }
 }
 

@@ -114,6 +114,13 @@ fn addr(a: Ipv4) -> Ipv4Address {
     Ipv4Address::from(a)
 }
 
+/// A unicast address (not 0.0.0.0, not broadcast or multicast): the only
+/// kind smoltcp accepts as an interface address, gateway or destination.
+pub fn is_unicast(a: Ipv4) -> bool {
+    let a = addr(a);
+    !(a.is_unspecified() || a.is_broadcast() || a.is_multicast())
+}
+
 impl<'a> NetStack<'a> {
     /// The stack at local time `now_us` on `queue`, without an address.
     pub fn new(
@@ -195,13 +202,15 @@ impl<'a> NetStack<'a> {
         self.stats
     }
 
-    /// Takes over IP parameters set by the master (E-096).
+    /// Takes over IP parameters set by the master (E-096). Addresses
+    /// smoltcp cannot hold (multicast, broadcast; it would panic) are
+    /// ignored: the previous ones stay.
     fn apply_ip(&mut self, p: &IpParams) {
-        if let Some(mac) = p.mac {
+        if let Some(mac) = p.mac.filter(|m| EthernetAddress(*m).is_unicast()) {
             self.iface
                 .set_hardware_addr(HardwareAddress::Ethernet(EthernetAddress(mac)));
         }
-        if let Some(ip) = p.ip {
+        if let Some(ip) = p.ip.filter(|a| is_unicast(*a)) {
             let prefix = p.mask.and_then(prefix_len).unwrap_or(24) as u8;
             let cidr = Ipv4Cidr::new(addr(ip), prefix);
             self.ip = Some(cidr);
@@ -210,13 +219,17 @@ impl<'a> NetStack<'a> {
                 let _ = addrs.push(IpCidr::Ipv4(cidr));
             });
         }
-        self.eoe_gateway = p.gateway.filter(|g| *g != [0; 4]);
+        self.eoe_gateway = match p.gateway {
+            Some(g) if is_unicast(g) => Some(g),
+            Some([0, 0, 0, 0]) | None => None,
+            Some(_) => self.eoe_gateway,
+        };
     }
 
     /// Puts the default route on A175 or else the EoE gateway.
     fn follow_gateway(&mut self, settings: &NetSettings) {
         let gw = Some(settings.gateway)
-            .filter(|g| *g != [0; 4])
+            .filter(|g| is_unicast(*g))
             .or(self.eoe_gateway);
         if gw != self.route {
             let routes = self.iface.routes_mut();
@@ -308,3 +321,58 @@ impl<'a> NetStack<'a> {
 
 /// Re-exported for the owner's convenience.
 pub use sntp::message_time_stamp;
+
+#[cfg(test)]
+mod tests {
+    #![allow(clippy::unwrap_used, clippy::indexing_slicing)]
+    use super::*;
+    use drive::dictionary::DriveObjects;
+
+    #[test]
+    fn e096_addresses_smoltcp_cannot_hold_are_ignored() {
+        let mut q = EoeQueue::new();
+        let mut bufs = NetBuffers::new();
+        let mut slots = [SocketStorage::EMPTY; SOCKETS];
+        let cfg = NetConfig {
+            mac: [2, 0, 0, 0, 0, 1],
+            seed: 1,
+        };
+        let mut net = NetStack::new(cfg, &mut bufs, &mut slots, &mut q, 0);
+        let mut d = DriveObjects::new();
+        let good = IpParams {
+            ip: Some([10, 0, 0, 5]),
+            mask: Some([255, 255, 255, 0]),
+            gateway: Some([10, 0, 0, 1]),
+            ..IpParams::default()
+        };
+        ecat::eoe::EthernetPort::ip_changed(&mut q, &good);
+        let s = NetSettings::default();
+        net.poll(1, &mut q, &mut d, CommState::PreOp, &s);
+        assert_eq!(net.ip(), Some(([10, 0, 0, 5], 24)));
+        assert_eq!(net.gateway(), Some([10, 0, 0, 1]));
+        // multicast / broadcast address, gateway and MAC: the old ones stay
+        let bad = IpParams {
+            mac: Some([1, 0, 0x5E, 0, 0, 1]),
+            ip: Some([224, 0, 0, 5]),
+            mask: Some([255, 255, 255, 0]),
+            gateway: Some([255, 255, 255, 255]),
+            ..IpParams::default()
+        };
+        ecat::eoe::EthernetPort::ip_changed(&mut q, &bad);
+        // A175 and the SNTP servers multicast/broadcast too
+        let s = NetSettings {
+            gateway: [239, 1, 1, 1],
+            sntp: SntpConfig {
+                active: true,
+                servers: [[255, 255, 255, 255], [224, 0, 1, 1]],
+            },
+        };
+        for t in [2, 400_000_000, 800_000_000] {
+            net.poll(t, &mut q, &mut d, CommState::PreOp, &s);
+        }
+        assert_eq!(net.ip(), Some(([10, 0, 0, 5], 24)));
+        assert_eq!(net.mac(), [2, 0, 0, 0, 0, 1]);
+        assert_eq!(net.gateway(), Some([10, 0, 0, 1]));
+        assert_eq!(net.sntp().stats().requests, 0);
+    }
+}
