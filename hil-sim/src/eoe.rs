@@ -32,6 +32,7 @@ pub const MBX_EOE: u8 = 2;
 pub fn net_settings<F: store::Flash, B: store::Flash>(drive: &Drive<F, B>) -> NetSettings {
     let s = drive.ip_settings();
     NetSettings {
+        dhcp: s.address_source == 2,
         gateway: s.gateway,
         sntp: net::sntp::SntpConfig {
             active: s.sntp_active,
@@ -364,6 +365,13 @@ impl HostNet {
             udp,
             ntp,
         }
+    }
+
+    /// Adds a UDP socket bound to `port` (one more fits).
+    pub fn add_udp(&mut self, port: u16) -> smoltcp::iface::SocketHandle {
+        let mut s = udp_socket();
+        let _ = s.bind(port);
+        self.sockets.add(s)
     }
 
     /// Runs the host interface at `now_ns`.

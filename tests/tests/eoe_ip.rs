@@ -138,6 +138,128 @@ fn e099_refused_eoe_configuration_shows_er10() {
     });
 }
 
+/// A DHCP server on the host side of the tunnel: answers DISCOVER with an
+/// OFFER and REQUEST with an ACK of `offer` (broadcast, as the client has no
+/// address yet). Returns the message types it answered.
+fn dhcp_serve(host: &mut HostNet, server: smoltcp::iface::SocketHandle, offer: [u8; 4]) -> Vec<&'static str> {
+    use smoltcp::wire::{DhcpMessageType, DhcpPacket, DhcpRepr, IpAddress, IpEndpoint, Ipv4Address};
+    let mut answered = Vec::new();
+    let sock = host.sockets.get_mut::<udp::Socket>(server);
+    while let Ok((data, _)) = sock.recv() {
+        let data = data.to_vec();
+        let pkt = DhcpPacket::new_checked(&data[..]).unwrap();
+        let req = DhcpRepr::parse(&pkt).unwrap();
+        let (kind, name) = match req.message_type {
+            DhcpMessageType::Discover => (DhcpMessageType::Offer, "offer"),
+            DhcpMessageType::Request => (DhcpMessageType::Ack, "ack"),
+            _ => continue,
+        };
+        let repr = DhcpRepr {
+            message_type: kind,
+            transaction_id: req.transaction_id,
+            secs: 0,
+            client_hardware_address: req.client_hardware_address,
+            client_ip: Ipv4Address::UNSPECIFIED,
+            your_ip: Ipv4Address::from(offer),
+            server_ip: Ipv4Address::from(HOST_IP),
+            router: Some(Ipv4Address::from(HOST_IP)),
+            subnet_mask: Some(Ipv4Address::from(MASK)),
+            relay_agent_ip: Ipv4Address::UNSPECIFIED,
+            broadcast: true,
+            requested_ip: None,
+            client_identifier: None,
+            server_identifier: Some(Ipv4Address::from(HOST_IP)),
+            parameter_request_list: None,
+            dns_servers: None,
+            max_size: None,
+            lease_duration: Some(3600),
+            renew_duration: None,
+            rebind_duration: None,
+            additional_options: &[],
+        };
+        let mut buf = vec![0u8; repr.buffer_len()];
+        repr.emit(&mut DhcpPacket::new_unchecked(&mut buf[..])).unwrap();
+        let to = IpEndpoint::new(IpAddress::Ipv4(Ipv4Address::BROADCAST), 68);
+        sock.send_slice(&buf, to).unwrap();
+        answered.push(name);
+    }
+    answered
+}
+
+#[test]
+fn e098_dhcp_while_a166_is_2_until_the_master_sets_an_address() {
+    let sim = sim_with_net();
+    with_master(&sim, async |md, clock| {
+        let group = init(md, clock).await;
+        let sd = group.subdevice(md, 0).unwrap();
+        let mut host = HostNet::new(HOST_MAC, &[(HOST_IP, 24)], clock.load(Ordering::Relaxed));
+        let server = host.add_udp(67);
+        // A166 = 2 (default): DISCOVER, OFFER, REQUEST, ACK
+        let mut answered = Vec::new();
+        for _ in 0..400 {
+            host.step(&sd, clock).await;
+            answered.extend(dhcp_serve(&mut host, server, [10, 0, 0, 50]));
+            if answered.len() == 2 {
+                break;
+            }
+        }
+        assert_eq!(answered, ["offer", "ack"]);
+        // the ACK on its way to the drive
+        for _ in 0..20 {
+            host.step(&sd, clock).await;
+        }
+        let leased = [10, 0, 0, 50];
+        assert!(
+            host.ping(&sd, clock, leased, 1, STEPS).await.is_some(),
+            "ping the leased address"
+        );
+        assert_eq!(
+            host.param_request(&sd, clock, leased, "R A166", STEPS)
+                .await
+                .map(|a| a.0),
+            Some("OK 2".to_string())
+        );
+        // the master's address wins and DHCP stops
+        assert_eq!(set_ip(&mut host, &sd, clock).await, vec![0x03, 0x01, 0x00, 0x00]);
+        // (the host sends its next ARP request only 1 s after the last)
+        let now = sim.borrow().now_ns();
+        sim.borrow_mut().catch_up(now + 1_100_000_000);
+        assert!(host.ping(&sd, clock, DRIVE_IP, 2, STEPS).await.is_some());
+        assert_eq!(
+            host.ping(&sd, clock, leased, 3, 60).await,
+            None,
+            "the lease is gone"
+        );
+    });
+    let s = sim.borrow();
+    let net = &s.drives()[0].net.as_ref().unwrap().stack;
+    assert_eq!(net.ip(), Some((DRIVE_IP, 24)));
+    assert!(!net.address_from_dhcp());
+}
+
+#[test]
+fn e098_no_dhcp_when_a166_is_not_2() {
+    let sim = sim_with_net();
+    // A166 = 0 before the first poll
+    sim.borrow_mut().drives_mut()[0]
+        .drive
+        .objects
+        .set(0x20A6, 0, 0)
+        .unwrap();
+    with_master(&sim, async |md, clock| {
+        let group = init(md, clock).await;
+        let sd = group.subdevice(md, 0).unwrap();
+        let mut host = HostNet::new(HOST_MAC, &[(HOST_IP, 24)], clock.load(Ordering::Relaxed));
+        let server = host.add_udp(67);
+        for _ in 0..200 {
+            host.step(&sd, clock).await;
+            assert!(dhcp_serve(&mut host, server, [10, 0, 0, 50]).is_empty());
+        }
+        assert_eq!(host.tunnel.stats().frames_in, 0, "the drive sent nothing");
+    });
+    assert_eq!(sim.borrow().drives()[0].net.as_ref().unwrap().stack.ip(), None);
+}
+
 /// A drive without motors or control cycles, with its IP stack: six
 /// simulated hours stay cheap (the 1 ms motor steps would be 21.6 million).
 struct NetNode {

@@ -10,12 +10,12 @@ use ecat::eoe::{prefix_len, IpParams};
 use ecat::eoe_queue::EoeQueue;
 use od::{CommState, Dictionary};
 use smoltcp::iface::{Config, Interface, SocketHandle, SocketSet, SocketStorage};
-use smoltcp::socket::udp;
+use smoltcp::socket::{dhcpv4, udp};
 use smoltcp::time::Instant;
 use smoltcp::wire::{EthernetAddress, HardwareAddress, IpAddress, IpCidr, IpEndpoint, Ipv4Address, Ipv4Cidr};
 
-/// Sockets of the stack (parameter service, SNTP).
-pub const SOCKETS: usize = 2;
+/// Sockets of the stack (parameter service, SNTP, DHCP client).
+pub const SOCKETS: usize = 3;
 /// The socket slots the owner provides.
 pub type SocketSlots<'a> = [SocketStorage<'a>; SOCKETS];
 
@@ -74,7 +74,10 @@ pub struct NetConfig {
 /// before each poll (A166, A175, A199).
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
 pub struct NetSettings {
-    /// A175: gateway; 0.0.0.0 = the one the master set over EoE.
+    /// A166 = 2 "DHCP + DS6": the address comes from DHCP until the master
+    /// sets one over EoE (E-098).
+    pub dhcp: bool,
+    /// A175: gateway; 0.0.0.0 = the one the master set over EoE (or DHCP's).
     pub gateway: Ipv4,
     /// A199: SNTP.
     pub sntp: SntpConfig,
@@ -98,9 +101,16 @@ pub struct NetStack<'a> {
     param: SocketHandle,
     sntp_socket: SocketHandle,
     sntp: SntpClient,
-    /// The address the master set (E-096).
+    /// The address in force (the master's, E-096, or DHCP's, E-098).
     ip: Option<Ipv4Cidr>,
+    /// The master set the address: DHCP stays off.
+    ip_from_master: bool,
     eoe_gateway: Option<Ipv4>,
+    /// The DHCP client while it runs.
+    dhcp: Option<SocketHandle>,
+    /// The address came from DHCP (dropped when DHCP stops).
+    ip_from_dhcp: bool,
+    dhcp_gateway: Option<Ipv4>,
     /// The gateway in force as a default route.
     route: Option<Ipv4>,
     stats: NetStats,
@@ -163,7 +173,11 @@ impl<'a> NetStack<'a> {
             sntp_socket,
             sntp: SntpClient::new(cfg.seed ^ 0x5A5A_5A5A),
             ip: None,
+            ip_from_master: false,
             eoe_gateway: None,
+            dhcp: None,
+            ip_from_dhcp: false,
+            dhcp_gateway: None,
             route: None,
             stats: NetStats::default(),
         }
@@ -212,12 +226,9 @@ impl<'a> NetStack<'a> {
         }
         if let Some(ip) = p.ip.filter(|a| is_unicast(*a)) {
             let prefix = p.mask.and_then(prefix_len).unwrap_or(24) as u8;
-            let cidr = Ipv4Cidr::new(addr(ip), prefix);
-            self.ip = Some(cidr);
-            self.iface.update_ip_addrs(|addrs| {
-                addrs.clear();
-                let _ = addrs.push(IpCidr::Ipv4(cidr));
-            });
+            self.set_address(Some(Ipv4Cidr::new(addr(ip), prefix)));
+            self.ip_from_master = true;
+            self.ip_from_dhcp = false;
         }
         self.eoe_gateway = match p.gateway {
             Some(g) if is_unicast(g) => Some(g),
@@ -226,11 +237,67 @@ impl<'a> NetStack<'a> {
         };
     }
 
-    /// Puts the default route on A175 or else the EoE gateway.
+    fn set_address(&mut self, cidr: Option<Ipv4Cidr>) {
+        self.ip = cidr;
+        self.iface.update_ip_addrs(|addrs| {
+            addrs.clear();
+            if let Some(c) = cidr {
+                let _ = addrs.push(IpCidr::Ipv4(c));
+            }
+        });
+    }
+
+    /// Starts the DHCP client while A166 = 2 and the master set no
+    /// address, stops it otherwise (E-098).
+    fn follow_dhcp(&mut self, settings: &NetSettings) {
+        let want = settings.dhcp && !self.ip_from_master;
+        match (want, self.dhcp) {
+            (true, None) => self.dhcp = Some(self.sockets.add(dhcpv4::Socket::new())),
+            (false, Some(h)) => {
+                self.sockets.remove(h);
+                self.dhcp = None;
+                self.dhcp_gateway = None;
+                if core::mem::take(&mut self.ip_from_dhcp) {
+                    self.set_address(None);
+                }
+            }
+            _ => {}
+        }
+    }
+
+    /// Takes the DHCP client's news.
+    fn run_dhcp(&mut self) {
+        let Some(h) = self.dhcp else { return };
+        let event = match self.sockets.get_mut::<dhcpv4::Socket>(h).poll() {
+            None => return,
+            Some(dhcpv4::Event::Configured(c)) => Some((c.address, c.router)),
+            Some(dhcpv4::Event::Deconfigured) => None,
+        };
+        match event {
+            Some((cidr, router)) if is_unicast(cidr.address().octets()) => {
+                self.set_address(Some(cidr));
+                self.ip_from_dhcp = true;
+                self.dhcp_gateway = router.map(|r| r.octets()).filter(|r| is_unicast(*r));
+            }
+            _ => {
+                self.set_address(None);
+                self.ip_from_dhcp = false;
+                self.dhcp_gateway = None;
+            }
+        }
+    }
+
+    /// Whether the address in force came from DHCP.
+    pub fn address_from_dhcp(&self) -> bool {
+        self.ip_from_dhcp
+    }
+
+    /// Puts the default route on A175, else the EoE gateway, else DHCP's router.
     fn follow_gateway(&mut self, settings: &NetSettings) {
         let gw = Some(settings.gateway)
             .filter(|g| is_unicast(*g))
-            .or(self.eoe_gateway);
+            .or(self.eoe_gateway)
+            .or(self.dhcp_gateway);
         if gw != self.route {
             let routes = self.iface.routes_mut();
             routes.remove_default_ipv4_route();
@@ -255,9 +322,11 @@ impl<'a> NetStack<'a> {
         if let Some(p) = queue.take_ip_change() {
             self.apply_ip(&p);
         }
-        self.follow_gateway(settings);
+        self.follow_dhcp(settings);
         let t = instant(now_us);
         self.iface.poll(t, &mut QueueDevice(queue), &mut self.sockets);
+        self.run_dhcp();
+        self.follow_gateway(settings);
         self.serve_parameters(dict, state);
         self.run_sntp(now_us, settings);
         self.iface.poll(t, &mut QueueDevice(queue), &mut self.sockets);
@@ -361,6 +430,7 @@ mod tests {
         ecat::eoe::EthernetPort::ip_changed(&mut q, &bad);
         // A175 and the SNTP servers multicast/broadcast too
         let s = NetSettings {
+            dhcp: false,
             gateway: [239, 1, 1, 1],
             sntp: SntpConfig {
                 active: true,
