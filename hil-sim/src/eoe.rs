@@ -458,8 +458,21 @@ impl HostNet {
         seq: u16,
         max_steps: usize,
     ) -> Option<u64> {
+        self.ping_with(sd, clock, to, seq, 56, max_steps).await
+    }
+
+    /// [`ping`](Self::ping) with a payload of `len` bytes (up to 1472 in one frame).
+    pub async fn ping_with<S>(
+        &mut self,
+        sd: &SubDeviceRef<'_, S>,
+        clock: &core::sync::atomic::AtomicU64,
+        to: [u8; 4],
+        seq: u16,
+        len: usize,
+        max_steps: usize,
+    ) -> Option<u64> {
         use core::sync::atomic::Ordering;
-        let payload: Vec<u8> = (0..56u8).map(|i| i ^ seq as u8).collect();
+        let payload: Vec<u8> = (0..len).map(|i| i as u8 ^ seq as u8).collect();
         let t0 = clock.load(Ordering::Relaxed);
         if !self.send_ping(to, seq, &payload) {
             return None;
