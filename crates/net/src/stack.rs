@@ -27,7 +27,7 @@ const PARAM_BYTES: usize = 2 * 512;
 /// SNTP buffers: one packet each way (plus slack for a longer answer).
 const SNTP_BYTES: usize = 2 * 68;
 
-/// The sockets' buffers (≈ 4.4 KiB).
+/// The sockets' buffers (under 3 KiB).
 pub struct NetBuffers {
     param_rx_meta: [udp::PacketMetadata; PARAM_DATAGRAMS],
     param_rx: [u8; PARAM_BYTES],
@@ -396,6 +396,11 @@ mod tests {
     #![allow(clippy::unwrap_used, clippy::indexing_slicing)]
     use super::*;
     use drive::dictionary::DriveObjects;
+
+    #[test]
+    fn buffers_stay_small() {
+        assert!(core::mem::size_of::<NetBuffers>() < 3 * 1024);
+    }
 
     #[test]
     fn e096_addresses_smoltcp_cannot_hold_are_ignored() {
