@@ -14,6 +14,8 @@ pub mod script;
 pub mod world;
 
 #[cfg(feature = "std")]
+pub mod eoe;
+#[cfg(feature = "std")]
 pub mod master;
 #[cfg(feature = "std")]
 pub mod pcap;

@@ -343,11 +343,20 @@ fn serve(args: &[String]) -> Result<(), String> {
         .map_err(|_| "--seconds S")?;
     let sock = hil_sim::raw::RawSocket::open(&iface).map_err(|e| format!("{iface}: {e}"))?;
     let mut sim = Simulation::new(slaves);
+    // every drive answers ping and the UDP parameter service on its EoE
+    // interface once the master set its IP address (docs/eoe.md)
+    for (i, d) in (1u8..).zip(sim.drives_mut()) {
+        d.bind_net([0x02, 0x00, 0x00, 0x00, 0x00, i], u64::from(i), 0);
+    }
     if let Some(p) = opt(args, "--pcap")? {
         sim.record_pcap(&PathBuf::from(&p))
             .map_err(|e| format!("{p}: {e}"))?;
     }
     println!("hil-sim serve: {slaves} simulated double-axis drive(s) on {iface} (--axes {axes}: a single-axis variant is not modelled yet)");
+    println!(
+        "EoE: ping and the UDP parameter service (port {}) answer at the IP address the master sets",
+        net::param::PARAM_PORT
+    );
     let start = Instant::now();
     let mut printed = Vec::new();
     let mut buf = [0u8; 1600];

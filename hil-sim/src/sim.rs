@@ -97,6 +97,8 @@ pub struct SimDrive {
     next_tick: Option<u64>,
     /// SM2 event pending after the last poll (a new one means a new RxPDO frame).
     sm2_event: bool,
+    /// The IP stack on the EoE interface, if bound ([`SimDrive::bind_net`]).
+    pub net: Option<Box<crate::eoe::DriveNet>>,
 }
 
 /// One control-cycle start under the PLL.
@@ -217,6 +219,7 @@ impl SimDrive {
             next_cycle_ns: CONTROL_CYCLE_NS,
             next_tick: None,
             sm2_event: false,
+            net: None,
         }
     }
 
@@ -410,6 +413,7 @@ impl SimDrive {
             self.state_log.push((now_ns, change));
         }
         self.sm2_event = self.esc.al_event_request() & ::esc::regs::al_event::sm(2) != 0;
+        self.poll_net(now_ns);
         self.follow_pll();
     }
 }

@@ -331,9 +331,10 @@ fn write_slot(od: &mut DriveObjects, slot: Option<Slot>, value: i64) {
 pub struct Drive<F: Flash, B: Flash = NoFlash> {
     /// The EtherCAT slave stack.
     pub slave: Slave,
-    /// The EoE interface (E-095): counts the Ethernet frames the master
-    /// tunnels to the drive until an IP stack is bound to it.
-    pub eoe: ecat::eoe::FrameCounter,
+    /// The EoE interface (E-095): the Ethernet frames the master tunnels
+    /// to the drive and those the IP stack (crate `net`) sends back, and the
+    /// IP parameters the master set (E-096). See [`Drive::with_eoe`].
+    pub eoe: ecat::eoe_queue::EoeQueue,
     /// The object dictionary (values in RAM).
     pub objects: DriveObjects,
     store: ParamStore<F>,
@@ -386,6 +387,19 @@ pub struct Drive<F: Flash, B: Flash = NoFlash> {
     mailbox_er: u8,
     /// The PLL follows the SM2 event (SM-Sync, E-110), not SYNC0.
     pll_from_sm: bool,
+}
+
+/// The dictionary's IP settings ([`Drive::ip_settings`]).
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
+pub struct IpSettings {
+    /// A166: IP address source (2 = DHCP + DS6).
+    pub address_source: u8,
+    /// A175: gateway (0.0.0.0 = none).
+    pub gateway: [u8; 4],
+    /// A199[0]: SNTP client on.
+    pub sntp_active: bool,
+    /// A199[1], A199[2]: SNTP servers (0.0.0.0 = none).
+    pub sntp_servers: [[u8; 4]; 2],
 }
 
 /// The ESC's link and error registers (A257[0..2], the link LEDs).
@@ -456,11 +470,7 @@ impl<F: Flash, B: Flash> Drive<F, B> {
     pub fn unstarted(flash: F, boot: Option<BootSlots<B>>) -> Self {
         Self {
             slave: Slave::new(&DEVICE),
-            eoe: ecat::eoe::FrameCounter {
-                frames: 0,
-                last_len: 0,
-                last_hash: 0,
-            },
+            eoe: ecat::eoe_queue::EoeQueue::new(),
             objects: DriveObjects::new(),
             store: ParamStore::new(flash),
             boot,
@@ -894,7 +904,9 @@ impl<F: Flash, B: Flash> Drive<F, B> {
     fn er_code(&self) -> u8 {
         let s = &self.slave;
         if !s.error() {
-            return 0;
+            // E-099: a refused EoE IP configuration (EMCY FFF0h sent) shows
+            // Er10 until an accepted one replaces it
+            return if s.eoe().address_error() { 10 } else { 0 };
         }
         let code = s.al_status_code();
         if s.sync_status().unsolicited {
@@ -1286,6 +1298,40 @@ impl<F: Flash, B: Flash> Drive<F, B> {
         use od::Dictionary as _;
         let mut live = Live { diag: &mut self.diag };
         self.objects.with_live(&mut live).read(index, sub, buf, state)
+    }
+
+    /// Runs `f` with the EoE queue and the object dictionary as the bus
+    /// sees it (live values included) in the present communication state:
+    /// the seam of the IP stack (crate `net`), which answers UDP parameter
+    /// requests through [`od::Dictionary::read`]/[`write`](od::Dictionary::write)
+    /// with exactly the SDO access rules and abort codes. Requests a write
+    /// raises (e.g. "save") run at the next [`poll`](Self::poll).
+    pub fn with_eoe<R>(
+        &mut self,
+        f: impl FnOnce(&mut ecat::eoe_queue::EoeQueue, &mut dyn od::Dictionary, od::CommState) -> R,
+    ) -> R {
+        let state = ecat::coe::comm_state(self.slave.state());
+        let mut live = Live { diag: &mut self.diag };
+        let mut dict = self.objects.with_live(&mut live);
+        f(&mut self.eoe, &mut dict, state)
+    }
+
+    /// The IP settings of the dictionary (A166, A175, A199) for the IP
+    /// stack. IPv4 addresses are DWORDs with the first octet in the most
+    /// significant byte (0A000001h = 10.0.0.1).
+    pub fn ip_settings(&self) -> IpSettings {
+        let get = |line: u16, sub: u8| {
+            self.objects
+                .get(crate::parameter_index(0, line), sub)
+                .unwrap_or(0)
+        };
+        let ip = |v: i64| (v as u32).to_be_bytes();
+        IpSettings {
+            address_source: get(166, 0) as u8,
+            gateway: ip(get(175, 0)),
+            sntp_active: get(199, 1) != 0,
+            sntp_servers: [ip(get(199, 2)), ip(get(199, 3))],
+        }
     }
 
     /// Writes the persistent values to the store (A00 / 1010h "save").

@@ -488,7 +488,7 @@ pub enum IpError {
     /// Subnet mask not contiguous, or without room for two hosts (/31, /32).
     BadMask,
     /// IP address is the first (network) or last (broadcast) address of its
-    /// subnet, or 0.0.0.0 / 255.255.255.255 (E-097).
+    /// subnet, 0.0.0.0 / 255.255.255.255, or multicast (E-097).
     HostAddress,
     /// Default gateway outside the subnet or not a host address.
     Gateway,
@@ -577,11 +577,14 @@ pub fn apply_set_ip(current: &IpParams, req: &IpParams) -> Result<IpParams, IpEr
         }
     }
     if let Some(ip) = next.ip {
-        let ok = match next.mask {
-            Some(mask) => is_host(ip, mask),
-            // no mask known: only the all-zero and all-ones addresses are refused
-            None => ip != [0; 4] && ip != [255; 4],
-        };
+        // a multicast (224/4) address cannot be an interface's address
+        let multicast = ip.first().is_some_and(|a| (224..=239).contains(a));
+        let ok = !multicast
+            && match next.mask {
+                Some(mask) => is_host(ip, mask),
+                // no mask known: only the all-zero and all-ones addresses are refused
+                None => ip != [0; 4] && ip != [255; 4],
+            };
         if !ok {
             return Err(IpError::HostAddress);
         }
@@ -1134,6 +1137,21 @@ mod tests {
         assert!(apply_set_ip(&cur, &r).is_ok());
         r.mac = Some([1, 0, 0, 0, 0, 1]);
         assert_eq!(apply_set_ip(&cur, &r), Err(IpError::Mac));
+        // a multicast address is no host address
+        assert_eq!(
+            apply_set_ip(&cur, &req([224, 0, 0, 5], MASK24)),
+            Err(IpError::HostAddress)
+        );
+        assert_eq!(
+            apply_set_ip(
+                &cur,
+                &IpParams {
+                    ip: Some([239, 1, 2, 3]),
+                    ..IpParams::default()
+                }
+            ),
+            Err(IpError::HostAddress)
+        );
         // a new mask alone that makes the kept IP the broadcast address
         let kept = apply_set_ip(&cur, &req([10, 0, 0, 127], MASK24)).unwrap();
         let m25 = IpParams {

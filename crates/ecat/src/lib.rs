@@ -33,6 +33,7 @@ pub mod desc;
 pub mod diag;
 pub mod emcy;
 pub mod eoe;
+pub mod eoe_queue;
 pub mod esm;
 pub mod foe;
 pub mod led;

@@ -1,0 +1,112 @@
+//! IP through EoE in simulated time: ping round-trip time and UDP
+//! parameter-read latency from a master-side host interface (smoltcp on
+//! `hil_sim::eoe::EoeTunnel`) through ethercrab in-process, the simulated
+//! ESC, the slave's EoE server and the drive's `net::NetStack`.
+//!
+//! `cargo bench -p hil-sim --bench eoe [-- --runs N]`
+//!
+//! The tunnel moves one mailbox message each way per round (SM1 status
+//! read, SM1 read, SM0 status read, SM0 write): the figures are those of a
+//! master that polls the mailbox back to back, with a 256-byte mailbox.
+#![allow(
+    clippy::unwrap_used,
+    clippy::expect_used,
+    clippy::indexing_slicing,
+    clippy::panic
+)]
+
+use hil_sim::eoe::{set_ip_request, HostNet};
+use hil_sim::sim::Simulation;
+use std::cell::RefCell;
+use std::sync::atomic::Ordering;
+
+const DRIVE_IP: [u8; 4] = [10, 0, 0, 20];
+const HOST_IP: [u8; 4] = [10, 0, 0, 1];
+
+fn stats(v: &mut [u64]) -> (f64, f64, f64) {
+    v.sort_unstable();
+    let mean = v.iter().sum::<u64>() as f64 / v.len() as f64;
+    (v[0] as f64 / 1e3, mean / 1e3, v[v.len() - 1] as f64 / 1e3)
+}
+
+fn main() {
+    let args: Vec<String> = std::env::args().collect();
+    let runs: usize = args
+        .iter()
+        .position(|a| a == "--runs")
+        .and_then(|i| args.get(i + 1))
+        .and_then(|s| s.parse().ok())
+        .unwrap_or(50);
+    let sim = RefCell::new(Simulation::new(1));
+    sim.borrow_mut().drives_mut()[0].bind_net([2, 0, 0, 0, 0, 0x14], 1, 0);
+    let config = ethercrab::MainDeviceConfig {
+        dc_static_sync_iterations: 100,
+        ..Default::default()
+    };
+    let wall = std::time::Instant::now();
+    let (mut ping, mut big, mut read, frames) = hil_sim::master::run_with(
+        &sim,
+        hil_sim::master::in_process_timeouts(),
+        config,
+        async |md, clock| {
+            let group = md
+                .init_single_group::<2, 64>(|| clock.load(Ordering::Relaxed))
+                .await
+                .expect("init");
+            let sd = group.subdevice(md, 0).expect("slave");
+            let mut host = HostNet::new(
+                [2, 0, 0, 0, 0, 1],
+                &[(HOST_IP, 24)],
+                clock.load(Ordering::Relaxed),
+            );
+            assert!(
+                host.tunnel
+                    .request(&sd, &set_ip_request(DRIVE_IP, [255, 255, 255, 0], HOST_IP))
+                    .await
+            );
+            while host.tunnel.responses.pop_front().is_none() {
+                host.step(&sd, clock).await;
+            }
+            // the first ping resolves the addresses (ARP both ways): not counted
+            host.ping(&sd, clock, DRIVE_IP, 0, 1000)
+                .await
+                .expect("first ping");
+            let f0 = sim.borrow().frames();
+            let mut ping = Vec::new();
+            let mut big = Vec::new();
+            let mut read = Vec::new();
+            for i in 1..=runs {
+                ping.push(
+                    host.ping(&sd, clock, DRIVE_IP, i as u16, 1000)
+                        .await
+                        .expect("ping"),
+                );
+                big.push(
+                    host.ping_with(&sd, clock, DRIVE_IP, 0x8000 | i as u16, 1472, 1000)
+                        .await
+                        .expect("ping 1472"),
+                );
+                let (answer, ns) = host
+                    .param_request(&sd, clock, DRIVE_IP, "R A150", 1000)
+                    .await
+                    .expect("answer");
+                assert_eq!(answer, "OK 1000");
+                read.push(ns);
+            }
+            (ping, big, read, sim.borrow().frames() - f0)
+        },
+    );
+    let wall = wall.elapsed();
+    let tunnel_frames = frames as f64 / runs as f64;
+    println!("IP over EoE, 1 drive, mailbox 256 bytes, {runs} runs (simulated time)");
+    let (lo, mean, hi) = stats(&mut ping);
+    println!("ping (56-byte payload) round trip: min {lo:.1} µs, mean {mean:.1} µs, max {hi:.1} µs");
+    let (lo, mean, hi) = stats(&mut big);
+    println!("ping (1472-byte payload, 7 fragments each way) round trip: min {lo:.1} µs, mean {mean:.1} µs, max {hi:.1} µs");
+    let (lo, mean, hi) = stats(&mut read);
+    println!("UDP parameter read (R A150) latency: min {lo:.1} µs, mean {mean:.1} µs, max {hi:.1} µs");
+    println!(
+        "{tunnel_frames:.1} EtherCAT frames per run (two pings + one read), {:.0} ms wall clock",
+        wall.as_secs_f64() * 1e3
+    );
+}
