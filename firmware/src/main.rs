@@ -9,7 +9,7 @@
 //! | `control` | CCU40_0 (control-cycle timer compare) | 3 | `node::tasks::control` |
 //! | `esc` | ECAT0_0 (ESC PDI interrupt: AL events, SM2/SM3, mailbox) | 2 | `node::tasks::esc_event` |
 //! | `mailbox` | CCU42_0 (a spare interrupt, pended by `esc`) | 1 | `node::tasks::mailbox` |
-//! | `idle` | — | 0 | background |
+//! | `idle` | — | 0 | `node::tasks::background` (a requested save) |
 //!
 //! The ESC is reached through `pdi::mmio::OnChip` over ECAT0's register
 //! window; the clock is the DWT cycle counter at the CPU clock.
@@ -149,11 +149,13 @@ mod app {
         Some(drive)
     }
 
-    /// Background: fires the control cycle when its time has come (until
-    /// the CCU4 compare does it in hardware).
-    #[idle(shared = [timer, clock])]
+    /// Background: a requested save (`tasks::background`), and firing the
+    /// control cycle when its time has come (until the CCU4 compare does it
+    /// in hardware).
+    #[idle(shared = [drive, timer, clock])]
     fn idle(mut cx: idle::Context) -> ! {
         loop {
+            cx.shared.drive.lock(|drive| tasks::background(drive));
             let now = cx.shared.clock.lock(|c| c.now_ns(DWT::cycle_count()));
             if cx.shared.timer.lock(|t| t.next_at_ns()) <= now {
                 rtic::pend(Interrupt::CCU40_0);

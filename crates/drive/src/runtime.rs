@@ -606,7 +606,8 @@ impl<F: Flash, B: Flash> Drive<F, B> {
 
     /// The mailbox part of [`poll`](Self::poll) for the low-priority task:
     /// one CoE/EoE/FoE request answered, queued EMCYs and EoE fragments
-    /// sent, then the dictionary's requests (A00/1010h save) served.
+    /// sent. A save it requests waits for
+    /// [`poll_background`](Self::poll_background).
     pub fn poll_mailbox<P: Pdi>(&mut self, pdi: &mut P, now_ns: u64) -> Result<(), P::Error> {
         self.update_live();
         let mut live = Live { diag: &mut self.diag };
@@ -618,8 +619,14 @@ impl<F: Flash, B: Flash> Drive<F, B> {
             &mut self.eoe,
             now_ns,
         )?;
-        self.serve_requests();
         Ok(())
+    }
+
+    /// The background part of [`poll`](Self::poll) for the idle loop: the
+    /// dictionary's requests (a save, A00/1010h, writes the parameter
+    /// store).
+    pub fn poll_background(&mut self) {
+        self.serve_requests();
     }
 
     /// The dictionary's requests: a save (A00, 1010h) writes the store.

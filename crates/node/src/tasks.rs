@@ -5,8 +5,8 @@
 //! | `sync0` | ESC SYNC0 output | 3 | [`sync0`]: acknowledge, PLL measurement |
 //! | `control` | control-cycle timer | 3 | [`control`]: one cycle of both axes |
 //! | `esc` | ESC PDI interrupt (AL event) | 2 | [`esc_event`]: ESM, process data, monitoring |
-//! | `mailbox` | spawned by `esc` | 1 | [`mailbox`]: one CoE/EoE/FoE request, EMCY, save |
-//! | `idle` | — | 0 | background (QEMU: the simulated world) |
+//! | `mailbox` | pended by `esc` | 1 | [`mailbox`]: one CoE/EoE/FoE request, EMCY |
+//! | `idle` | — | 0 | [`background`]: a requested save (QEMU: also the simulated world) |
 //!
 //! `sync0` and `control` share the priority so they never preempt each
 //! other (both touch the PLL); `esc` locks the drive for one poll without
@@ -58,9 +58,15 @@ pub fn esc_event<P: Pdi>(
     Ok(change)
 }
 
-/// The mailbox task at local time `now_ns` (spawned by the ESC task, runs
+/// The mailbox task at local time `now_ns` (pended by the ESC task, runs
 /// below it): one mailbox request from SM0 answered into SM1, queued EMCYs
-/// and EoE fragments sent, a requested save written.
+/// and EoE fragments sent.
 pub fn mailbox<P: Pdi>(drive: &mut Drive, pdi: &mut P, now_ns: u64) -> Result<(), P::Error> {
     drive.poll_mailbox(pdi, now_ns)
+}
+
+/// Background work from the idle loop: a save requested over the bus (A00,
+/// 1010h) is written to the parameter store.
+pub fn background(drive: &mut Drive) {
+    drive.poll_background();
 }

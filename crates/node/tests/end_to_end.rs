@@ -53,6 +53,7 @@ impl Board {
                     tasks::esc_event(&mut self.drive, &mut self.timer, &mut self.esc.pdi(), now).unwrap();
                     // the mailbox task runs after the ESC task returns (priority 1)
                     tasks::mailbox(&mut self.drive, &mut self.esc.pdi(), now).unwrap();
+                    tasks::background(&mut self.drive);
                     if p != Progress::Busy {
                         log.push(p);
                     }
@@ -139,4 +140,26 @@ fn save_fits_the_parameter_flash() {
     let drive = Drive::new(drive.into_flash());
     assert_eq!(drive.startup(), drive::runtime::Startup::Loaded);
     assert_eq!(drive.objects.get(0x6065, 0), Ok(1234));
+}
+
+/// E-018: a save requested over the bus (1010h:01 "save") is not written
+/// by the mailbox task but by the background task in idle, and is then in
+/// the parameter flash.
+#[test]
+fn e018_save_is_written_by_the_background_task() {
+    use od::Dictionary as _;
+    let mut b = Board::new();
+    b.drive.objects.set(0x6065, 0, 4321).unwrap();
+    let save = drive::SAVE_SIGNATURE.to_le_bytes();
+    b.drive
+        .objects
+        .write(0x1010, 1, &save, od::CommState::PreOp)
+        .unwrap();
+    tasks::mailbox(&mut b.drive, &mut b.esc.pdi(), 0).unwrap();
+    assert!(b.drive.objects.requests().save, "the mailbox task saved");
+    tasks::background(&mut b.drive);
+    assert!(!b.drive.objects.requests().save);
+    let drive = Drive::new(b.drive.into_flash());
+    assert_eq!(drive.startup(), drive::runtime::Startup::Loaded);
+    assert_eq!(drive.objects.get(0x6065, 0), Ok(4321));
 }
