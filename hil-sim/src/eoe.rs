@@ -75,6 +75,12 @@ impl DriveNet {
         let settings = net_settings(drive);
         let stack = &mut self.stack;
         drive.with_eoe(|q, dict, state| stack.poll(now_ns / 1000, q, dict, state, &settings));
+        // E-147: message time stamps fall back to the SNTP time
+        let sntp = stack.sntp_time_ns(now_ns / 1000);
+        drive.set_sntp_time(
+            sntp.map(|unix| net::sntp::message_time_stamp(None, Some(unix))),
+            now_ns,
+        );
     }
 }
 

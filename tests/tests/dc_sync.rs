@@ -1073,3 +1073,42 @@ fn e121_e122_e123_a287_failures_through_the_master() {
     });
     assert_eq!(result, 2, "E-121: DC not used");
 }
+
+/// E-147: with DC-Sync running and the PLL locked, a diagnosis message (a
+/// refused AL state change in Op) carries the DC system time (0x0910).
+#[test]
+fn e147_message_time_stamp_is_the_dc_system_time_when_synchronised() {
+    let sim = line();
+    let (stamp, system_time) = dc_op(
+        &sim,
+        SYNC0_NS,
+        async |_: &Sd<'_>| {},
+        150,
+        async |md, group| {
+            let sd = group.subdevice(md, 0).expect("drive");
+            assert!(sim.borrow().drives()[0]
+                .drive
+                .pll()
+                .is_some_and(|p| p.is_locked()));
+            // Op → Bootstrap is not a valid transition (0011h): a message
+            sd.register_write(esc::regs::AL_CONTROL, 3u16)
+                .await
+                .expect("AL control");
+            dc_cycles(md, group, &sim, 3, |_, _, _| {}).await;
+            let system_time: u64 = sd
+                .register_read(esc::regs::dc::SYSTEM_TIME)
+                .await
+                .expect("0x0910");
+            let s = sim.borrow();
+            let d = &s.drives()[0].drive;
+            let stamp = d.diag.message(d.diag.newest_subindex()).map(|(_, t)| t);
+            (stamp, system_time)
+        },
+    );
+    let stamp = stamp.expect("a message");
+    // written within the three cycles before the read
+    assert!(
+        stamp <= system_time && system_time - stamp < 4 * SYNC0_NS,
+        "{stamp} vs {system_time}"
+    );
+}

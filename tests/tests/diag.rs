@@ -459,3 +459,36 @@ fn e040_startup_list_writes_in_every_transition() {
         );
     });
 }
+
+/// E-147: a diagnosis message (a refused AL state change) carries time stamp
+/// 0 while neither DC nor SNTP gives the time, and the SNTP time (on the DC
+/// epoch) once the IP stack's client keeps one.
+#[test]
+fn e147_message_time_stamp_zero_then_sntp() {
+    let sim = line(1);
+    let newest = |sim: &RefCell<Simulation>| {
+        let s = sim.borrow();
+        let d = &s.drives()[0].drive;
+        d.diag.message(d.diag.newest_subindex()).map(|(_, t)| t)
+    };
+    with_master(&sim, async |md, clock| {
+        let group = init(md, clock).await;
+        let sd = group.subdevice(md, 0).unwrap();
+        request(&sd, OP).await;
+        assert_eq!(al_status(&sd).await, (PREOP | ERR, 0x0011));
+        assert_eq!(newest(&sim), Some(0), "no DC, no SNTP: 0");
+        request(&sd, PREOP | ACK).await;
+        // an SNTP client's time: 2026-11-22 on the DC epoch (2000-01-01)
+        let sntp = 847_584_000_000_000_000u64;
+        let local = sim.borrow().now_ns();
+        sim.borrow_mut().drives_mut()[0]
+            .drive
+            .set_sntp_time(Some(sntp), local);
+        advance(&sim, 5_000_000);
+        request(&sd, OP).await;
+        assert_eq!(al_status(&sd).await, (PREOP | ERR, 0x0011));
+        let t = newest(&sim).unwrap();
+        let elapsed = sim.borrow().now_ns() - local;
+        assert!(t > sntp && t <= sntp + elapsed, "{t} vs {sntp} + {elapsed}");
+    });
+}

@@ -380,6 +380,9 @@ pub struct Drive<F: Flash, B: Flash = NoFlash> {
     projected_fieldbus: u16,
     /// Event 52 cause 15 was raised for the present mismatch.
     wrong_firmware: bool,
+    /// SNTP time minus local time, ns (DC epoch), while an SNTP client
+    /// keeps the time ([`Drive::set_sntp_time`]).
+    sntp_offset_ns: Option<i64>,
     /// The ESC's port and error registers as the last poll read them.
     ports: PortDiag,
     /// A257 Er9 (SM1, mailbox Tx) or Er10 (SM0, mailbox Rx) for the last
@@ -493,6 +496,7 @@ impl<F: Flash, B: Flash> Drive<F, B> {
             event52_emcy_sent: [false; 2],
             projected_fieldbus: FIELDBUS_ID,
             wrong_firmware: false,
+            sntp_offset_ns: None,
             ports: PortDiag::default(),
             mailbox_er: 0,
             pll_from_sm: false,
@@ -622,6 +626,30 @@ impl<F: Flash, B: Flash> Drive<F, B> {
         Ok(())
     }
 
+    /// The SNTP time now, ns since 2000-01-01 (the DC epoch), from the IP
+    /// stack's SNTP client (`None`: no time); `local_now_ns` is the local
+    /// time it belongs to. Message time stamps use it when DC is not
+    /// synchronised (E-147).
+    pub fn set_sntp_time(&mut self, sntp_ns: Option<u64>, local_now_ns: u64) {
+        self.sntp_offset_ns = sntp_ns.map(|t| (t as i64).wrapping_sub(local_now_ns as i64));
+    }
+
+    /// The time stamp of a diagnosis message at local `now_ns` (E-147,
+    /// spec §17): the DC system time (0x0910) when the drive runs DC-Sync
+    /// with the PLL locked, else the SNTP time, else 0.
+    fn message_time_stamp<P: Pdi>(&self, pdi: &mut P, now_ns: u64) -> Result<u64, P::Error> {
+        let dc_synced = self.slave.sync_status().mode == SyncMode::DcSync0
+            && self.pll.as_ref().is_some_and(|p| p.is_locked());
+        if dc_synced {
+            let mut t = [0u8; 8];
+            pdi.read(regs::dc::SYSTEM_TIME, &mut t)?;
+            return Ok(u64::from_le_bytes(t));
+        }
+        Ok(self
+            .sntp_offset_ns
+            .map_or(0, |o| (now_ns as i64).wrapping_add(o) as u64))
+    }
+
     /// The background part of [`poll`](Self::poll) for the idle loop: the
     /// dictionary's requests (a save, A00/1010h, writes the parameter
     /// store).
@@ -687,7 +715,8 @@ impl<F: Flash, B: Flash> Drive<F, B> {
         if let Some(c) = change.filter(|c| c.code != AlStatusCode::NO_ERROR) {
             // a refused state change is an error message in the history (E-144)
             let msg = DiagMessage::new(DIAG_AL_STATUS | u32::from(c.code.0), DiagType::Error, c.code.0);
-            self.diag.push(msg, now_ns);
+            let stamp = self.message_time_stamp(pdi, now_ns)?;
+            self.diag.push(msg, stamp);
         }
         if change.is_some() {
             // A254/A256 as the ESC has them after the master's configuration
