@@ -57,7 +57,7 @@
 //! counters (read every poll), A257[3] from the AL status code, and the
 //! four LEDs as patterns of `ecat::led` ([`Drive::leds`]).
 
-use crate::axis::{Axis, AxisCommand, AxisIo};
+use crate::axis::{Axis, AxisCache, AxisCommand, AxisIo};
 use crate::dictionary::{DriveObjects, LiveValues, Slot, PERSISTENT_IMAGE_BYTES};
 use crate::objects::LAYOUT_HASH;
 use crate::pdo_image::{PdoImage, PdoImageError};
@@ -354,6 +354,8 @@ pub struct Drive<F: Flash, B: Flash = NoFlash> {
     last_rx_frames: u32,
     /// The two axes (A, B), stepped by [`Drive::control_cycle`].
     pub axes: [Axis; 2],
+    /// Each axis' snapshot and slots, read in place by the control cycle.
+    axis_caches: [AxisCache; 2],
     /// `Slave::outputs_received` at the previous control cycle (new
     /// cyclic set-points).
     ctl_rx_frames: u32,
@@ -485,6 +487,7 @@ impl<F: Flash, B: Flash> Drive<F, B> {
             last_state: AlState::Init,
             last_rx_frames: 0,
             axes: [Axis::new(0), Axis::new(1)],
+            axis_caches: [AxisCache::new(), AxisCache::new()],
             ctl_rx_frames: 0,
             pll: None,
             slots: RuntimeSlots::NONE,
@@ -823,10 +826,11 @@ impl<F: Flash, B: Flash> Drive<F, B> {
     ) -> [AxisCommand; 2] {
         let mut commands = [AxisCommand::OFF; 2];
         let mut register = 0u8;
-        let axes = self.axes.iter_mut().zip(io).zip(new_setpoint);
+        let axes = self.axes.iter_mut().zip(self.axis_caches.iter_mut());
+        let axes = axes.zip(io).zip(new_setpoint);
         let sent = self.event52_emcy_sent.iter_mut();
-        for ((((axis, io), new), command), sent) in axes.zip(commands.iter_mut()).zip(sent) {
-            let report = axis.cycle(&mut self.objects, io, now_ns, new);
+        for (((((axis, cache), io), new), command), sent) in axes.zip(commands.iter_mut()).zip(sent) {
+            let report = axis.cycle_cached(cache, &mut self.objects, io, now_ns, new);
             let mut emcy = report.emcy;
             if report.transition.is_some_and(|t| t.number == 13) {
                 // the event 52 EMCY is already queued (once for the device)

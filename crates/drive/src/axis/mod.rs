@@ -411,12 +411,9 @@ pub struct Axis {
     offset: i32,
     /// Last encoder reading (motor coordinates) for the velocity filter.
     last_raw: Option<i32>,
-    /// The last snapshot and the dictionary's configuration generation it
-    /// was read at: while the generation stands, only the cyclic set-points
-    /// are read again (docs/architecture.md, cycle cost).
-    snapshot: Option<(u32, Snapshot)>,
-    /// The entries read and written every cycle, resolved at the first.
-    slots: Option<CyclicSlots>,
+    /// The cache of [`Axis::cycle`]; the drive keeps its own next to the
+    /// axes and calls [`Axis::cycle_cached`], which reads it in place.
+    cache: AxisCache,
     /// What [`Self::configure`] last ran for: the configuration generation,
     /// the cycle and the mode class (homing, jog, other); it runs again
     /// only when one of them (or the parameters) changed.
@@ -513,8 +510,7 @@ impl Axis {
             homing: Homing::new(0),
             offset: 0,
             last_raw: None,
-            snapshot: None,
-            slots: None,
+            cache: AxisCache::new(),
             velocity: 0.0,
             last_sample: None,
             sp_pos: 0,
@@ -633,29 +629,45 @@ impl Axis {
         now_ns: u64,
         new_setpoint: bool,
     ) -> AxisReport {
+        let mut cache = core::mem::take(&mut self.cache);
+        let report = self.cycle_cached(&mut cache, od, io, now_ns, new_setpoint);
+        self.cache = cache;
+        report
+    }
+
+    /// [`cycle`](Self::cycle) with the snapshot and slots in `cache`, kept
+    /// by the caller (one cache per axis, never shared): read in place, no
+    /// copy per cycle.
+    pub fn cycle_cached(
+        &mut self,
+        cache: &mut AxisCache,
+        od: &mut DriveObjects,
+        io: &AxisIo,
+        now_ns: u64,
+        new_setpoint: bool,
+    ) -> AxisReport {
         let generation = od.config_generation();
-        let slots = *self
+        let window = self.window;
+        let slots: &CyclicSlots = cache
             .slots
-            .get_or_insert_with(|| CyclicSlots::resolve(od, self.window));
-        let raw = match &mut self.snapshot {
+            .get_or_insert_with(|| CyclicSlots::resolve(od, window));
+        let raw: &Snapshot = match &mut cache.snapshot {
             Some((g, cached)) if *g == generation => {
-                cached.refresh_setpoints(od, &slots);
-                *cached
+                cached.refresh_setpoints(od, slots);
+                cached
             }
-            _ => {
-                let fresh = Snapshot::read(od, self.window);
+            stale => {
+                let fresh = Snapshot::read(od, window);
                 // C-109: user units at the objects, increments inside
                 self.scaling = fresh.scaling();
                 self.velocity_decimals = fresh.decimal_factors().0 as f32;
-                self.snapshot = Some((generation, fresh));
-                fresh
+                &stale.insert((generation, fresh)).1
             }
         };
-        // one copy of the snapshot per cycle: converted only when user
-        // units are not increments
+        // converted (a copy) only when user units are not increments
         let converted;
         let o = if raw.in_increments(&self.scaling) {
-            &raw
+            raw
         } else {
             converted = raw.to_increments(&self.scaling);
             &converted
@@ -673,7 +685,7 @@ impl Axis {
             _ => 0,
         };
         if self.configured != Some((generation, dt_ns, class)) {
-            self.configure(od, &slots, o, dt_ns);
+            self.configure(od, slots, o, dt_ns);
             self.configured = Some((generation, dt_ns, class));
         }
         let io = &sourced(io, o);
@@ -744,10 +756,10 @@ impl Axis {
         let (torque, bits, fe) = self.control(demand, actual, now_ns, dt_ns);
 
         self.prev_cw = o.controlword;
-        self.write_back(od, &slots, &out, (bits, actual, torque, fe));
-        self.user_statusword(od, &slots, o);
-        self.switch_on_disabled_causes(od, &slots, &out, io, o.controlword);
-        self.digital_inputs(od, &slots, io);
+        self.write_back(od, slots, &out, (bits, actual, torque, fe));
+        self.user_statusword(od, slots, o);
+        self.switch_on_disabled_causes(od, slots, &out, io, o.controlword);
+        self.digital_inputs(od, slots, io);
 
         let sign = if o.polarity & 0x80 != 0 { -1.0 } else { 1.0 };
         AxisReport {
@@ -1861,6 +1873,27 @@ impl Axis {
         let bits =
             u32::from(io.limit_negative) | u32::from(io.limit_positive) << 1 | u32::from(io.reference) << 2;
         write(od, c.digital_inputs, i64::from(bits));
+    }
+}
+
+/// What an axis keeps between control cycles about the dictionary: the
+/// snapshot of its objects with the configuration generation it was read
+/// at (while the generation stands only the cyclic set-points are read
+/// again) and the resolved slots of its cyclic entries
+/// (docs/architecture.md, cycle cost).
+#[derive(Debug, Clone, Default)]
+pub struct AxisCache {
+    snapshot: Option<(u32, Snapshot)>,
+    slots: Option<CyclicSlots>,
+}
+
+impl AxisCache {
+    /// Empty: the first cycle reads everything.
+    pub const fn new() -> Self {
+        Self {
+            snapshot: None,
+            slots: None,
+        }
     }
 }
 
