@@ -735,6 +735,38 @@ impl DriveObjects {
         }
     }
 
+    /// The value of an INTEGER32 slot; `None` for a slot of another type.
+    #[inline(always)]
+    pub fn load_slot_i32(&self, slot: Slot) -> Option<i32> {
+        (slot.kind == SlotType::I32)
+            .then(|| bytes_at(&self.image, usize::from(slot.at)).map(i32::from_le_bytes))
+            .flatten()
+    }
+
+    /// The value of an INTEGER16 slot; `None` for a slot of another type.
+    #[inline(always)]
+    pub fn load_slot_i16(&self, slot: Slot) -> Option<i16> {
+        (slot.kind == SlotType::I16)
+            .then(|| bytes_at(&self.image, usize::from(slot.at)).map(i16::from_le_bytes))
+            .flatten()
+    }
+
+    /// The value of an UNSIGNED16 slot; `None` for a slot of another type.
+    #[inline(always)]
+    pub fn load_slot_u16(&self, slot: Slot) -> Option<u16> {
+        (slot.kind == SlotType::U16)
+            .then(|| bytes_at(&self.image, usize::from(slot.at)).map(u16::from_le_bytes))
+            .flatten()
+    }
+
+    /// The value of an INTEGER8 slot; `None` for a slot of another type.
+    #[inline(always)]
+    pub fn load_slot_i8(&self, slot: Slot) -> Option<i8> {
+        (slot.kind == SlotType::I8)
+            .then(|| bytes_at(&self.image, usize::from(slot.at)).map(i8::from_le_bytes))
+            .flatten()
+    }
+
     /// Stores a 16-bit value: straight into a 16-bit slot of the same
     /// signedness that is not a configuration entry (the actual values),
     /// else through [`store_slot`](Self::store_slot).

@@ -373,11 +373,25 @@ impl Snapshot {
     /// `CYCLIC_SETPOINTS` in the dictionary, whose writes do not move its
     /// configuration generation); the rest of the snapshot is kept.
     pub fn refresh_setpoints(&mut self, od: &DriveObjects, c: &CyclicSlots) {
-        let i32_ = |s: Option<Slot>, d: i64| sat(read(od, s, d), i32::MIN, i32::MAX);
-        let u16_ = |s: Option<Slot>, d: i64| sat(read(od, s, d), 0u16, u16::MAX);
-        let i16_ = |s: Option<Slot>, d: i64| sat(read(od, s, d), i16::MIN, i16::MAX);
+        // typed loads (one type compare) with the generic, saturating read
+        // as the fallback for an entry declared with another type
+        let i32_ = |s: Option<Slot>, d: i64| match s.and_then(|s| od.load_slot_i32(s)) {
+            Some(v) => v,
+            None => sat(read(od, s, d), i32::MIN, i32::MAX),
+        };
+        let u16_ = |s: Option<Slot>, d: i64| match s.and_then(|s| od.load_slot_u16(s)) {
+            Some(v) => v,
+            None => sat(read(od, s, d), 0u16, u16::MAX),
+        };
+        let i16_ = |s: Option<Slot>, d: i64| match s.and_then(|s| od.load_slot_i16(s)) {
+            Some(v) => v,
+            None => sat(read(od, s, d), i16::MIN, i16::MAX),
+        };
         self.controlword = u16_(c.controlword, 0);
-        self.mode = sat(read(od, c.mode, 8), i8::MIN, i8::MAX);
+        self.mode = match c.mode.and_then(|s| od.load_slot_i8(s)) {
+            Some(v) => v,
+            None => sat(read(od, c.mode, 8), i8::MIN, i8::MAX),
+        };
         self.target_position = i32_(c.target_position, 0);
         self.target_position_user = self.target_position;
         self.ip_setpoint = i32_(c.ip_setpoint, 0);

@@ -857,8 +857,9 @@ fn cyclic_slots_resolve_every_entry_on_both_axes() {
     }
 }
 
-/// The actual values written with a typed store have that type in the
-/// dictionary (else every store takes the generic path).
+/// The actual values written with a typed store and the set-points read
+/// with a typed load have that type in the dictionary (else every access
+/// takes the generic path).
 #[test]
 fn typed_actual_value_slots_have_their_types() {
     use crate::axis::snapshot::{CyclicSlots, Window};
@@ -875,6 +876,18 @@ fn typed_actual_value_slots_have_their_types() {
             (c.probe_status, U16),
             (c.e80, U8),
             (c.e48, U8),
+            // the set-points read with a typed load
+            (c.controlword, U16),
+            (c.mode, I8),
+            (c.target_position, I32),
+            (c.ip_setpoint, I32),
+            (c.target_velocity, I32),
+            (c.target_torque, I16),
+            (c.velocity_offset, I32),
+            (c.torque_offset, I16),
+            (c.probe_function, U16),
+            (c.vl_target, I16),
+            (c.i210, U16),
         ];
         for (k, (slot, t)) in typed.into_iter().enumerate() {
             assert_eq!(slot.map(|s| s.data_type()), Some(t), "axis {axis} entry {k}");
