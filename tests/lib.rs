@@ -1003,37 +1003,8 @@ impl<'a> RawCyclic<'a> {
 // an FoE client over `RawMailbox` (ethercrab 0.7.1 has no FoE)
 // ---------------------------------------------------------------------------
 
-/// The firmware flash of [`FwNode`]: 2 × 66 sectors of 4 KiB (a slot takes a
-/// 256 KiB image), NOR in RAM, on the heap.
-pub struct FwFlash(pub Box<drive::boot::RamFlash<4096, 132>>);
-
-impl FwFlash {
-    /// An erased flash.
-    pub fn new() -> Self {
-        Self(Box::new(drive::boot::RamFlash::new()))
-    }
-}
-
-impl Default for FwFlash {
-    fn default() -> Self {
-        Self::new()
-    }
-}
-
-impl drive::boot::Flash for FwFlash {
-    const SECTOR: usize = 4096;
-    const SECTORS: usize = 132;
-    const WRITE: usize = 8;
-    fn read(&mut self, addr: u32, buf: &mut [u8]) -> Result<(), drive::boot::FlashError> {
-        drive::boot::Flash::read(&mut *self.0, addr, buf)
-    }
-    fn erase(&mut self, sector: u32) -> Result<(), drive::boot::FlashError> {
-        drive::boot::Flash::erase(&mut *self.0, sector)
-    }
-    fn write(&mut self, addr: u32, data: &[u8]) -> Result<(), drive::boot::FlashError> {
-        drive::boot::Flash::write(&mut *self.0, addr, data)
-    }
-}
+/// The firmware flash of [`FwNode`] (hil-sim's).
+pub use hil_sim::sim::FirmwareFlash as FwFlash;
 
 /// The firmware slots of a [`FwNode`].
 pub type FwSlots = drive::boot::BootSlots<FwFlash>;

@@ -15,11 +15,11 @@
     clippy::panic
 )]
 
-use drive::boot::{BootSlots, Flash, FlashError, ImageHeader, RamFlash, IMAGE_HEADER_LEN};
+use drive::boot::{BootSlots, ImageHeader, IMAGE_HEADER_LEN};
 use drive::runtime::Drive;
 use ethercrab::SubDeviceRef;
 use hil_sim::esc::{Esc, EscConfig};
-use hil_sim::sim::{Node, SimFlash, Simulation};
+use hil_sim::sim::{FirmwareFlash, Node, SimFlash, Simulation};
 use std::cell::RefCell;
 use std::sync::atomic::Ordering;
 use std::time::Instant;
@@ -29,26 +29,9 @@ const MAILBOX_LEN: usize = 256;
 const SEGMENT: usize = MAILBOX_LEN - 12;
 
 /// 2 × 66 sectors of 4 KiB, on the heap.
-struct FwFlash(Box<RamFlash<4096, 132>>);
-
-impl Flash for FwFlash {
-    const SECTOR: usize = 4096;
-    const SECTORS: usize = 132;
-    const WRITE: usize = 8;
-    fn read(&mut self, addr: u32, buf: &mut [u8]) -> Result<(), FlashError> {
-        self.0.read(addr, buf)
-    }
-    fn erase(&mut self, sector: u32) -> Result<(), FlashError> {
-        self.0.erase(sector)
-    }
-    fn write(&mut self, addr: u32, data: &[u8]) -> Result<(), FlashError> {
-        self.0.write(addr, data)
-    }
-}
-
 struct FwNode {
     esc: Esc,
-    drive: Drive<SimFlash, FwFlash>,
+    drive: Drive<SimFlash, FirmwareFlash>,
 }
 
 impl Node for FwNode {
@@ -113,7 +96,7 @@ fn main() {
         .unwrap_or(3);
     let mut sii = [0u8; ecat::sii::EEPROM_BYTES];
     let n = ecat::build_sii(&drive::DEVICE, &mut sii).expect("SII");
-    let mut slots = BootSlots::new(FwFlash(Box::new(RamFlash::new())));
+    let mut slots = BootSlots::new(FirmwareFlash::new());
     slots.boot().expect("boot");
     let node = FwNode {
         esc: Esc::new(EscConfig::default(), &sii[..n]),

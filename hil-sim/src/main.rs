@@ -7,7 +7,7 @@
 //!   the simulated line answers EtherCAT frames on a raw Ethernet interface.
 
 use hil_sim::motor::PositionInput;
-use hil_sim::sim::Simulation;
+use hil_sim::sim::{SimDrive, Simulation};
 use std::cell::RefCell;
 use std::path::PathBuf;
 use std::process::ExitCode;
@@ -342,7 +342,8 @@ fn serve(args: &[String]) -> Result<(), String> {
         .transpose()
         .map_err(|_| "--seconds S")?;
     let sock = hil_sim::raw::RawSocket::open(&iface).map_err(|e| format!("{iface}: {e}"))?;
-    let mut sim = Simulation::new(slaves);
+    // drives with firmware slots: an FoE download in Bootstrap is accepted
+    let mut sim = Simulation::with_nodes((0..slaves).map(|_| SimDrive::with_firmware_slots()).collect());
     // every drive answers ping and the UDP parameter service on its EoE
     // interface once the master set its IP address (docs/eoe.md)
     for (i, d) in (1u8..).zip(sim.drives_mut()) {

@@ -26,6 +26,41 @@ const FRAME_OVERHEAD: u64 = 8 + 4 + 12;
 /// The simulated non-volatile memory of a drive: two 4 KiB sectors (one per slot).
 pub type SimFlash = store::RamFlash<4096, 2>;
 
+/// The simulated firmware flash: 2 × 66 sectors of 4 KiB (a slot takes a
+/// 256 KiB image), NOR in RAM, on the heap.
+pub struct FirmwareFlash(pub Box<drive::boot::RamFlash<4096, 132>>);
+
+impl FirmwareFlash {
+    /// An erased flash.
+    pub fn new() -> Self {
+        Self(Box::new(drive::boot::RamFlash::new()))
+    }
+}
+
+impl Default for FirmwareFlash {
+    fn default() -> Self {
+        Self::new()
+    }
+}
+
+impl drive::boot::Flash for FirmwareFlash {
+    const SECTOR: usize = 4096;
+    const SECTORS: usize = 132;
+    const WRITE: usize = 8;
+    fn read(&mut self, addr: u32, buf: &mut [u8]) -> Result<(), drive::boot::FlashError> {
+        drive::boot::Flash::read(&mut *self.0, addr, buf)
+    }
+    fn erase(&mut self, sector: u32) -> Result<(), drive::boot::FlashError> {
+        drive::boot::Flash::erase(&mut *self.0, sector)
+    }
+    fn write(&mut self, addr: u32, data: &[u8]) -> Result<(), drive::boot::FlashError> {
+        drive::boot::Flash::write(&mut *self.0, addr, data)
+    }
+}
+
+/// The firmware slots of a simulated drive.
+pub type FirmwareSlots = drive::boot::BootSlots<FirmwareFlash>;
+
 /// Control cycle of the simulated drive (A150 default), ns.
 pub const CONTROL_CYCLE_NS: u64 = 1_000_000;
 /// Control-cycle starts kept in [`SimDrive::cycle_log`].
@@ -78,7 +113,7 @@ pub struct SimDrive {
     /// The simulated ESC (what the master sees).
     pub esc: Esc,
     /// The drive firmware's communication runtime.
-    pub drive: drive::runtime::Drive<SimFlash>,
+    pub drive: drive::runtime::Drive<SimFlash, FirmwareFlash>,
     /// State changes with their simulated time, oldest first.
     pub state_log: Vec<(u64, ecat::StateChange)>,
     /// Motor and load of axis A and B.
@@ -202,13 +237,32 @@ impl SimDrive {
         Self::power_on(SimFlash::new())
     }
 
+    /// A drive with firmware slots (FoE firmware download in Bootstrap into
+    /// the inactive slot, `hil-sim serve`): both slots empty, so the first
+    /// download becomes the image the next power-on starts on trial.
+    pub fn with_firmware_slots() -> Self {
+        Self::power_on_with(SimFlash::new(), Some(FirmwareFlash::new()))
+    }
+
     /// A drive powered on with the given non-volatile memory.
     pub fn power_on(flash: SimFlash) -> Self {
+        Self::power_on_with(flash, None)
+    }
+
+    /// A drive powered on with the given parameter flash and, if any,
+    /// firmware flash (the boot decision runs first).
+    pub fn power_on_with(flash: SimFlash, firmware: Option<FirmwareFlash>) -> Self {
         let (sii, len) = sii_image();
         let esc = Esc::new(EscConfig::default(), sii.get(..len).unwrap_or(&[]));
+        let boot = firmware.map(|f| {
+            let mut slots = FirmwareSlots::new(f);
+            // a flash in RAM does not fail; nothing to start is "no image"
+            let _ = slots.boot();
+            slots
+        });
         Self {
             esc,
-            drive: drive::runtime::Drive::new(flash),
+            drive: drive::runtime::Drive::with_boot(flash, boot),
             state_log: Vec::new(),
             motors: [Motor::default_servo(), Motor::default_servo()],
             conditions: [AxisConditions::READY; 2],
@@ -231,7 +285,8 @@ impl SimDrive {
     pub fn power_cycle(&mut self) {
         let old = std::mem::replace(self, Self::power_on(SimFlash::new()));
         let (drift, offset) = (old.esc.config().clock_drift_ppb, old.esc.config().clock_offset_ns);
-        *self = Self::power_on(old.drive.into_flash());
+        let (flash, firmware) = old.drive.into_flashes();
+        *self = Self::power_on_with(flash, firmware);
         self.esc.set_clock(drift, offset);
     }
 

@@ -282,3 +282,35 @@ fn foe_wrong_packet_number_gets_8005_and_ends_the_transfer() {
         SlotState::Pending { seq: 2 }
     );
 }
+
+/// `hil-sim serve`'s drives ([`hil_sim::sim::SimDrive::with_firmware_slots`])
+/// take an FoE download in Bootstrap into a slot (pending), and the next
+/// power-on starts it on trial.
+#[test]
+fn foe_into_a_simulated_drive_with_firmware_slots() {
+    let sim = RefCell::new(Simulation::with_nodes(vec![
+        hil_sim::sim::SimDrive::with_firmware_slots(),
+    ]));
+    let file = firmware_file(3, 30_000);
+    with_master_on(&sim, async |md, clock| {
+        let group = init(md, clock).await;
+        let sd = group.subdevice(md, 0).unwrap();
+        to_boot(&sd).await;
+        FoeClient::new()
+            .write_file(&sd, "firmware.efw", &file)
+            .await
+            .expect("download accepted");
+        request(&sd, INIT).await;
+    });
+    let mut s = sim.borrow_mut();
+    let d = &mut s.drives_mut()[0];
+    let slots = d.drive.boot_slots_mut().expect("slots");
+    let pending = [Slot::A, Slot::B]
+        .into_iter()
+        .find(|&sl| matches!(slots.state(sl), Ok(SlotState::Pending { .. })));
+    let pending = pending.expect("the download is pending in a slot");
+    assert_eq!(slots.header(pending).unwrap().map(|h| h.version), Some(3));
+    d.power_cycle();
+    let slots = d.drive.boot_slots_mut().expect("slots after power-on");
+    assert_eq!(slots.active(), Some(pending), "the new image starts");
+}
