@@ -688,7 +688,15 @@ impl Axis {
             self.configure(od, slots, o, dt_ns);
             self.configured = Some((generation, dt_ns, class));
         }
-        let io = &sourced(io, o);
+        // the switches from the inputs (I101/I102 ≠ 2, I103 = 1): the
+        // hardware inputs as they are, without a copy
+        let io_sourced;
+        let io = if matches!(o.switch_source, [p, n, 1] if p != 2 && n != 2) {
+            io
+        } else {
+            io_sourced = sourced(io, o);
+            &io_sourced
+        };
 
         let mut actual = self.feedback(io, o.polarity, dt_ns, now_ns);
         let i199 = is_standstill(self.velocity, self.params.velocity_window_inc_per_s);
@@ -1757,7 +1765,7 @@ impl Axis {
         write_typed(od, c.e80, Actual::U8(e80));
         write_typed(od, c.mode_display, Actual::I8(out.mode_display));
         let position = self.user_position(actual);
-        write(od, c.position, position);
+        write_typed(od, c.position, Actual::I32(sat_i32(position)));
         let v = self.scaling.velocity_to_user(self.velocity) * self.velocity_decimals;
         write_typed(od, c.velocity, Actual::I32(round_i32(v)));
         let rated = self.params.rated_torque_nm;
@@ -1766,23 +1774,32 @@ impl Axis {
         write_typed(od, c.torque, Actual::I16(t));
         write_typed(od, c.current, Actual::I16(t));
         write(od, c.rated_current, i64::from(round_i32(rated * 1000.0).max(0)));
-        write(od, c.following_error, self.user(fe));
+        write_typed(od, c.following_error, Actual::I32(sat_i32(self.user(fe))));
         write_typed(od, c.probe_status, Actual::U16(self.probe.status()));
-        write(od, c.probe_values[0], self.user_position(self.probe.value_60ba()));
-        write(od, c.probe_values[1], self.user_position(self.probe.value_60bb()));
-        write(od, c.probe_values[2], self.user_position(self.probe.value_60bc()));
-        write(od, c.probe_values[3], self.user_position(self.probe.value_60bd()));
-        write(od, c.additional_position, position);
-        write(
+        write_typed(
             od,
-            c.vl_demand,
-            i64::from(round_i32(self.vl_demand / RPM_TO_INC_PER_S)).clamp(-32768, 32767),
+            c.probe_values[0],
+            Actual::I32(sat_i32(self.user_position(self.probe.value_60ba()))),
         );
-        write(
+        write_typed(
             od,
-            c.vl_actual,
-            i64::from(round_i32(self.velocity / RPM_TO_INC_PER_S)).clamp(-32768, 32767),
+            c.probe_values[1],
+            Actual::I32(sat_i32(self.user_position(self.probe.value_60bb()))),
         );
+        write_typed(
+            od,
+            c.probe_values[2],
+            Actual::I32(sat_i32(self.user_position(self.probe.value_60bc()))),
+        );
+        write_typed(
+            od,
+            c.probe_values[3],
+            Actual::I32(sat_i32(self.user_position(self.probe.value_60bd()))),
+        );
+        write_typed(od, c.additional_position, Actual::I32(sat_i32(position)));
+        let rpm = |v: f32| round_i32(v / RPM_TO_INC_PER_S).clamp(-32768, 32767) as i16;
+        write_typed(od, c.vl_demand, Actual::I16(rpm(self.vl_demand)));
+        write_typed(od, c.vl_actual, Actual::I16(rpm(self.velocity)));
         write_typed(od, c.e48, Actual::U8(e48(out.state)));
     }
 
@@ -1980,6 +1997,12 @@ fn ramp_rate((rpm, s): (u32, u16)) -> f32 {
 }
 
 /// Round half away from zero, saturating (NaN → 0).
+/// `v` saturated to `i32` (positions as the objects hold them: in range
+/// by construction, saturated rather than dropped otherwise).
+fn sat_i32(v: i64) -> i32 {
+    i32::try_from(v).unwrap_or(if v < 0 { i32::MIN } else { i32::MAX })
+}
+
 fn round_i32(x: f32) -> i32 {
     (if x >= 0.0 { x + 0.5 } else { x - 0.5 }) as i32
 }
