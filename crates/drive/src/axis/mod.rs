@@ -1873,7 +1873,8 @@ impl Axis {
     /// 0 or an unreadable entry: the bit is 0).
     fn user_statusword(&self, od: &mut DriveObjects, c: &CyclicSlots, o: &Snapshot) {
         let mut a67 = 0u16;
-        for (k, &src) in o.a66.iter().enumerate() {
+        let sources: &[u32] = if o.a66_used { o.a66.as_slice() } else { &[] };
+        for (k, &src) in sources.iter().enumerate() {
             let index = (src >> 16) as u16;
             let sub = (src >> 8) as u8;
             let bit = src & 0xFF;
@@ -1881,7 +1882,7 @@ impl Axis {
                 a67 |= 1 << k;
             }
         }
-        write(od, c.a67, i64::from(a67));
+        write_typed(od, c.a67, Actual::U16(a67));
     }
 
     /// The switch levels in 60FDh (bit 0 negative limit, bit 1 positive

@@ -340,6 +340,8 @@ pub(crate) struct Snapshot {
     pub override_percent: u16,
     /// A66 sources of the A67 bits (index << 16 | sub << 8 | bit, 0 = none).
     pub a66: [u32; 16],
+    /// Whether any A66 element names a source (else A67 is 0 without a look).
+    pub a66_used: bool,
     /// I02 position encoder (0 = motor encoder).
     pub i02: u8,
     /// I46 reference retaining (5 = direct absolute).
@@ -457,6 +459,7 @@ impl Snapshot {
             period_index: i8_(0x60C2, 2, -3),
             override_percent: sat(w.param(od, A340, 0, 100), 0u16, u16::MAX),
             a66: core::array::from_fn(|k| sat(w.param(od, A66, k as u8 + 1, 0), 0u32, u32::MAX)),
+            a66_used: (1..=16).any(|sub| w.param(od, A66, sub, 0) != 0),
             i02: sat(w.param(od, I02, 0, 0), 0u8, u8::MAX),
             i46: sat(w.param(od, I46, 0, 0), 0u8, u8::MAX),
             switch_source: [

@@ -885,6 +885,7 @@ fn typed_actual_value_slots_have_their_types() {
             (c.additional_position, I32),
             (c.vl_demand, I16),
             (c.vl_actual, I16),
+            (c.a67, U16),
             // the set-points read with a typed load
             (c.controlword, U16),
             (c.mode, I8),
