@@ -50,7 +50,9 @@ pub mod status;
 pub mod validate;
 
 pub use optimize::{FrameSample, OptimizeOutcome, OptimizeRequest, OptimizeResult, Optimizer};
-pub use pll::{Config, CycleCommand, CycleSequence, FrameTiming, Pll, PllState, Step, SyncFault, Tuning};
+pub use pll::{
+    gcd, Config, CycleCommand, CycleSequence, FrameTiming, Pll, PllState, Step, SyncFault, Tuning,
+};
 pub use status::{DiagCode, PllStatus, SyncDiagnostics};
 pub use validate::{recommended_sequence, validate, SyncError};
 

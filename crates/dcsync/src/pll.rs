@@ -314,8 +314,9 @@ pub(crate) fn wrap_signed(d: i64, p: i64) -> i64 {
     }
 }
 
-/// Greatest common divisor (Euclid), `gcd(0, b) = b`.
-const fn gcd(mut a: u64, mut b: u64) -> u64 {
+/// Greatest common divisor (Euclid), `gcd(0, b) = b`: reduces timer ticks
+/// per ns to a small fraction (here and in the firmware's cycle timer).
+pub const fn gcd(mut a: u64, mut b: u64) -> u64 {
     while b != 0 {
         let r = a % b;
         a = b;

@@ -373,6 +373,22 @@ fn bytes_at<const N: usize>(image: &[u8], at: usize) -> Option<[u8; N]> {
     image.get(at..at + N)?.try_into().ok()
 }
 
+/// The value in `slot`, or `default` without one (an entry that is not
+/// an integer in RAM).
+#[inline(always)]
+pub(crate) fn read_slot(od: &DriveObjects, slot: Option<Slot>, default: i64) -> i64 {
+    slot.map_or(default, |s| od.load_slot(s))
+}
+
+/// Stores `value` in `slot`; dropped without one or out of the type's
+/// range (a runtime value must never stop the cycle that writes it).
+#[inline(always)]
+pub(crate) fn write_slot(od: &mut DriveObjects, slot: Option<Slot>, value: i64) {
+    if let Some(s) = slot {
+        od.store_slot(s, value);
+    }
+}
+
 /// Copies `N` bytes from `src` at `from` to `dst` at `to`; `false`
 /// (nothing copied) when either range is outside its slice.
 #[inline(always)]
@@ -514,11 +530,13 @@ impl Slot {
 /// template and the requests for the runtime. Implements [`od::Dictionary`]
 /// (live entries from the RAM image; see [`DriveObjects::with_live`]).
 ///
-/// The runtime reads and writes ~60 entries per axis and control cycle
-/// through [`get`](Self::get)/[`set`](Self::set); a shared cache of
-/// resolved RAM slots (open addressing, filled on first use) makes those a
-/// hash, a compare and a load instead of a binary search, an entry scan and
-/// an offset sum (docs/architecture.md, cycle cost).
+/// [`get`](Self::get)/[`set`](Self::set) resolve `index`:`sub` through a
+/// shared cache (open addressing, filled on first use): a hash, a compare
+/// and a load instead of a binary search, an entry scan and an offset sum.
+/// The entries the control cycle and the process-data copy touch every
+/// cycle are resolved once into a [`Slot`] and then read and written with
+/// [`load_slot`](Self::load_slot)/[`store_slot`](Self::store_slot) and their
+/// typed forms (docs/architecture.md, cycle cost).
 #[derive(Debug, Clone)]
 pub struct DriveObjects {
     image: [u8; IMAGE_BYTES],
@@ -735,36 +753,50 @@ impl DriveObjects {
         }
     }
 
+    /// The raw bytes of `slot` when it has type `kind`.
+    #[inline(always)]
+    fn load_typed<const N: usize>(&self, slot: Slot, kind: SlotType) -> Option<[u8; N]> {
+        if slot.kind == kind {
+            bytes_at(&self.image, usize::from(slot.at))
+        } else {
+            None
+        }
+    }
+
+    /// Stores `bytes` straight into `slot` when it has type `kind` and is
+    /// not a configuration entry, else `wide` through
+    /// [`store_slot`](Self::store_slot).
+    #[inline(always)]
+    fn store_typed<const N: usize>(&mut self, slot: Slot, kind: SlotType, bytes: [u8; N], wide: i64) {
+        if slot.kind == kind && !slot.config {
+            put_at(&mut self.image, usize::from(slot.at), bytes);
+        } else {
+            self.store_slot(slot, wide);
+        }
+    }
+
     /// The value of an INTEGER32 slot; `None` for a slot of another type.
     #[inline(always)]
     pub fn load_slot_i32(&self, slot: Slot) -> Option<i32> {
-        (slot.kind == SlotType::I32)
-            .then(|| bytes_at(&self.image, usize::from(slot.at)).map(i32::from_le_bytes))
-            .flatten()
+        self.load_typed(slot, SlotType::I32).map(i32::from_le_bytes)
     }
 
     /// The value of an INTEGER16 slot; `None` for a slot of another type.
     #[inline(always)]
     pub fn load_slot_i16(&self, slot: Slot) -> Option<i16> {
-        (slot.kind == SlotType::I16)
-            .then(|| bytes_at(&self.image, usize::from(slot.at)).map(i16::from_le_bytes))
-            .flatten()
+        self.load_typed(slot, SlotType::I16).map(i16::from_le_bytes)
     }
 
     /// The value of an UNSIGNED16 slot; `None` for a slot of another type.
     #[inline(always)]
     pub fn load_slot_u16(&self, slot: Slot) -> Option<u16> {
-        (slot.kind == SlotType::U16)
-            .then(|| bytes_at(&self.image, usize::from(slot.at)).map(u16::from_le_bytes))
-            .flatten()
+        self.load_typed(slot, SlotType::U16).map(u16::from_le_bytes)
     }
 
     /// The value of an INTEGER8 slot; `None` for a slot of another type.
     #[inline(always)]
     pub fn load_slot_i8(&self, slot: Slot) -> Option<i8> {
-        (slot.kind == SlotType::I8)
-            .then(|| bytes_at(&self.image, usize::from(slot.at)).map(i8::from_le_bytes))
-            .flatten()
+        self.load_typed(slot, SlotType::I8).map(i8::from_le_bytes)
     }
 
     /// Stores a 16-bit value: straight into a 16-bit slot of the same
@@ -772,51 +804,31 @@ impl DriveObjects {
     /// else through [`store_slot`](Self::store_slot).
     #[inline(always)]
     pub fn store_slot_u16(&mut self, slot: Slot, value: u16) {
-        if slot.kind == SlotType::U16 && !slot.config {
-            put_at(&mut self.image, usize::from(slot.at), value.to_le_bytes());
-        } else {
-            self.store_slot(slot, i64::from(value));
-        }
+        self.store_typed(slot, SlotType::U16, value.to_le_bytes(), i64::from(value));
     }
 
     /// [`store_slot_u16`](Self::store_slot_u16) for INTEGER16.
     #[inline(always)]
     pub fn store_slot_i16(&mut self, slot: Slot, value: i16) {
-        if slot.kind == SlotType::I16 && !slot.config {
-            put_at(&mut self.image, usize::from(slot.at), value.to_le_bytes());
-        } else {
-            self.store_slot(slot, i64::from(value));
-        }
+        self.store_typed(slot, SlotType::I16, value.to_le_bytes(), i64::from(value));
     }
 
     /// [`store_slot_u16`](Self::store_slot_u16) for INTEGER32.
     #[inline(always)]
     pub fn store_slot_i32(&mut self, slot: Slot, value: i32) {
-        if slot.kind == SlotType::I32 && !slot.config {
-            put_at(&mut self.image, usize::from(slot.at), value.to_le_bytes());
-        } else {
-            self.store_slot(slot, i64::from(value));
-        }
+        self.store_typed(slot, SlotType::I32, value.to_le_bytes(), i64::from(value));
     }
 
     /// [`store_slot_u16`](Self::store_slot_u16) for INTEGER8.
     #[inline(always)]
     pub fn store_slot_i8(&mut self, slot: Slot, value: i8) {
-        if slot.kind == SlotType::I8 && !slot.config {
-            put_at(&mut self.image, usize::from(slot.at), value.to_le_bytes());
-        } else {
-            self.store_slot(slot, i64::from(value));
-        }
+        self.store_typed(slot, SlotType::I8, value.to_le_bytes(), i64::from(value));
     }
 
     /// [`store_slot_u16`](Self::store_slot_u16) for UNSIGNED8.
     #[inline(always)]
     pub fn store_slot_u8(&mut self, slot: Slot, value: u8) {
-        if slot.kind == SlotType::U8 && !slot.config {
-            put_at(&mut self.image, usize::from(slot.at), [value]);
-        } else {
-            self.store_slot(slot, i64::from(value));
-        }
+        self.store_typed(slot, SlotType::U8, [value], i64::from(value));
     }
 
     /// Copies the raw little-endian bytes of `slot` to `dst` at `at`

@@ -58,7 +58,7 @@
 //! four LEDs as patterns of `ecat::led` ([`Drive::leds`]).
 
 use crate::axis::{Axis, AxisCache, AxisCommand, AxisIo};
-use crate::dictionary::{DriveObjects, LiveValues, Slot, PERSISTENT_IMAGE_BYTES};
+use crate::dictionary::{read_slot, write_slot, DriveObjects, LiveValues, Slot, PERSISTENT_IMAGE_BYTES};
 use crate::objects::LAYOUT_HASH;
 use crate::pdo_image::{PdoImage, PdoImageError};
 use crate::DEVICE;
@@ -309,20 +309,6 @@ impl RuntimeSlots {
             self.error_register,
             self.new_messages,
         ]
-    }
-}
-
-/// The value in `slot`, or `default` without one.
-#[inline(always)]
-fn read_slot(od: &DriveObjects, slot: Option<Slot>, default: i64) -> i64 {
-    slot.map_or(default, |s| od.load_slot(s))
-}
-
-/// Stores `value` in `slot` (dropped without one or out of range).
-#[inline(always)]
-fn write_slot(od: &mut DriveObjects, slot: Option<Slot>, value: i64) {
-    if let Some(s) = slot {
-        od.store_slot(s, value);
     }
 }
 

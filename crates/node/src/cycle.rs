@@ -16,19 +16,9 @@ pub const CYCLE_NS: u64 = 1_000_000;
 
 const NS_PER_S: u64 = 1_000_000_000;
 
-/// Greatest common divisor (Euclid).
-const fn gcd(mut a: u64, mut b: u64) -> u64 {
-    while b != 0 {
-        let r = a % b;
-        a = b;
-        b = r;
-    }
-    a
-}
-
 /// Timer ticks per ns as a reduced fraction (144 MHz: 18/125), so the
 /// conversions stay in 64 bits for centuries of uptime.
-const G: u64 = gcd(TIMER_HZ as u64, NS_PER_S);
+const G: u64 = drive::runtime::dcsync::gcd(TIMER_HZ as u64, NS_PER_S);
 const TICK_NUM: u64 = TIMER_HZ as u64 / G;
 const NS_DEN: u64 = NS_PER_S / G;
 

@@ -78,6 +78,7 @@ mod snapshot;
 #[cfg(test)]
 mod tests;
 
+use crate::dictionary::write_slot;
 use crate::dictionary::DriveObjects;
 use cia402::{
     Decel, DeviceControl, FaultEvent, FaultReaction, Inputs, Mode, Options, Outputs, QuickStopOption, Ramp,
@@ -102,7 +103,7 @@ use motion::{
     CycleRatio, Event, FineInterpolator, InterpolatorConfig, MasterSetpoint, PositionTarget,
     ProfileGenerator, ProfileLimits, SetMode, VelocityInterpolator, INCREMENTS_PER_REVOLUTION,
 };
-use snapshot::{write, write_typed, Actual, CyclicSlots, Snapshot, Window};
+use snapshot::{write_typed, Actual, CyclicSlots, Snapshot, Window};
 
 /// The permitted direction of an endless axis (I04), for [`AxisParams::limits`].
 pub use motion::limits::PermittedDirection;
@@ -797,7 +798,7 @@ impl Axis {
         let master_ns = interpolation_period_ns(o.period_value, o.period_index).unwrap_or(dt_ns);
         if self.window.axis == 0 {
             let us = i64::from(master_ns / 1000);
-            write(od, slots.a291, us);
+            write_slot(od, slots.a291, us);
         }
         let ratio = CycleRatio::new(master_ns, dt_ns)
             .or_else(|_| CycleRatio::new(dt_ns, dt_ns))
@@ -1773,7 +1774,7 @@ impl Axis {
         let t = round_i32(per_mille).clamp(i32::from(i16::MIN), i32::from(i16::MAX)) as i16;
         write_typed(od, c.torque, Actual::I16(t));
         write_typed(od, c.current, Actual::I16(t));
-        write(od, c.rated_current, i64::from(round_i32(rated * 1000.0).max(0)));
+        write_slot(od, c.rated_current, i64::from(round_i32(rated * 1000.0).max(0)));
         write_typed(od, c.following_error, Actual::I32(sat_i32(self.user(fe))));
         write_typed(od, c.probe_status, Actual::U16(self.probe.status()));
         write_typed(
@@ -1864,8 +1865,8 @@ impl Axis {
         } else {
             causes.trailing_zeros() as u8 + 1
         };
-        write(od, c.e47, i64::from(first));
-        write(od, c.e49, i64::from(causes));
+        write_slot(od, c.e47, i64::from(first));
+        write_slot(od, c.e49, i64::from(causes));
     }
 
     /// A67 from the sources in A66 (C-143): bit k is bit `b` of the entry
@@ -1890,7 +1891,7 @@ impl Axis {
     fn digital_inputs(&self, od: &mut DriveObjects, c: &CyclicSlots, io: &AxisIo) {
         let bits =
             u32::from(io.limit_negative) | u32::from(io.limit_positive) << 1 | u32::from(io.reference) << 2;
-        write(od, c.digital_inputs, i64::from(bits));
+        write_slot(od, c.digital_inputs, i64::from(bits));
     }
 }
 

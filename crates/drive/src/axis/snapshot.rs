@@ -7,7 +7,7 @@
 //! cycle. Units are the objects' (increments, inc/s, inc/s², inc/s³, 0.1 % of
 //! the rated torque, ms, µs).
 
-use crate::dictionary::{DriveObjects, Slot};
+use crate::dictionary::{read_slot, DriveObjects, Slot};
 use crate::{parameter_index, AXIS_B_CIA402, AXIS_B_MANUFACTURER};
 use motion::scaling::AxisScaling;
 
@@ -214,12 +214,6 @@ impl CyclicSlots {
     }
 }
 
-/// The value in `slot`, or `default` without one.
-#[inline(always)]
-pub(crate) fn read(od: &DriveObjects, slot: Option<Slot>, default: i64) -> i64 {
-    slot.map_or(default, |s| od.load_slot(s))
-}
-
 /// A typed actual value for [`write_typed`].
 pub(crate) enum Actual {
     I8(i8),
@@ -241,15 +235,6 @@ pub(crate) fn write_typed(od: &mut DriveObjects, slot: Option<Slot>, value: Actu
             Actual::I16(v) => od.store_slot_i16(s, v),
             Actual::I32(v) => od.store_slot_i32(s, v),
         }
-    }
-}
-
-/// Stores `value` in `slot` (dropped without one or out of the type's
-/// range: an actual value must never stop the control cycle).
-#[inline(always)]
-pub(crate) fn write(od: &mut DriveObjects, slot: Option<Slot>, value: i64) {
-    if let Some(s) = slot {
-        od.store_slot(s, value);
     }
 }
 
@@ -379,20 +364,20 @@ impl Snapshot {
         // as the fallback for an entry declared with another type
         let i32_ = |s: Option<Slot>, d: i64| match s.and_then(|s| od.load_slot_i32(s)) {
             Some(v) => v,
-            None => sat(read(od, s, d), i32::MIN, i32::MAX),
+            None => sat(read_slot(od, s, d), i32::MIN, i32::MAX),
         };
         let u16_ = |s: Option<Slot>, d: i64| match s.and_then(|s| od.load_slot_u16(s)) {
             Some(v) => v,
-            None => sat(read(od, s, d), 0u16, u16::MAX),
+            None => sat(read_slot(od, s, d), 0u16, u16::MAX),
         };
         let i16_ = |s: Option<Slot>, d: i64| match s.and_then(|s| od.load_slot_i16(s)) {
             Some(v) => v,
-            None => sat(read(od, s, d), i16::MIN, i16::MAX),
+            None => sat(read_slot(od, s, d), i16::MIN, i16::MAX),
         };
         self.controlword = u16_(c.controlword, 0);
         self.mode = match c.mode.and_then(|s| od.load_slot_i8(s)) {
             Some(v) => v,
-            None => sat(read(od, c.mode, 8), i8::MIN, i8::MAX),
+            None => sat(read_slot(od, c.mode, 8), i8::MIN, i8::MAX),
         };
         self.target_position = i32_(c.target_position, 0);
         self.target_position_user = self.target_position;
