@@ -8,7 +8,11 @@ esc; the idle loop resets it), and prints per task the instructions per run
 and the top functions. Deterministic under `-icount`. About seven minutes for
 the end-to-end run; `scripts/cross profile` runs it.
 
-usage: qemu-system-arm ... -d in_asm,exec,nochain 2>&1 >/dev/null | qemu-profile.py ELF
+usage: qemu-system-arm ... -d in_asm,exec,nochain 2>&1 >/dev/null | qemu-profile.py ELF [TASK:FIRST:LAST]
+
+TASK:FIRST:LAST (e.g. EXTI1:69:319, the control cycles of the csp move)
+counts only runs FIRST..=LAST (1-based) of that handler; its other runs are
+reported as TASK-other.
 """
 import bisect
 import collections
@@ -18,6 +22,10 @@ import subprocess
 import sys
 
 elf = sys.argv[1]
+window = None
+if len(sys.argv) > 2:
+    t, a, b = sys.argv[2].split(':')
+    window = (t, int(a), int(b))
 # symbols
 syms = []
 nm = shutil.which('llvm-nm-22') or shutil.which('llvm-nm') or 'arm-none-eabi-nm'
@@ -61,6 +69,9 @@ for line in sys.stdin:
             if pc in entries:
                 task = entries[pc]
                 handlers[task] += 1
+                if window and task == window[0] and not window[1] <= handlers[task] <= window[2]:
+                    task = task + '-other'
+                    handlers[task] += 1
             elif idle_rng and idle_rng[0][0] <= pc < idle_rng[0][1]:
                 task = 'idle'
             counts[(task, pc)] += 1
@@ -73,6 +84,8 @@ for (t, pc), c in counts.items():
 print('handler entries', dict(handlers))
 for t in ('EXTI1', 'EXTI2', 'EXTI0'):
     k = max(handlers[t], 1)
+    if window and t == window[0]:
+        k = window[2] - window[1] + 1
     print(f'== {t}: {tot[t]} instructions, {tot[t]//k} per run ({handlers[t]} runs)')
     rows = [(c, f) for (tt, f), c in per.items() if tt == t]
     for c, f in sorted(rows, reverse=True)[:25]:
