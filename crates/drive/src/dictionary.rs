@@ -8,6 +8,7 @@
 //! (element + 1 for manufacturer arrays), so it does not change with the
 //! template.
 
+use core::marker::PhantomData;
 use core::sync::atomic::{AtomicU32, Ordering};
 
 use crate::objects::{self, enumeration, find, Object, Value, IMAGE_BYTES, INITIAL_IMAGE, OBJECTS, OFFSETS};
@@ -445,7 +446,7 @@ pub struct Slot {
 
 /// The types a [`Slot`] holds (one byte, so a slot is four).
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
-enum SlotType {
+pub(crate) enum SlotType {
     Bool,
     U8,
     I8,
@@ -513,7 +514,75 @@ impl SlotType {
     }
 }
 
+/// A [`Slot`] whose type was checked once against `T` ([`Slot::typed`]):
+/// the control cycle's loads and stores of its set-points and actual
+/// values, without a type dispatch or range check.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub(crate) struct Typed<T> {
+    at: u16,
+    config: bool,
+    value: PhantomData<T>,
+}
+
+/// The Rust type of a [`Typed`] slot's entry.
+pub(crate) trait SlotValue: Copy {
+    /// The entry type that holds it.
+    const KIND: SlotType;
+    /// The value at `at` of `image`; `None` outside it.
+    fn load(image: &[u8], at: usize) -> Option<Self>;
+    /// Writes the value at `at` of `image`; `false` outside it.
+    fn store(self, image: &mut [u8], at: usize) -> bool;
+    /// The value widened for [`DriveObjects::store_slot`].
+    fn wide(self) -> i64;
+}
+
+macro_rules! slot_value {
+    ($($t:ty => $kind:ident, $n:literal;)*) => {$(
+        impl SlotValue for $t {
+            const KIND: SlotType = SlotType::$kind;
+            #[inline(always)]
+            fn load(image: &[u8], at: usize) -> Option<Self> {
+                bytes_at::<$n>(image, at).map(<$t>::from_le_bytes)
+            }
+            #[inline(always)]
+            fn store(self, image: &mut [u8], at: usize) -> bool {
+                put_at(image, at, self.to_le_bytes())
+            }
+            #[inline(always)]
+            fn wide(self) -> i64 {
+                i64::from(self)
+            }
+        }
+    )*};
+}
+
+slot_value! {
+    u8 => U8, 1;
+    i8 => I8, 1;
+    u16 => U16, 2;
+    i16 => I16, 2;
+    u32 => U32, 4;
+    i32 => I32, 4;
+}
+
+impl<T> Typed<T> {
+    /// Byte offset in the RAM image.
+    #[cfg(test)]
+    pub(crate) fn at(self) -> u16 {
+        self.at
+    }
+}
+
 impl Slot {
+    /// The slot as a [`Typed`] one when its entry holds a `T`.
+    pub(crate) fn typed<T: SlotValue>(self) -> Option<Typed<T>> {
+        (self.kind == T::KIND).then_some(Typed {
+            at: self.at,
+            config: self.config,
+            value: PhantomData,
+        })
+    }
+
     /// Width of the value in bytes.
     #[inline]
     pub fn bytes(self) -> usize {
@@ -753,82 +822,31 @@ impl DriveObjects {
         }
     }
 
-    /// The raw bytes of `slot` when it has type `kind`.
+    /// The value in a typed slot; `None` without one.
     #[inline(always)]
-    fn load_typed<const N: usize>(&self, slot: Slot, kind: SlotType) -> Option<[u8; N]> {
-        if slot.kind == kind {
-            bytes_at(&self.image, usize::from(slot.at))
-        } else {
-            None
+    pub(crate) fn read_typed<T: SlotValue>(&self, slot: Option<Typed<T>>) -> Option<T> {
+        slot.and_then(|s| T::load(&self.image, usize::from(s.at)))
+    }
+
+    /// Stores `value` in a typed slot (dropped without one); a
+    /// configuration entry goes through [`store_slot`](Self::store_slot),
+    /// which notes a change.
+    #[inline(always)]
+    pub(crate) fn write_typed<T: SlotValue>(&mut self, slot: Option<Typed<T>>, value: T) {
+        match slot {
+            Some(s) if s.config => {
+                let slot = Slot {
+                    at: s.at,
+                    kind: T::KIND,
+                    config: true,
+                };
+                self.store_slot(slot, value.wide());
+            }
+            Some(s) => {
+                value.store(&mut self.image, usize::from(s.at));
+            }
+            None => {}
         }
-    }
-
-    /// Stores `bytes` straight into `slot` when it has type `kind` and is
-    /// not a configuration entry, else `wide` through
-    /// [`store_slot`](Self::store_slot).
-    #[inline(always)]
-    fn store_typed<const N: usize>(&mut self, slot: Slot, kind: SlotType, bytes: [u8; N], wide: i64) {
-        if slot.kind == kind && !slot.config {
-            put_at(&mut self.image, usize::from(slot.at), bytes);
-        } else {
-            self.store_slot(slot, wide);
-        }
-    }
-
-    /// The value of an INTEGER32 slot; `None` for a slot of another type.
-    #[inline(always)]
-    pub fn load_slot_i32(&self, slot: Slot) -> Option<i32> {
-        self.load_typed(slot, SlotType::I32).map(i32::from_le_bytes)
-    }
-
-    /// The value of an INTEGER16 slot; `None` for a slot of another type.
-    #[inline(always)]
-    pub fn load_slot_i16(&self, slot: Slot) -> Option<i16> {
-        self.load_typed(slot, SlotType::I16).map(i16::from_le_bytes)
-    }
-
-    /// The value of an UNSIGNED16 slot; `None` for a slot of another type.
-    #[inline(always)]
-    pub fn load_slot_u16(&self, slot: Slot) -> Option<u16> {
-        self.load_typed(slot, SlotType::U16).map(u16::from_le_bytes)
-    }
-
-    /// The value of an INTEGER8 slot; `None` for a slot of another type.
-    #[inline(always)]
-    pub fn load_slot_i8(&self, slot: Slot) -> Option<i8> {
-        self.load_typed(slot, SlotType::I8).map(i8::from_le_bytes)
-    }
-
-    /// Stores a 16-bit value: straight into a 16-bit slot of the same
-    /// signedness that is not a configuration entry (the actual values),
-    /// else through [`store_slot`](Self::store_slot).
-    #[inline(always)]
-    pub fn store_slot_u16(&mut self, slot: Slot, value: u16) {
-        self.store_typed(slot, SlotType::U16, value.to_le_bytes(), i64::from(value));
-    }
-
-    /// [`store_slot_u16`](Self::store_slot_u16) for INTEGER16.
-    #[inline(always)]
-    pub fn store_slot_i16(&mut self, slot: Slot, value: i16) {
-        self.store_typed(slot, SlotType::I16, value.to_le_bytes(), i64::from(value));
-    }
-
-    /// [`store_slot_u16`](Self::store_slot_u16) for INTEGER32.
-    #[inline(always)]
-    pub fn store_slot_i32(&mut self, slot: Slot, value: i32) {
-        self.store_typed(slot, SlotType::I32, value.to_le_bytes(), i64::from(value));
-    }
-
-    /// [`store_slot_u16`](Self::store_slot_u16) for INTEGER8.
-    #[inline(always)]
-    pub fn store_slot_i8(&mut self, slot: Slot, value: i8) {
-        self.store_typed(slot, SlotType::I8, value.to_le_bytes(), i64::from(value));
-    }
-
-    /// [`store_slot_u16`](Self::store_slot_u16) for UNSIGNED8.
-    #[inline(always)]
-    pub fn store_slot_u8(&mut self, slot: Slot, value: u8) {
-        self.store_typed(slot, SlotType::U8, [value], i64::from(value));
     }
 
     /// Copies the raw little-endian bytes of `slot` to `dst` at `at`

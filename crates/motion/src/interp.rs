@@ -340,26 +340,34 @@ impl FineInterpolator {
 
     /// Output at step k of N.
     fn evaluate(&self) -> InterpolatorOutput {
-        let n = i64::from(self.config.ratio.n());
-        let k = i64::from(self.k);
-        // 6N³·(x − p₋₁) = 6N²k∇¹ + 3Nk(k−N)∇² + (k+N)k(k−N)∇³; with N ≤ 512
-        // and the difference bounds every term stays below 2⁵⁸.
-        let num = 6 * n * n * k * self.d1 + 3 * n * k * (k - n) * self.d2 + (k + n) * k * (k - n) * self.d3;
-        let den = 6 * n * n * n;
-        // Round half up: floor((2·num + den) / (2·den)).
-        // (den ≥ 6: N ≥ 1 by construction; checked so no panic path remains)
-        let offset = (2 * num + den).checked_div_euclid(2 * den).unwrap_or(0);
+        let (n_steps, k_steps) = (self.config.ratio.n(), self.k);
+        let offset = if k_steps >= n_steps {
+            // the segment's end (every cycle when N = 1): x = p₀ = p₋₁ + ∇¹
+            // exactly, without the 64-bit division below
+            self.d1
+        } else {
+            let n = i64::from(n_steps);
+            let k = i64::from(k_steps);
+            // 6N³·(x − p₋₁) = 6N²k∇¹ + 3Nk(k−N)∇² + (k+N)k(k−N)∇³; with N ≤ 512
+            // and the difference bounds every term stays below 2⁵⁸.
+            let num =
+                6 * n * n * k * self.d1 + 3 * n * k * (k - n) * self.d2 + (k + n) * k * (k - n) * self.d3;
+            let den = 6 * n * n * n;
+            // Round half up: floor((2·num + den) / (2·den)).
+            // (den ≥ 6: N ≥ 1 by construction; checked so no panic path remains)
+            (2 * num + den).checked_div_euclid(2 * den).unwrap_or(0)
+        };
         // Truncation to i32 is the wrap-around of the position counter.
         let position = self.p1.wrapping_add(offset as i32);
 
         let master_s = self.config.ratio.master_ns() as f32 * 1e-9;
-        let t = k as f32 / n as f32;
+        let t = k_steps as f32 / n_steps as f32;
         let (velocity, acceleration) = match self.config.feedforward {
             FeedforwardSource::Internal => {
                 // dx/dt in increments per master cycle, then per second.
-                let d1 = self.d1 as f32;
-                let d2 = self.d2 as f32;
-                let d3 = self.d3 as f32;
+                let d1 = to_f32(self.d1);
+                let d2 = to_f32(self.d2);
+                let d3 = to_f32(self.d3);
                 let v = d1 + (2.0 * t - 1.0) * 0.5 * d2 + (3.0 * t * t - 1.0) / 6.0 * d3;
                 let a = d2 + t * d3;
                 (v / master_s, a / (master_s * master_s))
@@ -375,6 +383,15 @@ impl FineInterpolator {
             acceleration_feedforward: acceleration,
             extrapolating: self.extrapolating,
         }
+    }
+}
+
+/// `x` as `f32` (the same rounding): through 32 bits when it fits, which
+/// a Cortex-M4 converts in one instruction instead of a library call.
+fn to_f32(x: i64) -> f32 {
+    match i32::try_from(x) {
+        Ok(v) => v as f32,
+        Err(_) => x as f32,
     }
 }
 
@@ -556,6 +573,35 @@ mod tests {
                 for per_master in [0, 1, 3, 1049, -99_991, 50_000_000] {
                     check_constant_velocity(order, n, -5, per_master);
                 }
+            }
+        }
+    }
+
+    /// The feed-forward's differences go through 32 bits when they fit:
+    /// the same `f32` as the direct 64-bit conversion, at and beyond the
+    /// edges of `i32` (|∇³| reaches 2³³).
+    #[test]
+    fn c115_difference_conversion_rounds_like_the_direct_one() {
+        let edges = [
+            0i64,
+            1,
+            -1,
+            16_777_217,
+            -16_777_217,
+            i64::from(i32::MAX),
+            i64::from(i32::MIN),
+        ];
+        for &e in &edges {
+            for x in [
+                e,
+                e + 1,
+                e - 1,
+                e * 2 + 1,
+                -(e * 3) - 1,
+                (1 << 33) - 1,
+                -(1 << 33) + 3,
+            ] {
+                assert_eq!(to_f32(x).to_bits(), (x as f32).to_bits(), "{x}");
             }
         }
     }

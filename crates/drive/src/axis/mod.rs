@@ -78,7 +78,6 @@ mod snapshot;
 #[cfg(test)]
 mod tests;
 
-use crate::dictionary::write_slot;
 use crate::dictionary::DriveObjects;
 use cia402::{
     Decel, DeviceControl, FaultEvent, FaultReaction, Inputs, Mode, Options, Outputs, QuickStopOption, Ramp,
@@ -103,7 +102,7 @@ use motion::{
     CycleRatio, Event, FineInterpolator, InterpolatorConfig, MasterSetpoint, PositionTarget,
     ProfileGenerator, ProfileLimits, SetMode, VelocityInterpolator, INCREMENTS_PER_REVOLUTION,
 };
-use snapshot::{write_typed, Actual, CyclicSlots, Snapshot, Window};
+use snapshot::{CyclicSlots, Snapshot, Window};
 
 /// The permitted direction of an endless axis (I04), for [`AxisParams::limits`].
 pub use motion::limits::PermittedDirection;
@@ -419,6 +418,10 @@ pub struct Axis {
     /// the cycle and the mode class (homing, jog, other); it runs again
     /// only when one of them (or the parameters) changed.
     configured: Option<(u32, u32, u8)>,
+    /// The touch-probe values (60BAh – 60BDh, increments) last written to
+    /// the objects; they are converted and written again only when one
+    /// changed or the configuration did (`None`).
+    probe_shown: Option<[i32; 4]>,
     /// Filtered actual velocity, inc/s (user coordinates).
     velocity: f32,
     /// Last cycle's actual position sample (user coordinates).
@@ -499,6 +502,7 @@ impl Axis {
             vinterp: None,
             interp_key: None,
             configured: None,
+            probe_shown: None,
             profile: ProfileGenerator::new(0),
             cascade: Cascade::new(params.cascade, 0)
                 .or_else(|_| Cascade::new(CascadeConfig::DEFAULT, 0))
@@ -785,6 +789,12 @@ impl Axis {
     /// Applies the configuration objects and parameters.
     fn configure(&mut self, od: &mut DriveObjects, slots: &CyclicSlots, o: &Snapshot, dt_ns: u32) {
         let p = self.params;
+        // 6076h from the motor data, and the probe values in the (new) units
+        od.write_typed(
+            slots.rated_current,
+            round_i32(p.rated_torque_nm * 1000.0).max(0) as u32,
+        );
+        self.probe_shown = None;
         let opts = self.dc.options_mut();
         if let Ok(q) = QuickStopOption::try_from(o.quick_stop_option) {
             opts.quick_stop = q;
@@ -797,8 +807,7 @@ impl Axis {
         // cycle ratio (C-114): 60C2h over A150; 60C2h is copied into A291
         let master_ns = interpolation_period_ns(o.period_value, o.period_index).unwrap_or(dt_ns);
         if self.window.axis == 0 {
-            let us = i64::from(master_ns / 1000);
-            write_slot(od, slots.a291, us);
+            od.write_typed(slots.a291, master_ns / 1000);
         }
         let ratio = CycleRatio::new(master_ns, dt_ns)
             .or_else(|_| CycleRatio::new(dt_ns, dt_ns))
@@ -1272,7 +1281,9 @@ impl Axis {
         if new_setpoint {
             let from = self.last_master_sp.unwrap_or(self.sp_pos);
             let step = target.wrapping_sub(from).unsigned_abs() as f32;
-            let elapsed_s = self.sp_age_ns.max(master_ns) as f32 * 1e-9;
+            let elapsed_ns = self.sp_age_ns.max(master_ns);
+            // through 32 bits when it fits (one instruction, the same value)
+            let elapsed_s = u32::try_from(elapsed_ns).map_or(elapsed_ns as f32, |ns| ns as f32) * 1e-9;
             let allowed =
                 2.0 * o.max_profile_velocity as f32 * elapsed_s + self.params.position_window_inc as f32;
             self.last_master_sp = Some(target);
@@ -1752,7 +1763,7 @@ impl Axis {
         if out.drive_function {
             sw |= bits & SW_INTERNAL_LIMIT;
         }
-        write_typed(od, c.statusword, Actual::U16(sw));
+        od.write_typed(c.statusword, sw);
         let e80 = match self.denial {
             Some(DenialCause::IllegalDirection) => 15,
             Some(
@@ -1763,45 +1774,36 @@ impl Axis {
             ) => 20,
             _ => 0u8,
         };
-        write_typed(od, c.e80, Actual::U8(e80));
-        write_typed(od, c.mode_display, Actual::I8(out.mode_display));
+        od.write_typed(c.e80, e80);
+        od.write_typed(c.mode_display, out.mode_display);
         let position = self.user_position(actual);
-        write_typed(od, c.position, Actual::I32(sat_i32(position)));
+        od.write_typed(c.position, sat_i32(position));
         let v = self.scaling.velocity_to_user(self.velocity) * self.velocity_decimals;
-        write_typed(od, c.velocity, Actual::I32(round_i32(v)));
+        od.write_typed(c.velocity, round_i32(v));
         let rated = self.params.rated_torque_nm;
         let per_mille = if rated > 0.0 { torque / rated * 1000.0 } else { 0.0 };
         let t = round_i32(per_mille).clamp(i32::from(i16::MIN), i32::from(i16::MAX)) as i16;
-        write_typed(od, c.torque, Actual::I16(t));
-        write_typed(od, c.current, Actual::I16(t));
-        write_slot(od, c.rated_current, i64::from(round_i32(rated * 1000.0).max(0)));
-        write_typed(od, c.following_error, Actual::I32(sat_i32(self.user(fe))));
-        write_typed(od, c.probe_status, Actual::U16(self.probe.status()));
-        write_typed(
-            od,
-            c.probe_values[0],
-            Actual::I32(sat_i32(self.user_position(self.probe.value_60ba()))),
-        );
-        write_typed(
-            od,
-            c.probe_values[1],
-            Actual::I32(sat_i32(self.user_position(self.probe.value_60bb()))),
-        );
-        write_typed(
-            od,
-            c.probe_values[2],
-            Actual::I32(sat_i32(self.user_position(self.probe.value_60bc()))),
-        );
-        write_typed(
-            od,
-            c.probe_values[3],
-            Actual::I32(sat_i32(self.user_position(self.probe.value_60bd()))),
-        );
-        write_typed(od, c.additional_position, Actual::I32(sat_i32(position)));
+        od.write_typed(c.torque, t);
+        od.write_typed(c.current, t);
+        od.write_typed(c.following_error, sat_i32(self.user(fe)));
+        od.write_typed(c.probe_status, self.probe.status());
+        let probe = [
+            self.probe.value_60ba(),
+            self.probe.value_60bb(),
+            self.probe.value_60bc(),
+            self.probe.value_60bd(),
+        ];
+        if self.probe_shown != Some(probe) {
+            for (slot, value) in c.probe_values.into_iter().zip(probe) {
+                od.write_typed(slot, sat_i32(self.user_position(value)));
+            }
+            self.probe_shown = Some(probe);
+        }
+        od.write_typed(c.additional_position, sat_i32(position));
         let rpm = |v: f32| round_i32(v / RPM_TO_INC_PER_S).clamp(-32768, 32767) as i16;
-        write_typed(od, c.vl_demand, Actual::I16(rpm(self.vl_demand)));
-        write_typed(od, c.vl_actual, Actual::I16(rpm(self.velocity)));
-        write_typed(od, c.e48, Actual::U8(e48(out.state)));
+        od.write_typed(c.vl_demand, rpm(self.vl_demand));
+        od.write_typed(c.vl_actual, rpm(self.velocity));
+        od.write_typed(c.e48, e48(out.state));
     }
 
     /// A position (or distance) in increments as the objects show it: user
@@ -1865,8 +1867,8 @@ impl Axis {
         } else {
             causes.trailing_zeros() as u8 + 1
         };
-        write_slot(od, c.e47, i64::from(first));
-        write_slot(od, c.e49, i64::from(causes));
+        od.write_typed(c.e47, first);
+        od.write_typed(c.e49, causes);
     }
 
     /// A67 from the sources in A66 (C-143): bit k is bit `b` of the entry
@@ -1883,7 +1885,7 @@ impl Axis {
                 a67 |= 1 << k;
             }
         }
-        write_typed(od, c.a67, Actual::U16(a67));
+        od.write_typed(c.a67, a67);
     }
 
     /// The switch levels in 60FDh (bit 0 negative limit, bit 1 positive
@@ -1891,7 +1893,7 @@ impl Axis {
     fn digital_inputs(&self, od: &mut DriveObjects, c: &CyclicSlots, io: &AxisIo) {
         let bits =
             u32::from(io.limit_negative) | u32::from(io.limit_positive) << 1 | u32::from(io.reference) << 2;
-        write_slot(od, c.digital_inputs, i64::from(bits));
+        od.write_typed(c.digital_inputs, bits);
     }
 }
 

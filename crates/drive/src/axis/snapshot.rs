@@ -7,7 +7,7 @@
 //! cycle. Units are the objects' (increments, inc/s, inc/s², inc/s³, 0.1 % of
 //! the rated torque, ms, µs).
 
-use crate::dictionary::{read_slot, DriveObjects, Slot};
+use crate::dictionary::{DriveObjects, Slot, SlotValue, Typed};
 use crate::{parameter_index, AXIS_B_CIA402, AXIS_B_MANUFACTURER};
 use motion::scaling::AxisScaling;
 
@@ -92,149 +92,133 @@ impl Window {
 }
 
 /// The entries one axis reads (set-points) and writes (actual values) in
-/// every control cycle, resolved once: a load or store each instead of a
-/// dictionary lookup (docs/architecture.md, cycle cost). `None`: the entry
-/// is not an integer in RAM (reads give the default, writes are dropped).
+/// every control cycle, resolved once with their types: a load or store
+/// each instead of a dictionary lookup (docs/architecture.md, cycle cost).
+/// `None`: the entry is not in RAM with the type the cycle uses (reads give
+/// the default, writes are dropped; `cyclic_slots_resolve_every_entry_on_both_axes`
+/// keeps this from happening).
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
 pub(crate) struct CyclicSlots {
-    pub controlword: Option<Slot>,
-    pub mode: Option<Slot>,
-    pub target_position: Option<Slot>,
-    pub ip_setpoint: Option<Slot>,
-    pub target_velocity: Option<Slot>,
-    pub target_torque: Option<Slot>,
-    pub velocity_offset: Option<Slot>,
-    pub torque_offset: Option<Slot>,
-    pub probe_function: Option<Slot>,
-    pub vl_target: Option<Slot>,
-    pub i210: Option<Slot>,
-    pub statusword: Option<Slot>,
-    pub mode_display: Option<Slot>,
-    pub position: Option<Slot>,
-    pub velocity: Option<Slot>,
-    pub torque: Option<Slot>,
-    pub current: Option<Slot>,
-    pub rated_current: Option<Slot>,
-    pub following_error: Option<Slot>,
-    pub probe_status: Option<Slot>,
-    pub probe_values: [Option<Slot>; 4],
-    pub additional_position: Option<Slot>,
-    pub vl_demand: Option<Slot>,
-    pub vl_actual: Option<Slot>,
-    pub digital_inputs: Option<Slot>,
-    pub e80: Option<Slot>,
-    pub e48: Option<Slot>,
-    pub e47: Option<Slot>,
-    pub e49: Option<Slot>,
-    pub a67: Option<Slot>,
+    pub controlword: Option<Typed<u16>>,
+    pub mode: Option<Typed<i8>>,
+    pub target_position: Option<Typed<i32>>,
+    pub ip_setpoint: Option<Typed<i32>>,
+    pub target_velocity: Option<Typed<i32>>,
+    pub target_torque: Option<Typed<i16>>,
+    pub velocity_offset: Option<Typed<i32>>,
+    pub torque_offset: Option<Typed<i16>>,
+    pub probe_function: Option<Typed<u16>>,
+    pub vl_target: Option<Typed<i16>>,
+    pub i210: Option<Typed<u16>>,
+    pub statusword: Option<Typed<u16>>,
+    pub mode_display: Option<Typed<i8>>,
+    pub position: Option<Typed<i32>>,
+    pub velocity: Option<Typed<i32>>,
+    pub torque: Option<Typed<i16>>,
+    pub current: Option<Typed<i16>>,
+    pub rated_current: Option<Typed<u32>>,
+    pub following_error: Option<Typed<i32>>,
+    pub probe_status: Option<Typed<u16>>,
+    pub probe_values: [Option<Typed<i32>>; 4],
+    pub additional_position: Option<Typed<i32>>,
+    pub vl_demand: Option<Typed<i16>>,
+    pub vl_actual: Option<Typed<i16>>,
+    pub digital_inputs: Option<Typed<u32>>,
+    pub e80: Option<Typed<u8>>,
+    pub e48: Option<Typed<u8>>,
+    pub e47: Option<Typed<u8>>,
+    pub e49: Option<Typed<u8>>,
+    pub a67: Option<Typed<u16>>,
     /// A291 (global): the copy of 60C2h.
-    pub a291: Option<Slot>,
+    pub a291: Option<Typed<u32>>,
 }
 
 impl CyclicSlots {
     /// The slots of axis `w`.
     pub fn resolve(od: &DriveObjects, w: Window) -> Self {
+        fn t<T: SlotValue>(slot: Option<Slot>) -> Option<Typed<T>> {
+            slot.and_then(Slot::typed)
+        }
         let c = |index: u16, sub: u8| od.slot(w.cia402(index), sub);
         let m = |index: u16| od.slot(w.manufacturer(index), 0);
         Self {
-            controlword: c(0x6040, 0),
-            mode: c(0x6060, 0),
-            target_position: c(0x607A, 0),
-            ip_setpoint: c(0x60C1, 1),
-            target_velocity: c(0x60FF, 0),
-            target_torque: c(0x6071, 0),
-            velocity_offset: c(0x60B1, 0),
-            torque_offset: c(0x60B2, 0),
-            probe_function: c(0x60B8, 0),
-            vl_target: c(0x6042, 0),
-            i210: m(I210),
-            statusword: c(0x6041, 0),
-            mode_display: c(0x6061, 0),
-            position: c(0x6064, 0),
-            velocity: c(0x606C, 0),
-            torque: c(0x6077, 0),
-            current: c(0x6078, 0),
-            rated_current: c(0x6076, 0),
-            following_error: c(0x60F4, 0),
-            probe_status: c(0x60B9, 0),
-            probe_values: [c(0x60BA, 0), c(0x60BB, 0), c(0x60BC, 0), c(0x60BD, 0)],
-            additional_position: c(0x60E4, 1),
-            vl_demand: c(0x6043, 0),
-            vl_actual: c(0x6044, 0),
-            digital_inputs: c(0x60FD, 0),
-            e80: m(E80),
-            e48: m(E48),
-            e47: m(E47),
-            e49: m(E49),
-            a67: m(A67),
-            a291: od.slot(A291, 0),
+            controlword: t(c(0x6040, 0)),
+            mode: t(c(0x6060, 0)),
+            target_position: t(c(0x607A, 0)),
+            ip_setpoint: t(c(0x60C1, 1)),
+            target_velocity: t(c(0x60FF, 0)),
+            target_torque: t(c(0x6071, 0)),
+            velocity_offset: t(c(0x60B1, 0)),
+            torque_offset: t(c(0x60B2, 0)),
+            probe_function: t(c(0x60B8, 0)),
+            vl_target: t(c(0x6042, 0)),
+            i210: t(m(I210)),
+            statusword: t(c(0x6041, 0)),
+            mode_display: t(c(0x6061, 0)),
+            position: t(c(0x6064, 0)),
+            velocity: t(c(0x606C, 0)),
+            torque: t(c(0x6077, 0)),
+            current: t(c(0x6078, 0)),
+            rated_current: t(c(0x6076, 0)),
+            following_error: t(c(0x60F4, 0)),
+            probe_status: t(c(0x60B9, 0)),
+            probe_values: [t(c(0x60BA, 0)), t(c(0x60BB, 0)), t(c(0x60BC, 0)), t(c(0x60BD, 0))],
+            additional_position: t(c(0x60E4, 1)),
+            vl_demand: t(c(0x6043, 0)),
+            vl_actual: t(c(0x6044, 0)),
+            digital_inputs: t(c(0x60FD, 0)),
+            e80: t(m(E80)),
+            e48: t(m(E48)),
+            e47: t(m(E47)),
+            e49: t(m(E49)),
+            a67: t(m(A67)),
+            a291: t(od.slot(A291, 0)),
         }
     }
 
     /// Every slot, for the completeness test.
     #[cfg(test)]
-    pub fn all(&self) -> [Option<Slot>; 34] {
-        let [p0, p1, p2, p3] = self.probe_values;
+    pub fn all(&self) -> [Option<u16>; 34] {
+        let [p0, p1, p2, p3] = self.probe_values.map(|s| s.map(Typed::at));
+        fn at<T>(s: Option<Typed<T>>) -> Option<u16> {
+            s.map(Typed::at)
+        }
         [
-            self.controlword,
-            self.mode,
-            self.target_position,
-            self.ip_setpoint,
-            self.target_velocity,
-            self.target_torque,
-            self.velocity_offset,
-            self.torque_offset,
-            self.probe_function,
-            self.vl_target,
-            self.i210,
-            self.statusword,
-            self.mode_display,
-            self.position,
-            self.velocity,
-            self.torque,
-            self.current,
-            self.rated_current,
-            self.following_error,
-            self.probe_status,
+            at(self.controlword),
+            at(self.mode),
+            at(self.target_position),
+            at(self.ip_setpoint),
+            at(self.target_velocity),
+            at(self.target_torque),
+            at(self.velocity_offset),
+            at(self.torque_offset),
+            at(self.probe_function),
+            at(self.vl_target),
+            at(self.i210),
+            at(self.statusword),
+            at(self.mode_display),
+            at(self.position),
+            at(self.velocity),
+            at(self.torque),
+            at(self.current),
+            at(self.rated_current),
+            at(self.following_error),
+            at(self.probe_status),
             p0,
             p1,
             p2,
             p3,
-            self.additional_position,
-            self.vl_demand,
-            self.vl_actual,
-            self.digital_inputs,
-            self.e80,
-            self.e48,
-            self.e47,
-            self.e49,
-            self.a67,
-            self.a291,
+            at(self.additional_position),
+            at(self.vl_demand),
+            at(self.vl_actual),
+            at(self.digital_inputs),
+            at(self.e80),
+            at(self.e48),
+            at(self.e47),
+            at(self.e49),
+            at(self.a67),
+            at(self.a291),
         ]
-    }
-}
-
-/// A typed actual value for [`write_typed`].
-pub(crate) enum Actual {
-    I8(i8),
-    U8(u8),
-    U16(u16),
-    I16(i16),
-    I32(i32),
-}
-
-/// Stores a typed actual value in `slot` (dropped without one): one
-/// compare and a store when the slot has the value's type.
-#[inline(always)]
-pub(crate) fn write_typed(od: &mut DriveObjects, slot: Option<Slot>, value: Actual) {
-    if let Some(s) = slot {
-        match value {
-            Actual::I8(v) => od.store_slot_i8(s, v),
-            Actual::U8(v) => od.store_slot_u8(s, v),
-            Actual::U16(v) => od.store_slot_u16(s, v),
-            Actual::I16(v) => od.store_slot_i16(s, v),
-            Actual::I32(v) => od.store_slot_i32(s, v),
-        }
     }
 }
 
@@ -360,36 +344,19 @@ impl Snapshot {
     /// `CYCLIC_SETPOINTS` in the dictionary, whose writes do not move its
     /// configuration generation); the rest of the snapshot is kept.
     pub fn refresh_setpoints(&mut self, od: &DriveObjects, c: &CyclicSlots) {
-        // typed loads (one type compare) with the generic, saturating read
-        // as the fallback for an entry declared with another type
-        let i32_ = |s: Option<Slot>, d: i64| match s.and_then(|s| od.load_slot_i32(s)) {
-            Some(v) => v,
-            None => sat(read_slot(od, s, d), i32::MIN, i32::MAX),
-        };
-        let u16_ = |s: Option<Slot>, d: i64| match s.and_then(|s| od.load_slot_u16(s)) {
-            Some(v) => v,
-            None => sat(read_slot(od, s, d), 0u16, u16::MAX),
-        };
-        let i16_ = |s: Option<Slot>, d: i64| match s.and_then(|s| od.load_slot_i16(s)) {
-            Some(v) => v,
-            None => sat(read_slot(od, s, d), i16::MIN, i16::MAX),
-        };
-        self.controlword = u16_(c.controlword, 0);
-        self.mode = match c.mode.and_then(|s| od.load_slot_i8(s)) {
-            Some(v) => v,
-            None => sat(read_slot(od, c.mode, 8), i8::MIN, i8::MAX),
-        };
-        self.target_position = i32_(c.target_position, 0);
+        self.controlword = od.read_typed(c.controlword).unwrap_or(0);
+        self.mode = od.read_typed(c.mode).unwrap_or(8);
+        self.target_position = od.read_typed(c.target_position).unwrap_or(0);
         self.target_position_user = self.target_position;
-        self.ip_setpoint = i32_(c.ip_setpoint, 0);
+        self.ip_setpoint = od.read_typed(c.ip_setpoint).unwrap_or(0);
         self.ip_setpoint_user = self.ip_setpoint;
-        self.target_velocity = i32_(c.target_velocity, 0);
-        self.target_torque = i16_(c.target_torque, 0);
-        self.velocity_offset = i32_(c.velocity_offset, 0);
-        self.torque_offset = i16_(c.torque_offset, 0);
-        self.probe_function = u16_(c.probe_function, 0);
-        self.vl_target = i16_(c.vl_target, 0);
-        self.i210 = u16_(c.i210, 0);
+        self.target_velocity = od.read_typed(c.target_velocity).unwrap_or(0);
+        self.target_torque = od.read_typed(c.target_torque).unwrap_or(0);
+        self.velocity_offset = od.read_typed(c.velocity_offset).unwrap_or(0);
+        self.torque_offset = od.read_typed(c.torque_offset).unwrap_or(0);
+        self.probe_function = od.read_typed(c.probe_function).unwrap_or(0);
+        self.vl_target = od.read_typed(c.vl_target).unwrap_or(0);
+        self.i210 = od.read_typed(c.i210).unwrap_or(0);
     }
 
     /// Reads the snapshot of axis `w`.

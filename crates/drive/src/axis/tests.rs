@@ -548,6 +548,32 @@ fn c122_touch_probe_latches_the_rising_edge() {
     assert_eq!(rig.get(0, 0x60BA, 0), 777);
 }
 
+/// C-109 with C-122: a latched probe value is shown in the user units of
+/// the moment, so a new feed constant (6092h) converts it again although
+/// the probe latched nothing new.
+#[test]
+fn c109_c122_probe_value_follows_a_new_feed_constant() {
+    let mut rig = Rig::new();
+    rig.run(2);
+    rig.set(0, 0x60B8, 0, 0x11);
+    rig.run(1);
+    rig.io[0].probe_edges[0] = Some(ProbeEdge {
+        input: 1,
+        rising: true,
+        time_ns: rig.now,
+        position_inc: Some(1000),
+    });
+    rig.cycle();
+    rig.io[0].probe_edges[0] = None;
+    assert_eq!(rig.get(0, 0x60BA, 0), 1000);
+    rig.run(3);
+    assert_eq!(rig.get(0, 0x60BA, 0), 1000);
+    // half a user unit per increment
+    rig.set(0, 0x6092, 1, REV_I / 2);
+    rig.run(1);
+    assert_eq!(rig.get(0, 0x60BA, 0), 500);
+}
+
 #[test]
 fn c027_mode_change_between_classes_waits_for_standstill() {
     let mut rig = Rig::new();
@@ -838,9 +864,9 @@ fn cached_snapshot_equals_a_fresh_read_after_any_write() {
 }
 
 /// Every entry the control cycle reads or writes each cycle has a RAM slot
-/// on both axes (a missing one would silently read the default or drop an
-/// actual value), and no two per-axis entries share one (A291, the last,
-/// is global).
+/// of the type the cycle uses on both axes (a missing or differently typed
+/// one would silently read the default or drop an actual value), and no two
+/// per-axis entries share one (A291, the last, is global).
 #[test]
 fn cyclic_slots_resolve_every_entry_on_both_axes() {
     use crate::axis::snapshot::{CyclicSlots, Window};
@@ -854,53 +880,5 @@ fn cyclic_slots_resolve_every_entry_on_both_axes() {
         let s = s.unwrap_or_else(|| panic!("slot {k} missing"));
         assert!(!seen.contains(&s), "slot {k} shared");
         seen.push(s);
-    }
-}
-
-/// The actual values written with a typed store and the set-points read
-/// with a typed load have that type in the dictionary (else every access
-/// takes the generic path).
-#[test]
-fn typed_actual_value_slots_have_their_types() {
-    use crate::axis::snapshot::{CyclicSlots, Window};
-    use od::DataType::{I16, I32, I8, U16, U8};
-    let od = DriveObjects::new();
-    for axis in 0..2 {
-        let c = CyclicSlots::resolve(&od, Window { axis });
-        let typed = [
-            (c.statusword, U16),
-            (c.mode_display, I8),
-            (c.velocity, I32),
-            (c.torque, I16),
-            (c.current, I16),
-            (c.probe_status, U16),
-            (c.e80, U8),
-            (c.e48, U8),
-            (c.position, I32),
-            (c.following_error, I32),
-            (c.probe_values[0], I32),
-            (c.probe_values[1], I32),
-            (c.probe_values[2], I32),
-            (c.probe_values[3], I32),
-            (c.additional_position, I32),
-            (c.vl_demand, I16),
-            (c.vl_actual, I16),
-            (c.a67, U16),
-            // the set-points read with a typed load
-            (c.controlword, U16),
-            (c.mode, I8),
-            (c.target_position, I32),
-            (c.ip_setpoint, I32),
-            (c.target_velocity, I32),
-            (c.target_torque, I16),
-            (c.velocity_offset, I32),
-            (c.torque_offset, I16),
-            (c.probe_function, U16),
-            (c.vl_target, I16),
-            (c.i210, U16),
-        ];
-        for (k, (slot, t)) in typed.into_iter().enumerate() {
-            assert_eq!(slot.map(|s| s.data_type()), Some(t), "axis {axis} entry {k}");
-        }
     }
 }
