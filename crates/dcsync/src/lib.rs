@@ -51,7 +51,8 @@ pub mod validate;
 
 pub use optimize::{FrameSample, OptimizeOutcome, OptimizeRequest, OptimizeResult, Optimizer};
 pub use pll::{
-    gcd, Config, CycleCommand, CycleSequence, FrameTiming, Pll, PllState, Step, SyncFault, Tuning,
+    div_rem_u64, gcd, Config, CycleCommand, CycleSequence, FrameTiming, Pll, PllState, Step, SyncFault,
+    Tuning,
 };
 pub use status::{DiagCode, PllStatus, SyncDiagnostics};
 pub use validate::{recommended_sequence, validate, SyncError};

@@ -314,6 +314,29 @@ pub(crate) fn wrap_signed(d: i64, p: i64) -> i64 {
     }
 }
 
+/// `x / d` and `x % d` (`None` for `d = 0`). A divisor below 2^16 (the
+/// reduced ns denominators, 125 for 144 MHz) takes four 32-bit hardware
+/// divisions in base 2^16 instead of the ~100-instruction 64-bit library
+/// call a Cortex-M needs; larger ones take that call.
+#[inline]
+pub fn div_rem_u64(x: u64, d: u64) -> Option<(u64, u64)> {
+    let Ok(d16) = u16::try_from(d) else {
+        return Some((x.checked_div(d)?, x.checked_rem(d)?));
+    };
+    let d = u32::from(d16);
+    let hi = (x >> 32) as u32;
+    let (q_hi, r) = (hi.checked_div(d)?, hi.checked_rem(d)?);
+    // each step divides a value below d · 2^16 < 2^32
+    let x1 = (r << 16) | (x as u32 >> 16);
+    let (q1, r1) = (x1 / d, x1 % d);
+    let x0 = (r1 << 16) | (x as u32 & 0xFFFF);
+    let (q0, r0) = (x0 / d, x0 % d);
+    Some((
+        u64::from(q_hi) << 32 | u64::from(q1) << 16 | u64::from(q0),
+        u64::from(r0),
+    ))
+}
+
 /// Greatest common divisor (Euclid), `gcd(0, b) = b`: reduces timer ticks
 /// per ns to a small fraction (here and in the firmware's cycle timer).
 pub const fn gcd(mut a: u64, mut b: u64) -> u64 {
@@ -599,8 +622,11 @@ impl Pll {
             .and_then(|x| x.checked_add(self.carry))
         {
             Some(x) => {
-                let t = x.checked_div(den).unwrap_or(0);
-                self.carry = x - t * den;
+                // x ≥ 0; x / (ns_den · 2^Q) = (x >> Q) / ns_den, and the
+                // remainder keeps the low Q bits
+                let (t, r) = div_rem_u64(x.unsigned_abs() >> Q, self.ns_den.unsigned_abs()).unwrap_or((0, 0));
+                let t = t as i64;
+                self.carry = ((r as i64) << Q) | (x & ((1 << Q) - 1));
                 t
             }
             None => {
@@ -635,11 +661,10 @@ impl Pll {
         let est = self.cycle_est_ns();
         let s = self.last_sync0?;
         let elapsed = t.wrapping_sub(s) as i64;
-        let missed = if elapsed > est / 4 {
-            (elapsed - est / 4) / est
-        } else {
-            0
-        };
+        // the usual case, within 1¼ cycles of the last SYNC0, without
+        // dividing
+        let late = elapsed.saturating_sub(est / 4);
+        let missed = if late < est { 0 } else { late / est };
         self.missing = u32::try_from(missed).unwrap_or(u32::MAX);
         if self.missing >= u32::from(self.cfg.tuning.missing_limit.max(1)) {
             self.lose_sync0();
@@ -920,6 +945,40 @@ mod arith_tests {
             for &p in &[1, 2, 3, 1_000_000, 999_983, i64::MAX] {
                 assert_eq!(wrap_signed(d, p), reference(d, p), "{d} {p}");
             }
+        }
+    }
+
+    /// The base-2^16 division equals the plain 64-bit one for small and
+    /// large divisors and refuses 0.
+    #[test]
+    fn e111_div_rem_u64_matches_the_library_division() {
+        let xs = [
+            0u64,
+            1,
+            17,
+            18,
+            125,
+            65_535,
+            65_536,
+            1 << 32,
+            (1 << 32) - 1,
+            123_456_789_012_345,
+            u64::MAX,
+            u64::MAX - 1,
+        ];
+        let ds = [1u64, 2, 3, 18, 125, 999, 65_535, 65_536, 1_000_000_000, u64::MAX];
+        let mut seed = 0x9E37_79B9_7F4A_7C15u64;
+        let more: [u64; 2000] = core::array::from_fn(|_| {
+            seed ^= seed << 13;
+            seed ^= seed >> 7;
+            seed ^= seed << 17;
+            seed >> (seed % 64)
+        });
+        for &x in xs.iter().chain(&more) {
+            for &d in &ds {
+                assert_eq!(div_rem_u64(x, d), Some((x / d, x % d)), "{x} / {d}");
+            }
+            assert_eq!(div_rem_u64(x, 0), None);
         }
     }
 

@@ -347,6 +347,13 @@ pub struct Drive<F: Flash, B: Flash = NoFlash> {
     ctl_rx_frames: u32,
     /// The DC-Sync PLL while SYNC0 runs (built at the first pulse).
     pll: Option<Pll>,
+    /// The PLL settings of the objects (A292, A149, A290) with the
+    /// configuration generation they were read at: read again only when
+    /// it moved.
+    pll_settings: Option<(u32, PllSettings)>,
+    /// The PLL's status and fault as A298 and the sync diagnostics show
+    /// them (`None` without a PLL): rewritten only when they differ.
+    sync_shown: Option<(dcsync::PllStatus, Option<dcsync::SyncFault>)>,
     /// The entries of the cyclic paths.
     slots: RuntimeSlots,
     /// Why the PLL could not be built for the last SYNC0 configuration.
@@ -476,6 +483,8 @@ impl<F: Flash, B: Flash> Drive<F, B> {
             axis_caches: [AxisCache::new(), AxisCache::new()],
             ctl_rx_frames: 0,
             pll: None,
+            pll_settings: None,
+            sync_shown: None,
             slots: RuntimeSlots::NONE,
             sync_error: None,
             optimizer: dcsync::Optimizer::new(),
@@ -736,6 +745,7 @@ impl<F: Flash, B: Flash> Drive<F, B> {
             if state == AlState::Init || (self.pll_from_sm && state == AlState::PreOp) {
                 self.pll_from_sm = false;
                 self.pll = None;
+                self.sync_shown = None;
                 self.sync_error = None;
                 self.cycle_pdo = false;
                 self.update_sync_live();
@@ -1165,10 +1175,12 @@ impl<F: Flash, B: Flash> Drive<F, B> {
             match Pll::new(self.pll_config(cycle)) {
                 Ok(pll) => {
                     self.pll = Some(pll);
+                    self.sync_shown = None;
                     self.sync_error = None;
                 }
                 Err(e) => {
                     self.pll = None;
+                    self.sync_shown = None;
                     self.sync_error = Some(e);
                 }
             }
@@ -1185,28 +1197,41 @@ impl<F: Flash, B: Flash> Drive<F, B> {
     /// this cycle's length (program the next start at `start +
     /// period_ticks`). `None` without a PLL (free-running A150 timer).
     pub fn cycle_start(&mut self, t_local_ns: u64) -> Option<CycleCommand> {
-        let wanted = self.pll.as_ref().map(|p| *p.config())?;
-        let cfg = self.pll_config(wanted.sync0_cycle_ns);
+        let generation = self.objects.config_generation();
+        let settings = match self.pll_settings {
+            Some((g, s)) if g == generation => s,
+            _ => {
+                let cfg = self.pll_config(self.pll.as_ref()?.config().sync0_cycle_ns);
+                let s = PllSettings {
+                    a292_ns: cfg.a292_ns,
+                    sequence: cfg.sequence,
+                    enabled: cfg.enabled,
+                };
+                self.pll_settings = Some((generation, s));
+                s
+            }
+        };
         let pll = self.pll.as_mut()?;
-        if cfg.a292_ns != wanted.a292_ns {
-            pll.set_phase_offset(cfg.a292_ns);
+        let wanted = *pll.config();
+        if settings.a292_ns != wanted.a292_ns {
+            pll.set_phase_offset(settings.a292_ns);
         }
-        if cfg.sequence != wanted.sequence {
-            pll.set_sequence(cfg.sequence);
+        if settings.sequence != wanted.sequence {
+            pll.set_sequence(settings.sequence);
         }
-        if cfg.enabled != wanted.enabled {
-            pll.set_enabled(cfg.enabled);
+        if settings.enabled != wanted.enabled {
+            pll.set_enabled(settings.enabled);
         }
-        let before = (pll.status(), pll.fault());
         let cmd = pll.on_cycle_start(t_local_ns);
-        let changed = (pll.status(), pll.fault()) != before;
+        let now = (pll.status(), pll.fault());
         if cmd.index == 0 {
             self.record_optimizer_sample(t_local_ns);
         }
-        // A298 and the sync-error flags at once when they change here; the
-        // phase error of A261[3] follows with the next SYNC0 (on_sync0), so
-        // the control cycle does not rewrite the diagnostics every cycle
-        if changed {
+        // A298 and the sync-error flags at once when they differ from what
+        // they show; the phase error of A261[3] follows with the next SYNC0
+        // (on_sync0), so the control cycle does not rewrite the diagnostics
+        // every cycle
+        if self.sync_shown != Some(now) {
             self.update_sync_live();
         }
         Some(cmd)
@@ -1243,10 +1268,12 @@ impl<F: Flash, B: Flash> Drive<F, B> {
             match Pll::new(self.pll_config(cycle)) {
                 Ok(pll) => {
                     self.pll = Some(pll);
+                    self.sync_shown = None;
                     self.sync_error = None;
                 }
                 Err(e) => {
                     self.pll = None;
+                    self.sync_shown = None;
                     self.sync_error = Some(e);
                 }
             }
@@ -1261,6 +1288,7 @@ impl<F: Flash, B: Flash> Drive<F, B> {
     /// A296, A298 and A261 from the PLL (A261[0] also from a refused
     /// configuration; everything 0 without SYNC0).
     fn update_sync_live(&mut self) {
+        self.sync_shown = self.pll.as_ref().map(|p| (p.status(), p.fault()));
         let (status, diag, measured) = match &self.pll {
             Some(p) => (
                 p.status().0,
@@ -1455,6 +1483,15 @@ impl Text {
     fn bytes(&self) -> &[u8] {
         self.buf.get(..self.len).unwrap_or_default()
     }
+}
+
+/// The PLL settings the objects give (A292 phase offset, A149 sequence,
+/// A290 on/off), as [`Drive::cycle_start`] keeps them.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+struct PllSettings {
+    a292_ns: i32,
+    sequence: dcsync::CycleSequence,
+    enabled: bool,
 }
 
 #[cfg(test)]
