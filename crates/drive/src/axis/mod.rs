@@ -656,9 +656,9 @@ impl Axis {
         let slots: &CyclicSlots = cache
             .slots
             .get_or_insert_with(|| CyclicSlots::resolve(od, window));
-        let raw: &Snapshot = match &mut cache.snapshot {
-            Some((g, cached)) if *g == generation => {
-                cached.refresh_setpoints(od, slots);
+        let cached: &CachedSnapshot = match &mut cache.snapshot {
+            Some(cached) if cached.generation == generation => {
+                cached.snapshot.refresh_setpoints(od, slots);
                 cached
             }
             stale => {
@@ -666,24 +666,24 @@ impl Axis {
                 // C-109: user units at the objects, increments inside
                 self.scaling = fresh.scaling();
                 self.velocity_decimals = fresh.decimal_factors().0 as f32;
-                &stale.insert((generation, fresh)).1
+                stale.insert(CachedSnapshot {
+                    generation,
+                    in_increments: fresh.in_increments(&self.scaling),
+                    dt_ns: application_cycle_ns(u32::from(fresh.control_cycle_us).saturating_mul(1000))
+                        .unwrap_or(1_000_000),
+                    snapshot: fresh,
+                })
             }
         };
+        let (raw, dt_ns) = (&cached.snapshot, cached.dt_ns);
         // converted (a copy) only when user units are not increments
         let converted;
-        let o = if raw.in_increments(&self.scaling) {
+        let o = if cached.in_increments {
             raw
         } else {
             converted = raw.to_increments(&self.scaling);
             &converted
         };
-        self.modulo = if self.params.limits.endless_axis && o.modulo_length > 0 {
-            ModuloAxis::new(i64::from(o.modulo_length)).ok()
-        } else {
-            None
-        };
-        let dt_ns =
-            application_cycle_ns(u32::from(o.control_cycle_us).saturating_mul(1000)).unwrap_or(1_000_000);
         let class = match self.running {
             Some(Mode::Homing) => 1,
             Some(Mode::Jog) => 2,
@@ -789,6 +789,11 @@ impl Axis {
     /// Applies the configuration objects and parameters.
     fn configure(&mut self, od: &mut DriveObjects, slots: &CyclicSlots, o: &Snapshot, dt_ns: u32) {
         let p = self.params;
+        self.modulo = if p.limits.endless_axis && o.modulo_length > 0 {
+            ModuloAxis::new(i64::from(o.modulo_length)).ok()
+        } else {
+            None
+        };
         // 6076h from the motor data, and the probe values in the (new) units
         od.write_typed(
             slots.rated_current,
@@ -1904,8 +1909,20 @@ impl Axis {
 /// (docs/architecture.md, cycle cost).
 #[derive(Debug, Clone, Default)]
 pub struct AxisCache {
-    snapshot: Option<(u32, Snapshot)>,
+    snapshot: Option<CachedSnapshot>,
     slots: Option<CyclicSlots>,
+}
+
+/// The snapshot with the configuration generation it was read at and what
+/// follows from it alone.
+#[derive(Debug, Clone)]
+struct CachedSnapshot {
+    generation: u32,
+    snapshot: Snapshot,
+    /// The user units are increments (no conversion of the snapshot).
+    in_increments: bool,
+    /// The control cycle A150, ns (1 ms when A150 is not one of the cycles).
+    dt_ns: u32,
 }
 
 impl AxisCache {
