@@ -30,6 +30,7 @@
 //! with wrap-around (`wrapping_sub`), so crossing `i32::MAX` changes nothing.
 
 use crate::cycle::CycleRatio;
+use crate::float;
 use crate::Event;
 
 /// Order of the position interpolation polynomial (I425, spec §10.2).
@@ -365,9 +366,9 @@ impl FineInterpolator {
         let (velocity, acceleration) = match self.config.feedforward {
             FeedforwardSource::Internal => {
                 // dx/dt in increments per master cycle, then per second.
-                let d1 = to_f32(self.d1);
-                let d2 = to_f32(self.d2);
-                let d3 = to_f32(self.d3);
+                let d1 = float::from_i64(self.d1);
+                let d2 = float::from_i64(self.d2);
+                let d3 = float::from_i64(self.d3);
                 let v = d1 + (2.0 * t - 1.0) * 0.5 * d2 + (3.0 * t * t - 1.0) / 6.0 * d3;
                 let a = d2 + t * d3;
                 (v / master_s, a / (master_s * master_s))
@@ -383,15 +384,6 @@ impl FineInterpolator {
             acceleration_feedforward: acceleration,
             extrapolating: self.extrapolating,
         }
-    }
-}
-
-/// `x` as `f32` (the same rounding): through 32 bits when it fits, which
-/// a Cortex-M4 converts in one instruction instead of a library call.
-fn to_f32(x: i64) -> f32 {
-    match i32::try_from(x) {
-        Ok(v) => v as f32,
-        Err(_) => x as f32,
     }
 }
 
@@ -573,35 +565,6 @@ mod tests {
                 for per_master in [0, 1, 3, 1049, -99_991, 50_000_000] {
                     check_constant_velocity(order, n, -5, per_master);
                 }
-            }
-        }
-    }
-
-    /// The feed-forward's differences go through 32 bits when they fit:
-    /// the same `f32` as the direct 64-bit conversion, at and beyond the
-    /// edges of `i32` (|∇³| reaches 2³³).
-    #[test]
-    fn c115_difference_conversion_rounds_like_the_direct_one() {
-        let edges = [
-            0i64,
-            1,
-            -1,
-            16_777_217,
-            -16_777_217,
-            i64::from(i32::MAX),
-            i64::from(i32::MIN),
-        ];
-        for &e in &edges {
-            for x in [
-                e,
-                e + 1,
-                e - 1,
-                e * 2 + 1,
-                -(e * 3) - 1,
-                (1 << 33) - 1,
-                -(1 << 33) + 3,
-            ] {
-                assert_eq!(to_f32(x).to_bits(), (x as f32).to_bits(), "{x}");
             }
         }
     }

@@ -31,6 +31,7 @@
 
 pub mod cascade;
 pub mod cycle;
+pub mod float;
 pub mod homing;
 pub mod interp;
 pub mod limits;

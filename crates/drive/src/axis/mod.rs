@@ -1287,8 +1287,7 @@ impl Axis {
             let from = self.last_master_sp.unwrap_or(self.sp_pos);
             let step = target.wrapping_sub(from).unsigned_abs() as f32;
             let elapsed_ns = self.sp_age_ns.max(master_ns);
-            // through 32 bits when it fits (one instruction, the same value)
-            let elapsed_s = u32::try_from(elapsed_ns).map_or(elapsed_ns as f32, |ns| ns as f32) * 1e-9;
+            let elapsed_s = motion::float::from_u64(elapsed_ns) * 1e-9;
             let allowed =
                 2.0 * o.max_profile_velocity as f32 * elapsed_s + self.params.position_window_inc as f32;
             self.last_master_sp = Some(target);
@@ -1798,7 +1797,12 @@ impl Axis {
             self.probe.value_60bc(),
             self.probe.value_60bd(),
         ];
-        if self.probe_shown != Some(probe) {
+        // compared word by word (a compare of the arrays becomes a byte-wise
+        // memcmp call)
+        let shown = self
+            .probe_shown
+            .is_some_and(|p| p.iter().zip(probe).fold(0, |d, (a, b)| d | (a ^ b)) == 0);
+        if !shown {
             for (slot, value) in c.probe_values.into_iter().zip(probe) {
                 od.write_typed(slot, sat_i32(self.user_position(value)));
             }
