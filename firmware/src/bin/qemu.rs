@@ -360,10 +360,9 @@ mod app {
     #[task(binds = EXTI1, priority = 3, shared = [drive, timer, clock, io, cmd, cost])]
     fn control(cx: control::Context) {
         let now = { cx.shared.clock }.lock(|c| *c);
-        let io = { cx.shared.io }.lock(|i| *i);
         let t0 = measure::now();
-        let cmd =
-            (cx.shared.drive, cx.shared.timer).lock(|drive, timer| tasks::control(drive, timer, now, &io));
+        let cmd = (cx.shared.drive, cx.shared.timer, cx.shared.io)
+            .lock(|drive, timer, io| tasks::control(drive, timer, now, io));
         let t = measure::ticks(t0, measure::now());
         { cx.shared.cost }.lock(|c| c[0] = t);
         { cx.shared.cmd }.lock(|c| *c = cmd);
