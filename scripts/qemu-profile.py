@@ -88,5 +88,5 @@ for t in ('EXTI1', 'EXTI2', 'EXTI0'):
         k = window[2] - window[1] + 1
     print(f'== {t}: {tot[t]} instructions, {tot[t]//k} per run ({handlers[t]} runs)')
     rows = [(c, f) for (tt, f), c in per.items() if tt == t]
-    for c, f in sorted(rows, reverse=True)[:25]:
+    for c, f in sorted(rows, reverse=True)[:45]:
         print(f'{c//k:>9} per run {100*c/max(tot[t],1):5.1f}% {f[:110]}')

@@ -1078,7 +1078,7 @@ impl FwNode {
             },
         );
         let (param, fw) = old.drive.into_flashes();
-        *self = Self::power_on(param, fw.expect("firmware flash"));
+        *self = Self::power_on(param.expect("parameter flash"), fw.expect("firmware flash"));
     }
 
     /// The firmware slots.

@@ -155,7 +155,7 @@ mod app {
     #[idle(shared = [drive, timer, clock])]
     fn idle(mut cx: idle::Context) -> ! {
         loop {
-            cx.shared.drive.lock(|drive| tasks::background(drive));
+            tasks::background(&mut cx.shared.drive);
             let now = cx.shared.clock.lock(|c| c.now_ns(DWT::cycle_count()));
             if cx.shared.timer.lock(|t| t.next_at_ns()) <= now {
                 rtic::pend(Interrupt::CCU40_0);

@@ -286,7 +286,8 @@ impl SimDrive {
         let old = std::mem::replace(self, Self::power_on(SimFlash::new()));
         let (drift, offset) = (old.esc.config().clock_drift_ppb, old.esc.config().clock_offset_ns);
         let (flash, firmware) = old.drive.into_flashes();
-        *self = Self::power_on_with(flash, firmware);
+        // (the simulated drive saves at once: its store is never out in a job)
+        *self = Self::power_on_with(flash.unwrap_or_else(SimFlash::new), firmware);
         self.esc.set_clock(drift, offset);
     }
 

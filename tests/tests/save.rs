@@ -76,18 +76,26 @@ fn e020_power_cut_at_every_step_of_a_save_keeps_a_usable_set() {
     // how many flash operations one save takes
     let sim = line(1);
     write_a258(&sim, 111, Some((0x1010, 1, SAVE)));
-    let before = sim.borrow_mut().drives_mut()[0].drive.flash_mut().ops();
+    let before = sim.borrow_mut().drives_mut()[0].drive.flash_mut().unwrap().ops();
     write_a258(&sim, 112, Some((0x1010, 1, SAVE)));
-    let per_save = sim.borrow_mut().drives_mut()[0].drive.flash_mut().ops() - before;
+    let per_save = sim.borrow_mut().drives_mut()[0].drive.flash_mut().unwrap().ops() - before;
     assert!(per_save >= 2, "a save erases and writes");
 
     for cut in 0..per_save {
         let sim = line(1);
         write_a258(&sim, 500, Some((0x1010, 1, SAVE)));
         // power fails during the next save, after `cut` flash operations
-        sim.borrow_mut().drives_mut()[0].drive.flash_mut().cut_after(cut);
+        sim.borrow_mut().drives_mut()[0]
+            .drive
+            .flash_mut()
+            .unwrap()
+            .cut_after(cut);
         write_a258(&sim, 600, Some((0x1010, 1, SAVE)));
-        sim.borrow_mut().drives_mut()[0].drive.flash_mut().power_on();
+        sim.borrow_mut().drives_mut()[0]
+            .drive
+            .flash_mut()
+            .unwrap()
+            .power_on();
         power_cycle(&sim);
         assert_eq!(
             sim.borrow().drives()[0].drive.startup(),

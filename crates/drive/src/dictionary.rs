@@ -691,6 +691,11 @@ impl DriveObjects {
         core::mem::take(&mut self.requests)
     }
 
+    /// Requests a save (as A00[0] = 1 does).
+    pub fn request_save(&mut self) {
+        self.requests.save = true;
+    }
+
     /// The requests set since the last [`take_requests`](Self::take_requests).
     pub fn requests(&self) -> Requests {
         self.requests

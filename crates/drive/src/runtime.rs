@@ -312,6 +312,28 @@ impl RuntimeSlots {
     }
 }
 
+/// A save in progress ([`Drive::begin_save`]): the persistent values and
+/// the parameter store, out of the drive so the slow flash write runs
+/// without it (the firmware's idle loop holds no lock meanwhile; the
+/// control and ESC tasks keep running). Hand it back with
+/// [`Drive::end_save`].
+pub struct SaveJob<F: Flash> {
+    store: ParamStore<F>,
+    image: [u8; PERSISTENT_IMAGE_BYTES],
+    /// The image's length; `None` when the values did not serialise.
+    len: Option<usize>,
+    saved: bool,
+}
+
+impl<F: Flash> SaveJob<F> {
+    /// Erases and programs the store (E-018: the previous set stays intact
+    /// until the new one is complete).
+    pub fn write(&mut self) {
+        let image = self.len.and_then(|n| self.image.get(..n));
+        self.saved = image.is_some_and(|img| self.store.save(img, LAYOUT_HASH).is_ok());
+    }
+}
+
 /// One drive on the bus: slave stack + object dictionary + parameter store
 /// (+ the firmware slots on flash `B`, see [`Drive::with_boot`]).
 pub struct Drive<F: Flash, B: Flash = NoFlash> {
@@ -323,7 +345,8 @@ pub struct Drive<F: Flash, B: Flash = NoFlash> {
     pub eoe: ecat::eoe_queue::EoeQueue,
     /// The object dictionary (values in RAM).
     pub objects: DriveObjects,
-    store: ParamStore<F>,
+    /// The parameter store; out in a [`SaveJob`] while one runs.
+    store: Option<ParamStore<F>>,
     /// The firmware slots (FoE firmware update), if the drive has them.
     boot: Option<BootSlots<B>>,
     /// Diagnosis history 10F3h (volatile, E-145).
@@ -470,7 +493,7 @@ impl<F: Flash, B: Flash> Drive<F, B> {
             slave: Slave::new(&DEVICE),
             eoe: ecat::eoe_queue::EoeQueue::new(),
             objects: DriveObjects::new(),
-            store: ParamStore::new(flash),
+            store: Some(ParamStore::new(flash)),
             boot,
             diag: DiagHistory::new(),
             startup: Startup::Defaults,
@@ -515,7 +538,10 @@ impl<F: Flash, B: Flash> Drive<F, B> {
     /// there is none, it is from another layout or does not load).
     fn load_saved(&mut self) -> Startup {
         let mut image = [0u8; PERSISTENT_IMAGE_BYTES];
-        match self.store.load(LAYOUT_HASH, &mut image) {
+        let Some(store) = self.store.as_mut() else {
+            return Startup::Defaults;
+        };
+        match store.load(LAYOUT_HASH, &mut image) {
             Ok(n) => match image.get(..n).map(|img| self.objects.load_persistent(img)) {
                 Some(Ok(())) => Startup::Loaded,
                 _ => Startup::Defaults,
@@ -531,19 +557,25 @@ impl<F: Flash, B: Flash> Drive<F, B> {
         self.startup
     }
 
-    /// The store's flash (for power-cycle simulation and fault injection).
-    pub fn flash_mut(&mut self) -> &mut F {
-        self.store.flash_mut()
+    /// The store's flash (for power-cycle simulation and fault injection);
+    /// `None` while a [`SaveJob`] has it.
+    pub fn flash_mut(&mut self) -> Option<&mut F> {
+        self.store.as_mut().map(ParamStore::flash_mut)
     }
 
-    /// Powers off: gives the flash back (RAM values are lost).
-    pub fn into_flash(self) -> F {
-        self.store.into_inner()
+    /// Powers off: gives the flash back (RAM values are lost); `None` when
+    /// a [`SaveJob`] has it.
+    pub fn into_flash(self) -> Option<F> {
+        self.store.map(ParamStore::into_inner)
     }
 
-    /// Powers off: gives the parameter flash and the firmware slots' flash back.
-    pub fn into_flashes(self) -> (F, Option<B>) {
-        (self.store.into_inner(), self.boot.map(BootSlots::into_inner))
+    /// Powers off: gives the parameter flash (`None` when a [`SaveJob`] has
+    /// it) and the firmware slots' flash back.
+    pub fn into_flashes(self) -> (Option<F>, Option<B>) {
+        (
+            self.store.map(ParamStore::into_inner),
+            self.boot.map(BootSlots::into_inner),
+        )
     }
 
     /// The firmware slots, if the drive has them.
@@ -657,10 +689,46 @@ impl<F: Flash, B: Flash> Drive<F, B> {
 
     /// The dictionary's requests: a save (A00, 1010h) writes the store.
     fn serve_requests(&mut self) {
-        let requests = self.objects.take_requests();
-        if requests.save {
-            self.save();
+        if let Some(mut job) = self.begin_save() {
+            job.write();
+            self.end_save(job);
         }
+    }
+
+    /// A requested save (A00, 1010h) taken out of the drive: the persistent
+    /// values and the store, so that the firmware writes the flash
+    /// ([`SaveJob::write`]) without holding the drive; `None` without a
+    /// request or while another job has the store. A00[0] reads 1 (running)
+    /// until [`end_save`](Self::end_save).
+    pub fn begin_save(&mut self) -> Option<SaveJob<F>> {
+        if !self.objects.requests().save {
+            return None;
+        }
+        let store = self.store.take()?;
+        self.objects.take_requests();
+        let mut image = [0u8; PERSISTENT_IMAGE_BYTES];
+        let len = self.objects.persistent_image(&mut image).ok();
+        Some(SaveJob {
+            store,
+            image,
+            len,
+            saved: false,
+        })
+    }
+
+    /// Takes the store back from `job` and shows its result in A00 (E-018).
+    /// Returns whether the values were saved.
+    pub fn end_save(&mut self, job: SaveJob<F>) -> bool {
+        self.store = Some(job.store);
+        let _ = self.objects.set(A00, 1, 0);
+        let _ = self.objects.set(A00, 2, 100);
+        let result = if job.saved {
+            save_result::OK
+        } else {
+            save_result::FAILED
+        };
+        let _ = self.objects.set(A00, 3, result);
+        job.saved
     }
 
     fn poll_parts<P: Pdi>(
@@ -1388,27 +1456,17 @@ impl<F: Flash, B: Flash> Drive<F, B> {
         }
     }
 
-    /// Writes the persistent values to the store (A00 / 1010h "save").
+    /// Writes the persistent values to the store now (A00 / 1010h "save");
+    /// `false` when it failed or a [`SaveJob`] has the store.
     pub fn save(&mut self) -> bool {
-        let mut image = [0u8; PERSISTENT_IMAGE_BYTES];
-        let saved = match self.objects.persistent_image(&mut image) {
-            Ok(n) => image
-                .get(..n)
-                .is_some_and(|img| self.store.save(img, LAYOUT_HASH).is_ok()),
-            Err(_) => false,
-        };
-        let _ = self.objects.set(A00, 1, 0);
-        let _ = self.objects.set(A00, 2, 100);
-        let _ = self.objects.set(
-            A00,
-            3,
-            if saved {
-                save_result::OK
-            } else {
-                save_result::FAILED
-            },
-        );
-        saved
+        self.objects.request_save();
+        match self.begin_save() {
+            Some(mut job) => {
+                job.write();
+                self.end_save(job)
+            }
+            None => false,
+        }
     }
 
     /// A255 (state, +16 with error) and A257[3] ("AL xxxx") follow the slave.

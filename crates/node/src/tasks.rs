@@ -6,16 +6,19 @@
 //! | `control` | control-cycle timer | 3 | [`control`]: one cycle of both axes |
 //! | `esc` | ESC PDI interrupt (AL event) | 2 | [`esc_event`]: ESM, process data, monitoring |
 //! | `mailbox` | pended by `esc` | 1 | [`mailbox`]: one CoE/EoE/FoE request, EMCY |
-//! | `idle` | — | 0 | [`background`]: a requested save (QEMU: also the simulated world) |
+//! | `idle` | — | 0 | [`background`]: a requested save, the flash written outside the drive's lock (QEMU: also the simulated world) |
 //!
 //! `sync0` and `control` share the priority so they never preempt each
 //! other (both touch the PLL); `esc` locks the drive for one poll without
 //! the mailbox, `mailbox` for one request. See docs/architecture.md for the
 //! worst-case paths.
 
+use core::borrow::BorrowMut;
+
 use drive::axis::{AxisCommand, AxisIo};
 use ecat::StateChange;
 use esc::{regs, Pdi, PdiExt};
+use rtic_core::Mutex;
 
 use crate::cycle::CycleTimer;
 use crate::Drive;
@@ -66,7 +69,16 @@ pub fn mailbox<P: Pdi>(drive: &mut Drive, pdi: &mut P, now_ns: u64) -> Result<()
 }
 
 /// Background work from the idle loop: a save requested over the bus (A00,
-/// 1010h) is written to the parameter store.
-pub fn background(drive: &mut Drive) {
-    drive.poll_background();
+/// 1010h) is written to the parameter store. The drive is locked only to
+/// take the values and the store out
+/// ([`Drive::begin_save`](drive::runtime::Drive::begin_save)) and to hand
+/// the store back with the result; the flash is erased and programmed
+/// without the lock, so the control and ESC tasks keep running.
+/// (The resource holds the drive or, in the firmware, a `&'static mut` to
+/// it.)
+pub fn background<D: BorrowMut<Drive>>(drive: &mut impl Mutex<T = D>) {
+    if let Some(mut job) = drive.lock(|d| d.borrow_mut().begin_save()) {
+        job.write();
+        drive.lock(|d| d.borrow_mut().end_save(job));
+    }
 }

@@ -8,6 +8,7 @@ use hil_sim::world::{new_esc, Event, World};
 use node::clock::Clock;
 use node::cycle::{CycleTimer, CYCLE_NS};
 use node::{tasks, Drive, ParamFlash};
+use rtic_core::Exclusive;
 
 struct Board {
     drive: Drive,
@@ -53,7 +54,7 @@ impl Board {
                     tasks::esc_event(&mut self.drive, &mut self.timer, &mut self.esc.pdi(), now).unwrap();
                     // the mailbox task runs after the ESC task returns (priority 1)
                     tasks::mailbox(&mut self.drive, &mut self.esc.pdi(), now).unwrap();
-                    tasks::background(&mut self.drive);
+                    tasks::background(&mut Exclusive(&mut self.drive));
                     if p != Progress::Busy {
                         log.push(p);
                     }
@@ -137,7 +138,7 @@ fn save_fits_the_parameter_flash() {
     let mut drive = Drive::new(ParamFlash::new());
     drive.objects.set(0x6065, 0, 1234).unwrap();
     assert!(drive.save(), "save into {} bytes", 2 * 2048);
-    let drive = Drive::new(drive.into_flash());
+    let drive = Drive::new(drive.into_flash().unwrap());
     assert_eq!(drive.startup(), drive::runtime::Startup::Loaded);
     assert_eq!(drive.objects.get(0x6065, 0), Ok(1234));
 }
@@ -157,9 +158,49 @@ fn e018_save_is_written_by_the_background_task() {
         .unwrap();
     tasks::mailbox(&mut b.drive, &mut b.esc.pdi(), 0).unwrap();
     assert!(b.drive.objects.requests().save, "the mailbox task saved");
-    tasks::background(&mut b.drive);
+    tasks::background(&mut Exclusive(&mut b.drive));
     assert!(!b.drive.objects.requests().save);
-    let drive = Drive::new(b.drive.into_flash());
+    let drive = Drive::new(b.drive.into_flash().unwrap());
     assert_eq!(drive.startup(), drive::runtime::Startup::Loaded);
     assert_eq!(drive.objects.get(0x6065, 0), Ok(4321));
+}
+
+/// E-018 with the task map: the background task takes the values and the
+/// store out of the drive and writes the flash without holding it. While
+/// the job runs the drive keeps cycling, A00[0] reads 1 (running), a second
+/// request waits for the store, and the saved set is the one taken at the
+/// start.
+#[test]
+fn e018_save_job_writes_the_flash_outside_the_drive() {
+    use od::Dictionary as _;
+    const A00: u16 = 0x2000;
+    let request = |d: &mut Drive| d.objects.write(A00, 1, &[1], od::CommState::PreOp).unwrap();
+    let mut b = Board::new();
+    b.drive.objects.set(0x6065, 0, 1234).unwrap();
+    request(&mut b.drive);
+    let mut job = b.drive.begin_save().expect("a save was requested");
+    assert_eq!(b.drive.objects.get(A00, 1), Ok(1), "running");
+    assert!(b.drive.flash_mut().is_none(), "the job has the store");
+    // the drive runs on meanwhile; a new value and a new request wait
+    let io = [drive::axis::AxisIo::ready(0); 2];
+    for k in 1..=3u64 {
+        tasks::control(&mut b.drive, &mut b.timer, k * 1_000_000, &io);
+    }
+    b.drive.objects.set(0x6065, 0, 999).unwrap();
+    request(&mut b.drive);
+    assert!(b.drive.begin_save().is_none(), "one job at a time");
+    job.write();
+    assert!(b.drive.end_save(job));
+    assert_eq!(b.drive.objects.get(A00, 3), Ok(drive::runtime::save_result::OK));
+    assert!(
+        b.drive.objects.requests().save,
+        "the second request is still pending"
+    );
+    let drive = Drive::new(b.drive.into_flash().unwrap());
+    assert_eq!(drive.startup(), drive::runtime::Startup::Loaded);
+    assert_eq!(
+        drive.objects.get(0x6065, 0),
+        Ok(1234),
+        "the values at the start of the job"
+    );
 }

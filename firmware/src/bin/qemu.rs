@@ -279,7 +279,7 @@ mod app {
                     measure::paint();
                     run(Interrupt::EXTI2);
                     stack[2] = stack[2].max(measure::used());
-                    cx.shared.drive.lock(|drive| tasks::background(drive));
+                    tasks::background(&mut cx.shared.drive);
                     if moving {
                         esc_cost.add(insn(cx.shared.cost.lock(|c| c[1])));
                     }
