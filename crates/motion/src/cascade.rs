@@ -26,6 +26,7 @@
 //! actual velocity is computed from positions by a differentiating filter
 //! when the caller does not supply it.
 
+use crate::float::clamp;
 use crate::INCREMENTS_PER_REVOLUTION;
 
 /// Radians per increment: 2π / 2^20.
@@ -247,10 +248,11 @@ impl Cascade {
     pub fn set_config(&mut self, config: CascadeConfig) -> Result<(), CascadeError> {
         config.validate()?;
         self.config = config;
-        self.integral_nm = self
-            .integral_nm
-            .max(-config.torque_limit_negative_nm)
-            .min(config.torque_limit_positive_nm);
+        self.integral_nm = clamp(
+            self.integral_nm,
+            -config.torque_limit_negative_nm,
+            config.torque_limit_positive_nm,
+        );
         Ok(())
     }
 
@@ -300,7 +302,7 @@ impl Cascade {
                     finite_or_zero(input.velocity_inc_per_s)
                 };
                 let vmax = cfg.max_velocity_inc_per_s;
-                let command = raw_command.max(-vmax).min(vmax);
+                let command = clamp(raw_command, -vmax, vmax);
                 velocity_limited = command != raw_command;
 
                 let error_rad_per_s = (command - actual_velocity) * RAD_PER_INCREMENT;
@@ -319,7 +321,7 @@ impl Cascade {
                     let winds_up = (unsaturated >= lim_pos && increment > 0.0)
                         || (unsaturated <= -lim_neg && increment < 0.0);
                     if !winds_up {
-                        self.integral_nm = (self.integral_nm + increment).max(-lim_neg).min(lim_pos);
+                        self.integral_nm = clamp(self.integral_nm + increment, -lim_neg, lim_pos);
                     }
                 } else {
                     self.integral_nm = 0.0;
@@ -348,7 +350,7 @@ impl Cascade {
             }
         };
 
-        let torque = torque_unlimited.max(-lim_neg).min(lim_pos);
+        let torque = clamp(torque_unlimited, -lim_neg, lim_pos);
         let torque_limited = torque != torque_unlimited;
         if input.entry == ControlEntry::Torque {
             // Track the output so a later switch to the velocity entry starts

@@ -1,3 +1,5 @@
+//! `f32` helpers for the control cycle's instruction count.
+//!
 //! 64-bit integers to `f32` without the library call where they fit in 32
 //! bits: a Cortex-M4 converts 32-bit integers in one instruction, 64-bit ones
 //! in a call of ~40 instructions. The result is the same value (one rounding
@@ -25,6 +27,19 @@ pub fn from_u64(x: u64) -> f32 {
     }
 }
 
+/// `x.max(lo).min(hi)` for `lo ≤ hi` (NaN gives `lo`, as there), in two
+/// compares: a Cortex-M4 has no `f32` min/max instruction, `f32::min` and
+/// `f32::max` are library calls.
+#[inline]
+pub fn clamp(x: f32, lo: f32, hi: f32) -> f32 {
+    let y = if x >= lo { x } else { lo };
+    if y <= hi {
+        y
+    } else {
+        hi
+    }
+}
+
 #[cold]
 #[inline(never)]
 fn wide_i64(x: i64) -> f32 {
@@ -40,6 +55,39 @@ fn wide_u64(x: u64) -> f32 {
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    /// The compare clamp equals `max(lo).min(hi)`, NaN and infinities
+    /// included (the cascade of C-035: its torque and velocity limits).
+    #[test]
+    fn c035_clamp_equals_max_min() {
+        let xs = [
+            0.0f32,
+            -0.0,
+            1.5,
+            -1.5,
+            3.0,
+            -3.0,
+            2.0,
+            -2.0,
+            f32::NAN,
+            f32::INFINITY,
+            f32::NEG_INFINITY,
+        ];
+        for &(lo, hi) in &[
+            (-2.0f32, 2.0f32),
+            (0.0, 0.0),
+            (-1e9, 5e-3),
+            (f32::NEG_INFINITY, f32::INFINITY),
+        ] {
+            for &x in &xs {
+                assert_eq!(
+                    clamp(x, lo, hi).to_bits(),
+                    x.max(lo).min(hi).to_bits(),
+                    "{x} in {lo}..{hi}"
+                );
+            }
+        }
+    }
 
     /// The 32-bit path rounds like the direct 64-bit conversion, at and
     /// beyond the edges of the 32-bit types (the interpolator's |∇³| reaches
