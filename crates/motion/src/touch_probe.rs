@@ -225,9 +225,18 @@ impl TouchProbe {
 
     /// Writes 60B8h (A594) touch probe function (C-121, C-126 – C-128).
     pub fn set_function(&mut self, function_60b8: u16) {
+        if function_60b8 == self.function() {
+            return; // the same function again changes nothing
+        }
         let [low, high] = function_60b8.to_le_bytes();
         self.one.set_function(low);
         self.two.set_function(high);
+    }
+
+    /// Whether either probe is switched on (60B8h bit 0 or 8): off, no
+    /// edge latches anything.
+    pub fn is_enabled(&self) -> bool {
+        (self.one.function | self.two.function) & ENABLE != 0
     }
 
     /// 60B8h as last written.
@@ -321,6 +330,26 @@ mod tests {
         assert_eq!(tp.function(), 1);
         tp.set_function(0);
         assert_eq!(tp.status(), 0);
+    }
+
+    /// The control cycle writes 60B8h every cycle: the same function again
+    /// keeps the stored value, the status and the first-event lock; with
+    /// both probes off nothing is enabled.
+    #[test]
+    fn c124_rewriting_the_same_function_changes_nothing() {
+        let mut tp = TouchProbe::new();
+        assert!(!tp.is_enabled());
+        let f = (ENABLE | RISING_EDGE) as u16;
+        tp.set_function(f);
+        assert!(tp.is_enabled());
+        assert!(edge(&mut tp, Edge::Rising, 10));
+        let status = tp.status();
+        tp.set_function(f);
+        assert_eq!(tp.status(), status);
+        assert!(!edge(&mut tp, Edge::Rising, 20), "first event: still locked");
+        assert_eq!(tp.value_60ba(), 10);
+        tp.set_function(0);
+        assert!(!tp.is_enabled());
     }
 
     #[test]

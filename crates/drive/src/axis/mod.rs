@@ -1030,7 +1030,10 @@ impl Axis {
             time_ns: now_ns,
             position_inc: actual,
         };
-        let previous = self.last_sample.unwrap_or(current);
+        let previous = self.last_sample.replace(current).unwrap_or(current);
+        if !self.probe.is_enabled() {
+            return; // both probes off: no edge latches anything (C-126)
+        }
         let [src1, src2] = o.probe_source;
         for edge in io.probe_edges.iter().flatten() {
             let position = match edge.position_inc {
@@ -1050,7 +1053,6 @@ impl Axis {
             let p = self.to_user(index.position_inc, o.polarity);
             self.probe.latch(TriggerSignal::IndexPulse, Edge::Rising, p);
         }
-        self.last_sample = Some(current);
     }
 
     /// Drive function off: the set-point state follows the actual position.
