@@ -8,6 +8,7 @@
 //! (element + 1 for manufacturer arrays), so it does not change with the
 //! template.
 
+use core::cell::Cell;
 use core::marker::PhantomData;
 use core::sync::atomic::{AtomicU32, Ordering};
 
@@ -606,13 +607,21 @@ impl Slot {
 /// cycle are resolved once into a [`Slot`] and then read and written with
 /// [`load_slot`](Self::load_slot)/[`store_slot`](Self::store_slot) and their
 /// typed forms (docs/architecture.md, cycle cost).
+///
+/// (`repr(C)`: the RAM image first, at the struct's address, so the control
+/// cycle's loads and stores at a slot's offset need no extra add.)
 #[derive(Debug, Clone)]
+#[repr(C)]
 pub struct DriveObjects {
     image: [u8; IMAGE_BYTES],
     template: Template,
     requests: Requests,
     /// Counts configuration changes ([`Self::config_generation`]).
     config_generation: u32,
+    /// The SyncManager lengths of the mapping (RxPDO, TxPDO bytes) with the
+    /// configuration generation they were summed at: the slave asks every
+    /// poll, the mapping changes only with the generation.
+    pdo_bytes: Cell<Option<(u32, (usize, usize))>>,
 }
 
 /// Equal dictionaries hold the same values and template; how they got
@@ -652,6 +661,7 @@ impl DriveObjects {
                 defaults_restored: false,
             },
             config_generation: 0,
+            pdo_bytes: Cell::new(None),
         }
     }
 
@@ -1305,7 +1315,16 @@ impl Dictionary for DriveObjects {
     }
 
     fn process_data_bytes(&self) -> Option<(usize, usize)> {
-        Some((self.sm_bytes(0x1C12), self.sm_bytes(0x1C13)))
+        let generation = self.config_generation;
+        let bytes = match self.pdo_bytes.get() {
+            Some((g, bytes)) if g == generation => bytes,
+            _ => {
+                let bytes = (self.sm_bytes(0x1C12), self.sm_bytes(0x1C13));
+                self.pdo_bytes.set(Some((generation, bytes)));
+                bytes
+            }
+        };
+        Some(bytes)
     }
 
     fn sdo_info_enabled(&self) -> bool {

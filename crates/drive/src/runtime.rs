@@ -248,6 +248,8 @@ struct RuntimeSlots {
     error_register: Option<Slot>,
     /// 10F3h:04 (A250) new messages.
     new_messages: Option<Slot>,
+    /// A255 device state (ESM state, +16 with an error).
+    a255: Option<Slot>,
 }
 
 impl RuntimeSlots {
@@ -264,6 +266,7 @@ impl RuntimeSlots {
         sync_error: [None; 2],
         error_register: None,
         new_messages: None,
+        a255: None,
     };
 
     fn resolve(od: &DriveObjects) -> Self {
@@ -281,12 +284,13 @@ impl RuntimeSlots {
             sync_error: [s(0x1C32, 0x20), s(0x1C33, 0x20)],
             error_register: s(0x1001, 0),
             new_messages: s(0x10F3, 4),
+            a255: s(A255, 0),
         }
     }
 
     /// Every slot, for the completeness test.
     #[cfg(test)]
-    fn all(&self) -> [Option<Slot>; 17] {
+    fn all(&self) -> [Option<Slot>; 18] {
         let [r0, r1, r2, r3] = self.a261;
         let [m0, m1] = self.sm_missed;
         let [e0, e1] = self.sync_error;
@@ -308,6 +312,7 @@ impl RuntimeSlots {
             e1,
             self.error_register,
             self.new_messages,
+            self.a255,
         ]
     }
 }
@@ -1472,7 +1477,7 @@ impl<F: Flash, B: Flash> Drive<F, B> {
     /// A255 (state, +16 with error) and A257[3] ("AL xxxx") follow the slave.
     fn update_live(&mut self) {
         let state = i64::from(self.slave.state().code()) + if self.slave.error() { 16 } else { 0 };
-        let _ = self.objects.set(A255, 0, state);
+        write_slot(&mut self.objects, self.slots.a255, state);
         let code = self.slave.al_status_code();
         if code != self.last_code {
             self.last_code = code;

@@ -436,6 +436,22 @@ fn e054_assignment_checks() {
     );
 }
 
+/// E-034: the SyncManager lengths follow every mapping change (they are
+/// kept between changes, the slave asks each poll).
+#[test]
+fn e034_sm_lengths_follow_each_mapping_change() {
+    let mut d = DriveObjects::new();
+    let before = d.process_data_bytes().unwrap();
+    assert!(before.0 > 0 && before.1 > 0);
+    assert_eq!(d.process_data_bytes().unwrap(), before);
+    wr(&mut d, 0x1C13, 0, 0, 1).unwrap();
+    assert_eq!(d.process_data_bytes().unwrap(), (before.0, 0));
+    wr(&mut d, 0x1C12, 0, 0, 1).unwrap();
+    assert_eq!(d.process_data_bytes().unwrap(), (0, 0));
+    wr(&mut d, 0x1C13, 0, 1, 1).unwrap();
+    assert_eq!(d.process_data_bytes().unwrap(), (0, before.1));
+}
+
 #[test]
 fn pdo_maps_of_device_equal_od_defaults() {
     let mut d = DriveObjects::new();
