@@ -11,7 +11,7 @@
 use core::sync::atomic::{AtomicU32, Ordering};
 
 use crate::objects::{self, enumeration, find, Object, Value, IMAGE_BYTES, INITIAL_IMAGE, OBJECTS, OFFSETS};
-use crate::pdo_image::CopyOp;
+use crate::pdo_image::{CopyOp, WIDTH_SHIFT};
 use crate::{parameter_index, MAPPING_ENTRIES, SOFTWARE_BUILD};
 use od::{CommState, DataType, Dictionary, EntryInfo, ObjectInfo, SdoAbort};
 
@@ -896,18 +896,19 @@ impl DriveObjects {
     }
 
     /// The RxPDO copy program's stores of configuration entries (any of the
-    /// widths 1, 2, 4, 8 in `op.width`), as
+    /// widths 1, 2, 4, 8, its log2 in `op.img` from [`WIDTH_SHIFT`] on), as
     /// [`copy_slot_from`](Self::copy_slot_from) stores them: a value that
     /// differs from the one in RAM is a configuration change, the same value
     /// is not.
     #[inline(always)]
     pub(crate) fn copy_in_config(&mut self, ops: &[CopyOp], src: &[u8]) {
+        const OFFSET: u16 = (1 << WIDTH_SHIFT) - 1;
         for op in ops {
-            let (ram, img) = (usize::from(op.ram), usize::from(op.img));
-            match op.width {
-                1 => self.store_config::<1>(ram, src, img),
-                2 => self.store_config::<2>(ram, src, img),
-                4 => self.store_config::<4>(ram, src, img),
+            let (ram, img) = (usize::from(op.ram), usize::from(op.img & OFFSET));
+            match op.img >> WIDTH_SHIFT {
+                2 => self.store_config::<4>(ram, src, img),
+                1 => self.store_config::<2>(ram, src, img),
+                0 => self.store_config::<1>(ram, src, img),
                 _ => self.store_config::<8>(ram, src, img),
             }
         }
@@ -933,8 +934,14 @@ impl DriveObjects {
     #[inline(always)]
     pub(crate) fn copy_out<const N: usize>(&self, ops: &[CopyOp], dst: &mut [u8]) {
         for op in ops {
-            if let Some(b) = bytes_at::<N>(&self.image, usize::from(op.ram)) {
-                put_at(dst, usize::from(op.img), b);
+            let (ram, img) = (usize::from(op.ram), usize::from(op.img));
+            // the destination first: its check and the source's share one
+            // predicated block
+            let to = dst
+                .get_mut(img..img + N)
+                .and_then(|d| <&mut [u8; N]>::try_from(d).ok());
+            if let (Some(to), Some(b)) = (to, bytes_at::<N>(&self.image, ram)) {
+                *to = b;
             }
         }
     }

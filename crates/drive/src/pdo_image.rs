@@ -28,20 +28,22 @@
 //! by its two's complement bits. Gap entries (index 0) take their bits and
 //! are skipped (RxPDO) or sent as zeros (TxPDO).
 //!
-//! The copy program: [`PdoImage::compile`] also turns the entries that have
-//! a RAM [`Slot`] (integers of their full width at a byte boundary, the
-//! usual case) into a compact program of [`CopyOp`]s, two offsets each,
-//! grouped by width (1, 2, 4, 8 bytes; RxPDO configuration entries in groups
-//! of their own). Entries adjacent in both the RAM image and the process
-//! image are merged into wider copies. One cycle's copy is then a few tight
-//! loops of fixed-size loads and stores, with a bounds check per op but no
-//! lookup, no dispatch per entry and no `memcmp`. Everything else (gaps,
-//! entries off byte boundaries, strings) keeps the per-entry copy, which
-//! also serves a byte slice shorter than the image (entries beyond it are
-//! skipped whole) and an RxPDO mapping that stores twice into the same RAM
-//! bytes (the order of the stores matters there, and the program's groups
-//! do not keep it). The results are those of the per-entry copy, byte for
-//! byte and configuration change for configuration change.
+//! The copy program: [`PdoImage::compile`] also turns the entries that have a
+//! RAM [`Slot`] (integers of their full width at a byte boundary, the usual
+//! case) into a compact program of [`CopyOp`]s, two offsets each, grouped by
+//! width (1, 2, 4, 8 bytes; RxPDO configuration entries, any width, in a
+//! group of their own). Entries adjacent in both the RAM image and the
+//! process image are merged into wider copies. One cycle's copy is then a few
+//! tight loops of fixed-size loads and stores, with a bounds check per op but
+//! no lookup, no dispatch per entry and no `memcmp`. Each group is found from
+//! its start and length (`Program::groups`), without a running cursor, which
+//! keeps the loops' registers free. Everything else (gaps, entries off byte
+//! boundaries, strings) keeps the per-entry copy, which also serves a byte
+//! slice shorter than the image (entries beyond it are skipped whole) and an
+//! RxPDO mapping that stores twice into the same RAM bytes (the order of the
+//! stores matters there, and the program's groups do not keep it). The
+//! results are those of the per-entry copy, byte for byte and configuration
+//! change for configuration change.
 //!
 //! Subindices: a mapping entry names its object in the subindex numbering of
 //! the active template (as the mapping check does); the table holds the
@@ -257,18 +259,40 @@ fn fill_entry(e: &ImageEntry, objects: &DriveObjects, tx_bytes: &mut [u8]) {
     }
 }
 
-/// One copy of a [`Channel`]'s copy program: `width` bytes between the RAM
-/// image of [`DriveObjects`] (from offset `ram`) and the process image (from
-/// byte `img`).
+/// One copy of a [`Channel`]'s copy program: bytes between the RAM image of
+/// [`DriveObjects`] (from offset `ram`) and the process image (from byte
+/// `img`), as many as its group's width. Four bytes, so a group's ops are
+/// found with a shift.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
 pub struct CopyOp {
     /// Byte offset in the RAM image.
     pub(crate) ram: u16,
-    /// Byte offset in the process image.
+    /// Byte offset in the process image; in the group of configuration
+    /// entries (any width) the width's log2 is in the bits from
+    /// [`WIDTH_SHIFT`] on ([`CopyOp::config`]).
     pub(crate) img: u16,
-    /// Bytes: 1, 2, 4 or 8 (read only in the group of configuration
-    /// entries; the other groups have one width each).
-    pub(crate) width: u8,
+}
+
+/// Where a configuration op keeps its width's log2 (in `img`).
+pub(crate) const WIDTH_SHIFT: u32 = 14;
+// image offsets stay below it
+const _: () = assert!(MAX_IMAGE_BITS / 8 <= 1 << WIDTH_SHIFT);
+
+impl CopyOp {
+    /// A configuration op: `width` (1, 2, 4 or 8) bytes at `img`.
+    fn config(ram: u16, img: u16, width: usize) -> Option<Self> {
+        let log2 = u16::try_from(width.trailing_zeros()).ok()?;
+        (img >> WIDTH_SHIFT == 0 && width.is_power_of_two() && width <= 8).then_some(Self {
+            ram,
+            img: img | log2 << WIDTH_SHIFT,
+        })
+    }
+
+    /// Width in bytes of a configuration op.
+    #[cfg(test)]
+    fn width(self) -> usize {
+        1 << (self.img >> WIDTH_SHIFT)
+    }
 }
 
 /// Widths of the copies in bytes: groups `0..4` copy these.
@@ -282,11 +306,12 @@ const GROUPS: usize = CONFIG + 1;
 const _: () = assert!(MAX_ENTRIES <= u8::MAX as usize);
 
 /// The copy program of one direction (see the module docs): the ops of
-/// group 0, then those of group 1, …; `counts[g]` ops in group `g`.
+/// group 0, then those of group 1, …; group `g` is the `groups[g].1` ops
+/// from `groups[g].0` on.
 #[derive(Debug, Clone, PartialEq)]
 struct Program {
     ops: [CopyOp; MAX_ENTRIES],
-    counts: [u8; GROUPS],
+    groups: [(u8, u8); GROUPS],
     /// Mapped entries the program copies.
     entries: usize,
     /// The shortest byte slice the program serves (the image's length);
@@ -303,12 +328,8 @@ struct Program {
 
 impl Program {
     const NONE: Self = Self {
-        ops: [CopyOp {
-            ram: 0,
-            img: 0,
-            width: 0,
-        }; MAX_ENTRIES],
-        counts: [0; GROUPS],
+        ops: [CopyOp { ram: 0, img: 0 }; MAX_ENTRIES],
+        groups: [(0, 0); GROUPS],
         entries: 0,
         min_len: usize::MAX,
         whole_len: usize::MAX,
@@ -319,8 +340,8 @@ impl Program {
     /// configuration entries (`rx`) go to a group of their own. In place:
     /// the caller's frame holds two channels already.
     fn build(p: &mut Self, entries: &[ImageEntry], bytes: usize, rx: bool, objects: &DriveObjects) {
-        (p.counts, p.entries, p.min_len, p.whole_len, p.others) =
-            ([0; GROUPS], 0, usize::MAX, usize::MAX, false);
+        (p.groups, p.entries, p.min_len, p.whole_len, p.others) =
+            ([(0, 0); GROUPS], 0, usize::MAX, usize::MAX, false);
         if rx && stores_overlap(entries, objects) {
             return;
         }
@@ -333,17 +354,21 @@ impl Program {
                     return;
                 }
                 let fits = ram + width <= IMAGE_BYTES && img + width <= bytes;
-                let op = (u16::try_from(ram), u16::try_from(img), u8::try_from(width));
+                let op = match (u16::try_from(ram), u16::try_from(img)) {
+                    (Ok(ram), Ok(img)) if g == CONFIG => CopyOp::config(ram, img, width),
+                    (Ok(ram), Ok(img)) => Some(CopyOp { ram, img }),
+                    _ => None,
+                };
                 match (p.ops.get_mut(at), op) {
-                    (Some(op), (Ok(ram), Ok(img), Ok(width))) if fits => {
-                        *op = CopyOp { ram, img, width };
+                    (Some(slot), Some(op)) if fits => {
+                        *slot = op;
                         at += 1;
                     }
                     _ => ok = false,
                 }
             });
-            match (p.counts.get_mut(g), u8::try_from(at - start)) {
-                (Some(n), Ok(ops)) => *n = ops,
+            match (p.groups.get_mut(g), u8::try_from(start), u8::try_from(at - start)) {
+                (Some(group), Ok(from), Ok(n)) => *group = (from, n),
                 _ => ok = false,
             }
         }
@@ -374,45 +399,49 @@ impl Program {
         self.min_len != usize::MAX
     }
 
-    /// The ops of group `g`.
-    #[cfg(test)]
-    fn group(&self, g: usize) -> &[CopyOp] {
-        let from = self.counts.iter().take(g).map(|&n| usize::from(n)).sum::<usize>();
-        let n = self.counts.get(g).map_or(0, |&n| usize::from(n));
-        self.ops.get(from..from + n).unwrap_or_default()
+    /// The ops of group `g` (`None` only for a program that was not built).
+    #[inline(always)]
+    fn group(&self, g: usize) -> Option<&[CopyOp]> {
+        let &(from, n) = self.groups.get(g)?;
+        let from = usize::from(from);
+        self.ops.get(from..from + usize::from(n))
     }
 
     /// Runs the RxPDO program: `src` into the objects.
     #[inline(always)]
     fn copy_in(&self, src: &[u8], objects: &mut DriveObjects) {
-        let mut ops = self.ops.as_slice();
-        let mut next = |g: usize| {
-            let n = self.counts.get(g).copied().unwrap_or(0);
-            let (group, rest) = ops.split_at_checked(usize::from(n)).unwrap_or_default();
-            ops = rest;
-            group
-        };
-        objects.copy_in::<1>(next(0), src);
-        objects.copy_in::<2>(next(1), src);
-        objects.copy_in::<4>(next(2), src);
-        objects.copy_in::<8>(next(3), src);
-        objects.copy_in_config(next(CONFIG), src);
+        if let Some(ops) = self.group(0) {
+            objects.copy_in::<1>(ops, src);
+        }
+        if let Some(ops) = self.group(1) {
+            objects.copy_in::<2>(ops, src);
+        }
+        if let Some(ops) = self.group(2) {
+            objects.copy_in::<4>(ops, src);
+        }
+        if let Some(ops) = self.group(3) {
+            objects.copy_in::<8>(ops, src);
+        }
+        if let Some(ops) = self.group(CONFIG) {
+            objects.copy_in_config(ops, src);
+        }
     }
 
     /// Runs the TxPDO program: the objects into `dst`.
     #[inline(always)]
     fn copy_out(&self, objects: &DriveObjects, dst: &mut [u8]) {
-        let mut ops = self.ops.as_slice();
-        let mut next = |g: usize| {
-            let n = self.counts.get(g).copied().unwrap_or(0);
-            let (group, rest) = ops.split_at_checked(usize::from(n)).unwrap_or_default();
-            ops = rest;
-            group
-        };
-        objects.copy_out::<1>(next(0), dst);
-        objects.copy_out::<2>(next(1), dst);
-        objects.copy_out::<4>(next(2), dst);
-        objects.copy_out::<8>(next(3), dst);
+        if let Some(ops) = self.group(0) {
+            objects.copy_out::<1>(ops, dst);
+        }
+        if let Some(ops) = self.group(1) {
+            objects.copy_out::<2>(ops, dst);
+        }
+        if let Some(ops) = self.group(2) {
+            objects.copy_out::<4>(ops, dst);
+        }
+        if let Some(ops) = self.group(3) {
+            objects.copy_out::<8>(ops, dst);
+        }
     }
 }
 
@@ -911,7 +940,7 @@ mod tests {
                 let p = &ch.program;
                 assert!(p.usable() && !p.others, "{layout:?}");
                 assert_eq!(p.entries, ch.entries().len(), "{layout:?}");
-                assert!((0..GROUPS).map(|g| p.group(g).len()).sum::<usize>() <= ch.entries().len());
+                assert!((0..GROUPS).map(|g| p.group(g).unwrap().len()).sum::<usize>() <= ch.entries().len());
             }
             assert_eq!(img.tx.program.whole_len, img.tx.bytes(), "{layout:?}: no zeroing");
             let rx = img.rx.bytes();
@@ -922,8 +951,8 @@ mod tests {
         let mut objects = DriveObjects::new();
         objects.apply_map(PdoLayout::Standard).unwrap();
         let img = PdoImage::compile(&objects).unwrap();
-        assert_eq!(img.tx.program.group(3).len(), 1);
-        let ops: usize = (0..GROUPS).map(|g| img.tx.program.group(g).len()).sum();
+        assert_eq!(img.tx.program.group(3).unwrap().len(), 1);
+        let ops: usize = (0..GROUPS).map(|g| img.tx.program.group(g).unwrap().len()).sum();
         assert_eq!(ops, img.tx.entries().len() - 1);
 
         // gaps, configuration entries of 1, 2 and 4 bytes (6065h, 60C2h:02,
@@ -977,7 +1006,12 @@ mod tests {
         let img = PdoImage::compile(&objects).unwrap();
         let p = &img.rx.program;
         assert!(p.usable() && p.others && img.tx.program.whole_len == usize::MAX);
-        let config_ops = p.group(CONFIG).iter().map(|op| op.width).collect::<Vec<_>>();
+        let config_ops = p
+            .group(CONFIG)
+            .unwrap()
+            .iter()
+            .map(|op| op.width())
+            .collect::<Vec<_>>();
         assert_eq!(config_ops, [4, 1, 2, 4], "6065h, 60C2h:02, 605Ah, 60FEh:01");
         let rx = img.rx.bytes();
         assert_eq!(rx, 2 + 1 + 4 + 1 + 2 + 3 + 4 + 4 + 2 + 2 + 1 + 4 + 16);
