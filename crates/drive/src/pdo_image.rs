@@ -30,7 +30,7 @@
 //!
 //! The copy program: [`PdoImage::compile`] also turns the entries that have a
 //! RAM [`Slot`] (integers of their full width at a byte boundary, the usual
-//! case) into a compact program of [`CopyOp`]s, two offsets each, grouped by
+//! case) into a compact program of `CopyOp`s, two offsets each, grouped by
 //! width (1, 2, 4, 8 bytes; RxPDO configuration entries, any width, in a
 //! group of their own). Entries adjacent in both the RAM image and the
 //! process image are merged into wider copies. One cycle's copy is then a few
@@ -264,7 +264,7 @@ fn fill_entry(e: &ImageEntry, objects: &DriveObjects, tx_bytes: &mut [u8]) {
 /// `img`), as many as its group's width. Four bytes, so a group's ops are
 /// found with a shift.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
-pub struct CopyOp {
+pub(crate) struct CopyOp {
     /// Byte offset in the RAM image.
     pub(crate) ram: u16,
     /// Byte offset in the process image; in the group of configuration
