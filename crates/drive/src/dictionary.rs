@@ -13,6 +13,7 @@ use core::marker::PhantomData;
 use core::sync::atomic::{AtomicU32, Ordering};
 
 use crate::objects::{self, enumeration, find, Object, Value, IMAGE_BYTES, INITIAL_IMAGE, OBJECTS, OFFSETS};
+use crate::pdo_image::{CopyOp, WIDTH_SHIFT};
 use crate::{parameter_index, MAPPING_ENTRIES, SOFTWARE_BUILD};
 use od::{CommState, DataType, Dictionary, EntryInfo, ObjectInfo, SdoAbort};
 
@@ -594,6 +595,18 @@ impl Slot {
     pub fn data_type(self) -> DataType {
         self.kind.data_type()
     }
+
+    /// Byte offset of the value in the RAM image (for the PDO copy
+    /// program, [`crate::pdo_image`]).
+    pub(crate) fn ram_offset(self) -> u16 {
+        self.at
+    }
+
+    /// Whether a changed value is a configuration change
+    /// ([`DriveObjects::config_generation`]).
+    pub(crate) fn is_config(self) -> bool {
+        self.config
+    }
 }
 
 /// The drive's object dictionary: the RAM image of every value, the active
@@ -898,6 +911,71 @@ impl DriveObjects {
             2 => copy_bytes::<2>(src, at, &mut self.image, to),
             4 => copy_bytes::<4>(src, at, &mut self.image, to),
             _ => copy_bytes::<8>(src, at, &mut self.image, to),
+        }
+    }
+
+    /// The RxPDO copy program's stores of one width ([`crate::pdo_image`]):
+    /// `N` bytes of `src` at each `op.img` into the RAM image at `op.ram`, as
+    /// [`copy_slot_from`](Self::copy_slot_from) stores a slot that is not a
+    /// configuration entry. An op outside either buffer is skipped (the
+    /// program is checked when it is built, so none is).
+    #[inline(always)]
+    pub(crate) fn copy_in<const N: usize>(&mut self, ops: &[CopyOp], src: &[u8]) {
+        for op in ops {
+            if let Some(b) = bytes_at::<N>(src, usize::from(op.img)) {
+                put_at(&mut self.image, usize::from(op.ram), b);
+            }
+        }
+    }
+
+    /// The RxPDO copy program's stores of configuration entries (any of the
+    /// widths 1, 2, 4, 8, its log2 in `op.img` from [`WIDTH_SHIFT`] on), as
+    /// [`copy_slot_from`](Self::copy_slot_from) stores them: a value that
+    /// differs from the one in RAM is a configuration change, the same value
+    /// is not.
+    #[inline(always)]
+    pub(crate) fn copy_in_config(&mut self, ops: &[CopyOp], src: &[u8]) {
+        const OFFSET: u16 = (1 << WIDTH_SHIFT) - 1;
+        for op in ops {
+            let (ram, img) = (usize::from(op.ram), usize::from(op.img & OFFSET));
+            match op.img >> WIDTH_SHIFT {
+                2 => self.store_config::<4>(ram, src, img),
+                1 => self.store_config::<2>(ram, src, img),
+                0 => self.store_config::<1>(ram, src, img),
+                _ => self.store_config::<8>(ram, src, img),
+            }
+        }
+    }
+
+    /// Stores the `N` bytes of `src` at `img` at `ram` if they differ from
+    /// the value there (compared as one `N`-byte word, no `memcmp`), as a
+    /// configuration change.
+    #[inline(always)]
+    fn store_config<const N: usize>(&mut self, ram: usize, src: &[u8], img: usize) {
+        if let (Some(new), Some(old)) = (bytes_at::<N>(src, img), bytes_at::<N>(&self.image, ram)) {
+            if new != old {
+                self.config_changed();
+                put_at(&mut self.image, ram, new);
+            }
+        }
+    }
+
+    /// The TxPDO copy program's loads of one width ([`crate::pdo_image`]):
+    /// `N` bytes of the RAM image at each `op.ram` into `dst` at `op.img`,
+    /// as [`copy_slot_to`](Self::copy_slot_to) does; an op outside either
+    /// buffer is skipped.
+    #[inline(always)]
+    pub(crate) fn copy_out<const N: usize>(&self, ops: &[CopyOp], dst: &mut [u8]) {
+        for op in ops {
+            let (ram, img) = (usize::from(op.ram), usize::from(op.img));
+            // the destination first: its check and the source's share one
+            // predicated block
+            let to = dst
+                .get_mut(img..img + N)
+                .and_then(|d| <&mut [u8; N]>::try_from(d).ok());
+            if let (Some(to), Some(b)) = (to, bytes_at::<N>(&self.image, ram)) {
+                *to = b;
+            }
         }
     }
 

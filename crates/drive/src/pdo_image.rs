@@ -28,13 +28,30 @@
 //! by its two's complement bits. Gap entries (index 0) take their bits and
 //! are skipped (RxPDO) or sent as zeros (TxPDO).
 //!
+//! The copy program: [`PdoImage::compile`] also turns the entries that have a
+//! RAM [`Slot`] (integers of their full width at a byte boundary, the usual
+//! case) into a compact program of `CopyOp`s, two offsets each, grouped by
+//! width (1, 2, 4, 8 bytes; RxPDO configuration entries, any width, in a
+//! group of their own). Entries adjacent in both the RAM image and the
+//! process image are merged into wider copies. One cycle's copy is then a few
+//! tight loops of fixed-size loads and stores, with a bounds check per op but
+//! no lookup, no dispatch per entry and no `memcmp`. Each group is found from
+//! its start and length (`Program::groups`), without a running cursor, which
+//! keeps the loops' registers free. Everything else (gaps, entries off byte
+//! boundaries, strings) keeps the per-entry copy, which also serves a byte
+//! slice shorter than the image (entries beyond it are skipped whole) and an
+//! RxPDO mapping that stores twice into the same RAM bytes (the order of the
+//! stores matters there, and the program's groups do not keep it). The
+//! results are those of the per-entry copy, byte for byte and configuration
+//! change for configuration change.
+//!
 //! Subindices: a mapping entry names its object in the subindex numbering of
 //! the active template (as the mapping check does); the table holds the
 //! runtime ("EtherCAT Rx SDO Info") numbering of [`DriveObjects::get`] and
 //! [`DriveObjects::set_bytes`].
 
 use crate::dictionary::{DriveObjects, Slot, Template};
-use crate::objects::find;
+use crate::objects::{find, IMAGE_BYTES};
 use crate::MAPPING_ENTRIES;
 use od::{Access, DataType, EntryInfo};
 
@@ -99,6 +116,7 @@ pub struct Channel {
     entries: [ImageEntry; MAX_ENTRIES],
     len: usize,
     bits: usize,
+    program: Program,
 }
 
 impl Channel {
@@ -106,6 +124,7 @@ impl Channel {
         entries: [ImageEntry::UNUSED; MAX_ENTRIES],
         len: 0,
         bits: 0,
+        program: Program::NONE,
     };
 
     /// The mapped object entries in image order (gaps left out).
@@ -123,9 +142,9 @@ impl Channel {
         self.bits.div_ceil(8)
     }
 
-    /// Compiles the PDOs assigned in `assign` (1C12h or 1C13h).
-    fn compile(objects: &DriveObjects, assign: u16) -> Result<Self, PdoImageError> {
-        let mut ch = Self::EMPTY;
+    /// Compiles the PDOs assigned in `assign` (1C12h or 1C13h) into `ch`,
+    /// an empty channel (in place: a channel is ~2.7 KiB).
+    fn compile(ch: &mut Self, objects: &DriveObjects, assign: u16) -> Result<(), PdoImageError> {
         let sdo_info = objects.template() == Template::SdoInfo;
         for pdo in objects.assigned_pdos(assign) {
             for mapping in objects.mapping(pdo) {
@@ -171,8 +190,318 @@ impl Channel {
                 ch.len += 1;
             }
         }
-        Ok(ch)
+        let rx = assign == 0x1C12;
+        let bytes = ch.bytes();
+        let entries = ch.entries.get(..ch.len).unwrap_or_default();
+        Program::build(&mut ch.program, entries, bytes, rx, objects);
+        Ok(())
     }
+
+    /// Decodes every entry of `rx_bytes` one by one (the copy the program
+    /// stands for); returns the number of entries written.
+    fn apply_each(&self, rx_bytes: &[u8], objects: &mut DriveObjects) -> usize {
+        self.entries()
+            .iter()
+            .map(|e| usize::from(apply_entry(e, rx_bytes, objects)))
+            .sum()
+    }
+
+    /// Encodes every entry into `tx_bytes` one by one, after zeroing it (the
+    /// copy the program stands for).
+    fn fill_each(&self, objects: &DriveObjects, tx_bytes: &mut [u8]) {
+        tx_bytes.fill(0);
+        for e in self.entries() {
+            match e.slot {
+                Some(slot) => {
+                    objects.copy_slot_to(slot, tx_bytes, e.byte_offset());
+                }
+                None => fill_entry(e, objects, tx_bytes),
+            }
+        }
+    }
+}
+
+/// Decodes entry `e` of `rx_bytes` into its object; `false` when it lies
+/// beyond `rx_bytes` or the dictionary refuses it.
+fn apply_entry(e: &ImageEntry, rx_bytes: &[u8], objects: &mut DriveObjects) -> bool {
+    if let Some(slot) = e.slot {
+        objects.copy_slot_from(slot, rx_bytes, e.byte_offset())
+    } else if e.byte_aligned() {
+        let at = e.byte_offset();
+        rx_bytes
+            .get(at..at + usize::from(e.bits / 8))
+            .is_some_and(|raw| objects.set_bytes(e.index, e.sub, raw).is_ok())
+    } else {
+        let mut raw = [0u8; 8];
+        extract(rx_bytes, usize::from(e.bit_offset), usize::from(e.bits), &mut raw)
+            && raw
+                .get(..usize::from(e.bits).div_ceil(8))
+                .is_some_and(|raw| objects.set_bytes(e.index, e.sub, raw).is_ok())
+    }
+}
+
+/// Encodes entry `e`, one without a slot, from its object into `tx_bytes`
+/// (its bits only; nothing for an object without an integer value or an
+/// entry beyond `tx_bytes`).
+fn fill_entry(e: &ImageEntry, objects: &DriveObjects, tx_bytes: &mut [u8]) {
+    let Ok(value) = objects.get(e.index, e.sub) else {
+        return;
+    };
+    let raw = value.to_le_bytes();
+    if e.byte_aligned() {
+        let at = e.byte_offset();
+        let n = usize::from(e.bits / 8);
+        if let (Some(dst), Some(src)) = (tx_bytes.get_mut(at..at + n), raw.get(..n)) {
+            dst.copy_from_slice(src);
+        }
+    } else {
+        insert(tx_bytes, usize::from(e.bit_offset), usize::from(e.bits), &raw);
+    }
+}
+
+/// One copy of a [`Channel`]'s copy program: bytes between the RAM image of
+/// [`DriveObjects`] (from offset `ram`) and the process image (from byte
+/// `img`), as many as its group's width. Four bytes, so a group's ops are
+/// found with a shift.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub(crate) struct CopyOp {
+    /// Byte offset in the RAM image.
+    pub(crate) ram: u16,
+    /// Byte offset in the process image; in the group of configuration
+    /// entries (any width) the width's log2 is in the bits from
+    /// [`WIDTH_SHIFT`] on ([`CopyOp::config`]).
+    pub(crate) img: u16,
+}
+
+/// Where a configuration op keeps its width's log2 (in `img`).
+pub(crate) const WIDTH_SHIFT: u32 = 14;
+// image offsets stay below it
+const _: () = assert!(MAX_IMAGE_BITS / 8 <= 1 << WIDTH_SHIFT);
+
+impl CopyOp {
+    /// A configuration op: `width` (1, 2, 4 or 8) bytes at `img`.
+    fn config(ram: u16, img: u16, width: usize) -> Option<Self> {
+        let log2 = u16::try_from(width.trailing_zeros()).ok()?;
+        (img >> WIDTH_SHIFT == 0 && width.is_power_of_two() && width <= 8).then_some(Self {
+            ram,
+            img: img | log2 << WIDTH_SHIFT,
+        })
+    }
+
+    /// Width in bytes of a configuration op.
+    #[cfg(test)]
+    fn width(self) -> usize {
+        1 << (self.img >> WIDTH_SHIFT)
+    }
+}
+
+/// Widths of the copies in bytes: groups `0..4` copy these.
+const WIDTHS: [usize; 4] = [1, 2, 4, 8];
+/// Group of the RxPDO configuration entries, any width.
+const CONFIG: usize = WIDTHS.len();
+/// Groups of a copy program.
+const GROUPS: usize = CONFIG + 1;
+
+// group sizes are bytes
+const _: () = assert!(MAX_ENTRIES <= u8::MAX as usize);
+
+/// The copy program of one direction (see the module docs): the ops of
+/// group 0, then those of group 1, …; group `g` is the `groups[g].1` ops
+/// from `groups[g].0` on.
+#[derive(Debug, Clone, PartialEq)]
+struct Program {
+    ops: [CopyOp; MAX_ENTRIES],
+    groups: [(u8, u8); GROUPS],
+    /// Mapped entries the program copies.
+    entries: usize,
+    /// The shortest byte slice the program serves (the image's length);
+    /// `usize::MAX` when it does not stand for the per-entry copy (an
+    /// RxPDO mapping storing twice into the same RAM bytes).
+    min_len: usize,
+    /// TxPDO: the image's length when the program writes every byte of it
+    /// (no gaps, no other entries): a slice of this length needs no zeroing
+    /// first; `usize::MAX` otherwise.
+    whole_len: usize,
+    /// Entries (not gaps) outside the program: copied one by one after it.
+    others: bool,
+}
+
+impl Program {
+    const NONE: Self = Self {
+        ops: [CopyOp { ram: 0, img: 0 }; MAX_ENTRIES],
+        groups: [(0, 0); GROUPS],
+        entries: 0,
+        min_len: usize::MAX,
+        whole_len: usize::MAX,
+        others: false,
+    };
+
+    /// Makes `p` the program of `entries`, an image of `bytes` bytes; RxPDO
+    /// configuration entries (`rx`) go to a group of their own. In place:
+    /// the caller's frame holds two channels already.
+    fn build(p: &mut Self, entries: &[ImageEntry], bytes: usize, rx: bool, objects: &DriveObjects) {
+        (p.groups, p.entries, p.min_len, p.whole_len, p.others) =
+            ([(0, 0); GROUPS], 0, usize::MAX, usize::MAX, false);
+        if rx && stores_overlap(entries, objects) {
+            return;
+        }
+        let mut ok = true;
+        let mut at = 0usize;
+        for g in 0..GROUPS {
+            let start = at;
+            chunks(entries, rx, |group, ram, img, width| {
+                if group != g {
+                    return;
+                }
+                let fits = ram + width <= IMAGE_BYTES && img + width <= bytes;
+                let op = match (u16::try_from(ram), u16::try_from(img)) {
+                    (Ok(ram), Ok(img)) if g == CONFIG => CopyOp::config(ram, img, width),
+                    (Ok(ram), Ok(img)) => Some(CopyOp { ram, img }),
+                    _ => None,
+                };
+                match (p.ops.get_mut(at), op) {
+                    (Some(slot), Some(op)) if fits => {
+                        *slot = op;
+                        at += 1;
+                    }
+                    _ => ok = false,
+                }
+            });
+            match (p.groups.get_mut(g), u8::try_from(start), u8::try_from(at - start)) {
+                (Some(group), Ok(from), Ok(n)) => *group = (from, n),
+                _ => ok = false,
+            }
+        }
+        if !ok {
+            return;
+        }
+        let mut covered = 0;
+        for e in entries {
+            match e.slot {
+                Some(slot) => {
+                    p.entries += 1;
+                    covered += slot.bytes();
+                }
+                None => p.others = true,
+            }
+        }
+        p.min_len = bytes;
+        // the slot entries are disjoint in the image: their sum is all of
+        // it only without gaps and other entries
+        if !p.others && covered == bytes {
+            p.whole_len = bytes;
+        }
+    }
+
+    /// Whether the program serves byte slices of the image's length.
+    #[cfg(test)]
+    fn usable(&self) -> bool {
+        self.min_len != usize::MAX
+    }
+
+    /// The ops of group `g` (`None` only for a program that was not built).
+    #[inline(always)]
+    fn group(&self, g: usize) -> Option<&[CopyOp]> {
+        let &(from, n) = self.groups.get(g)?;
+        let from = usize::from(from);
+        self.ops.get(from..from + usize::from(n))
+    }
+
+    /// Runs the RxPDO program: `src` into the objects.
+    #[inline(always)]
+    fn copy_in(&self, src: &[u8], objects: &mut DriveObjects) {
+        if let Some(ops) = self.group(0) {
+            objects.copy_in::<1>(ops, src);
+        }
+        if let Some(ops) = self.group(1) {
+            objects.copy_in::<2>(ops, src);
+        }
+        if let Some(ops) = self.group(2) {
+            objects.copy_in::<4>(ops, src);
+        }
+        if let Some(ops) = self.group(3) {
+            objects.copy_in::<8>(ops, src);
+        }
+        if let Some(ops) = self.group(CONFIG) {
+            objects.copy_in_config(ops, src);
+        }
+    }
+
+    /// Runs the TxPDO program: the objects into `dst`.
+    #[inline(always)]
+    fn copy_out(&self, objects: &DriveObjects, dst: &mut [u8]) {
+        if let Some(ops) = self.group(0) {
+            objects.copy_out::<1>(ops, dst);
+        }
+        if let Some(ops) = self.group(1) {
+            objects.copy_out::<2>(ops, dst);
+        }
+        if let Some(ops) = self.group(2) {
+            objects.copy_out::<4>(ops, dst);
+        }
+        if let Some(ops) = self.group(3) {
+            objects.copy_out::<8>(ops, dst);
+        }
+    }
+}
+
+/// Calls `f(group, ram, img, width)` for every copy of the program of
+/// `entries`: runs of slot entries adjacent in both images cut into copies
+/// of 8, 4, 2 and 1 bytes, the largest first (never more copies than the
+/// run has entries); RxPDO configuration entries (`rx`) one by one, in group
+/// [`CONFIG`].
+fn chunks(entries: &[ImageEntry], rx: bool, mut f: impl FnMut(usize, usize, usize, usize)) {
+    // a run: copies of the widths, the largest first
+    let emit = |f: &mut dyn FnMut(usize, usize, usize, usize), (mut ram, mut img, mut len)| {
+        while let Some((g, &w)) = WIDTHS.iter().enumerate().rev().find(|&(_, &w)| w <= len) {
+            f(g, ram, img, w);
+            (ram, img, len) = (ram + w, img + w, len - w);
+        }
+    };
+    // the open run: RAM offset, image offset, length
+    let mut run: Option<(usize, usize, usize)> = None;
+    for e in entries {
+        let Some(slot) = e.slot else {
+            continue;
+        };
+        let (ram, img, w) = (usize::from(slot.ram_offset()), e.byte_offset(), slot.bytes());
+        if rx && slot.is_config() {
+            f(CONFIG, ram, img, w);
+            continue;
+        }
+        run = match run {
+            Some((r, i, len)) if r + len == ram && i + len == img => Some((r, i, len + w)),
+            Some(done) => {
+                emit(&mut f, done);
+                Some((ram, img, w))
+            }
+            None => Some((ram, img, w)),
+        };
+    }
+    if let Some(done) = run {
+        emit(&mut f, done);
+    }
+}
+
+/// Whether two of the RxPDO `entries` store into the same RAM bytes (one
+/// object mapped twice, or an alias and its target): the last store must win,
+/// so the copy keeps the mapping order.
+fn stores_overlap(entries: &[ImageEntry], objects: &DriveObjects) -> bool {
+    // the RAM bytes of an entry (integers only; pairwise: no array on the
+    // stack of the compile, which holds two channels already)
+    let ram = |e: &ImageEntry| {
+        let s = e.slot.or_else(|| objects.slot(e.index, e.sub))?;
+        let at = usize::from(s.ram_offset());
+        Some((at, at + s.bytes()))
+    };
+    entries.iter().enumerate().any(|(i, a)| {
+        ram(a).is_some_and(|(a0, a1)| {
+            entries
+                .iter()
+                .skip(i + 1)
+                .any(|b| ram(b).is_some_and(|(b0, b1)| a0 < b1 && b0 < a1))
+        })
+    })
 }
 
 /// The declaration of the entry a mapping names with `index`:`sub` in the
@@ -247,10 +576,10 @@ impl PdoImage {
     /// Compiles the current mapping: the PDOs assigned in 1C12h (RxPDO) and
     /// 1C13h (TxPDO), in assignment order, with their entries.
     pub fn compile(objects: &DriveObjects) -> Result<Self, PdoImageError> {
-        Ok(Self {
-            rx: Channel::compile(objects, 0x1C12)?,
-            tx: Channel::compile(objects, 0x1C13)?,
-        })
+        let mut img = Self::EMPTY;
+        Channel::compile(&mut img.rx, objects, 0x1C12)?;
+        Channel::compile(&mut img.tx, objects, 0x1C13)?;
+        Ok(img)
     }
 
     /// The RxPDO table (master → drive).
@@ -270,23 +599,16 @@ impl PdoImage {
     /// refuses (no RAM slot) are skipped. Returns the number of entries
     /// written.
     pub fn apply_outputs(&self, rx_bytes: &[u8], objects: &mut DriveObjects) -> usize {
-        let mut written = 0;
-        for e in self.rx.entries() {
-            let ok = if let Some(slot) = e.slot {
-                objects.copy_slot_from(slot, rx_bytes, e.byte_offset())
-            } else if e.byte_aligned() {
-                let at = e.byte_offset();
-                rx_bytes
-                    .get(at..at + usize::from(e.bits / 8))
-                    .is_some_and(|raw| objects.set_bytes(e.index, e.sub, raw).is_ok())
-            } else {
-                let mut raw = [0u8; 8];
-                extract(rx_bytes, usize::from(e.bit_offset), usize::from(e.bits), &mut raw)
-                    && raw
-                        .get(..usize::from(e.bits).div_ceil(8))
-                        .is_some_and(|raw| objects.set_bytes(e.index, e.sub, raw).is_ok())
-            };
-            written += usize::from(ok);
+        let p = &self.rx.program;
+        if rx_bytes.len() < p.min_len {
+            return self.rx.apply_each(rx_bytes, objects);
+        }
+        p.copy_in(rx_bytes, objects);
+        let mut written = p.entries;
+        if p.others {
+            for e in self.rx.entries().iter().filter(|e| e.slot.is_none()) {
+                written += usize::from(apply_entry(e, rx_bytes, objects));
+            }
         }
         written
     }
@@ -296,24 +618,17 @@ impl PdoImage {
     /// ([`DriveObjects::get`] refuses strings) are sent as zeros; entries
     /// beyond `tx_bytes` are left out.
     pub fn fill_inputs(&self, objects: &DriveObjects, tx_bytes: &mut [u8]) {
-        tx_bytes.fill(0);
-        for e in self.tx.entries() {
-            if let Some(slot) = e.slot {
-                objects.copy_slot_to(slot, tx_bytes, e.byte_offset());
-                continue;
-            }
-            let Ok(value) = objects.get(e.index, e.sub) else {
-                continue;
-            };
-            let raw = value.to_le_bytes();
-            if e.byte_aligned() {
-                let at = e.byte_offset();
-                let n = usize::from(e.bits / 8);
-                if let (Some(dst), Some(src)) = (tx_bytes.get_mut(at..at + n), raw.get(..n)) {
-                    dst.copy_from_slice(src);
-                }
-            } else {
-                insert(tx_bytes, usize::from(e.bit_offset), usize::from(e.bits), &raw);
+        let p = &self.tx.program;
+        if tx_bytes.len() < p.min_len {
+            return self.tx.fill_each(objects, tx_bytes);
+        }
+        if tx_bytes.len() != p.whole_len {
+            tx_bytes.fill(0);
+        }
+        p.copy_out(objects, tx_bytes);
+        if p.others {
+            for e in self.tx.entries().iter().filter(|e| e.slot.is_none()) {
+                fill_entry(e, objects, tx_bytes);
             }
         }
     }
@@ -535,6 +850,8 @@ mod tests {
             for e in slow.rx.entries.iter_mut().chain(slow.tx.entries.iter_mut()) {
                 e.slot = None;
             }
+            // no copy program either: every entry through the dictionary
+            (slow.rx.program, slow.tx.program) = (Program::NONE, Program::NONE);
             let with_slots = img
                 .rx
                 .entries()
@@ -561,6 +878,181 @@ mod tests {
             slow.fill_inputs(&a, &mut slow_tx);
             assert_eq!(fast_tx, slow_tx, "{layout:?}");
         }
+    }
+
+    /// Runs `img`'s RxPDO copy program and its per-entry copy on two copies
+    /// of `objects` with each of `frames` in turn (whole, longer and cut
+    /// short), then its TxPDO program and per-entry copy with buffers of
+    /// several lengths, and asserts that they agree: the count, the objects,
+    /// the configuration generation, the bytes. Returns the dictionary the
+    /// program wrote.
+    fn program_equals_entry_copy(
+        img: &PdoImage,
+        objects: &DriveObjects,
+        frames: &[Vec<u8>],
+        label: &str,
+    ) -> DriveObjects {
+        let (mut a, mut b) = (objects.clone(), objects.clone());
+        for (k, frame) in frames.iter().enumerate() {
+            let n = img.rx.apply_each(frame, &mut b);
+            assert_eq!(img.apply_outputs(frame, &mut a), n, "{label}: frame {k}");
+            assert_eq!(a, b, "{label}: frame {k}");
+            assert_eq!(a.config_generation(), b.config_generation(), "{label}: frame {k}");
+        }
+        // every TxPDO entry a distinct value (strings included)
+        for (k, e) in img.tx.entries().iter().enumerate() {
+            let raw: Vec<u8> = (0..e.info.data_type.bytes())
+                .map(|i| (k * 41 + i * 7 + 3) as u8)
+                .collect();
+            let _ = b.set_bytes(e.index, e.sub, &raw);
+        }
+        let bytes = img.tx.bytes();
+        for len in [bytes, bytes + 2, bytes.saturating_sub(1), bytes / 2, 0] {
+            let (mut fast, mut slow) = (std::vec![0x55u8; len], std::vec![0xAAu8; len]);
+            img.fill_inputs(&b, &mut fast);
+            img.tx.fill_each(&b, &mut slow);
+            assert_eq!(fast, slow, "{label}: {len} of {bytes} TxPDO bytes");
+        }
+        a
+    }
+
+    /// An RxPDO image of `bytes` bytes, byte `i` = `i * 37 + seed`.
+    fn frame(bytes: usize, seed: usize) -> Vec<u8> {
+        (0..bytes).map(|i| (i * 37 + seed) as u8).collect()
+    }
+
+    /// E-034/E-032: the copy program decodes and encodes exactly what the
+    /// per-entry copy does (the entries, gaps, entries off byte boundaries,
+    /// strings, configuration entries, byte slices shorter or longer than
+    /// the image), and a configuration entry written with the value it holds
+    /// is no configuration change, with another value it is.
+    #[test]
+    fn e034_copy_program_equals_the_entry_copy() {
+        // the layouts, both channels of each direction (the csp run of the
+        // end-to-end test): all entries in the program
+        for layout in [PdoLayout::Standard, PdoLayout::Ip, PdoLayout::Vl] {
+            let mut objects = DriveObjects::new();
+            objects.apply_map(layout).unwrap();
+            assign(&mut objects, 0x1C12, &[0x1600, 0x1601]);
+            assign(&mut objects, 0x1C13, &[0x1A00, 0x1A01]);
+            let img = PdoImage::compile(&objects).unwrap();
+            for ch in [&img.rx, &img.tx] {
+                let p = &ch.program;
+                assert!(p.usable() && !p.others, "{layout:?}");
+                assert_eq!(p.entries, ch.entries().len(), "{layout:?}");
+                assert!((0..GROUPS).map(|g| p.group(g).unwrap().len()).sum::<usize>() <= ch.entries().len());
+            }
+            assert_eq!(img.tx.program.whole_len, img.tx.bytes(), "{layout:?}: no zeroing");
+            let rx = img.rx.bytes();
+            let frames = [frame(rx, 201), frame(rx, 201), frame(rx, 7), frame(rx - 3, 90)];
+            program_equals_entry_copy(&img, &objects, &frames, &std::format!("{layout:?}"));
+        }
+        // standard: 60F4h and 60FDh adjacent in RAM and image, one copy of 8
+        let mut objects = DriveObjects::new();
+        objects.apply_map(PdoLayout::Standard).unwrap();
+        let img = PdoImage::compile(&objects).unwrap();
+        assert_eq!(img.tx.program.group(3).unwrap().len(), 1);
+        let ops: usize = (0..GROUPS).map(|g| img.tx.program.group(g).unwrap().len()).sum();
+        assert_eq!(ops, img.tx.entries().len() - 1);
+
+        // gaps, configuration entries of 1, 2 and 4 bytes (6065h, 60C2h:02,
+        // 605Ah; 6060h and 60FEh:01 of 1601h), an entry off byte boundaries,
+        // a string, and adjacent entries (60B1h, 60B2h)
+        let mut objects = DriveObjects::new();
+        map(
+            &mut objects,
+            0x1600,
+            &[
+                m(0x6040, 0, 16),
+                m(0, 0, 8),
+                m(0x6065, 0, 32),
+                m(0x60C2, 2, 8),
+                m(0x605A, 0, 16),
+                m(0, 0, 4),
+                m(0x6071, 0, 16),
+                m(0, 0, 4),
+                m(0x607A, 0, 32),
+                m(0x60B1, 0, 32),
+                m(0x60B2, 0, 16),
+            ],
+        );
+        map(
+            &mut objects,
+            0x1601,
+            &[m(0x6840, 0, 16), m(0x6060, 0, 8), m(0x60FE, 1, 32)],
+        );
+        assign(&mut objects, 0x1C12, &[0x1600, 0x1601]);
+        // E72 (STR16) through the runtime (no mapping check)
+        let e72 = crate::parameter_index(4, 72);
+        objects.set(0x1601, 4, i64::from(m(e72, 0, 128))).unwrap();
+        objects.set(0x1601, 0, 4).unwrap();
+        map(
+            &mut objects,
+            0x1A00,
+            &[
+                m(0x6041, 0, 16),
+                m(0x10F3, 4, 1),
+                m(0, 0, 7),
+                m(0x6061, 0, 8),
+                m(0x6064, 0, 32),
+                m(0x60F4, 0, 32),
+                m(0x60FD, 0, 32),
+                m(0, 0, 16),
+                m(0x6077, 0, 16),
+            ],
+        );
+        objects.set(0x1A00, 10, i64::from(m(e72, 0, 128))).unwrap();
+        objects.set(0x1A00, 0, 10).unwrap();
+        let img = PdoImage::compile(&objects).unwrap();
+        let p = &img.rx.program;
+        assert!(p.usable() && p.others && img.tx.program.whole_len == usize::MAX);
+        let config_ops = p
+            .group(CONFIG)
+            .unwrap()
+            .iter()
+            .map(|op| op.width())
+            .collect::<Vec<_>>();
+        assert_eq!(config_ops, [4, 1, 2, 4], "6065h, 60C2h:02, 605Ah, 60FEh:01");
+        let rx = img.rx.bytes();
+        assert_eq!(rx, 2 + 1 + 4 + 1 + 2 + 3 + 4 + 4 + 2 + 2 + 1 + 4 + 16);
+        let (first, other) = (frame(rx, 201), frame(rx, 202));
+        let frames = [
+            first.clone(),
+            first.clone(),
+            other.clone(),
+            other[..rx - 1].to_vec(),
+            first[..13].to_vec(),
+            [other.as_slice(), &[1, 2, 3]].concat(),
+        ];
+        program_equals_entry_copy(&img, &objects, &frames, "mixed");
+        // the configuration generation: the same values again are no change,
+        // other values of the five configuration entries are five
+        let mut a = objects.clone();
+        img.apply_outputs(&first, &mut a);
+        let generation = a.config_generation();
+        assert_eq!(img.apply_outputs(&first, &mut a), 12);
+        assert_eq!(a.config_generation(), generation, "same values");
+        img.apply_outputs(&other, &mut a);
+        assert_eq!(a.config_generation(), generation.wrapping_add(5), "other values");
+        assert_eq!(
+            a.get(0x6065, 0),
+            Ok(i64::from(u32::from_le_bytes(other[3..7].try_into().unwrap())))
+        );
+
+        // 6040h twice: the later one wins, so no program (mapping order)
+        let mut objects = DriveObjects::new();
+        map(
+            &mut objects,
+            0x1600,
+            &[m(0x6040, 0, 16), m(0x607A, 0, 32), m(0x6040, 0, 16)],
+        );
+        let img = PdoImage::compile(&objects).unwrap();
+        assert!(!img.rx.program.usable() && img.tx.program.usable());
+        let a = program_equals_entry_copy(&img, &objects, &[frame(8, 1)], "twice");
+        assert_eq!(
+            a.get(0x6040, 0),
+            Ok(i64::from(u16::from_le_bytes([6 * 37 + 1, (7 * 37 + 1) as u8])))
+        );
     }
 
     #[test]
