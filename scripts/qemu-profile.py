@@ -85,8 +85,8 @@ print('handler entries', dict(handlers))
 for t in ('EXTI1', 'EXTI2', 'EXTI0'):
     k = max(handlers[t], 1)
     if window and t == window[0]:
-        k = window[2] - window[1] + 1
-    print(f'== {t}: {tot[t]} instructions, {tot[t]//k} per run ({handlers[t]} runs)')
+        k = min(window[2], handlers[t]) - window[1] + 1
+    print(f'== {t}: {tot[t]} instructions, {tot[t]//max(k, 1)} per run ({k} runs)')
     rows = [(c, f) for (tt, f), c in per.items() if tt == t]
     for c, f in sorted(rows, reverse=True)[:45]:
-        print(f'{c//k:>9} per run {100*c/max(tot[t],1):5.1f}% {f[:110]}')
+        print(f'{c//max(k, 1):>9} per run {100*c/max(tot[t],1):5.1f}% {f[:110]}')
