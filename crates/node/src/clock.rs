@@ -6,10 +6,15 @@
 //! so two readings are never a whole wrap apart and the wraps can be counted.
 //! Time is an argument to the core crates: only the RTIC shell reads this.
 
+use drive::runtime::dcsync::{div_rem_u64, gcd};
+
 /// Extends a wrapping 32-bit tick counter of `hz` to monotonic ns.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
 pub struct Clock {
-    hz: u32,
+    /// ns per tick as the reduced fraction `ns_num / tick_den` (144 MHz:
+    /// 125/18), so a reading is a 64-bit product and a small division.
+    ns_num: u64,
+    tick_den: u64,
     last_raw: u32,
     ticks: u64,
 }
@@ -17,8 +22,11 @@ pub struct Clock {
 impl Clock {
     /// A clock over a counter of `hz` ticks per second (0 is taken as 1).
     pub const fn new(hz: u32) -> Self {
+        let hz = if hz == 0 { 1 } else { hz as u64 };
+        let g = gcd(hz, NS_PER_S);
         Self {
-            hz: if hz == 0 { 1 } else { hz },
+            ns_num: NS_PER_S / g,
+            tick_den: hz / g,
             last_raw: 0,
             ticks: 0,
         }
@@ -31,7 +39,52 @@ impl Clock {
             .ticks
             .wrapping_add(u64::from(raw.wrapping_sub(self.last_raw)));
         self.last_raw = raw;
-        let ns = u128::from(self.ticks) * 1_000_000_000 / u128::from(self.hz);
-        u64::try_from(ns).unwrap_or(u64::MAX)
+        // 144 MHz: 64 bits for 32 years of ticks, then 128 out of line
+        match self.ticks.checked_mul(self.ns_num) {
+            Some(x) => div_rem_u64(x, self.tick_den).map_or(u64::MAX, |(q, _)| q),
+            None => wide(self.ticks, self.ns_num, self.tick_den),
+        }
+    }
+}
+
+const NS_PER_S: u64 = 1_000_000_000;
+
+/// `ticks · num / den` in 128 bits, saturated (`den` ≥ 1).
+#[cold]
+#[inline(never)]
+fn wide(ticks: u64, num: u64, den: u64) -> u64 {
+    let ns = u128::from(ticks) * u128::from(num) / u128::from(den.max(1));
+    u64::try_from(ns).unwrap_or(u64::MAX)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// The reduced-fraction reading equals the exact 128-bit one, for the
+    /// board's clock and a clock whose ratio to 1 GHz does not reduce, up to
+    /// and beyond the 64-bit product.
+    #[test]
+    fn e111_clock_reading_equals_the_128_bit_reference() {
+        for hz in [144_000_000u32, 99_999_989, 1, 0] {
+            let mut c = Clock::new(hz);
+            let hz = u128::from(hz.max(1));
+            for ticks in [
+                0u64,
+                1,
+                17,
+                144_000,
+                1 << 32,
+                123_456_789_012_345,
+                1 << 60,
+                u64::MAX / 3,
+            ] {
+                c.ticks = ticks;
+                c.last_raw = 0;
+                let got = c.now_ns(0);
+                let want = u64::try_from(u128::from(ticks) * 1_000_000_000 / hz).unwrap_or(u64::MAX);
+                assert_eq!(got, want, "{hz} Hz, {ticks} ticks");
+            }
+        }
     }
 }
