@@ -53,9 +53,9 @@ const _: () = assert!(
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
 pub struct Requests {
     /// Save the persistent values ([`DriveObjects::persistent_image`]):
-    /// 1010h:01 = "save" or A00[0] = 1.
+    /// 1010h:01 = "save" or A00\[0\] = 1.
     pub save: bool,
-    /// Restart the device: A09[0] = 1.
+    /// Restart the device: A09\[0\] = 1.
     pub restart: bool,
     /// 1011h:01 = "load" restored the defaults in RAM (the stored image is
     /// unchanged until the next save).
@@ -714,7 +714,7 @@ impl DriveObjects {
         core::mem::take(&mut self.requests)
     }
 
-    /// Requests a save (as A00[0] = 1 does).
+    /// Requests a save (as A00\[0\] = 1 does).
     pub fn request_save(&mut self) {
         self.requests.save = true;
     }
@@ -724,7 +724,7 @@ impl DriveObjects {
         self.requests
     }
 
-    /// The access level of CoE accesses, A10[2] (E-017).
+    /// The access level of CoE accesses, A10\[2\] (E-017).
     pub fn access_level(&self) -> u8 {
         self.get(parameter_index(0, 10), 3).map_or(0, |v| v as u8)
     }

@@ -55,11 +55,11 @@ pub const PRODUCT_CODE: u32 = 15;
 /// Info", also in the SII (E-005, E-008): software build number << 1 | 1
 /// (bit 0 = template, see [`revision`]); build 0 for now.
 pub const SOFTWARE_BUILD: u32 = 1;
-/// Hardware version 1009h (E52[1]).
+/// Hardware version 1009h (E52\[1\]).
 pub const HARDWARE_VERSION: &str = "HW 1";
-/// Software version 100Ah (E52[3]).
+/// Software version 100Ah (E52\[3\]).
 pub const SOFTWARE_VERSION: &str = env!("CARGO_PKG_VERSION");
-/// Serial number placeholder; the real value is E52[2], from the device's
+/// Serial number placeholder; the real value is E52\[2\], from the device's
 /// production data (E-005).
 pub const SERIAL: u32 = 0;
 /// Device type 1000h: profile 402, servo drive (E-004).

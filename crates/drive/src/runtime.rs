@@ -3,7 +3,7 @@
 //! simulator run the same code.
 //!
 //! Each [`Drive::poll`] runs the slave stack over the given PDI, then feeds
-//! the live objects that mirror the EtherCAT state (A254, A255, A256, A257[3])
+//! the live objects that mirror the EtherCAT state (A254, A255, A256, A257\[3\])
 //! and serves the dictionary's requests: "save values" (A00, 1010h) writes the
 //! persistent image through [`store::ParamStore`]; at construction the newest
 //! saved image is loaded (E-018, E-020).
@@ -54,7 +54,7 @@
 //! [`Drive::new`] has no slots: FoE writes are refused (8002h).
 //!
 //! Diagnosis (E-132…E-139): A257[0..2] from the ESC's DL status and error
-//! counters (read every poll), A257[3] from the AL status code, and the
+//! counters (read every poll), A257\[3\] from the AL status code, and the
 //! four LEDs as patterns of `ecat::led` ([`Drive::leds`]).
 
 use crate::axis::{Axis, AxisCache, AxisCommand, AxisIo};
@@ -108,7 +108,7 @@ const E59: u16 = crate::parameter_index(4, 59);
 const E82: u16 = crate::parameter_index(4, 82);
 
 /// This firmware's fieldbus identification (EtherCAT), compared with the
-/// projected one (E59[2], [`Drive::set_projected_fieldbus`]) for event 52
+/// projected one (E59\[2\], [`Drive::set_projected_fieldbus`]) for event 52
 /// cause 15 (E-130). The code is our choice: the sources give no values.
 pub const FIELDBUS_ID: u16 = 1;
 
@@ -134,7 +134,7 @@ pub const TIMER_HZ: u32 = 144_000_000;
 /// master's frame when it proposes the A292 range, ns (our choice).
 pub const OPTIMIZE_GUARD_NS: u32 = 5_000;
 
-/// Result of the last save, as A00[2] shows it.
+/// Result of the last save, as A00\[2\] shows it.
 pub mod save_result {
     /// Saved (or nothing saved yet).
     pub const OK: i64 = 0;
@@ -422,9 +422,9 @@ pub struct IpSettings {
     pub address_source: u8,
     /// A175: gateway (0.0.0.0 = none).
     pub gateway: [u8; 4],
-    /// A199[0]: SNTP client on.
+    /// A199\[0\]: SNTP client on.
     pub sntp_active: bool,
-    /// A199[1], A199[2]: SNTP servers (0.0.0.0 = none).
+    /// A199\[1\], A199\[2\]: SNTP servers (0.0.0.0 = none).
     pub sntp_servers: [[u8; 4]; 2],
 }
 
@@ -703,7 +703,7 @@ impl<F: Flash, B: Flash> Drive<F, B> {
     /// A requested save (A00, 1010h) taken out of the drive: the persistent
     /// values and the store, so that the firmware writes the flash
     /// ([`SaveJob::write`]) without holding the drive; `None` without a
-    /// request or while another job has the store. A00[0] reads 1 (running)
+    /// request or while another job has the store. A00\[0\] reads 1 (running)
     /// until [`end_save`](Self::end_save).
     pub fn begin_save(&mut self) -> Option<SaveJob<F>> {
         if !self.objects.requests().save {
@@ -975,7 +975,7 @@ impl<F: Flash, B: Flash> Drive<F, B> {
         let _ = self.objects.set(E43, 0, i64::from(cause));
     }
 
-    /// The projected fieldbus identification (E59[2]; from the drive's
+    /// The projected fieldbus identification (E59\[2\]; from the drive's
     /// configuration project, which the firmware or board support passes
     /// in). A value other than [`FIELDBUS_ID`] raises event 52 cause 15 at
     /// the next poll (E-130).

@@ -294,7 +294,7 @@ pub enum PdoMonitor {
     /// No new RxPDO for longer than this (ns) is a PDO timeout.
     Timeout(u64),
     /// A258 = 65534: the ESC's SM watchdog decides (AL event 6, 0x0440 bit
-    /// 0); the tolerance (ns) is the watchdog time (A259[0]).
+    /// 0); the tolerance (ns) is the watchdog time (A259\[0\]).
     EscWatchdog(u64),
 }
 
@@ -323,7 +323,7 @@ pub fn pdo_monitor(a258: u16, cycle_ns: u32, wd: &EscWatchdog) -> Option<PdoMoni
     }
 }
 
-/// Longest watchdog tolerance A259[0] can show (u16 ms).
+/// Longest watchdog tolerance A259\[0\] can show (u16 ms).
 pub const MAX_WATCHDOG_NS: u64 = 65_535 * 1_000_000;
 
 /// P→S check of the SM watchdog settings (E-031, AL 001Fh). Invalid:
@@ -332,7 +332,7 @@ pub const MAX_WATCHDOG_NS: u64 = 65_535 * 1_000_000;
 /// - with A258 = 65534 (the drive relies on the master's SM watchdog, spec
 ///   §13.2): the watchdog disabled (time 0 or SM2 without its trigger bit
 ///   while outputs are mapped), shorter than one process-data cycle
-///   (`cycle_ns`: it would fire between two frames) or longer than A259[0]
+///   (`cycle_ns`: it would fire between two frames) or longer than A259\[0\]
 ///   can show (65535 ms).
 pub fn check_watchdog(
     a258: u16,
@@ -368,9 +368,9 @@ pub const STEADY_WAIT_NS: u64 = 200_000_000;
 ///
 /// | Cause | Raised by | When |
 /// |---|---|---|
-/// | [`PDO_TIMEOUT`] (6) | [`crate::Slave`] in Op | no RxPDO for longer than A258, or the ESC's SM watchdog (A258 = 65534) expired (AL 001Bh) |
-/// | [`SYNC`] (7) | [`crate::Slave`] in Op, DC mode | the application reports a synchronisation fault through [`crate::Slave::set_sync_state`]: SYNC0 timeout (0034h), late frames (0033h), lost lock (0032h) (E-131; the spec's cell merges synchronisation and connection errors, uncertain) |
-/// | [`WRONG_FIRMWARE`] (15) | the application (`drive::runtime`) | the projected fieldbus identification E59[2] ≠ the firmware's (E-130) |
+/// | [`PDO_TIMEOUT`](event52::PDO_TIMEOUT) (6) | [`crate::Slave`] in Op | no RxPDO for longer than A258, or the ESC's SM watchdog (A258 = 65534) expired (AL 001Bh) |
+/// | [`SYNC`](event52::SYNC) (7) | [`crate::Slave`] in Op, DC mode | the application reports a synchronisation fault through [`crate::Slave::set_sync_state`]: SYNC0 timeout (0034h), late frames (0033h), lost lock (0032h) (E-131; the spec's cell merges synchronisation and connection errors, uncertain) |
+/// | [`WRONG_FIRMWARE`](event52::WRONG_FIRMWARE) (15) | the application (`drive::runtime`) | the projected fieldbus identification E59\[2\] ≠ the firmware's (E-130) |
 pub mod event52 {
     /// `E82` of the event.
     pub const EVENT: u8 = 52;

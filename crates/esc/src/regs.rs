@@ -87,7 +87,7 @@ pub const WATCHDOG_COUNTER_PDI: u16 = 0x0443;
 pub const SII_CONFIG: u16 = 0x0500;
 /// SII EEPROM PDI access state (u8): bit 0 = PDI owns the EEPROM.
 pub const SII_PDI_ACCESS: u16 = 0x0501;
-/// SII EEPROM control/status (u16), see [`crate::sii::SiiControl`].
+/// SII EEPROM control/status (u16), see [`crate::sii::control`].
 pub const SII_CONTROL: u16 = 0x0502;
 /// SII EEPROM word address (u32).
 pub const SII_ADDRESS: u16 = 0x0504;

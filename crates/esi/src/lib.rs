@@ -70,7 +70,7 @@ pub fn sii(template: Template) -> Result<Vec<u8>, ecat::SiiError> {
 }
 
 /// The drive's object dictionary as the bus sees it in `template`, at the
-/// default access level (A10[2]): the objects and entries the ESI lists.
+/// default access level (A10\[2\]): the objects and entries the ESI lists.
 pub fn dictionary(template: Template) -> DriveObjects {
     let mut d = DriveObjects::new();
     d.set_template(template);

@@ -62,9 +62,9 @@ impl Rng {
 /// What configures the client (A199, spec §10).
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
 pub struct SntpConfig {
-    /// A199[0]: the client runs.
+    /// A199\[0\]: the client runs.
     pub active: bool,
-    /// A199[1], A199[2]: the servers (0.0.0.0 = none).
+    /// A199\[1\], A199\[2\]: the servers (0.0.0.0 = none).
     pub servers: [Ipv4; 2],
 }
 

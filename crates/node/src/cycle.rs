@@ -1,7 +1,7 @@
 //! The control-cycle timer.
 //!
 //! Without SYNC0 the control cycle runs free at A150 ([`CYCLE_NS`]). Once
-//! the drive's DC-Sync PLL exists, each cycle's [`CycleCommand`] gives the
+//! the drive's DC-Sync PLL exists, each cycle's [`CycleCommand`](drive::runtime::dcsync::CycleCommand) gives the
 //! length of the next one in timer ticks ([`TIMER_HZ`]): the board programs
 //! its compare register from [`CycleTimer::next_at_ns`] (the QEMU world pends
 //! the control interrupt at that time).

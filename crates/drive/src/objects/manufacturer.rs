@@ -7,7 +7,7 @@
 //! 1, E-013) derived. The parameters are those of spec §20 that are reachable
 //! over CoE (lines < 512) and the ones the stack needs; where the spec gives
 //! no type or range, the note says what was assumed. Levels: the access level
-//! (A10[2]) needed to see a parameter (E-016).
+//! (A10\[2\]) needed to see a parameter (E-016).
 
 use super::{comm, repeat, Object, Value};
 use crate::{parameter_index, DEVICE_NAME, HARDWARE_VERSION, SOFTWARE_VERSION};
