@@ -632,7 +632,7 @@ impl<F: Flash, B: Flash> Drive<F, B> {
     /// objects and the dictionary's requests.
     pub fn poll<P: Pdi>(&mut self, pdi: &mut P, now_ns: u64) -> Result<Option<StateChange>, P::Error> {
         let change = self.poll_parts(pdi, now_ns, true)?;
-        self.serve_requests();
+        let _ = self.serve_requests();
         Ok(change)
     }
 
@@ -645,8 +645,8 @@ impl<F: Flash, B: Flash> Drive<F, B> {
 
     /// The mailbox part of [`poll`](Self::poll) for the low-priority task:
     /// one CoE/EoE/FoE request answered, queued EMCYs and EoE fragments
-    /// sent. A save it requests waits for
-    /// [`poll_background`](Self::poll_background).
+    /// sent. A save it requests waits for the idle loop's
+    /// [`begin_save`](Self::begin_save).
     pub fn poll_mailbox<P: Pdi>(&mut self, pdi: &mut P, now_ns: u64) -> Result<(), P::Error> {
         self.update_live();
         let mut live = Live { diag: &mut self.diag };
@@ -685,18 +685,17 @@ impl<F: Flash, B: Flash> Drive<F, B> {
             .map_or(0, |o| (now_ns as i64).wrapping_add(o) as u64))
     }
 
-    /// The background part of [`poll`](Self::poll) for the idle loop: the
-    /// dictionary's requests (a save, A00/1010h, writes the parameter
-    /// store).
-    pub fn poll_background(&mut self) {
-        self.serve_requests();
-    }
-
-    /// The dictionary's requests: a save (A00, 1010h) writes the store.
-    fn serve_requests(&mut self) {
-        if let Some(mut job) = self.begin_save() {
-            job.write();
-            self.end_save(job);
+    /// The dictionary's requests: a save (A00, 1010h) writes the store at
+    /// once (`false`: none requested, the store is out in a job, or the
+    /// write failed). The firmware's idle loop splits it instead
+    /// ([`begin_save`](Self::begin_save)).
+    fn serve_requests(&mut self) -> bool {
+        match self.begin_save() {
+            Some(mut job) => {
+                job.write();
+                self.end_save(job)
+            }
+            None => false,
         }
     }
 
@@ -1465,13 +1464,7 @@ impl<F: Flash, B: Flash> Drive<F, B> {
     /// `false` when it failed or a [`SaveJob`] has the store.
     pub fn save(&mut self) -> bool {
         self.objects.request_save();
-        match self.begin_save() {
-            Some(mut job) => {
-                job.write();
-                self.end_save(job)
-            }
-            None => false,
-        }
+        self.serve_requests()
     }
 
     /// A255 (state, +16 with error) and A257[3] ("AL xxxx") follow the slave.

@@ -40,21 +40,30 @@ impl Clock {
             .wrapping_add(u64::from(raw.wrapping_sub(self.last_raw)));
         self.last_raw = raw;
         // 144 MHz: 64 bits for 32 years of ticks, then 128 out of line
-        match self.ticks.checked_mul(self.ns_num) {
-            Some(x) => div_rem_u64(x, self.tick_den).map_or(u64::MAX, |(q, _)| q),
-            None => wide(self.ticks, self.ns_num, self.tick_den),
-        }
+        mul_div(self.ticks, self.ns_num, self.tick_den).0
     }
 }
 
 const NS_PER_S: u64 = 1_000_000_000;
 
-/// `ticks · num / den` in 128 bits, saturated (`den` ≥ 1).
+/// `a · b / c` truncated and saturated, and whether it left a remainder
+/// (`c` = 0 counts as 1): a 64-bit product and [`div_rem_u64`]'s division
+/// by the small denominators of the reduced fractions, 128 bits out of line
+/// only when the product overflows. The clock and the cycle timer's
+/// tick ↔ ns conversions use it.
+pub(crate) fn mul_div(a: u64, b: u64, c: u64) -> (u64, bool) {
+    match a.checked_mul(b) {
+        Some(x) => div_rem_u64(x, c.max(1)).map_or((u64::MAX, false), |(q, r)| (q, r != 0)),
+        None => mul_div_wide(a, b, c),
+    }
+}
+
 #[cold]
 #[inline(never)]
-fn wide(ticks: u64, num: u64, den: u64) -> u64 {
-    let ns = u128::from(ticks) * u128::from(num) / u128::from(den.max(1));
-    u64::try_from(ns).unwrap_or(u64::MAX)
+fn mul_div_wide(a: u64, b: u64, c: u64) -> (u64, bool) {
+    let x = u128::from(a) * u128::from(b);
+    let c = u128::from(c.max(1));
+    (u64::try_from(x / c).unwrap_or(u64::MAX), x % c != 0)
 }
 
 #[cfg(test)]

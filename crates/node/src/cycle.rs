@@ -7,9 +7,9 @@
 //! the control interrupt at that time).
 
 use drive::axis::{AxisCommand, AxisIo};
-use drive::runtime::dcsync::div_rem_u64;
 use drive::runtime::TIMER_HZ;
 
+use crate::clock::mul_div;
 use crate::Drive;
 
 /// Free-running control cycle (A150 default), ns.
@@ -23,18 +23,10 @@ const G: u64 = drive::runtime::dcsync::gcd(TIMER_HZ as u64, NS_PER_S);
 const TICK_NUM: u64 = TIMER_HZ as u64 / G;
 const NS_DEN: u64 = NS_PER_S / G;
 
-/// `a · b / c` rounded up, in 64 bits when `a · b` fits (else 128); the
-/// division by the small `c` of the reduced fractions without the 64-bit
-/// library call.
+/// `a · b / c` rounded up, saturated ([`crate::clock::mul_div`]).
 fn mul_div_ceil(a: u64, b: u64, c: u64) -> u64 {
-    match a.checked_mul(b) {
-        Some(x) => match div_rem_u64(x, c) {
-            Some((q, 0)) => q,
-            Some((q, _)) => q + 1,
-            None => u64::MAX,
-        },
-        None => u64::try_from((u128::from(a) * u128::from(b)).div_ceil(u128::from(c))).unwrap_or(u64::MAX),
-    }
+    let (q, remainder) = mul_div(a, b, c);
+    q.saturating_add(u64::from(remainder))
 }
 
 /// Local time of timer tick `tick`, ns (rounded up: the tick is reached then).
