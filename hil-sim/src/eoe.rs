@@ -38,6 +38,7 @@ pub fn net_settings<F: store::Flash, B: store::Flash>(drive: &Drive<F, B>) -> Ne
             active: s.sntp_active,
             servers: s.sntp_servers,
         },
+        tunnel_open: s.tunnel_open,
     }
 }
 
@@ -280,18 +281,26 @@ impl Device for EoeTunnel {
     }
 }
 
-/// The EoE set-IP-parameter request (EoE header first) for `ip`/`mask`/`gateway`.
+/// The EoE set-IP-parameter request (EoE header first) for `ip`/`mask`/`gateway`,
+/// as SOEM's `ecx_EOEsetIp` writes it: only the flagged fields, packed, each
+/// address a little-endian UINT32 (the first octet last).
 pub fn set_ip_request(ip: [u8; 4], mask: [u8; 4], gateway: [u8; 4]) -> Vec<u8> {
+    let le = |a: [u8; 4]| [a[3], a[2], a[1], a[0]];
     let mut b = EoeHeader::response(frame_type::SET_IP_REQUEST, 0, 0)
         .to_bytes()
         .to_vec();
     b.extend_from_slice(&0x0Eu32.to_le_bytes()); // IP, mask, gateway
-    b.extend_from_slice(&[0; 6]);
-    b.extend_from_slice(&ip);
-    b.extend_from_slice(&mask);
-    b.extend_from_slice(&gateway);
-    b.extend_from_slice(&[0; 36]);
+    b.extend_from_slice(&le(ip));
+    b.extend_from_slice(&le(mask));
+    b.extend_from_slice(&le(gateway));
     b
+}
+
+/// The EoE get-IP-parameter request (EoE header only).
+pub fn get_ip_request() -> Vec<u8> {
+    EoeHeader::response(frame_type::GET_IP_REQUEST, 0, 0)
+        .to_bytes()
+        .to_vec()
 }
 
 /// A master-side IP host on an [`EoeTunnel`]: a smoltcp interface with an

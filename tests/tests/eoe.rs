@@ -46,14 +46,17 @@ fn fragments(f: &[u8], frame_no: u8) -> Vec<Vec<u8>> {
         .collect()
 }
 
-/// Set IP parameter request: IP, mask, gateway (fixed field positions).
+/// Set IP parameter request: IP, mask, gateway at fixed field positions,
+/// addresses as little-endian UINT32s (the first octet last), as TwinCAT
+/// sends it.
 fn set_ip(ip: [u8; 4]) -> Vec<u8> {
+    let le = |a: [u8; 4]| [a[3], a[2], a[1], a[0]];
     let mut b = vec![0x02, 0x01, 0, 0];
     b.extend_from_slice(&0x0Eu32.to_le_bytes());
     b.extend_from_slice(&[0; 6]);
-    b.extend_from_slice(&ip);
-    b.extend_from_slice(&[255, 255, 255, 0]);
-    b.extend_from_slice(&[10, 0, 0, 1]);
+    b.extend_from_slice(&le(ip));
+    b.extend_from_slice(&le([255, 255, 255, 0]));
+    b.extend_from_slice(&le([10, 0, 0, 1]));
     b.extend_from_slice(&[0; 36]);
     b
 }

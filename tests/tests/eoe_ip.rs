@@ -13,7 +13,7 @@
 use drive::runtime::Drive;
 use drive_tests::{init, line, with_master};
 use ethercrab::SubDeviceRef;
-use hil_sim::eoe::{set_ip_request, DriveNet, HostNet};
+use hil_sim::eoe::{get_ip_request, set_ip_request, DriveNet, HostNet};
 use hil_sim::esc::{Esc, EscConfig};
 use hil_sim::sim::{Node, SimFlash, Simulation};
 use net::sntp::{to_ntp, NTP_UNIX_OFFSET_S};
@@ -194,6 +194,21 @@ fn e098_dhcp_while_a166_is_2_until_the_master_sets_an_address() {
         let sd = group.subdevice(md, 0).unwrap();
         let mut host = HostNet::new(HOST_MAC, &[(HOST_IP, 24)], clock.load(Ordering::Relaxed));
         let server = host.add_udp(67);
+        // E-098: nothing before the master has used EoE
+        for _ in 0..100 {
+            host.step(&sd, clock).await;
+            assert!(dhcp_serve(&mut host, server, [10, 0, 0, 50]).is_empty());
+        }
+        assert_eq!(host.tunnel.stats().frames_in, 0, "the drive sent nothing yet");
+        // the master asks for the IP parameters: it uses EoE
+        assert!(host.tunnel.request(&sd, &get_ip_request()).await);
+        host.step(&sd, clock).await;
+        let r = host.tunnel.responses.pop_front().expect("get IP response");
+        assert_eq!(
+            &r[..4],
+            &[0x07, 0x01, 0x00, 0x00],
+            "get IP response, success, nothing set"
+        );
         // A166 = 2 (default): DISCOVER, OFFER, REQUEST, ACK
         let mut answered = Vec::new();
         for _ in 0..400 {
@@ -251,11 +266,15 @@ fn e098_no_dhcp_when_a166_is_not_2() {
         let sd = group.subdevice(md, 0).unwrap();
         let mut host = HostNet::new(HOST_MAC, &[(HOST_IP, 24)], clock.load(Ordering::Relaxed));
         let server = host.add_udp(67);
+        // the master uses EoE (E-098): DHCP could start now, but A166 says no
+        assert!(host.tunnel.request(&sd, &get_ip_request()).await);
+        host.step(&sd, clock).await;
+        assert!(host.tunnel.responses.pop_front().is_some(), "get IP response");
         for _ in 0..200 {
             host.step(&sd, clock).await;
             assert!(dhcp_serve(&mut host, server, [10, 0, 0, 50]).is_empty());
         }
-        assert_eq!(host.tunnel.stats().frames_in, 0, "the drive sent nothing");
+        assert_eq!(host.tunnel.stats().frames_in, 0, "the drive sent no frame");
     });
     assert_eq!(sim.borrow().drives()[0].net.as_ref().unwrap().stack.ip(), None);
 }
@@ -476,4 +495,62 @@ fn e105_e106_e102_sntp_over_eoe_in_simulated_time() {
         "rate {}",
         net.sntp().rate_ppb()
     );
+}
+
+/// SOEM reads the mailbox without an EoE handler: an EoE fragment the drive
+/// sent unasked answers its next SDO request and fails it. A master that
+/// speaks only CoE must get only CoE answers, on every drive of a line, for
+/// as long as it runs; DHCP (A166 = 2, the default) starts once the master
+/// has used EoE.
+#[test]
+fn e098_coe_only_master_gets_only_coe_answers_on_a_line() {
+    const DRIVES: usize = 3;
+    let sim = line(DRIVES);
+    for (i, d) in (1u8..).zip(sim.borrow_mut().drives_mut()) {
+        d.bind_net([0x02, 0, 0, 0, 0, i], u64::from(i), 0);
+    }
+    with_master(&sim, async |md, clock| {
+        let group = init(md, clock).await;
+        for k in 0..1000 {
+            for (i, sd) in group.iter(md).enumerate() {
+                let v: u32 = match sd.sdo_read(0x1000, 0).await {
+                    Ok(v) => v,
+                    Err(e) => panic!("request {k} to drive {i}: {e}"),
+                };
+                assert_eq!(v & 0xFFFF, 402, "device type: CiA 402");
+            }
+        }
+        let queued: Vec<u32> = sim
+            .borrow()
+            .drives()
+            .iter()
+            .map(|d| d.drive.eoe.stats().tx_frames)
+            .collect();
+        assert_eq!(
+            queued, [0; DRIVES],
+            "no EoE frame left a drive for a CoE-only master"
+        );
+        // the master starts to use EoE on drive 0: its DHCP client starts
+        let sd = group.subdevice(md, 0).unwrap();
+        let mut host = HostNet::new(HOST_MAC, &[(HOST_IP, 24)], clock.load(Ordering::Relaxed));
+        let server = host.add_udp(67);
+        assert!(host.tunnel.request(&sd, &get_ip_request()).await);
+        let mut answered = Vec::new();
+        for _ in 0..400 {
+            host.step(&sd, clock).await;
+            answered.extend(dhcp_serve(&mut host, server, [10, 0, 0, 50]));
+            if !answered.is_empty() {
+                break;
+            }
+        }
+        assert_eq!(
+            answered.first(),
+            Some(&"offer"),
+            "DHCP DISCOVER after the master used EoE"
+        );
+    });
+    let s = sim.borrow();
+    let sent: Vec<u32> = s.drives().iter().map(|d| d.drive.eoe.stats().tx_frames).collect();
+    assert!(sent[0] > 0, "drive 0 sent its DHCP frames");
+    assert_eq!(&sent[1..], &[0; DRIVES - 1], "the others sent nothing");
 }

@@ -426,6 +426,9 @@ pub struct IpSettings {
     pub sntp_active: bool,
     /// A199\[1\], A199\[2\]: SNTP servers (0.0.0.0 = none).
     pub sntp_servers: [[u8; 4]; 2],
+    /// The master has used EoE since the mailbox was set up: until then
+    /// the IP stack stays dormant (E-098).
+    pub tunnel_open: bool,
 }
 
 /// The ESC's link and error registers (A257[0..2], the link LEDs).
@@ -1457,6 +1460,7 @@ impl<F: Flash, B: Flash> Drive<F, B> {
             gateway: ip(get(175, 0)),
             sntp_active: get(199, 1) != 0,
             sntp_servers: [ip(get(199, 2)), ip(get(199, 3))],
+            tunnel_open: self.slave.eoe().master_active(),
         }
     }
 

@@ -966,16 +966,23 @@ fn eoe_fragments(f: &[u8], chunk: usize, frame_no: u8) -> Vec<Vec<u8>> {
         .collect()
 }
 
+/// A set-IP request in the fixed layout, addresses as little-endian
+/// UINT32s (the first octet last), as TwinCAT sends it.
 fn set_ip_request(ip: [u8; 4]) -> Vec<u8> {
+    let le = |a: [u8; 4]| [a[3], a[2], a[1], a[0]];
     let mut b = Vec::from([0x02u8, 0x01, 0, 0]);
     b.extend_from_slice(&0x0Eu32.to_le_bytes()); // IP, mask, gateway
     b.extend_from_slice(&[0; 6]);
-    b.extend_from_slice(&ip);
-    b.extend_from_slice(&[255, 255, 255, 0]);
-    b.extend_from_slice(&[10, 0, 0, 1]);
+    b.extend_from_slice(&le(ip));
+    b.extend_from_slice(&le([255, 255, 255, 0]));
+    b.extend_from_slice(&le([10, 0, 0, 1]));
     b.extend_from_slice(&[0; 36]);
     b
 }
+
+/// A get-IP-parameter request (EoE header only): the master shows that
+/// it uses EoE.
+const GET_IP: [u8; 4] = [0x06, 0x01, 0x00, 0x00];
 
 #[test]
 fn e095_eoe_frames_in_preop_safeop_op_not_in_init() {
@@ -1030,6 +1037,8 @@ fn e095_eoe_frames_to_the_master_one_fragment_per_mailbox() {
     let mut r = Rig::new();
     let mut port = Port::default();
     r.goto(AlState::PreOp);
+    let resp = r.eoe(&mut port, &GET_IP, 1).unwrap();
+    assert_eq!(resp[6], 0x07, "get IP response");
     let f = eth_frame(400);
     port.to_send.push(f.clone());
     port.to_send.push(eth_frame(60));
@@ -1060,6 +1069,77 @@ fn e095_eoe_frames_to_the_master_one_fragment_per_mailbox() {
     r.esc.request(1);
     r.poll_eth(&mut port);
     assert!(!r.slave.eoe().sending());
+}
+
+/// SDO upload request of 1008h with `counter`, written into SM0.
+fn upload_request(counter: u8) -> [u8; 16] {
+    [
+        10,
+        0,
+        0,
+        0,
+        0,
+        0x03 | (counter << 4),
+        0x00,
+        0x20,
+        0x40,
+        0x08,
+        0x10,
+        0,
+        0,
+        0,
+        0,
+        0,
+    ]
+}
+
+#[test]
+fn e098_no_unasked_eoe_before_the_master_uses_eoe() {
+    let mut r = Rig::new();
+    let mut port = Port::default();
+    r.goto(AlState::PreOp);
+    // the IP stack has frames to send (a DHCP DISCOVER, say) from the start
+    port.to_send.extend((0..4).map(|_| eth_frame(300)));
+    // a master that speaks only CoE: every answer is its SDO response
+    for k in 0..2000u32 {
+        let counter = (k % 7 + 1) as u8;
+        r.esc.mbx_write(&upload_request(counter));
+        r.poll_eth(&mut port);
+        let m = r.esc.mbx_read().expect("an answer to each upload");
+        assert_eq!(
+            m[5],
+            0x03 | (counter << 4),
+            "request {k}: CoE with the request's counter"
+        );
+        assert_eq!(m[8] >> 5, 2, "request {k}: SDO upload response");
+        // and nothing else between the requests
+        r.poll_eth(&mut port);
+        assert_eq!(r.esc.mbx_read(), None, "request {k}: no unasked message");
+    }
+    assert_eq!(port.to_send.len(), 4, "not one frame taken");
+    assert!(!r.slave.eoe().master_active());
+    // the master uses EoE: the frames go out
+    r.eoe(&mut port, &GET_IP, 1).unwrap();
+    assert!(r.slave.eoe().master_active());
+    let mut eoe = 0;
+    for _ in 0..40 {
+        r.poll_eth(&mut port);
+        if let Some(m) = r.esc.mbx_read() {
+            assert_eq!(m[5] & 0x0F, 2, "EoE");
+            eoe += 1;
+        }
+    }
+    assert!(eoe >= 4, "{eoe} EoE messages");
+    assert!(port.to_send.is_empty());
+    // back through Init: silent again until the master uses EoE again
+    assert_eq!(r.req(1), (1, 0));
+    r.goto(AlState::PreOp);
+    assert!(!r.slave.eoe().master_active());
+    port.to_send.push(eth_frame(100));
+    for _ in 0..20 {
+        r.poll_eth(&mut port);
+        assert_eq!(r.esc.mbx_read(), None);
+    }
 }
 
 #[test]

@@ -81,6 +81,10 @@ pub struct NetSettings {
     pub gateway: Ipv4,
     /// A199: SNTP.
     pub sntp: SntpConfig,
+    /// The master has used EoE since the mailbox was set up
+    /// (`ecat::eoe::EoeServer::master_active`). Until then the stack is
+    /// dormant: no DHCP, nothing queued for the master (E-098).
+    pub tunnel_open: bool,
 }
 
 /// Counters.
@@ -250,7 +254,7 @@ impl<'a> NetStack<'a> {
     /// Starts the DHCP client while A166 = 2 and the master set no
     /// address, stops it otherwise (E-098).
     fn follow_dhcp(&mut self, settings: &NetSettings) {
-        let want = settings.dhcp && !self.ip_from_master;
+        let want = settings.dhcp && settings.tunnel_open && !self.ip_from_master;
         match (want, self.dhcp) {
             (true, None) => self.dhcp = Some(self.sockets.add(dhcpv4::Socket::new())),
             (false, Some(h)) => {
@@ -323,6 +327,12 @@ impl<'a> NetStack<'a> {
             self.apply_ip(&p);
         }
         self.follow_dhcp(settings);
+        if !settings.tunnel_open {
+            // E-098: nothing goes to a master that has not used EoE (and
+            // nothing can arrive from it)
+            queue.clear();
+            return;
+        }
         let t = instant(now_us);
         self.iface.poll(t, &mut QueueDevice(queue), &mut self.sockets);
         self.run_dhcp();
@@ -420,7 +430,10 @@ mod tests {
             ..IpParams::default()
         };
         ecat::eoe::EthernetPort::ip_changed(&mut q, &good);
-        let s = NetSettings::default();
+        let s = NetSettings {
+            tunnel_open: true,
+            ..NetSettings::default()
+        };
         net.poll(1, &mut q, &mut d, CommState::PreOp, &s);
         assert_eq!(net.ip(), Some(([10, 0, 0, 5], 24)));
         assert_eq!(net.gateway(), Some([10, 0, 0, 1]));
@@ -441,6 +454,7 @@ mod tests {
                 active: true,
                 servers: [[255, 255, 255, 255], [224, 0, 1, 1]],
             },
+            tunnel_open: true,
         };
         for t in [2, 400_000_000, 800_000_000] {
             net.poll(t, &mut q, &mut d, CommState::PreOp, &s);
