@@ -30,6 +30,10 @@ fn e005_identity_in_sii() {
     assert_eq!(sii_string(strings, general[3]), Some(&b"SC6"[..]));
     assert_eq!(sii_string(strings, general[2]), Some(&b"SC6A062"[..]));
     assert_eq!(sii_string(strings, general[0]), Some(&b"Drives"[..]));
+    // string 1 is the device's type, as in vendor SIIs: SOEM names the
+    // slave after it
+    assert_eq!(sii_string(strings, 1), Some(&b"SC6A062"[..]));
+    assert_eq!(general[2], 1, "order index");
     // two MII ports (E-001)
     assert_eq!(u16_at(general, 16), 0x0011);
 }

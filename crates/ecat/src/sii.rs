@@ -115,7 +115,9 @@ pub fn build_sii(desc: &Device, out: &mut [u8]) -> Result<usize, SiiError> {
     let mut strings = Strings {
         list: heapless::Vec::new(),
     };
-    for s in [desc.group, desc.order_code, desc.name] {
+    // string 1 is the device's type (the ESI's `Type`, the order code), as
+    // in vendor SIIs: SOEM and other tools name a slave after string 1
+    for s in [desc.order_code, desc.name, desc.group] {
         strings.add(s)?;
     }
     for pdo in desc.rx_pdos.iter().chain(desc.tx_pdos) {

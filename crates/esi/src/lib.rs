@@ -396,9 +396,12 @@ fn dictionary_element(x: &mut Xml, template: Template, od: &DriveObjects) {
     for (name, t) in &base {
         x.open("DataType", &[]);
         x.leaf("Name", &[], name);
+        // EtherCATInfo.xsd: Name, BaseType, BitSize, ArrayInfo in this order
+        if let DataType::OctetString(_) = t {
+            x.leaf("BaseType", &[], "BYTE");
+        }
         x.leaf("BitSize", &[], &t.bits().to_string());
         if let DataType::OctetString(n) = t {
-            x.leaf("BaseType", &[], "BYTE");
             x.open("ArrayInfo", &[]);
             x.leaf("LBound", &[], "0");
             x.leaf("Elements", &[], &n.to_string());
