@@ -1,0 +1,186 @@
+//! The update file of the drive's firmware download (FoE, `docs/flashing.md`):
+//! the image header of `crates/boot` (magic "SC6F", body length, CRC-32 of
+//! the body, version) followed by the body, the flash contents of the image.
+//!
+//! The body comes from a flat binary as it is, or from an ELF: its loadable
+//! segments (program headers of type `PT_LOAD` with file contents) laid out
+//! at their load (physical) addresses, from the lowest one, gaps filled with
+//! FFh (erased flash). `objcopy -O binary` writes the same bytes, except
+//! that it fills the gaps with 00h (checked on the board image: 8 gap bytes
+//! differ, nothing else).
+#![forbid(unsafe_code)]
+
+use boot::{ImageHeader, IMAGE_HEADER_LEN};
+use object::read::elf::{ElfFile32, ProgramHeader as _};
+use object::{elf, Endianness};
+
+/// The name a file must start with for the drive to take it
+/// (`drive::runtime::FIRMWARE_FILE`); masters send the file name they are given.
+pub const FILE_PREFIX: &str = "firmware";
+
+/// Largest body the tool writes (a slot of the reference board is smaller;
+/// the drive refuses what does not fit with FoE 8003h).
+pub const MAX_BODY: usize = 4 << 20;
+
+/// Why no update file was made.
+#[derive(Debug, Clone, PartialEq, Eq)]
+pub enum ImageError {
+    /// Not an ELF the tool can read (32-bit little-endian).
+    Elf(String),
+    /// The ELF has no loadable segment with contents.
+    NoSegments,
+    /// Loadable segments overlap.
+    Overlap {
+        /// Load address of the later segment.
+        at: u32,
+    },
+    /// The body would be larger than [`MAX_BODY`].
+    TooLarge(u64),
+    /// The input is empty.
+    Empty,
+}
+
+impl core::fmt::Display for ImageError {
+    fn fmt(&self, f: &mut core::fmt::Formatter<'_>) -> core::fmt::Result {
+        match self {
+            ImageError::Elf(e) => write!(f, "not a 32-bit little-endian ELF: {e}"),
+            ImageError::NoSegments => write!(f, "the ELF has no loadable segment with contents"),
+            ImageError::Overlap { at } => write!(f, "loadable segments overlap at {at:#010x}"),
+            ImageError::TooLarge(n) => write!(f, "the body would be {n} bytes, more than {MAX_BODY}"),
+            ImageError::Empty => write!(f, "the input is empty"),
+        }
+    }
+}
+
+impl std::error::Error for ImageError {}
+
+/// The flash contents of an ELF: the body and its load address.
+#[derive(Debug, Clone, PartialEq, Eq)]
+pub struct Body {
+    /// Load address of the first byte.
+    pub address: u32,
+    /// The bytes, gaps filled with FFh.
+    pub bytes: Vec<u8>,
+}
+
+/// Lays out the loadable segments of `elf` (see the crate docs).
+pub fn body_from_elf(data: &[u8]) -> Result<Body, ImageError> {
+    let file = ElfFile32::<Endianness>::parse(data).map_err(|e| ImageError::Elf(e.to_string()))?;
+    let endian = file.endian();
+    let mut segments: Vec<(u32, &[u8])> = Vec::new();
+    for ph in file.elf_program_headers() {
+        if ph.p_type(endian) != elf::PT_LOAD || ph.p_filesz(endian) == 0 {
+            continue;
+        }
+        let bytes = ph
+            .data(endian, data)
+            .map_err(|()| ImageError::Elf("a segment lies outside the file".into()))?;
+        segments.push((ph.p_paddr(endian), bytes));
+    }
+    segments.sort_by_key(|s| s.0);
+    let (first, last) = match (segments.first(), segments.last()) {
+        (Some(f), Some(l)) => (f.0, l),
+        _ => return Err(ImageError::NoSegments),
+    };
+    let end = u64::from(last.0) + last.1.len() as u64;
+    let len = end - u64::from(first);
+    if len > MAX_BODY as u64 {
+        return Err(ImageError::TooLarge(len));
+    }
+    let mut bytes = vec![0xFF; len as usize];
+    let mut filled = 0usize;
+    for (addr, seg) in segments {
+        let at = (addr - first) as usize;
+        if at < filled {
+            return Err(ImageError::Overlap { at: addr });
+        }
+        let dst = bytes
+            .get_mut(at..at + seg.len())
+            .ok_or(ImageError::Overlap { at: addr })?;
+        dst.copy_from_slice(seg);
+        filled = at + seg.len();
+    }
+    Ok(Body {
+        address: first,
+        bytes,
+    })
+}
+
+/// Whether `data` starts like an ELF file.
+pub fn is_elf(data: &[u8]) -> bool {
+    data.starts_with(&[0x7F, b'E', b'L', b'F'])
+}
+
+/// The update file of `body` with `version`: header, then the body.
+pub fn update_file(body: &[u8], version: u32) -> Result<Vec<u8>, ImageError> {
+    if body.is_empty() {
+        return Err(ImageError::Empty);
+    }
+    if body.len() > MAX_BODY {
+        return Err(ImageError::TooLarge(body.len() as u64));
+    }
+    let mut f = Vec::with_capacity(IMAGE_HEADER_LEN + body.len());
+    f.extend_from_slice(&ImageHeader::for_body(body, version).to_bytes());
+    f.extend_from_slice(body);
+    Ok(f)
+}
+
+/// What is wrong with an update file, as the drive would find it.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum CheckError {
+    /// Shorter than the header, or not the magic "SC6F" (the drive: FoE 8004h).
+    Header,
+    /// The body is shorter or longer than the header says (800Ch).
+    Length {
+        /// Body length the header names.
+        expected: u32,
+        /// Body bytes in the file.
+        found: usize,
+    },
+    /// The body's CRC-32 is not the header's (800Ch).
+    Crc {
+        /// CRC in the header.
+        expected: u32,
+        /// CRC of the body.
+        found: u32,
+    },
+}
+
+impl core::fmt::Display for CheckError {
+    fn fmt(&self, f: &mut core::fmt::Formatter<'_>) -> core::fmt::Result {
+        match self {
+            CheckError::Header => write!(f, "no image header (magic \"SC6F\"): the drive refuses it with FoE 8004h"),
+            CheckError::Length { expected, found } => write!(
+                f,
+                "the header names {expected} body bytes, the file has {found}: the drive refuses it with FoE 800Ch"
+            ),
+            CheckError::Crc { expected, found } => write!(
+                f,
+                "body CRC-32 {found:#010x}, header {expected:#010x}: the drive refuses it with FoE 800Ch"
+            ),
+        }
+    }
+}
+
+impl std::error::Error for CheckError {}
+
+/// Checks an update file as the drive does at the end of the download;
+/// returns its header.
+pub fn check(file: &[u8]) -> Result<ImageHeader, CheckError> {
+    let h = ImageHeader::parse(file).ok_or(CheckError::Header)?;
+    let body = file.get(IMAGE_HEADER_LEN..).unwrap_or_default();
+    if usize::try_from(h.length).ok() != Some(body.len()) {
+        return Err(CheckError::Length {
+            expected: h.length,
+            found: body.len(),
+        });
+    }
+    let crc = boot::crc32(body);
+    if crc != h.crc {
+        return Err(CheckError::Crc {
+            expected: h.crc,
+            found: crc,
+        });
+    }
+    Ok(h)
+}

@@ -1,0 +1,250 @@
+//! The update file `foe-image` writes, through the simulated drive's FoE
+//! (Bootstrap, the slots of issue 8): the file of an ELF goes into the
+//! inactive slot and boots on the next power cycle; a truncated or
+//! bit-flipped file is refused with the documented FoE error (800Ch) and
+//! changes nothing.
+#![allow(
+    clippy::unwrap_used,
+    clippy::expect_used,
+    clippy::panic,
+    clippy::indexing_slicing
+)]
+
+use drive::boot::{Slot, SlotState};
+use drive_tests::al::{BOOT, INIT};
+use drive_tests::{al_status, init, request, with_master_on, FoeClient, FoeReply, FwNode};
+use ecat::foe::FoeError;
+use ethercrab::{MainDevice, SubDeviceRef};
+use hil_sim::sim::Simulation;
+use std::cell::RefCell;
+use std::path::{Path, PathBuf};
+use std::process::Command;
+
+/// A minimal 32-bit little-endian ARM executable with `segments` as
+/// `PT_LOAD` program headers: (physical address, virtual address, bytes,
+/// memory size).
+fn elf32(segments: &[(u32, u32, Vec<u8>, u32)]) -> Vec<u8> {
+    let phoff = 52u32;
+    let mut data_off = phoff + 32 * segments.len() as u32;
+    let mut f = vec![0x7F, b'E', b'L', b'F', 1, 1, 1, 0];
+    f.extend_from_slice(&[0; 8]);
+    f.extend_from_slice(&2u16.to_le_bytes()); // ET_EXEC
+    f.extend_from_slice(&40u16.to_le_bytes()); // EM_ARM
+    f.extend_from_slice(&1u32.to_le_bytes());
+    f.extend_from_slice(&segments[0].1.to_le_bytes()); // entry
+    f.extend_from_slice(&phoff.to_le_bytes());
+    f.extend_from_slice(&0u32.to_le_bytes()); // no section headers
+    f.extend_from_slice(&0x0500_0400u32.to_le_bytes());
+    for v in [52u16, 32, segments.len() as u16, 40, 0, 0] {
+        f.extend_from_slice(&v.to_le_bytes());
+    }
+    for (paddr, vaddr, bytes, memsz) in segments {
+        for v in [1u32, data_off, *vaddr, *paddr, bytes.len() as u32, *memsz, 5, 4] {
+            f.extend_from_slice(&v.to_le_bytes());
+        }
+        data_off += bytes.len() as u32;
+    }
+    for (_, _, bytes, _) in segments {
+        f.extend_from_slice(bytes);
+    }
+    f
+}
+
+fn pattern(len: usize, seed: u8) -> Vec<u8> {
+    (0..len)
+        .map(|i| (i as u8).wrapping_mul(31).wrapping_add(seed))
+        .collect()
+}
+
+/// A board-like image: code at the start of flash, the initial values of
+/// .data stored after it (run in RAM), .bss without contents.
+fn board_elf() -> (Vec<u8>, Vec<u8>) {
+    let text = pattern(6000, 1);
+    let data = pattern(300, 2);
+    let elf = elf32(&[
+        (0x0800_0000, 0x0800_0000, text.clone(), 6000),
+        // .data: loaded 0x800 bytes after the code, run at 0x2000_0000
+        (0x0800_2000, 0x2000_0000, data.clone(), 300),
+        // .bss: no bytes in the file
+        (0x2000_0200, 0x2000_0200, Vec::new(), 4096),
+    ]);
+    let mut body = text;
+    body.resize(0x2000, 0xFF);
+    body.extend_from_slice(&data);
+    (elf, body)
+}
+
+fn tool(args: &[&str]) -> std::process::Output {
+    Command::new(env!("CARGO_BIN_EXE_foe-image"))
+        .args(args)
+        .output()
+        .expect("run foe-image")
+}
+
+fn temp_dir(name: &str) -> PathBuf {
+    let d = std::env::temp_dir().join(format!("foe-image-{name}-{}", std::process::id()));
+    std::fs::create_dir_all(&d).unwrap();
+    d
+}
+
+fn make(dir: &Path, input: &[u8], version: u32) -> Vec<u8> {
+    let elf = dir.join("board.elf");
+    std::fs::write(&elf, input).unwrap();
+    let out = tool(&["make", "--version", &version.to_string(), elf.to_str().unwrap()]);
+    let stdout = String::from_utf8_lossy(&out.stdout);
+    assert!(
+        out.status.success(),
+        "foe-image make: {}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+    assert!(stdout.contains("firmware.sc6f"), "{stdout}");
+    // the default name beside the input: one the drive takes
+    std::fs::read(dir.join("firmware.sc6f")).unwrap()
+}
+
+fn line() -> RefCell<Simulation<FwNode>> {
+    RefCell::new(Simulation::with_nodes(vec![FwNode::factory(20_000)]))
+}
+
+fn in_boot<T>(
+    sim: &RefCell<Simulation<FwNode>>,
+    body: impl for<'a> AsyncFnOnce(&'a MainDevice<'a>, SubDeviceRef<'a, &'a ethercrab::SubDevice>) -> T,
+) -> T {
+    with_master_on(sim, async |md, clock| {
+        let group = init(md, clock).await;
+        let sd = group.subdevice(md, 0).unwrap();
+        request(&sd, INIT).await;
+        request(&sd, BOOT).await;
+        assert_eq!(al_status(&sd).await, (BOOT, 0));
+        let r = body(md, sd).await;
+        request(&group.subdevice(md, 0).unwrap(), INIT).await;
+        r
+    })
+}
+
+fn download(sim: &RefCell<Simulation<FwNode>>, file: &[u8]) -> Result<u32, FoeReply> {
+    in_boot(sim, async |_, sd| {
+        FoeClient::new().write_file(&sd, "firmware.sc6f", file).await
+    })
+}
+
+#[test]
+fn foe_image_of_an_elf_boots_from_the_inactive_slot() {
+    let dir = temp_dir("boot");
+    let (elf, body) = board_elf();
+    let file = make(&dir, &elf, 7);
+    // header: magic, body length, CRC-32 of the body, version; then the body
+    assert_eq!(&file[..4], b"SC6F");
+    assert_eq!(
+        u32::from_le_bytes(file[4..8].try_into().unwrap()) as usize,
+        body.len()
+    );
+    assert_eq!(
+        u32::from_le_bytes(file[8..12].try_into().unwrap()),
+        drive::boot::crc32(&body)
+    );
+    assert_eq!(u32::from_le_bytes(file[12..16].try_into().unwrap()), 7);
+    assert_eq!(
+        &file[16..],
+        &body[..],
+        "segments at their load addresses, gap FFh"
+    );
+    // the tool's own check agrees
+    let out = tool(&["check", dir.join("firmware.sc6f").to_str().unwrap()]);
+    assert!(out.status.success());
+    let sim = line();
+    let s = &sim;
+    let node = move || std::cell::RefMut::map(s.borrow_mut(), |s| &mut s.drives_mut()[0]);
+    assert_eq!(node().boot.map(|d| d.slot), Some(Slot::A));
+    download(&sim, &file).expect("the drive takes the file");
+    assert_eq!(
+        node().slots().state(Slot::B).unwrap(),
+        SlotState::Pending { seq: 2 }
+    );
+    assert_eq!(
+        node().slots().header(Slot::B).unwrap().map(|h| h.version),
+        Some(7)
+    );
+    node().power_cycle();
+    let d = node().boot.expect("a slot starts");
+    assert_eq!(
+        (d.slot, d.trial),
+        (Slot::B, true),
+        "the new image starts on trial"
+    );
+    assert!(node().drive.confirm_firmware());
+    std::fs::remove_dir_all(dir).unwrap();
+}
+
+#[test]
+fn foe_image_truncated_or_flipped_is_refused_and_changes_nothing() {
+    let dir = temp_dir("bad");
+    let (elf, _) = board_elf();
+    let file = make(&dir, &elf, 7);
+    let mut flipped = file.clone();
+    flipped[16 + 4321] ^= 0x10;
+    let truncated = &file[..file.len() - 100];
+    for (what, bad) in [("flipped", &flipped[..]), ("truncated", truncated)] {
+        // the tool says what the drive will say
+        let p = dir.join(format!("firmware-{what}.sc6f"));
+        std::fs::write(&p, bad).unwrap();
+        let out = tool(&["check", p.to_str().unwrap()]);
+        assert!(!out.status.success(), "{what}: check refuses it");
+        assert!(String::from_utf8_lossy(&out.stderr).contains("800Ch"), "{what}");
+        // the drive: FoE 800Ch on the last packet, slot B stays empty, A runs
+        let sim = line();
+        assert_eq!(
+            download(&sim, bad),
+            Err(FoeReply::Error(FoeError::CHECKSUM.0)),
+            "{what}"
+        );
+        let mut n = std::cell::RefMut::map(sim.borrow_mut(), |s| &mut s.drives_mut()[0]);
+        assert_eq!(n.slots().state(Slot::B).unwrap(), SlotState::Empty, "{what}");
+        assert_eq!(
+            n.slots().state(Slot::A).unwrap(),
+            SlotState::Confirmed { seq: 1 },
+            "{what}"
+        );
+        n.power_cycle();
+        let d = n.boot.unwrap();
+        assert_eq!((d.slot, d.trial, d.rolled_back), (Slot::A, false, None), "{what}");
+    }
+    std::fs::remove_dir_all(dir).unwrap();
+}
+
+#[test]
+fn foe_image_refuses_what_it_cannot_make() {
+    let dir = temp_dir("refuse");
+    // an ELF without loadable contents
+    let p = dir.join("empty.elf");
+    std::fs::write(&p, elf32(&[(0x2000_0000, 0x2000_0000, Vec::new(), 64)])).unwrap();
+    let out = tool(&["make", "--version", "1", p.to_str().unwrap()]);
+    assert!(!out.status.success());
+    assert!(String::from_utf8_lossy(&out.stderr).contains("no loadable segment"));
+    assert!(!dir.join("firmware.sc6f").exists(), "nothing written");
+    // overlapping segments: no sensible flash contents
+    let p2 = dir.join("overlap.elf");
+    let two = [
+        (0x0800_0000, 0x0800_0000, pattern(100, 1), 100),
+        (0x0800_0040, 0x0800_0040, pattern(100, 2), 100),
+    ];
+    std::fs::write(&p2, elf32(&two)).unwrap();
+    let out = tool(&["make", "--version", "1", p2.to_str().unwrap()]);
+    assert!(!out.status.success());
+    assert!(String::from_utf8_lossy(&out.stderr).contains("overlap at 0x08000040"));
+    assert!(!dir.join("firmware.sc6f").exists(), "nothing written");
+    // an output that cannot be written
+    let out = tool(&[
+        "make",
+        "--version",
+        "1",
+        "--out",
+        "/nonexistent/firmware.sc6f",
+        p.to_str().unwrap(),
+    ]);
+    assert!(!out.status.success());
+    // a missing version
+    let out = tool(&["make", p.to_str().unwrap()]);
+    assert!(!out.status.success());
+    std::fs::remove_dir_all(dir).unwrap();
+}
