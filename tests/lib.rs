@@ -1097,6 +1097,30 @@ impl hil_sim::sim::Node for FwNode {
     }
 }
 
+/// Pre-Op (ethercrab's init) → Init → Bootstrap.
+pub async fn to_boot<S>(sd: &SubDeviceRef<'_, S>) {
+    request(sd, al::INIT).await;
+    assert_eq!(al_status(sd).await, (al::INIT, 0));
+    request(sd, al::BOOT).await;
+    assert_eq!(al_status(sd).await, (al::BOOT, 0), "Init -> Bootstrap");
+}
+
+/// Runs `body` against the first drive in Bootstrap (and requests Init afterwards).
+pub fn in_boot<N: hil_sim::sim::Node, T>(
+    sim: &RefCell<Simulation<N>>,
+    body: impl for<'a> AsyncFnOnce(&'a MainDevice<'a>, SubDeviceRef<'a, &'a ethercrab::SubDevice>) -> T,
+) -> T {
+    with_master_on(sim, async |md, clock| {
+        let group = init(md, clock).await;
+        let sd = group.subdevice(md, 0).unwrap();
+        to_boot(&sd).await;
+        let r = body(md, sd).await;
+        // back to Init (what a master does after the download)
+        request(&group.subdevice(md, 0).unwrap(), al::INIT).await;
+        r
+    })
+}
+
 /// [`with_master`] for a line of any node type.
 pub fn with_master_on<N: hil_sim::sim::Node, T>(
     sim: &RefCell<Simulation<N>>,

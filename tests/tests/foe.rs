@@ -13,11 +13,11 @@
 use drive::boot::{Slot, SlotState};
 use drive_tests::al::{ACK, BOOT, ERR, INIT, PREOP};
 use drive_tests::{
-    al_status, firmware_file, init, request, with_master_on, FoeClient, FoeReply, FwNode, RawMailbox,
+    al_status, firmware_file, in_boot, init, request, to_boot, with_master_on, FoeClient, FoeReply, FwNode,
+    RawMailbox,
 };
 use ecat::foe::{FoeError, FOE_TIMEOUT_NS};
 use ecat::mailbox::MailboxError;
-use ethercrab::{MainDevice, SubDeviceRef};
 use hil_sim::sim::Simulation;
 use std::cell::RefCell;
 
@@ -32,30 +32,6 @@ fn line() -> RefCell<Simulation<FwNode>> {
 
 fn node(sim: &RefCell<Simulation<FwNode>>) -> std::cell::RefMut<'_, FwNode> {
     std::cell::RefMut::map(sim.borrow_mut(), |s| &mut s.drives_mut()[0])
-}
-
-/// Pre-Op (ethercrab's init) → Init → Bootstrap.
-async fn to_boot<S>(sd: &SubDeviceRef<'_, S>) {
-    request(sd, INIT).await;
-    assert_eq!(al_status(sd).await, (INIT, 0));
-    request(sd, BOOT).await;
-    assert_eq!(al_status(sd).await, (BOOT, 0), "Init -> Bootstrap");
-}
-
-/// Runs `body` against the first drive in Bootstrap.
-fn in_boot<T>(
-    sim: &RefCell<Simulation<FwNode>>,
-    body: impl for<'a> AsyncFnOnce(&'a MainDevice<'a>, SubDeviceRef<'a, &'a ethercrab::SubDevice>) -> T,
-) -> T {
-    with_master_on(sim, async |md, clock| {
-        let group = init(md, clock).await;
-        let sd = group.subdevice(md, 0).unwrap();
-        to_boot(&sd).await;
-        let r = body(md, sd).await;
-        // back to Init (what a master does after the download)
-        request(&group.subdevice(md, 0).unwrap(), INIT).await;
-        r
-    })
 }
 
 fn power_cycle(sim: &RefCell<Simulation<FwNode>>) {

@@ -11,10 +11,8 @@
 )]
 
 use drive::boot::{Slot, SlotState};
-use drive_tests::al::{BOOT, INIT};
-use drive_tests::{al_status, init, request, with_master_on, FoeClient, FoeReply, FwNode};
+use drive_tests::{in_boot, FoeClient, FoeReply, FwNode};
 use ecat::foe::FoeError;
-use ethercrab::{MainDevice, SubDeviceRef};
 use hil_sim::sim::Simulation;
 use std::cell::RefCell;
 use std::path::{Path, PathBuf};
@@ -104,22 +102,6 @@ fn make(dir: &Path, input: &[u8], version: u32) -> Vec<u8> {
 
 fn line() -> RefCell<Simulation<FwNode>> {
     RefCell::new(Simulation::with_nodes(vec![FwNode::factory(20_000)]))
-}
-
-fn in_boot<T>(
-    sim: &RefCell<Simulation<FwNode>>,
-    body: impl for<'a> AsyncFnOnce(&'a MainDevice<'a>, SubDeviceRef<'a, &'a ethercrab::SubDevice>) -> T,
-) -> T {
-    with_master_on(sim, async |md, clock| {
-        let group = init(md, clock).await;
-        let sd = group.subdevice(md, 0).unwrap();
-        request(&sd, INIT).await;
-        request(&sd, BOOT).await;
-        assert_eq!(al_status(&sd).await, (BOOT, 0));
-        let r = body(md, sd).await;
-        request(&group.subdevice(md, 0).unwrap(), INIT).await;
-        r
-    })
 }
 
 fn download(sim: &RefCell<Simulation<FwNode>>, file: &[u8]) -> Result<u32, FoeReply> {
