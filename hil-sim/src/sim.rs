@@ -120,7 +120,9 @@ pub struct SimDrive {
     pub motors: [Motor; 2],
     /// A60, supply and STO per axis.
     pub conditions: [AxisConditions; 2],
-    /// Control cycle, ns.
+    /// Length of the last control cycle, ns: the time until the next one
+    /// starts (A150 in free run, the PLL's period under DC), which the
+    /// motors are stepped by.
     pub cycle_ns: u64,
     /// The last [`SYNC0_LOG_LEN`] SYNC0 pulses the ESC delivered, oldest first.
     pub sync0_log: VecDeque<Sync0Stamp>,
@@ -434,11 +436,12 @@ impl SimDrive {
                     }
                     None => {
                         self.next_tick = None;
-                        self.next_cycle_ns = t.saturating_add(self.cycle_ns);
+                        self.next_cycle_ns = t.saturating_add(self.drive.free_run_period_ns());
                     }
                 }
             }
-            None => self.next_cycle_ns = t.saturating_add(self.cycle_ns),
+            // free run: the cycle the axes integrate with (A150, E-125)
+            None => self.next_cycle_ns = t.saturating_add(self.drive.free_run_period_ns()),
         }
         let io = [
             axis_io(self.feedback[0].as_ref(), &self.motors[0], self.conditions[0]),
@@ -448,6 +451,12 @@ impl SimDrive {
             Some(c) => self.drive.sync_cycle(&c, t, &io),
             None => self.drive.control_cycle(t, &io),
         };
+        // the torque holds until the next cycle starts (a broken timer that
+        // schedules nothing ahead steps the motors by the last length)
+        let dt = self.next_cycle_at().saturating_sub(t);
+        if dt > 0 {
+            self.cycle_ns = dt;
+        }
         for ((motor, fb), c) in self.motors.iter_mut().zip(self.feedback.iter_mut()).zip(cmd) {
             let torque = if c.power_stage {
                 f64::from(c.torque_nm)

@@ -464,6 +464,69 @@ fn c055_c056_pv_reaches_velocity_and_reports_zero_speed() {
     });
 }
 
+/// A150 (application cycle, U16 µs).
+const A150: u16 = drive::parameter_index(0, 150);
+
+/// E-125 / C-144 in free run (no SYNC0): the control cycle runs at A150,
+/// whatever its value, so a ramp takes the time its acceleration says and
+/// the axis turns at the commanded speed. (The control timer once stayed at
+/// 1 ms while the axis integrated with A150's dt: 4× too fast at 4 ms,
+/// 4× too slow at 250 µs.)
+#[test]
+fn e125_c144_free_run_moves_at_the_commanded_speed_at_every_a150() {
+    for a150_us in [4000u16, 250] {
+        let sim = line(1);
+        with_master(&sim, async |md, clock| {
+            let group = init(md, clock).await;
+            let sd = group.subdevice(md, 0).unwrap();
+            sd.sdo_write(A150, 0, a150_us).await.expect("A150 in Pre-Op");
+            let group = group.into_op(md).await.expect("OP");
+            let sd = group.subdevice(md, 0).unwrap();
+            sd.sdo_write(0x6083, 0, 40 * REV as u32).await.unwrap();
+            sd.sdo_write(0x6084, 0, 40 * REV as u32).await.unwrap();
+            let mut m = Cyclic::new(md, &group, &sim, 0);
+            m.set_mode(3);
+            m.run(3).await;
+            m.enable().await;
+            m.run(20).await;
+            // 0 → 4 rev/s at 40 rev/s² takes about 0.1 s of (simulated) time
+            let v = 4 * REV;
+            let t0 = sim.borrow().now_ns();
+            m.set_target_velocity(v);
+            m.run_until(2000, |t| t.bit(10) && t.velocity > v - REV / 20)
+                .await
+                .expect("velocity reached");
+            let ramp_ms = (sim.borrow().now_ns() - t0) as f64 / 1e6;
+            m.run(100).await;
+            // the plant turns at 4 rev/s: over 0.5 s it moves 2 revolutions
+            let p0 = sim.borrow().drives()[0].motors[0].position_inc_f64();
+            let t0 = sim.borrow().now_ns();
+            m.run(500).await;
+            let dt = (sim.borrow().now_ns() - t0) as f64 / 1e9;
+            let revs = (sim.borrow().drives()[0].motors[0].position_inc_f64() - p0) / REV_F;
+            println!(
+                "A150 = {a150_us} µs: ramp {ramp_ms:.1} ms, {revs:.3} rev in {dt:.3} s ({:.3} rev/s), 606Ch {:.3} rev/s",
+                revs / dt,
+                f64::from(m.tx.velocity) / REV_F
+            );
+            assert!(
+                (95.0..500.0).contains(&ramp_ms),
+                "A150 {a150_us}: ramp {ramp_ms} ms"
+            );
+            assert!(
+                (revs / dt - 4.0).abs() < 0.04,
+                "A150 {a150_us}: {} rev/s",
+                revs / dt
+            );
+            assert!(
+                (m.tx.velocity - v).abs() < REV / 100,
+                "A150 {a150_us}: 606Ch {}",
+                m.tx.velocity
+            );
+        });
+    }
+}
+
 #[test]
 fn c058_c061_c078_homing_method_37_through_pdo() {
     let sim = line(1);

@@ -174,6 +174,9 @@ pub enum Startup {
     Defaults,
 }
 
+/// The free-running control cycle while A150 holds no allowed value, ns.
+const FREE_RUN_DEFAULT_NS: u32 = 1_000_000;
+
 /// FoE file names (prefix) of the firmware image; other names: 8001h.
 pub const FIRMWARE_FILE: &[u8] = b"firmware";
 
@@ -1221,6 +1224,15 @@ impl<F: Flash, B: Flash> Drive<F, B> {
                 fault: None,
             },
         }
+    }
+
+    /// The period of the free-running control cycle (no SYNC0), ns: A150,
+    /// the cycle the axes integrate with (E-125, C-144); 1 ms while A150
+    /// holds no allowed cycle time.
+    pub fn free_run_period_ns(&self) -> u64 {
+        let a150_ns =
+            u32::try_from(read_slot(&self.objects, self.slots.a150, 0).saturating_mul(1000)).unwrap_or(0);
+        u64::from(motion::cycle::application_cycle_ns(a150_ns).unwrap_or(FREE_RUN_DEFAULT_NS))
     }
 
     /// The PLL configuration from the ESC's SYNC0 cycle and the objects

@@ -1,6 +1,8 @@
 //! The control-cycle timer.
 //!
-//! Without SYNC0 the control cycle runs free at A150 ([`CYCLE_NS`]). Once
+//! Without SYNC0 the control cycle runs free at A150
+//! ([`Drive::free_run_period_ns`](drive::runtime::Drive::free_run_period_ns);
+//! the first cycle at [`CYCLE_NS`]). Once
 //! the drive's DC-Sync PLL exists, each cycle's [`CycleCommand`](drive::runtime::dcsync::CycleCommand) gives the
 //! length of the next one in timer ticks ([`TIMER_HZ`]): the board programs
 //! its compare register from [`CycleTimer::next_at_ns`] (the QEMU world pends
@@ -12,7 +14,8 @@ use drive::runtime::TIMER_HZ;
 use crate::clock::mul_div;
 use crate::Drive;
 
-/// Free-running control cycle (A150 default), ns.
+/// The first free-running control cycle starts at this local time, ns
+/// (A150's default); the next ones follow A150.
 pub const CYCLE_NS: u64 = 1_000_000;
 
 const NS_PER_S: u64 = 1_000_000_000;
@@ -98,7 +101,7 @@ impl CycleTimer {
             }
             self.next_tick = None;
         }
-        self.next_ns = now_ns.saturating_add(CYCLE_NS);
+        self.next_ns = now_ns.saturating_add(drive.free_run_period_ns());
         drive.control_cycle(now_ns, io)
     }
 }

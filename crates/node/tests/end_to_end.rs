@@ -120,7 +120,7 @@ fn clock_counts_across_counter_wraps() {
 /// start counted from the actual start (the PLL following is checked by the
 /// end-to-end test above).
 #[test]
-fn e107_free_run_cycle_at_a150_without_sync0() {
+fn e107_e125_free_run_cycle_at_a150_without_sync0() {
     let mut drive = Drive::new(ParamFlash::new());
     let mut timer = CycleTimer::new();
     assert_eq!(timer.next_at_ns(), CYCLE_NS);
@@ -129,6 +129,20 @@ fn e107_free_run_cycle_at_a150_without_sync0() {
     assert_eq!(timer.next_at_ns(), 2 * CYCLE_NS);
     tasks::control(&mut drive, &mut timer, 2 * CYCLE_NS + 10, &io);
     assert_eq!(timer.next_at_ns(), 3 * CYCLE_NS + 10);
+    // E-125: the free-running period follows A150 (the axes' dt), 250 µs … 8 ms
+    for a150_us in [250, 500, 2000, 4000, 8000] {
+        drive
+            .objects
+            .set(drive::parameter_index(0, 150), 0, a150_us)
+            .unwrap();
+        let now = timer.next_at_ns();
+        tasks::control(&mut drive, &mut timer, now, &io);
+        assert_eq!(
+            timer.next_at_ns(),
+            now + a150_us as u64 * 1000,
+            "A150 = {a150_us} µs"
+        );
+    }
 }
 
 /// A save fits the images' parameter flash and loads
