@@ -37,6 +37,9 @@ static BIG_OBJECT: ObjectInfo = ObjectInfo {
 /// The drive's dictionary plus the 4 KiB block.
 struct BenchDict(DriveObjects);
 
+/// A 1 ms cycle, no RxPDO monitoring (the defaults).
+impl ecat::Application for BenchDict {}
+
 impl Dictionary for BenchDict {
     fn object(&self, index: u16) -> Option<&'static ObjectInfo> {
         if index == BIG {

@@ -31,6 +31,8 @@ use ecat::{DataType, DcOpMode, Device, FmmuUsage, Identity, MailboxSm, Pdo, PdoE
 pub mod axis;
 pub mod dictionary;
 pub mod doc;
+pub mod ecat_app;
+pub mod emcy;
 pub mod objects;
 pub mod pdo_image;
 pub mod runtime;

@@ -59,13 +59,14 @@
 
 use crate::axis::{Axis, AxisCache, AxisCommand, AxisIo};
 use crate::dictionary::{read_slot, write_slot, DriveObjects, LiveValues, Slot, PERSISTENT_IMAGE_BYTES};
+use crate::ecat_app::{event52, event52_cause};
 use crate::objects::LAYOUT_HASH;
 use crate::pdo_image::{PdoImage, PdoImageError};
 use crate::DEVICE;
 use boot::{BootSlots, NoFlash, UpdateError};
 use ecat::diag::{DiagHistory, DiagMessage, DiagType};
 use ecat::emcy::Emcy;
-use ecat::esm::{event52, SyncMode, SyncState};
+use ecat::esm::{SyncMode, SyncState};
 use ecat::foe::{Accept, FoeError, FoeHandler};
 use ecat::led::Pattern;
 use ecat::{Slave, StateChange};
@@ -774,14 +775,14 @@ impl<F: Flash, B: Flash> Drive<F, B> {
             self.update_sync_live();
         }
         self.process_outputs();
-        if let Some(cause) = self.slave.take_event52() {
-            // the slave left Op and queued EMCY 7500h: the axes' reaction only
-            self.raise_event52(cause, false);
+        if let Some(loss) = self.slave.take_op_loss() {
+            // the slave left Op by itself: event 52 with its EMCY 7500h
+            self.raise_event52(event52_cause(loss));
         }
         self.check_fieldbus_identification();
         if change.is_some_and(|c| c.code == AlStatusCode::INVALID_MAILBOX_CONFIG) {
-            let sm0 = pdi.read_sm(0)?;
-            self.mailbox_er = if ecat::esm::mailbox_sm_ok_alone(self.slave.device(), 0, &sm0) {
+            // Er10: the mailbox the master writes (SM0), Er9: the one it reads
+            self.mailbox_er = if self.slave.mailbox_fault() == Some(1) {
                 9
             } else {
                 10
@@ -960,14 +961,11 @@ impl<F: Flash, B: Flash> Drive<F, B> {
     /// on the slow-down / quick-stop ramp with the brake released, then
     /// off), ending in Fault with 603Fh = 7500h; a fault reset (controlword
     /// bit 7 edge) clears it. One EMCY 7500h / 10h / 52 / cause for the
-    /// device (axis byte 0): queued here when `queue_emcy`, else the slave
-    /// already did; the axes' own T13 EMCY for it is dropped. E82/E43 show
-    /// the event.
-    pub fn raise_event52(&mut self, cause: u8, queue_emcy: bool) {
-        let emcy = Emcy::for_event(event52::EVENT, cause, 0);
-        if queue_emcy {
-            self.slave.emergency(emcy);
-        }
+    /// device (axis byte 0); the axes' own T13 EMCY for it is dropped.
+    /// E82/E43 show the event.
+    pub fn raise_event52(&mut self, cause: u8) {
+        self.slave
+            .emergency(crate::emcy::for_event(event52::EVENT, cause, 0));
         let event = motion::Event {
             number: u16::from(event52::EVENT),
             cause,
@@ -995,7 +993,7 @@ impl<F: Flash, B: Flash> Drive<F, B> {
         let _ = self.objects.set(E59, 3, i64::from(self.projected_fieldbus));
         let mismatch = self.projected_fieldbus != FIELDBUS_ID;
         if mismatch && !self.wrong_firmware {
-            self.raise_event52(event52::WRONG_FIRMWARE, true);
+            self.raise_event52(event52::WRONG_FIRMWARE);
         }
         self.wrong_firmware = mismatch;
     }

@@ -2,6 +2,7 @@
 //! and the SyncManager checks of I→P and P→S. Pure functions; [`crate::Slave`]
 //! applies them to the ESC.
 
+use crate::app::PdoTimeout;
 use crate::desc::{Device, MailboxSm};
 use crate::emcy::SmFault;
 use esc::{regs, AlState, AlStatusCode, SmDirection, SmMode, SyncManager};
@@ -76,23 +77,21 @@ fn mailbox_sm_ok(sm: &SyncManager, want: &MailboxSm, dir: SmDirection) -> bool {
 /// between [`MIN_MAILBOX_LEN`] and the description's length, mailbox mode, right
 /// direction. Failure: AL 0016h.
 pub fn check_mailbox_sms(desc: &Device, sm0: &SyncManager, sm1: &SyncManager) -> Result<(), AlStatusCode> {
-    if mailbox_sm_ok(sm0, &desc.mailbox_out, SmDirection::MasterWrite)
-        && mailbox_sm_ok(sm1, &desc.mailbox_in, SmDirection::MasterRead)
-    {
-        Ok(())
-    } else {
-        Err(AlStatusCode::INVALID_MAILBOX_CONFIG)
+    match faulty_mailbox_sm(desc, sm0, sm1) {
+        None => Ok(()),
+        Some(_) => Err(AlStatusCode::INVALID_MAILBOX_CONFIG),
     }
 }
 
-/// Whether mailbox SyncManager `n` (0 = master → slave, "mailbox Rx"; 1 =
-/// slave → master, "mailbox Tx") alone passes the I→P check of
-/// [`check_mailbox_sms`]: which one failed (A257 Er10 / Er9).
-pub fn mailbox_sm_ok_alone(desc: &Device, n: u8, sm: &SyncManager) -> bool {
-    match n {
-        0 => mailbox_sm_ok(sm, &desc.mailbox_out, SmDirection::MasterWrite),
-        1 => mailbox_sm_ok(sm, &desc.mailbox_in, SmDirection::MasterRead),
-        _ => false,
+/// The first mailbox SyncManager (0 = master → slave, "mailbox Rx"; 1 =
+/// slave → master, "mailbox Tx") that fails [`check_mailbox_sms`].
+pub fn faulty_mailbox_sm(desc: &Device, sm0: &SyncManager, sm1: &SyncManager) -> Option<u8> {
+    if !mailbox_sm_ok(sm0, &desc.mailbox_out, SmDirection::MasterWrite) {
+        Some(0)
+    } else if !mailbox_sm_ok(sm1, &desc.mailbox_in, SmDirection::MasterRead) {
+        Some(1)
+    } else {
+        None
     }
 }
 
@@ -254,20 +253,6 @@ pub fn check_free_run(mode: SyncMode, sm2: &SyncManager, rx_bytes: usize) -> Res
     }
 }
 
-/// A258 values with a special meaning (spec §13.1).
-pub mod a258 {
-    /// Monitoring off (as is 0).
-    pub const OFF: u16 = 65535;
-    /// Largest plain timeout, ms.
-    pub const MAX_MS: u16 = 65531;
-    /// A single lost packet is tolerated.
-    pub const ONE_LOST: u16 = 65532;
-    /// Up to 3 consecutive lost packets are tolerated.
-    pub const THREE_LOST: u16 = 65533;
-    /// SyncManager watchdog mode: the tolerance is the master's SM watchdog (A259).
-    pub const SM_WATCHDOG: u16 = 65534;
-}
-
 /// The ESC's process-data watchdog as the master configured it (0x0400,
 /// 0x0420, SM2's watchdog trigger bit).
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
@@ -288,13 +273,14 @@ impl EscWatchdog {
     }
 }
 
-/// How the RxPDO reception is monitored in Op (A258, spec §13.1).
+/// How the RxPDO reception is monitored in Op (spec §13.1), from the
+/// application's [`PdoTimeout`] and the process-data cycle.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
 pub enum PdoMonitor {
     /// No new RxPDO for longer than this (ns) is a PDO timeout.
     Timeout(u64),
-    /// A258 = 65534: the ESC's SM watchdog decides (AL event 6, 0x0440 bit
-    /// 0); the tolerance (ns) is the watchdog time (A259\[0\]).
+    /// [`PdoTimeout::EscWatchdog`]: the ESC's SM watchdog decides (AL event
+    /// 6, 0x0440 bit 0); the tolerance (ns) is the watchdog time.
     EscWatchdog(u64),
 }
 
@@ -307,35 +293,34 @@ impl PdoMonitor {
     }
 }
 
-/// The monitoring A258 asks for, with `cycle_ns` the process-data cycle
-/// (SYNC0 cycle in DC mode, else `1C32h:02`) and the ESC's watchdog.
-/// 0/65535: off. 1…65531: that many ms. 65532 / 65533: one / three lost
-/// packets tolerated, i.e. a gap of 2 / 4 cycles passes, plus half a cycle
-/// for jitter. 65534: the ESC's SM watchdog (off when the master disabled it).
-pub fn pdo_monitor(a258: u16, cycle_ns: u32, wd: &EscWatchdog) -> Option<PdoMonitor> {
+/// The monitoring `timeout` asks for, with `cycle_ns` the process-data
+/// cycle (SYNC0 cycle in DC mode, else `1C32h:02`) and the ESC's watchdog.
+/// Lost frames: a gap of `lost + 1` cycles passes, plus half a cycle for
+/// jitter. The ESC's watchdog: off when the master disabled it.
+pub fn pdo_monitor(timeout: PdoTimeout, cycle_ns: u32, wd: &EscWatchdog) -> Option<PdoMonitor> {
     let cycle = u64::from(cycle_ns);
-    match a258 {
-        0 | a258::OFF => None,
-        1..=a258::MAX_MS => Some(PdoMonitor::Timeout(u64::from(a258) * 1_000_000)),
-        a258::ONE_LOST => Some(PdoMonitor::Timeout(2 * cycle + cycle / 2)),
-        a258::THREE_LOST => Some(PdoMonitor::Timeout(4 * cycle + cycle / 2)),
-        _ => wd.time_ns().map(PdoMonitor::EscWatchdog),
+    match timeout {
+        PdoTimeout::Off => None,
+        PdoTimeout::Ms(0) => None,
+        PdoTimeout::Ms(ms) => Some(PdoMonitor::Timeout(u64::from(ms) * 1_000_000)),
+        PdoTimeout::LostFrames(lost) => Some(PdoMonitor::Timeout((u64::from(lost) + 1) * cycle + cycle / 2)),
+        PdoTimeout::EscWatchdog => wd.time_ns().map(PdoMonitor::EscWatchdog),
     }
 }
 
-/// Longest watchdog tolerance A259\[0\] can show (u16 ms).
+/// Longest watchdog tolerance a u16 ms diagnosis value can show.
 pub const MAX_WATCHDOG_NS: u64 = 65_535 * 1_000_000;
 
 /// P→S check of the SM watchdog settings (E-031, AL 001Fh). Invalid:
 /// - a running process-data watchdog (time ≠ 0) with divider 0 (a 80 ns
 ///   unit: no master means that);
-/// - with A258 = 65534 (the drive relies on the master's SM watchdog, spec
-///   §13.2): the watchdog disabled (time 0 or SM2 without its trigger bit
-///   while outputs are mapped), shorter than one process-data cycle
-///   (`cycle_ns`: it would fire between two frames) or longer than A259\[0\]
-///   can show (65535 ms).
+/// - with [`PdoTimeout::EscWatchdog`] (the application relies on the
+///   master's SM watchdog, spec §13.2): the watchdog disabled (time 0 or
+///   SM2 without its trigger bit while outputs are mapped), shorter than
+///   one process-data cycle (`cycle_ns`: it would fire between two frames)
+///   or longer than [`MAX_WATCHDOG_NS`] (65535 ms).
 pub fn check_watchdog(
-    a258: u16,
+    timeout: PdoTimeout,
     wd: &EscWatchdog,
     cycle_ns: u32,
     rx_bytes: usize,
@@ -344,7 +329,7 @@ pub fn check_watchdog(
     if wd.pd_time != 0 && wd.divider == 0 {
         return invalid;
     }
-    if a258 == a258::SM_WATCHDOG && rx_bytes > 0 {
+    if timeout == PdoTimeout::EscWatchdog && rx_bytes > 0 {
         match wd.time_ns() {
             None => return invalid,
             Some(t) if t < u64::from(cycle_ns) || t > MAX_WATCHDOG_NS => return invalid,
@@ -361,27 +346,17 @@ pub const STEADY_FRAMES: u32 = 3;
 /// (spec §3.3), ns.
 pub const STEADY_WAIT_NS: u64 = 200_000_000;
 
-/// Event 52 "Communication" (spec §13.4): the causes (`E43`) this stack
-/// raises, in one place. The EMCY is 7500h, error register 10h, `E82` = 52,
-/// `E43` = the cause ([`crate::emcy::Emcy::for_event`]); the drive's reaction
-/// (A29 / A540, E-129) is the application's.
-///
-/// | Cause | Raised by | When |
-/// |---|---|---|
-/// | [`PDO_TIMEOUT`](event52::PDO_TIMEOUT) (6) | [`crate::Slave`] in Op | no RxPDO for longer than A258, or the ESC's SM watchdog (A258 = 65534) expired (AL 001Bh) |
-/// | [`SYNC`](event52::SYNC) (7) | [`crate::Slave`] in Op, DC mode | the application reports a synchronisation fault through [`crate::Slave::set_sync_state`]: SYNC0 timeout (0034h), late frames (0033h), lost lock (0032h) (E-131; the spec's cell merges synchronisation and connection errors, uncertain) |
-/// | [`WRONG_FIRMWARE`](event52::WRONG_FIRMWARE) (15) | the application (`drive::runtime`) | the projected fieldbus identification E59\[2\] ≠ the firmware's (E-130) |
-pub mod event52 {
-    /// `E82` of the event.
-    pub const EVENT: u8 = 52;
-    /// Cause 6: EtherCAT PDO timeout (process data missing).
-    pub const PDO_TIMEOUT: u8 = 6;
-    /// Cause 7: synchronisation (or connection) error; the value
-    /// `dcsync::EVENT52_CAUSE_SYNC` the PLL reports.
-    pub const SYNC: u8 = dcsync::EVENT52_CAUSE_SYNC;
-    /// Cause 15: wrong firmware for the application (detected by the
-    /// application, which queues the EMCY itself).
-    pub const WRONG_FIRMWARE: u8 = 15;
+/// Why the slave left Op by itself ([`crate::Slave::take_op_loss`]); the
+/// application raises its own event for it (the drive: event 52 with cause
+/// 6 or 7, EMCY 7500h, its fault reaction).
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum OpLoss {
+    /// No RxPDO within the monitoring's tolerance, or the ESC's SM watchdog
+    /// expired (AL 001Bh).
+    PdoTimeout,
+    /// In DC mode the application reported a synchronisation fault through
+    /// [`crate::Slave::set_sync_state`] (0032h, 0033h, 0034h).
+    Sync,
 }
 
 /// What the application tells the slave about its synchronisation (the
@@ -399,7 +374,7 @@ pub struct SyncState {
     pub ready: Result<(), AlStatusCode>,
     /// A latched synchronisation fault (0032h lost lock, 0033h late frames,
     /// 0034h SYNC0 timeout, 001Ah): in Op it drops to Safe-Op with this code
-    /// and EMCY 7500h cause [`event52::SYNC`]. The application clears it when
+    /// and [`OpLoss::Sync`]. The application clears it when
     /// the master acknowledges the error ([`crate::Slave::take_error_ack`]).
     pub fault: Option<AlStatusCode>,
 }

@@ -13,6 +13,9 @@
 //!   application's [`FoeHandler`]; [`eoe`]: Ethernet over EtherCAT ([`eoe::EoeServer`]:
 //!   fragment reassembly and fragmentation, set IP parameter, EMCY FFF0h) towards the
 //!   application's [`eoe::EthernetPort`].
+//! - [`app`]: what the stack asks of the application beyond its dictionary
+//!   ([`Application`]: its cycle, the RxPDO monitoring, the check of a DC
+//!   configuration); the stack knows no manufacturer object.
 //! - [`Slave`]: all of it composed; the application calls
 //!   [`Slave::poll`]`(pdi, app, now_ns)`
 //!   (or [`Slave::poll_with_eoe`] with the FoE handler and the Ethernet port) with the ESC behind an [`esc::Pdi`].
@@ -28,6 +31,7 @@
 )]
 #![deny(missing_docs)]
 
+pub mod app;
 pub mod coe;
 pub mod desc;
 pub mod diag;
@@ -42,6 +46,7 @@ pub mod sdo_info;
 pub mod sii;
 mod slave;
 
+pub use app::{Application, DcRequest, PdoTimeout};
 pub use coe::{CoeConfig, CoeServer, CommState, Dictionary, SdoAbort};
 pub use desc::{DataType, DcOpMode, Device, FmmuUsage, Identity, MailboxSm, Pdo, PdoEntry, ProcessSm};
 pub use foe::{FoeError, FoeHandler, FoeServer};

@@ -1,11 +1,12 @@
 //! The slave: ESM + mailbox + CoE dispatch + process data, driven by `poll`.
 
+use crate::app::{Application, DcRequest};
 use crate::coe::{service, CoeConfig, CoeHeader, CoeServer, CommState, Dictionary, COE_HEADER_LEN};
 use crate::desc::Device;
 use crate::emcy::{self, Emcy, EmcyQueue};
 use crate::eoe::{EoeServer, EthernetPort, NoEthernet};
 use crate::esm::{
-    self, event52, EscWatchdog, PdoMonitor, SyncMode, SyncState, MAX_MAILBOX_LEN, MAX_PDO_BYTES,
+    self, EscWatchdog, OpLoss, PdoMonitor, SyncMode, SyncState, MAX_MAILBOX_LEN, MAX_PDO_BYTES,
 };
 use crate::foe::{FoeHandler, FoeServer, NoFiles, FOE_HEADER_LEN};
 use crate::mailbox::{next_counter, MailboxError, MailboxHeader, MailboxType, HEADER_LEN};
@@ -26,7 +27,7 @@ pub struct StateChange {
     pub code: AlStatusCode,
     /// The slave left the state on its own (PDO timeout / SM watchdog / sync
     /// fault, E-038:
-    /// A257 Er3, red LED single flash); `requested` is then the state it left.
+    /// red LED single flash); `requested` is then the state it left.
     pub unsolicited: bool,
 }
 
@@ -56,40 +57,33 @@ static ZEROS: [u8; MAX_PDO_BYTES] = [0; MAX_PDO_BYTES];
 /// Emergencies the slave holds while the mailbox is busy (the oldest is dropped beyond).
 pub const EMCY_QUEUE: usize = 8;
 
-/// A150 (drive cycle, U16 µs; spec §12): parameter 2000h + 150.
-pub const A150_INDEX: u16 = 0x2096;
-/// A258 (PDO timeout, U16 ms; spec §13.1): parameter 2000h + 258.
-pub const A258_INDEX: u16 = 0x2102;
 /// Output / input SyncManager parameter objects (spec §11.9).
 pub const SM_OUTPUT_PARAMETER: u16 = 0x1C32;
 /// Input SyncManager parameter object.
 pub const SM_INPUT_PARAMETER: u16 = 0x1C33;
-/// A150 when the application has none, µs.
-const DEFAULT_A150_US: u32 = 1000;
 
 /// The synchronisation the slave accepted at the last P→S (spec §11), and
-/// the RxPDO monitoring (A258/A259, spec §13.1–13.2): what `1C32h`/`1C33h`,
-/// A259 and A257 show.
+/// the RxPDO monitoring (spec §13.1–13.2): what `1C32h`/`1C33h` and the
+/// application's diagnosis show.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
 pub struct SyncStatus {
     /// Mode accepted at P→S.
     pub mode: SyncMode,
     /// Process-data cycle, ns: the SYNC0 cycle in DC mode, else `1C32h:02`
-    /// (A150 when that is 0).
+    /// (the application's cycle when that is 0).
     pub cycle_ns: u32,
     /// Drive cycles per SYNC0 cycle (DC), 1 otherwise.
     pub k: u32,
-    /// Why the last P→S refused the DC configuration (for `A261[0]`).
-    pub sync_error: Option<dcsync::SyncError>,
-    /// The RxPDO monitoring in force (set at S→O from A258).
+    /// The RxPDO monitoring in force (set at S→O from the application's
+    /// [`PdoTimeout`](crate::app::PdoTimeout)).
     pub monitor: Option<PdoMonitor>,
-    /// A259[1]: the PDO timeout / SM watchdog triggered (until the master's
-    /// next acknowledged request).
+    /// The PDO timeout / SM watchdog triggered (until the master's next
+    /// acknowledged request).
     pub triggered: bool,
-    /// A259[2]: how often it triggered.
+    /// How often it triggered.
     pub trigger_count: u16,
-    /// The last state change was unsolicited (E-038, A257 Er3) until the
-    /// master's next acknowledged request.
+    /// The last state change was unsolicited (E-038) until the master's
+    /// next acknowledged request.
     pub unsolicited: bool,
 }
 
@@ -179,9 +173,10 @@ pub struct Slave {
     /// The master acknowledged an error indication since the last
     /// [`Slave::take_error_ack`].
     error_acked: bool,
-    /// Cause of the event 52 the slave raised since the last
-    /// [`Slave::take_event52`].
-    event52: Option<u8>,
+    /// Why the slave left Op by itself since the last [`Slave::take_op_loss`].
+    op_loss: Option<OpLoss>,
+    /// The mailbox SyncManager the last I→P check refused.
+    mailbox_fault: Option<u8>,
 }
 
 impl Slave {
@@ -227,12 +222,13 @@ impl Slave {
             },
             sync_state: SyncState::NONE,
             error_acked: false,
-            event52: None,
+            op_loss: None,
+            mailbox_fault: None,
         }
     }
 
-    /// The synchronisation and RxPDO monitoring state (1C32h/1C33h, A259,
-    /// A257 Er3/Er4).
+    /// The synchronisation and RxPDO monitoring state (1C32h/1C33h and the
+    /// application's diagnosis).
     pub fn sync_status(&self) -> &SyncStatus {
         &self.sync
     }
@@ -260,12 +256,18 @@ impl Slave {
         core::mem::take(&mut self.error_acked)
     }
 
-    /// The cause (`E43`) of the event 52 "Communication" the slave raised
-    /// since the last call ([`event52::PDO_TIMEOUT`] or [`event52::SYNC`],
-    /// with Op left for Safe-Op and EMCY 7500h queued): the application runs
-    /// its fault reaction (A540, E-129) without a second EMCY.
-    pub fn take_event52(&mut self) -> Option<u8> {
-        self.event52.take()
+    /// Why the slave left Op for Safe-Op by itself since the last call (a
+    /// PDO timeout or a synchronisation fault): the application raises its
+    /// event for it (its EMCY and fault reaction; the drive: event 52).
+    pub fn take_op_loss(&mut self) -> Option<OpLoss> {
+        self.op_loss.take()
+    }
+
+    /// The mailbox SyncManager (0 = master → slave, 1 = slave → master)
+    /// the last Init → Pre-Op / Bootstrap request was refused for (AL 0016h),
+    /// `None` when it passed.
+    pub fn mailbox_fault(&self) -> Option<u8> {
+        self.mailbox_fault
     }
 
     /// The RUN LED's pattern now (E-133, [`crate::led::run`]).
@@ -362,7 +364,7 @@ impl Slave {
     /// Returns the processed AL control request when it changed the state or was
     /// refused. FoE requests are refused ([`NoFiles`]); see
     /// [`poll_with_foe`](Self::poll_with_foe).
-    pub fn poll<P: Pdi, A: Dictionary>(
+    pub fn poll<P: Pdi, A: Application>(
         &mut self,
         pdi: &mut P,
         app: &mut A,
@@ -375,7 +377,7 @@ impl Slave {
     /// firmware slots): FoE writes in Bootstrap go to `foe`; a transfer in
     /// progress ends when the slave leaves Bootstrap or after
     /// [`crate::foe::FOE_TIMEOUT_NS`] without a packet.
-    pub fn poll_with_foe<P: Pdi, A: Dictionary, H: FoeHandler>(
+    pub fn poll_with_foe<P: Pdi, A: Application, H: FoeHandler>(
         &mut self,
         pdi: &mut P,
         app: &mut A,
@@ -391,7 +393,7 @@ impl Slave {
     /// from `eth.transmit` go out in fragments, one per mailbox message, when
     /// SM1 is free; set-IP-parameter requests are answered here (E-096,
     /// E-097, EMCY FFF0h on refusal, E-093).
-    pub fn poll_with_eoe<P: Pdi, A: Dictionary, H: FoeHandler, E: EthernetPort>(
+    pub fn poll_with_eoe<P: Pdi, A: Application, H: FoeHandler, E: EthernetPort>(
         &mut self,
         pdi: &mut P,
         app: &mut A,
@@ -408,7 +410,7 @@ impl Slave {
     /// high-priority task: AL control, process data and its monitoring,
     /// without the mailbox. Run [`poll_mailbox_only`](Self::poll_mailbox_only)
     /// at a lower priority to serve the mailbox.
-    pub fn poll_esc<P: Pdi, A: Dictionary>(
+    pub fn poll_esc<P: Pdi, A: Application>(
         &mut self,
         pdi: &mut P,
         app: &mut A,
@@ -422,7 +424,7 @@ impl Slave {
     /// low-priority task: one request from SM0 (CoE, EoE, FoE) answered
     /// into SM1, the EMCY queue, SDO Info fragments, outgoing EoE fragments
     /// and the FoE timeout. Nothing happens outside the mailbox states.
-    pub fn poll_mailbox_only<P: Pdi, A: Dictionary, H: FoeHandler, E: EthernetPort>(
+    pub fn poll_mailbox_only<P: Pdi, A: Application, H: FoeHandler, E: EthernetPort>(
         &mut self,
         pdi: &mut P,
         app: &mut A,
@@ -435,7 +437,7 @@ impl Slave {
     }
 
     /// The AL event request register and the AL control request it carries.
-    fn poll_al_control<P: Pdi, A: Dictionary>(
+    fn poll_al_control<P: Pdi, A: Application>(
         &mut self,
         pdi: &mut P,
         app: &mut A,
@@ -460,7 +462,7 @@ impl Slave {
         Ok((events, change))
     }
 
-    fn mailbox_step<P: Pdi, A: Dictionary, H: FoeHandler, E: EthernetPort>(
+    fn mailbox_step<P: Pdi, A: Application, H: FoeHandler, E: EthernetPort>(
         &mut self,
         pdi: &mut P,
         app: &mut A,
@@ -478,7 +480,7 @@ impl Slave {
         Ok(())
     }
 
-    fn poll_process_data<P: Pdi, A: Dictionary>(
+    fn poll_process_data<P: Pdi, A: Application>(
         &mut self,
         pdi: &mut P,
         app: &mut A,
@@ -505,7 +507,7 @@ impl Slave {
     /// (DC mode) the synchronisation ready, or refuses it after
     /// [`esm::STEADY_WAIT_NS`] (with the synchronisation's code when that is
     /// what is missing).
-    fn pending_op<P: Pdi, A: Dictionary>(
+    fn pending_op<P: Pdi, A: Application>(
         &mut self,
         pdi: &mut P,
         app: &mut A,
@@ -528,9 +530,8 @@ impl Slave {
             } else {
                 // Not stable within 200 ms: refused. The spec names no AL code
                 // (§3.3: 001Bh or 002Bh); 001Bh "SM watchdog" is the one §4 ties to
-                // "no RxPDO received, or not within the tolerated time". A257 Er6
-                // ("regular process data missing") is not modelled here: A257 is
-                // the runtime's, it can tell this refusal by the code and `from`.
+                // "no RxPDO received, or not within the tolerated time". The
+                // application's diagnosis tells this refusal by the code and `from`.
                 Err(AlStatusCode::SM_WATCHDOG)
             }
         } else {
@@ -559,7 +560,7 @@ impl Slave {
     }
 
     /// Whether the RxPDO is "stable and regular" for S→O (E-033): with
-    /// monitoring on (A258), the last [`esm::STEADY_FRAMES`] frames each
+    /// monitoring on, the last [`esm::STEADY_FRAMES`] frames each
     /// within the tolerance of the previous one and the newest within the
     /// tolerance of `now_ns`. With monitoring off nothing is required: the
     /// drive would never notice missing frames in Op either, and masters
@@ -614,9 +615,7 @@ impl Slave {
         self.sync.triggered = true;
         self.sync.trigger_count = self.sync.trigger_count.saturating_add(1);
         self.sync.unsolicited = true;
-        self.emcy
-            .push(Emcy::for_event(event52::EVENT, event52::PDO_TIMEOUT, 0));
-        self.event52 = Some(event52::PDO_TIMEOUT);
+        self.op_loss = Some(OpLoss::PdoTimeout);
         self.write_status(pdi)?;
         Ok(Some(StateChange {
             from: AlState::Op,
@@ -647,7 +646,7 @@ impl Slave {
     /// the application reports (SYNC0 timeout 0034h, late frames 0033h, lost
     /// lock 0032h) leaves Op for Safe-Op with the error indication and that
     /// code, EMCY 7500h (event 52, cause 7) and an unsolicited state change
-    /// (E-038). Not an RxPDO monitoring trigger: A259 is left alone.
+    /// (E-038). Not an RxPDO monitoring trigger (`triggered` is left alone).
     fn monitor_sync<P: Pdi>(&mut self, pdi: &mut P) -> Result<Option<StateChange>, P::Error> {
         if !self.sync_supervised() {
             return Ok(None);
@@ -659,8 +658,7 @@ impl Slave {
         self.error = true;
         self.code = code;
         self.sync.unsolicited = true;
-        self.emcy.push(Emcy::for_event(event52::EVENT, event52::SYNC, 0));
-        self.event52 = Some(event52::SYNC);
+        self.op_loss = Some(OpLoss::Sync);
         self.write_status(pdi)?;
         Ok(Some(StateChange {
             from: AlState::Op,
@@ -681,7 +679,7 @@ impl Slave {
         pdi.write_u16(regs::AL_STATUS, status.raw())
     }
 
-    fn al_control<P: Pdi, A: Dictionary>(
+    fn al_control<P: Pdi, A: Application>(
         &mut self,
         pdi: &mut P,
         app: &mut A,
@@ -744,7 +742,7 @@ impl Slave {
     }
 
     /// Checks and actions of one ESM transition; the outer `Result` is the PDI's.
-    fn transition<P: Pdi, A: Dictionary>(
+    fn transition<P: Pdi, A: Application>(
         &mut self,
         pdi: &mut P,
         app: &mut A,
@@ -756,6 +754,7 @@ impl Slave {
             (AlState::Init, AlState::PreOp | AlState::Bootstrap) => {
                 // the bootstrap mailbox is the standard one (the SII says so)
                 let (sm0, sm1) = (pdi.read_sm(0)?, pdi.read_sm(1)?);
+                self.mailbox_fault = esm::faulty_mailbox_sm(self.desc, &sm0, &sm1);
                 if let Err(code) = esm::check_mailbox_sms(self.desc, &sm0, &sm1) {
                     return Ok(Err(code));
                 }
@@ -787,25 +786,22 @@ impl Slave {
                     ));
                     return Ok(Err(refusal.code));
                 }
-                let a150_ns = read_uint(app, A150_INDEX, 0)
-                    .unwrap_or(DEFAULT_A150_US)
-                    .saturating_mul(1000);
+                let app_cycle_ns = app.cycle_ns();
                 let (cycle_ns, k) = match mode {
                     SyncMode::DcSync0 => {
-                        let sync0 = pdi.read_u32(regs::dc::SYNC0_CYCLE)?;
-                        let sm2_cycle = read_uint(app, SM_OUTPUT_PARAMETER, 2).unwrap_or(0);
-                        let sm3_cycle = read_uint(app, SM_INPUT_PARAMETER, 2).unwrap_or(0);
-                        match dcsync::validate(sync0, a150_ns, sm2_cycle, sm3_cycle) {
-                            Ok(k) => (sync0, k),
-                            Err(e) => {
-                                self.sync.sync_error = Some(e);
-                                return Ok(Err(AlStatusCode(e.al_status_code())));
-                            }
+                        let dc = DcRequest {
+                            sync0_ns: pdi.read_u32(regs::dc::SYNC0_CYCLE)?,
+                            sm2_cycle_ns: read_uint(app, SM_OUTPUT_PARAMETER, 2).unwrap_or(0),
+                            sm3_cycle_ns: read_uint(app, SM_INPUT_PARAMETER, 2).unwrap_or(0),
+                        };
+                        match app.check_dc(&dc) {
+                            Ok(k) => (dc.sync0_ns, k),
+                            Err(code) => return Ok(Err(code)),
                         }
                     }
                     _ => {
                         let c = read_uint(app, SM_OUTPUT_PARAMETER, 2).unwrap_or(0);
-                        (if c == 0 { a150_ns } else { c }, 1)
+                        (if c == 0 { app_cycle_ns } else { c }, 1)
                     }
                 };
                 if let Err(code) = self.check_watchdog(pdi, app, sm2, cycle_ns, rx)? {
@@ -814,7 +810,6 @@ impl Slave {
                 self.sync.mode = mode;
                 self.sync.cycle_ns = cycle_ns;
                 self.sync.k = k;
-                self.sync.sync_error = None;
                 self.sync.monitor = None;
                 if mode == SyncMode::DcSync0 {
                     // 1C32h/1C33h:01/:02 show what runs (the master may only
@@ -864,9 +859,9 @@ impl Slave {
         })
     }
 
-    /// P→S: the SM watchdog settings against A258 (E-031, AL 001Fh; see
-    /// [`esm::check_watchdog`]).
-    fn check_watchdog<P: Pdi, A: Dictionary>(
+    /// P→S: the SM watchdog settings against the application's RxPDO
+    /// monitoring (E-031, AL 001Fh; see [`esm::check_watchdog`]).
+    fn check_watchdog<P: Pdi, A: Application>(
         &mut self,
         pdi: &mut P,
         app: &mut A,
@@ -875,12 +870,12 @@ impl Slave {
         rx_bytes: usize,
     ) -> Result<Result<(), AlStatusCode>, P::Error> {
         let wd = Self::esc_watchdog(pdi, sm2)?;
-        let a258 = read_a258(app);
-        Ok(esm::check_watchdog(a258, &wd, cycle_ns, rx_bytes))
+        Ok(esm::check_watchdog(app.pdo_timeout(), &wd, cycle_ns, rx_bytes))
     }
 
-    /// The RxPDO monitoring A258 asks for now (read at each S→O request).
-    fn pdo_monitor<P: Pdi, A: Dictionary>(
+    /// The RxPDO monitoring the application asks for now (read at each S→O
+    /// request).
+    fn pdo_monitor<P: Pdi, A: Application>(
         &mut self,
         pdi: &mut P,
         app: &mut A,
@@ -890,7 +885,7 @@ impl Slave {
         }
         let sm2 = pdi.read_sm(2)?;
         let wd = Self::esc_watchdog(pdi, &sm2)?;
-        Ok(esm::pdo_monitor(read_a258(app), self.sync.cycle_ns, &wd))
+        Ok(esm::pdo_monitor(app.pdo_timeout(), self.sync.cycle_ns, &wd))
     }
 
     fn start_mailbox(&mut self, sm0: &SyncManager, sm1: &SyncManager) {
@@ -906,7 +901,7 @@ impl Slave {
         self.coe.reset();
     }
 
-    fn poll_mailbox<P: Pdi, A: Dictionary, H: FoeHandler, E: EthernetPort>(
+    fn poll_mailbox<P: Pdi, A: Application, H: FoeHandler, E: EthernetPort>(
         &mut self,
         pdi: &mut P,
         app: &mut A,
@@ -979,7 +974,7 @@ impl Slave {
     }
 
     /// Handles the request in `mbx.rx`; a response goes to `mbx.tx` and is pending.
-    fn handle_request<A: Dictionary, H: FoeHandler, E: EthernetPort>(
+    fn handle_request<A: Application, H: FoeHandler, E: EthernetPort>(
         &mut self,
         app: &mut A,
         foe: &mut H,
@@ -1057,7 +1052,7 @@ impl Slave {
     }
 
     /// Puts the next SDO Info fragment into `mbx.tx` (pending).
-    fn next_fragment<A: Dictionary>(&mut self, app: &mut A) {
+    fn next_fragment<A: Application>(&mut self, app: &mut A) {
         let m = &mut self.mbx;
         let Some(body) = m.tx.get_mut(HEADER_LEN..m.tx_len) else {
             self.coe.reset();
@@ -1102,11 +1097,4 @@ fn read_uint<A: Dictionary>(app: &mut A, index: u16, sub: u8) -> Option<u32> {
     let n = app.read(index, sub, &mut buf, CommState::PreOp).ok()?;
     let bytes = buf.get(..n)?;
     Some(bytes.iter().rev().fold(0u32, |v, &b| (v << 8) | u32::from(b)))
-}
-
-/// A258 (0 = monitoring off when the application has none).
-fn read_a258<A: Dictionary>(app: &mut A) -> u16 {
-    read_uint(app, A258_INDEX, 0)
-        .and_then(|v| u16::try_from(v).ok())
-        .unwrap_or(0)
 }

@@ -245,6 +245,9 @@ impl Dictionary for App {
     }
 }
 
+/// The defaults: a 1 ms cycle, no RxPDO monitoring, any SYNC0 cycle.
+impl crate::Application for App {}
+
 struct Rig {
     esc: Fake,
     slave: Slave,
@@ -710,8 +713,9 @@ fn e029_e030_sync_mode_and_free_run_check() {
 }
 
 #[test]
-fn e031_e126_e127_watchdog_check_and_pdo_monitor() {
+fn e031_e127_watchdog_check_and_pdo_monitor() {
     use crate::esm::{check_watchdog, pdo_monitor, EscWatchdog, PdoMonitor};
+    use crate::PdoTimeout::{EscWatchdog as Esc, LostFrames, Ms, Off};
     let wd = EscWatchdog {
         divider: 2498,
         pd_time: 1000,
@@ -719,58 +723,58 @@ fn e031_e126_e127_watchdog_check_and_pdo_monitor() {
     };
     let bad = Err(AlStatusCode::INVALID_WATCHDOG_CONFIG);
     assert_eq!(wd.time_ns(), Some(100_000_000));
-    assert_eq!(check_watchdog(0, &wd, 1_000_000, 23), Ok(()));
+    assert_eq!(check_watchdog(Off, &wd, 1_000_000, 23), Ok(()));
     assert_eq!(
-        check_watchdog(0, &EscWatchdog { divider: 0, ..wd }, 1_000_000, 23),
+        check_watchdog(Off, &EscWatchdog { divider: 0, ..wd }, 1_000_000, 23),
         bad
     );
     assert_eq!(
-        check_watchdog(0, &EscWatchdog { pd_time: 0, ..wd }, 1_000_000, 23),
+        check_watchdog(Off, &EscWatchdog { pd_time: 0, ..wd }, 1_000_000, 23),
         Ok(())
     );
     assert_eq!(
-        check_watchdog(65534, &EscWatchdog { pd_time: 0, ..wd }, 1_000_000, 23),
+        check_watchdog(Esc, &EscWatchdog { pd_time: 0, ..wd }, 1_000_000, 23),
         bad
     );
     let no_trigger = EscWatchdog {
         sm2_trigger: false,
         ..wd
     };
-    assert_eq!(check_watchdog(65534, &no_trigger, 1_000_000, 23), bad);
+    assert_eq!(check_watchdog(Esc, &no_trigger, 1_000_000, 23), bad);
     assert_eq!(
-        check_watchdog(65534, &EscWatchdog { pd_time: 5, ..wd }, 1_000_000, 23),
+        check_watchdog(Esc, &EscWatchdog { pd_time: 5, ..wd }, 1_000_000, 23),
         bad
     );
-    assert_eq!(check_watchdog(65534, &wd, 1_000_000, 23), Ok(()));
+    assert_eq!(check_watchdog(Esc, &wd, 1_000_000, 23), Ok(()));
     assert_eq!(
-        check_watchdog(65534, &EscWatchdog { pd_time: 0, ..wd }, 1_000_000, 0),
+        check_watchdog(Esc, &EscWatchdog { pd_time: 0, ..wd }, 1_000_000, 0),
         Ok(())
     );
 
-    assert_eq!(pdo_monitor(0, 1_000_000, &wd), None);
-    assert_eq!(pdo_monitor(65535, 1_000_000, &wd), None);
+    assert_eq!(pdo_monitor(Off, 1_000_000, &wd), None);
+    assert_eq!(pdo_monitor(Ms(0), 1_000_000, &wd), None);
     assert_eq!(
-        pdo_monitor(1, 1_000_000, &wd),
+        pdo_monitor(Ms(1), 1_000_000, &wd),
         Some(PdoMonitor::Timeout(1_000_000))
     );
     assert_eq!(
-        pdo_monitor(65531, 1_000_000, &wd),
+        pdo_monitor(Ms(65531), 1_000_000, &wd),
         Some(PdoMonitor::Timeout(65_531_000_000))
     );
     assert_eq!(
-        pdo_monitor(65532, 1_000_000, &wd),
+        pdo_monitor(LostFrames(1), 1_000_000, &wd),
         Some(PdoMonitor::Timeout(2_500_000))
     );
     assert_eq!(
-        pdo_monitor(65533, 1_000_000, &wd),
+        pdo_monitor(LostFrames(3), 1_000_000, &wd),
         Some(PdoMonitor::Timeout(4_500_000))
     );
     assert_eq!(
-        pdo_monitor(65534, 1_000_000, &wd),
+        pdo_monitor(Esc, 1_000_000, &wd),
         Some(PdoMonitor::EscWatchdog(100_000_000))
     );
     assert_eq!(
-        pdo_monitor(65534, 1_000_000, &EscWatchdog { pd_time: 0, ..wd }),
+        pdo_monitor(Esc, 1_000_000, &EscWatchdog { pd_time: 0, ..wd }),
         None
     );
 }
@@ -837,24 +841,24 @@ fn e046_e131_e038_dc_sync_state_gates_op_and_faults_in_op() {
     });
     assert_eq!(r.slave.run_led(), crate::led::Pattern::On);
     assert_eq!(r.slave.err_led(), crate::led::Pattern::Off);
-    assert_eq!(r.slave.take_event52(), None, "nothing raised in Op yet");
+    assert_eq!(r.slave.take_op_loss(), None, "nothing raised in Op yet");
     let c = r.poll().expect("dropped");
     assert!(c.unsolicited);
     assert_eq!(
         (c.from, c.to, c.code),
         (AlState::Op, AlState::SafeOp, AlStatusCode(0x0034))
     );
-    // the application learns the cause once (its fault reaction, E-129)
-    assert_eq!(r.slave.take_event52(), Some(7));
-    assert_eq!(r.slave.take_event52(), None);
+    // the application learns the cause once (its event, EMCY and fault reaction, E-129)
+    assert_eq!(r.slave.take_op_loss(), Some(crate::esm::OpLoss::Sync));
+    assert_eq!(r.slave.take_op_loss(), None);
     assert_eq!(r.slave.run_led(), crate::led::Pattern::SingleFlash);
     assert_eq!(r.slave.err_led(), crate::led::Pattern::SingleFlash, "unsolicited");
     assert_eq!((r.esc.status(), r.esc.code()), (0x14, 0x0034));
     assert!(r.slave.sync_status().unsolicited);
     assert!(!r.slave.sync_status().triggered, "not a PDO timeout (A259)");
+    // the event and its EMCY are the application's: the slave sends none
     r.poll();
-    let emcy = r.esc.mbx_read().expect("EMCY");
-    assert_eq!(&emcy[8..13], &[0x00, 0x75, 0x10, 52, 7]);
+    assert_eq!(r.esc.mbx_read(), None, "no EMCY from the slave itself");
     // no second drop while in Safe-Op; a request without acknowledge is ignored
     assert_eq!(r.poll(), None);
     assert_eq!(r.req(8), (0x14, 0x0034));
@@ -882,17 +886,6 @@ fn e046_e131_e038_dc_sync_state_gates_op_and_faults_in_op() {
         (0x14, 0x0032),
         "refused after 200 ms"
     );
-}
-
-#[test]
-fn e089_e131_event52_cause_codes() {
-    use crate::esm::event52;
-    assert_eq!(event52::EVENT, 52);
-    assert_eq!(event52::PDO_TIMEOUT, 6);
-    assert_eq!(event52::SYNC, 7);
-    assert_eq!(event52::WRONG_FIRMWARE, 15);
-    let e = crate::emcy::Emcy::for_event(event52::EVENT, event52::SYNC, 0).to_bytes();
-    assert_eq!(&e[..5], &[0x00, 0x75, 0x10, 52, 7]);
 }
 
 /// The application's Ethernet side for the EoE tests.

@@ -71,20 +71,21 @@
 //! limit switches (event 53), the extrapolation overrun of the interpolators
 //! (event 78 cause 3) and an excessive set-value jump of the master (event 78
 //! cause 4, C-148) raise a fault in the device control; on T13 the axis
-//! returns the EMCY ([`Emcy::for_event`]) and sets 603Fh and its error
-//! register, on T15 it returns [`Emcy::fault_cleared`].
+//! returns the EMCY ([`for_event`]) and sets 603Fh and its error
+//! register, on T15 it returns [`fault_cleared`].
 
 mod snapshot;
 #[cfg(test)]
 mod tests;
 
 use crate::dictionary::DriveObjects;
+use crate::emcy::{device_fault, fault_cleared, fault_code_for_event, for_event};
 use cia402::{
     Decel, DeviceControl, FaultEvent, FaultReaction, Inputs, Mode, Options, Outputs, QuickStopOption, Ramp,
     State, Transition, CW_HALT, CW_MODE_BIT4, CW_MODE_BIT5, CW_MODE_BIT6, SW_INTERNAL_LIMIT, SW_MODE_BIT12,
     SW_MODE_BIT13, SW_TARGET_REACHED,
 };
-use ecat::emcy::{fault_code_for_event, register, Emcy};
+use ecat::emcy::{register, Emcy};
 use motion::cascade::{Cascade, CascadeConfig, CascadeInput, CascadeOutput, ControlEntry};
 use motion::cycle::{application_cycle_ns, interpolation_period_ns};
 use motion::homing::{Homing, HomingConfig, HomingInput, SwitchInput};
@@ -998,8 +999,8 @@ impl Axis {
         match t.number {
             13 => {
                 let emcy = match self.event {
-                    Some(ev) => Emcy::for_event(ev.number.min(255) as u8, ev.cause, axis),
-                    None => Emcy::device_fault(
+                    Some(ev) => for_event(ev.number.min(255) as u8, ev.cause, axis),
+                    None => device_fault(
                         self.dc.fault().map_or(0x1000, |f| f.code),
                         register::GENERIC,
                         0,
@@ -1017,7 +1018,7 @@ impl Axis {
                 self.error_code = 0;
                 self.error_register = 0;
                 self.window.put(od, 0x603F, 0, 0);
-                Some(Emcy::fault_cleared(axis))
+                Some(fault_cleared(axis))
             }
             _ => None,
         }

@@ -148,7 +148,7 @@ pub struct IpParams {
 }
 
 /// Why a set-IP-parameter request is refused (result
-/// [`result::UNSPECIFIED_ERROR`], EMCY FFF0h/23h).
+/// [`result::UNSPECIFIED_ERROR`](super::result::UNSPECIFIED_ERROR), EMCY FFF0h/23h).
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
 pub enum IpError {
     /// The request is shorter than its included fields.
