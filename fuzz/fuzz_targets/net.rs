@@ -93,7 +93,11 @@ fuzz_target!(|data: &[u8]| {
         };
         drive.eoe.receive(&frame);
         t += 60_000_000_000;
-        let settings = net_settings(&drive);
+        // the frames arrive as if the master tunnelled them: the tunnel is open (E-098)
+        let settings = net::NetSettings {
+            tunnel_open: true,
+            ..net_settings(&drive)
+        };
         drive.with_eoe(|q, dict, state| net.poll(t / 1000, q, dict, state, &settings));
         while drive.eoe.transmit(&mut out).is_some() {}
     }
