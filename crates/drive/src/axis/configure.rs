@@ -1,0 +1,136 @@
+//! The configuration of an axis from its snapshot: what changes only when
+//! the configuration generation does (limits, windows, scaling, the
+//! cascade's gains, the interpolators).
+
+use super::*;
+
+impl Axis {
+    /// Applies the configuration objects and parameters.
+    pub(super) fn configure(&mut self, od: &mut DriveObjects, slots: &CyclicSlots, o: &Snapshot, dt_ns: u32) {
+        let p = self.params;
+        self.modulo = if p.limits.endless_axis && o.modulo_length > 0 {
+            ModuloAxis::new(i64::from(o.modulo_length)).ok()
+        } else {
+            None
+        };
+        // 6076h from the motor data, and the probe values in the (new) units
+        od.write_typed(
+            slots.rated_current,
+            round_i32(p.rated_torque_nm * 1000.0).max(0) as u32,
+        );
+        self.probe_shown = None;
+        let opts = self.dc.options_mut();
+        if let Ok(q) = QuickStopOption::try_from(o.quick_stop_option) {
+            opts.quick_stop = q;
+        }
+        if let Ok(f) = FaultReaction::try_from(o.fault_reaction_option) {
+            opts.fault_reaction = f;
+        }
+        opts.quick_stop_on_enable_loss = p.quick_stop_on_enable_loss;
+
+        // cycle ratio (C-114): 60C2h over A150; 60C2h is copied into A291
+        let master_ns = interpolation_period_ns(o.period_value, o.period_index).unwrap_or(dt_ns);
+        if self.window.axis == 0 {
+            od.write_typed(slots.a291, master_ns / 1000);
+        }
+        let ratio = CycleRatio::new(master_ns, dt_ns)
+            .or_else(|_| CycleRatio::new(dt_ns, dt_ns))
+            .ok();
+        let key = ratio.map(|r| {
+            (
+                r,
+                p.interpolation_i425,
+                p.feedforward_percent.to_bits(),
+                p.max_extrapolation_ns,
+            )
+        });
+        if key != self.interp_key {
+            self.interp_key = key;
+            self.ratio = ratio;
+            self.rebuild_interpolators();
+        }
+
+        // cascade: torque limits from 6072h (homing: I28), gains adapted to A150
+        let per_mille = if self.running == Some(Mode::Homing) {
+            o.max_torque.min(p.homing_torque_limit_per_mille)
+        } else {
+            o.max_torque
+        };
+        let max_nm = p.rated_torque_nm * f32::from(per_mille) * 0.001;
+        let cfg = CascadeConfig {
+            torque_limit_positive_nm: max_nm,
+            torque_limit_negative_nm: max_nm,
+            velocity_feedforward_percent: 100.0,
+            ..scaled_gains(&p.cascade, dt_ns)
+        };
+        if let Some(c) = self.cascade.as_mut() {
+            if *c.config() != cfg {
+                let _ = c.set_config(cfg);
+            }
+        }
+
+        self.following.set_config(FollowingErrorConfig {
+            window_inc: o.following_error_window,
+            timeout_ns: ms_to_ns(o.following_error_timeout_ms),
+            fault: p.following_error_fault,
+        });
+        self.in_position.set_config(PositionWindowConfig {
+            window_inc: p.position_window_inc,
+            time_ns: p.position_window_time_ns,
+        });
+        self.velocity_window.set_config(VelocityWindowConfig {
+            window_inc_per_s: p.velocity_window_inc_per_s,
+            time_ns: p.velocity_window_time_ns,
+        });
+        // C-091: jog under velocity control (I26 = 0) quick-stops at a
+        // software limit instead of faulting
+        self.retained = o.i46 == 5 && o.i02 == 0;
+        let soft_limit_reaction = if self.running == Some(Mode::Jog) && !p.jog_position_control {
+            SoftLimitReaction::QuickStop
+        } else {
+            p.limits.soft_limit_reaction
+        };
+        self.limits.set_config(LimitConfig {
+            software_min_inc: o.software_min,
+            software_max_inc: o.software_max,
+            window_inc: p.position_window_inc,
+            switch_polarity: SwitchPolarity::HighActive,
+            soft_limit_reaction,
+            // I101/I102 (C-104) switch the evaluation on as well
+            positive_switch: p.limits.positive_switch || o.switch_source[0] != 0,
+            negative_switch: p.limits.negative_switch || o.switch_source[1] != 0,
+            ..p.limits
+        });
+    }
+
+    pub(super) fn rebuild_interpolators(&mut self) {
+        let p = self.params;
+        let (interp, vinterp) = match (self.ratio, from_i425(p.interpolation_i425)) {
+            (Some(ratio), Ok((order, feedforward))) => (
+                FineInterpolator::new(InterpolatorConfig {
+                    ratio,
+                    order,
+                    feedforward,
+                    velocity_feedforward_percent: p.feedforward_percent,
+                    max_extrapolation_ns: p.max_extrapolation_ns,
+                })
+                .ok(),
+                Some(VelocityInterpolator::new(ratio, p.max_extrapolation_ns)),
+            ),
+            (Some(ratio), Err(_)) => (
+                None,
+                Some(VelocityInterpolator::new(ratio, p.max_extrapolation_ns)),
+            ),
+            _ => (None, None),
+        };
+        self.interp = interp;
+        self.vinterp = vinterp;
+        // a running cyclic mode restarts from the present set-point
+        if let Some(i) = self.interp.as_mut() {
+            i.start(self.sp_pos);
+        }
+        if let Some(v) = self.vinterp.as_mut() {
+            v.start(self.sp_vel);
+        }
+    }
+}

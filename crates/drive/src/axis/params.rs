@@ -1,0 +1,114 @@
+//! The axis' fixed parameters ([`AxisParams`]): what the board or the
+//! configuration gives it besides the object dictionary.
+
+use super::*;
+
+/// Parameters of the axis that the dictionary does not (yet) declare
+/// (manufacturer groups B–I), with their defaults. Change them through
+/// [`Axis::params_mut`]; they take effect in the next cycle.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct AxisParams {
+    /// 6076h rated torque, N·m (motor data); 0.1 % torque objects refer to it.
+    pub rated_torque_nm: f32,
+    /// Cascade gains and limits. The torque limits are replaced by 6072h, the
+    /// speed feedforward weight is applied by the interpolator (I25 below);
+    /// the inertia (motor data) turns the generators' acceleration into
+    /// torque feedforward.
+    pub cascade: CascadeConfig,
+    /// I25 speed feedforward of ip/csp, % (0 … 100).
+    pub feedforward_percent: f32,
+    /// I425 speed feedforward – interpolation (0, 1, 3, 4, 5).
+    pub interpolation_i425: u8,
+    /// I423 maximum extrapolation period, ns (C-117).
+    pub max_extrapolation_ns: u64,
+    /// C40 velocity window, inc/s (standstill I199, pv window).
+    pub velocity_window_inc_per_s: f32,
+    /// 606Eh velocity window time, ns.
+    pub velocity_window_time_ns: u64,
+    /// I22 position (target) window, inc.
+    pub position_window_inc: u32,
+    /// I87 time in the position window, ns.
+    pub position_window_time_ns: u64,
+    /// Following error (6065h/6066h) is a fault (event 54), not only
+    /// statusword bit 13.
+    pub following_error_fault: bool,
+    /// Limit switches and axis type (I101/I102, I00, I04, software-limit
+    /// reaction). The software limits come from 607Dh, the window from I22;
+    /// the switch polarity is the board's (see [`AxisIo::limit_positive`]).
+    pub limits: LimitConfig,
+    /// C-050: absolute pp moves need a referenced axis.
+    pub absolute_needs_reference: bool,
+    /// C-148 set-value monitoring: a cyclic position set-point further from
+    /// the previous one than twice 607Fh over the time between them trips
+    /// event 78 cause 4 "excessive set value jump".
+    pub set_value_monitoring: bool,
+    /// I12 jog velocity, inc/s.
+    pub jog_velocity: f32,
+    /// I13 jog acceleration, inc/s².
+    pub jog_acceleration: f32,
+    /// I45 jog deceleration, inc/s².
+    pub jog_deceleration: f32,
+    /// I18 jog jerk, inc/s³ (`f32::INFINITY` = none).
+    pub jog_jerk: f32,
+    /// I26 = 1: jog under position control (stops before a software limit).
+    pub jog_position_control: bool,
+    /// I44 referencing jerk, inc/s³.
+    pub homing_jerk: f32,
+    /// I43: after referencing, position on 607Ch.
+    pub homing_move_to_home: bool,
+    /// I53 index search offset, inc.
+    pub homing_index_offset: u32,
+    /// I28 torque limit while homing, 0.1 % of the rated torque (also the
+    /// "torque at the limit" threshold of the torque methods; 6072h caps it).
+    pub homing_torque_limit_per_mille: u16,
+    /// I29 time at the torque limit for the torque methods, ns.
+    pub homing_torque_hold_ns: u64,
+    /// I30 = 2: the limit switch serves as the reference switch.
+    pub homing_limit_as_reference: bool,
+    /// A44 = 1: losing A60 in Operation enabled gives a quick stop.
+    pub quick_stop_on_enable_loss: bool,
+    /// How long the axis must stand still (I199) after a stop ramp before
+    /// the stop counts as finished (T12, T14, T5/T8 with ramp), ns.
+    pub stop_settle_ns: u64,
+}
+
+impl Default for AxisParams {
+    /// Rated torque 1.3 N·m, the cascade defaults with an inertia of 1e-4
+    /// kg·m² (the simulated servo), I25 = 100 %, I425 = 0,
+    /// I423 = 10 ms, C40 = 0.1 rev/s, I22 = 1/360 rev, following error as
+    /// bit 13 only, no limit switches, jog 1 rev/s with 10 rev/s², I26 = 1,
+    /// no jerk limits, stops settle 10 ms.
+    fn default() -> Self {
+        Self {
+            rated_torque_nm: 1.3,
+            cascade: CascadeConfig {
+                inertia_kg_m2: 1.0e-4,
+                ..CascadeConfig::DEFAULT
+            },
+            feedforward_percent: 100.0,
+            interpolation_i425: 0,
+            max_extrapolation_ns: 10_000_000,
+            velocity_window_inc_per_s: 0.1 * REV,
+            velocity_window_time_ns: 0,
+            position_window_inc: INCREMENTS_PER_REVOLUTION / 360,
+            position_window_time_ns: 0,
+            following_error_fault: false,
+            limits: LimitConfig::default(),
+            absolute_needs_reference: true,
+            set_value_monitoring: true,
+            jog_velocity: REV,
+            jog_acceleration: 10.0 * REV,
+            jog_deceleration: 10.0 * REV,
+            jog_jerk: f32::INFINITY,
+            jog_position_control: true,
+            homing_jerk: f32::INFINITY,
+            homing_move_to_home: false,
+            homing_index_offset: 0,
+            homing_torque_limit_per_mille: 1000,
+            homing_torque_hold_ns: 100_000_000,
+            homing_limit_as_reference: false,
+            quick_stop_on_enable_loss: false,
+            stop_settle_ns: 10_000_000,
+        }
+    }
+}

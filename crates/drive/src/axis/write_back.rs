@@ -1,0 +1,164 @@
+//! The actual values of a cycle back into the dictionary: statusword and
+//! the values of the mode (6041h, 6064h, 606Ch, 6077h, …), user units,
+//! the causes of Switch on disabled (E47/E49), A67 and 60FDh.
+
+use super::*;
+
+impl Axis {
+    pub(super) fn write_back(
+        &mut self,
+        od: &mut DriveObjects,
+        c: &CyclicSlots,
+        out: &Outputs,
+        (bits, actual, torque, fe): (u16, i32, f32, i32),
+    ) {
+        let mut sw =
+            out.statusword & !(SW_TARGET_REACHED | SW_MODE_BIT12 | SW_MODE_BIT13 | SW_INTERNAL_LIMIT);
+        let enabled = out.state == State::OperationEnabled;
+        if enabled || out.state == State::QuickStopActive {
+            sw |= bits & SW_TARGET_REACHED;
+        }
+        if enabled {
+            sw |= bits & (SW_MODE_BIT12 | SW_MODE_BIT13);
+        }
+        if out.drive_function {
+            sw |= bits & SW_INTERNAL_LIMIT;
+        }
+        od.write_typed(c.statusword, sw);
+        let e80 = match self.denial {
+            Some(DenialCause::IllegalDirection) => 15,
+            Some(
+                DenialCause::HardwarePositive
+                | DenialCause::HardwareNegative
+                | DenialCause::SoftwarePositive
+                | DenialCause::SoftwareNegative,
+            ) => 20,
+            _ => 0u8,
+        };
+        od.write_typed(c.e80, e80);
+        od.write_typed(c.mode_display, out.mode_display);
+        let position = self.user_position(actual);
+        od.write_typed(c.position, sat_i32(position));
+        let v = self.scaling.velocity_to_user(self.velocity) * self.velocity_decimals;
+        od.write_typed(c.velocity, round_i32(v));
+        let rated = self.params.rated_torque_nm;
+        let per_mille = if rated > 0.0 { torque / rated * 1000.0 } else { 0.0 };
+        let t = round_i32(per_mille).clamp(i32::from(i16::MIN), i32::from(i16::MAX)) as i16;
+        od.write_typed(c.torque, t);
+        od.write_typed(c.current, t);
+        od.write_typed(c.following_error, sat_i32(self.user(fe)));
+        od.write_typed(c.probe_status, self.probe.status());
+        let probe = [
+            self.probe.value_60ba(),
+            self.probe.value_60bb(),
+            self.probe.value_60bc(),
+            self.probe.value_60bd(),
+        ];
+        // compared word by word (a compare of the arrays becomes a byte-wise
+        // memcmp call)
+        let shown = self
+            .probe_shown
+            .is_some_and(|p| p.iter().zip(probe).fold(0, |d, (a, b)| d | (a ^ b)) == 0);
+        if !shown {
+            for (slot, value) in c.probe_values.into_iter().zip(probe) {
+                od.write_typed(slot, sat_i32(self.user_position(value)));
+            }
+            self.probe_shown = Some(probe);
+        }
+        od.write_typed(c.additional_position, sat_i32(position));
+        let rpm = |v: f32| round_i32(v / RPM_TO_INC_PER_S).clamp(-32768, 32767) as i16;
+        od.write_typed(c.vl_demand, rpm(self.vl_demand));
+        od.write_typed(c.vl_actual, rpm(self.velocity));
+        od.write_typed(c.e48, e48(out.state));
+    }
+
+    /// A position (or distance) in increments as the objects show it: user
+    /// units of 6091h/6092h (C-109), wrapped to 32 bits like the counter.
+    pub(super) fn user(&self, increments: i32) -> i64 {
+        let u = self
+            .scaling
+            .to_user(i64::from(increments))
+            .unwrap_or(i64::from(increments));
+        i64::from(u as i32)
+    }
+
+    /// A position in increments as the objects show it: user units,
+    /// wrapped into 0 … 607Bh:02 − 1 on an endless axis (C-111).
+    #[inline]
+    pub(super) fn user_position(&self, increments: i32) -> i64 {
+        match self.modulo {
+            Some(m) => m.wrap(
+                self.scaling
+                    .to_user(i64::from(increments))
+                    .unwrap_or(i64::from(increments)),
+            ),
+            None => self.user(increments),
+        }
+    }
+
+    /// Increments of a distance in user units (saturating).
+    pub(super) fn increments(&self, user: i64) -> i32 {
+        let v = self.scaling.to_increments(user).unwrap_or(user);
+        i32::try_from(v).unwrap_or(if v < 0 { i32::MIN } else { i32::MAX })
+    }
+
+    /// E47 (first cause) and E49 (all causes) of Switch on disabled
+    /// (C-015): STO, supply, additional enable A60, and the controlword
+    /// (no Shutdown command). Both 0 outside Switch on disabled.
+    pub(super) fn switch_on_disabled_causes(
+        &self,
+        od: &mut DriveObjects,
+        c: &CyclicSlots,
+        out: &Outputs,
+        io: &AxisIo,
+        cw: u16,
+    ) {
+        let mut causes = 0u8;
+        if out.state == State::SwitchOnDisabled {
+            // Shutdown = xxxx x110 (bit 7 clear): anything else keeps SOD
+            let shutdown = cw & 0x0087 == 0x0006;
+            for (bit, present) in [
+                (0, io.sto_active),
+                (1, !io.supply_ok),
+                (2, !io.additional_enable),
+                (3, !shutdown),
+            ] {
+                if present {
+                    causes |= 1 << bit;
+                }
+            }
+        }
+        let first = if causes == 0 {
+            0
+        } else {
+            causes.trailing_zeros() as u8 + 1
+        };
+        od.write_typed(c.e47, first);
+        od.write_typed(c.e49, causes);
+    }
+
+    /// A67 from the sources in A66 (C-143): bit k is bit `b` of the entry
+    /// `index`:`sub` that element k names (index << 16 | sub << 8 | b;
+    /// 0 or an unreadable entry: the bit is 0).
+    pub(super) fn user_statusword(&self, od: &mut DriveObjects, c: &CyclicSlots, o: &Snapshot) {
+        let mut a67 = 0u16;
+        let sources: &[u32] = if o.a66_used { o.a66.as_slice() } else { &[] };
+        for (k, &src) in sources.iter().enumerate() {
+            let index = (src >> 16) as u16;
+            let sub = (src >> 8) as u8;
+            let bit = src & 0xFF;
+            if src != 0 && bit < 64 && od.get(index, sub).is_ok_and(|v| (v >> bit) & 1 != 0) {
+                a67 |= 1 << k;
+            }
+        }
+        od.write_typed(c.a67, a67);
+    }
+
+    /// The switch levels in 60FDh (bit 0 negative limit, bit 1 positive
+    /// limit, bit 2 home switch, CiA 402).
+    pub(super) fn digital_inputs(&self, od: &mut DriveObjects, c: &CyclicSlots, io: &AxisIo) {
+        let bits =
+            u32::from(io.limit_negative) | u32::from(io.limit_positive) << 1 | u32::from(io.reference) << 2;
+        od.write_typed(c.digital_inputs, bits);
+    }
+}
