@@ -1,0 +1,530 @@
+//! [`DriveObjects`]: the values of the declaration in [`crate::objects`] and
+//! the CoE access rules (spec §6.5 abort codes, §5 PDO mapping/assignment,
+//! §2.4 visibility, §2.5 save/restore).
+//!
+//! Subindex numbering: the bus side ([`od::Dictionary`]) uses the active
+//! [`Template`]; the runtime side ([`DriveObjects::get`], [`DriveObjects::set`],
+//! [`LiveValues`]) always uses the "EtherCAT Rx SDO Info" numbering
+//! (element + 1 for manufacturer arrays), so it does not change with the
+//! template.
+
+use core::cell::Cell;
+use core::marker::PhantomData;
+use core::sync::atomic::{AtomicU32, Ordering};
+
+use crate::objects::{self, enumeration, find, Object, Value, IMAGE_BYTES, INITIAL_IMAGE, OBJECTS, OFFSETS};
+use crate::pdo_image::{CopyOp, WIDTH_SHIFT};
+use crate::{parameter_index, MAPPING_ENTRIES, SOFTWARE_BUILD};
+use od::{CommState, DataType, Dictionary, EntryInfo, ObjectInfo, SdoAbort};
+
+mod mapping;
+mod persist;
+mod resolve;
+mod slot;
+
+pub use persist::{ImageError, PERSISTENT_IMAGE_BYTES};
+use resolve::*;
+pub use slot::Slot;
+use slot::*;
+pub(crate) use slot::{read_slot, write_slot, SlotValue, Typed};
+
+/// Signature written to 1010h:01 to save ("save", CiA 301).
+pub const SAVE_SIGNATURE: u32 = 0x6576_6173;
+/// Signature written to 1011h:01 to restore defaults ("load", CiA 301).
+pub const LOAD_SIGNATURE: u32 = 0x6461_6F6C;
+/// Longest PDO in bits: 24 entries of 32 bits (spec §5.3, inference).
+pub const MAX_PDO_BITS: u32 = MAPPING_ENTRIES as u32 * 32;
+
+/// The subindex template of manufacturer arrays and records (spec §2.6).
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum Template {
+    /// "EtherCAT Rx": subindex = element number; no SDO Info.
+    Rx,
+    /// "EtherCAT Rx SDO Info": subindex = element number + 1 (default).
+    SdoInfo,
+}
+
+/// Revision number 1018h:03 in `template` (E-008): the software build
+/// number shifted left by one, bit 0 = 1 for "EtherCAT Rx SDO Info".
+/// [`SOFTWARE_BUILD`] is the revision of the default template.
+pub const fn revision(template: Template) -> u32 {
+    (SOFTWARE_BUILD & !1)
+        | match template {
+            Template::Rx => 0,
+            Template::SdoInfo => 1,
+        }
+}
+const _: () = assert!(
+    SOFTWARE_BUILD & 1 == 1,
+    "SOFTWARE_BUILD is the SDO-Info template revision"
+);
+
+/// Requests for the runtime, set by bus writes, cleared by
+/// [`DriveObjects::take_requests`].
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
+pub struct Requests {
+    /// Save the persistent values ([`DriveObjects::persistent_image`]):
+    /// 1010h:01 = "save" or A00\[0\] = 1.
+    pub save: bool,
+    /// Restart the device: A09\[0\] = 1.
+    pub restart: bool,
+    /// 1011h:01 = "load" restored the defaults in RAM (the stored image is
+    /// unchanged until the next save).
+    pub defaults_restored: bool,
+}
+
+/// Values owned by other parts of the firmware ([`Value::Live`] objects):
+/// the statusword, actual values, error register, diagnosis history, ESM
+/// state… A provider answers what it owns and returns `None` for the rest,
+/// which the dictionary then answers from its RAM image (where the runtime
+/// may also push values with [`DriveObjects::set`]). Indices and subindices
+/// use the "EtherCAT Rx SDO Info" numbering.
+pub trait LiveValues {
+    /// Reads `index`:`sub` into `buf`: `Some(byte count or abort)` if owned.
+    fn read(&mut self, index: u16, sub: u8, buf: &mut [u8]) -> Option<Result<usize, SdoAbort>> {
+        let _ = (index, sub, buf);
+        None
+    }
+
+    /// A checked write (access, size, range) to a live entry, before the
+    /// dictionary stores it in its RAM image; an error refuses the write.
+    fn write(&mut self, index: u16, sub: u8, data: &[u8]) -> Result<(), SdoAbort> {
+        let _ = (index, sub, data);
+        Ok(())
+    }
+}
+
+/// No live-value provider: live entries answer from the RAM image.
+#[derive(Debug, Default, Clone, Copy)]
+pub struct NoLive;
+impl LiveValues for NoLive {}
+
+/// The drive's object dictionary: the RAM image of every value, the active
+/// template and the requests for the runtime. Implements [`od::Dictionary`]
+/// (live entries from the RAM image; see [`DriveObjects::with_live`]).
+///
+/// [`get`](Self::get)/[`set`](Self::set) resolve `index`:`sub` through a
+/// shared cache (open addressing, filled on first use): a hash, a compare
+/// and a load instead of a binary search, an entry scan and an offset sum.
+/// The entries the control cycle and the process-data copy touch every
+/// cycle are resolved once into a [`Slot`] and then read and written with
+/// [`load_slot`](Self::load_slot)/[`store_slot`](Self::store_slot) and their
+/// typed forms (docs/architecture.md, cycle cost).
+///
+/// (`repr(C)`: the RAM image first, at the struct's address, so the control
+/// cycle's loads and stores at a slot's offset need no extra add.)
+#[derive(Debug, Clone)]
+#[repr(C)]
+pub struct DriveObjects {
+    image: [u8; IMAGE_BYTES],
+    template: Template,
+    requests: Requests,
+    /// Counts configuration changes ([`Self::config_generation`]).
+    config_generation: u32,
+    /// The SyncManager lengths of the mapping (RxPDO, TxPDO bytes) with the
+    /// configuration generation they were summed at: the slave asks every
+    /// poll, the mapping changes only with the generation.
+    pdo_bytes: Cell<Option<(u32, (usize, usize))>>,
+}
+
+/// Equal dictionaries hold the same values and template; how they got
+/// there (the configuration generation) does not count.
+impl PartialEq for DriveObjects {
+    fn eq(&self, other: &Self) -> bool {
+        self.image == other.image && self.template == other.template && self.requests == other.requests
+    }
+}
+
+impl Eq for DriveObjects {}
+
+impl Default for DriveObjects {
+    fn default() -> Self {
+        Self::new()
+    }
+}
+
+/// [`DriveObjects`] with a [`LiveValues`] provider, as the CoE server sees it.
+#[derive(Debug)]
+pub struct WithLive<'a, L: LiveValues> {
+    /// The dictionary.
+    pub objects: &'a mut DriveObjects,
+    /// The provider of live values.
+    pub live: &'a mut L,
+}
+
+impl DriveObjects {
+    /// Every value at its default, template "EtherCAT Rx SDO Info".
+    pub const fn new() -> Self {
+        Self {
+            image: INITIAL_IMAGE,
+            template: Template::SdoInfo,
+            requests: Requests {
+                save: false,
+                restart: false,
+                defaults_restored: false,
+            },
+            config_generation: 0,
+            pdo_bytes: Cell::new(None),
+        }
+    }
+
+    /// A counter that changes whenever a configuration value may have
+    /// changed: a changed RAM value other than a cyclic set-point (6040h,
+    /// 6060h, 607Ah, 60C1h, 60FFh, 6071h, 60B1h, 60B2h, 6042h, 60B8h, I210 of
+    /// either axis), a load, a restore or a template switch. Live values never
+    /// change it. The axes re-read their configuration only when it moved.
+    pub fn config_generation(&self) -> u32 {
+        self.config_generation
+    }
+
+    fn config_changed(&mut self) {
+        self.config_generation = self.config_generation.wrapping_add(1);
+    }
+
+    /// This dictionary with `live` answering the live entries.
+    pub fn with_live<'a, L: LiveValues>(&'a mut self, live: &'a mut L) -> WithLive<'a, L> {
+        WithLive { objects: self, live }
+    }
+
+    /// The active subindex template.
+    pub fn template(&self) -> Template {
+        self.template
+    }
+
+    /// Switches the subindex template (a configuration setting of the
+    /// device; it changes 1018h:03, the addressing of manufacturer arrays and
+    /// the availability of SDO Info at once; the SII/ESI must follow).
+    pub fn set_template(&mut self, template: Template) {
+        self.template = template;
+        self.config_changed();
+    }
+
+    /// The requests set since the last call, cleared.
+    pub fn take_requests(&mut self) -> Requests {
+        core::mem::take(&mut self.requests)
+    }
+
+    /// Requests a save (as A00\[0\] = 1 does).
+    pub fn request_save(&mut self) {
+        self.requests.save = true;
+    }
+
+    /// The requests set since the last [`take_requests`](Self::take_requests).
+    pub fn requests(&self) -> Requests {
+        self.requests
+    }
+
+    /// The access level of CoE accesses, A10\[2\] (E-017).
+    pub fn access_level(&self) -> u8 {
+        self.get(parameter_index(0, 10), 3).map_or(0, |v| v as u8)
+    }
+
+    fn visible(&self, o: &Object) -> bool {
+        o.level <= self.access_level()
+    }
+
+    fn sdo_info(&self) -> bool {
+        self.template == Template::SdoInfo
+    }
+
+    /// The visible entry `index`:`sub` in the active template.
+    fn locate(&self, index: u16, sub: u8) -> Result<Loc, SdoAbort> {
+        let (obj, o) = find(index).ok_or(SdoAbort::NO_OBJECT)?;
+        if !self.visible(o) {
+            return Err(SdoAbort::NO_OBJECT);
+        }
+        let rx_view = !self.sdo_info() && o.rx.is_some();
+        let view = o.view(self.sdo_info());
+        let p = view
+            .entries
+            .iter()
+            .position(|e| e.sub == sub)
+            .ok_or(SdoAbort::NO_SUBINDEX)?;
+        Ok(Loc {
+            obj,
+            pos: if rx_view { p + 1 } else { p },
+        })
+    }
+
+    fn ram(&self, loc: Loc) -> Result<&[u8], SdoAbort> {
+        self.image.get(loc.slot()?).ok_or(SdoAbort::GENERAL)
+    }
+
+    /// The value of a target entry (after [`follow`]) from RAM or declaration.
+    fn read_loc(&self, loc: Loc, buf: &mut [u8]) -> Result<usize, SdoAbort> {
+        let o = loc.object()?;
+        let e = loc.entry()?;
+        match o.value {
+            Value::Ram | Value::Live => {
+                let raw = self.ram(loc)?;
+                let len = match e.data_type {
+                    DataType::VisibleString(_) => raw.iter().position(|&b| b == 0).unwrap_or(raw.len()),
+                    _ => raw.len(),
+                };
+                put(buf, raw.get(..len).ok_or(SdoAbort::GENERAL)?)
+            }
+            Value::Text(s) => put(buf, s.as_bytes()),
+            Value::Identity if e.sub == 3 => e.data_type.encode(i64::from(revision(self.template)), buf),
+            _ if e.data_type.is_string() => Ok(0),
+            _ => e.data_type.encode(e.default, buf),
+        }
+    }
+
+    /// The integer value of `index`:`sub` ("EtherCAT Rx SDO Info" numbering,
+    /// aliases followed; live entries as last set in the RAM image).
+    pub fn get(&self, index: u16, sub: u8) -> Result<i64, SdoAbort> {
+        if let Some(r) = resolve(index, sub) {
+            return match r.place {
+                Place::Ram(at) => load(&self.image, usize::from(at), r.data_type),
+                Place::Const(v) => Ok(v),
+            };
+        }
+        let loc = follow(canonical(index, sub)?)?;
+        let t = loc.entry()?.data_type;
+        let mut buf = [0u8; 8];
+        let n = self.read_loc(loc, &mut buf)?;
+        t.decode(buf.get(..n).ok_or(SdoAbort::GENERAL)?)
+    }
+
+    /// Sets `index`:`sub` from the runtime (statusword, actual values, ESM
+    /// state, …): no access, state or level check, only the type's bounds.
+    /// "EtherCAT Rx SDO Info" numbering; entries without a RAM slot
+    /// (constants) answer 0601 0002h.
+    pub fn set(&mut self, index: u16, sub: u8, value: i64) -> Result<(), SdoAbort> {
+        let resolved = resolve(index, sub);
+        let t = match resolved {
+            Some(r) => r.data_type,
+            None => follow(canonical(index, sub)?)?.entry()?.data_type,
+        };
+        if !t.is_integer() && t != DataType::F32 {
+            return Err(SdoAbort::TYPE_MISMATCH);
+        }
+        if t.is_integer() && (value < t.min_value() || value > t.max_value()) {
+            return Err(if value < t.min_value() {
+                SdoAbort::VALUE_TOO_LOW
+            } else {
+                SdoAbort::VALUE_TOO_HIGH
+            });
+        }
+        if let Some(r) = resolved {
+            let Place::Ram(at) = r.place else {
+                return Err(SdoAbort::READ_ONLY);
+            };
+            let at = usize::from(at);
+            let slot = self.image.get_mut(at..at + t.bytes()).ok_or(SdoAbort::GENERAL)?;
+            let mut new = [0u8; 8];
+            let n = t.encode(value, &mut new)?;
+            let new = new.get(..n).ok_or(SdoAbort::GENERAL)?;
+            if slot != new {
+                for (d, s) in slot.iter_mut().zip(new) {
+                    *d = *s;
+                }
+                if r.config {
+                    self.config_changed();
+                }
+            }
+            return Ok(());
+        }
+        let mut raw = [0u8; 8];
+        let n = t.encode(value, &mut raw)?;
+        self.set_bytes(index, sub, raw.get(..n).ok_or(SdoAbort::GENERAL)?)
+    }
+
+    /// Sets `index`:`sub` from raw little-endian bytes or string bytes (e.g.
+    /// the A257 texts), like [`set`](Self::set); strings shorter than the
+    /// entry are padded with 0.
+    pub fn set_bytes(&mut self, index: u16, sub: u8, data: &[u8]) -> Result<(), SdoAbort> {
+        if let Some(Resolved {
+            place: Place::Ram(at),
+            data_type,
+            config,
+            ..
+        }) = resolve(index, sub)
+        {
+            // a scalar of its full width: straight into its slot
+            if data.len() == data_type.bytes() {
+                let at = usize::from(at);
+                let slot = self.image.get_mut(at..at + data.len()).ok_or(SdoAbort::GENERAL)?;
+                if slot != data {
+                    for (d, s) in slot.iter_mut().zip(data) {
+                        *d = *s;
+                    }
+                    if config {
+                        self.config_changed();
+                    }
+                }
+                return Ok(());
+            }
+        }
+        let loc = follow(canonical(index, sub)?)?;
+        if !in_ram(loc)? {
+            return Err(SdoAbort::READ_ONLY);
+        }
+        loc.entry()?.data_type.check_len(data.len())?;
+        self.store(loc, data)
+    }
+
+    fn store(&mut self, loc: Loc, data: &[u8]) -> Result<(), SdoAbort> {
+        let config = is_config(loc.object()?);
+        let slot = self.image.get_mut(loc.slot()?).ok_or(SdoAbort::GENERAL)?;
+        if data.len() > slot.len() {
+            return Err(SdoAbort::LENGTH_TOO_HIGH);
+        }
+        let mut changed = false;
+        for (k, d) in slot.iter_mut().enumerate() {
+            let v = data.get(k).copied().unwrap_or(0);
+            changed |= *d != v;
+            *d = v;
+        }
+        if changed && config {
+            self.config_changed();
+        }
+        Ok(())
+    }
+
+    fn read_with<L: LiveValues>(
+        &self,
+        live: &mut L,
+        index: u16,
+        sub: u8,
+        buf: &mut [u8],
+    ) -> Result<usize, SdoAbort> {
+        let loc = self.locate(index, sub)?;
+        if !loc.entry()?.access.readable() {
+            return Err(SdoAbort::WRITE_ONLY);
+        }
+        let target = follow(loc)?;
+        let o = target.object()?;
+        if o.value == Value::Live {
+            if let Some(r) = live.read(o.info.index, target.entry()?.sub, buf) {
+                return r;
+            }
+        }
+        self.read_loc(target, buf)
+    }
+
+    fn write_with<L: LiveValues>(
+        &mut self,
+        live: &mut L,
+        index: u16,
+        sub: u8,
+        data: &[u8],
+        state: CommState,
+    ) -> Result<(), SdoAbort> {
+        let loc = self.locate(index, sub)?;
+        let access = loc.entry()?.access;
+        if !access.writable() {
+            return Err(SdoAbort::READ_ONLY);
+        }
+        if !access.writable_in(state.access_bit()) {
+            return Err(SdoAbort::DEVICE_STATE);
+        }
+        let target = follow(loc)?;
+        let (o, e) = (target.object()?, target.entry()?);
+        e.data_type.check_len(data.len())?;
+        let value = if e.data_type.is_string() {
+            None
+        } else {
+            Some(e.data_type.decode(data)?)
+        };
+        if let Some(v) = value {
+            self.check_consistency(o, e, v)?;
+            e.check_range(v)?;
+            if let Some(list) = enumeration(o.info.index, e.sub) {
+                if !list.contains(&v) {
+                    return Err(SdoAbort::INVALID_VALUE);
+                }
+            }
+        }
+        if o.value == Value::Live {
+            live.write(o.info.index, e.sub, data)?;
+        }
+        match (o.value, o.info.index) {
+            (Value::Command, 0x1010) => self.requests.save = true,
+            (Value::Command, _) => {
+                self.restore_defaults();
+                self.requests.defaults_restored = true;
+            }
+            _ => {
+                self.store(target, data)?;
+                self.side_effects(o.info.index, e.sub, value);
+            }
+        }
+        Ok(())
+    }
+
+    /// Actions started by a write: A00[0] = 1 save, A09[0] = 1 restart.
+    fn side_effects(&mut self, index: u16, sub: u8, value: Option<i64>) {
+        match (index, sub, value) {
+            (0x2000, 1, Some(1)) => self.requests.save = true,
+            (0x2009, 1, Some(1)) => self.requests.restart = true,
+            _ => {}
+        }
+    }
+
+    fn object_info(&self, o: &'static Object) -> Option<&'static ObjectInfo> {
+        self.visible(o).then(|| o.view(self.sdo_info()))
+    }
+}
+
+impl Dictionary for DriveObjects {
+    fn object(&self, index: u16) -> Option<&'static ObjectInfo> {
+        find(index).and_then(|(_, o)| self.object_info(o))
+    }
+
+    fn next_object(&self, after: Option<u16>) -> Option<&'static ObjectInfo> {
+        let start = after.map_or(0, |a| OBJECTS.partition_point(|o| o.info.index <= a));
+        OBJECTS.get(start..)?.iter().find_map(|o| self.object_info(o))
+    }
+
+    fn read(&mut self, index: u16, sub: u8, buf: &mut [u8], _state: CommState) -> Result<usize, SdoAbort> {
+        self.read_with(&mut NoLive, index, sub, buf)
+    }
+
+    fn write(&mut self, index: u16, sub: u8, data: &[u8], state: CommState) -> Result<(), SdoAbort> {
+        self.write_with(&mut NoLive, index, sub, data, state)
+    }
+
+    fn process_data_bytes(&self) -> Option<(usize, usize)> {
+        let generation = self.config_generation;
+        let bytes = match self.pdo_bytes.get() {
+            Some((g, bytes)) if g == generation => bytes,
+            _ => {
+                let bytes = (self.sm_bytes(0x1C12), self.sm_bytes(0x1C13));
+                self.pdo_bytes.set(Some((generation, bytes)));
+                bytes
+            }
+        };
+        Some(bytes)
+    }
+
+    fn sdo_info_enabled(&self) -> bool {
+        self.sdo_info()
+    }
+}
+
+impl<L: LiveValues> Dictionary for WithLive<'_, L> {
+    fn object(&self, index: u16) -> Option<&'static ObjectInfo> {
+        self.objects.object(index)
+    }
+
+    fn next_object(&self, after: Option<u16>) -> Option<&'static ObjectInfo> {
+        self.objects.next_object(after)
+    }
+
+    fn read(&mut self, index: u16, sub: u8, buf: &mut [u8], _state: CommState) -> Result<usize, SdoAbort> {
+        self.objects.read_with(self.live, index, sub, buf)
+    }
+
+    fn write(&mut self, index: u16, sub: u8, data: &[u8], state: CommState) -> Result<(), SdoAbort> {
+        self.objects.write_with(self.live, index, sub, data, state)
+    }
+
+    fn process_data_bytes(&self) -> Option<(usize, usize)> {
+        self.objects.process_data_bytes()
+    }
+
+    fn sdo_info_enabled(&self) -> bool {
+        self.objects.sdo_info_enabled()
+    }
+}

@@ -1,0 +1,115 @@
+//! The persistent image: what A00 saves and a restart loads (the values of
+//! the persistent entries with a header naming the layout), restoring the
+//! defaults.
+
+use super::*;
+
+/// Why a persistent image was refused.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum ImageError {
+    /// The output buffer is shorter than [`PERSISTENT_IMAGE_BYTES`].
+    BufferTooSmall,
+    /// Wrong length, magic or template byte.
+    Malformed,
+    /// Saved by another declaration (layout hash differs).
+    ForeignLayout,
+}
+
+pub(super) const IMAGE_MAGIC: [u8; 4] = *b"DOD1";
+
+pub(super) const IMAGE_HEADER: usize = 12;
+
+/// Size of a persistent image: 12-byte header (magic "DOD1", layout hash
+/// u32, payload length u16, template u8, 0) + the persistent values.
+pub const PERSISTENT_IMAGE_BYTES: usize = IMAGE_HEADER + objects::PERSISTENT_BYTES;
+
+impl DriveObjects {
+    /// The byte ranges of the persistent values, in declaration order.
+    pub(super) fn persistent_slots() -> impl Iterator<Item = core::ops::Range<usize>> {
+        OBJECTS.iter().enumerate().flat_map(|(obj, o)| {
+            let ram = matches!(o.value, Value::Ram | Value::Live);
+            o.info
+                .entries
+                .iter()
+                .enumerate()
+                .filter(move |(_, e)| ram && e.persistent)
+                .filter_map(move |(pos, _)| Loc { obj, pos }.slot().ok())
+        })
+    }
+
+    /// Writes the persistent values into `out` (header + values, see
+    /// [`PERSISTENT_IMAGE_BYTES`]) for the non-volatile store; returns the
+    /// byte count.
+    pub fn persistent_image(&self, out: &mut [u8]) -> Result<usize, ImageError> {
+        let out = out
+            .get_mut(..PERSISTENT_IMAGE_BYTES)
+            .ok_or(ImageError::BufferTooSmall)?;
+        let (header, mut payload) = out.split_at_mut(IMAGE_HEADER);
+        let len = (objects::PERSISTENT_BYTES as u16).to_le_bytes();
+        let hash = objects::LAYOUT_HASH.to_le_bytes();
+        let [m0, m1, m2, m3] = IMAGE_MAGIC;
+        let [h0, h1, h2, h3] = hash;
+        let t = u8::from(self.template == Template::SdoInfo);
+        header.copy_from_slice(&[m0, m1, m2, m3, h0, h1, h2, h3, len[0], len[1], t, 0]);
+        for slot in Self::persistent_slots() {
+            let n = slot.len();
+            let src = self.image.get(slot).ok_or(ImageError::Malformed)?;
+            let (dst, rest) = payload.split_at_mut(n.min(payload.len()));
+            dst.copy_from_slice(src.get(..dst.len()).ok_or(ImageError::Malformed)?);
+            payload = rest;
+        }
+        Ok(PERSISTENT_IMAGE_BYTES)
+    }
+
+    /// Loads an image made by [`persistent_image`](Self::persistent_image) of
+    /// the same declaration; anything else is refused and changes nothing.
+    pub fn load_persistent(&mut self, data: &[u8]) -> Result<(), ImageError> {
+        if data.len() != PERSISTENT_IMAGE_BYTES {
+            return Err(ImageError::Malformed);
+        }
+        let (header, mut payload) = data.split_at(IMAGE_HEADER);
+        let template = match header {
+            [m0, m1, m2, m3, _, _, _, _, l0, l1, t, 0]
+                if [*m0, *m1, *m2, *m3] == IMAGE_MAGIC
+                    && usize::from(u16::from_le_bytes([*l0, *l1])) == objects::PERSISTENT_BYTES =>
+            {
+                match t {
+                    0 => Template::Rx,
+                    1 => Template::SdoInfo,
+                    _ => return Err(ImageError::Malformed),
+                }
+            }
+            _ => return Err(ImageError::Malformed),
+        };
+        if header.get(4..8) != Some(&objects::LAYOUT_HASH.to_le_bytes()[..]) {
+            return Err(ImageError::ForeignLayout);
+        }
+        for slot in Self::persistent_slots() {
+            let (src, rest) = payload.split_at(slot.len().min(payload.len()));
+            if let Some(dst) = self.image.get_mut(slot) {
+                // equal lengths after the size check above; zip keeps it panic-free
+                for (d, s) in dst.iter_mut().zip(src) {
+                    *d = *s;
+                }
+            }
+            payload = rest;
+        }
+        self.template = template;
+        self.config_changed();
+        Ok(())
+    }
+
+    /// Sets every persistent value back to its default in RAM (1011h, CiA
+    /// 301 "restore default parameters"; the stored image changes with the
+    /// next save). Live and set-point values are untouched.
+    pub fn restore_defaults(&mut self) {
+        for slot in Self::persistent_slots() {
+            if let (Some(dst), Some(src)) = (self.image.get_mut(slot.clone()), INITIAL_IMAGE.get(slot)) {
+                for (d, s) in dst.iter_mut().zip(src) {
+                    *d = *s;
+                }
+            }
+        }
+        self.config_changed();
+    }
+}
