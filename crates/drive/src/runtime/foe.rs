@@ -1,0 +1,56 @@
+//! The firmware download over FoE (issue 8): file names, the handler that
+//! writes the boot slots, the FoE error of each update error.
+
+use super::*;
+
+/// FoE file names (prefix) of the firmware image; other names: 8001h.
+pub const FIRMWARE_FILE: &[u8] = b"firmware";
+
+/// The FoE handler of the drive: firmware images into the boot slots.
+pub struct FirmwareFoe<'a, B: Flash> {
+    pub(super) slots: Option<&'a mut BootSlots<B>>,
+}
+
+impl<'a, B: Flash> FirmwareFoe<'a, B> {
+    /// The handler over `slots` (`None`: every write is refused with 8002h).
+    pub fn new(slots: Option<&'a mut BootSlots<B>>) -> Self {
+        Self { slots }
+    }
+}
+
+/// The FoE error code of an update error (docs/conformance.md, decisions).
+pub fn foe_error(e: UpdateError) -> FoeError {
+    match e {
+        UpdateError::NotStarted | UpdateError::BadHeader => FoeError::ILLEGAL,
+        UpdateError::Unconfirmed => FoeError::ACCESS_DENIED,
+        UpdateError::TooLarge => FoeError::DISK_FULL,
+        UpdateError::Incomplete | UpdateError::Crc => FoeError::CHECKSUM,
+        UpdateError::Flash(_) => FoeError::PROGRAM_ERROR,
+    }
+}
+
+impl<B: Flash> FoeHandler for FirmwareFoe<'_, B> {
+    fn begin_write(&mut self, name: &[u8], _password: u32) -> Result<(), FoeError> {
+        if !name.starts_with(FIRMWARE_FILE) {
+            return Err(FoeError::NOT_FOUND);
+        }
+        let slots = self.slots.as_deref_mut().ok_or(FoeError::ACCESS_DENIED)?;
+        slots.begin().map(|_| ()).map_err(foe_error)
+    }
+
+    fn write(&mut self, data: &[u8]) -> Result<Accept, FoeError> {
+        let slots = self.slots.as_deref_mut().ok_or(FoeError::ILLEGAL)?;
+        slots.write(data).map(|()| Accept::Done).map_err(foe_error)
+    }
+
+    fn end_write(&mut self) -> Result<(), FoeError> {
+        let slots = self.slots.as_deref_mut().ok_or(FoeError::ILLEGAL)?;
+        slots.finish().map(|_| ()).map_err(foe_error)
+    }
+
+    fn abort(&mut self) {
+        if let Some(slots) = self.slots.as_deref_mut() {
+            slots.abort();
+        }
+    }
+}
