@@ -2,6 +2,7 @@
 
 pub mod args;
 pub mod demo;
+pub mod realtime;
 pub mod serve;
 
 use hil_sim::sim::Simulation;

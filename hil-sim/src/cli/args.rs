@@ -58,6 +58,27 @@ pub struct ServeArgs {
     /// Stop after this many seconds (default: run until killed).
     #[arg(long, value_name = "S")]
     pub seconds: Option<f64>,
+    /// Do not try SCHED_FIFO (nor `--cpu`).
+    #[arg(long)]
+    pub no_rt: bool,
+    /// Pin to this CPU (default: not pinned; on a shared machine another
+    /// real-time process may hold any given CPU).
+    #[arg(long, value_name = "N", conflicts_with = "no_rt")]
+    pub cpu: Option<usize>,
+    /// SCHED_FIFO priority to ask for.
+    #[arg(long, value_name = "1..99", default_value_t = 20, value_parser = clap::value_parser!(i32).range(1..=99))]
+    pub fifo_priority: i32,
+    /// Spin on the socket instead of sleeping between frames (lowest
+    /// latency; takes a whole CPU).
+    #[arg(long)]
+    pub busy_poll: bool,
+    /// Test only: hold each frame a seeded random 0..=MAX µs after its
+    /// arrival before processing it (a loaded machine's scheduling delay).
+    #[arg(long, value_name = "MAX", hide = true)]
+    pub delay_us: Option<u64>,
+    /// Test only: seed of `--delay-us`.
+    #[arg(long, value_name = "SEED", hide = true, default_value_t = 1)]
+    pub delay_seed: u64,
 }
 
 /// The default plot path of `demo`.

@@ -1,10 +1,53 @@
 //! `hil-sim serve`: the simulated line answers EtherCAT frames on a raw
 //! Ethernet interface, paced by the wall clock.
+//!
+//! # Timing
+//!
+//! Simulated time is `CLOCK_MONOTONIC` since the start. Each received frame
+//! carries the kernel's receive timestamp; the simulation runs to that instant
+//! ([`Simulation::catch_up`]) and only then processes the frame, so the drive
+//! sees the frame when it arrived, however long `serve` took to get to it (a
+//! wait, a busy machine, `--delay-us`). While no frame waits, the simulation
+//! is kept at the wall clock every [`IDLE_WAIT`] (or continuously with
+//! `--busy-poll`), so an arriving frame finds little left to simulate and is
+//! answered at once. Frames that queued up are processed in order, each at its
+//! own receive time; one whose time the simulation has already passed (it
+//! arrived while the simulation was being caught up) is processed at once and
+//! counted as late in the summary.
 
 use super::args::ServeArgs;
 use super::print_new_changes;
+use hil_sim::raw::{monotonic_ns, RawSocket};
 use hil_sim::sim::{SimDrive, Simulation};
-use std::time::{Duration, Instant};
+use std::sync::atomic::{AtomicBool, Ordering};
+use std::time::Duration;
+
+/// Set by SIGINT or SIGTERM: `serve` ends its loop, flushes the recording
+/// and prints its summary.
+static STOP: AtomicBool = AtomicBool::new(false);
+
+extern "C" fn on_stop_signal(_: libc::c_int) {
+    STOP.store(true, Ordering::Relaxed);
+}
+
+/// Ctrl-C and `kill` end `serve` in order (the recording complete).
+fn stop_on_signals() {
+    let handler = on_stop_signal as extern "C" fn(libc::c_int) as libc::sighandler_t;
+    for sig in [libc::SIGINT, libc::SIGTERM] {
+        // SAFETY: the handler only stores to an atomic (async-signal-safe).
+        #[allow(unsafe_code)]
+        unsafe {
+            libc::signal(sig, handler);
+        }
+    }
+}
+
+/// Longest sleep on the socket while no frame waits: the simulation is caught
+/// up with the wall clock at least this often.
+pub const IDLE_WAIT: Duration = Duration::from_micros(100);
+
+/// How often the pcap recording is flushed (a write error then ends `serve`).
+const FLUSH_EVERY_NS: u64 = 1_000_000_000;
 
 /// Runs `serve` until `--seconds` have passed (or forever).
 pub fn serve(args: &ServeArgs) -> Result<(), String> {
@@ -17,7 +60,7 @@ pub fn serve(args: &ServeArgs) -> Result<(), String> {
             .map_err(|e| format!("cannot write the pcap file {}: {e}", p.display()))?;
     }
     let iface = &args.iface;
-    let sock = hil_sim::raw::RawSocket::open(iface).map_err(|e| format!("{iface}: {e}"))?;
+    let sock = RawSocket::open(iface).map_err(|e| format!("{iface}: {e}"))?;
     // every drive answers ping and the UDP parameter service on its EoE
     // interface once the master set its IP address (docs/eoe.md)
     for (i, d) in (1u8..).zip(sim.drives_mut()) {
@@ -34,34 +77,92 @@ pub fn serve(args: &ServeArgs) -> Result<(), String> {
     if let Some(p) = &args.pcap {
         println!("recording frames to {}", p.display());
     }
-    let start = Instant::now();
+    if args.no_rt {
+        println!("real-time: not asked for (--no-rt)");
+    } else {
+        println!("{}", super::realtime::apply(args.fifo_priority, args.cpu));
+    }
+    if let Some(max) = args.delay_us {
+        println!(
+            "test: every frame held 0..={max} µs after its arrival (seed {})",
+            args.delay_seed
+        );
+    }
+    stop_on_signals();
+    let stats = run(&mut sim, &sock, args)?;
+    flush_recording(&mut sim, args)?;
+    println!(
+        "{} frames served; {} without a kernel timestamp; {} reached the simulation after its time \
+         (worst by {:.1} µs)",
+        sim.frames(),
+        stats.unstamped,
+        stats.late,
+        stats.worst_late_ns as f64 / 1e3
+    );
+    Ok(())
+}
+
+/// What the loop saw.
+#[derive(Debug, Default)]
+struct Stats {
+    /// Frames without a kernel timestamp (processed at the time they were read).
+    unstamped: u64,
+    /// Frames whose receive time the simulation had already passed.
+    late: u64,
+    /// The most the simulation had passed a frame's receive time, ns.
+    worst_late_ns: u64,
+}
+
+/// The serve loop (see the module's Timing section).
+fn run(sim: &mut Simulation, sock: &RawSocket, args: &ServeArgs) -> Result<Stats, String> {
+    let start = monotonic_ns();
+    let end = args
+        .seconds
+        .map(|s| start.saturating_add((s.max(0.0) * 1e9) as u64));
+    let mut delay = args.delay_us.map(|max| Delay::new(max, args.delay_seed));
+    let mut stats = Stats::default();
     let mut printed = Vec::new();
     let mut buf = [0u8; 1600];
-    let mut last_flush = start;
+    let mut next_flush = start + FLUSH_EVERY_NS;
     loop {
-        let elapsed = start.elapsed();
-        if args.seconds.is_some_and(|s| elapsed.as_secs_f64() >= s) {
-            break;
-        }
-        // The simulation is paced by the wall clock.
-        sim.catch_up(u64::try_from(elapsed.as_nanos()).unwrap_or(u64::MAX));
-        if let Some(n) = sock
-            .recv(&mut buf, Duration::from_millis(1))
-            .map_err(|e| e.to_string())?
-        {
-            let frame = &mut buf[..n];
+        // the clock is read before the socket: a frame not there yet arrives later
+        let now = monotonic_ns();
+        if let Some(rx) = sock.try_recv(&mut buf).map_err(|e| format!("receive: {e}"))? {
+            let rx_ns = rx.rx_ns.unwrap_or_else(|| {
+                stats.unstamped += 1;
+                now
+            });
+            if let Some(d) = delay.as_mut() {
+                d.hold(rx_ns);
+            }
+            let t = rx_ns.saturating_sub(start);
+            if t < sim.now_ns() {
+                stats.late += 1;
+                stats.worst_late_ns = stats.worst_late_ns.max(sim.now_ns() - t);
+            }
+            sim.catch_up(t);
+            let frame = buf.get_mut(..rx.len).unwrap_or_default();
             sim.exchange(frame);
             sock.send(frame).map_err(|e| format!("send: {e}"))?;
+            if let Some(e) = sim.recording_error() {
+                return Err(format!("the pcap recording failed: {e}"));
+            }
+            // drain what queued up before simulating further
+            continue;
         }
-        print_new_changes(&sim, &mut printed);
-        if last_flush.elapsed() >= Duration::from_secs(1) {
-            last_flush = Instant::now();
-            flush_recording(&mut sim, args)?;
+        sim.catch_up(now.saturating_sub(start));
+        print_new_changes(sim, &mut printed);
+        if now >= next_flush {
+            next_flush = now + FLUSH_EVERY_NS;
+            flush_recording(sim, args)?;
+        }
+        if end.is_some_and(|e| now >= e) || STOP.load(Ordering::Relaxed) {
+            return Ok(stats);
+        }
+        if !args.busy_poll {
+            sock.wait(IDLE_WAIT).map_err(|e| format!("wait: {e}"))?;
         }
     }
-    flush_recording(&mut sim, args)?;
-    println!("{} frames served", sim.frames());
-    Ok(())
 }
 
 /// Flushes the pcap recording: a write error ends `serve` with a message.
@@ -69,5 +170,36 @@ fn flush_recording(sim: &mut Simulation, args: &ServeArgs) -> Result<(), String>
     match (&args.pcap, sim.flush()) {
         (Some(p), Err(e)) => Err(format!("the pcap file {} is incomplete: {e}", p.display())),
         _ => Ok(()),
+    }
+}
+
+/// `--delay-us`: holds each frame a seeded random time after its arrival
+/// (xorshift64, uniform in 0..=max µs), as a loaded machine would.
+struct Delay {
+    max_ns: u64,
+    state: u64,
+}
+
+impl Delay {
+    fn new(max_us: u64, seed: u64) -> Self {
+        Self {
+            max_ns: max_us.saturating_mul(1000),
+            // a fixed mix of the seed, never state 0
+            state: (seed.wrapping_add(0x9E37_79B9_7F4A_7C15) ^ 0xBF58_476D_1CE4_E5B9).max(1),
+        }
+    }
+
+    /// Sleeps until `arrival_ns` (monotonic) plus the next random delay.
+    fn hold(&mut self, arrival_ns: u64) {
+        let mut x = self.state;
+        x ^= x << 13;
+        x ^= x >> 7;
+        x ^= x << 17;
+        self.state = x;
+        let until = arrival_ns.saturating_add(x % self.max_ns.saturating_add(1));
+        let now = monotonic_ns();
+        if until > now {
+            std::thread::sleep(Duration::from_nanos(until - now));
+        }
     }
 }
