@@ -69,7 +69,8 @@ pub struct ServeArgs {
     #[arg(long, value_name = "1..99", default_value_t = 20, value_parser = clap::value_parser!(i32).range(1..=99))]
     pub fifo_priority: i32,
     /// Spin on the socket instead of sleeping between frames (lowest
-    /// latency; takes a whole CPU).
+    /// latency; takes a whole CPU; runs without SCHED_FIFO, which the kernel
+    /// would throttle).
     #[arg(long)]
     pub busy_poll: bool,
     /// Test only: hold each frame a seeded random 0..=MAX µs after its

@@ -2,12 +2,14 @@
 //! of its own. Refusal (no root or CAP_SYS_NICE, a CPU not in the allowed
 //! set) is not an error: `serve` runs as an ordinary process and says so.
 
-/// Asks for SCHED_FIFO at `priority` and pins the process to `cpu` if given;
-/// returns a line saying what was applied.
-pub fn apply(priority: i32, cpu: Option<usize>) -> String {
-    let fifo = match set_fifo(priority) {
-        Ok(()) => format!("SCHED_FIFO priority {priority}"),
-        Err(e) => format!("no SCHED_FIFO ({e})"),
+/// Asks for SCHED_FIFO at `priority` if given (`None`: `--busy-poll`, which
+/// must not spin as a real-time process) and pins the process to `cpu` if
+/// given; returns a line saying what was applied.
+pub fn apply(priority: Option<i32>, cpu: Option<usize>) -> String {
+    let fifo = match priority.map(set_fifo) {
+        None => "no SCHED_FIFO (--busy-poll spins)".to_string(),
+        Some(Ok(p)) => format!("SCHED_FIFO priority {p}"),
+        Some(Err(e)) => format!("no SCHED_FIFO ({e})"),
     };
     let pin = match cpu.map(pin) {
         None => "not pinned (--cpu N pins)".to_string(),
@@ -17,7 +19,7 @@ pub fn apply(priority: i32, cpu: Option<usize>) -> String {
     format!("real-time: {fifo}, {pin}")
 }
 
-fn set_fifo(priority: i32) -> std::io::Result<()> {
+fn set_fifo(priority: i32) -> std::io::Result<i32> {
     let p = libc::sched_param {
         sched_priority: priority,
     };
@@ -27,7 +29,7 @@ fn set_fifo(priority: i32) -> std::io::Result<()> {
     if r < 0 {
         return Err(std::io::Error::last_os_error());
     }
-    Ok(())
+    Ok(priority)
 }
 
 fn pin(cpu: usize) -> Result<usize, String> {

@@ -89,8 +89,12 @@ pub fn serve(args: &ServeArgs) -> Result<(), String> {
     }
     if args.no_rt {
         println!("real-time: not asked for (--no-rt)");
+    } else if args.busy_poll {
+        // a spinning SCHED_FIFO process is throttled by the kernel (sched_rt_runtime_us)
+        // for tens of ms every second and starves its CPU's softirqs: no FIFO
+        println!("{}", super::realtime::apply(None, args.cpu));
     } else {
-        println!("{}", super::realtime::apply(args.fifo_priority, args.cpu));
+        println!("{}", super::realtime::apply(Some(args.fifo_priority), args.cpu));
     }
     if let Some(max) = args.delay_us {
         println!(
@@ -110,6 +114,13 @@ pub fn serve(args: &ServeArgs) -> Result<(), String> {
         LATE_NOTE_NS / 1000,
         stats.worst_late_ns as f64 / 1e3
     );
+    if sim.frames() > 0 {
+        println!(
+            "answer sent after the kernel's receive: {}; of that simulating: {}",
+            stats.answer.summary(),
+            stats.work.summary()
+        );
+    }
     Ok(())
 }
 
@@ -122,6 +133,62 @@ struct Stats {
     late: u64,
     /// The most the simulation had passed a frame's receive time, ns.
     worst_late_ns: u64,
+    /// From the kernel's receive timestamp to the answer sent (without `--delay-us`'s hold).
+    answer: Histogram,
+    /// Of that, catching the simulation up and processing the frame.
+    work: Histogram,
+}
+
+/// Durations in 1 µs buckets up to 10 ms (longer ones in the last).
+#[derive(Debug)]
+struct Histogram {
+    counts: Vec<u32>,
+    max_ns: u64,
+}
+
+impl Default for Histogram {
+    fn default() -> Self {
+        Self {
+            counts: vec![0; 10_001],
+            max_ns: 0,
+        }
+    }
+}
+
+impl Histogram {
+    fn add(&mut self, ns: u64) {
+        let i = usize::try_from(ns / 1000)
+            .unwrap_or(usize::MAX)
+            .min(self.counts.len() - 1);
+        if let Some(c) = self.counts.get_mut(i) {
+            *c = c.saturating_add(1);
+        }
+        self.max_ns = self.max_ns.max(ns);
+    }
+
+    /// The `p` quantile (0..=1), µs (bucket upper edge).
+    fn quantile_us(&self, p: f64) -> u64 {
+        let total: u64 = self.counts.iter().map(|&c| u64::from(c)).sum();
+        let want = ((total as f64) * p).ceil().max(1.0) as u64;
+        let mut seen = 0;
+        for (i, &c) in self.counts.iter().enumerate() {
+            seen += u64::from(c);
+            if seen >= want {
+                return i as u64 + 1;
+            }
+        }
+        0
+    }
+
+    /// "p50 a, p99 b, max c µs".
+    fn summary(&self) -> String {
+        format!(
+            "p50 {}, p99 {}, max {:.0} µs",
+            self.quantile_us(0.5),
+            self.quantile_us(0.99),
+            self.max_ns as f64 / 1e3
+        )
+    }
 }
 
 /// The serve loop (see the module's Timing section).
@@ -143,9 +210,12 @@ fn run(sim: &mut Simulation, sock: &RawSocket, args: &ServeArgs) -> Result<Stats
                 stats.unstamped += 1;
                 now
             });
-            if let Some(d) = delay.as_mut() {
-                d.hold(rx_ns);
-            }
+            let picked = monotonic_ns();
+            let held = match delay.as_mut() {
+                Some(d) => d.hold(rx_ns),
+                None => 0,
+            };
+            let begin = picked + held;
             let t = rx_ns.saturating_sub(start);
             let behind = sim.now_ns().saturating_sub(t);
             if behind > LATE_NOTE_NS {
@@ -156,6 +226,9 @@ fn run(sim: &mut Simulation, sock: &RawSocket, args: &ServeArgs) -> Result<Stats
             let frame = buf.get_mut(..rx.len).unwrap_or_default();
             sim.exchange(frame);
             sock.send(frame).map_err(|e| format!("send: {e}"))?;
+            let sent = monotonic_ns();
+            stats.work.add(sent.saturating_sub(begin));
+            stats.answer.add(sent.saturating_sub(rx_ns).saturating_sub(held));
             if let Some(e) = sim.recording_error() {
                 return Err(format!("the pcap recording failed: {e}"));
             }
@@ -201,8 +274,9 @@ impl Delay {
         }
     }
 
-    /// Sleeps until `arrival_ns` (monotonic) plus the next random delay.
-    fn hold(&mut self, arrival_ns: u64) {
+    /// Sleeps until `arrival_ns` (monotonic) plus the next random delay;
+    /// returns how long it slept, ns.
+    fn hold(&mut self, arrival_ns: u64) -> u64 {
         let mut x = self.state;
         x ^= x << 13;
         x ^= x >> 7;
@@ -213,5 +287,6 @@ impl Delay {
         if until > now {
             std::thread::sleep(Duration::from_nanos(until - now));
         }
+        monotonic_ns().saturating_sub(now)
     }
 }
