@@ -9,9 +9,11 @@
 //! The master is ethercrab's std transport on the other veth end: ethercrab
 //! brings the line up (DC start-up, SYNC0 at 1 ms), then a cyclic sender of
 //! its own sends one LRW frame per cycle at a fixed instant 300 µs before
-//! SYNC0 on the reference clock, without waiting for the previous answer (an
-//! answer may take 2 ms), and a monitor reads every drive's AL status and AL
-//! status code every 100 ms for 60 s. Needs root; skipped otherwise.
+//! SYNC0 on the reference clock (with a read of the reference's DC time, so
+//! the test can print when the frames reached the drive), without waiting
+//! for the previous answer (an answer may take 2 ms), and a monitor reads
+//! every drive's AL status and AL status code every 100 ms for 60 s. Needs
+//! root; skipped otherwise.
 #![allow(clippy::unwrap_used, clippy::expect_used, clippy::panic)]
 
 mod common;
@@ -125,10 +127,12 @@ fn rel_sync0(dc: u64, sync0_start: u64) -> i64 {
     }
 }
 
-/// The frames the master itself delivered late by the drive's rule (after
-/// SYNC0 or more than half a cycle before it): count, longest run of
-/// consecutive cycles, and the range of arrival times, ns before SYNC0.
-fn master_lateness(arrivals: &[AtomicI64]) -> (usize, usize, i64, i64) {
+/// The frames that reached the drive late by its rule (after SYNC0 or more
+/// than half a cycle before it), as the reference's DC time read in the same
+/// cycle shows: count, longest run of consecutive cycles, and the range of
+/// arrival times, ns before SYNC0. A late frame is the master's (it woke or
+/// sent late) or `serve`'s (it processed the frame at the wrong time).
+fn lateness(arrivals: &[AtomicI64]) -> (usize, usize, i64, i64) {
     let (mut late, mut run, mut worst_run) = (0, 0, 0);
     let (mut lo, mut hi) = (i64::MAX, i64::MIN);
     for a in arrivals {
@@ -344,10 +348,10 @@ fn e118_dc_aligned_master_keeps_op_while_serve_is_delayed_2ms() {
          late frames counted by the drives (1C32h:0B): {late_frames:?}",
         stats.worst_send_late_ns.load(Ordering::Relaxed) as f64 / 1e3
     );
-    let (master_late, master_run, closest, farthest) = master_lateness(&arrivals);
+    let (late, run, closest, farthest) = lateness(&arrivals);
     println!(
-        "the master's frames reached the drive {:.1}..{:.1} µs before SYNC0; {master_late} of them late by \
-         the drive's rule, at most {master_run} in a row",
+        "the cycles' frames reached the drive {:.1}..{:.1} µs before SYNC0; {late} of them late by \
+         the drive's rule, at most {run} in a row",
         closest as f64 / 1e3,
         farthest as f64 / 1e3
     );
