@@ -5,15 +5,16 @@
 //!
 //! Simulated time is `CLOCK_MONOTONIC` since the start. Each received frame
 //! carries the kernel's receive timestamp; the simulation runs to that instant
-//! ([`run_to`]) and only then processes the frame, so the drive
-//! sees the frame when it arrived, however long `serve` took to get to it (a
-//! wait, a busy machine, `--delay-us`). While no frame waits, the simulation
-//! is kept at the wall clock (less [`IDLE_LAG_NS`]) every [`IDLE_WAIT`] (or
-//! continuously with `--busy-poll`), so an arriving frame finds little left to simulate and is
-//! answered at once. Frames that queued up are processed in order, each at its
-//! own receive time; one whose time the simulation has already passed (it
-//! arrived while the simulation was being caught up) is processed at once and
-//! counted as late in the summary.
+//! ([`run_to`]) and only then processes the frame, so the drive sees the
+//! frame when it arrived, however long `serve` took to get to it (a wait, a
+//! busy machine, `--delay-us`). While no frame waits, the simulation is kept
+//! at the wall clock (less [`IDLE_LAG_NS`]) every [`IDLE_WAIT`] (or
+//! continuously with `--busy-poll`), so an arriving frame finds little left
+//! to simulate and is answered at once. Frames that queued up are processed
+//! in order, each at its own receive time; one whose time the simulation has
+//! already passed (it arrived while the simulation was being caught up) is
+//! processed at once, and counted in the summary when that was more than
+//! [`LATE_NOTE_NS`] late.
 
 use super::args::ServeArgs;
 use super::print_new_changes;
