@@ -5,8 +5,9 @@
 //!
 //! Simulated time is `CLOCK_MONOTONIC` since the start. Each received frame
 //! carries the kernel's receive timestamp; the simulation runs to that instant
-//! ([`run_to`]) and only then processes the frame, so the drive sees the
-//! frame when it arrived, however long `serve` took to get to it (a wait, a
+//! ([`Simulation::catch_up`]: SYNC0 edges and control cycles in between one
+//! by one, one firmware poll) and only then processes the frame, so the
+//! drive sees the frame when it arrived, however long `serve` took to get to it (a wait, a
 //! busy machine, `--delay-us`). While no frame waits, the simulation is kept
 //! at the wall clock (less [`IDLE_LAG_NS`]) every [`IDLE_WAIT`] (or
 //! continuously with `--busy-poll`), so an arriving frame finds little left
@@ -223,7 +224,7 @@ fn run(sim: &mut Simulation, sock: &RawSocket, args: &ServeArgs) -> Result<Stats
                 stats.late += 1;
             }
             stats.worst_late_ns = stats.worst_late_ns.max(behind);
-            run_to(sim, t);
+            sim.catch_up(t);
             let frame = buf.get_mut(..rx.len).unwrap_or_default();
             sim.exchange(frame);
             sock.send(frame).map_err(|e| format!("send: {e}"))?;
@@ -236,7 +237,7 @@ fn run(sim: &mut Simulation, sock: &RawSocket, args: &ServeArgs) -> Result<Stats
             // drain what queued up before simulating further
             continue;
         }
-        run_to(sim, now.saturating_sub(start + IDLE_LAG_NS));
+        sim.catch_up(now.saturating_sub(start + IDLE_LAG_NS));
         print_new_changes(sim, &mut printed);
         if now >= next_flush {
             next_flush = now + FLUSH_EVERY_NS;
@@ -250,22 +251,6 @@ fn run(sim: &mut Simulation, sock: &RawSocket, args: &ServeArgs) -> Result<Stats
         }
     }
 }
-
-/// Runs the simulation to `t_ns`: a short gap as the firmware would spend it
-/// ([`Simulation::advance_to`]: its poll every 100 µs, so a frame right after
-/// the last poll costs no extra poll), a long one (`serve` was held up) in one
-/// step ([`Simulation::catch_up`]: one poll, SYNC0 edges and cycles still one
-/// by one), so the simulation never falls behind for good.
-fn run_to(sim: &mut Simulation, t_ns: u64) {
-    if t_ns.saturating_sub(sim.now_ns()) <= STEP_GAP_NS {
-        sim.advance_to(t_ns);
-    } else {
-        sim.catch_up(t_ns);
-    }
-}
-
-/// The longest gap [`run_to`] simulates poll by poll, ns.
-const STEP_GAP_NS: u64 = 2_000_000;
 
 /// Flushes the pcap recording: a write error ends `serve` with a message.
 fn flush_recording(sim: &mut Simulation, args: &ServeArgs) -> Result<(), String> {
