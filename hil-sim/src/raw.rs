@@ -23,6 +23,8 @@ const PACKET_IGNORE_OUTGOING: libc::c_int = 23;
 pub struct Received {
     /// Length of the frame in the buffer, bytes.
     pub len: usize,
+    /// This host sent the frame (only from [`RawSocket::open_sniffer`]).
+    pub outgoing: bool,
     /// When the kernel received it, `CLOCK_MONOTONIC` ns (the time base of
     /// [`monotonic_ns`]); `None` if the kernel gave no timestamp.
     pub rx_ns: Option<u64>,
@@ -70,11 +72,24 @@ pub fn monotonic_from_realtime(realtime_ns: u64) -> u64 {
 pub struct RawSocket {
     fd: OwnedFd,
     ifindex: i32,
+    /// Frames this host sends are received too ([`RawSocket::open_sniffer`]).
+    sniff: bool,
 }
 
 impl RawSocket {
     /// Opens a socket on `iface` (name shorter than 16 bytes).
     pub fn open(iface: &str) -> io::Result<Self> {
+        Self::open_with(iface, false)
+    }
+
+    /// Like [`RawSocket::open`], but receives every frame on `iface`, of any
+    /// EtherType, including those this host sends ([`Received::outgoing`],
+    /// stamped when they left): tests watch a master's frames on the wire.
+    pub fn open_sniffer(iface: &str) -> io::Result<Self> {
+        Self::open_with(iface, true)
+    }
+
+    fn open_with(iface: &str, sniff: bool) -> io::Result<Self> {
         if iface.is_empty() || iface.len() >= libc::IFNAMSIZ {
             return Err(io::Error::new(
                 io::ErrorKind::InvalidInput,
@@ -90,7 +105,13 @@ impl RawSocket {
             if ifindex == 0 {
                 return Err(io::Error::last_os_error());
             }
-            let proto = (ETHERTYPE_ECAT).to_be() as i32;
+            // outgoing frames reach only ETH_P_ALL sockets: a sniffer takes every frame
+            let ethertype = if sniff {
+                libc::ETH_P_ALL as u16
+            } else {
+                ETHERTYPE_ECAT
+            };
+            let proto = ethertype.to_be() as i32;
             let raw = libc::socket(libc::AF_PACKET, libc::SOCK_RAW, proto);
             if raw < 0 {
                 return Err(io::Error::last_os_error());
@@ -98,7 +119,7 @@ impl RawSocket {
             let fd = OwnedFd::from_raw_fd(raw);
             let mut sll: libc::sockaddr_ll = std::mem::zeroed();
             sll.sll_family = libc::AF_PACKET as u16;
-            sll.sll_protocol = ETHERTYPE_ECAT.to_be();
+            sll.sll_protocol = ethertype.to_be();
             sll.sll_ifindex = ifindex;
             let r = libc::bind(
                 fd.as_raw_fd(),
@@ -122,8 +143,10 @@ impl RawSocket {
                 return Err(io::Error::last_os_error());
             }
             // best effort: without it our own frames are skipped one by one
-            let _ = opt(libc::SOL_PACKET, PACKET_IGNORE_OUTGOING);
-            Ok(Self { fd, ifindex })
+            if !sniff {
+                let _ = opt(libc::SOL_PACKET, PACKET_IGNORE_OUTGOING);
+            }
+            Ok(Self { fd, ifindex, sniff })
         }
     }
 
@@ -164,7 +187,8 @@ impl RawSocket {
     }
 
     /// Reads one waiting frame without blocking, with its kernel receive
-    /// time; `None` if no frame waits. Frames this host sent are skipped.
+    /// time; `None` if no frame waits. Frames this host sent are skipped
+    /// (unless the socket is a sniffer).
     pub fn try_recv(&self, buf: &mut [u8]) -> io::Result<Option<Received>> {
         loop {
             // SAFETY: all-zero bytes are a valid sockaddr_ll and msghdr (plain C data).
@@ -195,12 +219,14 @@ impl RawSocket {
                     _ => Err(e),
                 };
             }
-            if sll.sll_pkttype == libc::PACKET_OUTGOING {
+            let outgoing = sll.sll_pkttype == libc::PACKET_OUTGOING;
+            if outgoing && !self.sniff {
                 continue;
             }
             let len = (n as usize).min(buf.len());
             return Ok(Some(Received {
                 len,
+                outgoing,
                 rx_ns: rx_timestamp(&msg).map(monotonic_from_realtime),
             }));
         }

@@ -12,8 +12,14 @@
 //! SYNC0 on the reference clock (with a read of the reference's DC time, so
 //! the test can print when the frames reached the drive), without waiting
 //! for the previous answer (an answer may take 2 ms), and a monitor reads
-//! every drive's AL status and AL status code every 100 ms for 60 s. Needs
-//! root; skipped otherwise.
+//! every drive's AL status and AL status code every 100 ms for 60 s. A
+//! sniffer on the master's veth end pairs each cycle's DC-time read as it
+//! left (kernel timestamp) with the DC time the drive answered: so the test
+//! checks `serve`'s part on its own (99 % of the frames within 100 µs of
+//! their departure in the drive's time) and tells a late master from a late
+//! `serve`. Should the drives leave Op while the master itself sent five
+//! frames in a row late (a host too busy for it), the Op part is reported as
+//! inconclusive instead of failed. Needs root; skipped otherwise.
 #![allow(clippy::unwrap_used, clippy::expect_used, clippy::panic)]
 
 mod common;
@@ -22,7 +28,7 @@ use common::Netns;
 use ethercrab::subdevice_group::DcConfiguration;
 use ethercrab::{Command, DcSync, MainDevice, MainDeviceConfig, PduStorage, Timeouts};
 use futures_lite::future::block_on;
-use std::sync::atomic::{AtomicBool, AtomicI64, AtomicU64, Ordering};
+use std::sync::atomic::{AtomicBool, AtomicU64, Ordering};
 use std::time::{Duration, Instant};
 
 /// SYNC0 period and master cycle, ns.
@@ -45,6 +51,13 @@ const MAX_SEND_LATE_NS: u64 = 50_000;
 /// test on a shared machine may run, so the master's own cycle stays exact.
 const MASTER_PRIORITY: i32 = 80;
 
+/// The most `serve` may move 99 % of the frames in the drive's time against
+/// their departure, ns (the drive tolerates 300 µs late; holding frames 2 ms
+/// in serve without the receive timestamp moves most by hundreds of µs; the
+/// rest of the 1 % is left to a busy host: a virtual CPU taken away between
+/// the two timestamps moves a frame too).
+const MAX_MISPLACED_NS: i128 = 100_000;
+
 /// AL status register, AL status code register, DC system time.
 const AL_STATUS: u16 = 0x0130;
 const AL_STATUS_CODE: u16 = 0x0134;
@@ -57,11 +70,11 @@ fn mono_ns() -> u64 {
     hil_sim::raw::monotonic_ns()
 }
 
-/// Sleeps until monotonic `t_ns` (the last 150 µs spinning).
+/// Sleeps until monotonic `t_ns` (the last 60 µs spinning; a SCHED_FIFO thread has no timer slack).
 fn sleep_until(t_ns: u64) {
     let now = mono_ns();
-    if t_ns > now + 150_000 {
-        std::thread::sleep(Duration::from_nanos(t_ns - now - 150_000));
+    if t_ns > now + 60_000 {
+        std::thread::sleep(Duration::from_nanos(t_ns - now - 60_000));
     }
     while mono_ns() < t_ns {
         std::hint::spin_loop();
@@ -127,30 +140,129 @@ fn rel_sync0(dc: u64, sync0_start: u64) -> i64 {
     }
 }
 
-/// The frames that reached the drive late by its rule (after SYNC0 or more
-/// than half a cycle before it), as the reference's DC time read in the same
-/// cycle shows: count, longest run of consecutive cycles, and the range of
-/// arrival times, ns before SYNC0. A late frame is the master's (it woke or
-/// sent late) or `serve`'s (it processed the frame at the wrong time).
-fn lateness(arrivals: &[AtomicI64]) -> (usize, usize, i64, i64) {
-    let (mut late, mut run, mut worst_run) = (0, 0, 0);
-    let (mut lo, mut hi) = (i64::MAX, i64::MIN);
-    for a in arrivals {
-        let rel = a.load(Ordering::Relaxed);
-        if rel == i64::MIN {
-            continue; // not sent (skipped) or not answered: no frame, not a late one
+/// Late by the drive's rule (E-118): after SYNC0, or more than half a cycle before it.
+fn is_late(rel_ns: i64) -> bool {
+    rel_ns >= 0 || rel_ns < -((CYCLE_NS / 2) as i64)
+}
+
+/// One cycle's DC-time read as the wire showed it: when the master's frame
+/// left (kernel timestamp of the outgoing frame, monotonic ns) and the
+/// reference's DC time in the answer (when the drive processed the frame).
+#[derive(Clone, Copy)]
+struct WireSample {
+    tx_ns: u64,
+    dc_ns: u64,
+}
+
+/// The index and data of an FPRD of [`DC_SYSTEM_TIME`] at `reference` (an
+/// EtherCAT frame whose first datagram it is).
+fn dc_read(f: &[u8], reference: u16) -> Option<(usize, u64)> {
+    if f.get(12..14)? != hil_sim::raw::ETHERTYPE_ECAT.to_be_bytes() {
+        return None;
+    }
+    // Ethernet 14, EtherCAT header 2; datagram: cmd, idx, ADP, ADO, length, IRQ, data, WKC
+    let d = f.get(16..)?;
+    let word = |k: usize| Some(u16::from_le_bytes([*d.get(k)?, *d.get(k + 1)?]));
+    let fprd = *d.first()? == 0x04;
+    if !fprd || word(2)? != reference || word(4)? != DC_SYSTEM_TIME || word(6)? & 0x7FF != 8 {
+        return None;
+    }
+    Some((
+        usize::from(*d.get(1)?),
+        u64::from_le_bytes(d.get(10..18)?.try_into().ok()?),
+    ))
+}
+
+/// Watches the master's veth end until `stop`: every DC-time read that left
+/// and its answer.
+fn sniff(iface: &str, reference: u16, stop: &AtomicBool) -> Vec<WireSample> {
+    let sock = hil_sim::raw::RawSocket::open_sniffer(iface).expect("sniffer on the veth end");
+    let mut left = [None; 256];
+    let mut out = Vec::new();
+    let mut buf = [0u8; 2048];
+    while !stop.load(Ordering::Relaxed) {
+        if !sock.wait(Duration::from_millis(10)).expect("wait") {
+            continue;
         }
-        lo = lo.min(rel);
-        hi = hi.max(rel);
-        if rel >= 0 || rel < -((CYCLE_NS / 2) as i64) {
-            late += 1;
-            run += 1;
-            worst_run = worst_run.max(run);
-        } else {
-            run = 0;
+        while let Some(rx) = sock.try_recv(&mut buf).expect("sniff") {
+            let (Some(t), Some((idx, dc))) = (rx.rx_ns, dc_read(&buf[..rx.len], reference)) else {
+                continue;
+            };
+            if rx.outgoing {
+                left[idx] = Some(t);
+            } else if let Some(tx_ns) = left[idx].take() {
+                out.push(WireSample { tx_ns, dc_ns: dc });
+            }
         }
     }
-    (late, worst_run, -hi, -lo)
+    out
+}
+
+/// What the wire showed, ns: how far the drive's view of the frames lay
+/// behind their departure (beyond the 0.1 % quantile of that lag): p50,
+/// p99, p99.9 and worst; the frames
+/// late for the drive and their longest run, as it saw them and as the master
+/// sent them; the range of the drive's arrival times before SYNC0.
+#[derive(Debug)]
+struct WireFigures {
+    misplaced_q_ns: [i128; 3],
+    worst_misplaced_ns: i128,
+    late_seen: usize,
+    run_seen: usize,
+    late_sent: usize,
+    run_sent: usize,
+    closest_ns: i64,
+    farthest_ns: i64,
+}
+
+fn wire_figures(samples: &[WireSample], sync0_start: u64) -> WireFigures {
+    // DC time minus departure: a constant (the clocks' offset) plus how late
+    // the drive saw the frame; the constant is the 0.1 % quantile (robust
+    // against a departure stamp taken late, which makes a lag look small)
+    let lag = |s: &WireSample| i128::from(s.dc_ns) - i128::from(s.tx_ns);
+    let mut lags: Vec<i128> = samples.iter().map(lag).collect();
+    lags.sort_unstable();
+    let q = |p: f64| {
+        lags.get(((lags.len().max(1) - 1) as f64 * p) as usize)
+            .copied()
+            .unwrap_or(0)
+    };
+    let base = q(0.001);
+    let misplaced_q_ns = [q(0.5) - base, q(0.99) - base, q(0.999) - base];
+    let worst_misplaced_ns = lags.last().copied().unwrap_or(0) - base;
+    let runs = |rel: &dyn Fn(&WireSample) -> i64| {
+        let (mut late, mut run, mut worst) = (0, 0, 0);
+        for s in samples {
+            if is_late(rel(s)) {
+                late += 1;
+                run += 1;
+                worst = worst.max(run);
+            } else {
+                run = 0;
+            }
+        }
+        (late, worst)
+    };
+    let seen = |s: &WireSample| rel_sync0(s.dc_ns, sync0_start);
+    // departure on the DC time base, with the smallest lag
+    let sent = |s: &WireSample| {
+        rel_sync0(
+            u64::try_from(i128::from(s.tx_ns) + base).unwrap_or(0),
+            sync0_start,
+        )
+    };
+    let (late_seen, run_seen) = runs(&seen);
+    let (late_sent, run_sent) = runs(&sent);
+    WireFigures {
+        misplaced_q_ns,
+        worst_misplaced_ns,
+        late_seen,
+        run_seen,
+        late_sent,
+        run_sent,
+        closest_ns: -samples.iter().map(seen).max().unwrap_or(0),
+        farthest_ns: -samples.iter().map(seen).min().unwrap_or(0),
+    }
 }
 
 /// What the cyclic sender saw.
@@ -254,14 +366,14 @@ fn e118_dc_aligned_master_keeps_op_while_serve_is_delayed_2ms() {
 
     let stop = AtomicBool::new(false);
     let stats = CycleStats::default();
-    // per cycle: when its frames passed the reference relative to SYNC0, ns
-    let arrivals: Vec<AtomicI64> = (0..(HOLD.as_secs() + 40) * 1000)
-        .map(|_| AtomicI64::new(i64::MIN))
-        .collect();
     let wkc = u16::try_from(3 * DRIVES).unwrap();
-    let (reached_op, samples, bad, late_frames) = std::thread::scope(|s| {
+    let (reached_op, samples, bad, late_frames, wire) = std::thread::scope(|s| {
+        let sniffer = {
+            let (iface, stop, reference) = (net.host_if.as_str(), &stop, addrs[0]);
+            s.spawn(move || sniff(iface, reference, stop))
+        };
         for j in 0..SENDERS {
-            let (md, stop, stats, arrivals) = (&md, &stop, &stats, &arrivals);
+            let (md, stop, stats) = (&md, &stop, &stats);
             let reference = addrs[0];
             s.spawn(move || {
                 fifo(MASTER_PRIORITY);
@@ -281,15 +393,13 @@ fn e118_dc_aligned_master_keeps_op_while_serve_is_delayed_2ms() {
                     stats.sent.fetch_add(1, Ordering::Relaxed);
                     // the reference's DC time as the cycle's frames pass it (the
                     // drive's view of when they arrived), then the process data
-                    let (dc, r) = block_on(futures_lite::future::zip(
+                    // (the sniffer pairs the DC-time read with its answer)
+                    let (_, r) = block_on(futures_lite::future::zip(
                         Command::fprd(reference, DC_SYSTEM_TIME).receive::<u64>(md),
                         Command::lrw(image_start)
                             .with_wkc(wkc)
                             .send_receive_slice(md, outputs.as_slice()),
                     ));
-                    if let (Ok(dc), Some(slot)) = (dc, arrivals.get(usize::try_from(k - SENDERS).unwrap())) {
-                        slot.store(rel_sync0(dc, sync0_start), Ordering::Relaxed);
-                    }
                     match r {
                         Ok(_) => stats.answered.fetch_add(1, Ordering::Relaxed),
                         Err(_) => stats.failed.fetch_add(1, Ordering::Relaxed),
@@ -334,7 +444,7 @@ fn e118_dc_aligned_master_keeps_op_while_serve_is_delayed_2ms() {
             })
             .collect();
         stop.store(true, Ordering::Relaxed);
-        (reached_op, samples, bad, late)
+        (reached_op, samples, bad, late, sniffer.join().expect("sniffer"))
     });
     let (sent, answered, failed, skipped) = (
         stats.sent.load(Ordering::Relaxed),
@@ -348,15 +458,48 @@ fn e118_dc_aligned_master_keeps_op_while_serve_is_delayed_2ms() {
          late frames counted by the drives (1C32h:0B): {late_frames:?}",
         stats.worst_send_late_ns.load(Ordering::Relaxed) as f64 / 1e3
     );
-    let (late, run, closest, farthest) = lateness(&arrivals);
+    let w = wire_figures(&wire, sync0_start);
     println!(
-        "the cycles' frames reached the drive {:.1}..{:.1} µs before SYNC0; {late} of them late by \
-         the drive's rule, at most {run} in a row",
-        closest as f64 / 1e3,
-        farthest as f64 / 1e3
+        "on the wire: {} cycles; the drive saw them {:.1}..{:.1} µs before SYNC0, off their departure by \
+         p50 {:.1}, p99 {:.1}, p99.9 {:.1}, max {:.1} µs; late by the drive's rule: {} as seen (at most {} in \
+         a row), {} as sent by the master (at most {} in a row)",
+        wire.len(),
+        w.closest_ns as f64 / 1e3,
+        w.farthest_ns as f64 / 1e3,
+        w.misplaced_q_ns[0] as f64 / 1e3,
+        w.misplaced_q_ns[1] as f64 / 1e3,
+        w.misplaced_q_ns[2] as f64 / 1e3,
+        w.worst_misplaced_ns as f64 / 1e3,
+        w.late_seen,
+        w.run_seen,
+        w.late_sent,
+        w.run_sent
     );
     drop(group);
     drop(net);
+    // serve's part, whatever the machine does: each frame at its departure
+    assert!(
+        wire.len() as u64 >= sent * 9 / 10,
+        "the sniffer saw most cycles: {} of {sent}",
+        wire.len()
+    );
+    assert!(
+        w.misplaced_q_ns[1] <= MAX_MISPLACED_NS,
+        "serve moved 1 % of the frames more than {} µs in the drive's time (p99 {:.1} µs)",
+        MAX_MISPLACED_NS / 1000,
+        w.misplaced_q_ns[1] as f64 / 1e3
+    );
+    let op_kept = reached_op && bad.is_empty();
+    if !op_kept && w.run_sent >= 5 {
+        // the master itself sent five frames in a row late: the drive rightly
+        // leaves Op, whatever serve does
+        println!(
+            "e118 (serve delayed 2 ms): the Op part is inconclusive, the machine was too busy for the master \
+             ({} frames in a row sent late); serve's placement of the frames was checked",
+            w.run_sent
+        );
+        return;
+    }
     assert!(reached_op, "the drives reached OP with serve delayed");
     assert!(
         bad.is_empty(),
