@@ -1,7 +1,9 @@
 //! A pcap writer (classic format, link type Ethernet, nanosecond timestamps),
 //! so Wireshark's EtherCAT dissector reads what the simulator saw.
 
-use std::io::{self, Write};
+use std::fs::File;
+use std::io::{self, BufWriter, Write};
+use std::path::Path;
 
 /// Writes Ethernet frames with their simulated time to a pcap stream.
 pub struct PcapWriter<W: Write> {
@@ -51,6 +53,51 @@ impl<W: Write> PcapWriter<W> {
     }
 }
 
+/// A pcap recording in progress: the header is written and flushed when it is
+/// created, so an unwritable file fails at once, before any run; the first
+/// error of a later write is kept ([`Recording::error`]) and returned by
+/// [`Recording::flush`], so a run can never end claiming a recording it lost.
+pub struct Recording<W: Write = BufWriter<File>> {
+    writer: PcapWriter<W>,
+    error: Option<io::Error>,
+}
+
+impl Recording {
+    /// Creates (truncates) the file at `path` and writes its header.
+    pub fn create(path: &Path) -> io::Result<Self> {
+        Self::new(BufWriter::new(File::create(path)?))
+    }
+}
+
+impl<W: Write> Recording<W> {
+    /// Writes the header to `out` and flushes it.
+    pub fn new(out: W) -> io::Result<Self> {
+        let mut writer = PcapWriter::new(out)?;
+        writer.flush()?;
+        Ok(Self { writer, error: None })
+    }
+
+    /// Appends one frame seen at `t_ns`; after an error nothing more is written.
+    pub fn frame(&mut self, t_ns: u64, frame: &[u8]) {
+        if self.error.is_none() {
+            self.error = self.writer.frame(t_ns, frame).err();
+        }
+    }
+
+    /// The first write error, if any.
+    pub fn error(&self) -> Option<&io::Error> {
+        self.error.as_ref()
+    }
+
+    /// Flushes the stream; the first write error if there was one.
+    pub fn flush(&mut self) -> io::Result<()> {
+        if let Some(e) = self.error.take() {
+            return Err(e);
+        }
+        self.writer.flush()
+    }
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -66,5 +113,49 @@ mod tests {
         assert_eq!(u32::from_le_bytes(b[24..28].try_into().unwrap()), 1); // seconds
         assert_eq!(u32::from_le_bytes(b[28..32].try_into().unwrap()), 500_000_123); // ns
         assert_eq!(u32::from_le_bytes(b[32..36].try_into().unwrap()), 60);
+    }
+
+    /// A stream that takes `room` bytes, then fails (a full disk).
+    struct Full {
+        room: usize,
+    }
+
+    impl Write for Full {
+        fn write(&mut self, b: &[u8]) -> io::Result<usize> {
+            if self.room == 0 {
+                return Err(io::Error::new(io::ErrorKind::StorageFull, "disk full"));
+            }
+            let n = b.len().min(self.room);
+            self.room -= n;
+            Ok(n)
+        }
+        fn flush(&mut self) -> io::Result<()> {
+            Ok(())
+        }
+    }
+
+    #[test]
+    fn a_write_error_during_the_recording_is_kept_and_returned() {
+        assert!(Recording::new(Full { room: 10 }).is_err(), "header does not fit");
+        let mut r = Recording::new(Full {
+            room: 24 + 2 * (16 + 60) + 5,
+        })
+        .unwrap();
+        r.frame(1, &[0; 60]);
+        r.frame(2, &[0; 60]);
+        assert!(r.error().is_none());
+        r.frame(3, &[0; 60]);
+        assert_eq!(r.error().map(io::Error::kind), Some(io::ErrorKind::StorageFull));
+        r.frame(4, &[0; 60]);
+        assert_eq!(r.flush().map_err(|e| e.kind()), Err(io::ErrorKind::StorageFull));
+    }
+
+    #[test]
+    fn an_unwritable_path_fails_at_creation() {
+        let dir = std::env::temp_dir().join(format!("hil-sim-pcap-{}", std::process::id()));
+        std::fs::write(&dir, b"a file, not a directory").unwrap();
+        let err = Recording::create(&dir.join("a.pcap")).err();
+        std::fs::remove_file(&dir).unwrap();
+        assert!(err.is_some(), "a path below a regular file cannot be created");
     }
 }

@@ -2,7 +2,7 @@
 //! position, velocity, torque and following error over time.
 
 use plotters::prelude::*;
-use std::path::Path;
+use std::io::Write;
 
 /// One axis' signals sampled once per master cycle.
 #[derive(Debug, Default, Clone)]
@@ -65,9 +65,23 @@ impl Trace {
         (max, rms)
     }
 
-    /// Writes a four-panel SVG plot to `path`.
-    pub fn write_svg(&self, path: &Path, title: &str) -> Result<(), String> {
-        let root = SVGBackend::new(path, (1100, 1000)).into_drawing_area();
+    /// Writes a four-panel SVG plot to `out` (the caller opened the file
+    /// before the run, so an unwritable path fails before the work is done).
+    pub fn write_svg<W: Write>(&self, out: &mut W, title: &str) -> Result<(), String> {
+        let svg = self.svg(title)?;
+        out.write_all(svg.as_bytes()).map_err(|e| e.to_string())?;
+        out.flush().map_err(|e| e.to_string())
+    }
+
+    /// The four-panel SVG plot.
+    pub fn svg(&self, title: &str) -> Result<String, String> {
+        let mut svg = String::new();
+        self.draw(SVGBackend::with_string(&mut svg, (1100, 1000)), title)?;
+        Ok(svg)
+    }
+
+    fn draw(&self, backend: SVGBackend<'_>, title: &str) -> Result<(), String> {
+        let root = backend.into_drawing_area();
         root.fill(&WHITE).map_err(|e| e.to_string())?;
         let root = root
             .titled(title, ("sans-serif", 22))

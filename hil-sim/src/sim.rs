@@ -5,11 +5,10 @@
 use crate::esc::{Esc, EscConfig, LineTiming};
 use crate::frame::process_frame;
 use crate::motor::{Input, Motor, MotorOutputs};
-use crate::pcap::PcapWriter;
+use crate::pcap::Recording;
 use drive::axis::{AxisIo, IndexLatch, ProbeEdge, SwitchEdge, SwitchId};
 use std::collections::VecDeque;
-use std::fs::File;
-use std::io::{self, BufWriter};
+use std::io;
 use std::path::Path;
 
 /// Local poll period of the slave firmware between frames (the mailbox/ESM task), ns.
@@ -587,7 +586,7 @@ pub struct Simulation<N: Node = SimDrive> {
     now_ns: u64,
     last_poll_ns: u64,
     frames: u64,
-    pcap: Option<PcapWriter<BufWriter<File>>>,
+    pcap: Option<Recording>,
     jitter: Jitter,
 }
 
@@ -626,10 +625,17 @@ impl<N: Node> Simulation<N> {
         };
     }
 
-    /// Records every frame, both directions, to a pcap file at `path`.
+    /// Records every frame, both directions, to a pcap file at `path`
+    /// (created and its header written now: an unwritable path fails here).
     pub fn record_pcap(&mut self, path: &Path) -> io::Result<()> {
-        self.pcap = Some(PcapWriter::new(BufWriter::new(File::create(path)?))?);
+        self.pcap = Some(Recording::create(path)?);
         Ok(())
+    }
+
+    /// The first error writing the pcap recording, if any (also returned by
+    /// [`Simulation::flush`]).
+    pub fn recording_error(&self) -> Option<&io::Error> {
+        self.pcap.as_ref().and_then(Recording::error)
     }
 
     /// Simulated time, ns.
@@ -662,7 +668,7 @@ impl<N: Node> Simulation<N> {
         self.frames += 1;
         let t_out = self.now_ns;
         if let Some(p) = self.pcap.as_mut() {
-            let _ = p.frame(t_out, frame);
+            p.frame(t_out, frame);
         }
         let j = self.jitter.next();
         let t_arr = t_out.saturating_add(self.jitter.max_ns).saturating_add_signed(j);
@@ -687,7 +693,7 @@ impl<N: Node> Simulation<N> {
         self.deliver_events(t_back);
         self.now_ns = self.now_ns.max(t_back);
         if let Some(p) = self.pcap.as_mut() {
-            let _ = p.frame(self.now_ns, frame);
+            p.frame(self.now_ns, frame);
         }
         self.poll_all();
     }
@@ -766,7 +772,7 @@ impl<N: Node> Simulation<N> {
         self.last_poll_ns = now;
     }
 
-    /// Flushes the pcap file, if any.
+    /// Flushes the pcap file, if any; the first write error of the recording.
     pub fn flush(&mut self) -> io::Result<()> {
         match self.pcap.as_mut() {
             Some(p) => p.flush(),

@@ -5,83 +5,22 @@
 //! the other end. Needs root (CI runs as root); skipped with a message otherwise.
 #![allow(clippy::unwrap_used, clippy::expect_used, clippy::panic)]
 
+mod common;
+
+use common::Netns;
 use ethercrab::{MainDevice, MainDeviceConfig, PduStorage, Timeouts};
-use std::process::{Child, Command, Stdio};
-use std::time::Duration;
-
-struct Netns {
-    ns: String,
-    host_if: String,
-    server: Option<Child>,
-}
-
-fn ip(args: &[&str]) {
-    let st = Command::new("ip").args(args).status().expect("run ip");
-    assert!(st.success(), "ip {args:?} failed");
-}
-
-impl Netns {
-    fn new() -> Self {
-        let id = std::process::id() % 100_000;
-        let ns = format!("hilsim{id}");
-        let host_if = format!("hs{id}a");
-        let sim_if = format!("hs{id}b");
-        let _ = Command::new("ip")
-            .args(["netns", "del", &ns])
-            .stderr(Stdio::null())
-            .status();
-        ip(&["netns", "add", &ns]);
-        ip(&["link", "add", &host_if, "type", "veth", "peer", "name", &sim_if]);
-        ip(&["link", "set", &sim_if, "netns", &ns]);
-        ip(&["link", "set", &host_if, "up"]);
-        ip(&["-n", &ns, "link", "set", &sim_if, "up"]);
-        let server = Command::new("ip")
-            .args([
-                "netns",
-                "exec",
-                &ns,
-                env!("CARGO_BIN_EXE_hil-sim"),
-                "serve",
-                "--iface",
-                &sim_if,
-            ])
-            .args(["--slaves", "2", "--seconds", "60"])
-            .stdout(Stdio::inherit())
-            .spawn()
-            .expect("spawn hil-sim serve");
-        std::thread::sleep(Duration::from_millis(300));
-        Self {
-            ns,
-            host_if,
-            server: Some(server),
-        }
-    }
-}
-
-impl Drop for Netns {
-    fn drop(&mut self) {
-        if let Some(mut s) = self.server.take() {
-            let _ = s.kill();
-            let _ = s.wait();
-        }
-        let _ = Command::new("ip")
-            .args(["link", "del", &self.host_if])
-            .stderr(Stdio::null())
-            .status();
-        let _ = Command::new("ip").args(["netns", "del", &self.ns]).status();
-    }
-}
 
 #[test]
 fn e002_raw_ethernet_veth_master_reaches_op() {
-    // SAFETY: geteuid has no preconditions.
-    #[allow(unsafe_code)]
-    let root = unsafe { libc::geteuid() } == 0;
-    if !root {
+    if !common::is_root() {
         eprintln!("e002_raw_ethernet_veth: skipped, needs root for network namespaces and raw sockets");
         return;
     }
-    let net = Netns::new();
+    let net = Netns::new(
+        env!("CARGO_BIN_EXE_hil-sim"),
+        'v',
+        &["--slaves", "2", "--seconds", "60"],
+    );
     let storage: &'static PduStorage<16, { PduStorage::element_size(1100) }> =
         Box::leak(Box::new(PduStorage::new()));
     let (tx, rx, pdu_loop) = storage.try_split().expect("split");

@@ -1,0 +1,19 @@
+//! The `hil-sim` binary's parts: the command line, `demo` and `serve`.
+
+pub mod args;
+pub mod demo;
+pub mod realtime;
+pub mod serve;
+
+use hil_sim::sim::Simulation;
+
+/// Prints the state changes of every drive logged since the last call.
+pub fn print_new_changes(sim: &Simulation, printed: &mut Vec<usize>) {
+    printed.resize(sim.drives().len(), 0);
+    for (i, d) in sim.drives().iter().enumerate() {
+        for (t, c) in d.state_log.iter().skip(printed[i]) {
+            println!("  [{:>10.3} ms] slave {i}: {c}", *t as f64 / 1e6);
+        }
+        printed[i] = d.state_log.len();
+    }
+}

@@ -1,0 +1,104 @@
+//! The command line: `hil-sim [demo|serve] [OPTIONS]` (clap, derive). Every
+//! subcommand has `--help`; unknown arguments are refused with exit code 2.
+
+use clap::{Args, Parser, Subcommand};
+use std::fs::File;
+use std::path::{Path, PathBuf};
+
+/// The simulated servo drive on a PC: a simulated ESC and motor running the
+/// drive's firmware crates behind a real EtherCAT master.
+#[derive(Debug, Parser)]
+#[command(name = "hil-sim", version, propagate_version = true)]
+pub struct Cli {
+    /// What to run (default: `demo`).
+    #[command(subcommand)]
+    pub command: Option<Command>,
+}
+
+/// The subcommands.
+#[derive(Debug, Subcommand)]
+pub enum Command {
+    /// A real EtherCAT master (ethercrab, in-process, simulated time) drives
+    /// one simulated drive: INIT -> OP, enable axis A in csp, home it, run a
+    /// 10-revolution profile, write a plot of the run.
+    Demo(DemoArgs),
+    /// The simulated line answers EtherCAT frames on a network interface (raw
+    /// Ethernet, needs root or CAP_NET_RAW), so any master can drive it.
+    Serve(ServeArgs),
+}
+
+/// Options of `demo`.
+#[derive(Debug, Clone, Default, Args)]
+pub struct DemoArgs {
+    /// Record every frame (both directions) to this pcap file for Wireshark.
+    #[arg(long, value_name = "FILE")]
+    pub pcap: Option<PathBuf>,
+    /// Write the plot of set and actual position, velocity, torque and
+    /// following error here [default: target/hil-sim-demo.svg].
+    #[arg(long, value_name = "FILE.svg")]
+    pub plot: Option<PathBuf>,
+}
+
+/// Options of `serve`.
+#[derive(Debug, Clone, Args)]
+pub struct ServeArgs {
+    /// Network interface to answer on (e.g. one end of a veth pair).
+    #[arg(long, value_name = "IF")]
+    pub iface: String,
+    /// Drives on the simulated line.
+    #[arg(long, value_name = "N", default_value_t = 1, value_parser = clap::value_parser!(u16).range(1..=16))]
+    pub slaves: u16,
+    /// Axes per drive (every drive is the double-axis device; 1 is accepted,
+    /// a single-axis variant is not modelled yet).
+    #[arg(long, value_name = "1|2", default_value_t = 1, value_parser = clap::value_parser!(u8).range(1..=2))]
+    pub axes: u8,
+    /// Record every frame (both directions, simulated time) to this pcap file.
+    #[arg(long, value_name = "FILE")]
+    pub pcap: Option<PathBuf>,
+    /// Stop after this many seconds (default: run until killed).
+    #[arg(long, value_name = "S")]
+    pub seconds: Option<f64>,
+    /// Do not try SCHED_FIFO (nor `--cpu`).
+    #[arg(long)]
+    pub no_rt: bool,
+    /// Pin to this CPU (default: not pinned; on a shared machine another
+    /// real-time process may hold any given CPU).
+    #[arg(long, value_name = "N", conflicts_with = "no_rt")]
+    pub cpu: Option<usize>,
+    /// SCHED_FIFO priority to ask for.
+    #[arg(long, value_name = "1..99", default_value_t = 20, value_parser = clap::value_parser!(i32).range(1..=99))]
+    pub fifo_priority: i32,
+    /// Spin on the socket instead of sleeping between frames (lowest
+    /// latency; takes a whole CPU; runs without SCHED_FIFO, which the kernel
+    /// would throttle).
+    #[arg(long)]
+    pub busy_poll: bool,
+    /// Test only: hold each frame a seeded random 0..=MAX µs after its
+    /// arrival before processing it (a loaded machine's scheduling delay).
+    #[arg(long, value_name = "MAX", hide = true)]
+    pub delay_us: Option<u64>,
+    /// Test only: seed of `--delay-us`.
+    #[arg(long, value_name = "SEED", hide = true, default_value_t = 1)]
+    pub delay_seed: u64,
+}
+
+/// The default plot path of `demo`.
+pub const DEFAULT_PLOT: &str = "target/hil-sim-demo.svg";
+
+/// Creates (truncates) an output file before the run, so a path that cannot
+/// be written fails at once with a message naming it. `what` names the file
+/// in the message ("plot", "pcap file").
+pub fn create_output(path: &Path, what: &str) -> Result<File, String> {
+    File::create(path).map_err(|e| format!("cannot write the {what} {}: {e}", path.display()))
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use clap::CommandFactory;
+
+    #[test]
+    fn the_command_line_definition_is_consistent() {
+        Cli::command().debug_assert();
+    }
+}

@@ -1,0 +1,294 @@
+//! `hil-sim serve`: the simulated line answers EtherCAT frames on a raw
+//! Ethernet interface, paced by the wall clock.
+//!
+//! # Timing
+//!
+//! Simulated time is `CLOCK_MONOTONIC` since the start. Each received frame
+//! carries the kernel's receive timestamp; the simulation runs to that instant
+//! ([`Simulation::catch_up`]: SYNC0 edges and control cycles in between one
+//! by one, one firmware poll) and only then processes the frame, so the
+//! drive sees the frame when it arrived, however long `serve` took to get to it (a wait, a
+//! busy machine, `--delay-us`). While no frame waits, the simulation is kept
+//! at the wall clock (less [`IDLE_LAG_NS`]) every [`IDLE_WAIT`] (or
+//! continuously with `--busy-poll`), so an arriving frame finds little left
+//! to simulate and is answered at once. Frames that queued up are processed
+//! in order, each at its own receive time; one whose time the simulation has
+//! already passed (it arrived while the simulation was being caught up) is
+//! processed at once, and counted in the summary when that was more than
+//! [`LATE_NOTE_NS`] late.
+
+use super::args::ServeArgs;
+use super::print_new_changes;
+use hil_sim::raw::{monotonic_ns, RawSocket};
+use hil_sim::sim::{SimDrive, Simulation};
+use std::sync::atomic::{AtomicBool, Ordering};
+use std::time::Duration;
+
+/// Set by SIGINT or SIGTERM: `serve` ends its loop, flushes the recording
+/// and prints its summary.
+static STOP: AtomicBool = AtomicBool::new(false);
+
+extern "C" fn on_stop_signal(_: libc::c_int) {
+    STOP.store(true, Ordering::Relaxed);
+}
+
+/// Ctrl-C and `kill` end `serve` in order (the recording complete).
+fn stop_on_signals() {
+    let handler = on_stop_signal as extern "C" fn(libc::c_int) as libc::sighandler_t;
+    for sig in [libc::SIGINT, libc::SIGTERM] {
+        // SAFETY: the handler only stores to an atomic (async-signal-safe).
+        #[allow(unsafe_code)]
+        unsafe {
+            libc::signal(sig, handler);
+        }
+    }
+}
+
+/// Longest sleep on the socket while no frame waits: the simulation is caught
+/// up with the wall clock at least this often.
+pub const IDLE_WAIT: Duration = Duration::from_micros(100);
+
+/// Between frames the simulation stays this far behind the wall clock, ns: a
+/// frame the kernel stamped but had not queued yet when the socket was read
+/// (its softirq still to run on a busy machine) is then still in the
+/// simulation's future. Costs nothing: an arriving frame catches up anyway.
+const IDLE_LAG_NS: u64 = 50_000;
+
+/// A frame the simulation reaches later than this after its receive time is
+/// counted in the summary, ns (less is the wire time of the frame before).
+const LATE_NOTE_NS: u64 = 20_000;
+
+/// How often the pcap recording is flushed (a write error then ends `serve`).
+const FLUSH_EVERY_NS: u64 = 1_000_000_000;
+
+/// Runs `serve` until `--seconds` have passed (or forever).
+pub fn serve(args: &ServeArgs) -> Result<(), String> {
+    let slaves = usize::from(args.slaves);
+    // drives with firmware slots: an FoE download in Bootstrap is accepted
+    let mut sim = Simulation::with_nodes((0..slaves).map(|_| SimDrive::with_firmware_slots()).collect());
+    // the recording first: an unwritable path fails before anything else
+    if let Some(p) = &args.pcap {
+        sim.record_pcap(p)
+            .map_err(|e| format!("cannot write the pcap file {}: {e}", p.display()))?;
+    }
+    let iface = &args.iface;
+    let sock = RawSocket::open(iface).map_err(|e| format!("{iface}: {e}"))?;
+    // every drive answers ping and the UDP parameter service on its EoE
+    // interface once the master set its IP address (docs/eoe.md)
+    for (i, d) in (1u8..).zip(sim.drives_mut()) {
+        d.bind_net([0x02, 0x00, 0x00, 0x00, 0x00, i], u64::from(i), 0);
+    }
+    println!(
+        "hil-sim serve: {slaves} simulated double-axis drive(s) on {iface} (--axes {}: a single-axis variant is not modelled yet)",
+        args.axes
+    );
+    println!(
+        "EoE: ping and the UDP parameter service (port {}) answer at the IP address the master sets",
+        net::param::PARAM_PORT
+    );
+    if let Some(p) = &args.pcap {
+        println!("recording frames to {}", p.display());
+    }
+    if args.no_rt {
+        println!("real-time: not asked for (--no-rt)");
+    } else if args.busy_poll {
+        // a spinning SCHED_FIFO process is throttled by the kernel (sched_rt_runtime_us)
+        // for tens of ms every second and starves its CPU's softirqs: no FIFO
+        println!("{}", super::realtime::apply(None, args.cpu));
+    } else {
+        println!("{}", super::realtime::apply(Some(args.fifo_priority), args.cpu));
+    }
+    if let Some(max) = args.delay_us {
+        println!(
+            "test: every frame held 0..={max} µs after its arrival (seed {})",
+            args.delay_seed
+        );
+    }
+    stop_on_signals();
+    let stats = run(&mut sim, &sock, args)?;
+    flush_recording(&mut sim, args)?;
+    println!(
+        "{} frames served; {} without a kernel timestamp; {} reached the simulation more than {} µs after \
+         their receive time (worst by {:.1} µs)",
+        sim.frames(),
+        stats.unstamped,
+        stats.late,
+        LATE_NOTE_NS / 1000,
+        stats.worst_late_ns as f64 / 1e3
+    );
+    if sim.frames() > 0 {
+        println!(
+            "answer sent after the kernel's receive: {}; of that simulating: {}",
+            stats.answer.summary(),
+            stats.work.summary()
+        );
+    }
+    Ok(())
+}
+
+/// What the loop saw.
+#[derive(Debug, Default)]
+struct Stats {
+    /// Frames without a kernel timestamp (processed at the time they were read).
+    unstamped: u64,
+    /// Frames whose receive time the simulation had passed by more than [`LATE_NOTE_NS`].
+    late: u64,
+    /// The most the simulation had passed a frame's receive time, ns.
+    worst_late_ns: u64,
+    /// From the kernel's receive timestamp to the answer sent (without `--delay-us`'s hold).
+    answer: Histogram,
+    /// Of that, catching the simulation up and processing the frame.
+    work: Histogram,
+}
+
+/// Durations in 1 µs buckets up to 10 ms (longer ones in the last).
+#[derive(Debug)]
+struct Histogram {
+    counts: Vec<u32>,
+    max_ns: u64,
+}
+
+impl Default for Histogram {
+    fn default() -> Self {
+        Self {
+            counts: vec![0; 10_001],
+            max_ns: 0,
+        }
+    }
+}
+
+impl Histogram {
+    fn add(&mut self, ns: u64) {
+        let i = usize::try_from(ns / 1000)
+            .unwrap_or(usize::MAX)
+            .min(self.counts.len() - 1);
+        if let Some(c) = self.counts.get_mut(i) {
+            *c = c.saturating_add(1);
+        }
+        self.max_ns = self.max_ns.max(ns);
+    }
+
+    /// The `p` quantile (0..=1), µs (bucket upper edge).
+    fn quantile_us(&self, p: f64) -> u64 {
+        let total: u64 = self.counts.iter().map(|&c| u64::from(c)).sum();
+        let want = ((total as f64) * p).ceil().max(1.0) as u64;
+        let mut seen = 0;
+        for (i, &c) in self.counts.iter().enumerate() {
+            seen += u64::from(c);
+            if seen >= want {
+                return i as u64 + 1;
+            }
+        }
+        0
+    }
+
+    /// "p50 a, p99 b, max c µs".
+    fn summary(&self) -> String {
+        format!(
+            "p50 {}, p99 {}, max {:.0} µs",
+            self.quantile_us(0.5),
+            self.quantile_us(0.99),
+            self.max_ns as f64 / 1e3
+        )
+    }
+}
+
+/// The serve loop (see the module's Timing section).
+fn run(sim: &mut Simulation, sock: &RawSocket, args: &ServeArgs) -> Result<Stats, String> {
+    let start = monotonic_ns();
+    let end = args
+        .seconds
+        .map(|s| start.saturating_add((s.max(0.0) * 1e9) as u64));
+    let mut delay = args.delay_us.map(|max| Delay::new(max, args.delay_seed));
+    let mut stats = Stats::default();
+    let mut printed = Vec::new();
+    let mut buf = [0u8; 1600];
+    let mut next_flush = start + FLUSH_EVERY_NS;
+    loop {
+        // the clock is read before the socket: a frame not there yet arrives later
+        let now = monotonic_ns();
+        if let Some(rx) = sock.try_recv(&mut buf).map_err(|e| format!("receive: {e}"))? {
+            let rx_ns = rx.rx_ns.unwrap_or_else(|| {
+                stats.unstamped += 1;
+                now
+            });
+            let picked = monotonic_ns();
+            let held = match delay.as_mut() {
+                Some(d) => d.hold(rx_ns),
+                None => 0,
+            };
+            let begin = picked + held;
+            let t = rx_ns.saturating_sub(start);
+            let behind = sim.now_ns().saturating_sub(t);
+            if behind > LATE_NOTE_NS {
+                stats.late += 1;
+            }
+            stats.worst_late_ns = stats.worst_late_ns.max(behind);
+            sim.catch_up(t);
+            let frame = buf.get_mut(..rx.len).unwrap_or_default();
+            sim.exchange(frame);
+            sock.send(frame).map_err(|e| format!("send: {e}"))?;
+            let sent = monotonic_ns();
+            stats.work.add(sent.saturating_sub(begin));
+            stats.answer.add(sent.saturating_sub(rx_ns).saturating_sub(held));
+            if let Some(e) = sim.recording_error() {
+                return Err(format!("the pcap recording failed: {e}"));
+            }
+            // drain what queued up before simulating further
+            continue;
+        }
+        sim.catch_up(now.saturating_sub(start + IDLE_LAG_NS));
+        print_new_changes(sim, &mut printed);
+        if now >= next_flush {
+            next_flush = now + FLUSH_EVERY_NS;
+            flush_recording(sim, args)?;
+        }
+        if end.is_some_and(|e| now >= e) || STOP.load(Ordering::Relaxed) {
+            return Ok(stats);
+        }
+        if !args.busy_poll {
+            sock.wait(IDLE_WAIT).map_err(|e| format!("wait: {e}"))?;
+        }
+    }
+}
+
+/// Flushes the pcap recording: a write error ends `serve` with a message.
+fn flush_recording(sim: &mut Simulation, args: &ServeArgs) -> Result<(), String> {
+    match (&args.pcap, sim.flush()) {
+        (Some(p), Err(e)) => Err(format!("the pcap file {} is incomplete: {e}", p.display())),
+        _ => Ok(()),
+    }
+}
+
+/// `--delay-us`: holds each frame a seeded random time after its arrival
+/// (xorshift64, uniform in 0..=max µs), as a loaded machine would.
+struct Delay {
+    max_ns: u64,
+    state: u64,
+}
+
+impl Delay {
+    fn new(max_us: u64, seed: u64) -> Self {
+        Self {
+            max_ns: max_us.saturating_mul(1000),
+            // a fixed mix of the seed, never state 0
+            state: (seed.wrapping_add(0x9E37_79B9_7F4A_7C15) ^ 0xBF58_476D_1CE4_E5B9).max(1),
+        }
+    }
+
+    /// Sleeps until `arrival_ns` (monotonic) plus the next random delay;
+    /// returns how long it slept, ns.
+    fn hold(&mut self, arrival_ns: u64) -> u64 {
+        let mut x = self.state;
+        x ^= x << 13;
+        x ^= x >> 7;
+        x ^= x << 17;
+        self.state = x;
+        let until = arrival_ns.saturating_add(x % self.max_ns.saturating_add(1));
+        let now = monotonic_ns();
+        if until > now {
+            std::thread::sleep(Duration::from_nanos(until - now));
+        }
+        monotonic_ns().saturating_sub(now)
+    }
+}

@@ -1,0 +1,214 @@
+//! The command line as a newcomer meets it (issue 14): `--help` for every
+//! subcommand, unknown flags refused, and an output file that cannot be
+//! written refused up front with a non-zero exit and a message naming it,
+//! never a claim that a plot or a recording exists.
+#![allow(clippy::unwrap_used, clippy::expect_used, clippy::panic)]
+
+use std::path::PathBuf;
+use std::process::{Command, Output};
+
+fn hil_sim(args: &[&str]) -> Output {
+    Command::new(env!("CARGO_BIN_EXE_hil-sim"))
+        .args(args)
+        .output()
+        .expect("run hil-sim")
+}
+
+fn text(b: &[u8]) -> String {
+    String::from_utf8_lossy(b).into_owned()
+}
+
+/// A directory of this test's own, removed at the end.
+struct Scratch(PathBuf);
+
+impl Scratch {
+    fn new(name: &str) -> Self {
+        let d = std::env::temp_dir().join(format!("hil-sim-cli-{name}-{}", std::process::id()));
+        let _ = std::fs::remove_dir_all(&d);
+        std::fs::create_dir_all(&d).unwrap();
+        Self(d)
+    }
+    /// A path below a regular file: no one, not even root, can create it.
+    fn unwritable(&self, file: &str) -> PathBuf {
+        let blocker = self.0.join("not-a-directory");
+        std::fs::write(&blocker, b"a file").unwrap();
+        blocker.join(file)
+    }
+}
+
+impl Drop for Scratch {
+    fn drop(&mut self) {
+        let _ = std::fs::remove_dir_all(&self.0);
+    }
+}
+
+#[test]
+fn help_lists_the_subcommands() {
+    let o = hil_sim(&["--help"]);
+    assert!(o.status.success(), "{o:?}");
+    let out = text(&o.stdout);
+    for want in ["demo", "serve", "Usage: hil-sim"] {
+        assert!(out.contains(want), "`{want}` missing in:\n{out}");
+    }
+    assert!(out.ends_with('\n'), "help ends with a newline");
+}
+
+#[test]
+fn demo_help_lists_its_options() {
+    let o = hil_sim(&["demo", "--help"]);
+    assert!(o.status.success(), "{o:?}");
+    let out = text(&o.stdout);
+    for want in ["--pcap <FILE>", "--plot <FILE.svg>", "target/hil-sim-demo.svg"] {
+        assert!(out.contains(want), "`{want}` missing in:\n{out}");
+    }
+}
+
+#[test]
+fn serve_help_lists_its_options_not_the_test_ones() {
+    let o = hil_sim(&["serve", "--help"]);
+    assert!(o.status.success(), "{o:?}");
+    let out = text(&o.stdout);
+    for want in [
+        "--iface <IF>",
+        "--slaves <N>",
+        "--axes <1|2>",
+        "--pcap <FILE>",
+        "--seconds <S>",
+    ] {
+        assert!(out.contains(want), "`{want}` missing in:\n{out}");
+    }
+    assert!(
+        !out.contains("--delay-us"),
+        "test-only options stay hidden:\n{out}"
+    );
+}
+
+#[test]
+fn an_unknown_flag_is_refused() {
+    for args in [
+        &["demo", "--bogus"][..],
+        &["serve", "--iface", "lo", "--bogus"],
+        &["bogus"],
+    ] {
+        let o = hil_sim(args);
+        assert_eq!(o.status.code(), Some(2), "{args:?}: {o:?}");
+        let err = text(&o.stderr);
+        assert!(
+            err.contains("bogus"),
+            "{args:?}: the message names the argument: {err}"
+        );
+        assert!(o.stdout.is_empty(), "{args:?}: nothing ran: {}", text(&o.stdout));
+    }
+}
+
+#[test]
+fn an_out_of_range_value_is_refused() {
+    let o = hil_sim(&["serve", "--iface", "lo", "--slaves", "17"]);
+    assert_eq!(o.status.code(), Some(2), "{o:?}");
+    assert!(text(&o.stderr).contains("--slaves"));
+}
+
+#[test]
+fn demo_refuses_an_unwritable_plot_before_the_run() {
+    let s = Scratch::new("plot");
+    let plot = s.unwritable("x.svg");
+    let plot = plot.to_str().unwrap();
+    let o = hil_sim(&["demo", "--plot", plot]);
+    assert!(!o.status.success(), "{o:?}");
+    let (out, err) = (text(&o.stdout), text(&o.stderr));
+    assert!(err.contains(plot), "the message names the path: {err}");
+    assert!(!out.contains("plot:"), "no plot claimed: {out}");
+    assert!(!out.contains("found"), "refused before the run: {out}");
+}
+
+#[test]
+fn demo_refuses_an_unwritable_pcap_before_the_run() {
+    let s = Scratch::new("demo-pcap");
+    let pcap = s.unwritable("a.pcap");
+    let pcap = pcap.to_str().unwrap();
+    let plot = s.0.join("x.svg");
+    let o = hil_sim(&["demo", "--pcap", pcap, "--plot", plot.to_str().unwrap()]);
+    assert!(!o.status.success(), "{o:?}");
+    let (out, err) = (text(&o.stdout), text(&o.stderr));
+    assert!(err.contains(pcap), "the message names the path: {err}");
+    assert!(!out.contains("recording"), "no recording claimed: {out}");
+    assert!(!plot.exists(), "nothing ran, no plot");
+}
+
+#[test]
+fn demo_refuses_a_pcap_that_takes_no_data() {
+    // /dev/full opens but every write fails: the header is flushed at once
+    let o = hil_sim(&["demo", "--pcap", "/dev/full"]);
+    assert!(!o.status.success(), "{o:?}");
+    assert!(text(&o.stderr).contains("/dev/full"), "{}", text(&o.stderr));
+    assert!(!text(&o.stdout).contains("recording"));
+}
+
+#[test]
+fn serve_refuses_an_unwritable_pcap_before_opening_the_interface() {
+    let s = Scratch::new("serve-pcap");
+    let pcap = s.unwritable("a.pcap");
+    let pcap = pcap.to_str().unwrap();
+    // the interface does not exist either: the pcap is checked first
+    let o = hil_sim(&[
+        "serve",
+        "--iface",
+        "nonexistent0",
+        "--pcap",
+        pcap,
+        "--seconds",
+        "1",
+    ]);
+    assert!(!o.status.success(), "{o:?}");
+    let (out, err) = (text(&o.stdout), text(&o.stderr));
+    assert!(err.contains(pcap), "the message names the path: {err}");
+    assert!(!out.contains("recording"), "no recording claimed: {out}");
+}
+
+#[test]
+fn serve_needs_an_interface() {
+    let o = hil_sim(&["serve"]);
+    assert_eq!(o.status.code(), Some(2), "{o:?}");
+    assert!(text(&o.stderr).contains("--iface"));
+}
+
+#[test]
+fn demo_writes_the_plot_and_the_pcap_it_names() {
+    let s = Scratch::new("demo");
+    let (pcap, plot) = (s.0.join("run.pcap"), s.0.join("run.svg"));
+    let o = hil_sim(&[
+        "demo",
+        "--pcap",
+        pcap.to_str().unwrap(),
+        "--plot",
+        plot.to_str().unwrap(),
+    ]);
+    assert!(o.status.success(), "{o:?}");
+    let out = text(&o.stdout);
+    assert!(out.contains(&format!("plot: {}", plot.display())), "{out}");
+    assert!(
+        out.contains(&format!("recording frames to {}", pcap.display())),
+        "{out}"
+    );
+    let svg = std::fs::read_to_string(&plot).unwrap();
+    assert!(
+        svg.contains("<svg") && svg.trim_end().ends_with("</svg>"),
+        "a whole SVG"
+    );
+    let p = std::fs::read(&pcap).unwrap();
+    assert_eq!(p.get(..4), Some(&0xA1B2_3C4Du32.to_le_bytes()[..]), "pcap magic");
+    assert!(p.len() > 100_000, "frames recorded: {} bytes", p.len());
+}
+
+#[test]
+fn no_subcommand_runs_the_demo_with_the_default_plot() {
+    let s = Scratch::new("default");
+    let o = Command::new(env!("CARGO_BIN_EXE_hil-sim"))
+        .current_dir(&s.0)
+        .output()
+        .expect("run hil-sim");
+    assert!(o.status.success(), "{o:?}");
+    assert!(text(&o.stdout).contains("plot: target/hil-sim-demo.svg"));
+    let svg = std::fs::read_to_string(s.0.join("target/hil-sim-demo.svg")).unwrap();
+    assert!(svg.contains("<svg"));
+}

@@ -1,0 +1,96 @@
+//! A private network namespace with one end of a veth pair and `hil-sim
+//! serve` running inside it; the other end stays in this namespace for the
+//! master. Everything is removed on drop. Needs root ([`is_root`]).
+#![allow(clippy::unwrap_used, clippy::expect_used, clippy::panic, dead_code)]
+
+use std::process::{Child, Command, Stdio};
+use std::time::Duration;
+
+/// This process runs as root (network namespaces and raw sockets work).
+pub fn is_root() -> bool {
+    // SAFETY: geteuid has no preconditions.
+    #[allow(unsafe_code)]
+    unsafe {
+        libc::geteuid() == 0
+    }
+}
+
+/// The namespace, the veth pair and the server.
+pub struct Netns {
+    ns: String,
+    /// The master's end of the veth pair (in this namespace).
+    pub host_if: String,
+    server: Option<Child>,
+}
+
+fn ip(args: &[&str]) {
+    let st = Command::new("ip").args(args).status().expect("run ip");
+    assert!(st.success(), "ip {args:?} failed");
+}
+
+impl Netns {
+    /// Builds the namespace (names from this process' id and `tag`, one
+    /// letter) and starts `serve --iface <its end> <serve_args>` of `bin`.
+    pub fn new(bin: &str, tag: char, serve_args: &[&str]) -> Self {
+        let id = std::process::id() % 100_000;
+        let ns = format!("hilsim{id}{tag}");
+        let host_if = format!("hs{id}{tag}a");
+        let sim_if = format!("hs{id}{tag}b");
+        let _ = Command::new("ip")
+            .args(["netns", "del", &ns])
+            .stderr(Stdio::null())
+            .status();
+        ip(&["netns", "add", &ns]);
+        ip(&["link", "add", &host_if, "type", "veth", "peer", "name", &sim_if]);
+        ip(&["link", "set", &sim_if, "netns", &ns]);
+        ip(&["link", "set", &host_if, "up"]);
+        ip(&["-n", &ns, "link", "set", &sim_if, "up"]);
+        let server = Command::new("ip")
+            .args(["netns", "exec", &ns, bin, "serve", "--iface", &sim_if])
+            .args(serve_args)
+            .stdout(Stdio::inherit())
+            .spawn()
+            .expect("spawn hil-sim serve");
+        std::thread::sleep(Duration::from_millis(300));
+        Self {
+            ns,
+            host_if,
+            server: Some(server),
+        }
+    }
+}
+
+impl Netns {
+    /// Asks the server to stop (SIGTERM: it flushes its recording and prints
+    /// its summary), waits up to 5 s for it, then kills it.
+    pub fn stop_server(&mut self) {
+        let Some(mut s) = self.server.take() else { return };
+        if let Ok(pid) = i32::try_from(s.id()) {
+            // SAFETY: kill has no memory preconditions; pid is our child.
+            #[allow(unsafe_code)]
+            unsafe {
+                libc::kill(pid, libc::SIGTERM);
+            }
+        }
+        let end = std::time::Instant::now() + Duration::from_secs(5);
+        while std::time::Instant::now() < end {
+            if let Ok(Some(_)) = s.try_wait() {
+                return;
+            }
+            std::thread::sleep(Duration::from_millis(20));
+        }
+        let _ = s.kill();
+        let _ = s.wait();
+    }
+}
+
+impl Drop for Netns {
+    fn drop(&mut self) {
+        self.stop_server();
+        let _ = Command::new("ip")
+            .args(["link", "del", &self.host_if])
+            .stderr(Stdio::null())
+            .status();
+        let _ = Command::new("ip").args(["netns", "del", &self.ns]).status();
+    }
+}
