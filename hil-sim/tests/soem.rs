@@ -338,3 +338,39 @@ fn e002_e005_e080_e082_e056_e045_e029_e107_e015_soem_line_scan_sdo_info_pdo_dc_c
         fail_with(&line, &format!("line.py through SOEM failed: {status}"));
     }
 }
+
+/// EoE through SOEM as a user would (pysoem has no EoE call; the script uses
+/// its register access for SOEM's mailbox and EoE functions): on a line of 3
+/// drives nothing is in the send mailbox before the master used EoE (E-098);
+/// SOEM's exact set-IP request bytes (packed, addresses as little-endian
+/// UINT32) answered with result 0 (E-096); a Linux TAP in the master's
+/// namespace bridged to the drives' EoE with SOEM's fragmentation, and from
+/// that namespace `ping` (also 1200-byte pings, fragmented both ways) and
+/// the UDP parameter service (port 5011) of every drive (E-095).
+#[test]
+fn e096_e095_e098_soem_set_ip_ping_and_udp_through_a_tap_bridge() {
+    let python = match pysoem_python() {
+        Ok(p) => p,
+        Err(why) => {
+            eprintln!("soem EoE test: skipped, {why}");
+            return;
+        }
+    };
+    let _one = ONE_AT_A_TIME.lock().unwrap_or_else(|e| e.into_inner());
+    let dir = scratch("soem-eoe");
+    // A166 "IP address reference" as a fresh drive declares it (the UDP read's answer)
+    let a166 = drive::DriveObjects::default()
+        .object(drive::parameter_index(0, 166))
+        .and_then(|o| o.entry(0))
+        .expect("A166")
+        .default;
+    let line = Line::new("e", SLAVES, 200, &dir);
+    let status = line.run(
+        &python,
+        "eoe.py",
+        &["--slaves", &SLAVES.to_string(), "--a166", &a166.to_string()],
+    );
+    if !status.success() {
+        fail_with(&line, &format!("eoe.py through SOEM failed: {status}"));
+    }
+}
