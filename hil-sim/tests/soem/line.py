@@ -652,10 +652,7 @@ class Cycle:
 
     def stall(self, last=300):
         """The longest run of SYNC0 periods without a frame in the window
-        among the last `last` periods. From STALL_PERIODS on, the drive's
-        specified reactions may follow: AL 0033h after 5 late frames in a
-        row (E-046), event 78/3 (603Fh 8612h) after I423 = 10 ms without a
-        set-point (C-117)."""
+        among the last `last` periods."""
         run = longest = 0
         for ok in self.periods[-last:]:
             run = 0 if ok else run + 1
@@ -663,9 +660,12 @@ class Cycle:
         return longest
 
 
-# consecutive periods without an in-window frame from which the drive may
-# rightly leave Op or fault (its late-frame limit: 5)
-STALL_PERIODS = 5
+# the drives' specified reactions to a line without frames in time: AL 0033h
+# after 5 late frames in a row (E-046, dcsync's late-frame limit), event 78/3
+# (603Fh 8612h) after extrapolating longer than I423 = 10 ms (C-117)
+LATE_FRAME_LIMIT = 5
+I423_PERIODS = 10
+EXTRAPOLATION_OVERRUN = 0x8612
 # a run may be stalled by its machine this often (each is printed)
 MAX_STALLS = 3
 
@@ -690,7 +690,7 @@ SWITCH_ON_DISABLED = (0x4F, 0x40)
 READY = (0x6F, 0x21)
 SWITCHED_ON = (0x6F, 0x23)
 ENABLED = (0x6F, 0x27)
-FAULT = (0x4F, 0x08)
+FAULT = (0x08, 0x08)  # Fault or Fault reaction active
 
 
 def sw_is(sw, pattern):
@@ -746,16 +746,37 @@ class Line:
         return wkc
 
     def check_stalled(self, what, last=300):
-        """After a state or data error: was the line stalled (then the drive's
-        reaction is the specified one and the step is repeated), else fail."""
+        """After a state or data error: was it the drives' specified reaction
+        to a line the machine stalled? Then it is printed, and the caller
+        recovers and repeats the step; else it is a failure (False). A slave
+        out of Op must show AL 0033h after at least LATE_FRAME_LIMIT periods
+        without a frame in time; an axis fault without that must follow more
+        than I423 without frames, and axis A (603Fh is in its TxPDO) must show
+        8612h."""
+        m = self.m
         longest = self.cyc.stall(last)
-        if longest < STALL_PERIODS:
+        m.read_state()
+        codes = {s.al_status for s in m.slaves if s.state != OP}
+        if codes:
+            if codes != {0x0033}:
+                return False
+            need, reaction = LATE_FRAME_LIMIT, "AL 0033h"
+        else:
+            need, reaction = I423_PERIODS + 1, "event 78/3"
+            for row in self.axes:
+                a = row[0]
+                inp = self.inp[a.slave]
+                if sw_is(a.sw(inp), FAULT) and a.in_l.get(inp, 0x603F) != EXTRAPOLATION_OVERRUN:
+                    say(f"{a.name}: fault with 603Fh = {a.in_l.get(inp, 0x603F):04X}h, not {EXTRAPOLATION_OVERRUN:04X}h")
+                    return False
+        if longest < need:
+            say(f"(the longest run of periods without a frame in time was {longest}, {reaction} needs {need})")
             return False
         self.stalls.append(what)
         say(
             f"STALL: {what}, after {longest} SYNC0 periods in a row without a frame in the drives' window "
-            f"(the machine did not run the master or the simulator in time): the drives' reaction is the "
-            f"specified one; recovering and repeating the step ({len(self.stalls)} of at most {MAX_STALLS})"
+            f"(the machine did not run the master or the simulator in time): {reaction}, the drives' specified "
+            f"reaction; recovering and repeating the step ({len(self.stalls)} of at most {MAX_STALLS})"
         )
         if len(self.stalls) > MAX_STALLS:
             raise Fatal(f"the machine stalled the line {len(self.stalls)} times")
