@@ -124,6 +124,8 @@ impl Line {
         ip(&["-n", &master_ns, "link", "set", &master_if, "up"]);
         ip(&["-n", &sim_ns, "link", "set", &sim_if, "up"]);
         let serve_log = dir.join(format!("serve-{tag}.log"));
+        // SOEM_PCAP=1: serve records every frame (for a failure's evidence)
+        let pcap = std::env::var_os("SOEM_PCAP").map(|_| dir.join(format!("serve-{tag}.pcap")));
         let log = std::fs::File::create(&serve_log).expect("serve log");
         let mut server = Command::new("ip");
         server.args(["netns", "exec", &sim_ns]);
@@ -134,6 +136,10 @@ impl Line {
             .args([env!("CARGO_BIN_EXE_hil-sim"), "serve"])
             .args(["--iface", &sim_if, "--slaves", &slaves.to_string()])
             .args(["--seconds", &seconds.to_string()])
+            .args(
+                pcap.iter()
+                    .flat_map(|p| [std::ffi::OsStr::new("--pcap"), p.as_os_str()]),
+            )
             .stdout(log.try_clone().expect("log"))
             .stderr(log)
             .spawn()
@@ -209,6 +215,19 @@ impl Line {
 impl Drop for Line {
     fn drop(&mut self) {
         if let Some(mut s) = self.server.take() {
+            // SIGTERM first (`ip netns exec` and `chrt` exec serve, so this is
+            // serve's pid), then SIGKILL if it is still there after 2 s
+            if let Ok(pid) = i32::try_from(s.id()) {
+                // SAFETY: kill has no memory preconditions; the pid is our child's.
+                #[allow(unsafe_code)]
+                unsafe {
+                    libc::kill(pid, libc::SIGTERM);
+                }
+            }
+            let end = Instant::now() + Duration::from_secs(2);
+            while Instant::now() < end && matches!(s.try_wait(), Ok(None)) {
+                std::thread::sleep(Duration::from_millis(20));
+            }
             let _ = s.kill();
             let _ = s.wait();
         }
@@ -287,7 +306,7 @@ fn fail_with(line: &Line, what: &str) -> ! {
     let tail: Vec<&str> = serve.lines().rev().take(60).collect();
     let tail: Vec<&str> = tail.into_iter().rev().collect();
     panic!(
-        "{what}\n--- hil-sim serve ({}), last lines:\n{}",
+        "{what}\n--- hil-sim serve ({}), last lines:\n{}\n(SOEM_PCAP=1 records serve's frames next to its log)",
         line.serve_log.display(),
         tail.join("\n")
     );
