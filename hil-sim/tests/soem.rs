@@ -326,7 +326,7 @@ fn fail_with(line: &Line, what: &str) -> ! {
 /// sequence, a one-revolution csp move and a disable (E-034); 12 s of process
 /// data in Op, the cycles with a wrong working counter printed.
 #[test]
-fn e002_e005_e080_e082_e056_e045_e029_e107_e015_soem_line_scan_sdo_info_pdo_dc_cia402() {
+fn e002_e005_e080_e082_e045_e029_e015_soem_line_scan_sdo_info_pdo_dc_cia402() {
     let python = match pysoem_python() {
         Ok(p) => p,
         Err(why) => {
