@@ -318,7 +318,7 @@ fn fail_with(line: &Line, what: &str) -> ! {
 /// description through SDO Info (E-080, E-082); the default PDO assignment
 /// and mappings (E-048, E-049, E-054); refused SDOs with their abort codes
 /// (E-071, E-072); a different mapping and assignment written in Pre-Op and
-/// taken over by SOEM's config_map (E-056); the Pre-Op → Safe-Op refusals
+/// taken over by SOEM's config_map (a part of E-056); the Pre-Op → Safe-Op refusals
 /// 001Dh/001Eh (E-045, E-057, with EMCY A000h, E-028) and 0035h/0036h for
 /// SYNC0 cycles off the 250 µs grid or not k × A150 (E-029); DC SYNC0 at 1 ms
 /// with the master aligned to the reference clock (E-107), Safe-Op, Op
