@@ -395,3 +395,46 @@ fn e096_e095_e098_soem_set_ip_ping_and_udp_through_a_tap_bridge() {
         fail_with(&line, &format!("eoe.py through SOEM failed: {status}"));
     }
 }
+
+/// The firmware update as SOEM's `firm_update` sample does it (Init, the
+/// bootstrap mailbox from the SII, Bootstrap, `ecx_FOEwrite`, Init) with the
+/// update file of `tools/foe-image` (docs/flashing.md): a bit-flipped and a
+/// truncated file are refused (SOEM reports the FoE error answer as −5), a
+/// name that does not start with `firmware` gets 8001h (−10), the tool's
+/// file is taken, and the drive returns to Pre-Op. (That the file lands in
+/// the inactive slot and boots is checked in-process, where the slots can be
+/// seen: `tools/foe-image/tests/round_trip.rs`.)
+#[test]
+fn foe_image_through_soem_firm_update() {
+    let python = match pysoem_python() {
+        Ok(p) => p,
+        Err(why) => {
+            eprintln!("soem FoE test: skipped, {why}");
+            return;
+        }
+    };
+    let _one = ONE_AT_A_TIME.lock().unwrap_or_else(|e| e.into_inner());
+    let dir = scratch("soem-foe");
+    let body: Vec<u8> = (0..64 * 1024u32)
+        .map(|i| (i.wrapping_mul(2_654_435_761) >> 24) as u8)
+        .collect();
+    let good = foe_image::update_file(&body, 2).unwrap();
+    let mut flipped = good.clone();
+    flipped[16 + 20_000] ^= 0x04;
+    let truncated = good[..good.len() - 100].to_vec();
+    let path = |name: &str| dir.join(name);
+    for (name, data) in [("good", &good), ("flipped", &flipped), ("truncated", &truncated)] {
+        std::fs::write(path(name), data).unwrap();
+    }
+    let line = Line::new("f", 1, 120, &dir);
+    let arg = |name: &str| path(name).to_str().unwrap().to_string();
+    let (g, f, t) = (arg("good"), arg("flipped"), arg("truncated"));
+    let status = line.run(
+        &python,
+        "foe.py",
+        &["--good", &g, "--flipped", &f, "--truncated", &t],
+    );
+    if !status.success() {
+        fail_with(&line, &format!("foe.py through SOEM failed: {status}"));
+    }
+}

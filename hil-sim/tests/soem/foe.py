@@ -1,0 +1,111 @@
+#!/usr/bin/env python3
+"""The firmware update as SOEM's `firm_update` sample does it, with the
+update file `tools/foe-image` writes (docs/flashing.md).
+
+For drive 1 of the line: Init, the SyncManagers set to the bootstrap
+mailbox read from the SII (as firm_update and pysoem's
+examples/firmware_update.py do), Bootstrap, `ecx_FOEwrite` of a file, Init.
+SOEM reports an FoE error answer as -5 (EC_ERR_TYPE_FOE_ERROR) and the
+error 8001h "not found" as -10 (EC_ERR_TYPE_FOE_FILE_NOTFOUND); a positive
+result is the accepted download. Checks:
+  - a bit-flipped file and a truncated one are refused (the drive: 800Ch);
+  - a file name that does not start with "firmware" is refused (8001h);
+  - the tool's file itself is taken;
+  - the drive comes back to Pre-Op through Init afterwards.
+
+Run by `hil-sim/tests/soem.rs` as root inside the master's namespace.
+"""
+import argparse
+import struct
+import sys
+import time
+
+import pysoem
+
+failures = []
+
+# SOEM's FoE results (ethercattype.h)
+EC_ERR_TYPE_FOE_ERROR = 5
+EC_ERR_TYPE_FOE_FILE_NOTFOUND = 10
+
+
+def check(ok, what):
+    if not ok:
+        failures.append(what)
+        print(f"FAIL: {what}", flush=True)
+    return ok
+
+
+def say(*a):
+    print(*a, flush=True)
+
+
+def to_state(s, state, what):
+    s.state = state
+    s.write_state()
+    got = s.state_check(state, 3_000_000)
+    return check(got == state, f"{what}: state {got:#04x}, AL code {s.al_status:#06x}")
+
+
+def main():
+    ap = argparse.ArgumentParser(description=__doc__.split("\n")[0])
+    ap.add_argument("--iface", required=True)
+    ap.add_argument("--good", required=True, help="the update file foe-image wrote")
+    ap.add_argument("--flipped", required=True, help="the same with one bit of the body flipped")
+    ap.add_argument("--truncated", required=True, help="the same without its last 100 bytes")
+    args = ap.parse_args()
+    files = {k: open(getattr(args, k), "rb").read() for k in ("good", "flipped", "truncated")}
+    m = pysoem.Master()
+    m.open(args.iface)
+    try:
+        for _ in range(3):
+            n = m.config_init()
+            if n > 0:
+                break
+            time.sleep(0.5)
+        if not check(n > 0, "config_init found no slave"):
+            return 1
+        s = m.slaves[0]
+        say(f"drive 1: {s.name!r}, update file {len(files['good'])} bytes")
+        if not to_state(s, pysoem.INIT_STATE, "Init"):
+            return 1
+        # the bootstrap mailbox from the SII, as firm_update does
+        rx_addr, rx_len = struct.unpack("HH", s.eeprom_read(pysoem.SiiOffset.BOOT_RX_MBX))
+        tx_addr, tx_len = struct.unpack("HH", s.eeprom_read(pysoem.SiiOffset.BOOT_TX_MBX))
+        say(f"bootstrap mailbox: SM0 {rx_addr:#06x}/{rx_len}, SM1 {tx_addr:#06x}/{tx_len}")
+        s.amend_mbx(mailbox="out", start_address=rx_addr, size=rx_len)
+        s.amend_mbx(mailbox="in", start_address=tx_addr, size=tx_len)
+        if not to_state(s, pysoem.BOOT_STATE, "Init -> Bootstrap"):
+            return 1
+        for name, data, want, what in [
+            ("firmware.sc6f", files["flipped"], -EC_ERR_TYPE_FOE_ERROR, "bit-flipped file (800Ch)"),
+            ("firmware.sc6f", files["truncated"], -EC_ERR_TYPE_FOE_ERROR, "truncated file (800Ch)"),
+            ("image.sc6f", files["good"], -EC_ERR_TYPE_FOE_FILE_NOTFOUND, "name without 'firmware' (8001h)"),
+            ("firmware.sc6f", files["good"], None, "the tool's file"),
+        ]:
+            t = time.monotonic()
+            r = s.foe_write(name, 0, data, timeout=5_000_000)
+            dt = time.monotonic() - t
+            say(f"ecx_FOEwrite {name!r}, {len(data)} bytes: {r} ({dt:.2f} s) - {what}")
+            if want is None:
+                check(r > 0, f"{what}: accepted (result {r})")
+            else:
+                check(r == want, f"{what}: result {r}, expected {want}")
+        # what a master does after the download
+        to_state(s, pysoem.INIT_STATE, "Bootstrap -> Init")
+        # the standard mailbox again for Pre-Op (config_init set it up)
+        for _ in range(3):
+            if m.config_init() > 0:
+                break
+        to_state(m.slaves[0], pysoem.PREOP_STATE, "Init -> Pre-Op after the download")
+    finally:
+        m.close()
+    if failures:
+        say(f"\n{len(failures)} check(s) failed")
+        return 1
+    say("\nall checks passed")
+    return 0
+
+
+if __name__ == "__main__":
+    sys.exit(main())
