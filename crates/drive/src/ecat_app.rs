@@ -4,15 +4,11 @@
 //! event 52 is the drive's answer when the slave leaves Op by itself.
 
 use crate::dictionary::{LiveValues, WithLive};
-use crate::parameter_index;
 use ecat::esm::OpLoss;
 use ecat::{Application, DcRequest, PdoTimeout};
 use esc::AlStatusCode;
 
-/// A150 application cycle (U16 µs, spec §12).
-pub const A150: u16 = parameter_index(0, 150);
-/// A258 EtherCAT PDO timeout (U16 ms with special values, spec §13.1).
-pub const A258: u16 = parameter_index(0, 258);
+pub use crate::params::{A150, A258};
 
 /// A258 values with a special meaning (spec §13.1).
 pub mod a258 {

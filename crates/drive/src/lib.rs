@@ -34,6 +34,7 @@ pub mod doc;
 pub mod ecat_app;
 pub mod emcy;
 pub mod objects;
+pub mod params;
 pub mod pdo_image;
 pub mod runtime;
 

@@ -816,3 +816,17 @@ fn slot_access_equals_get_and_set() {
     }
     assert!(checked > 300, "{checked} slots");
 }
+
+/// A150's allowed cycle times are written down in three crates (the
+/// declaration's enumeration, `motion::cycle` for the axes, `dcsync` for the
+/// DC checks): the same six values everywhere (C-144, E-125).
+#[test]
+fn c144_e125_a150_values_agree_with_the_declaration() {
+    let declared: Vec<u32> = crate::objects::enumeration(crate::params::A150, 0)
+        .expect("A150 has an enumeration")
+        .iter()
+        .map(|&us| u32::try_from(us * 1000).unwrap())
+        .collect();
+    assert_eq!(declared, motion::cycle::APPLICATION_CYCLES_NS);
+    assert_eq!(declared, dcsync::validate::A150_VALUES_NS);
+}

@@ -7,42 +7,26 @@
 //! cycle. Units are the objects' (increments, inc/s, inc/s², inc/s³, 0.1 % of
 //! the rated torque, ms, µs).
 
+use core::cell::Cell;
+
 use crate::dictionary::{DriveObjects, Slot, SlotValue, Typed};
-use crate::{parameter_index, AXIS_B_CIA402, AXIS_B_MANUFACTURER};
+use crate::{AXIS_B_CIA402, AXIS_B_MANUFACTURER};
 use motion::scaling::AxisScaling;
 
-/// 1 rev = 2^20 increments (6092h default feed).
-const REV: i64 = 1 << 20;
+pub(crate) use crate::params::{
+    A150, A213, A291, A310, A340, A66, A67, E47, E48, E49, E80, I02, I101, I210, I46,
+};
 
-/// A150 application cycle time (µs, global).
-pub(crate) const A150: u16 = parameter_index(0, 150);
-/// A291 PLC cycle time (µs, global), the copy of 60C2h (C-114).
-pub(crate) const A291: u16 = parameter_index(0, 291);
-/// E47 / E49 causes of Switch on disabled (per axis).
-pub(crate) const E47: u16 = parameter_index(4, 47);
-pub(crate) const E49: u16 = parameter_index(4, 49);
-/// E48 device state (per axis).
-pub(crate) const E48: u16 = parameter_index(4, 48);
-/// A66 sources of the user status word (per axis, 16 elements).
-pub(crate) const A66: u16 = parameter_index(0, 66);
-/// A67 user-defined status word (per axis).
-pub(crate) const A67: u16 = parameter_index(0, 67);
-/// A340 velocity override, % (per axis).
-pub(crate) const A340: u16 = parameter_index(0, 340);
-/// E80 operating condition (per axis).
-pub(crate) const E80: u16 = parameter_index(4, 80);
-/// A213 fieldbus scaling (global; [0] process data: 1 native, 0 decimals).
-pub(crate) const A213: u16 = parameter_index(0, 213);
-/// A310 / A311 decimal places of velocities / accelerations (per axis).
-pub(crate) const A310: u16 = parameter_index(0, 310);
-/// I02 position encoder (per axis).
-pub(crate) const I02: u16 = parameter_index(8, 2);
-/// I46 reference retaining (per axis).
-pub(crate) const I46: u16 = parameter_index(8, 46);
-/// I101 / I102 / I103 sources of +LS, −LS and the reference switch.
-pub(crate) const I101: u16 = parameter_index(8, 101);
-/// I210 application control word (switch signals from the fieldbus).
-pub(crate) const I210: u16 = parameter_index(8, 210);
+/// Entry `index`:`sub`, or 0 with `misses` counted: the dictionary declares
+/// every entry the snapshot reads, with its default
+/// (`snapshot_reads_only_declared_entries`), so no value of the
+/// snapshot is written down twice.
+fn read_or_miss(od: &DriveObjects, index: u16, sub: u8, misses: &Cell<u32>) -> i64 {
+    od.get(index, sub).unwrap_or_else(|_| {
+        misses.set(misses.get().saturating_add(1));
+        0
+    })
+}
 
 /// The object window of one axis: CiA 402 objects at +800h, per-axis
 /// manufacturer parameters at +8000h for axis B.
@@ -73,14 +57,15 @@ impl Window {
     }
 
     /// Per-axis manufacturer entry `index`:`sub` ("SDO Info" numbering) of
-    /// this axis, or `default`.
-    pub fn param(self, od: &DriveObjects, index: u16, sub: u8, default: i64) -> i64 {
-        od.get(self.manufacturer(index), sub).unwrap_or(default)
+    /// this axis; 0 when it cannot be read (counted in `misses`).
+    pub fn param(self, od: &DriveObjects, index: u16, sub: u8, misses: &Cell<u32>) -> i64 {
+        read_or_miss(od, self.manufacturer(index), sub, misses)
     }
 
-    /// CiA 402 entry `index`:`sub` of this axis, or `default`.
-    pub fn get(self, od: &DriveObjects, index: u16, sub: u8, default: i64) -> i64 {
-        od.get(self.cia402(index), sub).unwrap_or(default)
+    /// CiA 402 entry `index`:`sub` of this axis; 0 when it cannot be read
+    /// (counted in `misses`).
+    pub fn get(self, od: &DriveObjects, index: u16, sub: u8, misses: &Cell<u32>) -> i64 {
+        read_or_miss(od, self.cia402(index), sub, misses)
     }
 
     /// Writes CiA 402 entry `index`:`sub` of this axis (clamped to the
@@ -345,7 +330,7 @@ impl Snapshot {
     /// configuration generation); the rest of the snapshot is kept.
     pub fn refresh_setpoints(&mut self, od: &DriveObjects, c: &CyclicSlots) {
         self.controlword = od.read_typed(c.controlword).unwrap_or(0);
-        self.mode = od.read_typed(c.mode).unwrap_or(8);
+        self.mode = od.read_typed(c.mode).unwrap_or(0);
         self.target_position = od.read_typed(c.target_position).unwrap_or(0);
         self.target_position_user = self.target_position;
         self.ip_setpoint = od.read_typed(c.ip_setpoint).unwrap_or(0);
@@ -361,79 +346,88 @@ impl Snapshot {
 
     /// Reads the snapshot of axis `w`.
     pub fn read(od: &DriveObjects, w: Window) -> Self {
-        let i32_ = |index: u16, sub: u8, d: i64| sat(w.get(od, index, sub, d), i32::MIN, i32::MAX);
-        let u32_ = |index: u16, sub: u8, d: i64| sat(w.get(od, index, sub, d), 0u32, u32::MAX);
-        let u16_ = |index: u16, sub: u8, d: i64| sat(w.get(od, index, sub, d), 0u16, u16::MAX);
-        let i16_ = |index: u16, sub: u8, d: i64| sat(w.get(od, index, sub, d), i16::MIN, i16::MAX);
-        let i8_ = |index: u16, sub: u8, d: i64| sat(w.get(od, index, sub, d), i8::MIN, i8::MAX);
-        let u8_ = |index: u16, sub: u8, d: i64| sat(w.get(od, index, sub, d), 0u8, u8::MAX);
-        let ramp = |index: u16| (u32_(index, 1, 3000), u16_(index, 2, 1));
-        Snapshot {
-            controlword: u16_(0x6040, 0, 0),
-            mode: i8_(0x6060, 0, 8),
-            target_position: i32_(0x607A, 0, 0),
-            ip_setpoint: i32_(0x60C1, 1, 0),
-            target_velocity: i32_(0x60FF, 0, 0),
-            target_torque: i16_(0x6071, 0, 0),
-            velocity_offset: i32_(0x60B1, 0, 0),
-            torque_offset: i16_(0x60B2, 0, 0),
-            max_torque: u16_(0x6072, 0, 3000),
-            torque_slope: u32_(0x6087, 0, 0),
-            profile_velocity: u32_(0x6081, 0, 10 * REV),
-            max_profile_velocity: u32_(0x607F, 0, 50 * REV),
-            acceleration: u32_(0x6083, 0, 100 * REV),
-            deceleration: u32_(0x6084, 0, 100 * REV),
-            quick_stop_deceleration: u32_(0x6085, 0, 1000 * REV),
-            jerk: u32_(0x60A4, 1, 0),
-            positioning_option: u16_(0x60F2, 0, 0),
-            quick_stop_option: i16_(0x605A, 0, 2),
-            fault_reaction_option: i16_(0x605E, 0, 2),
-            following_error_window: u32_(0x6065, 0, i64::from(u32::MAX)),
-            following_error_timeout_ms: u16_(0x6066, 0, 10),
-            software_min: i32_(0x607D, 1, 0),
-            software_max: i32_(0x607D, 2, 0),
-            polarity: u8_(0x607E, 0, 0),
-            homing_method: i8_(0x6098, 0, 35),
-            homing_fast: u32_(0x6099, 1, 2 * REV),
-            homing_slow: u32_(0x6099, 2, REV / 4),
-            homing_acceleration: u32_(0x609A, 0, 100 * REV),
-            home_offset: i32_(0x607C, 0, 0),
-            probe_function: u16_(0x60B8, 0, 0),
-            probe_source: [i16_(0x60D0, 1, 1), i16_(0x60D0, 2, 2)],
-            vl_target: i16_(0x6042, 0, 0),
-            vl_min: u32_(0x6046, 1, 0),
-            vl_max: u32_(0x6046, 2, 3000),
+        Self::read_counting(od, w).0
+    }
+
+    /// [`read`](Self::read) and how many entries could not be read (they
+    /// count as 0; none with the drive's dictionary).
+    pub fn read_counting(od: &DriveObjects, w: Window) -> (Self, u32) {
+        let misses = Cell::new(0);
+        let m = &misses;
+        let i32_ = |index: u16, sub: u8| sat(w.get(od, index, sub, m), i32::MIN, i32::MAX);
+        let u32_ = |index: u16, sub: u8| sat(w.get(od, index, sub, m), 0u32, u32::MAX);
+        let u16_ = |index: u16, sub: u8| sat(w.get(od, index, sub, m), 0u16, u16::MAX);
+        let i16_ = |index: u16, sub: u8| sat(w.get(od, index, sub, m), i16::MIN, i16::MAX);
+        let i8_ = |index: u16, sub: u8| sat(w.get(od, index, sub, m), i8::MIN, i8::MAX);
+        let u8_ = |index: u16, sub: u8| sat(w.get(od, index, sub, m), 0u8, u8::MAX);
+        let ramp = |index: u16| (u32_(index, 1), u16_(index, 2));
+        let snapshot = Snapshot {
+            controlword: u16_(0x6040, 0),
+            mode: i8_(0x6060, 0),
+            target_position: i32_(0x607A, 0),
+            ip_setpoint: i32_(0x60C1, 1),
+            target_velocity: i32_(0x60FF, 0),
+            target_torque: i16_(0x6071, 0),
+            velocity_offset: i32_(0x60B1, 0),
+            torque_offset: i16_(0x60B2, 0),
+            max_torque: u16_(0x6072, 0),
+            torque_slope: u32_(0x6087, 0),
+            profile_velocity: u32_(0x6081, 0),
+            max_profile_velocity: u32_(0x607F, 0),
+            acceleration: u32_(0x6083, 0),
+            deceleration: u32_(0x6084, 0),
+            quick_stop_deceleration: u32_(0x6085, 0),
+            jerk: u32_(0x60A4, 1),
+            positioning_option: u16_(0x60F2, 0),
+            quick_stop_option: i16_(0x605A, 0),
+            fault_reaction_option: i16_(0x605E, 0),
+            following_error_window: u32_(0x6065, 0),
+            following_error_timeout_ms: u16_(0x6066, 0),
+            software_min: i32_(0x607D, 1),
+            software_max: i32_(0x607D, 2),
+            polarity: u8_(0x607E, 0),
+            homing_method: i8_(0x6098, 0),
+            homing_fast: u32_(0x6099, 1),
+            homing_slow: u32_(0x6099, 2),
+            homing_acceleration: u32_(0x609A, 0),
+            home_offset: i32_(0x607C, 0),
+            probe_function: u16_(0x60B8, 0),
+            probe_source: [i16_(0x60D0, 1), i16_(0x60D0, 2)],
+            vl_target: i16_(0x6042, 0),
+            vl_min: u32_(0x6046, 1),
+            vl_max: u32_(0x6046, 2),
             vl_acceleration: ramp(0x6048),
             vl_deceleration: ramp(0x6049),
             vl_quick_stop: ramp(0x604A),
-            control_cycle_us: sat(od.get(A150, 0).unwrap_or(1000), 0u16, u16::MAX),
-            period_value: u8_(0x60C2, 1, 1),
-            period_index: i8_(0x60C2, 2, -3),
-            override_percent: sat(w.param(od, A340, 0, 100), 0u16, u16::MAX),
-            a66: core::array::from_fn(|k| sat(w.param(od, A66, k as u8 + 1, 0), 0u32, u32::MAX)),
-            a66_used: (1..=16).any(|sub| w.param(od, A66, sub, 0) != 0),
-            i02: sat(w.param(od, I02, 0, 0), 0u8, u8::MAX),
-            i46: sat(w.param(od, I46, 0, 0), 0u8, u8::MAX),
+            control_cycle_us: sat(read_or_miss(od, A150, 0, m), 0u16, u16::MAX),
+            period_value: u8_(0x60C2, 1),
+            period_index: i8_(0x60C2, 2),
+            override_percent: sat(w.param(od, A340, 0, m), 0u16, u16::MAX),
+            a66: core::array::from_fn(|k| sat(w.param(od, A66, k as u8 + 1, m), 0u32, u32::MAX)),
+            a66_used: (1..=16).any(|sub| w.param(od, A66, sub, m) != 0),
+            i02: sat(w.param(od, I02, 0, m), 0u8, u8::MAX),
+            i46: sat(w.param(od, I46, 0, m), 0u8, u8::MAX),
             switch_source: [
-                sat(w.param(od, I101, 0, 0), 0u8, u8::MAX),
-                sat(w.param(od, I101 + 1, 0, 0), 0u8, u8::MAX),
-                sat(w.param(od, I101 + 2, 0, 1), 0u8, u8::MAX),
+                sat(w.param(od, I101, 0, m), 0u8, u8::MAX),
+                sat(w.param(od, I101 + 1, 0, m), 0u8, u8::MAX),
+                sat(w.param(od, I101 + 2, 0, m), 0u8, u8::MAX),
             ],
-            i210: sat(w.param(od, I210, 0, 0), 0u16, u16::MAX),
-            gear: (u32_(0x6091, 1, 1), u32_(0x6091, 2, 1)),
-            feed: (u32_(0x6092, 1, REV), u32_(0x6092, 2, 1)),
-            modulo_length: i32_(0x607B, 2, 0),
-            target_position_user: i32_(0x607A, 0, 0),
-            ip_setpoint_user: i32_(0x60C1, 1, 0),
-            decimals: if od.get(A213, 1).unwrap_or(1) == 0 {
+            i210: sat(w.param(od, I210, 0, m), 0u16, u16::MAX),
+            gear: (u32_(0x6091, 1), u32_(0x6091, 2)),
+            feed: (u32_(0x6092, 1), u32_(0x6092, 2)),
+            modulo_length: i32_(0x607B, 2),
+            target_position_user: i32_(0x607A, 0),
+            ip_setpoint_user: i32_(0x60C1, 1),
+            decimals: if read_or_miss(od, A213, 1, m) == 0 {
                 (
-                    sat(w.param(od, A310, 0, 0), 0u8, 9),
-                    sat(w.param(od, A310 + 1, 0, 0), 0u8, 9),
+                    sat(w.param(od, A310, 0, m), 0u8, 9),
+                    sat(w.param(od, A310 + 1, 0, m), 0u8, 9),
                 )
             } else {
                 (0, 0)
             },
-        }
+        };
+        (snapshot, misses.get())
     }
 
     /// The scaling of 6091h/6092h (polarity is applied separately); the

@@ -882,3 +882,37 @@ fn cyclic_slots_resolve_every_entry_on_both_axes() {
         seen.push(s);
     }
 }
+
+/// The snapshot reads only entries the dictionary declares, on both axes
+/// and with the decimal places of A213 = 0, so none of its values falls back
+/// to a number written down a second time (the defaults live in the object
+/// declaration); a fresh dictionary gives the declared defaults.
+#[test]
+fn snapshot_reads_only_declared_entries() {
+    use crate::axis::snapshot::{Snapshot, Window, A213};
+    let mut od = DriveObjects::new();
+    for axis in [0, 1] {
+        let (s, misses) = Snapshot::read_counting(&od, Window { axis });
+        assert_eq!(misses, 0, "axis {axis}");
+        assert_eq!(
+            i64::from(s.mode),
+            od.get(Window { axis }.cia402(0x6060), 0).unwrap()
+        );
+        assert_eq!(
+            i64::from(s.max_torque),
+            od.get(Window { axis }.cia402(0x6072), 0).unwrap()
+        );
+        assert_eq!(
+            i64::from(s.following_error_window),
+            od.get(Window { axis }.cia402(0x6065), 0).unwrap()
+        );
+    }
+    od.set(A213, 1, 0).unwrap();
+    for axis in [0, 1] {
+        assert_eq!(
+            Snapshot::read_counting(&od, Window { axis }).1,
+            0,
+            "axis {axis}, A213 = 0"
+        );
+    }
+}

@@ -91,35 +91,9 @@ use store::{Flash, ParamStore, StoreError};
 pub use dcsync;
 pub use dcsync::{CycleCommand, FrameTiming, Pll, Step, SyncError};
 
-/// A00 "Save values": [0] start (sub 1), [1] progress (sub 2), [2] result (sub 3),
-/// in the SDO-Info numbering the runtime always uses.
-const A00: u16 = crate::parameter_index(0, 0);
-/// A254 station alias, A255 device state, A256 station address, A257 diagnosis texts.
-const A254: u16 = crate::parameter_index(0, 254);
-const A255: u16 = crate::parameter_index(0, 255);
-const A256: u16 = crate::parameter_index(0, 256);
-const A257: u16 = crate::parameter_index(0, 257);
-/// A149 cycle sequence, A150 cycle time (µs).
-const A149: u16 = crate::parameter_index(0, 149);
-const A150: u16 = crate::parameter_index(0, 150);
-/// A261 sync diagnostics: `[k]` is sub `k + 1`.
-const A261: u16 = crate::parameter_index(0, 261);
-/// A290 PLL control, A292 phase offset (µs), A296 measured cycle (µs), A298 status.
-const A290: u16 = crate::parameter_index(0, 290);
-/// A287 DC-Sync optimisation: [0] start, [1] progress, [2] result, [3]/[4]
-/// proposed A292 min/max, [5] end of frame → SYNC0, [6] frame duration,
-/// [7] SYNC0 → Rx (µs); `[k]` is sub `k + 1`.
-const A287: u16 = crate::parameter_index(0, 287);
-/// A291 PLC cycle time (µs).
-const A291: u16 = crate::parameter_index(0, 291);
-const A292: u16 = crate::parameter_index(0, 292);
-const A296: u16 = crate::parameter_index(0, 296);
-const A298: u16 = crate::parameter_index(0, 298);
-
-/// E43 event cause, E59 projected fieldbus identification, E82 event type.
-const E43: u16 = crate::parameter_index(4, 43);
-const E59: u16 = crate::parameter_index(4, 59);
-const E82: u16 = crate::parameter_index(4, 82);
+use crate::params::{
+    A00, A149, A150, A254, A255, A256, A257, A261, A287, A290, A291, A292, A296, A298, E43, E59, E82,
+};
 
 /// This firmware's fieldbus identification (EtherCAT), compared with the
 /// projected one (E59\[2\], [`Drive::set_projected_fieldbus`]) for event 52

@@ -1,0 +1,74 @@
+//! The manufacturer parameters the firmware itself reads or writes, by name
+//! (axis-A / global index, `parameter_index(group, line)`; axis B at +8000h
+//! through the axis' window). Declared once here; their entries (type,
+//! range, default) are in [`crate::objects`].
+
+use crate::parameter_index;
+
+/// A00 "Save values": \[0\] start (sub 1), \[1\] progress (sub 2), \[2\] result (sub 3),
+/// in the SDO-Info numbering the runtime always uses.
+pub const A00: u16 = parameter_index(0, 0);
+/// A254 station alias.
+pub const A254: u16 = parameter_index(0, 254);
+/// A255 device state (ESM state, +16 with an error).
+pub const A255: u16 = parameter_index(0, 255);
+/// A256 station address.
+pub const A256: u16 = parameter_index(0, 256);
+/// A257 diagnosis (Er codes and texts).
+pub const A257: u16 = parameter_index(0, 257);
+/// A149 cycle sequence.
+pub const A149: u16 = parameter_index(0, 149);
+/// A150 application cycle time, µs (250 … 8000, C-144).
+pub const A150: u16 = parameter_index(0, 150);
+/// A261 sync diagnostics: `[k]` is sub `k + 1`.
+pub const A261: u16 = parameter_index(0, 261);
+/// A290 PLL control.
+pub const A290: u16 = parameter_index(0, 290);
+/// A287 DC-Sync optimisation: \[0\] start, \[1\] progress, \[2\] result, \[3\]/\[4\]
+/// proposed A292 min/max, \[5\] end of frame → SYNC0, \[6\] frame duration,
+/// \[7\] SYNC0 → Rx (µs); `[k]` is sub `k + 1`.
+pub const A287: u16 = parameter_index(0, 287);
+/// A291 PLC cycle time (µs).
+pub const A291: u16 = parameter_index(0, 291);
+/// A292 phase offset of the drive task after SYNC0, µs.
+pub const A292: u16 = parameter_index(0, 292);
+/// A296 measured SYNC0 cycle, µs.
+pub const A296: u16 = parameter_index(0, 296);
+/// A298 PLL status.
+pub const A298: u16 = parameter_index(0, 298);
+
+/// E43 event cause.
+pub const E43: u16 = parameter_index(4, 43);
+/// E59 projected fieldbus identification (\[2\]).
+pub const E59: u16 = parameter_index(4, 59);
+/// E82 event type.
+pub const E82: u16 = parameter_index(4, 82);
+
+/// E47 causes of Switch on disabled (per axis).
+pub const E47: u16 = parameter_index(4, 47);
+/// E49 causes of Switch on disabled, second word (per axis).
+pub const E49: u16 = parameter_index(4, 49);
+/// E48 device state (per axis).
+pub const E48: u16 = parameter_index(4, 48);
+/// A66 sources of the user status word (per axis, 16 elements).
+pub const A66: u16 = parameter_index(0, 66);
+/// A67 user-defined status word (per axis).
+pub const A67: u16 = parameter_index(0, 67);
+/// A340 velocity override, % (per axis).
+pub const A340: u16 = parameter_index(0, 340);
+/// E80 operating condition (per axis).
+pub const E80: u16 = parameter_index(4, 80);
+/// A213 fieldbus scaling (global; \[0\] process data: 1 native, 0 decimals).
+pub const A213: u16 = parameter_index(0, 213);
+/// A310 / A311 decimal places of velocities / accelerations (per axis).
+pub const A310: u16 = parameter_index(0, 310);
+/// I02 position encoder (per axis).
+pub const I02: u16 = parameter_index(8, 2);
+/// I46 reference retaining (per axis).
+pub const I46: u16 = parameter_index(8, 46);
+/// I101 / I102 / I103 sources of +LS, −LS and the reference switch.
+pub const I101: u16 = parameter_index(8, 101);
+/// I210 application control word (switch signals from the fieldbus).
+pub const I210: u16 = parameter_index(8, 210);
+/// A258 EtherCAT PDO timeout (U16 ms with special values, spec §13.1).
+pub const A258: u16 = parameter_index(0, 258);
