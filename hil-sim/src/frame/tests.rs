@@ -1,0 +1,430 @@
+extern crate std;
+use super::testutil::*;
+use super::*;
+use crate::esc::{Esc, EscConfig};
+use ::esc::{regs, Fmmu, SmControl, SmDirection, SmMode, SyncManager};
+use std::vec::Vec;
+
+fn esc_with_type(t: u8) -> Esc {
+    Esc::new(
+        EscConfig {
+            esc_type: t,
+            ..EscConfig::default()
+        },
+        &[],
+    )
+}
+
+#[test]
+fn command_codes_round_trip() {
+    for c in 0..=255u8 {
+        assert_eq!(Command::from_code(c).code(), c);
+    }
+    assert_eq!(Command::from_code(12), Command::Lrw);
+    assert_eq!(Command::from_code(14), Command::Frmw);
+    assert!(Command::Lrd.is_logical());
+    assert!(!Command::Fprd.is_logical());
+}
+
+#[test]
+fn aprd_on_three_slaves_addresses_by_position() {
+    let (mut a, mut b, mut c) = (esc_with_type(0x11), esc_with_type(0x22), esc_with_type(0x33));
+    let mut f = build(&[
+        (Command::Aprd, phys(pos(0), regs::TYPE), &[0]),
+        (Command::Aprd, phys(pos(1), regs::TYPE), &[0]),
+        (Command::Aprd, phys(pos(2), regs::TYPE), &[0]),
+        (Command::Aprd, phys(pos(3), regs::TYPE), &[0xAB]),
+    ]);
+    process_frame(&mut [&mut a, &mut b, &mut c], &mut f, 0).unwrap();
+    let r = parse(&mut f);
+    assert_eq!(r[0].data, [0x11]);
+    assert_eq!(r[1].data, [0x22]);
+    assert_eq!(r[2].data, [0x33]);
+    for d in &r[..3] {
+        assert_eq!(d.wkc, 1);
+    }
+    // nobody at position 3: data untouched, WKC 0
+    assert_eq!(r[3].data, [0xAB]);
+    assert_eq!(r[3].wkc, 0);
+    // every slave counted ADP up once
+    assert_eq!(r[0].addr & 0xFFFF, 3);
+    assert_eq!(r[1].addr & 0xFFFF, 2);
+}
+
+#[test]
+fn brd_wkc_counts_every_slave_and_ors_data() {
+    let (mut a, mut b, mut c) = (esc_with_type(0x01), esc_with_type(0x02), esc_with_type(0x04));
+    let (data, wkc) = xfer(
+        &mut [&mut a, &mut b, &mut c],
+        Command::Brd,
+        phys(0, regs::TYPE),
+        &[0],
+        0,
+    );
+    assert_eq!(wkc, 3);
+    assert_eq!(data, [0x07]);
+}
+
+#[test]
+fn bwr_then_brd_wkc() {
+    let (mut a, mut b) = (esc_with_type(1), esc_with_type(1));
+    let mut line = [&mut a, &mut b];
+    let (_, wkc) = xfer(&mut line, Command::Bwr, phys(0, 0x0F00), &[0x5A, 0xA5], 0);
+    assert_eq!(wkc, 2);
+    let (data, wkc) = xfer(&mut line, Command::Brd, phys(0, 0x0F00), &[0, 0], 0);
+    assert_eq!(wkc, 2);
+    assert_eq!(data, [0x5A, 0xA5]);
+    let mut buf = [0u8; 2];
+    b.read_reg(0x0F00, &mut buf);
+    assert_eq!(buf, [0x5A, 0xA5]);
+}
+
+#[test]
+fn apwr_station_address_then_fprd() {
+    let (mut a, mut b) = (esc_with_type(0x11), esc_with_type(0x22));
+    let mut line = [&mut a, &mut b];
+    let (_, wkc) = xfer(
+        &mut line,
+        Command::Apwr,
+        phys(pos(0), regs::STATION_ADDRESS),
+        &0x1000u16.to_le_bytes(),
+        0,
+    );
+    assert_eq!(wkc, 1);
+    let (_, wkc) = xfer(
+        &mut line,
+        Command::Apwr,
+        phys(pos(1), regs::STATION_ADDRESS),
+        &0x1001u16.to_le_bytes(),
+        0,
+    );
+    assert_eq!(wkc, 1);
+    let (data, wkc) = xfer(&mut line, Command::Fprd, phys(0x1001, regs::TYPE), &[0], 0);
+    assert_eq!((data.as_slice(), wkc), (&[0x22u8][..], 1));
+    let (data, wkc) = xfer(&mut line, Command::Fprd, phys(0x1000, regs::TYPE), &[0], 0);
+    assert_eq!((data.as_slice(), wkc), (&[0x11u8][..], 1));
+    let (_, wkc) = xfer(&mut line, Command::Fprd, phys(0x1002, regs::TYPE), &[0], 0);
+    assert_eq!(wkc, 0);
+    assert_eq!(a.station_address(), 0x1000);
+    assert_eq!(b.station_address(), 0x1001);
+}
+
+#[test]
+fn fprd_matches_alias_only_when_enabled() {
+    let mut sii = [0u8; 16];
+    sii[8..10].copy_from_slice(&0x0042u16.to_le_bytes()); // word 4: alias
+    let mut a = Esc::new(EscConfig::default(), &sii);
+    let (_, wkc) = xfer1(&mut a, Command::Fprd, phys(0x0042, regs::TYPE), &[0], 0);
+    assert_eq!(wkc, 0);
+    // DL control bit 24: station alias addressing
+    xfer1(
+        &mut a,
+        Command::Apwr,
+        phys(0, regs::DL_CONTROL),
+        &0x0100_0001u32.to_le_bytes(),
+        0,
+    );
+    let (_, wkc) = xfer1(&mut a, Command::Fprd, phys(0x0042, regs::TYPE), &[0], 0);
+    assert_eq!(wkc, 1);
+}
+
+#[test]
+fn fprw_counts_three() {
+    let mut a = esc_with_type(1);
+    xfer1(
+        &mut a,
+        Command::Apwr,
+        phys(0, regs::STATION_ADDRESS),
+        &0x1000u16.to_le_bytes(),
+        0,
+    );
+    a.write_reg(0x0F10, &[1, 2]);
+    let (data, wkc) = xfer1(&mut a, Command::Fprw, phys(0x1000, 0x0F10), &[9, 8], 0);
+    assert_eq!(wkc, 3);
+    assert_eq!(data, [1, 2], "read-write returns the old value");
+    let mut buf = [0u8; 2];
+    a.read_reg(0x0F10, &mut buf);
+    assert_eq!(buf, [9, 8]);
+    // APRW on a read-only register: still read and "written" (+3), value unchanged
+    let (data, wkc) = xfer1(&mut a, Command::Aprw, phys(0, regs::TYPE), &[0x99], 0);
+    assert_eq!((data[0], wkc), (1, 3));
+    let mut t = [0u8; 1];
+    a.read_reg(regs::TYPE, &mut t);
+    assert_eq!(t[0], 1);
+}
+
+#[test]
+fn armw_distributes_reference_value() {
+    let (mut a, mut b, mut c) = (esc_with_type(1), esc_with_type(1), esc_with_type(1));
+    b.write_reg(0x0F20, &0xDEAD_BEEFu32.to_le_bytes());
+    // reference is position 1
+    let (data, wkc) = xfer(
+        &mut [&mut a, &mut b, &mut c],
+        Command::Armw,
+        phys(pos(1), 0x0F20),
+        &[0; 4],
+        0,
+    );
+    assert_eq!(data, 0xDEAD_BEEFu32.to_le_bytes());
+    assert_eq!(wkc, 3);
+    let mut buf = [0u8; 4];
+    c.read_reg(0x0F20, &mut buf);
+    assert_eq!(u32::from_le_bytes(buf), 0xDEAD_BEEF);
+    // slave 0 comes before the reference: it writes what the master sent
+    a.read_reg(0x0F20, &mut buf);
+    assert_eq!(u32::from_le_bytes(buf), 0);
+}
+
+#[test]
+fn frmw_reads_at_configured_slave_writes_others() {
+    let (mut a, mut b) = (esc_with_type(1), esc_with_type(1));
+    let mut line = [&mut a, &mut b];
+    xfer(
+        &mut line,
+        Command::Apwr,
+        phys(pos(0), regs::STATION_ADDRESS),
+        &0x1000u16.to_le_bytes(),
+        0,
+    );
+    xfer(
+        &mut line,
+        Command::Apwr,
+        phys(pos(1), regs::STATION_ADDRESS),
+        &0x1001u16.to_le_bytes(),
+        0,
+    );
+    a.write_reg(0x0F20, &[7, 7]);
+    let (data, wkc) = xfer(
+        &mut [&mut a, &mut b],
+        Command::Frmw,
+        phys(0x1000, 0x0F20),
+        &[0, 0],
+        0,
+    );
+    assert_eq!((data.as_slice(), wkc), (&[7u8, 7][..], 2));
+    let mut buf = [0u8; 2];
+    b.read_reg(0x0F20, &mut buf);
+    assert_eq!(buf, [7, 7]);
+}
+
+/// Configures SM2 (outputs, 3-buffer) at 0x1100 and SM3 (inputs) at 0x1400,
+/// and FMMU0 (write) / FMMU1 (read) at `log_out` / `log_in`.
+fn configure_pd(esc: &mut Esc, log_out: u32, log_in: u32, len: u16) {
+    let sm2 = SyncManager {
+        start: 0x1100,
+        length: len,
+        control: SmControl::new(SmMode::Buffered, SmDirection::MasterWrite, true, true).0,
+        status: 0,
+        activate: 1,
+        pdi_control: 0,
+    };
+    let sm3 = SyncManager {
+        start: 0x1400,
+        length: len,
+        control: SmControl::new(SmMode::Buffered, SmDirection::MasterRead, true, false).0,
+        ..sm2
+    };
+    let f0 = Fmmu {
+        logical_start: log_out,
+        length: len,
+        logical_start_bit: 0,
+        logical_stop_bit: 7,
+        physical_start: 0x1100,
+        physical_start_bit: 0,
+        kind: Fmmu::WRITE,
+        activate: 1,
+    };
+    let f1 = Fmmu {
+        logical_start: log_in,
+        physical_start: 0x1400,
+        kind: Fmmu::READ,
+        ..f0
+    };
+    for (addr, bytes) in [
+        (regs::sm(2), &sm2.to_bytes()[..]),
+        (regs::sm(3), &sm3.to_bytes()[..]),
+        (regs::fmmu(0), &f0.to_bytes()[..]),
+        (regs::fmmu(1), &f1.to_bytes()[..]),
+    ] {
+        let (_, wkc) = xfer1(esc, Command::Apwr, phys(0, addr), bytes, 0);
+        assert_eq!(wkc, 1);
+    }
+}
+
+#[test]
+fn lrw_through_fmmus_on_two_slaves() {
+    use ::esc::Pdi;
+    let (mut a, mut b) = (esc_with_type(1), esc_with_type(1));
+    // logical image: outputs a[0..4] b[4..8], inputs a[8..12] b[12..16]
+    configure_pd(&mut a, 0x0001_0000, 0x0001_0008, 4);
+    configure_pd(&mut b, 0x0001_0004, 0x0001_000C, 4);
+    a.write(0x1400, &[0xA0, 0xA1, 0xA2, 0xA3]).unwrap();
+    b.write(0x1400, &[0xB0, 0xB1, 0xB2, 0xB3]).unwrap();
+    let mut image: Vec<u8> = (1..=8).collect();
+    image.extend_from_slice(&[0; 8]);
+    let mut f = build(&[(Command::Lrw, 0x0001_0000, &image)]);
+    process_frame(&mut [&mut a, &mut b], &mut f, 0).unwrap();
+    let r = parse(&mut f).remove(0);
+    assert_eq!(r.wkc, 6, "each slave: +1 read, +2 write");
+    assert_eq!(&r.data[..8], &[1, 2, 3, 4, 5, 6, 7, 8], "outputs pass through");
+    assert_eq!(&r.data[8..], &[0xA0, 0xA1, 0xA2, 0xA3, 0xB0, 0xB1, 0xB2, 0xB3]);
+    let mut out = [0u8; 4];
+    a.read(0x1100, &mut out).unwrap();
+    assert_eq!(out, [1, 2, 3, 4]);
+    b.read(0x1100, &mut out).unwrap();
+    assert_eq!(out, [5, 6, 7, 8]);
+
+    // LRD sees only the inputs (+1 each), LWR only the outputs (+1 each)
+    let (_, wkc) = xfer(&mut [&mut a, &mut b], Command::Lrd, 0x0001_0000, &[0; 16], 0);
+    assert_eq!(wkc, 2);
+    let (_, wkc) = xfer(&mut [&mut a, &mut b], Command::Lwr, 0x0001_0000, &[0; 16], 0);
+    assert_eq!(wkc, 2);
+    // an LRW that maps nothing
+    let (_, wkc) = xfer(&mut [&mut a, &mut b], Command::Lrw, 0x0002_0000, &[0; 16], 0);
+    assert_eq!(wkc, 0);
+}
+
+#[test]
+fn lrw_on_pdi_deactivated_sm_does_not_count() {
+    use ::esc::{sm::pdi_control, Pdi};
+    let mut a = esc_with_type(1);
+    configure_pd(&mut a, 0x0001_0000, 0x0001_0008, 4);
+    // the slave deactivates SM2 (still in PreOp)
+    a.write(regs::sm(2) + 7, &[pdi_control::DEACTIVATE]).unwrap();
+    let (_, wkc) = xfer1(&mut a, Command::Lrw, 0x0001_0000, &[1; 12], 0);
+    assert_eq!(wkc, 1, "only the inputs count");
+}
+
+#[test]
+fn malformed_frames_are_errors_without_panic() {
+    let mut a = esc_with_type(1);
+    let good = build(&[
+        (Command::Aprd, phys(0, 0), &[0; 4]),
+        (Command::Aprd, phys(0, 0), &[0; 4]),
+    ]);
+    // every truncation of a valid frame: no panic; short ones are errors
+    for n in 0..good.len() {
+        let mut f = good[..n].to_vec();
+        let r = process_frame(&mut [&mut a], &mut f, 0);
+        // the datagram area ends at byte 16 + 2*16 = 48; shorter prefixes are errors
+        if n < 48 {
+            assert!(r.is_err(), "prefix {n}");
+            assert_eq!(f, good[..n], "untouched");
+        }
+    }
+    // wrong EtherType: error, untouched
+    let mut f = good.clone();
+    f[12] = 0x08;
+    f[13] = 0x00;
+    let before = f.clone();
+    assert_eq!(
+        process_frame(&mut [&mut a], &mut f, 0),
+        Err(FrameError::NotEthercat(0x0800))
+    );
+    assert_eq!(f, before);
+    // EtherCAT length field larger than the frame
+    let mut f = good.clone();
+    f[14] = 0xFF;
+    f[15] = 0x17;
+    assert_eq!(
+        process_frame(&mut [&mut a], &mut f, 0),
+        Err(FrameError::LengthMismatch)
+    );
+    // datagram length past the area
+    let mut f = good.clone();
+    f[16 + 6] = 0xF0;
+    let before = f.clone();
+    assert_eq!(
+        process_frame(&mut [&mut a], &mut f, 0),
+        Err(FrameError::MalformedDatagram)
+    );
+    assert_eq!(f, before);
+    // "more follows" on the last datagram
+    let mut f = good.clone();
+    f[16 + 16 + 7] |= 0x80;
+    assert_eq!(
+        process_frame(&mut [&mut a], &mut f, 0),
+        Err(FrameError::MalformedDatagram)
+    );
+    // wrong frame type
+    let mut f = good.clone();
+    f[15] = (f[15] & 0x0F) | 0x40;
+    assert_eq!(
+        process_frame(&mut [&mut a], &mut f, 0),
+        Err(FrameError::UnsupportedType(4))
+    );
+    // garbage of all lengths and patterns: never a panic
+    for n in 0..80usize {
+        for pat in [0x00u8, 0xFF, 0x88, 0xA4, 0x12] {
+            let mut f: Vec<u8> = (0..n).map(|i| pat.wrapping_add(i as u8)).collect();
+            if n > 14 {
+                f[12] = 0x88;
+                f[13] = 0xA4;
+            }
+            let _ = process_frame(&mut [&mut a], &mut f, 0);
+        }
+    }
+}
+
+#[test]
+fn datagram_iteration_stops_at_malformed() {
+    let mut area = [0u8; 30];
+    // first: 2 data bytes, more follows
+    area[6] = 2;
+    area[7] = 0x80;
+    // second (at 14): claims 100 bytes
+    area[14 + 6] = 100;
+    let mut it = Datagrams::new(&mut area);
+    let first = it.next().unwrap().unwrap();
+    assert_eq!(first.data_len(), 2);
+    assert_eq!(it.next().unwrap().unwrap_err(), FrameError::MalformedDatagram);
+    assert!(it.next().is_none());
+    assert!(Datagram::new_checked(&mut [0u8; 11]).is_err());
+}
+
+#[test]
+fn vlan_tagged_frame_is_processed() {
+    let mut a = esc_with_type(0x5C);
+    let plain = build(&[(Command::Aprd, phys(0, regs::TYPE), &[0])]);
+    let mut f = plain[..12].to_vec();
+    f.extend_from_slice(&[0x81, 0x00, 0x00, 0x01]);
+    f.extend_from_slice(&plain[12..]);
+    process_frame(&mut [&mut a], &mut f, 0).unwrap();
+    // data byte: 14 + 4 + 2 + 10
+    assert_eq!(f[30], 0x5C);
+}
+
+#[test]
+fn returned_frame_has_locally_administered_source_mac() {
+    let mut a = esc_with_type(1);
+    let mut f = build(&[(Command::Nop, 0, &[0])]);
+    assert_eq!(f[6] & MAC_LOCAL_BIT, 0);
+    process_frame(&mut [&mut a], &mut f, 0).unwrap();
+    assert_eq!(f[6], MASTER_MAC[0] | MAC_LOCAL_BIT);
+    assert_eq!(&f[7..12], &MASTER_MAC[1..]);
+    // also through an empty line
+    let mut f = build(&[(Command::Brd, 0, &[0])]);
+    process_frame(&mut [], &mut f, 0).unwrap();
+    assert_eq!(f[6] & MAC_LOCAL_BIT, MAC_LOCAL_BIT);
+    assert_eq!(parse(&mut f)[0].wkc, 0);
+}
+
+#[test]
+fn connect_line_opens_port1_except_last() {
+    let (mut a, mut b) = (esc_with_type(1), esc_with_type(1));
+    connect_line(&mut [&mut a, &mut b]);
+    let dl = |e: &Esc| {
+        let mut s = [0u8; 2];
+        e.read_reg(regs::DL_STATUS, &mut s);
+        u16::from_le_bytes(s)
+    };
+    // port 1: link bit 5, loop closed bit 10, communication bit 11
+    assert_eq!(dl(&a) & (1 << 5 | 1 << 10 | 1 << 11), 1 << 5 | 1 << 11);
+    assert_eq!(dl(&b) & (1 << 5 | 1 << 10 | 1 << 11), 1 << 10);
+    // process_frame applies the line it is given
+    let mut c = esc_with_type(1);
+    let mut f = build(&[(Command::Nop, 0, &[0])]);
+    process_frame(&mut [&mut b, &mut c], &mut f, 0).unwrap();
+    assert_eq!(dl(&b) & (1 << 5 | 1 << 10 | 1 << 11), 1 << 5 | 1 << 11);
+    assert_eq!(dl(&c) & (1 << 5 | 1 << 10 | 1 << 11), 1 << 10);
+}
