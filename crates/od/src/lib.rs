@@ -21,9 +21,11 @@
 #![deny(missing_docs)]
 
 mod abort;
+mod pdo;
 mod types;
 
 pub use abort::SdoAbort;
+pub use pdo::PdoEntry;
 pub use types::DataType;
 
 /// Object code (ETG.1000.6 SDO Info object description).

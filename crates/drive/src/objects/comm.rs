@@ -2,9 +2,11 @@
 //! device objects F0xxh (ETG.5000.1), as listed in `od-ethercat.md` parts 1–3.
 
 use super::{count_entry, repeat, Object, Value};
-use crate::{PdoEntry, DEVICE_NAME, DEVICE_TYPE, HARDWARE_VERSION, MAPPING_ENTRIES, SERIAL, SOFTWARE_BUILD};
-use crate::{PRODUCT_CODE, RX_A, RX_B, SOFTWARE_VERSION, TX_A, TX_B, VENDOR_ID};
+use crate::pdo_maps::{RX_A, RX_B, TX_A, TX_B};
+use crate::{DEVICE_NAME, DEVICE_TYPE, HARDWARE_VERSION, MAPPING_ENTRIES, SERIAL, SOFTWARE_BUILD};
+use crate::{PRODUCT_CODE, SOFTWARE_VERSION, VENDOR_ID};
 use od::DataType::{Bool, OctetString, VisibleString, U16, U32, U8};
+use od::PdoEntry;
 use od::{Access, EntryInfo, ObjectCode::*};
 
 const RO: Access = Access::RO;

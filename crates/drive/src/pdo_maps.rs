@@ -1,0 +1,110 @@
+//! The process-data maps the drive ships: the default RxPDO/TxPDO of each
+//! axis (1600h/1A00h, 1601h/1A01h) and the mode-specific maps of ip and vl
+//! (spec §5.4, cia402.md §6.5). The mapping objects' defaults and the
+//! EtherCAT device description both derive from them.
+
+use crate::{parameter_index, AXIS_B_CIA402, AXIS_B_MANUFACTURER};
+use od::{DataType, PdoEntry};
+
+/// Axis-A RxPDO entries (spec §5.4, 23 bytes): the default of 1600h.
+pub const RX_A: [PdoEntry; 8] = [
+    PdoEntry::new(0x6040, 0, DataType::U16, "Controlword"),
+    PdoEntry::new(0x6060, 0, DataType::I8, "Modes of operation"),
+    PdoEntry::new(0x607A, 0, DataType::I32, "Target position"),
+    PdoEntry::new(0x60FF, 0, DataType::I32, "Target velocity"),
+    PdoEntry::new(0x60B1, 0, DataType::I32, "Velocity offset"),
+    PdoEntry::new(0x60B2, 0, DataType::I16, "Torque offset"),
+    PdoEntry::new(0x6071, 0, DataType::I16, "Target torque"),
+    PdoEntry::new(0x60FE, 1, DataType::U32, "Digital outputs"),
+];
+
+/// Axis-A TxPDO entries (spec §5.4, 29 bytes): the default of 1A00h.
+pub const TX_A: [PdoEntry; 10] = [
+    PdoEntry::new(0x6041, 0, DataType::U16, "Statusword"),
+    PdoEntry::new(0x6061, 0, DataType::I8, "Modes of operation display"),
+    PdoEntry::new(0x6064, 0, DataType::I32, "Position actual value"),
+    PdoEntry::new(0x606C, 0, DataType::I32, "Velocity actual value"),
+    PdoEntry::new(0x6077, 0, DataType::I16, "Torque actual value"),
+    PdoEntry::new(0x60F4, 0, DataType::I32, "Following error actual value"),
+    PdoEntry::new(0x60FD, 0, DataType::U32, "Digital inputs"),
+    PdoEntry::new(0x60E4, 1, DataType::I32, "Additional position actual value"),
+    PdoEntry::new(parameter_index(4, 201), 0, DataType::U16, "E201 Status word 2"),
+    PdoEntry::new(
+        parameter_index(0, 67),
+        0,
+        DataType::U16,
+        "A67 Status word user-defined",
+    ),
+];
+
+/// The mode-specific maps of cia402.md §6.5.1 and §6.5.6: ip and vl cannot use
+/// the standard maps. A master (startup list) or the commissioning side writes
+/// them into 1600h/1A00h in Pre-Op ([`DriveObjects::apply_map`]).
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum PdoLayout {
+    /// RxPDO 23 bytes, TxPDO 29 bytes (spec §5.4).
+    Standard,
+    /// Interpolated position (ip, 7): 6040h, 6060h, 60C1h:01 / 6041h, 6061h, 6064h; 7 bytes each.
+    Ip,
+    /// Velocity mode (vl, 2): 6040h, 6060h, 6042h / 6041h, 6061h, 6044h; 5 bytes each.
+    Vl,
+}
+
+/// ip RxPDO (7 bytes).
+pub const IP_RX: [PdoEntry; 3] = [
+    PdoEntry::new(0x6040, 0, DataType::U16, "Controlword"),
+    PdoEntry::new(0x6060, 0, DataType::I8, "Modes of operation"),
+    PdoEntry::new(0x60C1, 1, DataType::I32, "Interpolation data record 1"),
+];
+/// ip TxPDO (7 bytes).
+pub const IP_TX: [PdoEntry; 3] = [
+    PdoEntry::new(0x6041, 0, DataType::U16, "Statusword"),
+    PdoEntry::new(0x6061, 0, DataType::I8, "Modes of operation display"),
+    PdoEntry::new(0x6064, 0, DataType::I32, "Position actual value"),
+];
+/// vl RxPDO (5 bytes).
+pub const VL_RX: [PdoEntry; 3] = [
+    PdoEntry::new(0x6040, 0, DataType::U16, "Controlword"),
+    PdoEntry::new(0x6060, 0, DataType::I8, "Modes of operation"),
+    PdoEntry::new(0x6042, 0, DataType::I16, "vl target velocity"),
+];
+/// vl TxPDO (5 bytes).
+pub const VL_TX: [PdoEntry; 3] = [
+    PdoEntry::new(0x6041, 0, DataType::U16, "Statusword"),
+    PdoEntry::new(0x6061, 0, DataType::I8, "Modes of operation display"),
+    PdoEntry::new(0x6044, 0, DataType::I16, "vl velocity actual value"),
+];
+
+impl PdoLayout {
+    /// The RxPDO and TxPDO entries of axis A.
+    pub const fn entries(self) -> (&'static [PdoEntry], &'static [PdoEntry]) {
+        match self {
+            PdoLayout::Standard => (&RX_A, &TX_A),
+            PdoLayout::Ip => (&IP_RX, &IP_TX),
+            PdoLayout::Vl => (&VL_RX, &VL_TX),
+        }
+    }
+}
+
+/// The same entries for axis B: CiA 402 objects +800h, manufacturer +8000h.
+const fn axis_b<const N: usize>(a: [PdoEntry; N]) -> [PdoEntry; N] {
+    let mut b = a;
+    let mut i = 0;
+    while i < N {
+        // N is the array's length: compile-time evaluation, no run-time index.
+        #[allow(clippy::indexing_slicing)]
+        let e = &mut b[i];
+        e.index += if e.index >= 0x6000 {
+            AXIS_B_CIA402
+        } else {
+            AXIS_B_MANUFACTURER
+        };
+        i += 1;
+    }
+    b
+}
+
+/// Axis-B RxPDO entries: the default of 1601h.
+pub const RX_B: [PdoEntry; 8] = axis_b(RX_A);
+/// Axis-B TxPDO entries: the default of 1A01h.
+pub const TX_B: [PdoEntry; 10] = axis_b(TX_A);
