@@ -434,7 +434,7 @@ fn c104_c107_limit_switches_from_i210_and_e80() {
         let code: u16 = sd.sdo_read(0x603F, 0).await.unwrap();
         assert_eq!(
             Some(code),
-            drive::emcy::fault_code_for_event(53).map(|(c, _)| c),
+            drive::faults::fault_code_for_event(53).map(|(c, _)| c),
             "event 53"
         );
         m.set_target_velocity(0);

@@ -16,7 +16,7 @@ use hil_sim::motor::{PositionInput, Switches};
 
 /// 603Fh of event 53 (limit switch).
 fn event_53() -> Option<u16> {
-    drive::emcy::fault_code_for_event(53).map(|(c, _)| c)
+    drive::faults::fault_code_for_event(53).map(|(c, _)| c)
 }
 
 // ---------------------------------------------------------------------------

@@ -1,73 +1,42 @@
-//! The drive's emergency messages for its events (spec §8.2, §8.3): the
-//! E82 event table of error codes and CiA error registers, and the layout of
-//! a device-fault EMCY (E82 event, E43 cause, axis). The EtherCAT
-//! personality sends them through the slave's queue ([`ecat::emcy::Emcy`]).
+//! The drive's emergency messages (spec §8.2): the EMCY of a fault change
+//! (E82 event, E43 cause, axis; code and register from [`crate::faults`]).
+//! The EtherCAT personality sends them through the slave's queue
+//! ([`ecat::emcy::Emcy`]).
 //!
 //! | bytes | 1–2 | 3 | 4 | 5 | 6–7 | 8 |
 //! |---|---|---|---|---|---|---|
 //! | device fault | error code (LE) | error register | E82 event | E43 cause | 0 | axis |
 //! | fault cleared | 0000h | 00h | 1Eh | 0 | 0 | axis |
 
-use ecat::emcy::{code, register, Emcy};
+use crate::faults::{Fault, FaultChange};
+use ecat::emcy::{code, Emcy};
 
 /// E82 event 30 "Inactive": byte 4 of the fault-cleared EMCY.
 pub const E82_INACTIVE: u8 = 30;
-
-/// Error code and CiA error register for a device fault with E82 event `e82` (spec
-/// §8.3, S Tab. 23); `None` for events S does not list. Event 80 (1000h,
-/// generic) is from P.
-pub fn fault_code_for_event(e82: u8) -> Option<(u16, u8)> {
-    use register::{COMMUNICATION as COM, CURRENT as CUR, GENERIC as GEN};
-    use register::{TEMPERATURE as TEMP, VOLTAGE as VOLT};
-    Some(match e82 {
-        30 => (code::NO_ERROR, 0x00),
-        31 => (0x2110, CUR),
-        32 => (0x2230, CUR),
-        33 => (0x2310, CUR),
-        36 => (0x3110, VOLT),
-        46 => (0x3120, VOLT),
-        83 => (0x3130, GEN),
-        84 => (0x3180, GEN),
-        38 => (0x4210, TEMP),
-        39 | 59 => (0x4280, TEMP),
-        41 => (0x4310, TEMP),
-        45 => (0x4380, TEMP),
-        34 => (0x5200, GEN),
-        35 | 57 | 71 => (0x6010, GEN),
-        40 | 70 => (0x6320, GEN),
-        86 => (0x6330, GEN),
-        48 | 49 | 72 | 73 => (0x7110, GEN),
-        42 => (0x7110, TEMP),
-        69 | 81 => (0x7120, GEN),
-        37 => (0x7303, GEN),
-        76 | 77 | 79 => (0x7304, GEN),
-        52 => (0x7500, COM),
-        88 => (0x7580, GEN),
-        47 => (0x8311, GEN),
-        56 => (0x8400, GEN),
-        53 => (0x8500, GEN),
-        85 => (0x8510, GEN),
-        51 => (0x8600, GEN),
-        54 => (0x8611, GEN),
-        78 => (0x8612, GEN),
-        60..=67 => (0xFF00 + u16::from(e82 - 60), GEN),
-        44 => (0xFF09, GEN),
-        68 => (0xFF0A, GEN),
-        80 => (code::GENERIC, GEN),
-        _ => return None,
-    })
-}
 
 /// Device fault: E82 event type, E43 cause, `axis` 0 = axis A or global, 1 = axis B.
 pub const fn device_fault(code: u16, register: u8, e82: u8, e43: u8, axis: u8) -> Emcy {
     Emcy::new(code, register, [e82, e43, 0, 0, axis])
 }
 
-/// Device fault for event `e82` with code and register from [`fault_code_for_event`];
+/// Device fault for event `e82` with code and register from
+/// [`crate::faults::fault_code_for_event`];
 /// events outside the table send 1000h / 01h (generic error).
 pub fn for_event(e82: u8, e43: u8, axis: u8) -> Emcy {
-    let (code, register) = fault_code_for_event(e82).unwrap_or((code::GENERIC, register::GENERIC));
-    device_fault(code, register, e82, e43, axis)
+    of_fault(&Fault::for_event(e82, e43), axis)
+}
+
+/// The device-fault EMCY of `fault` on `axis`.
+pub const fn of_fault(fault: &Fault, axis: u8) -> Emcy {
+    device_fault(fault.code, fault.register, fault.event, fault.cause, axis)
+}
+
+/// The EMCY of an axis' fault change: the fault on T13, "fault cleared" on T15.
+pub const fn of_change(change: &FaultChange, axis: u8) -> Emcy {
+    match change {
+        FaultChange::Raised(f) => of_fault(f, axis),
+        FaultChange::Cleared => fault_cleared(axis),
+    }
 }
 
 /// Fault cleared (device left the Fault state): 0000h, 00h, 1Eh (S; P sends 00h).
@@ -81,7 +50,7 @@ mod tests {
 
     #[test]
     fn e087_device_fault_layout() {
-        let e = device_fault(0x2310, register::CURRENT, 33, 2, 1);
+        let e = device_fault(0x2310, ecat::emcy::register::CURRENT, 33, 2, 1);
         assert_eq!(e.to_bytes(), [0x10, 0x23, 0x02, 33, 2, 0, 0, 1]);
         assert_eq!(Emcy::parse(&e.to_bytes()), Some(e));
         // Axis A / global.
@@ -102,72 +71,5 @@ mod tests {
     fn e088_fault_cleared() {
         assert_eq!(fault_cleared(0).to_bytes(), [0, 0, 0, 0x1E, 0, 0, 0, 0]);
         assert_eq!(fault_cleared(1).to_bytes(), [0, 0, 0, 0x1E, 0, 0, 0, 1]);
-    }
-
-    #[test]
-    fn e089_fault_table() {
-        let cases: &[(u8, u16, u8)] = &[
-            (30, 0x0000, 0x00),
-            (31, 0x2110, 0x02),
-            (32, 0x2230, 0x02),
-            (33, 0x2310, 0x02),
-            (36, 0x3110, 0x04),
-            (46, 0x3120, 0x04),
-            (83, 0x3130, 0x01),
-            (84, 0x3180, 0x01),
-            (38, 0x4210, 0x08),
-            (39, 0x4280, 0x08),
-            (59, 0x4280, 0x08),
-            (41, 0x4310, 0x08),
-            (45, 0x4380, 0x08),
-            (34, 0x5200, 0x01),
-            (35, 0x6010, 0x01),
-            (57, 0x6010, 0x01),
-            (71, 0x6010, 0x01),
-            (40, 0x6320, 0x01),
-            (70, 0x6320, 0x01),
-            (86, 0x6330, 0x01),
-            (69, 0x7120, 0x01),
-            (81, 0x7120, 0x01),
-            (37, 0x7303, 0x01),
-            (76, 0x7304, 0x01),
-            (77, 0x7304, 0x01),
-            (79, 0x7304, 0x01),
-            (52, 0x7500, 0x10),
-            (88, 0x7580, 0x01),
-            (47, 0x8311, 0x01),
-            (56, 0x8400, 0x01),
-            (53, 0x8500, 0x01),
-            (85, 0x8510, 0x01),
-            (51, 0x8600, 0x01),
-            (54, 0x8611, 0x01),
-            (78, 0x8612, 0x01),
-            (44, 0xFF09, 0x01),
-            (68, 0xFF0A, 0x01),
-            (80, 0x1000, 0x01),
-        ];
-        for &(e82, code, reg) in cases {
-            assert_eq!(fault_code_for_event(e82), Some((code, reg)), "event {e82}");
-        }
-        for n in 0..8u8 {
-            assert_eq!(fault_code_for_event(60 + n), Some((0xFF00 + u16::from(n), 0x01)));
-        }
-        // FF08h is unused; unlisted events have no entry and fall back to 1000h/01h.
-        for e82 in (0..=255u8).filter(|e| fault_code_for_event(*e).is_some()) {
-            assert_ne!(fault_code_for_event(e82).unwrap().0, 0xFF08);
-        }
-        for e82 in [0u8, 29, 43, 50, 55, 58, 74, 75, 82, 87, 89, 255] {
-            assert_eq!(fault_code_for_event(e82), None, "event {e82}");
-            let e = for_event(e82, 0, 0);
-            assert_eq!((e.code, e.register), (0x1000, 0x01));
-        }
-    }
-
-    #[test]
-    fn e090_brake_chopper_register() {
-        assert_eq!(fault_code_for_event(42), Some((0x7110, 0x08)));
-        for e82 in [48, 49, 72, 73] {
-            assert_eq!(fault_code_for_event(e82), Some((0x7110, 0x01)));
-        }
     }
 }

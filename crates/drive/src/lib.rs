@@ -34,6 +34,7 @@ pub mod dictionary;
 pub mod doc;
 pub mod ecat_app;
 pub mod emcy;
+pub mod faults;
 pub mod objects;
 pub mod params;
 pub mod pdo_image;

@@ -36,16 +36,7 @@ pub mod code {
 
 /// Error register values (CiA 301 bit masks, except the EoE sub-code).
 pub mod register {
-    /// Bit 0: generic error.
-    pub const GENERIC: u8 = 0x01;
-    /// Bit 1: current.
-    pub const CURRENT: u8 = 0x02;
-    /// Bit 2: voltage.
-    pub const VOLTAGE: u8 = 0x04;
-    /// Bit 3: temperature.
-    pub const TEMPERATURE: u8 = 0x08;
-    /// Bit 4: communication.
-    pub const COMMUNICATION: u8 = 0x10;
+    pub use od::error_register::*;
     /// 23h "EoE address occupied": a sub-code, not a bit mask (spec §8.5).
     pub const EOE_ADDRESS_OCCUPIED: u8 = 0x23;
 }

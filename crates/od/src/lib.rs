@@ -21,6 +21,7 @@
 #![deny(missing_docs)]
 
 mod abort;
+pub mod error_register;
 mod pdo;
 mod types;
 

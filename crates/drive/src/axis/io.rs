@@ -128,6 +128,7 @@ pub struct AxisReport {
     pub command: AxisCommand,
     /// The device-control transition taken, if any.
     pub transition: Option<Transition>,
-    /// An EMCY to queue: the fault on T13, "fault cleared" on T15.
-    pub emcy: Option<Emcy>,
+    /// The fault change of the cycle: the fault on T13, cleared on T15 (a
+    /// fieldbus personality sends its message for it).
+    pub fault: Option<crate::faults::FaultChange>,
 }

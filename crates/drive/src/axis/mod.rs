@@ -71,8 +71,9 @@
 //! limit switches (event 53), the extrapolation overrun of the interpolators
 //! (event 78 cause 3) and an excessive set-value jump of the master (event 78
 //! cause 4, C-148) raise a fault in the device control; on T13 the axis
-//! returns the EMCY ([`for_event`]) and sets 603Fh and its error
-//! register, on T15 it returns [`fault_cleared`].
+//! reports the fault ([`FaultChange::Raised`], code and register from
+//! [`fault_code_for_event`]) and sets 603Fh and its error register, on T15
+//! it reports [`FaultChange::Cleared`].
 
 mod configure;
 mod feedback;
@@ -86,13 +87,12 @@ mod units;
 mod write_back;
 
 use crate::dictionary::DriveObjects;
-use crate::emcy::{device_fault, fault_cleared, fault_code_for_event, for_event};
+use crate::faults::{fault_code_for_event, Fault, FaultChange, GENERIC_ERROR};
 use cia402::{
     Decel, DeviceControl, FaultEvent, FaultReaction, Inputs, Mode, Options, Outputs, QuickStopOption, Ramp,
     State, Transition, CW_HALT, CW_MODE_BIT4, CW_MODE_BIT5, CW_MODE_BIT6, SW_INTERNAL_LIMIT, SW_MODE_BIT12,
     SW_MODE_BIT13, SW_TARGET_REACHED,
 };
-use ecat::emcy::{register, Emcy};
 use motion::cascade::{Cascade, CascadeConfig, CascadeInput, CascadeOutput, ControlEntry};
 use motion::cycle::{application_cycle_ns, interpolation_period_ns};
 use motion::homing::{Homing, HomingConfig, HomingInput, SwitchInput};
@@ -110,6 +110,7 @@ use motion::{
     CycleRatio, Event, FineInterpolator, InterpolatorConfig, MasterSetpoint, PositionTarget,
     ProfileGenerator, ProfileLimits, SetMode, VelocityInterpolator, INCREMENTS_PER_REVOLUTION,
 };
+use od::error_register;
 use snapshot::{CyclicSlots, Snapshot, Window};
 
 pub use io::{AxisCommand, AxisIo, AxisReport, IndexLatch, ProbeEdge, SwitchEdge, SwitchId};
@@ -536,7 +537,7 @@ impl Axis {
             manufacturer_bits: 0,
         };
         let out = self.dc.step(&inputs, now_ns);
-        let emcy = self.on_transition(out.transition, od);
+        let fault = self.on_transition(out.transition, od);
 
         self.touch_probe(o, io, actual, now_ns);
 
@@ -557,7 +558,7 @@ impl Axis {
                 brake_release: out.brake_release,
             },
             transition: out.transition,
-            emcy,
+            fault,
         }
     }
 
@@ -581,33 +582,31 @@ impl Axis {
         self.dc.raise_fault(FaultEvent { code, reaction: None });
     }
 
-    /// EMCY, 603Fh and the error register on T13 / T15.
-    fn on_transition(&mut self, t: Option<Transition>, od: &mut DriveObjects) -> Option<Emcy> {
+    /// The fault change, 603Fh and the error register on T13 / T15.
+    fn on_transition(&mut self, t: Option<Transition>, od: &mut DriveObjects) -> Option<FaultChange> {
         let t = t?;
-        let axis = self.window.axis;
         match t.number {
             13 => {
-                let emcy = match self.event {
-                    Some(ev) => for_event(ev.number.min(255) as u8, ev.cause, axis),
-                    None => device_fault(
-                        self.dc.fault().map_or(0x1000, |f| f.code),
-                        register::GENERIC,
-                        0,
-                        0,
-                        axis,
-                    ),
+                let fault = match self.event {
+                    Some(ev) => Fault::for_event(ev.number.min(255) as u8, ev.cause),
+                    None => Fault {
+                        code: self.dc.fault().map_or(GENERIC_ERROR, |f| f.code),
+                        register: error_register::GENERIC,
+                        event: 0,
+                        cause: 0,
+                    },
                 };
-                self.error_code = emcy.code;
-                self.error_register = emcy.register | register::GENERIC;
-                self.window.put(od, 0x603F, 0, i64::from(emcy.code));
-                Some(emcy)
+                self.error_code = fault.code;
+                self.error_register = fault.register | error_register::GENERIC;
+                self.window.put(od, 0x603F, 0, i64::from(fault.code));
+                Some(FaultChange::Raised(fault))
             }
             15 => {
                 self.event = None;
                 self.error_code = 0;
                 self.error_register = 0;
                 self.window.put(od, 0x603F, 0, 0);
-                Some(fault_cleared(axis))
+                Some(FaultChange::Cleared)
             }
             _ => None,
         }

@@ -42,10 +42,9 @@ impl Leds {
     }
 }
 
-/// Whether `e` is the EMCY of event 52 (7500h, E82 = 52).
-pub(super) fn is_event52(e: &Emcy) -> bool {
-    let [e82, ..] = e.data;
-    e.code == 0x7500 && e82 == event52::EVENT
+/// Whether `f` is the fault of event 52.
+pub(super) fn is_event52(f: &FaultChange) -> bool {
+    matches!(f, FaultChange::Raised(f) if f.event == event52::EVENT)
 }
 
 /// A short diagnosis text (A257) built without the heap.

@@ -63,6 +63,7 @@ mod save;
 mod slots;
 mod sync;
 
+use crate::faults::FaultChange;
 pub use diag::Leds;
 use diag::{is_event52, PortDiag, Text};
 pub use foe::{foe_error, FirmwareFoe, FIRMWARE_FILE};
@@ -78,7 +79,6 @@ use crate::pdo_image::{PdoImage, PdoImageError};
 use crate::DEVICE;
 use boot::{BootSlots, NoFlash, UpdateError};
 use ecat::diag::{DiagHistory, DiagMessage, DiagType};
-use ecat::emcy::Emcy;
 use ecat::esm::{SyncMode, SyncState};
 use ecat::foe::{Accept, FoeError, FoeHandler};
 use ecat::led::Pattern;
@@ -631,16 +631,19 @@ impl<F: Flash, B: Flash> Drive<F, B> {
         let sent = self.event52_emcy_sent.iter_mut();
         for (((((axis, cache), io), new), command), sent) in axes.zip(commands.iter_mut()).zip(sent) {
             let report = axis.cycle_cached(cache, &mut self.objects, io, now_ns, new);
-            let mut emcy = report.emcy;
+            let mut fault = report.fault;
             if report.transition.is_some_and(|t| t.number == 13) {
                 // the event 52 EMCY is already queued (once for the device)
-                if core::mem::take(sent) && emcy.is_some_and(|e| is_event52(&e)) {
-                    emcy = None;
+                if core::mem::take(sent) && fault.is_some_and(|f| is_event52(&f)) {
+                    fault = None;
                 }
             }
-            if let Some(e) = emcy {
-                self.slave.emergency(e);
-                let [e82, e43, ..] = e.data;
+            if let Some(f) = fault {
+                self.slave.emergency(crate::emcy::of_change(&f, axis.index()));
+                let (e82, e43) = match f {
+                    FaultChange::Raised(f) => (f.event, f.cause),
+                    FaultChange::Cleared => (crate::emcy::E82_INACTIVE, 0),
+                };
                 let _ = self.objects.set(E82, 0, i64::from(e82));
                 let _ = self.objects.set(E43, 0, i64::from(e43));
             }
