@@ -39,7 +39,7 @@ pub const TX_A: [PdoEntry; 10] = [
 
 /// The mode-specific maps of cia402.md §6.5.1 and §6.5.6: ip and vl cannot use
 /// the standard maps. A master (startup list) or the commissioning side writes
-/// them into 1600h/1A00h in Pre-Op ([`DriveObjects::apply_map`]).
+/// them into 1600h/1A00h in Pre-Op ([`DriveObjects::apply_map`](crate::DriveObjects::apply_map)).
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
 pub enum PdoLayout {
     /// RxPDO 23 bytes, TxPDO 29 bytes (spec §5.4).
