@@ -7,6 +7,7 @@ use crate::dictionary::{LiveValues, WithLive};
 use ecat::esm::OpLoss;
 use ecat::{Application, DcRequest, PdoTimeout};
 use esc::AlStatusCode;
+use od::{CommState, Dictionary, ObjectInfo, SdoAbort};
 
 pub use crate::params::{A150, A258};
 
@@ -69,10 +70,16 @@ pub const fn event52_cause(loss: OpLoss) -> u8 {
 /// A150 when it holds nothing usable, µs.
 const DEFAULT_A150_US: u32 = 1000;
 
-impl<L: LiveValues> WithLive<'_, L> {
+/// The drive's dictionary (with its live values) as the slave stack's
+/// application: the [`od::Dictionary`] of the CoE server, and the settings
+/// of [`ecat::Application`] read from A150 and A258.
+pub struct EcatApp<'a, L: LiveValues>(pub WithLive<'a, L>);
+
+impl<L: LiveValues> EcatApp<'_, L> {
     /// A150 in ns.
     fn a150_ns(&self) -> u32 {
         let us = self
+            .0
             .objects
             .get(A150, 0)
             .ok()
@@ -82,13 +89,39 @@ impl<L: LiveValues> WithLive<'_, L> {
     }
 }
 
-impl<L: LiveValues> Application for WithLive<'_, L> {
+impl<L: LiveValues> Dictionary for EcatApp<'_, L> {
+    fn object(&self, index: u16) -> Option<&'static ObjectInfo> {
+        self.0.object(index)
+    }
+    fn next_object(&self, after: Option<u16>) -> Option<&'static ObjectInfo> {
+        self.0.next_object(after)
+    }
+    fn read(&mut self, index: u16, sub: u8, buf: &mut [u8], state: CommState) -> Result<usize, SdoAbort> {
+        self.0.read(index, sub, buf, state)
+    }
+    fn write(&mut self, index: u16, sub: u8, data: &[u8], state: CommState) -> Result<(), SdoAbort> {
+        self.0.write(index, sub, data, state)
+    }
+    fn process_data_bytes(&self) -> Option<(usize, usize)> {
+        self.0.process_data_bytes()
+    }
+    fn sdo_info_enabled(&self) -> bool {
+        self.0.sdo_info_enabled()
+    }
+}
+
+impl<L: LiveValues> Application for EcatApp<'_, L> {
     fn cycle_ns(&mut self) -> u32 {
         self.a150_ns()
     }
 
     fn pdo_timeout(&mut self) -> PdoTimeout {
-        let a258 = self.objects.get(A258, 0).ok().and_then(|v| u16::try_from(v).ok());
+        let a258 = self
+            .0
+            .objects
+            .get(A258, 0)
+            .ok()
+            .and_then(|v| u16::try_from(v).ok());
         pdo_timeout(a258.unwrap_or(0))
     }
 

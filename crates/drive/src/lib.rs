@@ -1,18 +1,14 @@
-//! The drive product: the SC6-class double-axis drive as seen on the bus.
+//! The drive on EtherCAT (SC6A062, double axis): the fieldbus-neutral core
+//! ([`drive_core`], re-exported whole) behind the EtherCAT slave stack.
 //!
-//! - [`DEVICE`]: the device description (identity, SyncManagers, FMMUs, PDO maps,
-//!   DC op modes), the one source the SII image, the stack's checks and later
-//!   the ESI XML and object dictionary derive from.
-//! - [`objects`]: the object dictionary, declared once (communication area,
-//!   manufacturer parameters, CiA 402 objects of both axes) with its RAM image
-//!   layout, computed at compile time.
-//! - [`DriveObjects`]: the values and the CoE access rules; implements
-//!   [`od::Dictionary`] for the CoE server. Live values come from the runtime
-//!   ([`DriveObjects::set`], [`LiveValues`]); saving and restoring go through
-//!   [`DriveObjects::persistent_image`], [`DriveObjects::load_persistent`] and
-//!   [`Requests`].
-//! - [`doc`]: the object-dictionary reference (`docs/object-dictionary.md`)
-//!   generated from the declaration.
+//! - [`DEVICE`]: the device description (identity, SyncManagers, FMMUs, PDO
+//!   maps, DC op modes), the one source the SII image, the stack's checks
+//!   and the ESI XML derive from.
+//! - [`runtime`]: [`runtime::Drive`], the core's axes and dictionary behind an
+//!   [`ecat::Slave`]: process data, ESM hooks, DC-Sync PLL, save, FoE, EoE,
+//!   diagnosis.
+//! - [`ecat_app`]: the drive as the slave stack's [`ecat::Application`]
+//!   (A150, A258, DC checks, event 52); [`emcy`]: its emergencies.
 #![no_std]
 #![cfg_attr(
     not(test),
@@ -25,66 +21,20 @@
 )]
 #![deny(missing_docs)]
 
+pub use drive_core::*;
+
+use drive_core::pdo_maps::{RX_A, RX_B, TX_A, TX_B};
 use ecat::desc::coe_details;
 use ecat::{DcOpMode, Device, FmmuUsage, Identity, MailboxSm, Pdo, PdoEntry, ProcessSm};
-use pdo_maps::{RX_A, RX_B, TX_A, TX_B};
+use esc::sii::mailbox_protocol;
 
-pub mod axis;
-pub mod dictionary;
-pub mod doc;
 pub mod ecat_app;
 pub mod emcy;
-pub mod faults;
-pub mod objects;
-pub mod params;
-pub mod pdo_image;
-pub mod pdo_maps;
 pub mod runtime;
-
-pub use dictionary::{
-    revision, DriveObjects, ImageError, LiveValues, NoLive, Requests, Slot, Template, WithLive,
-    LOAD_SIGNATURE, PERSISTENT_IMAGE_BYTES, SAVE_SIGNATURE,
-};
-use esc::sii::mailbox_protocol;
-pub use pdo_maps::{PdoLayout, IP_RX, IP_TX, VL_RX, VL_TX};
 
 /// The firmware slots crate (A/B images, boot decision), re-exported for the
 /// firmware, the simulator and the tests.
 pub use boot;
-
-/// STOBER's EtherCAT vendor ID (E-005).
-pub const VENDOR_ID: u32 = 0xB9;
-/// Product code = nominal power in 0.1 kW (E-005). The SC6A062's nominal power
-/// is not in the seeds or the spec; assumed 1.5 kW (2 × 0.75 kW) until checked
-/// against the SC6 manual.
-pub const PRODUCT_CODE: u32 = 15;
-/// Revision number 1018h:03 with the default template "EtherCAT Rx SDO
-/// Info", also in the SII (E-005, E-008): software build number << 1 | 1
-/// (bit 0 = template, see [`revision`]); build 0 for now.
-pub const SOFTWARE_BUILD: u32 = 1;
-/// Hardware version 1009h (E52\[1\]).
-pub const HARDWARE_VERSION: &str = "HW 1";
-/// Software version 100Ah (E52\[3\]).
-pub const SOFTWARE_VERSION: &str = env!("CARGO_PKG_VERSION");
-/// Serial number placeholder; the real value is E52\[2\], from the device's
-/// production data (E-005).
-pub const SERIAL: u32 = 0;
-/// Device type 1000h: profile 402, servo drive (E-004).
-pub const DEVICE_TYPE: u32 = 0x0002_0192;
-/// Device name (1008h, E50).
-pub const DEVICE_NAME: &str = "SC6";
-/// Entries per PDO mapping object (spec §5.1).
-pub const MAPPING_ENTRIES: u8 = 24;
-/// Offset of axis B's CiA 402 objects (E-015).
-pub const AXIS_B_CIA402: u16 = 0x0800;
-/// Offset of axis B's manufacturer objects (E-010).
-pub const AXIS_B_MANUFACTURER: u16 = 0x8000;
-
-/// CoE index of manufacturer parameter `group` (A = 0 … Z = 25), `line`, axis A
-/// window (spec §2.6, E-009).
-pub const fn parameter_index(group: u16, line: u16) -> u16 {
-    0x2000 + group * 0x200 + line
-}
 
 static RX_A_ENTRIES: [PdoEntry; 8] = RX_A;
 static RX_B_ENTRIES: [PdoEntry; 8] = RX_B;
@@ -202,6 +152,6 @@ pub static DEVICE: Device = Device {
 #[cfg(test)]
 extern crate std;
 #[cfg(test)]
-mod tests;
+mod axis_tests;
 #[cfg(test)]
-mod tests_od;
+mod tests;

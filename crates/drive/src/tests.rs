@@ -222,3 +222,59 @@ fn writes_to_missing_and_read_only_objects() {
         Err(SdoAbort::NO_OBJECT)
     );
 }
+
+/// The SII's revision is the dictionary's 1018h:03 (E-005).
+#[test]
+fn e005_sii_revision_equals_1018_03() {
+    let mut d = DriveObjects::new();
+    let mut buf = [0u8; 4];
+    let n = d.read(0x1018, 3, &mut buf, od::CommState::PreOp).unwrap();
+    assert_eq!(n, 4);
+    assert_eq!(DEVICE.identity.revision, u32::from_le_bytes(buf), "SII = OD");
+}
+
+#[test]
+fn pdo_maps_of_device_equal_od_defaults() {
+    let mut d = DriveObjects::new();
+    for pdo in DEVICE.rx_pdos.iter().chain(DEVICE.tx_pdos) {
+        assert_eq!(rd(&mut d, pdo.index, 0), [pdo.entries.len() as u8]);
+        for (i, e) in pdo.entries.iter().enumerate() {
+            assert_eq!(rd_u(&mut d, pdo.index, i as u8 + 1), u64::from(e.mapping_value()));
+        }
+    }
+    assert_eq!(
+        d.assigned_pdos(0x1C12).collect::<std::vec::Vec<_>>(),
+        DEVICE.rx_assign
+    );
+    assert_eq!(
+        d.assigned_pdos(0x1C13).collect::<std::vec::Vec<_>>(),
+        DEVICE.tx_assign
+    );
+    assert_eq!(
+        d.process_data_bytes(),
+        Some((DEVICE.output_bytes(), DEVICE.input_bytes()))
+    );
+    // every default mapping entry is valid: re-enabling each PDO passes the checks
+    for pdo in DEVICE.rx_pdos.iter().chain(DEVICE.tx_pdos) {
+        let n = pdo.entries.len() as u32;
+        wr(&mut d, pdo.index, 0, 0);
+        wr(&mut d, pdo.index, 0, n);
+    }
+}
+
+fn rd(d: &mut DriveObjects, index: u16, sub: u8) -> std::vec::Vec<u8> {
+    let mut buf = [0u8; 64];
+    let n = d.read(index, sub, &mut buf, od::CommState::PreOp).unwrap();
+    buf[..n].to_vec()
+}
+
+fn rd_u(d: &mut DriveObjects, index: u16, sub: u8) -> u64 {
+    rd(d, index, sub)
+        .iter()
+        .rev()
+        .fold(0u64, |v, &b| (v << 8) | u64::from(b))
+}
+
+fn wr(d: &mut DriveObjects, index: u16, sub: u8, value: u32) {
+    d.write(index, sub, &[value as u8], od::CommState::PreOp).unwrap();
+}

@@ -73,7 +73,7 @@ use sync::PllSettings;
 
 use crate::axis::{Axis, AxisCache, AxisCommand, AxisIo};
 use crate::dictionary::{read_slot, write_slot, DriveObjects, LiveValues, Slot, PERSISTENT_IMAGE_BYTES};
-use crate::ecat_app::{event52, event52_cause};
+use crate::ecat_app::{event52, event52_cause, EcatApp};
 use crate::objects::LAYOUT_HASH;
 use crate::pdo_image::{PdoImage, PdoImageError};
 use crate::DEVICE;
@@ -435,7 +435,7 @@ impl<F: Flash, B: Flash> Drive<F, B> {
         let mut foe = FirmwareFoe::new(self.boot.as_mut());
         self.slave.poll_mailbox_only(
             pdi,
-            &mut self.objects.with_live(&mut live),
+            &mut EcatApp(self.objects.with_live(&mut live)),
             &mut foe,
             &mut self.eoe,
             now_ns,
@@ -482,14 +482,14 @@ impl<F: Flash, B: Flash> Drive<F, B> {
         let change = if mailbox {
             self.slave.poll_with_eoe(
                 pdi,
-                &mut self.objects.with_live(&mut live),
+                &mut EcatApp(self.objects.with_live(&mut live)),
                 &mut foe,
                 &mut self.eoe,
                 now_ns,
             )?
         } else {
             self.slave
-                .poll_esc(pdi, &mut self.objects.with_live(&mut live), now_ns)?
+                .poll_esc(pdi, &mut EcatApp(self.objects.with_live(&mut live)), now_ns)?
         };
         if self.slave.take_error_ack() {
             // the master acknowledged the error: a latched PLL fault goes

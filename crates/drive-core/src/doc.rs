@@ -1,6 +1,6 @@
 //! The object-dictionary reference, generated from the declaration
 //! (`docs/object-dictionary.md`; the test `od_doc_is_current` keeps the file
-//! current, `UPDATE_OD_DOC=1 cargo test -p drive` rewrites it).
+//! current, `UPDATE_OD_DOC=1 cargo test -p drive-core` rewrites it).
 
 use crate::objects::{Object, Value, OBJECTS};
 use crate::{AXIS_B_CIA402, AXIS_B_MANUFACTURER};
@@ -29,8 +29,8 @@ pub fn write_reference(w: &mut impl Write) -> fmt::Result {
 
 const HEADER: &str = "# Object dictionary
 
-Generated from the declaration in `crates/drive/src/objects/` by the test `od_doc_is_current`
-(`UPDATE_OD_DOC=1 cargo test -p drive od_doc_is_current` rewrites this file). Do not edit by hand.
+Generated from the declaration in `crates/drive-core/src/objects/` by the test `od_doc_is_current`
+(`UPDATE_OD_DOC=1 cargo test -p drive-core od_doc_is_current` rewrites this file). Do not edit by hand.
 
 - **Sub**: subindex in the default template \"EtherCAT Rx SDO Info\". In the template \"EtherCAT Rx\"
   the elements of manufacturer arrays and records are at subindex = element number (one lower)

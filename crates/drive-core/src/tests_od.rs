@@ -44,7 +44,7 @@ fn od_doc_is_current() {
     let file = std::fs::read_to_string(path).unwrap_or_default();
     assert!(
         file == text,
-        "docs/object-dictionary.md is out of date: run UPDATE_OD_DOC=1 cargo test -p drive od_doc_is_current"
+        "docs/object-dictionary.md is out of date: run UPDATE_OD_DOC=1 cargo test -p drive-core od_doc_is_current"
     );
 }
 
@@ -57,11 +57,6 @@ fn e004_e005_identity() {
     assert_eq!(rd_u(&mut d, 0x1018, 2), u64::from(PRODUCT_CODE));
     assert_eq!(rd_u(&mut d, 0x1018, 3), u64::from(SOFTWARE_BUILD));
     assert_eq!(rd_u(&mut d, 0x1018, 4), u64::from(SERIAL));
-    assert_eq!(
-        u64::from(DEVICE.identity.revision),
-        rd_u(&mut d, 0x1018, 3),
-        "SII = OD"
-    );
 }
 
 #[test]
@@ -450,29 +445,6 @@ fn e034_sm_lengths_follow_each_mapping_change() {
     assert_eq!(d.process_data_bytes().unwrap(), (0, 0));
     wr(&mut d, 0x1C13, 0, 1, 1).unwrap();
     assert_eq!(d.process_data_bytes().unwrap(), (0, before.1));
-}
-
-#[test]
-fn pdo_maps_of_device_equal_od_defaults() {
-    let mut d = DriveObjects::new();
-    for pdo in DEVICE.rx_pdos.iter().chain(DEVICE.tx_pdos) {
-        assert_eq!(rd(&mut d, pdo.index, 0).unwrap(), [pdo.entries.len() as u8]);
-        for (i, e) in pdo.entries.iter().enumerate() {
-            assert_eq!(rd_u(&mut d, pdo.index, i as u8 + 1), u64::from(e.mapping_value()));
-        }
-    }
-    assert_eq!(d.assigned_pdos(0x1C12).collect::<Vec<_>>(), DEVICE.rx_assign);
-    assert_eq!(d.assigned_pdos(0x1C13).collect::<Vec<_>>(), DEVICE.tx_assign);
-    assert_eq!(
-        d.process_data_bytes(),
-        Some((DEVICE.output_bytes(), DEVICE.input_bytes()))
-    );
-    // every default mapping entry is valid: re-enabling each PDO passes the checks
-    for pdo in DEVICE.rx_pdos.iter().chain(DEVICE.tx_pdos) {
-        let n = pdo.entries.len() as u32;
-        wr(&mut d, pdo.index, 0, 0, 1).unwrap();
-        wr(&mut d, pdo.index, 0, n, 1).unwrap();
-    }
 }
 
 #[test]

@@ -12,14 +12,14 @@ pub(super) fn bytes_at<const N: usize>(image: &[u8], at: usize) -> Option<[u8; N
 /// The value in `slot`, or `default` without one (an entry that is not
 /// an integer in RAM).
 #[inline(always)]
-pub(crate) fn read_slot(od: &DriveObjects, slot: Option<Slot>, default: i64) -> i64 {
+pub fn read_slot(od: &DriveObjects, slot: Option<Slot>, default: i64) -> i64 {
     slot.map_or(default, |s| od.load_slot(s))
 }
 
 /// Stores `value` in `slot`; dropped without one or out of the type's
 /// range (a runtime value must never stop the cycle that writes it).
 #[inline(always)]
-pub(crate) fn write_slot(od: &mut DriveObjects, slot: Option<Slot>, value: i64) {
+pub fn write_slot(od: &mut DriveObjects, slot: Option<Slot>, value: i64) {
     if let Some(s) = slot {
         od.store_slot(s, value);
     }

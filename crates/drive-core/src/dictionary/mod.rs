@@ -26,7 +26,8 @@ pub use persist::{ImageError, PERSISTENT_IMAGE_BYTES};
 use resolve::*;
 pub use slot::Slot;
 use slot::*;
-pub(crate) use slot::{read_slot, write_slot, SlotValue, Typed};
+pub use slot::{read_slot, write_slot};
+pub(crate) use slot::{SlotValue, Typed};
 
 /// Signature written to 1010h:01 to save ("save", CiA 301).
 pub const SAVE_SIGNATURE: u32 = 0x6576_6173;

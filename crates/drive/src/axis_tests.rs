@@ -2,9 +2,14 @@
 //! friction, one control cycle of actuation delay. Objects are written with
 //! `DriveObjects::set`, as the PDO/SDO side would.
 
-use super::*;
-use crate::axis::snapshot::E48;
+use crate::axis::*;
+use crate::params::E48;
 use crate::runtime::Drive;
+use cia402::{State, SW_INTERNAL_LIMIT, SW_MODE_BIT12, SW_MODE_BIT13, SW_TARGET_REACHED};
+use motion::{Event, INCREMENTS_PER_REVOLUTION};
+
+/// Increments per revolution as `f32`.
+const REV: f32 = INCREMENTS_PER_REVOLUTION as f32;
 use store::RamFlash;
 
 type Flash = RamFlash<4096, 2>;
@@ -814,105 +819,4 @@ fn c071_homing_takes_the_latched_switch_edge() {
     );
     assert!(latched.abs() <= 2, "latched edge: exact: {latched}");
     assert!(latched.abs() < level.abs(), "{latched} vs {level}");
-}
-
-/// The cycle keeps its configuration while the dictionary's configuration
-/// generation stands and reads only the cyclic set-points again: for a write
-/// of a changed value to every scalar entry of the dictionary, either the
-/// generation moves or the refreshed snapshot equals a fresh read (both
-/// axes). A Live object feeding the snapshot, or a set-point missing from the
-/// refresh, fails here.
-#[test]
-fn cached_snapshot_equals_a_fresh_read_after_any_write() {
-    use crate::axis::snapshot::{CyclicSlots, Snapshot, Window};
-    use crate::objects::OBJECTS;
-    let mut checked = 0;
-    for o in OBJECTS.iter() {
-        for e in o.info.entries {
-            if !e.data_type.is_integer() {
-                continue;
-            }
-            let mut od = DriveObjects::new();
-            let windows = [Window { axis: 0 }, Window { axis: 1 }];
-            let before = windows.map(|w| Snapshot::read(&od, w));
-            let g0 = od.config_generation();
-            let Ok(v) = od.get(o.info.index, e.sub) else {
-                continue;
-            };
-            let v = if v < e.data_type.max_value() { v + 1 } else { v - 1 };
-            if od.set(o.info.index, e.sub, v).is_err() {
-                continue;
-            }
-            checked += 1;
-            if od.config_generation() != g0 {
-                continue;
-            }
-            for (w, mut cached) in windows.into_iter().zip(before) {
-                cached.refresh_setpoints(&od, &CyclicSlots::resolve(&od, w));
-                assert_eq!(
-                    cached,
-                    Snapshot::read(&od, w),
-                    "{:04X}:{} axis {}",
-                    o.info.index,
-                    e.sub,
-                    w.axis
-                );
-            }
-        }
-    }
-    assert!(checked > 300, "{checked} writes");
-}
-
-/// Every entry the control cycle reads or writes each cycle has a RAM slot
-/// of the type the cycle uses on both axes (a missing or differently typed
-/// one would silently read the default or drop an actual value), and no two
-/// per-axis entries share one (A291, the last, is global).
-#[test]
-fn cyclic_slots_resolve_every_entry_on_both_axes() {
-    use crate::axis::snapshot::{CyclicSlots, Window};
-    let od = DriveObjects::new();
-    let a = CyclicSlots::resolve(&od, Window { axis: 0 }).all();
-    let b = CyclicSlots::resolve(&od, Window { axis: 1 }).all();
-    let mut seen = std::vec::Vec::new();
-    let n = a.len() - 1;
-    assert_eq!(a[n], b[n]);
-    for (k, s) in a.iter().take(n).chain(b.iter()).enumerate() {
-        let s = s.unwrap_or_else(|| panic!("slot {k} missing"));
-        assert!(!seen.contains(&s), "slot {k} shared");
-        seen.push(s);
-    }
-}
-
-/// The snapshot reads only entries the dictionary declares, on both axes
-/// and with the decimal places of A213 = 0, so none of its values falls back
-/// to a number written down a second time (the defaults live in the object
-/// declaration); a fresh dictionary gives the declared defaults.
-#[test]
-fn snapshot_reads_only_declared_entries() {
-    use crate::axis::snapshot::{Snapshot, Window, A213};
-    let mut od = DriveObjects::new();
-    for axis in [0, 1] {
-        let (s, misses) = Snapshot::read_counting(&od, Window { axis });
-        assert_eq!(misses, 0, "axis {axis}");
-        assert_eq!(
-            i64::from(s.mode),
-            od.get(Window { axis }.cia402(0x6060), 0).unwrap()
-        );
-        assert_eq!(
-            i64::from(s.max_torque),
-            od.get(Window { axis }.cia402(0x6072), 0).unwrap()
-        );
-        assert_eq!(
-            i64::from(s.following_error_window),
-            od.get(Window { axis }.cia402(0x6065), 0).unwrap()
-        );
-    }
-    od.set(A213, 1, 0).unwrap();
-    for axis in [0, 1] {
-        assert_eq!(
-            Snapshot::read_counting(&od, Window { axis }).1,
-            0,
-            "axis {axis}, A213 = 0"
-        );
-    }
 }
