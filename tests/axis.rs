@@ -34,7 +34,7 @@ pub fn motor_position(sim: &RefCell<Simulation>, axis: usize) -> i64 {
 /// through the axis parameters.
 pub fn torque_mode_speed_limit(sim: &RefCell<Simulation>, rev_s: f32) {
     with_drive(sim, |d| {
-        let c = &mut d.drive.axes[0].params_mut().cascade;
+        let c = &mut d.drive.axes_mut()[0].params_mut().cascade;
         let v = rev_s * crate::REV as f32;
         c.torque_mode_velocity_limit_positive_inc_per_s = v;
         c.torque_mode_velocity_limit_negative_inc_per_s = v;

@@ -63,7 +63,7 @@ fuzz_target!(|data: &[u8]| {
     let mut drive = Drive::new(SimFlash::new());
     // SNTP on, server 1 = the host
     for (sub, v) in [(1u8, 1i64), (2, 0x0A00_0001), (3, 0x0A00_0002)] {
-        let _ = drive.objects.set(0x20C7, sub, v);
+        let _ = drive.objects_mut().set(0x20C7, sub, v);
     }
     // buffers on the stack (hil-sim's DriveNet leaks them: not for a fuzzer)
     let mut bufs = NetBuffers::new();
@@ -72,8 +72,8 @@ fuzz_target!(|data: &[u8]| {
         mac: DRIVE_MAC,
         seed: 1,
     };
-    let mut net = NetStack::new(cfg, &mut bufs, &mut slots, &mut drive.eoe, 0);
-    drive.eoe.ip_changed(&IpParams {
+    let mut net = NetStack::new(cfg, &mut bufs, &mut slots, drive.eoe_mut(), 0);
+    drive.eoe().ip_changed(&IpParams {
         ip: Some(DRIVE),
         mask: Some([255, 255, 255, 0]),
         gateway: Some(HOST),
@@ -91,7 +91,7 @@ fuzz_target!(|data: &[u8]| {
             1 => udp_frame(40_000, net::param::PARAM_PORT, bytes),
             _ => udp_frame(123, 123, bytes),
         };
-        drive.eoe.receive(&frame);
+        drive.eoe_mut().receive(&frame);
         t += 60_000_000_000;
         // the frames arrive as if the master tunnelled them: the tunnel is open (E-098)
         let settings = net::NetSettings {
@@ -99,6 +99,6 @@ fuzz_target!(|data: &[u8]| {
             ..net_settings(&drive)
         };
         drive.with_eoe(|q, dict, state| net.poll(t / 1000, q, dict, state, &settings));
-        while drive.eoe.transmit(&mut out).is_some() {}
+        while drive.eoe_mut().transmit(&mut out).is_some() {}
     }
 });

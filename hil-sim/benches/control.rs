@@ -61,15 +61,15 @@ fn main() {
     // enable both axes in csp (mode 8 is the default), holding position 0
     for cw in [0x06, 0x07, 0x0F, 0x0F, 0x0F] {
         for axis in 0..2u16 {
-            drive.objects.set(0x6040 + 0x800 * axis, 0, cw).unwrap();
-            drive.objects.set(0x607A + 0x800 * axis, 0, 0).unwrap();
+            drive.objects_mut().set(0x6040 + 0x800 * axis, 0, cw).unwrap();
+            drive.objects_mut().set(0x607A + 0x800 * axis, 0, 0).unwrap();
         }
         for _ in 0..5 {
             step(&mut drive, &mut motors, &mut pos, &mut now);
         }
     }
     for axis in 0..2u16 {
-        let sw = drive.objects.get(0x6041 + 0x800 * axis, 0).unwrap();
+        let sw = drive.objects().get(0x6041 + 0x800 * axis, 0).unwrap();
         assert_eq!(sw & 0x6F, 0x27, "axis {axis} operation enabled");
     }
     let t_move = 1500;
@@ -78,10 +78,10 @@ fn main() {
     for k in 0..total {
         let target = profile(k, t_move).round() as i64;
         for axis in 0..2u16 {
-            drive.objects.set(0x607A + 0x800 * axis, 0, target).unwrap();
+            drive.objects_mut().set(0x607A + 0x800 * axis, 0, target).unwrap();
         }
         spent += step(&mut drive, &mut motors, &mut pos, &mut now);
-        let ferr = drive.objects.get(0x60F4, 0).unwrap() as f64;
+        let ferr = drive.objects().get(0x60F4, 0).unwrap() as f64;
         max = max.max(ferr.abs());
         sq += ferr * ferr;
     }

@@ -65,7 +65,7 @@ impl DriveNet {
             NetConfig { mac, seed },
             bufs,
             slots,
-            &mut drive.eoe,
+            drive.eoe_mut(),
             now_ns / 1000,
         );
         Self { stack }

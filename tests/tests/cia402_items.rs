@@ -287,7 +287,7 @@ fn c040_csp_csv_cst_need_no_mode_specific_controlword_bits() {
 
         // cst: the torque acts with and without the bits (speed limit G472 lifted)
         with_drive(&sim, |d| {
-            let c = &mut d.drive.axes[0].params_mut().cascade;
+            let c = &mut d.drive.axes_mut()[0].params_mut().cascade;
             c.torque_mode_velocity_limit_positive_inc_per_s = 5.0 * REV as f32;
             c.torque_mode_velocity_limit_negative_inc_per_s = 5.0 * REV as f32;
         });
@@ -472,7 +472,7 @@ fn c104_c107_limit_switches_from_i210_and_e80() {
 fn c107_e80_shows_illegal_direction_on_an_endless_axis() {
     let sim = line(1);
     with_drive(&sim, |d| {
-        let l = &mut d.drive.axes[0].params_mut().limits;
+        let l = &mut d.drive.axes_mut()[0].params_mut().limits;
         l.endless_axis = true;
         l.permitted_direction = drive::axis::PermittedDirection::PositiveOnly;
     });
@@ -662,7 +662,7 @@ fn c148_set_value_jump_trips_the_monitor() {
         );
         // monitoring off (AxisParams): the same jump is followed
         with_drive(&sim, |d| {
-            d.drive.axes[0].params_mut().set_value_monitoring = false
+            d.drive.axes_mut()[0].params_mut().set_value_monitoring = false
         });
         m.set_controlword(CW_FAULT_RESET);
         m.run_until(20, |t| t.state() == sw::SOD).await.expect("reset");
@@ -809,7 +809,9 @@ fn c109_gear_and_feed_scale_positions_and_velocities_through_the_master() {
 #[test]
 fn c111_endless_axis_wraps_at_607b_through_the_master() {
     let sim = line(1);
-    with_drive(&sim, |d| d.drive.axes[0].params_mut().limits.endless_axis = true);
+    with_drive(&sim, |d| {
+        d.drive.axes_mut()[0].params_mut().limits.endless_axis = true
+    });
     const L: i32 = 360_000; // 0.001° per motor revolution
     with_master(&sim, async |md, clock| {
         let group = init(md, clock).await.into_op(md).await.expect("OP");

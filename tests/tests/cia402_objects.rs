@@ -288,7 +288,7 @@ fn c135_c136_c137_manufacturer_parameter_addresses_and_templates() {
         sd.sdo_write(a340 + 0x8000, 0, 30u16).await.unwrap();
         assert_eq!(sd.sdo_read::<u16>(a340, 0).await.unwrap(), 70);
         assert_eq!(sd.sdo_read::<u16>(a340 + 0x8000, 0).await.unwrap(), 30);
-        let objects = |sim: &RefCell<Simulation>, i: u16| sim.borrow().drives()[0].drive.objects.get(i, 0);
+        let objects = |sim: &RefCell<Simulation>, i: u16| sim.borrow().drives()[0].drive.objects().get(i, 0);
         assert_eq!(objects(&sim, 0xA154), Ok(30), "the axis-B parameter");
         // C-137, "SDO Info" template (default): E200[0] at sub 1, sub 0 = element count
         assert_eq!(
@@ -305,7 +305,7 @@ fn c135_c136_c137_manufacturer_parameter_addresses_and_templates() {
         // "EtherCAT Rx" template: element = subindex
         sim.borrow_mut().drives_mut()[0]
             .drive
-            .objects
+            .objects_mut()
             .set_template(Template::Rx);
         assert_eq!(
             c.upload(&sd, e200, 0).await.map(|v| v.len()),
@@ -320,7 +320,7 @@ fn c135_c136_c137_manufacturer_parameter_addresses_and_templates() {
             .unwrap();
         sim.borrow_mut().drives_mut()[0]
             .drive
-            .objects
+            .objects_mut()
             .set_template(Template::SdoInfo);
         assert_eq!(
             c.upload(&sd, parameter_index(0, 66), 4).await,

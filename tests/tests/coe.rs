@@ -66,7 +66,7 @@ fn encode(t: DataType, v: i64) -> Vec<u8> {
 }
 
 fn objects(sim: &RefCell<Simulation>) -> DriveObjects {
-    sim.borrow().drives()[0].drive.objects.clone()
+    sim.borrow().drives()[0].drive.objects().clone()
 }
 
 /// What a bus write may change and the runtime does not: every integer entry
@@ -564,7 +564,7 @@ fn e012_e013_e079_manufacturer_array_in_both_templates() {
         // "EtherCAT Rx": element = subindex, no SDO Info, revision bit 0 clear
         sim.borrow_mut().drives_mut()[0]
             .drive
-            .objects
+            .objects_mut()
             .set_template(Template::Rx);
         assert_eq!(c.upload(&sd, a10, 1).await, Ok(vec![1]), "A10[1] at subindex 1");
         assert_eq!(c.upload(&sd, a10, 2).await, Ok(vec![2]), "A10[2] at subindex 2");

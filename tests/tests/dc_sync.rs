@@ -470,7 +470,7 @@ fn e046_e131_e129_e038_dc_op_waits_for_pll_lock_and_sync0_loss_drops_to_safeop()
         let mut first_op = None;
         dc_cycles(md, &group, &sim, 150, |i, all_op, s| {
             for d in s.drives() {
-                let slave = &d.drive.slave;
+                let slave = d.drive.slave();
                 if slave.state() == esc::AlState::SafeOp {
                     assert!(!slave.error(), "cycle {i}: no error while waiting");
                     assert!(slave.op_pending(), "cycle {i}: S→O pending");
@@ -543,8 +543,8 @@ fn e046_e131_e129_e038_dc_op_waits_for_pll_lock_and_sync0_loss_drops_to_safeop()
                 ecat::led::Pattern::SingleFlash
             );
             let d = &s.drives()[i].drive;
-            for axis in &d.axes {
-                let state = d.objects.get(axis.cia402_index(0x6041), 0).unwrap() & 0x6F;
+            for axis in d.axes() {
+                let state = d.objects().get(axis.cia402_index(0x6041), 0).unwrap() & 0x6F;
                 assert!(
                     state == 0x08 || state == 0x0F,
                     "axis {}: {state:#x}",
@@ -552,13 +552,13 @@ fn e046_e131_e129_e038_dc_op_waits_for_pll_lock_and_sync0_loss_drops_to_safeop()
                 );
                 assert_eq!(axis.error_code(), 0x7500);
             }
-            assert_eq!(d.objects.get(drive::parameter_index(4, 43), 0), Ok(7), "E43");
+            assert_eq!(d.objects().get(drive::parameter_index(4, 43), 0), Ok(7), "E43");
             let (_, last) = s.drives()[i].state_log.last().copied().expect("state change");
             println!("drive {i}: {last}");
             assert!(last.unsolicited, "E-038: {last}");
             assert_eq!((last.from, last.to), (esc::AlState::Op, esc::AlState::SafeOp));
             assert_eq!(last.code, AlStatusCode(al::DC_SYNC_TIMEOUT));
-            assert!(s.drives()[i].drive.slave.sync_status().unsolicited);
+            assert!(s.drives()[i].drive.slave().sync_status().unsolicited);
             assert_eq!(
                 s.drives()[i].drive.pll().and_then(|p| p.fault()),
                 Some(SyncFault::Sync0Timeout)
@@ -737,7 +737,7 @@ fn e120_e123_e124_a287_optimisation_through_the_master() {
 /// Position actual value 6064h of axis A: the drive's object and its bytes in
 /// the TxPDO image the drive's Tx step wrote (what the next frame carries).
 fn actual_and_txpdo(d: &mut hil_sim::sim::SimDrive) -> (i64, i64) {
-    let obj = d.drive.objects.get(0x6064, 0).expect("6064h");
+    let obj = d.drive.objects().get(0x6064, 0).expect("6064h");
     let e = *d
         .drive
         .pdo_image()
@@ -747,7 +747,7 @@ fn actual_and_txpdo(d: &mut hil_sim::sim::SimDrive) -> (i64, i64) {
         .find(|e| e.index == 0x6064)
         .expect("6064h mapped");
     let at = usize::from(e.bit_offset / 8);
-    let img = d.drive.slave.inputs_mut();
+    let img = d.drive.slave_mut().inputs_mut();
     let tx = i32::from_le_bytes(img[at..at + 4].try_into().unwrap());
     (obj, i64::from(tx))
 }
@@ -835,7 +835,7 @@ fn e112_sync0_twice_a150() {
         let pll = d.drive.pll().expect("PLL");
         assert_eq!(pll.k(), 2, "drive {i}: k = 2");
         assert!(pll.is_locked(), "drive {i} locked");
-        assert_eq!(d.drive.slave.state(), esc::AlState::Op);
+        assert_eq!(d.drive.slave().state(), esc::AlState::Op);
         let log: Vec<_> = d.cycle_log.iter().filter(|c| c.locked).collect();
         assert!(log.len() >= 100, "drive {i}: {} locked cycles", log.len());
         for w in log.windows(2) {
@@ -878,7 +878,7 @@ fn e109_a292_beyond_one_a150_is_limited_to_one_cycle_through_the_master() {
     for (i, d) in s.drives().iter().enumerate() {
         let pll = d.drive.pll().expect("PLL");
         assert_eq!(
-            d.drive.objects.get(A292, 0),
+            d.drive.objects().get(A292, 0),
             Ok(-1500),
             "the object keeps the value"
         );
@@ -923,14 +923,14 @@ fn e115_a298_bits_through_the_master() {
     let mut ever = [0u16; 3];
     run(&sim, 600, Inject::Nothing, |_, s| {
         for (i, d) in s.drives().iter().enumerate() {
-            ever[i] |= d.drive.objects.get(A298, 0).unwrap() as u16;
+            ever[i] |= d.drive.objects().get(A298, 0).unwrap() as u16;
         }
     });
     let s = sim.borrow();
     let a298: Vec<u16> = s
         .drives()
         .iter()
-        .map(|d| d.drive.objects.get(A298, 0).unwrap() as u16)
+        .map(|d| d.drive.objects().get(A298, 0).unwrap() as u16)
         .collect();
     println!("A298 at 0 / +300 / −300 ppm: {a298:04x?}, seen {ever:04x?}");
     let locked = PllStatus::PHASE_LOCKED | PllStatus::SYNC0_PRESENT;
@@ -995,18 +995,18 @@ async fn a287_measurement<'a>(
     // started in the dictionary, not by SDO: mailbox traffic would delay the
     // next frames and look like master jitter (the SDO start is tested above)
     for d in sim.borrow_mut().drives_mut() {
-        d.drive.objects.set(A287, 1, 1).expect("A287[0] = 1");
+        d.drive.objects_mut().set(A287, 1, 1).expect("A287[0] = 1");
     }
     for k in 0..1500 {
         dc_cycles(md, group, sim, 1, |_, _, _| {}).await;
         let mut s = sim.borrow_mut();
         each(k, &mut s);
-        if s.drives()[0].drive.objects.get(A287, 3).unwrap() >= 2 {
+        if s.drives()[0].drive.objects().get(A287, 3).unwrap() >= 2 {
             break;
         }
     }
     let s = sim.borrow();
-    let get = |sub| s.drives()[0].drive.objects.get(A287, sub).unwrap();
+    let get = |sub| s.drives()[0].drive.objects().get(A287, sub).unwrap();
     (get(3), get(4), get(5))
 }
 
@@ -1101,7 +1101,7 @@ fn e147_message_time_stamp_is_the_dc_system_time_when_synchronised() {
                 .expect("0x0910");
             let s = sim.borrow();
             let d = &s.drives()[0].drive;
-            let stamp = d.diag.message(d.diag.newest_subindex()).map(|(_, t)| t);
+            let stamp = d.diag().message(d.diag().newest_subindex()).map(|(_, t)| t);
             (stamp, system_time)
         },
     );

@@ -91,7 +91,7 @@ fn e041_e042_e132_e133_a255_a257_3_and_the_run_and_err_leds() {
     // in Init before the master starts
     assert_eq!(leds(&sim, 0).run, Pattern::Off);
     assert_eq!(leds(&sim, 0).err, Pattern::Off);
-    assert_eq!(sim.borrow().drives()[0].drive.objects.get(A255, 0), Ok(1));
+    assert_eq!(sim.borrow().drives()[0].drive.objects().get(A255, 0), Ok(1));
     with_master(&sim, async |md, clock| {
         let group = init(md, clock).await;
         let sd = group.subdevice(md, 0).unwrap();
@@ -139,7 +139,7 @@ fn e041_e042_e132_e133_a255_a257_3_and_the_run_and_err_leds() {
         request(&sd, INIT | ACK).await;
     });
     let s = sim.borrow();
-    assert_eq!(s.drives()[0].drive.objects.get(A255, 0), Ok(1), "Init");
+    assert_eq!(s.drives()[0].drive.objects().get(A255, 0), Ok(1), "Init");
     assert_eq!(s.drives()[0].leds(s.now_ns()).run, Pattern::Off);
 }
 
@@ -244,7 +244,7 @@ fn e025_e033_e136_a257_0_error_codes_of_refused_transitions() {
     });
     let mut s = sim.borrow_mut();
     let d = &mut s.drives_mut()[0].drive;
-    assert_eq!(d.objects.get(A255, 0), Ok(17), "A255 Init + error");
+    assert_eq!(d.objects().get(A255, 0), Ok(17), "A255 Init + error");
     let mut buf = [0u8; 16];
     let n = d.read_object(A257, 1, &mut buf, od::CommState::PreOp).unwrap();
     let t = String::from_utf8(buf[..n].iter().copied().take_while(|&b| b != 0).collect()).unwrap();
@@ -334,8 +334,8 @@ fn e024_init_loads_the_saved_values_no_mailbox_no_process_data() {
         let s = sim.borrow();
         let d = &s.drives()[0].drive;
         assert_eq!(d.startup(), drive::runtime::Startup::Loaded);
-        assert_eq!(d.objects.get(A258, 0), Ok(77), "loaded in Init");
-        assert_eq!(d.slave.state(), esc::AlState::Init);
+        assert_eq!(d.objects().get(A258, 0), Ok(77), "loaded in Init");
+        assert_eq!(d.slave().state(), esc::AlState::Init);
     }
     // mailbox and process-data areas marked; a mailbox request in SM0's area
     let mark = [0xA5u8; 64];
@@ -358,7 +358,7 @@ fn e024_init_loads_the_saved_values_no_mailbox_no_process_data() {
     assert_eq!(buf, mark, "no mailbox reply in Init");
     esc.read_reg(0x1A00, &mut buf[..29]);
     assert_eq!(buf[..29], mark[..29], "no TxPDO in Init");
-    assert_eq!(s.drives()[0].drive.slave.state(), esc::AlState::Init);
+    assert_eq!(s.drives()[0].drive.slave().state(), esc::AlState::Init);
 }
 
 /// E-036 (spec §3.2): Op → Pre-Op stops the process data both ways: the
@@ -384,7 +384,7 @@ fn e036_op_to_preop_stops_process_data_both_ways() {
                 .esc
                 .write_reg(0x1A00, &[0xA5; 29]);
         };
-        let received = |sim: &RefCell<Simulation>| sim.borrow().drives()[0].drive.slave.outputs_received();
+        let received = |sim: &RefCell<Simulation>| sim.borrow().drives()[0].drive.slave().outputs_received();
         // in Op the TxPDO area is rewritten and the RxPDO read
         mark(&sim);
         let before = received(&sim);
@@ -426,7 +426,7 @@ fn e040_startup_list_writes_in_every_transition() {
         let group = group.into_safe_op(md).await.expect("SAFE-OP");
         let sd = group.subdevice(md, 0).unwrap();
         assert_eq!(
-            sim.borrow().drives()[0].drive.slave.sync_status().mode,
+            sim.borrow().drives()[0].drive.slave().sync_status().mode,
             ecat::esm::SyncMode::SmSync,
             "the P→S list's 1C32h:01 took effect"
         );
@@ -469,7 +469,7 @@ fn e147_message_time_stamp_zero_then_sntp() {
     let newest = |sim: &RefCell<Simulation>| {
         let s = sim.borrow();
         let d = &s.drives()[0].drive;
-        d.diag.message(d.diag.newest_subindex()).map(|(_, t)| t)
+        d.diag().message(d.diag().newest_subindex()).map(|(_, t)| t)
     };
     with_master(&sim, async |md, clock| {
         let group = init(md, clock).await;

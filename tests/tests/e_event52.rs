@@ -31,7 +31,7 @@ struct Sample {
 }
 
 fn get(sim: &RefCell<Simulation>, index: u16, sub: u8) -> i64 {
-    sim.borrow().drives()[0].drive.objects.get(index, sub).unwrap()
+    sim.borrow().drives()[0].drive.objects().get(index, sub).unwrap()
 }
 
 /// The 7500h EMCYs the master receives (while it does a few SDO uploads).
@@ -97,7 +97,7 @@ fn pdo_timeout_reaction(a540: i16) -> Vec<Sample> {
             let out = d.motor_outputs(0).unwrap();
             samples.push(Sample {
                 ms,
-                state: d.drive.objects.get(0x6041, 0).unwrap() as u16 & 0x6F,
+                state: d.drive.objects().get(0x6041, 0).unwrap() as u16 & 0x6F,
                 torque_nm: out.torque_applied_nm,
                 brake: out.brake_applied,
                 velocity_inc_s: out.velocity_inc_per_s,
@@ -236,9 +236,9 @@ fn e130_projected_fieldbus_mismatch_raises_event52_cause_15() {
         {
             let s = sim.borrow();
             let d = &s.drives()[0].drive;
-            for axis in &d.axes {
+            for axis in d.axes() {
                 let sw_index = axis.cia402_index(0x6041);
-                let state = d.objects.get(sw_index, 0).unwrap() as u16 & 0x6F;
+                let state = d.objects().get(sw_index, 0).unwrap() as u16 & 0x6F;
                 assert_eq!(state, sw::FAULT, "axis {}", axis.index());
                 assert_eq!(axis.error_code(), 0x7500);
             }
@@ -261,7 +261,7 @@ fn e130_projected_fieldbus_mismatch_raises_event52_cause_15() {
         let t = s.now_ns() + 5_000_000;
         s.advance_to(t);
         assert_eq!(
-            s.drives()[0].drive.objects.get(0x6041, 0).unwrap() as u16 & 0x6F,
+            s.drives()[0].drive.objects().get(0x6041, 0).unwrap() as u16 & 0x6F,
             sw::SOD
         );
     });

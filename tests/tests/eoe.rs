@@ -88,12 +88,12 @@ fn e095_e096_e097_e093_eoe_through_the_simulator() {
     });
     let s = sim.borrow();
     let drive = &s.drives()[0].drive;
-    assert_eq!(drive.eoe.frames, 1);
-    assert_eq!(drive.eoe.last_len, f.len());
-    assert_eq!(drive.eoe.last_hash, fnv1a(&f));
-    let params = drive.slave.eoe().params();
+    assert_eq!(drive.eoe().frames, 1);
+    assert_eq!(drive.eoe().last_len, f.len());
+    assert_eq!(drive.eoe().last_hash, fnv1a(&f));
+    let params = drive.slave().eoe().params();
     assert_eq!(params.ip, Some([10, 0, 0, 20]));
     assert_eq!(params.mask, Some([255, 255, 255, 0]));
     assert_eq!(params.gateway, Some([10, 0, 0, 1]));
-    assert!(drive.slave.eoe().address_error());
+    assert!(drive.slave().eoe().address_error());
 }

@@ -106,7 +106,7 @@ fn e096_e095_ping_and_parameters_over_udp() {
     assert_eq!(net.ip(), Some((DRIVE_IP, 24)));
     assert_eq!(net.gateway(), Some(HOST_IP));
     assert_eq!(net.stats().param_requests, 11);
-    assert_eq!(d.drive.slave.eoe().params().ip, Some(DRIVE_IP));
+    assert_eq!(d.drive.slave().eoe().params().ip, Some(DRIVE_IP));
 }
 
 #[test]
@@ -258,7 +258,7 @@ fn e098_no_dhcp_when_a166_is_not_2() {
     // A166 = 0 before the first poll
     sim.borrow_mut().drives_mut()[0]
         .drive
-        .objects
+        .objects_mut()
         .set(0x20A6, 0, 0)
         .unwrap();
     with_master(&sim, async |md, clock| {
@@ -524,7 +524,7 @@ fn e098_coe_only_master_gets_only_coe_answers_on_a_line() {
             .borrow()
             .drives()
             .iter()
-            .map(|d| d.drive.eoe.stats().tx_frames)
+            .map(|d| d.drive.eoe().stats().tx_frames)
             .collect();
         assert_eq!(
             queued, [0; DRIVES],
@@ -550,7 +550,11 @@ fn e098_coe_only_master_gets_only_coe_answers_on_a_line() {
         );
     });
     let s = sim.borrow();
-    let sent: Vec<u32> = s.drives().iter().map(|d| d.drive.eoe.stats().tx_frames).collect();
+    let sent: Vec<u32> = s
+        .drives()
+        .iter()
+        .map(|d| d.drive.eoe().stats().tx_frames)
+        .collect();
     assert!(sent[0] > 0, "drive 0 sent its DHCP frames");
     assert_eq!(&sent[1..], &[0; DRIVES - 1], "the others sent nothing");
 }

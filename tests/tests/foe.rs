@@ -171,8 +171,8 @@ fn foe_cut_connection_times_out_and_the_slot_is_not_pending() {
         sim.borrow_mut().advance_to(t + FOE_TIMEOUT_NS + 1_000_000);
         {
             let mut n = node(&sim);
-            assert_eq!(n.drive.slave.foe().timeouts(), 1, "transfer dropped");
-            assert!(!n.drive.slave.foe().busy());
+            assert_eq!(n.drive.slave().foe().timeouts(), 1, "transfer dropped");
+            assert!(!n.drive.slave().foe().busy());
             assert!(!n.slots().downloading());
         }
         // the master comes back and continues: no transfer any more

@@ -115,7 +115,7 @@ fn home(case: Case) -> Run {
         m.params_mut().index_offset_inc = INDEX_AT;
         m.params_mut().end_stops_inc = case.end_stops;
         m.set_position_inc(case.start);
-        let p = d.drive.axes[0].params_mut();
+        let p = d.drive.axes_mut()[0].params_mut();
         p.limits.positive_switch = case.limits;
         p.limits.negative_switch = case.limits;
         // torque methods: 40 % of the rated torque for 50 ms is the stop (I28/I29)
@@ -436,7 +436,7 @@ fn c086_limit_switch_as_reference_switch() {
         let mut s = sim.borrow_mut();
         let d = &mut s.drives_mut()[0];
         *d.motors[0].switches_mut() = sim_case.switches;
-        let p = d.drive.axes[0].params_mut();
+        let p = d.drive.axes_mut()[0].params_mut();
         p.limits.positive_switch = true;
         p.limits.negative_switch = true;
         p.homing_limit_as_reference = true;

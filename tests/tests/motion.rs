@@ -738,7 +738,7 @@ fn c016_c017_e007_e087_e088_following_error_fault_emcy_and_reset() {
     // a rigid end stop at +0.5 rev blocks the motor
     with_drive(&sim, |d| {
         d.motors[0].params_mut().end_stops_inc = Some((-10 * i64::from(REV), i64::from(REV / 2)));
-        d.drive.axes[0].params_mut().following_error_fault = true;
+        d.drive.axes_mut()[0].params_mut().following_error_fault = true;
     });
     with_master(&sim, async |md, clock| {
         let group = init(md, clock).await.into_op(md).await.expect("OP");

@@ -319,7 +319,7 @@ fn c088_c089_c090_jog_bits_4_and_5() {
 
         // I12/I13 from the parameters: 3 rev/s at 60 rev/s² (50 ms)
         with_drive(&sim, |d| {
-            let p = d.drive.axes[0].params_mut();
+            let p = d.drive.axes_mut()[0].params_mut();
             p.jog_velocity = 3.0 * REV as f32;
             p.jog_acceleration = 60.0 * REV as f32;
         });
@@ -382,7 +382,7 @@ fn c091_c092_jog_at_the_software_limits() {
 
         // I26 = 0: past −0.5 rev a quick stop, no fault; the negative direction locked (C-091)
         with_drive(&sim, |d| {
-            d.drive.axes[0].params_mut().jog_position_control = false
+            d.drive.axes_mut()[0].params_mut().jog_position_control = false
         });
         m.set_controlword(CW_ENABLED);
         m.run(200).await;
@@ -484,7 +484,7 @@ fn c093_c094_c095_hardware_limit_switch_faults_and_locks_the_direction() {
 
         // I101/I102 set: hitting +1 rev at 2 rev/s faults at once (event 53 cause 1)
         with_drive(&sim, |d| {
-            let l = &mut d.drive.axes[0].params_mut().limits;
+            let l = &mut d.drive.axes_mut()[0].params_mut().limits;
             l.positive_switch = true;
             l.negative_switch = true;
         });

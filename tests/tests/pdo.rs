@@ -26,7 +26,7 @@ const VELOCITY_ACTUAL: u32 = m(0x606C, 0, 32);
 
 fn pdo_bytes(sim: &std::cell::RefCell<hil_sim::sim::Simulation>) -> Option<(usize, usize)> {
     use ecat::Dictionary;
-    sim.borrow().drives()[0].drive.objects.process_data_bytes()
+    sim.borrow().drives()[0].drive.objects().process_data_bytes()
 }
 
 #[test]
@@ -77,7 +77,7 @@ fn e048_e049_e054_remap_in_preop_and_run_op_with_the_new_layout() {
         }
         let (received, outputs) = {
             let s = sim.borrow();
-            let slave = &s.drives()[0].drive.slave;
+            let slave = s.drives()[0].drive.slave();
             (slave.outputs_received(), slave.outputs().to_vec())
         };
         assert!(received > 0, "RxPDO frames reached the drive");
@@ -278,7 +278,7 @@ fn e048_e049_slave_process_image_follows_a_remapped_layout() {
         let group = group.into_op(md).await.unwrap();
         group.tx_rx(md).await.unwrap();
         let mut s = sim.borrow_mut();
-        let slave = &mut s.drives_mut()[0].drive.slave;
+        let slave = s.drives_mut()[0].drive.slave_mut();
         assert_eq!(slave.outputs().len(), 2, "RxPDO: controlword");
         assert_eq!(slave.inputs_mut().len(), 2, "TxPDO: statusword");
     });

@@ -34,7 +34,7 @@ fn default_outputs(controlword: u16, mode: i8, target_position: i32) -> [u8; 23]
 fn get(sim: &RefCell<Simulation>, index: u16, sub: u8) -> i64 {
     sim.borrow().drives()[0]
         .drive
-        .objects
+        .objects()
         .get(index, sub)
         .unwrap_or_else(|e| panic!("{index:04X}h:{sub}: {e:?}"))
 }
@@ -42,7 +42,7 @@ fn get(sim: &RefCell<Simulation>, index: u16, sub: u8) -> i64 {
 fn set(sim: &RefCell<Simulation>, index: u16, sub: u8, value: i64) {
     sim.borrow_mut().drives_mut()[0]
         .drive
-        .objects
+        .objects_mut()
         .set(index, sub, value)
         .unwrap_or_else(|e| panic!("{index:04X}h:{sub}: {e:?}"));
 }
@@ -149,7 +149,7 @@ fn e032_safeop_ignores_the_rxpdo() {
             group.tx_rx(md).await.expect("cycle");
         }
         assert!(
-            sim.borrow().drives()[0].drive.slave.outputs_received() > 0,
+            sim.borrow().drives()[0].drive.slave().outputs_received() > 0,
             "RxPDO frames did reach SM2"
         );
         assert_rx_defaults(&sim, "Safe-Op");

@@ -27,7 +27,7 @@ const SM2_CONTROL: u8 = 0x64;
 fn set(sim: &RefCell<Simulation>, index: u16, sub: u8, value: i64) {
     sim.borrow_mut().drives_mut()[0]
         .drive
-        .objects
+        .objects_mut()
         .set(index, sub, value)
         .unwrap_or_else(|e| panic!("{index:04X}h:{sub}: {e:?}"));
 }
@@ -250,7 +250,7 @@ fn e044_e126_e128_op_without_rxpdo_longer_than_a258_falls_to_safeop() {
         let (_, last) = log.last().unwrap();
         assert!(last.unsolicited, "{last}");
         assert_eq!((last.from, last.to), (esc::AlState::Op, esc::AlState::SafeOp));
-        let status = *sim.borrow().drives()[0].drive.slave.sync_status();
+        let status = *sim.borrow().drives()[0].drive.slave().sync_status();
         assert!(status.triggered && status.trigger_count == 1 && status.unsolicited);
     });
 }
@@ -311,7 +311,7 @@ fn e110_a292_applies_to_the_sm2_event_in_sm_sync() {
         let group = group.into_safe_op(md).await.expect("SAFE-OP");
         let sd = group.subdevice(md, 0).unwrap();
         assert_eq!(
-            sim.borrow().drives()[0].drive.slave.sync_status().mode,
+            sim.borrow().drives()[0].drive.slave().sync_status().mode,
             ecat::esm::SyncMode::SmSync
         );
         let mut sends = Vec::new();

@@ -103,13 +103,13 @@ impl Rig {
 
     fn set(&mut self, axis: usize, index: u16, sub: u8, value: i64) {
         self.drive
-            .objects
+            .objects_mut()
             .set(Self::index(axis, index), sub, value)
             .unwrap();
     }
 
     fn get(&self, axis: usize, index: u16, sub: u8) -> i64 {
-        self.drive.objects.get(Self::index(axis, index), sub).unwrap()
+        self.drive.objects().get(Self::index(axis, index), sub).unwrap()
     }
 
     fn sw(&self, axis: usize) -> u16 {
@@ -261,9 +261,9 @@ fn c035_csp_follows_target_position() {
 #[test]
 fn c035_csp_with_acceleration_feedforward_tracks_closely() {
     let mut rig = Rig::new();
-    rig.drive.axes[0].params_mut().cascade.inertia_kg_m2 = 1e-4;
+    rig.drive.axes_mut()[0].params_mut().cascade.inertia_kg_m2 = 1e-4;
     // I425 = 4: quadratic, internal feedforward (acceleration from ∇²)
-    rig.drive.axes[0].params_mut().interpolation_i425 = 4;
+    rig.drive.axes_mut()[0].params_mut().interpolation_i425 = 4;
     rig.enable(0);
     let mut max_fe = 0i64;
     for k in 1..=500 {
@@ -294,7 +294,7 @@ fn c037_csv_velocity_reached() {
 fn c038_cst_torque_produced() {
     let mut rig = Rig::new();
     // G472/G475: let the axis run up to 20 rev/s in the torque modes
-    for a in &mut rig.drive.axes {
+    for a in rig.drive.axes_mut() {
         a.params_mut()
             .cascade
             .torque_mode_velocity_limit_positive_inc_per_s = 20.0 * REV;
@@ -363,7 +363,7 @@ fn c061_homing_sets_the_home_offset() {
         "position {}",
         rig.position(0)
     );
-    assert!(rig.drive.axes[0].is_referenced());
+    assert!(rig.drive.axes()[0].is_referenced());
 }
 
 #[test]
@@ -448,27 +448,27 @@ fn c010_c011_quick_stop_to_standstill_then_switch_on_disabled() {
 #[test]
 fn c036_following_error_fault_goes_to_fault_and_queues_emcy() {
     let mut rig = Rig::new();
-    rig.drive.axes[0].params_mut().following_error_fault = true;
+    rig.drive.axes_mut()[0].params_mut().following_error_fault = true;
     rig.set(0, 0x6065, 0, 1000);
     rig.set(0, 0x6066, 0, 2);
     rig.enable(0);
-    assert_eq!(rig.drive.slave.emergencies_pending(), 0);
+    assert_eq!(rig.drive.slave().emergencies_pending(), 0);
     // block the motor and ask for a revolution
     rig.set(0, 0x607A, 0, REV_I / 10);
     rig.run_until(200, |r| r.state(0) == State::Fault);
     assert_eq!(rig.sw(0) & 0x4F, 0x08);
     assert_eq!(rig.get(0, E48, 0), 5);
-    assert_eq!(rig.drive.slave.emergencies_pending(), 1);
+    assert_eq!(rig.drive.slave().emergencies_pending(), 1);
     assert_eq!(rig.get(0, 0x603F, 0), 0x8611);
-    assert_ne!(rig.drive.objects.get(0x1001, 0).unwrap(), 0);
+    assert_ne!(rig.drive.objects().get(0x1001, 0).unwrap(), 0);
     assert!(!rig.commands[0].power_stage);
     // T15: fault reset edge → Switch on disabled, "fault cleared" EMCY
     rig.controlword(0, 0x80);
     rig.run(2);
     assert_eq!(rig.state(0), State::SwitchOnDisabled);
-    assert_eq!(rig.drive.slave.emergencies_pending(), 2);
+    assert_eq!(rig.drive.slave().emergencies_pending(), 2);
     assert_eq!(rig.get(0, 0x603F, 0), 0);
-    assert_eq!(rig.drive.objects.get(0x1001, 0).unwrap(), 0);
+    assert_eq!(rig.drive.objects().get(0x1001, 0).unwrap(), 0);
 }
 
 #[test]
@@ -517,7 +517,7 @@ fn c134_axis_b_is_independent_of_axis_a() {
     assert!(rig.commands[1].power_stage);
     // a fault on B leaves A alone
     rig.enable(0);
-    rig.drive.axes[1].raise_event(Event { number: 54, cause: 1 });
+    rig.drive.axes_mut()[1].raise_event(Event { number: 54, cause: 1 });
     rig.run_until(100, |r| r.state(1) == State::Fault);
     assert_eq!(rig.state(0), State::OperationEnabled);
     assert_eq!(rig.get(1, 0x603F, 0), 0x8611);
@@ -638,7 +638,7 @@ fn c144_invalid_cycle_settings_fall_back() {
     rig.set(0, 0x60C2, 1, 3);
     rig.enable(0);
     assert_eq!(
-        rig.drive.objects.get(objects_a291(), 0).unwrap(),
+        rig.drive.objects().get(objects_a291(), 0).unwrap(),
         3000,
         "60C2h copied into A291 (C-114)"
     );
@@ -665,7 +665,7 @@ fn objects_a291() -> u16 {
 fn arbitrary_object_values_do_not_panic() {
     let mut rig = Rig::new();
     rig.set(1, 0x6040, 0, 0x0F);
-    for a in &mut rig.drive.axes {
+    for a in rig.drive.axes_mut() {
         a.params_mut().limits.positive_switch = true;
         a.params_mut().limits.negative_switch = true;
         a.params_mut().following_error_fault = true;
@@ -715,7 +715,7 @@ fn arbitrary_object_values_do_not_panic() {
         // any value the type holds
         let _ = rig
             .drive
-            .objects
+            .objects_mut()
             .set(Rig::index(axis, index), sub, (r >> 16) as i32 as i64);
         if r & 0x3000 == 0 {
             rig.io[axis].limit_positive ^= true;
@@ -741,7 +741,7 @@ fn axis_memory_footprint() {
 #[test]
 fn c094_c095_hardware_limit_switch_faults_and_locks_the_direction() {
     let mut rig = Rig::new();
-    rig.drive.axes[0].params_mut().limits.positive_switch = true;
+    rig.drive.axes_mut()[0].params_mut().limits.positive_switch = true;
     rig.set(0, 0x6060, 0, 9);
     rig.enable(0);
     rig.set(0, 0x60FF, 0, REV_I);
@@ -749,7 +749,7 @@ fn c094_c095_hardware_limit_switch_faults_and_locks_the_direction() {
     rig.io[0].limit_positive = true;
     rig.run_until(200, |r| r.state(0) == State::Fault);
     assert_eq!(rig.get(0, 0x603F, 0), 0x8500, "event 53");
-    assert_eq!(rig.drive.slave.emergencies_pending(), 1);
+    assert_eq!(rig.drive.slave().emergencies_pending(), 1);
     // acknowledge, enable again: positive motion refused, negative allowed
     rig.controlword(0, 0x80);
     rig.run(2);

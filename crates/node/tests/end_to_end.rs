@@ -132,7 +132,7 @@ fn e107_e125_free_run_cycle_at_a150_without_sync0() {
     // E-125: the free-running period follows A150 (the axes' dt), 250 µs … 8 ms
     for a150_us in [250, 500, 2000, 4000, 8000] {
         drive
-            .objects
+            .objects_mut()
             .set(drive::parameter_index(0, 150), 0, a150_us)
             .unwrap();
         let now = timer.next_at_ns();
@@ -150,11 +150,11 @@ fn e107_e125_free_run_cycle_at_a150_without_sync0() {
 #[test]
 fn save_fits_the_parameter_flash() {
     let mut drive = Drive::new(ParamFlash::new());
-    drive.objects.set(0x6065, 0, 1234).unwrap();
+    drive.objects_mut().set(0x6065, 0, 1234).unwrap();
     assert!(drive.save(), "save into {} bytes", 2 * 2048);
     let drive = Drive::new(drive.into_flash().unwrap());
     assert_eq!(drive.startup(), drive::runtime::Startup::Loaded);
-    assert_eq!(drive.objects.get(0x6065, 0), Ok(1234));
+    assert_eq!(drive.objects().get(0x6065, 0), Ok(1234));
 }
 
 /// E-018: a save requested over the bus (1010h:01 "save") is not written
@@ -164,19 +164,19 @@ fn save_fits_the_parameter_flash() {
 fn e018_save_is_written_by_the_background_task() {
     use od::Dictionary as _;
     let mut b = Board::new();
-    b.drive.objects.set(0x6065, 0, 4321).unwrap();
+    b.drive.objects_mut().set(0x6065, 0, 4321).unwrap();
     let save = drive::SAVE_SIGNATURE.to_le_bytes();
     b.drive
-        .objects
+        .objects_mut()
         .write(0x1010, 1, &save, od::CommState::PreOp)
         .unwrap();
     tasks::mailbox(&mut b.drive, &mut b.esc.pdi(), 0).unwrap();
-    assert!(b.drive.objects.requests().save, "the mailbox task saved");
+    assert!(b.drive.objects().requests().save, "the mailbox task saved");
     tasks::background(&mut Exclusive(&mut b.drive));
-    assert!(!b.drive.objects.requests().save);
+    assert!(!b.drive.objects().requests().save);
     let drive = Drive::new(b.drive.into_flash().unwrap());
     assert_eq!(drive.startup(), drive::runtime::Startup::Loaded);
-    assert_eq!(drive.objects.get(0x6065, 0), Ok(4321));
+    assert_eq!(drive.objects().get(0x6065, 0), Ok(4321));
 }
 
 /// E-018 with the task map: the background task takes the values and the
@@ -188,32 +188,32 @@ fn e018_save_is_written_by_the_background_task() {
 fn e018_save_job_writes_the_flash_outside_the_drive() {
     use od::Dictionary as _;
     const A00: u16 = 0x2000;
-    let request = |d: &mut Drive| d.objects.write(A00, 1, &[1], od::CommState::PreOp).unwrap();
+    let request = |d: &mut Drive| d.objects_mut().write(A00, 1, &[1], od::CommState::PreOp).unwrap();
     let mut b = Board::new();
-    b.drive.objects.set(0x6065, 0, 1234).unwrap();
+    b.drive.objects_mut().set(0x6065, 0, 1234).unwrap();
     request(&mut b.drive);
     let mut job = b.drive.begin_save().expect("a save was requested");
-    assert_eq!(b.drive.objects.get(A00, 1), Ok(1), "running");
+    assert_eq!(b.drive.objects().get(A00, 1), Ok(1), "running");
     assert!(b.drive.flash_mut().is_none(), "the job has the store");
     // the drive runs on meanwhile; a new value and a new request wait
     let io = [drive::axis::AxisIo::ready(0); 2];
     for k in 1..=3u64 {
         tasks::control(&mut b.drive, &mut b.timer, k * 1_000_000, &io);
     }
-    b.drive.objects.set(0x6065, 0, 999).unwrap();
+    b.drive.objects_mut().set(0x6065, 0, 999).unwrap();
     request(&mut b.drive);
     assert!(b.drive.begin_save().is_none(), "one job at a time");
     job.write();
     assert!(b.drive.end_save(job));
-    assert_eq!(b.drive.objects.get(A00, 3), Ok(drive::runtime::save_result::OK));
+    assert_eq!(b.drive.objects().get(A00, 3), Ok(drive::runtime::save_result::OK));
     assert!(
-        b.drive.objects.requests().save,
+        b.drive.objects().requests().save,
         "the second request is still pending"
     );
     let drive = Drive::new(b.drive.into_flash().unwrap());
     assert_eq!(drive.startup(), drive::runtime::Startup::Loaded);
     assert_eq!(
-        drive.objects.get(0x6065, 0),
+        drive.objects().get(0x6065, 0),
         Ok(1234),
         "the values at the start of the job"
     );

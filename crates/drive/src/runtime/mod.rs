@@ -161,19 +161,19 @@ const FREE_RUN_DEFAULT_NS: u32 = 1_000_000;
 /// (+ the firmware slots on flash `B`, see [`Drive::with_boot`]).
 pub struct Drive<F: Flash, B: Flash = NoFlash> {
     /// The EtherCAT slave stack.
-    pub slave: Slave,
+    slave: Slave,
     /// The EoE interface (E-095): the Ethernet frames the master tunnels
     /// to the drive and those the IP stack (crate `net`) sends back, and the
     /// IP parameters the master set (E-096). See [`Drive::with_eoe`].
-    pub eoe: ecat::eoe_queue::EoeQueue,
+    eoe: ecat::eoe_queue::EoeQueue,
     /// The object dictionary (values in RAM).
-    pub objects: DriveObjects,
+    objects: DriveObjects,
     /// The parameter store; out in a [`SaveJob`] while one runs.
     store: Option<ParamStore<F>>,
     /// The firmware slots (FoE firmware update), if the drive has them.
     boot: Option<BootSlots<B>>,
     /// Diagnosis history 10F3h (volatile, E-145).
-    pub diag: DiagHistory,
+    diag: DiagHistory,
     startup: Startup,
     last_code: AlStatusCode,
     /// The process images of the mapping in force (compiled at P→S).
@@ -185,7 +185,7 @@ pub struct Drive<F: Flash, B: Flash = NoFlash> {
     /// `Slave::outputs_received` after the previous poll.
     last_rx_frames: u32,
     /// The two axes (A, B), stepped by [`Drive::control_cycle`].
-    pub axes: [Axis; 2],
+    axes: [Axis; 2],
     /// Each axis' snapshot and slots, read in place by the control cycle.
     axis_caches: [AxisCache; 2],
     /// `Slave::outputs_received` at the previous control cycle (new
@@ -259,6 +259,54 @@ impl<F: Flash> Drive<F> {
 }
 
 impl<F: Flash, B: Flash> Drive<F, B> {
+    /// The EtherCAT slave stack (ESM state, sync status, counters, FoE,
+    /// EoE server).
+    pub fn slave(&self) -> &Slave {
+        &self.slave
+    }
+
+    /// The slave stack, mutable: for board support and tests that work on
+    /// it directly (the process images, a queued emergency).
+    pub fn slave_mut(&mut self) -> &mut Slave {
+        &mut self.slave
+    }
+
+    /// The object dictionary.
+    pub fn objects(&self) -> &DriveObjects {
+        &self.objects
+    }
+
+    /// The object dictionary, mutable: what a local write (board support,
+    /// tests, the simulator's set-up) goes through.
+    pub fn objects_mut(&mut self) -> &mut DriveObjects {
+        &mut self.objects
+    }
+
+    /// The EoE interface's frame queues (E-095): see [`Drive::with_eoe`].
+    pub fn eoe(&self) -> &ecat::eoe_queue::EoeQueue {
+        &self.eoe
+    }
+
+    /// The EoE queues, mutable (an IP stack bound to them, tests).
+    pub fn eoe_mut(&mut self) -> &mut ecat::eoe_queue::EoeQueue {
+        &mut self.eoe
+    }
+
+    /// The two axes (A, B).
+    pub fn axes(&self) -> &[Axis; 2] {
+        &self.axes
+    }
+
+    /// The axes, mutable (their parameters, tests).
+    pub fn axes_mut(&mut self) -> &mut [Axis; 2] {
+        &mut self.axes
+    }
+
+    /// The diagnosis history 10F3h.
+    pub fn diag(&self) -> &DiagHistory {
+        &self.diag
+    }
+
     /// Powers the drive on with the firmware slots `boot` (as the boot left
     /// them: [`BootSlots::boot`] ran and chose the running slot): FoE
     /// firmware downloads in Bootstrap go into the inactive slot.
