@@ -73,7 +73,7 @@ fuzz_target!(|data: &[u8]| {
         seed: 1,
     };
     let mut net = NetStack::new(cfg, &mut bufs, &mut slots, drive.eoe_mut(), 0);
-    drive.eoe().ip_changed(&IpParams {
+    drive.eoe_mut().ip_changed(&IpParams {
         ip: Some(DRIVE),
         mask: Some([255, 255, 255, 0]),
         gateway: Some(HOST),
