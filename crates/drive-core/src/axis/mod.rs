@@ -419,6 +419,28 @@ impl Axis {
     /// [`cycle`](Self::cycle) with the snapshot and slots in `cache`, kept
     /// by the caller (one cache per axis, never shared): read in place, no
     /// copy per cycle.
+    ///
+    /// The steps, in order:
+    /// 1. **snapshot**: the cyclic set-points again while the configuration
+    ///    generation stands, else the whole snapshot (`snapshot.rs`), in
+    ///    increments;
+    /// 2. **configure** when the generation, the cycle or the mode class
+    ///    changed (`configure.rs`);
+    /// 3. **inputs**: the switch signals from their sources ([`AxisIo`] or
+    ///    I210);
+    /// 4. **feedback**: encoder → user position, velocity filter
+    ///    (`feedback.rs`);
+    /// 5. **limits**: limit switches, software limits, the direction lock
+    ///    of this cycle and a limit's stop;
+    /// 6. **device control**: the CiA 402 state machine step, a fault
+    ///    change on T13/T15 (603Fh, error register);
+    /// 7. **touch probe** (`feedback.rs`);
+    /// 8. **motion**: the active mode's generator gives the demand
+    ///    (`modes.rs`);
+    /// 9. **control**: the cascade turns the demand into a torque and the
+    ///    mode's status bits;
+    /// 10. **write-back**: statusword and actual values, A67, E47/E49,
+    ///     60FDh (`write_back.rs`).
     pub fn cycle_cached(
         &mut self,
         cache: &mut AxisCache,
