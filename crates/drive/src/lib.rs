@@ -152,6 +152,6 @@ pub static DEVICE: Device = Device {
 #[cfg(test)]
 extern crate std;
 #[cfg(test)]
-mod axis_tests;
-#[cfg(test)]
 mod tests;
+#[cfg(test)]
+mod tests_axis;

@@ -75,6 +75,7 @@
 //! [`fault_code_for_event`]) and sets 603Fh and its error register, on T15
 //! it reports [`FaultChange::Cleared`].
 
+mod cache;
 mod configure;
 mod feedback;
 mod io;
@@ -113,6 +114,8 @@ use motion::{
 use od::error_register;
 use snapshot::{CyclicSlots, Snapshot, Window};
 
+pub use cache::AxisCache;
+use cache::CachedSnapshot;
 pub use io::{AxisCommand, AxisIo, AxisReport, IndexLatch, ProbeEdge, SwitchEdge, SwitchId};
 pub use params::AxisParams;
 pub use units::{e48, scaled_gains, GAIN_REFERENCE_CYCLE_NS};
@@ -774,38 +777,5 @@ impl Axis {
             bits |= SW_INTERNAL_LIMIT;
         }
         (c.torque_nm, bits, c.following_error_inc)
-    }
-}
-
-/// What an axis keeps between control cycles about the dictionary: the
-/// snapshot of its objects with the configuration generation it was read
-/// at (while the generation stands only the cyclic set-points are read
-/// again) and the resolved slots of its cyclic entries
-/// (docs/architecture.md, cycle cost).
-#[derive(Debug, Clone, Default)]
-pub struct AxisCache {
-    snapshot: Option<CachedSnapshot>,
-    slots: Option<CyclicSlots>,
-}
-
-/// The snapshot with the configuration generation it was read at and what
-/// follows from it alone.
-#[derive(Debug, Clone)]
-struct CachedSnapshot {
-    generation: u32,
-    snapshot: Snapshot,
-    /// The user units are increments (no conversion of the snapshot).
-    in_increments: bool,
-    /// The control cycle A150, ns (1 ms when A150 is not one of the cycles).
-    dt_ns: u32,
-}
-
-impl AxisCache {
-    /// Empty: the first cycle reads everything.
-    pub const fn new() -> Self {
-        Self {
-            snapshot: None,
-            slots: None,
-        }
     }
 }
