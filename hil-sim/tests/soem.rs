@@ -18,6 +18,9 @@
 //! that cannot import pysoem fails them.
 #![allow(clippy::unwrap_used, clippy::expect_used, clippy::panic)]
 
+mod common;
+
+use common::ip;
 use ecat::Dictionary;
 use std::fmt::Write as _;
 use std::path::{Path, PathBuf};
@@ -35,19 +38,11 @@ const OP_SECONDS: u32 = 12;
 /// A script that has not finished after this long has hung.
 const SCRIPT_LIMIT: Duration = Duration::from_secs(240);
 
-fn root() -> bool {
-    // SAFETY: geteuid has no preconditions.
-    #[allow(unsafe_code)]
-    unsafe {
-        libc::geteuid() == 0
-    }
-}
-
 /// The python with pysoem, or why the test cannot run (not root, or
 /// `PYSOEM_PYTHON` not set). A `PYSOEM_PYTHON` that cannot import pysoem is
 /// a failure, not a skip: whoever set it wants the test to run.
 fn pysoem_python() -> Result<PathBuf, String> {
-    if !root() {
+    if !common::is_root() {
         return Err("needs root for network namespaces and raw sockets".into());
     }
     let py = std::env::var_os("PYSOEM_PYTHON").ok_or(
@@ -72,26 +67,12 @@ fn pysoem_python() -> Result<PathBuf, String> {
     Ok(PathBuf::from(py))
 }
 
-/// `chrt --fifo 50` when `chrt` is there: the simulated drives stand for
-/// hardware (an ESC and an MCU of their own), so `serve` gets the CPU before
-/// the compile jobs of a shared machine do. `serve` paces the simulation by
-/// the wall clock and processes a frame when it gets to run: descheduled, it
-/// shows the drive a frame late (a frame after SYNC0), which the drive rightly
-/// counts and, five in a row, answers with AL 0033h. The master runs at
-/// SCHED_FIFO 40 as SOEM's samples do (the script sets it).
-fn rt_prefix() -> Option<[&'static str; 3]> {
-    let ok = Command::new("chrt")
-        .args(["--fifo", "50", "true"])
-        .stderr(Stdio::null())
-        .status()
-        .is_ok_and(|s| s.success());
-    ok.then_some(["chrt", "--fifo", "50"])
-}
-
-fn ip(args: &[&str]) {
-    let st = Command::new("ip").args(args).status().expect("run ip");
-    assert!(st.success(), "ip {args:?} failed");
-}
+/// SCHED_FIFO priority of `serve`: the simulated drives stand for hardware
+/// (an ESC and an MCU of their own), so `serve` gets the CPU before the
+/// compile jobs of a shared machine do (a descheduled `serve` still sees
+/// each frame at its kernel receive time, but answers it late). The master
+/// runs at SCHED_FIFO 40 as SOEM's samples do (the script sets it).
+const SERVE_PRIORITY: &str = "50";
 
 /// Two private namespaces joined by a veth pair, `hil-sim serve` in one.
 struct Line {
@@ -127,13 +108,9 @@ impl Line {
         // SOEM_PCAP=1: serve records every frame (for a failure's evidence)
         let pcap = std::env::var_os("SOEM_PCAP").map(|_| dir.join(format!("serve-{tag}.pcap")));
         let log = std::fs::File::create(&serve_log).expect("serve log");
-        let mut server = Command::new("ip");
-        server.args(["netns", "exec", &sim_ns]);
-        if let Some(chrt) = rt_prefix() {
-            server.args(chrt);
-        }
-        let server = server
-            .args([env!("CARGO_BIN_EXE_hil-sim"), "serve"])
+        let server = Command::new("ip")
+            .args(["netns", "exec", &sim_ns, env!("CARGO_BIN_EXE_hil-sim"), "serve"])
+            .args(["--fifo-priority", SERVE_PRIORITY])
             .args(["--iface", &sim_if, "--slaves", &slaves.to_string()])
             .args(["--seconds", &seconds.to_string()])
             .args(
@@ -214,22 +191,8 @@ impl Line {
 
 impl Drop for Line {
     fn drop(&mut self) {
-        if let Some(mut s) = self.server.take() {
-            // SIGTERM first (`ip netns exec` and `chrt` exec serve, so this is
-            // serve's pid), then SIGKILL if it is still there after 2 s
-            if let Ok(pid) = i32::try_from(s.id()) {
-                // SAFETY: kill has no memory preconditions; the pid is our child's.
-                #[allow(unsafe_code)]
-                unsafe {
-                    libc::kill(pid, libc::SIGTERM);
-                }
-            }
-            let end = Instant::now() + Duration::from_secs(2);
-            while Instant::now() < end && matches!(s.try_wait(), Ok(None)) {
-                std::thread::sleep(Duration::from_millis(20));
-            }
-            let _ = s.kill();
-            let _ = s.wait();
+        if let Some(s) = self.server.take() {
+            common::stop_server(s, Duration::from_secs(2));
         }
         // deleting the namespaces deletes the veth pair
         for ns in [&self.master_ns, &self.sim_ns] {

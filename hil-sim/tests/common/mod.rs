@@ -23,9 +23,32 @@ pub struct Netns {
     server: Option<Child>,
 }
 
-fn ip(args: &[&str]) {
+/// Runs `ip args`, failing the test when it fails.
+pub fn ip(args: &[&str]) {
     let st = Command::new("ip").args(args).status().expect("run ip");
     assert!(st.success(), "ip {args:?} failed");
+}
+
+/// Stops a `serve` child: SIGTERM first (it flushes its recording and
+/// prints its summary; `ip netns exec` execs serve, so the child's pid is
+/// serve's), then SIGKILL if it is still there after `grace`.
+pub fn stop_server(mut s: Child, grace: Duration) {
+    if let Ok(pid) = i32::try_from(s.id()) {
+        // SAFETY: kill has no memory preconditions; pid is our child.
+        #[allow(unsafe_code)]
+        unsafe {
+            libc::kill(pid, libc::SIGTERM);
+        }
+    }
+    let end = std::time::Instant::now() + grace;
+    while std::time::Instant::now() < end {
+        if let Ok(Some(_)) = s.try_wait() {
+            return;
+        }
+        std::thread::sleep(Duration::from_millis(20));
+    }
+    let _ = s.kill();
+    let _ = s.wait();
 }
 
 impl Netns {
@@ -64,23 +87,9 @@ impl Netns {
     /// Asks the server to stop (SIGTERM: it flushes its recording and prints
     /// its summary), waits up to 5 s for it, then kills it.
     pub fn stop_server(&mut self) {
-        let Some(mut s) = self.server.take() else { return };
-        if let Ok(pid) = i32::try_from(s.id()) {
-            // SAFETY: kill has no memory preconditions; pid is our child.
-            #[allow(unsafe_code)]
-            unsafe {
-                libc::kill(pid, libc::SIGTERM);
-            }
+        if let Some(s) = self.server.take() {
+            stop_server(s, Duration::from_secs(5));
         }
-        let end = std::time::Instant::now() + Duration::from_secs(5);
-        while std::time::Instant::now() < end {
-            if let Ok(Some(_)) = s.try_wait() {
-                return;
-            }
-            std::thread::sleep(Duration::from_millis(20));
-        }
-        let _ = s.kill();
-        let _ = s.wait();
     }
 }
 
