@@ -20,6 +20,9 @@ pub const A257: u16 = parameter_index(0, 257);
 pub const A149: u16 = parameter_index(0, 149);
 /// A150 application cycle time, µs (250 … 8000, C-144).
 pub const A150: u16 = parameter_index(0, 150);
+/// The cycle assumed while A150 holds no allowed value, µs: A150's declared
+/// default (`c144_a150_fallback_is_the_declared_default`).
+pub const A150_FALLBACK_US: u32 = 1000;
 /// A261 sync diagnostics: `[k]` is sub `k + 1`.
 pub const A261: u16 = parameter_index(0, 261);
 /// A290 PLL control.

@@ -802,3 +802,14 @@ fn c144_e125_a150_values_agree_with_the_declaration() {
     assert_eq!(declared, motion::cycle::APPLICATION_CYCLES_NS);
     assert_eq!(declared, dcsync::validate::A150_VALUES_NS);
 }
+
+/// The cycle the drive assumes while A150 holds no allowed value is A150's
+/// declared default (C-144), not a second number.
+#[test]
+fn c144_a150_fallback_is_the_declared_default() {
+    let d = DriveObjects::new();
+    assert_eq!(
+        d.get(crate::params::A150, 0),
+        Ok(i64::from(crate::params::A150_FALLBACK_US))
+    );
+}

@@ -67,9 +67,6 @@ pub const fn event52_cause(loss: OpLoss) -> u8 {
     }
 }
 
-/// A150 when it holds nothing usable, µs.
-const DEFAULT_A150_US: u32 = 1000;
-
 /// The drive's dictionary (with its live values) as the slave stack's
 /// application: the [`od::Dictionary`] of the CoE server, and the settings
 /// of [`ecat::Application`] read from A150 and A258.
@@ -84,7 +81,7 @@ impl<L: LiveValues> EcatApp<'_, L> {
             .get(A150, 0)
             .ok()
             .and_then(|v| u32::try_from(v).ok())
-            .unwrap_or(DEFAULT_A150_US);
+            .unwrap_or(crate::params::A150_FALLBACK_US);
         us.saturating_mul(1000)
     }
 }

@@ -16,7 +16,7 @@ use crate::Drive;
 
 /// The first free-running control cycle starts at this local time, ns
 /// (A150's default); the next ones follow A150.
-pub const CYCLE_NS: u64 = 1_000_000;
+pub const CYCLE_NS: u64 = drive::params::A150_FALLBACK_US as u64 * 1000;
 
 const NS_PER_S: u64 = 1_000_000_000;
 

@@ -23,7 +23,8 @@ pub(super) struct CachedSnapshot {
     pub(super) snapshot: Snapshot,
     /// The user units are increments (no conversion of the snapshot).
     pub(super) in_increments: bool,
-    /// The control cycle A150, ns (1 ms when A150 is not one of the cycles).
+    /// The control cycle A150, ns (`A150_FALLBACK_US` when A150 is not one
+    /// of the cycles).
     pub(super) dt_ns: u32,
 }
 

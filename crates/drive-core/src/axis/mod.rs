@@ -471,7 +471,7 @@ impl Axis {
                     generation,
                     in_increments: fresh.in_increments(&self.scaling),
                     dt_ns: application_cycle_ns(u32::from(fresh.control_cycle_us).saturating_mul(1000))
-                        .unwrap_or(1_000_000),
+                        .unwrap_or(crate::params::A150_FALLBACK_US * 1000),
                     snapshot: fresh,
                 })
             }

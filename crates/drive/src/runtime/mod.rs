@@ -156,9 +156,6 @@ pub enum Startup {
     Defaults,
 }
 
-/// The free-running control cycle while A150 holds no allowed value, ns.
-const FREE_RUN_DEFAULT_NS: u32 = 1_000_000;
-
 /// One drive on the bus: slave stack + object dictionary + parameter store
 /// (+ the firmware slots on flash `B`, see [`Drive::with_boot`]).
 pub struct Drive<F: Flash, B: Flash = NoFlash> {

@@ -155,12 +155,15 @@ impl<F: Flash, B: Flash> Drive<F, B> {
     }
 
     /// The period of the free-running control cycle (no SYNC0), ns: A150,
-    /// the cycle the axes integrate with (E-125, C-144); 1 ms while A150
-    /// holds no allowed cycle time.
+    /// the cycle the axes integrate with (E-125, C-144);
+    /// [`A150_FALLBACK_US`](crate::params::A150_FALLBACK_US) while A150 holds
+    /// no allowed cycle time.
     pub fn free_run_period_ns(&self) -> u64 {
         let a150_ns =
             u32::try_from(read_slot(&self.objects, self.slots.a150, 0).saturating_mul(1000)).unwrap_or(0);
-        u64::from(motion::cycle::application_cycle_ns(a150_ns).unwrap_or(FREE_RUN_DEFAULT_NS))
+        u64::from(
+            motion::cycle::application_cycle_ns(a150_ns).unwrap_or(crate::params::A150_FALLBACK_US * 1000),
+        )
     }
 
     /// The PLL configuration from the ESC's SYNC0 cycle and the objects
