@@ -51,7 +51,7 @@ impl Axis {
         }
 
         // cascade: torque limits from 6072h (homing: I28), gains adapted to A150
-        let per_mille = if self.running == Some(Mode::Homing) {
+        let per_mille = if self.running == Running::Homing {
             o.max_torque.min(p.homing_torque_limit_per_mille)
         } else {
             o.max_torque
@@ -85,7 +85,7 @@ impl Axis {
         // C-091: jog under velocity control (I26 = 0) quick-stops at a
         // software limit instead of faulting
         self.retained = o.i46 == 5 && o.i02 == 0;
-        let soft_limit_reaction = if self.running == Some(Mode::Jog) && !p.jog_position_control {
+        let soft_limit_reaction = if matches!(self.running, Running::Jog(_)) && !p.jog_position_control {
             SoftLimitReaction::QuickStop
         } else {
             p.limits.soft_limit_reaction

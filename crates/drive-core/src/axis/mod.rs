@@ -27,6 +27,14 @@
 //! | jog (−1) | bits 4/5, I12/I13/I45/I18 ([`AxisParams`]) | [`ProfileGenerator`] | position (I26 = 1) / velocity |
 //! | no mode (0) | – | holds the set-point | position |
 //!
+//! The running mode and the state only it keeps (the pp target and its
+//! handshake, the pv/vl/jog velocity command, the pt torque ramp, the
+//! master's last csp/ip set-point) are one `Running` value (`running.rs`):
+//! activating a mode starts its variant fresh and a stop or disable drops
+//! it, so no mode reads what another left behind. What the modes share (the
+//! set-point, the profile generator, the interpolators, homing, the monitors
+//! and limits) stays in [`Axis`].
+//!
 //! Quick stop, the fault reaction and the disable ramps come from the device
 //! control's [`Ramp`]: slow-down (6084h) and quick-stop (6085h; vl: 604Ah)
 //! ramps run on the profile generator from the present set-point (fault
@@ -81,6 +89,7 @@ mod feedback;
 mod io;
 mod modes;
 mod params;
+mod running;
 mod snapshot;
 #[cfg(test)]
 mod tests;
@@ -112,6 +121,7 @@ use motion::{
     ProfileGenerator, ProfileLimits, SetMode, VelocityInterpolator, INCREMENTS_PER_REVOLUTION,
 };
 use od::error_register;
+use running::{MasterTrack, PpState, Running, VelocityCommand};
 use snapshot::{CyclicSlots, Snapshot, Window};
 
 pub use cache::AxisCache;
@@ -208,20 +218,12 @@ pub struct Axis {
     /// Set-point state: position (inc), velocity (inc/s).
     sp_pos: i32,
     sp_vel: f32,
-    /// The mode the motion core was set up for (None: not running).
-    running: Option<Mode>,
+    /// The mode the motion core was set up for, with its own state.
+    running: Running,
     /// A device-control stop in progress.
     stop: Option<Stop>,
-    /// A halt (bit 8, or a limit quick stop in jog) in progress.
-    halting: bool,
     /// Previous controlword (edges of bit 4).
     prev_cw: u16,
-    /// pp set-point acknowledge (bit 12).
-    pp_ack: bool,
-    /// Last commanded profile velocity of pv/vl/jog, inc/s.
-    commanded_velocity: Option<f32>,
-    /// pt torque ramp output, N·m.
-    pt_torque: f32,
     /// Last cascade output.
     last_out: Option<CascadeOutput>,
     /// Last cascade entry.
@@ -235,28 +237,19 @@ pub struct Axis {
     /// 603Fh and the error register while in a fault.
     error_code: u16,
     error_register: u8,
-    /// vl demand (6043h), inc/s.
+    /// vl demand (6043h), inc/s: the last vl cycle's, shown until the drive
+    /// function goes off.
     vl_demand: f32,
     /// I90 cause of this cycle's direction lock (E80).
     denial: Option<DenialCause>,
     /// I46 = 5 with I02 = 0: the encoder position is the reference (C-112).
     retained: bool,
-    /// The pp target being approached (override re-plans, C-030).
-    pp_target: Option<i32>,
-    /// The A340 override the pp move was planned with, %.
-    pp_override: u16,
-    /// Last cyclic position set-point of the master (C-148) and the time
-    /// since it arrived, ns.
-    last_master_sp: Option<i32>,
-    sp_age_ns: u64,
     /// 6091h/6092h of this cycle (C-109).
     scaling: AxisScaling,
     /// 10^A310 with A213 = 0, else 1 (C-142).
     velocity_decimals: f32,
     /// Endless axis (I00 = 1) with 607Bh:02 > 0, user units (C-111).
     modulo: Option<ModuloAxis>,
-    /// The last cyclic set-point of an endless axis as sent (user units).
-    last_master_user: Option<i64>,
 }
 
 impl Axis {
@@ -299,13 +292,9 @@ impl Axis {
             last_sample: None,
             sp_pos: 0,
             sp_vel: 0.0,
-            running: None,
+            running: Running::Idle,
             stop: None,
-            halting: false,
             prev_cw: 0,
-            pp_ack: false,
-            commanded_velocity: None,
-            pt_torque: 0.0,
             last_out: None,
             last_entry: None,
             standstill_since: None,
@@ -316,14 +305,9 @@ impl Axis {
             vl_demand: 0.0,
             denial: None,
             retained: false,
-            pp_target: None,
-            pp_override: 100,
-            last_master_sp: None,
-            sp_age_ns: 0,
             scaling: AxisScaling::INCREMENTAL,
             velocity_decimals: 1.0,
             modulo: None,
-            last_master_user: None,
         }
     }
 
@@ -486,8 +470,8 @@ impl Axis {
             &converted
         };
         let class = match self.running {
-            Some(Mode::Homing) => 1,
-            Some(Mode::Jog) => 2,
+            Running::Homing => 1,
+            Running::Jog(_) => 2,
             _ => 0,
         };
         if self.configured != Some((generation, dt_ns, class)) {
@@ -508,7 +492,7 @@ impl Axis {
         let i199 = is_standstill(self.velocity, self.params.velocity_window_inc_per_s);
 
         // limits first: the lock of this cycle filters the set-points
-        let homing_active = self.running == Some(Mode::Homing);
+        let homing_active = self.running == Running::Homing;
         let status = self.limits.update(&LimitInput {
             actual_position_inc: actual,
             position_setpoint_inc: self.sp_pos,
@@ -641,12 +625,8 @@ impl Axis {
     fn disengage(&mut self, actual: i32) {
         self.sp_pos = actual;
         self.sp_vel = 0.0;
-        self.running = None;
+        self.running = Running::Idle;
         self.stop = None;
-        self.halting = false;
-        self.pp_ack = false;
-        self.commanded_velocity = None;
-        self.pt_torque = 0.0;
         self.vl_demand = 0.0;
         self.profile.reset(actual);
         self.following.reset();
@@ -657,9 +637,11 @@ impl Axis {
 
     /// The limits asked for a quick stop without a fault (jog, I26 = 0).
     fn local_quick_stop(&mut self, o: &Snapshot) {
-        if self.running.is_some() && self.stop.is_none() {
+        if self.running != Running::Idle && self.stop.is_none() {
             let _ = self.profile.stop(o.quick_stop_deceleration as f32, f32::INFINITY);
-            self.commanded_velocity = Some(0.0);
+            if let Some(c) = self.running.velocity_command() {
+                c.commanded = Some(0.0);
+            }
         }
     }
 
@@ -703,14 +685,16 @@ impl Axis {
             return Some(Demand::hold(self.sp_pos));
         }
         let mode = self.dc.mode();
-        if self.running != Some(mode) {
+        if self.running.mode() != Some(mode) {
             self.activate(mode, o, *actual);
         }
         let halt = matches!(out.ramp, Ramp::Halt(_));
-        let d = match mode {
-            Mode::CyclicPosition | Mode::InterpolatedPosition => self.cyclic_position(o, mode, new_setpoint),
-            Mode::CyclicVelocity => self.cyclic_velocity(o, new_setpoint),
-            Mode::CyclicTorque => Demand {
+        // the mode's own state, out of the axis while its generator runs
+        let mut running = self.running;
+        let d = match &mut running {
+            Running::CyclicPosition { ip, master } => self.cyclic_position(master, o, *ip, new_setpoint),
+            Running::CyclicVelocity => self.cyclic_velocity(o, new_setpoint),
+            Running::CyclicTorque => Demand {
                 entry: ControlEntry::Torque,
                 torque: self
                     .lock
@@ -718,14 +702,15 @@ impl Axis {
                 bits: SW_MODE_BIT12,
                 ..Demand::hold(*actual)
             },
-            Mode::ProfilePosition => self.profile_position(o, halt, *actual, now_ns, dt_ns),
-            Mode::ProfileVelocity => self.profile_velocity(o, halt, now_ns, dt_ns),
-            Mode::ProfileTorque => self.profile_torque(o, dt_ns, *actual),
-            Mode::Velocity => self.velocity_mode(o, dt_ns),
-            Mode::Homing => self.run_homing(o, io, actual, i199, dt_ns),
-            Mode::Jog => self.jog(o, dt_ns),
-            Mode::NoMode => Demand::hold(self.sp_pos),
+            Running::ProfilePosition(pp) => self.profile_position(pp, o, halt, *actual, now_ns, dt_ns),
+            Running::ProfileVelocity(pv) => self.profile_velocity(pv, o, halt, now_ns, dt_ns),
+            Running::ProfileTorque { torque } => self.profile_torque(torque, o, dt_ns, *actual),
+            Running::Velocity(vl) => self.velocity_mode(vl, o, dt_ns),
+            Running::Homing => self.run_homing(o, io, actual, i199, dt_ns),
+            Running::Jog(jog) => self.jog(jog, o, dt_ns),
+            Running::NoMode | Running::Idle => Demand::hold(self.sp_pos),
         };
+        self.running = running;
         Some(d)
     }
 
@@ -759,8 +744,10 @@ impl Axis {
                 self.raise(ev);
             }
             // bit 13 of csp/pp is the monitor's state after this cycle
-            if matches!(self.running, Some(Mode::CyclicPosition | Mode::ProfilePosition))
-                && fe.following_error
+            if matches!(
+                self.running,
+                Running::CyclicPosition { ip: false, .. } | Running::ProfilePosition(_)
+            ) && fe.following_error
             {
                 bits |= SW_MODE_BIT13;
             }

@@ -8,19 +8,12 @@ impl Axis {
     /// Sets the generator of `mode` up from the present set-point state
     /// (bumpless mode change and enable).
     pub(super) fn activate(&mut self, mode: Mode, o: &Snapshot, actual: i32) {
-        self.running = Some(mode);
-        self.halting = false;
-        self.pp_ack = false;
-        self.commanded_velocity = None;
+        self.running = Running::start(mode, self.last_out.map_or(0.0, |c| c.torque_nm));
         self.following.reset();
         self.in_position.reset();
         self.velocity_window.reset();
         // a bit 4 already set is no edge (pp, homing)
         self.prev_cw = o.controlword;
-        self.pp_target = None;
-        self.last_master_sp = None;
-        self.last_master_user = None;
-        self.sp_age_ns = 0;
         match mode {
             Mode::CyclicPosition | Mode::InterpolatedPosition => {
                 if let Some(i) = self.interp.as_mut() {
@@ -32,9 +25,7 @@ impl Axis {
                     v.start(self.sp_vel);
                 }
             }
-            Mode::ProfileTorque => {
-                self.pt_torque = self.last_out.map_or(0.0, |c| c.torque_nm);
-            }
+            Mode::ProfileTorque => {}
             Mode::Homing => self.homing.activate(actual),
             Mode::ProfilePosition => {
                 // entered while moving (from pv, vl, jog): no target yet, so
@@ -58,7 +49,7 @@ impl Axis {
         dt_ns: u32,
     ) -> Demand {
         if self.stop.is_none() {
-            let vl = self.running == Some(Mode::Velocity);
+            let vl = matches!(self.running, Running::Velocity(_));
             let (decel, jerk_) = match d {
                 Decel::SlowDown if vl => (ramp_rate(o.vl_deceleration), f32::INFINITY),
                 Decel::SlowDown => (o.deceleration as f32, jerk(o.jerk)),
@@ -76,7 +67,7 @@ impl Axis {
                 Ok(()) => Some(Stop::Profile),
                 Err(_) => Some(Stop::Brake),
             };
-            self.running = None;
+            self.running = Running::Idle;
         }
         match self.stop {
             Some(Stop::Brake) => {
@@ -104,16 +95,21 @@ impl Axis {
         }
     }
 
-    pub(super) fn cyclic_position(&mut self, o: &Snapshot, mode: Mode, new_setpoint: bool) -> Demand {
-        let ip = mode == Mode::InterpolatedPosition;
+    pub(super) fn cyclic_position(
+        &mut self,
+        master: &mut MasterTrack,
+        o: &Snapshot,
+        ip: bool,
+        new_setpoint: bool,
+    ) -> Demand {
         let enabled = !ip || o.controlword & CW_MODE_BIT4 != 0;
         let torque = self.per_mille(i32::from(o.torque_offset));
         if !enabled {
             if let Some(interp) = self.interp.as_mut() {
                 interp.start(self.sp_pos);
             }
-            self.last_master_sp = None;
-            self.last_master_user = None;
+            master.setpoint = None;
+            master.user = None;
             return Demand {
                 torque,
                 ..Demand::hold(self.sp_pos)
@@ -127,31 +123,31 @@ impl Axis {
                 } else {
                     o.target_position_user
                 });
-                let (base, base_user) = match (self.last_master_sp, self.last_master_user) {
+                let (base, base_user) = match (master.setpoint, master.user) {
                     (Some(b), Some(u)) => (b, u),
                     _ => (self.sp_pos, self.user_position(self.sp_pos)),
                 };
-                self.last_master_user = Some(m.wrap(sent));
+                master.user = Some(m.wrap(sent));
                 base.wrapping_add(self.increments(m.distance(base_user, sent, ModuloDirection::Shortest)))
             }
-            Some(_) => self.last_master_sp.unwrap_or(self.sp_pos),
+            Some(_) => master.setpoint.unwrap_or(self.sp_pos),
             None if ip => o.ip_setpoint,
             None => o.target_position,
         };
         // C-148: set-value monitoring of the master's steps
         let master_ns = self.ratio.map_or(0, |r| u64::from(r.master_ns()));
-        self.sp_age_ns = self
-            .sp_age_ns
+        master.age_ns = master
+            .age_ns
             .saturating_add(u64::from(self.ratio.map_or(0, |r| r.control_ns())));
         if new_setpoint {
-            let from = self.last_master_sp.unwrap_or(self.sp_pos);
+            let from = master.setpoint.unwrap_or(self.sp_pos);
             let step = target.wrapping_sub(from).unsigned_abs() as f32;
-            let elapsed_ns = self.sp_age_ns.max(master_ns);
+            let elapsed_ns = master.age_ns.max(master_ns);
             let elapsed_s = motion::float::from_u64(elapsed_ns) * 1e-9;
             let allowed =
                 2.0 * o.max_profile_velocity as f32 * elapsed_s + self.params.position_window_inc as f32;
-            self.last_master_sp = Some(target);
-            self.sp_age_ns = 0;
+            master.setpoint = Some(target);
+            master.age_ns = 0;
             if self.params.set_value_monitoring && step > allowed {
                 self.raise(Event::SET_VALUE_JUMP);
                 return Demand::hold(self.sp_pos);
@@ -213,6 +209,7 @@ impl Axis {
 
     pub(super) fn profile_position(
         &mut self,
+        pp: &mut PpState,
         o: &Snapshot,
         halt: bool,
         actual: i32,
@@ -222,23 +219,23 @@ impl Axis {
         let cw = o.controlword;
         let bit4 = cw & CW_MODE_BIT4 != 0;
         let edge = bit4 && self.prev_cw & CW_MODE_BIT4 == 0;
-        if halt && !self.halting {
+        if halt && !pp.halting {
             let _ = self.profile.stop(o.deceleration as f32, jerk(o.jerk));
-            self.halting = true;
-            self.pp_target = None;
-        } else if !halt && self.halting {
-            self.halting = false;
+            pp.halting = true;
+            pp.target = None;
+        } else if !halt && pp.halting {
+            pp.halting = false;
         }
         if edge && !halt {
-            self.take_pp_target(o, actual);
+            self.take_pp_target(pp, o, actual);
         }
         if !bit4 {
-            self.pp_ack = false;
+            pp.ack = false;
         }
         // C-030: a changed override re-plans the running move (0 % pauses it)
-        if o.override_percent != self.pp_override && !self.halting {
-            self.pp_override = o.override_percent;
-            if let Some(t) = self.pp_target {
+        if o.override_percent != pp.override_percent && !pp.halting {
+            pp.override_percent = o.override_percent;
+            if let Some(t) = pp.target {
                 let _ = if o.override_percent == 0 {
                     self.profile.stop(o.deceleration as f32, jerk(o.jerk))
                 } else {
@@ -253,11 +250,11 @@ impl Axis {
             }
         }
         let s = self.profile.step(dt_ns);
-        let target = self.pp_target.unwrap_or(self.profile.target());
+        let target = pp.target.unwrap_or(self.profile.target());
         if s.done && s.position == target {
-            self.pp_target = None;
+            pp.target = None;
         }
-        let reached = if self.halting {
+        let reached = if pp.halting {
             s.done
         } else {
             self.in_position.update(target, actual, s.done, now_ns)
@@ -266,7 +263,7 @@ impl Axis {
         if reached {
             bits |= SW_TARGET_REACHED;
         }
-        if self.pp_ack {
+        if pp.ack {
             bits |= SW_MODE_BIT12;
         }
         Demand {
@@ -279,7 +276,7 @@ impl Axis {
     }
 
     /// A bit-4 edge in pp (C-041 – C-047, C-050).
-    pub(super) fn take_pp_target(&mut self, o: &Snapshot, actual: i32) {
+    pub(super) fn take_pp_target(&mut self, pp: &mut PpState, o: &Snapshot, actual: i32) {
         let cw = o.controlword;
         let d = o.target_position;
         let (target, resolved, relative) = if cw & CW_MODE_BIT6 == 0 {
@@ -314,7 +311,7 @@ impl Axis {
         } else {
             (
                 PositionTarget::Additive(d),
-                self.pp_target.unwrap_or(self.profile.target()).wrapping_add(d),
+                pp.target.unwrap_or(self.profile.target()).wrapping_add(d),
                 true,
             )
         };
@@ -331,40 +328,47 @@ impl Axis {
         };
         if o.override_percent == 0 {
             // paused by the override: taken over, started when A340 > 0
-            self.pp_target = Some(resolved);
-            self.pp_override = 0;
-            self.pp_ack = true;
+            pp.target = Some(resolved);
+            pp.override_percent = 0;
+            pp.ack = true;
             self.in_position.reset();
             return;
         }
         if let Ok(true) = self.profile.move_to(target, self.profile_limits(o), mode) {
-            self.pp_target = Some(self.profile.target());
-            self.pp_override = o.override_percent;
-            self.pp_ack = true;
+            pp.target = Some(self.profile.target());
+            pp.override_percent = o.override_percent;
+            pp.ack = true;
             self.in_position.reset();
         }
     }
 
-    pub(super) fn profile_velocity(&mut self, o: &Snapshot, halt: bool, now_ns: u64, dt_ns: u32) -> Demand {
+    pub(super) fn profile_velocity(
+        &mut self,
+        pv: &mut VelocityCommand,
+        o: &Snapshot,
+        halt: bool,
+        now_ns: u64,
+        dt_ns: u32,
+    ) -> Demand {
         // C-030: 60FFh × A340
         let target = self
             .lock
             .filter_velocity(o.target_velocity as f32 * override_factor(o));
         if halt {
-            if !self.halting {
+            if !pv.halting {
                 let _ = self.profile.stop(o.deceleration as f32, jerk(o.jerk));
-                self.halting = true;
-                self.commanded_velocity = None;
+                pv.halting = true;
+                pv.commanded = None;
             }
         } else {
-            self.halting = false;
-            if self.commanded_velocity != Some(target) {
+            pv.halting = false;
+            if pv.commanded != Some(target) {
                 let limits = ProfileLimits {
                     velocity: o.max_profile_velocity as f32,
                     ..self.profile_limits(o)
                 };
                 if self.profile.run_velocity(target, limits).is_ok() {
-                    self.commanded_velocity = Some(target);
+                    pv.commanded = Some(target);
                 }
             }
         }
@@ -391,31 +395,27 @@ impl Axis {
         }
     }
 
-    pub(super) fn profile_torque(&mut self, o: &Snapshot, dt_ns: u32, actual: i32) -> Demand {
+    pub(super) fn profile_torque(&mut self, ramp: &mut f32, o: &Snapshot, dt_ns: u32, actual: i32) -> Demand {
         let max = self.per_mille(i32::from(o.max_torque));
         let target = self
             .lock
             .filter_torque(self.per_mille(i32::from(o.target_torque)).max(-max).min(max));
         let slope = self.per_mille(i32::try_from(o.torque_slope).unwrap_or(i32::MAX)) * dt_ns as f32 * 1e-9;
-        let diff = target - self.pt_torque;
-        self.pt_torque = if o.torque_slope == 0 || diff.abs() <= slope {
+        let diff = target - *ramp;
+        *ramp = if o.torque_slope == 0 || diff.abs() <= slope {
             target
         } else {
-            self.pt_torque + slope.copysign(diff)
+            *ramp + slope.copysign(diff)
         };
         Demand {
             entry: ControlEntry::Torque,
-            torque: self.pt_torque,
-            bits: if self.pt_torque == target {
-                SW_TARGET_REACHED
-            } else {
-                0
-            },
+            torque: *ramp,
+            bits: if *ramp == target { SW_TARGET_REACHED } else { 0 },
             ..Demand::hold(actual)
         }
     }
 
-    pub(super) fn velocity_mode(&mut self, o: &Snapshot, dt_ns: u32) -> Demand {
+    pub(super) fn velocity_mode(&mut self, vl: &mut VelocityCommand, o: &Snapshot, dt_ns: u32) -> Demand {
         let cw = o.controlword;
         let max = o.vl_max as f32;
         let min = o.vl_min as f32;
@@ -430,7 +430,7 @@ impl Axis {
         } else {
             0.0
         };
-        if (unlocked || !enable) && self.commanded_velocity != Some(target) {
+        if (unlocked || !enable) && vl.commanded != Some(target) {
             let limits = ProfileLimits {
                 velocity: (max * RPM_TO_INC_PER_S).max(1.0),
                 acceleration: ramp_rate(o.vl_acceleration),
@@ -438,7 +438,7 @@ impl Axis {
                 jerk: f32::INFINITY,
             };
             if self.profile.run_velocity(target, limits).is_ok() {
-                self.commanded_velocity = Some(target);
+                vl.commanded = Some(target);
             }
         }
         let s = self.profile.step(dt_ns);
@@ -518,7 +518,7 @@ impl Axis {
         }
     }
 
-    pub(super) fn jog(&mut self, o: &Snapshot, dt_ns: u32) -> Demand {
+    pub(super) fn jog(&mut self, jog: &mut VelocityCommand, o: &Snapshot, dt_ns: u32) -> Demand {
         let p = self.params;
         let cw = o.controlword;
         let dir: f32 = match (cw & CW_MODE_BIT4 != 0, cw & CW_MODE_BIT5 != 0) {
@@ -535,7 +535,7 @@ impl Axis {
         let referenced = self.is_referenced();
         let soft = referenced && self.limits.config().software_limits_configured();
         let target = self.lock.filter_velocity(dir * p.jog_velocity);
-        if self.commanded_velocity != Some(target) {
+        if jog.commanded != Some(target) {
             let ok = if target == 0.0 {
                 self.profile.stop(p.jog_deceleration, p.jog_jerk).is_ok()
             } else if p.jog_position_control && soft {
@@ -549,7 +549,7 @@ impl Axis {
                 self.profile.run_velocity(target, limits).is_ok()
             };
             if ok {
-                self.commanded_velocity = Some(target);
+                jog.commanded = Some(target);
             }
         }
         let s = self.profile.step(dt_ns);
