@@ -17,15 +17,8 @@
 //! `#![no_std]`, heap-free and panic-free on every path frame bytes reach: every
 //! view is checked once (`new_checked`) and no accessor panics afterwards.
 #![no_std]
-#![cfg_attr(
-    not(test),
-    deny(
-        clippy::unwrap_used,
-        clippy::expect_used,
-        clippy::panic,
-        clippy::indexing_slicing
-    )
-)]
+// unwrap/expect/panic!/indexing are denied by the workspace lints
+// (Cargo.toml `[workspace.lints.clippy]`; tests may use them, clippy.toml).
 #![deny(missing_docs)]
 
 pub mod alarm;
