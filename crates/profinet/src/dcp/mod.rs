@@ -52,6 +52,10 @@ pub mod signal;
 
 #[cfg(test)]
 mod tests;
+#[cfg(test)]
+mod tests_frames;
+#[cfg(test)]
+mod tests_pdu;
 
 pub use name::{NameError, NameOfStation};
 pub use pdu::{BlockError, BlockType, IpSuite};
