@@ -211,7 +211,7 @@ impl DcpServer {
     }
 
     /// Sets the alias name learned on `port` (0-based) from the neighbour's
-    /// LLDP ("<its port ID>.<its chassis ID>"), or clears it. `false` if the
+    /// LLDP (`<its port ID>.<its chassis ID>`, see [`crate::lldp::Neighbor::alias`]), or clears it. `false` if the
     /// port does not exist or the alias is too long.
     pub fn set_alias(&mut self, port: usize, alias: Option<&[u8]>) -> bool {
         let Some(slot) = self.aliases.get_mut(port) else {
