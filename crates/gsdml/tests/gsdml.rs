@@ -374,3 +374,21 @@ fn p034_gsdml_every_text_id_is_defined_once_and_used() {
     // ModuleInfo names everywhere, data items and diagnosis included
     assert!(!descendants(doc.root_element(), "DataItem").is_empty());
 }
+
+#[test]
+fn p025_gsdml_file_passes_xmllint() {
+    let path = gsdml_dir().join(gsdml::file_name());
+    match std::process::Command::new("xmllint")
+        .arg("--noout")
+        .arg(&path)
+        .output()
+    {
+        Ok(out) => assert!(
+            out.status.success(),
+            "xmllint --noout {}: {}",
+            path.display(),
+            String::from_utf8_lossy(&out.stderr)
+        ),
+        Err(e) => println!("skipped: xmllint not runnable ({e}; Debian package libxml2-utils)"),
+    }
+}
