@@ -198,7 +198,7 @@ fn p026_profinet_py_sees_the_36_modules_with_their_lengths() {
 }
 
 #[test]
-fn p027_profinet_py_builds_the_manuals_example_slots() {
+fn p026_profinet_py_builds_the_manuals_example_slots() {
     let Some(slots) = lines("slot") else {
         return;
     };

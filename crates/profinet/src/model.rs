@@ -177,7 +177,7 @@ mod tests {
     }
 
     #[test]
-    fn p031_p032_diagnosis_error_types() {
+    fn diagnosis_error_types_are_0x1000_plus_main_and_sub() {
         assert_eq!(channel_error_type(8), 0x1008);
         assert_eq!(channel_error_type(22), 0x1016);
         assert_eq!(ext_channel_error_type(6), Some(0x1006));
