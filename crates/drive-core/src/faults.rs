@@ -49,47 +49,98 @@ pub enum FaultChange {
 /// E82 event 30 "Inactive": byte 4 of the fault-cleared EMCY.
 pub const E82_INACTIVE: u8 = 30;
 
+/// One E82 event of the drive's fault table (spec §8.3, S Tab. 23): its
+/// number, the name the manual prints, its CiA 402 error code and CiA 301
+/// error register bits. The one declaration of the drive's faults: the EMCY
+/// codes ([`fault_code_for_event`]) and the PROFINET diagnosis texts of the
+/// GSDML (`crates/gsdml`, `ChannelDiagList`) both read it.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub struct EventInfo {
+    /// E82 event number.
+    pub number: u8,
+    /// Name as S prints it (P's where only P lists the event).
+    pub name: &'static str,
+    /// CiA 402 error code (603Fh); 0000h for event 30 "Inactive".
+    pub code: u16,
+    /// CiA 301 error register bits.
+    pub register: u8,
+}
+
+const fn ev(number: u8, name: &'static str, code: u16, register: u8) -> EventInfo {
+    EventInfo {
+        number,
+        name,
+        code,
+        register,
+    }
+}
+
+/// The drive's E82 events in S Tab. 23 order (event 80 from P). Event 30
+/// "Inactive" is no fault: it marks a fault cleared.
+pub const EVENTS: [EventInfo; 51] = [
+    ev(30, "Inactive", 0x0000, 0x00),
+    ev(31, "Short/ground", 0x2110, CUR),
+    ev(32, "Short/ground internal", 0x2230, CUR),
+    ev(33, "Overcurrent", 0x2310, CUR),
+    ev(36, "High voltage", 0x3110, VOLT),
+    ev(46, "Low voltage", 0x3120, VOLT),
+    ev(83, "Failure of one/all phases (mains)", 0x3130, GEN),
+    ev(84, "Drop in mains voltage with power section active", 0x3180, GEN),
+    ev(38, "Temperature drive controller sensor", 0x4210, TEMP),
+    ev(39, "Overtemperature drive controller i2t", 0x4280, TEMP),
+    ev(59, "Overtemperature drive controller i2t", 0x4280, TEMP),
+    ev(41, "Temp.MotorTMP", 0x4310, TEMP),
+    ev(45, "Overtemp.motor i2t", 0x4380, TEMP),
+    ev(34, "Hardware fault", 0x5200, GEN),
+    ev(35, "Watchdog", 0x6010, GEN),
+    ev(57, "Runtime requirement", 0x6010, GEN),
+    ev(71, "Firmware", 0x6010, GEN),
+    ev(40, "Invalid data", 0x6320, GEN),
+    ev(70, "Parameter consistency", 0x6320, GEN),
+    ev(86, "Unknown LeanMotor", 0x6330, GEN),
+    ev(48, "Brake release monitoring", 0x7110, GEN),
+    ev(49, "Brake", 0x7110, GEN),
+    ev(72, "Brake test timeout", 0x7110, GEN),
+    ev(73, "Axis 2 brake test timeout", 0x7110, GEN),
+    ev(42, "TempBrakeRes", 0x7110, TEMP),
+    ev(69, "Motor connection", 0x7120, GEN),
+    ev(81, "Motor allocation", 0x7120, GEN),
+    ev(37, "Motor encoder", 0x7303, GEN),
+    ev(76, "Position encoder", 0x7304, GEN),
+    ev(77, "Master encoder", 0x7304, GEN),
+    ev(79, "Motor/position encoder plausibility", 0x7304, GEN),
+    ev(52, "Communication", 0x7500, COM),
+    ev(88, "Control panel", 0x7580, GEN),
+    ev(47, "Torque/force-max. limit", 0x8311, GEN),
+    ev(56, "Overspeed", 0x8400, GEN),
+    ev(53, "Limit switch", 0x8500, GEN),
+    ev(85, "Excessive jump in reference value", 0x8510, GEN),
+    ev(51, "Virtual master software limit switch", 0x8600, GEN),
+    ev(54, "Following error", 0x8611, GEN),
+    ev(78, "Position limit cyclic", 0x8612, GEN),
+    ev(60, "Application event 0", 0xFF00, GEN),
+    ev(61, "Application event 1", 0xFF01, GEN),
+    ev(62, "Application event 2", 0xFF02, GEN),
+    ev(63, "Application event 3", 0xFF03, GEN),
+    ev(64, "Application event 4", 0xFF04, GEN),
+    ev(65, "Application event 5", 0xFF05, GEN),
+    ev(66, "Application event 6", 0xFF06, GEN),
+    ev(67, "Application event 7", 0xFF07, GEN),
+    ev(44, "External fault 1", 0xFF09, GEN),
+    ev(68, "External fault 2", 0xFF0A, GEN),
+    ev(80, "Illegal action", GENERIC_ERROR, GEN),
+];
+
+/// The event `e82` of [`EVENTS`], if the table lists it.
+pub fn event(e82: u8) -> Option<&'static EventInfo> {
+    EVENTS.iter().find(|e| e.number == e82)
+}
+
 /// Error code and CiA error register for a device fault with E82 event `e82` (spec
-/// §8.3, S Tab. 23); `None` for events S does not list. Event 80 (1000h,
-/// generic) is from P.
+/// §8.3, S Tab. 23), from [`EVENTS`]; `None` for events S does not list. Event 80
+/// (1000h, generic) is from P.
 pub fn fault_code_for_event(e82: u8) -> Option<(u16, u8)> {
-    Some(match e82 {
-        30 => (0x0000, 0x00),
-        31 => (0x2110, CUR),
-        32 => (0x2230, CUR),
-        33 => (0x2310, CUR),
-        36 => (0x3110, VOLT),
-        46 => (0x3120, VOLT),
-        83 => (0x3130, GEN),
-        84 => (0x3180, GEN),
-        38 => (0x4210, TEMP),
-        39 | 59 => (0x4280, TEMP),
-        41 => (0x4310, TEMP),
-        45 => (0x4380, TEMP),
-        34 => (0x5200, GEN),
-        35 | 57 | 71 => (0x6010, GEN),
-        40 | 70 => (0x6320, GEN),
-        86 => (0x6330, GEN),
-        48 | 49 | 72 | 73 => (0x7110, GEN),
-        42 => (0x7110, TEMP),
-        69 | 81 => (0x7120, GEN),
-        37 => (0x7303, GEN),
-        76 | 77 | 79 => (0x7304, GEN),
-        52 => (0x7500, COM),
-        88 => (0x7580, GEN),
-        47 => (0x8311, GEN),
-        56 => (0x8400, GEN),
-        53 => (0x8500, GEN),
-        85 => (0x8510, GEN),
-        51 => (0x8600, GEN),
-        54 => (0x8611, GEN),
-        78 => (0x8612, GEN),
-        60..=67 => (0xFF00 + u16::from(e82 - 60), GEN),
-        44 => (0xFF09, GEN),
-        68 => (0xFF0A, GEN),
-        80 => (GENERIC_ERROR, GEN),
-        _ => return None,
-    })
+    event(e82).map(|e| (e.code, e.register))
 }
 
 #[cfg(test)]
@@ -153,6 +204,19 @@ mod tests {
             let e = Fault::for_event(e82, 0);
             assert_eq!((e.code, e.register), (0x1000, 0x01));
         }
+    }
+
+    #[test]
+    fn e089_events_are_listed_once_with_a_name() {
+        for (i, e) in EVENTS.iter().enumerate() {
+            assert!(!e.name.is_empty(), "event {}", e.number);
+            assert!(
+                EVENTS.iter().skip(i + 1).all(|o| o.number != e.number),
+                "event {} twice",
+                e.number
+            );
+        }
+        assert_eq!(event(54).map(|e| e.name), Some("Following error"));
     }
 
     #[test]

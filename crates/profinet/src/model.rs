@@ -25,10 +25,63 @@ pub const DAP_MODULE_IDENT: u32 = 0x0000_0001;
 pub const DAP_SUBMODULE_IDENT: u32 = 0x0000_0001;
 /// Submodule ident of the interface subslot 0x8000.
 pub const INTERFACE_SUBMODULE_IDENT: u32 = 0x0000_8000;
-/// Submodule ident of a port subslot 0x8001/0x8002.
+/// Submodule ident of a port subslot 0x8001/0x8002: port 1's; port 2's is
+/// [`port_submodule_ident`]`(2)`.
 pub const PORT_SUBMODULE_IDENT: u32 = 0x0000_8001;
 /// Number of Ethernet ports (P-003, P-006).
 pub const PORTS: u16 = 2;
+
+/// Submodule ident of port `port` (1 or 2): 0x8000 + port, one per port (a
+/// GSDML's PortSubmoduleItems carry distinct idents); port 1's is
+/// [`PORT_SUBMODULE_IDENT`].
+pub const fn port_submodule_ident(port: u16) -> u32 {
+    0x8000 + port as u32
+}
+
+/// Vendor name of the GSDML and of I&M0's manufacturer text. A placeholder,
+/// like [`VENDOR_ID`].
+pub const VENDOR_NAME: &str = "Open Servo Firmware";
+/// Order number (GSDML `OrderNumber`, I&M0 OrderID, at most 20 characters). A
+/// placeholder until the project has part numbers.
+pub const ORDER_NUMBER: &str = "BL4000-PN";
+/// Software release (GSDML `SoftwareRelease`): "V" and the crate version.
+pub const SOFTWARE_RELEASE: &str = concat!("V", env!("CARGO_PKG_VERSION"));
+
+/// Smallest cycle the device supports, in units of 31.25 µs (GSDML
+/// `MinDeviceInterval`): 32 = 1 ms, spec Q-17.
+pub const MIN_DEVICE_INTERVAL: u16 = 32;
+/// Send clock factor the device accepts (× 31.25 µs): 32 = 1 ms.
+pub const SEND_CLOCK_FACTOR: u16 = 32;
+/// Reduction ratios the device accepts with [`SEND_CLOCK_FACTOR`]: 1 ms … 512 ms.
+pub const REDUCTION_RATIOS: [u16; 10] = [1, 2, 4, 8, 16, 32, 64, 128, 256, 512];
+/// The slots data modules may be plugged into: one module per direction, in
+/// either order (the manual's example has OUT in slot 1, IN in slot 2).
+pub const DATA_SLOTS: core::ops::RangeInclusive<u16> = 1..=2;
+/// I&M records a controller may write on the DAP's subslot 1: I&M1…I&M4 (I&M0
+/// is read-only; spec Q-17 recommends I&M0–4).
+pub const WRITEABLE_IM_RECORDS: [u8; 4] = [1, 2, 3, 4];
+
+/// Diagnosis numbering (spec §2.7, P-031/P-032): a drive error HH-S is its
+/// main error HH, the drive's E82 event (`drive_core::faults::EVENTS`), and
+/// its sub error S, the E43 cause. ChannelErrorType = 0x1000 + HH, added as a
+/// binary number (decision on Q-13: 22 → 0x1016).
+pub const fn channel_error_type(main_error: u8) -> u16 {
+    0x1000 + main_error as u16
+}
+
+/// Sub errors with an ExtChannelErrorType: the manufacturer range 0x1000 …
+/// 0x100F of spec §2.7 holds S = 0 … 15.
+pub const SUB_ERRORS: core::ops::RangeInclusive<u8> = 0..=15;
+
+/// ExtChannelErrorType of sub error `sub` (P-032): 0x1000 + S; `None` beyond
+/// [`SUB_ERRORS`].
+pub const fn ext_channel_error_type(sub: u8) -> Option<u16> {
+    if sub <= *SUB_ERRORS.end() {
+        Some(0x1000 + sub as u16)
+    } else {
+        None
+    }
+}
 /// The DAP's subslots.
 pub const DAP_SUBSLOTS: [u16; 4] = [0x0001, 0x8000, 0x8001, 0x8002];
 /// Smallest and largest data module, in 16-bit words (P-026).
@@ -121,5 +174,17 @@ mod tests {
         };
         assert_eq!(out18.name().as_str(), "18 Word Output Data");
         assert_eq!(out18.bytes(), 36);
+    }
+
+    #[test]
+    fn diagnosis_error_types_are_0x1000_plus_main_and_sub() {
+        assert_eq!(channel_error_type(8), 0x1008);
+        assert_eq!(channel_error_type(22), 0x1016);
+        assert_eq!(ext_channel_error_type(6), Some(0x1006));
+        assert_eq!(ext_channel_error_type(15), Some(0x100F));
+        assert_eq!(ext_channel_error_type(16), None);
+        assert_eq!(port_submodule_ident(1), PORT_SUBMODULE_IDENT);
+        assert_eq!(port_submodule_ident(2), 0x8002);
+        assert!(ORDER_NUMBER.len() <= 20);
     }
 }
