@@ -381,9 +381,8 @@ fn system_defined_submodules(x: &mut Xml, t: &mut Texts) -> Result<(), Error> {
             ("SubslotNumber", "32768"),
             ("TextId", &text),
             ("SupportedRT_Classes", "RT_CLASS_1"),
-            ("SupportedProtocols", "SNMP;LLDP"),
-            ("PTP_BoundarySupported", "true"),
-            ("DCP_BoundarySupported", "true"),
+            // no SNMP agent (P-038, docs/conformance.md), no PTP/IRT
+            ("SupportedProtocols", "LLDP"),
         ],
     );
     x.open("ApplicationRelations", &[("StartupMode", "Advanced")]);
