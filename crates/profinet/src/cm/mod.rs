@@ -28,6 +28,8 @@ pub mod status;
 mod tests_connect;
 #[cfg(test)]
 mod tests_record;
+#[cfg(test)]
+mod tests_vectors;
 
 pub use ar::{AlarmCr, Ar, ArState, ArType, Fit, IoObject, Iocr, IocrType, Submodule, SubmoduleData};
 pub use record::{Im0, ImData, ImRecord, NoRecords, RecordAddr, RecordHook};

@@ -17,7 +17,7 @@ pub mod epm;
 pub mod header;
 pub mod server;
 #[cfg(test)]
-mod tests;
+pub(crate) mod tests;
 pub mod uuid;
 
 pub use cursor::Endian;
