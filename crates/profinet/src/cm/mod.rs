@@ -27,6 +27,8 @@ pub mod status;
 #[cfg(test)]
 mod tests_connect;
 #[cfg(test)]
+mod tests_pcap;
+#[cfg(test)]
 mod tests_record;
 #[cfg(test)]
 mod tests_vectors;

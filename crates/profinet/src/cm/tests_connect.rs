@@ -364,8 +364,9 @@ fn p041_prm_end_application_ready_and_release() {
     );
     assert_eq!(&body[20..28], &hex("0112 001c 0100 0000")[..]);
     assert_eq!(&body[20 + 28..20 + 30], &[0, 2]);
-    // The controller confirms: data exchange.
-    let out = d.rx(&ccontrol_response(req));
+    // The controller confirms (profinet-py's own answer to these bytes): data exchange.
+    assert_eq!(ccontrol_response(req), hex(CCONTROL_RESPONSE));
+    let out = d.rx(&hex(CCONTROL_RESPONSE));
     assert_eq!(Header::parse(&out[0].1).unwrap().0.ptype, PacketType::Ack);
     assert_eq!(d.cm.poll_event(), Some(CmEvent::Ready(AR_UUID)));
     assert_eq!(d.cm.ar().unwrap().state, ArState::Data);
