@@ -103,7 +103,7 @@ pub struct UdpDatagram<'a> {
 
 /// Why a frame was dropped. Each variant has its counter in [`Counters`].
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
-pub enum Drop {
+pub enum DropReason {
     /// Not ARP or IPv4.
     NotIp,
     /// ARP that is malformed, not for us, or a reply we did not need.
@@ -140,7 +140,7 @@ pub enum Received<'a> {
     /// A datagram for another UDP port (the caller may serve it or drop it).
     Udp(UdpDatagram<'a>),
     /// Dropped, counted.
-    Dropped(Drop),
+    Dropped(DropReason),
 }
 
 /// Events of the address conflict detection.
@@ -181,19 +181,19 @@ pub struct Counters {
 }
 
 impl Counters {
-    fn count(&mut self, d: Drop) {
+    fn count(&mut self, d: DropReason) {
         let c = match d {
-            Drop::NotIp => &mut self.not_ip,
-            Drop::ArpIgnored => &mut self.arp_ignored,
-            Drop::Ipv4Malformed => &mut self.ipv4_malformed,
-            Drop::Ipv4Checksum => &mut self.ipv4_checksum,
-            Drop::NotForUs => &mut self.not_for_us,
-            Drop::Fragment => &mut self.fragments,
-            Drop::Unsupported => &mut self.unsupported,
-            Drop::IcmpMalformed => &mut self.icmp_malformed,
-            Drop::UdpMalformed => &mut self.udp_malformed,
-            Drop::TxTooSmall => &mut self.tx_too_small,
-            Drop::NoAddress => &mut self.no_address,
+            DropReason::NotIp => &mut self.not_ip,
+            DropReason::ArpIgnored => &mut self.arp_ignored,
+            DropReason::Ipv4Malformed => &mut self.ipv4_malformed,
+            DropReason::Ipv4Checksum => &mut self.ipv4_checksum,
+            DropReason::NotForUs => &mut self.not_for_us,
+            DropReason::Fragment => &mut self.fragments,
+            DropReason::Unsupported => &mut self.unsupported,
+            DropReason::IcmpMalformed => &mut self.icmp_malformed,
+            DropReason::UdpMalformed => &mut self.udp_malformed,
+            DropReason::TxTooSmall => &mut self.tx_too_small,
+            DropReason::NoAddress => &mut self.no_address,
         };
         *c = c.saturating_add(1);
     }
@@ -283,7 +283,7 @@ impl Stack {
         self.neighbours.learn(now, ip, mac);
     }
 
-    fn drop_(&mut self, d: Drop) -> Received<'static> {
+    fn drop_(&mut self, d: DropReason) -> Received<'static> {
         self.counters.count(d);
         Received::Dropped(d)
     }
@@ -291,22 +291,22 @@ impl Stack {
     /// Handles one received Ethernet frame (without FCS). Replies go into `tx`.
     pub fn receive<'a>(&mut self, now: Nanos, frame: &'a [u8], tx: &mut [u8]) -> Received<'a> {
         let Some(eth) = EthFrame::parse(frame) else {
-            return self.drop_(Drop::NotIp);
+            return self.drop_(DropReason::NotIp);
         };
         match eth.ethertype {
             ethertype::ARP => self.receive_arp(now, &eth, tx),
             ethertype::IPV4 => self.receive_ipv4(now, &eth, tx),
-            _ => self.drop_(Drop::NotIp),
+            _ => self.drop_(DropReason::NotIp),
         }
     }
 
     fn receive_arp(&mut self, now: Nanos, eth: &EthFrame<'_>, tx: &mut [u8]) -> Received<'static> {
         let Some(arp) = ArpPacket::parse(eth.payload) else {
-            return self.drop_(Drop::ArpIgnored);
+            return self.drop_(DropReason::ArpIgnored);
         };
         let ours = self.config.addr;
         if ours == Ipv4Addr::UNSPECIFIED {
-            return self.drop_(Drop::NoAddress);
+            return self.drop_(DropReason::NoAddress);
         }
         if arp.sender_ip == ours && arp.sender_mac != self.mac {
             // Someone else uses our address (RFC 5227 conflict).
@@ -319,7 +319,7 @@ impl Stack {
             return if arp.op == ArpOp::Reply {
                 Received::Consumed
             } else {
-                self.drop_(Drop::ArpIgnored)
+                self.drop_(DropReason::ArpIgnored)
             };
         }
         let reply = ArpPacket {
@@ -340,7 +340,7 @@ impl Stack {
                 self.counters.arp_replies = self.counters.arp_replies.saturating_add(1);
                 Received::Replied(n)
             }
-            None => self.drop_(Drop::TxTooSmall),
+            None => self.drop_(DropReason::TxTooSmall),
         }
     }
 
@@ -369,20 +369,20 @@ impl Stack {
     fn receive_ipv4<'a>(&mut self, now: Nanos, eth: &EthFrame<'a>, tx: &mut [u8]) -> Received<'a> {
         let ip = match Ipv4Packet::parse(eth.payload) {
             Ok(ip) => ip,
-            Err(Ipv4Error::Checksum) => return self.drop_(Drop::Ipv4Checksum),
-            Err(_) => return self.drop_(Drop::Ipv4Malformed),
+            Err(Ipv4Error::Checksum) => return self.drop_(DropReason::Ipv4Checksum),
+            Err(_) => return self.drop_(DropReason::Ipv4Malformed),
         };
         let ours = self.config.addr;
         if ours == Ipv4Addr::UNSPECIFIED {
-            return self.drop_(Drop::NoAddress);
+            return self.drop_(DropReason::NoAddress);
         }
         let unicast = ip.dst == ours;
         let broadcast = ip.dst == Ipv4Addr::BROADCAST || self.config.is_subnet_broadcast(ip.dst);
         if !unicast && !broadcast {
-            return self.drop_(Drop::NotForUs);
+            return self.drop_(DropReason::NotForUs);
         }
         if ip.is_fragment {
-            return self.drop_(Drop::Fragment);
+            return self.drop_(DropReason::Fragment);
         }
         if unicast && self.config.same_subnet(ip.src) {
             self.neighbours.learn(now, ip.src, eth.src);
@@ -407,17 +407,17 @@ impl Stack {
                         Received::Udp(d)
                     }
                 }
-                Err(_) => self.drop_(Drop::UdpMalformed),
+                Err(_) => self.drop_(DropReason::UdpMalformed),
             },
-            _ => self.drop_(Drop::Unsupported),
+            _ => self.drop_(DropReason::Unsupported),
         }
     }
 
     fn receive_icmp(&mut self, eth: &EthFrame<'_>, ip: &Ipv4Packet<'_>, tx: &mut [u8]) -> Received<'static> {
         match icmp_type(ip.payload) {
-            None => return self.drop_(Drop::IcmpMalformed),
+            None => return self.drop_(DropReason::IcmpMalformed),
             Some(ICMP_ECHO_REQUEST) => {}
-            Some(_) => return self.drop_(Drop::Unsupported),
+            Some(_) => return self.drop_(DropReason::Unsupported),
         }
         let ident = self.next_ident();
         let n = (|| {
@@ -432,7 +432,7 @@ impl Stack {
                 self.counters.echo_replies = self.counters.echo_replies.saturating_add(1);
                 Received::Replied(n)
             }
-            None => self.drop_(Drop::TxTooSmall),
+            None => self.drop_(DropReason::TxTooSmall),
         }
     }
 

@@ -58,7 +58,7 @@ fn arp_for_another_host_is_ignored_and_conflicts_are_detected() {
     other[41] = 99;
     assert_eq!(
         s.receive(Nanos::ZERO, &other, &mut tx),
-        Received::Dropped(Drop::ArpIgnored)
+        Received::Dropped(DropReason::ArpIgnored)
     );
     // A gratuitous ARP from another MAC claiming our IP.
     let mut claim = arp_request();
@@ -120,7 +120,7 @@ fn bad_checksums_and_fragments_are_dropped_and_counted() {
     f[14 + 10] ^= 1;
     assert_eq!(
         s.receive(Nanos::ZERO, &f, &mut tx),
-        Received::Dropped(Drop::Ipv4Checksum)
+        Received::Dropped(DropReason::Ipv4Checksum)
     );
     let mut f = echo_request();
     f[14 + 6] = 0x20; // MF
@@ -129,21 +129,21 @@ fn bad_checksums_and_fragments_are_dropped_and_counted() {
     f[14 + 10..14 + 12].copy_from_slice(&c.to_be_bytes());
     assert_eq!(
         s.receive(Nanos::ZERO, &f, &mut tx),
-        Received::Dropped(Drop::Fragment)
+        Received::Dropped(DropReason::Fragment)
     );
     assert_eq!(s.counters().fragments, 1);
     let mut f = echo_request();
     f[34 + 9] ^= 0xFF;
     assert_eq!(
         s.receive(Nanos::ZERO, &f, &mut tx),
-        Received::Dropped(Drop::IcmpMalformed)
+        Received::Dropped(DropReason::IcmpMalformed)
     );
     for len in 0..60 {
         let _ = s.receive(Nanos::ZERO, &echo_request()[..len], &mut tx);
     }
     assert_eq!(
         s.receive(Nanos::ZERO, &echo_request(), &mut [0u8; 10]),
-        Received::Dropped(Drop::TxTooSmall)
+        Received::Dropped(DropReason::TxTooSmall)
     );
 }
 
@@ -197,7 +197,7 @@ fn udp_round_trip_through_the_rpc_port() {
     f[40] = 1;
     assert_eq!(
         s2.receive(Nanos::ZERO, &f, &mut [0u8; 64]),
-        Received::Dropped(Drop::UdpMalformed)
+        Received::Dropped(DropReason::UdpMalformed)
     );
     // Unknown neighbour: an ARP request instead.
     let far = Endpoint {
