@@ -1,0 +1,160 @@
+use super::tests_connect::{self, dev, dev_with, patch};
+use super::tests_vectors::*;
+use super::*;
+use crate::rpc::tests::hex;
+
+/// The NDR args of a read/write: header offsets.
+const INDEX_AT: usize = 34;
+
+const IM0: &str = "0020 0038 0100 fefe
+    424c343030302d43202020202020202020202020 534e3030303120202020202020202020
+    0001 56010000 0000 f600 0000 0101 001e";
+
+#[test]
+fn p039_im0_read_returns_the_identity() {
+    let mut d = dev();
+    d.call(CONNECT);
+    let (status, args) = d.call(READ_IM0);
+    assert_eq!(status, PnioStatus::OK);
+    let mut head = hex("8009 003c 0100 0000");
+    head.extend_from_slice(&tests_connect::AR_UUID.0);
+    head.extend_from_slice(&hex("00000000 0000 0001 0000 aff0 0000003c 0000 0000"));
+    head.extend_from_slice(&[0; 20]);
+    assert_eq!(&args[..64], &head[..]);
+    assert_eq!(&args[64..], &hex(IM0)[..]);
+}
+
+#[test]
+fn p039_im0_implicit_read_needs_no_ar_and_other_subslots_have_none() {
+    let mut d = dev();
+    let mut r = hex(READ_IM0);
+    r[68..70].copy_from_slice(&5u16.to_be_bytes()); // opnum: implicit read
+    let r: std::string::String = r.iter().map(|x| std::format!("{x:02x}")).collect();
+    let (status, args) = d.call(&r);
+    assert_eq!((status, &args[64..]), (PnioStatus::OK, &hex(IM0)[..]));
+    // A normal read without the AR: AR UUID unknown.
+    assert_eq!(d.call(READ_IM0).0, PnioStatus::cmrpc(0xDE, 5));
+    d.call(CONNECT);
+    // I&M0 at the interface subslot: invalid index; at a missing subslot: invalid slot/subslot.
+    let at_if = patch(READ_IM0, 30, &[0x80, 0x00]);
+    assert_eq!(d.call(&at_if).0, PnioStatus::rw(0xDE, 0xB0));
+    let missing = patch(READ_IM0, 28, &[0, 9]);
+    assert_eq!(d.call(&missing).0, PnioStatus::rw(0xDE, 0xB2));
+    let unknown = patch(READ_IM0, INDEX_AT, &[0x12, 0x34]);
+    let (status, args) = d.call(&unknown);
+    assert_eq!(
+        status,
+        PnioStatus {
+            code: 0xDE,
+            decode: 0x80,
+            code1: 0xB0,
+            code2: 0
+        }
+    );
+    assert_eq!(args.len(), 64); // the header names the record
+}
+
+#[test]
+fn p039_im1_im2_writes_from_profinet_py_are_stored_and_reported() {
+    let mut d = dev();
+    d.call(CONNECT);
+    let _ = d.cm.poll_event();
+    let (status, args) = d.call(WRITE_IM1);
+    assert_eq!(status, PnioStatus::OK);
+    assert_eq!(
+        (&args[..2], &args[44..48]),
+        (&[0x80, 0x08][..], &[0, 0, 0, 0][..])
+    );
+    assert_eq!(d.cm.poll_event(), Some(CmEvent::ImWritten(ImRecord::Im1)));
+    assert_eq!(&d.cm.im_data().tag_function[..8], b"Axis 1  ");
+    assert_eq!(&d.cm.im_data().tag_location[..9], b"Cabinet 3");
+    assert_eq!(d.call(WRITE_IM2).0, PnioStatus::OK);
+    assert_eq!(&d.cm.im_data().date, b"2024-05-28 10:30");
+    // Read back in the standard layout (no padding): block 0x0021, length 56.
+    let read = patch(READ_IM0, INDEX_AT, &[0xAF, 0xF1]);
+    let (status, args) = d.call(&read);
+    assert_eq!(status, PnioStatus::OK);
+    assert_eq!(&args[64..70], &hex("0021 0038 0100")[..]);
+    assert_eq!(&args[70..76], b"Axis 1");
+    assert_eq!(args.len(), 64 + 60);
+}
+
+#[test]
+fn p039_im_writes_of_wrong_length_or_to_im0_are_refused() {
+    let mut d = dev();
+    d.call(CONNECT);
+    let im0 = patch(WRITE_IM1, INDEX_AT, &[0xAF, 0xF0]);
+    let (status, args) = d.call(&im0);
+    assert_eq!(status, PnioStatus::rw(0xDF, 0xB6));
+    assert_eq!(&args[44..48], &[0xDF, 0x80, 0xB6, 0x00]);
+    // I&M1 block with its length one short.
+    let short = patch(WRITE_IM1, 64 + 2, &[0x00, 0x39]);
+    assert_eq!(d.call(&short).0, PnioStatus::rw(0xDF, 0xB1));
+    // I&M3 carrying an I&M1 block: invalid parameter.
+    let mismatched = patch(WRITE_IM1, INDEX_AT, &[0xAF, 0xF3]);
+    assert_eq!(d.call(&mismatched).0, PnioStatus::rw(0xDF, 0xB8));
+    assert_eq!(&d.cm.im_data().tag_function, &[b' '; 32]);
+}
+
+#[test]
+fn p041_write_multiple_answers_each_write() {
+    // profinet-py wraps its multiple write into a second E040 header; the
+    // nested one is flattened and each sub-write answered: raw bytes are no
+    // I&M block, so both get "write length error".
+    let mut d = dev();
+    d.call(CONNECT);
+    let (status, args) = d.call(WRITE_MULTIPLE);
+    assert_eq!(status, PnioStatus::OK);
+    assert_eq!(&args[INDEX_AT..INDEX_AT + 6], &hex("e040 00000080")[..]);
+    assert_eq!(args.len(), 64 * 3);
+    for (k, index) in [(1, 0xAFF3u16), (2, 0xAFF2)] {
+        let r = &args[64 * k..64 * (k + 1)];
+        assert_eq!(&r[..2], &[0x80, 0x08]);
+        assert_eq!(&r[INDEX_AT..INDEX_AT + 2], &index.to_be_bytes());
+        assert_eq!(&r[44..48], &[0xDF, 0x80, 0xB1, 0x00]);
+    }
+}
+
+struct Param(u32);
+
+impl RecordHook for Param {
+    fn read(&mut self, addr: RecordAddr, out: &mut [u8]) -> Result<usize, RecordError> {
+        match (addr.slot, addr.index) {
+            (1, 0x1000) => {
+                out[..4].copy_from_slice(&self.0.to_be_bytes());
+                Ok(4)
+            }
+            (_, 0x1000) => Err(RecordError::InvalidSlotSubslot),
+            _ => Err(RecordError::InvalidIndex),
+        }
+    }
+
+    fn write(&mut self, addr: RecordAddr, data: &[u8]) -> Result<(), RecordError> {
+        if addr.index != 0x1000 {
+            return Err(RecordError::InvalidIndex);
+        }
+        self.0 = u32::from_be_bytes(data.try_into().map_err(|_| RecordError::WriteLength)?);
+        Ok(())
+    }
+}
+
+#[test]
+fn p041_other_records_go_to_the_hook() {
+    let mut d = dev_with(Param(0x1122_3344));
+    d.call(CONNECT);
+    let read = patch(&patch(READ_IM0, INDEX_AT, &[0x10, 0x00]), 28, &[0, 1]);
+    let (status, args) = d.call(&read);
+    assert_eq!(
+        (status, &args[64..]),
+        (PnioStatus::OK, &[0x11, 0x22, 0x33, 0x44][..])
+    );
+    assert_eq!(&args[36..40], &[0, 0, 0, 4]);
+    let (status, _) = d.call(&patch(READ_IM0, INDEX_AT, &[0x10, 0x00]));
+    assert_eq!(status, PnioStatus::rw(0xDE, 0xB2));
+    // ModuleDiff read (0xE002) of a proper AR: no APIs.
+    let (status, args) = d.call(&patch(READ_IM0, INDEX_AT, &[0xE0, 0x02]));
+    assert_eq!(
+        (status, &args[64..]),
+        (PnioStatus::OK, &hex("8104 0004 0100 0000")[..])
+    );
+}
