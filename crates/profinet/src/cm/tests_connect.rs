@@ -8,7 +8,7 @@ use std::vec::Vec;
 pub(crate) const OUR_MAC: MacAddr = MacAddr([0x02, 0, 0, 0, 0, 0x01]);
 pub(crate) const CTRL_MAC: MacAddr = MacAddr([0x02, 0, 0, 0, 0, 0xC0]);
 pub(crate) const CTRL: Endpoint = Endpoint {
-    ip: Ipv4Addr([192, 168, 0, 10]),
+    ip: Ipv4Addr::new(192, 168, 0, 10),
     port: 50001,
 };
 pub(crate) const AR_UUID: Uuid = Uuid([
@@ -44,7 +44,7 @@ pub(crate) fn dev_with<H: RecordHook>(hook: H) -> Dev<H> {
             boot_time: 1,
             epm: epm::EpmInfo {
                 object: uuid::pnio_object(1, crate::model::DEVICE_ID, crate::model::VENDOR_ID),
-                ip: Ipv4Addr([192, 168, 0, 50]),
+                ip: Ipv4Addr::new(192, 168, 0, 50),
                 port: 34964,
                 annotation: epm::annotation(crate::model::STATION_TYPE, "BL4000-C", 1, (b'V', 1, 0, 0)),
             },

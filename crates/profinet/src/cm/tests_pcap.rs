@@ -20,8 +20,8 @@ fn stack(mac: crate::wire::MacAddr, last: u8) -> Stack {
     Stack::new(
         mac,
         IpConfig {
-            addr: Ipv4Addr([192, 168, 0, last]),
-            netmask: Ipv4Addr([255, 255, 255, 0]),
+            addr: Ipv4Addr::from([192, 168, 0, last]),
+            netmask: Ipv4Addr::new(255, 255, 255, 0),
             gateway: Ipv4Addr::UNSPECIFIED,
         },
     )
@@ -62,7 +62,7 @@ fn p041_exchange_dissects_without_malformed_packets() {
     let mut ctrl = stack(CTRL_MAC, 10);
     let mut devs = stack(OUR_MAC, 50);
     let dev_ep = Endpoint {
-        ip: Ipv4Addr([192, 168, 0, 50]),
+        ip: Ipv4Addr::new(192, 168, 0, 50),
         port: RPC_PORT,
     };
     ctrl.learn(Nanos::ZERO, dev_ep.ip, OUR_MAC);

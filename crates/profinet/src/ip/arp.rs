@@ -51,7 +51,7 @@ impl ArpPacket {
         let ip = |at: usize| -> Option<Ipv4Addr> {
             let mut a = [0u8; 4];
             a.copy_from_slice(h.get(at..at + 4)?);
-            Some(Ipv4Addr(a))
+            Some(Ipv4Addr::from(a))
         };
         Some(ArpPacket {
             op,
@@ -72,9 +72,9 @@ impl ArpPacket {
         };
         h.get_mut(6..8)?.copy_from_slice(&op.to_be_bytes());
         h.get_mut(8..14)?.copy_from_slice(&self.sender_mac.0);
-        h.get_mut(14..18)?.copy_from_slice(&self.sender_ip.0);
+        h.get_mut(14..18)?.copy_from_slice(&self.sender_ip.octets());
         h.get_mut(18..24)?.copy_from_slice(&self.target_mac.0);
-        h.get_mut(24..28)?.copy_from_slice(&self.target_ip.0);
+        h.get_mut(24..28)?.copy_from_slice(&self.target_ip.octets());
         Some(ARP_LEN)
     }
 

@@ -93,7 +93,7 @@ impl<'a> Ipv4Packet<'a> {
         let addr = |at: usize| -> Result<Ipv4Addr, Ipv4Error> {
             let mut a = [0u8; 4];
             a.copy_from_slice(header.get(at..at + 4).ok_or(Ipv4Error::Truncated)?);
-            Ok(Ipv4Addr(a))
+            Ok(Ipv4Addr::from(a))
         };
         Ok(Ipv4Packet {
             src: addr(12)?,
@@ -124,8 +124,8 @@ pub fn emit_ipv4(
     h.get_mut(6..8)?.copy_from_slice(&0x4000u16.to_be_bytes());
     *h.get_mut(8)? = TTL;
     *h.get_mut(9)? = protocol;
-    h.get_mut(12..16)?.copy_from_slice(&src.0);
-    h.get_mut(16..20)?.copy_from_slice(&dst.0);
+    h.get_mut(12..16)?.copy_from_slice(&src.octets());
+    h.get_mut(16..20)?.copy_from_slice(&dst.octets());
     let c = fold(sum16(0, h));
     h.get_mut(10..12)?.copy_from_slice(&c.to_be_bytes());
     Some(())
@@ -152,7 +152,7 @@ pub enum UdpError {
 }
 
 fn pseudo_sum(src: Ipv4Addr, dst: Ipv4Addr, protocol: u8, len: usize) -> u32 {
-    let acc = sum16(sum16(0, &src.0), &dst.0);
+    let acc = sum16(sum16(0, &src.octets()), &dst.octets());
     acc.wrapping_add(u32::from(protocol))
         .wrapping_add((len & 0xFFFF) as u32)
 }

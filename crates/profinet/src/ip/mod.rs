@@ -35,29 +35,11 @@ pub const UDP_PAYLOAD_OFFSET: usize = wire::HEADER_LEN + IPV4_HEADER_LEN + UDP_H
 /// Entries of the neighbour cache.
 pub const NEIGHBOURS: usize = 4;
 
-/// An IPv4 address.
-#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Hash, PartialOrd, Ord)]
-pub struct Ipv4Addr(pub [u8; 4]);
-
-impl Ipv4Addr {
-    /// 0.0.0.0.
-    pub const UNSPECIFIED: Ipv4Addr = Ipv4Addr([0; 4]);
-    /// 255.255.255.255.
-    pub const BROADCAST: Ipv4Addr = Ipv4Addr([0xFF; 4]);
-
-    /// As a big-endian integer.
-    pub const fn to_u32(self) -> u32 {
-        u32::from_be_bytes(self.0)
-    }
-
-    /// From a big-endian integer.
-    pub const fn from_u32(v: u32) -> Ipv4Addr {
-        Ipv4Addr(v.to_be_bytes())
-    }
-}
+/// An IPv4 address (the one `core::net` type DCP, LLDP and IP share).
+pub use core::net::Ipv4Addr;
 
 /// The interface's addresses (set by DCP or from the stored static IP).
-#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub struct IpConfig {
     /// Our IP address; 0.0.0.0 = none (then only ARP probes are watched).
     pub addr: Ipv4Addr,
@@ -67,20 +49,31 @@ pub struct IpConfig {
     pub gateway: Ipv4Addr,
 }
 
+impl Default for IpConfig {
+    /// No address.
+    fn default() -> Self {
+        IpConfig {
+            addr: Ipv4Addr::UNSPECIFIED,
+            netmask: Ipv4Addr::UNSPECIFIED,
+            gateway: Ipv4Addr::UNSPECIFIED,
+        }
+    }
+}
+
 impl IpConfig {
     fn same_subnet(&self, ip: Ipv4Addr) -> bool {
-        let m = self.netmask.to_u32();
-        ip.to_u32() & m == self.addr.to_u32() & m
+        let m = u32::from(self.netmask);
+        u32::from(ip) & m == u32::from(self.addr) & m
     }
 
     fn is_subnet_broadcast(&self, ip: Ipv4Addr) -> bool {
-        let m = self.netmask.to_u32();
-        m != 0 && m != u32::MAX && ip.to_u32() == (self.addr.to_u32() | !m)
+        let m = u32::from(self.netmask);
+        m != 0 && m != u32::MAX && u32::from(ip) == (u32::from(self.addr) | !m)
     }
 }
 
 /// Where a UDP datagram came from / goes to.
-#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Hash)]
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]
 pub struct Endpoint {
     /// IP address.
     pub ip: Ipv4Addr,

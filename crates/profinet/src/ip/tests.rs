@@ -3,15 +3,15 @@ use std::vec::Vec;
 
 const OUR_MAC: MacAddr = MacAddr([0x02, 0, 0, 0, 0, 0x01]);
 const PEER_MAC: MacAddr = MacAddr([0x02, 0, 0, 0, 0, 0xC0]);
-const OUR_IP: Ipv4Addr = Ipv4Addr([192, 168, 0, 50]);
-const PEER_IP: Ipv4Addr = Ipv4Addr([192, 168, 0, 10]);
+const OUR_IP: Ipv4Addr = Ipv4Addr::new(192, 168, 0, 50);
+const PEER_IP: Ipv4Addr = Ipv4Addr::new(192, 168, 0, 10);
 
 fn stack() -> Stack {
     Stack::new(
         OUR_MAC,
         IpConfig {
             addr: OUR_IP,
-            netmask: Ipv4Addr([255, 255, 255, 0]),
+            netmask: Ipv4Addr::new(255, 255, 255, 0),
             gateway: Ipv4Addr::UNSPECIFIED,
         },
     )
@@ -62,7 +62,7 @@ fn arp_for_another_host_is_ignored_and_conflicts_are_detected() {
     );
     // A gratuitous ARP from another MAC claiming our IP.
     let mut claim = arp_request();
-    claim[28..32].copy_from_slice(&OUR_IP.0);
+    claim[28..32].copy_from_slice(&OUR_IP.octets());
     assert!(!s.address_conflict());
     s.receive(Nanos::ZERO, &claim, &mut tx);
     assert!(s.address_conflict());
@@ -166,7 +166,7 @@ fn udp_round_trip_through_the_rpc_port() {
         PEER_MAC,
         IpConfig {
             addr: PEER_IP,
-            netmask: Ipv4Addr([255, 255, 255, 0]),
+            netmask: Ipv4Addr::new(255, 255, 255, 0),
             gateway: Ipv4Addr::UNSPECIFIED,
         },
     );
@@ -201,7 +201,7 @@ fn udp_round_trip_through_the_rpc_port() {
     );
     // Unknown neighbour: an ARP request instead.
     let far = Endpoint {
-        ip: Ipv4Addr([192, 168, 0, 77]),
+        ip: Ipv4Addr::new(192, 168, 0, 77),
         port: 1,
     };
     assert!(matches!(
@@ -209,7 +209,7 @@ fn udp_round_trip_through_the_rpc_port() {
         Ok(UdpTx::ArpRequest(60))
     ));
     let off = Endpoint {
-        ip: Ipv4Addr([10, 0, 0, 1]),
+        ip: Ipv4Addr::new(10, 0, 0, 1),
         port: 1,
     };
     assert_eq!(
@@ -221,7 +221,7 @@ fn udp_round_trip_through_the_rpc_port() {
 #[test]
 fn neighbour_cache_is_bounded_and_expires() {
     let mut c = NeighbourCache::<2>::default();
-    let ip = |n| Ipv4Addr([10, 0, 0, n]);
+    let ip = |n| Ipv4Addr::from([10, 0, 0, n]);
     c.learn(Nanos::from_secs(1), ip(1), PEER_MAC);
     c.learn(Nanos::from_secs(2), ip(2), PEER_MAC);
     c.learn(Nanos::from_secs(3), ip(3), OUR_MAC);

@@ -85,7 +85,7 @@ fn tower(w: &mut Writer<'_>, info: &EpmInfo) -> Option<()> {
     w.bytes(&[1, 0, 0x08, 2, 0])?; // UDP
     w.bytes(&info.port.to_be_bytes())?;
     w.bytes(&[1, 0, 0x09, 4, 0])?; // IP
-    w.bytes(&info.ip.0)
+    w.bytes(&info.ip.octets())
 }
 
 /// Answers an EPM call `opnum` with body `req` (in `endian`) into `out`;

@@ -12,10 +12,10 @@ pub(crate) fn hex(s: &str) -> Vec<u8> {
 }
 
 const PEER: Endpoint = Endpoint {
-    ip: Ipv4Addr([192, 168, 0, 10]),
+    ip: Ipv4Addr::new(192, 168, 0, 10),
     port: 50000,
 };
-const OUR_IP: Ipv4Addr = Ipv4Addr([192, 168, 0, 50]);
+const OUR_IP: Ipv4Addr = Ipv4Addr::new(192, 168, 0, 50);
 
 fn server() -> Server<4096> {
     Server::new(ServerConfig {
