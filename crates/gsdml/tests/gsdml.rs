@@ -217,7 +217,8 @@ fn p025_gsdml_has_the_dap_smartservo_bl_4000_in_slot_0() {
             )
         })
         .collect();
-    assert_eq!(ports, [(0x8001, 0x8001), (0x8002, 0x8002)]);
+    let ident = u64::from(model::PORT_SUBMODULE_IDENT);
+    assert_eq!(ports, [(0x8001, ident), (0x8002, ident)]);
     assert_eq!(ports.len(), usize::from(model::PORTS));
 }
 

@@ -11,6 +11,7 @@
 //! - [`cm`]: context management blocks (Connect, Read/Write, Control) and the AR.
 //! - [`rt`]: RT_CLASS_1 cyclic consumer/provider, watchdog and data hold.
 //! - [`alarm`]: the acyclic real-time alarm channel (RTA), diagnosis alarms.
+//! - [`device`]: all of them behind one frame input and one timer ([`device::Device`]).
 //! - [`model`]: the device's module model (DAP, IN/OUT modules) and identity, the
 //!   one declaration the firmware and the GSDML share.
 //!
@@ -24,6 +25,7 @@
 pub mod alarm;
 pub mod cm;
 pub mod dcp;
+pub mod device;
 pub mod ip;
 pub mod lldp;
 pub mod model;

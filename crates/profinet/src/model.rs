@@ -25,17 +25,16 @@ pub const DAP_MODULE_IDENT: u32 = 0x0000_0001;
 pub const DAP_SUBMODULE_IDENT: u32 = 0x0000_0001;
 /// Submodule ident of the interface subslot 0x8000.
 pub const INTERFACE_SUBMODULE_IDENT: u32 = 0x0000_8000;
-/// Submodule ident of a port subslot 0x8001/0x8002: port 1's; port 2's is
-/// [`port_submodule_ident`]`(2)`.
+/// Submodule ident of a port subslot 0x8001/0x8002 (both ports are alike).
 pub const PORT_SUBMODULE_IDENT: u32 = 0x0000_8001;
 /// Number of Ethernet ports (P-003, P-006).
 pub const PORTS: u16 = 2;
 
-/// Submodule ident of port `port` (1 or 2): 0x8000 + port, one per port (a
-/// GSDML's PortSubmoduleItems carry distinct idents); port 1's is
-/// [`PORT_SUBMODULE_IDENT`].
-pub const fn port_submodule_ident(port: u16) -> u32 {
-    0x8000 + port as u32
+/// Submodule ident of port `port` (1 or 2): the same [`PORT_SUBMODULE_IDENT`]
+/// for both, as their hardware is the same (the GSDML's two
+/// PortSubmoduleItems differ in ID and subslot, not in ident).
+pub const fn port_submodule_ident(_port: u16) -> u32 {
+    PORT_SUBMODULE_IDENT
 }
 
 /// Vendor name of the GSDML and of I&M0's manufacturer text. A placeholder,
@@ -46,6 +45,35 @@ pub const VENDOR_NAME: &str = "Open Servo Firmware";
 pub const ORDER_NUMBER: &str = "BL4000-PN";
 /// Software release (GSDML `SoftwareRelease`): "V" and the crate version.
 pub const SOFTWARE_RELEASE: &str = concat!("V", env!("CARGO_PKG_VERSION"));
+
+const fn parse_u8(s: &str) -> u8 {
+    let b = s.as_bytes();
+    let mut i = 0;
+    let mut v: u8 = 0;
+    while i < b.len() {
+        // in bounds: i < b.len() (`get` is not const-callable with a match here)
+        let d = match b.split_at_checked(i) {
+            Some((_, [d, ..])) => *d,
+            _ => 0,
+        };
+        if d.is_ascii_digit() {
+            v = v.saturating_mul(10).saturating_add(d - b'0');
+        }
+        i += 1;
+    }
+    v
+}
+
+/// Software revision of I&M0 and the endpoint mapper's annotation: 'V' and
+/// the crate version's major, minor and patch numbers.
+pub const SOFTWARE_REVISION: (u8, u8, u8, u8) = (
+    b'V',
+    parse_u8(env!("CARGO_PKG_VERSION_MAJOR")),
+    parse_u8(env!("CARGO_PKG_VERSION_MINOR")),
+    parse_u8(env!("CARGO_PKG_VERSION_PATCH")),
+);
+/// Hardware revision of I&M0.
+pub const HARDWARE_REVISION: u16 = 1;
 
 /// Smallest cycle the device supports, in units of 31.25 µs (GSDML
 /// `MinDeviceInterval`): 32 = 1 ms, spec Q-17.
@@ -184,7 +212,7 @@ mod tests {
         assert_eq!(ext_channel_error_type(15), Some(0x100F));
         assert_eq!(ext_channel_error_type(16), None);
         assert_eq!(port_submodule_ident(1), PORT_SUBMODULE_IDENT);
-        assert_eq!(port_submodule_ident(2), 0x8002);
+        assert_eq!(port_submodule_ident(2), PORT_SUBMODULE_IDENT);
         assert!(ORDER_NUMBER.len() <= 20);
     }
 }

@@ -15,8 +15,9 @@ use crate::wire::MacAddr;
 
 /// Submodules an AR can hold (4 DAP subslots + data slots).
 pub const MAX_SUBMODULES: usize = 16;
-/// Data slots the drive offers (slots 1…8, each one data module at subslot 1).
-pub const MAX_DATA_SLOTS: u16 = 8;
+/// The last data slot the drive offers (the model's [`crate::model::DATA_SLOTS`],
+/// each one data module at subslot 1).
+pub const MAX_DATA_SLOTS: u16 = *crate::model::DATA_SLOTS.end();
 /// Longest CMInitiatorStationName.
 pub const MAX_STATION_NAME: usize = 240;
 

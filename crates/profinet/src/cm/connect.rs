@@ -379,7 +379,7 @@ pub fn real_submodule(slot: u16, subslot: u16) -> Option<u32> {
     match (slot, subslot) {
         (0, 0x0001) => Some(model::DAP_SUBMODULE_IDENT),
         (0, 0x8000) => Some(model::INTERFACE_SUBMODULE_IDENT),
-        (0, 0x8001..=0x8002) => Some(model::PORT_SUBMODULE_IDENT),
+        (0, p @ 0x8001..=0x8002) => Some(model::port_submodule_ident(p - 0x8000)),
         (1..=MAX_DATA_SLOTS, 1) => Some(model::DATA_SUBMODULE_IDENT),
         _ => None,
     }

@@ -173,6 +173,24 @@ pub struct Im0 {
     pub im_supported: u16,
 }
 
+impl Im0 {
+    /// The drive's I&M0 from [`crate::model`] with its serial number.
+    pub fn drive(serial_number: &str) -> Im0 {
+        Im0 {
+            vendor_id: crate::model::VENDOR_ID,
+            order_id: visible(crate::model::ORDER_NUMBER),
+            serial_number: visible(serial_number),
+            hardware_revision: crate::model::HARDWARE_REVISION,
+            software_revision: crate::model::SOFTWARE_REVISION,
+            revision_counter: 0,
+            profile_id: 0xF600,
+            profile_specific_type: 0,
+            im_version: 0x0101,
+            im_supported: 0x001E,
+        }
+    }
+}
+
 /// Pads `s` with blanks into N visible characters (non-ASCII becomes '?').
 pub fn visible<const N: usize>(s: &str) -> [u8; N] {
     let mut out = [b' '; N];

@@ -1,0 +1,138 @@
+//! The device end to end through Ethernet frames: the frames profinet-py
+//! sends (DCP from `dcp::tests_frames`, RPC from `cm::tests_vectors`).
+
+use super::*;
+use crate::cm::tests_vectors::CONNECT;
+use crate::ip::{Endpoint, UdpTx};
+use crate::rpc::tests::hex;
+use core::net::Ipv4Addr;
+use std::vec::Vec;
+
+const OUR_MAC: MacAddr = MacAddr([0x02, 0, 0, 0, 0, 0x50]);
+const CTRL_MAC: MacAddr = MacAddr([0x02, 0, 0, 0, 0, 0xC0]);
+
+fn device() -> Device {
+    Device::plain(DeviceConfig {
+        mac: OUR_MAC,
+        port_macs: [
+            MacAddr([0x02, 0, 0, 0, 0, 0x51]),
+            MacAddr([0x02, 0, 0, 0, 0, 0x52]),
+        ],
+        name: "drive-1".parse().unwrap(),
+        ip: IpSuite {
+            ip: Ipv4Addr::new(192, 168, 0, 50),
+            mask: Ipv4Addr::new(255, 255, 255, 0),
+            gateway: Ipv4Addr::UNSPECIFIED,
+        },
+        im0: Im0::drive("SN0001"),
+        im: ImData::default(),
+        boot_time: 1,
+    })
+}
+
+fn identify_all() -> Vec<u8> {
+    let mut f = std::vec![0u8; 60];
+    f[..6].copy_from_slice(&MacAddr::DCP_IDENTIFY.0);
+    f[6..12].copy_from_slice(&CTRL_MAC.0);
+    f[12..14].copy_from_slice(&0x8892u16.to_be_bytes());
+    // FrameID FEFE, Identify request, xid 1, delay factor 1, 4 bytes: All
+    f[14..30].copy_from_slice(&[
+        0xFE, 0xFE, 0x05, 0x00, 0, 0, 0, 1, 0x00, 0x01, 0x00, 0x04, 0xFF, 0xFF, 0x00, 0x00,
+    ]);
+    f
+}
+
+fn sent(d: &mut Device, now: Nanos, frame: &[u8]) -> Vec<Vec<u8>> {
+    let mut out = Vec::new();
+    d.receive(now, frame, &mut |f: &[u8]| out.push(f.to_vec()));
+    out
+}
+
+#[test]
+fn p008_identify_through_the_device_answers_with_our_name() {
+    let mut d = device();
+    let out = sent(&mut d, Nanos::ZERO, &identify_all());
+    assert_eq!(out.len(), 1);
+    let f = EthFrame::parse(&out[0]).unwrap();
+    assert_eq!((f.dst, f.src, f.ethertype), (CTRL_MAC, OUR_MAC, 0x8892));
+    assert_eq!(
+        split_frame_id(f.payload).unwrap().0,
+        FrameKind::DcpIdentifyResponse
+    );
+    assert!(out[0].windows(7).any(|w| w == b"drive-1"));
+}
+
+#[test]
+fn p042_unknown_frame_ids_and_frames_for_others_are_dropped_and_counted() {
+    let mut d = device();
+    let mut f = identify_all();
+    f[14..16].copy_from_slice(&0x0100u16.to_be_bytes());
+    assert!(sent(&mut d, Nanos::ZERO, &f).is_empty());
+    f[..6].copy_from_slice(&[0x02, 0, 0, 0, 0, 0x99]);
+    assert!(sent(&mut d, Nanos::ZERO, &f).is_empty());
+    f[..6].copy_from_slice(&OUR_MAC.0);
+    f[14..16].copy_from_slice(&0xC001u16.to_be_bytes());
+    assert!(sent(&mut d, Nanos::ZERO, &f).is_empty());
+    assert_eq!(sent(&mut d, Nanos::ZERO, &f[..10]).len(), 0);
+    let c = d.counters();
+    assert_eq!((c.unknown_frame_id, c.not_for_us, c.no_ar, c.runt), (1, 1, 1, 1));
+}
+
+#[test]
+fn p041_connect_over_udp_through_the_device_establishes_the_ar() {
+    let mut d = device();
+    let mut ctrl = Stack::new(
+        CTRL_MAC,
+        IpConfig {
+            addr: Ipv4Addr::new(192, 168, 0, 10),
+            netmask: Ipv4Addr::new(255, 255, 255, 0),
+            gateway: Ipv4Addr::UNSPECIFIED,
+        },
+    );
+    let dev_ep = Endpoint {
+        ip: Ipv4Addr::new(192, 168, 0, 50),
+        port: RPC_PORT,
+    };
+    ctrl.learn(Nanos::ZERO, dev_ep.ip, OUR_MAC);
+    let req = hex(CONNECT);
+    let mut tx = std::vec![0u8; 1600];
+    tx[UDP_PAYLOAD_OFFSET..UDP_PAYLOAD_OFFSET + req.len()].copy_from_slice(&req);
+    let UdpTx::Frame(n) = ctrl
+        .emit_udp(Nanos::ZERO, &mut tx, 0xC000, dev_ep, req.len())
+        .unwrap()
+    else {
+        panic!("no neighbour")
+    };
+    let out = sent(&mut d, Nanos::ZERO, &tx[..n]);
+    assert_eq!(out.len(), 1, "one Connect response");
+    let f = EthFrame::parse(&out[0]).unwrap();
+    assert_eq!((f.dst, f.ethertype), (CTRL_MAC, 0x0800));
+    assert!(d.cm().ar().is_some());
+    assert!(matches!(
+        d.take_event(),
+        Some(DeviceEvent::Cm(CmEvent::Connected(_)))
+    ));
+    // in operation: DCP refuses a new name now (0x06), so nothing else changed
+    assert_eq!(d.take_event(), None);
+}
+
+#[test]
+fn p037_poll_sends_lldp_on_both_ports_then_waits_5_s() {
+    let mut d = device();
+    let mut out = Vec::new();
+    let next = d.poll(Nanos::ZERO, &mut |f: &[u8]| out.push(f.to_vec()));
+    assert_eq!(out.len(), 2);
+    for (f, port_mac) in out.iter().zip([0x51, 0x52]) {
+        let e = EthFrame::parse(f).unwrap();
+        assert_eq!(
+            (e.dst, e.src.0[5], e.ethertype),
+            (MacAddr::LLDP, port_mac, 0x88CC)
+        );
+    }
+    assert!(next <= Nanos::from_secs(5));
+    out.clear();
+    d.poll(Nanos::from_secs(1), &mut |f: &[u8]| out.push(f.to_vec()));
+    assert!(out.is_empty());
+    d.poll(Nanos::from_secs(5), &mut |f: &[u8]| out.push(f.to_vec()));
+    assert_eq!(out.len(), 2);
+}
