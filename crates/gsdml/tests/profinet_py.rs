@@ -217,7 +217,7 @@ fn p026_profinet_py_builds_the_manuals_example_slots() {
         vec![0, 1, 0, 0, dap, u64::from(model::DAP_SUBMODULE_IDENT)],
         vec![0, 0x8000, 0, 0, dap, u64::from(model::INTERFACE_SUBMODULE_IDENT)],
         vec![0, 0x8001, 0, 0, dap, 0x8001],
-        vec![0, 0x8002, 0, 0, dap, 0x8002],
+        vec![0, 0x8002, 0, 0, dap, u64::from(model::port_submodule_ident(2))],
         // slot 1: "18 Word Output Data" at PLC inputs I 0…35
         vec![1, 1, 36, 0, u64::from(out18.ident()), data],
         // slot 2: "18 Word Input Data" at PLC outputs Q 0…35
