@@ -8,9 +8,9 @@
 //!
 //! Arithmetic is explicit about the edge: `+` and `-` saturate (a span computed from two
 //! instants in the wrong order is zero, never a huge number and never a panic), and so
-//! does `*` by a count (`3 * cycle`); the
-//! `wrapping_*` and `checked_*` forms are there where a caller needs them. Conversions to
-//! and from µs/ms/s truncate toward zero and saturate on overflow.
+//! does `*` by a count (`3 * cycle`); the `wrapping_*` and `checked_*` forms are there
+//! where a caller needs them. Conversions to and from µs/ms/s truncate toward zero and
+//! saturate on overflow.
 //!
 //! `#![no_std]`, no dependencies, every operation `const` or `#[inline]` and panic-free;
 //! the newtype is `repr(transparent)` and costs nothing over a bare `u64`.
