@@ -216,7 +216,7 @@ impl Axis {
         o: &Snapshot,
         halt: bool,
         actual: i32,
-        now_ns: u64,
+        now_ns: Nanos,
         dt_ns: u32,
     ) -> Demand {
         let cw = o.controlword;
@@ -345,7 +345,7 @@ impl Axis {
         }
     }
 
-    pub(super) fn profile_velocity(&mut self, o: &Snapshot, halt: bool, now_ns: u64, dt_ns: u32) -> Demand {
+    pub(super) fn profile_velocity(&mut self, o: &Snapshot, halt: bool, now_ns: Nanos, dt_ns: u32) -> Demand {
         // C-030: 60FFh × A340
         let target = self
             .lock
@@ -469,7 +469,7 @@ impl Axis {
             home_offset: o.home_offset,
             move_to_home: p.homing_move_to_home,
             index_search_offset: p.homing_index_offset,
-            torque_hold_ns: p.homing_torque_hold_ns,
+            torque_hold: p.homing_torque_hold_ns,
             max_search_distance: 0,
             limit_as_reference: p.homing_limit_as_reference,
         };
