@@ -437,7 +437,7 @@ mod tests {
             tunnel_open: true,
             ..NetSettings::default()
         };
-        net.poll(1, &mut q, &mut d, CommState::PreOp, &s);
+        net.poll(Nanos::from_us(1), &mut q, &mut d, CommState::PreOp, &s);
         assert_eq!(net.ip(), Some(([10, 0, 0, 5], 24)));
         assert_eq!(net.gateway(), Some([10, 0, 0, 1]));
         // multicast / broadcast address, gateway and MAC: the old ones stay
@@ -460,7 +460,7 @@ mod tests {
             tunnel_open: true,
         };
         for t in [2, 400_000_000, 800_000_000] {
-            net.poll(t, &mut q, &mut d, CommState::PreOp, &s);
+            net.poll(Nanos::from_us(t), &mut q, &mut d, CommState::PreOp, &s);
         }
         assert_eq!(net.ip(), Some(([10, 0, 0, 5], 24)));
         assert_eq!(net.mac(), [2, 0, 0, 0, 0, 1]);
