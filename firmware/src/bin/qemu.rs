@@ -135,11 +135,11 @@ mod app {
     use cortex_m_semihosting::debug;
     use drive::axis::{AxisCommand, AxisIo};
     use firmware::cycle::{CycleTimer, CYCLE};
-    use nanos::Nanos;
     use firmware::world::{new_esc, Event, World};
     use firmware::{tasks, Drive, ParamFlash};
     use hil_sim::esc::Esc;
     use hil_sim::script::Progress;
+    use nanos::Nanos;
     use stm32f4::stm32f405::Interrupt;
 
     #[shared]
