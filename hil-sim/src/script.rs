@@ -7,7 +7,7 @@
 //! 1. Init: station address, mailbox SyncManagers, request Pre-Op;
 //! 2. Pre-Op: SDO downloads through the mailbox (both axes in csp, both
 //!    channels assigned, DC-Sync), process-data SyncManagers and FMMUs,
-//!    SYNC0 every [`CYCLE_NS`], request Safe-Op, then Op with cyclic LRW;
+//!    SYNC0 every [`CYCLE`], request Safe-Op, then Op with cyclic LRW;
 //! 3. Op: enable both axes (6 → 7 → 15 on the controlword), a csp move of
 //!    [`MOVE_INC`] increments on each axis with a smooth profile, settle,
 //!    disable, back to Init.
@@ -407,7 +407,7 @@ impl Script {
         }
     }
 
-    /// One master cycle (call every [`CYCLE_NS`]; the link carries the time).
+    /// One master cycle (call every [`CYCLE`]; the link carries the time).
     pub fn step(&mut self, link: &mut impl Link) -> Progress {
         let stage = self.stage;
         let (next, progress) = match self.run(link, stage) {

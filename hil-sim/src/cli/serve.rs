@@ -9,13 +9,13 @@
 //! by one, one firmware poll) and only then processes the frame, so the
 //! drive sees the frame when it arrived, however long `serve` took to get to it (a wait, a
 //! busy machine, `--delay-us`). While no frame waits, the simulation is kept
-//! at the wall clock (less [`IDLE_LAG_NS`]) every [`IDLE_WAIT`] (or
+//! at the wall clock (less [`IDLE_LAG`]) every [`IDLE_WAIT`] (or
 //! continuously with `--busy-poll`), so an arriving frame finds little left
 //! to simulate and is answered at once. Frames that queued up are processed
 //! in order, each at its own receive time; one whose time the simulation has
 //! already passed (it arrived while the simulation was being caught up) is
 //! processed at once, and counted in the summary when that was more than
-//! [`LATE_NOTE_NS`] late.
+//! [`LATE_NOTE`] late.
 
 use super::args::ServeArgs;
 use super::print_new_changes;

@@ -336,7 +336,7 @@ impl Slave {
     /// [`poll`](Self::poll) with the application's FoE file handler (the
     /// firmware slots): FoE writes in Bootstrap go to `foe`; a transfer in
     /// progress ends when the slave leaves Bootstrap or after
-    /// [`crate::foe::FOE_TIMEOUT_NS`] without a packet.
+    /// [`crate::foe::FOE_TIMEOUT`] without a packet.
     pub fn poll_with_foe<P: Pdi, A: Application, H: FoeHandler>(
         &mut self,
         pdi: &mut P,
