@@ -5,6 +5,7 @@ pub mod axis;
 
 use ethercrab::{MainDevice, SubDeviceGroup, SubDeviceRef, Timeouts};
 use hil_sim::sim::Simulation;
+use nanos::Nanos;
 use std::cell::RefCell;
 use std::sync::atomic::{AtomicU64, Ordering};
 
@@ -599,8 +600,8 @@ pub type OpGroup = ethercrab::SubDeviceGroup<
     ethercrab::subdevice_group::NoDc,
 >;
 
-/// One master cycle of the simulated line, ns (the drive's A150 default).
-pub const MASTER_CYCLE_NS: u64 = hil_sim::sim::CONTROL_CYCLE_NS;
+/// One master cycle of the simulated line (the drive's A150 default).
+pub const MASTER_CYCLE: Nanos = hil_sim::sim::CONTROL_CYCLE;
 
 /// Standard RxPDO length (C-130): 6040h, 6060h, 607Ah, 60FFh, 60B1h, 60B2h, 6071h, 60FEh:01.
 pub const RXPDO_LEN: usize = 23;
@@ -777,7 +778,7 @@ impl<'a> Cyclic<'a> {
         sd.outputs_raw_mut().copy_from_slice(&self.out);
         {
             let mut sim = self.sim.borrow_mut();
-            let t = sim.now_ns() + MASTER_CYCLE_NS;
+            let t = sim.now() + MASTER_CYCLE;
             sim.advance_to(t);
         }
         let r = self.group.tx_rx(self.md).await.expect("process data cycle");
@@ -828,9 +829,9 @@ impl<'a> Cyclic<'a> {
         self.command(0x000F, sw::OE, 20).await
     }
 
-    /// Simulated time, ns.
-    pub fn now_ns(&self) -> u64 {
-        self.sim.borrow().now_ns()
+    /// Simulated time.
+    pub fn now(&self) -> Nanos {
+        self.sim.borrow().now()
     }
 }
 
@@ -956,7 +957,7 @@ impl<'a> RawCyclic<'a> {
         sd.outputs_raw_mut().copy_from_slice(&self.out);
         {
             let mut sim = self.sim.borrow_mut();
-            let t = sim.now_ns() + MASTER_CYCLE_NS;
+            let t = sim.now() + MASTER_CYCLE;
             sim.advance_to(t);
         }
         let r = self.group.tx_rx(self.md).await.expect("process data cycle");
@@ -1091,9 +1092,9 @@ impl hil_sim::sim::Node for FwNode {
     fn esc_mut(&mut self) -> &mut hil_sim::esc::Esc {
         &mut self.esc
     }
-    fn poll(&mut self, now_ns: u64) {
-        self.esc.tick(now_ns);
-        let _ = self.drive.poll(&mut self.esc.pdi(), now_ns);
+    fn poll(&mut self, now: Nanos) {
+        self.esc.tick(now);
+        let _ = self.drive.poll(&mut self.esc.pdi(), now);
     }
 }
 

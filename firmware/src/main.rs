@@ -156,8 +156,8 @@ mod app {
     fn idle(mut cx: idle::Context) -> ! {
         loop {
             tasks::background(&mut cx.shared.drive);
-            let now = cx.shared.clock.lock(|c| c.now_ns(DWT::cycle_count()));
-            if cx.shared.timer.lock(|t| t.next_at_ns()) <= now {
+            let now = cx.shared.clock.lock(|c| c.now(DWT::cycle_count()));
+            if cx.shared.timer.lock(|t| t.next_at()) <= now {
                 rtic::pend(Interrupt::CCU40_0);
             }
         }
@@ -168,7 +168,7 @@ mod app {
     fn sync0(cx: sync0::Context) {
         (cx.shared.drive, cx.shared.timer, cx.shared.pdi, cx.shared.clock).lock(
             |drive, timer, pdi, clock| {
-                let now = clock.now_ns(DWT::cycle_count());
+                let now = clock.now(DWT::cycle_count());
                 if tasks::sync0(drive, timer, pdi, now).is_err() {
                     defmt::warn!("sync0: PDI access failed");
                 }
@@ -181,8 +181,8 @@ mod app {
     fn control(cx: control::Context) {
         (cx.shared.drive, cx.shared.timer, cx.shared.clock, cx.shared.cmd).lock(
             |drive, timer, clock, cmd| {
-                let now = clock.now_ns(DWT::cycle_count());
-                if timer.next_at_ns() <= now {
+                let now = clock.now(DWT::cycle_count());
+                if timer.next_at() <= now {
                     *cmd = tasks::control(drive, timer, now, &[AxisIo::ready(0); 2]);
                     crate::power::set(cmd.iter().any(|c| c.power_stage));
                 }
@@ -197,7 +197,7 @@ mod app {
         rtic::pend(Interrupt::CCU42_0);
         (cx.shared.drive, cx.shared.timer, cx.shared.pdi, cx.shared.clock).lock(
             |drive, timer, pdi, clock| {
-                let now = clock.now_ns(DWT::cycle_count());
+                let now = clock.now(DWT::cycle_count());
                 match tasks::esc_event(drive, timer, pdi, now) {
                     Ok(Some(c)) => {
                         defmt::info!("esc: AL state {=u8} (code {=u16:04X})", c.to.code(), c.code.0)
@@ -216,7 +216,7 @@ mod app {
     #[task(binds = CCU42_0, priority = 1, shared = [drive, pdi, clock])]
     fn mailbox(cx: mailbox::Context) {
         (cx.shared.drive, cx.shared.pdi, cx.shared.clock).lock(|drive, pdi, clock| {
-            let now = clock.now_ns(DWT::cycle_count());
+            let now = clock.now(DWT::cycle_count());
             if tasks::mailbox(drive, pdi, now).is_err() {
                 defmt::warn!("mailbox: PDI access failed");
             }

@@ -32,12 +32,26 @@ pub fn apwr(sim: &mut Simulation, ado: u16, data: &[u8]) {
 pub fn preop_line() -> Simulation {
     let mut sim = Simulation::new(1);
     apwr(&mut sim, esc::regs::STATION_ADDRESS, &0x1000u16.to_le_bytes());
-    let sm0 = esc::SyncManager { start: 0x1000, length: 256, control: 0x26, status: 0, activate: 1, pdi_control: 0 };
-    let sm1 = esc::SyncManager { start: 0x1100, length: 256, control: 0x22, status: 0, activate: 1, pdi_control: 0 };
+    let sm0 = esc::SyncManager {
+        start: 0x1000,
+        length: 256,
+        control: 0x26,
+        status: 0,
+        activate: 1,
+        pdi_control: 0,
+    };
+    let sm1 = esc::SyncManager {
+        start: 0x1100,
+        length: 256,
+        control: 0x22,
+        status: 0,
+        activate: 1,
+        pdi_control: 0,
+    };
     let mut both = sm0.to_bytes().to_vec();
     both.extend_from_slice(&sm1.to_bytes());
     apwr(&mut sim, esc::regs::sm(0), &both);
     apwr(&mut sim, esc::regs::AL_CONTROL, &2u16.to_le_bytes());
-    sim.advance_to(sim.now_ns() + 1_000_000);
+    sim.advance_to(sim.now() + nanos::Nanos::from_ms(1));
     sim
 }

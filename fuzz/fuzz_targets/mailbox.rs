@@ -15,7 +15,7 @@ fuzz_target!(|data: &[u8]| {
         buf[..chunk.len()].copy_from_slice(chunk);
         let mut w = common::frame(5, 0x1000, 0x1000, &buf); // FPWR into SM0
         sim.exchange(&mut w);
-        let t = sim.now_ns() + 200_000;
+        let t = sim.now() + nanos::Nanos::from_us(200);
         sim.advance_to(t);
         let mut r = common::frame(4, 0x1000, 0x1100, &[0u8; 256]); // FPRD of SM1
         sim.exchange(&mut r);

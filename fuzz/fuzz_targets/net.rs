@@ -11,15 +11,15 @@
 use drive::runtime::Drive;
 use ecat::eoe::{EthernetPort, IpParams};
 use hil_sim::eoe::net_settings;
-use net::smoltcp::iface::SocketStorage;
-use net::{NetBuffers, NetConfig, NetStack, SOCKETS};
 use hil_sim::sim::SimFlash;
 use libfuzzer_sys::fuzz_target;
+use net::smoltcp::iface::SocketStorage;
 use net::smoltcp::phy::ChecksumCapabilities;
 use net::smoltcp::wire::{
-    EthernetAddress, EthernetFrame, EthernetProtocol, EthernetRepr, IpAddress, IpProtocol, Ipv4Address, Ipv4Packet,
-    Ipv4Repr, UdpPacket, UdpRepr,
+    EthernetAddress, EthernetFrame, EthernetProtocol, EthernetRepr, IpAddress, IpProtocol, Ipv4Address,
+    Ipv4Packet, Ipv4Repr, UdpPacket, UdpRepr,
 };
+use net::{NetBuffers, NetConfig, NetStack, SOCKETS};
 
 const DRIVE: [u8; 4] = [10, 0, 0, 20];
 const HOST: [u8; 4] = [10, 0, 0, 1];
@@ -72,14 +72,14 @@ fuzz_target!(|data: &[u8]| {
         mac: DRIVE_MAC,
         seed: 1,
     };
-    let mut net = NetStack::new(cfg, &mut bufs, &mut slots, drive.eoe_mut(), 0);
+    let mut net = NetStack::new(cfg, &mut bufs, &mut slots, drive.eoe_mut(), nanos::Nanos::ZERO);
     drive.eoe_mut().ip_changed(&IpParams {
         ip: Some(DRIVE),
         mask: Some([255, 255, 255, 0]),
         gateway: Some(HOST),
         ..IpParams::default()
     });
-    let mut t: u64 = 0;
+    let mut t = nanos::Nanos::ZERO;
     let mut rest = data;
     let mut out = [0u8; 1536];
     while let [kind, l0, l1, tail @ ..] = rest {
@@ -92,13 +92,13 @@ fuzz_target!(|data: &[u8]| {
             _ => udp_frame(123, 123, bytes),
         };
         drive.eoe_mut().receive(&frame);
-        t += 60_000_000_000;
+        t += nanos::Nanos::from_secs(60);
         // the frames arrive as if the master tunnelled them: the tunnel is open (E-098)
         let settings = net::NetSettings {
             tunnel_open: true,
             ..net_settings(&drive)
         };
-        drive.with_eoe(|q, dict, state| net.poll(t / 1000, q, dict, state, &settings));
+        drive.with_eoe(|q, dict, state| net.poll(t, q, dict, state, &settings));
         while drive.eoe_mut().transmit(&mut out).is_some() {}
     }
 });

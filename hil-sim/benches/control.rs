@@ -11,7 +11,8 @@
 
 use drive::axis::AxisIo;
 use hil_sim::motor::Motor;
-use hil_sim::sim::{SimFlash, CONTROL_CYCLE_NS};
+use hil_sim::sim::{SimFlash, CONTROL_CYCLE};
+use nanos::Nanos;
 use std::time::Instant;
 
 const INC_PER_REV: f64 = 1_048_576.0;
@@ -36,12 +37,12 @@ fn main() {
     let mut drive = drive::runtime::Drive::new(SimFlash::new());
     let mut motors = [Motor::default_servo(), Motor::default_servo()];
     let mut pos = [0i32; 2];
-    let mut now = 0u64;
+    let mut now = Nanos::ZERO;
     let step = |drive: &mut drive::runtime::Drive<SimFlash>,
                 motors: &mut [Motor; 2],
                 pos: &mut [i32; 2],
-                now: &mut u64| {
-        *now += CONTROL_CYCLE_NS;
+                now: &mut Nanos| {
+        *now += CONTROL_CYCLE;
         let io = [AxisIo::ready(pos[0]), AxisIo::ready(pos[1])];
         let t0 = Instant::now();
         let cmd = drive.control_cycle_with(*now, &io, [true, true]);
@@ -53,7 +54,7 @@ fn main() {
                 0.0
             };
             pos[i] = motors[i]
-                .step(torque, !cmd[i].brake_release, CONTROL_CYCLE_NS)
+                .step(torque, !cmd[i].brake_release, CONTROL_CYCLE)
                 .position_inc;
         }
         spent

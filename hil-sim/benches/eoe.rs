@@ -17,16 +17,21 @@
 
 use hil_sim::eoe::{set_ip_request, HostNet};
 use hil_sim::sim::Simulation;
+use nanos::Nanos;
 use std::cell::RefCell;
 use std::sync::atomic::Ordering;
 
 const DRIVE_IP: [u8; 4] = [10, 0, 0, 20];
 const HOST_IP: [u8; 4] = [10, 0, 0, 1];
 
-fn stats(v: &mut [u64]) -> (f64, f64, f64) {
+fn stats(v: &mut [Nanos]) -> (f64, f64, f64) {
     v.sort_unstable();
-    let mean = v.iter().sum::<u64>() as f64 / v.len() as f64;
-    (v[0] as f64 / 1e3, mean / 1e3, v[v.len() - 1] as f64 / 1e3)
+    let mean = v.iter().map(|t| t.as_ns()).sum::<u64>() as f64 / v.len() as f64;
+    (
+        v[0].as_ns() as f64 / 1e3,
+        mean / 1e3,
+        v[v.len() - 1].as_ns() as f64 / 1e3,
+    )
 }
 
 fn main() {
@@ -38,7 +43,7 @@ fn main() {
         .and_then(|s| s.parse().ok())
         .unwrap_or(50);
     let sim = RefCell::new(Simulation::new(1));
-    sim.borrow_mut().drives_mut()[0].bind_net([2, 0, 0, 0, 0, 0x14], 1, 0);
+    sim.borrow_mut().drives_mut()[0].bind_net([2, 0, 0, 0, 0, 0x14], 1, Nanos::ZERO);
     let config = ethercrab::MainDeviceConfig {
         dc_static_sync_iterations: 100,
         ..Default::default()
@@ -57,7 +62,7 @@ fn main() {
             let mut host = HostNet::new(
                 [2, 0, 0, 0, 0, 1],
                 &[(HOST_IP, 24)],
-                clock.load(Ordering::Relaxed),
+                Nanos::from_ns(clock.load(Ordering::Relaxed)),
             );
             assert!(
                 host.tunnel

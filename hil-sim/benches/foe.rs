@@ -20,6 +20,7 @@ use drive::runtime::Drive;
 use ethercrab::SubDeviceRef;
 use hil_sim::esc::{Esc, EscConfig};
 use hil_sim::sim::{FirmwareFlash, Node, SimFlash, Simulation};
+use nanos::Nanos;
 use std::cell::RefCell;
 use std::sync::atomic::Ordering;
 use std::time::Instant;
@@ -38,9 +39,9 @@ impl Node for FwNode {
     fn esc_mut(&mut self) -> &mut Esc {
         &mut self.esc
     }
-    fn poll(&mut self, now_ns: u64) {
-        self.esc.tick(now_ns);
-        let _ = self.drive.poll(&mut self.esc.pdi(), now_ns);
+    fn poll(&mut self, now: Nanos) {
+        self.esc.tick(now);
+        let _ = self.drive.poll(&mut self.esc.pdi(), now);
     }
 }
 
@@ -131,7 +132,7 @@ fn main() {
             for _ in 0..runs {
                 let (t0, f0) = {
                     let s = sim.borrow();
-                    (s.now_ns(), s.frames())
+                    (s.now().as_ns(), s.frames())
                 };
                 let start = Instant::now();
                 assert_eq!(mbx.foe(&sd, 2, 0, b"firmware.efw").await, (4, 0), "WRQ acked");
@@ -145,7 +146,7 @@ fn main() {
                 }
                 let wall = start.elapsed();
                 let s = sim.borrow();
-                results.push((wall, s.now_ns() - t0, s.frames() - f0, chunks.len()));
+                results.push((wall, s.now().as_ns() - t0, s.frames() - f0, chunks.len()));
             }
             results
         },

@@ -51,14 +51,14 @@ fn main() {
                 .map(|s| s.io_raw().inputs().len() + s.io_raw().outputs().len())
                 .sum();
             let f0 = sim.borrow().frames();
-            let t0 = sim.borrow().now_ns();
+            let t0 = sim.borrow().now().as_ns();
             let start = Instant::now();
             for _ in 0..cycles {
                 group.tx_rx(md).await.expect("cycle");
             }
             let wall = start.elapsed();
             let s = sim.borrow();
-            (wall, s.frames() - f0, s.now_ns() - t0, pdi)
+            (wall, s.frames() - f0, s.now().as_ns() - t0, pdi)
         });
     println!("2-slave line, {cycles} process-data cycles, {pdi_bytes} PDI bytes per cycle");
     println!("{:<44} {:>14} {:>16}", "path", "frames/s wall", "sim µs/frame");
@@ -72,7 +72,7 @@ fn main() {
     let mut s = sim.borrow_mut();
     let frame = lrw_frame(pdi_bytes);
     let mut buf = frame.clone();
-    let t0 = s.now_ns();
+    let t0 = s.now().as_ns();
     let start = Instant::now();
     for _ in 0..cycles {
         buf.copy_from_slice(&frame);
@@ -84,6 +84,6 @@ fn main() {
         "{:<44} {:>14.0} {:>16.2}",
         format!("LRW replay -> ESCs -> slave firmware (wkc {wkc})"),
         cycles as f64 / wall.as_secs_f64(),
-        (s.now_ns() - t0) as f64 / cycles as f64 / 1e3
+        (s.now().as_ns() - t0) as f64 / cycles as f64 / 1e3
     );
 }

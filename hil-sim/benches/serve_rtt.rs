@@ -18,7 +18,11 @@
 #[path = "../tests/common/mod.rs"]
 mod common;
 
-use hil_sim::raw::{monotonic_ns, RawSocket};
+use hil_sim::raw::{monotonic, RawSocket};
+
+fn monotonic_ns() -> u64 {
+    monotonic().as_ns()
+}
 use std::time::Duration;
 
 /// Master cycle, ns.
@@ -113,7 +117,7 @@ fn measure(sock: &RawSocket, drives: usize, seconds: u64) -> Figures {
     let mut next_progress = start + 5_000_000_000;
     let mut receive = |sent_at: &[u64], rtt: &mut Vec<u64>, over: &mut u64| {
         while let Some(rx) = sock.try_recv(&mut buf).expect("receive") {
-            let (Some(seq), Some(t)) = (answer_seq(&buf[..rx.len]), rx.rx_ns) else {
+            let (Some(seq), Some(t)) = (answer_seq(&buf[..rx.len]), rx.rx.map(nanos::Nanos::as_ns)) else {
                 continue;
             };
             let Some(&t0) = sent_at.get(usize::try_from(seq).unwrap_or(usize::MAX)) else {

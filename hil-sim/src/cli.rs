@@ -12,7 +12,7 @@ pub fn print_new_changes(sim: &Simulation, printed: &mut Vec<usize>) {
     printed.resize(sim.drives().len(), 0);
     for (i, d) in sim.drives().iter().enumerate() {
         for (t, c) in d.state_log.iter().skip(printed[i]) {
-            println!("  [{:>10.3} ms] slave {i}: {c}", *t as f64 / 1e6);
+            println!("  [{:>10.3} ms] slave {i}: {c}", t.as_ns() as f64 / 1e6);
         }
         printed[i] = d.state_log.len();
     }

@@ -10,6 +10,7 @@ use crate::sim::SimDrive;
 use drive::runtime::Drive;
 use ecat::eoe::{frame_type, EoeHeader, Fragmenter, Reassembly, HEADER_LEN, MAX_FRAME};
 use ethercrab::SubDeviceRef;
+use nanos::Nanos;
 use net::smoltcp;
 use net::{NetBuffers, NetConfig, NetSettings, NetStack, SocketSlots};
 use smoltcp::iface::SocketStorage;
@@ -50,37 +51,31 @@ pub struct DriveNet {
 }
 
 impl DriveNet {
-    /// Bound to `drive`'s EoE queue at `now_ns`: MAC `mac` until the master
+    /// Bound to `drive`'s EoE queue at `now`: MAC `mac` until the master
     /// sets one, `seed` for the random delays.
     pub fn new<F: store::Flash, B: store::Flash>(
         drive: &mut Drive<F, B>,
         mac: [u8; 6],
         seed: u64,
-        now_ns: u64,
+        now: Nanos,
     ) -> Self {
         let bufs: &'static mut NetBuffers = Box::leak(Box::new(NetBuffers::new()));
         let slots: &'static mut SocketSlots<'static> =
             Box::leak(Box::new([SocketStorage::EMPTY; net::SOCKETS]));
-        let stack = NetStack::new(
-            NetConfig { mac, seed },
-            bufs,
-            slots,
-            drive.eoe_mut(),
-            now_ns / 1000,
-        );
+        let stack = NetStack::new(NetConfig { mac, seed }, bufs, slots, drive.eoe_mut(), now);
         Self { stack }
     }
 
     /// Polls the stack after the drive's poll (local time = simulation time).
-    pub fn poll<F: store::Flash, B: store::Flash>(&mut self, drive: &mut Drive<F, B>, now_ns: u64) {
+    pub fn poll<F: store::Flash, B: store::Flash>(&mut self, drive: &mut Drive<F, B>, now: Nanos) {
         let settings = net_settings(drive);
         let stack = &mut self.stack;
-        drive.with_eoe(|q, dict, state| stack.poll(now_ns / 1000, q, dict, state, &settings));
+        drive.with_eoe(|q, dict, state| stack.poll(now, q, dict, state, &settings));
         // E-147: message time stamps fall back to the SNTP time
-        let sntp = stack.sntp_time_ns(now_ns / 1000);
+        let sntp = stack.sntp_time(now);
         drive.set_sntp_time(
             sntp.map(|unix| net::sntp::message_time_stamp(None, Some(unix))),
-            now_ns,
+            now,
         );
     }
 }
@@ -88,14 +83,14 @@ impl DriveNet {
 impl SimDrive {
     /// Binds an IP stack to the drive's EoE interface ([`DriveNet::new`]),
     /// polled after each poll of the drive.
-    pub fn bind_net(&mut self, mac: [u8; 6], seed: u64, now_ns: u64) {
-        self.net = Some(Box::new(DriveNet::new(&mut self.drive, mac, seed, now_ns)));
+    pub fn bind_net(&mut self, mac: [u8; 6], seed: u64, now: Nanos) {
+        self.net = Some(Box::new(DriveNet::new(&mut self.drive, mac, seed, now)));
     }
 
     /// Polls the bound IP stack (after the drive's poll).
-    pub(crate) fn poll_net(&mut self, now_ns: u64) {
+    pub(crate) fn poll_net(&mut self, now: Nanos) {
         if let Some(net) = self.net.as_deref_mut() {
-            net.poll(&mut self.drive, now_ns);
+            net.poll(&mut self.drive, now);
         }
     }
 }
@@ -338,21 +333,21 @@ fn udp_socket() -> smoltcp::socket::udp::Socket<'static> {
     )
 }
 
-fn host_instant(now_ns: u64) -> Instant {
-    Instant::from_micros((now_ns / 1000) as i64)
+fn host_instant(now: Nanos) -> Instant {
+    Instant::from_micros(now.as_us() as i64)
 }
 
 impl HostNet {
     /// A host with MAC `mac` and the addresses `ips` (address, prefix) at
-    /// simulated time `now_ns`.
-    pub fn new(mac: [u8; 6], ips: &[([u8; 4], u8)], now_ns: u64) -> Self {
+    /// simulated time `now`.
+    pub fn new(mac: [u8; 6], ips: &[([u8; 4], u8)], now: Nanos) -> Self {
         use smoltcp::iface::{Config, Interface, SocketSet};
         use smoltcp::socket::icmp;
         use smoltcp::wire::{EthernetAddress, HardwareAddress, IpCidr, Ipv4Address};
         let mut tunnel = EoeTunnel::new();
         let mut cfg = Config::new(HardwareAddress::Ethernet(EthernetAddress(mac)));
         cfg.random_seed = 1;
-        let mut iface = Interface::new(cfg, &mut tunnel, host_instant(now_ns));
+        let mut iface = Interface::new(cfg, &mut tunnel, host_instant(now));
         iface.update_ip_addrs(|a| {
             for &(ip, prefix) in ips {
                 let _ = a.push(IpCidr::new(Ipv4Address::from(ip).into(), prefix));
@@ -389,10 +384,10 @@ impl HostNet {
         self.sockets.add(s)
     }
 
-    /// Runs the host interface at `now_ns`.
-    pub fn poll(&mut self, now_ns: u64) {
+    /// Runs the host interface at `now`.
+    pub fn poll(&mut self, now: Nanos) {
         self.iface
-            .poll(host_instant(now_ns), &mut self.tunnel, &mut self.sockets);
+            .poll(host_instant(now), &mut self.tunnel, &mut self.sockets);
     }
 
     /// Sends an ICMP echo request with `payload` to `to`.
@@ -457,13 +452,13 @@ impl HostNet {
     /// One step of the link: host interface, mailbox round, host interface.
     pub async fn step<S>(&mut self, sd: &SubDeviceRef<'_, S>, clock: &core::sync::atomic::AtomicU64) -> bool {
         use core::sync::atomic::Ordering;
-        self.poll(clock.load(Ordering::Relaxed));
+        self.poll(Nanos::from_ns(clock.load(Ordering::Relaxed)));
         let moved = self.tunnel.pump(sd).await;
-        self.poll(clock.load(Ordering::Relaxed));
+        self.poll(Nanos::from_ns(clock.load(Ordering::Relaxed)));
         moved
     }
 
-    /// Pings `to` once and returns the round-trip time in simulated ns
+    /// Pings `to` once and returns the round-trip time in simulated time
     /// (`None`: no reply within `max_steps` steps).
     pub async fn ping<S>(
         &mut self,
@@ -472,7 +467,7 @@ impl HostNet {
         to: [u8; 4],
         seq: u16,
         max_steps: usize,
-    ) -> Option<u64> {
+    ) -> Option<Nanos> {
         self.ping_with(sd, clock, to, seq, 56, max_steps).await
     }
 
@@ -485,7 +480,7 @@ impl HostNet {
         seq: u16,
         len: usize,
         max_steps: usize,
-    ) -> Option<u64> {
+    ) -> Option<Nanos> {
         use core::sync::atomic::Ordering;
         let payload: Vec<u8> = (0..len).map(|i| i as u8 ^ seq as u8).collect();
         let t0 = clock.load(Ordering::Relaxed);
@@ -496,7 +491,7 @@ impl HostNet {
             self.step(sd, clock).await;
             if let Some((s, data)) = self.recv_pong() {
                 if s == seq && data == payload {
-                    return Some(clock.load(Ordering::Relaxed) - t0);
+                    return Some(Nanos::from_ns(clock.load(Ordering::Relaxed) - t0));
                 }
             }
         }
@@ -504,7 +499,7 @@ impl HostNet {
     }
 
     /// Sends a parameter-service request to `to` and returns the answer and
-    /// its latency in simulated ns.
+    /// its latency in simulated time.
     pub async fn param_request<S>(
         &mut self,
         sd: &SubDeviceRef<'_, S>,
@@ -512,7 +507,7 @@ impl HostNet {
         to: [u8; 4],
         request: &str,
         max_steps: usize,
-    ) -> Option<(String, u64)> {
+    ) -> Option<(String, Nanos)> {
         use core::sync::atomic::Ordering;
         let t0 = clock.load(Ordering::Relaxed);
         if !self.send_udp(to, net::param::PARAM_PORT, request.as_bytes()) {
@@ -523,7 +518,7 @@ impl HostNet {
             if let Some(d) = self.recv_udp() {
                 return Some((
                     String::from_utf8_lossy(&d).into_owned(),
-                    clock.load(Ordering::Relaxed) - t0,
+                    Nanos::from_ns(clock.load(Ordering::Relaxed) - t0),
                 ));
             }
         }

@@ -11,7 +11,7 @@
 //! control/status ownership, AL events, the SII EEPROM interface, watchdogs
 //! and the distributed-clock receive-time latch.
 //!
-//! Time is an argument (`now_ns`); the ESC keeps the latest time it was
+//! Time is an argument (`now`, [`Nanos`]); the ESC keeps the latest time it was
 //! given and uses it for PDI accesses. `no_std`, heap-free, never panics on
 //! frame input.
 //!
@@ -51,6 +51,7 @@ use ::esc::{
     Fmmu, Pdi, SyncManager,
 };
 use core::convert::Infallible;
+use nanos::Nanos;
 
 use crate::frame::{Command, Datagram};
 use access::{dl, Op, Side};
@@ -99,7 +100,7 @@ pub struct EscConfig {
     pub dc_supported: bool,
     /// Simulated duration of an SII EEPROM command; 0 completes immediately
     /// (BUSY is then never seen).
-    pub sii_busy_ns: u64,
+    pub sii_busy: Nanos,
     /// Drift of the ESC's oscillator, ppb (+: the local clock runs fast),
     /// clamped to ±[`MAX_DRIFT_PPB`].
     pub clock_drift_ppb: i32,
@@ -119,7 +120,7 @@ impl EscConfig {
         port_descriptor: 0x0F,
         features: 0,
         dc_supported: true,
-        sii_busy_ns: 0,
+        sii_busy: Nanos::ZERO,
         clock_drift_ppb: 0,
         clock_offset_ns: 0,
     };
@@ -135,7 +136,7 @@ impl Default for EscConfig {
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
 struct SiiPending {
     command: u16,
-    done_at: u64,
+    done_at: Nanos,
 }
 
 /// One simulated ESC.
@@ -145,22 +146,22 @@ pub struct Esc {
     mem: [u8; MEM_SIZE],
     sii: [u8; SII_MAX_BYTES],
     sm: [SmState; MAX_SM],
-    now_ns: u64,
+    now: Nanos,
     sii_pending: Option<SiiPending>,
     /// Last retrigger of the process-data watchdog (None: not running / expired).
-    pd_wd_trigger: Option<u64>,
+    pd_wd_trigger: Option<Nanos>,
     /// Last retrigger of the PDI watchdog (None: not running / expired).
-    pdi_wd_trigger: Option<u64>,
+    pdi_wd_trigger: Option<Nanos>,
     /// Distributed clocks: local clock, drift-control loop, cyclic unit.
     dc: DcState,
     /// Time of the last frame that passed the ESC (port 0 receives every
     /// frame; port 1 forwards it when it has a link).
-    last_frame_ns: Option<u64>,
+    last_frame: Option<Nanos>,
 }
 
 /// How long a port counts as active after a frame (the LA_EC LED
-/// flickers), ns: two flicker periods (ETG.1300), our choice.
-pub const ACTIVITY_WINDOW_NS: u64 = 100_000_000;
+/// flickers): two flicker periods (ETG.1300), our choice.
+pub const ACTIVITY_WINDOW: Nanos = Nanos::from_ms(100);
 
 impl core::fmt::Debug for Esc {
     fn fmt(&self, f: &mut core::fmt::Formatter<'_>) -> core::fmt::Result {
@@ -168,7 +169,7 @@ impl core::fmt::Debug for Esc {
             .field("config", &self.config)
             .field("station_address", &self.station_address())
             .field("al_status", &self.al_status())
-            .field("now_ns", &self.now_ns)
+            .field("now", &self.now)
             .finish_non_exhaustive()
     }
 }
@@ -188,8 +189,8 @@ impl Esc {
             mem: [0; MEM_SIZE],
             sii: [0xFF; SII_MAX_BYTES],
             sm: [SmState::default(); MAX_SM],
-            last_frame_ns: None,
-            now_ns: 0,
+            last_frame: None,
+            now: Nanos::ZERO,
             sii_pending: None,
             pd_wd_trigger: None,
             pdi_wd_trigger: None,
@@ -271,8 +272,8 @@ impl Esc {
     }
 
     /// The latest time the ESC has seen (from datagrams or [`Esc::tick`]).
-    pub fn now_ns(&self) -> u64 {
-        self.now_ns
+    pub fn now(&self) -> Nanos {
+        self.now
     }
 
     /// SyncManager `n`'s register block (default for `n` out of range).
@@ -299,7 +300,7 @@ impl Esc {
     pub fn read_reg(&self, addr: u16, buf: &mut [u8]) {
         for (i, b) in buf.iter_mut().enumerate() {
             let a = u32::from(addr) + i as u32;
-            *b = self.computed(a, self.now_ns).unwrap_or_else(|| self.raw(a));
+            *b = self.computed(a, self.now).unwrap_or_else(|| self.raw(a));
         }
     }
 
@@ -348,17 +349,15 @@ impl Esc {
         self.set_u8(a, self.get_u8(a).saturating_add(1));
     }
 
-    /// Whether `port` (0 or 1) carried a frame within [`ACTIVITY_WINDOW_NS`]
-    /// before `now_ns` (what the ESC's LA_EC LED outputs show, E-134).
-    pub fn port_activity(&self, port: u8, now_ns: u64) -> bool {
+    /// Whether `port` (0 or 1) carried a frame within [`ACTIVITY_WINDOW`]
+    /// before `now` (what the ESC's LA_EC LED outputs show, E-134).
+    pub fn port_activity(&self, port: u8, now: Nanos) -> bool {
         let link = match port {
             0 => true,
             1..=3 => self.get_u16(regs::DL_STATUS) & (1 << (4 + port)) != 0,
             _ => false,
         };
-        link && self
-            .last_frame_ns
-            .is_some_and(|t| now_ns.saturating_sub(t) < ACTIVITY_WINDOW_NS)
+        link && self.last_frame.is_some_and(|t| now.since(t) < ACTIVITY_WINDOW)
     }
 
     /// A PDI handle (implements [`::esc::Pdi`]); [`Esc`] implements it too.
@@ -368,13 +367,13 @@ impl Esc {
 
     // ------------------------------------------------------------------- time
 
-    /// Advances the ESC's time to `now_ns` (never backwards): completes a
+    /// Advances the ESC's time to `now` (never backwards): completes a
     /// pending SII command, checks the process-data and PDI watchdogs and
     /// generates the SYNC pulses that are due. [`Esc::process_datagram`] calls
     /// it too.
-    pub fn tick(&mut self, now_ns: u64) {
-        self.now_ns = self.now_ns.max(now_ns);
-        let now = self.now_ns;
+    pub fn tick(&mut self, now: Nanos) {
+        self.now = self.now.max(now);
+        let now = self.now;
         if let Some(p) = self.sii_pending {
             if now >= p.done_at {
                 self.sii_pending = None;
@@ -403,26 +402,26 @@ impl Esc {
         self.dc_tick(now);
     }
 
-    /// Watchdog period in ns for the time register at `reg`; `None` when the time is 0 (disabled).
-    fn wd_period(&self, reg: u16) -> Option<u64> {
+    /// Watchdog period for the time register at `reg`; `None` when the time is 0 (disabled).
+    fn wd_period(&self, reg: u16) -> Option<Nanos> {
         let time = u64::from(self.get_u16(reg));
         if time == 0 {
             return None;
         }
         let div = u64::from(self.get_u16(regs::WATCHDOG_DIVIDER)) + 2;
-        Some(time * div * 40)
+        Some(Nanos::from_ns(time * div * 40))
     }
 
     /// Retriggers the process-data watchdog (completed ECAT write to an SM with the watchdog bit).
     fn retrigger_pd_watchdog(&mut self) {
-        self.pd_wd_trigger = Some(self.now_ns);
+        self.pd_wd_trigger = Some(self.now);
         let st = self.get_u16(regs::WATCHDOG_STATUS_PD) | 1;
         self.set_u16(regs::WATCHDOG_STATUS_PD, st);
     }
 
     /// Any PDI access retriggers the PDI watchdog.
     fn pdi_touch(&mut self) {
-        self.pdi_wd_trigger = Some(self.now_ns);
+        self.pdi_wd_trigger = Some(self.now);
         let s = self.get_u16(regs::DL_STATUS) | dl::PDI_WATCHDOG;
         self.set_u16(regs::DL_STATUS, s);
     }

@@ -22,6 +22,7 @@
 #![deny(missing_docs)]
 
 use crate::esc::Esc;
+use nanos::Nanos;
 
 /// EtherType of EtherCAT frames.
 pub const ETHERTYPE_ETHERCAT: u16 = 0x88A4;
@@ -441,14 +442,14 @@ impl<'a> EthercatFrame<'a> {
 ///
 /// A frame that is not EtherCAT or is malformed (truncated, length field past
 /// the end, datagram past the area) is an error and left untouched.
-pub fn process_frame(escs: &mut [&mut Esc], frame: &mut [u8], now_ns: u64) -> Result<(), FrameError> {
+pub fn process_frame(escs: &mut [&mut Esc], frame: &mut [u8], now: Nanos) -> Result<(), FrameError> {
     let mut f = EthercatFrame::new_checked(frame)?;
     connect_line(escs);
     for esc in escs.iter_mut() {
         for dg in f.datagrams() {
             // The chain was validated in `new_checked`; an error here cannot happen.
             let mut dg = dg?;
-            esc.process_datagram(&mut dg, now_ns);
+            esc.process_datagram(&mut dg, now);
         }
     }
     f.mark_returned();
@@ -535,10 +536,10 @@ pub(crate) mod testutil {
             .collect()
     }
 
-    /// Sends one datagram through the line and returns (data, wkc).
+    /// Sends one datagram through the line at `now` ns and returns (data, wkc).
     pub fn xfer(escs: &mut [&mut Esc], cmd: Command, addr: u32, data: &[u8], now: u64) -> (Vec<u8>, u16) {
         let mut f = build(&[(cmd, addr, data)]);
-        process_frame(escs, &mut f, now).unwrap();
+        process_frame(escs, &mut f, Nanos::from_ns(now)).unwrap();
         let r = parse(&mut f).remove(0);
         (r.data, r.wkc)
     }

@@ -50,7 +50,7 @@ impl<N: Node> Future for InProcessLink<'_, N> {
             let now = {
                 let mut sim = self.sim.borrow_mut();
                 sim.exchange(&mut buf[..len]);
-                sim.now_ns()
+                sim.now().as_ns()
             };
             self.clock.store(now, Ordering::Relaxed);
             // A frame the master no longer waits for (timed out) is dropped by ethercrab.
@@ -105,7 +105,7 @@ where
     let Ok((tx, rx, pdu_loop)) = storage.try_split() else {
         unreachable!("a fresh PduStorage splits once")
     };
-    let clock = AtomicU64::new(sim.borrow().now_ns());
+    let clock = AtomicU64::new(sim.borrow().now().as_ns());
     let md = ethercrab::MainDevice::new(pdu_loop, timeouts, config);
     let link = InProcessLink::new(tx, rx, sim, &clock);
     futures_lite::future::block_on(futures_lite::future::or(

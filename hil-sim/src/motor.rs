@@ -32,7 +32,7 @@
 //! - Optional rigid end stops (for torque-limit homing, spec §9 methods −1…−4):
 //!   the rotor stops dead at them.
 //!
-//! Internal sub-steps of at most [`MotorParams::max_substep_ns`] (default
+//! Internal sub-steps of at most [`MotorParams::max_substep`] (default
 //! 10 µs) make 62.5 µs … 8 ms control cycles equally accurate. Velocity uses
 //! semi-implicit Euler; position the trapezoid rule (exact for constant
 //! acceleration). Position is an `i64` encoder count plus an `f64` fraction of
@@ -71,6 +71,7 @@ pub use inputs::{
 
 use core::f64::consts::{FRAC_PI_2, PI, TAU};
 use inputs::Crossing;
+use nanos::Nanos;
 
 /// Encoder increments per revolution (2^20), fixed.
 pub const INC_PER_REV: i64 = 1 << 20;
@@ -137,9 +138,9 @@ pub struct MotorParams {
     pub initial_position_inc: i64,
     /// Rigid end stops `(lowest, highest)`, increments, or `None`.
     pub end_stops_inc: Option<(i64, i64)>,
-    /// Longest internal integration sub-step, ns (values below 100 ns are
+    /// Longest internal integration sub-step (values below 100 ns are
     /// treated as 100 ns).
-    pub max_substep_ns: u64,
+    pub max_substep: Nanos,
     /// Encoder noise amplitude, increments: the reported position gets a
     /// uniform offset in `±encoder_noise_inc`. 0 = off (default).
     pub encoder_noise_inc: u32,
@@ -176,7 +177,7 @@ impl MotorParams {
             index_offset_inc: 0,
             initial_position_inc: 0,
             end_stops_inc: None,
-            max_substep_ns: 10_000,
+            max_substep: Nanos::from_us(10),
             encoder_noise_inc: 0,
             noise_seed: 0x5eed_0000_0000_0001,
         }
@@ -236,8 +237,8 @@ impl Default for MotorParams {
 pub struct IndexEvent {
     /// Encoder position of the pulse, increments, wrapped to `i32`.
     pub position_inc: i32,
-    /// Time of the pulse after the start of the step, ns.
-    pub time_offset_ns: u64,
+    /// Time of the pulse after the start of the step.
+    pub time_offset: Nanos,
     /// Crossed while moving in the positive direction.
     pub positive: bool,
 }
@@ -262,8 +263,8 @@ pub struct MotorOutputs {
     pub inputs: InputLevels,
     /// Level changes of the inputs during the step, earliest first.
     pub edges: EdgeList,
-    /// Simulated time at the start of the step, ns since creation.
-    pub step_start_ns: u64,
+    /// Simulated time at the start of the step, since creation.
+    pub step_start: Nanos,
     /// The rotor rests against an end stop at the end of the step.
     pub at_end_stop: bool,
 }
@@ -290,8 +291,8 @@ pub struct Motor {
     at_end_stop: bool,
     /// The command that acts during the next step.
     pending: Actuation,
-    /// Simulated time, ns.
-    time_ns: u64,
+    /// Simulated time.
+    time: Nanos,
     rng: u64,
 }
 
@@ -310,7 +311,7 @@ impl Motor {
                 torque_nm: 0.0,
                 brake: params.initial_brake_engaged,
             },
-            time_ns: 0,
+            time: Nanos::ZERO,
             rng: 0,
         };
         m.set_position_inc(params.initial_position_inc);
@@ -383,9 +384,9 @@ impl Motor {
         self.vel_rad_s
     }
 
-    /// Simulated time, ns since creation (sum of all `dt_ns`).
-    pub fn time_ns(&self) -> u64 {
-        self.time_ns
+    /// Simulated time since creation (sum of all `dt`).
+    pub fn time(&self) -> Nanos {
+        self.time
     }
 
     /// Electrical input levels now.
@@ -393,12 +394,13 @@ impl Motor {
         self.switches.levels_at(self.pos_int)
     }
 
-    /// Advances the simulation by `dt_ns` (one control cycle).
+    /// Advances the simulation by `dt` (one control cycle).
     ///
     /// `torque_cmd_nm` and `brake_engaged` take effect one cycle later: during
     /// this step the command of the previous call acts. Returns the state at
     /// the end of the step and the events during it.
-    pub fn step(&mut self, torque_cmd_nm: f64, brake_engaged: bool, dt_ns: u64) -> MotorOutputs {
+    pub fn step(&mut self, torque_cmd_nm: f64, brake_engaged: bool, dt: Nanos) -> MotorOutputs {
+        let dt_ns = dt.as_ns();
         let act = self.pending;
         self.pending = Actuation {
             torque_nm: self.params.clamp_torque(torque_cmd_nm),
@@ -409,7 +411,7 @@ impl Motor {
         let mut index = None;
         let mut index_count = 0u32;
 
-        let max_sub = self.params.max_substep_ns.max(100);
+        let max_sub = self.params.max_substep.as_ns().max(100);
         let n = dt_ns.div_ceil(max_sub).max(1);
         let mut t_prev = 0u64;
         for i in 1..=n {
@@ -434,8 +436,8 @@ impl Motor {
         }
         edges.sort_by_time();
 
-        let step_start_ns = self.time_ns;
-        self.time_ns = self.time_ns.saturating_add(dt_ns);
+        let step_start = self.time;
+        self.time = self.time.saturating_add(dt);
         let noise = self.noise();
         MotorOutputs {
             position_inc: self.pos_int.wrapping_add(noise) as i32,
@@ -446,7 +448,7 @@ impl Motor {
             index_count,
             inputs: self.inputs(),
             edges,
-            step_start_ns,
+            step_start,
             at_end_stop: self.at_end_stop,
         }
     }
@@ -456,10 +458,10 @@ impl Motor {
         &mut self,
         torque_cmd_permille: i16,
         brake_engaged: bool,
-        dt_ns: u64,
+        dt: Nanos,
     ) -> MotorOutputs {
         let t = self.params.torque_from_permille(torque_cmd_permille);
-        self.step(t, brake_engaged, dt_ns)
+        self.step(t, brake_engaged, dt)
     }
 
     /// Load torque from gravity at the current position, N·m.
@@ -582,7 +584,7 @@ impl Motor {
         if first.is_none() {
             *first = Some(IndexEvent {
                 position_inc: mark as i32,
-                time_offset_ns: c.time_of(mark),
+                time_offset: Nanos::from_ns(c.time_of(mark)),
                 positive,
             });
         }

@@ -1,6 +1,7 @@
 //! A pcap writer (classic format, link type Ethernet, nanosecond timestamps),
 //! so Wireshark's EtherCAT dissector reads what the simulator saw.
 
+use nanos::Nanos;
 use std::fs::File;
 use std::io::{self, BufWriter, Write};
 use std::path::Path;
@@ -30,8 +31,9 @@ impl<W: Write> PcapWriter<W> {
         Ok(Self { out })
     }
 
-    /// Appends one frame seen at `t_ns` nanoseconds of simulated time.
-    pub fn frame(&mut self, t_ns: u64, frame: &[u8]) -> io::Result<()> {
+    /// Appends one frame seen at simulated time `t`.
+    pub fn frame(&mut self, t: Nanos, frame: &[u8]) -> io::Result<()> {
+        let t_ns = t.as_ns();
         let len = u32::try_from(frame.len()).unwrap_or(u32::MAX);
         let sec = u32::try_from(t_ns / 1_000_000_000).unwrap_or(u32::MAX);
         let nsec = (t_ns % 1_000_000_000) as u32;
@@ -77,10 +79,10 @@ impl<W: Write> Recording<W> {
         Ok(Self { writer, error: None })
     }
 
-    /// Appends one frame seen at `t_ns`; after an error nothing more is written.
-    pub fn frame(&mut self, t_ns: u64, frame: &[u8]) {
+    /// Appends one frame seen at `t`; after an error nothing more is written.
+    pub fn frame(&mut self, t: Nanos, frame: &[u8]) {
         if self.error.is_none() {
-            self.error = self.writer.frame(t_ns, frame).err();
+            self.error = self.writer.frame(t, frame).err();
         }
     }
 
@@ -105,7 +107,7 @@ mod tests {
     #[test]
     fn header_and_record_layout() {
         let mut w = PcapWriter::new(Vec::new()).unwrap();
-        w.frame(1_500_000_123, &[0xAA; 60]).unwrap();
+        w.frame(Nanos::from_ns(1_500_000_123), &[0xAA; 60]).unwrap();
         let b = w.into_inner();
         assert_eq!(b.len(), 24 + 16 + 60);
         assert_eq!(&b[0..4], &MAGIC_NS.to_le_bytes());
@@ -141,12 +143,12 @@ mod tests {
             room: 24 + 2 * (16 + 60) + 5,
         })
         .unwrap();
-        r.frame(1, &[0; 60]);
-        r.frame(2, &[0; 60]);
+        r.frame(Nanos::from_ns(1), &[0; 60]);
+        r.frame(Nanos::from_ns(2), &[0; 60]);
         assert!(r.error().is_none());
-        r.frame(3, &[0; 60]);
+        r.frame(Nanos::from_ns(3), &[0; 60]);
         assert_eq!(r.error().map(io::Error::kind), Some(io::ErrorKind::StorageFull));
-        r.frame(4, &[0; 60]);
+        r.frame(Nanos::from_ns(4), &[0; 60]);
         assert_eq!(r.flush().map_err(|e| e.kind()), Err(io::ErrorKind::StorageFull));
     }
 

@@ -1,6 +1,7 @@
 //! Time traces of a simulated run and their SVG plot: set and actual
 //! position, velocity, torque and following error over time.
 
+use nanos::Nanos;
 use plotters::prelude::*;
 use std::io::Write;
 
@@ -32,14 +33,14 @@ impl Trace {
     /// velocity in increments per second, torque in 0.1 % of rated torque.
     pub fn push(
         &mut self,
-        t_ns: u64,
+        t: Nanos,
         set_inc: i32,
         act_inc: i32,
         vel_inc_s: i32,
         torque_permille: i16,
         ferr_inc: i32,
     ) {
-        self.t_ms.push(t_ns as f64 / 1e6);
+        self.t_ms.push(t.as_ns() as f64 / 1e6);
         self.set_rev.push(f64::from(set_inc) / INC_PER_REV);
         self.act_rev.push(f64::from(act_inc) / INC_PER_REV);
         self.vel_rpm.push(f64::from(vel_inc_s) / INC_PER_REV * 60.0);

@@ -3,10 +3,11 @@
 //! Linux only; needs root or CAP_NET_RAW.
 //!
 //! Every received frame carries the kernel's receive timestamp
-//! (`SO_TIMESTAMPNS`, [`Received::rx_ns`]): `hil-sim serve` runs the
+//! (`SO_TIMESTAMPNS`, [`Received::rx`]): `hil-sim serve` runs the
 //! simulation to that instant before processing the frame, so neither its own
 //! waiting nor its scheduling delays change the timing the drive sees.
 
+use nanos::Nanos;
 use std::io;
 use std::os::fd::{AsRawFd, FromRawFd, OwnedFd};
 use std::time::Duration;
@@ -25,9 +26,9 @@ pub struct Received {
     pub len: usize,
     /// This host sent the frame (only from [`RawSocket::open_sniffer`]).
     pub outgoing: bool,
-    /// When the kernel received it, `CLOCK_MONOTONIC` ns (the time base of
-    /// [`monotonic_ns`]); `None` if the kernel gave no timestamp.
-    pub rx_ns: Option<u64>,
+    /// When the kernel received it, on `CLOCK_MONOTONIC` (the time base of
+    /// [`monotonic`]); `None` if the kernel gave no timestamp.
+    pub rx: Option<Nanos>,
 }
 
 /// Reads a clock, ns.
@@ -50,22 +51,22 @@ fn timespec_ns(ts: &libc::timespec) -> u64 {
     s.saturating_mul(1_000_000_000).saturating_add(ns)
 }
 
-/// `CLOCK_MONOTONIC`, ns (what [`std::time::Instant`] reads on Linux).
-pub fn monotonic_ns() -> u64 {
-    clock_ns(libc::CLOCK_MONOTONIC)
+/// `CLOCK_MONOTONIC` (what [`std::time::Instant`] reads on Linux).
+pub fn monotonic() -> Nanos {
+    Nanos::from_ns(clock_ns(libc::CLOCK_MONOTONIC))
 }
 
 /// A `CLOCK_REALTIME` instant (socket timestamps) on the `CLOCK_MONOTONIC`
 /// time base, with the offset between the clocks as it is now (both clocks
 /// are slewed alike; only a step of the wall clock changes the offset, and
 /// then only frames received before the step are misplaced).
-pub fn monotonic_from_realtime(realtime_ns: u64) -> u64 {
-    let mono = monotonic_ns();
+pub fn monotonic_from_realtime(realtime: Nanos) -> Nanos {
+    let mono = clock_ns(libc::CLOCK_MONOTONIC);
     let real = clock_ns(libc::CLOCK_REALTIME);
-    let mono2 = monotonic_ns();
+    let mono2 = clock_ns(libc::CLOCK_MONOTONIC);
     // the realtime reading sits between the two monotonic ones
     let offset = i128::from(real) - (i128::from(mono) + i128::from(mono2)) / 2;
-    u64::try_from((i128::from(realtime_ns) - offset).max(0)).unwrap_or(0)
+    Nanos::from_ns(u64::try_from((i128::from(realtime.as_ns()) - offset).max(0)).unwrap_or(0))
 }
 
 /// An AF_PACKET socket bound to one interface, receiving only EtherCAT frames.
@@ -227,7 +228,7 @@ impl RawSocket {
             return Ok(Some(Received {
                 len,
                 outgoing,
-                rx_ns: rx_timestamp(&msg).map(monotonic_from_realtime),
+                rx: rx_timestamp(&msg).map(|t| monotonic_from_realtime(Nanos::from_ns(t))),
             }));
         }
     }
@@ -285,12 +286,12 @@ mod tests {
 
     #[test]
     fn realtime_maps_onto_the_monotonic_clock() {
-        let mono = monotonic_ns();
+        let mono = monotonic().as_ns();
         let real = clock_ns(libc::CLOCK_REALTIME);
-        let back = monotonic_from_realtime(real);
+        let back = monotonic_from_realtime(Nanos::from_ns(real)).as_ns();
         assert!(back.abs_diff(mono) < 1_000_000, "{back} vs {mono}");
         // a realtime instant 1 ms earlier maps 1 ms earlier
-        let earlier = monotonic_from_realtime(real - 1_000_000);
+        let earlier = monotonic_from_realtime(Nanos::from_ns(real - 1_000_000)).as_ns();
         assert!(back.abs_diff(earlier + 1_000_000) < 100_000);
     }
 }

@@ -7,7 +7,7 @@
 //! 1. Init: station address, mailbox SyncManagers, request Pre-Op;
 //! 2. Pre-Op: SDO downloads through the mailbox (both axes in csp, both
 //!    channels assigned, DC-Sync), process-data SyncManagers and FMMUs,
-//!    SYNC0 every [`CYCLE_NS`], request Safe-Op, then Op with cyclic LRW;
+//!    SYNC0 every [`CYCLE`], request Safe-Op, then Op with cyclic LRW;
 //! 3. Op: enable both axes (6 → 7 → 15 on the controlword), a csp move of
 //!    [`MOVE_INC`] increments on each axis with a smooth profile, settle,
 //!    disable, back to Init.
@@ -30,22 +30,23 @@ pub trait Link {
 pub struct EscLink<'a> {
     /// The ESC.
     pub esc: &'a mut Esc,
-    /// Simulation time of the frame, ns.
-    pub now_ns: u64,
+    /// Simulation time of the frame.
+    pub now: Nanos,
 }
 
 impl Link for EscLink<'_> {
     fn transfer(&mut self, datagram: &mut [u8]) {
         if let Ok(mut dg) = Datagram::new_checked(datagram) {
-            self.esc.process_datagram(&mut dg, self.now_ns);
+            self.esc.process_datagram(&mut dg, self.now);
         }
     }
 }
 use ::esc::regs;
 use ::esc::{Fmmu, SyncManager};
+use nanos::Nanos;
 
-/// Master cycle (and SYNC0 period), ns.
-pub const CYCLE_NS: u64 = 1_000_000;
+/// Master cycle (and SYNC0 period).
+pub const CYCLE: Nanos = Nanos::from_ms(1);
 /// Configured station address the script assigns.
 pub const STATION: u16 = 0x1001;
 /// Distance of the csp move of each axis, increments (2^20 per revolution).
@@ -406,7 +407,7 @@ impl Script {
         }
     }
 
-    /// One master cycle (call every [`CYCLE_NS`]; the link carries the time).
+    /// One master cycle (call every [`CYCLE`]; the link carries the time).
     pub fn step(&mut self, link: &mut impl Link) -> Progress {
         let stage = self.stage;
         let (next, progress) = match self.run(link, stage) {
@@ -497,8 +498,9 @@ impl Script {
                 // cycles ahead (the master's frames go out half a cycle off it)
                 let mut t = [0u8; 8];
                 self.read(link, regs::dc::SYSTEM_TIME, &mut t)?;
-                let start = (u64::from_le_bytes(t) / CYCLE_NS).saturating_add(3) * CYCLE_NS;
-                let cycle = CYCLE_NS as u32;
+                let cycle_ns = CYCLE.as_ns();
+                let start = (u64::from_le_bytes(t) / cycle_ns).saturating_add(3) * cycle_ns;
+                let cycle = cycle_ns as u32;
                 self.write(link, regs::dc::SYNC0_CYCLE, &cycle.to_le_bytes())?;
                 self.write(link, regs::dc::START_TIME, &start.to_le_bytes())?;
                 self.write(link, regs::dc::ACTIVATION, &[0x03])?;

@@ -7,12 +7,13 @@ use crate::frame::process_frame;
 use crate::motor::{Input, Motor, MotorOutputs};
 use crate::pcap::Recording;
 use drive::axis::{AxisIo, IndexLatch, ProbeEdge, SwitchEdge, SwitchId};
+use nanos::Nanos;
 use std::collections::VecDeque;
 use std::io;
 use std::path::Path;
 
-/// Local poll period of the slave firmware between frames (the mailbox/ESM task), ns.
-pub const POLL_PERIOD_NS: u64 = 100_000;
+/// Local poll period of the slave firmware between frames (the mailbox/ESM task).
+pub const POLL_PERIOD: Nanos = Nanos::from_us(100);
 /// Forwarding delay of one slave, ns (out and back: half of it each way).
 const SLAVE_DELAY_NS: u64 = 500;
 /// SYNC0 pulses kept in [`SimDrive::sync0_log`].
@@ -60,8 +61,8 @@ impl drive::boot::Flash for FirmwareFlash {
 /// The firmware slots of a simulated drive.
 pub type FirmwareSlots = drive::boot::BootSlots<FirmwareFlash>;
 
-/// Control cycle of the simulated drive (A150 default), ns.
-pub const CONTROL_CYCLE_NS: u64 = 1_000_000;
+/// Control cycle of the simulated drive (A150 default).
+pub const CONTROL_CYCLE: Nanos = Nanos::from_ms(1);
 /// Control-cycle starts kept in [`SimDrive::cycle_log`].
 pub const CYCLE_LOG_LEN: usize = 256;
 /// Tick frequency of the simulated control-cycle timer, Hz.
@@ -102,7 +103,7 @@ impl AxisConditions {
 /// only trims the ESC's DC clock. So the PLL sees the oscillator's full
 /// drift against the DC system time and trims it, and aligns the phase.
 ///
-/// - Without SYNC0: a free-running [`CONTROL_CYCLE_NS`] cycle in simulation
+/// - Without SYNC0: a free-running [`CONTROL_CYCLE`] cycle in simulation
 ///   time, run when [`SimDrive::poll`] finds it due (as before DC-Sync).
 /// - From the first SYNC0 pulse the PLL runs ([`drive::runtime::Drive::pll`]):
 ///   the next start is the PLL's `start + period_ticks`, converted to
@@ -114,21 +115,21 @@ pub struct SimDrive {
     /// The drive firmware's communication runtime.
     pub drive: drive::runtime::Drive<SimFlash, FirmwareFlash>,
     /// State changes with their simulated time, oldest first.
-    pub state_log: Vec<(u64, ecat::StateChange)>,
+    pub state_log: Vec<(Nanos, ecat::StateChange)>,
     /// Motor and load of axis A and B.
     pub motors: [Motor; 2],
     /// A60, supply and STO per axis.
     pub conditions: [AxisConditions; 2],
-    /// Length of the last control cycle, ns: the time until the next one
+    /// Length of the last control cycle: the time until the next one
     /// starts (A150 in free run, the PLL's period under DC), which the
     /// motors are stepped by.
-    pub cycle_ns: u64,
+    pub cycle: Nanos,
     /// The last [`SYNC0_LOG_LEN`] SYNC0 pulses the ESC delivered, oldest first.
     pub sync0_log: VecDeque<Sync0Stamp>,
     /// The last [`CYCLE_LOG_LEN`] control-cycle starts under the PLL, oldest first.
     pub cycle_log: VecDeque<CycleStamp>,
     feedback: [Option<MotorOutputs>; 2],
-    next_cycle_ns: u64,
+    next_cycle: Nanos,
     /// Next start of the PLL-driven timer, ticks of the MCU clock (`None`: free-running).
     next_tick: Option<u64>,
     /// SM2 event pending after the last poll (a new one means a new RxPDO frame).
@@ -140,10 +141,10 @@ pub struct SimDrive {
 /// One control-cycle start under the PLL.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
 pub struct CycleStamp {
-    /// Simulation time of the start, ns.
-    pub now_ns: u64,
-    /// The MCU's local time of the start, ns.
-    pub local_ns: u64,
+    /// Simulation time of the start.
+    pub now: Nanos,
+    /// The MCU's local time of the start (the drive's clock).
+    pub local: Nanos,
     /// The ESC's DC system time at the start, ns.
     pub system_ns: u64,
     /// Position in the SYNC0 cycle (0 = the aligned cycle).
@@ -159,8 +160,8 @@ pub struct CycleStamp {
 /// One SYNC0 pulse as the drive saw it.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
 pub struct Sync0Stamp {
-    /// Simulation time of the pulse, ns.
-    pub now_ns: u64,
+    /// Simulation time of the pulse.
+    pub now: Nanos,
     /// The ESC's local time at the pulse, ns.
     pub local_ns: u64,
     /// The ESC's DC system time of the pulse (start time + k · cycle), ns.
@@ -195,7 +196,7 @@ fn axis_io(out: Option<&MotorOutputs>, motor: &Motor, c: AxisConditions) -> Axis
     io.reference = hit(Input::Reference);
     io.index = out.index.map(|i| IndexLatch {
         position_inc: i.position_inc,
-        time_ns: out.step_start_ns + i.time_offset_ns,
+        time_ns: out.step_start + i.time_offset,
     });
     let probes = out.edges.iter().filter_map(|e| {
         let input = match e.input {
@@ -206,7 +207,7 @@ fn axis_io(out: Option<&MotorOutputs>, motor: &Motor, c: AxisConditions) -> Axis
         Some(ProbeEdge {
             input,
             rising: e.rising,
-            time_ns: out.step_start_ns + e.time_offset_ns,
+            time_ns: out.step_start + e.time_offset,
             position_inc: Some(e.position_inc),
         })
     });
@@ -267,11 +268,11 @@ impl SimDrive {
             state_log: Vec::new(),
             motors: [Motor::default_servo(), Motor::default_servo()],
             conditions: [AxisConditions::READY; 2],
-            cycle_ns: CONTROL_CYCLE_NS,
+            cycle: CONTROL_CYCLE,
             sync0_log: VecDeque::with_capacity(SYNC0_LOG_LEN),
             cycle_log: VecDeque::with_capacity(CYCLE_LOG_LEN),
             feedback: [None, None],
-            next_cycle_ns: CONTROL_CYCLE_NS,
+            next_cycle: CONTROL_CYCLE,
             next_tick: None,
             sm2_event: false,
             net: None,
@@ -300,44 +301,45 @@ impl SimDrive {
         self.esc.set_clock(ppb, offset_ns);
     }
 
-    /// The MCU's local time at simulation time `now_ns` (the ESC's crystal
-    /// without the DC drift correction), ns.
-    pub fn mcu_local_ns(&self, now_ns: u64) -> u64 {
+    /// The MCU's local time at simulation time `now` (the ESC's crystal
+    /// without the DC drift correction).
+    pub fn mcu_local(&self, now: Nanos) -> Nanos {
         let c = self.esc.config();
-        let drift = i128::from(now_ns) * i128::from(c.clock_drift_ppb) / 1_000_000_000;
-        let t = i128::from(c.clock_offset_ns) + i128::from(now_ns) + drift;
-        u64::try_from(t.max(0)).unwrap_or(u64::MAX)
+        let now = i128::from(now.as_ns());
+        let drift = now * i128::from(c.clock_drift_ppb) / 1_000_000_000;
+        let t = i128::from(c.clock_offset_ns) + now + drift;
+        Nanos::from_ns(u64::try_from(t.max(0)).unwrap_or(u64::MAX))
     }
 
-    /// The first simulation time at which the MCU's local time reaches `local_ns`.
-    fn mcu_now_for(&self, local_ns: u64) -> u64 {
+    /// The first simulation time at which the MCU's local time reaches `local`.
+    fn mcu_now_for(&self, local: Nanos) -> Nanos {
         let c = self.esc.config();
-        let rel = i128::from(local_ns) - i128::from(c.clock_offset_ns);
+        let rel = i128::from(local.as_ns()) - i128::from(c.clock_offset_ns);
         if rel <= 0 {
-            return 0;
+            return Nanos::ZERO;
         }
         let den = 1_000_000_000 + i128::from(c.clock_drift_ppb);
         let mut t = u64::try_from(rel * 1_000_000_000 / den.max(1)).unwrap_or(u64::MAX);
-        while self.mcu_local_ns(t) < local_ns {
+        while self.mcu_local(Nanos::from_ns(t)) < local {
             t = t.saturating_add(1);
         }
-        while t > 0 && self.mcu_local_ns(t - 1) >= local_ns {
+        while t > 0 && self.mcu_local(Nanos::from_ns(t - 1)) >= local {
             t -= 1;
         }
-        t
+        Nanos::from_ns(t)
     }
 
-    /// Local time of timer tick `tick`, ns (rounded up: the tick is reached then).
-    fn tick_local_ns(tick: u64) -> u64 {
+    /// Local time of timer tick `tick` (rounded up to the ns: the tick is reached then).
+    fn tick_local(tick: u64) -> Nanos {
         let ns = (u128::from(tick) * NS_PER_S).div_ceil(u128::from(TIMER_HZ));
-        u64::try_from(ns).unwrap_or(u64::MAX)
+        Nanos::from_ns(u64::try_from(ns).unwrap_or(u64::MAX))
     }
 
     /// Simulation time of the next control-cycle start.
-    pub fn next_cycle_at(&self) -> u64 {
+    pub fn next_cycle_at(&self) -> Nanos {
         match self.next_tick {
-            Some(tick) => self.mcu_now_for(Self::tick_local_ns(tick)),
-            None => self.next_cycle_ns,
+            Some(tick) => self.mcu_now_for(Self::tick_local(tick)),
+            None => self.next_cycle,
         }
     }
 
@@ -346,12 +348,12 @@ impl SimDrive {
     fn follow_pll(&mut self) {
         match (self.drive.pll().is_some(), self.next_tick) {
             (true, None) => {
-                let local = u128::from(self.mcu_local_ns(self.next_cycle_ns));
+                let local = u128::from(self.mcu_local(self.next_cycle).as_ns());
                 let tick = (local * u128::from(TIMER_HZ)).div_ceil(NS_PER_S);
                 self.next_tick = Some(u64::try_from(tick).unwrap_or(u64::MAX));
             }
             (false, Some(_)) => {
-                self.next_cycle_ns = self.next_cycle_at();
+                self.next_cycle = self.next_cycle_at();
                 self.next_tick = None;
             }
             _ => {}
@@ -362,8 +364,8 @@ impl SimDrive {
     /// acknowledges it (reads 0x098E through the PDI, as the firmware's SYNC0
     /// interrupt does) and hands the MCU's local time of the edge to the
     /// drive's PLL (built at the first pulse).
-    pub fn on_sync0(&mut self, now_ns: u64) {
-        let p = self.esc.take_sync0_events(now_ns);
+    pub fn on_sync0(&mut self, now: Nanos) {
+        let p = self.esc.take_sync0_events(now);
         if p.count == 0 {
             return;
         }
@@ -373,34 +375,34 @@ impl SimDrive {
             self.sync0_log.pop_front();
         }
         self.sync0_log.push_back(Sync0Stamp {
-            now_ns: p.last_now_ns,
-            local_ns: self.esc.local_ns(p.last_now_ns),
+            now: p.last_now,
+            local_ns: self.esc.local_ns(p.last_now),
             system_ns: p.last_system_ns,
             pulses: p.count,
         });
-        let local = self.mcu_local_ns(p.last_now_ns);
+        let local = self.mcu_local(p.last_now);
         let mut pdi = self.esc.pdi();
         let _ = self.drive.on_sync0(&mut pdi, local);
         self.follow_pll();
     }
 
-    /// A frame passed the ESC at `arrival_ns`: when it completed an SM2
+    /// A frame passed the ESC at `arrival`: when it completed an SM2
     /// (RxPDO) buffer, the drive's SM2 event tells the PLL (`A261[1]`, `[2]`).
-    pub fn on_frame(&mut self, arrival_ns: u64) {
+    pub fn on_frame(&mut self, arrival: Nanos) {
         let event = self.esc.al_event_request() & ::esc::regs::al_event::sm(2) != 0;
         if event && !self.sm2_event {
-            let local = self.mcu_local_ns(arrival_ns);
+            let local = self.mcu_local(arrival);
             let _ = self.drive.on_frame(local);
         }
         self.sm2_event = event;
     }
 
-    /// Runs every control cycle due at `now_ns`, each at its own start time.
-    pub fn run_due_cycles(&mut self, now_ns: u64) {
+    /// Runs every control cycle due at `now`, each at its own start time.
+    pub fn run_due_cycles(&mut self, now: Nanos) {
         // bounded: a broken timer cannot hang the simulation
         for _ in 0..1_000_000 {
             let t = self.next_cycle_at();
-            if t > now_ns {
+            if t > now {
                 return;
             }
             self.run_cycle(t);
@@ -411,11 +413,11 @@ impl SimDrive {
     /// programs the next start and gives the cycle's steps (Rx, application,
     /// Tx in the A149 order, Rx/Tx in the aligned cycle only:
     /// [`drive::runtime::Drive::sync_cycle`]); then one motor step.
-    fn run_cycle(&mut self, t: u64) {
+    fn run_cycle(&mut self, t: Nanos) {
         let mut command = None;
         match self.next_tick {
             Some(tick) => {
-                let local = Self::tick_local_ns(tick);
+                let local = Self::tick_local(tick);
                 match self.drive.cycle_start(local) {
                     Some(cmd) => {
                         self.next_tick = Some(tick.saturating_add(u64::from(cmd.period_ticks.max(1))));
@@ -423,8 +425,8 @@ impl SimDrive {
                             self.cycle_log.pop_front();
                         }
                         self.cycle_log.push_back(CycleStamp {
-                            now_ns: t,
-                            local_ns: local,
+                            now: t,
+                            local,
                             system_ns: self.esc.system_time_ns(t),
                             index: cmd.index,
                             locked: self.drive.pll().is_some_and(|p| p.is_locked()),
@@ -435,12 +437,12 @@ impl SimDrive {
                     }
                     None => {
                         self.next_tick = None;
-                        self.next_cycle_ns = t.saturating_add(self.drive.free_run_period_ns());
+                        self.next_cycle = t.saturating_add(self.drive.free_run_period());
                     }
                 }
             }
             // free run: the cycle the axes integrate with (A150, E-125)
-            None => self.next_cycle_ns = t.saturating_add(self.drive.free_run_period_ns()),
+            None => self.next_cycle = t.saturating_add(self.drive.free_run_period()),
         }
         let io = [
             axis_io(self.feedback[0].as_ref(), &self.motors[0], self.conditions[0]),
@@ -453,8 +455,8 @@ impl SimDrive {
         // the torque holds until the next cycle starts (a broken timer that
         // schedules nothing ahead steps the motors by the last length)
         let dt = self.next_cycle_at().saturating_sub(t);
-        if dt > 0 {
-            self.cycle_ns = dt;
+        if !dt.is_zero() {
+            self.cycle = dt;
         }
         for ((motor, fb), c) in self.motors.iter_mut().zip(self.feedback.iter_mut()).zip(cmd) {
             let torque = if c.power_stage {
@@ -462,22 +464,22 @@ impl SimDrive {
             } else {
                 0.0
             };
-            *fb = Some(motor.step(torque, !c.brake_release, self.cycle_ns));
+            *fb = Some(motor.step(torque, !c.brake_release, self.cycle));
         }
     }
 
-    /// Runs the drive firmware up to `now_ns`: every control cycle that is due
+    /// Runs the drive firmware up to `now`: every control cycle that is due
     /// (axis runtime, then one motor step with the commanded torque), then the
     /// communication stack once.
-    pub fn poll(&mut self, now_ns: u64) {
-        self.esc.tick(now_ns);
-        self.run_due_cycles(now_ns);
+    pub fn poll(&mut self, now: Nanos) {
+        self.esc.tick(now);
+        self.run_due_cycles(now);
         let mut pdi = self.esc.pdi();
-        if let Ok(Some(change)) = self.drive.poll(&mut pdi, now_ns) {
-            self.state_log.push((now_ns, change));
+        if let Ok(Some(change)) = self.drive.poll(&mut pdi, now) {
+            self.state_log.push((now, change));
         }
         self.sm2_event = self.esc.al_event_request() & ::esc::regs::al_event::sm(2) != 0;
-        self.poll_net(now_ns);
+        self.poll_net(now);
         self.follow_pll();
     }
 }
@@ -489,14 +491,11 @@ impl SimDrive {
         self.feedback.get(axis).and_then(Option::as_ref)
     }
 
-    /// The drive's four EtherCAT LEDs at `now_ns` (E-132…E-134): the
+    /// The drive's four EtherCAT LEDs at `now` (E-132…E-134): the
     /// firmware's patterns ([`drive::runtime::Drive::leds`]) with the port
     /// activity the simulated ESC saw.
-    pub fn leds(&self, now_ns: u64) -> drive::runtime::Leds {
-        let activity = [
-            self.esc.port_activity(0, now_ns),
-            self.esc.port_activity(1, now_ns),
-        ];
+    pub fn leds(&self, now: Nanos) -> drive::runtime::Leds {
+        let activity = [self.esc.port_activity(0, now), self.esc.port_activity(1, now)];
         self.drive.leds(activity)
     }
 }
@@ -512,27 +511,27 @@ impl Default for SimDrive {
 pub trait Node {
     /// The node's simulated ESC.
     fn esc_mut(&mut self) -> &mut Esc;
-    /// Runs the node's firmware once at `now_ns`.
-    fn poll(&mut self, now_ns: u64);
-    /// The ESC raised SYNC0 at `now_ns` (the simulation stops at each edge and
+    /// Runs the node's firmware once at `now`.
+    fn poll(&mut self, now: Nanos);
+    /// The ESC raised SYNC0 at `now` (the simulation stops at each edge and
     /// calls this after advancing the ESC to it). Default: nothing.
-    fn on_sync0(&mut self, now_ns: u64) {
-        let _ = now_ns;
+    fn on_sync0(&mut self, now: Nanos) {
+        let _ = now;
     }
     /// Simulation time of the node's next timer interrupt that must run at
     /// its exact time (the simulation stops there and calls
     /// [`Node::on_timer`]). Default: none.
-    fn next_timer_at(&self) -> Option<u64> {
+    fn next_timer_at(&self) -> Option<Nanos> {
         None
     }
-    /// The timer of [`Node::next_timer_at`] is due at `now_ns`. Default: nothing.
-    fn on_timer(&mut self, now_ns: u64) {
-        let _ = now_ns;
+    /// The timer of [`Node::next_timer_at`] is due at `now`. Default: nothing.
+    fn on_timer(&mut self, now: Nanos) {
+        let _ = now;
     }
-    /// A frame passed the node's ESC, arriving there at `arrival_ns`.
+    /// A frame passed the node's ESC, arriving there at `arrival`.
     /// Default: nothing.
-    fn on_frame(&mut self, arrival_ns: u64) {
-        let _ = arrival_ns;
+    fn on_frame(&mut self, arrival: Nanos) {
+        let _ = arrival;
     }
 }
 
@@ -540,20 +539,20 @@ impl Node for SimDrive {
     fn esc_mut(&mut self) -> &mut Esc {
         &mut self.esc
     }
-    fn poll(&mut self, now_ns: u64) {
-        SimDrive::poll(self, now_ns);
+    fn poll(&mut self, now: Nanos) {
+        SimDrive::poll(self, now);
     }
-    fn on_sync0(&mut self, now_ns: u64) {
-        SimDrive::on_sync0(self, now_ns);
+    fn on_sync0(&mut self, now: Nanos) {
+        SimDrive::on_sync0(self, now);
     }
-    fn next_timer_at(&self) -> Option<u64> {
+    fn next_timer_at(&self) -> Option<Nanos> {
         self.next_tick.map(|_| self.next_cycle_at())
     }
-    fn on_timer(&mut self, now_ns: u64) {
-        self.run_due_cycles(now_ns);
+    fn on_timer(&mut self, now: Nanos) {
+        self.run_due_cycles(now);
     }
-    fn on_frame(&mut self, arrival_ns: u64) {
-        SimDrive::on_frame(self, arrival_ns);
+    fn on_frame(&mut self, arrival: Nanos) {
+        SimDrive::on_frame(self, arrival);
     }
 }
 
@@ -583,8 +582,8 @@ impl Jitter {
 /// A line of simulated slaves (drives by default) and the simulated clock.
 pub struct Simulation<N: Node = SimDrive> {
     drives: Vec<N>,
-    now_ns: u64,
-    last_poll_ns: u64,
+    now: Nanos,
+    last_poll: Nanos,
     frames: u64,
     pcap: Option<Recording>,
     jitter: Jitter,
@@ -602,25 +601,25 @@ impl<N: Node> Simulation<N> {
     pub fn with_nodes(nodes: Vec<N>) -> Self {
         Self {
             drives: nodes,
-            now_ns: 0,
-            last_poll_ns: 0,
+            now: Nanos::ZERO,
+            last_poll: Nanos::ZERO,
             frames: 0,
             pcap: None,
             jitter: Jitter { max_ns: 0, state: 1 },
         }
     }
 
-    /// Frame-arrival jitter: every frame reaches the line `max_ns + u` after
-    /// the master sent it, `u` uniform in `-max_ns..=max_ns` from a xorshift
+    /// Frame-arrival jitter: every frame reaches the line `max + u` after
+    /// the master sent it, `u` uniform in `-max..=max` from a xorshift
     /// generator seeded with `seed` (deterministic; 0 = no jitter, the default).
-    pub fn set_frame_jitter(&mut self, max_ns: u64, seed: u64) {
+    pub fn set_frame_jitter(&mut self, max: Nanos, seed: u64) {
         // splitmix64 of the seed: nearby seeds give unrelated sequences, never state 0
         let mut z = seed.wrapping_add(0x9E37_79B9_7F4A_7C15);
         z = (z ^ (z >> 30)).wrapping_mul(0xBF58_476D_1CE4_E5B9);
         z = (z ^ (z >> 27)).wrapping_mul(0x94D0_49BB_1331_11EB);
         z ^= z >> 31;
         self.jitter = Jitter {
-            max_ns: max_ns.min(i64::MAX as u64 / 4),
+            max_ns: max.as_ns().min(i64::MAX as u64 / 4),
             state: z.max(1),
         };
     }
@@ -638,9 +637,9 @@ impl<N: Node> Simulation<N> {
         self.pcap.as_ref().and_then(Recording::error)
     }
 
-    /// Simulated time, ns.
-    pub fn now_ns(&self) -> u64 {
-        self.now_ns
+    /// Simulated time.
+    pub fn now(&self) -> Nanos {
+        self.now
     }
 
     /// Frames exchanged so far.
@@ -666,85 +665,90 @@ impl<N: Node> Simulation<N> {
     /// back unchanged.
     pub fn exchange(&mut self, frame: &mut [u8]) {
         self.frames += 1;
-        let t_out = self.now_ns;
+        let t_out = self.now;
         if let Some(p) = self.pcap.as_mut() {
             p.frame(t_out, frame);
         }
         let j = self.jitter.next();
-        let t_arr = t_out.saturating_add(self.jitter.max_ns).saturating_add_signed(j);
+        let t_arr = Nanos::from_ns(
+            t_out
+                .as_ns()
+                .saturating_add(self.jitter.max_ns)
+                .saturating_add_signed(j),
+        );
         self.deliver_events(t_arr);
-        self.now_ns = self.now_ns.max(t_arr);
+        self.now = self.now.max(t_arr);
         let n = self.drives.len() as u64;
         let wire = (frame.len() as u64 + FRAME_OVERHEAD) * BYTE_NS + n * SLAVE_DELAY_NS;
         let hop = SLAVE_DELAY_NS / 2;
         let mut escs: Vec<&mut Esc> = self.drives.iter_mut().map(|d| d.esc_mut()).collect();
         for (k, esc) in (0u64..).zip(escs.iter_mut()) {
             esc.set_line_timing(LineTiming {
-                arrival_ns: k * hop,
-                loop_ns: 2 * n.saturating_sub(k + 1) * hop,
+                arrival: Nanos::from_ns(k * hop),
+                loop_time: Nanos::from_ns(2 * n.saturating_sub(k + 1) * hop),
             });
         }
         let _ = process_frame(&mut escs, frame, t_arr);
         drop(escs);
         for (k, d) in (0u64..).zip(self.drives.iter_mut()) {
-            d.on_frame(t_arr.saturating_add(k * hop));
+            d.on_frame(t_arr.saturating_add(Nanos::from_ns(k * hop)));
         }
-        let t_back = t_arr.saturating_add(wire);
+        let t_back = t_arr.saturating_add(Nanos::from_ns(wire));
         self.deliver_events(t_back);
-        self.now_ns = self.now_ns.max(t_back);
+        self.now = self.now.max(t_back);
         if let Some(p) = self.pcap.as_mut() {
-            p.frame(self.now_ns, frame);
+            p.frame(self.now, frame);
         }
         self.poll_all();
     }
 
-    /// Advances the clock to `t_ns` (no frames), running the slaves' firmware
-    /// every [`POLL_PERIOD_NS`] and delivering SYNC0 edges at their times.
-    pub fn advance_to(&mut self, t_ns: u64) {
-        while self.now_ns < t_ns {
-            let next = (self.last_poll_ns + POLL_PERIOD_NS).min(t_ns).max(self.now_ns);
+    /// Advances the clock to `t` (no frames), running the slaves' firmware
+    /// every [`POLL_PERIOD`] and delivering SYNC0 edges at their times.
+    pub fn advance_to(&mut self, t: Nanos) {
+        while self.now < t {
+            let next = (self.last_poll + POLL_PERIOD).min(t).max(self.now);
             self.deliver_events(next);
-            self.now_ns = next;
-            if self.now_ns >= self.last_poll_ns + POLL_PERIOD_NS {
+            self.now = next;
+            if self.now >= self.last_poll + POLL_PERIOD {
                 self.poll_all();
             }
         }
     }
 
-    /// Moves the clock to `t_ns` and runs the slaves' firmware once, however
+    /// Moves the clock to `t` and runs the slaves' firmware once, however
     /// far behind the simulation is: for wall-clock pacing (`hil-sim serve`),
     /// where simulating every poll period of a long gap would starve the frames.
     /// SYNC0 edges in the gap are still delivered one by one.
-    pub fn catch_up(&mut self, t_ns: u64) {
-        if t_ns > self.now_ns {
-            self.deliver_events(t_ns);
-            self.now_ns = t_ns;
+    pub fn catch_up(&mut self, t: Nanos) {
+        if t > self.now {
+            self.deliver_events(t);
+            self.now = t;
             self.poll_all();
         }
     }
 
     /// Delivers every SYNC0 edge and node timer ([`Node::next_timer_at`]) up
-    /// to and including `t_ns` in time order (SYNC0 before a timer, then
+    /// to and including `t` in time order (SYNC0 before a timer, then
     /// position order, for events at the same time): the clock moves to the
     /// event; for an edge the node's ESC is advanced to it and
     /// [`Node::on_sync0`] runs, for a timer [`Node::on_timer`].
-    fn deliver_events(&mut self, t_ns: u64) {
+    fn deliver_events(&mut self, t: Nanos) {
         // bounded: a pathological SYNC0 cycle cannot hang the simulation
         for _ in 0..1_000_000 {
             // (time, 0 = SYNC0 / 1 = timer, node)
-            let mut best: Option<(u64, u8, usize)> = None;
+            let mut best: Option<(Nanos, u8, usize)> = None;
             for (i, d) in self.drives.iter_mut().enumerate() {
                 let sync0 = d.esc_mut().next_sync0_at().map(|e| (e, 0u8, i));
                 let timer = d.next_timer_at().map(|e| (e, 1u8, i));
                 for ev in [sync0, timer].into_iter().flatten() {
-                    if ev.0 <= t_ns && best.is_none_or(|b| ev < b) {
+                    if ev.0 <= t && best.is_none_or(|b| ev < b) {
                         best = Some(ev);
                     }
                 }
             }
             let Some((e, kind, i)) = best else { return };
-            self.now_ns = self.now_ns.max(e);
-            let now = self.now_ns;
+            self.now = self.now.max(e);
+            let now = self.now;
             let Some(d) = self.drives.get_mut(i) else { return };
             if kind == 1 {
                 d.on_timer(now);
@@ -765,11 +769,11 @@ impl<N: Node> Simulation<N> {
     }
 
     fn poll_all(&mut self) {
-        let now = self.now_ns;
+        let now = self.now;
         for d in &mut self.drives {
             d.poll(now);
         }
-        self.last_poll_ns = now;
+        self.last_poll = now;
     }
 
     /// Flushes the pcap file, if any; the first write error of the recording.

@@ -12,8 +12,9 @@
 
 use crate::esc::{Esc, EscConfig};
 use crate::motor::{Motor, MotorOutputs};
-use crate::script::{EscLink, Progress, Script, CYCLE_NS};
+use crate::script::{EscLink, Progress, Script, CYCLE};
 use drive::axis::{AxisCommand, AxisIo};
+use nanos::Nanos;
 
 /// What happens next in the world.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
@@ -28,8 +29,8 @@ pub enum Event {
 
 /// Simulated time, motors and master.
 pub struct World {
-    now_ns: u64,
-    next_frame_ns: u64,
+    now: Nanos,
+    next_frame: Nanos,
     motors: [Motor; 2],
     feedback: [Option<MotorOutputs>; 2],
     script: Script,
@@ -57,8 +58,8 @@ impl World {
     /// Time 0, motors at rest, the master at the start of its script.
     pub fn new() -> Self {
         Self {
-            now_ns: 0,
-            next_frame_ns: CYCLE_NS / 2,
+            now: Nanos::ZERO,
+            next_frame: Nanos::from_ns(CYCLE.as_ns() / 2),
             motors: [Motor::default_servo(), Motor::default_servo()],
             feedback: [None, None],
             script: Script::new(),
@@ -66,9 +67,9 @@ impl World {
         }
     }
 
-    /// Simulated time, ns (the firmware's clock in QEMU).
-    pub fn now_ns(&self) -> u64 {
-        self.now_ns
+    /// Simulated time (the firmware's clock in QEMU).
+    pub fn now(&self) -> Nanos {
+        self.now
     }
 
     /// Whether the master's script ended, and whether it succeeded.
@@ -79,27 +80,24 @@ impl World {
     /// The next event given the ESC's next SYNC0 and the control timer's
     /// next start (local = simulation time); the clock moves to it. Ties go
     /// SYNC0, control, frame.
-    pub fn next(&mut self, next_sync0_ns: Option<u64>, next_control_ns: u64) -> Event {
-        let sync0 = next_sync0_ns.unwrap_or(u64::MAX);
-        let (t, event) = if sync0 <= next_control_ns && sync0 <= self.next_frame_ns {
+    pub fn next(&mut self, next_sync0: Option<Nanos>, next_control: Nanos) -> Event {
+        let sync0 = next_sync0.unwrap_or(Nanos::MAX);
+        let (t, event) = if sync0 <= next_control && sync0 <= self.next_frame {
             (sync0, Event::Sync0)
-        } else if next_control_ns <= self.next_frame_ns {
-            (next_control_ns, Event::Control)
+        } else if next_control <= self.next_frame {
+            (next_control, Event::Control)
         } else {
-            (self.next_frame_ns, Event::Frame)
+            (self.next_frame, Event::Frame)
         };
-        self.now_ns = self.now_ns.max(t);
+        self.now = self.now.max(t);
         event
     }
 
     /// The master's frame of this cycle through `esc`; schedules the next.
     pub fn frame(&mut self, esc: &mut Esc) -> Progress {
-        let mut link = EscLink {
-            esc,
-            now_ns: self.now_ns,
-        };
+        let mut link = EscLink { esc, now: self.now };
         let p = self.script.step(&mut link);
-        self.next_frame_ns = self.next_frame_ns.saturating_add(CYCLE_NS);
+        self.next_frame = self.next_frame.saturating_add(CYCLE);
         p
     }
 
@@ -117,7 +115,7 @@ impl World {
     }
 
     /// One motor step per axis with the control cycle's commands.
-    pub fn actuate(&mut self, cmd: &[AxisCommand; 2], cycle_ns: u64) {
+    pub fn actuate(&mut self, cmd: &[AxisCommand; 2], cycle: Nanos) {
         self.cycles = self.cycles.wrapping_add(1);
         for ((motor, fb), c) in self.motors.iter_mut().zip(self.feedback.iter_mut()).zip(cmd) {
             let torque = if c.power_stage {
@@ -125,7 +123,7 @@ impl World {
             } else {
                 0.0
             };
-            *fb = Some(motor.step(torque, !c.brake_release, cycle_ns));
+            *fb = Some(motor.step(torque, !c.brake_release, cycle));
         }
     }
 }

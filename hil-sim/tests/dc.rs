@@ -8,6 +8,7 @@
 use ethercrab::subdevice_group::DcConfiguration;
 use ethercrab::{DcSync, MainDevice, MainDeviceConfig, SubDeviceGroup};
 use hil_sim::sim::{SimDrive, Simulation};
+use nanos::Nanos;
 use std::cell::RefCell;
 use std::sync::atomic::{AtomicU64, Ordering};
 use std::time::Duration;
@@ -61,7 +62,7 @@ fn signed(v: u32) -> i64 {
 /// System time of drive 0 minus drive 1, at the same instant.
 fn skew(sim: &RefCell<Simulation>) -> i64 {
     let s = sim.borrow();
-    let now = s.now_ns();
+    let now = s.now();
     let [a, b] = [0, 1].map(|i| s.drives()[i].esc.system_time_ns(now));
     a.wrapping_sub(b) as i64
 }
@@ -84,7 +85,7 @@ fn e107_dc_start_up_synchronises_drifting_clocks() {
         "after init ({} frames, {:.1} ms): 0x092C of drive 1 = {diff} ns, system time skew {skew_after_init} ns, \
          clock rates {rate:?} ppb",
         s.frames(),
-        s.now_ns() as f64 / 1e6
+        s.now().as_ns() as f64 / 1e6
     );
     assert!(diff.abs() <= 5, "system time difference {diff} ns");
     assert!(skew_after_init.abs() <= 5, "skew {skew_after_init} ns");
@@ -141,7 +142,7 @@ fn run_sync0(sim: &RefCell<Simulation>, cycles: usize) -> (i64, i64) {
             }
             let wait = r.extra.next_cycle_wait.as_nanos() as u64;
             let mut s = sim.borrow_mut();
-            let t = s.now_ns() + wait;
+            let t = s.now() + Nanos::from_ns(wait);
             s.advance_to(t);
         }
         assert!(op, "the group reached OP");
@@ -173,11 +174,11 @@ fn check_sync0_logs(sim: &RefCell<Simulation>) -> (f64, u64) {
     let mut worst = 0;
     for p in &logs[0] {
         if let Some(q) = logs[1].iter().find(|q| q.system_ns == p.system_ns) {
-            worst = worst.max(p.now_ns.abs_diff(q.now_ns));
+            worst = worst.max(p.now.as_ns().abs_diff(q.now.as_ns()));
         }
     }
     let l = &logs[0];
-    let period = (l[l.len() - 1].now_ns - l[0].now_ns) as f64 / (l.len() - 1) as f64;
+    let period = (l[l.len() - 1].now - l[0].now).as_ns() as f64 / (l.len() - 1) as f64;
     (period, worst)
 }
 
@@ -202,7 +203,7 @@ fn e107_sync0_pulses_at_the_configured_period_on_drifting_drives() {
 #[test]
 fn e113_frame_jitter_of_5us_does_not_disturb_sync0() {
     let sim = line();
-    sim.borrow_mut().set_frame_jitter(5_000, 0xE113);
+    sim.borrow_mut().set_frame_jitter(Nanos::from_us(5), 0xE113);
     let (diff, skew) = run_sync0(&sim, 300);
     let (period, edge_skew) = check_sync0_logs(&sim);
     println!(

@@ -3,8 +3,9 @@
 //! failure there can be reproduced here.
 
 use hil_sim::frame::{ECAT_HEADER_LEN, ETHERNET_HEADER_LEN, ETHERTYPE_ETHERCAT};
-use hil_sim::script::{Link, Progress, Script, CYCLE_NS, MOVE_INC};
+use hil_sim::script::{Link, Progress, Script, CYCLE, MOVE_INC};
 use hil_sim::sim::Simulation;
+use nanos::Nanos;
 
 /// Wraps each datagram in an Ethernet frame and passes it down the line.
 struct SimLink<'a>(&'a mut Simulation);
@@ -30,9 +31,9 @@ fn e107_scripted_master_selects_dc_sync_and_runs_csp_on_both_axes() {
     let mut script = Script::new();
     let mut log = Vec::new();
     // frames half a cycle away from SYNC0 (which the script puts on whole cycles)
-    let mut t = CYCLE_NS / 2;
-    while !script.finished() && t < 5_000_000_000 {
-        t += CYCLE_NS;
+    let mut t = Nanos::from_ns(CYCLE.as_ns() / 2);
+    while !script.finished() && t < Nanos::from_secs(5) {
+        t += CYCLE;
         sim.advance_to(t);
         let p = script.step(&mut SimLink(&mut sim));
         if p != Progress::Busy {

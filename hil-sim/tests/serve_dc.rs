@@ -67,7 +67,7 @@ const FMMU0: u16 = 0x0600;
 
 /// `CLOCK_MONOTONIC`, ns (ethercrab's `ethercat_now` and `Instant` read it).
 fn mono_ns() -> u64 {
-    hil_sim::raw::monotonic_ns()
+    hil_sim::raw::monotonic().as_ns()
 }
 
 /// Sleeps until monotonic `t_ns` (the last 60 µs spinning; a SCHED_FIFO thread has no timer slack).
@@ -185,7 +185,9 @@ fn sniff(iface: &str, reference: u16, stop: &AtomicBool) -> Vec<WireSample> {
             continue;
         }
         while let Some(rx) = sock.try_recv(&mut buf).expect("sniff") {
-            let (Some(t), Some((idx, dc))) = (rx.rx_ns, dc_read(&buf[..rx.len], reference)) else {
+            let (Some(t), Some((idx, dc))) =
+                (rx.rx.map(nanos::Nanos::as_ns), dc_read(&buf[..rx.len], reference))
+            else {
                 continue;
             };
             if rx.outgoing {

@@ -79,9 +79,9 @@ impl Node for BenchNode {
     fn esc_mut(&mut self) -> &mut Esc {
         &mut self.esc
     }
-    fn poll(&mut self, now_ns: u64) {
-        self.esc.tick(now_ns);
-        let _ = self.slave.poll(&mut self.esc.pdi(), &mut self.dict, now_ns);
+    fn poll(&mut self, now: nanos::Nanos) {
+        self.esc.tick(now);
+        let _ = self.slave.poll(&mut self.esc.pdi(), &mut self.dict, now);
     }
 }
 
@@ -120,7 +120,7 @@ fn main() {
             assert!(first.iter().enumerate().all(|(i, &b)| b == i as u8), "content");
             let (t0, f0) = {
                 let s = sim.borrow();
-                (s.now_ns(), s.frames())
+                (s.now().as_ns(), s.frames())
             };
             let start = Instant::now();
             for _ in 0..reads {
@@ -131,7 +131,7 @@ fn main() {
             }
             let wall = start.elapsed();
             let s = sim.borrow();
-            (wall, s.now_ns() - t0, s.frames() - f0)
+            (wall, s.now().as_ns() - t0, s.frames() - f0)
         },
     );
     let bytes = (reads * BIG_LEN) as f64;

@@ -37,8 +37,8 @@ fn offsets(entries: &[u32]) -> (Vec<usize>, usize) {
 
 fn advance(sim: &RefCell<Simulation>, ns: u64) {
     let mut s = sim.borrow_mut();
-    let t = s.now_ns() + ns;
-    s.advance_to(t);
+    let t = s.now().as_ns() + ns;
+    s.advance_to(nanos::Nanos::from_ns(t));
 }
 
 // ---------------------------------------------------------------------------

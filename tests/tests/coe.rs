@@ -669,8 +669,8 @@ fn e065_e067_e068_segmented_download_byte_for_byte_and_toggle_error() {
         assert_eq!(r[0], 0x60);
         {
             let mut s = sim.borrow_mut();
-            let t = s.now_ns() + ecat::coe::SDO_TIMEOUT_NS + 1_000_000;
-            s.advance_to(t);
+            let t = s.now().as_ns() + ecat::coe::SDO_TIMEOUT.as_ns() + 1_000_000;
+            s.advance_to(nanos::Nanos::from_ns(t));
         }
         let r = c
             .sdo(&sd, &[0x00, b'a', b'b', b'c', b'd', b'e', b'f', b'g'])

@@ -137,8 +137,8 @@ fn run(
                 wait += 2 * FRAME_LEAD_NS;
             }
             let mut s = sim.borrow_mut();
-            let t = s.now_ns() + wait;
-            s.advance_to(t);
+            let t = s.now().as_ns() + wait;
+            s.advance_to(nanos::Nanos::from_ns(t));
         }
         assert!(op, "the group reached OP");
         let mut seen = [Seen {
@@ -195,14 +195,14 @@ fn e107_e109_e114_pll_locks_control_cycle_to_sync0_minus_a292_on_drifting_drives
     let seen = run(&sim, 400, Inject::Nothing, |_, s| {
         let d = &s.drives()[0];
         if first_sync0.is_none() {
-            first_sync0 = d.sync0_log.front().map(|p| p.now_ns);
+            first_sync0 = d.sync0_log.front().map(|p| p.now.as_ns());
         }
         let locked = s
             .drives()
             .iter()
             .all(|d| d.drive.pll().is_some_and(|p| p.is_locked()));
         if all_locked.is_none() && locked {
-            all_locked = Some(s.now_ns());
+            all_locked = Some(s.now().as_ns());
         }
     });
     let lock_ms = all_locked.zip(first_sync0).map(|(l, f)| (l - f) as f64 / 1e6);
@@ -215,7 +215,7 @@ fn e107_e109_e114_pll_locks_control_cycle_to_sync0_minus_a292_on_drifting_drives
         let errors = phase_errors(&s, i);
         let worst = errors.iter().map(|e| e.abs()).max().unwrap_or(i64::MAX);
         let mean = errors.iter().sum::<i64>() as f64 / errors.len().max(1) as f64;
-        let first_lock = d.cycle_log.iter().find(|c| c.locked).map(|c| c.now_ns);
+        let first_lock = d.cycle_log.iter().find(|c| c.locked).map(|c| c.now.as_ns());
         println!(
             "drive {i} ({:+} ppm): A298 {:#06x} (SDO), A296 {} µs, A261 {:?}, PLL phase error {:?} ns, \
              {} locked aligned cycles in the log: mean {mean:.1} ns, worst |error| {worst} ns; first locked \
@@ -268,7 +268,8 @@ fn e107_e109_e114_pll_locks_control_cycle_to_sync0_minus_a292_on_drifting_drives
 #[test]
 fn e113_pll_stays_locked_with_5us_frame_jitter() {
     let sim = line();
-    sim.borrow_mut().set_frame_jitter(5_000, 0xE113);
+    sim.borrow_mut()
+        .set_frame_jitter(nanos::Nanos::from_ns(5_000), 0xE113);
     run(&sim, 400, Inject::Nothing, |_, _| {});
     let s = sim.borrow();
     for i in 0..2 {
@@ -388,8 +389,8 @@ fn e116_a_sync0_cycle_the_pll_cannot_run_is_refused() {
             .expect("DC configuration");
         {
             let mut s = sim.borrow_mut();
-            let t = s.now_ns() + 20_000_000;
-            s.advance_to(t);
+            let t = s.now().as_ns() + 20_000_000;
+            s.advance_to(nanos::Nanos::from_ns(t));
         }
         let sd = group.subdevice(md, 0).expect("drive");
         let a298: u16 = sd.sdo_read(A298, 0).await.expect("A298");
@@ -432,8 +433,8 @@ async fn dc_cycles<'a>(
         probe(i, r.all_op(), &sim.borrow());
         let wait = r.extra.next_cycle_wait.as_nanos() as u64;
         let mut s = sim.borrow_mut();
-        let t = s.now_ns() + wait;
-        s.advance_to(t);
+        let t = s.now().as_ns() + wait;
+        s.advance_to(nanos::Nanos::from_ns(t));
     }
 }
 
@@ -539,7 +540,7 @@ fn e046_e131_e129_e038_dc_op_waits_for_pll_lock_and_sync0_loss_drops_to_safeop()
             assert!(a257.starts_with(b"Er3 "), "A257[0] {a257:02x?}");
             let s = sim.borrow();
             assert_eq!(
-                s.drives()[i].leds(s.now_ns()).err,
+                s.drives()[i].leds(nanos::Nanos::from_ns(s.now().as_ns())).err,
                 ecat::led::Pattern::SingleFlash
             );
             let d = &s.drives()[i].drive;
@@ -1039,12 +1040,12 @@ fn e121_e122_e123_a287_failures_through_the_master() {
             .await;
             let master = a287_measurement(md, group, &sim, |k, s| {
                 if k == 0 {
-                    s.set_frame_jitter(20_000, 0xE122);
+                    s.set_frame_jitter(nanos::Nanos::from_ns(20_000), 0xE122);
                 }
                 offsets(s, 0, 985_000);
             })
             .await;
-            sim.borrow_mut().set_frame_jitter(0, 0);
+            sim.borrow_mut().set_frame_jitter(nanos::Nanos::from_ns(0), 0);
             // A291 ≠ the master cycle: 60C2h = 2 ms is copied into A291
             let sd = group.subdevice(md, 0).expect("drive");
             sd.sdo_write(0x60C2, 1, 2u8).await.expect("60C2h:01");
@@ -1101,7 +1102,10 @@ fn e147_message_time_stamp_is_the_dc_system_time_when_synchronised() {
                 .expect("0x0910");
             let s = sim.borrow();
             let d = &s.drives()[0].drive;
-            let stamp = d.diag().message(d.diag().newest_subindex()).map(|(_, t)| t);
+            let stamp = d
+                .diag()
+                .message(d.diag().newest_subindex())
+                .map(|(_, t)| t.as_ns());
             (stamp, system_time)
         },
     );

@@ -23,8 +23,8 @@ const A258: u16 = drive::parameter_index(0, 258);
 
 fn advance(sim: &RefCell<Simulation>, ns: u64) {
     let mut s = sim.borrow_mut();
-    let t = s.now_ns() + ns;
-    s.advance_to(t);
+    let t = s.now().as_ns() + ns;
+    s.advance_to(nanos::Nanos::from_ns(t));
 }
 
 /// A257[`element`] by SDO (SDO Info numbering: sub = element + 1), without
@@ -50,7 +50,7 @@ where
 
 fn leds(sim: &RefCell<Simulation>, i: usize) -> drive::runtime::Leds {
     let s = sim.borrow();
-    s.drives()[i].leds(s.now_ns())
+    s.drives()[i].leds(nanos::Nanos::from_ns(s.now().as_ns()))
 }
 
 /// `n` process-data cycles of 1 ms.
@@ -74,8 +74,11 @@ fn lit_fraction(sim: &RefCell<Simulation>, k: usize, span_ns: u64) -> f64 {
     for _ in 0..n {
         advance(sim, 10_000_000);
         let s = sim.borrow();
-        let now = s.now_ns();
-        if s.drives()[0].leds(now).lit(now)[k] {
+        let now = s.now().as_ns();
+        if s.drives()[0]
+            .leds(nanos::Nanos::from_ns(now))
+            .lit(nanos::Nanos::from_ns(now))[k]
+        {
             on += 1;
         }
     }
@@ -140,7 +143,10 @@ fn e041_e042_e132_e133_a255_a257_3_and_the_run_and_err_leds() {
     });
     let s = sim.borrow();
     assert_eq!(s.drives()[0].drive.objects().get(A255, 0), Ok(1), "Init");
-    assert_eq!(s.drives()[0].leds(s.now_ns()).run, Pattern::Off);
+    assert_eq!(
+        s.drives()[0].leds(nanos::Nanos::from_ns(s.now().as_ns())).run,
+        Pattern::Off
+    );
 }
 
 /// E-134 (LA_EC LEDs per port), E-135 (A256 station address), E-136
@@ -469,7 +475,9 @@ fn e147_message_time_stamp_zero_then_sntp() {
     let newest = |sim: &RefCell<Simulation>| {
         let s = sim.borrow();
         let d = &s.drives()[0].drive;
-        d.diag().message(d.diag().newest_subindex()).map(|(_, t)| t)
+        d.diag()
+            .message(d.diag().newest_subindex())
+            .map(|(_, t)| t.as_ns())
     };
     with_master(&sim, async |md, clock| {
         let group = init(md, clock).await;
@@ -480,15 +488,15 @@ fn e147_message_time_stamp_zero_then_sntp() {
         request(&sd, PREOP | ACK).await;
         // an SNTP client's time: 2026-11-22 on the DC epoch (2000-01-01)
         let sntp = 847_584_000_000_000_000u64;
-        let local = sim.borrow().now_ns();
+        let local = sim.borrow().now().as_ns();
         sim.borrow_mut().drives_mut()[0]
             .drive
-            .set_sntp_time(Some(sntp), local);
+            .set_sntp_time(Some(nanos::Nanos::from_ns(sntp)), nanos::Nanos::from_ns(local));
         advance(&sim, 5_000_000);
         request(&sd, OP).await;
         assert_eq!(al_status(&sd).await, (PREOP | ERR, 0x0011));
         let t = newest(&sim).unwrap();
-        let elapsed = sim.borrow().now_ns() - local;
+        let elapsed = sim.borrow().now().as_ns() - local;
         assert!(t > sntp && t <= sntp + elapsed, "{t} vs {sntp} + {elapsed}");
     });
 }

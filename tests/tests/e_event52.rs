@@ -69,8 +69,8 @@ fn pdo_timeout_reaction(a540: i16) -> Vec<Sample> {
         for _ in 0..5 {
             {
                 let mut s = sim.borrow_mut();
-                let t = s.now_ns() + 1_000_000;
-                s.advance_to(t);
+                let t = s.now().as_ns() + 1_000_000;
+                s.advance_to(nanos::Nanos::from_ns(t));
             }
             group.tx_rx(md).await.expect("process data");
         }
@@ -88,11 +88,11 @@ fn pdo_timeout_reaction(a540: i16) -> Vec<Sample> {
         assert_eq!(get(&sim, 0x603F, 0), 0);
 
         // the master stops sending process data
-        let t0 = sim.borrow().now_ns();
+        let t0 = sim.borrow().now().as_ns();
         let mut samples = Vec::new();
         for ms in 1..=400u64 {
             let mut s = sim.borrow_mut();
-            s.advance_to(t0 + ms * 1_000_000);
+            s.advance_to(nanos::Nanos::from_ns(t0 + ms * 1_000_000));
             let d = &s.drives()[0];
             let out = d.motor_outputs(0).unwrap();
             samples.push(Sample {
@@ -123,8 +123,8 @@ fn pdo_timeout_reaction(a540: i16) -> Vec<Sample> {
         c.download(&sd, 0x6040, 0, &0x80u16.to_le_bytes()).await.unwrap();
         {
             let mut s = sim.borrow_mut();
-            let t = s.now_ns() + 5_000_000;
-            s.advance_to(t);
+            let t = s.now().as_ns() + 5_000_000;
+            s.advance_to(nanos::Nanos::from_ns(t));
         }
         assert_eq!(get(&sim, 0x6041, 0) as u16 & 0x6F, sw::SOD, "fault reset");
         assert_eq!(get(&sim, 0x603F, 0), 0);
@@ -222,8 +222,8 @@ fn e130_projected_fieldbus_mismatch_raises_event52_cause_15() {
         // the axes' fault reaction (quick stop at standstill, settle time)
         {
             let mut s = sim.borrow_mut();
-            let t = s.now_ns() + 50_000_000;
-            s.advance_to(t);
+            let t = s.now().as_ns() + 50_000_000;
+            s.advance_to(nanos::Nanos::from_ns(t));
         }
         let e59: u16 = sd.sdo_read(E59, 3).await.unwrap();
         assert_eq!(
@@ -247,8 +247,8 @@ fn e130_projected_fieldbus_mismatch_raises_event52_cause_15() {
         // still mismatching: no new event (raised once)
         {
             let mut s = sim.borrow_mut();
-            let t = s.now_ns() + 20_000_000;
-            s.advance_to(t);
+            let t = s.now().as_ns() + 20_000_000;
+            s.advance_to(nanos::Nanos::from_ns(t));
         }
         assert!(event52_emcys(&sd).await.is_empty(), "raised once");
         // the projection fixed: a fault reset works
@@ -258,8 +258,8 @@ fn e130_projected_fieldbus_mismatch_raises_event52_cause_15() {
         let mut c = CoeClient::new();
         c.download(&sd, 0x6040, 0, &0x80u16.to_le_bytes()).await.unwrap();
         let mut s = sim.borrow_mut();
-        let t = s.now_ns() + 5_000_000;
-        s.advance_to(t);
+        let t = s.now().as_ns() + 5_000_000;
+        s.advance_to(nanos::Nanos::from_ns(t));
         assert_eq!(
             s.drives()[0].drive.objects().get(0x6041, 0).unwrap() as u16 & 0x6F,
             sw::SOD

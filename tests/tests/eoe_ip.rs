@@ -31,7 +31,7 @@ const STEPS: usize = 200;
 
 fn sim_with_net() -> RefCell<Simulation> {
     let sim = line(1);
-    sim.borrow_mut().drives_mut()[0].bind_net(DRIVE_MAC, 0x5EED, 0);
+    sim.borrow_mut().drives_mut()[0].bind_net(DRIVE_MAC, 0x5EED, nanos::Nanos::from_ns(0));
     sim
 }
 
@@ -64,19 +64,27 @@ fn e096_e095_ping_and_parameters_over_udp() {
     with_master(&sim, async |md, clock| {
         let group = init(md, clock).await;
         let sd = group.subdevice(md, 0).unwrap();
-        let mut host = HostNet::new(HOST_MAC, &[(HOST_IP, 24)], clock.load(Ordering::Relaxed));
+        let mut host = HostNet::new(
+            HOST_MAC,
+            &[(HOST_IP, 24)],
+            nanos::Nanos::from_ns(clock.load(Ordering::Relaxed)),
+        );
         // no address yet: no answer
         assert_eq!(host.ping(&sd, clock, DRIVE_IP, 1, 60).await, None);
         // (the host repeats its unanswered ARP request only after 1 s)
-        let now = sim.borrow().now_ns();
-        sim.borrow_mut().catch_up(now + 1_100_000_000);
+        let now = sim.borrow().now().as_ns();
+        sim.borrow_mut()
+            .catch_up(nanos::Nanos::from_ns(now + 1_100_000_000));
         // E-096: the address from the master
         assert_eq!(set_ip(&mut host, &sd, clock).await, vec![0x03, 0x01, 0x00, 0x00]);
         let rtt = host
             .ping(&sd, clock, DRIVE_IP, 2, STEPS)
             .await
             .expect("echo reply");
-        assert!(rtt > 0 && rtt < 50_000_000, "rtt {rtt} ns");
+        assert!(
+            rtt > nanos::Nanos::ZERO && rtt < nanos::Nanos::from_ms(50),
+            "rtt {rtt}"
+        );
         // parameters by coordinate
         assert_eq!(ask(&mut host, &sd, clock, "R A150").await, "OK 1000");
         assert_eq!(ask(&mut host, &sd, clock, "W A150 2000").await, "OK");
@@ -115,7 +123,11 @@ fn e099_refused_eoe_configuration_shows_er10() {
     with_master(&sim, async |md, clock| {
         let group = init(md, clock).await;
         let sd = group.subdevice(md, 0).unwrap();
-        let mut host = HostNet::new(HOST_MAC, &[(HOST_IP, 24)], clock.load(Ordering::Relaxed));
+        let mut host = HostNet::new(
+            HOST_MAC,
+            &[(HOST_IP, 24)],
+            nanos::Nanos::from_ns(clock.load(Ordering::Relaxed)),
+        );
         assert_eq!(set_ip(&mut host, &sd, clock).await, vec![0x03, 0x01, 0x00, 0x00]);
         let er = |t: &str| t.split(' ').nth(1).unwrap_or_default().to_string();
         assert_eq!(er(&ask(&mut host, &sd, clock, "R A257[0]").await), "Er0");
@@ -192,7 +204,11 @@ fn e098_dhcp_while_a166_is_2_until_the_master_sets_an_address() {
     with_master(&sim, async |md, clock| {
         let group = init(md, clock).await;
         let sd = group.subdevice(md, 0).unwrap();
-        let mut host = HostNet::new(HOST_MAC, &[(HOST_IP, 24)], clock.load(Ordering::Relaxed));
+        let mut host = HostNet::new(
+            HOST_MAC,
+            &[(HOST_IP, 24)],
+            nanos::Nanos::from_ns(clock.load(Ordering::Relaxed)),
+        );
         let server = host.add_udp(67);
         // E-098: nothing before the master has used EoE
         for _ in 0..100 {
@@ -237,8 +253,9 @@ fn e098_dhcp_while_a166_is_2_until_the_master_sets_an_address() {
         // the master's address wins and DHCP stops
         assert_eq!(set_ip(&mut host, &sd, clock).await, vec![0x03, 0x01, 0x00, 0x00]);
         // (the host sends its next ARP request only 1 s after the last)
-        let now = sim.borrow().now_ns();
-        sim.borrow_mut().catch_up(now + 1_100_000_000);
+        let now = sim.borrow().now().as_ns();
+        sim.borrow_mut()
+            .catch_up(nanos::Nanos::from_ns(now + 1_100_000_000));
         assert!(host.ping(&sd, clock, DRIVE_IP, 2, STEPS).await.is_some());
         assert_eq!(
             host.ping(&sd, clock, leased, 3, 60).await,
@@ -264,7 +281,11 @@ fn e098_no_dhcp_when_a166_is_not_2() {
     with_master(&sim, async |md, clock| {
         let group = init(md, clock).await;
         let sd = group.subdevice(md, 0).unwrap();
-        let mut host = HostNet::new(HOST_MAC, &[(HOST_IP, 24)], clock.load(Ordering::Relaxed));
+        let mut host = HostNet::new(
+            HOST_MAC,
+            &[(HOST_IP, 24)],
+            nanos::Nanos::from_ns(clock.load(Ordering::Relaxed)),
+        );
         let server = host.add_udp(67);
         // the master uses EoE (E-098): DHCP could start now, but A166 says no
         assert!(host.tunnel.request(&sd, &get_ip_request()).await);
@@ -292,7 +313,7 @@ impl NetNode {
         let mut sii = [0u8; ecat::sii::EEPROM_BYTES];
         let n = ecat::build_sii(&drive::DEVICE, &mut sii).unwrap();
         let mut drive = Drive::new(SimFlash::new());
-        let net = DriveNet::new(&mut drive, DRIVE_MAC, 0x5EED, 0);
+        let net = DriveNet::new(&mut drive, DRIVE_MAC, 0x5EED, nanos::Nanos::ZERO);
         Self {
             esc: Esc::new(EscConfig::default(), &sii[..n]),
             drive,
@@ -305,10 +326,10 @@ impl Node for NetNode {
     fn esc_mut(&mut self) -> &mut Esc {
         &mut self.esc
     }
-    fn poll(&mut self, now_ns: u64) {
-        self.esc.tick(now_ns);
-        let _ = self.drive.poll(&mut self.esc.pdi(), now_ns);
-        self.net.poll(&mut self.drive, now_ns);
+    fn poll(&mut self, now: nanos::Nanos) {
+        self.esc.tick(now);
+        let _ = self.drive.poll(&mut self.esc.pdi(), now);
+        self.net.poll(&mut self.drive, now);
     }
 }
 
@@ -349,15 +370,16 @@ async fn run_until<S>(
     stop: usize,
 ) {
     loop {
-        let now = sim.borrow().now_ns();
+        let now = sim.borrow().now().as_ns();
         if now >= until_ns || seen.len() >= stop {
             return;
         }
-        sim.borrow_mut().catch_up((now + step_ns).min(until_ns));
+        sim.borrow_mut()
+            .catch_up(nanos::Nanos::from_ns((now + step_ns).min(until_ns)));
         loop {
             pump(host, sd, clock).await;
             // each request is answered as soon as the host has it
-            let now = sim.borrow().now_ns();
+            let now = sim.borrow().now().as_ns();
             let sock = host.sockets.get_mut::<udp::Socket>(host.ntp);
             let mut got = false;
             while let Ok((data, meta)) = sock.recv() {
@@ -413,7 +435,11 @@ fn e105_e106_e102_sntp_over_eoe_in_simulated_time() {
         let group = init(md, clock).await;
         let sd = group.subdevice(md, 0).unwrap();
         let t0 = clock.load(Ordering::Relaxed);
-        let mut host = HostNet::new(HOST_MAC, &[(HOST_IP, 24), (SERVER2_IP, 24)], t0);
+        let mut host = HostNet::new(
+            HOST_MAC,
+            &[(HOST_IP, 24), (SERVER2_IP, 24)],
+            nanos::Nanos::from_ns(t0),
+        );
         assert_eq!(set_ip(&mut host, &sd, clock).await, vec![0x03, 0x01, 0x00, 0x00]);
         // A199: on, servers 10.0.0.1 and 10.0.0.2 (written over UDP)
         for req in ["W A199[0] 1", "W A199[1] 0x0A000001", "W A199[2] 0x0A000002"] {
@@ -428,7 +454,11 @@ fn e105_e106_e102_sntp_over_eoe_in_simulated_time() {
         // E-102: the drive's clock follows the server (compared where it was
         // set: the rate is learnt from the second answer on)
         let now = first;
-        let drive_time = sim.borrow().drives()[0].net.stack.sntp_time_ns(now / 1000);
+        let drive_time = sim.borrow().drives()[0]
+            .net
+            .stack
+            .sntp_time(nanos::Nanos::from_ns(now))
+            .map(nanos::Nanos::as_ns);
         let server_unix = server_ntp_ns(now) - NTP_UNIX_OFFSET_S * S;
         let err = drive_time.expect("SNTP time") as i64 - server_unix as i64;
         assert!(err.abs() < 1_000_000, "clock error {err} ns");
@@ -507,7 +537,7 @@ fn e098_coe_only_master_gets_only_coe_answers_on_a_line() {
     const DRIVES: usize = 3;
     let sim = line(DRIVES);
     for (i, d) in (1u8..).zip(sim.borrow_mut().drives_mut()) {
-        d.bind_net([0x02, 0, 0, 0, 0, i], u64::from(i), 0);
+        d.bind_net([0x02, 0, 0, 0, 0, i], u64::from(i), nanos::Nanos::from_ns(0));
     }
     with_master(&sim, async |md, clock| {
         let group = init(md, clock).await;
@@ -532,7 +562,11 @@ fn e098_coe_only_master_gets_only_coe_answers_on_a_line() {
         );
         // the master starts to use EoE on drive 0: its DHCP client starts
         let sd = group.subdevice(md, 0).unwrap();
-        let mut host = HostNet::new(HOST_MAC, &[(HOST_IP, 24)], clock.load(Ordering::Relaxed));
+        let mut host = HostNet::new(
+            HOST_MAC,
+            &[(HOST_IP, 24)],
+            nanos::Nanos::from_ns(clock.load(Ordering::Relaxed)),
+        );
         let server = host.add_udp(67);
         assert!(host.tunnel.request(&sd, &get_ip_request()).await);
         let mut answered = Vec::new();

@@ -16,7 +16,7 @@ use drive_tests::{
     al_status, firmware_file, in_boot, init, request, to_boot, with_master_on, FoeClient, FoeReply, FwNode,
     RawMailbox,
 };
-use ecat::foe::{FoeError, FOE_TIMEOUT_NS};
+use ecat::foe::{FoeError, FOE_TIMEOUT};
 use ecat::mailbox::MailboxError;
 use hil_sim::sim::Simulation;
 use std::cell::RefCell;
@@ -167,8 +167,9 @@ fn foe_cut_connection_times_out_and_the_slot_is_not_pending() {
             assert_eq!(foe.data(&sd, i as u32 + 1, c).await, FoeReply::Ack(i as u32 + 1));
         }
         // the cable is cut: no packet for longer than the timeout
-        let t = sim.borrow().now_ns();
-        sim.borrow_mut().advance_to(t + FOE_TIMEOUT_NS + 1_000_000);
+        let t = sim.borrow().now().as_ns();
+        sim.borrow_mut()
+            .advance_to(nanos::Nanos::from_ns(t + FOE_TIMEOUT.as_ns() + 1_000_000));
         {
             let mut n = node(&sim);
             assert_eq!(n.drive.slave().foe().timeouts(), 1, "transfer dropped");

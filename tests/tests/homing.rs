@@ -120,7 +120,7 @@ fn home(case: Case) -> Run {
         p.limits.negative_switch = case.limits;
         // torque methods: 40 % of the rated torque for 50 ms is the stop (I28/I29)
         p.homing_torque_limit_per_mille = 400;
-        p.homing_torque_hold_ns = 50_000_000;
+        p.homing_torque_hold_ns = nanos::Nanos::from_ms(50);
     }
     let run = RefCell::new(None);
     with_master(&sim, async |md, clock| {
@@ -141,7 +141,7 @@ fn home(case: Case) -> Run {
             tx.statusword
         );
         m.set_controlword(CW_ENABLED | CW_BIT4);
-        let t0 = m.now_ns();
+        let t0 = m.now().as_ns();
         let (mut min, mut max) = (case.start, case.start);
         let mut done = false;
         for k in 0..20_000 {
@@ -181,7 +181,7 @@ fn home(case: Case) -> Run {
             "method {}: homing done (011): {:#06x}",
             case.method, m.tx.statusword
         );
-        let ms = (m.now_ns() - t0) / 1_000_000;
+        let ms = (m.now().as_ns() - t0) / 1_000_000;
         m.set_controlword(CW_ENABLED);
         let tx = m.run(20).await;
         assert!(

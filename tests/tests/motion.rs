@@ -355,7 +355,7 @@ fn c041_c048_pp_moves_to_target_and_sets_target_reached() {
         m.run(3).await;
 
         // absolute 0 → 3 rev: 0.25 rev ramps at 50 rev/s² (+ jerk), 2.5 rev at 5 rev/s
-        let t0 = m.now_ns();
+        let t0 = m.now().as_ns();
         pp_start(&mut m, 3 * REV, 0).await;
         assert!(!m.tx.bit(10), "target reached clears with the new set-point");
         let mut peak = 0i32;
@@ -373,7 +373,7 @@ fn c041_c048_pp_moves_to_target_and_sets_target_reached() {
             "bit 10 target reached: {:#06x}",
             m.tx.statusword
         );
-        let took_ms = (m.now_ns() - t0) / 1_000_000;
+        let took_ms = (m.now().as_ns() - t0) / 1_000_000;
         let tx = m.tx;
         println!(
             "pp 0 → 3 rev (5 rev/s, 50 rev/s²): target reached after {took_ms} ms, peak 606Ch {:.3} rev/s, \
@@ -491,18 +491,18 @@ fn e125_c144_free_run_moves_at_the_commanded_speed_at_every_a150() {
             m.run(20).await;
             // 0 → 4 rev/s at 40 rev/s² takes about 0.1 s of (simulated) time
             let v = 4 * REV;
-            let t0 = sim.borrow().now_ns();
+            let t0 = sim.borrow().now().as_ns();
             m.set_target_velocity(v);
             m.run_until(2000, |t| t.bit(10) && t.velocity > v - REV / 20)
                 .await
                 .expect("velocity reached");
-            let ramp_ms = (sim.borrow().now_ns() - t0) as f64 / 1e6;
+            let ramp_ms = (sim.borrow().now().as_ns() - t0) as f64 / 1e6;
             m.run(100).await;
             // the plant turns at 4 rev/s: over 0.5 s it moves 2 revolutions
             let p0 = sim.borrow().drives()[0].motors[0].position_inc_f64();
-            let t0 = sim.borrow().now_ns();
+            let t0 = sim.borrow().now().as_ns();
             m.run(500).await;
-            let dt = (sim.borrow().now_ns() - t0) as f64 / 1e9;
+            let dt = (sim.borrow().now().as_ns() - t0) as f64 / 1e9;
             let revs = (sim.borrow().drives()[0].motors[0].position_inc_f64() - p0) / REV_F;
             println!(
                 "A150 = {a150_us} µs: ramp {ramp_ms:.1} ms, {revs:.3} rev in {dt:.3} s ({:.3} rev/s), 606Ch {:.3} rev/s",
@@ -581,7 +581,7 @@ fn c058_c059_c071_homing_method_19_on_a_reference_switch() {
         m.run(3).await;
         m.enable().await;
         m.set_controlword(CW_ENABLED | CW_BIT4);
-        let t0 = m.now_ns();
+        let t0 = m.now().as_ns();
         let mut saw_switch = false;
         let mut peak = 0i32;
         let mut running_bits_ok = true;
@@ -603,7 +603,7 @@ fn c058_c059_c071_homing_method_19_on_a_reference_switch() {
         assert!(done, "homing done (bits 12 and 10): {:#06x}", m.tx.statusword);
         assert!(running_bits_ok, "bits 13/10 stay 0 while homing runs");
         assert!(saw_switch, "60FDh bit 2 showed the home switch on the way");
-        let took_ms = (m.now_ns() - t0) / 1_000_000;
+        let took_ms = (m.now().as_ns() - t0) / 1_000_000;
         m.set_controlword(CW_ENABLED);
         let tx = m.run(20).await;
         // the switch edge now reads 607Ch: compare through the plant's encoder
@@ -657,7 +657,7 @@ fn c010_c011_quick_stop_through_pdo() {
         m.run(20).await;
 
         // quick stop: bit 2 = 0 with bits 0, 1, 3 kept (0x000B)
-        let t0 = m.now_ns();
+        let t0 = m.now().as_ns();
         let p0 = m.tx.position;
         m.set_controlword(0x000B);
         let qsa = m.run_until(5, |t| t.state() == sw::QSA).await;
@@ -673,13 +673,13 @@ fn c010_c011_quick_stop_through_pdo() {
             let tx = m.cycle().await;
             // standstill as the drive sees it: |606Ch| < C40 (0.1 rev/s)
             if stopped_at.is_none() && tx.velocity.abs() < REV / 10 {
-                stopped_at = Some((m.now_ns() - t0) / 1_000_000);
+                stopped_at = Some((m.now().as_ns() - t0) / 1_000_000);
             }
             if *states.last().unwrap() != tx.state() {
                 states.push(tx.state());
             }
             if tx.state() == sw::SOD {
-                left_at = Some((m.now_ns() - t0) / 1_000_000);
+                left_at = Some((m.now().as_ns() - t0) / 1_000_000);
                 break;
             }
             // the set velocity of csv is ignored meanwhile (C-024)

@@ -34,8 +34,8 @@ fn set(sim: &RefCell<Simulation>, index: u16, sub: u8, value: i64) {
 
 fn advance(sim: &RefCell<Simulation>, ns: u64) {
     let mut s = sim.borrow_mut();
-    let t = s.now_ns() + ns;
-    s.advance_to(t);
+    let t = s.now().as_ns() + ns;
+    s.advance_to(nanos::Nanos::from_ns(t));
 }
 
 /// `n` process-data cycles of 1 ms (the master writes the RxPDO).
@@ -316,10 +316,11 @@ fn e110_a292_applies_to_the_sm2_event_in_sm_sync() {
         );
         let mut sends = Vec::new();
         // a master cycle of exactly 1 ms (the PLL's range is ±500 ppm)
-        let t0 = sim.borrow().now_ns();
+        let t0 = sim.borrow().now().as_ns();
         for k in 1..=300u64 {
-            sim.borrow_mut().advance_to(t0 + k * 1_000_000);
-            sends.push(sim.borrow().now_ns());
+            sim.borrow_mut()
+                .advance_to(nanos::Nanos::from_ns(t0 + k * 1_000_000));
+            sends.push(sim.borrow().now().as_ns());
             group.tx_rx(md).await.expect("process data cycle");
         }
         assert_eq!(al_status(&sd).await, (SAFEOP, 0));
@@ -335,8 +336,8 @@ fn e110_a292_applies_to_the_sm2_event_in_sm_sync() {
     let mut worst = 0;
     for c in &locked {
         // the frame this cycle follows: the last one sent before it
-        let sent = sends.iter().rev().find(|&&t| t <= c.now_ns).unwrap();
-        let after = c.now_ns as i64 - *sent as i64;
+        let sent = sends.iter().rev().find(|&&t| t <= c.now.as_ns()).unwrap();
+        let after = c.now.as_ns() as i64 - *sent as i64;
         worst = worst.max((after - 200_000).abs());
     }
     println!("SM-Sync, A292 = −200 µs: cycle start − SM2 event within ±{worst} ns");

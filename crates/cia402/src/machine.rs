@@ -7,6 +7,7 @@ use crate::state::{
     State, SW_INTERNAL_LIMIT, SW_MANUFACTURER_MASK, SW_MODE_BIT12, SW_MODE_BIT13, SW_REMOTE,
     SW_TARGET_REACHED, SW_VOLTAGE_ENABLED, SW_WARNING,
 };
+use nanos::Nanos;
 
 /// Configuration: the option codes and device parameters the state machine reads. All
 /// fields may be changed between two [`DeviceControl::step`] calls
@@ -33,13 +34,13 @@ pub struct Options {
     pub supported_modes: u32,
     /// The mode active after start-up (6061h before the first accepted request).
     pub initial_mode: Mode,
-    /// Brake closing time in ns: after a ramped stop reaches standstill with the brake
+    /// Brake closing time: after a ramped stop reaches standstill with the brake
     /// released, the brake is engaged and torque is held this long before the drive
     /// function goes off. 0 = no wait.
-    pub brake_close_ns: u64,
-    /// Longest time in ns a ramped stop (quick stop, fault reaction, disable ramp) may take;
+    pub brake_close: Nanos,
+    /// Longest time a ramped stop (quick stop, fault reaction, disable ramp) may take;
     /// after it the stop counts as finished even without standstill. 0 = no limit.
-    pub stop_timeout_ns: u64,
+    pub stop_timeout: Nanos,
 }
 
 impl Default for Options {
@@ -54,8 +55,8 @@ impl Default for Options {
             enable_from_ready: true,
             supported_modes: SUPPORTED_DRIVE_MODES,
             initial_mode: Mode::DEFAULT,
-            brake_close_ns: 0,
-            stop_timeout_ns: 0,
+            brake_close: Nanos::ZERO,
+            stop_timeout: Nanos::ZERO,
         }
     }
 }
@@ -229,8 +230,8 @@ pub struct Outputs {
 
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
 enum Phase {
-    Ramping { since_ns: u64 },
-    BrakeClosing { since_ns: u64 },
+    Ramping { start: Nanos },
+    BrakeClosing { start: Nanos },
     Holding,
 }
 
@@ -324,8 +325,8 @@ impl DeviceControl {
     }
 
     /// One control cycle: decodes the controlword, takes at most one transition, updates
-    /// the mode and returns the outputs. `now_ns` is a monotonic time in ns.
-    pub fn step(&mut self, inp: &Inputs, now_ns: u64) -> Outputs {
+    /// the mode and returns the outputs. `now` is a monotonic time in ns.
+    pub fn step(&mut self, inp: &Inputs, now: Nanos) -> Outputs {
         let cw = inp.controlword;
         let reset_bit = cw & CW_FAULT_RESET != 0;
         let reset_edge = reset_bit && !self.prev_fault_reset;
@@ -342,8 +343,8 @@ impl DeviceControl {
             None => None,
         };
         let transition = match fault {
-            Some(ev) => Some(self.enter_fault(ev, inp, now_ns)),
-            None => self.run_state(cmd, reset_edge, enable_lost, inp, now_ns),
+            Some(ev) => Some(self.enter_fault(ev, inp, now)),
+            None => self.run_state(cmd, reset_edge, enable_lost, inp, now),
         };
 
         self.outputs(inp, cmd, transition, mode_error, mode_pending)
@@ -383,7 +384,7 @@ impl DeviceControl {
         self.brake_released = false;
     }
 
-    fn enter_fault(&mut self, ev: FaultEvent, inp: &Inputs, now_ns: u64) -> Transition {
+    fn enter_fault(&mut self, ev: FaultEvent, inp: &Inputs, now: Nanos) -> Transition {
         let from = self.state;
         let reaction = ev.reaction.unwrap_or(self.options.fault_reaction);
         let torque = match from {
@@ -403,7 +404,7 @@ impl DeviceControl {
         self.stop = Some(Stopping {
             ramp,
             hold: false,
-            phase: Phase::Ramping { since_ns: now_ns },
+            phase: Phase::Ramping { start: now },
         });
         self.fault = Some(ev);
         Transition {
@@ -413,7 +414,7 @@ impl DeviceControl {
         }
     }
 
-    fn enter_quick_stop(&mut self, now_ns: u64) -> Option<Transition> {
+    fn enter_quick_stop(&mut self, now: Nanos) -> Option<Transition> {
         let from = self.state;
         let (ramp, hold) = match self.options.quick_stop {
             QuickStopOption::Coast => (Ramp::None, false),
@@ -427,7 +428,7 @@ impl DeviceControl {
         self.stop = Some(Stopping {
             ramp,
             hold,
-            phase: Phase::Ramping { since_ns: now_ns },
+            phase: Phase::Ramping { start: now },
         });
         Some(Transition {
             number: 11,
@@ -437,7 +438,7 @@ impl DeviceControl {
     }
 
     /// Advances the running stop; `true` once it is finished (coast: at once).
-    fn advance_stop(&mut self, inp: &Inputs, now_ns: u64) -> bool {
+    fn advance_stop(&mut self, inp: &Inputs, now: Nanos) -> bool {
         let opts = self.options;
         let Some(stop) = self.stop.as_mut() else {
             return true;
@@ -446,9 +447,8 @@ impl DeviceControl {
             return true;
         }
         match stop.phase {
-            Phase::Ramping { since_ns } => {
-                let timed_out =
-                    opts.stop_timeout_ns != 0 && now_ns.saturating_sub(since_ns) >= opts.stop_timeout_ns;
+            Phase::Ramping { start } => {
+                let timed_out = !opts.stop_timeout.is_zero() && now.since(start) >= opts.stop_timeout;
                 if !(inp.standstill || timed_out) {
                     return false;
                 }
@@ -456,14 +456,14 @@ impl DeviceControl {
                     stop.phase = Phase::Holding;
                     return false;
                 }
-                if self.brake_released && opts.brake_close_ns != 0 {
+                if self.brake_released && !opts.brake_close.is_zero() {
                     self.brake_released = false;
-                    stop.phase = Phase::BrakeClosing { since_ns: now_ns };
+                    stop.phase = Phase::BrakeClosing { start: now };
                     return false;
                 }
                 true
             }
-            Phase::BrakeClosing { since_ns } => now_ns.saturating_sub(since_ns) >= opts.brake_close_ns,
+            Phase::BrakeClosing { start } => now.since(start) >= opts.brake_close,
             Phase::Holding => false,
         }
     }
@@ -475,7 +475,7 @@ impl DeviceControl {
         number: u8,
         option: DisableOption,
         inp: &Inputs,
-        now_ns: u64,
+        now: Nanos,
     ) -> Option<Transition> {
         match option {
             DisableOption::Coast => self.go(to, number),
@@ -484,10 +484,10 @@ impl DeviceControl {
                     self.stop = Some(Stopping {
                         ramp: Ramp::Disable(Decel::SlowDown),
                         hold: false,
-                        phase: Phase::Ramping { since_ns: now_ns },
+                        phase: Phase::Ramping { start: now },
                     });
                 }
-                if self.advance_stop(inp, now_ns) {
+                if self.advance_stop(inp, now) {
                     self.go(to, number)
                 } else {
                     None
@@ -517,7 +517,7 @@ impl DeviceControl {
         reset_edge: bool,
         enable_lost: bool,
         inp: &Inputs,
-        now_ns: u64,
+        now: Nanos,
     ) -> Option<Transition> {
         let powered = inp.supply_ok && !inp.sto_active;
         let a60 = inp.additional_enable;
@@ -564,7 +564,7 @@ impl DeviceControl {
                 if !powered || (!a60 && !a44) || cmd == Some(Command::DisableVoltage) {
                     self.go(State::SwitchOnDisabled, 9)
                 } else if !a60 || cmd == Some(Command::QuickStop) {
-                    self.enter_quick_stop(now_ns)
+                    self.enter_quick_stop(now)
                 } else {
                     match cmd {
                         Some(Command::Shutdown) => self.disable_from_enabled(
@@ -572,14 +572,14 @@ impl DeviceControl {
                             8,
                             self.options.shutdown,
                             inp,
-                            now_ns,
+                            now,
                         ),
                         Some(Command::SwitchOn) => self.disable_from_enabled(
                             State::SwitchedOn,
                             5,
                             self.options.disable_operation,
                             inp,
-                            now_ns,
+                            now,
                         ),
                         Some(Command::EnableOperation) => {
                             self.stop = None;
@@ -596,7 +596,7 @@ impl DeviceControl {
                 // Disable voltage, a switch-on-disabled cause or A60 dropping while here
                 // end the quick stop at once; otherwise it ends when the stop is done.
                 let abort = !powered || cmd == Some(Command::DisableVoltage) || enable_lost;
-                if abort || self.advance_stop(inp, now_ns) {
+                if abort || self.advance_stop(inp, now) {
                     self.go(State::SwitchOnDisabled, 12)
                 } else {
                     None
@@ -606,7 +606,7 @@ impl DeviceControl {
                 if !powered {
                     self.coast();
                 }
-                if self.advance_stop(inp, now_ns) {
+                if self.advance_stop(inp, now) {
                     self.go(State::Fault, 14)
                 } else {
                     None

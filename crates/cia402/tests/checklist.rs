@@ -4,6 +4,7 @@
 //! list (halt, controlword decoding, instances).
 
 use cia402::*;
+use nanos::Nanos;
 
 const SHUTDOWN: u16 = 0x0006;
 const SWITCH_ON: u16 = 0x0007;
@@ -17,7 +18,7 @@ const FAULT_RESET: u16 = 0x0080;
 struct Rig {
     dc: DeviceControl,
     inp: Inputs,
-    t: u64,
+    t: Nanos,
 }
 
 impl Rig {
@@ -36,13 +37,13 @@ impl Rig {
                 remote: true,
                 ..Inputs::default()
             },
-            t: 0,
+            t: Nanos::ZERO,
         }
     }
 
     /// One control cycle of 1 ms.
     fn step(&mut self) -> Outputs {
-        self.t += 1_000_000;
+        self.t += Nanos::from_ms(1);
         self.dc.step(&self.inp, self.t)
     }
 
@@ -780,7 +781,7 @@ fn c016_fault_present_level_raises_generic_fault() {
 #[test]
 fn c016_stop_timeout_ends_reaction_without_standstill() {
     let mut r = Rig::with(Options {
-        stop_timeout_ns: 10_000_000,
+        stop_timeout: Nanos::from_ms(10),
         ..Options::default()
     });
     r.goto(State::FaultReactionActive);
@@ -1033,7 +1034,7 @@ fn c022_brake_in_quick_stop_and_fault_reaction() {
 #[test]
 fn c022_brake_closes_before_power_off() {
     let mut r = Rig::with(Options {
-        brake_close_ns: 5_000_000,
+        brake_close: Nanos::from_ms(5),
         ..Options::default()
     });
     r.inp.motion_command = true;
@@ -1130,7 +1131,7 @@ fn c026_default_mode_is_csp() {
     assert_eq!(Inputs::default().mode_request, 8);
     let mut dc = DeviceControl::new(Options::default());
     assert_eq!(dc.mode(), Mode::CyclicPosition);
-    assert_eq!(dc.step(&Inputs::default(), 0).mode_display, 8);
+    assert_eq!(dc.step(&Inputs::default(), Nanos::ZERO).mode_display, 8);
 }
 
 #[test]

@@ -18,6 +18,7 @@
 
 use dcsync::sim::{Scenario, SimEvent, Simulator};
 use dcsync::{Config, PllStatus};
+use nanos::Nanos;
 
 struct Row {
     sync0_ns: u32,
@@ -36,7 +37,7 @@ struct Result {
     frames: u32,
 }
 
-const RUN_NS: u64 = 3_000_000_000;
+const RUN: Nanos = Nanos::from_secs(3);
 
 fn run(row: &Row) -> Result {
     let sc = Scenario {
@@ -54,21 +55,21 @@ fn run(row: &Row) -> Result {
             std::process::exit(1);
         }
     };
-    let first = sim.sync0_dc_ns(0);
+    let first = sim.sync0_dc(0);
     let mut lock_at = None;
     let mut errors = Vec::new();
     let mut was_locked = false;
     let mut unlocks = 0;
     let mut frames = 0;
-    sim.run_until(RUN_NS, |pll, ev| match ev {
+    sim.run_until(RUN, |pll, ev| match ev {
         SimEvent::Cycle {
-            dc_ns,
+            dc,
             error_ns: Some(e),
             ..
         } => {
             let locked = pll.status().contains(PllStatus::PHASE_LOCKED);
             if locked && lock_at.is_none() {
-                lock_at = Some(*dc_ns);
+                lock_at = Some(*dc);
             }
             if was_locked && !locked {
                 unlocks += 1;
@@ -91,7 +92,7 @@ fn run(row: &Row) -> Result {
         .unwrap_or(0);
     let max = abs.last().copied().unwrap_or(0);
     Result {
-        lock_ms: lock_at.map(|t| (t.saturating_sub(first)) as f64 / 1e6),
+        lock_ms: lock_at.map(|t: Nanos| t.since(first).as_ns() as f64 / 1e6),
         mean,
         p99,
         max,

@@ -2,10 +2,10 @@
 //! benchmark (not used by the firmware).
 //!
 //! - DC time is the reference ("true" time, ns from 0). SYNC0 edges are at
-//!   `first_sync0_ns + n × SYNC0 cycle` exactly: the ESC generates them in
+//!   `first_sync0 + n × SYNC0 cycle` exactly: the ESC generates them in
 //!   hardware from DC time, so frame jitter does not move them.
 //! - The local counter runs at `(1 + drift_ppb·10⁻⁹)` × DC rate from
-//!   `local_offset_ns`; the cycle timer counts ticks of `timer_hz` of that
+//!   `local_offset`; the cycle timer counts ticks of `timer_hz` of that
 //!   local time. The firmware reads local ns as whole ticks converted to ns.
 //! - The SYNC0 interrupt runs `sync0_latency_ns ± latency_jitter_ns`
 //!   (uniform) after the edge and timestamps the local counter then; the PLL
@@ -19,6 +19,7 @@
 
 use crate::pll::{wrap_signed, Config, CycleCommand, FrameTiming, Pll};
 use crate::validate::SyncError;
+use nanos::Nanos;
 
 /// xorshift64 (Marsaglia); a zero seed is replaced.
 #[derive(Debug, Clone)]
@@ -63,12 +64,12 @@ pub struct Scenario {
     pub frame_lead_ns: i64,
     /// Uniform frame arrival jitter, ± DC ns.
     pub frame_jitter_ns: u32,
-    /// DC time of the first SYNC0 edge, ns.
-    pub first_sync0_ns: u64,
-    /// Local counter value at DC time 0, ns.
-    pub local_offset_ns: u64,
+    /// DC time of the first SYNC0 edge.
+    pub first_sync0: Nanos,
+    /// Local counter value at DC time 0.
+    pub local_offset: Nanos,
     /// DC time window `[from, to)` without SYNC0 pulses and frames.
-    pub sync0_gap: Option<(u64, u64)>,
+    pub sync0_gap: Option<(Nanos, Nanos)>,
     /// Random seed.
     pub seed: u64,
 }
@@ -83,8 +84,8 @@ impl Default for Scenario {
             latency_jitter_ns: 100,
             frame_lead_ns: 20_000,
             frame_jitter_ns: 0,
-            first_sync0_ns: 1_234_567,
-            local_offset_ns: 987_654_321,
+            first_sync0: Nanos::from_ns(1_234_567),
+            local_offset: Nanos::from_ns(987_654_321),
             sync0_gap: None,
             seed: 1,
         }
@@ -94,22 +95,22 @@ impl Default for Scenario {
 /// What happened in one [`Simulator::step`].
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
 pub enum SimEvent {
-    /// SYNC0 interrupt at DC time `dc_ns`.
+    /// SYNC0 interrupt at DC time `dc`.
     Sync0 {
-        /// DC time of the interrupt, ns.
-        dc_ns: u64,
+        /// DC time of the interrupt.
+        dc: Nanos,
     },
     /// Frame arrival.
     Frame {
-        /// DC time, ns.
-        dc_ns: u64,
+        /// DC time.
+        dc: Nanos,
         /// What the PLL made of it.
         timing: Option<FrameTiming>,
     },
     /// Local cycle start.
     Cycle {
-        /// DC time of the start, ns.
-        dc_ns: u64,
+        /// DC time of the start.
+        dc: Nanos,
         /// The PLL's answer.
         cmd: CycleCommand,
         /// True phase error of an aligned cycle (DC ns, positive = late).
@@ -176,35 +177,36 @@ impl Simulator {
         &mut self.sc
     }
 
-    /// DC time of SYNC0 edge `n`, ns.
-    pub fn sync0_dc_ns(&self, n: u64) -> u64 {
-        self.sc.first_sync0_ns + n * self.cycle_ns as u64
+    /// DC time of SYNC0 edge `n`.
+    pub fn sync0_dc(&self, n: u64) -> Nanos {
+        self.sc.first_sync0 + Nanos::from_ns(self.cycle_ns as u64).saturating_mul(n)
     }
 
     fn local_ns(&self, dc: i128) -> i128 {
-        i128::from(self.sc.local_offset_ns) + (dc * (GIGA + i128::from(self.sc.drift_ppb))).div_euclid(GIGA)
+        i128::from(self.sc.local_offset.as_ns())
+            + (dc * (GIGA + i128::from(self.sc.drift_ppb))).div_euclid(GIGA)
     }
 
     fn tick_of_local(&self, local: i128) -> i128 {
         (local * self.hz).div_euclid(GIGA)
     }
 
-    fn local_of_tick(&self, tick: i128) -> u64 {
-        (tick * GIGA).div_euclid(self.hz) as u64
+    fn local_of_tick(&self, tick: i128) -> Nanos {
+        Nanos::from_ns((tick * GIGA).div_euclid(self.hz) as u64)
     }
 
     fn dc_of_tick(&self, tick: i128) -> i128 {
-        let num = (tick * GIGA - i128::from(self.sc.local_offset_ns) * self.hz) * GIGA;
+        let num = (tick * GIGA - i128::from(self.sc.local_offset.as_ns()) * self.hz) * GIGA;
         let den = self.hz * (GIGA + i128::from(self.sc.drift_ppb));
         -((-num).div_euclid(den))
     }
 
-    fn read_counter(&self, dc: i128) -> u64 {
+    fn read_counter(&self, dc: i128) -> Nanos {
         self.local_of_tick(self.tick_of_local(self.local_ns(dc)))
     }
 
     fn in_gap(&self, n: u64) -> bool {
-        let s = self.sync0_dc_ns(n);
+        let s = self.sync0_dc(n);
         self.sc.sync0_gap.is_some_and(|(a, b)| s >= a && s < b)
     }
 
@@ -213,7 +215,7 @@ impl Simulator {
             self.next_sync0 += 1;
         }
         let lat = i64::from(self.sc.sync0_latency_ns) + self.rng.symmetric(self.sc.latency_jitter_ns);
-        self.sync0_isr = i128::from(self.sync0_dc_ns(self.next_sync0)) + i128::from(lat);
+        self.sync0_isr = i128::from(self.sync0_dc(self.next_sync0).as_ns()) + i128::from(lat);
     }
 
     fn schedule_frame(&mut self) {
@@ -222,7 +224,8 @@ impl Simulator {
                 self.next_frame += 1;
             }
             let j = self.rng.symmetric(self.sc.frame_jitter_ns);
-            self.frame_at = i128::from(self.sync0_dc_ns(self.next_frame)) - i128::from(self.sc.frame_lead_ns)
+            self.frame_at = i128::from(self.sync0_dc(self.next_frame).as_ns())
+                - i128::from(self.sc.frame_lead_ns)
                 + i128::from(j);
             if self.frame_at >= 0 {
                 return;
@@ -237,13 +240,13 @@ impl Simulator {
             let dc = self.tick_at;
             let cmd = self.pll.on_cycle_start(self.local_of_tick(self.tick));
             let error_ns = (cmd.index == 0).then(|| {
-                let x = dc + i128::from(self.pll.phase_offset_ns()) - i128::from(self.sc.first_sync0_ns);
+                let x = dc + i128::from(self.pll.phase_offset_ns()) - i128::from(self.sc.first_sync0.as_ns());
                 wrap_signed(x as i64, self.cycle_ns as i64)
             });
             self.tick += i128::from(cmd.period_ticks.max(1));
             self.tick_at = self.dc_of_tick(self.tick);
             SimEvent::Cycle {
-                dc_ns: dc as u64,
+                dc: Nanos::from_ns(dc as u64),
                 cmd,
                 error_ns,
             }
@@ -252,24 +255,26 @@ impl Simulator {
             self.pll.on_sync0(self.read_counter(dc));
             self.next_sync0 += 1;
             self.schedule_sync0();
-            SimEvent::Sync0 { dc_ns: dc as u64 }
+            SimEvent::Sync0 {
+                dc: Nanos::from_ns(dc as u64),
+            }
         } else {
             let dc = self.frame_at;
             let timing = self.pll.on_frame(self.read_counter(dc));
             self.next_frame += 1;
             self.schedule_frame();
             SimEvent::Frame {
-                dc_ns: dc as u64,
+                dc: Nanos::from_ns(dc as u64),
                 timing,
             }
         }
     }
 
-    /// Steps until DC time `dc_ns`, calling `f` for every event.
-    pub fn run_until(&mut self, dc_ns: u64, mut f: impl FnMut(&Pll, &SimEvent)) {
+    /// Steps until DC time `until`, calling `f` for every event.
+    pub fn run_until(&mut self, until: Nanos, mut f: impl FnMut(&Pll, &SimEvent)) {
         loop {
             let next = self.tick_at.min(self.sync0_isr).min(self.frame_at);
-            if next >= i128::from(dc_ns) {
+            if next >= i128::from(until.as_ns()) {
                 return;
             }
             let ev = self.step();

@@ -7,14 +7,15 @@
 
 use dcsync::sim::{Scenario, SimEvent, Simulator};
 use dcsync::{al, Config, CycleSequence, DiagCode, Pll, PllState, PllStatus, Step, SyncFault};
+use nanos::Nanos;
 
-const MS: u64 = 1_000_000;
+const MS: Nanos = Nanos::from_ms(1);
 const TIMER_HZ: u32 = 144_000_000;
 
 /// What a run saw.
 struct Run {
     sim: Simulator,
-    lock_ns: Option<u64>,
+    lock: Option<Nanos>,
     /// True phase errors of aligned cycles after the lock, DC ns.
     errors: Vec<i64>,
     /// A298 words seen at aligned cycles.
@@ -35,31 +36,31 @@ fn scenario(drift_ppm: i64, frame_jitter_ns: u32, seed: u64) -> Scenario {
 fn start(sc: Scenario, cfg: Config) -> Run {
     Run {
         sim: Simulator::new(sc, cfg).unwrap(),
-        lock_ns: None,
+        lock: None,
         errors: Vec::new(),
         statuses: Vec::new(),
         cycles: Vec::new(),
     }
 }
 
-fn advance(run: &mut Run, until_ns: u64) {
-    let first = run.sim.sync0_dc_ns(0);
+fn advance(run: &mut Run, until: Nanos) {
+    let first = run.sim.sync0_dc(0);
     let Run {
         sim,
-        lock_ns,
+        lock,
         errors,
         statuses,
         cycles,
     } = run;
-    sim.run_until(until_ns, |pll, ev| {
-        if let SimEvent::Cycle { dc_ns, cmd, error_ns } = ev {
+    sim.run_until(until, |pll, ev| {
+        if let SimEvent::Cycle { dc, cmd, error_ns } = ev {
             cycles.push((cmd.index, cmd.rx, cmd.tx));
             if let Some(e) = error_ns {
                 statuses.push(pll.status());
-                if pll.is_locked() && lock_ns.is_none() {
-                    *lock_ns = Some(dc_ns - first);
+                if pll.is_locked() && lock.is_none() {
+                    *lock = Some(*dc - first);
                 }
-                if lock_ns.is_some() {
+                if lock.is_some() {
                     errors.push(*e);
                 }
             }
@@ -67,9 +68,9 @@ fn advance(run: &mut Run, until_ns: u64) {
     });
 }
 
-fn run(sc: Scenario, cfg: Config, until_ns: u64) -> Run {
+fn run(sc: Scenario, cfg: Config, until: Nanos) -> Run {
     let mut r = start(sc, cfg);
-    advance(&mut r, until_ns);
+    advance(&mut r, until);
     r
 }
 
@@ -86,7 +87,7 @@ fn e114_pll_locks_within_100ms_at_100ppm() {
                 Config::new(1_000_000, 1_000_000, TIMER_HZ),
                 1000 * MS,
             );
-            let lock = r.lock_ns.unwrap();
+            let lock = r.lock.unwrap();
             assert!(lock <= 100 * MS, "drift {drift} ppm: lock after {lock} ns");
             assert!(
                 max_abs(&r.errors) <= 1_000,
@@ -111,13 +112,13 @@ fn e109_aligned_cycle_starts_at_sync0_minus_a292() {
         cfg.a292_ns = a292;
         let sc = scenario(80, 0, 3);
         let mut sim = Simulator::new(sc, cfg).unwrap();
-        let first = sim.sync0_dc_ns(0);
+        let first = sim.sync0_dc(0);
         let mut offsets = Vec::new();
         sim.run_until(500 * MS, |pll, ev| {
-            if let SimEvent::Cycle { dc_ns, cmd, .. } = ev {
+            if let SimEvent::Cycle { dc, cmd, .. } = ev {
                 if cmd.index == 0 && pll.is_locked() {
                     // Where the aligned cycle starts after its SYNC0, DC ns.
-                    offsets.push((*dc_ns as i64 - first as i64).rem_euclid(1_000_000));
+                    offsets.push((dc.as_ns() as i64 - first.as_ns() as i64).rem_euclid(1_000_000));
                 }
             }
         });
@@ -153,7 +154,7 @@ fn e109_a292_change_is_followed() {
     // A large step is re-aligned in one go, then locked again.
     r.sim.pll_mut().set_phase_offset(250_000);
     r.errors.clear();
-    r.lock_ns = None;
+    r.lock = None;
     advance(&mut r, 400 * MS);
     assert!(r.sim.pll().is_locked());
     let tail = &r.errors[r.errors.len() - 100..];
@@ -179,8 +180,8 @@ fn e111_cycle_sequence_a149() {
     let mut cfg = Config::new(1_000_000, 500_000, TIMER_HZ);
     cfg.sequence = CycleSequence::RxTxApp;
     let mut pll = Pll::new(cfg).unwrap();
-    let a = pll.on_cycle_start(0);
-    let b = pll.on_cycle_start(500_000);
+    let a = pll.on_cycle_start(Nanos::from_ns(0));
+    let b = pll.on_cycle_start(Nanos::from_ns(500_000));
     assert_eq!((a.index, a.rx, a.tx), (0, true, true));
     assert_eq!(
         a.steps(),
@@ -193,7 +194,7 @@ fn e111_cycle_sequence_a149() {
     assert_eq!((b.index, b.rx, b.tx), (1, false, false));
     assert_eq!(b.steps(), [None, None, Some(Step::Application)]);
     pll.set_sequence(CycleSequence::RxAppTx);
-    let c = pll.on_cycle_start(1_000_000);
+    let c = pll.on_cycle_start(Nanos::from_ns(1_000_000));
     assert_eq!(
         c.steps(),
         [
@@ -210,7 +211,7 @@ fn e112_sync0_cycle_k_times_a150_locks_only_index_0_aligned() {
     cfg.a292_ns = -100_000;
     let r = run(scenario(100, 5_000, 11), cfg, 1000 * MS);
     assert_eq!(r.sim.pll().k(), 4);
-    assert!(r.lock_ns.unwrap() <= 100 * MS, "{:?}", r.lock_ns);
+    assert!(r.lock.unwrap() <= 100 * MS, "{:?}", r.lock);
     assert!(max_abs(&r.errors) <= 1_000);
     // After the lock the indices run 0, 1, 2, 3 and only 0 does Rx/Tx.
     let tail = &r.cycles[r.cycles.len() - 400..];
@@ -279,13 +280,13 @@ fn e114_lock_lost_when_sync0_missing() {
     assert!(r.sim.pll().is_locked());
 
     // One missing pulse is bridged.
-    r.sim.scenario_mut().sync0_gap = Some((200 * MS, 201 * MS + 500_000));
+    r.sim.scenario_mut().sync0_gap = Some((200 * MS, 201 * MS + Nanos::from_ns(500_000)));
     advance(&mut r, 260 * MS);
     assert!(r.sim.pll().is_locked());
     assert_eq!(r.sim.pll().fault(), None);
 
     // Five in a row lose SYNC0 and the lock.
-    r.sim.scenario_mut().sync0_gap = Some((300 * MS, 305 * MS + 500_000));
+    r.sim.scenario_mut().sync0_gap = Some((300 * MS, 305 * MS + Nanos::from_ns(500_000)));
     advance(&mut r, 305 * MS);
     let pll = r.sim.pll();
     assert!(!pll.is_locked());
@@ -392,7 +393,7 @@ fn e115_bit4_and_a261_code_4_when_sync0_cycle_longer_than_a291() {
     // The master runs 2 ms, A291 says 1 ms.
     let mut pll = Pll::new(Config::new(1_000_000, 1_000_000, TIMER_HZ)).unwrap();
     for n in 0..10u64 {
-        pll.on_sync0(5_000_000 + n * 2_000_000);
+        pll.on_sync0(Nanos::from_ns(5_000_000 + n * 2_000_000));
     }
     let s = pll.status();
     assert!(s.contains(PllStatus::SYNC_CYCLE_TOO_LONG | PllStatus::ERROR));
@@ -404,7 +405,7 @@ fn e115_bit4_and_a261_code_4_when_sync0_cycle_longer_than_a291() {
     // 2 % fast: plausible interval, outside the ±500 ppm range.
     let mut pll = Pll::new(Config::new(1_000_000, 1_000_000, TIMER_HZ)).unwrap();
     for n in 0..40u64 {
-        pll.on_sync0(n * 1_020_000);
+        pll.on_sync0(Nanos::from_ns(n * 1_020_000));
     }
     assert!(pll.status().contains(PllStatus::SYNC_CYCLE_TOO_LONG));
     assert_eq!(pll.diagnostics().code, DiagCode::PllStartFailed);

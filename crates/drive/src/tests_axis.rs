@@ -7,6 +7,7 @@ use crate::params::E48;
 use crate::runtime::Drive;
 use cia402::{State, SW_INTERNAL_LIMIT, SW_MODE_BIT12, SW_MODE_BIT13, SW_TARGET_REACHED};
 use motion::{Event, INCREMENTS_PER_REVOLUTION};
+use nanos::Nanos;
 
 /// Increments per revolution as `f32`.
 const REV: f32 = INCREMENTS_PER_REVOLUTION as f32;
@@ -74,7 +75,7 @@ struct Rig {
     drive: Drive<Flash>,
     motors: [Motor; 2],
     io: [AxisIo; 2],
-    now: u64,
+    now: Nanos,
     commands: [AxisCommand; 2],
     new_setpoint: Option<[bool; 2]>,
 }
@@ -85,7 +86,7 @@ impl Rig {
             drive: Drive::new(Flash::new()),
             motors: [Motor::new(), Motor::new()],
             io: [AxisIo::ready(0), AxisIo::ready(0)],
-            now: 0,
+            now: Nanos::ZERO,
             commands: [AxisCommand::OFF; 2],
             new_setpoint: None,
         }
@@ -132,7 +133,7 @@ impl Rig {
             io.probe_edges = [None; 4];
             io.index = None;
         }
-        self.now += DT_NS;
+        self.now += Nanos::from_ns(DT_NS);
     }
 
     fn run(&mut self, cycles: usize) {

@@ -16,6 +16,7 @@
 //! subindex holds no message); above 19h → 0609 0031h. Overwriting a message that was not
 //! acknowledged sets 03h to 0 and sets flag bit 5.
 
+use nanos::Nanos;
 use od::SdoAbort;
 
 /// Messages kept.
@@ -106,12 +107,12 @@ impl DiagMessage {
     /// ETG.1020 encoding into `out`: diag code u32, flags u16, text ID u16, time stamp
     /// u64 (ns), then per parameter flags u16 (0007h = UINT32) and the u32 value, all
     /// little-endian. Returns the length, `None` when `out` is too short.
-    pub fn encode(&self, time_ns: u64, out: &mut [u8]) -> Option<usize> {
+    pub fn encode(&self, time: Nanos, out: &mut [u8]) -> Option<usize> {
         let mut w = Writer { out, at: 0 };
         w.put(&self.code.to_le_bytes())?;
         w.put(&self.flags().to_le_bytes())?;
         w.put(&self.text_id.to_le_bytes())?;
-        w.put(&time_ns.to_le_bytes())?;
+        w.put(&time.as_ns().to_le_bytes())?;
         for v in self.params.iter().flatten() {
             w.put(&PARAM_U32.to_le_bytes())?;
             w.put(&v.to_le_bytes())?;
@@ -137,7 +138,7 @@ impl Writer<'_> {
 #[derive(Debug, Clone, Copy)]
 struct Entry {
     msg: DiagMessage,
-    time_ns: u64,
+    time: Nanos,
     /// 1 for the first message since restart; never wraps.
     seq: u64,
 }
@@ -173,10 +174,10 @@ impl DiagHistory {
         }
     }
 
-    /// Stores `msg` with time stamp `now_ns` (DC or SNTP time, 0 when unknown; spec
+    /// Stores `msg` with time stamp `now` (DC or SNTP time, 0 when unknown; spec
     /// §17), overwriting the oldest message when full. Returns `false` when the type
     /// is filtered out by 10F3h:05 (nothing stored).
-    pub fn push(&mut self, msg: DiagMessage, now_ns: u64) -> bool {
+    pub fn push(&mut self, msg: DiagMessage, now: Nanos) -> bool {
         if self.flags & msg.kind.disable_flag() != 0 {
             return false;
         }
@@ -190,7 +191,7 @@ impl DiagHistory {
             }
             *cell = Some(Entry {
                 msg,
-                time_ns: now_ns,
+                time: now,
                 seq: self.seq,
             });
         }
@@ -218,9 +219,9 @@ impl DiagHistory {
     }
 
     /// The message and its time stamp at subindex `sub` (06h..19h).
-    pub fn message(&self, sub: u8) -> Option<(DiagMessage, u64)> {
+    pub fn message(&self, sub: u8) -> Option<(DiagMessage, Nanos)> {
         let e = self.entry(sub)?;
-        Some((e.msg, e.time_ns))
+        Some((e.msg, e.time))
     }
 
     fn entry(&self, sub: u8) -> Option<&Entry> {
@@ -259,7 +260,7 @@ impl DiagHistory {
             5 => &flag_bytes,
             FIRST_MESSAGE_SUB..=LAST_SUB => match self.entry(sub) {
                 Some(e) => {
-                    let n = e.msg.encode(e.time_ns, &mut small).ok_or(SdoAbort::GENERAL)?;
+                    let n = e.msg.encode(e.time, &mut small).ok_or(SdoAbort::GENERAL)?;
                     small.get(..n).unwrap_or_default()
                 }
                 None => &[],
@@ -341,7 +342,7 @@ mod tests {
 
         let mut m = DiagMessage::new(0x4310_E800, DiagType::Warning, 0x1234);
         m.params = [Some(0xAABB_CCDD), Some(7)];
-        assert!(h.push(m, 0x0102_0304_0506_0708));
+        assert!(h.push(m, Nanos::from_ns(0x0102_0304_0506_0708)));
         assert_eq!(read_u8(&h, 2), 6);
         assert_eq!(h.read(6, &mut b), Ok(MESSAGE_MAX_LEN));
         assert_eq!(
@@ -355,7 +356,7 @@ mod tests {
                 0x07, 0x00, 0x07, 0x00, 0x00, 0x00,
             ]
         );
-        assert!(h.push(DiagMessage::new(1, DiagType::Info, 2), 0));
+        assert!(h.push(DiagMessage::new(1, DiagType::Info, 2), Nanos::ZERO));
         assert_eq!(h.read(7, &mut b), Ok(16));
         assert_eq!(b[4..6], [0x00, 0x00], "info, no parameters");
         assert_eq!(h.read(7, &mut [0u8; 15]), Err(SdoAbort::OUT_OF_MEMORY));
@@ -365,18 +366,18 @@ mod tests {
     fn e144_ring_overwrites_oldest_at_21() {
         let mut h = DiagHistory::new();
         for n in 1..=20 {
-            h.push(msg(n), u64::from(n));
+            h.push(msg(n), Nanos::from_ns(u64::from(n)));
         }
         assert_eq!(h.newest_subindex(), 25);
         assert_eq!(code_at(&h, 6), 1);
-        h.push(msg(21), 21);
+        h.push(msg(21), Nanos::from_ns(21));
         // Newest wraps to 06h; the oldest (message 2) now sits in 07h.
         assert_eq!(h.newest_subindex(), 6);
         assert_eq!(code_at(&h, 6), 21);
         assert_eq!(code_at(&h, 7), 2);
         assert_eq!(code_at(&h, 25), 20);
         for n in 22..=45 {
-            h.push(msg(n), 0);
+            h.push(msg(n), Nanos::ZERO);
         }
         assert_eq!(h.newest_subindex(), 6 + (45 - 1) % 20);
         assert!((6..=25).all(|s| h.message(s).is_some()));
@@ -395,7 +396,7 @@ mod tests {
     fn e146_acknowledge_and_new_flag() {
         let mut h = DiagHistory::new();
         for n in 1..=3 {
-            h.push(msg(n), 0);
+            h.push(msg(n), Nanos::ZERO);
         }
         assert!(h.new_messages());
         assert_eq!(read_u8(&h, 4), 1);
@@ -406,7 +407,7 @@ mod tests {
         assert_eq!(h.write(3, &[8]), Ok(()));
         assert!(!h.new_messages());
         assert_eq!(read_u8(&h, 4), 0);
-        h.push(msg(4), 0);
+        h.push(msg(4), Nanos::ZERO);
         assert!(h.new_messages());
         assert_eq!(read_u8(&h, 3), 8);
 
@@ -426,7 +427,7 @@ mod tests {
         assert_eq!(h.write(3, &[0]), Ok(()));
         assert_eq!((h.newest_subindex(), h.newest_acknowledged_subindex()), (0, 0));
         assert!(!h.new_messages());
-        h.push(msg(5), 0);
+        h.push(msg(5), Nanos::ZERO);
         assert_eq!(h.newest_subindex(), 10);
         assert!(h.new_messages());
     }
@@ -435,16 +436,16 @@ mod tests {
     fn e146_overwriting_unacknowledged_resets_ack() {
         let mut h = DiagHistory::new();
         for n in 1..=20 {
-            h.push(msg(n), 0);
+            h.push(msg(n), Nanos::ZERO);
         }
         // All acknowledged: overwriting acknowledged messages keeps the ack state.
         h.write(3, &[25]).unwrap();
-        h.push(msg(21), 0);
+        h.push(msg(21), Nanos::ZERO);
         assert_eq!(h.newest_acknowledged_subindex(), 25);
         assert_eq!(h.flags() & flags::OVERWRITTEN, 0);
         // 20 more: message 21 (unacknowledged) is overwritten.
         for n in 22..=41 {
-            h.push(msg(n), 0);
+            h.push(msg(n), Nanos::ZERO);
         }
         assert_eq!(h.newest_acknowledged_subindex(), 0);
         assert_ne!(h.flags() & flags::OVERWRITTEN, 0);
@@ -459,15 +460,15 @@ mod tests {
         h.write(5, &(flags::ACK_MODE | flags::DISABLE_WARNING).to_le_bytes())
             .unwrap();
         assert_eq!(h.flags(), flags::EMERGENCY | flags::DISABLE_WARNING);
-        assert!(!h.push(DiagMessage::new(1, DiagType::Warning, 0), 0));
+        assert!(!h.push(DiagMessage::new(1, DiagType::Warning, 0), Nanos::ZERO));
         assert_eq!(h.newest_subindex(), 0);
-        assert!(h.push(DiagMessage::new(2, DiagType::Info, 0), 0));
-        assert!(h.push(DiagMessage::new(3, DiagType::Error, 0), 0));
+        assert!(h.push(DiagMessage::new(2, DiagType::Info, 0), Nanos::ZERO));
+        assert!(h.push(DiagMessage::new(3, DiagType::Error, 0), Nanos::ZERO));
         h.write(5, &(flags::DISABLE_INFO | flags::DISABLE_ERROR).to_le_bytes())
             .unwrap();
-        assert!(!h.push(DiagMessage::new(4, DiagType::Info, 0), 0));
-        assert!(!h.push(DiagMessage::new(5, DiagType::Error, 0), 0));
-        assert!(h.push(DiagMessage::new(6, DiagType::Warning, 0), 0));
+        assert!(!h.push(DiagMessage::new(4, DiagType::Info, 0), Nanos::ZERO));
+        assert!(!h.push(DiagMessage::new(5, DiagType::Error, 0), Nanos::ZERO));
+        assert!(h.push(DiagMessage::new(6, DiagType::Warning, 0), Nanos::ZERO));
         assert_eq!(h.newest_subindex(), 8);
         assert_eq!(h.write(5, &[0]), Err(SdoAbort::LENGTH_TOO_LOW));
         h.write(5, &0u16.to_le_bytes()).unwrap();

@@ -6,6 +6,7 @@ use crate::app::PdoTimeout;
 use crate::desc::{Device, MailboxSm};
 use crate::emcy::SmFault;
 use esc::{regs, AlState, AlStatusCode, SmDirection, SmMode, SyncManager};
+use nanos::Nanos;
 
 /// Smallest mailbox SyncManager length accepted: header + CoE header + SDO frame.
 pub const MIN_MAILBOX_LEN: u16 = 16;
@@ -266,10 +267,10 @@ pub struct EscWatchdog {
 }
 
 impl EscWatchdog {
-    /// The watchdog time in ns, `None` when disabled (time 0 or no SM2 trigger).
-    pub fn time_ns(&self) -> Option<u64> {
+    /// The watchdog time, `None` when disabled (time 0 or no SM2 trigger).
+    pub fn time(&self) -> Option<Nanos> {
         (self.pd_time != 0 && self.sm2_trigger)
-            .then(|| u64::from(self.pd_time) * (u64::from(self.divider) + 2) * 40)
+            .then(|| Nanos::from_ns(u64::from(self.pd_time) * (u64::from(self.divider) + 2) * 40))
     }
 }
 
@@ -277,16 +278,16 @@ impl EscWatchdog {
 /// application's [`PdoTimeout`] and the process-data cycle.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
 pub enum PdoMonitor {
-    /// No new RxPDO for longer than this (ns) is a PDO timeout.
-    Timeout(u64),
+    /// No new RxPDO for longer than this is a PDO timeout.
+    Timeout(Nanos),
     /// [`PdoTimeout::EscWatchdog`]: the ESC's SM watchdog decides (AL event
-    /// 6, 0x0440 bit 0); the tolerance (ns) is the watchdog time.
-    EscWatchdog(u64),
+    /// 6, 0x0440 bit 0); the tolerance is the watchdog time.
+    EscWatchdog(Nanos),
 }
 
 impl PdoMonitor {
-    /// The tolerated time without RxPDO, ns.
-    pub const fn tolerance_ns(&self) -> u64 {
+    /// The tolerated time without RxPDO.
+    pub const fn tolerance(&self) -> Nanos {
         match *self {
             Self::Timeout(t) | Self::EscWatchdog(t) => t,
         }
@@ -302,14 +303,16 @@ pub fn pdo_monitor(timeout: PdoTimeout, cycle_ns: u32, wd: &EscWatchdog) -> Opti
     match timeout {
         PdoTimeout::Off => None,
         PdoTimeout::Ms(0) => None,
-        PdoTimeout::Ms(ms) => Some(PdoMonitor::Timeout(u64::from(ms) * 1_000_000)),
-        PdoTimeout::LostFrames(lost) => Some(PdoMonitor::Timeout((u64::from(lost) + 1) * cycle + cycle / 2)),
-        PdoTimeout::EscWatchdog => wd.time_ns().map(PdoMonitor::EscWatchdog),
+        PdoTimeout::Ms(ms) => Some(PdoMonitor::Timeout(Nanos::from_ms(u64::from(ms)))),
+        PdoTimeout::LostFrames(lost) => Some(PdoMonitor::Timeout(Nanos::from_ns(
+            (u64::from(lost) + 1) * cycle + cycle / 2,
+        ))),
+        PdoTimeout::EscWatchdog => wd.time().map(PdoMonitor::EscWatchdog),
     }
 }
 
 /// Longest watchdog tolerance a u16 ms diagnosis value can show.
-pub const MAX_WATCHDOG_NS: u64 = 65_535 * 1_000_000;
+pub const MAX_WATCHDOG: Nanos = Nanos::from_ms(65_535);
 
 /// P→S check of the SM watchdog settings (E-031, AL 001Fh). Invalid:
 /// - a running process-data watchdog (time ≠ 0) with divider 0 (a 80 ns
@@ -318,7 +321,7 @@ pub const MAX_WATCHDOG_NS: u64 = 65_535 * 1_000_000;
 ///   master's SM watchdog, spec §13.2): the watchdog disabled (time 0 or
 ///   SM2 without its trigger bit while outputs are mapped), shorter than
 ///   one process-data cycle (`cycle_ns`: it would fire between two frames)
-///   or longer than [`MAX_WATCHDOG_NS`] (65535 ms).
+///   or longer than [`MAX_WATCHDOG`] (65535 ms).
 pub fn check_watchdog(
     timeout: PdoTimeout,
     wd: &EscWatchdog,
@@ -330,9 +333,9 @@ pub fn check_watchdog(
         return invalid;
     }
     if timeout == PdoTimeout::EscWatchdog && rx_bytes > 0 {
-        match wd.time_ns() {
+        match wd.time() {
             None => return invalid,
-            Some(t) if t < u64::from(cycle_ns) || t > MAX_WATCHDOG_NS => return invalid,
+            Some(t) if t < Nanos::from_ns(u64::from(cycle_ns)) || t > MAX_WATCHDOG => return invalid,
             Some(_) => {}
         }
     }
@@ -343,8 +346,8 @@ pub fn check_watchdog(
 /// that make the reception "stable and regular" for S→O (E-033).
 pub const STEADY_FRAMES: u32 = 3;
 /// How long an S→O request waits for stable RxPDO before it is refused
-/// (spec §3.3), ns.
-pub const STEADY_WAIT_NS: u64 = 200_000_000;
+/// (spec §3.3).
+pub const STEADY_WAIT: Nanos = Nanos::from_ms(200);
 
 /// Why the slave left Op by itself ([`crate::Slave::take_op_loss`]); the
 /// application raises its own event for it (the drive: event 52 with cause

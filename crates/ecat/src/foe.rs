@@ -13,17 +13,18 @@
 //! - read requests: no file can be read, [`FoeError::NOT_FOUND`];
 //! - a DATA packet whose number is not the expected one: [`FoeError::PACKET_NUMBER`],
 //!   the transfer ends; DATA or ACK/BUSY without a transfer: [`FoeError::ILLEGAL`];
-//! - no packet for [`FOE_TIMEOUT_NS`] during a transfer (a cut connection): the
+//! - no packet for [`FOE_TIMEOUT`] during a transfer (a cut connection): the
 //!   transfer is dropped ([`FoeHandler::abort`]), silently — nobody is listening.
 
 use crate::mailbox::MailboxError;
+use nanos::Nanos;
 
 /// Length of the FoE header (opcode, reserved, 32-bit field).
 pub const FOE_HEADER_LEN: usize = 6;
 
 /// A transfer without a packet for this long is dropped (our choice: ETG.1000.6
-/// names no slave-side timeout), ns.
-pub const FOE_TIMEOUT_NS: u64 = 5_000_000_000;
+/// names no slave-side timeout).
+pub const FOE_TIMEOUT: Nanos = Nanos::from_secs(5);
 
 /// FoE opcodes (ETG.1000.6 Table 89).
 pub mod opcode {
@@ -125,7 +126,7 @@ pub struct FoeServer {
     /// Number of the next DATA packet of the write in progress.
     next: Option<u32>,
     /// Time of the last packet of the transfer.
-    last_ns: u64,
+    last: Nanos,
     /// Transfers dropped by the timeout.
     timeouts: u32,
 }
@@ -151,7 +152,7 @@ impl FoeServer {
     pub const fn new() -> Self {
         Self {
             next: None,
-            last_ns: 0,
+            last: Nanos::ZERO,
             timeouts: 0,
         }
     }
@@ -173,10 +174,10 @@ impl FoeServer {
         }
     }
 
-    /// Drops a transfer that saw no packet for [`FOE_TIMEOUT_NS`]; returns whether
+    /// Drops a transfer that saw no packet for [`FOE_TIMEOUT`]; returns whether
     /// it did now.
-    pub fn tick<H: FoeHandler>(&mut self, handler: &mut H, now_ns: u64) -> bool {
-        if self.next.is_some() && now_ns.wrapping_sub(self.last_ns) > FOE_TIMEOUT_NS {
+    pub fn tick<H: FoeHandler>(&mut self, handler: &mut H, now: Nanos) -> bool {
+        if self.next.is_some() && now.wrapping_sub(self.last) > FOE_TIMEOUT {
             self.reset(handler);
             self.timeouts = self.timeouts.saturating_add(1);
             true
@@ -206,7 +207,7 @@ impl FoeServer {
         handler: &mut H,
         boot: bool,
         max_data: usize,
-        now_ns: u64,
+        now: Nanos,
     ) -> Result<Option<usize>, MailboxError> {
         if req.len() < FOE_HEADER_LEN {
             return Err(MailboxError::SIZE_TOO_SHORT);
@@ -214,7 +215,7 @@ impl FoeServer {
         let op = req.first().copied().unwrap_or(0);
         let field = le32(req, 2);
         let rest = req.get(FOE_HEADER_LEN..).unwrap_or_default();
-        self.last_ns = now_ns;
+        self.last = now;
         match op {
             opcode::WRITE => {
                 self.reset(handler);
@@ -311,7 +312,7 @@ mod tests {
 
     fn send(s: &mut FoeServer, h: &mut Sink, req: &[u8], boot: bool, t: u64) -> Option<Vec<u8>> {
         let mut out = [0u8; 64];
-        s.handle(req, &mut out, h, boot, MAX, t)
+        s.handle(req, &mut out, h, boot, MAX, Nanos::from_ns(t))
             .unwrap()
             .map(|n| out[..n].to_vec())
     }
@@ -401,8 +402,8 @@ mod tests {
         let (mut s, mut h) = (FoeServer::new(), Sink::default());
         send(&mut s, &mut h, &wrq(b"firmware.bin"), true, 1000);
         send(&mut s, &mut h, &data(1, &[1; MAX]), true, 2000);
-        assert!(!s.tick(&mut h, 2000 + FOE_TIMEOUT_NS));
-        assert!(s.tick(&mut h, 2001 + FOE_TIMEOUT_NS));
+        assert!(!s.tick(&mut h, Nanos::from_ns(2000) + FOE_TIMEOUT));
+        assert!(s.tick(&mut h, Nanos::from_ns(2001) + FOE_TIMEOUT));
         assert_eq!((h.aborted, s.timeouts()), (1, 1));
         assert!(!s.busy());
     }
@@ -441,7 +442,7 @@ mod tests {
         );
         let mut out = [0u8; 8];
         assert_eq!(
-            s.handle(&[2, 0, 0], &mut out, &mut h, true, MAX, 0),
+            s.handle(&[2, 0, 0], &mut out, &mut h, true, MAX, Nanos::ZERO),
             Err(MailboxError::SIZE_TOO_SHORT)
         );
     }

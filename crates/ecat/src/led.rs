@@ -19,13 +19,14 @@
 //! 50 ms on, 50 ms off.
 
 use esc::{AlState, AlStatusCode};
+use nanos::Nanos;
 
-/// One on or off phase of blinking and flashes, ns.
-pub const FLASH_NS: u64 = 200_000_000;
-/// The long off phase after a flash, ns.
-pub const FLASH_PAUSE_NS: u64 = 1_000_000_000;
-/// One on or off phase of flickering, ns.
-pub const FLICKER_NS: u64 = 50_000_000;
+/// One on or off phase of blinking and flashes.
+pub const FLASH: Nanos = Nanos::from_ms(200);
+/// The long off phase after a flash.
+pub const FLASH_PAUSE: Nanos = Nanos::from_ms(1_000);
+/// One on or off phase of flickering.
+pub const FLICKER: Nanos = Nanos::from_ms(50);
 
 /// An ETG.1300 indicator pattern.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Hash)]
@@ -45,27 +46,30 @@ pub enum Pattern {
 }
 
 impl Pattern {
-    /// Length of one repetition, ns (0 for the steady patterns).
-    pub const fn period_ns(self) -> u64 {
+    /// Length of one repetition (zero for the steady patterns).
+    pub const fn period(self) -> Nanos {
         match self {
-            Pattern::Off | Pattern::On => 0,
-            Pattern::Blinking => 2 * FLASH_NS,
-            Pattern::SingleFlash => FLASH_NS + FLASH_PAUSE_NS,
-            Pattern::DoubleFlash => 3 * FLASH_NS + FLASH_PAUSE_NS,
-            Pattern::Flickering => 2 * FLICKER_NS,
+            Pattern::Off | Pattern::On => Nanos::ZERO,
+            Pattern::Blinking => FLASH.saturating_mul(2),
+            Pattern::SingleFlash => FLASH.saturating_add(FLASH_PAUSE),
+            Pattern::DoubleFlash => FLASH.saturating_mul(3).saturating_add(FLASH_PAUSE),
+            Pattern::Flickering => FLICKER.saturating_mul(2),
         }
     }
 
-    /// Whether the LED is lit at `t_ns`.
-    pub const fn is_on(self, t_ns: u64) -> bool {
-        let period = self.period_ns();
-        let phase = if period == 0 { 0 } else { t_ns % period };
+    /// Whether the LED is lit at `t`.
+    pub const fn is_on(self, t: Nanos) -> bool {
+        let phase = match t.checked_rem(self.period()) {
+            Some(p) => p.as_ns(),
+            None => 0,
+        };
+        let flash = FLASH.as_ns();
         match self {
             Pattern::Off => false,
             Pattern::On => true,
-            Pattern::Blinking | Pattern::SingleFlash => phase < FLASH_NS,
-            Pattern::DoubleFlash => phase < FLASH_NS || (phase >= 2 * FLASH_NS && phase < 3 * FLASH_NS),
-            Pattern::Flickering => phase < FLICKER_NS,
+            Pattern::Blinking | Pattern::SingleFlash => phase < flash,
+            Pattern::DoubleFlash => phase < flash || (phase >= 2 * flash && phase < 3 * flash),
+            Pattern::Flickering => phase < FLICKER.as_ns(),
         }
     }
 }
@@ -112,7 +116,9 @@ mod tests {
 
     /// The lit/unlit sequence of `p` sampled every `step` ns over `span`.
     fn trace(p: Pattern, step: u64, span: u64) -> std::vec::Vec<bool> {
-        (0..span / step).map(|k| p.is_on(k * step)).collect()
+        (0..span / step)
+            .map(|k| p.is_on(Nanos::from_ns(k * step)))
+            .collect()
     }
 
     extern crate std;
@@ -121,7 +127,7 @@ mod tests {
     fn e132_e133_etg1300_timing() {
         let ms = 1_000_000;
         // 100 ms samples over one repetition
-        let t = |p| trace(p, 100 * ms, p.period_ns().max(100 * ms));
+        let t = |p| trace(p, 100 * ms, p.period().as_ns().max(100 * ms));
         assert_eq!(t(Pattern::Blinking), [true, true, false, false]);
         let mut single = std::vec![true, true];
         single.extend([false; 10]);
@@ -133,18 +139,32 @@ mod tests {
             trace(Pattern::Flickering, 25 * ms, 100 * ms),
             [true, true, false, false]
         );
-        assert!((0..50).all(|k| Pattern::On.is_on(k * 37 * ms) && !Pattern::Off.is_on(k * 37 * ms)));
+        assert!((0..50).all(|k| Pattern::On.is_on(Nanos::from_ns(k * 37 * ms))
+            && !Pattern::Off.is_on(Nanos::from_ns(k * 37 * ms))));
         // repeats with its period, from any time base
         let p = Pattern::DoubleFlash;
         for k in 0..40u64 {
             let t0 = k * 50 * ms + 7;
-            assert_eq!(p.is_on(t0), p.is_on(t0 + 5 * p.period_ns()), "{t0}");
+            assert_eq!(
+                p.is_on(Nanos::from_ns(t0)),
+                p.is_on(Nanos::from_ns(t0 + 5 * p.period().as_ns())),
+                "{t0}"
+            );
         }
         // edges exactly at the ETG.1300 times
-        assert!(Pattern::SingleFlash.is_on(200 * ms - 1) && !Pattern::SingleFlash.is_on(200 * ms));
-        assert!(!Pattern::SingleFlash.is_on(1200 * ms - 1) && Pattern::SingleFlash.is_on(1200 * ms));
-        assert!(!Pattern::DoubleFlash.is_on(400 * ms - 1) && Pattern::DoubleFlash.is_on(400 * ms));
-        assert!(!Pattern::DoubleFlash.is_on(600 * ms));
+        assert!(
+            Pattern::SingleFlash.is_on(Nanos::from_ns(200 * ms - 1))
+                && !Pattern::SingleFlash.is_on(Nanos::from_ns(200 * ms))
+        );
+        assert!(
+            !Pattern::SingleFlash.is_on(Nanos::from_ns(1200 * ms - 1))
+                && Pattern::SingleFlash.is_on(Nanos::from_ns(1200 * ms))
+        );
+        assert!(
+            !Pattern::DoubleFlash.is_on(Nanos::from_ns(400 * ms - 1))
+                && Pattern::DoubleFlash.is_on(Nanos::from_ns(400 * ms))
+        );
+        assert!(!Pattern::DoubleFlash.is_on(Nanos::from_ns(600 * ms)));
     }
 
     #[test]

@@ -17,7 +17,7 @@
 //!   ([`Application`]: its cycle, the RxPDO monitoring, the check of a DC
 //!   configuration); the stack knows no manufacturer object.
 //! - [`Slave`]: all of it composed; the application calls
-//!   [`Slave::poll`]`(pdi, app, now_ns)`
+//!   [`Slave::poll`]`(pdi, app, now)`
 //!   (or [`Slave::poll_with_eoe`] with the FoE handler and the Ethernet port) with the ESC behind an [`esc::Pdi`].
 #![no_std]
 #![cfg_attr(

@@ -12,6 +12,7 @@ use esc::regs::{self, al_event};
 use esc::sii::mailbox_protocol;
 use esc::sm::{activate, pdi_control, status};
 use esc::{AlState, AlStatusCode, Pdi};
+use nanos::Nanos;
 
 static RX_ENTRIES: [PdoEntry; 2] = [
     PdoEntry::new(0x7000, 1, DataType::U16, "Out word"),
@@ -252,7 +253,7 @@ struct Rig {
     esc: Fake,
     slave: Slave,
     app: App,
-    t: u64,
+    t: Nanos,
 }
 
 impl Rig {
@@ -264,13 +265,13 @@ impl Rig {
             esc: Fake::new(),
             slave: Slave::new(dev),
             app: App { value: 0 },
-            t: 0,
+            t: Nanos::ZERO,
         };
         r.poll();
         r
     }
     fn poll(&mut self) -> Option<StateChange> {
-        self.t += 1_000_000;
+        self.t += Nanos::from_ms(1);
         let Ok(c) = self.slave.poll(&mut self.esc, &mut self.app, self.t);
         c
     }
@@ -722,7 +723,7 @@ fn e031_e127_watchdog_check_and_pdo_monitor() {
         sm2_trigger: true,
     };
     let bad = Err(AlStatusCode::INVALID_WATCHDOG_CONFIG);
-    assert_eq!(wd.time_ns(), Some(100_000_000));
+    assert_eq!(wd.time(), Some(Nanos::from_ms(100)));
     assert_eq!(check_watchdog(Off, &wd, 1_000_000, 23), Ok(()));
     assert_eq!(
         check_watchdog(Off, &EscWatchdog { divider: 0, ..wd }, 1_000_000, 23),
@@ -755,23 +756,23 @@ fn e031_e127_watchdog_check_and_pdo_monitor() {
     assert_eq!(pdo_monitor(Ms(0), 1_000_000, &wd), None);
     assert_eq!(
         pdo_monitor(Ms(1), 1_000_000, &wd),
-        Some(PdoMonitor::Timeout(1_000_000))
+        Some(PdoMonitor::Timeout(Nanos::from_ns(1_000_000)))
     );
     assert_eq!(
         pdo_monitor(Ms(65531), 1_000_000, &wd),
-        Some(PdoMonitor::Timeout(65_531_000_000))
+        Some(PdoMonitor::Timeout(Nanos::from_ns(65_531_000_000)))
     );
     assert_eq!(
         pdo_monitor(LostFrames(1), 1_000_000, &wd),
-        Some(PdoMonitor::Timeout(2_500_000))
+        Some(PdoMonitor::Timeout(Nanos::from_ns(2_500_000)))
     );
     assert_eq!(
         pdo_monitor(LostFrames(3), 1_000_000, &wd),
-        Some(PdoMonitor::Timeout(4_500_000))
+        Some(PdoMonitor::Timeout(Nanos::from_ns(4_500_000)))
     );
     assert_eq!(
         pdo_monitor(Esc, 1_000_000, &wd),
-        Some(PdoMonitor::EscWatchdog(100_000_000))
+        Some(PdoMonitor::EscWatchdog(Nanos::from_ns(100_000_000)))
     );
     assert_eq!(
         pdo_monitor(Esc, 1_000_000, &EscWatchdog { pd_time: 0, ..wd }),
@@ -915,7 +916,7 @@ impl crate::eoe::EthernetPort for Port {
 
 impl Rig {
     fn poll_eth(&mut self, port: &mut Port) {
-        self.t += 1_000_000;
+        self.t += Nanos::from_ms(1);
         let Ok(_) = self.slave.poll_with_eoe(
             &mut self.esc,
             &mut self.app,
@@ -1180,7 +1181,7 @@ fn e095_eoe_unsupported_without_the_sii_protocol() {
 fn e027_e037_mailbox_served_by_its_own_task() {
     let mut r = Rig::new();
     let split = |r: &mut Rig, mailbox: bool| {
-        r.t += 1_000_000;
+        r.t += Nanos::from_ms(1);
         let Ok(c) = r.slave.poll_esc(&mut r.esc, &mut r.app, r.t);
         if mailbox {
             let Ok(()) = r.slave.poll_mailbox_only(

@@ -57,7 +57,7 @@ fn measure(order: InterpolationOrder, ratio: CycleRatio, traj: &Trajectory) -> S
         order,
         feedforward: FeedforwardSource::Internal,
         velocity_feedforward_percent: 100.0,
-        max_extrapolation_ns: 10_000_000,
+        max_extrapolation: nanos::Nanos::from_ms(10),
     };
     let mut ip = FineInterpolator::new(cfg).expect("config");
     let n = ratio.n() as usize;
@@ -97,7 +97,7 @@ fn ns_per_cycle(order: InterpolationOrder, ratio: CycleRatio) -> f64 {
         order,
         feedforward: FeedforwardSource::Internal,
         velocity_feedforward_percent: 100.0,
-        max_extrapolation_ns: 10_000_000,
+        max_extrapolation: nanos::Nanos::from_ms(10),
     };
     let mut ip = FineInterpolator::new(cfg).expect("config");
     ip.start(0);

@@ -32,6 +32,7 @@
 use crate::cycle::CycleRatio;
 use crate::float;
 use crate::Event;
+use nanos::Nanos;
 
 /// Order of the position interpolation polynomial (I425, spec §10.2).
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
@@ -89,8 +90,8 @@ pub struct InterpolatorConfig {
     pub feedforward: FeedforwardSource,
     /// I25 speed feedforward weight in % (0 … 100; 0 disables, C-120).
     pub velocity_feedforward_percent: f32,
-    /// I423 maximum extrapolation period in ns (C-117).
-    pub max_extrapolation_ns: u64,
+    /// I423 maximum extrapolation period (C-117).
+    pub max_extrapolation: Nanos,
 }
 
 /// One set-point from the master, delivered once per master cycle.
@@ -135,10 +136,10 @@ impl InterpolationFault {
 /// Counts extrapolated time against I423 (shared by both interpolators).
 #[derive(Debug, Clone, Copy)]
 struct ExtrapolationMonitor {
-    /// I423 in ns.
-    limit_ns: u64,
-    /// Time extrapolated since the last real set-point, ns.
-    extrapolated_ns: u64,
+    /// I423.
+    limit: Nanos,
+    /// Time extrapolated since the last real set-point.
+    extrapolated: Nanos,
     /// A set-point has arrived since `start`; before that nothing is counted.
     armed: bool,
     /// Latched fault, cleared only by `start`.
@@ -146,25 +147,27 @@ struct ExtrapolationMonitor {
 }
 
 impl ExtrapolationMonitor {
-    const fn new(limit_ns: u64) -> Self {
+    const fn new(limit: Nanos) -> Self {
         Self {
-            limit_ns,
-            extrapolated_ns: 0,
+            limit,
+            extrapolated: Nanos::ZERO,
             armed: false,
             faulted: false,
         }
     }
 
     fn received(&mut self) {
-        self.extrapolated_ns = 0;
+        self.extrapolated = Nanos::ZERO;
         self.armed = true;
     }
 
     /// One master cycle of `master_ns` is extrapolated.
     fn missed(&mut self, master_ns: u32) -> Result<(), InterpolationFault> {
         if self.armed {
-            self.extrapolated_ns = self.extrapolated_ns.saturating_add(u64::from(master_ns));
-            if self.extrapolated_ns > self.limit_ns {
+            self.extrapolated = self
+                .extrapolated
+                .saturating_add(Nanos::from_ns(u64::from(master_ns)));
+            if self.extrapolated > self.limit {
                 self.faulted = true;
                 return Err(InterpolationFault::ExtrapolationOverrun);
             }
@@ -222,7 +225,7 @@ impl FineInterpolator {
             d3: 0,
             k: 0,
             pending: None,
-            monitor: ExtrapolationMonitor::new(config.max_extrapolation_ns),
+            monitor: ExtrapolationMonitor::new(config.max_extrapolation),
             extrapolating: false,
         };
         s.start(0);
@@ -250,7 +253,7 @@ impl FineInterpolator {
         self.d3 = 0;
         self.k = self.config.ratio.n();
         self.pending = None;
-        self.monitor = ExtrapolationMonitor::new(self.config.max_extrapolation_ns);
+        self.monitor = ExtrapolationMonitor::new(self.config.max_extrapolation);
         self.extrapolating = false;
     }
 
@@ -412,21 +415,21 @@ pub struct VelocityInterpolator {
     pending: Option<f32>,
     monitor: ExtrapolationMonitor,
     extrapolating: bool,
-    max_extrapolation_ns: u64,
+    max_extrapolation: Nanos,
 }
 
 impl VelocityInterpolator {
-    /// A new interpolator at velocity 0; `max_extrapolation_ns` is I423.
-    pub const fn new(ratio: CycleRatio, max_extrapolation_ns: u64) -> Self {
+    /// A new interpolator at velocity 0; `max_extrapolation` is I423.
+    pub const fn new(ratio: CycleRatio, max_extrapolation: Nanos) -> Self {
         Self {
             ratio,
             v1: 0.0,
             v0: 0.0,
             k: ratio.n(),
             pending: None,
-            monitor: ExtrapolationMonitor::new(max_extrapolation_ns),
+            monitor: ExtrapolationMonitor::new(max_extrapolation),
             extrapolating: false,
-            max_extrapolation_ns,
+            max_extrapolation,
         }
     }
 
@@ -438,7 +441,7 @@ impl VelocityInterpolator {
         self.v0 = v;
         self.k = self.ratio.n();
         self.pending = None;
-        self.monitor = ExtrapolationMonitor::new(self.max_extrapolation_ns);
+        self.monitor = ExtrapolationMonitor::new(self.max_extrapolation);
         self.extrapolating = false;
     }
 

@@ -16,7 +16,8 @@
 //! Units: positions are `i32` increments, 2^20 per motor revolution, with
 //! wrap-around (two's complement) arithmetic; velocities in increments per
 //! second, accelerations in increments per second², jerk in increments per
-//! second³ (`f32` at the API). Time is always an argument (nanoseconds).
+//! second³ (`f32` at the API). Time is always an argument: instants and spans as
+//! [`nanos::Nanos`], the control cycle `dt` as `u32` ns (A150).
 #![no_std]
 #![cfg_attr(
     not(test),

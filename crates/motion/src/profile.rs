@@ -20,6 +20,7 @@
 //! full resolution; at the API they are `f32`.
 
 use libm::{floor, sqrt};
+use nanos::Nanos;
 
 /// Limits of one profile (units in increments).
 #[derive(Debug, Clone, Copy, PartialEq)]
@@ -402,8 +403,8 @@ pub struct ProfileGenerator {
     mode: Mode,
     /// The plan of [`Mode::Plan`].
     plan: Plan,
-    /// Time since the plan started, ns.
-    elapsed_ns: u64,
+    /// Time since the plan started.
+    elapsed: Nanos,
     /// Last target position (MC_MoveAdditive reference), increments.
     target: i32,
 }
@@ -416,7 +417,7 @@ impl ProfileGenerator {
             frac: 0.0,
             mode: Mode::Idle,
             plan: Plan::EMPTY,
-            elapsed_ns: 0,
+            elapsed: Nanos::ZERO,
             target: position,
         }
     }
@@ -464,13 +465,13 @@ impl ProfileGenerator {
     }
 
     fn elapsed_s(&self) -> f64 {
-        self.elapsed_ns as f64 * 1e-9
+        self.elapsed.as_secs_f64()
     }
 
     fn start_plan(&mut self, base: i32, frac: f64, plan: Option<Plan>) {
         self.base = base;
         self.frac = frac;
-        self.elapsed_ns = 0;
+        self.elapsed = Nanos::ZERO;
         self.mode = match plan {
             Some(p) => {
                 self.plan = p;
@@ -580,7 +581,7 @@ impl ProfileGenerator {
                 }
             }
             Mode::Plan => {
-                self.elapsed_ns = self.elapsed_ns.saturating_add(u64::from(dt_ns));
+                self.elapsed = self.elapsed.saturating_add(Nanos::from_ns(u64::from(dt_ns)));
                 let t = self.elapsed_s();
                 let p = &self.plan;
                 if t >= p.total {
@@ -635,7 +636,7 @@ impl ProfileGenerator {
                 let (b, f) = split(self.base, self.frac + p.dir * p.x_end + v * over_s);
                 self.base = b;
                 self.frac = f;
-                self.elapsed_ns = 0;
+                self.elapsed = Nanos::ZERO;
                 if v == 0.0 {
                     let at = round_pos(b, f);
                     return idle(self, at);

@@ -16,7 +16,9 @@
 //! falling-edge position stored, bit 6 toggles on every rising-edge capture
 //! and bit 7 on every falling-edge capture in continuous mode.
 //!
-//! Positions are increments; time stamps ns.
+//! Positions are increments; time stamps [`nanos::Nanos`].
+
+use nanos::Nanos;
 
 /// 60B8h/60B9h bit: probe enabled.
 pub const ENABLE: u8 = 1 << 0;
@@ -69,23 +71,23 @@ pub enum TriggerSignal {
 /// A position sample at a control-cycle boundary.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
 pub struct PositionSample {
-    /// Time of the sample, ns.
-    pub time_ns: u64,
+    /// Time of the sample.
+    pub time: Nanos,
     /// Actual position, increments.
     pub position_inc: i32,
 }
 
-/// The position at `edge_time_ns`, linearly interpolated between
+/// The position at `edge_time`, linearly interpolated between
 /// `previous` and `current` (wrap-around difference, rounded to the nearest
 /// increment). Times outside the interval are clamped to it; an empty
 /// interval gives `current`.
-pub fn interpolate_position(previous: PositionSample, current: PositionSample, edge_time_ns: u64) -> i32 {
-    if current.time_ns <= previous.time_ns {
+pub fn interpolate_position(previous: PositionSample, current: PositionSample, edge_time: Nanos) -> i32 {
+    if current.time <= previous.time {
         return current.position_inc;
     }
-    let t = edge_time_ns.max(previous.time_ns).min(current.time_ns);
-    let span = i128::from(current.time_ns - previous.time_ns);
-    let elapsed = i128::from(t - previous.time_ns);
+    let t = edge_time.max(previous.time).min(current.time);
+    let span = i128::from((current.time - previous.time).as_ns());
+    let elapsed = i128::from((t - previous.time).as_ns());
     let delta = i128::from(current.position_inc.wrapping_sub(previous.position_inc));
     // Round half up: floor((2·δ·e + span) / (2·span)).
     let step = (2 * delta * elapsed + span).div_euclid(2 * span);
@@ -290,22 +292,18 @@ impl TouchProbe {
         (one, two)
     }
 
-    /// An `edge` of `signal` time-stamped `edge_time_ns`, with the position
+    /// An `edge` of `signal` time-stamped `edge_time`, with the position
     /// interpolated between the cycle samples `previous` and `current`
     /// ([`interpolate_position`]). Returns which probes stored it.
     pub fn latch_interpolated(
         &mut self,
         signal: TriggerSignal,
         edge: Edge,
-        edge_time_ns: u64,
+        edge_time: Nanos,
         previous: PositionSample,
         current: PositionSample,
     ) -> (bool, bool) {
-        self.latch(
-            signal,
-            edge,
-            interpolate_position(previous, current, edge_time_ns),
-        )
+        self.latch(signal, edge, interpolate_position(previous, current, edge_time))
     }
 }
 
@@ -508,35 +506,41 @@ mod tests {
     #[test]
     fn c122_timestamped_edge_interpolates_between_cycle_samples() {
         let prev = PositionSample {
-            time_ns: 1_000_000,
+            time: Nanos::from_ns(1_000_000),
             position_inc: 10_000,
         };
         let cur = PositionSample {
-            time_ns: 1_250_000,
+            time: Nanos::from_ns(1_250_000),
             position_inc: 11_000,
         };
-        assert_eq!(interpolate_position(prev, cur, 1_000_000), 10_000);
-        assert_eq!(interpolate_position(prev, cur, 1_100_000), 10_400);
-        assert_eq!(interpolate_position(prev, cur, 1_250_000), 11_000);
+        assert_eq!(interpolate_position(prev, cur, Nanos::from_ns(1_000_000)), 10_000);
+        assert_eq!(interpolate_position(prev, cur, Nanos::from_ns(1_100_000)), 10_400);
+        assert_eq!(interpolate_position(prev, cur, Nanos::from_ns(1_250_000)), 11_000);
         // 1/64 µs resolution: 15.625 ns → 0.0625 inc, rounds to 0.
-        assert_eq!(interpolate_position(prev, cur, 1_000_016), 10_000);
-        assert_eq!(interpolate_position(prev, cur, 1_000_125), 10_001);
+        assert_eq!(interpolate_position(prev, cur, Nanos::from_ns(1_000_016)), 10_000);
+        assert_eq!(interpolate_position(prev, cur, Nanos::from_ns(1_000_125)), 10_001);
         // Clamped outside the interval, empty interval gives current.
-        assert_eq!(interpolate_position(prev, cur, 2_000_000), 11_000);
-        assert_eq!(interpolate_position(cur, cur, 0), 11_000);
+        assert_eq!(interpolate_position(prev, cur, Nanos::from_ns(2_000_000)), 11_000);
+        assert_eq!(interpolate_position(cur, cur, Nanos::from_ns(0)), 11_000);
         // Moving backwards across the i32 wrap.
         let prev = PositionSample {
-            time_ns: 0,
+            time: Nanos::from_ns(0),
             position_inc: i32::MIN + 100,
         };
         let cur = PositionSample {
-            time_ns: 250_000,
+            time: Nanos::from_ns(250_000),
             position_inc: i32::MAX - 99,
         };
-        assert_eq!(interpolate_position(prev, cur, 125_000), i32::MIN);
+        assert_eq!(interpolate_position(prev, cur, Nanos::from_ns(125_000)), i32::MIN);
         let mut tp = TouchProbe::new();
         tp.set_function(u16::from(ENABLE | RISING_EDGE));
-        let r = tp.latch_interpolated(TriggerSignal::Input1, Edge::Rising, 187_500, prev, cur);
+        let r = tp.latch_interpolated(
+            TriggerSignal::Input1,
+            Edge::Rising,
+            Nanos::from_ns(187_500),
+            prev,
+            cur,
+        );
         assert_eq!(r, (true, false));
         assert_eq!(tp.value_60ba(), i32::MAX - 49);
     }

@@ -13,9 +13,10 @@
 //!   input of the device control.
 //!
 //! Positions are increments (wrap-around differences), velocities
-//! increments/s, times ns (monotonic `now_ns` arguments).
+//! increments/s, times [`Nanos`] (monotonic `now` arguments).
 
 use crate::Event;
+use nanos::Nanos;
 
 /// Fault event "Following error" (event 54, cause 1), raised by
 /// [`FollowingErrorMonitor`] when configured to fault (the spec names no
@@ -23,9 +24,9 @@ use crate::Event;
 pub const FOLLOWING_ERROR_EVENT: Event = Event { number: 54, cause: 1 };
 
 /// 6066h following error timeout / 6068h position window time (ms, UINT16)
-/// in ns.
-pub const fn ms_to_ns(ms: u16) -> u64 {
-    ms as u64 * 1_000_000
+/// as [`Nanos`].
+pub const fn ms_to_ns(ms: u16) -> Nanos {
+    Nanos::from_ms(ms as u64)
 }
 
 /// Configuration of the following-error monitor.
@@ -34,8 +35,8 @@ pub struct FollowingErrorConfig {
     /// 6065h (A546) following error window in increments; `u32::MAX`
     /// switches the monitoring off (`[std]`).
     pub window_inc: u32,
-    /// 6066h (A547) following error timeout in ns (see [`ms_to_ns`]).
-    pub timeout_ns: u64,
+    /// 6066h (A547) following error timeout (see [`ms_to_ns`]).
+    pub timeout: Nanos,
     /// Raise [`FOLLOWING_ERROR_EVENT`] (fault) when bit 13 comes on;
     /// `false` = statusword bit 13 only (`[std]`).
     pub fault: bool,
@@ -46,7 +47,7 @@ impl Default for FollowingErrorConfig {
     fn default() -> Self {
         Self {
             window_inc: crate::INCREMENTS_PER_REVOLUTION / 4,
-            timeout_ns: ms_to_ns(10),
+            timeout: ms_to_ns(10),
             fault: false,
         }
     }
@@ -67,8 +68,8 @@ pub struct FollowingErrorStatus {
 #[derive(Debug, Clone)]
 pub struct FollowingErrorMonitor {
     config: FollowingErrorConfig,
-    /// Time the error left the window, ns.
-    outside_since_ns: Option<u64>,
+    /// Time the error left the window.
+    outside_since: Option<Nanos>,
     active: bool,
 }
 
@@ -77,7 +78,7 @@ impl FollowingErrorMonitor {
     pub const fn new(config: FollowingErrorConfig) -> Self {
         Self {
             config,
-            outside_since_ns: None,
+            outside_since: None,
             active: false,
         }
     }
@@ -89,7 +90,7 @@ impl FollowingErrorMonitor {
 
     /// Clears bit 13 and the timer (mode change, enable, fault reset).
     pub fn reset(&mut self) {
-        self.outside_since_ns = None;
+        self.outside_since = None;
         self.active = false;
     }
 
@@ -98,23 +99,23 @@ impl FollowingErrorMonitor {
         self.active
     }
 
-    /// Evaluates one cycle at `now_ns`. Bit 13 comes on once the error has
+    /// Evaluates one cycle at `now`. Bit 13 comes on once the error has
     /// stayed outside the window for at least the timeout and goes off as
     /// soon as the error is back inside.
     pub fn update(
         &mut self,
         position_setpoint_inc: i32,
         actual_position_inc: i32,
-        now_ns: u64,
+        now: Nanos,
     ) -> FollowingErrorStatus {
         let error_inc = position_setpoint_inc.wrapping_sub(actual_position_inc);
         let outside = self.config.window_inc != u32::MAX && error_inc.unsigned_abs() > self.config.window_inc;
         let was_active = self.active;
         if outside {
-            let since = *self.outside_since_ns.get_or_insert(now_ns);
-            self.active = now_ns.saturating_sub(since) >= self.config.timeout_ns;
+            let since = *self.outside_since.get_or_insert(now);
+            self.active = now.since(since) >= self.config.timeout;
         } else {
-            self.outside_since_ns = None;
+            self.outside_since = None;
             self.active = false;
         }
         let event = (self.active && !was_active && self.config.fault).then_some(FOLLOWING_ERROR_EVENT);
@@ -133,8 +134,8 @@ pub struct PositionWindowConfig {
     /// window off: target reached as soon as the set-point is at the target
     /// (`[std]`).
     pub window_inc: u32,
-    /// I87 (6068h) time the actual position must stay in the window, ns.
-    pub time_ns: u64,
+    /// I87 (6068h) time the actual position must stay in the window.
+    pub time: Nanos,
 }
 
 impl Default for PositionWindowConfig {
@@ -142,7 +143,7 @@ impl Default for PositionWindowConfig {
     fn default() -> Self {
         Self {
             window_inc: crate::INCREMENTS_PER_REVOLUTION / 360,
-            time_ns: 0,
+            time: Nanos::ZERO,
         }
     }
 }
@@ -151,7 +152,7 @@ impl Default for PositionWindowConfig {
 #[derive(Debug, Clone)]
 pub struct TargetReachedMonitor {
     config: PositionWindowConfig,
-    inside_since_ns: Option<u64>,
+    inside_since: Option<Nanos>,
 }
 
 impl TargetReachedMonitor {
@@ -159,7 +160,7 @@ impl TargetReachedMonitor {
     pub const fn new(config: PositionWindowConfig) -> Self {
         Self {
             config,
-            inside_since_ns: None,
+            inside_since: None,
         }
     }
 
@@ -170,10 +171,10 @@ impl TargetReachedMonitor {
 
     /// Restarts the window time (e.g. on a new set-point).
     pub fn reset(&mut self) {
-        self.inside_since_ns = None;
+        self.inside_since = None;
     }
 
-    /// Bit 10 at `now_ns`: the profile has finished at the target
+    /// Bit 10 at `now`: the profile has finished at the target
     /// (`setpoint_done`, e.g. [`ProfileSample::done`](crate::ProfileSample))
     /// and |target − actual| ≤ I22 has held for at least I87.
     pub fn update(
@@ -181,10 +182,10 @@ impl TargetReachedMonitor {
         target_inc: i32,
         actual_position_inc: i32,
         setpoint_done: bool,
-        now_ns: u64,
+        now: Nanos,
     ) -> bool {
         if !setpoint_done {
-            self.inside_since_ns = None;
+            self.inside_since = None;
             return false;
         }
         if self.config.window_inc == u32::MAX {
@@ -192,11 +193,11 @@ impl TargetReachedMonitor {
         }
         let inside = target_inc.wrapping_sub(actual_position_inc).unsigned_abs() <= self.config.window_inc;
         if !inside {
-            self.inside_since_ns = None;
+            self.inside_since = None;
             return false;
         }
-        let since = *self.inside_since_ns.get_or_insert(now_ns);
-        now_ns.saturating_sub(since) >= self.config.time_ns
+        let since = *self.inside_since.get_or_insert(now);
+        now.since(since) >= self.config.time
     }
 }
 
@@ -205,8 +206,8 @@ impl TargetReachedMonitor {
 pub struct VelocityWindowConfig {
     /// C40 (606Dh) velocity window in increments/s.
     pub window_inc_per_s: f32,
-    /// 606Eh velocity window time in ns.
-    pub time_ns: u64,
+    /// 606Eh velocity window time.
+    pub time: Nanos,
 }
 
 impl Default for VelocityWindowConfig {
@@ -214,7 +215,7 @@ impl Default for VelocityWindowConfig {
     fn default() -> Self {
         Self {
             window_inc_per_s: 0.1 * crate::INCREMENTS_PER_REVOLUTION as f32,
-            time_ns: 0,
+            time: Nanos::ZERO,
         }
     }
 }
@@ -234,7 +235,7 @@ pub struct ProfileVelocityStatus {
 #[derive(Debug, Clone)]
 pub struct VelocityWindowMonitor {
     config: VelocityWindowConfig,
-    inside_since_ns: Option<u64>,
+    inside_since: Option<Nanos>,
 }
 
 impl VelocityWindowMonitor {
@@ -242,7 +243,7 @@ impl VelocityWindowMonitor {
     pub const fn new(config: VelocityWindowConfig) -> Self {
         Self {
             config,
-            inside_since_ns: None,
+            inside_since: None,
         }
     }
 
@@ -253,10 +254,10 @@ impl VelocityWindowMonitor {
 
     /// Restarts the window time.
     pub fn reset(&mut self) {
-        self.inside_since_ns = None;
+        self.inside_since = None;
     }
 
-    /// Evaluates one cycle at `now_ns`: `target_inc_per_s` is 60FFh (the
+    /// Evaluates one cycle at `now`: `target_inc_per_s` is 60FFh (the
     /// final velocity), `setpoint_inc_per_s` the profile's current
     /// (effective) set velocity, `actual_inc_per_s` 606Ch. Non-finite inputs
     /// count as outside every window.
@@ -265,16 +266,16 @@ impl VelocityWindowMonitor {
         target_inc_per_s: f32,
         setpoint_inc_per_s: f32,
         actual_inc_per_s: f32,
-        now_ns: u64,
+        now: Nanos,
     ) -> ProfileVelocityStatus {
         let w = self.config.window_inc_per_s;
         let slip = (setpoint_inc_per_s - actual_inc_per_s).abs();
         let inside = (target_inc_per_s - actual_inc_per_s).abs() <= w;
         let target_reached = if inside {
-            let since = *self.inside_since_ns.get_or_insert(now_ns);
-            now_ns.saturating_sub(since) >= self.config.time_ns
+            let since = *self.inside_since.get_or_insert(now);
+            now.since(since) >= self.config.time
         } else {
-            self.inside_since_ns = None;
+            self.inside_since = None;
             false
         };
         ProfileVelocityStatus {
@@ -295,12 +296,12 @@ pub fn is_standstill(actual_inc_per_s: f32, window_c40_inc_per_s: f32) -> bool {
 mod tests {
     use super::*;
 
-    const MS: u64 = 1_000_000;
+    const MS: Nanos = Nanos::from_ms(1);
 
     fn fe_config(fault: bool) -> FollowingErrorConfig {
         FollowingErrorConfig {
             window_inc: 1000,
-            timeout_ns: ms_to_ns(5),
+            timeout: ms_to_ns(5),
             fault,
         }
     }
@@ -309,40 +310,40 @@ mod tests {
     fn c036_following_error_sets_bit13_after_timeout() {
         let mut m = FollowingErrorMonitor::new(fe_config(false));
         // Inside the window: nothing.
-        let s = m.update(1000, 0, 0);
+        let s = m.update(1000, 0, Nanos::ZERO);
         assert_eq!(s.error_inc, 1000);
         assert!(!s.following_error);
         // Outside from t = 1 ms: bit 13 only at ≥ 6 ms.
         assert!(!m.update(1001, 0, MS).following_error);
-        assert!(!m.update(1500, 0, 5 * MS).following_error);
-        assert!(!m.update(1500, 0, 6 * MS - 1).following_error);
-        let s = m.update(1500, 0, 6 * MS);
+        assert!(!m.update(1500, 0, Nanos::from_ms(5)).following_error);
+        assert!(!m.update(1500, 0, Nanos::from_ns(6_000_000 - 1)).following_error);
+        let s = m.update(1500, 0, Nanos::from_ms(6));
         assert!(s.following_error);
         assert_eq!(s.event, None, "no fault unless configured");
         // Back inside: off at once.
-        assert!(!m.update(0, -999, 7 * MS).following_error);
+        assert!(!m.update(0, -999, Nanos::from_ms(7)).following_error);
     }
 
     #[test]
     fn c036_following_error_timer_restarts_when_back_inside() {
         let mut m = FollowingErrorMonitor::new(fe_config(false));
-        assert!(!m.update(2000, 0, 0).following_error);
-        assert!(!m.update(0, 0, 4 * MS).following_error);
-        assert!(!m.update(-2000, 0, 5 * MS).following_error);
-        assert!(!m.update(-2000, 0, 9 * MS).following_error);
-        assert!(m.update(-2000, 0, 10 * MS).following_error);
+        assert!(!m.update(2000, 0, Nanos::ZERO).following_error);
+        assert!(!m.update(0, 0, Nanos::from_ms(4)).following_error);
+        assert!(!m.update(-2000, 0, Nanos::from_ms(5)).following_error);
+        assert!(!m.update(-2000, 0, Nanos::from_ms(9)).following_error);
+        assert!(m.update(-2000, 0, Nanos::from_ms(10)).following_error);
     }
 
     #[test]
     fn c036_following_error_fault_event_once_when_configured() {
         let mut m = FollowingErrorMonitor::new(fe_config(true));
-        assert_eq!(m.update(5000, 0, 0).event, None);
-        let s = m.update(5000, 0, 5 * MS);
+        assert_eq!(m.update(5000, 0, Nanos::ZERO).event, None);
+        let s = m.update(5000, 0, Nanos::from_ms(5));
         assert!(s.following_error);
         assert_eq!(s.event, Some(FOLLOWING_ERROR_EVENT));
         assert_eq!(s.event.unwrap().number, 54);
         // Still active: no second event.
-        assert_eq!(m.update(5000, 0, 6 * MS).event, None);
+        assert_eq!(m.update(5000, 0, Nanos::from_ms(6)).event, None);
         m.reset();
         assert!(!m.is_active());
     }
@@ -351,69 +352,75 @@ mod tests {
     fn c036_following_error_wraps_and_can_be_switched_off() {
         let mut m = FollowingErrorMonitor::new(fe_config(false));
         // 20 increments across the i32 wrap: inside the window.
-        let s = m.update(i32::MIN + 9, i32::MAX - 10, 0);
+        let s = m.update(i32::MIN + 9, i32::MAX - 10, Nanos::ZERO);
         assert_eq!(s.error_inc, 20);
-        assert!(!m.update(i32::MIN + 9, i32::MAX - 10, 100 * MS).following_error);
+        assert!(
+            !m.update(i32::MIN + 9, i32::MAX - 10, Nanos::from_ms(100))
+                .following_error
+        );
         let mut off = FollowingErrorMonitor::new(FollowingErrorConfig {
             window_inc: u32::MAX,
             ..fe_config(true)
         });
-        assert!(!off.update(i32::MAX, i32::MIN, 0).following_error);
-        assert!(!off.update(i32::MAX, i32::MIN, 100 * MS).following_error);
+        assert!(!off.update(i32::MAX, i32::MIN, Nanos::ZERO).following_error);
+        assert!(
+            !off.update(i32::MAX, i32::MIN, Nanos::from_ms(100))
+                .following_error
+        );
     }
 
     #[test]
     fn c048_target_reached_needs_window_and_time() {
         let mut m = TargetReachedMonitor::new(PositionWindowConfig {
             window_inc: 100,
-            time_ns: 2 * MS,
+            time: Nanos::from_ms(2),
         });
         // Profile still running: never.
-        assert!(!m.update(10_000, 10_000, false, 0));
+        assert!(!m.update(10_000, 10_000, false, Nanos::ZERO));
         // Done but outside the window.
         assert!(!m.update(10_000, 9_800, true, MS));
         // Inside from 2 ms: reached at ≥ 4 ms.
-        assert!(!m.update(10_000, 9_950, true, 2 * MS));
-        assert!(!m.update(10_000, 10_050, true, 3 * MS));
-        assert!(m.update(10_000, 10_100, true, 4 * MS));
+        assert!(!m.update(10_000, 9_950, true, Nanos::from_ms(2)));
+        assert!(!m.update(10_000, 10_050, true, Nanos::from_ms(3)));
+        assert!(m.update(10_000, 10_100, true, Nanos::from_ms(4)));
         // Leaves the window: off, and the time restarts.
-        assert!(!m.update(10_000, 10_101, true, 5 * MS));
-        assert!(!m.update(10_000, 10_000, true, 6 * MS));
-        assert!(m.update(10_000, 10_000, true, 8 * MS));
+        assert!(!m.update(10_000, 10_101, true, Nanos::from_ms(5)));
+        assert!(!m.update(10_000, 10_000, true, Nanos::from_ms(6)));
+        assert!(m.update(10_000, 10_000, true, Nanos::from_ms(8)));
     }
 
     #[test]
     fn c048_target_reached_without_window() {
         let mut m = TargetReachedMonitor::new(PositionWindowConfig {
             window_inc: u32::MAX,
-            time_ns: 2 * MS,
+            time: Nanos::from_ms(2),
         });
-        assert!(!m.update(0, 1_000_000, false, 0));
-        assert!(m.update(0, 1_000_000, true, 0));
+        assert!(!m.update(0, 1_000_000, false, Nanos::ZERO));
+        assert!(m.update(0, 1_000_000, true, Nanos::ZERO));
     }
 
     #[test]
     fn c056_pv_velocity_window_bits() {
         let mut m = VelocityWindowMonitor::new(VelocityWindowConfig {
             window_inc_per_s: 1000.0,
-            time_ns: MS,
+            time: MS,
         });
         // Accelerating: set velocity 20 000, actual 18 000 → slippage, not reached.
-        let s = m.update(50_000.0, 20_000.0, 18_000.0, 0);
+        let s = m.update(50_000.0, 20_000.0, 18_000.0, Nanos::ZERO);
         assert!(!s.target_reached && !s.zero_speed && s.slippage_error);
         // At the target within the window: reached after 606Eh.
         let s = m.update(50_000.0, 50_000.0, 49_500.0, MS);
         assert!(!s.target_reached && !s.slippage_error);
-        let s = m.update(50_000.0, 50_000.0, 50_900.0, 2 * MS);
+        let s = m.update(50_000.0, 50_000.0, 50_900.0, Nanos::from_ms(2));
         assert!(s.target_reached);
         // Target 0 and standing: bit 12.
         let mut m = VelocityWindowMonitor::new(VelocityWindowConfig {
             window_inc_per_s: 1000.0,
-            time_ns: 0,
+            time: Nanos::ZERO,
         });
-        let s = m.update(0.0, 0.0, 10.0, 0);
+        let s = m.update(0.0, 0.0, 10.0, Nanos::ZERO);
         assert!(s.target_reached && s.zero_speed && !s.slippage_error);
-        let s = m.update(0.0, 0.0, f32::NAN, 0);
+        let s = m.update(0.0, 0.0, f32::NAN, Nanos::ZERO);
         assert!(!s.target_reached && !s.zero_speed && s.slippage_error);
     }
 

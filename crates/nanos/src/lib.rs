@@ -7,9 +7,10 @@
 //! firmware never sees it wrap.
 //!
 //! Arithmetic is explicit about the edge: `+` and `-` saturate (a span computed from two
-//! instants in the wrong order is zero, never a huge number and never a panic); the
-//! `wrapping_*` and `checked_*` forms are there where a caller needs them. Conversions to
-//! and from µs/ms/s truncate toward zero and saturate on overflow.
+//! instants in the wrong order is zero, never a huge number and never a panic), and so
+//! does `*` by a count (`3 * cycle`); the `wrapping_*` and `checked_*` forms are there
+//! where a caller needs them. Conversions to and from µs/ms/s truncate toward zero and
+//! saturate on overflow.
 //!
 //! `#![no_std]`, no dependencies, every operation `const` or `#[inline]` and panic-free;
 //! the newtype is `repr(transparent)` and costs nothing over a bare `u64`.
@@ -17,7 +18,7 @@
 #![deny(missing_docs)]
 
 use core::fmt;
-use core::ops::{Add, AddAssign, Sub, SubAssign};
+use core::ops::{Add, AddAssign, Mul, Sub, SubAssign};
 
 /// Nanoseconds: an instant since the caller's epoch, or a span.
 #[derive(Clone, Copy, Default, PartialEq, Eq, PartialOrd, Ord, Hash)]
@@ -213,6 +214,24 @@ impl Sub for Nanos {
     }
 }
 
+/// `span × n`, saturating (as [`Nanos::saturating_mul`]).
+impl Mul<u64> for Nanos {
+    type Output = Nanos;
+    #[inline]
+    fn mul(self, n: u64) -> Nanos {
+        self.saturating_mul(n)
+    }
+}
+
+/// `n × span`, saturating (as [`Nanos::saturating_mul`]): `200 * MS`.
+impl Mul<Nanos> for u64 {
+    type Output = Nanos;
+    #[inline]
+    fn mul(self, span: Nanos) -> Nanos {
+        span.saturating_mul(self)
+    }
+}
+
 impl AddAssign for Nanos {
     #[inline]
     fn add_assign(&mut self, rhs: Nanos) {
@@ -285,6 +304,10 @@ mod tests {
         c += b;
         c -= Nanos::from_ns(20);
         assert_eq!(c, Nanos::ZERO);
+        let ms = Nanos::from_ms(1);
+        assert_eq!(3 * ms, Nanos::from_ms(3));
+        assert_eq!(ms * 3, Nanos::from_ms(3));
+        assert_eq!(u64::MAX * ms, Nanos::MAX);
     }
 
     #[test]

@@ -1,8 +1,8 @@
 //! SNTP client (RFC 4330, spec §10), sans-IO: it says when to send which
 //! request to which server and takes the answers; the socket is the
 //! stack's ([`crate::NetStack`]). Time is always an argument (`now_us`, the
-//! drive's local monotonic clock since power-on).
-//!
+//! drive's local monotonic clock since power-on, in whole µs; [`crate::NetStack`]
+//! takes it as [`Nanos`] and hands the client `now.as_us()`).//!
 //! - First request after a random delay of 1–5 min (E-105), then every
 //!   5–6 h (random within) to the same server (E-106).
 //! - A server that does not answer within [`RESPONSE_TIMEOUT_US`] or
@@ -12,6 +12,8 @@
 //! - Each answer gives the clock offset; the first one sets the clock, the
 //!   following ones also trim its rate (E-102). [`SntpClient::time_ns`]
 //!   is the disciplined clock.
+
+use nanos::Nanos;
 
 /// Length of an SNTP packet.
 pub const PACKET_LEN: usize = 48;
@@ -343,11 +345,11 @@ pub const DC_EPOCH_UNIX_S: u64 = 946_684_800;
 /// The time stamp of a message (spec §17, E-147), ns since 2000-01-01 (the
 /// DC system time's epoch): the DC system time when the drive is
 /// DC-synchronised, else the SNTP time (Unix ns), else 0.
-pub fn message_time_stamp(dc_synced_ns: Option<u64>, sntp_unix_ns: Option<u64>) -> u64 {
-    match (dc_synced_ns, sntp_unix_ns) {
+pub fn message_time_stamp(dc_synced: Option<Nanos>, sntp_unix: Option<Nanos>) -> Nanos {
+    match (dc_synced, sntp_unix) {
         (Some(dc), _) => dc,
-        (None, Some(unix)) => unix.saturating_sub(DC_EPOCH_UNIX_S * 1_000_000_000),
-        (None, None) => 0,
+        (None, Some(unix)) => unix.saturating_sub(Nanos::from_secs(DC_EPOCH_UNIX_S)),
+        (None, None) => Nanos::ZERO,
     }
 }
 
@@ -483,12 +485,12 @@ mod tests {
     #[test]
     fn e147_time_stamp_dc_then_sntp_then_zero() {
         assert_eq!(
-            message_time_stamp(Some(5), Some(7 * 1_000_000_000_000_000_000)),
-            5
+            message_time_stamp(Some(Nanos::from_ns(5)), Some(Nanos::from_secs(7_000_000_000))),
+            Nanos::from_ns(5)
         );
-        let unix = (DC_EPOCH_UNIX_S + 10) * 1_000_000_000;
-        assert_eq!(message_time_stamp(None, Some(unix)), 10_000_000_000);
-        assert_eq!(message_time_stamp(None, None), 0);
+        let unix = Nanos::from_secs(DC_EPOCH_UNIX_S + 10);
+        assert_eq!(message_time_stamp(None, Some(unix)), Nanos::from_secs(10));
+        assert_eq!(message_time_stamp(None, None), Nanos::ZERO);
     }
 
     #[test]

@@ -8,6 +8,7 @@ use crate::param::{self, MAX_MESSAGE, PARAM_PORT};
 use crate::sntp::{self, Ipv4, SntpClient, SntpConfig, NTP_PORT};
 use ecat::eoe::{prefix_len, IpParams};
 use ecat::eoe_queue::EoeQueue;
+use nanos::Nanos;
 use od::{CommState, Dictionary};
 use smoltcp::iface::{Config, Interface, SocketHandle, SocketSet, SocketStorage};
 use smoltcp::socket::{dhcpv4, udp};
@@ -120,8 +121,9 @@ pub struct NetStack<'a> {
     stats: NetStats,
 }
 
-fn instant(now_us: u64) -> Instant {
-    Instant::from_micros(i64::try_from(now_us).unwrap_or(i64::MAX))
+/// smoltcp's time: whole µs (truncated, as the callers did before they passed [`Nanos`]).
+fn instant(now: Nanos) -> Instant {
+    Instant::from_micros(i64::try_from(now.as_us()).unwrap_or(i64::MAX))
 }
 
 fn addr(a: Ipv4) -> Ipv4Address {
@@ -136,17 +138,17 @@ pub fn is_unicast(a: Ipv4) -> bool {
 }
 
 impl<'a> NetStack<'a> {
-    /// The stack at local time `now_us` on `queue`, without an address.
+    /// The stack at local time `now` on `queue`, without an address.
     pub fn new(
         cfg: NetConfig,
         bufs: &'a mut NetBuffers,
         slots: &'a mut SocketSlots<'a>,
         queue: &mut EoeQueue,
-        now_us: u64,
+        now: Nanos,
     ) -> Self {
         let mut c = Config::new(HardwareAddress::Ethernet(EthernetAddress(cfg.mac)));
         c.random_seed = cfg.seed;
-        let iface = Interface::new(c, &mut QueueDevice(queue), instant(now_us));
+        let iface = Interface::new(c, &mut QueueDevice(queue), instant(now));
         let mut sockets = SocketSet::new(slots.as_mut_slice());
         let NetBuffers {
             param_rx_meta,
@@ -209,10 +211,10 @@ impl<'a> NetStack<'a> {
         &self.sntp
     }
 
-    /// The SNTP time at local `now_us`, ns since the Unix epoch (`None`
-    /// until a server answered).
-    pub fn sntp_time_ns(&self, now_us: u64) -> Option<u64> {
-        self.sntp.time_ns(now_us)
+    /// The SNTP time at local `now`, since the Unix epoch (`None` until a
+    /// server answered).
+    pub fn sntp_time(&self, now: Nanos) -> Option<Nanos> {
+        self.sntp.time_ns(now.as_us()).map(Nanos::from_ns)
     }
 
     /// Counters.
@@ -312,12 +314,12 @@ impl<'a> NetStack<'a> {
         }
     }
 
-    /// One pass at local time `now_us`: frames in and out of `queue`, the
+    /// One pass at local time `now`: frames in and out of `queue`, the
     /// parameter requests answered through `dict` in `state`, the SNTP
     /// schedule. Call it after each poll of the slave stack.
     pub fn poll<D: Dictionary + ?Sized>(
         &mut self,
-        now_us: u64,
+        now: Nanos,
         queue: &mut EoeQueue,
         dict: &mut D,
         state: CommState,
@@ -333,12 +335,12 @@ impl<'a> NetStack<'a> {
             queue.clear();
             return;
         }
-        let t = instant(now_us);
+        let t = instant(now);
         self.iface.poll(t, &mut QueueDevice(queue), &mut self.sockets);
         self.run_dhcp();
         self.follow_gateway(settings);
         self.serve_parameters(dict, state);
-        self.run_sntp(now_us, settings);
+        self.run_sntp(now.as_us(), settings);
         self.iface.poll(t, &mut QueueDevice(queue), &mut self.sockets);
     }
 
@@ -387,14 +389,15 @@ impl<'a> NetStack<'a> {
         }
     }
 
-    /// When the stack wants to be polled next at the latest (local µs):
-    /// smoltcp's timers and the SNTP schedule.
-    pub fn poll_at_us(&mut self, now_us: u64) -> u64 {
+    /// When the stack wants to be polled next at the latest (local time, whole
+    /// µs): smoltcp's timers and the SNTP schedule.
+    pub fn poll_at(&mut self, now: Nanos) -> Nanos {
+        let now_us = now.as_us();
         let iface = self
             .iface
-            .poll_at(instant(now_us), &self.sockets)
+            .poll_at(instant(now), &self.sockets)
             .map_or(u64::MAX, |t| u64::try_from(t.total_micros()).unwrap_or(0));
-        iface.min(self.sntp.next_request_us()).max(now_us)
+        Nanos::from_us(iface.min(self.sntp.next_request_us()).max(now_us))
     }
 }
 
@@ -421,7 +424,7 @@ mod tests {
             mac: [2, 0, 0, 0, 0, 1],
             seed: 1,
         };
-        let mut net = NetStack::new(cfg, &mut bufs, &mut slots, &mut q, 0);
+        let mut net = NetStack::new(cfg, &mut bufs, &mut slots, &mut q, Nanos::ZERO);
         let mut d = DriveObjects::new();
         let good = IpParams {
             ip: Some([10, 0, 0, 5]),
@@ -434,7 +437,7 @@ mod tests {
             tunnel_open: true,
             ..NetSettings::default()
         };
-        net.poll(1, &mut q, &mut d, CommState::PreOp, &s);
+        net.poll(Nanos::from_us(1), &mut q, &mut d, CommState::PreOp, &s);
         assert_eq!(net.ip(), Some(([10, 0, 0, 5], 24)));
         assert_eq!(net.gateway(), Some([10, 0, 0, 1]));
         // multicast / broadcast address, gateway and MAC: the old ones stay
@@ -457,7 +460,7 @@ mod tests {
             tunnel_open: true,
         };
         for t in [2, 400_000_000, 800_000_000] {
-            net.poll(t, &mut q, &mut d, CommState::PreOp, &s);
+            net.poll(Nanos::from_us(t), &mut q, &mut d, CommState::PreOp, &s);
         }
         assert_eq!(net.ip(), Some(([10, 0, 0, 5], 24)));
         assert_eq!(net.mac(), [2, 0, 0, 0, 0, 1]);

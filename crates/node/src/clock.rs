@@ -7,6 +7,7 @@
 //! Time is an argument to the core crates: only the RTIC shell reads this.
 
 use drive::runtime::dcsync::{div_rem_u64, gcd};
+use nanos::Nanos;
 
 /// Extends a wrapping 32-bit tick counter of `hz` to monotonic ns.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
@@ -32,15 +33,15 @@ impl Clock {
         }
     }
 
-    /// The time at counter value `raw`, ns since the counter's first reading
-    /// of 0. Readings must come at least once per counter wrap.
-    pub fn now_ns(&mut self, raw: u32) -> u64 {
+    /// The time at counter value `raw`, since the counter's first reading of 0.
+    /// Readings must come at least once per counter wrap.
+    pub fn now(&mut self, raw: u32) -> Nanos {
         self.ticks = self
             .ticks
             .wrapping_add(u64::from(raw.wrapping_sub(self.last_raw)));
         self.last_raw = raw;
         // 144 MHz: 64 bits for 32 years of ticks, then 128 out of line
-        mul_div(self.ticks, self.ns_num, self.tick_den).0
+        Nanos::from_ns(mul_div(self.ticks, self.ns_num, self.tick_den).0)
     }
 }
 
@@ -90,7 +91,7 @@ mod tests {
             ] {
                 c.ticks = ticks;
                 c.last_raw = 0;
-                let got = c.now_ns(0);
+                let got = c.now(0).as_ns();
                 let want = u64::try_from(u128::from(ticks) * 1_000_000_000 / hz).unwrap_or(u64::MAX);
                 assert_eq!(got, want, "{hz} Hz, {ticks} ticks");
             }

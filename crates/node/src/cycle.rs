@@ -1,22 +1,24 @@
 //! The control-cycle timer.
 //!
 //! Without SYNC0 the control cycle runs free at A150
-//! ([`Drive::free_run_period_ns`](drive::runtime::Drive::free_run_period_ns);
-//! the first cycle at [`CYCLE_NS`]). Once
+//! ([`Drive::free_run_period`](drive::runtime::Drive::free_run_period);
+//! the first cycle at [`CYCLE`]). Once
 //! the drive's DC-Sync PLL exists, each cycle's [`CycleCommand`](drive::runtime::dcsync::CycleCommand) gives the
 //! length of the next one in timer ticks ([`TIMER_HZ`]): the board programs
-//! its compare register from [`CycleTimer::next_at_ns`] (the QEMU world pends
+//! its compare register from [`CycleTimer::next_at`] (the QEMU world pends
 //! the control interrupt at that time).
 
 use drive::axis::{AxisCommand, AxisIo};
 use drive::runtime::TIMER_HZ;
 
+use nanos::Nanos;
+
 use crate::clock::mul_div;
 use crate::Drive;
 
-/// The first free-running control cycle starts at this local time, ns
-/// (A150's default); the next ones follow A150.
-pub const CYCLE_NS: u64 = drive::params::A150_FALLBACK_US as u64 * 1000;
+/// The first free-running control cycle starts at this local time (A150's
+/// default); the next ones follow A150.
+pub const CYCLE: Nanos = Nanos::from_us(drive::params::A150_FALLBACK_US as u64);
 
 const NS_PER_S: u64 = 1_000_000_000;
 
@@ -32,14 +34,14 @@ fn mul_div_ceil(a: u64, b: u64, c: u64) -> u64 {
     q.saturating_add(u64::from(remainder))
 }
 
-/// Local time of timer tick `tick`, ns (rounded up: the tick is reached then).
-fn tick_ns(tick: u64) -> u64 {
-    mul_div_ceil(tick, NS_DEN, TICK_NUM)
+/// Local time of timer tick `tick` (rounded up to the ns: the tick is reached then).
+fn tick_time(tick: u64) -> Nanos {
+    Nanos::from_ns(mul_div_ceil(tick, NS_DEN, TICK_NUM))
 }
 
-/// The tick at or after local time `ns`.
-fn ns_tick(ns: u64) -> u64 {
-    mul_div_ceil(ns, TICK_NUM, NS_DEN)
+/// The tick at or after local time `t`.
+fn tick_at(t: Nanos) -> u64 {
+    mul_div_ceil(t.as_ns(), TICK_NUM, NS_DEN)
 }
 
 /// When the next control cycle starts and how it runs.
@@ -47,8 +49,8 @@ fn ns_tick(ns: u64) -> u64 {
 pub struct CycleTimer {
     /// The next start in timer ticks while the PLL runs.
     next_tick: Option<u64>,
-    /// The next start in local ns while free-running.
-    next_ns: u64,
+    /// The next start in local time while free-running.
+    next: Nanos,
 }
 
 impl Default for CycleTimer {
@@ -58,19 +60,19 @@ impl Default for CycleTimer {
 }
 
 impl CycleTimer {
-    /// Free-running, first cycle at [`CYCLE_NS`].
+    /// Free-running, first cycle at [`CYCLE`].
     pub const fn new() -> Self {
         Self {
             next_tick: None,
-            next_ns: CYCLE_NS,
+            next: CYCLE,
         }
     }
 
-    /// Local time of the next cycle start, ns.
-    pub fn next_at_ns(&self) -> u64 {
+    /// Local time of the next cycle start.
+    pub fn next_at(&self) -> Nanos {
         match self.next_tick {
-            Some(tick) => tick_ns(tick),
-            None => self.next_ns,
+            Some(tick) => tick_time(tick),
+            None => self.next,
         }
     }
 
@@ -79,30 +81,30 @@ impl CycleTimer {
     /// and the ESC task.
     pub fn follow_pll(&mut self, drive: &Drive) {
         match (drive.pll().is_some(), self.next_tick) {
-            (true, None) => self.next_tick = Some(ns_tick(self.next_ns)),
+            (true, None) => self.next_tick = Some(tick_at(self.next)),
             (false, Some(_)) => {
-                self.next_ns = self.next_at_ns();
+                self.next = self.next_at();
                 self.next_tick = None;
             }
             _ => {}
         }
     }
 
-    /// Runs the control cycle due at local time `now_ns` (the timer's
+    /// Runs the control cycle due at local time `now` (the timer's
     /// compare time): under the PLL its cycle command
     /// (steps in the A149 order, Rx/Tx in the aligned cycle), else a
     /// free-running cycle; programs the next start. Returns the power-stage
     /// commands.
-    pub fn run(&mut self, drive: &mut Drive, now_ns: u64, io: &[AxisIo; 2]) -> [AxisCommand; 2] {
+    pub fn run(&mut self, drive: &mut Drive, now: Nanos, io: &[AxisIo; 2]) -> [AxisCommand; 2] {
         if let Some(tick) = self.next_tick {
-            if let Some(cmd) = drive.cycle_start(tick_ns(tick)) {
+            if let Some(cmd) = drive.cycle_start(tick_time(tick)) {
                 self.next_tick = Some(tick.saturating_add(u64::from(cmd.period_ticks.max(1))));
-                return drive.sync_cycle(&cmd, now_ns, io);
+                return drive.sync_cycle(&cmd, now, io);
             }
             self.next_tick = None;
         }
-        self.next_ns = now_ns.saturating_add(drive.free_run_period_ns());
-        drive.control_cycle(now_ns, io)
+        self.next = now.saturating_add(drive.free_run_period());
+        drive.control_cycle(now, io)
     }
 }
 
@@ -128,9 +130,9 @@ mod tests {
             u64::MAX / 200,
         ] {
             let t = u64::try_from((u128::from(v) * ns).div_ceil(hz)).unwrap_or(u64::MAX);
-            assert_eq!(tick_ns(v), t, "tick {v}");
+            assert_eq!(tick_time(v), Nanos::from_ns(t), "tick {v}");
             let n = u64::try_from((u128::from(v) * hz).div_ceil(ns)).unwrap_or(u64::MAX);
-            assert_eq!(ns_tick(v), n, "ns {v}");
+            assert_eq!(tick_at(Nanos::from_ns(v)), n, "ns {v}");
         }
     }
 }

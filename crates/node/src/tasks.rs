@@ -18,32 +18,33 @@ use core::borrow::BorrowMut;
 use drive::axis::{AxisCommand, AxisIo};
 use ecat::StateChange;
 use esc::{regs, Pdi, PdiExt};
+use nanos::Nanos;
 use rtic_core::Mutex;
 
 use crate::cycle::CycleTimer;
 use crate::Drive;
 
-/// SYNC0 at local time `now_ns`: reads 0x098E (acknowledges the pulse in
+/// SYNC0 at local time `now`: reads 0x098E (acknowledges the pulse in
 /// the ESC), hands the edge to the PLL and lets the timer follow it.
 pub fn sync0<P: Pdi>(
     drive: &mut Drive,
     timer: &mut CycleTimer,
     pdi: &mut P,
-    now_ns: u64,
+    now: Nanos,
 ) -> Result<(), P::Error> {
     let _ack = pdi.read_u8(regs::dc::SYNC0_STATUS)?;
-    drive.on_sync0(pdi, now_ns)?;
+    drive.on_sync0(pdi, now)?;
     timer.follow_pll(drive);
     Ok(())
 }
 
-/// The control-cycle timer fired at local time `now_ns`: one cycle of both
+/// The control-cycle timer fired at local time `now`: one cycle of both
 /// axes with the hardware inputs `io`; returns the power-stage commands.
-pub fn control(drive: &mut Drive, timer: &mut CycleTimer, now_ns: u64, io: &[AxisIo; 2]) -> [AxisCommand; 2] {
-    timer.run(drive, now_ns, io)
+pub fn control(drive: &mut Drive, timer: &mut CycleTimer, now: Nanos, io: &[AxisIo; 2]) -> [AxisCommand; 2] {
+    timer.run(drive, now, io)
 }
 
-/// The ESC's PDI interrupt at local time `now_ns`: an SM2 frame is handed to
+/// The ESC's PDI interrupt at local time `now`: an SM2 frame is handed to
 /// the PLL's frame timing (A261), then the slave stack runs once (AL
 /// control, process data, monitoring; the mailbox is the [`mailbox`]
 /// task's). Returns the ESM change.
@@ -51,21 +52,21 @@ pub fn esc_event<P: Pdi>(
     drive: &mut Drive,
     timer: &mut CycleTimer,
     pdi: &mut P,
-    now_ns: u64,
+    now: Nanos,
 ) -> Result<Option<StateChange>, P::Error> {
     if pdi.al_event()? & regs::al_event::sm(2) != 0 {
-        let _ = drive.on_frame(now_ns);
+        let _ = drive.on_frame(now);
     }
-    let change = drive.poll_esc(pdi, now_ns)?;
+    let change = drive.poll_esc(pdi, now)?;
     timer.follow_pll(drive);
     Ok(change)
 }
 
-/// The mailbox task at local time `now_ns` (pended by the ESC task, runs
+/// The mailbox task at local time `now` (pended by the ESC task, runs
 /// below it): one mailbox request from SM0 answered into SM1, queued EMCYs
 /// and EoE fragments sent.
-pub fn mailbox<P: Pdi>(drive: &mut Drive, pdi: &mut P, now_ns: u64) -> Result<(), P::Error> {
-    drive.poll_mailbox(pdi, now_ns)
+pub fn mailbox<P: Pdi>(drive: &mut Drive, pdi: &mut P, now: Nanos) -> Result<(), P::Error> {
+    drive.poll_mailbox(pdi, now)
 }
 
 /// Background work from the idle loop: a save requested over the bus (A00,

@@ -5,8 +5,9 @@
 use hil_sim::esc::Esc;
 use hil_sim::script::Progress;
 use hil_sim::world::{new_esc, Event, World};
+use nanos::Nanos;
 use node::clock::Clock;
-use node::cycle::{CycleTimer, CYCLE_NS};
+use node::cycle::{CycleTimer, CYCLE};
 use node::{tasks, Drive, ParamFlash};
 use rtic_core::Exclusive;
 
@@ -36,8 +37,8 @@ impl Board {
             if self.world.finished().is_some() {
                 break;
             }
-            let event = self.world.next(self.esc.next_sync0_at(), self.timer.next_at_ns());
-            let now = self.world.now_ns();
+            let event = self.world.next(self.esc.next_sync0_at(), self.timer.next_at());
+            let now = self.world.now();
             match event {
                 Event::Sync0 => {
                     let _ = self.esc.take_sync0_events(now);
@@ -47,7 +48,7 @@ impl Board {
                     let io = self.world.io();
                     let cmd = tasks::control(&mut self.drive, &mut self.timer, now, &io);
                     pll_cycles += u32::from(self.drive.pll().is_some_and(|p| p.is_locked()));
-                    self.world.actuate(&cmd, CYCLE_NS);
+                    self.world.actuate(&cmd, CYCLE);
                 }
                 Event::Frame => {
                     let p = self.world.frame(&mut self.esc);
@@ -102,18 +103,18 @@ fn e107_task_bodies_run_the_end_to_end_sequence_on_the_pll() {
 #[test]
 fn clock_counts_across_counter_wraps() {
     let mut c = Clock::new(144_000_000);
-    assert_eq!(c.now_ns(0), 0);
-    assert_eq!(c.now_ns(144_000), 1_000_000);
+    assert_eq!(c.now(0), Nanos::ZERO);
+    assert_eq!(c.now(144_000), Nanos::from_ms(1));
     // five readings three quarters of the counter range apart: past three wraps
     let mut raw = 144_000u32;
-    let mut t = 0;
+    let mut t = Nanos::ZERO;
     for _ in 0..5 {
         raw = raw.wrapping_add(3 << 30);
-        t = c.now_ns(raw);
+        t = c.now(raw);
     }
     let ticks = 144_000u64 + 5 * (3u64 << 30);
     assert!(ticks > 3 * (1u64 << 32));
-    assert_eq!(t, ticks * 1_000_000_000 / 144_000_000);
+    assert_eq!(t, Nanos::from_ns(ticks * 1_000_000_000 / 144_000_000));
 }
 
 /// E-107 free run: without SYNC0 the control cycle runs at A150, the next
@@ -123,23 +124,23 @@ fn clock_counts_across_counter_wraps() {
 fn e107_e125_free_run_cycle_at_a150_without_sync0() {
     let mut drive = Drive::new(ParamFlash::new());
     let mut timer = CycleTimer::new();
-    assert_eq!(timer.next_at_ns(), CYCLE_NS);
+    assert_eq!(timer.next_at(), CYCLE);
     let io = [drive::axis::AxisIo::ready(0); 2];
-    tasks::control(&mut drive, &mut timer, CYCLE_NS, &io);
-    assert_eq!(timer.next_at_ns(), 2 * CYCLE_NS);
-    tasks::control(&mut drive, &mut timer, 2 * CYCLE_NS + 10, &io);
-    assert_eq!(timer.next_at_ns(), 3 * CYCLE_NS + 10);
+    tasks::control(&mut drive, &mut timer, CYCLE, &io);
+    assert_eq!(timer.next_at(), 2 * CYCLE);
+    tasks::control(&mut drive, &mut timer, 2 * CYCLE + Nanos::from_ns(10), &io);
+    assert_eq!(timer.next_at(), 3 * CYCLE + Nanos::from_ns(10));
     // E-125: the free-running period follows A150 (the axes' dt), 250 µs … 8 ms
     for a150_us in [250, 500, 2000, 4000, 8000] {
         drive
             .objects_mut()
             .set(drive::parameter_index(0, 150), 0, a150_us)
             .unwrap();
-        let now = timer.next_at_ns();
+        let now = timer.next_at();
         tasks::control(&mut drive, &mut timer, now, &io);
         assert_eq!(
-            timer.next_at_ns(),
-            now + a150_us as u64 * 1000,
+            timer.next_at(),
+            now + Nanos::from_us(a150_us as u64),
             "A150 = {a150_us} µs"
         );
     }
@@ -170,7 +171,7 @@ fn e018_save_is_written_by_the_background_task() {
         .objects_mut()
         .write(0x1010, 1, &save, od::CommState::PreOp)
         .unwrap();
-    tasks::mailbox(&mut b.drive, &mut b.esc.pdi(), 0).unwrap();
+    tasks::mailbox(&mut b.drive, &mut b.esc.pdi(), Nanos::ZERO).unwrap();
     assert!(b.drive.objects().requests().save, "the mailbox task saved");
     tasks::background(&mut Exclusive(&mut b.drive));
     assert!(!b.drive.objects().requests().save);
@@ -198,7 +199,7 @@ fn e018_save_job_writes_the_flash_outside_the_drive() {
     // the drive runs on meanwhile; a new value and a new request wait
     let io = [drive::axis::AxisIo::ready(0); 2];
     for k in 1..=3u64 {
-        tasks::control(&mut b.drive, &mut b.timer, k * 1_000_000, &io);
+        tasks::control(&mut b.drive, &mut b.timer, Nanos::from_ms(k), &io);
     }
     b.drive.objects_mut().set(0x6065, 0, 999).unwrap();
     request(&mut b.drive);

@@ -134,11 +134,12 @@ mod app {
     use cortex_m::peripheral::syst::SystClkSource;
     use cortex_m_semihosting::debug;
     use drive::axis::{AxisCommand, AxisIo};
-    use firmware::cycle::{CycleTimer, CYCLE_NS};
+    use firmware::cycle::{CycleTimer, CYCLE};
     use firmware::world::{new_esc, Event, World};
     use firmware::{tasks, Drive, ParamFlash};
     use hil_sim::esc::Esc;
     use hil_sim::script::Progress;
+    use nanos::Nanos;
     use stm32f4::stm32f405::Interrupt;
 
     #[shared]
@@ -148,8 +149,8 @@ mod app {
         timer: CycleTimer,
         /// The simulated ESC (on the board: the chip behind the PDI).
         esc: &'static mut Esc,
-        /// The firmware's clock: the world's simulated time, ns.
-        clock: u64,
+        /// The firmware's clock: the world's simulated time.
+        clock: Nanos,
         /// Hardware inputs of the next control cycle / its power-stage commands.
         io: [AxisIo; 2],
         cmd: [AxisCommand; 2],
@@ -186,7 +187,7 @@ mod app {
                 drive,
                 timer: CycleTimer::new(),
                 esc,
-                clock: 0,
+                clock: Nanos::ZERO,
                 io: [AxisIo::ready(0); 2],
                 cmd: [AxisCommand::OFF; 2],
                 cost: [0; 2],
@@ -251,9 +252,9 @@ mod app {
                 break false;
             }
             let sync0 = cx.shared.esc.lock(|e| e.next_sync0_at());
-            let next_cycle = cx.shared.timer.lock(|t| t.next_at_ns());
+            let next_cycle = cx.shared.timer.lock(|t| t.next_at());
             let event = world.next(sync0, next_cycle);
-            let now = world.now_ns();
+            let now = world.now();
             cx.shared.clock.lock(|c| *c = now);
             match event {
                 Event::Sync0 => {
@@ -269,7 +270,7 @@ mod app {
                     run(Interrupt::EXTI1);
                     stack[1] = stack[1].max(measure::used());
                     let cmd = cx.shared.cmd.lock(|c| *c);
-                    world.actuate(&cmd, CYCLE_NS);
+                    world.actuate(&cmd, CYCLE);
                     if moving {
                         control.add(insn(cx.shared.cost.lock(|c| c[0])));
                     }

@@ -6,14 +6,15 @@ use super::args::{create_output, DemoArgs, DEFAULT_PLOT};
 use super::print_new_changes;
 use hil_sim::motor::PositionInput;
 use hil_sim::sim::Simulation;
+use nanos::Nanos;
 use std::cell::RefCell;
 use std::path::PathBuf;
 use std::sync::atomic::Ordering;
 
 /// Position of axis A's reference switch, increments (a quarter revolution).
 const REFERENCE_SWITCH_INC: i64 = 1 << 18;
-/// Master cycle of the demo, ns (DC-style: one frame per cycle, clock advanced by it).
-const MASTER_CYCLE_NS: u64 = 1_000_000;
+/// Master cycle of the demo (DC-style: one frame per cycle, clock advanced by it).
+const MASTER_CYCLE: Nanos = Nanos::from_ms(1);
 /// Increments per revolution.
 const INC_PER_REV: f64 = 1_048_576.0;
 
@@ -63,9 +64,9 @@ fn read_inputs(group: &Group<'_>, md: &ethercrab::MainDevice<'_>) -> Result<Inpu
     })
 }
 
-/// Where in the drive's control cycle the master's frame arrives, ns (a DC
-/// shift: the frame lands mid-cycle, never on a cycle boundary).
-const FRAME_PHASE_NS: u64 = MASTER_CYCLE_NS / 2;
+/// Where in the drive's control cycle the master's frame arrives (a DC shift:
+/// the frame lands mid-cycle, never on a cycle boundary).
+const FRAME_PHASE: Nanos = Nanos::from_us(500);
 
 /// One master cycle, DC-style: the clock advances to the next cycle start
 /// (multiples of the master cycle plus a fixed phase, so master and drive
@@ -75,8 +76,12 @@ async fn cycle(
     md: &ethercrab::MainDevice<'_>,
     sim: &RefCell<Simulation>,
 ) -> Result<Inputs, String> {
-    let now = sim.borrow().now_ns();
-    let t = (now.saturating_sub(FRAME_PHASE_NS) / MASTER_CYCLE_NS + 1) * MASTER_CYCLE_NS + FRAME_PHASE_NS;
+    let now = sim.borrow().now();
+    let k = now
+        .saturating_sub(FRAME_PHASE)
+        .checked_div_span(MASTER_CYCLE)
+        .unwrap_or(0);
+    let t = (k + 1) * MASTER_CYCLE + FRAME_PHASE;
     sim.borrow_mut().advance_to(t);
     group.tx_rx(md).await.map_err(|e| format!("cycle: {e}"))?;
     read_inputs(group, md)
@@ -177,7 +182,7 @@ async fn motion_demo(
         let target = p0.wrapping_add((x * dist).round() as i32);
         write_outputs(group, md, 0x0F, 8, target)?;
         i = cycle(group, md, sim).await?;
-        trace.push(sim.borrow().now_ns(), target, i.pos, i.vel, i.torque, i.ferr);
+        trace.push(sim.borrow().now(), target, i.pos, i.vel, i.torque, i.ferr);
         bar.inc(1);
     }
     bar.finish_and_clear();
@@ -290,7 +295,7 @@ pub fn demo(args: &DemoArgs) -> Result<(), String> {
     println!(
         "{} frames in {:.3} ms of simulated time",
         s.frames(),
-        s.now_ns() as f64 / 1e6
+        s.now().as_ns() as f64 / 1e6
     );
     result
 }

@@ -9,18 +9,19 @@
 //! by one, one firmware poll) and only then processes the frame, so the
 //! drive sees the frame when it arrived, however long `serve` took to get to it (a wait, a
 //! busy machine, `--delay-us`). While no frame waits, the simulation is kept
-//! at the wall clock (less [`IDLE_LAG_NS`]) every [`IDLE_WAIT`] (or
+//! at the wall clock (less [`IDLE_LAG`]) every [`IDLE_WAIT`] (or
 //! continuously with `--busy-poll`), so an arriving frame finds little left
 //! to simulate and is answered at once. Frames that queued up are processed
 //! in order, each at its own receive time; one whose time the simulation has
 //! already passed (it arrived while the simulation was being caught up) is
 //! processed at once, and counted in the summary when that was more than
-//! [`LATE_NOTE_NS`] late.
+//! [`LATE_NOTE`] late.
 
 use super::args::ServeArgs;
 use super::print_new_changes;
-use hil_sim::raw::{monotonic_ns, RawSocket};
+use hil_sim::raw::{monotonic, RawSocket};
 use hil_sim::sim::{SimDrive, Simulation};
+use nanos::Nanos;
 use std::sync::atomic::{AtomicBool, Ordering};
 use std::time::Duration;
 
@@ -48,18 +49,18 @@ fn stop_on_signals() {
 /// up with the wall clock at least this often.
 pub const IDLE_WAIT: Duration = Duration::from_micros(100);
 
-/// Between frames the simulation stays this far behind the wall clock, ns: a
+/// Between frames the simulation stays this far behind the wall clock: a
 /// frame the kernel stamped but had not queued yet when the socket was read
 /// (its softirq still to run on a busy machine) is then still in the
 /// simulation's future. Costs nothing: an arriving frame catches up anyway.
-const IDLE_LAG_NS: u64 = 50_000;
+const IDLE_LAG: Nanos = Nanos::from_us(50);
 
 /// A frame the simulation reaches later than this after its receive time is
-/// counted in the summary, ns (less is the wire time of the frame before).
-const LATE_NOTE_NS: u64 = 20_000;
+/// counted in the summary (less is the wire time of the frame before).
+const LATE_NOTE: Nanos = Nanos::from_us(20);
 
 /// How often the pcap recording is flushed (a write error then ends `serve`).
-const FLUSH_EVERY_NS: u64 = 1_000_000_000;
+const FLUSH_EVERY: Nanos = Nanos::from_secs(1);
 
 /// Runs `serve` until `--seconds` have passed (or forever).
 pub fn serve(args: &ServeArgs) -> Result<(), String> {
@@ -76,7 +77,7 @@ pub fn serve(args: &ServeArgs) -> Result<(), String> {
     // every drive answers ping and the UDP parameter service on its EoE
     // interface once the master set its IP address (docs/eoe.md)
     for (i, d) in (1u8..).zip(sim.drives_mut()) {
-        d.bind_net([0x02, 0x00, 0x00, 0x00, 0x00, i], u64::from(i), 0);
+        d.bind_net([0x02, 0x00, 0x00, 0x00, 0x00, i], u64::from(i), Nanos::ZERO);
     }
     println!(
         "hil-sim serve: {slaves} simulated double-axis drive(s) on {iface} (--axes {}: a single-axis variant is not modelled yet)",
@@ -113,8 +114,8 @@ pub fn serve(args: &ServeArgs) -> Result<(), String> {
         sim.frames(),
         stats.unstamped,
         stats.late,
-        LATE_NOTE_NS / 1000,
-        stats.worst_late_ns as f64 / 1e3
+        LATE_NOTE.as_us(),
+        stats.worst_late.as_ns() as f64 / 1e3
     );
     if sim.frames() > 0 {
         println!(
@@ -131,10 +132,10 @@ pub fn serve(args: &ServeArgs) -> Result<(), String> {
 struct Stats {
     /// Frames without a kernel timestamp (processed at the time they were read).
     unstamped: u64,
-    /// Frames whose receive time the simulation had passed by more than [`LATE_NOTE_NS`].
+    /// Frames whose receive time the simulation had passed by more than [`LATE_NOTE`].
     late: u64,
-    /// The most the simulation had passed a frame's receive time, ns.
-    worst_late_ns: u64,
+    /// The most the simulation had passed a frame's receive time.
+    worst_late: Nanos,
     /// From the kernel's receive timestamp to the answer sent (without `--delay-us`'s hold).
     answer: Histogram,
     /// Of that, catching the simulation up and processing the frame.
@@ -145,27 +146,27 @@ struct Stats {
 #[derive(Debug)]
 struct Histogram {
     counts: Vec<u32>,
-    max_ns: u64,
+    max: Nanos,
 }
 
 impl Default for Histogram {
     fn default() -> Self {
         Self {
             counts: vec![0; 10_001],
-            max_ns: 0,
+            max: Nanos::ZERO,
         }
     }
 }
 
 impl Histogram {
-    fn add(&mut self, ns: u64) {
-        let i = usize::try_from(ns / 1000)
+    fn add(&mut self, span: Nanos) {
+        let i = usize::try_from(span.as_us())
             .unwrap_or(usize::MAX)
             .min(self.counts.len() - 1);
         if let Some(c) = self.counts.get_mut(i) {
             *c = c.saturating_add(1);
         }
-        self.max_ns = self.max_ns.max(ns);
+        self.max = self.max.max(span);
     }
 
     /// The `p` quantile (0..=1), µs (bucket upper edge).
@@ -188,59 +189,61 @@ impl Histogram {
             "p50 {}, p99 {}, max {:.0} µs",
             self.quantile_us(0.5),
             self.quantile_us(0.99),
-            self.max_ns as f64 / 1e3
+            self.max.as_ns() as f64 / 1e3
         )
     }
 }
 
 /// The serve loop (see the module's Timing section).
 fn run(sim: &mut Simulation, sock: &RawSocket, args: &ServeArgs) -> Result<Stats, String> {
-    let start = monotonic_ns();
+    let start = monotonic();
     let end = args
         .seconds
-        .map(|s| start.saturating_add((s.max(0.0) * 1e9) as u64));
+        .map(|s| start.saturating_add(Nanos::from_ns((s.max(0.0) * 1e9) as u64)));
     let mut delay = args.delay_us.map(|max| Delay::new(max, args.delay_seed));
     let mut stats = Stats::default();
     let mut printed = Vec::new();
     let mut buf = [0u8; 1600];
-    let mut next_flush = start + FLUSH_EVERY_NS;
+    let mut next_flush = start + FLUSH_EVERY;
     loop {
         // the clock is read before the socket: a frame not there yet arrives later
-        let now = monotonic_ns();
+        let now = monotonic();
         if let Some(rx) = sock.try_recv(&mut buf).map_err(|e| format!("receive: {e}"))? {
-            let rx_ns = rx.rx_ns.unwrap_or_else(|| {
+            let rx_time = rx.rx.unwrap_or_else(|| {
                 stats.unstamped += 1;
                 now
             });
-            let picked = monotonic_ns();
+            let picked = monotonic();
             let held = match delay.as_mut() {
-                Some(d) => d.hold(rx_ns),
-                None => 0,
+                Some(d) => d.hold(rx_time),
+                None => Nanos::ZERO,
             };
             let begin = picked + held;
-            let t = rx_ns.saturating_sub(start);
-            let behind = sim.now_ns().saturating_sub(t);
-            if behind > LATE_NOTE_NS {
+            let t = rx_time.saturating_sub(start);
+            let behind = sim.now().saturating_sub(t);
+            if behind > LATE_NOTE {
                 stats.late += 1;
             }
-            stats.worst_late_ns = stats.worst_late_ns.max(behind);
+            stats.worst_late = stats.worst_late.max(behind);
             sim.catch_up(t);
             let frame = buf.get_mut(..rx.len).unwrap_or_default();
             sim.exchange(frame);
             sock.send(frame).map_err(|e| format!("send: {e}"))?;
-            let sent = monotonic_ns();
+            let sent = monotonic();
             stats.work.add(sent.saturating_sub(begin));
-            stats.answer.add(sent.saturating_sub(rx_ns).saturating_sub(held));
+            stats
+                .answer
+                .add(sent.saturating_sub(rx_time).saturating_sub(held));
             if let Some(e) = sim.recording_error() {
                 return Err(format!("the pcap recording failed: {e}"));
             }
             // drain what queued up before simulating further
             continue;
         }
-        sim.catch_up(now.saturating_sub(start + IDLE_LAG_NS));
+        sim.catch_up(now.saturating_sub(start + IDLE_LAG));
         print_new_changes(sim, &mut printed);
         if now >= next_flush {
-            next_flush = now + FLUSH_EVERY_NS;
+            next_flush = now + FLUSH_EVERY;
             flush_recording(sim, args)?;
         }
         if end.is_some_and(|e| now >= e) || STOP.load(Ordering::Relaxed) {
@@ -263,32 +266,32 @@ fn flush_recording(sim: &mut Simulation, args: &ServeArgs) -> Result<(), String>
 /// `--delay-us`: holds each frame a seeded random time after its arrival
 /// (xorshift64, uniform in 0..=max µs), as a loaded machine would.
 struct Delay {
-    max_ns: u64,
+    max: Nanos,
     state: u64,
 }
 
 impl Delay {
     fn new(max_us: u64, seed: u64) -> Self {
         Self {
-            max_ns: max_us.saturating_mul(1000),
+            max: Nanos::from_us(max_us),
             // a fixed mix of the seed, never state 0
             state: (seed.wrapping_add(0x9E37_79B9_7F4A_7C15) ^ 0xBF58_476D_1CE4_E5B9).max(1),
         }
     }
 
-    /// Sleeps until `arrival_ns` (monotonic) plus the next random delay;
-    /// returns how long it slept, ns.
-    fn hold(&mut self, arrival_ns: u64) -> u64 {
+    /// Sleeps until `arrival` (monotonic) plus the next random delay;
+    /// returns how long it slept.
+    fn hold(&mut self, arrival: Nanos) -> Nanos {
         let mut x = self.state;
         x ^= x << 13;
         x ^= x >> 7;
         x ^= x << 17;
         self.state = x;
-        let until = arrival_ns.saturating_add(x % self.max_ns.saturating_add(1));
-        let now = monotonic_ns();
+        let until = arrival.saturating_add(Nanos::from_ns(x % self.max.as_ns().saturating_add(1)));
+        let now = monotonic();
         if until > now {
-            std::thread::sleep(Duration::from_nanos(until - now));
+            std::thread::sleep(Duration::from_nanos((until - now).as_ns()));
         }
-        monotonic_ns().saturating_sub(now)
+        monotonic().saturating_sub(now)
     }
 }

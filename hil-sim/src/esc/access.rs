@@ -135,13 +135,13 @@ pub(super) fn writable(side: Side, a: u32) -> bool {
 
 impl Esc {
     /// Processes one datagram as it passes this ESC: addressing, memory access
-    /// with all side effects, working counter, ADP auto-increment. `now_ns` is
+    /// with all side effects, working counter, ADP auto-increment. `now` is
     /// the time the frame entered the line; DC registers use the frame's
     /// arrival at this ESC (see [`Esc::set_line_timing`]).
-    pub fn process_datagram(&mut self, dg: &mut Datagram<'_>, now_ns: u64) {
-        self.tick(now_ns);
-        self.last_frame_ns = Some(self.now_ns);
-        self.dc.ecat_time = self.now_ns.saturating_add(self.dc.line.arrival_ns);
+    pub fn process_datagram(&mut self, dg: &mut Datagram<'_>, now: Nanos) {
+        self.tick(now);
+        self.last_frame = Some(self.now);
+        self.dc.ecat_time = self.now.saturating_add(self.dc.line.arrival);
         let adp = dg.adp();
         let ado = u32::from(dg.ado());
         let cmd = dg.command();
@@ -283,7 +283,7 @@ impl Esc {
     }
 
     /// Bytes computed on read at time `t`: the DC system time (local time + offset).
-    pub(super) fn computed(&self, a: u32, t: u64) -> Option<u8> {
+    pub(super) fn computed(&self, a: u32, t: Nanos) -> Option<u8> {
         self.dc_computed(a, t)
     }
 
@@ -333,7 +333,7 @@ impl Esc {
         let present = self.present_end();
         let t_read = match side {
             Side::Ecat => self.dc.ecat_time,
-            Side::Pdi => self.now_ns,
+            Side::Pdi => self.now,
         };
         for (i, byte) in data.iter_mut().enumerate() {
             let a = addr + i as u32;

@@ -11,8 +11,8 @@
 //!   clock is piecewise linear: a change of speed re-anchors it, so it never
 //!   jumps. Integer arithmetic (parts per trillion), deterministic.
 //! - **Position in the line.** The line tells each ESC when a frame reaches it
-//!   ([`LineTiming`]): port 0 at `arrival_ns` after the frame entered the line,
-//!   port 1 (the frame coming back from the rest of the line) `loop_ns` later.
+//!   ([`LineTiming`]): port 0 at `arrival` after the frame entered the line,
+//!   port 1 (the frame coming back from the rest of the line) `loop_time` later.
 //!   A write to 0x0900 latches `local` at these instants into 0x0900 (port 0),
 //!   0x0904 (port 1) and 0x0918 (processing unit, 64 bit), so a master's
 //!   topology and propagation-delay calculation works.
@@ -48,6 +48,7 @@
 use ::esc::regs::{self, al_event, dc};
 
 use super::Esc;
+use nanos::Nanos;
 
 /// One in parts per trillion.
 const PPT: i128 = 1_000_000_000_000;
@@ -73,11 +74,11 @@ const SPEED_DIFF_UNIT_PPT: i64 = 100_000;
 /// Where an ESC sits in the line, in time: when a frame reaches it.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
 pub struct LineTiming {
-    /// From the frame entering the line to its start at this ESC's port 0, ns.
-    pub arrival_ns: u64,
+    /// From the frame entering the line to its start at this ESC's port 0.
+    pub arrival: Nanos,
     /// From the frame leaving port 1 to its return at port 1 (the round trip
-    /// through the rest of the line), ns; 0 for the last ESC.
-    pub loop_ns: u64,
+    /// through the rest of the line); zero for the last ESC.
+    pub loop_time: Nanos,
 }
 
 /// SYNC pulses since the last [`Esc::take_sync0_events`] call.
@@ -85,8 +86,8 @@ pub struct LineTiming {
 pub struct SyncPulses {
     /// Number of pulses.
     pub count: u32,
-    /// Simulation time of the last pulse, ns (valid when `count > 0`).
-    pub last_now_ns: u64,
+    /// Simulation time of the last pulse (valid when `count > 0`).
+    pub last_now: Nanos,
     /// System time of the last pulse (exactly `start + k · cycle`), ns.
     pub last_system_ns: u64,
 }
@@ -97,7 +98,8 @@ pub struct SyncPulses {
 /// change of speed) never loses time.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
 pub(super) struct LocalClock {
-    anchor_now: u64,
+    /// Simulation time of the anchor.
+    anchor_now: Nanos,
     anchor_local: u64,
     /// Sub-nanosecond part of the local time at the anchor, 1e-12 ns (0..1e12).
     anchor_frac: i64,
@@ -109,7 +111,7 @@ impl LocalClock {
     /// A clock reading `offset_ns` at time 0 and running `rate_ppt` fast.
     pub(super) fn new(offset_ns: u64, rate_ppt: i64) -> Self {
         Self {
-            anchor_now: 0,
+            anchor_now: Nanos::ZERO,
             anchor_local: offset_ns,
             anchor_frac: 0,
             rate_ppt,
@@ -117,25 +119,25 @@ impl LocalClock {
     }
 
     /// Local time since the anchor at `t`, in 1e-12 ns (fraction included).
-    fn elapsed_fine(&self, t: u64) -> i128 {
-        let dt = i128::from(t) - i128::from(self.anchor_now);
+    fn elapsed_fine(&self, t: Nanos) -> i128 {
+        let dt = i128::from(t.as_ns()) - i128::from(self.anchor_now.as_ns());
         dt * (PPT + i128::from(self.rate_ppt)) + i128::from(self.anchor_frac)
     }
 
     /// Local time at simulation time `t` (rounded down), wrapping like a 64-bit counter.
-    pub(super) fn local_at(&self, t: u64) -> u64 {
+    pub(super) fn local_at(&self, t: Nanos) -> u64 {
         let whole = self.elapsed_fine(t).div_euclid(PPT);
         self.anchor_local.wrapping_add(whole as u64)
     }
 
     /// The earliest simulation time at which the local time reaches `local`
-    /// (wrapping comparison), saturated at 0 and `u64::MAX`.
-    pub(super) fn now_for_local(&self, local: u64) -> u64 {
+    /// (wrapping comparison), saturated at zero and [`Nanos::MAX`].
+    pub(super) fn now_for_local(&self, local: u64) -> Nanos {
         let dl = i128::from(local.wrapping_sub(self.anchor_local) as i64);
         let den = PPT + i128::from(self.rate_ppt);
         let dt = (dl * PPT - i128::from(self.anchor_frac) + den - 1).div_euclid(den);
-        let mut t = clamp_u64(i128::from(self.anchor_now) + dt);
-        let reached = |c: &Self, t: u64| c.local_at(t).wrapping_sub(local) as i64 >= 0;
+        let mut t = clamp_u64(i128::from(self.anchor_now.as_ns()) + dt);
+        let reached = |c: &Self, t: u64| c.local_at(Nanos::from_ns(t)).wrapping_sub(local) as i64 >= 0;
         for _ in 0..4 {
             if reached(self, t) {
                 break;
@@ -149,11 +151,11 @@ impl LocalClock {
                 break;
             }
         }
-        t
+        Nanos::from_ns(t)
     }
 
     /// Changes the speed from `t` on (the local time is continuous at `t`).
-    pub(super) fn set_rate(&mut self, t: u64, rate_ppt: i64) {
+    pub(super) fn set_rate(&mut self, t: Nanos, rate_ppt: i64) {
         if rate_ppt == self.rate_ppt {
             return;
         }
@@ -205,10 +207,10 @@ pub(super) struct DcState {
     /// Mean time difference, ns · 2^MEAN_FRAC.
     mean: i64,
     /// Time of the previous drift-control sample.
-    last_sample: Option<u64>,
+    last_sample: Option<Nanos>,
     pub(super) line: LineTiming,
     /// Time of the ECAT access in progress at this ESC (frame arrival).
-    pub(super) ecat_time: u64,
+    pub(super) ecat_time: Nanos,
     sync0: Pulse,
     sync1: Pulse,
     /// SYNC1 period, ns of system time (0 = single pulse).
@@ -226,7 +228,7 @@ impl DcState {
             mean: 0,
             last_sample: None,
             line: LineTiming::default(),
-            ecat_time: 0,
+            ecat_time: Nanos::ZERO,
             sync0: Pulse::default(),
             sync1: Pulse::default(),
             sync1_period: 0,
@@ -258,14 +260,15 @@ impl Esc {
         self.dc.last_sample = None;
     }
 
-    /// The ESC's local time at simulation time `now_ns`.
-    pub fn local_ns(&self, now_ns: u64) -> u64 {
-        self.dc.clock.local_at(now_ns)
+    /// The ESC's local time (register value, ns) at simulation time `now`.
+    pub fn local_ns(&self, now: Nanos) -> u64 {
+        self.dc.clock.local_at(now)
     }
 
-    /// The ESC's system time (local time + 0x0920) at simulation time `now_ns`.
-    pub fn system_time_ns(&self, now_ns: u64) -> u64 {
-        self.local_ns(now_ns)
+    /// The ESC's system time (local time + 0x0920; register value, ns) at
+    /// simulation time `now`.
+    pub fn system_time_ns(&self, now: Nanos) -> u64 {
+        self.local_ns(now)
             .wrapping_add(self.get_u64(dc::SYSTEM_TIME_OFFSET))
     }
 
@@ -282,25 +285,25 @@ impl Esc {
     /// Simulation time of the next SYNC0 pulse (inverting the local clock at
     /// its current speed), `None` when SYNC0 is not active. A time loop that
     /// stops exactly there and calls [`Esc::tick`] sees the pulse.
-    pub fn next_sync0_at(&self) -> Option<u64> {
+    pub fn next_sync0_at(&self) -> Option<Nanos> {
         self.dc.sync0.next.map(|s| self.now_for_system(s))
     }
 
     /// Simulation time of the next SYNC1 pulse, `None` when SYNC1 is not active.
-    pub fn next_sync1_at(&self) -> Option<u64> {
+    pub fn next_sync1_at(&self) -> Option<Nanos> {
         self.dc.sync1.next.map(|s| self.now_for_system(s))
     }
 
-    /// Advances to `now_ns` and returns the SYNC0 pulses since the last call
+    /// Advances to `now` and returns the SYNC0 pulses since the last call
     /// (count, time of the last one); the count restarts at 0.
-    pub fn take_sync0_events(&mut self, now_ns: u64) -> SyncPulses {
-        self.tick(now_ns);
+    pub fn take_sync0_events(&mut self, now: Nanos) -> SyncPulses {
+        self.tick(now);
         core::mem::take(&mut self.dc.sync0.pending)
     }
 
-    /// Advances to `now_ns` and returns the SYNC1 pulses since the last call.
-    pub fn take_sync1_events(&mut self, now_ns: u64) -> SyncPulses {
-        self.tick(now_ns);
+    /// Advances to `now` and returns the SYNC1 pulses since the last call.
+    pub fn take_sync1_events(&mut self, now: Nanos) -> SyncPulses {
+        self.tick(now);
         core::mem::take(&mut self.dc.sync1.pending)
     }
 
@@ -312,13 +315,13 @@ impl Esc {
     // -------------------------------------------------------------- internal
 
     /// Simulation time at which the system time reaches `system`.
-    fn now_for_system(&self, system: u64) -> u64 {
+    fn now_for_system(&self, system: u64) -> Nanos {
         let local = system.wrapping_sub(self.get_u64(dc::SYSTEM_TIME_OFFSET));
         self.dc.clock.now_for_local(local)
     }
 
     /// The byte `a` of the computed DC registers at time `t` (system time 0x0910).
-    pub(super) fn dc_computed(&self, a: u32, t: u64) -> Option<u8> {
+    pub(super) fn dc_computed(&self, a: u32, t: Nanos) -> Option<u8> {
         let st = u32::from(dc::SYSTEM_TIME);
         if self.config.dc_supported && (st..st + 8).contains(&a) {
             let bytes = self.system_time_ns(t).to_le_bytes();
@@ -335,7 +338,7 @@ impl Esc {
         }
         let t0 = self.dc.ecat_time;
         let p0 = self.dc.clock.local_at(t0);
-        let p1 = self.dc.clock.local_at(t0.saturating_add(self.dc.line.loop_ns));
+        let p1 = self.dc.clock.local_at(t0.saturating_add(self.dc.line.loop_time));
         self.set_u32(dc::RECEIVE_TIME_PORT0, p0 as u32);
         self.set_u32(dc::RECEIVE_TIME_PORT1, p1 as u32);
         self.set_u64(dc::RECEIVE_TIME_PU, p0);
@@ -386,7 +389,7 @@ impl Esc {
 
         // PI on the clock speed
         let e = i128::from(diff);
-        let dt = self.dc.last_sample.map(|l| i128::from(t.saturating_sub(l)));
+        let dt = self.dc.last_sample.map(|l| i128::from(t.since(l).as_ns()));
         let (p_scale_num, p_scale_den) = match dt {
             Some(dt) if dt > LOOP_TMAX_NS => (LOOP_TMAX_NS, dt),
             _ => (1, 1),
@@ -466,7 +469,7 @@ impl Esc {
     }
 
     /// Generates the SYNC pulses due at `now` (called by [`Esc::tick`]).
-    pub(super) fn dc_tick(&mut self, now: u64) {
+    pub(super) fn dc_tick(&mut self, now: Nanos) {
         if self.dc.sync0.next.is_none() && self.dc.sync1.next.is_none() {
             return;
         }
@@ -508,7 +511,7 @@ impl Esc {
                 .pending
                 .count
                 .saturating_add(u32::try_from(count).unwrap_or(u32::MAX)),
-            last_now_ns: last_now,
+            last_now,
             last_system_ns: last,
         };
         let (status, event) = if zero {

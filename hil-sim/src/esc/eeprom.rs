@@ -72,14 +72,14 @@ impl Esc {
             self.set_u16(regs::SII_CONTROL, c);
             return;
         }
-        if self.config.sii_busy_ns == 0 {
+        if self.config.sii_busy.is_zero() {
             self.set_u16(regs::SII_CONTROL, c);
             self.sii_execute(cmd);
         } else {
             self.set_u16(regs::SII_CONTROL, c | control::BUSY | cmd);
             self.sii_pending = Some(SiiPending {
                 command: cmd,
-                done_at: self.now_ns.saturating_add(self.config.sii_busy_ns),
+                done_at: self.now.saturating_add(self.config.sii_busy),
             });
         }
     }

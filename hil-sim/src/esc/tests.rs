@@ -181,7 +181,7 @@ fn e152_sii_write_with_enable_and_reload_sets_alias() {
 #[test]
 fn sii_busy_clears_with_later_time() {
     let cfg = EscConfig {
-        sii_busy_ns: 20_000,
+        sii_busy: Nanos::from_us(20),
         ..EscConfig::default()
     };
     let mut e = Esc::new(cfg, &sii_image());
@@ -190,7 +190,7 @@ fn sii_busy_clears_with_later_time() {
     assert_eq!(rd(&mut e, regs::SII_DATA, 8, 20_999).0, [0; 8], "not yet");
     // a command while busy is ignored
     sii_cmd(&mut e, control::CMD_READ, 0, 21_000 - 1);
-    e.tick(21_000);
+    e.tick(Nanos::from_ns(21_000));
     assert_eq!(
         reg16(&e, regs::SII_CONTROL) & (control::BUSY | control::CMD_MASK),
         0
@@ -484,10 +484,10 @@ fn pd_watchdog_expires_after_configured_time() {
     wr(&mut e, regs::WATCHDOG_TIME_PD, &10u16.to_le_bytes(), 0); // 10 × 100 µs
     wr(&mut e, 0x1100, &[1; 4], 1_000_000);
     assert_eq!(reg16(&e, regs::WATCHDOG_STATUS_PD) & 1, 1);
-    e.tick(1_999_999);
+    e.tick(Nanos::from_ns(1_999_999));
     assert_eq!(reg16(&e, regs::WATCHDOG_STATUS_PD) & 1, 1);
     assert_eq!(e.al_event_request() & al_event::WATCHDOG_PD, 0);
-    e.tick(2_000_000);
+    e.tick(Nanos::from_ns(2_000_000));
     assert_eq!(reg16(&e, regs::WATCHDOG_STATUS_PD) & 1, 0);
     assert_eq!(rd(&mut e, regs::WATCHDOG_COUNTER_PD, 1, 2_000_000).0, [1]);
     assert_ne!(e.al_event().unwrap() & al_event::WATCHDOG_PD, 0);
@@ -495,29 +495,29 @@ fn pd_watchdog_expires_after_configured_time() {
     assert_eq!(e.al_event().unwrap() & al_event::WATCHDOG_PD, 0);
     // retriggered by the next output write, expires once more
     wr(&mut e, 0x1100, &[2; 4], 3_000_000);
-    e.tick(3_500_000);
+    e.tick(Nanos::from_ns(3_500_000));
     assert_eq!(reg16(&e, regs::WATCHDOG_STATUS_PD) & 1, 1);
-    e.tick(4_000_000);
+    e.tick(Nanos::from_ns(4_000_000));
     assert_eq!(rd(&mut e, regs::WATCHDOG_COUNTER_PD, 1, 4_000_000).0, [2]);
     // an ECAT write clears the counter; time 0 disables the watchdog
     wr(&mut e, regs::WATCHDOG_COUNTER_PD, &[0], 4_000_000);
     wr(&mut e, regs::WATCHDOG_TIME_PD, &[0, 0], 4_000_000);
     wr(&mut e, 0x1100, &[3; 4], 5_000_000);
-    e.tick(1_000_000_000);
+    e.tick(Nanos::from_ns(1_000_000_000));
     assert_eq!(rd(&mut e, regs::WATCHDOG_COUNTER_PD, 1, 1_000_000_000).0, [0]);
 }
 
 #[test]
 fn pdi_watchdog_expires_without_pdi_access() {
     let mut e = esc();
-    e.tick(1_000);
+    e.tick(Nanos::from_ns(1_000));
     e.read_u8(0).unwrap();
     assert_ne!(reg16(&e, regs::DL_STATUS) & dl::PDI_WATCHDOG, 0);
-    e.tick(1_000 + 100_000_000 - 1);
+    e.tick(Nanos::from_ns(1_000 + 100_000_000 - 1));
     assert_eq!(e.read_u8(regs::WATCHDOG_COUNTER_PDI).unwrap(), 0); // also retriggers
-    e.tick(200_000_998);
+    e.tick(Nanos::from_ns(200_000_998));
     assert_eq!(e.get_u8(regs::WATCHDOG_COUNTER_PDI), 0);
-    e.tick(200_000_999);
+    e.tick(Nanos::from_ns(200_000_999));
     assert_eq!(e.get_u8(regs::WATCHDOG_COUNTER_PDI), 1);
     assert_eq!(reg16(&e, regs::DL_STATUS) & dl::PDI_WATCHDOG, 0);
 }

@@ -35,7 +35,7 @@ fn aprd_on_three_slaves_addresses_by_position() {
         (Command::Aprd, phys(pos(2), regs::TYPE), &[0]),
         (Command::Aprd, phys(pos(3), regs::TYPE), &[0xAB]),
     ]);
-    process_frame(&mut [&mut a, &mut b, &mut c], &mut f, 0).unwrap();
+    process_frame(&mut [&mut a, &mut b, &mut c], &mut f, Nanos::from_ns(0)).unwrap();
     let r = parse(&mut f);
     assert_eq!(r[0].data, [0x11]);
     assert_eq!(r[1].data, [0x22]);
@@ -263,7 +263,7 @@ fn lrw_through_fmmus_on_two_slaves() {
     let mut image: Vec<u8> = (1..=8).collect();
     image.extend_from_slice(&[0; 8]);
     let mut f = build(&[(Command::Lrw, 0x0001_0000, &image)]);
-    process_frame(&mut [&mut a, &mut b], &mut f, 0).unwrap();
+    process_frame(&mut [&mut a, &mut b], &mut f, Nanos::from_ns(0)).unwrap();
     let r = parse(&mut f).remove(0);
     assert_eq!(r.wkc, 6, "each slave: +1 read, +2 write");
     assert_eq!(&r.data[..8], &[1, 2, 3, 4, 5, 6, 7, 8], "outputs pass through");
@@ -305,7 +305,7 @@ fn malformed_frames_are_errors_without_panic() {
     // every truncation of a valid frame: no panic; short ones are errors
     for n in 0..good.len() {
         let mut f = good[..n].to_vec();
-        let r = process_frame(&mut [&mut a], &mut f, 0);
+        let r = process_frame(&mut [&mut a], &mut f, Nanos::from_ns(0));
         // the datagram area ends at byte 16 + 2*16 = 48; shorter prefixes are errors
         if n < 48 {
             assert!(r.is_err(), "prefix {n}");
@@ -318,7 +318,7 @@ fn malformed_frames_are_errors_without_panic() {
     f[13] = 0x00;
     let before = f.clone();
     assert_eq!(
-        process_frame(&mut [&mut a], &mut f, 0),
+        process_frame(&mut [&mut a], &mut f, Nanos::from_ns(0)),
         Err(FrameError::NotEthercat(0x0800))
     );
     assert_eq!(f, before);
@@ -327,7 +327,7 @@ fn malformed_frames_are_errors_without_panic() {
     f[14] = 0xFF;
     f[15] = 0x17;
     assert_eq!(
-        process_frame(&mut [&mut a], &mut f, 0),
+        process_frame(&mut [&mut a], &mut f, Nanos::from_ns(0)),
         Err(FrameError::LengthMismatch)
     );
     // datagram length past the area
@@ -335,7 +335,7 @@ fn malformed_frames_are_errors_without_panic() {
     f[16 + 6] = 0xF0;
     let before = f.clone();
     assert_eq!(
-        process_frame(&mut [&mut a], &mut f, 0),
+        process_frame(&mut [&mut a], &mut f, Nanos::from_ns(0)),
         Err(FrameError::MalformedDatagram)
     );
     assert_eq!(f, before);
@@ -343,14 +343,14 @@ fn malformed_frames_are_errors_without_panic() {
     let mut f = good.clone();
     f[16 + 16 + 7] |= 0x80;
     assert_eq!(
-        process_frame(&mut [&mut a], &mut f, 0),
+        process_frame(&mut [&mut a], &mut f, Nanos::from_ns(0)),
         Err(FrameError::MalformedDatagram)
     );
     // wrong frame type
     let mut f = good.clone();
     f[15] = (f[15] & 0x0F) | 0x40;
     assert_eq!(
-        process_frame(&mut [&mut a], &mut f, 0),
+        process_frame(&mut [&mut a], &mut f, Nanos::from_ns(0)),
         Err(FrameError::UnsupportedType(4))
     );
     // garbage of all lengths and patterns: never a panic
@@ -361,7 +361,7 @@ fn malformed_frames_are_errors_without_panic() {
                 f[12] = 0x88;
                 f[13] = 0xA4;
             }
-            let _ = process_frame(&mut [&mut a], &mut f, 0);
+            let _ = process_frame(&mut [&mut a], &mut f, Nanos::from_ns(0));
         }
     }
 }
@@ -389,7 +389,7 @@ fn vlan_tagged_frame_is_processed() {
     let mut f = plain[..12].to_vec();
     f.extend_from_slice(&[0x81, 0x00, 0x00, 0x01]);
     f.extend_from_slice(&plain[12..]);
-    process_frame(&mut [&mut a], &mut f, 0).unwrap();
+    process_frame(&mut [&mut a], &mut f, Nanos::from_ns(0)).unwrap();
     // data byte: 14 + 4 + 2 + 10
     assert_eq!(f[30], 0x5C);
 }
@@ -399,12 +399,12 @@ fn returned_frame_has_locally_administered_source_mac() {
     let mut a = esc_with_type(1);
     let mut f = build(&[(Command::Nop, 0, &[0])]);
     assert_eq!(f[6] & MAC_LOCAL_BIT, 0);
-    process_frame(&mut [&mut a], &mut f, 0).unwrap();
+    process_frame(&mut [&mut a], &mut f, Nanos::from_ns(0)).unwrap();
     assert_eq!(f[6], MASTER_MAC[0] | MAC_LOCAL_BIT);
     assert_eq!(&f[7..12], &MASTER_MAC[1..]);
     // also through an empty line
     let mut f = build(&[(Command::Brd, 0, &[0])]);
-    process_frame(&mut [], &mut f, 0).unwrap();
+    process_frame(&mut [], &mut f, Nanos::from_ns(0)).unwrap();
     assert_eq!(f[6] & MAC_LOCAL_BIT, MAC_LOCAL_BIT);
     assert_eq!(parse(&mut f)[0].wkc, 0);
 }
@@ -424,7 +424,7 @@ fn connect_line_opens_port1_except_last() {
     // process_frame applies the line it is given
     let mut c = esc_with_type(1);
     let mut f = build(&[(Command::Nop, 0, &[0])]);
-    process_frame(&mut [&mut b, &mut c], &mut f, 0).unwrap();
+    process_frame(&mut [&mut b, &mut c], &mut f, Nanos::from_ns(0)).unwrap();
     assert_eq!(dl(&b) & (1 << 5 | 1 << 10 | 1 << 11), 1 << 5 | 1 << 11);
     assert_eq!(dl(&c) & (1 << 5 | 1 << 10 | 1 << 11), 1 << 10);
 }

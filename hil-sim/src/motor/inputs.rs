@@ -10,6 +10,8 @@
 //! continuous position `m`, whichever the direction. The electrical level is
 //! the actuation, inverted for an active-low (normally closed) contact.
 
+use nanos::Nanos;
+
 /// Most marks (toggle positions) one input can hold.
 pub const MAX_MARKS: usize = 16;
 
@@ -267,8 +269,8 @@ pub struct Edge {
     pub rising: bool,
     /// Encoder position at the edge: the mark, increments, wrapped to `i32`.
     pub position_inc: i32,
-    /// Time of the edge after the start of the step, ns.
-    pub time_offset_ns: u64,
+    /// Time of the edge after the start of the step.
+    pub time_offset: Nanos,
 }
 
 /// The edges of one step, sorted by time (edges at the same time keep the
@@ -286,7 +288,7 @@ impl EdgeList {
             input: Input::Probe1,
             rising: false,
             position_inc: 0,
-            time_offset_ns: 0,
+            time_offset: Nanos::ZERO,
         };
         Self {
             edges: [NONE; MAX_EDGES_PER_STEP],
@@ -344,7 +346,7 @@ impl EdgeList {
                 let (Some(a), Some(b)) = (edges.get(j - 1), edges.get(j)) else {
                     break;
                 };
-                if a.time_offset_ns <= b.time_offset_ns {
+                if a.time_offset <= b.time_offset {
                     break;
                 }
                 edges.swap(j - 1, j);
@@ -432,7 +434,7 @@ fn detect_input(which: Input, input: &PositionInput, c: &Crossing, edges: &mut E
             input: which,
             rising: level,
             position_inc: m as i32,
-            time_offset_ns: c.time_of(m),
+            time_offset: Nanos::from_ns(c.time_of(m)),
         });
     }
 }

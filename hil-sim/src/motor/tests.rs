@@ -11,9 +11,9 @@ fn frictionless(j: f64) -> Motor {
 
 /// Runs `steps` steps with a constant command; returns the last outputs.
 fn run(m: &mut Motor, torque: f64, brake: bool, dt_ns: u64, steps: u32) -> MotorOutputs {
-    let mut out = m.step(torque, brake, dt_ns);
+    let mut out = m.step(torque, brake, Nanos::from_ns(dt_ns));
     for _ in 1..steps {
-        out = m.step(torque, brake, dt_ns);
+        out = m.step(torque, brake, Nanos::from_ns(dt_ns));
     }
     out
 }
@@ -32,7 +32,7 @@ fn constant_torque_accelerates_at_t_over_j() {
     for dt in [62_500, 250_000, MS] {
         let mut m = frictionless(1.0e-4);
         let t = 0.1; // a = 1000 rad/s²
-        m.step(t, false, dt); // acts from the next step on
+        m.step(t, false, Nanos::from_ns(dt)); // acts from the next step on
         let steps = (100 * MS / dt) as u32; // 100 ms of torque
         let out = run(&mut m, t, false, dt, steps);
         let secs = 0.1;
@@ -50,7 +50,7 @@ fn viscous_friction_terminal_velocity_is_t_over_b() {
     let mut p = MotorParams::frictionless(1.0e-4);
     p.viscous_friction_nm_s_per_rad = 1.0e-3; // τ = J/b = 0.1 s
     let mut m = Motor::new(p, Switches::default());
-    m.step(0.1, false, MS);
+    m.step(0.1, false, Nanos::from_ns(MS));
     // After one time constant: ω = T/b · (1 − 1/e).
     let out = run(&mut m, 0.1, false, MS, 100);
     let v = out.velocity_inc_per_s / INC_PER_RAD;
@@ -73,7 +73,7 @@ fn coulomb_friction_sticks_below_breakaway_and_moves_above() {
     assert_eq!(m.position_inc_f64(), 0.0);
 
     let mut m = Motor::new(p, Switches::default());
-    m.step(-0.031, false, MS);
+    m.step(-0.031, false, Nanos::from_ns(MS));
     let out = run(&mut m, -0.031, false, MS, 100);
     // Sliding: a = (T − T_coulomb)/J = −0.011/1e-4 = −110 rad/s² for 0.1 s.
     let v = out.velocity_inc_per_s / INC_PER_RAD;
@@ -91,7 +91,7 @@ fn coulomb_friction_stops_without_chatter() {
         let mut stopped_at = None;
         let mut last_pos = 0;
         for k in 0..(1000 * MS / dt) {
-            let out = m.step(0.0, false, dt);
+            let out = m.step(0.0, false, Nanos::from_ns(dt));
             assert!(out.velocity_inc_per_s >= 0.0, "reversed at step {k}");
             if out.velocity_inc_per_s == 0.0 && stopped_at.is_none() {
                 stopped_at = Some(k * dt + dt);
@@ -122,7 +122,7 @@ fn brake_holds_below_holding_torque_and_slips_above() {
     assert!(out.brake_applied);
 
     let mut m = Motor::new(p, Switches::default());
-    m.step(2.5, true, MS);
+    m.step(2.5, true, Nanos::from_ns(MS));
     let out = run(&mut m, 2.5, true, MS, 10);
     // Slipping: (2.5 − 2.0 − 0.02)/1e-4 = 4800 rad/s² for 10 ms.
     let v = out.velocity_inc_per_s / INC_PER_RAD;
@@ -131,7 +131,7 @@ fn brake_holds_below_holding_torque_and_slips_above() {
     // Engaging the brake on a moving rotor stops it and holds it.
     let mut m = Motor::new(p, Switches::default());
     m.set_velocity_rad_s(100.0);
-    m.step(0.0, true, MS);
+    m.step(0.0, true, Nanos::from_ns(MS));
     let out = run(&mut m, 0.0, true, MS, 100);
     assert_eq!(out.velocity_inc_per_s, 0.0);
     let held = out.position_inc;
@@ -159,7 +159,7 @@ fn gravity_load_falls_without_torque_and_brake() {
 
     // Holding torque compensation: motor torque cancels gravity.
     let mut m = Motor::new(p, Switches::default());
-    m.step(0.5, false, MS);
+    m.step(0.5, false, Nanos::from_ns(MS));
     let out = run(&mut m, 0.5, false, MS, 200);
     assert_eq!(out.position_inc, 0);
 }
@@ -208,21 +208,21 @@ fn encoder_quantises_with_floor() {
     let mut m = frictionless(1.0e-4);
     // −0.25 increments per 1 ms step.
     m.set_velocity_rad_s(-250.0 / INC_PER_RAD);
-    let out = m.step(0.0, false, MS);
+    let out = m.step(0.0, false, Nanos::from_ns(MS));
     assert_eq!(out.position_inc, -1);
-    let outs: [i32; 4] = core::array::from_fn(|_| m.step(0.0, false, MS).position_inc);
+    let outs: [i32; 4] = core::array::from_fn(|_| m.step(0.0, false, Nanos::from_ns(MS)).position_inc);
     assert_eq!(outs, [-1, -1, -1, -2]);
     // +0.3 increments per step from 0.
     let mut m = frictionless(1.0e-4);
     m.set_velocity_rad_s(300.0 / INC_PER_RAD);
-    let outs: [i32; 4] = core::array::from_fn(|_| m.step(0.0, false, MS).position_inc);
+    let outs: [i32; 4] = core::array::from_fn(|_| m.step(0.0, false, Nanos::from_ns(MS)).position_inc);
     assert_eq!(outs, [0, 0, 0, 1]);
 }
 
 #[test]
 fn encoder_wraps_on_i32_over_many_revolutions() {
     let mut p = MotorParams::frictionless(1.0e-4);
-    p.max_substep_ns = MS;
+    p.max_substep = Nanos::from_ns(MS);
     p.index_offset_inc = 12_345;
     let mut m = Motor::new(p, Switches::default());
     m.set_velocity_rad_s(rev_s(50.0));
@@ -230,7 +230,7 @@ fn encoder_wraps_on_i32_over_many_revolutions() {
     let mut index = 0u64;
     let mut wrapped = false;
     for _ in 0..50_000 {
-        let out = m.step(0.0, false, MS);
+        let out = m.step(0.0, false, Nanos::from_ns(MS));
         let d = out.position_inc.wrapping_sub(prev);
         assert!((d - 50 * (1 << 20) / 1000).abs() <= 1, "step {d}");
         wrapped |= out.position_inc < prev;
@@ -248,7 +248,7 @@ fn encoder_wraps_on_i32_over_many_revolutions() {
     let mut m = frictionless(1.0e-4);
     m.set_position_inc(i64::from(i32::MAX) - 10);
     m.set_velocity_rad_s(20_000.0 / INC_PER_RAD); // 20 increments per ms
-    let out = m.step(0.0, false, MS);
+    let out = m.step(0.0, false, Nanos::from_ns(MS));
     assert_eq!(out.position_inc, i32::MIN + 9);
 }
 
@@ -264,12 +264,12 @@ fn index_pulse_once_per_revolution_both_directions() {
         let mut seen = [0i64; 8];
         let mut n = 0;
         for _ in 0..350 {
-            let out = m.step(0.0, false, MS);
+            let out = m.step(0.0, false, Nanos::from_ns(MS));
             assert!(out.index_count <= 1);
             if let Some(ix) = out.index {
                 assert_eq!(ix.positive, dir > 0.0);
                 assert_eq!(i64::from(ix.position_inc).rem_euclid(REV), off);
-                let t = (out.step_start_ns + ix.time_offset_ns) as f64;
+                let t = (out.step_start + ix.time_offset).as_ns() as f64;
                 let expected = i64::from(ix.position_inc) as f64 / v_inc * 1e9;
                 assert!(close(t, expected, 2.0), "t {t} vs {expected}");
                 seen[n] = i64::from(ix.position_inc);
@@ -314,7 +314,7 @@ fn limit_and_reference_switch_states() {
     let mut events = [(Input::Probe1, false, 0i32); 4];
     let mut n = 0;
     for _ in 0..2500 {
-        let out = m.step(0.0, false, MS);
+        let out = m.step(0.0, false, Nanos::from_ns(MS));
         assert_eq!(out.inputs, m.switches().levels_at(m.position_inc_i64()));
         for e in &out.edges {
             events[n] = (e.input, e.rising, e.position_inc);
@@ -346,9 +346,9 @@ fn touch_probe_edge_times_are_exact() {
         let mut n1 = 0;
         let mut p2 = None;
         for _ in 0..(500 * MS / dt) {
-            let out = m.step(0.0, false, dt);
+            let out = m.step(0.0, false, Nanos::from_ns(dt));
             for e in out.edges.of(Input::Probe1) {
-                p1[n1] = (e.rising, e.position_inc, out.step_start_ns + e.time_offset_ns);
+                p1[n1] = (e.rising, e.position_inc, (out.step_start + e.time_offset).as_ns());
                 n1 += 1;
             }
             if let Some(e) = out.edges.of(Input::Probe2).next() {
@@ -378,7 +378,7 @@ fn edges_within_one_step_are_time_ordered() {
     let mut m = Motor::new(MotorParams::frictionless(1e-4), sw);
     m.set_velocity_rad_s(-4_000_000.0 / INC_PER_RAD);
     m.set_position_inc(3500);
-    let out = m.step(0.0, false, MS); // 3500 → −500
+    let out = m.step(0.0, false, Nanos::from_ns(MS)); // 3500 → −500
     let got: [(Input, bool, i32); 4] = core::array::from_fn(|k| {
         let e = out.edges.as_slice()[k];
         (e.input, e.rising, e.position_inc)
@@ -393,30 +393,30 @@ fn edges_within_one_step_are_time_ordered() {
             (Input::Reference, false, 500),
         ]
     );
-    let times: [u64; 4] = core::array::from_fn(|k| out.edges.as_slice()[k].time_offset_ns);
+    let times: [u64; 4] = core::array::from_fn(|k| out.edges.as_slice()[k].time_offset.as_ns());
     assert!(times.windows(2).all(|w| w[0] < w[1]), "{times:?}");
 }
 
 #[test]
 fn one_cycle_actuation_delay() {
     let mut m = frictionless(1.0e-4);
-    let out = m.step(1.0, false, MS);
+    let out = m.step(1.0, false, Nanos::from_ns(MS));
     assert_eq!(out.velocity_inc_per_s, 0.0);
     assert_eq!(out.position_inc, 0);
     assert_eq!(out.torque_applied_nm, 0.0);
-    let out = m.step(0.0, false, MS);
+    let out = m.step(0.0, false, Nanos::from_ns(MS));
     assert_eq!(out.torque_applied_nm, 1.0);
     let v = out.velocity_inc_per_s / INC_PER_RAD;
     assert!(close(v, 10.0, 1e-9), "v {v}"); // 1 N·m / 1e-4 kg·m² for 1 ms
-    let out = m.step(0.0, false, MS);
+    let out = m.step(0.0, false, Nanos::from_ns(MS));
     assert_eq!(out.torque_applied_nm, 0.0);
     assert!(close(out.velocity_inc_per_s / INC_PER_RAD, 10.0, 1e-9));
 
     // The brake is delayed the same way.
     let mut m = frictionless(1.0e-4);
     m.params_mut().brake_holding_torque_nm = 5.0;
-    assert!(!m.step(0.0, true, MS).brake_applied);
-    assert!(m.step(0.0, true, MS).brake_applied);
+    assert!(!m.step(0.0, true, Nanos::from_ns(MS)).brake_applied);
+    assert!(m.step(0.0, true, Nanos::from_ns(MS)).brake_applied);
 }
 
 #[test]
@@ -431,10 +431,17 @@ fn torque_is_clamped_and_permille_helpers() {
     assert_eq!(p.torque_to_permille(f64::NAN), 0);
 
     let mut m = Motor::default_servo();
-    m.step(100.0, false, MS);
-    assert_eq!(m.step(f64::NAN, false, MS).torque_applied_nm, 3.9);
-    assert_eq!(m.step_permille(2000, false, MS).torque_applied_nm, 0.0);
-    assert!(close(m.step(0.0, false, MS).torque_applied_nm, 2.6, 1e-12));
+    m.step(100.0, false, Nanos::from_ns(MS));
+    assert_eq!(m.step(f64::NAN, false, Nanos::from_ns(MS)).torque_applied_nm, 3.9);
+    assert_eq!(
+        m.step_permille(2000, false, Nanos::from_ns(MS)).torque_applied_nm,
+        0.0
+    );
+    assert!(close(
+        m.step(0.0, false, Nanos::from_ns(MS)).torque_applied_nm,
+        2.6,
+        1e-12
+    ));
 }
 
 #[test]
@@ -442,7 +449,7 @@ fn end_stop_stops_the_rotor() {
     let mut p = MotorParams::frictionless(1.0e-4);
     p.end_stops_inc = Some((-REV, 100_000));
     let mut m = Motor::new(p, Switches::default());
-    m.step(0.5, false, MS);
+    m.step(0.5, false, Nanos::from_ns(MS));
     let out = run(&mut m, 0.5, false, MS, 100);
     assert!(out.at_end_stop);
     assert_eq!(out.position_inc, 100_000);
@@ -460,7 +467,7 @@ fn encoder_noise_is_bounded_and_seeded() {
     let mut m = Motor::new(p, Switches::default());
     let mut seen = [false; 7];
     for _ in 0..200 {
-        let out = m.step(0.0, false, MS);
+        let out = m.step(0.0, false, Nanos::from_ns(MS));
         let d = i64::from(out.position_inc);
         assert!(d.abs() <= 3);
         seen[(d + 3) as usize] = true;
@@ -485,8 +492,8 @@ fn trace(seed: u64) -> [(i32, u64, u32, usize, u64); 400] {
     core::array::from_fn(|k| {
         lcg = lcg.wrapping_mul(1_103_515_245).wrapping_add(12345);
         let torque = (f64::from(lcg >> 16) / 65536.0 - 0.5) * 2.0;
-        let out = m.step(torque, k % 97 == 0, 250_000);
-        let edge_t = out.edges.iter().map(|e| e.time_offset_ns).sum();
+        let out = m.step(torque, k % 97 == 0, Nanos::from_ns(250_000));
+        let edge_t: u64 = out.edges.iter().map(|e| e.time_offset.as_ns()).sum();
         (
             out.position_inc,
             out.velocity_inc_per_s.to_bits(),

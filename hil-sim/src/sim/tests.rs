@@ -33,12 +33,12 @@ fn start_sync0(sim: &mut Simulation, start: u64, cycle: u32) {
 fn frame_jitter_is_seeded_deterministic_and_bounded() {
     let run = |max: u64, seed: u64| {
         let mut sim = Simulation::with_nodes(Vec::<SimDrive>::new());
-        sim.set_frame_jitter(max, seed);
+        sim.set_frame_jitter(Nanos::from_ns(max), seed);
         let mut times = Vec::new();
         for _ in 0..200 {
-            let t0 = sim.now_ns();
+            let t0 = sim.now().as_ns();
             send(&mut sim, Command::Brd, phys(0, 0), &[0; 2]);
-            times.push(sim.now_ns() - t0);
+            times.push(sim.now().as_ns() - t0);
         }
         times
     };
@@ -62,7 +62,7 @@ fn sync0_is_delivered_at_each_edge_in_time_order() {
     sim.drives_mut()[1].set_clock(-80.0, 7_777_777);
     start_sync0(&mut sim, 2_000_000, 250_000);
     // the second drive's system time is ahead (its local clock is): no offsets written
-    sim.advance_to(20_000_000);
+    sim.advance_to(Nanos::from_ns(20_000_000));
     for (i, d) in sim.drives().iter().enumerate() {
         let log: Vec<_> = d.sync0_log.iter().copied().collect();
         assert!(log.len() >= 40, "drive {i}: {} pulses", log.len());
@@ -71,9 +71,12 @@ fn sync0_is_delivered_at_each_edge_in_time_order() {
             assert_eq!(w[1].pulses, 1, "each edge delivered");
         }
         for s in &log {
-            assert!(d.esc.system_time_ns(s.now_ns) >= s.system_ns);
-            assert!(d.esc.system_time_ns(s.now_ns - 1) < s.system_ns, "at the edge");
-            assert_eq!(s.local_ns, d.esc.local_ns(s.now_ns));
+            assert!(d.esc.system_time_ns(s.now) >= s.system_ns);
+            assert!(
+                d.esc.system_time_ns(s.now - Nanos::from_ns(1)) < s.system_ns,
+                "at the edge"
+            );
+            assert_eq!(s.local_ns, d.esc.local_ns(s.now));
         }
         assert_eq!(
             d.esc.al_event_request() & ::esc::regs::al_event::SYNC0,
@@ -83,19 +86,19 @@ fn sync0_is_delivered_at_each_edge_in_time_order() {
     }
     // with frames in between: still every edge, never late
     let before = sim.drives()[0].sync0_log.back().copied().unwrap();
-    let t0 = sim.now_ns();
+    let t0 = sim.now().as_ns();
     for _ in 0..100 {
         send(&mut sim, Command::Brd, phys(0, 0), &[0; 64]);
     }
-    sim.advance_to(sim.now_ns() + 1_000_000);
+    sim.advance_to(Nanos::from_ns(sim.now().as_ns() + 1_000_000));
     let log = &sim.drives()[0].sync0_log;
     let after: Vec<_> = log.iter().filter(|s| s.system_ns > before.system_ns).collect();
-    let expected = (sim.now_ns() - t0) / 250_000;
+    let expected = (sim.now().as_ns() - t0) / 250_000;
     assert!(
         after.len() as u64 >= expected,
         "{} pulses in {} ns",
         after.len(),
-        sim.now_ns() - t0
+        sim.now().as_ns() - t0
     );
     assert!(after.iter().all(|s| s.pulses == 1));
     assert_eq!(after[0].system_ns, before.system_ns + 250_000);
@@ -107,5 +110,8 @@ fn power_cycle_keeps_the_oscillator() {
     d.set_clock(-25.0, 42);
     d.power_cycle();
     assert_eq!(d.esc.config().clock_drift_ppb, -25_000);
-    assert_eq!(d.esc.local_ns(1_000_000_000), 42 + 1_000_000_000 - 25_000);
+    assert_eq!(
+        d.esc.local_ns(Nanos::from_ns(1_000_000_000)),
+        42 + 1_000_000_000 - 25_000
+    );
 }

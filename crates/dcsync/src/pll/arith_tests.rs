@@ -69,11 +69,11 @@ fn e111_cycle_ticks_carry_exactly() {
         let mut pll = Pll::new(Config::new(1_000_000, 1_000_000, hz)).unwrap();
         let n = 10_000u64;
         let total: u64 = (0..n)
-            .map(|i| u64::from(pll.on_cycle_start(i * 1_000_000).period_ticks))
+            .map(|i| u64::from(pll.on_cycle_start(Nanos::from_ns(i * 1_000_000)).period_ticks))
             .sum();
         // nominal 1 ms per cycle, no SYNC0: the exact tick count of 10 s
         assert_eq!(total, u64::from(hz) * 10, "{hz} Hz");
-        let c = pll.on_cycle_start(n * 1_000_000);
+        let c = pll.on_cycle_start(Nanos::from_ns(n * 1_000_000));
         // the local length of the issued ticks: within one tick
         let tick_ns = 1_000_000_000 / hz + 1;
         assert!(

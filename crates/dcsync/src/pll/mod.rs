@@ -68,6 +68,7 @@ pub use config::*;
 use crate::al;
 use crate::status::{DiagCode, PllStatus, SyncDiagnostics};
 use crate::validate::{validate, SyncError};
+use nanos::Nanos;
 
 /// The PLL. See the module documentation.
 #[derive(Debug, Clone)]
@@ -79,10 +80,10 @@ pub struct Pll {
     a292_ns: i64,
     state: PllState,
     /// Last SYNC0 timestamp, latency subtracted, local ns.
-    last_sync0: Option<u64>,
+    last_sync0: Option<Nanos>,
     missing: u32,
-    acq_first: u64,
-    acq_last: u64,
+    acq_first: Nanos,
+    acq_last: Nanos,
     acq_count: u32,
     acq_bad: u32,
     measured_ns: Option<i64>,
@@ -139,8 +140,8 @@ impl Pll {
             },
             last_sync0: None,
             missing: 0,
-            acq_first: 0,
-            acq_last: 0,
+            acq_first: Nanos::ZERO,
+            acq_last: Nanos::ZERO,
             acq_count: 0,
             acq_bad: 0,
             measured_ns: None,
@@ -234,9 +235,9 @@ impl Pll {
         self.range_q
     }
 
-    /// SYNC0 interrupt: `t_local_ns` = local time the SYNC0 edge was seen.
-    pub fn on_sync0(&mut self, t_local_ns: u64) {
-        let s = t_local_ns.wrapping_sub(u64::from(self.cfg.sync0_latency_ns));
+    /// SYNC0 interrupt: `t_local` = local time the SYNC0 edge was seen.
+    pub fn on_sync0(&mut self, t_local: Nanos) {
+        let s = t_local.wrapping_sub(Nanos::from_ns(u64::from(self.cfg.sync0_latency_ns)));
         self.last_sync0 = Some(s);
         self.missing = 0;
         if self.state != PllState::Acquiring {
@@ -248,7 +249,7 @@ impl Pll {
             self.acq_count = 1;
             return;
         }
-        let interval = s.wrapping_sub(self.acq_last) as i64;
+        let interval = s.wrapping_sub(self.acq_last).as_ns() as i64;
         self.acq_last = s;
         if (interval - self.nominal_ns).abs() > self.nominal_ns / 4 {
             // A missing pulse or a different master cycle: start over; three
@@ -269,7 +270,7 @@ impl Pll {
         if self.acq_count <= window {
             return;
         }
-        let span = s.wrapping_sub(self.acq_first) as i64;
+        let span = s.wrapping_sub(self.acq_first).as_ns() as i64;
         let cycle_q = (i128::from(span) << Q) / i128::from(window);
         let dev_q = i64::try_from(cycle_q - (i128::from(self.nominal_ns) << Q)).unwrap_or(i64::MAX);
         self.measured_ns = Some(i64::try_from(cycle_q >> Q).unwrap_or(i64::MAX));
@@ -291,12 +292,12 @@ impl Pll {
         }
     }
 
-    /// Local cycle start: `t_local_ns` = programmed start of the cycle that
+    /// Local cycle start: `t_local` = programmed start of the cycle that
     /// has just begun. Returns its length and what it does.
-    pub fn on_cycle_start(&mut self, t_local_ns: u64) -> CycleCommand {
+    pub fn on_cycle_start(&mut self, t_local: Nanos) -> CycleCommand {
         let mut index = self.next_index;
         if self.cfg.enabled && index == 0 {
-            if let Some(new_index) = self.evaluate(t_local_ns) {
+            if let Some(new_index) = self.evaluate(t_local) {
                 index = new_index;
             }
         }
@@ -347,18 +348,18 @@ impl Pll {
 
     /// Phase error of an aligned cycle starting at `t`, local ns, against
     /// the SYNC0 edge nearest to its target.
-    fn phase_error(&self, t: u64, s: u64, est: i64) -> i64 {
+    fn phase_error(&self, t: Nanos, s: Nanos, est: i64) -> i64 {
         let offset = mul_div(self.a292_ns, est, self.nominal_ns.max(1));
-        let d = (t.wrapping_sub(s) as i64).saturating_add(offset);
+        let d = (t.wrapping_sub(s).as_ns() as i64).saturating_add(offset);
         wrap_signed(d, est)
     }
 
     /// Runs at an aligned cycle start; returns a new index for this cycle
     /// when the sequence is re-numbered.
-    fn evaluate(&mut self, t: u64) -> Option<u32> {
+    fn evaluate(&mut self, t: Nanos) -> Option<u32> {
         let est = self.cycle_est_ns();
         let s = self.last_sync0?;
-        let elapsed = t.wrapping_sub(s) as i64;
+        let elapsed = t.wrapping_sub(s).as_ns() as i64;
         // the usual case, within 1¼ cycles of the last SYNC0, without
         // dividing
         let late = elapsed.saturating_sub(est / 4);
@@ -470,11 +471,11 @@ impl Pll {
         self.sat = 0;
     }
 
-    /// The master's process data arrived (SM2 event) at `t_local_ns`
+    /// The master's process data arrived (SM2 event) at `t_local`
     /// (interrupt latency already subtracted by the caller). Updates `A261[1]`
     /// and `[2]`; `None` before the first SYNC0.
-    pub fn on_frame(&mut self, t_local_ns: u64) -> Option<FrameTiming> {
-        let rel = self.relative_to_sync0(t_local_ns)?;
+    pub fn on_frame(&mut self, t_local: Nanos) -> Option<FrameTiming> {
+        let rel = self.relative_to_sync0(t_local)?;
         self.data_to_sync0_ns = Some(-rel);
         let half = i64::from(self.cfg.a150_ns) / 2;
         let late = rel >= 0 || (self.cfg.tuning.late_half_cycle_rule && -rel > half);
@@ -493,13 +494,13 @@ impl Pll {
         })
     }
 
-    /// `t_local_ns` relative to the nearest SYNC0 edge (last timestamp plus
+    /// `t_local` relative to the nearest SYNC0 edge (last timestamp plus
     /// whole measured cycles), local ns: negative = before SYNC0. `None`
     /// before the first SYNC0. For the A287 samples.
-    pub fn relative_to_sync0(&self, t_local_ns: u64) -> Option<i64> {
+    pub fn relative_to_sync0(&self, t_local: Nanos) -> Option<i64> {
         let s = self.last_sync0?;
         Some(wrap_signed(
-            t_local_ns.wrapping_sub(s) as i64,
+            t_local.wrapping_sub(s).as_ns() as i64,
             self.cycle_est_ns(),
         ))
     }

@@ -71,16 +71,16 @@ impl Axis {
 
         self.following.set_config(FollowingErrorConfig {
             window_inc: o.following_error_window,
-            timeout_ns: ms_to_ns(o.following_error_timeout_ms),
+            timeout: ms_to_ns(o.following_error_timeout_ms),
             fault: p.following_error_fault,
         });
         self.in_position.set_config(PositionWindowConfig {
             window_inc: p.position_window_inc,
-            time_ns: p.position_window_time_ns,
+            time: p.position_window_time_ns,
         });
         self.velocity_window.set_config(VelocityWindowConfig {
             window_inc_per_s: p.velocity_window_inc_per_s,
-            time_ns: p.velocity_window_time_ns,
+            time: p.velocity_window_time_ns,
         });
         // C-091: jog under velocity control (I26 = 0) quick-stops at a
         // software limit instead of faulting
@@ -112,7 +112,7 @@ impl Axis {
                     order,
                     feedforward,
                     velocity_feedforward_percent: p.feedforward_percent,
-                    max_extrapolation_ns: p.max_extrapolation_ns,
+                    max_extrapolation: p.max_extrapolation_ns,
                 })
                 .ok(),
                 Some(VelocityInterpolator::new(ratio, p.max_extrapolation_ns)),

@@ -5,7 +5,7 @@ use super::*;
 
 impl Axis {
     /// Reads the encoder: user position and the filtered velocity.
-    pub(super) fn feedback(&mut self, io: &AxisIo, polarity: u8, dt_ns: u32, now_ns: u64) -> i32 {
+    pub(super) fn feedback(&mut self, io: &AxisIo, polarity: u8, dt_ns: u32, now_ns: Nanos) -> i32 {
         let inverted = polarity & 0x80 != 0;
         let raw = io.position_inc;
         let dt_s = dt_ns as f32 * 1e-9;
@@ -26,7 +26,7 @@ impl Axis {
         let actual = self.to_user(raw, polarity);
         if self.last_sample.is_none() {
             self.last_sample = Some(PositionSample {
-                time_ns: now_ns,
+                time: now_ns,
                 position_inc: actual,
             });
             // power-on: the set-point state starts at the actual position
@@ -61,10 +61,10 @@ impl Axis {
     }
 
     /// Touch probe (C-121 – C-129): 60B8h, the input edges and the index pulse.
-    pub(super) fn touch_probe(&mut self, o: &Snapshot, io: &AxisIo, actual: i32, now_ns: u64) {
+    pub(super) fn touch_probe(&mut self, o: &Snapshot, io: &AxisIo, actual: i32, now_ns: Nanos) {
         self.probe.set_function(o.probe_function);
         let current = PositionSample {
-            time_ns: now_ns,
+            time: now_ns,
             position_inc: actual,
         };
         let previous = self.last_sample.replace(current).unwrap_or(current);

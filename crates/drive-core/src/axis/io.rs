@@ -10,8 +10,8 @@ pub struct IndexLatch {
     /// Encoder position at the pulse, increments (motor coordinates, like
     /// [`AxisIo::position_inc`]).
     pub position_inc: i32,
-    /// Time of the pulse, ns (same clock as `now_ns`).
-    pub time_ns: u64,
+    /// Time of the pulse (same clock as `now_ns`).
+    pub time_ns: Nanos,
 }
 
 /// An edge of a touch-probe input seen in this cycle.
@@ -21,8 +21,8 @@ pub struct ProbeEdge {
     pub input: u8,
     /// `true` = rising (0 → 1), `false` = falling.
     pub rising: bool,
-    /// Time stamp of the edge, ns (same clock as `now_ns`).
-    pub time_ns: u64,
+    /// Time stamp of the edge (same clock as `now_ns`).
+    pub time_ns: Nanos,
     /// Encoder position latched by the hardware at the edge, increments
     /// (motor coordinates); `None`: interpolated between the last and this
     /// cycle's positions at `time_ns`.

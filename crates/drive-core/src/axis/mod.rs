@@ -120,6 +120,7 @@ use motion::{
     CycleRatio, Event, FineInterpolator, InterpolatorConfig, MasterSetpoint, PositionTarget,
     ProfileGenerator, ProfileLimits, SetMode, VelocityInterpolator, INCREMENTS_PER_REVOLUTION,
 };
+use nanos::Nanos;
 use od::error_register;
 use running::{MasterTrack, PpState, Running, VelocityCommand};
 use snapshot::{CyclicSlots, Snapshot, Window};
@@ -187,7 +188,7 @@ pub struct Axis {
     interp: Option<FineInterpolator>,
     vinterp: Option<VelocityInterpolator>,
     /// (ratio, I425, I25, I423) the interpolators were built with.
-    interp_key: Option<(CycleRatio, u8, u32, u64)>,
+    interp_key: Option<(CycleRatio, u8, u32, Nanos)>,
     profile: ProfileGenerator,
     cascade: Option<Cascade>,
     following: FollowingErrorMonitor,
@@ -229,7 +230,7 @@ pub struct Axis {
     /// Last cascade entry.
     last_entry: Option<ControlEntry>,
     /// Since when I199 (standstill) holds, ns.
-    standstill_since: Option<u64>,
+    standstill_since: Option<Nanos>,
     /// Direction lock of this cycle.
     lock: DirectionLock,
     /// Event behind the fault being raised / handled.
@@ -394,7 +395,7 @@ impl Axis {
         &mut self,
         od: &mut DriveObjects,
         io: &AxisIo,
-        now_ns: u64,
+        now_ns: Nanos,
         new_setpoint: bool,
     ) -> AxisReport {
         let mut cache = core::mem::take(&mut self.cache);
@@ -433,7 +434,7 @@ impl Axis {
         cache: &mut AxisCache,
         od: &mut DriveObjects,
         io: &AxisIo,
-        now_ns: u64,
+        now_ns: Nanos,
         new_setpoint: bool,
     ) -> AxisReport {
         let generation = od.config_generation();
@@ -516,7 +517,7 @@ impl Axis {
         // stood still for the settle time (no coasting out of an overshoot)
         let settled = i199 && {
             let since = *self.standstill_since.get_or_insert(now_ns);
-            now_ns.saturating_sub(since) >= self.params.stop_settle_ns
+            now_ns.since(since) >= self.params.stop_settle_ns
         };
         if !i199 {
             self.standstill_since = None;
@@ -665,7 +666,7 @@ impl Axis {
         io: &AxisIo,
         actual: &mut i32,
         i199: bool,
-        now_ns: u64,
+        now_ns: Nanos,
         dt_ns: u32,
         new_setpoint: bool,
     ) -> Option<Demand> {
@@ -716,7 +717,7 @@ impl Axis {
 
     /// The cascade and the monitors; returns (torque N·m user coordinates,
     /// mode bits incl. bit 11, following error inc).
-    fn control(&mut self, demand: Option<Demand>, actual: i32, now_ns: u64, dt_ns: u32) -> (f32, u16, i32) {
+    fn control(&mut self, demand: Option<Demand>, actual: i32, now_ns: Nanos, dt_ns: u32) -> (f32, u16, i32) {
         let (Some(d), Some(cascade)) = (demand, self.cascade.as_mut()) else {
             self.last_out = None;
             self.last_entry = None;

@@ -135,19 +135,17 @@ impl Axis {
             None => o.target_position,
         };
         // C-148: set-value monitoring of the master's steps
-        let master_ns = self.ratio.map_or(0, |r| u64::from(r.master_ns()));
-        master.age_ns = master
-            .age_ns
-            .saturating_add(u64::from(self.ratio.map_or(0, |r| r.control_ns())));
+        let master_period = Nanos::from_ns(self.ratio.map_or(0, |r| u64::from(r.master_ns())));
+        master.age += Nanos::from_ns(u64::from(self.ratio.map_or(0, |r| r.control_ns())));
         if new_setpoint {
             let from = master.setpoint.unwrap_or(self.sp_pos);
             let step = target.wrapping_sub(from).unsigned_abs() as f32;
-            let elapsed_ns = master.age_ns.max(master_ns);
-            let elapsed_s = motion::float::from_u64(elapsed_ns) * 1e-9;
+            let elapsed = master.age.max(master_period);
+            let elapsed_s = motion::float::from_u64(elapsed.as_ns()) * 1e-9;
             let allowed =
                 2.0 * o.max_profile_velocity as f32 * elapsed_s + self.params.position_window_inc as f32;
             master.setpoint = Some(target);
-            master.age_ns = 0;
+            master.age = Nanos::ZERO;
             if self.params.set_value_monitoring && step > allowed {
                 self.raise(Event::SET_VALUE_JUMP);
                 return Demand::hold(self.sp_pos);
@@ -213,7 +211,7 @@ impl Axis {
         o: &Snapshot,
         halt: bool,
         actual: i32,
-        now_ns: u64,
+        now_ns: Nanos,
         dt_ns: u32,
     ) -> Demand {
         let cw = o.controlword;
@@ -347,7 +345,7 @@ impl Axis {
         pv: &mut VelocityCommand,
         o: &Snapshot,
         halt: bool,
-        now_ns: u64,
+        now_ns: Nanos,
         dt_ns: u32,
     ) -> Demand {
         // C-030: 60FFh × A340
@@ -469,7 +467,7 @@ impl Axis {
             home_offset: o.home_offset,
             move_to_home: p.homing_move_to_home,
             index_search_offset: p.homing_index_offset,
-            torque_hold_ns: p.homing_torque_hold_ns,
+            torque_hold: p.homing_torque_hold_ns,
             max_search_distance: 0,
             limit_as_reference: p.homing_limit_as_reference,
         };

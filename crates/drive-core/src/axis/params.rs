@@ -19,16 +19,16 @@ pub struct AxisParams {
     pub feedforward_percent: f32,
     /// I425 speed feedforward – interpolation (0, 1, 3, 4, 5).
     pub interpolation_i425: u8,
-    /// I423 maximum extrapolation period, ns (C-117).
-    pub max_extrapolation_ns: u64,
+    /// I423 maximum extrapolation period (C-117).
+    pub max_extrapolation_ns: Nanos,
     /// C40 velocity window, inc/s (standstill I199, pv window).
     pub velocity_window_inc_per_s: f32,
-    /// 606Eh velocity window time, ns.
-    pub velocity_window_time_ns: u64,
+    /// 606Eh velocity window time.
+    pub velocity_window_time_ns: Nanos,
     /// I22 position (target) window, inc.
     pub position_window_inc: u32,
-    /// I87 time in the position window, ns.
-    pub position_window_time_ns: u64,
+    /// I87 time in the position window.
+    pub position_window_time_ns: Nanos,
     /// Following error (6065h/6066h) is a fault (event 54), not only
     /// statusword bit 13.
     pub following_error_fault: bool,
@@ -61,15 +61,15 @@ pub struct AxisParams {
     /// I28 torque limit while homing, 0.1 % of the rated torque (also the
     /// "torque at the limit" threshold of the torque methods; 6072h caps it).
     pub homing_torque_limit_per_mille: u16,
-    /// I29 time at the torque limit for the torque methods, ns.
-    pub homing_torque_hold_ns: u64,
+    /// I29 time at the torque limit for the torque methods.
+    pub homing_torque_hold_ns: Nanos,
     /// I30 = 2: the limit switch serves as the reference switch.
     pub homing_limit_as_reference: bool,
     /// A44 = 1: losing A60 in Operation enabled gives a quick stop.
     pub quick_stop_on_enable_loss: bool,
     /// How long the axis must stand still (I199) after a stop ramp before
-    /// the stop counts as finished (T12, T14, T5/T8 with ramp), ns.
-    pub stop_settle_ns: u64,
+    /// the stop counts as finished (T12, T14, T5/T8 with ramp).
+    pub stop_settle_ns: Nanos,
 }
 
 impl Default for AxisParams {
@@ -87,11 +87,11 @@ impl Default for AxisParams {
             },
             feedforward_percent: 100.0,
             interpolation_i425: 0,
-            max_extrapolation_ns: 10_000_000,
+            max_extrapolation_ns: Nanos::from_ms(10),
             velocity_window_inc_per_s: 0.1 * REV,
-            velocity_window_time_ns: 0,
+            velocity_window_time_ns: Nanos::ZERO,
             position_window_inc: INCREMENTS_PER_REVOLUTION / 360,
-            position_window_time_ns: 0,
+            position_window_time_ns: Nanos::ZERO,
             following_error_fault: false,
             limits: LimitConfig::default(),
             absolute_needs_reference: true,
@@ -105,10 +105,10 @@ impl Default for AxisParams {
             homing_move_to_home: false,
             homing_index_offset: 0,
             homing_torque_limit_per_mille: 1000,
-            homing_torque_hold_ns: 100_000_000,
+            homing_torque_hold_ns: Nanos::from_ms(100),
             homing_limit_as_reference: false,
             quick_stop_on_enable_loss: false,
-            stop_settle_ns: 10_000_000,
+            stop_settle_ns: Nanos::from_ms(10),
         }
     }
 }

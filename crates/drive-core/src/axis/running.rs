@@ -5,6 +5,7 @@
 //! the monitors) stays in [`super::Axis`].
 
 use cia402::Mode;
+use nanos::Nanos;
 
 /// The mode the motion core was set up for, with its own state.
 #[derive(Debug, Clone, Copy, PartialEq, Default)]
@@ -103,8 +104,8 @@ pub(super) struct MasterTrack {
     pub(super) setpoint: Option<i32>,
     /// The same set-point as sent, user units (endless axis only).
     pub(super) user: Option<i64>,
-    /// Time since it arrived, ns.
-    pub(super) age_ns: u64,
+    /// Time since it arrived.
+    pub(super) age: Nanos,
 }
 
 /// pp: the move being approached and its handshake.

@@ -30,15 +30,10 @@ pub struct Leds {
 }
 
 impl Leds {
-    /// Whether each LED is lit at `t_ns`: RUN, ERR, IN, OUT.
-    pub const fn lit(&self, t_ns: u64) -> [bool; 4] {
+    /// Whether each LED is lit at `t`: RUN, ERR, IN, OUT.
+    pub const fn lit(&self, t: Nanos) -> [bool; 4] {
         let [p0, p1] = self.ports;
-        [
-            self.run.is_on(t_ns),
-            self.err.is_on(t_ns),
-            p0.is_on(t_ns),
-            p1.is_on(t_ns),
-        ]
+        [self.run.is_on(t), self.err.is_on(t), p0.is_on(t), p1.is_on(t)]
     }
 }
 

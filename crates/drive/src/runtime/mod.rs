@@ -86,6 +86,7 @@ use ecat::foe::{Accept, FoeError, FoeHandler};
 use ecat::led::Pattern;
 use ecat::{Slave, StateChange};
 use esc::{regs, AlState, AlStatusCode, Pdi, PdiExt};
+use nanos::Nanos;
 use od::SdoAbort;
 use store::{Flash, ParamStore, StoreError};
 
@@ -441,10 +442,10 @@ impl<F: Flash, B: Flash> Drive<F, B> {
         }
     }
 
-    /// Runs the slave stack once at `now_ns`, then process data, the live
+    /// Runs the slave stack once at `now`, then process data, the live
     /// objects and the dictionary's requests.
-    pub fn poll<P: Pdi>(&mut self, pdi: &mut P, now_ns: u64) -> Result<Option<StateChange>, P::Error> {
-        let change = self.poll_parts(pdi, now_ns, true)?;
+    pub fn poll<P: Pdi>(&mut self, pdi: &mut P, now: Nanos) -> Result<Option<StateChange>, P::Error> {
+        let change = self.poll_parts(pdi, now, true)?;
         let _ = self.serve_requests();
         Ok(change)
     }
@@ -452,15 +453,15 @@ impl<F: Flash, B: Flash> Drive<F, B> {
     /// The ESC-event part of [`poll`](Self::poll) for the priority-2 task:
     /// AL control, process data, monitoring, live values; the mailbox
     /// waits for [`poll_mailbox`](Self::poll_mailbox).
-    pub fn poll_esc<P: Pdi>(&mut self, pdi: &mut P, now_ns: u64) -> Result<Option<StateChange>, P::Error> {
-        self.poll_parts(pdi, now_ns, false)
+    pub fn poll_esc<P: Pdi>(&mut self, pdi: &mut P, now: Nanos) -> Result<Option<StateChange>, P::Error> {
+        self.poll_parts(pdi, now, false)
     }
 
     /// The mailbox part of [`poll`](Self::poll) for the low-priority task:
     /// one CoE/EoE/FoE request answered, queued EMCYs and EoE fragments
     /// sent. A save it requests waits for the idle loop's
     /// [`begin_save`](Self::begin_save).
-    pub fn poll_mailbox<P: Pdi>(&mut self, pdi: &mut P, now_ns: u64) -> Result<(), P::Error> {
+    pub fn poll_mailbox<P: Pdi>(&mut self, pdi: &mut P, now: Nanos) -> Result<(), P::Error> {
         self.update_live();
         let mut live = Live { diag: &mut self.diag };
         let mut foe = FirmwareFoe::new(self.boot.as_mut());
@@ -469,39 +470,39 @@ impl<F: Flash, B: Flash> Drive<F, B> {
             &mut EcatApp(self.objects.with_live(&mut live)),
             &mut foe,
             &mut self.eoe,
-            now_ns,
+            now,
         )?;
         Ok(())
     }
 
     /// The SNTP time now, ns since 2000-01-01 (the DC epoch), from the IP
-    /// stack's SNTP client (`None`: no time); `local_now_ns` is the local
+    /// stack's SNTP client (`None`: no time); `local_now` is the local
     /// time it belongs to. Message time stamps use it when DC is not
     /// synchronised (E-147).
-    pub fn set_sntp_time(&mut self, sntp_ns: Option<u64>, local_now_ns: u64) {
-        self.sntp_offset_ns = sntp_ns.map(|t| (t as i64).wrapping_sub(local_now_ns as i64));
+    pub fn set_sntp_time(&mut self, sntp: Option<Nanos>, local_now: Nanos) {
+        self.sntp_offset_ns = sntp.map(|t| (t.as_ns() as i64).wrapping_sub(local_now.as_ns() as i64));
     }
 
-    /// The time stamp of a diagnosis message at local `now_ns` (E-147,
+    /// The time stamp of a diagnosis message at local `now` (E-147,
     /// spec §17): the DC system time (0x0910) when the drive runs DC-Sync
     /// with the PLL locked, else the SNTP time, else 0.
-    fn message_time_stamp<P: Pdi>(&self, pdi: &mut P, now_ns: u64) -> Result<u64, P::Error> {
+    fn message_time_stamp<P: Pdi>(&self, pdi: &mut P, now: Nanos) -> Result<Nanos, P::Error> {
         let dc_synced = self.slave.sync_status().mode == SyncMode::DcSync0
             && self.pll.as_ref().is_some_and(|p| p.is_locked());
         if dc_synced {
             let mut t = [0u8; 8];
             pdi.read(regs::dc::SYSTEM_TIME, &mut t)?;
-            return Ok(u64::from_le_bytes(t));
+            return Ok(Nanos::from_ns(u64::from_le_bytes(t)));
         }
-        Ok(self
-            .sntp_offset_ns
-            .map_or(0, |o| (now_ns as i64).wrapping_add(o) as u64))
+        Ok(self.sntp_offset_ns.map_or(Nanos::ZERO, |o| {
+            Nanos::from_ns((now.as_ns() as i64).wrapping_add(o) as u64)
+        }))
     }
 
     fn poll_parts<P: Pdi>(
         &mut self,
         pdi: &mut P,
-        now_ns: u64,
+        now: Nanos,
         mailbox: bool,
     ) -> Result<Option<StateChange>, P::Error> {
         if !self.cycle_owns_pdo() {
@@ -516,11 +517,11 @@ impl<F: Flash, B: Flash> Drive<F, B> {
                 &mut EcatApp(self.objects.with_live(&mut live)),
                 &mut foe,
                 &mut self.eoe,
-                now_ns,
+                now,
             )?
         } else {
             self.slave
-                .poll_esc(pdi, &mut EcatApp(self.objects.with_live(&mut live)), now_ns)?
+                .poll_esc(pdi, &mut EcatApp(self.objects.with_live(&mut live)), now)?
         };
         if self.slave.take_error_ack() {
             // the master acknowledged the error: a latched PLL fault goes
@@ -548,7 +549,7 @@ impl<F: Flash, B: Flash> Drive<F, B> {
         if let Some(c) = change.filter(|c| c.code != AlStatusCode::NO_ERROR) {
             // a refused state change is an error message in the history (E-144)
             let msg = DiagMessage::new(DIAG_AL_STATUS | u32::from(c.code.0), DiagType::Error, c.code.0);
-            let stamp = self.message_time_stamp(pdi, now_ns)?;
+            let stamp = self.message_time_stamp(pdi, now)?;
             self.diag.push(msg, stamp);
         }
         if change.is_some() {
@@ -628,7 +629,7 @@ impl<F: Flash, B: Flash> Drive<F, B> {
         }
     }
 
-    /// One control cycle (A150) of both axes at `now_ns` with the hardware
+    /// One control cycle (A150) of both axes at `now` with the hardware
     /// inputs `io`; returns the power-stage commands. Call it once per
     /// control cycle (SYNC0 / the control timer), independent of
     /// [`poll`](Self::poll): the set-points are the objects as the last poll
@@ -638,11 +639,11 @@ impl<F: Flash, B: Flash> Drive<F, B> {
     /// arrived in Op since the last control cycle; outside Op (set-points
     /// written by SDO or directly) every cycle carries one. Use
     /// [`control_cycle_with`](Self::control_cycle_with) to say it explicitly.
-    pub fn control_cycle(&mut self, now_ns: u64, io: &[AxisIo; 2]) -> [AxisCommand; 2] {
+    pub fn control_cycle(&mut self, now: Nanos, io: &[AxisIo; 2]) -> [AxisCommand; 2] {
         let frames = self.slave.outputs_received();
         let new = self.slave.state() != AlState::Op || frames != self.ctl_rx_frames;
         self.ctl_rx_frames = frames;
-        self.control_cycle_with(now_ns, io, [new, new])
+        self.control_cycle_with(now, io, [new, new])
     }
 
     /// [`control_cycle`](Self::control_cycle) with the "new set-point" flag
@@ -651,7 +652,7 @@ impl<F: Flash, B: Flash> Drive<F, B> {
     /// and keeps 1001h (error register) at the OR of both axes' faults.
     pub fn control_cycle_with(
         &mut self,
-        now_ns: u64,
+        now: Nanos,
         io: &[AxisIo; 2],
         new_setpoint: [bool; 2],
     ) -> [AxisCommand; 2] {
@@ -661,7 +662,7 @@ impl<F: Flash, B: Flash> Drive<F, B> {
         let axes = axes.zip(io).zip(new_setpoint);
         let sent = self.event52_emcy_sent.iter_mut();
         for (((((axis, cache), io), new), command), sent) in axes.zip(commands.iter_mut()).zip(sent) {
-            let report = axis.cycle_cached(cache, &mut self.objects, io, now_ns, new);
+            let report = axis.cycle_cached(cache, &mut self.objects, io, now, new);
             let mut fault = report.fault;
             if report.transition.is_some_and(|t| t.number == 13) {
                 // the event 52 EMCY is already queued (once for the device)
@@ -697,7 +698,7 @@ impl<F: Flash, B: Flash> Drive<F, B> {
     /// itself (until the PLL goes). A new set-point is flagged when Rx
     /// decoded a new frame (outside Op every cycle, as in
     /// [`control_cycle`](Self::control_cycle)).
-    pub fn sync_cycle(&mut self, cmd: &CycleCommand, now_ns: u64, io: &[AxisIo; 2]) -> [AxisCommand; 2] {
+    pub fn sync_cycle(&mut self, cmd: &CycleCommand, now: Nanos, io: &[AxisIo; 2]) -> [AxisCommand; 2] {
         self.cycle_pdo = self.pll.is_some();
         let mut commands = [AxisCommand::OFF; 2];
         let mut new = self.slave.state() != AlState::Op;
@@ -707,7 +708,7 @@ impl<F: Flash, B: Flash> Drive<F, B> {
                     new |= self.read_outputs();
                     self.ctl_rx_frames = self.slave.outputs_received();
                 }
-                Step::Application => commands = self.control_cycle_with(now_ns, io, [new, new]),
+                Step::Application => commands = self.control_cycle_with(now, io, [new, new]),
                 Step::WriteInputs => self.process_inputs(),
             }
         }

@@ -88,15 +88,15 @@ impl<F: Flash, B: Flash> Drive<F, B> {
         }
     }
 
-    /// One A287 sample for the aligned cycle starting at `t_local_ns`: the
+    /// One A287 sample for the aligned cycle starting at `t_local`: the
     /// last frame's arrival (start = end: the SM2 event gives one time), the
     /// cycle start and the Rx/Tx offsets, all relative to SYNC0.
-    pub(super) fn record_optimizer_sample(&mut self, t_local_ns: u64) {
+    pub(super) fn record_optimizer_sample(&mut self, t_local: Nanos) {
         if !self.optimizer.is_running() {
             return;
         }
         let Some(pll) = self.pll.as_ref() else { return };
-        let (Some(frame), Some(start)) = (self.frame_rel_sync0_ns.take(), pll.relative_to_sync0(t_local_ns))
+        let (Some(frame), Some(start)) = (self.frame_rel_sync0_ns.take(), pll.relative_to_sync0(t_local))
         else {
             return;
         };
@@ -154,16 +154,16 @@ impl<F: Flash, B: Flash> Drive<F, B> {
         }
     }
 
-    /// The period of the free-running control cycle (no SYNC0), ns: A150,
+    /// The period of the free-running control cycle (no SYNC0): A150,
     /// the cycle the axes integrate with (E-125, C-144);
     /// [`A150_FALLBACK_US`](crate::params::A150_FALLBACK_US) while A150 holds
     /// no allowed cycle time.
-    pub fn free_run_period_ns(&self) -> u64 {
+    pub fn free_run_period(&self) -> Nanos {
         let a150_ns =
             u32::try_from(read_slot(&self.objects, self.slots.a150, 0).saturating_mul(1000)).unwrap_or(0);
-        u64::from(
+        Nanos::from_ns(u64::from(
             motion::cycle::application_cycle_ns(a150_ns).unwrap_or(crate::params::A150_FALLBACK_US * 1000),
-        )
+        ))
     }
 
     /// The PLL configuration from the ESC's SYNC0 cycle and the objects
@@ -181,11 +181,11 @@ impl<F: Flash, B: Flash> Drive<F, B> {
         cfg
     }
 
-    /// SYNC0 interrupt at local time `t_local_ns` (the timer's time base).
+    /// SYNC0 interrupt at local time `t_local` (the timer's time base).
     /// Builds the PLL at the first pulse, or again when the SYNC0 cycle
     /// (0x09A0, read through `pdi`) changed; a refused configuration leaves
     /// the PLL off ([`Drive::sync_error`], `A261[0]`).
-    pub fn on_sync0<P: Pdi>(&mut self, pdi: &mut P, t_local_ns: u64) -> Result<(), P::Error> {
+    pub fn on_sync0<P: Pdi>(&mut self, pdi: &mut P, t_local: Nanos) -> Result<(), P::Error> {
         let cycle = pdi.read_u32(regs::dc::SYNC0_CYCLE)?;
         let current = self.pll.as_ref().map(|p| p.config().sync0_cycle_ns);
         if current != Some(cycle) || self.pll_from_sm {
@@ -204,17 +204,17 @@ impl<F: Flash, B: Flash> Drive<F, B> {
             }
         }
         if let Some(pll) = self.pll.as_mut() {
-            pll.on_sync0(t_local_ns);
+            pll.on_sync0(t_local);
         }
         self.update_sync_live();
         Ok(())
     }
 
     /// Control-cycle timer interrupt at the programmed local start
-    /// `t_local_ns`: applies changed A292/A149/A290 and asks the PLL for
+    /// `t_local`: applies changed A292/A149/A290 and asks the PLL for
     /// this cycle's length (program the next start at `start +
     /// period_ticks`). `None` without a PLL (free-running A150 timer).
-    pub fn cycle_start(&mut self, t_local_ns: u64) -> Option<CycleCommand> {
+    pub fn cycle_start(&mut self, t_local: Nanos) -> Option<CycleCommand> {
         let generation = self.objects.config_generation();
         let settings = match self.pll_settings {
             Some((g, s)) if g == generation => s,
@@ -240,10 +240,10 @@ impl<F: Flash, B: Flash> Drive<F, B> {
         if settings.enabled != wanted.enabled {
             pll.set_enabled(settings.enabled);
         }
-        let cmd = pll.on_cycle_start(t_local_ns);
+        let cmd = pll.on_cycle_start(t_local);
         let now = (pll.status(), pll.fault());
         if cmd.index == 0 {
-            self.record_optimizer_sample(t_local_ns);
+            self.record_optimizer_sample(t_local);
         }
         // A298 and the sync-error flags at once when they differ from what
         // they show; the phase error of A261[3] follows with the next SYNC0
@@ -255,7 +255,7 @@ impl<F: Flash, B: Flash> Drive<F, B> {
         Some(cmd)
     }
 
-    /// The master's process data (SM2) arrived at local time `t_local_ns`:
+    /// The master's process data (SM2) arrived at local time `t_local`:
     /// `A261[1]`, `[2]`. `None` without a PLL or before the first SYNC0.
     ///
     /// In SM-Sync (`1C32h:01` = 1 accepted at P→S, Safe-Op and Op) the SM2
@@ -263,14 +263,14 @@ impl<F: Flash, B: Flash> Drive<F, B> {
     /// PLL is built at the first event with the process-data cycle
     /// (`1C32h:02`, else A150) and locks the control cycle to event − A292
     /// like to SYNC0 − A292; it goes when the drive leaves Safe-Op/Op.
-    pub fn on_frame(&mut self, t_local_ns: u64) -> Option<FrameTiming> {
+    pub fn on_frame(&mut self, t_local: Nanos) -> Option<FrameTiming> {
         if self.slave.sync_status().mode == SyncMode::SmSync
             && matches!(self.slave.state(), AlState::SafeOp | AlState::Op)
         {
-            self.on_sm_event(t_local_ns);
+            self.on_sm_event(t_local);
             return None;
         }
-        let timing = self.pll.as_mut()?.on_frame(t_local_ns);
+        let timing = self.pll.as_mut()?.on_frame(t_local);
         if let Some(t) = timing {
             self.frame_rel_sync0_ns = Some(t.rel_sync0_ns);
         }
@@ -278,8 +278,8 @@ impl<F: Flash, B: Flash> Drive<F, B> {
         timing
     }
 
-    /// SM-Sync: the SM2 event at `t_local_ns` as the PLL's sync pulse.
-    pub(super) fn on_sm_event(&mut self, t_local_ns: u64) {
+    /// SM-Sync: the SM2 event at `t_local` as the PLL's sync pulse.
+    pub(super) fn on_sm_event(&mut self, t_local: Nanos) {
         let cycle = self.slave.sync_status().cycle_ns;
         let current = self.pll.as_ref().map(|p| p.config().sync0_cycle_ns);
         if current != Some(cycle) || !self.pll_from_sm {
@@ -298,7 +298,7 @@ impl<F: Flash, B: Flash> Drive<F, B> {
             self.pll_from_sm = true;
         }
         if let Some(pll) = self.pll.as_mut() {
-            pll.on_sync0(t_local_ns);
+            pll.on_sync0(t_local);
         }
         self.update_sync_live();
     }

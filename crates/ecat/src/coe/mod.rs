@@ -11,7 +11,7 @@
 //!   response when it fits the mailbox), segmented otherwise; the value is read
 //!   with one [`Dictionary::read`] at the initiate.
 //! - Complete access to ARRAY and RECORD objects (see [`complete`]).
-//! - Abort from the master (no reply), SDO protocol timeout ([`SDO_TIMEOUT_NS`]).
+//! - Abort from the master (no reply), SDO protocol timeout ([`SDO_TIMEOUT`]).
 //! - SDO Information (service 8, [`crate::sdo_info`]), fragmented OD lists.
 //!
 //! Requests are parsed into typed values first ([`SdoRequest`],
@@ -40,6 +40,7 @@ mod sdo;
 use crate::mailbox::MailboxError;
 use crate::sdo_info::{self, OdListCursor};
 use esc::AlState;
+use nanos::Nanos;
 
 pub use od::{CommState, Dictionary, SdoAbort};
 pub use sdo::SdoRequest;
@@ -53,7 +54,7 @@ pub const SDO_LEN: usize = 8;
 pub const MAX_TRANSFER: usize = 4096;
 /// A segmented transfer that sees no segment request for this long is dropped;
 /// the next segment request is answered with abort 0504 0000h.
-pub const SDO_TIMEOUT_NS: u64 = 1_000_000_000;
+pub const SDO_TIMEOUT: Nanos = Nanos::from_secs(1);
 
 /// CoE services (CoE header bits 12..15).
 pub mod service {
@@ -138,7 +139,7 @@ enum Transfer {
         size: Option<usize>,
         /// Toggle bit the next segment must carry.
         toggle: bool,
-        last_ns: u64,
+        last: Nanos,
     },
     Upload {
         index: u16,
@@ -146,7 +147,7 @@ enum Transfer {
         /// Bytes of `buf` already sent.
         pos: usize,
         toggle: bool,
-        last_ns: u64,
+        last: Nanos,
     },
     /// Dropped by the protocol timeout; the next segment request gets 0504 0000h.
     TimedOut {
@@ -213,27 +214,24 @@ impl CoeServer {
         sdo_info::next_fragment(out, dict, &mut self.od_list)
     }
 
-    /// Checks the SDO protocol timeout at `now_ns`: a segmented transfer idle
-    /// for more than [`SDO_TIMEOUT_NS`] is dropped. [`CoeServer::handle`] calls it
+    /// Checks the SDO protocol timeout at `now`: a segmented transfer idle
+    /// for more than [`SDO_TIMEOUT`] is dropped. [`CoeServer::handle`] calls it
     /// too.
-    pub fn tick(&mut self, now_ns: u64) {
-        let (index, sub, last_ns) = match self.transfer {
-            Transfer::Download {
-                index, sub, last_ns, ..
+    pub fn tick(&mut self, now: Nanos) {
+        let (index, sub, last) = match self.transfer {
+            Transfer::Download { index, sub, last, .. } | Transfer::Upload { index, sub, last, .. } => {
+                (index, sub, last)
             }
-            | Transfer::Upload {
-                index, sub, last_ns, ..
-            } => (index, sub, last_ns),
             Transfer::Idle | Transfer::TimedOut { .. } => return,
         };
-        if now_ns.saturating_sub(last_ns) > SDO_TIMEOUT_NS {
+        if now.since(last) > SDO_TIMEOUT {
             self.transfer = Transfer::TimedOut { index, sub };
             self.len = 0;
         }
     }
 
     /// Handles one CoE mailbox payload (`req` = CoE header + service data) in
-    /// ESM state `state` at `now_ns` and writes the response's mailbox data into
+    /// ESM state `state` at `now` and writes the response's mailbox data into
     /// `out` (capacity = SM1 length − 6). Returns the response length, `None`
     /// when nothing is to be sent, or the mailbox error to reply with.
     ///
@@ -244,16 +242,16 @@ impl CoeServer {
         out: &mut [u8],
         dict: &mut D,
         state: AlState,
-        now_ns: u64,
+        now: Nanos,
     ) -> Result<Option<usize>, MailboxError> {
-        self.tick(now_ns);
+        self.tick(now);
         self.od_list = None;
         let header = CoeHeader::parse(req).ok_or(MailboxError::SIZE_TOO_SHORT)?;
         let body = req.get(COE_HEADER_LEN..).unwrap_or_default();
         match header.service {
             service::SDO_REQUEST => {
                 let request = SdoRequest::parse(body).ok_or(MailboxError::SIZE_TOO_SHORT)?;
-                match self.sdo(request, out, dict, comm_state(state), now_ns) {
+                match self.sdo(request, out, dict, comm_state(state), now) {
                     Ok(reply) => Ok(reply),
                     Err((index, sub, code)) => {
                         // an abort ends the transfer in progress

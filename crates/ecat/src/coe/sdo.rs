@@ -3,6 +3,7 @@
 use super::{
     complete, sdo_frame, service, CoeServer, Failure, Transfer, Writer, COE_HEADER_LEN, MAX_TRANSFER, SDO_LEN,
 };
+use nanos::Nanos;
 use od::{CommState, Dictionary, SdoAbort};
 
 /// Data bytes of a CAN-style segment (the minimum segment).
@@ -181,7 +182,7 @@ impl CoeServer {
         out: &mut [u8],
         dict: &mut D,
         state: CommState,
-        now_ns: u64,
+        now: Nanos,
     ) -> Result<Option<usize>, Failure> {
         match request {
             SdoRequest::Abort { .. } => {
@@ -204,7 +205,7 @@ impl CoeServer {
                     out,
                     dict,
                     state,
-                    now_ns,
+                    now,
                     (index, sub, complete_access),
                     expedited,
                     size,
@@ -213,7 +214,7 @@ impl CoeServer {
                 .map(Some)
             }
             SdoRequest::DownloadSegment { toggle, last, data } => self
-                .download_segment(out, dict, state, now_ns, toggle, last, data)
+                .download_segment(out, dict, state, now, toggle, last, data)
                 .map(Some),
             SdoRequest::InitiateUpload {
                 index,
@@ -222,10 +223,10 @@ impl CoeServer {
             } => {
                 self.transfer = Transfer::Idle;
                 self.len = 0;
-                self.initiate_upload(out, dict, state, now_ns, index, sub, complete_access)
+                self.initiate_upload(out, dict, state, now, index, sub, complete_access)
                     .map(Some)
             }
-            SdoRequest::UploadSegment { toggle } => self.upload_segment(out, now_ns, toggle).map(Some),
+            SdoRequest::UploadSegment { toggle } => self.upload_segment(out, now, toggle).map(Some),
             SdoRequest::Unknown { index, sub, .. } => Err((index, sub, SdoAbort::INVALID_COMMAND)),
         }
     }
@@ -245,7 +246,7 @@ impl CoeServer {
         out: &mut [u8],
         dict: &mut D,
         state: CommState,
-        now_ns: u64,
+        now: Nanos,
         (index, sub, complete_access): (u16, u8, bool),
         expedited: bool,
         size: Option<u32>,
@@ -303,7 +304,7 @@ impl CoeServer {
             complete_access,
             size,
             toggle: false,
-            last_ns: now_ns,
+            last: now,
         };
         Ok(n)
     }
@@ -314,7 +315,7 @@ impl CoeServer {
         out: &mut [u8],
         dict: &mut D,
         state: CommState,
-        now_ns: u64,
+        now: Nanos,
         toggle: bool,
         last: bool,
         data: &[u8],
@@ -366,7 +367,7 @@ impl CoeServer {
                 complete_access,
                 size,
                 toggle: !toggle,
-                last_ns: now_ns,
+                last: now,
             };
         }
         segment_frame(out, cmd, &[]).ok_or((index, sub, SdoAbort::OUT_OF_MEMORY))
@@ -378,7 +379,7 @@ impl CoeServer {
         out: &mut [u8],
         dict: &mut D,
         state: CommState,
-        now_ns: u64,
+        now: Nanos,
         index: u16,
         sub: u8,
         complete_access: bool,
@@ -417,12 +418,12 @@ impl CoeServer {
             sub,
             pos: 0,
             toggle: false,
-            last_ns: now_ns,
+            last: now,
         };
         Ok(head)
     }
 
-    fn upload_segment(&mut self, out: &mut [u8], now_ns: u64, toggle: bool) -> Result<usize, Failure> {
+    fn upload_segment(&mut self, out: &mut [u8], now: Nanos, toggle: bool) -> Result<usize, Failure> {
         let (index, sub, pos) = match self.transfer {
             Transfer::Upload {
                 index,
@@ -460,7 +461,7 @@ impl CoeServer {
                 sub,
                 pos: pos + seg,
                 toggle: !toggle,
-                last_ns: now_ns,
+                last: now,
             }
         };
         Ok(len)

@@ -190,7 +190,7 @@ struct T {
     srv: CoeServer,
     dict: Dict,
     cap: usize,
-    now: u64,
+    now: Nanos,
     state: AlState,
 }
 
@@ -200,13 +200,13 @@ impl T {
             srv: CoeServer::new(CoeConfig::ALL),
             dict: Dict::new(),
             cap,
-            now: 0,
+            now: Nanos::ZERO,
             state: AlState::PreOp,
         }
     }
     /// One CoE request (header included); the reply's bytes.
     fn raw(&mut self, req: &[u8]) -> Result<Option<Vec<u8>>, MailboxError> {
-        self.now += 1_000_000;
+        self.now += Nanos::from_ms(1);
         let mut out = vec![0xEE; self.cap];
         let r = self
             .srv
@@ -481,10 +481,10 @@ fn e069_segment_without_transfer_and_unknown_command_abort_0504_0001() {
 fn e069_protocol_timeout_aborts_0504_0000() {
     let mut t = T::new(64);
     t.sdo(&[0x21, 0x01, 0x20, 0x00, 16, 0, 0, 0]);
-    t.now += 900_000_000; // within the timeout
+    t.now += Nanos::from_ms(900); // within the timeout
     let r = t.sdo(&[0x00, 1, 2, 3, 4, 5, 6, 7]);
     assert_eq!(resp(&r)[0], 0x20);
-    t.now += SDO_TIMEOUT_NS + 1;
+    t.now += SDO_TIMEOUT + Nanos::from_ns(1);
     t.srv.tick(t.now);
     assert!(!t.srv.transfer_in_progress());
     // the next segment learns about it
@@ -496,7 +496,7 @@ fn e069_protocol_timeout_aborts_0504_0000() {
     // upload: timeout seen by handle itself
     let mut t = T::new(10);
     t.sdo(&upload_req(0x2001, 0));
-    t.now += 2 * SDO_TIMEOUT_NS;
+    t.now += 2 * SDO_TIMEOUT;
     let r = t.sdo(&[0x60, 0, 0, 0, 0, 0, 0, 0]);
     assert_eq!(abort(&r, 0x2001, 0), 0x0504_0000);
 }
@@ -1000,7 +1000,7 @@ fn random_requests_never_panic_and_replies_are_well_formed() {
             req[7] = if rng.below(2) == 0 { 0 } else { 0x20 };
         }
         if rng.below(50) == 0 {
-            t.now += 2 * SDO_TIMEOUT_NS;
+            t.now += 2 * SDO_TIMEOUT;
         }
         if let Ok(Some(r)) = t.raw(&req) {
             assert!(r.len() <= t.cap && r.len() >= 2, "{req:x?} -> {r:x?}");

@@ -11,7 +11,7 @@ impl Slave {
         &mut self,
         pdi: &mut P,
         app: &mut A,
-        now_ns: u64,
+        now: Nanos,
     ) -> Result<(u32, Option<StateChange>), P::Error> {
         if !self.started {
             self.write_status(pdi)?;
@@ -22,7 +22,7 @@ impl Slave {
             self.pdo_bytes = bytes;
         }
         let change = if events & al_event::AL_CONTROL != 0 {
-            self.al_control(pdi, app, now_ns)?
+            self.al_control(pdi, app, now)?
         } else {
             None
         };
@@ -46,7 +46,7 @@ impl Slave {
         &mut self,
         pdi: &mut P,
         app: &mut A,
-        now_ns: u64,
+        now: Nanos,
     ) -> Result<Option<StateChange>, P::Error> {
         let ctrl = AlControl::from_raw(pdi.read_u16(regs::AL_CONTROL)?);
         if self.error && !ctrl.ack {
@@ -67,20 +67,20 @@ impl Slave {
             Ok(None) => Ok(from),
             Ok(Some(AlState::Op)) if from == AlState::SafeOp => {
                 self.sync.monitor = self.pdo_monitor(pdi, app)?;
-                if !self.outputs_steady(now_ns) || self.sync_ready().is_err() {
+                if !self.outputs_steady(now) || self.sync_ready().is_err() {
                     // E-033: wait (up to 200 ms) for stable RxPDO and, in DC
                     // mode, for the PLL lock; the status stays Safe-Op
                     // without error meanwhile
-                    self.pending_op = Some(now_ns);
+                    self.pending_op = Some(now);
                     self.error = false;
                     self.code = AlStatusCode::NO_ERROR;
                     self.write_status(pdi)?;
                     return Ok(None);
                 }
-                self.transition(pdi, app, from, AlState::Op, now_ns)?
+                self.transition(pdi, app, from, AlState::Op, now)?
                     .map(|()| AlState::Op)
             }
-            Ok(Some(to)) => self.transition(pdi, app, from, to, now_ns)?.map(|()| to),
+            Ok(Some(to)) => self.transition(pdi, app, from, to, now)?.map(|()| to),
         };
         match result {
             Ok(to) => {
@@ -111,7 +111,7 @@ impl Slave {
         app: &mut A,
         from: AlState,
         to: AlState,
-        now_ns: u64,
+        now: Nanos,
     ) -> Result<Result<(), AlStatusCode>, P::Error> {
         match (from, to) {
             (AlState::Init, AlState::PreOp | AlState::Bootstrap) => {
@@ -196,7 +196,7 @@ impl Slave {
                 // the steadiness (E-033) was checked by the caller
                 self.outputs.fill(0);
                 // the PDO timeout runs from the entry into Op at the earliest
-                self.op_entry_ns = now_ns;
+                self.op_entry = now;
                 if let Some(PdoMonitor::EscWatchdog(_)) = self.sync.monitor {
                     // clears an SM watchdog event left over from Safe-Op
                     let _ = pdi.read_u16(regs::WATCHDOG_STATUS_PD)?;
@@ -253,13 +253,13 @@ impl Slave {
 
     /// E-033: answers a waiting S→O request once the RxPDO is steady and
     /// (DC mode) the synchronisation ready, or refuses it after
-    /// [`esm::STEADY_WAIT_NS`] (with the synchronisation's code when that is
+    /// [`esm::STEADY_WAIT`] (with the synchronisation's code when that is
     /// what is missing).
     pub(super) fn pending_op<P: Pdi, A: Application>(
         &mut self,
         pdi: &mut P,
         app: &mut A,
-        now_ns: u64,
+        now: Nanos,
     ) -> Result<Option<StateChange>, P::Error> {
         let Some(since) = self.pending_op else {
             return Ok(None);
@@ -269,9 +269,9 @@ impl Slave {
             return Ok(None);
         }
         let sync = self.sync_ready();
-        let result = if self.outputs_steady(now_ns) && sync.is_ok() {
-            self.transition(pdi, app, AlState::SafeOp, AlState::Op, now_ns)?
-        } else if now_ns.wrapping_sub(since) > esm::STEADY_WAIT_NS {
+        let result = if self.outputs_steady(now) && sync.is_ok() {
+            self.transition(pdi, app, AlState::SafeOp, AlState::Op, now)?
+        } else if now.wrapping_sub(since) > esm::STEADY_WAIT {
             // spec §3.3 "S→O: SYNC0 present, PLL locked": 002Dh / 0032h / …
             if let Err(code) = sync {
                 Err(code)
@@ -310,19 +310,19 @@ impl Slave {
     /// Whether the RxPDO is "stable and regular" for S→O (E-033): with
     /// monitoring on, the last [`esm::STEADY_FRAMES`] frames each
     /// within the tolerance of the previous one and the newest within the
-    /// tolerance of `now_ns`. With monitoring off nothing is required: the
+    /// tolerance of `now`. With monitoring off nothing is required: the
     /// drive would never notice missing frames in Op either, and masters
     /// that request Op before their cyclic task runs (ethercrab's `into_op`)
     /// still get there.
-    pub(super) fn outputs_steady(&self, now_ns: u64) -> bool {
+    pub(super) fn outputs_steady(&self, now: Nanos) -> bool {
         let Some(m) = self.sync.monitor else {
             return true;
         };
-        let tol = m.tolerance_ns();
+        let tol = m.tolerance();
         if self.rx_seen < esm::STEADY_FRAMES {
             return false;
         }
-        let mut newer = now_ns;
+        let mut newer = now;
         for &t in &self.rx_times {
             if newer.wrapping_sub(t) > tol {
                 return false;

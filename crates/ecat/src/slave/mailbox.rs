@@ -60,13 +60,13 @@ impl Slave {
         foe: &mut H,
         eth: &mut E,
         events: u32,
-        now_ns: u64,
+        now: Nanos,
     ) -> Result<(), P::Error> {
         if self.state != AlState::Bootstrap {
             self.foe.reset(foe);
         }
         if esm::mailbox_on(self.state) {
-            self.poll_mailbox(pdi, app, foe, eth, events, now_ns)?;
+            self.poll_mailbox(pdi, app, foe, eth, events, now)?;
         }
         Ok(())
     }
@@ -91,7 +91,7 @@ impl Slave {
         foe: &mut H,
         eth: &mut E,
         events: u32,
-        now_ns: u64,
+        now: Nanos,
     ) -> Result<(), P::Error> {
         let sm1 = pdi.read_sm(1)?;
         let mut full = sm1.status & status::MAILBOX_FULL != 0;
@@ -114,14 +114,14 @@ impl Slave {
             let m = &mut self.mbx;
             if let Some(rx) = m.rx.get_mut(..m.rx_len) {
                 pdi.read(m.rx_start, rx)?;
-                self.handle_request(app, foe, eth, now_ns);
+                self.handle_request(app, foe, eth, now);
                 if let Some(e) = self.eoe.take_emcy() {
                     self.emcy.push(e);
                 }
             }
         }
-        self.coe.tick(now_ns);
-        self.foe.tick(foe, now_ns);
+        self.coe.tick(now);
+        self.foe.tick(foe, now);
         // emergencies go out first once SM1 is free (E-094: through the mailbox);
         // not in Bootstrap (FoE only), they wait
         if !self.mbx.pending && self.state != AlState::Bootstrap {
@@ -162,7 +162,7 @@ impl Slave {
         app: &mut A,
         foe: &mut H,
         eth: &mut E,
-        now_ns: u64,
+        now: Nanos,
     ) {
         let state = self.state;
         let boot = state == AlState::Bootstrap;
@@ -184,12 +184,12 @@ impl Slave {
                     MailboxType::Foe if foe_on => {
                         let max_data = m.rx_len.saturating_sub(HEADER_LEN + FOE_HEADER_LEN);
                         self.foe
-                            .handle(payload, body, foe, boot, max_data, now_ns)
+                            .handle(payload, body, foe, boot, max_data, now)
                             .map(|n| n.map(|n| (MailboxType::Foe, n)))
                     }
                     MailboxType::Coe if !boot => self
                         .coe
-                        .handle(payload, body, app, state, now_ns)
+                        .handle(payload, body, app, state, now)
                         .map(|n| n.map(|n| (MailboxType::Coe, n))),
                     // E-095: Pre-Op, Safe-Op and Op
                     MailboxType::Eoe if eoe => self

@@ -19,6 +19,7 @@ use crate::mailbox::{next_counter, MailboxError, MailboxHeader, MailboxType, HEA
 use esc::regs::{self, al_event};
 use esc::sm::{activate, pdi_control, status};
 use esc::{AlControl, AlState, AlStatus, AlStatusCode, Pdi, PdiExt, SyncManager};
+use nanos::Nanos;
 
 /// An AL control request the slave processed: a state change or a refusal.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
@@ -119,13 +120,13 @@ pub struct Slave {
     outputs: [u8; MAX_PDO_BYTES],
     rx_frames: u32,
     /// Times of the last [`esm::STEADY_FRAMES`] RxPDO frames (newest first).
-    rx_times: [u64; esm::STEADY_FRAMES as usize],
+    rx_times: [Nanos; esm::STEADY_FRAMES as usize],
     /// Frames recorded in `rx_times` (saturating).
     rx_seen: u32,
     /// An S→O request waiting for stable RxPDO since this time (E-033).
-    pending_op: Option<u64>,
+    pending_op: Option<Nanos>,
     /// When Op was last entered (start of the PDO timeout).
-    op_entry_ns: u64,
+    op_entry: Nanos,
     sync: SyncStatus,
     /// The application's synchronisation state (DC-Sync PLL), set before each poll.
     sync_state: SyncState,
@@ -171,10 +172,10 @@ impl Slave {
             inputs: [0; MAX_PDO_BYTES],
             outputs: [0; MAX_PDO_BYTES],
             rx_frames: 0,
-            rx_times: [0; esm::STEADY_FRAMES as usize],
+            rx_times: [Nanos::ZERO; esm::STEADY_FRAMES as usize],
             rx_seen: 0,
             pending_op: None,
-            op_entry_ns: 0,
+            op_entry: Nanos::ZERO,
             sync: SyncStatus {
                 k: 1,
                 ..SyncStatus::default()
@@ -327,23 +328,23 @@ impl Slave {
         &mut self,
         pdi: &mut P,
         app: &mut A,
-        now_ns: u64,
+        now: Nanos,
     ) -> Result<Option<StateChange>, P::Error> {
-        self.poll_with_foe(pdi, app, &mut NoFiles, now_ns)
+        self.poll_with_foe(pdi, app, &mut NoFiles, now)
     }
 
     /// [`poll`](Self::poll) with the application's FoE file handler (the
     /// firmware slots): FoE writes in Bootstrap go to `foe`; a transfer in
     /// progress ends when the slave leaves Bootstrap or after
-    /// [`crate::foe::FOE_TIMEOUT_NS`] without a packet.
+    /// [`crate::foe::FOE_TIMEOUT`] without a packet.
     pub fn poll_with_foe<P: Pdi, A: Application, H: FoeHandler>(
         &mut self,
         pdi: &mut P,
         app: &mut A,
         foe: &mut H,
-        now_ns: u64,
+        now: Nanos,
     ) -> Result<Option<StateChange>, P::Error> {
-        self.poll_with_eoe(pdi, app, foe, &mut NoEthernet, now_ns)
+        self.poll_with_eoe(pdi, app, foe, &mut NoEthernet, now)
     }
 
     /// [`poll_with_foe`](Self::poll_with_foe) with the application's
@@ -358,11 +359,11 @@ impl Slave {
         app: &mut A,
         foe: &mut H,
         eth: &mut E,
-        now_ns: u64,
+        now: Nanos,
     ) -> Result<Option<StateChange>, P::Error> {
-        let (events, change) = self.poll_al_control(pdi, app, now_ns)?;
-        self.mailbox_step(pdi, app, foe, eth, events, now_ns)?;
-        self.poll_process_data(pdi, app, events, change, now_ns)
+        let (events, change) = self.poll_al_control(pdi, app, now)?;
+        self.mailbox_step(pdi, app, foe, eth, events, now)?;
+        self.poll_process_data(pdi, app, events, change, now)
     }
 
     /// The ESC-event part of [`poll_with_eoe`](Self::poll_with_eoe) for a
@@ -373,10 +374,10 @@ impl Slave {
         &mut self,
         pdi: &mut P,
         app: &mut A,
-        now_ns: u64,
+        now: Nanos,
     ) -> Result<Option<StateChange>, P::Error> {
-        let (events, change) = self.poll_al_control(pdi, app, now_ns)?;
-        self.poll_process_data(pdi, app, events, change, now_ns)
+        let (events, change) = self.poll_al_control(pdi, app, now)?;
+        self.poll_process_data(pdi, app, events, change, now)
     }
 
     /// The mailbox part of [`poll_with_eoe`](Self::poll_with_eoe) for a
@@ -389,10 +390,10 @@ impl Slave {
         app: &mut A,
         foe: &mut H,
         eth: &mut E,
-        now_ns: u64,
+        now: Nanos,
     ) -> Result<(), P::Error> {
         let events = pdi.al_event()?;
-        self.mailbox_step(pdi, app, foe, eth, events, now_ns)
+        self.mailbox_step(pdi, app, foe, eth, events, now)
     }
 }
 

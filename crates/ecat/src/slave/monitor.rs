@@ -11,16 +11,16 @@ impl Slave {
         app: &mut A,
         events: u32,
         mut change: Option<StateChange>,
-        now_ns: u64,
+        now: Nanos,
     ) -> Result<Option<StateChange>, P::Error> {
         if esm::process_data_on(self.state) {
-            self.process_data(pdi, events, now_ns)?;
+            self.process_data(pdi, events, now)?;
         }
         if change.is_none() {
-            change = self.pending_op(pdi, app, now_ns)?;
+            change = self.pending_op(pdi, app, now)?;
         }
         if change.is_none() && self.state == AlState::Op {
-            change = self.monitor_rxpdo(pdi, events, now_ns)?;
+            change = self.monitor_rxpdo(pdi, events, now)?;
         }
         if change.is_none() && self.state == AlState::Op {
             change = self.monitor_sync(pdi)?;
@@ -32,7 +32,7 @@ impl Slave {
         &mut self,
         pdi: &mut P,
         events: u32,
-        now_ns: u64,
+        now: Nanos,
     ) -> Result<(), P::Error> {
         if self.out_len > 0 && events & al_event::sm(2) != 0 {
             if let Some(out) = self.outputs.get_mut(..self.out_len) {
@@ -41,7 +41,7 @@ impl Slave {
                 self.rx_frames = self.rx_frames.wrapping_add(1);
                 self.rx_times.rotate_right(1);
                 if let Some(newest) = self.rx_times.first_mut() {
-                    *newest = now_ns;
+                    *newest = now;
                 }
                 self.rx_seen = self.rx_seen.saturating_add(1);
             }
@@ -62,14 +62,14 @@ impl Slave {
         &mut self,
         pdi: &mut P,
         events: u32,
-        now_ns: u64,
+        now: Nanos,
     ) -> Result<Option<StateChange>, P::Error> {
         let expired = match self.sync.monitor {
             None => false,
             Some(PdoMonitor::Timeout(t)) => {
                 let newest = self.rx_times.first().copied().filter(|_| self.rx_seen > 0);
-                let last = newest.map_or(self.op_entry_ns, |t| t.max(self.op_entry_ns));
-                now_ns.wrapping_sub(last) > t
+                let last = newest.map_or(self.op_entry, |t| t.max(self.op_entry));
+                now.wrapping_sub(last) > t
             }
             Some(PdoMonitor::EscWatchdog(_)) => {
                 // the event is cleared by reading 0x0440; bit 0 = 0: expired

@@ -27,9 +27,9 @@ pub struct HomingConfig {
     /// far (or farther) beyond where the index search starts (the switch
     /// edge, the mechanical stop or the start for 33/34).
     pub index_search_offset: u32,
-    /// I29: how long the torque must be at the limit I28 without a break,
-    /// ns (torque methods).
-    pub torque_hold_ns: u64,
+    /// I29: how long the torque must be at the limit I28 without a break
+    /// (torque methods).
+    pub torque_hold: Nanos,
     /// Travel before the reference event after which the search fails
     /// ([`HomingError::TravelExceeded`]), increments; 0 = no limit.
     pub max_search_distance: u32,
@@ -53,7 +53,7 @@ impl Default for HomingConfig {
             home_offset: 0,
             move_to_home: false,
             index_search_offset: 0,
-            torque_hold_ns: 100_000_000,
+            torque_hold: Nanos::from_ms(100),
             max_search_distance: 0,
             limit_as_reference: false,
         }

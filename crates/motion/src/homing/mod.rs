@@ -66,6 +66,7 @@ pub use method::{Direction, HomingMethod};
 use method::{Kind, Target};
 
 use crate::profile::{PositionTarget, ProfileError, ProfileGenerator, ProfileLimits, SetMode};
+use nanos::Nanos;
 
 /// Statusword bit 10 "target reached" (homing: referencing finished or
 /// interrupted).
@@ -150,8 +151,8 @@ pub struct Homing {
     last_velocity: f32,
     /// Travel since the start, increments.
     travelled: u64,
-    /// Time the torque has been at the limit, ns.
-    torque_ns: u64,
+    /// Time the torque has been at the limit.
+    torque_time: Nanos,
     referenced: bool,
 }
 
@@ -172,7 +173,7 @@ impl Homing {
             last_position: actual_position,
             last_velocity: 0.0,
             travelled: 0,
-            torque_ns: 0,
+            torque_time: Nanos::ZERO,
             referenced: false,
         }
     }
@@ -322,7 +323,7 @@ impl Homing {
         self.referenced = false;
         self.reversed = false;
         self.travelled = 0;
-        self.torque_ns = 0;
+        self.torque_time = Nanos::ZERO;
         self.prev = Levels {
             neg: input.negative_limit.active,
             pos: input.positive_limit.active,
@@ -526,12 +527,12 @@ impl Homing {
                 self.check_index(input, from, approach, event);
             }
             (Phase::Torque, _) => {
-                self.torque_ns = if input.torque_limit {
-                    self.torque_ns.saturating_add(u64::from(dt_ns))
+                self.torque_time = if input.torque_limit {
+                    self.torque_time.saturating_add(Nanos::from_ns(u64::from(dt_ns)))
                 } else {
-                    0
+                    Nanos::ZERO
                 };
-                if input.torque_limit && self.torque_ns >= self.cfg.torque_hold_ns {
+                if input.torque_limit && self.torque_time >= self.cfg.torque_hold {
                     let at = self.local(input.actual_position);
                     self.gen.reset(at);
                     self.last_position = at;

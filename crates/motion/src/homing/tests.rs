@@ -152,7 +152,7 @@ fn config(method: i8) -> HomingConfig {
         home_offset: 7_000_000,
         move_to_home: false,
         index_search_offset: 0,
-        torque_hold_ns: 5_000_000,
+        torque_hold: Nanos::from_ms(5),
         max_search_distance: 0,
         limit_as_reference: false,
     }

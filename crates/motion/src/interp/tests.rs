@@ -6,7 +6,7 @@ fn config(order: InterpolationOrder, n: u32) -> InterpolatorConfig {
         order,
         feedforward: FeedforwardSource::Internal,
         velocity_feedforward_percent: 100.0,
-        max_extrapolation_ns: 3_000_000,
+        max_extrapolation: Nanos::from_ms(3),
     }
 }
 
@@ -203,7 +203,7 @@ fn c117_no_fault_before_first_setpoint() {
 #[test]
 fn c117_i423_zero_faults_on_first_missing() {
     let mut cfg = config(InterpolationOrder::Linear, 2);
-    cfg.max_extrapolation_ns = 0;
+    cfg.max_extrapolation = Nanos::ZERO;
     let mut ip = FineInterpolator::new(cfg).unwrap();
     ip.start(0);
     ip.cycle(sp(10)).unwrap();
@@ -317,7 +317,7 @@ fn c120_i25_zero_disables_velocity_feedforward() {
 #[test]
 fn c115_csv_velocity_interpolated_linearly() {
     let ratio = CycleRatio::new(1_000_000, 250_000).unwrap();
-    let mut vi = VelocityInterpolator::new(ratio, 2_000_000);
+    let mut vi = VelocityInterpolator::new(ratio, Nanos::from_ms(2));
     vi.start(0.0);
     let out: [f32; 4] = core::array::from_fn(|k| {
         vi.cycle(if k == 0 { Some(1000.0) } else { None })

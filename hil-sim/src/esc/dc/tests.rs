@@ -41,18 +41,24 @@ fn difference(e: &Esc) -> i64 {
 #[test]
 fn local_clock_runs_with_drift_and_offset_and_inverts_exactly() {
     let c = LocalClock::new(5_000, 100_000_000); // +100 ppm
-    assert_eq!(c.local_at(0), 5_000);
-    assert_eq!(c.local_at(1_000_000_000), 5_000 + 1_000_000_000 + 100_000);
+    assert_eq!(c.local_at(Nanos::from_ns(0)), 5_000);
+    assert_eq!(
+        c.local_at(Nanos::from_ns(1_000_000_000)),
+        5_000 + 1_000_000_000 + 100_000
+    );
     let slow = LocalClock::new(0, -80_000_000); // -80 ppm
-    assert_eq!(slow.local_at(1_000_000_000), 1_000_000_000 - 80_000);
+    assert_eq!(
+        slow.local_at(Nanos::from_ns(1_000_000_000)),
+        1_000_000_000 - 80_000
+    );
     for clock in [c, slow, LocalClock::new(u64::MAX - 10, 3_456_789)] {
         for target in [0u64, 1, 999, 123_456_789, 1_000_000_007, 98_765_432_123] {
-            let target = clock.local_at(0).wrapping_add(target);
+            let target = clock.local_at(Nanos::from_ns(0)).wrapping_add(target);
             let t = clock.now_for_local(target);
             assert!(clock.local_at(t).wrapping_sub(target) as i64 >= 0);
-            if t > 0 {
+            if t > Nanos::ZERO {
                 assert!(
-                    (clock.local_at(t - 1).wrapping_sub(target) as i64) < 0,
+                    (clock.local_at(t - Nanos::from_ns(1)).wrapping_sub(target) as i64) < 0,
                     "earliest"
                 );
             }
@@ -60,16 +66,19 @@ fn local_clock_runs_with_drift_and_offset_and_inverts_exactly() {
     }
     // a change of speed keeps the time continuous
     let mut c = c;
-    let before = c.local_at(2_000_000);
-    c.set_rate(2_000_000, -50_000_000);
-    assert_eq!(c.local_at(2_000_000), before);
-    assert_eq!(c.local_at(3_000_000), before + 1_000_000 - 50);
+    let before = c.local_at(Nanos::from_ns(2_000_000));
+    c.set_rate(Nanos::from_ns(2_000_000), -50_000_000);
+    assert_eq!(c.local_at(Nanos::from_ns(2_000_000)), before);
+    assert_eq!(c.local_at(Nanos::from_ns(3_000_000)), before + 1_000_000 - 50);
 }
 
 #[test]
 fn esc_local_and_system_time_follow_the_configured_clock() {
     let mut e = esc_with_clock(50_000, 1_000); // +50 ppm
-    assert_eq!(e.local_ns(2_000_000_000), 1_000 + 2_000_000_000 + 100_000);
+    assert_eq!(
+        e.local_ns(Nanos::from_ns(2_000_000_000)),
+        1_000 + 2_000_000_000 + 100_000
+    );
     xfer1(
         &mut e,
         Command::Apwr,
@@ -88,7 +97,10 @@ fn esc_local_and_system_time_follow_the_configured_clock() {
     // the PDI reads it at the ESC's time
     let mut b = [0u8; 8];
     e.read(dc::SYSTEM_TIME, &mut b).unwrap();
-    assert_eq!(u64::from_le_bytes(b), e.system_time_ns(1_000_000_000));
+    assert_eq!(
+        u64::from_le_bytes(b),
+        e.system_time_ns(Nanos::from_ns(1_000_000_000))
+    );
 }
 
 #[test]
@@ -96,12 +108,12 @@ fn receive_times_per_port_follow_the_line() {
     let mut a = esc_with_clock(0, 0);
     let mut b = esc_with_clock(20_000, 1_000_000); // +20 ppm, another phase
     a.set_line_timing(LineTiming {
-        arrival_ns: 0,
-        loop_ns: 500,
+        arrival: Nanos::from_ns(0),
+        loop_time: Nanos::from_ns(500),
     });
     b.set_line_timing(LineTiming {
-        arrival_ns: 250,
-        loop_ns: 0,
+        arrival: Nanos::from_ns(250),
+        loop_time: Nanos::from_ns(0),
     });
     let t = 10_000_000u64;
     let (_, wkc) = xfer(
@@ -130,7 +142,11 @@ fn receive_times_per_port_follow_the_line() {
         "round trip through the rest of the line"
     );
     let (p0, p1, pu) = ports(&mut b);
-    assert_eq!(pu, b.local_ns(t + 250), "port 0 at its arrival, local clock");
+    assert_eq!(
+        pu,
+        b.local_ns(Nanos::from_ns(t + 250)),
+        "port 0 at its arrival, local clock"
+    );
     assert_eq!((p0, p1), (pu as u32, pu as u32), "last slave: port 1 closed");
 }
 
@@ -138,8 +154,8 @@ fn receive_times_per_port_follow_the_line() {
 fn ecat_system_time_is_taken_at_the_frames_arrival() {
     let mut e = esc_with_clock(0, 0);
     e.set_line_timing(LineTiming {
-        arrival_ns: 750,
-        loop_ns: 0,
+        arrival: Nanos::from_ns(750),
+        loop_time: Nanos::from_ns(0),
     });
     let (d, _) = xfer1(&mut e, Command::Aprd, phys(0, dc::SYSTEM_TIME), &[0; 8], 5_000);
     assert_eq!(u64_of(&d), 5_750);
@@ -162,12 +178,12 @@ fn drift_run(
     let mut a = esc_with_clock(drift_a, 3_000_000);
     let mut b = esc_with_clock(drift_b, 987_654_321);
     a.set_line_timing(LineTiming {
-        arrival_ns: 0,
-        loop_ns: 500,
+        arrival: Nanos::from_ns(0),
+        loop_time: Nanos::from_ns(500),
     });
     b.set_line_timing(LineTiming {
-        arrival_ns: 250,
-        loop_ns: 0,
+        arrival: Nanos::from_ns(250),
+        loop_time: Nanos::from_ns(0),
     });
     let mut t = 1_000_000u64;
     for (p, addr) in [(0u16, 0x1000u16), (1, 0x1001)] {
@@ -253,12 +269,16 @@ fn drift_control_converges_for_plus_minus_100_ppm() {
         let mut worst_late = 0i64;
         let (a, b, t) = drift_run(da, db, 10_000, 8_000, 1_000, 1_000_000, |a, b, t| {
             if t > 500_000_000 {
-                let d = a.system_time_ns(t).wrapping_sub(b.system_time_ns(t)) as i64;
+                let d = a
+                    .system_time_ns(Nanos::from_ns(t))
+                    .wrapping_sub(b.system_time_ns(Nanos::from_ns(t))) as i64;
                 worst_late = worst_late.max(d.abs());
             }
         });
         let d = difference(&b);
-        let sync = a.system_time_ns(t).wrapping_sub(b.system_time_ns(t)) as i64;
+        let sync = a
+            .system_time_ns(Nanos::from_ns(t))
+            .wrapping_sub(b.system_time_ns(Nanos::from_ns(t))) as i64;
         std::println!(
             "drifts {da}/{db} ppb: 0x092C {d} ns, true offset {sync} ns, worst after 0.5 s {worst_late} ns, rate a {} b {} ppb",
             a.clock_rate_ppb(),
@@ -283,11 +303,15 @@ fn drift_control_converges_for_plus_minus_100_ppm() {
 fn drift_control_after_static_sync_alone_and_with_slow_cycles() {
     // after the static drift compensation alone
     let (a, b, t) = drift_run(50_000, -80_000, 10_000, 8_000, 0, 0, |_, _, _| {});
-    let sync = a.system_time_ns(t).wrapping_sub(b.system_time_ns(t)) as i64;
+    let sync = a
+        .system_time_ns(Nanos::from_ns(t))
+        .wrapping_sub(b.system_time_ns(Nanos::from_ns(t))) as i64;
     assert!(sync.abs() <= 2 && difference(&b).abs() <= 2, "{sync}");
     // 10 ms cycles only (gains reduced): still converges
     let (a, b, t) = drift_run(50_000, -80_000, 0, 0, 1_000, 10_000_000, |_, _, _| {});
-    let sync = a.system_time_ns(t).wrapping_sub(b.system_time_ns(t)) as i64;
+    let sync = a
+        .system_time_ns(Nanos::from_ns(t))
+        .wrapping_sub(b.system_time_ns(Nanos::from_ns(t))) as i64;
     assert!(sync.abs() <= 5, "{sync}");
 }
 
@@ -316,7 +340,9 @@ fn drift_control_with_time_filter_depth_stays_stable() {
             t,
         );
     }
-    let sync = a.system_time_ns(t).wrapping_sub(b.system_time_ns(t)) as i64;
+    let sync = a
+        .system_time_ns(Nanos::from_ns(t))
+        .wrapping_sub(b.system_time_ns(Nanos::from_ns(t))) as i64;
     assert!(sync.abs() <= 2, "{sync}");
     assert!(difference(&b).abs() <= 2);
     // speed counter difference shows the frequency correction (-100 ppm, 0.1 ppm units)
@@ -387,10 +413,10 @@ fn start_sync(e: &mut Esc, start: u64, c0: u32, c1: u32, act: u8, now: u64) {
 /// Steps to every SYNC0 edge up to `until` and returns (sim time, system time) of each pulse.
 fn sync0_edges(e: &mut Esc, until: u64) -> Vec<(u64, u64)> {
     let mut out = Vec::new();
-    while let Some(t) = e.next_sync0_at().filter(|&t| t <= until) {
+    while let Some(t) = e.next_sync0_at().filter(|&t| t <= Nanos::from_ns(until)) {
         let p = e.take_sync0_events(t);
-        assert_eq!((p.count, p.last_now_ns), (1, t));
-        out.push((t, p.last_system_ns));
+        assert_eq!((p.count, p.last_now), (1, t));
+        out.push((t.as_ns(), p.last_system_ns));
     }
     out
 }
@@ -407,13 +433,13 @@ fn sync0_pulses_are_exact_in_system_time() {
     );
     let start = 1_020_000_000u64; // system time
     start_sync(&mut e, start, 1_000_000, 0, 0x03, 1_000);
-    assert_eq!(e.take_sync0_events(1_000).count, 0);
+    assert_eq!(e.take_sync0_events(Nanos::from_ns(1_000)).count, 0);
     let edges = sync0_edges(&mut e, 200_000_000);
     assert!(edges.len() > 150);
     for (k, &(t, sys)) in edges.iter().enumerate() {
         assert_eq!(sys, start + k as u64 * 1_000_000);
         assert!(
-            e.system_time_ns(t) >= sys && e.system_time_ns(t - 1) < sys,
+            e.system_time_ns(Nanos::from_ns(t)) >= sys && e.system_time_ns(Nanos::from_ns(t - 1)) < sys,
             "edge exact"
         );
     }
@@ -422,7 +448,7 @@ fn sync0_pulses_are_exact_in_system_time() {
     let (t100, _) = edges[100];
     assert!(((t100 - t0) as i64 - 100_003_701).abs() <= 1, "{}", t100 - t0);
     // 0x0990 reads the next pulse
-    let now = e.now_ns();
+    let now = e.now().as_ns();
     let (d, _) = xfer1(&mut e, Command::Aprd, phys(0, dc::START_TIME), &[0; 8], now);
     assert_eq!(u64_of(&d), edges.last().unwrap().1 + 1_000_000);
     // deactivation stops it
@@ -434,9 +460,9 @@ fn sync0_pulses_are_exact_in_system_time() {
 fn sync0_status_and_al_event_clear_on_pdi_read() {
     let mut e = esc_with_clock(0, 0);
     start_sync(&mut e, 100_000, 50_000, 0, 0x03, 0);
-    e.tick(99_999);
+    e.tick(Nanos::from_ns(99_999));
     assert_eq!(e.get_u8(dc::SYNC0_STATUS), 0);
-    e.tick(100_000);
+    e.tick(Nanos::from_ns(100_000));
     assert_eq!(e.get_u8(dc::SYNC0_STATUS) & 1, 1);
     assert_ne!(Pdi::al_event(&mut e).unwrap() & al_event::SYNC0, 0);
     // an ECAT read does not acknowledge
@@ -448,14 +474,14 @@ fn sync0_status_and_al_event_clear_on_pdi_read() {
     assert_eq!(e.get_u8(dc::SYNC0_STATUS) & 1, 0, "cleared by reading");
     assert_eq!(Pdi::al_event(&mut e).unwrap() & al_event::SYNC0, 0);
     // several pulses missed: counted, the last one's time is reported
-    let p = e.take_sync0_events(330_000);
+    let p = e.take_sync0_events(Nanos::from_ns(330_000));
     assert_eq!((p.count, p.last_system_ns), (5, 300_000));
-    assert_eq!(e.next_sync0_at(), Some(350_000));
+    assert_eq!(e.next_sync0_at(), Some(Nanos::from_ns(350_000)));
     // masked out: no AL event, the status still shows it
     e.write(::esc::regs::AL_EVENT_MASK, &(!al_event::SYNC0).to_le_bytes())
         .unwrap();
     e.read(dc::SYNC0_STATUS, &mut s).unwrap();
-    e.tick(350_000);
+    e.tick(Nanos::from_ns(350_000));
     assert_eq!(e.al_event_request() & al_event::SYNC0, 0);
     assert_eq!(e.get_u8(dc::SYNC0_STATUS) & 1, 1);
     // the master cannot write the status
@@ -469,9 +495,9 @@ fn sync1_follows_the_cycle_rules() {
         let mut e = esc_with_clock(0, 0);
         start_sync(&mut e, 1_000_000, 100_000, c1, 0x07, 0);
         let mut times = Vec::new();
-        while let Some(t) = e.next_sync1_at().filter(|&t| t < 2_000_000) {
+        while let Some(t) = e.next_sync1_at().filter(|&t| t < Nanos::from_ms(2)) {
             e.take_sync1_events(t);
-            times.push(t);
+            times.push(t.as_ns());
         }
         times.truncate(3);
         times
@@ -499,8 +525,8 @@ fn sync1_follows_the_cycle_rules() {
 fn start_time_in_the_past_starts_at_the_next_cycle_boundary() {
     let mut e = esc_with_clock(0, 0);
     start_sync(&mut e, 100_000, 300_000, 0, 0x03, 1_000_000);
-    assert_eq!(e.next_sync0_at(), Some(1_000_000));
+    assert_eq!(e.next_sync0_at(), Some(Nanos::from_ns(1_000_000)));
     let mut e = esc_with_clock(0, 0);
     start_sync(&mut e, 100_000, 300_000, 0, 0x03, 1_000_001);
-    assert_eq!(e.next_sync0_at(), Some(1_300_000));
+    assert_eq!(e.next_sync0_at(), Some(Nanos::from_ns(1_300_000)));
 }
