@@ -32,6 +32,7 @@ pub mod alarm;
 pub mod cm;
 pub mod dcp;
 pub mod ip;
+pub mod led;
 pub mod lldp;
 pub mod model;
 pub mod rpc;
