@@ -405,3 +405,42 @@ fn p043_high_and_low_are_independent_and_only_low_folds_them() {
     );
     assert_eq!(cr.poll_at(ms(0)), Nanos::MAX);
 }
+
+#[test]
+fn p043_alarm_cr_never_panics_on_mutated_or_truncated_frames() {
+    let n = diag_notification();
+    let valid = [
+        ctl_rta(Priority::Low, 3, 0x01, 0xFFFE, 0xFFFF, &[]),
+        ctl_rta(
+            Priority::Low,
+            1,
+            0x11,
+            0xFFFF,
+            0xFFFF,
+            &ack_block(&n, PnioStatus::OK),
+        ),
+        ctl_rta(Priority::High, 4, 0x01, 0xFFFF, 0xFFFE, &[0xCF, 0x81, 0xFD, 0x0F]),
+    ];
+    let mut seed = 0x0F0F_1234_5678_9ABCu64;
+    let mut buf = [0u8; 128];
+    for i in 0..20_000u64 {
+        let mut cr = AlarmCr::new(config()).unwrap();
+        cr.send(ms(0), &n).unwrap();
+        let _ = cr.poll(ms(0), &mut buf);
+        let mut f = valid[(i % 3) as usize].clone();
+        for _ in 0..crate::rt::tests::xorshift(&mut seed) % 4 {
+            let at = (crate::rt::tests::xorshift(&mut seed) as usize) % f.len();
+            f[at] = crate::rt::tests::xorshift(&mut seed) as u8;
+        }
+        let cut = (crate::rt::tests::xorshift(&mut seed) as usize) % (f.len() + 8);
+        f.resize(cut, 0);
+        if let Some(e) = EthFrame::parse(&f) {
+            let _ = cr.receive(ms(1), &e);
+            let _ = RtaHeader::parse(e.payload);
+            let _ = AlarmAck::parse(e.payload);
+        }
+        while cr.poll(ms(i % 1000), &mut buf).is_some() {}
+        // short buffers get nothing, never a panic
+        let _ = cr.poll(ms(5000), &mut [0u8; 20]);
+    }
+}

@@ -1,6 +1,7 @@
 //! The consumer of the controller's output CR (controller → drive).
 
 use super::{counter_is_newer, ConfigError, CrConfig, DataStatus, IoDataObject, Ioxs};
+use crate::alarm::AbortCode;
 use crate::wire::{ethertype, split_frame_id, EthFrame, FrameKind};
 use nanos::Nanos;
 
@@ -27,6 +28,18 @@ pub enum ConsumerEvent {
     /// ([`crate::alarm::AbortCode::CONSUMER_DHT_EXPIRED`]); the drive
     /// personality raises its communication fault.
     WatchdogExpired,
+}
+
+impl ConsumerEvent {
+    /// The AR abort this event calls for: the watchdog's is
+    /// [`AbortCode::CONSUMER_DHT_EXPIRED`] (for [`crate::alarm::AlarmCr::abort`]);
+    /// a data hold expiry aborts nothing.
+    pub const fn abort_code(self) -> Option<AbortCode> {
+        match self {
+            ConsumerEvent::WatchdogExpired => Some(AbortCode::CONSUMER_DHT_EXPIRED),
+            ConsumerEvent::DataHoldExpired => None,
+        }
+    }
 }
 
 /// Why a received frame was dropped. Every drop is counted

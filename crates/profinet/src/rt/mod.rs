@@ -305,6 +305,6 @@ pub const fn counter_is_newer(counter: u16, last: u16) -> bool {
 }
 
 #[cfg(test)]
-mod tests;
+pub(crate) mod tests;
 #[cfg(test)]
 pub(crate) mod tests_vectors;

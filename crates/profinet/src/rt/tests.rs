@@ -294,6 +294,11 @@ fn p036_watchdog_expiry_is_ar_loss_and_data_hold_comes_first() {
     assert_eq!(c.poll_at(), ms(292));
     assert_eq!(c.poll(ms(291)), None);
     assert_eq!(c.poll(ms(292)), Some(ConsumerEvent::WatchdogExpired));
+    assert_eq!(
+        ConsumerEvent::WatchdogExpired.abort_code(),
+        Some(crate::alarm::AbortCode::CONSUMER_DHT_EXPIRED)
+    );
+    assert_eq!(ConsumerEvent::DataHoldExpired.abort_code(), None);
     assert_eq!(c.state(), ConsumerState::Expired);
     assert_eq!(c.poll_at(), Nanos::MAX);
     let f = ctl_frame(3072, 0x35, 0, 1);
@@ -420,4 +425,35 @@ fn p042_provider_frames_feed_a_consumer() {
         assert_eq!(r.outputs.unwrap().data(2, 1).unwrap()[0], k as u8);
         assert_eq!(c.poll(ms(32 * k + 2)), None);
     }
+}
+
+/// A deterministic xorshift for the mutation tests.
+pub(crate) fn xorshift(seed: &mut u64) -> u64 {
+    *seed ^= *seed << 13;
+    *seed ^= *seed >> 7;
+    *seed ^= *seed << 17;
+    *seed
+}
+
+#[test]
+fn p042_consumer_never_panics_on_mutated_or_truncated_frames() {
+    let good = ctl_frame(1024, 0x35, 0, 1);
+    let mut c = Consumer::new(output_cr()).unwrap();
+    let mut seed = 0x1234_5678_9ABC_DEF0u64;
+    for i in 0..20_000u64 {
+        let mut f = good.clone();
+        let flips = xorshift(&mut seed) % 4;
+        for _ in 0..flips {
+            let at = (xorshift(&mut seed) as usize) % f.len();
+            f[at] = xorshift(&mut seed) as u8;
+        }
+        let cut = (xorshift(&mut seed) as usize) % (f.len() + 8);
+        f.resize(cut, 0);
+        if let Some(e) = EthFrame::parse(&f) {
+            let _ = c.receive(ms(i), &e);
+        }
+        let _ = c.poll(ms(i));
+    }
+    let s = c.stats();
+    assert!(s.accepted > 0 && s.wrong_length > 0 && s.wrong_frame_id > 0);
 }
