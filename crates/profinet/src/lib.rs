@@ -27,6 +27,7 @@ pub mod cm;
 pub mod dcp;
 pub mod device;
 pub mod ip;
+pub mod led;
 pub mod lldp;
 pub mod model;
 pub mod rpc;
