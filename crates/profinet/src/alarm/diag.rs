@@ -27,7 +27,9 @@ use super::blocks::{
 };
 use super::Priority;
 
-/// A drive error HH-S (spec §2.7): main index 1…96, sub-index 0…9.
+/// A drive error HH-S (spec §2.7): main index 1…96; sub-index 0…15
+/// ([`crate::model::SUB_ERRORS`]: the manual's S is 0…9, the drive's event
+/// causes, which S carries, go to 15 — the GSDML's ExtChannelDiagList).
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]
 pub struct DriveError {
     main: u8,
@@ -35,9 +37,9 @@ pub struct DriveError {
 }
 
 impl DriveError {
-    /// The error HH-S, if HH is 1…96 and S 0…9.
+    /// The error HH-S, if HH is 1…96 and S 0…15.
     pub const fn new(main: u8, sub: u8) -> Option<DriveError> {
-        if main >= 1 && main <= 96 && sub <= 9 {
+        if main >= 1 && main <= 96 && sub <= *crate::model::SUB_ERRORS.end() {
             Some(DriveError { main, sub })
         } else {
             None

@@ -70,7 +70,8 @@ fn p031_q13_main_index_is_added_as_a_binary_number() {
     assert_eq!(err(1, 0).channel_error_type(), 0x1001);
     assert!(DriveError::new(0, 0).is_none());
     assert!(DriveError::new(97, 0).is_none());
-    assert!(DriveError::new(8, 10).is_none());
+    assert!(DriveError::new(8, 15).is_some());
+    assert!(DriveError::new(8, 16).is_none());
 }
 
 #[test]

@@ -21,24 +21,34 @@
 use heapless::{Deque, Vec};
 use nanos::Nanos;
 
+use crate::alarm::{AbortCode, AlarmEvent, DiagList, DriveError, Maintenance, Output, Priority};
 use crate::cm::{Cm, CmConfig, CmEvent, Im0, ImData, NoRecords, RecordHook};
 use crate::dcp::server::{DcpServer, Event as DcpEvent, Identity};
 use crate::dcp::{IpSuite, NameOfStation};
 use crate::ip::{IpConfig, Received, Stack, UdpTx, RPC_PORT, UDP_PAYLOAD_OFFSET};
+use crate::led::LedInputs;
 use crate::lldp::{self, PortIdForm, PortInfo, Schedule};
 use crate::model;
 use crate::rpc::epm::{self, EpmInfo};
 use crate::rpc::server::{Server, ServerConfig};
 use crate::rpc::uuid;
+use crate::rpc::uuid::Uuid;
+use crate::rt::ConsumerEvent;
 use crate::wire::{ethertype, split_frame_id, EthFrame, FrameKind, MacAddr};
 
+mod cyclic;
 #[cfg(test)]
 mod tests;
+
+use cyclic::Cyclic;
+pub use cyclic::{MAX_MODULES, MAX_MODULE_BYTES};
 
 /// The largest frame the device sends or accepts (without FCS, with a VLAN tag).
 pub const MAX_FRAME: usize = 1518;
 /// Events kept for the application between two [`Device::take_event`] drains.
 pub const MAX_DEVICE_EVENTS: usize = 16;
+/// Diagnoses the device keeps at once.
+pub const MAX_DIAGNOSES: usize = 16;
 
 /// What the device starts with (from the parameter store and the production data).
 #[derive(Clone, Debug)]
@@ -68,6 +78,22 @@ pub enum DeviceEvent {
     /// Connection management: an AR established, ready, released, aborted; an
     /// I&M record written.
     Cm(CmEvent),
+    /// The real-time side of the AR.
+    Rt(RtEvent),
+}
+
+/// What the cyclic and alarm channels report.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum RtEvent {
+    /// The first valid output frame arrived: cyclic data is exchanged.
+    Exchanging(Uuid),
+    /// No valid output frame for the data hold time: the outputs are no
+    /// longer current (substitute values; spec Q-07, docs/conformance.md).
+    DataHoldExpired(Uuid),
+    /// The AR is lost: the output CR's watchdog expired (no frame for
+    /// WatchdogFactor cycles), the alarm channel gave up, or the controller
+    /// sent an RTA error. The drive raises its communication fault.
+    ArLost(Uuid),
 }
 
 /// Frames the device did not take, by reason.
@@ -100,6 +126,10 @@ pub struct Device<H: RecordHook = NoRecords> {
     events: Deque<DeviceEvent, MAX_DEVICE_EVENTS>,
     counters: DeviceCounters,
     started: bool,
+    cyclic: Option<Cyclic>,
+    diag: DiagList<MAX_DIAGNOSES>,
+    link_up: bool,
+    watchdog_expired: bool,
 }
 
 fn ip_config(s: IpSuite) -> IpConfig {
@@ -148,6 +178,10 @@ impl<H: RecordHook> Device<H> {
             events: Deque::new(),
             counters: DeviceCounters::default(),
             started: false,
+            cyclic: None,
+            diag: DiagList::new(),
+            link_up: true,
+            watchdog_expired: false,
         }
     }
 
@@ -243,8 +277,20 @@ impl<H: RecordHook> Device<H> {
                 }
             }
             FrameKind::DcpHello | FrameKind::DcpIdentifyResponse => {}
-            FrameKind::Cyclic(_) | FrameKind::AlarmHigh | FrameKind::AlarmLow => {
-                self.counters.no_ar = self.counters.no_ar.saturating_add(1);
+            FrameKind::Cyclic(_) => self.cyclic_frame(now, f),
+            FrameKind::AlarmHigh | FrameKind::AlarmLow => {
+                let got = self
+                    .cyclic
+                    .as_mut()
+                    .and_then(|c| c.alarm.as_mut())
+                    .map(|a| a.receive(now, f));
+                match got {
+                    None => self.counters.no_ar = self.counters.no_ar.saturating_add(1),
+                    Some(Ok(Some(e))) => self.on_alarm_event(e),
+                    // refused frames are counted by the alarm CR
+                    Some(_) => {}
+                }
+                self.run_alarms(now, tx);
             }
             FrameKind::Other(_) => {
                 self.counters.unknown_frame_id = self.counters.unknown_frame_id.saturating_add(1);
@@ -296,9 +342,24 @@ impl<H: RecordHook> Device<H> {
         }
         while let Some(e) = self.cm.poll_event() {
             match e {
-                CmEvent::Connected(_) => self.dcp.set_in_operation(true),
-                CmEvent::Released(_) | CmEvent::Aborted(..) => {
-                    self.dcp.set_in_operation(self.cm.ar().is_some())
+                CmEvent::Connected(uuid) => {
+                    self.dcp.set_in_operation(true);
+                    let cyclic = self
+                        .cm
+                        .ar()
+                        .filter(|ar| ar.ar_uuid == uuid)
+                        .map(|ar| Cyclic::new(ar, self.dcp.mac(), now));
+                    self.diag
+                        .set_alarms(cyclic.as_ref().is_some_and(|c| c.alarm.is_some()));
+                    self.watchdog_expired = false;
+                    self.cyclic = cyclic;
+                }
+                CmEvent::Released(uuid) | CmEvent::Aborted(uuid, _) => {
+                    self.dcp.set_in_operation(self.cm.ar().is_some());
+                    if self.cyclic.as_ref().is_some_and(|c| c.ar == uuid) {
+                        self.cyclic = None;
+                        self.diag.set_alarms(false);
+                    }
                 }
                 _ => {}
             }
@@ -340,7 +401,20 @@ impl<H: RecordHook> Device<H> {
             self.lldp.sent(port, now);
         }
         self.drain_rpc(now, tx);
+        self.run_cyclic(now, tx);
+        self.run_alarms(now, tx);
         let mut next = now.saturating_add(Nanos::from_ms(100));
+        if let Some(c) = &self.cyclic {
+            if let Some(p) = &c.provider {
+                next = next.min(p.poll_at());
+            }
+            if let Some(k) = &c.consumer {
+                next = next.min(k.poll_at());
+            }
+            if let Some(a) = &c.alarm {
+                next = next.min(a.poll_at(now));
+            }
+        }
         if let Some(t) = self.lldp.next_deadline() {
             next = next.min(t);
         }
@@ -348,6 +422,228 @@ impl<H: RecordHook> Device<H> {
             next = next.min(*t);
         }
         next.max(now)
+    }
+}
+
+impl<H: RecordHook> Device<H> {
+    /// The controller's output data for the IN module at `slot` (controller →
+    /// drive, the receive telegram), while it is current: an AR exchanges
+    /// valid cyclic data and the data hold time has not expired.
+    pub fn output_data(&self, slot: u16) -> Option<&[u8]> {
+        let c = self.cyclic.as_ref().filter(|c| c.outputs_valid)?;
+        c.outputs
+            .iter()
+            .find(|m| m.slot == slot)
+            .map(|m| m.data.as_slice())
+    }
+
+    /// Sets the input data of the OUT module at `slot` (drive → controller,
+    /// the response telegram) for the next provider frames; `false` if the
+    /// AR has no such module (or no AR runs). Extra bytes are ignored; missing
+    /// ones stay as they were.
+    pub fn set_input_data(&mut self, slot: u16, data: &[u8]) -> bool {
+        let Some(m) = self
+            .cyclic
+            .as_mut()
+            .and_then(|c| c.inputs.iter_mut().find(|m| m.slot == slot))
+        else {
+            return false;
+        };
+        for (d, s) in m.data.iter_mut().zip(data) {
+            *d = *s;
+        }
+        true
+    }
+
+    /// The configured lengths of the AR's data modules (P-028): (slot, bytes,
+    /// direction seen from the drive: `true` = to the drive).
+    pub fn data_modules(&self) -> impl Iterator<Item = (u16, usize, bool)> + '_ {
+        self.cyclic.iter().flat_map(|c| {
+            let outs = c.outputs.iter().map(|m| (m.slot, m.data.len(), true));
+            let ins = c.inputs.iter().map(|m| (m.slot, m.data.len(), false));
+            outs.chain(ins)
+        })
+    }
+
+    /// A drive error HH-S appears (P-030): a diagnosis alarm goes to the
+    /// controller when an AR with an alarm CR runs; the diagnosis records and
+    /// the station-problem bit show it in any case. `false` if HH-S is out of
+    /// range or the list is full.
+    pub fn raise_diagnosis(&mut self, main: u8, sub: u8) -> bool {
+        let Some(e) = DriveError::new(main, sub) else {
+            return false;
+        };
+        self.diag
+            .raise(Cyclic::drive_location(), e, Maintenance::Fault, 0)
+            .is_ok()
+    }
+
+    /// The drive error HH-S is gone (acknowledged, P-035): a "disappears"
+    /// alarm follows.
+    pub fn clear_diagnosis(&mut self, main: u8, sub: u8) -> bool {
+        DriveError::new(main, sub).is_some_and(|e| self.diag.clear(&Cyclic::drive_location(), e))
+    }
+
+    /// Whether any diagnosis is present.
+    pub fn diagnosis_present(&self) -> bool {
+        self.diag.any_present()
+    }
+
+    /// Whether an AR exchanges valid cyclic data now.
+    pub fn exchanging(&self) -> bool {
+        self.cyclic.as_ref().is_some_and(|c| c.outputs_valid)
+    }
+
+    /// The link state (LED BF, P-023); the board or simulator sets it.
+    pub fn set_link(&mut self, up: bool) {
+        self.link_up = up;
+    }
+
+    /// The SF and BF LEDs at `now` (P-011, P-020…P-024): `(sf_lit, bf_lit)`.
+    pub fn leds(&self, now: Nanos) -> (bool, bool) {
+        let signal = self.dcp.signal();
+        let inputs = LedInputs {
+            link_up: self.link_up,
+            ar_established: self.cyclic.is_some(),
+            cyclic_exchange: self.exchanging(),
+            watchdog_expired: self.watchdog_expired,
+            diagnosis: self.diag.any_present(),
+            system_error: false,
+            dcp_signal_until: signal.until(now),
+        };
+        (inputs.sf_lit(now), inputs.bf_lit(now))
+    }
+
+    fn cyclic_frame(&mut self, now: Nanos, f: &EthFrame<'_>) {
+        let Some(c) = self.cyclic.as_mut() else {
+            self.counters.no_ar = self.counters.no_ar.saturating_add(1);
+            return;
+        };
+        let Some(consumer) = c.consumer.as_mut() else {
+            self.counters.no_ar = self.counters.no_ar.saturating_add(1);
+            return;
+        };
+        // a refused frame is counted by the consumer and changes nothing
+        let Ok(r) = consumer.receive(now, f) else {
+            return;
+        };
+        match r.outputs {
+            Ok(data) => {
+                for m in c.outputs.iter_mut() {
+                    if let Some(d) = data.data(m.slot, 1) {
+                        for (o, i) in m.data.iter_mut().zip(d) {
+                            *o = *i;
+                        }
+                    }
+                }
+                let first = !c.outputs_valid && c.consumer.as_ref().is_some_and(|k| k.stats().accepted == 1);
+                c.outputs_valid = true;
+                if first {
+                    let ar = c.ar;
+                    self.push(DeviceEvent::Rt(RtEvent::Exchanging(ar)));
+                }
+            }
+            Err(_) => c.outputs_valid = false,
+        }
+    }
+
+    fn lose_ar(&mut self, code: Option<AbortCode>) {
+        let Some(c) = self.cyclic.as_mut() else {
+            return;
+        };
+        let ar = c.ar;
+        if let (Some(a), Some(code)) = (c.alarm.as_mut(), code) {
+            // the ERR-RTA-PDU goes out with the next alarm poll
+            a.abort(code);
+        }
+        c.consumer = None;
+        c.provider = None;
+        c.outputs_valid = false;
+        c.lost = true;
+        self.watchdog_expired = true;
+        self.cm.abort(ar);
+        self.push(DeviceEvent::Rt(RtEvent::ArLost(ar)));
+    }
+
+    fn on_alarm_event(&mut self, e: AlarmEvent) {
+        match e {
+            AlarmEvent::Acked {
+                priority: Priority::Low,
+                ..
+            } => self.diag.acked(),
+            AlarmEvent::Acked { .. } => {}
+            AlarmEvent::Abort(_) | AlarmEvent::ErrReceived(_) => self.lose_ar(None),
+        }
+    }
+
+    fn run_cyclic(&mut self, now: Nanos, tx: &mut impl FnMut(&[u8])) {
+        let event = self
+            .cyclic
+            .as_mut()
+            .and_then(|c| c.consumer.as_mut())
+            .and_then(|k| k.poll(now));
+        match event {
+            Some(ConsumerEvent::WatchdogExpired) => self.lose_ar(ConsumerEvent::WatchdogExpired.abort_code()),
+            Some(ConsumerEvent::DataHoldExpired) => {
+                if let Some(c) = self.cyclic.as_mut() {
+                    c.outputs_valid = false;
+                    let ar = c.ar;
+                    self.push(DeviceEvent::Rt(RtEvent::DataHoldExpired(ar)));
+                }
+            }
+            None => {}
+        }
+        let problem = self.diag.any_present();
+        let Some(c) = self.cyclic.as_mut() else {
+            return;
+        };
+        let Some(p) = c.provider.as_mut() else {
+            return;
+        };
+        p.set_station_problem(problem);
+        let mut buf = [0u8; MAX_FRAME];
+        if let Ok(Some(mut frame)) = p.poll(now, &mut buf) {
+            for m in &c.inputs {
+                frame.set_data(m.slot, 1, &m.data);
+            }
+            tx(frame.bytes());
+        }
+    }
+
+    fn run_alarms(&mut self, now: Nanos, tx: &mut impl FnMut(&[u8])) {
+        if self.cyclic.as_ref().is_some_and(|c| c.alarm_free()) {
+            if let Some(n) = self.diag.next_alarm() {
+                let sent = self
+                    .cyclic
+                    .as_mut()
+                    .and_then(|c| c.alarm.as_mut())
+                    .is_some_and(|a| a.send(now, &n).is_ok());
+                if sent {
+                    self.diag.sent();
+                }
+            }
+        }
+        let mut buf = [0u8; MAX_FRAME];
+        while let Some(out) = self
+            .cyclic
+            .as_mut()
+            .and_then(|c| c.alarm.as_mut())
+            .and_then(|a| a.poll(now, &mut buf))
+        {
+            match out {
+                Output::Frame(n) => tx(buf.get(..n).unwrap_or(&[])),
+                Output::Event(e) => self.on_alarm_event(e),
+            }
+        }
+        // an alarm CR that closed (after its ERR PDU) ends the AR's RT side
+        if self
+            .cyclic
+            .as_ref()
+            .is_some_and(|c| c.lost && c.alarm.as_ref().is_none_or(|a| a.is_closed()))
+        {
+            self.cyclic = None;
+            self.diag.set_alarms(false);
+        }
     }
 }
 

@@ -136,3 +136,154 @@ fn p037_poll_sends_lldp_on_both_ports_then_waits_5_s() {
     d.poll(Nanos::from_secs(5), &mut |f: &[u8]| out.push(f.to_vec()));
     assert_eq!(out.len(), 2);
 }
+
+/// The device after profinet-py's Connect (slot 1 OUT 18 words, slot 2 IN 18
+/// words; 1 ms × 8, watchdog and data hold 6 cycles).
+fn connected() -> Device {
+    let mut d = device();
+    let mut ctrl = Stack::new(
+        CTRL_MAC,
+        IpConfig {
+            addr: Ipv4Addr::new(192, 168, 0, 10),
+            netmask: Ipv4Addr::new(255, 255, 255, 0),
+            gateway: Ipv4Addr::UNSPECIFIED,
+        },
+    );
+    let dev_ep = Endpoint {
+        ip: Ipv4Addr::new(192, 168, 0, 50),
+        port: RPC_PORT,
+    };
+    ctrl.learn(Nanos::ZERO, dev_ep.ip, OUR_MAC);
+    let req = hex(CONNECT);
+    let mut tx = std::vec![0u8; 1600];
+    tx[UDP_PAYLOAD_OFFSET..UDP_PAYLOAD_OFFSET + req.len()].copy_from_slice(&req);
+    let UdpTx::Frame(n) = ctrl
+        .emit_udp(Nanos::ZERO, &mut tx, 0xC000, dev_ep, req.len())
+        .unwrap()
+    else {
+        panic!("no neighbour")
+    };
+    sent(&mut d, Nanos::ZERO, &tx[..n]);
+    while d.take_event().is_some() {}
+    d
+}
+
+/// A controller output frame with `fill` in slot 2's 36 bytes.
+fn output_frame(d: &Device, counter: u16, fill: u8) -> Vec<u8> {
+    let cr = d.cm().ar().unwrap().output_cr.clone().unwrap();
+    let mut f = std::vec![0u8; 14 + 2 + cr.data_length as usize + 4];
+    f[..6].copy_from_slice(&OUR_MAC.0);
+    f[6..12].copy_from_slice(&CTRL_MAC.0);
+    f[12..14].copy_from_slice(&0x8892u16.to_be_bytes());
+    f[14..16].copy_from_slice(&cr.frame_id.to_be_bytes());
+    let csdu = &mut f[16..16 + cr.data_length as usize];
+    for o in &cr.data {
+        let at = o.frame_offset as usize;
+        if o.data_len > 0 {
+            csdu[at..at + o.data_len as usize].fill(fill);
+        }
+        csdu[at + o.data_len as usize] = 0x80;
+    }
+    for c in &cr.iocs {
+        csdu[c.frame_offset as usize] = 0x80;
+    }
+    let n = f.len();
+    f[n - 4..n - 2].copy_from_slice(&counter.to_be_bytes());
+    f[n - 2] = 0x35;
+    f
+}
+
+fn poll(d: &mut Device, now: Nanos) -> Vec<Vec<u8>> {
+    let mut out = Vec::new();
+    d.poll(now, &mut |f: &[u8]| out.push(f.to_vec()));
+    out
+}
+
+fn frame_id(f: &[u8]) -> Option<u16> {
+    let e = EthFrame::parse(f)?;
+    (e.ethertype == 0x8892).then(|| u16::from_be_bytes([e.payload[0], e.payload[1]]))
+}
+
+#[test]
+fn p042_cyclic_outputs_reach_the_drive_and_inputs_go_out_every_cycle() {
+    let mut d = connected();
+    let input_id = d.cm().ar().unwrap().input_cr.as_ref().unwrap().frame_id;
+    assert_eq!(d.output_data(2), None, "nothing before the first frame");
+    let cycle = Nanos::from_ms(8);
+    let mut provided = 0;
+    for k in 0..20u16 {
+        let now = cycle * u64::from(k);
+        let f = output_frame(&d, k * 256, k as u8);
+        sent(&mut d, now, &f);
+        assert_eq!(d.output_data(2), Some(&[k as u8; 36][..]));
+        assert!(d.set_input_data(1, &[0xA5; 36]));
+        for f in poll(&mut d, now) {
+            if frame_id(&f) == Some(input_id) {
+                provided += 1;
+                assert!(f.windows(36).any(|w| w == [0xA5; 36]));
+            }
+        }
+    }
+    assert!(provided >= 19, "{provided} input frames in 20 cycles");
+    assert!(d.exchanging());
+    assert!(!d.set_input_data(2, &[0; 36]), "slot 2 is an IN module");
+    let events: Vec<_> = std::iter::from_fn(|| d.take_event()).collect();
+    assert!(
+        matches!(events[..], [DeviceEvent::Rt(RtEvent::Exchanging(_))]),
+        "{events:?}"
+    );
+}
+
+#[test]
+fn p036_no_output_frames_for_the_watchdog_time_loses_the_ar() {
+    let mut d = connected();
+    let cycle = Nanos::from_ms(8);
+    for k in 0..5u16 {
+        let f = output_frame(&d, k * 256, 1);
+        sent(&mut d, cycle * u64::from(k), &f);
+        poll(&mut d, cycle * u64::from(k));
+    }
+    while d.take_event().is_some() {}
+    let mut err_pdu = false;
+    let mut t = cycle * 5;
+    while t < Nanos::from_ms(200) {
+        for f in poll(&mut d, t) {
+            err_pdu |= matches!(frame_id(&f), Some(0xFC01 | 0xFE01));
+        }
+        t += Nanos::from_ms(1);
+    }
+    let events: Vec<_> = std::iter::from_fn(|| d.take_event()).collect();
+    assert!(
+        events
+            .iter()
+            .any(|e| matches!(e, DeviceEvent::Rt(RtEvent::ArLost(_)))),
+        "{events:?}"
+    );
+    assert!(
+        events
+            .iter()
+            .any(|e| matches!(e, DeviceEvent::Cm(CmEvent::Aborted(..)))),
+        "{events:?}"
+    );
+    assert!(err_pdu, "the ERR-RTA-PDU tells the controller");
+    assert!(d.cm().ar().is_none());
+    assert_eq!(d.output_data(2), None);
+    assert!(d.leds(t).0, "SF steady after a watchdog expiry (P-021)");
+}
+
+#[test]
+fn p030_a_drive_error_goes_out_as_a_diagnosis_alarm_with_0x1000_plus_hh_s() {
+    let mut d = connected();
+    let f = output_frame(&d, 0, 1);
+    sent(&mut d, Nanos::ZERO, &f);
+    assert!(d.raise_diagnosis(54, 3));
+    let frames = poll(&mut d, Nanos::ZERO);
+    let alarm = frames
+        .iter()
+        .find(|f| frame_id(f) == Some(0xFE01))
+        .expect("a low-priority alarm frame");
+    // ChannelErrorType 0x1036 (HH 54), ExtChannelErrorType 0x1003 (S 3)
+    assert!(alarm.windows(4).any(|w| w == [0x10, 0x36, 0x10, 0x03]));
+    assert!(d.diagnosis_present());
+    assert!(!d.raise_diagnosis(97, 0), "HH outside 1…96");
+}
