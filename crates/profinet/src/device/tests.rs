@@ -79,7 +79,7 @@ fn p042_unknown_frame_ids_and_frames_for_others_are_dropped_and_counted() {
 }
 
 #[test]
-fn p041_connect_over_udp_through_the_device_establishes_the_ar() {
+fn p010_p041_connect_over_udp_to_the_stored_static_ip_establishes_the_ar() {
     let mut d = device();
     let mut ctrl = Stack::new(
         CTRL_MAC,
@@ -117,7 +117,7 @@ fn p041_connect_over_udp_through_the_device_establishes_the_ar() {
 }
 
 #[test]
-fn p037_poll_sends_lldp_on_both_ports_then_waits_5_s() {
+fn p006_p037_poll_sends_lldp_from_both_port_macs_then_waits_5_s() {
     let mut d = device();
     let mut out = Vec::new();
     let next = d.poll(Nanos::ZERO, &mut |f: &[u8]| out.push(f.to_vec()));
@@ -205,7 +205,7 @@ fn frame_id(f: &[u8]) -> Option<u16> {
 }
 
 #[test]
-fn p042_cyclic_outputs_reach_the_drive_and_inputs_go_out_every_cycle() {
+fn p027_p042_cyclic_outputs_reach_the_drive_and_inputs_go_out_every_cycle() {
     let mut d = connected();
     let input_id = d.cm().ar().unwrap().input_cr.as_ref().unwrap().frame_id;
     assert_eq!(d.output_data(2), None, "nothing before the first frame");
