@@ -1,0 +1,142 @@
+//! The drive on PROFINET through frames: a fault becomes a diagnosis alarm
+//! and goes with the reset; a lost AR faults both axes.
+
+use super::*;
+use core::net::Ipv4Addr;
+use profinet::cm::{CmEvent, Im0, ImData};
+use profinet::dcp::IpSuite;
+use profinet::ip::{Endpoint, IpConfig, Stack, UdpTx, RPC_PORT, UDP_PAYLOAD_OFFSET};
+use profinet::wire::{EthFrame, MacAddr};
+use std::vec::Vec;
+
+const OUR: MacAddr = MacAddr([2, 0, 0, 0, 0, 0x50]);
+const CTRL: MacAddr = MacAddr([2, 0, 0, 0, 0, 0xC0]);
+
+#[path = "../../profinet/src/cm/tests_vectors.rs"]
+#[allow(dead_code)]
+mod vectors;
+
+fn hex(s: &str) -> Vec<u8> {
+    let s: std::string::String = s.chars().filter(|c| c.is_ascii_hexdigit()).collect();
+    (0..s.len() / 2)
+        .map(|i| u8::from_str_radix(&s[2 * i..2 * i + 2], 16).unwrap())
+        .collect()
+}
+
+fn drive() -> PnDrive {
+    let mut d = PnDrive::new(DeviceConfig {
+        mac: OUR,
+        port_macs: [MacAddr([2, 0, 0, 0, 0, 0x51]), MacAddr([2, 0, 0, 0, 0, 0x52])],
+        name: "drive-1".parse().unwrap(),
+        ip: IpSuite {
+            ip: Ipv4Addr::new(192, 168, 0, 50),
+            mask: Ipv4Addr::new(255, 255, 255, 0),
+            gateway: Ipv4Addr::UNSPECIFIED,
+        },
+        im0: Im0::drive("T1"),
+        im: ImData::default(),
+        boot_time: 1,
+    });
+    let mut ctrl = Stack::new(
+        CTRL,
+        IpConfig {
+            addr: Ipv4Addr::new(192, 168, 0, 10),
+            netmask: Ipv4Addr::new(255, 255, 255, 0),
+            gateway: Ipv4Addr::UNSPECIFIED,
+        },
+    );
+    let ep = Endpoint {
+        ip: Ipv4Addr::new(192, 168, 0, 50),
+        port: RPC_PORT,
+    };
+    ctrl.learn(Nanos::ZERO, ep.ip, OUR);
+    let req = hex(vectors::CONNECT);
+    let mut tx = std::vec![0u8; 1600];
+    tx[UDP_PAYLOAD_OFFSET..UDP_PAYLOAD_OFFSET + req.len()].copy_from_slice(&req);
+    let Ok(UdpTx::Frame(n)) = ctrl.emit_udp(Nanos::ZERO, &mut tx, 0xC000, ep, req.len()) else {
+        panic!("no frame")
+    };
+    let mut connected = false;
+    d.receive(Nanos::ZERO, &tx[..n], &mut |_: &[u8]| {}, &mut |e| {
+        connected |= matches!(e, DeviceEvent::Cm(CmEvent::Connected(_)))
+    });
+    assert!(connected);
+    d
+}
+
+fn output_frame(d: &PnDrive, counter: u16) -> Vec<u8> {
+    let cr = d.device().cm().ar().unwrap().output_cr.clone().unwrap();
+    let n = 14 + 2 + cr.data_length as usize + 4;
+    let mut f = std::vec![0u8; n];
+    f[..6].copy_from_slice(&OUR.0);
+    f[6..12].copy_from_slice(&CTRL.0);
+    f[12..14].copy_from_slice(&0x8892u16.to_be_bytes());
+    f[14..16].copy_from_slice(&cr.frame_id.to_be_bytes());
+    for o in &cr.data {
+        f[16 + o.frame_offset as usize + o.data_len as usize] = 0x80;
+    }
+    for c in &cr.iocs {
+        f[16 + c.frame_offset as usize] = 0x80;
+    }
+    f[n - 4..n - 2].copy_from_slice(&counter.to_be_bytes());
+    f[n - 2] = 0x35;
+    f
+}
+
+/// Runs 1 ms steps from `from` to `to`: output frames every 8 ms while
+/// `frames`, a control cycle every ms; returns the alarm frames sent.
+fn run(d: &mut PnDrive, from: u64, to: u64, frames: bool) -> Vec<Vec<u8>> {
+    let mut alarms = Vec::new();
+    let io = [AxisIo::ready(0), AxisIo::ready(0)];
+    for ms in from..to {
+        let now = Nanos::from_ms(ms);
+        let mut tx = |f: &[u8]| {
+            if let Some(e) = EthFrame::parse(f) {
+                if e.ethertype == 0x8892 && e.payload.get(..2) == Some(&[0xFE, 0x01]) {
+                    alarms.push(f.to_vec());
+                }
+            }
+        };
+        if frames && ms % 8 == 0 {
+            let f = output_frame(d, (ms / 8 * 256) as u16);
+            d.receive(now, &f, &mut tx, &mut |_| {});
+        }
+        d.poll(now, &mut tx, &mut |_| {});
+        d.control_cycle(now, &io);
+    }
+    alarms
+}
+
+#[test]
+fn p030_p035_a_drive_fault_is_a_diagnosis_alarm_and_goes_with_the_reset() {
+    let mut d = drive();
+    run(&mut d, 0, 50, true);
+    // a following error (event 54) on axis A
+    d.axes_mut()[0].raise_event(motion::Event { number: 54, cause: 2 });
+    let alarms = run(&mut d, 50, 60, true);
+    assert_eq!(alarms.len(), 1, "one appears alarm");
+    assert!(
+        alarms[0].windows(4).any(|w| w == [0x10, 0x36, 0x10, 0x02]),
+        "0x1036 / 0x1002"
+    );
+    assert!(d.device().diagnosis_present());
+    assert_eq!(d.objects().get(E82, 0).unwrap(), 54);
+    // fault reset: controlword 0x80 on axis A
+    d.objects_mut().set(0x6040, 0, 0x80).unwrap();
+    run(&mut d, 60, 70, true);
+    assert!(!d.device().diagnosis_present(), "the reset clears the diagnosis");
+}
+
+#[test]
+fn p036_a_lost_ar_faults_both_axes_with_event_52() {
+    let mut d = drive();
+    run(&mut d, 0, 50, true);
+    run(&mut d, 50, 200, false);
+    assert!(d.device().cm().ar().is_none(), "the watchdog ended the AR");
+    for a in d.axes() {
+        assert!(a.state().is_fault(), "{:?}", a.state());
+    }
+    assert_eq!(d.objects().get(E82, 0).unwrap(), i64::from(AR_LOST_EVENT));
+    assert_eq!(d.objects().get(E43, 0).unwrap(), i64::from(AR_LOST_CAUSE));
+    assert!(d.device().diagnosis_present(), "kept for the next AR's records");
+}
