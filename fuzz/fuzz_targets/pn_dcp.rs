@@ -16,7 +16,11 @@ fuzz_target!(|data: &[u8]| {
         return;
     };
     let id = [0xFEFE, 0xFEFD, 0xFEFC, 0xFEFF][usize::from(sel & 3)];
-    let dst = if sel & 4 != 0 { MacAddr::DCP_IDENTIFY } else { common::OUR_MAC };
+    let dst = if sel & 4 != 0 {
+        MacAddr::DCP_IDENTIFY
+    } else {
+        common::OUR_MAC
+    };
     let frame = common::rt_frame(dst, id, rest);
     let mut fresh = common::device();
     fresh.receive(Nanos::ZERO, &frame, &mut |_: &[u8]| {});

@@ -15,7 +15,11 @@ fuzz_target!(|data: &[u8]| {
         return;
     };
     let mut d = common::connected();
-    let out_id = d.cm().ar().and_then(|a| a.output_cr.as_ref()).map_or(0x8000, |c| c.frame_id);
+    let out_id = d
+        .cm()
+        .ar()
+        .and_then(|a| a.output_cr.as_ref())
+        .map_or(0x8000, |c| c.frame_id);
     let id = match sel & 3 {
         0 => out_id,
         1 => out_id ^ 0x0001,
@@ -23,7 +27,11 @@ fuzz_target!(|data: &[u8]| {
         _ => 0xFE01,
     };
     let before = d.output_data(2).map(<[u8]>::to_vec);
-    d.receive(Nanos::ZERO, &common::rt_frame(common::OUR_MAC, id, rest), &mut |_: &[u8]| {});
+    d.receive(
+        Nanos::ZERO,
+        &common::rt_frame(common::OUR_MAC, id, rest),
+        &mut |_: &[u8]| {},
+    );
     if sel & 3 == 1 {
         assert_eq!(d.output_data(2).map(<[u8]>::to_vec), before);
         assert!(d.cm().ar().is_some());

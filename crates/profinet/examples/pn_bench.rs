@@ -2,89 +2,28 @@
 //! `Device` (an output frame received, the input frame built and sent: one
 //! RT_CLASS_1 exchange), and the cost of a DCP Identify answer.
 //!
-//! `cargo run --release -p profinet --example pn_bench`
+//! `cargo run --release -p profinet --features testing --example pn_bench`
 //!
 //! A host benchmark, not device code: it may index and unwrap its own fixed
 //! frames.
 #![allow(clippy::indexing_slicing, clippy::expect_used, clippy::unwrap_used)]
 
-#[path = "../src/cm/tests_vectors.rs"]
-#[allow(dead_code)]
-mod vectors;
-
-use core::net::Ipv4Addr;
 use nanos::Nanos;
-use profinet::cm::{Im0, ImData};
-use profinet::dcp::IpSuite;
-use profinet::device::{Device, DeviceConfig};
-use profinet::ip::{Endpoint, IpConfig, Stack, UdpTx, RPC_PORT, UDP_PAYLOAD_OFFSET};
+use profinet::device::Device;
+use profinet::testing::{self, connect_frame, CONTROLLER_MAC as CTRL};
 use profinet::wire::MacAddr;
 use std::time::Instant;
 
-const OUR: MacAddr = MacAddr([2, 0, 0, 0, 0, 0x50]);
-const CTRL: MacAddr = MacAddr([2, 0, 0, 0, 0, 0xC0]);
-
-fn hex(s: &str) -> Vec<u8> {
-    let s: String = s.chars().filter(|c| c.is_ascii_hexdigit()).collect();
-    (0..s.len() / 2)
-        .map(|i| u8::from_str_radix(&s[2 * i..2 * i + 2], 16).unwrap_or(0))
-        .collect()
-}
-
 fn device() -> Device {
-    Device::plain(DeviceConfig {
-        mac: OUR,
-        port_macs: [MacAddr([2, 0, 0, 0, 0, 0x51]), MacAddr([2, 0, 0, 0, 0, 0x52])],
-        name: "drive-1".parse().expect("a valid name"),
-        ip: IpSuite {
-            ip: Ipv4Addr::new(192, 168, 0, 50),
-            mask: Ipv4Addr::new(255, 255, 255, 0),
-            gateway: Ipv4Addr::UNSPECIFIED,
-        },
-        im0: Im0::drive("BENCH"),
-        im: ImData::default(),
-        boot_time: 1,
-    })
+    Device::plain(testing::device_config())
 }
 
 fn connect(d: &mut Device) {
-    let mut ctrl = Stack::new(
-        CTRL,
-        IpConfig {
-            addr: Ipv4Addr::new(192, 168, 0, 10),
-            netmask: Ipv4Addr::new(255, 255, 255, 0),
-            gateway: Ipv4Addr::UNSPECIFIED,
-        },
-    );
-    let ep = Endpoint {
-        ip: Ipv4Addr::new(192, 168, 0, 50),
-        port: RPC_PORT,
-    };
-    ctrl.learn(Nanos::ZERO, ep.ip, OUR);
-    let req = hex(vectors::CONNECT);
-    let mut tx = vec![0u8; 1600];
-    tx[UDP_PAYLOAD_OFFSET..UDP_PAYLOAD_OFFSET + req.len()].copy_from_slice(&req);
-    if let Ok(UdpTx::Frame(n)) = ctrl.emit_udp(Nanos::ZERO, &mut tx, 0xC000, ep, req.len()) {
-        d.receive(Nanos::ZERO, &tx[..n], &mut |_: &[u8]| {});
-    }
+    d.receive(Nanos::ZERO, &connect_frame(), &mut |_: &[u8]| {});
 }
 
 fn output_frame(d: &Device) -> Vec<u8> {
-    let cr = d.cm().ar().and_then(|a| a.output_cr.clone()).expect("connected");
-    let n = 14 + 2 + cr.data_length as usize + 4;
-    let mut f = vec![0u8; n];
-    f[..6].copy_from_slice(&OUR.0);
-    f[6..12].copy_from_slice(&CTRL.0);
-    f[12..14].copy_from_slice(&0x8892u16.to_be_bytes());
-    f[14..16].copy_from_slice(&cr.frame_id.to_be_bytes());
-    for o in &cr.data {
-        f[16 + o.frame_offset as usize + o.data_len as usize] = 0x80;
-    }
-    for c in &cr.iocs {
-        f[16 + c.frame_offset as usize] = 0x80;
-    }
-    f[n - 2] = 0x35;
-    f
+    testing::output_frame(d.cm().ar().expect("connected"), 0, 0)
 }
 
 fn main() {

@@ -36,5 +36,7 @@ pub mod wire;
 
 pub use nanos::Nanos;
 
-#[cfg(test)]
+#[cfg(any(test, feature = "testing"))]
 extern crate std;
+#[cfg(any(test, feature = "testing"))]
+pub mod testing;

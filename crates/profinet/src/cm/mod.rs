@@ -31,7 +31,7 @@ mod tests_pcap;
 #[cfg(test)]
 mod tests_record;
 #[cfg(test)]
-pub(crate) mod tests_vectors;
+pub(crate) use crate::testing::vectors as tests_vectors;
 
 pub use ar::{AlarmCr, Ar, ArState, ArType, Fit, IoObject, Iocr, IocrType, Submodule, SubmoduleData};
 pub use record::{Im0, ImData, ImRecord, NoRecords, RecordAddr, RecordHook};

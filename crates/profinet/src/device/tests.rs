@@ -2,32 +2,11 @@
 //! sends (DCP from `dcp::tests_frames`, RPC from `cm::tests_vectors`).
 
 use super::*;
-use crate::cm::tests_vectors::CONNECT;
-use crate::ip::{Endpoint, UdpTx};
-use crate::rpc::tests::hex;
-use core::net::Ipv4Addr;
+use crate::testing::{self, connect_frame, CONTROLLER_MAC as CTRL_MAC, DEVICE_MAC as OUR_MAC};
 use std::vec::Vec;
 
-const OUR_MAC: MacAddr = MacAddr([0x02, 0, 0, 0, 0, 0x50]);
-const CTRL_MAC: MacAddr = MacAddr([0x02, 0, 0, 0, 0, 0xC0]);
-
 fn device() -> Device {
-    Device::plain(DeviceConfig {
-        mac: OUR_MAC,
-        port_macs: [
-            MacAddr([0x02, 0, 0, 0, 0, 0x51]),
-            MacAddr([0x02, 0, 0, 0, 0, 0x52]),
-        ],
-        name: "drive-1".parse().unwrap(),
-        ip: IpSuite {
-            ip: Ipv4Addr::new(192, 168, 0, 50),
-            mask: Ipv4Addr::new(255, 255, 255, 0),
-            gateway: Ipv4Addr::UNSPECIFIED,
-        },
-        im0: Im0::drive("SN0001"),
-        im: ImData::default(),
-        boot_time: 1,
-    })
+    Device::plain(testing::device_config())
 }
 
 fn identify_all() -> Vec<u8> {
@@ -81,29 +60,7 @@ fn p042_unknown_frame_ids_and_frames_for_others_are_dropped_and_counted() {
 #[test]
 fn p010_p041_connect_over_udp_to_the_stored_static_ip_establishes_the_ar() {
     let mut d = device();
-    let mut ctrl = Stack::new(
-        CTRL_MAC,
-        IpConfig {
-            addr: Ipv4Addr::new(192, 168, 0, 10),
-            netmask: Ipv4Addr::new(255, 255, 255, 0),
-            gateway: Ipv4Addr::UNSPECIFIED,
-        },
-    );
-    let dev_ep = Endpoint {
-        ip: Ipv4Addr::new(192, 168, 0, 50),
-        port: RPC_PORT,
-    };
-    ctrl.learn(Nanos::ZERO, dev_ep.ip, OUR_MAC);
-    let req = hex(CONNECT);
-    let mut tx = std::vec![0u8; 1600];
-    tx[UDP_PAYLOAD_OFFSET..UDP_PAYLOAD_OFFSET + req.len()].copy_from_slice(&req);
-    let UdpTx::Frame(n) = ctrl
-        .emit_udp(Nanos::ZERO, &mut tx, 0xC000, dev_ep, req.len())
-        .unwrap()
-    else {
-        panic!("no neighbour")
-    };
-    let out = sent(&mut d, Nanos::ZERO, &tx[..n]);
+    let out = sent(&mut d, Nanos::ZERO, &connect_frame());
     assert_eq!(out.len(), 1, "one Connect response");
     let f = EthFrame::parse(&out[0]).unwrap();
     assert_eq!((f.dst, f.ethertype), (CTRL_MAC, 0x0800));
@@ -141,56 +98,14 @@ fn p006_p037_poll_sends_lldp_from_both_port_macs_then_waits_5_s() {
 /// words; 1 ms × 8, watchdog and data hold 6 cycles).
 fn connected() -> Device {
     let mut d = device();
-    let mut ctrl = Stack::new(
-        CTRL_MAC,
-        IpConfig {
-            addr: Ipv4Addr::new(192, 168, 0, 10),
-            netmask: Ipv4Addr::new(255, 255, 255, 0),
-            gateway: Ipv4Addr::UNSPECIFIED,
-        },
-    );
-    let dev_ep = Endpoint {
-        ip: Ipv4Addr::new(192, 168, 0, 50),
-        port: RPC_PORT,
-    };
-    ctrl.learn(Nanos::ZERO, dev_ep.ip, OUR_MAC);
-    let req = hex(CONNECT);
-    let mut tx = std::vec![0u8; 1600];
-    tx[UDP_PAYLOAD_OFFSET..UDP_PAYLOAD_OFFSET + req.len()].copy_from_slice(&req);
-    let UdpTx::Frame(n) = ctrl
-        .emit_udp(Nanos::ZERO, &mut tx, 0xC000, dev_ep, req.len())
-        .unwrap()
-    else {
-        panic!("no neighbour")
-    };
-    sent(&mut d, Nanos::ZERO, &tx[..n]);
+    sent(&mut d, Nanos::ZERO, &connect_frame());
     while d.take_event().is_some() {}
     d
 }
 
 /// A controller output frame with `fill` in slot 2's 36 bytes.
 fn output_frame(d: &Device, counter: u16, fill: u8) -> Vec<u8> {
-    let cr = d.cm().ar().unwrap().output_cr.clone().unwrap();
-    let mut f = std::vec![0u8; 14 + 2 + cr.data_length as usize + 4];
-    f[..6].copy_from_slice(&OUR_MAC.0);
-    f[6..12].copy_from_slice(&CTRL_MAC.0);
-    f[12..14].copy_from_slice(&0x8892u16.to_be_bytes());
-    f[14..16].copy_from_slice(&cr.frame_id.to_be_bytes());
-    let csdu = &mut f[16..16 + cr.data_length as usize];
-    for o in &cr.data {
-        let at = o.frame_offset as usize;
-        if o.data_len > 0 {
-            csdu[at..at + o.data_len as usize].fill(fill);
-        }
-        csdu[at + o.data_len as usize] = 0x80;
-    }
-    for c in &cr.iocs {
-        csdu[c.frame_offset as usize] = 0x80;
-    }
-    let n = f.len();
-    f[n - 4..n - 2].copy_from_slice(&counter.to_be_bytes());
-    f[n - 2] = 0x35;
-    f
+    testing::output_frame(d.cm().ar().unwrap(), counter, fill)
 }
 
 fn poll(d: &mut Device, now: Nanos) -> Vec<Vec<u8>> {
