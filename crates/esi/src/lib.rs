@@ -575,7 +575,7 @@ impl Xml {
             self.out.push(' ');
             self.out.push_str(k);
             self.out.push_str("=\"");
-            escape(&mut self.out, v);
+            generated::escape_into(&mut self.out, v);
             self.out.push('"');
         }
     }
@@ -599,7 +599,7 @@ impl Xml {
     fn leaf(&mut self, tag: &str, attrs: &[(&str, &str)], text: &str) {
         self.start(tag, attrs);
         self.out.push('>');
-        escape(&mut self.out, text);
+        generated::escape_into(&mut self.out, text);
         self.out.push_str("</");
         self.out.push_str(tag);
         self.out.push_str(">\n");
@@ -608,18 +608,5 @@ impl Xml {
     fn empty(&mut self, tag: &str, attrs: &[(&str, &str)]) {
         self.start(tag, attrs);
         self.out.push_str("/>\n");
-    }
-}
-
-fn escape(out: &mut String, s: &str) {
-    for c in s.chars() {
-        match c {
-            '&' => out.push_str("&amp;"),
-            '<' => out.push_str("&lt;"),
-            '>' => out.push_str("&gt;"),
-            '"' => out.push_str("&quot;"),
-            '\'' => out.push_str("&apos;"),
-            c => out.push(c),
-        }
     }
 }

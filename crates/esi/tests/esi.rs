@@ -69,31 +69,14 @@ fn esi(template: Template) -> String {
 
 #[test]
 fn esi_files_are_current() {
-    let dir = esi_dir();
     let files = esi::files().unwrap();
-    if std::env::var_os("UPDATE_ESI").is_some() {
-        for (name, text) in &files {
-            std::fs::write(dir.join(name), text).unwrap();
-        }
-    }
-    for (name, text) in &files {
-        let file = std::fs::read_to_string(dir.join(name)).unwrap_or_default();
-        assert!(
-            &file == text,
-            "esi/{name} is out of date: run UPDATE_ESI=1 cargo test -p esi esi_files_are_current"
-        );
-    }
-    // no stale ESI from an earlier declaration
-    let wanted: BTreeSet<&str> = files.iter().map(|(n, _)| n.as_str()).collect();
-    for entry in std::fs::read_dir(&dir).unwrap() {
-        let name = entry.unwrap().file_name().into_string().unwrap();
-        if name.ends_with(".xml") {
-            assert!(
-                wanted.contains(name.as_str()),
-                "esi/{name} is not generated: delete it"
-            );
-        }
-    }
+    let check = generated::check_current(
+        &esi_dir(),
+        &files,
+        "UPDATE_ESI",
+        "cargo test -p esi esi_files_are_current",
+    );
+    assert_eq!(check, Ok(()));
 }
 
 #[test]

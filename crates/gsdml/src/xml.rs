@@ -13,21 +13,7 @@ pub struct Xml {
     unbalanced: bool,
 }
 
-/// `s` with `&`, `<`, `>`, `"` and `'` escaped, for attribute values.
-pub fn escape(s: &str) -> String {
-    let mut out = String::with_capacity(s.len());
-    for c in s.chars() {
-        match c {
-            '&' => out.push_str("&amp;"),
-            '<' => out.push_str("&lt;"),
-            '>' => out.push_str("&gt;"),
-            '"' => out.push_str("&quot;"),
-            '\'' => out.push_str("&apos;"),
-            c => out.push(c),
-        }
-    }
-    out
-}
+pub use generated::escape;
 
 impl Xml {
     /// A document starting with the XML declaration (UTF-8).

@@ -77,32 +77,14 @@ fn text_of(doc: &Document, n: Node, tag: &str) -> String {
 
 #[test]
 fn gsdml_is_current() {
-    let dir = gsdml_dir();
     let files = gsdml::files().unwrap();
-    if std::env::var_os("UPDATE_GSDML").is_some() {
-        std::fs::create_dir_all(&dir).unwrap();
-        for (name, text) in &files {
-            std::fs::write(dir.join(name), text).unwrap();
-        }
-    }
-    for (name, text) in &files {
-        let file = std::fs::read_to_string(dir.join(name)).unwrap_or_default();
-        assert!(
-            &file == text,
-            "gsdml/{name} is out of date: run UPDATE_GSDML=1 cargo test -p gsdml gsdml_is_current"
-        );
-    }
-    // no stale GSDML from an earlier declaration (or an earlier date)
-    let wanted: BTreeSet<&str> = files.iter().map(|(n, _)| n.as_str()).collect();
-    for entry in std::fs::read_dir(&dir).unwrap() {
-        let name = entry.unwrap().file_name().into_string().unwrap();
-        if name.ends_with(".xml") {
-            assert!(
-                wanted.contains(name.as_str()),
-                "gsdml/{name} is not generated: delete it"
-            );
-        }
-    }
+    let check = generated::check_current(
+        &gsdml_dir(),
+        &files,
+        "UPDATE_GSDML",
+        "cargo test -p gsdml gsdml_is_current",
+    );
+    assert_eq!(check, Ok(()));
 }
 
 #[test]

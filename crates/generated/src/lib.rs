@@ -1,0 +1,96 @@
+//! What the generators of the description files share (`crates/esi` for the
+//! EtherCAT ESI, `crates/gsdml` for the PROFINET GSDML): XML text escaping,
+//! and the drift check their tests run on the committed files.
+#![deny(missing_docs)]
+
+use std::collections::BTreeSet;
+use std::path::Path;
+
+/// Appends `s` to `out` with `&`, `<`, `>`, `"` and `'` escaped (text and
+/// attribute values).
+pub fn escape_into(out: &mut String, s: &str) {
+    for c in s.chars() {
+        match c {
+            '&' => out.push_str("&amp;"),
+            '<' => out.push_str("&lt;"),
+            '>' => out.push_str("&gt;"),
+            '"' => out.push_str("&quot;"),
+            '\'' => out.push_str("&apos;"),
+            c => out.push(c),
+        }
+    }
+}
+
+/// `s` escaped as by [`escape_into`].
+pub fn escape(s: &str) -> String {
+    let mut out = String::with_capacity(s.len());
+    escape_into(&mut out, s);
+    out
+}
+
+/// The drift check: with the environment variable `update` set, writes
+/// `files` (name, text) into `dir` first; then every file must equal its
+/// generated text and `dir` must hold no other `.xml` (a stale file from an
+/// earlier declaration). `Err` says which file and how to regenerate
+/// (`command`).
+pub fn check_current(
+    dir: &Path,
+    files: &[(String, String)],
+    update: &str,
+    command: &str,
+) -> Result<(), String> {
+    let shown = dir.file_name().and_then(|n| n.to_str()).unwrap_or("?");
+    if std::env::var_os(update).is_some() {
+        std::fs::create_dir_all(dir).map_err(|e| e.to_string())?;
+        for (name, text) in files {
+            std::fs::write(dir.join(name), text).map_err(|e| e.to_string())?;
+        }
+    }
+    for (name, text) in files {
+        let file = std::fs::read_to_string(dir.join(name)).unwrap_or_default();
+        if &file != text {
+            return Err(format!("{shown}/{name} is out of date: run {update}=1 {command}"));
+        }
+    }
+    let wanted: BTreeSet<&str> = files.iter().map(|(n, _)| n.as_str()).collect();
+    for entry in std::fs::read_dir(dir).map_err(|e| e.to_string())? {
+        let name = entry
+            .map_err(|e| e.to_string())?
+            .file_name()
+            .into_string()
+            .unwrap_or_default();
+        if name.ends_with(".xml") && !wanted.contains(name.as_str()) {
+            return Err(format!("{shown}/{name} is not generated: delete it"));
+        }
+    }
+    Ok(())
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn escapes_the_five_characters() {
+        assert_eq!(escape(r#"a<b>&"c'"#), "a&lt;b&gt;&amp;&quot;c&apos;");
+    }
+
+    #[test]
+    fn drift_check_finds_changed_and_stale_files() {
+        let dir = std::env::temp_dir().join(format!("generated-test-{}", std::process::id()));
+        std::fs::create_dir_all(&dir).unwrap();
+        let files = vec![("a.xml".to_string(), "<a/>".to_string())];
+        std::fs::write(dir.join("a.xml"), "<a/>").unwrap();
+        assert_eq!(check_current(&dir, &files, "NO_SUCH_VAR_X", "cmd"), Ok(()));
+        std::fs::write(dir.join("a.xml"), "<b/>").unwrap();
+        assert!(check_current(&dir, &files, "NO_SUCH_VAR_X", "cmd")
+            .unwrap_err()
+            .contains("out of date"));
+        std::fs::write(dir.join("a.xml"), "<a/>").unwrap();
+        std::fs::write(dir.join("old.xml"), "").unwrap();
+        assert!(check_current(&dir, &files, "NO_SUCH_VAR_X", "cmd")
+            .unwrap_err()
+            .contains("not generated"));
+        std::fs::remove_dir_all(&dir).unwrap();
+    }
+}
