@@ -1,9 +1,11 @@
-//! The `hil-sim` binary's parts: the command line, `demo` and `serve`.
+//! The `hil-sim` binary's parts: the command line, `demo` and `serve`
+//! (EtherCAT in `serve`, PROFINET in `serve_pn`).
 
 pub mod args;
 pub mod demo;
 pub mod realtime;
 pub mod serve;
+pub mod serve_pn;
 
 use hil_sim::sim::Simulation;
 

@@ -22,6 +22,8 @@ pub mod pcap;
 #[cfg(feature = "std")]
 pub mod plot;
 #[cfg(feature = "std")]
+pub mod pn;
+#[cfg(feature = "std")]
 pub mod raw;
 #[cfg(feature = "std")]
 pub mod sim;

@@ -5,6 +5,8 @@
 //!   enables axis A, homes it, runs a csp profile and plots the run.
 //! - `hil-sim serve --iface IF [--slaves N] [--axes 1|2] [--pcap FILE] [--seconds S]`:
 //!   the simulated line answers EtherCAT frames on a raw Ethernet interface.
+//! - `hil-sim serve --fieldbus profinet --iface IF [--name NAME] [--pcap FILE]`:
+//!   one simulated drive answers as a PROFINET IO device on the interface.
 //!
 //! `hil-sim --help` and `hil-sim SUBCOMMAND --help` list every option.
 

@@ -1,7 +1,7 @@
 //! The command line: `hil-sim [demo|serve] [OPTIONS]` (clap, derive). Every
 //! subcommand has `--help`; unknown arguments are refused with exit code 2.
 
-use clap::{Args, Parser, Subcommand};
+use clap::{Args, Parser, Subcommand, ValueEnum};
 use std::fs::File;
 use std::path::{Path, PathBuf};
 
@@ -23,7 +23,9 @@ pub enum Command {
     /// 10-revolution profile, write a plot of the run.
     Demo(DemoArgs),
     /// The simulated line answers EtherCAT frames on a network interface (raw
-    /// Ethernet, needs root or CAP_NET_RAW), so any master can drive it.
+    /// Ethernet, needs root or CAP_NET_RAW), so any master can drive it;
+    /// with `--fieldbus profinet` a simulated PROFINET IO device answers
+    /// instead, for any IO controller.
     Serve(ServeArgs),
 }
 
@@ -39,20 +41,39 @@ pub struct DemoArgs {
     pub plot: Option<PathBuf>,
 }
 
+/// The fieldbus `serve` speaks.
+#[derive(Debug, Clone, Copy, Default, PartialEq, Eq, ValueEnum)]
+pub enum Fieldbus {
+    /// A line of simulated EtherCAT drives (simulated ESCs).
+    #[default]
+    Ethercat,
+    /// One simulated drive as a PROFINET IO device (DCP, RPC, LLDP, RT_CLASS_1).
+    Profinet,
+}
+
 /// Options of `serve`.
 #[derive(Debug, Clone, Args)]
 pub struct ServeArgs {
     /// Network interface to answer on (e.g. one end of a veth pair).
     #[arg(long, value_name = "IF")]
     pub iface: String,
-    /// Drives on the simulated line.
+    /// The fieldbus: a line of EtherCAT drives, or one PROFINET IO device
+    /// (its interface MAC is the interface's own).
+    #[arg(long, value_enum, value_name = "BUS", default_value_t = Fieldbus::Ethercat)]
+    pub fieldbus: Fieldbus,
+    /// PROFINET only: the stored name of station (default: none, as shipped;
+    /// a controller names the device by DCP).
+    #[arg(long, value_name = "NAME")]
+    pub name: Option<String>,
+    /// Drives on the simulated line (EtherCAT only).
     #[arg(long, value_name = "N", default_value_t = 1, value_parser = clap::value_parser!(u16).range(1..=16))]
     pub slaves: u16,
-    /// Axes per drive (every drive is the double-axis device; 1 is accepted,
-    /// a single-axis variant is not modelled yet).
+    /// Axes per drive (EtherCAT only; every drive is the double-axis device;
+    /// 1 is accepted, a single-axis variant is not modelled yet).
     #[arg(long, value_name = "1|2", default_value_t = 1, value_parser = clap::value_parser!(u8).range(1..=2))]
     pub axes: u8,
-    /// Record every frame (both directions, simulated time) to this pcap file.
+    /// Record every frame (both directions, simulated time; PROFINET: time
+    /// since the start) to this pcap file.
     #[arg(long, value_name = "FILE")]
     pub pcap: Option<PathBuf>,
     /// Stop after this many seconds (default: run until killed).

@@ -17,7 +17,7 @@
 //! processed at once, and counted in the summary when that was more than
 //! [`LATE_NOTE`] late.
 
-use super::args::ServeArgs;
+use super::args::{Fieldbus, ServeArgs};
 use super::print_new_changes;
 use hil_sim::raw::{monotonic, RawSocket};
 use hil_sim::sim::{SimDrive, Simulation};
@@ -27,14 +27,14 @@ use std::time::Duration;
 
 /// Set by SIGINT or SIGTERM: `serve` ends its loop, flushes the recording
 /// and prints its summary.
-static STOP: AtomicBool = AtomicBool::new(false);
+pub(super) static STOP: AtomicBool = AtomicBool::new(false);
 
 extern "C" fn on_stop_signal(_: libc::c_int) {
     STOP.store(true, Ordering::Relaxed);
 }
 
 /// Ctrl-C and `kill` end `serve` in order (the recording complete).
-fn stop_on_signals() {
+pub(super) fn stop_on_signals() {
     let handler = on_stop_signal as extern "C" fn(libc::c_int) as libc::sighandler_t;
     for sig in [libc::SIGINT, libc::SIGTERM] {
         // SAFETY: the handler only stores to an atomic (async-signal-safe).
@@ -64,6 +64,12 @@ const FLUSH_EVERY: Nanos = Nanos::from_secs(1);
 
 /// Runs `serve` until `--seconds` have passed (or forever).
 pub fn serve(args: &ServeArgs) -> Result<(), String> {
+    if args.fieldbus == Fieldbus::Profinet {
+        return super::serve_pn::serve(args);
+    }
+    if args.name.is_some() {
+        return Err("--name is PROFINET-only (--fieldbus profinet)".into());
+    }
     let slaves = usize::from(args.slaves);
     // drives with firmware slots: an FoE download in Bootstrap is accepted
     let mut sim = Simulation::with_nodes((0..slaves).map(|_| SimDrive::with_firmware_slots()).collect());

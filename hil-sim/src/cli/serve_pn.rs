@@ -1,0 +1,267 @@
+//! `hil-sim serve --fieldbus profinet`: one simulated drive answers as a
+//! PROFINET IO device ([`hil_sim::pn::PnDrive`]) on a raw Ethernet
+//! interface, paced by the wall clock.
+//!
+//! The device's interface MAC is the interface's own (its port MACs are
+//! derived from it, [`hil_sim::pn::port_macs`]); it starts as shipped:
+//! unnamed unless `--name` gives one, no IP address, I&M0 of the drive.
+//!
+//! # Timing
+//!
+//! The device's time is `CLOCK_MONOTONIC` since the start. Each received
+//! frame goes to `Device::receive` at the kernel's receive timestamp (never
+//! before a time the device has already seen), and `Device::poll` runs at the
+//! deadline it returned, or after frames arrived. Between the two `serve`
+//! sleeps on the socket, never past the deadline and at most [`MAX_WAIT`].
+//! Frames in both directions go to the `--pcap` recording at the device's
+//! time.
+
+use super::args::ServeArgs;
+use super::serve::{stop_on_signals, STOP};
+use hil_sim::pcap::Recording;
+use hil_sim::pn::{self, PnDrive};
+use hil_sim::raw::{monotonic, RawSocket};
+use nanos::Nanos;
+use profinet::dcp::NameOfStation;
+use profinet::device::DeviceEvent;
+use profinet::wire::MacAddr;
+use std::io;
+use std::sync::atomic::Ordering;
+use std::time::{Duration, SystemTime, UNIX_EPOCH};
+
+/// The longest sleep on the socket.
+pub const MAX_WAIT: Nanos = Nanos::from_ms(1);
+
+/// How often the pcap recording is flushed (a write error then ends `serve`).
+const FLUSH_EVERY: Nanos = Nanos::from_secs(1);
+
+/// The interface's MAC, from `/sys/class/net/IF/address`.
+fn interface_mac(iface: &str) -> Result<MacAddr, String> {
+    let path = format!("/sys/class/net/{iface}/address");
+    let text =
+        std::fs::read_to_string(&path).map_err(|e| format!("{iface}: cannot read its MAC ({path}: {e})"))?;
+    pn::parse_mac(&text).ok_or_else(|| format!("{iface}: {path} holds no MAC: {}", text.trim()))
+}
+
+/// Refuses the options that only mean something on EtherCAT.
+fn check_options(args: &ServeArgs) -> Result<(), String> {
+    if args.slaves != 1 {
+        return Err("--slaves is EtherCAT-only: --fieldbus profinet serves one drive".into());
+    }
+    if args.axes != 1 {
+        return Err("--axes is EtherCAT-only".into());
+    }
+    if args.delay_us.is_some() {
+        return Err("--delay-us is EtherCAT-only".into());
+    }
+    Ok(())
+}
+
+/// What the loop counted.
+#[derive(Debug, Default)]
+struct Stats {
+    /// Frames received (not our own).
+    received: u64,
+    /// Received frames without a kernel timestamp (taken at the time they were read).
+    unstamped: u64,
+}
+
+/// The frames' way out: the socket and the recording.
+struct Out<'a> {
+    sock: &'a RawSocket,
+    pcap: Option<Recording>,
+    sent: u64,
+    error: Option<io::Error>,
+}
+
+impl Out<'_> {
+    fn record(&mut self, t: Nanos, frame: &[u8]) {
+        if let Some(r) = self.pcap.as_mut() {
+            r.frame(t, frame);
+        }
+    }
+
+    fn send(&mut self, t: Nanos, frame: &[u8]) {
+        self.record(t, frame);
+        self.sent += 1;
+        if let Err(e) = self.sock.send(frame) {
+            self.error.get_or_insert(e);
+        }
+    }
+
+    /// A send or recording error ends `serve`.
+    fn check(&mut self) -> Result<(), String> {
+        if let Some(e) = self.error.take() {
+            return Err(format!("send: {e}"));
+        }
+        match self.pcap.as_ref().and_then(|r| r.error()) {
+            Some(e) => Err(format!("the pcap recording failed: {e}")),
+            None => Ok(()),
+        }
+    }
+
+    fn flush(&mut self, args: &ServeArgs) -> Result<(), String> {
+        match (&args.pcap, self.pcap.as_mut().map(Recording::flush)) {
+            (Some(p), Some(Err(e))) => Err(format!("the pcap file {} is incomplete: {e}", p.display())),
+            _ => Ok(()),
+        }
+    }
+}
+
+/// Runs the PROFINET device until `--seconds` have passed, SIGINT or SIGTERM.
+pub fn serve(args: &ServeArgs) -> Result<(), String> {
+    check_options(args)?;
+    let name = args.name.as_deref().unwrap_or_default();
+    let name = NameOfStation::new(name.as_bytes()).map_err(|e| format!("--name {name:?}: {e:?}"))?;
+    // the recording first: an unwritable path fails before anything else
+    let pcap = match &args.pcap {
+        Some(p) => Some(
+            Recording::create(p).map_err(|e| format!("cannot write the pcap file {}: {e}", p.display()))?,
+        ),
+        None => None,
+    };
+    let iface = &args.iface;
+    let mac = interface_mac(iface)?;
+    // every EtherType (DCP, RT, ARP, IPv4, LLDP); our own frames are skipped
+    let sock = RawSocket::open_sniffer(iface).map_err(|e| format!("{iface}: {e}"))?;
+    // a boot time that differs after every start (the RPC server's)
+    let boot_time = SystemTime::now()
+        .duration_since(UNIX_EPOCH)
+        .map(|d| d.as_secs() as u32)
+        .unwrap_or(1);
+    let mut drive = PnDrive::new(pn::device_config(mac, name.clone(), boot_time));
+    let ports = pn::port_macs(mac);
+    println!(
+        "hil-sim serve: one simulated drive as a PROFINET IO device on {iface} (MAC {}, ports {} {})",
+        pn::mac_text(mac),
+        pn::mac_text(ports[0]),
+        pn::mac_text(ports[1])
+    );
+    println!(
+        "name of station: {}; IP: unset; I&M0 serial {}; the drive echoes its outputs into its inputs",
+        if name.is_empty() {
+            "none".to_string()
+        } else {
+            format!("\"{}\"", name.as_str())
+        },
+        pn::SERIAL_NUMBER
+    );
+    if let Some(p) = &args.pcap {
+        println!("recording frames to {}", p.display());
+    }
+    if args.no_rt {
+        println!("real-time: not asked for (--no-rt)");
+    } else if args.busy_poll {
+        println!("{}", super::realtime::apply(None, args.cpu));
+    } else {
+        println!("{}", super::realtime::apply(Some(args.fifo_priority), args.cpu));
+    }
+    stop_on_signals();
+    let mut out = Out {
+        sock: &sock,
+        pcap,
+        sent: 0,
+        error: None,
+    };
+    let result = run(&mut drive, &sock, &mut out, args);
+    let flushed = out.flush(args);
+    let stats = result?;
+    flushed?;
+    summary(&drive, &stats, out.sent);
+    Ok(())
+}
+
+fn print_events(drive: &mut PnDrive, t: Nanos) {
+    while let Some(e) = drive.take_event() {
+        print_event(t, &e);
+    }
+}
+
+fn print_event(t: Nanos, e: &DeviceEvent) {
+    println!("[{:>10.3} s] {}", t.as_ns() as f64 / 1e9, pn::describe(e));
+}
+
+/// The serve loop (see the module's Timing section).
+fn run(drive: &mut PnDrive, sock: &RawSocket, out: &mut Out<'_>, args: &ServeArgs) -> Result<Stats, String> {
+    let start = monotonic();
+    let since = |t: Nanos| t.saturating_sub(start);
+    let end = args.seconds.map(|s| Nanos::from_ns((s.max(0.0) * 1e9) as u64));
+    let mut stats = Stats::default();
+    let mut buf = [0u8; 1600];
+    // the latest time the device has seen: its clock never goes back
+    let mut last = Nanos::ZERO;
+    let mut deadline = Nanos::ZERO;
+    let mut next_flush = FLUSH_EVERY;
+    loop {
+        let mut got = false;
+        while let Some(rx) = sock.try_recv(&mut buf).map_err(|e| format!("receive: {e}"))? {
+            if rx.outgoing {
+                continue;
+            }
+            let t = match rx.rx {
+                Some(t) => since(t),
+                None => {
+                    stats.unstamped += 1;
+                    since(monotonic())
+                }
+            }
+            .max(last);
+            last = t;
+            let frame = buf.get(..rx.len).unwrap_or_default();
+            stats.received += 1;
+            got = true;
+            out.record(t, frame);
+            drive.receive(t, frame, &mut |f: &[u8]| out.send(t, f));
+            print_events(drive, t);
+            out.check()?;
+        }
+        let now = since(monotonic()).max(last);
+        if got || now >= deadline {
+            last = now;
+            deadline = drive.poll(now, &mut |f: &[u8]| out.send(now, f));
+            print_events(drive, now);
+            out.check()?;
+        }
+        if now >= next_flush {
+            next_flush = now + FLUSH_EVERY;
+            out.flush(args)?;
+        }
+        if end.is_some_and(|e| now >= e) || STOP.load(Ordering::Relaxed) {
+            return Ok(stats);
+        }
+        if !args.busy_poll {
+            let wait = deadline.saturating_sub(since(monotonic())).min(MAX_WAIT);
+            if wait > Nanos::ZERO {
+                sock.wait(Duration::from_nanos(wait.as_ns()))
+                    .map_err(|e| format!("wait: {e}"))?;
+            }
+        }
+    }
+}
+
+fn summary(drive: &PnDrive, stats: &Stats, sent: u64) {
+    let d = drive.device();
+    println!(
+        "{} frames received, {} sent; {} without a kernel timestamp",
+        stats.received, sent, stats.unstamped
+    );
+    let c = d.counters();
+    println!(
+        "device counters: runt {}, not for us {}, unknown FrameID {}, no AR {}, other EtherType {}, events lost {}",
+        c.runt, c.not_for_us, c.unknown_frame_id, c.no_ar, c.other_ethertype, c.events_lost
+    );
+    println!("ip counters: {:?}", d.ip().counters());
+    println!("rpc counters: {:?}", d.rpc().counters());
+    let name = d.dcp().name_of_station();
+    let ip = d.dcp().ip_suite();
+    println!(
+        "name of station at the end: {}; IP {} mask {}",
+        if name.is_empty() {
+            "none".to_string()
+        } else {
+            format!("\"{}\"", name.as_str())
+        },
+        ip.ip,
+        ip.mask
+    );
+}
