@@ -75,3 +75,28 @@ pub const I101: u16 = parameter_index(8, 101);
 pub const I210: u16 = parameter_index(8, 210);
 /// A258 EtherCAT PDO timeout (U16 ms with special values, spec §13.1).
 pub const A258: u16 = parameter_index(0, 258);
+
+/// A270 PROFINET active (BOOL; the PROFINET personality's parameters
+/// A270…A278, spec §2.4): off takes effect at once, on after save and
+/// restart.
+pub const A270: u16 = parameter_index(0, 270);
+/// A271 name of station (string of up to
+/// [`PN_NAME_LEN`](crate::objects::manufacturer::PN_NAME_LEN) bytes, empty = none).
+pub const A271: u16 = parameter_index(0, 271);
+/// A272 static IP address of the PROFINET interface (UINT32, first octet in
+/// the most significant byte; 0 = none).
+pub const A272: u16 = parameter_index(0, 272);
+/// A273 its subnet mask (as A272).
+pub const A273: u16 = parameter_index(0, 273);
+/// A274 its default gateway (as A272; 0 = none).
+pub const A274: u16 = parameter_index(0, 274);
+/// A275 PROFIenergy active (BOOL).
+pub const A275: u16 = parameter_index(0, 275);
+/// A276 PROFINET protocol: 0 = standard protocol, the only value.
+pub const A276: u16 = parameter_index(0, 276);
+/// A277 parameterisation interface: 0 automatic, 1 on-board Ethernet, 2 PROFINET.
+pub const A277: u16 = parameter_index(0, 277);
+/// A278 vendor service port (UINT16, default 8802).
+pub const A278: u16 = parameter_index(0, 278);
+/// The PROFINET personality's persistent parameters, A270…A278.
+pub const PROFINET_PARAMS: [u16; 9] = [A270, A271, A272, A273, A274, A275, A276, A277, A278];

@@ -117,12 +117,15 @@ macro_rules! mirror {
     }};
 }
 
+/// The longest name of station, bytes (IEC 61158-6-10: 240).
+pub const PN_NAME_LEN: u16 = 240;
+
 const fn string(s: &str) -> DataType {
     VisibleString(s.len() as u16)
 }
 
 /// Global and axis-A manufacturer parameters, sorted by index.
-pub const PARAMS: [Object; 65] = [
+pub const PARAMS: [Object; 74] = [
     param_array!(a(0), "Save values", Record, Value::Ram, from ACTION)
         .note("A00; [0] = 1 requests saving (E-018); progress/result set by the store"),
     param_array!(a(9), "Restart", Record, Value::Ram, from ACTION)
@@ -426,6 +429,54 @@ pub const PARAMS: [Object; 65] = [
     )
     .level(2)
     .note("A268; encoding assumed (0 standard, 1 manufacturer, 2 all; bit per group A…Z); not applied yet"),
+    // A270…A278: the PROFINET personality's operating parameters (spec
+    // §2.4, P-007…P-019; lines ours). The EtherCAT personality declares and
+    // stores them like every parameter and reads none of them.
+    Object::var(
+        a(270),
+        Value::Ram,
+        entries![e(0, "PROFINET active", Bool, RW).default_value(1).saved()],
+    )
+    .note("A270; 1 = active (default: a drive running the PROFINET personality answers out of the box); off takes effect at once, on after save and restart (P-012, P-013)"),
+    Object::var(
+        a(271),
+        Value::Ram,
+        entries![e(0, "Name of station", VisibleString(PN_NAME_LEN), RW).saved()],
+    )
+    .note("A271; up to 240 characters (IEC 61158-6-10), empty = none; read at start (P-007); DCP Set writes it"),
+    Object::var(a(272), Value::Ram, entries![e(0, "PROFINET IP address", U32, RW).saved()])
+        .note("A272; static IPv4 address, first octet in the most significant byte; 0 = none; used while DCP assigns none (P-010), overwritten by DCP (P-009)"),
+    Object::var(a(273), Value::Ram, entries![e(0, "PROFINET subnet mask", U32, RW).saved()])
+        .note("A273; as A272"),
+    Object::var(a(274), Value::Ram, entries![e(0, "PROFINET gateway", U32, RW).saved()])
+        .note("A274; as A272; 0 = no gateway"),
+    Object::var(
+        a(275),
+        Value::Ram,
+        entries![e(0, "PROFIenergy active", Bool, RW).saved()],
+    )
+    .note("A275; 1 = active (P-015); the PROFIenergy services themselves are not built (P-016)"),
+    Object::var(
+        a(276),
+        Value::Ram,
+        entries![e(0, "PROFINET protocol", U8, RW).range(0, 0).saved()],
+    )
+    .note("A276; 0 = standard protocol, the only one (P-014)"),
+    Object::var(
+        a(277),
+        Value::Ram,
+        entries![e(0, "Parameterisation interface", U8, RW).range(0, 2).saved()],
+    )
+    .note("A277; 0 automatic, 1 on-board Ethernet (service port), 2 PROFINET (P-017)"),
+    Object::var(
+        a(278),
+        Value::Ram,
+        entries![e(0, "Vendor service port", U16, RW)
+            .range(1, 65535)
+            .default_value(8802)
+            .saved()],
+    )
+    .note("A278; UDP/TCP port of the vendor service protocol on the PROFINET IP while A277 = 2 (P-018); the service itself is not built"),
     param_array!(a(287), "DC-Sync optimization", Record, Value::Ram, from A287_ELEMENTS)
         .level(2)
         .note("A287; action, results not stored (spec §22); [3]..[7] measurement results (our choice, spec §11.8 leaves their place open)"),
