@@ -1,7 +1,8 @@
 //! The drive on PROFINET: [`PnDrive`] puts the PROFINET IO device
 //! ([`profinet::device::Device`]) in front of the fieldbus-neutral drive core
-//! ([`drive_core`]: the object dictionary and both axes), the way `drive`
-//! puts the EtherCAT slave stack in front of it.
+//! ([`drive_core`]: the object dictionary and both axes) and its parameter
+//! store ([`store::ParamStore`]), the way `drive` puts the EtherCAT slave
+//! stack in front of it.
 //!
 //! What the personality translates:
 //!
@@ -11,35 +12,102 @@
 //! | the fault reset (T15) | "disappears" (P-035) |
 //! | event 52 cause 6 (communication: process data lost), both axes, fault reaction | the AR lost: the output CR's watchdog expired or the alarm channel failed (P-036, Q-07) |
 //! | a new set-point each control cycle | a valid output frame since the last cycle |
+//! | A270…A278, the PROFINET operating parameters ([`settings`]) | the device's name and IP at start, DCP Set / Reset to factory written back and saved, PROFINET on or off |
+//!
+//! Parameters (spec §2.4). At start ([`PnDrive::new`]) the newest saved
+//! set is loaded from the flash; the device starts with the name of station
+//! A271 (P-007) and the static IP suite A272…A274 (P-010, used until DCP
+//! assigns another). DCP events go into the objects:
+//!
+//! - a permanent Set of the name or the IP suite writes A271 / A272…A274
+//!   and saves (P-009: a DCP IP overwrites the stored static one);
+//! - a temporary Set writes them in RAM and saves their defaults (empty,
+//!   0.0.0.0): the value is gone after a restart and the one stored before
+//!   does not come back. Until the restart every save ([`PnDrive::save`])
+//!   stores the default in its place, so the temporary value never reaches
+//!   the flash;
+//! - Reset to factory: the communication modes clear name and IP (the DCP
+//!   server raises the matching permanent Sets); mode "All" restores every
+//!   parameter default first; mode 1 ("application data") restores every
+//!   default except the PROFINET parameters A270…A278. Each is saved.
+//!
+//! PROFINET active (A270, P-012/P-013) is read at start: with 0 the drive
+//! is silent from power-on. Switched off while running it takes effect at
+//! once (sampled at every [`receive`](PnDrive::receive),
+//! [`poll`](PnDrive::poll) and [`control_cycle`](PnDrive::control_cycle)):
+//! every received frame is dropped unseen (counted,
+//! [`PnDrive::dropped_inactive`]) and everything the device would send is
+//! discarded, while its timers keep running, so a running AR's watchdog
+//! expires and the axes get the AR-loss fault as for any lost AR. Switched
+//! on again it stays off until the next start: activation needs a save and a
+//! restart (Save & Reset, P-019), as the spec says.
+//!
+//! Saving is synchronous here ([`PnDrive::save`]: the image is built and
+//! the flash written in one call). The EtherCAT runtime's save job
+//! (`drive::runtime::Drive::begin_save` / `SaveJob::write` / `end_save`,
+//! the flash written without holding the drive) is the model for the board.
 //!
 //! The telegram mapping of the profile (CW1/ZSW1, PNU) is the next layer
 //! (issue 17); until then the cyclic data is reachable as bytes
-//! ([`PnDrive::device`]). `#![no_std]`, heap-free, time as an argument.
-#![no_std]
+//! ([`PnDrive::device`]). `#![no_std]
 #![deny(missing_docs)]
 
 use drive_core::axis::{Axis, AxisCache, AxisCommand, AxisIo};
 use drive_core::faults::{FaultChange, E82_INACTIVE};
-use drive_core::params::{E43, E82};
-use drive_core::DriveObjects;
+use drive_core::objects::LAYOUT_HASH;
+use drive_core::params::{A00, A270, A271, E43, E82, PROFINET_PARAMS};
+use drive_core::{DriveObjects, PERSISTENT_IMAGE_BYTES};
 use nanos::Nanos;
 use profinet::cm::{NoRecords, RecordHook};
-use profinet::device::{Device, DeviceConfig, DeviceEvent, RtEvent};
+use profinet::dcp::{Event as DcpEvent, IpSuite, NameOfStation, ResetMode};
+use profinet::device::{Device, DeviceEvent, RtEvent};
+use store::{Flash, ParamStore};
+
+pub mod settings;
+pub use settings::Hardware;
+use settings::NAME_LEN;
 
 #[cfg(test)]
 extern crate std;
 #[cfg(test)]
 mod tests;
+#[cfg(test)]
+mod tests_params;
 
 /// The event a lost AR raises on both axes: event 52 (communication).
 pub const AR_LOST_EVENT: u8 = 52;
 /// Its cause: 6, process data lost (the cause EtherCAT's PDO timeout uses).
 pub const AR_LOST_CAUSE: u8 = 6;
 
+/// What happened to the saved parameters at start.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum Startup {
+    /// A saved set was loaded.
+    Loaded,
+    /// Nothing saved yet, from another declaration, or unreadable: defaults.
+    Defaults,
+}
+
+/// Which of the DCP-set values in RAM are temporary (their stored value is
+/// the default until a restart).
+#[derive(Debug, Clone, Copy, Default, PartialEq, Eq)]
+struct Temporary {
+    name: bool,
+    ip: bool,
+}
+
 /// The drive on PROFINET. See the [crate documentation](crate).
-pub struct PnDrive<H: RecordHook = NoRecords> {
+pub struct PnDrive<F: Flash, H: RecordHook = NoRecords> {
     device: Device<H>,
     objects: DriveObjects,
+    store: ParamStore<F>,
+    startup: Startup,
+    /// PROFINET active: A270 at start, cleared for good (until the next
+    /// start) as soon as A270 reads 0.
+    active: bool,
+    /// Frames dropped while PROFINET is off.
+    dropped_inactive: u32,
+    temporary: Temporary,
     axes: [Axis; 2],
     caches: [AxisCache; 2],
     /// The diagnosis (HH, S) each axis' fault raised, to clear it on T15.
@@ -48,19 +116,32 @@ pub struct PnDrive<H: RecordHook = NoRecords> {
     exchanged: bool,
 }
 
-impl PnDrive<NoRecords> {
-    /// A drive with the device settings `config` and default parameters.
-    pub fn new(config: DeviceConfig) -> PnDrive<NoRecords> {
-        PnDrive::with_hook(config, NoRecords)
+impl<F: Flash> PnDrive<F, NoRecords> {
+    /// Powers the drive on: defaults, then the newest saved set from
+    /// `flash`; the device gets its name and IP from the objects
+    /// ([`settings::device_config`]) and the rest from `hw`.
+    pub fn new(flash: F, hw: Hardware) -> PnDrive<F, NoRecords> {
+        PnDrive::with_hook(flash, hw, NoRecords)
     }
 }
 
-impl<H: RecordHook> PnDrive<H> {
-    /// A drive whose device serves the profile's records through `hook`.
-    pub fn with_hook(config: DeviceConfig, hook: H) -> PnDrive<H> {
+impl<F: Flash, H: RecordHook> PnDrive<F, H> {
+    /// [`new`](PnDrive::new) with a device that serves the profile's
+    /// records through `hook`.
+    pub fn with_hook(flash: F, hw: Hardware, hook: H) -> PnDrive<F, H> {
+        let mut objects = DriveObjects::new();
+        let mut store = ParamStore::new(flash);
+        let startup = load(&mut store, &mut objects);
+        let active = objects.get(A270, 0) != Ok(0);
+        let config = settings::device_config(&mut objects, hw);
         PnDrive {
             device: Device::new(config, hook),
-            objects: DriveObjects::new(),
+            objects,
+            store,
+            startup,
+            active,
+            dropped_inactive: 0,
+            temporary: Temporary::default(),
             axes: [Axis::new(0), Axis::new(1)],
             caches: [AxisCache::new(), AxisCache::new()],
             raised: [None; 2],
@@ -98,9 +179,75 @@ impl<H: RecordHook> PnDrive<H> {
         &mut self.axes
     }
 
+    /// Whether the saved set was loaded at start.
+    pub fn startup(&self) -> Startup {
+        self.startup
+    }
+
+    /// The parameter flash (power-cycle simulation, fault injection).
+    pub fn flash_mut(&mut self) -> &mut F {
+        self.store.flash_mut()
+    }
+
+    /// Powers off: gives the flash back (RAM values are lost).
+    pub fn into_flash(self) -> F {
+        self.store.into_inner()
+    }
+
+    /// PROFINET active (A270) as in force: on only if it was 1 at start and
+    /// has not read 0 since.
+    pub fn profinet_active(&mut self) -> bool {
+        if self.active && self.objects.get(A270, 0) == Ok(0) {
+            self.active = false;
+        }
+        self.active
+    }
+
+    /// Frames dropped unseen because PROFINET is off.
+    pub fn dropped_inactive(&self) -> u32 {
+        self.dropped_inactive
+    }
+
+    /// Writes the persistent values to the store now (Save; A00\[1\]/\[2\]
+    /// show progress and result as on EtherCAT). A name or IP suite DCP set
+    /// temporarily is saved as its default. `false` when the store failed
+    /// (the previous set is still intact).
+    pub fn save(&mut self) -> bool {
+        let mut name = [0u8; NAME_LEN];
+        let name_len = if self.temporary.name {
+            let n = settings::name_bytes(&mut self.objects, &mut name);
+            settings::write_name(&mut self.objects, &NameOfStation::EMPTY);
+            Some(n)
+        } else {
+            None
+        };
+        let ip = if self.temporary.ip {
+            let s = settings::stored_ip(&self.objects);
+            settings::write_ip(&mut self.objects, IpSuite::UNSET);
+            Some(s)
+        } else {
+            None
+        };
+        let mut image = [0u8; PERSISTENT_IMAGE_BYTES];
+        let len = self.objects.persistent_image(&mut image).ok();
+        if let Some(n) = name_len {
+            let _ = self.objects.set_bytes(A271, 0, name.get(..n).unwrap_or(&[]));
+        }
+        if let Some(s) = ip {
+            settings::write_ip(&mut self.objects, s);
+        }
+        let saved = len
+            .and_then(|n| image.get(..n))
+            .is_some_and(|img| self.store.save(img, LAYOUT_HASH).is_ok());
+        let _ = self.objects.set(A00, 2, 100);
+        let _ = self.objects.set(A00, 3, if saved { 0 } else { 1 });
+        saved
+    }
+
     /// A received Ethernet frame at `now`; answers go out through `tx`.
-    /// Returns the device's events the application acts on (name/IP to
-    /// persist, DCP signal, AR changes), one at a time through `on_event`.
+    /// Returns the device's events the application acts on (DCP signal, AR
+    /// changes; name and IP are already written and saved), one at a time
+    /// through `on_event`. While PROFINET is off the frame is dropped.
     pub fn receive(
         &mut self,
         now: Nanos,
@@ -108,18 +255,27 @@ impl<H: RecordHook> PnDrive<H> {
         tx: &mut impl FnMut(&[u8]),
         on_event: &mut impl FnMut(&DeviceEvent),
     ) {
+        if !self.profinet_active() {
+            self.dropped_inactive = self.dropped_inactive.saturating_add(1);
+            return;
+        }
         self.device.receive(now, frame, tx);
         self.events(on_event);
     }
 
-    /// The device's timers at `now`; returns when to call again at the latest.
+    /// The device's timers at `now`; returns when to call again at the
+    /// latest. While PROFINET is off the timers run and nothing is sent.
     pub fn poll(
         &mut self,
         now: Nanos,
         tx: &mut impl FnMut(&[u8]),
         on_event: &mut impl FnMut(&DeviceEvent),
     ) -> Nanos {
-        let next = self.device.poll(now, tx);
+        let next = if self.profinet_active() {
+            self.device.poll(now, tx)
+        } else {
+            self.device.poll(now, &mut |_: &[u8]| {})
+        };
         self.events(on_event);
         next
     }
@@ -128,12 +284,63 @@ impl<H: RecordHook> PnDrive<H> {
         if self.device.exchanging() {
             self.exchanged = true;
         }
+        let mut save = false;
         while let Some(e) = self.device.take_event() {
-            if let DeviceEvent::Rt(RtEvent::ArLost(_)) = e {
-                self.raise_ar_lost();
+            match &e {
+                DeviceEvent::Rt(RtEvent::ArLost(_)) => self.raise_ar_lost(),
+                DeviceEvent::Dcp(d) => save |= self.apply_dcp(d),
+                _ => {}
             }
             on_event(&e);
         }
+        if save {
+            // the result shows in A00[2]
+            let _ = self.save();
+        }
+    }
+
+    /// Writes a DCP change into the objects; returns whether to save.
+    fn apply_dcp(&mut self, e: &DcpEvent) -> bool {
+        match e {
+            DcpEvent::NameOfStation { name, permanent } => {
+                settings::write_name(&mut self.objects, name);
+                self.temporary.name = !permanent;
+                true
+            }
+            DcpEvent::IpSuite { suite, permanent } => {
+                settings::write_ip(&mut self.objects, *suite);
+                self.temporary.ip = !permanent;
+                true
+            }
+            DcpEvent::ResetToFactory(ResetMode::All) => {
+                self.objects.restore_defaults();
+                self.temporary = Temporary::default();
+                true
+            }
+            DcpEvent::ResetToFactory(ResetMode::ApplicationData) => {
+                self.restore_application_defaults();
+                true
+            }
+            // name and IP follow as permanent Sets
+            DcpEvent::ResetToFactory(ResetMode::Communication) | DcpEvent::Signal { .. } => false,
+        }
+    }
+
+    /// Every parameter default except the PROFINET parameters A270…A278.
+    fn restore_application_defaults(&mut self) {
+        let mut name = [0u8; NAME_LEN];
+        let n = settings::name_bytes(&mut self.objects, &mut name);
+        let mut kept = [0i64; PROFINET_PARAMS.len()];
+        for (v, index) in kept.iter_mut().zip(PROFINET_PARAMS) {
+            *v = self.objects.get(index, 0).unwrap_or(0);
+        }
+        self.objects.restore_defaults();
+        for (v, index) in kept.iter().zip(PROFINET_PARAMS) {
+            if index != A271 {
+                let _ = self.objects.set(index, 0, *v);
+            }
+        }
+        let _ = self.objects.set_bytes(A271, 0, name.get(..n).unwrap_or(&[]));
     }
 
     /// the AR is gone; both axes run their fault reaction.
@@ -151,6 +358,7 @@ impl<H: RecordHook> PnDrive<H> {
     /// returns the power-stage commands. A fault raised or reset becomes a
     /// diagnosis alarm appearing or disappearing, and E82/E43 follow it.
     pub fn control_cycle(&mut self, now: Nanos, io: &[AxisIo; 2]) -> [AxisCommand; 2] {
+        self.profinet_active();
         let new = core::mem::take(&mut self.exchanged) || !self.device.exchanging();
         let mut commands = [AxisCommand::OFF; 2];
         for (i, ((axis, cache), io)) in self
@@ -193,5 +401,18 @@ impl<H: RecordHook> PnDrive<H> {
             *command = report.command;
         }
         commands
+    }
+}
+
+/// Loads the newest saved set into `objects` (defaults stay when there is
+/// none, it is from another declaration or does not load).
+fn load<F: Flash>(store: &mut ParamStore<F>, objects: &mut DriveObjects) -> Startup {
+    let mut image = [0u8; PERSISTENT_IMAGE_BYTES];
+    match store.load(LAYOUT_HASH, &mut image) {
+        Ok(n) => match image.get(..n).map(|img| objects.load_persistent(img)) {
+            Some(Ok(())) => Startup::Loaded,
+            _ => Startup::Defaults,
+        },
+        Err(_) => Startup::Defaults,
     }
 }

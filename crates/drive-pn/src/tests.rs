@@ -23,20 +23,39 @@ fn hex(s: &str) -> Vec<u8> {
         .collect()
 }
 
-fn drive() -> PnDrive {
-    let mut d = PnDrive::new(DeviceConfig {
+/// The flash of these tests (the board's parameter flash: 2 × 2 KiB).
+pub(crate) type TestFlash = store::RamFlash<2048, 2>;
+
+/// The board's data of the test device.
+pub(crate) fn hardware() -> Hardware {
+    Hardware {
         mac: OUR,
         port_macs: [MacAddr([2, 0, 0, 0, 0, 0x51]), MacAddr([2, 0, 0, 0, 0, 0x52])],
-        name: "drive-1".parse().unwrap(),
-        ip: IpSuite {
+        im0: Im0::drive("T1"),
+        im: ImData::default(),
+        boot_time: 1,
+    }
+}
+
+/// A drive commissioned as "drive-1" at 192.168.0.50/24 (saved, restarted).
+pub(crate) fn commissioned() -> PnDrive<TestFlash> {
+    let mut d = PnDrive::new(TestFlash::new(), hardware());
+    settings::write_name(&mut d.objects, &"drive-1".parse().unwrap());
+    settings::write_ip(
+        &mut d.objects,
+        IpSuite {
             ip: Ipv4Addr::new(192, 168, 0, 50),
             mask: Ipv4Addr::new(255, 255, 255, 0),
             gateway: Ipv4Addr::UNSPECIFIED,
         },
-        im0: Im0::drive("T1"),
-        im: ImData::default(),
-        boot_time: 1,
-    });
+    );
+    assert!(d.save());
+    PnDrive::new(d.into_flash(), hardware())
+}
+
+/// [`commissioned`], with profinet-py's AR connected.
+pub(crate) fn drive() -> PnDrive<TestFlash> {
+    let mut d = commissioned();
     let mut ctrl = Stack::new(
         CTRL,
         IpConfig {
@@ -64,7 +83,7 @@ fn drive() -> PnDrive {
     d
 }
 
-fn output_frame(d: &PnDrive, counter: u16) -> Vec<u8> {
+fn output_frame(d: &PnDrive<TestFlash>, counter: u16) -> Vec<u8> {
     let cr = d.device().cm().ar().unwrap().output_cr.clone().unwrap();
     let n = 14 + 2 + cr.data_length as usize + 4;
     let mut f = std::vec![0u8; n];
@@ -85,7 +104,7 @@ fn output_frame(d: &PnDrive, counter: u16) -> Vec<u8> {
 
 /// Runs 1 ms steps from `from` to `to`: output frames every 8 ms while
 /// `frames`, a control cycle every ms; returns the alarm frames sent.
-fn run(d: &mut PnDrive, from: u64, to: u64, frames: bool) -> Vec<Vec<u8>> {
+pub(crate) fn run(d: &mut PnDrive<TestFlash>, from: u64, to: u64, frames: bool) -> Vec<Vec<u8>> {
     let mut alarms = Vec::new();
     let io = [AxisIo::ready(0), AxisIo::ready(0)];
     for ms in from..to {

@@ -1,0 +1,114 @@
+//! The PROFINET operating parameters (spec §2.4) as the core's objects
+//! A270…A278 ([`drive_core::params::PROFINET_PARAMS`]; type, range, default
+//! and persistence are declared once, in `drive_core::objects`), and the
+//! device settings built from them at start.
+//!
+//! | line | parameter | used |
+//! |---|---|---|
+//! | A270 | PROFINET active (BOOL, default 1) | read at start; a 0 takes effect at once ([`crate::PnDrive`]) |
+//! | A271 | name of station (STRING(240), empty = none) | the device's name at start (P-007); DCP Set writes it |
+//! | A272…A274 | static IP, subnet mask, gateway (UINT32, first octet in the MSB, 0 = none) | the device's IP suite at start (P-010); DCP Set writes them (P-009) |
+//! | A275 | PROFIenergy active (BOOL, default 0) | declared only: the PROFIenergy services are not built (P-016) |
+//! | A276 | protocol (0 = standard protocol, range 0…0) | declared only: there is one protocol (P-014) |
+//! | A277 | parameterisation interface (0 automatic, 1 on-board Ethernet, 2 PROFINET) | declared only (P-017) |
+//! | A278 | vendor service port (UINT16, default 8802) | declared only: the vendor service protocol is not built (P-018) |
+
+use core::net::Ipv4Addr;
+
+use drive_core::params::{A271, A272, A273, A274};
+use drive_core::DriveObjects;
+use od::{CommState, Dictionary};
+use profinet::cm::{Im0, ImData};
+use profinet::dcp::server::ip_suite_valid;
+use profinet::dcp::{IpSuite, NameOfStation};
+use profinet::device::DeviceConfig;
+use profinet::model;
+use profinet::wire::MacAddr;
+
+/// The longest name of station in A271, bytes.
+pub const NAME_LEN: usize = drive_core::objects::manufacturer::PN_NAME_LEN as usize;
+
+/// What the board knows about the device apart from the parameters: the
+/// production data and the boot counter.
+#[derive(Clone, Debug)]
+pub struct Hardware {
+    /// The interface MAC (DCP, IP, RT).
+    pub mac: MacAddr,
+    /// The port MACs (LLDP sources, P-006).
+    pub port_macs: [MacAddr; model::PORTS as usize],
+    /// I&M0 (identity).
+    pub im0: Im0,
+    /// The stored I&M1–4 (kept by the board; not in the parameter image yet).
+    pub im: ImData,
+    /// The RPC server boot time: different after every start.
+    pub boot_time: u32,
+}
+
+/// The name of station in A271 into `buf`; returns its length (0 when the
+/// object does not read).
+pub(crate) fn name_bytes(objects: &mut DriveObjects, buf: &mut [u8; NAME_LEN]) -> usize {
+    // A271 is a string: read through the dictionary's checked path (level 0,
+    // visible at every access level)
+    objects.read(A271, 0, buf, CommState::PreOp).unwrap_or(0)
+}
+
+/// The stored name of station (A271); a name that breaks the
+/// name-of-station rules counts as none (the drive starts unnamed).
+pub fn name_of_station(objects: &mut DriveObjects) -> NameOfStation {
+    let mut buf = [0u8; NAME_LEN];
+    let n = name_bytes(objects, &mut buf);
+    buf.get(..n)
+        .and_then(|b| NameOfStation::new(b).ok())
+        .unwrap_or(NameOfStation::EMPTY)
+}
+
+/// Writes `name` into A271 (RAM; the rest of the string is zeroed).
+pub fn write_name(objects: &mut DriveObjects, name: &NameOfStation) {
+    let _ = objects.set_bytes(A271, 0, name.as_bytes());
+}
+
+fn addr(objects: &DriveObjects, index: u16) -> Ipv4Addr {
+    let v = objects.get(index, 0).unwrap_or(0);
+    Ipv4Addr::from(u32::try_from(v).unwrap_or(0))
+}
+
+/// The stored static IP suite (A272…A274); a suite DCP would refuse (see
+/// [`ip_suite_valid`]) counts as none.
+pub fn ip_suite(objects: &DriveObjects) -> IpSuite {
+    let s = stored_ip(objects);
+    if ip_suite_valid(&s) {
+        s
+    } else {
+        IpSuite::UNSET
+    }
+}
+
+/// A272…A274 as they are, valid or not.
+pub(crate) fn stored_ip(objects: &DriveObjects) -> IpSuite {
+    IpSuite {
+        ip: addr(objects, A272),
+        mask: addr(objects, A273),
+        gateway: addr(objects, A274),
+    }
+}
+
+/// Writes `suite` into A272…A274 (RAM).
+pub fn write_ip(objects: &mut DriveObjects, suite: IpSuite) {
+    for (index, a) in [(A272, suite.ip), (A273, suite.mask), (A274, suite.gateway)] {
+        let _ = objects.set(index, 0, i64::from(u32::from(a)));
+    }
+}
+
+/// The device settings at start: name and IP from the objects, the rest
+/// from `hw`.
+pub fn device_config(objects: &mut DriveObjects, hw: Hardware) -> DeviceConfig {
+    DeviceConfig {
+        mac: hw.mac,
+        port_macs: hw.port_macs,
+        name: name_of_station(objects),
+        ip: ip_suite(objects),
+        im0: hw.im0,
+        im: hw.im,
+        boot_time: hw.boot_time,
+    }
+}
