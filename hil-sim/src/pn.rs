@@ -250,12 +250,10 @@ mod tests {
     }
 
     /// profinet-py asks with response delay factor 0x80 (up to 1.28 s): the
-    /// device keeps the delayed answer in a `heapless::Vec<u8, 128>`
-    /// (`Device::identify`), the unnamed drive's answer has 140 bytes, so
-    /// it is dropped and never sent.
+    /// delayed answer (140 bytes for the unnamed drive) is kept whole and
+    /// sent when due.
     #[test]
-    #[ignore = "profinet::device drops delayed Identify answers over 128 bytes"]
-    fn a_fresh_drive_answers_a_delayed_identify() {
+    fn p008_a_fresh_drive_answers_a_delayed_identify() {
         assert_eq!(identify_answers(0x80).len(), 1);
     }
 }

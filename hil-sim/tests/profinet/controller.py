@@ -50,12 +50,6 @@ from profinet.dcp import (
 from profinet.exceptions import DCPDeviceNotFoundError
 from profinet.util import ethernet_socket, get_mac, mac2s, s2mac
 
-# The device's known problem with profinet-py's DCP Identify (reported, not
-# worked around in the device): a delayed Identify answer is kept in a
-# 128-byte buffer (profinet::device::Device::identify, heapless::Vec<u8, 128>);
-# the drive's answer has 140 bytes or more, so Vec::from_slice fails and the
-# answer is silently dropped. Answers without delay (factor 0 or 1) go out.
-DELAYED = "device drops delayed Identify answers over 128 bytes"
 
 failures = []
 
@@ -166,10 +160,8 @@ def main():
     want_mac = a.device_mac.lower()
     sock = ethernet_socket(iface)
 
-    # (a) Identify All. profinet-py asks with response delay factor 0x80
-    # (answers spread over 1.28 s); the device drops such delayed answers
-    # (see DELAYED below), so the step asks again with factor 1 (at once),
-    # which profinet-py's send_discover takes as an argument.
+    # (a) Identify All with profinet-py's response delay factor 0x80 (answers
+    # spread over 1.28 s: the device answers after its MAC's share of it).
     def identify_all(delay):
         xid = dcp.send_discover(sock, src, response_delay=delay)
         found = dcp.read_response(sock, src, timeout_sec=3, expected_xid=xid, strict_xid=True)
@@ -180,11 +172,6 @@ def main():
 
     def step_a():
         d = identify_all(0x0080)
-        if isinstance(d, dcp.DCPDeviceDescription):
-            print("  Identify All with profinet-py's delay 0x80 answered: the device sends delayed answers now", flush=True)
-        else:
-            expected_fail("a", f"Identify All with profinet-py's default response delay 0x0080: no answer ({DELAYED})")
-            d = identify_all(0x0001)
         if not isinstance(d, dcp.DCPDeviceDescription):
             report("a", False, f"Identify All: {want_mac} not among {d}")
             return
@@ -210,28 +197,13 @@ def main():
 
     run("b", set_name_and_ip)
 
-    # (c) Identify by name: profinet-py's get_station_info (delay 0x80, then
-    # an Identify All with 0x80), and with factor 1 built as its send_request
-    # builds it
+    # (c) Identify by name: profinet-py's get_station_info (delay 0x80)
     def identify_by_name():
         try:
             d = get_station_info(sock, src, a.name, timeout_sec=3, strict_xid=True)
-            print("  get_station_info answered: the device sends delayed answers now", flush=True)
         except DCPDeviceNotFoundError as e:
-            expected_fail("c", f"get_station_info({a.name!r}) (response delay 0x0080): {e} ({DELAYED})")
-            value = a.name.encode()
-            block = PNDCPBlockRequest(PNDCPBlock.NAME_OF_STATION[0], PNDCPBlock.NAME_OF_STATION[1], len(value), payload=value)
-            xid = 0x5EED0001
-            hdr = PNDCPHeader(
-                DCP_IDENTIFY_REQUEST_FRAME_ID, PNDCPHeader.IDENTIFY, PNDCPHeader.REQUEST, xid, 0x0001, len(block), payload=block
-            )
-            sock.send(bytes(EthernetHeader(s2mac(DCP_MULTICAST_MAC), src, PROFINET_ETHERTYPE, payload=hdr)))
-            found = dcp.read_response(sock, src, timeout_sec=3, once=True, expected_xid=xid, strict_xid=True)
-            if not found:
-                report("c", False, f"Identify by name {a.name!r} (delay 1): no answer")
-                return None
-            mac, blocks = list(found.items())[0]
-            d = dcp.DCPDeviceDescription(mac, blocks)
+            report("c", False, f"get_station_info({a.name!r}): {e}")
+            return None
         ok = d.mac == want_mac and d.ip == a.ip and d.netmask == a.mask and d.name == a.name
         report("c", ok, f"Identify by name {a.name!r}: {d.mac} ip {d.ip} mask {d.netmask} name {d.name!r}")
         return d

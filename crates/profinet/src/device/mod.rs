@@ -122,7 +122,7 @@ pub struct Device<H: RecordHook = NoRecords> {
     lldp: Schedule,
     port_macs: [MacAddr; model::PORTS as usize],
     /// A delayed DCP Identify answer and when to send it.
-    identify: Option<(Nanos, Vec<u8, 128>)>,
+    identify: Option<(Nanos, Vec<u8, 1500>)>,
     events: Deque<DeviceEvent, MAX_DEVICE_EVENTS>,
     counters: DeviceCounters,
     started: bool,
