@@ -23,7 +23,7 @@ fn connect(d: &mut Device) {
 }
 
 fn output_frame(d: &Device) -> Vec<u8> {
-    testing::output_frame(d.cm().ar().expect("connected"), 0, 0)
+    testing::output_frame(d.cm().ar().expect("connected"), 0, 0).to_vec()
 }
 
 fn main() {

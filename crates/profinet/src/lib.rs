@@ -36,7 +36,7 @@ pub mod wire;
 
 pub use nanos::Nanos;
 
-#[cfg(any(test, feature = "testing"))]
+#[cfg(test)]
 extern crate std;
 #[cfg(any(test, feature = "testing"))]
 pub mod testing;

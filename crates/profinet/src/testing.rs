@@ -1,10 +1,13 @@
-//! A scripted controller for tests, benchmarks and fuzz targets (feature
-//! `testing`, never in the firmware): the device settings the tests use,
-//! profinet-py's Connect as a UDP frame, and controller output frames for an
-//! established AR.
+//! A scripted controller for tests, benchmarks, fuzz targets and the QEMU
+//! measurement image (feature `testing`, never in a product image): the
+//! device settings the tests use, profinet-py's Connect as a UDP frame, and
+//! controller output frames for an established AR.
+//!
+//! `no_std` and heap-free: every frame is a [`Frame`] (a `heapless::Vec` of
+//! up to [`FRAME_CAP`] bytes), so the firmware's QEMU image can script a
+//! controller too.
 
 use core::net::Ipv4Addr;
-use std::vec::Vec;
 
 use nanos::Nanos;
 
@@ -48,19 +51,42 @@ pub fn device_config() -> DeviceConfig {
     }
 }
 
-/// Hex text (whitespace and line breaks ignored) as bytes.
-pub fn hex(s: &str) -> Vec<u8> {
-    let digits: Vec<u8> = s.bytes().filter(u8::is_ascii_hexdigit).collect();
-    digits
-        .chunks(2)
-        .filter_map(|p| core::str::from_utf8(p).ok())
-        .filter_map(|p| u8::from_str_radix(p, 16).ok())
-        .collect()
+/// The longest frame these helpers build, bytes.
+pub const FRAME_CAP: usize = 1600;
+
+/// A frame (or payload) built by these helpers.
+pub type Frame = heapless::Vec<u8, FRAME_CAP>;
+
+fn nibble(c: u8) -> Option<u8> {
+    match c {
+        b'0'..=b'9' => Some(c - b'0'),
+        b'a'..=b'f' => Some(c - b'a' + 10),
+        b'A'..=b'F' => Some(c - b'A' + 10),
+        _ => None,
+    }
+}
+
+/// Hex text (anything but hex digits ignored) as bytes; an odd last digit
+/// and anything beyond [`FRAME_CAP`] bytes are dropped.
+pub fn hex(s: &str) -> Frame {
+    let mut out = Frame::new();
+    let mut high: Option<u8> = None;
+    for d in s.bytes().filter_map(nibble) {
+        match high.take() {
+            None => high = Some(d),
+            Some(h) => {
+                if out.push(h << 4 | d).is_err() {
+                    break;
+                }
+            }
+        }
+    }
+    out
 }
 
 /// `payload` (cut to 1400 bytes) as a UDP datagram from the controller
 /// (port 0xC000) to the device's RPC port, as a whole Ethernet frame.
-pub fn udp_to_device(payload: &[u8]) -> Vec<u8> {
+pub fn udp_to_device(payload: &[u8]) -> Frame {
     let mut ctrl = Stack::new(
         CONTROLLER_MAC,
         IpConfig {
@@ -71,7 +97,7 @@ pub fn udp_to_device(payload: &[u8]) -> Vec<u8> {
     );
     ctrl.learn(Nanos::ZERO, DEVICE_IP, DEVICE_MAC);
     let payload = payload.get(..payload.len().min(1400)).unwrap_or(&[]);
-    let mut tx = std::vec![0u8; 1600];
+    let mut tx = [0u8; FRAME_CAP];
     if let Some(dst) = tx.get_mut(UDP_PAYLOAD_OFFSET..UDP_PAYLOAD_OFFSET + payload.len()) {
         dst.copy_from_slice(payload);
     }
@@ -80,30 +106,32 @@ pub fn udp_to_device(payload: &[u8]) -> Vec<u8> {
         port: RPC_PORT,
     };
     match ctrl.emit_udp(Nanos::ZERO, &mut tx, 0xC000, ep, payload.len()) {
-        Ok(UdpTx::Frame(n)) => tx.get(..n).map(<[u8]>::to_vec).unwrap_or_default(),
-        _ => Vec::new(),
+        Ok(UdpTx::Frame(n)) => tx
+            .get(..n)
+            .and_then(|f| Frame::from_slice(f).ok())
+            .unwrap_or_default(),
+        _ => Frame::new(),
     }
 }
 
 /// profinet-py's Connect (slot 1 OUT 18 words, slot 2 IN 18 words; 1 ms × 8,
 /// watchdog and data hold 6 cycles) as a frame to the device.
-pub fn connect_frame() -> Vec<u8> {
+pub fn connect_frame() -> Frame {
     udp_to_device(&hex(vectors::CONNECT))
 }
 
 /// A controller output frame for `ar`'s output CR: every data object filled
 /// with `fill`, IOPS and IOCS good, DataStatus 0x35, cycle counter `counter`.
-pub fn output_frame(ar: &Ar, counter: u16, fill: u8) -> Vec<u8> {
+/// Empty when the AR has no output CR or its data does not fit a [`Frame`].
+pub fn output_frame(ar: &Ar, counter: u16, fill: u8) -> Frame {
     let Some(cr) = ar.output_cr.as_ref() else {
-        return Vec::new();
+        return Frame::new();
     };
     let len = usize::from(cr.data_length);
-    let mut f = Vec::with_capacity(16 + len + 4);
-    f.extend_from_slice(&DEVICE_MAC.0);
-    f.extend_from_slice(&CONTROLLER_MAC.0);
-    f.extend_from_slice(&0x8892u16.to_be_bytes());
-    f.extend_from_slice(&cr.frame_id.to_be_bytes());
-    let mut csdu = std::vec![0u8; len];
+    let mut csdu_buf = [0u8; FRAME_CAP];
+    let Some(csdu) = csdu_buf.get_mut(..len) else {
+        return Frame::new();
+    };
     for o in &cr.data {
         let at = usize::from(o.frame_offset);
         let n = usize::from(o.data_len);
@@ -119,8 +147,20 @@ pub fn output_frame(ar: &Ar, counter: u16, fill: u8) -> Vec<u8> {
             *iocs = 0x80;
         }
     }
-    f.extend_from_slice(&csdu);
-    f.extend_from_slice(&counter.to_be_bytes());
-    f.extend_from_slice(&[0x35, 0x00]);
+    let mut f = Frame::new();
+    let parts: [&[u8]; 7] = [
+        &DEVICE_MAC.0,
+        &CONTROLLER_MAC.0,
+        &0x8892u16.to_be_bytes(),
+        &cr.frame_id.to_be_bytes(),
+        csdu,
+        &counter.to_be_bytes(),
+        &[0x35, 0x00],
+    ];
+    for p in parts {
+        if f.extend_from_slice(p).is_err() {
+            return Frame::new();
+        }
+    }
     f
 }

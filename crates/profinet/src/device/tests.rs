@@ -105,7 +105,7 @@ fn connected() -> Device {
 
 /// A controller output frame with `fill` in slot 2's 36 bytes.
 fn output_frame(d: &Device, counter: u16, fill: u8) -> Vec<u8> {
-    testing::output_frame(d.cm().ar().unwrap(), counter, fill)
+    testing::output_frame(d.cm().ar().unwrap(), counter, fill).to_vec()
 }
 
 fn poll(d: &mut Device, now: Nanos) -> Vec<Vec<u8>> {
