@@ -1,15 +1,24 @@
-//! A simulated drive on PROFINET: the firmware's PROFINET IO device
-//! ([`profinet::device::Device`]) with the settings a fresh drive ships with,
-//! and the drive's side of the cyclic data as a loop-back (what the
-//! controller writes into the drive's IN module comes back in its OUT
-//! module), so a controller can check round trips. `hil-sim serve
-//! --fieldbus profinet` runs it on a raw interface (`cli/serve_pn.rs`).
+//! A simulated drive on PROFINET ([`PnSim`]): the firmware's drive
+//! personality (`drive_pn`: the PROFINET IO device in front of the
+//! fieldbus-neutral drive core) with a motor on each axis, its control
+//! cycle run at A150, and the drive's side of the cyclic data as a loop-back
+//! until the profile maps telegrams (issue 17): what the controller writes
+//! into the drive's IN module comes back in its OUT module, so a controller
+//! can check round trips. A control channel ([`Command`]) raises drive
+//! events and acknowledges faults. `hil-sim serve --fieldbus profinet` runs
+//! it on a raw interface (`cli/serve_pn.rs`).
 
+use std::collections::VecDeque;
+
+use crate::motor::{Motor, MotorOutputs};
+use crate::sim::{axis_io, AxisConditions, SimFlash};
+use drive::params::{E43, E82};
+use drive_pn::Hardware;
 use nanos::Nanos;
 use profinet::cm::{CmEvent, Im0, ImData};
 use profinet::dcp::server::Event as DcpEvent;
 use profinet::dcp::{IpSuite, NameOfStation};
-use profinet::device::{Device, DeviceConfig, DeviceEvent, RtEvent, MAX_MODULE_BYTES};
+use profinet::device::{Device, DeviceEvent, RtEvent, MAX_MODULE_BYTES};
 use profinet::model;
 use profinet::rpc::uuid::Uuid;
 use profinet::wire::MacAddr;
@@ -27,21 +36,6 @@ pub fn port_macs(mac: MacAddr) -> [MacAddr; model::PORTS as usize] {
         m.0[5] = mac.0[5].wrapping_add(port);
     }
     out
-}
-
-/// The settings of a drive as shipped (no IP, the given name: empty for
-/// none) on interface `mac`, started at `boot_time` (any value that differs
-/// after every start: the wall clock's seconds).
-pub fn device_config(mac: MacAddr, name: NameOfStation, boot_time: u32) -> DeviceConfig {
-    DeviceConfig {
-        mac,
-        port_macs: port_macs(mac),
-        name,
-        ip: IpSuite::UNSET,
-        im0: Im0::drive(SERIAL_NUMBER),
-        im: ImData::default(),
-        boot_time,
-    }
 }
 
 /// A MAC written as `aa:bb:cc:dd:ee:ff` (as `/sys/class/net/IF/address`).
@@ -126,49 +120,278 @@ pub fn describe(e: &DeviceEvent) -> String {
     }
 }
 
-/// The simulated drive: the device and the loop-back of its process data.
-pub struct PnDrive {
-    device: Device,
+/// The axis letters of the control channel.
+const AXES: [char; 2] = ['A', 'B'];
+
+/// Control cycles a fault acknowledgement holds controlword bit 7.
+const ACK_CYCLES: u8 = 2;
+
+/// A command of the simulator's control channel (`serve --control`).
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum Command {
+    /// Raise drive event `event` with `cause` on `axis` (0 = A, 1 = B), as
+    /// the power stage or a monitoring function would.
+    Fault {
+        /// 0 = A, 1 = B.
+        axis: usize,
+        /// The E82 event number (HH).
+        event: u8,
+        /// The E43 cause (S, 0…15).
+        cause: u8,
+    },
+    /// Acknowledge the fault of `axis`: controlword bit 7 (C-017), which
+    /// the profile's CW1 bit 7 will carry (issue 17).
+    Reset {
+        /// 0 = A, 1 = B.
+        axis: usize,
+    },
+    /// Report the axes' state.
+    Status,
 }
 
-impl PnDrive {
-    /// A drive with `config` ([`device_config`]).
-    pub fn new(config: DeviceConfig) -> PnDrive {
-        PnDrive {
-            device: Device::plain(config),
+impl Command {
+    /// Parses one line: `fault A 44 1`, `reset B`, `status`.
+    pub fn parse(line: &str) -> Result<Command, String> {
+        let words: Vec<&str> = line.split_whitespace().collect();
+        let axis = |w: Option<&&str>| -> Result<usize, String> {
+            let w = w.ok_or("an axis (A or B) is missing")?;
+            AXES.iter()
+                .position(|c| w.eq_ignore_ascii_case(&c.to_string()))
+                .ok_or_else(|| format!("{w:?} is no axis (A or B)"))
+        };
+        let number = |w: Option<&&str>, what: &str| -> Result<u8, String> {
+            let w = w.ok_or_else(|| format!("the {what} is missing"))?;
+            w.parse()
+                .map_err(|_| format!("{what} {w:?} is not a number 0…255"))
+        };
+        match words.as_slice() {
+            ["fault", rest @ ..] if rest.len() == 3 => {
+                let cause = number(rest.get(2), "cause")?;
+                if cause > 15 {
+                    return Err(format!("cause {cause}: E43 causes are 0…15"));
+                }
+                Ok(Command::Fault {
+                    axis: axis(rest.first())?,
+                    event: number(rest.get(1), "event")?,
+                    cause,
+                })
+            }
+            ["reset", rest @ ..] if rest.len() == 1 => Ok(Command::Reset {
+                axis: axis(rest.first())?,
+            }),
+            ["status"] => Ok(Command::Status),
+            _ => Err(format!(
+                "{:?}: commands are `fault A|B EVENT CAUSE`, `reset A|B`, `status`",
+                line.trim()
+            )),
         }
+    }
+}
+
+/// A simulated drive on PROFINET: the firmware's drive personality
+/// ([`drive_pn::PnDrive`]: the device, the object dictionary, both axes, the
+/// parameter store) with a motor on each axis, its control cycle run at A150
+/// on the caller's clock, and the cyclic data looped back (what the
+/// controller writes into the drive's IN module comes back in its OUT
+/// module) until the profile maps telegrams (issue 17).
+pub struct PnSim {
+    drive: drive_pn::PnDrive<SimFlash>,
+    motors: [Motor; 2],
+    feedback: [Option<MotorOutputs>; 2],
+    conditions: [AxisConditions; 2],
+    /// When the next control cycle starts.
+    next_cycle: Nanos,
+    /// Control cycles run.
+    cycles: u64,
+    /// Cycles left that hold controlword bit 7 per axis.
+    acknowledge: [u8; 2],
+    /// The personality's events, oldest first.
+    events: VecDeque<DeviceEvent>,
+}
+
+impl PnSim {
+    /// A drive powered on over `flash` (empty: as shipped) on interface
+    /// `mac`, started at `boot_time` (any value that differs after every
+    /// start: the wall clock's seconds).
+    pub fn power_on(flash: SimFlash, mac: MacAddr, boot_time: u32) -> PnSim {
+        let hw = Hardware {
+            mac,
+            port_macs: port_macs(mac),
+            im0: Im0::drive(SERIAL_NUMBER),
+            im: ImData::default(),
+            boot_time,
+        };
+        PnSim {
+            drive: drive_pn::PnDrive::new(flash, hw),
+            motors: [Motor::default_servo(), Motor::default_servo()],
+            feedback: [None, None],
+            conditions: [AxisConditions::READY; 2],
+            next_cycle: Nanos::ZERO,
+            cycles: 0,
+            acknowledge: [0; 2],
+            events: VecDeque::new(),
+        }
+    }
+
+    /// A drive as shipped, except that its name of station is `name`
+    /// (stored in A271 and saved, then powered on again: the name a
+    /// commissioning tool left behind).
+    pub fn named(mac: MacAddr, name: &NameOfStation, boot_time: u32) -> PnSim {
+        let mut first = PnSim::power_on(SimFlash::new(), mac, boot_time);
+        if name.is_empty() {
+            return first;
+        }
+        drive_pn::settings::write_name(first.drive.objects_mut(), name);
+        first.drive.save();
+        PnSim::power_on(first.drive.into_flash(), mac, boot_time)
+    }
+
+    /// The drive personality (objects, axes, store).
+    pub fn drive(&self) -> &drive_pn::PnDrive<SimFlash> {
+        &self.drive
+    }
+
+    /// The drive personality, mutable.
+    pub fn drive_mut(&mut self) -> &mut drive_pn::PnDrive<SimFlash> {
+        &mut self.drive
     }
 
     /// The device (name, IP, AR, counters).
     pub fn device(&self) -> &Device {
-        &self.device
+        self.drive.device()
+    }
+
+    /// Control cycles run so far.
+    pub fn cycles(&self) -> u64 {
+        self.cycles
     }
 
     /// The next event, oldest first.
     pub fn take_event(&mut self) -> Option<DeviceEvent> {
-        self.device.take_event()
+        self.events.pop_front()
     }
 
-    /// One received frame at `now`; answers go out through `tx`.
+    /// One received frame at `now` (the control cycles due before it run
+    /// first); answers go out through `tx`.
     pub fn receive(&mut self, now: Nanos, frame: &[u8], tx: &mut impl FnMut(&[u8])) {
-        self.device.receive(now, frame, tx);
+        self.run_due_cycles(now);
+        let events = &mut self.events;
+        self.drive
+            .receive(now, frame, tx, &mut |e| events.push_back(e.clone()));
         self.echo();
     }
 
-    /// The device's timers at `now`; returns when to call again at the latest.
+    /// The control cycles due at `now`, then the device's timers; returns
+    /// when to call again at the latest (the next control cycle or the
+    /// device's deadline).
     pub fn poll(&mut self, now: Nanos, tx: &mut impl FnMut(&[u8])) -> Nanos {
+        self.run_due_cycles(now);
         self.echo();
-        self.device.poll(now, tx)
+        let events = &mut self.events;
+        let next = self.drive.poll(now, tx, &mut |e| events.push_back(e.clone()));
+        next.min(self.next_cycle)
     }
 
-    /// The drive's application: the first IN module's current output data
-    /// (controller → drive) is copied into the first OUT module's inputs
-    /// (drive → controller), as far as both reach. Nothing changes while the
-    /// outputs are not current.
+    /// Carries out a control-channel command; returns what to print.
+    pub fn command(&mut self, c: Command) -> String {
+        match c {
+            Command::Fault { axis, event, cause } => {
+                let Some(a) = self.drive.axes_mut().get_mut(axis) else {
+                    return format!("no axis {axis}");
+                };
+                a.raise_event(motion_event(event, cause));
+                format!("axis {}: event {event} cause {cause} raised", axis_name(axis))
+            }
+            Command::Reset { axis } => {
+                if let Some(n) = self.acknowledge.get_mut(axis) {
+                    *n = ACK_CYCLES;
+                }
+                format!("axis {}: fault acknowledged (controlword bit 7)", axis_name(axis))
+            }
+            Command::Status => self.status(),
+        }
+    }
+
+    /// The axes' state, E82/E43 and the device's diagnosis, one line.
+    pub fn status(&self) -> String {
+        let objects = self.drive.objects();
+        let e82 = objects.get(E82, 0).unwrap_or(-1);
+        let e43 = objects.get(E43, 0).unwrap_or(-1);
+        let axes: Vec<String> = self
+            .drive
+            .axes()
+            .iter()
+            .enumerate()
+            .map(|(i, a)| format!("axis {} {:?}", axis_name(i), a.state()))
+            .collect();
+        format!(
+            "{}; E82 {e82} E43 {e43}; diagnosis {}",
+            axes.join(", "),
+            if self.device().diagnosis_present() {
+                "present"
+            } else {
+                "none"
+            }
+        )
+    }
+
+    /// Runs every control cycle due at `now`, each at its own start time:
+    /// the axes with the motors' last feedback, then one motor step each
+    /// with the commanded torque.
+    fn run_due_cycles(&mut self, now: Nanos) {
+        // bounded: a clock jump cannot hang the simulation
+        for _ in 0..100_000 {
+            let t = self.next_cycle;
+            if t > now {
+                return;
+            }
+            self.acknowledge_step();
+            let io = [
+                axis_io(self.feedback[0].as_ref(), &self.motors[0], self.conditions[0]),
+                axis_io(self.feedback[1].as_ref(), &self.motors[1], self.conditions[1]),
+            ];
+            let commands = self.drive.control_cycle(t, &io);
+            let period = self.drive.control_period();
+            for ((motor, fb), c) in self.motors.iter_mut().zip(self.feedback.iter_mut()).zip(commands) {
+                let torque = if c.power_stage {
+                    f64::from(c.torque_nm)
+                } else {
+                    0.0
+                };
+                *fb = Some(motor.step(torque, !c.brake_release, period));
+            }
+            self.cycles += 1;
+            self.next_cycle = t + period;
+        }
+        // far behind (the first call after a long pause): skip to now
+        self.next_cycle = now;
+    }
+
+    /// Holds controlword bit 7 for [`ACK_CYCLES`] cycles after a reset
+    /// command (the rising edge acknowledges, C-017), then clears it.
+    fn acknowledge_step(&mut self) {
+        for (axis, left) in self.acknowledge.iter_mut().enumerate() {
+            if *left == 0 {
+                continue;
+            }
+            *left -= 1;
+            let word = if *left > 0 { 0x80 } else { 0x00 };
+            let index = self.drive.axes().get(axis).map(|a| a.cia402_index(0x6040));
+            if let Some(index) = index {
+                let _ = self.drive.objects_mut().set(index, 0, word);
+            }
+        }
+    }
+
+    /// The drive's application until the profile maps telegrams: the first
+    /// IN module's current output data (controller → drive) is copied into
+    /// the first OUT module's inputs (drive → controller), as far as both
+    /// reach. Nothing changes while the outputs are not current.
     fn echo(&mut self) {
+        let device = self.drive.device_mut();
         let mut to_drive = None;
         let mut from_drive = None;
-        for (slot, _, to) in self.device.data_modules() {
+        for (slot, _, to) in device.data_modules() {
             match to {
                 true if to_drive.is_none() => to_drive = Some(slot),
                 false if from_drive.is_none() => from_drive = Some(slot),
@@ -179,7 +402,7 @@ impl PnDrive {
             return;
         };
         let mut buf = [0u8; MAX_MODULE_BYTES];
-        let Some(n) = self.device.output_data(src).map(|d| {
+        let Some(n) = device.output_data(src).map(|d| {
             let n = d.len().min(buf.len());
             buf.get_mut(..n)
                 .unwrap_or_default()
@@ -188,7 +411,18 @@ impl PnDrive {
         }) else {
             return;
         };
-        self.device.set_input_data(dst, buf.get(..n).unwrap_or_default());
+        device.set_input_data(dst, buf.get(..n).unwrap_or_default());
+    }
+}
+
+fn axis_name(axis: usize) -> char {
+    AXES.get(axis).copied().unwrap_or('?')
+}
+
+fn motion_event(event: u8, cause: u8) -> motion::Event {
+    motion::Event {
+        number: u16::from(event),
+        cause,
     }
 }
 
@@ -230,7 +464,7 @@ mod tests {
     /// The DCP frames a fresh drive sends within 1.3 s of an Identify All.
     fn identify_answers(delay: u8) -> Vec<Vec<u8>> {
         let mac = MacAddr([0x02, 0, 0, 0, 0, 0x42]);
-        let mut d = PnDrive::new(device_config(mac, NameOfStation::EMPTY, 7));
+        let mut d = PnSim::power_on(SimFlash::new(), mac, 7);
         assert!(d.device().dcp().name_of_station().is_empty());
         assert_eq!(d.device().dcp().ip_suite(), IpSuite::UNSET);
         let mut out = Vec::new();
@@ -255,5 +489,70 @@ mod tests {
     #[test]
     fn p008_a_fresh_drive_answers_a_delayed_identify() {
         assert_eq!(identify_answers(0x80).len(), 1);
+    }
+
+    #[test]
+    fn control_commands_parse_and_bad_ones_say_why() {
+        assert_eq!(
+            Command::parse("fault A 44 1"),
+            Ok(Command::Fault {
+                axis: 0,
+                event: 44,
+                cause: 1
+            })
+        );
+        assert_eq!(Command::parse(" reset b\n"), Ok(Command::Reset { axis: 1 }));
+        assert_eq!(Command::parse("status"), Ok(Command::Status));
+        for bad in [
+            "fault C 44 1",
+            "fault A 44 16",
+            "fault A x 1",
+            "reset",
+            "fault A 44",
+            "jump",
+        ] {
+            assert!(Command::parse(bad).is_err(), "{bad:?}");
+        }
+    }
+
+    #[test]
+    fn c144_the_simulated_drive_runs_its_control_cycle_at_a150() {
+        let mut d = PnSim::power_on(SimFlash::new(), MacAddr([2, 0, 0, 0, 0, 1]), 7);
+        d.poll(Nanos::from_ms(100), &mut |_: &[u8]| {});
+        assert_eq!(d.cycles(), 101, "0, 1, …, 100 ms");
+    }
+
+    /// A drive event raised through the control channel faults the axis
+    /// and shows as the drive's diagnosis (E82/E43 set); the reset command
+    /// clears both. (Without an AR no alarm goes out: the diagnosis is
+    /// kept for the records.)
+    #[test]
+    fn p030_p035_a_control_channel_fault_is_a_diagnosis_until_its_reset() {
+        let mut d = PnSim::power_on(SimFlash::new(), MacAddr([2, 0, 0, 0, 0, 1]), 7);
+        let mut t = 0;
+        let mut run = |d: &mut PnSim, ms: u64| {
+            t += ms;
+            d.poll(Nanos::from_ms(t), &mut |_: &[u8]| {});
+        };
+        run(&mut d, 10);
+        assert!(!d.device().diagnosis_present());
+        d.command(Command::parse("fault B 44 1").unwrap());
+        run(&mut d, 10);
+        assert!(d.drive().axes()[1].state().is_fault(), "{}", d.status());
+        assert!(!d.drive().axes()[0].state().is_fault());
+        assert!(d.device().diagnosis_present());
+        assert_eq!(d.drive().objects().get(E82, 0).unwrap(), 44);
+        assert_eq!(d.drive().objects().get(E43, 0).unwrap(), 1);
+        d.command(Command::parse("reset B").unwrap());
+        run(&mut d, 10);
+        assert!(!d.drive().axes()[1].state().is_fault(), "{}", d.status());
+        assert!(!d.device().diagnosis_present(), "{}", d.status());
+    }
+
+    #[test]
+    fn p007_a_named_simulated_drive_starts_with_its_stored_name() {
+        let name: NameOfStation = "drive-7".parse().unwrap();
+        let d = PnSim::named(MacAddr([2, 0, 0, 0, 0, 1]), &name, 7);
+        assert_eq!(d.device().dcp().name_of_station().as_str(), "drive-7");
     }
 }

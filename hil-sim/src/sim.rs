@@ -178,7 +178,7 @@ fn sii_image() -> ([u8; ecat::sii::EEPROM_BYTES], usize) {
 }
 
 /// What the axis runtime reads from the motor's last step.
-fn axis_io(out: Option<&MotorOutputs>, motor: &Motor, c: AxisConditions) -> AxisIo {
+pub(crate) fn axis_io(out: Option<&MotorOutputs>, motor: &Motor, c: AxisConditions) -> AxisIo {
     let mut io = AxisIo::ready(0);
     io.additional_enable = c.additional_enable;
     io.supply_ok = c.supply_ok;

@@ -10,7 +10,11 @@
 //!   I&M0 through an RPC read, Connect with the GSDML's DAP and the manual's
 //!   example modules, PrmEnd, ApplicationReady, Release, a Connect with a wrong
 //!   module (ModuleDiff), ≥ 10 s of cyclic data at 1 ms with the drive echoing
-//!   its outputs, and the AR's abort when the controller stops sending.
+//!   its outputs, a drive fault (raised through serve's control channel) as
+//!   a diagnosis alarm that profinet-py acknowledges and that disappears
+//!   after the fault reset, and the AR's abort when the controller stops
+//!   sending. The figure "DCP identify to first valid cyclic data" goes to
+//!   `target/tmp/profinet-py/figures.txt` (`.ci/run` prints it).
 //!
 //! The test asserts on the script's step lines and on the events `serve`
 //! prints, then dissects `serve`'s recording with tshark: no malformed
@@ -40,6 +44,9 @@ const CYCLIC_SECONDS: &str = "12";
 const CONTROLLER_IP: &str = "192.168.0.10/24";
 /// The name and IP the controller gives the device.
 const NAME: &str = "drive-1";
+/// The drive fault of step (i): event 44 "External fault 1", cause 1.
+const FAULT_EVENT: u8 = 44;
+const FAULT_CAUSE: u8 = 1;
 const DEVICE_IP: &str = "192.168.0.50";
 
 /// The python with profinet-py, or why the test cannot run.
@@ -88,6 +95,8 @@ struct Line {
     device_mac: String,
     server: Option<Child>,
     serve_log: PathBuf,
+    /// serve's control FIFO (`--control`).
+    control: PathBuf,
 }
 
 impl Line {
@@ -111,6 +120,7 @@ impl Line {
             device_mac: String::new(),
             server: None,
             serve_log: dir.join("serve.log"),
+            control: dir.join("control"),
         };
         let (c, d) = (line.ctl_ns.clone(), line.dev_ns.clone());
         for ns in [&c, &d] {
@@ -155,6 +165,8 @@ impl Line {
                 .args(["--fieldbus", "profinet", "--iface", &dev_if])
                 .arg("--pcap")
                 .arg(pcap)
+                .arg("--control")
+                .arg(&line.control)
                 .stdout(log.try_clone().expect("log"))
                 .stderr(log)
                 .spawn()
@@ -276,7 +288,7 @@ fn step_lines<'a>(lines: &'a [String], step: &str) -> Vec<&'a str> {
 /// goes silent), all with profinet-py as the controller; every frame of the
 /// device dissected by Wireshark without a warning.
 #[test]
-fn p008_p027_p029_p042_profinet_py_names_connects_exchanges_and_loses_the_drive() {
+fn p008_p027_p029_p030_p035_p036_p042_profinet_py_names_connects_faults_and_loses_the_drive() {
     let python = match profinet_py_python() {
         Ok(p) => p,
         Err(why) => {
@@ -314,12 +326,18 @@ fn p008_p027_p029_p042_profinet_py_names_connects_exchanges_and_loses_the_drive(
             DEVICE_IP,
             "--cyclic-seconds",
             CYCLIC_SECONDS,
+            "--control",
+            line.control.to_str().unwrap(),
+            "--fault-event",
+            &FAULT_EVENT.to_string(),
+            "--fault-cause",
+            &FAULT_CAUSE.to_string(),
         ],
     );
     line.stop_server();
     let serve = line.serve_output();
     println!("--- hil-sim serve ({}):\n{serve}", line.serve_log.display());
-    for step in ["a", "b", "c", "d", "e", "f", "g", "h", "i"] {
+    for step in ["a", "b", "c", "d", "e", "f", "g", "h", "i", "j"] {
         let got = step_lines(&lines, step);
         assert!(
             got.iter().any(|l| l.starts_with("ok: ")) && !got.iter().any(|l| l.starts_with("FAIL: ")),
@@ -327,6 +345,12 @@ fn p008_p027_p029_p042_profinet_py_names_connects_exchanges_and_loses_the_drive(
         );
     }
     assert!(ok, "controller.py failed");
+    // the figures, for .ci/run to print after the tests
+    let figures: Vec<&str> = lines.iter().filter_map(|l| l.strip_prefix("figure: ")).collect();
+    assert!(!figures.is_empty(), "controller.py printed no figure");
+    let text: String = figures.iter().map(|f| format!("figure: {f}\n")).collect();
+    std::fs::write(dir.join("figures.txt"), &text).expect("figures.txt");
+    print!("{text}");
     let a = step_lines(&lines, "a");
     assert!(
         a.iter()
@@ -350,6 +374,11 @@ fn p008_p027_p029_p042_profinet_py_names_connects_exchanges_and_loses_the_drive(
         ": cyclic data exchanged".into(),
         ": lost (cyclic watchdog or alarm channel)".into(),
         ": aborted (Local)".into(),
+        format!("axis A: event {FAULT_EVENT} cause {FAULT_CAUSE} raised"),
+        format!("diagnosis appears: axis A Fault"),
+        "axis A: fault acknowledged (controlword bit 7)".into(),
+        "diagnosis disappears:".into(),
+        "alarms: 2 sent, 2 acknowledged".into(),
         "device counters:".into(),
     ] {
         assert!(serve.contains(&want), "serve did not print `{want}`");

@@ -55,7 +55,7 @@
 use drive_core::axis::{Axis, AxisCache, AxisCommand, AxisIo};
 use drive_core::faults::{FaultChange, E82_INACTIVE};
 use drive_core::objects::LAYOUT_HASH;
-use drive_core::params::{A00, A270, A271, E43, E82, PROFINET_PARAMS};
+use drive_core::params::{A00, A150, A150_FALLBACK_US, A270, A271, E43, E82, PROFINET_PARAMS};
 use drive_core::{DriveObjects, PERSISTENT_IMAGE_BYTES};
 use nanos::Nanos;
 use profinet::cm::{NoRecords, RecordHook};
@@ -177,6 +177,21 @@ impl<F: Flash, H: RecordHook> PnDrive<F, H> {
     /// The axes, mutable.
     pub fn axes_mut(&mut self) -> &mut [Axis; 2] {
         &mut self.axes
+    }
+
+    /// The period of the control cycle: A150 (the cycle the axes integrate
+    /// with, C-144), [`A150_FALLBACK_US`] while A150 holds no allowed cycle
+    /// time. PROFINET has no SYNC0: the board's timer runs free at it.
+    pub fn control_period(&self) -> Nanos {
+        let a150_ns = self
+            .objects
+            .get(A150, 0)
+            .ok()
+            .and_then(|us| u32::try_from(us.saturating_mul(1000)).ok())
+            .unwrap_or(0);
+        Nanos::from_ns(u64::from(
+            motion::cycle::application_cycle_ns(a150_ns).unwrap_or(A150_FALLBACK_US * 1000),
+        ))
     }
 
     /// Whether the saved set was loaded at start.

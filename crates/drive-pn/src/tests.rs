@@ -159,3 +159,15 @@ fn p036_a_lost_ar_faults_both_axes_with_event_52() {
     assert_eq!(d.objects().get(E43, 0).unwrap(), i64::from(AR_LOST_CAUSE));
     assert!(d.device().diagnosis_present(), "kept for the next AR's records");
 }
+
+/// The free-running control cycle follows A150 (there is no SYNC0 on
+/// PROFINET); a value A150 does not allow falls back to the default.
+#[test]
+fn c144_the_control_period_is_a150() {
+    let mut d = commissioned();
+    assert_eq!(d.control_period(), Nanos::from_us(u64::from(A150_FALLBACK_US)));
+    d.objects_mut().set(A150, 0, 250).unwrap();
+    assert_eq!(d.control_period(), Nanos::from_us(250));
+    d.objects_mut().set(A150, 0, 2000).unwrap();
+    assert_eq!(d.control_period(), Nanos::from_ms(2));
+}

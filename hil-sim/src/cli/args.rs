@@ -65,6 +65,13 @@ pub struct ServeArgs {
     /// a controller names the device by DCP).
     #[arg(long, value_name = "NAME")]
     pub name: Option<String>,
+    /// PROFINET only: the simulator's control channel, a FIFO created at
+    /// this path (removed at the end) that takes one command per line:
+    /// `fault A|B EVENT CAUSE` raises a drive event on an axis (as the power
+    /// stage would), `reset A|B` acknowledges its fault (controlword bit 7,
+    /// until the profile maps CW1), `status` prints the axes' state.
+    #[arg(long, value_name = "PATH")]
+    pub control: Option<PathBuf>,
     /// Drives on the simulated line (EtherCAT only).
     #[arg(long, value_name = "N", default_value_t = 1, value_parser = clap::value_parser!(u16).range(1..=16))]
     pub slaves: u16,

@@ -70,6 +70,9 @@ pub fn serve(args: &ServeArgs) -> Result<(), String> {
     if args.name.is_some() {
         return Err("--name is PROFINET-only (--fieldbus profinet)".into());
     }
+    if args.control.is_some() {
+        return Err("--control is PROFINET-only (--fieldbus profinet)".into());
+    }
     let slaves = usize::from(args.slaves);
     // drives with firmware slots: an FoE download in Bootstrap is accepted
     let mut sim = Simulation::with_nodes((0..slaves).map(|_| SimDrive::with_firmware_slots()).collect());

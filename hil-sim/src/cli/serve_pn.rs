@@ -1,10 +1,19 @@
-//! `hil-sim serve --fieldbus profinet`: one simulated drive answers as a
-//! PROFINET IO device ([`hil_sim::pn::PnDrive`]) on a raw Ethernet
+//! `hil-sim serve --fieldbus profinet`: one simulated drive
+//! ([`hil_sim::pn::PnSim`]: the drive personality `drive_pn` with both axes
+//! and their motors) answers as a PROFINET IO device on a raw Ethernet
 //! interface, paced by the wall clock.
 //!
 //! The device's interface MAC is the interface's own (its port MACs are
 //! derived from it, [`hil_sim::pn::port_macs`]); it starts as shipped:
-//! unnamed unless `--name` gives one, no IP address, I&M0 of the drive.
+//! unnamed unless `--name` gives one (stored in A271), no IP address, I&M0
+//! of the drive.
+//!
+//! `--control PATH` makes a FIFO there that takes the simulator's commands
+//! ([`hil_sim::pn::Command`]: raise a drive event on an axis, acknowledge
+//! its fault), one per line, from any process that writes to it (a test's
+//! controller in another network namespace shares the file system). Each
+//! command's result, every change of the drive's diagnosis and the alarm
+//! channel's counters (sent, acknowledged) are printed.
 //!
 //! # Timing
 //!
@@ -19,13 +28,18 @@
 use super::args::ServeArgs;
 use super::serve::{stop_on_signals, STOP};
 use hil_sim::pcap::Recording;
-use hil_sim::pn::{self, PnDrive};
+use hil_sim::pn::{self, Command, PnSim};
 use hil_sim::raw::{monotonic, RawSocket};
 use nanos::Nanos;
 use profinet::dcp::NameOfStation;
 use profinet::device::DeviceEvent;
 use profinet::wire::MacAddr;
-use std::io;
+use std::ffi::CString;
+use std::fs::File;
+use std::io::{self, Read};
+use std::os::unix::ffi::OsStrExt;
+use std::os::unix::fs::OpenOptionsExt;
+use std::path::{Path, PathBuf};
 use std::sync::atomic::Ordering;
 use std::time::{Duration, SystemTime, UNIX_EPOCH};
 
@@ -55,6 +69,86 @@ fn check_options(args: &ServeArgs) -> Result<(), String> {
         return Err("--delay-us is EtherCAT-only".into());
     }
     Ok(())
+}
+
+/// The control channel: a FIFO read without blocking, line by line.
+struct Control {
+    path: PathBuf,
+    file: File,
+    pending: Vec<u8>,
+}
+
+impl Control {
+    /// Makes the FIFO at `path` (an old one is replaced) and opens it for
+    /// reading without blocking.
+    fn create(path: &Path) -> Result<Control, String> {
+        let _ = std::fs::remove_file(path);
+        let c = CString::new(path.as_os_str().as_bytes())
+            .map_err(|_| format!("--control {path:?}: a NUL in the path"))?;
+        // SAFETY: `c` is a valid NUL-terminated path for the call's duration.
+        #[allow(unsafe_code)]
+        if unsafe { libc::mkfifo(c.as_ptr(), 0o622) } != 0 {
+            return Err(format!(
+                "--control {}: mkfifo: {}",
+                path.display(),
+                io::Error::last_os_error()
+            ));
+        }
+        let file = std::fs::OpenOptions::new()
+            .read(true)
+            .custom_flags(libc::O_NONBLOCK)
+            .open(path)
+            .map_err(|e| format!("--control {}: {e}", path.display()))?;
+        Ok(Control {
+            path: path.to_path_buf(),
+            file,
+            pending: Vec::new(),
+        })
+    }
+
+    /// The complete lines written since the last call.
+    fn lines(&mut self) -> Vec<String> {
+        let mut buf = [0u8; 512];
+        loop {
+            match self.file.read(&mut buf) {
+                Ok(0) => break,
+                Ok(n) => self.pending.extend_from_slice(buf.get(..n).unwrap_or_default()),
+                Err(_) => break,
+            }
+        }
+        let mut out = Vec::new();
+        while let Some(end) = self.pending.iter().position(|b| *b == b'\n') {
+            let line: Vec<u8> = self.pending.drain(..=end).collect();
+            out.push(String::from_utf8_lossy(&line).trim().to_string());
+        }
+        out
+    }
+}
+
+impl Drop for Control {
+    fn drop(&mut self) {
+        let _ = std::fs::remove_file(&self.path);
+    }
+}
+
+/// What the log reports when it changes: the drive's diagnosis and the
+/// alarm channel's counters.
+#[derive(Debug, Default, PartialEq, Eq)]
+struct Watched {
+    diagnosis: bool,
+    alarms: Option<(u32, u32, u32)>,
+}
+
+impl Watched {
+    fn of(drive: &PnSim) -> Watched {
+        Watched {
+            diagnosis: drive.device().diagnosis_present(),
+            alarms: drive
+                .device()
+                .alarm_stats()
+                .map(|a| (a.sent, a.acked, a.retransmitted)),
+        }
+    }
 }
 
 /// What the loop counted.
@@ -129,7 +223,8 @@ pub fn serve(args: &ServeArgs) -> Result<(), String> {
         .duration_since(UNIX_EPOCH)
         .map(|d| d.as_secs() as u32)
         .unwrap_or(1);
-    let mut drive = PnDrive::new(pn::device_config(mac, name.clone(), boot_time));
+    let mut drive = PnSim::named(mac, &name, boot_time);
+    let mut control = args.control.as_deref().map(Control::create).transpose()?;
     let ports = pn::port_macs(mac);
     println!(
         "hil-sim serve: one simulated drive as a PROFINET IO device on {iface} (MAC {}, ports {} {})",
@@ -138,14 +233,21 @@ pub fn serve(args: &ServeArgs) -> Result<(), String> {
         pn::mac_text(ports[1])
     );
     println!(
-        "name of station: {}; IP: unset; I&M0 serial {}; the drive echoes its outputs into its inputs",
+        "name of station: {}; IP: unset; I&M0 serial {}; two axes at rest, control cycle {} us; the drive echoes its outputs into its inputs",
         if name.is_empty() {
             "none".to_string()
         } else {
             format!("\"{}\"", name.as_str())
         },
-        pn::SERIAL_NUMBER
+        pn::SERIAL_NUMBER,
+        drive.drive().control_period().as_us()
     );
+    if let Some(c) = &control {
+        println!(
+            "control channel: {} (fault A|B EVENT CAUSE, reset A|B, status)",
+            c.path.display()
+        );
+    }
     if let Some(p) = &args.pcap {
         println!("recording frames to {}", p.display());
     }
@@ -163,7 +265,7 @@ pub fn serve(args: &ServeArgs) -> Result<(), String> {
         sent: 0,
         error: None,
     };
-    let result = run(&mut drive, &sock, &mut out, args);
+    let result = run(&mut drive, &sock, &mut out, control.as_mut(), args);
     let flushed = out.flush(args);
     let stats = result?;
     flushed?;
@@ -171,7 +273,7 @@ pub fn serve(args: &ServeArgs) -> Result<(), String> {
     Ok(())
 }
 
-fn print_events(drive: &mut PnDrive, t: Nanos) {
+fn print_events(drive: &mut PnSim, t: Nanos) {
     while let Some(e) = drive.take_event() {
         print_event(t, &e);
     }
@@ -182,7 +284,13 @@ fn print_event(t: Nanos, e: &DeviceEvent) {
 }
 
 /// The serve loop (see the module's Timing section).
-fn run(drive: &mut PnDrive, sock: &RawSocket, out: &mut Out<'_>, args: &ServeArgs) -> Result<Stats, String> {
+fn run(
+    drive: &mut PnSim,
+    sock: &RawSocket,
+    out: &mut Out<'_>,
+    mut control: Option<&mut Control>,
+    args: &ServeArgs,
+) -> Result<Stats, String> {
     let start = monotonic();
     let since = |t: Nanos| t.saturating_sub(start);
     let end = args.seconds.map(|s| Nanos::from_ns((s.max(0.0) * 1e9) as u64));
@@ -192,6 +300,7 @@ fn run(drive: &mut PnDrive, sock: &RawSocket, out: &mut Out<'_>, args: &ServeArg
     let mut last = Nanos::ZERO;
     let mut deadline = Nanos::ZERO;
     let mut next_flush = FLUSH_EVERY;
+    let mut watched = Watched::of(drive);
     loop {
         let mut got = false;
         while let Some(rx) = sock.try_recv(&mut buf).map_err(|e| format!("receive: {e}"))? {
@@ -222,6 +331,20 @@ fn run(drive: &mut PnDrive, sock: &RawSocket, out: &mut Out<'_>, args: &ServeArg
             print_events(drive, now);
             out.check()?;
         }
+        if let Some(c) = control.as_deref_mut() {
+            for line in c.lines().iter().filter(|l| !l.is_empty()) {
+                let said = match Command::parse(line) {
+                    Ok(cmd) => drive.command(cmd),
+                    Err(e) => format!("control: {e}"),
+                };
+                println!("[{:>10.3} s] {said}", now.as_ns() as f64 / 1e9);
+            }
+        }
+        let w = Watched::of(drive);
+        if w != watched {
+            print_watched(now, &watched, &w, drive);
+            watched = w;
+        }
         if now >= next_flush {
             next_flush = now + FLUSH_EVERY;
             out.flush(args)?;
@@ -239,12 +362,27 @@ fn run(drive: &mut PnDrive, sock: &RawSocket, out: &mut Out<'_>, args: &ServeArg
     }
 }
 
-fn summary(drive: &PnDrive, stats: &Stats, sent: u64) {
+fn print_watched(t: Nanos, old: &Watched, new: &Watched, drive: &PnSim) {
+    let at = t.as_ns() as f64 / 1e9;
+    if old.diagnosis != new.diagnosis {
+        println!(
+            "[{at:>10.3} s] diagnosis {}: {}",
+            if new.diagnosis { "appears" } else { "disappears" },
+            drive.status()
+        );
+    }
+    if let (Some((sent, acked, again)), true) = (new.alarms, old.alarms != new.alarms) {
+        println!("[{at:>10.3} s] alarms: {sent} sent, {acked} acknowledged, {again} retransmitted");
+    }
+}
+
+fn summary(drive: &PnSim, stats: &Stats, sent: u64) {
     let d = drive.device();
     println!(
         "{} frames received, {} sent; {} without a kernel timestamp",
         stats.received, sent, stats.unstamped
     );
+    println!("drive: {} control cycles; {}", drive.cycles(), drive.status());
     let c = d.counters();
     println!(
         "device counters: runt {}, not for us {}, unknown FrameID {}, no AR {}, other EtherType {}, events lost {}",

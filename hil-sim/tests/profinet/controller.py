@@ -15,9 +15,18 @@ both bind UDP 34964) and goes step by step, one line per result:
     module in slot 2, PrmEnd, the device's ApplicationReady confirmed;
 (f) Release (answered);
 (g) Connect with a wrong module ident: a ModuleDiff block, then Release;
-(h) cyclic data at the shortest cycle profinet-py runs (1 ms) for
-    --cyclic-seconds, the drive echoing its outputs into its inputs;
-(i) the controller stops sending output frames: the device aborts the AR
+(h) DCP Identify by name again, Connect, cyclic data at the shortest cycle
+    profinet-py runs (1 ms) for --cyclic-seconds, the drive echoing its
+    outputs into its inputs; prints the figure "DCP identify to first valid
+    cyclic data";
+(i) a drive fault (event --fault-event, cause --fault-cause on axis A,
+    raised through serve's control channel --control) arrives as a
+    diagnosis alarm at the drive (slot 0, subslot 1) with ChannelErrorType
+    0x1000 + event and ExtChannelErrorType 0x1000 + cause; profinet-py
+    acknowledges it; after the fault reset (control channel) the diagnosis
+    disappears with a "Diagnosis disappears" alarm (which the device sends
+    only once the first one was acknowledged);
+(j) the controller stops sending output frames: the device aborts the AR
     (RTA ERR PDU) and stops its input frames.
 """
 
@@ -29,11 +38,13 @@ import logging
 import socket
 import struct
 import sys
+import threading
 import time
 import traceback
 
 import profinet
 from profinet import dcp, rpc
+from profinet.alarms import DiagnosisItem
 from profinet.blocks import parse_module_diff_block
 from profinet.device import ProfinetDevice
 from profinet.gsdml import load_gsdml
@@ -146,6 +157,9 @@ def main():
     ap.add_argument("--ip", default="192.168.0.50")
     ap.add_argument("--mask", default="255.255.255.0")
     ap.add_argument("--cyclic-seconds", type=float, default=12.0)
+    ap.add_argument("--control", required=True, help="serve's control FIFO")
+    ap.add_argument("--fault-event", type=int, default=44)
+    ap.add_argument("--fault-cause", type=int, default=1)
     a = ap.parse_args()
 
     records = Records()
@@ -296,20 +310,79 @@ def main():
 
     run("g", module_diff)
 
-    # (h) cyclic data at 1 ms, the drive echoing; (i) the controller goes silent
+    def control(command):
+        # serve reads its FIFO without blocking; the open waits for it
+        with open(a.control, "w") as f:
+            f.write(command + "\n")
+
+    alarms = []
+    alarm_seen = threading.Event()
+
+    def on_alarm(n):
+        alarms.append(n)
+        alarm_seen.set()
+
+    def wait_alarm(since, timeout):
+        end = time.monotonic() + timeout
+        while time.monotonic() < end:
+            if len(alarms) > since:
+                return alarms[since]
+            alarm_seen.wait(0.01)
+            alarm_seen.clear()
+        return None
+
+    def diagnosis_items(n):
+        return [i for i in n.items if isinstance(i, DiagnosisItem)]
+
+    def describe(n):
+        items = ", ".join(
+            f"ChannelErrorType 0x{i.channel_error_type:04X} ExtChannelErrorType 0x{i.ext_channel_error_type:04X}"
+            for i in diagnosis_items(n)
+        )
+        return (
+            f"{n.alarm_type_name} (0x{n.alarm_type:04X}) at {n.location} seq {n.alarm_sequence_number}"
+            f"{': ' + items if items else ''}"
+        )
+
+    # (h) cyclic data at 1 ms, the drive echoing; (i) a drive fault as a
+    # diagnosis alarm; (j) the controller goes silent
     def cyclic():
         # 1 ms = send clock 32 x 31.25 us, reduction ratio 1: profinet-py's
         # CyclicController refuses anything shorter. The watchdog (and data
         # hold) at 50 cycles keeps a Python sender's scheduling gaps on a
         # shared machine from ending the AR.
         setup = IOCRSetup(slots=slots, reduction_ratio=1, watchdog_factor=50, data_hold_factor=50)
-        dev = ProfinetDevice(info, iface, src, timeout=5.0)
+        out_slot = next(s for s in slots if s.output_length > 0)
+        in_slot = next(s for s in slots if s.input_length > 0)
+        n = min(out_slot.output_length, in_slot.input_length)
+        # the figure: from the DCP identify by name to the first input
+        # frame with valid data (IOPS good) through profinet-py
+        sock2 = ethernet_socket(iface)
+        t_identify = time.monotonic()
+        try:
+            found = get_station_info(sock2, src, a.name, timeout_sec=3, strict_xid=True)
+        finally:
+            sock2.close()
+        t_found = time.monotonic()
+        dev = ProfinetDevice(found, iface, src, timeout=5.0)
+        dev.on_alarm(on_alarm)
         ctl = None
         try:
             ctl = dev.start_cyclic(setup)
-            out_slot = next(s for s in slots if s.output_length > 0)
-            in_slot = next(s for s in slots if s.input_length > 0)
-            n = min(out_slot.output_length, in_slot.input_length)
+            t_connected = time.monotonic()
+            while ctl.get_input_data(in_slot.slot, in_slot.subslot) is None:
+                if time.monotonic() - t_connected > 5.0:
+                    raise RuntimeError("no valid input data within 5 s of the connect")
+                time.sleep(0.0002)
+            t_first = time.monotonic()
+            print(
+                f"figure: DCP identify to first valid cyclic data through profinet-py: "
+                f"{1000 * (t_first - t_identify):.0f} ms (identify by name "
+                f"{1000 * (t_found - t_identify):.0f} ms, connect to PrmEnd and ApplicationReady "
+                f"{1000 * (t_connected - t_found):.0f} ms, first valid input frame "
+                f"{1000 * (t_first - t_connected):.1f} ms later)",
+                flush=True,
+            )
             start = time.monotonic()
             patterns = 0
             back = 0
@@ -343,7 +416,49 @@ def main():
                 f"state {ctl.state.value}",
             )
 
-            # (i) stop sending output frames, keep listening
+            # (i) a drive fault: appears, acknowledged, disappears after the reset
+            def fault():
+                want_ch = 0x1000 + a.fault_event
+                want_ext = 0x1000 + a.fault_cause
+                seen = len(alarms)
+                control(f"fault A {a.fault_event} {a.fault_cause}")
+                t0 = time.monotonic()
+                appears = wait_alarm(seen, 5.0)
+                if appears is None:
+                    report("i", False, f"fault A {a.fault_event} {a.fault_cause}: no alarm within 5 s")
+                    return
+                t_appears = time.monotonic() - t0
+                items = diagnosis_items(appears)
+                ok = (
+                    appears.alarm_type == 0x0001
+                    and (appears.slot_number, appears.subslot_number) == (0, 1)
+                    and appears.channel_diagnosis
+                    and any(i.channel_error_type == want_ch and i.ext_channel_error_type == want_ext for i in items)
+                )
+                report("i", ok, f"fault raised: after {1000 * t_appears:.0f} ms {describe(appears)} (acknowledged by profinet-py)")
+                # the data keeps flowing while the drive is faulted
+                time.sleep(0.3)
+                if not ctl.is_running:
+                    report("i", False, f"the AR ended after the alarm: {ctl.state.value}")
+                    return
+                seen = len(alarms)
+                control("reset A")
+                t0 = time.monotonic()
+                gone = wait_alarm(seen, 5.0)
+                if gone is None:
+                    report("i", False, "fault reset: no disappears alarm within 5 s")
+                    return
+                t_gone = time.monotonic() - t0
+                items = diagnosis_items(gone)
+                ok = gone.alarm_type == 0x000C and (gone.slot_number, gone.subslot_number) == (0, 1)
+                report("i", ok, f"fault reset: after {1000 * t_gone:.0f} ms {describe(gone)}")
+                extra = alarms[seen + 1 :]
+                if extra:
+                    report("i", False, f"more alarms than expected: {[describe(x) for x in extra]}")
+
+            run("i", fault)
+
+            # (j) stop sending output frames, keep listening
             before = len(records.lines)
             ctl._tx_cycle = lambda: None
             silent = time.monotonic()
@@ -355,7 +470,7 @@ def main():
                 time.sleep(0.01)
             ok = err is not None and ctl.state.value == "fault"
             report(
-                "i",
+                "j",
                 ok,
                 f"outputs stopped: after {time.monotonic() - silent:.2f} s the alarm listener saw "
                 f"{err or 'no RTA ERR PDU'!r}; the controller is in {ctl.state.value} "

@@ -484,6 +484,12 @@ impl<H: RecordHook> Device<H> {
         DriveError::new(main, sub).is_some_and(|e| self.diag.clear(&Cyclic::drive_location(), e))
     }
 
+    /// The alarm channel's counters of the AR in data exchange (sent,
+    /// retransmitted, acknowledged), `None` without one.
+    pub fn alarm_stats(&self) -> Option<crate::alarm::AlarmStats> {
+        self.cyclic.as_ref().and_then(|c| c.alarm.as_ref()).map(|a| *a.stats())
+    }
+
     /// Whether any diagnosis is present.
     pub fn diagnosis_present(&self) -> bool {
         self.diag.any_present()
