@@ -49,7 +49,8 @@
 //!
 //! The telegram mapping of the profile (CW1/ZSW1, PNU) is the next layer
 //! (issue 17); until then the cyclic data is reachable as bytes
-//! ([`PnDrive::device`]). `#![no_std]
+//! ([`PnDrive::device`]).
+#![no_std]
 #![deny(missing_docs)]
 
 use drive_core::axis::{Axis, AxisCache, AxisCommand, AxisIo};
