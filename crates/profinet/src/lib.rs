@@ -11,6 +11,9 @@
 //! - [`cm`]: context management blocks (Connect, Read/Write, Control) and the AR.
 //! - [`rt`]: RT_CLASS_1 cyclic consumer/provider, watchdog and data hold.
 //! - [`alarm`]: the acyclic real-time alarm channel (RTA), diagnosis alarms.
+//! - [`pdev`]: the physical device records (PDPortDataReal/Adjust,
+//!   PDInterfaceDataReal) of the interface and its ports.
+//! - [`profienergy`]: the PROFIenergy service protocol of record 0x80A0.
 //! - [`device`]: all of them behind one frame input and one timer ([`device::Device`]).
 //! - [`model`]: the device's module model (DAP, IN/OUT modules) and identity, the
 //!   one declaration the firmware and the GSDML share.
@@ -30,6 +33,8 @@ pub mod ip;
 pub mod led;
 pub mod lldp;
 pub mod model;
+pub mod pdev;
+pub mod profienergy;
 pub mod rpc;
 pub mod rt;
 pub mod wire;
@@ -40,3 +45,5 @@ pub use nanos::Nanos;
 extern crate std;
 #[cfg(any(test, feature = "testing"))]
 pub mod testing;
+#[cfg(test)]
+pub(crate) mod tests_tshark;

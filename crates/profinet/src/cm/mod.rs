@@ -25,7 +25,7 @@ pub mod ndr;
 pub mod record;
 pub mod status;
 #[cfg(test)]
-mod tests_connect;
+pub(crate) mod tests_connect;
 #[cfg(test)]
 mod tests_pcap;
 #[cfg(test)]
@@ -40,6 +40,7 @@ pub use status::{PnioStatus, RecordError};
 use heapless::Deque;
 use nanos::Nanos;
 
+use crate::pdev::Pdev;
 use crate::rpc::cursor::{Endian, Reader, Writer};
 use crate::rpc::{self, opnum, uuid::PNIO_CONTROLLER_INTERFACE, Call, CallError, ClientError, Request, Uuid};
 use crate::wire::MacAddr;
@@ -97,6 +98,7 @@ pub struct Cm<H: RecordHook = NoRecords> {
     config: CmConfig,
     im: ImData,
     hook: H,
+    pdev: Pdev,
     io_ar: Option<Ar>,
     sv_ar: Option<Ar>,
     events: Deque<CmEvent, 8>,
@@ -112,6 +114,12 @@ impl<H: RecordHook> Cm<H> {
             config,
             im,
             hook,
+            pdev: Pdev::new(
+                config.mac,
+                [config.mac; crate::model::PORTS as usize],
+                crate::dcp::NameOfStation::EMPTY,
+                crate::dcp::IpSuite::UNSET,
+            ),
             io_ar: None,
             sv_ar: None,
             events: Deque::new(),
@@ -137,8 +145,23 @@ impl<H: RecordHook> Cm<H> {
     }
 
     /// The record hook.
+    pub fn hook(&self) -> &H {
+        &self.hook
+    }
+
+    /// The record hook, mutable.
     pub fn hook_mut(&mut self) -> &mut H {
         &mut self.hook
+    }
+
+    /// The physical device the PDev records report (P-040).
+    pub fn pdev(&self) -> &Pdev {
+        &self.pdev
+    }
+
+    /// The physical device, mutable: the device keeps it current.
+    pub fn pdev_mut(&mut self) -> &mut Pdev {
+        &mut self.pdev
     }
 
     /// The next event.
@@ -338,6 +361,7 @@ impl<H: RecordHook> Cm<H> {
                 emit_module_diff(&mut w, ar).ok_or(RecordError::ReadError)?;
                 Ok(w.pos())
             }
+            i if Pdev::serves(i) => self.pdev.read(addr, out),
             _ => self.hook.read(addr, out),
         }
     }
@@ -389,6 +413,7 @@ impl<H: RecordHook> Cm<H> {
                 self.event(CmEvent::ImWritten(rec));
                 Ok(())
             }
+            i if Pdev::serves(i) => self.pdev.write(addr, data),
             _ => self.hook.write(addr, data),
         }
     }

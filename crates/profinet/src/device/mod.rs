@@ -29,6 +29,7 @@ use crate::ip::{IpConfig, Received, Stack, UdpTx, RPC_PORT, UDP_PAYLOAD_OFFSET};
 use crate::led::LedInputs;
 use crate::lldp::{self, PortIdForm, PortInfo, Schedule};
 use crate::model;
+use crate::pdev::{Pdev, Peer};
 use crate::rpc::epm::{self, EpmInfo};
 use crate::rpc::server::{Server, ServerConfig};
 use crate::rpc::uuid;
@@ -128,7 +129,6 @@ pub struct Device<H: RecordHook = NoRecords> {
     started: bool,
     cyclic: Option<Cyclic>,
     diag: DiagList<MAX_DIAGNOSES>,
-    link_up: bool,
     watchdog_expired: bool,
 }
 
@@ -157,6 +157,7 @@ fn epm_info(ip: IpSuite) -> EpmInfo {
 impl<H: RecordHook> Device<H> {
     /// A device with its stored settings and the profile's record hook.
     pub fn new(config: DeviceConfig, hook: H) -> Device<H> {
+        let name = config.name.clone();
         Device {
             dcp: DcpServer::new(config.mac, Identity::DRIVE, config.name, config.ip),
             ip: Stack::new(config.mac, ip_config(config.ip)),
@@ -180,9 +181,20 @@ impl<H: RecordHook> Device<H> {
             started: false,
             cyclic: None,
             diag: DiagList::new(),
-            link_up: true,
             watchdog_expired: false,
         }
+        .with_pdev(config.port_macs, name, config.ip)
+    }
+
+    fn with_pdev(
+        mut self,
+        port_macs: [MacAddr; model::PORTS as usize],
+        name: NameOfStation,
+        ip: IpSuite,
+    ) -> Self {
+        let mac = self.dcp.mac();
+        *self.cm.pdev_mut() = Pdev::new(mac, port_macs, name, ip);
+        self
     }
 
     /// The DCP server (name, IP, signal).
@@ -206,6 +218,11 @@ impl<H: RecordHook> Device<H> {
     }
 
     /// The record hook of the profile.
+    pub fn hook(&self) -> &H {
+        self.cm.hook()
+    }
+
+    /// The record hook of the profile, mutable.
     pub fn hook_mut(&mut self) -> &mut H {
         self.cm.hook_mut()
     }
@@ -245,6 +262,10 @@ impl<H: RecordHook> Device<H> {
                     let mut alias = Vec::new();
                     if n.alias(&mut alias).is_some() {
                         self.dcp.set_alias(0, Some(&alias));
+                    }
+                    // one receive path: the neighbour is port 1's (P-040)
+                    if let Some(p) = self.cm.pdev_mut().port_mut(1) {
+                        p.peer = Peer::from_lldp(&n, f.src, now);
                     }
                 }
             }
@@ -298,9 +319,10 @@ impl<H: RecordHook> Device<H> {
         }
     }
 
-    fn on_dcp_event(&mut self, now: Nanos, e: &DcpEvent, tx: &mut impl FnMut(&[u8])) {
+    pub(crate) fn on_dcp_event(&mut self, now: Nanos, e: &DcpEvent, tx: &mut impl FnMut(&[u8])) {
         match e {
             DcpEvent::IpSuite { suite, .. } => {
+                self.cm.pdev_mut().ip = *suite;
                 self.ip.set_config(ip_config(*suite));
                 let mut cfg = *self.rpc.config();
                 cfg.epm = epm_info(*suite);
@@ -311,7 +333,10 @@ impl<H: RecordHook> Device<H> {
                 }
                 self.lldp.kick(now);
             }
-            DcpEvent::NameOfStation { .. } => self.lldp.kick(now),
+            DcpEvent::NameOfStation { name, .. } => {
+                self.cm.pdev_mut().name = name.clone();
+                self.lldp.kick(now);
+            }
             DcpEvent::Signal { .. } | DcpEvent::ResetToFactory(_) => {}
         }
     }
@@ -382,7 +407,13 @@ impl<H: RecordHook> Device<H> {
                 }
             }
         }
+        self.cm.pdev_mut().expire(now);
         while let Some(port) = self.lldp.due(now) {
+            if !self.cm.pdev().lldp_allowed(port) {
+                // stopped by the controller's peer-to-peer boundary
+                self.lldp.sent(port, now);
+                continue;
+            }
             let station = lldp::Station {
                 name: self.dcp.name_of_station(),
                 interface_mac: self.dcp.mac(),
@@ -487,7 +518,10 @@ impl<H: RecordHook> Device<H> {
     /// The alarm channel's counters of the AR in data exchange (sent,
     /// retransmitted, acknowledged), `None` without one.
     pub fn alarm_stats(&self) -> Option<crate::alarm::AlarmStats> {
-        self.cyclic.as_ref().and_then(|c| c.alarm.as_ref()).map(|a| *a.stats())
+        self.cyclic
+            .as_ref()
+            .and_then(|c| c.alarm.as_ref())
+            .map(|a| *a.stats())
     }
 
     /// Whether any diagnosis is present.
@@ -500,16 +534,30 @@ impl<H: RecordHook> Device<H> {
         self.cyclic.as_ref().is_some_and(|c| c.outputs_valid)
     }
 
-    /// The link state (LED BF, P-023); the board or simulator sets it.
+    /// The link state of every port (LED BF, P-023; PDPortDataReal, P-040);
+    /// the board or simulator sets it.
     pub fn set_link(&mut self, up: bool) {
-        self.link_up = up;
+        for p in 1..=model::PORTS {
+            self.set_port_link(p, up);
+        }
+    }
+
+    /// The link state of port `port` (1-based). At start port 1 is up and
+    /// port 2 down (the simulator has one interface).
+    pub fn set_port_link(&mut self, port: u16, up: bool) {
+        if let Some(p) = self.cm.pdev_mut().port_mut(port) {
+            if !up {
+                p.peer = None;
+            }
+            p.link_up = up;
+        }
     }
 
     /// The SF and BF LEDs at `now` (P-011, P-020…P-024): `(sf_lit, bf_lit)`.
     pub fn leds(&self, now: Nanos) -> (bool, bool) {
         let signal = self.dcp.signal();
         let inputs = LedInputs {
-            link_up: self.link_up,
+            link_up: self.cm.pdev().any_link_up(),
             ar_established: self.cyclic.is_some(),
             cyclic_exchange: self.exchanging(),
             watchdog_expired: self.watchdog_expired,
