@@ -15,7 +15,7 @@ use crate::sim::{axis_io, AxisConditions, SimFlash};
 use drive::params::{E43, E82};
 use drive_pn::Hardware;
 use nanos::Nanos;
-use profinet::cm::{CmEvent, Im0, ImData};
+use profinet::cm::{CmEvent, Im0, ImData, RecordHook};
 use profinet::dcp::server::Event as DcpEvent;
 use profinet::dcp::{IpSuite, NameOfStation};
 use profinet::device::{Device, DeviceEvent, RtEvent, MAX_MODULE_BYTES};
@@ -257,7 +257,7 @@ impl PnSim {
     }
 
     /// The device (name, IP, AR, counters).
-    pub fn device(&self) -> &Device {
+    pub fn device(&self) -> &Device<impl RecordHook> {
         self.drive.device()
     }
 
