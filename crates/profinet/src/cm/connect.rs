@@ -496,7 +496,10 @@ pub fn parse_connect(args: &[u8], ctx: &ConnectContext) -> Result<Ar, PnioStatus
             }
         }
     }
-    for mut cr in crs {
+    // in order, by value, without a heapless IntoIter (whose drop carries an
+    // index panic)
+    crs.reverse();
+    while let Some(mut cr) = crs.pop() {
         resolve(&mut cr, &subs)?;
         if cr.frame_id == 0xFFFF {
             let base = match cr.iocr_type {

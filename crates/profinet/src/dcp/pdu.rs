@@ -624,32 +624,39 @@ impl<'a> Value<'a> {
     pub fn emit(&self, buf: &mut [u8]) -> Result<(), Error> {
         let out = buf.get_mut(..self.len()).ok_or(Error::Exhausted)?;
         match self {
-            Value::Mac(m) => out.copy_from_slice(&m.0),
-            Value::IpParameter(s) => out.copy_from_slice(&s.octets()),
+            Value::Mac(m) => put(out, &m.0),
+            Value::IpParameter(s) => put(out, &s.octets()),
             Value::IpFullSuite(s, dns) => {
-                let (head, tail) = out.split_at_mut(12);
-                head.copy_from_slice(&s.octets());
+                let (head, tail) = out.split_at_mut_checked(12).ok_or(Error::Exhausted)?;
+                put(head, &s.octets());
                 for (chunk, d) in tail.chunks_exact_mut(4).zip(dns) {
-                    chunk.copy_from_slice(&d.octets());
+                    put(chunk, &d.octets());
                 }
             }
-            Value::Bytes(b) | Value::DeviceOptions(b) => out.copy_from_slice(b),
+            Value::Bytes(b) | Value::DeviceOptions(b) => put(out, b),
             Value::DeviceId { vendor_id, device_id } => {
-                let mut v = [0u8; 4];
-                v[..2].copy_from_slice(&vendor_id.to_be_bytes());
-                v[2..].copy_from_slice(&device_id.to_be_bytes());
-                out.copy_from_slice(&v);
+                let [v0, v1] = vendor_id.to_be_bytes();
+                let [d0, d1] = device_id.to_be_bytes();
+                put(out, &[v0, v1, d0, d1]);
             }
-            Value::DeviceRole(r) => out.copy_from_slice(&[*r, 0]),
-            Value::DeviceInstance(h, l) => out.copy_from_slice(&[*h, *l]),
-            Value::DeviceInitiative(v) | Value::Signal(v) => out.copy_from_slice(&v.to_be_bytes()),
+            Value::DeviceRole(r) => put(out, &[*r, 0]),
+            Value::DeviceInstance(h, l) => put(out, &[*h, *l]),
+            Value::DeviceInitiative(v) | Value::Signal(v) => put(out, &v.to_be_bytes()),
             Value::Response(kind, err) => {
                 let (o, s) = kind.pair();
-                out.copy_from_slice(&[o, s, u8::from(*err)]);
+                put(out, &[o, s, u8::from(*err)]);
             }
             Value::Empty => {}
         }
         Ok(())
+    }
+}
+
+/// Copies `src` into the start of `dst` (as far as both go; the callers
+/// cut `dst` to the value's length first): no length-mismatch panic path.
+fn put(dst: &mut [u8], src: &[u8]) {
+    for (d, s) in dst.iter_mut().zip(src) {
+        *d = *s;
     }
 }
 
@@ -682,12 +689,14 @@ impl BlockRepr<'_> {
         let out = buf.get_mut(..n).ok_or(Error::Exhausted)?;
         let len = u16::try_from(self.block_length()).map_err(|_| Error::Malformed)?;
         let (o, s) = self.kind.pair();
-        let (head, rest) = out.split_at_mut(BLOCK_HEADER_LEN);
-        head.copy_from_slice(&[o, s, (len >> 8) as u8, len as u8]);
+        let (head, rest) = out
+            .split_at_mut_checked(BLOCK_HEADER_LEN)
+            .ok_or(Error::Exhausted)?;
+        put(head, &[o, s, (len >> 8) as u8, len as u8]);
         let rest = match self.prefix {
             Some(p) => {
-                let (pre, rest) = rest.split_at_mut(2);
-                pre.copy_from_slice(&p.to_be_bytes());
+                let (pre, rest) = rest.split_at_mut_checked(2).ok_or(Error::Exhausted)?;
+                put(pre, &p.to_be_bytes());
                 rest
             }
             None => rest,

@@ -292,7 +292,11 @@ impl<H: RecordHook> Device<H> {
                         self.identify = Some((reply.send_at, v));
                     }
                 }
-                for e in outcome.events {
+                // popped from the front in order: a by-value `for` over the
+                // heapless Vec carries an index panic in its iterator's drop
+                let mut events = outcome.events;
+                events.reverse();
+                while let Some(e) = events.pop() {
                     self.on_dcp_event(now, &e, tx);
                     self.push(DeviceEvent::Dcp(e));
                 }

@@ -280,7 +280,9 @@ impl<const N: usize> Server<N> {
             self.queue(peer, hdr, Body::Status(nca::FAULT_REMOTE_NO_MEMORY));
             return;
         };
-        dst.copy_from_slice(body);
+        for (d, s) in dst.iter_mut().zip(body) {
+            *d = *s;
+        }
         // The answer's fragment size: the request's own when it came in fragments
         // (the client evidently handles PDUs that big), else MustRecvFragSize.
         let pdu = if h.is_frag() {

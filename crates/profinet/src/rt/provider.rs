@@ -191,9 +191,11 @@ impl Provider {
         )
         .ok_or(TxError::BufferTooShort)?;
         let body = buf.get_mut(at..).ok_or(TxError::BufferTooShort)?;
-        let (id, rest) = body.split_at_mut(2);
-        id.copy_from_slice(&self.cfg.frame_id.to_be_bytes());
-        let (csdu, trailer) = rest.split_at_mut(self.cfg.data_length as usize);
+        let (id, rest) = body.split_at_mut_checked(2).ok_or(TxError::BufferTooShort)?;
+        put(id, &self.cfg.frame_id.to_be_bytes());
+        let (csdu, trailer) = rest
+            .split_at_mut_checked(self.cfg.data_length as usize)
+            .ok_or(TxError::BufferTooShort)?;
         for (o, v) in self.cfg.objects.iter().zip(&self.iops) {
             if let Some(b) = csdu.get_mut(o.iops_offset()) {
                 *b = v.0;
@@ -269,5 +271,12 @@ impl TxFrame<'_, '_> {
     /// The frame's bytes.
     pub fn bytes(&self) -> &[u8] {
         self.frame
+    }
+}
+
+/// Copies `src` into the start of `dst` (as far as both go): no length panic.
+fn put(dst: &mut [u8], src: &[u8]) {
+    for (d, s) in dst.iter_mut().zip(src) {
+        *d = *s;
     }
 }
