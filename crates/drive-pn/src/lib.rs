@@ -13,6 +13,7 @@
 //! | event 52 cause 6 (communication: process data lost), both axes, fault reaction | the AR lost: the output CR's watchdog expired or the alarm channel failed (P-036, Q-07) |
 //! | a new set-point each control cycle | a valid output frame since the last cycle |
 //! | A270…A278, the PROFINET operating parameters ([`settings`]) | the device's name and IP at start, DCP Set / Reset to factory written back and saved, PROFINET on or off |
+//! | A275 and the power stages ([`energy`]) | PROFIenergy (record 0x80A0): the pause switches both power stages' supply off, taken only with the axes idle (P-015, P-016) |
 //!
 //! Parameters (spec §2.4). At start ([`PnDrive::new`]) the newest saved
 //! set is loaded from the flash; the device starts with the name of station
@@ -56,15 +57,19 @@
 use drive_core::axis::{Axis, AxisCache, AxisCommand, AxisIo};
 use drive_core::faults::{FaultChange, E82_INACTIVE};
 use drive_core::objects::LAYOUT_HASH;
-use drive_core::params::{A00, A150, A150_FALLBACK_US, A270, A271, E43, E82, PROFINET_PARAMS};
+use drive_core::params::{A00, A150, A150_FALLBACK_US, A270, A271, A275, E43, E82, PROFINET_PARAMS};
 use drive_core::{DriveObjects, PERSISTENT_IMAGE_BYTES};
 use nanos::Nanos;
+use profinet::cm::CmEvent;
 use profinet::cm::{NoRecords, RecordHook};
 use profinet::dcp::{Event as DcpEvent, IpSuite, NameOfStation, ResetMode};
 use profinet::device::{Device, DeviceEvent, RtEvent};
+use profinet::profienergy::ProfiEnergy;
 use store::{Flash, ParamStore};
 
+pub mod energy;
 pub mod settings;
+pub use energy::{DriveEnergy, PnRecords};
 pub use settings::Hardware;
 use settings::NAME_LEN;
 
@@ -72,6 +77,8 @@ use settings::NAME_LEN;
 extern crate std;
 #[cfg(test)]
 mod tests;
+#[cfg(test)]
+mod tests_energy;
 #[cfg(test)]
 mod tests_params;
 
@@ -99,7 +106,7 @@ struct Temporary {
 
 /// The drive on PROFINET. See the [crate documentation](crate).
 pub struct PnDrive<F: Flash, H: RecordHook = NoRecords> {
-    device: Device<H>,
+    device: Device<PnRecords<H>>,
     objects: DriveObjects,
     store: ParamStore<F>,
     startup: Startup,
@@ -115,6 +122,8 @@ pub struct PnDrive<F: Flash, H: RecordHook = NoRecords> {
     raised: [Option<(u8, u8)>; 2],
     /// A valid output frame arrived since the last control cycle.
     exchanged: bool,
+    /// Each axis' power stage was on in the last control cycle.
+    powered: [bool; 2],
 }
 
 impl<F: Flash> PnDrive<F, NoRecords> {
@@ -136,7 +145,14 @@ impl<F: Flash, H: RecordHook> PnDrive<F, H> {
         let active = objects.get(A270, 0) != Ok(0);
         let config = settings::device_config(&mut objects, hw);
         PnDrive {
-            device: Device::new(config, hook),
+            device: Device::new(
+                config,
+                PnRecords {
+                    pe: ProfiEnergy::default(),
+                    app: DriveEnergy::default(),
+                    inner: hook,
+                },
+            ),
             objects,
             store,
             startup,
@@ -147,16 +163,17 @@ impl<F: Flash, H: RecordHook> PnDrive<F, H> {
             caches: [AxisCache::new(), AxisCache::new()],
             raised: [None; 2],
             exchanged: false,
+            powered: [false; 2],
         }
     }
 
     /// The PROFINET device.
-    pub fn device(&self) -> &Device<H> {
+    pub fn device(&self) -> &Device<PnRecords<H>> {
         &self.device
     }
 
     /// The PROFINET device, mutable (input data, link state).
-    pub fn device_mut(&mut self) -> &mut Device<H> {
+    pub fn device_mut(&mut self) -> &mut Device<PnRecords<H>> {
         &mut self.device
     }
 
@@ -275,6 +292,7 @@ impl<F: Flash, H: RecordHook> PnDrive<F, H> {
             self.dropped_inactive = self.dropped_inactive.saturating_add(1);
             return;
         }
+        self.energy_inputs();
         self.device.receive(now, frame, tx);
         self.events(on_event);
     }
@@ -287,6 +305,7 @@ impl<F: Flash, H: RecordHook> PnDrive<F, H> {
         tx: &mut impl FnMut(&[u8]),
         on_event: &mut impl FnMut(&DeviceEvent),
     ) -> Nanos {
+        self.energy_inputs();
         let next = if self.profinet_active() {
             self.device.poll(now, tx)
         } else {
@@ -303,7 +322,16 @@ impl<F: Flash, H: RecordHook> PnDrive<F, H> {
         let mut save = false;
         while let Some(e) = self.device.take_event() {
             match &e {
-                DeviceEvent::Rt(RtEvent::ArLost(_)) => self.raise_ar_lost(),
+                DeviceEvent::Rt(RtEvent::ArLost(_)) => {
+                    self.raise_ar_lost();
+                    self.device.hook_mut().pe.end_pause();
+                }
+                DeviceEvent::Cm(CmEvent::Released(_) | CmEvent::Aborted(..)) => {
+                    // the controller that paused is gone
+                    let pe = &mut self.device.hook_mut().pe;
+                    pe.end_pause();
+                    pe.clear_response();
+                }
                 DeviceEvent::Dcp(d) => save |= self.apply_dcp(d),
                 _ => {}
             }
@@ -313,6 +341,23 @@ impl<F: Flash, H: RecordHook> PnDrive<F, H> {
             // the result shows in A00[2]
             let _ = self.save();
         }
+    }
+
+    /// PROFIenergy's view of the drive (A275, the power stages), before the
+    /// device sees a frame or a timer; A275 = 0 ends a pause.
+    fn energy_inputs(&mut self) {
+        let enabled = self.objects.get(A275, 0) == Ok(1);
+        let idle = !self.powered.contains(&true);
+        let hook = self.device.hook_mut();
+        hook.app = DriveEnergy { enabled, idle };
+        if !enabled {
+            hook.pe.end_pause();
+        }
+    }
+
+    /// Whether the PROFIenergy pause (power stage off, [`energy`]) is in force.
+    pub fn energy_paused(&self) -> bool {
+        self.device.hook().pe.paused()
     }
 
     /// Writes a DCP change into the objects; returns whether to save.
@@ -373,15 +418,24 @@ impl<F: Flash, H: RecordHook> PnDrive<F, H> {
     /// One control cycle of both axes at `now` with the hardware inputs `io`;
     /// returns the power-stage commands. A fault raised or reset becomes a
     /// diagnosis alarm appearing or disappearing, and E82/E43 follow it.
+    /// While PROFIenergy pauses ([`energy`]) the axes see no supply.
     pub fn control_cycle(&mut self, now: Nanos, io: &[AxisIo; 2]) -> [AxisCommand; 2] {
         self.profinet_active();
+        self.energy_inputs();
+        let paused = self.energy_paused();
+        let io = io.map(|mut io| {
+            if paused {
+                io.supply_ok = false;
+            }
+            io
+        });
         let new = core::mem::take(&mut self.exchanged) || !self.device.exchanging();
         let mut commands = [AxisCommand::OFF; 2];
         for (i, ((axis, cache), io)) in self
             .axes
             .iter_mut()
             .zip(self.caches.iter_mut())
-            .zip(io)
+            .zip(&io)
             .enumerate()
         {
             let report = axis.cycle_cached(cache, &mut self.objects, io, now, new);
@@ -416,6 +470,7 @@ impl<F: Flash, H: RecordHook> PnDrive<F, H> {
             }
             *command = report.command;
         }
+        self.powered = commands.map(|c| c.power_stage);
         commands
     }
 }

@@ -8,7 +8,7 @@
 //! | A270 | PROFINET active (BOOL, default 1) | read at start; a 0 takes effect at once ([`crate::PnDrive`]) |
 //! | A271 | name of station (STRING(240), empty = none) | the device's name at start (P-007); DCP Set writes it |
 //! | A272…A274 | static IP, subnet mask, gateway (UINT32, first octet in the MSB, 0 = none) | the device's IP suite at start (P-010); DCP Set writes them (P-009) |
-//! | A275 | PROFIenergy active (BOOL, default 0) | declared only: the PROFIenergy services are not built (P-016) |
+//! | A275 | PROFIenergy active (BOOL, default 0) | record 0x80A0 served only while 1; 0 ends a pause ([`crate::energy`], P-015/P-016) |
 //! | A276 | protocol (0 = standard protocol, range 0…0) | declared only: there is one protocol (P-014) |
 //! | A277 | parameterisation interface (0 automatic, 1 on-board Ethernet, 2 PROFINET) | declared only (P-017) |
 //! | A278 | vendor service port (UINT16, default 8802) | declared only: the vendor service protocol is not built (P-018) |

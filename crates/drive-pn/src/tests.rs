@@ -14,7 +14,7 @@ const CTRL: MacAddr = MacAddr([2, 0, 0, 0, 0, 0xC0]);
 
 #[path = "../../profinet/src/cm/tests_vectors.rs"]
 #[allow(dead_code)]
-mod vectors;
+pub(crate) mod vectors;
 
 fn hex(s: &str) -> Vec<u8> {
     let s: std::string::String = s.chars().filter(|c| c.is_ascii_hexdigit()).collect();
