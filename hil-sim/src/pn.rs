@@ -23,8 +23,29 @@ use profinet::model;
 use profinet::rpc::uuid::Uuid;
 use profinet::wire::MacAddr;
 
-/// The serial number in the simulated drive's I&M0.
+/// The serial number in the first simulated drive's I&M0 (the k-th is
+/// [`serial_number`]`(k)`).
 pub const SERIAL_NUMBER: &str = "SIM0001";
+
+/// The serial number of drive `k` (0-based): SIM0001, SIM0002, …
+pub fn serial_number(k: u16) -> String {
+    format!("SIM{:04}", u32::from(k) + 1)
+}
+
+/// The interface MAC of drive `k` of a simulated line on an interface
+/// with MAC `iface`: drive 0 has the interface's own, drive k > 0 a locally
+/// administered variant (byte 0 | 0x02, byte 4 XOR k), never one of
+/// another drive's port MACs ([`port_macs`] changes byte 5 only).
+pub fn device_mac(iface: MacAddr, k: u16) -> MacAddr {
+    if k == 0 {
+        return iface;
+    }
+    let mut m = iface;
+    m.0[0] |= 0x02;
+    m.0[4] ^= (k & 0xFF) as u8;
+    m.0[3] ^= (k >> 8) as u8;
+    m
+}
 
 /// The port MACs for an interface MAC (LLDP sources): locally administered
 /// variants of it (bit 1 of the first byte set, the last byte + port number),
@@ -214,10 +235,16 @@ impl PnSim {
     /// `mac`, started at `boot_time` (any value that differs after every
     /// start: the wall clock's seconds).
     pub fn power_on(flash: SimFlash, mac: MacAddr, boot_time: u32) -> PnSim {
+        PnSim::power_on_as(flash, mac, SERIAL_NUMBER, boot_time)
+    }
+
+    /// [`power_on`](PnSim::power_on) with the serial number `serial` in
+    /// I&M0.
+    pub fn power_on_as(flash: SimFlash, mac: MacAddr, serial: &str, boot_time: u32) -> PnSim {
         let hw = Hardware {
             mac,
             port_macs: port_macs(mac),
-            im0: Im0::drive(SERIAL_NUMBER),
+            im0: Im0::drive(serial),
             im: ImData::default(),
             boot_time,
         };
@@ -236,14 +263,14 @@ impl PnSim {
     /// A drive as shipped, except that its name of station is `name`
     /// (stored in A271 and saved, then powered on again: the name a
     /// commissioning tool left behind).
-    pub fn named(mac: MacAddr, name: &NameOfStation, boot_time: u32) -> PnSim {
-        let mut first = PnSim::power_on(SimFlash::new(), mac, boot_time);
+    pub fn named(mac: MacAddr, serial: &str, name: &NameOfStation, boot_time: u32) -> PnSim {
+        let mut first = PnSim::power_on_as(SimFlash::new(), mac, serial, boot_time);
         if name.is_empty() {
             return first;
         }
         drive_pn::settings::write_name(first.drive.objects_mut(), name);
         first.drive.save();
-        PnSim::power_on(first.drive.into_flash(), mac, boot_time)
+        PnSim::power_on_as(first.drive.into_flash(), mac, serial, boot_time)
     }
 
     /// The drive personality (objects, axes, store).
@@ -440,6 +467,24 @@ mod tests {
     }
 
     #[test]
+    fn p006_the_drives_of_a_line_have_distinct_interface_and_port_macs() {
+        let iface = MacAddr([0x00, 0x1b, 0x1b, 0x01, 0x02, 0x03]);
+        let mut all = Vec::new();
+        for k in 0..300 {
+            let m = device_mac(iface, k);
+            all.push(m);
+            all.extend(port_macs(m));
+        }
+        assert_eq!(device_mac(iface, 0), iface);
+        let n = all.len();
+        all.sort_by_key(|m| m.0);
+        all.dedup();
+        assert_eq!(all.len(), n, "a MAC is used twice");
+        assert_eq!(serial_number(0), SERIAL_NUMBER);
+        assert_eq!(serial_number(11), "SIM0012");
+    }
+
+    #[test]
     fn a_mac_is_read_as_sysfs_writes_it() {
         let mac = parse_mac("aa:bb:cc:0d:0e:0f\n").unwrap();
         assert_eq!(mac.0, [0xaa, 0xbb, 0xcc, 0x0d, 0x0e, 0x0f]);
@@ -552,7 +597,7 @@ mod tests {
     #[test]
     fn p007_a_named_simulated_drive_starts_with_its_stored_name() {
         let name: NameOfStation = "drive-7".parse().unwrap();
-        let d = PnSim::named(MacAddr([2, 0, 0, 0, 0, 1]), &name, 7);
+        let d = PnSim::named(MacAddr([2, 0, 0, 0, 0, 1]), SERIAL_NUMBER, &name, 7);
         assert_eq!(d.device().dcp().name_of_station().as_str(), "drive-7");
     }
 }

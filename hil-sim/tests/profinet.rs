@@ -44,6 +44,9 @@ const CYCLIC_SECONDS: &str = "12";
 const CONTROLLER_IP: &str = "192.168.0.10/24";
 /// The name and IP the controller gives the device.
 const NAME: &str = "drive-1";
+/// Drives serve runs on the line (the controller talks to the first, finds
+/// them all).
+const DRIVES: u16 = 2;
 /// The drive fault of step (i): event 44 "External fault 1", cause 1.
 const FAULT_EVENT: u8 = 44;
 const FAULT_CAUSE: u8 = 1;
@@ -163,6 +166,7 @@ impl Line {
             Command::new("ip")
                 .args(["netns", "exec", &d, env!("CARGO_BIN_EXE_hil-sim"), "serve"])
                 .args(["--fieldbus", "profinet", "--iface", &dev_if])
+                .args(["--slaves", &DRIVES.to_string()])
                 .arg("--pcap")
                 .arg(pcap)
                 .arg("--control")
@@ -328,6 +332,8 @@ fn p008_p027_p029_p030_p035_p036_p042_profinet_py_names_connects_faults_and_lose
             CYCLIC_SECONDS,
             "--control",
             line.control.to_str().unwrap(),
+            "--drives",
+            &DRIVES.to_string(),
             "--fault-event",
             &FAULT_EVENT.to_string(),
             "--fault-cause",
@@ -375,7 +381,7 @@ fn p008_p027_p029_p030_p035_p036_p042_profinet_py_names_connects_faults_and_lose
         ": lost (cyclic watchdog or alarm channel)".into(),
         ": aborted (Local)".into(),
         format!("axis A: event {FAULT_EVENT} cause {FAULT_CAUSE} raised"),
-        format!("diagnosis appears: axis A Fault"),
+        "diagnosis appears: axis A Fault".into(),
         "axis A: fault acknowledged (controlword bit 7)".into(),
         "diagnosis disappears:".into(),
         "alarms: 2 sent, 2 acknowledged".into(),

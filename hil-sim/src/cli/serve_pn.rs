@@ -1,18 +1,21 @@
-//! `hil-sim serve --fieldbus profinet`: one simulated drive
-//! ([`hil_sim::pn::PnSim`]: the drive personality `drive_pn` with both axes
-//! and their motors) answers as a PROFINET IO device on a raw Ethernet
-//! interface, paced by the wall clock.
+//! `hil-sim serve --fieldbus profinet`: `--slaves N` (default 1) simulated
+//! drives ([`hil_sim::pn::PnSim`]: the drive personality `drive_pn` with
+//! both axes and their motors) answer as PROFINET IO devices on a raw
+//! Ethernet interface, as if behind a switch, paced by the wall clock.
 //!
-//! The device's interface MAC is the interface's own (its port MACs are
-//! derived from it, [`hil_sim::pn::port_macs`]); it starts as shipped:
-//! unnamed unless `--name` gives one (stored in A271), no IP address, I&M0
-//! of the drive.
+//! The first device's interface MAC is the interface's own, the others'
+//! are derived from it ([`hil_sim::pn::device_mac`]), their port MACs from
+//! theirs ([`hil_sim::pn::port_macs`]); every device sees every frame and
+//! takes what is addressed to it. Each starts as shipped: unnamed unless
+//! `--name` gives the first one a name (stored in A271), no IP address,
+//! I&M0 of the drive with serial numbers SIM0001, SIM0002, …
 //!
 //! `--control PATH` makes a FIFO there that takes the simulator's commands
 //! ([`hil_sim::pn::Command`]: raise a drive event on an axis, acknowledge
 //! its fault), one per line, from any process that writes to it (a test's
-//! controller in another network namespace shares the file system). Each
-//! command's result, every change of the drive's diagnosis and the alarm
+//! controller in another network namespace shares the file system); a line
+//! starting `@K ` goes to drive K (1-based), any other to drive 1. Each
+//! command's result, every change of a drive's diagnosis and of its alarm
 //! channel's counters (sent, acknowledged) are printed.
 //!
 //! # Timing
@@ -32,7 +35,6 @@ use hil_sim::pn::{self, Command, PnSim};
 use hil_sim::raw::{monotonic, RawSocket};
 use nanos::Nanos;
 use profinet::dcp::NameOfStation;
-use profinet::device::DeviceEvent;
 use profinet::wire::MacAddr;
 use std::ffi::CString;
 use std::fs::File;
@@ -59,8 +61,8 @@ fn interface_mac(iface: &str) -> Result<MacAddr, String> {
 
 /// Refuses the options that only mean something on EtherCAT.
 fn check_options(args: &ServeArgs) -> Result<(), String> {
-    if args.slaves != 1 {
-        return Err("--slaves is EtherCAT-only: --fieldbus profinet serves one drive".into());
+    if args.slaves == 0 {
+        return Err("--slaves 0: at least one drive".into());
     }
     if args.axes != 1 {
         return Err("--axes is EtherCAT-only".into());
@@ -223,28 +225,49 @@ pub fn serve(args: &ServeArgs) -> Result<(), String> {
         .duration_since(UNIX_EPOCH)
         .map(|d| d.as_secs() as u32)
         .unwrap_or(1);
-    let mut drive = PnSim::named(mac, &name, boot_time);
+    let mut drives: Vec<PnSim> = (0..args.slaves)
+        .map(|k| {
+            let first_name = if k == 0 {
+                name.clone()
+            } else {
+                NameOfStation::EMPTY
+            };
+            PnSim::named(
+                pn::device_mac(mac, k),
+                &pn::serial_number(k),
+                &first_name,
+                boot_time,
+            )
+        })
+        .collect();
     let mut control = args.control.as_deref().map(Control::create).transpose()?;
-    let ports = pn::port_macs(mac);
     println!(
-        "hil-sim serve: one simulated drive as a PROFINET IO device on {iface} (MAC {}, ports {} {})",
-        pn::mac_text(mac),
-        pn::mac_text(ports[0]),
-        pn::mac_text(ports[1])
+        "hil-sim serve: {} simulated drive(s) as PROFINET IO devices on {iface}",
+        drives.len()
     );
-    println!(
-        "name of station: {}; IP: unset; I&M0 serial {}; two axes at rest, control cycle {} us; the drive echoes its outputs into its inputs",
-        if name.is_empty() {
-            "none".to_string()
-        } else {
-            format!("\"{}\"", name.as_str())
-        },
-        pn::SERIAL_NUMBER,
-        drive.drive().control_period().as_us()
-    );
+    for (k, d) in (0u16..).zip(&drives) {
+        let m = pn::device_mac(mac, k);
+        let ports = pn::port_macs(m);
+        let dcp_name = d.device().dcp().name_of_station();
+        println!(
+            "drive {}: MAC {}, ports {} {}; name of station {}; IP unset; I&M0 serial {}; two axes at rest, control cycle {} us",
+            k + 1,
+            pn::mac_text(m),
+            pn::mac_text(ports[0]),
+            pn::mac_text(ports[1]),
+            if dcp_name.is_empty() {
+                "none".to_string()
+            } else {
+                format!("\"{}\"", dcp_name.as_str())
+            },
+            pn::serial_number(k),
+            d.drive().control_period().as_us()
+        );
+    }
+    println!("each drive echoes its outputs into its inputs (until the profile maps telegrams)");
     if let Some(c) = &control {
         println!(
-            "control channel: {} (fault A|B EVENT CAUSE, reset A|B, status)",
+            "control channel: {} ([@K] fault A|B EVENT CAUSE, reset A|B, status)",
             c.path.display()
         );
     }
@@ -265,27 +288,60 @@ pub fn serve(args: &ServeArgs) -> Result<(), String> {
         sent: 0,
         error: None,
     };
-    let result = run(&mut drive, &sock, &mut out, control.as_mut(), args);
+    let result = run(&mut drives, &sock, &mut out, control.as_mut(), args);
     let flushed = out.flush(args);
     let stats = result?;
     flushed?;
-    summary(&drive, &stats, out.sent);
+    summary(&drives, &stats, out.sent);
     Ok(())
 }
 
-fn print_events(drive: &mut PnSim, t: Nanos) {
-    while let Some(e) = drive.take_event() {
-        print_event(t, &e);
+/// The log's prefix of drive `k` (0-based): none with one drive.
+fn who(k: usize, n: usize) -> String {
+    if n > 1 {
+        format!("drive {}: ", k + 1)
+    } else {
+        String::new()
     }
 }
 
-fn print_event(t: Nanos, e: &DeviceEvent) {
-    println!("[{:>10.3} s] {}", t.as_ns() as f64 / 1e9, pn::describe(e));
+fn print_events(drives: &mut [PnSim], t: Nanos) {
+    let n = drives.len();
+    for (k, d) in drives.iter_mut().enumerate() {
+        while let Some(e) = d.take_event() {
+            println!(
+                "[{:>10.3} s] {}{}",
+                t.as_ns() as f64 / 1e9,
+                who(k, n),
+                pn::describe(&e)
+            );
+        }
+    }
+}
+
+/// A control line: `@K command` for drive K (1-based), else drive 1.
+fn control_line(drives: &mut [PnSim], line: &str) -> String {
+    let (k, rest) = match line.strip_prefix('@') {
+        Some(r) => {
+            let (num, rest) = r.split_once(char::is_whitespace).unwrap_or((r, ""));
+            match num.parse::<usize>() {
+                Ok(k) if (1..=drives.len()).contains(&k) => (k - 1, rest),
+                _ => return format!("control: {line:?}: no drive {num:?} (1…{})", drives.len()),
+            }
+        }
+        None => (0, line),
+    };
+    let n = drives.len();
+    match (Command::parse(rest), drives.get_mut(k)) {
+        (Ok(cmd), Some(d)) => format!("{}{}", who(k, n), d.command(cmd)),
+        (Err(e), _) => format!("control: {e}"),
+        (Ok(_), None) => format!("control: no drive {}", k + 1),
+    }
 }
 
 /// The serve loop (see the module's Timing section).
 fn run(
-    drive: &mut PnSim,
+    drives: &mut [PnSim],
     sock: &RawSocket,
     out: &mut Out<'_>,
     mut control: Option<&mut Control>,
@@ -300,7 +356,7 @@ fn run(
     let mut last = Nanos::ZERO;
     let mut deadline = Nanos::ZERO;
     let mut next_flush = FLUSH_EVERY;
-    let mut watched = Watched::of(drive);
+    let mut watched: Vec<Watched> = drives.iter().map(Watched::of).collect();
     loop {
         let mut got = false;
         while let Some(rx) = sock.try_recv(&mut buf).map_err(|e| format!("receive: {e}"))? {
@@ -320,30 +376,35 @@ fn run(
             stats.received += 1;
             got = true;
             out.record(t, frame);
-            drive.receive(t, frame, &mut |f: &[u8]| out.send(t, f));
-            print_events(drive, t);
+            for d in drives.iter_mut() {
+                d.receive(t, frame, &mut |f: &[u8]| out.send(t, f));
+            }
+            print_events(drives, t);
             out.check()?;
         }
         let now = since(monotonic()).max(last);
         if got || now >= deadline {
             last = now;
-            deadline = drive.poll(now, &mut |f: &[u8]| out.send(now, f));
-            print_events(drive, now);
+            deadline = Nanos::MAX;
+            for d in drives.iter_mut() {
+                deadline = deadline.min(d.poll(now, &mut |f: &[u8]| out.send(now, f)));
+            }
+            print_events(drives, now);
             out.check()?;
         }
         if let Some(c) = control.as_deref_mut() {
             for line in c.lines().iter().filter(|l| !l.is_empty()) {
-                let said = match Command::parse(line) {
-                    Ok(cmd) => drive.command(cmd),
-                    Err(e) => format!("control: {e}"),
-                };
+                let said = control_line(drives, line);
                 println!("[{:>10.3} s] {said}", now.as_ns() as f64 / 1e9);
             }
         }
-        let w = Watched::of(drive);
-        if w != watched {
-            print_watched(now, &watched, &w, drive);
-            watched = w;
+        let n = drives.len();
+        for (k, (d, old)) in drives.iter().zip(watched.iter_mut()).enumerate() {
+            let w = Watched::of(d);
+            if w != *old {
+                print_watched(now, old, &w, d, &who(k, n));
+                *old = w;
+            }
         }
         if now >= next_flush {
             next_flush = now + FLUSH_EVERY;
@@ -362,44 +423,52 @@ fn run(
     }
 }
 
-fn print_watched(t: Nanos, old: &Watched, new: &Watched, drive: &PnSim) {
+fn print_watched(t: Nanos, old: &Watched, new: &Watched, drive: &PnSim, who: &str) {
     let at = t.as_ns() as f64 / 1e9;
     if old.diagnosis != new.diagnosis {
         println!(
-            "[{at:>10.3} s] diagnosis {}: {}",
+            "[{at:>10.3} s] {who}diagnosis {}: {}",
             if new.diagnosis { "appears" } else { "disappears" },
             drive.status()
         );
     }
     if let (Some((sent, acked, again)), true) = (new.alarms, old.alarms != new.alarms) {
-        println!("[{at:>10.3} s] alarms: {sent} sent, {acked} acknowledged, {again} retransmitted");
+        println!("[{at:>10.3} s] {who}alarms: {sent} sent, {acked} acknowledged, {again} retransmitted");
     }
 }
 
-fn summary(drive: &PnSim, stats: &Stats, sent: u64) {
-    let d = drive.device();
+fn summary(drives: &[PnSim], stats: &Stats, sent: u64) {
     println!(
         "{} frames received, {} sent; {} without a kernel timestamp",
         stats.received, sent, stats.unstamped
     );
-    println!("drive: {} control cycles; {}", drive.cycles(), drive.status());
-    let c = d.counters();
-    println!(
-        "device counters: runt {}, not for us {}, unknown FrameID {}, no AR {}, other EtherType {}, events lost {}",
-        c.runt, c.not_for_us, c.unknown_frame_id, c.no_ar, c.other_ethertype, c.events_lost
-    );
-    println!("ip counters: {:?}", d.ip().counters());
-    println!("rpc counters: {:?}", d.rpc().counters());
-    let name = d.dcp().name_of_station();
-    let ip = d.dcp().ip_suite();
-    println!(
-        "name of station at the end: {}; IP {} mask {}",
-        if name.is_empty() {
-            "none".to_string()
-        } else {
-            format!("\"{}\"", name.as_str())
-        },
-        ip.ip,
-        ip.mask
-    );
+    let n = drives.len();
+    for (k, drive) in drives.iter().enumerate() {
+        let who = who(k, n);
+        let d = drive.device();
+        println!(
+            "{who}drive: {} control cycles; {}",
+            drive.cycles(),
+            drive.status()
+        );
+        let c = d.counters();
+        println!(
+            "{who}device counters: runt {}, not for us {}, unknown FrameID {}, no AR {}, other EtherType {}, events lost {}",
+            c.runt, c.not_for_us, c.unknown_frame_id, c.no_ar, c.other_ethertype, c.events_lost
+        );
+        println!("{who}ip counters: {:?}", d.ip().counters());
+        println!("{who}rpc counters: {:?}", d.rpc().counters());
+        let name = d.dcp().name_of_station();
+        let ip = d.dcp().ip_suite();
+        println!(
+            "{who}name of station at the end: {}; IP {} mask {}",
+            if name.is_empty() {
+                "none".to_string()
+            } else {
+                format!("\"{}\"", name.as_str())
+            },
+            ip.ip,
+            ip.mask
+        );
+    }
 }

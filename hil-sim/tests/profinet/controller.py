@@ -7,7 +7,8 @@ both bind UDP 34964) and goes step by step, one line per result:
     step X: FAIL: ...            it did not (the script exits 1 at the end)
     step X: expected-fail: ...   a known problem of the device (see the text)
 
-(a) DCP Identify All finds the device, unnamed, by its MAC;
+(a) DCP Identify All finds the device, unnamed, by its MAC, and as many
+    drives of ours (vendor ID) on the line as --drives says;
 (b) DCP Set name of station (permanent) and IP suite;
 (c) DCP Identify by name finds it again with that IP;
 (d) RPC read of I&M0 (device-access AR): vendor ID and order number;
@@ -158,6 +159,7 @@ def main():
     ap.add_argument("--mask", default="255.255.255.0")
     ap.add_argument("--cyclic-seconds", type=float, default=12.0)
     ap.add_argument("--control", required=True, help="serve's control FIFO")
+    ap.add_argument("--drives", type=int, default=1, help="drives serve runs on the line")
     ap.add_argument("--fault-event", type=int, default=44)
     ap.add_argument("--fault-cause", type=int, default=1)
     a = ap.parse_args()
@@ -179,15 +181,13 @@ def main():
     def identify_all(delay):
         xid = dcp.send_discover(sock, src, response_delay=delay)
         found = dcp.read_response(sock, src, timeout_sec=3, expected_xid=xid, strict_xid=True)
-        for mac, blocks in found.items():
-            if mac2s(mac) == want_mac:
-                return dcp.DCPDeviceDescription(mac, blocks)
-        return [mac2s(m) for m in found]
+        return [dcp.DCPDeviceDescription(mac, blocks) for mac, blocks in found.items()]
 
     def step_a():
-        d = identify_all(0x0080)
-        if not isinstance(d, dcp.DCPDeviceDescription):
-            report("a", False, f"Identify All: {want_mac} not among {d}")
+        found = identify_all(0x0080)
+        d = next((x for x in found if x.mac == want_mac), None)
+        if d is None:
+            report("a", False, f"Identify All: {want_mac} not among {[x.mac for x in found]}")
             return
         ok = d.name == "" and d.ip == "0.0.0.0" and d.vendor_id == a.vendor_id
         report(
@@ -195,6 +195,12 @@ def main():
             ok,
             f"Identify All: {d.mac} name {d.name!r} ip {d.ip} vendor 0x{d.vendor_id:04X} "
             f"device 0x{d.device_id:04X} type {d.device_type!r} roles {d.device_roles}",
+        )
+        ours = sorted(x.mac for x in found if x.vendor_id == a.vendor_id)
+        report(
+            "a",
+            len(ours) == a.drives and len(set(ours)) == len(ours),
+            f"Identify All: {len(ours)} drive(s) of ours on the line ({', '.join(ours)}), {a.drives} expected",
         )
 
     run("a", step_a)
@@ -380,7 +386,8 @@ def main():
                 f"{1000 * (t_first - t_identify):.0f} ms (identify by name "
                 f"{1000 * (t_found - t_identify):.0f} ms, connect to PrmEnd and ApplicationReady "
                 f"{1000 * (t_connected - t_found):.0f} ms, first valid input frame "
-                f"{1000 * (t_first - t_connected):.1f} ms later)",
+                f"{1000 * (t_first - t_connected):.1f} ms later; profinet-py identifies with response delay "
+                f"factor 0x80, so the device answers after its MAC's share of up to 1.28 s)",
                 flush=True,
             )
             start = time.monotonic()
