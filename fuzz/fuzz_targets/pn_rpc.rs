@@ -1,5 +1,6 @@
 //! Arbitrary UDP payloads to the RPC port 34964 (DCE/RPC header, fragments,
-//! the endpoint mapper, the CM blocks of Connect, Read, Write and Control)
+//! the endpoint mapper, the CM blocks of Connect, Read, Write and Control,
+//! the records behind Read and Write: I&M, PDev, PROFIenergy)
 //! into a fresh and a connected PROFINET device, two datagrams per input
 //! (split at the first byte's value) so fragments and follow-ups are
 //! reached: nothing may panic, and a fresh device only gains an AR from a
