@@ -1,0 +1,239 @@
+//! QEMU measurement image of the PROFINET personality
+//! (`qemu-system-arm -machine netduinoplus2`, STM32F405, Cortex-M4F; no NIC
+//! needed): the drive on PROFINET ([`drive_pn::PnDrive`], as the board image
+//! `firmware-pn` runs it) fed by the scripted controller of `profinet`'s
+//! `testing` feature: profinet-py's Connect, then cyclic output frames, one
+//! per cycle of the AR (1 ms × 8).
+//!
+//! Measured under `-icount shift=0` (one instruction per virtual ns) with
+//! SysTick at the CPU clock, calibrated at boot against a loop of known
+//! length, as `firmware-qemu` measures the control cycle:
+//!
+//! - `receive` of one cyclic output frame (frame check, consumer, data
+//!   hold), the RT_CLASS_1 input;
+//! - `poll` at the cycle time when it sends the input frame (provider:
+//!   the frame built and handed to the transmit closure);
+//! - one control cycle of both axes (`PnDrive::control_cycle`).
+//!
+//! Without the MAC driver's copy into its DMA buffer (`gmac`: a 1.5 KiB
+//! bounded copy per frame sent) and without interrupt entry. `scripts/cross
+//! qemu` prints the figures and compares the other lines with
+//! `firmware/qemu/expected/firmware-qemu-pn.log`.
+#![no_std]
+#![no_main]
+
+use cortex_m::peripheral::syst::SystClkSource;
+use cortex_m::peripheral::SYST;
+use cortex_m_rt::entry;
+use cortex_m_semihosting::debug;
+use defmt_semihosting as _;
+use drive::axis::AxisIo;
+use drive_pn::{Hardware, PnDrive};
+use firmware::ParamFlash;
+use nanos::Nanos;
+use profinet::cm::{CmEvent, ImData};
+use profinet::device::{DeviceEvent, RtEvent};
+use profinet::testing;
+use stm32f4 as _; // the interrupt vectors
+
+#[panic_handler]
+fn panic(info: &core::panic::PanicInfo) -> ! {
+    defmt::error!("panic: {}", defmt::Display2Format(info));
+    debug::exit(debug::EXIT_FAILURE);
+    loop {
+        cortex_m::asm::wfi();
+    }
+}
+
+/// Cyclic frames measured.
+const FRAMES: u32 = 1000;
+
+type Drive = PnDrive<ParamFlash>;
+
+fn hardware() -> Hardware {
+    let c = testing::device_config();
+    Hardware {
+        mac: c.mac,
+        port_macs: c.port_macs,
+        im0: c.im0,
+        im: ImData::default(),
+        boot_time: 1,
+    }
+}
+
+/// Running figures of one measurement.
+#[derive(Default, Clone, Copy)]
+struct Figure {
+    n: u32,
+    sum: u64,
+    min: u32,
+    max: u32,
+}
+
+impl Figure {
+    fn add(&mut self, v: u32) {
+        self.min = if self.n == 0 { v } else { self.min.min(v) };
+        self.n += 1;
+        self.sum += u64::from(v);
+        self.max = self.max.max(v);
+    }
+    fn mean(&self) -> u32 {
+        (self.sum / u64::from(self.n.max(1))) as u32
+    }
+}
+
+fn now_ticks() -> u32 {
+    SYST::get_current()
+}
+
+fn ticks(start: u32, end: u32) -> u32 {
+    start.wrapping_sub(end) & 0x00FF_FFFF
+}
+
+/// Instructions per 1000 SysTick ticks, from a loop of `2 · n` instructions.
+#[allow(unsafe_code)]
+fn calibrate() -> u32 {
+    let n: u32 = 200_000;
+    let t0 = now_ticks();
+    // SAFETY: a register-only countdown loop, no memory access.
+    unsafe {
+        core::arch::asm!("1:", "subs {0}, {0}, #1", "bne 1b", inout(reg) n => _, options(nomem, nostack));
+    }
+    let t = ticks(t0, now_ticks()).max(1);
+    (u64::from(2 * n) * 1000 / u64::from(t)) as u32
+}
+
+/// The drive commissioned as the scripted controller expects it ("drive-1",
+/// 192.168.0.50/24, saved) and restarted, in its static.
+#[inline(never)]
+#[allow(unsafe_code)]
+fn make_drive() -> Option<&'static mut Drive> {
+    static mut DRIVE: core::mem::MaybeUninit<Drive> = core::mem::MaybeUninit::uninit();
+    static TAKEN: core::sync::atomic::AtomicBool = core::sync::atomic::AtomicBool::new(false);
+    if TAKEN.swap(true, core::sync::atomic::Ordering::AcqRel) {
+        return None;
+    }
+    // SAFETY: the flag hands out the static once.
+    let slot = unsafe { &mut *core::ptr::addr_of_mut!(DRIVE) };
+    let first = slot.write(Drive::new(ParamFlash::new(), hardware()));
+    let c = testing::device_config();
+    drive_pn::settings::write_name(first.objects_mut(), &c.name);
+    drive_pn::settings::write_ip(first.objects_mut(), c.ip);
+    if !first.save() {
+        return None;
+    }
+    // SAFETY: `slot` was initialised just above; it is read out once and
+    // written again before any other use (the power cycle keeps the flash).
+    let flash = unsafe { slot.assume_init_read() }.into_flash();
+    Some(slot.write(Drive::new(flash, hardware())))
+}
+
+#[entry]
+fn main() -> ! {
+    let Some(mut cp) = cortex_m::Peripherals::take() else {
+        debug::exit(debug::EXIT_FAILURE);
+        loop {}
+    };
+    cp.SYST.set_clock_source(SystClkSource::Core);
+    cp.SYST.set_reload(0x00FF_FFFF);
+    cp.SYST.clear_current();
+    cp.SYST.enable_counter();
+    let per_kilo_tick = calibrate();
+    let insn = |t: u32| (u64::from(t) * u64::from(per_kilo_tick) / 1000) as u32;
+    defmt::info!("init: firmware-qemu-pn (STM32F405): PnDrive + scripted PROFINET controller");
+    let ok = run(insn);
+    if ok {
+        defmt::info!("done: PROFINET sequence complete, exit 0");
+        debug::exit(debug::EXIT_SUCCESS);
+    } else {
+        defmt::error!("done: PROFINET sequence failed");
+        debug::exit(debug::EXIT_FAILURE);
+    }
+    loop {
+        cortex_m::asm::wfi();
+    }
+}
+
+fn run(insn: impl Fn(u32) -> u32) -> bool {
+    let Some(d) = make_drive() else {
+        defmt::error!("init: drive not built (save failed?)");
+        return false;
+    };
+    let (mut connected, mut exchanging) = (false, false);
+    let mut sent = 0u32;
+    d.receive(
+        Nanos::ZERO,
+        &testing::connect_frame(),
+        &mut |_: &[u8]| sent += 1,
+        &mut |e| connected |= matches!(e, DeviceEvent::Cm(CmEvent::Connected(_))),
+    );
+    defmt::info!(
+        "controller: Connect answered: {=bool} ({=u32} frame)",
+        connected && sent == 1,
+        sent
+    );
+    let Some(ar) = d.device().cm().ar().cloned() else {
+        return false;
+    };
+    let cycle = ar.output_cr.as_ref().map_or(Nanos::from_ms(1), |c| c.cycle());
+    let mut frame = testing::output_frame(&ar, 0, 0x11);
+    let n = frame.len();
+    let io = [AxisIo::ready(0); 2];
+    let (mut rx, mut tx_poll, mut ctl) = (Figure::default(), Figure::default(), Figure::default());
+    let mut inputs = 0u32;
+    for k in 1..=FRAMES {
+        let now = cycle.saturating_mul(u64::from(k));
+        let counter = (k as u16).wrapping_mul(256);
+        if let Some(c) = frame.get_mut(n.saturating_sub(4)..n.saturating_sub(2)) {
+            c.copy_from_slice(&counter.to_be_bytes());
+        }
+        let t0 = now_ticks();
+        d.receive(now, &frame, &mut |_: &[u8]| {}, &mut |e| {
+            exchanging |= matches!(e, DeviceEvent::Rt(RtEvent::Exchanging(_)))
+        });
+        rx.add(insn(ticks(t0, now_ticks())));
+        let mut out = 0u32;
+        let t0 = now_ticks();
+        let _ = d.poll(now, &mut |_: &[u8]| out += 1, &mut |_| {});
+        let t = insn(ticks(t0, now_ticks()));
+        if out > 0 {
+            tx_poll.add(t);
+            inputs += 1;
+        }
+        let t0 = now_ticks();
+        let _ = d.control_cycle(now, &io);
+        ctl.add(insn(ticks(t0, now_ticks())));
+    }
+    let valid = d.device().output_data(2).is_some();
+    defmt::info!(
+        "controller: cyclic data exchanged: {=bool}, outputs valid: {=bool}",
+        exchanging,
+        valid
+    );
+    defmt::info!(
+        "figure: PROFINET receive of a cyclic output frame ({=usize} bytes): mean {=u32} min {=u32} max {=u32} instructions over {=u32} frames",
+        n,
+        rx.mean(),
+        rx.min,
+        rx.max,
+        rx.n
+    );
+    defmt::info!(
+        "figure: PROFINET poll sending the input frame: mean {=u32} min {=u32} max {=u32} instructions over {=u32} cycles",
+        tx_poll.mean(),
+        tx_poll.min,
+        tx_poll.max,
+        tx_poll.n
+    );
+    defmt::info!(
+        "figure: PnDrive control cycle (2 axes, at rest): mean {=u32} max {=u32} instructions",
+        ctl.mean(),
+        ctl.max
+    );
+    defmt::info!(
+        "figure: input frames sent {=u32} of {=u32} cycles",
+        inputs,
+        FRAMES
+    );
+    connected && exchanging && valid && inputs > FRAMES / 2
+}
