@@ -62,6 +62,12 @@ pub struct PnCycle {
     next: nanos::Nanos,
 }
 
+impl Default for PnCycle {
+    fn default() -> Self {
+        Self::new()
+    }
+}
+
 impl PnCycle {
     /// First cycle at A150's default.
     pub const fn new() -> PnCycle {

@@ -132,7 +132,9 @@ fn make_drive() -> Option<&'static mut Drive> {
 fn main() -> ! {
     let Some(mut cp) = cortex_m::Peripherals::take() else {
         debug::exit(debug::EXIT_FAILURE);
-        loop {}
+        loop {
+            cortex_m::asm::wfi();
+        }
     };
     cp.SYST.set_clock_source(SystClkSource::Core);
     cp.SYST.set_reload(0x00FF_FFFF);
