@@ -402,6 +402,12 @@ fn p008_p027_p029_p030_p035_p036_p042_profinet_py_names_connects_faults_and_lose
         device_warnings.trim().is_empty(),
         "frames from the device that Wireshark flags:\n{device_warnings}"
     );
+    // every captured frame, the controller's too, dissects without a malformed packet
+    let malformed = tshark(&pcap, &["-Y", "_ws.malformed"]);
+    assert!(
+        malformed.trim().is_empty(),
+        "malformed frames in the recording:\n{malformed}"
+    );
     let protocols = tshark(&pcap, &["-T", "fields", "-e", "frame.protocols"]);
     let mut histogram = std::collections::BTreeMap::<&str, usize>::new();
     for p in protocols.lines() {
