@@ -39,6 +39,7 @@ pub mod limits;
 pub mod profile;
 pub mod scaling;
 pub mod touch_probe;
+pub mod units;
 pub mod windows;
 
 pub use cycle::{CycleError, CycleRatio};
