@@ -53,6 +53,8 @@ mod tests_cw;
 mod tests_pkw;
 #[cfg(test)]
 mod tests_telegram;
+#[cfg(test)]
+mod tests_tshark;
 
 /// A parameter address: PNU or CANopen index, and subindex (P-057).
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Default, Hash)]
