@@ -52,6 +52,8 @@ mod tests_cw;
 #[cfg(test)]
 mod tests_pkw;
 #[cfg(test)]
+mod tests_random;
+#[cfg(test)]
 mod tests_telegram;
 #[cfg(test)]
 mod tests_tshark;
