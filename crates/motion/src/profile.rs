@@ -146,6 +146,9 @@ enum End {
     Stop,
     /// Stand still, then plan a move to this target with these limits.
     StopThenMove(i32, ProfileLimits),
+    /// Pass this target (increments) at this end velocity (increments/s,
+    /// plan coordinates, > 0) and go on at it: a gap-free sequence.
+    Pass(i32, f64),
 }
 
 #[derive(Debug, Clone, Copy)]
@@ -308,11 +311,57 @@ impl From<ProfileLimits> for Lim {
 /// Ramp to `vc`, cruise `cruise_s` s, ramp to standstill; plan coordinates
 /// (direction +1), starting at (0, `v0`, `a0`).
 fn direct_plan(v0: f64, a0: f64, vc: f64, cruise_s: f64, l: &Lim) -> Plan {
+    direct_plan_to(v0, a0, vc, cruise_s, 0.0, l)
+}
+
+/// [`direct_plan`] ending at velocity `ve` (≥ 0) instead of standstill.
+fn direct_plan_to(v0: f64, a0: f64, vc: f64, cruise_s: f64, ve: f64, l: &Lim) -> Plan {
     let mut p = Plan::new(1.0, v0, a0);
     p.ramp_to(vc, l.acc, l.dec, l.jerk);
     p.push(cruise_s, 0.0, 0.0);
-    p.ramp(0.0, l.dec, l.jerk);
+    if ve > 0.0 {
+        p.ramp_to(ve, l.acc, l.dec, l.jerk);
+    } else {
+        p.ramp(0.0, l.dec, l.jerk);
+    }
     p
+}
+
+/// Plans a move over `d` (increments) from (`v`, `a`) that passes `target`
+/// at the end velocity `ve` (increments/s, > 0, capped at the velocity
+/// limit) in the direction of the move. `None`: the end velocity cannot be
+/// reached within the distance (the caller plans an ordinary move).
+fn plan_pass(d: f64, v: f64, a: f64, target: i32, ve: f64, limits: ProfileLimits) -> Option<Plan> {
+    let l = Lim::from(limits);
+    let dir = if d >= 0.0 { 1.0 } else { -1.0 };
+    let dn = d.abs();
+    let (vn, an) = (dir * v, dir * a);
+    let ve = ve.min(l.v);
+    if ve.is_nan() || ve <= 0.0 || dn == 0.0 || vn < 0.0 {
+        return None;
+    }
+    let dist = |vc: f64| direct_plan_to(vn, an, vc, 0.0, ve, &l).x_end;
+    if dist(ve) > dn + 0.5 {
+        return None;
+    }
+    let mut plan = if dist(l.v) <= dn {
+        direct_plan_to(vn, an, l.v, (dn - dist(l.v)) / l.v, ve, &l)
+    } else {
+        let (mut lo, mut hi) = (ve, l.v);
+        for _ in 0..BISECTION_STEPS {
+            let mid = 0.5 * (lo + hi);
+            if dist(mid) <= dn {
+                lo = mid;
+            } else {
+                hi = mid;
+            }
+        }
+        direct_plan_to(vn, an, lo, ((dn - dist(lo)) / lo).max(0.0), ve, &l)
+    };
+    plan.dir = dir;
+    plan.x_max = dn;
+    plan.end = End::Pass(target, ve);
+    Some(plan)
 }
 
 /// Bisection steps for the cruise velocity (2^-40 of the velocity limit).
@@ -407,6 +456,9 @@ pub struct ProfileGenerator {
     elapsed: Nanos,
     /// Last target position (MC_MoveAdditive reference), increments.
     target: i32,
+    /// A passing move ([`Self::move_through`]) reached its target and the
+    /// generator goes on at the end velocity.
+    passed: bool,
 }
 
 impl ProfileGenerator {
@@ -419,6 +471,7 @@ impl ProfileGenerator {
             plan: Plan::EMPTY,
             elapsed: Nanos::ZERO,
             target: position,
+            passed: false,
         }
     }
 
@@ -469,6 +522,7 @@ impl ProfileGenerator {
     }
 
     fn start_plan(&mut self, base: i32, frac: f64, plan: Option<Plan>) {
+        self.passed = false;
         self.base = base;
         self.frac = frac;
         self.elapsed = Nanos::ZERO;
@@ -511,6 +565,43 @@ impl ProfileGenerator {
             None => self.start_plan(target, 0.0, None),
         }
         Ok(true)
+    }
+
+    /// A move to `target` (always re-planned from the current state, as
+    /// [`SetMode::Immediate`]) that passes the target at `end_velocity`
+    /// (increments/s, magnitude, in the direction of the move; 6082h, the
+    /// end velocity of a position record) and goes on at that velocity until
+    /// the next command: the first move of a gap-free sequence.
+    /// [`passed`](Self::passed) turns true once the target is passed. An end
+    /// velocity of 0, or one that cannot be reached within the distance,
+    /// gives an ordinary move that stops on the target.
+    pub fn move_through(
+        &mut self,
+        target: i32,
+        end_velocity: f32,
+        limits: ProfileLimits,
+    ) -> Result<(), ProfileError> {
+        limits.validate()?;
+        let (base, frac, v, a) = self.current();
+        let d = f64::from(target.wrapping_sub(base)) - frac;
+        let ve = f64::from(end_velocity).abs();
+        match plan_pass(d, v, a, target, ve, limits) {
+            Some(plan) => {
+                self.target = target;
+                self.start_plan(base, frac, Some(plan));
+            }
+            None => {
+                self.move_to(PositionTarget::Absolute(target), limits, SetMode::Immediate)?;
+            }
+        }
+        Ok(())
+    }
+
+    /// A passing move ([`move_through`](Self::move_through)) has passed its
+    /// target; the generator goes on at the end velocity. Cleared by the
+    /// next command.
+    pub const fn passed(&self) -> bool {
+        self.passed
     }
 
     /// pv: ramps to `target_velocity` (increments/s, capped at ±
@@ -630,6 +721,21 @@ impl ProfileGenerator {
                     velocity: 0.0,
                     acceleration: 0.0,
                     done: self.is_standstill(),
+                }
+            }
+            End::Pass(target, ve) => {
+                let v = p.dir * ve;
+                let (b, f) = split(target, v * over_s);
+                self.base = b;
+                self.frac = f;
+                self.elapsed = Nanos::ZERO;
+                self.mode = Mode::Cruise(v);
+                self.passed = true;
+                ProfileSample {
+                    position: round_pos(b, f),
+                    velocity: v as f32,
+                    acceleration: 0.0,
+                    done: false,
                 }
             }
             End::Velocity(v) => {

@@ -516,3 +516,61 @@ fn c049_random_commands_always_end_exactly() {
     let (_, last) = run(&mut g, DT, 10_000_000, |_, _| {});
     assert_eq!(last.position, -77);
 }
+
+/// P-137: a passing move reaches its target at the end velocity without a
+/// stop (monotonic velocity never below the end velocity near the target,
+/// jerk-limited), then goes on at it; a follow-up move from that state
+/// continues gap-free to the second target and stops there.
+#[test]
+fn p137_move_through_passes_the_target_at_the_end_velocity() {
+    let mut g = ProfileGenerator::new(0);
+    let l = limits();
+    let ve = 20_000_000.0f32;
+    g.move_through(3_000_000, ve, l).unwrap();
+    assert!(!g.passed());
+    let mut last = g.step(DT);
+    let mut steps = 0;
+    while !g.passed() {
+        let s = g.step(DT);
+        assert!(s.velocity > 0.0, "no stop on the way: {s:?}");
+        assert!(s.position >= last.position);
+        last = s;
+        steps += 1;
+        assert!(steps < 100_000);
+    }
+    // passed within one cycle's travel at the end velocity
+    let step = (ve as f64 * DT as f64 * 1e-9) as i32 + 2;
+    assert!(
+        last.position >= 3_000_000 - step && last.position <= 3_000_000 + step,
+        "{last:?}"
+    );
+    assert!((last.velocity - ve).abs() < 1.0, "{last:?}");
+    let cruise = g.step(DT);
+    assert_eq!(cruise.velocity, ve);
+    assert!(!cruise.done);
+    // the follow-up: from the cruising state to the second target, no gap
+    g.move_to(PositionTarget::Absolute(6_000_000), l, SetMode::Immediate)
+        .unwrap();
+    assert!(!g.passed(), "a new command clears passed");
+    let (_, end) = run(&mut g, DT, 100_000, |p, s| {
+        assert!(s.position >= p.position, "no reversal: {p:?} → {s:?}");
+    });
+    assert_eq!(end.position, 6_000_000);
+}
+
+/// P-137: an end velocity that cannot be reached within the distance, or
+/// an end velocity of 0, gives an ordinary move that stops on the target.
+#[test]
+fn p137_unreachable_or_zero_end_velocity_stops_on_the_target() {
+    for (target, ve) in [(1_000, 50_000_000.0f32), (2_000_000, 0.0)] {
+        let mut g = ProfileGenerator::new(0);
+        let l = ProfileLimits {
+            acceleration: 1.0e6,
+            ..limits()
+        };
+        g.move_through(target, ve, l).unwrap();
+        let (_, end) = run(&mut g, DT, 1_000_000, |_, _| {});
+        assert_eq!(end.position, target);
+        assert!(!g.passed());
+    }
+}
