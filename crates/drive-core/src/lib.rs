@@ -31,6 +31,7 @@ pub mod objects;
 pub mod params;
 pub mod pdo_image;
 pub mod pdo_maps;
+pub mod user_units;
 
 pub use dictionary::{
     revision, DriveObjects, ImageError, LiveValues, NoLive, Requests, Slot, Template, WithLive,
@@ -76,3 +77,5 @@ pub const fn parameter_index(group: u16, line: u16) -> u16 {
 extern crate std;
 #[cfg(test)]
 mod tests_od;
+#[cfg(test)]
+mod tests_records_od;

@@ -129,7 +129,7 @@ fn e009_manufacturer_index_formula() {
 
 #[test]
 fn e010_axis_b_parameters_at_plus_8000() {
-    let mut d = DriveObjects::new();
+    let mut d = all_visible();
     for o in OBJECTS
         .iter()
         .filter(|o| o.info.index >= 0xA000 && o.info.index < 0xE000)

@@ -19,6 +19,7 @@ use od::{CommState, DataType, Dictionary, EntryInfo, ObjectInfo, SdoAbort};
 
 mod mapping;
 mod persist;
+mod records;
 mod resolve;
 mod slot;
 
@@ -126,6 +127,8 @@ pub struct DriveObjects {
     /// configuration generation they were summed at: the slave asks every
     /// poll, the mapping changes only with the generation.
     pdo_bytes: Cell<Option<(u32, (usize, usize))>>,
+    /// J401\[5\] of each axis as last synchronised with \[3\] (`records.rs`).
+    all_accelerations: [u32; 2],
 }
 
 /// Equal dictionaries hold the same values and template; how they got
@@ -166,6 +169,7 @@ impl DriveObjects {
             },
             config_generation: 0,
             pdo_bytes: Cell::new(None),
+            all_accelerations: [records::ALL_ACCELERATIONS_DEFAULT; 2],
         }
     }
 
@@ -447,8 +451,10 @@ impl DriveObjects {
                 self.requests.defaults_restored = true;
             }
             _ => {
+                self.record_write_check(o.info.index);
                 self.store(target, data)?;
                 self.side_effects(o.info.index, e.sub, value);
+                self.record_written(o.info.index, e.sub, value);
             }
         }
         Ok(())

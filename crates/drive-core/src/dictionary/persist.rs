@@ -95,6 +95,7 @@ impl DriveObjects {
             payload = rest;
         }
         self.template = template;
+        self.records_reloaded(false);
         self.config_changed();
         Ok(())
     }
@@ -110,6 +111,7 @@ impl DriveObjects {
                 }
             }
         }
+        self.records_reloaded(true);
         self.config_changed();
     }
 }

@@ -126,7 +126,7 @@ pub(super) const CONFIG_FLAG: u32 = 0x40;
 
 /// Set-points the control cycle reads every cycle (axis-A indices; axis B
 /// at +800h / +8000h): writes to them are not configuration changes.
-pub(super) const CYCLIC_SETPOINTS: [u16; 11] = [
+pub(super) const CYCLIC_SETPOINTS: [u16; 14] = [
     0x6040,
     0x6060,
     0x607A,
@@ -138,6 +138,11 @@ pub(super) const CYCLIC_SETPOINTS: [u16; 11] = [
     0x6042,
     0x60B8,
     parameter_index(8, 210),
+    // the record window, start number and override (written cyclically by
+    // a telegram; the axis reads them at a start, not every cycle)
+    crate::objects::records::J401,
+    crate::objects::records::J402,
+    crate::objects::records::J403,
 ];
 
 /// Whether a changed value of object `o` is a configuration change

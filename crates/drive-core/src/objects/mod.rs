@@ -4,6 +4,9 @@
 //!   objects F0xxh (ETG.1000.6, ETG.1020, ETG.5000.1; `od-ethercat.md`).
 //! - [`manufacturer`]: the manufacturer parameters at 2000h + group·200h + line
 //!   (axis-B copies of axis parameters at +8000h; spec §2.6).
+//! - [`records`]: the position records, their selector, start number,
+//!   override and set-up speed in group J (3390h…339Bh, per-axis ones also
+//!   at +8000h).
 //! - [`cia402`]: the CiA 402 objects of axis A (6000h–65FFh); axis B is
 //!   derived at +800h (`od-cia402.md`).
 //!
@@ -61,6 +64,7 @@ macro_rules! numbered {
 pub mod cia402;
 pub mod comm;
 pub mod manufacturer;
+pub mod records;
 
 /// Where the values of an object live.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
@@ -352,14 +356,18 @@ const fn entries_sorted(objs: &[Object]) -> bool {
 const AXIS_B_PARAMS: usize = count_axis(&manufacturer::PARAMS);
 const MANUFACTURER_B: [Object; AXIS_B_PARAMS] =
     axis_copies(&manufacturer::PARAMS, crate::AXIS_B_MANUFACTURER);
+const AXIS_B_RECORDS: usize = count_axis(&records::PARAMS);
+const RECORDS_B: [Object; AXIS_B_RECORDS] = axis_copies(&records::PARAMS, crate::AXIS_B_MANUFACTURER);
 const CIA402_B: [Object; cia402::AXIS_A.len()] = offset(cia402::AXIS_A, crate::AXIS_B_CIA402);
 
 /// Number of objects.
 pub const COUNT: usize = comm::COMM.len()
     + manufacturer::PARAMS.len()
+    + records::PARAMS.len()
     + cia402::AXIS_A.len()
     + CIA402_B.len()
     + MANUFACTURER_B.len()
+    + RECORDS_B.len()
     + comm::MDP.len();
 
 // Only used in const evaluation (the offsets, the initial image, the layout
@@ -368,9 +376,11 @@ pub const COUNT: usize = comm::COMM.len()
 const TABLE: [Object; COUNT] = join(&[
     &comm::COMM,
     &manufacturer::PARAMS,
+    &records::PARAMS,
     &cia402::AXIS_A,
     &CIA402_B,
     &MANUFACTURER_B,
+    &RECORDS_B,
     &comm::MDP,
 ]);
 const _: () = assert!(sorted(&TABLE), "objects must be sorted by index, each index once");
@@ -418,6 +428,22 @@ const fn offsets() -> ([u16; COUNT], usize) {
 /// Size of the RAM image in bytes.
 pub const IMAGE_BYTES: usize = offsets().1;
 
+/// Byte offset in the RAM image of the values of the object at `index`
+/// (0 when it has none), computed at compile time.
+pub const fn image_offset(index: u16) -> usize {
+    let (offs, _) = offsets();
+    let mut i = 0;
+    while i < COUNT {
+        // i < COUNT (compile-time evaluation)
+        #[allow(clippy::indexing_slicing)]
+        if TABLE[i].info.index == index {
+            return offs[i] as usize;
+        }
+        i += 1;
+    }
+    0
+}
+
 /// Byte offset of each object's values in the RAM image (objects with
 /// [`Value::Ram`] / [`Value::Live`]; entries follow each other in subindex
 /// order, each [`DataType::bytes`] long).
@@ -447,9 +473,29 @@ pub const INITIAL_IMAGE: [u8; IMAGE_BYTES] = {
         let (o, mut at) = (&TABLE[i], offs[i] as usize);
         if o.ram_bytes() > 0 {
             let mut rest = o.info.entries;
+            // the record memory (J410/J411 of either axis) starts with the
+            // records' defaults
+            let mut memory_at = 0;
+            let memory = match o.info.index {
+                i if i >= crate::AXIS_B_MANUFACTURER => i - crate::AXIS_B_MANUFACTURER,
+                i => i,
+            };
             while let [e, tail @ ..] = rest {
                 if !e.data_type.is_string() {
                     put(&mut image, at, e.default, e.data_type.bytes());
+                } else if matches!(memory, records::J410 | records::J411) {
+                    let mut k = 0;
+                    while k < e.data_type.bytes() {
+                        if let Some(b) = records::initial_byte(memory, memory_at + k) {
+                            // at + k < IMAGE_BYTES by construction
+                            #[allow(clippy::indexing_slicing)]
+                            {
+                                image[at + k] = b;
+                            }
+                        }
+                        k += 1;
+                    }
+                    memory_at += e.data_type.bytes();
                 }
                 at += e.data_type.bytes();
                 rest = tail;

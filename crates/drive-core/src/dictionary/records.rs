@@ -1,0 +1,221 @@
+//! The position records in the dictionary ([`crate::objects::records`]):
+//! J401 is the window on the record J400 selects. A bus write of J401 goes
+//! through to the record at once; a write of J400 first puts the window back
+//! into the record it showed (a cyclic mapping of J401 writes the window
+//! only) and then shows the new one. J401\[5\] "all accelerations" (P-144):
+//! a bus write sets \[3\] and \[4\]; it reads as \[3\] (a write of \[3\]
+//! sets it too); a value a cyclic mapping wrote into \[5\] (it differs from
+//! what was last synchronised) sets both accelerations when the record is
+//! used ([`DriveObjects::take_record`]).
+
+use super::*;
+pub(super) use crate::objects::records::ALL_ACCELERATIONS_DEFAULT;
+use crate::objects::records::{
+    place, Record, FIELDBUS, J400, J401, J410, J411, OPT_IMMEDIATE, OPT_RELATIVE, RECORDS, RECORD_BYTES,
+};
+use crate::AXIS_B_MANUFACTURER;
+
+/// The axis (0, 1) of per-axis record object `index`, if it is `object`
+/// (axis-A numbering) or its axis-B copy.
+fn axis_of(index: u16, object: u16) -> Option<u8> {
+    if index == object {
+        Some(0)
+    } else if index == object.wrapping_add(AXIS_B_MANUFACTURER) {
+        Some(1)
+    } else {
+        None
+    }
+}
+
+/// `index` of axis `axis` (axis-A numbering given).
+fn at_axis(index: u16, axis: u8) -> u16 {
+    if axis == 0 {
+        index
+    } else {
+        index.wrapping_add(AXIS_B_MANUFACTURER)
+    }
+}
+
+/// J401 element `k` in the runtime ("SDO Info") numbering.
+const fn data_sub(k: u8) -> u8 {
+    k + 1
+}
+
+impl DriveObjects {
+    /// The record selector J400 of `axis`.
+    pub fn record_selector(&self, axis: u8) -> u16 {
+        self.get(at_axis(J400, axis), 0)
+            .map_or(FIELDBUS, |v| u16::try_from(v).unwrap_or(FIELDBUS))
+    }
+
+    /// Byte range of record `n` of `axis` in the image and of its options.
+    fn record_range(axis: u8, n: u16) -> Option<(core::ops::Range<usize>, usize)> {
+        let (object, at, options) = place(n)?;
+        let index = if object == J410 { J410 } else { at_axis(J411, axis) };
+        // arrays: the elements follow sub 0 (UNSIGNED8)
+        let base = objects::image_offset(index) + 1;
+        Some((base + at..base + at + RECORD_BYTES, base + options))
+    }
+
+    /// Record `n` (0 … 267) of `axis` as stored (a cyclic write of the
+    /// window J401 not yet put back is not in it; see
+    /// [`take_record`](Self::take_record)).
+    pub fn record(&self, axis: u8, n: u16) -> Option<Record> {
+        let (range, options) = Self::record_range(axis, n)?;
+        let options = self.image.get(options).copied().unwrap_or(0);
+        Record::from_bytes(self.image.get(range)?, options)
+    }
+
+    /// Stores record `n` of `axis`;
+    /// the window J401 follows when it shows `n`. `false`: no such record.
+    pub fn set_record(&mut self, axis: u8, n: u16, r: &Record) -> bool {
+        if !self.store_record(axis, n, r) {
+            return false;
+        }
+        if self.record_selector(axis) == n {
+            self.show_record(axis, n);
+        }
+        true
+    }
+
+    fn store_record(&mut self, axis: u8, n: u16, r: &Record) -> bool {
+        let Some((range, options)) = Self::record_range(axis, n) else {
+            return false;
+        };
+        let Some(dst) = self.image.get_mut(range) else {
+            return false;
+        };
+        dst.copy_from_slice(&r.to_bytes());
+        if let Some(b) = self.image.get_mut(options) {
+            *b = r.options & (OPT_RELATIVE | OPT_IMMEDIATE);
+        }
+        true
+    }
+
+    /// Record `n` of `axis` for a start or a jog: the window J401 when it
+    /// shows `n` (with a value a cyclic mapping left in J401\[5\] applied to
+    /// both accelerations), put back into the record; else the record.
+    pub fn take_record(&mut self, axis: u8, n: u16) -> Option<Record> {
+        if n >= RECORDS {
+            return None;
+        }
+        if self.record_selector(axis) != n {
+            return self.record(axis, n);
+        }
+        let r = self.window(axis)?;
+        self.store_record(axis, n, &r);
+        Some(r)
+    }
+
+    /// The window J401 of `axis` as a record: a new value in \[5\] set both
+    /// accelerations; afterwards \[5\] = \[3\].
+    fn window(&mut self, axis: u8) -> Option<Record> {
+        let w = at_axis(J401, axis);
+        let get = |k: u8| self.get(w, data_sub(k)).ok();
+        let all = get(5).and_then(|v| u32::try_from(v).ok()).unwrap_or(0);
+        let mut r = Record {
+            target: i32::try_from(get(0)?).ok()?,
+            profile_velocity: u32::try_from(get(1)?).ok()?,
+            end_velocity: u32::try_from(get(2)?).ok()?,
+            acceleration: u32::try_from(get(3)?).ok()?,
+            deceleration: u32::try_from(get(4)?).ok()?,
+            options: u8::try_from(get(6)?).ok()?,
+        };
+        let seen = self.all_accelerations.get_mut(usize::from(axis))?;
+        if all != *seen {
+            r.acceleration = all;
+            r.deceleration = all;
+            let _ = self.set(w, data_sub(4), i64::from(all));
+        }
+        self.sync_all_accelerations(axis, r.acceleration);
+        Some(r)
+    }
+
+    /// J401\[3\] and \[5\] of `axis` = `acceleration`, synchronised.
+    fn sync_all_accelerations(&mut self, axis: u8, acceleration: u32) {
+        let w = at_axis(J401, axis);
+        let _ = self.set(w, data_sub(3), i64::from(acceleration));
+        let _ = self.set(w, data_sub(5), i64::from(acceleration));
+        if let Some(seen) = self.all_accelerations.get_mut(usize::from(axis)) {
+            *seen = acceleration;
+        }
+    }
+
+    /// Shows record `n` of `axis` in the window J401.
+    fn show_record(&mut self, axis: u8, n: u16) {
+        let Some(r) = self.record(axis, n) else {
+            return;
+        };
+        let w = at_axis(J401, axis);
+        let values = [
+            i64::from(r.target),
+            i64::from(r.profile_velocity),
+            i64::from(r.end_velocity),
+            i64::from(r.acceleration),
+            i64::from(r.deceleration),
+        ];
+        for (k, v) in (0u8..).zip(values) {
+            let _ = self.set(w, data_sub(k), v);
+        }
+        let _ = self.set(w, data_sub(6), i64::from(r.options));
+        self.sync_all_accelerations(axis, r.acceleration);
+    }
+
+    /// Before a bus write of `index`: puts the window back before the
+    /// selector moves.
+    pub(super) fn record_write_check(&mut self, index: u16) {
+        if let Some(axis) = axis_of(index, J400) {
+            let n = self.record_selector(axis);
+            if let Some(r) = self.window(axis) {
+                self.store_record(axis, n, &r);
+            }
+        }
+    }
+
+    /// After a bus write of `index`:`sub`: the window goes through to its
+    /// record, a new selector shows its record.
+    pub(super) fn record_written(&mut self, index: u16, sub: u8, value: Option<i64>) {
+        if let Some(axis) = axis_of(index, J401) {
+            let w = at_axis(J401, axis);
+            let v = value.and_then(|v| u32::try_from(v).ok());
+            match v {
+                Some(v) if sub == data_sub(5) => {
+                    let _ = self.set(w, data_sub(4), i64::from(v));
+                    self.sync_all_accelerations(axis, v);
+                }
+                Some(v) if sub == data_sub(3) => self.sync_all_accelerations(axis, v),
+                _ => {}
+            }
+            let n = self.record_selector(axis);
+            if let Some(r) = self.window(axis) {
+                self.store_record(axis, n, &r);
+            }
+        } else if let Some(axis) = axis_of(index, J400) {
+            let n = self.record_selector(axis);
+            self.show_record(axis, n);
+        }
+    }
+
+    /// After the defaults were restored or a saved set loaded: the record
+    /// memory at its defaults where it is not kept (restore), and every
+    /// window showing its record.
+    pub(super) fn records_reloaded(&mut self, restore: bool) {
+        if restore {
+            for index in [J410, J411, J411.wrapping_add(AXIS_B_MANUFACTURER)] {
+                let Some((_, obj)) = find(index) else { continue };
+                let base = objects::image_offset(index);
+                let len = obj.ram_bytes();
+                if let (Some(dst), Some(src)) = (
+                    self.image.get_mut(base..base + len),
+                    INITIAL_IMAGE.get(base..base + len),
+                ) {
+                    dst.copy_from_slice(src);
+                }
+            }
+        }
+        for axis in [0, 1] {
+            let n = self.record_selector(axis);
+            self.show_record(axis, n);
+        }
+    }
+}
