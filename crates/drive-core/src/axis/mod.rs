@@ -89,10 +89,13 @@ mod feedback;
 mod io;
 mod modes;
 mod params;
+mod records;
 mod running;
 mod snapshot;
 #[cfg(test)]
 mod tests;
+#[cfg(test)]
+mod tests_records;
 mod units;
 mod write_back;
 
@@ -123,12 +126,14 @@ use motion::{
 use nanos::Nanos;
 use od::error_register;
 use running::{MasterTrack, PpState, Running, VelocityCommand};
-use snapshot::{CyclicSlots, Snapshot, Window};
+pub(crate) use snapshot::{CyclicSlots, Snapshot, Window};
 
 pub use cache::AxisCache;
 use cache::CachedSnapshot;
 pub use io::{AxisCommand, AxisIo, AxisReport, IndexLatch, ProbeEdge, SwitchEdge, SwitchId};
 pub use params::AxisParams;
+use records::RecordTasks;
+pub use records::{RecordCommand, RecordStatus, StartRefusal};
 pub use units::{e48, scaled_gains, GAIN_REFERENCE_CYCLE_NS};
 use units::{jerk, override_factor, ramp_rate, round_i32, sat_i32, sourced};
 
@@ -251,6 +256,8 @@ pub struct Axis {
     velocity_decimals: f32,
     /// Endless axis (I00 = 1) with 607Bh:02 > 0, user units (C-111).
     modulo: Option<ModuloAxis>,
+    /// Record positioning in pp (`records.rs`).
+    tasks: RecordTasks,
 }
 
 impl Axis {
@@ -309,6 +316,7 @@ impl Axis {
             scaling: AxisScaling::INCREMENTAL,
             velocity_decimals: 1.0,
             modulo: None,
+            tasks: RecordTasks::default(),
         }
     }
 
@@ -550,6 +558,9 @@ impl Axis {
         let fault = self.on_transition(out.transition, od);
 
         self.touch_probe(o, io, actual, now_ns);
+        if self.tasks.command.is_some() && matches!(self.running, Running::ProfilePosition(_)) {
+            self.record_inputs(od, raw);
+        }
 
         let demand = self.motion(o, &out, io, &mut actual, i199, now_ns, dt_ns, new_setpoint);
         let (torque, bits, fe) = self.control(demand, actual, now_ns, dt_ns);
@@ -711,6 +722,9 @@ impl Axis {
                 bits: SW_MODE_BIT12,
                 ..Demand::hold(*actual)
             },
+            Running::ProfilePosition(_) if self.tasks.command.is_some() => {
+                self.record_position(o, halt, *actual, i199, now_ns, dt_ns)
+            }
             Running::ProfilePosition(pp) => self.profile_position(pp, o, halt, *actual, now_ns, dt_ns),
             Running::ProfileVelocity(pv) => self.profile_velocity(pv, o, halt, now_ns, dt_ns),
             Running::ProfileTorque { torque } => self.profile_torque(torque, o, dt_ns, *actual),

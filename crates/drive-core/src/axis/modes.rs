@@ -28,6 +28,7 @@ impl Axis {
             Mode::ProfileTorque => {}
             Mode::Homing => self.homing.activate(actual),
             Mode::ProfilePosition => {
+                self.tasks.reset();
                 // entered while moving (from pv, vl, jog): no target yet, so
                 // brake with 6084h instead of cruising on
                 self.profile.take_over(self.sp_pos, self.sp_vel);
@@ -532,12 +533,27 @@ impl Axis {
             deceleration: p.jog_deceleration,
             jerk: p.jog_jerk,
         };
+        self.jog_with(jog, dir, limits, dt_ns)
+    }
+
+    /// The core's jog: `dir` (+1, −1, 0 = stop) at `limits.velocity` with
+    /// `limits`' ramps; under position control (I26 = 1) it stops before a
+    /// software limit (C-092). A changed velocity re-plans. Jog mode (−1)
+    /// and the jog records (259/260, `records.rs`) run on it.
+    pub(super) fn jog_with(
+        &mut self,
+        jog: &mut VelocityCommand,
+        dir: f32,
+        limits: ProfileLimits,
+        dt_ns: u32,
+    ) -> Demand {
+        let p = self.params;
         let referenced = self.is_referenced();
         let soft = referenced && self.limits.config().software_limits_configured();
-        let target = self.lock.filter_velocity(dir * p.jog_velocity);
+        let target = self.lock.filter_velocity(dir * limits.velocity);
         if jog.commanded != Some(target) {
             let ok = if target == 0.0 {
-                self.profile.stop(p.jog_deceleration, p.jog_jerk).is_ok()
+                self.profile.stop(limits.deceleration, limits.jerk).is_ok()
             } else if p.jog_position_control && soft {
                 // C-092: stop before the software limit
                 let far = if target > 0.0 { i32::MAX } else { i32::MIN };
