@@ -139,8 +139,8 @@ impl TickClock {
 /// The drive on PROFINET as this image runs it.
 pub type Drive = drive_pn::PnDrive<firmware::ParamFlash>;
 
-/// The identity of this image: the MAC from the controller (QEMU's
-/// `mac=`), the port MACs next to it.
+/// The identity of this image: the station address the LAN9118 reports
+/// (QEMU's `macaddr=`), the port MACs next to it.
 fn hardware(mac: [u8; 6]) -> drive_pn::Hardware {
     let port = |k: u8| {
         let mut m = mac;
