@@ -1,11 +1,9 @@
 //! A simulated drive on PROFINET ([`PnSim`]): the firmware's drive
 //! personality (`drive_pn`: the PROFINET IO device in front of the
-//! fieldbus-neutral drive core) with a motor on each axis, its control
-//! cycle run at A150, and the drive's side of the cyclic data as a loop-back
-//! until the profile maps telegrams (issue 17): what the controller writes
-//! into the drive's IN module comes back in its OUT module, so a controller
-//! can check round trips. A control channel ([`Command`]) raises drive
-//! events and acknowledges faults. `hil-sim serve --fieldbus profinet` runs
+//! fieldbus-neutral drive core, with the PROFIdrive-style profile on its
+//! cyclic data) with a motor on each axis, its control cycle run at A150. A
+//! control channel ([`Command`]) raises drive events and acknowledges
+//! faults. `hil-sim serve --fieldbus profinet` runs
 //! it on a raw interface (`cli/serve_pn.rs`).
 
 use std::collections::VecDeque;
@@ -18,7 +16,7 @@ use nanos::Nanos;
 use profinet::cm::{CmEvent, Im0, ImData, RecordHook};
 use profinet::dcp::server::Event as DcpEvent;
 use profinet::dcp::{IpSuite, NameOfStation};
-use profinet::device::{Device, DeviceEvent, RtEvent, MAX_MODULE_BYTES};
+use profinet::device::{Device, DeviceEvent, RtEvent};
 use profinet::model;
 use profinet::rpc::uuid::Uuid;
 use profinet::wire::MacAddr;
@@ -160,8 +158,10 @@ pub enum Command {
         /// The E43 cause (S, 0…15).
         cause: u8,
     },
-    /// Acknowledge the fault of `axis`: controlword bit 7 (C-017), which
-    /// the profile's CW1 bit 7 will carry (issue 17).
+    /// Acknowledge the fault of `axis`: controlword bit 7 (C-017), as the
+    /// drive's own acknowledgement input would; while a controller sends
+    /// CW1 the profile writes the controlword of axis A every cycle, and
+    /// CW1 bit 7 is the acknowledgement there.
     Reset {
         /// 0 = A, 1 = B.
         axis: usize,
@@ -211,10 +211,8 @@ impl Command {
 
 /// A simulated drive on PROFINET: the firmware's drive personality
 /// ([`drive_pn::PnDrive`]: the device, the object dictionary, both axes, the
-/// parameter store) with a motor on each axis, its control cycle run at A150
-/// on the caller's clock, and the cyclic data looped back (what the
-/// controller writes into the drive's IN module comes back in its OUT
-/// module) until the profile maps telegrams (issue 17).
+/// parameter store, the PROFIdrive profile on the cyclic data) with a motor
+/// on each axis, its control cycle run at A150 on the caller's clock.
 pub struct PnSim {
     drive: drive_pn::PnDrive<SimFlash>,
     motors: [Motor; 2],
@@ -305,7 +303,6 @@ impl PnSim {
         let events = &mut self.events;
         self.drive
             .receive(now, frame, tx, &mut |e| events.push_back(e.clone()));
-        self.echo();
     }
 
     /// The control cycles due at `now`, then the device's timers; returns
@@ -313,7 +310,6 @@ impl PnSim {
     /// device's deadline).
     pub fn poll(&mut self, now: Nanos, tx: &mut impl FnMut(&[u8])) -> Nanos {
         self.run_due_cycles(now);
-        self.echo();
         let events = &mut self.events;
         let next = self.drive.poll(now, tx, &mut |e| events.push_back(e.clone()));
         next.min(self.next_cycle)
@@ -408,37 +404,6 @@ impl PnSim {
                 let _ = self.drive.objects_mut().set(index, 0, word);
             }
         }
-    }
-
-    /// The drive's application until the profile maps telegrams: the first
-    /// IN module's current output data (controller → drive) is copied into
-    /// the first OUT module's inputs (drive → controller), as far as both
-    /// reach. Nothing changes while the outputs are not current.
-    fn echo(&mut self) {
-        let device = self.drive.device_mut();
-        let mut to_drive = None;
-        let mut from_drive = None;
-        for (slot, _, to) in device.data_modules() {
-            match to {
-                true if to_drive.is_none() => to_drive = Some(slot),
-                false if from_drive.is_none() => from_drive = Some(slot),
-                _ => {}
-            }
-        }
-        let (Some(src), Some(dst)) = (to_drive, from_drive) else {
-            return;
-        };
-        let mut buf = [0u8; MAX_MODULE_BYTES];
-        let Some(n) = device.output_data(src).map(|d| {
-            let n = d.len().min(buf.len());
-            buf.get_mut(..n)
-                .unwrap_or_default()
-                .copy_from_slice(d.get(..n).unwrap_or_default());
-            n
-        }) else {
-            return;
-        };
-        device.set_input_data(dst, buf.get(..n).unwrap_or_default());
     }
 }
 

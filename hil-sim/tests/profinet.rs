@@ -9,8 +9,9 @@
 //!   drive by its MAC), DCP Set name and IP (permanent), Identify by name,
 //!   I&M0 through an RPC read, Connect with the GSDML's DAP and the manual's
 //!   example modules, PrmEnd, ApplicationReady, Release, a Connect with a wrong
-//!   module (ModuleDiff), ≥ 10 s of cyclic data at 1 ms with the drive echoing
-//!   its outputs, a drive fault (raised through serve's control channel) as
+//!   module (ModuleDiff), ≥ 10 s of cyclic data at 1 ms through the PROFIdrive
+//!   profile (telegram 1: the enable sequence in CW1/ZSW1, 100 rpm, a PKW
+//!   read), a drive fault (raised through serve's control channel) as
 //!   a diagnosis alarm that profinet-py acknowledges and that disappears
 //!   after the fault reset, and the AR's abort when the controller stops
 //!   sending. The figure "DCP identify to first valid cyclic data" goes to
@@ -288,11 +289,15 @@ fn step_lines<'a>(lines: &'a [String], step: &str) -> Vec<&'a str> {
 
 /// P-008 (Identify), P-007/P-010 (DCP Set name and IP), P-039 (I&M0), P-027
 /// (Connect, PrmEnd, ApplicationReady, Release), P-029 (ModuleDiff), P-042
-/// and P-036 (cyclic data, echo), Q-07 (the AR aborted when the controller
-/// goes silent), all with profinet-py as the controller; every frame of the
-/// device dissected by Wireshark without a warning.
+/// (cyclic data), P-110…P-114 and P-223 (the profile's telegram 1: the
+/// enable sequence answered in ZSW1, a speed set-point seen in PNU 1101),
+/// P-191 (a PKW read), P-030/P-035/P-085 (a drive fault as a diagnosis
+/// alarm, acknowledged by CW1 bit 7), P-036 and Q-07 (the AR aborted when the
+/// controller goes silent), all with profinet-py as the controller; every
+/// frame of the device dissected by Wireshark without a warning.
 #[test]
-fn p008_p027_p029_p030_p035_p036_p042_profinet_py_names_connects_faults_and_loses_the_drive() {
+fn p008_p027_p029_p030_p035_p036_p042_p085_p110_p191_p223_profinet_py_names_connects_drives_and_loses_the_drive(
+) {
     let python = match profinet_py_python() {
         Ok(p) => p,
         Err(why) => {
@@ -334,6 +339,7 @@ fn p008_p027_p029_p030_p035_p036_p042_profinet_py_names_connects_faults_and_lose
             line.control.to_str().unwrap(),
             "--drives",
             &DRIVES.to_string(),
+            "--motor",
             "--fault-event",
             &FAULT_EVENT.to_string(),
             "--fault-cause",
@@ -382,7 +388,6 @@ fn p008_p027_p029_p030_p035_p036_p042_profinet_py_names_connects_faults_and_lose
         ": aborted (Local)".into(),
         format!("axis A: event {FAULT_EVENT} cause {FAULT_CAUSE} raised"),
         "diagnosis appears: axis A Fault".into(),
-        "axis A: fault acknowledged (controlword bit 7)".into(),
         "diagnosis disappears:".into(),
         "alarms: 2 sent, 2 acknowledged".into(),
         "device counters:".into(),

@@ -31,6 +31,7 @@ pub mod objects;
 pub mod params;
 pub mod pdo_image;
 pub mod pdo_maps;
+pub mod user_units;
 
 pub use dictionary::{
     revision, DriveObjects, ImageError, LiveValues, NoLive, Requests, Slot, Template, WithLive,

@@ -68,6 +68,7 @@ use profinet::profienergy::ProfiEnergy;
 use store::{Flash, ParamStore};
 
 pub mod energy;
+pub mod profile;
 pub mod settings;
 pub use energy::{DriveEnergy, PnRecords};
 pub use settings::Hardware;
@@ -124,6 +125,8 @@ pub struct PnDrive<F: Flash, H: RecordHook = NoRecords> {
     exchanged: bool,
     /// Each axis' power stage was on in the last control cycle.
     powered: [bool; 2],
+    /// The PROFIdrive-style profile on axis A (issue 17).
+    profile: profile::Profile,
 }
 
 impl<F: Flash> PnDrive<F, NoRecords> {
@@ -144,6 +147,8 @@ impl<F: Flash, H: RecordHook> PnDrive<F, H> {
         let startup = load(&mut store, &mut objects);
         let active = objects.get(A270, 0) != Ok(0);
         let config = settings::device_config(&mut objects, hw);
+        let axes_a = Axis::new(0);
+        let profile = profile::Profile::new(&mut objects, &axes_a);
         PnDrive {
             device: Device::new(
                 config,
@@ -159,11 +164,12 @@ impl<F: Flash, H: RecordHook> PnDrive<F, H> {
             active,
             dropped_inactive: 0,
             temporary: Temporary::default(),
-            axes: [Axis::new(0), Axis::new(1)],
+            axes: [axes_a, Axis::new(1)],
             caches: [AxisCache::new(), AxisCache::new()],
             raised: [None; 2],
             exchanged: false,
             powered: [false; 2],
+            profile,
         }
     }
 
@@ -430,6 +436,7 @@ impl<F: Flash, H: RecordHook> PnDrive<F, H> {
             io
         });
         let new = core::mem::take(&mut self.exchanged) || !self.device.exchanging();
+        self.profile_receive();
         let mut commands = [AxisCommand::OFF; 2];
         for (i, ((axis, cache), io)) in self
             .axes
@@ -471,7 +478,79 @@ impl<F: Flash, H: RecordHook> PnDrive<F, H> {
             *command = report.command;
         }
         self.powered = commands.map(|c| c.power_stage);
+        self.profile_respond();
         commands
+    }
+
+    /// The profile (telegrams, CW1/ZSW1, PKW).
+    pub fn profile(&self) -> &profile::Profile {
+        &self.profile
+    }
+
+    /// The data modules: (controller → drive slot, drive → controller slot).
+    fn data_slots(&self) -> (Option<u16>, Option<u16>) {
+        let (mut to_drive, mut from_drive) = (None, None);
+        for (slot, _, to) in self.device.data_modules() {
+            match to {
+                true if to_drive.is_none() => to_drive = Some(slot),
+                false if from_drive.is_none() => from_drive = Some(slot),
+                _ => {}
+            }
+        }
+        (to_drive, from_drive)
+    }
+
+    /// The received telegram into the objects and axis A (before the axes'
+    /// cycle), while the outputs are current.
+    fn profile_receive(&mut self) {
+        let (Some(slot), _) = self.data_slots() else {
+            return;
+        };
+        let mut frame = [0u8; profinet::device::MAX_MODULE_BYTES];
+        let Some(n) = self.device.output_data(slot).map(|d| {
+            let n = d.len().min(frame.len());
+            if let (Some(dst), Some(src)) = (frame.get_mut(..n), d.get(..n)) {
+                dst.copy_from_slice(src);
+            }
+            n
+        }) else {
+            return;
+        };
+        let Some(data) = frame.get(..n) else {
+            return;
+        };
+        let [axis, _] = &mut self.axes;
+        self.profile.receive(data, &mut self.objects, axis);
+        if self.profile.take_save_request() {
+            // PNU 971: the parameters and the records (one image)
+            let _ = self.save();
+            self.profile.save_done();
+        }
+    }
+
+    /// The response telegram into the input data (after the axes' cycle).
+    fn profile_respond(&mut self) {
+        let (_, Some(slot)) = self.data_slots() else {
+            return;
+        };
+        let Some(len) = self
+            .device
+            .data_modules()
+            .find(|(s, _, _)| *s == slot)
+            .map(|(_, l, _)| l)
+        else {
+            return;
+        };
+        let mut buf = [0u8; profinet::device::MAX_MODULE_BYTES];
+        let Some(out) = buf.get_mut(..len) else {
+            return;
+        };
+        let [axis, _] = &self.axes;
+        if let Some(n) = self.profile.respond(&mut self.objects, axis, out) {
+            if let Some(data) = buf.get(..n) {
+                self.device.set_input_data(slot, data);
+            }
+        }
     }
 }
 

@@ -9,8 +9,8 @@ use profinet::ip::{Endpoint, IpConfig, Stack, UdpTx, RPC_PORT, UDP_PAYLOAD_OFFSE
 use profinet::wire::{EthFrame, MacAddr};
 use std::vec::Vec;
 
-const OUR: MacAddr = MacAddr([2, 0, 0, 0, 0, 0x50]);
-const CTRL: MacAddr = MacAddr([2, 0, 0, 0, 0, 0xC0]);
+pub(crate) const OUR: MacAddr = MacAddr([2, 0, 0, 0, 0, 0x50]);
+pub(crate) const CTRL: MacAddr = MacAddr([2, 0, 0, 0, 0, 0xC0]);
 
 #[path = "../../profinet/src/cm/tests_vectors.rs"]
 #[allow(dead_code)]

@@ -181,7 +181,7 @@ mod app {
     use firmware::ParamFlash;
     use nanos::Nanos;
     use profinet::cm::CmEvent;
-    use profinet::device::{DeviceEvent, RtEvent, MAX_MODULE_BYTES};
+    use profinet::device::{DeviceEvent, RtEvent};
 
     #[shared]
     struct Shared {
@@ -340,7 +340,6 @@ mod app {
                     }
                 }
             }
-            echo(drive);
             *deadline = drive.poll(now, &mut send, &mut log_event);
             if now >= *next_report {
                 *next_report = now.saturating_add(Nanos::from_ms(10_000));
@@ -360,39 +359,6 @@ mod app {
                 rtic::pend(Interrupt::ETHERNET);
             }
         });
-    }
-
-    /// The drive's application in this test image, as `hil-sim serve`'s
-    /// (until the profile maps telegrams): the first IN module's current
-    /// output data (controller → drive) copied into the first OUT module's
-    /// inputs (drive → controller), as far as both reach; nothing while the
-    /// outputs are not current.
-    fn echo(drive: &mut Drive) {
-        let device = drive.device_mut();
-        let (mut to_drive, mut from_drive) = (None, None);
-        for (slot, _, to) in device.data_modules() {
-            match to {
-                true if to_drive.is_none() => to_drive = Some(slot),
-                false if from_drive.is_none() => from_drive = Some(slot),
-                _ => {}
-            }
-        }
-        let (Some(src), Some(dst)) = (to_drive, from_drive) else {
-            return;
-        };
-        let mut buf = [0u8; MAX_MODULE_BYTES];
-        let Some(n) = device.output_data(src).map(|d| {
-            let n = d.len().min(buf.len());
-            if let (Some(b), Some(d)) = (buf.get_mut(..n), d.get(..n)) {
-                b.copy_from_slice(d);
-            }
-            n
-        }) else {
-            return;
-        };
-        if let Some(b) = buf.get(..n) {
-            device.set_input_data(dst, b);
-        }
     }
 
     /// One line per device event the operator cares about.

@@ -264,7 +264,9 @@ pub fn serve(args: &ServeArgs) -> Result<(), String> {
             d.drive().control_period().as_us()
         );
     }
-    println!("each drive echoes its outputs into its inputs (until the profile maps telegrams)");
+    println!(
+        "each drive runs the PROFIdrive profile (the Example Function block's telegrams) on its cyclic data"
+    );
     if let Some(c) = &control {
         println!(
             "control channel: {} ([@K] fault A|B EVENT CAUSE, reset A|B, status)",

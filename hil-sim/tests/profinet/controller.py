@@ -17,14 +17,19 @@ both bind UDP 34964) and goes step by step, one line per result:
 (f) Release (answered);
 (g) Connect with a wrong module ident: a ModuleDiff block, then Release;
 (h) DCP Identify by name again, Connect, cyclic data at the shortest cycle
-    profinet-py runs (1 ms) for --cyclic-seconds, the drive echoing its
-    outputs into its inputs; prints the figure "DCP identify to first valid
+    profinet-py runs (1 ms) for --cyclic-seconds through the PROFIdrive
+    profile: receive telegram 1 (speed control) of the Example Function
+    block, CW1 0x0400 -> 0x0406 -> 0x0407 -> 0x040F answered by ZSW1's
+    states, 100 rpm through PNU 1010 and CW1 bits 4-6 seen in the vl
+    demand 6043h (a PKW read of a CANopen object) and, with --motor, in PNU
+    1101, a PKW read of PNU 964.0 after the 0x00 toggle, the set-point disabled (bit 6) and the drive
+    switched off again; prints the figure "DCP identify to first valid
     cyclic data";
 (i) a drive fault (event --fault-event, cause --fault-cause on axis A,
     raised through serve's control channel --control) arrives as a
     diagnosis alarm at the drive (slot 0, subslot 1) with ChannelErrorType
     0x1000 + event and ExtChannelErrorType 0x1000 + cause; profinet-py
-    acknowledges it; after the fault reset (control channel) the diagnosis
+    acknowledges it; after the fault reset (CW1 bit 7) the diagnosis
     disappears with a "Diagnosis disappears" alarm (which the device sends
     only once the first one was acknowledged);
     (skipped without --control: a device without a control channel, such
@@ -166,6 +171,11 @@ def main():
         "fault injection, e.g. the firmware in QEMU)",
     )
     ap.add_argument("--drives", type=int, default=1, help="drives serve runs on the line")
+    ap.add_argument(
+        "--motor",
+        action="store_true",
+        help="the device has motors (hil-sim serve): step (h) also checks the actual velocity",
+    )
     ap.add_argument("--fault-event", type=int, default=44)
     ap.add_argument("--fault-cause", type=int, default=1)
     a = ap.parse_args()
@@ -356,8 +366,8 @@ def main():
             f"{': ' + items if items else ''}"
         )
 
-    # (h) cyclic data at 1 ms, the drive echoing; (i) a drive fault as a
-    # diagnosis alarm; (j) the controller goes silent
+    # (h) cyclic data at 1 ms through the profile's telegrams; (i) a drive
+    # fault as a diagnosis alarm; (j) the controller goes silent
     def cyclic():
         # 1 ms = send clock 32 x 31.25 us, reduction ratio 1: profinet-py's
         # CyclicController refuses anything shorter. The watchdog (and data
@@ -396,37 +406,107 @@ def main():
                 f"factor 0x80, so the device answers after its MAC's share of up to 1.28 s)",
                 flush=True,
             )
-            start = time.monotonic()
-            patterns = 0
-            back = 0
-            worst = 0.0
-            total = 0.0
-            while time.monotonic() - start < a.cyclic_seconds:
-                patterns += 1
-                data = bytes((patterns + i) & 0xFF for i in range(out_slot.output_length))
+            # the profile (issue 17) on the cyclic data: receive telegram 1
+            # (speed control) of the Example Function block, response 0xF1
+            def telegram1(cw1, rpm=0, ramps=10_000, pkw=bytes(8)):
+                t = bytearray(out_slot.output_length)
+                t[0] = 0xE1
+                t[2:4] = cw1.to_bytes(2, "big")
+                t[4:8] = rpm.to_bytes(4, "big", signed=True)
+                t[16:20] = ramps.to_bytes(4, "big")
+                t[24:32] = pkw
+                return bytes(t)
+
+            def zsw1(r):
+                return int.from_bytes(r[2:4], "big")
+
+            def i32(r, at):
+                return int.from_bytes(r[at : at + 4], "big", signed=True)
+
+            def send_until(data, pred, timeout=2.0):
                 ctl.set_output_data(out_slot.slot, out_slot.subslot, data)
-                sent = time.monotonic()
-                while time.monotonic() - sent < 0.5:
-                    got = ctl.get_input_data(in_slot.slot, in_slot.subslot)
-                    if got is not None and got[:n] == data[:n]:
-                        rtt = time.monotonic() - sent
-                        back += 1
-                        worst = max(worst, rtt)
-                        total += rtt
-                        break
+                t0 = time.monotonic()
+                while time.monotonic() - t0 < timeout:
+                    r = ctl.get_input_data(in_slot.slot, in_slot.subslot)
+                    if r is not None and pred(r):
+                        return time.monotonic() - t0, r
                     time.sleep(0.0005)
+                return None, ctl.get_input_data(in_slot.slot, in_slot.subslot)
+
+            start = time.monotonic()
+            results = []
+
+            def expect(what, data, pred, timeout=2.0, show=None):
+                dt, r = send_until(data, pred, timeout)
+                seen = "nothing" if r is None else (show(r) if show else f"{r[0]:#04x} ZSW1 {zsw1(r):#06x}")
+                results.append((dt is not None, f"{what}: {'%.0f ms' % (1000 * dt) if dt is not None else 'not within %.0f s' % timeout} ({seen})"))
+                return r
+
+            for cw1, want, name in [
+                (0x0400, 0x40, "switching on inhibited"),
+                (0x0406, 0x01, "ready for switching on"),
+                (0x0407, 0x03, "switched on"),
+                (0x040F, 0x07, "operation"),
+            ]:
+                expect(
+                    f"CW1 {cw1:#06x} -> {name}",
+                    telegram1(cw1),
+                    lambda r, want=want: r[0] == 0xF1 and r[1] == 0x08 and zsw1(r) & 0x47 == want,
+                )
+            def pkw_read(index, sub):
+                return bytes([0x41, index >> 8, index & 0xFF, sub, 0, 0, 0, 0])
+
+            ctl.set_output_data(out_slot.slot, out_slot.subslot, telegram1(0x047F, 100))
+            time.sleep(0.5)
+            # the vl mode's velocity demand 6043h, a CANopen object through PKW (P-194)
+            expect(
+                "100 rpm (bits 4-6, PNU 1010) -> vl demand 6043h read through PKW",
+                telegram1(0x047F, 100, pkw=pkw_read(0x6043, 0)),
+                lambda r: r[24] == 0x41 and abs(i32(r, 28) - 100) <= 1 and zsw1(r) & 0x47 == 0x07,
+                show=lambda r: f"code {r[24]:#04x} value {i32(r, 28)}, ZSW1 {zsw1(r):#06x}",
+            )
+            if a.motor:
+                expect(
+                    "the motor at 100 rpm -> PNU 1101",
+                    telegram1(0x047F, 100, pkw=pkw_read(0x6043, 0)),
+                    lambda r: abs(i32(r, 8) - 100) <= 2,
+                    timeout=3.0,
+                    show=lambda r: f"{i32(r, 8)} rpm",
+                )
+            # two reads in a row: 0x00 in between, mirrored (P-193)
+            expect("PKW toggle 0x00", telegram1(0x047F, 100), lambda r: r[24] == 0x00, show=lambda r: f"code {r[24]:#04x}")
+            vendor = a.vendor_id.to_bytes(4, "big")
+            expect(
+                "PKW read of PNU 964.0",
+                telegram1(0x047F, 100, pkw=pkw_read(964, 0)),
+                lambda r: r[24] == 0x41 and r[28:32] == vendor,
+                show=lambda r: f"code {r[24]:#04x} value {r[28:32].hex()}",
+            )
+            expect(
+                "bit 6 = 0 -> 0 rpm",
+                telegram1(0x043F),
+                lambda r: abs(i32(r, 8)) <= 2,
+                timeout=3.0,
+                show=lambda r: f"{i32(r, 8)} rpm",
+            )
+            expect("CW1 0x0406 -> ready for switching on", telegram1(0x0406), lambda r: zsw1(r) & 0x47 == 0x01)
+            # the rest of the time: the response keeps coming
+            answered = 0
+            while time.monotonic() - start < a.cyclic_seconds:
+                r = ctl.get_input_data(in_slot.slot, in_slot.subslot)
+                if r is not None and r[0] == 0xF1 and zsw1(r) & 0x47 == 0x01:
+                    answered += 1
                 time.sleep(0.05)
             elapsed = time.monotonic() - start
             st = ctl.stats
-            ok = back == patterns and patterns > 0 and ctl.is_running
+            ok = all(k for k, _ in results) and answered > 0 and ctl.is_running
             report(
                 "h",
                 ok,
-                f"{elapsed:.1f} s of cyclic data at {setup.cycle_time_ms:g} ms: {back}/{patterns} patterns echoed "
-                f"({n} bytes, slot {out_slot.slot} -> slot {in_slot.slot}), round trip mean "
-                f"{1000 * total / max(back, 1):.1f} ms max {1000 * worst:.1f} ms; frames sent {st.frames_sent} "
-                f"received {st.frames_received} missed {st.frames_missed} invalid {st.frames_invalid}; "
-                f"state {ctl.state.value}",
+                f"{elapsed:.1f} s of cyclic data at {setup.cycle_time_ms:g} ms with the profile's telegram 1: "
+                + "; ".join(t for _, t in results)
+                + f"; frames sent {st.frames_sent} received {st.frames_received} missed {st.frames_missed} "
+                f"invalid {st.frames_invalid}; state {ctl.state.value}",
             )
 
             # (i) a drive fault: appears, acknowledged, disappears after the reset
@@ -454,8 +534,11 @@ def main():
                 if not ctl.is_running:
                     report("i", False, f"the AR ended after the alarm: {ctl.state.value}")
                     return
+                # the acknowledgement: a rising edge of CW1 bit 7 (P-085)
                 seen = len(alarms)
-                control("reset A")
+                ctl.set_output_data(out_slot.slot, out_slot.subslot, telegram1(0x0406))
+                time.sleep(0.05)
+                ctl.set_output_data(out_slot.slot, out_slot.subslot, telegram1(0x0486))
                 t0 = time.monotonic()
                 gone = wait_alarm(seen, 5.0)
                 if gone is None:

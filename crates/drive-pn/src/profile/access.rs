@@ -1,0 +1,471 @@
+//! The drive's parameters as the PROFIdrive profile sees them
+//! ([`profidrive::ParamAccess`]): the PNU catalogue ([`super::pnu`]) with
+//! its unit conversions, and every CANopen object of the drive as it is
+//! (P-045, P-194: in the CiA 402 factor group's units), both through the
+//! core's object dictionary with its access, range and state checks.
+
+use super::pnu::{self, Jog, RecordField, Source, Unit};
+use drive_core::axis::Axis;
+use drive_core::faults::E82_INACTIVE;
+use drive_core::objects::records::{Record, JOG_NEGATIVE, JOG_POSITIVE};
+use drive_core::params::{E43, E82};
+use drive_core::user_units::UserUnits;
+use drive_core::DriveObjects;
+use motion::units::UnitProfile;
+use motion::INCREMENTS_PER_REVOLUTION;
+use od::{CommState, DataType, Dictionary, SdoAbort};
+use profidrive::{Addr, Completion, Describe, ParamAccess, PdError};
+use profinet::model;
+
+/// The profile's own values, kept between cycles.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
+pub struct OwnValues {
+    /// CW1 as last received or written (967).
+    pub cw1: u16,
+    /// ZSW1 as last computed (968).
+    pub zsw1: u16,
+    /// The homing method in PROFIdrive numbering (1050).
+    pub homing_method: i8,
+    /// 2415h.02 current limit, mA.
+    pub current_limit_ma: i32,
+    /// 2416h.02 speed limit.
+    pub speed_limit: i32,
+    /// A save asked through PNU 971 and not yet done.
+    pub save_requested: bool,
+    /// A save is running or asked (PNU 971 reads 1).
+    pub saving: bool,
+}
+
+/// The PNU 1050 methods and the core's 6098h codes (spec §8.5: the
+/// numbering differs from CiA 402 for index pulse, current position and
+/// the mechanical stop; −23/−27 have no core method).
+pub const HOMING_METHODS: [(i8, i8); 14] = [
+    (-18, -1),
+    (-17, -2),
+    (-2, -3),
+    (-1, -4),
+    (1, 1),
+    (2, 2),
+    (7, 7),
+    (11, 11),
+    (17, 17),
+    (18, 18),
+    (23, 23),
+    (27, 27),
+    (32, 33),
+    (33, 34),
+];
+
+/// The 6098h code of PROFIdrive method `m` (34 → 37, current position).
+pub fn core_homing_method(m: i8) -> Option<i8> {
+    if m == 34 {
+        return Some(37);
+    }
+    HOMING_METHODS
+        .iter()
+        .find(|(pd, _)| *pd == m)
+        .map(|(_, core)| *core)
+}
+
+/// An SDO abort as the PROFIdrive error it means.
+pub fn pd_error(a: SdoAbort) -> PdError {
+    match a {
+        SdoAbort::NO_OBJECT => PdError::IMPERMISSIBLE_PNU,
+        SdoAbort::NO_SUBINDEX => PdError::FAULTY_SUBINDEX,
+        SdoAbort::READ_ONLY | SdoAbort::WRITE_ONLY | SdoAbort::UNSUPPORTED_ACCESS => PdError::CANNOT_CHANGE,
+        SdoAbort::VALUE_TOO_HIGH | SdoAbort::VALUE_TOO_LOW | SdoAbort::MAX_BELOW_MIN => {
+            PdError::LIMIT_EXCEEDED
+        }
+        SdoAbort::INVALID_VALUE => PdError::VALUE_IMPERMISSIBLE,
+        SdoAbort::TYPE_MISMATCH | SdoAbort::LENGTH_TOO_HIGH | SdoAbort::LENGTH_TOO_LOW => {
+            PdError::INCORRECT_DATA_TYPE
+        }
+        _ => PdError::NOT_IN_STATE,
+    }
+}
+
+fn size(t: DataType) -> usize {
+    match t {
+        DataType::Bool | DataType::I8 | DataType::U8 => 1,
+        DataType::I16 | DataType::U16 => 2,
+        DataType::I32 | DataType::U32 | DataType::F32 => 4,
+        _ => 8,
+    }
+}
+
+fn signed(t: DataType) -> bool {
+    matches!(t, DataType::I8 | DataType::I16 | DataType::I32 | DataType::I64)
+}
+
+/// The drive as the profile reaches it, for one cycle or one request.
+pub struct DriveAccess<'a> {
+    /// The object dictionary.
+    pub objects: &'a mut DriveObjects,
+    /// The axis the profile drives (A).
+    pub axis: &'a Axis,
+    /// The PROFINET units of the PNUs.
+    pub units: &'a UnitProfile,
+    /// The profile's own values.
+    pub own: &'a mut OwnValues,
+}
+
+impl DriveAccess<'_> {
+    fn index(&self, index: u16) -> u16 {
+        if (0x6000..0x6800).contains(&index) {
+            self.axis.cia402_index(index)
+        } else if (0x2000..0x6000).contains(&index) {
+            self.axis.manufacturer_index(index)
+        } else {
+            index
+        }
+    }
+
+    fn user_units(&self) -> UserUnits {
+        UserUnits::read(self.objects, self.axis)
+    }
+
+    /// An object's value through the dictionary (Op, its access rules).
+    fn read_object(&mut self, index: u16, sub: u8) -> Result<i64, PdError> {
+        let info = self
+            .objects
+            .object(index)
+            .ok_or(PdError::IMPERMISSIBLE_PNU)?
+            .entry(sub)
+            .ok_or(PdError::FAULTY_SUBINDEX)?;
+        let t = info.data_type;
+        let mut buf = [0u8; 8];
+        let n = self
+            .objects
+            .read(index, sub, &mut buf, CommState::Op)
+            .map_err(pd_error)?;
+        let mut v: u64 = 0;
+        for (k, b) in buf.iter().take(n.min(8)).enumerate() {
+            v |= u64::from(*b) << (8 * k);
+        }
+        let bits = 8 * n.min(8) as u32;
+        Ok(
+            if signed(t) && bits < 64 && bits > 0 && v & (1 << (bits - 1)) != 0 {
+                (v | (u64::MAX << bits)) as i64
+            } else {
+                v as i64
+            },
+        )
+    }
+
+    fn write_object(&mut self, index: u16, sub: u8, value: i64) -> Result<(), PdError> {
+        let info = self
+            .objects
+            .object(index)
+            .ok_or(PdError::IMPERMISSIBLE_PNU)?
+            .entry(sub)
+            .ok_or(PdError::FAULTY_SUBINDEX)?;
+        let n = size(info.data_type);
+        let bytes = value.to_le_bytes();
+        let data = bytes.get(..n).ok_or(PdError::INCORRECT_DATA_TYPE)?;
+        self.objects
+            .write(index, sub, data, CommState::Op)
+            .map_err(pd_error)
+    }
+
+    /// Bus units → the object's units.
+    fn to_object(&self, unit: Unit, bus: i64) -> Result<i64, PdError> {
+        let u = self.user_units();
+        let range = PdError::LIMIT_EXCEEDED;
+        Ok(match unit {
+            Unit::None => bus,
+            Unit::Position => {
+                let inc = self.units.position.from_bus(bus).map_err(|_| range)?;
+                u.position_from_increments(inc).ok_or(range)?
+            }
+            // the integer path: exact to the increment (f32 is not, above 2^24)
+            Unit::Velocity => {
+                u.velocity_from_increments(self.units.velocity.from_bus(bus).map_err(|_| range)? as f64)
+            }
+            Unit::Acceleration => u.acceleration_from_increments(
+                self.units.acceleration.from_bus(bus).map_err(|_| range)? as f64,
+            ),
+            Unit::Rpm => rpm_of(self.units.velocity.from_bus(bus).map_err(|_| range)? as f64),
+            Unit::RpmPerSecond => rpm_of(self.units.acceleration.from_bus(bus).map_err(|_| range)? as f64),
+        })
+    }
+
+    /// The object's units → bus units.
+    fn to_bus(&self, unit: Unit, object: i64) -> Result<i64, PdError> {
+        let u = self.user_units();
+        let range = PdError::LIMIT_EXCEEDED;
+        let v = match unit {
+            Unit::None => return Ok(object),
+            Unit::Position => {
+                let inc = u.position_to_increments(object).ok_or(range)?;
+                self.units.position.to_bus(inc)
+            }
+            Unit::Velocity => self
+                .units
+                .velocity
+                .to_bus(round_i64(u.velocity_to_increments(object))),
+            Unit::Acceleration => self
+                .units
+                .acceleration
+                .to_bus(round_i64(u.acceleration_to_increments(object))),
+            Unit::Rpm => self.units.velocity.to_bus(round_i64(increments_of_rpm(object))),
+            Unit::RpmPerSecond => self
+                .units
+                .acceleration
+                .to_bus(round_i64(increments_of_rpm(object))),
+        };
+        v.map(i64::from).map_err(|_| range)
+    }
+
+    fn record_number(&self, jog: Option<Jog>) -> u16 {
+        match jog {
+            Some(Jog::Negative) => JOG_NEGATIVE,
+            Some(_) => JOG_POSITIVE,
+            None => self.objects.record_selector(self.axis.index()),
+        }
+    }
+
+    fn read_record(&mut self, jog: Option<Jog>, field: RecordField, unit: Unit) -> Result<i64, PdError> {
+        let n = self.record_number(jog);
+        let r = self
+            .objects
+            .record(self.axis.index(), n)
+            .ok_or(PdError::NOT_IN_STATE)?;
+        let v = match field {
+            RecordField::Target => i64::from(r.target),
+            RecordField::ProfileVelocity => i64::from(r.profile_velocity),
+            RecordField::EndVelocity => i64::from(r.end_velocity),
+            RecordField::Acceleration | RecordField::BothAccelerations => i64::from(r.acceleration),
+            RecordField::Deceleration => i64::from(r.deceleration),
+        };
+        self.to_bus(unit, v)
+    }
+
+    fn write_record(
+        &mut self,
+        jog: Option<Jog>,
+        field: RecordField,
+        unit: Unit,
+        bus: i64,
+    ) -> Result<(), PdError> {
+        let value = self.to_object(unit, bus)?;
+        let numbers: &[u16] = match jog {
+            Some(Jog::Both) => &[JOG_POSITIVE, JOG_NEGATIVE],
+            _ => &[0],
+        };
+        let axis = self.axis.index();
+        for &k in numbers {
+            let n = if k == 0 { self.record_number(jog) } else { k };
+            let mut r: Record = self.objects.record(axis, n).ok_or(PdError::NOT_IN_STATE)?;
+            let as_u32 = || u32::try_from(value).map_err(|_| PdError::LIMIT_EXCEEDED);
+            match field {
+                RecordField::Target => {
+                    r.target = i32::try_from(value).map_err(|_| PdError::LIMIT_EXCEEDED)?
+                }
+                RecordField::ProfileVelocity => r.profile_velocity = as_u32()?,
+                RecordField::EndVelocity => r.end_velocity = as_u32()?,
+                RecordField::Acceleration => r.acceleration = as_u32()?,
+                RecordField::Deceleration => r.deceleration = as_u32()?,
+                RecordField::BothAccelerations => {
+                    r.acceleration = as_u32()?;
+                    r.deceleration = r.acceleration;
+                }
+            }
+            if !self.objects.set_record(axis, n, &r) {
+                return Err(PdError::NOT_IN_STATE);
+            }
+        }
+        Ok(())
+    }
+
+    /// 6060h code ⇄ PNU 1500 code.
+    fn operating_mode(&self) -> i64 {
+        match self.objects.get(self.axis.cia402_index(0x6061), 0) {
+            // positioning, with homing and jog inside it
+            Ok(1 | 6 | -1) => 0x10,
+            Ok(2 | 3) => 0x08,
+            Ok(4) => 0x04,
+            _ => 0,
+        }
+    }
+
+    fn identification(sub: u8) -> i64 {
+        let (_, major, minor, _) = model::SOFTWARE_REVISION;
+        match sub {
+            0 => i64::from(model::VENDOR_ID),
+            1 => i64::from(model::DEVICE_ID),
+            2 => i64::from(u16::from(major) << 8 | u16::from(minor)),
+            3 => 2026,
+            // DDMMh: 1 December
+            _ => 0x0112,
+        }
+    }
+
+    fn last_error(&self) -> i64 {
+        let e82 = self.objects.get(E82, 0).unwrap_or(0);
+        if e82 == i64::from(E82_INACTIVE) || e82 == 0 {
+            return 0;
+        }
+        let e43 = self.objects.get(E43, 0).unwrap_or(0).clamp(0, 15);
+        (e82 << 4) | e43
+    }
+
+    /// 60FDh in the manual's PNU 1141 map (limit switch 0 = negative: bit 7,
+    /// limit switch 1 = positive: bit 8).
+    fn digital_inputs(&self) -> i64 {
+        let d = self.objects.get(self.axis.cia402_index(0x60FD), 0).unwrap_or(0);
+        ((d & 1) << 7) | ((d >> 1 & 1) << 8)
+    }
+}
+
+/// inc/s (or /s²) → rpm (or rpm/s), rounded.
+fn rpm_of(increments: f64) -> i64 {
+    let rpm = increments * 60.0 / f64::from(INCREMENTS_PER_REVOLUTION);
+    let r = if rpm >= 0.0 { rpm + 0.5 } else { rpm - 0.5 };
+    r as i64
+}
+
+fn increments_of_rpm(rpm: i64) -> f64 {
+    rpm as f64 * f64::from(INCREMENTS_PER_REVOLUTION) / 60.0
+}
+
+/// Half away from zero; `as` saturates.
+fn round_i64(x: f64) -> i64 {
+    (if x >= 0.0 { x + 0.5 } else { x - 0.5 }) as i64
+}
+
+impl ParamAccess for DriveAccess<'_> {
+    fn describe(&self, addr: Addr) -> Result<Describe, PdError> {
+        if pnu::is_catalogue_index(addr.index) {
+            let p = pnu::find(addr)?;
+            return Ok(Describe {
+                data_type: p.data_type,
+                readable: p.readable,
+                writable: p.writable,
+            });
+        }
+        let index = self.index(addr.index);
+        let e = self
+            .objects
+            .object(index)
+            .ok_or(PdError::IMPERMISSIBLE_PNU)?
+            .entry(addr.sub)
+            .ok_or(PdError::FAULTY_SUBINDEX)?;
+        Ok(Describe {
+            data_type: e.data_type,
+            readable: e.access.readable(),
+            writable: e.access.writable(),
+        })
+    }
+
+    fn read(&mut self, addr: Addr) -> Result<i64, PdError> {
+        if !pnu::is_catalogue_index(addr.index) {
+            let index = self.index(addr.index);
+            return self.read_object(index, addr.sub);
+        }
+        let p = pnu::find(addr)?;
+        match p.source {
+            Source::Object { index, sub } => {
+                let index = self.index(index);
+                let v = self.read_object(index, sub)?;
+                self.to_bus(p.unit, v)
+            }
+            Source::SelectedRecord(f) => self.read_record(None, f, p.unit),
+            Source::JogRecord(j, f) => self.read_record(Some(j), f, p.unit),
+            Source::VlBothRamps => {
+                let index = self.index(0x6048);
+                let v = self.read_object(index, 1)?;
+                self.to_bus(p.unit, v)
+            }
+            Source::Cw1 => Ok(i64::from(self.own.cw1)),
+            Source::Zsw1 => Ok(i64::from(self.own.zsw1)),
+            Source::OperatingMode => Ok(self.operating_mode()),
+            Source::HomingMethod => Ok(i64::from(self.own.homing_method)),
+            Source::DigitalInputs => Ok(self.digital_inputs()),
+            Source::LastError => Ok(self.last_error()),
+            Source::Identification => Ok(Self::identification(addr.sub)),
+            Source::Save => Ok(i64::from(self.own.saving)),
+            Source::Own => Ok(i64::from(if addr.index == 0x2415 {
+                self.own.current_limit_ma
+            } else {
+                self.own.speed_limit
+            })),
+        }
+    }
+
+    fn write(&mut self, addr: Addr, value: i64, _cyclic: bool) -> Result<Completion, PdError> {
+        // every write here is a RAM write: the store is written only by a save
+        if !pnu::is_catalogue_index(addr.index) {
+            let index = self.index(addr.index);
+            self.write_object(index, addr.sub, value)?;
+            return Ok(Completion::Done);
+        }
+        let p = pnu::find(addr)?;
+        if !p.writable {
+            return Err(PdError::CANNOT_CHANGE);
+        }
+        match p.source {
+            Source::Object { index, sub } => {
+                let v = self.to_object(p.unit, value)?;
+                let index = self.index(index);
+                self.write_object(index, sub, v)?;
+            }
+            Source::SelectedRecord(f) => self.write_record(None, f, p.unit, value)?,
+            Source::JogRecord(j, f) => self.write_record(Some(j), f, p.unit, value)?,
+            Source::VlBothRamps => {
+                let v = self.to_object(p.unit, value)?;
+                for i in [0x6048, 0x6049] {
+                    let index = self.index(i);
+                    self.write_object(index, 1, v)?;
+                    self.write_object(index, 2, 1)?;
+                }
+            }
+            Source::Cw1 => self.own.cw1 = u16::try_from(value).map_err(|_| PdError::LIMIT_EXCEEDED)?,
+            Source::OperatingMode => {
+                let code = match value {
+                    0x10 => 1,
+                    0x08 => 2,
+                    0x04 => 4,
+                    _ => return Err(PdError::VALUE_IMPERMISSIBLE),
+                };
+                let index = self.index(0x6060);
+                self.write_object(index, 0, code)?;
+            }
+            Source::HomingMethod => {
+                let m = i8::try_from(value).map_err(|_| PdError::LIMIT_EXCEEDED)?;
+                if core_homing_method(m).is_none() {
+                    return Err(PdError::VALUE_IMPERMISSIBLE);
+                }
+                self.own.homing_method = m;
+            }
+            Source::Save => match value {
+                0 => {}
+                1 | 256 => {
+                    self.own.save_requested = true;
+                    self.own.saving = true;
+                    return Ok(Completion::Pending);
+                }
+                // 257/258: no encoder memory on this drive
+                _ => return Err(PdError::VALUE_IMPERMISSIBLE),
+            },
+            Source::Own => {
+                let v = i32::try_from(value).map_err(|_| PdError::LIMIT_EXCEEDED)?;
+                if addr.index == 0x2415 {
+                    self.own.current_limit_ma = v;
+                } else {
+                    self.own.speed_limit = v;
+                }
+            }
+            Source::Zsw1 | Source::DigitalInputs | Source::LastError | Source::Identification => {
+                return Err(PdError::CANNOT_CHANGE)
+            }
+        }
+        Ok(Completion::Done)
+    }
+
+    fn poll_write(&mut self, addr: Addr) -> Result<Completion, PdError> {
+        if addr == Addr::new(971, 0) && self.own.saving {
+            return Ok(Completion::Pending);
+        }
+        Ok(Completion::Done)
+    }
+}

@@ -1,0 +1,261 @@
+//! The PROFIdrive-style profile of the Metronix manual on the drive (issue
+//! 17): the thin personality spec §16 describes, over the drive core that
+//! the CiA 402 side uses too.
+//!
+//! Each control cycle, with valid output data from the controller:
+//! 1. the receive telegram ([`profidrive::telegram`]) writes its entries
+//!    into the objects (RAM only, P-067) through [`access::DriveAccess`]
+//!    (PNUs with their PROFINET units, CANopen objects as they are);
+//!    telegram 0 selects positioning, telegram 1 speed control (P-051,
+//!    P-052: 6060h = 1 / 2), telegrams 2 and 3 keep the mode (PNU 1500);
+//! 2. the PKW request is served ([`profidrive::pkw`]);
+//! 3. CW1 is applied last (P-066): bits 0–3 and 7 are the CiA 402
+//!    controlword of axis A (the core's device state machine); in
+//!    positioning the task bits go to the core's record positioning
+//!    ([`drive_core::axis::RecordCommand`]) and bit 11 runs the core's
+//!    homing (6060h = 6, the method PNU 1050 latched at the start edge,
+//!    Q-11); in speed control bits 4–6 are the vl mode's ramp bits.
+//!
+//! After the axes' cycle the response telegram is built into the input
+//! data: ZSW1 from the axis' state and statusword ([`status`]).
+
+pub mod access;
+pub mod pnu;
+mod status;
+
+use access::{DriveAccess, OwnValues};
+use drive_core::axis::{Axis, RecordCommand};
+use drive_core::DriveObjects;
+use motion::units::UnitProfile;
+use profidrive::cw1::{Context, Cw1Decoder, Mode, ModeCommands};
+use profidrive::pkw::Pkw;
+use profidrive::telegram::{ModeBinding, Telegrams, MAX_TELEGRAM_BYTES};
+
+/// 6040h bits 4–6: the vl ramp bits, the pp / homing "start" bit.
+const BITS_4_6: u16 = 0x0070;
+/// 6040h bit 4.
+const BIT_4: u16 = 0x0010;
+
+/// What the profile keeps between cycles.
+pub struct Profile {
+    telegrams: Option<Telegrams>,
+    pkw: Pkw,
+    pkw_response: [u8; 8],
+    cw1: Cw1Decoder,
+    units: UnitProfile,
+    own: OwnValues,
+    /// The response telegram to send.
+    response: Option<u8>,
+    /// A homing run the profile started (bit 11) is active.
+    homing: bool,
+    /// Frames with an unknown identifier or another warning.
+    warnings: u32,
+}
+
+impl Profile {
+    /// The profile with the Example Function block's telegrams (P-071…P-074)
+    /// and the default units (P-207).
+    pub fn new(objects: &mut DriveObjects, axis: &Axis) -> Profile {
+        let units = UnitProfile::default_profile();
+        let mut own = OwnValues::default();
+        let telegrams = {
+            let access = DriveAccess {
+                objects,
+                axis,
+                units: &units,
+                own: &mut own,
+            };
+            Telegrams::with_defaults(&access).ok()
+        };
+        Profile {
+            telegrams,
+            pkw: Pkw::new(),
+            pkw_response: [0; 8],
+            cw1: Cw1Decoder::new(),
+            units,
+            own,
+            response: None,
+            homing: false,
+            warnings: 0,
+        }
+    }
+
+    /// Whether the telegram configuration took (the catalogue holds every
+    /// entry of the defaults).
+    pub fn configured(&self) -> bool {
+        self.telegrams.is_some()
+    }
+
+    /// The telegrams (layouts, live view).
+    pub fn telegrams(&self) -> Option<&Telegrams> {
+        self.telegrams.as_ref()
+    }
+
+    /// The profile's own values (CW1, ZSW1, the homing method, …).
+    pub fn own(&self) -> &OwnValues {
+        &self.own
+    }
+
+    /// Frames that raised a warning (unknown identifier, length, refused
+    /// entry).
+    pub fn warnings(&self) -> u32 {
+        self.warnings
+    }
+
+    /// A save asked through PNU 971: taken by the drive, which saves and
+    /// reports back with [`save_done`](Self::save_done).
+    pub fn take_save_request(&mut self) -> bool {
+        core::mem::take(&mut self.own.save_requested)
+    }
+
+    /// The save asked through PNU 971 is over (PNU 971 reads 0 again).
+    pub fn save_done(&mut self) {
+        self.own.saving = false;
+    }
+
+    /// Step 1–3 of a cycle: the received OUT module's data `frame`.
+    pub fn receive(&mut self, frame: &[u8], objects: &mut DriveObjects, axis: &mut Axis) {
+        let Some(telegrams) = self.telegrams.as_mut() else {
+            return;
+        };
+        let mut access = DriveAccess {
+            objects,
+            axis,
+            units: &self.units,
+            own: &mut self.own,
+        };
+        let rx = telegrams.apply_receive(frame, &mut access);
+        if !rx.warnings.is_empty() {
+            self.warnings = self.warnings.saturating_add(1);
+        }
+        if rx.telegram.is_none() {
+            // an unknown identifier changes nothing
+            return;
+        }
+        self.response = rx.response;
+        let binding = match rx.mode {
+            ModeBinding::Positioning => Some(1),
+            ModeBinding::Speed => Some(2),
+            ModeBinding::None => None,
+        };
+        if let Some(code) = binding {
+            let index = axis.cia402_index(0x6060);
+            let now = access.objects.get(index, 0).unwrap_or(0);
+            // homing runs inside positioning (6060h = 6 while it runs)
+            if !(code == 1 && now == 6 && self.homing) && now != code {
+                let _ = access.objects.set(index, 0, code);
+            }
+        }
+        if let Some(req) = rx.pkw {
+            self.pkw_response = self.pkw.step(req, &mut access);
+        }
+        if let Some(cw1) = rx.cw1 {
+            access.own.cw1 = cw1;
+        }
+        let display = access.objects.get(axis.cia402_index(0x6061), 0).unwrap_or(0);
+        let mode = match Ok::<i64, ()>(display) {
+            Ok(1 | 6 | -1) => Mode::Positioning,
+            Ok(2 | 3) => Mode::Speed,
+            _ => Mode::Other,
+        };
+        let t = self.cw1.decode(
+            rx.cw1,
+            Context {
+                mode,
+                homing_active: self.homing,
+            },
+        );
+        if !t.evaluated {
+            return;
+        }
+        let cw_index = axis.cia402_index(0x6040);
+        let mut controlword = t.controlword;
+        let record_command = match t.mode {
+            ModeCommands::Positioning(p) => {
+                if p.homing_start && !self.homing {
+                    if let Some(m) = access::core_homing_method(access.own.homing_method) {
+                        let _ = access.objects.set(axis.cia402_index(0x6098), 0, i64::from(m));
+                        let _ = access.objects.set(axis.cia402_index(0x6060), 0, 6);
+                        self.homing = true;
+                    }
+                }
+                if p.homing_cancel {
+                    self.homing = false;
+                }
+                if self.homing {
+                    // 6040h bit 4 starts and holds the homing run (its rising
+                    // edge once the axis is in homing mode); clearing it ends
+                    // the run without an error
+                    if display == 6 {
+                        controlword |= BIT_4;
+                    }
+                    None
+                } else {
+                    Some(RecordCommand {
+                        enable: !p.cancel,
+                        proceed: !p.intermediate_stop,
+                        start: p.start,
+                        relative: p.relative,
+                        immediate: p.immediate,
+                        jog_positive: p.jog_positive,
+                        jog_negative: p.jog_negative,
+                        setup_mode: false,
+                    })
+                }
+            }
+            ModeCommands::Speed(s) => {
+                // vl: bit 4 enable ramp, bit 5 unlock ramp, bit 6 use the
+                // set-point (Q-04: PROFIdrive polarity, 1 = the ramp runs)
+                controlword &= !BITS_4_6;
+                if s.rfg_enable {
+                    controlword |= 0x0010;
+                }
+                if !s.rfg_freeze {
+                    controlword |= 0x0020;
+                }
+                if s.setpoint_enable {
+                    controlword |= 0x0040;
+                }
+                None
+            }
+            ModeCommands::Other => None,
+        };
+        let _ = access.objects.set(cw_index, 0, i64::from(controlword));
+        axis.set_record_command(record_command);
+    }
+
+    /// After the cycle: ends a finished homing run (back to positioning)
+    /// and builds the response telegram into `buf` (the IN module's
+    /// length); returns the bytes written, `None` before any telegram.
+    pub fn respond(&mut self, objects: &mut DriveObjects, axis: &Axis, buf: &mut [u8]) -> Option<usize> {
+        if self.homing {
+            let sw = objects.get(axis.cia402_index(0x6041), 0).unwrap_or(0);
+            let mode = objects.get(axis.cia402_index(0x6061), 0).unwrap_or(0);
+            // homing attained (bit 12) or an error (bit 13): the run is over
+            if mode == 6 && sw & 0x3000 != 0 {
+                self.homing = false;
+                let _ = objects.set(axis.cia402_index(0x6060), 0, 1);
+            }
+        }
+        self.own.zsw1 = status::zsw1(objects, axis, self.cw1.last(), self.homing);
+        let n = self.response?;
+        let telegrams = self.telegrams.as_mut()?;
+        let mut access = DriveAccess {
+            objects,
+            axis,
+            units: &self.units,
+            own: &mut self.own,
+        };
+        let mut out = [0u8; MAX_TELEGRAM_BYTES];
+        let len = buf.len().min(out.len());
+        let tx = telegrams.build_response(n, &mut access, self.pkw_response, out.get_mut(..len)?)?;
+        if !tx.warnings.is_empty() {
+            self.warnings = self.warnings.saturating_add(1);
+        }
+        buf.get_mut(..len)?.copy_from_slice(out.get(..len)?);
+        Some(len)
+    }
+}
+
+#[cfg(test)]
+mod tests;

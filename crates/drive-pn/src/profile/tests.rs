@@ -1,0 +1,308 @@
+//! The profile through the drive: telegrams in the controller's output
+//! frames (profinet-py's AR, 18-word modules), responses read from the
+//! drive's input frames.
+
+use crate::tests::{drive, TestFlash};
+use crate::PnDrive;
+use drive_core::axis::AxisIo;
+use nanos::Nanos;
+use profinet::wire::EthFrame;
+use std::vec::Vec;
+
+use crate::tests::CTRL;
+
+/// The drive in data exchange at 1 ms steps.
+struct Bench {
+    d: PnDrive<TestFlash>,
+    ms: u64,
+    counter: u16,
+    /// Axis A's position, increments (a motor that follows exactly: the
+    /// position integrates the commanded velocity is not modelled; the axes
+    /// run open against an encoder standing still unless told).
+    response: Vec<u8>,
+}
+
+fn slot(d: &PnDrive<TestFlash>, to_drive: bool) -> u16 {
+    d.device()
+        .data_modules()
+        .find(|(_, _, to)| *to == to_drive)
+        .map(|(s, _, _)| s)
+        .unwrap()
+}
+
+impl Bench {
+    fn new() -> Bench {
+        Bench {
+            d: drive(),
+            ms: 0,
+            counter: 0,
+            response: Vec::new(),
+        }
+    }
+
+    /// An output frame carrying `telegram` in the controller → drive module.
+    fn frame(&self, telegram: &[u8]) -> Vec<u8> {
+        let ar = self.d.device().cm().ar().unwrap();
+        let cr = ar.output_cr.clone().unwrap();
+        let n = 14 + 2 + cr.data_length as usize + 4;
+        let mut f = std::vec![0u8; n];
+        f[..6].copy_from_slice(&crate::tests::OUR.0);
+        f[6..12].copy_from_slice(&CTRL.0);
+        f[12..14].copy_from_slice(&0x8892u16.to_be_bytes());
+        f[14..16].copy_from_slice(&cr.frame_id.to_be_bytes());
+        let to = slot(&self.d, true);
+        for o in &cr.data {
+            let at = 16 + o.frame_offset as usize;
+            if o.slot == to {
+                f[at..at + telegram.len()].copy_from_slice(telegram);
+            }
+            f[at + o.data_len as usize] = 0x80;
+        }
+        for c in &cr.iocs {
+            f[16 + c.frame_offset as usize] = 0x80;
+        }
+        f[n - 4..n - 2].copy_from_slice(&self.counter.to_be_bytes());
+        f[n - 2] = 0x35;
+        f
+    }
+
+    /// `ms` milliseconds with `telegram` in every output frame; keeps the
+    /// last response telegram the drive sent.
+    fn run(&mut self, telegram: &[u8], ms: u64) {
+        let ar = self.d.device().cm().ar().unwrap().clone();
+        let input = ar.input_cr.clone().unwrap();
+        let from = slot(&self.d, false);
+        let io = [AxisIo::ready(0), AxisIo::ready(0)];
+        for _ in 0..ms {
+            let now = Nanos::from_ms(self.ms);
+            self.counter = self.counter.wrapping_add(32);
+            let f = self.frame(telegram);
+            let mut last = None;
+            self.d.receive(now, &f, &mut |_: &[u8]| {}, &mut |_| {});
+            self.d.control_cycle(now, &io);
+            self.d.poll(
+                now,
+                &mut |b: &[u8]| {
+                    if let Some(e) = EthFrame::parse(b) {
+                        if e.ethertype == 0x8892 && e.payload.get(..2) == Some(&input.frame_id.to_be_bytes())
+                        {
+                            last = Some(e.payload.to_vec());
+                        }
+                    }
+                },
+                &mut |_| {},
+            );
+            if let Some(p) = last {
+                for o in &input.data {
+                    if o.slot == from {
+                        let at = 2 + o.frame_offset as usize;
+                        self.response = p[at..at + o.data_len as usize].to_vec();
+                    }
+                }
+            }
+            self.ms += 1;
+        }
+    }
+
+    fn zsw1(&self) -> u16 {
+        u16::from_be_bytes([self.response[2], self.response[3]])
+    }
+
+    fn i32_at(&self, at: usize) -> i32 {
+        i32::from_be_bytes(self.response[at..at + 4].try_into().unwrap())
+    }
+}
+
+/// Receive telegram 1 (speed): CW1, target velocity, all ramps, PKW.
+fn speed(cw1: u16, rpm: i32, ramps: u32, pkw: [u8; 8]) -> [u8; 36] {
+    let mut t = [0u8; 36];
+    t[0] = 0xE1;
+    t[2..4].copy_from_slice(&cw1.to_be_bytes());
+    t[4..8].copy_from_slice(&rpm.to_be_bytes());
+    t[16..20].copy_from_slice(&ramps.to_be_bytes());
+    t[24..32].copy_from_slice(&pkw);
+    t
+}
+
+/// Receive telegram 0 (positioning): homing method, CW1, target, profile
+/// velocity, end velocity, all accelerations.
+fn positioning(cw1: u16, target: i32, velocity: i32, accelerations: u32) -> [u8; 36] {
+    let mut t = [0u8; 36];
+    t[0] = 0xE0;
+    t[1] = 34u8; // PNU 1050: method 34 (current position)
+    t[2..4].copy_from_slice(&cw1.to_be_bytes());
+    t[4..8].copy_from_slice(&target.to_be_bytes());
+    t[8..12].copy_from_slice(&velocity.to_be_bytes());
+    t[16..20].copy_from_slice(&accelerations.to_be_bytes());
+    t
+}
+
+#[test]
+fn p071_p072_p073_p074_the_drive_ships_with_the_function_blocks_telegrams() {
+    let d = drive();
+    let p = d.profile();
+    assert!(
+        p.configured(),
+        "the Example FB's telegrams configure against the catalogue"
+    );
+    let t = p.telegrams().unwrap();
+    for n in 0..3 {
+        assert_eq!(t.layout(profidrive::telegram::Dir::Receive, n).unwrap().len(), 36);
+        assert_eq!(
+            t.layout(profidrive::telegram::Dir::Response, n).unwrap().len(),
+            36
+        );
+    }
+}
+
+/// 0x0406 → 0x0407 → 0x040F, each answered by its ZSW1 state (spec §7.3).
+#[test]
+fn p110_p111_p113_p114_p096_the_enable_sequence_is_answered_in_zsw1() {
+    let mut b = Bench::new();
+    b.run(&speed(0x0400, 0, 10_000, [0; 8]), 20);
+    assert_eq!(b.response[0], 0xF1, "the response to telegram 1");
+    assert_eq!(b.zsw1() & 0x47, 0x40, "switching on inhibited: {:#06x}", b.zsw1());
+    assert_eq!(b.response[1], 0x08, "PNU 1500: speed control (P-052)");
+    for (cw1, state) in [(0x0406, 0x01), (0x0407, 0x03), (0x040F, 0x07)] {
+        b.run(&speed(cw1, 0, 10_000, [0; 8]), 20);
+        assert_eq!(b.zsw1() & 0x47, state, "CW1 {cw1:#06x}: ZSW1 {:#06x}", b.zsw1());
+        assert_ne!(b.zsw1() & 0x0200, 0, "bit 9 mirrors CW1 bit 10 (P-103)");
+        assert_ne!(b.zsw1() & 0x0030, 0x0000, "no coast or quick stop (P-098, P-099)");
+    }
+    // coast stop: bit 1 = 0 → switching on inhibited at once
+    b.run(&speed(0x0405, 0, 10_000, [0; 8]), 20);
+    assert_eq!(b.zsw1() & 0x47, 0x40, "coast stop: {:#06x}", b.zsw1());
+    assert_eq!(b.zsw1() & 0x0010, 0, "bit 4: coast stop active");
+}
+
+/// Without bit 10 CW1 is not evaluated: the drive stays where it is and
+/// ZSW1 bit 9 is 0.
+#[test]
+fn p089_p103_without_control_by_plc_cw1_is_not_evaluated() {
+    let mut b = Bench::new();
+    b.run(&speed(0x0006, 0, 10_000, [0; 8]), 20);
+    assert_eq!(b.zsw1() & 0x47, 0x40, "{:#06x}", b.zsw1());
+    assert_eq!(b.zsw1() & 0x0200, 0);
+    b.run(&speed(0x0406, 0, 10_000, [0; 8]), 20);
+    assert_eq!(b.zsw1() & 0x47, 0x01);
+}
+
+/// A fault sets ZSW1 bit 3 and disables the drive; the rising edge of CW1
+/// bit 7 acknowledges it once the cause is gone.
+#[test]
+fn p085_p097_p215_a_fault_shows_in_bit_3_and_bit_7_acknowledges_it() {
+    let mut b = Bench::new();
+    for cw1 in [0x0406, 0x0407, 0x040F] {
+        b.run(&speed(cw1, 0, 10_000, [0; 8]), 20);
+    }
+    b.d.axes_mut()[0].raise_event(motion::Event { number: 44, cause: 1 });
+    b.run(&speed(0x040F, 0, 10_000, [0; 8]), 50);
+    assert_ne!(b.zsw1() & 0x0008, 0, "fault present: {:#06x}", b.zsw1());
+    assert_eq!(b.zsw1() & 0x0007, 0, "disabled");
+    b.run(&speed(0x048F, 0, 10_000, [0; 8]), 20);
+    assert_eq!(b.zsw1() & 0x0008, 0, "acknowledged: {:#06x}", b.zsw1());
+    assert_eq!(b.zsw1() & 0x47, 0x40, "back in switching on inhibited");
+}
+
+/// PKW through the telegram: read PNU 964.0 (the manufacturer), write the
+/// override PNU 1004, read it back; the response mirrors the access code.
+#[test]
+fn p191_p192_p202_pkw_reads_and_writes_a_pnu() {
+    let mut b = Bench::new();
+    let read = |pnu: u16, sub: u8| {
+        let i = pnu.to_be_bytes();
+        [0x41, i[0], i[1], sub, 0, 0, 0, 0]
+    };
+    b.run(&speed(0x0400, 0, 0, read(964, 0)), 10);
+    assert_eq!(b.response[24], 0x41, "mirrored");
+    assert_eq!(b.i32_at(28), i32::from(profinet::model::VENDOR_ID));
+    b.run(&speed(0x0400, 0, 0, [0; 8]), 10);
+    assert_eq!(b.response[24], 0x00, "the toggle");
+    let mut write = [0x42, 0x03, 0xEC, 0, 0, 0, 0, 0];
+    write[4..8].copy_from_slice(&1500u32.to_be_bytes());
+    b.run(&speed(0x0400, 0, 0, write), 10);
+    assert_eq!(b.response[24], 0x42);
+    assert_eq!(b.d.objects().get(drive_core::objects::records::J403, 0), Ok(1500));
+    b.run(&speed(0x0400, 0, 0, [0; 8]), 10);
+    b.run(&speed(0x0400, 0, 0, read(1004, 0)), 10);
+    assert_eq!((b.response[24], b.i32_at(28)), (0x41, 1500));
+}
+
+/// A PKW request for a missing PNU or a read-only one gets its error and
+/// changes nothing (P-196: 0xC1/0xC2 with the error number).
+#[test]
+fn p196_pkw_errors_for_a_missing_or_read_only_pnu() {
+    let mut b = Bench::new();
+    let before = b.d.objects().get(0x6064, 0);
+    b.run(&speed(0x0400, 0, 0, [0x41, 0x03, 0xE7, 0, 0, 0, 0, 0]), 10); // PNU 999
+    assert_eq!(b.response[24], 0xC1);
+    assert_eq!(b.i32_at(28), 0x00, "impermissible PNU");
+    b.run(&speed(0x0400, 0, 0, [0; 8]), 10);
+    b.run(&speed(0x0400, 0, 0, [0x42, 0x04, 0x4C, 0, 0, 0, 0x10, 0]), 10); // 1100 := 4096
+    assert_eq!(b.response[24], 0xC2);
+    assert_eq!(b.i32_at(28), 0x01, "cannot be changed");
+    assert_eq!(b.d.objects().get(0x6064, 0), before);
+}
+
+/// Telegram 0 selects positioning, telegram 1 speed control (6060h, PNU
+/// 1500 in the response's byte 1).
+#[test]
+fn p051_p052_p054_the_telegram_selects_the_mode() {
+    let mut b = Bench::new();
+    b.run(&positioning(0x0400, 0, 1000, 10_000), 20);
+    assert_eq!((b.response[0], b.response[1]), (0xF0, 0x10));
+    assert_eq!(b.d.objects().get(0x6061, 0), Ok(1));
+    b.run(&speed(0x0400, 0, 10_000, [0; 8]), 20);
+    assert_eq!((b.response[0], b.response[1]), (0xF1, 0x08));
+    assert_eq!(b.d.objects().get(0x6061, 0), Ok(2));
+}
+
+/// Speed control: the ramp bits 4–6 with a target of 100 rpm; the velocity
+/// demand of the vl mode follows the ramp (the axis runs against a motor
+/// standing still here: the demand, not the actual velocity, is checked).
+#[test]
+fn p079_p178_p181_speed_control_ramps_to_the_target_velocity() {
+    let mut b = Bench::new();
+    for cw1 in [0x0406, 0x0407, 0x040F] {
+        b.run(&speed(cw1, 100, 1000, [0; 8]), 20);
+    }
+    assert_eq!(
+        b.d.objects().get(0x6048, 1),
+        Ok(1000),
+        "1011.2 wrote the vl ramps"
+    );
+    assert_eq!(b.d.objects().get(0x6042, 0), Ok(100), "1010 wrote the vl target");
+    b.run(&speed(0x047F, 100, 1000, [0; 8]), 200);
+    let demand = b.d.objects().get(0x6043, 0).unwrap();
+    assert!(demand >= 99, "the vl demand reached 100 rpm: {demand}");
+    // bit 6 = 0: the set-point is 0
+    b.run(&speed(0x043F, 100, 1000, [0; 8]), 200);
+    let demand = b.d.objects().get(0x6043, 0).unwrap();
+    assert!(demand <= 1, "set-point disabled: {demand}");
+}
+
+/// Positioning: bit 6 rising starts record 266 from telegram 0's values
+/// (P-082); the task acknowledgement and the record's target show.
+#[test]
+fn p082_p143_p146_bit_6_starts_the_fieldbus_record() {
+    let mut b = Bench::new();
+    for cw1 in [0x0406, 0x0407, 0x040F] {
+        b.run(&positioning(cw1, 0, 1000, 10_000), 20);
+    }
+    // home first (method 34: the current position, bit 11)
+    b.run(&positioning(0x083F | 0x0400, 0, 1000, 10_000), 50);
+    b.run(&positioning(0x043F, 0, 1000, 10_000), 20);
+    assert_ne!(b.zsw1() & 0x0800, 0, "home position set: {:#06x}", b.zsw1());
+    let r =
+        b.d.objects()
+            .record(0, drive_core::objects::records::FIELDBUS)
+            .unwrap();
+    assert_eq!(r.profile_velocity as i64, {
+        // 1000 rpm in the CiA default units (increments/s)
+        (1000.0 * f64::from(motion::INCREMENTS_PER_REVOLUTION) / 60.0).round() as i64
+    });
+    b.run(&positioning(0x047F, 5000, 1000, 10_000), 5);
+    let s = b.d.axes()[0].record_status();
+    assert!(s.record.is_some() || s.refused.is_some(), "{s:?}");
+    assert_eq!(s.refused, None, "the start was taken: {s:?}");
+}
