@@ -124,15 +124,19 @@ impl DriveAccess<'_> {
         UserUnits::read(self.objects, self.axis)
     }
 
-    /// An object's value through the dictionary (Op, its access rules).
-    fn read_object(&mut self, index: u16, sub: u8) -> Result<i64, PdError> {
-        let info = self
-            .objects
+    /// The declaration of `index`:`sub`: 0x00 without the object, 0x03
+    /// without the subindex.
+    fn entry(&self, index: u16, sub: u8) -> Result<&'static od::EntryInfo, PdError> {
+        self.objects
             .object(index)
             .ok_or(PdError::IMPERMISSIBLE_PNU)?
             .entry(sub)
-            .ok_or(PdError::FAULTY_SUBINDEX)?;
-        let t = info.data_type;
+            .ok_or(PdError::FAULTY_SUBINDEX)
+    }
+
+    /// An object's value through the dictionary (Op, its access rules).
+    fn read_object(&mut self, index: u16, sub: u8) -> Result<i64, PdError> {
+        let t = self.entry(index, sub)?.data_type;
         let mut buf = [0u8; 8];
         let n = self
             .objects
@@ -153,13 +157,7 @@ impl DriveAccess<'_> {
     }
 
     fn write_object(&mut self, index: u16, sub: u8, value: i64) -> Result<(), PdError> {
-        let info = self
-            .objects
-            .object(index)
-            .ok_or(PdError::IMPERMISSIBLE_PNU)?
-            .entry(sub)
-            .ok_or(PdError::FAULTY_SUBINDEX)?;
-        let n = size(info.data_type);
+        let n = size(self.entry(index, sub)?.data_type);
         let bytes = value.to_le_bytes();
         let data = bytes.get(..n).ok_or(PdError::INCORRECT_DATA_TYPE)?;
         self.objects
@@ -343,13 +341,7 @@ impl ParamAccess for DriveAccess<'_> {
                 writable: p.writable,
             });
         }
-        let index = self.index(addr.index);
-        let e = self
-            .objects
-            .object(index)
-            .ok_or(PdError::IMPERMISSIBLE_PNU)?
-            .entry(addr.sub)
-            .ok_or(PdError::FAULTY_SUBINDEX)?;
+        let e = self.entry(self.index(addr.index), addr.sub)?;
         Ok(Describe {
             data_type: e.data_type,
             readable: e.access.readable(),
