@@ -89,6 +89,7 @@ mod feedback;
 mod io;
 mod modes;
 mod params;
+mod record_state;
 mod records;
 mod running;
 mod snapshot;
@@ -132,7 +133,7 @@ pub use cache::AxisCache;
 use cache::CachedSnapshot;
 pub use io::{AxisCommand, AxisIo, AxisReport, IndexLatch, ProbeEdge, SwitchEdge, SwitchId};
 pub use params::AxisParams;
-use records::RecordTasks;
+pub(crate) use records::RecordTasks;
 pub use records::{RecordCommand, RecordStatus, StartRefusal};
 pub use units::{e48, scaled_gains, GAIN_REFERENCE_CYCLE_NS};
 use units::{jerk, override_factor, ramp_rate, round_i32, sat_i32, sourced};
@@ -256,8 +257,14 @@ pub struct Axis {
     velocity_decimals: f32,
     /// Endless axis (I00 = 1) with 607Bh:02 > 0, user units (C-111).
     modulo: Option<ModuloAxis>,
-    /// Record positioning in pp (`records.rs`).
-    tasks: RecordTasks,
+    /// pp was (re)activated: the record tasks start afresh (their state is
+    /// in the dictionary's image, `records.rs`).
+    record_fresh: bool,
+    /// The record command ([`Axis::set_record_command`]): 0 none, else
+    /// 0x100 | its bits (`record_state.rs`).
+    record_command: u16,
+    /// The record status of the last cycle, packed.
+    record_status: u32,
 }
 
 impl Axis {
@@ -316,7 +323,9 @@ impl Axis {
             scaling: AxisScaling::INCREMENTAL,
             velocity_decimals: 1.0,
             modulo: None,
-            tasks: RecordTasks::default(),
+            record_fresh: true,
+            record_command: 0,
+            record_status: 0,
         }
     }
 
@@ -558,11 +567,8 @@ impl Axis {
         let fault = self.on_transition(out.transition, od);
 
         self.touch_probe(o, io, actual, now_ns);
-        if self.tasks.command.is_some() && matches!(self.running, Running::ProfilePosition(_)) {
-            self.record_inputs(od, raw);
-        }
 
-        let demand = self.motion(o, &out, io, &mut actual, i199, now_ns, dt_ns, new_setpoint);
+        let demand = self.motion(od, o, &out, io, &mut actual, i199, now_ns, dt_ns, new_setpoint);
         let (torque, bits, fe) = self.control(demand, actual, now_ns, dt_ns);
 
         self.prev_cw = o.controlword;
@@ -672,6 +678,7 @@ impl Axis {
     #[allow(clippy::too_many_arguments)]
     fn motion(
         &mut self,
+        od: &mut DriveObjects,
         o: &Snapshot,
         out: &Outputs,
         io: &AxisIo,
@@ -722,8 +729,8 @@ impl Axis {
                 bits: SW_MODE_BIT12,
                 ..Demand::hold(*actual)
             },
-            Running::ProfilePosition(_) if self.tasks.command.is_some() => {
-                self.record_position(o, halt, *actual, i199, now_ns, dt_ns)
+            Running::ProfilePosition(_) if self.record_command != 0 => {
+                self.record_position(od, o, halt, *actual, i199, now_ns, dt_ns)
             }
             Running::ProfilePosition(pp) => self.profile_position(pp, o, halt, *actual, now_ns, dt_ns),
             Running::ProfileVelocity(pv) => self.profile_velocity(pv, o, halt, now_ns, dt_ns),

@@ -28,7 +28,7 @@ impl Axis {
             Mode::ProfileTorque => {}
             Mode::Homing => self.homing.activate(actual),
             Mode::ProfilePosition => {
-                self.tasks.reset();
+                self.record_fresh = true;
                 // entered while moving (from pv, vl, jog): no target yet, so
                 // brake with 6084h instead of cruising on
                 self.profile.take_over(self.sp_pos, self.sp_vel);

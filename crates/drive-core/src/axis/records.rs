@@ -47,6 +47,7 @@
 //! task starts (jog: every cycle). Nothing here runs in a cycle without a
 //! [`RecordCommand`].
 
+use super::record_state::{command_bits, command_of, status_bits, status_of};
 use super::*;
 use crate::objects::records::{
     Record, FIELDBUS, J402, J403, J404, JOG_NEGATIVE, JOG_POSITIVE, OPT_IMMEDIATE, OPT_RELATIVE,
@@ -115,13 +116,13 @@ pub struct RecordStatus {
 /// A task: its record in increments.
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub(super) struct Task {
-    record: u16,
+    pub(super) record: u16,
     /// Target, increments (resolved).
-    target: i32,
+    pub(super) target: i32,
     /// Limits without override and caps.
-    limits: ProfileLimits,
+    pub(super) limits: ProfileLimits,
     /// End velocity, inc/s.
-    end_velocity: f32,
+    pub(super) end_velocity: f32,
 }
 
 /// A record in increments (from its user units).
@@ -150,45 +151,88 @@ pub(super) struct RecordInputs {
 
 /// A jog on a record.
 #[derive(Debug, Clone, Copy, PartialEq)]
-struct RecordJog {
-    record: u16,
+pub(super) struct RecordJog {
+    pub(super) record: u16,
     /// +1 / −1; 0 once released (decelerating).
-    dir: f32,
-    command: VelocityCommand,
+    pub(super) dir: f32,
+    pub(super) command: VelocityCommand,
 }
 
-/// The record positioning state of an axis.
-#[derive(Debug, Clone, Copy, PartialEq, Default)]
-pub(super) struct RecordTasks {
+/// The record positioning state of an axis. It is kept in the RAM image
+/// (J411's last element, `record_state.rs`) rather than in [`Axis`] or
+/// beside the image: every byte more in the axis or in the dictionary's
+/// fields moves fields the csp cycle uses past the load/store immediates
+/// (~220 bytes in the axis were ~16 instructions per cycle, 240 bytes
+/// behind the image ~9); inside the image it costs nothing.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub(crate) struct RecordTasks {
     pub(super) command: Option<RecordCommand>,
-    prev: RecordCommand,
-    inputs: RecordInputs,
-    current: Option<Task>,
-    next: Option<Task>,
-    jog: Option<RecordJog>,
+    pub(super) prev: RecordCommand,
+    pub(super) current: Option<Task>,
+    pub(super) next: Option<Task>,
+    pub(super) jog: Option<RecordJog>,
     /// Intermediate stop in effect.
-    halted: bool,
+    pub(super) halted: bool,
     /// The override the running task is planned with (0: paused).
-    planned_override: u16,
+    pub(super) planned_override: u16,
     /// Set-up mode when it was planned.
-    planned_setup: bool,
+    pub(super) planned_setup: bool,
     /// The start input's acknowledgement latch.
-    ack: bool,
+    pub(super) ack: bool,
     /// The last task ended (target reached once in the window).
-    finished: bool,
+    pub(super) finished: bool,
     /// The last sample decelerated (|v| shrinking).
-    braking: bool,
-    refused: Option<StartRefusal>,
-    status: RecordStatus,
+    pub(super) braking: bool,
+    pub(super) refused: Option<StartRefusal>,
+    pub(super) status: RecordStatus,
 }
+
+const NO_COMMAND: RecordCommand = RecordCommand {
+    enable: false,
+    proceed: false,
+    start: false,
+    relative: false,
+    immediate: false,
+    jog_positive: false,
+    jog_negative: false,
+    setup_mode: false,
+};
 
 impl RecordTasks {
+    /// No command, no task.
+    pub(crate) const IDLE: RecordTasks = RecordTasks {
+        command: None,
+        prev: NO_COMMAND,
+        current: None,
+        next: None,
+        jog: None,
+        halted: false,
+        planned_override: 0,
+        planned_setup: false,
+        ack: false,
+        finished: false,
+        braking: false,
+        refused: None,
+        status: RecordStatus {
+            acknowledge: false,
+            target_reached: false,
+            stopped: false,
+            record: None,
+            waiting: false,
+            jogging: false,
+            refused: None,
+        },
+    };
+
     /// Drops tasks and jog (mode change, stop, disable); keeps the command.
     pub(super) fn reset(&mut self) {
         *self = RecordTasks {
             command: self.command,
-            prev: self.command.unwrap_or_default(),
-            ..RecordTasks::default()
+            prev: match self.command {
+                Some(c) => c,
+                None => NO_COMMAND,
+            },
+            ..RecordTasks::IDLE
         };
     }
 }
@@ -198,14 +242,19 @@ impl Axis {
     /// pp). A personality calls this every cycle before
     /// [`cycle`](Self::cycle).
     pub fn set_record_command(&mut self, command: Option<RecordCommand>) {
-        self.tasks.command = command;
+        self.record_command = command.map_or(0, |c| 0x100 | u16::from(command_bits(&c)));
     }
 
-    /// The record positioning's status after the last cycle (outside pp:
-    /// no task, stopped at standstill).
+    /// The record command set by [`set_record_command`](Self::set_record_command).
+    fn record_command(&self) -> Option<RecordCommand> {
+        (self.record_command & 0x100 != 0).then(|| command_of(self.record_command as u8))
+    }
+
+    /// The record positioning's status after the last cycle (outside pp or
+    /// without a command: no task, stopped at standstill).
     pub fn record_status(&self) -> RecordStatus {
-        if matches!(self.running, Running::ProfilePosition(_)) && self.tasks.command.is_some() {
-            self.tasks.status
+        if matches!(self.running, Running::ProfilePosition(_)) && self.record_command != 0 {
+            status_of(self.record_status)
         } else {
             RecordStatus {
                 stopped: self.profile.is_standstill()
@@ -215,53 +264,50 @@ impl Axis {
         }
     }
 
-    /// Reads what this cycle's record positioning needs (only with a record
-    /// command in pp): the start record on a start edge, the jog record,
-    /// J403 and J404 (`raw`: the snapshot in user units, for the decimals).
-    #[inline(never)]
-    pub(super) fn record_inputs(&mut self, od: &mut DriveObjects, raw: &Snapshot) {
-        let Some(cmd) = self.tasks.command else {
-            return;
-        };
+    /// Reads what this cycle's record positioning needs: the start record
+    /// on a start edge, the jog record, J403 and J404.
+    fn record_inputs(
+        &self,
+        od: &mut DriveObjects,
+        rt: &RecordTasks,
+        cmd: &RecordCommand,
+        o: &Snapshot,
+    ) -> RecordInputs {
         let axis = self.window.axis;
-        let prev = self.tasks.prev;
+        let prev = rt.prev;
         let param = |od: &DriveObjects, index: u16| od.get(self.window.manufacturer(index), 0).unwrap_or(0);
         let start = if cmd.start && !prev.start {
             let n = match param(od, J402) {
                 n @ 0..=254 => n as u16,
                 _ => FIELDBUS,
             };
-            od.take_record(axis, n)
-                .map(|r| self.record_increments(n, &r, raw))
+            od.take_record(axis, n).map(|r| self.record_increments(n, &r, o))
         } else {
             None
         };
-        let jog_record = match self.tasks.jog {
+        let jog_record = match rt.jog {
             Some(j) => Some(j.record),
             None if cmd.jog_positive && !prev.jog_positive => Some(JOG_POSITIVE),
             None if cmd.jog_negative && !prev.jog_negative => Some(JOG_NEGATIVE),
             None => None,
         };
-        let jog = jog_record.and_then(|n| {
-            od.take_record(axis, n)
-                .map(|r| self.record_increments(n, &r, raw))
-        });
+        let jog = jog_record.and_then(|n| od.take_record(axis, n).map(|r| self.record_increments(n, &r, o)));
         let setup = param(od, J404);
-        self.tasks.inputs = RecordInputs {
+        RecordInputs {
             start,
             jog,
             override_per_mille: u16::try_from(param(od, J403)).unwrap_or(1000).min(2000),
-            setup_speed: self.velocity_increments(u32::try_from(setup).unwrap_or(u32::MAX), raw),
-        };
+            setup_speed: self.velocity_increments(u32::try_from(setup).unwrap_or(u32::MAX), o),
+        }
     }
 
-    fn velocity_increments(&self, v: u32, raw: &Snapshot) -> f32 {
-        let k = self.scaling.user_per_increment().abs() * raw.decimal_factors().0;
+    fn velocity_increments(&self, v: u32, o: &Snapshot) -> f32 {
+        let k = self.scaling.user_per_increment().abs() * o.decimal_factors().0;
         (f64::from(v) / k) as f32
     }
 
-    fn record_increments(&self, n: u16, r: &Record, raw: &Snapshot) -> RecordInc {
-        let (_, fa) = raw.decimal_factors();
+    fn record_increments(&self, n: u16, r: &Record, o: &Snapshot) -> RecordInc {
+        let (_, fa) = o.decimal_factors();
         let k = self.scaling.user_per_increment().abs();
         let acc = |v: u32| (f64::from(v) / (k * fa)) as f32;
         RecordInc {
@@ -271,8 +317,8 @@ impl Axis {
                     .to_increments(i64::from(r.target))
                     .unwrap_or(i64::from(r.target)),
             ),
-            velocity: self.velocity_increments(r.profile_velocity, raw),
-            end_velocity: self.velocity_increments(r.end_velocity, raw),
+            velocity: self.velocity_increments(r.profile_velocity, o),
+            end_velocity: self.velocity_increments(r.end_velocity, o),
             acceleration: acc(r.acceleration),
             deceleration: acc(r.deceleration),
             options: r.options,
@@ -280,20 +326,27 @@ impl Axis {
     }
 
     /// The velocity cap of this cycle: 607Fh, and J404 in set-up mode.
-    fn record_velocity_cap(&self, o: &Snapshot, cmd: &RecordCommand) -> f32 {
+    fn record_velocity_cap(&self, inputs: &RecordInputs, o: &Snapshot, cmd: &RecordCommand) -> f32 {
         let cap = o.max_profile_velocity as f32;
         if cmd.setup_mode {
-            cap.min(self.tasks.inputs.setup_speed)
+            cap.min(inputs.setup_speed)
         } else {
             cap
         }
     }
 
     /// `t`'s limits with the override `per_mille` (× A340) and the caps.
-    fn task_limits(&self, t: &Task, o: &Snapshot, cmd: &RecordCommand, per_mille: u16) -> ProfileLimits {
+    fn task_limits(
+        &self,
+        inputs: &RecordInputs,
+        t: &Task,
+        o: &Snapshot,
+        cmd: &RecordCommand,
+        per_mille: u16,
+    ) -> ProfileLimits {
         let v = t.limits.velocity * f32::from(per_mille) * 0.001 * override_factor(o);
         ProfileLimits {
-            velocity: v.min(self.record_velocity_cap(o, cmd)),
+            velocity: v.min(self.record_velocity_cap(inputs, o, cmd)),
             ..t.limits
         }
     }
@@ -301,20 +354,20 @@ impl Axis {
     /// Plans the running task from the present state: passing its target
     /// at its end velocity when a task waits, else stopping on it; the
     /// override 0 pauses it.
-    fn plan_task(&mut self, o: &Snapshot, cmd: &RecordCommand) {
-        let Some(t) = self.tasks.current else {
+    fn plan_task(&mut self, rt: &mut RecordTasks, inputs: &RecordInputs, o: &Snapshot, cmd: &RecordCommand) {
+        let Some(t) = rt.current else {
             return;
         };
-        let per_mille = self.tasks.inputs.override_per_mille;
-        self.tasks.planned_override = per_mille;
-        self.tasks.planned_setup = cmd.setup_mode;
+        let per_mille = inputs.override_per_mille;
+        rt.planned_override = per_mille;
+        rt.planned_setup = cmd.setup_mode;
         if per_mille == 0 || override_factor(o) == 0.0 {
-            self.tasks.planned_override = 0;
+            rt.planned_override = 0;
             let _ = self.profile.stop(t.limits.deceleration, t.limits.jerk);
             return;
         }
-        let limits = self.task_limits(&t, o, cmd, per_mille);
-        let ok = if self.tasks.next.is_some() && t.end_velocity > 0.0 {
+        let limits = self.task_limits(inputs, &t, o, cmd, per_mille);
+        let ok = if rt.next.is_some() && t.end_velocity > 0.0 {
             self.profile
                 .move_through(t.target, t.end_velocity.min(limits.velocity), limits)
                 .is_ok()
@@ -324,24 +377,31 @@ impl Axis {
                 .is_ok()
         };
         if !ok {
-            self.tasks.current = None;
+            rt.current = None;
         }
     }
 
     /// A start edge: the task of `r`, or why not.
-    fn start_task(&mut self, r: &RecordInc, o: &Snapshot, cmd: &RecordCommand) -> Result<(), StartRefusal> {
+    fn start_task(
+        &mut self,
+        rt: &mut RecordTasks,
+        inputs: &RecordInputs,
+        r: &RecordInc,
+        o: &Snapshot,
+        cmd: &RecordCommand,
+    ) -> Result<(), StartRefusal> {
         let options = if r.record == FIELDBUS {
             (u8::from(cmd.relative) * OPT_RELATIVE) | (u8::from(cmd.immediate) * OPT_IMMEDIATE)
         } else {
             r.options
         };
-        let running = self.tasks.current.is_some();
+        let running = rt.current.is_some();
         let immediate = options & OPT_IMMEDIATE != 0 || !running;
-        if !immediate && self.tasks.next.is_some() {
+        if !immediate && rt.next.is_some() {
             return Err(StartRefusal::Busy);
         }
         let relative = options & OPT_RELATIVE != 0;
-        let base = match (immediate, self.tasks.current) {
+        let base = match (immediate, rt.current) {
             (false, Some(t)) => t.target,
             _ => self.sp_pos,
         };
@@ -379,27 +439,30 @@ impl Axis {
         if task.limits.validate().is_err() {
             return Err(StartRefusal::InvalidRecord);
         }
-        self.tasks.finished = false;
+        rt.finished = false;
         self.in_position.reset();
         if immediate {
-            self.tasks.current = Some(task);
-            self.tasks.next = None;
-            if !self.tasks.halted {
-                self.plan_task(o, cmd);
+            rt.current = Some(task);
+            rt.next = None;
+            if !rt.halted {
+                self.plan_task(rt, inputs, o, cmd);
             }
         } else {
-            self.tasks.next = Some(task);
+            rt.next = Some(task);
             // the running task now passes its target at its end velocity
-            if !self.tasks.halted && !self.tasks.braking {
-                self.plan_task(o, cmd);
+            if !rt.halted && !rt.braking {
+                self.plan_task(rt, inputs, o, cmd);
             }
         }
         Ok(())
     }
 
     /// One cycle of record positioning in pp (`halt`: the CiA halt, bit 8).
+    #[allow(clippy::too_many_arguments)]
+    #[inline(never)]
     pub(super) fn record_position(
         &mut self,
+        od: &mut DriveObjects,
         o: &Snapshot,
         halt: bool,
         actual: i32,
@@ -407,57 +470,64 @@ impl Axis {
         now_ns: Nanos,
         dt_ns: u32,
     ) -> Demand {
-        let cmd = self.tasks.command.unwrap_or_default();
-        let prev = self.tasks.prev;
-        self.tasks.prev = cmd;
-        let inputs = self.tasks.inputs;
-        self.tasks.inputs.start = None;
+        let axis = self.window.axis;
+        let mut rt = od.record_tasks(axis);
+        rt.command = self.record_command();
+        if self.record_fresh {
+            // pp (re)activated: no task survives a mode change or a stop; an
+            // input already set is no edge
+            self.record_fresh = false;
+            rt.reset();
+        }
+        let cmd = rt.command.unwrap_or_default();
+        let inputs = self.record_inputs(od, &rt, &cmd, o);
+        let prev = rt.prev;
+        rt.prev = cmd;
 
         // cancel: tasks dropped, braked with the running task's deceleration
         if !cmd.enable {
-            if let Some(t) = self.tasks.current.or(self.tasks.next) {
+            if let Some(t) = rt.current.or(rt.next) {
                 let _ = self.profile.stop(t.limits.deceleration, t.limits.jerk);
             }
-            self.tasks.current = None;
-            self.tasks.next = None;
-            self.tasks.finished = false;
+            rt.current = None;
+            rt.next = None;
+            rt.finished = false;
         }
         // intermediate stop and resume of the same task
         let stop = !cmd.proceed || halt;
-        if stop && !self.tasks.halted {
-            self.tasks.halted = true;
-            if let Some(t) = self.tasks.current {
+        if stop && !rt.halted {
+            rt.halted = true;
+            if let Some(t) = rt.current {
                 let _ = self.profile.stop(t.limits.deceleration, t.limits.jerk);
             }
-        } else if !stop && self.tasks.halted {
-            self.tasks.halted = false;
-            self.plan_task(o, &cmd);
+        } else if !stop && rt.halted {
+            rt.halted = false;
+            self.plan_task(&mut rt, &inputs, o, &cmd);
         }
         if !cmd.start {
-            self.tasks.ack = false;
+            rt.ack = false;
         }
         if let Some(r) = inputs.start {
-            let idle = self.tasks.jog.is_none();
+            let idle = rt.jog.is_none();
             if cmd.enable && cmd.proceed && !halt && idle {
-                match self.start_task(&r, o, &cmd) {
+                match self.start_task(&mut rt, &inputs, &r, o, &cmd) {
                     Ok(()) => {
-                        self.tasks.ack = true;
-                        self.tasks.refused = None;
+                        rt.ack = true;
+                        rt.refused = None;
                     }
-                    Err(why) => self.tasks.refused = Some(why),
+                    Err(why) => rt.refused = Some(why),
                 }
             }
         }
         // override and set-up mode: re-planned unless the axis brakes (P-150)
-        let running = self.tasks.current.is_some() && !self.tasks.halted;
-        let changed = inputs.override_per_mille != self.tasks.planned_override
-            || cmd.setup_mode != self.tasks.planned_setup;
-        if running && changed && !self.tasks.braking {
-            self.plan_task(o, &cmd);
+        let running = rt.current.is_some() && !rt.halted;
+        let changed = inputs.override_per_mille != rt.planned_override || cmd.setup_mode != rt.planned_setup;
+        if running && changed && !rt.braking {
+            self.plan_task(&mut rt, &inputs, o, &cmd);
         }
 
-        let d = if self.tasks.current.is_none() && self.tasks.next.is_none() {
-            self.record_jog(&cmd, &prev, &inputs, o, dt_ns)
+        let d = if rt.current.is_none() && rt.next.is_none() {
+            self.record_jog(&mut rt, &cmd, &prev, &inputs, o, dt_ns)
         } else {
             None
         };
@@ -465,7 +535,7 @@ impl Axis {
             Some(d) => d,
             None => {
                 let s = self.profile.step(dt_ns);
-                self.record_progress(&s, o, &cmd);
+                self.record_progress(&mut rt, &inputs, &s, o, &cmd);
                 Demand {
                     position: s.position,
                     velocity: s.velocity,
@@ -474,24 +544,26 @@ impl Axis {
                 }
             }
         };
-        self.tasks.braking = d.velocity * d.acceleration < 0.0;
+        rt.braking = d.velocity * d.acceleration < 0.0;
 
         let target = self.profile.target();
-        let reached = self.tasks.finished
-            && self.tasks.current.is_none()
+        let reached = rt.finished
+            && rt.current.is_none()
             && self
                 .in_position
                 .update(target, actual, self.profile.is_standstill(), now_ns);
-        let acknowledge = self.tasks.ack || self.tasks.next.is_some();
-        self.tasks.status = RecordStatus {
+        let acknowledge = rt.ack || rt.next.is_some();
+        rt.status = RecordStatus {
             acknowledge,
             target_reached: reached,
             stopped: self.profile.is_standstill() && i199,
-            record: self.tasks.current.map(|t| t.record),
-            waiting: self.tasks.next.is_some(),
-            jogging: self.tasks.jog.is_some(),
-            refused: self.tasks.refused,
+            record: rt.current.map(|t| t.record),
+            waiting: rt.next.is_some(),
+            jogging: rt.jog.is_some(),
+            refused: rt.refused,
         };
+        od.set_record_tasks(axis, &rt);
+        self.record_status = status_bits(&rt.status);
         let mut bits = 0;
         if reached {
             bits |= SW_TARGET_REACHED;
@@ -504,33 +576,41 @@ impl Axis {
 
     /// After the generator's step: the running task done (on its target,
     /// or passed at its end velocity) → the waiting task starts from there.
-    fn record_progress(&mut self, s: &motion::ProfileSample, o: &Snapshot, cmd: &RecordCommand) {
-        let Some(t) = self.tasks.current else {
+    fn record_progress(
+        &mut self,
+        rt: &mut RecordTasks,
+        inputs: &RecordInputs,
+        s: &motion::ProfileSample,
+        o: &Snapshot,
+        cmd: &RecordCommand,
+    ) {
+        let Some(t) = rt.current else {
             return;
         };
-        let paused = self.tasks.halted || self.tasks.planned_override == 0;
+        let paused = rt.halted || rt.planned_override == 0;
         let done = self.profile.passed() || (!paused && s.done && s.position == t.target);
         if !done {
             return;
         }
-        self.tasks.current = self.tasks.next.take();
-        if self.tasks.current.is_some() {
-            self.plan_task(o, cmd);
+        rt.current = rt.next.take();
+        if rt.current.is_some() {
+            self.plan_task(rt, inputs, o, cmd);
         } else {
-            self.tasks.finished = true;
+            rt.finished = true;
         }
     }
 
     /// Jog on records 259/260 while no task runs; `None`: no jog.
     fn record_jog(
         &mut self,
+        rt: &mut RecordTasks,
         cmd: &RecordCommand,
         prev: &RecordCommand,
         inputs: &RecordInputs,
         o: &Snapshot,
         dt_ns: u32,
     ) -> Option<Demand> {
-        if self.tasks.jog.is_none() {
+        if rt.jog.is_none() {
             let dir = match (
                 cmd.jog_positive && !prev.jog_positive,
                 cmd.jog_negative && !prev.jog_negative,
@@ -540,14 +620,14 @@ impl Axis {
                 _ => return None,
             };
             let r = inputs.jog?;
-            self.tasks.finished = false;
-            self.tasks.jog = Some(RecordJog {
+            rt.finished = false;
+            rt.jog = Some(RecordJog {
                 record: r.record,
                 dir,
                 command: VelocityCommand::default(),
             });
         }
-        let mut jog = self.tasks.jog?;
+        let mut jog = rt.jog?;
         let held = if jog.dir > 0.0 {
             cmd.jog_positive
         } else {
@@ -558,7 +638,7 @@ impl Axis {
         }
         let r = inputs.jog?;
         let limits = ProfileLimits {
-            velocity: r.velocity.min(self.record_velocity_cap(o, cmd)),
+            velocity: r.velocity.min(self.record_velocity_cap(inputs, o, cmd)),
             acceleration: r.acceleration,
             deceleration: r.deceleration,
             jerk: f32::INFINITY,
@@ -577,7 +657,7 @@ impl Axis {
             ..limits
         };
         let d = self.jog_with(&mut jog.command, jog.dir, stop_limits, dt_ns);
-        self.tasks.jog = if jog.dir == 0.0 && self.profile.is_standstill() {
+        rt.jog = if jog.dir == 0.0 && self.profile.is_standstill() {
             None
         } else {
             Some(jog)

@@ -12,6 +12,7 @@ use super::*;
 pub(super) use crate::objects::records::ALL_ACCELERATIONS_DEFAULT;
 use crate::objects::records::{
     place, Record, FIELDBUS, J400, J401, J410, J411, OPT_IMMEDIATE, OPT_RELATIVE, RECORDS, RECORD_BYTES,
+    TASK_STATE_AT, TASK_STATE_BYTES,
 };
 use crate::AXIS_B_MANUFACTURER;
 
@@ -42,6 +43,25 @@ const fn data_sub(k: u8) -> u8 {
 }
 
 impl DriveObjects {
+    /// Where the record positioning state of `axis` lives in the image.
+    fn task_state_range(axis: u8) -> core::ops::Range<usize> {
+        let at = objects::image_offset(at_axis(J411, axis)) + 1 + TASK_STATE_AT;
+        at..at + TASK_STATE_BYTES
+    }
+
+    /// The record positioning state of `axis` (decoded).
+    pub(crate) fn record_tasks(&self, axis: u8) -> crate::axis::RecordTasks {
+        let bytes = self.image.get(Self::task_state_range(axis)).unwrap_or(&[]);
+        crate::axis::RecordTasks::from_bytes(bytes)
+    }
+
+    /// Stores the record positioning state of `axis`.
+    pub(crate) fn set_record_tasks(&mut self, axis: u8, t: &crate::axis::RecordTasks) {
+        if let Some(dst) = self.image.get_mut(Self::task_state_range(axis)) {
+            dst.copy_from_slice(&t.to_bytes());
+        }
+    }
+
     /// The record selector J400 of `axis`.
     pub fn record_selector(&self, axis: u8) -> u16 {
         self.get(at_axis(J400, axis), 0)

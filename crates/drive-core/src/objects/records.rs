@@ -13,7 +13,7 @@
 //! | J403 | 3393h | positioning override (PNU 1004), ‰ | yes | no |
 //! | J404 | 3394h | set-up speed (PNU 1060) | yes | yes |
 //! | J410 | 339Ah | memory of the standard records 0 … 255 and their options | no | see [`STANDARD_RECORDS_SAVED`] |
-//! | J411 | 339Bh | memory of the special records 256 … 267 | yes | 256 … 260 |
+//! | J411 | 339Bh | memory of the special records 256 … 267, the axis' task state | yes | 256 … 260 |
 //!
 //! Records are in the CiA 402 user units of the axis (the factor group
 //! 6091h/6092h, decimals A310/A311), like 607Ah, 6081h, 6082h, 6083h and
@@ -87,6 +87,11 @@ const SPECIAL: usize = SPECIAL_SAVED + SPECIAL_VOLATILE;
 /// Standard records per element of J410 (an element stays below the CoE
 /// server's 4 KiB transfer buffer).
 const HALF: usize = STANDARD as usize / 2;
+/// Bytes of the record positioning state of an axis (J411's "Task state",
+/// not saved; the axis' running tasks, `axis/record_state.rs`).
+pub const TASK_STATE_BYTES: usize = 72;
+/// Where it starts in J411's element values.
+pub const TASK_STATE_AT: usize = SPECIAL * (RECORD_BYTES + 1);
 /// Bytes of J410's values: the standard records, then their options.
 pub const STANDARD_BYTES: usize = STANDARD as usize * (RECORD_BYTES + 1);
 
@@ -263,7 +268,7 @@ const STANDARD_ELEMENTS: [EntryInfo; 3] = {
             OctetString((HALF * RECORD_BYTES) as u16),
             RO,
         ),
-        e(2, "Options 0-255", OctetString(STANDARD as u16), RO),
+        e(2, "Options 0-255", OctetString(STANDARD), RO),
     ];
     if STANDARD_RECORDS_SAVED {
         [els[0].saved(), els[1].saved(), els[2].saved()]
@@ -272,7 +277,8 @@ const STANDARD_ELEMENTS: [EntryInfo; 3] = {
     }
 };
 
-/// J411: records 256 … 260 (kept), 261 … 267 (not kept), their options.
+/// J411: records 256 … 260 (kept), 261 … 267 (not kept), their options,
+/// the task state of the axis' record positioning (not kept).
 const SPECIAL_ELEMENTS: &[EntryInfo] = &[
     e(
         0,
@@ -288,6 +294,7 @@ const SPECIAL_ELEMENTS: &[EntryInfo] = &[
         RO,
     ),
     e(2, "Options 256-267", OctetString(SPECIAL as u16), RO),
+    e(3, "Task state", OctetString(TASK_STATE_BYTES as u16), RO),
 ];
 const _: () = assert!(SPECIAL == (RECORDS - STANDARD) as usize);
 const _: () = assert!(HALF * RECORD_BYTES < 4096);
