@@ -37,6 +37,31 @@ fn at_axis(index: u16, axis: u8) -> u16 {
     }
 }
 
+/// Where the values of J410, J411 (axis A) and J411 (axis B) start in the
+/// image (compile time).
+const J410_AT: usize = objects::image_offset(J410);
+const J411_AT: [usize; 2] = [
+    objects::image_offset(J411),
+    objects::image_offset(J411 + AXIS_B_MANUFACTURER),
+];
+const _: () = assert!(J410_AT > 0 && J411_AT[0] > 0 && J411_AT[1] > 0);
+
+/// Where J411 of `axis` starts in the image.
+fn j411_at(axis: u8) -> usize {
+    if axis == 0 {
+        J411_AT[0]
+    } else {
+        J411_AT[1]
+    }
+}
+
+/// Copies `src` into `dst` (as far as both reach; no length panic).
+fn copy(dst: &mut [u8], src: &[u8]) {
+    for (d, s) in dst.iter_mut().zip(src) {
+        *d = *s;
+    }
+}
+
 /// J401 element `k` in the runtime ("SDO Info") numbering.
 const fn data_sub(k: u8) -> u8 {
     k + 1
@@ -45,7 +70,7 @@ const fn data_sub(k: u8) -> u8 {
 impl DriveObjects {
     /// Where the record positioning state of `axis` lives in the image.
     fn task_state_range(axis: u8) -> core::ops::Range<usize> {
-        let at = objects::image_offset(at_axis(J411, axis)) + 1 + TASK_STATE_AT;
+        let at = j411_at(axis) + 1 + TASK_STATE_AT;
         at..at + TASK_STATE_BYTES
     }
 
@@ -58,7 +83,7 @@ impl DriveObjects {
     /// Stores the record positioning state of `axis`.
     pub(crate) fn set_record_tasks(&mut self, axis: u8, t: &crate::axis::RecordTasks) {
         if let Some(dst) = self.image.get_mut(Self::task_state_range(axis)) {
-            dst.copy_from_slice(&t.to_bytes());
+            copy(dst, &t.to_bytes());
         }
     }
 
@@ -71,9 +96,8 @@ impl DriveObjects {
     /// Byte range of record `n` of `axis` in the image and of its options.
     fn record_range(axis: u8, n: u16) -> Option<(core::ops::Range<usize>, usize)> {
         let (object, at, options) = place(n)?;
-        let index = if object == J410 { J410 } else { at_axis(J411, axis) };
         // arrays: the elements follow sub 0 (UNSIGNED8)
-        let base = objects::image_offset(index) + 1;
+        let base = if object == J410 { J410_AT } else { j411_at(axis) } + 1;
         Some((base + at..base + at + RECORD_BYTES, base + options))
     }
 
@@ -105,7 +129,7 @@ impl DriveObjects {
         let Some(dst) = self.image.get_mut(range) else {
             return false;
         };
-        dst.copy_from_slice(&r.to_bytes());
+        copy(dst, &r.to_bytes());
         if let Some(b) = self.image.get_mut(options) {
             *b = r.options & (OPT_RELATIVE | OPT_IMMEDIATE);
         }
@@ -221,15 +245,14 @@ impl DriveObjects {
     /// window showing its record.
     pub(super) fn records_reloaded(&mut self, restore: bool) {
         if restore {
-            for index in [J410, J411, J411.wrapping_add(AXIS_B_MANUFACTURER)] {
+            for (index, base) in [(J410, J410_AT), (J411, J411_AT[0]), (J411, J411_AT[1])] {
                 let Some((_, obj)) = find(index) else { continue };
-                let base = objects::image_offset(index);
                 let len = obj.ram_bytes();
                 if let (Some(dst), Some(src)) = (
                     self.image.get_mut(base..base + len),
                     INITIAL_IMAGE.get(base..base + len),
                 ) {
-                    dst.copy_from_slice(src);
+                    copy(dst, src);
                 }
             }
         }
