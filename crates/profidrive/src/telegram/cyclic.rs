@@ -167,8 +167,12 @@ impl Telegrams {
                 Kind::Pad => {}
                 Kind::Cw1 => out.cw1 = Some(decode_be(od::DataType::U16, bytes) as u16),
                 Kind::Pkw => {
+                    // a zip: the slot's size is 8 by construction, which the
+                    // compiler cannot see (no length-mismatch panic path)
                     let mut p = [0u8; 8];
-                    p.copy_from_slice(bytes);
+                    for (d, b) in p.iter_mut().zip(bytes) {
+                        *d = *b;
+                    }
                     out.pkw = Some(p);
                 }
                 Kind::Object(t) => {
@@ -210,7 +214,11 @@ impl Telegrams {
             };
             match s.kind {
                 Kind::Pad => {}
-                Kind::Pkw => dst.copy_from_slice(&pkw),
+                Kind::Pkw => {
+                    for (d, b) in dst.iter_mut().zip(pkw) {
+                        *d = b;
+                    }
+                }
                 Kind::Cw1 | Kind::Object(_) => match access.read(s.addr) {
                     Ok(v) => encode_be(v, dst),
                     Err(_) => warnings.0 |= Warnings::ACCESS_REFUSED,
