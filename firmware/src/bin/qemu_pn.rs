@@ -207,6 +207,45 @@ fn run(insn: impl Fn(u32) -> u32) -> bool {
         ctl.add(insn(ticks(t0, now_ticks())));
     }
     let valid = d.device().output_data(2).is_some();
+    // the PROFIdrive profile's cyclic path: receive telegram 1 of the
+    // Example Function block (CW1 0x0406, 100 rpm, ramps) in the
+    // controller → drive module, the response built every cycle
+    let mut telegram = [0u8; 36];
+    telegram[0] = 0xE1;
+    telegram[2..4].copy_from_slice(&0x0406u16.to_be_bytes());
+    telegram[4..8].copy_from_slice(&100i32.to_be_bytes());
+    telegram[16..20].copy_from_slice(&10_000u32.to_be_bytes());
+    if let Some(cr) = ar.output_cr.as_ref() {
+        let csdu = n.saturating_sub(4 + usize::from(cr.data_length));
+        for o in cr.data.iter().filter(|o| o.slot == 2) {
+            let at = csdu + usize::from(o.frame_offset);
+            for (dst, b) in frame
+                .iter_mut()
+                .skip(at)
+                .zip(telegram.iter().take(usize::from(o.data_len)))
+            {
+                *dst = *b;
+            }
+        }
+    }
+    let mut profiled = Figure::default();
+    for k in FRAMES + 1..=2 * FRAMES {
+        let now = cycle.saturating_mul(u64::from(k));
+        let counter = (k as u16).wrapping_mul(256);
+        if let Some(c) = frame.get_mut(n.saturating_sub(4)..n.saturating_sub(2)) {
+            c.copy_from_slice(&counter.to_be_bytes());
+        }
+        d.receive(now, &frame, &mut |_: &[u8]| {}, &mut |_| {});
+        let _ = d.poll(now, &mut |_: &[u8]| {}, &mut |_| {});
+        let t0 = now_ticks();
+        let _ = d.control_cycle(now, &io);
+        profiled.add(insn(ticks(t0, now_ticks())));
+    }
+    let zsw1 = d.profile().own().zsw1;
+    defmt::info!(
+        "controller: PROFIdrive telegram 1 with CW1 0x0406 answered, ZSW1 state {=u16:#06x}",
+        zsw1 & 0x47
+    );
     defmt::info!(
         "controller: cyclic data exchanged: {=bool}, outputs valid: {=bool}",
         exchanging,
@@ -233,9 +272,15 @@ fn run(insn: impl Fn(u32) -> u32) -> bool {
         ctl.max
     );
     defmt::info!(
+        "figure: PnDrive control cycle with the PROFIdrive telegram 1 (receive, CW1, response): mean {=u32} max {=u32} instructions, {=i32} more than at rest",
+        profiled.mean(),
+        profiled.max,
+        profiled.mean() as i32 - ctl.mean() as i32
+    );
+    defmt::info!(
         "figure: input frames sent {=u32} of {=u32} cycles",
         inputs,
         FRAMES
     );
-    connected && exchanging && valid && inputs > FRAMES / 2
+    connected && exchanging && valid && inputs > FRAMES / 2 && zsw1 & 0x47 == 0x01
 }
