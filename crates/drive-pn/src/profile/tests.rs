@@ -306,3 +306,84 @@ fn p082_p143_p146_bit_6_starts_the_fieldbus_record() {
     assert!(s.record.is_some() || s.refused.is_some(), "{s:?}");
     assert_eq!(s.refused, None, "the start was taken: {s:?}");
 }
+
+fn pkw_request(code: u8, pnu: u16, sub: u8, value: u32) -> [u8; 8] {
+    let i = pnu.to_be_bytes();
+    let v = value.to_be_bytes();
+    [code, i[0], i[1], sub, v[0], v[1], v[2], v[3]]
+}
+
+/// A method the drive has no homing for is refused and the stored one
+/// stays (P-172); a known one is kept (P-161).
+#[test]
+fn p161_p172_an_unsupported_homing_method_is_refused() {
+    let mut b = Bench::new();
+    b.run(&speed(0x0400, 0, 0, pkw_request(0x42, 1050, 0, 99)), 10);
+    assert_eq!(
+        (b.response[24], b.i32_at(28)),
+        (0xC2, 0x14),
+        "value impermissible"
+    );
+    assert_eq!(b.d.profile().own().homing_method, 0);
+    b.run(&speed(0x0400, 0, 0, [0; 8]), 10);
+    b.run(
+        &speed(0x0400, 0, 0, pkw_request(0x42, 1050, 0, (-17i32) as u32)),
+        10,
+    );
+    assert_eq!(b.response[24], 0x42);
+    assert_eq!(b.d.profile().own().homing_method, -17);
+}
+
+/// PNU 1600: main × 16 + sub of the present error, 0 without one (P-217).
+#[test]
+fn p217_pnu_1600_is_main_times_16_plus_sub() {
+    let mut b = Bench::new();
+    b.run(&speed(0x0400, 0, 0, pkw_request(0x41, 1600, 0, 0)), 10);
+    assert_eq!((b.response[24], b.i32_at(28)), (0x41, 0));
+    b.d.axes_mut()[0].raise_event(motion::Event { number: 44, cause: 1 });
+    b.run(&speed(0x0400, 0, 0, [0; 8]), 30);
+    b.run(&speed(0x0400, 0, 0, pkw_request(0x41, 1600, 0, 0)), 10);
+    assert_eq!((b.response[24], b.i32_at(28)), (0x41, 44 * 16 + 1));
+}
+
+/// PNU 971 = 1 saves the parameters (and the records with them) through
+/// PKW; 257 (encoder memory) is refused: this drive has none (P-199, P-201).
+#[test]
+fn p199_p201_pnu_971_saves_and_refuses_the_encoder_memory() {
+    let mut b = Bench::new();
+    b.d.objects_mut()
+        .set(drive_core::objects::records::J404, 0, 1234)
+        .unwrap();
+    b.run(&speed(0x0400, 0, 0, pkw_request(0x42, 971, 0, 1)), 10);
+    assert_eq!(b.response[24], 0x42, "done");
+    b.run(&speed(0x0400, 0, 0, [0; 8]), 10);
+    b.run(&speed(0x0400, 0, 0, pkw_request(0x42, 971, 0, 257)), 10);
+    assert_eq!((b.response[24], b.i32_at(28)), (0xC2, 0x14));
+    // the saved set has the set-up speed: a new drive over the same flash
+    let flash = core::mem::replace(&mut b.d, crate::tests::commissioned()).into_flash();
+    let again = PnDrive::new(flash, crate::tests::hardware());
+    assert_eq!(
+        again.objects().get(drive_core::objects::records::J404, 0),
+        Ok(1234)
+    );
+}
+
+/// PNU 1040.0, mapped at offset 20 of telegram 1, writes the velocity of
+/// both jog records 259/260 every cycle; a PKW read of 1040.0 returns the
+/// positive one (P-173).
+#[test]
+fn p173_symmetrical_jog_velocity_writes_both_jog_records() {
+    let mut b = Bench::new();
+    let mut t = speed(0x0400, 0, 0, pkw_request(0x41, 1040, 0, 0));
+    t[20..24].copy_from_slice(&300i32.to_be_bytes());
+    b.run(&t, 10);
+    let inc_per_s = (300.0 * f64::from(motion::INCREMENTS_PER_REVOLUTION) / 60.0).round() as u32;
+    for n in [
+        drive_core::objects::records::JOG_POSITIVE,
+        drive_core::objects::records::JOG_NEGATIVE,
+    ] {
+        let r = b.d.objects().record(0, n).unwrap();
+        assert_eq!(r.profile_velocity, inc_per_s, "record {n}");
+    }
+    assert_eq!((b.response[24], b.i32_at(28)), (0x41, 300));
+}
