@@ -678,6 +678,8 @@ EXTRAPOLATION_OVERRUN = 0x8612
 # periods after one without a frame in time before the following error
 # counts again (the cascade settles within a few; 50 leaves a margin)
 SETTLE_PERIODS = 50
+# a following error this small counts as settled at the end of a move
+SETTLED_INC = 100
 # a run may be stalled by its machine this often (each is printed)
 MAX_STALLS = 3
 
@@ -902,9 +904,12 @@ def motion(line, axes, move_cycles=1000, hold_cycles=200):
                 clean[a.name] += 1
                 max_ferr[a.name] = max(max_ferr[a.name], ferr)
     total = move_cycles + hold_cycles
-    # the end position once the line has been undisturbed for a while
-    for _ in range(1000):
-        if all(line.cyc.periods[-SETTLE_PERIODS:]):
+    # the end position once the line has been undisturbed for a while and
+    # the axes have settled (after a late master's gap late in the move the
+    # axis may still be on its way back to the set-point)
+    for _ in range(2000):
+        settled = all(abs(a.ferr(line.inp[a.slave])) <= SETTLED_INC for a in axes)
+        if all(line.cyc.periods[-SETTLE_PERIODS:]) and settled:
             break
         line.cycle(curve)
     too_few = [a.name for a in axes if clean[a.name] < total // 2]
