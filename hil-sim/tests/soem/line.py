@@ -675,9 +675,12 @@ class Cycle:
 LATE_FRAME_LIMIT = 5
 I423_PERIODS = 10
 EXTRAPOLATION_OVERRUN = 0x8612
-# periods after one without a frame in time before the following error
-# counts again (the cascade settles within a few; 50 leaves a margin)
-SETTLE_PERIODS = 50
+# periods after a gap before the following error counts again (the
+# cascade settles within a few; 20 leaves a margin)
+SETTLE_PERIODS = 20
+# a run of this many periods without a frame in time is a gap (one or two
+# the drive bridges by extrapolating, C-116, within its tracking)
+GAP_PERIODS = 3
 # a following error this small counts as settled at the end of a move
 SETTLED_INC = 100
 # a run may be stalled by its machine this often (each is printed)
@@ -881,15 +884,16 @@ def motion(line, axes, move_cycles=1000, hold_cycles=200):
             a.write(line.outs[a.slave], 0x0F, 8, start[a.name] + round(x * INC_PER_REV))
 
     # The tracking check counts the cycles of an undisturbed line only: a
-    # period without a frame in the window (a late or descheduled master)
-    # makes the drive extrapolate the set-point (C-116/C-117) and the
-    # following error after it measures the gap, not the control. Samples
-    # within SETTLE_PERIODS of such a period are left out (and counted).
+    # gap of GAP_PERIODS or more periods without a frame in the window (a
+    # late or descheduled master) makes the drive extrapolate the set-point
+    # for longer (C-116/C-117) and the following error after it measures the
+    # gap, not the control. Samples within SETTLE_PERIODS of such a gap are
+    # left out (and counted).
     clean = {a.name: 0 for a in axes}
     raw_ferr = {a.name: 0 for a in axes}
     for _ in range(move_cycles + hold_cycles):
         line.cycle(curve)
-        undisturbed = all(line.cyc.periods[-SETTLE_PERIODS:])
+        undisturbed = line.cyc.stall(SETTLE_PERIODS) < GAP_PERIODS
         for a in axes:
             sw = a.sw(line.inp[a.slave])
             if not sw_is(sw, ENABLED):
@@ -909,7 +913,7 @@ def motion(line, axes, move_cycles=1000, hold_cycles=200):
     # axis may still be on its way back to the set-point)
     for _ in range(2000):
         settled = all(abs(a.ferr(line.inp[a.slave])) <= SETTLED_INC for a in axes)
-        if all(line.cyc.periods[-SETTLE_PERIODS:]) and settled:
+        if line.cyc.stall(SETTLE_PERIODS) < GAP_PERIODS and settled:
             break
         line.cycle(curve)
     too_few = [a.name for a in axes if clean[a.name] < total // 2]
