@@ -4,10 +4,10 @@
 //! back: the PROFIdrive-style profile writes set-points into CiA objects
 //! from values in its PROFINET units (spec `profidrive.md` §11, P-214).
 //!
-//! The conversions are the axis' own ([`crate::axis::Snapshot::to_increments`]:
+//! The conversions are the axis' own (`Snapshot::to_increments` in `axis/snapshot.rs`:
 //! positions through [`AxisScaling`] with the position polarity, rates
 //! through the magnitude of user units per increment and the decimals);
-//! `user_units_agree_with_the_axis_snapshot` keeps the two together.
+//! `c109_user_units_agree_with_the_axis_snapshot` keeps the two together.
 
 use crate::axis::Axis;
 use crate::params::{A213, A310};

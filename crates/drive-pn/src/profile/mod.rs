@@ -21,7 +21,7 @@
 
 pub mod access;
 pub mod pnu;
-mod status;
+pub mod status;
 
 use access::{DriveAccess, OwnValues};
 use drive_core::axis::{Axis, RecordCommand};
