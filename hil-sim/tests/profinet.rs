@@ -32,7 +32,6 @@ mod common;
 
 use common::ip;
 use profinet::model::{self, DataModule, Direction};
-use std::io::BufRead;
 use std::path::{Path, PathBuf};
 use std::process::{Child, Command, Stdio};
 use std::time::{Duration, Instant};
@@ -194,7 +193,7 @@ impl Line {
     /// are printed as they come and returned with the exit status.
     fn run(&self, python: &Path, args: &[&str]) -> (bool, Vec<String>) {
         let script = Path::new(env!("CARGO_MANIFEST_DIR")).join("tests/profinet/controller.py");
-        let mut child = Command::new("ip")
+        let child = Command::new("ip")
             .args(["netns", "exec", &self.ctl_ns])
             .arg(python)
             .arg("-u")
@@ -205,36 +204,7 @@ impl Line {
             .stderr(Stdio::piped())
             .spawn()
             .expect("run the script");
-        let out = child.stdout.take().expect("stdout");
-        let err = child.stderr.take().expect("stderr");
-        let t_out = std::thread::spawn(move || {
-            let mut lines = Vec::new();
-            for line in std::io::BufReader::new(out).lines().map_while(Result::ok) {
-                println!("{line}");
-                lines.push(line);
-            }
-            lines
-        });
-        let t_err = std::thread::spawn(move || {
-            for line in std::io::BufReader::new(err).lines().map_while(Result::ok) {
-                println!("stderr: {line}");
-            }
-        });
-        let start = Instant::now();
-        let status = loop {
-            if let Some(st) = child.try_wait().expect("wait") {
-                break st;
-            }
-            if start.elapsed() > SCRIPT_LIMIT {
-                let _ = child.kill();
-                let st = child.wait().expect("wait");
-                println!("{} hung: killed after {SCRIPT_LIMIT:?}", script.display());
-                break st;
-            }
-            std::thread::sleep(Duration::from_millis(50));
-        };
-        let lines = t_out.join().unwrap_or_default();
-        let _ = t_err.join();
+        let (status, lines) = common::watch_script(child, &script, SCRIPT_LIMIT);
         (status.success(), lines)
     }
 

@@ -26,7 +26,7 @@ use std::fmt::Write as _;
 use std::path::{Path, PathBuf};
 use std::process::{Child, Command, ExitStatus, Stdio};
 use std::sync::Mutex;
-use std::time::{Duration, Instant};
+use std::time::Duration;
 
 /// One SOEM run at a time: each needs the cores for its 1 ms cycle.
 static ONE_AT_A_TIME: Mutex<()> = Mutex::new(());
@@ -139,7 +139,7 @@ impl Line {
         let script = Path::new(env!("CARGO_MANIFEST_DIR"))
             .join("tests/soem")
             .join(script);
-        let mut child = Command::new("ip")
+        let child = Command::new("ip")
             .args(["netns", "exec", &self.master_ns])
             .arg(python)
             .arg("-u")
@@ -151,36 +151,7 @@ impl Line {
             .spawn()
             .expect("run the script");
         // print line by line (println! goes through the test harness's capture)
-        let out = child.stdout.take().expect("stdout");
-        let err = child.stderr.take().expect("stderr");
-        let t_out = std::thread::spawn(move || {
-            use std::io::BufRead;
-            for line in std::io::BufReader::new(out).lines().map_while(Result::ok) {
-                println!("{line}");
-            }
-        });
-        let t_err = std::thread::spawn(move || {
-            use std::io::BufRead;
-            for line in std::io::BufReader::new(err).lines().map_while(Result::ok) {
-                println!("stderr: {line}");
-            }
-        });
-        let start = Instant::now();
-        let status = loop {
-            if let Some(st) = child.try_wait().expect("wait") {
-                break st;
-            }
-            if start.elapsed() > SCRIPT_LIMIT {
-                let _ = child.kill();
-                let st = child.wait().expect("wait");
-                println!("{} hung: killed after {SCRIPT_LIMIT:?}", script.display());
-                break st;
-            }
-            std::thread::sleep(Duration::from_millis(50));
-        };
-        let _ = t_out.join();
-        let _ = t_err.join();
-        status
+        common::watch_script(child, &script, SCRIPT_LIMIT).0
     }
 
     /// What `serve` printed (state changes of every drive, with AL codes).

@@ -103,3 +103,45 @@ impl Drop for Netns {
         let _ = Command::new("ip").args(["netns", "del", &self.ns]).status();
     }
 }
+
+/// Follows a test peer's script `child` (spawned with piped stdout and
+/// stderr) to its end: prints its lines as they come (stderr prefixed),
+/// kills it after `limit`; returns its exit status and its stdout lines.
+pub fn watch_script(
+    mut child: Child,
+    script: &std::path::Path,
+    limit: Duration,
+) -> (std::process::ExitStatus, Vec<String>) {
+    use std::io::BufRead;
+    let out = child.stdout.take().expect("stdout");
+    let err = child.stderr.take().expect("stderr");
+    let t_out = std::thread::spawn(move || {
+        let mut lines = Vec::new();
+        for line in std::io::BufReader::new(out).lines().map_while(Result::ok) {
+            println!("{line}");
+            lines.push(line);
+        }
+        lines
+    });
+    let t_err = std::thread::spawn(move || {
+        for line in std::io::BufReader::new(err).lines().map_while(Result::ok) {
+            println!("stderr: {line}");
+        }
+    });
+    let start = std::time::Instant::now();
+    let status = loop {
+        if let Some(st) = child.try_wait().expect("wait") {
+            break st;
+        }
+        if start.elapsed() > limit {
+            let _ = child.kill();
+            let st = child.wait().expect("wait");
+            println!("{} hung: killed after {limit:?}", script.display());
+            break st;
+        }
+        std::thread::sleep(Duration::from_millis(50));
+    };
+    let lines = t_out.join().unwrap_or_default();
+    let _ = t_err.join();
+    (status, lines)
+}
