@@ -20,6 +20,11 @@ struct Bench {
     /// position integrates the commanded velocity is not modelled; the axes
     /// run open against an encoder standing still unless told).
     response: Vec<u8>,
+    /// The axes' inputs each cycle (ready, encoder at 0, unless a test
+    /// changes them); `advance` increments are added to the encoders per
+    /// cycle (a motor turning at a constant speed).
+    io: [AxisIo; 2],
+    advance: i32,
 }
 
 fn slot(d: &PnDrive<TestFlash>, to_drive: bool) -> u16 {
@@ -37,6 +42,8 @@ impl Bench {
             ms: 0,
             counter: 0,
             response: Vec::new(),
+            io: [AxisIo::ready(0), AxisIo::ready(0)],
+            advance: 0,
         }
     }
 
@@ -72,8 +79,11 @@ impl Bench {
         let ar = self.d.device().cm().ar().unwrap().clone();
         let input = ar.input_cr.clone().unwrap();
         let from = slot(&self.d, false);
-        let io = [AxisIo::ready(0), AxisIo::ready(0)];
         for _ in 0..ms {
+            for io in &mut self.io {
+                io.position_inc = io.position_inc.wrapping_add(self.advance);
+            }
+            let io = self.io;
             let now = Nanos::from_ms(self.ms);
             self.counter = self.counter.wrapping_add(32);
             let f = self.frame(telegram);
@@ -157,7 +167,7 @@ fn p071_p072_p073_p074_the_drive_ships_with_the_function_blocks_telegrams() {
 
 /// 0x0406 → 0x0407 → 0x040F, each answered by its ZSW1 state (spec §7.3).
 #[test]
-fn p110_p111_p113_p114_p096_the_enable_sequence_is_answered_in_zsw1() {
+fn p110_p111_p113_p114_p096_p125_the_enable_sequence_is_answered_in_zsw1() {
     let mut b = Bench::new();
     b.run(&speed(0x0400, 0, 10_000, [0; 8]), 20);
     assert_eq!(b.response[0], 0xF1, "the response to telegram 1");
@@ -387,3 +397,6 @@ fn p173_symmetrical_jog_velocity_writes_both_jog_records() {
     }
     assert_eq!((b.response[24], b.i32_at(28)), (0x41, 300));
 }
+
+#[path = "tests_sm.rs"]
+mod sm;

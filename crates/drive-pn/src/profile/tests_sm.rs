@@ -1,0 +1,244 @@
+//! The device state machine through CW1/ZSW1 (spec §7.3: each transition
+//! from its source state), the mode PNU 1500 and the status PNUs 967/968,
+//! through the drive's telegrams.
+
+use super::{pkw_request, positioning, speed, Bench};
+
+/// ZSW1's state bits.
+const STATE: u16 = 0x0047;
+const SOI: u16 = 0x0040;
+const RTSO: u16 = 0x0001;
+const SO: u16 = 0x0003;
+const OP: u16 = 0x0007;
+
+impl Bench {
+    /// CW1 `cw1` in receive telegram 1 for `ms` ms; ZSW1's state.
+    fn cw(&mut self, cw1: u16, ms: u64) -> u16 {
+        self.run(&speed(cw1, 0, 10_000, [0; 8]), ms);
+        self.zsw1() & STATE
+    }
+
+    /// From switching on inhibited to `state` with the enable sequence.
+    fn reach(&mut self, state: u16) {
+        assert_eq!(self.cw(0x0400, 20), SOI, "{:#06x}", self.zsw1());
+        for (cw1, s) in [(0x0406, RTSO), (0x0407, SO), (0x040F, OP)] {
+            assert_eq!(self.cw(cw1, 20), s, "CW1 {cw1:#06x}: ZSW1 {:#06x}", self.zsw1());
+            if s == state {
+                return;
+            }
+        }
+    }
+
+    /// A PKW read of `pnu`.`sub` answered (after the 0x00 toggle): the
+    /// response's code and value.
+    fn pkw_read(&mut self, pnu: u16, sub: u8, cw1: u16) -> (u8, i32) {
+        self.run(&speed(cw1, 0, 10_000, [0; 8]), 5);
+        self.run(&speed(cw1, 0, 10_000, pkw_request(0x41, pnu, sub, 0)), 10);
+        (self.response[24], self.i32_at(28))
+    }
+}
+
+/// T1 needs the hardware controller-enable input (A60 here): without it
+/// OFF leaves the drive in switching on inhibited; with it ready; losing it
+/// in operation takes the drive back to switching on inhibited.
+#[test]
+fn p112_the_controller_enable_input_gates_ready_for_switching_on() {
+    let mut b = Bench::new();
+    b.io[0].additional_enable = false;
+    assert_eq!(b.cw(0x0400, 20), SOI);
+    assert_eq!(b.cw(0x0406, 50), SOI, "no enable input: {:#06x}", b.zsw1());
+    b.io[0].additional_enable = true;
+    assert_eq!(b.cw(0x0406, 20), RTSO, "{:#06x}", b.zsw1());
+    assert_eq!(b.cw(0x0407, 20), SO);
+    assert_eq!(b.cw(0x040F, 20), OP);
+    b.io[0].additional_enable = false;
+    assert_eq!(
+        b.cw(0x040F, 50),
+        SOI,
+        "input lost in operation: {:#06x}",
+        b.zsw1()
+    );
+}
+
+/// T4: disable operation (0111) in operation → switched on.
+#[test]
+fn p115_disable_operation_returns_to_switched_on() {
+    let mut b = Bench::new();
+    b.reach(OP);
+    assert_eq!(b.cw(0x0407, 50), SO, "{:#06x}", b.zsw1());
+    assert_eq!(b.cw(0x040F, 20), OP, "enable again from switched on");
+}
+
+/// T5: OFF (x110) in switched on → ready.
+#[test]
+fn p116_off_returns_switched_on_to_ready() {
+    let mut b = Bench::new();
+    b.reach(SO);
+    assert_eq!(b.cw(0x0406, 20), RTSO, "{:#06x}", b.zsw1());
+}
+
+/// T6, T7, T8: coast stop (bit 1 = 0) from ready, operation and switched
+/// on → switching on inhibited at once, ZSW1 bit 4 = 0 while commanded.
+#[test]
+fn p117_p118_p119_coast_stop_from_each_state() {
+    for from in [RTSO, OP, SO] {
+        let mut b = Bench::new();
+        b.reach(from);
+        assert_eq!(b.cw(0x040D, 20), SOI, "from {from:#06x}: {:#06x}", b.zsw1());
+        assert_eq!(b.zsw1() & 0x0010, 0, "bit 4: coast stop active");
+        assert_ne!(b.zsw1() & 0x0020, 0, "bit 5: no quick stop");
+        assert_eq!(b.cw(0x0406, 20), RTSO, "OFF leaves the coast stop");
+    }
+}
+
+/// T9, T10, T12: quick stop (bit 2 = 0, bit 1 = 1) from operation,
+/// switched on and ready → switching on inhibited; bit 5 = 0 meanwhile.
+#[test]
+fn p120_p121_p123_quick_stop_from_each_state() {
+    for from in [OP, SO, RTSO] {
+        let mut b = Bench::new();
+        b.reach(from);
+        assert_eq!(b.cw(0x040B, 50), SOI, "from {from:#06x}: {:#06x}", b.zsw1());
+        assert_eq!(b.zsw1() & 0x0020, 0, "bit 5: quick stop active");
+        assert_ne!(b.zsw1() & 0x0010, 0, "bit 4: no coast stop");
+        assert_eq!(b.cw(0x0406, 20), RTSO);
+    }
+}
+
+/// T11: OFF (x110) in operation → ready.
+#[test]
+fn p122_off_in_operation_returns_to_ready() {
+    let mut b = Bench::new();
+    b.reach(OP);
+    assert_eq!(b.cw(0x0406, 50), RTSO, "{:#06x}", b.zsw1());
+}
+
+/// F: an error in any state ends in switching on inhibited with bit 3,
+/// after the error reaction; the acknowledge needs the full sequence again.
+#[test]
+fn p124_an_error_in_any_state_ends_in_soi_with_bit_3() {
+    for from in [SOI, RTSO, SO, OP] {
+        let mut b = Bench::new();
+        b.reach(from);
+        let cw1 = [(SOI, 0x0400), (RTSO, 0x0406), (SO, 0x0407), (OP, 0x040F)]
+            .iter()
+            .find(|(s, _)| *s == from)
+            .map(|(_, c)| *c)
+            .unwrap();
+        b.d.axes_mut()[0].raise_event(motion::Event { number: 44, cause: 1 });
+        b.cw(cw1, 50);
+        assert_ne!(b.zsw1() & 0x0008, 0, "from {from:#06x}: fault {:#06x}", b.zsw1());
+        assert_eq!(b.zsw1() & 0x0007, 0, "disabled");
+        // enable commands do nothing while the fault is present
+        assert_eq!(b.cw(0x040F, 20) & 0x0007, 0);
+        b.cw(0x0480 | cw1, 20);
+        assert_eq!(b.zsw1() & 0x0008, 0, "acknowledged");
+        assert_eq!(b.zsw1() & STATE, SOI);
+        b.reach(OP);
+    }
+}
+
+/// PNU 1500 reads 0x10 in positioning, 0x08 in speed control and 0x04 in
+/// torque control; a write of 0x04 with telegram 2 (no bound mode)
+/// switches to torque control; a value outside the three is refused.
+#[test]
+fn p127_p128_p055_pnu_1500_reports_and_switches_the_mode() {
+    let mut b = Bench::new();
+    b.run(&positioning(0x0400, 0, 100, 10_000), 10);
+    assert_eq!(b.pkw_positioning(0x41, 1500, 0, 0), (0x41, 0x10));
+    assert_eq!(b.pkw_read(1500, 0, 0x0400), (0x41, 0x08));
+    // telegram 2 keeps the mode; PKW writes 0x04
+    let mut t = [0u8; 36];
+    t[0] = 0xE2;
+    t[2..4].copy_from_slice(&0x0400u16.to_be_bytes());
+    b.run(&t, 10);
+    assert_eq!(b.response[0], 0xF2);
+    assert_eq!(b.response[1], 0x08, "telegram 2 has no bound mode");
+    t[24..32].copy_from_slice(&pkw_request(0x42, 1500, 0, 0x04));
+    b.run(&t, 10);
+    assert_eq!(b.response[24], 0x42, "written");
+    assert_eq!(b.d.objects().get(0x6060, 0), Ok(4));
+    assert_eq!(b.response[1], 0x04, "torque control in byte 1");
+    t[24..32].copy_from_slice(&[0; 8]);
+    b.run(&t, 5);
+    t[24..32].copy_from_slice(&pkw_request(0x42, 1500, 0, 0x20));
+    b.run(&t, 10);
+    assert_eq!((b.response[24], b.i32_at(28)), (0xC2, 0x14), "0x20 is no mode");
+    assert_eq!(b.d.objects().get(0x6060, 0), Ok(4), "unchanged");
+}
+
+impl Bench {
+    /// A PKW request in receive telegram 0 (after the 0x00 toggle): the
+    /// response's code and value.
+    fn pkw_positioning(&mut self, code: u8, pnu: u16, sub: u8, value: u32) -> (u8, i32) {
+        let mut t = positioning(0x0400, 0, 100, 10_000);
+        self.run(&t, 5);
+        t[24..32].copy_from_slice(&pkw_request(code, pnu, sub, value));
+        self.run(&t, 10);
+        (self.response[24], self.i32_at(28))
+    }
+}
+
+/// PNU 967 reads the CW1 the telegram carries (default 0 before any);
+/// PNU 968 reads ZSW1 and refuses a write.
+#[test]
+fn p076_p095_cw1_and_zsw1_as_pnus() {
+    let mut b = Bench::new();
+    assert_eq!(b.d.profile().own().cw1, 0, "default 0");
+    assert_eq!(b.pkw_read(967, 0, 0x0406), (0x41, 0x0406));
+    let (code, zsw1) = b.pkw_read(968, 0, 0x0406);
+    assert_eq!(code, 0x41);
+    assert_eq!(zsw1 as u16, b.zsw1(), "the ZSW1 of the response");
+    assert_eq!(zsw1 as u16 & STATE, RTSO);
+    b.run(&speed(0x0406, 0, 10_000, [0; 8]), 5);
+    b.run(&speed(0x0406, 0, 10_000, pkw_request(0x42, 968, 0, 0)), 10);
+    assert_eq!((b.response[24], b.i32_at(28)), (0xC2, 0x01), "cannot be changed");
+}
+
+/// PNU 1011.0 / .1 write the vl ramp of both directions (6048h / 6049h:
+/// rpm per second); reading returns it (telegram 0 here: telegram 1 maps
+/// 1011.2 and writes both ramps every cycle).
+#[test]
+fn p179_p180_pnu_1011_ramps() {
+    let mut b = Bench::new();
+    // the one declaration's default (6048h/6049h: 3 000 rpm per 1 s), not
+    // the Metronix drive's 14 100 rpm/s (docs/conformance.md, P-182)
+    assert_eq!(
+        b.pkw_positioning(0x41, 1011, 0, 0),
+        (0x41, 3_000),
+        "default acceleration"
+    );
+    assert_eq!(
+        b.pkw_positioning(0x41, 1011, 1, 0),
+        (0x41, 3_000),
+        "default deceleration"
+    );
+    assert_eq!(b.pkw_positioning(0x42, 1011, 0, 2_000).0, 0x42);
+    assert_eq!(b.d.objects().get(0x6048, 1), Ok(2_000));
+    assert_eq!(b.d.objects().get(0x6048, 2), Ok(1), "per 1 s");
+    assert_eq!(b.d.objects().get(0x6049, 1), Ok(3_000), "deceleration kept");
+    assert_eq!(b.pkw_positioning(0x41, 1011, 0, 0), (0x41, 2_000));
+    assert_eq!(b.pkw_positioning(0x42, 1011, 1, 3_000).0, 0x42);
+    assert_eq!(b.d.objects().get(0x6049, 1), Ok(3_000));
+    assert_eq!(b.d.objects().get(0x6048, 1), Ok(2_000), "acceleration kept");
+    assert_eq!(b.pkw_positioning(0x41, 1011, 1, 0), (0x41, 3_000));
+}
+
+/// PNU 1101 is the actual velocity in the velocity unit (rpm): the encoder
+/// turning at 300 rpm reads 300; PNU 1100 the position in 1/1000 rev.
+#[test]
+fn p184_p185_actual_position_and_velocity_in_profinet_units() {
+    let mut b = Bench::new();
+    // 300 rpm = 5 rev/s = 5 · 2^20 increments per second
+    b.advance = 5 * (1 << 20) / 1000;
+    b.run(&speed(0x0400, 0, 10_000, [0; 8]), 200);
+    let rpm = b.i32_at(8);
+    assert!((rpm - 300).abs() <= 1, "PNU 1101 in the response: {rpm}");
+    // standing still: the position, exactly
+    b.advance = 0;
+    b.run(&speed(0x0400, 0, 10_000, [0; 8]), 100);
+    let at = b.io[0].position_inc;
+    let expect = (f64::from(at) * 1000.0 / f64::from(1 << 20)).round() as i32;
+    assert_eq!(b.i32_at(4), expect, "PNU 1100, encoder at {at} increments");
+    assert_eq!(b.i32_at(8), 0, "standing");
+}
