@@ -14,6 +14,27 @@ const SW_INTERNAL_LIMIT: i64 = 1 << 11;
 const SW_SPEED_ZERO: i64 = 1 << 12;
 const SW_FOLLOWING_ERROR: i64 = 1 << 13;
 
+/// rpm → increments per second.
+const RPM_TO_INC_PER_S: f32 = motion::INCREMENTS_PER_REVOLUTION as f32 / 60.0;
+
+/// ZSW1 bits 8 and 10 in speed control (vl) from the actual velocity and
+/// the set-point: bit 8 the actual speed inside the velocity window around
+/// the set-point (P-102), bit 10 the set-point reached or exceeded, signed
+/// (P-106: actual ≥ set-point − window). The window is the core's C40 (the
+/// manual names no PNU for the "speed signal" settings; docs/conformance.md).
+/// The set-point is 6042h while CW1 bits 4 and 6 enable it, else 0.
+pub fn speed_bits(target_rpm: i64, cw1: u16, actual_inc_per_s: f32, window_inc_per_s: f32) -> (bool, bool) {
+    let enabled = cw1 & 0x0050 == 0x0050;
+    let target = if enabled {
+        target_rpm as f32 * RPM_TO_INC_PER_S
+    } else {
+        0.0
+    };
+    let within = (actual_inc_per_s - target).abs() <= window_inc_per_s;
+    let reached = actual_inc_per_s >= target - window_inc_per_s;
+    (within, reached)
+}
+
 fn state(s: Cia) -> State {
     match s {
         Cia::NotReadyToSwitchOn => State::NotReady,
@@ -35,6 +56,12 @@ pub fn zsw1(objects: &DriveObjects, axis: &Axis, cw1: u16, homing: bool) -> u16 
     let speed = matches!(mode, 2 | 3);
     let records = axis.record_status();
     let velocity = axis.actual_velocity();
+    // vl has no statusword mode bits (C-053): its speed signals come from
+    // the velocity here; pv reports them in 6041h bit 10
+    let vl = (mode == 2).then(|| {
+        let target = objects.get(axis.cia402_index(0x6042), 0).unwrap_or(0);
+        speed_bits(target, cw1, velocity, axis.params().velocity_window_inc_per_s)
+    });
     let at_rest = velocity.abs() < 1.0e3;
     let status = Status {
         state: state(axis.state()),
@@ -42,14 +69,18 @@ pub fn zsw1(objects: &DriveObjects, axis: &Axis, cw1: u16, homing: bool) -> u16 
         warning: sw & (SW_WARNING | SW_INTERNAL_LIMIT) != 0,
         coast_stop: cw1 & 0x0002 == 0,
         quick_stop: cw1 & 0x0004 == 0 || axis.state() == Cia::QuickStopActive,
-        within_tolerance: if speed {
-            // vl / pv: the speed inside its window (the target reached bit)
+        within_tolerance: if let Some((within, _)) = vl {
+            within
+        } else if speed {
+            // pv: the speed inside its window (the target reached bit)
             sw & SW_TARGET_REACHED != 0
         } else {
             sw & SW_FOLLOWING_ERROR == 0
         },
         control_requested: cw1 & CONTROL_BY_PLC != 0,
-        reached: if speed {
+        reached: if let Some((_, reached)) = vl {
+            reached
+        } else if speed {
             sw & SW_TARGET_REACHED != 0
         } else {
             records.target_reached

@@ -242,3 +242,40 @@ fn p184_p185_actual_position_and_velocity_in_profinet_units() {
     assert_eq!(b.i32_at(4), expect, "PNU 1100, encoder at {at} increments");
     assert_eq!(b.i32_at(8), 0, "standing");
 }
+
+/// Speed control: ZSW1 bit 8 = the actual speed inside the window (C40,
+/// 0.1 rev/s) around the set-point, bit 10 = the set-point reached or
+/// exceeded (signed); the encoder turns at the speeds given.
+#[test]
+fn p102_p106_speed_mode_window_and_reached_bits() {
+    const BIT_8: u16 = 0x0100;
+    const BIT_10: u16 = 0x0400;
+    // increments per 1 ms cycle at `rpm`
+    let per_ms = |rpm: i32| rpm * (1 << 20) / 60 / 1000;
+    for (target, actual, within, reached) in [
+        (300, 300, true, true),
+        (300, 0, false, false),
+        (300, 400, false, true),
+        (300, 280, false, false),
+        (-300, -300, true, true),
+        (-300, 0, false, true),
+        (0, 0, true, true),
+    ] {
+        let mut b = Bench::new();
+        b.advance = per_ms(actual);
+        // CW1 bits 4, 5, 6: the set-point enabled (the drive stays disabled:
+        // the encoder, not the drive, turns the axis here)
+        b.run(&speed(0x0470, target, 10_000, [0; 8]), 300);
+        let z = b.zsw1();
+        assert_eq!(
+            (z & BIT_8 != 0, z & BIT_10 != 0),
+            (within, reached),
+            "target {target} rpm, actual {actual} rpm: ZSW1 {z:#06x}"
+        );
+    }
+    // bit 6 = 0: the set-point is 0, so a turning axis is outside it
+    let mut b = Bench::new();
+    b.advance = per_ms(300);
+    b.run(&speed(0x0430, 300, 10_000, [0; 8]), 300);
+    assert_eq!(b.zsw1() & BIT_8, 0, "{:#06x}", b.zsw1());
+}
