@@ -279,3 +279,92 @@ fn p102_p106_speed_mode_window_and_reached_bits() {
     b.run(&speed(0x0430, 300, 10_000, [0; 8]), 300);
     assert_eq!(b.zsw1() & BIT_8, 0, "{:#06x}", b.zsw1());
 }
+
+/// PNU 1060, the set-up speed, defaults to 3276 rpm and writes J404.
+#[test]
+fn p183_pnu_1060_set_up_speed_default_3276_rpm() {
+    let mut b = Bench::new();
+    assert_eq!(b.pkw_read(1060, 0, 0x0400), (0x41, 3276));
+    b.run(&speed(0x0400, 0, 10_000, [0; 8]), 5);
+    b.run(&speed(0x0400, 0, 10_000, pkw_request(0x42, 1060, 0, 600)), 10);
+    assert_eq!(b.response[24], 0x42);
+    assert_eq!(b.pkw_read(1060, 0, 0x0400), (0x41, 600));
+}
+
+/// PNU 964.1…4: this drive's device ID, the version 0xMMSS of its
+/// software revision, the creation year and day/month (DDMMh in BCD,
+///
+#[test]
+fn p203_p204_p205_pnu_964_identification() {
+    let mut b = Bench::new();
+    let (_, major, minor, _) = profinet::model::SOFTWARE_REVISION;
+    assert_eq!(
+        b.pkw_read(964, 1, 0x0400),
+        (0x41, i32::from(profinet::model::DEVICE_ID))
+    );
+    assert_eq!(
+        b.pkw_read(964, 2, 0x0400),
+        (0x41, i32::from(major) << 8 | i32::from(minor))
+    );
+    let (code, year) = b.pkw_read(964, 3, 0x0400);
+    assert_eq!(code, 0x41);
+    assert!((2026..2100).contains(&year), "{year}");
+    let (code, ddmm) = b.pkw_read(964, 4, 0x0400);
+    assert_eq!(code, 0x41);
+    // the digits of day and month read in hex (BCD): 0x0112 is 1 Dec
+    let bcd = |v: i32| (v >> 4) * 10 + (v & 0xF);
+    assert!(
+        ddmm >> 4 & 0xF <= 9 && ddmm >> 12 <= 3 && ddmm & 0xF <= 9,
+        "BCD digits: {ddmm:#06x}"
+    );
+    let (day, month) = (bcd(ddmm >> 8), bcd(ddmm & 0xFF));
+    assert!(
+        (1..=31).contains(&day) && (1..=12).contains(&month),
+        "{ddmm:#06x}"
+    );
+    // read-only
+    b.run(&speed(0x0400, 0, 10_000, [0; 8]), 5);
+    b.run(&speed(0x0400, 0, 10_000, pkw_request(0x42, 964, 1, 1)), 10);
+    assert_eq!((b.response[24], b.i32_at(28)), (0xC2, 0x01));
+}
+
+/// PNU 1141: the limit switches are bits 7 (negative, DIN6) and 8
+/// (positive, DIN7) of the manual's bit map; response bytes 14…17.
+#[test]
+fn p189_pnu_1141_limit_switch_bits() {
+    let mut b = Bench::new();
+    let inputs = |b: &Bench| u32::from_be_bytes(b.response[14..18].try_into().unwrap());
+    b.run(&speed(0x0400, 0, 10_000, [0; 8]), 20);
+    assert_eq!(inputs(&b), 0);
+    b.io[0].limit_negative = true;
+    b.run(&speed(0x0400, 0, 10_000, [0; 8]), 20);
+    assert_eq!(inputs(&b), 1 << 7);
+    b.io[0].limit_negative = false;
+    b.io[0].limit_positive = true;
+    b.run(&speed(0x0400, 0, 10_000, [0; 8]), 20);
+    assert_eq!(inputs(&b), 1 << 8);
+    assert_eq!(b.pkw_read(1141, 0, 0x0400), (0x41, 1 << 8));
+}
+
+/// Homing runs inside positioning: PNU 1500 reads 0x10 while the homing
+/// run goes and after it (6060h back to 1), and ZSW1 bit 11 is 0 during
+/// the run (method 1: the negative limit switch, never reached here).
+#[test]
+fn p139_p107_homing_runs_inside_positioning() {
+    let mut b = Bench::new();
+    for cw1 in [0x0406, 0x0407, 0x040F] {
+        b.run(&positioning(cw1, 0, 1000, 10_000), 20);
+    }
+    let mut t = positioning(0x043F | 0x0800, 0, 1000, 10_000);
+    t[1] = 1;
+    b.run(&t, 50);
+    assert_eq!(b.d.objects().get(0x6061, 0), Ok(6), "the core's homing mode runs");
+    assert_eq!(b.response[1], 0x10, "PNU 1500 stays positioning");
+    assert_eq!(b.zsw1() & 0x0800, 0, "not homed during the run");
+    // the falling edge of bit 11 cancels: back to positioning, no error
+    t[2..4].copy_from_slice(&0x043Fu16.to_be_bytes());
+    b.run(&t, 50);
+    assert_eq!(b.d.objects().get(0x6061, 0), Ok(1));
+    assert_eq!(b.response[1], 0x10);
+    assert_eq!(b.zsw1() & 0x0008, 0, "no fault: {:#06x}", b.zsw1());
+}
