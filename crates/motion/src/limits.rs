@@ -352,6 +352,13 @@ impl Limits {
         self.positive_memory.is_none() && self.negative_memory.is_none()
     }
 
+    /// Both hardware limit switches read hit in the last update (the cause
+    /// of event 53 cause 7 is still there: its fault cannot be
+    /// acknowledged, C-017).
+    pub fn both_switches_hit(&self) -> bool {
+        self.positive_hit && self.negative_hit
+    }
+
     /// Referencing finished or the reference was deleted (I452): clears the
     /// switch memory (C-098) and restarts the computing limit at the new
     /// position set-point `position_inc`.

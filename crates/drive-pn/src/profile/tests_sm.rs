@@ -368,3 +368,28 @@ fn p139_p107_homing_runs_inside_positioning() {
     assert_eq!(b.response[1], 0x10);
     assert_eq!(b.zsw1() & 0x0008, 0, "no fault: {:#06x}", b.zsw1());
 }
+
+/// A fault whose cause is still there is not acknowledged: both limit
+/// switches evaluated (I101, I102 = 1: input) and hit (event 53 cause 7);
+/// CW1 bit 7 does nothing until one is released, then its next rising edge
+/// acknowledges (C-017 through CW1).
+#[test]
+fn p218_c017_acknowledge_fails_while_the_cause_persists() {
+    let mut b = Bench::new();
+    for index in [drive_core::params::I101, drive_core::params::I101 + 1] {
+        b.d.objects_mut().set(index, 0, 1).unwrap();
+    }
+    b.reach(OP);
+    b.io[0].limit_positive = true;
+    b.io[0].limit_negative = true;
+    b.cw(0x040F, 50);
+    assert_ne!(b.zsw1() & 0x0008, 0, "fault: {:#06x}", b.zsw1());
+    b.run(&speed(0x0480, 0, 10_000, [0; 8]), 20);
+    assert_ne!(b.zsw1() & 0x0008, 0, "the cause persists: {:#06x}", b.zsw1());
+    b.cw(0x0400, 20);
+    b.io[0].limit_negative = false;
+    b.cw(0x0400, 20);
+    assert_ne!(b.zsw1() & 0x0008, 0, "no edge yet");
+    b.run(&speed(0x0480, 0, 10_000, [0; 8]), 20);
+    assert_eq!(b.zsw1() & 0x0008, 0, "acknowledged: {:#06x}", b.zsw1());
+}
