@@ -57,12 +57,16 @@ impl Axis {
             o.max_torque
         };
         let max_nm = p.rated_torque_nm * f32::from(per_mille) * 0.001;
-        let cfg = CascadeConfig {
+        let mut cfg = CascadeConfig {
             torque_limit_positive_nm: max_nm,
             torque_limit_negative_nm: max_nm,
             velocity_feedforward_percent: 100.0,
             ..scaled_gains(&p.cascade, dt_ns)
         };
+        if !self.torque_mode_speed_limit.is_nan() {
+            cfg.torque_mode_velocity_limit_positive_inc_per_s = self.torque_mode_speed_limit;
+            cfg.torque_mode_velocity_limit_negative_inc_per_s = self.torque_mode_speed_limit;
+        }
         if let Some(c) = self.cascade.as_mut() {
             if *c.config() != cfg {
                 let _ = c.set_config(cfg);

@@ -264,6 +264,10 @@ pub struct Axis {
     /// The record command ([`Axis::set_record_command`]): 0 none, else
     /// 0x100 | its bits (`record_state.rs`).
     record_command: u16,
+    /// The torque-mode speed limit a personality sets
+    /// ([`Axis::set_torque_mode_speed_limit`]), inc/s; NaN: none (G472/G475
+    /// of the parameters).
+    torque_mode_speed_limit: f32,
     /// The record status of the last cycle, packed.
     record_status: u32,
 }
@@ -326,6 +330,7 @@ impl Axis {
             modulo: None,
             record_fresh: true,
             record_command: 0,
+            torque_mode_speed_limit: f32::NAN,
             record_status: 0,
         }
     }

@@ -245,6 +245,24 @@ impl Axis {
         self.record_command = command.map_or(0, |c| 0x100 | u16::from(command_bits(&c)));
     }
 
+    /// Sets the speed limit of the torque modes (both directions, inc/s,
+    /// magnitude) in place of G472/G475 of the parameters; `None` goes back
+    /// to them. A personality whose fieldbus carries the limit (PROFINET's
+    /// 2416h.02, P-130) calls this before [`cycle`](Self::cycle); a
+    /// non-finite or negative limit counts as 0 (the axis does not move).
+    pub fn set_torque_mode_speed_limit(&mut self, limit_inc_per_s: Option<f32>) {
+        let limit = match limit_inc_per_s {
+            Some(v) if v.is_finite() && v > 0.0 => v,
+            Some(_) => 0.0,
+            None => f32::NAN,
+        };
+        if limit.to_bits() != self.torque_mode_speed_limit.to_bits() {
+            self.torque_mode_speed_limit = limit;
+            // the cascade takes it at the next configuration
+            self.configured = None;
+        }
+    }
+
     /// The record command set by [`set_record_command`](Self::set_record_command).
     fn record_command(&self) -> Option<RecordCommand> {
         (self.record_command & 0x100 != 0).then(|| command_of(self.record_command as u8))

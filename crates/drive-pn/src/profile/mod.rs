@@ -221,6 +221,13 @@ impl Profile {
             ModeCommands::Other => None,
         };
         let _ = access.objects.set(cw_index, 0, i64::from(controlword));
+        // torque control: 2416h.02 (user velocity units, the CANopen factor
+        // group) is the speed limit in both directions (P-130)
+        let speed_limit = (display == 4).then(|| {
+            let u = drive_core::user_units::UserUnits::read(access.objects, axis);
+            u.velocity_to_increments(i64::from(access.own.speed_limit)).abs() as f32
+        });
+        axis.set_torque_mode_speed_limit(speed_limit);
         axis.set_record_command(record_command);
     }
 

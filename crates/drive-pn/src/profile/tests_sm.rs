@@ -393,3 +393,71 @@ fn p218_c017_acknowledge_fails_while_the_cause_persists() {
     b.run(&speed(0x0480, 0, 10_000, [0; 8]), 20);
     assert_eq!(b.zsw1() & 0x0008, 0, "acknowledged: {:#06x}", b.zsw1());
 }
+
+/// Receive telegram 2 (torque): CW1, target torque 6071h (‰), PKW, the
+/// speed limit 2416h.02 (user velocity units: increments/s by default).
+fn torque(cw1: u16, per_mille: i16, limit: i32, pkw: [u8; 8]) -> [u8; 36] {
+    let mut t = [0u8; 36];
+    t[0] = 0xE2;
+    t[2..4].copy_from_slice(&cw1.to_be_bytes());
+    t[4..6].copy_from_slice(&per_mille.to_be_bytes());
+    t[24..32].copy_from_slice(&pkw);
+    t[32..36].copy_from_slice(&limit.to_be_bytes());
+    t
+}
+
+impl Bench {
+    /// Torque control through telegram 2 and PNU 1500 = 0x04, enabled.
+    fn torque_mode(&mut self, limit: i32) {
+        self.run(&torque(0x0400, 0, limit, pkw_request(0x42, 1500, 0, 0x04)), 10);
+        assert_eq!(self.response[24], 0x42);
+        for cw1 in [0x0406, 0x0407, 0x040F] {
+            self.run(&torque(cw1, 0, limit, [0; 8]), 20);
+        }
+        assert_eq!(self.zsw1() & STATE, OP, "{:#06x}", self.zsw1());
+        assert_eq!(self.response[1], 0x04);
+    }
+
+    /// 6077h, ‰ of the rated torque (response bytes 12…13).
+    fn torque_actual(&self) -> i16 {
+        i16::from_be_bytes([self.response[12], self.response[13]])
+    }
+}
+
+/// Torque control: 6071h from telegram 2 through the torque ramp 6087h
+/// (‰ per second): 500 ‰ at 1000 ‰/s takes half a second.
+#[test]
+fn p129_torque_setpoint_through_the_ramp() {
+    let mut b = Bench::new();
+    b.d.objects_mut().set(0x6087, 0, 1000).unwrap();
+    let limit = 20 << 20; // 20 rev/s: the speed limiter leaves 500 ‰ alone
+    b.torque_mode(limit);
+    b.run(&torque(0x040F, 500, limit, [0; 8]), 100);
+    assert_eq!(b.d.objects().get(0x6071, 0), Ok(500), "6071h from the telegram");
+    let t = b.torque_actual();
+    assert!((60..=140).contains(&t), "ramping: {t} ‰ after 100 ms");
+    b.run(&torque(0x040F, 500, limit, [0; 8]), 600);
+    assert_eq!(b.torque_actual(), 500, "the set-point after the ramp");
+}
+
+/// Torque control: 2416h.02 limits the speed: below the limit the torque
+/// set-point goes through, above it the speed limiter takes the torque
+/// back (below zero here: the encoder turns at twice the limit).
+#[test]
+fn p130_the_speed_limit_of_telegram_2_limits_torque_mode() {
+    let limit = 10 << 20; // 10 rev/s in increments/s
+    let per_ms = |rev_per_s: f64| (rev_per_s * f64::from(1 << 20) / 1000.0) as i32;
+    let mut b = Bench::new();
+    b.torque_mode(limit);
+    // the limiter is a P band around the limit: well below it, the set-point
+    b.advance = per_ms(2.0);
+    b.run(&torque(0x040F, 300, limit, [0; 8]), 100);
+    assert_eq!(b.torque_actual(), 300, "below the limit");
+    b.advance = per_ms(20.0);
+    b.run(&torque(0x040F, 300, limit, [0; 8]), 100);
+    assert!(b.torque_actual() < 0, "above the limit: {} ‰", b.torque_actual());
+    // a limit of 0 keeps the axis still (as G472 = 0 % does)
+    b.advance = per_ms(0.5);
+    b.run(&torque(0x040F, 300, 0, [0; 8]), 100);
+    assert!(b.torque_actual() < 0, "limit 0: {} ‰", b.torque_actual());
+}
