@@ -67,6 +67,8 @@ pub const A213: u16 = parameter_index(0, 213);
 pub const A310: u16 = parameter_index(0, 310);
 /// I02 position encoder (per axis).
 pub const I02: u16 = parameter_index(8, 2);
+/// I22 target window (per axis, user position units).
+pub const I22: u16 = parameter_index(8, 22);
 /// I46 reference retaining (per axis).
 pub const I46: u16 = parameter_index(8, 46);
 /// I101 / I102 / I103 sources of +LS, −LS and the reference switch.

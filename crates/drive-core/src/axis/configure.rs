@@ -79,7 +79,7 @@ impl Axis {
             fault: p.following_error_fault,
         });
         self.in_position.set_config(PositionWindowConfig {
-            window_inc: p.position_window_inc,
+            window_inc: o.target_window,
             time: p.position_window_time_ns,
         });
         self.velocity_window.set_config(VelocityWindowConfig {
@@ -97,7 +97,7 @@ impl Axis {
         self.limits.set_config(LimitConfig {
             software_min_inc: o.software_min,
             software_max_inc: o.software_max,
-            window_inc: p.position_window_inc,
+            window_inc: o.target_window,
             switch_polarity: SwitchPolarity::HighActive,
             soft_limit_reaction,
             // I101/I102 (C-104) switch the evaluation on as well

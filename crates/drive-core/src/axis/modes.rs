@@ -145,8 +145,7 @@ impl Axis {
             let step = target.wrapping_sub(from).unsigned_abs() as f32;
             let elapsed = master.age.max(master_period);
             let elapsed_s = motion::float::from_u64(elapsed.as_ns()) * 1e-9;
-            let allowed =
-                2.0 * o.max_profile_velocity as f32 * elapsed_s + self.params.position_window_inc as f32;
+            let allowed = 2.0 * o.max_profile_velocity as f32 * elapsed_s + o.target_window as f32;
             master.setpoint = Some(target);
             master.age = Nanos::ZERO;
             if self.params.set_value_monitoring && step > allowed {

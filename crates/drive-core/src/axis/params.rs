@@ -25,8 +25,6 @@ pub struct AxisParams {
     pub velocity_window_inc_per_s: f32,
     /// 606Eh velocity window time.
     pub velocity_window_time_ns: Nanos,
-    /// I22 position (target) window, inc.
-    pub position_window_inc: u32,
     /// I87 time in the position window.
     pub position_window_time_ns: Nanos,
     /// Following error (6065h/6066h) is a fault (event 54), not only
@@ -90,7 +88,6 @@ impl Default for AxisParams {
             max_extrapolation_ns: Nanos::from_ms(10),
             velocity_window_inc_per_s: 0.1 * REV,
             velocity_window_time_ns: Nanos::ZERO,
-            position_window_inc: INCREMENTS_PER_REVOLUTION / 360,
             position_window_time_ns: Nanos::ZERO,
             following_error_fault: false,
             limits: LimitConfig::default(),

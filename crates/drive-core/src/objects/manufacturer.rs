@@ -125,7 +125,7 @@ const fn string(s: &str) -> DataType {
 }
 
 /// Global and axis-A manufacturer parameters, sorted by index.
-pub const PARAMS: [Object; 74] = [
+pub const PARAMS: [Object; 75] = [
     param_array!(a(0), "Save values", Record, Value::Ram, from ACTION)
         .note("A00; [0] = 1 requests saving (E-018); progress/result set by the store"),
     param_array!(a(9), "Restart", Record, Value::Ram, from ACTION)
@@ -642,6 +642,14 @@ pub const PARAMS: [Object; 74] = [
     .axis()
     .level(1)
     .note("I02; 0 = motor encoder, the only encoder of this hardware model (C-113)"),
+    Object::var(
+        i_(22),
+        Value::Ram,
+        entries![e(0, "Target window", U32, RW).default_value(2912).unit("inc").saved()],
+    )
+    .axis()
+    .level(1)
+    .note("I22; position window of target reached and in position (CiA 402 6067h's role; default 1° in increments); PROFINET PNU 1271 (P-158)"),
     Object::var(
         i_(46),
         Value::Ram,

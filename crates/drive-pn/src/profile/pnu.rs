@@ -420,7 +420,15 @@ pub const CATALOGUE: &[Pnu] = &[
         Unit::None,
         Source::DigitalInputs,
     ),
-    p(1271, 0, "Target Window", U32, RW, Unit::Position, obj(0x6067, 0)),
+    p(
+        1271,
+        0,
+        "Target Window",
+        U32,
+        RW,
+        Unit::Position,
+        obj(drive_core::params::I22, 0),
+    ),
     p(
         1272,
         0,
@@ -490,5 +498,30 @@ mod tests {
         assert_eq!(find(Addr::new(1001, 6)), Err(PdError::FAULTY_SUBINDEX));
         assert_eq!(find(Addr::new(1003, 0)), Err(PdError::IMPERMISSIBLE_PNU));
         assert!(is_catalogue_index(999) && is_catalogue_index(0x2415) && !is_catalogue_index(0x6040));
+    }
+
+    /// Every PNU that is a view of a core object names one the drive
+    /// declares, with the access the PNU promises (PNU 1271 once named
+    /// 6067h, which this drive does not have).
+    #[test]
+    fn p190_every_object_view_names_a_declared_entry() {
+        use od::Dictionary;
+        let objects = drive_core::DriveObjects::new();
+        for p in CATALOGUE {
+            if let Source::Object { index, sub } = p.source {
+                let object = objects.object(index);
+                let entry = object.and_then(|o| o.entry(sub));
+                let Some(entry) = entry else {
+                    panic!(
+                        "PNU {:?} ({}): {index:#06x}:{sub} is not declared",
+                        p.addr, p.name
+                    );
+                };
+                assert_eq!(p.readable, entry.access.readable(), "{}", p.name);
+                if p.writable {
+                    assert!(entry.access.writable(), "{}", p.name);
+                }
+            }
+        }
     }
 }

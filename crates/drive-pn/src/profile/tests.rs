@@ -400,3 +400,6 @@ fn p173_symmetrical_jog_velocity_writes_both_jog_records() {
 
 #[path = "tests_sm.rs"]
 mod sm;
+
+#[path = "tests_pnu.rs"]
+mod pnu;

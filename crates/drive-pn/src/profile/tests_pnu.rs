@@ -1,0 +1,149 @@
+//! The profile's parameter side through the drive: what PROFINET reaches
+//! (PNUs and CANopen objects in one index space), in which units, and what
+//! survives a restart.
+
+use super::{pkw_request, positioning, speed, Bench};
+use crate::PnDrive;
+
+impl Bench {
+    /// A PKW request in receive telegram 0 after the 0x00 toggle.
+    fn pkw0(&mut self, code: u8, index: u16, sub: u8, value: u32) -> (u8, i32) {
+        let mut t = positioning(0x0400, 0, 100, 10_000);
+        self.run(&t, 5);
+        t[24..32].copy_from_slice(&pkw_request(code, index, sub, value));
+        self.run(&t, 10);
+        (self.response[24], self.i32_at(28))
+    }
+}
+
+/// A manufacturer profile, not PROFIdrive's standard telegrams: standard
+/// telegram 1 (STW1, NSOLL_A: no identifier byte) is not understood, the
+/// drive neither moves nor answers it, and no telegram but E0…E3 exists.
+#[test]
+fn p044_standard_telegram_1_is_not_understood() {
+    let mut b = Bench::new();
+    // standard telegram 1: STW1 0x047F at bytes 0–1, NSOLL_A 0x4000 (100 %)
+    let mut std1 = [0u8; 36];
+    std1[0..2].copy_from_slice(&0x047Fu16.to_be_bytes());
+    std1[2..4].copy_from_slice(&0x4000u16.to_be_bytes());
+    b.run(&std1, 50);
+    assert!(
+        b.response.iter().all(|&x| x == 0),
+        "no response telegram: {:02x?}",
+        b.response
+    );
+    assert_eq!(b.d.objects().get(0x6040, 0), Ok(0), "controlword untouched");
+    assert!(b.d.profile().warnings() > 0, "counted as unknown frames");
+    let t = b.d.profile().telegrams().unwrap();
+    for n in 4..8 {
+        assert!(
+            t.layout(profidrive::telegram::Dir::Receive, n).is_none(),
+            "telegram {n}"
+        );
+    }
+}
+
+/// Any CANopen object is reachable from PROFINET in the one index space:
+/// PKW reads the statusword 6041h and a manufacturer object (A150 at
+/// 2096h), writes 6071h; the telegrams map CANopen objects (6071h in
+/// telegram 2, 6077h in the responses).
+#[test]
+fn p045_canopen_objects_through_pkw_and_telegrams() {
+    let mut b = Bench::new();
+    let (code, sw) = b.pkw0(0x41, 0x6041, 0, 0);
+    assert_eq!(code, 0x41);
+    assert_eq!(i64::from(sw), b.d.objects().get(0x6041, 0).unwrap());
+    let a150 = drive_core::params::A150;
+    let (code, v) = b.pkw0(0x41, a150, 0, 0);
+    assert_eq!((code, i64::from(v)), (0x41, b.d.objects().get(a150, 0).unwrap()));
+    assert_eq!(b.pkw0(0x42, 0x6071, 0, 250).0, 0x42);
+    assert_eq!(b.d.objects().get(0x6071, 0), Ok(250));
+    // a missing object: error 0 (impermissible PNU), nothing written
+    assert_eq!(b.pkw0(0x42, 0x6FFF, 0, 1), (0xC2, 0));
+    let t = b.d.profile().telegrams().unwrap();
+    let receive2 = t.layout(profidrive::telegram::Dir::Receive, 2).unwrap();
+    assert!(receive2
+        .slots()
+        .iter()
+        .any(|e| e.addr == profidrive::Addr::new(0x6071, 0)));
+}
+
+/// No 0x4000 normalisation: values are physical (rpm, 1/1000 rev): 100 rpm
+/// in PNU 1010 is 6042h = 100 rpm, not 100/16384 of a reference speed.
+#[test]
+fn p046_values_are_physical_not_normalised() {
+    let mut b = Bench::new();
+    b.run(&speed(0x0400, 100, 10_000, [0; 8]), 10);
+    assert_eq!(b.d.objects().get(0x6042, 0), Ok(100));
+    b.run(&speed(0x0400, 0x4000, 10_000, [0; 8]), 10);
+    assert_eq!(b.d.objects().get(0x6042, 0), Ok(0x4000), "16384 rpm, not 100 %");
+}
+
+/// The speed set-point PNU 1010 (6042h) is never saved: after PNU 971
+/// saves and the drive restarts, it is 0 (P-132).
+#[test]
+fn p132_the_speed_setpoint_is_zero_after_a_restart() {
+    let mut b = Bench::new();
+    b.run(&speed(0x0400, 250, 10_000, [0; 8]), 10);
+    assert_eq!(b.d.objects().get(0x6042, 0), Ok(250));
+    b.run(&positioning(0x0400, 0, 100, 10_000), 5);
+    assert_eq!(b.pkw0(0x42, 971, 0, 1).0, 0x42, "saved");
+    let flash = core::mem::replace(&mut b.d, crate::tests::commissioned()).into_flash();
+    let again = PnDrive::new(flash, crate::tests::hardware());
+    assert_eq!(again.objects().get(0x6042, 0), Ok(0));
+}
+
+/// PNU 1271 (I22) is the target window of ZSW1 bit 10: the encoder 2°
+/// from the target is inside a 5° window and outside a 1° one (P-158); a
+/// PKW write takes the PROFINET position unit (1/1000 rev).
+#[test]
+fn p158_target_window_drives_bit_10() {
+    const BIT_10: u16 = 0x0400;
+    let deg = |d: f64| (d / 360.0 * f64::from(1 << 20)) as i32;
+    let mut b = Bench::new();
+    // 5° window = 13.9/1000 rev: 14
+    assert_eq!(b.pkw0(0x42, 1271, 0, 14), (0x42, 14));
+    assert_eq!(
+        b.d.objects().get(drive_core::params::I22, 0),
+        Ok(i64::from(14 * (1 << 20) / 1000))
+    );
+    for cw1 in [0x0406, 0x0407, 0x040F] {
+        b.run(&positioning(cw1, 0, 1000, 10_000), 20);
+    }
+    b.run(&positioning(0x0C3F, 0, 1000, 10_000), 50); // home (method 34)
+    b.run(&positioning(0x043F, 0, 1000, 10_000), 20);
+    b.run(&positioning(0x047F, 0, 1000, 10_000), 100); // a task to 0
+    assert_ne!(b.zsw1() & BIT_10, 0, "on the target: {:#06x}", b.zsw1());
+    b.io[0].position_inc = deg(2.0);
+    b.run(&positioning(0x047F, 0, 1000, 10_000), 200);
+    assert_ne!(b.zsw1() & BIT_10, 0, "inside 5°: {:#06x}", b.zsw1());
+    // 1° = 2.8/1000 rev: 3
+    let mut t = positioning(0x047F, 0, 1000, 10_000);
+    t[24..32].copy_from_slice(&pkw_request(0x42, 1271, 0, 3));
+    b.run(&t, 200);
+    assert_eq!(b.response[24], 0x42);
+    assert_eq!(b.zsw1() & BIT_10, 0, "outside 1°: {:#06x}", b.zsw1());
+}
+
+/// PNU 1051 (607Ch) is the home offset in 1/1000 rev: with method 34 the
+/// present position becomes the offset (CiA 402's rule, which the core
+/// follows: the zero point lies the offset below the reference point, so a
+/// positive value shifts zero in the negative direction; docs/conformance.md,
+/// P-162).
+#[test]
+fn p162_home_offset_in_position_units() {
+    let mut b = Bench::new();
+    assert_eq!(b.pkw0(0x42, 1051, 0, 500).0, 0x42);
+    assert_eq!(
+        b.d.objects().get(0x607C, 0),
+        Ok(i64::from(1 << 19)),
+        "half a revolution"
+    );
+    for cw1 in [0x0406, 0x0407, 0x040F] {
+        b.run(&positioning(cw1, 0, 1000, 10_000), 20);
+    }
+    b.run(&positioning(0x0C3F, 0, 1000, 10_000), 50);
+    b.run(&positioning(0x043F, 0, 1000, 10_000), 50);
+    assert_ne!(b.zsw1() & 0x0800, 0, "homed");
+    assert_eq!(b.i32_at(4), 500, "PNU 1100 at the reference point");
+}
