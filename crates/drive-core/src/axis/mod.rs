@@ -112,8 +112,7 @@ use motion::cycle::{application_cycle_ns, interpolation_period_ns};
 use motion::homing::{Homing, HomingConfig, HomingInput, SwitchInput};
 use motion::interp::from_i425;
 use motion::limits::{
-    DenialCause, DirectionLock, LimitCause, LimitConfig, LimitInput, Limits, SoftLimitReaction, StopRamp,
-    SwitchPolarity,
+    DenialCause, DirectionLock, LimitConfig, LimitInput, Limits, SoftLimitReaction, StopRamp, SwitchPolarity,
 };
 use motion::scaling::{AxisScaling, ModuloAxis, ModuloDirection};
 use motion::touch_probe::{interpolate_position, Edge, PositionSample, TouchProbe, TriggerSignal};
@@ -559,9 +558,9 @@ impl Axis {
             sto_active: io.sto_active,
             standstill: i199 && stop_done,
             // a cause that is still there holds the fault (T15, C-017):
-            // both limit switches hit (event 53 cause 7)
-            fault_present: self.event == Some(LimitCause::BothSwitches.event())
-                && self.limits.both_switches_hit(),
+            // both limit switches hit (event 53 cause 7, a wiring fault no
+            // acknowledge can end)
+            fault_present: self.limits.both_switches_hit(),
             motion_command: self.motion_command(o),
             brake_override: false,
             target_reached: false,
