@@ -10,6 +10,11 @@
 //!   ZSW1 (§7.3: each command waits for its state); CW1 bit 10 is always set.
 //! - [`pkw`]: a PKW (PNU 2000) read/write helper over the FB's `pkw_*`
 //!   inputs and outputs, with the toggle rule (§9.2).
+//! - [`controller`]: a scripted in-process controller (Connect, then one
+//!   output frame per millisecond) in front of a [`crate::pn::PnSim`].
+//! - [`sequence`]: the demo sequence of `hil-sim demo --fieldbus profinet`
+//!   (enable, home, positioning chain, speed, jog, PKW, fault and reset),
+//!   and what it tells ([`report`]).
 //!
 //! Multi-byte values are big-endian (§4.4, Q-01), as the drive's profile
 //! reads them. Units are the PROFINET defaults (§11): position 1/1000 rev,
@@ -26,7 +31,10 @@
 //! does with [`pkw::PkwClient`]; `following_error` is inverted ZSW1 bit 8
 //! (E-09 corrected), `pos_task_ack` is ZSW1 bit 12 as sent (E-10).
 
+pub mod controller;
 pub mod pkw;
+pub mod report;
+pub mod sequence;
 
 use profidrive::cw1::CONTROL_BY_PLC;
 use profidrive::telegram::Dir;
