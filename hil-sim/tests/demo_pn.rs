@@ -180,3 +180,140 @@ fn p215_p227_a_provoked_fault_is_seen_acknowledged_and_the_drive_enables_again()
     assert!(c.lines.iter().any(|l| l.contains("state OP -> fault")));
     assert!(c.lines.iter().any(|l| l.contains("state fault -> SOI")));
 }
+
+/// The FB against the drive without the demo's script: enable and home
+/// (method 34), then the positioning inputs the demo sequence leaves out.
+struct Bench {
+    ctl: hil_sim::fb::controller::PnController,
+    fb: hil_sim::fb::ExampleFb,
+    i: hil_sim::fb::FbInputs,
+}
+
+impl Bench {
+    fn enabled() -> Bench {
+        use hil_sim::fb::controller::PnController;
+        let ctl = PnController::connect(PnController::drive(), Nanos::from_ms(10), None).unwrap();
+        let mut b = Bench {
+            ctl,
+            fb: hil_sim::fb::ExampleFb::new(),
+            i: hil_sim::fb::FbInputs {
+                drive_enable: true,
+                ..Default::default()
+            },
+        };
+        assert!(b.until(500, |o| o.drive_is_enabled), "enabled");
+        // absolute targets need a reference (C-050): method 34, the
+        // current position, without a move
+        b.i.start_homing = true;
+        assert!(b.until(1_000, |o| o.home_valid), "homed");
+        b.i.start_homing = false;
+        b.run(10);
+        b
+    }
+
+    fn cycle(&mut self) {
+        let t = self.fb.receive_telegram(&self.i);
+        let r = self.ctl.exchange(&t).unwrap().map(<[u8]>::to_vec);
+        if let (Some(r), true) = (r, self.ctl.fresh()) {
+            let _ = self.fb.response(&r, self.i.drive_enable);
+        }
+    }
+
+    fn until(&mut self, ms: u64, done: impl Fn(&hil_sim::fb::FbOutputs) -> bool) -> bool {
+        for _ in 0..ms {
+            self.cycle();
+            if done(self.fb.outputs()) {
+                return true;
+            }
+        }
+        false
+    }
+
+    fn run(&mut self, ms: u64) {
+        for _ in 0..ms {
+            self.cycle();
+        }
+    }
+
+    fn position(&self) -> i32 {
+        self.fb.outputs().position_actual_value
+    }
+
+    /// Starts a task to `target` (1/1000 rev) at 1000 rpm.
+    fn start(&mut self, target: i32, immediately: bool) {
+        self.i.target_position = target;
+        self.i.change_immediatly = immediately;
+        if !immediately {
+            assert!(self.until(5_000, |o| !o.pos_task_ack), "a task can be taken");
+        }
+        self.i.start_pos = true;
+        assert!(self.until(100, |o| o.pos_task_ack), "the start is acknowledged");
+        self.i.start_pos = false;
+        self.cycle();
+    }
+}
+
+#[test]
+fn p221_intermediate_stop_pauses_and_resumes_the_task() {
+    let mut b = Bench::enabled();
+    b.start(20_000, false);
+    b.run(500);
+    assert!(!b.fb.outputs().velo_zero, "moving");
+    b.i.intermediate_stop = true;
+    assert!(b.until(2_000, |o| o.velo_zero), "stopped (ZSW1 bit 13)");
+    let held = b.position();
+    b.run(300);
+    assert!(
+        (b.position() - held).abs() <= 2,
+        "held: {held} -> {}",
+        b.position()
+    );
+    assert!(!b.fb.outputs().target_reached);
+    b.i.intermediate_stop = false;
+    assert!(b.until(20_000, |o| o.target_reached), "the task continues");
+    b.run(200);
+    assert!((b.position() - 20_000).abs() <= 1, "{}", b.position());
+}
+
+#[test]
+fn p221_hold_cancels_the_task_without_target_reached() {
+    let mut b = Bench::enabled();
+    b.start(20_000, false);
+    b.run(500);
+    b.i.hold = true;
+    assert!(b.until(2_000, |o| o.velo_zero), "braked to a stop");
+    b.run(300);
+    let stopped = b.position();
+    assert!(
+        stopped < 20_000 - 1_000,
+        "cancelled well before the target: {stopped}"
+    );
+    assert!(!b.fb.outputs().target_reached, "not target reached");
+    // releasing hold does nothing (§13.1)
+    b.i.hold = false;
+    b.run(500);
+    assert!(
+        (b.position() - stopped).abs() <= 2,
+        "{stopped} -> {}",
+        b.position()
+    );
+    assert!(!b.fb.outputs().target_reached);
+}
+
+#[test]
+fn p221_change_immediately_replaces_the_running_task() {
+    let mut b = Bench::enabled();
+    b.start(20_000, false);
+    b.run(500);
+    let at = b.position();
+    assert!(at > 0 && at < 20_000, "{at}");
+    b.start(2_000, true);
+    assert!(b.until(20_000, |o| o.target_reached));
+    b.run(200);
+    assert!(
+        (b.position() - 2_000).abs() <= 1,
+        "the new target: {}",
+        b.position()
+    );
+    assert!(b.fb.outputs().target_reached);
+}
