@@ -48,7 +48,7 @@ pub const HOMING_METHOD: i8 = 33;
 /// The CANopen object the PKW phase writes: 6065h following error window.
 pub const PKW_OBJECT: (u16, u8) = (0x6065, 0);
 
-/// 1/1000 rev as increments, rounded to nearest (the drive's conversion).
+/// 1/1000 rev (the PROFINET position unit) as increments, rounded to nearest.
 pub fn milli_rev_to_inc(v: i64) -> i64 {
     (v * INC_PER_REV + v.signum() * 500) / 1000
 }
