@@ -1,8 +1,9 @@
 //! The `hil-sim` binary's parts: the command line, `demo` and `serve`
-//! (EtherCAT in `serve`, PROFINET in `serve_pn`).
+//! (EtherCAT in `demo` and `serve`, PROFINET in `demo_pn` and `serve_pn`).
 
 pub mod args;
 pub mod demo;
+pub mod demo_pn;
 pub mod realtime;
 pub mod serve;
 pub mod serve_pn;

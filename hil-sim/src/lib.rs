@@ -16,6 +16,8 @@ pub mod world;
 #[cfg(feature = "std")]
 pub mod eoe;
 #[cfg(feature = "std")]
+pub mod fb;
+#[cfg(feature = "std")]
 pub mod master;
 #[cfg(feature = "std")]
 pub mod pcap;

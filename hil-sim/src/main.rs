@@ -3,6 +3,9 @@
 //! - `hil-sim demo [--pcap FILE] [--plot FILE.svg]` (the default): a real
 //!   EtherCAT master (ethercrab, in-process) brings one simulated drive to OP,
 //!   enables axis A, homes it, runs a csp profile and plots the run.
+//! - `hil-sim demo --fieldbus profinet [--pcap FILE] [--plot FILE.svg]`: a
+//!   scripted IO controller (in-process) runs the Example Function block's
+//!   sequence against one simulated PROFINET drive and plots the run.
 //! - `hil-sim serve --iface IF [--slaves N] [--axes 1|2] [--pcap FILE] [--seconds S]`:
 //!   the simulated line answers EtherCAT frames on a raw Ethernet interface.
 //! - `hil-sim serve --fieldbus profinet --iface IF [--name NAME] [--pcap FILE]`:
@@ -13,13 +16,14 @@
 mod cli;
 
 use clap::Parser;
-use cli::args::{Cli, Command, DemoArgs};
+use cli::args::{Cli, Command, DemoArgs, Fieldbus};
 use std::process::ExitCode;
 
 fn main() -> ExitCode {
     let cli = Cli::parse();
     let result = match &cli.command {
         None => cli::demo::demo(&DemoArgs::default()),
+        Some(Command::Demo(a)) if a.fieldbus == Fieldbus::Profinet => cli::demo_pn::demo(a),
         Some(Command::Demo(a)) => cli::demo::demo(a),
         Some(Command::Serve(a)) => cli::serve::serve(a),
     };

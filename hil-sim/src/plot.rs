@@ -20,10 +20,19 @@ pub struct Trace {
     pub torque_pct: Vec<f64>,
     /// Following error (60F4h), increments.
     pub ferr_inc: Vec<f64>,
+    /// The set position's legend (empty: "set 607Ah").
+    pub set_name: String,
+    /// Optional: a state per sample (e.g. a status word's state as a
+    /// number), drawn as a fifth panel when not empty.
+    pub state: Vec<f64>,
+    /// The fifth panel's axis label.
+    pub state_name: String,
+    /// Optional: phases (start time in ms, name), marked in every panel.
+    pub phases: Vec<(f64, String)>,
 }
 
 /// One line of a panel: values, colour, legend.
-type Line<'a> = (&'a [f64], RGBColor, &'static str);
+type Line<'a> = (&'a [f64], RGBColor, &'a str);
 
 /// Increments per revolution (2^20).
 const INC_PER_REV: f64 = 1_048_576.0;
@@ -66,7 +75,17 @@ impl Trace {
         (max, rms)
     }
 
-    /// Writes a four-panel SVG plot to `out` (the caller opened the file
+    /// Appends one sample's state (the fifth panel).
+    pub fn push_state(&mut self, state: f64) {
+        self.state.push(state);
+    }
+
+    /// Marks the start of a phase at `t`.
+    pub fn mark_phase(&mut self, t: Nanos, name: &str) {
+        self.phases.push((t.as_ns() as f64 / 1e6, name.to_string()));
+    }
+
+    /// Writes a four-panel (five with a state) SVG plot to `out` (the caller opened the file
     /// before the run, so an unwritable path fails before the work is done).
     pub fn write_svg<W: Write>(&self, out: &mut W, title: &str) -> Result<(), String> {
         let svg = self.svg(title)?;
@@ -87,14 +106,20 @@ impl Trace {
         let root = root
             .titled(title, ("sans-serif", 22))
             .map_err(|e| e.to_string())?;
-        let panels = root.split_evenly((4, 1));
+        let with_state = !self.state.is_empty();
+        let panels = root.split_evenly((if with_state { 5 } else { 4 }, 1));
+        let set_name = if self.set_name.is_empty() {
+            "set 607Ah"
+        } else {
+            self.set_name.as_str()
+        };
         let t_end = self.t_ms.last().copied().unwrap_or(1.0).max(1e-3);
         let t0 = self.t_ms.first().copied().unwrap_or(0.0);
-        let series: [(&str, Vec<Line>); 4] = [
+        let mut series: Vec<(&str, Vec<Line>)> = vec![
             (
                 "position [rev]",
                 vec![
-                    (&self.set_rev, BLUE, "set 607Ah"),
+                    (&self.set_rev, BLUE, set_name),
                     (&self.act_rev, RED, "actual 6064h"),
                 ],
             ),
@@ -105,7 +130,10 @@ impl Trace {
             ),
             ("following error [inc]", vec![(&self.ferr_inc, BLACK, "60F4h")]),
         ];
-        for (area, (label, lines)) in panels.iter().zip(series.iter()) {
+        if with_state {
+            series.push((self.state_name.as_str(), vec![(&self.state, CYAN, "state")]));
+        }
+        for (k, (area, (label, lines))) in panels.iter().zip(series.iter()).enumerate() {
             let (lo, hi) = lines
                 .iter()
                 .flat_map(|(v, _, _)| v.iter())
@@ -124,6 +152,19 @@ impl Trace {
                 .y_desc(*label)
                 .draw()
                 .map_err(|e| e.to_string())?;
+            for (n, (at, name)) in self.phases.iter().enumerate() {
+                let (lo, hi) = (lo - pad, hi + pad);
+                // alternate rows: names of phases close together stay apart
+                let y = hi - (hi - lo) * 0.08 * (n % 2) as f64;
+                chart
+                    .draw_series(LineSeries::new([(*at, lo), (*at, hi)], BLACK.mix(0.3)))
+                    .map_err(|e| e.to_string())?;
+                if k == 0 {
+                    chart
+                        .draw_series([Text::new(name.clone(), (*at, y), ("sans-serif", 12))])
+                        .map_err(|e| e.to_string())?;
+                }
+            }
             for (values, color, name) in lines {
                 let color = *color;
                 chart

@@ -271,6 +271,24 @@ impl PnSim {
         PnSim::power_on_as(first.drive.into_flash(), mac, serial, boot_time)
     }
 
+    /// A drive as shipped, except that its name of station is `name` and
+    /// its IP suite `ip` (both stored and saved, then powered on again: a
+    /// drive a commissioning tool has named and addressed, ready for a
+    /// controller's Connect without DCP).
+    pub fn commissioned(
+        mac: MacAddr,
+        serial: &str,
+        name: &NameOfStation,
+        ip: IpSuite,
+        boot_time: u32,
+    ) -> PnSim {
+        let mut first = PnSim::power_on_as(SimFlash::new(), mac, serial, boot_time);
+        drive_pn::settings::write_name(first.drive.objects_mut(), name);
+        drive_pn::settings::write_ip(first.drive.objects_mut(), ip);
+        first.drive.save();
+        PnSim::power_on_as(first.drive.into_flash(), mac, serial, boot_time)
+    }
+
     /// The drive personality (objects, axes, store).
     pub fn drive(&self) -> &drive_pn::PnDrive<SimFlash> {
         &self.drive

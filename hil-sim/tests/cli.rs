@@ -212,3 +212,80 @@ fn no_subcommand_runs_the_demo_with_the_default_plot() {
     let svg = std::fs::read_to_string(s.0.join("target/hil-sim-demo.svg")).unwrap();
     assert!(svg.contains("<svg"));
 }
+
+#[test]
+fn demo_help_documents_the_fieldbus_and_its_plot() {
+    let o = hil_sim(&["demo", "--help"]);
+    assert!(o.status.success(), "{o:?}");
+    let out = text(&o.stdout);
+    for want in [
+        "--fieldbus <BUS>",
+        "ethercat",
+        "profinet",
+        "target/hil-sim-demo-pn.svg",
+    ] {
+        assert!(out.contains(want), "`{want}` missing in:\n{out}");
+    }
+}
+
+#[test]
+fn demo_refuses_an_unknown_fieldbus() {
+    let o = hil_sim(&["demo", "--fieldbus", "canopen"]);
+    assert_eq!(o.status.code(), Some(2), "{o:?}");
+    assert!(text(&o.stderr).contains("canopen"), "{}", text(&o.stderr));
+    assert!(o.stdout.is_empty(), "nothing ran: {}", text(&o.stdout));
+}
+
+#[test]
+fn demo_profinet_refuses_an_unwritable_plot_before_the_run() {
+    let s = Scratch::new("pn-plot");
+    let plot = s.unwritable("x.svg");
+    let plot = plot.to_str().unwrap();
+    let o = hil_sim(&["demo", "--fieldbus", "profinet", "--plot", plot]);
+    assert!(!o.status.success(), "{o:?}");
+    let (out, err) = (text(&o.stdout), text(&o.stderr));
+    assert!(err.contains(plot), "the message names the path: {err}");
+    assert!(!out.contains("plot:"), "no plot claimed: {out}");
+    assert!(!out.contains("AR "), "refused before the run: {out}");
+}
+
+/// P-219…P-227 through the binary: the FB's sequence prints its state
+/// changes and a summary, writes the plot (with the ZSW1 state panel) and
+/// records the PROFINET frames.
+#[test]
+fn p219_p227_demo_profinet_writes_the_plot_and_the_pcap_it_names() {
+    let s = Scratch::new("demo-pn");
+    let (pcap, plot) = (s.0.join("run.pcap"), s.0.join("run.svg"));
+    let o = hil_sim(&[
+        "demo",
+        "--fieldbus",
+        "profinet",
+        "--pcap",
+        pcap.to_str().unwrap(),
+        "--plot",
+        plot.to_str().unwrap(),
+    ]);
+    assert!(o.status.success(), "{o:?}");
+    let out = text(&o.stdout);
+    for want in [
+        "state SOI -> RTSO",
+        "drive_is_enabled 0->1",
+        "home_valid 0->1",
+        "target_reached 0->1",
+        "operation_mode_actual 0x10 -> 0x08",
+        "jog_pos: moved",
+        "PKW write 6065h.0: 20000",
+        "state OP -> fault",
+        "summary:",
+        "following error max",
+    ] {
+        assert!(out.contains(want), "`{want}` missing in:\n{out}");
+    }
+    assert!(out.contains(&format!("plot: {}", plot.display())), "{out}");
+    let svg = std::fs::read_to_string(&plot).unwrap();
+    assert!(svg.contains("<svg") && svg.trim_end().ends_with("</svg>"));
+    assert!(svg.contains("ZSW1 state"), "the state panel");
+    let p = std::fs::read(&pcap).unwrap();
+    assert_eq!(p.get(..4), Some(&0xA1B2_3C4Du32.to_le_bytes()[..]), "pcap magic");
+    assert!(p.len() > 1_000_000, "both directions every ms: {} bytes", p.len());
+}

@@ -20,7 +20,10 @@ pub struct Cli {
 pub enum Command {
     /// A real EtherCAT master (ethercrab, in-process, simulated time) drives
     /// one simulated drive: INIT -> OP, enable axis A in csp, home it, run a
-    /// 10-revolution profile, write a plot of the run.
+    /// 10-revolution profile, write a plot of the run. With `--fieldbus
+    /// profinet` a scripted IO controller with a model of the Example
+    /// Function block runs its sequence instead: enable, home, positioning
+    /// chain, speed, jog, PKW, fault and acknowledge.
     Demo(DemoArgs),
     /// The simulated line answers EtherCAT frames on a network interface (raw
     /// Ethernet, needs root or CAP_NET_RAW), so any master can drive it;
@@ -32,16 +35,22 @@ pub enum Command {
 /// Options of `demo`.
 #[derive(Debug, Clone, Default, Args)]
 pub struct DemoArgs {
+    /// The fieldbus: EtherCAT (ethercrab, CiA 402 in csp) or PROFINET (a
+    /// scripted IO controller in the process, the Example Function block's
+    /// telegrams, 1 ms IO cycle).
+    #[arg(long, value_enum, value_name = "BUS", default_value_t = Fieldbus::Ethercat)]
+    pub fieldbus: Fieldbus,
     /// Record every frame (both directions) to this pcap file for Wireshark.
     #[arg(long, value_name = "FILE")]
     pub pcap: Option<PathBuf>,
     /// Write the plot of set and actual position, velocity, torque and
-    /// following error here [default: target/hil-sim-demo.svg].
+    /// following error here (PROFINET: also the ZSW1 state, phases marked)
+    /// [default: target/hil-sim-demo.svg, PROFINET: target/hil-sim-demo-pn.svg].
     #[arg(long, value_name = "FILE.svg")]
     pub plot: Option<PathBuf>,
 }
 
-/// The fieldbus `serve` speaks.
+/// The fieldbus `serve` and `demo` speak.
 #[derive(Debug, Clone, Copy, Default, PartialEq, Eq, ValueEnum)]
 pub enum Fieldbus {
     /// A line of simulated EtherCAT drives (simulated ESCs).
@@ -112,6 +121,8 @@ pub struct ServeArgs {
 
 /// The default plot path of `demo`.
 pub const DEFAULT_PLOT: &str = "target/hil-sim-demo.svg";
+/// The default plot path of `demo --fieldbus profinet`.
+pub const DEFAULT_PLOT_PN: &str = "target/hil-sim-demo-pn.svg";
 
 /// Creates (truncates) an output file before the run, so a path that cannot
 /// be written fails at once with a message naming it. `what` names the file
