@@ -299,6 +299,16 @@ impl PnSim {
         &mut self.drive
     }
 
+    /// The motor of `axis` (0 = A).
+    pub fn motor(&self, axis: usize) -> Option<&Motor> {
+        self.motors.get(axis)
+    }
+
+    /// The motor of `axis`, mutable (switches, end stops, index offset).
+    pub fn motor_mut(&mut self, axis: usize) -> Option<&mut Motor> {
+        self.motors.get_mut(axis)
+    }
+
     /// The device (name, IP, AR, counters).
     pub fn device(&self) -> &Device<impl RecordHook> {
         self.drive.device()

@@ -147,3 +147,25 @@ fn p162_home_offset_in_position_units() {
     assert_ne!(b.zsw1() & 0x0800, 0, "homed");
     assert_eq!(b.i32_at(4), 500, "PNU 1100 at the reference point");
 }
+
+/// Methods −23/−27 (end of travel, then the last of several reference
+/// switches on one input) are not built: PNU 1050 refuses them with error
+/// 0x14 and keeps the method it had (P-169, P-172).
+#[test]
+fn p169_methods_minus_23_and_minus_27_are_refused() {
+    // telegram 1: telegram 0 writes 1050.0 from its byte 1 every cycle
+    let mut b = Bench::new();
+    let write = |b: &mut Bench, m: i32| {
+        b.run(&speed(0x0400, 0, 10_000, [0; 8]), 5);
+        b.run(
+            &speed(0x0400, 0, 10_000, pkw_request(0x42, 1050, 0, m as u32)),
+            10,
+        );
+        (b.response[24], b.i32_at(28))
+    };
+    assert_eq!(write(&mut b, 33).0, 0x42);
+    for m in [-23, -27] {
+        assert_eq!(write(&mut b, m), (0xC2, 0x14), "method {m}");
+    }
+    assert_eq!(b.d.profile().own().homing_method, 33);
+}
