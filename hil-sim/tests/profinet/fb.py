@@ -373,6 +373,16 @@ def p222_homing(fb, sc):
     mark = len(fb.samples)
     start = fb.o.position_actual_value
     fb.i.start_homing = True
+    # start_pos during the run is ignored: no task towards -5000 at 300 rpm
+    fb.run_for(0.1)
+    fb.i.target_position, fb.i.profile_velocity = -5000, 300
+    fb.i.start_pos = True
+    ignored = fb.run_for(0.2)
+    fb.i.start_pos = False
+    fastest = max(abs(o.velocity_actual_value) for o in ignored)
+    sc.check(fastest <= 50 and all(o.velocity_actual_value >= 0 for o in ignored),
+             f"start_pos during homing: ignored (speed {min(o.velocity_actual_value for o in ignored)}.."
+             f"{max(o.velocity_actual_value for o in ignored)} rpm, the search's)")
     dt = fb.until(lambda o: o.home_valid and stopped(o), 10.0)
     during = fb.since(mark)
     not_valid = any(not o.home_valid and abs(o.velocity_actual_value) > 5 for o in during)
@@ -520,9 +530,15 @@ def p221_positioning(fb, sc, tol):
     fb.run_for(0.01)
     fb.i.start_pos = True
     fb.run_for(0.3)
+    v_hold = fb.o.velocity_actual_value
     fb.i.hold = True
     dt = fb.until(stopped, 3.0)
     p1 = fb.o.position_actual_value
+    # the task's deceleration: 1001.5 = 6000 rpm/s (the response's delay and
+    # the settling to standstill are inside the time measured)
+    decel = v_hold / dt if dt else 0
+    sc.check(0.7 * 6000 <= decel <= 1.3 * 6000,
+             f"hold: braked from {v_hold} rpm in {ms(dt)}, {decel:.0f} rpm/s (the task's 6000 rpm/s +-30 %)")
     after = fb.run_for(0.3)
     fb.i.hold = False
     fb.i.start_pos = False
