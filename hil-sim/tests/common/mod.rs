@@ -145,3 +145,32 @@ pub fn watch_script(
     let _ = t_err.join();
     (status, lines)
 }
+
+/// The python with profinet-py (`PROFINET_PY_PYTHON`, `.ci/run` sets it to
+/// target/profinet-venv/bin/python), or why a profinet-py test cannot run
+/// (not root, the variable unset); a python that cannot import profinet
+/// fails the test.
+pub fn profinet_py_python() -> Result<std::path::PathBuf, String> {
+    if !is_root() {
+        return Err("needs root for network namespaces and raw sockets".into());
+    }
+    let py = std::env::var_os("PROFINET_PY_PYTHON").ok_or(
+        "PROFINET_PY_PYTHON is not set (`.ci/run` installs profinet-py into target/profinet-venv and sets \
+         it to target/profinet-venv/bin/python)",
+    )?;
+    let show = std::path::Path::new(&py).display().to_string();
+    let out = Command::new(&py)
+        .args(["-c", "import profinet; print(profinet.__version__)"])
+        .output()
+        .unwrap_or_else(|e| panic!("PROFINET_PY_PYTHON={show}: {e}"));
+    assert!(
+        out.status.success(),
+        "PROFINET_PY_PYTHON={show} cannot import profinet: {}",
+        String::from_utf8_lossy(&out.stderr).trim()
+    );
+    println!(
+        "profinet-py {} ({show})",
+        String::from_utf8_lossy(&out.stdout).trim()
+    );
+    Ok(std::path::PathBuf::from(py))
+}

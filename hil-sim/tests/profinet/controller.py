@@ -39,12 +39,8 @@ both bind UDP 34964) and goes step by step, one line per result:
 """
 
 import argparse
-import ctypes
 import dataclasses
-import fcntl
 import logging
-import socket
-import struct
 import sys
 import threading
 import time
@@ -68,6 +64,8 @@ from profinet.dcp import (
 )
 from profinet.exceptions import DCPDeviceNotFoundError
 from profinet.util import ethernet_socket, get_mac, mac2s, s2mac
+
+from pnctl import Records, tx_checksum_offload_off
 
 
 failures = []
@@ -93,28 +91,6 @@ def run(step, fn):
         tb = traceback.format_exc().strip().replace("\n", "\n    ")
         report(step, False, f"{type(e).__name__}: {e}\n    {tb}")
         return None
-
-
-class Records(logging.Handler):
-    """Keeps profinet-py's log records (the RTA ERR PDU is only logged)."""
-
-    def __init__(self):
-        super().__init__(logging.DEBUG)
-        self.lines = []
-
-    def emit(self, record):
-        self.lines.append(f"{record.name}: {record.getMessage()}")
-
-
-def tx_checksum_offload_off(iface):
-    """`ethtool -K IF tx off` (SIOCETHTOOL, ETHTOOL_STXCSUM): a veth leaves
-    the UDP checksum of the kernel's datagrams to the receiver (offload), so
-    the device, reading raw frames on the other end, would see them as
-    corrupt and drop them, as it must."""
-    value = ctypes.create_string_buffer(struct.pack("II", 0x17, 0))
-    ifr = struct.pack("16sP", iface.encode()[:15], ctypes.addressof(value))
-    with socket.socket(socket.AF_INET, socket.SOCK_DGRAM) as s:
-        fcntl.ioctl(s.fileno(), 0x8946, ifr)
 
 
 def release(con):
