@@ -56,6 +56,7 @@ impl Axis {
         } else {
             o.max_torque
         };
+        let per_mille = per_mille.min(self.torque_limit_per_mille);
         let max_nm = p.rated_torque_nm * f32::from(per_mille) * 0.001;
         let mut cfg = CascadeConfig {
             torque_limit_positive_nm: max_nm,

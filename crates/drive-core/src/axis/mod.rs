@@ -267,6 +267,10 @@ pub struct Axis {
     /// ([`Axis::set_torque_mode_speed_limit`]), inc/s; NaN: none (G472/G475
     /// of the parameters).
     torque_mode_speed_limit: f32,
+    /// The torque limit a personality sets
+    /// ([`Axis::set_torque_limit_per_mille`]), ‰ of the rated torque;
+    /// `u16::MAX`: none.
+    torque_limit_per_mille: u16,
     /// The record status of the last cycle, packed.
     record_status: u32,
 }
@@ -330,6 +334,7 @@ impl Axis {
             record_fresh: true,
             record_command: 0,
             torque_mode_speed_limit: f32::NAN,
+            torque_limit_per_mille: u16::MAX,
             record_status: 0,
         }
     }

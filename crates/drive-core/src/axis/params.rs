@@ -10,6 +10,9 @@ use super::*;
 pub struct AxisParams {
     /// 6076h rated torque, N·m (motor data); 0.1 % torque objects refer to it.
     pub rated_torque_nm: f32,
+    /// Rated motor current, mA (motor data, at the rated torque): current
+    /// limits in mA become torque limits through it (PROFINET's 2415h.02).
+    pub rated_current_ma: u32,
     /// Cascade gains and limits. The torque limits are replaced by 6072h, the
     /// speed feedforward weight is applied by the interpolator (I25 below);
     /// the inertia (motor data) turns the generators' acceleration into
@@ -73,12 +76,13 @@ pub struct AxisParams {
 impl Default for AxisParams {
     /// Rated torque 1.3 N·m, the cascade defaults with an inertia of 1e-4
     /// kg·m² (the simulated servo), I25 = 100 %, I425 = 0,
-    /// I423 = 10 ms, C40 = 0.1 rev/s, I22 = 1/360 rev, following error as
+    /// I423 = 10 ms, C40 = 0.1 rev/s, a 1.3 N·m / 2 A motor, following error as
     /// bit 13 only, no limit switches, jog 1 rev/s with 10 rev/s², I26 = 1,
     /// no jerk limits, stops settle 10 ms.
     fn default() -> Self {
         Self {
             rated_torque_nm: 1.3,
+            rated_current_ma: 2000,
             cascade: CascadeConfig {
                 inertia_kg_m2: 1.0e-4,
                 ..CascadeConfig::DEFAULT

@@ -263,6 +263,19 @@ impl Axis {
         }
     }
 
+    /// Sets a torque limit in ‰ of the rated torque below 6072h (both
+    /// directions; the lower of the two applies); `None` removes it. A
+    /// personality whose fieldbus carries a current limit (PROFINET's
+    /// 2415h.02 in speed control, P-133) calls this before
+    /// [`cycle`](Self::cycle).
+    pub fn set_torque_limit_per_mille(&mut self, limit: Option<u16>) {
+        let limit = limit.unwrap_or(u16::MAX);
+        if limit != self.torque_limit_per_mille {
+            self.torque_limit_per_mille = limit;
+            self.configured = None;
+        }
+    }
+
     /// The record command set by [`set_record_command`](Self::set_record_command).
     fn record_command(&self) -> Option<RecordCommand> {
         (self.record_command & 0x100 != 0).then(|| command_of(self.record_command as u8))

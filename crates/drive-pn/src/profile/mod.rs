@@ -221,13 +221,24 @@ impl Profile {
             ModeCommands::Other => None,
         };
         let _ = access.objects.set(cw_index, 0, i64::from(controlword));
-        // torque control: 2416h.02 (user velocity units, the CANopen factor
-        // group) is the speed limit in both directions (P-130)
+        // torque control: 2416h.02 (the PROFINET velocity unit, rpm by
+        // default) is the speed limit in both directions (P-130)
         let speed_limit = (display == 4).then(|| {
-            let u = drive_core::user_units::UserUnits::read(access.objects, axis);
-            u.velocity_to_increments(i64::from(access.own.speed_limit)).abs() as f32
+            let bus = i64::from(access.own.speed_limit);
+            self.units
+                .velocity
+                .from_bus(bus)
+                .map_or(f32::MAX, |v| v.unsigned_abs() as f32)
+        });
+        // speed control: 2415h.02 (mA) limits the torque through the motor's
+        // rated current (P-133); 0 sets no limit
+        let current = access.own.current_limit_ma;
+        let torque_limit = (matches!(display, 2 | 3) && current > 0).then(|| {
+            let rated = u64::from(axis.params().rated_current_ma.max(1));
+            (u64::from(current.unsigned_abs()) * 1000 / rated).min(u64::from(u16::MAX - 1)) as u16
         });
         axis.set_torque_mode_speed_limit(speed_limit);
+        axis.set_torque_limit_per_mille(torque_limit);
         axis.set_record_command(record_command);
     }
 

@@ -395,7 +395,7 @@ fn p218_c017_acknowledge_fails_while_the_cause_persists() {
 }
 
 /// Receive telegram 2 (torque): CW1, target torque 6071h (‰), PKW, the
-/// speed limit 2416h.02 (user velocity units: increments/s by default).
+/// speed limit 2416h.02 (the PROFINET velocity unit: rpm).
 fn torque(cw1: u16, per_mille: i16, limit: i32, pkw: [u8; 8]) -> [u8; 36] {
     let mut t = [0u8; 36];
     t[0] = 0xE2;
@@ -430,7 +430,7 @@ impl Bench {
 fn p129_torque_setpoint_through_the_ramp() {
     let mut b = Bench::new();
     b.d.objects_mut().set(0x6087, 0, 1000).unwrap();
-    let limit = 20 << 20; // 20 rev/s: the speed limiter leaves 500 ‰ alone
+    let limit = 1200; // rpm (20 rev/s): the speed limiter leaves 500 ‰ alone
     b.torque_mode(limit);
     b.run(&torque(0x040F, 500, limit, [0; 8]), 100);
     assert_eq!(b.d.objects().get(0x6071, 0), Ok(500), "6071h from the telegram");
@@ -445,7 +445,7 @@ fn p129_torque_setpoint_through_the_ramp() {
 /// back (below zero here: the encoder turns at twice the limit).
 #[test]
 fn p130_the_speed_limit_of_telegram_2_limits_torque_mode() {
-    let limit = 10 << 20; // 10 rev/s in increments/s
+    let limit = 600; // rpm = 10 rev/s
     let per_ms = |rev_per_s: f64| (rev_per_s * f64::from(1 << 20) / 1000.0) as i32;
     let mut b = Bench::new();
     b.torque_mode(limit);
@@ -460,4 +460,31 @@ fn p130_the_speed_limit_of_telegram_2_limits_torque_mode() {
     b.advance = per_ms(0.5);
     b.run(&torque(0x040F, 300, 0, [0; 8]), 100);
     assert!(b.torque_actual() < 0, "limit 0: {} ‰", b.torque_actual());
+}
+
+/// Speed control: 2415h.02 (mA, offset 32 of telegram 1) limits the torque
+/// through the motor's rated current (2 A here): 100 mA = 50 ‰; the axis
+/// held still against a 300 rpm set-point saturates at the limit; 0 sets
+/// no limit (P-133).
+#[test]
+fn p133_the_current_limit_limits_the_torque_in_speed_control() {
+    let telegram = |cw1: u16, ma: i32| {
+        let mut t = speed(cw1, 300, 100_000, [0; 8]);
+        t[32..36].copy_from_slice(&ma.to_be_bytes());
+        t
+    };
+    for (ma, most) in [(100, Some(50)), (0, None)] {
+        let mut b = Bench::new();
+        for cw1 in [0x0406, 0x0407, 0x040F] {
+            b.run(&telegram(cw1, ma), 20);
+        }
+        assert_eq!(b.zsw1() & STATE, OP);
+        // the encoder stands still: the speed controller asks for all it may
+        b.run(&telegram(0x047F, ma), 200);
+        let t = b.torque_actual();
+        match most {
+            Some(m) => assert_eq!(t, m, "{ma} mA: {t} per mille"),
+            None => assert!(t > 500, "no current limit: {t} per mille"),
+        }
+    }
 }
