@@ -411,6 +411,26 @@ pub const CATALOGUE: &[Pnu] = &[
         Unit::None,
         obj(0x6078, 0),
     ),
+    // the sample input is touch probe 1 (60B8h configures it, 60D0h:01 its
+    // source): its positive and negative edge values (P-188)
+    p(
+        1110,
+        0,
+        "Sampling Position Rising Edge",
+        I32,
+        RO,
+        Unit::Position,
+        obj(0x60BA, 0),
+    ),
+    p(
+        1110,
+        1,
+        "Sampling Position Falling Edge",
+        I32,
+        RO,
+        Unit::Position,
+        obj(0x60BB, 0),
+    ),
     p(
         1141,
         0,

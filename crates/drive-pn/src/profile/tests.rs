@@ -271,7 +271,7 @@ fn p051_p052_p054_the_telegram_selects_the_mode() {
 /// demand of the vl mode follows the ramp (the axis runs against a motor
 /// standing still here: the demand, not the actual velocity, is checked).
 #[test]
-fn p079_p178_p181_speed_control_ramps_to_the_target_velocity() {
+fn p079_p131_p178_p181_speed_control_ramps_to_the_target_velocity() {
     let mut b = Bench::new();
     for cw1 in [0x0406, 0x0407, 0x040F] {
         b.run(&speed(cw1, 100, 1000, [0; 8]), 20);
@@ -294,7 +294,7 @@ fn p079_p178_p181_speed_control_ramps_to_the_target_velocity() {
 /// Positioning: bit 6 rising starts record 266 from telegram 0's values
 /// (P-082); the task acknowledgement and the record's target show.
 #[test]
-fn p082_p143_p146_bit_6_starts_the_fieldbus_record() {
+fn p082_p143_p146_p171_bit_6_starts_the_fieldbus_record() {
     let mut b = Bench::new();
     for cw1 in [0x0406, 0x0407, 0x040F] {
         b.run(&positioning(cw1, 0, 1000, 10_000), 20);

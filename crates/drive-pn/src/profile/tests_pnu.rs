@@ -169,3 +169,106 @@ fn p169_methods_minus_23_and_minus_27_are_refused() {
     }
     assert_eq!(b.d.profile().own().homing_method, 33);
 }
+
+/// PNU 1110.0/.1: the position latched on the rising and the falling edge
+/// of the sample input (touch probe 1, enabled for both edges in 60B8h),
+/// in the PROFINET position unit (P-188).
+#[test]
+fn p188_pnu_1110_sampling_positions() {
+    use drive_core::axis::ProbeEdge;
+    let mut b = Bench::new();
+    // probe 1 on, continuous, input 1, both edges
+    b.d.objects_mut().set(0x60B8, 0, 0x0033).unwrap();
+    b.run(&speed(0x0400, 0, 10_000, [0; 8]), 10);
+    let edge = |rising: bool, at: i32, t: u64| ProbeEdge {
+        input: 1,
+        rising,
+        time_ns: nanos::Nanos::from_ms(t),
+        position_inc: Some(at),
+    };
+    let t = b.ms;
+    b.io[0].probe_edges[0] = Some(edge(true, 1 << 20, t));
+    b.run(&speed(0x0400, 0, 10_000, [0; 8]), 1);
+    b.io[0].probe_edges[0] = Some(edge(false, 3 << 19, t + 1));
+    b.run(&speed(0x0400, 0, 10_000, [0; 8]), 1);
+    b.io[0].probe_edges[0] = None;
+    assert_eq!(b.pkw0(0x41, 1110, 0, 0), (0x41, 1000), "rising: 1 rev");
+    assert_eq!(b.pkw0(0x41, 1110, 1, 0), (0x41, 1500), "falling: 1.5 rev");
+    // read-only
+    b.run(&speed(0x0400, 0, 10_000, [0; 8]), 5);
+    b.run(&speed(0x0400, 0, 10_000, pkw_request(0x42, 1110, 0, 1)), 10);
+    assert_eq!((b.response[24], b.i32_at(28)), (0xC2, 0x01));
+}
+
+/// CANopen objects keep the CANopen factor group, PNUs the PROFINET
+/// units: with a feed of 60 user units per revolution (6092h), 6064h reads
+/// in 1/60 rev while PNU 1100 still reads 1/1000 rev (P-214).
+#[test]
+fn p214_canopen_objects_use_their_factor_group_pnus_the_profinet_units() {
+    let mut b = Bench::new();
+    b.d.objects_mut().set(0x6092, 1, 60).unwrap();
+    b.d.objects_mut().set(0x6092, 2, 1).unwrap();
+    b.io[0].position_inc = 2 << 20;
+    b.run(&speed(0x0400, 0, 10_000, [0; 8]), 50);
+    assert_eq!(
+        b.pkw0(0x41, 0x6064, 0, 0),
+        (0x41, 120),
+        "6064h: 2 rev in 1/60 rev"
+    );
+    assert_eq!(
+        b.pkw0(0x41, 1100, 0, 0),
+        (0x41, 2000),
+        "PNU 1100: 2 rev in 1/1000 rev"
+    );
+    assert_eq!(b.i32_at(4), 2000, "the response telegram's 1100.0");
+}
+
+/// A PKW request in receive telegram 2, which maps no jog entry (telegrams
+/// 0 and 1 write 1040.0 every cycle).
+fn pkw2(b: &mut Bench, code: u8, index: u16, sub: u8, value: u32) -> (u8, i32) {
+    let mut t = [0u8; 36];
+    t[0] = 0xE2;
+    t[2..4].copy_from_slice(&0x0400u16.to_be_bytes());
+    b.run(&t, 5);
+    t[24..32].copy_from_slice(&pkw_request(code, index, sub, value));
+    b.run(&t, 10);
+    (b.response[24], b.i32_at(28))
+}
+
+/// PNU 1041 (TIPP0, record 259) and 1042 (TIPP1, record 260): .0 the
+/// velocity, .1 the acceleration, .2 the deceleration, .3 writes both
+/// and reads .1; each direction's record only (P-174, P-175).
+#[test]
+fn p174_p175_jog_records_per_direction() {
+    use drive_core::objects::records::{JOG_NEGATIVE, JOG_POSITIVE};
+    let inc = |rpm: f64| (rpm * f64::from(1 << 20) / 60.0).round() as u32;
+    let mut b = Bench::new();
+    for (pnu, mine, other) in [
+        (1041, JOG_POSITIVE, JOG_NEGATIVE),
+        (1042, JOG_NEGATIVE, JOG_POSITIVE),
+    ] {
+        let before = b.d.objects().record(0, other).unwrap();
+        assert_eq!(pkw2(&mut b, 0x42, pnu, 0, 250).0, 0x42);
+        assert_eq!(pkw2(&mut b, 0x42, pnu, 1, 2000).0, 0x42);
+        assert_eq!(pkw2(&mut b, 0x42, pnu, 2, 3000).0, 0x42);
+        let r = b.d.objects().record(0, mine).unwrap();
+        assert_eq!(
+            (r.profile_velocity, r.acceleration, r.deceleration),
+            (inc(250.0), inc(2000.0), inc(3000.0))
+        );
+        assert_eq!(pkw2(&mut b, 0x41, pnu, 0, 0), (0x41, 250));
+        assert_eq!(pkw2(&mut b, 0x42, pnu, 3, 1500).0, 0x42);
+        let r = b.d.objects().record(0, mine).unwrap();
+        assert_eq!(
+            (r.acceleration, r.deceleration),
+            (inc(1500.0), inc(1500.0)),
+            "sub 3 writes both"
+        );
+        assert_eq!(pkw2(&mut b, 0x41, pnu, 3, 0), (0x41, 1500), "sub 3 reads sub 1");
+        assert_eq!(
+            b.d.objects().record(0, other).unwrap(),
+            before,
+            "record {other} untouched"
+        );
+    }
+}

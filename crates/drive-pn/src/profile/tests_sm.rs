@@ -427,7 +427,7 @@ impl Bench {
 /// Torque control: 6071h from telegram 2 through the torque ramp 6087h
 /// (‰ per second): 500 ‰ at 1000 ‰/s takes half a second.
 #[test]
-fn p129_torque_setpoint_through_the_ramp() {
+fn p129_p187_torque_setpoint_through_the_ramp() {
     let mut b = Bench::new();
     b.d.objects_mut().set(0x6087, 0, 1000).unwrap();
     let limit = 1200; // rpm (20 rev/s): the speed limiter leaves 500 ‰ alone
