@@ -488,3 +488,31 @@ fn p133_the_current_limit_limits_the_torque_in_speed_control() {
         }
     }
 }
+
+/// A warning leaves the drive enabled and clears by itself: after the
+/// positive limit switch's fault is acknowledged with the switch still hit,
+/// the set-point lock (the direction is locked) shows in ZSW1 bit 7 while
+/// the drive runs; off the switch and back behind it, bit 7 clears
+/// (P-216, P-100).
+#[test]
+fn p216_p100_the_limit_switch_lock_is_a_warning_that_clears_itself() {
+    const WARNING: u16 = 0x0080;
+    let mut b = Bench::new();
+    b.d.objects_mut().set(drive_core::params::I101, 0, 1).unwrap();
+    b.io[0].position_inc = 1000;
+    b.reach(OP);
+    b.io[0].limit_positive = true;
+    b.cw(0x040F, 50);
+    assert_ne!(b.zsw1() & 0x0008, 0, "limit switch fault: {:#06x}", b.zsw1());
+    b.run(&speed(0x0480, 0, 10_000, [0; 8]), 20);
+    assert_eq!(b.zsw1() & 0x0008, 0, "acknowledged: {:#06x}", b.zsw1());
+    b.reach(OP);
+    b.cw(0x040F, 50);
+    assert_eq!(b.zsw1() & STATE, OP, "enabled with the lock");
+    assert_ne!(b.zsw1() & WARNING, 0, "the lock is a warning: {:#06x}", b.zsw1());
+    b.io[0].limit_positive = false;
+    b.io[0].position_inc = 0;
+    b.cw(0x040F, 50);
+    assert_eq!(b.zsw1() & WARNING, 0, "gone by itself: {:#06x}", b.zsw1());
+    assert_eq!(b.zsw1() & STATE, OP);
+}
