@@ -67,6 +67,8 @@ pub const A213: u16 = parameter_index(0, 213);
 pub const A310: u16 = parameter_index(0, 310);
 /// I02 position encoder (per axis).
 pub const I02: u16 = parameter_index(8, 2);
+/// A279 PROFINET units (the PROFIdrive personality's unit choices).
+pub const A279: u16 = parameter_index(0, 279);
 /// I22 target window (per axis, user position units).
 pub const I22: u16 = parameter_index(8, 22);
 /// I46 reference retaining (per axis).

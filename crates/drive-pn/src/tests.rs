@@ -55,7 +55,11 @@ pub(crate) fn commissioned() -> PnDrive<TestFlash> {
 
 /// [`commissioned`], with profinet-py's AR connected.
 pub(crate) fn drive() -> PnDrive<TestFlash> {
-    let mut d = commissioned();
+    connected(commissioned())
+}
+
+/// `d` (commissioned as "drive-1") with profinet-py's AR connected.
+pub(crate) fn connected(mut d: PnDrive<TestFlash>) -> PnDrive<TestFlash> {
     let mut ctrl = Stack::new(
         CTRL,
         IpConfig {

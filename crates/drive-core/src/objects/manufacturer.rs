@@ -40,6 +40,39 @@ const A66_ELEMENTS: [EntryInfo; 16] = repeat(
     &numbered!("Source bit "; "0" "1" "2" "3" "4" "5" "6" "7" "8" "9" "10" "11" "12" "13" "14" "15"),
 );
 
+/// A279 PROFINET units (spec §11, P-208…P-213): each unit as a code
+/// (time base 0x1000 = per minute, dimension × 0x100: 0 revolution, 1
+/// degree, 2 metre, plus the number of decimals 0…9), the gear and the feed
+/// constant with its unit (0xFFFF: unitless). Defaults: 1/1000 rev, rpm,
+/// rpm/s, 1 : 1, feed 1 unitless (P-207).
+const A279_ELEMENTS: &[EntryInfo] = &[
+    e(0, "Position unit", U16, RW)
+        .range(0, 0x1209)
+        .default_value(0x0003)
+        .saved(),
+    e(1, "Velocity unit", U16, RW)
+        .range(0, 0x1209)
+        .default_value(0x1000)
+        .saved(),
+    e(2, "Acceleration unit", U16, RW)
+        .range(0, 0x1209)
+        .default_value(0x1000)
+        .saved(),
+    e(3, "Gear motor revolutions", U32, RW)
+        .range(1, u32::MAX as i64)
+        .default_value(1)
+        .saved(),
+    e(4, "Gear output revolutions", U32, RW)
+        .range(1, u32::MAX as i64)
+        .default_value(1)
+        .saved(),
+    e(5, "Feed constant", U32, RW)
+        .range(1, u32::MAX as i64)
+        .default_value(1)
+        .saved(),
+    e(6, "Feed unit", U16, RW).default_value(0xFFFF).saved(),
+];
+
 /// An action parameter (A00, A09, A37, A287): [0] start, [1] progress, [2] result.
 const ACTION: &[EntryInfo] = &[
     e(0, "Start", U8, RW).range(0, 1),
@@ -125,7 +158,7 @@ const fn string(s: &str) -> DataType {
 }
 
 /// Global and axis-A manufacturer parameters, sorted by index.
-pub const PARAMS: [Object; 75] = [
+pub const PARAMS: [Object; 76] = [
     param_array!(a(0), "Save values", Record, Value::Ram, from ACTION)
         .note("A00; [0] = 1 requests saving (E-018); progress/result set by the store"),
     param_array!(a(9), "Restart", Record, Value::Ram, from ACTION)
@@ -477,6 +510,8 @@ pub const PARAMS: [Object; 75] = [
             .saved()],
     )
     .note("A278; UDP/TCP port of the vendor service protocol on the PROFINET IP while A277 = 2 (P-018); the service itself is not built"),
+    param_array!(a(279), "PROFINET units", Record, Value::Ram, from A279_ELEMENTS)
+        .note("A279; the PROFINET personality's unit choices (P-208…P-213); a setting whose conversion does not fit 32-bit fractions raises event 70 cause 4 (the manual's 22-4) and the previous units stay"),
     param_array!(a(287), "DC-Sync optimization", Record, Value::Ram, from A287_ELEMENTS)
         .level(2)
         .note("A287; action, results not stored (spec §22); [3]..[7] measurement results (our choice, spec §11.8 leaves their place open)"),

@@ -22,6 +22,7 @@
 pub mod access;
 pub mod pnu;
 pub mod status;
+pub mod unit_choice;
 
 use access::{DriveAccess, OwnValues};
 use drive_core::axis::{Axis, RecordCommand};
@@ -43,6 +44,8 @@ pub struct Profile {
     pkw_response: [u8; 8],
     cw1: Cw1Decoder,
     units: UnitProfile,
+    /// A279 as last looked at.
+    unit_choice: unit_choice::UnitChoice,
     own: OwnValues,
     /// The response telegram to send.
     response: Option<u8>,
@@ -73,6 +76,7 @@ impl Profile {
             pkw_response: [0; 8],
             cw1: Cw1Decoder::new(),
             units,
+            unit_choice: unit_choice::UnitChoice::default(),
             own,
             response: None,
             homing: false,
@@ -89,6 +93,11 @@ impl Profile {
     /// The telegrams (layouts, live view).
     pub fn telegrams(&self) -> Option<&Telegrams> {
         self.telegrams.as_ref()
+    }
+
+    /// The PROFINET units in force (A279, P-208).
+    pub fn units(&self) -> &UnitProfile {
+        &self.units
     }
 
     /// The profile's own values (CW1, ZSW1, the homing method, …).
@@ -115,6 +124,13 @@ impl Profile {
 
     /// Step 1–3 of a cycle: the received OUT module's data `frame`.
     pub fn receive(&mut self, frame: &[u8], objects: &mut DriveObjects, axis: &mut Axis) {
+        // the unit choices A279 (P-212): new units once they convert; a
+        // setting that does not raises 22-4 and the units stay
+        match self.unit_choice.refresh(objects) {
+            Ok(Some(u)) => self.units = u,
+            Ok(None) => {}
+            Err(_) => axis.raise_event(unit_choice::UNIT_OVERFLOW),
+        }
         let Some(telegrams) = self.telegrams.as_mut() else {
             return;
         };

@@ -272,3 +272,60 @@ fn p174_p175_jog_records_per_direction() {
         );
     }
 }
+
+/// A279 chooses the PROFINET units: the position in 1/10 degree reads one
+/// revolution as 3600 in PNU 1100 (P-208); gear and feed take positive
+/// values only (P-213: 0 is out of range).
+#[test]
+fn p208_p213_a279_chooses_the_units() {
+    let a279 = drive_core::params::A279;
+    let mut b = Bench::new();
+    b.io[0].position_inc = 1 << 20;
+    assert_eq!(pkw2(&mut b, 0x42, a279, 1, 0x0101).0, 0x42, "1/10 degree");
+    b.run(&speed(0x0400, 0, 10_000, [0; 8]), 20);
+    assert_eq!(b.i32_at(4), 3600, "PNU 1100 in 1/10 degree");
+    assert_eq!(
+        pkw2(&mut b, 0x42, a279, 4, 0),
+        (0xC2, 0x02),
+        "gear 0: limit exceeded"
+    );
+    assert_eq!(b.d.objects().get(a279, 4), Ok(1));
+}
+
+/// A unit setting whose conversion does not fit 32-bit fractions raises the
+/// error 22-4 (event 70 cause 4: ZSW1 bit 3, PNU 1600 = 70 × 16 + 4) and the
+/// previous units stay; after Save & Reset the drive raises it again at
+/// start (the setting is really invalid) and runs on the default units
+/// (P-211, P-212).
+#[test]
+fn p211_p212_an_overflowing_unit_setting_raises_22_4_and_keeps_the_units() {
+    let a279 = drive_core::params::A279;
+    let mut b = Bench::new();
+    b.io[0].position_inc = 1 << 20;
+    b.run(&speed(0x0400, 0, 10_000, [0; 8]), 20);
+    assert_eq!(b.i32_at(4), 1000);
+    let before = *b.d.profile().units();
+    // two large primes as gear: the fraction needs more than 32 bits
+    assert_eq!(pkw2(&mut b, 0x42, a279, 4, 4_294_967_291).0, 0x42);
+    assert_eq!(pkw2(&mut b, 0x42, a279, 5, 4_294_967_279).0, 0x42);
+    b.run(&speed(0x0400, 0, 10_000, [0; 8]), 20);
+    assert_ne!(b.zsw1() & 0x0008, 0, "22-4 is a fault: {:#06x}", b.zsw1());
+    assert_eq!(pkw2(&mut b, 0x41, 1600, 0, 0), (0x41, 70 * 16 + 4));
+    assert_eq!(*b.d.profile().units(), before, "the units stay");
+    assert_eq!(b.i32_at(4), 1000, "PNU 1100 still in 1/1000 rev");
+    // saved and started again: raised at start, default units
+    assert_eq!(pkw2(&mut b, 0x42, 971, 0, 1).0, 0x42);
+    let flash = core::mem::replace(&mut b.d, crate::tests::commissioned()).into_flash();
+    b.d = crate::tests::connected(PnDrive::new(flash, crate::tests::hardware()));
+    b.run(&speed(0x0400, 0, 10_000, [0; 8]), 20);
+    assert_ne!(
+        b.zsw1() & 0x0008,
+        0,
+        "raised again after the restart: {:#06x}",
+        b.zsw1()
+    );
+    assert_eq!(
+        *b.d.profile().units(),
+        motion::units::UnitProfile::default_profile()
+    );
+}
