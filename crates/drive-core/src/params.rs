@@ -69,6 +69,8 @@ pub const A310: u16 = parameter_index(0, 310);
 pub const I02: u16 = parameter_index(8, 2);
 /// A279 PROFINET units (the PROFIdrive personality's unit choices).
 pub const A279: u16 = parameter_index(0, 279);
+/// A280 PROFINET telegrams (the profile's stored telegram configuration).
+pub const A280: u16 = parameter_index(0, 280);
 /// I22 target window (per axis, user position units).
 pub const I22: u16 = parameter_index(8, 22);
 /// I46 reference retaining (per axis).

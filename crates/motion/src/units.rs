@@ -147,13 +147,29 @@ pub struct Fraction {
     den: u32,
 }
 
+/// Binary GCD (Stein): shifts and subtractions only; a 128-bit `%` is a
+/// long library loop on a 32-bit MCU. gcd(0, b) = b.
 const fn gcd(mut a: u128, mut b: u128) -> u128 {
-    while b != 0 {
-        let t = a % b;
-        a = b;
-        b = t;
+    if a == 0 {
+        return b;
     }
-    a
+    if b == 0 {
+        return a;
+    }
+    let shift = (a | b).trailing_zeros();
+    a >>= a.trailing_zeros();
+    loop {
+        b >>= b.trailing_zeros();
+        if a > b {
+            let t = a;
+            a = b;
+            b = t;
+        }
+        b -= a;
+        if b == 0 {
+            return a << shift;
+        }
+    }
 }
 
 /// Rounds n/d to the nearest integer, half away from zero (d > 0).
@@ -168,12 +184,17 @@ fn div_round(n: i128, d: i128) -> Option<i128> {
 
 impl Fraction {
     /// num/den reduced; refused when a part is 0 or does not fit 32 bits.
+    /// Not inlined: one copy serves the three quantities (flash).
+    #[inline(never)]
     pub fn new(num: u128, den: u128) -> Result<Fraction, UnitError> {
         if num == 0 || den == 0 {
             return Err(UnitError::Zero);
         }
         let g = gcd(num, den);
-        let (n, d) = (num / g, den / g);
+        // g ≥ 1 here; checked so the MCU build has no panic path
+        let (Some(n), Some(d)) = (num.checked_div(g), den.checked_div(g)) else {
+            return Err(UnitError::Zero);
+        };
         match (u32::try_from(n), u32::try_from(d)) {
             (Ok(num), Ok(den)) => Ok(Fraction { num, den }),
             _ => Err(UnitError::Overflow),
@@ -263,6 +284,17 @@ fn per_output_rev(d: Distance, feed: Feed) -> Result<(u128, u128), UnitError> {
     }
 }
 
+/// Bus units of distance `d` (per `time` seconds) per increment:
+/// (units per output rev) · gear_out / (gear_in · 2^20). Not inlined (one
+/// copy for the three quantities).
+#[inline(never)]
+fn fraction_of(s: &UnitSettings, d: Distance, time: u64) -> Result<Fraction, UnitError> {
+    let inc = u128::from(INCREMENTS_PER_REVOLUTION);
+    let (gi, go) = (u128::from(s.gear_in), u128::from(s.gear_out));
+    let (n, den) = per_output_rev(d, s.feed)?;
+    Fraction::new(n * go * u128::from(time), den * gi * inc)
+}
+
 impl UnitProfile {
     /// The manual's defaults.
     pub fn default_profile() -> UnitProfile {
@@ -290,18 +322,11 @@ impl UnitProfile {
         if s.gear_in == 0 || s.gear_out == 0 || s.feed.value == 0 {
             return Err(UnitError::Zero);
         }
-        let inc = u128::from(INCREMENTS_PER_REVOLUTION);
-        let (gi, go) = (u128::from(s.gear_in), u128::from(s.gear_out));
-        // units per increment = (units per output rev) · gear_out / (gear_in · 2^20)
-        let fraction = |d: Distance, time: u64| -> Result<Fraction, UnitError> {
-            let (n, den) = per_output_rev(d, s.feed)?;
-            Fraction::new(n * go * u128::from(time), den * gi * inc)
-        };
         Ok(UnitProfile {
             settings: s,
-            position: fraction(s.position, 1)?,
-            velocity: fraction(s.velocity, s.velocity_time.seconds())?,
-            acceleration: fraction(s.acceleration, s.acceleration_time.seconds())?,
+            position: fraction_of(&s, s.position, 1)?,
+            velocity: fraction_of(&s, s.velocity, s.velocity_time.seconds())?,
+            acceleration: fraction_of(&s, s.acceleration, s.acceleration_time.seconds())?,
         })
     }
 

@@ -108,6 +108,9 @@ fn calibrate() -> u32 {
 #[inline(never)]
 #[allow(unsafe_code)]
 fn make_drive() -> Option<&'static mut Drive> {
+    // in the core-coupled RAM (qemu/memory.x): building a drive takes two
+    // drives' worth of stack (the value and its copy), which RAM must hold
+    #[link_section = ".ccm"]
     static mut DRIVE: core::mem::MaybeUninit<Drive> = core::mem::MaybeUninit::uninit();
     static TAKEN: core::sync::atomic::AtomicBool = core::sync::atomic::AtomicBool::new(false);
     if TAKEN.swap(true, core::sync::atomic::Ordering::AcqRel) {
@@ -122,9 +125,9 @@ fn make_drive() -> Option<&'static mut Drive> {
     if !first.save() {
         return None;
     }
-    // SAFETY: `slot` was initialised just above; it is read out once and
-    // written again before any other use (the power cycle keeps the flash).
-    let flash = unsafe { slot.assume_init_read() }.into_flash();
+    // the power cycle keeps the flash: taken out of the first drive (not the
+    // whole drive read out onto the stack: two drives do not fit it)
+    let flash = core::mem::replace(first.flash_mut(), ParamFlash::new());
     Some(slot.write(Drive::new(flash, hardware())))
 }
 

@@ -11,7 +11,7 @@
 
 use super::{comm, repeat, Object, Value};
 use crate::{parameter_index, DEVICE_NAME, HARDWARE_VERSION, SOFTWARE_VERSION};
-use od::DataType::{Bool, VisibleString, I32, U16, U32, U8};
+use od::DataType::{Bool, OctetString, VisibleString, I32, U16, U32, U8};
 use od::{Access, DataType, EntryInfo, ObjectCode::*, ObjectInfo};
 
 const RO: Access = Access::RO;
@@ -153,12 +153,16 @@ macro_rules! mirror {
 /// The longest name of station, bytes (IEC 61158-6-10: 240).
 pub const PN_NAME_LEN: u16 = 240;
 
+/// A280's length: the longest stored telegram configuration (the profile's
+/// `profidrive::telegram::MAX_SERIAL_BYTES`, a test ties the two).
+pub const PN_TELEGRAMS_LEN: u16 = 255;
+
 const fn string(s: &str) -> DataType {
     VisibleString(s.len() as u16)
 }
 
 /// Global and axis-A manufacturer parameters, sorted by index.
-pub const PARAMS: [Object; 76] = [
+pub const PARAMS: [Object; 77] = [
     param_array!(a(0), "Save values", Record, Value::Ram, from ACTION)
         .note("A00; [0] = 1 requests saving (E-018); progress/result set by the store"),
     param_array!(a(9), "Restart", Record, Value::Ram, from ACTION)
@@ -512,6 +516,12 @@ pub const PARAMS: [Object; 76] = [
     .note("A278; UDP/TCP port of the vendor service protocol on the PROFINET IP while A277 = 2 (P-018); the service itself is not built"),
     param_array!(a(279), "PROFINET units", Record, Value::Ram, from A279_ELEMENTS)
         .note("A279; the PROFINET personality's unit choices (P-208…P-213); a setting whose conversion does not fit 32-bit fractions raises event 70 cause 4 (the manual's 22-4) and the previous units stay"),
+    Object::var(
+        a(280),
+        Value::Ram,
+        entries![e(0, "PROFINET telegrams", OctetString(PN_TELEGRAMS_LEN), RO).saved()],
+    )
+    .note("A280; the PROFIdrive profile's telegram configuration in its stored form (P-069; version 0 = the Example Function block's telegrams); written by the profile when an edited telegram is applied, saved with the parameters"),
     param_array!(a(287), "DC-Sync optimization", Record, Value::Ram, from A287_ELEMENTS)
         .level(2)
         .note("A287; action, results not stored (spec §22); [3]..[7] measurement results (our choice, spec §11.8 leaves their place open)"),

@@ -34,6 +34,8 @@ pub struct OwnValues {
     pub save_requested: bool,
     /// A save is running or asked (PNU 971 reads 1).
     pub saving: bool,
+    /// The telegram editor (PNU 2020…2022).
+    pub edit: super::telegram_config::TelegramEdit,
 }
 
 /// The PNU 1050 methods and the core's 6098h codes (spec §8.5: the
@@ -376,6 +378,10 @@ impl ParamAccess for DriveAccess<'_> {
             Source::LastError => Ok(self.last_error()),
             Source::Identification => Ok(Self::identification(addr.sub)),
             Source::Save => Ok(i64::from(self.own.saving)),
+            Source::TelegramEditor => {
+                let edit = self.own.edit;
+                edit.read(addr, self)
+            }
             Source::Own => Ok(i64::from(if addr.index == 0x2415 {
                 self.own.current_limit_ma
             } else {
@@ -447,6 +453,12 @@ impl ParamAccess for DriveAccess<'_> {
                     self.own.speed_limit = v;
                 }
             }
+            Source::TelegramEditor => {
+                let mut edit = self.own.edit;
+                let done = edit.write(addr, value, self);
+                self.own.edit = edit;
+                return done;
+            }
             Source::Zsw1 | Source::DigitalInputs | Source::LastError | Source::Identification => {
                 return Err(PdError::CANNOT_CHANGE)
             }
@@ -458,6 +470,15 @@ impl ParamAccess for DriveAccess<'_> {
         if addr == Addr::new(971, 0) && self.own.saving {
             return Ok(Completion::Pending);
         }
+        if addr.index == super::telegram_config::SELECT || addr.index == super::telegram_config::APPLY {
+            return self.own.edit.poll();
+        }
         Ok(Completion::Done)
+    }
+}
+
+impl super::telegram_config::StoreA280 for DriveAccess<'_> {
+    fn store_a280(&mut self, set: &profidrive::telegram::TelegramSet) {
+        self.objects.store_a280(set);
     }
 }

@@ -22,6 +22,7 @@
 pub mod access;
 pub mod pnu;
 pub mod status;
+pub mod telegram_config;
 pub mod unit_choice;
 
 use access::{DriveAccess, OwnValues};
@@ -61,6 +62,7 @@ impl Profile {
     pub fn new(objects: &mut DriveObjects, axis: &Axis) -> Profile {
         let units = UnitProfile::default_profile();
         let mut own = OwnValues::default();
+        let stored = telegram_config::stored(objects);
         let telegrams = {
             let access = DriveAccess {
                 objects,
@@ -68,8 +70,17 @@ impl Profile {
                 units: &units,
                 own: &mut own,
             };
-            Telegrams::with_defaults(&access).ok()
+            // the stored configuration (A280, P-069), else the FB's
+            stored
+                .and_then(|set| {
+                    let mut t = Telegrams::new();
+                    t.configure(&set, &access).ok().map(|()| t)
+                })
+                .or_else(|| Telegrams::with_defaults(&access).ok())
         };
+        if let Some(t) = &telegrams {
+            own.edit = telegram_config::TelegramEdit::of(t.set());
+        }
         Profile {
             telegrams,
             pkw: Pkw::new(),
@@ -164,6 +175,12 @@ impl Profile {
         }
         if let Some(req) = rx.pkw {
             self.pkw_response = self.pkw.step(req, &mut access);
+        }
+        // a telegram select or apply the PKW step asked for
+        if access.own.edit.request.is_some() {
+            let mut edit = access.own.edit;
+            telegram_config::serve(&mut edit, telegrams, &mut access);
+            access.own.edit = edit;
         }
         if let Some(cw1) = rx.cw1 {
             access.own.cw1 = cw1;

@@ -403,3 +403,6 @@ mod sm;
 
 #[path = "tests_pnu.rs"]
 mod pnu;
+
+#[path = "tests_telegrams.rs"]
+mod telegrams;

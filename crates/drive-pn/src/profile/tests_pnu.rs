@@ -225,7 +225,7 @@ fn p214_canopen_objects_use_their_factor_group_pnus_the_profinet_units() {
 
 /// A PKW request in receive telegram 2, which maps no jog entry (telegrams
 /// 0 and 1 write 1040.0 every cycle).
-fn pkw2(b: &mut Bench, code: u8, index: u16, sub: u8, value: u32) -> (u8, i32) {
+pub(super) fn pkw2(b: &mut Bench, code: u8, index: u16, sub: u8, value: u32) -> (u8, i32) {
     let mut t = [0u8; 36];
     t[0] = 0xE2;
     t[2..4].copy_from_slice(&0x0400u16.to_be_bytes());

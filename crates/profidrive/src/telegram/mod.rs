@@ -380,6 +380,14 @@ impl Telegrams {
     }
 }
 
+/// Checks one entry for a `dir` telegram as it is entered (spec §4.2's
+/// entry check: the object exists, its type has a telegram size, its
+/// access fits the direction; P-058…P-060); returns its size in bytes (0
+/// for 2011.0). The whole telegram is checked when it is configured.
+pub fn check_entry(dir: Dir, addr: Addr, access: &impl ParamAccess) -> Result<u8, Reason> {
+    Ok(entry_kind(dir, addr, access)?.map_or(0, |(size, _)| size))
+}
+
 /// Size and kind of one configured entry.
 fn entry_kind(dir: Dir, addr: Addr, access: &impl ParamAccess) -> Result<Option<(u8, Kind)>, Reason> {
     match addr {
