@@ -59,5 +59,6 @@ impl PeApplication for DriveEnergy {
 }
 
 /// The records the drive's device serves beyond the CM's own: PROFIenergy,
-/// then the profile's `H`.
-pub type PnRecords<H> = WithProfiEnergy<DriveEnergy, H>;
+/// the PROFIdrive parameter record 0xB02E ([`crate::bmp_record`]), then
+/// the application's `H`.
+pub type PnRecords<H> = WithProfiEnergy<DriveEnergy, crate::bmp_record::WithBmp<H>>;

@@ -67,6 +67,7 @@ use profinet::device::{Device, DeviceEvent, RtEvent};
 use profinet::profienergy::ProfiEnergy;
 use store::{Flash, ParamStore};
 
+pub mod bmp_record;
 pub mod energy;
 pub mod profile;
 pub mod settings;
@@ -78,6 +79,8 @@ use settings::NAME_LEN;
 extern crate std;
 #[cfg(test)]
 mod tests;
+#[cfg(test)]
+mod tests_bmp;
 #[cfg(test)]
 mod tests_energy;
 #[cfg(test)]
@@ -155,7 +158,10 @@ impl<F: Flash, H: RecordHook> PnDrive<F, H> {
                 PnRecords {
                     pe: ProfiEnergy::default(),
                     app: DriveEnergy::default(),
-                    inner: hook,
+                    inner: bmp_record::WithBmp {
+                        bmp: bmp_record::BmpRecord::default(),
+                        inner: hook,
+                    },
                 },
             ),
             objects,
@@ -300,7 +306,26 @@ impl<F: Flash, H: RecordHook> PnDrive<F, H> {
         }
         self.energy_inputs();
         self.device.receive(now, frame, tx);
+        self.serve_bmp();
         self.events(on_event);
+    }
+
+    /// A parameter request written to record 0xB02E in the frame just
+    /// received, served at once (P-206).
+    fn serve_bmp(&mut self) {
+        let Some((req, n)) = self.device.hook_mut().inner.bmp.take_request() else {
+            return;
+        };
+        let mut out = [0u8; bmp_record::MAX_BYTES];
+        let [a, _] = &mut self.axes;
+        let len = self
+            .profile
+            .serve_bmp(req.get(..n).unwrap_or(&[]), &mut self.objects, a, &mut out);
+        self.device
+            .hook_mut()
+            .inner
+            .bmp
+            .set_response(out.get(..len).unwrap_or(&[]));
     }
 
     /// The device's timers at `now`; returns when to call again at the

@@ -23,11 +23,23 @@ fn hex(s: &str) -> Vec<u8> {
 /// A record read or write of 0x80A0 at slot 0 subslot 1 as the Connect's
 /// AR: the PNIO status, and for a read the record data.
 fn record(d: &mut PnDrive<TestFlash>, seq: u32, write: bool, data: &[u8]) -> (PnioStatus, Vec<u8>) {
+    record_at(d, seq, write, INDEX, data)
+}
+
+/// A record read or write of `index` at slot 0 subslot 1 as the Connect's
+/// AR: the PNIO status, and for a read the record data.
+pub(crate) fn record_at(
+    d: &mut PnDrive<TestFlash>,
+    seq: u32,
+    write: bool,
+    index: u16,
+    data: &[u8],
+) -> (PnioStatus, Vec<u8>) {
     let mut rpc = hex(vectors::READ_IM0);
     rpc[64..68].copy_from_slice(&seq.to_be_bytes());
     rpc[68..70].copy_from_slice(&(if write { 3u16 } else { 2 }).to_be_bytes());
     rpc[101] = if write { 0x08 } else { 0x09 };
-    rpc[100 + 34..100 + 36].copy_from_slice(&INDEX.to_be_bytes());
+    rpc[100 + 34..100 + 36].copy_from_slice(&index.to_be_bytes());
     if write {
         rpc[100 + 36..100 + 40].copy_from_slice(&(data.len() as u32).to_be_bytes());
         rpc.extend_from_slice(data);

@@ -275,6 +275,26 @@ impl Profile {
         axis.set_record_command(record_command);
     }
 
+    /// Serves a PROFIdrive parameter request (record 0xB02E, P-206) over
+    /// the same parameter access as the PKW channel; the response goes
+    /// into `out`, its length is returned (0: nothing to answer, the
+    /// request shorter than its header).
+    pub fn serve_bmp(
+        &mut self,
+        req: &[u8],
+        objects: &mut DriveObjects,
+        axis: &Axis,
+        out: &mut [u8],
+    ) -> usize {
+        let mut access = DriveAccess {
+            objects,
+            axis,
+            units: &self.units,
+            own: &mut self.own,
+        };
+        profidrive::bmp::serve(req, &mut access, out).unwrap_or(0)
+    }
+
     /// After the cycle: ends a finished homing run (back to positioning)
     /// and builds the response telegram into `buf` (the IN module's
     /// length); returns the bytes written, `None` before any telegram.

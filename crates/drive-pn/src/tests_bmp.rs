@@ -1,0 +1,77 @@
+//! Record 0xB02E through the drive's device (P-206): a parameter request
+//! written, its response read back, over the RPC record channel of the
+//! Connect's AR.
+
+use super::tests::drive;
+use super::tests_energy::record_at;
+use profidrive::bmp::RECORD_INDEX;
+use profinet::cm::PnioStatus;
+
+/// A read request of (PNU, subindex) values.
+fn read_req(reference: u8, params: &[(u16, u16)]) -> std::vec::Vec<u8> {
+    let mut v = std::vec![reference, 0x01, 0x01, params.len() as u8];
+    for &(pnu, sub) in params {
+        v.extend_from_slice(&[0x10, 1]);
+        v.extend_from_slice(&pnu.to_be_bytes());
+        v.extend_from_slice(&sub.to_be_bytes());
+    }
+    v
+}
+
+/// Written, then read: the response; PNU 964.0 (U16) and the CANopen
+/// object 6041h (U16) in one request; a change of PNU 1004 (U16) is done
+/// and reads back.
+#[test]
+fn p206_record_0xb02e_serves_parameter_requests() {
+    let mut d = drive();
+    let (s, _) = record_at(
+        &mut d,
+        10,
+        true,
+        RECORD_INDEX,
+        &read_req(5, &[(964, 0), (0x6041, 0)]),
+    );
+    assert_eq!(s, PnioStatus::OK, "the request is taken");
+    let (s, r) = record_at(&mut d, 11, false, RECORD_INDEX, &[]);
+    assert_eq!(s, PnioStatus::OK);
+    let vendor = profinet::model::VENDOR_ID.to_be_bytes();
+    let sw = (d.objects().get(0x6041, 0).unwrap() as u16).to_be_bytes();
+    assert_eq!(
+        r,
+        [5, 0x01, 0x01, 2, 0x06, 1, vendor[0], vendor[1], 0x06, 1, sw[0], sw[1]]
+    );
+    // change PNU 1004 (override) to 1500 ‰
+    let mut change = std::vec![6, 0x02, 0x01, 1, 0x10, 1, 0x03, 0xEC, 0, 0];
+    change.extend_from_slice(&[0x06, 1, 0x05, 0xDC]);
+    assert_eq!(
+        record_at(&mut d, 12, true, RECORD_INDEX, &change).0,
+        PnioStatus::OK
+    );
+    let (_, r) = record_at(&mut d, 13, false, RECORD_INDEX, &[]);
+    assert_eq!(r, [6, 0x02, 0x01, 1], "done: the header only");
+    assert_eq!(d.objects().get(drive_core::objects::records::J403, 0), Ok(1500));
+}
+
+/// A read before any request, or a second read of one response, is a
+/// state conflict; a request too short for its header a write length
+/// error; a missing PNU answers its error block (0x81, format 0x44, error
+/// 0x00) and changes nothing.
+#[test]
+fn p206_record_0xb02e_refusals() {
+    let mut d = drive();
+    let (s, _) = record_at(&mut d, 20, false, RECORD_INDEX, &[]);
+    assert_ne!(s, PnioStatus::OK, "nothing to read yet");
+    assert_ne!(
+        record_at(&mut d, 21, true, RECORD_INDEX, &[1, 1]).0,
+        PnioStatus::OK,
+        "too short"
+    );
+    assert_eq!(
+        record_at(&mut d, 22, true, RECORD_INDEX, &read_req(9, &[(999, 0)])).0,
+        PnioStatus::OK
+    );
+    let (_, r) = record_at(&mut d, 23, false, RECORD_INDEX, &[]);
+    assert_eq!(r, [9, 0x81, 0x01, 1, 0x44, 1, 0x00, 0x00]);
+    let (s, _) = record_at(&mut d, 24, false, RECORD_INDEX, &[]);
+    assert_ne!(s, PnioStatus::OK, "read once");
+}
