@@ -659,7 +659,7 @@ def p226_pkw(fb, sc):
     access("read 607Ch (the same object in increments)", PKW_READ, 0x607C, 0, (PKW_READ, 250 * INC_PER_REV // 1000))
     access("write 607Ch = 0", PKW_WRITE, 0x607C, 0, (PKW_WRITE, 0), 0)
     access("read PNU 1051 again", PKW_READ, 1051, 0, (PKW_READ, 0))
-    access("read PNU 1003 (none)", PKW_READ, 1003, 0, (0xC1, 0x00))
+    access("read PNU 1007 (none)", PKW_READ, 1007, 0, (0xC1, 0x00))
     access("read PNU 1001.9 (no such subindex)", PKW_READ, 1001, 9, (0xC1, 0x03))
     access("write PNU 968 (read-only)", PKW_WRITE, 968, 0, (0xC2, 0x01), 0)
 

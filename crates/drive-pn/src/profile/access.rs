@@ -382,6 +382,7 @@ impl ParamAccess for DriveAccess<'_> {
                 let edit = self.own.edit;
                 edit.read(addr, self)
             }
+            Source::ProfileType => Ok(0),
             Source::Own => Ok(i64::from(if addr.index == 0x2415 {
                 self.own.current_limit_ma
             } else {
@@ -453,6 +454,11 @@ impl ParamAccess for DriveAccess<'_> {
                     self.own.speed_limit = v;
                 }
             }
+            Source::ProfileType => match value {
+                0 => {}
+                1 => return Err(PdError::VALUE_IMPERMISSIBLE),
+                _ => return Err(PdError::LIMIT_EXCEEDED),
+            },
             Source::TelegramEditor => {
                 let mut edit = self.own.edit;
                 let done = edit.write(addr, value, self);

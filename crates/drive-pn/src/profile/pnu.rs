@@ -100,6 +100,9 @@ pub enum Source {
     Own,
     /// The telegram editor (2020…2022, ours: [`super::telegram_config`]).
     TelegramEditor,
+    /// The position profile type (1003): 0 = jerk filter 0, what record
+    /// tasks do (P-147); 1, the automatic jerk filter, is not built.
+    ProfileType,
 }
 
 /// One PNU.sub.
@@ -248,6 +251,15 @@ pub const CATALOGUE: &[Pnu] = &[
         Source::SelectedRecord(RecordField::BothAccelerations),
     ),
     p(1002, 0, "Start Set Number", U8, RW, Unit::None, obj(J402, 0)),
+    p(
+        1003,
+        0,
+        "Position Profile Type",
+        U16,
+        RW,
+        Unit::None,
+        Source::ProfileType,
+    ),
     p(1004, 0, "Override Factor", U16, RW, Unit::None, obj(J403, 0)),
     p(
         1005,
@@ -639,7 +651,7 @@ mod tests {
             "All Accelerations Positioning"
         );
         assert_eq!(find(Addr::new(1001, 6)), Err(PdError::FAULTY_SUBINDEX));
-        assert_eq!(find(Addr::new(1003, 0)), Err(PdError::IMPERMISSIBLE_PNU));
+        assert_eq!(find(Addr::new(1007, 0)), Err(PdError::IMPERMISSIBLE_PNU));
         assert!(is_catalogue_index(999) && is_catalogue_index(0x2415) && !is_catalogue_index(0x6040));
     }
 

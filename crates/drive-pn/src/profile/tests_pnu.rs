@@ -329,3 +329,20 @@ fn p211_p212_an_overflowing_unit_setting_raises_22_4_and_keeps_the_units() {
         motion::units::UnitProfile::default_profile()
     );
 }
+
+/// PNU 1003, the position profile type: 0 (jerk filter 0, what record
+/// tasks do) reads and writes; 1 (the automatic jerk filter) is refused
+/// with 0x14, anything else with 0x02 (P-147, P-148).
+#[test]
+fn p147_p148_pnu_1003_profile_type() {
+    let mut b = Bench::new();
+    assert_eq!(pkw2(&mut b, 0x41, 1003, 0, 0), (0x41, 0));
+    assert_eq!(pkw2(&mut b, 0x42, 1003, 0, 0).0, 0x42);
+    assert_eq!(
+        pkw2(&mut b, 0x42, 1003, 0, 1),
+        (0xC2, 0x14),
+        "automatic jerk: not built"
+    );
+    assert_eq!(pkw2(&mut b, 0x42, 1003, 0, 2), (0xC2, 0x02));
+    assert_eq!(pkw2(&mut b, 0x41, 1003, 0, 0), (0x41, 0));
+}
