@@ -34,6 +34,7 @@
 pub mod controller;
 pub mod pkw;
 pub mod report;
+pub mod rig;
 pub mod sequence;
 
 use profidrive::cw1::CONTROL_BY_PLC;

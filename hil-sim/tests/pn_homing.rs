@@ -6,9 +6,8 @@
 //! the first direction of travel and the feature the reference lies on.
 
 use hil_sim::fb::controller::PnController;
-use hil_sim::fb::{ExampleFb, FbInputs, FbOutputs};
+use hil_sim::fb::rig::FbRig;
 use hil_sim::motor::{Motor, PositionInput, Switches};
-use nanos::Nanos;
 
 const REV: i64 = 1 << 20;
 /// The index pulse sits a quarter revolution into every revolution.
@@ -33,12 +32,7 @@ enum Feature {
     Here,
 }
 
-struct Rig {
-    ctl: PnController,
-    fb: ExampleFb,
-    i: FbInputs,
-    o: FbOutputs,
-}
+struct Rig(FbRig);
 
 impl Rig {
     /// The drive with axis A's motor on the test axis; `reference` is the
@@ -63,90 +57,55 @@ impl Rig {
                 objects.set(index, 0, 1).expect("I101/I102");
             }
         }
-        let ctl = PnController::connect(sim, Nanos::from_ms(10), None).expect("connect");
-        Rig {
-            ctl,
-            fb: ExampleFb::new(),
-            i: FbInputs::default(),
-            o: *ExampleFb::new().outputs(),
-        }
-    }
-
-    fn encoder(&self) -> i64 {
-        self.ctl.sim().motor(0).expect("axis A").position_inc_i64()
-    }
-
-    fn cycle(&mut self) {
-        let t = self.fb.receive_telegram(&self.i);
-        let r = self.ctl.exchange(&t).expect("exchange").map(<[u8]>::to_vec);
-        if let (Some(r), true) = (r, self.ctl.fresh()) {
-            if let Ok(o) = self.fb.response(&r, self.i.drive_enable) {
-                self.o = *o;
-            }
-        }
-    }
-
-    fn until(&mut self, ms: u64, done: impl Fn(&FbOutputs) -> bool) -> bool {
-        for _ in 0..ms {
-            self.cycle();
-            if self.ctl.fresh() && done(&self.o) {
-                return true;
-            }
-        }
-        false
+        Rig(FbRig::connect(sim).expect("connect"))
     }
 
     fn enable(&mut self) {
-        assert!(self.until(100, |o| o.identifier != 0), "a response telegram");
-        self.i.drive_enable = true;
-        assert!(
-            self.until(500, |o| o.drive_is_enabled),
-            "enabled: {:#06x}",
-            self.o.zsw1
-        );
+        assert!(self.0.enable().expect("cycle"), "enabled: {:#06x}", self.0.o.zsw1);
     }
 
     /// Homes with `method`; returns the first direction of travel (+1 / −1,
     /// 0 without motion) and the reference in encoder increments.
     fn home(&mut self, method: i8) -> (i64, i64) {
-        self.i.homing_method = method;
-        self.i.start_homing = true;
-        let start = self.encoder();
+        let r = &mut self.0;
+        r.i.homing_method = method;
+        r.i.start_homing = true;
+        let start = r.encoder();
         let mut first = 0;
         let mut done = false;
         for _ in 0..40_000 {
-            self.cycle();
-            let moved = self.encoder() - start;
+            r.cycle().expect("cycle");
+            let moved = r.encoder() - start;
             if first == 0 && moved.abs() > REV / 100 {
                 first = moved.signum();
             }
-            if self.ctl.fresh() && self.o.home_valid {
+            if r.ctl.fresh() && r.o.home_valid {
                 done = true;
                 break;
             }
-            if self.o.fault {
-                let o = self.ctl.sim().drive().objects();
+            if r.o.fault {
+                let o = r.ctl.sim().drive().objects();
                 panic!(
                     "method {method}: fault {:#06x}, E82 {:?} E43 {:?} at {} inc",
-                    self.o.zsw1,
+                    r.o.zsw1,
                     o.get(drive::params::E82, 0),
                     o.get(drive::params::E43, 0),
-                    self.encoder()
+                    r.encoder()
                 );
             }
         }
         assert!(
             done,
             "method {method}: home_valid within 40 s ({:#06x})",
-            self.o.zsw1
+            r.o.zsw1
         );
-        self.i.start_homing = false;
+        r.i.start_homing = false;
         for _ in 0..50 {
-            self.cycle();
+            r.cycle().expect("cycle");
         }
         // the reference reads 0 (home offset 0): encoder − actual position
-        let actual = i64::from(self.o.position_actual_value) * REV / 1000;
-        (first, self.encoder() - actual)
+        let actual = i64::from(r.o.position_actual_value) * REV / 1000;
+        (first, r.encoder() - actual)
     }
 }
 
@@ -173,7 +132,7 @@ fn check(method: i8, reference: PositionInput, edges: (i64, i64), first: i64, fe
     let limits = method > 0;
     let mut r = Rig::new(reference, limits);
     r.enable();
-    let start = r.encoder();
+    let start = r.0.encoder();
     let (dir, at) = r.home(method);
     println!(
         "PROFIdrive method {method:>3}: first move {dir:+}, reference at {at} inc ({:.4} rev), {feature:?}",
@@ -186,7 +145,7 @@ fn check(method: i8, reference: PositionInput, edges: (i64, i64), first: i64, fe
         on_feature(at, feature, side, start, edges),
         "method {method}: reference {at} inc is not on {feature:?} (side {side})"
     );
-    assert_eq!(r.o.operation_mode_actual, 0x10, "back in positioning");
+    assert_eq!(r.0.o.operation_mode_actual, 0x10, "back in positioning");
 }
 
 /// The reference switch on the positive side (actuated from +1 rev on).

@@ -12,8 +12,7 @@
 use drive_tests::axis::*;
 use drive_tests::{init, line, with_master, Cyclic, REV};
 use hil_sim::fb::controller::PnController;
-use hil_sim::fb::{ExampleFb, FbInputs, FbOutputs};
-use nanos::Nanos;
+use hil_sim::fb::rig::FbRig;
 
 /// Cycles recorded after the start command (1 ms each).
 const CYCLES: usize = 700;
@@ -70,65 +69,27 @@ fn over_ethercat() -> Vec<i64> {
     })
 }
 
-struct Pn {
-    ctl: PnController,
-    fb: ExampleFb,
-    i: FbInputs,
-    o: FbOutputs,
-}
-
-impl Pn {
-    fn cycle(&mut self) {
-        let t = self.fb.receive_telegram(&self.i);
-        let r = self.ctl.exchange(&t).expect("exchange").map(<[u8]>::to_vec);
-        if let (Some(r), true) = (r, self.ctl.fresh()) {
-            if let Ok(o) = self.fb.response(&r, self.i.drive_enable) {
-                self.o = *o;
-            }
-        }
-    }
-
-    fn until(&mut self, ms: u64, done: impl Fn(&FbOutputs) -> bool) -> bool {
-        (0..ms).any(|_| {
-            self.cycle();
-            self.ctl.fresh() && done(&self.o)
-        })
-    }
-
-    fn encoder(&self) -> i64 {
-        self.ctl.sim().motor(0).expect("axis A").position_inc_i64()
-    }
-}
-
 /// The move over PROFINET: record 266 from telegram 0 (target, profile
 /// velocity, end velocity 0, all accelerations), started by CW1 bit 6,
 /// homed by PROFIdrive method 34 (the core's 37) first.
 fn over_profinet() -> Vec<i64> {
-    let ctl = PnController::connect(PnController::drive(), Nanos::from_ms(10), None).expect("connect");
-    let mut p = Pn {
-        ctl,
-        fb: ExampleFb::new(),
-        i: FbInputs::default(),
-        o: *ExampleFb::new().outputs(),
-    };
-    assert!(p.until(100, |o| o.identifier != 0));
-    p.i.drive_enable = true;
-    assert!(p.until(500, |o| o.drive_is_enabled));
+    let mut p = FbRig::connect(PnController::drive()).expect("connect");
+    assert!(p.enable().unwrap(), "enabled");
     p.i.homing_method = 34;
     p.i.start_homing = true;
-    assert!(p.until(500, |o| o.home_valid), "homed");
+    assert!(p.until(500, |o| o.home_valid).unwrap(), "homed");
     p.i.start_homing = false;
     p.i.target_position = TARGET_MILLI;
     p.i.profile_velocity = RPM;
     p.i.end_velocity = 0;
     p.i.all_accelerations_positioning = RPM_PER_S;
     for _ in 0..50 {
-        p.cycle();
+        p.cycle().unwrap();
     }
     p.i.start_pos = true;
     let mut trace = vec![p.encoder()];
     for _ in 0..CYCLES {
-        p.cycle();
+        p.cycle().unwrap();
         trace.push(p.encoder());
     }
     assert!(p.o.target_reached, "record: target reached: {:#06x}", p.o.zsw1);
