@@ -30,18 +30,17 @@
 
 mod common;
 
-use common::ip;
+use common::pn_line::PnLine;
 use profinet::model::{self, DataModule, Direction};
-use std::path::{Path, PathBuf};
-use std::process::{Child, Command, Stdio};
-use std::time::{Duration, Instant};
+use std::ffi::OsStr;
+use std::path::Path;
+use std::process::Command;
+use std::time::Duration;
 
 /// A script that has not finished after this long has hung.
 const SCRIPT_LIMIT: Duration = Duration::from_secs(240);
 /// Seconds of cyclic data exchange (at least 10).
 const CYCLIC_SECONDS: &str = "12";
-/// The controller's address (in its own namespace only).
-const CONTROLLER_IP: &str = "192.168.0.10/24";
 /// The name and IP the controller gives the device.
 const NAME: &str = "drive-1";
 /// Drives serve runs on the line (the controller talks to the first, finds
@@ -51,188 +50,6 @@ const DRIVES: u16 = 2;
 const FAULT_EVENT: u8 = 44;
 const FAULT_CAUSE: u8 = 1;
 const DEVICE_IP: &str = "192.168.0.50";
-
-/// The python with profinet-py, or why the test cannot run.
-fn profinet_py_python() -> Result<PathBuf, String> {
-    if !common::is_root() {
-        return Err("needs root for network namespaces and raw sockets".into());
-    }
-    let py = std::env::var_os("PROFINET_PY_PYTHON").ok_or(
-        "PROFINET_PY_PYTHON is not set (`.ci/run` installs profinet-py into target/profinet-venv and sets \
-         it to target/profinet-venv/bin/python; locally e.g. /tmp/pnvenv/bin/python)",
-    )?;
-    let show = Path::new(&py).display().to_string();
-    let out = Command::new(&py)
-        .args(["-c", "import profinet; print(profinet.__version__)"])
-        .output()
-        .unwrap_or_else(|e| panic!("PROFINET_PY_PYTHON={show}: {e}"));
-    assert!(
-        out.status.success(),
-        "PROFINET_PY_PYTHON={show} cannot import profinet: {}",
-        String::from_utf8_lossy(&out.stderr).trim()
-    );
-    println!(
-        "profinet-py {} ({show})",
-        String::from_utf8_lossy(&out.stdout).trim()
-    );
-    Ok(PathBuf::from(py))
-}
-
-/// Runs `cmd`, returning its stdout; fails the test if it fails.
-fn output(cmd: &mut Command) -> String {
-    let out = cmd.output().unwrap_or_else(|e| panic!("{cmd:?}: {e}"));
-    assert!(
-        out.status.success(),
-        "{cmd:?} failed: {}",
-        String::from_utf8_lossy(&out.stderr)
-    );
-    String::from_utf8_lossy(&out.stdout).into_owned()
-}
-
-/// Two private namespaces joined by a veth pair, `serve --fieldbus profinet`
-/// in one. Everything is removed on drop (also when the test fails).
-struct Line {
-    ctl_ns: String,
-    dev_ns: String,
-    ctl_if: String,
-    device_mac: String,
-    server: Option<Child>,
-    serve_log: PathBuf,
-    /// serve's control FIFO (`--control`).
-    control: PathBuf,
-}
-
-impl Line {
-    fn new(dir: &Path, pcap: &Path) -> Self {
-        let id = std::process::id() % 100_000;
-        let ctl_ns = format!("pnctl{id}");
-        let dev_ns = format!("pndev{id}");
-        let ctl_if = format!("pn{id}c");
-        let dev_if = format!("pn{id}d");
-        for ns in [&ctl_ns, &dev_ns] {
-            let _ = Command::new("ip")
-                .args(["netns", "del", ns])
-                .stderr(Stdio::null())
-                .status();
-        }
-        // from here on Drop cleans up whatever was made
-        let mut line = Self {
-            ctl_ns,
-            dev_ns,
-            ctl_if,
-            device_mac: String::new(),
-            server: None,
-            serve_log: dir.join("serve.log"),
-            control: dir.join("control"),
-        };
-        let (c, d) = (line.ctl_ns.clone(), line.dev_ns.clone());
-        for ns in [&c, &d] {
-            ip(&["netns", "add", ns]);
-            ip(&["-n", ns, "link", "set", "lo", "up"]);
-        }
-        ip(&[
-            "link",
-            "add",
-            &line.ctl_if,
-            "netns",
-            &c,
-            "type",
-            "veth",
-            "peer",
-            "name",
-            &dev_if,
-            "netns",
-            &d,
-        ]);
-        // no IPv6 chatter from either kernel in the recording
-        for (ns, ifc) in [(&c, &line.ctl_if), (&d, &dev_if)] {
-            let _ = Command::new("ip")
-                .args(["netns", "exec", ns, "sysctl", "-qw"])
-                .arg(format!("net.ipv6.conf.{ifc}.disable_ipv6=1"))
-                .status();
-        }
-        ip(&["-n", &c, "link", "set", &line.ctl_if, "up"]);
-        ip(&["-n", &d, "link", "set", &dev_if, "up"]);
-        ip(&["-n", &c, "addr", "add", CONTROLLER_IP, "dev", &line.ctl_if]);
-        line.device_mac = output(
-            Command::new("ip")
-                .args(["netns", "exec", &d, "cat"])
-                .arg(format!("/sys/class/net/{dev_if}/address")),
-        )
-        .trim()
-        .to_string();
-        let log = std::fs::File::create(&line.serve_log).expect("serve log");
-        line.server = Some(
-            Command::new("ip")
-                .args(["netns", "exec", &d, env!("CARGO_BIN_EXE_hil-sim"), "serve"])
-                .args(["--fieldbus", "profinet", "--iface", &dev_if])
-                .args(["--slaves", &DRIVES.to_string()])
-                .arg("--pcap")
-                .arg(pcap)
-                .arg("--control")
-                .arg(&line.control)
-                .stdout(log.try_clone().expect("log"))
-                .stderr(log)
-                .spawn()
-                .expect("spawn hil-sim serve"),
-        );
-        // serve prints its first line once its socket is open
-        let until = Instant::now() + Duration::from_secs(10);
-        while !line.serve_output().contains("hil-sim serve:") {
-            assert!(
-                Instant::now() < until,
-                "serve did not start:\n{}",
-                line.serve_output()
-            );
-            std::thread::sleep(Duration::from_millis(50));
-        }
-        line
-    }
-
-    /// Runs the controller script in the controller's namespace; its lines
-    /// are printed as they come and returned with the exit status.
-    fn run(&self, python: &Path, args: &[&str]) -> (bool, Vec<String>) {
-        let script = Path::new(env!("CARGO_MANIFEST_DIR")).join("tests/profinet/controller.py");
-        let child = Command::new("ip")
-            .args(["netns", "exec", &self.ctl_ns])
-            .arg(python)
-            .arg("-u")
-            .arg(&script)
-            .args(["--iface", &self.ctl_if, "--device-mac", &self.device_mac])
-            .args(args)
-            .stdout(Stdio::piped())
-            .stderr(Stdio::piped())
-            .spawn()
-            .expect("run the script");
-        let (status, lines) = common::watch_script(child, &script, SCRIPT_LIMIT);
-        (status.success(), lines)
-    }
-
-    /// Stops serve (SIGTERM: it flushes the recording and prints its
-    /// summary).
-    fn stop_server(&mut self) {
-        if let Some(s) = self.server.take() {
-            common::stop_server(s, Duration::from_secs(5));
-        }
-    }
-
-    fn serve_output(&self) -> String {
-        std::fs::read_to_string(&self.serve_log).unwrap_or_default()
-    }
-}
-
-impl Drop for Line {
-    fn drop(&mut self) {
-        self.stop_server();
-        // deleting the namespaces deletes the veth pair and the address
-        for ns in [&self.ctl_ns, &self.dev_ns] {
-            let _ = Command::new("ip")
-                .args(["netns", "del", ns])
-                .stderr(Stdio::null())
-                .status();
-        }
-    }
-}
 
 /// tshark on `pcap` with `args`; its stdout (the "running as root" note on
 /// stderr is dropped).
@@ -268,7 +85,7 @@ fn step_lines<'a>(lines: &'a [String], step: &str) -> Vec<&'a str> {
 #[test]
 fn p008_p027_p029_p030_p035_p036_p042_p085_p110_p191_p223_profinet_py_names_connects_drives_and_loses_the_drive(
 ) {
-    let python = match profinet_py_python() {
+    let python = match common::profinet_py_python() {
         Ok(p) => p,
         Err(why) => {
             eprintln!("profinet-py test: skipped, {why}");
@@ -278,7 +95,17 @@ fn p008_p027_p029_p030_p035_p036_p042_p085_p110_p191_p223_profinet_py_names_conn
     let dir = Path::new(env!("CARGO_TARGET_TMPDIR")).join("profinet-py");
     std::fs::create_dir_all(&dir).expect("scratch dir");
     let pcap = dir.join("serve.pcap");
-    let mut line = Line::new(&dir, &pcap);
+    let drives = DRIVES.to_string();
+    let mut line = PnLine::new(
+        "pn",
+        &dir,
+        &[
+            "--slaves".as_ref(),
+            drives.as_ref(),
+            "--pcap".as_ref(),
+            pcap.as_os_str(),
+        ],
+    );
     let gsdml = Path::new(env!("CARGO_MANIFEST_DIR"))
         .join("../gsdml")
         .join(gsdml::file_name());
@@ -286,36 +113,38 @@ fn p008_p027_p029_p030_p035_p036_p042_p085_p110_p191_p223_profinet_py_names_conn
     // the manual's example: slot 1 "18 Word Output Data", slot 2 "18 Word Input Data"
     let (out18, in18) = (module(Direction::FromDrive, 18), module(Direction::ToDrive, 18));
     let vendor = format!("{:#06x}", model::VENDOR_ID);
-    let (ok, lines) = line.run(
-        &python,
-        &[
-            "--gsdml",
-            gsdml.to_str().unwrap(),
-            "--out-module",
-            &out18,
-            "--in-module",
-            &in18,
-            "--vendor-id",
-            &vendor,
-            "--order",
-            model::ORDER_NUMBER,
-            "--name",
-            NAME,
-            "--ip",
-            DEVICE_IP,
-            "--cyclic-seconds",
-            CYCLIC_SECONDS,
-            "--control",
-            line.control.to_str().unwrap(),
-            "--drives",
-            &DRIVES.to_string(),
-            "--motor",
-            "--fault-event",
-            &FAULT_EVENT.to_string(),
-            "--fault-cause",
-            &FAULT_CAUSE.to_string(),
-        ],
-    );
+    let script = Path::new(env!("CARGO_MANIFEST_DIR")).join("tests/profinet/controller.py");
+    let (fault_event, fault_cause) = (FAULT_EVENT.to_string(), FAULT_CAUSE.to_string());
+    let words = [
+        "--gsdml",
+        gsdml.to_str().unwrap(),
+        "--out-module",
+        &out18,
+        "--in-module",
+        &in18,
+        "--vendor-id",
+        &vendor,
+        "--order",
+        model::ORDER_NUMBER,
+        "--name",
+        NAME,
+        "--ip",
+        DEVICE_IP,
+        "--cyclic-seconds",
+        CYCLIC_SECONDS,
+        "--control",
+        line.control.to_str().unwrap(),
+        "--drives",
+        &drives,
+        "--motor",
+        "--fault-event",
+        &fault_event,
+        "--fault-cause",
+        &fault_cause,
+    ];
+    let args: Vec<&OsStr> = words.iter().map(OsStr::new).collect();
+    let (status, lines) = line.run(&python, &script, &args, SCRIPT_LIMIT);
+    let ok = status.success();
     line.stop_server();
     let serve = line.serve_output();
     println!("--- hil-sim serve ({}):\n{serve}", line.serve_log.display());

@@ -6,6 +6,8 @@
 use std::process::{Child, Command, Stdio};
 use std::time::Duration;
 
+pub mod pn_line;
+
 /// This process runs as root (network namespaces and raw sockets work).
 pub fn is_root() -> bool {
     // SAFETY: geteuid has no preconditions.
