@@ -5,6 +5,7 @@
 //! core's object dictionary with its access, range and state checks.
 
 use super::pnu::{self, Jog, RecordField, Source, Unit};
+use super::units::{self, UnitsCache};
 use drive_core::axis::Axis;
 use drive_core::faults::E82_INACTIVE;
 use drive_core::objects::records::{Record, JOG_NEGATIVE, JOG_POSITIVE};
@@ -12,7 +13,6 @@ use drive_core::params::{E43, E82};
 use drive_core::user_units::UserUnits;
 use drive_core::DriveObjects;
 use motion::units::UnitProfile;
-use motion::INCREMENTS_PER_REVOLUTION;
 use od::{CommState, DataType, Dictionary, SdoAbort};
 use profidrive::{Addr, Completion, Describe, ParamAccess, PdError};
 use profinet::model;
@@ -105,6 +105,9 @@ pub struct DriveAccess<'a> {
     pub axis: &'a Axis,
     /// The PROFINET units of the PNUs.
     pub units: &'a UnitProfile,
+    /// The axis' CiA 402 user units, read once per configuration
+    /// generation.
+    pub user_units: &'a UnitsCache,
     /// The profile's own values.
     pub own: &'a mut OwnValues,
 }
@@ -121,7 +124,7 @@ impl DriveAccess<'_> {
     }
 
     fn user_units(&self) -> UserUnits {
-        UserUnits::read(self.objects, self.axis)
+        self.user_units.get(self.objects, self.axis)
     }
 
     /// The declaration of `index`:`sub`: 0x00 without the object, 0x03
@@ -167,49 +170,48 @@ impl DriveAccess<'_> {
 
     /// Bus units → the object's units.
     fn to_object(&self, unit: Unit, bus: i64) -> Result<i64, PdError> {
-        let u = self.user_units();
         let range = PdError::LIMIT_EXCEEDED;
+        let p = self.units;
         Ok(match unit {
             Unit::None => bus,
             Unit::Position => {
-                let inc = self.units.position.from_bus(bus).map_err(|_| range)?;
-                u.position_from_increments(inc).ok_or(range)?
+                let inc = units::from_bus(&p.position, bus).map_err(|_| range)?;
+                self.user_units().position_from_increments(inc).ok_or(range)?
             }
             // the integer path: exact to the increment (f32 is not, above 2^24)
             Unit::Velocity => {
-                u.velocity_from_increments(self.units.velocity.from_bus(bus).map_err(|_| range)? as f64)
+                let inc = units::from_bus(&p.velocity, bus).map_err(|_| range)?;
+                units::velocity_from_increments(&self.user_units(), inc)
             }
-            Unit::Acceleration => u.acceleration_from_increments(
-                self.units.acceleration.from_bus(bus).map_err(|_| range)? as f64,
-            ),
-            Unit::Rpm => rpm_of(self.units.velocity.from_bus(bus).map_err(|_| range)? as f64),
-            Unit::RpmPerSecond => rpm_of(self.units.acceleration.from_bus(bus).map_err(|_| range)? as f64),
+            Unit::Acceleration => {
+                let inc = units::from_bus(&p.acceleration, bus).map_err(|_| range)?;
+                units::acceleration_from_increments(&self.user_units(), inc)
+            }
+            Unit::Rpm => units::rpm_of(units::from_bus(&p.velocity, bus).map_err(|_| range)?),
+            Unit::RpmPerSecond => units::rpm_of(units::from_bus(&p.acceleration, bus).map_err(|_| range)?),
         })
     }
 
     /// The object's units → bus units.
     fn to_bus(&self, unit: Unit, object: i64) -> Result<i64, PdError> {
-        let u = self.user_units();
         let range = PdError::LIMIT_EXCEEDED;
+        let p = self.units;
         let v = match unit {
             Unit::None => return Ok(object),
             Unit::Position => {
-                let inc = u.position_to_increments(object).ok_or(range)?;
-                self.units.position.to_bus(inc)
+                let inc = self.user_units().position_to_increments(object).ok_or(range)?;
+                units::to_bus(&p.position, inc)
             }
-            Unit::Velocity => self
-                .units
-                .velocity
-                .to_bus(round_i64(u.velocity_to_increments(object))),
-            Unit::Acceleration => self
-                .units
-                .acceleration
-                .to_bus(round_i64(u.acceleration_to_increments(object))),
-            Unit::Rpm => self.units.velocity.to_bus(round_i64(increments_of_rpm(object))),
-            Unit::RpmPerSecond => self
-                .units
-                .acceleration
-                .to_bus(round_i64(increments_of_rpm(object))),
+            Unit::Velocity => units::to_bus(
+                &p.velocity,
+                units::velocity_to_increments(&self.user_units(), object),
+            ),
+            Unit::Acceleration => units::to_bus(
+                &p.acceleration,
+                units::acceleration_to_increments(&self.user_units(), object),
+            ),
+            Unit::Rpm => units::to_bus(&p.velocity, units::increments_of_rpm(object)),
+            Unit::RpmPerSecond => units::to_bus(&p.acceleration, units::increments_of_rpm(object)),
         };
         v.map(i64::from).map_err(|_| range)
     }
@@ -313,22 +315,6 @@ impl DriveAccess<'_> {
         let d = self.objects.get(self.axis.cia402_index(0x60FD), 0).unwrap_or(0);
         ((d & 1) << 7) | ((d >> 1 & 1) << 8)
     }
-}
-
-/// inc/s (or /s²) → rpm (or rpm/s), rounded.
-fn rpm_of(increments: f64) -> i64 {
-    let rpm = increments * 60.0 / f64::from(INCREMENTS_PER_REVOLUTION);
-    let r = if rpm >= 0.0 { rpm + 0.5 } else { rpm - 0.5 };
-    r as i64
-}
-
-fn increments_of_rpm(rpm: i64) -> f64 {
-    rpm as f64 * f64::from(INCREMENTS_PER_REVOLUTION) / 60.0
-}
-
-/// Half away from zero; `as` saturates.
-fn round_i64(x: f64) -> i64 {
-    (if x >= 0.0 { x + 0.5 } else { x - 0.5 }) as i64
 }
 
 impl ParamAccess for DriveAccess<'_> {

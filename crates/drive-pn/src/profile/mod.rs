@@ -22,6 +22,7 @@
 pub mod access;
 pub mod pnu;
 pub mod status;
+pub mod units;
 
 use access::{DriveAccess, OwnValues};
 use drive_core::axis::{Axis, RecordCommand};
@@ -30,6 +31,7 @@ use motion::units::UnitProfile;
 use profidrive::cw1::{Context, Cw1Decoder, Mode, ModeCommands};
 use profidrive::pkw::Pkw;
 use profidrive::telegram::{ModeBinding, Telegrams, MAX_TELEGRAM_BYTES};
+use units::UnitsCache;
 
 /// 6040h bits 4–6: the vl ramp bits, the pp / homing "start" bit.
 const BITS_4_6: u16 = 0x0070;
@@ -43,6 +45,7 @@ pub struct Profile {
     pkw_response: [u8; 8],
     cw1: Cw1Decoder,
     units: UnitProfile,
+    user_units: UnitsCache,
     own: OwnValues,
     /// The response telegram to send.
     response: Option<u8>,
@@ -57,12 +60,14 @@ impl Profile {
     /// and the default units (P-207).
     pub fn new(objects: &mut DriveObjects, axis: &Axis) -> Profile {
         let units = UnitProfile::default_profile();
+        let user_units = UnitsCache::new();
         let mut own = OwnValues::default();
         let telegrams = {
             let access = DriveAccess {
                 objects,
                 axis,
                 units: &units,
+                user_units: &user_units,
                 own: &mut own,
             };
             Telegrams::with_defaults(&access).ok()
@@ -73,6 +78,7 @@ impl Profile {
             pkw_response: [0; 8],
             cw1: Cw1Decoder::new(),
             units,
+            user_units,
             own,
             response: None,
             homing: false,
@@ -122,6 +128,7 @@ impl Profile {
             objects,
             axis,
             units: &self.units,
+            user_units: &self.user_units,
             own: &mut self.own,
         };
         let rx = telegrams.apply_receive(frame, &mut access);
@@ -244,6 +251,7 @@ impl Profile {
             objects,
             axis,
             units: &self.units,
+            user_units: &self.user_units,
             own: &mut self.own,
         };
         let mut out = [0u8; MAX_TELEGRAM_BYTES];
