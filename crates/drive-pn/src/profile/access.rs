@@ -4,7 +4,8 @@
 //! (P-045, P-194: in the CiA 402 factor group's units), both through the
 //! core's object dictionary with its access, range and state checks.
 
-use super::pnu::{self, Jog, RecordField, Source, Unit};
+use super::lookup::{self as pnu, PreparedCache};
+use super::pnu::{Jog, RecordField, Source, Unit};
 use super::units::{self, UnitsCache};
 use drive_core::axis::Axis;
 use drive_core::faults::E82_INACTIVE;
@@ -108,6 +109,9 @@ pub struct DriveAccess<'a> {
     /// The axis' CiA 402 user units, read once per configuration
     /// generation.
     pub user_units: &'a UnitsCache,
+    /// The CiA 402 entries accessed, prepared once per configuration
+    /// generation.
+    pub prepared: &'a PreparedCache,
     /// The profile's own values.
     pub own: &'a mut OwnValues,
 }
@@ -137,14 +141,20 @@ impl DriveAccess<'_> {
             .ok_or(PdError::FAULTY_SUBINDEX)
     }
 
-    /// An object's value through the dictionary (Op, its access rules).
+    /// An object's value through the dictionary (Op, its access rules);
+    /// a CiA 402 entry through its prepared access (the same answers).
     fn read_object(&mut self, index: u16, sub: u8) -> Result<i64, PdError> {
-        let t = self.entry(index, sub)?.data_type;
         let mut buf = [0u8; 8];
-        let n = self
-            .objects
-            .read(index, sub, &mut buf, CommState::Op)
-            .map_err(pd_error)?;
+        let (t, n) = match self.prepared.get(self.objects, index, sub) {
+            Some(p) => match self.objects.read_prepared(&p, &mut buf) {
+                Some(r) => (p.data_type(), r.map_err(pd_error)?),
+                None => (p.data_type(), self.read_full(index, sub, &mut buf)?),
+            },
+            None => {
+                let t = self.entry(index, sub)?.data_type;
+                (t, self.read_full(index, sub, &mut buf)?)
+            }
+        };
         let mut v: u64 = 0;
         for (k, b) in buf.iter().take(n.min(8)).enumerate() {
             v |= u64::from(*b) << (8 * k);
@@ -159,10 +169,23 @@ impl DriveAccess<'_> {
         )
     }
 
+    fn read_full(&mut self, index: u16, sub: u8, buf: &mut [u8]) -> Result<usize, PdError> {
+        self.objects
+            .read(index, sub, buf, CommState::Op)
+            .map_err(pd_error)
+    }
+
     fn write_object(&mut self, index: u16, sub: u8, value: i64) -> Result<(), PdError> {
-        let n = size(self.entry(index, sub)?.data_type);
+        let prepared = self.prepared.get(self.objects, index, sub);
+        let t = match prepared {
+            Some(p) => p.data_type(),
+            None => self.entry(index, sub)?.data_type,
+        };
         let bytes = value.to_le_bytes();
-        let data = bytes.get(..n).ok_or(PdError::INCORRECT_DATA_TYPE)?;
+        let data = bytes.get(..size(t)).ok_or(PdError::INCORRECT_DATA_TYPE)?;
+        if let Some(r) = prepared.and_then(|p| self.objects.write_prepared(&p, data)) {
+            return r.map_err(pd_error);
+        }
         self.objects
             .write(index, sub, data, CommState::Op)
             .map_err(pd_error)

@@ -20,6 +20,7 @@
 //! data: ZSW1 from the axis' state and statusword ([`status`]).
 
 pub mod access;
+pub mod lookup;
 pub mod pnu;
 pub mod status;
 pub mod units;
@@ -27,6 +28,7 @@ pub mod units;
 use access::{DriveAccess, OwnValues};
 use drive_core::axis::{Axis, RecordCommand};
 use drive_core::DriveObjects;
+use lookup::PreparedCache;
 use motion::units::UnitProfile;
 use profidrive::cw1::{Context, Cw1Decoder, Mode, ModeCommands};
 use profidrive::pkw::Pkw;
@@ -46,6 +48,7 @@ pub struct Profile {
     cw1: Cw1Decoder,
     units: UnitProfile,
     user_units: UnitsCache,
+    prepared: PreparedCache,
     own: OwnValues,
     /// The response telegram to send.
     response: Option<u8>,
@@ -61,6 +64,7 @@ impl Profile {
     pub fn new(objects: &mut DriveObjects, axis: &Axis) -> Profile {
         let units = UnitProfile::default_profile();
         let user_units = UnitsCache::new();
+        let prepared = PreparedCache::new();
         let mut own = OwnValues::default();
         let telegrams = {
             let access = DriveAccess {
@@ -68,6 +72,7 @@ impl Profile {
                 axis,
                 units: &units,
                 user_units: &user_units,
+                prepared: &prepared,
                 own: &mut own,
             };
             Telegrams::with_defaults(&access).ok()
@@ -79,6 +84,7 @@ impl Profile {
             cw1: Cw1Decoder::new(),
             units,
             user_units,
+            prepared,
             own,
             response: None,
             homing: false,
@@ -129,6 +135,7 @@ impl Profile {
             axis,
             units: &self.units,
             user_units: &self.user_units,
+            prepared: &self.prepared,
             own: &mut self.own,
         };
         let rx = telegrams.apply_receive(frame, &mut access);
@@ -252,6 +259,7 @@ impl Profile {
             axis,
             units: &self.units,
             user_units: &self.user_units,
+            prepared: &self.prepared,
             own: &mut self.own,
         };
         let mut out = [0u8; MAX_TELEGRAM_BYTES];
