@@ -59,7 +59,9 @@ impl UserUnits {
     };
 
     /// The units of `axis` as its objects say now (a factor of 0 counts as
-    /// increments, as the axis takes it).
+    /// increments, as the axis takes it). (Not inlined: read once per
+    /// configuration by a cache, its place is not the cyclic path.)
+    #[inline(never)]
     pub fn read(objects: &DriveObjects, axis: &Axis) -> UserUnits {
         let get = |index: u16, sub: u8| objects.get(axis.cia402_index(index), sub).unwrap_or(0);
         let u32_ = |index: u16, sub: u8| u32::try_from(get(index, sub)).unwrap_or(0);

@@ -18,26 +18,23 @@ use super::*;
 #[derive(Debug, Clone, Copy)]
 pub struct Prepared {
     generation: u32,
-    /// The value's bytes in the RAM image (the target entry, aliases
-    /// followed).
-    at: u16,
-    width: u8,
+    /// The value in the RAM image (the target entry, aliases followed; its
+    /// type is the visible entry's).
+    slot: Slot,
     readable: bool,
     writable: bool,
-    /// A changed value is a configuration change.
-    config: bool,
-    /// The visible entry's type (as [`Dictionary::object`] declares it).
-    visible: DataType,
+    /// The target has a value list ([`enumeration`], looked up at a write).
+    listed: bool,
     /// The target entry (type, range).
     target: &'static EntryInfo,
-    /// The target's value list, if it has one.
-    values: Option<&'static [i64]>,
+    /// The target object's index (for its value list).
+    index: u16,
 }
 
 impl Prepared {
     /// The type of the entry as the bus sees it.
     pub fn data_type(&self) -> DataType {
-        self.visible
+        self.target.data_type
     }
 }
 
@@ -57,26 +54,29 @@ impl DriveObjects {
         let e = loc.entry().ok()?;
         let target = follow(loc).ok()?;
         let (to, te) = (target.object().ok()?, target.entry().ok()?);
-        if o.rx.is_some() || !matches!(to.value, Value::Ram | Value::Live) || !te.data_type.is_integer() {
+        let t = te.data_type;
+        if o.rx.is_some() || !matches!(to.value, Value::Ram | Value::Live) || e.data_type != t {
             return None;
         }
         let range = target.slot().ok()?;
-        if range.end > IMAGE_BYTES {
+        if range.end > IMAGE_BYTES || range.len() != t.bytes() {
             return None;
         }
         Some(Prepared {
             generation: self.config_generation,
-            at: u16::try_from(range.start).ok()?,
-            width: u8::try_from(range.len()).ok()?,
+            slot: Slot {
+                at: u16::try_from(range.start).ok()?,
+                kind: SlotType::of(t)?,
+                config: is_config(to),
+            },
             readable: e.access.readable(),
             // a live entry's write goes to its provider first: not here
             writable: e.access.writable()
                 && e.access.writable_in(state.access_bit())
-                && to.value == Value::Ram,
-            config: is_config(to),
-            visible: e.data_type,
+                && matches!(to.value, Value::Ram),
+            listed: enumeration(to.info.index, te.sub).is_some(),
             target: te,
-            values: enumeration(to.info.index, te.sub),
+            index: to.info.index,
         })
     }
 
@@ -87,16 +87,12 @@ impl DriveObjects {
         p.generation == self.config_generation
     }
 
-    /// [`Dictionary::read`] of the prepared entry into `buf`; `None` when
-    /// `p` is stale or the entry is not readable (take the full path).
+    /// The value [`Dictionary::read`] of the prepared entry gives (its bytes
+    /// as its type reads them); `None` when `p` is stale or the entry is not
+    /// readable (take the full path).
     #[inline]
-    pub fn read_prepared(&self, p: &Prepared, buf: &mut [u8]) -> Option<Result<usize, SdoAbort>> {
-        if !self.is_current(p) || !p.readable {
-            return None;
-        }
-        let at = usize::from(p.at);
-        let raw = self.image.get(at..at + usize::from(p.width))?;
-        Some(put(buf, raw))
+    pub fn read_prepared(&self, p: &Prepared) -> Option<i64> {
+        (self.is_current(p) && p.readable).then(|| self.load_slot(p.slot))
     }
 
     /// [`Dictionary::write`] of `data` to the prepared entry (the state it
@@ -104,29 +100,23 @@ impl DriveObjects {
     /// writable there or `data` is not the value's width (take the full
     /// path).
     pub fn write_prepared(&mut self, p: &Prepared, data: &[u8]) -> Option<Result<(), SdoAbort>> {
-        if !self.is_current(p) || !p.writable || data.len() != usize::from(p.width) {
+        if !self.is_current(p) || !p.writable || data.len() != p.slot.bytes() {
             return None;
         }
-        let at = usize::from(p.at);
-        let slot = self.image.get_mut(at..at + data.len())?;
         // the checks of `write_with` for an entry without consistency
-        // checks, record hooks or side effects; its type's own width
-        // (`load`: the typed loads of the common widths, as `decode` reads
-        // them at the type's own width)
+        // checks, record hooks or side effects (`load`: the value as
+        // `decode` reads it at the type's own width), then its store: the
+        // same bytes, a changed configuration value counted
         let check = load(data, 0, p.target.data_type).and_then(|v| {
             p.target.check_range(v)?;
-            match p.values {
+            match enumeration(p.index, p.target.sub).filter(|_| p.listed) {
                 Some(list) if !list.contains(&v) => Err(SdoAbort::INVALID_VALUE),
-                _ => Ok(()),
+                _ => Ok(v),
             }
         });
-        if check.is_ok() && slot != data {
-            slot.copy_from_slice(data);
-            if p.config {
-                self.config_changed();
-            }
-        }
-        Some(check)
+        Some(check.map(|v| {
+            self.store_slot(p.slot, v);
+        }))
     }
 }
 
@@ -178,17 +168,15 @@ mod tests {
                     );
                 }
             }
-            let mut buf = [0u8; 8];
-            let n = od.read_prepared(&p, &mut buf).expect("readable").unwrap();
-            assert_eq!(Ok(buf[..n].to_vec()), read(&mut od, index, sub));
-            // too small a buffer: the full path's answer
-            assert_eq!(od.read_prepared(&p, &mut []), Some(Err(SdoAbort::OUT_OF_MEMORY)));
+            let v = od.read_prepared(&p).expect("readable");
+            let bytes = read(&mut od, index, sub).unwrap();
+            assert_eq!(Ok(v), p.data_type().decode(&bytes), "{index:04X}:{sub}");
         }
         // a parameter changed: stale
         let p = od.prepare(0x6042, 0, CommState::Op).unwrap();
         od.set(0x6048, 1, 77).unwrap();
         assert!(od.write_prepared(&p, &[1, 0]).is_none());
-        assert!(od.read_prepared(&p, &mut [0; 8]).is_none());
+        assert!(od.read_prepared(&p).is_none());
         // not prepared: outside the CiA 402 range, records, unknown entries
         for (index, sub) in [(0x1010, 1), (0x1600, 0), (0x2000, 1), (0x6042, 9), (0x6FFF, 0)] {
             assert!(

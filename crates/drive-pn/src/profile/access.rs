@@ -4,7 +4,7 @@
 //! (P-045, P-194: in the CiA 402 factor group's units), both through the
 //! core's object dictionary with its access, range and state checks.
 
-use super::lookup::{self as pnu, PreparedCache};
+use super::lookup::{self, Core, CoreSlots, PreparedCache};
 use super::pnu::{Jog, RecordField, Source, Unit};
 use super::units::{self, UnitsCache};
 use drive_core::axis::Axis;
@@ -111,7 +111,9 @@ pub struct DriveAccess<'a> {
     pub user_units: &'a UnitsCache,
     /// The CiA 402 entries accessed, prepared once per configuration
     /// generation.
-    pub prepared: &'a PreparedCache,
+    pub prepared: &'a mut PreparedCache,
+    /// The core entries the profile reads itself, resolved.
+    pub core: &'a CoreSlots,
     /// The profile's own values.
     pub own: &'a mut OwnValues,
 }
@@ -144,17 +146,15 @@ impl DriveAccess<'_> {
     /// An object's value through the dictionary (Op, its access rules);
     /// a CiA 402 entry through its prepared access (the same answers).
     fn read_object(&mut self, index: u16, sub: u8) -> Result<i64, PdError> {
-        let mut buf = [0u8; 8];
-        let (t, n) = match self.prepared.get(self.objects, index, sub) {
-            Some(p) => match self.objects.read_prepared(&p, &mut buf) {
-                Some(r) => (p.data_type(), r.map_err(pd_error)?),
-                None => (p.data_type(), self.read_full(index, sub, &mut buf)?),
+        let t = match self.prepared.get(self.objects, index, sub) {
+            Some(p) => match self.objects.read_prepared(p) {
+                Some(v) => return Ok(v),
+                None => p.data_type(),
             },
-            None => {
-                let t = self.entry(index, sub)?.data_type;
-                (t, self.read_full(index, sub, &mut buf)?)
-            }
+            None => self.entry(index, sub)?.data_type,
         };
+        let mut buf = [0u8; 8];
+        let n = self.read_full(index, sub, &mut buf)?;
         let mut v: u64 = 0;
         for (k, b) in buf.iter().take(n.min(8)).enumerate() {
             v |= u64::from(*b) << (8 * k);
@@ -176,16 +176,20 @@ impl DriveAccess<'_> {
     }
 
     fn write_object(&mut self, index: u16, sub: u8, value: i64) -> Result<(), PdError> {
-        let prepared = self.prepared.get(self.objects, index, sub);
-        let t = match prepared {
-            Some(p) => p.data_type(),
+        let bytes = value.to_le_bytes();
+        let t = match self.prepared.get(self.objects, index, sub) {
+            Some(p) => {
+                let data = bytes
+                    .get(..size(p.data_type()))
+                    .ok_or(PdError::INCORRECT_DATA_TYPE)?;
+                if let Some(r) = self.objects.write_prepared(p, data) {
+                    return r.map_err(pd_error);
+                }
+                p.data_type()
+            }
             None => self.entry(index, sub)?.data_type,
         };
-        let bytes = value.to_le_bytes();
         let data = bytes.get(..size(t)).ok_or(PdError::INCORRECT_DATA_TYPE)?;
-        if let Some(r) = prepared.and_then(|p| self.objects.write_prepared(&p, data)) {
-            return r.map_err(pd_error);
-        }
         self.objects
             .write(index, sub, data, CommState::Op)
             .map_err(pd_error)
@@ -302,11 +306,12 @@ impl DriveAccess<'_> {
 
     /// 6060h code ⇄ PNU 1500 code.
     fn operating_mode(&self) -> i64 {
-        match self.objects.get(self.axis.cia402_index(0x6061), 0) {
+        // (a missing 6061h reads 0: no mode either way)
+        match self.core.get(self.objects, self.axis, Core::ModeDisplay) {
             // positioning, with homing and jog inside it
-            Ok(1 | 6 | -1) => 0x10,
-            Ok(2 | 3) => 0x08,
-            Ok(4) => 0x04,
+            1 | 6 | -1 => 0x10,
+            2 | 3 => 0x08,
+            4 => 0x04,
             _ => 0,
         }
     }
@@ -335,15 +340,15 @@ impl DriveAccess<'_> {
     /// 60FDh in the manual's PNU 1141 map (limit switch 0 = negative: bit 7,
     /// limit switch 1 = positive: bit 8).
     fn digital_inputs(&self) -> i64 {
-        let d = self.objects.get(self.axis.cia402_index(0x60FD), 0).unwrap_or(0);
+        let d = self.core.get(self.objects, self.axis, Core::Inputs);
         ((d & 1) << 7) | ((d >> 1 & 1) << 8)
     }
 }
 
 impl ParamAccess for DriveAccess<'_> {
     fn describe(&self, addr: Addr) -> Result<Describe, PdError> {
-        if pnu::is_catalogue_index(addr.index) {
-            let p = pnu::find(addr)?;
+        if lookup::is_catalogue_index(addr.index) {
+            let p = lookup::find(addr)?;
             return Ok(Describe {
                 data_type: p.data_type,
                 readable: p.readable,
@@ -359,11 +364,11 @@ impl ParamAccess for DriveAccess<'_> {
     }
 
     fn read(&mut self, addr: Addr) -> Result<i64, PdError> {
-        if !pnu::is_catalogue_index(addr.index) {
+        if !lookup::is_catalogue_index(addr.index) {
             let index = self.index(addr.index);
             return self.read_object(index, addr.sub);
         }
-        let p = pnu::find(addr)?;
+        let p = lookup::find(addr)?;
         match p.source {
             Source::Object { index, sub } => {
                 let index = self.index(index);
@@ -395,12 +400,12 @@ impl ParamAccess for DriveAccess<'_> {
 
     fn write(&mut self, addr: Addr, value: i64, _cyclic: bool) -> Result<Completion, PdError> {
         // every write here is a RAM write: the store is written only by a save
-        if !pnu::is_catalogue_index(addr.index) {
+        if !lookup::is_catalogue_index(addr.index) {
             let index = self.index(addr.index);
             self.write_object(index, addr.sub, value)?;
             return Ok(Completion::Done);
         }
-        let p = pnu::find(addr)?;
+        let p = lookup::find(addr)?;
         if !p.writable {
             return Err(PdError::CANNOT_CHANGE);
         }

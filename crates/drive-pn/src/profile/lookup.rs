@@ -7,8 +7,8 @@
 //! looked up and checked by the dictionary at each access.
 
 use super::pnu::{self, Pnu};
-use core::cell::Cell;
-use drive_core::{DriveObjects, Prepared};
+use drive_core::axis::Axis;
+use drive_core::{DriveObjects, Prepared, Slot};
 use od::CommState;
 use profidrive::{Addr, PdError};
 
@@ -39,17 +39,19 @@ pub fn is_catalogue_index(index: u16) -> bool {
             .is_some_and(|p| p.addr.index == index)
 }
 
-/// Entries kept (the default telegrams touch nine CiA 402 entries).
-const ENTRIES: usize = 12;
+/// Entries kept (the default telegrams touch nine CiA 402 entries, eight
+/// of them with telegram 1).
+const ENTRIES: usize = 8;
 
 /// The CiA 402 entries last accessed, prepared (Op, the profile's state);
-/// a stale one is prepared again, a new one takes the oldest place.
+/// a stale one is prepared again, a new one takes the oldest place. Handed
+/// out by reference: a handle is too large to copy cheaply.
 #[derive(Debug)]
 pub struct PreparedCache {
     /// `1 << 24 | index << 8 | sub`, 0 = free.
-    keys: [Cell<u32>; ENTRIES],
-    handles: [Cell<Option<Prepared>>; ENTRIES],
-    next: Cell<usize>,
+    keys: [u32; ENTRIES],
+    handles: [Option<Prepared>; ENTRIES],
+    next: usize,
 }
 
 impl Default for PreparedCache {
@@ -62,36 +64,125 @@ impl PreparedCache {
     /// Empty.
     pub const fn new() -> Self {
         Self {
-            keys: [const { Cell::new(0) }; ENTRIES],
-            handles: [const { Cell::new(None) }; ENTRIES],
-            next: Cell::new(0),
+            keys: [0; ENTRIES],
+            handles: [None; ENTRIES],
+            next: 0,
         }
     }
 
     /// `index`:`sub` prepared and current, or `None` (not a CiA 402 entry
     /// [`DriveObjects::prepare`] takes: the full path).
-    pub fn get(&self, objects: &DriveObjects, index: u16, sub: u8) -> Option<Prepared> {
+    pub fn get(&mut self, objects: &DriveObjects, index: u16, sub: u8) -> Option<&Prepared> {
         if !(0x6000..=0x6FFF).contains(&index) {
             return None;
         }
         let key = 1 << 24 | u32::from(index) << 8 | u32::from(sub);
-        let at = match self.keys.iter().position(|k| k.get() == key) {
-            Some(at) => {
-                if let Some(p) = self.handles.get(at)?.get().filter(|p| objects.is_current(p)) {
-                    return Some(p);
-                }
-                at
+        let at = match self.keys.iter().position(|&k| k == key) {
+            Some(at)
+                if self
+                    .handles
+                    .get(at)?
+                    .as_ref()
+                    .is_some_and(|p| objects.is_current(p)) =>
+            {
+                return self.handles.get(at)?.as_ref();
             }
+            Some(at) => at,
             None => {
-                let at = self.next.get() % ENTRIES;
-                self.next.set(at + 1);
+                let at = self.next % ENTRIES;
+                self.next = at + 1;
                 at
             }
         };
         let p = objects.prepare(index, sub, CommState::Op);
-        self.keys.get(at)?.set(if p.is_some() { key } else { 0 });
-        self.handles.get(at)?.set(p);
-        p
+        *self.keys.get_mut(at)? = if p.is_some() { key } else { 0 };
+        let slot = self.handles.get_mut(at)?;
+        *slot = p;
+        slot.as_ref()
+    }
+}
+
+/// The core entries the profile itself reads and writes every cycle
+/// ([`DriveObjects::get`] / [`DriveObjects::set`], no bus rules).
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum Core {
+    /// 6040h controlword.
+    Controlword,
+    /// 6060h modes of operation.
+    Mode,
+    /// 6061h modes of operation display.
+    ModeDisplay,
+    /// 60FDh digital inputs.
+    Inputs,
+}
+
+impl Core {
+    const ALL: [Core; 4] = [Core::Controlword, Core::Mode, Core::ModeDisplay, Core::Inputs];
+
+    /// The axis-A index.
+    const fn index(self) -> u16 {
+        match self {
+            Core::Controlword => 0x6040,
+            Core::Mode => 0x6060,
+            Core::ModeDisplay => 0x6061,
+            Core::Inputs => 0x60FD,
+        }
+    }
+}
+
+/// [`Core`]'s entries of one axis resolved once to their [`Slot`]s: a load
+/// or store where `get`/`set` hash and probe the dictionary's cache (the
+/// same values: these are integers in RAM).
+#[derive(Debug, Clone, Copy, Default)]
+pub struct CoreSlots {
+    axis: Option<u8>,
+    slots: [Option<Slot>; 4],
+}
+
+impl CoreSlots {
+    /// Nothing resolved yet.
+    pub const fn new() -> Self {
+        Self {
+            axis: None,
+            slots: [None; 4],
+        }
+    }
+
+    /// Resolves the entries of `axis` (once; again for another axis).
+    pub fn resolve(&mut self, objects: &DriveObjects, axis: &Axis) {
+        if self.axis != Some(axis.index()) {
+            for (s, e) in self.slots.iter_mut().zip(Core::ALL) {
+                *s = objects.slot(axis.cia402_index(e.index()), 0);
+            }
+            self.axis = Some(axis.index());
+        }
+    }
+
+    fn slot(&self, axis: &Axis, e: Core) -> Option<Slot> {
+        if self.axis != Some(axis.index()) {
+            return None;
+        }
+        self.slots.get(e as usize).copied().flatten()
+    }
+
+    /// `objects.get(e of axis, 0).unwrap_or(0)`.
+    pub fn get(&self, objects: &DriveObjects, axis: &Axis, e: Core) -> i64 {
+        match self.slot(axis, e) {
+            Some(s) => objects.load_slot(s),
+            None => objects.get(axis.cia402_index(e.index()), 0).unwrap_or(0),
+        }
+    }
+
+    /// `let _ = objects.set(e of axis, 0, v)`.
+    pub fn set(&self, objects: &mut DriveObjects, axis: &Axis, e: Core, v: i64) {
+        match self.slot(axis, e) {
+            Some(s) => {
+                objects.store_slot(s, v);
+            }
+            None => {
+                let _ = objects.set(axis.cia402_index(e.index()), 0, v);
+            }
+        }
     }
 }
 
@@ -125,18 +216,50 @@ mod tests {
         }
     }
 
+    /// P-051, P-052 (the mode the telegram selects): the resolved entries
+    /// read and write as `get` / `set`, for both axes.
+    #[test]
+    fn p051_p052_core_slots_read_and_write_as_get_and_set() {
+        let mut od = DriveObjects::new();
+        let mut core = CoreSlots::new();
+        for axis in [Axis::new(0), Axis::new(1)] {
+            core.resolve(&od, &axis);
+            for (e, v) in [
+                (Core::Controlword, 0x0F),
+                (Core::Mode, 2),
+                (Core::Mode, -1),
+                (Core::Controlword, 0x1F),
+            ] {
+                let mut full = od.clone();
+                let _ = full.set(axis.cia402_index(e.index()), 0, v);
+                core.set(&mut od, &axis, e, v);
+                assert!(od == full && od.config_generation() == full.config_generation());
+            }
+            for e in Core::ALL {
+                let index = axis.cia402_index(e.index());
+                od.set(index, 0, 1).unwrap();
+                assert_eq!(core.get(&od, &axis, e), od.get(index, 0).unwrap());
+            }
+        }
+        // another axis than resolved: the dictionary's answer
+        let b = Axis::new(1);
+        core.resolve(&od, &Axis::new(0));
+        od.set(b.cia402_index(0x6061), 0, 3).unwrap();
+        assert_eq!(core.get(&od, &b, Core::ModeDisplay), 3);
+    }
+
     /// P-067: the cache hands out current handles and prepares stale ones
     /// again; entries outside the CiA 402 range get none.
     #[test]
     fn p067_the_prepared_cache_follows_the_configuration() {
         let mut od = DriveObjects::new();
-        let cache = PreparedCache::new();
-        let p = cache.get(&od, 0x6042, 0).unwrap();
+        let mut cache = PreparedCache::new();
+        let p = *cache.get(&od, 0x6042, 0).unwrap();
         assert!(od.is_current(&p));
         od.set(0x6048, 1, 99).unwrap();
         assert!(!od.is_current(&p));
         let q = cache.get(&od, 0x6042, 0).unwrap();
-        assert!(od.is_current(&q));
+        assert!(od.is_current(q));
         assert!(cache.get(&od, 0x2000, 1).is_none());
         assert!(cache.get(&od, 0x6042, 99).is_none());
         // more entries than places: every one still answers

@@ -28,7 +28,7 @@ pub mod units;
 use access::{DriveAccess, OwnValues};
 use drive_core::axis::{Axis, RecordCommand};
 use drive_core::DriveObjects;
-use lookup::PreparedCache;
+use lookup::{Core, CoreSlots, PreparedCache};
 use motion::units::UnitProfile;
 use profidrive::cw1::{Context, Cw1Decoder, Mode, ModeCommands};
 use profidrive::pkw::Pkw;
@@ -49,6 +49,7 @@ pub struct Profile {
     units: UnitProfile,
     user_units: UnitsCache,
     prepared: PreparedCache,
+    core: CoreSlots,
     own: OwnValues,
     /// The response telegram to send.
     response: Option<u8>,
@@ -62,34 +63,33 @@ impl Profile {
     /// The profile with the Example Function block's telegrams (P-071…P-074)
     /// and the default units (P-207).
     pub fn new(objects: &mut DriveObjects, axis: &Axis) -> Profile {
-        let units = UnitProfile::default_profile();
-        let user_units = UnitsCache::new();
-        let prepared = PreparedCache::new();
-        let mut own = OwnValues::default();
-        let telegrams = {
-            let access = DriveAccess {
-                objects,
-                axis,
-                units: &units,
-                user_units: &user_units,
-                prepared: &prepared,
-                own: &mut own,
-            };
-            Telegrams::with_defaults(&access).ok()
-        };
-        Profile {
-            telegrams,
+        // built in place, the telegrams configured through its own fields
+        // (no second copy of the caches on the stack)
+        let mut p = Profile {
+            telegrams: None,
             pkw: Pkw::new(),
             pkw_response: [0; 8],
             cw1: Cw1Decoder::new(),
-            units,
-            user_units,
-            prepared,
-            own,
+            units: UnitProfile::default_profile(),
+            user_units: UnitsCache::new(),
+            prepared: PreparedCache::new(),
+            core: CoreSlots::new(),
+            own: OwnValues::default(),
             response: None,
             homing: false,
             warnings: 0,
-        }
+        };
+        let access = DriveAccess {
+            objects,
+            axis,
+            units: &p.units,
+            user_units: &p.user_units,
+            prepared: &mut p.prepared,
+            core: &p.core,
+            own: &mut p.own,
+        };
+        p.telegrams = Telegrams::with_defaults(&access).ok();
+        p
     }
 
     /// Whether the telegram configuration took (the catalogue holds every
@@ -130,12 +130,15 @@ impl Profile {
         let Some(telegrams) = self.telegrams.as_mut() else {
             return;
         };
+        self.core.resolve(objects, axis);
+        let core = &self.core;
         let mut access = DriveAccess {
             objects,
             axis,
             units: &self.units,
             user_units: &self.user_units,
-            prepared: &self.prepared,
+            prepared: &mut self.prepared,
+            core,
             own: &mut self.own,
         };
         let rx = telegrams.apply_receive(frame, &mut access);
@@ -153,11 +156,10 @@ impl Profile {
             ModeBinding::None => None,
         };
         if let Some(code) = binding {
-            let index = axis.cia402_index(0x6060);
-            let now = access.objects.get(index, 0).unwrap_or(0);
+            let now = core.get(access.objects, axis, Core::Mode);
             // homing runs inside positioning (6060h = 6 while it runs)
             if !(code == 1 && now == 6 && self.homing) && now != code {
-                let _ = access.objects.set(index, 0, code);
+                core.set(access.objects, axis, Core::Mode, code);
             }
         }
         if let Some(req) = rx.pkw {
@@ -166,7 +168,7 @@ impl Profile {
         if let Some(cw1) = rx.cw1 {
             access.own.cw1 = cw1;
         }
-        let display = access.objects.get(axis.cia402_index(0x6061), 0).unwrap_or(0);
+        let display = core.get(access.objects, axis, Core::ModeDisplay);
         let mode = match Ok::<i64, ()>(display) {
             Ok(1 | 6 | -1) => Mode::Positioning,
             Ok(2 | 3) => Mode::Speed,
@@ -182,7 +184,6 @@ impl Profile {
         if !t.evaluated {
             return;
         }
-        let cw_index = axis.cia402_index(0x6040);
         let mut controlword = t.controlword;
         let record_command = match t.mode {
             ModeCommands::Positioning(p) => {
@@ -234,7 +235,7 @@ impl Profile {
             }
             ModeCommands::Other => None,
         };
-        let _ = access.objects.set(cw_index, 0, i64::from(controlword));
+        core.set(access.objects, axis, Core::Controlword, i64::from(controlword));
         axis.set_record_command(record_command);
     }
 
@@ -254,21 +255,23 @@ impl Profile {
         self.own.zsw1 = status::zsw1(objects, axis, self.cw1.last(), self.homing);
         let n = self.response?;
         let telegrams = self.telegrams.as_mut()?;
+        self.core.resolve(objects, axis);
         let mut access = DriveAccess {
             objects,
             axis,
             units: &self.units,
             user_units: &self.user_units,
-            prepared: &self.prepared,
+            prepared: &mut self.prepared,
+            core: &self.core,
             own: &mut self.own,
         };
-        let mut out = [0u8; MAX_TELEGRAM_BYTES];
-        let len = buf.len().min(out.len());
-        let tx = telegrams.build_response(n, &mut access, self.pkw_response, out.get_mut(..len)?)?;
+        // straight into the module's data (the telegram is cut to it or
+        // zero-padded up to it)
+        let len = buf.len().min(MAX_TELEGRAM_BYTES);
+        let tx = telegrams.build_response(n, &mut access, self.pkw_response, buf.get_mut(..len)?)?;
         if !tx.warnings.is_empty() {
             self.warnings = self.warnings.saturating_add(1);
         }
-        buf.get_mut(..len)?.copy_from_slice(out.get(..len)?);
         Some(len)
     }
 }

@@ -43,7 +43,9 @@ impl UnitsCache {
 }
 
 /// `m / d` rounded half away from zero (`m` < 2^96, so `m + d/2` cannot
-/// overflow); a 32-bit division when the sum fits, `None` for d = 0.
+/// overflow); a 32-bit division when the sum fits, `None` for d = 0. (Not
+/// inlined: one copy of the 128-bit division for both directions.)
+#[inline(never)]
 fn div_round(m: u128, d: u32) -> Option<u128> {
     let n = m + u128::from(d / 2);
     match u32::try_from(n) {
