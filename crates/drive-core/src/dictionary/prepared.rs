@@ -109,7 +109,7 @@ impl DriveObjects {
         // same bytes, a changed configuration value counted
         let check = load(data, 0, p.target.data_type).and_then(|v| {
             p.target.check_range(v)?;
-            match enumeration(p.index, p.target.sub).filter(|_| p.listed) {
+            match p.listed.then(|| enumeration(p.index, p.target.sub)).flatten() {
                 Some(list) if !list.contains(&v) => Err(SdoAbort::INVALID_VALUE),
                 _ => Ok(v),
             }
