@@ -34,7 +34,7 @@ pub mod pdo_maps;
 pub mod user_units;
 
 pub use dictionary::{
-    revision, DriveObjects, ImageError, LiveValues, NoLive, Requests, Slot, Template, WithLive,
+    revision, DriveObjects, ImageError, LiveValues, NoLive, Prepared, Requests, Slot, Template, WithLive,
     LOAD_SIGNATURE, PERSISTENT_IMAGE_BYTES, SAVE_SIGNATURE,
 };
 pub use pdo_maps::{PdoLayout, IP_RX, IP_TX, VL_RX, VL_TX};

@@ -13,7 +13,7 @@ use crate::axis::Axis;
 use crate::params::{A213, A310};
 use crate::DriveObjects;
 use motion::scaling::polarity_inverted;
-use motion::AxisScaling;
+use motion::{AxisScaling, INCREMENTS_PER_REVOLUTION};
 
 /// The user units of one axis, read from the objects.
 #[derive(Debug, Clone, Copy, PartialEq)]
@@ -22,6 +22,12 @@ pub struct UserUnits {
     inverted: bool,
     /// 10^A310, 10^A311 (1 with native fieldbus scaling).
     decimals: (f64, f64),
+    /// |user units per increment| of `scaling`, computed once by
+    /// [`read`](Self::read) (a 128-bit fraction to `f64`: hundreds of
+    /// instructions on a Cortex-M4F, where `f64` is software).
+    per_increment: f64,
+    /// Every conversion is the identity ([`is_identity`](Self::is_identity)).
+    identity: bool,
 }
 
 /// Half away from zero.
@@ -48,21 +54,29 @@ impl UserUnits {
         scaling: AxisScaling::INCREMENTAL,
         inverted: false,
         decimals: (1.0, 1.0),
+        per_increment: 1.0,
+        identity: true,
     };
 
     /// The units of `axis` as its objects say now (a factor of 0 counts as
-    /// increments, as the axis takes it).
+    /// increments, as the axis takes it). (Not inlined: read once per
+    /// configuration by a cache, its place is not the cyclic path.)
+    #[inline(never)]
     pub fn read(objects: &DriveObjects, axis: &Axis) -> UserUnits {
         let get = |index: u16, sub: u8| objects.get(axis.cia402_index(index), sub).unwrap_or(0);
         let u32_ = |index: u16, sub: u8| u32::try_from(get(index, sub)).unwrap_or(0);
-        let scaling = AxisScaling::new(
-            u32_(0x6091, 1),
-            u32_(0x6091, 2),
-            u32_(0x6092, 1),
-            u32_(0x6092, 2),
-            0,
-        )
-        .unwrap_or(AxisScaling::INCREMENTAL);
+        let (motor, shaft, feed, feed_shaft) =
+            (u32_(0x6091, 1), u32_(0x6091, 2), u32_(0x6092, 1), u32_(0x6092, 2));
+        let (scaling, one) = match AxisScaling::new(motor, shaft, feed, feed_shaft, 0) {
+            // user units per increment = shaft · feed / (2^20 · motor · feed shaft), exactly 1?
+            Ok(s) => {
+                let per_rev = u64::from(motor) * u64::from(feed_shaft);
+                let one = per_rev <= u64::MAX / u64::from(INCREMENTS_PER_REVOLUTION)
+                    && u64::from(shaft) * u64::from(feed) == per_rev * u64::from(INCREMENTS_PER_REVOLUTION);
+                (s, one)
+            }
+            Err(_) => (AxisScaling::INCREMENTAL, true),
+        };
         let polarity = u8::try_from(get(0x607E, 0)).unwrap_or(0);
         let decimals = if objects.get(A213, 1) == Ok(0) {
             let d = |i: u16| {
@@ -76,11 +90,23 @@ impl UserUnits {
         } else {
             (1.0, 1.0)
         };
+        let inverted = polarity_inverted(polarity);
         UserUnits {
             scaling,
-            inverted: polarity_inverted(polarity),
+            inverted,
             decimals,
+            per_increment: scaling.user_per_increment().abs(),
+            identity: one && !inverted && decimals == (1.0, 1.0),
         }
+    }
+
+    /// Whether every conversion is the identity: user units are
+    /// increments (gear and feed give exactly one user unit per increment),
+    /// polarity normal, no decimal places. The conversions of positions then
+    /// return their argument, those of rates their argument rounded (exact
+    /// for integers below 2^52 in magnitude).
+    pub fn is_identity(&self) -> bool {
+        self.identity
     }
 
     fn sign(&self) -> i64 {
@@ -107,7 +133,7 @@ impl UserUnits {
     }
 
     fn per_increment(&self) -> f64 {
-        self.scaling.user_per_increment().abs()
+        self.per_increment
     }
 
     /// A velocity object's value (user units/s × 10^A310) → increments/s.
@@ -182,6 +208,40 @@ mod tests {
         assert_eq!(u, UserUnits::INCREMENTS);
         assert_eq!(u.position_to_increments(1 << 20), Some(1 << 20));
         assert_eq!(u.velocity_from_increments(1234.4), 1234);
+    }
+
+    /// The identity takes exactly one user unit per increment, normal
+    /// polarity and no decimals; the conversions agree with it.
+    #[test]
+    fn c108_user_units_are_the_identity_only_at_one_unit_per_increment() {
+        let axis = Axis::new(0);
+        let units = |set: &[(u16, u8, i64)]| {
+            let mut od = DriveObjects::new();
+            for &(i, s, v) in set {
+                od.set(i, s, v).unwrap();
+            }
+            UserUnits::read(&od, &axis)
+        };
+        assert!(units(&[]).is_identity());
+        // gear 2 : 2 and a feed of 2^21 per 2 revolutions: still 1 per increment
+        let same = units(&[
+            (0x6091, 1, 2),
+            (0x6091, 2, 2),
+            (0x6092, 1, 1 << 21),
+            (0x6092, 2, 2),
+        ]);
+        assert!(same.is_identity());
+        assert_eq!(same.position_to_increments(-77), Some(-77));
+        assert_eq!(same.velocity_from_increments(-1234.0), -1234);
+        for u in [
+            units(&[(0x6092, 1, 1000)]),
+            units(&[(0x607E, 0, 0x80)]),
+            units(&[(A213, 1, 0), (A310, 0, 1)]),
+        ] {
+            assert!(!u.is_identity(), "{u:?}");
+        }
+        // decimals 0 with A213 = 0: the identity again
+        assert!(units(&[(A213, 1, 0)]).is_identity());
     }
 
     #[test]

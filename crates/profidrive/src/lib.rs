@@ -218,7 +218,9 @@ pub(crate) fn encode_be(value: i64, out: &mut [u8]) {
     }
 }
 
-/// Does `value` fit `t` (integers; BOOLEAN is 0 or 1)?
+/// Does `value` fit `t` (integers; BOOLEAN is 0 or 1)? (Inlined: every
+/// entry of a receive telegram asks, every cycle.)
+#[inline]
 pub(crate) fn fits(t: DataType, value: i64) -> bool {
     match t {
         DataType::Bool => value == 0 || value == 1,

@@ -108,9 +108,9 @@ fn calibrate() -> u32 {
 #[inline(never)]
 #[allow(unsafe_code)]
 fn make_drive() -> Option<&'static mut Drive> {
-    // in the core-coupled RAM (qemu/memory.x): building a drive takes two
-    // drives' worth of stack (the value and its copy), which RAM must hold
-    #[link_section = ".ccm"]
+    // in the CCM RAM (qemu/memory.x): the start builds two drives by value on
+    // the stack (about 100 KiB), which must not run into this one or `.bss`
+    #[link_section = ".ccmram"]
     static mut DRIVE: core::mem::MaybeUninit<Drive> = core::mem::MaybeUninit::uninit();
     static TAKEN: core::sync::atomic::AtomicBool = core::sync::atomic::AtomicBool::new(false);
     if TAKEN.swap(true, core::sync::atomic::Ordering::AcqRel) {

@@ -19,11 +19,13 @@ use od::{CommState, DataType, Dictionary, EntryInfo, ObjectInfo, SdoAbort};
 
 mod mapping;
 mod persist;
+mod prepared;
 mod records;
 mod resolve;
 mod slot;
 
 pub use persist::{ImageError, PERSISTENT_IMAGE_BYTES};
+pub use prepared::Prepared;
 use resolve::*;
 pub use slot::Slot;
 use slot::*;

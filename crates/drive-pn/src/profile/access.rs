@@ -4,7 +4,9 @@
 //! (P-045, P-194: in the CiA 402 factor group's units), both through the
 //! core's object dictionary with its access, range and state checks.
 
-use super::pnu::{self, Jog, RecordField, Source, Unit};
+use super::lookup::{self, Core, CoreSlots, PreparedCache};
+use super::pnu::{Jog, RecordField, Source, Unit};
+use super::units::{self, UnitsCache};
 use drive_core::axis::Axis;
 use drive_core::faults::E82_INACTIVE;
 use drive_core::objects::records::{Record, JOG_NEGATIVE, JOG_POSITIVE};
@@ -12,7 +14,6 @@ use drive_core::params::{E43, E82};
 use drive_core::user_units::UserUnits;
 use drive_core::DriveObjects;
 use motion::units::UnitProfile;
-use motion::INCREMENTS_PER_REVOLUTION;
 use od::{CommState, DataType, Dictionary, SdoAbort};
 use profidrive::{Addr, Completion, Describe, ParamAccess, PdError};
 use profinet::model;
@@ -107,6 +108,14 @@ pub struct DriveAccess<'a> {
     pub axis: &'a Axis,
     /// The PROFINET units of the PNUs.
     pub units: &'a UnitProfile,
+    /// The axis' CiA 402 user units, read once per configuration
+    /// generation.
+    pub user_units: &'a UnitsCache,
+    /// The CiA 402 entries accessed, prepared once per configuration
+    /// generation.
+    pub prepared: &'a mut PreparedCache,
+    /// The core entries the profile reads itself, resolved.
+    pub core: &'a CoreSlots,
     /// The profile's own values.
     pub own: &'a mut OwnValues,
 }
@@ -123,7 +132,7 @@ impl DriveAccess<'_> {
     }
 
     fn user_units(&self) -> UserUnits {
-        UserUnits::read(self.objects, self.axis)
+        self.user_units.get(self.objects, self.axis)
     }
 
     /// The declaration of `index`:`sub`: 0x00 without the object, 0x03
@@ -136,14 +145,18 @@ impl DriveAccess<'_> {
             .ok_or(PdError::FAULTY_SUBINDEX)
     }
 
-    /// An object's value through the dictionary (Op, its access rules).
+    /// An object's value through the dictionary (Op, its access rules);
+    /// a CiA 402 entry through its prepared access (the same answers).
     fn read_object(&mut self, index: u16, sub: u8) -> Result<i64, PdError> {
-        let t = self.entry(index, sub)?.data_type;
+        let t = match self.prepared.get(self.objects, index, sub) {
+            Some(p) => match self.objects.read_prepared(p) {
+                Some(v) => return Ok(v),
+                None => p.data_type(),
+            },
+            None => self.entry(index, sub)?.data_type,
+        };
         let mut buf = [0u8; 8];
-        let n = self
-            .objects
-            .read(index, sub, &mut buf, CommState::Op)
-            .map_err(pd_error)?;
+        let n = self.read_full(index, sub, &mut buf)?;
         let mut v: u64 = 0;
         for (k, b) in buf.iter().take(n.min(8)).enumerate() {
             v |= u64::from(*b) << (8 * k);
@@ -158,10 +171,27 @@ impl DriveAccess<'_> {
         )
     }
 
+    fn read_full(&mut self, index: u16, sub: u8, buf: &mut [u8]) -> Result<usize, PdError> {
+        self.objects
+            .read(index, sub, buf, CommState::Op)
+            .map_err(pd_error)
+    }
+
     fn write_object(&mut self, index: u16, sub: u8, value: i64) -> Result<(), PdError> {
-        let n = size(self.entry(index, sub)?.data_type);
         let bytes = value.to_le_bytes();
-        let data = bytes.get(..n).ok_or(PdError::INCORRECT_DATA_TYPE)?;
+        let t = match self.prepared.get(self.objects, index, sub) {
+            Some(p) => {
+                let data = bytes
+                    .get(..size(p.data_type()))
+                    .ok_or(PdError::INCORRECT_DATA_TYPE)?;
+                if let Some(r) = self.objects.write_prepared(p, data) {
+                    return r.map_err(pd_error);
+                }
+                p.data_type()
+            }
+            None => self.entry(index, sub)?.data_type,
+        };
+        let data = bytes.get(..size(t)).ok_or(PdError::INCORRECT_DATA_TYPE)?;
         self.objects
             .write(index, sub, data, CommState::Op)
             .map_err(pd_error)
@@ -169,49 +199,48 @@ impl DriveAccess<'_> {
 
     /// Bus units → the object's units.
     fn to_object(&self, unit: Unit, bus: i64) -> Result<i64, PdError> {
-        let u = self.user_units();
         let range = PdError::LIMIT_EXCEEDED;
+        let p = self.units;
         Ok(match unit {
             Unit::None => bus,
             Unit::Position => {
-                let inc = self.units.position.from_bus(bus).map_err(|_| range)?;
-                u.position_from_increments(inc).ok_or(range)?
+                let inc = units::from_bus(&p.position, bus).map_err(|_| range)?;
+                self.user_units().position_from_increments(inc).ok_or(range)?
             }
             // the integer path: exact to the increment (f32 is not, above 2^24)
             Unit::Velocity => {
-                u.velocity_from_increments(self.units.velocity.from_bus(bus).map_err(|_| range)? as f64)
+                let inc = units::from_bus(&p.velocity, bus).map_err(|_| range)?;
+                units::velocity_from_increments(&self.user_units(), inc)
             }
-            Unit::Acceleration => u.acceleration_from_increments(
-                self.units.acceleration.from_bus(bus).map_err(|_| range)? as f64,
-            ),
-            Unit::Rpm => rpm_of(self.units.velocity.from_bus(bus).map_err(|_| range)? as f64),
-            Unit::RpmPerSecond => rpm_of(self.units.acceleration.from_bus(bus).map_err(|_| range)? as f64),
+            Unit::Acceleration => {
+                let inc = units::from_bus(&p.acceleration, bus).map_err(|_| range)?;
+                units::acceleration_from_increments(&self.user_units(), inc)
+            }
+            Unit::Rpm => units::rpm_of(units::from_bus(&p.velocity, bus).map_err(|_| range)?),
+            Unit::RpmPerSecond => units::rpm_of(units::from_bus(&p.acceleration, bus).map_err(|_| range)?),
         })
     }
 
     /// The object's units → bus units.
     fn to_bus(&self, unit: Unit, object: i64) -> Result<i64, PdError> {
-        let u = self.user_units();
         let range = PdError::LIMIT_EXCEEDED;
+        let p = self.units;
         let v = match unit {
             Unit::None => return Ok(object),
             Unit::Position => {
-                let inc = u.position_to_increments(object).ok_or(range)?;
-                self.units.position.to_bus(inc)
+                let inc = self.user_units().position_to_increments(object).ok_or(range)?;
+                units::to_bus(&p.position, inc)
             }
-            Unit::Velocity => self
-                .units
-                .velocity
-                .to_bus(round_i64(u.velocity_to_increments(object))),
-            Unit::Acceleration => self
-                .units
-                .acceleration
-                .to_bus(round_i64(u.acceleration_to_increments(object))),
-            Unit::Rpm => self.units.velocity.to_bus(round_i64(increments_of_rpm(object))),
-            Unit::RpmPerSecond => self
-                .units
-                .acceleration
-                .to_bus(round_i64(increments_of_rpm(object))),
+            Unit::Velocity => units::to_bus(
+                &p.velocity,
+                units::velocity_to_increments(&self.user_units(), object),
+            ),
+            Unit::Acceleration => units::to_bus(
+                &p.acceleration,
+                units::acceleration_to_increments(&self.user_units(), object),
+            ),
+            Unit::Rpm => units::to_bus(&p.velocity, units::increments_of_rpm(object)),
+            Unit::RpmPerSecond => units::to_bus(&p.acceleration, units::increments_of_rpm(object)),
         };
         v.map(i64::from).map_err(|_| range)
     }
@@ -279,11 +308,12 @@ impl DriveAccess<'_> {
 
     /// 6060h code ⇄ PNU 1500 code.
     fn operating_mode(&self) -> i64 {
-        match self.objects.get(self.axis.cia402_index(0x6061), 0) {
+        // (a missing 6061h reads 0: no mode either way)
+        match self.core.get(self.objects, self.axis, Core::ModeDisplay) {
             // positioning, with homing and jog inside it
-            Ok(1 | 6 | -1) => 0x10,
-            Ok(2 | 3) => 0x08,
-            Ok(4) => 0x04,
+            1 | 6 | -1 => 0x10,
+            2 | 3 => 0x08,
+            4 => 0x04,
             _ => 0,
         }
     }
@@ -312,31 +342,15 @@ impl DriveAccess<'_> {
     /// 60FDh in the manual's PNU 1141 map (limit switch 0 = negative: bit 7,
     /// limit switch 1 = positive: bit 8).
     fn digital_inputs(&self) -> i64 {
-        let d = self.objects.get(self.axis.cia402_index(0x60FD), 0).unwrap_or(0);
+        let d = self.core.get(self.objects, self.axis, Core::Inputs);
         ((d & 1) << 7) | ((d >> 1 & 1) << 8)
     }
 }
 
-/// inc/s (or /s²) → rpm (or rpm/s), rounded.
-fn rpm_of(increments: f64) -> i64 {
-    let rpm = increments * 60.0 / f64::from(INCREMENTS_PER_REVOLUTION);
-    let r = if rpm >= 0.0 { rpm + 0.5 } else { rpm - 0.5 };
-    r as i64
-}
-
-fn increments_of_rpm(rpm: i64) -> f64 {
-    rpm as f64 * f64::from(INCREMENTS_PER_REVOLUTION) / 60.0
-}
-
-/// Half away from zero; `as` saturates.
-fn round_i64(x: f64) -> i64 {
-    (if x >= 0.0 { x + 0.5 } else { x - 0.5 }) as i64
-}
-
 impl ParamAccess for DriveAccess<'_> {
     fn describe(&self, addr: Addr) -> Result<Describe, PdError> {
-        if pnu::is_catalogue_index(addr.index) {
-            let p = pnu::find(addr)?;
+        if lookup::is_catalogue_index(addr.index) {
+            let p = lookup::find(addr)?;
             return Ok(Describe {
                 data_type: p.data_type,
                 readable: p.readable,
@@ -352,11 +366,11 @@ impl ParamAccess for DriveAccess<'_> {
     }
 
     fn read(&mut self, addr: Addr) -> Result<i64, PdError> {
-        if !pnu::is_catalogue_index(addr.index) {
+        if !lookup::is_catalogue_index(addr.index) {
             let index = self.index(addr.index);
             return self.read_object(index, addr.sub);
         }
-        let p = pnu::find(addr)?;
+        let p = lookup::find(addr)?;
         match p.source {
             Source::Object { index, sub } => {
                 let index = self.index(index);
@@ -393,12 +407,12 @@ impl ParamAccess for DriveAccess<'_> {
 
     fn write(&mut self, addr: Addr, value: i64, _cyclic: bool) -> Result<Completion, PdError> {
         // every write here is a RAM write: the store is written only by a save
-        if !pnu::is_catalogue_index(addr.index) {
+        if !lookup::is_catalogue_index(addr.index) {
             let index = self.index(addr.index);
             self.write_object(index, addr.sub, value)?;
             return Ok(Completion::Done);
         }
-        let p = pnu::find(addr)?;
+        let p = lookup::find(addr)?;
         if !p.writable {
             return Err(PdError::CANNOT_CHANGE);
         }

@@ -20,18 +20,22 @@
 //! data: ZSW1 from the axis' state and statusword ([`status`]).
 
 pub mod access;
+pub mod lookup;
 pub mod pnu;
 pub mod status;
 pub mod telegram_config;
 pub mod unit_choice;
+pub mod units;
 
 use access::{DriveAccess, OwnValues};
 use drive_core::axis::{Axis, RecordCommand};
 use drive_core::DriveObjects;
+use lookup::{Core, CoreSlots, PreparedCache};
 use motion::units::UnitProfile;
 use profidrive::cw1::{Context, Cw1Decoder, Mode, ModeCommands};
 use profidrive::pkw::Pkw;
 use profidrive::telegram::{ModeBinding, Telegrams, MAX_TELEGRAM_BYTES};
+use units::UnitsCache;
 
 /// 6040h bits 4–6: the vl ramp bits, the pp / homing "start" bit.
 const BITS_4_6: u16 = 0x0070;
@@ -47,6 +51,9 @@ pub struct Profile {
     units: UnitProfile,
     /// A279 as last looked at.
     unit_choice: unit_choice::UnitChoice,
+    user_units: UnitsCache,
+    prepared: PreparedCache,
+    core: CoreSlots,
     own: OwnValues,
     /// The response telegram to send.
     response: Option<u8>,
@@ -60,39 +67,47 @@ impl Profile {
     /// The profile with the Example Function block's telegrams (P-071…P-074)
     /// and the default units (P-207).
     pub fn new(objects: &mut DriveObjects, axis: &Axis) -> Profile {
-        let units = UnitProfile::default_profile();
-        let mut own = OwnValues::default();
         let stored = telegram_config::stored(objects);
-        let telegrams = {
-            let access = DriveAccess {
-                objects,
-                axis,
-                units: &units,
-                own: &mut own,
-            };
-            // the stored configuration (A280, P-069), else the FB's
-            stored
-                .and_then(|set| {
-                    let mut t = Telegrams::new();
-                    t.configure(&set, &access).ok().map(|()| t)
-                })
-                .or_else(|| Telegrams::with_defaults(&access).ok())
-        };
-        if let Some(t) = &telegrams {
-            own.edit = telegram_config::TelegramEdit::of(t.set());
-        }
-        Profile {
-            telegrams,
+        // built in place, the telegrams configured through its own fields
+        // (no second copy of the caches on the stack)
+        let mut p = Profile {
+            telegrams: None,
             pkw: Pkw::new(),
             pkw_response: [0; 8],
             cw1: Cw1Decoder::new(),
-            units,
+            units: UnitProfile::default_profile(),
             unit_choice: unit_choice::UnitChoice::default(),
-            own,
+            user_units: UnitsCache::new(),
+            prepared: PreparedCache::new(),
+            core: CoreSlots::new(),
+            own: OwnValues::default(),
             response: None,
             homing: false,
             warnings: 0,
+        };
+        let access = DriveAccess {
+            objects,
+            axis,
+            units: &p.units,
+            user_units: &p.user_units,
+            prepared: &mut p.prepared,
+            core: &p.core,
+            own: &mut p.own,
+        };
+        // the stored configuration (A280, P-069), else the FB's
+        if let Some(set) = stored {
+            let mut t = Telegrams::new();
+            if t.configure(&set, &access).is_ok() {
+                p.telegrams = Some(t);
+            }
         }
+        if p.telegrams.is_none() {
+            p.telegrams = Telegrams::with_defaults(&access).ok();
+        }
+        if let Some(t) = &p.telegrams {
+            p.own.edit = telegram_config::TelegramEdit::of(t.set());
+        }
+        p
     }
 
     /// Whether the telegram configuration took (the catalogue holds every
@@ -145,10 +160,15 @@ impl Profile {
         let Some(telegrams) = self.telegrams.as_mut() else {
             return;
         };
+        self.core.resolve(objects, axis);
+        let core = &self.core;
         let mut access = DriveAccess {
             objects,
             axis,
             units: &self.units,
+            user_units: &self.user_units,
+            prepared: &mut self.prepared,
+            core,
             own: &mut self.own,
         };
         let rx = telegrams.apply_receive(frame, &mut access);
@@ -166,11 +186,10 @@ impl Profile {
             ModeBinding::None => None,
         };
         if let Some(code) = binding {
-            let index = axis.cia402_index(0x6060);
-            let now = access.objects.get(index, 0).unwrap_or(0);
+            let now = core.get(access.objects, axis, Core::Mode);
             // homing runs inside positioning (6060h = 6 while it runs)
             if !(code == 1 && now == 6 && self.homing) && now != code {
-                let _ = access.objects.set(index, 0, code);
+                core.set(access.objects, axis, Core::Mode, code);
             }
         }
         if let Some(req) = rx.pkw {
@@ -185,7 +204,7 @@ impl Profile {
         if let Some(cw1) = rx.cw1 {
             access.own.cw1 = cw1;
         }
-        let display = access.objects.get(axis.cia402_index(0x6061), 0).unwrap_or(0);
+        let display = core.get(access.objects, axis, Core::ModeDisplay);
         let mode = match Ok::<i64, ()>(display) {
             Ok(1 | 6 | -1) => Mode::Positioning,
             Ok(2 | 3) => Mode::Speed,
@@ -201,7 +220,6 @@ impl Profile {
         if !t.evaluated {
             return;
         }
-        let cw_index = axis.cia402_index(0x6040);
         let mut controlword = t.controlword;
         let record_command = match t.mode {
             ModeCommands::Positioning(p) => {
@@ -253,7 +271,7 @@ impl Profile {
             }
             ModeCommands::Other => None,
         };
-        let _ = access.objects.set(cw_index, 0, i64::from(controlword));
+        core.set(access.objects, axis, Core::Controlword, i64::from(controlword));
         // torque control: 2416h.02 (the PROFINET velocity unit, rpm by
         // default) is the speed limit in both directions (P-130)
         let speed_limit = (display == 4).then(|| {
@@ -290,6 +308,9 @@ impl Profile {
             objects,
             axis,
             units: &self.units,
+            user_units: &self.user_units,
+            prepared: &mut self.prepared,
+            core: &self.core,
             own: &mut self.own,
         };
         profidrive::bmp::serve(req, &mut access, out).unwrap_or(0)
@@ -311,19 +332,23 @@ impl Profile {
         self.own.zsw1 = status::zsw1(objects, axis, self.cw1.last(), self.homing);
         let n = self.response?;
         let telegrams = self.telegrams.as_mut()?;
+        self.core.resolve(objects, axis);
         let mut access = DriveAccess {
             objects,
             axis,
             units: &self.units,
+            user_units: &self.user_units,
+            prepared: &mut self.prepared,
+            core: &self.core,
             own: &mut self.own,
         };
-        let mut out = [0u8; MAX_TELEGRAM_BYTES];
-        let len = buf.len().min(out.len());
-        let tx = telegrams.build_response(n, &mut access, self.pkw_response, out.get_mut(..len)?)?;
+        // straight into the module's data (the telegram is cut to it or
+        // zero-padded up to it)
+        let len = buf.len().min(MAX_TELEGRAM_BYTES);
+        let tx = telegrams.build_response(n, &mut access, self.pkw_response, buf.get_mut(..len)?)?;
         if !tx.warnings.is_empty() {
             self.warnings = self.warnings.saturating_add(1);
         }
-        buf.get_mut(..len)?.copy_from_slice(out.get(..len)?);
         Some(len)
     }
 }

@@ -1,0 +1,276 @@
+//! Lookups of the cyclic path, cheap (issue 17, cycle cost): the PNU
+//! catalogue by binary search (it is sorted by PNU and subindex, which
+//! `p190_the_catalogue_is_sorted_without_duplicates` keeps) with the answers
+//! of [`pnu::find`] / [`pnu::is_catalogue_index`], and the CiA 402 entries a
+//! telegram reads and writes every cycle prepared once per configuration
+//! generation ([`PreparedCache`], [`drive_core::Prepared`]) instead of
+//! looked up and checked by the dictionary at each access.
+
+use super::pnu::{self, Pnu};
+use drive_core::axis::Axis;
+use drive_core::{DriveObjects, Prepared, Slot};
+use od::CommState;
+use profidrive::{Addr, PdError};
+
+/// [`pnu::find`]: the entry of `addr`, 0x00 without the PNU, 0x03 without
+/// the subindex.
+pub fn find(addr: Addr) -> Result<&'static Pnu, PdError> {
+    let c = pnu::CATALOGUE;
+    let key = |a: Addr| u32::from(a.index) << 8 | u32::from(a.sub);
+    let i = c.partition_point(|p| key(p.addr) < key(addr));
+    let here = c.get(i);
+    if let Some(p) = here.filter(|p| p.addr == addr) {
+        return Ok(p);
+    }
+    // the PNU's other subindices sit just before or at `i`
+    let known = |p: Option<&Pnu>| p.is_some_and(|p| p.addr.index == addr.index);
+    Err(if known(here) || known(i.checked_sub(1).and_then(|j| c.get(j))) {
+        PdError::FAULTY_SUBINDEX
+    } else {
+        PdError::IMPERMISSIBLE_PNU
+    })
+}
+
+/// [`pnu::is_catalogue_index`].
+pub fn is_catalogue_index(index: u16) -> bool {
+    let c = pnu::CATALOGUE;
+    index < 0x1000
+        || c.get(c.partition_point(|p| p.addr.index < index))
+            .is_some_and(|p| p.addr.index == index)
+}
+
+/// Entries kept (the default telegrams touch nine CiA 402 entries, eight
+/// of them with telegram 1).
+const ENTRIES: usize = 8;
+
+/// The CiA 402 entries last accessed, prepared (Op, the profile's state);
+/// a stale one is prepared again, a new one takes the oldest place. Handed
+/// out by reference: a handle is too large to copy cheaply.
+#[derive(Debug)]
+pub struct PreparedCache {
+    /// `1 << 24 | index << 8 | sub`, 0 = free.
+    keys: [u32; ENTRIES],
+    handles: [Option<Prepared>; ENTRIES],
+    next: usize,
+}
+
+impl Default for PreparedCache {
+    fn default() -> Self {
+        Self::new()
+    }
+}
+
+impl PreparedCache {
+    /// Empty.
+    pub const fn new() -> Self {
+        Self {
+            keys: [0; ENTRIES],
+            handles: [None; ENTRIES],
+            next: 0,
+        }
+    }
+
+    /// `index`:`sub` prepared and current, or `None` (not a CiA 402 entry
+    /// [`DriveObjects::prepare`] takes: the full path).
+    pub fn get(&mut self, objects: &DriveObjects, index: u16, sub: u8) -> Option<&Prepared> {
+        if !(0x6000..=0x6FFF).contains(&index) {
+            return None;
+        }
+        let key = 1 << 24 | u32::from(index) << 8 | u32::from(sub);
+        let at = match self.keys.iter().position(|&k| k == key) {
+            Some(at)
+                if self
+                    .handles
+                    .get(at)?
+                    .as_ref()
+                    .is_some_and(|p| objects.is_current(p)) =>
+            {
+                return self.handles.get(at)?.as_ref();
+            }
+            Some(at) => at,
+            None => {
+                let at = self.next % ENTRIES;
+                self.next = at + 1;
+                at
+            }
+        };
+        let p = objects.prepare(index, sub, CommState::Op);
+        *self.keys.get_mut(at)? = if p.is_some() { key } else { 0 };
+        let slot = self.handles.get_mut(at)?;
+        *slot = p;
+        slot.as_ref()
+    }
+}
+
+/// The core entries the profile itself reads and writes every cycle
+/// ([`DriveObjects::get`] / [`DriveObjects::set`], no bus rules).
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum Core {
+    /// 6040h controlword.
+    Controlword,
+    /// 6060h modes of operation.
+    Mode,
+    /// 6061h modes of operation display.
+    ModeDisplay,
+    /// 60FDh digital inputs.
+    Inputs,
+}
+
+impl Core {
+    const ALL: [Core; 4] = [Core::Controlword, Core::Mode, Core::ModeDisplay, Core::Inputs];
+
+    /// The axis-A index.
+    const fn index(self) -> u16 {
+        match self {
+            Core::Controlword => 0x6040,
+            Core::Mode => 0x6060,
+            Core::ModeDisplay => 0x6061,
+            Core::Inputs => 0x60FD,
+        }
+    }
+}
+
+/// [`Core`]'s entries of one axis resolved once to their [`Slot`]s: a load
+/// or store where `get`/`set` hash and probe the dictionary's cache (the
+/// same values: these are integers in RAM).
+#[derive(Debug, Clone, Copy, Default)]
+pub struct CoreSlots {
+    axis: Option<u8>,
+    slots: [Option<Slot>; 4],
+}
+
+impl CoreSlots {
+    /// Nothing resolved yet.
+    pub const fn new() -> Self {
+        Self {
+            axis: None,
+            slots: [None; 4],
+        }
+    }
+
+    /// Resolves the entries of `axis` (once; again for another axis).
+    pub fn resolve(&mut self, objects: &DriveObjects, axis: &Axis) {
+        if self.axis != Some(axis.index()) {
+            for (s, e) in self.slots.iter_mut().zip(Core::ALL) {
+                *s = objects.slot(axis.cia402_index(e.index()), 0);
+            }
+            self.axis = Some(axis.index());
+        }
+    }
+
+    fn slot(&self, axis: &Axis, e: Core) -> Option<Slot> {
+        if self.axis != Some(axis.index()) {
+            return None;
+        }
+        self.slots.get(e as usize).copied().flatten()
+    }
+
+    /// `objects.get(e of axis, 0).unwrap_or(0)`.
+    pub fn get(&self, objects: &DriveObjects, axis: &Axis, e: Core) -> i64 {
+        match self.slot(axis, e) {
+            Some(s) => objects.load_slot(s),
+            None => objects.get(axis.cia402_index(e.index()), 0).unwrap_or(0),
+        }
+    }
+
+    /// `let _ = objects.set(e of axis, 0, v)`.
+    pub fn set(&self, objects: &mut DriveObjects, axis: &Axis, e: Core, v: i64) {
+        match self.slot(axis, e) {
+            Some(s) => {
+                objects.store_slot(s, v);
+            }
+            None => {
+                let _ = objects.set(axis.cia402_index(e.index()), 0, v);
+            }
+        }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// P-190: the binary search answers as the catalogue's own lookups, for
+    /// every PNU and subindex around the catalogue's.
+    #[test]
+    fn p190_the_lookups_answer_as_the_catalogue() {
+        let mut indices: std::vec::Vec<u16> = (0..1200).chain(0x1000..0x1010).collect();
+        for p in pnu::CATALOGUE {
+            indices.extend([p.addr.index.saturating_sub(1), p.addr.index, p.addr.index + 1]);
+        }
+        indices.extend([0x2415, 0x2416, 0x2417, 0x6040, u16::MAX]);
+        for index in indices {
+            assert_eq!(
+                is_catalogue_index(index),
+                pnu::is_catalogue_index(index),
+                "{index}"
+            );
+            for sub in 0..=8 {
+                let a = Addr::new(index, sub);
+                assert_eq!(find(a).map(|p| p.addr), pnu::find(a).map(|p| p.addr), "{a:?}");
+            }
+            assert_eq!(
+                find(Addr::new(index, 255)).map(|p| p.addr),
+                pnu::find(Addr::new(index, 255)).map(|p| p.addr)
+            );
+        }
+    }
+
+    /// P-051, P-052 (the mode the telegram selects): the resolved entries
+    /// read and write as `get` / `set`, for both axes.
+    #[test]
+    fn p051_p052_core_slots_read_and_write_as_get_and_set() {
+        let mut od = DriveObjects::new();
+        let mut core = CoreSlots::new();
+        for axis in [Axis::new(0), Axis::new(1)] {
+            core.resolve(&od, &axis);
+            for (e, v) in [
+                (Core::Controlword, 0x0F),
+                (Core::Mode, 2),
+                (Core::Mode, -1),
+                (Core::Controlword, 0x1F),
+            ] {
+                let mut full = od.clone();
+                let _ = full.set(axis.cia402_index(e.index()), 0, v);
+                core.set(&mut od, &axis, e, v);
+                assert!(od == full && od.config_generation() == full.config_generation());
+            }
+            for e in Core::ALL {
+                let index = axis.cia402_index(e.index());
+                od.set(index, 0, 1).unwrap();
+                assert_eq!(core.get(&od, &axis, e), od.get(index, 0).unwrap());
+            }
+        }
+        // another axis than resolved: the dictionary's answer
+        let b = Axis::new(1);
+        core.resolve(&od, &Axis::new(0));
+        od.set(b.cia402_index(0x6061), 0, 3).unwrap();
+        assert_eq!(core.get(&od, &b, Core::ModeDisplay), 3);
+    }
+
+    /// P-067: the cache hands out current handles and prepares stale ones
+    /// again; entries outside the CiA 402 range get none.
+    #[test]
+    fn p067_the_prepared_cache_follows_the_configuration() {
+        let mut od = DriveObjects::new();
+        let mut cache = PreparedCache::new();
+        let p = *cache.get(&od, 0x6042, 0).unwrap();
+        assert!(od.is_current(&p));
+        od.set(0x6048, 1, 99).unwrap();
+        assert!(!od.is_current(&p));
+        let q = cache.get(&od, 0x6042, 0).unwrap();
+        assert!(od.is_current(q));
+        assert!(cache.get(&od, 0x2000, 1).is_none());
+        assert!(cache.get(&od, 0x6042, 99).is_none());
+        // more entries than places: every one still answers
+        for sub in 0..=2 {
+            for index in [
+                0x6040, 0x6042, 0x6048, 0x6049, 0x6060, 0x6064, 0x606C, 0x6071, 0x6077,
+            ] {
+                if od.prepare(index, sub, CommState::Op).is_some() {
+                    assert!(cache.get(&od, index, sub).is_some(), "{index:04X}:{sub}");
+                }
+            }
+        }
+    }
+}
