@@ -172,7 +172,27 @@ const fn gcd(mut a: u128, mut b: u128) -> u128 {
     }
 }
 
+/// `x · num / den` rounded half away from zero, exactly, in 64-bit
+/// arithmetic (a 128-bit division is a long library routine on the MCU):
+/// |x| = q · den + r, so |x| · num / den = q · num + r · num / den, where
+/// r · num < 2^64 − 2^33 leaves room for the rounding half. `None` when
+/// the result does not fit i64 (or den = 0).
+fn scale_round(x: i64, num: u32, den: u32) -> Option<i64> {
+    let (num, den) = (u64::from(num), u64::from(den));
+    let m = x.unsigned_abs();
+    let q = m.checked_div(den)?;
+    let r = m.checked_rem(den)?;
+    let frac = (r * num + den / 2).checked_div(den)?;
+    let v = q.checked_mul(num)?.checked_add(frac)?;
+    if x < 0 {
+        0i64.checked_sub_unsigned(v)
+    } else {
+        i64::try_from(v).ok()
+    }
+}
+
 /// Rounds n/d to the nearest integer, half away from zero (d > 0).
+#[cfg(test)]
 fn div_round(n: i128, d: i128) -> Option<i128> {
     let half = d / 2;
     if n >= 0 {
@@ -208,14 +228,13 @@ impl Fraction {
 
     /// internal → bus, rounded, as INT32.
     pub fn to_bus(&self, internal: i64) -> Result<i32, UnitError> {
-        let v = div_round(i128::from(internal) * i128::from(self.num), i128::from(self.den));
-        v.and_then(|v| i32::try_from(v).ok()).ok_or(UnitError::OutOfRange)
+        let v = scale_round(internal, self.num, self.den).ok_or(UnitError::OutOfRange)?;
+        i32::try_from(v).map_err(|_| UnitError::OutOfRange)
     }
 
     /// bus → internal, rounded.
     pub fn from_bus(&self, bus: i64) -> Result<i64, UnitError> {
-        let v = div_round(i128::from(bus) * i128::from(self.den), i128::from(self.num));
-        v.and_then(|v| i64::try_from(v).ok()).ok_or(UnitError::OutOfRange)
+        scale_round(bus, self.den, self.num).ok_or(UnitError::OutOfRange)
     }
 
     /// internal → bus for a real value (velocities and accelerations are
@@ -339,6 +358,55 @@ impl UnitProfile {
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    /// The 64-bit scaling gives exactly what the 128-bit form gives
+    /// (where that fits i64), over edge and pseudo-random arguments.
+    #[test]
+    fn p211_scale_round_equals_the_128_bit_form() {
+        let reference = |x: i64, num: u32, den: u32| {
+            div_round(i128::from(x) * i128::from(num), i128::from(den)).and_then(|v| i64::try_from(v).ok())
+        };
+        let xs = [
+            0,
+            1,
+            -1,
+            2,
+            -2,
+            i64::MAX,
+            i64::MIN,
+            i64::MAX - 1,
+            i64::MIN + 1,
+            1 << 40,
+            -(1 << 40),
+        ];
+        let nds = [
+            (1u32, 1u32),
+            (u32::MAX, 1),
+            (1, u32::MAX),
+            (u32::MAX, u32::MAX - 1),
+            (125, 131_072),
+            (3, 2),
+            (2, 3),
+        ];
+        for &x in &xs {
+            for &(n, d) in &nds {
+                assert_eq!(scale_round(x, n, d), reference(x, n, d), "{x} * {n} / {d}");
+            }
+        }
+        let mut seed = 0x1234_5678_9abc_def0u64;
+        let mut next = || {
+            seed ^= seed << 13;
+            seed ^= seed >> 7;
+            seed ^= seed << 17;
+            seed
+        };
+        for _ in 0..200_000 {
+            let x = next() as i64 >> (next() % 64);
+            let n = ((next() as u32) >> (next() % 32)).max(1);
+            let d = ((next() as u32) >> (next() % 32)).max(1);
+            assert_eq!(scale_round(x, n, d), reference(x, n, d), "{x} * {n} / {d}");
+        }
+    }
 
     const REV: i64 = INCREMENTS_PER_REVOLUTION as i64;
 

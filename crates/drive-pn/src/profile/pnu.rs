@@ -110,7 +110,9 @@ pub enum Source {
 pub struct Pnu {
     /// The address.
     pub addr: Addr,
-    /// The manual's name ("" in a bare-metal build).
+    /// The manual's name (host builds only: the docs and the catalogue's
+    /// tests; a bare-metal build keeps the names out of flash).
+    #[cfg(not(target_os = "none"))]
     pub name: &'static str,
     /// The type on the bus.
     pub data_type: DataType,
@@ -126,12 +128,13 @@ pub struct Pnu {
 
 use DataType::{I32, I8, U16, U32, U8};
 
-/// One catalogue entry. The names are for the host (the docs and the
-/// catalogue's tests): a bare-metal build keeps them out of flash.
+/// One catalogue entry (the name only in host builds).
+#[cfg_attr(target_os = "none", allow(unused_variables))]
 const fn p(pnu: u16, sub: u8, name: &'static str, t: DataType, w: bool, unit: Unit, source: Source) -> Pnu {
     Pnu {
         addr: Addr::new(pnu, sub),
-        name: if cfg!(target_os = "none") { "" } else { name },
+        #[cfg(not(target_os = "none"))]
+        name,
         data_type: t,
         readable: true,
         writable: w,
