@@ -583,3 +583,44 @@ fn c021_p082_p086_a_record_start_or_jog_opens_the_brake() {
     r.cmd.jog_positive = false;
     r.run(300);
 }
+
+/// P-104, P-105: at the end of an appended chain (the demo's: 3 rev at
+/// 1000 rpm ending at 600 rpm, 6 rev at 600 ending at 300, 8 rev at 300,
+/// 10 000 rpm/s) target reached comes once the last task is done in the
+/// window and does not fall again while the axis stays in the window.
+#[test]
+fn p104_p105_target_reached_holds_at_the_end_of_an_appended_chain() {
+    let mut r = Rig::new();
+    let rps = |rpm: f32| rpm / 60.0;
+    let acc = rps(10_000.0);
+    let chain = [(3.0, 1000.0, 600.0), (6.0, 600.0, 300.0), (8.0, 300.0, 0.0)];
+    for (k, (target, v, ve)) in chain.into_iter().enumerate() {
+        r.record(FIELDBUS, target, rps(v), rps(ve), acc, 0);
+        let s = r.start(FIELDBUS);
+        assert!(s.acknowledge, "task {k} taken");
+        // the start input falls; a waiting task keeps the acknowledge
+        r.run_until(1000, |_, s| !s.acknowledge || k > 0)
+            .expect("start released");
+        if k > 0 {
+            r.run_until(3000, |_, s| !s.waiting).expect("the next task runs");
+        }
+    }
+    let window = r.od.get(crate::params::I22, 0).unwrap();
+    let first = r
+        .run_until(10_000, |_, s| s.target_reached)
+        .expect("target reached");
+    let mut trace = std::vec::Vec::new();
+    for k in 0..500 {
+        let s = r.cycle();
+        let error = 8 * REV_I - r.position();
+        trace.push((k, s.target_reached, error));
+        if i64::from(error.unsigned_abs()) <= window {
+            assert!(
+                s.target_reached,
+                "target reached fell {k} ms after it came at {first} ms, {error} inc from the target \
+                 (window {window}): {:?}",
+                &trace[trace.len().saturating_sub(8)..]
+            );
+        }
+    }
+}
