@@ -31,6 +31,7 @@
 //! does with [`pkw::PkwClient`]; `following_error` is inverted ZSW1 bit 8
 //! (E-09 corrected), `pos_task_ack` is ZSW1 bit 12 as sent (E-10).
 
+pub mod alarms;
 pub mod controller;
 pub mod pkw;
 pub mod report;

@@ -37,6 +37,19 @@ type Line<'a> = (&'a [f64], RGBColor, &'a str);
 /// Increments per revolution (2^20).
 const INC_PER_REV: f64 = 1_048_576.0;
 
+/// The plot's size as shown, pixels.
+const SIZE: (u32, u32) = (1100, 1000);
+/// It is drawn this many times finer and shown at [`SIZE`] (the root's
+/// width and height; its viewBox stays the drawing's): plotters places every
+/// point on whole drawing pixels, so at 1:1 a slow creep (1 rev in 4 s over
+/// a panel of 9 rev) becomes a staircase of 1 px steps ~200 ms apart.
+const FINE: u32 = 4;
+
+/// `v` in drawing units (pixels as shown × [`FINE`]).
+const fn fine(v: u32) -> u32 {
+    v * FINE
+}
+
 impl Trace {
     /// Appends one sample: positions and following error in increments,
     /// velocity in increments per second, torque in 0.1 % of rated torque.
@@ -96,15 +109,24 @@ impl Trace {
     /// The four-panel SVG plot.
     pub fn svg(&self, title: &str) -> Result<String, String> {
         let mut svg = String::new();
-        self.draw(SVGBackend::with_string(&mut svg, (1100, 1000)), title)?;
-        Ok(svg)
+        self.draw(
+            SVGBackend::with_string(&mut svg, (fine(SIZE.0), fine(SIZE.1))),
+            title,
+        )?;
+        // shown at SIZE: the root's width and height (its first attributes)
+        let drawn = format!("width=\"{}\" height=\"{}\"", fine(SIZE.0), fine(SIZE.1));
+        let shown = format!("width=\"{}\" height=\"{}\"", SIZE.0, SIZE.1);
+        if !svg.contains(&drawn) {
+            return Err("the SVG root has no width and height to set".into());
+        }
+        Ok(svg.replacen(&drawn, &shown, 1))
     }
 
     fn draw(&self, backend: SVGBackend<'_>, title: &str) -> Result<(), String> {
         let root = backend.into_drawing_area();
         root.fill(&WHITE).map_err(|e| e.to_string())?;
         let root = root
-            .titled(title, ("sans-serif", 22))
+            .titled(title, ("sans-serif", fine(22)))
             .map_err(|e| e.to_string())?;
         let with_state = !self.state.is_empty();
         let panels = root.split_evenly((if with_state { 5 } else { 4 }, 1));
@@ -141,15 +163,20 @@ impl Trace {
             let (lo, hi) = if lo > hi { (-1.0, 1.0) } else { (lo, hi) };
             let pad = ((hi - lo) * 0.08).max(1e-9);
             let mut chart = ChartBuilder::on(area)
-                .margin(8)
-                .x_label_area_size(30)
-                .y_label_area_size(70)
+                .margin(fine(8))
+                .x_label_area_size(fine(30))
+                .y_label_area_size(fine(70))
                 .build_cartesian_2d(t0..t_end, (lo - pad)..(hi + pad))
                 .map_err(|e| e.to_string())?;
             chart
                 .configure_mesh()
                 .x_desc("time [ms]")
                 .y_desc(*label)
+                .label_style(("sans-serif", fine(12)))
+                .axis_desc_style(("sans-serif", fine(12)))
+                .axis_style(BLACK.stroke_width(FINE))
+                .bold_line_style(BLACK.mix(0.2).stroke_width(FINE))
+                .light_line_style(BLACK.mix(0.08).stroke_width(FINE))
                 .draw()
                 .map_err(|e| e.to_string())?;
             for (n, (at, name)) in self.phases.iter().enumerate() {
@@ -157,11 +184,14 @@ impl Trace {
                 // alternate rows: names of phases close together stay apart
                 let y = hi - (hi - lo) * 0.08 * (n % 2) as f64;
                 chart
-                    .draw_series(LineSeries::new([(*at, lo), (*at, hi)], BLACK.mix(0.3)))
+                    .draw_series(LineSeries::new(
+                        [(*at, lo), (*at, hi)],
+                        BLACK.mix(0.3).stroke_width(FINE),
+                    ))
                     .map_err(|e| e.to_string())?;
                 if k == 0 {
                     chart
-                        .draw_series([Text::new(name.clone(), (*at, y), ("sans-serif", 12))])
+                        .draw_series([Text::new(name.clone(), (*at, y), ("sans-serif", fine(12)))])
                         .map_err(|e| e.to_string())?;
                 }
             }
@@ -170,19 +200,79 @@ impl Trace {
                 chart
                     .draw_series(LineSeries::new(
                         self.t_ms.iter().copied().zip(values.iter().copied()),
-                        color,
+                        color.stroke_width(FINE),
                     ))
                     .map_err(|e| e.to_string())?
                     .label(*name)
-                    .legend(move |(x, y)| PathElement::new(vec![(x, y), (x + 18, y)], color));
+                    .legend(move |(x, y)| {
+                        PathElement::new(vec![(x, y), (x + fine(18) as i32, y)], color.stroke_width(FINE))
+                    });
             }
             chart
                 .configure_series_labels()
+                .label_font(("sans-serif", fine(12)))
+                .legend_area_size(fine(30))
+                .margin(fine(10))
                 .background_style(WHITE.mix(0.8))
-                .border_style(BLACK)
+                .border_style(BLACK.stroke_width(FINE))
                 .draw()
                 .map_err(|e| e.to_string())?;
         }
         root.present().map_err(|e| e.to_string())
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// The y coordinates of the first polyline drawn in `stroke`, in
+    /// displayed pixels (the root's width over its viewBox width).
+    fn polyline_y(svg: &str, stroke: &str) -> Vec<f64> {
+        let attr = |tag: &str, name: &str| -> Option<f64> {
+            let at = tag.find(&format!("{name}=\""))? + name.len() + 2;
+            tag[at..].split('"').next()?.parse().ok()
+        };
+        let root = &svg[svg.find("<svg").unwrap()..];
+        let root = &root[..root.find('>').unwrap()];
+        let view_w: f64 = root
+            .split("viewBox=\"")
+            .nth(1)
+            .and_then(|v| v.split(' ').nth(2))
+            .unwrap()
+            .parse()
+            .unwrap();
+        let k = attr(root, "width").unwrap() / view_w;
+        let line = svg
+            .split("<polyline")
+            .find(|p| p.contains(&format!("stroke=\"{stroke}\"")))
+            .expect("the polyline");
+        let points = line.split("points=\"").nth(1).unwrap().split('"').next().unwrap();
+        points
+            .split_whitespace()
+            .map(|p| p.split(',').nth(1).unwrap().parse::<f64>().unwrap() * k)
+            .collect()
+    }
+
+    /// A slow creep (the demo's homing: 1 rev in 4 s, in a panel spanning
+    /// 9 rev) is drawn as a slope, not as a staircase of whole pixels
+    /// (plotters' backends place points on integer coordinates): the plot
+    /// is drawn at a finer internal resolution and shown at its size.
+    #[test]
+    fn a_slow_creep_is_no_staircase_of_whole_pixels() {
+        let mut t = Trace::default();
+        for k in 0..4000u32 {
+            let act = (f64::from(k) / 4000.0 * INC_PER_REV) as i32;
+            t.push(Nanos::from_ms(u64::from(k)), 9 << 20, act, 0, 0, 0);
+        }
+        let svg = t.svg("creep").unwrap();
+        assert!(
+            svg.contains("width=\"1100\" height=\"1000\""),
+            "shown at its size"
+        );
+        let y = polyline_y(&svg, "#FF0000");
+        assert_eq!(y.len(), 4000);
+        let step = y.windows(2).map(|w| (w[1] - w[0]).abs()).fold(0.0, f64::max);
+        assert!(step <= 0.3, "the creep moves in steps of {step} px");
     }
 }

@@ -309,6 +309,12 @@ impl PnSim {
         self.motors.get_mut(axis)
     }
 
+    /// The last step of the motor of `axis` (0 = A): position, torque,
+    /// whether the holding brake acted; `None` before the first cycle.
+    pub fn motor_outputs(&self, axis: usize) -> Option<&MotorOutputs> {
+        self.feedback.get(axis).and_then(Option::as_ref)
+    }
+
     /// The device (name, IP, AR, counters).
     pub fn device(&self) -> &Device<impl RecordHook> {
         self.drive.device()

@@ -11,8 +11,9 @@ use std::sync::OnceLock;
 
 /// Every end position within one PROFINET position unit (1/1000 rev =
 /// 1049 increments): the finest target a controller can command through
-/// PNU 1001.0, and 28 times tighter than the target window (PNU 1271,
-/// 10° = 29 127 inc) that `target_reached` alone guarantees.
+/// PNU 1001.0, and nearly 3 times tighter than the target window that
+/// `target_reached` alone guarantees (PNU 1271 = I22, this drive's 1° =
+/// 2 913 inc; the manual's default is 10°, docs/conformance.md P-158).
 const END_POSITION_TOLERANCE_INC: i64 = 1049;
 
 #[derive(Default)]

@@ -4,8 +4,11 @@
 //! × 1 so the controller exchanges a telegram every millisecond, the
 //! drive's control cycle A150), then one output frame per cycle carrying
 //! the receive telegram, and the drive's input frames read back for the
-//! response telegram.
+//! response telegram. The drive's alarms are acknowledged as profinet-py
+//! does ([`AlarmAcker`]: a transport ACK and an AlarmAck, at the time the
+//! alarm goes out), so a fault does not cost the AR.
 
+use super::alarms::{AlarmAcker, AlarmStats, Received};
 use crate::pcap::Recording;
 use crate::pn::PnSim;
 use nanos::Nanos;
@@ -15,7 +18,6 @@ use profinet::device::DeviceEvent;
 use profinet::ip::{Ipv4Addr, UDP_PAYLOAD_OFFSET};
 use profinet::testing::{self, CONTROLLER_MAC, DEVICE_IP, DEVICE_MAC};
 use profinet::wire::EthFrame;
-use std::cell::Cell;
 
 /// The controller's cycle (and the drive's control cycle, A150 default).
 pub const CYCLE: Nanos = Nanos::from_ms(1);
@@ -41,7 +43,19 @@ pub struct PnController {
     events: Vec<(Nanos, String)>,
     /// Every frame both ways, when recording.
     pcap: Option<Recording>,
+    /// The controller's end of the alarm CR.
+    alarms: AlarmAcker,
 }
+
+/// Where the response telegram lies in the drive's input frames.
+struct InputLayout {
+    frame_id: [u8; 2],
+    /// (offset in the C_SDU, length) of the IN module's data objects.
+    objects: Vec<(usize, usize)>,
+}
+
+/// Device frames one call may set off (answers to answers), bounded.
+const MAX_FRAMES_PER_STEP: usize = 64;
 
 /// profinet-py's Connect with the IOCRs' ReductionRatio set to `ratio`
 /// (the UDP payload rebuilt: the checksum stays right). The IOCR blocks
@@ -117,6 +131,18 @@ impl PnController {
         let (Some(out_slot), Some(in_slot)) = (slot(true), slot(false)) else {
             return Err("the AR has no OUT or no IN module".into());
         };
+        let alarm_cr = sim
+            .device()
+            .cm()
+            .ar()
+            .and_then(|a| a.alarm_cr)
+            .ok_or("the AR has no alarm CR")?;
+        let alarms = AlarmAcker::new(
+            CONTROLLER_MAC,
+            DEVICE_MAC,
+            alarm_cr.timeout(),
+            alarm_cr.rta_retries,
+        );
         Ok(PnController {
             sim,
             now: at,
@@ -129,7 +155,13 @@ impl PnController {
             frames_in: 0,
             events,
             pcap,
+            alarms,
         })
+    }
+
+    /// The controller's alarm counters (alarms taken and acknowledged).
+    pub fn alarm_stats(&self) -> AlarmStats {
+        self.alarms.stats()
     }
 
     /// The simulated time.
@@ -197,51 +229,109 @@ impl PnController {
         Ok(f)
     }
 
+    /// Where the response telegram lies in the input frames.
+    fn input_layout(&self) -> Result<InputLayout, String> {
+        let ar = self.sim.device().cm().ar().ok_or("the AR is gone")?;
+        let input = ar.input_cr.as_ref().ok_or("the AR has no input CR")?;
+        Ok(InputLayout {
+            frame_id: input.frame_id.to_be_bytes(),
+            objects: input
+                .data
+                .iter()
+                .filter(|o| o.slot == self.in_slot)
+                .map(|o| (usize::from(o.frame_offset), usize::from(o.data_len)))
+                .collect(),
+        })
+    }
+
+    /// Takes the frames the drive sent at `at`: each is recorded, an input
+    /// frame's IN module becomes the response telegram, an alarm is
+    /// acknowledged at once (the answers go to the drive at `at`, and what
+    /// it sends back is taken in turn). Returns whether an input frame came.
+    fn take_from_drive(&mut self, at: Nanos, sent: Vec<Vec<u8>>, layout: &InputLayout) -> bool {
+        let mut queue = std::collections::VecDeque::from(sent);
+        let mut got = false;
+        let mut answers = Vec::new();
+        for _ in 0..MAX_FRAMES_PER_STEP {
+            let Some(b) = queue.pop_front() else { break };
+            if let Some(r) = self.pcap.as_mut() {
+                r.frame(at, &b);
+            }
+            let Some(e) = EthFrame::parse(&b) else { continue };
+            if e.ethertype == ETHERTYPE_PN && e.payload.get(..2) == Some(&layout.frame_id[..]) {
+                for (o, n) in &layout.objects {
+                    if let Some(d) = e.payload.get(2 + o..2 + o + n) {
+                        self.response = d.to_vec();
+                        got = true;
+                    }
+                }
+                continue;
+            }
+            match self.alarms.receive(at, &b, &mut answers) {
+                Some(Received::Alarm {
+                    alarm_type,
+                    slot,
+                    subslot,
+                    sequence,
+                }) => self.events.push((
+                    at,
+                    format!(
+                        "alarm {alarm_type:#06x} at {slot}/{subslot:#06x} (sequence {sequence}) acknowledged"
+                    ),
+                )),
+                Some(Received::Abort(s)) => {
+                    self.events.push((
+                        at,
+                        format!("alarm channel: the drive aborted the AR ({:02x?})", s.0),
+                    ));
+                }
+                _ => {}
+            }
+            for a in answers.drain(..) {
+                if let Some(r) = self.pcap.as_mut() {
+                    r.frame(at, &a);
+                }
+                let mut back = Vec::new();
+                self.sim.receive(at, &a, &mut |f| back.push(f.to_vec()));
+                // the drive's transport ACK of our AlarmAck goes out at its
+                // next poll: now
+                self.sim.poll(at, &mut |f| back.push(f.to_vec()));
+                queue.extend(back);
+            }
+        }
+        got
+    }
+
     /// Runs the drive up to `t` (its control cycles and timers at their own
     /// times) and takes its input frames.
     fn run_to(&mut self, t: Nanos) -> Result<(), String> {
-        let ar = self.sim.device().cm().ar().ok_or("the AR is gone")?;
-        let input = ar.input_cr.as_ref().ok_or("the AR has no input CR")?;
-        let frame_id = input.frame_id.to_be_bytes();
-        let objects: Vec<(usize, usize)> = input
-            .data
-            .iter()
-            .filter(|o| o.slot == self.in_slot)
-            .map(|o| (usize::from(o.frame_offset), usize::from(o.data_len)))
-            .collect();
-        let mut got: Option<Vec<u8>> = None;
-        let clock = Cell::new(self.now);
-        let pcap = &mut self.pcap;
-        let mut tx = |b: &[u8]| {
-            if let Some(r) = pcap.as_mut() {
-                r.frame(clock.get(), b);
-            }
-            let Some(e) = EthFrame::parse(b) else { return };
-            if e.ethertype != ETHERTYPE_PN || e.payload.get(..2) != Some(&frame_id[..]) {
-                return;
-            }
-            for (at, n) in &objects {
-                if let Some(d) = e.payload.get(2 + at..2 + at + n) {
-                    got = Some(d.to_vec());
-                }
-            }
-        };
+        let layout = self.input_layout()?;
+        let mut got = false;
         // every deadline up to t, bounded: a deadline that does not move on
         // cannot hang the simulation
         let mut at = self.now;
         for _ in 0..1000 {
-            let next = self.sim.poll(at, &mut tx);
+            let mut due = Vec::new();
+            self.alarms.poll(at, &mut due);
+            let mut sent = Vec::new();
+            for f in &due {
+                if let Some(r) = self.pcap.as_mut() {
+                    r.frame(at, f);
+                }
+                self.sim.receive(at, f, &mut |b| sent.push(b.to_vec()));
+            }
+            let next = self.sim.poll(at, &mut |b| sent.push(b.to_vec()));
+            got |= self.take_from_drive(at, sent, &layout);
             if next >= t || next <= at {
                 break;
             }
             at = next;
-            clock.set(at);
         }
-        clock.set(t);
-        self.sim.poll(t, &mut tx);
+        let mut sent = Vec::new();
+        self.sim.poll(t, &mut |b| sent.push(b.to_vec()));
+        got |= self.take_from_drive(t, sent, &layout);
         self.now = t;
-        if let Some(r) = got {
-            self.response = r;
+        if got {
             self.fresh = true;
             self.frames_in += 1;
         }
@@ -265,14 +355,16 @@ impl PnController {
         self.run_to(t)?;
         self.counter = self.counter.wrapping_add(32);
         let f = self.output_frame(telegram)?;
-        let pcap = &mut self.pcap;
-        let mut record = |b: &[u8]| {
-            if let Some(r) = pcap.as_mut() {
-                r.frame(t, b);
-            }
-        };
-        record(&f);
-        self.sim.receive(t, &f, &mut record);
+        if let Some(r) = self.pcap.as_mut() {
+            r.frame(t, &f);
+        }
+        let mut sent = Vec::new();
+        self.sim.receive(t, &f, &mut |b| sent.push(b.to_vec()));
+        let layout = self.input_layout()?;
+        if self.take_from_drive(t, sent, &layout) {
+            self.fresh = true;
+            self.frames_in += 1;
+        }
         self.frames_out += 1;
         Ok((!self.response.is_empty()).then_some(self.response.as_slice()))
     }

@@ -555,7 +555,7 @@ impl Axis {
             None => true,
         };
         let inputs = Inputs {
-            controlword: o.controlword,
+            controlword: o.controlword | self.record_brake_trigger(),
             mode_request: o.mode,
             initialised: true,
             additional_enable: io.additional_enable,

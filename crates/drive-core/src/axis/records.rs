@@ -40,6 +40,10 @@
 //!   jog inputs do nothing while it runs.
 //! - **Set-up mode** (P-140): `setup_mode` caps the velocities of tasks and
 //!   jog at J404, at once.
+//! - **Holding brake** (C-021): CiA 402 pp opens it with the first set-point
+//!   (6040h bit 4), which record positioning leaves clear; a task start or
+//!   a jog input counts as that set-point for the device control, so the
+//!   first task after the enable (and after a fault's reset) opens it.
 //! - **Jerk**: none (the profile's "jerk filter 0", P-147); 60A4h is CiA
 //!   402 pp's.
 //!
@@ -237,12 +241,19 @@ impl RecordTasks {
     }
 }
 
+/// Bit 12 of the packed record command: its start or a jog input is set
+/// (shifted down by 8 it is 6040h bit 4, [`Axis::record_brake_trigger`]).
+const RECORD_MOTION: u16 = CW_MODE_BIT4 << 8;
+
 impl Axis {
     /// Sets the record command for the next cycles (`None`: pp is CiA 402
     /// pp). A personality calls this every cycle before
     /// [`cycle`](Self::cycle).
     pub fn set_record_command(&mut self, command: Option<RecordCommand>) {
-        self.record_command = command.map_or(0, |c| 0x100 | u16::from(command_bits(&c)));
+        self.record_command = command.map_or(0, |c| {
+            let motion = c.start || c.jog_positive || c.jog_negative;
+            0x100 | u16::from(command_bits(&c)) | (u16::from(motion) * RECORD_MOTION)
+        });
     }
 
     /// Sets the speed limit of the torque modes (both directions, inc/s,
@@ -274,6 +285,19 @@ impl Axis {
             self.torque_limit_per_mille = limit;
             self.configured = None;
         }
+    }
+
+    /// 6040h bit 4 for the device control's brake release (C-021) while a
+    /// record command is set: CiA 402 pp opens the holding brake with its
+    /// first set-point (bit 4), record positioning leaves bit 4 clear and
+    /// starts tasks and jogs with the command, so its start and jog inputs
+    /// count as that set-point (0 without a command: pp unchanged).
+    /// (Packed by [`set_record_command`](Self::set_record_command) as bit
+    /// 12 of the command, [`RECORD_MOTION`]: one shift and mask per cycle,
+    /// nothing to test on the EtherCAT path.)
+    #[inline(always)]
+    pub(super) fn record_brake_trigger(&self) -> u16 {
+        (self.record_command >> 8) & CW_MODE_BIT4
     }
 
     /// The record command set by [`set_record_command`](Self::set_record_command).

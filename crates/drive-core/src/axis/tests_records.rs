@@ -50,6 +50,8 @@ struct Rig {
     /// Position set-point velocity (607Ah…: from 6064h differences is too
     /// noisy; the axis' own set-point), inc/s, per cycle.
     sp_velocity: f32,
+    /// The last cycle's brake command: released.
+    brake_release: bool,
 }
 
 impl Rig {
@@ -70,6 +72,7 @@ impl Rig {
                 ..RecordCommand::default()
             },
             sp_velocity: 0.0,
+            brake_release: false,
         };
         r.axis.params_mut().absolute_needs_reference = false;
         r.od.set(0x6060, 0, 1).unwrap();
@@ -87,6 +90,7 @@ impl Rig {
         let io = AxisIo::ready(self.motor.position.round() as i32);
         let report = self.axis.cycle(&mut self.od, &io, self.now, false);
         self.motor.step(&report.command);
+        self.brake_release = report.command.brake_release;
         self.now = self.now.saturating_add(Nanos::from_ns(DT_NS));
         self.sp_velocity = self.axis.sp_vel;
         self.axis.record_status()
@@ -532,4 +536,91 @@ fn pp_without_a_record_command_is_cia402_pp() {
             ..Default::default()
         }
     );
+}
+
+/// C-021 with P-082, P-086: in pp the brake opens with the first set-point
+/// (6040h bit 4); record positioning leaves bit 4 clear and starts tasks
+/// with the record command, so a task start or a jog opens it. It closes
+/// with a fault and opens again at the first start after the reset and the
+/// enable sequence (before, only a homing run did: every record move after
+/// a fault dragged the engaged brake, 60F4h ~100 times larger).
+#[test]
+fn c021_p082_p086_a_record_start_or_jog_opens_the_brake() {
+    let mut r = Rig::new();
+    r.run(5);
+    assert!(!r.brake_release, "enabled, no motion command yet: engaged");
+    r.record(FIELDBUS, 1.0, 5.0, 0.0, 50.0, 0);
+    r.start(FIELDBUS);
+    assert!(r.brake_release, "the task start opens it");
+    assert!(r.run_until(3000, |_, s| s.target_reached).is_some());
+    assert!(r.brake_release, "open until the drive function goes off");
+    // a fault closes it
+    r.axis.raise_event(motion::Event { number: 44, cause: 1 });
+    r.run(50);
+    assert!(r.axis.state().is_fault());
+    assert!(!r.brake_release, "fault: engaged");
+    for cw in [0x80, 0x06, 0x07, 0x0F] {
+        r.od.set(0x6040, 0, cw).unwrap();
+        r.run(5);
+    }
+    assert_eq!(r.axis.state(), State::OperationEnabled);
+    assert!(!r.brake_release, "enabled again, no motion command: engaged");
+    r.record(FIELDBUS, 2.0, 5.0, 0.0, 50.0, 0);
+    r.start(FIELDBUS);
+    assert!(r.brake_release, "the first start after the reset opens it");
+    assert!(r.run_until(3000, |_, s| s.target_reached).is_some());
+    assert!((rev(r.position()) - 2.0).abs() < 0.01);
+    // the jog records open it as well
+    r.od.set(0x6040, 0, 0x07).unwrap();
+    r.run(5);
+    r.od.set(0x6040, 0, 0x0F).unwrap();
+    r.run(5);
+    assert!(!r.brake_release, "switched on and enabled again: engaged");
+    r.record(JOG_POSITIVE, 0.0, 2.0, 0.0, 20.0, 0);
+    r.cmd.jog_positive = true;
+    r.run(1);
+    assert!(r.brake_release, "a jog opens it");
+    r.cmd.jog_positive = false;
+    r.run(300);
+}
+
+/// P-104, P-105: at the end of an appended chain (the demo's: 3 rev at
+/// 1000 rpm ending at 600 rpm, 6 rev at 600 ending at 300, 8 rev at 300,
+/// 10 000 rpm/s) target reached comes once the last task is done in the
+/// window and does not fall again while the axis stays in the window.
+#[test]
+fn p104_p105_target_reached_holds_at_the_end_of_an_appended_chain() {
+    let mut r = Rig::new();
+    let rps = |rpm: f32| rpm / 60.0;
+    let acc = rps(10_000.0);
+    let chain = [(3.0, 1000.0, 600.0), (6.0, 600.0, 300.0), (8.0, 300.0, 0.0)];
+    for (k, (target, v, ve)) in chain.into_iter().enumerate() {
+        r.record(FIELDBUS, target, rps(v), rps(ve), acc, 0);
+        let s = r.start(FIELDBUS);
+        assert!(s.acknowledge, "task {k} taken");
+        // the start input falls; a waiting task keeps the acknowledge
+        r.run_until(1000, |_, s| !s.acknowledge || k > 0)
+            .expect("start released");
+        if k > 0 {
+            r.run_until(3000, |_, s| !s.waiting).expect("the next task runs");
+        }
+    }
+    let window = r.od.get(crate::params::I22, 0).unwrap();
+    let first = r
+        .run_until(10_000, |_, s| s.target_reached)
+        .expect("target reached");
+    let mut trace = std::vec::Vec::new();
+    for k in 0..500 {
+        let s = r.cycle();
+        let error = 8 * REV_I - r.position();
+        trace.push((k, s.target_reached, error));
+        if i64::from(error.unsigned_abs()) <= window {
+            assert!(
+                s.target_reached,
+                "target reached fell {k} ms after it came at {first} ms, {error} inc from the target \
+                 (window {window}): {:?}",
+                &trace[trace.len().saturating_sub(8)..]
+            );
+        }
+    }
 }
