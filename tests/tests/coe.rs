@@ -88,7 +88,8 @@ fn settled(sim: &RefCell<Simulation>) -> (Vec<i64>, Vec<u8>, Template, drive::Re
 
 /// The value the drive's dictionary holds for `index`:`sub`, read locally.
 fn local_read(sim: &RefCell<Simulation>, index: u16, sub: u8) -> Vec<u8> {
-    let mut buf = [0u8; 64];
+    // the longest entry: A280's 255 bytes
+    let mut buf = [0u8; 512];
     let n = sim.borrow_mut().drives_mut()[0]
         .drive
         .read_object(index, sub, &mut buf, CommState::PreOp)
