@@ -9,28 +9,31 @@
 #![allow(clippy::unwrap_used, clippy::expect_used, clippy::panic)]
 
 use hil_sim::fb::controller::PnController;
-use hil_sim::fb::{ExampleFb, FbInputs, FbOutputs, OPMODE_POS};
+use hil_sim::fb::rig::FbRig;
+use hil_sim::fb::{FbOutputs, OPMODE_POS};
 use hil_sim::pn::Command;
-use nanos::Nanos;
 
 const REV: i64 = 1 << 20;
 
-struct Rig {
-    ctl: PnController,
-    fb: ExampleFb,
-    i: FbInputs,
-    o: FbOutputs,
+/// The FB rig ([`FbRig`]) with this test's steps.
+struct Rig(FbRig);
+
+impl std::ops::Deref for Rig {
+    type Target = FbRig;
+    fn deref(&self) -> &FbRig {
+        &self.0
+    }
+}
+
+impl std::ops::DerefMut for Rig {
+    fn deref_mut(&mut self) -> &mut FbRig {
+        &mut self.0
+    }
 }
 
 impl Rig {
     fn new() -> Rig {
-        let ctl = PnController::connect(PnController::drive(), Nanos::from_ms(10), None).expect("connect");
-        let mut r = Rig {
-            ctl,
-            fb: ExampleFb::new(),
-            i: FbInputs::default(),
-            o: *ExampleFb::new().outputs(),
-        };
+        let mut r = Rig(FbRig::connect(PnController::drive()).expect("connect"));
         assert!(r.until(100, |o| o.identifier != 0), "a response telegram");
         r.i.operation_mode = OPMODE_POS;
         r.i.all_accelerations_positioning = 6000;
@@ -44,23 +47,11 @@ impl Rig {
     }
 
     fn cycle(&mut self) {
-        let t = self.fb.receive_telegram(&self.i);
-        let r = self.ctl.exchange(&t).expect("exchange").map(<[u8]>::to_vec);
-        if let (Some(r), true) = (r, self.ctl.fresh()) {
-            if let Ok(o) = self.fb.response(&r, self.i.drive_enable) {
-                self.o = *o;
-            }
-        }
+        self.0.cycle().expect("exchange");
     }
 
     fn until(&mut self, ms: u64, done: impl Fn(&FbOutputs) -> bool) -> bool {
-        for _ in 0..ms {
-            self.cycle();
-            if self.ctl.fresh() && done(&self.o) {
-                return true;
-            }
-        }
-        false
+        self.0.until(ms, done).expect("exchange")
     }
 
     fn wait(&mut self, ms: u64) {

@@ -5,6 +5,7 @@
 
 use super::controller::PnController;
 use super::{ExampleFb, FbInputs, FbOutputs};
+use crate::pcap::Recording;
 use crate::pn::PnSim;
 use nanos::Nanos;
 
@@ -22,7 +23,13 @@ pub struct FbRig {
 impl FbRig {
     /// `sim` connected at 10 ms (its start-up done), the FB at rest.
     pub fn connect(sim: PnSim) -> Result<FbRig, String> {
-        let ctl = PnController::connect(sim, Nanos::from_ms(10), None)?;
+        FbRig::recorded(sim, None)
+    }
+
+    /// [`connect`](Self::connect), every frame from the Connect on in
+    /// `pcap`.
+    pub fn recorded(sim: PnSim, pcap: Option<Recording>) -> Result<FbRig, String> {
+        let ctl = PnController::connect(sim, Nanos::from_ms(10), pcap)?;
         Ok(FbRig {
             ctl,
             fb: ExampleFb::new(),
