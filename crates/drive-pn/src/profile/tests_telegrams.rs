@@ -107,6 +107,20 @@ fn p058_p059_p060_entries_are_checked_as_they_are_entered() {
     assert_eq!(pkw2(&mut b, 0x42, 2020, 0, 8), (0xC2, 0x02), "no telegram 8");
 }
 
+/// A280's bytes as they stand.
+fn a280(b: &mut Bench) -> std::vec::Vec<u8> {
+    let mut buf = [0u8; 255];
+    let n = od::Dictionary::read(
+        b.d.objects_mut(),
+        drive_core::params::A280,
+        0,
+        &mut buf,
+        od::CommState::Op,
+    )
+    .unwrap();
+    buf[..n].to_vec()
+}
+
 /// A telegram set that does not check as a whole is refused at apply with
 /// 0x18 and its reason in PNU 2022, and nothing changes: receive telegram 0
 /// with CW1 moved off offset 2 (P-061) keeps working as it was, A280 keeps
@@ -114,18 +128,7 @@ fn p058_p059_p060_entries_are_checked_as_they_are_entered() {
 #[test]
 fn p061_p069_a_malformed_telegram_is_refused_at_apply_and_changes_nothing() {
     let mut b = Bench::new();
-    let a280_before = {
-        let mut buf = [0u8; 255];
-        let n = od::Dictionary::read(
-            b.d.objects_mut(),
-            drive_core::params::A280,
-            0,
-            &mut buf,
-            od::CommState::Op,
-        )
-        .unwrap();
-        buf[..n].to_vec()
-    };
+    let a280_before = a280(&mut b);
     assert_eq!(pkw2(&mut b, 0x42, 2020, 0, 0).0, 0x42, "receive telegram 0");
     // byte 1 the homing method, then the target position before CW1
     assert_eq!(pkw2(&mut b, 0x42, 2021, 1, entry(1001, 0)).0, 0x42);
@@ -136,18 +139,7 @@ fn p061_p069_a_malformed_telegram_is_refused_at_apply_and_changes_nothing() {
     assert_eq!(code, 0x41);
     assert_eq!(why & 0x00FF, 6, "CW1 not at offset 2: {why:#06x}");
     assert_eq!(why & 0x7000, 0, "receive telegram 0");
-    let a280_after = {
-        let mut buf = [0u8; 255];
-        let n = od::Dictionary::read(
-            b.d.objects_mut(),
-            drive_core::params::A280,
-            0,
-            &mut buf,
-            od::CommState::Op,
-        )
-        .unwrap();
-        buf[..n].to_vec()
-    };
+    let a280_after = a280(&mut b);
     assert_eq!(a280_after, a280_before, "A280 unchanged");
     // telegram 0 as before: CW1 at offset 2
     b.run(&super::positioning(0x0406, 0, 100, 10_000), 20);
