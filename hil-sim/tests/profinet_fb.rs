@@ -1,4 +1,5 @@
-//! The Example Function block's scenarios P-219…P-227 through profinet-py
+//! The Example Function block's scenarios P-219…P-227 (and P-206, the
+//! standard parameter record 0xB02E on the running AR) through profinet-py
 //! (PyPI, 0.6.6), an IO controller written by others, against `hil-sim
 //! serve --fieldbus profinet --control FIFO` (one drive with its motors)
 //! over a veth pair between two private network namespaces.
@@ -32,8 +33,8 @@ const SCRIPT_LIMIT: Duration = Duration::from_secs(150);
 /// The figure lines of this test (fb.py prints them so).
 const FIGURE: &str = "figure: P-2";
 /// The scenarios, each reported once.
-const SCENARIOS: [&str; 9] = [
-    "P-219", "P-220", "P-221", "P-222", "P-223", "P-224", "P-225", "P-226", "P-227",
+const SCENARIOS: [&str; 10] = [
+    "P-219", "P-220", "P-221", "P-222", "P-223", "P-224", "P-225", "P-226", "P-206", "P-227",
 ];
 
 /// The result word of a scenario line: `ok`, `FAIL` or `expected-fail`.
@@ -47,9 +48,10 @@ fn verdict(line: &str) -> Option<(&str, &str, &str)> {
 /// P-219…P-227: the Example Function block's scenarios (enable, operating
 /// modes, homing, positioning with appended records, relative, change
 /// immediately, intermediate stop and hold, speed and torque control, jog,
-/// PKW, fault and its reset) through profinet-py against serve.
+/// PKW with a unit change (P-208), the parameter record (P-206), fault and
+/// its reset) through profinet-py against serve.
 #[test]
-fn p219_p220_p221_p222_p223_p224_p225_p226_p227_the_example_function_block_through_profinet_py() {
+fn p206_p208_p219_p220_p221_p222_p223_p224_p225_p226_p227_the_example_function_block_through_profinet_py() {
     let python = match common::profinet_py_python() {
         Ok(p) => p,
         Err(why) => {

@@ -1,6 +1,6 @@
 """The Example Function block (spec profidrive.md §13, the manual's §2.5.1)
 as a Python model on profinet-py's cyclic exchange, and the scenarios
-P-219…P-227 through it against `hil-sim serve --fieldbus profinet`.
+P-219…P-227 (and P-206, the parameter record) through it against `hil-sim serve --fieldbus profinet`.
 
 The model (`ExampleFB`) takes the FB's inputs (§13.1: drive_enable,
 operation_mode, start_pos, …, pkw_*) and builds the 36-byte receive
@@ -41,6 +41,10 @@ from pnctl import Scenario, ms
 OPMODE_POS, OPMODE_VELO, OPMODE_TORQUE = 0x10, 0x08, 0x04
 RECEIVE_ID = {OPMODE_POS: 0xE0, OPMODE_VELO: 0xE1, OPMODE_TORQUE: 0xE2}
 PKW_NONE, PKW_READ, PKW_WRITE = 0x00, 0x41, 0x42
+# A279 PROFINET units: parameter_index(0, 279); element e at subindex e + 1
+A279 = 0x2000 + 279
+# the standard PROFIdrive parameter record (P-206)
+BMP_RECORD = 0xB02E
 TELEGRAM_BYTES = 36
 # ZSW1 & 0x47 states (spec §7.1)
 SOI, RTSO, SO, OP = 0x40, 0x01, 0x03, 0x07
@@ -612,6 +616,10 @@ def p225_jog(fb, sc):
     """jog_pos / jog_neg at jogging_velocity (changed while jogging); jog
     ignored during homing."""
     fb.i.operation_mode = OPMODE_POS
+    # jog is an edge: set while the mode is still changing, the bit is
+    # already on when positioning starts and is no edge (P-086), so the
+    # FB user waits for the mode first
+    fb.until(lambda o: o.operation_mode_actual == OPMODE_POS and o.drive_is_enabled, 3.0)
     fb.i.jogging_velocity = 300
     fb.i.jog_pos = True
     dt = fb.until(lambda o: abs(o.velocity_actual_value - 300) <= 6, 3.0)
@@ -662,6 +670,65 @@ def p226_pkw(fb, sc):
     access("read PNU 1007 (none)", PKW_READ, 1007, 0, (0xC1, 0x00))
     access("read PNU 1001.9 (no such subindex)", PKW_READ, 1001, 9, (0xC1, 0x03))
     access("write PNU 968 (read-only)", PKW_WRITE, 968, 0, (0xC2, 0x01), 0)
+    # P-208: A279 (0x2117) element 0 chooses the position unit: 0x0101 = degree with one decimal,
+    # so the 1 degree target window reads 10; 0x0003 (1/1000 rev) gives 3 again
+    access("write A279.0 = 0x0101 (0.1 degree)", PKW_WRITE, A279, 1, (PKW_WRITE, 0x0101), 0x0101)
+    access("read PNU 1271 in 0.1 degree", PKW_READ, 1271, 0, (PKW_READ, 10))
+    access("write A279.0 = 0x0003 (1/1000 rev)", PKW_WRITE, A279, 1, (PKW_WRITE, 0x0003), 0x0003)
+    access("read PNU 1271 in 1/1000 rev", PKW_READ, 1271, 0, (PKW_READ, 3))
+
+
+def bmp_read_request(ref, params):
+    """A PROFIdrive parameter request "request parameter" (0x01) for axis 1:
+    per parameter attribute value (0x10), one element, PNU and subindex."""
+    b = bytes([ref, 0x01, 0x01, len(params)])
+    for pnu, sub in params:
+        b += bytes([0x10, 1]) + pnu.to_bytes(2, "big") + sub.to_bytes(2, "big")
+    return b
+
+
+def bmp_value(fmt, count, value):
+    return bytes([fmt, count]) + value
+
+
+def p206_record(fb, sc, dev):
+    """The standard PROFIdrive parameter record 0xB02E on the running AR:
+    a read of two parameters, a change, an error block, and the refused
+    second read of one response."""
+    def exchange(what, request):
+        # profinet-py connects again before a record access once its last RPC is 10 s old, which
+        # replaces the running AR; the cyclic exchange keeps it alive, so say so
+        dev._rpc._live_monotonic = time.monotonic()
+        try:
+            dev.write(0, 1, BMP_RECORD, request)
+            return dev.read(0, 1, BMP_RECORD)
+        except Exception as e:  # noqa: BLE001 - reported as the check's failure
+            sc.check(False, f"{what}: {type(e).__name__}: {e}")
+            return None
+    r = exchange("read 1271 and 1004", bmp_read_request(0x31, [(1271, 0), (1004, 0)]))
+    want = bytes([0x31, 0x01, 0x01, 2]) + bmp_value(0x07, 1, (3).to_bytes(4, "big")) \
+        + bmp_value(0x06, 1, (1000).to_bytes(2, "big"))
+    sc.check(r == want, f"read PNU 1271 (UINT32 3) and 1004 (UINT16 1000): {r.hex() if r else r} "
+             f"(want {want.hex()})")
+    change = bytes([0x32, 0x02, 0x01, 1, 0x10, 1]) + (1004).to_bytes(2, "big") + bytes([0, 0]) \
+        + bmp_value(0x06, 1, (1500).to_bytes(2, "big"))
+    r = exchange("change PNU 1004", change)
+    p = fb.pkw(PKW_READ, 1004, 0)
+    sc.check(r == bytes([0x32, 0x02, 0x01, 1]) and p == (PKW_READ, 1500),
+             f"change PNU 1004 (override) to 1500: {r.hex() if r else r}, PKW reads {p}")
+    exchange("change PNU 1004 back", change[:-2] + (1000).to_bytes(2, "big"))
+    r = exchange("read PNU 999", bmp_read_request(0x33, [(999, 0)]))
+    want = bytes([0x33, 0x81, 0x01, 1, 0x44, 1, 0x00, 0x00])
+    sc.check(r == want, f"PNU 999: error block {r.hex() if r else r} (want {want.hex()}: error 0, no PNU)")
+    try:
+        dev._rpc._live_monotonic = time.monotonic()
+        again = dev.read(0, 1, BMP_RECORD)
+        sc.check(False, f"a second read of one response answers {again.hex()}")
+    except Exception as e:  # noqa: BLE001 - the refusal is what is wanted
+        sc.check(True, f"a second read of one response is refused ({type(e).__name__})")
+    sc.check(fb.o.drive_is_enabled and fb.o.identifier == 0xF0,
+             f"cyclic data went on throughout (enabled {fb.o.drive_is_enabled}, "
+             f"identifier {fb.o.identifier:#04x})")
 
 
 def p227_fault(fb, sc, fifo):
@@ -753,6 +820,7 @@ def main():
             ("P-224", p224_torque, ()),
             ("P-225", p225_jog, ()),
             ("P-226", p226_pkw, ()),
+            ("P-206", p206_record, (dev,)),
             ("P-227", p227_fault, (a.control,)),
         ]
         t_all = time.monotonic()
