@@ -551,6 +551,78 @@ fn e080_e081_e082_e084_sdo_info_lists_and_descriptions_match_the_dictionary() {
     });
 }
 
+/// E-083: A268 selects what the OD lists show: [0] index area (0 the
+/// standard area, 1 the manufacturer area 2000h…5FFFh and axis B's
+/// A000h…DFFFh, 2 all), [1] a bit per manufacturer group A…Z. Objects left
+/// out keep their descriptions; a value beyond the range is refused and
+/// changes nothing.
+#[test]
+fn e083_a268_selects_the_listed_objects() {
+    let sim = line(1);
+    let a268 = drive::parameter_index(0, 268);
+    with_master(&sim, async |md, clock| {
+        let group = init(md, clock).await;
+        let sd = group.subdevice(md, 0).unwrap();
+        let mut c = CoeClient::new();
+        let manufacturer = |i: &u16| matches!(i & 0x7FFF, 0x2000..=0x5FFF);
+        let all = c.od_list(&sd, 1).await;
+        assert!(all.iter().any(manufacturer) && all.iter().any(|i| !manufacturer(i)));
+        // standard area only
+        c.download(&sd, a268, 1, &[0]).await.unwrap();
+        let standard = c.od_list(&sd, 1).await;
+        assert_eq!(
+            standard,
+            all.iter()
+                .copied()
+                .filter(|i| !manufacturer(i))
+                .collect::<Vec<_>>()
+        );
+        let tx = c.od_list(&sd, 3).await;
+        assert!(
+            tx.contains(&0x6041) && !tx.iter().any(manufacturer),
+            "TxPDO list too"
+        );
+        let (_, d) = c.info(&sd, 1, &0u16.to_le_bytes()).await;
+        assert_eq!(
+            u16::from_le_bytes([d[2], d[3]]) as usize,
+            standard.len(),
+            "list lengths follow"
+        );
+        assert_eq!(
+            c.object_desc(&sd, a268).await.unwrap().name,
+            "SDO Info object selection",
+            "a left-out object keeps its description"
+        );
+        // manufacturer area, groups A (bit 0) and I (bit 8) only
+        c.download(&sd, a268, 1, &[1]).await.unwrap();
+        c.download(&sd, a268, 2, &0x0101u32.to_le_bytes()).await.unwrap();
+        let chosen = c.od_list(&sd, 1).await;
+        let in_a_or_i = |i: &u16| manufacturer(i) && matches!(((i & 0x7FFF) - 0x2000) >> 9, 0 | 8);
+        assert_eq!(chosen, all.iter().copied().filter(in_a_or_i).collect::<Vec<_>>());
+        assert!(chosen.contains(&a268) && chosen.contains(&drive::parameter_index(8, 22)));
+        // all, groups as chosen: the standard area again beside A and I
+        c.download(&sd, a268, 1, &[2]).await.unwrap();
+        let mixed = c.od_list(&sd, 1).await;
+        let want: Vec<u16> = all
+            .iter()
+            .copied()
+            .filter(|i| !manufacturer(i) || in_a_or_i(i))
+            .collect();
+        assert_eq!(mixed, want);
+        // out of range: refused, the selection unchanged
+        assert_eq!(
+            c.download(&sd, a268, 1, &[3]).await,
+            Err(0x0609_0031),
+            "value too high"
+        );
+        assert_eq!(c.od_list(&sd, 1).await, want);
+        c.download(&sd, a268, 2, &0x03FF_FFFFu32.to_le_bytes())
+            .await
+            .unwrap();
+        assert_eq!(c.od_list(&sd, 1).await, all, "the defaults list everything");
+    });
+}
+
 #[test]
 fn e012_e013_e079_manufacturer_array_in_both_templates() {
     let sim = line(1);

@@ -8,6 +8,9 @@ use crate::parameter_index;
 /// A00 "Save values": \[0\] start (sub 1), \[1\] progress (sub 2), \[2\] result (sub 3),
 /// in the SDO-Info numbering the runtime always uses.
 pub const A00: u16 = parameter_index(0, 0);
+/// A268 SDO Info object selection: sub 1 index area (0 standard, 1
+/// manufacturer, 2 all), sub 2 manufacturer groups (bit g = group A + g).
+pub const A268: u16 = parameter_index(0, 268);
 /// A254 station alias.
 pub const A254: u16 = parameter_index(0, 254);
 /// A255 device state (ESM state, +16 with an error).

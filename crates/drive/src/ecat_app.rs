@@ -105,6 +105,9 @@ impl<L: LiveValues> Dictionary for EcatApp<'_, L> {
     fn sdo_info_enabled(&self) -> bool {
         self.0.sdo_info_enabled()
     }
+    fn listed(&self, index: u16) -> bool {
+        self.0.listed(index)
+    }
 }
 
 impl<L: LiveValues> Application for EcatApp<'_, L> {

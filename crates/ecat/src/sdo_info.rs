@@ -256,7 +256,7 @@ fn next_listed<D: Dictionary>(dict: &D, list_type: u16, mut after: Option<u16>) 
         if after.is_some_and(|a| o.index <= a) {
             return None;
         }
-        if listed(o, list_type) {
+        if listed(o, list_type) && dict.listed(o.index) {
             return Some(o.index);
         }
         after = Some(o.index);

@@ -319,4 +319,11 @@ pub trait Dictionary {
     fn sdo_info_enabled(&self) -> bool {
         true
     }
+
+    /// Does the SDO Info OD list show object `index`? (A device's own
+    /// selection of the listed objects, e.g. the drive's A268; objects not
+    /// listed keep their descriptions and values.)
+    fn listed(&self, _index: u16) -> bool {
+        true
+    }
 }

@@ -510,6 +510,29 @@ impl Dictionary for DriveObjects {
     fn sdo_info_enabled(&self) -> bool {
         self.sdo_info()
     }
+
+    fn listed(&self, index: u16) -> bool {
+        let a268 = crate::params::A268;
+        sdo_info_selection(self.get(a268, 1), self.get(a268, 2), index)
+    }
+}
+
+/// E-083: is `index` in the SDO Info lists under A268 = (`area`, `groups`)?
+/// The manufacturer area is 2000h…5FFFh (axis A and the device) and
+/// A000h…DFFFh (axis B), group A at 2000h/A000h, 200h per group; everything
+/// else is the standard area. A value that cannot be read lists all.
+fn sdo_info_selection(area: Result<i64, SdoAbort>, groups: Result<i64, SdoAbort>, index: u16) -> bool {
+    let group = match index & 0x7FFF {
+        i @ 0x2000..=0x5FFF => Some((i - 0x2000) >> 9),
+        _ => None,
+    };
+    let in_groups = |g: u16| groups.map_or(true, |bits| bits >> g & 1 != 0);
+    match (area.unwrap_or(2), group) {
+        (0, g) => g.is_none(),
+        (1, None) => false,
+        (_, None) => true,
+        (_, Some(g)) => in_groups(g),
+    }
 }
 
 impl<L: LiveValues> Dictionary for WithLive<'_, L> {
@@ -535,5 +558,9 @@ impl<L: LiveValues> Dictionary for WithLive<'_, L> {
 
     fn sdo_info_enabled(&self) -> bool {
         self.objects.sdo_info_enabled()
+    }
+
+    fn listed(&self, index: u16) -> bool {
+        self.objects.listed(index)
     }
 }

@@ -465,7 +465,7 @@ pub const PARAMS: [Object; 77] = [
         ]
     )
     .level(2)
-    .note("A268; encoding assumed (0 standard, 1 manufacturer, 2 all; bit per group A…Z); not applied yet"),
+    .note("A268; encoding ours (0 standard area, 1 manufacturer area, 2 all; bit g of [1] lists group A + g, E-083); selects the SDO Info OD lists only"),
     // A270…A278: the PROFINET personality's operating parameters (spec
     // §2.4, P-007…P-019; lines ours). The EtherCAT personality declares and
     // stores them like every parameter and reads none of them.
