@@ -40,6 +40,10 @@ pub fn net_settings<F: store::Flash, B: store::Flash>(drive: &Drive<F, B>) -> Ne
             servers: s.sntp_servers,
         },
         tunnel_open: s.tunnel_open,
+        param_policy: net::param::Policy {
+            writes: s.udp_writes,
+            guard: Some(drive::params::A269),
+        },
     }
 }
 

@@ -11,7 +11,7 @@
 )]
 
 use drive::runtime::Drive;
-use drive_tests::{init, line, with_master};
+use drive_tests::{al_status, init, line, with_master, CoeClient};
 use ethercrab::SubDeviceRef;
 use hil_sim::eoe::{get_ip_request, set_ip_request, DriveNet, HostNet};
 use hil_sim::esc::{Esc, EscConfig};
@@ -85,8 +85,15 @@ fn e096_e095_ping_and_parameters_over_udp() {
             rtt > nanos::Nanos::ZERO && rtt < nanos::Nanos::from_ms(50),
             "rtt {rtt}"
         );
-        // parameters by coordinate
+        // parameters by coordinate; writes only once the master opens them
+        // with A269 over CoE (E-101, docs/eoe.md)
         assert_eq!(ask(&mut host, &sd, clock, "R A150").await, "OK 1000");
+        assert_eq!(ask(&mut host, &sd, clock, "W A150 2000").await, "ERR 06010000");
+        assert_eq!(ask(&mut host, &sd, clock, "W A269 1").await, "ERR 06010002");
+        let mut coe = CoeClient::new();
+        coe.hand_over(&sd).await;
+        coe.download(&sd, drive::params::A269, 0, &[1]).await.unwrap();
+        coe.hand_over(&sd).await;
         assert_eq!(ask(&mut host, &sd, clock, "W A150 2000").await, "OK");
         assert_eq!(ask(&mut host, &sd, clock, "R A150").await, "OK 2000");
         assert_eq!(ask(&mut host, &sd, clock, "M 2.E200[0]").await, "OK A8C8:01");
@@ -113,8 +120,73 @@ fn e096_e095_ping_and_parameters_over_udp() {
     let net = &d.net.as_ref().unwrap().stack;
     assert_eq!(net.ip(), Some((DRIVE_IP, 24)));
     assert_eq!(net.gateway(), Some(HOST_IP));
-    assert_eq!(net.stats().param_requests, 11);
+    assert_eq!(net.stats().param_requests, 13);
+    assert_eq!(net.stats().param_writes_refused, 2);
+    assert_eq!(net.stats().param_malformed, 1, "W A150 twenty");
     assert_eq!(d.drive.slave().eoe().params().ip, Some(DRIVE_IP));
+}
+
+/// E-101: a flood of parameter requests through the gateway is answered
+/// at the service's rate (a burst of 16, then 100 per second), the rest
+/// dropped and counted, oversized datagrams dropped unanswered; the drive
+/// stays in its state without an error and its mailbox keeps answering
+/// CoE; once the flood ends a request is answered again.
+#[test]
+fn e101_a_parameter_flood_is_rate_limited_and_the_drive_keeps_serving() {
+    let sim = sim_with_net();
+    with_master(&sim, async |md, clock| {
+        let group = init(md, clock).await;
+        let sd = group.subdevice(md, 0).unwrap();
+        let mut host = HostNet::new(
+            HOST_MAC,
+            &[(HOST_IP, 24)],
+            nanos::Nanos::from_ns(clock.load(Ordering::Relaxed)),
+        );
+        assert_eq!(set_ip(&mut host, &sd, clock).await, vec![0x03, 0x01, 0x00, 0x00]);
+        assert_eq!(ask(&mut host, &sd, clock, "R A150").await, "OK 1000");
+        let before = al_status(&sd).await;
+        let t0 = sim.borrow().now();
+        let (mut sent, mut answered) = (0u32, 0u32);
+        let big = "R A150 ".repeat(60);
+        for k in 0..400 {
+            for _ in 0..4 {
+                sent += u32::from(host.send_udp(DRIVE_IP, net::param::PARAM_PORT, b"R A150"));
+            }
+            if k % 50 == 0 {
+                sent += u32::from(host.send_udp(DRIVE_IP, net::param::PARAM_PORT, big.as_bytes()));
+            }
+            // 1 ms of the line per round: 400 ms of flood
+            let now = sim.borrow().now().as_ns();
+            sim.borrow_mut().catch_up(nanos::Nanos::from_ns(now + 1_000_000));
+            host.step(&sd, clock).await;
+            while let Some(a) = host.recv_udp() {
+                assert_eq!(a, b"OK 1000");
+                answered += 1;
+            }
+        }
+        let elapsed = sim.borrow().now().saturating_sub(t0);
+        let allowed = net::PARAM_BURST + (elapsed.as_ns() / net::PARAM_REFILL.as_ns()) as u32 + 1;
+        println!("figure: e101 flood: {sent} requests sent in {elapsed}, {answered} answered (the rate allows {allowed})");
+        assert!(sent > 4 * allowed, "a flood: {sent} sent");
+        assert!(
+            answered >= allowed / 2 && answered <= allowed,
+            "{answered} answered, {allowed} allowed: the rate, neither more nor starved"
+        );
+        assert_eq!(al_status(&sd).await, before, "AL state and code unchanged");
+        let mut coe = CoeClient::new();
+        coe.hand_over(&sd).await; // the mailbox answers CoE
+        coe.hand_over(&sd).await;
+        // the flood over, the service answers again
+        let now = sim.borrow().now().as_ns();
+        sim.borrow_mut()
+            .catch_up(nanos::Nanos::from_ns(now + 200_000_000));
+        while host.recv_udp().is_some() {}
+        assert_eq!(ask(&mut host, &sd, clock, "R A150").await, "OK 1000");
+    });
+    let s = sim.borrow();
+    let st = s.drives()[0].net.as_ref().unwrap().stack.stats();
+    assert!(st.param_limited > 0, "{st:?}");
+    assert!(st.param_malformed > 0, "the oversized datagrams: {st:?}");
 }
 
 #[test]
@@ -441,10 +513,20 @@ fn e105_e106_e102_sntp_over_eoe_in_simulated_time() {
             nanos::Nanos::from_ns(t0),
         );
         assert_eq!(set_ip(&mut host, &sd, clock).await, vec![0x03, 0x01, 0x00, 0x00]);
-        // A199: on, servers 10.0.0.1 and 10.0.0.2 (written over UDP)
-        for req in ["W A199[0] 1", "W A199[1] 0x0A000001", "W A199[2] 0x0A000002"] {
-            assert_eq!(ask(&mut host, &sd, clock, req).await, "OK", "{req}");
-        }
+        // A199: on, servers 10.0.0.1 and 10.0.0.2 (written by the master;
+        // the UDP service only reads while A269 = 0)
+        let a199 = drive::parameter_index(0, 199);
+        let mut coe = CoeClient::new();
+        coe.hand_over(&sd).await;
+        coe.download(&sd, a199, 1, &[1]).await.unwrap();
+        coe.download(&sd, a199, 2, &0x0A00_0001u32.to_le_bytes())
+            .await
+            .unwrap();
+        coe.download(&sd, a199, 3, &0x0A00_0002u32.to_le_bytes())
+            .await
+            .unwrap();
+        coe.hand_over(&sd).await;
+        assert_eq!(ask(&mut host, &sd, clock, "R A199[2]").await, "OK 167772162");
         // E-105: the first request 1..5 min after power-on, to server 1
         run_until(&sim, &mut host, &sd, clock, 310 * S, S, &|_| true, &mut seen, 9).await;
         assert_eq!(seen.len(), 1, "{seen:?}");

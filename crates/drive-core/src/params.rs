@@ -11,6 +11,8 @@ pub const A00: u16 = parameter_index(0, 0);
 /// A268 SDO Info object selection: sub 1 index area (0 standard, 1
 /// manufacturer, 2 all), sub 2 manufacturer groups (bit g = group A + g).
 pub const A268: u16 = parameter_index(0, 268);
+/// A269 UDP parameter writes (0 = the UDP parameter service only reads).
+pub const A269: u16 = parameter_index(0, 269);
 /// A254 station alias.
 pub const A254: u16 = parameter_index(0, 254);
 /// A255 device state (ESM state, +16 with an error).

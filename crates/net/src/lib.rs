@@ -20,4 +20,6 @@ pub mod stack;
 pub use device::QueueDevice;
 /// smoltcp, as this crate uses it (for the owner's `SocketStorage::EMPTY`).
 pub use smoltcp;
-pub use stack::{NetBuffers, NetConfig, NetSettings, NetStack, NetStats, SocketSlots, SOCKETS};
+pub use stack::{
+    NetBuffers, NetConfig, NetSettings, NetStack, NetStats, SocketSlots, PARAM_BURST, PARAM_REFILL, SOCKETS,
+};

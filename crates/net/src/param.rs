@@ -31,6 +31,34 @@ pub const MAX_MESSAGE: usize = 300;
 /// Largest value read (a longer string is refused with 0504 0005h).
 const MAX_VALUE: usize = 128;
 
+/// What the service may do (docs/eoe.md, "Who may write"). Reads always
+/// go through (with the dictionary's access level, A10\[2\]); writes only
+/// when the device allows them.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
+pub struct Policy {
+    /// Writes allowed (the drive's A269 = 1); off: every `W` is refused
+    /// with [`WRITES_OFF`] and nothing is written.
+    pub writes: bool,
+    /// An index the service never writes, whatever `writes` says (the
+    /// switch itself: only CoE opens the service), 0601 0002h.
+    pub guard: Option<u16>,
+}
+
+/// The abort a write gets while writes are off: 0601 0000h "unsupported
+/// access to an object" (the object may be writable, not through here).
+pub const WRITES_OFF: SdoAbort = SdoAbort(0x0601_0000);
+
+/// How a request was answered (the stack counts them).
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum Outcome {
+    /// Read, written or mapped, or refused by the dictionary with its abort.
+    Served,
+    /// Not a request (`ERR SYNTAX`).
+    Malformed,
+    /// A write refused by the [`Policy`].
+    WriteRefused,
+}
+
 /// A parameter coordinate.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
 pub struct Coordinate {
@@ -128,22 +156,32 @@ impl core::fmt::Write for Out<'_> {
     }
 }
 
-/// Handles one request and writes the answer into `out`; returns its
-/// length (0 only when `out` cannot hold even an error answer).
+/// Handles one request under `policy` and writes the answer into `out`;
+/// returns its length (0 only when `out` cannot hold even an error answer)
+/// and how it was answered.
 pub fn handle<D: Dictionary + ?Sized>(
     request: &[u8],
     out: &mut [u8],
     dict: &mut D,
     state: CommState,
-) -> usize {
+    policy: Policy,
+) -> (usize, Outcome) {
     let mut o = Out { buf: out, len: 0 };
-    let r = answer(request, &mut o, dict, state);
+    let r = answer(request, &mut o, dict, state, policy);
+    let mut outcome = Outcome::Served;
     let r = match r {
         Ok(()) => Ok(()),
         Err(e) => {
             o.len = 0;
             match e {
-                Error::Syntax => o.write_str("ERR SYNTAX"),
+                Error::Syntax => {
+                    outcome = Outcome::Malformed;
+                    o.write_str("ERR SYNTAX")
+                }
+                Error::Refused(a) => {
+                    outcome = Outcome::WriteRefused;
+                    write!(o, "ERR {:08X}", a.0)
+                }
                 Error::Abort(a) => write!(o, "ERR {:08X}", a.0),
             }
         }
@@ -151,15 +189,17 @@ pub fn handle<D: Dictionary + ?Sized>(
     if r.is_err() {
         o.len = 0;
         if o.write_str("ERR 05040005").is_err() {
-            return 0;
+            return (0, outcome);
         }
     }
-    o.len
+    (o.len, outcome)
 }
 
 enum Error {
     Syntax,
     Abort(SdoAbort),
+    /// A write the policy refuses.
+    Refused(SdoAbort),
 }
 
 impl From<SdoAbort> for Error {
@@ -179,6 +219,7 @@ fn answer<D: Dictionary + ?Sized>(
     o: &mut Out<'_>,
     dict: &mut D,
     state: CommState,
+    policy: Policy,
 ) -> Result<(), Error> {
     let text = core::str::from_utf8(request).map_err(|_| Error::Syntax)?;
     let text = text.trim_end_matches(['\r', '\n', '\0']);
@@ -198,6 +239,12 @@ fn answer<D: Dictionary + ?Sized>(
             format_value(o, ty, data)
         }
         "W" | "w" if !value.is_empty() => {
+            if policy.guard == Some(index) {
+                return Err(Error::Refused(SdoAbort::READ_ONLY));
+            }
+            if !policy.writes {
+                return Err(Error::Refused(WRITES_OFF));
+            }
             let mut buf = [0u8; MAX_VALUE];
             let n = encode_value(ty, value, &mut buf)?;
             let data = buf.get(..n).ok_or(Error::Abort(SdoAbort::OUT_OF_MEMORY))?;
@@ -318,10 +365,67 @@ mod tests {
     use drive::dictionary::DriveObjects;
     use std::string::String;
 
-    fn ask(d: &mut DriveObjects, req: &str, state: CommState) -> String {
+    const OPEN: Policy = Policy {
+        writes: true,
+        guard: None,
+    };
+
+    fn ask_with(d: &mut DriveObjects, req: &str, state: CommState, policy: Policy) -> (String, Outcome) {
         let mut out = [0u8; MAX_MESSAGE];
-        let n = handle(req.as_bytes(), &mut out, d, state);
-        String::from_utf8(out[..n].to_vec()).unwrap()
+        let (n, outcome) = handle(req.as_bytes(), &mut out, d, state, policy);
+        (String::from_utf8(out[..n].to_vec()).unwrap(), outcome)
+    }
+
+    fn ask(d: &mut DriveObjects, req: &str, state: CommState) -> String {
+        ask_with(d, req, state, OPEN).0
+    }
+
+    /// E-101 (the service DS6's role takes over the gateway): reads always,
+    /// writes only with the policy's consent, the guard never; a refused
+    /// write changes nothing and is told apart from a malformed request.
+    #[test]
+    fn e101_writes_only_when_the_policy_allows_and_never_the_guard() {
+        let mut d = DriveObjects::new();
+        let pre = CommState::PreOp;
+        let closed = Policy {
+            writes: false,
+            guard: Some(0x2000 + 269),
+        };
+        assert_eq!(
+            ask_with(&mut d, "R A150", pre, closed),
+            ("OK 1000".into(), Outcome::Served)
+        );
+        assert_eq!(
+            ask_with(&mut d, "W A150 2000", pre, closed),
+            ("ERR 06010000".into(), Outcome::WriteRefused)
+        );
+        assert_eq!(ask(&mut d, "R A150", pre), "OK 1000", "nothing written");
+        assert_eq!(
+            ask_with(&mut d, "W A150", pre, closed),
+            ("ERR SYNTAX".into(), Outcome::Malformed)
+        );
+        let open = Policy {
+            writes: true,
+            ..closed
+        };
+        assert_eq!(
+            ask_with(&mut d, "W A150 2000", pre, open),
+            ("OK".into(), Outcome::Served)
+        );
+        assert_eq!(ask(&mut d, "R A150", pre), "OK 2000");
+        // the switch itself: never through here, open or not
+        for p in [closed, open] {
+            assert_eq!(
+                ask_with(&mut d, "W A269 1", pre, p),
+                ("ERR 06010002".into(), Outcome::WriteRefused)
+            );
+        }
+        assert_eq!(ask(&mut d, "R A269", pre), "OK 0");
+        // a refused dictionary write is served (its abort), not a policy refusal
+        assert_eq!(
+            ask_with(&mut d, "W E50 XY", pre, open),
+            ("ERR 06010002".into(), Outcome::Served)
+        );
     }
 
     #[test]
@@ -388,7 +492,10 @@ mod tests {
             assert_eq!(ask(&mut d, bad, pre), "ERR SYNTAX", "{bad:?}");
         }
         let mut out = [0u8; MAX_MESSAGE];
-        assert_eq!(handle(&[0xFF, 0xFE], &mut out, &mut d, pre), 10);
+        assert_eq!(
+            handle(&[0xFF, 0xFE], &mut out, &mut d, pre, OPEN),
+            (10, Outcome::Malformed)
+        );
         assert_eq!(ask(&mut d, "R A166", pre), "OK 2");
         // a string
         assert_eq!(ask(&mut d, "R E50", pre), "OK SC6");
@@ -406,6 +513,6 @@ mod tests {
         );
         assert_eq!(sdo, SdoAbort::DEVICE_STATE);
         // an answer buffer too small
-        assert_eq!(handle(b"R A150", &mut [0u8; 4], &mut d, pre), 0);
+        assert_eq!(handle(b"R A150", &mut [0u8; 4], &mut d, pre, OPEN).0, 0);
     }
 }

@@ -86,6 +86,46 @@ pub struct NetSettings {
     /// (`ecat::eoe::EoeServer::master_active`). Until then the stack is
     /// dormant: no DHCP, nothing queued for the master (E-098).
     pub tunnel_open: bool,
+    /// What the UDP parameter service may do (A269).
+    pub param_policy: param::Policy,
+}
+
+/// Parameter requests taken at once before the rate applies.
+pub const PARAM_BURST: u32 = 16;
+/// One more request is taken per this time (100 per second): a flood
+/// cannot keep the mailbox task busy with dictionary accesses.
+pub const PARAM_REFILL: Nanos = Nanos::from_ms(10);
+
+/// The parameter service's rate limit: a token bucket of [`PARAM_BURST`]
+/// requests, refilled one per [`PARAM_REFILL`].
+#[derive(Debug, Clone, Copy)]
+struct Bucket {
+    tokens: u32,
+    /// Time the last token was added (`None`: never used, full).
+    at: Option<Nanos>,
+}
+
+impl Bucket {
+    const FULL: Bucket = Bucket {
+        tokens: PARAM_BURST,
+        at: None,
+    };
+
+    /// Takes one token at `now`; `false` when none is left.
+    fn take(&mut self, now: Nanos) -> bool {
+        let at = *self.at.get_or_insert(now);
+        let earned = now.saturating_sub(at).checked_div_span(PARAM_REFILL).unwrap_or(0);
+        if earned > 0 {
+            let earned32 = u32::try_from(earned).unwrap_or(u32::MAX);
+            self.tokens = self.tokens.saturating_add(earned32).min(PARAM_BURST);
+            self.at = Some(at.saturating_add(PARAM_REFILL.saturating_mul(earned)));
+        }
+        if self.tokens == 0 {
+            return false;
+        }
+        self.tokens -= 1;
+        true
+    }
 }
 
 /// Counters.
@@ -95,6 +135,14 @@ pub struct NetStats {
     pub param_requests: u32,
     /// Answers that could not be sent (buffer full).
     pub param_dropped: u32,
+    /// Requests that were not requests: answered `ERR SYNTAX`, or dropped
+    /// unanswered when longer than [`param::MAX_MESSAGE`].
+    pub param_malformed: u32,
+    /// Writes the policy refused (writes off, or the guard).
+    pub param_writes_refused: u32,
+    /// Requests dropped unanswered by the rate limit ([`PARAM_BURST`],
+    /// [`PARAM_REFILL`]).
+    pub param_limited: u32,
     /// SNTP packets not used (see [`sntp::Reject`]).
     pub sntp_rejected: u32,
 }
@@ -119,6 +167,7 @@ pub struct NetStack<'a> {
     /// The gateway in force as a default route.
     route: Option<Ipv4>,
     stats: NetStats,
+    param_bucket: Bucket,
 }
 
 /// smoltcp's time: whole µs (truncated, as the callers did before they passed [`Nanos`]).
@@ -186,6 +235,7 @@ impl<'a> NetStack<'a> {
             dhcp_gateway: None,
             route: None,
             stats: NetStats::default(),
+            param_bucket: Bucket::FULL,
         }
     }
 
@@ -339,35 +389,57 @@ impl<'a> NetStack<'a> {
         self.iface.poll(t, &mut QueueDevice(queue), &mut self.sockets);
         self.run_dhcp();
         self.follow_gateway(settings);
-        self.serve_parameters(dict, state);
+        self.serve_parameters(now, dict, state, settings.param_policy);
         self.run_sntp(now.as_us(), settings);
         self.iface.poll(t, &mut QueueDevice(queue), &mut self.sockets);
     }
 
-    fn serve_parameters<D: Dictionary + ?Sized>(&mut self, dict: &mut D, state: CommState) {
+    /// Answers the waiting parameter requests at `now` (docs/eoe.md): at
+    /// most [`PARAM_DATAGRAMS`] per poll and the rate of the bucket, the
+    /// rest dropped unanswered and counted; an oversized datagram is
+    /// dropped and counted as malformed.
+    fn serve_parameters<D: Dictionary + ?Sized>(
+        &mut self,
+        now: Nanos,
+        dict: &mut D,
+        state: CommState,
+        policy: param::Policy,
+    ) {
         let sock = self.sockets.get_mut::<udp::Socket>(self.param);
+        let stats = &mut self.stats;
         for _ in 0..PARAM_DATAGRAMS {
             if !sock.can_send() {
                 break;
             }
             let mut answer = [0u8; MAX_MESSAGE];
             let (n, to) = match sock.recv() {
-                Ok((data, meta)) if data.len() <= MAX_MESSAGE => {
-                    (param::handle(data, &mut answer, dict, state), meta.endpoint)
+                Ok(_) if !self.param_bucket.take(now) => {
+                    stats.param_limited = stats.param_limited.wrapping_add(1);
+                    continue;
                 }
-                Ok((_, meta)) => {
-                    let e = b"ERR SYNTAX";
-                    if let Some(dst) = answer.get_mut(..e.len()) {
-                        dst.copy_from_slice(e);
+                Ok((data, meta)) if data.len() <= MAX_MESSAGE => {
+                    let (n, outcome) = param::handle(data, &mut answer, dict, state, policy);
+                    match outcome {
+                        param::Outcome::Served => {}
+                        param::Outcome::Malformed => {
+                            stats.param_malformed = stats.param_malformed.wrapping_add(1);
+                        }
+                        param::Outcome::WriteRefused => {
+                            stats.param_writes_refused = stats.param_writes_refused.wrapping_add(1);
+                        }
                     }
-                    (e.len(), meta.endpoint)
+                    (n, meta.endpoint)
+                }
+                Ok(_) => {
+                    stats.param_malformed = stats.param_malformed.wrapping_add(1);
+                    continue;
                 }
                 Err(_) => break,
             };
-            self.stats.param_requests = self.stats.param_requests.wrapping_add(1);
+            stats.param_requests = stats.param_requests.wrapping_add(1);
             let out = answer.get(..n).unwrap_or_default();
             if sock.send_slice(out, to).is_err() {
-                self.stats.param_dropped = self.stats.param_dropped.wrapping_add(1);
+                stats.param_dropped = stats.param_dropped.wrapping_add(1);
             }
         }
     }
@@ -409,6 +481,24 @@ mod tests {
     #![allow(clippy::unwrap_used, clippy::indexing_slicing)]
     use super::*;
     use drive::dictionary::DriveObjects;
+
+    /// The parameter service's rate: a burst of 16, then one request per
+    /// 10 ms, never more than 16 saved up.
+    #[test]
+    fn e101_the_rate_limit_takes_a_burst_then_one_per_10_ms() {
+        let mut b = Bucket::FULL;
+        let t0 = Nanos::from_secs(3);
+        assert_eq!((0..20).filter(|_| b.take(t0)).count(), PARAM_BURST as usize);
+        assert!(!b.take(t0 + Nanos::from_ms(9)));
+        assert!(b.take(t0 + Nanos::from_ms(10)));
+        assert!(!b.take(t0 + Nanos::from_ms(19)));
+        // 1 s of flood at 1 per ms: 100 taken
+        let taken = (20..1020).filter(|ms| b.take(t0 + Nanos::from_ms(*ms))).count();
+        assert!((99..=101).contains(&taken), "{taken} in 1 s");
+        // a long pause saves up the burst, not more
+        let later = t0 + Nanos::from_secs(60);
+        assert_eq!((0..40).filter(|_| b.take(later)).count(), PARAM_BURST as usize);
+    }
 
     #[test]
     fn buffers_stay_small() {
@@ -458,6 +548,7 @@ mod tests {
                 servers: [[255, 255, 255, 255], [224, 0, 1, 1]],
             },
             tunnel_open: true,
+            param_policy: param::Policy::default(),
         };
         for t in [2, 400_000_000, 800_000_000] {
             net.poll(Nanos::from_us(t), &mut q, &mut d, CommState::PreOp, &s);

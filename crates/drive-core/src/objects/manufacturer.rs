@@ -162,7 +162,7 @@ const fn string(s: &str) -> DataType {
 }
 
 /// Global and axis-A manufacturer parameters, sorted by index.
-pub const PARAMS: [Object; 77] = [
+pub const PARAMS: [Object; 78] = [
     param_array!(a(0), "Save values", Record, Value::Ram, from ACTION)
         .note("A00; [0] = 1 requests saving (E-018); progress/result set by the store"),
     param_array!(a(9), "Restart", Record, Value::Ram, from ACTION)
@@ -466,6 +466,13 @@ pub const PARAMS: [Object; 77] = [
     )
     .level(2)
     .note("A268; encoding ours (0 standard area, 1 manufacturer area, 2 all; bit g of [1] lists group A + g, E-083); selects the SDO Info OD lists only"),
+    Object::var(
+        a(269),
+        Value::Ram,
+        entries![e(0, "UDP parameter writes", U8, RW).range(0, 1).saved()],
+    )
+    .level(1)
+    .note("A269 (line ours); 0 = the UDP parameter service only reads (default), 1 = it writes too; the service never writes A269 itself, so only CoE (the master) or the panel opens it (docs/eoe.md)"),
     // A270…A278: the PROFINET personality's operating parameters (spec
     // §2.4, P-007…P-019; lines ours). The EtherCAT personality declares and
     // stores them like every parameter and reads none of them.

@@ -18,6 +18,8 @@ pub struct IpSettings {
     /// The master has used EoE since the mailbox was set up: until then
     /// the IP stack stays dormant (E-098).
     pub tunnel_open: bool,
+    /// A269 = 1: the UDP parameter service may write.
+    pub udp_writes: bool,
 }
 
 impl<F: Flash, B: Flash> Drive<F, B> {
@@ -53,6 +55,7 @@ impl<F: Flash, B: Flash> Drive<F, B> {
             sntp_active: get(199, 1) != 0,
             sntp_servers: [ip(get(199, 2)), ip(get(199, 3))],
             tunnel_open: self.slave.eoe().master_active(),
+            udp_writes: get(269, 0) == 1,
         }
     }
 }
