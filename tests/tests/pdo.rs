@@ -90,6 +90,54 @@ fn e048_e049_e054_remap_in_preop_and_run_op_with_the_new_layout() {
     });
 }
 
+/// E-061: A250 (= 10F3h:04, BOOL) maps into the TxPDO: one bit beside the
+/// statusword, padded to the byte with a gap entry. It is 0 in Op until a
+/// diagnosis message arrives (here: a refused state request, E-144), then
+/// the master sees 1 cyclically without reading 10F3h; acknowledging the
+/// message clears it. A250 in the RxPDO is refused (0604 0041h).
+#[test]
+fn e061_a250_new_messages_flag_in_the_txpdo() {
+    let sim = line(1);
+    let a250 = drive::parameter_index(0, 250);
+    with_master(&sim, async |md, clock| {
+        let group = init(md, clock).await;
+        let sd = group.subdevice(md, 0).unwrap();
+        sd.sdo_write(0x1A00, 0, 0u8).await.expect("1A00h:00 = 0");
+        sd.sdo_write(0x1A00, 1, STATUSWORD).await.expect("1A00h:01");
+        sd.sdo_write(0x1A00, 2, m(a250, 0, 1))
+            .await
+            .expect("1A00h:02 = A250, 1 bit");
+        sd.sdo_write(0x1A00, 3, m(0, 0, 7))
+            .await
+            .expect("1A00h:03 = 7-bit gap");
+        sd.sdo_write(0x1A00, 0, 3u8).await.expect("1A00h:00 = 3");
+        assert!(
+            sd.sdo_write(0x1600, 2, m(a250, 0, 1)).await.is_err(),
+            "not RxPDO-mappable"
+        );
+        let (_, tx) = pdo_bytes(&sim).unwrap();
+        assert_eq!(tx, 3, "statusword + one byte");
+        let group = group.into_op(md).await.expect("PRE-OP -> OP");
+        let sd = group.subdevice(md, 0).unwrap();
+        let flag = async || {
+            for _ in 0..5 {
+                group.tx_rx(md).await.expect("cycle");
+            }
+            sd.io_raw().inputs()[2]
+        };
+        assert_eq!(flag().await, 0, "no new message");
+        // a refused request (Bootstrap from Op, 0011h) is a new message
+        drive_tests::request(&sd, drive_tests::al::BOOT).await;
+        for _ in 0..20 {
+            group.tx_rx(md).await.expect("cycle");
+        }
+        assert_eq!(flag().await, 1, "new message, seen in the process data");
+        let newest: u8 = sd.sdo_read(0x10F3, 2).await.expect("10F3h:02");
+        sd.sdo_write(0x10F3, 3, newest).await.expect("acknowledge");
+        assert_eq!(flag().await, 0, "acknowledged");
+    });
+}
+
 #[test]
 fn e058_mapping_refusals_0604_0041_0604_0042_0604_0043() {
     let sim = line(1);
