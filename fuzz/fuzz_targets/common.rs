@@ -27,9 +27,20 @@ pub fn apwr(sim: &mut Simulation, ado: u16, data: &[u8]) {
     sim.exchange(&mut f);
 }
 
+thread_local! {
+    /// [`build_preop_line`] once per process: each input starts from a copy.
+    static PREOP: Simulation = build_preop_line();
+}
+
+/// A one-slave line in PRE-OP: a copy of the one built once per process
+/// ([`Simulation::try_clone`]), so an input costs its own frames only.
+pub fn preop_line() -> Simulation {
+    PREOP.with(|s| s.try_clone()).unwrap_or_else(build_preop_line)
+}
+
 /// A one-slave line brought to PRE-OP the way a master does it: station
 /// address, mailbox SyncManagers from the SII defaults, AL control = 2.
-pub fn preop_line() -> Simulation {
+pub fn build_preop_line() -> Simulation {
     let mut sim = Simulation::new(1);
     apwr(&mut sim, esc::regs::STATION_ADDRESS, &0x1000u16.to_le_bytes());
     let sm0 = esc::SyncManager {
@@ -54,4 +65,13 @@ pub fn preop_line() -> Simulation {
     apwr(&mut sim, esc::regs::AL_CONTROL, &2u16.to_le_bytes());
     sim.advance_to(sim.now() + nanos::Nanos::from_ms(1));
     sim
+}
+
+/// The datagram data and working counter of a one-datagram frame built by
+/// [`frame`], after the exchange.
+#[allow(dead_code)] // the mailbox target's
+pub fn reply(f: &[u8]) -> (&[u8], u16) {
+    let len = usize::from(u16::from_le_bytes([f[22], f[23]]) & 0x07FF);
+    let data = &f[26..26 + len];
+    (data, u16::from_le_bytes([f[26 + len], f[27 + len]]))
 }

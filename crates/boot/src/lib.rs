@@ -276,7 +276,7 @@ struct Download {
 }
 
 /// The two firmware slots over a [`Flash`].
-#[derive(Debug)]
+#[derive(Clone, Debug)]
 pub struct BootSlots<F: Flash> {
     flash: F,
     /// The slot the running firmware started from.

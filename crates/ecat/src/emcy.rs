@@ -159,7 +159,7 @@ impl Emcy {
 
 /// Bounded FIFO of pending EMCYs (`N` ≥ 1). When full, [`EmcyQueue::push`] drops the
 /// oldest message and counts it in [`EmcyQueue::dropped`].
-#[derive(Debug)]
+#[derive(Clone, Debug)]
 pub struct EmcyQueue<const N: usize> {
     queue: Deque<Emcy, N>,
     dropped: u32,

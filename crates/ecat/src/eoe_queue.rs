@@ -26,6 +26,7 @@ pub struct QueueStats {
 }
 
 /// Receive and transmit queues between the slave's EoE server and an IP stack.
+#[derive(Clone)]
 pub struct EoeQueue {
     rx: Deque<Frame, QUEUE_FRAMES>,
     tx: Deque<Frame, QUEUE_FRAMES>,

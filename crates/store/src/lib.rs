@@ -130,7 +130,7 @@ fn le32(b: &[u8], at: usize) -> u32 {
 }
 
 /// The two-slot parameter store over a [`Flash`].
-#[derive(Debug)]
+#[derive(Clone, Debug)]
 pub struct ParamStore<F: Flash> {
     flash: F,
 }

@@ -159,6 +159,7 @@ pub enum Startup {
 
 /// One drive on the bus: slave stack + object dictionary + parameter store
 /// (+ the firmware slots on flash `B`, see [`Drive::with_boot`]).
+#[derive(Clone)]
 pub struct Drive<F: Flash, B: Flash = NoFlash> {
     /// The EtherCAT slave stack.
     slave: Slave,

@@ -161,6 +161,7 @@ type Failure = (u16, u8, SdoAbort);
 
 /// The CoE server: SDO transfers and SDO Information with the state that spans
 /// mailbox messages. One per slave; [`crate::Slave`] holds it.
+#[derive(Clone)]
 pub struct CoeServer {
     config: CoeConfig,
     transfer: Transfer,

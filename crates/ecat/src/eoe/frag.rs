@@ -22,6 +22,7 @@ pub enum FragmentError {
 }
 
 /// Reassembly of one Ethernet frame from EoE fragments into a fixed buffer.
+#[derive(Clone)]
 pub struct Reassembly {
     buf: [u8; MAX_FRAME],
     len: usize,
@@ -157,6 +158,7 @@ impl Reassembly {
 
 /// Fragmentation of one outgoing Ethernet frame into mailbox-sized EoE
 /// fragments (one per mailbox message).
+#[derive(Clone)]
 pub struct Fragmenter {
     buf: [u8; MAX_FRAME],
     len: usize,

@@ -234,6 +234,7 @@ pub struct EoeStats {
 }
 
 /// The EoE server of the slave: one port (port numbers are not checked).
+#[derive(Clone)]
 pub struct EoeServer {
     rx: Reassembly,
     tx: Fragmenter,

@@ -7,6 +7,7 @@ use super::*;
 
 /// Mailbox state: the SM areas as configured at I→P, the request buffer and the
 /// last (or pending) response.
+#[derive(Clone)]
 pub(super) struct Mailbox {
     pub(super) rx_start: u16,
     pub(super) rx_len: usize,

@@ -95,6 +95,7 @@ pub struct SyncStatus {
 }
 
 /// The EtherCAT slave stack (sans-IO). See the crate documentation.
+#[derive(Clone)]
 pub struct Slave {
     desc: &'static Device,
     state: AlState,
