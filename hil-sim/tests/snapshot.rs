@@ -31,7 +31,13 @@ fn send(sim: &mut Simulation, cmd: u8, adp: u16, ado: u16, data: &[u8]) -> Vec<u
 /// Station address 1000h, SM0/SM1 mailboxes at 1000h/1100h, PRE-OP.
 fn preop() -> Simulation {
     let mut sim = Simulation::new(1);
-    send(&mut sim, 2, 0, esc::regs::STATION_ADDRESS, &0x1000u16.to_le_bytes());
+    send(
+        &mut sim,
+        2,
+        0,
+        esc::regs::STATION_ADDRESS,
+        &0x1000u16.to_le_bytes(),
+    );
     let sm = |start, control| esc::SyncManager {
         start,
         length: 256,
@@ -70,7 +76,10 @@ fn sim_snapshot_answers_like_the_line_it_was_copied_from() {
     let mut copy = line.try_clone().expect("no IP stack, no capture");
     assert_eq!(copy.now(), line.now());
     // the same requests, the same answers, frame for frame
-    for (k, (index, sub)) in [(0x1018, 1), (0x6041, 0), (0x1000, 0), (0x5000, 0)].into_iter().enumerate() {
+    for (k, (index, sub)) in [(0x1018, 1), (0x6041, 0), (0x1000, 0), (0x5000, 0)]
+        .into_iter()
+        .enumerate()
+    {
         let counter = k as u8 % 7 + 1;
         let a = upload(&mut line, counter, index, sub);
         let b = upload(&mut copy, counter, index, sub);
