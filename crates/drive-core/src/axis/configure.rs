@@ -51,7 +51,7 @@ impl Axis {
         }
 
         // cascade: torque limits from 6072h (homing: I28), gains adapted to A150
-        let per_mille = if self.running == Running::Homing {
+        let per_mille = if matches!(self.running, Running::Homing) {
             o.max_torque.min(p.homing_torque_limit_per_mille)
         } else {
             o.max_torque

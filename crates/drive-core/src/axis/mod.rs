@@ -521,7 +521,7 @@ impl Axis {
         let i199 = is_standstill(self.velocity, self.params.velocity_window_inc_per_s);
 
         // limits first: the lock of this cycle filters the set-points
-        let homing_active = self.running == Running::Homing;
+        let homing_active = matches!(self.running, Running::Homing);
         let status = self.limits.update(&LimitInput {
             actual_position_inc: actual,
             position_setpoint_inc: self.sp_pos,
@@ -630,7 +630,7 @@ impl Axis {
 
     /// The limits asked for a quick stop without a fault (jog, I26 = 0).
     fn local_quick_stop(&mut self, o: &Snapshot) {
-        if self.running != Running::Idle && self.stop.is_none() {
+        if !matches!(self.running, Running::Idle) && self.stop.is_none() {
             let _ = self.profile.stop(o.quick_stop_deceleration as f32, f32::INFINITY);
             if let Some(c) = self.running.velocity_command() {
                 c.commanded = Some(0.0);
@@ -679,7 +679,7 @@ impl Axis {
             return Some(Demand::hold(self.sp_pos));
         }
         let mode = self.dc.mode();
-        if self.running.mode() != Some(mode) {
+        if !self.running.is(mode) {
             self.activate(mode, o, *actual);
         }
         let halt = matches!(out.ramp, Ramp::Halt(_));
