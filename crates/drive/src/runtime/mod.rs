@@ -92,6 +92,7 @@ use store::{Flash, ParamStore, StoreError};
 
 /// The DC-Sync crate (PLL, A298/A261 types), re-exported for the firmware and tests.
 pub use dcsync;
+use dcsync::CycleSequence;
 pub use dcsync::{CycleCommand, FrameTiming, Pll, Step, SyncError};
 
 use crate::params::{
@@ -672,9 +673,9 @@ impl<F: Flash, B: Flash> Drive<F, B> {
     }
 
     /// One control cycle under the PLL (E-111, E-112), started by
-    /// [`cycle_start`](Self::cycle_start) which returned `cmd`: runs
-    /// [`CycleCommand::steps`] in their A149 order — Rx (decode the RxPDO
-    /// frame the last poll read from SM2; Op only), the application
+    /// [`cycle_start`](Self::cycle_start) which returned `cmd`: runs the
+    /// steps [`CycleCommand::steps`] lists, in their A149 order — Rx
+    /// (decode the RxPDO frame the last poll read from SM2; Op only), the application
     /// ([`control_cycle_with`](Self::control_cycle_with)), Tx (encode the
     /// TxPDO image the next poll copies to SM3; Safe-Op and Op) — with Rx and
     /// Tx only in the aligned cycle (`index == 0`): A149 = 0 sends this
@@ -685,17 +686,25 @@ impl<F: Flash, B: Flash> Drive<F, B> {
     /// [`control_cycle`](Self::control_cycle)).
     pub fn sync_cycle(&mut self, cmd: &CycleCommand, now: Nanos, io: &[AxisIo; 2]) -> [AxisCommand; 2] {
         self.cycle_pdo = self.pll.is_some();
-        let mut commands = [AxisCommand::OFF; 2];
         let mut new = self.slave.state() != AlState::Op;
-        for step in cmd.steps().into_iter().flatten() {
-            match step {
-                Step::ReadOutputs => {
-                    new |= self.read_outputs();
-                    self.ctl_rx_frames = self.slave.outputs_received();
-                }
-                Step::Application => commands = self.control_cycle_with(now, io, [new, new]),
-                Step::WriteInputs => self.process_inputs(),
-            }
+        // A149's two orders run directly (Rx first in both; Tx before or
+        // after the application), not through `CycleCommand::steps` and a
+        // match per step (~90 instructions per cycle less)
+        if cmd.rx {
+            new |= self.read_outputs();
+            self.ctl_rx_frames = self.slave.outputs_received();
+        }
+        // (exhaustive: a new order must be written out here)
+        let tx_first = match cmd.sequence {
+            CycleSequence::RxAppTx => false,
+            CycleSequence::RxTxApp => true,
+        };
+        if cmd.tx && tx_first {
+            self.process_inputs();
+        }
+        let commands = self.control_cycle_with(now, io, [new, new]);
+        if cmd.tx && !tx_first {
+            self.process_inputs();
         }
         commands
     }
