@@ -18,7 +18,7 @@ impl Axis {
             slots.rated_current,
             round_i32(p.rated_torque_nm * 1000.0).max(0) as u32,
         );
-        self.probe_shown = None;
+        self.probe_shown = false;
         let opts = self.dc.options_mut();
         if let Ok(q) = QuickStopOption::try_from(o.quick_stop_option) {
             opts.quick_stop = q;

@@ -215,10 +215,11 @@ pub struct Axis {
     /// the cycle and the mode class (homing, jog, other); it runs again
     /// only when one of them (or the parameters) changed.
     configured: Option<(u32, u32, u8)>,
-    /// The touch-probe values (60BAh – 60BDh, increments) last written to
-    /// the objects; they are converted and written again only when one
-    /// changed or the configuration did (`None`).
-    probe_shown: Option<[i32; 4]>,
+    /// The objects show the touch-probe values (60BAh – 60BDh): cleared
+    /// when a probe stores a value or the configuration changed, they are
+    /// then converted and written again (no compare of the four values
+    /// per cycle).
+    probe_shown: bool,
     /// Filtered actual velocity, inc/s (user coordinates).
     velocity: f32,
     /// Last cycle's actual position sample (user coordinates).
@@ -298,7 +299,7 @@ impl Axis {
             vinterp: None,
             interp_key: None,
             configured: None,
-            probe_shown: None,
+            probe_shown: false,
             profile: ProfileGenerator::new(0),
             cascade: Cascade::new(params.cascade, 0)
                 .or_else(|_| Cascade::new(CascadeConfig::DEFAULT, 0))
