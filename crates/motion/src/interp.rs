@@ -367,6 +367,13 @@ impl FineInterpolator {
         let master_s = self.config.ratio.master_ns() as f32 * 1e-9;
         let t = k_steps as f32 / n_steps as f32;
         let (velocity, acceleration) = match self.config.feedforward {
+            // a straight segment (constant velocity, ∇² = ∇³ = 0): the
+            // polynomial's derivative is ∇¹ and its second derivative 0
+            // exactly (what the general path gives, master_s > 0), without
+            // its float conversions and products
+            FeedforwardSource::Internal if self.d2 == 0 && self.d3 == 0 => {
+                (float::from_i64(self.d1) / master_s, 0.0)
+            }
             FeedforwardSource::Internal => {
                 // dx/dt in increments per master cycle, then per second.
                 let d1 = float::from_i64(self.d1);

@@ -121,25 +121,42 @@ impl AxisScaling {
     /// Whether user units equal increments (num = den, polarity normal): the
     /// conversions are then the identity, without the 128-bit division
     /// (a few hundred instructions on a Cortex-M each).
+    #[inline]
     fn is_identity(&self) -> bool {
         self.identity
     }
 
     /// Increments → user units (rounded to the nearest unit).
+    ///
+    /// Inline for the identity (the control cycle converts its actual
+    /// values every cycle); the fraction is out of line.
+    #[inline]
     pub fn to_user(&self, increments: i64) -> Result<i64, ScalingError> {
         if self.is_identity() {
             return Ok(increments);
         }
+        self.scaled_user(increments)
+    }
+
+    #[inline(never)]
+    fn scaled_user(&self, increments: i64) -> Result<i64, ScalingError> {
         let (num, den) = self.ratio();
         let u = div_round(self.sign() * i128::from(increments) * num, den);
         i64::try_from(u).map_err(|_| ScalingError::Overflow)
     }
 
-    /// User units → increments (rounded to the nearest increment).
+    /// User units → increments (rounded to the nearest increment); inline
+    /// for the identity like [`to_user`](Self::to_user).
+    #[inline]
     pub fn to_increments(&self, user: i64) -> Result<i64, ScalingError> {
         if self.is_identity() {
             return Ok(user);
         }
+        self.scaled_increments(user)
+    }
+
+    #[inline(never)]
+    fn scaled_increments(&self, user: i64) -> Result<i64, ScalingError> {
         let (num, den) = self.ratio();
         let inc = div_round(self.sign() * i128::from(user) * den, num);
         i64::try_from(inc).map_err(|_| ScalingError::Overflow)
@@ -153,6 +170,7 @@ impl AxisScaling {
 
     /// Velocity (or acceleration, jerk) in increments/s (/s², /s³) → user
     /// units/s (/s², /s³).
+    #[inline]
     pub fn velocity_to_user(&self, increments_per_s: f32) -> f32 {
         if self.is_identity() {
             return increments_per_s;

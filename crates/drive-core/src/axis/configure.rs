@@ -18,7 +18,7 @@ impl Axis {
             slots.rated_current,
             round_i32(p.rated_torque_nm * 1000.0).max(0) as u32,
         );
-        self.probe_shown = None;
+        self.probe_shown = false;
         let opts = self.dc.options_mut();
         if let Ok(q) = QuickStopOption::try_from(o.quick_stop_option) {
             opts.quick_stop = q;
@@ -51,7 +51,7 @@ impl Axis {
         }
 
         // cascade: torque limits from 6072h (homing: I28), gains adapted to A150
-        let per_mille = if self.running == Running::Homing {
+        let per_mille = if matches!(self.running, Running::Homing) {
             o.max_torque.min(p.homing_torque_limit_per_mille)
         } else {
             o.max_torque

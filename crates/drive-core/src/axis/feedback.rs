@@ -80,15 +80,24 @@ impl Axis {
             let e = if edge.rising { Edge::Rising } else { Edge::Falling };
             let input = i16::from(edge.input);
             if input == src1 {
-                self.probe.latch(TriggerSignal::Input1, e, position);
+                self.latch_probe(TriggerSignal::Input1, e, position);
             }
             if input == src2 {
-                self.probe.latch(TriggerSignal::Input2, e, position);
+                self.latch_probe(TriggerSignal::Input2, e, position);
             }
         }
         if let Some(index) = io.index {
             let p = self.to_user(index.position_inc, o.polarity);
-            self.probe.latch(TriggerSignal::IndexPulse, Edge::Rising, p);
+            self.latch_probe(TriggerSignal::IndexPulse, Edge::Rising, p);
+        }
+    }
+
+    /// One edge to the touch probe; a stored value is written to the
+    /// objects by the write-back of this cycle.
+    fn latch_probe(&mut self, signal: TriggerSignal, edge: Edge, position: i32) {
+        let (one, two) = self.probe.latch(signal, edge, position);
+        if one || two {
+            self.probe_shown = false;
         }
     }
 }

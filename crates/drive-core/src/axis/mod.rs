@@ -215,10 +215,11 @@ pub struct Axis {
     /// the cycle and the mode class (homing, jog, other); it runs again
     /// only when one of them (or the parameters) changed.
     configured: Option<(u32, u32, u8)>,
-    /// The touch-probe values (60BAh – 60BDh, increments) last written to
-    /// the objects; they are converted and written again only when one
-    /// changed or the configuration did (`None`).
-    probe_shown: Option<[i32; 4]>,
+    /// The objects show the touch-probe values (60BAh – 60BDh): cleared
+    /// when a probe stores a value or the configuration changed, they are
+    /// then converted and written again (no compare of the four values
+    /// per cycle).
+    probe_shown: bool,
     /// Filtered actual velocity, inc/s (user coordinates).
     velocity: f32,
     /// Last cycle's actual position sample (user coordinates).
@@ -298,7 +299,7 @@ impl Axis {
             vinterp: None,
             interp_key: None,
             configured: None,
-            probe_shown: None,
+            probe_shown: false,
             profile: ProfileGenerator::new(0),
             cascade: Cascade::new(params.cascade, 0)
                 .or_else(|_| Cascade::new(CascadeConfig::DEFAULT, 0))
@@ -521,7 +522,7 @@ impl Axis {
         let i199 = is_standstill(self.velocity, self.params.velocity_window_inc_per_s);
 
         // limits first: the lock of this cycle filters the set-points
-        let homing_active = self.running == Running::Homing;
+        let homing_active = matches!(self.running, Running::Homing);
         let status = self.limits.update(&LimitInput {
             actual_position_inc: actual,
             position_setpoint_inc: self.sp_pos,
@@ -630,7 +631,7 @@ impl Axis {
 
     /// The limits asked for a quick stop without a fault (jog, I26 = 0).
     fn local_quick_stop(&mut self, o: &Snapshot) {
-        if self.running != Running::Idle && self.stop.is_none() {
+        if !matches!(self.running, Running::Idle) && self.stop.is_none() {
             let _ = self.profile.stop(o.quick_stop_deceleration as f32, f32::INFINITY);
             if let Some(c) = self.running.velocity_command() {
                 c.commanded = Some(0.0);
@@ -679,7 +680,7 @@ impl Axis {
             return Some(Demand::hold(self.sp_pos));
         }
         let mode = self.dc.mode();
-        if self.running.mode() != Some(mode) {
+        if !self.running.is(mode) {
             self.activate(mode, o, *actual);
         }
         let halt = matches!(out.ramp, Ramp::Halt(_));

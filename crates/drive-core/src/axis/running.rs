@@ -87,6 +87,19 @@ impl Running {
         })
     }
 
+    /// Whether `mode` is the running mode (`mode() == Some(mode)`), the
+    /// cyclic modes a master drives every cycle checked first by pattern.
+    #[inline]
+    pub(super) fn is(&self, mode: Mode) -> bool {
+        match (self, mode) {
+            (Running::CyclicPosition { ip: false, .. }, Mode::CyclicPosition)
+            | (Running::CyclicPosition { ip: true, .. }, Mode::InterpolatedPosition)
+            | (Running::CyclicVelocity, Mode::CyclicVelocity)
+            | (Running::CyclicTorque, Mode::CyclicTorque) => true,
+            _ => self.mode() == Some(mode),
+        }
+    }
+
     /// The velocity command of pv, vl and jog, if one of them runs.
     pub(super) fn velocity_command(&mut self) -> Option<&mut VelocityCommand> {
         match self {

@@ -48,22 +48,17 @@ impl Axis {
         od.write_typed(c.current, t);
         od.write_typed(c.following_error, sat_i32(self.user(fe)));
         od.write_typed(c.probe_status, self.probe.status());
-        let probe = [
-            self.probe.value_60ba(),
-            self.probe.value_60bb(),
-            self.probe.value_60bc(),
-            self.probe.value_60bd(),
-        ];
-        // compared word by word (a compare of the arrays becomes a byte-wise
-        // memcmp call)
-        let shown = self
-            .probe_shown
-            .is_some_and(|p| p.iter().zip(probe).fold(0, |d, (a, b)| d | (a ^ b)) == 0);
-        if !shown {
+        if !self.probe_shown {
+            let probe = [
+                self.probe.value_60ba(),
+                self.probe.value_60bb(),
+                self.probe.value_60bc(),
+                self.probe.value_60bd(),
+            ];
             for (slot, value) in c.probe_values.into_iter().zip(probe) {
                 od.write_typed(slot, sat_i32(self.user_position(value)));
             }
-            self.probe_shown = Some(probe);
+            self.probe_shown = true;
         }
         od.write_typed(c.additional_position, sat_i32(position));
         let rpm = |v: f32| round_i32(v / RPM_TO_INC_PER_S).clamp(-32768, 32767) as i16;

@@ -92,6 +92,7 @@ use store::{Flash, ParamStore, StoreError};
 
 /// The DC-Sync crate (PLL, A298/A261 types), re-exported for the firmware and tests.
 pub use dcsync;
+use dcsync::CycleSequence;
 pub use dcsync::{CycleCommand, FrameTiming, Pll, Step, SyncError};
 
 use crate::params::{
@@ -657,40 +658,25 @@ impl<F: Flash, B: Flash> Drive<F, B> {
         io: &[AxisIo; 2],
         new_setpoint: [bool; 2],
     ) -> [AxisCommand; 2] {
-        let mut commands = [AxisCommand::OFF; 2];
-        let mut register = 0u8;
-        let axes = self.axes.iter_mut().zip(self.axis_caches.iter_mut());
-        let axes = axes.zip(io).zip(new_setpoint);
-        let sent = self.event52_emcy_sent.iter_mut();
-        for (((((axis, cache), io), new), command), sent) in axes.zip(commands.iter_mut()).zip(sent) {
-            let report = axis.cycle_cached(cache, &mut self.objects, io, now, new);
-            let mut fault = report.fault;
-            if report.transition.is_some_and(|t| t.number == 13) {
-                // the event 52 EMCY is already queued (once for the device)
-                if core::mem::take(sent) && fault.is_some_and(|f| is_event52(&f)) {
-                    fault = None;
-                }
-            }
-            if let Some(f) = fault {
-                self.slave.emergency(crate::emcy::of_change(&f, axis.index()));
-                let (e82, e43) = match f {
-                    FaultChange::Raised(f) => (f.event, f.cause),
-                    FaultChange::Cleared => (crate::emcy::E82_INACTIVE, 0),
-                };
-                let _ = self.objects.set(E82, 0, i64::from(e82));
-                let _ = self.objects.set(E43, 0, i64::from(e43));
-            }
-            register |= axis.error_register();
-            *command = report.command;
-        }
+        // the two axes one after the other, without zipped iterators over
+        // six arrays (~20 instructions per cycle less)
+        let [axis_a, axis_b] = &mut self.axes;
+        let [cache_a, cache_b] = &mut self.axis_caches;
+        let [sent_a, sent_b] = &mut self.event52_emcy_sent;
+        let [io_a, io_b] = io;
+        let [new_a, new_b] = new_setpoint;
+        let (objects, slave) = (&mut self.objects, &mut self.slave);
+        let a = axis_cycle(axis_a, cache_a, sent_a, objects, slave, io_a, now, new_a);
+        let b = axis_cycle(axis_b, cache_b, sent_b, objects, slave, io_b, now, new_b);
+        let register = axis_a.error_register() | axis_b.error_register();
         write_slot(&mut self.objects, self.slots.error_register, i64::from(register));
-        commands
+        [a, b]
     }
 
     /// One control cycle under the PLL (E-111, E-112), started by
-    /// [`cycle_start`](Self::cycle_start) which returned `cmd`: runs
-    /// [`CycleCommand::steps`] in their A149 order — Rx (decode the RxPDO
-    /// frame the last poll read from SM2; Op only), the application
+    /// [`cycle_start`](Self::cycle_start) which returned `cmd`: runs the
+    /// steps [`CycleCommand::steps`] lists, in their A149 order — Rx
+    /// (decode the RxPDO frame the last poll read from SM2; Op only), the application
     /// ([`control_cycle_with`](Self::control_cycle_with)), Tx (encode the
     /// TxPDO image the next poll copies to SM3; Safe-Op and Op) — with Rx and
     /// Tx only in the aligned cycle (`index == 0`): A149 = 0 sends this
@@ -701,17 +687,25 @@ impl<F: Flash, B: Flash> Drive<F, B> {
     /// [`control_cycle`](Self::control_cycle)).
     pub fn sync_cycle(&mut self, cmd: &CycleCommand, now: Nanos, io: &[AxisIo; 2]) -> [AxisCommand; 2] {
         self.cycle_pdo = self.pll.is_some();
-        let mut commands = [AxisCommand::OFF; 2];
         let mut new = self.slave.state() != AlState::Op;
-        for step in cmd.steps().into_iter().flatten() {
-            match step {
-                Step::ReadOutputs => {
-                    new |= self.read_outputs();
-                    self.ctl_rx_frames = self.slave.outputs_received();
-                }
-                Step::Application => commands = self.control_cycle_with(now, io, [new, new]),
-                Step::WriteInputs => self.process_inputs(),
-            }
+        // A149's two orders run directly (Rx first in both; Tx before or
+        // after the application), not through `CycleCommand::steps` and a
+        // match per step (~90 instructions per cycle less)
+        if cmd.rx {
+            new |= self.read_outputs();
+            self.ctl_rx_frames = self.slave.outputs_received();
+        }
+        // (exhaustive: a new order must be written out here)
+        let tx_first = match cmd.sequence {
+            CycleSequence::RxAppTx => false,
+            CycleSequence::RxTxApp => true,
+        };
+        if cmd.tx && tx_first {
+            self.process_inputs();
+        }
+        let commands = self.control_cycle_with(now, io, [new, new]);
+        if cmd.tx && !tx_first {
+            self.process_inputs();
         }
         commands
     }
@@ -746,6 +740,40 @@ impl<F: Flash, B: Flash> Drive<F, B> {
             self.update_a257_texts();
         }
     }
+}
+
+/// One axis of [`Drive::control_cycle_with`]: its cycle, the EMCY of a
+/// fault change (the event 52 EMCY only once for the device) with E82/E43;
+/// returns the power-stage command.
+#[allow(clippy::too_many_arguments)]
+fn axis_cycle(
+    axis: &mut Axis,
+    cache: &mut AxisCache,
+    sent: &mut bool,
+    objects: &mut DriveObjects,
+    slave: &mut Slave,
+    io: &AxisIo,
+    now: Nanos,
+    new: bool,
+) -> AxisCommand {
+    let report = axis.cycle_cached(cache, objects, io, now, new);
+    let mut fault = report.fault;
+    if report.transition.is_some_and(|t| t.number == 13) {
+        // the event 52 EMCY is already queued (once for the device)
+        if core::mem::take(sent) && fault.is_some_and(|f| is_event52(&f)) {
+            fault = None;
+        }
+    }
+    if let Some(f) = fault {
+        slave.emergency(crate::emcy::of_change(&f, axis.index()));
+        let (e82, e43) = match f {
+            FaultChange::Raised(f) => (f.event, f.cause),
+            FaultChange::Cleared => (crate::emcy::E82_INACTIVE, 0),
+        };
+        let _ = objects.set(E82, 0, i64::from(e82));
+        let _ = objects.set(E43, 0, i64::from(e43));
+    }
+    report.command
 }
 
 #[cfg(test)]

@@ -229,6 +229,63 @@ fn c119_internal_feedforward_from_setpoints() {
     }
 }
 
+/// The feedforward of the general polynomial (the path before the
+/// straight-segment shortcut), from the interpolator's differences.
+fn general_feedforward(ip: &FineInterpolator) -> (f32, f32) {
+    let master_s = ip.config.ratio.master_ns() as f32 * 1e-9;
+    let t = ip.k as f32 / ip.config.ratio.n() as f32;
+    let d1 = float::from_i64(ip.d1);
+    let d2 = float::from_i64(ip.d2);
+    let d3 = float::from_i64(ip.d3);
+    let v = d1 + (2.0 * t - 1.0) * 0.5 * d2 + (3.0 * t * t - 1.0) / 6.0 * d3;
+    let a = d2 + t * d3;
+    (
+        v / master_s * (ip.config.velocity_feedforward_percent * 0.01),
+        a / (master_s * master_s),
+    )
+}
+
+#[test]
+fn c119_internal_feedforward_unchanged_on_straight_segment() {
+    // constant velocity (straight segments) and then a ramp (not straight),
+    // every order, N = 1, 3, 8, I25 = 100 % and 40 %: the output equals
+    // the general polynomial's bit for bit
+    for order in ORDERS {
+        for n in [1, 3, 8] {
+            for weight in [100.0, 40.0] {
+                let mut c = config(order, n);
+                c.velocity_feedforward_percent = weight;
+                let mut ip = FineInterpolator::new(c).unwrap();
+                ip.start(-5_000);
+                let (mut pos, mut straight) = (-5_000i32, 0);
+                for m in 1..=40i32 {
+                    pos += if m <= 20 { 1_234 } else { 1_234 + 50 * (m - 20) };
+                    for k in 0..n {
+                        let out = ip.cycle(if k == 0 { sp(pos) } else { None }).unwrap();
+                        let (v, a) = general_feedforward(&ip);
+                        assert_eq!(
+                            out.velocity_feedforward.to_bits(),
+                            v.to_bits(),
+                            "{order:?} N={n} m={m}"
+                        );
+                        assert_eq!(
+                            out.acceleration_feedforward.to_bits(),
+                            a.to_bits(),
+                            "{order:?} N={n} m={m}"
+                        );
+                        if ip.d2 == 0 && ip.d3 == 0 {
+                            straight += 1;
+                        }
+                    }
+                }
+                // both paths ran (linear: only straight segments)
+                let linear = order == InterpolationOrder::Linear;
+                assert!(straight > 0 && (linear || straight < 40 * n), "{order:?} N={n}");
+            }
+        }
+    }
+}
+
 #[test]
 fn c119_internal_quadratic_feedforward_tracks_acceleration() {
     // x = a/2·t² sampled every 1 ms with a = 2e9 inc/s² (x = 1000·m²):
