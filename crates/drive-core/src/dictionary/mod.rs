@@ -12,10 +12,12 @@ use core::cell::Cell;
 use core::marker::PhantomData;
 use core::sync::atomic::{AtomicU32, Ordering};
 
-use crate::objects::{self, enumeration, find, Object, Value, IMAGE_BYTES, INITIAL_IMAGE, OBJECTS, OFFSETS};
+use crate::objects::{
+    self, enumeration, find, Object, Value, ENTRY_TABLE, IMAGE_BYTES, INITIAL_IMAGE, OBJECTS, OFFSETS,
+};
 use crate::pdo_image::{CopyOp, WIDTH_SHIFT};
 use crate::{parameter_index, MAPPING_ENTRIES, SOFTWARE_BUILD};
-use od::{CommState, DataType, Dictionary, EntryInfo, ObjectInfo, SdoAbort};
+use od::{CommState, DataType, Dictionary, EntryInfo, ObjectInfo, PackedEntry, SdoAbort};
 
 mod mapping;
 mod persist;
@@ -435,7 +437,7 @@ impl DriveObjects {
             Some(e.data_type.decode(data)?)
         };
         if let Some(v) = value {
-            self.check_consistency(o, e, v)?;
+            self.check_consistency(o, &e, v)?;
             e.check_range(v)?;
             if let Some(list) = enumeration(o.info.index, e.sub) {
                 if !list.contains(&v) {

@@ -25,8 +25,8 @@ pub struct Prepared {
     writable: bool,
     /// The target has a value list ([`enumeration`], looked up at a write).
     listed: bool,
-    /// The target entry (type, range).
-    target: &'static EntryInfo,
+    /// The target entry's record in [`ENTRY_TABLE`] (type, range).
+    target: &'static PackedEntry,
     /// The target object's index (for its value list).
     index: u16,
 }
@@ -34,7 +34,7 @@ pub struct Prepared {
 impl Prepared {
     /// The type of the entry as the bus sees it.
     pub fn data_type(&self) -> DataType {
-        self.target.data_type
+        self.target.data_type()
     }
 }
 
@@ -53,8 +53,8 @@ impl DriveObjects {
         let o = loc.object().ok()?;
         let e = loc.entry().ok()?;
         let target = follow(loc).ok()?;
-        let (to, te) = (target.object().ok()?, target.entry().ok()?);
-        let t = te.data_type;
+        let (to, te) = (target.object().ok()?, target.record().ok()?);
+        let t = te.data_type();
         if o.rx.is_some() || !matches!(to.value, Value::Ram | Value::Live) || e.data_type != t {
             return None;
         }
@@ -74,7 +74,7 @@ impl DriveObjects {
             writable: e.access.writable()
                 && e.access.writable_in(state.access_bit())
                 && matches!(to.value, Value::Ram),
-            listed: enumeration(to.info.index, te.sub).is_some(),
+            listed: enumeration(to.info.index, te.sub()).is_some(),
             target: te,
             index: to.info.index,
         })
@@ -107,9 +107,9 @@ impl DriveObjects {
         // checks, record hooks or side effects (`load`: the value as
         // `decode` reads it at the type's own width), then its store: the
         // same bytes, a changed configuration value counted
-        let check = load(data, 0, p.target.data_type).and_then(|v| {
-            p.target.check_range(v)?;
-            match p.listed.then(|| enumeration(p.index, p.target.sub)).flatten() {
+        let check = load(data, 0, p.target.data_type()).and_then(|v| {
+            ENTRY_TABLE.check_range(p.target, v)?;
+            match p.listed.then(|| enumeration(p.index, p.target.sub())).flatten() {
                 Some(list) if !list.contains(&v) => Err(SdoAbort::INVALID_VALUE),
                 _ => Ok(v),
             }

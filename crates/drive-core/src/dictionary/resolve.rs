@@ -17,11 +17,20 @@ impl Loc {
         OBJECTS.get(self.obj).ok_or(SdoAbort::NO_OBJECT)
     }
 
-    pub(super) fn entry(self) -> Result<&'static EntryInfo, SdoAbort> {
+    pub(super) fn entry(self) -> Result<EntryInfo, SdoAbort> {
         self.object()?
             .info
             .entries
             .get(self.pos)
+            .ok_or(SdoAbort::NO_SUBINDEX)
+    }
+
+    /// The entry's packed record in [`crate::objects::ENTRY_TABLE`].
+    pub(super) fn record(self) -> Result<&'static PackedEntry, SdoAbort> {
+        self.object()?
+            .info
+            .entries
+            .record(self.pos)
             .ok_or(SdoAbort::NO_SUBINDEX)
     }
 
