@@ -12,9 +12,7 @@ use core::cell::Cell;
 use core::marker::PhantomData;
 use core::sync::atomic::{AtomicU32, Ordering};
 
-use crate::objects::{
-    self, enumeration, find, Object, Value, ENTRY_TABLE, IMAGE_BYTES, INITIAL_IMAGE, OBJECTS, OFFSETS,
-};
+use crate::objects::{self, enumeration, find, Object, Value, ENTRY_TABLE, IMAGE_BYTES, OBJECTS, OFFSETS};
 use crate::pdo_image::{CopyOp, WIDTH_SHIFT};
 use crate::{parameter_index, MAPPING_ENTRIES, SOFTWARE_BUILD};
 use od::{CommState, DataType, Dictionary, EntryInfo, ObjectInfo, PackedEntry, SdoAbort};
@@ -162,9 +160,10 @@ pub struct WithLive<'a, L: LiveValues> {
 
 impl DriveObjects {
     /// Every value at its default, template "EtherCAT Rx SDO Info".
-    pub const fn new() -> Self {
-        Self {
-            image: INITIAL_IMAGE,
+    #[inline(always)]
+    pub fn new() -> Self {
+        let mut objects = Self {
+            image: [0; IMAGE_BYTES],
             template: Template::SdoInfo,
             requests: Requests {
                 save: false,
@@ -174,7 +173,9 @@ impl DriveObjects {
             config_generation: 0,
             pdo_bytes: Cell::new(None),
             all_accelerations: [records::ALL_ACCELERATIONS_DEFAULT; 2],
-        }
+        };
+        persist::write_defaults(&mut objects.image, |_, _| true);
+        objects
     }
 
     /// A counter that changes whenever a configuration value may have

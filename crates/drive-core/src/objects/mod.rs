@@ -480,7 +480,8 @@ const fn put(image: &mut [u8; IMAGE_BYTES], at: usize, v: i64, n: usize) {
     }
 }
 
-/// The RAM image with every default, computed at compile time.
+/// The RAM image with every default, computed at compile time: the reference
+/// for the image the dictionary writes at start (not in the firmware image).
 pub const INITIAL_IMAGE: [u8; IMAGE_BYTES] = {
     let mut image = [0u8; IMAGE_BYTES];
     let (offs, _) = offsets();
