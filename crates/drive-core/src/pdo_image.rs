@@ -508,7 +508,7 @@ fn stores_overlap(entries: &[ImageEntry], objects: &DriveObjects) -> bool {
 fn resolve(index: u16, sub: u8, sdo_info: bool) -> Option<&'static PackedEntry> {
     let (_, o) = find(index)?;
     let view = o.view(sdo_info);
-    let p = view.entries.iter().position(|e| e.sub == sub)?;
+    let p = view.entries.position(sub)?;
     // the "EtherCAT Rx" view of a manufacturer array has element e at
     // position e, the runtime numbering at e + 1 (after sub 0)
     let pos = if !sdo_info && o.rx.is_some() { p + 1 } else { p };

@@ -245,11 +245,7 @@ impl DriveObjects {
         }
         let rx_view = !self.sdo_info() && o.rx.is_some();
         let view = o.view(self.sdo_info());
-        let p = view
-            .entries
-            .iter()
-            .position(|e| e.sub == sub)
-            .ok_or(SdoAbort::NO_SUBINDEX)?;
+        let p = view.entries.position(sub).ok_or(SdoAbort::NO_SUBINDEX)?;
         Ok(Loc {
             obj,
             pos: if rx_view { p + 1 } else { p },
@@ -290,7 +286,7 @@ impl DriveObjects {
             };
         }
         let loc = follow(canonical(index, sub)?)?;
-        let t = loc.entry()?.data_type;
+        let t = loc.data_type()?;
         let mut buf = [0u8; 8];
         let n = self.read_loc(loc, &mut buf)?;
         t.decode(buf.get(..n).ok_or(SdoAbort::GENERAL)?)
@@ -304,7 +300,7 @@ impl DriveObjects {
         let resolved = resolve(index, sub);
         let t = match resolved {
             Some(r) => r.data_type,
-            None => follow(canonical(index, sub)?)?.entry()?.data_type,
+            None => follow(canonical(index, sub)?)?.data_type()?,
         };
         if !t.is_integer() && t != DataType::F32 {
             return Err(SdoAbort::TYPE_MISMATCH);
@@ -370,7 +366,7 @@ impl DriveObjects {
         if !in_ram(loc)? {
             return Err(SdoAbort::READ_ONLY);
         }
-        loc.entry()?.data_type.check_len(data.len())?;
+        loc.data_type()?.check_len(data.len())?;
         self.store(loc, data)
     }
 
@@ -400,13 +396,13 @@ impl DriveObjects {
         buf: &mut [u8],
     ) -> Result<usize, SdoAbort> {
         let loc = self.locate(index, sub)?;
-        if !loc.entry()?.access.readable() {
+        if !loc.record()?.access().readable() {
             return Err(SdoAbort::WRITE_ONLY);
         }
         let target = follow(loc)?;
         let o = target.object()?;
         if o.value == Value::Live {
-            if let Some(r) = live.read(o.info.index, target.entry()?.sub, buf) {
+            if let Some(r) = live.read(o.info.index, target.record()?.sub(), buf) {
                 return r;
             }
         }
@@ -422,7 +418,7 @@ impl DriveObjects {
         state: CommState,
     ) -> Result<(), SdoAbort> {
         let loc = self.locate(index, sub)?;
-        let access = loc.entry()?.access;
+        let access = loc.record()?.access();
         if !access.writable() {
             return Err(SdoAbort::READ_ONLY);
         }

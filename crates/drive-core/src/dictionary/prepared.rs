@@ -51,11 +51,11 @@ impl DriveObjects {
         }
         let loc = self.locate(index, sub).ok()?;
         let o = loc.object().ok()?;
-        let e = loc.entry().ok()?;
+        let e = loc.record().ok()?;
         let target = follow(loc).ok()?;
         let (to, te) = (target.object().ok()?, target.record().ok()?);
         let t = te.data_type();
-        if o.rx.is_some() || !matches!(to.value, Value::Ram | Value::Live) || e.data_type != t {
+        if o.rx.is_some() || !matches!(to.value, Value::Ram | Value::Live) || e.data_type() != t {
             return None;
         }
         let range = target.slot().ok()?;
@@ -69,10 +69,10 @@ impl DriveObjects {
                 kind: SlotType::of(t)?,
                 config: is_config(to),
             },
-            readable: e.access.readable(),
+            readable: e.access().readable(),
             // a live entry's write goes to its provider first: not here
-            writable: e.access.writable()
-                && e.access.writable_in(state.access_bit())
+            writable: e.access().writable()
+                && e.access().writable_in(state.access_bit())
                 && matches!(to.value, Value::Ram),
             listed: enumeration(to.info.index, te.sub()).is_some(),
             target: te,

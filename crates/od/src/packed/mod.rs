@@ -311,6 +311,26 @@ impl Entries {
         self.get(0)
     }
 
+    /// Position of the entry with subindex `sub` (without decoding).
+    pub fn position(&self, sub: u8) -> Option<usize> {
+        match self.0 {
+            Repr::Slice(s) => s.iter().position(|e| e.sub == sub),
+            Repr::Packed { table, start, len } => {
+                let from = usize::from(start);
+                let run = table.entries.get(from..from + usize::from(len))?;
+                run.iter().position(|p| p.sub == sub)
+            }
+        }
+    }
+
+    /// Data type of the entry at position `pos` (without decoding).
+    pub fn data_type(&self, pos: usize) -> Option<DataType> {
+        match self.0 {
+            Repr::Slice(s) => s.get(pos).map(|e| e.data_type),
+            Repr::Packed { .. } => self.record(pos).map(PackedEntry::data_type),
+        }
+    }
+
     /// The packed record at position `pos` (`None` for slices).
     pub fn record(&self, pos: usize) -> Option<&'static PackedEntry> {
         match self.0 {
