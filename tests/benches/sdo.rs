@@ -31,7 +31,7 @@ static BIG_OBJECT: ObjectInfo = ObjectInfo {
     index: BIG,
     name: "Benchmark block",
     code: ObjectCode::Var,
-    entries: &BIG_ENTRIES,
+    entries: od::Entries::slice(&BIG_ENTRIES),
 };
 
 /// The drive's dictionary plus the 4 KiB block.

@@ -389,7 +389,7 @@ fn local_value(sim: &RefCell<Simulation>, index: u16, sub: u8, readable: bool) -
 /// of a VAR, the element type of an ARRAY, the standard structure of a RECORD.
 fn object_type(o: &Object) -> u16 {
     match o.info.code.code() {
-        7 => o.info.entries[0].data_type.code(),
+        7 => o.info.entries.get(0).unwrap().data_type.code(),
         8 => o
             .info
             .entries

@@ -75,12 +75,12 @@ fn copies(w: &mut impl Write, title: &str, range: core::ops::Range<u16>, by: u16
 
 fn object(w: &mut impl Write, o: &Object) -> fmt::Result {
     let notes = Notes(o);
-    match (o.info.code, o.info.entries) {
-        (ObjectCode::Var, [e]) => {
+    match (o.info.code, o.info.entries.get(0)) {
+        (ObjectCode::Var, Some(e)) if o.info.entries.len() == 1 => {
             write!(w, "| {:04X}h ", o.info.index)?;
-            entry(w, o, e, &notes)
+            entry(w, o, &e, &notes)
         }
-        (code, entries) => {
+        (code, _) => {
             let code = match code {
                 ObjectCode::Var => "VAR",
                 ObjectCode::Array => "ARRAY",
@@ -91,9 +91,9 @@ fn object(w: &mut impl Write, o: &Object) -> fmt::Result {
                 "| {:04X}h | | **{}** | {code} | | | | | | | {notes} |",
                 o.info.index, o.info.name
             )?;
-            for e in entries {
+            for e in o.info.entries {
                 w.write_str("| ")?;
-                entry(w, o, e, &"")?;
+                entry(w, o, &e, &"")?;
             }
             Ok(())
         }

@@ -51,9 +51,10 @@
 //! [`DriveObjects::set_bytes`].
 
 use crate::dictionary::{DriveObjects, Slot, Template};
+use crate::objects::ENTRY_TABLE;
 use crate::objects::{find, IMAGE_BYTES};
 use crate::MAPPING_ENTRIES;
-use od::{Access, DataType, EntryInfo};
+use od::{DataType, PackedEntry};
 
 /// Assigned PDOs per direction (1C12h/1C13h sub 1–4, spec §5.1).
 pub const MAX_PDOS: usize = 4;
@@ -62,9 +63,6 @@ pub const MAX_ENTRIES: usize = MAX_PDOS * MAPPING_ENTRIES as usize;
 /// Longest process image per direction in bits (4 × 24 × 32 bits = 384 bytes,
 /// the slave stack's `MAX_PDO_BYTES`).
 pub const MAX_IMAGE_BITS: usize = MAX_ENTRIES * 32;
-
-/// Entry info of unused table slots.
-const UNUSED: EntryInfo = EntryInfo::new(0, "", DataType::U8, Access::RO);
 
 /// One mapped object entry of a process image.
 #[derive(Debug, Clone, Copy, PartialEq)]
@@ -77,8 +75,9 @@ pub struct ImageEntry {
     pub index: u16,
     /// Subindex in the runtime ("EtherCAT Rx SDO Info") numbering.
     pub sub: u8,
-    /// The entry's declaration (data type, default, persistence).
-    pub info: &'static EntryInfo,
+    /// The entry's declaration (data type, default, persistence): its
+    /// record in [`ENTRY_TABLE`].
+    pub info: &'static PackedEntry,
     /// The value [`PdoImage::restore_rx_defaults`] restores (RxPDO): the
     /// declared default, for persistent entries the value captured by
     /// [`PdoImage::capture_fallbacks`].
@@ -94,7 +93,7 @@ impl ImageEntry {
         bits: 0,
         index: 0,
         sub: 0,
-        info: &UNUSED,
+        info: &PackedEntry::UNUSED,
         fallback: 0,
         slot: None,
     };
@@ -165,21 +164,21 @@ impl Channel {
                     kind,
                 };
                 let info = resolve(index, sub, sdo_info).ok_or(bad(EntryFault::Unknown))?;
-                if info.bit_len() != u16::from(bits) {
+                if info.data_type().bits() != u16::from(bits) {
                     return Err(bad(EntryFault::BitLength));
                 }
                 let mut entry = ImageEntry {
                     bit_offset: u16::try_from(at).map_err(|_| PdoImageError::TooLong { pdo })?,
                     bits,
                     index,
-                    sub: info.sub,
+                    sub: info.sub(),
                     info,
-                    fallback: info.default,
+                    fallback: ENTRY_TABLE.default_of(info),
                     slot: None,
                 };
                 if entry.byte_aligned() {
                     entry.slot = objects
-                        .slot(index, info.sub)
+                        .slot(index, info.sub())
                         .filter(|s| s.bytes() * 8 == usize::from(bits));
                 }
                 if !entry.byte_aligned() && bits > 64 {
@@ -506,14 +505,14 @@ fn stores_overlap(entries: &[ImageEntry], objects: &DriveObjects) -> bool {
 
 /// The declaration of the entry a mapping names with `index`:`sub` in the
 /// active template (the runtime subindex is `EntryInfo::sub`).
-fn resolve(index: u16, sub: u8, sdo_info: bool) -> Option<&'static EntryInfo> {
+fn resolve(index: u16, sub: u8, sdo_info: bool) -> Option<&'static PackedEntry> {
     let (_, o) = find(index)?;
     let view = o.view(sdo_info);
-    let p = view.entries.iter().position(|e| e.sub == sub)?;
+    let p = view.entries.position(sub)?;
     // the "EtherCAT Rx" view of a manufacturer array has element e at
     // position e, the runtime numbering at e + 1 (after sub 0)
     let pos = if !sdo_info && o.rx.is_some() { p + 1 } else { p };
-    o.info.entries.get(pos)
+    o.info.entries.record(pos)
 }
 
 /// Why a mapping could not be compiled. The mapping checks of the dictionary
@@ -640,10 +639,12 @@ impl PdoImage {
     pub fn capture_fallbacks(&mut self, objects: &DriveObjects) {
         let len = self.rx.len;
         for e in self.rx.entries.iter_mut().take(len) {
-            e.fallback = if e.info.persistent {
-                objects.get(e.index, e.sub).unwrap_or(e.info.default)
+            e.fallback = if e.info.persistent() {
+                objects
+                    .get(e.index, e.sub)
+                    .unwrap_or(ENTRY_TABLE.default_of(e.info))
             } else {
-                e.info.default
+                ENTRY_TABLE.default_of(e.info)
             };
         }
     }
@@ -656,7 +657,7 @@ impl PdoImage {
     /// (VISIBLE_STRING) or stay (OCTET_STRING).
     pub fn restore_rx_defaults(&self, objects: &mut DriveObjects) {
         for e in self.rx.entries() {
-            let _ = match e.info.data_type {
+            let _ = match e.info.data_type() {
                 DataType::VisibleString(_) => objects.set_bytes(e.index, e.sub, &[]),
                 DataType::OctetString(_) => Ok(()),
                 _ => objects.set(e.index, e.sub, e.fallback),

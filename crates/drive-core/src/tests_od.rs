@@ -456,7 +456,7 @@ fn mirrors_and_aliases_have_the_target_types() {
                 let t = d.object(index).unwrap();
                 let skip = usize::from(!sub0);
                 (skip..o.info.entries.len())
-                    .map(|k| (k, index, t.entries[k].sub))
+                    .map(|k| (k, index, t.entries.get(k).unwrap().sub))
                     .collect()
             }
             Value::Alias(list) => list
@@ -468,7 +468,7 @@ fn mirrors_and_aliases_have_the_target_types() {
             _ => continue,
         };
         for (k, index, sub) in targets {
-            let own = o.info.entries[k];
+            let own = o.info.entries.get(k).unwrap();
             let t = d
                 .object(index)
                 .unwrap()

@@ -370,7 +370,7 @@ fn entry_description<D: Dictionary>(
     ];
     let mut supplied = requested & (value_info::ACCESS | value_info::OBJECT | value_info::MAPPABLE);
     for (bit, v) in values {
-        if requested & bit != 0 && v.is_some() && encode(entry, 0).is_some() {
+        if requested & bit != 0 && v.is_some() && encode(&entry, 0).is_some() {
             supplied |= bit;
         }
     }
@@ -385,7 +385,7 @@ fn entry_description<D: Dictionary>(
         w.u16(entry.access.0)?;
         for (bit, v) in values {
             if let (true, Some(v)) = (supplied & bit != 0, v) {
-                let (bytes, n) = encode(entry, v)?;
+                let (bytes, n) = encode(&entry, v)?;
                 w.bytes(bytes.get(..n)?)?;
             }
         }

@@ -94,7 +94,7 @@ static MANY: [od::ObjectInfo; MANY_N] = {
         index: 0x3000,
         name: "Many",
         code: od::ObjectCode::Var,
-        entries: &MANY_ENTRIES,
+        entries: od::Entries::slice(&MANY_ENTRIES),
     }; MANY_N];
     let mut i = 0;
     while i < MANY_N {

@@ -353,7 +353,7 @@ pub fn listed_objects(od: &DriveObjects) -> Vec<&'static ObjectInfo> {
 
 /// Is `o` written as a single VAR (one entry, sub 0)?
 pub fn is_var(o: &ObjectInfo) -> bool {
-    matches!((o.code, o.entries), (ObjectCode::Var, [e]) if e.sub == 0)
+    o.code == ObjectCode::Var && o.entries.len() == 1 && o.entries.get(0).is_some_and(|e| e.sub == 0)
 }
 
 /// Bit offsets of the entries of an ARRAY/RECORD and its total size: sub 0
@@ -410,7 +410,8 @@ fn dictionary_element(x: &mut Xml, template: Template, od: &DriveObjects) {
         x.close("DataType");
     }
     for o in objects.iter().filter(|o| !is_var(o)) {
-        let (offs, size) = layout(o.entries);
+        let entries: Vec<EntryInfo> = o.entries.iter().collect();
+        let (offs, size) = layout(&entries);
         x.open("DataType", &[]);
         x.leaf("Name", &[], &object_type_name(o.index));
         x.leaf("BitSize", &[], &size.to_string());
@@ -433,7 +434,8 @@ fn dictionary_element(x: &mut Xml, template: Template, od: &DriveObjects) {
         x.open("Object", &[]);
         x.leaf("Index", &[], &hex16(o.index));
         x.leaf("Name", &[], o.name);
-        if let (true, [e]) = (is_var(o), o.entries) {
+        let entries: Vec<EntryInfo> = o.entries.iter().collect();
+        if let (true, [e]) = (is_var(o), entries.as_slice()) {
             x.leaf("Type", &[], &type_name(e.data_type));
             x.leaf("BitSize", &[], &e.bit_len().to_string());
             x.open("Info", &[]);
@@ -442,9 +444,9 @@ fn dictionary_element(x: &mut Xml, template: Template, od: &DriveObjects) {
             flags(x, e.access, e.persistent);
         } else {
             x.leaf("Type", &[], &object_type_name(o.index));
-            x.leaf("BitSize", &[], &layout(o.entries).1.to_string());
+            x.leaf("BitSize", &[], &layout(&entries).1.to_string());
             x.open("Info", &[]);
-            for e in o.entries {
+            for e in &entries {
                 x.open("SubItem", &[]);
                 x.leaf("Name", &[], e.name);
                 x.open("Info", &[]);
@@ -453,7 +455,7 @@ fn dictionary_element(x: &mut Xml, template: Template, od: &DriveObjects) {
                 x.close("SubItem");
             }
             x.close("Info");
-            let sub0 = o.entries.first().map_or(Access::RO, |e| e.access);
+            let sub0 = entries.first().map_or(Access::RO, |e| e.access);
             flags(x, Access(sub0.0 & (Access::READ | Access::WRITE)), false);
         }
         x.close("Object");

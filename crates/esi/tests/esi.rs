@@ -435,9 +435,10 @@ fn esi_dictionary_matches_od() {
             assert_eq!(num(text(*node, "Index")), u64::from(o.index), "{what}");
             assert_eq!(text(*node, "Name"), o.name, "{what}");
             let ty = text(*node, "Type");
-            let var = o.code == od::ObjectCode::Var && o.entries.len() == 1 && o.entries[0].sub == 0;
+            let var =
+                o.code == od::ObjectCode::Var && o.entries.len() == 1 && o.entries.get(0).unwrap().sub == 0;
             if var {
-                let e = &o.entries[0];
+                let e = &o.entries.get(0).unwrap();
                 assert_eq!(ty, expected_type(e.data_type), "{what}");
                 assert_eq!(num(text(*node, "BitSize")), u64::from(e.bit_len()), "{what}");
                 assert!(types.contains_key(ty), "{what}: type {ty} declared");

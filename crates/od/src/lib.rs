@@ -5,6 +5,8 @@
 //! - [`ObjectInfo`] / [`EntryInfo`]: the static metadata of an object and its
 //!   entries (name, type, access rights, PDO mapping, range, default, unit,
 //!   persistence): what SDO Info, PDO mapping checks, ESI, SII and the docs read.
+//! - [`packed`]: the same metadata in a compact form ([`PackedTable`],
+//!   [`Entries`]) for firmware images.
 //! - [`Dictionary`]: what the CoE server needs from an object dictionary:
 //!   metadata lookup and value access with the spec's abort codes.
 //! - [`SdoAbort`]: the abort codes of spec §6.5.
@@ -22,10 +24,12 @@
 
 mod abort;
 pub mod error_register;
+pub mod packed;
 mod pdo;
 mod types;
 
 pub use abort::SdoAbort;
+pub use packed::{Entries, PackedEntry, PackedTable, UNITS};
 pub use pdo::PdoEntry;
 pub use types::DataType;
 
@@ -272,18 +276,18 @@ pub struct ObjectInfo {
     /// Object code.
     pub code: ObjectCode,
     /// Entries, sub 0 first, sorted by subindex.
-    pub entries: &'static [EntryInfo],
+    pub entries: Entries,
 }
 
 impl ObjectInfo {
-    /// The entry with subindex `sub`.
-    pub fn entry(&self, sub: u8) -> Option<&'static EntryInfo> {
-        self.entries.iter().find(|e| e.sub == sub)
+    /// The entry with subindex `sub`, decoded.
+    pub fn entry(&self, sub: u8) -> Option<EntryInfo> {
+        self.entries.find(sub)
     }
 
     /// Highest subindex.
     pub fn max_sub(&self) -> u8 {
-        self.entries.iter().map(|e| e.sub).max().unwrap_or(0)
+        self.entries.max_sub()
     }
 }
 

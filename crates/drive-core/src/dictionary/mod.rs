@@ -12,10 +12,10 @@ use core::cell::Cell;
 use core::marker::PhantomData;
 use core::sync::atomic::{AtomicU32, Ordering};
 
-use crate::objects::{self, enumeration, find, Object, Value, IMAGE_BYTES, INITIAL_IMAGE, OBJECTS, OFFSETS};
+use crate::objects::{self, enumeration, find, Object, Value, ENTRY_TABLE, IMAGE_BYTES, OBJECTS, OFFSETS};
 use crate::pdo_image::{CopyOp, WIDTH_SHIFT};
 use crate::{parameter_index, MAPPING_ENTRIES, SOFTWARE_BUILD};
-use od::{CommState, DataType, Dictionary, EntryInfo, ObjectInfo, SdoAbort};
+use od::{CommState, DataType, Dictionary, EntryInfo, ObjectInfo, PackedEntry, SdoAbort};
 
 mod mapping;
 mod persist;
@@ -160,9 +160,10 @@ pub struct WithLive<'a, L: LiveValues> {
 
 impl DriveObjects {
     /// Every value at its default, template "EtherCAT Rx SDO Info".
-    pub const fn new() -> Self {
-        Self {
-            image: INITIAL_IMAGE,
+    #[inline(always)]
+    pub fn new() -> Self {
+        let mut objects = Self {
+            image: [0; IMAGE_BYTES],
             template: Template::SdoInfo,
             requests: Requests {
                 save: false,
@@ -172,7 +173,9 @@ impl DriveObjects {
             config_generation: 0,
             pdo_bytes: Cell::new(None),
             all_accelerations: [records::ALL_ACCELERATIONS_DEFAULT; 2],
-        }
+        };
+        persist::write_defaults(&mut objects.image, |_, _| true);
+        objects
     }
 
     /// A counter that changes whenever a configuration value may have
@@ -242,11 +245,7 @@ impl DriveObjects {
         }
         let rx_view = !self.sdo_info() && o.rx.is_some();
         let view = o.view(self.sdo_info());
-        let p = view
-            .entries
-            .iter()
-            .position(|e| e.sub == sub)
-            .ok_or(SdoAbort::NO_SUBINDEX)?;
+        let p = view.entries.position(sub).ok_or(SdoAbort::NO_SUBINDEX)?;
         Ok(Loc {
             obj,
             pos: if rx_view { p + 1 } else { p },
@@ -287,7 +286,7 @@ impl DriveObjects {
             };
         }
         let loc = follow(canonical(index, sub)?)?;
-        let t = loc.entry()?.data_type;
+        let t = loc.data_type()?;
         let mut buf = [0u8; 8];
         let n = self.read_loc(loc, &mut buf)?;
         t.decode(buf.get(..n).ok_or(SdoAbort::GENERAL)?)
@@ -301,7 +300,7 @@ impl DriveObjects {
         let resolved = resolve(index, sub);
         let t = match resolved {
             Some(r) => r.data_type,
-            None => follow(canonical(index, sub)?)?.entry()?.data_type,
+            None => follow(canonical(index, sub)?)?.data_type()?,
         };
         if !t.is_integer() && t != DataType::F32 {
             return Err(SdoAbort::TYPE_MISMATCH);
@@ -367,7 +366,7 @@ impl DriveObjects {
         if !in_ram(loc)? {
             return Err(SdoAbort::READ_ONLY);
         }
-        loc.entry()?.data_type.check_len(data.len())?;
+        loc.data_type()?.check_len(data.len())?;
         self.store(loc, data)
     }
 
@@ -397,13 +396,13 @@ impl DriveObjects {
         buf: &mut [u8],
     ) -> Result<usize, SdoAbort> {
         let loc = self.locate(index, sub)?;
-        if !loc.entry()?.access.readable() {
+        if !loc.record()?.access().readable() {
             return Err(SdoAbort::WRITE_ONLY);
         }
         let target = follow(loc)?;
         let o = target.object()?;
         if o.value == Value::Live {
-            if let Some(r) = live.read(o.info.index, target.entry()?.sub, buf) {
+            if let Some(r) = live.read(o.info.index, target.record()?.sub(), buf) {
                 return r;
             }
         }
@@ -419,7 +418,7 @@ impl DriveObjects {
         state: CommState,
     ) -> Result<(), SdoAbort> {
         let loc = self.locate(index, sub)?;
-        let access = loc.entry()?.access;
+        let access = loc.record()?.access();
         if !access.writable() {
             return Err(SdoAbort::READ_ONLY);
         }
@@ -435,7 +434,7 @@ impl DriveObjects {
             Some(e.data_type.decode(data)?)
         };
         if let Some(v) = value {
-            self.check_consistency(o, e, v)?;
+            self.check_consistency(o, &e, v)?;
             e.check_range(v)?;
             if let Some(list) = enumeration(o.info.index, e.sub) {
                 if !list.contains(&v) {

@@ -23,6 +23,47 @@ pub(super) const IMAGE_HEADER: usize = 12;
 /// u32, payload length u16, template u8, 0) + the persistent values.
 pub const PERSISTENT_IMAGE_BYTES: usize = IMAGE_HEADER + objects::PERSISTENT_BYTES;
 
+/// Writes into `image` the defaults of the entries `pick` (object index,
+/// entry) selects, as the declaration gives them: a number its default, the
+/// record memory (J410, J411 of either axis) its records' defaults, another
+/// string zeros. The image the dictionary starts with, filled at start instead
+/// of a 9 KB constant in flash (`objects::INITIAL_IMAGE`, the same bytes).
+pub(super) fn write_defaults(image: &mut [u8], mut pick: impl FnMut(u16, &EntryInfo) -> bool) {
+    use objects::records::{initial_byte, J410, J411};
+    for (o, &base) in OBJECTS.iter().zip(OFFSETS.iter()) {
+        if !matches!(o.value, Value::Ram | Value::Live) {
+            continue;
+        }
+        let index = o.info.index;
+        let memory = index.checked_sub(crate::AXIS_B_MANUFACTURER).unwrap_or(index);
+        let record_memory = memory == J410 || memory == J411;
+        let (mut at, mut memory_at) = (usize::from(base), 0);
+        for e in o.info.entries {
+            let n = e.data_type.bytes();
+            let string = e.data_type.is_string();
+            if pick(index, &e) {
+                if let Some(dst) = image.get_mut(at..at + n) {
+                    if !string {
+                        let _ = e.data_type.encode(e.default, dst);
+                    } else {
+                        for (k, d) in dst.iter_mut().enumerate() {
+                            *d = if record_memory {
+                                initial_byte(memory, memory_at + k).unwrap_or(0)
+                            } else {
+                                0
+                            };
+                        }
+                    }
+                }
+            }
+            if string && record_memory {
+                memory_at += n;
+            }
+            at += n;
+        }
+    }
+}
+
 impl DriveObjects {
     /// The byte ranges of the persistent values, in declaration order.
     pub(super) fn persistent_slots() -> impl Iterator<Item = core::ops::Range<usize>> {
@@ -104,14 +145,42 @@ impl DriveObjects {
     /// 301 "restore default parameters"; the stored image changes with the
     /// next save). Live and set-point values are untouched.
     pub fn restore_defaults(&mut self) {
-        for slot in Self::persistent_slots() {
-            if let (Some(dst), Some(src)) = (self.image.get_mut(slot.clone()), INITIAL_IMAGE.get(slot)) {
-                for (d, s) in dst.iter_mut().zip(src) {
-                    *d = *s;
-                }
-            }
-        }
+        write_defaults(&mut self.image, |_, e| e.persistent);
         self.records_reloaded(true);
         self.config_changed();
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn the_image_filled_at_start_and_by_a_restore_is_the_declared_one() {
+        let mut od = DriveObjects::new();
+        assert!(od.image == objects::INITIAL_IMAGE, "start");
+        od.image = [0xA5; IMAGE_BYTES];
+        od.restore_defaults();
+        let mut restored = 0;
+        for slot in DriveObjects::persistent_slots() {
+            assert_eq!(
+                od.image[slot.clone()],
+                objects::INITIAL_IMAGE[slot.clone()],
+                "{slot:?}"
+            );
+            restored += slot.len();
+        }
+        assert_eq!(restored, objects::PERSISTENT_BYTES);
+        // the record memory of both axes is restored too
+        for index in [
+            objects::records::J410,
+            objects::records::J411,
+            objects::records::J411 + crate::AXIS_B_MANUFACTURER,
+        ] {
+            let (i, o) = find(index).unwrap();
+            let at = usize::from(OFFSETS[i]);
+            let r = at..at + o.ram_bytes();
+            assert_eq!(od.image[r.clone()], objects::INITIAL_IMAGE[r], "{index:04X}h");
+        }
     }
 }

@@ -25,8 +25,8 @@ pub struct Prepared {
     writable: bool,
     /// The target has a value list ([`enumeration`], looked up at a write).
     listed: bool,
-    /// The target entry (type, range).
-    target: &'static EntryInfo,
+    /// The target entry's record in [`ENTRY_TABLE`] (type, range).
+    target: &'static PackedEntry,
     /// The target object's index (for its value list).
     index: u16,
 }
@@ -34,7 +34,7 @@ pub struct Prepared {
 impl Prepared {
     /// The type of the entry as the bus sees it.
     pub fn data_type(&self) -> DataType {
-        self.target.data_type
+        self.target.data_type()
     }
 }
 
@@ -51,11 +51,11 @@ impl DriveObjects {
         }
         let loc = self.locate(index, sub).ok()?;
         let o = loc.object().ok()?;
-        let e = loc.entry().ok()?;
+        let e = loc.record().ok()?;
         let target = follow(loc).ok()?;
-        let (to, te) = (target.object().ok()?, target.entry().ok()?);
-        let t = te.data_type;
-        if o.rx.is_some() || !matches!(to.value, Value::Ram | Value::Live) || e.data_type != t {
+        let (to, te) = (target.object().ok()?, target.record().ok()?);
+        let t = te.data_type();
+        if o.rx.is_some() || !matches!(to.value, Value::Ram | Value::Live) || e.data_type() != t {
             return None;
         }
         let range = target.slot().ok()?;
@@ -69,12 +69,12 @@ impl DriveObjects {
                 kind: SlotType::of(t)?,
                 config: is_config(to),
             },
-            readable: e.access.readable(),
+            readable: e.access().readable(),
             // a live entry's write goes to its provider first: not here
-            writable: e.access.writable()
-                && e.access.writable_in(state.access_bit())
+            writable: e.access().writable()
+                && e.access().writable_in(state.access_bit())
                 && matches!(to.value, Value::Ram),
-            listed: enumeration(to.info.index, te.sub).is_some(),
+            listed: enumeration(to.info.index, te.sub()).is_some(),
             target: te,
             index: to.info.index,
         })
@@ -107,9 +107,9 @@ impl DriveObjects {
         // checks, record hooks or side effects (`load`: the value as
         // `decode` reads it at the type's own width), then its store: the
         // same bytes, a changed configuration value counted
-        let check = load(data, 0, p.target.data_type).and_then(|v| {
-            p.target.check_range(v)?;
-            match p.listed.then(|| enumeration(p.index, p.target.sub)).flatten() {
+        let check = load(data, 0, p.target.data_type()).and_then(|v| {
+            ENTRY_TABLE.check_range(p.target, v)?;
+            match p.listed.then(|| enumeration(p.index, p.target.sub())).flatten() {
                 Some(list) if !list.contains(&v) => Err(SdoAbort::INVALID_VALUE),
                 _ => Ok(v),
             }

@@ -245,16 +245,8 @@ impl DriveObjects {
     /// window showing its record.
     pub(super) fn records_reloaded(&mut self, restore: bool) {
         if restore {
-            for (index, base) in [(J410, J410_AT), (J411, J411_AT[0]), (J411, J411_AT[1])] {
-                let Some((_, obj)) = find(index) else { continue };
-                let len = obj.ram_bytes();
-                if let (Some(dst), Some(src)) = (
-                    self.image.get_mut(base..base + len),
-                    INITIAL_IMAGE.get(base..base + len),
-                ) {
-                    copy(dst, src);
-                }
-            }
+            let memory = [J410, J411, J411 + AXIS_B_MANUFACTURER];
+            super::persist::write_defaults(&mut self.image, |index, _| memory.contains(&index));
         }
         for axis in [0, 1] {
             let n = self.record_selector(axis);

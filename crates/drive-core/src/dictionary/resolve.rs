@@ -17,7 +17,7 @@ impl Loc {
         OBJECTS.get(self.obj).ok_or(SdoAbort::NO_OBJECT)
     }
 
-    pub(super) fn entry(self) -> Result<&'static EntryInfo, SdoAbort> {
+    pub(super) fn entry(self) -> Result<EntryInfo, SdoAbort> {
         self.object()?
             .info
             .entries
@@ -25,31 +25,42 @@ impl Loc {
             .ok_or(SdoAbort::NO_SUBINDEX)
     }
 
+    /// The entry's data type (from its record, not decoded).
+    pub(super) fn data_type(self) -> Result<DataType, SdoAbort> {
+        self.object()?
+            .info
+            .entries
+            .data_type(self.pos)
+            .ok_or(SdoAbort::NO_SUBINDEX)
+    }
+
+    /// The entry's packed record in [`crate::objects::ENTRY_TABLE`].
+    pub(super) fn record(self) -> Result<&'static PackedEntry, SdoAbort> {
+        self.object()?
+            .info
+            .entries
+            .record(self.pos)
+            .ok_or(SdoAbort::NO_SUBINDEX)
+    }
+
     /// Byte range of the entry in the RAM image.
     pub(super) fn slot(self) -> Result<core::ops::Range<usize>, SdoAbort> {
         let o = self.object()?;
         let base = usize::from(*OFFSETS.get(self.obj).ok_or(SdoAbort::NO_OBJECT)?);
-        let before: usize = o
-            .info
-            .entries
-            .iter()
-            .take(self.pos)
-            .map(|e| e.data_type.bytes())
+        let entries = o.info.entries;
+        let before: usize = (0..self.pos)
+            .filter_map(|k| entries.data_type(k))
+            .map(DataType::bytes)
             .sum();
         let at = base + before;
-        Ok(at..at + self.entry()?.data_type.bytes())
+        Ok(at..at + self.data_type()?.bytes())
     }
 }
 
 /// The entry `index`:`sub` in "EtherCAT Rx SDO Info" numbering, visible or not.
 pub(super) fn canonical(index: u16, sub: u8) -> Result<Loc, SdoAbort> {
     let (obj, o) = find(index).ok_or(SdoAbort::NO_OBJECT)?;
-    let pos = o
-        .info
-        .entries
-        .iter()
-        .position(|e| e.sub == sub)
-        .ok_or(SdoAbort::NO_SUBINDEX)?;
+    let pos = o.info.entries.position(sub).ok_or(SdoAbort::NO_SUBINDEX)?;
     Ok(Loc { obj, pos })
 }
 

@@ -12,7 +12,7 @@
 use super::{comm, repeat, Object, Value};
 use crate::{parameter_index, DEVICE_NAME, HARDWARE_VERSION, SOFTWARE_VERSION};
 use od::DataType::{Bool, OctetString, VisibleString, I32, U16, U32, U8};
-use od::{Access, DataType, EntryInfo, ObjectCode::*, ObjectInfo};
+use od::{Access, DataType, EntryInfo, ObjectCode::*};
 
 const RO: Access = Access::RO;
 const RW: Access = Access::RW;
@@ -128,11 +128,11 @@ const ASSIGN_RX_VIEW: [EntryInfo; 4] = repeat(
 /// template).
 macro_rules! mirror {
     ($index:expr, $name:expr, $target:expr, $entries:expr, $rx:expr, $note:expr) => {{
-        const RX: &ObjectInfo = &ObjectInfo {
+        const RX: &od::ObjectInfo = &od::ObjectInfo {
             index: $index,
             name: $name,
             code: Array,
-            entries: $rx,
+            entries: od::Entries::slice($rx),
         };
         Object::new(
             $index,
@@ -144,7 +144,7 @@ macro_rules! mirror {
                 sub0: true,
             },
         )
-        .rx_view(RX, RX)
+        .rx_view(RX)
         .level(2)
         .note($note)
     }};

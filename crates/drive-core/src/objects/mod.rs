@@ -16,7 +16,7 @@
 //! (element + 1 for manufacturer arrays/records); manufacturer arrays carry
 //! the "EtherCAT Rx" view (element = subindex) in [`Object::rx`].
 
-use od::{Access, DataType, EntryInfo, ObjectCode, ObjectInfo};
+use od::{Access, DataType, Entries, EntryInfo, ObjectCode, ObjectInfo};
 
 /// Builds a `'static` entry list from entry expressions (the list becomes a
 /// `const`, so it can be passed to the `const fn` constructors).
@@ -38,19 +38,14 @@ macro_rules! param_array {
     ($index:expr, $name:expr, $code:ident, $value:expr, from $els:expr) => {{
         const ELS: &[od::EntryInfo] = $els;
         const INFO: [od::EntryInfo; ELS.len() + 1] = $crate::objects::sdo_info_view(ELS);
+        // the view's index and entries are set when the table is packed
         const RX: &od::ObjectInfo = &od::ObjectInfo {
             index: $index,
             name: $name,
             code: od::ObjectCode::$code,
-            entries: ELS,
+            entries: od::Entries::slice(ELS),
         };
-        const RX_B: &od::ObjectInfo = &od::ObjectInfo {
-            index: $index + $crate::AXIS_B_MANUFACTURER,
-            name: $name,
-            code: od::ObjectCode::$code,
-            entries: ELS,
-        };
-        $crate::objects::Object::new($index, $name, od::ObjectCode::$code, &INFO, $value).rx_view(RX, RX_B)
+        $crate::objects::Object::new($index, $name, od::ObjectCode::$code, &INFO, $value).rx_view(RX)
     }};
 }
 
@@ -64,7 +59,10 @@ macro_rules! numbered {
 pub mod cia402;
 pub mod comm;
 pub mod manufacturer;
+mod pack;
 pub mod records;
+
+pub use pack::ENTRY_TABLE;
 
 /// Where the values of an object live.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
@@ -100,7 +98,8 @@ pub enum Value {
 }
 
 /// One object of the drive: its metadata, where its values live and who may
-/// see it.
+/// see it. Declared with slices of entries; [`OBJECTS`] holds the same objects
+/// with their entries in [`ENTRY_TABLE`].
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct Object {
     /// Metadata in the "EtherCAT Rx SDO Info" template (what SDO Info reports).
@@ -108,8 +107,6 @@ pub struct Object {
     /// Metadata in the "EtherCAT Rx" template, for manufacturer arrays and
     /// records (subindex = element number); `None`: the same in both.
     pub rx: Option<&'static ObjectInfo>,
-    /// The same for the axis-B copy of a per-axis parameter.
-    pub rx_b: Option<&'static ObjectInfo>,
     /// Where the values live.
     pub value: Value,
     /// Access level (0–3) needed to see the object; hidden objects answer
@@ -117,7 +114,8 @@ pub struct Object {
     pub level: u8,
     /// A per-axis manufacturer parameter (axis-B copy at +8000h).
     pub axis: bool,
-    /// Reference note: parameter coordinate, assumptions.
+    /// Reference note: parameter coordinate, assumptions (host builds only).
+    #[cfg(not(target_os = "none"))]
     pub note: &'static str,
 }
 
@@ -135,13 +133,13 @@ impl Object {
                 index,
                 name,
                 code,
-                entries,
+                entries: Entries::slice(entries),
             },
             rx: None,
-            rx_b: None,
             value,
             level: 0,
             axis: false,
+            #[cfg(not(target_os = "none"))]
             note: "",
         }
     }
@@ -168,28 +166,30 @@ impl Object {
     }
 
     /// With a reference note. The notes are for the host (the object
-    /// reference `doc`, the declaration's tests): a bare-metal build keeps
-    /// them out of flash (about 6 KB) and sees "".
+    /// reference `doc`, the declaration's tests): a bare-metal build has no
+    /// such field and keeps them out of flash.
+    #[allow(unused_mut, unused_variables)]
     pub const fn note(mut self, note: &'static str) -> Self {
-        if !cfg!(target_os = "none") {
+        #[cfg(not(target_os = "none"))]
+        {
             self.note = note;
         }
         self
     }
 
-    /// With "EtherCAT Rx" template views (axis-A window, axis-B copy).
-    pub const fn rx_view(mut self, rx: &'static ObjectInfo, rx_b: &'static ObjectInfo) -> Self {
+    /// With the "EtherCAT Rx" template view `rx` (subindex = element number;
+    /// packing gives it the object's index).
+    pub const fn rx_view(mut self, rx: &'static ObjectInfo) -> Self {
         self.rx = Some(rx);
-        self.rx_b = Some(rx_b);
         self
     }
 
-    /// Bytes this object takes in the RAM image.
-    pub const fn ram_bytes(&self) -> usize {
+    /// Bytes this object takes in the RAM image (from a declaration).
+    pub const fn declared_ram_bytes(&self) -> usize {
         match self.value {
             Value::Ram | Value::Live => {
                 let mut sum = 0;
-                let mut rest = self.info.entries;
+                let mut rest = declared(self.info.entries);
                 while let [e, tail @ ..] = rest {
                     sum += e.data_type.bytes();
                     rest = tail;
@@ -200,12 +200,28 @@ impl Object {
         }
     }
 
+    /// Bytes this object takes in the RAM image.
+    pub fn ram_bytes(&self) -> usize {
+        match self.value {
+            Value::Ram | Value::Live => self.info.entries.iter().map(|e| e.data_type.bytes()).sum(),
+            _ => 0,
+        }
+    }
+
     /// The metadata in the template (`sdo_info` = "EtherCAT Rx SDO Info").
     pub const fn view(&self, sdo_info: bool) -> &ObjectInfo {
         match (sdo_info, self.rx) {
             (false, Some(rx)) => rx,
             _ => &self.info,
         }
+    }
+}
+
+/// The entries of a declared object (a slice; empty for packed ones).
+pub const fn declared(entries: Entries) -> &'static [EntryInfo] {
+    match entries.as_slice() {
+        Some(s) => s,
+        None => &[],
     }
 }
 
@@ -295,8 +311,6 @@ pub const fn axis_copies<const N: usize>(objs: &[Object], by: u16) -> [Object; N
             {
                 out[i] = *o;
                 out[i].info.index += by;
-                out[i].rx = o.rx_b;
-                out[i].rx_b = None;
             }
             i += 1;
         }
@@ -343,7 +357,7 @@ const fn sorted(objs: &[Object]) -> bool {
 const fn entries_sorted(objs: &[Object]) -> bool {
     let mut rest = objs;
     while let [o, tail @ ..] = rest {
-        let mut es = o.info.entries;
+        let mut es = declared(o.info.entries);
         while let [a, more @ ..] = es {
             if let [b, ..] = more {
                 if a.sub >= b.sub {
@@ -375,7 +389,7 @@ pub const COUNT: usize = comm::COMM.len()
     + comm::MDP.len();
 
 // Only used in const evaluation (the offsets, the initial image, the layout
-// hash) and copied once into OBJECTS.
+// hash, the packed table) and packed once into OBJECTS.
 #[allow(clippy::large_const_arrays)]
 const TABLE: [Object; COUNT] = join(&[
     &comm::COMM,
@@ -397,7 +411,7 @@ const _: () = assert!(
 const fn defaults_in_range(objs: &[Object]) -> bool {
     let mut rest = objs;
     while let [o, tail @ ..] = rest {
-        let mut es = o.info.entries;
+        let mut es = declared(o.info.entries);
         while let [e, more @ ..] = es {
             if e.data_type.is_integer() && (e.default < e.lowest() || e.default > e.highest()) {
                 return false;
@@ -409,8 +423,8 @@ const fn defaults_in_range(objs: &[Object]) -> bool {
     true
 }
 
-/// Every object of the drive, sorted by index.
-pub static OBJECTS: [Object; COUNT] = TABLE;
+/// Every object of the drive, sorted by index, its entries in [`ENTRY_TABLE`].
+pub static OBJECTS: [Object; COUNT] = pack::objects(&TABLE, &ENTRY_TABLE, &pack::RX_VIEWS);
 
 const fn offsets() -> ([u16; COUNT], usize) {
     let mut out = [0u16; COUNT];
@@ -421,7 +435,7 @@ const fn offsets() -> ([u16; COUNT], usize) {
         #[allow(clippy::indexing_slicing)]
         {
             out[i] = at as u16;
-            at += TABLE[i].ram_bytes();
+            at += TABLE[i].declared_ram_bytes();
         }
         i += 1;
     }
@@ -466,7 +480,8 @@ const fn put(image: &mut [u8; IMAGE_BYTES], at: usize, v: i64, n: usize) {
     }
 }
 
-/// The RAM image with every default, computed at compile time.
+/// The RAM image with every default, computed at compile time: the reference
+/// for the image the dictionary writes at start (not in the firmware image).
 pub const INITIAL_IMAGE: [u8; IMAGE_BYTES] = {
     let mut image = [0u8; IMAGE_BYTES];
     let (offs, _) = offsets();
@@ -475,8 +490,8 @@ pub const INITIAL_IMAGE: [u8; IMAGE_BYTES] = {
         // i < COUNT (compile-time evaluation)
         #[allow(clippy::indexing_slicing)]
         let (o, mut at) = (&TABLE[i], offs[i] as usize);
-        if o.ram_bytes() > 0 {
-            let mut rest = o.info.entries;
+        if o.declared_ram_bytes() > 0 {
+            let mut rest = declared(o.info.entries);
             // the record memory (J410/J411 of either axis) starts with the
             // records' defaults
             let mut memory_at = 0;
@@ -519,8 +534,8 @@ pub const LAYOUT_HASH: u32 = {
         // i < COUNT (compile-time evaluation)
         #[allow(clippy::indexing_slicing)]
         let o = &TABLE[i];
-        if o.ram_bytes() > 0 {
-            let mut rest = o.info.entries;
+        if o.declared_ram_bytes() > 0 {
+            let mut rest = declared(o.info.entries);
             while let [e, tail @ ..] = rest {
                 if e.persistent {
                     let words = [
@@ -561,8 +576,8 @@ pub const PERSISTENT_BYTES: usize = {
         // i < COUNT (compile-time evaluation)
         #[allow(clippy::indexing_slicing)]
         let o = &TABLE[i];
-        if o.ram_bytes() > 0 {
-            let mut rest = o.info.entries;
+        if o.declared_ram_bytes() > 0 {
+            let mut rest = declared(o.info.entries);
             while let [e, tail @ ..] = rest {
                 if e.persistent {
                     n += e.data_type.bytes();

@@ -203,7 +203,7 @@ fn program_equals_entry_copy(
     }
     // every TxPDO entry a distinct value (strings included)
     for (k, e) in img.tx.entries().iter().enumerate() {
-        let raw: Vec<u8> = (0..e.info.data_type.bytes())
+        let raw: Vec<u8> = (0..e.info.data_type().bytes())
             .map(|i| (k * 41 + i * 7 + 3) as u8)
             .collect();
         let _ = b.set_bytes(e.index, e.sub, &raw);
@@ -427,13 +427,13 @@ fn rx_template_subindices_resolve_to_the_runtime_numbering() {
     // A00 "Save values" (2000h): element 0 is subindex 0 in the "EtherCAT
     // Rx" template and subindex 1 in the runtime numbering
     let a00 = crate::parameter_index(0, 0);
-    assert_eq!(resolve(a00, 0, false).map(|e| e.sub), Some(1));
-    assert_eq!(resolve(a00, 2, false).map(|e| e.sub), Some(3));
-    assert_eq!(resolve(a00, 1, true).map(|e| e.sub), Some(1));
+    assert_eq!(resolve(a00, 0, false).map(|e| e.sub()), Some(1));
+    assert_eq!(resolve(a00, 2, false).map(|e| e.sub()), Some(3));
+    assert_eq!(resolve(a00, 1, true).map(|e| e.sub()), Some(1));
     assert_eq!(resolve(a00, 3, false), None, "three elements");
     // standard objects are the same in both templates
-    assert_eq!(resolve(0x6040, 0, false).map(|e| e.sub), Some(0));
-    assert_eq!(resolve(0x60FE, 1, false).map(|e| e.sub), Some(1));
+    assert_eq!(resolve(0x6040, 0, false).map(|e| e.sub()), Some(0));
+    assert_eq!(resolve(0x60FE, 1, false).map(|e| e.sub()), Some(1));
     let mut objects = DriveObjects::new();
     objects.set_template(Template::Rx);
     let img = PdoImage::compile(&objects).unwrap();

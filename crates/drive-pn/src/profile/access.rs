@@ -137,7 +137,7 @@ impl DriveAccess<'_> {
 
     /// The declaration of `index`:`sub`: 0x00 without the object, 0x03
     /// without the subindex.
-    fn entry(&self, index: u16, sub: u8) -> Result<&'static od::EntryInfo, PdError> {
+    fn entry(&self, index: u16, sub: u8) -> Result<od::EntryInfo, PdError> {
         self.objects
             .object(index)
             .ok_or(PdError::IMPERMISSIBLE_PNU)?

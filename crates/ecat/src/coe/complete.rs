@@ -54,7 +54,7 @@ pub fn capacity(info: &ObjectInfo) -> u8 {
 
 /// The metadata of entry `sub` (an ARRAY's element template for elements
 /// without an entry of their own).
-pub fn element(info: &ObjectInfo, sub: u8) -> Option<&'static EntryInfo> {
+pub fn element(info: &ObjectInfo, sub: u8) -> Option<EntryInfo> {
     if let Some(e) = info.entry(sub) {
         return Some(e);
     }
@@ -117,7 +117,7 @@ pub fn download<D: Dictionary>(
             return Err(SdoAbort::VALUE_TOO_HIGH);
         }
         if let Some(e) = sub0 {
-            check_range(e, &[count])?;
+            check_range(&e, &[count])?;
         }
         if !sub0_writable && count != sub0_value(dict, index, state)? {
             return Err(SdoAbort::READ_ONLY);
@@ -141,7 +141,7 @@ pub fn download<D: Dictionary>(
                 SdoAbort::READ_ONLY
             });
         }
-        check_range(entry, value)?;
+        check_range(&entry, value)?;
         pos = end;
     }
     if pos != body.len() {

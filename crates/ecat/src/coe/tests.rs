@@ -66,7 +66,7 @@ const fn object(
         index,
         name,
         code,
-        entries,
+        entries: od::Entries::slice(entries),
     }
 }
 
@@ -131,7 +131,7 @@ impl Dict {
         OBJECTS.iter().chain(many.iter())
     }
 
-    fn entry(&self, index: u16, sub: u8) -> Result<&'static EntryInfo, SdoAbort> {
+    fn entry(&self, index: u16, sub: u8) -> Result<EntryInfo, SdoAbort> {
         let info = self.object(index).ok_or(SdoAbort::NO_OBJECT)?;
         complete::element(info, sub).ok_or(SdoAbort::NO_SUBINDEX)
     }

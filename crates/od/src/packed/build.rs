@@ -1,0 +1,452 @@
+//! The compile-time builder of a [`PackedTable`](super::PackedTable): the
+//! string table, the shared range and default tables and the records, from a
+//! `const` slice of [`EntryInfo`]; [`packed_table!`](crate::packed_table) calls
+//! these in order. Each check is an `assert!` in compile-time evaluation: a
+//! declaration that does not fit the packed form does not compile.
+
+use super::{kind, narrow, PackedEntry, ACCESS_MASK, NO_RANGE, PERSISTENT, UNITS, UNIT_SHIFT};
+use crate::EntryInfo;
+
+const fn str_eq(a: &str, b: &str) -> bool {
+    let (a, b) = (a.as_bytes(), b.as_bytes());
+    if a.len() != b.len() {
+        return false;
+    }
+    let mut i = 0;
+    while i < a.len() {
+        // i < a.len() = b.len() (compile-time evaluation)
+        #[allow(clippy::indexing_slicing)]
+        if a[i] != b[i] {
+            return false;
+        }
+        i += 1;
+    }
+    true
+}
+
+const fn opt_eq(a: Option<i64>, b: Option<i64>) -> bool {
+    match (a, b) {
+        (Some(a), Some(b)) => a == b,
+        (None, None) => true,
+        _ => false,
+    }
+}
+
+/// The same entry (every field)? For de-duplicating lists at compile time.
+pub const fn same_entry(a: &EntryInfo, b: &EntryInfo) -> bool {
+    let (ka, kb) = (kind(a.data_type), kind(b.data_type));
+    a.sub == b.sub
+        && ka.0 == kb.0
+        && ka.1 == kb.1
+        && a.access.0 == b.access.0
+        && opt_eq(a.min, b.min)
+        && opt_eq(a.max, b.max)
+        && a.default == b.default
+        && a.persistent == b.persistent
+        && str_eq(a.name, b.name)
+        && str_eq(a.unit, b.unit)
+}
+
+/// The same entries, in the same order?
+pub const fn same_entries(a: &[EntryInfo], b: &[EntryInfo]) -> bool {
+    if a.len() != b.len() {
+        return false;
+    }
+    let mut i = 0;
+    while i < a.len() {
+        // i < a.len() = b.len() (compile-time evaluation)
+        #[allow(clippy::indexing_slicing)]
+        if !same_entry(&a[i], &b[i]) {
+            return false;
+        }
+        i += 1;
+    }
+    true
+}
+
+/// Position of the first entry before `i` with the name of entry `i`.
+const fn first_name(es: &[EntryInfo], i: usize) -> usize {
+    let mut j = 0;
+    while j < i {
+        // j < i < es.len() (compile-time evaluation)
+        #[allow(clippy::indexing_slicing)]
+        if str_eq(es[j].name, es[i].name) {
+            return j;
+        }
+        j += 1;
+    }
+    i
+}
+
+/// Is `extra[k]` neither an entry name of `es` nor an earlier extra?
+const fn extra_is_new(es: &[EntryInfo], extra: &[&str], k: usize) -> bool {
+    let mut i = 0;
+    while i < es.len() {
+        // i < es.len() (compile-time evaluation)
+        #[allow(clippy::indexing_slicing)]
+        if str_eq(es[i].name, extra[k]) {
+            return false;
+        }
+        i += 1;
+    }
+    let mut j = 0;
+    while j < k {
+        // j < k < extra.len() (compile-time evaluation)
+        #[allow(clippy::indexing_slicing)]
+        if str_eq(extra[j], extra[k]) {
+            return false;
+        }
+        j += 1;
+    }
+    true
+}
+
+/// Bytes of the de-duplicated names of `es` and the strings `extra` (e.g.
+/// object names).
+pub const fn string_bytes(es: &[EntryInfo], extra: &[&str]) -> usize {
+    let mut n = 0;
+    let mut i = 0;
+    while i < es.len() {
+        if first_name(es, i) == i {
+            // i < es.len() (compile-time evaluation)
+            #[allow(clippy::indexing_slicing)]
+            {
+                n += es[i].name.len();
+            }
+        }
+        i += 1;
+    }
+    let mut k = 0;
+    while k < extra.len() {
+        if extra_is_new(es, extra, k) {
+            // k < extra.len() (compile-time evaluation)
+            #[allow(clippy::indexing_slicing)]
+            {
+                n += extra[k].len();
+            }
+        }
+        k += 1;
+    }
+    assert!(n <= u16::MAX as usize, "packed names exceed 64 KiB");
+    n
+}
+
+/// The name offsets of `es` (in the order [`strings`] lays the names out).
+const fn name_offsets<const N: usize>(es: &[EntryInfo]) -> [u16; N] {
+    let mut out = [0u16; N];
+    let mut at = 0usize;
+    let mut i = 0;
+    while i < N {
+        let j = first_name(es, i);
+        // i, j < N = es.len() (compile-time evaluation)
+        #[allow(clippy::indexing_slicing)]
+        if j == i {
+            out[i] = at as u16;
+            at += es[i].name.len();
+        } else {
+            out[i] = out[j];
+        }
+        i += 1;
+    }
+    out
+}
+
+const fn put(out: &mut [u8], at: usize, s: &str) -> usize {
+    let b = s.as_bytes();
+    let mut k = 0;
+    while k < b.len() {
+        // at + k < out.len() by [`string_bytes`] (compile-time evaluation)
+        #[allow(clippy::indexing_slicing)]
+        {
+            out[at + k] = b[k];
+        }
+        k += 1;
+    }
+    at + b.len()
+}
+
+/// The string table of `es` and `extra`: each distinct name once, the entry
+/// names first. `S` = [`string_bytes`].
+pub const fn strings<const S: usize>(es: &[EntryInfo], extra: &[&str]) -> [u8; S] {
+    let mut out = [0u8; S];
+    let mut at = 0usize;
+    let mut i = 0;
+    while i < es.len() {
+        if first_name(es, i) == i {
+            // i < es.len() (compile-time evaluation)
+            #[allow(clippy::indexing_slicing)]
+            {
+                at = put(&mut out, at, es[i].name);
+            }
+        }
+        i += 1;
+    }
+    let mut k = 0;
+    while k < extra.len() {
+        if extra_is_new(es, extra, k) {
+            // k < extra.len() (compile-time evaluation)
+            #[allow(clippy::indexing_slicing)]
+            {
+                at = put(&mut out, at, extra[k]);
+            }
+        }
+        k += 1;
+    }
+    assert!(at == S, "string table size");
+    out
+}
+
+/// Offsets in the string table of `es` and `extra` ([`strings`]) of the
+/// strings `extra`. `N` = `es.len()`, `K` = `extra.len()`.
+pub const fn extra_offsets<const N: usize, const K: usize>(es: &[EntryInfo], extra: &[&str]) -> [u16; K] {
+    let names = name_offsets::<N>(es);
+    let mut at = 0usize;
+    let mut i = 0;
+    while i < N {
+        if first_name(es, i) == i {
+            // i < N = es.len() (compile-time evaluation)
+            #[allow(clippy::indexing_slicing)]
+            {
+                at += es[i].name.len();
+            }
+        }
+        i += 1;
+    }
+    let mut out = [0u16; K];
+    let mut k = 0;
+    while k < K {
+        // k < K = extra.len(), i < N, j < k (compile-time evaluation)
+        #[allow(clippy::indexing_slicing)]
+        let s = extra[k];
+        let mut found = false;
+        let mut i = 0;
+        while i < N && !found {
+            #[allow(clippy::indexing_slicing)]
+            if str_eq(es[i].name, s) {
+                out[k] = names[i];
+                found = true;
+            }
+            i += 1;
+        }
+        let mut j = 0;
+        while j < k && !found {
+            #[allow(clippy::indexing_slicing)]
+            if str_eq(extra[j], s) {
+                out[k] = out[j];
+                found = true;
+            }
+            j += 1;
+        }
+        if !found {
+            #[allow(clippy::indexing_slicing)]
+            {
+                out[k] = at as u16;
+            }
+            at += s.len();
+        }
+        k += 1;
+    }
+    out
+}
+
+/// The `len` bytes at `at` of the string table `table` (compile-time
+/// evaluation; "" when that is not a string).
+pub const fn str_at(table: &'static str, at: u16, len: usize) -> &'static str {
+    let t = table.as_bytes();
+    if at as usize + len > t.len() {
+        return "";
+    }
+    let (_, rest) = t.split_at(at as usize);
+    let (s, _) = rest.split_at(len);
+    match core::str::from_utf8(s) {
+        Ok(s) => s,
+        Err(_) => "",
+    }
+}
+
+const fn range_of(e: &EntryInfo) -> Option<[u32; 2]> {
+    assert!(
+        e.min.is_some() == e.max.is_some(),
+        "a packed entry has both range ends or none"
+    );
+    match (e.min, e.max) {
+        (Some(lo), Some(hi)) => Some([narrow(e.data_type, lo), narrow(e.data_type, hi)]),
+        _ => None,
+    }
+}
+
+const fn position_range(table: &[[u32; 2]], n: usize, r: [u32; 2]) -> usize {
+    let mut j = 0;
+    while j < n {
+        // j < n <= table.len() (compile-time evaluation)
+        #[allow(clippy::indexing_slicing)]
+        if table[j][0] == r[0] && table[j][1] == r[1] {
+            return j;
+        }
+        j += 1;
+    }
+    n
+}
+
+const fn position_value(table: &[u32], n: usize, v: u32) -> usize {
+    let mut j = 0;
+    while j < n {
+        // j < n <= table.len() (compile-time evaluation)
+        #[allow(clippy::indexing_slicing)]
+        if table[j] == v {
+            return j;
+        }
+        j += 1;
+    }
+    n
+}
+
+/// Distinct ranges of `es` (at most `MAX`), and how many.
+const fn collect_ranges<const MAX: usize>(es: &[EntryInfo]) -> ([[u32; 2]; MAX], usize) {
+    let mut out = [[0u32; 2]; MAX];
+    let mut n = 0;
+    let mut i = 0;
+    while i < es.len() {
+        // i < es.len(), n < MAX (compile-time evaluation)
+        #[allow(clippy::indexing_slicing)]
+        if let Some(r) = range_of(&es[i]) {
+            if position_range(&out, n, r) == n {
+                out[n] = r;
+                n += 1;
+            }
+        }
+        i += 1;
+    }
+    (out, n)
+}
+
+/// Distinct defaults of `es` (at most `MAX`), and how many.
+const fn collect_defaults<const MAX: usize>(es: &[EntryInfo]) -> ([u32; MAX], usize) {
+    let mut out = [0u32; MAX];
+    let mut n = 0;
+    let mut i = 0;
+    while i < es.len() {
+        // i < es.len(), n < MAX (compile-time evaluation)
+        #[allow(clippy::indexing_slicing)]
+        let v = narrow(es[i].data_type, es[i].default);
+        if position_value(&out, n, v) == n {
+            #[allow(clippy::indexing_slicing)]
+            {
+                out[n] = v;
+            }
+            n += 1;
+        }
+        i += 1;
+    }
+    (out, n)
+}
+
+/// Number of distinct ranges of `es` (`MAX`: an upper bound, e.g. `es.len()`).
+pub const fn range_count<const MAX: usize>(es: &[EntryInfo]) -> usize {
+    collect_ranges::<MAX>(es).1
+}
+
+/// The distinct ranges of `es`. `R` = [`range_count`].
+pub const fn ranges<const MAX: usize, const R: usize>(es: &[EntryInfo]) -> [[u32; 2]; R] {
+    let (all, n) = collect_ranges::<MAX>(es);
+    assert!(n == R && R < NO_RANGE as usize, "range count");
+    let mut out = [[0u32; 2]; R];
+    let mut i = 0;
+    while i < R {
+        // i < R <= MAX (compile-time evaluation)
+        #[allow(clippy::indexing_slicing)]
+        {
+            out[i] = all[i];
+        }
+        i += 1;
+    }
+    out
+}
+
+/// Number of distinct defaults of `es` (`MAX`: an upper bound).
+pub const fn default_count<const MAX: usize>(es: &[EntryInfo]) -> usize {
+    collect_defaults::<MAX>(es).1
+}
+
+/// The distinct defaults of `es`. `D` = [`default_count`].
+pub const fn defaults<const MAX: usize, const D: usize>(es: &[EntryInfo]) -> [u32; D] {
+    let (all, n) = collect_defaults::<MAX>(es);
+    assert!(n == D && D <= u16::MAX as usize, "default count");
+    let mut out = [0u32; D];
+    let mut i = 0;
+    while i < D {
+        // i < D <= MAX (compile-time evaluation)
+        #[allow(clippy::indexing_slicing)]
+        {
+            out[i] = all[i];
+        }
+        i += 1;
+    }
+    out
+}
+
+const fn unit_index(unit: &str) -> u16 {
+    let mut i = 0;
+    // i < UNITS.len() (compile-time evaluation)
+    #[allow(clippy::indexing_slicing)]
+    while i < UNITS.len() && !str_eq(UNITS[i], unit) {
+        i += 1;
+    }
+    assert!(i < UNITS.len(), "a packed entry's unit must be in od::UNITS");
+    i as u16
+}
+
+/// The records of `es` against the tables built from the same `es`.
+pub const fn entries<const N: usize>(
+    es: &[EntryInfo],
+    ranges: &[[u32; 2]],
+    defaults: &[u32],
+) -> [PackedEntry; N] {
+    assert!(N == es.len(), "entry count");
+    assert!(UNITS.len() <= 32, "5-bit unit index");
+    let names = name_offsets::<N>(es);
+    let mut out = [PackedEntry {
+        name: 0,
+        name_len: 0,
+        sub: 0,
+        flags: 0,
+        ty: 0,
+        range: NO_RANGE,
+        default: 0,
+    }; N];
+    let mut i = 0;
+    while i < N {
+        // i < N = es.len() (compile-time evaluation)
+        #[allow(clippy::indexing_slicing)]
+        let e = &es[i];
+        assert!(
+            e.name.len() <= u8::MAX as usize,
+            "a packed name has at most 255 bytes"
+        );
+        assert!(e.access.0 & !ACCESS_MASK == 0, "access bits 0..9");
+        let (k, n) = kind(e.data_type);
+        assert!(n < 1 << 12, "a packed string has at most 4095 bytes");
+        let range = match range_of(e) {
+            Some(r) => position_range(ranges, ranges.len(), r) as u16,
+            None => NO_RANGE,
+        };
+        let default = position_value(defaults, defaults.len(), narrow(e.data_type, e.default));
+        assert!(default < defaults.len(), "default in the table");
+        #[allow(clippy::indexing_slicing)]
+        {
+            out[i] = PackedEntry {
+                name: names[i],
+                name_len: e.name.len() as u8,
+                sub: e.sub,
+                flags: e.access.0
+                    | if e.persistent { PERSISTENT } else { 0 }
+                    | unit_index(e.unit) << UNIT_SHIFT,
+                ty: k | n << 4,
+                range,
+                default: default as u16,
+            };
+        }
+        i += 1;
+    }
+    out
+}

@@ -1,0 +1,538 @@
+//! The compact form of entry metadata: 12-byte [`PackedEntry`] records
+//! pointing into one de-duplicated string table, shared range and default
+//! tables of 32-bit values and the unit table [`UNITS`], built at compile time
+//! from a declaration of [`EntryInfo`] values ([`packed_table!`](crate::packed_table)).
+//!
+//! [`Entries`] is the handle an [`ObjectInfo`](crate::ObjectInfo) holds: a run
+//! of records in a [`PackedTable`], or a plain slice of [`EntryInfo`] (small
+//! hand-made dictionaries, tests). Either way entries are read by value, decoded.
+//!
+//! Constraints of the packed form (checked when the table is built, a violation
+//! is a compile error): names at most 255 bytes and 64 KiB of distinct names in
+//! all; a unit from [`UNITS`]; a range has both ends or none; ranges and
+//! defaults fit 32 bits (signed types: `i32`, the others `u32`); strings at most
+//! 4095 bytes; at most 65 535 distinct ranges and defaults.
+
+use crate::{Access, DataType, EntryInfo};
+
+mod build;
+pub use build::*;
+
+/// The units an entry of a packed table may have (index 0: none).
+pub static UNITS: [&str; 17] = [
+    "", "inc", "inc/s", "inc/s²", "inc/s³", "0.1 %", "0.1 %/s", "0.1 kW", "%", "‰", "rpm", "s", "ms", "µs",
+    "ns", "mNm", "mV",
+];
+
+/// No range ([`PackedEntry`] range index).
+const NO_RANGE: u16 = u16::MAX;
+const PERSISTENT: u16 = 1 << 10;
+const UNIT_SHIFT: u16 = 11;
+const ACCESS_MASK: u16 = (1 << 10) - 1;
+
+/// One entry in 12 bytes: name (offset and length in the string table),
+/// subindex, access bits with the persistence flag and the unit index, data
+/// type with its string length, range and default (indices into the shared
+/// tables).
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub struct PackedEntry {
+    name: u16,
+    name_len: u8,
+    sub: u8,
+    /// bits 0..9 access, bit 10 persistent, bits 11..15 unit
+    flags: u16,
+    /// bits 0..3 kind, bits 4..15 string length
+    ty: u16,
+    range: u16,
+    default: u16,
+}
+
+const fn kind(t: DataType) -> (u16, u16) {
+    match t {
+        DataType::Bool => (0, 0),
+        DataType::I8 => (1, 0),
+        DataType::I16 => (2, 0),
+        DataType::I32 => (3, 0),
+        DataType::U8 => (4, 0),
+        DataType::U16 => (5, 0),
+        DataType::U32 => (6, 0),
+        DataType::F32 => (7, 0),
+        DataType::VisibleString(n) => (8, n),
+        DataType::OctetString(n) => (9, n),
+        DataType::I64 => (10, 0),
+        DataType::U64 => (11, 0),
+    }
+}
+
+impl PackedEntry {
+    /// A record of no table: subindex 0, UNSIGNED8, read-only, no name
+    /// (placeholder in fixed-size tables).
+    pub const UNUSED: Self = Self {
+        name: 0,
+        name_len: 0,
+        sub: 0,
+        flags: crate::Access::READ,
+        ty: 4,
+        range: NO_RANGE,
+        default: u16::MAX,
+    };
+
+    /// Saved by "save values"?
+    pub const fn persistent(&self) -> bool {
+        self.flags & PERSISTENT != 0
+    }
+
+    /// Subindex.
+    pub const fn sub(&self) -> u8 {
+        self.sub
+    }
+
+    /// Data type.
+    pub const fn data_type(&self) -> DataType {
+        let n = self.ty >> 4;
+        match self.ty & 0xF {
+            0 => DataType::Bool,
+            1 => DataType::I8,
+            2 => DataType::I16,
+            3 => DataType::I32,
+            4 => DataType::U8,
+            5 => DataType::U16,
+            6 => DataType::U32,
+            7 => DataType::F32,
+            8 => DataType::VisibleString(n),
+            9 => DataType::OctetString(n),
+            10 => DataType::I64,
+            _ => DataType::U64,
+        }
+    }
+
+    /// Access rights.
+    pub const fn access(&self) -> Access {
+        Access(self.flags & ACCESS_MASK)
+    }
+}
+
+/// A table of packed entries with its string, range and default tables.
+#[derive(Debug)]
+pub struct PackedTable {
+    entries: &'static [PackedEntry],
+    strings: &'static str,
+    ranges: &'static [[u32; 2]],
+    defaults: &'static [u32],
+}
+
+/// A 32-bit table value as the entry's type reads it.
+const fn widen(t: DataType, raw: u32) -> i64 {
+    if t.signed() {
+        raw as i32 as i64
+    } else {
+        raw as i64
+    }
+}
+
+/// `v` as a 32-bit table value of type `t`; a compile error when it does not fit.
+const fn narrow(t: DataType, v: i64) -> u32 {
+    if t.signed() {
+        assert!(
+            v >= i32::MIN as i64 && v <= i32::MAX as i64,
+            "a packed range/default must fit i32"
+        );
+        v as i32 as u32
+    } else {
+        assert!(
+            v >= 0 && v <= u32::MAX as i64,
+            "a packed range/default must fit u32"
+        );
+        v as u32
+    }
+}
+
+impl PackedTable {
+    /// A table (used by [`packed_table!`](crate::packed_table)).
+    pub const fn new(
+        entries: &'static [PackedEntry],
+        strings: &'static str,
+        ranges: &'static [[u32; 2]],
+        defaults: &'static [u32],
+    ) -> Self {
+        Self {
+            entries,
+            strings,
+            ranges,
+            defaults,
+        }
+    }
+
+    /// The `len` entries from position `start`.
+    pub const fn list(&'static self, start: u16, len: u16) -> Entries {
+        Entries(Repr::Packed {
+            table: self,
+            start,
+            len,
+        })
+    }
+
+    /// Number of entries.
+    pub const fn len(&self) -> usize {
+        self.entries.len()
+    }
+
+    /// No entries?
+    pub const fn is_empty(&self) -> bool {
+        self.entries.is_empty()
+    }
+
+    /// The string table (entry names, then further names, each once).
+    pub const fn strings(&self) -> &'static str {
+        self.strings
+    }
+
+    /// Bytes of the records, strings, ranges and defaults.
+    pub const fn bytes(&self) -> usize {
+        core::mem::size_of_val(self.entries)
+            + self.strings.len()
+            + core::mem::size_of_val(self.ranges)
+            + core::mem::size_of_val(self.defaults)
+    }
+
+    /// The entry at position `at`, decoded.
+    pub fn get(&self, at: usize) -> Option<EntryInfo> {
+        self.entries.get(at).map(|p| self.decode(p))
+    }
+
+    /// The declared default of a record of this table.
+    pub fn default_of(&self, p: &PackedEntry) -> i64 {
+        self.defaults
+            .get(usize::from(p.default))
+            .map_or(0, |&d| widen(p.data_type(), d))
+    }
+
+    /// [`EntryInfo::check_range`] of a record of this table.
+    pub fn check_range(&self, p: &PackedEntry, value: i64) -> Result<(), crate::SdoAbort> {
+        let t = p.data_type();
+        let (lo, hi) = match self.ranges.get(usize::from(p.range)) {
+            Some(&[lo, hi]) => (widen(t, lo), widen(t, hi)),
+            None => (t.min_value(), t.max_value()),
+        };
+        if !t.is_integer() {
+            Ok(())
+        } else if value < lo {
+            Err(crate::SdoAbort::VALUE_TOO_LOW)
+        } else if value > hi {
+            Err(crate::SdoAbort::VALUE_TOO_HIGH)
+        } else {
+            Ok(())
+        }
+    }
+
+    /// Decodes a record of this table.
+    pub fn decode(&self, p: &PackedEntry) -> EntryInfo {
+        let t = p.data_type();
+        let start = usize::from(p.name);
+        let name = self
+            .strings
+            .get(start..start + usize::from(p.name_len))
+            .unwrap_or("");
+        let (min, max) = match self.ranges.get(usize::from(p.range)) {
+            Some(&[lo, hi]) => (Some(widen(t, lo)), Some(widen(t, hi))),
+            None => (None, None),
+        };
+        EntryInfo {
+            sub: p.sub,
+            name,
+            data_type: t,
+            access: p.access(),
+            min,
+            max,
+            default: self.default_of(p),
+            unit: UNITS
+                .get(usize::from(p.flags >> UNIT_SHIFT))
+                .copied()
+                .unwrap_or(""),
+            persistent: p.flags & PERSISTENT != 0,
+        }
+    }
+}
+
+/// The entries of an object: a run of a [`PackedTable`] or a slice.
+#[derive(Clone, Copy)]
+pub struct Entries(Repr);
+
+#[derive(Clone, Copy)]
+enum Repr {
+    Slice(&'static [EntryInfo]),
+    Packed {
+        table: &'static PackedTable,
+        start: u16,
+        len: u16,
+    },
+}
+
+impl Entries {
+    /// Entries given as a slice (hand-made dictionaries).
+    pub const fn slice(entries: &'static [EntryInfo]) -> Self {
+        Self(Repr::Slice(entries))
+    }
+
+    /// The slice, for entries given as one (compile-time evaluation).
+    pub const fn as_slice(&self) -> Option<&'static [EntryInfo]> {
+        match self.0 {
+            Repr::Slice(s) => Some(s),
+            Repr::Packed { .. } => None,
+        }
+    }
+
+    /// Number of entries.
+    pub const fn len(&self) -> usize {
+        match self.0 {
+            Repr::Slice(s) => s.len(),
+            Repr::Packed { len, .. } => len as usize,
+        }
+    }
+
+    /// No entries?
+    pub const fn is_empty(&self) -> bool {
+        self.len() == 0
+    }
+
+    /// The entry at position `pos` (not subindex), decoded.
+    pub fn get(&self, pos: usize) -> Option<EntryInfo> {
+        match self.0 {
+            Repr::Slice(s) => s.get(pos).copied(),
+            Repr::Packed { table, start, len } if pos < usize::from(len) => {
+                table.get(usize::from(start) + pos)
+            }
+            Repr::Packed { .. } => None,
+        }
+    }
+
+    /// The first entry (sub 0 when there is one).
+    pub fn first(&self) -> Option<EntryInfo> {
+        self.get(0)
+    }
+
+    /// Position of the entry with subindex `sub` (without decoding).
+    pub fn position(&self, sub: u8) -> Option<usize> {
+        match self.0 {
+            Repr::Slice(s) => s.iter().position(|e| e.sub == sub),
+            Repr::Packed { table, start, len } => {
+                let from = usize::from(start);
+                let run = table.entries.get(from..from + usize::from(len))?;
+                run.iter().position(|p| p.sub == sub)
+            }
+        }
+    }
+
+    /// Data type of the entry at position `pos` (without decoding).
+    pub fn data_type(&self, pos: usize) -> Option<DataType> {
+        match self.0 {
+            Repr::Slice(s) => s.get(pos).map(|e| e.data_type),
+            Repr::Packed { .. } => self.record(pos).map(PackedEntry::data_type),
+        }
+    }
+
+    /// The packed record at position `pos` (`None` for slices).
+    pub fn record(&self, pos: usize) -> Option<&'static PackedEntry> {
+        match self.0 {
+            Repr::Slice(_) => None,
+            Repr::Packed { table, start, len } if pos < usize::from(len) => {
+                table.entries.get(usize::from(start) + pos)
+            }
+            Repr::Packed { .. } => None,
+        }
+    }
+
+    /// The entry with subindex `sub`.
+    pub fn find(&self, sub: u8) -> Option<EntryInfo> {
+        match self.0 {
+            Repr::Slice(s) => s.iter().find(|e| e.sub == sub).copied(),
+            Repr::Packed { table, start, len } => {
+                let from = usize::from(start);
+                let run = table.entries.get(from..from + usize::from(len))?;
+                run.iter().find(|p| p.sub == sub).map(|p| table.decode(p))
+            }
+        }
+    }
+
+    /// Highest subindex (0 without entries).
+    pub fn max_sub(&self) -> u8 {
+        match self.0 {
+            Repr::Slice(s) => s.iter().map(|e| e.sub).max().unwrap_or(0),
+            Repr::Packed { table, start, len } => {
+                let from = usize::from(start);
+                let run = table.entries.get(from..from + usize::from(len)).unwrap_or(&[]);
+                run.iter().map(|p| p.sub).max().unwrap_or(0)
+            }
+        }
+    }
+
+    /// The entries in order, decoded.
+    pub fn iter(&self) -> Iter {
+        Iter {
+            entries: *self,
+            front: 0,
+            back: self.len(),
+        }
+    }
+}
+
+impl PartialEq for Entries {
+    fn eq(&self, other: &Self) -> bool {
+        self.len() == other.len() && self.iter().eq(other.iter())
+    }
+}
+
+impl core::fmt::Debug for Entries {
+    fn fmt(&self, f: &mut core::fmt::Formatter<'_>) -> core::fmt::Result {
+        f.debug_list().entries(self.iter()).finish()
+    }
+}
+
+impl IntoIterator for Entries {
+    type Item = EntryInfo;
+    type IntoIter = Iter;
+    fn into_iter(self) -> Iter {
+        self.iter()
+    }
+}
+
+impl IntoIterator for &Entries {
+    type Item = EntryInfo;
+    type IntoIter = Iter;
+    fn into_iter(self) -> Iter {
+        self.iter()
+    }
+}
+
+/// Iterator over [`Entries`], yielding decoded entries.
+#[derive(Clone)]
+pub struct Iter {
+    entries: Entries,
+    front: usize,
+    back: usize,
+}
+
+impl Iterator for Iter {
+    type Item = EntryInfo;
+    fn next(&mut self) -> Option<EntryInfo> {
+        if self.front >= self.back {
+            return None;
+        }
+        self.front += 1;
+        self.entries.get(self.front - 1)
+    }
+
+    fn size_hint(&self) -> (usize, Option<usize>) {
+        let n = self.back.saturating_sub(self.front);
+        (n, Some(n))
+    }
+}
+
+impl DoubleEndedIterator for Iter {
+    fn next_back(&mut self) -> Option<EntryInfo> {
+        if self.front >= self.back {
+            return None;
+        }
+        self.back -= 1;
+        self.entries.get(self.back)
+    }
+}
+
+impl ExactSizeIterator for Iter {}
+
+/// A `static` [`PackedTable`] of the entries `$entries` (a `const` slice of
+/// [`EntryInfo`]): positions in the table are positions in the slice. An
+/// optional `names = <const slice of &str>;` adds further strings to the
+/// string table (after the entry names, each once; [`extra_offsets`] says
+/// where).
+///
+/// The records, names, ranges and defaults become statics of their own
+/// (`<NAME>_ENTRIES`, ... are not nameable; they appear in the image as
+/// `…::<NAME>::ENTRIES` and so on).
+#[macro_export]
+macro_rules! packed_table {
+    ($(#[$m:meta])* $vis:vis static $name:ident = $entries:expr;) => {
+        $crate::packed_table!($(#[$m])* $vis static $name = $entries; names = &[];);
+    };
+    ($(#[$m:meta])* $vis:vis static $name:ident = $entries:expr; names = $names:expr;) => {
+        $(#[$m])*
+        $vis static $name: $crate::PackedTable = {
+            const PACKED_INPUT: &[$crate::EntryInfo] = $entries;
+            #[allow(long_running_const_eval)]
+            const N: usize = PACKED_INPUT.len();
+            #[allow(long_running_const_eval)]
+            const EXTRA: &[&str] = $names;
+            #[allow(long_running_const_eval)]
+            const S: usize = $crate::packed::string_bytes(PACKED_INPUT, EXTRA);
+            #[allow(long_running_const_eval)]
+            const R: usize = $crate::packed::range_count::<N>(PACKED_INPUT);
+            #[allow(long_running_const_eval)]
+            const D: usize = $crate::packed::default_count::<N>(PACKED_INPUT);
+            #[allow(long_running_const_eval)]
+            static ENTRIES: [$crate::PackedEntry; N] = $crate::packed::entries::<N>(PACKED_INPUT, &RANGES, &DEFAULTS);
+            #[allow(long_running_const_eval)]
+            static RANGES: [[u32; 2]; R] = $crate::packed::ranges::<N, R>(PACKED_INPUT);
+            #[allow(long_running_const_eval)]
+            static DEFAULTS: [u32; D] = $crate::packed::defaults::<N, D>(PACKED_INPUT);
+            #[allow(long_running_const_eval)]
+            static STRINGS: [u8; S] = $crate::packed::strings::<S>(PACKED_INPUT, EXTRA);
+            const _: () = assert!(::core::str::from_utf8(&STRINGS).is_ok(), "names are UTF-8");
+            #[allow(long_running_const_eval)]
+            const NAMES: &str = match ::core::str::from_utf8(&STRINGS) {
+                Ok(s) => s,
+                Err(_) => "",
+            };
+            $crate::PackedTable::new(&ENTRIES, NAMES, &RANGES, &DEFAULTS)
+        };
+    };
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::DataType::{OctetString, I16, U32, U8};
+
+    const ES: &[EntryInfo] = &[
+        EntryInfo::new(0, "Highest subindex supported", U8, Access::RO).default_value(2),
+        EntryInfo::new(1, "Speed", I16, Access::RW)
+            .range(-100, 100)
+            .default_value(-5)
+            .unit("rpm")
+            .saved(),
+        EntryInfo::new(2, "Limit", U32, Access::RW.with(Access::RXPDO))
+            .range(1, u32::MAX as i64)
+            .default_value(0xFFFF_FFFF),
+        EntryInfo::new(0, "Highest subindex supported", U8, Access::RO).default_value(2),
+        EntryInfo::new(1, "Blob", OctetString(16), Access::RO).unit("µs"),
+    ];
+    packed_table!(static TABLE = ES;);
+
+    #[test]
+    fn packs_and_decodes_every_field() {
+        assert_eq!(core::mem::size_of::<PackedEntry>(), 12);
+        assert_eq!(TABLE.len(), ES.len());
+        for (i, e) in ES.iter().enumerate() {
+            assert_eq!(TABLE.get(i), Some(*e), "entry {i}");
+        }
+        // one copy of the repeated name, one of the shared default
+        assert_eq!(
+            TABLE.strings.len(),
+            "Highest subindex supportedSpeedLimitBlob".len()
+        );
+        assert_eq!(TABLE.defaults.len(), 4);
+        assert_eq!(TABLE.ranges.len(), 2);
+    }
+
+    #[test]
+    fn runs_read_like_slices() {
+        let run = TABLE.list(0, 3);
+        let slice = Entries::slice(&ES[..3]);
+        assert_eq!(run, slice);
+        assert_eq!(run.find(2), ES.get(2).copied());
+        assert_eq!(run.find(3), None);
+        assert_eq!(run.get(3), None);
+        assert_eq!(run.max_sub(), 2);
+        assert_eq!(run.iter().next_back(), ES.get(2).copied());
+        assert_eq!(TABLE.list(3, 2).iter().count(), 2);
+    }
+}
