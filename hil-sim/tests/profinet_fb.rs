@@ -49,9 +49,11 @@ fn verdict(line: &str) -> Option<(&str, &str, &str)> {
 /// modes, homing, positioning with appended records, relative, change
 /// immediately, intermediate stop and hold, speed and torque control, jog,
 /// PKW with a unit change (P-208), the parameter record (P-206), fault and
-/// its reset) through profinet-py against serve.
+/// its reset, the position error limit PNU 1273 (P-160)) through profinet-py
+/// against serve.
 #[test]
-fn p206_p208_p219_p220_p221_p222_p223_p224_p225_p226_p227_the_example_function_block_through_profinet_py() {
+fn p160_p206_p208_p219_p220_p221_p222_p223_p224_p225_p226_p227_the_example_function_block_through_profinet_py(
+) {
     let python = match common::profinet_py_python() {
         Ok(p) => p,
         Err(why) => {

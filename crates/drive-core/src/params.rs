@@ -76,8 +76,12 @@ pub const I02: u16 = parameter_index(8, 2);
 pub const A279: u16 = parameter_index(0, 279);
 /// A280 PROFINET telegrams (the profile's stored telegram configuration).
 pub const A280: u16 = parameter_index(0, 280);
+/// I21 position error limit (per axis, user position units; `u32::MAX` = off).
+pub const I21: u16 = parameter_index(8, 21);
 /// I22 target window (per axis, user position units).
 pub const I22: u16 = parameter_index(8, 22);
+/// I23 position controller dead band (per axis, user position units).
+pub const I23: u16 = parameter_index(8, 23);
 /// I46 reference retaining (per axis).
 pub const I46: u16 = parameter_index(8, 46);
 /// I101 / I102 / I103 sources of +LS, −LS and the reference switch.

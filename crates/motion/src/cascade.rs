@@ -75,6 +75,11 @@ pub struct CascadeConfig {
     /// Position controller gain Kv in 1/s (velocity command in increments/s
     /// per increment of following error).
     pub position_gain_per_s: f32,
+    /// I23 dead band of the position controller in increments (PROFINET
+    /// PNU 1270.2, P-157): while |following error| is within it, the position
+    /// controller adds no velocity command (the feedforward still passes),
+    /// so a gear's backlash does not make the axis hunt. 0 = off.
+    pub position_dead_band_inc: u32,
     /// I25 speed feedforward weight in % (0 … 100; 0 disables, C-120),
     /// applied to the velocity feedforward in the position entry. The
     /// [`FineInterpolator`](crate::FineInterpolator) output is already
@@ -115,6 +120,7 @@ impl CascadeConfig {
     /// of 0 %), no acceleration feedforward.
     pub const DEFAULT: CascadeConfig = CascadeConfig {
         position_gain_per_s: 100.0,
+        position_dead_band_inc: 0,
         velocity_feedforward_percent: 100.0,
         velocity_gain_nm_per_rad_per_s: 0.06,
         velocity_integral_time_ns: 8_000_000,
@@ -297,7 +303,13 @@ impl Cascade {
                         .wrapping_sub(input.actual_position_inc);
                     let ff =
                         finite_or_zero(input.velocity_inc_per_s) * cfg.velocity_feedforward_percent * 0.01;
-                    cfg.position_gain_per_s * following_error_inc as f32 + ff
+                    // P-157: no correction inside the dead band (|0| ≤ 0 when off)
+                    let corrected = if following_error_inc.unsigned_abs() <= cfg.position_dead_band_inc {
+                        0
+                    } else {
+                        following_error_inc
+                    };
+                    cfg.position_gain_per_s * corrected as f32 + ff
                 } else {
                     finite_or_zero(input.velocity_inc_per_s)
                 };
@@ -536,6 +548,53 @@ mod tests {
         assert_eq!(out.torque_nm, 0.0);
         assert_eq!(out.following_error_inc, 0);
         assert!(!out.internal_limit);
+    }
+
+    /// P-157: inside the dead band the position controller's output is only
+    /// the feedforward; one increment beyond it Kv·error comes back.
+    #[test]
+    fn p157_no_position_correction_inside_the_dead_band() {
+        let cfg = CascadeConfig {
+            position_dead_band_inc: 100,
+            ..CascadeConfig::DEFAULT
+        };
+        let command = |error: i32, ff: f32| {
+            let mut cascade = Cascade::new(cfg, 0).unwrap();
+            let out = cascade.cycle(
+                &CascadeInput {
+                    entry: ControlEntry::Position,
+                    position_setpoint_inc: error,
+                    velocity_inc_per_s: ff,
+                    acceleration_feedforward_inc_per_s2: 0.0,
+                    torque_nm: 0.0,
+                    actual_position_inc: 0,
+                    actual_velocity_inc_per_s: Some(0.0),
+                },
+                DT_NS,
+            );
+            assert_eq!(out.following_error_inc, error, "reported unchanged");
+            out.velocity_command_inc_per_s
+        };
+        assert_eq!(command(100, 0.0), 0.0);
+        assert_eq!(command(-100, 0.0), 0.0);
+        assert_eq!(command(60, 5000.0), 5000.0, "feedforward passes");
+        assert_eq!(command(101, 0.0), 100.0 * 101.0);
+        assert_eq!(command(-101, 0.0), -100.0 * 101.0);
+        // off (the default): any error is corrected
+        let mut cascade = Cascade::new(CascadeConfig::DEFAULT, 0).unwrap();
+        let out = cascade.cycle(
+            &CascadeInput {
+                entry: ControlEntry::Position,
+                position_setpoint_inc: 1,
+                velocity_inc_per_s: 0.0,
+                acceleration_feedforward_inc_per_s2: 0.0,
+                torque_nm: 0.0,
+                actual_position_inc: 0,
+                actual_velocity_inc_per_s: Some(0.0),
+            },
+            DT_NS,
+        );
+        assert_eq!(out.velocity_command_inc_per_s, 100.0);
     }
 
     #[test]

@@ -23,6 +23,11 @@ use nanos::Nanos;
 /// number; 54 is the device family's following-error event).
 pub const FOLLOWING_ERROR_EVENT: Event = Event { number: 54, cause: 1 };
 
+/// Fault event "Position error limit" (event 54, cause 2), raised by
+/// [`FollowingErrorMonitor`] the cycle |following error| passes I21
+/// (PROFINET PNU 1273, P-160): the second, larger window, without a time.
+pub const POSITION_ERROR_LIMIT_EVENT: Event = Event { number: 54, cause: 2 };
+
 /// 6066h following error timeout / 6068h position window time (ms, UINT16)
 /// as [`Nanos`].
 pub const fn ms_to_ns(ms: u16) -> Nanos {
@@ -40,6 +45,10 @@ pub struct FollowingErrorConfig {
     /// Raise [`FOLLOWING_ERROR_EVENT`] (fault) when bit 13 comes on;
     /// `false` = statusword bit 13 only (`[std]`).
     pub fault: bool,
+    /// I21 position error limit in increments: beyond it
+    /// [`POSITION_ERROR_LIMIT_EVENT`] is raised at once (always a fault);
+    /// `u32::MAX` switches it off.
+    pub limit_inc: u32,
 }
 
 impl Default for FollowingErrorConfig {
@@ -49,6 +58,7 @@ impl Default for FollowingErrorConfig {
             window_inc: crate::INCREMENTS_PER_REVOLUTION / 4,
             timeout: ms_to_ns(10),
             fault: false,
+            limit_inc: u32::MAX,
         }
     }
 }
@@ -62,6 +72,9 @@ pub struct FollowingErrorStatus {
     pub following_error: bool,
     /// [`FOLLOWING_ERROR_EVENT`] on the cycle bit 13 comes on, if configured.
     pub event: Option<Event>,
+    /// [`POSITION_ERROR_LIMIT_EVENT`] on the cycle the error passes the
+    /// limit (I21).
+    pub limit_event: Option<Event>,
 }
 
 /// Following-error monitoring of csp and pp (C-036).
@@ -71,6 +84,8 @@ pub struct FollowingErrorMonitor {
     /// Time the error left the window.
     outside_since: Option<Nanos>,
     active: bool,
+    /// |error| beyond I21 in the last update.
+    beyond_limit: bool,
 }
 
 impl FollowingErrorMonitor {
@@ -80,6 +95,7 @@ impl FollowingErrorMonitor {
             config,
             outside_since: None,
             active: false,
+            beyond_limit: false,
         }
     }
 
@@ -92,6 +108,7 @@ impl FollowingErrorMonitor {
     pub fn reset(&mut self) {
         self.outside_since = None;
         self.active = false;
+        self.beyond_limit = false;
     }
 
     /// Bit 13 as of the last update.
@@ -119,10 +136,15 @@ impl FollowingErrorMonitor {
             self.active = false;
         }
         let event = (self.active && !was_active && self.config.fault).then_some(FOLLOWING_ERROR_EVENT);
+        let was_beyond = self.beyond_limit;
+        self.beyond_limit =
+            self.config.limit_inc != u32::MAX && error_inc.unsigned_abs() > self.config.limit_inc;
+        let limit_event = (self.beyond_limit && !was_beyond).then_some(POSITION_ERROR_LIMIT_EVENT);
         FollowingErrorStatus {
             error_inc,
             following_error: self.active,
             event,
+            limit_event,
         }
     }
 }
@@ -303,7 +325,38 @@ mod tests {
             window_inc: 1000,
             timeout: ms_to_ns(5),
             fault,
+            limit_inc: u32::MAX,
         }
+    }
+
+    /// P-160: beyond I21 the limit event comes at once (no timeout), once
+    /// per crossing, independent of the window's fault setting.
+    #[test]
+    fn p160_position_error_limit_raises_54_2_at_once() {
+        let mut m = FollowingErrorMonitor::new(FollowingErrorConfig {
+            limit_inc: 5000,
+            ..fe_config(false)
+        });
+        assert_eq!(m.update(5000, 0, Nanos::ZERO).limit_event, None, "at the limit");
+        let s = m.update(-5001, 0, MS);
+        assert_eq!(s.limit_event, Some(POSITION_ERROR_LIMIT_EVENT));
+        assert!(!s.following_error, "the window's timeout still runs");
+        assert_eq!(m.update(-6000, 0, Nanos::from_ms(2)).limit_event, None, "once");
+        assert_eq!(m.update(0, 0, Nanos::from_ms(3)).limit_event, None);
+        assert_eq!(
+            m.update(0, 5001, Nanos::from_ms(4)).limit_event,
+            Some(POSITION_ERROR_LIMIT_EVENT),
+            "again after coming back"
+        );
+        m.reset();
+        assert_eq!(
+            m.update(0, 5001, Nanos::from_ms(5)).limit_event,
+            Some(POSITION_ERROR_LIMIT_EVENT),
+            "a reset (fault reset, enable) re-arms it"
+        );
+        // off: u32::MAX
+        let mut off = FollowingErrorMonitor::new(fe_config(true));
+        assert_eq!(off.update(i32::MAX, i32::MIN + 1, Nanos::ZERO).limit_event, None);
     }
 
     #[test]

@@ -733,7 +733,9 @@ def p206_record(fb, sc, dev):
 
 def p227_fault(fb, sc, fifo):
     """A drive fault (serve's control channel): fault, fault_reset (rising
-    edge of CW1 bit 7) clears it, drive_enable enables again."""
+    edge of CW1 bit 7) clears it, drive_enable enables again; the
+    following-error message (PNU 1272) and the position error limit's fault
+    (PNU 1273, P-160)."""
     if fifo is None:
         sc.note("n/a: no --control (fault injection needs serve's control FIFO)")
         return
@@ -770,6 +772,29 @@ def p227_fault(fb, sc, fifo):
              f"enabled throughout {all(o.drive_is_enabled for o in run)}")
     if r is not None:
         fb.pkw(PKW_WRITE, 1272, 0, r[1])
+    # P-160: PNU 1273 (I21) at 1/1000 rev: the same move passes it and the drive faults at once with
+    # 54-2; the limit restored from the value read (4 096 000 = off), the fault is acknowledged
+    r = fb.pkw(PKW_READ, 1273, 0)
+    w = fb.pkw(PKW_WRITE, 1273, 0, 1)
+    start = fb.o.position_actual_value
+    fb.i.target_position = start + 3000
+    fb.i.profile_velocity = 600
+    fb.i.start_pos = True
+    dt = fb.until(lambda o: o.fault, 3.0)
+    fb.i.start_pos = False
+    last = fb.pkw(PKW_READ, 1600, 0)
+    sc.check(r == (PKW_READ, 4_096_000) and w == (PKW_WRITE, 1) and dt is not None
+             and last == (PKW_READ, 54 * 16 + 2),
+             f"PNU 1273 {r} -> 1 ({w}): a move faults after {ms(dt)} at {fb.o.position_actual_value}, "
+             f"PNU 1600 {last} (want 54 x 16 + 2 = {54 * 16 + 2})")
+    back = fb.pkw(PKW_WRITE, 1273, 0, r[1] if r else 4_096_000)
+    fb.run_for(0.2)  # the fault reaction has ended
+    fb.i.fault_reset = True
+    dt = fb.until(lambda o: not o.fault, 3.0)
+    fb.i.fault_reset = False
+    dt2 = fb.until(lambda o: o.drive_is_enabled, 3.0)
+    sc.check(back == (PKW_WRITE, 4_096_000) and dt is not None and dt2 is not None,
+             f"PNU 1273 back to {back}: fault_reset cleared it after {ms(dt)}, enabled again after {ms(dt2)}")
     sc.note(f"warning (ZSW1 bit 7) {any(o.warning for o in run)}: no warning source in serve (no limit "
             "switches; the 1272 reaction is a message), not checked")
     sc.note("fault_reset while the cause persists: n/a (serve's control channel raises one-shot events, "

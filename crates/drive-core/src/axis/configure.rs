@@ -62,6 +62,7 @@ impl Axis {
             torque_limit_positive_nm: max_nm,
             torque_limit_negative_nm: max_nm,
             velocity_feedforward_percent: 100.0,
+            position_dead_band_inc: o.dead_band,
             ..scaled_gains(&p.cascade, dt_ns)
         };
         if !self.torque_mode_speed_limit.is_nan() {
@@ -78,6 +79,7 @@ impl Axis {
             window_inc: o.following_error_window,
             timeout: ms_to_ns(o.following_error_timeout_ms),
             fault: p.following_error_fault,
+            limit_inc: o.position_error_limit,
         });
         self.in_position.set_config(PositionWindowConfig {
             window_inc: o.target_window,

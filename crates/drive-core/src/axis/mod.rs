@@ -750,6 +750,9 @@ impl Axis {
             if let Some(ev) = fe.event {
                 self.raise(ev);
             }
+            if let Some(ev) = fe.limit_event {
+                self.raise(ev);
+            }
             // bit 13 of csp/pp is the monitor's state after this cycle
             if matches!(
                 self.running,

@@ -14,7 +14,7 @@ use crate::{AXIS_B_CIA402, AXIS_B_MANUFACTURER};
 use motion::scaling::AxisScaling;
 
 pub(crate) use crate::params::{
-    A150, A213, A291, A310, A340, A66, A67, E47, E48, E49, E80, I02, I101, I210, I22, I46,
+    A150, A213, A291, A310, A340, A66, A67, E47, E48, E49, E80, I02, I101, I21, I210, I22, I23, I46,
 };
 
 /// Entry `index`:`sub`, or 0 with `misses` counted: the dictionary declares
@@ -254,6 +254,10 @@ pub(crate) struct Snapshot {
     pub following_error_timeout_ms: u16,
     /// I22 target window, inc.
     pub target_window: u32,
+    /// I21 position error limit, inc (`u32::MAX` = off).
+    pub position_error_limit: u32,
+    /// I23 position controller dead band, inc.
+    pub dead_band: u32,
     /// 607Dh:01 / :02 software position limits, inc.
     pub software_min: i32,
     /// 607Dh:02.
@@ -386,6 +390,8 @@ impl Snapshot {
             following_error_window: u32_(0x6065, 0),
             following_error_timeout_ms: u16_(0x6066, 0),
             target_window: sat(w.param(od, I22, 0, m), 0u32, u32::MAX),
+            position_error_limit: sat(w.param(od, I21, 0, m), 0u32, u32::MAX),
+            dead_band: sat(w.param(od, I23, 0, m), 0u32, u32::MAX),
             software_min: i32_(0x607D, 1),
             software_max: i32_(0x607D, 2),
             polarity: u8_(0x607E, 0),
@@ -495,6 +501,12 @@ impl Snapshot {
                 mag(self.following_error_window)
             },
             target_window: mag(self.target_window),
+            position_error_limit: if self.position_error_limit == u32::MAX {
+                u32::MAX
+            } else {
+                mag(self.position_error_limit)
+            },
+            dead_band: mag(self.dead_band),
             ..self
         }
     }

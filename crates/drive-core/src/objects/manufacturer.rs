@@ -162,7 +162,7 @@ const fn string(s: &str) -> DataType {
 }
 
 /// Global and axis-A manufacturer parameters, sorted by index.
-pub const PARAMS: [Object; 78] = [
+pub const PARAMS: [Object; 80] = [
     param_array!(a(0), "Save values", Record, Value::Ram, from ACTION)
         .note("A00; [0] = 1 requests saving (E-018); progress/result set by the store"),
     param_array!(a(9), "Restart", Record, Value::Ram, from ACTION)
@@ -695,6 +695,17 @@ pub const PARAMS: [Object; 78] = [
     .level(1)
     .note("I02; 0 = motor encoder, the only encoder of this hardware model (C-113)"),
     Object::var(
+        i_(21),
+        Value::Ram,
+        entries![e(0, "Position error limit", U32, RW)
+            .default_value(u32::MAX as i64)
+            .unit("inc")
+            .saved()],
+    )
+    .axis()
+    .level(1)
+    .note("I21; beyond it event 54 cause 2 (a fault) at once; 4294967295 = off; PROFINET PNU 1273 (P-160)"),
+    Object::var(
         i_(22),
         Value::Ram,
         entries![e(0, "Target window", U32, RW).default_value(2912).unit("inc").saved()],
@@ -702,6 +713,14 @@ pub const PARAMS: [Object; 78] = [
     .axis()
     .level(1)
     .note("I22; position window of target reached and in position (CiA 402 6067h's role; default 1° in increments); PROFINET PNU 1271 (P-158)"),
+    Object::var(
+        i_(23),
+        Value::Ram,
+        entries![e(0, "Position dead band", U32, RW).unit("inc").saved()],
+    )
+    .axis()
+    .level(1)
+    .note("I23; no position correction while |following error| is within it (backlash); 0 = off; PROFINET PNU 1270.2 (P-157)"),
     Object::var(
         i_(46),
         Value::Ram,

@@ -100,6 +100,16 @@ fn signed(t: DataType) -> bool {
     matches!(t, DataType::I8 | DataType::I16 | DataType::I32 | DataType::I64)
 }
 
+/// The smallest and largest value of `t` (64-bit types: all of `i64`).
+fn type_limits(t: DataType) -> (i64, i64) {
+    let bits = 8 * size(t) as u32;
+    match (bits, signed(t)) {
+        (64, _) => (i64::MIN, i64::MAX),
+        (b, true) => (-(1i64 << (b - 1)), (1i64 << (b - 1)) - 1),
+        (b, false) => (0, (1i64 << b) - 1),
+    }
+}
+
 /// The drive as the profile reaches it, for one cycle or one request.
 pub struct DriveAccess<'a> {
     /// The object dictionary.
@@ -177,10 +187,22 @@ impl DriveAccess<'_> {
             .map_err(pd_error)
     }
 
+    /// Writes `value` (the object's units) into `index`:`sub`; a value
+    /// beyond the object's type is refused with 0x02 (never cut to its low
+    /// bytes).
     fn write_object(&mut self, index: u16, sub: u8, value: i64) -> Result<(), PdError> {
         let bytes = value.to_le_bytes();
+        let fits = |t: DataType| {
+            let (min, max) = type_limits(t);
+            if (min..=max).contains(&value) {
+                Ok(())
+            } else {
+                Err(PdError::LIMIT_EXCEEDED)
+            }
+        };
         let t = match self.prepared.get(self.objects, index, sub) {
             Some(p) => {
+                fits(p.data_type())?;
                 let data = bytes
                     .get(..size(p.data_type()))
                     .ok_or(PdError::INCORRECT_DATA_TYPE)?;
@@ -191,6 +213,7 @@ impl DriveAccess<'_> {
             }
             None => self.entry(index, sub)?.data_type,
         };
+        fits(t)?;
         let data = bytes.get(..size(t)).ok_or(PdError::INCORRECT_DATA_TYPE)?;
         self.objects
             .write(index, sub, data, CommState::Op)
@@ -219,6 +242,23 @@ impl DriveAccess<'_> {
             Unit::Rpm => units::rpm_of(units::from_bus(&p.velocity, bus).map_err(|_| range)?),
             Unit::RpmPerSecond => units::rpm_of(units::from_bus(&p.acceleration, bus).map_err(|_| range)?),
         })
+    }
+
+    /// [`Self::to_object`] for a write of `index`:`sub`, where the bus value a
+    /// read of the type's limit returns writes that limit: a value read can
+    /// be written back although its rounding lands just beyond the type
+    /// (PNU 1273's default `u32::MAX` increments reads 4 096 000/1000 rev,
+    /// which converts to 2^32 increments).
+    fn to_object_read_back(&self, unit: Unit, bus: i64, index: u16, sub: u8) -> Result<i64, PdError> {
+        let v = self.to_object(unit, bus)?;
+        let (min, max) = type_limits(self.entry(index, sub)?.data_type);
+        if v > max && self.to_bus(unit, max) == Ok(bus) {
+            return Ok(max);
+        }
+        if v < min && self.to_bus(unit, min) == Ok(bus) {
+            return Ok(min);
+        }
+        Ok(v)
     }
 
     /// The object's units → bus units.
@@ -418,8 +458,8 @@ impl ParamAccess for DriveAccess<'_> {
         }
         match p.source {
             Source::Object { index, sub } => {
-                let v = self.to_object(p.unit, value)?;
                 let index = self.index(index);
+                let v = self.to_object_read_back(p.unit, value, index, sub)?;
                 self.write_object(index, sub, v)?;
             }
             Source::SelectedRecord(f) => self.write_record(None, f, p.unit, value)?,

@@ -459,6 +459,17 @@ pub const CATALOGUE: &[Pnu] = &[
         Unit::None,
         Source::DigitalInputs,
     ),
+    // P-157: a RECORD of max sub 2 in the manual, whose subindices 0 and 1
+    // it does not name: only .2 exists here (0 and 1 answer error 0x03)
+    p(
+        1270,
+        2,
+        "Position Error Tolerance Window",
+        U32,
+        RW,
+        Unit::Position,
+        obj(drive_core::params::I23, 0),
+    ),
     p(
         1271,
         0,
@@ -476,6 +487,16 @@ pub const CATALOGUE: &[Pnu] = &[
         RW,
         Unit::Position,
         obj(0x6065, 0),
+    ),
+    // P-160: the second, larger window; its reaction is always the fault 54-2
+    p(
+        1273,
+        0,
+        "Position Error Limit",
+        U32,
+        RW,
+        Unit::Position,
+        obj(drive_core::params::I21, 0),
     ),
     p(
         1500,

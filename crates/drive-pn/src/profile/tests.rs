@@ -4,7 +4,7 @@
 
 use crate::tests::{drive, TestFlash};
 use crate::PnDrive;
-use drive_core::axis::AxisIo;
+use drive_core::axis::{AxisCommand, AxisIo};
 use nanos::Nanos;
 use profinet::wire::EthFrame;
 use std::vec::Vec;
@@ -25,6 +25,8 @@ struct Bench {
     /// cycle (a motor turning at a constant speed).
     io: [AxisIo; 2],
     advance: i32,
+    /// The axes' commands of the last control cycle.
+    commands: [AxisCommand; 2],
 }
 
 fn slot(d: &PnDrive<TestFlash>, to_drive: bool) -> u16 {
@@ -44,6 +46,7 @@ impl Bench {
             response: Vec::new(),
             io: [AxisIo::ready(0), AxisIo::ready(0)],
             advance: 0,
+            commands: [AxisCommand::OFF; 2],
         }
     }
 
@@ -89,7 +92,7 @@ impl Bench {
             let f = self.frame(telegram);
             let mut last = None;
             self.d.receive(now, &f, &mut |_: &[u8]| {}, &mut |_| {});
-            self.d.control_cycle(now, &io);
+            self.commands = self.d.control_cycle(now, &io);
             self.d.poll(
                 now,
                 &mut |b: &[u8]| {

@@ -125,6 +125,96 @@ fn p158_target_window_drives_bit_10() {
     assert_eq!(b.zsw1() & BIT_10, 0, "outside 1°: {:#06x}", b.zsw1());
 }
 
+impl Bench {
+    /// Enabled in positioning and homed at the encoder's position (method
+    /// 34), standing.
+    fn enabled_and_homed(&mut self) {
+        for cw1 in [0x0406, 0x0407, 0x040F] {
+            self.run(&positioning(cw1, 0, 1000, 10_000), 20);
+        }
+        self.run(&positioning(0x0C3F, 0, 1000, 10_000), 50);
+        self.run(&positioning(0x043F, 0, 1000, 10_000), 20);
+    }
+}
+
+/// PNU 1270.2 (I23) is the position controller's dead band, in 1/1000 rev:
+/// with the axis held 1000 increments off its set-point, no torque inside a
+/// 2/1000 rev band (2097 increments), the correction without it (P-157).
+/// PNU 1270 has no subindex 0 or 1.
+#[test]
+fn p157_inside_the_dead_band_the_position_controller_is_quiet() {
+    let held_off = |band: Option<u32>| {
+        let mut b = Bench::new();
+        if let Some(band) = band {
+            assert_eq!(b.pkw0(0x42, 1270, 2, band), (0x42, band as i32));
+            assert_eq!(
+                b.d.objects().get(drive_core::params::I23, 0),
+                Ok(i64::from(band) * (1 << 20) / 1000)
+            );
+        }
+        b.enabled_and_homed();
+        assert_eq!(b.zsw1() & 0x0007, 0x0007, "enabled: {:#06x}", b.zsw1());
+        // the jump's one-cycle velocity leaves the velocity controller's
+        // integral part; after it only the position controller can act
+        b.io[0].position_inc = 1000;
+        b.run(&positioning(0x043F, 0, 1000, 10_000), 5);
+        let early = b.commands[0].torque_nm;
+        b.run(&positioning(0x043F, 0, 1000, 10_000), 100);
+        (early, b.commands[0].torque_nm)
+    };
+    let (early, late) = held_off(Some(2));
+    assert!(
+        (late - early).abs() < 1e-3 && late.abs() < 0.01,
+        "inside the band, nothing pulls: {early} → {late} N·m"
+    );
+    let (early, late) = held_off(None);
+    assert!(
+        late < -0.01 && late - early < -0.01,
+        "without the band, pulled back: {early} → {late} N·m"
+    );
+    let mut b = Bench::new();
+    assert_eq!(b.pkw0(0x41, 1270, 2, 0), (0x41, 0), "off by default");
+    assert_eq!(b.pkw0(0x42, 1270, 0, 5), (0xC2, 3), "no subindex 0");
+    assert_eq!(b.pkw0(0x41, 1270, 1, 0), (0xC1, 3), "no subindex 1");
+    assert_eq!(b.d.objects().get(drive_core::params::I23, 0), Ok(0));
+}
+
+/// PNU 1273 (I21) is the position error limit, in 1/1000 rev: the encoder
+/// pulled 2000 increments off the set-point passes a 1/1000 rev limit (1049
+/// increments) and the drive faults at once with 54-2 (ZSW1 bit 3, PNU 1600
+/// = 54 × 16 + 2); off by default, and the value a read of the default
+/// returns writes the default back (P-160).
+#[test]
+fn p160_the_position_error_limit_faults_at_once() {
+    let mut b = Bench::new();
+    let i21 = drive_core::params::I21;
+    let (code, off) = b.pkw0(0x41, 1273, 0, 0);
+    assert_eq!((code, off), (0x41, 4_096_000), "u32::MAX increments");
+    assert_eq!(b.pkw0(0x42, 1273, 0, 4_096_000).0, 0x42, "read value writes back");
+    assert_eq!(b.d.objects().get(i21, 0), Ok(i64::from(u32::MAX)));
+    assert_eq!(b.pkw0(0x42, 1273, 0, 4_096_001), (0xC2, 2), "beyond UINT32");
+    assert_eq!(b.d.objects().get(i21, 0), Ok(i64::from(u32::MAX)), "unchanged");
+    // off: far off the set-point, no fault
+    b.enabled_and_homed();
+    b.io[0].position_inc = 500_000;
+    b.run(&positioning(0x043F, 0, 1000, 10_000), 3);
+    assert_eq!(b.zsw1() & 0x0008, 0, "no limit: {:#06x}", b.zsw1());
+
+    let mut b = Bench::new();
+    assert_eq!(b.pkw0(0x42, 1273, 0, 1), (0x42, 1));
+    assert_eq!(b.d.objects().get(i21, 0), Ok(1049));
+    b.enabled_and_homed();
+    b.io[0].position_inc = 1000;
+    b.run(&positioning(0x043F, 0, 1000, 10_000), 3);
+    assert_eq!(b.zsw1() & 0x0008, 0, "inside: {:#06x}", b.zsw1());
+    b.io[0].position_inc = 2000;
+    // the fault reaction (quick stop) runs first, then ZSW1 bit 3
+    b.run(&positioning(0x043F, 0, 1000, 10_000), 50);
+    assert_ne!(b.zsw1() & 0x0008, 0, "fault: {:#06x}", b.zsw1());
+    b.run(&speed(0x0400, 0, 0, super::pkw_request(0x41, 1600, 0, 0)), 10);
+    assert_eq!((b.response[24], b.i32_at(28)), (0x41, 54 * 16 + 2));
+}
+
 /// PNU 1051 (607Ch) is the home offset in 1/1000 rev: with method 34 the
 /// present position becomes the offset (CiA 402's rule, which the core
 /// follows: the zero point lies the offset below the reference point, so a
