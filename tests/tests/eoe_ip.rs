@@ -51,6 +51,17 @@ async fn set_ip<S>(host: &mut HostNet, sd: &SubDeviceRef<'_, S>, clock: &AtomicU
     panic!("no set-IP response")
 }
 
+/// The master-side host at 10.0.0.1 with the drive's address set over EoE.
+async fn addressed_host<S>(sd: &SubDeviceRef<'_, S>, clock: &AtomicU64) -> HostNet {
+    let mut host = HostNet::new(
+        HOST_MAC,
+        &[(HOST_IP, 24)],
+        nanos::Nanos::from_ns(clock.load(Ordering::Relaxed)),
+    );
+    assert_eq!(set_ip(&mut host, sd, clock).await, vec![0x03, 0x01, 0x00, 0x00]);
+    host
+}
+
 async fn ask<S>(host: &mut HostNet, sd: &SubDeviceRef<'_, S>, clock: &AtomicU64, req: &str) -> String {
     match host.param_request(sd, clock, DRIVE_IP, req, STEPS).await {
         Some((answer, _)) => answer,
@@ -137,12 +148,7 @@ fn e101_a_parameter_flood_is_rate_limited_and_the_drive_keeps_serving() {
     with_master(&sim, async |md, clock| {
         let group = init(md, clock).await;
         let sd = group.subdevice(md, 0).unwrap();
-        let mut host = HostNet::new(
-            HOST_MAC,
-            &[(HOST_IP, 24)],
-            nanos::Nanos::from_ns(clock.load(Ordering::Relaxed)),
-        );
-        assert_eq!(set_ip(&mut host, &sd, clock).await, vec![0x03, 0x01, 0x00, 0x00]);
+        let mut host = addressed_host(&sd, clock).await;
         assert_eq!(ask(&mut host, &sd, clock, "R A150").await, "OK 1000");
         let before = al_status(&sd).await;
         let t0 = sim.borrow().now();
@@ -195,12 +201,7 @@ fn e099_refused_eoe_configuration_shows_er10() {
     with_master(&sim, async |md, clock| {
         let group = init(md, clock).await;
         let sd = group.subdevice(md, 0).unwrap();
-        let mut host = HostNet::new(
-            HOST_MAC,
-            &[(HOST_IP, 24)],
-            nanos::Nanos::from_ns(clock.load(Ordering::Relaxed)),
-        );
-        assert_eq!(set_ip(&mut host, &sd, clock).await, vec![0x03, 0x01, 0x00, 0x00]);
+        let mut host = addressed_host(&sd, clock).await;
         let er = |t: &str| t.split(' ').nth(1).unwrap_or_default().to_string();
         assert_eq!(er(&ask(&mut host, &sd, clock, "R A257[0]").await), "Er0");
         // the subnet's broadcast address: refused (0001h), the old address stays
