@@ -29,10 +29,10 @@ impl Axis {
         opts.quick_stop_on_enable_loss = p.quick_stop_on_enable_loss;
 
         // cycle ratio (C-114): 60C2h over A150; 60C2h is copied into A291
+        // when the interpolation's configuration changes (60C2h, A150, at
+        // start), not at every configuration change: a master's own A291
+        // write stays until then
         let master_ns = interpolation_period_ns(o.period_value, o.period_index).unwrap_or(dt_ns);
-        if self.window.axis == 0 {
-            od.write_typed(slots.a291, master_ns / 1000);
-        }
         let ratio = CycleRatio::new(master_ns, dt_ns)
             .or_else(|_| CycleRatio::new(dt_ns, dt_ns))
             .ok();
@@ -44,7 +44,11 @@ impl Axis {
                 p.max_extrapolation_ns,
             )
         });
-        if key != self.interp_key {
+        if key != self.interp_key || self.interp_master_ns != master_ns {
+            if self.window.axis == 0 {
+                od.write_typed(slots.a291, master_ns / 1000);
+            }
+            self.interp_master_ns = master_ns;
             self.interp_key = key;
             self.ratio = ratio;
             self.rebuild_interpolators();

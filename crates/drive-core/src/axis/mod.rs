@@ -196,6 +196,8 @@ pub struct Axis {
     vinterp: Option<VelocityInterpolator>,
     /// (ratio, I425, I25, I423) the interpolators were built with.
     interp_key: Option<(CycleRatio, u8, u32, Nanos)>,
+    /// The 60C2h period (ns) last copied into A291.
+    interp_master_ns: u32,
     profile: ProfileGenerator,
     cascade: Option<Cascade>,
     following: FollowingErrorMonitor,
@@ -298,6 +300,7 @@ impl Axis {
             interp: None,
             vinterp: None,
             interp_key: None,
+            interp_master_ns: 0,
             configured: None,
             probe_shown: false,
             profile: ProfileGenerator::new(0),

@@ -548,7 +548,7 @@ pub const PARAMS: [Object; 80] = [
             .saved()],
     )
     .level(2)
-    .note("A291"),
+    .note("A291; 60C2h copied into it when the interpolation period or A150 changes and at start (C-114)"),
     Object::var(
         a(292),
         Value::Ram,
