@@ -91,6 +91,11 @@ fn main() {
                         .await
                         .expect("ping 1472"),
                 );
+                // the service takes one request per 10 ms beyond a burst of 16
+                // (docs/eoe.md): each read after a refill, so none is dropped
+                let now = sim.borrow().now();
+                sim.borrow_mut().catch_up(now + net::PARAM_REFILL);
+                host.step(&sd, clock).await; // the master's clock follows
                 let (answer, ns) = host
                     .param_request(&sd, clock, DRIVE_IP, "R A150", 1000)
                     .await
