@@ -14,6 +14,7 @@
 
 pub mod device;
 pub mod param;
+pub mod real;
 pub mod sntp;
 pub mod stack;
 

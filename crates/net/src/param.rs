@@ -272,7 +272,7 @@ fn format_value(o: &mut Out<'_>, ty: Option<DataType>, data: &[u8]) -> Result<()
         }
         Some(DataType::F32) => {
             let v = u32::from_le_bytes(le4(data));
-            Ok(write!(o, "{}", f32::from_bits(v))?)
+            Ok(crate::real::write_f32(o, f32::from_bits(v))?)
         }
         Some(DataType::U64) => {
             let mut raw = [0u8; 8];
@@ -328,7 +328,7 @@ fn encode_value(ty: Option<DataType>, value: &str, buf: &mut [u8]) -> Result<usi
             Ok(n)
         }
         Some(DataType::F32) => {
-            let v: f32 = value.parse().map_err(|_| Error::Syntax)?;
+            let v = crate::real::parse_f32(value).ok_or(Error::Syntax)?;
             let dst = buf.get_mut(..4).ok_or(Error::Abort(SdoAbort::OUT_OF_MEMORY))?;
             dst.copy_from_slice(&v.to_bits().to_le_bytes());
             Ok(4)
