@@ -8,8 +8,12 @@
 use crate::eoe::{fnv1a, EthernetPort, IpParams, MAX_FRAME};
 use heapless::{Deque, Vec};
 
-/// Frames each queue holds.
-pub const QUEUE_FRAMES: usize = 2;
+/// Frames each queue holds. One: the mailbox task polls the IP stack after
+/// every mailbox request, so a reassembled frame is taken before the next
+/// can be complete, and the stack takes a frame only when its answer has
+/// room (`net::device`); a second slot each way cost 3 KiB of the board's
+/// RAM for no frame that would otherwise be lost (issue 18).
+pub const QUEUE_FRAMES: usize = 1;
 
 /// One Ethernet frame (destination MAC first, no FCS).
 pub type Frame = Vec<u8, MAX_FRAME>;
@@ -150,32 +154,43 @@ impl EthernetPort for EoeQueue {
 mod tests {
     use super::*;
 
+    /// E-095: each queue holds [`QUEUE_FRAMES`] frames in order; one more
+    /// is dropped and counted, and a frame stays queued until SM1 takes it.
     #[test]
     fn e095_queue_fifo_and_overflow() {
         let mut q = EoeQueue::new();
-        q.receive(&[1; 60]);
-        q.receive(&[2; 70]);
-        q.receive(&[3; 80]);
-        assert_eq!((q.frames, q.last_len, q.last_hash), (3, 80, fnv1a(&[3; 80])));
+        for k in 0..=QUEUE_FRAMES {
+            q.receive(&[k as u8; 60 + 10 * QUEUE_FRAMES][..60 + 10 * k]);
+        }
+        let last = 60 + 10 * QUEUE_FRAMES;
+        assert_eq!((q.frames as usize, q.last_len), (QUEUE_FRAMES + 1, last));
+        assert_eq!(
+            q.last_hash,
+            fnv1a(&[QUEUE_FRAMES as u8; 60 + 10 * QUEUE_FRAMES][..last])
+        );
         assert_eq!(q.stats().rx_overflow, 1);
-        assert_eq!(q.pop_rx().map(|f| f.len()), Some(60));
-        assert_eq!(q.pop_rx().map(|f| f.len()), Some(70));
+        for k in 0..QUEUE_FRAMES {
+            assert_eq!(q.pop_rx().map(|f| f.len()), Some(60 + 10 * k));
+        }
         assert!(q.pop_rx().is_none());
 
-        assert!(q.push_tx(&[7; 100]));
-        assert!(q.push_tx(&[8; 42]));
+        for k in 0..QUEUE_FRAMES {
+            assert!(q.push_tx(&[7 + k as u8; 100][..100 - k]));
+        }
         assert!(!q.tx_ready());
         assert!(!q.push_tx(&[9; 10]));
         assert!(!q.push_tx_with(MAX_FRAME + 1, |_| {}));
         assert_eq!(q.stats().tx_overflow, 2);
         let mut buf = [0u8; MAX_FRAME];
-        assert_eq!(q.transmit(&mut buf), Some(100));
-        assert_eq!(buf.get(..100), Some(&[7u8; 100][..]));
         // a buffer too small keeps the frame queued
         assert_eq!(q.transmit(&mut [0u8; 10]), None);
-        assert_eq!(q.transmit(&mut buf), Some(42));
+        for k in 0..QUEUE_FRAMES {
+            assert_eq!(q.transmit(&mut buf), Some(100 - k));
+            assert_eq!(buf.get(..100 - k), Some(&[7 + k as u8; 100][..100 - k]));
+        }
         assert_eq!(q.transmit(&mut buf), None);
-        assert_eq!(q.stats().tx_frames, 2);
+        assert!(q.tx_ready());
+        assert_eq!(q.stats().tx_frames as usize, QUEUE_FRAMES);
     }
 
     #[test]
