@@ -18,7 +18,7 @@
     )
 )]
 
-pub use node::{clock, cycle, tasks, Drive, ParamFlash};
+pub use node::{clock, cycle, net, tasks, Drive, ParamFlash};
 
 /// The simulated world of the QEMU image.
 #[cfg(feature = "qemu")]

@@ -8,7 +8,7 @@
 //! | `sync0` | ERU1_0 (ESC SYNC0 routed through ERU1) | 3 | `node::tasks::sync0` |
 //! | `control` | CCU40_0 (control-cycle timer compare) | 3 | `node::tasks::control` |
 //! | `esc` | ECAT0_0 (ESC PDI interrupt: AL events, SM2/SM3, mailbox) | 2 | `node::tasks::esc_event` |
-//! | `mailbox` | CCU42_0 (a spare interrupt, pended by `esc`) | 1 | `node::tasks::mailbox` |
+//! | `mailbox` | CCU42_0 (a spare interrupt, pended by `esc` and by `idle` when the IP stack's timers are due) | 1 | `node::tasks::mailbox_net` (mailbox request, IP stack over EoE) |
 //! | `idle` | — | 0 | `node::tasks::background` (a requested save) |
 //!
 //! The ESC is reached through `pdi::mmio::OnChip` over ECAT0's register
@@ -85,6 +85,10 @@ mod app {
     use drive::axis::{AxisCommand, AxisIo};
     use firmware::clock::Clock;
     use firmware::cycle::CycleTimer;
+    #[cfg(not(feature = "net"))]
+    use firmware::net::NoNet as Net;
+    #[cfg(feature = "net")]
+    use firmware::net::{NetBuffers, NodeNet as Net, SocketSlots, BOARD_NET, EMPTY_SLOTS};
     use firmware::{tasks, Drive, ParamFlash};
     use pdi::mmio::{OnChip, VolatileWindow};
 
@@ -96,6 +100,9 @@ mod app {
         pdi: OnChip<VolatileWindow>,
         clock: Clock,
         cmd: [AxisCommand; 2],
+        /// The IP stack on the EoE interface (docs/eoe.md), polled by
+        /// `mailbox` (feature `net`; without it EoE frames are counted and dropped).
+        net: &'static mut Net,
     }
 
     #[local]
@@ -113,7 +120,7 @@ mod app {
         #[allow(unsafe_code)]
         let window = unsafe { VolatileWindow::xmc4800_ecat0() };
         // built once into its static, not moved through `init`'s stack
-        let Some(drive) = make_drive() else {
+        let Some((drive, net)) = make_drive().and_then(|d| make_net(d).map(|n| (d, n))) else {
             defmt::error!("init: drive already taken");
             loop {
                 cortex_m::asm::bkpt();
@@ -126,6 +133,7 @@ mod app {
                 pdi: OnChip::new(window),
                 clock: Clock::new(CPU_HZ),
                 cmd: [AxisCommand::OFF; 2],
+                net,
             },
             Local {},
         )
@@ -149,16 +157,44 @@ mod app {
         Some(drive)
     }
 
+    /// The IP stack on `drive`'s EoE queue, in its statics (buffers, socket
+    /// slots, the stack itself: built in place like the drive).
+    #[cfg(feature = "net")]
+    #[inline(never)]
+    #[allow(unsafe_code)]
+    fn make_net(drive: &mut Drive) -> Option<&'static mut Net> {
+        static mut NET: core::mem::MaybeUninit<Net> = core::mem::MaybeUninit::uninit();
+        static TAKEN: core::sync::atomic::AtomicBool = core::sync::atomic::AtomicBool::new(false);
+        if TAKEN.swap(true, core::sync::atomic::Ordering::AcqRel) {
+            return None;
+        }
+        let bufs = cortex_m::singleton!(: NetBuffers = NetBuffers::new())?;
+        let slots = cortex_m::singleton!(: SocketSlots<'static> = EMPTY_SLOTS)?;
+        // SAFETY: as for the drive's static.
+        let slot = unsafe { &mut *core::ptr::addr_of_mut!(NET) };
+        Some(slot.write(Net::new(drive, BOARD_NET, bufs, slots, nanos::Nanos::ZERO)))
+    }
+
+    /// No IP stack in this image.
+    #[cfg(not(feature = "net"))]
+    fn make_net(_drive: &mut Drive) -> Option<&'static mut Net> {
+        cortex_m::singleton!(: Net = Net)
+    }
+
     /// Background: a requested save (`tasks::background`), and firing the
     /// control cycle when its time has come (until the CCU4 compare does it
     /// in hardware).
-    #[idle(shared = [drive, timer, clock])]
+    #[idle(shared = [drive, timer, clock, net])]
     fn idle(mut cx: idle::Context) -> ! {
         loop {
             tasks::background(&mut cx.shared.drive);
             let now = cx.shared.clock.lock(|c| c.now(DWT::cycle_count()));
             if cx.shared.timer.lock(|t| t.next_at()) <= now {
                 rtic::pend(Interrupt::CCU40_0);
+            }
+            // the IP stack's own timers (DHCP, ARP, SNTP) without a frame
+            if cx.shared.net.lock(|n| tasks::NetPoll::poll_at(&**n)) <= now {
+                rtic::pend(Interrupt::CCU42_0);
             }
         }
     }
@@ -209,15 +245,16 @@ mod app {
         );
     }
 
-    /// The mailbox (CoE, EoE, FoE, EMCY, save) below the ESC task: the
-    /// drive is locked for one request. A hardware task on a spare
-    /// interrupt, not an async software task: an `async fn` carries a
-    /// "resumed after completion" panic path.
-    #[task(binds = CCU42_0, priority = 1, shared = [drive, pdi, clock])]
+    /// The mailbox (CoE, EoE, FoE, EMCY, save) below the ESC task, and the
+    /// IP stack behind EoE: the drive is locked for one request and the
+    /// stack's poll. A hardware task on a spare interrupt, not an async
+    /// software task: an `async fn` carries a "resumed after completion"
+    /// panic path.
+    #[task(binds = CCU42_0, priority = 1, shared = [drive, pdi, clock, net])]
     fn mailbox(cx: mailbox::Context) {
-        (cx.shared.drive, cx.shared.pdi, cx.shared.clock).lock(|drive, pdi, clock| {
+        (cx.shared.drive, cx.shared.pdi, cx.shared.clock, cx.shared.net).lock(|drive, pdi, clock, net| {
             let now = clock.now(DWT::cycle_count());
-            if tasks::mailbox(drive, pdi, now).is_err() {
+            if tasks::mailbox_net(drive, &mut **net, pdi, now).is_err() {
                 defmt::warn!("mailbox: PDI access failed");
             }
         });

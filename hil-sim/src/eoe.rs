@@ -12,7 +12,7 @@ use ecat::eoe::{frame_type, EoeHeader, Fragmenter, Reassembly, HEADER_LEN, MAX_F
 use ethercrab::SubDeviceRef;
 use nanos::Nanos;
 use net::smoltcp;
-use net::{NetBuffers, NetConfig, NetSettings, NetStack, SocketSlots};
+use net::{NetBuffers, NetConfig, NetStack, SocketSlots};
 use smoltcp::iface::SocketStorage;
 use smoltcp::phy::{Device, DeviceCapabilities, Medium, RxToken, TxToken};
 use smoltcp::time::Instant;
@@ -29,30 +29,12 @@ const MBX_HEADER: usize = 6;
 /// Mailbox type EoE.
 pub const MBX_EOE: u8 = 2;
 
-/// The settings the drive's stack follows, from its dictionary.
-pub fn net_settings<F: store::Flash, B: store::Flash>(drive: &Drive<F, B>) -> NetSettings {
-    let s = drive.ip_settings();
-    NetSettings {
-        dhcp: s.address_source == 2,
-        gateway: s.gateway,
-        sntp: net::sntp::SntpConfig {
-            active: s.sntp_active,
-            servers: s.sntp_servers,
-        },
-        tunnel_open: s.tunnel_open,
-        param_policy: net::param::Policy {
-            writes: s.udp_writes,
-            guard: Some(drive::params::A269),
-        },
-    }
-}
+pub use node::net::net_settings;
 
-/// A drive's IP stack in the simulation: [`NetStack`] on leaked buffers
-/// (a few KiB per drive, for the life of the process).
-pub struct DriveNet {
-    /// The stack.
-    pub stack: NetStack<'static>,
-}
+/// A drive's IP stack in the simulation: the firmware's [`node::net::NodeNet`]
+/// (the same poll the mailbox task runs) on leaked buffers (a few KiB per
+/// drive, for the life of the process).
+pub struct DriveNet(node::net::NodeNet);
 
 impl DriveNet {
     /// Bound to `drive`'s EoE queue at `now`: MAC `mac` until the master
@@ -66,21 +48,23 @@ impl DriveNet {
         let bufs: &'static mut NetBuffers = Box::leak(Box::new(NetBuffers::new()));
         let slots: &'static mut SocketSlots<'static> =
             Box::leak(Box::new([SocketStorage::EMPTY; net::SOCKETS]));
-        let stack = NetStack::new(NetConfig { mac, seed }, bufs, slots, drive.eoe_mut(), now);
-        Self { stack }
+        Self(node::net::NodeNet::new(
+            drive,
+            NetConfig { mac, seed },
+            bufs,
+            slots,
+            now,
+        ))
     }
 
     /// Polls the stack after the drive's poll (local time = simulation time).
     pub fn poll<F: store::Flash, B: store::Flash>(&mut self, drive: &mut Drive<F, B>, now: Nanos) {
-        let settings = net_settings(drive);
-        let stack = &mut self.stack;
-        drive.with_eoe(|q, dict, state| stack.poll(now, q, dict, state, &settings));
-        // E-147: message time stamps fall back to the SNTP time
-        let sntp = stack.sntp_time(now);
-        drive.set_sntp_time(
-            sntp.map(|unix| net::sntp::message_time_stamp(None, Some(unix))),
-            now,
-        );
+        self.0.poll(drive, now);
+    }
+
+    /// The stack (address, counters).
+    pub fn stack(&self) -> &NetStack<'static> {
+        self.0.stack()
     }
 }
 

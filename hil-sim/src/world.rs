@@ -67,6 +67,15 @@ impl World {
         }
     }
 
+    /// The same with the master's EoE step in Pre-Op ([`Script::with_eoe`]):
+    /// the firmware polls its IP stack in the mailbox task.
+    pub fn with_eoe() -> Self {
+        Self {
+            script: Script::with_eoe(),
+            ..Self::new()
+        }
+    }
+
     /// Simulated time (the firmware's clock in QEMU).
     pub fn now(&self) -> Nanos {
         self.now

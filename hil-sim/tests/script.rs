@@ -59,3 +59,53 @@ fn e107_scripted_master_selects_dc_sync_and_runs_csp_on_both_axes() {
         "{max_following_error:?}"
     );
 }
+
+/// E-095/E-096 through the scripted master (the sequence `firmware-qemu`
+/// runs): in Pre-Op it sets the drive's IP over EoE, resolves it by ARP,
+/// pings it and reads A150 over the UDP parameter service, with frames it
+/// builds byte by byte; then the rest of the sequence runs as without EoE.
+#[test]
+fn e095_e096_scripted_master_pings_and_reads_a_parameter_over_eoe() {
+    use hil_sim::script::eoe::DRIVE_IP;
+    let mut sim = Simulation::new(1);
+    let mac = [0x02, 0x5C, 0x06, 0, 0, 0x01];
+    sim.drives_mut()[0].bind_net(mac, 7, Nanos::ZERO);
+    let mut script = Script::with_eoe();
+    let mut log = Vec::new();
+    let mut t = Nanos::from_ns(CYCLE.as_ns() / 2);
+    while !script.finished() && t < Nanos::from_secs(5) {
+        t += CYCLE;
+        sim.advance_to(t);
+        let p = script.step(&mut SimLink(&mut sim));
+        if p != Progress::Busy {
+            log.push(p);
+        }
+    }
+    assert!(script.succeeded(), "{log:?}");
+    let eoe: Vec<Progress> = log
+        .iter()
+        .copied()
+        .filter(|p| {
+            matches!(
+                p,
+                Progress::IpSet | Progress::Arp(_) | Progress::Pinged | Progress::UdpRead(_)
+            )
+        })
+        .collect();
+    // A150 = 1000 µs (the default cycle)
+    assert_eq!(
+        eoe,
+        [
+            Progress::IpSet,
+            Progress::Arp(mac),
+            Progress::Pinged,
+            Progress::UdpRead(1000)
+        ],
+        "{log:?}"
+    );
+    let ip = sim.drives()[0].net.as_ref().unwrap().stack().ip();
+    assert_eq!(ip, Some((DRIVE_IP, 24)));
+    // the EoE step came before Safe-Op
+    let at = |p: Progress| log.iter().position(|q| *q == p).unwrap();
+    assert!(at(Progress::UdpRead(1000)) < at(Progress::State(4)), "{log:?}");
+}

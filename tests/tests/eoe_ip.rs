@@ -128,7 +128,7 @@ fn e096_e095_ping_and_parameters_over_udp() {
         .unwrap();
     assert_eq!(u16::from_le_bytes([buf[0], buf[1]]), 2000);
     assert_eq!(n, 2);
-    let net = &d.net.as_ref().unwrap().stack;
+    let net = &d.net.as_ref().unwrap().stack();
     assert_eq!(net.ip(), Some((DRIVE_IP, 24)));
     assert_eq!(net.gateway(), Some(HOST_IP));
     assert_eq!(net.stats().param_requests, 13);
@@ -190,7 +190,7 @@ fn e101_a_parameter_flood_is_rate_limited_and_the_drive_keeps_serving() {
         assert_eq!(ask(&mut host, &sd, clock, "R A150").await, "OK 1000");
     });
     let s = sim.borrow();
-    let st = s.drives()[0].net.as_ref().unwrap().stack.stats();
+    let st = s.drives()[0].net.as_ref().unwrap().stack().stats();
     assert!(st.param_limited > 0, "{st:?}");
     assert!(st.param_malformed > 0, "the oversized datagrams: {st:?}");
 }
@@ -337,7 +337,7 @@ fn e098_dhcp_while_a166_is_2_until_the_master_sets_an_address() {
         );
     });
     let s = sim.borrow();
-    let net = &s.drives()[0].net.as_ref().unwrap().stack;
+    let net = &s.drives()[0].net.as_ref().unwrap().stack();
     assert_eq!(net.ip(), Some((DRIVE_IP, 24)));
     assert!(!net.address_from_dhcp());
 }
@@ -370,7 +370,7 @@ fn e098_no_dhcp_when_a166_is_not_2() {
         }
         assert_eq!(host.tunnel.stats().frames_in, 0, "the drive sent no frame");
     });
-    assert_eq!(sim.borrow().drives()[0].net.as_ref().unwrap().stack.ip(), None);
+    assert_eq!(sim.borrow().drives()[0].net.as_ref().unwrap().stack().ip(), None);
 }
 
 /// A drive without motors or control cycles, with its IP stack: six
@@ -539,7 +539,7 @@ fn e105_e106_e102_sntp_over_eoe_in_simulated_time() {
         let now = first;
         let drive_time = sim.borrow().drives()[0]
             .net
-            .stack
+            .stack()
             .sntp_time(nanos::Nanos::from_ns(now))
             .map(nanos::Nanos::as_ns);
         let server_unix = server_ntp_ns(now) - NTP_UNIX_OFFSET_S * S;
@@ -599,7 +599,7 @@ fn e105_e106_e102_sntp_over_eoe_in_simulated_time() {
         assert!((second + 64 * S..=second + 67 * S).contains(&third), "{seen:?}");
     });
     let s = sim.borrow();
-    let net = &s.drives()[0].net.stack;
+    let net = &s.drives()[0].net.stack();
     let st = net.sntp().stats();
     assert_eq!((st.requests, st.answers, st.failures), (3, 2, 1), "{st:?}");
     // two answers 5..6 h apart: the 25 ppm rate difference is learned

@@ -8,11 +8,13 @@
 //! - [`clock::Clock`]: a wrapping hardware counter extended to 64-bit ns;
 //! - [`cycle::CycleTimer`]: the control-cycle timer that follows the
 //!   DC-Sync PLL (free-running at A150 without SYNC0);
-//! - [`tasks`]: SYNC0, control cycle and ESC event.
+//! - [`tasks`]: SYNC0, control cycle and ESC event;
+//! - [`net`]: the IP stack on the EoE interface, polled by the mailbox task.
 #![no_std]
 
 pub mod clock;
 pub mod cycle;
+pub mod net;
 pub mod tasks;
 
 /// The parameter flash of the images: two 2 KiB sectors, one per slot (the

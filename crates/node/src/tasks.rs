@@ -5,7 +5,7 @@
 //! | `sync0` | ESC SYNC0 output | 3 | [`sync0`]: acknowledge, PLL measurement |
 //! | `control` | control-cycle timer | 3 | [`control`]: one cycle of both axes |
 //! | `esc` | ESC PDI interrupt (AL event) | 2 | [`esc_event`]: ESM, process data, monitoring |
-//! | `mailbox` | pended by `esc` | 1 | [`mailbox`]: one CoE/EoE/FoE request, EMCY |
+//! | `mailbox` | pended by `esc`, and by `idle` when the IP stack's timers are due | 1 | [`mailbox_net`]: one CoE/EoE/FoE request, EMCY, the IP stack ([`mailbox`] without it) |
 //! | `idle` | — | 0 | [`background`]: a requested save, the flash written outside the drive's lock (QEMU: also the simulated world) |
 //!
 //! `sync0` and `control` share the priority so they never preempt each
@@ -22,6 +22,7 @@ use nanos::Nanos;
 use rtic_core::Mutex;
 
 use crate::cycle::CycleTimer;
+pub use crate::net::NetPoll;
 use crate::Drive;
 
 /// SYNC0 at local time `now`: reads 0x098E (acknowledges the pulse in
@@ -67,6 +68,27 @@ pub fn esc_event<P: Pdi>(
 /// and EoE fragments sent.
 pub fn mailbox<P: Pdi>(drive: &mut Drive, pdi: &mut P, now: Nanos) -> Result<(), P::Error> {
     drive.poll_mailbox(pdi, now)
+}
+
+/// The mailbox task with the IP stack at local time `now`: the mailbox
+/// request ([`mailbox`]), then the stack takes the Ethernet frames it
+/// brought and queues its answers, then a second mailbox poll puts the
+/// first answer fragment into SM1 if it is free (the master's next read
+/// raises the next ESC event, which pends this task again for the rest).
+/// Also run when the stack's own timers are due ([`NetPoll::poll_at`]).
+/// With [`NoNet`](crate::net::NoNet) it is [`mailbox`].
+pub fn mailbox_net<P: Pdi, N: NetPoll>(
+    drive: &mut Drive,
+    net: &mut N,
+    pdi: &mut P,
+    now: Nanos,
+) -> Result<(), P::Error> {
+    drive.poll_mailbox(pdi, now)?;
+    if N::ACTIVE {
+        net.poll(drive, now);
+        drive.poll_mailbox(pdi, now)?;
+    }
+    Ok(())
 }
 
 /// Background work from the idle loop: a save requested over the bus (A00,

@@ -8,6 +8,7 @@ use hil_sim::world::{new_esc, Event, World};
 use nanos::Nanos;
 use node::clock::Clock;
 use node::cycle::{CycleTimer, CYCLE};
+use node::net::{NetBuffers, NodeNet, BOARD_NET, EMPTY_SLOTS};
 use node::{tasks, Drive, ParamFlash};
 use rtic_core::Exclusive;
 
@@ -16,6 +17,8 @@ struct Board {
     timer: CycleTimer,
     esc: Esc,
     world: World,
+    /// The IP stack, polled by the mailbox task (the world's master runs its EoE step).
+    net: Option<NodeNet>,
 }
 
 impl Board {
@@ -25,7 +28,18 @@ impl Board {
             timer: CycleTimer::new(),
             esc: new_esc(),
             world: World::new(),
+            net: None,
         }
+    }
+
+    /// With the IP stack on buffers leaked for the test, as the images' statics.
+    fn with_net() -> Self {
+        let mut b = Self::new();
+        b.world = World::with_eoe();
+        let bufs = Box::leak(Box::new(NetBuffers::new()));
+        let slots = Box::leak(Box::new(EMPTY_SLOTS));
+        b.net = Some(NodeNet::new(&mut b.drive, BOARD_NET, bufs, slots, Nanos::ZERO));
+        b
     }
 
     /// Runs events until the script ends; returns its progress log and the
@@ -54,7 +68,12 @@ impl Board {
                     let p = self.world.frame(&mut self.esc);
                     tasks::esc_event(&mut self.drive, &mut self.timer, &mut self.esc.pdi(), now).unwrap();
                     // the mailbox task runs after the ESC task returns (priority 1)
-                    tasks::mailbox(&mut self.drive, &mut self.esc.pdi(), now).unwrap();
+                    match self.net.as_mut() {
+                        Some(net) => {
+                            tasks::mailbox_net(&mut self.drive, net, &mut self.esc.pdi(), now).unwrap()
+                        }
+                        None => tasks::mailbox(&mut self.drive, &mut self.esc.pdi(), now).unwrap(),
+                    }
                     tasks::background(&mut Exclusive(&mut self.drive));
                     if p != Progress::Busy {
                         log.push(p);
@@ -97,6 +116,28 @@ fn e107_task_bodies_run_the_end_to_end_sequence_on_the_pll() {
         .collect();
     assert!(!img.tx().entries().is_empty());
     assert!(slow.is_empty(), "{slow:04X?}");
+}
+
+/// E-095/E-096 with the task map: the mailbox task polls the IP stack
+/// after each mailbox request (`tasks::mailbox_net`), so the world's master
+/// sets the IP, gets the ARP reply with the board's MAC, the ping and the
+/// UDP read of A150 in Pre-Op, and the rest of the sequence still runs.
+#[test]
+fn e095_e096_mailbox_task_runs_the_ip_stack() {
+    let mut b = Board::with_net();
+    let (log, _) = b.run();
+    assert_eq!(b.world.finished(), Some(true), "{log:?}");
+    for p in [
+        Progress::IpSet,
+        Progress::Arp(BOARD_NET.mac),
+        Progress::Pinged,
+        Progress::UdpRead(1000),
+    ] {
+        assert!(log.contains(&p), "{p:?} missing: {log:?}");
+    }
+    assert!(log.contains(&Progress::Enabled), "{log:?}");
+    let ip = b.net.as_ref().unwrap().stack().ip();
+    assert_eq!(ip, Some((hil_sim::script::eoe::DRIVE_IP, 24)));
 }
 
 /// The clock extends a wrapping counter without losing wraps.

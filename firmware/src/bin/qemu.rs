@@ -14,8 +14,10 @@
 //! | EXTI2 | `esc` (ESC PDI interrupt) | 2 |
 //! | USART1 | `mailbox` (pended by `esc`) | 1 |
 //!
-//! The scripted master goes INIT → OP, enables both axes, moves them in csp
-//! and disables them. The log goes out over semihosting; `scripts/cross qemu`
+//! The scripted master goes INIT → OP (in Pre-Op it sets the drive's IP over
+//! EoE, resolves it by ARP, pings it and reads A150 over the UDP parameter
+//! service: the mailbox task runs the IP stack, `node::tasks::mailbox_net`),
+//! enables both axes, moves them in csp and disables them. The log goes out over semihosting; `scripts/cross qemu`
 //! compares it with `firmware/qemu/expected/firmware-qemu.log` (lines with
 //! `figure:` are measurements, printed but not compared). Measured under
 //! `-icount shift=0` (one instruction per virtual ns): SysTick counts the
@@ -135,6 +137,7 @@ mod app {
     use cortex_m_semihosting::debug;
     use drive::axis::{AxisCommand, AxisIo};
     use firmware::cycle::{CycleTimer, CYCLE};
+    use firmware::net::{NetBuffers, NodeNet, SocketSlots, BOARD_NET, EMPTY_SLOTS};
     use firmware::world::{new_esc, Event, World};
     use firmware::{tasks, Drive, ParamFlash};
     use hil_sim::esc::Esc;
@@ -154,8 +157,10 @@ mod app {
         /// Hardware inputs of the next control cycle / its power-stage commands.
         io: [AxisIo; 2],
         cmd: [AxisCommand; 2],
-        /// SysTick ticks of the last run of `control` and `esc`.
-        cost: [u32; 2],
+        /// SysTick ticks of the last run of `control`, `esc` and `mailbox`.
+        cost: [u32; 3],
+        /// The IP stack on the EoE interface, polled by `mailbox`.
+        net: &'static mut NodeNet,
     }
 
     #[local]
@@ -182,6 +187,13 @@ mod app {
                 cortex_m::asm::wfi();
             }
         };
+        let Some(net) = make_net(drive) else {
+            defmt::error!("init: resources already taken");
+            debug::exit(debug::EXIT_FAILURE);
+            loop {
+                cortex_m::asm::wfi();
+            }
+        };
         (
             Shared {
                 drive,
@@ -190,7 +202,8 @@ mod app {
                 clock: Nanos::ZERO,
                 io: [AxisIo::ready(0); 2],
                 cmd: [AxisCommand::OFF; 2],
-                cost: [0; 2],
+                cost: [0; 3],
+                net,
             },
             Local { world, per_kilo_tick },
         )
@@ -216,13 +229,28 @@ mod app {
     }
 
     #[inline(never)]
+    #[allow(unsafe_code)]
+    fn make_net(drive: &mut Drive) -> Option<&'static mut NodeNet> {
+        static mut NET: core::mem::MaybeUninit<NodeNet> = core::mem::MaybeUninit::uninit();
+        static TAKEN: core::sync::atomic::AtomicBool = core::sync::atomic::AtomicBool::new(false);
+        if TAKEN.swap(true, core::sync::atomic::Ordering::AcqRel) {
+            return None;
+        }
+        let bufs = cortex_m::singleton!(: NetBuffers = NetBuffers::new())?;
+        let slots = cortex_m::singleton!(: SocketSlots<'static> = EMPTY_SLOTS)?;
+        // SAFETY: the flag hands out the static once, as for the drive.
+        let slot = unsafe { &mut *core::ptr::addr_of_mut!(NET) };
+        Some(slot.write(NodeNet::new(drive, BOARD_NET, bufs, slots, Nanos::ZERO)))
+    }
+
+    #[inline(never)]
     fn make_esc() -> Option<&'static mut Esc> {
         cortex_m::singleton!(: Esc = new_esc())
     }
 
     #[inline(never)]
     fn make_world() -> Option<&'static mut World> {
-        cortex_m::singleton!(: World = World::new())
+        cortex_m::singleton!(: World = World::with_eoe())
     }
 
     /// Pends `irq` and lets it run (QEMU takes a pended interrupt only
@@ -240,6 +268,7 @@ mod app {
         let world = &mut **cx.local.world;
         let insn = |ticks: u32| (u64::from(ticks) * u64::from(*cx.local.per_kilo_tick) / 1000) as u32;
         let (mut control, mut esc_cost) = (Figure::default(), Figure::default());
+        let mut mailbox_cost = Figure::default();
         let mut stack = [0u32; 3];
         let mut moving = false;
         let mut events: u32 = 0;
@@ -278,8 +307,13 @@ mod app {
                 Event::Frame => {
                     let progress = cx.shared.esc.lock(|e| world.frame(e));
                     measure::paint();
+                    cx.shared.cost.lock(|c| c[2] = 0);
                     run(Interrupt::EXTI2);
                     stack[2] = stack[2].max(measure::used());
+                    let mbx = cx.shared.cost.lock(|c| c[2]);
+                    if mbx != 0 && !moving {
+                        mailbox_cost.add(insn(mbx));
+                    }
                     tasks::background(&mut cx.shared.drive);
                     if moving {
                         esc_cost.add(insn(cx.shared.cost.lock(|c| c[1])));
@@ -313,6 +347,18 @@ mod app {
                             );
                         }
                         Progress::Disabled => defmt::info!("master: both axes Switched on (disabled)"),
+                        Progress::IpSet => defmt::info!("master: EoE IP parameters set (192.168.10.2/24)"),
+                        Progress::Arp(m) => defmt::info!(
+                            "master: EoE ARP reply from {=u8:02X}:{=u8:02X}:{=u8:02X}:{=u8:02X}:{=u8:02X}:{=u8:02X}",
+                            m[0],
+                            m[1],
+                            m[2],
+                            m[3],
+                            m[4],
+                            m[5]
+                        ),
+                        Progress::Pinged => defmt::info!("master: EoE ping answered"),
+                        Progress::UdpRead(v) => defmt::info!("master: EoE UDP parameter read R A150 = {=i32}", v),
                         Progress::Failed(f) => defmt::error!("master: failed: {}", defmt::Debug2Format(&f)),
                     }
                 }
@@ -328,6 +374,12 @@ mod app {
             "figure: ESC event task in Op: mean {=u32} max {=u32} instructions",
             esc_cost.mean(),
             esc_cost.max
+        );
+        defmt::info!(
+            "figure: mailbox task with the IP stack, outside the move: mean {=u32} max {=u32} instructions over {=u32} runs",
+            mailbox_cost.mean(),
+            mailbox_cost.max,
+            mailbox_cost.n
         );
         defmt::info!(
             "figure: stack use sync0 {=u32} control {=u32} esc {=u32} bytes (measured, incl. exception frame)",
@@ -389,12 +441,16 @@ mod app {
         }
     }
 
-    /// The mailbox (CoE, EoE, FoE, EMCY, save) below the ESC task.
-    #[task(binds = USART1, priority = 1, shared = [drive, esc, clock])]
+    /// The mailbox (CoE, EoE, FoE, EMCY, save) below the ESC task, and the
+    /// IP stack behind EoE.
+    #[task(binds = USART1, priority = 1, shared = [drive, esc, clock, net, cost])]
     fn mailbox(cx: mailbox::Context) {
         let now = { cx.shared.clock }.lock(|c| *c);
-        (cx.shared.drive, cx.shared.esc).lock(|drive, esc| {
-            let _ = tasks::mailbox(drive, &mut esc.pdi(), now);
+        let t0 = measure::now();
+        (cx.shared.drive, cx.shared.esc, cx.shared.net).lock(|drive, esc, net| {
+            let _ = tasks::mailbox_net(drive, &mut **net, &mut esc.pdi(), now);
         });
+        let t = measure::ticks(t0, measure::now());
+        { cx.shared.cost }.lock(|c| c[2] = t.max(1));
     }
 }

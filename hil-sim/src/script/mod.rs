@@ -7,7 +7,9 @@
 //! 1. Init: station address, mailbox SyncManagers, request Pre-Op;
 //! 2. Pre-Op: SDO downloads through the mailbox (both axes in csp, both
 //!    channels assigned, DC-Sync), process-data SyncManagers and FMMUs,
-//!    SYNC0 every [`CYCLE`], request Safe-Op, then Op with cyclic LRW;
+//!    with [`Script::with_eoe`] the EoE step ([`eoe`]: set the IP, ARP,
+//!    ping, a UDP parameter read), SYNC0 every [`CYCLE`], request Safe-Op,
+//!    then Op with cyclic LRW;
 //! 3. Op: enable both axes (6 → 7 → 15 on the controlword), a csp move of
 //!    [`MOVE_INC`] increments on each axis with a smooth profile, settle,
 //!    disable, back to Init.
@@ -15,6 +17,8 @@
 //! Each step reports [`Progress`] for the log. The same script runs on the
 //! host against the same drive code (this crate's tests), so a failure in
 //! QEMU can be reproduced with `cargo test`.
+
+pub mod eoe;
 
 use crate::esc::Esc;
 use crate::frame::{Command, Datagram, DATAGRAM_HEADER_LEN, WKC_LEN};
@@ -106,6 +110,14 @@ pub enum Progress {
     },
     /// Both axes report Switched on after the disable.
     Disabled,
+    /// EoE: the drive confirmed the IP parameters ([`eoe::DRIVE_IP`]).
+    IpSet,
+    /// EoE: the drive answered the master's ARP request with this MAC.
+    Arp([u8; 6]),
+    /// EoE: the drive answered the ping.
+    Pinged,
+    /// EoE: the UDP parameter service answered [`eoe::UDP_REQUEST`] with this value.
+    UdpRead(i32),
     /// The sequence failed at this stage (see [`Failure`]).
     Failed(Failure),
 }
@@ -121,7 +133,13 @@ pub enum Failure {
     SdoAbort { index: u16, sub: u8, code: u32 },
     /// A state, SDO answer or statusword did not come in time.
     Timeout { stage: u8 },
+    /// An EoE answer was an error (step: 0 set-IP, 3 UDP read; the result
+    /// code or 0).
+    Eoe { step: u8, result: u16 },
 }
+
+/// The EoE step's exchanges, in order.
+const EOE_STEPS: u8 = 4;
 
 /// Stages of the sequence.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
@@ -130,6 +148,9 @@ enum Stage {
     WaitPreOp,
     Sdo(usize),
     SdoAnswer(usize),
+    /// EoE exchange `k` ([`EOE_STEPS`]): request sent / answer awaited.
+    Eoe(u8),
+    EoeAnswer(u8),
     ProcessData,
     WaitSafeOp,
     WaitOp,
@@ -159,6 +180,8 @@ impl Stage {
             Stage::WaitInit => 11,
             Stage::Done => 12,
             Stage::Failed => 13,
+            Stage::Eoe(_) => 14,
+            Stage::EoeAnswer(_) => 15,
         }
     }
 }
@@ -177,6 +200,10 @@ pub struct Script {
     inputs: [u8; 2 * TX_AXIS],
     start: [i32; 2],
     max_ferr: [i32; 2],
+    /// Run the EoE step in Pre-Op.
+    eoe: bool,
+    /// The drive's MAC from its ARP reply.
+    drive_mac: [u8; 6],
 }
 
 impl Default for Script {
@@ -226,7 +253,17 @@ impl Script {
             inputs: [0; 2 * TX_AXIS],
             start: [0; 2],
             max_ferr: [0; 2],
+            eoe: false,
+            drive_mac: [0xFF; 6],
         }
+    }
+
+    /// The same sequence with the EoE step in Pre-Op (the drive needs its
+    /// IP stack polled after each mailbox request).
+    pub const fn with_eoe() -> Self {
+        let mut s = Self::new();
+        s.eoe = true;
+        s
     }
 
     /// Whether the sequence ended (done or failed).
@@ -367,35 +404,104 @@ impl Script {
         let Some(&(index, sub, value, len)) = STARTUP.get(i) else {
             return Ok(());
         };
-        let dev = &drive::DEVICE;
-        self.mbx_counter = ecat::mailbox::next_counter(self.mbx_counter);
-        let mut m = [0u8; MAX_DATA];
-        let n = usize::from(dev.mailbox_out.length).min(MAX_DATA);
-        // mailbox header: length 10, address 0, channel/priority 0, type CoE (3) + counter
-        put(&mut m, 0, &10u16.to_le_bytes());
-        put(&mut m, 5, &[0x03 | (self.mbx_counter << 4)]);
+        let mut m = [0u8; 10];
         // CoE header: SDO request (2 << 12)
-        put(&mut m, 6, &0x2000u16.to_le_bytes());
+        put(&mut m, 0, &0x2000u16.to_le_bytes());
         // expedited download, size indicated
         let ccs = 0x20 | 0x03 | ((4 - len) << 2);
-        put(&mut m, 8, &[ccs]);
-        put(&mut m, 9, &index.to_le_bytes());
-        put(&mut m, 11, &[sub]);
-        put(&mut m, 12, &value.to_le_bytes());
-        self.write(link, dev.mailbox_out.start, m.get(..n).unwrap_or(&[]))
+        put(&mut m, 2, &[ccs]);
+        put(&mut m, 3, &index.to_le_bytes());
+        put(&mut m, 5, &[sub]);
+        put(&mut m, 6, &value.to_le_bytes());
+        // mailbox type CoE (3)
+        self.mailbox_out(link, 0x03, &m)
     }
 
-    /// Reads the SM1 mailbox when full: `Ok(true)` on a download response.
-    fn sdo_answer(&mut self, link: &mut impl Link, i: usize) -> Result<bool, Failure> {
+    /// Reads the SM1 mailbox when full: the whole mailbox buffer.
+    fn mailbox_in(&mut self, link: &mut impl Link) -> Result<Option<[u8; MAX_DATA]>, Failure> {
         let dev = &drive::DEVICE;
         let mut st = [0u8; 1];
         self.read(link, regs::sm(1) + 5, &mut st)?;
         if st.first().copied().unwrap_or(0) & 0x08 == 0 {
-            return Ok(false);
+            return Ok(None);
         }
         let mut m = [0u8; MAX_DATA];
         let n = usize::from(dev.mailbox_in.length).min(MAX_DATA);
         self.read(link, dev.mailbox_in.start, m.get_mut(..n).unwrap_or(&mut []))?;
+        Ok(Some(m))
+    }
+
+    /// Writes `body` as a mailbox message of type `kind` into SM0.
+    fn mailbox_out(&mut self, link: &mut impl Link, kind: u8, body: &[u8]) -> Result<(), Failure> {
+        let dev = &drive::DEVICE;
+        self.mbx_counter = ecat::mailbox::next_counter(self.mbx_counter);
+        let mut m = [0u8; MAX_DATA];
+        let n = usize::from(dev.mailbox_out.length).min(MAX_DATA);
+        let len = body.len().min(n.saturating_sub(6));
+        put(&mut m, 0, &(len as u16).to_le_bytes());
+        put(&mut m, 5, &[kind | (self.mbx_counter << 4)]);
+        put(&mut m, 6, body.get(..len).unwrap_or(&[]));
+        self.write(link, dev.mailbox_out.start, m.get(..n).unwrap_or(&[]))
+    }
+
+    /// Sends EoE request `k`.
+    fn eoe_request(&mut self, link: &mut impl Link, k: u8) -> Result<(), Failure> {
+        let mut b = [0u8; MAX_DATA];
+        let n = match k {
+            0 => eoe::set_ip_request(&mut b),
+            1 => eoe::arp_request(&mut b),
+            2 => eoe::echo_request(&mut b, self.drive_mac),
+            _ => eoe::param_request(&mut b, self.drive_mac),
+        };
+        self.mailbox_out(link, eoe::MBX_EOE, b.get(..n).unwrap_or(&[]))
+    }
+
+    /// Reads SM1 for the answer to EoE request `k`: `Ok(Some(progress))`
+    /// when it came; other messages (an unsolicited frame) are skipped.
+    fn eoe_answer(&mut self, link: &mut impl Link, k: u8) -> Result<Option<Progress>, Failure> {
+        let Some(m) = self.mailbox_in(link)? else {
+            return Ok(None);
+        };
+        let len = usize::from(get_u16(&m, 0));
+        let body = m.get(6..6 + len).unwrap_or(&[]);
+        if m.get(5).copied().unwrap_or(0) & 0x0F != eoe::MBX_EOE {
+            return Ok(None);
+        }
+        if k == 0 {
+            return match eoe::set_ip_result(body) {
+                Some(0) => Ok(Some(Progress::IpSet)),
+                Some(result) => Err(Failure::Eoe { step: 0, result }),
+                None => Ok(None),
+            };
+        }
+        // the answers are short: one fragment each
+        let frame = match ecat::eoe::EoeHeader::parse(body) {
+            Some(h)
+                if h.frame_type == ecat::eoe::frame_type::FRAGMENT && h.last && h.fragment_number() == 0 =>
+            {
+                body.get(ecat::eoe::HEADER_LEN..).unwrap_or(&[])
+            }
+            _ => return Ok(None),
+        };
+        Ok(match k {
+            1 => eoe::arp_reply(frame).map(|mac| {
+                self.drive_mac = mac;
+                Progress::Arp(mac)
+            }),
+            2 => eoe::is_echo_reply(frame).then_some(Progress::Pinged),
+            _ => match eoe::param_answer(frame) {
+                Some(Ok(v)) => Some(Progress::UdpRead(v)),
+                Some(Err(())) => return Err(Failure::Eoe { step: 3, result: 0 }),
+                None => None,
+            },
+        })
+    }
+
+    /// Reads the SM1 mailbox when full: `Ok(true)` on a download response.
+    fn sdo_answer(&mut self, link: &mut impl Link, i: usize) -> Result<bool, Failure> {
+        let Some(m) = self.mailbox_in(link)? else {
+            return Ok(false);
+        };
         let (index, sub) = STARTUP.get(i).map_or((0, 0), |s| (s.0, s.1));
         match m.get(8).copied().unwrap_or(0) >> 5 {
             3 => Ok(true),
@@ -458,7 +564,19 @@ impl Script {
                 true => (Stage::Sdo(0), Progress::State(2)),
                 false => (stage, Progress::Busy),
             },
-            Stage::Sdo(i) if i >= STARTUP.len() => (Stage::ProcessData, Progress::Busy),
+            Stage::Sdo(i) if i >= STARTUP.len() => match self.eoe {
+                true => (Stage::Eoe(0), Progress::Busy),
+                false => (Stage::ProcessData, Progress::Busy),
+            },
+            Stage::Eoe(k) if k >= EOE_STEPS => (Stage::ProcessData, Progress::Busy),
+            Stage::Eoe(k) => {
+                self.eoe_request(link, k)?;
+                (Stage::EoeAnswer(k), Progress::Busy)
+            }
+            Stage::EoeAnswer(k) => match self.eoe_answer(link, k)? {
+                Some(p) => (Stage::Eoe(k + 1), p),
+                None => (stage, Progress::Busy),
+            },
             Stage::Sdo(i) => {
                 self.sdo_request(link, i)?;
                 (Stage::SdoAnswer(i), Progress::Busy)
