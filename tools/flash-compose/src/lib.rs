@@ -1,0 +1,198 @@
+//! The flash file of the boot-loader scenarios (`scripts/cross boot-qemu`,
+//! docs/flashing.md): QEMU's mps2-an386 starts with it at address 0
+//! (`bootloader::mps2`: the boot loader at 0, the slot region at 0x8000).
+//!
+//! The boot loader's bytes come from its ELF (`foe_image::body_from_elf`, linked
+//! at 0). The slot region is filled the way the drive fills it, by `crates/boot`
+//! itself: a list of [`Step`]s — downloads of update files (`tools/foe-image`'s
+//! output) into the inactive slot with `BootSlots::begin/write/finish`, power-ons
+//! through the boot loader's own decision (`bootloader::select`), confirmations,
+//! and two faults: a body byte flipped after the download, a power cut in the
+//! middle of one.
+#![forbid(unsafe_code)]
+
+use boot::{BootSlots, Flash, FlashError, Slot};
+use bootloader::{mps2, select, slot_name, state_name, NoMirror, Outcome};
+
+/// One step of a scenario's history.
+#[derive(Debug, Clone, PartialEq, Eq)]
+pub enum Step {
+    /// The running image downloads this update file into the inactive slot.
+    Install(Vec<u8>),
+    /// Power-on: the boot loader's decision (marks written as it writes them).
+    Reset,
+    /// The running image confirms itself.
+    Confirm,
+    /// Flips bit 4 of this body byte of the slot last installed (after the
+    /// download: the header and the VALID mark are already written).
+    Flip(usize),
+    /// A download of this file during which the power fails at flash
+    /// operation `n` (erase or program unit, from 0): it and all later ones do
+    /// not happen; the flash stays as it was then.
+    Cut(Vec<u8>, u32),
+}
+
+/// The slot region's flash with a power-cut switch.
+struct Cuttable<'a> {
+    flash: mps2::SlotFlash<'a, NoMirror>,
+    left: Option<u32>,
+}
+
+impl Flash for Cuttable<'_> {
+    const SECTOR: usize = mps2::SECTOR;
+    const SECTORS: usize = mps2::SECTORS;
+    const WRITE: usize = mps2::WRITE;
+    fn read(&mut self, addr: u32, buf: &mut [u8]) -> Result<(), FlashError> {
+        self.flash.read(addr, buf)
+    }
+    fn erase(&mut self, sector: u32) -> Result<(), FlashError> {
+        self.spend()?;
+        self.flash.erase(sector)
+    }
+    fn write(&mut self, addr: u32, data: &[u8]) -> Result<(), FlashError> {
+        self.spend()?;
+        self.flash.write(addr, data)
+    }
+}
+
+impl Cuttable<'_> {
+    fn spend(&mut self) -> Result<(), FlashError> {
+        match self.left {
+            Some(0) => Err(FlashError::Device),
+            Some(n) => {
+                self.left = Some(n - 1);
+                Ok(())
+            }
+            None => Ok(()),
+        }
+    }
+}
+
+fn download(s: &mut BootSlots<Cuttable<'_>>, file: &[u8]) -> Result<Slot, String> {
+    s.begin().map_err(|e| format!("begin: {e:?}"))?;
+    for chunk in file.chunks(1024) {
+        s.write(chunk).map_err(|e| format!("write: {e:?}"))?;
+    }
+    s.finish().map_err(|e| format!("finish: {e:?}"))
+}
+
+/// The flash file: `boot_elf`'s bytes at 0, FFh up to the slot region, the slot
+/// region after `steps` (from erased flash). `log` gets one line per step.
+pub fn compose(boot_elf: &[u8], steps: &[Step], log: &mut dyn FnMut(String)) -> Result<Vec<u8>, String> {
+    let boot = foe_image::body_from_elf(boot_elf).map_err(|e| format!("boot loader: {e}"))?;
+    if boot.address != 0 {
+        return Err(format!("boot loader linked at {:#010x}, not 0", boot.address));
+    }
+    if boot.bytes.len() > mps2::SLOTS_BASE as usize {
+        return Err(format!(
+            "boot loader ({} bytes) runs into the slot region",
+            boot.bytes.len()
+        ));
+    }
+    let mut region = vec![0xFF; mps2::REGION_LEN];
+    let mut slots = BootSlots::new(Cuttable {
+        flash: mps2::SlotFlash::new(&mut region, NoMirror),
+        left: None,
+    });
+    let mut last = None;
+    for step in steps {
+        match step {
+            Step::Install(file) => {
+                let slot = download(&mut slots, file)?;
+                last = Some(slot);
+                log(format!(
+                    "install: slot {} pending ({} bytes)",
+                    slot_name(slot),
+                    file.len()
+                ));
+            }
+            Step::Reset => {
+                let mut s = BootSlots::new(slots.into_inner());
+                s.flash_mut().left = None;
+                match select(&mut s, &mps2::LAYOUT) {
+                    Outcome::Start(st) => {
+                        log(format!("reset: slot {} starts", slot_name(st.slot)));
+                        // the running image's view
+                        let flash = s.into_inner();
+                        slots = BootSlots::resume(flash, st.slot).map_err(|e| format!("resume: {e:?}"))?;
+                    }
+                    Outcome::Halt { .. } => {
+                        log("reset: nothing to start".into());
+                        slots = s;
+                    }
+                }
+            }
+            Step::Confirm => {
+                slots.confirm().map_err(|e| format!("confirm: {e:?}"))?;
+                log("confirm".into());
+            }
+            Step::Flip(at) => {
+                let slot = last.ok_or("flip: no slot installed yet")?;
+                let i = slot.index() * BootSlots::<Cuttable>::slot_len()
+                    + BootSlots::<Cuttable>::body_offset()
+                    + at;
+                let b = slots
+                    .flash_mut()
+                    .flash
+                    .bytes_mut()
+                    .get_mut(i)
+                    .ok_or("flip: offset outside the slot")?;
+                *b ^= 0x10;
+                log(format!("flip: slot {} body byte {at}", slot_name(slot)));
+            }
+            Step::Cut(file, n) => {
+                slots.flash_mut().left = Some(*n);
+                let slot = slots.inactive();
+                match download(&mut slots, file) {
+                    Ok(_) => return Err(format!("cut: the download needs fewer than {n} flash operations")),
+                    Err(e) => log(format!(
+                        "cut: power lost in the download into slot {} ({e})",
+                        slot_name(slot)
+                    )),
+                }
+                slots.abort();
+            }
+        }
+    }
+    let states = slots.states().map_err(|e| format!("states: {e:?}"))?;
+    log(format!(
+        "flash: slot A {}, slot B {}",
+        state_name(states[0]),
+        state_name(states[1])
+    ));
+    drop(slots);
+    let mut out = boot.bytes;
+    out.resize(mps2::SLOTS_BASE as usize, 0xFF);
+    out.extend_from_slice(&region);
+    Ok(out)
+}
+
+/// Parses the steps of the command line (see `main.rs`); `read` loads a file.
+pub fn parse_steps(
+    args: &[String],
+    read: &dyn Fn(&str) -> Result<Vec<u8>, String>,
+) -> Result<Vec<Step>, String> {
+    let mut steps = Vec::new();
+    let mut it = args.iter();
+    let num = |s: Option<&String>, what: &str| -> Result<u64, String> {
+        let s = s.ok_or(format!("{what}: a number is missing"))?;
+        s.parse().map_err(|_| format!("{what}: {s} is not a number"))
+    };
+    while let Some(a) = it.next() {
+        steps.push(match a.as_str() {
+            "install" => Step::Install(read(it.next().ok_or("install: FILE is missing")?)?),
+            "reset" => Step::Reset,
+            "confirm" => Step::Confirm,
+            "flip" => Step::Flip(usize::try_from(num(it.next(), "flip")?).map_err(|e| e.to_string())?),
+            "cut" => {
+                let f = read(it.next().ok_or("cut: FILE is missing")?)?;
+                Step::Cut(
+                    f,
+                    u32::try_from(num(it.next(), "cut")?).map_err(|e| e.to_string())?,
+                )
+            }
+            other => return Err(format!("unknown step `{other}`")),
+        });
+    }
+    Ok(steps)
+}
