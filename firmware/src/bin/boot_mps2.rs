@@ -56,9 +56,8 @@ fn main() -> ! {
                     seq
                 ),
                 None => hprintln!(
-                    "boot: slot {}: {} (header version {})",
+                    "boot: slot {}: not bootable (header of version {}: no VALID mark or CRC-32 mismatch)",
                     slot_name(slot),
-                    state_name(s),
                     v
                 ),
             },

@@ -68,12 +68,24 @@ impl Cuttable<'_> {
     }
 }
 
+/// Downloads `file` in chunks of 256 bytes (an FoE packet's worth, roughly).
 fn download(s: &mut BootSlots<Cuttable<'_>>, file: &[u8]) -> Result<Slot, String> {
-    s.begin().map_err(|e| format!("begin: {e:?}"))?;
-    for chunk in file.chunks(1024) {
-        s.write(chunk).map_err(|e| format!("write: {e:?}"))?;
+    download_counted(s, file).1
+}
+
+/// [`download`], and the file bytes taken before it ended.
+fn download_counted(s: &mut BootSlots<Cuttable<'_>>, file: &[u8]) -> (usize, Result<Slot, String>) {
+    if let Err(e) = s.begin() {
+        return (0, Err(format!("begin: {e:?}")));
     }
-    s.finish().map_err(|e| format!("finish: {e:?}"))
+    let mut sent = 0;
+    for chunk in file.chunks(256) {
+        if let Err(e) = s.write(chunk) {
+            return (sent, Err(format!("write: {e:?}")));
+        }
+        sent += chunk.len();
+    }
+    (sent, s.finish().map_err(|e| format!("finish: {e:?}")))
 }
 
 /// The flash file: `boot_elf`'s bytes at 0, FFh up to the slot region, the slot
@@ -143,11 +155,13 @@ pub fn compose(boot_elf: &[u8], steps: &[Step], log: &mut dyn FnMut(String)) -> 
             Step::Cut(file, n) => {
                 slots.flash_mut().left = Some(*n);
                 let slot = slots.inactive();
-                match download(&mut slots, file) {
+                let (sent, r) = download_counted(&mut slots, file);
+                match r {
                     Ok(_) => return Err(format!("cut: the download needs fewer than {n} flash operations")),
                     Err(e) => log(format!(
-                        "cut: power lost in the download into slot {} ({e})",
-                        slot_name(slot)
+                        "cut: power lost at flash operation {n} of the download into slot {}: {sent} of {} bytes taken ({e})",
+                        slot_name(slot),
+                        file.len()
                     )),
                 }
                 slots.abort();
@@ -160,7 +174,6 @@ pub fn compose(boot_elf: &[u8], steps: &[Step], log: &mut dyn FnMut(String)) -> 
         state_name(states[0]),
         state_name(states[1])
     ));
-    drop(slots);
     let mut out = boot.bytes;
     out.resize(mps2::SLOTS_BASE as usize, 0xFF);
     out.extend_from_slice(&region);
