@@ -88,17 +88,24 @@ fn download_counted(s: &mut BootSlots<Cuttable<'_>>, file: &[u8]) -> (usize, Res
     (sent, s.finish().map_err(|e| format!("finish: {e:?}")))
 }
 
-/// The flash file: `boot_elf`'s bytes at 0, FFh up to the slot region, the slot
-/// region after `steps` (from erased flash). `log` gets one line per step.
-pub fn compose(boot_elf: &[u8], steps: &[Step], log: &mut dyn FnMut(String)) -> Result<Vec<u8>, String> {
+/// The boot loader's bytes from its ELF (linked at 0, shorter than the space
+/// before the slot region).
+pub fn boot_bytes(boot_elf: &[u8]) -> Result<Vec<u8>, String> {
     let boot = foe_image::body_from_elf(boot_elf).map_err(|e| format!("boot loader: {e}"))?;
     if boot.address != 0 {
         return Err(format!("boot loader linked at {:#010x}, not 0", boot.address));
     }
-    if boot.bytes.len() > mps2::SLOTS_BASE as usize {
+    Ok(boot.bytes)
+}
+
+/// The flash file: `boot` (the boot loader's bytes, [`boot_bytes`]) at 0, FFh up
+/// to the slot region, the slot region after `steps` (from erased flash). `log`
+/// gets one line per step.
+pub fn compose(boot: &[u8], steps: &[Step], log: &mut dyn FnMut(String)) -> Result<Vec<u8>, String> {
+    if boot.len() > mps2::SLOTS_BASE as usize {
         return Err(format!(
             "boot loader ({} bytes) runs into the slot region",
-            boot.bytes.len()
+            boot.len()
         ));
     }
     let mut region = vec![0xFF; mps2::REGION_LEN];
@@ -174,7 +181,7 @@ pub fn compose(boot_elf: &[u8], steps: &[Step], log: &mut dyn FnMut(String)) -> 
         state_name(states[0]),
         state_name(states[1])
     ));
-    let mut out = boot.bytes;
+    let mut out = boot.to_vec();
     out.resize(mps2::SLOTS_BASE as usize, 0xFF);
     out.extend_from_slice(&region);
     Ok(out)
@@ -209,3 +216,6 @@ pub fn parse_steps(
     }
     Ok(steps)
 }
+
+#[cfg(test)]
+mod tests;

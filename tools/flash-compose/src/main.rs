@@ -11,7 +11,7 @@
 //! ```
 #![forbid(unsafe_code)]
 
-use flash_compose::{compose, parse_steps};
+use flash_compose::{boot_bytes, compose, parse_steps};
 use std::process::ExitCode;
 
 fn run(args: &[String]) -> Result<(), String> {
@@ -22,7 +22,7 @@ fn run(args: &[String]) -> Result<(), String> {
     };
     let read = |p: &str| std::fs::read(p).map_err(|e| format!("{p}: {e}"));
     let steps = parse_steps(steps, &read)?;
-    let image = compose(&read(boot)?, &steps, &mut |line| {
+    let image = compose(&boot_bytes(&read(boot)?)?, &steps, &mut |line| {
         println!("flash-compose: {line}")
     })?;
     std::fs::write(out, &image).map_err(|e| format!("{out}: {e}"))?;
