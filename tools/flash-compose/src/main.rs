@@ -2,7 +2,8 @@
 //! mps2-an386 (docs/flashing.md, "Boot scenarios in QEMU").
 //!
 //! ```text
-//! flash-compose BOOT.elf OUT.bin STEP...
+//! flash-compose [--board] BOOT.elf OUT.bin STEP...
+//!   --board        the XMC4800 layout: a file to flash at 0x0C00_0000 (default: QEMU's mps2-an386, at 0)
 //!   install FILE   the running image downloads update file FILE into the inactive slot
 //!   reset          power-on: the boot loader's decision (TRIED mark, rollback)
 //!   confirm        the running image confirms itself
@@ -11,18 +12,22 @@
 //! ```
 #![forbid(unsafe_code)]
 
-use flash_compose::{boot_bytes, compose, parse_steps};
+use flash_compose::{boot_bytes, compose_for, parse_steps, Target};
 use std::process::ExitCode;
 
 fn run(args: &[String]) -> Result<(), String> {
+    let (target, args) = match args {
+        [flag, rest @ ..] if flag == "--board" => (Target::Xmc4800, rest),
+        _ => (Target::Mps2, args),
+    };
     let [boot, out, steps @ ..] = args else {
         return Err(
-            "usage: flash-compose BOOT.elf OUT.bin [install FILE|reset|confirm|flip N|cut FILE N]...".into(),
+            "usage: flash-compose [--board] BOOT.elf OUT.bin [install FILE|reset|confirm|flip N|cut FILE N]...".into(),
         );
     };
     let read = |p: &str| std::fs::read(p).map_err(|e| format!("{p}: {e}"));
     let steps = parse_steps(steps, &read)?;
-    let image = compose(&boot_bytes(&read(boot)?)?, &steps, &mut |line| {
+    let image = compose_for(target, &boot_bytes(&read(boot)?, target)?, &steps, &mut |line| {
         println!("flash-compose: {line}")
     })?;
     std::fs::write(out, &image).map_err(|e| format!("{out}: {e}"))?;

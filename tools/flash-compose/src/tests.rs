@@ -104,3 +104,26 @@ fn steps_parse_from_the_command_line() {
     assert!(parse_steps(&["flip".to_string()], &read).is_err());
     assert!(parse_steps(&["boot".to_string()], &read).is_err());
 }
+
+#[test]
+fn the_board_file_starts_at_the_boot_loader_and_ends_after_slot_b() {
+    type Board = MemFlash<'static, NoMirror, { xmc4800::SECTOR }, { xmc4800::SECTORS }, { xmc4800::WRITE }>;
+    let at = xmc4800::LAYOUT.body_address::<Board>(Slot::A).unwrap();
+    assert_eq!(at, 0x0804_0400);
+    let mut body = vec![0x5A; 4000];
+    body[..4].copy_from_slice(&xmc4800::LAYOUT.ram_end.to_le_bytes());
+    body[4..8].copy_from_slice(&(at + 0x41).to_le_bytes());
+    let steps = [
+        Step::Install(foe_image::update_file(&body, 9).unwrap()),
+        Step::Reset,
+        Step::Confirm,
+    ];
+    let mut log = Vec::new();
+    let f = compose_for(Target::Xmc4800, &[0xAB; 64], &steps, &mut |l| log.push(l)).unwrap();
+    assert_eq!(f.len(), 0x4_0000 + 4 * 256 * 1024);
+    assert_eq!(&f[0x4_0000..0x4_0004], b"SC6F");
+    assert_eq!(&f[0x4_0400..0x4_0404], &xmc4800::LAYOUT.ram_end.to_le_bytes());
+    assert_eq!(log.last().unwrap(), "flash: slot A confirmed, slot B empty");
+    // a boot loader larger than S0..S1 does not fit
+    assert!(compose_for(Target::Xmc4800, &[0; 32 * 1024 + 1], &[], &mut |_| {}).is_err());
+}
