@@ -181,13 +181,19 @@ mod app {
         cortex_m::singleton!(: Net = Net)
     }
 
-    /// Background: a requested save (`tasks::background`), and firing the
+    /// Background: a requested save (`tasks::background`), the image's
+    /// confirmation point (`tasks::confirm_point`: the first Op; this image's
+    /// drive has no firmware slots yet, docs/flashing.md), and firing the
     /// control cycle when its time has come (until the CCU4 compare does it
     /// in hardware).
     #[idle(shared = [drive, timer, clock, net])]
     fn idle(mut cx: idle::Context) -> ! {
+        let mut confirmed = false;
         loop {
             tasks::background(&mut cx.shared.drive);
+            if !confirmed {
+                confirmed = cx.shared.drive.lock(|d| tasks::confirm_point(d));
+            }
             let now = cx.shared.clock.lock(|c| c.now(DWT::cycle_count()));
             if cx.shared.timer.lock(|t| t.next_at()) <= now {
                 rtic::pend(Interrupt::CCU40_0);

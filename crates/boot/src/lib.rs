@@ -314,6 +314,29 @@ impl<F: Flash> BootSlots<F> {
         }
     }
 
+    /// The slots as a separate boot loader left them (it ran
+    /// [`boot`](Self::boot) and started `slot`): the running image's view,
+    /// on trial unless its slot carries the CONFIRMED mark. Reads (and
+    /// CRC-checks) `slot` only; writes nothing.
+    pub fn resume(flash: F, slot: Slot) -> Result<Self, FlashError> {
+        let mut s = Self::new(flash);
+        let state = s.state(slot)?;
+        s.active = Some(slot);
+        s.trial = matches!(state, SlotState::Trial { .. });
+        Ok(s)
+    }
+
+    /// Offset of the image body (the firmware's first byte) in a slot:
+    /// the header and the three mark units before it.
+    pub const fn body_offset() -> usize {
+        Self::BODY
+    }
+
+    /// Bytes per slot (slot A at 0, slot B at this offset of the region).
+    pub const fn slot_len() -> usize {
+        Self::SLOT_LEN
+    }
+
     /// The flash (for tests and fault injection).
     pub fn flash_mut(&mut self) -> &mut F {
         &mut self.flash

@@ -195,3 +195,23 @@ fn a_flipped_bit_in_flash_makes_the_slot_unbootable() {
     let (_, d) = power_cycle(s);
     assert_eq!(d.map(|d| (d.slot, d.trial)), Some((Slot::A, false)));
 }
+
+#[test]
+fn resume_sees_the_running_slot_as_the_boot_loader_left_it() {
+    // a separate boot loader ran boot() and started B on trial
+    let mut s = factory();
+    assert_eq!(download(&mut s, &file(&body(2, 700), 2), 64), Ok(Slot::B));
+    let (s, d) = power_cycle(s);
+    assert_eq!(d.map(|d| (d.slot, d.trial)), Some((Slot::B, true)));
+    // the image in B: on trial, confirms itself
+    let mut app = BootSlots::resume(s.into_inner(), Slot::B).unwrap();
+    assert_eq!((app.active(), app.on_trial()), (Some(Slot::B), true));
+    app.confirm().unwrap();
+    // the next start of B: confirmed, nothing to do
+    let app = BootSlots::resume(app.into_inner(), Slot::B).unwrap();
+    assert!(!app.on_trial());
+    let (_, d) = power_cycle(app);
+    assert_eq!(d.map(|d| (d.slot, d.trial)), Some((Slot::B, false)));
+    assert_eq!(BootSlots::<Ram>::body_offset(), 16 + 3 * 8);
+    assert_eq!(BootSlots::<Ram>::slot_len(), 8 * 256);
+}

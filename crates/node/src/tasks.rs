@@ -105,3 +105,20 @@ pub fn background<D: BorrowMut<Drive>>(drive: &mut impl Mutex<T = D>) {
         drive.lock(|d| d.borrow_mut().end_save(job));
     }
 }
+
+/// The running firmware image's confirmation point (issue 18, docs/flashing.md
+/// "Boot flow"), called from the idle loop until it returns `true`: the first
+/// time the EtherCAT state machine is in Op — a master configured the drive and
+/// exchanges process data with this image, so the image runs and can be reached
+/// for the next update — the image confirms itself
+/// ([`Drive::confirm_firmware`](drive::runtime::Drive::confirm_firmware)): an
+/// image on trial is kept from then on instead of being rolled back at the next
+/// reset. A drive without firmware slots has nothing to confirm (still `true`
+/// once in Op).
+pub fn confirm_point(drive: &mut Drive) -> bool {
+    if drive.slave().state() != esc::AlState::Op {
+        return false;
+    }
+    let _ = drive.confirm_firmware();
+    true
+}
