@@ -111,6 +111,30 @@ mod measure {
     }
 }
 
+/// The simulated ESC's PDI with the SysTick ticks spent inside it (the
+/// register model, which on the board is the ESC chip itself) added to
+/// `ticks`, so the ESC task's own part can be printed apart.
+pub struct TimedPdi<'a, P> {
+    inner: P,
+    ticks: &'a mut u32,
+}
+
+impl<P: esc::pdi::Pdi> esc::pdi::Pdi for TimedPdi<'_, P> {
+    type Error = P::Error;
+    fn read(&mut self, addr: u16, buf: &mut [u8]) -> Result<(), Self::Error> {
+        let t0 = measure::now();
+        let r = self.inner.read(addr, buf);
+        *self.ticks = self.ticks.wrapping_add(measure::ticks(t0, measure::now()));
+        r
+    }
+    fn write(&mut self, addr: u16, data: &[u8]) -> Result<(), Self::Error> {
+        let t0 = measure::now();
+        let r = self.inner.write(addr, data);
+        *self.ticks = self.ticks.wrapping_add(measure::ticks(t0, measure::now()));
+        r
+    }
+}
+
 /// Running figures of one task.
 #[derive(Default, Clone, Copy)]
 pub struct Figure {
@@ -159,6 +183,8 @@ mod app {
         cmd: [AxisCommand; 2],
         /// SysTick ticks of the last run of `control`, `esc` and `mailbox`.
         cost: [u32; 3],
+        /// SysTick ticks of the last `esc` run spent in the simulated ESC.
+        esc_model: u32,
         /// The IP stack on the EoE interface, polled by `mailbox`.
         net: &'static mut NodeNet,
     }
@@ -203,6 +229,7 @@ mod app {
                 io: [AxisIo::ready(0); 2],
                 cmd: [AxisCommand::OFF; 2],
                 cost: [0; 3],
+                esc_model: 0,
                 net,
             },
             Local { world, per_kilo_tick },
@@ -263,12 +290,13 @@ mod app {
 
     /// The simulated world: advances time event by event and pends the task
     /// of each event; logs the master's progress and the figures.
-    #[idle(shared = [drive, timer, esc, clock, io, cmd, cost], local = [world, per_kilo_tick])]
+    #[idle(shared = [drive, timer, esc, clock, io, cmd, cost, esc_model], local = [world, per_kilo_tick])]
     fn idle(mut cx: idle::Context) -> ! {
         let world = &mut **cx.local.world;
         let insn = |ticks: u32| (u64::from(ticks) * u64::from(*cx.local.per_kilo_tick) / 1000) as u32;
         let (mut control, mut esc_cost) = (Figure::default(), Figure::default());
         let mut mailbox_cost = Figure::default();
+        let mut esc_own = Figure::default();
         let mut stack = [0u32; 3];
         let mut moving = false;
         let mut events: u32 = 0;
@@ -316,7 +344,10 @@ mod app {
                     }
                     tasks::background(&mut cx.shared.drive);
                     if moving {
-                        esc_cost.add(insn(cx.shared.cost.lock(|c| c[1])));
+                        let total = cx.shared.cost.lock(|c| c[1]);
+                        esc_cost.add(insn(total));
+                        let model = cx.shared.esc_model.lock(|m| *m);
+                        esc_own.add(insn(total.saturating_sub(model)));
                     }
                     match progress {
                         Progress::Busy => {}
@@ -376,6 +407,11 @@ mod app {
             esc_cost.max
         );
         defmt::info!(
+            "figure: ESC event task in Op without the simulated ESC's register model (the task's own part): mean {=u32} max {=u32} instructions",
+            esc_own.mean(),
+            esc_own.max
+        );
+        defmt::info!(
             "figure: mailbox task with the IP stack, outside the move: mean {=u32} max {=u32} instructions over {=u32} runs",
             mailbox_cost.mean(),
             mailbox_cost.max,
@@ -422,16 +458,23 @@ mod app {
     }
 
     /// The ESC's PDI interrupt: the slave stack (ESM, mailbox, process data).
-    #[task(binds = EXTI2, priority = 2, shared = [drive, timer, esc, clock, cost])]
+    #[task(binds = EXTI2, priority = 2, shared = [drive, timer, esc, clock, cost, esc_model])]
     fn esc(cx: esc::Context) {
         // a pended mailbox task runs once more after this one
         rtic::pend(Interrupt::USART1);
         let now = { cx.shared.clock }.lock(|c| *c);
+        let mut model = 0u32;
         let t0 = measure::now();
-        let change = (cx.shared.drive, cx.shared.timer, cx.shared.esc)
-            .lock(|drive, timer, esc| tasks::esc_event(drive, timer, &mut esc.pdi(), now));
+        let change = (cx.shared.drive, cx.shared.timer, cx.shared.esc).lock(|drive, timer, esc| {
+            let mut pdi = super::TimedPdi {
+                inner: esc.pdi(),
+                ticks: &mut model,
+            };
+            tasks::esc_event(drive, timer, &mut pdi, now)
+        });
         let t = measure::ticks(t0, measure::now());
         { cx.shared.cost }.lock(|c| c[1] = t);
+        { cx.shared.esc_model }.lock(|m| *m = model);
         if let Ok(Some(c)) = change {
             defmt::info!(
                 "esc: AL state {=u8} (status code {=u16:04X})",
