@@ -11,7 +11,7 @@ use ecat::eoe_queue::EoeQueue;
 use nanos::Nanos;
 use od::{CommState, Dictionary};
 use smoltcp::iface::{Config, Interface, SocketHandle, SocketSet, SocketStorage};
-use smoltcp::socket::{dhcpv4, udp};
+use smoltcp::socket::{dhcpv4, udp, Socket};
 use smoltcp::time::Instant;
 use smoltcp::wire::{EthernetAddress, HardwareAddress, IpAddress, IpCidr, IpEndpoint, Ipv4Address, Ipv4Cidr};
 
@@ -170,6 +170,27 @@ pub struct NetStack<'a> {
     param_bucket: Bucket,
 }
 
+/// The UDP socket of handle `h`: looked up by iterating the set rather than
+/// with `SocketSet::get_mut`, whose `expect` and wrong-type panic are code
+/// on the board even though the stack only passes its own handles.
+fn udp_socket<'s, 'a>(sockets: &'s mut SocketSet<'a>, h: SocketHandle) -> Option<&'s mut udp::Socket<'a>> {
+    sockets.iter_mut().find_map(|(k, s)| match s {
+        Socket::Udp(u) if k == h => Some(u),
+        _ => None,
+    })
+}
+
+/// The DHCP socket of handle `h` (as [`udp_socket`]).
+fn dhcp_socket<'s, 'a>(
+    sockets: &'s mut SocketSet<'a>,
+    h: SocketHandle,
+) -> Option<&'s mut dhcpv4::Socket<'a>> {
+    sockets.iter_mut().find_map(|(k, s)| match s {
+        Socket::Dhcpv4(d) if k == h => Some(d),
+        _ => None,
+    })
+}
+
 /// smoltcp's time: whole µs (truncated, as the callers did before they passed [`Nanos`]).
 fn instant(now: Nanos) -> Instant {
     Instant::from_micros(i64::try_from(now.as_us()).unwrap_or(i64::MAX))
@@ -324,7 +345,10 @@ impl<'a> NetStack<'a> {
     /// Takes the DHCP client's news.
     fn run_dhcp(&mut self) {
         let Some(h) = self.dhcp else { return };
-        let event = match self.sockets.get_mut::<dhcpv4::Socket>(h).poll() {
+        let Some(dhcp) = dhcp_socket(&mut self.sockets, h) else {
+            return;
+        };
+        let event = match dhcp.poll() {
             None => return,
             Some(dhcpv4::Event::Configured(c)) => Some((c.address, c.router)),
             Some(dhcpv4::Event::Deconfigured) => None,
@@ -405,7 +429,9 @@ impl<'a> NetStack<'a> {
         state: CommState,
         policy: param::Policy,
     ) {
-        let sock = self.sockets.get_mut::<udp::Socket>(self.param);
+        let Some(sock) = udp_socket(&mut self.sockets, self.param) else {
+            return;
+        };
         let stats = &mut self.stats;
         for _ in 0..PARAM_DATAGRAMS {
             if !sock.can_send() {
@@ -445,7 +471,9 @@ impl<'a> NetStack<'a> {
     }
 
     fn run_sntp(&mut self, now_us: u64, settings: &NetSettings) {
-        let sock = self.sockets.get_mut::<udp::Socket>(self.sntp_socket);
+        let Some(sock) = udp_socket(&mut self.sockets, self.sntp_socket) else {
+            return;
+        };
         while let Ok((data, meta)) = sock.recv() {
             let from = match meta.endpoint.addr {
                 IpAddress::Ipv4(a) => a.octets(),
