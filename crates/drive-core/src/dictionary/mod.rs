@@ -12,10 +12,10 @@ use core::cell::Cell;
 use core::marker::PhantomData;
 use core::sync::atomic::{AtomicU32, Ordering};
 
-use crate::objects::{self, enumeration, find, Object, Value, ENTRY_TABLE, IMAGE_BYTES, OBJECTS, OFFSETS};
+use crate::objects::{self, enumeration, find, Object, Value, IMAGE_BYTES, OBJECTS, OFFSETS};
 use crate::pdo_image::{CopyOp, WIDTH_SHIFT};
 use crate::{parameter_index, MAPPING_ENTRIES, SOFTWARE_BUILD};
-use od::{CommState, DataType, Dictionary, EntryInfo, ObjectInfo, PackedEntry, SdoAbort};
+use od::{CommState, DataType, Dictionary, EntryInfo, ObjectInfo, PackedRef, SdoAbort};
 
 mod mapping;
 mod persist;

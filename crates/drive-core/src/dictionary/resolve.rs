@@ -35,7 +35,7 @@ impl Loc {
     }
 
     /// The entry's packed record in [`crate::objects::ENTRY_TABLE`].
-    pub(super) fn record(self) -> Result<&'static PackedEntry, SdoAbort> {
+    pub(super) fn record(self) -> Result<PackedRef, SdoAbort> {
         self.object()?
             .info
             .entries

@@ -4,7 +4,11 @@
 //! these in order. Each check is an `assert!` in compile-time evaluation: a
 //! declaration that does not fit the packed form does not compile.
 
-use super::{kind, narrow, PackedEntry, ACCESS_MASK, NO_RANGE, PERSISTENT, UNITS, UNIT_SHIFT};
+use super::record::{
+    kind_of, type_code, ACCESS_MASK, MAX_KINDS, MAX_NAME, MAX_STRING, MAX_STRINGS, MAX_UNITS, NO_DEFAULT,
+    PLACEHOLDER_KIND,
+};
+use super::{narrow, PackedEntry, NO_RANGE, UNITS};
 use crate::EntryInfo;
 
 const fn str_eq(a: &str, b: &str) -> bool {
@@ -34,7 +38,7 @@ const fn opt_eq(a: Option<i64>, b: Option<i64>) -> bool {
 
 /// The same entry (every field)? For de-duplicating lists at compile time.
 pub const fn same_entry(a: &EntryInfo, b: &EntryInfo) -> bool {
-    let (ka, kb) = (kind(a.data_type), kind(b.data_type));
+    let (ka, kb) = (type_code(a.data_type), type_code(b.data_type));
     a.sub == b.sub
         && ka.0 == kb.0
         && ka.1 == kb.1
@@ -127,7 +131,7 @@ pub const fn string_bytes(es: &[EntryInfo], extra: &[&str]) -> usize {
         }
         k += 1;
     }
-    assert!(n <= u16::MAX as usize, "packed names exceed 64 KiB");
+    assert!(n <= MAX_STRINGS, "packed names exceed 16 KiB");
     n
 }
 
@@ -385,7 +389,7 @@ pub const fn defaults<const MAX: usize, const D: usize>(es: &[EntryInfo]) -> [u3
     out
 }
 
-const fn unit_index(unit: &str) -> u16 {
+const fn unit_index(unit: &str) -> u32 {
     let mut i = 0;
     // i < UNITS.len() (compile-time evaluation)
     #[allow(clippy::indexing_slicing)]
@@ -393,39 +397,89 @@ const fn unit_index(unit: &str) -> u16 {
         i += 1;
     }
     assert!(i < UNITS.len(), "a packed entry's unit must be in od::UNITS");
-    i as u16
+    i as u32
+}
+
+/// The kind of `e` (type, access, persistence, unit).
+const fn entry_kind(e: &EntryInfo) -> u32 {
+    assert!(e.access.0 as u32 & !ACCESS_MASK == 0, "access bits 0..9");
+    assert!(
+        type_code(e.data_type).1 <= MAX_STRING,
+        "a packed string has at most 4095 bytes"
+    );
+    kind_of(e.data_type, e.access, e.persistent, unit_index(e.unit))
+}
+
+/// Distinct kinds of `es`, [`PLACEHOLDER_KIND`] first (at most `MAX`), and how many.
+const fn collect_kinds<const MAX: usize>(es: &[EntryInfo]) -> ([u32; MAX], usize) {
+    let mut out = [0u32; MAX];
+    out[0] = PLACEHOLDER_KIND;
+    let mut n = 1;
+    let mut i = 0;
+    while i < es.len() {
+        // i < es.len(), n < MAX (compile-time evaluation)
+        #[allow(clippy::indexing_slicing)]
+        let k = entry_kind(&es[i]);
+        if position_value(&out, n, k) == n {
+            assert!(n < MAX, "kind table size");
+            #[allow(clippy::indexing_slicing)]
+            {
+                out[n] = k;
+            }
+            n += 1;
+        }
+        i += 1;
+    }
+    (out, n)
+}
+
+/// Number of distinct kinds of `es` with the placeholder kind (`MAX`: an
+/// upper bound, e.g. `es.len() + 1`).
+pub const fn kind_count<const MAX: usize>(es: &[EntryInfo]) -> usize {
+    collect_kinds::<MAX>(es).1
+}
+
+/// The distinct kinds of `es`, [`PLACEHOLDER_KIND`] first. `K` = [`kind_count`].
+pub const fn kinds<const MAX: usize, const K: usize>(es: &[EntryInfo]) -> [u32; K] {
+    let (all, n) = collect_kinds::<MAX>(es);
+    assert!(n == K && K <= MAX_KINDS, "at most 128 distinct kinds");
+    let mut out = [0u32; K];
+    let mut i = 0;
+    while i < K {
+        // i < K <= MAX (compile-time evaluation)
+        #[allow(clippy::indexing_slicing)]
+        {
+            out[i] = all[i];
+        }
+        i += 1;
+    }
+    out
 }
 
 /// The records of `es` against the tables built from the same `es`.
 pub const fn entries<const N: usize>(
     es: &[EntryInfo],
+    kinds: &[u32],
     ranges: &[[u32; 2]],
     defaults: &[u32],
 ) -> [PackedEntry; N] {
     assert!(N == es.len(), "entry count");
-    assert!(UNITS.len() <= 32, "5-bit unit index");
+    assert!(UNITS.len() <= MAX_UNITS, "5-bit unit index");
+    assert!(ranges.len() < NO_RANGE as usize, "at most 31 distinct ranges");
+    assert!(
+        defaults.len() < NO_DEFAULT as usize,
+        "at most 255 distinct defaults"
+    );
     let names = name_offsets::<N>(es);
-    let mut out = [PackedEntry {
-        name: 0,
-        name_len: 0,
-        sub: 0,
-        flags: 0,
-        ty: 0,
-        range: NO_RANGE,
-        default: 0,
-    }; N];
+    let mut out = [PackedEntry::UNUSED; N];
     let mut i = 0;
     while i < N {
         // i < N = es.len() (compile-time evaluation)
         #[allow(clippy::indexing_slicing)]
         let e = &es[i];
-        assert!(
-            e.name.len() <= u8::MAX as usize,
-            "a packed name has at most 255 bytes"
-        );
-        assert!(e.access.0 & !ACCESS_MASK == 0, "access bits 0..9");
-        let (k, n) = kind(e.data_type);
-        assert!(n < 1 << 12, "a packed string has at most 4095 bytes");
+        assert!(e.name.len() <= MAX_NAME, "a packed name has at most 63 bytes");
+        let kind = position_value(kinds, kinds.len(), entry_kind(e));
+        assert!(kind < kinds.len(), "kind in the table");
         let range = match range_of(e) {
             Some(r) => position_range(ranges, ranges.len(), r) as u16,
             None => NO_RANGE,
@@ -434,17 +488,14 @@ pub const fn entries<const N: usize>(
         assert!(default < defaults.len(), "default in the table");
         #[allow(clippy::indexing_slicing)]
         {
-            out[i] = PackedEntry {
-                name: names[i],
-                name_len: e.name.len() as u8,
-                sub: e.sub,
-                flags: e.access.0
-                    | if e.persistent { PERSISTENT } else { 0 }
-                    | unit_index(e.unit) << UNIT_SHIFT,
-                ty: k | n << 4,
+            out[i] = PackedEntry::new(
+                names[i],
+                e.name.len() as u16,
+                e.sub,
+                kind as u16,
                 range,
-                default: default as u16,
-            };
+                default as u16,
+            );
         }
         i += 1;
     }

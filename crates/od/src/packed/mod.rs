@@ -24,99 +24,16 @@ pub static UNITS: [&str; 17] = [
     "ns", "mNm", "mV",
 ];
 
-/// No range ([`PackedEntry`] range index).
-const NO_RANGE: u16 = u16::MAX;
-const PERSISTENT: u16 = 1 << 10;
-const UNIT_SHIFT: u16 = 11;
-const ACCESS_MASK: u16 = (1 << 10) - 1;
+mod record;
+pub use record::PackedEntry;
+use record::{type_of, NO_RANGE};
 
-/// One entry in 12 bytes: name (offset and length in the string table),
-/// subindex, access bits with the persistence flag and the unit index, data
-/// type with its string length, range and default (indices into the shared
-/// tables).
-#[derive(Debug, Clone, Copy, PartialEq, Eq)]
-pub struct PackedEntry {
-    name: u16,
-    name_len: u8,
-    sub: u8,
-    /// bits 0..9 access, bit 10 persistent, bits 11..15 unit
-    flags: u16,
-    /// bits 0..3 kind, bits 4..15 string length
-    ty: u16,
-    range: u16,
-    default: u16,
-}
-
-const fn kind(t: DataType) -> (u16, u16) {
-    match t {
-        DataType::Bool => (0, 0),
-        DataType::I8 => (1, 0),
-        DataType::I16 => (2, 0),
-        DataType::I32 => (3, 0),
-        DataType::U8 => (4, 0),
-        DataType::U16 => (5, 0),
-        DataType::U32 => (6, 0),
-        DataType::F32 => (7, 0),
-        DataType::VisibleString(n) => (8, n),
-        DataType::OctetString(n) => (9, n),
-        DataType::I64 => (10, 0),
-        DataType::U64 => (11, 0),
-    }
-}
-
-impl PackedEntry {
-    /// A record of no table: subindex 0, UNSIGNED8, read-only, no name
-    /// (placeholder in fixed-size tables).
-    pub const UNUSED: Self = Self {
-        name: 0,
-        name_len: 0,
-        sub: 0,
-        flags: crate::Access::READ,
-        ty: 4,
-        range: NO_RANGE,
-        default: u16::MAX,
-    };
-
-    /// Saved by "save values"?
-    pub const fn persistent(&self) -> bool {
-        self.flags & PERSISTENT != 0
-    }
-
-    /// Subindex.
-    pub const fn sub(&self) -> u8 {
-        self.sub
-    }
-
-    /// Data type.
-    pub const fn data_type(&self) -> DataType {
-        let n = self.ty >> 4;
-        match self.ty & 0xF {
-            0 => DataType::Bool,
-            1 => DataType::I8,
-            2 => DataType::I16,
-            3 => DataType::I32,
-            4 => DataType::U8,
-            5 => DataType::U16,
-            6 => DataType::U32,
-            7 => DataType::F32,
-            8 => DataType::VisibleString(n),
-            9 => DataType::OctetString(n),
-            10 => DataType::I64,
-            _ => DataType::U64,
-        }
-    }
-
-    /// Access rights.
-    pub const fn access(&self) -> Access {
-        Access(self.flags & ACCESS_MASK)
-    }
-}
-
-/// A table of packed entries with its string, range and default tables.
+/// A table of packed entries with its string, kind, range and default tables.
 #[derive(Debug)]
 pub struct PackedTable {
     entries: &'static [PackedEntry],
     strings: &'static str,
+    kinds: &'static [u32],
     ranges: &'static [[u32; 2]],
     defaults: &'static [u32],
 }
@@ -152,12 +69,14 @@ impl PackedTable {
     pub const fn new(
         entries: &'static [PackedEntry],
         strings: &'static str,
+        kinds: &'static [u32],
         ranges: &'static [[u32; 2]],
         defaults: &'static [u32],
     ) -> Self {
         Self {
             entries,
             strings,
+            kinds,
             ranges,
             defaults,
         }
@@ -187,10 +106,11 @@ impl PackedTable {
         self.strings
     }
 
-    /// Bytes of the records, strings, ranges and defaults.
+    /// Bytes of the records, strings, kinds, ranges and defaults.
     pub const fn bytes(&self) -> usize {
         core::mem::size_of_val(self.entries)
             + self.strings.len()
+            + core::mem::size_of_val(self.kinds)
             + core::mem::size_of_val(self.ranges)
             + core::mem::size_of_val(self.defaults)
     }
@@ -200,17 +120,40 @@ impl PackedTable {
         self.entries.get(at).map(|p| self.decode(p))
     }
 
+    /// The kind of a record (kind 0 when the table has no such kind).
+    fn kind(&self, p: &PackedEntry) -> u32 {
+        self.kinds
+            .get(p.kind())
+            .copied()
+            .unwrap_or(record::PLACEHOLDER_KIND)
+    }
+
+    /// Data type of a record of this table.
+    pub fn data_type(&self, p: &PackedEntry) -> DataType {
+        type_of(self.kind(p))
+    }
+
+    /// Access rights of a record of this table.
+    pub fn access(&self, p: &PackedEntry) -> Access {
+        record::access_of(self.kind(p))
+    }
+
+    /// Is a record of this table saved by "save values"?
+    pub fn persistent(&self, p: &PackedEntry) -> bool {
+        record::persistent_of(self.kind(p))
+    }
+
     /// The declared default of a record of this table.
     pub fn default_of(&self, p: &PackedEntry) -> i64 {
         self.defaults
-            .get(usize::from(p.default))
-            .map_or(0, |&d| widen(p.data_type(), d))
+            .get(p.default())
+            .map_or(0, |&d| widen(self.data_type(p), d))
     }
 
     /// [`EntryInfo::check_range`] of a record of this table.
     pub fn check_range(&self, p: &PackedEntry, value: i64) -> Result<(), crate::SdoAbort> {
-        let t = p.data_type();
-        let (lo, hi) = match self.ranges.get(usize::from(p.range)) {
+        let t = self.data_type(p);
+        let (lo, hi) = match self.ranges.get(p.range()) {
             Some(&[lo, hi]) => (widen(t, lo), widen(t, hi)),
             None => (t.min_value(), t.max_value()),
         };
@@ -227,32 +170,90 @@ impl PackedTable {
 
     /// Decodes a record of this table.
     pub fn decode(&self, p: &PackedEntry) -> EntryInfo {
-        let t = p.data_type();
-        let start = usize::from(p.name);
-        let name = self
-            .strings
-            .get(start..start + usize::from(p.name_len))
-            .unwrap_or("");
-        let (min, max) = match self.ranges.get(usize::from(p.range)) {
+        let kind = self.kind(p);
+        let t = type_of(kind);
+        let start = p.name_at();
+        let name = self.strings.get(start..start + p.name_len()).unwrap_or("");
+        let (min, max) = match self.ranges.get(p.range()) {
             Some(&[lo, hi]) => (Some(widen(t, lo)), Some(widen(t, hi))),
             None => (None, None),
         };
         EntryInfo {
-            sub: p.sub,
+            sub: p.sub(),
             name,
             data_type: t,
-            access: p.access(),
+            access: record::access_of(kind),
             min,
             max,
             default: self.default_of(p),
-            unit: UNITS
-                .get(usize::from(p.flags >> UNIT_SHIFT))
-                .copied()
-                .unwrap_or(""),
-            persistent: p.flags & PERSISTENT != 0,
+            unit: UNITS.get(record::unit_of(kind)).copied().unwrap_or(""),
+            persistent: record::persistent_of(kind),
         }
     }
 }
+
+/// A record with its table: what the record says, read without decoding the
+/// whole entry (8 bytes, `Copy`).
+#[derive(Debug, Clone, Copy)]
+pub struct PackedRef {
+    table: &'static PackedTable,
+    record: &'static PackedEntry,
+}
+
+const EMPTY: PackedTable = PackedTable::new(&[], "", &[], &[], &[]);
+
+impl PackedRef {
+    /// A reference of no table: [`PackedEntry::UNUSED`] (subindex 0,
+    /// UNSIGNED8, read-only, default 0; placeholder in fixed-size tables).
+    pub const UNUSED: Self = Self {
+        table: &EMPTY,
+        record: &PackedEntry::UNUSED,
+    };
+
+    /// Subindex.
+    pub const fn sub(&self) -> u8 {
+        self.record.sub()
+    }
+
+    /// Data type.
+    pub fn data_type(&self) -> DataType {
+        self.table.data_type(self.record)
+    }
+
+    /// Access rights.
+    pub fn access(&self) -> Access {
+        self.table.access(self.record)
+    }
+
+    /// Saved by "save values"?
+    pub fn persistent(&self) -> bool {
+        self.table.persistent(self.record)
+    }
+
+    /// The declared default.
+    pub fn default_value(&self) -> i64 {
+        self.table.default_of(self.record)
+    }
+
+    /// [`EntryInfo::check_range`] of the entry.
+    pub fn check_range(&self, value: i64) -> Result<(), crate::SdoAbort> {
+        self.table.check_range(self.record, value)
+    }
+
+    /// The entry, decoded.
+    pub fn decode(&self) -> EntryInfo {
+        self.table.decode(self.record)
+    }
+}
+
+/// Equal records (as `PackedEntry` values; the table is not compared).
+impl PartialEq for PackedRef {
+    fn eq(&self, other: &Self) -> bool {
+        self.record == other.record
+    }
+}
+
+impl Eq for PackedRef {}
 
 /// The entries of an object: a run of a [`PackedTable`] or a slice.
 #[derive(Clone, Copy)]
@@ -318,7 +319,7 @@ impl Entries {
             Repr::Packed { table, start, len } => {
                 let from = usize::from(start);
                 let run = table.entries.get(from..from + usize::from(len))?;
-                run.iter().position(|p| p.sub == sub)
+                run.iter().position(|p| p.sub() == sub)
             }
         }
     }
@@ -327,17 +328,18 @@ impl Entries {
     pub fn data_type(&self, pos: usize) -> Option<DataType> {
         match self.0 {
             Repr::Slice(s) => s.get(pos).map(|e| e.data_type),
-            Repr::Packed { .. } => self.record(pos).map(PackedEntry::data_type),
+            Repr::Packed { .. } => self.record(pos).map(|p| p.data_type()),
         }
     }
 
-    /// The packed record at position `pos` (`None` for slices).
-    pub fn record(&self, pos: usize) -> Option<&'static PackedEntry> {
+    /// The packed record at position `pos` with its table (`None` for slices).
+    pub fn record(&self, pos: usize) -> Option<PackedRef> {
         match self.0 {
             Repr::Slice(_) => None,
-            Repr::Packed { table, start, len } if pos < usize::from(len) => {
-                table.entries.get(usize::from(start) + pos)
-            }
+            Repr::Packed { table, start, len } if pos < usize::from(len) => table
+                .entries
+                .get(usize::from(start) + pos)
+                .map(|record| PackedRef { table, record }),
             Repr::Packed { .. } => None,
         }
     }
@@ -349,7 +351,7 @@ impl Entries {
             Repr::Packed { table, start, len } => {
                 let from = usize::from(start);
                 let run = table.entries.get(from..from + usize::from(len))?;
-                run.iter().find(|p| p.sub == sub).map(|p| table.decode(p))
+                run.iter().find(|p| p.sub() == sub).map(|p| table.decode(p))
             }
         }
     }
@@ -361,7 +363,7 @@ impl Entries {
             Repr::Packed { table, start, len } => {
                 let from = usize::from(start);
                 let run = table.entries.get(from..from + usize::from(len)).unwrap_or(&[]);
-                run.iter().map(|p| p.sub).max().unwrap_or(0)
+                run.iter().map(|p| p.sub()).max().unwrap_or(0)
             }
         }
     }
@@ -469,7 +471,12 @@ macro_rules! packed_table {
             #[allow(long_running_const_eval)]
             const D: usize = $crate::packed::default_count::<N>(PACKED_INPUT);
             #[allow(long_running_const_eval)]
-            static ENTRIES: [$crate::PackedEntry; N] = $crate::packed::entries::<N>(PACKED_INPUT, &RANGES, &DEFAULTS);
+            const K: usize = $crate::packed::kind_count::<{ N + 1 }>(PACKED_INPUT);
+            #[allow(long_running_const_eval)]
+            static ENTRIES: [$crate::PackedEntry; N] =
+                $crate::packed::entries::<N>(PACKED_INPUT, &KINDS, &RANGES, &DEFAULTS);
+            #[allow(long_running_const_eval)]
+            static KINDS: [u32; K] = $crate::packed::kinds::<{ N + 1 }, K>(PACKED_INPUT);
             #[allow(long_running_const_eval)]
             static RANGES: [[u32; 2]; R] = $crate::packed::ranges::<N, R>(PACKED_INPUT);
             #[allow(long_running_const_eval)]
@@ -482,7 +489,7 @@ macro_rules! packed_table {
                 Ok(s) => s,
                 Err(_) => "",
             };
-            $crate::PackedTable::new(&ENTRIES, NAMES, &RANGES, &DEFAULTS)
+            $crate::PackedTable::new(&ENTRIES, NAMES, &KINDS, &RANGES, &DEFAULTS)
         };
     };
 }
@@ -509,7 +516,7 @@ mod tests {
 
     #[test]
     fn packs_and_decodes_every_field() {
-        assert_eq!(core::mem::size_of::<PackedEntry>(), 12);
+        assert_eq!(core::mem::size_of::<PackedEntry>(), 6);
         assert_eq!(TABLE.len(), ES.len());
         for (i, e) in ES.iter().enumerate() {
             assert_eq!(TABLE.get(i), Some(*e), "entry {i}");
