@@ -510,7 +510,7 @@ fn resolve(index: u16, sub: u8, sdo_info: bool) -> Option<PackedRef> {
     let p = view.entries.position(sub)?;
     // the "EtherCAT Rx" view of a manufacturer array has element e at
     // position e, the runtime numbering at e + 1 (after sub 0)
-    let pos = if !sdo_info && o.rx.is_some() { p + 1 } else { p };
+    let pos = if !sdo_info && o.has_rx_view() { p + 1 } else { p };
     o.info.entries.record(pos)
 }
 

@@ -243,7 +243,7 @@ impl DriveObjects {
         if !self.visible(o) {
             return Err(SdoAbort::NO_OBJECT);
         }
-        let rx_view = !self.sdo_info() && o.rx.is_some();
+        let rx_view = !self.sdo_info() && o.has_rx_view();
         let view = o.view(self.sdo_info());
         let p = view.entries.position(sub).ok_or(SdoAbort::NO_SUBINDEX)?;
         Ok(Loc {

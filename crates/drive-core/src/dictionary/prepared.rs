@@ -55,7 +55,7 @@ impl DriveObjects {
         let target = follow(loc).ok()?;
         let (to, te) = (target.object().ok()?, target.record().ok()?);
         let t = te.data_type();
-        if o.rx.is_some() || !matches!(to.value, Value::Ram | Value::Live) || e.data_type() != t {
+        if o.has_rx_view() || !matches!(to.value, Value::Ram | Value::Live) || e.data_type() != t {
             return None;
         }
         let range = target.slot().ok()?;

@@ -84,10 +84,20 @@ impl PackedTable {
 
     /// The `len` entries from position `start`.
     pub const fn list(&'static self, start: u16, len: u16) -> Entries {
+        self.renumbered(start, len, 0)
+    }
+
+    /// The `len` entries from position `start`, each at its record's
+    /// subindex minus `shift` (e.g. the "EtherCAT Rx" view of a manufacturer
+    /// array: the SDO Info view's elements 1… at subindices 0…). Every record
+    /// of the run must have a subindex of at least `shift` (the builder's
+    /// check).
+    pub const fn renumbered(&'static self, start: u16, len: u16, shift: u8) -> Entries {
         Entries(Repr::Packed {
             table: self,
             start,
             len,
+            shift,
         })
     }
 
@@ -266,6 +276,8 @@ enum Repr {
         table: &'static PackedTable,
         start: u16,
         len: u16,
+        /// subindex = record subindex - shift
+        shift: u8,
     },
 }
 
@@ -296,14 +308,33 @@ impl Entries {
         self.len() == 0
     }
 
+    /// The run of records, its table and its subindex shift (packed entries).
+    fn run(&self) -> Option<(&'static PackedTable, &'static [PackedEntry], u8)> {
+        match self.0 {
+            Repr::Slice(_) => None,
+            Repr::Packed {
+                table,
+                start,
+                len,
+                shift,
+            } => {
+                let from = usize::from(start);
+                let run = table.entries.get(from..from + usize::from(len))?;
+                Some((table, run, shift))
+            }
+        }
+    }
+
     /// The entry at position `pos` (not subindex), decoded.
     pub fn get(&self, pos: usize) -> Option<EntryInfo> {
         match self.0 {
             Repr::Slice(s) => s.get(pos).copied(),
-            Repr::Packed { table, start, len } if pos < usize::from(len) => {
-                table.get(usize::from(start) + pos)
+            Repr::Packed { .. } => {
+                let (table, run, shift) = self.run()?;
+                let mut e = table.decode(run.get(pos)?);
+                e.sub = e.sub.wrapping_sub(shift);
+                Some(e)
             }
-            Repr::Packed { .. } => None,
         }
     }
 
@@ -316,10 +347,9 @@ impl Entries {
     pub fn position(&self, sub: u8) -> Option<usize> {
         match self.0 {
             Repr::Slice(s) => s.iter().position(|e| e.sub == sub),
-            Repr::Packed { table, start, len } => {
-                let from = usize::from(start);
-                let run = table.entries.get(from..from + usize::from(len))?;
-                run.iter().position(|p| p.sub() == sub)
+            Repr::Packed { .. } => {
+                let (_, run, shift) = self.run()?;
+                run.iter().position(|p| p.sub().wrapping_sub(shift) == sub)
             }
         }
     }
@@ -328,19 +358,20 @@ impl Entries {
     pub fn data_type(&self, pos: usize) -> Option<DataType> {
         match self.0 {
             Repr::Slice(s) => s.get(pos).map(|e| e.data_type),
-            Repr::Packed { .. } => self.record(pos).map(|p| p.data_type()),
+            Repr::Packed { .. } => {
+                let (table, run, _) = self.run()?;
+                run.get(pos).map(|p| table.data_type(p))
+            }
         }
     }
 
-    /// The packed record at position `pos` with its table (`None` for slices).
+    /// The packed record at position `pos` with its table (`None` for slices
+    /// and for runs that renumber their records, see
+    /// [`PackedTable::renumbered`]: a record's subindex is its table's).
     pub fn record(&self, pos: usize) -> Option<PackedRef> {
-        match self.0 {
-            Repr::Slice(_) => None,
-            Repr::Packed { table, start, len } if pos < usize::from(len) => table
-                .entries
-                .get(usize::from(start) + pos)
-                .map(|record| PackedRef { table, record }),
-            Repr::Packed { .. } => None,
+        match self.run()? {
+            (table, run, 0) => run.get(pos).map(|record| PackedRef { table, record }),
+            _ => None,
         }
     }
 
@@ -348,11 +379,7 @@ impl Entries {
     pub fn find(&self, sub: u8) -> Option<EntryInfo> {
         match self.0 {
             Repr::Slice(s) => s.iter().find(|e| e.sub == sub).copied(),
-            Repr::Packed { table, start, len } => {
-                let from = usize::from(start);
-                let run = table.entries.get(from..from + usize::from(len))?;
-                run.iter().find(|p| p.sub() == sub).map(|p| table.decode(p))
-            }
+            Repr::Packed { .. } => self.get(self.position(sub)?),
         }
     }
 
@@ -360,11 +387,9 @@ impl Entries {
     pub fn max_sub(&self) -> u8 {
         match self.0 {
             Repr::Slice(s) => s.iter().map(|e| e.sub).max().unwrap_or(0),
-            Repr::Packed { table, start, len } => {
-                let from = usize::from(start);
-                let run = table.entries.get(from..from + usize::from(len)).unwrap_or(&[]);
-                run.iter().map(|p| p.sub()).max().unwrap_or(0)
-            }
+            Repr::Packed { .. } => self.run().map_or(0, |(_, run, shift)| {
+                run.iter().map(|p| p.sub().wrapping_sub(shift)).max().unwrap_or(0)
+            }),
         }
     }
 
