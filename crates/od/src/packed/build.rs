@@ -105,21 +105,141 @@ const fn extra_is_new(es: &[EntryInfo], extra: &[&str], k: usize) -> bool {
     true
 }
 
-/// Bytes of the de-duplicated names of `es` and the strings `extra` (e.g.
-/// object names).
-pub const fn string_bytes(es: &[EntryInfo], extra: &[&str]) -> usize {
-    let mut n = 0;
+/// Is `needle` the part of `hay` from byte `at` on, up to its length?
+const fn is_at(hay: &[u8], needle: &[u8], at: usize) -> bool {
+    if at + needle.len() > hay.len() {
+        return false;
+    }
+    let mut k = 0;
+    while k < needle.len() {
+        // at + k < hay.len(), k < needle.len() (compile-time evaluation)
+        #[allow(clippy::indexing_slicing)]
+        if hay[at + k] != needle[k] {
+            return false;
+        }
+        k += 1;
+    }
+    true
+}
+
+/// Where `needle` is in `hay` when it is its beginning or its end.
+const fn find_in(hay: &str, needle: &str) -> Option<usize> {
+    let (h, n) = (hay.as_bytes(), needle.as_bytes());
+    if n.len() > h.len() {
+        None
+    } else if is_at(h, n, 0) {
+        Some(0)
+    } else if is_at(h, n, h.len() - n.len()) {
+        Some(h.len() - n.len())
+    } else {
+        None
+    }
+}
+
+/// Where `needle` is in `hay`, anywhere.
+const fn position_in(hay: &str, needle: &str) -> Option<usize> {
+    let (h, n) = (hay.as_bytes(), needle.as_bytes());
+    let mut at = 0;
+    while at + n.len() <= h.len() {
+        if is_at(h, n, at) {
+            return Some(at);
+        }
+        at += 1;
+    }
+    None
+}
+
+/// Where the names of `es` are in the string table: a name that begins or
+/// ends a longer name (e.g. "Application object 1" of "Application object
+/// 10") points into it; the others ("stored") follow each other in entry order.
+/// Computed once per table ([`packed_table!`](crate::packed_table)).
+pub struct NameLayout<const N: usize> {
+    /// Offset of each entry's name.
+    offsets: [u16; N],
+    /// Is entry `i` the one whose name is laid out?
+    stored: [bool; N],
+    /// Bytes of the stored names.
+    bytes: usize,
+}
+
+/// The [`NameLayout`] of `es`. `N` = `es.len()`.
+pub const fn name_layout<const N: usize>(es: &[EntryInfo]) -> NameLayout<N> {
+    assert!(N == es.len(), "entry count");
+    let mut first = [0usize; N];
     let mut i = 0;
-    while i < es.len() {
-        if first_name(es, i) == i {
-            // i < es.len() (compile-time evaluation)
-            #[allow(clippy::indexing_slicing)]
-            {
-                n += es[i].name.len();
-            }
+    while i < N {
+        // i < N = es.len() (compile-time evaluation)
+        #[allow(clippy::indexing_slicing)]
+        {
+            first[i] = first_name(es, i);
         }
         i += 1;
     }
+    // stored: the first entry of a name that no longer name contains
+    let mut stored = [false; N];
+    let mut i = 0;
+    while i < N {
+        // i, j < N = es.len() (compile-time evaluation)
+        #[allow(clippy::indexing_slicing)]
+        if first[i] == i {
+            let mut inside = false;
+            let mut j = 0;
+            while j < N && !inside {
+                let (a, b) = (es[i].name, es[j].name);
+                inside = first[j] == j && b.len() > a.len() && find_in(b, a).is_some();
+                j += 1;
+            }
+            stored[i] = !inside;
+        }
+        i += 1;
+    }
+    let mut offsets = [0u16; N];
+    let mut at = 0usize;
+    let mut i = 0;
+    while i < N {
+        // i < N (compile-time evaluation)
+        #[allow(clippy::indexing_slicing)]
+        if stored[i] {
+            offsets[i] = at as u16;
+            at += es[i].name.len();
+        }
+        i += 1;
+    }
+    // the other names: in a stored one (a chain of containing names ends
+    // at a stored one), or the same as an earlier entry's
+    let mut i = 0;
+    while i < N {
+        // i, j, first[i] < N (compile-time evaluation)
+        #[allow(clippy::indexing_slicing)]
+        if first[i] == i && !stored[i] {
+            let mut found = false;
+            let mut j = 0;
+            while j < N && !found {
+                if stored[j] {
+                    if let Some(p) = position_in(es[j].name, es[i].name) {
+                        offsets[i] = offsets[j] + p as u16;
+                        found = true;
+                    }
+                }
+                j += 1;
+            }
+            assert!(found, "a contained name is in a stored one");
+        } else if first[i] != i {
+            offsets[i] = offsets[first[i]];
+        }
+        i += 1;
+    }
+    NameLayout {
+        offsets,
+        stored,
+        bytes: at,
+    }
+}
+
+/// Bytes of the names of `es` (laid out by [`NameLayout`]) and the strings
+/// `extra` (e.g. object names, each once). `N` = `es.len()`.
+pub const fn string_bytes<const N: usize>(layout: &NameLayout<N>, es: &[EntryInfo], extra: &[&str]) -> usize {
+    let mut n = layout.bytes;
     let mut k = 0;
     while k < extra.len() {
         if extra_is_new(es, extra, k) {
@@ -133,26 +253,6 @@ pub const fn string_bytes(es: &[EntryInfo], extra: &[&str]) -> usize {
     }
     assert!(n <= MAX_STRINGS, "packed names exceed 16 KiB");
     n
-}
-
-/// The name offsets of `es` (in the order [`strings`] lays the names out).
-const fn name_offsets<const N: usize>(es: &[EntryInfo]) -> [u16; N] {
-    let mut out = [0u16; N];
-    let mut at = 0usize;
-    let mut i = 0;
-    while i < N {
-        let j = first_name(es, i);
-        // i, j < N = es.len() (compile-time evaluation)
-        #[allow(clippy::indexing_slicing)]
-        if j == i {
-            out[i] = at as u16;
-            at += es[i].name.len();
-        } else {
-            out[i] = out[j];
-        }
-        i += 1;
-    }
-    out
 }
 
 const fn put(out: &mut [u8], at: usize, s: &str) -> usize {
@@ -169,19 +269,22 @@ const fn put(out: &mut [u8], at: usize, s: &str) -> usize {
     at + b.len()
 }
 
-/// The string table of `es` and `extra`: each distinct name once, the entry
-/// names first. `S` = [`string_bytes`].
-pub const fn strings<const S: usize>(es: &[EntryInfo], extra: &[&str]) -> [u8; S] {
+/// The string table of `es` and `extra`: the entry names laid out by
+/// [`NameLayout`], then each new extra string once. `N` = `es.len()`, `S` =
+/// [`string_bytes`].
+pub const fn strings<const N: usize, const S: usize>(
+    layout: &NameLayout<N>,
+    es: &[EntryInfo],
+    extra: &[&str],
+) -> [u8; S] {
     let mut out = [0u8; S];
     let mut at = 0usize;
     let mut i = 0;
-    while i < es.len() {
-        if first_name(es, i) == i {
-            // i < es.len() (compile-time evaluation)
-            #[allow(clippy::indexing_slicing)]
-            {
-                at = put(&mut out, at, es[i].name);
-            }
+    while i < N {
+        // i < N = es.len() (compile-time evaluation)
+        #[allow(clippy::indexing_slicing)]
+        if layout.stored[i] {
+            at = put(&mut out, at, es[i].name);
         }
         i += 1;
     }
@@ -203,19 +306,9 @@ pub const fn strings<const S: usize>(es: &[EntryInfo], extra: &[&str]) -> [u8; S
 /// Offsets in the string table of `es` and `extra` ([`strings`]) of the
 /// strings `extra`. `N` = `es.len()`, `K` = `extra.len()`.
 pub const fn extra_offsets<const N: usize, const K: usize>(es: &[EntryInfo], extra: &[&str]) -> [u16; K] {
-    let names = name_offsets::<N>(es);
-    let mut at = 0usize;
-    let mut i = 0;
-    while i < N {
-        if first_name(es, i) == i {
-            // i < N = es.len() (compile-time evaluation)
-            #[allow(clippy::indexing_slicing)]
-            {
-                at += es[i].name.len();
-            }
-        }
-        i += 1;
-    }
+    let layout = name_layout::<N>(es);
+    let names = layout.offsets;
+    let mut at = layout.bytes;
     let mut out = [0u16; K];
     let mut k = 0;
     while k < K {
@@ -458,6 +551,7 @@ pub const fn kinds<const MAX: usize, const K: usize>(es: &[EntryInfo]) -> [u32; 
 
 /// The records of `es` against the tables built from the same `es`.
 pub const fn entries<const N: usize>(
+    layout: &NameLayout<N>,
     es: &[EntryInfo],
     kinds: &[u32],
     ranges: &[[u32; 2]],
@@ -470,7 +564,7 @@ pub const fn entries<const N: usize>(
         defaults.len() < NO_DEFAULT as usize,
         "at most 255 distinct defaults"
     );
-    let names = name_offsets::<N>(es);
+    let names = layout.offsets;
     let mut out = [PackedEntry::UNUSED; N];
     let mut i = 0;
     while i < N {

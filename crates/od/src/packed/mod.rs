@@ -1,17 +1,22 @@
-//! The compact form of entry metadata: 12-byte [`PackedEntry`] records
-//! pointing into one de-duplicated string table, shared range and default
-//! tables of 32-bit values and the unit table [`UNITS`], built at compile time
-//! from a declaration of [`EntryInfo`] values ([`packed_table!`](crate::packed_table)).
+//! The compact form of entry metadata: 6-byte [`PackedEntry`] records
+//! pointing into one string table (a name that begins or ends a longer one
+//! points into it), a table of 32-bit kinds (type, access, persistence, unit),
+//! shared range and default tables of 32-bit values and the unit table
+//! [`UNITS`], built at compile time from a declaration of [`EntryInfo`] values
+//! ([`packed_table!`](crate::packed_table)).
 //!
 //! [`Entries`] is the handle an [`ObjectInfo`](crate::ObjectInfo) holds: a run
-//! of records in a [`PackedTable`], or a plain slice of [`EntryInfo`] (small
-//! hand-made dictionaries, tests). Either way entries are read by value, decoded.
+//! of records in a [`PackedTable`] (optionally renumbered, see
+//! [`PackedTable::renumbered`]), or a plain slice of [`EntryInfo`] (small
+//! hand-made dictionaries, tests). Either way entries are read by value,
+//! decoded; [`PackedRef`] reads single fields of a record without decoding.
 //!
 //! Constraints of the packed form (checked when the table is built, a violation
-//! is a compile error): names at most 255 bytes and 64 KiB of distinct names in
-//! all; a unit from [`UNITS`]; a range has both ends or none; ranges and
-//! defaults fit 32 bits (signed types: `i32`, the others `u32`); strings at most
-//! 4095 bytes; at most 65 535 distinct ranges and defaults.
+//! is a compile error): names at most 63 bytes and 16 KiB of names in all; a
+//! unit from [`UNITS`]; a range has both ends or none; ranges and defaults fit
+//! 32 bits (signed types: `i32`, the others `u32`); strings at most 4095
+//! bytes; at most 128 distinct kinds, 31 distinct ranges and 255 distinct
+//! defaults per table.
 
 use crate::{Access, DataType, EntryInfo};
 
@@ -483,6 +488,7 @@ macro_rules! packed_table {
     };
     ($(#[$m:meta])* $vis:vis static $name:ident = $entries:expr; names = $names:expr;) => {
         $(#[$m])*
+        #[allow(long_running_const_eval)]
         $vis static $name: $crate::PackedTable = {
             const PACKED_INPUT: &[$crate::EntryInfo] = $entries;
             #[allow(long_running_const_eval)]
@@ -490,7 +496,9 @@ macro_rules! packed_table {
             #[allow(long_running_const_eval)]
             const EXTRA: &[&str] = $names;
             #[allow(long_running_const_eval)]
-            const S: usize = $crate::packed::string_bytes(PACKED_INPUT, EXTRA);
+            const NAME_LAYOUT: $crate::packed::NameLayout<N> = $crate::packed::name_layout::<N>(PACKED_INPUT);
+            #[allow(long_running_const_eval)]
+            const S: usize = $crate::packed::string_bytes::<N>(&NAME_LAYOUT, PACKED_INPUT, EXTRA);
             #[allow(long_running_const_eval)]
             const R: usize = $crate::packed::range_count::<N>(PACKED_INPUT);
             #[allow(long_running_const_eval)]
@@ -499,7 +507,7 @@ macro_rules! packed_table {
             const K: usize = $crate::packed::kind_count::<{ N + 1 }>(PACKED_INPUT);
             #[allow(long_running_const_eval)]
             static ENTRIES: [$crate::PackedEntry; N] =
-                $crate::packed::entries::<N>(PACKED_INPUT, &KINDS, &RANGES, &DEFAULTS);
+                $crate::packed::entries::<N>(&NAME_LAYOUT, PACKED_INPUT, &KINDS, &RANGES, &DEFAULTS);
             #[allow(long_running_const_eval)]
             static KINDS: [u32; K] = $crate::packed::kinds::<{ N + 1 }, K>(PACKED_INPUT);
             #[allow(long_running_const_eval)]
@@ -507,7 +515,8 @@ macro_rules! packed_table {
             #[allow(long_running_const_eval)]
             static DEFAULTS: [u32; D] = $crate::packed::defaults::<N, D>(PACKED_INPUT);
             #[allow(long_running_const_eval)]
-            static STRINGS: [u8; S] = $crate::packed::strings::<S>(PACKED_INPUT, EXTRA);
+            static STRINGS: [u8; S] = $crate::packed::strings::<N, S>(&NAME_LAYOUT, PACKED_INPUT, EXTRA);
+            #[allow(long_running_const_eval)]
             const _: () = assert!(::core::str::from_utf8(&STRINGS).is_ok(), "names are UTF-8");
             #[allow(long_running_const_eval)]
             const NAMES: &str = match ::core::str::from_utf8(&STRINGS) {
@@ -553,6 +562,22 @@ mod tests {
         );
         assert_eq!(TABLE.defaults.len(), 4);
         assert_eq!(TABLE.ranges.len(), 2);
+    }
+
+    const NUMBERED: &[EntryInfo] = &[
+        EntryInfo::new(0, "Source bit 1", U8, Access::RO),
+        EntryInfo::new(1, "Source bit 10", U8, Access::RO),
+        EntryInfo::new(2, "bit 10", U8, Access::RO),
+        EntryInfo::new(3, "Source", U8, Access::RO),
+    ];
+    packed_table!(static SHARED = NUMBERED;);
+
+    #[test]
+    fn names_that_begin_or_end_another_share_its_bytes() {
+        assert_eq!(SHARED.strings(), "Source bit 10");
+        for (i, e) in NUMBERED.iter().enumerate() {
+            assert_eq!(SHARED.get(i), Some(*e), "entry {i}");
+        }
     }
 
     #[test]
