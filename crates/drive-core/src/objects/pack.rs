@@ -46,19 +46,19 @@ const fn same_rx(a: (&[EntryInfo], RxView), b: (&[EntryInfo], RxView)) -> bool {
 
 /// Where object `i`'s SDO Info list (`rx` false) or own Rx view (`rx` true)
 /// starts among the lists laid out before it, if it is there.
-const fn earlier(objs: &[Object], starts: &[[u16; 2]; COUNT], i: usize, rx: bool) -> Option<u16> {
+const fn earlier(objs: &[Object], starts: &[Starts; COUNT], i: usize, rx: bool) -> Option<Starts> {
     let mut j = 0;
     while j < i {
         // j < i < COUNT (compile-time evaluation)
         #[allow(clippy::indexing_slicing)]
         let s = starts[j];
         if !rx && same_entries(info(objs, j), info(objs, i)) {
-            return Some(s[0]);
+            return Some(s);
         }
         if rx {
             if let (Some(a), Some(b)) = (own_rx(objs, j), own_rx(objs, i)) {
                 if same_rx(a, b) {
-                    return Some(s[1]);
+                    return Some(s);
                 }
             }
         }
@@ -67,30 +67,70 @@ const fn earlier(objs: &[Object], starts: &[[u16; 2]; COUNT], i: usize, rx: bool
     None
 }
 
-/// Start of each object's two lists (SDO Info, own Rx view) in the packed
-/// table, and its length.
-const fn layout(objs: &[Object]) -> ([[u16; 2]; COUNT], usize) {
-    let mut starts = [[0u16; 2]; COUNT];
+/// Where the entries after the first of object `i`'s SDO Info list are
+/// among the lists laid out before it, if they are there (lists that differ
+/// in sub 0 only, e.g. the RxPDO and TxPDO mapping objects).
+const fn earlier_rest(objs: &[Object], starts: &[Starts; COUNT], i: usize) -> Option<u16> {
+    let mine = info(objs, i);
+    let Some((_, rest)) = mine.split_first() else {
+        return None;
+    };
+    if rest.is_empty() {
+        return None;
+    }
+    let mut j = 0;
+    while j < i {
+        if let Some((_, theirs)) = info(objs, j).split_first() {
+            // j < i < COUNT (compile-time evaluation)
+            #[allow(clippy::indexing_slicing)]
+            if same_entries(theirs, rest) {
+                return Some(starts[j].info[1]);
+            }
+        }
+        j += 1;
+    }
+    None
+}
+
+/// Where an object's lists are in the packed table: its SDO Info list (the
+/// record of position 0, the records from position 1 on, see
+/// `PackedTable::joined`) and its own Rx view (a plain run).
+#[derive(Clone, Copy)]
+struct Starts {
+    info: [u16; 2],
+    rx: u16,
+}
+
+/// Where each object's lists are in the packed table, and its length.
+const fn layout(objs: &[Object]) -> ([Starts; COUNT], usize) {
+    let mut starts = [Starts { info: [0, 1], rx: 0 }; COUNT];
     let mut total = 0usize;
     let mut i = 0;
     while i < COUNT {
         let n = info(objs, i).len();
-        let sa = match earlier(objs, &starts, i, false) {
-            Some(s) => s,
-            None => {
-                total += n;
-                (total - n) as u16
-            }
+        let info_at = match earlier(objs, &starts, i, false) {
+            Some(s) => s.info,
+            None => match earlier_rest(objs, &starts, i) {
+                // a record of its own for position 0
+                Some(rest) => {
+                    total += 1;
+                    [(total - 1) as u16, rest]
+                }
+                None => {
+                    total += n;
+                    [(total - n) as u16, (total - n + 1) as u16]
+                }
+            },
         };
         // i < COUNT (compile-time evaluation)
         #[allow(clippy::indexing_slicing)]
         {
-            starts[i][0] = sa;
+            starts[i].info = info_at;
         }
         if own_rx(objs, i).is_some() {
             assert!(n > 0, "an array has sub 0");
             let sb = match earlier(objs, &starts, i, true) {
-                Some(s) => s,
+                Some(s) => s.rx,
                 None => {
                     total += n - 1;
                     (total - (n - 1)) as u16
@@ -98,16 +138,16 @@ const fn layout(objs: &[Object]) -> ([[u16; 2]; COUNT], usize) {
             };
             #[allow(clippy::indexing_slicing)]
             {
-                starts[i][1] = sb;
+                starts[i].rx = sb;
             }
         }
         i += 1;
     }
-    assert!(total <= u16::MAX as usize, "packed entry positions are u16");
+    assert!(total < u16::MAX as usize, "packed entry positions are u16");
     (starts, total)
 }
 
-const LAYOUT: ([[u16; 2]; COUNT], usize) = layout(&TABLE);
+const LAYOUT: ([Starts; COUNT], usize) = layout(&TABLE);
 /// Entries in the packed table.
 const ENTRY_COUNT: usize = LAYOUT.1;
 
@@ -119,20 +159,26 @@ const FLAT: [EntryInfo; ENTRY_COUNT] = {
     let mut i = 0;
     while i < COUNT {
         let list = info(&TABLE, i);
-        // i < COUNT; start + k < ENTRY_COUNT by the layout (compile-time evaluation)
+        // i < COUNT; the positions < ENTRY_COUNT by the layout (compile-time
+        // evaluation; shared records are written again with the same entry)
         #[allow(clippy::indexing_slicing)]
-        let at = starts[i][0] as usize;
+        let [first, rest] = starts[i].info;
         let mut k = 0;
         while k < list.len() {
+            let at = if k == 0 {
+                first as usize
+            } else {
+                rest as usize + k - 1
+            };
             #[allow(clippy::indexing_slicing)]
             {
-                out[at + k] = list[k];
+                out[at] = list[k];
             }
             k += 1;
         }
         if let Some((list, rx)) = own_rx(&TABLE, i) {
             #[allow(clippy::indexing_slicing)]
-            let at = starts[i][1] as usize;
+            let at = starts[i].rx as usize;
             let mut k = 0;
             while k + 1 < list.len() {
                 #[allow(clippy::indexing_slicing)]
@@ -180,8 +226,8 @@ static RX_VIEWS: [ObjectInfo; RX_COUNT] = {
         let entries = match TABLE[i].rx {
             RxView::Same => None,
             // elements 1… of the SDO Info list at subindex - 1
-            RxView::Elements => Some(table.renumbered(starts[i][0] + 1, n - 1, 1)),
-            RxView::ElementsNoDefaults => Some(table.list(starts[i][1], n - 1)),
+            RxView::Elements => Some(table.renumbered(starts[i].info[1], n - 1, 1)),
+            RxView::ElementsNoDefaults => Some(table.list(starts[i].rx, n - 1)),
         };
         if let Some(entries) = entries {
             #[allow(clippy::indexing_slicing)]
@@ -215,7 +261,7 @@ pub(super) const fn objects(objs: &[Object; COUNT], table: &'static PackedTable)
         // i < COUNT (compile-time evaluation)
         #[allow(clippy::indexing_slicing)]
         {
-            out[i].info.entries = table.list(starts[i][0], n);
+            out[i].info.entries = table.joined(starts[i].info[0], starts[i].info[1], n);
         }
         i += 1;
     }

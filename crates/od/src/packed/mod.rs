@@ -100,9 +100,23 @@ impl PackedTable {
     pub const fn renumbered(&'static self, start: u16, len: u16, shift: u8) -> Entries {
         Entries(Repr::Packed {
             table: self,
-            start,
+            first: start,
+            rest: start.wrapping_add(1),
             len,
             shift,
+        })
+    }
+
+    /// `len` entries: the record at position `first`, then the `len - 1`
+    /// records from position `rest` (lists that differ only in their first
+    /// entry, e.g. sub 0, share the others).
+    pub const fn joined(&'static self, first: u16, rest: u16, len: u16) -> Entries {
+        Entries(Repr::Packed {
+            table: self,
+            first,
+            rest,
+            len,
+            shift: 0,
         })
     }
 
@@ -279,7 +293,10 @@ enum Repr {
     Slice(&'static [EntryInfo]),
     Packed {
         table: &'static PackedTable,
-        start: u16,
+        /// the record of position 0
+        first: u16,
+        /// the record of position 1; position p > 0 is at `rest + p - 1`
+        rest: u16,
         len: u16,
         /// subindex = record subindex - shift
         shift: u8,
@@ -313,20 +330,25 @@ impl Entries {
         self.len() == 0
     }
 
-    /// The run of records, its table and its subindex shift (packed entries).
-    fn run(&self) -> Option<(&'static PackedTable, &'static [PackedEntry], u8)> {
+    /// The record at position `pos`, its table and the subindex shift
+    /// (packed entries).
+    fn at(&self, pos: usize) -> Option<(&'static PackedTable, &'static PackedEntry, u8)> {
         match self.0 {
             Repr::Slice(_) => None,
             Repr::Packed {
                 table,
-                start,
+                first,
+                rest,
                 len,
                 shift,
-            } => {
-                let from = usize::from(start);
-                let run = table.entries.get(from..from + usize::from(len))?;
-                Some((table, run, shift))
+            } if pos < usize::from(len) => {
+                let at = match pos {
+                    0 => usize::from(first),
+                    p => usize::from(rest) + p - 1,
+                };
+                table.entries.get(at).map(|p| (table, p, shift))
             }
+            Repr::Packed { .. } => None,
         }
     }
 
@@ -335,8 +357,8 @@ impl Entries {
         match self.0 {
             Repr::Slice(s) => s.get(pos).copied(),
             Repr::Packed { .. } => {
-                let (table, run, shift) = self.run()?;
-                let mut e = table.decode(run.get(pos)?);
+                let (table, p, shift) = self.at(pos)?;
+                let mut e = table.decode(p);
                 e.sub = e.sub.wrapping_sub(shift);
                 Some(e)
             }
@@ -348,14 +370,16 @@ impl Entries {
         self.get(0)
     }
 
+    /// Subindex of the entry at position `pos` (packed entries).
+    fn sub_at(&self, pos: usize) -> Option<u8> {
+        self.at(pos).map(|(_, p, shift)| p.sub().wrapping_sub(shift))
+    }
+
     /// Position of the entry with subindex `sub` (without decoding).
     pub fn position(&self, sub: u8) -> Option<usize> {
         match self.0 {
             Repr::Slice(s) => s.iter().position(|e| e.sub == sub),
-            Repr::Packed { .. } => {
-                let (_, run, shift) = self.run()?;
-                run.iter().position(|p| p.sub().wrapping_sub(shift) == sub)
-            }
+            Repr::Packed { len, .. } => (0..usize::from(len)).find(|&pos| self.sub_at(pos) == Some(sub)),
         }
     }
 
@@ -363,10 +387,7 @@ impl Entries {
     pub fn data_type(&self, pos: usize) -> Option<DataType> {
         match self.0 {
             Repr::Slice(s) => s.get(pos).map(|e| e.data_type),
-            Repr::Packed { .. } => {
-                let (table, run, _) = self.run()?;
-                run.get(pos).map(|p| table.data_type(p))
-            }
+            Repr::Packed { .. } => self.at(pos).map(|(table, p, _)| table.data_type(p)),
         }
     }
 
@@ -374,8 +395,8 @@ impl Entries {
     /// and for runs that renumber their records, see
     /// [`PackedTable::renumbered`]: a record's subindex is its table's).
     pub fn record(&self, pos: usize) -> Option<PackedRef> {
-        match self.run()? {
-            (table, run, 0) => run.get(pos).map(|record| PackedRef { table, record }),
+        match self.at(pos)? {
+            (table, record, 0) => Some(PackedRef { table, record }),
             _ => None,
         }
     }
@@ -392,9 +413,10 @@ impl Entries {
     pub fn max_sub(&self) -> u8 {
         match self.0 {
             Repr::Slice(s) => s.iter().map(|e| e.sub).max().unwrap_or(0),
-            Repr::Packed { .. } => self.run().map_or(0, |(_, run, shift)| {
-                run.iter().map(|p| p.sub().wrapping_sub(shift)).max().unwrap_or(0)
-            }),
+            Repr::Packed { len, .. } => (0..usize::from(len))
+                .filter_map(|pos| self.sub_at(pos))
+                .max()
+                .unwrap_or(0),
         }
     }
 
@@ -591,5 +613,12 @@ mod tests {
         assert_eq!(run.max_sub(), 2);
         assert_eq!(run.iter().next_back(), ES.get(2).copied());
         assert_eq!(TABLE.list(3, 2).iter().count(), 2);
+        // sub 0 of the second list, then the first list's elements
+        let joined = TABLE.joined(3, 1, 3);
+        assert_eq!(joined.get(0), ES.get(3).copied());
+        assert_eq!(joined.find(2), ES.get(2).copied());
+        assert_eq!(joined.position(1), Some(1));
+        assert_eq!(joined.max_sub(), 2);
+        assert_eq!(joined.get(3), None);
     }
 }
