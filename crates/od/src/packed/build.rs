@@ -5,7 +5,7 @@
 //! declaration that does not fit the packed form does not compile.
 
 use super::record::{
-    kind_of, type_code, ACCESS_MASK, MAX_KINDS, MAX_NAME, MAX_STRING, MAX_STRINGS, MAX_UNITS, NO_DEFAULT,
+    kind_of, type_code, ACCESS_MASK, MAX_DETAILS, MAX_KINDS, MAX_NAME, MAX_STRINGS, NO_DEFAULT,
     PLACEHOLDER_KIND,
 };
 use super::{narrow, PackedEntry, NO_RANGE, UNITS};
@@ -493,27 +493,128 @@ const fn unit_index(unit: &str) -> u32 {
     i as u32
 }
 
-/// The kind of `e` (type, access, persistence, unit).
-const fn entry_kind(e: &EntryInfo) -> u32 {
-    assert!(e.access.0 as u32 & !ACCESS_MASK == 0, "access bits 0..9");
+/// Position of `v` in `table[from..n]` (`n` when it is not there).
+const fn position_u16(table: &[u16], from: usize, n: usize, v: u16) -> usize {
+    let mut j = from;
+    while j < n {
+        // j < n <= table.len() (compile-time evaluation)
+        #[allow(clippy::indexing_slicing)]
+        if table[j] == v {
+            return j;
+        }
+        j += 1;
+    }
+    n
+}
+
+/// The details of `es` (at most `MAX`): read-only first, the other distinct
+/// accesses, then the distinct string lengths; how many, and how many
+/// accesses.
+const fn collect_details<const MAX: usize>(es: &[EntryInfo]) -> ([u16; MAX], usize, usize) {
+    let mut out = [0u16; MAX];
+    out[0] = crate::Access::READ;
+    let mut n = 1;
+    let mut i = 0;
+    while i < es.len() {
+        // i < es.len(), n < MAX (compile-time evaluation)
+        #[allow(clippy::indexing_slicing)]
+        let a = es[i].access.0;
+        assert!(a & !ACCESS_MASK == 0, "access bits 0..9");
+        if position_u16(&out, 0, n, a) == n {
+            assert!(n < MAX, "detail table size");
+            #[allow(clippy::indexing_slicing)]
+            {
+                out[n] = a;
+            }
+            n += 1;
+        }
+        i += 1;
+    }
+    let accesses = n;
+    let mut i = 0;
+    while i < es.len() {
+        // i < es.len(), n < MAX (compile-time evaluation)
+        #[allow(clippy::indexing_slicing)]
+        let t = es[i].data_type;
+        if t.is_string() {
+            let len = type_code(t).1;
+            if position_u16(&out, accesses, n, len) == n {
+                assert!(n < MAX, "detail table size");
+                #[allow(clippy::indexing_slicing)]
+                {
+                    out[n] = len;
+                }
+                n += 1;
+            }
+        }
+        i += 1;
+    }
     assert!(
-        type_code(e.data_type).1 <= MAX_STRING,
-        "a packed string has at most 4095 bytes"
+        n < NO_DEFAULT as usize,
+        "at most 254 distinct accesses and string lengths"
     );
-    kind_of(e.data_type, e.access, e.persistent, unit_index(e.unit))
+    (out, n, accesses)
+}
+
+/// Number of details of `es` (`MAX`: an upper bound, e.g. `2 * es.len() + 1`).
+pub const fn detail_count<const MAX: usize>(es: &[EntryInfo]) -> usize {
+    collect_details::<MAX>(es).1
+}
+
+/// Number of accesses among the details of `es` (`MAX` as for
+/// [`detail_count`]).
+pub const fn access_count<const MAX: usize>(es: &[EntryInfo]) -> usize {
+    collect_details::<MAX>(es).2
+}
+
+/// The details of `es`. `X` = [`detail_count`].
+pub const fn details<const MAX: usize, const X: usize>(es: &[EntryInfo]) -> [u16; X] {
+    let (all, n, _) = collect_details::<MAX>(es);
+    assert!(n == X, "detail count");
+    let mut out = [0u16; X];
+    let mut i = 0;
+    while i < X {
+        // i < X <= MAX (compile-time evaluation)
+        #[allow(clippy::indexing_slicing)]
+        {
+            out[i] = all[i];
+        }
+        i += 1;
+    }
+    out
+}
+
+/// The kind of `e` against the details `details` of which the first
+/// `accesses` are accesses.
+const fn entry_kind(e: &EntryInfo, details: &[u16], accesses: usize) -> u16 {
+    let access_at = position_u16(details, 0, accesses, e.access.0);
+    assert!(access_at < accesses, "access in the details");
+    kind_of(access_at, e.persistent, e.data_type, unit_index(e.unit) as usize)
+}
+
+/// Position of the string length of `e` (a string) in the details.
+const fn length_at(e: &EntryInfo, details: &[u16], accesses: usize) -> usize {
+    let (_, len) = type_code(e.data_type);
+    let at = position_u16(details, accesses, details.len(), len);
+    assert!(at < details.len(), "string length in the details");
+    at
 }
 
 /// Distinct kinds of `es`, [`PLACEHOLDER_KIND`] first (at most `MAX`), and how many.
-const fn collect_kinds<const MAX: usize>(es: &[EntryInfo]) -> ([u32; MAX], usize) {
-    let mut out = [0u32; MAX];
+const fn collect_kinds<const MAX: usize>(
+    es: &[EntryInfo],
+    details: &[u16],
+    accesses: usize,
+) -> ([u16; MAX], usize) {
+    let mut out = [0u16; MAX];
     out[0] = PLACEHOLDER_KIND;
     let mut n = 1;
     let mut i = 0;
     while i < es.len() {
         // i < es.len(), n < MAX (compile-time evaluation)
         #[allow(clippy::indexing_slicing)]
-        let k = entry_kind(&es[i]);
-        if position_value(&out, n, k) == n {
+        let k = entry_kind(&es[i], details, accesses);
+        if position_u16(&out, 0, n, k) == n {
             assert!(n < MAX, "kind table size");
             #[allow(clippy::indexing_slicing)]
             {
@@ -528,15 +629,19 @@ const fn collect_kinds<const MAX: usize>(es: &[EntryInfo]) -> ([u32; MAX], usize
 
 /// Number of distinct kinds of `es` with the placeholder kind (`MAX`: an
 /// upper bound, e.g. `es.len() + 1`).
-pub const fn kind_count<const MAX: usize>(es: &[EntryInfo]) -> usize {
-    collect_kinds::<MAX>(es).1
+pub const fn kind_count<const MAX: usize>(es: &[EntryInfo], details: &[u16], accesses: usize) -> usize {
+    collect_kinds::<MAX>(es, details, accesses).1
 }
 
 /// The distinct kinds of `es`, [`PLACEHOLDER_KIND`] first. `K` = [`kind_count`].
-pub const fn kinds<const MAX: usize, const K: usize>(es: &[EntryInfo]) -> [u32; K] {
-    let (all, n) = collect_kinds::<MAX>(es);
+pub const fn kinds<const MAX: usize, const K: usize>(
+    es: &[EntryInfo],
+    details: &[u16],
+    accesses: usize,
+) -> [u16; K] {
+    let (all, n) = collect_kinds::<MAX>(es, details, accesses);
     assert!(n == K && K <= MAX_KINDS, "at most 128 distinct kinds");
-    let mut out = [0u32; K];
+    let mut out = [0u16; K];
     let mut i = 0;
     while i < K {
         // i < K <= MAX (compile-time evaluation)
@@ -553,12 +658,13 @@ pub const fn kinds<const MAX: usize, const K: usize>(es: &[EntryInfo]) -> [u32; 
 pub const fn entries<const N: usize>(
     layout: &NameLayout<N>,
     es: &[EntryInfo],
-    kinds: &[u32],
+    kinds: &[u16],
+    details: (&[u16], usize),
     ranges: &[[u32; 2]],
     defaults: &[u32],
 ) -> [PackedEntry; N] {
     assert!(N == es.len(), "entry count");
-    assert!(UNITS.len() <= MAX_UNITS, "5-bit unit index");
+    assert!(UNITS.len() <= MAX_DETAILS, "5-bit unit index");
     assert!(ranges.len() < NO_RANGE as usize, "at most 31 distinct ranges");
     assert!(
         defaults.len() < NO_DEFAULT as usize,
@@ -572,14 +678,23 @@ pub const fn entries<const N: usize>(
         #[allow(clippy::indexing_slicing)]
         let e = &es[i];
         assert!(e.name.len() <= MAX_NAME, "a packed name has at most 63 bytes");
-        let kind = position_value(kinds, kinds.len(), entry_kind(e));
+        let kind = position_u16(kinds, 0, kinds.len(), entry_kind(e, details.0, details.1));
         assert!(kind < kinds.len(), "kind in the table");
         let range = match range_of(e) {
             Some(r) => position_range(ranges, ranges.len(), r) as u16,
             None => NO_RANGE,
         };
-        let default = position_value(defaults, defaults.len(), narrow(e.data_type, e.default));
-        assert!(default < defaults.len(), "default in the table");
+        // strings: the default index is the position of the length
+        let default = if e.data_type.is_string() {
+            assert!(e.default == 0, "a packed string's default is 0");
+            length_at(e, details.0, details.1)
+        } else {
+            position_value(defaults, defaults.len(), narrow(e.data_type, e.default))
+        };
+        assert!(
+            e.data_type.is_string() || default < defaults.len(),
+            "default in the table"
+        );
         #[allow(clippy::indexing_slicing)]
         {
             out[i] = PackedEntry::new(

@@ -1,6 +1,7 @@
 //! The compact form of entry metadata: 6-byte [`PackedEntry`] records
 //! pointing into one string table (a name that begins or ends a longer one
-//! points into it), a table of 32-bit kinds (type, access, persistence, unit),
+//! points into it), a table of 16-bit kinds (type, access, persistence, unit)
+//! with their 16-bit details (the distinct accesses and string lengths),
 //! shared range and default tables of 32-bit values and the unit table
 //! [`UNITS`], built at compile time from a declaration of [`EntryInfo`] values
 //! ([`packed_table!`](crate::packed_table)).
@@ -14,9 +15,9 @@
 //! Constraints of the packed form (checked when the table is built, a violation
 //! is a compile error): names at most 63 bytes and 16 KiB of names in all; a
 //! unit from [`UNITS`]; a range has both ends or none; ranges and defaults fit
-//! 32 bits (signed types: `i32`, the others `u32`); strings at most 4095
-//! bytes; at most 128 distinct kinds, 31 distinct ranges and 255 distinct
-//! defaults per table.
+//! 32 bits (signed types: `i32`, the others `u32`); strings have default 0;
+//! per table at most 128 distinct kinds, 16 distinct accesses, 31 distinct
+//! ranges and 255 distinct defaults.
 
 use crate::{Access, DataType, EntryInfo};
 
@@ -38,7 +39,8 @@ use record::{type_of, NO_RANGE};
 pub struct PackedTable {
     entries: &'static [PackedEntry],
     strings: &'static str,
-    kinds: &'static [u32],
+    kinds: &'static [u16],
+    details: &'static [u16],
     ranges: &'static [[u32; 2]],
     defaults: &'static [u32],
 }
@@ -74,7 +76,8 @@ impl PackedTable {
     pub const fn new(
         entries: &'static [PackedEntry],
         strings: &'static str,
-        kinds: &'static [u32],
+        kinds: &'static [u16],
+        details: &'static [u16],
         ranges: &'static [[u32; 2]],
         defaults: &'static [u32],
     ) -> Self {
@@ -82,6 +85,7 @@ impl PackedTable {
             entries,
             strings,
             kinds,
+            details,
             ranges,
             defaults,
         }
@@ -140,6 +144,7 @@ impl PackedTable {
         core::mem::size_of_val(self.entries)
             + self.strings.len()
             + core::mem::size_of_val(self.kinds)
+            + core::mem::size_of_val(self.details)
             + core::mem::size_of_val(self.ranges)
             + core::mem::size_of_val(self.defaults)
     }
@@ -150,21 +155,40 @@ impl PackedTable {
     }
 
     /// The kind of a record (kind 0 when the table has no such kind).
-    fn kind(&self, p: &PackedEntry) -> u32 {
+    fn kind(&self, p: &PackedEntry) -> u16 {
         self.kinds
             .get(p.kind())
             .copied()
             .unwrap_or(record::PLACEHOLDER_KIND)
     }
 
+    /// The data type of a record of kind `kind`.
+    fn type_of(&self, p: &PackedEntry, kind: u16) -> DataType {
+        let n = match record::is_string(kind) {
+            true => self.details.get(p.default()).copied().unwrap_or(0),
+            false => 0,
+        };
+        type_of(kind, n)
+    }
+
+    /// The access of a kind (read-only when the table has none).
+    fn access_of(&self, kind: u16) -> Access {
+        Access(
+            self.details
+                .get(record::access_at(kind))
+                .copied()
+                .unwrap_or(Access::READ),
+        )
+    }
+
     /// Data type of a record of this table.
     pub fn data_type(&self, p: &PackedEntry) -> DataType {
-        type_of(self.kind(p))
+        self.type_of(p, self.kind(p))
     }
 
     /// Access rights of a record of this table.
     pub fn access(&self, p: &PackedEntry) -> Access {
-        record::access_of(self.kind(p))
+        self.access_of(self.kind(p))
     }
 
     /// Is a record of this table saved by "save values"?
@@ -174,9 +198,13 @@ impl PackedTable {
 
     /// The declared default of a record of this table.
     pub fn default_of(&self, p: &PackedEntry) -> i64 {
+        let kind = self.kind(p);
+        if record::is_string(kind) {
+            return 0;
+        }
         self.defaults
             .get(p.default())
-            .map_or(0, |&d| widen(self.data_type(p), d))
+            .map_or(0, |&d| widen(self.type_of(p, kind), d))
     }
 
     /// [`EntryInfo::check_range`] of a record of this table.
@@ -200,7 +228,7 @@ impl PackedTable {
     /// Decodes a record of this table.
     pub fn decode(&self, p: &PackedEntry) -> EntryInfo {
         let kind = self.kind(p);
-        let t = type_of(kind);
+        let t = self.type_of(p, kind);
         let start = p.name_at();
         let name = self.strings.get(start..start + p.name_len()).unwrap_or("");
         let (min, max) = match self.ranges.get(p.range()) {
@@ -211,11 +239,11 @@ impl PackedTable {
             sub: p.sub(),
             name,
             data_type: t,
-            access: record::access_of(kind),
+            access: self.access_of(kind),
             min,
             max,
             default: self.default_of(p),
-            unit: UNITS.get(record::unit_of(kind)).copied().unwrap_or(""),
+            unit: UNITS.get(record::detail_of(kind)).copied().unwrap_or(""),
             persistent: record::persistent_of(kind),
         }
     }
@@ -229,7 +257,7 @@ pub struct PackedRef {
     record: &'static PackedEntry,
 }
 
-const EMPTY: PackedTable = PackedTable::new(&[], "", &[], &[], &[]);
+const EMPTY: PackedTable = PackedTable::new(&[], "", &[], &[], &[], &[]);
 
 impl PackedRef {
     /// A reference of no table: [`PackedEntry::UNUSED`] (subindex 0,
@@ -526,12 +554,18 @@ macro_rules! packed_table {
             #[allow(long_running_const_eval)]
             const D: usize = $crate::packed::default_count::<N>(PACKED_INPUT);
             #[allow(long_running_const_eval)]
-            const K: usize = $crate::packed::kind_count::<{ N + 1 }>(PACKED_INPUT);
+            const X: usize = $crate::packed::detail_count::<{ 2 * N + 1 }>(PACKED_INPUT);
+            #[allow(long_running_const_eval)]
+            static DETAILS: [u16; X] = $crate::packed::details::<{ 2 * N + 1 }, X>(PACKED_INPUT);
+            #[allow(long_running_const_eval)]
+            const A: usize = $crate::packed::access_count::<{ 2 * N + 1 }>(PACKED_INPUT);
+            #[allow(long_running_const_eval)]
+            const K: usize = $crate::packed::kind_count::<{ N + 1 }>(PACKED_INPUT, &DETAILS, A);
             #[allow(long_running_const_eval)]
             static ENTRIES: [$crate::PackedEntry; N] =
-                $crate::packed::entries::<N>(&NAME_LAYOUT, PACKED_INPUT, &KINDS, &RANGES, &DEFAULTS);
+                $crate::packed::entries::<N>(&NAME_LAYOUT, PACKED_INPUT, &KINDS, (&DETAILS, A), &RANGES, &DEFAULTS);
             #[allow(long_running_const_eval)]
-            static KINDS: [u32; K] = $crate::packed::kinds::<{ N + 1 }, K>(PACKED_INPUT);
+            static KINDS: [u16; K] = $crate::packed::kinds::<{ N + 1 }, K>(PACKED_INPUT, &DETAILS, A);
             #[allow(long_running_const_eval)]
             static RANGES: [[u32; 2]; R] = $crate::packed::ranges::<N, R>(PACKED_INPUT);
             #[allow(long_running_const_eval)]
@@ -545,7 +579,7 @@ macro_rules! packed_table {
                 Ok(s) => s,
                 Err(_) => "",
             };
-            $crate::PackedTable::new(&ENTRIES, NAMES, &KINDS, &RANGES, &DEFAULTS)
+            $crate::PackedTable::new(&ENTRIES, NAMES, &KINDS, &DETAILS, &RANGES, &DEFAULTS)
         };
     };
 }

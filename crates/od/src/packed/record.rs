@@ -4,10 +4,13 @@
 //!
 //! A record is 48 bits, from bit 0: name offset in the string table (14),
 //! name length (6), subindex (8), kind index (7), range index (5, all ones:
-//! none), default index (8, all ones: none = 0). A kind is 32 bits: access
-//! (10), persistent (1), unit index (5), type (4), string length (12).
+//! none), default index (8, all ones: none = 0; strings, whose default is 0:
+//! the position of the length in the details). A kind is 16 bits: position of
+//! the access in the table's "details" (4), persistent (1), type (4), unit
+//! index (5); the details are 16-bit values, the distinct accesses, then the
+//! distinct string lengths.
 
-use crate::{Access, DataType};
+use crate::DataType;
 
 const OFF: (u32, u32) = (0, 14);
 const LEN: (u32, u32) = (14, 6);
@@ -90,43 +93,53 @@ impl PackedEntry {
     }
 }
 
-const PERSISTENT: u32 = 1 << 10;
-const UNIT_SHIFT: u32 = 11;
-const TYPE_SHIFT: u32 = 16;
-const LEN_SHIFT: u32 = 20;
-/// Access bits of a kind.
-pub(super) const ACCESS_MASK: u32 = (1 << 10) - 1;
-/// Most units a kind can name.
-pub(super) const MAX_UNITS: usize = 1 << (TYPE_SHIFT - UNIT_SHIFT);
-/// Longest string type.
-pub(super) const MAX_STRING: u16 = (1 << 12) - 1;
+const ACCESS_BITS: u32 = 4;
+const PERSISTENT: u16 = 1 << ACCESS_BITS;
+const TYPE_SHIFT: u32 = ACCESS_BITS + 1;
+const DETAIL_SHIFT: u32 = TYPE_SHIFT + 4;
+const DETAIL_BITS: u32 = 5;
+/// Most accesses a table can have (kind field).
+pub(super) const MAX_ACCESSES: usize = 1 << ACCESS_BITS;
+/// Most units (kind field).
+pub(super) const MAX_DETAILS: usize = 1 << DETAIL_BITS;
+/// Access bits.
+pub(super) const ACCESS_MASK: u16 = (1 << 10) - 1;
 
-/// The kind of an entry: data type, access, persistence, unit index.
-pub(super) const fn kind_of(t: DataType, access: Access, persistent: bool, unit: u32) -> u32 {
-    let (k, n) = type_code(t);
-    access.0 as u32 & ACCESS_MASK
+/// The kind of an entry: the position of its access in the table's
+/// "details", persistence, type code and unit index.
+pub(super) const fn kind_of(access_at: usize, persistent: bool, t: DataType, detail: usize) -> u16 {
+    assert!(access_at < MAX_ACCESSES, "at most 16 distinct accesses");
+    assert!(detail < MAX_DETAILS, "at most 32 units");
+    access_at as u16
         | if persistent { PERSISTENT } else { 0 }
-        | unit << UNIT_SHIFT
-        | (k as u32) << TYPE_SHIFT
-        | (n as u32) << LEN_SHIFT
+        | type_code(t).0 << TYPE_SHIFT
+        | (detail as u16) << DETAIL_SHIFT
 }
 
-/// Kind 0 of every table (and of [`PackedEntry::UNUSED`]).
-pub(super) const PLACEHOLDER_KIND: u32 = kind_of(DataType::U8, Access::RO, false, 0);
+/// Kind 0 of every table (and of [`PackedEntry::UNUSED`]): the table's
+/// first access (read-only, [`super::build`] puts it there), UNSIGNED8, no
+/// unit.
+pub(super) const PLACEHOLDER_KIND: u16 = kind_of(0, false, DataType::U8, 0);
 
-/// Access of a kind.
-pub(super) const fn access_of(kind: u32) -> Access {
-    Access((kind & ACCESS_MASK) as u16)
+/// Position of the access of a kind in the details.
+pub(super) const fn access_at(kind: u16) -> usize {
+    (kind & (PERSISTENT - 1)) as usize
 }
 
 /// Persistent kind?
-pub(super) const fn persistent_of(kind: u32) -> bool {
+pub(super) const fn persistent_of(kind: u16) -> bool {
     kind & PERSISTENT != 0
 }
 
-/// Unit index of a kind.
-pub(super) const fn unit_of(kind: u32) -> usize {
-    ((kind >> UNIT_SHIFT) as usize) & (MAX_UNITS - 1)
+/// The unit index of a kind.
+pub(super) const fn detail_of(kind: u16) -> usize {
+    ((kind >> DETAIL_SHIFT) as usize) & (MAX_DETAILS - 1)
+}
+
+/// Is the kind a string type's (the record's default index is then the
+/// position of the length in the details)?
+pub(super) const fn is_string(kind: u16) -> bool {
+    matches!((kind >> TYPE_SHIFT) & 0xF, 8 | 9)
 }
 
 /// Type code and string length of `t`.
@@ -147,9 +160,8 @@ pub(super) const fn type_code(t: DataType) -> (u16, u16) {
     }
 }
 
-/// Data type of a kind.
-pub(super) const fn type_of(kind: u32) -> DataType {
-    let n = (kind >> LEN_SHIFT) as u16 & MAX_STRING;
+/// Data type of a kind with the string length `n` (strings).
+pub(super) const fn type_of(kind: u16, n: u16) -> DataType {
     match (kind >> TYPE_SHIFT) & 0xF {
         0 => DataType::Bool,
         1 => DataType::I8,
