@@ -417,8 +417,14 @@ const fn collect_ranges<const MAX: usize>(es: &[EntryInfo]) -> ([[u32; 2]; MAX],
     (out, n)
 }
 
-/// Distinct defaults of `es` (at most `MAX`), and how many.
-const fn collect_defaults<const MAX: usize>(es: &[EntryInfo]) -> ([u32; MAX], usize) {
+/// Does a 32-bit table value go into the 16-bit defaults?
+const fn small(v: u32) -> bool {
+    v <= u16::MAX as u32
+}
+
+/// Distinct defaults of `es` (at most `MAX`) that are `wide` (else those that
+/// fit 16 bits), and how many.
+const fn collect_defaults<const MAX: usize>(es: &[EntryInfo], wide: bool) -> ([u32; MAX], usize) {
     let mut out = [0u32; MAX];
     let mut n = 0;
     let mut i = 0;
@@ -426,7 +432,7 @@ const fn collect_defaults<const MAX: usize>(es: &[EntryInfo]) -> ([u32; MAX], us
         // i < es.len(), n < MAX (compile-time evaluation)
         #[allow(clippy::indexing_slicing)]
         let v = narrow(es[i].data_type, es[i].default);
-        if position_value(&out, n, v) == n {
+        if small(v) != wide && position_value(&out, n, v) == n {
             #[allow(clippy::indexing_slicing)]
             {
                 out[n] = v;
@@ -460,15 +466,33 @@ pub const fn ranges<const MAX: usize, const R: usize>(es: &[EntryInfo]) -> [[u32
     out
 }
 
-/// Number of distinct defaults of `es` (`MAX`: an upper bound).
-pub const fn default_count<const MAX: usize>(es: &[EntryInfo]) -> usize {
-    collect_defaults::<MAX>(es).1
+/// Number of distinct defaults of `es` that are `wide` (32 bits), else of
+/// those that fit 16 bits (`MAX`: an upper bound).
+pub const fn default_count<const MAX: usize>(es: &[EntryInfo], wide: bool) -> usize {
+    collect_defaults::<MAX>(es, wide).1
 }
 
-/// The distinct defaults of `es`. `D` = [`default_count`].
-pub const fn defaults<const MAX: usize, const D: usize>(es: &[EntryInfo]) -> [u32; D] {
-    let (all, n) = collect_defaults::<MAX>(es);
-    assert!(n == D && D <= u16::MAX as usize, "default count");
+/// The distinct defaults of `es` that fit 16 bits. `D` = [`default_count`].
+pub const fn small_defaults<const MAX: usize, const D: usize>(es: &[EntryInfo]) -> [u16; D] {
+    let (all, n) = collect_defaults::<MAX>(es, false);
+    assert!(n == D, "default count");
+    let mut out = [0u16; D];
+    let mut i = 0;
+    while i < D {
+        // i < D <= MAX (compile-time evaluation)
+        #[allow(clippy::indexing_slicing)]
+        {
+            out[i] = all[i] as u16;
+        }
+        i += 1;
+    }
+    out
+}
+
+/// The distinct defaults of `es` that need 32 bits. `D` = [`default_count`].
+pub const fn wide_defaults<const MAX: usize, const D: usize>(es: &[EntryInfo]) -> [u32; D] {
+    let (all, n) = collect_defaults::<MAX>(es, true);
+    assert!(n == D, "default count");
     let mut out = [0u32; D];
     let mut i = 0;
     while i < D {
@@ -661,13 +685,13 @@ pub const fn entries<const N: usize>(
     kinds: &[u16],
     details: (&[u16], usize),
     ranges: &[[u32; 2]],
-    defaults: &[u32],
+    defaults: (&[u16], &[u32]),
 ) -> [PackedEntry; N] {
     assert!(N == es.len(), "entry count");
     assert!(UNITS.len() <= MAX_DETAILS, "5-bit unit index");
     assert!(ranges.len() < NO_RANGE as usize, "at most 31 distinct ranges");
     assert!(
-        defaults.len() < NO_DEFAULT as usize,
+        defaults.0.len() + defaults.1.len() < NO_DEFAULT as usize,
         "at most 255 distinct defaults"
     );
     let names = layout.offsets;
@@ -689,10 +713,21 @@ pub const fn entries<const N: usize>(
             assert!(e.default == 0, "a packed string's default is 0");
             length_at(e, details.0, details.1)
         } else {
-            position_value(defaults, defaults.len(), narrow(e.data_type, e.default))
+            let v = narrow(e.data_type, e.default);
+            let (s16, s32) = defaults;
+            if small(v) {
+                position_u16(s16, 0, s16.len(), v as u16)
+            } else {
+                let at = position_value(s32, s32.len(), v);
+                if at < s32.len() {
+                    s16.len() + at
+                } else {
+                    usize::MAX
+                }
+            }
         };
         assert!(
-            e.data_type.is_string() || default < defaults.len(),
+            e.data_type.is_string() || default < defaults.0.len() + defaults.1.len(),
             "default in the table"
         );
         #[allow(clippy::indexing_slicing)]

@@ -2,7 +2,7 @@
 //! pointing into one string table (a name that begins or ends a longer one
 //! points into it), a table of 16-bit kinds (type, access, persistence, unit)
 //! with their 16-bit details (the distinct accesses and string lengths),
-//! shared range and default tables of 32-bit values and the unit table
+//! shared range (32-bit) and default (16-bit, 32-bit) tables and the unit table
 //! [`UNITS`], built at compile time from a declaration of [`EntryInfo`] values
 //! ([`packed_table!`](crate::packed_table)).
 //!
@@ -42,7 +42,31 @@ pub struct PackedTable {
     kinds: &'static [u16],
     details: &'static [u16],
     ranges: &'static [[u32; 2]],
-    defaults: &'static [u32],
+    defaults: Defaults,
+}
+
+/// The defaults of a table: those that fit 16 bits, then the others (one
+/// index space).
+#[derive(Debug)]
+struct Defaults {
+    small: &'static [u16],
+    wide: &'static [u32],
+}
+
+impl Defaults {
+    /// Number of defaults.
+    #[cfg(test)]
+    const fn len(&self) -> usize {
+        self.small.len() + self.wide.len()
+    }
+
+    /// The default at index `i`, as a 32-bit table value.
+    fn get(&self, i: usize) -> Option<u32> {
+        match i.checked_sub(self.small.len()) {
+            None => self.small.get(i).map(|&v| u32::from(v)),
+            Some(w) => self.wide.get(w).copied(),
+        }
+    }
 }
 
 /// A 32-bit table value as the entry's type reads it.
@@ -79,7 +103,8 @@ impl PackedTable {
         kinds: &'static [u16],
         details: &'static [u16],
         ranges: &'static [[u32; 2]],
-        defaults: &'static [u32],
+        small_defaults: &'static [u16],
+        wide_defaults: &'static [u32],
     ) -> Self {
         Self {
             entries,
@@ -87,7 +112,10 @@ impl PackedTable {
             kinds,
             details,
             ranges,
-            defaults,
+            defaults: Defaults {
+                small: small_defaults,
+                wide: wide_defaults,
+            },
         }
     }
 
@@ -146,7 +174,8 @@ impl PackedTable {
             + core::mem::size_of_val(self.kinds)
             + core::mem::size_of_val(self.details)
             + core::mem::size_of_val(self.ranges)
-            + core::mem::size_of_val(self.defaults)
+            + core::mem::size_of_val(self.defaults.small)
+            + core::mem::size_of_val(self.defaults.wide)
     }
 
     /// The entry at position `at`, decoded.
@@ -204,7 +233,7 @@ impl PackedTable {
         }
         self.defaults
             .get(p.default())
-            .map_or(0, |&d| widen(self.type_of(p, kind), d))
+            .map_or(0, |d| widen(self.type_of(p, kind), d))
     }
 
     /// [`EntryInfo::check_range`] of a record of this table.
@@ -257,7 +286,7 @@ pub struct PackedRef {
     record: &'static PackedEntry,
 }
 
-const EMPTY: PackedTable = PackedTable::new(&[], "", &[], &[], &[], &[]);
+const EMPTY: PackedTable = PackedTable::new(&[], "", &[], &[], &[], &[], &[]);
 
 impl PackedRef {
     /// A reference of no table: [`PackedEntry::UNUSED`] (subindex 0,
@@ -552,7 +581,9 @@ macro_rules! packed_table {
             #[allow(long_running_const_eval)]
             const R: usize = $crate::packed::range_count::<N>(PACKED_INPUT);
             #[allow(long_running_const_eval)]
-            const D: usize = $crate::packed::default_count::<N>(PACKED_INPUT);
+            const D16: usize = $crate::packed::default_count::<N>(PACKED_INPUT, false);
+            #[allow(long_running_const_eval)]
+            const D32: usize = $crate::packed::default_count::<N>(PACKED_INPUT, true);
             #[allow(long_running_const_eval)]
             const X: usize = $crate::packed::detail_count::<{ 2 * N + 1 }>(PACKED_INPUT);
             #[allow(long_running_const_eval)]
@@ -563,13 +594,15 @@ macro_rules! packed_table {
             const K: usize = $crate::packed::kind_count::<{ N + 1 }>(PACKED_INPUT, &DETAILS, A);
             #[allow(long_running_const_eval)]
             static ENTRIES: [$crate::PackedEntry; N] =
-                $crate::packed::entries::<N>(&NAME_LAYOUT, PACKED_INPUT, &KINDS, (&DETAILS, A), &RANGES, &DEFAULTS);
+                $crate::packed::entries::<N>(&NAME_LAYOUT, PACKED_INPUT, &KINDS, (&DETAILS, A), &RANGES, (&SMALL_DEFAULTS, &WIDE_DEFAULTS));
             #[allow(long_running_const_eval)]
             static KINDS: [u16; K] = $crate::packed::kinds::<{ N + 1 }, K>(PACKED_INPUT, &DETAILS, A);
             #[allow(long_running_const_eval)]
             static RANGES: [[u32; 2]; R] = $crate::packed::ranges::<N, R>(PACKED_INPUT);
             #[allow(long_running_const_eval)]
-            static DEFAULTS: [u32; D] = $crate::packed::defaults::<N, D>(PACKED_INPUT);
+            static SMALL_DEFAULTS: [u16; D16] = $crate::packed::small_defaults::<N, D16>(PACKED_INPUT);
+            #[allow(long_running_const_eval)]
+            static WIDE_DEFAULTS: [u32; D32] = $crate::packed::wide_defaults::<N, D32>(PACKED_INPUT);
             #[allow(long_running_const_eval)]
             static STRINGS: [u8; S] = $crate::packed::strings::<N, S>(&NAME_LAYOUT, PACKED_INPUT, EXTRA);
             #[allow(long_running_const_eval)]
@@ -579,7 +612,7 @@ macro_rules! packed_table {
                 Ok(s) => s,
                 Err(_) => "",
             };
-            $crate::PackedTable::new(&ENTRIES, NAMES, &KINDS, &DETAILS, &RANGES, &DEFAULTS)
+            $crate::PackedTable::new(&ENTRIES, NAMES, &KINDS, &DETAILS, &RANGES, &SMALL_DEFAULTS, &WIDE_DEFAULTS)
         };
     };
 }
