@@ -8,7 +8,7 @@ use super::record::{
     kind_of, type_code, ACCESS_MASK, MAX_DETAILS, MAX_KINDS, MAX_NAME, MAX_STRINGS, NO_DEFAULT,
     PLACEHOLDER_KIND,
 };
-use super::{narrow, PackedEntry, NO_RANGE, UNITS};
+use super::{narrow, PackedEntry, NO_RANGE, UNIT_NAMES as UNITS};
 use crate::EntryInfo;
 
 const fn str_eq(a: &str, b: &str) -> bool {
@@ -513,7 +513,10 @@ const fn unit_index(unit: &str) -> u32 {
     while i < UNITS.len() && !str_eq(UNITS[i], unit) {
         i += 1;
     }
-    assert!(i < UNITS.len(), "a packed entry's unit must be in od::UNITS");
+    assert!(
+        i < UNITS.len(),
+        "a packed entry's unit must be in od::packed::UNIT_NAMES"
+    );
     i as u32
 }
 

@@ -14,7 +14,7 @@
 //!
 //! Constraints of the packed form (checked when the table is built, a violation
 //! is a compile error): names at most 63 bytes and 16 KiB of names in all; a
-//! unit from [`UNITS`]; a range has both ends or none; ranges and defaults fit
+//! unit from [`UNIT_NAMES`]; a range has both ends or none; ranges and defaults fit
 //! 32 bits (signed types: `i32`, the others `u32`); strings have default 0;
 //! per table at most 128 distinct kinds, 16 distinct accesses, 31 distinct
 //! ranges and 255 distinct defaults.
@@ -24,11 +24,88 @@ use crate::{Access, DataType, EntryInfo};
 mod build;
 pub use build::*;
 
-/// The units an entry of a packed table may have (index 0: none).
-pub static UNITS: [&str; 17] = [
+/// The units an entry of a packed table may have (index 0: none); in the
+/// image as [`UNITS`].
+pub const UNIT_NAMES: [&str; 17] = [
     "", "inc", "inc/s", "inc/s²", "inc/s³", "0.1 %", "0.1 %/s", "0.1 kW", "%", "‰", "rpm", "s", "ms", "µs",
     "ns", "mNm", "mV",
 ];
+
+/// Bytes of the unit names.
+const UNIT_BYTES: usize = {
+    let mut n = 0;
+    let mut i = 0;
+    while i < UNIT_NAMES.len() {
+        // i < UNIT_NAMES.len() (compile-time evaluation)
+        #[allow(clippy::indexing_slicing)]
+        {
+            n += UNIT_NAMES[i].len();
+        }
+        i += 1;
+    }
+    assert!(n <= u8::MAX as usize, "unit names in 255 bytes");
+    n
+};
+
+/// [`UNIT_NAMES`] packed: the names one after the other and where each ends.
+#[derive(Debug)]
+pub struct Units {
+    text: [u8; UNIT_BYTES],
+    ends: [u8; UNIT_NAMES.len()],
+}
+
+impl Units {
+    const fn new() -> Self {
+        let mut out = Self {
+            text: [0; UNIT_BYTES],
+            ends: [0; UNIT_NAMES.len()],
+        };
+        let (mut at, mut i) = (0, 0);
+        while i < UNIT_NAMES.len() {
+            // i < UNIT_NAMES.len(), at + k < UNIT_BYTES (compile-time evaluation)
+            #[allow(clippy::indexing_slicing)]
+            let b = UNIT_NAMES[i].as_bytes();
+            let mut k = 0;
+            while k < b.len() {
+                #[allow(clippy::indexing_slicing)]
+                {
+                    out.text[at + k] = b[k];
+                }
+                k += 1;
+            }
+            at += b.len();
+            #[allow(clippy::indexing_slicing)]
+            {
+                out.ends[i] = at as u8;
+            }
+            i += 1;
+        }
+        out
+    }
+
+    /// Unit `i` (`None` past the last).
+    pub fn get(&'static self, i: usize) -> Option<&'static str> {
+        let start = match i.checked_sub(1) {
+            None => 0,
+            Some(j) => usize::from(*self.ends.get(j)?),
+        };
+        let end = usize::from(*self.ends.get(i)?);
+        core::str::from_utf8(self.text.get(start..end)?).ok()
+    }
+
+    /// Number of units.
+    pub const fn len(&self) -> usize {
+        self.ends.len()
+    }
+
+    /// No units?
+    pub const fn is_empty(&self) -> bool {
+        self.ends.is_empty()
+    }
+}
+
+/// The units of packed entries (index 0: none), packed.
+pub static UNITS: Units = Units::new();
 
 mod record;
 pub use record::PackedEntry;
@@ -272,7 +349,7 @@ impl PackedTable {
             min,
             max,
             default: self.default_of(p),
-            unit: UNITS.get(record::detail_of(kind)).copied().unwrap_or(""),
+            unit: UNITS.get(record::detail_of(kind)).unwrap_or(""),
             persistent: record::persistent_of(kind),
         }
     }
