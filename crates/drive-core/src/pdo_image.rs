@@ -51,9 +51,10 @@
 //! [`DriveObjects::set_bytes`].
 
 use crate::dictionary::{DriveObjects, Slot, Template};
+use crate::objects::EntryRecord;
 use crate::objects::{find, IMAGE_BYTES};
 use crate::MAPPING_ENTRIES;
-use od::{DataType, PackedRef};
+use od::DataType;
 
 /// Assigned PDOs per direction (1C12h/1C13h sub 1–4, spec §5.1).
 pub const MAX_PDOS: usize = 4;
@@ -76,7 +77,7 @@ pub struct ImageEntry {
     pub sub: u8,
     /// The entry's declaration (data type, default, persistence): its
     /// record in [`crate::objects::ENTRY_TABLE`].
-    pub info: PackedRef,
+    pub info: EntryRecord,
     /// The value [`PdoImage::restore_rx_defaults`] restores (RxPDO): the
     /// declared default, for persistent entries the value captured by
     /// [`PdoImage::capture_fallbacks`].
@@ -92,7 +93,7 @@ impl ImageEntry {
         bits: 0,
         index: 0,
         sub: 0,
-        info: PackedRef::UNUSED,
+        info: EntryRecord::UNUSED,
         fallback: 0,
         slot: None,
     };
@@ -504,14 +505,14 @@ fn stores_overlap(entries: &[ImageEntry], objects: &DriveObjects) -> bool {
 
 /// The declaration of the entry a mapping names with `index`:`sub` in the
 /// active template (the runtime subindex is `EntryInfo::sub`).
-fn resolve(index: u16, sub: u8, sdo_info: bool) -> Option<PackedRef> {
+fn resolve(index: u16, sub: u8, sdo_info: bool) -> Option<EntryRecord> {
     let (_, o) = find(index)?;
     let view = o.view(sdo_info);
     let p = view.entries.position(sub)?;
     // the "EtherCAT Rx" view of a manufacturer array has element e at
     // position e, the runtime numbering at e + 1 (after sub 0)
     let pos = if !sdo_info && o.has_rx_view() { p + 1 } else { p };
-    o.info.entries.record(pos)
+    o.info.entries.record(pos).map(EntryRecord::of)
 }
 
 /// Why a mapping could not be compiled. The mapping checks of the dictionary

@@ -15,7 +15,7 @@ use core::sync::atomic::{AtomicU32, Ordering};
 use crate::objects::{self, enumeration, find, Object, Value, IMAGE_BYTES, OBJECTS, OFFSETS};
 use crate::pdo_image::{CopyOp, WIDTH_SHIFT};
 use crate::{parameter_index, MAPPING_ENTRIES, SOFTWARE_BUILD};
-use od::{CommState, DataType, Dictionary, EntryInfo, ObjectInfo, PackedRef, SdoAbort};
+use od::{CommState, DataType, Dictionary, EntryInfo, ObjectInfo, SdoAbort};
 
 mod mapping;
 mod persist;

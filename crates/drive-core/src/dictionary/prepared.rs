@@ -26,7 +26,7 @@ pub struct Prepared {
     /// The target has a value list ([`enumeration`], looked up at a write).
     listed: bool,
     /// The target entry's record in [`crate::objects::ENTRY_TABLE`] (type, range).
-    target: PackedRef,
+    target: crate::objects::EntryRecord,
     /// The target object's index (for its value list).
     index: u16,
 }

@@ -62,7 +62,7 @@ pub mod manufacturer;
 mod pack;
 pub mod records;
 
-pub use pack::ENTRY_TABLE;
+pub use pack::{EntryRecord, ENTRY_TABLE};
 
 /// Where the values of an object live.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]

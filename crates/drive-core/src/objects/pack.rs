@@ -9,7 +9,7 @@
 
 use super::{declared, rx_entry, Object, RxView, COUNT, TABLE};
 use od::packed::{same_entries, same_entry};
-use od::{EntryInfo, ObjectInfo, PackedTable};
+use od::{Access, DataType, EntryInfo, ObjectInfo, PackedEntry, PackedRef, PackedTable, SdoAbort};
 
 /// The SDO Info entries of object `i`.
 const fn info(objs: &[Object], i: usize) -> &'static [EntryInfo] {
@@ -197,6 +197,54 @@ od::packed_table!(
     /// The entries of every object of the drive (both templates), packed.
     pub static ENTRY_TABLE = &FLAT;
 );
+
+/// A record of [`ENTRY_TABLE`] in 4 bytes (the table is implied): what the
+/// declaration says of one entry, read without decoding it (the process
+/// images keep one per mapped entry).
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub struct EntryRecord(&'static PackedEntry);
+
+impl EntryRecord {
+    /// No entry: subindex 0, UNSIGNED8, read-only, default 0 (placeholder in
+    /// fixed-size tables).
+    pub const UNUSED: Self = Self(&PackedEntry::UNUSED);
+
+    /// The record of `r`, a record of [`ENTRY_TABLE`] (the objects' entries
+    /// are).
+    pub const fn of(r: PackedRef) -> Self {
+        Self(r.entry())
+    }
+
+    /// Subindex.
+    pub const fn sub(&self) -> u8 {
+        self.0.sub()
+    }
+
+    /// Data type.
+    pub fn data_type(&self) -> DataType {
+        ENTRY_TABLE.data_type(self.0)
+    }
+
+    /// Access rights.
+    pub fn access(&self) -> Access {
+        ENTRY_TABLE.access(self.0)
+    }
+
+    /// Saved by "save values"?
+    pub fn persistent(&self) -> bool {
+        ENTRY_TABLE.persistent(self.0)
+    }
+
+    /// The declared default.
+    pub fn default_value(&self) -> i64 {
+        ENTRY_TABLE.default_of(self.0)
+    }
+
+    /// [`EntryInfo::check_range`] of the entry.
+    pub fn check_range(&self, value: i64) -> Result<(), SdoAbort> {
+        ENTRY_TABLE.check_range(self.0, value)
+    }
+}
 
 /// Number of objects with an "EtherCAT Rx" view of their own.
 const RX_COUNT: usize = {

@@ -378,6 +378,11 @@ impl PackedRef {
         self.record.sub()
     }
 
+    /// The record (its table's).
+    pub const fn entry(&self) -> &'static PackedEntry {
+        self.record
+    }
+
     /// Data type.
     pub fn data_type(&self) -> DataType {
         self.table.data_type(self.record)
