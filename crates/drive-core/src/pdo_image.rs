@@ -51,10 +51,10 @@
 //! [`DriveObjects::set_bytes`].
 
 use crate::dictionary::{DriveObjects, Slot, Template};
-use crate::objects::ENTRY_TABLE;
+use crate::objects::EntryRecord;
 use crate::objects::{find, IMAGE_BYTES};
 use crate::MAPPING_ENTRIES;
-use od::{DataType, PackedEntry};
+use od::DataType;
 
 /// Assigned PDOs per direction (1C12h/1C13h sub 1–4, spec §5.1).
 pub const MAX_PDOS: usize = 4;
@@ -76,8 +76,8 @@ pub struct ImageEntry {
     /// Subindex in the runtime ("EtherCAT Rx SDO Info") numbering.
     pub sub: u8,
     /// The entry's declaration (data type, default, persistence): its
-    /// record in [`ENTRY_TABLE`].
-    pub info: &'static PackedEntry,
+    /// record in [`crate::objects::ENTRY_TABLE`].
+    pub info: EntryRecord,
     /// The value [`PdoImage::restore_rx_defaults`] restores (RxPDO): the
     /// declared default, for persistent entries the value captured by
     /// [`PdoImage::capture_fallbacks`].
@@ -93,7 +93,7 @@ impl ImageEntry {
         bits: 0,
         index: 0,
         sub: 0,
-        info: &PackedEntry::UNUSED,
+        info: EntryRecord::UNUSED,
         fallback: 0,
         slot: None,
     };
@@ -173,7 +173,7 @@ impl Channel {
                     index,
                     sub: info.sub(),
                     info,
-                    fallback: ENTRY_TABLE.default_of(info),
+                    fallback: info.default_value(),
                     slot: None,
                 };
                 if entry.byte_aligned() {
@@ -505,14 +505,14 @@ fn stores_overlap(entries: &[ImageEntry], objects: &DriveObjects) -> bool {
 
 /// The declaration of the entry a mapping names with `index`:`sub` in the
 /// active template (the runtime subindex is `EntryInfo::sub`).
-fn resolve(index: u16, sub: u8, sdo_info: bool) -> Option<&'static PackedEntry> {
+fn resolve(index: u16, sub: u8, sdo_info: bool) -> Option<EntryRecord> {
     let (_, o) = find(index)?;
     let view = o.view(sdo_info);
     let p = view.entries.position(sub)?;
     // the "EtherCAT Rx" view of a manufacturer array has element e at
     // position e, the runtime numbering at e + 1 (after sub 0)
-    let pos = if !sdo_info && o.rx.is_some() { p + 1 } else { p };
-    o.info.entries.record(pos)
+    let pos = if !sdo_info && o.has_rx_view() { p + 1 } else { p };
+    o.info.entries.record(pos).map(EntryRecord::of)
 }
 
 /// Why a mapping could not be compiled. The mapping checks of the dictionary
@@ -640,11 +640,9 @@ impl PdoImage {
         let len = self.rx.len;
         for e in self.rx.entries.iter_mut().take(len) {
             e.fallback = if e.info.persistent() {
-                objects
-                    .get(e.index, e.sub)
-                    .unwrap_or(ENTRY_TABLE.default_of(e.info))
+                objects.get(e.index, e.sub).unwrap_or(e.info.default_value())
             } else {
-                ENTRY_TABLE.default_of(e.info)
+                e.info.default_value()
             };
         }
     }

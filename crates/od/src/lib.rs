@@ -29,7 +29,7 @@ mod pdo;
 mod types;
 
 pub use abort::SdoAbort;
-pub use packed::{Entries, PackedEntry, PackedTable, UNITS};
+pub use packed::{Entries, PackedEntry, PackedRef, PackedTable, UNITS};
 pub use pdo::PdoEntry;
 pub use types::DataType;
 

@@ -12,10 +12,10 @@ use core::cell::Cell;
 use core::marker::PhantomData;
 use core::sync::atomic::{AtomicU32, Ordering};
 
-use crate::objects::{self, enumeration, find, Object, Value, ENTRY_TABLE, IMAGE_BYTES, OBJECTS, OFFSETS};
+use crate::objects::{self, enumeration, find, Object, Value, IMAGE_BYTES, OBJECTS, OFFSETS};
 use crate::pdo_image::{CopyOp, WIDTH_SHIFT};
 use crate::{parameter_index, MAPPING_ENTRIES, SOFTWARE_BUILD};
-use od::{CommState, DataType, Dictionary, EntryInfo, ObjectInfo, PackedEntry, SdoAbort};
+use od::{CommState, DataType, Dictionary, EntryInfo, ObjectInfo, SdoAbort};
 
 mod mapping;
 mod persist;
@@ -243,7 +243,7 @@ impl DriveObjects {
         if !self.visible(o) {
             return Err(SdoAbort::NO_OBJECT);
         }
-        let rx_view = !self.sdo_info() && o.rx.is_some();
+        let rx_view = !self.sdo_info() && o.has_rx_view();
         let view = o.view(self.sdo_info());
         let p = view.entries.position(sub).ok_or(SdoAbort::NO_SUBINDEX)?;
         Ok(Loc {

@@ -25,8 +25,8 @@ pub struct Prepared {
     writable: bool,
     /// The target has a value list ([`enumeration`], looked up at a write).
     listed: bool,
-    /// The target entry's record in [`ENTRY_TABLE`] (type, range).
-    target: &'static PackedEntry,
+    /// The target entry's record in [`crate::objects::ENTRY_TABLE`] (type, range).
+    target: crate::objects::EntryRecord,
     /// The target object's index (for its value list).
     index: u16,
 }
@@ -55,7 +55,7 @@ impl DriveObjects {
         let target = follow(loc).ok()?;
         let (to, te) = (target.object().ok()?, target.record().ok()?);
         let t = te.data_type();
-        if o.rx.is_some() || !matches!(to.value, Value::Ram | Value::Live) || e.data_type() != t {
+        if o.has_rx_view() || !matches!(to.value, Value::Ram | Value::Live) || e.data_type() != t {
             return None;
         }
         let range = target.slot().ok()?;
@@ -108,7 +108,7 @@ impl DriveObjects {
         // `decode` reads it at the type's own width), then its store: the
         // same bytes, a changed configuration value counted
         let check = load(data, 0, p.target.data_type()).and_then(|v| {
-            ENTRY_TABLE.check_range(p.target, v)?;
+            p.target.check_range(v)?;
             match p.listed.then(|| enumeration(p.index, p.target.sub())).flatten() {
                 Some(list) if !list.contains(&v) => Err(SdoAbort::INVALID_VALUE),
                 _ => Ok(v),

@@ -35,11 +35,12 @@ impl Loc {
     }
 
     /// The entry's packed record in [`crate::objects::ENTRY_TABLE`].
-    pub(super) fn record(self) -> Result<&'static PackedEntry, SdoAbort> {
+    pub(super) fn record(self) -> Result<crate::objects::EntryRecord, SdoAbort> {
         self.object()?
             .info
             .entries
             .record(self.pos)
+            .map(crate::objects::EntryRecord::of)
             .ok_or(SdoAbort::NO_SUBINDEX)
     }
 

@@ -162,13 +162,13 @@ pub const COMM: [Object; 22] = [
         .note("E-007: live, from the EMCY/diagnosis module"),
     Object::var(
         0x1008,
-        Value::Text(DEVICE_NAME),
+        Value::Text(&DEVICE_NAME),
         entries![e(0, "Manufacturer device name", string(DEVICE_NAME), RO)],
     )
     .note("E50"),
     Object::var(
         0x1009,
-        Value::Text(HARDWARE_VERSION),
+        Value::Text(&HARDWARE_VERSION),
         entries![e(
             0,
             "Manufacturer hardware version",
@@ -179,7 +179,7 @@ pub const COMM: [Object; 22] = [
     .note("E52[1]"),
     Object::var(
         0x100A,
-        Value::Text(SOFTWARE_VERSION),
+        Value::Text(&SOFTWARE_VERSION),
         entries![e(
             0,
             "Manufacturer software version",

@@ -128,12 +128,12 @@ const ASSIGN_RX_VIEW: [EntryInfo; 4] = repeat(
 /// template).
 macro_rules! mirror {
     ($index:expr, $name:expr, $target:expr, $entries:expr, $rx:expr, $note:expr) => {{
-        const RX: &od::ObjectInfo = &od::ObjectInfo {
-            index: $index,
-            name: $name,
-            code: Array,
-            entries: od::Entries::slice($rx),
-        };
+        // the "EtherCAT Rx" view is the SDO Info view's elements renumbered
+        // from 0 (packing shares their records)
+        const _: () = assert!(
+            super::is_rx_view($rx, &$entries, super::RxView::ElementsNoDefaults),
+            "the Rx view of a mirror is its SDO Info elements from subindex 0, without defaults"
+        );
         Object::new(
             $index,
             $name,
@@ -144,7 +144,7 @@ macro_rules! mirror {
                 sub0: true,
             },
         )
-        .rx_view(RX)
+        .rx_view(super::RxView::ElementsNoDefaults)
         .level(2)
         .note($note)
     }};
@@ -345,7 +345,10 @@ pub const PARAMS: [Object; 80] = [
     ),
     Object::var(
         a(250),
-        Value::Alias(&[(0x10F3, 4)]),
+        Value::Alias({
+            const LIST: &[(u16, u8)] = &[(0x10F3, 4)];
+            &LIST
+        }),
         entries![e(0, "New diagnosis messages available", Bool, RO).tx()],
     )
     .note("A250 = 10F3h:04"),
@@ -619,7 +622,10 @@ pub const PARAMS: [Object; 80] = [
     .note("E49; all causes: bit 0 STO, 1 supply, 2 A60, 3 controlword (encoding ours, C-015)"),
     Object::var(
         e_(50),
-        Value::Alias(&[(0x1008, 0)]),
+        Value::Alias({
+            const LIST: &[(u16, u8)] = &[(0x1008, 0)];
+            &LIST
+        }),
         entries![e(0, "Device name", string(DEVICE_NAME), RO)],
     )
     .note("E50 = 1008h"),
@@ -627,7 +633,10 @@ pub const PARAMS: [Object; 80] = [
         e_(52),
         "Device identification",
         Record,
-        Value::Alias(&[(0, 0), (0, 0), (0x1009, 0), (0x1018, 4), (0x100A, 0)]),
+        Value::Alias({
+            const LIST: &[(u16, u8)] = &[(0, 0), (0, 0), (0x1009, 0), (0x1018, 4), (0x100A, 0)];
+            &LIST
+        }),
         [
             e(0, "Identification", U32, RO),
             e(1, "Hardware version", string(HARDWARE_VERSION), RO),

@@ -14,7 +14,7 @@
 //! [`OFFSETS`] gives each object's place in the RAM image, computed at compile
 //! time. Subindices are declared in the "EtherCAT Rx SDO Info" numbering
 //! (element + 1 for manufacturer arrays/records); manufacturer arrays carry
-//! the "EtherCAT Rx" view (element = subindex) in [`Object::rx`].
+//! the "EtherCAT Rx" view (element = subindex): [`Object::rx`], [`Object::view`].
 
 use od::{Access, DataType, Entries, EntryInfo, ObjectCode, ObjectInfo};
 
@@ -38,14 +38,14 @@ macro_rules! param_array {
     ($index:expr, $name:expr, $code:ident, $value:expr, from $els:expr) => {{
         const ELS: &[od::EntryInfo] = $els;
         const INFO: [od::EntryInfo; ELS.len() + 1] = $crate::objects::sdo_info_view(ELS);
-        // the view's index and entries are set when the table is packed
-        const RX: &od::ObjectInfo = &od::ObjectInfo {
-            index: $index,
-            name: $name,
-            code: od::ObjectCode::$code,
-            entries: od::Entries::slice(ELS),
-        };
-        $crate::objects::Object::new($index, $name, od::ObjectCode::$code, &INFO, $value).rx_view(RX)
+        // the "EtherCAT Rx" view is the SDO Info view's elements renumbered
+        // from 0 (packing shares their records)
+        const _: () = assert!(
+            $crate::objects::is_rx_view(ELS, &INFO, $crate::objects::RxView::Elements),
+            "manufacturer elements have subindex = element number"
+        );
+        $crate::objects::Object::new($index, $name, od::ObjectCode::$code, &INFO, $value)
+            .rx_view($crate::objects::RxView::Elements)
     }};
 }
 
@@ -62,15 +62,16 @@ pub mod manufacturer;
 mod pack;
 pub mod records;
 
-pub use pack::ENTRY_TABLE;
+pub use pack::{EntryRecord, ENTRY_TABLE};
 
 /// Where the values of an object live.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
 pub enum Value {
     /// Constants: every entry reads its declared default.
     Const,
-    /// A constant string (VAR).
-    Text(&'static str),
+    /// A constant string (VAR; behind a reference, so that a [`Value`] takes
+    /// 8 bytes in the firmware image).
+    Text(&'static &'static str),
     /// 1018h: constants, except the revision 1018h:03, which follows the
     /// subindex template (E-008).
     Identity,
@@ -93,8 +94,22 @@ pub enum Value {
         sub0: bool,
     },
     /// Entry position k is the target entry `(index, sub)` of the list; `(0, 0)`
-    /// = the parameter's own constant.
-    Alias(&'static [(u16, u8)]),
+    /// = the parameter's own constant (behind a reference, as [`Value::Text`]).
+    Alias(&'static &'static [(u16, u8)]),
+}
+
+/// The "EtherCAT Rx" template view of an object (manufacturer arrays and
+/// records have element e at subindex e there, at e + 1 in the SDO Info
+/// view).
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum RxView {
+    /// The same as in the SDO Info template.
+    Same,
+    /// The SDO Info view's elements (its entries after sub 0) at subindex - 1.
+    Elements,
+    /// The same without defaults (a mirror's elements read the target's
+    /// values; its view declares none).
+    ElementsNoDefaults,
 }
 
 /// One object of the drive: its metadata, where its values live and who may
@@ -104,9 +119,8 @@ pub enum Value {
 pub struct Object {
     /// Metadata in the "EtherCAT Rx SDO Info" template (what SDO Info reports).
     pub info: ObjectInfo,
-    /// Metadata in the "EtherCAT Rx" template, for manufacturer arrays and
-    /// records (subindex = element number); `None`: the same in both.
-    pub rx: Option<&'static ObjectInfo>,
+    /// Its view in the "EtherCAT Rx" template ([`Object::view`]).
+    pub rx: RxView,
     /// Where the values live.
     pub value: Value,
     /// Access level (0–3) needed to see the object; hidden objects answer
@@ -135,7 +149,7 @@ impl Object {
                 code,
                 entries: Entries::slice(entries),
             },
-            rx: None,
+            rx: RxView::Same,
             value,
             level: 0,
             axis: false,
@@ -177,11 +191,16 @@ impl Object {
         self
     }
 
-    /// With the "EtherCAT Rx" template view `rx` (subindex = element number;
-    /// packing gives it the object's index).
-    pub const fn rx_view(mut self, rx: &'static ObjectInfo) -> Self {
-        self.rx = Some(rx);
+    /// With the "EtherCAT Rx" template view `rx` (built when the table is
+    /// packed).
+    pub const fn rx_view(mut self, rx: RxView) -> Self {
+        self.rx = rx;
         self
+    }
+
+    /// Has a view of its own in the "EtherCAT Rx" template?
+    pub const fn has_rx_view(&self) -> bool {
+        !matches!(self.rx, RxView::Same)
     }
 
     /// Bytes this object takes in the RAM image (from a declaration).
@@ -209,10 +228,11 @@ impl Object {
     }
 
     /// The metadata in the template (`sdo_info` = "EtherCAT Rx SDO Info").
-    pub const fn view(&self, sdo_info: bool) -> &ObjectInfo {
-        match (sdo_info, self.rx) {
-            (false, Some(rx)) => rx,
-            _ => &self.info,
+    pub fn view(&self, sdo_info: bool) -> &ObjectInfo {
+        if !sdo_info && self.has_rx_view() {
+            pack::rx_view(self.info.index).unwrap_or(&self.info)
+        } else {
+            &self.info
         }
     }
 }
@@ -223,6 +243,36 @@ pub const fn declared(entries: Entries) -> &'static [EntryInfo] {
         Some(s) => s,
         None => &[],
     }
+}
+
+/// Entry `k` of the "EtherCAT Rx" view `rx` of an object with the SDO Info
+/// entries `info` (`k + 1 < info.len()`).
+pub const fn rx_entry(info: &[EntryInfo], rx: RxView, k: usize) -> EntryInfo {
+    // k + 1 < info.len() (compile-time evaluation)
+    #[allow(clippy::indexing_slicing)]
+    let mut e = info[k + 1].at(k as u8);
+    if matches!(rx, RxView::ElementsNoDefaults) {
+        e.default = 0;
+    }
+    e
+}
+
+/// Is `list` the "EtherCAT Rx" view `rx` of an object with the SDO Info
+/// entries `info`?
+pub const fn is_rx_view(list: &[EntryInfo], info: &[EntryInfo], rx: RxView) -> bool {
+    if matches!(rx, RxView::Same) || list.len() + 1 != info.len() {
+        return false;
+    }
+    let mut k = 0;
+    while k < list.len() {
+        // k < list.len() (compile-time evaluation)
+        #[allow(clippy::indexing_slicing)]
+        if !od::packed::same_entry(&list[k], &rx_entry(info, rx, k)) {
+            return false;
+        }
+        k += 1;
+    }
+    true
 }
 
 /// "Highest subindex supported" entry of an array/record with `n` entries.
@@ -276,7 +326,7 @@ pub const fn offset<const N: usize>(objs: [Object; N], by: u16) -> [Object; N] {
         // i < N (compile-time evaluation)
         #[allow(clippy::indexing_slicing)]
         {
-            assert!(out[i].rx.is_none(), "CiA 402 objects have one view");
+            assert!(!out[i].has_rx_view(), "CiA 402 objects have one view");
             out[i].info.index += by;
         }
         i += 1;
@@ -424,7 +474,7 @@ const fn defaults_in_range(objs: &[Object]) -> bool {
 }
 
 /// Every object of the drive, sorted by index, its entries in [`ENTRY_TABLE`].
-pub static OBJECTS: [Object; COUNT] = pack::objects(&TABLE, &ENTRY_TABLE, &pack::RX_VIEWS);
+pub static OBJECTS: [Object; COUNT] = pack::objects(&TABLE, &ENTRY_TABLE);
 
 const fn offsets() -> ([u16; COUNT], usize) {
     let mut out = [0u16; COUNT];

@@ -1,124 +1,149 @@
-//! The compact form of entry metadata: 12-byte [`PackedEntry`] records
-//! pointing into one de-duplicated string table, shared range and default
-//! tables of 32-bit values and the unit table [`UNITS`], built at compile time
-//! from a declaration of [`EntryInfo`] values ([`packed_table!`](crate::packed_table)).
+//! The compact form of entry metadata: 6-byte [`PackedEntry`] records
+//! pointing into one string table (a name that begins or ends a longer one
+//! points into it), a table of 16-bit kinds (type, access, persistence, unit)
+//! with their 16-bit details (the distinct accesses and string lengths),
+//! shared range (32-bit) and default (16-bit, 32-bit) tables and the unit table
+//! [`UNITS`], built at compile time from a declaration of [`EntryInfo`] values
+//! ([`packed_table!`](crate::packed_table)).
 //!
 //! [`Entries`] is the handle an [`ObjectInfo`](crate::ObjectInfo) holds: a run
-//! of records in a [`PackedTable`], or a plain slice of [`EntryInfo`] (small
-//! hand-made dictionaries, tests). Either way entries are read by value, decoded.
+//! of records in a [`PackedTable`] (optionally renumbered, see
+//! [`PackedTable::renumbered`]), or a plain slice of [`EntryInfo`] (small
+//! hand-made dictionaries, tests). Either way entries are read by value,
+//! decoded; [`PackedRef`] reads single fields of a record without decoding.
 //!
 //! Constraints of the packed form (checked when the table is built, a violation
-//! is a compile error): names at most 255 bytes and 64 KiB of distinct names in
-//! all; a unit from [`UNITS`]; a range has both ends or none; ranges and
-//! defaults fit 32 bits (signed types: `i32`, the others `u32`); strings at most
-//! 4095 bytes; at most 65 535 distinct ranges and defaults.
+//! is a compile error): names at most 63 bytes and 16 KiB of names in all; a
+//! unit from [`UNIT_NAMES`]; a range has both ends or none; ranges and defaults fit
+//! 32 bits (signed types: `i32`, the others `u32`); strings have default 0;
+//! per table at most 128 distinct kinds, 16 distinct accesses, 31 distinct
+//! ranges and 255 distinct defaults.
 
 use crate::{Access, DataType, EntryInfo};
 
 mod build;
 pub use build::*;
 
-/// The units an entry of a packed table may have (index 0: none).
-pub static UNITS: [&str; 17] = [
+/// The units an entry of a packed table may have (index 0: none); in the
+/// image as [`UNITS`].
+pub const UNIT_NAMES: [&str; 17] = [
     "", "inc", "inc/s", "inc/s²", "inc/s³", "0.1 %", "0.1 %/s", "0.1 kW", "%", "‰", "rpm", "s", "ms", "µs",
     "ns", "mNm", "mV",
 ];
 
-/// No range ([`PackedEntry`] range index).
-const NO_RANGE: u16 = u16::MAX;
-const PERSISTENT: u16 = 1 << 10;
-const UNIT_SHIFT: u16 = 11;
-const ACCESS_MASK: u16 = (1 << 10) - 1;
-
-/// One entry in 12 bytes: name (offset and length in the string table),
-/// subindex, access bits with the persistence flag and the unit index, data
-/// type with its string length, range and default (indices into the shared
-/// tables).
-#[derive(Debug, Clone, Copy, PartialEq, Eq)]
-pub struct PackedEntry {
-    name: u16,
-    name_len: u8,
-    sub: u8,
-    /// bits 0..9 access, bit 10 persistent, bits 11..15 unit
-    flags: u16,
-    /// bits 0..3 kind, bits 4..15 string length
-    ty: u16,
-    range: u16,
-    default: u16,
-}
-
-const fn kind(t: DataType) -> (u16, u16) {
-    match t {
-        DataType::Bool => (0, 0),
-        DataType::I8 => (1, 0),
-        DataType::I16 => (2, 0),
-        DataType::I32 => (3, 0),
-        DataType::U8 => (4, 0),
-        DataType::U16 => (5, 0),
-        DataType::U32 => (6, 0),
-        DataType::F32 => (7, 0),
-        DataType::VisibleString(n) => (8, n),
-        DataType::OctetString(n) => (9, n),
-        DataType::I64 => (10, 0),
-        DataType::U64 => (11, 0),
-    }
-}
-
-impl PackedEntry {
-    /// A record of no table: subindex 0, UNSIGNED8, read-only, no name
-    /// (placeholder in fixed-size tables).
-    pub const UNUSED: Self = Self {
-        name: 0,
-        name_len: 0,
-        sub: 0,
-        flags: crate::Access::READ,
-        ty: 4,
-        range: NO_RANGE,
-        default: u16::MAX,
-    };
-
-    /// Saved by "save values"?
-    pub const fn persistent(&self) -> bool {
-        self.flags & PERSISTENT != 0
-    }
-
-    /// Subindex.
-    pub const fn sub(&self) -> u8 {
-        self.sub
-    }
-
-    /// Data type.
-    pub const fn data_type(&self) -> DataType {
-        let n = self.ty >> 4;
-        match self.ty & 0xF {
-            0 => DataType::Bool,
-            1 => DataType::I8,
-            2 => DataType::I16,
-            3 => DataType::I32,
-            4 => DataType::U8,
-            5 => DataType::U16,
-            6 => DataType::U32,
-            7 => DataType::F32,
-            8 => DataType::VisibleString(n),
-            9 => DataType::OctetString(n),
-            10 => DataType::I64,
-            _ => DataType::U64,
+/// Bytes of the unit names.
+const UNIT_BYTES: usize = {
+    let mut n = 0;
+    let mut i = 0;
+    while i < UNIT_NAMES.len() {
+        // i < UNIT_NAMES.len() (compile-time evaluation)
+        #[allow(clippy::indexing_slicing)]
+        {
+            n += UNIT_NAMES[i].len();
         }
+        i += 1;
+    }
+    assert!(n <= u8::MAX as usize, "unit names in 255 bytes");
+    n
+};
+
+/// [`UNIT_NAMES`] packed: the names one after the other and where each ends.
+#[derive(Debug)]
+pub struct Units {
+    text: [u8; UNIT_BYTES],
+    ends: [u8; UNIT_NAMES.len()],
+}
+
+impl Units {
+    const fn new() -> Self {
+        let mut out = Self {
+            text: [0; UNIT_BYTES],
+            ends: [0; UNIT_NAMES.len()],
+        };
+        let (mut at, mut i) = (0, 0);
+        while i < UNIT_NAMES.len() {
+            // i < UNIT_NAMES.len(), at + k < UNIT_BYTES (compile-time evaluation)
+            #[allow(clippy::indexing_slicing)]
+            let b = UNIT_NAMES[i].as_bytes();
+            let mut k = 0;
+            while k < b.len() {
+                #[allow(clippy::indexing_slicing)]
+                {
+                    out.text[at + k] = b[k];
+                }
+                k += 1;
+            }
+            at += b.len();
+            #[allow(clippy::indexing_slicing)]
+            {
+                out.ends[i] = at as u8;
+            }
+            i += 1;
+        }
+        out
     }
 
-    /// Access rights.
-    pub const fn access(&self) -> Access {
-        Access(self.flags & ACCESS_MASK)
+    /// Unit `i` (`None` past the last).
+    pub fn get(&'static self, i: usize) -> Option<&'static str> {
+        let start = match i.checked_sub(1) {
+            None => 0,
+            Some(j) => usize::from(*self.ends.get(j)?),
+        };
+        let end = usize::from(*self.ends.get(i)?);
+        core::str::from_utf8(self.text.get(start..end)?).ok()
+    }
+
+    /// Number of units.
+    pub const fn len(&self) -> usize {
+        self.ends.len()
+    }
+
+    /// No units?
+    pub const fn is_empty(&self) -> bool {
+        self.ends.is_empty()
     }
 }
 
-/// A table of packed entries with its string, range and default tables.
+/// The units of packed entries (index 0: none), packed.
+pub static UNITS: Units = Units::new();
+
+mod record;
+pub use record::PackedEntry;
+use record::{type_of, NO_RANGE};
+
+/// A table of packed entries with its string, kind, range and default tables.
 #[derive(Debug)]
 pub struct PackedTable {
     entries: &'static [PackedEntry],
     strings: &'static str,
+    kinds: &'static [u16],
+    details: &'static [u16],
     ranges: &'static [[u32; 2]],
-    defaults: &'static [u32],
+    defaults: Defaults,
+}
+
+/// The defaults of a table: those that fit 16 bits, then the others (one
+/// index space).
+#[derive(Debug)]
+struct Defaults {
+    small: &'static [u16],
+    wide: &'static [u32],
+}
+
+impl Defaults {
+    /// Number of defaults.
+    #[cfg(test)]
+    const fn len(&self) -> usize {
+        self.small.len() + self.wide.len()
+    }
+
+    /// The default at index `i`, as a 32-bit table value.
+    fn get(&self, i: usize) -> Option<u32> {
+        match i.checked_sub(self.small.len()) {
+            None => self.small.get(i).map(|&v| u32::from(v)),
+            Some(w) => self.wide.get(w).copied(),
+        }
+    }
 }
 
 /// A 32-bit table value as the entry's type reads it.
@@ -152,23 +177,55 @@ impl PackedTable {
     pub const fn new(
         entries: &'static [PackedEntry],
         strings: &'static str,
+        kinds: &'static [u16],
+        details: &'static [u16],
         ranges: &'static [[u32; 2]],
-        defaults: &'static [u32],
+        small_defaults: &'static [u16],
+        wide_defaults: &'static [u32],
     ) -> Self {
         Self {
             entries,
             strings,
+            kinds,
+            details,
             ranges,
-            defaults,
+            defaults: Defaults {
+                small: small_defaults,
+                wide: wide_defaults,
+            },
         }
     }
 
     /// The `len` entries from position `start`.
     pub const fn list(&'static self, start: u16, len: u16) -> Entries {
+        self.renumbered(start, len, 0)
+    }
+
+    /// The `len` entries from position `start`, each at its record's
+    /// subindex minus `shift` (e.g. the "EtherCAT Rx" view of a manufacturer
+    /// array: the SDO Info view's elements 1… at subindices 0…). Every record
+    /// of the run must have a subindex of at least `shift` (the builder's
+    /// check).
+    pub const fn renumbered(&'static self, start: u16, len: u16, shift: u8) -> Entries {
         Entries(Repr::Packed {
             table: self,
-            start,
+            first: start,
+            rest: start.wrapping_add(1),
             len,
+            shift,
+        })
+    }
+
+    /// `len` entries: the record at position `first`, then the `len - 1`
+    /// records from position `rest` (lists that differ only in their first
+    /// entry, e.g. sub 0, share the others).
+    pub const fn joined(&'static self, first: u16, rest: u16, len: u16) -> Entries {
+        Entries(Repr::Packed {
+            table: self,
+            first,
+            rest,
+            len,
+            shift: 0,
         })
     }
 
@@ -187,12 +244,15 @@ impl PackedTable {
         self.strings
     }
 
-    /// Bytes of the records, strings, ranges and defaults.
+    /// Bytes of the records, strings, kinds, ranges and defaults.
     pub const fn bytes(&self) -> usize {
         core::mem::size_of_val(self.entries)
             + self.strings.len()
+            + core::mem::size_of_val(self.kinds)
+            + core::mem::size_of_val(self.details)
             + core::mem::size_of_val(self.ranges)
-            + core::mem::size_of_val(self.defaults)
+            + core::mem::size_of_val(self.defaults.small)
+            + core::mem::size_of_val(self.defaults.wide)
     }
 
     /// The entry at position `at`, decoded.
@@ -200,17 +260,63 @@ impl PackedTable {
         self.entries.get(at).map(|p| self.decode(p))
     }
 
+    /// The kind of a record (kind 0 when the table has no such kind).
+    fn kind(&self, p: &PackedEntry) -> u16 {
+        self.kinds
+            .get(p.kind())
+            .copied()
+            .unwrap_or(record::PLACEHOLDER_KIND)
+    }
+
+    /// The data type of a record of kind `kind`.
+    fn type_of(&self, p: &PackedEntry, kind: u16) -> DataType {
+        let n = match record::is_string(kind) {
+            true => self.details.get(p.default()).copied().unwrap_or(0),
+            false => 0,
+        };
+        type_of(kind, n)
+    }
+
+    /// The access of a kind (read-only when the table has none).
+    fn access_of(&self, kind: u16) -> Access {
+        Access(
+            self.details
+                .get(record::access_at(kind))
+                .copied()
+                .unwrap_or(Access::READ),
+        )
+    }
+
+    /// Data type of a record of this table.
+    pub fn data_type(&self, p: &PackedEntry) -> DataType {
+        self.type_of(p, self.kind(p))
+    }
+
+    /// Access rights of a record of this table.
+    pub fn access(&self, p: &PackedEntry) -> Access {
+        self.access_of(self.kind(p))
+    }
+
+    /// Is a record of this table saved by "save values"?
+    pub fn persistent(&self, p: &PackedEntry) -> bool {
+        record::persistent_of(self.kind(p))
+    }
+
     /// The declared default of a record of this table.
     pub fn default_of(&self, p: &PackedEntry) -> i64 {
+        let kind = self.kind(p);
+        if record::is_string(kind) {
+            return 0;
+        }
         self.defaults
-            .get(usize::from(p.default))
-            .map_or(0, |&d| widen(p.data_type(), d))
+            .get(p.default())
+            .map_or(0, |d| widen(self.type_of(p, kind), d))
     }
 
     /// [`EntryInfo::check_range`] of a record of this table.
     pub fn check_range(&self, p: &PackedEntry, value: i64) -> Result<(), crate::SdoAbort> {
-        let t = p.data_type();
-        let (lo, hi) = match self.ranges.get(usize::from(p.range)) {
+        let t = self.data_type(p);
+        let (lo, hi) = match self.ranges.get(p.range()) {
             Some(&[lo, hi]) => (widen(t, lo), widen(t, hi)),
             None => (t.min_value(), t.max_value()),
         };
@@ -227,32 +333,95 @@ impl PackedTable {
 
     /// Decodes a record of this table.
     pub fn decode(&self, p: &PackedEntry) -> EntryInfo {
-        let t = p.data_type();
-        let start = usize::from(p.name);
-        let name = self
-            .strings
-            .get(start..start + usize::from(p.name_len))
-            .unwrap_or("");
-        let (min, max) = match self.ranges.get(usize::from(p.range)) {
+        let kind = self.kind(p);
+        let t = self.type_of(p, kind);
+        let start = p.name_at();
+        let name = self.strings.get(start..start + p.name_len()).unwrap_or("");
+        let (min, max) = match self.ranges.get(p.range()) {
             Some(&[lo, hi]) => (Some(widen(t, lo)), Some(widen(t, hi))),
             None => (None, None),
         };
         EntryInfo {
-            sub: p.sub,
+            sub: p.sub(),
             name,
             data_type: t,
-            access: p.access(),
+            access: self.access_of(kind),
             min,
             max,
             default: self.default_of(p),
-            unit: UNITS
-                .get(usize::from(p.flags >> UNIT_SHIFT))
-                .copied()
-                .unwrap_or(""),
-            persistent: p.flags & PERSISTENT != 0,
+            unit: UNITS.get(record::detail_of(kind)).unwrap_or(""),
+            persistent: record::persistent_of(kind),
         }
     }
 }
+
+/// A record with its table: what the record says, read without decoding the
+/// whole entry (8 bytes, `Copy`).
+#[derive(Debug, Clone, Copy)]
+pub struct PackedRef {
+    table: &'static PackedTable,
+    record: &'static PackedEntry,
+}
+
+const EMPTY: PackedTable = PackedTable::new(&[], "", &[], &[], &[], &[], &[]);
+
+impl PackedRef {
+    /// A reference of no table: [`PackedEntry::UNUSED`] (subindex 0,
+    /// UNSIGNED8, read-only, default 0; placeholder in fixed-size tables).
+    pub const UNUSED: Self = Self {
+        table: &EMPTY,
+        record: &PackedEntry::UNUSED,
+    };
+
+    /// Subindex.
+    pub const fn sub(&self) -> u8 {
+        self.record.sub()
+    }
+
+    /// The record (its table's).
+    pub const fn entry(&self) -> &'static PackedEntry {
+        self.record
+    }
+
+    /// Data type.
+    pub fn data_type(&self) -> DataType {
+        self.table.data_type(self.record)
+    }
+
+    /// Access rights.
+    pub fn access(&self) -> Access {
+        self.table.access(self.record)
+    }
+
+    /// Saved by "save values"?
+    pub fn persistent(&self) -> bool {
+        self.table.persistent(self.record)
+    }
+
+    /// The declared default.
+    pub fn default_value(&self) -> i64 {
+        self.table.default_of(self.record)
+    }
+
+    /// [`EntryInfo::check_range`] of the entry.
+    pub fn check_range(&self, value: i64) -> Result<(), crate::SdoAbort> {
+        self.table.check_range(self.record, value)
+    }
+
+    /// The entry, decoded.
+    pub fn decode(&self) -> EntryInfo {
+        self.table.decode(self.record)
+    }
+}
+
+/// Equal records (as `PackedEntry` values; the table is not compared).
+impl PartialEq for PackedRef {
+    fn eq(&self, other: &Self) -> bool {
+        self.record == other.record
+    }
+}
+
+impl Eq for PackedRef {}
 
 /// The entries of an object: a run of a [`PackedTable`] or a slice.
 #[derive(Clone, Copy)]
@@ -263,8 +432,13 @@ enum Repr {
     Slice(&'static [EntryInfo]),
     Packed {
         table: &'static PackedTable,
-        start: u16,
+        /// the record of position 0
+        first: u16,
+        /// the record of position 1; position p > 0 is at `rest + p - 1`
+        rest: u16,
         len: u16,
+        /// subindex = record subindex - shift
+        shift: u8,
     },
 }
 
@@ -295,14 +469,38 @@ impl Entries {
         self.len() == 0
     }
 
+    /// The record at position `pos`, its table and the subindex shift
+    /// (packed entries).
+    fn at(&self, pos: usize) -> Option<(&'static PackedTable, &'static PackedEntry, u8)> {
+        match self.0 {
+            Repr::Slice(_) => None,
+            Repr::Packed {
+                table,
+                first,
+                rest,
+                len,
+                shift,
+            } if pos < usize::from(len) => {
+                let at = match pos {
+                    0 => usize::from(first),
+                    p => usize::from(rest) + p - 1,
+                };
+                table.entries.get(at).map(|p| (table, p, shift))
+            }
+            Repr::Packed { .. } => None,
+        }
+    }
+
     /// The entry at position `pos` (not subindex), decoded.
     pub fn get(&self, pos: usize) -> Option<EntryInfo> {
         match self.0 {
             Repr::Slice(s) => s.get(pos).copied(),
-            Repr::Packed { table, start, len } if pos < usize::from(len) => {
-                table.get(usize::from(start) + pos)
+            Repr::Packed { .. } => {
+                let (table, p, shift) = self.at(pos)?;
+                let mut e = table.decode(p);
+                e.sub = e.sub.wrapping_sub(shift);
+                Some(e)
             }
-            Repr::Packed { .. } => None,
         }
     }
 
@@ -311,15 +509,16 @@ impl Entries {
         self.get(0)
     }
 
+    /// Subindex of the entry at position `pos` (packed entries).
+    fn sub_at(&self, pos: usize) -> Option<u8> {
+        self.at(pos).map(|(_, p, shift)| p.sub().wrapping_sub(shift))
+    }
+
     /// Position of the entry with subindex `sub` (without decoding).
     pub fn position(&self, sub: u8) -> Option<usize> {
         match self.0 {
             Repr::Slice(s) => s.iter().position(|e| e.sub == sub),
-            Repr::Packed { table, start, len } => {
-                let from = usize::from(start);
-                let run = table.entries.get(from..from + usize::from(len))?;
-                run.iter().position(|p| p.sub == sub)
-            }
+            Repr::Packed { len, .. } => (0..usize::from(len)).find(|&pos| self.sub_at(pos) == Some(sub)),
         }
     }
 
@@ -327,18 +526,17 @@ impl Entries {
     pub fn data_type(&self, pos: usize) -> Option<DataType> {
         match self.0 {
             Repr::Slice(s) => s.get(pos).map(|e| e.data_type),
-            Repr::Packed { .. } => self.record(pos).map(PackedEntry::data_type),
+            Repr::Packed { .. } => self.at(pos).map(|(table, p, _)| table.data_type(p)),
         }
     }
 
-    /// The packed record at position `pos` (`None` for slices).
-    pub fn record(&self, pos: usize) -> Option<&'static PackedEntry> {
-        match self.0 {
-            Repr::Slice(_) => None,
-            Repr::Packed { table, start, len } if pos < usize::from(len) => {
-                table.entries.get(usize::from(start) + pos)
-            }
-            Repr::Packed { .. } => None,
+    /// The packed record at position `pos` with its table (`None` for slices
+    /// and for runs that renumber their records, see
+    /// [`PackedTable::renumbered`]: a record's subindex is its table's).
+    pub fn record(&self, pos: usize) -> Option<PackedRef> {
+        match self.at(pos)? {
+            (table, record, 0) => Some(PackedRef { table, record }),
+            _ => None,
         }
     }
 
@@ -346,11 +544,7 @@ impl Entries {
     pub fn find(&self, sub: u8) -> Option<EntryInfo> {
         match self.0 {
             Repr::Slice(s) => s.iter().find(|e| e.sub == sub).copied(),
-            Repr::Packed { table, start, len } => {
-                let from = usize::from(start);
-                let run = table.entries.get(from..from + usize::from(len))?;
-                run.iter().find(|p| p.sub == sub).map(|p| table.decode(p))
-            }
+            Repr::Packed { .. } => self.get(self.position(sub)?),
         }
     }
 
@@ -358,11 +552,10 @@ impl Entries {
     pub fn max_sub(&self) -> u8 {
         match self.0 {
             Repr::Slice(s) => s.iter().map(|e| e.sub).max().unwrap_or(0),
-            Repr::Packed { table, start, len } => {
-                let from = usize::from(start);
-                let run = table.entries.get(from..from + usize::from(len)).unwrap_or(&[]);
-                run.iter().map(|p| p.sub).max().unwrap_or(0)
-            }
+            Repr::Packed { len, .. } => (0..usize::from(len))
+                .filter_map(|pos| self.sub_at(pos))
+                .max()
+                .unwrap_or(0),
         }
     }
 
@@ -456,6 +649,7 @@ macro_rules! packed_table {
     };
     ($(#[$m:meta])* $vis:vis static $name:ident = $entries:expr; names = $names:expr;) => {
         $(#[$m])*
+        #[allow(long_running_const_eval)]
         $vis static $name: $crate::PackedTable = {
             const PACKED_INPUT: &[$crate::EntryInfo] = $entries;
             #[allow(long_running_const_eval)]
@@ -463,26 +657,44 @@ macro_rules! packed_table {
             #[allow(long_running_const_eval)]
             const EXTRA: &[&str] = $names;
             #[allow(long_running_const_eval)]
-            const S: usize = $crate::packed::string_bytes(PACKED_INPUT, EXTRA);
+            const NAME_LAYOUT: $crate::packed::NameLayout<N> = $crate::packed::name_layout::<N>(PACKED_INPUT);
+            #[allow(long_running_const_eval)]
+            const S: usize = $crate::packed::string_bytes::<N>(&NAME_LAYOUT, PACKED_INPUT, EXTRA);
             #[allow(long_running_const_eval)]
             const R: usize = $crate::packed::range_count::<N>(PACKED_INPUT);
             #[allow(long_running_const_eval)]
-            const D: usize = $crate::packed::default_count::<N>(PACKED_INPUT);
+            const D16: usize = $crate::packed::default_count::<N>(PACKED_INPUT, false);
             #[allow(long_running_const_eval)]
-            static ENTRIES: [$crate::PackedEntry; N] = $crate::packed::entries::<N>(PACKED_INPUT, &RANGES, &DEFAULTS);
+            const D32: usize = $crate::packed::default_count::<N>(PACKED_INPUT, true);
+            #[allow(long_running_const_eval)]
+            const X: usize = $crate::packed::detail_count::<{ 2 * N + 1 }>(PACKED_INPUT);
+            #[allow(long_running_const_eval)]
+            static DETAILS: [u16; X] = $crate::packed::details::<{ 2 * N + 1 }, X>(PACKED_INPUT);
+            #[allow(long_running_const_eval)]
+            const A: usize = $crate::packed::access_count::<{ 2 * N + 1 }>(PACKED_INPUT);
+            #[allow(long_running_const_eval)]
+            const K: usize = $crate::packed::kind_count::<{ N + 1 }>(PACKED_INPUT, &DETAILS, A);
+            #[allow(long_running_const_eval)]
+            static ENTRIES: [$crate::PackedEntry; N] =
+                $crate::packed::entries::<N>(&NAME_LAYOUT, PACKED_INPUT, &KINDS, (&DETAILS, A), &RANGES, (&SMALL_DEFAULTS, &WIDE_DEFAULTS));
+            #[allow(long_running_const_eval)]
+            static KINDS: [u16; K] = $crate::packed::kinds::<{ N + 1 }, K>(PACKED_INPUT, &DETAILS, A);
             #[allow(long_running_const_eval)]
             static RANGES: [[u32; 2]; R] = $crate::packed::ranges::<N, R>(PACKED_INPUT);
             #[allow(long_running_const_eval)]
-            static DEFAULTS: [u32; D] = $crate::packed::defaults::<N, D>(PACKED_INPUT);
+            static SMALL_DEFAULTS: [u16; D16] = $crate::packed::small_defaults::<N, D16>(PACKED_INPUT);
             #[allow(long_running_const_eval)]
-            static STRINGS: [u8; S] = $crate::packed::strings::<S>(PACKED_INPUT, EXTRA);
+            static WIDE_DEFAULTS: [u32; D32] = $crate::packed::wide_defaults::<N, D32>(PACKED_INPUT);
+            #[allow(long_running_const_eval)]
+            static STRINGS: [u8; S] = $crate::packed::strings::<N, S>(&NAME_LAYOUT, PACKED_INPUT, EXTRA);
+            #[allow(long_running_const_eval)]
             const _: () = assert!(::core::str::from_utf8(&STRINGS).is_ok(), "names are UTF-8");
             #[allow(long_running_const_eval)]
             const NAMES: &str = match ::core::str::from_utf8(&STRINGS) {
                 Ok(s) => s,
                 Err(_) => "",
             };
-            $crate::PackedTable::new(&ENTRIES, NAMES, &RANGES, &DEFAULTS)
+            $crate::PackedTable::new(&ENTRIES, NAMES, &KINDS, &DETAILS, &RANGES, &SMALL_DEFAULTS, &WIDE_DEFAULTS)
         };
     };
 }
@@ -509,7 +721,7 @@ mod tests {
 
     #[test]
     fn packs_and_decodes_every_field() {
-        assert_eq!(core::mem::size_of::<PackedEntry>(), 12);
+        assert_eq!(core::mem::size_of::<PackedEntry>(), 6);
         assert_eq!(TABLE.len(), ES.len());
         for (i, e) in ES.iter().enumerate() {
             assert_eq!(TABLE.get(i), Some(*e), "entry {i}");
@@ -523,6 +735,22 @@ mod tests {
         assert_eq!(TABLE.ranges.len(), 2);
     }
 
+    const NUMBERED: &[EntryInfo] = &[
+        EntryInfo::new(0, "Source bit 1", U8, Access::RO),
+        EntryInfo::new(1, "Source bit 10", U8, Access::RO),
+        EntryInfo::new(2, "bit 10", U8, Access::RO),
+        EntryInfo::new(3, "Source", U8, Access::RO),
+    ];
+    packed_table!(static SHARED = NUMBERED;);
+
+    #[test]
+    fn names_that_begin_or_end_another_share_its_bytes() {
+        assert_eq!(SHARED.strings(), "Source bit 10");
+        for (i, e) in NUMBERED.iter().enumerate() {
+            assert_eq!(SHARED.get(i), Some(*e), "entry {i}");
+        }
+    }
+
     #[test]
     fn runs_read_like_slices() {
         let run = TABLE.list(0, 3);
@@ -534,5 +762,12 @@ mod tests {
         assert_eq!(run.max_sub(), 2);
         assert_eq!(run.iter().next_back(), ES.get(2).copied());
         assert_eq!(TABLE.list(3, 2).iter().count(), 2);
+        // sub 0 of the second list, then the first list's elements
+        let joined = TABLE.joined(3, 1, 3);
+        assert_eq!(joined.get(0), ES.get(3).copied());
+        assert_eq!(joined.find(2), ES.get(2).copied());
+        assert_eq!(joined.position(1), Some(1));
+        assert_eq!(joined.max_sub(), 2);
+        assert_eq!(joined.get(3), None);
     }
 }
