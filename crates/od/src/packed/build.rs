@@ -660,7 +660,7 @@ pub const fn kind_count<const MAX: usize>(es: &[EntryInfo], details: &[u16], acc
     collect_kinds::<MAX>(es, details, accesses).1
 }
 
-/// The distinct kinds of `es`, [`PLACEHOLDER_KIND`] first. `K` = [`kind_count`].
+/// The distinct kinds of `es`, `PLACEHOLDER_KIND` first. `K` = [`kind_count`].
 pub const fn kinds<const MAX: usize, const K: usize>(
     es: &[EntryInfo],
     details: &[u16],
