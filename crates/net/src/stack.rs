@@ -151,8 +151,11 @@ pub struct NetStats {
 pub struct NetStack<'a> {
     iface: Interface,
     sockets: SocketSet<'a>,
-    param: SocketHandle,
-    sntp_socket: SocketHandle,
+    /// The parameter service's socket (`None` only if the set had no room, which
+    /// [`SOCKETS`] rules out).
+    param: Option<SocketHandle>,
+    /// The SNTP client's socket (as `param`).
+    sntp_socket: Option<SocketHandle>,
     sntp: SntpClient,
     /// The address in force (the master's, E-096, or DHCP's, E-098).
     ip: Option<Ipv4Cidr>,
@@ -173,7 +176,11 @@ pub struct NetStack<'a> {
 /// The UDP socket of handle `h`: looked up by iterating the set rather than
 /// with `SocketSet::get_mut`, whose `expect` and wrong-type panic are code
 /// on the board even though the stack only passes its own handles.
-fn udp_socket<'s, 'a>(sockets: &'s mut SocketSet<'a>, h: SocketHandle) -> Option<&'s mut udp::Socket<'a>> {
+fn udp_socket<'s, 'a>(
+    sockets: &'s mut SocketSet<'a>,
+    h: Option<SocketHandle>,
+) -> Option<&'s mut udp::Socket<'a>> {
+    let h = h?;
     sockets.iter_mut().find_map(|(k, s)| match s {
         Socket::Udp(u) if k == h => Some(u),
         _ => None,
@@ -189,6 +196,31 @@ fn dhcp_socket<'s, 'a>(
         Socket::Dhcpv4(d) if k == h => Some(d),
         _ => None,
     })
+}
+
+/// Adds `socket` to the set; `None` when the set is full.
+///
+/// With the firmware's smoltcp (feature `patched-smoltcp`, firmware/patches/smoltcp) this is
+/// `SocketSet::try_add`, so the board image has no panic behind it; crates.io's 0.12.0 has only
+/// the panicking `add`, which cannot fail here: [`SOCKETS`] slots take the two fixed sockets
+/// and the DHCP client, which is added only while its handle is `None`.
+fn add_socket<'a, T: smoltcp::socket::AnySocket<'a>>(
+    sockets: &mut SocketSet<'a>,
+    socket: T,
+) -> Option<SocketHandle> {
+    #[cfg(feature = "patched-smoltcp")]
+    return sockets.try_add(socket).ok();
+    #[cfg(not(feature = "patched-smoltcp"))]
+    return Some(sockets.add(socket));
+}
+
+/// Removes the socket of `h` (as [`add_socket`]: `try_remove` with the firmware's smoltcp;
+/// `remove` cannot panic here as `h` is a handle of this set still in it).
+fn remove_socket(sockets: &mut SocketSet<'_>, h: SocketHandle) {
+    #[cfg(feature = "patched-smoltcp")]
+    let _ = sockets.try_remove(h);
+    #[cfg(not(feature = "patched-smoltcp"))]
+    let _ = sockets.remove(h);
 }
 
 /// smoltcp's time: whole µs (truncated, as the callers did before they passed [`Nanos`]).
@@ -240,8 +272,8 @@ impl<'a> NetStack<'a> {
             udp::PacketBuffer::new(sntp_tx_meta.as_mut_slice(), sntp_tx.as_mut_slice()),
         );
         let _ = s.bind(NTP_PORT);
-        let param = sockets.add(p);
-        let sntp_socket = sockets.add(s);
+        let param = add_socket(&mut sockets, p);
+        let sntp_socket = add_socket(&mut sockets, s);
         Self {
             iface,
             sockets,
@@ -329,9 +361,9 @@ impl<'a> NetStack<'a> {
     fn follow_dhcp(&mut self, settings: &NetSettings) {
         let want = settings.dhcp && settings.tunnel_open && !self.ip_from_master;
         match (want, self.dhcp) {
-            (true, None) => self.dhcp = Some(self.sockets.add(dhcpv4::Socket::new())),
+            (true, None) => self.dhcp = add_socket(&mut self.sockets, dhcpv4::Socket::new()),
             (false, Some(h)) => {
-                self.sockets.remove(h);
+                remove_socket(&mut self.sockets, h);
                 self.dhcp = None;
                 self.dhcp_gateway = None;
                 if core::mem::take(&mut self.ip_from_dhcp) {
