@@ -174,3 +174,78 @@ fn e053_four_channels_per_direction_in_op_at_once() {
         assert_eq!(al_status(&sd).await, (OP, 0), "still Op");
     });
 }
+
+/// E-148: F050h (sub 0 = 2) reports the module ident of the PDO
+/// configuration each axis's channel carries: the system module of the
+/// standard layout on both axes by default, the ip module after a master
+/// puts the ip maps into channel 1, a user module (bit 31, the same ident
+/// for the same configuration) for any other mapping, 0 for an empty
+/// channel. The master cannot write it (0601 0002h).
+#[test]
+fn e148_f050_reports_the_module_ident_per_axis() {
+    let sim = line(1);
+    with_master(&sim, async |md, clock| {
+        let group = init(md, clock).await;
+        let sd = group.subdevice(md, 0).unwrap();
+        let standard = drive::module_ident(drive::PdoLayout::Standard);
+        let ip = drive::module_ident(drive::PdoLayout::Ip);
+        assert_eq!(sd.sdo_read::<u8>(0xF050, 0).await.unwrap(), 2);
+        assert_eq!(sd.sdo_read::<u32>(0xF050, 1).await.unwrap(), standard, "axis A");
+        assert_eq!(sd.sdo_read::<u32>(0xF050, 2).await.unwrap(), standard, "axis B");
+        let remap = async |pdo: u16, entries: &[u32]| {
+            sd.sdo_write(pdo, 0, 0u8).await.unwrap();
+            for (s, e) in (1u8..).zip(entries) {
+                sd.sdo_write(pdo, s, *e).await.unwrap();
+            }
+            sd.sdo_write(pdo, 0, entries.len() as u8).await.unwrap();
+        };
+        // the ip layout (cia402.md §6.5.1) in channel 1
+        let (rx, tx) = drive::PdoLayout::Ip.entries();
+        let rx: Vec<u32> = rx.iter().map(|e| e.mapping_value()).collect();
+        let tx: Vec<u32> = tx.iter().map(|e| e.mapping_value()).collect();
+        remap(0x1600, &rx).await;
+        remap(0x1A00, &tx).await;
+        assert_eq!(sd.sdo_read::<u32>(0xF050, 1).await.unwrap(), ip, "axis A in ip");
+        assert_eq!(
+            sd.sdo_read::<u32>(0xF050, 2).await.unwrap(),
+            standard,
+            "axis B unchanged"
+        );
+        // a user configuration
+        remap(0x1A00, &[m(0x6041, 0, 16), m(0x606C, 0, 32)]).await;
+        let user = sd.sdo_read::<u32>(0xF050, 1).await.unwrap();
+        assert_eq!(
+            user & drive::USER_MODULE,
+            drive::USER_MODULE,
+            "{user:08X}h is a user module"
+        );
+        remap(0x1A00, &[m(0x6041, 0, 16), m(0x6064, 0, 32)]).await;
+        let other = sd.sdo_read::<u32>(0xF050, 1).await.unwrap();
+        assert_ne!(other, user, "another configuration, another ident");
+        remap(0x1A00, &[m(0x6041, 0, 16), m(0x606C, 0, 32)]).await;
+        assert_eq!(
+            sd.sdo_read::<u32>(0xF050, 1).await.unwrap(),
+            user,
+            "the same again"
+        );
+        // axis B's channel emptied
+        remap(0x1601, &[]).await;
+        remap(0x1A01, &[]).await;
+        assert_eq!(
+            sd.sdo_read::<u32>(0xF050, 2).await.unwrap(),
+            0,
+            "no module on axis B"
+        );
+        let mut c = CoeClient::new();
+        assert_eq!(
+            c.download(&sd, 0xF050, 1, &ip.to_le_bytes()).await,
+            Err(SdoAbort::READ_ONLY.0)
+        );
+        // (read with the same client: ethercrab's own mailbox counter no longer matches)
+        assert_eq!(
+            c.upload(&sd, 0xF050, 1).await,
+            Ok(user.to_le_bytes().to_vec()),
+            "unchanged"
+        );
+    });
+}

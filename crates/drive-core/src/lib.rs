@@ -39,7 +39,7 @@ pub use dictionary::{
     revision, DriveObjects, ImageError, LiveValues, NoLive, Prepared, Requests, Slot, Template, WithLive,
     LOAD_SIGNATURE, PERSISTENT_IMAGE_BYTES, SAVE_SIGNATURE,
 };
-pub use pdo_maps::{PdoLayout, IP_RX, IP_TX, VL_RX, VL_TX};
+pub use pdo_maps::{module_ident, PdoLayout, IP_RX, IP_TX, USER_MODULE, VL_RX, VL_TX};
 
 /// STOBER's EtherCAT vendor ID (E-005).
 pub const VENDOR_ID: u32 = 0xB9;

@@ -75,7 +75,25 @@ pub const VL_TX: [PdoEntry; 3] = [
     PdoEntry::new(0x6044, 0, DataType::I16, "vl velocity actual value"),
 ];
 
+/// Module ident of a user PDO configuration (bit 31; the low bits are a hash
+/// of the mapping, [`DriveObjects::module_ident`](crate::DriveObjects::module_ident)).
+pub const USER_MODULE: u32 = 0x8000_0000;
+
+/// The ident of the ESI module of `layout` (E-148, E-149): CiA 402's profile
+/// number 0192h in the high word, the layout's number (1…) in the low word.
+pub const fn module_ident(layout: PdoLayout) -> u32 {
+    0x0192_0000
+        | match layout {
+            PdoLayout::Standard => 1,
+            PdoLayout::Ip => 2,
+            PdoLayout::Vl => 3,
+        }
+}
+
 impl PdoLayout {
+    /// Every layout, the system modules of the ESI.
+    pub const ALL: [PdoLayout; 3] = [PdoLayout::Standard, PdoLayout::Ip, PdoLayout::Vl];
+
     /// The RxPDO and TxPDO entries of axis A.
     pub const fn entries(self) -> (&'static [PdoEntry], &'static [PdoEntry]) {
         match self {

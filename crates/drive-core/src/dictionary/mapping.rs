@@ -129,4 +129,52 @@ impl DriveObjects {
             .sum();
         (bits as usize).div_ceil(8)
     }
+
+    /// The module ident of `axis` (0 = A, 1 = B) as F050h reports it (E-148):
+    /// the ident of the ESI module whose PDO configuration axis's channel
+    /// (1600h/1A00h + axis) carries now. One of the system modules
+    /// ([`crate::module_ident`] of a [`crate::PdoLayout`], axis B's with its
+    /// objects at +800h/+8000h), else a user module: [`crate::USER_MODULE`]
+    /// with an FNV-1a hash of the mapping entries in the low 31 bits, the
+    /// same for the same configuration; 0 when both PDOs are empty.
+    pub fn module_ident(&self, axis: u16) -> u32 {
+        let (rx, tx) = (0x1600 + axis, 0x1A00 + axis);
+        if self.mapping(rx).next().is_none() && self.mapping(tx).next().is_none() {
+            return 0;
+        }
+        let shift = |m: u32| -> u32 {
+            let index = (m >> 16) as u16;
+            if axis == 0 {
+                m
+            } else if index >= 0x6000 {
+                m + (u32::from(crate::AXIS_B_CIA402) << 16)
+            } else {
+                m + (u32::from(crate::AXIS_B_MANUFACTURER) << 16)
+            }
+        };
+        for layout in crate::PdoLayout::ALL {
+            let (lrx, ltx) = layout.entries();
+            let same = |pdo: u16, entries: &[od::PdoEntry]| {
+                self.mapping(pdo)
+                    .eq(entries.iter().map(|e| shift(e.mapping_value())))
+            };
+            if same(rx, lrx) && same(tx, ltx) {
+                return crate::module_ident(layout);
+            }
+        }
+        let mut h: u32 = 0x811C_9DC5;
+        for m in self.mapping(rx).chain([0]).chain(self.mapping(tx)) {
+            for b in m.to_le_bytes() {
+                h = (h ^ u32::from(b)).wrapping_mul(0x0100_0193);
+            }
+        }
+        crate::USER_MODULE | (h & !crate::USER_MODULE)
+    }
+
+    /// Puts both axes' [`module_ident`](Self::module_ident) into F050h:01/:02.
+    pub(super) fn refresh_module_idents(&mut self) {
+        for axis in [0u16, 1] {
+            let _ = self.set(0xF050, axis as u8 + 1, i64::from(self.module_ident(axis)));
+        }
+    }
 }

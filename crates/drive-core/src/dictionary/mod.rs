@@ -175,6 +175,7 @@ impl DriveObjects {
             all_accelerations: [records::ALL_ACCELERATIONS_DEFAULT; 2],
         };
         persist::write_defaults(&mut objects.image, |_, _| true);
+        objects.refresh_module_idents();
         objects
     }
 
@@ -466,6 +467,8 @@ impl DriveObjects {
         match (index, sub, value) {
             (0x2000, 1, Some(1)) => self.requests.save = true,
             (0x2009, 1, Some(1)) => self.requests.restart = true,
+            // E-148: F050h follows the axis channels' mapping
+            (0x1600 | 0x1601 | 0x1A00 | 0x1A01, 0, _) => self.refresh_module_idents(),
             _ => {}
         }
     }

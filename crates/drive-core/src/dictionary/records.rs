@@ -244,6 +244,7 @@ impl DriveObjects {
     /// memory at its defaults where it is not kept (restore), and every
     /// window showing its record.
     pub(super) fn records_reloaded(&mut self, restore: bool) {
+        self.refresh_module_idents();
         if restore {
             let memory = [J410, J411, J411 + AXIS_B_MANUFACTURER];
             super::persist::write_defaults(&mut self.image, |index, _| memory.contains(&index));

@@ -341,6 +341,9 @@ pub const COMM: [Object; 22] = [
     .note("A265; counters and times live, from the sync module"),
 ];
 
+/// F050h's default: the module of the standard PDO layout (E-148).
+const STANDARD_MODULE: i64 = crate::module_ident(crate::PdoLayout::Standard) as i64;
+
 /// The modular-device objects (ETG.5000.1, S Tab. 14).
 pub const MDP: [Object; 1] = [Object::new(
     0xF050,
@@ -348,9 +351,10 @@ pub const MDP: [Object; 1] = [Object::new(
     Record,
     entries![
         count_entry(2),
-        e(1, "Module ident axis A", U32, RO),
-        e(2, "Module ident axis B", U32, RO),
+        // (the defaults: the standard layout's module, what both axes carry at start)
+        e(1, "Module ident axis A", U32, RO).default_value(STANDARD_MODULE),
+        e(2, "Module ident axis B", U32, RO).default_value(STANDARD_MODULE),
     ],
     Value::Live,
 )
-.note("live: ident of the ESI module in use per axis")];
+.note("ident of the ESI module of each axis's PDO configuration (E-148)")];
