@@ -23,6 +23,7 @@
 )]
 #![deny(missing_docs)]
 
+pub mod actions;
 pub mod axis;
 pub mod dictionary;
 // the reference reads the notes, which bare-metal builds do not keep

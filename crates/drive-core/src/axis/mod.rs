@@ -398,6 +398,13 @@ impl Axis {
         self.homing.is_referenced() || self.retained
     }
 
+    /// Deletes the reference (I38 "clear reference", the fieldbus action
+    /// E-140): homing's and a retained one; absolute moves need homing again.
+    pub fn clear_reference(&mut self) {
+        self.homing.clear_reference();
+        self.retained = false;
+    }
+
     /// 603Fh error code of the fault being handled (0 = none).
     pub fn error_code(&self) -> u16 {
         self.error_code

@@ -220,6 +220,11 @@ impl DriveObjects {
         self.requests.save = true;
     }
 
+    /// Requests a restart (as A09\[0\] = 1 does).
+    pub fn request_restart(&mut self) {
+        self.requests.restart = true;
+    }
+
     /// The requests set since the last [`take_requests`](Self::take_requests).
     pub fn requests(&self) -> Requests {
         self.requests

@@ -188,6 +188,8 @@ pub struct Drive<F: Flash, B: Flash = NoFlash> {
     last_rx_frames: u32,
     /// The two axes (A, B), stepped by [`Drive::control_cycle`].
     axes: [Axis; 2],
+    /// A75/A69 actions over the fieldbus (E-140), served after each RxPDO.
+    actions: drive_core::actions::Actions,
     /// Each axis' snapshot and slots, read in place by the control cycle.
     axis_caches: [AxisCache; 2],
     /// `Slave::outputs_received` at the previous control cycle (new
@@ -324,6 +326,7 @@ impl<F: Flash, B: Flash> Drive<F, B> {
             last_state: AlState::Init,
             last_rx_frames: 0,
             axes: [Axis::new(0), Axis::new(1)],
+            actions: drive_core::actions::Actions::new(),
             axis_caches: [AxisCache::new(), AxisCache::new()],
             ctl_rx_frames: 0,
             pll: None,
@@ -534,6 +537,13 @@ impl<F: Flash, B: Flash> Drive<F, B> {
             self.update_sync_live();
         }
         self.process_outputs();
+        // E-140: the axes' A75 as the RxPDO (or an SDO) left it
+        let fx = self.actions.serve(&mut self.objects);
+        for (axis, clear) in self.axes.iter_mut().zip(fx.clear_reference) {
+            if clear {
+                axis.clear_reference();
+            }
+        }
         if let Some(loss) = self.slave.take_op_loss() {
             // the slave left Op by itself: event 52 with its EMCY 7500h
             self.raise_event52(event52_cause(loss));

@@ -1,0 +1,375 @@
+//! Actions over the fieldbus (spec §14; E-060, E-140…E-142): per axis the
+//! action control byte A75 in the RxPDO and the action status word A69 in the
+//! TxPDO.
+//!
+//! A75: bit 0 = Execute, bits 1–4 = the action selector (the bit position is
+//! not in the manual: spec §14, our choice). A rising Execute starts the
+//! selected action if its precondition on the axis's device state E48 holds;
+//! the master clears Execute when A69 shows the end, and A69 returns to idle.
+//!
+//! A69 (layout not in the manual either, docs/conformance.md): bits 0–7 the
+//! progress in % (100 at the end), bits 8–11 the selector of the action shown,
+//! bits 12–15 its [`state`].
+//!
+//! Action activation (E-142) is the commissioning option "action activation"
+//! of the axis: here, A75 mapped in the axis's RxPDO channel (1600h for axis A,
+//! 1601h for axis B), which is what that option sets up. A75 written over SDO,
+//! or mapped in another channel, starts nothing ([`state::NOT_ACTIVATED`]).
+
+use crate::params::E48;
+use crate::{parameter_index, DriveObjects, AXIS_B_MANUFACTURER};
+
+/// A75 control byte for actions (axis A; axis B + 8000h).
+pub const A75: u16 = parameter_index(0, 75);
+/// A69 status word for actions (axis A; axis B + 8000h).
+pub const A69: u16 = parameter_index(0, 69);
+/// A00 save values: \[1\] progress, \[2\] result (sub = element + 1).
+const A00: u16 = parameter_index(0, 0);
+
+/// A69 bits 12–15.
+pub mod state {
+    /// Nothing started (Execute low).
+    pub const IDLE: u16 = 0;
+    /// Started, not finished.
+    pub const RUNNING: u16 = 1;
+    /// Finished (progress 100 %).
+    pub const DONE: u16 = 2;
+    /// The precondition on E48 does not hold (E-141): not started.
+    pub const REFUSED: u16 = 3;
+    /// This drive cannot run the action (the motor and brake tests need the
+    /// power stage's measurement functions, not built): not started.
+    pub const NOT_AVAILABLE: u16 = 4;
+    /// Started and failed (e.g. the save found the store broken).
+    pub const FAILED: u16 = 5;
+    /// Action activation is off for the axis (E-142): not started.
+    pub const NOT_ACTIVATED: u16 = 6;
+    /// The selector names no action (0000b, 1111b).
+    pub const UNKNOWN: u16 = 7;
+}
+
+/// The actions of spec §14 by their 4-bit selector.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum Action {
+    /// 0001b, A00 save values.
+    Save,
+    /// 0010b, A09 restart.
+    Restart,
+    /// 0011b, A37 reset memorised values.
+    ResetMemorised,
+    /// 0100b, B300 test brake.
+    TestBrake,
+    /// 0101b, B301 grind brake.
+    GrindBrake,
+    /// 0110b, B302 grind brake 2.
+    GrindBrake2,
+    /// 0111b, I38 clear reference.
+    ClearReference,
+    /// 1000b, I52 delete limit-switch memory.
+    DeleteLimitMemory,
+    /// 1001b, S18 test brake (safety).
+    TestBrakeSafety,
+    /// 1010b, B40 test phase.
+    TestPhase,
+    /// 1011b, B41 calibrate motor.
+    CalibrateMotor,
+    /// 1100b, B42 optimise current controller.
+    OptimiseCurrent,
+    /// 1101b, B43 test winding.
+    TestWinding,
+    /// 1110b, B49 optimise current controller at standstill.
+    OptimiseCurrentStandstill,
+}
+
+impl Action {
+    /// The action of selector `s` (bits 1–4 of A75); `None` for 0000b, 1111b.
+    pub const fn from_selector(s: u8) -> Option<Self> {
+        Some(match s {
+            0b0001 => Action::Save,
+            0b0010 => Action::Restart,
+            0b0011 => Action::ResetMemorised,
+            0b0100 => Action::TestBrake,
+            0b0101 => Action::GrindBrake,
+            0b0110 => Action::GrindBrake2,
+            0b0111 => Action::ClearReference,
+            0b1000 => Action::DeleteLimitMemory,
+            0b1001 => Action::TestBrakeSafety,
+            0b1010 => Action::TestPhase,
+            0b1011 => Action::CalibrateMotor,
+            0b1100 => Action::OptimiseCurrent,
+            0b1101 => Action::TestWinding,
+            0b1110 => Action::OptimiseCurrentStandstill,
+            _ => return None,
+        })
+    }
+
+    /// E-141: whether the action may start in device state `e48` (2 ready
+    /// to switch on, 4 enabled, 7 quick stop).
+    pub const fn may_start(self, e48: i64) -> bool {
+        match self {
+            Action::Save | Action::ResetMemorised | Action::ClearReference | Action::DeleteLimitMemory => {
+                true
+            }
+            Action::Restart => e48 != 4 && e48 != 7,
+            _ => e48 == 2,
+        }
+    }
+}
+
+/// What the caller does for the axes after [`Actions::serve`].
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
+pub struct Effects {
+    /// Clear the axis's reference (I38), per axis.
+    pub clear_reference: [bool; 2],
+}
+
+/// The running action of one axis.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+enum Running {
+    /// The save requested; done when A00 shows progress 100.
+    Save,
+    /// The restart requested; it ends with the restart.
+    Restart,
+}
+
+/// One axis's part: its last Execute bit, the running action, A69.
+#[derive(Debug, Clone, Copy, Default)]
+struct AxisActions {
+    execute: bool,
+    running: Option<Running>,
+    status: u16,
+}
+
+/// The action unit of both axes: the last Execute bits and what runs.
+#[derive(Debug, Clone, Copy, Default)]
+pub struct Actions {
+    axes: [AxisActions; 2],
+}
+
+fn offset(axis: usize) -> u16 {
+    if axis == 0 {
+        0
+    } else {
+        AXIS_B_MANUFACTURER
+    }
+}
+
+/// A69's value.
+const fn status(progress: u16, selector: u8, st: u16) -> u16 {
+    progress | (selector as u16 & 0xF) << 8 | st << 12
+}
+
+impl Actions {
+    /// Idle on both axes.
+    pub const fn new() -> Self {
+        const IDLE: AxisActions = AxisActions {
+            execute: false,
+            running: None,
+            status: 0,
+        };
+        Self { axes: [IDLE; 2] }
+    }
+
+    /// A69 of `axis` as last set.
+    pub fn status(&self, axis: usize) -> u16 {
+        self.axes.get(axis).map_or(0, |a| a.status)
+    }
+
+    /// Whether action activation is on for `axis` (E-142): A75 of the axis
+    /// mapped in its RxPDO channel.
+    pub fn activated(objects: &DriveObjects, axis: usize) -> bool {
+        let a75 = u32::from(A75 + offset(axis));
+        let channel = 0x1600 + axis as u16;
+        objects.mapping(channel).any(|m| m >> 16 == a75)
+    }
+
+    /// One pass after the RxPDO was decoded into `objects`: starts the
+    /// action of a rising Execute, follows a running one, shows A69.
+    pub fn serve(&mut self, objects: &mut DriveObjects) -> Effects {
+        let mut fx = Effects::default();
+        for ((axis, a), clear) in self
+            .axes
+            .iter_mut()
+            .enumerate()
+            .zip(fx.clear_reference.iter_mut())
+        {
+            let off = offset(axis);
+            let a75 = objects.get(A75 + off, 0).unwrap_or(0) as u8;
+            let (execute, selector) = (a75 & 1 != 0, (a75 >> 1) & 0xF);
+            let rising = execute && !a.execute;
+            a.execute = execute;
+            if !execute {
+                // the master ended it (or never started one); a running save
+                // goes on, its result is no longer shown
+                a.status = status(0, 0, state::IDLE);
+            } else if rising {
+                a.status = start(a, objects, axis, selector, clear);
+            } else if let Some(r) = a.running {
+                a.status = follow(objects, r, selector).unwrap_or(a.status);
+                if a.status >> 12 != state::RUNNING {
+                    a.running = None;
+                }
+            }
+            let _ = objects.set(A69 + off, 0, i64::from(a.status));
+        }
+        fx
+    }
+}
+
+/// Starts action `selector` on `axis` (E-140…E-142); returns A69.
+fn start(
+    a: &mut AxisActions,
+    objects: &mut DriveObjects,
+    axis: usize,
+    selector: u8,
+    clear: &mut bool,
+) -> u16 {
+    let Some(action) = Action::from_selector(selector) else {
+        return status(0, selector, state::UNKNOWN);
+    };
+    if !Actions::activated(objects, axis) {
+        return status(0, selector, state::NOT_ACTIVATED);
+    }
+    let e48 = objects.get(E48 + offset(axis), 0).unwrap_or(0);
+    if !action.may_start(e48) {
+        return status(0, selector, state::REFUSED);
+    }
+    match action {
+        Action::Save => {
+            let _ = objects.set(A00, 2, 0);
+            objects.request_save();
+            a.running = Some(Running::Save);
+            status(0, selector, state::RUNNING)
+        }
+        Action::Restart => {
+            objects.request_restart();
+            a.running = Some(Running::Restart);
+            status(0, selector, state::RUNNING)
+        }
+        Action::ClearReference => {
+            *clear = true;
+            status(100, selector, state::DONE)
+        }
+        // A37 (the memorised extreme values) and I52 (the limit-switch
+        // memory) hold nothing in this drive; the tests need the power
+        // stage's measurement functions
+        _ => status(0, selector, state::NOT_AVAILABLE),
+    }
+}
+
+/// A69 of running action `r`; `None` while it runs unchanged.
+fn follow(objects: &DriveObjects, r: Running, selector: u8) -> Option<u16> {
+    match r {
+        Running::Save => {
+            let progress = objects.get(A00, 2).ok()?;
+            if objects.requests().save || progress != 100 {
+                return None;
+            }
+            let failed = objects.get(A00, 3).unwrap_or(0) != 0;
+            Some(if failed {
+                status(100, selector, state::FAILED)
+            } else {
+                status(100, selector, state::DONE)
+            })
+        }
+        Running::Restart => None,
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    #![allow(clippy::unwrap_used)]
+    use super::*;
+
+    fn objects_with_a75_mapped() -> DriveObjects {
+        let mut od = DriveObjects::new();
+        let n = od.get(0x1600, 0).unwrap() as u8;
+        let entry = i64::from(u32::from(A75) << 16 | 8);
+        let _ = od.set(0x1600, 0, 0);
+        od.set(0x1600, n + 1, entry).unwrap();
+        od.set(0x1600, 0, i64::from(n + 1)).unwrap();
+        od
+    }
+
+    fn execute(od: &mut DriveObjects, axis: usize, selector: u8, on: bool) {
+        let v = i64::from(selector << 1 | u8::from(on));
+        od.set(A75 + offset(axis), 0, v).unwrap();
+    }
+
+    #[test]
+    fn e140_save_runs_until_a00_shows_the_end_and_idles_when_execute_drops() {
+        let mut od = objects_with_a75_mapped();
+        let mut a = Actions::new();
+        execute(&mut od, 0, 0b0001, true);
+        a.serve(&mut od);
+        assert_eq!(a.status(0), status(0, 1, state::RUNNING));
+        assert!(od.requests().save);
+        a.serve(&mut od);
+        assert_eq!(a.status(0) >> 12, state::RUNNING, "until the save ends");
+        // the runtime's save: takes the request, shows progress 100 and result 0
+        od.take_requests();
+        od.set(A00, 2, 100).unwrap();
+        od.set(A00, 3, 0).unwrap();
+        a.serve(&mut od);
+        assert_eq!(a.status(0), status(100, 1, state::DONE));
+        assert_eq!(od.get(A69, 0).unwrap(), i64::from(status(100, 1, state::DONE)));
+        execute(&mut od, 0, 0b0001, false);
+        a.serve(&mut od);
+        assert_eq!(a.status(0), 0);
+    }
+
+    #[test]
+    fn e141_preconditions_on_e48() {
+        assert!(!Action::Restart.may_start(4));
+        assert!(!Action::Restart.may_start(7));
+        assert!(Action::Restart.may_start(2));
+        assert!(Action::TestWinding.may_start(2));
+        assert!(!Action::TestWinding.may_start(1));
+        assert!(Action::Save.may_start(4));
+        let mut od = objects_with_a75_mapped();
+        let mut a = Actions::new();
+        od.set(E48, 0, 4).unwrap();
+        execute(&mut od, 0, 0b0010, true);
+        a.serve(&mut od);
+        assert_eq!(a.status(0), status(0, 2, state::REFUSED));
+        assert!(!od.requests().restart, "nothing requested");
+    }
+
+    #[test]
+    fn e142_without_a75_in_the_axis_channel_nothing_starts() {
+        let mut od = DriveObjects::new();
+        let mut a = Actions::new();
+        execute(&mut od, 0, 0b0001, true);
+        a.serve(&mut od);
+        assert_eq!(a.status(0), status(0, 1, state::NOT_ACTIVATED));
+        assert!(!od.requests().save);
+        // axis B's channel does not activate axis A, nor A's axis B
+        execute(&mut od, 1, 0b0111, true);
+        assert_eq!(a.serve(&mut od), Effects::default());
+        assert_eq!(a.status(1) >> 12, state::NOT_ACTIVATED);
+    }
+
+    #[test]
+    fn e140_clear_reference_and_unknown_selectors() {
+        let mut od = objects_with_a75_mapped();
+        let mut a = Actions::new();
+        execute(&mut od, 0, 0b0111, true);
+        let fx = a.serve(&mut od);
+        assert_eq!(fx.clear_reference, [true, false]);
+        assert_eq!(a.status(0), status(100, 7, state::DONE));
+        // held high: no second start
+        assert_eq!(a.serve(&mut od), Effects::default());
+        for s in [0b0000, 0b1111] {
+            execute(&mut od, 0, s, false);
+            a.serve(&mut od);
+            execute(&mut od, 0, s, true);
+            a.serve(&mut od);
+            assert_eq!(a.status(0) >> 12, state::UNKNOWN, "selector {s:04b}");
+        }
+        execute(&mut od, 0, 0, false);
+        a.serve(&mut od);
+        execute(&mut od, 0, 0b1101, true);
+        od.set(E48, 0, 2).unwrap();
+        a.serve(&mut od);
+        assert_eq!(a.status(0) >> 12, state::NOT_AVAILABLE, "test winding in E48 = 2");
+    }
+}
