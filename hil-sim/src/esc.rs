@@ -241,6 +241,18 @@ impl Esc {
         &self.sii
     }
 
+    /// The SII image, to change (a test's damaged EEPROM); the ESC takes it
+    /// over at the next [`reload_sii`](Self::reload_sii).
+    pub fn sii_mut(&mut self) -> &mut [u8] {
+        &mut self.sii
+    }
+
+    /// Loads the configuration area from the SII image as at power on (the
+    /// reload command): alias, PDI and ESC configuration, the checksum check.
+    pub fn reload_sii(&mut self) {
+        self.load_sii_config();
+    }
+
     /// AL status (0x0130) as written by the PDI.
     pub fn al_status(&self) -> u16 {
         self.get_u16(regs::AL_STATUS)

@@ -237,7 +237,8 @@ fn e025_e033_e136_a257_0_error_codes_of_refused_transitions() {
         request(&sd, SAFEOP).await;
         request(&sd, OP).await;
         advance(&sim, 250_000_000);
-        assert_eq!(al_status(&sd).await, (SAFEOP | ERR, 0x001B));
+        // (none at all: 002Bh "no valid inputs and outputs", E-047)
+        assert_eq!(al_status(&sd).await, (SAFEOP | ERR, 0x002B));
         assert_eq!(a257(&sd, 0).await, "Er6 L01 L10");
         request(&sd, SAFEOP | ACK).await;
         assert_eq!(a257(&sd, 0).await, "Er0 L01 L10");

@@ -184,8 +184,10 @@ fn e031_invalid_sm_watchdog_settings_refused_with_001f() {
     });
 }
 
+/// E-033; E-047: refused with 002Bh "no valid inputs and outputs" when no
+/// RxPDO came at all, with 001Bh when it came but not regularly.
 #[test]
-fn e033_safeop_to_op_waits_for_steady_rxpdo_and_refuses_after_200ms() {
+fn e033_e047_safeop_to_op_waits_for_steady_rxpdo_and_refuses_after_200ms() {
     let sim = line(1);
     with_master(&sim, async |md, clock| {
         set(&sim, A258, 0, 50);
@@ -202,8 +204,19 @@ fn e033_safeop_to_op_waits_for_steady_rxpdo_and_refuses_after_200ms() {
         advance(&sim, 150_000_000);
         assert_eq!(
             al_status(&sd).await,
-            (SAFEOP | ERR, AlStatusCode::SM_WATCHDOG.0),
+            (SAFEOP | ERR, AlStatusCode::NO_VALID_IO.0),
             "no RxPDO within 200 ms"
+        );
+
+        // one frame, then none: RxPDO, but not steady: 001Bh
+        request(&sd, OP | ACK).await;
+        assert_eq!(al_status(&sd).await, (SAFEOP, 0), "pending");
+        cycles(md, &group, &sim, 1).await;
+        advance(&sim, 250_000_000);
+        assert_eq!(
+            al_status(&sd).await,
+            (SAFEOP | ERR, AlStatusCode::SM_WATCHDOG.0),
+            "RxPDO not steady within 200 ms"
         );
 
         // a waiting request is granted once the RxPDO runs

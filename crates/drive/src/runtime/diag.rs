@@ -162,7 +162,9 @@ impl<F: Flash, B: Flash> Drive<F, B> {
             return if code == AlStatusCode::SM_WATCHDOG { 4 } else { 3 };
         }
         match code {
-            AlStatusCode::SM_WATCHDOG => 6,
+            // Er6 "regular process data missing": not steady (001Bh) or none
+            // at all (002Bh) at S→O
+            AlStatusCode::SM_WATCHDOG | AlStatusCode::NO_VALID_IO => 6,
             AlStatusCode::INVALID_INPUT_CONFIG => 7,
             AlStatusCode::INVALID_OUTPUT_CONFIG => 8,
             AlStatusCode::INVALID_MAILBOX_CONFIG => self.mailbox_er,

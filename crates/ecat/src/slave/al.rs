@@ -72,6 +72,7 @@ impl Slave {
                     // mode, for the PLL lock; the status stays Safe-Op
                     // without error meanwhile
                     self.pending_op = Some(now);
+                    self.pending_op_frames = self.rx_frames;
                     self.error = false;
                     self.code = AlStatusCode::NO_ERROR;
                     self.write_status(pdi)?;
@@ -115,6 +116,11 @@ impl Slave {
     ) -> Result<Result<(), AlStatusCode>, P::Error> {
         match (from, to) {
             (AlState::Init, AlState::PreOp | AlState::Bootstrap) => {
+                // E-047: the ESC could not load its configuration area from the
+                // SII EEPROM (checksum error, 0502h bit 11): AL 0051h
+                if pdi.read_u16(regs::SII_CONTROL)? & esc::sii::control::CHECKSUM_ERROR != 0 {
+                    return Ok(Err(AlStatusCode::EEPROM_ERROR));
+                }
                 // the bootstrap mailbox is the standard one (the SII says so)
                 let (sm0, sm1) = (pdi.read_sm(0)?, pdi.read_sm(1)?);
                 self.mailbox_fault = esm::faulty_mailbox_sm(self.desc, &sm0, &sm1);
@@ -277,10 +283,16 @@ impl Slave {
                 Err(code)
             } else {
                 // Not stable within 200 ms: refused. The spec names no AL code
-                // (§3.3: 001Bh or 002Bh); 001Bh "SM watchdog" is the one §4 ties to
-                // "no RxPDO received, or not within the tolerated time". The
-                // application's diagnosis tells this refusal by the code and `from`.
-                Err(AlStatusCode::SM_WATCHDOG)
+                // (§3.3: 001Bh or 002Bh). E-047: no RxPDO at all since the
+                // request is 002Bh "no valid inputs and outputs"; RxPDO that
+                // came but not regularly is 001Bh "SM watchdog", the one §4 ties
+                // to "not within the tolerated time". The application's
+                // diagnosis tells this refusal by the code and `from`.
+                if self.rx_frames == self.pending_op_frames {
+                    Err(AlStatusCode::NO_VALID_IO)
+                } else {
+                    Err(AlStatusCode::SM_WATCHDOG)
+                }
             }
         } else {
             return Ok(None);

@@ -126,6 +126,9 @@ pub struct Slave {
     rx_seen: u32,
     /// An S→O request waiting for stable RxPDO since this time (E-033).
     pending_op: Option<Nanos>,
+    /// `rx_frames` when that request came: none since means "no valid
+    /// outputs" (AL 002Bh) rather than "not steady" (001Bh) at the refusal.
+    pending_op_frames: u32,
     /// When Op was last entered (start of the PDO timeout).
     op_entry: Nanos,
     sync: SyncStatus,
@@ -176,6 +179,7 @@ impl Slave {
             rx_times: [Nanos::ZERO; esm::STEADY_FRAMES as usize],
             rx_seen: 0,
             pending_op: None,
+            pending_op_frames: 0,
             op_entry: Nanos::ZERO,
             sync: SyncStatus {
                 k: 1,
