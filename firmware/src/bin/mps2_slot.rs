@@ -49,7 +49,8 @@ fn main() -> ! {
         hprintln!("app: vector table at {:#010x}: not started from a slot", vtor);
         stop(false)
     };
-    let Ok(mut slots) = BootSlots::resume(semiflash::slot_flash(), slot) else {
+    let Ok(mut slots) = BootSlots::resume_with_base(semiflash::slot_flash(), mps2::LAYOUT.region_xip, slot)
+    else {
         hprintln!("app: slot {}: flash read failed", slot_name(slot));
         stop(false)
     };
