@@ -59,8 +59,9 @@ mod verified;
 pub use sign::public_key;
 use sign::CHUNK;
 pub use sign::{
-    ed25519_verify, parse_key_hex, verify_digest, verify_file, verify_image, ImageHasher, ImageHeader,
-    VerifyError, DEV_PUBLIC_KEY, FIRMWARE_KEY_IS_DEVELOPMENT, FIRMWARE_PUBLIC_KEY, IMAGE_FORMAT,
+    boot_api_code, boot_api_result, ed25519_verify, ed25519_verify_builtin, parse_key_hex, verify_digest,
+    verify_file, verify_image, BootApi, ImageHasher, ImageHeader, VerifyError, BOOT_API_MAGIC,
+    BOOT_API_OFFSET, DEV_PUBLIC_KEY, FIRMWARE_KEY_IS_DEVELOPMENT, FIRMWARE_PUBLIC_KEY, IMAGE_FORMAT,
     IMAGE_HEADER_LEN, IMAGE_MAGIC, KEY_LEN, SIGNATURE_LEN, SIGNED_HEADER_LEN,
 };
 

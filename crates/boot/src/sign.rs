@@ -121,7 +121,7 @@ pub struct ImageHeader {
 
 impl ImageHeader {
     /// The unsigned header of `body` (signature all zero): sign it with
-    /// [`ImageHeader::sign`].
+    /// `ImageHeader::sign` (feature `sign`).
     pub fn for_body(body: &[u8], version: u32, load_address: u32, security_counter: u32) -> Self {
         Self {
             length: u32::try_from(body.len()).unwrap_or(u32::MAX),
@@ -289,9 +289,37 @@ pub fn verify_digest(
 /// Built from salty's curve and scalar arithmetic with two parts of our own,
 /// so that no panic site is reachable (`scripts/cross panics`): the SHA-512 is
 /// RustCrypto's `sha2` (salty's own indexes and unwraps where the compiler
-/// cannot prove the bounds), and [`mul`] replaces salty's `Scalar *
+/// cannot prove the bounds), and `mul` replaces salty's `Scalar *
 /// EdwardsPoint` (an indexed bit loop) with the same ladder over iterators.
 pub fn ed25519_verify(
+    public_key: &[u8; KEY_LEN],
+    message: &[u8],
+    signature: &[u8; SIGNATURE_LEN],
+) -> Result<(), VerifyError> {
+    #[cfg(feature = "external-ed25519")]
+    {
+        extern "Rust" {
+            fn sc6_ed25519_verify(
+                public_key: &[u8; KEY_LEN],
+                message: &[u8],
+                signature: &[u8; SIGNATURE_LEN],
+            ) -> Result<(), VerifyError>;
+        }
+        // SAFETY: the feature's contract (see `BootApi`): the binary defines
+        // `sc6_ed25519_verify` as a safe Rust function of exactly this
+        // signature, so the call is an ordinary safe call across crates.
+        #[allow(unsafe_code)]
+        unsafe {
+            sc6_ed25519_verify(public_key, message, signature)
+        }
+    }
+    #[cfg(not(feature = "external-ed25519"))]
+    ed25519_verify_builtin(public_key, message, signature)
+}
+
+/// [`ed25519_verify`] with this crate's own verifier, whatever the features:
+/// what a boot loader offers the running image through its [`BootApi`].
+pub fn ed25519_verify_builtin(
     public_key: &[u8; KEY_LEN],
     message: &[u8],
     signature: &[u8; SIGNATURE_LEN],
@@ -338,6 +366,66 @@ fn mul(scalar: &Scalar, point: &EdwardsPoint) -> EdwardsPoint {
         EdwardsPoint::conditional_swap(&mut p, &mut q, b);
     }
     p
+}
+
+/// The boot loader's services for the running image: a table at a fixed flash
+/// address ([`BOOT_API_OFFSET`] from the boot loader's start), so the image can
+/// verify a download with the boot loader's Ed25519 code instead of linking a
+/// second copy (the board image's flash goal, docs/flashing.md "Signed
+/// images"). An image built with the feature `external-ed25519` defines
+///
+/// ```text
+/// #[no_mangle]
+/// fn sc6_ed25519_verify(public_key: &[u8; 32], message: &[u8], signature: &[u8; 64])
+///     -> Result<(), boot::VerifyError>
+/// ```
+///
+/// which reads this table, checks [`BootApi::magic`] (a missing or older boot
+/// loader: refused, [`VerifyError::Key`]) and calls
+/// [`BootApi::ed25519_verify`]. The boot loader's flash is never erased in the
+/// field, so the table stays where the image expects it.
+#[repr(C)]
+#[derive(Debug, Clone, Copy)]
+pub struct BootApi {
+    /// [`BOOT_API_MAGIC`]: the table's layout and calling convention.
+    pub magic: [u8; 8],
+    /// [`ed25519_verify_builtin`] of the boot loader: `public_key` (32 bytes),
+    /// `message` (`message_len` bytes), `signature` (64 bytes) must be readable
+    /// for the call; returns 0 (verified), 1 (signature), 2 (key).
+    pub ed25519_verify: Option<
+        unsafe extern "C" fn(
+            public_key: *const u8,
+            message: *const u8,
+            message_len: usize,
+            signature: *const u8,
+        ) -> u32,
+    >,
+}
+
+/// Magic and version of the [`BootApi`] table.
+pub const BOOT_API_MAGIC: [u8; 8] = *b"SC6BAPI1";
+
+/// Offset of the [`BootApi`] table from the boot loader's first byte: right
+/// after a vector table of 256 words.
+pub const BOOT_API_OFFSET: u32 = 0x400;
+
+/// The [`BootApi::ed25519_verify`] result of a verification.
+pub const fn boot_api_code(r: Result<(), VerifyError>) -> u32 {
+    match r {
+        Ok(()) => 0,
+        Err(VerifyError::Key) => 2,
+        Err(_) => 1,
+    }
+}
+
+/// The verification result of a [`BootApi::ed25519_verify`] code (anything
+/// but 0 is a refusal).
+pub const fn boot_api_result(code: u32) -> Result<(), VerifyError> {
+    match code {
+        0 => Ok(()),
+        2 => Err(VerifyError::Key),
+        _ => Err(VerifyError::Signature),
+    }
 }
 
 /// Read chunk for the streamed checks (stack).

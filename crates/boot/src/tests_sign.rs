@@ -328,3 +328,22 @@ fn ed25519_verify_agrees_with_salty() {
         assert!(ed25519_verify(&key, &msg, &bad).is_err());
     }
 }
+
+/// The boot loader's table (`BootApi`) carries a verification result as a
+/// code: every refusal stays a refusal on the image's side, a key error stays
+/// a key error.
+#[test]
+fn boot_api_codes_carry_the_verification_result() {
+    for r in [
+        Ok(()),
+        Err(VerifyError::Signature),
+        Err(VerifyError::Key),
+        Err(VerifyError::Header),
+    ] {
+        let back = boot_api_result(boot_api_code(r));
+        assert_eq!(back.is_ok(), r.is_ok());
+        assert_eq!(back == Err(VerifyError::Key), r == Err(VerifyError::Key));
+    }
+    assert_eq!(boot_api_result(7), Err(VerifyError::Signature));
+    assert_eq!(BOOT_API_MAGIC, *b"SC6BAPI1");
+}

@@ -38,8 +38,9 @@
 #![deny(missing_docs)]
 
 pub use boot::{
-    decide, verify_image, BootSlots, Decision, Flash, FlashError, ImageHeader, Slot, SlotState, VerifyError,
-    IMAGE_HEADER_LEN, KEY_LEN,
+    boot_api_code, boot_api_result, decide, ed25519_verify, ed25519_verify_builtin, verify_image, BootApi,
+    BootSlots, Decision, Flash, FlashError, ImageHeader, Slot, SlotState, VerifyError, BOOT_API_MAGIC,
+    BOOT_API_OFFSET, IMAGE_HEADER_LEN, KEY_LEN, SIGNATURE_LEN,
 };
 
 /// The public key images must be signed with, built into the boot loader:

@@ -32,6 +32,10 @@ use cortex_m_semihosting::{debug, hprintln};
 #[path = "../semiflash.rs"]
 mod semiflash;
 
+/// The service table for the running image (`boot::BootApi`).
+#[path = "../bootapi.rs"]
+mod bootapi;
+
 #[panic_handler]
 fn panic(_info: &core::panic::PanicInfo) -> ! {
     hprintln!("boot: panic");

@@ -25,6 +25,10 @@ use bootloader::{
 use cortex_m_rt::entry;
 use defmt_rtt as _;
 
+/// The service table for the running image (`boot::BootApi`).
+#[path = "../bootapi.rs"]
+mod bootapi;
+
 #[panic_handler]
 fn panic(_info: &core::panic::PanicInfo) -> ! {
     defmt::error!("boot: panic");
