@@ -100,6 +100,16 @@ fn main() {
         assert!(layout.contains(from), "{src} has no line `{from}`");
         layout = layout.replace(from, flash_region(&image));
     }
+    if boot_board || boot_mps2 {
+        // the boot loader's service table (boot::BootApi, src/bootapi.rs) at a
+        // fixed address: BOOT_API_OFFSET (0x400) after the start, right after
+        // the vector table; the code follows it
+        layout.push_str(
+            "\n/* the boot loader's service table (boot::BootApi) at ORIGIN(FLASH) + 0x400 (build.rs) */\n\
+             SECTIONS\n{\n  .boot_api ORIGIN(FLASH) + 0x400 :\n  {\n    KEEP(*(.boot_api));\n  } > FLASH\n}\n\
+             INSERT AFTER .vector_table;\n_stext = ORIGIN(FLASH) + 0x440;\n",
+        );
+    }
     fs::write(out.join("memory.x"), layout).expect("write memory layout");
     println!("cargo:rustc-link-search={}", out.display());
     println!("cargo:rerun-if-changed={src}");

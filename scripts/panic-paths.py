@@ -15,7 +15,11 @@ with one shortest call chain from an entry point. Exit status 1 when there is on
 Limits: calls through function pointers (trait objects, `blx reg`) are not
 followed; the core crates use generics, not `dyn`, on the bus paths.
 
-usage: panic-paths.py ELF [--objdump TOOL] [--check] [--allow REGEX]...
+--entry REGEX adds the functions whose names match as entry points (a boot
+loader's service table, boot::BootApi, is called by the running image, not
+through the vector table).
+
+usage: panic-paths.py ELF [--objdump TOOL] [--check] [--allow REGEX]... [--entry REGEX]...
 """
 import argparse
 import collections
@@ -33,9 +37,15 @@ def main():
     ap.add_argument("--objdump")
     ap.add_argument("--check", action="store_true")
     ap.add_argument("--allow", action="append", default=[], help="regex of caller functions whose panic paths are accepted")
+    ap.add_argument("--entry", action="append", default=[], help="regex of further entry points (functions called from outside)")
     args = ap.parse_args()
     calls, _frames, addr_of = parse(args.elf, args.objdump)
-    entries = vector_entries(args.elf, addr_of, args.objdump)
+    entries = set(vector_entries(args.elf, addr_of, args.objdump))
+    for e in args.entry:
+        found = {f for f in set(addr_of.values()) | set(calls) if re.search(e, f)}
+        if not found:
+            sys.exit(f"panic-paths: no function matches --entry {e}")
+        entries |= found
     allow = [re.compile(a) for a in args.allow]
     # breadth-first from the entries, remembering one parent per function
     parent = {e: None for e in entries}

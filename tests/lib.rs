@@ -1010,9 +1010,33 @@ pub use hil_sim::sim::FirmwareFlash as FwFlash;
 /// The firmware slots of a [`FwNode`].
 pub type FwSlots = drive::boot::BootSlots<FwFlash>;
 
-/// An image file as the master downloads it: header (length, CRC-32,
-/// `version`) and a body of `len` bytes derived from `version`.
+/// The secret seed of the development key pair (`keys/dev-ed25519.key`),
+/// whose public key the drive trusts in the simulator.
+pub fn dev_seed() -> [u8; 32] {
+    drive::boot::parse_key_hex(include_str!("../keys/dev-ed25519.key")).expect("keys/dev-ed25519.key")
+}
+
+/// The load address of `slot` of a [`FwNode`]'s firmware flash.
+pub fn fw_load_address(slot: drive::boot::Slot) -> u32 {
+    FwSlots::new(FwFlash::new()).load_address(slot)
+}
+
+/// An image file as the master downloads it: the signed header v2 (length,
+/// CRC-32, `version`, the load address of slot B, security counter 1, the
+/// development key's signature) and a body of `len` bytes derived from
+/// `version`. Slot B is where a [`FwNode::factory`] drive downloads to.
 pub fn firmware_file(version: u32, len: usize) -> Vec<u8> {
+    signed_file(drive::boot::Slot::B, version, 1, len, &dev_seed())
+}
+
+/// [`firmware_file`] for `slot` with security counter `counter`, signed with `seed`.
+pub fn signed_file(
+    slot: drive::boot::Slot,
+    version: u32,
+    counter: u32,
+    len: usize,
+    seed: &[u8; 32],
+) -> Vec<u8> {
     let body: Vec<u8> = (0..len)
         .map(|i| {
             (i as u32)
@@ -1021,9 +1045,9 @@ pub fn firmware_file(version: u32, len: usize) -> Vec<u8> {
                 .to_le_bytes()[3]
         })
         .collect();
-    let mut f = drive::boot::ImageHeader::for_body(&body, version)
-        .to_bytes()
-        .to_vec();
+    let mut h = drive::boot::ImageHeader::for_body(&body, version, fw_load_address(slot), counter);
+    h.sign(&body, seed);
+    let mut f = h.to_bytes().to_vec();
     f.extend_from_slice(&body);
     f
 }
@@ -1044,7 +1068,9 @@ impl FwNode {
     /// the boot decision, then the drive.
     pub fn power_on(param: hil_sim::sim::SimFlash, fw: FwFlash) -> Self {
         let mut slots = FwSlots::new(fw);
-        let boot = slots.boot().expect("boot: read the slots");
+        let boot = slots
+            .boot_verified(&drive::runtime::FIRMWARE_PUBLIC_KEY, 0)
+            .expect("boot: read the slots");
         let mut sii = [0u8; ecat::sii::EEPROM_BYTES];
         let n = ecat::build_sii(&drive::DEVICE, &mut sii).expect("SII");
         Self {
@@ -1055,13 +1081,16 @@ impl FwNode {
     }
 
     /// A drive whose slot A holds a confirmed image of `factory_len` body
-    /// bytes, version 1 (the firmware it was delivered with).
+    /// bytes, version 1, security counter 1 (the firmware it was delivered with).
     pub fn factory(factory_len: usize) -> Self {
         let mut slots = FwSlots::new(FwFlash::new());
         slots.boot().expect("boot");
         slots.begin().expect("begin");
-        slots.write(&firmware_file(1, factory_len)).expect("write");
-        slots.finish().expect("finish");
+        let file = signed_file(drive::boot::Slot::A, 1, 1, factory_len, &dev_seed());
+        slots.write(&file).expect("write");
+        slots
+            .finish_verified(&drive::runtime::FIRMWARE_PUBLIC_KEY)
+            .expect("finish");
         let mut slots = FwSlots::new(slots.into_inner());
         slots.boot().expect("boot");
         slots.confirm().expect("confirm");

@@ -26,6 +26,12 @@
 use cortex_m_rt as _; // the reset handler and vector table; the PAC does not pull it in
 use defmt_rtt as _;
 
+/// Ed25519 through the boot loader's table (`boot::BootApi`): the FoE path's
+/// signature check (`BootSlots::finish_verified`) without a second copy of
+/// the verifier in this image.
+#[path = "bootapi.rs"]
+mod bootapi;
+
 /// A panic masks every interrupt first, so no task can command the power
 /// stage again, switches the power stage off (gate enable low), then
 /// reports over RTT and stops the core. `scripts/cross panics` checks that

@@ -82,7 +82,13 @@ fn file(version: u32) -> Vec<u8> {
                 .to_le_bytes()[3]
         })
         .collect();
-    let mut f = ImageHeader::for_body(&body, version).to_bytes().to_vec();
+    // signed with the development key for slot A, where the download goes
+    // (the flash is empty); the drive verifies it at the end (issue 18)
+    let seed = drive::boot::parse_key_hex(include_str!("../../keys/dev-ed25519.key")).expect("dev key");
+    let load = BootSlots::new(FirmwareFlash::new()).load_address(drive::boot::Slot::A);
+    let mut h = ImageHeader::for_body(&body, version, load, 1);
+    h.sign(&body, &seed);
+    let mut f = h.to_bytes().to_vec();
     f.extend_from_slice(&body);
     f
 }
@@ -98,7 +104,9 @@ fn main() {
     let mut sii = [0u8; ecat::sii::EEPROM_BYTES];
     let n = ecat::build_sii(&drive::DEVICE, &mut sii).expect("SII");
     let mut slots = BootSlots::new(FirmwareFlash::new());
-    slots.boot().expect("boot");
+    slots
+        .boot_verified(&drive::runtime::FIRMWARE_PUBLIC_KEY, 0)
+        .expect("boot");
     let node = FwNode {
         esc: Esc::new(EscConfig::default(), &sii[..n]),
         drive: Drive::with_boot(SimFlash::new(), Some(slots)),

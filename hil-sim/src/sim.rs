@@ -260,8 +260,9 @@ impl SimDrive {
         let esc = Esc::new(EscConfig::default(), sii.get(..len).unwrap_or(&[]));
         let boot = firmware.map(|f| {
             let mut slots = FirmwareSlots::new(f);
-            // a flash in RAM does not fail; nothing to start is "no image"
-            let _ = slots.boot();
+            // a flash in RAM does not fail; nothing to start is "no image";
+            // only images signed with the drive's key start (issue 18)
+            let _ = slots.boot_verified(&drive::runtime::FIRMWARE_PUBLIC_KEY, 0);
             slots
         });
         Self {

@@ -352,9 +352,18 @@ fn foe_image_through_soem_firm_update() {
     let body: Vec<u8> = (0..64 * 1024u32)
         .map(|i| (i.wrapping_mul(2_654_435_761) >> 24) as u8)
         .collect();
-    let good = foe_image::update_file(&body, 2).unwrap();
+    // signed with the development key for slot A, where `serve`'s empty
+    // drive downloads to (issue 18)
+    let seed = drive::boot::parse_key_hex(include_str!("../../keys/dev-ed25519.key")).unwrap();
+    let info = foe_image::ImageInfo {
+        version: 2,
+        load_address: hil_sim::sim::FirmwareSlots::new(hil_sim::sim::FirmwareFlash::new())
+            .load_address(drive::boot::Slot::A),
+        security_counter: 1,
+    };
+    let good = foe_image::update_file(&body, info, &seed).unwrap();
     let mut flipped = good.clone();
-    flipped[16 + 20_000] ^= 0x04;
+    flipped[drive::boot::IMAGE_HEADER_LEN + 20_000] ^= 0x04;
     let truncated = good[..good.len() - 100].to_vec();
     let path = |name: &str| dir.join(name);
     for (name, data) in [("good", &good), ("flipped", &flipped), ("truncated", &truncated)] {

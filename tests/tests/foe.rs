@@ -1,8 +1,10 @@
 //! FoE firmware update through a real master's frames (issue 8): Bootstrap
 //! through Init only, the download of an image into the inactive slot, its
 //! CRC check, the switch at the next power-on, confirmation and rollback, a
-//! cut connection, FoE errors. ethercrab has no FoE: the FoE packets go
-//! through [`drive_tests::RawMailbox`] ([`FoeClient`]).
+//! cut connection, FoE errors. Signed images (issue 18): a changed body or
+//! header, another key, a wrong load address or a lower security counter are
+//! refused through the real FoE path. ethercrab has no FoE: the FoE packets
+//! go through [`drive_tests::RawMailbox`] ([`FoeClient`]).
 #![allow(
     clippy::unwrap_used,
     clippy::expect_used,
@@ -10,11 +12,12 @@
     clippy::indexing_slicing
 )]
 
+use drive::boot::{ImageHeader, IMAGE_HEADER_LEN};
 use drive::boot::{Slot, SlotState};
 use drive_tests::al::{ACK, BOOT, ERR, INIT, PREOP};
 use drive_tests::{
-    al_status, firmware_file, in_boot, init, request, to_boot, with_master_on, FoeClient, FoeReply, FwNode,
-    RawMailbox,
+    al_status, dev_seed, firmware_file, in_boot, init, request, signed_file, to_boot, with_master_on,
+    FoeClient, FoeReply, FwNode, RawMailbox,
 };
 use ecat::foe::{FoeError, FOE_TIMEOUT};
 use ecat::mailbox::MailboxError;
@@ -268,7 +271,8 @@ fn foe_into_a_simulated_drive_with_firmware_slots() {
     let sim = RefCell::new(Simulation::with_nodes(vec![
         hil_sim::sim::SimDrive::with_firmware_slots(),
     ]));
-    let file = firmware_file(3, 30_000);
+    // both slots empty: the download goes to A
+    let file = signed_file(Slot::A, 3, 1, 30_000, &dev_seed());
     with_master_on(&sim, async |md, clock| {
         let group = init(md, clock).await;
         let sd = group.subdevice(md, 0).unwrap();
@@ -290,4 +294,103 @@ fn foe_into_a_simulated_drive_with_firmware_slots() {
     d.power_cycle();
     let slots = d.drive.boot_slots_mut().expect("slots after power-on");
     assert_eq!(slots.active(), Some(pending), "the new image starts");
+}
+
+/// Downloads `file` and checks it was refused with `code` and changed nothing:
+/// slot B empty, the next power-on starts A as before.
+fn refused(sim: &RefCell<Simulation<FwNode>>, what: &str, file: &[u8], code: FoeError) {
+    let r = in_boot(sim, async |_, sd| {
+        FoeClient::new().write_file(&sd, "firmware.efw", file).await
+    });
+    assert_eq!(r, Err(FoeReply::Error(code.0)), "{what}");
+    assert!(!node(sim).slots().downloading(), "{what}");
+    assert_eq!(
+        node(sim).slots().state(Slot::B).unwrap(),
+        SlotState::Empty,
+        "{what}: no VALID mark"
+    );
+    power_cycle(sim);
+    let d = node(sim).boot.unwrap();
+    assert_eq!((d.slot, d.trial, d.rolled_back), (Slot::A, false, None), "{what}");
+}
+
+#[test]
+fn foe_signature_refuses_changed_images_other_keys_wrong_slots_and_downgrades() {
+    let sim = line();
+    let good = firmware_file(2, 20_000);
+    let body = &good[IMAGE_HEADER_LEN..];
+    // one flipped body byte: the CRC fails first (800Ch at the end)
+    let mut flipped = good.clone();
+    flipped[IMAGE_HEADER_LEN + 7_777] ^= 0x08;
+    refused(&sim, "body byte", &flipped, FoeError::CHECKSUM);
+    // the same body with its CRC mended: the signature fails (800Ch)
+    let mut h = ImageHeader::parse(&flipped).unwrap();
+    h.crc = drive::boot::crc32(&flipped[IMAGE_HEADER_LEN..]);
+    flipped[..IMAGE_HEADER_LEN].copy_from_slice(&h.to_bytes());
+    refused(&sim, "body byte, CRC mended", &flipped, FoeError::CHECKSUM);
+    // one flipped header byte (the version): signature (800Ch)
+    let mut header = good.clone();
+    header[13] ^= 0x01;
+    refused(&sim, "header byte", &header, FoeError::CHECKSUM);
+    // signed with another key
+    let other = signed_file(Slot::B, 2, 1, 20_000, &[0x5A; 32]);
+    assert_eq!(&other[IMAGE_HEADER_LEN..], body);
+    refused(&sim, "other key", &other, FoeError::CHECKSUM);
+    // linked for slot A (the running one): 8004h at the header
+    let for_a = signed_file(Slot::A, 2, 1, 20_000, &dev_seed());
+    refused(&sim, "load address", &for_a, FoeError::ILLEGAL);
+    // security counter 0 below the running image's 1: 800Ah at the header
+    let old = signed_file(Slot::B, 2, 0, 20_000, &dev_seed());
+    refused(&sim, "security counter", &old, FoeError::NO_RIGHTS);
+    // an unsigned v1 file (16-byte header): 8004h
+    let mut v1 = good[..16].to_vec();
+    v1.extend_from_slice(body);
+    refused(&sim, "v1 header", &v1, FoeError::ILLEGAL);
+    // and the good file still goes in and starts
+    in_boot(&sim, async |_, sd| {
+        FoeClient::new()
+            .write_file(&sd, "firmware.efw", &good)
+            .await
+            .expect("taken");
+    });
+    assert_eq!(
+        node(&sim).slots().state(Slot::B).unwrap(),
+        SlotState::Pending { seq: 2 }
+    );
+    power_cycle(&sim);
+    let d = node(&sim).boot.unwrap();
+    assert_eq!((d.slot, d.trial), (Slot::B, true));
+}
+
+#[test]
+fn foe_signature_counter_floor_follows_the_running_image() {
+    let sim = line();
+    // counter 3 over the factory's 1: taken, started, confirmed
+    let three = signed_file(Slot::B, 2, 3, 5_000, &dev_seed());
+    in_boot(&sim, async |_, sd| {
+        FoeClient::new()
+            .write_file(&sd, "firmware", &three)
+            .await
+            .expect("taken");
+    });
+    power_cycle(&sim);
+    assert!(node(&sim).drive.confirm_firmware());
+    assert_eq!(node(&sim).slots().security_floor(), 3);
+    // now an image with counter 2 for slot A is a downgrade; 3 is not
+    let two = signed_file(Slot::A, 3, 2, 5_000, &dev_seed());
+    let r = in_boot(&sim, async |_, sd| {
+        FoeClient::new().write_file(&sd, "firmware", &two).await
+    });
+    assert_eq!(r, Err(FoeReply::Error(FoeError::NO_RIGHTS.0)));
+    let same = signed_file(Slot::A, 3, 3, 5_000, &dev_seed());
+    in_boot(&sim, async |_, sd| {
+        FoeClient::new()
+            .write_file(&sd, "firmware", &same)
+            .await
+            .expect("taken");
+    });
+    assert_eq!(
+        node(&sim).slots().state(Slot::A).unwrap(),
+        SlotState::Pending { seq: 3 }
+    );
 }

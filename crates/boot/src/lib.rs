@@ -10,19 +10,27 @@
 //! # The image file (what the master downloads, e.g. over FoE)
 //!
 //! ```text
-//! offset 0   magic "SC6F" u32, body length u32, CRC-32/ISO-HDLC of the body u32,
-//!            version u32 (all LE)                                  = IMAGE_HEADER_LEN bytes
-//! offset 16  body (the firmware), `length` bytes
+//! offset 0   magic "SC6F", body length, CRC-32/ISO-HDLC of the body, version,
+//!            format (2), load address, security counter, reserved (0): u32 LE each
+//! offset 32  Ed25519 signature (64 bytes) of SHA-256(bytes 0..32 ‖ body)
+//! offset 96  body (the firmware), `length` bytes      (IMAGE_HEADER_LEN = 96)
 //! ```
+//!
+//! The load address is where the body is linked to run: the CPU address of the
+//! body in the slot it executes in place from ([`BootSlots::load_address`]), so
+//! an image is built for slot A or for slot B. The security counter is the
+//! downgrade protection: see [`BootSlots::boot_verified`]. Signing and
+//! verification: module `sign` ([`verify_image`], [`BootSlots::verify`]).
 //!
 //! # A slot in flash
 //!
 //! ```text
 //! 0          the image header, padded with FFh to a multiple of Flash::WRITE (H)
-//! H          VALID unit:     "VAL1", sequence u32, 00h padding — written after the CRC check
+//! H          VALID unit:     "VAL1", sequence u32, 00h padding — written after the checks
 //! H + W      TRIED unit:     "TRY1", 00h padding — written by the boot that first runs it
 //! H + 2W     CONFIRMED unit: "CNF1", 00h padding — written by the running image
-//! H + 3W     body
+//! B          body, B = H + 3W rounded up to BODY_ALIGN (1024): a vector table can sit
+//!            at the body's start ([`BootSlots::body_offset`])
 //! ```
 //!
 //! Every mark is one program unit written once after the slot's erase (NOR semantics,
@@ -45,16 +53,25 @@
 
 pub use store::{crc32, Crc32, Flash, FlashError, RamFlash, MAX_WRITE};
 
-/// "SC6F": the image file's magic.
-pub const IMAGE_MAGIC: u32 = 0x4636_4353;
-/// Length of the image file's header.
-pub const IMAGE_HEADER_LEN: usize = 16;
+mod sign;
+mod verified;
+#[cfg(feature = "sign")]
+pub use sign::public_key;
+use sign::CHUNK;
+pub use sign::{
+    boot_api_code, boot_api_result, ed25519_verify, ed25519_verify_builtin, parse_key_hex, verify_digest,
+    verify_file, verify_image, BootApi, ImageHasher, ImageHeader, VerifyError, BOOT_API_MAGIC,
+    BOOT_API_OFFSET, DEV_PUBLIC_KEY, FIRMWARE_KEY_IS_DEVELOPMENT, FIRMWARE_PUBLIC_KEY, IMAGE_FORMAT,
+    IMAGE_HEADER_LEN, IMAGE_MAGIC, KEY_LEN, SIGNATURE_LEN, SIGNED_HEADER_LEN,
+};
+
+/// Alignment of the body in a slot (its offset from the slot's start): enough
+/// for a Cortex-M vector table of up to 256 entries at the body's start.
+pub const BODY_ALIGN: usize = 1024;
 
 const VALID: [u8; 4] = *b"VAL1";
 const TRIED: [u8; 4] = *b"TRY1";
 const CONFIRMED: [u8; 4] = *b"CNF1";
-/// Read chunk for the CRC check (stack).
-const CHUNK: usize = 256;
 
 /// One of the two slots.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
@@ -80,49 +97,6 @@ impl Slot {
             Slot::A => Slot::B,
             Slot::B => Slot::A,
         }
-    }
-}
-
-/// The image file's header.
-#[derive(Debug, Clone, Copy, PartialEq, Eq)]
-pub struct ImageHeader {
-    /// Body length in bytes.
-    pub length: u32,
-    /// CRC-32/ISO-HDLC of the body.
-    pub crc: u32,
-    /// Version of the image (informational).
-    pub version: u32,
-}
-
-impl ImageHeader {
-    /// The header of `body` with `version`.
-    pub fn for_body(body: &[u8], version: u32) -> Self {
-        Self {
-            length: u32::try_from(body.len()).unwrap_or(u32::MAX),
-            crc: crc32(body),
-            version,
-        }
-    }
-
-    /// The header's bytes.
-    pub fn to_bytes(&self) -> [u8; IMAGE_HEADER_LEN] {
-        let mut b = [0u8; IMAGE_HEADER_LEN];
-        for (dst, v) in b
-            .chunks_exact_mut(4)
-            .zip([IMAGE_MAGIC, self.length, self.crc, self.version])
-        {
-            dst.copy_from_slice(&v.to_le_bytes());
-        }
-        b
-    }
-
-    /// Parses a header; `None` when the magic is wrong or `b` is short.
-    pub fn parse(b: &[u8]) -> Option<Self> {
-        (le32(b, 0)? == IMAGE_MAGIC).then_some(Self {
-            length: le32(b, 4)?,
-            crc: le32(b, 8)?,
-            version: le32(b, 12)?,
-        })
     }
 }
 
@@ -249,6 +223,15 @@ pub enum UpdateError {
     Incomplete,
     /// The CRC-32 of the body in flash does not match the header.
     Crc,
+    /// The signature does not verify with the drive's public key
+    /// ([`BootSlots::finish_verified`]).
+    Signature,
+    /// The image is linked for another address than the body of the slot it
+    /// goes to ([`BootSlots::load_address`]).
+    LoadAddress,
+    /// The image's security counter is below the running image's
+    /// ([`BootSlots::security_floor`]): a downgrade.
+    Downgrade,
     /// The flash failed.
     Flash(FlashError),
 }
@@ -256,6 +239,18 @@ pub enum UpdateError {
 impl From<FlashError> for UpdateError {
     fn from(e: FlashError) -> Self {
         UpdateError::Flash(e)
+    }
+}
+
+impl From<VerifyError> for UpdateError {
+    fn from(e: VerifyError) -> Self {
+        match e {
+            VerifyError::Header => UpdateError::BadHeader,
+            VerifyError::Crc => UpdateError::Crc,
+            VerifyError::Signature | VerifyError::Key => UpdateError::Signature,
+            VerifyError::LoadAddress => UpdateError::LoadAddress,
+            VerifyError::Flash(e) => UpdateError::Flash(e),
+        }
     }
 }
 
@@ -284,6 +279,10 @@ pub struct BootSlots<F: Flash> {
     /// The running firmware is on trial (not yet confirmed).
     trial: bool,
     download: Option<Download>,
+    /// CPU address of flash offset 0 (the load addresses of the slots).
+    base: u32,
+    /// Lowest security counter a download may have (see [`BootSlots::security_floor`]).
+    floor: u32,
 }
 
 fn addr(n: usize) -> Result<u32, FlashError> {
@@ -298,11 +297,17 @@ impl<F: Flash> BootSlots<F> {
     /// Header size including padding to the program unit.
     const HEAD: usize = IMAGE_HEADER_LEN.div_ceil(F::WRITE) * F::WRITE;
     /// Offset of the body in a slot.
-    const BODY: usize = Self::HEAD + 3 * F::WRITE;
+    const BODY: usize = (Self::HEAD + 3 * F::WRITE).div_ceil(BODY_ALIGN) * BODY_ALIGN;
 
-    /// The slots over `flash`; nothing runs yet (see [`BootSlots::boot`]). Does not
-    /// touch the flash.
+    /// The slots over `flash` mapped at CPU address 0; nothing runs yet (see
+    /// [`BootSlots::boot`]). Does not touch the flash.
     pub fn new(flash: F) -> Self {
+        Self::with_base(flash, 0)
+    }
+
+    /// The slots over `flash` whose offset 0 the CPU reads at `base` (the
+    /// load addresses of the slots, [`BootSlots::load_address`]).
+    pub fn with_base(flash: F, base: u32) -> Self {
         const {
             assert!(F::WRITE.is_power_of_two() && F::WRITE >= 8 && F::WRITE <= MAX_WRITE);
         }
@@ -311,23 +316,34 @@ impl<F: Flash> BootSlots<F> {
             active: None,
             trial: false,
             download: None,
+            base,
+            floor: 0,
         }
     }
 
     /// The slots as a separate boot loader left them (it ran
     /// [`boot`](Self::boot) and started `slot`): the running image's view,
-    /// on trial unless its slot carries the CONFIRMED mark. Reads (and
-    /// CRC-checks) `slot` only; writes nothing.
+    /// on trial unless its slot carries the CONFIRMED mark, the flash mapped
+    /// at CPU address 0 (see [`resume_with_base`](Self::resume_with_base)).
+    /// Reads (and CRC-checks) `slot` only; writes nothing.
     pub fn resume(flash: F, slot: Slot) -> Result<Self, FlashError> {
-        let mut s = Self::new(flash);
+        Self::resume_with_base(flash, 0, slot)
+    }
+
+    /// [`resume`](Self::resume) with the flash's offset 0 at CPU address
+    /// `base` ([`with_base`](Self::with_base)); the security floor for
+    /// downloads is the running image's security counter.
+    pub fn resume_with_base(flash: F, base: u32, slot: Slot) -> Result<Self, FlashError> {
+        let mut s = Self::with_base(flash, base);
         let state = s.state(slot)?;
         s.active = Some(slot);
         s.trial = matches!(state, SlotState::Trial { .. });
+        s.floor = s.header(slot)?.map_or(0, |h| h.security_counter);
         Ok(s)
     }
 
-    /// Offset of the image body (the firmware's first byte) in a slot:
-    /// the header and the three mark units before it.
+    /// Where the body starts in a slot (bytes from the slot's start): after the
+    /// header and the marks, a multiple of [`BODY_ALIGN`].
     pub const fn body_offset() -> usize {
         Self::BODY
     }
@@ -335,6 +351,19 @@ impl<F: Flash> BootSlots<F> {
     /// Bytes per slot (slot A at 0, slot B at this offset of the region).
     pub const fn slot_len() -> usize {
         Self::SLOT_LEN
+    }
+
+    /// The load address an image for `slot` must have: the CPU address of the
+    /// body in that slot.
+    pub fn load_address(&self, slot: Slot) -> u32 {
+        let off = slot.index() * Self::SLOT_LEN + Self::BODY;
+        self.base.wrapping_add(u32::try_from(off).unwrap_or(u32::MAX))
+    }
+
+    /// The lowest security counter a download may have: the running image's,
+    /// or the higher floor [`BootSlots::boot_verified`] found.
+    pub fn security_floor(&self) -> u32 {
+        self.floor
     }
 
     /// The flash (for tests and fault injection).
@@ -372,6 +401,12 @@ impl<F: Flash> BootSlots<F> {
     /// mark of a pending image and records the slot as the running one.
     pub fn boot(&mut self) -> Result<Option<Decision>, FlashError> {
         let states = self.states()?;
+        self.start(states, 0)
+    }
+
+    /// Runs the decision over `states`; `floor` is the lowest security counter
+    /// for downloads (raised to the running image's).
+    fn start(&mut self, states: [SlotState; 2], floor: u32) -> Result<Option<Decision>, FlashError> {
         let decision = decide(states);
         self.download = None;
         self.active = decision.map(|d| d.slot);
@@ -382,6 +417,11 @@ impl<F: Flash> BootSlots<F> {
             }
             self.trial = d.trial || matches!(state_of(states, d.slot), SlotState::Trial { .. });
         }
+        let running = match decision {
+            Some(d) => self.header(d.slot)?.map_or(0, |h| h.security_counter),
+            None => 0,
+        };
+        self.floor = floor.max(running);
         Ok(decision)
     }
 
@@ -405,11 +445,21 @@ impl<F: Flash> BootSlots<F> {
 
     /// One slot's state; a slot whose body fails its CRC is [`SlotState::Empty`].
     pub fn state(&mut self, slot: Slot) -> Result<SlotState, FlashError> {
-        let base = slot.index() * Self::SLOT_LEN;
-        let mut head = [0u8; IMAGE_HEADER_LEN];
-        self.flash.read(addr(base)?, &mut head)?;
-        let Some(header) = ImageHeader::parse(&head) else {
+        let Some((header, state)) = self.marks(slot)? else {
             return Ok(SlotState::Empty);
+        };
+        if self.body_crc(slot, header.length)? != header.crc {
+            return Ok(SlotState::Empty);
+        }
+        Ok(state)
+    }
+
+    /// The header and the state of `slot` by its marks, the body unchecked
+    /// (`None`: no header, no VALID mark, or a body larger than a slot).
+    fn marks(&mut self, slot: Slot) -> Result<Option<(ImageHeader, SlotState)>, FlashError> {
+        let base = slot.index() * Self::SLOT_LEN;
+        let Some(header) = self.header(slot)? else {
+            return Ok(None);
         };
         let mut marks = [[0u8; 8]; 3];
         for (i, m) in marks.iter_mut().enumerate() {
@@ -417,19 +467,19 @@ impl<F: Flash> BootSlots<F> {
         }
         let [valid, tried, confirmed] = marks;
         if valid.get(..4) != Some(&VALID[..]) || header.length as usize > self.capacity() {
-            return Ok(SlotState::Empty);
-        }
-        if self.body_crc(slot, header.length)? != header.crc {
-            return Ok(SlotState::Empty);
+            return Ok(None);
         }
         let seq = le32(&valid, 4).unwrap_or(0);
-        Ok(if confirmed.get(..4) == Some(&CONFIRMED[..]) {
-            SlotState::Confirmed { seq }
-        } else if tried.get(..4) == Some(&TRIED[..]) {
-            SlotState::Trial { seq }
-        } else {
-            SlotState::Pending { seq }
-        })
+        Ok(Some((
+            header,
+            if confirmed.get(..4) == Some(&CONFIRMED[..]) {
+                SlotState::Confirmed { seq }
+            } else if tried.get(..4) == Some(&TRIED[..]) {
+                SlotState::Trial { seq }
+            } else {
+                SlotState::Pending { seq }
+            },
+        )))
     }
 
     /// The header of the image in `slot` (whatever its state).
@@ -530,6 +580,12 @@ impl<F: Flash> BootSlots<F> {
                 if h.length as usize > self.capacity() {
                     return Err(UpdateError::TooLarge);
                 }
+                if h.load_address != self.load_address(d.slot) {
+                    return Err(UpdateError::LoadAddress);
+                }
+                if h.security_counter < self.floor {
+                    return Err(UpdateError::Downgrade);
+                }
                 d.length = h.length;
                 let mut unit = [0xFFu8; MAX_WRITE];
                 let u = unit.get_mut(..Self::HEAD).ok_or(UpdateError::TooLarge)?;
@@ -579,9 +635,22 @@ impl<F: Flash> BootSlots<F> {
     }
 
     /// Ends the download: checks the length and the CRC-32 of the body as it is in
-    /// flash, then marks the slot pending (VALID with the next sequence number) so
-    /// the next [`boot`](Self::boot) tries it. On an error the slot stays empty.
+    /// flash (not the signature: see [`finish_verified`](Self::finish_verified)),
+    /// then marks the slot pending (VALID with the next sequence number) so the
+    /// next [`boot`](Self::boot) tries it. On an error the slot stays empty.
     pub fn finish(&mut self) -> Result<Slot, UpdateError> {
+        self.finish_with(None)
+    }
+
+    /// [`finish`](Self::finish) that also verifies the image in flash against
+    /// `public_key` ([`BootSlots::verify`]: CRC-32, signature, load address)
+    /// and its security counter against [`security_floor`](Self::security_floor).
+    /// A refused image gets no VALID mark: the slot stays empty.
+    pub fn finish_verified(&mut self, public_key: &[u8; KEY_LEN]) -> Result<Slot, UpdateError> {
+        self.finish_with(Some(public_key))
+    }
+
+    fn finish_with(&mut self, public_key: Option<&[u8; KEY_LEN]>) -> Result<Slot, UpdateError> {
         let mut d = self.download.take().ok_or(UpdateError::NotStarted)?;
         if (d.received as usize) < IMAGE_HEADER_LEN
             || d.received as usize - IMAGE_HEADER_LEN != d.length as usize
@@ -590,8 +659,21 @@ impl<F: Flash> BootSlots<F> {
         }
         self.flush(&mut d)?;
         let header = ImageHeader::parse(&d.header).ok_or(UpdateError::BadHeader)?;
-        if self.body_crc(d.slot, header.length)? != header.crc {
-            return Err(UpdateError::Crc);
+        match public_key {
+            Some(key) => {
+                let h = self.verify(d.slot, key)?;
+                if h != header {
+                    return Err(UpdateError::BadHeader);
+                }
+            }
+            None => {
+                if self.body_crc(d.slot, header.length)? != header.crc {
+                    return Err(UpdateError::Crc);
+                }
+            }
+        }
+        if header.security_counter < self.floor {
+            return Err(UpdateError::Downgrade);
         }
         let seq = match self.state(d.slot.other())?.seq() {
             Some(s) => s.wrapping_add(1),
@@ -629,3 +711,5 @@ impl Flash for NoFlash {
 
 #[cfg(test)]
 mod tests;
+#[cfg(test)]
+mod tests_sign;

@@ -4,23 +4,47 @@ use std::vec::Vec;
 use crate::*;
 use store::RamFlash;
 
-/// 16 sectors of 256 bytes: 2 KiB per slot, capacity 2048 − 16 − 24 bytes.
-type Ram = RamFlash<256, 16>;
+/// 64 sectors of 256 bytes: 8 KiB per slot, the body at 1 KiB.
+pub(crate) type Ram = RamFlash<256, 64>;
 
-fn body(n: u8, len: usize) -> Vec<u8> {
+/// The development key pair's secret seed (keys/dev-ed25519.key).
+pub(crate) fn dev_seed() -> [u8; 32] {
+    parse_key_hex(include_str!("../../../keys/dev-ed25519.key")).unwrap()
+}
+
+/// The load address of `slot` of a [`Ram`] (mapped at 0).
+pub(crate) fn load(slot: Slot) -> u32 {
+    (slot.index() * 32 * 256 + BootSlots::<Ram>::body_offset()) as u32
+}
+
+pub(crate) fn body(n: u8, len: usize) -> Vec<u8> {
     (0..len)
         .map(|i| n.wrapping_mul(31).wrapping_add(i as u8))
         .collect()
 }
 
-fn file(body: &[u8], version: u32) -> Vec<u8> {
-    let mut f = ImageHeader::for_body(body, version).to_bytes().to_vec();
+/// The update file of `body` for `slot`, security counter 0, signed with the
+/// development key.
+pub(crate) fn file_for(slot: Slot, body: &[u8], version: u32) -> Vec<u8> {
+    signed(slot, body, version, 0, &dev_seed())
+}
+
+/// The update file of `body` for `slot` with `counter`, signed with `seed`.
+pub(crate) fn signed(slot: Slot, body: &[u8], version: u32, counter: u32, seed: &[u8; 32]) -> Vec<u8> {
+    let mut h = ImageHeader::for_body(body, version, load(slot), counter);
+    h.sign(body, seed);
+    let mut f = h.to_bytes().to_vec();
     f.extend_from_slice(body);
     f
 }
 
+/// An update file for slot B (where the tests' downloads go after the factory image).
+fn file(body: &[u8], version: u32) -> Vec<u8> {
+    file_for(Slot::B, body, version)
+}
+
 /// Downloads `f` in chunks of `chunk` bytes.
-fn download(s: &mut BootSlots<Ram>, f: &[u8], chunk: usize) -> Result<Slot, UpdateError> {
+pub(crate) fn download(s: &mut BootSlots<Ram>, f: &[u8], chunk: usize) -> Result<Slot, UpdateError> {
     s.begin()?;
     for c in f.chunks(chunk) {
         s.write(c)?;
@@ -28,17 +52,20 @@ fn download(s: &mut BootSlots<Ram>, f: &[u8], chunk: usize) -> Result<Slot, Upda
     s.finish()
 }
 
-fn power_cycle(s: BootSlots<Ram>) -> (BootSlots<Ram>, Option<Decision>) {
+pub(crate) fn power_cycle(s: BootSlots<Ram>) -> (BootSlots<Ram>, Option<Decision>) {
     let mut s = BootSlots::new(s.into_inner());
     let d = s.boot().unwrap();
     (s, d)
 }
 
 /// A device with a confirmed image (version 1) in slot A.
-fn factory() -> BootSlots<Ram> {
+pub(crate) fn factory() -> BootSlots<Ram> {
     let mut s = BootSlots::new(Ram::new());
     assert_eq!(s.boot().unwrap(), None, "empty flash: nothing to start");
-    assert_eq!(download(&mut s, &file(&body(1, 1000), 1), 100), Ok(Slot::A));
+    assert_eq!(
+        download(&mut s, &file_for(Slot::A, &body(1, 1000), 1), 100),
+        Ok(Slot::A)
+    );
     let (mut s, d) = power_cycle(s);
     assert_eq!(d.map(|d| (d.slot, d.trial)), Some((Slot::A, true)));
     s.confirm().unwrap();
@@ -155,12 +182,11 @@ fn cut_download_leaves_the_slot_empty() {
 fn header_length_and_size_checks() {
     let mut s = factory();
     s.begin().unwrap();
-    assert_eq!(s.write(&[0u8; 20]), Err(UpdateError::BadHeader));
+    assert_eq!(s.write(&[0u8; 100]), Err(UpdateError::BadHeader));
     let cap = s.capacity();
     let big = ImageHeader {
         length: cap as u32 + 1,
-        crc: 0,
-        version: 9,
+        ..ImageHeader::for_body(&[], 9, load(Slot::B), 0)
     };
     s.begin().unwrap();
     assert_eq!(s.write(&big.to_bytes()), Err(UpdateError::TooLarge));
@@ -182,6 +208,11 @@ fn no_download_over_the_rollback_target_while_on_trial() {
     assert_eq!(s.begin(), Err(UpdateError::Unconfirmed));
     s.confirm().unwrap();
     assert_eq!(s.begin(), Ok(Slot::A));
+    // and an image for A now goes there
+    assert_eq!(
+        download(&mut s, &file_for(Slot::A, &body(3, 50), 3), 50),
+        Ok(Slot::A)
+    );
 }
 
 #[test]
@@ -189,7 +220,7 @@ fn a_flipped_bit_in_flash_makes_the_slot_unbootable() {
     let mut s = factory();
     download(&mut s, &file(&body(2, 300), 2), 300).unwrap();
     // corrupt one body byte of slot B in flash (bits can only be cleared)
-    let at = 8 * 256 + 16 + 24 + 10;
+    let at = 32 * 256 + 1024 + 10;
     let b = s.flash_mut().bytes_mut().nth(at).unwrap();
     *b &= 0x0F;
     let (_, d) = power_cycle(s);
@@ -212,6 +243,20 @@ fn resume_sees_the_running_slot_as_the_boot_loader_left_it() {
     assert!(!app.on_trial());
     let (_, d) = power_cycle(app);
     assert_eq!(d.map(|d| (d.slot, d.trial)), Some((Slot::B, false)));
-    assert_eq!(BootSlots::<Ram>::body_offset(), 16 + 3 * 8);
-    assert_eq!(BootSlots::<Ram>::slot_len(), 8 * 256);
+    assert_eq!(BootSlots::<Ram>::body_offset(), 1024);
+    assert_eq!(BootSlots::<Ram>::slot_len(), 32 * 256);
+}
+
+#[test]
+fn resume_takes_the_running_images_security_counter_as_the_floor() {
+    let mut s = factory();
+    let f = signed(Slot::B, &body(2, 700), 2, 7, &dev_seed());
+    assert_eq!(download(&mut s, &f, 64), Ok(Slot::B));
+    let (s, _) = power_cycle(s);
+    let mut app = BootSlots::resume(s.into_inner(), Slot::B).unwrap();
+    assert_eq!(app.security_floor(), 7);
+    app.confirm().unwrap();
+    // a download below the running image's counter is refused at the header
+    let older = signed(Slot::A, &body(3, 700), 3, 6, &dev_seed());
+    assert_eq!(download(&mut app, &older, 64), Err(UpdateError::Downgrade));
 }

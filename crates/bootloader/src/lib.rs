@@ -6,7 +6,8 @@
 //!    through [`BootSlots::boot`], which also writes the TRIED mark of a pending
 //!    image (it starts on trial) and rolls back a trial that never confirmed itself;
 //! 2. checks the chosen image ([`check_image`]: the one place where an image is
-//!    judged before it runs);
+//!    judged before it runs), its Ed25519 signature included, against the public
+//!    key built into the boot loader ([`PUBLIC_KEY`]);
 //! 3. starts it in place (direct execute-in-place, as MCUboot's direct-XIP mode
 //!    does): VTOR = the slot's body address, MSP = word 0 of the vector table found
 //!    there, jump to word 1, the reset vector. Images are linked for their slot
@@ -36,7 +37,17 @@
 )]
 #![deny(missing_docs)]
 
-pub use boot::{decide, BootSlots, Decision, Flash, FlashError, ImageHeader, Slot, SlotState};
+pub use boot::{
+    boot_api_code, boot_api_result, decide, ed25519_verify, ed25519_verify_builtin, verify_image, BootApi,
+    BootSlots, Decision, Flash, FlashError, ImageHeader, Slot, SlotState, VerifyError, BOOT_API_MAGIC,
+    BOOT_API_OFFSET, IMAGE_HEADER_LEN, KEY_LEN, SIGNATURE_LEN,
+};
+
+/// The public key images must be signed with, built into the boot loader:
+/// [`boot::FIRMWARE_PUBLIC_KEY`] (the 64 hex digits of `SC6_FIRMWARE_PUBLIC_KEY`
+/// when `crates/boot` is built, else the **development** key
+/// `keys/dev-ed25519.pub`), the same key the application's FoE path checks.
+pub const PUBLIC_KEY: [u8; KEY_LEN] = boot::FIRMWARE_PUBLIC_KEY;
 
 mod mem;
 pub use mem::{MemFlash, Mirror, NoMirror};
@@ -88,6 +99,12 @@ pub enum ImageFault {
     /// The slot holds no image that passes `crates/boot`'s checks (header, VALID
     /// mark, length, CRC-32 of the body).
     NotBootable,
+    /// The Ed25519 signature does not verify with the boot loader's key (signed
+    /// with another key, changed after signing, or unsigned).
+    Signature,
+    /// The header's load address is not the body address of the slot the image
+    /// is in.
+    LoadAddress,
     /// The body address is not a valid VTOR value (bits 6..0 must be zero).
     Misaligned(u32),
     /// Word 0 is not a stack pointer into RAM.
@@ -145,23 +162,31 @@ pub struct Start {
 /// The image check before a start: **the one place where the boot loader judges
 /// an image.**
 ///
-/// Today: the slot must be bootable as `crates/boot` sees it ([`BootSlots::state`]:
+/// The slot must be bootable as `crates/boot` sees it ([`BootSlots::state`]:
 /// image header, VALID mark, length within the slot, CRC-32 of the body; the
-/// [`BootSlots::boot`] before this already ran the same check), the body address a
-/// valid VTOR value, word 0 of its vector table a stack pointer into RAM and word 1
-/// a Thumb address inside the body (an image linked for the other slot fails here).
-///
-/// The signature check (`BootSlots::verify(slot, &key)`, being added to
-/// `crates/boot`) goes here, before the vector table is read.
+/// [`BootSlots::boot`] before this already ran the same check); its image must
+/// verify with `public_key` ([`BootSlots::verify`]: the Ed25519 signature over
+/// SHA-256 of the header and the body as they are in flash, and the header's
+/// load address against the slot's; `slots` must be made with
+/// [`BootSlots::with_base`]`(flash, layout.region_xip)`); then the body address
+/// must be a valid VTOR value, word 0 of its vector table a stack pointer into
+/// RAM and word 1 a Thumb address inside the body (an image linked for the
+/// other slot fails here).
 pub fn check_image<F: Flash>(
     slots: &mut BootSlots<F>,
     slot: Slot,
     layout: &Layout,
+    public_key: &[u8; KEY_LEN],
 ) -> Result<Entry, ImageFault> {
     if slots.state(slot)? == SlotState::Empty {
         return Err(ImageFault::NotBootable);
     }
-    let header = slots.header(slot)?.ok_or(ImageFault::NotBootable)?;
+    let header = slots.verify(slot, public_key).map_err(|e| match e {
+        VerifyError::Signature | VerifyError::Key => ImageFault::Signature,
+        VerifyError::LoadAddress => ImageFault::LoadAddress,
+        VerifyError::Header | VerifyError::Crc => ImageFault::NotBootable,
+        VerifyError::Flash(e) => ImageFault::Flash(e),
+    })?;
     let vtor = layout
         .body_address::<F>(slot)
         .ok_or(ImageFault::Misaligned(u32::MAX))?;
@@ -191,9 +216,9 @@ pub fn check_image<F: Flash>(
 }
 
 /// Power-on: the boot decision ([`BootSlots::boot`]) and the check of the chosen
-/// image ([`check_image`]); when that fails, the other slot if it holds an image
-/// that passes. See [`Outcome`].
-pub fn select<F: Flash>(slots: &mut BootSlots<F>, layout: &Layout) -> Outcome {
+/// image ([`check_image`] with `public_key`); when that fails, the other slot if
+/// it holds an image that passes. See [`Outcome`].
+pub fn select<F: Flash>(slots: &mut BootSlots<F>, layout: &Layout, public_key: &[u8; KEY_LEN]) -> Outcome {
     let (decision, marks_failed) = match slots.boot() {
         Ok(d) => (d, None),
         Err(e) => match slots.states() {
@@ -225,7 +250,7 @@ pub fn select<F: Flash>(slots: &mut BootSlots<F>, layout: &Layout) -> Outcome {
             fallback,
         })
     };
-    match check_image(slots, decision.slot, layout) {
+    match check_image(slots, decision.slot, layout, public_key) {
         Ok(entry) => start(decision.slot, entry, None, slots),
         Err(fault) => {
             // the other slot, if it holds an image that ran before (a pending
@@ -235,7 +260,7 @@ pub fn select<F: Flash>(slots: &mut BootSlots<F>, layout: &Layout) -> Outcome {
                 slots.state(other),
                 Ok(SlotState::Confirmed { .. } | SlotState::Trial { .. })
             );
-            match check_image(slots, other, layout) {
+            match check_image(slots, other, layout, public_key) {
                 Ok(entry) if ran => start(other, entry, Some(fault), slots),
                 _ => Outcome::Halt {
                     error: None,
@@ -275,6 +300,8 @@ pub fn slot_name(s: Slot) -> &'static str {
 pub fn fault_name(f: ImageFault) -> &'static str {
     match f {
         ImageFault::NotBootable => "no bootable image",
+        ImageFault::Signature => "signature does not verify with the boot loader's key",
+        ImageFault::LoadAddress => "header's load address is not this slot's",
         ImageFault::Misaligned(_) => "body address is no VTOR value",
         ImageFault::BadStack(_) => "initial stack pointer outside RAM",
         ImageFault::BadReset(_) => "reset vector outside the image (linked for another slot?)",

@@ -18,10 +18,38 @@ fn body_for(slot: Slot, len: usize, fill: u8) -> Vec<u8> {
     b
 }
 
-fn file(body: &[u8], version: u32) -> Vec<u8> {
-    let mut f = ImageHeader::for_body(body, version).to_bytes().to_vec();
+/// The development key pair's secret seed (keys/dev-ed25519.key).
+fn dev_seed() -> [u8; 32] {
+    boot::parse_key_hex(include_str!("../../../keys/dev-ed25519.key")).unwrap()
+}
+
+/// Another key pair's seed: not the boot loader's.
+const OTHER_SEED: [u8; 32] = [0x5A; 32];
+
+/// The update file of `body` whose header names `slot`'s load address,
+/// signed with `seed`.
+fn signed(slot: Slot, body: &[u8], version: u32, seed: &[u8; 32]) -> Vec<u8> {
+    let load = L.body_address::<Mem>(slot).unwrap();
+    let mut h = ImageHeader::for_body(body, version, load, 0);
+    h.sign(body, seed);
+    let mut f = h.to_bytes().to_vec();
     f.extend_from_slice(body);
     f
+}
+
+/// The update file for `slot`, signed with the development key.
+fn file(slot: Slot, body: &[u8], version: u32) -> Vec<u8> {
+    signed(slot, body, version, &dev_seed())
+}
+
+/// The slots of the QEMU layout over `f`, mapped where the images run.
+fn slots<F: Flash>(f: F) -> BootSlots<F> {
+    BootSlots::with_base(f, L.region_xip)
+}
+
+/// The running image's view of the slots (it was started from `slot`).
+fn resume<F: Flash>(f: F, slot: Slot) -> BootSlots<F> {
+    BootSlots::resume_with_base(f, L.region_xip, slot).unwrap()
 }
 
 fn install<F: Flash>(s: &mut BootSlots<F>, f: &[u8]) -> Result<Slot, boot::UpdateError> {
@@ -41,26 +69,26 @@ fn start_of(o: Outcome) -> Start {
 
 /// Slot A holds a confirmed image (version 1).
 fn factory(mem: &mut [u8]) {
-    let mut s = BootSlots::new(Mem::new(mem, NoMirror));
+    let mut s = slots(Mem::new(mem, NoMirror));
     assert_eq!(
-        install(&mut s, &file(&body_for(Slot::A, 3000, 0xA1), 1)),
+        install(&mut s, &file(Slot::A, &body_for(Slot::A, 3000, 0xA1), 1)),
         Ok(Slot::A)
     );
-    let mut s = BootSlots::new(s.into_inner());
-    let st = start_of(select(&mut s, &L));
+    let mut s = slots(s.into_inner());
+    let st = start_of(select(&mut s, &L, &PUBLIC_KEY));
     assert_eq!((st.slot, st.decision.trial), (Slot::A, true));
-    let mut app = BootSlots::resume(s.into_inner(), Slot::A).unwrap();
+    let mut app = resume(s.into_inner(), Slot::A);
     app.confirm().unwrap();
 }
 
 /// The running image in `slot` installs `f` into the other slot.
 fn update(mem: &mut [u8], running: Slot, f: &[u8]) -> Result<Slot, boot::UpdateError> {
-    let mut app = BootSlots::resume(Mem::new(mem, NoMirror), running).unwrap();
+    let mut app = resume(Mem::new(mem, NoMirror), running);
     install(&mut app, f)
 }
 
 fn boot(mem: &mut [u8]) -> Outcome {
-    select(&mut BootSlots::new(Mem::new(mem, NoMirror)), &L)
+    select(&mut slots(Mem::new(mem, NoMirror)), &L, &PUBLIC_KEY)
 }
 
 fn region() -> Vec<u8> {
@@ -116,13 +144,17 @@ fn a_new_image_starts_on_trial_and_stays_once_confirmed() {
     let mut mem = region();
     factory(&mut mem);
     assert_eq!(
-        update(&mut mem, Slot::A, &file(&body_for(Slot::B, 5000, 0xB2), 2)),
+        update(
+            &mut mem,
+            Slot::A,
+            &file(Slot::B, &body_for(Slot::B, 5000, 0xB2), 2)
+        ),
         Ok(Slot::B)
     );
     let st = start_of(boot(&mut mem));
     assert_eq!((st.slot, st.decision.trial, st.version), (Slot::B, true, 2));
     assert_eq!(st.entry.vtor, 0x1_8400);
-    let mut app = BootSlots::resume(Mem::new(&mut mem, NoMirror), Slot::B).unwrap();
+    let mut app = resume(Mem::new(&mut mem, NoMirror), Slot::B);
     assert!(app.on_trial());
     app.confirm().unwrap();
     for _ in 0..2 {
@@ -135,7 +167,12 @@ fn a_new_image_starts_on_trial_and_stays_once_confirmed() {
 fn an_unconfirmed_image_is_rolled_back_at_the_next_reset() {
     let mut mem = region();
     factory(&mut mem);
-    update(&mut mem, Slot::A, &file(&body_for(Slot::B, 5000, 0xB2), 2)).unwrap();
+    update(
+        &mut mem,
+        Slot::A,
+        &file(Slot::B, &body_for(Slot::B, 5000, 0xB2), 2),
+    )
+    .unwrap();
     assert_eq!(start_of(boot(&mut mem)).slot, Slot::B);
     // B never confirms
     let st = start_of(boot(&mut mem));
@@ -147,15 +184,23 @@ fn an_unconfirmed_image_is_rolled_back_at_the_next_reset() {
 fn a_body_byte_flipped_after_the_download_is_never_started() {
     let mut mem = region();
     factory(&mut mem);
-    update(&mut mem, Slot::A, &file(&body_for(Slot::B, 5000, 0xB2), 2)).unwrap();
+    update(
+        &mut mem,
+        Slot::A,
+        &file(Slot::B, &body_for(Slot::B, 5000, 0xB2), 2),
+    )
+    .unwrap();
     let at = BootSlots::<Mem>::slot_len() + BootSlots::<Mem>::body_offset() + 1234;
     mem[at] ^= 0x10;
     for _ in 0..2 {
         let st = start_of(boot(&mut mem));
         assert_eq!((st.slot, st.decision.trial, st.version), (Slot::A, false, 1));
     }
-    let mut s = BootSlots::new(Mem::new(&mut mem, NoMirror));
-    assert_eq!(check_image(&mut s, Slot::B, &L), Err(ImageFault::NotBootable));
+    let mut s = slots(Mem::new(&mut mem, NoMirror));
+    assert_eq!(
+        check_image(&mut s, Slot::B, &L, &PUBLIC_KEY),
+        Err(ImageFault::NotBootable)
+    );
 }
 
 /// Fails every erase/write from the `left`-th on (a power cut).
@@ -183,7 +228,7 @@ impl<F: Flash> Flash for Cut<F> {
 
 #[test]
 fn a_power_cut_at_any_point_of_a_download_leaves_the_old_image_running() {
-    let f = file(&body_for(Slot::B, 9000, 0xB3), 2);
+    let f = file(Slot::B, &body_for(Slot::B, 9000, 0xB3), 2);
     let mut cuts = 0;
     for left in 0.. {
         let mut mem = region();
@@ -192,7 +237,7 @@ fn a_power_cut_at_any_point_of_a_download_leaves_the_old_image_running() {
             inner: Mem::new(&mut mem, NoMirror),
             left,
         };
-        let mut app = BootSlots::resume(flash, Slot::A).unwrap();
+        let mut app = resume(flash, Slot::A);
         if install(&mut app, &f).is_ok() {
             break;
         }
@@ -213,7 +258,13 @@ fn an_image_linked_for_the_other_slot_is_not_started() {
     let mut mem = region();
     factory(&mut mem);
     // linked for A, downloaded into B
-    update(&mut mem, Slot::A, &file(&body_for(Slot::A, 2000, 0xB4), 2)).unwrap();
+    // (signed, its header naming B's load address: a build mistake)
+    update(
+        &mut mem,
+        Slot::A,
+        &file(Slot::B, &body_for(Slot::A, 2000, 0xB4), 2),
+    )
+    .unwrap();
     let st = start_of(boot(&mut mem));
     assert_eq!(st.slot, Slot::A);
     assert_eq!(st.decision.slot, Slot::B);
@@ -227,12 +278,74 @@ fn an_image_linked_for_the_other_slot_is_not_started() {
 }
 
 #[test]
+fn a_wrongly_signed_image_is_never_started() {
+    let mut mem = region();
+    factory(&mut mem);
+    // valid CRC, load address and vector table; signed with another key
+    let f = signed(Slot::B, &body_for(Slot::B, 5000, 0xB6), 2, &OTHER_SEED);
+    update(&mut mem, Slot::A, &f).unwrap();
+    let st = start_of(boot(&mut mem));
+    assert_eq!((st.slot, st.version), (Slot::A, 1));
+    assert_eq!(
+        (st.decision.slot, st.fallback),
+        (Slot::B, Some(ImageFault::Signature))
+    );
+    // marked TRIED when it was chosen: rolled back from now on, never started
+    for _ in 0..2 {
+        let st = start_of(boot(&mut mem));
+        assert_eq!(
+            (st.slot, st.decision.rolled_back, st.fallback),
+            (Slot::A, Some(Slot::B), None)
+        );
+    }
+    let mut s = slots(Mem::new(&mut mem, NoMirror));
+    assert_eq!(
+        check_image(&mut s, Slot::B, &L, &PUBLIC_KEY),
+        Err(ImageFault::Signature)
+    );
+}
+
+#[test]
+fn a_lone_wrongly_signed_image_halts() {
+    let mut mem = region();
+    let mut s = slots(Mem::new(&mut mem, NoMirror));
+    install(
+        &mut s,
+        &signed(Slot::A, &body_for(Slot::A, 600, 0xC6), 1, &OTHER_SEED),
+    )
+    .unwrap();
+    assert_eq!(
+        boot(&mut mem),
+        Outcome::Halt {
+            error: None,
+            fault: Some((Slot::A, ImageFault::Signature))
+        }
+    );
+}
+
+#[test]
+fn an_image_whose_header_names_another_slot_is_not_started() {
+    let mut mem = region();
+    factory(&mut mem);
+    // the header of slot B's image rewritten to name A's load address and
+    // signed again (the download itself refuses it at the header)
+    let body = body_for(Slot::B, 3000, 0xB7);
+    let mut h = ImageHeader::for_body(&body, 2, L.body_address::<Mem>(Slot::A).unwrap(), 0);
+    h.sign(&body, &dev_seed());
+    update(&mut mem, Slot::A, &file(Slot::B, &body, 2)).unwrap();
+    let b = BootSlots::<Mem>::slot_len();
+    mem[b..b + boot::IMAGE_HEADER_LEN].copy_from_slice(&h.to_bytes());
+    let st = start_of(boot(&mut mem));
+    assert_eq!((st.slot, st.fallback), (Slot::A, Some(ImageFault::LoadAddress)));
+}
+
+#[test]
 fn a_lone_image_with_a_bad_stack_pointer_halts() {
     let mut mem = region();
     let mut body = body_for(Slot::A, 600, 0xC5);
     body[..4].copy_from_slice(&0x1000u32.to_le_bytes());
-    let mut s = BootSlots::new(Mem::new(&mut mem, NoMirror));
-    install(&mut s, &file(&body, 7)).unwrap();
+    let mut s = slots(Mem::new(&mut mem, NoMirror));
+    install(&mut s, &file(Slot::A, &body, 7)).unwrap();
     assert_eq!(
         boot(&mut mem),
         Outcome::Halt {
@@ -264,18 +377,23 @@ impl<F: Flash> Flash for ReadOnly<F> {
 fn without_marks_a_pending_image_is_not_started() {
     let mut mem = region();
     factory(&mut mem);
-    update(&mut mem, Slot::A, &file(&body_for(Slot::B, 5000, 0xB2), 2)).unwrap();
-    let mut s = BootSlots::new(ReadOnly(Mem::new(&mut mem, NoMirror)));
-    let st = start_of(select(&mut s, &L));
+    update(
+        &mut mem,
+        Slot::A,
+        &file(Slot::B, &body_for(Slot::B, 5000, 0xB2), 2),
+    )
+    .unwrap();
+    let mut s = slots(ReadOnly(Mem::new(&mut mem, NoMirror)));
+    let st = start_of(select(&mut s, &L, &PUBLIC_KEY));
     assert_eq!((st.slot, st.decision.trial), (Slot::A, false));
     assert_eq!(st.marks_failed, Some(FlashError::Device));
     // a pending image alone: nothing starts
     let mut mem = region();
-    let mut s = BootSlots::new(Mem::new(&mut mem, NoMirror));
-    install(&mut s, &file(&body_for(Slot::A, 500, 1), 1)).unwrap();
-    let mut s = BootSlots::new(ReadOnly(Mem::new(&mut mem, NoMirror)));
+    let mut s = slots(Mem::new(&mut mem, NoMirror));
+    install(&mut s, &file(Slot::A, &body_for(Slot::A, 500, 1), 1)).unwrap();
+    let mut s = slots(ReadOnly(Mem::new(&mut mem, NoMirror)));
     assert_eq!(
-        select(&mut s, &L),
+        select(&mut s, &L, &PUBLIC_KEY),
         Outcome::Halt {
             error: None,
             fault: None
@@ -298,14 +416,15 @@ impl Mirror for Log {
 fn every_change_reaches_the_mirror_as_it_now_reads() {
     let mut mem = region();
     factory(&mut mem);
-    let mut s = BootSlots::new(mps2::SlotFlash::new(&mut mem, Log::default()));
-    let st = start_of(select(&mut s, &L));
+    let mut s = slots(mps2::SlotFlash::new(&mut mem, Log::default()));
+    let st = start_of(select(&mut s, &L, &PUBLIC_KEY));
     assert_eq!(st.slot, Slot::A);
     // confirmed: the boot writes nothing
     assert!(s.flash_mut().mirror_mut().0.is_empty());
-    let mut app = BootSlots::resume(s.into_inner(), Slot::A).unwrap();
+    let mut app = resume(s.into_inner(), Slot::A);
     app.begin().unwrap();
-    app.write(&file(&body_for(Slot::B, 100, 9), 2)[..16]).unwrap();
+    app.write(&file(Slot::B, &body_for(Slot::B, 100, 9), 2)[..boot::IMAGE_HEADER_LEN])
+        .unwrap();
     let log = &app.flash_mut().mirror_mut().0;
     // erase of B's first sector, then its header unit ("SC6F" starts with 'S')
     assert_eq!(log.as_slice(), &[(0x1_0000, 4096, 0xFF), (0x1_0000, 256, b'S')]);

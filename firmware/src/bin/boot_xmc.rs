@@ -5,7 +5,10 @@
 //! alias, runs the boot decision and the image check (`bootloader::select`)
 //! and starts the chosen image in place from the cached alias: VTOR = the
 //! slot's body, MSP = word 0, jump to word 1. With nothing to start it stays in
-//! a safe loop (interrupts masked, WFI). Log: defmt over RTT.
+//! a safe loop (interrupts masked, WFI). Log: defmt over RTT. The image check
+//! verifies the Ed25519 signature of the image with the key built in
+//! (`bootloader::PUBLIC_KEY`: set `SC6_FIRMWARE_PUBLIC_KEY` for a production
+//! build, else it is the development key).
 //!
 //! **The program-flash driver is a stub**: [`XmcFlash`] reads the memory-mapped
 //! flash, but its erase and write return `FlashError::Device` (the XMC4800's
@@ -16,9 +19,15 @@
 #![no_std]
 #![no_main]
 
-use bootloader::{select, slot_name, xmc4800, BootSlots, Entry, Flash, FlashError, Outcome};
+use bootloader::{
+    fault_name, select, slot_name, xmc4800, BootSlots, Entry, Flash, FlashError, Outcome, PUBLIC_KEY,
+};
 use cortex_m_rt::entry;
 use defmt_rtt as _;
+
+/// The service table for the running image (`boot::BootApi`).
+#[path = "../bootapi.rs"]
+mod bootapi;
 
 #[panic_handler]
 fn panic(_info: &core::panic::PanicInfo) -> ! {
@@ -78,16 +87,17 @@ fn main() -> ! {
         "boot: boot loader (XMC4800), slots at {=u32:#010x}",
         xmc4800::SLOTS_UNCACHED
     );
-    let mut slots = BootSlots::new(XmcFlash);
-    match select(&mut slots, &xmc4800::LAYOUT) {
+    let mut slots = BootSlots::with_base(XmcFlash, xmc4800::LAYOUT.region_xip);
+    match select(&mut slots, &xmc4800::LAYOUT, &PUBLIC_KEY) {
         Outcome::Start(s) => {
             if let Some(r) = s.decision.rolled_back {
                 defmt::warn!("boot: slot {=str} never confirmed: rolled back", slot_name(r));
             }
-            if s.fallback.is_some() {
+            if let Some(f) = s.fallback {
                 defmt::warn!(
-                    "boot: slot {=str} failed the image check",
-                    slot_name(s.decision.slot)
+                    "boot: slot {=str} not started: {=str}",
+                    slot_name(s.decision.slot),
+                    fault_name(f)
                 );
             }
             if s.marks_failed.is_some() {

@@ -13,12 +13,16 @@
 #![no_std]
 #![no_main]
 
-use bootloader::{mps2, slot_name, state_name, BootSlots, SlotState};
+use bootloader::{mps2, slot_name, state_name, BootSlots, SlotState, PUBLIC_KEY};
 use cortex_m_rt::entry;
 use cortex_m_semihosting::{debug, hprintln};
 
 #[path = "../semiflash.rs"]
 mod semiflash;
+
+/// Ed25519 through the boot loader's table (`boot::BootApi`).
+#[path = "../bootapi.rs"]
+mod bootapi;
 
 /// Whether this image confirms itself.
 const CONFIRMS: bool = !cfg!(feature = "mps2-slot-noconfirm");
@@ -49,7 +53,8 @@ fn main() -> ! {
         hprintln!("app: vector table at {:#010x}: not started from a slot", vtor);
         stop(false)
     };
-    let Ok(mut slots) = BootSlots::resume(semiflash::slot_flash(), slot) else {
+    let Ok(mut slots) = BootSlots::resume_with_base(semiflash::slot_flash(), mps2::LAYOUT.region_xip, slot)
+    else {
         hprintln!("app: slot {}: flash read failed", slot_name(slot));
         stop(false)
     };
@@ -62,6 +67,16 @@ fn main() -> ! {
         state_name(state),
         vtor
     );
+    // the download check of the drive's FoE path, on this image's own slot:
+    // Ed25519 by the boot loader's code, through its table
+    match slots.verify(slot, &PUBLIC_KEY) {
+        Ok(_) => hprintln!(
+            "app: slot {} verified with the boot loader's Ed25519 (table at {:#010x})",
+            slot_name(slot),
+            bootapi::BOOT_API_AT
+        ),
+        Err(e) => hprintln!("app: slot {} does not verify: {:?}", slot_name(slot), e),
+    }
     for cycle in 1..=3u32 {
         hprintln!("app: cycle {} ok", cycle);
         if cycle == 1 && slots.on_trial() {

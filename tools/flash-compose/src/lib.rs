@@ -9,13 +9,24 @@
 //! at 0). The slot region is filled the way the drive fills it, by `crates/boot`
 //! itself: a list of [`Step`]s — downloads of update files (`tools/foe-image`'s
 //! output) into the inactive slot with `BootSlots::begin/write/finish`, power-ons
-//! through the boot loader's own decision (`bootloader::select`), confirmations,
-//! and two faults: a body byte flipped after the download, a power cut in the
+//! through the boot loader's own decision (`bootloader::select`, with the key
+//! built into the boot loader, `bootloader::PUBLIC_KEY`), confirmations, and
+//! two faults: a body byte flipped after the download, a power cut in the
 //! middle of one.
+//!
+//! The scenarios' update files are signed (`foe-image make --key
+//! keys/dev-ed25519.key`: the development key the QEMU boot loader is built
+//! with). An install checks only what `BootSlots::finish` checks (header, load
+//! address, length, CRC-32), not the signature, as a programmer writing the
+//! flash would: so a wrongly signed image can reach a slot, and a scenario
+//! shows that the boot loader never starts it (the drive's FoE path refuses
+//! it already, `BootSlots::finish_verified`).
 #![forbid(unsafe_code)]
 
 use boot::{BootSlots, Flash, FlashError, Slot};
-use bootloader::{mps2, select, slot_name, state_name, xmc4800, Layout, MemFlash, NoMirror, Outcome};
+use bootloader::{
+    mps2, select, slot_name, state_name, xmc4800, Layout, MemFlash, NoMirror, Outcome, PUBLIC_KEY,
+};
 
 /// One step of a scenario's history.
 #[derive(Debug, Clone, PartialEq, Eq)]
@@ -206,7 +217,7 @@ fn run_steps<F: Flash + Bytes>(
     steps: &[Step],
     log: &mut dyn FnMut(String),
 ) -> Result<(), String> {
-    let mut slots = BootSlots::new(Cuttable { flash, left: None });
+    let mut slots = BootSlots::with_base(Cuttable { flash, left: None }, layout.region_xip);
     let mut last = None;
     for step in steps {
         match step {
@@ -220,14 +231,15 @@ fn run_steps<F: Flash + Bytes>(
                 ));
             }
             Step::Reset => {
-                let mut s = BootSlots::new(slots.into_inner());
+                let mut s = BootSlots::with_base(slots.into_inner(), layout.region_xip);
                 s.flash_mut().left = None;
-                match select(&mut s, layout) {
+                match select(&mut s, layout, &PUBLIC_KEY) {
                     Outcome::Start(st) => {
                         log(format!("reset: slot {} starts", slot_name(st.slot)));
                         // the running image's view
                         let flash = s.into_inner();
-                        slots = BootSlots::resume(flash, st.slot).map_err(|e| format!("resume: {e:?}"))?;
+                        slots = BootSlots::resume_with_base(flash, layout.region_xip, st.slot)
+                            .map_err(|e| format!("resume: {e:?}"))?;
                     }
                     Outcome::Halt { .. } => {
                         log("reset: nothing to start".into());

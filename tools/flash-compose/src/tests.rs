@@ -1,16 +1,35 @@
 use crate::*;
 use boot::SlotState;
+use bootloader::ImageFault;
+
+/// The development key pair's secret seed (keys/dev-ed25519.key).
+fn dev_seed() -> [u8; 32] {
+    boot::parse_key_hex(include_str!("../../../keys/dev-ed25519.key")).unwrap()
+}
+
+fn info(at: u32, version: u32) -> foe_image::ImageInfo {
+    foe_image::ImageInfo {
+        version,
+        load_address: at,
+        security_counter: 0,
+    }
+}
 
 /// An update file of a body linked for `slot` (vector table: stack at the end
 /// of RAM, reset handler 0x41 into the body).
 fn image(slot: Slot, len: usize, version: u32) -> Vec<u8> {
+    image_signed(slot, len, version, &dev_seed())
+}
+
+/// [`image`] signed with `seed`.
+fn image_signed(slot: Slot, len: usize, version: u32, seed: &[u8; 32]) -> Vec<u8> {
     let at = mps2::LAYOUT
         .body_address::<mps2::SlotFlash<'static, NoMirror>>(slot)
         .unwrap();
     let mut body = vec![0x5A; len];
     body[..4].copy_from_slice(&mps2::LAYOUT.ram_end.to_le_bytes());
     body[4..8].copy_from_slice(&(at + 0x41).to_le_bytes());
-    foe_image::update_file(&body, version).unwrap()
+    foe_image::update_file(&body, info(at, version), seed).unwrap()
 }
 
 fn run(steps: &[Step]) -> (Vec<u8>, Vec<String>) {
@@ -22,12 +41,31 @@ fn run(steps: &[Step]) -> (Vec<u8>, Vec<String>) {
 /// The states of the file's slot region and the slot the boot loader starts.
 fn boot(file: &[u8]) -> ([SlotState; 2], Option<Slot>) {
     let mut region = file[mps2::SLOTS_BASE as usize..].to_vec();
-    let mut s = BootSlots::new(mps2::SlotFlash::new(&mut region, NoMirror));
+    let (states, start) = boot_start(&mut region);
+    (states, start.map(|st| st.slot))
+}
+
+fn boot_start(region: &mut [u8]) -> ([SlotState; 2], Option<bootloader::Start>) {
+    let mut s = BootSlots::with_base(mps2::SlotFlash::new(region, NoMirror), mps2::SLOTS_BASE);
     let states = s.states().unwrap();
-    match select(&mut s, &mps2::LAYOUT) {
-        Outcome::Start(st) => (states, Some(st.slot)),
+    match select(&mut s, &mps2::LAYOUT, &PUBLIC_KEY) {
+        Outcome::Start(st) => (states, Some(st)),
         Outcome::Halt { .. } => (states, None),
     }
+}
+
+#[test]
+fn an_image_signed_with_another_key_is_installed_but_never_started() {
+    let mut steps = factory();
+    steps.push(Step::Install(image_signed(Slot::B, 5000, 2, &[0x33; 32])));
+    let (f, log) = run(&steps);
+    // valid CRC: the slot is pending as crates/boot's marks and CRC see it
+    assert_eq!(log.last().unwrap(), "flash: slot A confirmed, slot B pending");
+    let mut region = f[mps2::SLOTS_BASE as usize..].to_vec();
+    let (_, st) = boot_start(&mut region);
+    let st = st.unwrap();
+    assert_eq!(st.slot, Slot::A);
+    assert_eq!(st.fallback, Some(ImageFault::Signature));
 }
 
 fn factory() -> Vec<Step> {
@@ -114,7 +152,7 @@ fn the_board_file_starts_at_the_boot_loader_and_ends_after_slot_b() {
     body[..4].copy_from_slice(&xmc4800::LAYOUT.ram_end.to_le_bytes());
     body[4..8].copy_from_slice(&(at + 0x41).to_le_bytes());
     let steps = [
-        Step::Install(foe_image::update_file(&body, 9).unwrap()),
+        Step::Install(foe_image::update_file(&body, info(at, 9), &dev_seed()).unwrap()),
         Step::Reset,
         Step::Confirm,
     ];

@@ -1,6 +1,9 @@
 //! The update file of the drive's firmware download (FoE, `docs/flashing.md`):
-//! the image header of `crates/boot` (magic "SC6F", body length, CRC-32 of
-//! the body, version) followed by the body, the flash contents of the image.
+//! the image header v2 of `crates/boot` (magic "SC6F", body length, CRC-32 of
+//! the body, version, format 2, load address, security counter, and the
+//! Ed25519 signature of SHA-256(header bytes 0..32 ‖ body)) followed by the
+//! body, the flash contents of the image. Key pairs: [`generate_seed`],
+//! [`read_key`], [`key_hex`].
 //!
 //! The body comes from a flat binary as it is, or from an ELF: its loadable
 //! segments (program headers of type `PT_LOAD` with file contents) laid out
@@ -10,9 +13,10 @@
 //! differ, nothing else).
 #![forbid(unsafe_code)]
 
-use boot::{ImageHeader, IMAGE_HEADER_LEN};
+use boot::{ImageHeader, VerifyError, IMAGE_HEADER_LEN, KEY_LEN};
 use object::read::elf::{ElfFile32, ProgramHeader as _};
 use object::{elf, Endianness};
+use std::path::{Path, PathBuf};
 
 /// The name a file must start with for the drive to take it
 /// (`drive::runtime::FIRMWARE_FILE`); masters send the file name they are given.
@@ -111,24 +115,78 @@ pub fn is_elf(data: &[u8]) -> bool {
     data.starts_with(&[0x7F, b'E', b'L', b'F'])
 }
 
-/// The update file of `body` with `version`: header, then the body.
-pub fn update_file(body: &[u8], version: u32) -> Result<Vec<u8>, ImageError> {
+/// What goes into the header besides length and CRC.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub struct ImageInfo {
+    /// Version (informational).
+    pub version: u32,
+    /// The address the body is linked to run from (the body of the slot it
+    /// goes to: the drive refuses another with FoE 8004h).
+    pub load_address: u32,
+    /// Security counter (the drive refuses one below its running image's
+    /// with FoE 800Ah).
+    pub security_counter: u32,
+}
+
+/// The update file of `body`: header signed with the secret `seed`, then the body.
+pub fn update_file(body: &[u8], info: ImageInfo, seed: &[u8; KEY_LEN]) -> Result<Vec<u8>, ImageError> {
     if body.is_empty() {
         return Err(ImageError::Empty);
     }
     if body.len() > MAX_BODY {
         return Err(ImageError::TooLarge(body.len() as u64));
     }
+    let mut h = ImageHeader::for_body(body, info.version, info.load_address, info.security_counter);
+    h.sign(body, seed);
     let mut f = Vec::with_capacity(IMAGE_HEADER_LEN + body.len());
-    f.extend_from_slice(&ImageHeader::for_body(body, version).to_bytes());
+    f.extend_from_slice(&h.to_bytes());
     f.extend_from_slice(body);
     Ok(f)
+}
+
+/// A new secret seed (32 bytes) from the operating system's random source.
+pub fn generate_seed() -> Result<[u8; KEY_LEN], String> {
+    let mut seed = [0u8; KEY_LEN];
+    getrandom::fill(&mut seed).map_err(|e| format!("no random numbers from the OS: {e}"))?;
+    Ok(seed)
+}
+
+/// The public key of a secret seed.
+pub fn public_key(seed: &[u8; KEY_LEN]) -> [u8; KEY_LEN] {
+    boot::public_key(seed)
+}
+
+/// A key as the key files hold it: 64 lower-case hex digits and a newline.
+pub fn key_hex(key: &[u8; KEY_LEN]) -> String {
+    let mut s: String = key.iter().map(|b| format!("{b:02x}")).collect();
+    s.push('\n');
+    s
+}
+
+/// Reads a key file (a secret seed or a public key: 64 hex digits).
+pub fn read_key(path: &Path) -> Result<[u8; KEY_LEN], String> {
+    let bytes = std::fs::read(path).map_err(|e| format!("{}: {e}", path.display()))?;
+    boot::parse_key_hex(&String::from_utf8_lossy(&bytes))
+        .ok_or_else(|| format!("{}: not a key file (64 hex digits)", path.display()))
+}
+
+/// The public key file beside the secret `key` file: `NAME.pub` for
+/// `NAME.key`, else `key` with `.pub` appended.
+pub fn pub_path(key: &Path) -> PathBuf {
+    if key.extension().is_some_and(|e| e == "key") {
+        key.with_extension("pub")
+    } else {
+        let mut s = key.as_os_str().to_owned();
+        s.push(".pub");
+        PathBuf::from(s)
+    }
 }
 
 /// What is wrong with an update file, as the drive would find it.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
 pub enum CheckError {
-    /// Shorter than the header, or not the magic "SC6F" (the drive: FoE 8004h).
+    /// Shorter than the header, not the magic "SC6F" or not the header
+    /// format 2 (e.g. an unsigned v1 file; the drive: FoE 8004h).
     Header,
     /// The body is shorter or longer than the header says (800Ch).
     Length {
@@ -144,12 +202,17 @@ pub enum CheckError {
         /// CRC of the body.
         found: u32,
     },
+    /// The signature does not verify with the public key (800Ch).
+    Signature,
 }
 
 impl core::fmt::Display for CheckError {
     fn fmt(&self, f: &mut core::fmt::Formatter<'_>) -> core::fmt::Result {
         match self {
-            CheckError::Header => write!(f, "no image header (magic \"SC6F\"): the drive refuses it with FoE 8004h"),
+            CheckError::Header => write!(
+                f,
+                "no image header v2 (magic \"SC6F\", format 2): the drive refuses it with FoE 8004h"
+            ),
             CheckError::Length { expected, found } => write!(
                 f,
                 "the header names {expected} body bytes, the file has {found}: the drive refuses it with FoE 800Ch"
@@ -158,15 +221,21 @@ impl core::fmt::Display for CheckError {
                 f,
                 "body CRC-32 {found:#010x}, header {expected:#010x}: the drive refuses it with FoE 800Ch"
             ),
+            CheckError::Signature => write!(
+                f,
+                "the signature does not verify with the public key: a drive with that key refuses it with FoE 800Ch"
+            ),
         }
     }
 }
 
 impl std::error::Error for CheckError {}
 
-/// Checks an update file as the drive does at the end of the download;
+/// Checks an update file as the drive does at the end of the download
+/// (header, length, CRC-32 and, with `public_key`, the signature; not the
+/// load address and the security counter, which depend on the drive);
 /// returns its header.
-pub fn check(file: &[u8]) -> Result<ImageHeader, CheckError> {
+pub fn check(file: &[u8], public_key: Option<&[u8; KEY_LEN]>) -> Result<ImageHeader, CheckError> {
     let h = ImageHeader::parse(file).ok_or(CheckError::Header)?;
     let body = file.get(IMAGE_HEADER_LEN..).unwrap_or_default();
     if usize::try_from(h.length).ok() != Some(body.len()) {
@@ -181,6 +250,18 @@ pub fn check(file: &[u8]) -> Result<ImageHeader, CheckError> {
             expected: h.crc,
             found: crc,
         });
+    }
+    if let Some(key) = public_key {
+        match boot::verify_file(file, key) {
+            Ok(_) => {}
+            Err(VerifyError::Crc) => {
+                return Err(CheckError::Crc {
+                    expected: h.crc,
+                    found: crc,
+                })
+            }
+            Err(_) => return Err(CheckError::Signature),
+        }
     }
     Ok(h)
 }

@@ -2,7 +2,9 @@
 //! (Bootstrap, the slots of issue 8): the file of an ELF goes into the
 //! inactive slot and boots on the next power cycle; a truncated or
 //! bit-flipped file is refused with the documented FoE error (800Ch) and
-//! changes nothing.
+//! changes nothing. Signed images (issue 18): the tool signs with a key
+//! file, makes key pairs and verifies with a public key; a file of another
+//! key or linked for the other slot is refused by the drive.
 #![allow(
     clippy::unwrap_used,
     clippy::expect_used,
@@ -11,7 +13,7 @@
 )]
 
 use drive::boot::{Slot, SlotState};
-use drive_tests::{in_boot, FoeClient, FoeReply, FwNode};
+use drive_tests::{fw_load_address, in_boot, FoeClient, FoeReply, FwNode};
 use ecat::foe::FoeError;
 use hil_sim::sim::Simulation;
 use std::cell::RefCell;
@@ -54,15 +56,28 @@ fn pattern(len: usize, seed: u8) -> Vec<u8> {
         .collect()
 }
 
-/// A board-like image: code at the start of flash, the initial values of
-/// .data stored after it (run in RAM), .bss without contents.
+/// The development key files in the repository.
+fn dev_key() -> String {
+    concat!(env!("CARGO_MANIFEST_DIR"), "/../../keys/dev-ed25519.key").to_string()
+}
+fn dev_pub() -> String {
+    concat!(env!("CARGO_MANIFEST_DIR"), "/../../keys/dev-ed25519.pub").to_string()
+}
+
+/// A board-like image linked for the simulated drive's slot B: code at the
+/// start of the slot's body, the initial values of .data stored after it
+/// (run in RAM), .bss without contents.
 fn board_elf() -> (Vec<u8>, Vec<u8>) {
+    board_elf_at(fw_load_address(Slot::B))
+}
+
+fn board_elf_at(base: u32) -> (Vec<u8>, Vec<u8>) {
     let text = pattern(6000, 1);
     let data = pattern(300, 2);
     let elf = elf32(&[
-        (0x0800_0000, 0x0800_0000, text.clone(), 6000),
-        // .data: loaded 0x800 bytes after the code, run at 0x2000_0000
-        (0x0800_2000, 0x2000_0000, data.clone(), 300),
+        (base, base, text.clone(), 6000),
+        // .data: loaded 0x2000 bytes after the code's start, run at 0x2000_0000
+        (base + 0x2000, 0x2000_0000, data.clone(), 300),
         // .bss: no bytes in the file
         (0x2000_0200, 0x2000_0200, Vec::new(), 4096),
     ]);
@@ -86,9 +101,18 @@ fn temp_dir(name: &str) -> PathBuf {
 }
 
 fn make(dir: &Path, input: &[u8], version: u32) -> Vec<u8> {
+    // the factory image of FwNode has security counter 1
+    make_with(dir, input, version, &dev_key(), &["--security-counter", "1"])
+}
+
+fn make_with(dir: &Path, input: &[u8], version: u32, key: &str, extra: &[&str]) -> Vec<u8> {
     let elf = dir.join("board.elf");
     std::fs::write(&elf, input).unwrap();
-    let out = tool(&["make", "--version", &version.to_string(), elf.to_str().unwrap()]);
+    let v = version.to_string();
+    let mut args = vec!["make", "--version", &v, "--key", key];
+    args.extend_from_slice(extra);
+    args.push(elf.to_str().unwrap());
+    let out = tool(&args);
     let stdout = String::from_utf8_lossy(&out.stdout);
     assert!(
         out.status.success(),
@@ -115,7 +139,8 @@ fn foe_image_of_an_elf_boots_from_the_inactive_slot() {
     let dir = temp_dir("boot");
     let (elf, body) = board_elf();
     let file = make(&dir, &elf, 7);
-    // header: magic, body length, CRC-32 of the body, version; then the body
+    // header v2: magic, body length, CRC-32 of the body, version, format,
+    // load address, security counter, reserved, signature; then the body
     assert_eq!(&file[..4], b"SC6F");
     assert_eq!(
         u32::from_le_bytes(file[4..8].try_into().unwrap()) as usize,
@@ -126,14 +151,30 @@ fn foe_image_of_an_elf_boots_from_the_inactive_slot() {
         drive::boot::crc32(&body)
     );
     assert_eq!(u32::from_le_bytes(file[12..16].try_into().unwrap()), 7);
+    assert_eq!(u32::from_le_bytes(file[16..20].try_into().unwrap()), 2);
     assert_eq!(
-        &file[16..],
+        u32::from_le_bytes(file[20..24].try_into().unwrap()),
+        fw_load_address(Slot::B),
+        "the ELF's lowest load address"
+    );
+    assert_eq!(u32::from_le_bytes(file[24..28].try_into().unwrap()), 1);
+    assert!(drive::boot::verify_file(&file, &drive::boot::DEV_PUBLIC_KEY).is_ok());
+    assert_eq!(
+        &file[drive::boot::IMAGE_HEADER_LEN..],
         &body[..],
         "segments at their load addresses, gap FFh"
     );
-    // the tool's own check agrees
+    // the tool's own check agrees, with and without the public key
     let out = tool(&["check", dir.join("firmware.sc6f").to_str().unwrap()]);
     assert!(out.status.success());
+    let out = tool(&[
+        "check",
+        "--pub",
+        &dev_pub(),
+        dir.join("firmware.sc6f").to_str().unwrap(),
+    ]);
+    assert!(out.status.success());
+    assert!(String::from_utf8_lossy(&out.stdout).contains("signature verified"));
     let sim = line();
     let s = &sim;
     let node = move || std::cell::RefMut::map(s.borrow_mut(), |s| &mut s.drives_mut()[0]);
@@ -164,7 +205,7 @@ fn foe_image_truncated_or_flipped_is_refused_and_changes_nothing() {
     let (elf, _) = board_elf();
     let file = make(&dir, &elf, 7);
     let mut flipped = file.clone();
-    flipped[16 + 4321] ^= 0x10;
+    flipped[drive::boot::IMAGE_HEADER_LEN + 4321] ^= 0x10;
     let truncated = &file[..file.len() - 100];
     for (what, bad) in [("flipped", &flipped[..]), ("truncated", truncated)] {
         // the tool says what the drive will say
@@ -200,7 +241,7 @@ fn foe_image_refuses_what_it_cannot_make() {
     // an ELF without loadable contents
     let p = dir.join("empty.elf");
     std::fs::write(&p, elf32(&[(0x2000_0000, 0x2000_0000, Vec::new(), 64)])).unwrap();
-    let out = tool(&["make", "--version", "1", p.to_str().unwrap()]);
+    let out = tool(&["make", "--version", "1", "--key", &dev_key(), p.to_str().unwrap()]);
     assert!(!out.status.success());
     assert!(String::from_utf8_lossy(&out.stderr).contains("no loadable segment"));
     assert!(!dir.join("firmware.sc6f").exists(), "nothing written");
@@ -211,7 +252,14 @@ fn foe_image_refuses_what_it_cannot_make() {
         (0x0800_0040, 0x0800_0040, pattern(100, 2), 100),
     ];
     std::fs::write(&p2, elf32(&two)).unwrap();
-    let out = tool(&["make", "--version", "1", p2.to_str().unwrap()]);
+    let out = tool(&[
+        "make",
+        "--version",
+        "1",
+        "--key",
+        &dev_key(),
+        p2.to_str().unwrap(),
+    ]);
     assert!(!out.status.success());
     assert!(String::from_utf8_lossy(&out.stderr).contains("overlap at 0x08000040"));
     assert!(!dir.join("firmware.sc6f").exists(), "nothing written");
@@ -220,13 +268,116 @@ fn foe_image_refuses_what_it_cannot_make() {
         "make",
         "--version",
         "1",
+        "--key",
+        &dev_key(),
         "--out",
         "/nonexistent/firmware.sc6f",
         p.to_str().unwrap(),
     ]);
     assert!(!out.status.success());
-    // a missing version
-    let out = tool(&["make", p.to_str().unwrap()]);
+    // a missing version, a missing key
+    let out = tool(&["make", "--key", &dev_key(), p.to_str().unwrap()]);
     assert!(!out.status.success());
+    let out = tool(&["make", "--version", "1", p.to_str().unwrap()]);
+    assert!(!out.status.success());
+    // a flat binary without --load-addr: no address to put into the header
+    let bin = dir.join("flat.bin");
+    std::fs::write(&bin, pattern(100, 3)).unwrap();
+    let out = tool(&[
+        "make",
+        "--version",
+        "1",
+        "--key",
+        &dev_key(),
+        bin.to_str().unwrap(),
+    ]);
+    assert!(!out.status.success());
+    assert!(String::from_utf8_lossy(&out.stderr).contains("--load-addr"));
+    assert!(!dir.join("firmware.sc6f").exists(), "nothing written");
+    // a key file that is no key
+    let out = tool(&[
+        "make",
+        "--version",
+        "1",
+        "--key",
+        bin.to_str().unwrap(),
+        p2.to_str().unwrap(),
+    ]);
+    assert!(!out.status.success());
+    assert!(String::from_utf8_lossy(&out.stderr).contains("not a key file"));
+    std::fs::remove_dir_all(dir).unwrap();
+}
+
+#[test]
+fn foe_signature_keygen_sign_check_and_the_drive_refuses_another_key() {
+    let dir = temp_dir("keygen");
+    let key = dir.join("prod.key");
+    let out = tool(&["keygen", "--out", key.to_str().unwrap()]);
+    assert!(out.status.success(), "{}", String::from_utf8_lossy(&out.stderr));
+    let seed = drive::boot::parse_key_hex(&std::fs::read_to_string(&key).unwrap()).unwrap();
+    let public = drive::boot::parse_key_hex(&std::fs::read_to_string(dir.join("prod.pub")).unwrap()).unwrap();
+    assert_eq!(
+        drive::boot::public_key(&seed),
+        public,
+        "the pair belongs together"
+    );
+    assert_ne!(public, drive::boot::DEV_PUBLIC_KEY);
+    #[cfg(unix)]
+    {
+        use std::os::unix::fs::PermissionsExt;
+        let mode = std::fs::metadata(&key).unwrap().permissions().mode();
+        assert_eq!(mode & 0o077, 0, "the secret is its owner's only");
+    }
+    // no overwriting
+    let out = tool(&["keygen", "--out", key.to_str().unwrap()]);
+    assert!(!out.status.success());
+    // sign with the new key: its public key verifies, the development key does not
+    let (elf, _) = board_elf();
+    let file = make_with(&dir, &elf, 8, key.to_str().unwrap(), &["--security-counter", "3"]);
+    let f = dir.join("firmware.sc6f");
+    let pubfile = dir.join("prod.pub");
+    let out = tool(&["check", "--pub", pubfile.to_str().unwrap(), f.to_str().unwrap()]);
+    assert!(out.status.success(), "{}", String::from_utf8_lossy(&out.stderr));
+    assert!(String::from_utf8_lossy(&out.stdout).contains("security counter 3"));
+    let out = tool(&["check", "--pub", &dev_pub(), f.to_str().unwrap()]);
+    assert!(!out.status.success());
+    assert!(String::from_utf8_lossy(&out.stderr).contains("800Ch"));
+    // the simulated drive trusts the development key only: 800Ch at the end,
+    // slot B stays empty, A runs on
+    let sim = line();
+    assert_eq!(download(&sim, &file), Err(FoeReply::Error(FoeError::CHECKSUM.0)));
+    let mut n = std::cell::RefMut::map(sim.borrow_mut(), |s| &mut s.drives_mut()[0]);
+    assert_eq!(n.slots().state(Slot::B).unwrap(), SlotState::Empty);
+    n.power_cycle();
+    assert_eq!(n.boot.map(|d| (d.slot, d.trial)), Some((Slot::A, false)));
+    std::fs::remove_dir_all(dir).unwrap();
+}
+
+#[test]
+fn foe_signature_load_address_and_security_counter_from_the_tool() {
+    let dir = temp_dir("addr");
+    // linked for slot A while A runs: refused at the header with 8004h
+    let (elf, _) = board_elf_at(fw_load_address(Slot::A));
+    let file = make(&dir, &elf, 7);
+    let sim = line();
+    assert_eq!(download(&sim, &file), Err(FoeReply::Error(FoeError::ILLEGAL.0)));
+    // --load-addr puts another address into the header (the body is the same)
+    let b = fw_load_address(Slot::B);
+    let file = make_with(
+        &dir,
+        &elf,
+        7,
+        &dev_key(),
+        &["--security-counter", "1", "--load-addr", &format!("{b:#x}")],
+    );
+    assert_eq!(u32::from_le_bytes(file[20..24].try_into().unwrap()), b);
+    assert_eq!(download(&sim, &file).map(|_| ()), Ok(()));
+    // a security counter below the running image's (1): 800Ah at the header
+    let (elf, _) = board_elf();
+    let file = make_with(&dir, &elf, 6, &dev_key(), &["--security-counter", "0"]);
+    let sim = line();
+    assert_eq!(download(&sim, &file), Err(FoeReply::Error(FoeError::NO_RIGHTS.0)));
+    let mut n = std::cell::RefMut::map(sim.borrow_mut(), |s| &mut s.drives_mut()[0]);
+    assert_eq!(n.slots().state(Slot::B).unwrap(), SlotState::Empty);
     std::fs::remove_dir_all(dir).unwrap();
 }

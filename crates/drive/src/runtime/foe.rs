@@ -1,7 +1,21 @@
 //! The firmware download over FoE (issue 8): file names, the handler that
-//! writes the boot slots, the FoE error of each update error.
+//! writes the boot slots, the FoE error of each update error. Signed images
+//! (issue 18): at the end of a download the image in flash is verified against
+//! [`FIRMWARE_PUBLIC_KEY`]; a wrong load address or a security counter below
+//! the running image's is refused at the header already.
 
 use super::*;
+
+/// The public key a downloaded image must be signed with, chosen at build
+/// time: [`boot::FIRMWARE_PUBLIC_KEY`] (the 64 hex digits of the environment
+/// variable `SC6_FIRMWARE_PUBLIC_KEY` when `crates/boot` is built, else the
+/// **development** key `keys/dev-ed25519.pub`, which the simulator and the
+/// QEMU images use): the key built into the boot loader too.
+pub const FIRMWARE_PUBLIC_KEY: [u8; 32] = boot::FIRMWARE_PUBLIC_KEY;
+
+/// Whether [`FIRMWARE_PUBLIC_KEY`] is the development key (never for a
+/// production drive).
+pub const FIRMWARE_KEY_IS_DEVELOPMENT: bool = boot::FIRMWARE_KEY_IS_DEVELOPMENT;
 
 /// FoE file names (prefix) of the firmware image; other names: 8001h.
 pub const FIRMWARE_FILE: &[u8] = b"firmware";
@@ -24,7 +38,9 @@ pub fn foe_error(e: UpdateError) -> FoeError {
         UpdateError::NotStarted | UpdateError::BadHeader => FoeError::ILLEGAL,
         UpdateError::Unconfirmed => FoeError::ACCESS_DENIED,
         UpdateError::TooLarge => FoeError::DISK_FULL,
-        UpdateError::Incomplete | UpdateError::Crc => FoeError::CHECKSUM,
+        UpdateError::Incomplete | UpdateError::Crc | UpdateError::Signature => FoeError::CHECKSUM,
+        UpdateError::LoadAddress => FoeError::ILLEGAL,
+        UpdateError::Downgrade => FoeError::NO_RIGHTS,
         UpdateError::Flash(_) => FoeError::PROGRAM_ERROR,
     }
 }
@@ -45,7 +61,10 @@ impl<B: Flash> FoeHandler for FirmwareFoe<'_, B> {
 
     fn end_write(&mut self) -> Result<(), FoeError> {
         let slots = self.slots.as_deref_mut().ok_or(FoeError::ILLEGAL)?;
-        slots.finish().map(|_| ()).map_err(foe_error)
+        slots
+            .finish_verified(&FIRMWARE_PUBLIC_KEY)
+            .map(|_| ())
+            .map_err(foe_error)
     }
 
     fn abort(&mut self) {

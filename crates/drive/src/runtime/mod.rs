@@ -49,7 +49,8 @@
 //! the firmware slots ([`boot::BootSlots`]) and passes FoE writes in
 //! Bootstrap through to them ([`FirmwareFoe`]): a file named
 //! `firmware…` ([`FIRMWARE_FILE`]) goes into the inactive slot, is
-//! CRC-checked at its end and marked pending; the next boot tries it and
+//! CRC-checked and its signature verified against [`FIRMWARE_PUBLIC_KEY`]
+//! at its end (issue 18) and marked pending; the next boot tries it and
 //! the running image confirms itself with [`Drive::confirm_firmware`].
 //! [`Drive::new`] has no slots: FoE writes are refused (8002h).
 //!
@@ -68,7 +69,7 @@ use crate::faults::FaultChange;
 pub use diag::Leds;
 use diag::{is_event52, PortDiag, Text};
 pub use eoe::IpSettings;
-pub use foe::{foe_error, FirmwareFoe, FIRMWARE_FILE};
+pub use foe::{foe_error, FirmwareFoe, FIRMWARE_FILE, FIRMWARE_KEY_IS_DEVELOPMENT, FIRMWARE_PUBLIC_KEY};
 pub use save::{save_result, SaveJob};
 use slots::RuntimeSlots;
 use sync::PllSettings;
