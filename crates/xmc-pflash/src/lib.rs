@@ -297,6 +297,9 @@ impl From<Error> for FlashError {
 /// times: the FSR seen, or [`Error::Timeout`]. The last write of `seq` starts the
 /// program or erase, so this function and all it runs are in RAM on the target:
 /// nothing may be fetched from the PFLASH until it is idle.
+// (`link_section` counts as unsafe code: the section must hold executable code
+// that the runtime copies to RAM before use, which cortex-m-rt does for .data.*)
+#[allow(unsafe_code)]
 #[cfg_attr(all(target_arch = "arm", target_os = "none"), link_section = ".data.ramfunc")]
 #[inline(never)]
 fn issue_and_wait<B: Bus>(bus: &mut B, seq: &[(u32, u32)], polls: u32) -> Result<u32, Error> {
@@ -523,6 +526,9 @@ pub struct Region<B, const BASE: u32, const SECTOR: usize, const SECTORS: usize>
 }
 
 impl<B: Bus, const BASE: u32, const SECTOR: usize, const SECTORS: usize> Region<B, BASE, SECTOR, SECTORS> {
+    /// Uncached address of the region's byte 0.
+    pub const BASE: u32 = BASE;
+
     /// The region on `flash`. Compile-time check: each of its sectors is one logical
     /// sector of the PFLASH.
     pub fn new(flash: Pflash<B>) -> Self {
