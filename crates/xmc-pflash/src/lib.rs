@@ -30,7 +30,8 @@
 //! (`crates/store`) and the firmware slots (`crates/boot`) never rely on that value
 //! when they read (an erased header has no magic, an erased mark unit no tag, an
 //! erased commit unit not the commit pattern), and program every unit once after an
-//! erase, whole, so the FFh padding they write reads back as written. [`Region`]
+//! erase, whole (the driver refuses to program a page that does not read erased:
+//! on the chip a second program corrupts the page and its ECC), so the FFh padding they write reads back as written. [`Region`]
 //! therefore passes the chip's contents through unchanged (an image in a slot must be
 //! stored as it executes); the crate's tests run both crates over it to show that.
 //!
@@ -279,6 +280,9 @@ pub enum Error {
     Timeout,
     /// After an erase, the sector does not read 00h everywhere.
     NotBlank,
+    /// Before a write, the page does not read 00h everywhere: it was programmed
+    /// since its erase (programming it again would corrupt it and its ECC).
+    NotErased,
     /// After a write, the page does not read back as written.
     ReadBack,
 }
@@ -410,11 +414,19 @@ impl<B: Bus> Pflash<B> {
         Ok(())
     }
 
-    /// Programs one page at `addr` (a page boundary), then checks its read-back.
+    /// Programs one page at `addr` (a page boundary) that reads erased (00h), then
+    /// checks its read-back.
     pub fn write_page(&mut self, addr: u32, page: &[u8; PAGE]) -> Result<(), Error> {
         offset_of(addr, PAGE)?;
         if addr as usize % PAGE != 0 {
             return Err(Error::Misaligned);
+        }
+        let mut at = 0;
+        while at < PAGE as u32 {
+            if self.bus.read32(addr.wrapping_add(at)) != 0 {
+                return Err(Error::NotErased);
+            }
+            at += 4;
         }
         self.prepare();
         let r = self.load_and_write(addr, page);

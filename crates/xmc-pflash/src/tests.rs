@@ -332,11 +332,20 @@ fn erase_verifies_blank() {
 }
 
 #[test]
-fn write_verifies_read_back() {
+fn write_over_a_programmed_page_is_refused_without_a_command() {
     let mut f = driver();
     f.write_page(S9, &pattern(8)).unwrap();
-    // programming again without an erase ORs the cells: not what was asked
-    assert_eq!(f.write_page(S9, &pattern(9)), Err(Error::ReadBack));
+    let n = f.bus_mut().writes.len();
+    assert_eq!(f.write_page(S9, &pattern(9)), Err(Error::NotErased));
+    assert_eq!(f.bus_mut().writes.len(), n, "no command for a programmed page");
+    assert_eq!(f.bus_mut().at(S9, PAGE), &pattern(8));
+    // one 1 bit anywhere in the page is enough
+    f.bus_mut().mem[(S9 - UNCACHED_BASE) as usize + 2 * PAGE - 1] = 0x80;
+    assert_eq!(f.write_page(S9 + PAGE as u32, &pattern(9)), Err(Error::NotErased));
+    // after an erase the page is taken again
+    f.erase_sector(S9).unwrap();
+    f.write_page(S9, &pattern(9)).unwrap();
+    clean(&mut f);
 }
 
 #[test]
@@ -353,6 +362,7 @@ fn errors_map_to_the_flash_trait() {
         Error::NotStarted,
         Error::Timeout,
         Error::NotBlank,
+        Error::NotErased,
         Error::ReadBack,
     ] {
         assert_eq!(FlashError::from(e), FlashError::Device);

@@ -4,7 +4,9 @@
 //! What it models (from the sources named in the crate docs):
 //!
 //! - erased cells read 00h; Write Page ORs the page buffer into the cells (bits go
-//!   0 → 1), so a page programmed twice without an erase reads the OR of both;
+//!   0 → 1), so a page programmed twice without an erase reads the OR of both (on
+//!   the chip such a page is corrupt, with a double-bit ECC error on reading, as an
+//!   Infineon forum thread on the XMC4500 reports; the driver refuses to do it);
 //! - the command sequences of `crate::cmd`, exactly: Reset to Read (F0h) from any
 //!   state (aborts a sequence, leaves page mode); Clear Status (F5h) and Enter Page
 //!   Mode (50h) from an idle sequence; Load Page (55F0h then 55F4h, 32 pairs) only in
