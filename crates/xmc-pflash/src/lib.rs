@@ -30,22 +30,22 @@
 //! (`crates/store`) and the firmware slots (`crates/boot`) never rely on that value
 //! when they read (an erased header has no magic, an erased mark unit no tag, an
 //! erased commit unit not the commit pattern), and program every unit once after an
-//! erase, whole (the driver refuses to program a page that does not read erased:
-//! on the chip a second program corrupts the page and its ECC), so the FFh padding they write reads back as written. [`Region`]
-//! therefore passes the chip's contents through unchanged (an image in a slot must be
-//! stored as it executes); the crate's tests run both crates over it to show that.
+//! erase, whole, so the FFh padding they write reads back as written (the driver
+//! refuses to program a page that does not read erased: on the chip a second
+//! program corrupts the page and its ECC). [`Region`] therefore passes the chip's
+//! contents through unchanged (an image in a slot must be stored as it executes);
+//! the crate's tests run both crates over it to show that.
 //!
 //! # Must run from RAM
 //!
 //! The XMC4800 has one PFLASH bank: while it erases or programs, it cannot be read,
-//! instruction fetches from it stall (and a stalled fetch that gives up would see
-//! garbage). The function that writes a command's last cycle and polls FSR until the
-//! flash is idle again is placed in RAM on the target (`#[link_section =
-//! ".data.ramfunc"]`, never inlined: cortex-m-rt copies `.data.*` to RAM at reset);
-//! the rest of the driver runs from flash (before a command starts or after it
-//! ended). With [`Volatile`] the caller must also keep interrupts masked during an
-//! erase or a write (their handlers and vector table are in flash) — see
-//! [`Volatile::new`].
+//! instruction fetches from it stall until it is idle. The function that writes a
+//! command's last cycle and polls FSR until the flash is idle again is placed in RAM
+//! on the target (`#[link_section = ".data.ramfunc"]`, never inlined: cortex-m-rt
+//! copies `.data.*` to RAM at reset); the rest of the driver runs from flash (before
+//! a command starts or after it ended). With [`Volatile`] the caller must also keep
+//! interrupts masked during an erase or a write (their handlers and vector table are
+//! in flash) — see [`Volatile::new`].
 #![no_std]
 #![cfg_attr(
     not(test),
