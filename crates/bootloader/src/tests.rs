@@ -355,7 +355,7 @@ fn a_lone_image_with_a_bad_stack_pointer_halts() {
     );
 }
 
-/// Reads only: every erase/write fails (the board's flash driver stub).
+/// Reads only: every erase/write fails (a flash whose marks cannot be written).
 struct ReadOnly<F>(F);
 
 impl<F: Flash> Flash for ReadOnly<F> {

@@ -10,12 +10,11 @@
 //! (`bootloader::PUBLIC_KEY`: set `SC6_FIRMWARE_PUBLIC_KEY` for a production
 //! build, else it is the development key).
 //!
-//! **The program-flash driver is a stub**: [`XmcFlash`] reads the memory-mapped
-//! flash, but its erase and write return `FlashError::Device` (the XMC4800's
-//! PFLASH command sequences are not written yet, docs/flashing.md). So the
-//! TRIED mark cannot be written: `select` then never starts a pending image
-//! (it would be retried at every reset) and starts a confirmed one, or a trial
-//! image when it is all there is. Updates are taken once the driver exists.
+//! The slot region is erased and programmed with the PFLASH driver
+//! `xmc-pflash` ([`XmcFlash`]; its command-issuing part runs from RAM,
+//! interrupts masked), so the TRIED mark of a pending image is written and
+//! updates are taken. The driver is host-tested against a model of the chip
+//! only: it has not run on silicon (docs/flashing.md, "The PFLASH driver").
 #![no_std]
 #![no_main]
 
@@ -43,11 +42,35 @@ fn safe_loop() -> ! {
     }
 }
 
-/// The slot region of program flash (S9..S12), read through the uncached
-/// alias. Erase and write: stub (see the crate docs).
-struct XmcFlash;
+/// The slot region of program flash (S9..S12) through the PFLASH driver, read
+/// through the uncached alias. Each erase and write runs with interrupts masked
+/// (the boot loader enables none; a handler in flash must not run while the
+/// single PFLASH bank is busy).
+struct XmcFlash(xmc_pflash::SlotRegion<xmc_pflash::Volatile>);
 
-const REGION_LEN: usize = xmc4800::SECTOR * xmc4800::SECTORS;
+// the driver's slot region is the one `bootloader::xmc4800` lays out
+const _: () = {
+    type R = xmc_pflash::SlotRegion<xmc_pflash::Volatile>;
+    assert!(R::BASE == xmc4800::SLOTS_UNCACHED);
+    assert!(<R as Flash>::SECTOR == xmc4800::SECTOR && <R as Flash>::SECTORS == xmc4800::SECTORS);
+    assert!(<R as Flash>::WRITE == xmc4800::WRITE);
+};
+
+/// CPU clock bound for the busy waits: the boot loader runs at the reset clock
+/// (below 144 MHz); assuming the maximum makes the bounds only longer.
+const CPU_HZ_MAX: u32 = 144_000_000;
+
+impl XmcFlash {
+    fn new() -> Self {
+        // SAFETY: the XMC4800's PFLASH and FLASH0; the boot loader is the only
+        // user of the flash commands, runs single-threaded and masks interrupts
+        // around every erase and write (below).
+        #[allow(unsafe_code)]
+        let bus = unsafe { xmc_pflash::Volatile::new() };
+        let limits = xmc_pflash::Limits::at_cpu_hz(CPU_HZ_MAX);
+        Self(xmc_pflash::Region::new(xmc_pflash::Pflash::new(bus, limits)))
+    }
+}
 
 impl Flash for XmcFlash {
     const SECTOR: usize = xmc4800::SECTOR;
@@ -55,29 +78,15 @@ impl Flash for XmcFlash {
     const WRITE: usize = xmc4800::WRITE;
 
     fn read(&mut self, addr: u32, buf: &mut [u8]) -> Result<(), FlashError> {
-        let a = addr as usize;
-        match a.checked_add(buf.len()) {
-            Some(end) if end <= REGION_LEN => {}
-            _ => return Err(FlashError::OutOfRange),
-        }
-        let base = (xmc4800::SLOTS_UNCACHED as usize + a) as *const u8;
-        for (i, b) in buf.iter_mut().enumerate() {
-            // SAFETY: inside the slot region of the 2 MiB program flash,
-            // memory-mapped and always readable.
-            #[allow(unsafe_code)]
-            {
-                *b = unsafe { core::ptr::read_volatile(base.add(i)) };
-            }
-        }
-        Ok(())
+        self.0.read(addr, buf)
     }
 
-    fn erase(&mut self, _sector: u32) -> Result<(), FlashError> {
-        Err(FlashError::Device)
+    fn erase(&mut self, sector: u32) -> Result<(), FlashError> {
+        cortex_m::interrupt::free(|_| self.0.erase(sector))
     }
 
-    fn write(&mut self, _addr: u32, _data: &[u8]) -> Result<(), FlashError> {
-        Err(FlashError::Device)
+    fn write(&mut self, addr: u32, data: &[u8]) -> Result<(), FlashError> {
+        cortex_m::interrupt::free(|_| self.0.write(addr, data))
     }
 }
 
@@ -87,7 +96,7 @@ fn main() -> ! {
         "boot: boot loader (XMC4800), slots at {=u32:#010x}",
         xmc4800::SLOTS_UNCACHED
     );
-    let mut slots = BootSlots::with_base(XmcFlash, xmc4800::LAYOUT.region_xip);
+    let mut slots = BootSlots::with_base(XmcFlash::new(), xmc4800::LAYOUT.region_xip);
     match select(&mut slots, &xmc4800::LAYOUT, &PUBLIC_KEY) {
         Outcome::Start(s) => {
             if let Some(r) = s.decision.rolled_back {
@@ -101,7 +110,7 @@ fn main() -> ! {
                 );
             }
             if s.marks_failed.is_some() {
-                defmt::warn!("boot: marks cannot be written (flash driver stub): no pending image started");
+                defmt::warn!("boot: marks cannot be written (flash error): no pending image started");
             }
             defmt::info!(
                 "boot: starting slot {=str} (version {=u32}) at {=u32:#010x}",

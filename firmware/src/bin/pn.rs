@@ -13,8 +13,8 @@
 //! pends the control interrupt when [`PnCycle::next_at`] has passed; the
 //! device's next deadline (the input frame of each cycle, watchdogs) is
 //! kept the same way. The parameter store is `firmware::ParamFlash` (two
-//! 2 KiB sectors in RAM until the flash driver exists, as on the EtherCAT
-//! image). Board bring-up that needs the hardware to verify — ETH0 pins,
+//! 2 KiB sectors in RAM: the PFLASH driver is not used by the images yet,
+//! as on the EtherCAT image). Board bring-up that needs the hardware to verify — ETH0 pins,
 //! PHY address, RMII clock, the MAC address — is listed in docs/hardware.md.
 #![no_std]
 #![no_main]
