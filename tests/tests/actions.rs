@@ -47,17 +47,11 @@ fn e060_e140_save_values_through_a75_and_a69_in_the_process_data() {
         let group = group.into_op(md).await.expect("Op with A75/A69 mapped");
         let sd = group.subdevice(md, 0).unwrap();
         assert_eq!(al_status(&sd).await, (OP, 0));
-        macro_rules! a69_of {
-            ($sd:expr) => {{
-                let io = $sd.io_raw();
-                u16::from_le_bytes([io.inputs()[a69], io.inputs()[a69 + 1]])
-            }};
-        }
         sd.outputs_raw_mut()[a75] = 0b0001 << 1 | 1;
         let mut seen = Vec::new();
         for _ in 0..50 {
             group.tx_rx(md).await.expect("cycle");
-            let s = a69_of!(sd);
+            let s = a69_of(sd.io_raw().inputs(), a69);
             if seen.last() != Some(&s) {
                 seen.push(s);
             }
@@ -81,8 +75,30 @@ fn e060_e140_save_values_through_a75_and_a69_in_the_process_data() {
         for _ in 0..5 {
             group.tx_rx(md).await.expect("cycle");
         }
-        assert_eq!(a69_of!(sd), 0, "idle once Execute is low");
+        assert_eq!(a69_of(sd.io_raw().inputs(), a69), 0, "idle once Execute is low");
     });
+}
+
+/// A69 at byte `at` of the inputs.
+fn a69_of(inputs: &[u8], at: usize) -> u16 {
+    u16::from_le_bytes([inputs[at], inputs[at + 1]])
+}
+
+/// `n` process-data cycles, the simulated time advanced one master cycle before each.
+async fn cycles<S: ethercrab::subdevice_group::HasPdi>(
+    sim: &std::cell::RefCell<hil_sim::sim::Simulation>,
+    group: &ethercrab::SubDeviceGroup<8, 512, ethercrab::DefaultLock, S>,
+    md: &ethercrab::MainDevice<'_>,
+    n: usize,
+) {
+    for _ in 0..n {
+        {
+            let mut sim = sim.borrow_mut();
+            let t = sim.now() + drive_tests::MASTER_CYCLE;
+            sim.advance_to(t);
+        }
+        group.tx_rx(md).await.expect("cycle");
+    }
 }
 
 /// E-141: a motor test (test winding, 1101b) needs E48 = 2 (ready to switch
@@ -99,18 +115,9 @@ fn e141_test_winding_refused_outside_ready_to_switch_on() {
         let e48 = sd.sdo_read::<u8>(drive::params::E48, 0).await.unwrap();
         assert_ne!(e48, 2, "the axis is not ready to switch on");
         sd.outputs_raw_mut()[a75] = 0b1101 << 1 | 1;
-        for _ in 0..5 {
-            {
-                let mut sim = sim.borrow_mut();
-                let t = sim.now() + drive_tests::MASTER_CYCLE;
-                sim.advance_to(t);
-            }
-            group.tx_rx(md).await.expect("cycle");
-        }
-        let io = sd.io_raw();
-        let s = u16::from_le_bytes([io.inputs()[a69], io.inputs()[a69 + 1]]);
+        cycles(&sim, &group, md, 5).await;
+        let s = a69_of(sd.io_raw().inputs(), a69);
         assert_eq!(s, 0b1101 << 8 | state::REFUSED << 12, "{s:04X}h");
-        drop(io);
         // shutdown (6040h = 6): ready to switch on; the precondition holds, and
         // the test itself is not available on this drive
         {
@@ -118,26 +125,11 @@ fn e141_test_winding_refused_outside_ready_to_switch_on() {
             out[0..2].copy_from_slice(&6u16.to_le_bytes());
             out[a75] = 0;
         }
-        for _ in 0..20 {
-            {
-                let mut sim = sim.borrow_mut();
-                let t = sim.now() + drive_tests::MASTER_CYCLE;
-                sim.advance_to(t);
-            }
-            group.tx_rx(md).await.expect("cycle");
-        }
+        cycles(&sim, &group, md, 20).await;
         assert_eq!(sd.sdo_read::<u8>(drive::params::E48, 0).await.unwrap(), 2);
         sd.outputs_raw_mut()[a75] = 0b1101 << 1 | 1;
-        for _ in 0..5 {
-            {
-                let mut sim = sim.borrow_mut();
-                let t = sim.now() + drive_tests::MASTER_CYCLE;
-                sim.advance_to(t);
-            }
-            group.tx_rx(md).await.expect("cycle");
-        }
-        let io = sd.io_raw();
-        let s = u16::from_le_bytes([io.inputs()[a69], io.inputs()[a69 + 1]]);
+        cycles(&sim, &group, md, 5).await;
+        let s = a69_of(sd.io_raw().inputs(), a69);
         assert_eq!(s, 0b1101 << 8 | state::NOT_AVAILABLE << 12, "{s:04X}h");
     });
 }

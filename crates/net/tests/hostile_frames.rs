@@ -96,25 +96,14 @@ struct Rig<'a> {
 }
 
 impl<'a> Rig<'a> {
+    /// With the address the master set over EoE (E-096).
     fn new(bufs: &'a mut NetBuffers, slots: &'a mut [SocketStorage<'a>; SOCKETS]) -> Self {
-        let mut q = EoeQueue::new();
-        let cfg = NetConfig {
-            mac: DRIVE_MAC,
-            seed: 7,
-        };
-        let net = NetStack::new(cfg, bufs, slots, &mut q, Nanos::ZERO);
-        let mut rig = Rig {
-            q,
-            net,
-            d: DriveObjects::new(),
-            t_us: 1,
-        };
+        let mut rig = Self::without_ip(bufs, slots);
         rig.set_ip();
         rig
     }
 
     /// Without an address yet (for DHCP).
-    #[cfg(feature = "patched-smoltcp")]
     fn without_ip(bufs: &'a mut NetBuffers, slots: &'a mut [SocketStorage<'a>; SOCKETS]) -> Self {
         let mut q = EoeQueue::new();
         let cfg = NetConfig {
