@@ -197,6 +197,7 @@ impl Actions {
             let (execute, selector) = (a75 & 1 != 0, (a75 >> 1) & 0xF);
             let rising = execute && !a.execute;
             a.execute = execute;
+            let before = a.status;
             if !execute {
                 // the master ended it (or never started one); a running save
                 // goes on, its result is no longer shown
@@ -209,7 +210,11 @@ impl Actions {
                     a.running = None;
                 }
             }
-            let _ = objects.set(A69 + off, 0, i64::from(a.status));
+            // (written only when it changes: a dictionary write per axis and
+            // ESC poll cost the ESC task ~400 instructions, QEMU figure)
+            if a.status != before {
+                let _ = objects.set(A69 + off, 0, i64::from(a.status));
+            }
         }
         fx
     }
