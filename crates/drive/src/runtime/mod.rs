@@ -786,19 +786,3 @@ fn axis_cycle(
     }
     report.command
 }
-
-#[cfg(test)]
-mod slot_tests {
-    use super::*;
-
-    /// Every entry the cyclic paths write has a RAM slot (a missing one
-    /// would drop A261, 1C32h or 1001h silently), and no two share one.
-    #[test]
-    fn runtime_slots_resolve_every_entry() {
-        let all = RuntimeSlots::resolve(&DriveObjects::new()).all();
-        for (k, s) in all.iter().enumerate() {
-            assert!(s.is_some(), "slot {k} missing");
-            assert!(!all[..k].contains(s), "slot {k} shared");
-        }
-    }
-}
