@@ -204,7 +204,17 @@ impl Profile {
         if let Some(cw1) = rx.cw1 {
             access.own.cw1 = cw1;
         }
-        let display = core.get(access.objects, axis, Core::ModeDisplay);
+        // the mode this frame's CW1 counts in: the one its telegram binds
+        // (6060h, set above, which the core takes at its next cycle, where
+        // CW1 acts) or else 6061h; the display alone lagged a cycle behind
+        // a telegram switch, so the first positioning cycle ran without a
+        // record command and a jog bit of the next frame was no edge (P-086)
+        let shown = core.get(access.objects, axis, Core::ModeDisplay);
+        let display = match binding {
+            Some(1) if matches!(shown, 1 | 6 | -1) => shown,
+            Some(code) => code,
+            None => shown,
+        };
         let mode = match Ok::<i64, ()>(display) {
             Ok(1 | 6 | -1) => Mode::Positioning,
             Ok(2 | 3) => Mode::Speed,

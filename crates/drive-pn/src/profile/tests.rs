@@ -409,3 +409,27 @@ mod pnu;
 
 #[path = "tests_telegrams.rs"]
 mod telegrams;
+
+/// P-086: a jog bit that rises in the frame after the one that switched
+/// the telegram (and so the mode) to positioning is an edge. The CW1 of the
+/// switching frame counts in the mode that frame binds: the mode display
+/// 6061h still shows the old mode until the next control cycle, and reading
+/// CW1 in it left the first pp cycle without a record command, so the jog
+/// bit of the next frame was taken for one already set at the mode change
+/// (seen through profinet-py when its output buffer skipped a frame).
+#[test]
+fn p086_p052_jog_right_after_the_telegram_switched_to_positioning() {
+    let mut b = Bench::new();
+    for cw1 in [0x0406, 0x0407, 0x040F, 0x047F] {
+        b.run(&speed(cw1, 0, 10_000, [0; 8]), 20);
+    }
+    assert_eq!(b.d.objects().get(0x6061, 0), Ok(2));
+    let mut t = positioning(0x043F, 0, 1000, 10_000);
+    t[20..24].copy_from_slice(&300i32.to_be_bytes());
+    b.run(&t, 1);
+    t[2..4].copy_from_slice(&0x053Fu16.to_be_bytes());
+    b.run(&t, 5);
+    assert_eq!(b.d.objects().get(0x6061, 0), Ok(1));
+    let s = b.d.axes()[0].record_status();
+    assert!(s.jogging, "jog bit 8 one frame after the switch: {s:?}");
+}
