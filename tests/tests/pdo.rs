@@ -139,7 +139,7 @@ fn e061_a250_new_messages_flag_in_the_txpdo() {
 }
 
 #[test]
-fn e058_mapping_refusals_0604_0041_0604_0042_0604_0043() {
+fn e058_e075_mapping_refusals_0604_0041_0604_0042_0604_0043() {
     let sim = line(1);
     with_master(&sim, async |md, clock| {
         let group = init(md, clock).await;
