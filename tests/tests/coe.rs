@@ -860,12 +860,23 @@ fn e078_complete_access_upload_1018h_1600h_and_download_1c12h_in_cia301_order() 
         );
         assert_eq!(settled(&sim), before, "nothing written");
         // a TxPDO in the RxPDO assignment: refused by the entry write, after
-        // sub 0 = 0, which stays (an empty, consistent assignment)
+        // sub 0 = 0; the old assignment comes back, nothing changed
         assert_eq!(
             c.download_normal(&sd, 0x1C12, 0, &[1, 0, 0x00, 0x1A], true).await,
             Err(PARAMETER_INCOMPATIBLE)
         );
-        assert_eq!(c.upload(&sd, 0x1C12, 0).await, Ok(vec![0]));
+        assert_eq!(c.upload_kind(&sd, 0x1C12, 0, true).await.unwrap().0, assign);
+        assert_eq!(settled(&sim), before, "the refused assignment changed nothing");
+        // the mailbox fuzz target's finding: an expedited complete download
+        // of 1600h:01 (size not indicated: four bytes 6Eh, entry 6E6Eh:6Eh)
+        // was refused with 0604 0041h after sub 0 = 0, and the default
+        // mapping was gone
+        assert_eq!(
+            c.download_normal(&sd, 0x1600, 1, &[0x6E; 4], true).await,
+            Err(SdoAbort::NOT_MAPPABLE.0)
+        );
+        assert_eq!(c.upload_kind(&sd, 0x1600, 0, true).await.unwrap().0, map);
+        assert_eq!(settled(&sim), before, "the refused mapping changed nothing");
         // back to the default
         c.download_normal(&sd, 0x1C12, 0, &[1, 0, 0x00, 0x16], true)
             .await
@@ -924,13 +935,17 @@ fn e078_ethercrab_complete_access_from_subindex_1_to_assignment_and_mapping() {
             .expect("CA download from sub 1 of 1600h");
         assert_eq!(c.upload(&sd, 0x1600, 0).await, Ok(vec![1]));
         assert_eq!(objects(&sim).process_data_bytes(), Some((2, 29)));
-        // refused entries leave an empty mapping (sub 0 = 0), as from sub 0
+        // a refused entry puts the mapping back, as from sub 0
         assert_eq!(
             c.download_normal(&sd, 0x1600, 1, &0x6041_0010u32.to_le_bytes(), true)
                 .await,
             Err(SdoAbort::NOT_MAPPABLE.0)
         );
-        assert_eq!(c.upload(&sd, 0x1600, 0).await, Ok(vec![0]));
+        assert_eq!(c.upload(&sd, 0x1600, 0).await, Ok(vec![1]));
+        assert_eq!(
+            c.upload(&sd, 0x1600, 1).await,
+            Ok(0x6040_0010u32.to_le_bytes().to_vec())
+        );
     });
 }
 

@@ -22,9 +22,10 @@
 //! the number of entries the data holds). Before anything is written the whole
 //! value is checked: length, access rights in the present state, and the
 //! integer ranges of the metadata. A refusal by the dictionary after that
-//! (e.g. a PDO-mapping consistency check) aborts with its code; entries written
-//! until then stay written, and when the sequence had started with subindex 0
-//! = 0, subindex 0 stays 0 (an empty, consistent object).
+//! (e.g. a PDO-mapping consistency check) aborts with its code, and the
+//! entries written until then and subindex 0 get their old values back, so
+//! the object reads as before (up to 128 bytes of entries: every mapping and
+//! assignment object; a bigger one keeps what was written).
 
 use od::{CommState, DataType, Dictionary, EntryInfo, ObjectCode, ObjectInfo, SdoAbort};
 
@@ -150,22 +151,104 @@ pub fn download<D: Dictionary>(
     // from subindex 1 too (ethercrab's complete access starts there): the
     // entries of a mapping/assignment object change only while sub 0 = 0
     let order_sub0 = sub0_writable;
+    let mut undo = Undo::new(if order_sub0 {
+        sub0_value(dict, index, state)?
+    } else {
+        0
+    });
     if order_sub0 {
         dict.write(index, 0, &[0], state)?;
     }
     let mut pos = 0usize;
+    let mut result = Ok(());
     for s in 1..=count {
         let Some(entry) = element(info, s) else {
             continue;
         };
         let end = pos.saturating_add(entry.data_type.bytes());
-        dict.write(index, s, body.get(pos..end).unwrap_or_default(), state)?;
+        undo.keep(dict, index, s, entry.data_type.bytes(), state);
+        result = dict.write(index, s, body.get(pos..end).unwrap_or_default(), state);
+        if result.is_err() {
+            break;
+        }
         pos = end;
     }
-    if order_sub0 {
-        dict.write(index, 0, &[count], state)?;
+    if result.is_ok() && order_sub0 {
+        result = dict.write(index, 0, &[count], state);
     }
-    Ok(())
+    if result.is_err() {
+        undo.restore(dict, info, order_sub0, state);
+    }
+    result
+}
+
+/// Entry bytes a refused complete download puts back (a PDO mapping object
+/// holds 24 × 4).
+const UNDO_BYTES: usize = 128;
+
+/// The values a complete download overwrote, to put back when the
+/// dictionary refuses a later entry or the final subindex 0 (the object
+/// then reads as before; bus input that is refused changes nothing).
+struct Undo {
+    bytes: [u8; UNDO_BYTES],
+    len: usize,
+    /// Entries 1..=`upto` are kept, in subindex order.
+    upto: u8,
+    sub0: u8,
+    /// An entry did not fit or did not read: nothing is put back.
+    lost: bool,
+}
+
+impl Undo {
+    fn new(sub0: u8) -> Self {
+        Self {
+            bytes: [0; UNDO_BYTES],
+            len: 0,
+            upto: 0,
+            sub0,
+            lost: false,
+        }
+    }
+
+    /// Keeps the present value of `index`:`sub` (`size` bytes) before it is
+    /// written.
+    fn keep<D: Dictionary>(&mut self, dict: &mut D, index: u16, sub: u8, size: usize, state: CommState) {
+        let end = self.len.saturating_add(size);
+        let Some(dst) = self.bytes.get_mut(self.len..end) else {
+            self.lost = true;
+            return;
+        };
+        match dict.read(index, sub, dst, state) {
+            Ok(n) if n == size => {
+                self.len = end;
+                self.upto = sub;
+            }
+            _ => self.lost = true,
+        }
+    }
+
+    /// Writes the kept values back (sub 0 = 0 still set when `order_sub0`),
+    /// then the old subindex 0.
+    fn restore<D: Dictionary>(&self, dict: &mut D, info: &ObjectInfo, order_sub0: bool, state: CommState) {
+        if self.lost {
+            return;
+        }
+        let index = info.index;
+        let mut pos = 0usize;
+        for s in 1..=self.upto {
+            let Some(entry) = element(info, s) else {
+                continue;
+            };
+            let end = pos.saturating_add(entry.data_type.bytes());
+            if let Some(v) = self.bytes.get(pos..end) {
+                let _ = dict.write(index, s, v, state);
+            }
+            pos = end;
+        }
+        if order_sub0 {
+            let _ = dict.write(index, 0, &[self.sub0], state);
+        }
+    }
 }
 
 /// The present value of subindex 0 (0 when it reads as nothing).

@@ -101,6 +101,8 @@ struct Dict {
     many: bool,
     /// Refuse writes to this entry with this code.
     refuse: Option<(u16, u8, SdoAbort)>,
+    /// Refuse writes of exactly this value to this entry with this code.
+    refuse_value: Option<(u16, u8, Vec<u8>, SdoAbort)>,
 }
 
 impl Dict {
@@ -123,6 +125,7 @@ impl Dict {
             reads: 0,
             many: false,
             refuse: None,
+            refuse_value: None,
         }
     }
 
@@ -178,6 +181,11 @@ impl Dictionary for Dict {
         if let Some((i, s, code)) = self.refuse {
             if (i, s) == (index, sub) {
                 return Err(code);
+            }
+        }
+        if let Some((i, s, v, code)) = &self.refuse_value {
+            if (*i, *s) == (index, sub) && v == data {
+                return Err(*code);
             }
         }
         self.writes.push((index, sub, data.to_vec()));
@@ -747,17 +755,39 @@ fn e078_complete_access_download_checks_before_writing() {
     assert_eq!(t.dict.writes.len(), 5);
 }
 
+/// A refusal part-way (the dictionary's consistency check on entry 2)
+/// aborts with its code and puts entry 1 and sub 0 back: the object reads
+/// as before (found by the mailbox fuzz target's oracle: a complete
+/// download of 1600h:01 aborted 0604 0041h and left the mapping empty).
 #[test]
-fn e078_complete_access_refused_entry_leaves_sub0_zero() {
+fn e078_complete_access_refused_entry_puts_the_old_values_back() {
     let mut t = T::new(64);
+    t.dict.values.insert((0x1C12, 0), vec![1]);
+    t.dict.values.insert((0x1C12, 1), vec![0x01, 0x16]);
+    t.dict.values.insert((0x1C12, 2), vec![0x00, 0x00]);
     t.dict.refuse = Some((0x1C12, 2, SdoAbort::PARAMETER_INCOMPATIBLE));
     let r = t.sdo(&[0x31, 0x12, 0x1C, 0x00, 6, 0, 0, 0, 2, 0, 0x00, 0x16, 0x05, 0x16]);
     assert_eq!(abort(&r, 0x1C12, 0), 0x0604_0043);
     assert_eq!(
         t.dict.writes,
-        vec![(0x1C12, 0, vec![0]), (0x1C12, 1, vec![0x00, 0x16])]
+        vec![
+            (0x1C12, 0, vec![0]),
+            (0x1C12, 1, vec![0x00, 0x16]),
+            (0x1C12, 1, vec![0x01, 0x16]),
+            (0x1C12, 0, vec![1]),
+        ]
     );
-    assert_eq!(t.dict.values[&(0x1C12, 0)], vec![0]);
+    assert_eq!(t.dict.values[&(0x1C12, 0)], vec![1]);
+    assert_eq!(t.dict.values[&(0x1C12, 1)], vec![0x01, 0x16]);
+    // the final sub 0 refused (e.g. 0604 0042h, too long): every entry back
+    let mut t = T::new(64);
+    t.dict.values.insert((0x1C12, 0), vec![1]);
+    t.dict.values.insert((0x1C12, 1), vec![0x01, 0x16]);
+    t.dict.refuse_value = Some((0x1C12, 0, vec![2], SdoAbort::PDO_LENGTH));
+    let r = t.sdo(&[0x31, 0x12, 0x1C, 0x00, 6, 0, 0, 0, 2, 0, 0x00, 0x16, 0x05, 0x16]);
+    assert_eq!(abort(&r, 0x1C12, 0), 0x0604_0042);
+    assert_eq!(t.dict.values[&(0x1C12, 0)], vec![1]);
+    assert_eq!(t.dict.values[&(0x1C12, 1)], vec![0x01, 0x16]);
 }
 
 #[test]
