@@ -91,11 +91,19 @@ def main():
                 dt = time.monotonic() - t
                 say(f"ecx_FOEwrite {name!r}, {len(data)} bytes: {r} ({dt:.2f} s) - {what}")
                 # EC_NOFRAME: a frame of the transfer came back too late for
-                # SOEM (a loaded machine), not an answer of the drive; a new
-                # write request starts the transfer again
+                # SOEM (a loaded machine), not an answer of the drive; the
+                # drive's answer to it may still wait in SM1 and would answer
+                # the next request (SOEM: -7, packet number), so the master
+                # ends the session as after any broken transfer: Init (the
+                # mailbox and the FoE state are reset), the bootstrap
+                # mailbox again, Bootstrap, and a new write request
                 if r != EC_NOFRAME:
                     break
-                say(f"RETRY {what}: SOEM lost a frame (attempt {attempt})")
+                say(f"RETRY {what}: SOEM lost a frame (attempt {attempt}); Init and Bootstrap again")
+                to_state(s, pysoem.INIT_STATE, "Bootstrap -> Init (retry)")
+                s.amend_mbx(mailbox="out", start_address=rx_addr, size=rx_len)
+                s.amend_mbx(mailbox="in", start_address=tx_addr, size=tx_len)
+                to_state(s, pysoem.BOOT_STATE, "Init -> Bootstrap (retry)")
             if want is None:
                 check(r > 0, f"{what}: accepted (result {r})")
             else:
