@@ -891,9 +891,12 @@ def motion(line, axes, move_cycles=1000, hold_cycles=200):
     # left out (and counted).
     clean = {a.name: 0 for a in axes}
     raw_ferr = {a.name: 0 for a in axes}
+    gap = 0  # the longest gap seen (runs longer than SETTLE_PERIODS count as that)
     for _ in range(move_cycles + hold_cycles):
         line.cycle(curve)
-        undisturbed = line.cyc.stall(SETTLE_PERIODS) < GAP_PERIODS
+        recent = line.cyc.stall(SETTLE_PERIODS)
+        gap = max(gap, recent)
+        undisturbed = recent < GAP_PERIODS
         for a in axes:
             sw = a.sw(line.inp[a.slave])
             if not sw_is(sw, ENABLED):
@@ -917,6 +920,13 @@ def motion(line, axes, move_cycles=1000, hold_cycles=200):
             break
         line.cycle(curve)
     too_few = [a.name for a in axes if clean[a.name] < total // 2]
+    # a gap longer than the drive extrapolates (I423) ends the extrapolation
+    # (C-117) and the set-point jumps by the motion of the whole gap when the
+    # master is back: the catch-up after it takes longer than SETTLE_PERIODS
+    # and measures the gap, so such a move is not judged either (repeated)
+    if gap > I423_PERIODS and not too_few:
+        say(f"(a gap of {gap} or more periods without a frame in time during the move, longer than I423 = {I423_PERIODS})")
+        too_few = [a.name for a in axes]
     for a in axes:
         moved = a.pos(line.inp[a.slave]) - start[a.name]
         say(
@@ -934,8 +944,9 @@ def motion(line, axes, move_cycles=1000, hold_cycles=200):
         # the machine, not the drive: the move is repeated (a bounded number of times)
         line.stalls.append(f"move disturbed: {too_few}")
         say(
-            f"(fewer than {total // 2} of {total} cycles on an undisturbed line for {too_few}: "
-            f"the machine disturbed the move, repeating it ({len(line.stalls)} of at most {MAX_STALLS}))"
+            f"(fewer than {total // 2} of {total} cycles on an undisturbed line, or a gap longer than I423, "
+            f"for {too_few}: the machine disturbed the move, repeating it ({len(line.stalls)} of at most "
+            f"{MAX_STALLS}))"
         )
         if len(line.stalls) > MAX_STALLS:
             check(False, f"{too_few}: every move disturbed, the tracking could not be judged")
