@@ -34,6 +34,7 @@ thread_local! {
 
 /// A one-slave line in PRE-OP: a copy of the one built once per process
 /// ([`Simulation::try_clone`]), so an input costs its own frames only.
+#[allow(dead_code)] // the line targets' (the mailbox targets copy the drive)
 pub fn preop_line() -> Simulation {
     PREOP.with(|s| s.try_clone()).unwrap_or_else(build_preop_line)
 }

@@ -8,6 +8,8 @@
 
 #[path = "common.rs"]
 mod common;
+#[path = "mbx_esc.rs"]
+mod mbx_esc;
 #[path = "mbx_oracle.rs"]
 mod mbx_oracle;
 

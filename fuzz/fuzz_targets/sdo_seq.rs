@@ -11,6 +11,8 @@
 
 #[path = "common.rs"]
 mod common;
+#[path = "mbx_esc.rs"]
+mod mbx_esc;
 #[path = "mbx_oracle.rs"]
 mod mbx_oracle;
 
@@ -21,6 +23,11 @@ const OBJECTS: [u16; 16] = [
     0x1600, 0x1601, 0x1A00, 0x1A01, 0x1C12, 0x1C13, 0x10F3, 0x1018, 0x1010, 0x1011, 0x6040, 0x607A, 0x60C1,
     0xF050, 0x2000, 0x200A,
 ];
+
+/// Operations per input at most: a sequence long enough for a segmented
+/// transfer interleaved with other requests and aborts; longer ones cost
+/// executions (an OD list walks the whole dictionary) and reach no more.
+const OPS: usize = 8;
 
 /// Takes `n` bytes from the input (fewer at its end).
 fn take<'a>(data: &mut &'a [u8], n: usize) -> &'a [u8] {
@@ -37,7 +44,7 @@ fuzz_target!(|input: &[u8]| {
     let mut data = input;
     let mut m = mbx_oracle::Checked::new();
     let mut counter = 0u8;
-    for _ in 0..32 {
+    for _ in 0..OPS {
         if data.is_empty() {
             break;
         }
@@ -48,7 +55,13 @@ fuzz_target!(|input: &[u8]| {
         let ca = if flags & 1 != 0 { 0x10 } else { 0 };
         let [i0, i1] = index.to_le_bytes();
         let mut service = 2u16;
-        let sdo: Vec<u8> = match op % 8 {
+        // an OD list walks the whole dictionary: 1 operation in 16 (the
+        // `mailbox` target sends them too), its other half uploads
+        let kind = match op % 16 {
+            14 => 3,
+            k => k % 8,
+        };
+        let sdo: Vec<u8> = match kind {
             // expedited download, size indicated with n = flags bits 1-2
             0 => {
                 let n = (flags >> 1) & 3;

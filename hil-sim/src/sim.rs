@@ -28,14 +28,16 @@ const FRAME_OVERHEAD: u64 = 8 + 4 + 12;
 pub type SimFlash = store::RamFlash<4096, 2>;
 
 /// The simulated firmware flash: 2 × 66 sectors of 4 KiB (a slot takes a
-/// 256 KiB image), NOR in RAM, on the heap.
+/// 256 KiB image), NOR in RAM, on the heap. Copy on write: a clone (a copy
+/// of a line, [`Simulation::try_clone`]) shares the 528 KiB until one of
+/// them erases or writes, so a snapshot costs what it changes.
 #[derive(Clone)]
-pub struct FirmwareFlash(pub Box<drive::boot::RamFlash<4096, 132>>);
+pub struct FirmwareFlash(pub std::sync::Arc<drive::boot::RamFlash<4096, 132>>);
 
 impl FirmwareFlash {
     /// An erased flash.
     pub fn new() -> Self {
-        Self(Box::new(drive::boot::RamFlash::new()))
+        Self(std::sync::Arc::new(drive::boot::RamFlash::new()))
     }
 }
 
@@ -50,13 +52,14 @@ impl drive::boot::Flash for FirmwareFlash {
     const SECTORS: usize = 132;
     const WRITE: usize = 8;
     fn read(&mut self, addr: u32, buf: &mut [u8]) -> Result<(), drive::boot::FlashError> {
-        drive::boot::Flash::read(&mut *self.0, addr, buf)
+        // a read changes nothing: only erase and write copy a shared flash
+        self.0.read_shared(addr, buf)
     }
     fn erase(&mut self, sector: u32) -> Result<(), drive::boot::FlashError> {
-        drive::boot::Flash::erase(&mut *self.0, sector)
+        drive::boot::Flash::erase(std::sync::Arc::make_mut(&mut self.0), sector)
     }
     fn write(&mut self, addr: u32, data: &[u8]) -> Result<(), drive::boot::FlashError> {
-        drive::boot::Flash::write(&mut *self.0, addr, data)
+        drive::boot::Flash::write(std::sync::Arc::make_mut(&mut self.0), addr, data)
     }
 }
 

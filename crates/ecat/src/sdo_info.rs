@@ -235,12 +235,17 @@ fn error_frame(out: &mut [u8], code: SdoAbort) -> Option<usize> {
     Some(w.len())
 }
 
-/// Does `info` belong to list `list_type`?
+/// Does `info` belong to list `list_type`? (Reads the entries' access
+/// only: a list walks the whole dictionary, once per fragment and five
+/// times for the list lengths.)
 fn listed(info: &ObjectInfo, list_type: u16) -> bool {
+    let any = |f: fn(od::Access) -> bool| {
+        (0..info.entries.len()).any(|pos| info.entries.access(pos).is_some_and(f))
+    };
     match list_type {
         list_type::ALL => true,
-        list_type::RXPDO => info.entries.iter().any(|e| e.access.rx_mappable()),
-        list_type::TXPDO => info.entries.iter().any(|e| e.access.tx_mappable()),
+        list_type::RXPDO => any(od::Access::rx_mappable),
+        list_type::TXPDO => any(od::Access::tx_mappable),
         _ => false,
     }
 }

@@ -520,7 +520,9 @@ impl Dictionary for DriveObjects {
 
     fn listed(&self, index: u16) -> bool {
         let a268 = crate::params::A268;
-        sdo_info_selection(self.get(a268, 1), self.get(a268, 2), index)
+        // the groups (sub 2) matter in the manufacturer area only
+        let groups = || self.get(a268, 2);
+        sdo_info_selection(self.get(a268, 1), groups, index)
     }
 }
 
@@ -528,12 +530,16 @@ impl Dictionary for DriveObjects {
 /// The manufacturer area is 2000h…5FFFh (axis A and the device) and
 /// A000h…DFFFh (axis B), group A at 2000h/A000h, 200h per group; everything
 /// else is the standard area. A value that cannot be read lists all.
-fn sdo_info_selection(area: Result<i64, SdoAbort>, groups: Result<i64, SdoAbort>, index: u16) -> bool {
+fn sdo_info_selection(
+    area: Result<i64, SdoAbort>,
+    groups: impl FnOnce() -> Result<i64, SdoAbort>,
+    index: u16,
+) -> bool {
     let group = match index & 0x7FFF {
         i @ 0x2000..=0x5FFF => Some((i - 0x2000) >> 9),
         _ => None,
     };
-    let in_groups = |g: u16| groups.map_or(true, |bits| bits >> g & 1 != 0);
+    let in_groups = |g: u16| groups().map_or(true, |bits| bits >> g & 1 != 0);
     match (area.unwrap_or(2), group) {
         (0, g) => g.is_none(),
         (1, None) => false,

@@ -530,6 +530,14 @@ impl Entries {
         }
     }
 
+    /// Access rights of the entry at position `pos` (without decoding).
+    pub fn access(&self, pos: usize) -> Option<Access> {
+        match self.0 {
+            Repr::Slice(s) => s.get(pos).map(|e| e.access),
+            Repr::Packed { .. } => self.at(pos).map(|(table, p, _)| table.access(p)),
+        }
+    }
+
     /// The packed record at position `pos` with its table (`None` for slices
     /// and for runs that renumber their records, see
     /// [`PackedTable::renumbered`]: a record's subindex is its table's).
