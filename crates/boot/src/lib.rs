@@ -36,7 +36,9 @@
 //! Every mark is one program unit written once after the slot's erase (NOR semantics,
 //! see [`store::Flash`]), so the states only move forward:
 //! erased/partial → pending (VALID) → trial (TRIED) → confirmed (CONFIRMED). A transfer
-//! cut at any point leaves no VALID unit: the slot counts as empty and never boots.
+//! cut at any point leaves no VALID unit: the slot counts as empty and never boots; a
+//! VALID unit cut after its tag (its sequence number still reads FFFFFFFFh) does not
+//! count either.
 //!
 //! The boot decision is the pure function [`decide`] of the two [`SlotState`]s.
 #![no_std]
@@ -70,6 +72,10 @@ pub use sign::{
 pub const BODY_ALIGN: usize = 1024;
 
 const VALID: [u8; 4] = *b"VAL1";
+/// A VALID unit's sequence number as erased flash reads it: the unit was
+/// cut after its tag, so it does not count (no sequence number is ever
+/// this value).
+const ERASED_SEQ: u32 = u32::MAX;
 const TRIED: [u8; 4] = *b"TRY1";
 const CONFIRMED: [u8; 4] = *b"CNF1";
 
@@ -469,7 +475,11 @@ impl<F: Flash> BootSlots<F> {
         if valid.get(..4) != Some(&VALID[..]) || header.length as usize > self.capacity() {
             return Ok(None);
         }
-        let seq = le32(&valid, 4).unwrap_or(0);
+        let seq = le32(&valid, 4).unwrap_or(ERASED_SEQ);
+        if seq == ERASED_SEQ {
+            // the VALID unit was cut after its tag: not committed
+            return Ok(None);
+        }
         Ok(Some((
             header,
             if confirmed.get(..4) == Some(&CONFIRMED[..]) {
@@ -676,6 +686,8 @@ impl<F: Flash> BootSlots<F> {
             return Err(UpdateError::Downgrade);
         }
         let seq = match self.state(d.slot.other())?.seq() {
+            // never the erased pattern (a cut VALID unit reads so)
+            Some(s) if s.wrapping_add(1) == ERASED_SEQ => 0,
             Some(s) => s.wrapping_add(1),
             None => 1,
         };

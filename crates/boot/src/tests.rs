@@ -178,6 +178,37 @@ fn cut_download_leaves_the_slot_empty() {
     assert_eq!(d.map(|d| d.slot), Some(Slot::A));
 }
 
+/// A power cut while the VALID unit is written (the flash programs the tag,
+/// not the sequence number) commits nothing: the slot stays empty, the
+/// running image starts, and the next download is taken and starts on
+/// trial (the fault matrix found it through FoE: the torn unit read as the
+/// newest image, sequence FFFFFFFFh).
+#[test]
+fn e020_a_valid_unit_cut_after_its_tag_commits_nothing() {
+    let f = file(&body(2, 900), 2);
+    let written = || {
+        let mut s = factory();
+        s.begin().unwrap();
+        s.write(&f).unwrap();
+        s
+    };
+    // the flash operations finish makes: the VALID unit is the last
+    let mut s = written();
+    let before = s.flash_mut().ops();
+    assert_eq!(s.finish(), Ok(Slot::B));
+    let last = s.flash_mut().ops() - before - 1;
+    let mut s = written();
+    s.flash_mut().cut_after(last);
+    assert!(s.finish().is_err(), "the cut fails the finish");
+    s.flash_mut().power_on();
+    let (mut s, d) = power_cycle(s);
+    assert_eq!(s.state(Slot::B).unwrap(), SlotState::Empty, "torn VALID unit");
+    assert_eq!(d.map(|d| (d.slot, d.trial)), Some((Slot::A, false)));
+    assert_eq!(download(&mut s, &f, 100), Ok(Slot::B));
+    let (_, d) = power_cycle(s);
+    assert_eq!(d.map(|d| (d.slot, d.trial)), Some((Slot::B, true)));
+}
+
 #[test]
 fn header_length_and_size_checks() {
     let mut s = factory();
