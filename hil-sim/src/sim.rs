@@ -75,7 +75,7 @@ const TIMER_HZ: u64 = drive::runtime::TIMER_HZ as u64;
 const NS_PER_S: u128 = 1_000_000_000;
 
 /// The conditions of one axis that are not the motor's: additional enable
-/// (A60), supply, STO. "Ready" by default in the simulator, so a master alone
+/// (A60), supply, STO, the encoder's health. "Ready" by default in the simulator, so a master alone
 /// can enable the drive; tests switch them off to check each refusal.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
 pub struct AxisConditions {
@@ -85,6 +85,9 @@ pub struct AxisConditions {
     pub supply_ok: bool,
     /// Safe torque off active.
     pub sto_active: bool,
+    /// The motor encoder delivers its position (false: an encoder fault,
+    /// the drive sees [`AxisIo::encoder_ok`] false).
+    pub encoder_ok: bool,
 }
 
 impl AxisConditions {
@@ -93,6 +96,7 @@ impl AxisConditions {
         additional_enable: true,
         supply_ok: true,
         sto_active: false,
+        encoder_ok: true,
     };
 }
 
@@ -188,6 +192,7 @@ pub(crate) fn axis_io(out: Option<&MotorOutputs>, motor: &Motor, c: AxisConditio
     io.additional_enable = c.additional_enable;
     io.supply_ok = c.supply_ok;
     io.sto_active = c.sto_active;
+    io.encoder_ok = c.encoder_ok;
     let Some(out) = out else {
         io.position_inc = motor.position_inc_i64() as i32;
         return io;

@@ -8,12 +8,17 @@ impl Axis {
     /// Latches `ev` as the axis' fault (T13 in the next cycle); a fault
     /// already present or latched keeps its own.
     pub(super) fn raise(&mut self, ev: Event) {
+        self.raise_with(ev, None);
+    }
+
+    /// [`raise`](Self::raise) with the event's own reaction (`None`: 605Eh).
+    pub(super) fn raise_with(&mut self, ev: Event, reaction: Option<FaultReaction>) {
         if self.dc.state().is_fault() || self.event.is_some() {
             return;
         }
         let code = fault_code_for_event(ev.number.min(255) as u8).map_or(0x1000, |(c, _)| c);
         self.event = Some(ev);
-        self.dc.raise_fault(FaultEvent { code, reaction: None });
+        self.dc.raise_fault(FaultEvent { code, reaction });
     }
 
     /// The fault change, 603Fh and the error register on T13 / T15.

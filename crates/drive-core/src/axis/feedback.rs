@@ -7,7 +7,11 @@ impl Axis {
     /// Reads the encoder: user position and the filtered velocity.
     pub(super) fn feedback(&mut self, io: &AxisIo, polarity: u8, dt_ns: u32, now_ns: Nanos) -> i32 {
         let inverted = polarity & 0x80 != 0;
-        let raw = io.position_inc;
+        // a faulty encoder's position is not used: the last valid one holds
+        let raw = match (io.encoder_ok, self.last_raw) {
+            (false, Some(last)) => last,
+            _ => io.position_inc,
+        };
         let dt_s = dt_ns as f32 * 1e-9;
         let v_raw = match self.last_raw {
             Some(last) if dt_ns > 0 => raw.wrapping_sub(last) as f32 / dt_s,

@@ -80,11 +80,16 @@ pub struct AxisIo {
     pub supply_ok: bool,
     /// Safe torque off active.
     pub sto_active: bool,
+    /// The motor encoder delivers a valid position (the feedback driver's
+    /// own check: signal, communication, plausibility). While `false`,
+    /// `position_inc` is not used and the axis faults (event 37).
+    pub encoder_ok: bool,
 }
 
 impl AxisIo {
     /// A ready axis at `position_inc`: enable A60 on, supply present, STO
-    /// off, no switches or edges (what the simulator passes by default).
+    /// off, encoder valid, no switches or edges (what the simulator passes
+    /// by default).
     pub const fn ready(position_inc: i32) -> Self {
         Self {
             position_inc,
@@ -97,6 +102,7 @@ impl AxisIo {
             additional_enable: true,
             supply_ok: true,
             sto_active: false,
+            encoder_ok: true,
         }
     }
 }

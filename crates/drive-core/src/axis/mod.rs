@@ -89,6 +89,7 @@ mod fault;
 mod feedback;
 mod io;
 mod modes;
+mod monitor;
 mod params;
 mod record_state;
 mod records;
@@ -133,6 +134,7 @@ pub(crate) use snapshot::{CyclicSlots, Snapshot, Window};
 pub use cache::AxisCache;
 use cache::CachedSnapshot;
 pub use io::{AxisCommand, AxisIo, AxisReport, IndexLatch, ProbeEdge, SwitchEdge, SwitchId};
+pub use monitor::{LOW_VOLTAGE, MOTOR_ENCODER};
 pub use params::AxisParams;
 pub(crate) use records::RecordTasks;
 pub use records::{RecordCommand, RecordStatus, StartRefusal};
@@ -456,7 +458,8 @@ impl Axis {
     /// 3. **inputs**: the switch signals from their sources ([`AxisIo`] or
     ///    I210);
     /// 4. **feedback**: encoder → user position, velocity filter
-    ///    (`feedback.rs`);
+    ///    (`feedback.rs`); the encoder and the supply watched
+    ///    (`monitor.rs`: events 37, 46);
     /// 5. **limits**: limit switches, software limits, the direction lock
     ///    of this cycle and a limit's stop;
     /// 6. **device control**: the CiA 402 state machine step, a fault
@@ -529,6 +532,7 @@ impl Axis {
         };
 
         let mut actual = self.feedback(io, o.polarity, dt_ns, now_ns);
+        self.monitor(io);
         let i199 = is_standstill(self.velocity, self.params.velocity_window_inc_per_s);
 
         // limits first: the lock of this cycle filters the set-points
@@ -577,7 +581,8 @@ impl Axis {
             // a cause that is still there holds the fault (T15, C-017):
             // both limit switches hit (event 53 cause 7, a wiring fault no
             // acknowledge can end)
-            fault_present: self.limits.both_switches_hit(),
+            // a faulty encoder (event 37) as well
+            fault_present: self.limits.both_switches_hit() || !io.encoder_ok,
             motion_command: self.motion_command(o),
             brake_override: false,
             target_reached: false,

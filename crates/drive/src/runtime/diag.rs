@@ -3,6 +3,15 @@
 
 use super::*;
 
+/// Diag code of a refused ESM transition: this prefix | AL status code (our
+/// choice; the message texts belong in the ESI).
+pub const DIAG_AL_STATUS: u32 = 0xE000_0000;
+
+/// Diag code of an axis fault: ETG.1020's E800h for an emergency, the
+/// EMCY error code (603Fh) in bits 16…31; the message's parameters are
+/// the axis (0 = A) and the E82 event << 8 | the E43 cause.
+pub const DIAG_EMCY: u32 = 0x0000_E800;
+
 /// The ESC's link and error registers (A257[0..2], the link LEDs).
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
 pub(super) struct PortDiag {
@@ -113,6 +122,24 @@ impl<F: Flash, B: Flash> Drive<F, B> {
         }
         let _ = self.objects.set(E82, 0, i64::from(event52::EVENT));
         let _ = self.objects.set(E43, 0, i64::from(cause));
+    }
+
+    /// The axes' faults raised since the last poll as error messages in the
+    /// history 10F3h (E-144): [`DIAG_EMCY`] with the EMCY code, parameters
+    /// the axis (0 = A) and event << 8 | cause.
+    pub(super) fn push_fault_messages<P: Pdi>(&mut self, pdi: &mut P, now: Nanos) -> Result<(), P::Error> {
+        if self.fault_diag.iter().all(Option::is_none) {
+            return Ok(());
+        }
+        let stamp = self.message_time_stamp(pdi, now)?;
+        for (axis, slot) in (0u32..).zip(self.fault_diag.iter_mut()) {
+            if let Some(f) = slot.take() {
+                let mut msg = DiagMessage::new(DIAG_EMCY | u32::from(f.code) << 16, DiagType::Error, f.code);
+                msg.params = [Some(axis), Some(u32::from(f.event) << 8 | u32::from(f.cause))];
+                self.diag.push(msg, stamp);
+            }
+        }
+        Ok(())
     }
 
     /// The projected fieldbus identification (E59\[2\]; from the drive's

@@ -66,8 +66,8 @@ mod slots;
 mod sync;
 
 use crate::faults::FaultChange;
-pub use diag::Leds;
 use diag::{is_event52, PortDiag, Text};
+pub use diag::{Leds, DIAG_AL_STATUS, DIAG_EMCY};
 pub use eoe::IpSettings;
 pub use foe::{foe_error, FirmwareFoe, FIRMWARE_FILE, FIRMWARE_KEY_IS_DEVELOPMENT, FIRMWARE_PUBLIC_KEY};
 pub use save::{save_result, SaveJob};
@@ -126,10 +126,6 @@ pub const TIMER_HZ: u32 = 144_000_000;
 /// Distance the A287 measurement keeps between the drive's Rx/Tx and the
 /// master's frame when it proposes the A292 range, ns (our choice).
 pub const OPTIMIZE_GUARD_NS: u32 = 5_000;
-
-/// Diag code of a refused ESM transition: this prefix | AL status code (our
-/// choice; the message texts belong in the ESI).
-pub const DIAG_AL_STATUS: u32 = 0xE000_0000;
 
 /// The live objects the runtime owns: 10F3h from the diagnosis history.
 struct Live<'a> {
@@ -222,6 +218,9 @@ pub struct Drive<F: Flash, B: Flash = NoFlash> {
     /// Per axis: an event 52 was injected whose EMCY is already queued, so
     /// the axis' own EMCY at T13 is dropped (one EMCY per event, E-087).
     event52_emcy_sent: [bool; 2],
+    /// Per axis: the fault its last T13 raised, for the diagnosis history
+    /// at the next poll (which reads the time stamp, E-144).
+    fault_diag: [Option<drive_core::faults::Fault>; 2],
     /// The projected fieldbus identification (E59[2]).
     projected_fieldbus: u16,
     /// Event 52 cause 15 was raised for the present mismatch.
@@ -340,6 +339,7 @@ impl<F: Flash, B: Flash> Drive<F, B> {
             step_offsets_ns: (0, 0),
             cycle_pdo: false,
             event52_emcy_sent: [false; 2],
+            fault_diag: [None; 2],
             projected_fieldbus: FIELDBUS_ID,
             wrong_firmware: false,
             sntp_offset_ns: None,
@@ -565,6 +565,7 @@ impl<F: Flash, B: Flash> Drive<F, B> {
             let stamp = self.message_time_stamp(pdi, now)?;
             self.diag.push(msg, stamp);
         }
+        self.push_fault_messages(pdi, now)?;
         if change.is_some() {
             // A254/A256 as the ESC has them after the master's configuration
             let alias = pdi.read_u16(regs::STATION_ALIAS)?;
@@ -677,8 +678,9 @@ impl<F: Flash, B: Flash> Drive<F, B> {
         let [io_a, io_b] = io;
         let [new_a, new_b] = new_setpoint;
         let (objects, slave) = (&mut self.objects, &mut self.slave);
-        let a = axis_cycle(axis_a, cache_a, sent_a, objects, slave, io_a, now, new_a);
-        let b = axis_cycle(axis_b, cache_b, sent_b, objects, slave, io_b, now, new_b);
+        let [diag_a, diag_b] = &mut self.fault_diag;
+        let a = axis_cycle(axis_a, cache_a, sent_a, objects, slave, io_a, now, new_a, diag_a);
+        let b = axis_cycle(axis_b, cache_b, sent_b, objects, slave, io_b, now, new_b, diag_b);
         let register = axis_a.error_register() | axis_b.error_register();
         write_slot(&mut self.objects, self.slots.error_register, i64::from(register));
         [a, b]
@@ -754,8 +756,9 @@ impl<F: Flash, B: Flash> Drive<F, B> {
 }
 
 /// One axis of [`Drive::control_cycle_with`]: its cycle, the EMCY of a
-/// fault change (the event 52 EMCY only once for the device) with E82/E43;
-/// returns the power-stage command.
+/// fault change (the event 52 EMCY only once for the device) with E82/E43,
+/// a raised fault noted in `diag` for the history; returns the power-stage
+/// command.
 #[allow(clippy::too_many_arguments)]
 fn axis_cycle(
     axis: &mut Axis,
@@ -766,6 +769,7 @@ fn axis_cycle(
     io: &AxisIo,
     now: Nanos,
     new: bool,
+    diag: &mut Option<drive_core::faults::Fault>,
 ) -> AxisCommand {
     let report = axis.cycle_cached(cache, objects, io, now, new);
     let mut fault = report.fault;
@@ -778,7 +782,10 @@ fn axis_cycle(
     if let Some(f) = fault {
         slave.emergency(crate::emcy::of_change(&f, axis.index()));
         let (e82, e43) = match f {
-            FaultChange::Raised(f) => (f.event, f.cause),
+            FaultChange::Raised(f) => {
+                *diag = Some(f);
+                (f.event, f.cause)
+            }
             FaultChange::Cleared => (crate::emcy::E82_INACTIVE, 0),
         };
         let _ = objects.set(E82, 0, i64::from(e82));
