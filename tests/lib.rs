@@ -2,6 +2,7 @@
 //! master (ethercrab) talks to the simulated line in-process, in simulated time.
 
 pub mod axis;
+pub mod matrix;
 
 use ethercrab::{MainDevice, SubDeviceGroup, SubDeviceRef, Timeouts};
 use hil_sim::sim::Simulation;

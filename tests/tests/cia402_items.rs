@@ -725,9 +725,20 @@ fn c015_switch_on_disabled_causes_in_e47_and_e49() {
         with_drive(&sim, |d| d.conditions[0] = AxisConditions::READY);
         m.run_until(10, |t| t.state() == sw::RTSO).await.expect("T2");
         assert_eq!(causes(&mut m).await, (0, 0), "not in Switch on disabled");
-        // enabled, then the supply drops: forced to SOD with the supply as cause
+        // enabled, then the supply drops: event 46 "Low voltage" (the power
+        // stage was on, decisions), and the fault reset, with the supply
+        // still missing, leads to SOD with the supply as cause
         m.enable().await;
         with_drive(&sim, |d| d.conditions[0].supply_ok = false);
+        m.run_until(50, |t| t.state() == sw::FAULT)
+            .await
+            .expect("event 46");
+        assert_eq!(
+            sd.sdo_read::<u16>(0x603F, 0).await.unwrap(),
+            0x3120,
+            "low voltage"
+        );
+        m.set_controlword(0x0080);
         m.run_until(50, |t| t.state() == sw::SOD)
             .await
             .expect("forced to SOD");

@@ -450,7 +450,7 @@ fn e046_e131_e129_e038_dc_op_waits_for_pll_lock_and_sync0_loss_drops_to_safeop()
     use drive_tests::{al_status, request, CoeClient};
     use esc::AlStatusCode;
     let sim = line();
-    with_master(&sim, async |md, clock| {
+    let seen = with_master(&sim, async |md, clock| {
         let mut group = init(md, clock).await;
         for mut sd in group.iter_mut(md) {
             sd.set_dc_sync(DcSync::Sync0);
@@ -510,10 +510,13 @@ fn e046_e131_e129_e038_dc_op_waits_for_pll_lock_and_sync0_loss_drops_to_safeop()
                 .expect("0x0981");
         }
         dc_cycles(md, &group, &sim, 20, |_, _, _| {}).await;
+        // the fault matrix's row: drive 0 as the master sees it
+        let mut seen = Vec::new();
         for i in 0..2 {
             let sd = group.subdevice(md, i).expect("drive");
+            let status = al_status(&sd).await;
             assert_eq!(
-                al_status(&sd).await,
+                status,
                 (SAFEOP | 0x10, al::DC_SYNC_TIMEOUT),
                 "drive {i}: SYNC0 timeout"
             );
@@ -564,6 +567,27 @@ fn e046_e131_e129_e038_dc_op_waits_for_pll_lock_and_sync0_loss_drops_to_safeop()
                 s.drives()[i].drive.pll().and_then(|p| p.fault()),
                 Some(SyncFault::Sync0Timeout)
             );
+            if i == 0 {
+                let axes: Vec<String> = d
+                    .axes()
+                    .iter()
+                    .map(|a| {
+                        let sw = d.objects().get(a.cia402_index(0x6041), 0).unwrap() as u16;
+                        format!(
+                            "{} {:04X}h",
+                            drive_tests::matrix::cia402_state(sw),
+                            a.error_code()
+                        )
+                    })
+                    .collect();
+                seen.push(format!(
+                    "{}; {}; axes A, B: {}; A257[0] {}",
+                    drive_tests::matrix::al(status),
+                    drive_tests::matrix::emcys(&c.emergencies),
+                    axes.join(", "),
+                    String::from_utf8_lossy(&a257[..3])
+                ));
+            }
         }
         // without acknowledge a request is ignored
         let sd0 = group.subdevice(md, 0).expect("drive");
@@ -587,6 +611,7 @@ fn e046_e131_e129_e038_dc_op_waits_for_pll_lock_and_sync0_loss_drops_to_safeop()
         .await;
         println!("Op again after {back:?} cycles");
         assert!(back.is_some(), "Op again after acknowledge");
+        seen.push("after SYNC0 is back and an acknowledge: Op once the PLL locks".into());
         for i in 0..2 {
             let sd = group.subdevice(md, i).expect("drive");
             assert_eq!(al_status(&sd).await, (OP, 0), "drive {i}");
@@ -595,7 +620,17 @@ fn e046_e131_e129_e038_dc_op_waits_for_pll_lock_and_sync0_loss_drops_to_safeop()
             assert_eq!(pll.fault(), None, "acknowledge cleared the PLL fault");
             assert!(pll.is_locked());
         }
+        seen.join("; ")
     });
+    let row = drive_tests::matrix::Row {
+        order: "11",
+        case: "SYNC0 stops in Op (0x0981 = 0) on a line of two drives under DC",
+        spec: "E-131, E-129, E-038",
+        peer: "ethercrab",
+        expected: "Safe-Op + ERR, AL 0034h; EMCY 7500h/10h event 52 cause 7; axes A, B: Fault 7500h, Fault \
+                   7500h; A257[0] Er3; after SYNC0 is back and an acknowledge: Op once the PLL locks",
+    };
+    drive_tests::fault_row!(row, seen);
 }
 
 const A149: u16 = drive::parameter_index(0, 149);

@@ -113,11 +113,17 @@ fn c003_c015_enable_refused_without_a60_supply_or_sto() {
             m.set_controlword(0);
             m.run(2).await;
             m.enable().await;
-            // lost while enabled: forced out of Operation enabled (C-013/C-015)
+            // lost while enabled: forced out of Operation enabled (C-013/C-015);
+            // the supply with the power stage on is event 46 (decisions)
             with_drive(&sim, |d| cut(&mut d.conditions[0]));
-            let left = m.run_until(50, |t| t.state() == sw::SOD).await;
+            let to = if what == "no supply" { sw::FAULT } else { sw::SOD };
+            let left = m.run_until(50, |t| t.state() == to).await;
             assert!(left.is_some(), "{what} in OE: {:#06x}", m.tx.statusword);
             with_drive(&sim, |d| d.conditions[0] = AxisConditions::READY);
+            m.set_controlword(0);
+            m.run(2).await;
+            m.set_controlword(0x0080);
+            m.run(2).await;
             m.set_controlword(0);
             m.run(2).await;
         }

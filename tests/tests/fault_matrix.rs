@@ -1,0 +1,96 @@
+//! The fault matrix (issue 19, docs/fault-matrix.md): each case brings a
+//! drive to the state the case needs through a real master (ethercrab,
+//! in-process), makes the fault happen (lost frames, SYNC0 gone, a master
+//! that stops reading its mailbox or restarts mid-transfer, power cut at
+//! every flash operation, encoder fault, STO, undervoltage, a limit switch
+//! during homing, a second master), and checks the end the spec names:
+//! AL state and status code, the CiA 402 state, EMCY, 603Fh, the
+//! diagnosis history, and that nothing is lost. Each test ends with
+//! [`drive_tests::fault_row!`], which leaves its row for the printed table
+//! (`scripts/fault-matrix`). Cases elsewhere join the table the same way:
+//! SYNC0 loss (dc_sync.rs), power cut during a save (save.rs).
+#![allow(
+    clippy::unwrap_used,
+    clippy::expect_used,
+    clippy::panic,
+    clippy::indexing_slicing
+)]
+
+#[path = "fault_matrix/axis.rs"]
+mod axis;
+#[path = "fault_matrix/bus.rs"]
+mod bus;
+#[path = "fault_matrix/flash.rs"]
+mod flash;
+#[path = "fault_matrix/mailbox.rs"]
+mod mailbox;
+
+use drive_tests::CoeClient;
+use ethercrab::SubDeviceRef;
+use hil_sim::sim::Simulation;
+use std::cell::RefCell;
+
+/// Runs the line `ns` of simulated time on, without frames.
+pub fn advance<N: hil_sim::sim::Node>(sim: &RefCell<Simulation<N>>, ns: u64) {
+    let mut s = sim.borrow_mut();
+    let t = s.now().as_ns() + ns;
+    s.advance_to(nanos::Nanos::from_ns(t));
+}
+
+/// An object of the first drive, read locally.
+pub fn get(sim: &RefCell<Simulation>, index: u16, sub: u8) -> i64 {
+    sim.borrow().drives()[0].drive.objects().get(index, sub).unwrap()
+}
+
+/// The EMCYs queued for the master, collected while it uploads 1000h a
+/// few times.
+pub async fn emcys<S>(sd: &SubDeviceRef<'_, S>) -> Vec<Vec<u8>>
+where
+    S: std::ops::Deref<Target = ethercrab::SubDevice>,
+{
+    let mut c = CoeClient::new();
+    for _ in 0..4 {
+        c.upload(sd, 0x1000, 0).await.unwrap();
+    }
+    // ethercrab's next request must not look like a repeat of ours
+    c.hand_over(sd).await;
+    c.emergencies
+}
+
+/// The newest message of the diagnosis history 10F3h: "history: error
+/// E800h|code, axis, event/cause" for an axis fault, "history: error
+/// AL xxxxh" for a refused or lost state, "history empty".
+pub async fn newest_diag<S>(sd: &SubDeviceRef<'_, S>) -> String
+where
+    S: std::ops::Deref<Target = ethercrab::SubDevice>,
+{
+    let newest: u8 = sd.sdo_read(0x10F3, 2).await.expect("10F3h:02");
+    if newest == 0 {
+        return "history empty".into();
+    }
+    let mut c = CoeClient::new();
+    let msg = c.upload(sd, 0x10F3, newest).await.expect("message");
+    c.hand_over(sd).await;
+    let code = u32::from_le_bytes(msg[0..4].try_into().unwrap());
+    let kind = match u16::from_le_bytes([msg[4], msg[5]]) & 0x0F {
+        0 => "info",
+        1 => "warning",
+        _ => "error",
+    };
+    if code & 0xFFFF == drive::runtime::DIAG_EMCY {
+        // parameters: flags u16 + u32 each, after the 16 fixed bytes
+        let param = |k: usize| u32::from_le_bytes(msg[18 + 6 * k..22 + 6 * k].try_into().unwrap());
+        let (axis, ev) = (param(0), param(1));
+        format!(
+            "history: {kind} {:04X}h axis {} event {}/{}",
+            code >> 16,
+            if axis == 0 { "A" } else { "B" },
+            ev >> 8,
+            ev & 0xFF
+        )
+    } else if code & 0xFFFF_0000 == drive::runtime::DIAG_AL_STATUS {
+        format!("history: {kind} AL {:04X}h", code & 0xFFFF)
+    } else {
+        format!("history: {kind} {code:08X}h")
+    }
+}
