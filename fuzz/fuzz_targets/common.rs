@@ -30,6 +30,36 @@ pub fn apwr(sim: &mut Simulation, ado: u16, data: &[u8]) {
 thread_local! {
     /// [`build_preop_line`] once per process: each input starts from a copy.
     static PREOP: Simulation = build_preop_line();
+    /// [`build_op_line`] once per process.
+    static OP: Simulation = build_op_line();
+}
+
+/// The station address [`build_preop_line`] gives the drive.
+#[allow(dead_code)] // the frame target's
+pub const PREOP_STATION: u16 = 0x1000;
+
+/// A copy of the line in Op ([`build_op_line`]).
+#[allow(dead_code)] // the frame target's
+pub fn op_line() -> Simulation {
+    OP.with(|s| s.try_clone()).unwrap_or_else(build_op_line)
+}
+
+/// A one-slave line as the QEMU run's scripted master leaves it once both
+/// axes are enabled: Pre-Op start-up SDOs, both channels assigned, DC
+/// SYNC0 at 1 ms, the PDOs mapped at logical 0x0000/0x0800, Op, csp.
+pub fn build_op_line() -> Simulation {
+    use hil_sim::script::{Progress, Script, SimLink, CYCLE};
+    let mut sim = Simulation::new(1);
+    let mut script = Script::new();
+    let mut t = nanos::Nanos::from_ns(CYCLE.as_ns() / 2);
+    while !script.finished() && t < nanos::Nanos::from_secs(5) {
+        t += CYCLE;
+        sim.advance_to(t);
+        if script.step(&mut SimLink(&mut sim)) == Progress::Enabled {
+            return sim;
+        }
+    }
+    panic!("the scripted master did not enable the drive")
 }
 
 /// A one-slave line in PRE-OP: a copy of the one built once per process
@@ -43,7 +73,7 @@ pub fn preop_line() -> Simulation {
 /// address, mailbox SyncManagers from the SII defaults, AL control = 2.
 pub fn build_preop_line() -> Simulation {
     let mut sim = Simulation::new(1);
-    apwr(&mut sim, esc::regs::STATION_ADDRESS, &0x1000u16.to_le_bytes());
+    apwr(&mut sim, esc::regs::STATION_ADDRESS, &PREOP_STATION.to_le_bytes());
     let sm0 = esc::SyncManager {
         start: 0x1000,
         length: 256,

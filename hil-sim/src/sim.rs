@@ -4,10 +4,12 @@
 
 use crate::esc::{Esc, EscConfig, LineTiming};
 use crate::frame::process_frame;
-use crate::motor::{Input, Motor, MotorOutputs};
+use crate::motor::{Motor, MotorOutputs};
+mod axis_io;
 mod snapshot;
+
 use crate::pcap::Recording;
-use drive::axis::{AxisIo, IndexLatch, ProbeEdge, SwitchEdge, SwitchId};
+pub(crate) use axis_io::axis_io;
 use nanos::Nanos;
 use std::collections::VecDeque;
 use std::io;
@@ -15,6 +17,9 @@ use std::path::Path;
 
 /// Local poll period of the slave firmware between frames (the mailbox/ESM task).
 pub const POLL_PERIOD: Nanos = Nanos::from_us(100);
+/// SYNC0 pulses closer than this reach the drive as one interrupt (a
+/// cycle no drive runs; a master or a fuzzer can still set it).
+const MIN_SYNC0_IRQ_NS: u32 = 10_000;
 /// Forwarding delay of one slave, ns (out and back: half of it each way).
 const SLAVE_DELAY_NS: u64 = 500;
 /// SYNC0 pulses kept in [`SimDrive::sync0_log`].
@@ -86,7 +91,7 @@ pub struct AxisConditions {
     /// Safe torque off active.
     pub sto_active: bool,
     /// The motor encoder delivers its position (false: an encoder fault,
-    /// the drive sees [`AxisIo::encoder_ok`] false).
+    /// the drive sees [`drive::axis::AxisIo::encoder_ok`] false).
     pub encoder_ok: bool,
 }
 
@@ -184,63 +189,6 @@ fn sii_image() -> ([u8; ecat::sii::EEPROM_BYTES], usize) {
     let mut sii = [0u8; ecat::sii::EEPROM_BYTES];
     let len = ecat::build_sii(&drive::DEVICE, &mut sii).unwrap_or(0);
     (sii, len)
-}
-
-/// What the axis runtime reads from the motor's last step.
-pub(crate) fn axis_io(out: Option<&MotorOutputs>, motor: &Motor, c: AxisConditions) -> AxisIo {
-    let mut io = AxisIo::ready(0);
-    io.additional_enable = c.additional_enable;
-    io.supply_ok = c.supply_ok;
-    io.sto_active = c.sto_active;
-    io.encoder_ok = c.encoder_ok;
-    let Some(out) = out else {
-        io.position_inc = motor.position_inc_i64() as i32;
-        return io;
-    };
-    io.position_inc = out.position_inc;
-    let sw = motor.switches();
-    // electrical level -> "switch actuated" (normally closed contacts read low when hit)
-    let hit = |which: Input| out.inputs.get(which) != sw.get(which).is_active_low();
-    io.limit_positive = hit(Input::PositiveLimit);
-    io.limit_negative = hit(Input::NegativeLimit);
-    io.reference = hit(Input::Reference);
-    io.index = out.index.map(|i| IndexLatch {
-        position_inc: i.position_inc,
-        time_ns: out.step_start + i.time_offset,
-    });
-    let probes = out.edges.iter().filter_map(|e| {
-        let input = match e.input {
-            Input::Probe1 => 1,
-            Input::Probe2 => 2,
-            _ => return None,
-        };
-        Some(ProbeEdge {
-            input,
-            rising: e.rising,
-            time_ns: out.step_start + e.time_offset,
-            position_inc: Some(e.position_inc),
-        })
-    });
-    for (slot, edge) in io.probe_edges.iter_mut().zip(probes) {
-        *slot = Some(edge);
-    }
-    // limit and reference switch changes, latched where the motor crossed them
-    let switches = out.edges.iter().filter_map(|e| {
-        let switch = match e.input {
-            Input::PositiveLimit => SwitchId::PositiveLimit,
-            Input::NegativeLimit => SwitchId::NegativeLimit,
-            Input::Reference => SwitchId::Reference,
-            _ => return None,
-        };
-        Some(SwitchEdge {
-            switch,
-            position_inc: e.position_inc,
-        })
-    });
-    for (slot, edge) in io.switch_edges.iter_mut().zip(switches) {
-        *slot = Some(edge);
-    }
-    io
 }
 
 impl SimDrive {
@@ -770,7 +718,14 @@ impl<N: Node> Simulation<N> {
                 continue;
             }
             let before = d.esc_mut().sync0_total();
-            d.esc_mut().tick(now);
+            // pulses closer together than the drive's SYNC0 interrupt can
+            // take them coalesce into one interrupt (all up to `t` at once)
+            let upto = if d.esc_mut().sync0_cycle_ns() < MIN_SYNC0_IRQ_NS {
+                t
+            } else {
+                now
+            };
+            d.esc_mut().tick(upto);
             if d.esc_mut().sync0_total() == before {
                 // no pulse fired (cannot happen: the edge time is exact); stop
                 return;

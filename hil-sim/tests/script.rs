@@ -2,26 +2,9 @@
 //! simulated drive on the host: the same script `firmware-qemu` runs, so a
 //! failure there can be reproduced here.
 
-use hil_sim::frame::{ECAT_HEADER_LEN, ETHERNET_HEADER_LEN, ETHERTYPE_ETHERCAT};
-use hil_sim::script::{Link, Progress, Script, CYCLE, MOVE_INC};
+use hil_sim::script::{Progress, Script, SimLink, CYCLE, MOVE_INC};
 use hil_sim::sim::Simulation;
 use nanos::Nanos;
-
-/// Wraps each datagram in an Ethernet frame and passes it down the line.
-struct SimLink<'a>(&'a mut Simulation);
-
-impl Link for SimLink<'_> {
-    fn transfer(&mut self, datagram: &mut [u8]) {
-        let mut f = vec![0xFFu8; 6];
-        f.extend_from_slice(&[0x02, 0, 0, 0, 0, 1]);
-        f.extend_from_slice(&ETHERTYPE_ETHERCAT.to_be_bytes());
-        f.extend_from_slice(&(datagram.len() as u16 | 0x1000).to_le_bytes());
-        f.extend_from_slice(datagram);
-        self.0.exchange(&mut f);
-        let off = ETHERNET_HEADER_LEN + ECAT_HEADER_LEN;
-        datagram.copy_from_slice(&f[off..off + datagram.len()]);
-    }
-}
 
 /// E-107 (DC-Sync selected by the master) through the scripted master: Pre-Op SDOs, DC SYNC0, Op,
 /// enable, a csp move on both axes, disable and back to Init.

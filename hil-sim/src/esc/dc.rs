@@ -289,6 +289,11 @@ impl Esc {
         self.dc.sync0.next.map(|s| self.now_for_system(s))
     }
 
+    /// The SYNC0 cycle time register (0x09A0), ns (0: single shot).
+    pub fn sync0_cycle_ns(&self) -> u32 {
+        self.get_u32(dc::SYNC0_CYCLE)
+    }
+
     /// Simulation time of the next SYNC1 pulse, `None` when SYNC1 is not active.
     pub fn next_sync1_at(&self) -> Option<Nanos> {
         self.dc.sync1.next.map(|s| self.now_for_system(s))

@@ -19,6 +19,10 @@
 //! QEMU can be reproduced with `cargo test`.
 
 pub mod eoe;
+#[cfg(feature = "std")]
+mod sim_link;
+#[cfg(feature = "std")]
+pub use sim_link::SimLink;
 
 use crate::esc::Esc;
 use crate::frame::{Command, Datagram, DATAGRAM_HEADER_LEN, WKC_LEN};
