@@ -419,65 +419,62 @@ fn c140_pdo_timeout_a258_values() {
 // C-142 native scaling, C-145 synchronisation
 // ---------------------------------------------------------------------------
 
-#[test]
-fn c142_native_scaling_passes_values_unchanged_and_a310_sets_decimals() {
+/// csv at 60FFh = `v` after the Pre-Op writes `setup` (index, sub, value):
+/// 60FFh as the parameter channel shows it, 606Ch in the TxPDO, the plant's
+/// velocity in rev/s.
+fn csv_at(setup: &[(u16, u8, u8)], v: i32) -> (i32, i32, f64) {
     let sim = line(1);
     with_master(&sim, async |md, clock| {
         let group = init(md, clock).await;
         let sd = group.subdevice(md, 0).unwrap();
         let a213: u8 = sd.sdo_read(parameter_index(0, 213), 1).await.unwrap();
         assert_eq!(a213, 1, "A213[0] = 1 native by default");
+        for &(index, sub, value) in setup {
+            sd.sdo_write(index, sub, value).await.unwrap();
+        }
         let group = group.into_op(md).await.expect("OP");
         let sd = group.subdevice(md, 0).unwrap();
         let mut c = Cyclic::new(md, &group, &sim, 0);
         c.set_mode(9);
         c.run(3).await;
         c.enable().await;
-        // 60FFh in inc/s as sent: 1 234 567 inc/s reaches the object and the axis unchanged
-        let v = 1_234_567;
         c.set_target_velocity(v);
         let t = c.run(600).await;
-        assert_eq!(sd.sdo_read::<i32>(0x60FF, 0).await.unwrap(), v, "60FFh as sent");
-        let motor =
-            sim.borrow().drives()[0].motors[0].velocity_rad_s() / std::f64::consts::TAU * f64::from(REV);
-        println!("native: 60FFh {v}, 606Ch {}, plant {motor:.0} inc/s", t.velocity);
-        assert!(
-            (t.velocity - v).abs() < v / 100,
-            "606Ch in the same unit: {}",
-            t.velocity
-        );
-        assert!(
-            (motor - f64::from(v)).abs() < f64::from(v) / 100.0,
-            "the plant turns {motor}"
-        );
-
-        // A213[0] = 0 with A310 = 2: velocities count in 0.01 units/s
-        sd.sdo_write(parameter_index(0, 213), 1, 0u8).await.unwrap();
-        sd.sdo_write(parameter_index(0, 310), 0, 2u8).await.unwrap();
-        c.set_target_velocity(REV * 50); // 0.5 rev/s in 0.01 inc/s
-        let t = c.run(600).await;
+        let shown = sd.sdo_read::<i32>(0x60FF, 0).await.unwrap();
         let motor = sim.borrow().drives()[0].motors[0].velocity_rad_s() / std::f64::consts::TAU;
         println!(
-            "A310 = 2: 60FFh {}, 606Ch {}, plant {motor:.4} rev/s",
-            REV * 50,
+            "{setup:?}: 60FFh {v} (SDO {shown}), 606Ch {}, plant {motor:.4} rev/s",
             t.velocity
         );
-        assert!((motor - 0.5).abs() < 0.01, "0.5 rev/s: {motor}");
-        assert!(
-            (t.velocity - REV * 50).abs() < REV / 2,
-            "606Ch in 0.01 inc/s: {}",
-            t.velocity
-        );
-        // native again: the same objects in inc/s
-        sd.sdo_write(parameter_index(0, 213), 1, 1u8).await.unwrap();
-        c.set_target_velocity(REV / 2);
-        let t = c.run(600).await;
-        assert!(
-            (t.velocity - REV / 2).abs() < REV / 100,
-            "native again: {}",
-            t.velocity
-        );
-    });
+        (shown, t.velocity, motor)
+    })
+}
+
+#[test]
+fn c142_native_scaling_passes_values_unchanged_and_a310_sets_decimals() {
+    // native: 60FFh in inc/s as sent, 1 234 567 inc/s reaches the object and the axis unchanged
+    let v = 1_234_567;
+    let (shown, velocity, motor) = csv_at(&[], v);
+    assert_eq!(shown, v, "60FFh as sent");
+    assert!(
+        (velocity - v).abs() < v / 100,
+        "606Ch in the same unit: {velocity}"
+    );
+    let motor = motor * f64::from(REV);
+    assert!(
+        (motor - f64::from(v)).abs() < f64::from(v) / 100.0,
+        "the plant turns {motor}"
+    );
+    // A213[0] = 0 with A310 = 2 (Pre-Op, C-142/E-143): velocities count in 0.01 units/s
+    let a213 = parameter_index(0, 213);
+    let a310 = parameter_index(0, 310);
+    let (shown, velocity, motor) = csv_at(&[(a213, 1, 0), (a310, 0, 2)], REV * 50);
+    assert!((motor - 0.5).abs() < 0.01, "0.5 rev/s: {motor}");
+    assert!(
+        (velocity - REV * 50).abs() < REV / 2,
+        "606Ch in 0.01 inc/s: {velocity}"
+    );
+    assert_eq!(shown, REV / 2, "the native parameter channel shows inc/s");
 }
 
 #[test]

@@ -24,7 +24,35 @@ pub fn write_reference(w: &mut impl Write) -> fmt::Result {
         0xA000..0xE000,
         AXIS_B_MANUFACTURER,
     )?;
-    section(w, "Modular device profile, F000h–FFFEh", 0xF000..0xFFFF)
+    section(w, "Modular device profile, F000h–FFFEh", 0xF000..0xFFFF)?;
+    scaling(w)
+}
+
+/// The entries fieldbus scaling acts on ([`crate::objects::scaling`]).
+fn scaling(w: &mut impl Write) -> fmt::Result {
+    w.write_str(
+        "\n## Fieldbus scaling (A213)\n\n\
+         With A213 = 1 \"native\" (the default) these entries count in the user units of their axis \
+         (6091h/6092h; the unit column names the default, increments); with A213 = 0 \"integer with \
+         decimal places\" in user units / 10^A310 (velocities) or / 10^A311 (accelerations, \
+         decelerations, jerk) of their axis. A213[0] is the representation of the process data and \
+         of the values the dictionary keeps (the axis converts them); A213[1] that of the parameter \
+         channel (SDO, UDP parameter service), converted from the kept value when the two differ. \
+         Axis B's entries are at +800h (CiA 402) and +8000h (group J). Every other entry has a fixed \
+         unit; positions take decimal places through the feed constant 6092h.\n\n\
+         | Index | Sub | Name | Decimal places |\n|---|---|---|---|\n",
+    )?;
+    for (index, sub, q) in crate::objects::scaling::SCALED {
+        let name = crate::objects::find(index)
+            .and_then(|(_, o)| o.info.entry(sub))
+            .map_or("", |e| e.name);
+        let decimals = match q {
+            crate::objects::scaling::Quantity::Velocity => "A310",
+            crate::objects::scaling::Quantity::Acceleration => "A311",
+        };
+        writeln!(w, "| {index:04X}h | {sub:02X}h | {name} | {decimals} |")?;
+    }
+    Ok(())
 }
 
 const HEADER: &str = "# Object dictionary

@@ -82,3 +82,5 @@ extern crate std;
 mod tests_od;
 #[cfg(test)]
 mod tests_records_od;
+#[cfg(test)]
+mod tests_scaling;

@@ -66,10 +66,16 @@ pub const A67: u16 = parameter_index(0, 67);
 pub const A340: u16 = parameter_index(0, 340);
 /// E80 operating condition (per axis).
 pub const E80: u16 = parameter_index(4, 80);
-/// A213 fieldbus scaling (global; \[0\] process data: 1 native, 0 decimals).
+/// A213 fieldbus scaling (global; 1 native, 0 integer with decimal places):
+/// \[0\] (sub 1) the process data and the values the objects hold, \[1\]
+/// (sub 2) the parameter channel (SDO, UDP parameter service); see
+/// [`crate::objects::scaling`].
 pub const A213: u16 = parameter_index(0, 213);
-/// A310 / A311 decimal places of velocities / accelerations (per axis).
+/// A310 decimal places of the velocity objects (per axis).
 pub const A310: u16 = parameter_index(0, 310);
+/// A311 decimal places of the acceleration, deceleration and jerk objects
+/// (per axis).
+pub const A311: u16 = parameter_index(0, 311);
 /// I02 position encoder (per axis).
 pub const I02: u16 = parameter_index(8, 2);
 /// A279 PROFINET units (the PROFIdrive personality's unit choices).

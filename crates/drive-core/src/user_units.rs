@@ -10,7 +10,7 @@
 //! `c109_user_units_agree_with_the_axis_snapshot` keeps the two together.
 
 use crate::axis::Axis;
-use crate::params::{A213, A310};
+use crate::params::{A213, A310, A311};
 use crate::DriveObjects;
 use motion::scaling::polarity_inverted;
 use motion::{AxisScaling, INCREMENTS_PER_REVOLUTION};
@@ -86,7 +86,7 @@ impl UserUnits {
                     .clamp(0, 9);
                 (0..n).fold(1.0f64, |f, _| f * 10.0)
             };
-            (d(A310), d(A310 + 1))
+            (d(A310), d(A311))
         } else {
             (1.0, 1.0)
         };
@@ -183,7 +183,7 @@ mod tests {
         }
         od.set(A213, 1, 0).unwrap();
         od.set(A310, 0, 2).unwrap();
-        od.set(A310 + 1, 0, 3).unwrap();
+        od.set(A311, 0, 3).unwrap();
         let snap = Snapshot::read(&od, Window { axis: 0 });
         let inc = snap.to_increments(&snap.scaling());
         let u = UserUnits::read(&od, &axis);

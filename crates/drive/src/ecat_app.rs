@@ -68,8 +68,10 @@ pub const fn event52_cause(loss: OpLoss) -> u8 {
 }
 
 /// The drive's dictionary (with its live values) as the slave stack's
-/// application: the [`od::Dictionary`] of the CoE server, and the settings
-/// of [`ecat::Application`] read from A150 and A258.
+/// application: the [`od::Dictionary`] of the CoE server (the runtime
+/// passes [`DriveObjects::parameter_channel`](crate::DriveObjects::parameter_channel):
+/// SDO values of the A213-scaled entries in A213\[1\]'s representation), and
+/// the settings of [`ecat::Application`] read from A150 and A258.
 pub struct EcatApp<'a, L: LiveValues>(pub WithLive<'a, L>);
 
 impl<L: LiveValues> EcatApp<'_, L> {

@@ -278,3 +278,28 @@ fn rd_u(d: &mut DriveObjects, index: u16, sub: u8) -> u64 {
 fn wr(d: &mut DriveObjects, index: u16, sub: u8, value: u32) {
     d.write(index, sub, &[value as u8], od::CommState::PreOp).unwrap();
 }
+
+/// E-143: besides CoE, the UDP parameter service (the dictionary of
+/// `Drive::with_eoe`) and `Drive::read_object` are the parameter channel:
+/// with A213 = (0, 1) and A310 = 2 they show and take 6081h in inc/s while
+/// the dictionary keeps the process data's 0.01 inc/s.
+#[test]
+fn e143_udp_parameter_service_and_read_object_are_the_parameter_channel() {
+    use crate::params::{A213, A310};
+    use od::CommState;
+    let mut drive = crate::runtime::Drive::new(store::RamFlash::<4096, 2>::new());
+    let o = drive.objects_mut();
+    o.write(A213, 1, &[0], CommState::PreOp).unwrap();
+    o.write(A310, 0, &[2], CommState::PreOp).unwrap();
+    o.set(0x6081, 0, 123_456).unwrap();
+    let mut b = [0u8; 4];
+    drive.read_object(0x6081, 0, &mut b, CommState::PreOp).unwrap();
+    assert_eq!(u32::from_le_bytes(b), 1235);
+    let (read, wrote) = drive.with_eoe(|_, dict, state| {
+        let mut b = [0u8; 4];
+        let read = dict.read(0x6081, 0, &mut b, state).map(|_| u32::from_le_bytes(b));
+        (read, dict.write(0x6081, 0, &1000u32.to_le_bytes(), state))
+    });
+    assert_eq!((read, wrote), (Ok(1235), Ok(())));
+    assert_eq!(drive.objects().get(0x6081, 0), Ok(100_000));
+}

@@ -14,7 +14,7 @@ use crate::{AXIS_B_CIA402, AXIS_B_MANUFACTURER};
 use motion::scaling::AxisScaling;
 
 pub(crate) use crate::params::{
-    A150, A213, A291, A310, A340, A66, A67, E47, E48, E49, E80, I02, I101, I21, I210, I22, I23, I46,
+    A150, A213, A291, A310, A311, A340, A66, A67, E47, E48, E49, E80, I02, I101, I21, I210, I22, I23, I46,
 };
 
 /// Entry `index`:`sub`, or 0 with `misses` counted: the dictionary declares
@@ -430,7 +430,7 @@ impl Snapshot {
             decimals: if read_or_miss(od, A213, 1, m) == 0 {
                 (
                     sat(w.param(od, A310, 0, m), 0u8, 9),
-                    sat(w.param(od, A310 + 1, 0, m), 0u8, 9),
+                    sat(w.param(od, A311, 0, m), 0u8, 9),
                 )
             } else {
                 (0, 0)

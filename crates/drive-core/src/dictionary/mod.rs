@@ -22,6 +22,7 @@ mod persist;
 mod prepared;
 mod records;
 mod resolve;
+mod scaling;
 mod slot;
 
 pub use persist::{ImageError, PERSISTENT_IMAGE_BYTES};
@@ -149,13 +150,18 @@ impl Default for DriveObjects {
     }
 }
 
-/// [`DriveObjects`] with a [`LiveValues`] provider, as the CoE server sees it.
+/// [`DriveObjects`] with a [`LiveValues`] provider, as a fieldbus sees it:
+/// from [`DriveObjects::with_live`] the values as the dictionary keeps them,
+/// from [`DriveObjects::parameter_channel`] the A213-scaled entries in the
+/// parameter channel's representation (A213\[1\], `scaling.rs`).
 #[derive(Debug)]
 pub struct WithLive<'a, L: LiveValues> {
     /// The dictionary.
     pub objects: &'a mut DriveObjects,
     /// The provider of live values.
     pub live: &'a mut L,
+    /// Reads and writes convert the A213-scaled entries (parameter channel).
+    channel: bool,
 }
 
 impl DriveObjects {
@@ -192,9 +198,29 @@ impl DriveObjects {
         self.config_generation = self.config_generation.wrapping_add(1);
     }
 
-    /// This dictionary with `live` answering the live entries.
+    /// This dictionary with `live` answering the live entries; values as
+    /// the dictionary keeps them (the A213-scaled entries in the process
+    /// data's representation, A213\[0\]).
     pub fn with_live<'a, L: LiveValues>(&'a mut self, live: &'a mut L) -> WithLive<'a, L> {
-        WithLive { objects: self, live }
+        WithLive {
+            objects: self,
+            live,
+            channel: false,
+        }
+    }
+
+    /// This dictionary as a fieldbus's parameter channel sees it (CoE SDO
+    /// and the UDP parameter service of the EtherCAT drive): `live` answers
+    /// the live entries, and the entries fieldbus scaling acts on read and
+    /// write in the representation of A213\[1\] (E-143, E-086;
+    /// [`DriveObjects::channel_shift`]). With A213\[1\] = A213\[0\] (both
+    /// native by default) the same as [`with_live`](Self::with_live).
+    pub fn parameter_channel<'a, L: LiveValues>(&'a mut self, live: &'a mut L) -> WithLive<'a, L> {
+        WithLive {
+            objects: self,
+            live,
+            channel: true,
+        }
     }
 
     /// The active subindex template.
@@ -394,12 +420,14 @@ impl DriveObjects {
         Ok(())
     }
 
+    /// A bus read; `channel`: in the parameter channel's representation.
     fn read_with<L: LiveValues>(
         &self,
         live: &mut L,
         index: u16,
         sub: u8,
         buf: &mut [u8],
+        channel: bool,
     ) -> Result<usize, SdoAbort> {
         let loc = self.locate(index, sub)?;
         if !loc.record()?.access().readable() {
@@ -407,14 +435,24 @@ impl DriveObjects {
         }
         let target = follow(loc)?;
         let o = target.object()?;
-        if o.value == Value::Live {
-            if let Some(r) = live.read(o.info.index, target.record()?.sub(), buf) {
-                return r;
+        let owned = match o.value {
+            Value::Live => live.read(o.info.index, target.record()?.sub(), buf),
+            _ => None,
+        };
+        let n = match owned {
+            Some(r) => r?,
+            None => self.read_loc(target, buf)?,
+        };
+        if channel {
+            let shift = self.channel_shift(o.info.index, target.record()?.sub());
+            if shift != 0 {
+                return Self::channel_read(buf, n, shift, target.data_type()?);
             }
         }
-        self.read_loc(target, buf)
+        Ok(n)
     }
 
+    /// A bus write; `channel`: in the parameter channel's representation.
     fn write_with<L: LiveValues>(
         &mut self,
         live: &mut L,
@@ -422,6 +460,7 @@ impl DriveObjects {
         sub: u8,
         data: &[u8],
         state: CommState,
+        channel: bool,
     ) -> Result<(), SdoAbort> {
         let loc = self.locate(index, sub)?;
         let access = loc.record()?.access();
@@ -434,11 +473,24 @@ impl DriveObjects {
         let target = follow(loc)?;
         let (o, e) = (target.object()?, target.entry()?);
         e.data_type.check_len(data.len())?;
-        let value = if e.data_type.is_string() {
+        let mut value = if e.data_type.is_string() {
             None
         } else {
             Some(e.data_type.decode(data)?)
         };
+        // the parameter channel's value of a scaled entry → the value kept
+        let mut kept = [0u8; 8];
+        let mut data = data;
+        if let (true, Some(v)) = (channel, value) {
+            let shift = self.channel_shift(o.info.index, e.sub);
+            if shift != 0 {
+                let v = self.channel_write(target, e.data_type, v, shift)?;
+                e.check_range(v)?;
+                let n = e.data_type.encode(v, &mut kept)?;
+                data = kept.get(..n).ok_or(SdoAbort::GENERAL)?;
+                value = Some(v);
+            }
+        }
         if let Some(v) = value {
             self.check_consistency(o, &e, v)?;
             e.check_range(v)?;
@@ -494,11 +546,11 @@ impl Dictionary for DriveObjects {
     }
 
     fn read(&mut self, index: u16, sub: u8, buf: &mut [u8], _state: CommState) -> Result<usize, SdoAbort> {
-        self.read_with(&mut NoLive, index, sub, buf)
+        self.read_with(&mut NoLive, index, sub, buf, false)
     }
 
     fn write(&mut self, index: u16, sub: u8, data: &[u8], state: CommState) -> Result<(), SdoAbort> {
-        self.write_with(&mut NoLive, index, sub, data, state)
+        self.write_with(&mut NoLive, index, sub, data, state, false)
     }
 
     fn process_data_bytes(&self) -> Option<(usize, usize)> {
@@ -558,11 +610,12 @@ impl<L: LiveValues> Dictionary for WithLive<'_, L> {
     }
 
     fn read(&mut self, index: u16, sub: u8, buf: &mut [u8], _state: CommState) -> Result<usize, SdoAbort> {
-        self.objects.read_with(self.live, index, sub, buf)
+        self.objects.read_with(self.live, index, sub, buf, self.channel)
     }
 
     fn write(&mut self, index: u16, sub: u8, data: &[u8], state: CommState) -> Result<(), SdoAbort> {
-        self.objects.write_with(self.live, index, sub, data, state)
+        self.objects
+            .write_with(self.live, index, sub, data, state, self.channel)
     }
 
     fn process_data_bytes(&self) -> Option<(usize, usize)> {

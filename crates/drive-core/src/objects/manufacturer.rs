@@ -270,7 +270,10 @@ pub const PARAMS: [Object; 80] = [
         Array,
         Value::Ram,
         [
-            e(0, "Process data", U8, RW).range(0, 1).default_value(1).saved(),
+            e(0, "Process data", U8, RW_PREOP)
+                .range(0, 1)
+                .default_value(1)
+                .saved(),
             e(1, "Parameter channel", U8, RW)
                 .range(0, 1)
                 .default_value(1)
@@ -278,7 +281,7 @@ pub const PARAMS: [Object; 80] = [
         ]
     )
     .level(2)
-    .note("A213; 1 = native (default), 0 = integer with decimal places; element roles assumed"),
+    .note("A213 (E-143): 1 = native (default), 0 = integer with the decimal places A310/A311; [0] the process data and what the objects hold, [1] the SDO and UDP parameter channel (element roles assumed); see Fieldbus scaling below"),
     mirror!(
         0x20E1,
         "RxPDO 1 mapping",
@@ -578,19 +581,23 @@ pub const PARAMS: [Object; 80] = [
     Object::var(
         a(310),
         Value::Ram,
-        entries![e(0, "Decimal places velocity", U8, RW).range(0, 9).saved()],
+        entries![e(0, "Decimal places velocity", U8, RW_PREOP)
+            .range(0, 9)
+            .saved()],
     )
     .axis()
     .level(2)
-    .note("A310; CiA 402 scaling (A213)"),
+    .note("A310: decimal places of the velocity objects under A213 = 0 (C-142)"),
     Object::var(
         a(311),
         Value::Ram,
-        entries![e(0, "Decimal places acceleration", U8, RW).range(0, 9).saved()],
+        entries![e(0, "Decimal places acceleration", U8, RW_PREOP)
+            .range(0, 9)
+            .saved()],
     )
     .axis()
     .level(2)
-    .note("A311"),
+    .note("A311: decimal places of the acceleration, deceleration and jerk objects under A213 = 0 (C-142)"),
     Object::var(
         a(340),
         Value::Ram,

@@ -9,6 +9,8 @@
 //!   at +8000h).
 //! - [`cia402`]: the CiA 402 objects of axis A (6000h–65FFh); axis B is
 //!   derived at +800h (`od-cia402.md`).
+//! - [`scaling`]: the entries fieldbus scaling A213 acts on and their
+//!   decimal places (A310 velocities, A311 accelerations).
 //!
 //! [`OBJECTS`] joins them, sorted by index (checked at compile time);
 //! [`OFFSETS`] gives each object's place in the RAM image, computed at compile
@@ -61,6 +63,7 @@ pub mod comm;
 pub mod manufacturer;
 mod pack;
 pub mod records;
+pub mod scaling;
 
 pub use pack::{EntryRecord, ENTRY_TABLE};
 

@@ -24,7 +24,9 @@ pub struct IpSettings {
 
 impl<F: Flash, B: Flash> Drive<F, B> {
     /// Runs `f` with the EoE queue and the object dictionary as the bus
-    /// sees it (live values included) in the present communication state:
+    /// sees it (live values included, the A213-scaled entries in the
+    /// parameter channel's representation A213\[1\], as over SDO) in the
+    /// present communication state:
     /// the seam of the IP stack (crate `net`), which answers UDP parameter
     /// requests through [`od::Dictionary::read`]/[`write`](od::Dictionary::write)
     /// with exactly the SDO access rules and abort codes. Requests a write
@@ -35,7 +37,7 @@ impl<F: Flash, B: Flash> Drive<F, B> {
     ) -> R {
         let state = ecat::coe::comm_state(self.slave.state());
         let mut live = Live { diag: &mut self.diag };
-        let mut dict = self.objects.with_live(&mut live);
+        let mut dict = self.objects.parameter_channel(&mut live);
         f(&mut self.eoe, &mut dict, state)
     }
 

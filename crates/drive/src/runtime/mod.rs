@@ -473,7 +473,7 @@ impl<F: Flash, B: Flash> Drive<F, B> {
         let mut foe = FirmwareFoe::new(self.boot.as_mut());
         self.slave.poll_mailbox_only(
             pdi,
-            &mut EcatApp(self.objects.with_live(&mut live)),
+            &mut EcatApp(self.objects.parameter_channel(&mut live)),
             &mut foe,
             &mut self.eoe,
             now,
@@ -520,14 +520,14 @@ impl<F: Flash, B: Flash> Drive<F, B> {
         let change = if mailbox {
             self.slave.poll_with_eoe(
                 pdi,
-                &mut EcatApp(self.objects.with_live(&mut live)),
+                &mut EcatApp(self.objects.parameter_channel(&mut live)),
                 &mut foe,
                 &mut self.eoe,
                 now,
             )?
         } else {
             self.slave
-                .poll_esc(pdi, &mut EcatApp(self.objects.with_live(&mut live)), now)?
+                .poll_esc(pdi, &mut EcatApp(self.objects.parameter_channel(&mut live)), now)?
         };
         if self.slave.take_error_ack() {
             // the master acknowledged the error: a latched PLL fault goes
@@ -733,7 +733,9 @@ impl<F: Flash, B: Flash> Drive<F, B> {
     ) -> Result<usize, SdoAbort> {
         use od::Dictionary as _;
         let mut live = Live { diag: &mut self.diag };
-        self.objects.with_live(&mut live).read(index, sub, buf, state)
+        self.objects
+            .parameter_channel(&mut live)
+            .read(index, sub, buf, state)
     }
 
     /// A255 (state, +16 with error) and A257[3] ("AL xxxx") follow the slave.
