@@ -1125,6 +1125,10 @@ impl hil_sim::sim::Node for FwNode {
     fn poll(&mut self, now: Nanos) {
         self.esc.tick(now);
         let _ = self.drive.poll(&mut self.esc.pdi(), now);
+        if self.drive.restart_due(now) {
+            // A09: the device restarts as after a power cycle
+            self.power_cycle();
+        }
     }
 }
 

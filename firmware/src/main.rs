@@ -189,7 +189,8 @@ mod app {
 
     /// Background: a requested save (`tasks::background`), the image's
     /// confirmation point (`tasks::confirm_point`: the first Op; this image's
-    /// drive has no firmware slots yet, docs/flashing.md), and firing the
+    /// drive has no firmware slots yet, docs/flashing.md), a restart A09
+    /// requested (`Drive::restart_due`: a system reset), and firing the
     /// control cycle when its time has come (until the CCU4 compare does it
     /// in hardware).
     #[idle(shared = [drive, timer, clock, net])]
@@ -201,6 +202,11 @@ mod app {
                 confirmed = cx.shared.drive.lock(|d| tasks::confirm_point(d));
             }
             let now = cx.shared.clock.lock(|c| c.now(DWT::cycle_count()));
+            // A09 restart (E-019): the MCU resets, the boot loader decides anew
+            if cx.shared.drive.lock(|d| d.restart_due(now)) {
+                defmt::info!("restart requested (A09)");
+                cortex_m::peripheral::SCB::sys_reset();
+            }
             if cx.shared.timer.lock(|t| t.next_at()) <= now {
                 rtic::pend(Interrupt::CCU40_0);
             }

@@ -252,6 +252,22 @@ impl SimDrive {
         self.esc.set_clock(drift, offset);
     }
 
+    /// The device restarts (A09, [`drive::runtime::Drive::restart_due`]):
+    /// a [`power_cycle`](Self::power_cycle) of the electronics; the motors,
+    /// the axes' conditions, the state log and a bound IP stack stay (the
+    /// machine did not move, the line did not change).
+    pub fn restart(&mut self) {
+        let motors = self.motors.clone();
+        let conditions = self.conditions;
+        let log = std::mem::take(&mut self.state_log);
+        let net = self.net.take();
+        self.power_cycle();
+        self.motors = motors;
+        self.conditions = conditions;
+        self.state_log = log;
+        self.net = net;
+    }
+
     /// Sets the drive's oscillator: drift in ppm (+: runs fast) and the ESC's
     /// local time at simulation time 0, ns. Call it before the first frame.
     pub fn set_clock(&mut self, drift_ppm: f64, offset_ns: u64) {
@@ -436,6 +452,10 @@ impl SimDrive {
         let mut pdi = self.esc.pdi();
         if let Ok(Some(change)) = self.drive.poll(&mut pdi, now) {
             self.state_log.push((now, change));
+        }
+        if self.drive.restart_due(now) {
+            self.restart();
+            return;
         }
         self.sm2_event = self.esc.al_event_request() & ::esc::regs::al_event::sm(2) != 0;
         self.poll_net(now);

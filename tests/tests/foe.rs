@@ -394,3 +394,36 @@ fn foe_signature_counter_floor_follows_the_running_image() {
         SlotState::Pending { seq: 3 }
     );
 }
+
+/// E-019: new firmware takes effect at a restart, which A09 requests over
+/// the bus: a downloaded image stays pending while the drive runs, and the
+/// restart A09 asks for starts it on trial.
+#[test]
+fn e019_e140_a09_restart_starts_a_pending_firmware_image() {
+    const A09: u16 = drive::parameter_index(0, 9);
+    let sim = line();
+    let file = firmware_file(2, 5000);
+    in_boot(&sim, async |_, sd| {
+        FoeClient::new().write_file(&sd, "firmware", &file).await.unwrap();
+    });
+    assert!(matches!(
+        node(&sim).slots().state(Slot::B).unwrap(),
+        SlotState::Pending { .. }
+    ));
+    with_master_on(&sim, async |md, clock| {
+        let group = init(md, clock).await;
+        let sd = group.subdevice(md, 0).unwrap();
+        assert_eq!(node(&sim).boot.map(|d| d.slot), Some(Slot::A), "A runs");
+        sd.sdo_write(A09, 1, 1u8).await.expect("A09[0] = 1");
+    });
+    let t = sim.borrow().now().as_ns();
+    sim.borrow_mut().advance_to(nanos::Nanos::from_ns(
+        t + drive::runtime::RESTART_DELAY.as_ns() + 1_000_000,
+    ));
+    let d = node(&sim).boot.expect("a slot starts");
+    assert_eq!(
+        (d.slot, d.trial),
+        (Slot::B, true),
+        "the restart started B on trial"
+    );
+}

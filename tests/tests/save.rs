@@ -126,3 +126,56 @@ fn e020_power_cut_at_every_step_of_a_save_keeps_a_usable_set() {
     };
     drive_tests::fault_row!(row, seen);
 }
+
+/// A09 restart (E-019, E-140, E-145): the answer to the request comes
+/// first; 100 ms later the device restarts as after a power cycle: the ESC
+/// is back in Init, the saved values are in force (a value written after
+/// the save is gone), the diagnosis history is empty; a request in the
+/// first 100 ms does not restart it yet.
+#[test]
+fn e019_e140_e145_a09_restart_starts_again_with_the_saved_values() {
+    use drive_tests::al_status;
+    const A09: u16 = drive::parameter_index(0, 9);
+    let sim = line(1);
+    let before = with_master(&sim, async |md, clock| {
+        let group = init(md, clock).await;
+        let sd = group.subdevice(md, 0).unwrap();
+        sd.sdo_write(A258, 0, 777u16).await.unwrap();
+        sd.sdo_write(0x1010, 1, SAVE).await.unwrap();
+        sd.sdo_write(A258, 0, 888u16).await.unwrap();
+        // a refused state change: a message in the history
+        drive_tests::request(&sd, drive_tests::al::BOOT).await;
+        let history: u8 = sd.sdo_read(0x10F3, 2).await.unwrap();
+        sd.sdo_write(A09, 1, 1u8).await.expect("A09[0] = 1 answered");
+        // within the delay: still the same device
+        let t = sim.borrow().now().as_ns();
+        sim.borrow_mut().advance_to(nanos::Nanos::from_ns(t + 50_000_000));
+        let still = sd.sdo_read::<u16>(A258, 0).await.unwrap();
+        (history, still, al_status(&sd).await)
+    });
+    assert_ne!(before.0, 0, "a message in the history before the restart");
+    assert_eq!(before.1, 888, "no restart within 100 ms");
+    assert_eq!(before.2 .0 & 0x0F, drive_tests::al::PREOP);
+    let t = sim.borrow().now().as_ns();
+    sim.borrow_mut()
+        .advance_to(nanos::Nanos::from_ns(t + 100_000_000));
+    {
+        let s = sim.borrow();
+        let d = &s.drives()[0];
+        assert_eq!(d.drive.slave().state(), esc::AlState::Init, "restarted: Init");
+        assert_eq!(
+            d.drive.startup(),
+            drive::runtime::Startup::Loaded,
+            "the saved set"
+        );
+    }
+    let after = with_master(&sim, async |md, clock| {
+        let group = init(md, clock).await;
+        let sd = group.subdevice(md, 0).unwrap();
+        let a258: u16 = sd.sdo_read(A258, 0).await.unwrap();
+        let history: u8 = sd.sdo_read(0x10F3, 2).await.unwrap();
+        let restart: u8 = sd.sdo_read(A09, 1).await.unwrap();
+        (a258, history, restart)
+    });
+    assert_eq!(after, (777, 0, 0), "saved A258, empty history, A09[0] back to 0");
+}

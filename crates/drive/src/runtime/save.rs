@@ -1,8 +1,13 @@
 //! A00 save values (E-018, E-020): the job that takes the persistent
 //! values and the store out of the drive, writes the flash without holding
-//! it and hands the store back with the result.
+//! it and hands the store back with the result. A09 restart (E-019,
+//! E-140): when the firmware or the simulator restarts the device.
 
 use super::*;
+
+/// How long a restart requested by A09 waits, so the master reads the
+/// answer to its request first (our choice; the manual gives no time).
+pub const RESTART_DELAY: Nanos = Nanos::from_ms(100);
 
 /// Result of the last save, as A00\[2\] shows it.
 pub mod save_result {
@@ -59,7 +64,10 @@ impl<F: Flash, B: Flash> Drive<F, B> {
             return None;
         }
         let store = self.store.take()?;
-        self.objects.take_requests();
+        // (a restart requested as well stays requested)
+        if self.objects.take_requests().restart {
+            self.objects.request_restart();
+        }
         let mut image = [0u8; PERSISTENT_IMAGE_BYTES];
         let len = self.objects.persistent_image(&mut image).ok();
         Some(SaveJob {
@@ -83,6 +91,20 @@ impl<F: Flash, B: Flash> Drive<F, B> {
         };
         let _ = self.objects.set(A00, 3, result);
         job.saved
+    }
+
+    /// Whether the device is to restart now (A09\[0\] = 1, the A75 action
+    /// "restart"; E-019, E-140): [`RESTART_DELAY`] after the request, and
+    /// not while a save has the store (the restart waits for its end).
+    /// The caller restarts the device as a power cycle does (the firmware
+    /// resets the MCU, the simulator powers the drive off and on with its
+    /// flashes): the saved values load, a pending firmware image starts.
+    pub fn restart_due(&mut self, now: Nanos) -> bool {
+        if self.objects.requests().restart && self.restart_requested.is_none() {
+            self.restart_requested = Some(now);
+        }
+        self.restart_requested
+            .is_some_and(|t| now.since(t) >= RESTART_DELAY && self.store.is_some())
     }
 
     /// Writes the persistent values to the store now (A00 / 1010h "save");
