@@ -142,6 +142,8 @@ pub struct SimDrive {
     pub sync0_log: VecDeque<Sync0Stamp>,
     /// The last [`CYCLE_LOG_LEN`] control-cycle starts under the PLL, oldest first.
     pub cycle_log: VecDeque<CycleStamp>,
+    /// The PLL's phase lock over the whole run (every gain and loss counted).
+    pub pll_lock: PllLock,
     feedback: [Option<MotorOutputs>; 2],
     next_cycle: Nanos,
     /// Next start of the PLL-driven timer, ticks of the MCU clock (`None`: free-running).
@@ -169,6 +171,57 @@ pub struct CycleStamp {
     pub rx: bool,
     /// The cycle wrote the TxPDO (the aligned cycle).
     pub tx: bool,
+}
+
+/// The PLL's phase lock (the SYNC0 lock, A298 bit 10) as the control cycles
+/// saw it: followed at every control cycle, so a loss between two looks of
+/// a caller is counted too (`hil-sim serve` prints it).
+#[derive(Debug, Clone, Copy, Default, PartialEq, Eq)]
+pub struct PllLock {
+    /// Phase locked after the last control cycle.
+    pub locked: bool,
+    /// Times the lock was gained.
+    pub gained: u32,
+    /// Times it was lost (the PLL lost it, or went: SYNC0 stopped or changed).
+    pub lost: u32,
+    /// Simulation time of the last gain or loss.
+    pub changed: Nanos,
+    /// The last loss.
+    pub last_loss: Option<LockLoss>,
+    /// Simulation time of the last frame that passed the drive's ESC.
+    pub last_frame: Option<Nanos>,
+}
+
+/// One loss of the PLL's phase lock.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub struct LockLoss {
+    /// Simulation time of the control cycle that found the lock lost.
+    pub at: Nanos,
+    /// The drive's AL state then.
+    pub state: ::esc::AlState,
+    /// Time since the last frame had passed the drive's ESC (`None`: no frame yet).
+    pub since_frame: Option<Nanos>,
+}
+
+impl PllLock {
+    /// Follows the lock after the control cycle at `now`.
+    fn follow(&mut self, locked: bool, now: Nanos, state: ::esc::AlState) {
+        if locked == self.locked {
+            return;
+        }
+        self.locked = locked;
+        self.changed = now;
+        if locked {
+            self.gained = self.gained.saturating_add(1);
+        } else {
+            self.lost = self.lost.saturating_add(1);
+            self.last_loss = Some(LockLoss {
+                at: now,
+                state,
+                since_frame: self.last_frame.map(|f| now.saturating_sub(f)),
+            });
+        }
+    }
 }
 
 /// One SYNC0 pulse as the drive saw it.
@@ -230,6 +283,7 @@ impl SimDrive {
             cycle: CONTROL_CYCLE,
             sync0_log: VecDeque::with_capacity(SYNC0_LOG_LEN),
             cycle_log: VecDeque::with_capacity(CYCLE_LOG_LEN),
+            pll_lock: PllLock::default(),
             feedback: [None, None],
             next_cycle: CONTROL_CYCLE,
             next_tick: None,
@@ -364,6 +418,7 @@ impl SimDrive {
     /// A frame passed the ESC at `arrival`: when it completed an SM2
     /// (RxPDO) buffer, the drive's SM2 event tells the PLL (`A261[1]`, `[2]`).
     pub fn on_frame(&mut self, arrival: Nanos) {
+        self.pll_lock.last_frame = Some(arrival);
         let event = self.esc.al_event_request() & ::esc::regs::al_event::sm(2) != 0;
         if event && !self.sm2_event {
             let local = self.mcu_local(arrival);
@@ -427,6 +482,8 @@ impl SimDrive {
             Some(c) => self.drive.sync_cycle(&c, t, &io),
             None => self.drive.control_cycle(t, &io),
         };
+        let locked = self.drive.pll().is_some_and(|p| p.is_locked());
+        self.pll_lock.follow(locked, t, self.drive.slave().state());
         // the torque holds until the next cycle starts (a broken timer that
         // schedules nothing ahead steps the motors by the last length)
         let dt = self.next_cycle_at().saturating_sub(t);

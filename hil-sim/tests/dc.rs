@@ -198,6 +198,12 @@ fn e107_sync0_pulses_at_the_configured_period_on_drifting_drives() {
         "SYNC0 of both drives at the same instant: {edge_skew} ns"
     );
     assert!(diff <= 5 && skew <= 5, "stays synchronised: {diff} / {skew} ns");
+    // the SYNC0 lock as `serve` reports it, followed at every control
+    // cycle: gained once, never lost
+    for (i, d) in sim.borrow().drives().iter().enumerate() {
+        let l = d.pll_lock;
+        assert!(l.locked && l.gained == 1 && l.lost == 0, "drive {i}: {l:?}");
+    }
 }
 
 #[test]

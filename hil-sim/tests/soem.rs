@@ -20,13 +20,11 @@
 
 mod common;
 
-use common::ip;
+use common::soem_line::{pysoem_python, Line};
 use ecat::Dictionary;
 use std::fmt::Write as _;
 use std::path::{Path, PathBuf};
-use std::process::{Child, Command, ExitStatus, Stdio};
 use std::sync::Mutex;
-use std::time::Duration;
 
 /// One SOEM run at a time: each needs the cores for its 1 ms cycle.
 static ONE_AT_A_TIME: Mutex<()> = Mutex::new(());
@@ -35,143 +33,6 @@ static ONE_AT_A_TIME: Mutex<()> = Mutex::new(());
 const SLAVES: usize = 3;
 /// Process data in Op, s (at least 10 s of 1 ms cycles).
 const OP_SECONDS: u32 = 12;
-/// A script that has not finished after this long has hung.
-const SCRIPT_LIMIT: Duration = Duration::from_secs(240);
-
-/// The python with pysoem, or why the test cannot run (not root, or
-/// `PYSOEM_PYTHON` not set). A `PYSOEM_PYTHON` that cannot import pysoem is
-/// a failure, not a skip: whoever set it wants the test to run.
-fn pysoem_python() -> Result<PathBuf, String> {
-    if !common::is_root() {
-        return Err("needs root for network namespaces and raw sockets".into());
-    }
-    let py = std::env::var_os("PYSOEM_PYTHON").ok_or(
-        "PYSOEM_PYTHON is not set (`.ci/run` installs pysoem into target/pysoem-venv and sets it to \
-         target/pysoem-venv/bin/python)",
-    )?;
-    let out = Command::new(&py)
-        .args(["-c", "import pysoem; print(pysoem.__version__)"])
-        .output()
-        .unwrap_or_else(|e| panic!("PYSOEM_PYTHON={}: {e}", Path::new(&py).display()));
-    assert!(
-        out.status.success(),
-        "PYSOEM_PYTHON={} cannot import pysoem: {}",
-        Path::new(&py).display(),
-        String::from_utf8_lossy(&out.stderr).trim()
-    );
-    println!(
-        "pysoem {} ({})",
-        String::from_utf8_lossy(&out.stdout).trim(),
-        Path::new(&py).display()
-    );
-    Ok(PathBuf::from(py))
-}
-
-/// SCHED_FIFO priority of `serve`: the simulated drives stand for hardware
-/// (an ESC and an MCU of their own), so `serve` gets the CPU before the
-/// compile jobs of a shared machine do (a descheduled `serve` still sees
-/// each frame at its kernel receive time, but answers it late). The master
-/// runs at SCHED_FIFO 40 as SOEM's samples do (the script sets it).
-const SERVE_PRIORITY: &str = "50";
-
-/// Two private namespaces joined by a veth pair, `hil-sim serve` in one.
-struct Line {
-    master_ns: String,
-    sim_ns: String,
-    master_if: String,
-    server: Option<Child>,
-    serve_log: PathBuf,
-}
-
-impl Line {
-    fn new(tag: &str, slaves: usize, seconds: u32, dir: &Path) -> Self {
-        let id = std::process::id() % 100_000;
-        let master_ns = format!("soem{tag}{id}m");
-        let sim_ns = format!("soem{tag}{id}s");
-        let master_if = format!("so{tag}{id}m");
-        let sim_if = format!("so{tag}{id}s");
-        for ns in [&master_ns, &sim_ns] {
-            let _ = Command::new("ip")
-                .args(["netns", "del", ns])
-                .stderr(Stdio::null())
-                .status();
-            ip(&["netns", "add", ns]);
-            ip(&["-n", ns, "link", "set", "lo", "up"]);
-        }
-        ip(&[
-            "link", "add", &master_if, "netns", &master_ns, "type", "veth", "peer", "name", &sim_if, "netns",
-            &sim_ns,
-        ]);
-        ip(&["-n", &master_ns, "link", "set", &master_if, "up"]);
-        ip(&["-n", &sim_ns, "link", "set", &sim_if, "up"]);
-        let serve_log = dir.join(format!("serve-{tag}.log"));
-        // SOEM_PCAP=1: serve records every frame (for a failure's evidence)
-        let pcap = std::env::var_os("SOEM_PCAP").map(|_| dir.join(format!("serve-{tag}.pcap")));
-        let log = std::fs::File::create(&serve_log).expect("serve log");
-        let server = Command::new("ip")
-            .args(["netns", "exec", &sim_ns, env!("CARGO_BIN_EXE_hil-sim"), "serve"])
-            .args(["--fifo-priority", SERVE_PRIORITY])
-            .args(["--iface", &sim_if, "--slaves", &slaves.to_string()])
-            .args(["--seconds", &seconds.to_string()])
-            .args(
-                pcap.iter()
-                    .flat_map(|p| [std::ffi::OsStr::new("--pcap"), p.as_os_str()]),
-            )
-            .stdout(log.try_clone().expect("log"))
-            .stderr(log)
-            .spawn()
-            .expect("spawn hil-sim serve");
-        // serve opens its socket at once; the script's scan retries as well
-        std::thread::sleep(Duration::from_millis(300));
-        Self {
-            master_ns,
-            sim_ns,
-            master_if,
-            server: Some(server),
-            serve_log,
-        }
-    }
-
-    /// Runs `python script args` in the master's namespace; its output is
-    /// printed as it comes, the exit status returned (killed after
-    /// [`SCRIPT_LIMIT`]).
-    fn run(&self, python: &Path, script: &str, args: &[&str]) -> ExitStatus {
-        let script = Path::new(env!("CARGO_MANIFEST_DIR"))
-            .join("tests/soem")
-            .join(script);
-        let child = Command::new("ip")
-            .args(["netns", "exec", &self.master_ns])
-            .arg(python)
-            .arg("-u")
-            .arg(&script)
-            .args(["--iface", &self.master_if])
-            .args(args)
-            .stdout(Stdio::piped())
-            .stderr(Stdio::piped())
-            .spawn()
-            .expect("run the script");
-        // print line by line (println! goes through the test harness's capture)
-        common::watch_script(child, &script, SCRIPT_LIMIT).0
-    }
-
-    /// What `serve` printed (state changes of every drive, with AL codes).
-    fn serve_output(&self) -> String {
-        std::fs::read_to_string(&self.serve_log).unwrap_or_default()
-    }
-}
-
-impl Drop for Line {
-    fn drop(&mut self) {
-        if let Some(s) = self.server.take() {
-            common::stop_server(s, Duration::from_secs(2));
-        }
-        // deleting the namespaces deletes the veth pair
-        for ns in [&self.master_ns, &self.sim_ns] {
-            let _ = Command::new("ip").args(["netns", "del", ns]).status();
-        }
-    }
-}
-
 /// The SII image the simulated drives carry.
 fn sii_image() -> Vec<u8> {
     let mut sii = vec![0u8; ecat::sii::EEPROM_BYTES];

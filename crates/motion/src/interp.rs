@@ -203,6 +203,14 @@ pub struct FineInterpolator {
     pending: Option<MasterSetpoint>,
     monitor: ExtrapolationMonitor,
     extrapolating: bool,
+    /// The last set-point that arrived (not extrapolated), increments.
+    last_real: i32,
+    /// Master cycles extrapolated since `last_real`.
+    since_real: u32,
+    /// The master's last increment per master cycle (between the last two
+    /// set-points that arrived, spread over the cycles between them): what a
+    /// missing set-point is extrapolated with (C-116).
+    step: i32,
 }
 
 impl FineInterpolator {
@@ -227,6 +235,9 @@ impl FineInterpolator {
             pending: None,
             monitor: ExtrapolationMonitor::new(config.max_extrapolation),
             extrapolating: false,
+            last_real: 0,
+            since_real: 0,
+            step: 0,
         };
         s.start(0);
         Ok(s)
@@ -255,6 +266,9 @@ impl FineInterpolator {
         self.pending = None;
         self.monitor = ExtrapolationMonitor::new(self.config.max_extrapolation);
         self.extrapolating = false;
+        self.last_real = position;
+        self.since_real = 0;
+        self.step = 0;
     }
 
     /// Delay of the output behind the master's trajectory: one master cycle
@@ -293,12 +307,28 @@ impl FineInterpolator {
     }
 
     /// Master-cycle boundary: take the new set-point or extrapolate one.
+    ///
+    /// A missing set-point is extrapolated with the master's last increment
+    /// per master cycle (`step`): after a gap it is the
+    /// increment from the set-point before the gap to the one after it,
+    /// spread over the cycles between, not the step from the last
+    /// extrapolated point to the new set-point. That step is the correction
+    /// of the extrapolation's error, and extrapolating with it again at the
+    /// next gap multiplies the error by −(gap − 1): a master missing every
+    /// third set-point for a while sent the demand away by revolutions.
     fn boundary(&mut self) -> Result<(), InterpolationFault> {
         self.k = 0;
         let next = match self.pending.take() {
             Some(sp) => {
                 self.monitor.received();
                 self.extrapolating = false;
+                // rounded half up; cycles ≥ 1 (checked: no panic path)
+                let cycles = i64::from(self.since_real) + 1;
+                let moved = i64::from(sp.position.wrapping_sub(self.last_real));
+                let step = (2 * moved + cycles).checked_div_euclid(2 * cycles).unwrap_or(0);
+                self.step = i32::try_from(step).unwrap_or(0);
+                self.last_real = sp.position;
+                self.since_real = 0;
                 let v = if sp.velocity_offset.is_finite() {
                     sp.velocity_offset
                 } else {
@@ -312,8 +342,11 @@ impl FineInterpolator {
             None => {
                 self.monitor.missed(self.config.ratio.master_ns())?;
                 self.extrapolating = self.monitor.armed;
+                if self.monitor.armed {
+                    self.since_real = self.since_real.saturating_add(1);
+                }
                 MasterSetpoint {
-                    position: self.p0.wrapping_add(self.p0.wrapping_sub(self.p1)),
+                    position: self.p0.wrapping_add(self.step),
                     velocity_offset: self.v0,
                 }
             }

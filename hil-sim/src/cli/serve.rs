@@ -117,6 +117,7 @@ pub fn serve(args: &ServeArgs) -> Result<(), String> {
     stop_on_signals();
     let stats = run(&mut sim, &sock, args)?;
     flush_recording(&mut sim, args)?;
+    print_lock_summary(&sim);
     println!(
         "{} frames served; {} without a kernel timestamp; {} reached the simulation more than {} µs after \
          their receive time (worst by {:.1} µs)",
@@ -212,6 +213,7 @@ fn run(sim: &mut Simulation, sock: &RawSocket, args: &ServeArgs) -> Result<Stats
     let mut delay = args.delay_us.map(|max| Delay::new(max, args.delay_seed));
     let mut stats = Stats::default();
     let mut printed = Vec::new();
+    let mut locks = Vec::new();
     let mut buf = [0u8; 1600];
     let mut next_flush = start + FLUSH_EVERY;
     loop {
@@ -251,6 +253,13 @@ fn run(sim: &mut Simulation, sock: &RawSocket, args: &ServeArgs) -> Result<Stats
         }
         sim.catch_up(now.saturating_sub(start + IDLE_LAG));
         print_new_changes(sim, &mut printed);
+        // printed is done with: serve keeps no log, its memory stays the
+        // same however long it runs (the soak benchmark checks it)
+        for d in sim.drives_mut() {
+            d.state_log.clear();
+        }
+        printed.fill(0);
+        print_lock_changes(sim, &mut locks);
         if now >= next_flush {
             next_flush = now + FLUSH_EVERY;
             flush_recording(sim, args)?;
@@ -261,6 +270,78 @@ fn run(sim: &mut Simulation, sock: &RawSocket, args: &ServeArgs) -> Result<Stats
         if !args.busy_poll {
             sock.wait(IDLE_WAIT).map_err(|e| format!("wait: {e}"))?;
         }
+    }
+}
+
+/// Milliseconds of a simulation time, for the log.
+fn ms(t: Nanos) -> f64 {
+    t.as_ns() as f64 / 1e6
+}
+
+/// Prints every drive's gains and losses of the SYNC0 lock (the PLL's phase
+/// lock, [`hil_sim::sim::PllLock`]) since the last call; `seen` keeps the
+/// counts printed so far. A loss names the drive's AL state and the time
+/// since the last frame then (a loss while frames flowed is a defect; one
+/// after the master stopped may be SYNC0 going with it).
+fn print_lock_changes(sim: &Simulation, seen: &mut Vec<(u32, u32)>) {
+    seen.resize(sim.drives().len(), (0, 0));
+    for (i, (d, s)) in sim.drives().iter().zip(seen.iter_mut()).enumerate() {
+        let l = &d.pll_lock;
+        if (l.gained, l.lost) == *s {
+            continue;
+        }
+        if let (true, Some(loss)) = (l.lost != s.1, l.last_loss) {
+            let frame = loss.since_frame.map_or_else(
+                || "no frame before".to_string(),
+                |g| format!("the last frame {:.1} ms before", ms(g)),
+            );
+            let more = l.lost - s.1;
+            let more = if more > 1 {
+                format!(" (lost {more} times since the last line)")
+            } else {
+                String::new()
+            };
+            println!(
+                "  [{:>10.3} ms] slave {i}: SYNC0 lock (PLL) lost in {:?}, {frame}{more}",
+                ms(loss.at),
+                loss.state
+            );
+        }
+        if l.gained != s.0 && l.locked {
+            println!(
+                "  [{:>10.3} ms] slave {i}: SYNC0 lock (PLL) gained",
+                ms(l.changed)
+            );
+        }
+        *s = (l.gained, l.lost);
+    }
+}
+
+/// The end summary of the SYNC0 lock: drives locked at the end, losses in
+/// all, and a line for every drive that lost it or is not locked.
+fn print_lock_summary(sim: &Simulation) {
+    let drives = sim.drives();
+    let locked = drives.iter().filter(|d| d.pll_lock.locked).count();
+    let lost: u64 = drives.iter().map(|d| u64::from(d.pll_lock.lost)).sum();
+    let gained: u64 = drives.iter().map(|d| u64::from(d.pll_lock.gained)).sum();
+    println!(
+        "SYNC0 lock (PLL): {locked} of {} drive(s) locked at the end; gained {gained}, lost {lost} time(s) in all",
+        drives.len()
+    );
+    for (i, d) in drives.iter().enumerate() {
+        let l = &d.pll_lock;
+        if l.lost == 0 && (l.locked || l.gained == 0) {
+            continue;
+        }
+        let last = l.last_loss.map_or_else(String::new, |loss| {
+            format!(", the last at {:.3} ms in {:?}", ms(loss.at), loss.state)
+        });
+        println!(
+            "  slave {i}: gained {}, lost {} time(s){last}; locked at the end: {}",
+            l.gained,
+            l.lost,
+            if l.locked { "yes" } else { "no" }
+        );
     }
 }
 

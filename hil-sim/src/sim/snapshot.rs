@@ -19,6 +19,7 @@ impl SimDrive {
             cycle: self.cycle,
             sync0_log: self.sync0_log.clone(),
             cycle_log: self.cycle_log.clone(),
+            pll_lock: self.pll_lock,
             feedback: self.feedback,
             next_cycle: self.next_cycle,
             next_tick: self.next_tick,

@@ -7,6 +7,7 @@ use std::process::{Child, Command, Stdio};
 use std::time::Duration;
 
 pub mod pn_line;
+pub mod soem_line;
 
 /// This process runs as root (network namespaces and raw sockets work).
 pub fn is_root() -> bool {

@@ -604,6 +604,10 @@ class Cycle:
         self.max_delta = 0
         # per SYNC0 period: a frame in the window (True) or not (False)
         self.periods = []
+        # the SYNC0 period of the last frame that came back, and the entries
+        # of `periods` since (slots left out, frames lost)
+        self.last_period = None
+        self.since_good = 0
 
     def sync(self, reftime):
         # ec_sync: sync point FRAME_LEAD_NS before SYNC0 (SYNC0 at multiples of the cycle)
@@ -630,6 +634,7 @@ class Cycle:
             self.next += CYCLE_NS
             self.skipped += 1
             self.periods.append(False)
+            self.since_good += 1
         if fill:
             fill(self.n + self.skipped)
         while True:
@@ -649,6 +654,20 @@ class Cycle:
                 self.bad_wkc.append((self.op_cycles, wkc))
         self.sync(self.m.dc_time)
         inside = -(CYCLE_NS // 2 - FRAME_LEAD_NS) < self.delta < FRAME_LEAD_NS
+        if wkc > 0:
+            # the periods between this frame and the last one that came back,
+            # by the drives' clock: a master that overslept its slot after
+            # deciding to send in it (descheduled in the wait) or a frame
+            # answered late leaves periods without a frame that no left-out
+            # slot or lost frame stands for
+            period = -(-self.m.dc_time // CYCLE_NS)
+            if self.last_period is not None:
+                missing = period - self.last_period - 1 - self.since_good
+                self.periods.extend([False] * min(max(missing, 0), 1000))
+            self.last_period = period
+            self.since_good = 0
+        else:
+            self.since_good += 1
         self.periods.append(wkc > 0 and inside)
         del self.periods[:-1000]
         if TRACE:

@@ -151,6 +151,47 @@ fn c116_extrapolates_missing_setpoint_with_last_increment() {
     }
 }
 
+/// C-116 with a master that misses set-points again and again (the soak
+/// test's SOEM master on a loaded machine sent one frame every 3–7 ms for a
+/// while): each extrapolation continues with the master's own increment per
+/// master cycle (between the last two set-points that arrived), not with the
+/// step from the last extrapolated point to the set-point that ended it.
+/// That step is the correction of the last extrapolation: continuing with it
+/// multiplied the error by −(gap − 1) at every gap, and the drive's demand
+/// ran away by revolutions into a limit switch.
+#[test]
+fn c116_repeated_gaps_extrapolate_with_the_masters_increment() {
+    for order in ORDERS {
+        for n in [1, 4] {
+            for gap in [2i64, 3, 4] {
+                let mut ip = FineInterpolator::new(config(order, n)).unwrap();
+                ip.start(0);
+                // an accelerating master trajectory, 5·m² increments at master
+                // cycle m (second difference 10); a set-point every cycle for a
+                // start, then only every `gap`-th one (the gaps within I423)
+                let at = |m: i64| 5 * m * m;
+                let mut worst = 0i64;
+                for m in 1..=80i64 {
+                    let give = m <= 8 || m % gap == 0;
+                    for k in 0..n {
+                        let setpoint = (give && k == 0).then(|| at(m) as i32);
+                        let out = ip.cycle(setpoint.and_then(sp)).unwrap();
+                        if m > 8 && k + 1 == n {
+                            worst = worst.max((i64::from(out.position) - at(m)).abs());
+                        }
+                    }
+                }
+                // extrapolating a gap with the master's increment misses by the
+                // acceleration: 10·gap² at most
+                assert!(
+                    worst <= 10 * gap * gap,
+                    "{order:?} N={n} gap {gap}: {worst} increments off the trajectory"
+                );
+            }
+        }
+    }
+}
+
 #[test]
 fn c117_extrapolates_missing_setpoint_then_faults() {
     // I423 = 3 ms, master 1 ms (N = 8): 3 extrapolated master cycles are
