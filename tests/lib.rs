@@ -2,7 +2,9 @@
 //! master (ethercrab) talks to the simulated line in-process, in simulated time.
 
 pub mod axis;
-pub mod matrix;
+
+/// The fault matrix's rows (`hil_sim::matrix`, docs/fault-matrix.md).
+pub use hil_sim::{fault_row, matrix};
 
 use ethercrab::{MainDevice, SubDeviceGroup, SubDeviceRef, Timeouts};
 use hil_sim::sim::Simulation;

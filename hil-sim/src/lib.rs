@@ -20,6 +20,8 @@ pub mod fb;
 #[cfg(feature = "std")]
 pub mod master;
 #[cfg(feature = "std")]
+pub mod matrix;
+#[cfg(feature = "std")]
 pub mod pcap;
 #[cfg(feature = "std")]
 pub mod plot;

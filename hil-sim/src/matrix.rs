@@ -1,5 +1,5 @@
 //! The fault matrix (issue 19, `docs/fault-matrix.md`): a test that checks
-//! a fault case ends it with [`fault_row!`], which asserts that what the
+//! a fault case ends it with [`fault_row!`](crate::fault_row), which asserts that what the
 //! test saw is what the case expects and leaves the row in
 //! `target/tmp/fault-matrix/`; `scripts/fault-matrix` prints the rows as a
 //! table (CI) and checks the table in the docs against them.
