@@ -37,11 +37,14 @@ fn pow10(k: u32) -> i64 {
     POW10.get(k as usize).copied().unwrap_or(1_000_000_000)
 }
 
-/// `v` / `p` rounded half away from zero (`p` ≥ 1).
+/// `v` / `p` rounded half away from zero (`p` ≥ 1; checked, so no
+/// division can panic: `p` < 1 gives `v`).
 fn div_round(v: i64, p: i64) -> i64 {
-    let (q, r) = (v / p, v % p);
-    if r.abs() >= p - r.abs() {
-        q + v.signum()
+    let (Some(q), Some(r)) = (v.checked_div(p), v.checked_rem(p)) else {
+        return v;
+    };
+    if r.unsigned_abs() >= p.unsigned_abs() - r.unsigned_abs() {
+        q.saturating_add(v.signum())
     } else {
         q
     }
