@@ -213,6 +213,18 @@ pub struct FineInterpolator {
     step: i32,
 }
 
+/// The master's increment per master cycle after a gap: `moved` over the
+/// `missed` + 1 cycles since the last set-point that arrived, rounded half
+/// up (checked: no panic path). Out of line: it runs after a gap only, and
+/// its 64-bit division would weigh on the cycle's common path.
+#[cold]
+#[inline(never)]
+fn step_after_gap(moved: i32, missed: u32) -> i32 {
+    let cycles = i64::from(missed) + 1;
+    let step = (2 * i64::from(moved) + cycles).checked_div_euclid(2 * cycles);
+    step.and_then(|s| i32::try_from(s).ok()).unwrap_or(0)
+}
+
 impl FineInterpolator {
     /// A new interpolator at standstill at position 0; validates I25.
     pub fn new(config: InterpolatorConfig) -> Result<Self, ConfigError> {
@@ -322,11 +334,13 @@ impl FineInterpolator {
             Some(sp) => {
                 self.monitor.received();
                 self.extrapolating = false;
-                // rounded half up; cycles ≥ 1 (checked: no panic path)
-                let cycles = i64::from(self.since_real) + 1;
-                let moved = i64::from(sp.position.wrapping_sub(self.last_real));
-                let step = (2 * moved + cycles).checked_div_euclid(2 * cycles).unwrap_or(0);
-                self.step = i32::try_from(step).unwrap_or(0);
+                let moved = sp.position.wrapping_sub(self.last_real);
+                self.step = if self.since_real == 0 {
+                    // no gap (every cycle but after one): no 64-bit division
+                    moved
+                } else {
+                    step_after_gap(moved, self.since_real)
+                };
                 self.last_real = sp.position;
                 self.since_real = 0;
                 let v = if sp.velocity_offset.is_finite() {
