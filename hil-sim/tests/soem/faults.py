@@ -22,6 +22,14 @@ not apply), axis B left in Switch on disabled.
                   config_init would reset every drive to Init first), then
                   a new SOEM master scans, reads what the drives kept and
                   brings the line to Op again.
+  --case stop-restart
+                  A reproducer, not a row of the matrix yet (the drive fails
+                  it; docs/fault-matrix.md): a master stops as SOEM's
+                  samples do (Op, Safe-Op, Init, socket closed, SYNC0 left
+                  active) and a new one brings the line to Op under DC;
+                  prints `ROW 64` with what it saw. Specified: Op at the
+                  first request; the drive today: Safe-Op + ERR, AL 0034h,
+                  Op after an acknowledge.
 
 Each case prints one line `ROW <order> <seen>`: the end the master read,
 written in the words of hil_sim::matrix (the Rust test compares it with the
@@ -606,11 +614,68 @@ def case_restart(args):
             m.close()
 
 
+def case_stop_restart(args):
+    """`ROW 64` (a reproducer, see the module doc): a master stops as
+    SOEM's samples do (Op, Safe-Op, Init, the socket closed; SYNC0 left
+    active, the drives' PLLs lock again in Init), a new master scans
+    (SOEM's config_init deactivates SYNC0 and resets the DC registers) and
+    brings the line to Op with DC again; a refused Op is acknowledged and
+    requested again, and the row says so."""
+    n = args.slaves
+    writes = [(A258, 0, A258_MS.to_bytes(2, "little")), (0x6065, 0, WINDOW_BEFORE_RESTART.to_bytes(4, "little"))]
+    for attempt in range(1, MAX_TRIES + 1):
+        m = pysoem.Master()
+        m.open(args.iface)
+        try:
+            bus = bring_up(m, n, writes)
+            bus.ready()
+            bus.cycles(100)
+            leave(bus)
+        finally:
+            m.close()
+        say("first master stopped (Init, SYNC0 left active, socket closed); 300 ms without a master")
+        time.sleep(0.3)
+        m = pysoem.Master()
+        m.open(args.iface)
+        try:
+            L.scan(m, n)
+            bus = bring_up(m, n, scan=False, must_op=False)
+            got = bus.states()
+            if not all_op(got) and bus.stalled(got) and attempt < MAX_TRIES:
+                leave(bus)
+                continue
+            first = per_drive([al_text(*g) for g in got])
+            acked = ""
+            if not all_op(got):
+                ok = bus.to_op()
+                acked = f"; after an acknowledge: {per_drive([al_text(*g) for g in bus.states()])}"
+                say(f"Op after the acknowledge: {ok}")
+            bus.cyc.watch()
+            enabled = bus.enable_a()
+            axes = bus.axis_states()
+            kept = []
+            for i in range(n):
+                window = sdo_u(m, i, 0x6065, 0)
+                bus.cycles(10)
+                a258 = sdo_u(m, i, A258, 0)
+                bus.cycles(10)
+                kept.append(f"axis A {axes[i][0]}; 6065h {window}, A258 {a258}")
+            end = bus.states()
+            if not (enabled and all_op(end)) and bus.stalled(end) and attempt < MAX_TRIES:
+                leave(bus)
+                continue
+            row("64", f"the new master's scan, maps, DC, Safe-Op and Op request: {first}{acked}; the enable: {per_drive(kept)}")
+            leave(bus)
+            return
+        finally:
+            m.close()
+
+
 def main():
-    ap = argparse.ArgumentParser(description=__doc__.split("\n")[0])
+    ap = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
     ap.add_argument("--iface", required=True)
     ap.add_argument("--slaves", type=int, default=2)
-    ap.add_argument("--case", choices=["pause", "restart"])
+    ap.add_argument("--case", choices=["pause", "restart", "stop-restart"])
     ap.add_argument("--dc", action="store_true", help="restart: both masters with DC SYNC0 1 ms (default free run)")
     ap.add_argument("--role", choices=["master", "first-master"], default="master")
     args = ap.parse_args()
@@ -627,8 +692,10 @@ def main():
                 case_pause(m, args.slaves)
             finally:
                 m.close()
-        else:
+        elif args.case == "restart":
             case_restart(args)
+        else:
+            case_stop_restart(args)
     except L.Fatal as e:
         L.check(False, f"stopped: {e}")
     except L.SOEM_ERRORS as e:
