@@ -7,6 +7,12 @@
 //! - the simulator's namespace holds the other end and runs
 //!   `hil-sim serve --iface … --slaves 3`.
 //!
+//! The fault cases (`faults.py`, rows 6x of the fault matrix,
+//! docs/fault-matrix.md) print the end SOEM read as `ROW <order> <seen>`
+//! lines; each test compares them with its rows' expected ends
+//! (`hil_sim::fault_row!`, which also leaves the rows for
+//! `scripts/fault-matrix`).
+//!
 //! The expected values come from the drive's own declarations: the SII image
 //! `ecat::build_sii(&drive::DEVICE, …)` and the objects a fresh dictionary
 //! shows, written to files the scripts compare SOEM's readings with.
@@ -20,8 +26,9 @@
 
 mod common;
 
-use common::soem_line::{pysoem_python, Line};
+use common::soem_line::{pysoem_python, Line, SCRIPT_LIMIT};
 use ecat::Dictionary;
+use hil_sim::matrix::Row;
 use std::fmt::Write as _;
 use std::path::{Path, PathBuf};
 use std::sync::Mutex;
@@ -241,4 +248,125 @@ fn foe_image_through_soem_firm_update() {
     if !status.success() {
         fail_with(&line, &format!("foe.py through SOEM failed: {status}"));
     }
+}
+
+/// Drives on the line of the fault cases.
+const FAULT_SLAVES: usize = 2;
+/// The peer of the SOEM rows of the fault matrix (`scripts/fault-matrix`
+/// lets them be missing when no SOEM test ran, and checks them when one did).
+const SOEM_PEER: &str = "SOEM (pysoem) over veth";
+
+/// Runs `faults.py --case <case>` on a line of [`FAULT_SLAVES`] drives
+/// (`tag`: one letter for the namespaces); the rows it printed (`ROW
+/// <order> <seen>`), or the test fails with serve's log.
+fn fault_rows(python: &Path, tag: &str, case: &[&str]) -> Vec<(String, String)> {
+    let dir = scratch(&format!("soem-faults-{}", case[0]));
+    let line = Line::new(tag, FAULT_SLAVES, 120, &dir);
+    let slaves = FAULT_SLAVES.to_string();
+    let mut args = vec!["--slaves", &slaves, "--case"];
+    args.extend_from_slice(case);
+    let (child, script) = line.spawn(python, "faults.py", &args);
+    let (status, lines) = common::watch_script(child, &script, SCRIPT_LIMIT);
+    if !status.success() {
+        fail_with(
+            &line,
+            &format!("faults.py {case:?} through SOEM failed: {status}"),
+        );
+    }
+    lines
+        .iter()
+        .filter_map(|l| l.strip_prefix("ROW "))
+        .filter_map(|r| r.split_once(' '))
+        .map(|(order, seen)| (order.to_string(), seen.to_string()))
+        .collect()
+}
+
+/// The end faults.py printed for row `order`.
+fn seen_in<'a>(rows: &'a [(String, String)], order: &str) -> &'a str {
+    rows.iter()
+        .find(|(o, _)| o == order)
+        .map(|(_, seen)| seen.as_str())
+        .unwrap_or_else(|| panic!("faults.py printed no row {order}: {rows:?}"))
+}
+
+/// Fault matrix rows 61 and 62 through SOEM: two drives in Op under DC
+/// SYNC0 1 ms with A258 = 100 ms (E-126: a time, not a count of frames, so
+/// the Python master's own jitter does not decide), axis A of each enabled
+/// in pv at standstill (no cyclic set-point: I423's extrapolation limit,
+/// C-117, does not apply), axis B disabled. The master sends no frame for
+/// 20 ms: nothing happens. For 500 ms: the PDO timeout (E-044, E-128),
+/// event 52 cause 6 with its EMCY and both axes in Fault (E-129), SOEM
+/// acknowledges, requests Op and resets the faults (C-017); 6065h and A258
+/// as written before. A stall of the master that the drives' clock shows
+/// at least as long as A258 repeats a case (faults.py).
+#[test]
+fn e126_e044_e128_e129_soem_frame_pauses_under_dc_with_a258_100_ms() {
+    let python = match pysoem_python() {
+        Ok(p) => p,
+        Err(why) => {
+            eprintln!("soem fault matrix (frame pauses): skipped, {why}");
+            return;
+        }
+    };
+    let _one = ONE_AT_A_TIME.lock().unwrap_or_else(|e| e.into_inner());
+    let rows = fault_rows(&python, "p", &["pause"]);
+    let short = Row {
+        order: "61",
+        case: "SOEM in Op under DC SYNC0 1 ms (axis A of both drives enabled in pv at standstill), A258 = 100 ms: \
+               no frame from the master for 20 ms",
+        spec: "E-126",
+        peer: SOEM_PEER,
+        expected: "drives 1, 2: Op, AL 0000h; axis A Operation enabled, axis B Switch on disabled; no EMCY; \
+                   603Fh 0000h, 683Fh 0000h; history: no new message",
+    };
+    hil_sim::fault_row!(short, seen_in(&rows, "61"));
+    let long = Row {
+        order: "62",
+        case: "the same, no frame for 500 ms; then SOEM acknowledges, requests Op and resets the faults",
+        spec: "E-126, E-044, E-128, E-129, C-017",
+        peer: SOEM_PEER,
+        expected:
+            "drives 1, 2: Safe-Op + ERR, AL 001Bh; axis A Fault, axis B Fault; EMCY 7500h/10h event 52 \
+                   cause 6; 603Fh 7500h, 683Fh 7500h; history: error AL 001Bh; the master acknowledges and \
+                   requests Op: drives 1, 2: Op, AL 0000h; a fault reset: axis A Switch on disabled, axis B \
+                   Switch on disabled; 6065h 123456, A258 100",
+    };
+    hil_sim::fault_row!(long, seen_in(&rows, "62"));
+}
+
+/// Fault matrix row 63 through SOEM: a master process killed (SIGKILL) in
+/// Op with process data (two drives in free run, A258 = 100 ms and 6065h
+/// written by it, axis A enabled in pv): 500 ms later the drives are in
+/// Safe-Op + ERR with AL 001Bh (E-126, E-044; the AL status read by one
+/// raw APRD frame, since SOEM's scan resets every drive to Init first). A
+/// new master process scans (Init, Pre-Op: the unread EMCY went with the
+/// mailbox, E-037; 603Fh and the history keep the fault), finds A258 and
+/// 6065h as the first master wrote them, maps, Safe-Op, Op (E-021), resets
+/// the faults and enables axis A. Free run: under DC the new master's first
+/// Op request would depend on how soon after the Init its scan deactivates
+/// SYNC0 (docs/fault-matrix.md, the SYNC0 loss in Init).
+#[test]
+fn e126_e044_e037_e021_soem_master_killed_in_op_and_a_new_master() {
+    let python = match pysoem_python() {
+        Ok(p) => p,
+        Err(why) => {
+            eprintln!("soem fault matrix (master killed): skipped, {why}");
+            return;
+        }
+    };
+    let _one = ONE_AT_A_TIME.lock().unwrap_or_else(|e| e.into_inner());
+    let rows = fault_rows(&python, "r", &["restart"]);
+    let killed = Row {
+        order: "63",
+        case: "the SOEM master process is killed (SIGKILL) in Op (free run, axis A enabled in pv; it wrote A258 = \
+               100 ms and 6065h); 500 ms later a new SOEM master process scans and brings the line to Op",
+        spec: "E-126, E-044, E-037, E-021",
+        peer: SOEM_PEER,
+        expected: "500 ms after the kill (AL status by a raw APRD frame): drives 1, 2: Safe-Op + ERR, AL 001Bh; \
+                   the new master's scan: drives 1, 2: Pre-Op, AL 0000h; axis A Fault, axis B Fault; no EMCY; \
+                   603Fh 7500h, 683Fh 7500h; history: error AL 001Bh; 6065h 654321, A258 100; its maps, \
+                   Safe-Op, Op, a fault reset and the enable: drives 1, 2: Op, AL 0000h; axis A Operation \
+                   enabled, axis B Switch on disabled",
+    };
+    hil_sim::fault_row!(killed, seen_in(&rows, "63"));
 }
