@@ -370,3 +370,33 @@ fn e126_e044_e037_e021_soem_master_killed_in_op_and_a_new_master() {
     };
     hil_sim::fault_row!(killed, seen_in(&rows, "63"));
 }
+
+/// Fault matrix row 64 through SOEM: a master stops as SOEM's samples do
+/// (Op, Safe-Op, Init, the socket closed, SYNC0 left running: the drives'
+/// PLLs lock again in Init), and a new master process scans (its start-up
+/// switches SYNC0 off: a SYNC0 timeout latches below Safe-Op, where the
+/// drive shows no error) and brings the line to Op under DC: Op at the
+/// first request (E-046; it was refused with 0034h until Pre-Op → Safe-Op
+/// cleared a PLL fault latched below Safe-Op).
+#[test]
+fn e046_e021_soem_a_master_stopped_in_init_and_a_new_master_under_dc() {
+    let python = match pysoem_python() {
+        Ok(p) => p,
+        Err(why) => {
+            eprintln!("soem fault matrix (stop and restart under DC): skipped, {why}");
+            return;
+        }
+    };
+    let _one = ONE_AT_A_TIME.lock().unwrap_or_else(|e| e.into_inner());
+    let rows = fault_rows(&python, "s", &["stop-restart"]);
+    let row = Row {
+        order: "64",
+        case: "a SOEM master stops as SOEM's samples do (Op, Safe-Op, Init, socket closed, SYNC0 left running); \
+               300 ms later a new SOEM master process scans and brings the line to Op under DC SYNC0",
+        spec: "E-046, E-021",
+        peer: SOEM_PEER,
+        expected: "the new master's scan, maps, DC, Safe-Op and Op request: drives 1, 2: Op, AL 0000h; the \
+                   enable: drives 1, 2: axis A Operation enabled; 6065h 654321, A258 100",
+    };
+    hil_sim::fault_row!(row, seen_in(&rows, "64"));
+}

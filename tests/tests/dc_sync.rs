@@ -1151,3 +1151,86 @@ fn e147_message_time_stamp_is_the_dc_system_time_when_synchronised() {
         "{stamp} vs {system_time}"
     );
 }
+
+/// E-046 (spec §3.3: S→O needs SYNC0 and the PLL locked, nothing older): a
+/// master that leaves the line in Init with SYNC0 running (the PLL is
+/// built anew and locks there) and then switches SYNC0 off (a new master's
+/// start-up does) leaves a SYNC0 timeout latched below Safe-Op, where the
+/// drive shows no error to acknowledge; the next master's Safe-Op → Op must
+/// not be refused for it (it was with 0034h until P→S cleared it; SOEM's
+/// stop and restart found it, `faults.py --case stop-restart`).
+#[test]
+fn e046_a_sync0_stop_below_safe_op_does_not_refuse_the_next_op() {
+    use drive_tests::{al_status, request};
+    let sim = line();
+    let first_op = with_master(&sim, async |md, clock| {
+        let mut group = init(md, clock).await;
+        for mut sd in group.iter_mut(md) {
+            sd.set_dc_sync(DcSync::Sync0);
+        }
+        let group = group
+            .into_pre_op_pdi(md)
+            .await
+            .expect("PRE-OP with PDI")
+            .configure_dc_sync(md, dc_config(SYNC0_NS))
+            .await
+            .expect("DC configuration")
+            .request_into_op(md)
+            .await
+            .expect("request OP");
+        let mut op = false;
+        dc_cycles(md, &group, &sim, 300, |_, all_op, _| op |= all_op).await;
+        // the master stops as SOEM's samples do: Init, SYNC0 left running
+        for sd in group.iter(md) {
+            request(&sd, drive_tests::al::INIT).await;
+        }
+        let t = sim.borrow().now().as_ns();
+        sim.borrow_mut()
+            .advance_to(nanos::Nanos::from_ns(t + 100_000_000));
+        // the PLL was built again in Init and locked
+        assert!(sim.borrow().drives()[0]
+            .drive
+            .pll()
+            .is_some_and(|p| p.is_locked()));
+        // then SYNC0 goes off (the next master's start-up): a timeout latches
+        for sd in group.iter(md) {
+            sd.register_write(esc::regs::dc::ACTIVATION, 0u8)
+                .await
+                .expect("0x0981");
+        }
+        let t = sim.borrow().now().as_ns();
+        sim.borrow_mut().advance_to(nanos::Nanos::from_ns(t + 50_000_000));
+        for sd in group.iter(md) {
+            assert_eq!(
+                al_status(&sd).await,
+                (drive_tests::al::INIT, 0),
+                "no error shown in Init"
+            );
+        }
+        op
+    });
+    assert!(first_op, "the first master reached Op");
+    // a new master: its start-up, DC, Op
+    let (op, status) = with_master(&sim, async |md, clock| {
+        let mut group = init(md, clock).await;
+        for mut sd in group.iter_mut(md) {
+            sd.set_dc_sync(DcSync::Sync0);
+        }
+        let group = group
+            .into_pre_op_pdi(md)
+            .await
+            .expect("PRE-OP with PDI")
+            .configure_dc_sync(md, dc_config(SYNC0_NS))
+            .await
+            .expect("DC configuration")
+            .request_into_op(md)
+            .await
+            .expect("request OP");
+        let mut op = false;
+        dc_cycles(md, &group, &sim, 300, |_, all_op, _| op |= all_op).await;
+        let sd = group.subdevice(md, 0).expect("drive");
+        (op, al_status(&sd).await)
+    });
+    assert!(op, "the new master's Op: {status:04x?}");
+    assert_eq!(status, (OP, 0));
+}

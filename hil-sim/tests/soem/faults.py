@@ -23,13 +23,11 @@ not apply), axis B left in Switch on disabled.
                   a new SOEM master scans, reads what the drives kept and
                   brings the line to Op again.
   --case stop-restart
-                  A reproducer, not a row of the matrix yet (the drive fails
-                  it; docs/fault-matrix.md): a master stops as SOEM's
-                  samples do (Op, Safe-Op, Init, socket closed, SYNC0 left
-                  active) and a new one brings the line to Op under DC;
-                  prints `ROW 64` with what it saw. Specified: Op at the
-                  first request; the drive today: Safe-Op + ERR, AL 0034h,
-                  Op after an acknowledge.
+                  row 64: a master stops as SOEM's samples do (Op, Safe-Op,
+                  Init, socket closed, SYNC0 left active) and a new one
+                  brings the line to Op under DC. Specified: Op at the first
+                  request (the drive refused it with AL 0034h until Pre-Op
+                  → Safe-Op cleared a PLL fault latched below Safe-Op).
 
 Each case prints one line `ROW <order> <seen>`: the end the master read,
 written in the words of hil_sim::matrix (the Rust test compares it with the
@@ -615,7 +613,7 @@ def case_restart(args):
 
 
 def case_stop_restart(args):
-    """`ROW 64` (a reproducer, see the module doc): a master stops as
+    """`ROW 64`: a master stops as
     SOEM's samples do (Op, Safe-Op, Init, the socket closed; SYNC0 left
     active, the drives' PLLs lock again in Init), a new master scans
     (SOEM's config_init deactivates SYNC0 and resets the DC registers) and

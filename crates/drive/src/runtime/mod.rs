@@ -36,7 +36,8 @@
 //! 1): Safe-Op → Op waits for the lock (002Dh without SYNC0, 0032h not
 //! locked), a latched PLL fault in Op drops to Safe-Op with its AL code and
 //! EMCY 7500h cause 7 (spec §3.3, §13.4). The master's error acknowledge
-//! clears the PLL fault. In SM-Sync the SM2 event drives the PLL instead
+//! clears the PLL fault, and so does Pre-Op → Safe-Op (a fault latched
+//! below Safe-Op, where no error is shown, is not the new configuration's). In SM-Sync the SM2 event drives the PLL instead
 //! of SYNC0 (E-110, [`Drive::on_frame`]).
 //!
 //! Event 52 "Communication" (E-128…E-131): when the slave leaves Op for a
@@ -595,6 +596,14 @@ impl<F: Flash, B: Flash> Drive<F, B> {
             }
             if state == AlState::SafeOp {
                 self.compile_pdo_image();
+                // a PLL fault latched below Safe-Op (SYNC0 stopped in Init or
+                // Pre-Op, where the drive shows no error to acknowledge) is
+                // not this synchronisation's: S→O asks for SYNC0 and the lock
+                if self.last_state == AlState::PreOp {
+                    if let Some(pll) = self.pll.as_mut() {
+                        pll.clear_fault();
+                    }
+                }
             }
             if state == AlState::Init || (self.pll_from_sm && state == AlState::PreOp) {
                 self.pll_from_sm = false;
