@@ -27,6 +27,8 @@ const FULL: u8 = esc::sm::status::MAILBOX_FULL;
 #[derive(Clone)]
 pub struct MailboxEsc {
     mem: Vec<u8>,
+    /// An AL control write the slave has not read yet (the AL control event).
+    al_control: bool,
 }
 
 impl MailboxEsc {
@@ -45,7 +47,16 @@ impl MailboxEsc {
             let at = usize::from(regs::sm(n));
             mem[at..at + 8].copy_from_slice(&sm.to_bytes());
         }
-        Self { mem }
+        Self { mem, al_control: false }
+    }
+
+    /// The master writes AL control (0x0120): the AL control event is
+    /// raised until the slave reads the register.
+    #[allow(dead_code)] // the foe target's
+    pub fn master_al_control(&mut self, value: u16) {
+        let at = usize::from(regs::AL_CONTROL);
+        self.mem[at..at + 2].copy_from_slice(&value.to_le_bytes());
+        self.al_control = true;
     }
 
     fn status(&mut self, n: u8) -> &mut u8 {
@@ -85,8 +96,12 @@ impl esc::Pdi for MailboxEsc {
         let end = a + buf.len();
         if a == usize::from(regs::AL_EVENT_REQUEST) && buf.len() <= 4 {
             let sm0 = if *self.status(0) & FULL != 0 { regs::al_event::sm(0) } else { 0 };
-            buf.copy_from_slice(&sm0.to_le_bytes()[..buf.len()]);
+            let al = if self.al_control { regs::al_event::AL_CONTROL } else { 0 };
+            buf.copy_from_slice(&(sm0 | al).to_le_bytes()[..buf.len()]);
             return Ok(());
+        }
+        if a == usize::from(regs::AL_CONTROL) {
+            self.al_control = false;
         }
         for (i, b) in buf.iter_mut().enumerate() {
             *b = self.mem.get(a + i).copied().unwrap_or(0);
