@@ -2,7 +2,7 @@
 //! objects it declares differently from the double-axis device. Everything
 //! else is the double-axis declaration without axis B's objects
 //! ([`crate::variant::is_axis_b`]); each object here is the double-axis one
-//! with its packed entries ([`super::pack`]) and only what differs changed,
+//! with its packed entries (those of [`super::OBJECTS`]) and only what differs changed,
 //! so the entries' subindices, names, types, access and ranges stay those
 //! of the one declaration (a test checks it):
 //!
