@@ -90,6 +90,7 @@ fn e002_e005_serve_axes_1_is_the_single_axis_device() {
     let timeouts = Timeouts {
         pdu: std::time::Duration::from_millis(500),
         eeprom: std::time::Duration::from_millis(500),
+        mailbox_echo: std::time::Duration::from_millis(2000),
         mailbox_response: std::time::Duration::from_millis(2000),
         ..Timeouts::default()
     };
