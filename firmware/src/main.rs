@@ -145,6 +145,15 @@ mod app {
         )
     }
 
+    /// The device this image is: the double-axis drive (SC6A062), or with
+    /// the feature `single-axis` the single-axis drive (SI6A061: its own
+    /// identity and SII, no axis-B objects or PDOs, axis B idle).
+    const VARIANT: drive::Variant = if cfg!(feature = "single-axis") {
+        drive::Variant::Single
+    } else {
+        drive::Variant::Double
+    };
+
     /// The drive in its static, built in this function's own frame.
     #[inline(never)]
     #[allow(unsafe_code)]
@@ -158,7 +167,7 @@ mod app {
         // be built in place (no copy of ~30 KiB through this frame, which
         // `cortex_m::singleton!` makes).
         let slot = unsafe { &mut *core::ptr::addr_of_mut!(DRIVE) };
-        let drive = slot.write(Drive::unstarted(ParamFlash::new(), None));
+        let drive = slot.write(Drive::unstarted_for(VARIANT, ParamFlash::new(), None));
         drive.start();
         Some(drive)
     }

@@ -7,7 +7,8 @@
 //!   scripted IO controller (in-process) runs the Example Function block's
 //!   sequence against one simulated PROFINET drive and plots the run.
 //! - `hil-sim serve --iface IF [--slaves N] [--axes 1|2] [--pcap FILE] [--seconds S]`:
-//!   the simulated line answers EtherCAT frames on a raw Ethernet interface.
+//!   the simulated line answers EtherCAT frames on a raw Ethernet interface
+//!   (`--axes 1`: single-axis drives, SI6A061).
 //! - `hil-sim serve --fieldbus profinet --iface IF [--name NAME] [--pcap FILE]`:
 //!   one simulated drive answers as a PROFINET IO device on the interface.
 //!

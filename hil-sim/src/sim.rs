@@ -7,6 +7,7 @@ use crate::frame::process_frame;
 use crate::motor::{Motor, MotorOutputs};
 mod axis_io;
 mod snapshot;
+mod variant;
 
 use crate::pcap::Recording;
 pub(crate) use axis_io::axis_io;
@@ -237,10 +238,11 @@ pub struct Sync0Stamp {
     pub pulses: u32,
 }
 
-/// The SII image generated from [`drive::DEVICE`].
-fn sii_image() -> ([u8; ecat::sii::EEPROM_BYTES], usize) {
+/// The SII image generated from the description of `variant`
+/// ([`drive::device`]).
+fn sii_image(variant: drive::Variant) -> ([u8; ecat::sii::EEPROM_BYTES], usize) {
     let mut sii = [0u8; ecat::sii::EEPROM_BYTES];
-    let len = ecat::build_sii(&drive::DEVICE, &mut sii).unwrap_or(0);
+    let len = ecat::build_sii(drive::device(variant), &mut sii).unwrap_or(0);
     (sii, len)
 }
 
@@ -265,7 +267,13 @@ impl SimDrive {
     /// A drive powered on with the given parameter flash and, if any,
     /// firmware flash (the boot decision runs first).
     pub fn power_on_with(flash: SimFlash, firmware: Option<FirmwareFlash>) -> Self {
-        let (sii, len) = sii_image();
+        Self::power_on_for(drive::Variant::Double, flash, firmware)
+    }
+
+    /// [`power_on_with`](Self::power_on_with) for the device `variant`: its
+    /// SII in the ESC's EEPROM, its dictionary and axes.
+    pub fn power_on_for(variant: drive::Variant, flash: SimFlash, firmware: Option<FirmwareFlash>) -> Self {
+        let (sii, len) = sii_image(variant);
         let esc = Esc::new(EscConfig::default(), sii.get(..len).unwrap_or(&[]));
         let boot = firmware.map(|f| {
             let mut slots = FirmwareSlots::new(f);
@@ -276,7 +284,7 @@ impl SimDrive {
         });
         Self {
             esc,
-            drive: drive::runtime::Drive::with_boot(flash, boot),
+            drive: drive::runtime::Drive::with_boot_for(variant, flash, boot),
             state_log: Vec::new(),
             motors: [Motor::default_servo(), Motor::default_servo()],
             conditions: [AxisConditions::READY; 2],
@@ -300,9 +308,10 @@ impl SimDrive {
     pub fn power_cycle(&mut self) {
         let old = std::mem::replace(self, Self::power_on(SimFlash::new()));
         let (drift, offset) = (old.esc.config().clock_drift_ppb, old.esc.config().clock_offset_ns);
+        let variant = old.drive.variant();
         let (flash, firmware) = old.drive.into_flashes();
         // (the simulated drive saves at once: its store is never out in a job)
-        *self = Self::power_on_with(flash.unwrap_or_else(SimFlash::new), firmware);
+        *self = Self::power_on_for(variant, flash.unwrap_or_else(SimFlash::new), firmware);
         self.esc.set_clock(drift, offset);
     }
 

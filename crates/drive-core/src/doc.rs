@@ -25,7 +25,63 @@ pub fn write_reference(w: &mut impl Write) -> fmt::Result {
         AXIS_B_MANUFACTURER,
     )?;
     section(w, "Modular device profile, F000h–FFFEh", 0xF000..0xFFFF)?;
+    single_axis(w)?;
     scaling(w)
+}
+
+/// The single-axis device ([`crate::Variant::Single`]): what it leaves out
+/// and what it declares differently ([`crate::objects::single`]).
+fn single_axis(w: &mut impl Write) -> fmt::Result {
+    w.write_str(
+        "\n## The single-axis device (SI6A061)\n\n\
+         The single-axis device (`Variant::Single`, `DriveObjects::for_variant`) has every object \
+         above except axis B's, 6800h–6FFFh and A000h–DFFFh (0602 0000h, \
+         not in the SDO Info lists, not mappable: 0604 0041h), and declares these entries differently \
+         (`crates/drive-core/src/objects/single.rs`); its RAM image has the same layout.\n\n\
+         | Index | Sub | Name | Double-axis device | Single-axis device | Notes |\n|---|---|---|---|---|---|\n",
+    )?;
+    for r in crate::Variant::Single.redeclared() {
+        let Some((_, o)) = crate::objects::find(r.info.index) else {
+            continue;
+        };
+        let notes = Notes(r);
+        if let (Value::Text(a), Value::Text(b)) = (o.value, r.value) {
+            writeln!(
+                w,
+                "| {:04X}h | 00h | {} | \"{a}\" | \"{b}\" | {notes} |",
+                r.info.index, r.info.name
+            )?;
+        }
+        // the entries whose defaults differ, one row per object
+        let differ = || {
+            o.info
+                .entries
+                .iter()
+                .zip(r.info.entries.iter())
+                .filter(|(a, b)| a.default != b.default)
+        };
+        let (Some((_, first)), Some((_, last))) = (differ().next(), differ().next_back()) else {
+            continue;
+        };
+        write!(w, "| {:04X}h | {:02X}h", r.info.index, first.sub)?;
+        if last.sub != first.sub {
+            write!(w, "–{:02X}h", last.sub)?;
+        }
+        write!(w, " | {}", first.name)?;
+        if last.sub != first.sub {
+            write!(w, " … {}", last.name)?;
+        }
+        for single in [false, true] {
+            w.write_str(" | ")?;
+            for (k, (a, b)) in differ().enumerate() {
+                let e = if single { b } else { a };
+                let sep = if k == 0 { "" } else { ", " };
+                write!(w, "{sep}{}", Num(&e, e.default))?;
+            }
+        }
+        writeln!(w, " | {notes} |")?;
+    }
+    Ok(())
 }
 
 /// The entries fieldbus scaling acts on ([`crate::objects::scaling`]).

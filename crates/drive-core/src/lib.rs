@@ -1,5 +1,6 @@
-//! The fieldbus-neutral drive (SC6-class, two axes): what every fieldbus
-//! personality shares. No fieldbus crate is a dependency.
+//! The fieldbus-neutral drive (SC6-class, two axes; or the SI6-class
+//! single-axis device, [`Variant`]): what every fieldbus personality shares.
+//! No fieldbus crate is a dependency.
 //!
 //! - [`objects`]: the object dictionary, declared once (communication area,
 //!   manufacturer parameters, CiA 402 objects of both axes) with its RAM image
@@ -35,12 +36,14 @@ pub mod params;
 pub mod pdo_image;
 pub mod pdo_maps;
 pub mod user_units;
+pub mod variant;
 
 pub use dictionary::{
     revision, DriveObjects, ImageError, LiveValues, NoLive, Prepared, Requests, Slot, Template, WithLive,
     LOAD_SIGNATURE, PERSISTENT_IMAGE_BYTES, SAVE_SIGNATURE,
 };
 pub use pdo_maps::{module_ident, PdoLayout, IP_RX, IP_TX, USER_MODULE, VL_RX, VL_TX};
+pub use variant::Variant;
 
 /// STOBER's EtherCAT vendor ID (E-005).
 pub const VENDOR_ID: u32 = 0xB9;
@@ -48,6 +51,11 @@ pub const VENDOR_ID: u32 = 0xB9;
 /// is not in the seeds or the spec; assumed 1.5 kW (2 × 0.75 kW) until checked
 /// against the SC6 manual.
 pub const PRODUCT_CODE: u32 = 15;
+/// Product code of the single-axis device (SI6A061, [`Variant::Single`]):
+/// its nominal power is not in the seeds either; assumed 0.75 kW (one axis
+/// of the SC6A062's assumed 2 × 0.75 kW), 7.5 rounded to 8 (docs/conformance.md,
+/// decisions).
+pub const PRODUCT_CODE_SINGLE: u32 = 8;
 /// Revision number 1018h:03 with the default template "EtherCAT Rx SDO
 /// Info", also in the SII (E-005, E-008): software build number << 1 | 1
 /// (bit 0 = template, see [`revision`]); build 0 for now.
@@ -63,6 +71,8 @@ pub const SERIAL: u32 = 0;
 pub const DEVICE_TYPE: u32 = 0x0002_0192;
 /// Device name (1008h, E50).
 pub const DEVICE_NAME: &str = "SC6";
+/// Device name of the single-axis device (1008h, E50; [`Variant::Single`]).
+pub const DEVICE_NAME_SINGLE: &str = "SI6";
 /// Entries per PDO mapping object (spec §5.1).
 pub const MAPPING_ENTRIES: u8 = 24;
 /// Offset of axis B's CiA 402 objects (E-015).
@@ -84,3 +94,5 @@ mod tests_od;
 mod tests_records_od;
 #[cfg(test)]
 mod tests_scaling;
+#[cfg(test)]
+mod tests_variant;

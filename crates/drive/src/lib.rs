@@ -1,9 +1,11 @@
-//! The drive on EtherCAT (SC6A062, double axis): the fieldbus-neutral core
-//! ([`drive_core`], re-exported whole) behind the EtherCAT slave stack.
+//! The drive on EtherCAT (SC6A062, double axis; or SI6A061, single axis):
+//! the fieldbus-neutral core ([`drive_core`], re-exported whole) behind the
+//! EtherCAT slave stack.
 //!
 //! - [`DEVICE`]: the device description (identity, SyncManagers, FMMUs, PDO
 //!   maps, DC op modes), the one source the SII image, the stack's checks
-//!   and the ESI XML derive from.
+//!   and the ESI XML derive from; [`DEVICE_SINGLE`] the single-axis
+//!   device's ([`device`] of a [`Variant`]).
 //! - [`runtime`]: [`runtime::Drive`], the core's axes and dictionary behind an
 //!   [`ecat::Slave`]: process data, ESM hooks, DC-Sync PLL, save, FoE, EoE,
 //!   diagnosis.
@@ -41,12 +43,20 @@ static RX_B_ENTRIES: [PdoEntry; 8] = RX_B;
 static TX_A_ENTRIES: [PdoEntry; 10] = TX_A;
 static TX_B_ENTRIES: [PdoEntry; 10] = TX_B;
 
+const RX_PDO_A: Pdo = Pdo {
+    index: 0x1600,
+    name: "RxPDO axis A",
+    entries: &RX_A_ENTRIES,
+};
+
+const TX_PDO_A: Pdo = Pdo {
+    index: 0x1A00,
+    name: "TxPDO axis A",
+    entries: &TX_A_ENTRIES,
+};
+
 static RX_PDOS: [Pdo; 2] = [
-    Pdo {
-        index: 0x1600,
-        name: "RxPDO axis A",
-        entries: &RX_A_ENTRIES,
-    },
+    RX_PDO_A,
     Pdo {
         index: 0x1601,
         name: "RxPDO axis B",
@@ -55,11 +65,7 @@ static RX_PDOS: [Pdo; 2] = [
 ];
 
 static TX_PDOS: [Pdo; 2] = [
-    Pdo {
-        index: 0x1A00,
-        name: "TxPDO axis A",
-        entries: &TX_A_ENTRIES,
-    },
+    TX_PDO_A,
     Pdo {
         index: 0x1A01,
         name: "TxPDO axis B",
@@ -95,16 +101,46 @@ static DC_MODES: [DcOpMode; 3] = [
     },
 ];
 
+/// The single-axis device's PDOs: axis A's only.
+static RX_PDOS_SINGLE: [Pdo; 1] = [RX_PDO_A];
+static TX_PDOS_SINGLE: [Pdo; 1] = [TX_PDO_A];
+
 /// The drive as seen on the bus (SC6A062, double axis).
-pub static DEVICE: Device = Device {
+pub static DEVICE: Device = DOUBLE;
+
+/// The single-axis device as seen on the bus (SI6A061,
+/// [`Variant::Single`]): the double-axis description with its own identity
+/// (product code [`PRODUCT_CODE_SINGLE`], name, order code) and axis A's
+/// PDOs only (no 1601h/1A01h: channel 2 is a free channel there, empty).
+pub static DEVICE_SINGLE: Device = Device {
+    identity: Identity {
+        product_code: Variant::Single.product_code(),
+        ..DOUBLE.identity
+    },
+    name: Variant::Single.device_name(),
+    order_code: "SI6A061",
+    rx_pdos: &RX_PDOS_SINGLE,
+    tx_pdos: &TX_PDOS_SINGLE,
+    ..DOUBLE
+};
+
+/// The description of `variant`: [`DEVICE`] or [`DEVICE_SINGLE`].
+pub fn device(variant: Variant) -> &'static Device {
+    match variant {
+        Variant::Double => &DEVICE,
+        Variant::Single => &DEVICE_SINGLE,
+    }
+}
+
+const DOUBLE: Device = Device {
     identity: Identity {
         vendor_id: VENDOR_ID,
-        product_code: PRODUCT_CODE,
+        product_code: Variant::Double.product_code(),
         revision: SOFTWARE_BUILD,
         serial: SERIAL,
     },
     device_type: DEVICE_TYPE,
-    name: DEVICE_NAME,
+    name: Variant::Double.device_name(),
     order_code: "SC6A062",
     group: "Drives",
     mailbox_out: MailboxSm {
@@ -155,3 +191,5 @@ extern crate std;
 mod tests;
 #[cfg(test)]
 mod tests_axis;
+#[cfg(test)]
+mod tests_single;

@@ -5,9 +5,12 @@
 //! lists exactly what the device shows in each subindex template) and the SII
 //! builder [`ecat::build_sii`] (EEPROM size, ConfigData, bootstrap mailbox).
 //!
-//! One file per subindex template (E-150): "EtherCAT Rx SDO Info" (the
-//! default) and "EtherCAT Rx", each with the revision number 1018h:03 of its
-//! template (E-151, [`drive::revision`]). The checked-in files under `esi/`
+//! One file per device and subindex template (E-150): the double-axis device
+//! ([`drive::DEVICE`], SC6A062) and the single-axis device
+//! ([`drive::DEVICE_SINGLE`], SI6A061, [`Variant::Single`]: no axis-B
+//! objects or PDOs), each in "EtherCAT Rx SDO Info" (the default) and
+//! "EtherCAT Rx", each with the revision number 1018h:03 of its template
+//! (E-151, [`drive::revision`]). The checked-in files under `esi/`
 //! are kept equal to [`files`] by the test `esi_files_are_current`
 //! (`UPDATE_ESI=1 cargo test -p esi` rewrites them; `cargo run -p esi` too).
 //!
@@ -16,7 +19,7 @@
 use std::collections::BTreeMap;
 use std::fmt::Write;
 
-use drive::{revision, DriveObjects, Template, DEVICE};
+use drive::{revision, DriveObjects, Template, Variant};
 use ecat::desc::{coe_details, DcOpMode, Device, Pdo};
 use ecat::sii::EEPROM_BYTES;
 use esc::sii::{mailbox_protocol, word};
@@ -40,21 +43,26 @@ pub const fn template_name(template: Template) -> &'static str {
     }
 }
 
-/// File name of the template's ESI under `esi/`.
-pub fn file_name(template: Template) -> String {
+/// The devices, each with its own ESIs (the double-axis device first).
+pub const VARIANTS: [Variant; 2] = Variant::ALL;
+
+/// File name of the ESI of `variant` in `template` under `esi/` (named
+/// after the order code).
+pub fn file_name(variant: Variant, template: Template) -> String {
     let suffix = match template {
         Template::SdoInfo => "rx-sdo-info",
         Template::Rx => "rx",
     };
-    format!("{}-{suffix}.xml", DEVICE.order_code)
+    format!("{}-{suffix}.xml", drive::device(variant).order_code)
 }
 
-/// The device description in `template`: [`DEVICE`] with the template's
-/// revision number (E-151) and, for "EtherCAT Rx", without SDO Information.
-/// In the default template this is [`DEVICE`] itself (the SII the drive
-/// carries); the SII of the "EtherCAT Rx" variant is `build_sii` of this.
-pub fn device(template: Template) -> Device {
-    let mut d = DEVICE;
+/// The description of `variant` in `template`: [`drive::device`] with the
+/// template's revision number (E-151) and, for "EtherCAT Rx", without SDO
+/// Information. In the default template this is [`drive::device`] itself
+/// (the SII the drive carries); the SII of the "EtherCAT Rx" template is
+/// `build_sii` of this.
+pub fn device(variant: Variant, template: Template) -> Device {
+    let mut d = *drive::device(variant);
     d.identity.revision = revision(template);
     if template == Template::Rx {
         d.coe_details &= !coe_details::SDO_INFO;
@@ -62,26 +70,28 @@ pub fn device(template: Template) -> Device {
     d
 }
 
-/// The SII image of the device in `template` ([`EEPROM_BYTES`] long).
-pub fn sii(template: Template) -> Result<Vec<u8>, ecat::SiiError> {
+/// The SII image of `variant` in `template` ([`EEPROM_BYTES`] long).
+pub fn sii(variant: Variant, template: Template) -> Result<Vec<u8>, ecat::SiiError> {
     let mut img = vec![0u8; EEPROM_BYTES];
-    ecat::build_sii(&device(template), &mut img)?;
+    ecat::build_sii(&device(variant, template), &mut img)?;
     Ok(img)
 }
 
-/// The drive's object dictionary as the bus sees it in `template`, at the
-/// default access level (A10\[2\]): the objects and entries the ESI lists.
-pub fn dictionary(template: Template) -> DriveObjects {
-    let mut d = DriveObjects::new();
+/// The object dictionary of `variant` as the bus sees it in `template`, at
+/// the default access level (A10\[2\]): the objects and entries the ESI
+/// lists.
+pub fn dictionary(variant: Variant, template: Template) -> DriveObjects {
+    let mut d = DriveObjects::for_variant(variant);
     d.set_template(template);
     d
 }
 
-/// Every generated file: (file name, contents).
+/// Every generated file: (file name, contents), per device and template.
 pub fn files() -> Result<Vec<(String, String)>, Error> {
-    TEMPLATES
+    VARIANTS
         .iter()
-        .map(|&t| Ok((file_name(t), generate(t)?)))
+        .flat_map(|&v| TEMPLATES.iter().map(move |&t| (v, t)))
+        .map(|(v, t)| Ok((file_name(v, t), generate(v, t)?)))
         .collect()
 }
 
@@ -102,15 +112,19 @@ impl std::fmt::Display for Error {
 
 impl std::error::Error for Error {}
 
-/// The ESI of the device in `template`.
-pub fn generate(template: Template) -> Result<String, Error> {
-    let dev = device(template);
-    let image = sii(template).map_err(Error::Sii)?;
-    let od = dictionary(template);
+/// The ESI of `variant` in `template`.
+pub fn generate(variant: Variant, template: Template) -> Result<String, Error> {
+    let dev = device(variant, template);
+    let image = sii(variant, template).map_err(Error::Sii)?;
+    let od = dictionary(variant, template);
+    let source = match variant {
+        Variant::Double => "drive::DEVICE",
+        Variant::Single => "drive::DEVICE_SINGLE",
+    };
     let mut x = Xml::default();
     x.raw("<?xml version=\"1.0\" encoding=\"UTF-8\"?>\n");
     x.raw(&format!(
-        "<!-- Generated by crates/esi from drive::DEVICE and the object dictionary; do not edit.\n     \
+        "<!-- Generated by crates/esi from {source} and the object dictionary; do not edit.\n     \
          Regenerate: UPDATE_ESI=1 cargo test -p esi (or cargo run -p esi). Template \"{}\". -->\n",
         template_name(template)
     ));
@@ -439,7 +453,7 @@ fn dictionary_element(x: &mut Xml, template: Template, od: &DriveObjects) {
             x.leaf("Type", &[], &type_name(e.data_type));
             x.leaf("BitSize", &[], &e.bit_len().to_string());
             x.open("Info", &[]);
-            default_value(x, o, e, template);
+            default_value(x, od, o, e, template);
             x.close("Info");
             flags(x, e.access, e.persistent);
         } else {
@@ -450,7 +464,7 @@ fn dictionary_element(x: &mut Xml, template: Template, od: &DriveObjects) {
                 x.open("SubItem", &[]);
                 x.leaf("Name", &[], e.name);
                 x.open("Info", &[]);
-                default_value(x, o, e, template);
+                default_value(x, od, o, e, template);
                 x.close("Info");
                 x.close("SubItem");
             }
@@ -464,16 +478,17 @@ fn dictionary_element(x: &mut Xml, template: Template, od: &DriveObjects) {
     x.close("Dictionary");
 }
 
-/// The default of entry `e` of `o`: the declared default; 1018h:03 is the
-/// template's revision (E-151); constant strings as `DefaultString`.
-fn default_value(x: &mut Xml, o: &ObjectInfo, e: &EntryInfo, template: Template) {
+/// The default of entry `e` of `o`: the declared default (the device's
+/// declaration, as `od` shows it); 1018h:03 is the template's revision
+/// (E-151); constant strings as `DefaultString`.
+fn default_value(x: &mut Xml, od: &DriveObjects, o: &ObjectInfo, e: &EntryInfo, template: Template) {
     let value = if o.index == 0x1018 && e.sub == 3 {
         i64::from(revision(template))
     } else {
         e.default
     };
     if e.data_type.is_string() {
-        if let Some(s) = constant_text(o.index) {
+        if let Some(s) = constant_text(od, o.index) {
             x.leaf("DefaultString", &[], s);
         }
         return;
@@ -483,9 +498,10 @@ fn default_value(x: &mut Xml, o: &ObjectInfo, e: &EntryInfo, template: Template)
     x.leaf("DefaultData", &[], &hex_bytes(buf.get(..n).unwrap_or(&[])));
 }
 
-/// The constant text of a VAR string object (1008h, 1009h, 100Ah, …).
-fn constant_text(index: u16) -> Option<&'static str> {
-    match drive::objects::find(index)?.1.value {
+/// The constant text of a VAR string object (1008h, 1009h, 100Ah, …) as
+/// the device declares it.
+fn constant_text(od: &DriveObjects, index: u16) -> Option<&'static str> {
+    match od.declared_object(index)?.value {
         drive::objects::Value::Text(s) => Some(s),
         _ => None,
     }

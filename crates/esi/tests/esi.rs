@@ -11,7 +11,7 @@
 use std::collections::{BTreeMap, BTreeSet};
 use std::path::PathBuf;
 
-use drive::{revision, Template, DEVICE};
+use drive::{revision, Template, Variant};
 use ecat::sii::{categories, find_category, records, sii_string, sii_word};
 use esc::sii::{category, word};
 use od::{CommState, DataType, Dictionary};
@@ -62,9 +62,18 @@ fn device_node<'a, 'i>(doc: &'a Document<'i>) -> Node<'a, 'i> {
     )
 }
 
-/// The ESI text of `template`, as generated (the drift test keeps the files equal).
-fn esi(template: Template) -> String {
-    esi::generate(template).unwrap()
+/// The ESI text of `variant` in `template`, as generated (the drift test
+/// keeps the files equal).
+fn esi(variant: Variant, template: Template) -> String {
+    esi::generate(variant, template).unwrap()
+}
+
+/// Every (device, template) pair with an ESI.
+fn each() -> Vec<(Variant, Template)> {
+    esi::VARIANTS
+        .iter()
+        .flat_map(|&v| esi::TEMPLATES.iter().map(move |&t| (v, t)))
+        .collect()
 }
 
 #[test]
@@ -82,33 +91,36 @@ fn esi_files_are_current() {
 #[test]
 fn e150_one_esi_per_template_with_its_own_revision() {
     let files = esi::files().unwrap();
-    assert_eq!(files.len(), 2);
-    assert_ne!(files[0].0, files[1].0);
-    let mut revisions = BTreeSet::new();
-    for t in esi::TEMPLATES {
-        let xml = esi(t);
-        let doc = Document::parse(&xml).unwrap();
-        let dev = device_node(&doc);
-        let rev = num(child(dev, "Type").attribute("RevisionNo").unwrap());
-        revisions.insert(rev);
-        assert!(text_of(dev, "Name").contains(esi::template_name(t)));
-        // SDO Information only in "EtherCAT Rx SDO Info" (spec §6.1)
-        let coe = child(child(dev, "Mailbox"), "CoE");
-        let sdo_info = t == Template::SdoInfo;
-        assert_eq!(coe.attribute("SdoInfo"), Some(if sdo_info { "1" } else { "0" }));
-        // the template's subindex numbering: A10 (2000h + 10) has sub 0 =
-        // element count in SDO Info, sub 0 = element 0 in Rx
-        let a10 = drive::parameter_index(0, 10);
-        let dt = data_type(child(dev, "Profile"), &format!("DT{a10:04X}"));
-        let sub0 = children(dt, "SubItem").next().unwrap();
-        let name = text(sub0, "Name");
-        if sdo_info {
-            assert_eq!(name, "Highest subindex supported");
-        } else {
-            assert_eq!(name, "Operating unit");
+    assert_eq!(files.len(), 4, "two devices, two templates each");
+    let names: BTreeSet<&str> = files.iter().map(|f| f.0.as_str()).collect();
+    assert_eq!(names.len(), 4);
+    for v in esi::VARIANTS {
+        let mut revisions = BTreeSet::new();
+        for t in esi::TEMPLATES {
+            let xml = esi(v, t);
+            let doc = Document::parse(&xml).unwrap();
+            let dev = device_node(&doc);
+            let rev = num(child(dev, "Type").attribute("RevisionNo").unwrap());
+            revisions.insert(rev);
+            assert!(text_of(dev, "Name").contains(esi::template_name(t)));
+            // SDO Information only in "EtherCAT Rx SDO Info" (spec §6.1)
+            let coe = child(child(dev, "Mailbox"), "CoE");
+            let sdo_info = t == Template::SdoInfo;
+            assert_eq!(coe.attribute("SdoInfo"), Some(if sdo_info { "1" } else { "0" }));
+            // the template's subindex numbering: A10 (2000h + 10) has sub 0 =
+            // element count in SDO Info, sub 0 = element 0 in Rx
+            let a10 = drive::parameter_index(0, 10);
+            let dt = data_type(child(dev, "Profile"), &format!("DT{a10:04X}"));
+            let sub0 = children(dt, "SubItem").next().unwrap();
+            let name = text(sub0, "Name");
+            if sdo_info {
+                assert_eq!(name, "Highest subindex supported");
+            } else {
+                assert_eq!(name, "Operating unit");
+            }
         }
+        assert_eq!(revisions.len(), 2, "each template has its own revision number");
     }
-    assert_eq!(revisions.len(), 2, "each template has its own revision number");
 }
 
 fn text_of(n: Node, tag: &str) -> String {
@@ -117,14 +129,14 @@ fn text_of(n: Node, tag: &str) -> String {
 
 #[test]
 fn e151_esi_revision_equals_1018_03() {
-    for t in esi::TEMPLATES {
-        let mut od = esi::dictionary(t);
+    for (v, t) in each() {
+        let mut od = esi::dictionary(v, t);
         let mut buf = [0u8; 4];
         assert_eq!(od.read(0x1018, 3, &mut buf, CommState::PreOp), Ok(4));
         let od_rev = u32::from_le_bytes(buf);
         assert_eq!(od_rev, revision(t));
 
-        let xml = esi(t);
+        let xml = esi(v, t);
         let doc = Document::parse(&xml).unwrap();
         let dev = device_node(&doc);
         assert_eq!(
@@ -133,7 +145,7 @@ fn e151_esi_revision_equals_1018_03() {
             "ESI RevisionNo = 1018h:03 in {t:?}"
         );
         // the SII of that template carries the same revision
-        let img = esi::sii(t).unwrap();
+        let img = esi::sii(v, t).unwrap();
         let sii_rev = u32::from(sii_word(&img, word::REVISION).unwrap())
             | u32::from(sii_word(&img, word::REVISION + 1).unwrap()) << 16;
         assert_eq!(sii_rev, od_rev);
@@ -145,14 +157,16 @@ fn e151_esi_revision_equals_1018_03() {
         let default = hex_bytes(text(child(info, "Info"), "DefaultData"));
         assert_eq!(default, od_rev.to_le_bytes());
     }
-    // the default template's SII is the one the drive carries (drive::DEVICE)
-    assert_eq!(esi::device(Template::SdoInfo), DEVICE);
+    // the default template's SII is the one the drive carries (drive::device)
+    for v in esi::VARIANTS {
+        assert_eq!(esi::device(v, Template::SdoInfo), *drive::device(v));
+    }
 }
 
 #[test]
 fn e108_dc_sync0_is_the_default_op_mode() {
-    for t in esi::TEMPLATES {
-        let xml = esi(t);
+    for (v, t) in each() {
+        let xml = esi(v, t);
         let doc = Document::parse(&xml).unwrap();
         let dc = child(device_node(&doc), "Dc");
         let modes: Vec<Node> = children(dc, "OpMode").collect();
@@ -184,11 +198,12 @@ fn e108_dc_sync0_is_the_default_op_mode() {
 
 #[test]
 fn esi_matches_sii_image() {
-    for t in esi::TEMPLATES {
-        let img = esi::sii(t).unwrap();
+    for (v, t) in each() {
+        let img = esi::sii(v, t).unwrap();
         let w = |n: u16| u64::from(sii_word(&img, n).unwrap());
         let w32 = |n: u16| w(n) | w(n + 1) << 16;
-        let xml = esi(t);
+        let xml = esi(v, t);
+        let declared = drive::device(v);
         let doc = Document::parse(&xml).unwrap();
         let root = doc.root_element();
         let dev = device_node(&doc);
@@ -245,11 +260,11 @@ fn esi_matches_sii_image() {
         );
         assert_eq!(
             num(sms[2].attribute("DefaultSize").unwrap()),
-            DEVICE.output_bytes() as u64
+            declared.output_bytes() as u64
         );
         assert_eq!(
             num(sms[3].attribute("DefaultSize").unwrap()),
-            DEVICE.input_bytes() as u64
+            declared.input_bytes() as u64
         );
 
         // FMMUs
@@ -404,15 +419,15 @@ fn check_flags(flags: Node, a: od::Access, persistent: bool, what: &str) {
 
 #[test]
 fn esi_dictionary_matches_od() {
-    for t in esi::TEMPLATES {
-        let od = esi::dictionary(t);
-        let xml = esi(t);
+    for (v, t) in each() {
+        let od = esi::dictionary(v, t);
+        let xml = esi(v, t);
         let doc = Document::parse(&xml).unwrap();
         let dev = device_node(&doc);
         let profile = child(dev, "Profile");
         assert_eq!(
             num(text(profile, "ProfileNo")),
-            u64::from(DEVICE.device_type & 0xFFFF)
+            u64::from(drive::device(v).device_type & 0xFFFF)
         );
         let dict = child(profile, "Dictionary");
         let types: BTreeMap<&str, Node> = children(child(dict, "DataTypes"), "DataType")
@@ -431,7 +446,7 @@ fn esi_dictionary_matches_od() {
         assert!(visible.len() > 100);
 
         for (node, o) in listed.iter().zip(&visible) {
-            let what = format!("{t:?} {:04X}h", o.index);
+            let what = format!("{v:?} {t:?} {:04X}h", o.index);
             assert_eq!(num(text(*node, "Index")), u64::from(o.index), "{what}");
             assert_eq!(text(*node, "Name"), o.name, "{what}");
             let ty = text(*node, "Type");
@@ -492,15 +507,15 @@ fn esi_dictionary_matches_od() {
 
 #[test]
 fn esi_pdo_entries_are_mappable_objects() {
-    for t in esi::TEMPLATES {
-        let od = esi::dictionary(t);
-        let xml = esi(t);
+    for (v, t) in each() {
+        let od = esi::dictionary(v, t);
+        let xml = esi(v, t);
         let doc = Document::parse(&xml).unwrap();
         let dev = device_node(&doc);
         for (tag, rx) in [("RxPdo", true), ("TxPdo", false)] {
             for pdo in children(dev, tag) {
                 let index = num(text(pdo, "Index")) as u16;
-                let declared = DEVICE.pdo(index).unwrap();
+                let declared = drive::device(v).pdo(index).unwrap();
                 let entries: Vec<Node> = children(pdo, "Entry").collect();
                 assert_eq!(entries.len(), declared.entries.len());
                 for (node, d) in entries.iter().zip(declared.entries) {
@@ -542,10 +557,10 @@ fn defaults(profile: Node, index: u16) -> Vec<u64> {
 fn esi_pdos_match_mapping_and_assignment_objects() {
     // the standard layout of axis A is what 1600h/1A00h carry (PdoLayout::Standard)
     let (rx_a, tx_a) = drive::PdoLayout::Standard.entries();
-    assert_eq!(DEVICE.pdo(0x1600).unwrap().entries, rx_a);
-    assert_eq!(DEVICE.pdo(0x1A00).unwrap().entries, tx_a);
-    for t in esi::TEMPLATES {
-        let xml = esi(t);
+    for (v, t) in each() {
+        assert_eq!(drive::device(v).pdo(0x1600).unwrap().entries, rx_a);
+        assert_eq!(drive::device(v).pdo(0x1A00).unwrap().entries, tx_a);
+        let xml = esi(v, t);
         let doc = Document::parse(&xml).unwrap();
         let dev = device_node(&doc);
         let profile = child(dev, "Profile");
@@ -569,6 +584,64 @@ fn esi_pdos_match_mapping_and_assignment_objects() {
             let d = defaults(profile, assign);
             assert_eq!(d[0], assigned.len() as u64, "{assign:04X}h:00");
             assert_eq!(&d[1..=assigned.len()], &assigned[..], "{assign:04X}h");
+        }
+    }
+}
+
+/// The single-axis device's ESIs (issue 20): its own product code and type,
+/// no axis-B object (6800h…6FFFh, A000h…DFFFh) and only axis A's PDOs,
+/// channel 2 an empty free channel; the double-axis ESIs keep axis B.
+#[test]
+fn e005_e084_e150_the_single_axis_esi_has_no_axis_b() {
+    let axis_b = |i: u64| (0x6800..=0x6FFF).contains(&i) || (0xA000..=0xDFFF).contains(&i);
+    for (v, t) in each() {
+        let xml = esi(v, t);
+        let doc = Document::parse(&xml).unwrap();
+        let dev = device_node(&doc);
+        let ty = child(dev, "Type");
+        let profile = child(dev, "Profile");
+        let objects: Vec<u64> = children(child(child(profile, "Dictionary"), "Objects"), "Object")
+            .map(|o| num(text(o, "Index")))
+            .collect();
+        let pdos = |tag| -> Vec<u64> { children(dev, tag).map(|p| num(text(p, "Index"))).collect() };
+        let entries: Vec<u64> = children(dev, "RxPdo")
+            .chain(children(dev, "TxPdo"))
+            .flat_map(|p| children(p, "Entry").map(|e| num(text(e, "Index"))))
+            .collect();
+        match v {
+            Variant::Single => {
+                assert_eq!(
+                    num(ty.attribute("ProductCode").unwrap()),
+                    u64::from(drive::PRODUCT_CODE_SINGLE)
+                );
+                assert_eq!(ty.text(), Some("SI6A061"));
+                assert!(text(dev, "Name").starts_with("SI6 SI6A061"), "{t:?}");
+                assert!(!objects.iter().any(|&i| axis_b(i)), "{t:?}: an axis-B object");
+                assert!(!entries.iter().any(|&i| axis_b(i)), "{t:?}: an axis-B PDO entry");
+                assert_eq!((pdos("RxPdo"), pdos("TxPdo")), (vec![0x1600], vec![0x1A00]));
+                // channel 2 is there, free and empty
+                for pdo in [0x1601, 0x1A01] {
+                    assert!(defaults(profile, pdo).iter().all(|&d| d == 0), "{pdo:04X}h");
+                }
+                assert_eq!(
+                    defaults(profile, 0xF050),
+                    [2, u64::from(drive::module_ident(drive::PdoLayout::Standard)), 0]
+                );
+                let name = children(child(object(profile, 0x1008), "Info"), "DefaultString").next();
+                assert_eq!(name.and_then(|n| n.text()), Some("SI6"));
+            }
+            Variant::Double => {
+                assert_eq!(
+                    num(ty.attribute("ProductCode").unwrap()),
+                    u64::from(drive::PRODUCT_CODE)
+                );
+                assert!(objects.iter().any(|&i| (0x6800..=0x6FFF).contains(&i)));
+                assert!(objects.iter().any(|&i| (0xA000..=0xDFFF).contains(&i)));
+                assert_eq!(
+                    (pdos("RxPdo"), pdos("TxPdo")),
+                    (vec![0x1600, 0x1601], vec![0x1A00, 0x1A01])
+                );
+            }
         }
     }
 }

@@ -84,10 +84,11 @@ pub struct ServeArgs {
     /// Drives on the simulated line (EtherCAT only).
     #[arg(long, value_name = "N", default_value_t = 1, value_parser = clap::value_parser!(u16).range(1..=16))]
     pub slaves: u16,
-    /// Axes per drive (EtherCAT only; every drive is the double-axis device;
-    /// 1 is accepted, a single-axis variant is not modelled yet).
-    #[arg(long, value_name = "1|2", default_value_t = 1, value_parser = clap::value_parser!(u8).range(1..=2))]
-    pub axes: u8,
+    /// Axes per drive (EtherCAT only): 2 = the double-axis device (SC6A062,
+    /// axis B's objects at +800h/+8000h), 1 = the single-axis device
+    /// (SI6A061: its own identity, no axis-B objects or PDOs) [default: 2].
+    #[arg(long, value_name = "1|2", value_parser = clap::value_parser!(u8).range(1..=2))]
+    pub axes: Option<u8>,
     /// Record every frame (both directions, simulated time; PROFINET: time
     /// since the start) to this pcap file.
     #[arg(long, value_name = "FILE")]

@@ -74,8 +74,16 @@ pub fn serve(args: &ServeArgs) -> Result<(), String> {
         return Err("--control is PROFINET-only (--fieldbus profinet)".into());
     }
     let slaves = usize::from(args.slaves);
+    let variant = match args.axes {
+        Some(1) => drive::Variant::Single,
+        _ => drive::Variant::Double,
+    };
     // drives with firmware slots: an FoE download in Bootstrap is accepted
-    let mut sim = Simulation::with_nodes((0..slaves).map(|_| SimDrive::with_firmware_slots()).collect());
+    let mut sim = Simulation::with_nodes(
+        (0..slaves)
+            .map(|_| SimDrive::with_firmware_slots_for(variant))
+            .collect(),
+    );
     // the recording first: an unwritable path fails before anything else
     if let Some(p) = &args.pcap {
         sim.record_pcap(p)
@@ -88,9 +96,14 @@ pub fn serve(args: &ServeArgs) -> Result<(), String> {
     for (i, d) in (1u8..).zip(sim.drives_mut()) {
         d.bind_net([0x02, 0x00, 0x00, 0x00, 0x00, i], u64::from(i), Nanos::ZERO);
     }
+    let device = drive::device(variant);
+    let kind = match variant {
+        drive::Variant::Double => "double-axis",
+        drive::Variant::Single => "single-axis",
+    };
     println!(
-        "hil-sim serve: {slaves} simulated double-axis drive(s) on {iface} (--axes {}: a single-axis variant is not modelled yet)",
-        args.axes
+        "hil-sim serve: {slaves} simulated {kind} drive(s) {} (product code {}) on {iface}",
+        device.order_code, device.identity.product_code
     );
     println!(
         "EoE: ping and the UDP parameter service (port {}) answer at the IP address the master sets",

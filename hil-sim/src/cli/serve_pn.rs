@@ -64,7 +64,7 @@ fn check_options(args: &ServeArgs) -> Result<(), String> {
     if args.slaves == 0 {
         return Err("--slaves 0: at least one drive".into());
     }
-    if args.axes != 1 {
+    if args.axes.is_some() {
         return Err("--axes is EtherCAT-only".into());
     }
     if args.delay_us.is_some() {

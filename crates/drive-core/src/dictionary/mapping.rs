@@ -171,9 +171,10 @@ impl DriveObjects {
         crate::USER_MODULE | (h & !crate::USER_MODULE)
     }
 
-    /// Puts both axes' [`module_ident`](Self::module_ident) into F050h:01/:02.
+    /// Puts the axes' [`module_ident`](Self::module_ident) into F050h:01/:02
+    /// (the single-axis device's F050h:02 keeps 0: no axis B).
     pub(super) fn refresh_module_idents(&mut self) {
-        for axis in [0u16, 1] {
+        for axis in (0u16..2).take(self.variant.axes()) {
             let _ = self.set(0xF050, axis as u8 + 1, i64::from(self.module_ident(axis)));
         }
     }

@@ -14,7 +14,7 @@ use core::sync::atomic::{AtomicU32, Ordering};
 
 use crate::objects::{self, enumeration, find, Object, Value, IMAGE_BYTES, OBJECTS, OFFSETS};
 use crate::pdo_image::{CopyOp, WIDTH_SHIFT};
-use crate::{parameter_index, MAPPING_ENTRIES, SOFTWARE_BUILD};
+use crate::{parameter_index, Variant, MAPPING_ENTRIES, SOFTWARE_BUILD};
 use od::{CommState, DataType, Dictionary, EntryInfo, ObjectInfo, SdoAbort};
 
 mod mapping;
@@ -132,13 +132,18 @@ pub struct DriveObjects {
     pdo_bytes: Cell<Option<(u32, (usize, usize))>>,
     /// J401\[5\] of each axis as last synchronised with \[3\] (`records.rs`).
     all_accelerations: [u32; 2],
+    /// The device the dictionary describes (fixed at construction).
+    variant: Variant,
 }
 
 /// Equal dictionaries hold the same values and template; how they got
 /// there (the configuration generation) does not count.
 impl PartialEq for DriveObjects {
     fn eq(&self, other: &Self) -> bool {
-        self.image == other.image && self.template == other.template && self.requests == other.requests
+        self.image == other.image
+            && self.template == other.template
+            && self.requests == other.requests
+            && self.variant == other.variant
     }
 }
 
@@ -165,9 +170,19 @@ pub struct WithLive<'a, L: LiveValues> {
 }
 
 impl DriveObjects {
-    /// Every value at its default, template "EtherCAT Rx SDO Info".
+    /// The double-axis device's dictionary ([`Variant::Double`]): every
+    /// value at its default, template "EtherCAT Rx SDO Info".
     #[inline(always)]
     pub fn new() -> Self {
+        Self::for_variant(Variant::Double)
+    }
+
+    /// The dictionary of `variant`: every value at its default, template
+    /// "EtherCAT Rx SDO Info". The single-axis device's has no axis-B
+    /// objects (0602 0000h, not in SDO Info, not mappable) and its own
+    /// declaration of a few objects ([`crate::objects::single`]).
+    #[inline(always)]
+    pub fn for_variant(variant: Variant) -> Self {
         let mut objects = Self {
             image: [0; IMAGE_BYTES],
             template: Template::SdoInfo,
@@ -179,10 +194,24 @@ impl DriveObjects {
             config_generation: 0,
             pdo_bytes: Cell::new(None),
             all_accelerations: [records::ALL_ACCELERATIONS_DEFAULT; 2],
+            variant,
         };
         persist::write_defaults(&mut objects.image, |_, _| true);
+        objects.write_variant_defaults(|_| true);
         objects.refresh_module_idents();
         objects
+    }
+
+    /// The device this dictionary describes.
+    pub fn variant(&self) -> Variant {
+        self.variant
+    }
+
+    /// The object at `index` as this device declares it
+    /// ([`Variant::declared`]), whether the bus sees it or not; `None` when
+    /// the declaration has no such index.
+    pub fn declared_object(&self, index: u16) -> Option<&'static Object> {
+        find(index).map(|(_, o)| self.variant.declared(o))
     }
 
     /// A counter that changes whenever a configuration value may have
@@ -261,8 +290,10 @@ impl DriveObjects {
         self.get(parameter_index(0, 10), 3).map_or(0, |v| v as u8)
     }
 
+    /// Seen on the bus: an object of this device (the single-axis device
+    /// has no axis-B objects) within the access level.
     fn visible(&self, o: &Object) -> bool {
-        o.level <= self.access_level()
+        self.variant.has_object(o.info.index) && o.level <= self.access_level()
     }
 
     fn sdo_info(&self) -> bool {
@@ -288,10 +319,11 @@ impl DriveObjects {
         self.image.get(loc.slot()?).ok_or(SdoAbort::GENERAL)
     }
 
-    /// The value of a target entry (after [`follow`]) from RAM or declaration.
+    /// The value of a target entry (after [`follow`]) from RAM or the
+    /// declaration (this device's: [`Variant::declared`]).
     fn read_loc(&self, loc: Loc, buf: &mut [u8]) -> Result<usize, SdoAbort> {
-        let o = loc.object()?;
-        let e = loc.entry()?;
+        let o = self.variant.declared(loc.object()?);
+        let e = o.info.entries.get(loc.pos).ok_or(SdoAbort::NO_SUBINDEX)?;
         match o.value {
             Value::Ram | Value::Live => {
                 let raw = self.ram(loc)?;
@@ -531,7 +563,8 @@ impl DriveObjects {
     }
 
     fn object_info(&self, o: &'static Object) -> Option<&'static ObjectInfo> {
-        self.visible(o).then(|| o.view(self.sdo_info()))
+        self.visible(o)
+            .then(|| self.variant.declared(o).view(self.sdo_info()))
     }
 }
 

@@ -65,6 +65,38 @@ pub(super) fn write_defaults(image: &mut [u8], mut pick: impl FnMut(u16, &EntryI
 }
 
 impl DriveObjects {
+    /// The layout hash of this device's saved sets ([`Variant::layout_hash`]):
+    /// what [`persistent_image`](Self::persistent_image) writes and
+    /// [`load_persistent`](Self::load_persistent) and the store's load
+    /// require.
+    pub fn layout_hash(&self) -> u32 {
+        self.variant.layout_hash()
+    }
+
+    /// Writes the defaults of the entries `pick` selects of the objects this
+    /// device declares again ([`Variant::redeclared`]) over those
+    /// [`write_defaults`] wrote from the double-axis declaration.
+    pub(super) fn write_variant_defaults(&mut self, mut pick: impl FnMut(&EntryInfo) -> bool) {
+        for o in self.variant.redeclared() {
+            if !matches!(o.value, Value::Ram | Value::Live) {
+                continue;
+            }
+            for e in o
+                .info
+                .entries
+                .iter()
+                .filter(|e| !e.data_type.is_string() && pick(e))
+            {
+                let Ok(slot) = canonical(o.info.index, e.sub).and_then(Loc::slot) else {
+                    continue;
+                };
+                if let Some(dst) = self.image.get_mut(slot) {
+                    let _ = e.data_type.encode(e.default, dst);
+                }
+            }
+        }
+    }
+
     /// The byte ranges of the persistent values, in declaration order.
     pub(super) fn persistent_slots() -> impl Iterator<Item = core::ops::Range<usize>> {
         OBJECTS.iter().enumerate().flat_map(|(obj, o)| {
@@ -87,7 +119,7 @@ impl DriveObjects {
             .ok_or(ImageError::BufferTooSmall)?;
         let (header, mut payload) = out.split_at_mut(IMAGE_HEADER);
         let len = (objects::PERSISTENT_BYTES as u16).to_le_bytes();
-        let hash = objects::LAYOUT_HASH.to_le_bytes();
+        let hash = self.layout_hash().to_le_bytes();
         let [m0, m1, m2, m3] = IMAGE_MAGIC;
         let [h0, h1, h2, h3] = hash;
         let t = u8::from(self.template == Template::SdoInfo);
@@ -122,7 +154,7 @@ impl DriveObjects {
             }
             _ => return Err(ImageError::Malformed),
         };
-        if header.get(4..8) != Some(&objects::LAYOUT_HASH.to_le_bytes()[..]) {
+        if header.get(4..8) != Some(&self.layout_hash().to_le_bytes()[..]) {
             return Err(ImageError::ForeignLayout);
         }
         for slot in Self::persistent_slots() {
@@ -146,6 +178,7 @@ impl DriveObjects {
     /// next save). Live and set-point values are untouched.
     pub fn restore_defaults(&mut self) {
         write_defaults(&mut self.image, |_, e| e.persistent);
+        self.write_variant_defaults(|e| e.persistent);
         self.records_reloaded(true);
         self.config_changed();
     }

@@ -11,6 +11,8 @@
 //!   derived at +800h (`od-cia402.md`).
 //! - [`scaling`]: the entries fieldbus scaling A213 acts on and their
 //!   decimal places (A310 velocities, A311 accelerations).
+//! - [`single`]: the objects the single-axis device declares differently
+//!   (it has no axis-B objects: [`crate::Variant`]).
 //!
 //! [`OBJECTS`] joins them, sorted by index (checked at compile time);
 //! [`OFFSETS`] gives each object's place in the RAM image, computed at compile
@@ -64,6 +66,7 @@ pub mod manufacturer;
 mod pack;
 pub mod records;
 pub mod scaling;
+pub mod single;
 
 pub use pack::{EntryRecord, ENTRY_TABLE};
 

@@ -315,3 +315,28 @@ pub(super) const fn objects(objs: &[Object; COUNT], table: &'static PackedTable)
     }
     out
 }
+
+/// The object at `index` as [`super::OBJECTS`] holds it (its entries in
+/// `table`, [`ENTRY_TABLE`]): for declarations built from the double-axis
+/// one (the single-axis device's objects, `super::single`), which then
+/// share its packed records. Compile-time evaluation; `index` must be
+/// declared.
+pub(super) const fn packed_object(table: &'static PackedTable, index: u16) -> Object {
+    let (starts, _) = LAYOUT;
+    let mut i = 0;
+    // i < COUNT (compile-time evaluation)
+    #[allow(clippy::indexing_slicing)]
+    while i < COUNT && TABLE[i].info.index != index {
+        i += 1;
+    }
+    assert!(i < COUNT, "packed_object: no such object");
+    let n = info(&TABLE, i).len() as u16;
+    // i < COUNT (compile-time evaluation)
+    #[allow(clippy::indexing_slicing)]
+    let mut o = TABLE[i];
+    #[allow(clippy::indexing_slicing)]
+    {
+        o.info.entries = table.joined(starts[i].info[0], starts[i].info[1], n);
+    }
+    o
+}

@@ -25,7 +25,9 @@ impl<F: Flash, B: Flash> Drive<F, B> {
     /// [`control_cycle`](Self::control_cycle) with the "new set-point" flag
     /// of each axis given by the caller (e.g. a per-cycle RxPDO flag of the
     /// board). Queues the axes' EMCYs (fault on T13, fault cleared on T15)
-    /// and keeps 1001h (error register) at the OR of both axes' faults.
+    /// and keeps 1001h (error register) at the OR of both axes' faults. The
+    /// single-axis device ([`crate::Variant::Single`]) runs axis A only and
+    /// returns [`AxisCommand::OFF`] for B.
     pub fn control_cycle_with(
         &mut self,
         now: Nanos,
@@ -42,7 +44,13 @@ impl<F: Flash, B: Flash> Drive<F, B> {
         let (objects, slave) = (&mut self.objects, &mut self.slave);
         let [diag_a, diag_b] = &mut self.fault_diag;
         let a = axis_cycle(axis_a, cache_a, sent_a, objects, slave, io_a, now, new_a, diag_a);
-        let b = axis_cycle(axis_b, cache_b, sent_b, objects, slave, io_b, now, new_b, diag_b);
+        // the single-axis device has no axis B: it stays idle (power stage
+        // off, brake applied, no objects, no EMCY)
+        let b = if objects.variant().axes() > 1 {
+            axis_cycle(axis_b, cache_b, sent_b, objects, slave, io_b, now, new_b, diag_b)
+        } else {
+            AxisCommand::OFF
+        };
         let register = axis_a.error_register() | axis_b.error_register();
         write_slot(&mut self.objects, self.slots.error_register, i64::from(register));
         [a, b]

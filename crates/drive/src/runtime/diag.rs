@@ -102,7 +102,7 @@ impl Text {
 
 impl<F: Flash, B: Flash> Drive<F, B> {
     /// Event 52 "Communication" with `cause` (E-129…E-131, spec §13.4): both
-    /// axes take T13 in their next control cycle and run the fault reaction
+    /// axes (the single-axis device's one) take T13 in their next control cycle and run the fault reaction
     /// of 605Eh (A540: 0 = power unit off at once, brake engages; 1–4 = stop
     /// on the slow-down / quick-stop ramp with the brake released, then
     /// off), ending in Fault with 603Fh = 7500h; a fault reset (controlword
@@ -116,7 +116,13 @@ impl<F: Flash, B: Flash> Drive<F, B> {
             number: u16::from(event52::EVENT),
             cause,
         };
-        for (axis, sent) in self.axes.iter_mut().zip(self.event52_emcy_sent.iter_mut()) {
+        let axes = self.objects.variant().axes();
+        for (axis, sent) in self
+            .axes
+            .iter_mut()
+            .zip(self.event52_emcy_sent.iter_mut())
+            .take(axes)
+        {
             axis.raise_event(event);
             *sent = true;
         }

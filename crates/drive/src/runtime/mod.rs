@@ -63,6 +63,7 @@ mod control;
 mod diag;
 mod eoe;
 mod foe;
+mod power;
 mod save;
 mod slots;
 mod sync;
@@ -79,9 +80,7 @@ use sync::PllSettings;
 use crate::axis::{Axis, AxisCache, AxisCommand, AxisIo};
 use crate::dictionary::{read_slot, write_slot, DriveObjects, LiveValues, Slot, PERSISTENT_IMAGE_BYTES};
 use crate::ecat_app::{event52, event52_cause, EcatApp};
-use crate::objects::LAYOUT_HASH;
 use crate::pdo_image::{PdoImage, PdoImageError};
-use crate::DEVICE;
 use boot::{BootSlots, NoFlash, UpdateError};
 use ecat::diag::{DiagHistory, DiagMessage, DiagType};
 use ecat::esm::{SyncMode, SyncState};
@@ -241,15 +240,6 @@ pub struct Drive<F: Flash, B: Flash = NoFlash> {
     pll_from_sm: bool,
 }
 
-impl<F: Flash> Drive<F> {
-    /// Powers the drive on: defaults, then the newest saved set from `flash`.
-    /// No firmware slots: FoE writes are refused.
-    #[inline(always)]
-    pub fn new(flash: F) -> Self {
-        Self::with_boot(flash, None)
-    }
-}
-
 impl<F: Flash, B: Flash> Drive<F, B> {
     /// The EtherCAT slave stack (ESM state, sync status, counters, FoE,
     /// EoE server).
@@ -297,133 +287,6 @@ impl<F: Flash, B: Flash> Drive<F, B> {
     /// The diagnosis history 10F3h.
     pub fn diag(&self) -> &DiagHistory {
         &self.diag
-    }
-
-    /// Powers the drive on with the firmware slots `boot` (as the boot left
-    /// them: [`BootSlots::boot`] ran and chose the running slot): FoE
-    /// firmware downloads in Bootstrap go into the inactive slot.
-    #[inline(always)]
-    pub fn with_boot(flash: F, boot: Option<BootSlots<B>>) -> Self {
-        let mut drive = Self::unstarted(flash, boot);
-        drive.start();
-        drive
-    }
-
-    /// The drive before [`start`](Self::start): every part at its power-on
-    /// value, nothing loaded. A plain value, so a firmware can write it
-    /// straight into its static (`MaybeUninit::write`) and start it there:
-    /// a drive assembled and loaded in one function needed several copies
-    /// of itself on the stack (docs/architecture.md).
-    #[inline(always)]
-    pub fn unstarted(flash: F, boot: Option<BootSlots<B>>) -> Self {
-        Self {
-            slave: Slave::new(&DEVICE),
-            eoe: ecat::eoe_queue::EoeQueue::new(),
-            objects: DriveObjects::new(),
-            store: Some(ParamStore::new(flash)),
-            boot,
-            diag: DiagHistory::new(),
-            startup: Startup::Defaults,
-            last_code: AlStatusCode(0xFFFF),
-            pdo: PdoImage::EMPTY,
-            pdo_error: None,
-            last_state: AlState::Init,
-            last_rx_frames: 0,
-            axes: [Axis::new(0), Axis::new(1)],
-            actions: drive_core::actions::Actions::new(),
-            axis_caches: [AxisCache::new(), AxisCache::new()],
-            ctl_rx_frames: 0,
-            pll: None,
-            pll_settings: None,
-            sync_shown: None,
-            slots: RuntimeSlots::NONE,
-            sync_error: None,
-            optimizer: dcsync::Optimizer::new(),
-            frame_rel_sync0_ns: None,
-            step_offsets_ns: (0, 0),
-            cycle_pdo: false,
-            event52_emcy_sent: [false; 2],
-            fault_diag: [None; 2],
-            restart_requested: None,
-            projected_fieldbus: FIELDBUS_ID,
-            wrong_firmware: false,
-            sntp_offset_ns: None,
-            ports: PortDiag::default(),
-            mailbox_er: 0,
-            pll_from_sm: false,
-        }
-    }
-
-    /// Power-on of an [`unstarted`](Self::unstarted) drive: resolves the
-    /// cyclic entries, loads the newest saved set, compiles the process
-    /// images and fills the live values.
-    pub fn start(&mut self) {
-        self.slots = RuntimeSlots::resolve(&self.objects);
-        self.startup = self.load_saved();
-        self.compile_pdo_image();
-        self.update_live();
-    }
-
-    /// Loads the saved parameter set into the dictionary (defaults stay when
-    /// there is none, it is from another layout or does not load).
-    fn load_saved(&mut self) -> Startup {
-        let mut image = [0u8; PERSISTENT_IMAGE_BYTES];
-        let Some(store) = self.store.as_mut() else {
-            return Startup::Defaults;
-        };
-        match store.load(LAYOUT_HASH, &mut image) {
-            Ok(n) => match image.get(..n).map(|img| self.objects.load_persistent(img)) {
-                Some(Ok(())) => Startup::Loaded,
-                _ => Startup::Defaults,
-            },
-            Err(
-                StoreError::NoData | StoreError::LayoutMismatch | StoreError::TooLarge | StoreError::Flash(_),
-            ) => Startup::Defaults,
-        }
-    }
-
-    /// Whether the saved set was loaded at power-on.
-    pub fn startup(&self) -> Startup {
-        self.startup
-    }
-
-    /// The store's flash (for power-cycle simulation and fault injection);
-    /// `None` while a [`SaveJob`] has it.
-    pub fn flash_mut(&mut self) -> Option<&mut F> {
-        self.store.as_mut().map(ParamStore::flash_mut)
-    }
-
-    /// Powers off: gives the flash back (RAM values are lost); `None` when
-    /// a [`SaveJob`] has it.
-    pub fn into_flash(self) -> Option<F> {
-        self.store.map(ParamStore::into_inner)
-    }
-
-    /// Powers off: gives the parameter flash (`None` when a [`SaveJob`] has
-    /// it) and the firmware slots' flash back.
-    pub fn into_flashes(self) -> (Option<F>, Option<B>) {
-        (
-            self.store.map(ParamStore::into_inner),
-            self.boot.map(BootSlots::into_inner),
-        )
-    }
-
-    /// The firmware slots, if the drive has them.
-    pub fn boot_slots(&self) -> Option<&BootSlots<B>> {
-        self.boot.as_ref()
-    }
-
-    /// The firmware slots, mutable (tests, fault injection).
-    pub fn boot_slots_mut(&mut self) -> Option<&mut BootSlots<B>> {
-        self.boot.as_mut()
-    }
-
-    /// The running firmware confirms itself after a successful start: a
-    /// trial image (first start after an update) is kept from now on instead
-    /// of being rolled back at the next boot. `false` when the drive has no
-    /// slots or the flash failed.
-    pub fn confirm_firmware(&mut self) -> bool {
-        self.boot.as_mut().is_some_and(|b| b.confirm().is_ok())
     }
 
     /// The process images in force (compiled at the last change into Safe-Op).

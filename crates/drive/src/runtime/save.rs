@@ -28,6 +28,8 @@ pub struct SaveJob<F: Flash> {
     /// The image's length; `None` when the values did not serialise.
     pub(super) len: Option<usize>,
     pub(super) saved: bool,
+    /// The layout hash of the drive's variant ([`DriveObjects::layout_hash`]).
+    pub(super) hash: u32,
 }
 
 impl<F: Flash> SaveJob<F> {
@@ -35,7 +37,7 @@ impl<F: Flash> SaveJob<F> {
     /// until the new one is complete).
     pub fn write(&mut self) {
         let image = self.len.and_then(|n| self.image.get(..n));
-        self.saved = image.is_some_and(|img| self.store.save(img, LAYOUT_HASH).is_ok());
+        self.saved = image.is_some_and(|img| self.store.save(img, self.hash).is_ok());
     }
 }
 
@@ -75,6 +77,7 @@ impl<F: Flash, B: Flash> Drive<F, B> {
             image,
             len,
             saved: false,
+            hash: self.objects.layout_hash(),
         })
     }
 
