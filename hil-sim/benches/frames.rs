@@ -28,10 +28,12 @@
 //! first frame out to its last back; `cycle µs` the master cycle run;
 //! `frames/s` through the whole chain (master, link, ESCs, drive firmware)
 //! per wall-clock second; `RTF` simulated time / wall time of the whole
-//! chain (> 1: faster than real time); `RTF sim` the same for the
-//! simulation alone (the wall time inside `Simulation::exchange` and
-//! `advance_to`: what `hil-sim serve` has to keep up with, where the master
-//! is another machine); `wkc` the cycle's working counter (3 per drive, more
+//! chain (> 1: faster than real time); `RTF cpu` simulated time / the
+//! CPU time the benchmark's thread used (on a shared machine the wall time
+//! includes the time other processes had the CPU); `RTF sim` simulated
+//! time / the wall time inside `Simulation::exchange` and `advance_to` (the
+//! simulation alone: what `hil-sim serve` has to keep up with, where the
+//! master is another machine); `wkc` the cycle's working counter (3 per drive, more
 //! where a drive's data is split between two frames) and the cycles that
 //! had it; `Op` drives in Op at the end; `setup s` wall time to Op.
 //!
@@ -106,6 +108,21 @@ impl Future for TimedLink<'_> {
     }
 }
 
+/// The CPU time this thread has used (on a shared machine the wall time
+/// also holds the time other processes had the CPU).
+fn thread_cpu() -> Duration {
+    let mut ts = libc::timespec {
+        tv_sec: 0,
+        tv_nsec: 0,
+    };
+    // SAFETY: `ts` is a valid timespec for the call to fill.
+    #[allow(unsafe_code)]
+    unsafe {
+        libc::clock_gettime(libc::CLOCK_THREAD_CPUTIME_ID, &mut ts);
+    }
+    Duration::new(ts.tv_sec as u64, ts.tv_nsec as u32)
+}
+
 /// What one master cycle gave: working counter, drives in Op, and (DC)
 /// ethercrab's wait from the cycle's start to the next cycle.
 type CycleResult = (u16, usize, Option<Duration>);
@@ -127,6 +144,8 @@ struct Row {
     /// Simulated time of the measured cycles.
     sim: Nanos,
     wall: Duration,
+    /// CPU time of the measured cycles.
+    cpu: Duration,
     /// Wall time inside the simulation.
     in_sim: Duration,
     bus_sum: Nanos,
@@ -176,6 +195,7 @@ impl Rig<'_> {
             (s.frames(), s.now())
         };
         let mut m = Measured::default();
+        let cpu = thread_cpu();
         let start = Instant::now();
         for _ in 0..cycles {
             let a = Instant::now();
@@ -189,6 +209,7 @@ impl Rig<'_> {
             next = out + wait.map_or(cycle, |w| Nanos::from_ns(w.as_nanos() as u64));
         }
         m.wall = start.elapsed();
+        m.cpu = thread_cpu() - cpu;
         let s = sim.borrow();
         m.frames = s.frames() - f0;
         m.sim = s.now() - t0;
@@ -202,6 +223,7 @@ struct Measured {
     frames: u64,
     sim: Nanos,
     wall: Duration,
+    cpu: Duration,
     bus_sum: Nanos,
     wkc_ok: usize,
     op: usize,
@@ -358,6 +380,7 @@ fn run_case(drives: usize, hz: u32, cycles: usize) -> Row {
             frames: m.frames,
             sim: m.sim,
             wall: m.wall,
+            cpu: m.cpu,
             in_sim: in_sim.get(),
             bus_sum: m.bus_sum,
             wkc,
@@ -387,10 +410,14 @@ fn main() {
     let drives: Vec<usize> = arg(&args, "--drives").map_or(vec![2, 16, 64, 128], |n| vec![n]);
     let rates: Vec<u32> = arg(&args, "--hz").map_or(vec![1000, 4000], |f| vec![f]);
     println!(
-        "{cycles} process-data cycles per case through ethercrab in-process (RTF: simulated / wall time)"
+        "{cycles} process-data cycles per case through ethercrab in-process (RTF: simulated / wall time); \
+         load average {}",
+        std::fs::read_to_string("/proc/loadavg")
+            .map(|l| l.split_whitespace().take(3).collect::<Vec<_>>().join(" "))
+            .unwrap_or_else(|_| "unknown".into())
     );
     println!(
-        "{:>6} {:>5} {:>5} {:>5} {:>6} {:>7} {:>8} {:>9} {:>6} {:>7} {:>14} {:>7} {:>7}",
+        "{:>6} {:>5} {:>5} {:>5} {:>6} {:>7} {:>8} {:>9} {:>6} {:>7} {:>7} {:>14} {:>7} {:>7}",
         "drives",
         "Hz",
         "sync",
@@ -400,6 +427,7 @@ fn main() {
         "cycle µs",
         "frames/s",
         "RTF",
+        "RTF cpu",
         "RTF sim",
         "wkc",
         "Op",
@@ -411,7 +439,7 @@ fn main() {
             let wall = r.wall.as_secs_f64();
             let sim_s = r.sim.as_ns() as f64 / 1e9;
             println!(
-                "{:>6} {:>5} {:>5} {:>5} {:>6.1} {:>7.1} {:>8.1} {:>9.0} {:>6.2} {:>7.2} {:>14} {:>7} {:>7.1}",
+                "{:>6} {:>5} {:>5} {:>5} {:>6.1} {:>7.1} {:>8.1} {:>9.0} {:>6.2} {:>7.2} {:>7.2} {:>14} {:>7} {:>7.1}",
                 r.drives,
                 r.hz,
                 if r.dc { "DC" } else { "free" },
@@ -421,6 +449,7 @@ fn main() {
                 r.sim.as_ns() as f64 / r.cycles as f64 / 1e3,
                 r.frames as f64 / wall,
                 sim_s / wall,
+                sim_s / r.cpu.as_secs_f64(),
                 sim_s / r.in_sim.as_secs_f64(),
                 format!("{} {}/{}", r.wkc, r.wkc_ok, r.cycles),
                 format!("{}/{}", r.op, r.drives),
