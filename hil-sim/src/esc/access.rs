@@ -294,9 +294,12 @@ impl Esc {
         }
         let len = data.len() as u32;
         let end = addr.saturating_add(len);
-        // Old values of the bytes with write side effects.
-        let old_activate = self.sm_bytes(6);
-        let old_pdi_control = self.sm_bytes(7);
+        // Old values of the bytes with write side effects (a write's only).
+        let (old_activate, old_pdi_control) = if op.writes() {
+            (self.sm_bytes(6), self.sm_bytes(7))
+        } else {
+            ([0; MAX_SM], [0; MAX_SM])
+        };
 
         // SyncManager pre-phase: permission, buffer selection, opening.
         let mut plans = [sm::Plan::default(); MAX_SM];
@@ -329,49 +332,26 @@ impl Esc {
             }
         }
 
-        // Data phase, byte by byte.
-        let present = self.present_end();
+        // Data phase.
         let t_read = match side {
             Side::Ecat => self.dc.ecat_time,
             Side::Pdi => self.now,
         };
-        for (i, byte) in data.iter_mut().enumerate() {
-            let a = addr + i as u32;
-            let incoming = *byte;
-            let (phys, rd, wr) = match sm::classify(&plans, a) {
-                sm::Where::Buffer(p) => {
-                    if !(p.read_ok || p.write_ok) {
-                        if side == Side::Pdi && op.reads() {
-                            *byte = 0;
-                        }
-                        continue;
-                    }
-                    (a + u32::from(p.buffer) * p.len, p.read_ok, p.write_ok)
-                }
-                sm::Where::Hidden => (a, false, false),
-                sm::Where::Plain => {
-                    // the EEPROM address and data registers are locked while busy
-                    let sii_locked = self.sii_pending.is_some() && (0x0504..=0x050F).contains(&a);
-                    (a, op.reads(), op.writes() && writable(side, a) && !sii_locked)
-                }
-            };
-            let value = if a >= present || !rd {
-                0
-            } else {
-                self.computed(a, t_read).unwrap_or_else(|| self.raw(phys))
-            };
-            if op.reads() {
-                if op.ors() {
-                    *byte |= value;
-                } else {
-                    *byte = value;
-                }
+        // the SMs whose areas (hidden buffers included) the access overlaps,
+        // in SM order: only these can classify one of its bytes
+        let mut near = [sm::Plan::default(); MAX_SM];
+        let mut k = 0;
+        for p in plans.iter().filter(|p| p.reaches(addr, end)) {
+            if let Some(slot) = near.get_mut(k) {
+                *slot = *p;
+                k += 1;
             }
-            if wr && phys < present {
-                if let Some(m) = self.mem.get_mut(phys as usize) {
-                    *m = incoming;
-                }
-            }
+        }
+        let near = near.get(..k).unwrap_or_default();
+        if near.is_empty() {
+            self.plain_data(side, addr, data, op, t_read);
+        } else {
+            self.sm_data(side, addr, data, op, t_read, near);
         }
 
         // SyncManager post-phase: completion on the last byte.
@@ -461,6 +441,137 @@ impl Esc {
             Side::Ecat => {}
         }
         out
+    }
+
+    /// The data phase byte by byte when SyncManager areas overlap the
+    /// access (`near`: their plans, in SM order): each byte through its SM's
+    /// buffer mapping, hidden, or plain memory ([`sm::classify`]).
+    pub(super) fn sm_data(
+        &mut self,
+        side: Side,
+        addr: u32,
+        data: &mut [u8],
+        op: Op,
+        t_read: Nanos,
+        near: &[sm::Plan],
+    ) {
+        let present = self.present_end();
+        for (i, byte) in data.iter_mut().enumerate() {
+            let a = addr + i as u32;
+            let incoming = *byte;
+            let (phys, rd, wr) = match sm::classify(near, a) {
+                sm::Where::Buffer(p) => {
+                    if !(p.read_ok || p.write_ok) {
+                        if side == Side::Pdi && op.reads() {
+                            *byte = 0;
+                        }
+                        continue;
+                    }
+                    (a + u32::from(p.buffer) * p.len, p.read_ok, p.write_ok)
+                }
+                sm::Where::Hidden => (a, false, false),
+                sm::Where::Plain => {
+                    // the EEPROM address and data registers are locked while busy
+                    let sii_locked = self.sii_pending.is_some() && (0x0504..=0x050F).contains(&a);
+                    (a, op.reads(), op.writes() && writable(side, a) && !sii_locked)
+                }
+            };
+            let value = if a >= present || !rd {
+                0
+            } else {
+                self.computed(a, t_read).unwrap_or_else(|| self.raw(phys))
+            };
+            if op.reads() {
+                if op.ors() {
+                    *byte |= value;
+                } else {
+                    *byte = value;
+                }
+            }
+            if wr && phys < present {
+                if let Some(m) = self.mem.get_mut(phys as usize) {
+                    *m = incoming;
+                }
+            }
+        }
+    }
+
+    /// The data phase of an access that no SyncManager area overlaps: every
+    /// byte is plain memory (what [`sm::classify`] says of it), read from
+    /// memory (the DC system time computed at `t_read`, absent memory 0) and
+    /// written where `side` may write it (not the EEPROM registers while a
+    /// command runs). Ranges in the process RAM and register reads without
+    /// the computed system time go as slices.
+    pub(super) fn plain_data(&mut self, side: Side, addr: u32, data: &mut [u8], op: Op, t_read: Nanos) {
+        let present = self.present_end();
+        let end = addr.saturating_add(data.len() as u32);
+        let st = u32::from(regs::dc::SYSTEM_TIME);
+        let computed = self.config.dc_supported && addr < st + 8 && st < end;
+        // every byte present and read from memory as it is
+        let reads_mem = end <= present && !computed;
+        // every byte writable from both sides (the process RAM)
+        let writes_all = addr >= RAM_START && end <= present;
+        let (lo, hi) = (addr as usize, end as usize);
+        // (the ranges are exactly as long as `data`: `end` is in memory)
+        match op {
+            Op::Read if reads_mem => {
+                if let Some(m) = self.mem.get(lo..hi) {
+                    for (d, m) in data.iter_mut().zip(m) {
+                        *d = *m;
+                    }
+                    return;
+                }
+            }
+            Op::ReadOr if reads_mem => {
+                if let Some(m) = self.mem.get(lo..hi) {
+                    for (d, m) in data.iter_mut().zip(m) {
+                        *d |= *m;
+                    }
+                    return;
+                }
+            }
+            Op::Write if writes_all => {
+                if let Some(m) = self.mem.get_mut(lo..hi) {
+                    for (m, d) in m.iter_mut().zip(data.iter()) {
+                        *m = *d;
+                    }
+                    return;
+                }
+            }
+            Op::ReadWrite if writes_all && reads_mem => {
+                if let Some(m) = self.mem.get_mut(lo..hi) {
+                    for (m, d) in m.iter_mut().zip(data.iter_mut()) {
+                        core::mem::swap(m, d);
+                    }
+                    return;
+                }
+            }
+            _ => {}
+        }
+        let sii_locked = self.sii_pending.is_some();
+        for (i, byte) in data.iter_mut().enumerate() {
+            let a = addr + i as u32;
+            let incoming = *byte;
+            if op.reads() {
+                let value = if a >= present {
+                    0
+                } else {
+                    self.computed(a, t_read).unwrap_or_else(|| self.raw(a))
+                };
+                if op.ors() {
+                    *byte |= value;
+                } else {
+                    *byte = value;
+                }
+            }
+            // the EEPROM address and data registers are locked while busy
+            let locked = sii_locked && (0x0504..=0x050F).contains(&a);
+            if op.writes() && a < present && writable(side, a) && !locked {
+                if let Some(m) = self.mem.get_mut(a as usize) {
+                    *m = incoming;
+                }
+            }
+        }
     }
 
     /// Byte `off` of every SM register block (used to see what a write changed).
