@@ -308,6 +308,14 @@ impl Esc {
             written: op.writes(),
         };
         for n in 0..usize::from(self.config.sm_count) {
+            // an SM whose area (three buffers at most) lies apart from the
+            // access plays no part in it: its plan stays inactive, and its
+            // registers are not parsed
+            let base = regs::sm(n as u8);
+            let (start, length) = (u32::from(self.get_u16(base)), u32::from(self.get_u16(base + 2)));
+            if !(start < end && addr < start + 3 * length) {
+                continue;
+            }
             let regs_n = self.sync_manager(n as u8);
             let Some(plan) = plans.get_mut(n) else { break };
             *plan = sm::Plan::new(&regs_n, side);
