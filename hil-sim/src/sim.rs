@@ -526,7 +526,9 @@ pub trait Node {
     }
     /// Simulation time of the node's next timer interrupt that must run at
     /// its exact time (the simulation stops there and calls
-    /// [`Node::on_timer`]). Default: none.
+    /// [`Node::on_timer`]). Default: none. A function of the node's own
+    /// state: the simulation asks once per round of event delivery and again
+    /// after each event it delivered to this node.
     fn next_timer_at(&self) -> Option<Nanos> {
         None
     }
@@ -593,6 +595,9 @@ pub struct Simulation<N: Node = SimDrive> {
     frames: u64,
     pcap: Option<Recording>,
     jitter: Jitter,
+    /// Scratch of [`Simulation::deliver_events`]: each node's next SYNC0
+    /// edge and timer (kept to reuse its allocation).
+    next_events: Vec<(Option<Nanos>, Option<Nanos>)>,
 }
 
 impl Simulation<SimDrive> {
@@ -612,6 +617,7 @@ impl<N: Node> Simulation<N> {
             frames: 0,
             pcap: None,
             jitter: Jitter { max_ns: 0, state: 1 },
+            next_events: Vec::new(),
         }
     }
 
@@ -739,28 +745,36 @@ impl<N: Node> Simulation<N> {
     /// event; for an edge the node's ESC is advanced to it and
     /// [`Node::on_sync0`] runs, for a timer [`Node::on_timer`].
     fn deliver_events(&mut self, t: Nanos) {
+        // each node's next SYNC0 edge and timer, worked out once: an event
+        // changes only the node it goes to, whose entry is then renewed
+        let mut next = core::mem::take(&mut self.next_events);
+        next.clear();
+        next.extend(self.drives.iter_mut().map(Self::next_events_of));
         // bounded: a pathological SYNC0 cycle cannot hang the simulation
         for _ in 0..1_000_000 {
             // (time, 0 = SYNC0 / 1 = timer, node)
             let mut best: Option<(Nanos, u8, usize)> = None;
-            for (i, d) in self.drives.iter_mut().enumerate() {
-                let sync0 = d.esc_mut().next_sync0_at().map(|e| (e, 0u8, i));
-                let timer = d.next_timer_at().map(|e| (e, 1u8, i));
+            for (i, &(sync0, timer)) in next.iter().enumerate() {
+                let sync0 = sync0.map(|e| (e, 0u8, i));
+                let timer = timer.map(|e| (e, 1u8, i));
                 for ev in [sync0, timer].into_iter().flatten() {
                     if ev.0 <= t && best.is_none_or(|b| ev < b) {
                         best = Some(ev);
                     }
                 }
             }
-            let Some((e, kind, i)) = best else { return };
+            let Some((e, kind, i)) = best else { break };
             self.now = self.now.max(e);
             let now = self.now;
-            let Some(d) = self.drives.get_mut(i) else { return };
+            let (Some(d), Some(slot)) = (self.drives.get_mut(i), next.get_mut(i)) else {
+                break;
+            };
             if kind == 1 {
                 d.on_timer(now);
-                if d.next_timer_at().is_some_and(|n| n <= e) {
+                *slot = Self::next_events_of(d);
+                if slot.1.is_some_and(|n| n <= e) {
                     // the timer did not move on (cannot happen); stop
-                    return;
+                    break;
                 }
                 continue;
             }
@@ -768,10 +782,17 @@ impl<N: Node> Simulation<N> {
             d.esc_mut().tick(now);
             if d.esc_mut().sync0_total() == before {
                 // no pulse fired (cannot happen: the edge time is exact); stop
-                return;
+                break;
             }
             d.on_sync0(now);
+            *slot = Self::next_events_of(d);
         }
+        self.next_events = next;
+    }
+
+    /// A node's next SYNC0 edge and next timer.
+    fn next_events_of(d: &mut N) -> (Option<Nanos>, Option<Nanos>) {
+        (d.esc_mut().next_sync0_at(), d.next_timer_at())
     }
 
     fn poll_all(&mut self) {

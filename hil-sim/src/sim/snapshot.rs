@@ -50,6 +50,7 @@ impl Simulation<SimDrive> {
             frames: self.frames,
             pcap: None,
             jitter: self.jitter,
+            next_events: Vec::new(),
         })
     }
 }
