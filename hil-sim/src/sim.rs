@@ -311,8 +311,14 @@ impl SimDrive {
     /// without the DC drift correction).
     pub fn mcu_local(&self, now: Nanos) -> Nanos {
         let c = self.esc.config();
+        // the drift term in 64 bits where the product fits (the same
+        // truncating division)
+        let drift = i64::try_from(now.as_ns())
+            .ok()
+            .and_then(|n| n.checked_mul(i64::from(c.clock_drift_ppb)))
+            .map(|p| i128::from(p / 1_000_000_000));
         let now = i128::from(now.as_ns());
-        let drift = now * i128::from(c.clock_drift_ppb) / 1_000_000_000;
+        let drift = drift.unwrap_or_else(|| now * i128::from(c.clock_drift_ppb) / 1_000_000_000);
         let t = i128::from(c.clock_offset_ns) + now + drift;
         Nanos::from_ns(u64::try_from(t.max(0)).unwrap_or(u64::MAX))
     }
@@ -324,8 +330,16 @@ impl SimDrive {
         if rel <= 0 {
             return Nanos::ZERO;
         }
-        let den = 1_000_000_000 + i128::from(c.clock_drift_ppb);
-        let mut t = u64::try_from(rel * 1_000_000_000 / den.max(1)).unwrap_or(u64::MAX);
+        let den = (1_000_000_000 + i128::from(c.clock_drift_ppb)).max(1);
+        // rel · 1e9 / den (rel > 0: rounded down) = rel + ⌊−rel · (den − 1e9) / den⌋,
+        // in 64 bits where it fits
+        let quick = i64::try_from(rel).ok().and_then(|r| {
+            let d = i64::try_from(den).ok()?;
+            let y = r.checked_mul(d - 1_000_000_000)?.checked_neg()?;
+            r.checked_add(y.div_euclid(d))
+        });
+        let first = quick.map_or_else(|| rel * 1_000_000_000 / den, i128::from);
+        let mut t = u64::try_from(first).unwrap_or(u64::MAX);
         while self.mcu_local(Nanos::from_ns(t)) < local {
             t = t.saturating_add(1);
         }
@@ -337,7 +351,10 @@ impl SimDrive {
 
     /// Local time of timer tick `tick` (rounded up to the ns: the tick is reached then).
     fn tick_local(tick: u64) -> Nanos {
-        let ns = (u128::from(tick) * NS_PER_S).div_ceil(u128::from(TIMER_HZ));
+        let ns = match tick.checked_mul(NS_PER_S as u64) {
+            Some(p) => u128::from(p.div_ceil(TIMER_HZ)),
+            None => (u128::from(tick) * NS_PER_S).div_ceil(u128::from(TIMER_HZ)),
+        };
         Nanos::from_ns(u64::try_from(ns).unwrap_or(u64::MAX))
     }
 

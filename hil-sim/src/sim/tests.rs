@@ -115,3 +115,63 @@ fn power_cycle_keeps_the_oscillator() {
         42 + 1_000_000_000 - 25_000
     );
 }
+
+/// The MCU clock's 64-bit paths (`mcu_local`, `mcu_now_for`, `tick_local`)
+/// give what the 128-bit arithmetic they replaced gives, for drifts up to
+/// the ESC's limit, offsets and times up to 2^62 ns (146 years).
+#[test]
+fn mcu_clock_64_bit_paths_equal_the_128_bit_arithmetic() {
+    fn local_wide(offset: u64, ppb: i32, now: u64) -> u64 {
+        let now = i128::from(now);
+        let t = i128::from(offset) + now + now * i128::from(ppb) / 1_000_000_000;
+        u64::try_from(t.max(0)).unwrap_or(u64::MAX)
+    }
+    fn first_wide(offset: u64, ppb: i32, local: u64) -> Option<u64> {
+        let rel = i128::from(local) - i128::from(offset);
+        let den = (1_000_000_000 + i128::from(ppb)).max(1);
+        (rel > 0).then(|| u64::try_from(rel * 1_000_000_000 / den).unwrap_or(u64::MAX))
+    }
+    let mut x = 0x9E37_79B9_7F4A_7C15u64;
+    let mut next = move || {
+        x ^= x << 13;
+        x ^= x >> 7;
+        x ^= x << 17;
+        x
+    };
+    let mut d = SimDrive::new();
+    for _ in 0..20_000 {
+        let ppb = match next() % 3 {
+            0 => 0,
+            1 => (next() % 200_001) as i32 - 100_000,
+            _ => (next() % 200_000_001) as i32 - 100_000_000,
+        };
+        let offset = next() >> (2 + next() % 62);
+        d.esc.set_clock(ppb, offset);
+        let now = next() >> (2 + next() % 62);
+        assert_eq!(
+            d.mcu_local(Nanos::from_ns(now)).as_ns(),
+            local_wide(offset, ppb, now),
+            "{ppb} ppb, offset {offset}, at {now}"
+        );
+        let local = next() >> (2 + next() % 62);
+        let t = d.mcu_now_for(Nanos::from_ns(local)).as_ns();
+        // the first time the clock reaches `local`, found from the same estimate
+        let mut want = first_wide(offset, ppb, local).unwrap_or(0);
+        if local > offset {
+            while local_wide(offset, ppb, want) < local {
+                want = want.saturating_add(1);
+            }
+            while want > 0 && local_wide(offset, ppb, want - 1) >= local {
+                want -= 1;
+            }
+        }
+        assert_eq!(t, want, "{ppb} ppb, offset {offset}, reaching {local}");
+        let tick = next() >> (next() % 64);
+        let wide = (u128::from(tick) * NS_PER_S).div_ceil(u128::from(TIMER_HZ));
+        assert_eq!(
+            SimDrive::tick_local(tick).as_ns(),
+            u64::try_from(wide).unwrap_or(u64::MAX),
+            "tick {tick}"
+        );
+    }
+}
