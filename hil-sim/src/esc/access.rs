@@ -301,88 +301,39 @@ impl Esc {
             ([0; MAX_SM], [0; MAX_SM])
         };
 
-        // SyncManager pre-phase: permission, buffer selection, opening.
-        let mut plans = [sm::Plan::default(); MAX_SM];
-        let mut out = Outcome {
-            read: op.reads(),
-            written: op.writes(),
-        };
-        for n in 0..usize::from(self.config.sm_count) {
-            // an SM whose area (three buffers at most) lies apart from the
-            // access plays no part in it: its plan stays inactive, and its
-            // registers are not parsed
-            let base = regs::sm(n as u8);
+        // the SMs whose area (three buffers at most) can overlap the access;
+        // the others play no part in it (their registers are not parsed)
+        let mut near_sms = 0u16;
+        for n in 0..self.config.sm_count.min(MAX_SM as u8) {
+            let base = regs::sm(n);
             let (start, length) = (u32::from(self.get_u16(base)), u32::from(self.get_u16(base + 2)));
-            if !(start < end && addr < start + 3 * length) {
-                continue;
-            }
-            let regs_n = self.sync_manager(n as u8);
-            let Some(plan) = plans.get_mut(n) else { break };
-            *plan = sm::Plan::new(&regs_n, side);
-            if !plan.active || !plan.overlaps(addr, end) {
-                continue;
-            }
-            plan.involved = true;
-            let Some(state) = self.sm.get_mut(n) else { break };
-            let full = regs_n.status & ::esc::sm::status::MAILBOX_FULL != 0;
-            plan.decide(state, op, full, addr, end);
-            if op.reads() && !plan.read_ok {
-                out.read = false;
-            }
-            if op.writes() && !plan.write_ok {
-                out.written = false;
+            if start < end && addr < start + 3 * length {
+                near_sms |= 1 << n;
             }
         }
-        for n in 0..usize::from(self.config.sm_count) {
-            let Some(plan) = plans.get(n).copied() else { break };
-            if plan.involved && (plan.read_ok || plan.write_ok) {
-                self.sm_open(n as u8, &plan);
-            }
-        }
-
-        // Data phase.
-        let t_read = match side {
-            Side::Ecat => self.dc.ecat_time,
-            Side::Pdi => self.now,
-        };
-        // the SMs whose areas (hidden buffers included) the access overlaps,
-        // in SM order: only these can classify one of its bytes
-        let mut near = [sm::Plan::default(); MAX_SM];
-        let mut k = 0;
-        for p in plans.iter().filter(|p| p.reaches(addr, end)) {
-            if let Some(slot) = near.get_mut(k) {
-                *slot = *p;
-                k += 1;
-            }
-        }
-        let near = near.get(..k).unwrap_or_default();
-        if near.is_empty() {
+        let out = if near_sms == 0 {
+            // every byte plain memory (what the SM phases find then)
+            let t_read = self.read_time(side);
             self.plain_data(side, addr, data, op, t_read);
-        } else {
-            self.sm_data(side, addr, data, op, t_read, near);
-        }
-
-        // SyncManager post-phase: completion on the last byte.
-        for n in 0..usize::from(self.config.sm_count) {
-            let Some(plan) = plans.get(n).copied() else { break };
-            if plan.involved && plan.touches_last {
-                if plan.read_ok {
-                    self.sm_read_done(n as u8, &plan);
-                }
-                if plan.write_ok {
-                    self.sm_write_done(n as u8, &plan);
-                }
+            Outcome {
+                read: op.reads(),
+                written: op.writes(),
             }
-        }
+        } else {
+            self.sm_phases(side, addr, data, op, near_sms)
+        };
 
         // Register side effects.
         let touches = |lo: u16, hi: u16| addr <= u32::from(hi) && u32::from(lo) < end;
+        // (the SM register blocks looked at one by one only when touched)
+        let sm_count = self.config.sm_count;
+        let sm_block = sm_count > 0 && touches(regs::SM_BASE, regs::sm(sm_count) - 1);
         match side {
             Side::Ecat if op.writes() => {
                 if touches(regs::AL_CONTROL, regs::AL_CONTROL + 1) {
                     self.set_al_event(al_event::AL_CONTROL);
                 }
-                for n in 0..self.config.sm_count {
+                for n in (0..sm_count).filter(|_| sm_block) {
                     let a = regs::sm(n) + 6;
                     if touches(a, a) {
                         let old = old_activate.get(usize::from(n)).copied().unwrap_or(0);
@@ -423,7 +374,7 @@ impl Esc {
                     if touches(regs::AL_CONTROL, regs::AL_CONTROL + 1) {
                         self.clear_al_event(al_event::AL_CONTROL);
                     }
-                    if (0..self.config.sm_count).any(|n| touches(regs::sm(n) + 6, regs::sm(n) + 6)) {
+                    if sm_block && (0..sm_count).any(|n| touches(regs::sm(n) + 6, regs::sm(n) + 6)) {
                         self.clear_al_event(al_event::SM_ACTIVATION);
                     }
                     if touches(regs::WATCHDOG_STATUS_PD, regs::WATCHDOG_STATUS_PD + 1) {
@@ -432,7 +383,7 @@ impl Esc {
                     self.dc_pdi_read(|r| touches(r, r));
                 }
                 if op.writes() {
-                    for n in 0..self.config.sm_count {
+                    for n in (0..sm_count).filter(|_| sm_block) {
                         let a = regs::sm(n) + 7;
                         if touches(a, a) {
                             let old = old_pdi_control.get(usize::from(n)).copied().unwrap_or(0);
@@ -447,6 +398,90 @@ impl Esc {
                 }
             }
             Side::Ecat => {}
+        }
+        out
+    }
+
+    /// Where a byte of the DC system time is read at: the frame's arrival
+    /// for the master, the ESC's time for the PDI.
+    fn read_time(&self, side: Side) -> Nanos {
+        match side {
+            Side::Ecat => self.dc.ecat_time,
+            Side::Pdi => self.now,
+        }
+    }
+
+    /// The SyncManager phases of an access and its data phase, for an access
+    /// the SMs of `near_sms` (bit n: SM n) can concern: permission, buffer
+    /// selection and opening; each byte through its SM's buffer mapping;
+    /// completion on the last byte.
+    fn sm_phases(&mut self, side: Side, addr: u32, data: &mut [u8], op: Op, near_sms: u16) -> Outcome {
+        let end = addr.saturating_add(data.len() as u32);
+        // SyncManager pre-phase: permission, buffer selection, opening.
+        let mut plans = [sm::Plan::default(); MAX_SM];
+        let mut out = Outcome {
+            read: op.reads(),
+            written: op.writes(),
+        };
+        for n in 0..usize::from(self.config.sm_count) {
+            // the plans of the SMs apart from the access stay inactive
+            if near_sms & 1 << n == 0 {
+                continue;
+            }
+            let regs_n = self.sync_manager(n as u8);
+            let Some(plan) = plans.get_mut(n) else { break };
+            *plan = sm::Plan::new(&regs_n, side);
+            if !plan.active || !plan.overlaps(addr, end) {
+                continue;
+            }
+            plan.involved = true;
+            let Some(state) = self.sm.get_mut(n) else { break };
+            let full = regs_n.status & ::esc::sm::status::MAILBOX_FULL != 0;
+            plan.decide(state, op, full, addr, end);
+            if op.reads() && !plan.read_ok {
+                out.read = false;
+            }
+            if op.writes() && !plan.write_ok {
+                out.written = false;
+            }
+        }
+        for n in 0..usize::from(self.config.sm_count) {
+            let Some(plan) = plans.get(n).copied() else { break };
+            if plan.involved && (plan.read_ok || plan.write_ok) {
+                self.sm_open(n as u8, &plan);
+            }
+        }
+
+        // Data phase.
+        let t_read = self.read_time(side);
+        // the SMs whose areas (hidden buffers included) the access overlaps,
+        // in SM order: only these can classify one of its bytes
+        let mut near = [sm::Plan::default(); MAX_SM];
+        let mut k = 0;
+        for p in plans.iter().filter(|p| p.reaches(addr, end)) {
+            if let Some(slot) = near.get_mut(k) {
+                *slot = *p;
+                k += 1;
+            }
+        }
+        let near = near.get(..k).unwrap_or_default();
+        if near.is_empty() {
+            self.plain_data(side, addr, data, op, t_read);
+        } else {
+            self.sm_data(side, addr, data, op, t_read, near);
+        }
+
+        // SyncManager post-phase: completion on the last byte.
+        for n in 0..usize::from(self.config.sm_count) {
+            let Some(plan) = plans.get(n).copied() else { break };
+            if plan.involved && plan.touches_last {
+                if plan.read_ok {
+                    self.sm_read_done(n as u8, &plan);
+                }
+                if plan.write_ok {
+                    self.sm_write_done(n as u8, &plan);
+                }
+            }
         }
         out
     }
