@@ -498,6 +498,74 @@ impl Esc {
         t_read: Nanos,
         near: &[sm::Plan],
     ) {
+        if let [p] = near {
+            if self.buffer_data(side, addr, data, op, p) {
+                return;
+            }
+        }
+        self.sm_data_bytes(side, addr, data, op, t_read, near);
+    }
+
+    /// The data phase of an access that lies inside the buffer area of one
+    /// SM (`p`, the only one near it), as slices: what
+    /// [`Esc::sm_data_bytes`] does byte by byte there. `false` (nothing
+    /// done) for an access it does not cover: outside the area, the
+    /// buffer past the present memory, the DC system time among the bytes.
+    pub(super) fn buffer_data(
+        &mut self,
+        side: Side,
+        addr: u32,
+        data: &mut [u8],
+        op: Op,
+        p: &sm::Plan,
+    ) -> bool {
+        let end = addr.saturating_add(data.len() as u32);
+        let present = self.present_end();
+        let st = u32::from(regs::dc::SYSTEM_TIME);
+        let computed = self.config.dc_supported && addr < st + 8 && st < end;
+        let shift = u32::from(p.buffer) * p.len;
+        if !(p.active && p.start <= addr && end <= p.start + p.len) || computed || end + shift > present {
+            return false;
+        }
+        if !(p.read_ok || p.write_ok) {
+            // refused: the PDI reads zeros, nothing is written
+            if side == Side::Pdi && op.reads() {
+                data.fill(0);
+            }
+            return true;
+        }
+        let (lo, hi) = ((addr + shift) as usize, (end + shift) as usize);
+        let Some(m) = self.mem.get_mut(lo..hi) else {
+            return false;
+        };
+        let (rd, wr) = (p.read_ok, p.write_ok);
+        for (m, d) in m.iter_mut().zip(data.iter_mut()) {
+            let incoming = *d;
+            if op.reads() {
+                let value = if rd { *m } else { 0 };
+                if op.ors() {
+                    *d |= value;
+                } else {
+                    *d = value;
+                }
+            }
+            if wr {
+                *m = incoming;
+            }
+        }
+        true
+    }
+
+    /// [`Esc::sm_data`] byte by byte: each byte through [`sm::classify`].
+    pub(super) fn sm_data_bytes(
+        &mut self,
+        side: Side,
+        addr: u32,
+        data: &mut [u8],
+        op: Op,
+        t_read: Nanos,
+        near: &[sm::Plan],
+    ) {
         let present = self.present_end();
         for (i, byte) in data.iter_mut().enumerate() {
             let a = addr + i as u32;
