@@ -13,6 +13,10 @@ use std::collections::VecDeque;
 use std::io;
 use std::path::Path;
 
+/// Most drives on one simulated line that `hil-sim serve --slaves` takes:
+/// a line of 128 reaches Op through ethercrab in-process
+/// (`e002_line_of_128_drives_reaches_op`). The simulation itself has no limit.
+pub const MAX_DRIVES: usize = 128;
 /// Local poll period of the slave firmware between frames (the mailbox/ESM task).
 pub const POLL_PERIOD: Nanos = Nanos::from_us(100);
 /// Forwarding delay of one slave, ns (out and back: half of it each way).
