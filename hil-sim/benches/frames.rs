@@ -2,7 +2,7 @@
 //! cycle: frames per wall-clock second and the real-time factor (simulated
 //! time / wall time).
 //!
-//! `cargo bench -p hil-sim --bench frames [-- --cycles N] [--drives N] [--hz F]`
+//! `cargo bench -p hil-sim --bench frames [-- --cycles N] [--drives N] [--hz F] [--pcap FILE]`
 //!
 //! Each case: ethercrab (in-process, its own time the simulated clock)
 //! brings the line to Op with A150 = the cycle (1000 µs at 1 kHz, 250 µs at
@@ -37,7 +37,11 @@
 //! where a drive's data is split between two frames) and the cycles that
 //! had it; `Op` drives in Op at the end; `setup s` wall time to Op.
 //!
-//! `--drives N` and `--hz F` run one case (e.g. under `perf record`).
+//! `--drives N` and `--hz F` run one case (e.g. under `perf record`);
+//! `--pcap FILE` records its frames, setup included, at their simulated
+//! times (the simulation is deterministic: an optimisation of the simulator
+//! that changes no behaviour leaves the file as it was; the figures then
+//! include writing it).
 #![allow(
     clippy::unwrap_used,
     clippy::expect_used,
@@ -229,12 +233,15 @@ struct Measured {
     op: usize,
 }
 
-fn run_case(drives: usize, hz: u32, cycles: usize) -> Row {
+fn run_case(drives: usize, hz: u32, cycles: usize, pcap: Option<&std::path::Path>) -> Row {
     let setup_start = Instant::now();
     let period = Nanos::from_ns(1_000_000_000 / u64::from(hz));
     let quarter = Nanos::from_ns(period.as_ns() / 4);
     let a150_us = u16::try_from(period.as_us()).expect("A150 in µs");
     let sim = RefCell::new(Simulation::new(drives));
+    if let Some(p) = pcap {
+        sim.borrow_mut().record_pcap(p).expect("the pcap file");
+    }
     let storage =
         ethercrab::PduStorage::<{ hil_sim::master::MAX_FRAMES }, { hil_sim::master::MAX_PDU_DATA }>::new();
     let (tx, rx, pdu_loop) = storage.try_split().expect("split once");
@@ -388,13 +395,15 @@ fn run_case(drives: usize, hz: u32, cycles: usize) -> Row {
             op: m.op,
         }
     };
-    futures_lite::future::block_on(futures_lite::future::or(
+    let row = futures_lite::future::block_on(futures_lite::future::or(
         async {
             link.await;
             unreachable!("the link never completes")
         },
         body,
-    ))
+    ));
+    sim.borrow_mut().flush().expect("the pcap file");
+    row
 }
 
 fn arg<T: std::str::FromStr>(args: &[String], name: &str) -> Option<T> {
@@ -409,6 +418,11 @@ fn main() {
     let cycles: usize = arg(&args, "--cycles").unwrap_or(500);
     let drives: Vec<usize> = arg(&args, "--drives").map_or(vec![2, 16, 64, 128], |n| vec![n]);
     let rates: Vec<u32> = arg(&args, "--hz").map_or(vec![1000, 4000], |f| vec![f]);
+    let pcap: Option<std::path::PathBuf> = arg(&args, "--pcap");
+    assert!(
+        pcap.is_none() || drives.len() * rates.len() == 1,
+        "--pcap records one case: give --drives and --hz"
+    );
     println!(
         "{cycles} process-data cycles per case through ethercrab in-process (RTF: simulated / wall time); \
          load average {}",
@@ -435,7 +449,7 @@ fn main() {
     );
     for &n in &drives {
         for &hz in &rates {
-            let r = run_case(n, hz, cycles);
+            let r = run_case(n, hz, cycles, pcap.as_deref());
             let wall = r.wall.as_secs_f64();
             let sim_s = r.sim.as_ns() as f64 / 1e9;
             println!(
