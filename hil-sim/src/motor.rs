@@ -415,10 +415,13 @@ impl Motor {
         let n = dt_ns.div_ceil(max_sub).max(1);
         let mut t_prev = 0u64;
         for i in 1..=n {
-            let t_next = (u128::from(dt_ns) * u128::from(i) / u128::from(n)) as u64;
+            let t_next = match dt_ns.checked_mul(i) {
+                Some(p) => p / n,
+                None => (u128::from(dt_ns) * u128::from(i) / u128::from(n)) as u64,
+            };
             let h_ns = t_next - t_prev;
             let (p0_int, p0_frac) = (self.pos_int, self.pos_frac);
-            self.substep(act, h_ns as f64 * 1.0e-9);
+            let held = self.substep(act, h_ns as f64 * 1.0e-9);
             if self.pos_int != p0_int {
                 let c = Crossing {
                     p0_int,
@@ -433,6 +436,11 @@ impl Motor {
                 self.switches.detect(&c, &mut edges);
             }
             t_prev = t_next;
+            if held {
+                // the rotor holds: so does every later sub-step of this step
+                // (the same torque at the same position), changing nothing
+                break;
+            }
         }
         edges.sort_by_time();
 
@@ -480,8 +488,10 @@ impl Motor {
         }
     }
 
-    /// One integration sub-step of `h` seconds under `act`.
-    fn substep(&mut self, act: Actuation, h: f64) {
+    /// One integration sub-step of `h` seconds under `act`; `true` when the
+    /// rotor holds (at rest, the driving torque within the static friction
+    /// and brake): the sub-step then only sets it at rest, whatever `h`.
+    fn substep(&mut self, act: Actuation, h: f64) -> bool {
         let p = &self.params;
         let j = p.inertia_kg_m2.max(1.0e-9);
         let b = p.viscous_friction_nm_s_per_rad.max(0.0);
@@ -502,14 +512,14 @@ impl Motor {
             if holds {
                 self.vel_rad_s = 0.0;
                 self.stuck = true;
-                return;
+                return true;
             }
             // Break away: sliding friction opposes the driving torque.
             self.stuck = false;
             let net = drive - sign(drive) * kinetic;
             let v1 = (v0 + h * net / j) / damp;
             self.advance(v0, v1, h);
-            return;
+            return false;
         }
 
         let friction = -sign(v0) * kinetic;
@@ -524,6 +534,7 @@ impl Motor {
         } else {
             self.advance(v0, v1, h);
         }
+        false
     }
 
     /// Moves by the trapezoid `(v0 + v1)/2 · h` and sets the velocity to `v1`.

@@ -6,18 +6,24 @@ use crate::esc::{Esc, EscConfig, LineTiming};
 use crate::frame::process_frame;
 use crate::motor::{Motor, MotorOutputs};
 mod axis_io;
+mod flash;
 mod snapshot;
 mod stamps;
 mod variant;
 
 use crate::pcap::Recording;
 pub(crate) use axis_io::axis_io;
+pub use flash::{FirmwareFlash, FirmwareSlots, SimFlash};
 use nanos::Nanos;
 pub use stamps::{CycleStamp, LockLoss, PllLock, Sync0Stamp};
 use std::collections::VecDeque;
 use std::io;
 use std::path::Path;
 
+/// Most drives on one simulated line that `hil-sim serve --slaves` takes:
+/// a line of 128 reaches Op through ethercrab in-process
+/// (`e002_line_of_128_drives_reaches_op`). The simulation itself has no limit.
+pub const MAX_DRIVES: usize = 128;
 /// Local poll period of the slave firmware between frames (the mailbox/ESM task).
 pub const POLL_PERIOD: Nanos = Nanos::from_us(100);
 /// SYNC0 pulses closer than this reach the drive as one interrupt (a
@@ -31,48 +37,6 @@ pub const SYNC0_LOG_LEN: usize = 64;
 const BYTE_NS: u64 = 80;
 /// Preamble, FCS and inter-frame gap, bytes.
 const FRAME_OVERHEAD: u64 = 8 + 4 + 12;
-
-/// The simulated non-volatile memory of a drive: two 4 KiB sectors (one per slot).
-pub type SimFlash = store::RamFlash<4096, 2>;
-
-/// The simulated firmware flash: 2 × 66 sectors of 4 KiB (a slot takes a
-/// 256 KiB image), NOR in RAM, on the heap. Copy on write: a clone (a copy
-/// of a line, [`Simulation::try_clone`]) shares the 528 KiB until one of
-/// them erases or writes, so a snapshot costs what it changes.
-#[derive(Clone)]
-pub struct FirmwareFlash(pub std::sync::Arc<drive::boot::RamFlash<4096, 132>>);
-
-impl FirmwareFlash {
-    /// An erased flash.
-    pub fn new() -> Self {
-        Self(std::sync::Arc::new(drive::boot::RamFlash::new()))
-    }
-}
-
-impl Default for FirmwareFlash {
-    fn default() -> Self {
-        Self::new()
-    }
-}
-
-impl drive::boot::Flash for FirmwareFlash {
-    const SECTOR: usize = 4096;
-    const SECTORS: usize = 132;
-    const WRITE: usize = 8;
-    fn read(&mut self, addr: u32, buf: &mut [u8]) -> Result<(), drive::boot::FlashError> {
-        // a read changes nothing: only erase and write copy a shared flash
-        self.0.read_shared(addr, buf)
-    }
-    fn erase(&mut self, sector: u32) -> Result<(), drive::boot::FlashError> {
-        drive::boot::Flash::erase(std::sync::Arc::make_mut(&mut self.0), sector)
-    }
-    fn write(&mut self, addr: u32, data: &[u8]) -> Result<(), drive::boot::FlashError> {
-        drive::boot::Flash::write(std::sync::Arc::make_mut(&mut self.0), addr, data)
-    }
-}
-
-/// The firmware slots of a simulated drive.
-pub type FirmwareSlots = drive::boot::BootSlots<FirmwareFlash>;
 
 /// Control cycle of the simulated drive (A150 default).
 pub const CONTROL_CYCLE: Nanos = Nanos::from_ms(1);
@@ -262,8 +226,14 @@ impl SimDrive {
     /// without the DC drift correction).
     pub fn mcu_local(&self, now: Nanos) -> Nanos {
         let c = self.esc.config();
+        // the drift term in 64 bits where the product fits (the same
+        // truncating division)
+        let drift = i64::try_from(now.as_ns())
+            .ok()
+            .and_then(|n| n.checked_mul(i64::from(c.clock_drift_ppb)))
+            .map(|p| i128::from(p / 1_000_000_000));
         let now = i128::from(now.as_ns());
-        let drift = now * i128::from(c.clock_drift_ppb) / 1_000_000_000;
+        let drift = drift.unwrap_or_else(|| now * i128::from(c.clock_drift_ppb) / 1_000_000_000);
         let t = i128::from(c.clock_offset_ns) + now + drift;
         Nanos::from_ns(u64::try_from(t.max(0)).unwrap_or(u64::MAX))
     }
@@ -275,8 +245,16 @@ impl SimDrive {
         if rel <= 0 {
             return Nanos::ZERO;
         }
-        let den = 1_000_000_000 + i128::from(c.clock_drift_ppb);
-        let mut t = u64::try_from(rel * 1_000_000_000 / den.max(1)).unwrap_or(u64::MAX);
+        let den = (1_000_000_000 + i128::from(c.clock_drift_ppb)).max(1);
+        // rel · 1e9 / den (rel > 0: rounded down) = rel + ⌊−rel · (den − 1e9) / den⌋,
+        // in 64 bits where it fits
+        let quick = i64::try_from(rel).ok().and_then(|r| {
+            let d = i64::try_from(den).ok()?;
+            let y = r.checked_mul(d - 1_000_000_000)?.checked_neg()?;
+            r.checked_add(y.div_euclid(d))
+        });
+        let first = quick.map_or_else(|| rel * 1_000_000_000 / den, i128::from);
+        let mut t = u64::try_from(first).unwrap_or(u64::MAX);
         while self.mcu_local(Nanos::from_ns(t)) < local {
             t = t.saturating_add(1);
         }
@@ -288,7 +266,10 @@ impl SimDrive {
 
     /// Local time of timer tick `tick` (rounded up to the ns: the tick is reached then).
     fn tick_local(tick: u64) -> Nanos {
-        let ns = (u128::from(tick) * NS_PER_S).div_ceil(u128::from(TIMER_HZ));
+        let ns = match tick.checked_mul(NS_PER_S as u64) {
+            Some(p) => u128::from(p.div_ceil(TIMER_HZ)),
+            None => (u128::from(tick) * NS_PER_S).div_ceil(u128::from(TIMER_HZ)),
+        };
         Nanos::from_ns(u64::try_from(ns).unwrap_or(u64::MAX))
     }
 
@@ -484,7 +465,9 @@ pub trait Node {
     }
     /// Simulation time of the node's next timer interrupt that must run at
     /// its exact time (the simulation stops there and calls
-    /// [`Node::on_timer`]). Default: none.
+    /// [`Node::on_timer`]). Default: none. A function of the node's own
+    /// state: the simulation asks once per round of event delivery and again
+    /// after each event it delivered to this node.
     fn next_timer_at(&self) -> Option<Nanos> {
         None
     }
@@ -551,6 +534,9 @@ pub struct Simulation<N: Node = SimDrive> {
     frames: u64,
     pcap: Option<Recording>,
     jitter: Jitter,
+    /// Scratch of [`Simulation::deliver_events`]: each node's next SYNC0
+    /// edge and timer (kept to reuse its allocation).
+    next_events: Vec<(Option<Nanos>, Option<Nanos>)>,
 }
 
 impl Simulation<SimDrive> {
@@ -570,6 +556,7 @@ impl<N: Node> Simulation<N> {
             frames: 0,
             pcap: None,
             jitter: Jitter { max_ns: 0, state: 1 },
+            next_events: Vec::new(),
         }
     }
 
@@ -697,28 +684,36 @@ impl<N: Node> Simulation<N> {
     /// event; for an edge the node's ESC is advanced to it and
     /// [`Node::on_sync0`] runs, for a timer [`Node::on_timer`].
     fn deliver_events(&mut self, t: Nanos) {
+        // each node's next SYNC0 edge and timer, worked out once: an event
+        // changes only the node it goes to, whose entry is then renewed
+        let mut next = core::mem::take(&mut self.next_events);
+        next.clear();
+        next.extend(self.drives.iter_mut().map(Self::next_events_of));
         // bounded: a pathological SYNC0 cycle cannot hang the simulation
         for _ in 0..1_000_000 {
             // (time, 0 = SYNC0 / 1 = timer, node)
             let mut best: Option<(Nanos, u8, usize)> = None;
-            for (i, d) in self.drives.iter_mut().enumerate() {
-                let sync0 = d.esc_mut().next_sync0_at().map(|e| (e, 0u8, i));
-                let timer = d.next_timer_at().map(|e| (e, 1u8, i));
+            for (i, &(sync0, timer)) in next.iter().enumerate() {
+                let sync0 = sync0.map(|e| (e, 0u8, i));
+                let timer = timer.map(|e| (e, 1u8, i));
                 for ev in [sync0, timer].into_iter().flatten() {
                     if ev.0 <= t && best.is_none_or(|b| ev < b) {
                         best = Some(ev);
                     }
                 }
             }
-            let Some((e, kind, i)) = best else { return };
+            let Some((e, kind, i)) = best else { break };
             self.now = self.now.max(e);
             let now = self.now;
-            let Some(d) = self.drives.get_mut(i) else { return };
+            let (Some(d), Some(slot)) = (self.drives.get_mut(i), next.get_mut(i)) else {
+                break;
+            };
             if kind == 1 {
                 d.on_timer(now);
-                if d.next_timer_at().is_some_and(|n| n <= e) {
+                *slot = Self::next_events_of(d);
+                if slot.1.is_some_and(|n| n <= e) {
                     // the timer did not move on (cannot happen); stop
-                    return;
+                    break;
                 }
                 continue;
             }
@@ -733,10 +728,17 @@ impl<N: Node> Simulation<N> {
             d.esc_mut().tick(upto);
             if d.esc_mut().sync0_total() == before {
                 // no pulse fired (cannot happen: the edge time is exact); stop
-                return;
+                break;
             }
             d.on_sync0(now);
+            *slot = Self::next_events_of(d);
         }
+        self.next_events = next;
+    }
+
+    /// A node's next SYNC0 edge and next timer.
+    fn next_events_of(d: &mut N) -> (Option<Nanos>, Option<Nanos>) {
+        (d.esc_mut().next_sync0_at(), d.next_timer_at())
     }
 
     fn poll_all(&mut self) {

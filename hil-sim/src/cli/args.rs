@@ -81,8 +81,9 @@ pub struct ServeArgs {
     /// until the profile maps CW1), `status` prints the axes' state.
     #[arg(long, value_name = "PATH")]
     pub control: Option<PathBuf>,
-    /// Drives on the simulated line (EtherCAT only).
-    #[arg(long, value_name = "N", default_value_t = 1, value_parser = clap::value_parser!(u16).range(1..=16))]
+    /// Drives on the simulated line (EtherCAT; PROFINET: IO devices), 1 to
+    /// 128.
+    #[arg(long, value_name = "N", default_value_t = 1, value_parser = clap::value_parser!(u16).range(1..=i64::from(MAX_SLAVES)))]
     pub slaves: u16,
     /// Axes per drive (EtherCAT only): 2 = the double-axis device (SC6A062,
     /// axis B's objects at +800h/+8000h), 1 = the single-axis device
@@ -119,6 +120,9 @@ pub struct ServeArgs {
     #[arg(long, value_name = "SEED", hide = true, default_value_t = 1)]
     pub delay_seed: u64,
 }
+
+/// Most drives `serve --slaves` takes ([`hil_sim::sim::MAX_DRIVES`]).
+pub const MAX_SLAVES: u16 = hil_sim::sim::MAX_DRIVES as u16;
 
 /// The default plot path of `demo`.
 pub const DEFAULT_PLOT: &str = "target/hil-sim-demo.svg";

@@ -92,9 +92,11 @@ pub fn serve(args: &ServeArgs) -> Result<(), String> {
     let iface = &args.iface;
     let sock = RawSocket::open(iface).map_err(|e| format!("{iface}: {e}"))?;
     // every drive answers ping and the UDP parameter service on its EoE
-    // interface once the master set its IP address (docs/eoe.md)
-    for (i, d) in (1u8..).zip(sim.drives_mut()) {
-        d.bind_net([0x02, 0x00, 0x00, 0x00, 0x00, i], u64::from(i), Nanos::ZERO);
+    // interface once the master set its IP address (docs/eoe.md); drive k
+    // (from 1) has the MAC 02:00:00:00:hi(k):lo(k)
+    for (k, d) in (1u16..).zip(sim.drives_mut()) {
+        let [hi, lo] = k.to_be_bytes();
+        d.bind_net([0x02, 0x00, 0x00, 0x00, hi, lo], u64::from(k), Nanos::ZERO);
     }
     let device = drive::device(variant);
     let kind = match variant {

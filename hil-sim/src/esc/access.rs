@@ -294,107 +294,46 @@ impl Esc {
         }
         let len = data.len() as u32;
         let end = addr.saturating_add(len);
-        // Old values of the bytes with write side effects.
-        let old_activate = self.sm_bytes(6);
-        let old_pdi_control = self.sm_bytes(7);
-
-        // SyncManager pre-phase: permission, buffer selection, opening.
-        let mut plans = [sm::Plan::default(); MAX_SM];
-        let mut out = Outcome {
-            read: op.reads(),
-            written: op.writes(),
+        // Old values of the bytes with write side effects (a write's only).
+        let (old_activate, old_pdi_control) = if op.writes() {
+            (self.sm_bytes(6), self.sm_bytes(7))
+        } else {
+            ([0; MAX_SM], [0; MAX_SM])
         };
-        for n in 0..usize::from(self.config.sm_count) {
-            let regs_n = self.sync_manager(n as u8);
-            let Some(plan) = plans.get_mut(n) else { break };
-            *plan = sm::Plan::new(&regs_n, side);
-            if !plan.active || !plan.overlaps(addr, end) {
-                continue;
-            }
-            plan.involved = true;
-            let Some(state) = self.sm.get_mut(n) else { break };
-            let full = regs_n.status & ::esc::sm::status::MAILBOX_FULL != 0;
-            plan.decide(state, op, full, addr, end);
-            if op.reads() && !plan.read_ok {
-                out.read = false;
-            }
-            if op.writes() && !plan.write_ok {
-                out.written = false;
-            }
-        }
-        for n in 0..usize::from(self.config.sm_count) {
-            let Some(plan) = plans.get(n).copied() else { break };
-            if plan.involved && (plan.read_ok || plan.write_ok) {
-                self.sm_open(n as u8, &plan);
-            }
-        }
 
-        // Data phase, byte by byte.
-        let present = self.present_end();
-        let t_read = match side {
-            Side::Ecat => self.dc.ecat_time,
-            Side::Pdi => self.now,
+        // the SMs whose area (three buffers at most) can overlap the access;
+        // the others play no part in it (their registers are not parsed)
+        let mut near_sms = 0u16;
+        for n in 0..self.config.sm_count.min(MAX_SM as u8) {
+            let base = regs::sm(n);
+            let (start, length) = (u32::from(self.get_u16(base)), u32::from(self.get_u16(base + 2)));
+            if start < end && addr < start + 3 * length {
+                near_sms |= 1 << n;
+            }
+        }
+        let out = if near_sms == 0 {
+            // every byte plain memory (what the SM phases find then)
+            let t_read = self.read_time(side);
+            self.plain_data(side, addr, data, op, t_read);
+            Outcome {
+                read: op.reads(),
+                written: op.writes(),
+            }
+        } else {
+            self.sm_phases(side, addr, data, op, near_sms)
         };
-        for (i, byte) in data.iter_mut().enumerate() {
-            let a = addr + i as u32;
-            let incoming = *byte;
-            let (phys, rd, wr) = match sm::classify(&plans, a) {
-                sm::Where::Buffer(p) => {
-                    if !(p.read_ok || p.write_ok) {
-                        if side == Side::Pdi && op.reads() {
-                            *byte = 0;
-                        }
-                        continue;
-                    }
-                    (a + u32::from(p.buffer) * p.len, p.read_ok, p.write_ok)
-                }
-                sm::Where::Hidden => (a, false, false),
-                sm::Where::Plain => {
-                    // the EEPROM address and data registers are locked while busy
-                    let sii_locked = self.sii_pending.is_some() && (0x0504..=0x050F).contains(&a);
-                    (a, op.reads(), op.writes() && writable(side, a) && !sii_locked)
-                }
-            };
-            let value = if a >= present || !rd {
-                0
-            } else {
-                self.computed(a, t_read).unwrap_or_else(|| self.raw(phys))
-            };
-            if op.reads() {
-                if op.ors() {
-                    *byte |= value;
-                } else {
-                    *byte = value;
-                }
-            }
-            if wr && phys < present {
-                if let Some(m) = self.mem.get_mut(phys as usize) {
-                    *m = incoming;
-                }
-            }
-        }
-
-        // SyncManager post-phase: completion on the last byte.
-        for n in 0..usize::from(self.config.sm_count) {
-            let Some(plan) = plans.get(n).copied() else { break };
-            if plan.involved && plan.touches_last {
-                if plan.read_ok {
-                    self.sm_read_done(n as u8, &plan);
-                }
-                if plan.write_ok {
-                    self.sm_write_done(n as u8, &plan);
-                }
-            }
-        }
 
         // Register side effects.
         let touches = |lo: u16, hi: u16| addr <= u32::from(hi) && u32::from(lo) < end;
+        // (the SM register blocks looked at one by one only when touched)
+        let sm_count = self.config.sm_count;
+        let sm_block = sm_count > 0 && touches(regs::SM_BASE, regs::sm(sm_count) - 1);
         match side {
             Side::Ecat if op.writes() => {
                 if touches(regs::AL_CONTROL, regs::AL_CONTROL + 1) {
                     self.set_al_event(al_event::AL_CONTROL);
                 }
-                for n in 0..self.config.sm_count {
+                for n in (0..sm_count).filter(|_| sm_block) {
                     let a = regs::sm(n) + 6;
                     if touches(a, a) {
                         let old = old_activate.get(usize::from(n)).copied().unwrap_or(0);
@@ -435,7 +374,7 @@ impl Esc {
                     if touches(regs::AL_CONTROL, regs::AL_CONTROL + 1) {
                         self.clear_al_event(al_event::AL_CONTROL);
                     }
-                    if (0..self.config.sm_count).any(|n| touches(regs::sm(n) + 6, regs::sm(n) + 6)) {
+                    if sm_block && (0..sm_count).any(|n| touches(regs::sm(n) + 6, regs::sm(n) + 6)) {
                         self.clear_al_event(al_event::SM_ACTIVATION);
                     }
                     if touches(regs::WATCHDOG_STATUS_PD, regs::WATCHDOG_STATUS_PD + 1) {
@@ -444,7 +383,7 @@ impl Esc {
                     self.dc_pdi_read(|r| touches(r, r));
                 }
                 if op.writes() {
-                    for n in 0..self.config.sm_count {
+                    for n in (0..sm_count).filter(|_| sm_block) {
                         let a = regs::sm(n) + 7;
                         if touches(a, a) {
                             let old = old_pdi_control.get(usize::from(n)).copied().unwrap_or(0);
@@ -461,6 +400,289 @@ impl Esc {
             Side::Ecat => {}
         }
         out
+    }
+
+    /// Where a byte of the DC system time is read at: the frame's arrival
+    /// for the master, the ESC's time for the PDI.
+    fn read_time(&self, side: Side) -> Nanos {
+        match side {
+            Side::Ecat => self.dc.ecat_time,
+            Side::Pdi => self.now,
+        }
+    }
+
+    /// The SyncManager phases of an access and its data phase, for an access
+    /// the SMs of `near_sms` (bit n: SM n) can concern: permission, buffer
+    /// selection and opening; each byte through its SM's buffer mapping;
+    /// completion on the last byte.
+    fn sm_phases(&mut self, side: Side, addr: u32, data: &mut [u8], op: Op, near_sms: u16) -> Outcome {
+        let end = addr.saturating_add(data.len() as u32);
+        // SyncManager pre-phase: permission, buffer selection, opening.
+        let mut plans = [sm::Plan::default(); MAX_SM];
+        let mut out = Outcome {
+            read: op.reads(),
+            written: op.writes(),
+        };
+        for n in 0..usize::from(self.config.sm_count) {
+            // the plans of the SMs apart from the access stay inactive
+            if near_sms & 1 << n == 0 {
+                continue;
+            }
+            let regs_n = self.sync_manager(n as u8);
+            let Some(plan) = plans.get_mut(n) else { break };
+            *plan = sm::Plan::new(&regs_n, side);
+            if !plan.active || !plan.overlaps(addr, end) {
+                continue;
+            }
+            plan.involved = true;
+            let Some(state) = self.sm.get_mut(n) else { break };
+            let full = regs_n.status & ::esc::sm::status::MAILBOX_FULL != 0;
+            plan.decide(state, op, full, addr, end);
+            if op.reads() && !plan.read_ok {
+                out.read = false;
+            }
+            if op.writes() && !plan.write_ok {
+                out.written = false;
+            }
+        }
+        for n in 0..usize::from(self.config.sm_count) {
+            let Some(plan) = plans.get(n).copied() else { break };
+            if plan.involved && (plan.read_ok || plan.write_ok) {
+                self.sm_open(n as u8, &plan);
+            }
+        }
+
+        // Data phase.
+        let t_read = self.read_time(side);
+        // the SMs whose areas (hidden buffers included) the access overlaps,
+        // in SM order: only these can classify one of its bytes
+        let mut near = [sm::Plan::default(); MAX_SM];
+        let mut k = 0;
+        for p in plans.iter().filter(|p| p.reaches(addr, end)) {
+            if let Some(slot) = near.get_mut(k) {
+                *slot = *p;
+                k += 1;
+            }
+        }
+        let near = near.get(..k).unwrap_or_default();
+        if near.is_empty() {
+            self.plain_data(side, addr, data, op, t_read);
+        } else {
+            self.sm_data(side, addr, data, op, t_read, near);
+        }
+
+        // SyncManager post-phase: completion on the last byte.
+        for n in 0..usize::from(self.config.sm_count) {
+            let Some(plan) = plans.get(n).copied() else { break };
+            if plan.involved && plan.touches_last {
+                if plan.read_ok {
+                    self.sm_read_done(n as u8, &plan);
+                }
+                if plan.write_ok {
+                    self.sm_write_done(n as u8, &plan);
+                }
+            }
+        }
+        out
+    }
+
+    /// The data phase byte by byte when SyncManager areas overlap the
+    /// access (`near`: their plans, in SM order): each byte through its SM's
+    /// buffer mapping, hidden, or plain memory ([`sm::classify`]).
+    pub(super) fn sm_data(
+        &mut self,
+        side: Side,
+        addr: u32,
+        data: &mut [u8],
+        op: Op,
+        t_read: Nanos,
+        near: &[sm::Plan],
+    ) {
+        if let [p] = near {
+            if self.buffer_data(side, addr, data, op, p) {
+                return;
+            }
+        }
+        self.sm_data_bytes(side, addr, data, op, t_read, near);
+    }
+
+    /// The data phase of an access that lies inside the buffer area of one
+    /// SM (`p`, the only one near it), as slices: what
+    /// [`Esc::sm_data_bytes`] does byte by byte there. `false` (nothing
+    /// done) for an access it does not cover: outside the area, the
+    /// buffer past the present memory, the DC system time among the bytes.
+    pub(super) fn buffer_data(
+        &mut self,
+        side: Side,
+        addr: u32,
+        data: &mut [u8],
+        op: Op,
+        p: &sm::Plan,
+    ) -> bool {
+        let end = addr.saturating_add(data.len() as u32);
+        let present = self.present_end();
+        let st = u32::from(regs::dc::SYSTEM_TIME);
+        let computed = self.config.dc_supported && addr < st + 8 && st < end;
+        let shift = u32::from(p.buffer) * p.len;
+        if !(p.active && p.start <= addr && end <= p.start + p.len) || computed || end + shift > present {
+            return false;
+        }
+        if !(p.read_ok || p.write_ok) {
+            // refused: the PDI reads zeros, nothing is written
+            if side == Side::Pdi && op.reads() {
+                data.fill(0);
+            }
+            return true;
+        }
+        let (lo, hi) = ((addr + shift) as usize, (end + shift) as usize);
+        let Some(m) = self.mem.get_mut(lo..hi) else {
+            return false;
+        };
+        let (rd, wr) = (p.read_ok, p.write_ok);
+        for (m, d) in m.iter_mut().zip(data.iter_mut()) {
+            let incoming = *d;
+            if op.reads() {
+                let value = if rd { *m } else { 0 };
+                if op.ors() {
+                    *d |= value;
+                } else {
+                    *d = value;
+                }
+            }
+            if wr {
+                *m = incoming;
+            }
+        }
+        true
+    }
+
+    /// [`Esc::sm_data`] byte by byte: each byte through [`sm::classify`].
+    pub(super) fn sm_data_bytes(
+        &mut self,
+        side: Side,
+        addr: u32,
+        data: &mut [u8],
+        op: Op,
+        t_read: Nanos,
+        near: &[sm::Plan],
+    ) {
+        let present = self.present_end();
+        for (i, byte) in data.iter_mut().enumerate() {
+            let a = addr + i as u32;
+            let incoming = *byte;
+            let (phys, rd, wr) = match sm::classify(near, a) {
+                sm::Where::Buffer(p) => {
+                    if !(p.read_ok || p.write_ok) {
+                        if side == Side::Pdi && op.reads() {
+                            *byte = 0;
+                        }
+                        continue;
+                    }
+                    (a + u32::from(p.buffer) * p.len, p.read_ok, p.write_ok)
+                }
+                sm::Where::Hidden => (a, false, false),
+                sm::Where::Plain => {
+                    // the EEPROM address and data registers are locked while busy
+                    let sii_locked = self.sii_pending.is_some() && (0x0504..=0x050F).contains(&a);
+                    (a, op.reads(), op.writes() && writable(side, a) && !sii_locked)
+                }
+            };
+            let value = if a >= present || !rd {
+                0
+            } else {
+                self.computed(a, t_read).unwrap_or_else(|| self.raw(phys))
+            };
+            if op.reads() {
+                if op.ors() {
+                    *byte |= value;
+                } else {
+                    *byte = value;
+                }
+            }
+            if wr && phys < present {
+                if let Some(m) = self.mem.get_mut(phys as usize) {
+                    *m = incoming;
+                }
+            }
+        }
+    }
+
+    /// The data phase of an access that no SyncManager area overlaps: every
+    /// byte is plain memory (what [`sm::classify`] says of it), read from
+    /// memory (the DC system time computed at `t_read`, absent memory 0) and
+    /// written where `side` may write it (not the EEPROM registers while a
+    /// command runs). Ranges in the process RAM and register reads without
+    /// the computed system time go as slices.
+    pub(super) fn plain_data(&mut self, side: Side, addr: u32, data: &mut [u8], op: Op, t_read: Nanos) {
+        let present = self.present_end();
+        let end = addr.saturating_add(data.len() as u32);
+        let st = u32::from(regs::dc::SYSTEM_TIME);
+        let computed = self.config.dc_supported && addr < st + 8 && st < end;
+        // every byte present and read from memory as it is
+        let reads_mem = end <= present && !computed;
+        // every byte writable from both sides (the process RAM)
+        let writes_all = addr >= RAM_START && end <= present;
+        let (lo, hi) = (addr as usize, end as usize);
+        // (the ranges are exactly as long as `data`: `end` is in memory)
+        match op {
+            Op::Read if reads_mem => {
+                if let Some(m) = self.mem.get(lo..hi) {
+                    for (d, m) in data.iter_mut().zip(m) {
+                        *d = *m;
+                    }
+                    return;
+                }
+            }
+            Op::ReadOr if reads_mem => {
+                if let Some(m) = self.mem.get(lo..hi) {
+                    for (d, m) in data.iter_mut().zip(m) {
+                        *d |= *m;
+                    }
+                    return;
+                }
+            }
+            Op::Write if writes_all => {
+                if let Some(m) = self.mem.get_mut(lo..hi) {
+                    for (m, d) in m.iter_mut().zip(data.iter()) {
+                        *m = *d;
+                    }
+                    return;
+                }
+            }
+            Op::ReadWrite if writes_all && reads_mem => {
+                if let Some(m) = self.mem.get_mut(lo..hi) {
+                    for (m, d) in m.iter_mut().zip(data.iter_mut()) {
+                        core::mem::swap(m, d);
+                    }
+                    return;
+                }
+            }
+            _ => {}
+        }
+        let sii_locked = self.sii_pending.is_some();
+        for (i, byte) in data.iter_mut().enumerate() {
+            let a = addr + i as u32;
+            let incoming = *byte;
+            if op.reads() {
+                let value = if a >= present {
+                    0
+                } else {
+                    self.computed(a, t_read).unwrap_or_else(|| self.raw(a))
+                };
+                if op.ors() {
+                    *byte |= value;
+                } else {
+                    *byte = value;
+                }
+            }
+            // the EEPROM address and data registers are locked while busy
+            let locked = sii_locked && (0x0504..=0x050F).contains(&a);
+            if op.writes() && a < present && writable(side, a) && !locked {
+                if let Some(m) = self.mem.get_mut(a as usize) {
+                    *m = incoming;
+                }
+            }
+        }
     }
 
     /// Byte `off` of every SM register block (used to see what a write changed).

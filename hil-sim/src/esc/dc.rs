@@ -126,6 +126,22 @@ impl LocalClock {
 
     /// Local time at simulation time `t` (rounded down), wrapping like a 64-bit counter.
     pub(super) fn local_at(&self, t: Nanos) -> u64 {
+        // whole ns since the anchor: ⌊(dt·(1e12 + rate) + frac) / 1e12⌋ =
+        // dt + ⌊(dt·rate + frac) / 1e12⌋, in 64 bits where it fits
+        let whole = i64::try_from(i128::from(t.as_ns()) - i128::from(self.anchor_now.as_ns()))
+            .ok()
+            .and_then(|dt| {
+                let fine = dt.checked_mul(self.rate_ppt)?.checked_add(self.anchor_frac)?;
+                dt.checked_add(fine.div_euclid(PPT as i64))
+            });
+        match whole {
+            Some(w) => self.anchor_local.wrapping_add(w as u64),
+            None => self.local_at_wide(t),
+        }
+    }
+
+    /// [`LocalClock::local_at`] in 128-bit arithmetic throughout.
+    pub(super) fn local_at_wide(&self, t: Nanos) -> u64 {
         let whole = self.elapsed_fine(t).div_euclid(PPT);
         self.anchor_local.wrapping_add(whole as u64)
     }
@@ -133,10 +149,56 @@ impl LocalClock {
     /// The earliest simulation time at which the local time reaches `local`
     /// (wrapping comparison), saturated at zero and [`Nanos::MAX`].
     pub(super) fn now_for_local(&self, local: u64) -> Nanos {
-        let dl = i128::from(local.wrapping_sub(self.anchor_local) as i64);
+        let dl = local.wrapping_sub(self.anchor_local) as i64;
+        // ⌈(dl·1e12 − frac) / den⌉ with den = 1e12 + rate (> 0) is
+        // dl + ⌈(−dl·rate − frac) / den⌉, in 64 bits where it fits
+        let den = PPT as i64 + self.rate_ppt;
+        let dt = Some(dl)
+            .filter(|_| den > 0)
+            .and_then(|dl| dl.checked_mul(self.rate_ppt))
+            .and_then(i64::checked_neg)
+            .and_then(|y| y.checked_sub(self.anchor_frac)?.checked_add(den - 1))
+            .and_then(|y| dl.checked_add(y.div_euclid(den)));
+        let dt = match dt {
+            Some(dt) => i128::from(dt),
+            None => self.first_now_wide(dl),
+        };
+        self.settle(local, clamp_u64(i128::from(self.anchor_now.as_ns()) + dt))
+    }
+
+    /// [`LocalClock::now_for_local`]'s estimate (simulation time since the
+    /// anchor) in 128-bit arithmetic throughout.
+    pub(super) fn first_now_wide(&self, dl: i64) -> i128 {
+        let dl = i128::from(dl);
         let den = PPT + i128::from(self.rate_ppt);
-        let dt = (dl * PPT - i128::from(self.anchor_frac) + den - 1).div_euclid(den);
-        let mut t = clamp_u64(i128::from(self.anchor_now.as_ns()) + dt);
+        (dl * PPT - i128::from(self.anchor_frac) + den - 1).div_euclid(den)
+    }
+
+    /// [`LocalClock::now_for_local`] in 128-bit arithmetic throughout (the
+    /// tests compare the two).
+    #[cfg(test)]
+    pub(super) fn now_for_local_wide(&self, local: u64) -> Nanos {
+        let dl = local.wrapping_sub(self.anchor_local) as i64;
+        let mut t = clamp_u64(i128::from(self.anchor_now.as_ns()) + self.first_now_wide(dl));
+        let reached = |c: &Self, t: u64| c.local_at_wide(Nanos::from_ns(t)).wrapping_sub(local) as i64 >= 0;
+        for _ in 0..4 {
+            if reached(self, t) {
+                break;
+            }
+            t = t.saturating_add(1);
+        }
+        for _ in 0..4 {
+            if t > 0 && reached(self, t - 1) {
+                t -= 1;
+            } else {
+                break;
+            }
+        }
+        Nanos::from_ns(t)
+    }
+
+    /// The earliest time at or near `t` at which the local time reaches `local`.
+    fn settle(&self, local: u64, mut t: u64) -> Nanos {
         let reached = |c: &Self, t: u64| c.local_at(Nanos::from_ns(t)).wrapping_sub(local) as i64 >= 0;
         for _ in 0..4 {
             if reached(self, t) {

@@ -129,6 +129,13 @@ impl Plan {
         self.start < end && addr < self.start + self.len
     }
 
+    /// The access `addr .. end` overlaps the area [`classify`] gives this SM
+    /// (an active SM's buffer, and a three-buffer SM's hidden buffers).
+    pub fn reaches(&self, addr: u32, end: u32) -> bool {
+        let span = if self.buffered { 3 * self.len } else { self.len };
+        self.active && self.start < end && addr < self.start + span
+    }
+
     fn last(&self) -> u32 {
         self.start + self.len - 1
     }

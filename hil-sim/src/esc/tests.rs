@@ -574,3 +574,110 @@ fn pdi_handle_and_direct_impl_agree() {
     assert_ne!(sm_status(&e, 1) & status::MAILBOX_FULL, 0);
     assert_eq!(rd(&mut e, 0x1200, 600, 0), (msg, 1));
 }
+
+/// The data phase of an access no SyncManager area overlaps
+/// (`Esc::plain_data`, slices where it can) does byte for byte what the
+/// general per-byte phase does with every byte plain (`Esc::sm_data` with no
+/// SM near): random accesses of every kind, from both sides, over the
+/// registers (the DC system time computed, the EEPROM registers locked while
+/// a command runs), the process RAM and beyond the present memory.
+#[test]
+fn plain_data_phase_is_the_per_byte_phase() {
+    let mut base = esc();
+    // a system time that is not zero and moves
+    base.set_clock(30_000, 123_456_789);
+    base.tick(Nanos::from_us(777));
+    for (i, m) in base.mem.iter_mut().enumerate() {
+        *m = (i as u8).wrapping_mul(37) ^ 0x5A;
+    }
+    let mut x = 0x9E37_79B9_7F4A_7C15u64;
+    let mut next = move || {
+        x ^= x << 13;
+        x ^= x >> 7;
+        x ^= x << 17;
+        x
+    };
+    let ops = [Op::Read, Op::ReadOr, Op::Write, Op::ReadWrite, Op::ReadOrWrite];
+    for round in 0..20_000 {
+        let r = next();
+        let addr = match r % 4 {
+            0 => 0x0900 + (r >> 8) as u32 % 0x40,
+            1 => 0x0500 + (r >> 8) as u32 % 0x20,
+            2 => (r >> 8) as u32 % 0x3100,
+            _ => 0x1000 + (r >> 8) as u32 % 0x2100,
+        };
+        let len = 1 + (next() % 40) as usize;
+        let op = ops[(next() % 5) as usize];
+        let side = if next() % 2 == 0 { Side::Ecat } else { Side::Pdi };
+        let mut e = base.clone();
+        e.sii_pending = (round % 3 == 0).then_some(SiiPending {
+            command: 0x0100,
+            done_at: Nanos::from_secs(1),
+        });
+        let t = Nanos::from_us(round);
+        let mut f = e.clone();
+        let data: Vec<u8> = (0..len).map(|_| next() as u8).collect();
+        let (mut a, mut b) = (data.clone(), data);
+        e.plain_data(side, addr, &mut a, op, t);
+        f.sm_data(side, addr, &mut b, op, t, &[]);
+        assert_eq!(a, b, "{op:?} {side:?} {addr:#06x} +{len}: data");
+        assert!(e.mem == f.mem, "{op:?} {side:?} {addr:#06x} +{len}: memory");
+    }
+}
+
+/// The data phase of an access inside one SyncManager's buffer area
+/// (`Esc::sm_data` with one SM near: slices) does byte for byte what the
+/// per-byte phase does (`Esc::sm_data_bytes`): random SMs (mailbox and
+/// three-buffer, reader and writer side, refused, buffers 0..2, areas over
+/// the registers, the RAM and its end) and random accesses in and around them.
+#[test]
+fn buffer_data_phase_is_the_per_byte_phase() {
+    let mut base = esc();
+    base.set_clock(-20_000, 987_654_321);
+    base.tick(Nanos::from_us(1234));
+    for (i, m) in base.mem.iter_mut().enumerate() {
+        *m = (i as u8).wrapping_mul(91) ^ 0xA5;
+    }
+    let mut x = 0x1234_5678_9ABC_DEF1u64;
+    let mut next = move || {
+        x ^= x << 13;
+        x ^= x >> 7;
+        x ^= x << 17;
+        x
+    };
+    let ops = [Op::Read, Op::ReadOr, Op::Write, Op::ReadWrite, Op::ReadOrWrite];
+    for _ in 0..20_000 {
+        let start = match next() % 3 {
+            0 => 0x0900 + (next() % 0x20) as u32,
+            1 => 0x1000 + (next() % 0x2000) as u32,
+            _ => 0x2F00 + (next() % 0x100) as u32,
+        };
+        let len = 1 + (next() % 64) as u32;
+        let reader = next() % 2 == 0;
+        let ok = next() % 4 != 0;
+        let p = sm::Plan {
+            active: true,
+            buffered: next() % 2 == 0,
+            start,
+            len,
+            side: if next() % 2 == 0 { Side::Ecat } else { Side::Pdi },
+            reader,
+            involved: true,
+            read_ok: ok && reader,
+            write_ok: ok && !reader,
+            buffer: (next() % 3) as u8,
+            ..sm::Plan::default()
+        };
+        let addr = start + (next() % u64::from(len + 4)) as u32 - (next() % 3) as u32;
+        let n = 1 + (next() % 70) as usize;
+        let op = ops[(next() % 5) as usize];
+        let (mut e, mut f) = (base.clone(), base.clone());
+        let data: Vec<u8> = (0..n).map(|_| next() as u8).collect();
+        let (mut a, mut b) = (data.clone(), data);
+        let t = Nanos::from_us(next() % 10_000);
+        e.sm_data(p.side, addr, &mut a, op, t, &[p]);
+        f.sm_data_bytes(p.side, addr, &mut b, op, t, &[p]);
+        assert_eq!(a, b, "{op:?} {p:?} at {addr:#06x} +{n}: data");
+        assert!(e.mem == f.mem, "{op:?} {p:?} at {addr:#06x} +{n}: memory");
+    }
+}

@@ -51,6 +51,7 @@ impl Simulation<SimDrive> {
             frames: self.frames,
             pcap: None,
             jitter: self.jitter,
+            next_events: Vec::new(),
         })
     }
 }

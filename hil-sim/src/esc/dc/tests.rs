@@ -530,3 +530,52 @@ fn start_time_in_the_past_starts_at_the_next_cycle_boundary() {
     start_sync(&mut e, 100_000, 300_000, 0, 0x03, 1_000_001);
     assert_eq!(e.next_sync0_at(), Some(Nanos::from_ns(1_300_000)));
 }
+
+/// The local clock's 64-bit fast paths give what the 128-bit arithmetic
+/// gives: random speeds (drift and correction at their limits and small),
+/// fractions left by re-anchoring, times before and long after the anchor.
+#[test]
+fn local_clock_64_bit_paths_equal_the_128_bit_arithmetic() {
+    let mut x = 0x2545_F491_4F6C_DD1Du64;
+    let mut next = move || {
+        x ^= x << 13;
+        x ^= x >> 7;
+        x ^= x << 17;
+        x
+    };
+    let limit = i64::from(MAX_DRIFT_PPB) * 1000 + MAX_CORRECTION_PPT;
+    for round in 0..2_000u64 {
+        let rate = |r: u64| match r % 4 {
+            0 => 0,
+            1 => (r >> 8) as i64 % 100_000_000 - 50_000_000,
+            _ => (r >> 8) as i64 % (2 * limit + 1) - limit,
+        };
+        let mut c = LocalClock::new(next(), rate(next()));
+        let mut t = next() % 1_000_000_000_000;
+        for _ in 0..(round % 5) {
+            t += next() % 10_000_000_000;
+            c.set_rate(Nanos::from_ns(t), rate(next()));
+        }
+        for _ in 0..20 {
+            let r = next();
+            let probe = match r % 4 {
+                0 => t.saturating_sub(r >> 40),
+                1 => t + (r >> 40),
+                2 => t + (r >> 16),
+                _ => r,
+            };
+            let p = Nanos::from_ns(probe);
+            assert_eq!(c.local_at(p), c.local_at_wide(p), "{c:?} at {probe}");
+            let local = match next() % 3 {
+                0 => c.local_at(p),
+                1 => c.local_at(p).wrapping_add(next() >> 20),
+                _ => next(),
+            };
+            assert_eq!(
+                c.now_for_local(local),
+                c.now_for_local_wide(local),
+                "{c:?} reaching {local}"
+            );
+        }
+    }
+}

@@ -1,0 +1,45 @@
+//! The simulated drives' non-volatile memories: the parameter store's
+//! flash and the firmware slots' flash (copy on write, so a copy of a line
+//! shares it).
+
+/// The simulated non-volatile memory of a drive: two 4 KiB sectors (one per slot).
+pub type SimFlash = store::RamFlash<4096, 2>;
+
+/// The simulated firmware flash: 2 × 66 sectors of 4 KiB (a slot takes a
+/// 256 KiB image), NOR in RAM, on the heap. Copy on write: a clone (a copy
+/// of a line, [`Simulation::try_clone`](super::Simulation::try_clone)) shares the 528 KiB until one of
+/// them erases or writes, so a snapshot costs what it changes.
+#[derive(Clone)]
+pub struct FirmwareFlash(pub std::sync::Arc<drive::boot::RamFlash<4096, 132>>);
+
+impl FirmwareFlash {
+    /// An erased flash.
+    pub fn new() -> Self {
+        Self(std::sync::Arc::new(drive::boot::RamFlash::new()))
+    }
+}
+
+impl Default for FirmwareFlash {
+    fn default() -> Self {
+        Self::new()
+    }
+}
+
+impl drive::boot::Flash for FirmwareFlash {
+    const SECTOR: usize = 4096;
+    const SECTORS: usize = 132;
+    const WRITE: usize = 8;
+    fn read(&mut self, addr: u32, buf: &mut [u8]) -> Result<(), drive::boot::FlashError> {
+        // a read changes nothing: only erase and write copy a shared flash
+        self.0.read_shared(addr, buf)
+    }
+    fn erase(&mut self, sector: u32) -> Result<(), drive::boot::FlashError> {
+        drive::boot::Flash::erase(std::sync::Arc::make_mut(&mut self.0), sector)
+    }
+    fn write(&mut self, addr: u32, data: &[u8]) -> Result<(), drive::boot::FlashError> {
+        drive::boot::Flash::write(std::sync::Arc::make_mut(&mut self.0), addr, data)
+    }
+}
+
+/// The firmware slots of a simulated drive.
+pub type FirmwareSlots = drive::boot::BootSlots<FirmwareFlash>;
