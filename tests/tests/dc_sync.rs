@@ -415,6 +415,34 @@ const ERR_ACK: u16 = 0x10;
 /// Runs `n` `tx_rx_dc` cycles, the clock advanced as ethercrab computes it;
 /// calls `probe` after each with the cycle number, whether the group is in
 /// OP, and the simulation.
+/// The line with DC SYNC0 at [`SYNC0_NS`] on every drive and Op requested
+/// (ethercrab's init, Pre-Op with PDI, the DC configuration).
+async fn dc_requested_op<'a>(
+    md: &'a MainDevice<'a>,
+    clock: &'a AtomicU64,
+) -> SubDeviceGroup<
+    8,
+    512,
+    ethercrab::DefaultLock,
+    ethercrab::subdevice_group::Op,
+    ethercrab::subdevice_group::HasDc,
+> {
+    let mut group = init(md, clock).await;
+    for mut sd in group.iter_mut(md) {
+        sd.set_dc_sync(DcSync::Sync0);
+    }
+    group
+        .into_pre_op_pdi(md)
+        .await
+        .expect("PRE-OP with PDI")
+        .configure_dc_sync(md, dc_config(SYNC0_NS))
+        .await
+        .expect("DC configuration")
+        .request_into_op(md)
+        .await
+        .expect("request OP")
+}
+
 async fn dc_cycles<'a>(
     md: &'a MainDevice<'a>,
     group: &SubDeviceGroup<
@@ -451,20 +479,7 @@ fn e046_e131_e129_e038_dc_op_waits_for_pll_lock_and_sync0_loss_drops_to_safeop()
     use esc::AlStatusCode;
     let sim = line();
     let seen = with_master(&sim, async |md, clock| {
-        let mut group = init(md, clock).await;
-        for mut sd in group.iter_mut(md) {
-            sd.set_dc_sync(DcSync::Sync0);
-        }
-        let group = group
-            .into_pre_op_pdi(md)
-            .await
-            .expect("PRE-OP with PDI")
-            .configure_dc_sync(md, dc_config(SYNC0_NS))
-            .await
-            .expect("DC configuration")
-            .request_into_op(md)
-            .await
-            .expect("request OP");
+        let group = dc_requested_op(md, clock).await;
 
         // S→O waits for the lock: Safe-Op without error, 002Dh then 0032h
         let mut waiting = Vec::new();
@@ -1164,20 +1179,7 @@ fn e046_a_sync0_stop_below_safe_op_does_not_refuse_the_next_op() {
     use drive_tests::{al_status, request};
     let sim = line();
     let first_op = with_master(&sim, async |md, clock| {
-        let mut group = init(md, clock).await;
-        for mut sd in group.iter_mut(md) {
-            sd.set_dc_sync(DcSync::Sync0);
-        }
-        let group = group
-            .into_pre_op_pdi(md)
-            .await
-            .expect("PRE-OP with PDI")
-            .configure_dc_sync(md, dc_config(SYNC0_NS))
-            .await
-            .expect("DC configuration")
-            .request_into_op(md)
-            .await
-            .expect("request OP");
+        let group = dc_requested_op(md, clock).await;
         let mut op = false;
         dc_cycles(md, &group, &sim, 300, |_, all_op, _| op |= all_op).await;
         // the master stops as SOEM's samples do: Init, SYNC0 left running
@@ -1212,20 +1214,7 @@ fn e046_a_sync0_stop_below_safe_op_does_not_refuse_the_next_op() {
     assert!(first_op, "the first master reached Op");
     // a new master: its start-up, DC, Op
     let (op, status) = with_master(&sim, async |md, clock| {
-        let mut group = init(md, clock).await;
-        for mut sd in group.iter_mut(md) {
-            sd.set_dc_sync(DcSync::Sync0);
-        }
-        let group = group
-            .into_pre_op_pdi(md)
-            .await
-            .expect("PRE-OP with PDI")
-            .configure_dc_sync(md, dc_config(SYNC0_NS))
-            .await
-            .expect("DC configuration")
-            .request_into_op(md)
-            .await
-            .expect("request OP");
+        let group = dc_requested_op(md, clock).await;
         let mut op = false;
         dc_cycles(md, &group, &sim, 300, |_, all_op, _| op |= all_op).await;
         let sd = group.subdevice(md, 0).expect("drive");
