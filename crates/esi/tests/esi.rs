@@ -625,7 +625,11 @@ fn e005_e084_e150_the_single_axis_esi_has_no_axis_b() {
                 }
                 assert_eq!(
                     defaults(profile, 0xF050),
-                    [2, u64::from(drive::module_ident(drive::PdoLayout::Standard)), 0]
+                    [
+                        2,
+                        u64::from(drive::module_ident(drive::PdoLayout::Standard, 0)),
+                        0
+                    ]
                 );
                 let name = children(child(object(profile, 0x1008), "Info"), "DefaultString").next();
                 assert_eq!(name.and_then(|n| n.text()), Some("SI6"));
