@@ -124,6 +124,15 @@ impl PdoLayout {
             (PdoLayout::Vl, _) => (&VL_RX_B, &VL_TX_B),
         }
     }
+
+    /// The layout's name (the ESI module names, E-149).
+    pub const fn name(self) -> &'static str {
+        match self {
+            PdoLayout::Standard => "Standard",
+            PdoLayout::Ip => "Interpolated position (ip)",
+            PdoLayout::Vl => "Velocity mode (vl)",
+        }
+    }
 }
 
 /// The same entries for axis B: CiA 402 objects +800h, manufacturer +8000h.
