@@ -176,22 +176,26 @@ fn e053_four_channels_per_direction_in_op_at_once() {
 }
 
 /// E-148: F050h (sub 0 = 2) reports the module ident of the PDO
-/// configuration each axis's channel carries: the system module of the
-/// standard layout on both axes by default, the ip module after a master
-/// puts the ip maps into channel 1, a user module (bit 31, the same ident
-/// for the same configuration) for any other mapping, 0 for an empty
-/// channel. The master cannot write it (0601 0002h).
+/// configuration each axis's channel carries, the ident of the ESI module
+/// that describes it (E-149): the system module of the standard layout on
+/// both axes by default, axis B's with its own ident, the ip module after a
+/// master puts the ip maps into channel 1 (and axis B's ip module after it
+/// puts axis B's into channel 2), a user module (bit 31, the same ident for
+/// the same configuration) for any other mapping, 0 for an empty channel.
+/// The master cannot write it (0601 0002h).
 #[test]
 fn e148_f050_reports_the_module_ident_per_axis() {
     let sim = line(1);
     with_master(&sim, async |md, clock| {
         let group = init(md, clock).await;
         let sd = group.subdevice(md, 0).unwrap();
-        let standard = drive::module_ident(drive::PdoLayout::Standard);
-        let ip = drive::module_ident(drive::PdoLayout::Ip);
+        let standard = drive::module_ident(drive::PdoLayout::Standard, 0);
+        let standard_b = drive::module_ident(drive::PdoLayout::Standard, 1);
+        let ip = drive::module_ident(drive::PdoLayout::Ip, 0);
+        assert_ne!(standard, standard_b, "axis B's modules have their own idents");
         assert_eq!(sd.sdo_read::<u8>(0xF050, 0).await.unwrap(), 2);
         assert_eq!(sd.sdo_read::<u32>(0xF050, 1).await.unwrap(), standard, "axis A");
-        assert_eq!(sd.sdo_read::<u32>(0xF050, 2).await.unwrap(), standard, "axis B");
+        assert_eq!(sd.sdo_read::<u32>(0xF050, 2).await.unwrap(), standard_b, "axis B");
         let remap = async |pdo: u16, entries: &[u32]| {
             sd.sdo_write(pdo, 0, 0u8).await.unwrap();
             for (s, e) in (1u8..).zip(entries) {
@@ -208,8 +212,24 @@ fn e148_f050_reports_the_module_ident_per_axis() {
         assert_eq!(sd.sdo_read::<u32>(0xF050, 1).await.unwrap(), ip, "axis A in ip");
         assert_eq!(
             sd.sdo_read::<u32>(0xF050, 2).await.unwrap(),
-            standard,
+            standard_b,
             "axis B unchanged"
+        );
+        // axis B's ip layout (objects at +800h) in channel 2
+        let (rx_b, tx_b) = drive::PdoLayout::Ip.axis_entries(1);
+        let rx_b: Vec<u32> = rx_b.iter().map(|e| e.mapping_value()).collect();
+        let tx_b: Vec<u32> = tx_b.iter().map(|e| e.mapping_value()).collect();
+        remap(0x1601, &rx_b).await;
+        remap(0x1A01, &tx_b).await;
+        assert_eq!(
+            sd.sdo_read::<u32>(0xF050, 2).await.unwrap(),
+            drive::module_ident(drive::PdoLayout::Ip, 1),
+            "axis B in ip"
+        );
+        assert_eq!(
+            sd.sdo_read::<u32>(0xF050, 1).await.unwrap(),
+            ip,
+            "axis A unchanged"
         );
         // a user configuration
         remap(0x1A00, &[m(0x6041, 0, 16), m(0x606C, 0, 32)]).await;

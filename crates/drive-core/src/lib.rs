@@ -42,7 +42,7 @@ pub use dictionary::{
     revision, DriveObjects, ImageError, LiveValues, NoLive, Prepared, Requests, Slot, Template, WithLive,
     LOAD_SIGNATURE, PERSISTENT_IMAGE_BYTES, SAVE_SIGNATURE,
 };
-pub use pdo_maps::{module_ident, PdoLayout, IP_RX, IP_TX, USER_MODULE, VL_RX, VL_TX};
+pub use pdo_maps::{module_ident, PdoLayout, AXIS_B_MODULE, IP_RX, IP_TX, USER_MODULE, VL_RX, VL_TX};
 pub use variant::Variant;
 
 /// STOBER's EtherCAT vendor ID (E-005).

@@ -79,15 +79,28 @@ pub const VL_TX: [PdoEntry; 3] = [
 /// of the mapping, [`DriveObjects::module_ident`](crate::DriveObjects::module_ident)).
 pub const USER_MODULE: u32 = 0x8000_0000;
 
-/// The ident of the ESI module of `layout` (E-148, E-149): CiA 402's profile
-/// number 0192h in the high word, the layout's number (1…) in the low word.
-pub const fn module_ident(layout: PdoLayout) -> u32 {
-    0x0192_0000
-        | match layout {
-            PdoLayout::Standard => 1,
-            PdoLayout::Ip => 2,
-            PdoLayout::Vl => 3,
-        }
+/// The bit that sets an axis-B module's ident apart from axis A's module of
+/// the same layout ([`module_ident`]).
+pub const AXIS_B_MODULE: u32 = 0x0000_0100;
+
+/// The ident of the ESI module of `layout` on `axis` (0 = A, any other = B;
+/// E-148, E-149): CiA 402's profile number 0192h in the high word, the axis
+/// in bits 8…15 ([`AXIS_B_MODULE`] for axis B), the layout's number (1…) in
+/// bits 0…7; bit 31 clear (set: a user module, [`USER_MODULE`]).
+///
+/// | layout | axis A | axis B |
+/// |---|---|---|
+/// | standard | 0192_0001h | 0192_0101h |
+/// | ip | 0192_0002h | 0192_0102h |
+/// | vl | 0192_0003h | 0192_0103h |
+pub const fn module_ident(layout: PdoLayout, axis: u16) -> u32 {
+    let number = match layout {
+        PdoLayout::Standard => 1,
+        PdoLayout::Ip => 2,
+        PdoLayout::Vl => 3,
+    };
+    let axis_bit = if axis == 0 { 0 } else { AXIS_B_MODULE };
+    0x0192_0000 | axis_bit | number
 }
 
 impl PdoLayout {
@@ -96,10 +109,28 @@ impl PdoLayout {
 
     /// The RxPDO and TxPDO entries of axis A.
     pub const fn entries(self) -> (&'static [PdoEntry], &'static [PdoEntry]) {
+        self.axis_entries(0)
+    }
+
+    /// The RxPDO and TxPDO entries of the layout on `axis` (0 = A, any other
+    /// = B: the CiA 402 objects at +800h, the manufacturer ones at +8000h).
+    pub const fn axis_entries(self, axis: u16) -> (&'static [PdoEntry], &'static [PdoEntry]) {
+        match (self, axis) {
+            (PdoLayout::Standard, 0) => (&RX_A, &TX_A),
+            (PdoLayout::Ip, 0) => (&IP_RX, &IP_TX),
+            (PdoLayout::Vl, 0) => (&VL_RX, &VL_TX),
+            (PdoLayout::Standard, _) => (&RX_B, &TX_B),
+            (PdoLayout::Ip, _) => (&IP_RX_B, &IP_TX_B),
+            (PdoLayout::Vl, _) => (&VL_RX_B, &VL_TX_B),
+        }
+    }
+
+    /// The layout's name (the ESI module names, E-149).
+    pub const fn name(self) -> &'static str {
         match self {
-            PdoLayout::Standard => (&RX_A, &TX_A),
-            PdoLayout::Ip => (&IP_RX, &IP_TX),
-            PdoLayout::Vl => (&VL_RX, &VL_TX),
+            PdoLayout::Standard => "Standard",
+            PdoLayout::Ip => "Interpolated position (ip)",
+            PdoLayout::Vl => "Velocity mode (vl)",
         }
     }
 }
@@ -126,3 +157,11 @@ const fn axis_b<const N: usize>(a: [PdoEntry; N]) -> [PdoEntry; N] {
 pub const RX_B: [PdoEntry; 8] = axis_b(RX_A);
 /// Axis-B TxPDO entries: the default of 1A01h.
 pub const TX_B: [PdoEntry; 10] = axis_b(TX_A);
+/// Axis-B ip RxPDO entries.
+pub const IP_RX_B: [PdoEntry; 3] = axis_b(IP_RX);
+/// Axis-B ip TxPDO entries.
+pub const IP_TX_B: [PdoEntry; 3] = axis_b(IP_TX);
+/// Axis-B vl RxPDO entries.
+pub const VL_RX_B: [PdoEntry; 3] = axis_b(VL_RX);
+/// Axis-B vl TxPDO entries.
+pub const VL_TX_B: [PdoEntry; 3] = axis_b(VL_TX);

@@ -179,7 +179,7 @@ fn e051_e054_e148_channel_1_is_axis_a_and_channel_2_is_free_and_empty() {
         assert_eq!(rd(&mut d, 0xF050, 0).unwrap(), [2]);
         assert_eq!(
             rd_u(&mut d, 0xF050, 1),
-            u64::from(module_ident(PdoLayout::Standard))
+            u64::from(module_ident(PdoLayout::Standard, 0))
         );
         assert_eq!(rd_u(&mut d, 0xF050, 2), 0);
         // what SDO Info reports as defaults
@@ -284,4 +284,72 @@ fn the_double_axis_dictionary_is_the_default() {
     assert_eq!(DriveObjects::new(), DriveObjects::for_variant(Variant::Double));
     assert_eq!(Variant::default(), Variant::Double);
     assert_ne!(single(), DriveObjects::new());
+}
+
+/// E-148 (and the ESI modules of E-149): every layout on every axis the
+/// device has is reported in F050h with that axis's own ident (axis B's
+/// with [`AXIS_B_MODULE`]), the other axis unchanged; axis A's layout in
+/// channel 2 is a user module there, not axis A's module; the single-axis
+/// device refuses axis B's maps and keeps F050h:02 = 0.
+#[test]
+fn e148_every_layout_on_every_axis_has_its_own_module_ident() {
+    let mut seen = Vec::new();
+    for axis in 0..2u16 {
+        for layout in PdoLayout::ALL {
+            let mut d = DriveObjects::new();
+            let other = d.module_ident(1 - axis);
+            d.apply_axis_map(axis, layout).unwrap();
+            let ident = module_ident(layout, axis);
+            assert_eq!(d.module_ident(axis), ident, "{layout:?} on axis {axis}");
+            assert_eq!(rd_u(&mut d, 0xF050, axis as u8 + 1), u64::from(ident));
+            assert_eq!(d.module_ident(1 - axis), other, "the other axis unchanged");
+            assert_eq!(ident & USER_MODULE, 0, "a system module");
+            assert_eq!(ident & AXIS_B_MODULE != 0, axis == 1);
+            assert_eq!(ident & !AXIS_B_MODULE, module_ident(layout, 0));
+            seen.push(ident);
+        }
+    }
+    seen.sort_unstable();
+    seen.dedup();
+    assert_eq!(seen.len(), 6, "six distinct system modules");
+    // the defaults: the standard layout on both axes, each with its ident
+    let mut d = DriveObjects::new();
+    assert_eq!(
+        rd_u(&mut d, 0xF050, 1),
+        u64::from(module_ident(PdoLayout::Standard, 0))
+    );
+    assert_eq!(
+        rd_u(&mut d, 0xF050, 2),
+        u64::from(module_ident(PdoLayout::Standard, 1))
+    );
+    let declared = d.object(0xF050).unwrap();
+    assert_eq!(
+        declared.entry(2).unwrap().default,
+        i64::from(module_ident(PdoLayout::Standard, 1))
+    );
+    // axis A's objects in channel 2: a user module of axis B
+    let (rx, tx) = PdoLayout::Ip.entries();
+    for (pdo, entries) in [(0x1601u16, rx), (0x1A01, tx)] {
+        d.write(pdo, 0, &[0], PREOP).unwrap();
+        for (sub, e) in (1u8..).zip(entries) {
+            d.write(pdo, sub, &e.mapping_value().to_le_bytes(), PREOP)
+                .unwrap();
+        }
+        d.write(pdo, 0, &[entries.len() as u8], PREOP).unwrap();
+    }
+    let user = d.module_ident(1);
+    assert_eq!(user & USER_MODULE, USER_MODULE, "{user:08X}h");
+    assert_eq!(rd_u(&mut d, 0xF050, 2), u64::from(user));
+    // the single-axis device has no axis-B module
+    let mut one = single();
+    assert_eq!(
+        one.apply_axis_map(1, PdoLayout::Standard),
+        Err(SdoAbort::NOT_MAPPABLE)
+    );
+    assert_eq!(rd_u(&mut one, 0xF050, 2), 0);
+    one.apply_axis_map(0, PdoLayout::Vl).unwrap();
+    assert_eq!(
+        rd_u(&mut one, 0xF050, 1),
+        u64::from(module_ident(PdoLayout::Vl, 0))
+    );
 }

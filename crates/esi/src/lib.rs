@@ -14,15 +14,24 @@
 //! are kept equal to [`files`] by the test `esi_files_are_current`
 //! (`UPDATE_ESI=1 cargo test -p esi` rewrites them; `cargo run -p esi` too).
 //!
+//! Each ESI is modular (E-149): one slot per axis ([`slots`]), each allowing
+//! the system modules of that axis, one per application layout
+//! ([`drive::PdoLayout::ALL`], the standard layout the default), with their
+//! own PDO indexes and entries ([`Module`]) and the idents F050h reports
+//! ([`drive::module_ident`], E-148). The device-level PDOs stay the default
+//! configuration the SII carries, marked `OverwrittenByModule` where a
+//! slot's module describes the same PDO (docs/esi.md).
+//!
 //! A host tool: it uses `std` (`String`, `BTreeMap`).
 
 use std::collections::BTreeMap;
 use std::fmt::Write;
 
-use drive::{revision, DriveObjects, Template, Variant};
-use ecat::desc::{coe_details, DcOpMode, Device, Pdo};
+use drive::{revision, DriveObjects, PdoLayout, Template, Variant};
+use ecat::desc::{coe_details, DcOpMode, Device};
 use ecat::sii::EEPROM_BYTES;
 use esc::sii::{mailbox_protocol, word};
+use od::PdoEntry;
 use od::{Access, DataType, Dictionary, EntryInfo, ObjectCode, ObjectInfo};
 
 /// Vendor name of vendor ID B9h (spec §18).
@@ -84,6 +93,65 @@ pub fn dictionary(variant: Variant, template: Template) -> DriveObjects {
     let mut d = DriveObjects::for_variant(variant);
     d.set_template(template);
     d
+}
+
+/// A system module of the ESI (E-149): one application layout on one axis,
+/// its PDOs in the axis's channel (1600h/1A00h + axis) with the layout's
+/// entries on that axis (axis B's objects at +800h/+8000h), so each slot's
+/// modules carry their own indexes rather than one `SlotIndexIncrement`.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub struct Module {
+    /// The axis (0 = A, 1 = B): the slot the module goes in.
+    pub axis: u16,
+    /// The layout.
+    pub layout: PdoLayout,
+}
+
+impl Module {
+    /// The ident (`Type@ModuleIdent`), as F050h reports it for this axis
+    /// when its channel carries the layout (E-148).
+    pub const fn ident(&self) -> u32 {
+        drive::module_ident(self.layout, self.axis)
+    }
+
+    /// The RxPDO (channel 1 + axis) and TxPDO indexes.
+    pub const fn pdo_indexes(&self) -> (u16, u16) {
+        (0x1600 + self.axis, 0x1A00 + self.axis)
+    }
+
+    /// The RxPDO and TxPDO entries.
+    pub const fn entries(&self) -> (&'static [PdoEntry], &'static [PdoEntry]) {
+        self.layout.axis_entries(self.axis)
+    }
+
+    /// Is this the default module of its slot (the standard layout, what the
+    /// channel carries by default)?
+    pub fn is_default(&self) -> bool {
+        self.layout == PdoLayout::Standard
+    }
+}
+
+/// The axis's letter.
+pub const fn axis_letter(axis: u16) -> char {
+    if axis == 0 {
+        'A'
+    } else {
+        'B'
+    }
+}
+
+/// The slots of `variant`: one per axis (axis A; and axis B on the
+/// double-axis device), each with the modules it allows (every layout on
+/// that axis, [`PdoLayout::ALL`] order, the standard layout first).
+pub fn slots(variant: Variant) -> Vec<Vec<Module>> {
+    (0..variant.axes() as u16)
+        .map(|axis| {
+            PdoLayout::ALL
+                .iter()
+                .map(|&layout| Module { axis, layout })
+                .collect()
+        })
+        .collect()
 }
 
 /// Every generated file: (file name, contents), per device and template.
@@ -148,14 +216,27 @@ pub fn generate(variant: Variant, template: Template) -> Result<String, Error> {
     x.close("Group");
     x.close("Groups");
     x.open("Devices", &[]);
-    device_element(&mut x, &dev, template, &image, &od);
+    let slots = slots(variant);
+    device_element(&mut x, &dev, template, &image, &od, &slots);
     x.close("Devices");
+    x.open("Modules", &[]);
+    for m in slots.iter().flatten() {
+        module_element(&mut x, &dev, m);
+    }
+    x.close("Modules");
     x.close("Descriptions");
     x.close("EtherCATInfo");
     Ok(x.out)
 }
 
-fn device_element(x: &mut Xml, dev: &Device, template: Template, image: &[u8], od: &DriveObjects) {
+fn device_element(
+    x: &mut Xml,
+    dev: &Device,
+    template: Template,
+    image: &[u8],
+    od: &DriveObjects,
+    slots: &[Vec<Module>],
+) {
     let physics = "Y".repeat(usize::from(dev.ports));
     x.open("Device", &[("Physics", &physics)]);
     x.leaf(
@@ -227,11 +308,25 @@ fn device_element(x: &mut Xml, dev: &Device, template: Template, image: &[u8], o
             kind,
         );
     }
-    for pdo in dev.rx_pdos {
-        pdo_element(x, "RxPdo", pdo, dev, dev.rx_assign, 2);
-    }
-    for pdo in dev.tx_pdos {
-        pdo_element(x, "TxPdo", pdo, dev, dev.tx_assign, 3);
+    // the default configuration (the SII's PDOs); a slot's module with the
+    // same index replaces the PDO for a master that configures modules
+    let in_module = |index: u16| {
+        slots.iter().flatten().any(|m| {
+            let (rx, tx) = m.pdo_indexes();
+            index == rx || index == tx
+        })
+    };
+    for (tag, pdos, assign, sm) in [
+        ("RxPdo", dev.rx_pdos, dev.rx_assign, 2),
+        ("TxPdo", dev.tx_pdos, dev.tx_assign, 3),
+    ] {
+        for pdo in pdos {
+            let mut attrs = pdo_attrs(dev, assign.contains(&pdo.index), sm);
+            if in_module(pdo.index) {
+                attrs.push(("OverwrittenByModule", "1".into()));
+            }
+            pdo_element(x, tag, &attrs, pdo.index, pdo.name, pdo.entries);
+        }
     }
 
     let flag = |b: bool| if b { "1" } else { "0" };
@@ -284,6 +379,26 @@ fn device_element(x: &mut Xml, dev: &Device, template: Template, image: &[u8], o
         x.close("Dc");
     }
 
+    // one slot per axis, its modules by ident, the standard layout the default
+    x.open("Slots", &[]);
+    for (axis, modules) in slots.iter().enumerate() {
+        x.open("Slot", &[("MinInstances", "1"), ("MaxInstances", "1")]);
+        x.leaf(
+            "Name",
+            &[("LcId", "1033")],
+            &format!("Axis {}", axis_letter(axis as u16)),
+        );
+        for m in modules {
+            if m.is_default() {
+                x.leaf("ModuleIdent", &[("Default", "1")], &hex32(m.ident()));
+            } else {
+                x.leaf("ModuleIdent", &[], &hex32(m.ident()));
+            }
+        }
+        x.close("Slot");
+    }
+    x.close("Slots");
+
     x.open("Eeprom", &[]);
     x.leaf("ByteSize", &[], &EEPROM_BYTES.to_string());
     x.leaf(
@@ -310,23 +425,36 @@ pub fn dc_modes(dev: &Device) -> Vec<&'static DcOpMode> {
     sync0.chain(other).collect()
 }
 
-fn pdo_element(x: &mut Xml, tag: &str, pdo: &Pdo, dev: &Device, assigned: &[u16], sm: u8) {
-    let sm_text = sm.to_string();
-    let mut attrs: Vec<(&str, &str)> = Vec::new();
+/// The attributes of a PDO: `Fixed` only without PDO configuration,
+/// `Mandatory` for an assigned PDO only without PDO assignment, `Sm` when
+/// assigned.
+fn pdo_attrs(dev: &Device, assigned: bool, sm: u8) -> Vec<(&'static str, String)> {
+    let mut attrs = Vec::new();
     if dev.coe_details & coe_details::PDO_CONFIG == 0 {
-        attrs.push(("Fixed", "1"));
+        attrs.push(("Fixed", "1".into()));
     }
-    let is_assigned = assigned.contains(&pdo.index);
-    if is_assigned && dev.coe_details & coe_details::PDO_ASSIGN == 0 {
-        attrs.push(("Mandatory", "1"));
+    if assigned && dev.coe_details & coe_details::PDO_ASSIGN == 0 {
+        attrs.push(("Mandatory", "1".into()));
     }
-    if is_assigned {
-        attrs.push(("Sm", &sm_text));
+    if assigned {
+        attrs.push(("Sm", sm.to_string()));
     }
+    attrs
+}
+
+fn pdo_element(
+    x: &mut Xml,
+    tag: &str,
+    attrs: &[(&str, String)],
+    index: u16,
+    name: &str,
+    entries: &[PdoEntry],
+) {
+    let attrs: Vec<(&str, &str)> = attrs.iter().map(|(k, v)| (*k, v.as_str())).collect();
     x.open(tag, &attrs);
-    x.leaf("Index", &[], &hex16(pdo.index));
-    x.leaf("Name", &[], pdo.name);
-    for e in pdo.entries {
+    x.leaf("Index", &[], &hex16(index));
+    x.leaf("Name", &[], name);
+    for e in entries {
         x.open("Entry", &[]);
         x.leaf("Index", &[], &hex16(e.index));
         x.leaf("SubIndex", &[], &e.sub.to_string());
@@ -336,6 +464,31 @@ fn pdo_element(x: &mut Xml, tag: &str, pdo: &Pdo, dev: &Device, assigned: &[u16]
         x.close("Entry");
     }
     x.close(tag);
+}
+
+/// A module (E-149): its ident and names, its RxPDO and TxPDO in the axis's
+/// channel, assigned (`Sm`) when the module is in its slot, named as the
+/// device names the channel's PDOs.
+fn module_element(x: &mut Xml, dev: &Device, m: &Module) {
+    let letter = axis_letter(m.axis);
+    x.open("Module", &[]);
+    x.leaf(
+        "Type",
+        &[("ModuleIdent", &hex32(m.ident()))],
+        &format!("{} axis {letter} {}", dev.name, m.layout.name()),
+    );
+    x.leaf(
+        "Name",
+        &[("LcId", "1033")],
+        &format!("Axis {letter}: {}", m.layout.name()),
+    );
+    let (rx_index, tx_index) = m.pdo_indexes();
+    let (rx, tx) = m.entries();
+    for (tag, index, entries, sm) in [("RxPdo", rx_index, rx, 2), ("TxPdo", tx_index, tx, 3)] {
+        let name = dev.pdo(index).map_or("", |p| p.name);
+        pdo_element(x, tag, &pdo_attrs(dev, true, sm), index, name, entries);
+    }
+    x.close("Module");
 }
 
 /// The ESI name of a data type: the ETG base type names, `STRING(n)` and

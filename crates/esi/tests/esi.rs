@@ -62,6 +62,34 @@ fn device_node<'a, 'i>(doc: &'a Document<'i>) -> Node<'a, 'i> {
     )
 }
 
+/// The `<Modules>` of the file (E-149).
+fn modules<'a, 'i>(doc: &'a Document<'i>) -> Vec<Node<'a, 'i>> {
+    children(
+        child(child(doc.root_element(), "Descriptions"), "Modules"),
+        "Module",
+    )
+    .collect()
+}
+
+/// The ident of a `<Module>`.
+fn module_ident(m: Node) -> u32 {
+    num(child(m, "Type").attribute("ModuleIdent").unwrap()) as u32
+}
+
+/// The `<Slot>`s of the device.
+fn slots<'a, 'i>(dev: Node<'a, 'i>) -> Vec<Node<'a, 'i>> {
+    children(child(dev, "Slots"), "Slot").collect()
+}
+
+/// A PDO's entries as mapping values (index << 16 | sub << 8 | bit length).
+fn mapped(pdo: Node) -> Vec<u32> {
+    children(pdo, "Entry")
+        .map(|e| {
+            (num(text(e, "Index")) << 16 | num(text(e, "SubIndex")) << 8 | num(text(e, "BitLen"))) as u32
+        })
+        .collect()
+}
+
 /// The ESI text of `variant` in `template`, as generated (the drift test
 /// keeps the files equal).
 fn esi(variant: Variant, template: Template) -> String {
@@ -505,6 +533,10 @@ fn esi_dictionary_matches_od() {
     }
 }
 
+/// Every PDO the ESI describes, at device level and in every module (E-149):
+/// its entries are the declared ones (the device's PDO, or the module's
+/// layout on its axis) and exist in the dictionary with the same bit length,
+/// mappable in the PDO's direction.
 #[test]
 fn esi_pdo_entries_are_mappable_objects() {
     for (v, t) in each() {
@@ -512,38 +544,69 @@ fn esi_pdo_entries_are_mappable_objects() {
         let xml = esi(v, t);
         let doc = Document::parse(&xml).unwrap();
         let dev = device_node(&doc);
-        for (tag, rx) in [("RxPdo", true), ("TxPdo", false)] {
+        // (PDO node, the declared entries, where)
+        let mut pdos: Vec<(Node, &[od::PdoEntry], String)> = Vec::new();
+        for tag in ["RxPdo", "TxPdo"] {
             for pdo in children(dev, tag) {
                 let index = num(text(pdo, "Index")) as u16;
                 let declared = drive::device(v).pdo(index).unwrap();
-                let entries: Vec<Node> = children(pdo, "Entry").collect();
-                assert_eq!(entries.len(), declared.entries.len());
-                for (node, d) in entries.iter().zip(declared.entries) {
-                    let (i, s) = (
-                        num(text(*node, "Index")) as u16,
-                        num(text(*node, "SubIndex")) as u8,
-                    );
-                    assert_eq!((i, s), (d.index, d.sub));
-                    assert_eq!(text(*node, "DataType"), expected_type(d.data_type));
-                    let e = od
-                        .object(i)
-                        .and_then(|o| o.entry(s))
-                        .unwrap_or_else(|| panic!("{tag} {index:04X}h: {i:04X}h:{s} not in the OD"));
-                    assert_eq!(num(text(*node, "BitLen")), u64::from(e.bit_len()), "{i:04X}h:{s}");
-                    let mappable = if rx {
-                        e.access.rx_mappable()
-                    } else {
-                        e.access.tx_mappable()
-                    };
-                    assert!(mappable, "{tag} {index:04X}h: {i:04X}h:{s} not mappable");
+                pdos.push((pdo, declared.entries, format!("device {index:04X}h")));
+            }
+        }
+        let system: Vec<(u32, u16, drive::PdoLayout)> = (0..v.axes() as u16)
+            .flat_map(|axis| drive::PdoLayout::ALL.map(|l| (drive::module_ident(l, axis), axis, l)))
+            .collect();
+        let mut in_modules = 0;
+        for m in modules(&doc) {
+            let ident = module_ident(m);
+            let &(_, axis, layout) = system
+                .iter()
+                .find(|s| s.0 == ident)
+                .unwrap_or_else(|| panic!("{v:?} {t:?}: module {ident:08X}h is no system module"));
+            let (rx, tx) = layout.axis_entries(axis);
+            for (tag, declared) in [("RxPdo", rx), ("TxPdo", tx)] {
+                for pdo in children(m, tag) {
+                    pdos.push((pdo, declared, format!("module {ident:08X}h")));
+                    in_modules += 1;
                 }
+            }
+        }
+        assert_eq!(in_modules, 2 * system.len(), "an RxPDO and a TxPDO per module");
+        for (pdo, declared, what) in pdos {
+            let rx = pdo.has_tag_name("RxPdo");
+            let index = num(text(pdo, "Index")) as u16;
+            assert_eq!(rx, (0x1600..0x1A00).contains(&index), "{what}: direction");
+            let entries: Vec<Node> = children(pdo, "Entry").collect();
+            assert_eq!(entries.len(), declared.len(), "{what}");
+            for (node, d) in entries.iter().zip(declared) {
+                let (i, s) = (
+                    num(text(*node, "Index")) as u16,
+                    num(text(*node, "SubIndex")) as u8,
+                );
+                assert_eq!((i, s), (d.index, d.sub), "{what}");
+                assert_eq!(text(*node, "DataType"), expected_type(d.data_type), "{what}");
+                let e = od
+                    .object(i)
+                    .and_then(|o| o.entry(s))
+                    .unwrap_or_else(|| panic!("{what} {index:04X}h: {i:04X}h:{s} not in the OD"));
+                assert_eq!(
+                    num(text(*node, "BitLen")),
+                    u64::from(e.bit_len()),
+                    "{what} {i:04X}h:{s}"
+                );
+                let mappable = if rx {
+                    e.access.rx_mappable()
+                } else {
+                    e.access.tx_mappable()
+                };
+                assert!(mappable, "{what} {index:04X}h: {i:04X}h:{s} not mappable");
             }
         }
     }
 }
 
 /// The numeric defaults of object `index` in the ESI dictionary, in entry order.
-fn defaults(profile: Node, index: u16) -> Vec<u64> {
+fn defaults_of(profile: Node, index: u16) -> Vec<u64> {
     let info = child(object(profile, index), "Info");
     children(info, "SubItem")
         .map(|s| {
@@ -577,11 +640,11 @@ fn esi_pdos_match_mapping_and_assignment_objects() {
                         num(text(e, "Index")) << 16 | num(text(e, "SubIndex")) << 8 | num(text(e, "BitLen"))
                     })
                     .collect();
-                let d = defaults(profile, index);
+                let d = defaults_of(profile, index);
                 assert_eq!(d[0], mapped.len() as u64, "{index:04X}h:00");
                 assert_eq!(&d[1..=mapped.len()], &mapped[..], "{index:04X}h");
             }
-            let d = defaults(profile, assign);
+            let d = defaults_of(profile, assign);
             assert_eq!(d[0], assigned.len() as u64, "{assign:04X}h:00");
             assert_eq!(&d[1..=assigned.len()], &assigned[..], "{assign:04X}h");
         }
@@ -604,8 +667,14 @@ fn e005_e084_e150_the_single_axis_esi_has_no_axis_b() {
             .map(|o| num(text(o, "Index")))
             .collect();
         let pdos = |tag| -> Vec<u64> { children(dev, tag).map(|p| num(text(p, "Index"))).collect() };
+        let module_pdos: Vec<Node> = modules(&doc)
+            .into_iter()
+            .flat_map(|m| children(m, "RxPdo").chain(children(m, "TxPdo")))
+            .collect();
+        let module_indexes: BTreeSet<u64> = module_pdos.iter().map(|p| num(text(*p, "Index"))).collect();
         let entries: Vec<u64> = children(dev, "RxPdo")
             .chain(children(dev, "TxPdo"))
+            .chain(module_pdos.iter().copied())
             .flat_map(|p| children(p, "Entry").map(|e| num(text(e, "Index"))))
             .collect();
         match v {
@@ -619,13 +688,19 @@ fn e005_e084_e150_the_single_axis_esi_has_no_axis_b() {
                 assert!(!objects.iter().any(|&i| axis_b(i)), "{t:?}: an axis-B object");
                 assert!(!entries.iter().any(|&i| axis_b(i)), "{t:?}: an axis-B PDO entry");
                 assert_eq!((pdos("RxPdo"), pdos("TxPdo")), (vec![0x1600], vec![0x1A00]));
+                assert_eq!(module_indexes, BTreeSet::from([0x1600, 0x1A00]), "{t:?}: modules");
+                assert_eq!(slots(dev).len(), 1, "{t:?}: one slot, axis A");
                 // channel 2 is there, free and empty
                 for pdo in [0x1601, 0x1A01] {
-                    assert!(defaults(profile, pdo).iter().all(|&d| d == 0), "{pdo:04X}h");
+                    assert!(defaults_of(profile, pdo).iter().all(|&d| d == 0), "{pdo:04X}h");
                 }
                 assert_eq!(
-                    defaults(profile, 0xF050),
-                    [2, u64::from(drive::module_ident(drive::PdoLayout::Standard)), 0]
+                    defaults_of(profile, 0xF050),
+                    [
+                        2,
+                        u64::from(drive::module_ident(drive::PdoLayout::Standard, 0)),
+                        0
+                    ]
                 );
                 let name = children(child(object(profile, 0x1008), "Info"), "DefaultString").next();
                 assert_eq!(name.and_then(|n| n.text()), Some("SI6"));
@@ -641,6 +716,243 @@ fn e005_e084_e150_the_single_axis_esi_has_no_axis_b() {
                     (pdos("RxPdo"), pdos("TxPdo")),
                     (vec![0x1600, 0x1601], vec![0x1A00, 0x1A01])
                 );
+                assert_eq!(
+                    module_indexes,
+                    BTreeSet::from([0x1600, 0x1601, 0x1A00, 0x1A01]),
+                    "{t:?}: modules"
+                );
+                assert!(entries.iter().any(|&i| (0x6800..=0x6FFF).contains(&i)));
+                assert_eq!(slots(dev).len(), 2, "{t:?}: axes A and B");
+            }
+        }
+    }
+}
+
+/// E-149: the ESI is modular. One slot per axis (axis A; axis B only on
+/// the double-axis device), each with exactly one module per application
+/// layout (`PdoLayout::ALL`) of that axis, the standard layout the default;
+/// every module in `<Modules>` once, in one slot, with its own ident (axis
+/// B's differ from axis A's), its RxPDO and TxPDO in the axis's channel
+/// (1600h/1A00h + axis, assigned to SM2/SM3 when in the slot) named after
+/// the layout. The device-level PDOs stay (the SII's default configuration),
+/// each described once, and those a module describes again are marked
+/// `OverwrittenByModule`, so no PDO index is described twice in a way a
+/// master would reject.
+#[test]
+fn e056_e149_one_slot_per_axis_with_a_module_per_layout() {
+    for (v, t) in each() {
+        let what = format!("{v:?} {t:?}");
+        let xml = esi(v, t);
+        let doc = Document::parse(&xml).unwrap();
+        let dev = device_node(&doc);
+        let slots = slots(dev);
+        assert_eq!(slots.len(), v.axes(), "{what}: a slot per axis");
+        let modules = modules(&doc);
+        assert_eq!(modules.len(), drive::PdoLayout::ALL.len() * v.axes(), "{what}");
+        let by_ident: BTreeMap<u32, Node> = modules.iter().map(|m| (module_ident(*m), *m)).collect();
+        assert_eq!(by_ident.len(), modules.len(), "{what}: idents unique");
+        let mut slotted = BTreeSet::new();
+        let mut module_pdos = BTreeSet::new();
+        for (axis, slot) in (0u16..).zip(&slots) {
+            let letter = ["A", "B"][usize::from(axis)];
+            assert_eq!(text(*slot, "Name"), format!("Axis {letter}"), "{what}");
+            assert_eq!(num(slot.attribute("MinInstances").unwrap()), 1, "{what}");
+            assert_eq!(num(slot.attribute("MaxInstances").unwrap()), 1, "{what}");
+            let idents: Vec<Node> = children(*slot, "ModuleIdent").collect();
+            let listed: Vec<u32> = idents.iter().map(|i| num(i.text().unwrap()) as u32).collect();
+            let layouts = drive::PdoLayout::ALL.map(|l| drive::module_ident(l, axis));
+            assert_eq!(listed, layouts, "{what}: axis {letter}");
+            let defaults: Vec<u32> = idents
+                .iter()
+                .filter(|i| i.attribute("Default").is_some_and(|d| num(d) == 1))
+                .map(|i| num(i.text().unwrap()) as u32)
+                .collect();
+            assert_eq!(
+                defaults,
+                [drive::module_ident(drive::PdoLayout::Standard, axis)],
+                "{what}: axis {letter} defaults to the standard layout"
+            );
+            for (layout, ident) in drive::PdoLayout::ALL.iter().zip(listed) {
+                assert!(slotted.insert(ident), "{what}: {ident:08X}h in one slot only");
+                let m = by_ident
+                    .get(&ident)
+                    .unwrap_or_else(|| panic!("{what}: no module {ident:08X}h"));
+                assert_eq!(ident & drive::AXIS_B_MODULE != 0, axis == 1, "{what}");
+                assert_eq!(
+                    text(*m, "Name"),
+                    format!("Axis {letter}: {}", layout.name()),
+                    "{what}"
+                );
+                let rx: Vec<Node> = children(*m, "RxPdo").collect();
+                let tx: Vec<Node> = children(*m, "TxPdo").collect();
+                assert_eq!((rx.len(), tx.len()), (1, 1), "{what}: {ident:08X}h");
+                for (pdo, index, sm) in [(rx[0], 0x1600 + axis, 2), (tx[0], 0x1A00 + axis, 3)] {
+                    assert_eq!(num(text(pdo, "Index")), u64::from(index), "{what}: {ident:08X}h");
+                    assert_eq!(pdo.attribute("Sm").map(num), Some(sm), "{what}: {ident:08X}h");
+                    // the device has PDO configuration: no module PDO is fixed
+                    assert_eq!(pdo.attribute("Fixed"), None, "{what}: {ident:08X}h");
+                    assert!(!mapped(pdo).is_empty(), "{what}: {ident:08X}h");
+                    module_pdos.insert(index);
+                }
+            }
+        }
+        assert_eq!(slotted.len(), modules.len(), "{what}: every module in a slot");
+        // device level: each PDO once; those a module describes are overwritten by it
+        for tag in ["RxPdo", "TxPdo"] {
+            let mut seen = BTreeSet::new();
+            for pdo in children(dev, tag) {
+                let index = num(text(pdo, "Index")) as u16;
+                assert!(seen.insert(index), "{what}: {index:04X}h twice at device level");
+                assert_eq!(
+                    pdo.attribute("OverwrittenByModule") == Some("1"),
+                    module_pdos.contains(&index),
+                    "{what}: {index:04X}h"
+                );
+            }
+        }
+        for index in &module_pdos {
+            assert!(
+                drive::device(v).pdo(*index).is_some(),
+                "{what}: {index:04X}h has a device-level default"
+            );
+        }
+    }
+}
+
+/// E-148 with E-149: F050h reports for each axis exactly the ident of the
+/// ESI module that describes the axis's mapping. Each module's PDOs, written
+/// into a fresh dictionary as a master's startup list would (Pre-Op, sub 0 =
+/// 0, the entries, sub 0 = n: the mapping checks accept every entry), make
+/// F050h:(slot + 1) read the module's ident; the default configuration reads
+/// the slots' default idents (0 for the single-axis device's axis B), as the
+/// ESI dictionary's F050h defaults say.
+#[test]
+fn e148_e149_f050_reports_the_ident_of_the_esi_module() {
+    for (v, t) in each() {
+        let what = format!("{v:?} {t:?}");
+        let xml = esi(v, t);
+        let doc = Document::parse(&xml).unwrap();
+        let dev = device_node(&doc);
+        let read_f050 = |od: &mut drive::DriveObjects, sub: u8| {
+            let mut buf = [0u8; 4];
+            assert_eq!(od.read(0xF050, sub, &mut buf, CommState::PreOp), Ok(4));
+            u32::from_le_bytes(buf)
+        };
+        // the default configuration
+        let defaults: Vec<u32> = slots(dev)
+            .iter()
+            .map(|s| {
+                let d = children(*s, "ModuleIdent")
+                    .find(|i| i.attribute("Default") == Some("1"))
+                    .unwrap();
+                num(d.text().unwrap()) as u32
+            })
+            .collect();
+        let mut od = esi::dictionary(v, t);
+        let mut f050 = vec![read_f050(&mut od, 1), read_f050(&mut od, 2)];
+        if v == Variant::Single {
+            assert_eq!(f050.pop(), Some(0), "{what}: no module on axis B");
+        }
+        assert_eq!(f050, defaults, "{what}: F050h = the slots' defaults");
+        let esi_f050 = defaults_of(child(dev, "Profile"), 0xF050);
+        assert_eq!(esi_f050[0], 2, "{what}");
+        assert_eq!(
+            &esi_f050[1..=f050.len()],
+            &f050.iter().map(|&i| u64::from(i)).collect::<Vec<_>>()[..]
+        );
+        // every module, written into its axis's channel
+        for (axis, slot) in (0u8..).zip(slots(dev)) {
+            for ident in children(slot, "ModuleIdent").map(|i| num(i.text().unwrap()) as u32) {
+                let m = modules(&doc)
+                    .into_iter()
+                    .find(|m| module_ident(*m) == ident)
+                    .unwrap();
+                let mut od = esi::dictionary(v, t);
+                let other = (v == Variant::Double).then(|| read_f050(&mut od, 2 - axis));
+                for pdo in children(m, "RxPdo").chain(children(m, "TxPdo")) {
+                    let index = num(text(pdo, "Index")) as u16;
+                    let entries = mapped(pdo);
+                    od.write(index, 0, &[0], CommState::PreOp).unwrap();
+                    for (sub, e) in (1u8..).zip(&entries) {
+                        let r = od.write(index, sub, &e.to_le_bytes(), CommState::PreOp);
+                        assert_eq!(r, Ok(()), "{what}: {ident:08X}h {index:04X}h:{sub} = {e:08X}h");
+                    }
+                    od.write(index, 0, &[entries.len() as u8], CommState::PreOp)
+                        .unwrap_or_else(|e| panic!("{what}: {ident:08X}h {index:04X}h: {e:?}"));
+                }
+                assert_eq!(
+                    read_f050(&mut od, axis + 1),
+                    ident,
+                    "{what}: F050h:{:02X} after module {ident:08X}h",
+                    axis + 1
+                );
+                if let Some(other) = other {
+                    assert_eq!(read_f050(&mut od, 2 - axis), other, "{what}: the other axis");
+                }
+            }
+        }
+    }
+}
+
+/// E-149 with the SII: the default module of each slot is the default
+/// mapping of its channel. Its PDOs' entries equal the dictionary's mapping
+/// (16xxh/1Axxh at start, read through the dictionary and as the ESI
+/// dictionary's defaults), the device-level PDO of the same index and the
+/// SII's RXPDO/TXPDO record of it (what SOEM and ethercrab read).
+#[test]
+fn e149_default_modules_equal_the_default_mapping_and_the_sii() {
+    for (v, t) in each() {
+        let what = format!("{v:?} {t:?}");
+        let xml = esi(v, t);
+        let doc = Document::parse(&xml).unwrap();
+        let dev = device_node(&doc);
+        let profile = child(dev, "Profile");
+        let od = esi::dictionary(v, t);
+        let img = esi::sii(v, t).unwrap();
+        let sii_pdo = |kind: u16, index: u16| -> Vec<u32> {
+            let cat = find_category(&img, kind).unwrap();
+            let mut pos = 0;
+            while pos < cat.len() {
+                let head = &cat[pos..pos + 8];
+                let n = usize::from(head[2]);
+                let entries = (0..n).map(|k| {
+                    let r = &cat[pos + 8 + 8 * k..pos + 16 + 8 * k];
+                    u32::from(u16::from_le_bytes([r[0], r[1]])) << 16 | u32::from(r[2]) << 8 | u32::from(r[5])
+                });
+                if u16::from_le_bytes([head[0], head[1]]) == index {
+                    return entries.collect();
+                }
+                pos += 8 + 8 * n;
+            }
+            panic!("{what}: {index:04X}h not in the SII");
+        };
+        for slot in slots(dev) {
+            let default = children(slot, "ModuleIdent")
+                .find(|i| i.attribute("Default") == Some("1"))
+                .map(|i| num(i.text().unwrap()) as u32)
+                .unwrap();
+            let m = modules(&doc)
+                .into_iter()
+                .find(|m| module_ident(*m) == default)
+                .unwrap();
+            for (tag, kind) in [("RxPdo", category::RXPDO), ("TxPdo", category::TXPDO)] {
+                let pdo = child(m, tag);
+                let index = num(text(pdo, "Index")) as u16;
+                let entries = mapped(pdo);
+                assert_eq!(
+                    od.mapping(index).collect::<Vec<_>>(),
+                    entries,
+                    "{what}: {index:04X}h"
+                );
+                let d = defaults_of(profile, index);
+                assert_eq!(d[0], entries.len() as u64, "{what}: {index:04X}h:00");
+                let listed: Vec<u32> = d[1..=entries.len()].iter().map(|&x| x as u32).collect();
+                assert_eq!(listed, entries, "{what}: {index:04X}h defaults");
+                let device = children(dev, tag)
+                    .find(|p| num(text(*p, "Index")) == u64::from(index))
+                    .unwrap();
+                assert_eq!(mapped(device), entries, "{what}: device-level {index:04X}h");
+                assert_eq!(sii_pdo(kind, index), entries, "{what}: SII {index:04X}h");
             }
         }
     }

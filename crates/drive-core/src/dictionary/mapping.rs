@@ -94,11 +94,19 @@ impl DriveObjects {
     }
 
     /// Puts `layout` into 1600h/1A00h (axis A), as a startup list in Pre-Op
-    /// would: sub 0 = 0, the entries, sub 0 = n (CiA 301 order), through the
-    /// same checks as a bus write. Takes effect at the next Pre-Op → Safe-Op.
+    /// would ([`apply_axis_map`](Self::apply_axis_map) of axis A).
     pub fn apply_map(&mut self, layout: crate::PdoLayout) -> Result<(), SdoAbort> {
-        let (rx, tx) = layout.entries();
-        for (pdo, entries) in [(0x1600u16, rx), (0x1A00, tx)] {
+        self.apply_axis_map(0, layout)
+    }
+
+    /// Puts `layout` on `axis` (0 = A, any other = B) into the axis's channel
+    /// (1600h/1A00h + axis), as a startup list in Pre-Op would: sub 0 = 0, the
+    /// entries, sub 0 = n (CiA 301 order), through the same checks as a bus
+    /// write. Takes effect at the next Pre-Op → Safe-Op.
+    pub fn apply_axis_map(&mut self, axis: u16, layout: crate::PdoLayout) -> Result<(), SdoAbort> {
+        let axis = u16::from(axis != 0);
+        let (rx, tx) = layout.axis_entries(axis);
+        for (pdo, entries) in [(0x1600 + axis, rx), (0x1A00 + axis, tx)] {
             self.write(pdo, 0, &[0], CommState::PreOp)?;
             for (sub, e) in (1u8..).zip(entries) {
                 self.write(pdo, sub, &e.mapping_value().to_le_bytes(), CommState::PreOp)?;
@@ -130,36 +138,27 @@ impl DriveObjects {
         (bits as usize).div_ceil(8)
     }
 
-    /// The module ident of `axis` (0 = A, 1 = B) as F050h reports it (E-148):
+    /// The module ident of `axis` (0 = A, any other = B) as F050h reports it (E-148):
     /// the ident of the ESI module whose PDO configuration axis's channel
     /// (1600h/1A00h + axis) carries now. One of the system modules
-    /// ([`crate::module_ident`] of a [`crate::PdoLayout`], axis B's with its
-    /// objects at +800h/+8000h), else a user module: [`crate::USER_MODULE`]
-    /// with an FNV-1a hash of the mapping entries in the low 31 bits, the
-    /// same for the same configuration; 0 when both PDOs are empty.
+    /// ([`crate::module_ident`] of a [`crate::PdoLayout`] on that axis: axis
+    /// B's with its objects at +800h/+8000h and its own ident), else a user
+    /// module: [`crate::USER_MODULE`] with an FNV-1a hash of the mapping
+    /// entries in the low 31 bits, the same for the same configuration; 0
+    /// when both PDOs are empty.
     pub fn module_ident(&self, axis: u16) -> u32 {
+        let axis = u16::from(axis != 0);
         let (rx, tx) = (0x1600 + axis, 0x1A00 + axis);
         if self.mapping(rx).next().is_none() && self.mapping(tx).next().is_none() {
             return 0;
         }
-        let shift = |m: u32| -> u32 {
-            let index = (m >> 16) as u16;
-            if axis == 0 {
-                m
-            } else if index >= 0x6000 {
-                m + (u32::from(crate::AXIS_B_CIA402) << 16)
-            } else {
-                m + (u32::from(crate::AXIS_B_MANUFACTURER) << 16)
-            }
-        };
         for layout in crate::PdoLayout::ALL {
-            let (lrx, ltx) = layout.entries();
+            let (lrx, ltx) = layout.axis_entries(axis);
             let same = |pdo: u16, entries: &[od::PdoEntry]| {
-                self.mapping(pdo)
-                    .eq(entries.iter().map(|e| shift(e.mapping_value())))
+                self.mapping(pdo).eq(entries.iter().map(|e| e.mapping_value()))
             };
             if same(rx, lrx) && same(tx, ltx) {
-                return crate::module_ident(layout);
+                return crate::module_ident(layout, axis);
             }
         }
         let mut h: u32 = 0x811C_9DC5;

@@ -341,8 +341,10 @@ pub const COMM: [Object; 22] = [
     .note("A265; counters and times live, from the sync module"),
 ];
 
-/// F050h's default: the module of the standard PDO layout (E-148).
-const STANDARD_MODULE: i64 = crate::module_ident(crate::PdoLayout::Standard) as i64;
+/// F050h's defaults: the modules of the standard PDO layout on axes A and B
+/// (E-148).
+const STANDARD_MODULE_A: i64 = crate::module_ident(crate::PdoLayout::Standard, 0) as i64;
+const STANDARD_MODULE_B: i64 = crate::module_ident(crate::PdoLayout::Standard, 1) as i64;
 
 /// The modular-device objects (ETG.5000.1, S Tab. 14).
 pub const MDP: [Object; 1] = [Object::new(
@@ -352,8 +354,8 @@ pub const MDP: [Object; 1] = [Object::new(
     entries![
         count_entry(2),
         // (the defaults: the standard layout's module, what both axes carry at start)
-        e(1, "Module ident axis A", U32, RO).default_value(STANDARD_MODULE),
-        e(2, "Module ident axis B", U32, RO).default_value(STANDARD_MODULE),
+        e(1, "Module ident axis A", U32, RO).default_value(STANDARD_MODULE_A),
+        e(2, "Module ident axis B", U32, RO).default_value(STANDARD_MODULE_B),
     ],
     Value::Live,
 )
