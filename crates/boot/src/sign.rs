@@ -388,7 +388,12 @@ mod fuzz_memo {
         })
     }
 
-    pub(super) fn put(key: &[u8; KEY_LEN], sig: &[u8; SIGNATURE_LEN], hash: &[u8; 64], r: Result<(), VerifyError>) {
+    pub(super) fn put(
+        key: &[u8; KEY_LEN],
+        sig: &[u8; SIGNATURE_LEN],
+        hash: &[u8; 64],
+        r: Result<(), VerifyError>,
+    ) {
         LAST.with(|l| *l.borrow_mut() = Some(((*key, *sig, *hash), r)));
     }
 }
