@@ -61,10 +61,10 @@ fn e005_slave_count_addresses_identity_and_name_from_sii() {
         for sd in group.iter(md) {
             let id = sd.identity();
             assert_eq!(id.vendor_id, 0xB9, "E-005 vendor ID");
-            assert_eq!(id.product_id, drive::PRODUCT_CODE);
+            assert_eq!(id.product_id, drive_tests::variant().product_code());
             assert_eq!(id.revision, drive::SOFTWARE_BUILD);
             assert_eq!(id.serial, drive::SERIAL);
-            assert_eq!(sd.name(), drive::DEVICE.order_code);
+            assert_eq!(sd.name(), drive_tests::device().order_code);
         }
         // the configured addresses really are in the ESCs
         for i in 0..2 {

@@ -13,7 +13,7 @@
 
 use drive::{parameter_index, Template};
 use drive_tests::al::{ERR, OP, SAFEOP};
-use drive_tests::{al_status, init, line, map_layout, with_master, CoeClient, Cyclic, REV};
+use drive_tests::{al_status, init, line, map_layout, variant, with_master, CoeClient, Cyclic, REV};
 use ecat::SdoAbort;
 use esc::AlStatusCode;
 use hil_sim::sim::Simulation;
@@ -233,9 +233,12 @@ fn c138_only_mappable_objects_in_their_direction() {
             c.download(&sd, 0x1601, 1, &m(0x6898, 0, 8).to_le_bytes()).await,
             not
         );
-        c.download(&sd, 0x1601, 1, &m(0x6840, 0, 16).to_le_bytes())
-            .await
-            .expect("6840h in an RxPDO");
+        let axis_b = c.download(&sd, 0x1601, 1, &m(0x6840, 0, 16).to_le_bytes()).await;
+        if variant().axes() == 2 {
+            axis_b.expect("6840h in an RxPDO");
+        } else {
+            assert_eq!(axis_b, not, "the single-axis device has no 6840h");
+        }
     });
 }
 
@@ -257,6 +260,11 @@ fn c139_subindex_0_constants() {
             (0x6846, 2),
             (0x68E3, 0x14),
         ] {
+            if !variant().has_object(index) {
+                let missing = sd.sdo_read::<u8>(index, 0).await;
+                assert!(missing.is_err(), "{index:04X}h on the single-axis device");
+                continue;
+            }
             let v: u8 = sd.sdo_read(index, 0).await.unwrap();
             assert_eq!(v, n, "{index:04X}h:00");
             assert!(
@@ -284,12 +292,23 @@ fn c135_c136_c137_manufacturer_parameter_addresses_and_templates() {
         let sd = group.subdevice(md, 0).unwrap();
         let mut c = CoeClient::new();
         // C-135/C-136: A340 of axis A at 2154h, of axis B at A154h, independent
+        let axis_b = variant().axes() == 2;
         sd.sdo_write(a340, 0, 70u16).await.unwrap();
-        sd.sdo_write(a340 + 0x8000, 0, 30u16).await.unwrap();
+        let b_write = sd.sdo_write(a340 + 0x8000, 0, 30u16).await;
         assert_eq!(sd.sdo_read::<u16>(a340, 0).await.unwrap(), 70);
-        assert_eq!(sd.sdo_read::<u16>(a340 + 0x8000, 0).await.unwrap(), 30);
         let objects = |sim: &RefCell<Simulation>, i: u16| sim.borrow().drives()[0].drive.objects().get(i, 0);
-        assert_eq!(objects(&sim, 0xA154), Ok(30), "the axis-B parameter");
+        if axis_b {
+            b_write.unwrap();
+            assert_eq!(sd.sdo_read::<u16>(a340 + 0x8000, 0).await.unwrap(), 30);
+            assert_eq!(objects(&sim, 0xA154), Ok(30), "the axis-B parameter");
+        } else {
+            assert!(b_write.is_err(), "no A154h on the single-axis device");
+            assert_eq!(
+                c.upload(&sd, a340 + 0x8000, 0).await,
+                Err(SdoAbort::NO_OBJECT.0),
+                "no A154h on the single-axis device"
+            );
+        }
         // C-137, "SDO Info" template (default): E200[0] at sub 1, sub 0 = element count
         assert_eq!(
             c.upload(&sd, e200, 0).await,
@@ -297,8 +316,9 @@ fn c135_c136_c137_manufacturer_parameter_addresses_and_templates() {
             "E200 sub 0 = 2 elements"
         );
         assert!(c.upload(&sd, e200, 1).await.is_ok(), "E200[0] at sub 1");
-        assert!(
+        assert_eq!(
             c.upload(&sd, e200 + 0x8000, 1).await.is_ok(),
+            axis_b,
             "axis B E200[0] at A8C8h:01"
         );
         assert!(c.upload(&sd, e200, 3).await.is_err(), "no element 2");

@@ -12,7 +12,8 @@
 
 use drive::objects::{enumeration, Object, Value, OBJECTS};
 use drive::{revision, DriveObjects, Template};
-use drive_tests::{init, line, with_master, CoeClient, UploadKind, MAILBOX_LEN};
+use drive_tests::objects as device_objects;
+use drive_tests::{init, line, variant, with_master, CoeClient, UploadKind, MAILBOX_LEN};
 use ecat::{CommState, DataType, Dictionary, SdoAbort};
 use hil_sim::sim::Simulation;
 use std::cell::RefCell;
@@ -74,8 +75,7 @@ fn objects(sim: &RefCell<Simulation>) -> DriveObjects {
 /// included), the template and the pending requests.
 fn settled(sim: &RefCell<Simulation>) -> (Vec<i64>, Vec<u8>, Template, drive::Requests) {
     let o = objects(sim);
-    let values = OBJECTS
-        .iter()
+    let values = device_objects()
         .filter(|obj| obj.value == Value::Ram)
         .flat_map(|obj| obj.info.entries.iter().map(move |e| (obj.info.index, e)))
         .filter(|(_, e)| e.data_type.is_integer())
@@ -105,11 +105,18 @@ fn e063_e064_e071_e072_e016_every_entry_reads_with_its_declared_size() {
         let sd = group.subdevice(md, 0).unwrap();
         let mut c = CoeClient::new();
         let (mut read, mut hidden, mut write_only) = (0, 0, 0);
+        let device = variant();
         for o in OBJECTS.iter() {
             let index = o.info.index;
+            let o = device.declared(o);
             for e in o.info.entries {
                 let at = format!("{index:04X}h:{:02X}h {}", e.sub, e.name);
                 let got = c.upload_kind(&sd, index, e.sub, false).await;
+                if !device.has_object(index) {
+                    assert_eq!(got, Err(NO_OBJECT), "not on the single-axis device: {at}");
+                    hidden += 1;
+                    continue;
+                }
                 if !visible(o) {
                     assert_eq!(got, Err(NO_OBJECT), "E-016 hidden {at}");
                     hidden += 1;
@@ -186,7 +193,7 @@ fn e063_e064_e076_writable_entries_take_range_ends_and_default_preop_only_refuse
         let mut c = CoeClient::new();
         let mut written = 0;
         let start = settled(&sim);
-        for o in OBJECTS.iter().filter(|o| visible(o)) {
+        for o in device_objects().filter(|o| visible(o)) {
             let index = o.info.index;
             // live objects (10F3h) check writes against their own state: tested on their own
             if pdo_object(index) || o.value == Value::Command || o.value == Value::Live {
@@ -244,7 +251,7 @@ async fn state_writes<S>(
     bit: u8,
 ) -> (usize, usize) {
     let (mut accepted, mut refused) = (0, 0);
-    for o in OBJECTS.iter().filter(|o| visible(o)) {
+    for o in device_objects().filter(|o| visible(o)) {
         let index = o.info.index;
         if index == 0x1010 {
             continue; // a command: any value but "save" is 0800 0020h
@@ -285,8 +292,12 @@ fn e071_e073_e074_e016_bad_writes_get_the_exact_abort_and_change_nothing() {
         let mut c = CoeClient::new();
         let mut cases = 0usize;
         let start = settled(&sim);
+        let device = variant();
         for o in OBJECTS.iter() {
             let index = o.info.index;
+            let o = device.declared(o);
+            // an object the single-axis device does not have is refused as a hidden one
+            let visible = |o: &Object| visible(o) && device.has_object(index);
             for e in o.info.entries {
                 let n = e.data_type.bytes();
                 let current = if visible(o) {
@@ -423,7 +434,7 @@ fn e080_e081_e082_e084_sdo_info_lists_and_descriptions_match_the_dictionary() {
         let group = init(md, clock).await;
         let sd = group.subdevice(md, 0).unwrap();
         let mut c = CoeClient::new();
-        let shown: Vec<&Object> = OBJECTS.iter().filter(|o| visible(o)).collect();
+        let shown: Vec<&Object> = device_objects().filter(|o| visible(o)).collect();
         let all: Vec<u16> = shown.iter().map(|o| o.info.index).collect();
         let mappable = |rx: bool| -> Vec<u16> {
             shown
@@ -441,7 +452,7 @@ fn e080_e081_e082_e084_sdo_info_lists_and_descriptions_match_the_dictionary() {
                 .collect()
         };
         assert!(
-            all.len() < OBJECTS.len(),
+            all.len() < device_objects().count(),
             "some objects are hidden at level {LEVEL}"
         );
         // E-080: all, RxPDO- and TxPDO-mappable (fragmented: the lists are long)
@@ -535,7 +546,7 @@ fn e080_e081_e082_e084_sdo_info_lists_and_descriptions_match_the_dictionary() {
 
         // errors: unknown and hidden objects, unknown subindex
         assert_eq!(c.object_desc(&sd, 0x5000).await, Err(NO_OBJECT));
-        let hidden = OBJECTS.iter().find(|o| !visible(o)).unwrap().info.index;
+        let hidden = device_objects().find(|o| !visible(o)).unwrap().info.index;
         assert_eq!(c.object_desc(&sd, hidden).await, Err(NO_OBJECT), "E-084");
         assert_eq!(c.entry_desc(&sd, 0x1018, 9, 0, 0).await, Err(NO_SUBINDEX));
 
@@ -808,7 +819,7 @@ fn e078_complete_access_upload_1018h_1600h_and_download_1c12h_in_cia301_order() 
         let mut identity = vec![4, 0];
         for v in [
             drive::VENDOR_ID,
-            drive::PRODUCT_CODE,
+            variant().product_code(),
             revision(Template::SdoInfo),
             drive::SERIAL,
         ] {
@@ -961,8 +972,7 @@ fn e016_e017_e084_access_level_a10_2_decides_what_coe_sees() {
         let mut c = CoeClient::new();
         for level in [0u8, 1, 3, 2] {
             c.download(&sd, a10, 3, &[level]).await.unwrap();
-            let expected: Vec<u16> = OBJECTS
-                .iter()
+            let expected: Vec<u16> = device_objects()
                 .filter(|o| o.level <= level)
                 .map(|o| o.info.index)
                 .collect();

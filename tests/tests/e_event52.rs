@@ -236,7 +236,8 @@ fn e130_projected_fieldbus_mismatch_raises_event52_cause_15() {
         {
             let s = sim.borrow();
             let d = &s.drives()[0].drive;
-            for axis in d.axes() {
+            // every axis the device has (axis B stays idle on the single-axis device)
+            for axis in d.axes().iter().take(drive_tests::variant().axes()) {
                 let sw_index = axis.cia402_index(0x6041);
                 let state = d.objects().get(sw_index, 0).unwrap() as u16 & 0x6F;
                 assert_eq!(state, sw::FAULT, "axis {}", axis.index());

@@ -845,6 +845,9 @@ fn c016_c017_e007_e087_e088_following_error_fault_emcy_and_reset() {
 
 #[test]
 fn c134_axis_b_moves_independently_by_sdo() {
+    if !drive_tests::has_axis_b("c134: axis B moves") {
+        return;
+    }
     let sim = line(1);
     with_master(&sim, async |md, clock| {
         let group = init(md, clock).await.into_op(md).await.expect("OP");

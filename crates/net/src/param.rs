@@ -251,7 +251,13 @@ fn answer<D: Dictionary + ?Sized>(
             dict.write(index, sub, data, state)?;
             Ok(o.write_str("OK")?)
         }
-        "M" | "m" if value.is_empty() => Ok(write!(o, "OK {index:04X}:{sub:02X}")?),
+        "M" | "m" if value.is_empty() => {
+            // only an address the device has (as an SDO would find it): not
+            // one of a hidden parameter or of axis B on the single-axis device
+            let object = dict.object(index).ok_or(Error::Abort(SdoAbort::NO_OBJECT))?;
+            object.entry(sub).ok_or(Error::Abort(SdoAbort::NO_SUBINDEX))?;
+            Ok(write!(o, "OK {index:04X}:{sub:02X}")?)
+        }
         _ => Err(Error::Syntax),
     }
 }
@@ -514,5 +520,20 @@ mod tests {
         assert_eq!(sdo, SdoAbort::DEVICE_STATE);
         // an answer buffer too small
         assert_eq!(handle(b"R A150", &mut [0u8; 4], &mut d, pre, OPEN).0, 0);
+    }
+
+    #[test]
+    fn e096_mapping_answers_only_addresses_the_device_has() {
+        let pre = CommState::PreOp;
+        let mut double = DriveObjects::new();
+        assert_eq!(ask(&mut double, "M 2.E200[0]", pre), "OK A8C8:01");
+        assert_eq!(ask(&mut double, "M A511", pre), "ERR 06020000");
+        assert_eq!(ask(&mut double, "M A199[9]", pre), "ERR 06090011");
+        assert_eq!(ask(&mut double, "M 2.A150", pre), "ERR 06020000");
+        // the single-axis device has no axis-B window (issue 20)
+        let mut single = DriveObjects::for_variant(drive::Variant::Single);
+        assert_eq!(ask(&mut single, "M E200[0]", pre), "OK 28C8:01");
+        assert_eq!(ask(&mut single, "M 2.E200[0]", pre), "ERR 06020000");
+        assert_eq!(ask(&mut single, "R 2.E200[0]", pre), "ERR 06020000");
     }
 }
