@@ -1,0 +1,293 @@
+//! One axis' current loop: sample in, compare values out, once per PWM period.
+
+use crate::params::{Gains, LoopParams, MotorData, ParamError};
+use crate::pi::CurrentPi;
+use crate::protect::{current_limit, DcLink, I2t, I2tState, OverCurrent, PhaseSum, Trip};
+use crate::seam::{PwmOut, Sample, Scaling, Shunts};
+use crate::svm::{compensate_dead_time, svm};
+use crate::transform::{clarke, inverse_park, park, Abc, AlphaBeta, Dq};
+use crate::trig::{sin_cos, Angle, ANGLE_PER_RAD, RAD_PER_ANGLE};
+
+/// PWM periods per step of the i²t model (16 ms at 16 kHz).
+pub const I2T_DECIMATION: u32 = 256;
+
+/// Protection thresholds of one axis (the drive's own limits).
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct Protection {
+    /// Software over-current trip.
+    pub over_current: OverCurrent,
+    /// Plausibility of the three measured currents (three shunts only).
+    pub phase_sum: PhaseSum,
+    /// DC-link window.
+    pub dc_link: DcLink,
+    /// The power stage's current limit, A.
+    pub stage_current_a: f32,
+}
+
+impl Protection {
+    /// Trip at 9 A, phase sum within 0.3 A, DC link 400…800 V (400 V mains,
+    /// 565 V nominal), power stage 8 A.
+    pub const fn default_stage() -> Self {
+        Self {
+            over_current: OverCurrent { threshold_a: 9.0 },
+            phase_sum: PhaseSum { tolerance_a: 0.3 },
+            dc_link: DcLink {
+                min_v: 400.0,
+                max_v: 800.0,
+            },
+            stage_current_a: 8.0,
+        }
+    }
+}
+
+/// What the last step measured and commanded (the actual torque 6077h and current
+/// 6078h/PNU 1102 come from `current.q`).
+#[derive(Debug, Clone, Copy, PartialEq, Default)]
+pub struct Measured {
+    /// Phase currents, A.
+    pub phases: Abc,
+    /// dq currents, A.
+    pub current: Dq,
+    /// DC-link voltage, V.
+    pub vdc: f32,
+    /// Electrical angle of the sample.
+    pub angle: Angle,
+    /// Electrical speed, rad/s (angle difference over one period).
+    pub omega_e: f32,
+    /// dq voltage commanded, V.
+    pub voltage: Dq,
+    /// The voltage circle limited the last step.
+    pub voltage_limited: bool,
+    /// The current limit in force, A.
+    pub current_limit_a: f32,
+    /// The i²t model's verdict.
+    pub i2t: Option<I2tState>,
+}
+
+/// The current loop of one axis with its protection.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct FocAxis {
+    gains: Gains,
+    motor: MotorData,
+    scaling: Scaling,
+    protection: Protection,
+    pi: CurrentPi,
+    i2t: I2t,
+    i2t_alpha: f64,
+    i2t_sum: f32,
+    i2t_count: u32,
+    i2t_state: I2tState,
+    last_angle: Option<Angle>,
+    trip: Option<Trip>,
+    enabled: bool,
+    external_limit_a: f32,
+    measured: Measured,
+}
+
+impl FocAxis {
+    /// An axis with these parameters, disabled (gates off), or the first parameter
+    /// that is refused.
+    pub fn new(
+        motor: MotorData,
+        params: LoopParams,
+        scaling: Scaling,
+        protection: Protection,
+    ) -> Result<Self, ParamError> {
+        let gains = Gains::from_motor(&motor, &params)?;
+        let i2t = I2t::new(motor.rated_current_a, motor.thermal_time_constant_s);
+        Ok(Self {
+            gains,
+            motor,
+            scaling,
+            protection,
+            pi: CurrentPi::new(),
+            i2t_alpha: i2t.alpha(gains.ts_s * I2T_DECIMATION as f32),
+            i2t,
+            i2t_sum: 0.0,
+            i2t_count: 0,
+            i2t_state: I2tState::Normal,
+            last_angle: None,
+            trip: None,
+            enabled: false,
+            external_limit_a: f32::INFINITY,
+            measured: Measured::default(),
+        })
+    }
+
+    /// New motor data and loop parameters; on a refusal nothing changes. The
+    /// integrators restart from zero on success.
+    pub fn set_params(&mut self, motor: MotorData, params: LoopParams) -> Result<(), ParamError> {
+        let gains = Gains::from_motor(&motor, &params)?;
+        // keep the winding's heat: the new model starts at the present level
+        let x = self.i2t.level();
+        self.gains = gains;
+        self.motor = motor;
+        self.i2t = I2t::new(motor.rated_current_a, motor.thermal_time_constant_s);
+        self.i2t.set_level(x);
+        self.i2t_alpha = self.i2t.alpha(gains.ts_s * I2T_DECIMATION as f32);
+        self.pi.reset();
+        Ok(())
+    }
+
+    /// The gains in force.
+    pub fn gains(&self) -> &Gains {
+        &self.gains
+    }
+
+    /// Gates on (true) or off. Enabling clears the integrators.
+    pub fn enable(&mut self, on: bool) {
+        if on && !self.enabled {
+            self.pi.reset();
+        }
+        self.enabled = on;
+    }
+
+    /// A further current limit, A (2415h in speed mode, P-133); infinity = none.
+    pub fn set_external_limit(&mut self, limit_a: f32) {
+        self.external_limit_a = limit_a;
+    }
+
+    /// The latched trip, if any.
+    pub fn trip(&self) -> Option<Trip> {
+        self.trip
+    }
+
+    /// Fault reset: clears the latched trip (a cause still present trips again in
+    /// the next step).
+    pub fn reset_trip(&mut self) {
+        self.trip = None;
+    }
+
+    /// What the last step measured.
+    pub fn measured(&self) -> &Measured {
+        &self.measured
+    }
+
+    /// The i²t model.
+    pub fn i2t(&self) -> &I2t {
+        &self.i2t
+    }
+
+    /// The current reference of a torque command: iq = torque / kt, id = 0 (no field
+    /// weakening yet: the speed range ends where the back-EMF meets the voltage
+    /// circle; a negative id reference there is future work).
+    pub fn current_reference(&self, torque_nm: f32) -> Dq {
+        Dq {
+            d: 0.0,
+            q: torque_nm / self.gains.kt_nm_per_a,
+        }
+    }
+
+    /// One PWM period: the sample of this period's centre in, the compare values of
+    /// the next period out. Trips latch and switch the gates off in the same step.
+    pub fn step(&mut self, s: &Sample, reference: Dq) -> PwmOut {
+        let sc = &self.scaling;
+        let g = &self.gains;
+        let [ca, cb, cc] = s.phase_counts;
+        let [za, zb, zc] = sc.zero_counts;
+        let a = (f32::from(ca) - za) * sc.amps_per_count;
+        let b = (f32::from(cb) - zb) * sc.amps_per_count;
+        let phases = match sc.shunts {
+            Shunts::Three => Abc {
+                a,
+                b,
+                c: (f32::from(cc) - zc) * sc.amps_per_count,
+            },
+            Shunts::Two => Abc { a, b, c: -a - b },
+        };
+        let vdc = f32::from(s.dc_link_count) * sc.volts_per_count;
+
+        let angle: Angle = s
+            .position_inc
+            .wrapping_sub(sc.commutation_offset_inc)
+            .wrapping_mul(g.pole_pairs)
+            << 12;
+        let omega_e = match self.last_angle {
+            Some(last) => (angle.wrapping_sub(last) as i32) as f32 * (RAD_PER_ANGLE * g.inv_ts),
+            None => 0.0,
+        };
+        self.last_angle = Some(angle);
+        let (sin, cos) = sin_cos(angle);
+        let current = park(clarke(phases), sin, cos);
+
+        // i²t: the mean square current of I2T_DECIMATION periods, one model step
+        self.i2t_sum += current.d * current.d + current.q * current.q;
+        self.i2t_count += 1;
+        if self.i2t_count >= I2T_DECIMATION {
+            self.i2t_state = self
+                .i2t
+                .step_alpha(self.i2t_sum * (1.0 / I2T_DECIMATION as f32), self.i2t_alpha);
+            self.i2t_sum = 0.0;
+            self.i2t_count = 0;
+        }
+        let i2t = self.i2t_state;
+        if self.trip.is_none() {
+            let p = &self.protection;
+            self.trip = if p.over_current.tripped(phases) {
+                Some(Trip::OverCurrent)
+            } else if sc.shunts == Shunts::Three && p.phase_sum.implausible(phases) {
+                Some(Trip::PhaseSum)
+            } else if let Some(t) = p.dc_link.check(vdc) {
+                Some(t)
+            } else if !s.encoder_ok {
+                Some(Trip::EncoderLost)
+            } else if i2t == I2tState::Fault {
+                Some(Trip::MotorI2t)
+            } else {
+                None
+            };
+        }
+        let i2t_limit = if i2t == I2tState::Normal || i2t == I2tState::Warning {
+            f32::INFINITY
+        } else {
+            self.motor.rated_current_a
+        };
+        let limit = current_limit(&[
+            self.motor.max_current_a,
+            self.protection.stage_current_a,
+            self.external_limit_a,
+            i2t_limit,
+        ]);
+        self.measured = Measured {
+            phases,
+            current,
+            vdc,
+            angle,
+            omega_e,
+            voltage: Dq::default(),
+            voltage_limited: false,
+            current_limit_a: limit,
+            i2t: Some(i2t),
+        };
+        let half = sc.pwm_period_counts / 2;
+        if self.trip.is_some() || !self.enabled {
+            self.pi.reset();
+            return PwmOut {
+                compare: [half; 3],
+                gate_enable: false,
+            };
+        }
+
+        let reference = Dq {
+            d: reference.d.clamp(-limit, limit),
+            q: reference.q.clamp(-limit, limit),
+        };
+        let v_max = g.v_limit_per_vdc * vdc;
+        let (v, cut) = self.pi.step(g, reference, current, omega_e, v_max);
+        self.measured.voltage = v;
+        self.measured.voltage_limited = cut;
+
+        // the voltage acts over the next period, centred one period after the sample
+        let advance = (omega_e * g.ts_s * ANGLE_PER_RAD) as i32 as u32;
+        let (so, co) = sin_cos(angle.wrapping_add(advance));
+        let v_ab: AlphaBeta = inverse_park(v, so, co);
+        let (duty, _) = svm(v_ab, vdc, 1.0 / vdc.max(1.0));
+        let duty = compensate_dead_time(duty, phases, g.dead_time_duty, g.inv_dead_time_band);
+        let period = f32::from(sc.pwm_period_counts);
+        let cmp = |d: f32| (d * period + 0.5) as u16;
+        PwmOut {
+            compare: [cmp(duty.a), cmp(duty.b), cmp(duty.c)],
+            gate_enable: true,
+        }
+    }
+}

@@ -1,0 +1,425 @@
+//! The building blocks against their definitions and closed forms.
+
+use foc::params::{Gains, LoopParams, MotorData, Param, Violation};
+use foc::pi::limit_voltage_circle;
+use foc::protect::{current_limit, DcLink, I2t, I2tState, OverCurrent, PhaseSum, Trip};
+use foc::svm::{compensate_dead_time, svm, Duty};
+use foc::transform::*;
+use foc::trig::{angle_from_rad, sin_cos};
+use foc::{FocAxis, Protection, PwmOut, Sample, Scaling};
+use std::f64::consts::TAU;
+
+fn close(a: f32, b: f32, tol: f32) -> bool {
+    (a - b).abs() <= tol
+}
+
+#[test]
+fn sin_cos_table_accuracy() {
+    let mut worst = 0.0f64;
+    for k in 0..100_000u32 {
+        let angle = k.wrapping_mul(42_949); // spread over the turn, between table points
+        let x = f64::from(angle) / 4_294_967_296.0 * TAU;
+        let (s, c) = sin_cos(angle);
+        worst = worst
+            .max((f64::from(s) - x.sin()).abs())
+            .max((f64::from(c) - x.cos()).abs());
+    }
+    println!("sin/cos table: worst error {worst:.2e}");
+    // linear interpolation bound (2π/512)²/8 = 1.88e-5, plus f32 rounding
+    assert!(worst < 2.0e-5, "{worst}");
+    assert!(
+        worst > 1.0e-6,
+        "the bound is that of a 512-entry table, not exact: {worst}"
+    );
+    // angle_from_rad wraps negative angles onto the same turn
+    let (s, c) = sin_cos(angle_from_rad(-1.0));
+    assert!(close(s, (-1.0f32).sin(), 3e-5) && close(c, (-1.0f32).cos(), 3e-5));
+}
+
+#[test]
+fn clarke_park_round_trip() {
+    for k in 0..360 {
+        let th = k as f32 * 0.017_453_3 * 7.3;
+        let (s, c) = (th.sin(), th.cos());
+        let dq = Dq {
+            d: 0.3 - k as f32 * 0.01,
+            q: 1.7,
+        };
+        let ab = inverse_park(dq, s, c);
+        let abc = inverse_clarke(ab);
+        assert!(close(abc.a + abc.b + abc.c, 0.0, 1e-5));
+        // amplitude-invariant: a phase's amplitude is the vector's length
+        let back = park(clarke(abc), s, c);
+        assert!(
+            close(back.d, dq.d, 1e-5) && close(back.q, dq.q, 1e-5),
+            "{back:?} vs {dq:?}"
+        );
+        let back2 = park(clarke2(abc.a, abc.b), s, c);
+        assert!(close(back2.d, dq.d, 1e-5) && close(back2.q, dq.q, 1e-5));
+    }
+    // a balanced set of amplitude 2 with phase a at its peak is α = 2, β = 0
+    let ab = clarke(Abc {
+        a: 2.0,
+        b: -1.0,
+        c: -1.0,
+    });
+    assert!(close(ab.alpha, 2.0, 1e-6) && close(ab.beta, 0.0, 1e-6));
+    // the common mode drops out
+    let ab2 = clarke(Abc {
+        a: 12.0,
+        b: 9.0,
+        c: 9.0,
+    });
+    assert!(close(ab2.alpha, 2.0, 1e-5) && close(ab2.beta, 0.0, 1e-5));
+}
+
+#[test]
+fn svm_duties_reproduce_commanded_phase_voltages() {
+    let vdc = 560.0f32;
+    for k in 0..720 {
+        let th = k as f32 * 0.5f32.to_radians();
+        // up to the inscribed circle Vdc/√3, the linear range
+        let mag = vdc * FRAC_1_SQRT_3 * (k % 10) as f32 / 9.0;
+        let v = AlphaBeta {
+            alpha: mag * th.cos(),
+            beta: mag * th.sin(),
+        };
+        let (d, over) = svm(v, vdc, 1.0 / vdc);
+        assert!(!over);
+        for x in [d.a, d.b, d.c] {
+            assert!((0.0..=1.0 + 1e-6).contains(&x), "{d:?}");
+        }
+        // the averaged leg voltages d·Vdc, less their mean (the floating star),
+        // are the commanded phase voltages
+        let cmd = inverse_clarke(v);
+        let m = (d.a + d.b + d.c) / 3.0;
+        for (dx, vx) in [(d.a, cmd.a), (d.b, cmd.b), (d.c, cmd.c)] {
+            assert!(close((dx - m) * vdc, vx, 0.02), "{} vs {vx}", (dx - m) * vdc);
+        }
+    }
+}
+
+#[test]
+fn svm_over_modulation_stays_in_unit_interval_and_keeps_the_angle() {
+    let vdc = 560.0f32;
+    for k in 0..720 {
+        let th = k as f32 * 0.5f32.to_radians();
+        let mag = vdc * (0.7 + k as f32 / 720.0); // up to 1.7·Vdc: far beyond the hexagon
+        let v = AlphaBeta {
+            alpha: mag * th.cos(),
+            beta: mag * th.sin(),
+        };
+        let (d, _) = svm(v, vdc, 1.0 / vdc);
+        for x in [d.a, d.b, d.c] {
+            assert!((-1e-6..=1.0 + 1e-6).contains(&x), "{d:?} at {mag}");
+        }
+        let m = (d.a + d.b + d.c) / 3.0;
+        let out = clarke(Abc {
+            a: (d.a - m) * vdc,
+            b: (d.b - m) * vdc,
+            c: (d.c - m) * vdc,
+        });
+        let cross = out.alpha * v.beta - out.beta * v.alpha;
+        assert!(cross.abs() <= 1e-3 * mag * mag, "angle changed");
+        let len = out.alpha.hypot(out.beta);
+        assert!(len <= mag * 1.0001);
+        // onto the hexagon: at least the inscribed circle, at most its corners
+        assert!(
+            len >= vdc * FRAC_1_SQRT_3 * 0.999 - 0.01 || len >= mag * 0.999,
+            "{len}"
+        );
+        assert!(len <= vdc * 2.0 / 3.0 * 1.0001, "{len}");
+    }
+}
+
+#[test]
+fn dead_time_compensation_adds_duty_in_the_current_direction() {
+    let d = Duty {
+        a: 0.5,
+        b: 0.5,
+        c: 0.999,
+    };
+    let out = compensate_dead_time(
+        d,
+        Abc {
+            a: 3.0,
+            b: -3.0,
+            c: 0.01,
+        },
+        0.016,
+        1.0 / 0.05,
+    );
+    assert!(close(out.a, 0.516, 1e-6) && close(out.b, 0.484, 1e-6));
+    assert!(close(out.c, 1.0, 1e-6), "clamped to [0, 1]: {}", out.c);
+}
+
+#[test]
+fn voltage_circle_limit_gives_d_priority() {
+    let (v, cut) = limit_voltage_circle(Dq { d: 30.0, q: 40.0 }, 50.0);
+    assert!(!cut && v == Dq { d: 30.0, q: 40.0 });
+    let (v, cut) = limit_voltage_circle(Dq { d: 30.0, q: 100.0 }, 50.0);
+    assert!(cut && close(v.d, 30.0, 1e-6) && close(v.q, 40.0, 1e-4), "{v:?}");
+    let (v, cut) = limit_voltage_circle(Dq { d: -80.0, q: -10.0 }, 50.0);
+    assert!(cut && close(v.d, -50.0, 1e-6) && close(v.q, 0.0, 1e-6), "{v:?}");
+    let (v, _) = limit_voltage_circle(Dq { d: 1.0, q: -500.0 }, 50.0);
+    assert!(close(v.d.hypot(v.q), 50.0, 1e-3) && v.q < 0.0);
+}
+
+#[test]
+fn gains_by_pole_zero_cancellation() {
+    let m = MotorData::default_servo();
+    let l = LoopParams::default_16k();
+    let g = Gains::from_motor(&m, &l).unwrap();
+    assert!(close(g.kp_d, l.omega_c_rad_s * m.ld_h, 1e-4));
+    // discrete zero on the plant's discrete pole: Kp/(Kp + Ki·Ts) = e^(−R·Ts/L)
+    let zero = g.kp_q / (g.kp_q + g.ki_ts_q);
+    let pole = (-(m.r_ohm * l.period_s() / m.lq_h)).exp();
+    assert!(close(zero, pole, 1e-6));
+    // first order: Ki·Ts ≈ ω_c·R·Ts
+    assert!(close(
+        g.ki_ts_d,
+        l.omega_c_rad_s * m.r_ohm * l.period_s(),
+        0.02 * g.ki_ts_d
+    ));
+    assert!(
+        close(g.kt_nm_per_a * m.rated_current_a, 1.3, 1e-5),
+        "kt·I_rated is hil-sim's rated torque"
+    );
+}
+
+#[test]
+fn bad_motor_data_is_refused_with_sdo_abort_codes() {
+    let l = LoopParams::default_16k();
+    type Edit = fn(&mut MotorData, &mut LoopParams);
+    let cases: [(Edit, Param, Violation, u32); 7] = [
+        (
+            |m, _| m.r_ohm = 0.0,
+            Param::Resistance,
+            Violation::TooLow,
+            0x0609_0032,
+        ),
+        (
+            |m, _| m.r_ohm = -1.0,
+            Param::Resistance,
+            Violation::TooLow,
+            0x0609_0032,
+        ),
+        (|m, _| m.ld_h = 0.0, Param::Ld, Violation::TooLow, 0x0609_0032),
+        (
+            |m, _| m.lq_h = f32::NAN,
+            Param::Lq,
+            Violation::OutOfRange,
+            0x0609_0030,
+        ),
+        (
+            |m, _| m.pole_pairs = 0,
+            Param::PolePairs,
+            Violation::TooLow,
+            0x0609_0032,
+        ),
+        // f_c above a fifth of the PWM rate
+        (
+            |_, l| l.omega_c_rad_s = core::f32::consts::TAU * 3300.0,
+            Param::Bandwidth,
+            Violation::TooHigh,
+            0x0609_0031,
+        ),
+        (
+            |_, l| {
+                l.pwm_hz = 8000.0;
+                l.omega_c_rad_s = core::f32::consts::TAU * 1700.0
+            },
+            Param::Bandwidth,
+            Violation::TooHigh,
+            0x0609_0031,
+        ),
+    ];
+    for (f, param, violation, code) in cases {
+        let (mut m, mut lp) = (MotorData::default_servo(), l);
+        f(&mut m, &mut lp);
+        let e = Gains::from_motor(&m, &lp).unwrap_err();
+        assert_eq!(
+            (e.param, e.violation, e.sdo_abort_code()),
+            (param, violation, code)
+        );
+    }
+    // exactly a fifth is accepted
+    let mut lp = l;
+    lp.omega_c_rad_s = core::f32::consts::TAU * 3200.0;
+    assert!(Gains::from_motor(&MotorData::default_servo(), &lp).is_ok());
+    // a refused write to an axis changes nothing
+    let mut axis = FocAxis::new(
+        MotorData::default_servo(),
+        l,
+        Scaling::default_board(),
+        Protection::default_stage(),
+    )
+    .unwrap();
+    let before = *axis.gains();
+    let mut bad = MotorData::default_servo();
+    bad.r_ohm = -3.0;
+    assert!(axis.set_params(bad, l).is_err());
+    assert_eq!(*axis.gains(), before);
+}
+
+#[test]
+fn i2t_follows_its_closed_form_exponential() {
+    let (rated, tau) = (2.0f32, 60.0f32);
+    let mut m = I2t::new(rated, tau);
+    let dt = 1.0e-3f32;
+    let i = 1.5 * rated; // 225 % steady state
+    let mut t = 0.0f64;
+    let mut warned_at = None;
+    let mut limit_at = None;
+    for _ in 0..60_000 {
+        let s = m.step(i, dt);
+        t += f64::from(dt);
+        let x_cf = 2.25 * (1.0 - (-t / f64::from(tau)).exp());
+        assert!(
+            (f64::from(m.level()) - x_cf).abs() < 2e-4 * x_cf.max(1.0),
+            "t {t}: {} vs {x_cf}",
+            m.level()
+        );
+        if s == I2tState::Warning && warned_at.is_none() {
+            warned_at = Some(t);
+        }
+        if s == I2tState::Limiting && limit_at.is_none() {
+            limit_at = Some(t);
+        }
+        if s == I2tState::Fault {
+            break;
+        }
+    }
+    // closed form crossing times: t = −τ·ln(1 − level/2.25)
+    let cross = |level: f64| -f64::from(tau) * (1.0 - level / 2.25).ln();
+    assert!((warned_at.unwrap() - cross(0.8)).abs() < 2e-3);
+    assert!((limit_at.unwrap() - cross(1.0)).abs() < 2e-3);
+    assert_eq!(m.state(), I2tState::Fault);
+    assert!((t - cross(1.1)).abs() < 2e-3);
+    // cooling from 1.1 with no current: x = 1.1·e^(−t/τ)
+    let x0 = f64::from(m.level());
+    for _ in 0..30_000 {
+        m.step(0.0, dt);
+    }
+    assert!((f64::from(m.level()) - x0 * (-30.0 / f64::from(tau)).exp()).abs() < 1e-4);
+}
+
+#[test]
+fn p133_current_limit_is_the_lowest_of_the_limits() {
+    assert_eq!(current_limit(&[6.0, 8.0, 2.5, f32::INFINITY]), 2.5);
+    assert_eq!(current_limit(&[6.0, -1.0]), 0.0);
+    assert_eq!(current_limit(&[6.0, f32::NAN]), 0.0);
+    assert_eq!(current_limit(&[]), 0.0);
+    assert_eq!(current_limit(&[f32::INFINITY]), 0.0);
+}
+
+#[test]
+fn protection_blocks_trip_at_their_thresholds() {
+    let oc = OverCurrent { threshold_a: 9.0 };
+    assert!(!oc.tripped(Abc {
+        a: 8.9,
+        b: -4.0,
+        c: -4.9
+    }));
+    assert!(oc.tripped(Abc {
+        a: 4.0,
+        b: 5.1,
+        c: -9.1
+    }));
+    let ps = PhaseSum { tolerance_a: 0.3 };
+    assert!(!ps.implausible(Abc {
+        a: 1.0,
+        b: -0.6,
+        c: -0.2
+    }));
+    assert!(ps.implausible(Abc {
+        a: 1.0,
+        b: -0.6,
+        c: 0.2
+    }));
+    let dc = DcLink {
+        min_v: 400.0,
+        max_v: 800.0,
+    };
+    assert_eq!(dc.check(399.0), Some(Trip::DcUnderVoltage));
+    assert_eq!(dc.check(801.0), Some(Trip::DcOverVoltage));
+    assert_eq!(dc.check(565.0), None);
+}
+
+fn sample(counts: [u16; 3], vdc_count: u16) -> Sample {
+    Sample {
+        phase_counts: counts,
+        dc_link_count: vdc_count,
+        position_inc: 0,
+        encoder_ok: true,
+    }
+}
+
+#[test]
+fn axis_trips_switch_the_gates_off_in_the_same_step() {
+    let sc = Scaling::default_board();
+    let mk = || {
+        let mut a = FocAxis::new(
+            MotorData::default_servo(),
+            LoopParams::default_16k(),
+            sc,
+            Protection::default_stage(),
+        )
+        .unwrap();
+        a.enable(true);
+        a
+    };
+    let q = foc::Dq { d: 0.0, q: 1.0 };
+    let ok = sample([2048; 3], 2260);
+    let mut a = mk();
+    assert!(a.step(&ok, q).gate_enable);
+    // 10 A on phase a (over 9 A), balanced by b
+    let amps = |i: f32| (2048.0 + i / sc.amps_per_count) as u16;
+    let cases = [
+        (sample([amps(10.0), amps(-10.0), 2048], 2260), Trip::OverCurrent),
+        (sample([amps(1.0), amps(0.0), amps(0.0)], 2260), Trip::PhaseSum),
+        (sample([2048; 3], 1500), Trip::DcUnderVoltage),
+        (sample([2048; 3], 3300), Trip::DcOverVoltage),
+        (
+            Sample {
+                encoder_ok: false,
+                ..ok
+            },
+            Trip::EncoderLost,
+        ),
+    ];
+    for (s, trip) in cases {
+        let mut a = mk();
+        a.step(&ok, q);
+        let out: PwmOut = a.step(&s, q);
+        assert!(!out.gate_enable, "{trip:?}");
+        assert_eq!(a.trip(), Some(trip));
+        // latched: a good sample keeps the gates off until the fault reset
+        assert!(!a.step(&ok, q).gate_enable);
+        a.reset_trip();
+        assert!(a.step(&ok, q).gate_enable);
+    }
+    // a NaN reference neither panics nor produces gate signals beyond the period
+    let out = a.step(
+        &ok,
+        foc::Dq {
+            d: f32::NAN,
+            q: f32::NAN,
+        },
+    );
+    assert!(out.compare.iter().all(|&c| c <= sc.pwm_period_counts));
+}
+
+#[test]
+fn torque_reference_is_iq_through_the_torque_constant_with_id_zero() {
+    let a = FocAxis::new(
+        MotorData::default_servo(),
+        LoopParams::default_16k(),
+        Scaling::default_board(),
+        Protection::default_stage(),
+    )
+    .unwrap();
+    let r = a.current_reference(1.3);
+    assert_eq!(r.d, 0.0);
+    assert!(close(r.q, 2.0, 1e-5));
+}
