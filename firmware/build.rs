@@ -48,6 +48,7 @@ fn main() {
     let on = |f: &str| env::var_os(f).is_some();
     let qemu = on("CARGO_FEATURE_QEMU") || on("CARGO_FEATURE_QEMU_PN");
     let board = on("CARGO_FEATURE_BOARD") || on("CARGO_FEATURE_BOARD_PN");
+    let mps2_foc = on("CARGO_FEATURE_MPS2_FOC");
     let mps2 = on("CARGO_FEATURE_MPS2_PN");
     let boot_board = on("CARGO_FEATURE_BOOT_BOARD");
     let boot_mps2 = on("CARGO_FEATURE_BOOT_MPS2");
@@ -56,6 +57,9 @@ fn main() {
     let boot_images = [boot_board, boot_mps2, mps2_slot].iter().filter(|&&b| b).count();
     if boot_images > 0 && (boot_images > 1 || qemu || board || mps2) {
         panic!("features `boot-board`, `boot-mps2` and `mps2-slot` each build one image: build it alone with --no-default-features");
+    }
+    if mps2_foc && (qemu || board || mps2 || boot_images > 0) {
+        panic!("feature `mps2-foc` builds one image: build it alone with --no-default-features --features mps2-foc");
     }
     if mps2 && (qemu || board) {
         panic!("feature `mps2-pn` selects QEMU's MPS2-AN386: build it alone with --no-default-features --features mps2-pn");
@@ -82,7 +86,7 @@ fn main() {
     } else if mps2_slot {
         let s = slot.expect("the mps2-slot image is linked for a slot: set FIRMWARE_SLOT=a or b");
         ("qemu-mps2/memory.x", Some(format!("mps2-{s}")))
-    } else if mps2 {
+    } else if mps2 || mps2_foc {
         ("qemu-mps2/memory.x", None)
     } else if qemu {
         ("qemu/memory.x", None)

@@ -1,12 +1,13 @@
 //! One axis' current loop: sample in, compare values out, once per PWM period.
 
+use crate::fmath;
 use crate::params::{Gains, LoopParams, MotorData, ParamError};
 use crate::pi::CurrentPi;
-use crate::protect::{current_limit, DcLink, I2t, I2tState, OverCurrent, PhaseSum, Trip};
+use crate::protect::{DcLink, I2t, I2tState, OverCurrent, PhaseSum, Trip};
 use crate::seam::{PwmOut, Sample, Scaling, Shunts};
 use crate::svm::{compensate_dead_time, svm};
 use crate::transform::{clarke, inverse_park, park, Abc, AlphaBeta, Dq};
-use crate::trig::{sin_cos, Angle, ANGLE_PER_RAD, RAD_PER_ANGLE};
+use crate::trig::{sin_cos, Angle, RAD_PER_ANGLE};
 
 /// PWM periods per step of the i²t model (16 ms at 16 kHz).
 pub const I2T_DECIMATION: u32 = 256;
@@ -144,7 +145,8 @@ impl FocAxis {
 
     /// A further current limit, A (2415h in speed mode, P-133); infinity = none.
     pub fn set_external_limit(&mut self, limit_a: f32) {
-        self.external_limit_a = limit_a;
+        // a NaN limit is no licence: 0 A; negative likewise
+        self.external_limit_a = if limit_a >= 0.0 { limit_a } else { 0.0 };
     }
 
     /// The latched trip, if any.
@@ -242,12 +244,12 @@ impl FocAxis {
         } else {
             self.motor.rated_current_a
         };
-        let limit = current_limit(&[
-            self.motor.max_current_a,
-            self.protection.stage_current_a,
-            self.external_limit_a,
-            i2t_limit,
-        ]);
+        // the lowest of the limits (`protect::current_limit`, unrolled: all are
+        // validated positive, the external one sanitised where it is set)
+        let limit = fmath::min(
+            fmath::min(self.motor.max_current_a, self.protection.stage_current_a),
+            fmath::min(self.external_limit_a, i2t_limit),
+        );
         self.measured = Measured {
             phases,
             current,
@@ -269,8 +271,8 @@ impl FocAxis {
         }
 
         let reference = Dq {
-            d: reference.d.clamp(-limit, limit),
-            q: reference.q.clamp(-limit, limit),
+            d: fmath::clamp(reference.d, -limit, limit),
+            q: fmath::clamp(reference.q, -limit, limit),
         };
         let v_max = g.v_limit_per_vdc * vdc;
         let (v, cut) = self.pi.step(g, reference, current, omega_e, v_max);
@@ -278,10 +280,13 @@ impl FocAxis {
         self.measured.voltage_limited = cut;
 
         // the voltage acts over the next period, centred one period after the sample
-        let advance = (omega_e * g.ts_s * ANGLE_PER_RAD) as i32 as u32;
-        let (so, co) = sin_cos(angle.wrapping_add(advance));
+        // rotating (sin, cos) by δ = ω·Ts to second order (|δ| ≤ 0.08 rad at
+        // 3000 rpm and 16 kHz: error δ³/6 < 10⁻⁴) instead of a second table lookup
+        let delta = omega_e * g.ts_s;
+        let k = 1.0 - 0.5 * delta * delta;
+        let (so, co) = (sin * k + cos * delta, cos * k - sin * delta);
         let v_ab: AlphaBeta = inverse_park(v, so, co);
-        let (duty, _) = svm(v_ab, vdc, 1.0 / vdc.max(1.0));
+        let (duty, _) = svm(v_ab, vdc, 1.0 / fmath::max(vdc, 1.0));
         let duty = compensate_dead_time(duty, phases, g.dead_time_duty, g.inv_dead_time_band);
         let period = f32::from(sc.pwm_period_counts);
         let cmp = |d: f32| (d * period + 0.5) as u16;

@@ -48,3 +48,41 @@ pub use params::{Gains, LoopParams, MotorData, Param, ParamError, Violation};
 pub use protect::{I2tState, Trip};
 pub use seam::{PowerStage, PwmOut, Sample, Scaling, Shunts};
 pub use transform::{Abc, AlphaBeta, Dq};
+
+/// f32 helpers that compile to a compare and a conditional move on the M4F (core's
+/// `f32::max`/`min` call `fmaxf`/`fminf`, and `clamp` has a panic path for bounds it
+/// cannot prove ordered). NaN passes through `clamp`; callers' outputs are bounded
+/// again where they become integers (`as` saturates, NaN → 0).
+pub mod fmath {
+    /// The larger of two (b if a is NaN).
+    #[inline(always)]
+    pub fn max(a: f32, b: f32) -> f32 {
+        if a > b {
+            a
+        } else {
+            b
+        }
+    }
+
+    /// The smaller of two (b if a is NaN).
+    #[inline(always)]
+    pub fn min(a: f32, b: f32) -> f32 {
+        if a < b {
+            a
+        } else {
+            b
+        }
+    }
+
+    /// x limited to [lo, hi] (no panic when lo > hi: hi wins).
+    #[inline(always)]
+    pub fn clamp(x: f32, lo: f32, hi: f32) -> f32 {
+        if x > hi {
+            hi
+        } else if x < lo {
+            lo
+        } else {
+            x
+        }
+    }
+}

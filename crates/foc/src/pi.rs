@@ -1,5 +1,6 @@
 //! The two dq PI current controllers: decoupling, anti-windup, the voltage circle.
 
+use crate::fmath;
 use crate::params::Gains;
 use crate::transform::Dq;
 
@@ -13,12 +14,12 @@ pub fn limit_voltage_circle(v: Dq, v_max: f32) -> (Dq, bool) {
     if v.d * v.d + v.q * v.q <= vm2 {
         return (v, false);
     }
-    let d = v.d.clamp(-v_max, v_max);
-    let q_max = libm::sqrtf((vm2 - d * d).max(0.0));
+    let d = fmath::clamp(v.d, -v_max, v_max);
+    let q_max = libm::sqrtf(fmath::max(vm2 - d * d, 0.0));
     (
         Dq {
             d,
-            q: v.q.clamp(-q_max, q_max),
+            q: fmath::clamp(v.q, -q_max, q_max),
         },
         true,
     )
@@ -82,8 +83,8 @@ impl CurrentPi {
         } else {
             (0.0, 0.0)
         };
-        let int_d = (self.int_d + g.ki_ts_d * ed).clamp(-v_max, v_max);
-        let int_q = (self.int_q + g.ki_ts_q * eq).clamp(-v_max, v_max);
+        let int_d = fmath::clamp(self.int_d + g.ki_ts_d * ed, -v_max, v_max);
+        let int_q = fmath::clamp(self.int_q + g.ki_ts_q * eq, -v_max, v_max);
         let v = Dq {
             d: g.kp_d * ed + int_d + ffd,
             q: g.kp_q * eq + int_q + ffq,

@@ -183,10 +183,10 @@ pub fn current_limit(limits: &[f32]) -> f32 {
         if l.is_nan() {
             return 0.0;
         }
-        lowest = lowest.min(l);
+        lowest = crate::fmath::min(l, lowest);
     }
     if lowest.is_finite() {
-        lowest.max(0.0)
+        crate::fmath::max(lowest, 0.0)
     } else {
         0.0
     }

@@ -1,6 +1,7 @@
 //! Space-vector modulation by min/max (midpoint) injection, over-modulation, and
 //! dead-time compensation.
 
+use crate::fmath;
 use crate::transform::{inverse_clarke, Abc, AlphaBeta};
 
 /// Duty cycles of the three half bridges, each the fraction of the period the high
@@ -28,8 +29,8 @@ pub struct Duty {
 #[inline]
 pub fn svm(v: AlphaBeta, vdc: f32, inv_vdc: f32) -> (Duty, bool) {
     let p = inverse_clarke(v);
-    let max = p.a.max(p.b).max(p.c);
-    let min = p.a.min(p.b).min(p.c);
+    let max = fmath::max(fmath::max(p.a, p.b), p.c);
+    let min = fmath::min(fmath::min(p.a, p.b), p.c);
     let span = max - min;
     let mid = 0.5 * (max + min);
     let (k, over) = if span > vdc {
@@ -55,10 +56,10 @@ pub fn svm(v: AlphaBeta, vdc: f32, inv_vdc: f32) -> (Duty, bool) {
 /// kept in [0, 1].
 #[inline]
 pub fn compensate_dead_time(d: Duty, i: Abc, dead_time_duty: f32, inv_band: f32) -> Duty {
-    let c = |x: f32| (x * inv_band).clamp(-1.0, 1.0) * dead_time_duty;
+    let c = |x: f32| fmath::clamp(x * inv_band, -1.0, 1.0) * dead_time_duty;
     Duty {
-        a: (d.a + c(i.a)).clamp(0.0, 1.0),
-        b: (d.b + c(i.b)).clamp(0.0, 1.0),
-        c: (d.c + c(i.c)).clamp(0.0, 1.0),
+        a: fmath::clamp(d.a + c(i.a), 0.0, 1.0),
+        b: fmath::clamp(d.b + c(i.b), 0.0, 1.0),
+        c: fmath::clamp(d.c + c(i.c), 0.0, 1.0),
     }
 }

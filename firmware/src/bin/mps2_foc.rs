@@ -1,0 +1,136 @@
+//! Instructions per current-loop step on a Cortex-M4F: `foc::FocAxis::step` for
+//! two axes, as the fast task will run them, on QEMU's mps2-an386 under
+//! `-icount shift=0` (one instruction per virtual ns; SysTick calibrated against
+//! a loop of known length, as `boot-mps2` does). `scripts/cross foc` builds and
+//! runs it. The samples are a precomputed rotating current set (64 of them, a
+//! turning encoder), so the step takes its ordinary path: no trip, the voltage
+//! circle not reached; the loop's own overhead (sample fetch, black-boxed output)
+//! is measured with an empty step and subtracted. Prints the figure and exits.
+#![no_std]
+#![no_main]
+
+use core::hint::black_box;
+use cortex_m_rt::entry;
+use cortex_m_semihosting::{debug, hprintln};
+use foc::{Dq, FocAxis, LoopParams, MotorData, Protection, PwmOut, Sample, Scaling};
+
+#[panic_handler]
+fn panic(_info: &core::panic::PanicInfo) -> ! {
+    hprintln!("foc: panic");
+    stop(false)
+}
+
+fn stop(ok: bool) -> ! {
+    debug::exit(if ok {
+        debug::EXIT_SUCCESS
+    } else {
+        debug::EXIT_FAILURE
+    });
+    loop {
+        cortex_m::asm::wfi();
+    }
+}
+
+/// Steps per measurement (each: both axes).
+const STEPS: u32 = 4096;
+
+fn ticks(start: u32, end: u32) -> u32 {
+    start.wrapping_sub(end) & 0x00FF_FFFF
+}
+
+/// Instructions per 1000 SysTick ticks (`subs` + `bne` loop).
+fn calibrate() -> u32 {
+    let n: u32 = 200_000;
+    let t0 = cortex_m::peripheral::SYST::get_current();
+    // SAFETY: a register-only countdown loop, no memory access.
+    #[allow(unsafe_code)]
+    unsafe {
+        core::arch::asm!("1:", "subs {0}, {0}, #1", "bne 1b", inout(reg) n => _, options(nomem, nostack));
+    }
+    let t = ticks(t0, cortex_m::peripheral::SYST::get_current()).max(1);
+    (u64::from(2 * n) * 1000 / u64::from(t)) as u32
+}
+
+/// A rotating current of 1.5 A amplitude, sampled as the default board would.
+fn samples() -> [Sample; 64] {
+    let sc = Scaling::default_board();
+    core::array::from_fn(|k| {
+        // 1/64 of an electrical turn per step; 4 pole pairs: 2^20/(4·64) increments
+        let pos = (k as u32) * 4096;
+        let th = k as f32 * (core::f32::consts::TAU / 64.0);
+        let (s, c) = foc::trig::sin_cos(foc::trig::angle_from_rad(th));
+        let ia = -1.5 * s;
+        let ib = -1.5 * (-0.5 * s + 0.866_025_4 * c);
+        let cnt = |i: f32| (2048.0 + i / sc.amps_per_count) as u16;
+        Sample {
+            phase_counts: [cnt(ia), cnt(ib), cnt(-ia - ib)],
+            dc_link_count: 2260,
+            position_inc: pos,
+            encoder_ok: true,
+        }
+    })
+}
+
+#[entry]
+fn main() -> ! {
+    let Some(cp) = cortex_m::Peripherals::take() else {
+        stop(false)
+    };
+    let mut syst = cp.SYST;
+    syst.set_clock_source(cortex_m::peripheral::syst::SystClkSource::Core);
+    syst.set_reload(0x00FF_FFFF);
+    syst.clear_current();
+    syst.enable_counter();
+    let per_1000 = calibrate();
+
+    let mk = || {
+        FocAxis::new(
+            MotorData::default_servo(),
+            LoopParams::default_16k(),
+            Scaling::default_board(),
+            Protection::default_stage(),
+        )
+        .ok()
+    };
+    let (Some(mut a), Some(mut b)) = (mk(), mk()) else {
+        hprintln!("foc: parameters refused");
+        stop(false)
+    };
+    a.enable(true);
+    b.enable(true);
+    let s = samples();
+    let reference = Dq { d: 0.0, q: 1.5 };
+
+    // the loop without the step: fetch, black box
+    let t0 = cortex_m::peripheral::SYST::get_current();
+    for k in 0..STEPS {
+        let x = black_box(&s[(k & 63) as usize]);
+        black_box(PwmOut {
+            compare: [x.phase_counts[0]; 3],
+            gate_enable: true,
+        });
+        black_box(PwmOut {
+            compare: [x.phase_counts[1]; 3],
+            gate_enable: true,
+        });
+    }
+    let empty = ticks(t0, cortex_m::peripheral::SYST::get_current());
+
+    let t0 = cortex_m::peripheral::SYST::get_current();
+    for k in 0..STEPS {
+        let x = black_box(&s[(k & 63) as usize]);
+        black_box(a.step(x, reference));
+        black_box(b.step(x, reference));
+    }
+    let full = ticks(t0, cortex_m::peripheral::SYST::get_current());
+    let ok = a.trip().is_none() && b.trip().is_none() && a.measured().current.q.abs() > 1.0;
+    let per_step = u64::from(full.saturating_sub(empty)) * u64::from(per_1000) / 1000 / u64::from(STEPS);
+    hprintln!(
+        "foc: figure: current-loop step, two axes: {} instructions ({} per axis; goal 350 per axis) over {} steps{}",
+        per_step,
+        per_step / 2,
+        STEPS,
+        if ok { "" } else { " (FAILED: tripped or wrong current)" }
+    );
+    stop(ok)
+}
