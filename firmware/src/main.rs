@@ -194,7 +194,7 @@ mod app {
                 let now = clock.now(DWT::cycle_count());
                 if timer.next_at() <= now {
                     *cmd = tasks::control(drive, timer, now, &[AxisIo::ready(0); 2]);
-                    crate::power::set(cmd.iter().any(|c| c.power_stage));
+                    crate::power::follow(cmd);
                 }
             },
         );

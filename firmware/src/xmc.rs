@@ -35,6 +35,13 @@ pub mod power {
             .omr()
             .write(|w| if on { w.ps9().set_bit() } else { w.pr9().set_bit() });
     }
+
+    /// The gate enable after a control cycle: high while any axis' command
+    /// wants its power stage on (one enable for both axes on this board).
+    #[inline]
+    pub fn follow(cmd: &[drive::axis::AxisCommand; 2]) {
+        set(cmd.iter().any(|c| c.power_stage));
+    }
 }
 
 /// The board images' panic: masks every interrupt first, so no task can

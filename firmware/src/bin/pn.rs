@@ -243,7 +243,7 @@ mod app {
                 let now = clock.now(DWT::cycle_count());
                 if timer.next_at() <= now {
                     *cmd = timer.run(drive, now, &[AxisIo::ready(0); 2]);
-                    firmware::xmc::power::set(cmd.iter().any(|c| c.power_stage));
+                    firmware::xmc::power::follow(cmd);
                 }
             },
         );
