@@ -32,53 +32,18 @@ use defmt_rtt as _;
 #[path = "bootapi.rs"]
 mod bootapi;
 
-/// A panic masks every interrupt first, so no task can command the power
-/// stage again, switches the power stage off (gate enable low), then
-/// reports over RTT and stops the core. `scripts/cross panics` checks that
-/// no panic path is reachable from any task.
+/// The board's panic stop (`firmware::xmc::panic_stop`): interrupts
+/// masked, power stage off, reported over RTT, core stopped.
 #[panic_handler]
 fn panic(_info: &core::panic::PanicInfo) -> ! {
-    cortex_m::interrupt::disable();
-    power::set(false);
-    defmt::error!("panic: interrupts masked, power stage off, halted");
-    loop {
-        cortex_m::asm::bkpt();
-    }
+    firmware::xmc::panic_stop()
 }
 
-/// The XMC4800 PAC as RTIC expects a device crate: svd2rust 0.14 output lacks
-/// the `interrupt` alias of the `Interrupt` enum, so it is added here.
-mod pac {
-    pub use xmc4800::Interrupt as interrupt;
-    pub use xmc4800::*;
-}
+/// The XMC4800 PAC as RTIC expects a device crate (`firmware::xmc::pac`).
+use firmware::xmc::pac;
 
-/// The power stage's gate-driver enable: P5.9, push-pull, active high
-/// (docs/flashing.md, wiring). Low from `init` until a control cycle
-/// commands an axis' power stage on; the panic handler drives it low.
-mod power {
-    /// Port 5 (only its output-modification register, whose set/reset
-    /// writes are atomic, and at `init` its pin 8–11 control register).
-    #[allow(unsafe_code)]
-    fn port() -> &'static xmc4800::port5::RegisterBlock {
-        // SAFETY: PORT5 is a fixed peripheral address; OMR writes touch only
-        // the bits written (no read-modify-write race with other users).
-        unsafe { &*xmc4800::PORT5::ptr() }
-    }
-
-    /// P5.9 as a push-pull output, low.
-    pub fn init() {
-        port().omr().write(|w| w.pr9().set_bit());
-        port().iocr8().modify(|_, w| w.pc9().value9());
-    }
-
-    /// Gate enable high (`on`) or low.
-    pub fn set(on: bool) {
-        port()
-            .omr()
-            .write(|w| if on { w.ps9().set_bit() } else { w.pr9().set_bit() });
-    }
-}
+/// The power stage's gate-driver enable (P5.9), shared with `firmware-pn`.
+use firmware::xmc::power;
 
 /// CPU clock after the boot ROM's PLL setup, Hz (DWT CYCCNT counts it).
 const CPU_HZ: u32 = 144_000_000;
@@ -94,7 +59,8 @@ mod app {
     #[cfg(not(feature = "net"))]
     use firmware::net::NoNet as Net;
     #[cfg(feature = "net")]
-    use firmware::net::{NetBuffers, NodeNet as Net, SocketSlots, BOARD_NET, EMPTY_SLOTS};
+    use firmware::net::NodeNet as Net;
+    use firmware::once::Once;
     use firmware::{tasks, Drive, ParamFlash};
     use pdi::mmio::{OnChip, VolatileWindow};
 
@@ -156,38 +122,19 @@ mod app {
 
     /// The drive in its static, built in this function's own frame.
     #[inline(never)]
-    #[allow(unsafe_code)]
     fn make_drive() -> Option<&'static mut Drive> {
-        static mut DRIVE: core::mem::MaybeUninit<Drive> = core::mem::MaybeUninit::uninit();
-        static TAKEN: core::sync::atomic::AtomicBool = core::sync::atomic::AtomicBool::new(false);
-        if TAKEN.swap(true, core::sync::atomic::Ordering::AcqRel) {
-            return None;
-        }
-        // SAFETY: the flag hands out the static once; `write` lets the drive
-        // be built in place (no copy of ~30 KiB through this frame, which
-        // `cortex_m::singleton!` makes).
-        let slot = unsafe { &mut *core::ptr::addr_of_mut!(DRIVE) };
-        let drive = slot.write(Drive::unstarted_for(VARIANT, ParamFlash::new(), None));
+        static DRIVE: Once<Drive> = Once::new();
+        let drive = DRIVE
+            .take()?
+            .write(Drive::unstarted_for(VARIANT, ParamFlash::new(), None));
         drive.start();
         Some(drive)
     }
 
-    /// The IP stack on `drive`'s EoE queue, in its statics (buffers, socket
-    /// slots, the stack itself: built in place like the drive).
+    /// The IP stack on `drive`'s EoE queue, in its statics.
     #[cfg(feature = "net")]
-    #[inline(never)]
-    #[allow(unsafe_code)]
     fn make_net(drive: &mut Drive) -> Option<&'static mut Net> {
-        static mut NET: core::mem::MaybeUninit<Net> = core::mem::MaybeUninit::uninit();
-        static TAKEN: core::sync::atomic::AtomicBool = core::sync::atomic::AtomicBool::new(false);
-        if TAKEN.swap(true, core::sync::atomic::Ordering::AcqRel) {
-            return None;
-        }
-        let bufs = cortex_m::singleton!(: NetBuffers = NetBuffers::new())?;
-        let slots = cortex_m::singleton!(: SocketSlots<'static> = EMPTY_SLOTS)?;
-        // SAFETY: as for the drive's static.
-        let slot = unsafe { &mut *core::ptr::addr_of_mut!(NET) };
-        Some(slot.write(Net::new(drive, BOARD_NET, bufs, slots, nanos::Nanos::ZERO)))
+        firmware::make_net(drive)
     }
 
     /// No IP stack in this image.
@@ -247,7 +194,7 @@ mod app {
                 let now = clock.now(DWT::cycle_count());
                 if timer.next_at() <= now {
                     *cmd = tasks::control(drive, timer, now, &[AxisIo::ready(0); 2]);
-                    crate::power::set(cmd.iter().any(|c| c.power_stage));
+                    crate::power::follow(cmd);
                 }
             },
         );

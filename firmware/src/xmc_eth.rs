@@ -1,6 +1,6 @@
-//! XMC4800 board glue of the PROFINET image: the power-stage gate enable
-//! (P5.9, as on the EtherCAT image), ETH0's clock, reset, port pins and
-//! RMII selection, the board's identity.
+//! XMC4800 board glue of the PROFINET image: ETH0's clock, reset, port pins
+//! and RMII selection, the board's identity (the power-stage gate enable is
+//! the EtherCAT image's, `firmware::xmc::power`).
 //!
 //! NOT VERIFIED ON HARDWARE (docs/hardware.md, "ETH0 and the PHY"): the
 //! reference kit KIT_XMC48_RELAX_ECAT_V1 wires its two PHYs to the EtherCAT
@@ -34,25 +34,6 @@ pub fn hardware() -> Hardware {
         // should differ; a product keeps a boot counter in its flash)
         boot_time: 1,
     }
-}
-
-#[allow(unsafe_code)]
-fn port5() -> &'static xmc4800::port5::RegisterBlock {
-    // SAFETY: a fixed peripheral address; OMR writes touch only the bits written.
-    unsafe { &*xmc4800::PORT5::ptr() }
-}
-
-/// P5.9 as a push-pull output, low.
-pub fn power_init() {
-    port5().omr().write(|w| w.pr9().set_bit());
-    port5().iocr8().modify(|_, w| w.pc9().value9());
-}
-
-/// Gate enable high (`on`) or low.
-pub fn power_set(on: bool) {
-    port5()
-        .omr()
-        .write(|w| if on { w.ps9().set_bit() } else { w.pr9().set_bit() });
 }
 
 /// IOCR pin control: ALT1 push-pull output.

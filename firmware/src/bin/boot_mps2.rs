@@ -27,7 +27,10 @@ use bootloader::{
     Outcome, Slot, IMAGE_HEADER_LEN, PUBLIC_KEY,
 };
 use cortex_m_rt::entry;
+// SysTick ticks and their calibration, as `firmware-qemu` measures (one wrap
+// at most: 2^24 ticks are about 670 million instructions on this machine)
 use cortex_m_semihosting::{debug, hprintln};
+use firmware::systick::{calibrate, now, ticks};
 
 #[path = "../semiflash.rs"]
 mod semiflash;
@@ -44,10 +47,7 @@ fn panic(_info: &core::panic::PanicInfo) -> ! {
 
 /// The safe stop: QEMU exits with a failure status.
 fn halt() -> ! {
-    debug::exit(debug::EXIT_FAILURE);
-    loop {
-        cortex_m::asm::wfi();
-    }
+    firmware::semihost::exit(false)
 }
 
 #[entry]
@@ -133,14 +133,11 @@ fn main() -> ! {
 /// Starts the image at `e` in place (direct execute-in-place).
 fn start(e: Entry) -> ! {
     // SAFETY: `check_image` found a vector table at `e.vtor` whose stack
-    // pointer is in RAM and whose reset vector lies in the image; nothing of
-    // this image is used after the jump. No interrupt was enabled here.
+    // pointer is in RAM and whose reset vector lies in the image; nothing
+    // of the boot loader is used after the jump. No interrupt was enabled.
     #[allow(unsafe_code)]
     unsafe {
-        (*cortex_m::peripheral::SCB::PTR).vtor.write(e.vtor);
-        cortex_m::asm::dsb();
-        cortex_m::asm::isb();
-        cortex_m::asm::bootload(e.vtor as *const u32)
+        firmware::start_image(e.vtor)
     }
 }
 
@@ -173,7 +170,7 @@ fn bench() {
     syst.clear_current();
     syst.enable_counter();
     let per_1000 = calibrate();
-    let t0 = cortex_m::peripheral::SYST::get_current();
+    let t0 = now();
     let r = verify_image(
         head,
         |at, buf| {
@@ -186,7 +183,7 @@ fn bench() {
         },
         &PUBLIC_KEY,
     );
-    let t = ticks(t0, cortex_m::peripheral::SYST::get_current());
+    let t = ticks(t0, now());
     let instructions = u64::from(t) * u64::from(per_1000) / 1000;
     hprintln!(
         "boot: figure: verification of a {} KiB image (CRC-32, SHA-256 of header and body in 256-byte reads, Ed25519): {} instructions ({})",
@@ -199,24 +196,4 @@ fn bench() {
     } else {
         debug::EXIT_FAILURE
     });
-}
-
-/// SysTick ticks from `start` to `end` (a 24-bit down counter; one wrap at
-/// most: 2^24 ticks are about 670 million instructions on this machine).
-fn ticks(start: u32, end: u32) -> u32 {
-    start.wrapping_sub(end) & 0x00FF_FFFF
-}
-
-/// Instructions per 1000 SysTick ticks, from a loop of `2 · n` instructions
-/// (`subs` + `bne`), as `firmware-qemu` calibrates.
-fn calibrate() -> u32 {
-    let n: u32 = 200_000;
-    let t0 = cortex_m::peripheral::SYST::get_current();
-    // SAFETY: a register-only countdown loop, no memory access.
-    #[allow(unsafe_code)]
-    unsafe {
-        core::arch::asm!("1:", "subs {0}, {0}, #1", "bne 1b", inout(reg) n => _, options(nomem, nostack));
-    }
-    let t = ticks(t0, cortex_m::peripheral::SYST::get_current()).max(1);
-    (u64::from(2 * n) * 1000 / u64::from(t)) as u32
 }

@@ -134,9 +134,6 @@ fn start(e: Entry) -> ! {
     // of the boot loader is used after the jump. No interrupt was enabled.
     #[allow(unsafe_code)]
     unsafe {
-        (*cortex_m::peripheral::SCB::PTR).vtor.write(e.vtor);
-        cortex_m::asm::dsb();
-        cortex_m::asm::isb();
-        cortex_m::asm::bootload(e.vtor as *const u32)
+        firmware::start_image(e.vtor)
     }
 }

@@ -84,10 +84,7 @@ mod mps2 {
 fn panic(_info: &core::panic::PanicInfo) -> ! {
     cortex_m::interrupt::disable();
     defmt::error!("panic: interrupts masked, halted");
-    cortex_m_semihosting::debug::exit(cortex_m_semihosting::debug::EXIT_FAILURE);
-    loop {
-        cortex_m::asm::wfi();
-    }
+    firmware::semihost::exit(false)
 }
 
 /// The core clock (the MPS2's SYSCLK).
@@ -178,10 +175,9 @@ mod app {
     use core::sync::atomic::Ordering;
     use cortex_m::peripheral::syst::SystClkSource;
     use drive::axis::{AxisCommand, AxisIo};
+    use firmware::pn_log::log_event;
     use firmware::ParamFlash;
     use nanos::Nanos;
-    use profinet::cm::CmEvent;
-    use profinet::device::{DeviceEvent, RtEvent};
 
     #[shared]
     struct Shared {
@@ -257,16 +253,13 @@ mod app {
 
     /// The drive in its static, built in this function's own frame.
     #[inline(never)]
-    #[allow(unsafe_code)]
     fn make_drive(mac: [u8; 6]) -> Option<&'static mut Drive> {
-        static mut DRIVE: core::mem::MaybeUninit<Drive> = core::mem::MaybeUninit::uninit();
-        static TAKEN: core::sync::atomic::AtomicBool = core::sync::atomic::AtomicBool::new(false);
-        if TAKEN.swap(true, core::sync::atomic::Ordering::AcqRel) {
-            return None;
-        }
-        // SAFETY: the flag hands out the static once.
-        let slot = unsafe { &mut *core::ptr::addr_of_mut!(DRIVE) };
-        Some(slot.write(Drive::new(ParamFlash::new(), crate::hardware(mac))))
+        static DRIVE: firmware::once::Once<Drive> = firmware::once::Once::new();
+        Some(
+            DRIVE
+                .take()?
+                .write(Drive::new(ParamFlash::new(), crate::hardware(mac))),
+        )
     }
 
     /// Background: fires the control cycle and the device's timers when
@@ -359,19 +352,5 @@ mod app {
                 rtic::pend(Interrupt::ETHERNET);
             }
         });
-    }
-
-    /// One line per device event the operator cares about.
-    fn log_event(e: &DeviceEvent) {
-        match e {
-            DeviceEvent::Dcp(_) => defmt::info!("pn: DCP set/signal/reset"),
-            DeviceEvent::Cm(CmEvent::Connected(_)) => defmt::info!("pn: AR connected"),
-            DeviceEvent::Cm(CmEvent::Ready(_)) => defmt::info!("pn: AR ready"),
-            DeviceEvent::Cm(CmEvent::Released(_)) => defmt::info!("pn: AR released"),
-            DeviceEvent::Cm(CmEvent::Aborted(..)) => defmt::warn!("pn: AR aborted"),
-            DeviceEvent::Rt(RtEvent::Exchanging(_)) => defmt::info!("pn: cyclic data exchanged"),
-            DeviceEvent::Rt(RtEvent::ArLost(_)) => defmt::warn!("pn: AR lost"),
-            _ => {}
-        }
     }
 }

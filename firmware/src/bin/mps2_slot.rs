@@ -15,7 +15,7 @@
 
 use bootloader::{mps2, slot_name, state_name, BootSlots, SlotState, PUBLIC_KEY};
 use cortex_m_rt::entry;
-use cortex_m_semihosting::{debug, hprintln};
+use cortex_m_semihosting::hprintln;
 
 #[path = "../semiflash.rs"]
 mod semiflash;
@@ -33,16 +33,7 @@ fn panic(_info: &core::panic::PanicInfo) -> ! {
     stop(false)
 }
 
-fn stop(ok: bool) -> ! {
-    debug::exit(if ok {
-        debug::EXIT_SUCCESS
-    } else {
-        debug::EXIT_FAILURE
-    });
-    loop {
-        cortex_m::asm::wfi();
-    }
-}
+use firmware::semihost::exit as stop;
 
 #[entry]
 fn main() -> ! {

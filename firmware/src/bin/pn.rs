@@ -25,19 +25,11 @@ use defmt_rtt as _;
 /// As on the EtherCAT image: interrupts masked, power stage off, report, stop.
 #[panic_handler]
 fn panic(_info: &core::panic::PanicInfo) -> ! {
-    cortex_m::interrupt::disable();
-    board::power_set(false);
-    defmt::error!("panic: interrupts masked, power stage off, halted");
-    loop {
-        cortex_m::asm::bkpt();
-    }
+    firmware::xmc::panic_stop()
 }
 
-/// The XMC4800 PAC as RTIC expects a device crate (see src/main.rs).
-mod pac {
-    pub use xmc4800::Interrupt as interrupt;
-    pub use xmc4800::*;
-}
+/// The XMC4800 PAC as RTIC expects a device crate, as on the EtherCAT image.
+use firmware::xmc::pac;
 
 #[path = "../xmc_eth.rs"]
 mod board;
@@ -98,11 +90,10 @@ mod app {
     use cortex_m::peripheral::DWT;
     use drive::axis::{AxisCommand, AxisIo};
     use firmware::clock::Clock;
+    use firmware::pn_log::log_event;
     use firmware::ParamFlash;
     use gmac::phy;
     use nanos::Nanos;
-    use profinet::cm::CmEvent;
-    use profinet::device::{DeviceEvent, RtEvent};
 
     #[shared]
     struct Shared {
@@ -131,7 +122,7 @@ mod app {
         let mut core = cx.core;
         core.DCB.enable_trace();
         core.DWT.enable_cycle_counter();
-        board::power_init();
+        firmware::xmc::power::init();
         defmt::info!("init: firmware-pn (XMC4800), PROFINET on ETH0 (RMII), control on CCU40_0");
         let Some(drive) = make_drive() else {
             defmt::error!("init: drive already taken");
@@ -165,16 +156,13 @@ mod app {
 
     /// The drive in its static, built in this function's own frame.
     #[inline(never)]
-    #[allow(unsafe_code)]
     fn make_drive() -> Option<&'static mut Drive> {
-        static mut DRIVE: core::mem::MaybeUninit<Drive> = core::mem::MaybeUninit::uninit();
-        static TAKEN: core::sync::atomic::AtomicBool = core::sync::atomic::AtomicBool::new(false);
-        if TAKEN.swap(true, core::sync::atomic::Ordering::AcqRel) {
-            return None;
-        }
-        // SAFETY: the flag hands out the static once.
-        let slot = unsafe { &mut *core::ptr::addr_of_mut!(DRIVE) };
-        Some(slot.write(Drive::new(ParamFlash::new(), board::hardware())))
+        static DRIVE: firmware::once::Once<Drive> = firmware::once::Once::new();
+        Some(
+            DRIVE
+                .take()?
+                .write(Drive::new(ParamFlash::new(), board::hardware())),
+        )
     }
 
     /// ETH0's clock, reset, pins and RMII selection, the MAC with its rings
@@ -255,7 +243,7 @@ mod app {
                 let now = clock.now(DWT::cycle_count());
                 if timer.next_at() <= now {
                     *cmd = timer.run(drive, now, &[AxisIo::ready(0); 2]);
-                    board::power_set(cmd.iter().any(|c| c.power_stage));
+                    firmware::xmc::power::follow(cmd);
                 }
             },
         );
@@ -301,19 +289,5 @@ mod app {
                     &mut log_event,
                 );
             });
-    }
-
-    /// One line per device event the operator cares about.
-    fn log_event(e: &DeviceEvent) {
-        match e {
-            DeviceEvent::Dcp(_) => defmt::info!("pn: DCP set/signal/reset"),
-            DeviceEvent::Cm(CmEvent::Connected(_)) => defmt::info!("pn: AR connected"),
-            DeviceEvent::Cm(CmEvent::Ready(_)) => defmt::info!("pn: AR ready"),
-            DeviceEvent::Cm(CmEvent::Released(_)) => defmt::info!("pn: AR released"),
-            DeviceEvent::Cm(CmEvent::Aborted(..)) => defmt::warn!("pn: AR aborted"),
-            DeviceEvent::Rt(RtEvent::Exchanging(_)) => defmt::info!("pn: cyclic data exchanged"),
-            DeviceEvent::Rt(RtEvent::ArLost(_)) => defmt::warn!("pn: AR lost"),
-            _ => {}
-        }
     }
 }

@@ -32,41 +32,13 @@ use defmt_semihosting as _;
 /// torque again: QEMU exits) and reports.
 #[panic_handler]
 fn panic(info: &core::panic::PanicInfo) -> ! {
-    defmt::error!("panic: {}", defmt::Display2Format(info));
-    cortex_m_semihosting::debug::exit(cortex_m_semihosting::debug::EXIT_FAILURE);
-    loop {
-        cortex_m::asm::wfi();
-    }
+    firmware::semihost::panic_exit(info)
 }
 
-/// Measurement helpers (SysTick, stack painting): the only `unsafe` code of
-/// the image, isolated here.
+/// Measurement helpers: SysTick (`firmware::systick`, shared with the other
+/// QEMU images) and stack painting, the only `unsafe` code of the image.
 mod measure {
-    use cortex_m::peripheral::SYST;
-
-    /// SysTick value now (24-bit down counter).
-    pub fn now() -> u32 {
-        SYST::get_current()
-    }
-
-    /// SysTick ticks from `start` to `end` (down counter, wraps at 2^24).
-    pub fn ticks(start: u32, end: u32) -> u32 {
-        start.wrapping_sub(end) & 0x00FF_FFFF
-    }
-
-    /// Instructions per 1000 SysTick ticks, from a loop of `2 · n`
-    /// instructions (`subs` + `bne`).
-    #[allow(unsafe_code)]
-    pub fn calibrate() -> u32 {
-        let n: u32 = 200_000;
-        let t0 = now();
-        // SAFETY: a register-only countdown loop, no memory access.
-        unsafe {
-            core::arch::asm!("1:", "subs {0}, {0}, #1", "bne 1b", inout(reg) n => _, options(nomem, nostack));
-        }
-        let t = ticks(t0, now()).max(1);
-        (u64::from(2 * n) * 1000 / u64::from(t)) as u32
-    }
+    pub use firmware::systick::{calibrate, now, ticks};
 
     extern "C" {
         static _stack_end: u32;
@@ -161,7 +133,8 @@ mod app {
     use cortex_m_semihosting::debug;
     use drive::axis::{AxisCommand, AxisIo};
     use firmware::cycle::{CycleTimer, CYCLE};
-    use firmware::net::{NetBuffers, NodeNet, SocketSlots, BOARD_NET, EMPTY_SLOTS};
+    use firmware::net::NodeNet;
+    use firmware::once::Once;
     use firmware::world::{new_esc, Event, World};
     use firmware::{tasks, Drive, ParamFlash};
     use hil_sim::esc::Esc;
@@ -213,7 +186,7 @@ mod app {
                 cortex_m::asm::wfi();
             }
         };
-        let Some(net) = make_net(drive) else {
+        let Some(net) = firmware::make_net(drive) else {
             defmt::error!("init: resources already taken");
             debug::exit(debug::EXIT_FAILURE);
             loop {
@@ -239,35 +212,11 @@ mod app {
     // One function per singleton, never inlined: each builds its value in
     // its own frame, which is gone before the next one is built.
     #[inline(never)]
-    #[allow(unsafe_code)]
     fn make_drive() -> Option<&'static mut Drive> {
-        static mut DRIVE: core::mem::MaybeUninit<Drive> = core::mem::MaybeUninit::uninit();
-        static TAKEN: core::sync::atomic::AtomicBool = core::sync::atomic::AtomicBool::new(false);
-        if TAKEN.swap(true, core::sync::atomic::Ordering::AcqRel) {
-            return None;
-        }
-        // SAFETY: the flag hands out the static once; `write` lets the drive
-        // be built in place (no copy of ~30 KiB through this frame, which
-        // `cortex_m::singleton!` makes).
-        let slot = unsafe { &mut *core::ptr::addr_of_mut!(DRIVE) };
-        let drive = slot.write(Drive::unstarted(ParamFlash::new(), None));
+        static DRIVE: Once<Drive> = Once::new();
+        let drive = DRIVE.take()?.write(Drive::unstarted(ParamFlash::new(), None));
         drive.start();
         Some(drive)
-    }
-
-    #[inline(never)]
-    #[allow(unsafe_code)]
-    fn make_net(drive: &mut Drive) -> Option<&'static mut NodeNet> {
-        static mut NET: core::mem::MaybeUninit<NodeNet> = core::mem::MaybeUninit::uninit();
-        static TAKEN: core::sync::atomic::AtomicBool = core::sync::atomic::AtomicBool::new(false);
-        if TAKEN.swap(true, core::sync::atomic::Ordering::AcqRel) {
-            return None;
-        }
-        let bufs = cortex_m::singleton!(: NetBuffers = NetBuffers::new())?;
-        let slots = cortex_m::singleton!(: SocketSlots<'static> = EMPTY_SLOTS)?;
-        // SAFETY: the flag hands out the static once, as for the drive.
-        let slot = unsafe { &mut *core::ptr::addr_of_mut!(NET) };
-        Some(slot.write(NodeNet::new(drive, BOARD_NET, bufs, slots, Nanos::ZERO)))
     }
 
     #[inline(never)]
@@ -426,14 +375,10 @@ mod app {
         defmt::info!("figure: control cycles run {=u32}", world.cycles);
         if ok {
             defmt::info!("done: end-to-end sequence complete, exit 0");
-            debug::exit(debug::EXIT_SUCCESS);
         } else {
             defmt::error!("done: end-to-end sequence failed");
-            debug::exit(debug::EXIT_FAILURE);
         }
-        loop {
-            cortex_m::asm::wfi();
-        }
+        firmware::semihost::exit(ok)
     }
 
     /// SYNC0 (ESC SYNC0 output): acknowledge, PLL measurement.

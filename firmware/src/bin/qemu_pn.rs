@@ -23,12 +23,12 @@
 #![no_main]
 
 use cortex_m::peripheral::syst::SystClkSource;
-use cortex_m::peripheral::SYST;
 use cortex_m_rt::entry;
 use cortex_m_semihosting::debug;
 use defmt_semihosting as _;
 use drive::axis::AxisIo;
 use drive_pn::{Hardware, PnDrive};
+use firmware::systick::{calibrate, now as now_ticks, ticks};
 use firmware::ParamFlash;
 use nanos::Nanos;
 use profinet::cm::{CmEvent, ImData};
@@ -38,11 +38,7 @@ use stm32f4 as _; // the interrupt vectors
 
 #[panic_handler]
 fn panic(info: &core::panic::PanicInfo) -> ! {
-    defmt::error!("panic: {}", defmt::Display2Format(info));
-    debug::exit(debug::EXIT_FAILURE);
-    loop {
-        cortex_m::asm::wfi();
-    }
+    firmware::semihost::panic_exit(info)
 }
 
 /// Cyclic frames measured.
@@ -80,27 +76,6 @@ impl Figure {
     fn mean(&self) -> u32 {
         (self.sum / u64::from(self.n.max(1))) as u32
     }
-}
-
-fn now_ticks() -> u32 {
-    SYST::get_current()
-}
-
-fn ticks(start: u32, end: u32) -> u32 {
-    start.wrapping_sub(end) & 0x00FF_FFFF
-}
-
-/// Instructions per 1000 SysTick ticks, from a loop of `2 · n` instructions.
-#[allow(unsafe_code)]
-fn calibrate() -> u32 {
-    let n: u32 = 200_000;
-    let t0 = now_ticks();
-    // SAFETY: a register-only countdown loop, no memory access.
-    unsafe {
-        core::arch::asm!("1:", "subs {0}, {0}, #1", "bne 1b", inout(reg) n => _, options(nomem, nostack));
-    }
-    let t = ticks(t0, now_ticks()).max(1);
-    (u64::from(2 * n) * 1000 / u64::from(t)) as u32
 }
 
 /// The drive commissioned as the scripted controller expects it ("drive-1",
@@ -149,14 +124,10 @@ fn main() -> ! {
     let ok = run(insn);
     if ok {
         defmt::info!("done: PROFINET sequence complete, exit 0");
-        debug::exit(debug::EXIT_SUCCESS);
     } else {
         defmt::error!("done: PROFINET sequence failed");
-        debug::exit(debug::EXIT_FAILURE);
     }
-    loop {
-        cortex_m::asm::wfi();
-    }
+    firmware::semihost::exit(ok)
 }
 
 fn run(insn: impl Fn(u32) -> u32) -> bool {
