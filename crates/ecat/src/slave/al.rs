@@ -57,8 +57,13 @@ impl Slave {
             self.error_acked = true;
         }
         // any processed request replaces a waiting S→O and ends the
-        // "unsolicited" / "triggered" indications
-        self.pending_op = None;
+        // "unsolicited" / "triggered" indications; a repeated Op request
+        // while S→O waits keeps its start (E-033: masters that rewrite AL
+        // control every cycle get the refusal 200 ms after the first one)
+        let waiting = self
+            .pending_op
+            .take()
+            .map(|since| (since, self.pending_op_frames));
         self.sync.unsolicited = false;
         self.sync.triggered = false;
         let from = self.state;
@@ -71,8 +76,9 @@ impl Slave {
                     // E-033: wait (up to 200 ms) for stable RxPDO and, in DC
                     // mode, for the PLL lock; the status stays Safe-Op
                     // without error meanwhile
-                    self.pending_op = Some(now);
-                    self.pending_op_frames = self.rx_frames;
+                    let (since, frames) = waiting.unwrap_or((now, self.rx_frames));
+                    self.pending_op = Some(since);
+                    self.pending_op_frames = frames;
                     self.error = false;
                     self.code = AlStatusCode::NO_ERROR;
                     self.write_status(pdi)?;

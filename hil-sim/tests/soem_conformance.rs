@@ -1,0 +1,53 @@
+//! Checks in the style of the ETG conformance test tool, written on SOEM's
+//! low-level register access (pysoem's `_fprd`/`_fpwr`), against `hil-sim
+//! serve` over a veth pair (issue 33): `hil-sim/tests/soem/conformance.py`,
+//! one case per test, on a line of one drive.
+//!
+//! Needs root and pysoem (`PYSOEM_PYTHON`, as `soem.rs`); without them the
+//! tests print why and pass without running.
+#![allow(clippy::unwrap_used, clippy::expect_used, clippy::panic)]
+
+mod common;
+
+use common::soem_line::{pysoem_python, Line};
+use std::path::Path;
+use std::sync::Mutex;
+
+/// One SOEM run at a time.
+static ONE_AT_A_TIME: Mutex<()> = Mutex::new(());
+
+/// Runs `conformance.py --case <case>` on a line of one drive (`tag`: one
+/// letter for the namespaces); fails with serve's log.
+fn run_case(tag: &str, case: &str) {
+    let python = match pysoem_python() {
+        Ok(p) => p,
+        Err(why) => {
+            eprintln!("soem conformance case {case}: skipped, {why}");
+            return;
+        }
+    };
+    let _one = ONE_AT_A_TIME.lock().unwrap_or_else(|e| e.into_inner());
+    let dir = Path::new(env!("CARGO_TARGET_TMPDIR")).join(format!("soem-conformance-{case}"));
+    std::fs::create_dir_all(&dir).expect("scratch dir");
+    let line = Line::new(tag, 1, 90, &dir);
+    let status = line.run(&python, "conformance.py", &["--case", case]);
+    if !status.success() {
+        let serve = line.serve_output();
+        let tail: Vec<&str> = serve.lines().rev().take(40).collect();
+        let tail: Vec<&str> = tail.into_iter().rev().collect();
+        panic!(
+            "conformance.py --case {case} through SOEM failed: {status}\n--- hil-sim serve ({}), last lines:\n{}",
+            line.serve_log.display(),
+            tail.join("\n")
+        );
+    }
+}
+
+/// E-033, E-047: Safe-Op → Op that cannot succeed (A258 = 100 ms, no
+/// process data) is refused with 002Bh 200 ms after the request whether
+/// SOEM writes AL control once, every 5 ms (as libethercat does) or every
+/// 1 ms: a repeated identical request does not restart the wait.
+#[test]
+fn e033_e047_soem_repeated_op_request_refused_on_time() {
+    run_case("o", "op-repeat");
+}
