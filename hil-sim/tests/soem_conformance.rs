@@ -51,3 +51,21 @@ fn run_case(tag: &str, case: &str) {
 fn e033_e047_soem_repeated_op_request_refused_on_time() {
     run_case("o", "op-repeat");
 }
+
+/// E-025, E-045, E-038: SOEM switches a SyncManager off with an FPWR of its
+/// activate register (0x0806 + 8n bit 0 = 0): SM0 or SM1 in Pre-Op, Safe-Op
+/// or Op gives Init + ERR 0016h, SM2 in Safe-Op/Op Pre-Op + ERR 001Dh, SM3
+/// 001Eh; SM2/SM3 in Pre-Op nothing; SOEM's next scan brings the drive back.
+#[test]
+fn e025_e045_e038_soem_sm_switched_off_by_register_write() {
+    run_case("m", "sm-off");
+}
+
+/// E-027: mailbox requests of reserved types (6, 14) and of protocols the
+/// drive does not speak (AoE, SoE), written into SM0 with SOEM's FPWR, are
+/// answered with the mailbox error 0002h (unsupported protocol), not 0001h;
+/// SOEM's SDO read works afterwards.
+#[test]
+fn e027_soem_reserved_mailbox_type_unsupported_protocol() {
+    run_case("t", "mbx-type");
+}

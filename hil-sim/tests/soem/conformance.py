@@ -8,6 +8,17 @@ as root inside the master's network namespace (or by hand against `serve`).
                     100 ms, no process data): refused with 002Bh whether the
                     master writes AL control once or every 5 ms (a repeated
                     identical request does not restart the drive's wait).
+  --case sm-off     E-025/E-045: a SyncManager switched off by the master
+                    (FPWR of its activate register 0x0806 + 8n, bit 0 = 0):
+                    SM0/SM1 in Pre-Op, Safe-Op, Op -> Init + ERR 0016h; SM2 in
+                    Safe-Op/Op -> Pre-Op + ERR 001Dh, SM3 001Eh; SM2/SM3 in
+                    Pre-Op: nothing. After each, SOEM's scan (Init with
+                    acknowledge, the SMs again) brings the drive back.
+  --case mbx-type   E-027: mailbox requests of a reserved type (6, 14) and
+                    of protocols the drive does not speak (AoE 1, SoE 5)
+                    written into SM0 by FPWR: the mailbox error reply
+                    (type 0) with 0002h "unsupported protocol"; an SDO read
+                    through SOEM works afterwards.
 
 Exit status 0 when every check passed; each failed check is printed.
 """
@@ -109,17 +120,104 @@ def case_op_repeat(m):
         check((st, code) == (SAFEOP, 0), f"acknowledged: {st:#04x}/{code:04X}h")
 
 
+def case_sm_off(m):
+    s = m.slaves[0]
+    names = {INIT: "Init", PREOP: "Pre-Op", SAFEOP: "Safe-Op", OP: "Op"}
+    cases = [
+        (0, PREOP, (INIT, 0x0016)),
+        (1, PREOP, (INIT, 0x0016)),
+        (2, PREOP, None),
+        (3, PREOP, None),
+        (0, SAFEOP, (INIT, 0x0016)),
+        (1, SAFEOP, (INIT, 0x0016)),
+        (2, SAFEOP, (PREOP, 0x001D)),
+        (3, SAFEOP, (PREOP, 0x001E)),
+        (0, OP, (INIT, 0x0016)),
+        (1, OP, (INIT, 0x0016)),
+        (2, OP, (PREOP, 0x001D)),
+        (3, OP, (PREOP, 0x001E)),
+    ]
+    mapped = False
+    for n, state, want in cases:
+        what = f"SM{n} off in {names[state]}"
+        # SOEM's map activates SM2/SM3 (in Pre-Op)
+        if n >= 2 or state != PREOP:
+            if not mapped:
+                m.manual_state_change = 1
+                m.config_map()
+                mapped = True
+        if state != PREOP:
+            st, code = to(s, SAFEOP, SAFEOP)
+            if state == OP and st == SAFEOP:
+                # no RxPDO monitoring by default (A258): Op without frames
+                st, code = to(s, OP, OP)
+            if not check((st, code) == (state, 0), f"{what}: {names[state]} first, got {st:#04x}/{code:04X}h"):
+                continue
+        act = rd(s, 0x0806 + 8 * n, 1)[0]
+        check(act & 1 == 1, f"{what}: SM{n} active before ({act:#04x})")
+        wr(s, 0x0806 + 8 * n, bytes([act & 0xFE]))
+        end = time.monotonic() + 1.0
+        while True:
+            st, code = al(s)
+            if st & ERR or time.monotonic() > end:
+                break
+            time.sleep(0.005)
+        say(f"{what}: {st:#04x}/{code:04X}h")
+        if want is None:
+            check((st, code) == (state, 0), f"{what}: stays {names[state]} without error, got {st:#04x}/{code:04X}h")
+            wr(s, 0x0806 + 8 * n, bytes([act]))
+            continue
+        check((st, code) == (want[0] | ERR, want[1]), f"{what}: {names[want[0]]} + ERR {want[1]:04X}h expected, got {st:#04x}/{code:04X}h")
+        # SOEM's scan: Init with acknowledge, the mailbox SMs again, Pre-Op
+        m.manual_state_change = 0
+        L.scan(m, 1)
+        st, code = to(s, PREOP, PREOP)
+        check((st, code) == (PREOP, 0), f"{what}: Pre-Op again after SOEM's scan, got {st:#04x}/{code:04X}h")
+        mapped = False
+
+
+def mbx_read(s, timeout_s=1.0):
+    """The SM1 mailbox content once it is full (None after the timeout)."""
+    start, length = struct.unpack("<HH", rd(s, 0x0808, 4))
+    end = time.monotonic() + timeout_s
+    while time.monotonic() < end:
+        if rd(s, 0x080D, 1)[0] & 0x08:
+            return rd(s, start, length)
+        time.sleep(0.002)
+    return None
+
+
+def case_mbx_type(m):
+    s = m.slaves[0]
+    start, length = struct.unpack("<HH", rd(s, 0x0800, 4))
+    while mbx_read(s, 0.05) is not None:
+        pass  # anything the drive had queued (EMCY)
+    for k, ty in enumerate((6, 14, 1, 5)):
+        counter = k + 1
+        msg = struct.pack("<HHBB", 4, 0, 0, ty | (counter << 4)) + bytes([0x11, 0x22, 0x33, 0x44])
+        wr(s, start, msg + bytes(length - len(msg)))
+        got = mbx_read(s)
+        if not check(got is not None, f"type {ty}: no answer"):
+            continue
+        kind = got[5] & 0x0F
+        etype, detail = struct.unpack_from("<HH", got, 6)
+        say(f"mailbox type {ty}: reply type {kind}, {etype:04X}h/{detail:04X}h")
+        check((kind, etype, detail) == (0, 0x0001, 0x0002), f"type {ty}: mailbox error 0002h expected")
+    # SOEM's own mailbox counter starts again from whatever it holds; an SDO read works
+    check(L.u(s.sdo_read(0x1000, 0)) == 0x00020192, "1000h by SDO afterwards")
+
+
 def main():
     p = argparse.ArgumentParser()
     p.add_argument("--iface", required=True)
-    p.add_argument("--case", required=True, choices=["op-repeat"])
+    p.add_argument("--case", required=True, choices=["op-repeat", "sm-off", "mbx-type"])
     args = p.parse_args()
     m = pysoem.Master()
     m.open(args.iface)
     try:
         L.scan(m, 1)
         check(m.read_state() == PREOP, f"Pre-Op after the scan: {L.state_report(m)}")
-        {"op-repeat": case_op_repeat}[args.case](m)
+        {"op-repeat": case_op_repeat, "sm-off": case_sm_off, "mbx-type": case_mbx_type}[args.case](m)
     except L.Fatal as e:
         check(False, str(e))
     finally:

@@ -21,15 +21,66 @@ impl Slave {
         if let Some(bytes) = app.process_data_bytes() {
             self.pdo_bytes = bytes;
         }
-        let change = if events & al_event::AL_CONTROL != 0 {
+        let mut change = if events & al_event::AL_CONTROL != 0 {
             self.al_control(pdi, app, now)?
         } else {
             None
         };
+        if change.is_none() {
+            change = self.check_sm_enables(pdi)?;
+        }
         if !eoe_on(self.state) {
             self.eoe.reset();
         }
         Ok((events, change))
+    }
+
+    /// E-025, E-045 (issue 33): a SyncManager the master switched off
+    /// (activate register bit 0) while the state needs it is a local error:
+    /// a mailbox SM (0, 1) in Pre-Op, Safe-Op or Op falls back to Init with
+    /// 0016h; SM2 (outputs) / SM3 (inputs) in Safe-Op or Op to Pre-Op with
+    /// 001Dh / 001Eh (an SM without process data is not needed). An
+    /// unsolicited change with the error indication (ETG.1000.6 ESM).
+    pub(super) fn check_sm_enables<P: Pdi>(&mut self, pdi: &mut P) -> Result<Option<StateChange>, P::Error> {
+        let from = self.state;
+        if !matches!(from, AlState::PreOp | AlState::SafeOp | AlState::Op) {
+            return Ok(None);
+        }
+        let off = |pdi: &mut P, n: u8| -> Result<bool, P::Error> {
+            Ok(pdi.read_u8(regs::sm(n) + 6)? & activate::ENABLE == 0)
+        };
+        let fault = if off(pdi, 0)? || off(pdi, 1)? {
+            Some((AlState::Init, AlStatusCode::INVALID_MAILBOX_CONFIG))
+        } else if from == AlState::PreOp {
+            None
+        } else if self.out_len > 0 && off(pdi, 2)? {
+            Some((AlState::PreOp, AlStatusCode::INVALID_OUTPUT_CONFIG))
+        } else if self.in_len > 0 && off(pdi, 3)? {
+            Some((AlState::PreOp, AlStatusCode::INVALID_INPUT_CONFIG))
+        } else {
+            None
+        };
+        let Some((to, code)) = fault else {
+            return Ok(None);
+        };
+        self.pending_op = None;
+        if to == AlState::Init {
+            self.mbx.pending = false;
+            self.mbx.tx_valid = false;
+            self.coe.reset();
+        }
+        self.state = to;
+        self.error = true;
+        self.code = code;
+        self.sync.unsolicited = true;
+        self.write_status(pdi)?;
+        Ok(Some(StateChange {
+            from,
+            to,
+            requested: from.code(),
+            code,
+            unsolicited: true,
+        }))
     }
 
     pub(super) fn write_status<P: Pdi>(&self, pdi: &mut P) -> Result<(), P::Error> {

@@ -1,4 +1,5 @@
-//! ESM requests as masters other than ours send them (issue 33): repeated
+//! ESM requests and mailbox types as masters other than ours and the
+//! conformance test tool send them (issue 33): repeated
 //! requests, SyncManagers switched off, device identification.
 
 use super::*;
@@ -74,4 +75,107 @@ fn e033_e044_another_request_ends_the_wait_and_op_starts_a_new_one() {
         r.poll();
     }
     assert_eq!((r.esc.status(), r.esc.code()), (0x14, 0x001B));
+}
+
+/// Switches SyncManager `n` off as a master does (activate register bit 0).
+fn sm_off(r: &mut Rig, n: u8) {
+    r.esc.mem[regs::sm(n) as usize + 6] &= !activate::ENABLE;
+}
+
+#[test]
+fn e025_e045_e038_sm_switched_off_falls_back_with_its_code() {
+    // (SM, state, expected state afterwards, AL status code); None = stays
+    type Fallback = Option<(AlState, u16)>;
+    let cases: [(u8, AlState, Fallback); 12] = [
+        (0, AlState::PreOp, Some((AlState::Init, 0x0016))),
+        (0, AlState::SafeOp, Some((AlState::Init, 0x0016))),
+        (0, AlState::Op, Some((AlState::Init, 0x0016))),
+        (1, AlState::PreOp, Some((AlState::Init, 0x0016))),
+        (1, AlState::SafeOp, Some((AlState::Init, 0x0016))),
+        (1, AlState::Op, Some((AlState::Init, 0x0016))),
+        (2, AlState::PreOp, None),
+        (2, AlState::SafeOp, Some((AlState::PreOp, 0x001D))),
+        (2, AlState::Op, Some((AlState::PreOp, 0x001D))),
+        (3, AlState::PreOp, None),
+        (3, AlState::SafeOp, Some((AlState::PreOp, 0x001E))),
+        (3, AlState::Op, Some((AlState::PreOp, 0x001E))),
+    ];
+    for (n, state, expected) in cases {
+        let mut r = Rig::new();
+        r.goto(state);
+        sm_off(&mut r, n);
+        let c = r.poll();
+        let what = std::format!("SM{n} off in {state:?}");
+        match expected {
+            None => {
+                assert_eq!(c, None, "{what}");
+                assert_eq!((r.esc.status(), r.esc.code()), (state.code().into(), 0), "{what}");
+            }
+            Some((to, code)) => {
+                let c = c.expect(&what);
+                assert_eq!(
+                    (c.from, c.to, c.code.0, c.unsolicited),
+                    (state, to, code, true),
+                    "{what}"
+                );
+                assert_eq!(
+                    (r.esc.status(), r.esc.code()),
+                    (u16::from(to.code()) | 0x10, code),
+                    "{what}"
+                );
+                assert_eq!(r.slave.err_led(), crate::led::Pattern::SingleFlash, "{what}");
+                // once: the next poll changes nothing
+                assert_eq!(r.poll(), None, "{what}");
+                // the master sets the SM up again and acknowledges: the way up is open
+                r.esc.mem[regs::sm(n) as usize + 6] |= activate::ENABLE;
+                let back = u16::from(to.code()) | 0x10;
+                assert_eq!(r.req(back), (to.code().into(), 0), "{what}");
+                r.goto(state);
+            }
+        }
+    }
+    // outputs are zero again once Op is left
+    let mut r = Rig::new();
+    r.goto(AlState::Op);
+    sm_off(&mut r, 2);
+    r.poll();
+    assert!(r.slave.outputs().iter().all(|&b| b == 0));
+}
+
+#[test]
+fn e025_no_mailbox_sm_check_in_init() {
+    // in Init the SMs are the master's to set up: nothing happens
+    let mut r = Rig::new();
+    for n in 0..4 {
+        sm_off(&mut r, n);
+    }
+    assert_eq!(r.poll(), None);
+    assert_eq!((r.esc.status(), r.esc.code()), (1, 0));
+}
+
+#[test]
+fn e027_reserved_and_unspoken_mailbox_types_get_unsupported_protocol() {
+    let mut r = Rig::new();
+    r.goto(AlState::PreOp);
+    // AoE (1), SoE (5), VoE (15) and the reserved types 6..14, each with a
+    // new counter: mailbox error 0002h "unsupported protocol"
+    for (k, ty) in [1u8, 5, 6, 7, 9, 14, 15].into_iter().enumerate() {
+        let counter = (k % 7) as u8 + 1;
+        r.esc
+            .mbx_write(&[4, 0, 0, 0, 0, ty | (counter << 4), 0x11, 0x22, 0x33, 0x44]);
+        r.poll();
+        let got = r.esc.mbx_read().expect("an answer");
+        assert_eq!(got[5] & 0x0F, 0, "type {ty}: a mailbox error reply");
+        assert_eq!(&got[..2], &[4, 0], "type {ty}");
+        assert_eq!(
+            (
+                u16::from_le_bytes([got[6], got[7]]),
+                u16::from_le_bytes([got[8], got[9]])
+            ),
+            (0x0001, 0x0002),
+            "type {ty}: 0002h"
+        );
+    }
+    // the mailbox still serves CoE afterwards
+    assert!(r.upload(0x1008, 0, 1).is_some());
 }
