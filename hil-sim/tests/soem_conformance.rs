@@ -69,3 +69,13 @@ fn e025_e045_e038_soem_sm_switched_off_by_register_write() {
 fn e027_soem_reserved_mailbox_type_unsupported_protocol() {
     run_case("t", "mbx-type");
 }
+
+/// E-026, explicit device identification (ETG.1000.6): SOEM writes an
+/// alias into the SII (word 4 and the CRC of words 0–7), the ESC reloads it
+/// into 0x0012; AL control with the ID request bit (Init, Pre-Op) gives AL
+/// status bit 5 and the alias in 0x0134; a request without the bit clears
+/// them; a refused request shows its error code, not the ID.
+#[test]
+fn e026_soem_explicit_device_identification_through_registers() {
+    run_case("i", "id-request");
+}

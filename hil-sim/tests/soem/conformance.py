@@ -19,6 +19,12 @@ as root inside the master's network namespace (or by hand against `serve`).
                     written into SM0 by FPWR: the mailbox error reply
                     (type 0) with 0002h "unsupported protocol"; an SDO read
                     through SOEM works afterwards.
+  --case id-request E-026 (ETG.1000.6 explicit device identification): an
+                    alias written into the SII (word 4, with the words 0-7
+                    CRC) and reloaded into 0x0012 by the ESC; AL control Init
+                    + ID request (bit 5) -> AL status 0x21 with the alias in
+                    0x0134; Pre-Op + ID -> 0x22, the alias; a request without
+                    bit 5 clears both; a refused request shows its error.
 
 Exit status 0 when every check passed; each failed check is printed.
 """
@@ -207,17 +213,61 @@ def case_mbx_type(m):
     check(L.u(s.sdo_read(0x1000, 0)) == 0x00020192, "1000h by SDO afterwards")
 
 
+def crc8(data):
+    """The SII words 0-7 checksum (CRC-8, polynomial 0x07, initial 0xFF)."""
+    c = 0xFF
+    for b in data:
+        c ^= b
+        for _ in range(8):
+            c = ((c << 1) ^ 0x07) & 0xFF if c & 0x80 else (c << 1) & 0xFF
+    return c
+
+
+def case_id_request(m):
+    s = m.slaves[0]
+    alias = 0x0B0E
+    words = b"".join(s.eeprom_read(w)[:2] for w in range(7))
+    words = words[:8] + struct.pack("<H", alias) + words[10:14]
+    s.eeprom_write(4, struct.pack("<H", alias))
+    s.eeprom_write(7, bytes([crc8(words), 0]))
+    # the ESC reloads its configuration from the SII (0x0502 command 100b)
+    wr(s, 0x0502, struct.pack("<H", 0x0400))
+    end = time.monotonic() + 1.0
+    while rd(s, 0x0502, 2)[1] & 0x80 and time.monotonic() < end:
+        time.sleep(0.002)
+    got = struct.unpack("<H", rd(s, 0x0012, 2))[0]
+    check(got == alias, f"station alias {got:#06x} after the reload, {alias:#06x} expected")
+    for value, want, what in [
+        (INIT | 0x20, (INIT | 0x20, alias), "Init + ID request"),
+        (PREOP | 0x20, (PREOP | 0x20, alias), "Pre-Op + ID request"),
+        (PREOP, (PREOP, 0), "Pre-Op without it"),
+        (OP | 0x20, (PREOP | ERR, 0x0011), "Op + ID request from Pre-Op (refused)"),
+        (INIT | ACK | 0x20, (INIT | 0x20, alias), "acknowledge + Init + ID request"),
+        (INIT, (INIT, 0), "Init without it"),
+    ]:
+        control(s, value)
+        deadline = time.monotonic() + 1.0
+        while True:
+            raw = rd(s, AL_STATUS, 6)
+            st, code = struct.unpack_from("<H", raw, 0)[0] & 0x3F, struct.unpack_from("<H", raw, 4)[0]
+            if (st, code) == want or time.monotonic() > deadline:
+                break
+            time.sleep(0.005)
+        say(f"{what}: AL status {st:#04x}, 0x0134 = {code:#06x}")
+        check((st, code) == want, f"{what}: {want[0]:#04x}/{want[1]:#06x} expected")
+
+
 def main():
     p = argparse.ArgumentParser()
     p.add_argument("--iface", required=True)
-    p.add_argument("--case", required=True, choices=["op-repeat", "sm-off", "mbx-type"])
+    p.add_argument("--case", required=True, choices=["op-repeat", "sm-off", "mbx-type", "id-request"])
     args = p.parse_args()
     m = pysoem.Master()
     m.open(args.iface)
     try:
         L.scan(m, 1)
         check(m.read_state() == PREOP, f"Pre-Op after the scan: {L.state_report(m)}")
-        {"op-repeat": case_op_repeat, "sm-off": case_sm_off, "mbx-type": case_mbx_type}[args.case](m)
+        {"op-repeat": case_op_repeat, "sm-off": case_sm_off, "mbx-type": case_mbx_type, "id-request": case_id_request}[args.case](m)
     except L.Fatal as e:
         check(False, str(e))
     finally:

@@ -84,12 +84,15 @@ impl Slave {
     }
 
     pub(super) fn write_status<P: Pdi>(&self, pdi: &mut P) -> Result<(), P::Error> {
+        // explicit device identification: the ID stands in the status code
+        // register while no error is shown
+        let id = self.id_loaded.filter(|_| !self.error);
         let status = AlStatus {
             state: self.state,
             error: self.error,
-            id_loaded: false,
+            id_loaded: id.is_some(),
         };
-        pdi.write_u16(regs::AL_STATUS_CODE, self.code.0)?;
+        pdi.write_u16(regs::AL_STATUS_CODE, id.unwrap_or(self.code.0))?;
         pdi.write_u16(regs::AL_STATUS, status.raw())
     }
 
@@ -117,6 +120,17 @@ impl Slave {
             .map(|since| (since, self.pending_op_frames));
         self.sync.unsolicited = false;
         self.sync.triggered = false;
+        // ETG.1000.6 explicit device identification (AL control bit 5): the
+        // ID (the settable value, else the station alias 0x0012) is shown
+        // in 0x0134 with AL status bit 5 until a request without the bit
+        self.id_loaded = if ctrl.id_request {
+            Some(match self.identification {
+                Some(id) => id,
+                None => pdi.read_u16(regs::STATION_ALIAS)?,
+            })
+        } else {
+            None
+        };
         let from = self.state;
         let result = match esm::target_with_boot(from, ctrl.requested, self.foe_supported()) {
             Err(code) => Err(code),

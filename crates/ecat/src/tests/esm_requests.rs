@@ -179,3 +179,27 @@ fn e027_reserved_and_unspoken_mailbox_types_get_unsupported_protocol() {
     // the mailbox still serves CoE afterwards
     assert!(r.upload(0x1008, 0, 1).is_some());
 }
+
+#[test]
+fn e026_explicit_device_identification_shows_the_alias_in_0134() {
+    let mut r = Rig::new();
+    let alias = regs::STATION_ALIAS as usize;
+    r.esc.mem[alias..alias + 2].copy_from_slice(&0x1234u16.to_le_bytes());
+    // Init + ID request: the ID in 0x0134, AL status bit 5, no error
+    assert_eq!(r.req(0x21), (0x21, 0x1234));
+    assert!(!r.slave.error());
+    // with a transition: shown in the new state
+    assert_eq!(r.req(0x22), (0x22, 0x1234));
+    assert_eq!(r.slave.state(), AlState::PreOp);
+    // a request without the bit ends it
+    assert_eq!(r.req(0x02), (0x02, 0));
+    // a refused request shows its error, not the ID
+    assert_eq!(r.req(0x28), (0x12, 0x0011));
+    assert_eq!(r.req(0x31), (0x21, 0x1234), "acknowledge + Init + ID");
+    // a settable ID replaces the alias
+    r.slave.set_identification(Some(0xBEEF));
+    assert_eq!(r.req(0x21), (0x21, 0xBEEF));
+    r.slave.set_identification(None);
+    assert_eq!(r.req(0x21), (0x21, 0x1234));
+    assert_eq!(r.req(0x01), (0x01, 0));
+}
