@@ -51,8 +51,6 @@ pub enum FrameError {
     NotEthercat(u16),
     /// The EtherCAT header's type is not 1 (EtherCAT commands).
     UnsupportedType(u8),
-    /// The EtherCAT header's length runs past the end of the frame.
-    LengthMismatch,
     /// A datagram runs past the datagram area, or the area holds no complete datagram.
     MalformedDatagram,
 }
@@ -335,6 +333,15 @@ struct Layout {
 }
 
 /// Checks the Ethernet and EtherCAT headers and every datagram; returns the layout.
+///
+/// As an ESC does (issue 33): the datagrams are followed from the first one by
+/// their own length fields and "more" bits; the EtherCAT header's length field
+/// is not relied on (libethercat writes it 16 bytes too large), bytes after
+/// the last datagram are padding or trailer and ignored, and a frame shorter
+/// than Ethernet's 60 bytes (veth does not pad) is processed like any other.
+/// Strict where silicon is: the EtherType, frame type 1, and a datagram that
+/// runs past the end of the frame (the ESC would see the frame end early and
+/// commit nothing).
 fn check(frame: &[u8]) -> Result<Layout, FrameError> {
     let mut ethertype = get_u16_be(frame, 12).ok_or(FrameError::Truncated)?;
     let mut ecat = ETHERNET_HEADER_LEN;
@@ -354,27 +361,22 @@ fn check(frame: &[u8]) -> Result<Layout, FrameError> {
         return Err(FrameError::UnsupportedType(kind));
     }
     let area_start = ecat + ECAT_HEADER_LEN;
-    let area_len = usize::from(hdr & 0x07FF);
-    let area = frame
-        .get(area_start..area_start + area_len)
-        .ok_or(FrameError::LengthMismatch)?;
-    // Walk the chain: every datagram must fit, the last one clears "more".
+    let area = frame.get(area_start..).ok_or(FrameError::Truncated)?;
+    // Walk the chain: every datagram must fit in the frame, the last one clears "more".
     let mut off = 0usize;
-    let mut count = 0usize;
     loop {
         let rest = area.get(off..).ok_or(FrameError::MalformedDatagram)?;
         let total = Datagram::total_len_of(rest)?;
-        count += 1;
         let more = get_u16(rest, 6) & 0x8000 != 0;
         off += total;
         if !more {
             break;
         }
     }
-    if count == 0 {
-        return Err(FrameError::MalformedDatagram);
-    }
-    Ok(Layout { area_start, area_len })
+    Ok(Layout {
+        area_start,
+        area_len: off,
+    })
 }
 
 /// Reads a big-endian u16 (Ethernet byte order) at `off`.
@@ -399,7 +401,8 @@ impl<'a> EthercatFrame<'a> {
         Ok(Self { buf, layout })
     }
 
-    /// Length of the datagram area (EtherCAT header length field).
+    /// Length of the datagram area: the bytes the datagram chain spans (not
+    /// the EtherCAT header's length field, which an ESC does not rely on).
     pub fn area_len(&self) -> usize {
         self.layout.area_len
     }
@@ -440,8 +443,9 @@ impl<'a> EthercatFrame<'a> {
 /// the last is marked linked and open in its DL status ([`connect_line`]);
 /// masters derive the topology (and DC delays) from these bits.
 ///
-/// A frame that is not EtherCAT or is malformed (truncated, length field past
-/// the end, datagram past the area) is an error and left untouched.
+/// A frame that is not EtherCAT or is malformed (truncated, a datagram past
+/// the end of the frame) is an error and left untouched; the EtherCAT header's
+/// length, padding and trailing bytes are not looked at (see `check`).
 pub fn process_frame(escs: &mut [&mut Esc], frame: &mut [u8], now: Nanos) -> Result<(), FrameError> {
     let mut f = EthercatFrame::new_checked(frame)?;
     connect_line(escs);

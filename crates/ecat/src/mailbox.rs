@@ -104,7 +104,9 @@ impl MailboxHeader {
         }
         match h.kind {
             MailboxType::Error => Err(MailboxError::INVALID_HEADER),
-            MailboxType::Reserved(_) => Err(MailboxError::SYNTAX),
+            // a type the slave does not speak (issue 33: what masters
+            // expect, not the header syntax error 0001h)
+            MailboxType::Reserved(_) => Err(MailboxError::UNSUPPORTED_PROTOCOL),
             _ => Ok(h),
         }
     }
@@ -200,8 +202,14 @@ mod tests {
         buf[4] = 1;
         assert_eq!(MailboxHeader::check(&buf), Err(MailboxError::INVALID_CHANNEL));
         buf[4] = 0;
-        buf[5] = 0x17;
-        assert_eq!(MailboxHeader::check(&buf), Err(MailboxError::SYNTAX));
+        for ty in 6..=14u8 {
+            buf[5] = 0x10 | ty;
+            assert_eq!(
+                MailboxHeader::check(&buf),
+                Err(MailboxError::UNSUPPORTED_PROTOCOL),
+                "reserved type {ty}"
+            );
+        }
         assert_eq!(MailboxHeader::check(&buf[..3]), Err(MailboxError::SIZE_TOO_SHORT));
     }
 

@@ -214,6 +214,8 @@ impl Pdi for Fake {
 /// 0x1000:0 = "Test", 0x2000:0 u16 writable.
 struct App {
     value: u16,
+    /// The RxPDO monitoring the application asks for (default off).
+    pdo_timeout: crate::PdoTimeout,
 }
 
 impl Dictionary for App {
@@ -246,8 +248,12 @@ impl Dictionary for App {
     }
 }
 
-/// The defaults: a 1 ms cycle, no RxPDO monitoring, any SYNC0 cycle.
-impl crate::Application for App {}
+/// The defaults but the RxPDO monitoring: a 1 ms cycle, any SYNC0 cycle.
+impl crate::Application for App {
+    fn pdo_timeout(&mut self) -> crate::PdoTimeout {
+        self.pdo_timeout
+    }
+}
 
 struct Rig {
     esc: Fake,
@@ -264,7 +270,10 @@ impl Rig {
         let mut r = Rig {
             esc: Fake::new(),
             slave: Slave::new(dev),
-            app: App { value: 0 },
+            app: App {
+                value: 0,
+                pdo_timeout: crate::PdoTimeout::Off,
+            },
             t: Nanos::ZERO,
         };
         r.poll();
@@ -1219,3 +1228,5 @@ fn e027_e037_mailbox_served_by_its_own_task() {
     split(&mut r, true);
     assert!(r.esc.mbx_read().is_none());
 }
+
+mod esm_requests;

@@ -252,6 +252,11 @@ fn device_element(
         &[("LcId", "1033")],
         &format!("{} {} ({})", dev.name, dev.order_code, template_name(template)),
     );
+    // ETG.1000.6 explicit device identification: the ID (the station
+    // alias) in register 0x0134 on an ID request (issue 33)
+    x.open("Info", &[]);
+    x.leaf("IdentificationReg134", &[], "true");
+    x.close("Info");
     x.leaf("GroupType", &[], dev.group);
 
     x.open("Profile", &[]);

@@ -957,3 +957,17 @@ fn e149_default_modules_equal_the_default_mapping_and_the_sii() {
         }
     }
 }
+
+/// Explicit device identification (issue 33): every ESI declares the ID in
+/// register 0x0134 (ETG.2000 `Info/IdentificationReg134`), which the drive
+/// answers an AL control ID request with (the station alias).
+#[test]
+fn e026_esi_declares_explicit_device_identification_in_0134() {
+    for (v, t) in each() {
+        let xml = esi(v, t);
+        let doc = roxmltree::Document::parse(&xml).unwrap();
+        let dev = device_node(&doc);
+        let info = child(dev, "Info");
+        assert_eq!(text(info, "IdentificationReg134"), "true", "{v:?} {t:?}");
+    }
+}

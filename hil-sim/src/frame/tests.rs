@@ -322,14 +322,6 @@ fn malformed_frames_are_errors_without_panic() {
         Err(FrameError::NotEthercat(0x0800))
     );
     assert_eq!(f, before);
-    // EtherCAT length field larger than the frame
-    let mut f = good.clone();
-    f[14] = 0xFF;
-    f[15] = 0x17;
-    assert_eq!(
-        process_frame(&mut [&mut a], &mut f, Nanos::from_ns(0)),
-        Err(FrameError::LengthMismatch)
-    );
     // datagram length past the area
     let mut f = good.clone();
     f[16 + 6] = 0xF0;
@@ -339,8 +331,8 @@ fn malformed_frames_are_errors_without_panic() {
         Err(FrameError::MalformedDatagram)
     );
     assert_eq!(f, before);
-    // "more follows" on the last datagram
-    let mut f = good.clone();
+    // "more follows" on the last datagram with nothing after it (unpadded)
+    let mut f = good[..48].to_vec();
     f[16 + 16 + 7] |= 0x80;
     assert_eq!(
         process_frame(&mut [&mut a], &mut f, Nanos::from_ns(0)),
@@ -427,4 +419,116 @@ fn connect_line_opens_port1_except_last() {
     process_frame(&mut [&mut b, &mut c], &mut f, Nanos::from_ns(0)).unwrap();
     assert_eq!(dl(&b) & (1 << 5 | 1 << 10 | 1 << 11), 1 << 5 | 1 << 11);
     assert_eq!(dl(&c) & (1 << 5 | 1 << 10 | 1 << 11), 1 << 10);
+}
+
+/// A frame built by `build`, unpadded, with the EtherCAT header's length
+/// field changed by `delta` bytes (libethercat: +16).
+fn as_sent(dgs: &[(Command, u32, &[u8])], delta: i32, pad_to: usize) -> Vec<u8> {
+    let mut f = build(dgs);
+    let area: usize = dgs
+        .iter()
+        .map(|(_, _, d)| DATAGRAM_HEADER_LEN + d.len() + WKC_LEN)
+        .sum();
+    f.truncate(ETHERNET_HEADER_LEN + ECAT_HEADER_LEN + area);
+    let len = (area as i32 + delta) as u16 & 0x07FF;
+    f[14..16].copy_from_slice(&(len | 0x1000).to_le_bytes());
+    f.resize(f.len().max(pad_to), 0);
+    f
+}
+
+/// Two slaves: BRD of the type register (WKC 2), APWR of the station address
+/// of position 1, FPRD of it back; the replies (WKC, data) of one frame.
+fn scan_frame(f: &mut [u8]) -> Result<Vec<(u16, Vec<u8>)>, FrameError> {
+    let (mut a, mut b) = (esc_with_type(1), esc_with_type(1));
+    process_frame(&mut [&mut a, &mut b], f, Nanos::from_ns(0))?;
+    let first = parse(f).into_iter().map(|r| (r.wkc, r.data)).collect();
+    // the station address written by the first frame answers a second one
+    let mut g = build(&[(Command::Fprd, phys(0x1001, regs::STATION_ADDRESS), &[0; 2])]);
+    process_frame(&mut [&mut a, &mut b], &mut g, Nanos::from_ns(0)).unwrap();
+    let r = parse(&mut g).remove(0);
+    assert_eq!((r.wkc, r.data), (1, std::vec![0x01, 0x10]), "FPWR applied");
+    Ok(first)
+}
+
+fn scan_dgs() -> [(Command, u32, &'static [u8]); 2] {
+    [
+        (Command::Brd, phys(0, 0), &[0; 1]),
+        (Command::Apwr, phys(pos(1), regs::STATION_ADDRESS), &[0x01, 0x10]),
+    ]
+}
+
+#[test]
+fn e002_header_length_larger_than_the_datagrams_is_processed_as_silicon_does() {
+    // libethercat: header length 16 bytes more than its datagrams, unpadded
+    for delta in [16, 1, 200] {
+        let mut f = as_sent(&scan_dgs(), delta, 0);
+        let got = scan_frame(&mut f).unwrap_or_else(|e| panic!("+{delta}: {e:?}"));
+        assert_eq!(
+            got,
+            std::vec![(2, std::vec![1]), (1, std::vec![0x01, 0x10])],
+            "+{delta}"
+        );
+    }
+}
+
+#[test]
+fn e002_header_length_smaller_than_the_datagrams_is_processed_as_silicon_does() {
+    for delta in [-1, -16, -30] {
+        let mut f = as_sent(&scan_dgs(), delta, 60);
+        let got = scan_frame(&mut f).unwrap_or_else(|e| panic!("{delta}: {e:?}"));
+        assert_eq!(
+            got,
+            std::vec![(2, std::vec![1]), (1, std::vec![0x01, 0x10])],
+            "{delta}"
+        );
+    }
+}
+
+#[test]
+fn e002_frame_shorter_than_60_bytes_is_processed() {
+    let mut f = as_sent(&scan_dgs(), 0, 0);
+    assert_eq!(f.len(), 16 + 13 + 14, "no padding");
+    assert!(f.len() < 60);
+    let got = scan_frame(&mut f).unwrap();
+    assert_eq!(got, std::vec![(2, std::vec![1]), (1, std::vec![0x01, 0x10])]);
+}
+
+#[test]
+fn e002_trailing_bytes_after_the_last_datagram_are_ignored_and_kept() {
+    let mut f = as_sent(&scan_dgs(), 0, 0);
+    let n = f.len();
+    f.extend_from_slice(&[0xAA; 24]); // a trailer (e.g. a time stamp) or odd padding
+    let got = scan_frame(&mut f).unwrap();
+    assert_eq!(got, std::vec![(2, std::vec![1]), (1, std::vec![0x01, 0x10])]);
+    assert_eq!(&f[n..], &[0xAA; 24], "the trailer comes back as it was");
+}
+
+#[test]
+fn e002_datagram_past_the_end_of_the_frame_is_refused_untouched() {
+    // strict where silicon is: the frame ends inside a datagram
+    let full = as_sent(&scan_dgs(), 0, 0);
+    for cut in [full.len() - 1, full.len() - 2, 16 + 11 + 5] {
+        let mut f = full[..cut].to_vec();
+        let before = f.clone();
+        let mut a = esc_with_type(1);
+        assert_eq!(
+            process_frame(&mut [&mut a], &mut f, Nanos::from_ns(0)),
+            Err(FrameError::MalformedDatagram),
+            "cut at {cut}"
+        );
+        assert_eq!(f, before, "untouched");
+    }
+}
+
+/// A libethercat-style frame as its scan sends it: BRD 0x0000 (type), header
+/// length = datagrams + 16, no padding (veth), through the frame path `serve`
+/// uses (`Simulation::exchange`): both drives answer.
+#[test]
+fn e002_libethercat_style_frame_through_the_simulated_line() {
+    let mut sim = crate::sim::Simulation::new(2);
+    let mut f = as_sent(&[(Command::Brd, phys(0, 0), &[0; 2])], 16, 0);
+    assert!(f.len() < 60);
+    sim.exchange(&mut f);
+    let r = parse(&mut f).remove(0);
+    assert_eq!(r.wkc, 2, "both drives answered");
 }

@@ -21,24 +21,78 @@ impl Slave {
         if let Some(bytes) = app.process_data_bytes() {
             self.pdo_bytes = bytes;
         }
-        let change = if events & al_event::AL_CONTROL != 0 {
+        let mut change = if events & al_event::AL_CONTROL != 0 {
             self.al_control(pdi, app, now)?
         } else {
             None
         };
+        if change.is_none() {
+            change = self.check_sm_enables(pdi)?;
+        }
         if !eoe_on(self.state) {
             self.eoe.reset();
         }
         Ok((events, change))
     }
 
+    /// E-025, E-045 (issue 33): a SyncManager the master switched off
+    /// (activate register bit 0) while the state needs it is a local error:
+    /// a mailbox SM (0, 1) in Pre-Op, Safe-Op or Op falls back to Init with
+    /// 0016h; SM2 (outputs) / SM3 (inputs) in Safe-Op or Op to Pre-Op with
+    /// 001Dh / 001Eh (an SM without process data is not needed). An
+    /// unsolicited change with the error indication (ETG.1000.6 ESM).
+    pub(super) fn check_sm_enables<P: Pdi>(&mut self, pdi: &mut P) -> Result<Option<StateChange>, P::Error> {
+        let from = self.state;
+        if !matches!(from, AlState::PreOp | AlState::SafeOp | AlState::Op) {
+            return Ok(None);
+        }
+        let off = |pdi: &mut P, n: u8| -> Result<bool, P::Error> {
+            Ok(pdi.read_u8(regs::sm(n) + 6)? & activate::ENABLE == 0)
+        };
+        let fault = if off(pdi, 0)? || off(pdi, 1)? {
+            Some((AlState::Init, AlStatusCode::INVALID_MAILBOX_CONFIG))
+        } else if from == AlState::PreOp {
+            None
+        } else if self.out_len > 0 && off(pdi, 2)? {
+            Some((AlState::PreOp, AlStatusCode::INVALID_OUTPUT_CONFIG))
+        } else if self.in_len > 0 && off(pdi, 3)? {
+            Some((AlState::PreOp, AlStatusCode::INVALID_INPUT_CONFIG))
+        } else {
+            None
+        };
+        let Some((to, code)) = fault else {
+            return Ok(None);
+        };
+        self.pending_op = None;
+        if to == AlState::Init {
+            self.mbx.pending = false;
+            self.mbx.tx_valid = false;
+            self.coe.reset();
+        }
+        self.state = to;
+        self.error = true;
+        self.code = code;
+        self.sync.unsolicited = true;
+        self.write_status(pdi)?;
+        Ok(Some(StateChange {
+            from,
+            to,
+            requested: from.code(),
+            code,
+            unsolicited: true,
+        }))
+    }
+
     pub(super) fn write_status<P: Pdi>(&self, pdi: &mut P) -> Result<(), P::Error> {
+        // explicit device identification: the ID stands in the status code
+        // register while no error is shown
+        let id = self.id_loaded.filter(|_| !self.error);
         let status = AlStatus {
             state: self.state,
             error: self.error,
-            id_loaded: false,
+            id_loaded: id.is_some(),
         };
-        pdi.write_u16(regs::AL_STATUS_CODE, self.code.0)?;
+        pdi.write_u16(regs::AL_STATUS_CODE, id.unwrap_or(self.code.0))?;
         pdi.write_u16(regs::AL_STATUS, status.raw())
     }
 
@@ -57,10 +111,26 @@ impl Slave {
             self.error_acked = true;
         }
         // any processed request replaces a waiting S→O and ends the
-        // "unsolicited" / "triggered" indications
-        self.pending_op = None;
+        // "unsolicited" / "triggered" indications; a repeated Op request
+        // while S→O waits keeps its start (E-033: masters that rewrite AL
+        // control every cycle get the refusal 200 ms after the first one)
+        let waiting = self
+            .pending_op
+            .take()
+            .map(|since| (since, self.pending_op_frames));
         self.sync.unsolicited = false;
         self.sync.triggered = false;
+        // ETG.1000.6 explicit device identification (AL control bit 5): the
+        // ID (the settable value, else the station alias 0x0012) is shown
+        // in 0x0134 with AL status bit 5 until a request without the bit
+        self.id_loaded = if ctrl.id_request {
+            Some(match self.identification {
+                Some(id) => id,
+                None => pdi.read_u16(regs::STATION_ALIAS)?,
+            })
+        } else {
+            None
+        };
         let from = self.state;
         let result = match esm::target_with_boot(from, ctrl.requested, self.foe_supported()) {
             Err(code) => Err(code),
@@ -71,8 +141,9 @@ impl Slave {
                     // E-033: wait (up to 200 ms) for stable RxPDO and, in DC
                     // mode, for the PLL lock; the status stays Safe-Op
                     // without error meanwhile
-                    self.pending_op = Some(now);
-                    self.pending_op_frames = self.rx_frames;
+                    let (since, frames) = waiting.unwrap_or((now, self.rx_frames));
+                    self.pending_op = Some(since);
+                    self.pending_op_frames = frames;
                     self.error = false;
                     self.code = AlStatusCode::NO_ERROR;
                     self.write_status(pdi)?;

@@ -141,6 +141,11 @@ pub struct Slave {
     op_loss: Option<OpLoss>,
     /// The mailbox SyncManager the last I→P check refused.
     mailbox_fault: Option<u8>,
+    /// The explicit device identification value set by the application
+    /// (`None`: the station alias, register 0x0012).
+    identification: Option<u16>,
+    /// The ID shown in 0x0134 (AL status bit 5) after an ID request.
+    id_loaded: Option<u16>,
 }
 
 impl Slave {
@@ -189,7 +194,17 @@ impl Slave {
             error_acked: false,
             op_loss: None,
             mailbox_fault: None,
+            identification: None,
+            id_loaded: None,
         }
+    }
+
+    /// Sets the value explicit device identification reports (ETG.1000.6:
+    /// AL control bit 5 → the ID in 0x0134, AL status bit 5); `None` (the
+    /// default) reports the station alias the ESC loaded from the SII
+    /// (0x0012). Takes effect at the next ID request.
+    pub fn set_identification(&mut self, id: Option<u16>) {
+        self.identification = id;
     }
 
     /// The synchronisation and RxPDO monitoring state (1C32h/1C33h and the
