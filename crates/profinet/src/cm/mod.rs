@@ -379,6 +379,10 @@ impl<H: RecordHook> Cm<H> {
                 None => return PnioStatus::cmrpc(code, cmrpc::AR_UUID_UNKNOWN),
             }
         };
+        // the whole header or nothing: an answer never ends in half a block
+        if w.rest_mut().len() < RW_HEADER_LEN {
+            return PnioStatus::cmrpc(code, cmrpc::OUT_OF_RESOURCES);
+        }
         let at = w.pos();
         if record::emit_read_res(w, &req, 0).is_none() {
             return PnioStatus::cmrpc(code, cmrpc::OUT_OF_RESOURCES);
@@ -418,6 +422,27 @@ impl<H: RecordHook> Cm<H> {
         }
     }
 
+    /// The number of sub-writes of a multiple write as [`Cm::write_multiple`]
+    /// walks them; `None` if one is malformed. Checked before any sub-write
+    /// is done, so that a refused multiple write changes nothing.
+    fn count_writes(data: &[u8], depth: u8) -> Option<usize> {
+        let mut r = Reader::new(data, Endian::Big);
+        let mut n = 0usize;
+        while r.remaining() > 0 {
+            let (req, rest) = RwRequest::parse(r.rest()).filter(|(q, _)| q.write)?;
+            let len = usize::try_from(req.record_len).ok()?;
+            let sub = rest.get(..len)?;
+            r.skip(RW_HEADER_LEN.checked_add(len)?)?;
+            r.align(4).or(Some(()))?;
+            n = n.checked_add(if req.addr.index == index::WRITE_MULTIPLE && depth == 0 {
+                Self::count_writes(sub, 1)?
+            } else {
+                1
+            })?;
+        }
+        Some(n)
+    }
+
     /// The sub-writes of a multiple write (`depth` 0 for the outer one). A
     /// multiple write nested inside one (as profinet-py 0.6.6 sends) is
     /// flattened once; deeper nesting is refused.
@@ -454,6 +479,11 @@ impl<H: RecordHook> Cm<H> {
         if self.find(req.ar_uuid).is_none() {
             return PnioStatus::cmrpc(code, cmrpc::AR_UUID_UNKNOWN);
         }
+        // room for the answer's header (and, below, each sub-write's) before
+        // anything is written: a write refused for want of room changes nothing
+        if w.rest_mut().len() < RW_HEADER_LEN {
+            return PnioStatus::cmrpc(code, cmrpc::OUT_OF_RESOURCES);
+        }
         let len = usize::try_from(req.record_len).unwrap_or(usize::MAX);
         let Some(data) = rest.get(..len).filter(|_| rest.len() == len) else {
             let s = RecordError::WriteLength.status(code);
@@ -461,6 +491,13 @@ impl<H: RecordHook> Cm<H> {
             return s;
         };
         if req.addr.index == index::WRITE_MULTIPLE {
+            let Some(n) = Self::count_writes(data, 0) else {
+                return PnioStatus::pnio(code, error_code1::RECORD, 0);
+            };
+            let room = n.checked_add(1).and_then(|k| k.checked_mul(RW_HEADER_LEN));
+            if room.is_none_or(|r| w.rest_mut().len() < r) {
+                return PnioStatus::cmrpc(code, cmrpc::OUT_OF_RESOURCES);
+            }
             let at = w.pos();
             if record::emit_write_res(w, &req, 0, PnioStatus::OK).is_none() {
                 return PnioStatus::cmrpc(code, cmrpc::OUT_OF_RESOURCES);

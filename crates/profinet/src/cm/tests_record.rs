@@ -158,3 +158,72 @@ fn p041_other_records_go_to_the_hook() {
         (PnioStatus::OK, &hex("8104 0004 0100 0000")[..])
     );
 }
+
+/// A request like `vector`'s (its RPC header, big-endian) with opnum `op`,
+/// ArgsMaximum `max` and NDR args `args`; the answer's status and args.
+fn call_with(
+    d: &mut tests_connect::Dev,
+    vector: &str,
+    op: u16,
+    max: u32,
+    args: &[u8],
+) -> (PnioStatus, std::vec::Vec<u8>) {
+    let mut req = hex(vector)[..80].to_vec();
+    req[68..70].copy_from_slice(&op.to_be_bytes());
+    req[74..76].copy_from_slice(&((20 + args.len()) as u16).to_be_bytes());
+    let n = args.len() as u32;
+    for v in [max, n, max.max(n), 0, n] {
+        req.extend_from_slice(&v.to_be_bytes());
+    }
+    req.extend_from_slice(args);
+    let out = d.rx(&req);
+    let (_, body) = crate::rpc::Header::parse(&out[0].1).unwrap();
+    let status = PnioStatus::from_u32(u32::from_be_bytes(body[0..4].try_into().unwrap()));
+    let len = u32::from_be_bytes(body[4..8].try_into().unwrap()) as usize;
+    assert_eq!(body.len(), 20 + len);
+    (status, body[20..].to_vec())
+}
+
+#[test]
+fn p041_a_small_args_maximum_gets_whole_blocks_or_none_and_changes_nothing() {
+    // Found by the pn_seq fuzz target: with an ArgsMaximum below a record
+    // header's 64 bytes the answer ended in half an IODReadResHeader, and a
+    // multiple write without room for every answer did its first sub-writes
+    // and then answered with an error.
+    let mut d = dev();
+    d.call(CONNECT);
+    let no_room = PnioStatus::cmrpc(0xDE, cmrpc::OUT_OF_RESOURCES);
+    let read_args = &hex(READ_IM0)[100..];
+    assert_eq!(
+        call_with(&mut d, READ_IM0, 2, 40, read_args),
+        (no_room, std::vec![])
+    );
+    let im1 = hex(WRITE_IM1)[100..].to_vec();
+    let (status, args) = call_with(&mut d, WRITE_IM1, 3, 40, &im1);
+    assert_eq!(
+        (status, args.len()),
+        (PnioStatus::cmrpc(0xDF, cmrpc::OUT_OF_RESOURCES), 0)
+    );
+    assert_eq!(d.cm.im_data(), &ImData::default());
+    // a multiple write of I&M1 and I&M2 with room for two of its three answers
+    let im2 = hex(WRITE_IM2)[100..].to_vec();
+    let mut subs = im1.clone();
+    while subs.len() % 4 != 0 {
+        subs.push(0);
+    }
+    subs.extend_from_slice(&im2);
+    let mut multi = im1[..64].to_vec();
+    multi[INDEX_AT..INDEX_AT + 2].copy_from_slice(&index::WRITE_MULTIPLE.to_be_bytes());
+    multi[36..40].copy_from_slice(&(subs.len() as u32).to_be_bytes());
+    multi.extend_from_slice(&subs);
+    let (status, args) = call_with(&mut d, WRITE_IM1, 3, 128, &multi);
+    assert_eq!(
+        (status, args.len()),
+        (PnioStatus::cmrpc(0xDF, cmrpc::OUT_OF_RESOURCES), 0)
+    );
+    assert_eq!(d.cm.im_data(), &ImData::default());
+    // with room for all three, both are written
+    let (status, args) = call_with(&mut d, WRITE_IM1, 3, 192, &multi);
+    assert_eq!((status, args.len()), (PnioStatus::OK, 192));
+    assert_ne!(d.cm.im_data(), &ImData::default());
+}
