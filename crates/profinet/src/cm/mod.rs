@@ -31,6 +31,8 @@ mod tests_pcap;
 #[cfg(test)]
 mod tests_record;
 #[cfg(test)]
+mod tests_startup;
+#[cfg(test)]
 pub(crate) use crate::testing::vectors as tests_vectors;
 
 pub use ar::{AlarmCr, Ar, ArState, ArType, Fit, IoObject, Iocr, IocrType, Submodule, SubmoduleData};
@@ -232,7 +234,7 @@ impl<H: RecordHook> Cm<H> {
             let old = old.ar_uuid;
             self.remove(old, Some(AbortReason::Superseded));
         }
-        if emit_connect_response(w, &ar, self.config.mac).is_none() {
+        if emit_connect_response(w, &ar, self.config.mac, self.pdev.name.as_bytes()).is_none() {
             return PnioStatus::cmrpc(ec::IOD_CONNECT_RES, cmrpc::OUT_OF_RESOURCES);
         }
         self.next_alarm_ref = self.next_alarm_ref.wrapping_add(1).max(1);
