@@ -31,6 +31,8 @@ mod tests_pcap;
 #[cfg(test)]
 mod tests_record;
 #[cfg(test)]
+mod tests_record_size;
+#[cfg(test)]
 mod tests_startup;
 #[cfg(test)]
 pub(crate) use crate::testing::vectors as tests_vectors;
@@ -437,6 +439,8 @@ impl<H: RecordHook> Cm<H> {
             }
             let status = if req.addr.index == index::WRITE_MULTIPLE {
                 RecordError::InvalidIndex.status(ec::IOD_WRITE_RES)
+            } else if len > crate::model::MAX_RECORD_SIZE {
+                RecordError::WriteLength.status(ec::IOD_WRITE_RES)
             } else {
                 match self.write_one(req.addr, sub) {
                     Ok(()) => PnioStatus::OK,
@@ -457,7 +461,11 @@ impl<H: RecordHook> Cm<H> {
             return PnioStatus::cmrpc(code, cmrpc::AR_UUID_UNKNOWN);
         }
         let len = usize::try_from(req.record_len).unwrap_or(usize::MAX);
-        let Some(data) = rest.get(..len).filter(|_| rest.len() == len) else {
+        // A record above MaxSupportedRecordSize (a multiple write may be
+        // longer by its sub-headers), or a request cut short because it did
+        // not fit the RPC buffer: write length error, with the header.
+        let too_long = req.addr.index != index::WRITE_MULTIPLE && len > crate::model::MAX_RECORD_SIZE;
+        let Some(data) = rest.get(..len).filter(|_| rest.len() == len && !too_long) else {
             let s = RecordError::WriteLength.status(code);
             let _ = record::emit_write_res(w, &req, req.record_len, s);
             return s;
@@ -499,7 +507,12 @@ fn service(op: u16) -> u8 {
 impl<H: RecordHook> rpc::Handler for Cm<H> {
     fn call(&mut self, _now: Nanos, call: &Call, body: &[u8], out: &mut [u8]) -> Result<usize, CallError> {
         let too_big = CallError::Fault(rpc::nca::OUT_ARGS_TOO_BIG);
-        let Some(ndr) = NdrRequest::parse(body, call.endian) else {
+        let ndr = if call.truncated {
+            NdrRequest::parse_truncated(body, call.endian)
+        } else {
+            NdrRequest::parse(body, call.endian)
+        };
+        let Some(ndr) = ndr else {
             let s = PnioStatus::cmrpc(service(call.opnum), cmrpc::ARGS_LENGTH_INVALID);
             return ndr::emit_response(out, call.endian, s, 0, 0).ok_or(too_big);
         };

@@ -44,6 +44,27 @@ impl<'a> NdrRequest<'a> {
             args,
         })
     }
+
+    /// The same checks for the beginning of a request that was longer than
+    /// the buffer ([`crate::rpc::Call::truncated`]): `args` are the
+    /// arguments that arrived, shorter than ArgsLength.
+    pub fn parse_truncated(body: &'a [u8], endian: Endian) -> Option<NdrRequest<'a>> {
+        let mut r = Reader::new(body, endian);
+        let args_maximum = r.u32()?;
+        let args_length = r.u32()?;
+        let maximum_count = r.u32()?;
+        let offset = r.u32()?;
+        let actual_count = r.u32()?;
+        if offset != 0 || actual_count != args_length || args_length > maximum_count {
+            return None;
+        }
+        let args = r.rest();
+        (args.len() < usize::try_from(args_length).ok()?).then_some(NdrRequest {
+            args_maximum,
+            maximum_count,
+            args,
+        })
+    }
 }
 
 /// Writes a response NDR header in front of `args_len` bytes already at
