@@ -148,6 +148,11 @@ impl<H: RecordHook> Cm<H> {
         &self.im
     }
 
+    /// Replaces I&M1…4 (e.g. cleared by a reset to factory).
+    pub fn set_im_data(&mut self, im: ImData) {
+        self.im = im;
+    }
+
     /// The record hook.
     pub fn hook(&self) -> &H {
         &self.hook
@@ -380,7 +385,12 @@ impl<H: RecordHook> Cm<H> {
         } else {
             match self.find(req.ar_uuid) {
                 Some(a) => Some(a.clone()),
-                None => return PnioStatus::cmrpc(code, cmrpc::AR_UUID_UNKNOWN),
+                None => {
+                    // refused with the header that names the record (an
+                    // answer without blocks is malformed to Wireshark)
+                    let _ = record::emit_read_res(w, &req, 0);
+                    return PnioStatus::cmrpc(code, cmrpc::AR_UUID_UNKNOWN);
+                }
             }
         };
         let at = w.pos();
@@ -458,7 +468,9 @@ impl<H: RecordHook> Cm<H> {
             return PnioStatus::pnio(code, error_code1::RECORD, 0);
         };
         if self.find(req.ar_uuid).is_none() {
-            return PnioStatus::cmrpc(code, cmrpc::AR_UUID_UNKNOWN);
+            let s = PnioStatus::cmrpc(code, cmrpc::AR_UUID_UNKNOWN);
+            let _ = record::emit_write_res(w, &req, req.record_len, s);
+            return s;
         }
         let len = usize::try_from(req.record_len).unwrap_or(usize::MAX);
         // A record above MaxSupportedRecordSize (a multiple write may be
