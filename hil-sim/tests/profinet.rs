@@ -17,7 +17,9 @@
 //!   sending; the cyclic AR in advanced startup (RTClass 2 IOCRs, FrameIDs
 //!   0x8000–0xBBFF, as an S7-1500 connects; profinet-py's block builders
 //!   wrapped for it), and one more Connect, PrmEnd, ApplicationReady,
-//!   Release in advanced startup. The figure "DCP identify to first valid cyclic data" goes to
+//!   Release in advanced startup, in which a 4,068-byte record goes in
+//!   DCE/RPC fragments (answered for its index) and a 4,069-byte one gets
+//!   "write length error". The figure "DCP identify to first valid cyclic data" goes to
 //!   `target/tmp/profinet-py/figures.txt` (`.ci/run` prints it).
 //!
 //! The test asserts on the script's step lines and on the events `serve`
@@ -153,7 +155,7 @@ fn p008_p027_p029_p030_p035_p036_p042_p085_p110_p191_p223_profinet_py_names_conn
     line.stop_server();
     let serve = line.serve_output();
     println!("--- hil-sim serve ({}):\n{serve}", line.serve_log.display());
-    for step in ["a", "b", "c", "d", "e", "f", "g", "h", "i", "j", "k"] {
+    for step in ["a", "b", "c", "d", "e", "f", "g", "h", "i", "j", "k", "l"] {
         let got = step_lines(&lines, step);
         assert!(
             got.iter().any(|l| l.starts_with("ok: ")) && !got.iter().any(|l| l.starts_with("FAIL: ")),
@@ -188,6 +190,12 @@ fn p008_p027_p029_p030_p035_p036_p042_p085_p110_p191_p223_profinet_py_names_conn
             .iter()
             .any(|l| l.contains("advanced startup: input FrameID 0x80")),
         "step h did not connect in advanced startup"
+    );
+    // P-041: records of MaxSupportedRecordSize in fragments
+    let l = step_lines(&lines, "l");
+    assert!(
+        l.iter().any(|x| x.starts_with("ok: 4068-byte")) && l.iter().any(|x| x.starts_with("ok: 4069-byte")),
+        "{l:?}"
     );
     let d = step_lines(&lines, "d");
     assert!(

@@ -39,7 +39,13 @@ both bind UDP 34964) and goes step by step, one line per result:
 (k) Connect in advanced startup as an S7-1500 sends it (ARProperties
     StartupMode = 1, IOCRs of RTClass 2 with FrameIDs 0x8000-0xBBFF), PrmEnd,
     ApplicationReady, Release: the device assigns the output CR's FrameID in
-    that range and answers with an ARServerBlockRes naming itself.
+    that range and answers with an ARServerBlockRes naming itself;
+(l) in that AR, a write of a 4,068-byte record (MaxSupportedRecordSize)
+    to an index the drive does not have, sent in DCE/RPC fragments of 1,024
+    bytes (profinet-py sends a request as one datagram, which IP would have
+    to fragment; the fragmenting sender is ours): the device reassembles it
+    and answers the record's header with "invalid index" (DF 80 B0), not an
+    RPC fault; a 4,069-byte one gets "write length error" (DF 80 B1).
 
 Steps (a)-(g) use legacy startup (profinet-py's own Connect: RTClass 1,
 FrameIDs 0xC000-0xF7FF); with --startup advanced, step (h) connects in
@@ -158,6 +164,42 @@ class AdvancedStartup:
     def __exit__(self, *exc):
         rpc.PNARBlockRequest, rpc.PNIOCRBlockReqHeader = self.ar, self.iocr
         return False
+
+
+def fragmented_write(con, slot, subslot, index, data, frag=1024, timeout=5.0):
+    """An IODWrite in DCE/RPC fragments of `frag` body bytes over profinet-py's
+    AR and socket; returns (NDR PNIO status, the IODWriteRes's status)."""
+    block = rpc.PNBlockHeader(0x0008, 60, 0x01, 0x00)
+    iod = rpc.PNIODHeader(
+        bytes(block), 0, con.ar_uuid, 0, slot, subslot, 0, index, len(data), bytes(16), bytes(8),
+        payload=bytes(data),
+    )
+    whole = bytes(con._create_rpc(rpc.PNRPCHeader.WRITE, bytes(con._create_nrd(bytes(iod)))))
+    head, body = whole[:80], whole[80:]  # big-endian drep (profinet-py's)
+    seq = head[64:68]
+    chunks = [body[k : k + frag] for k in range(0, len(body), frag)]
+    for n, c in enumerate(chunks):
+        h = bytearray(head)
+        h[2] = 0x20 | 0x04 | (0x02 if n == len(chunks) - 1 else 0)  # idempotent, frag, last
+        h[74:76] = len(c).to_bytes(2, "big")
+        h[76:78] = n.to_bytes(2, "big")
+        con._socket.sendto(bytes(h) + c, con.peer)
+    end = time.monotonic() + timeout
+    while time.monotonic() < end:
+        con._socket.settimeout(max(0.01, end - time.monotonic()))
+        try:
+            d = con._socket.recvfrom(65535)[0]
+        except TimeoutError:
+            break
+        if len(d) < 80 or d[64:68] != seq:
+            continue
+        if d[1] == 3:  # fault
+            raise RuntimeError(f"RPC fault 0x{int.from_bytes(d[80:84], 'big'):08X}")
+        if d[1] == 2:  # response
+            b = d[80:]
+            res = b[20:]
+            return int.from_bytes(b[0:4], "big"), int.from_bytes(res[44:48], "big") if len(res) >= 48 else None
+    raise RuntimeError("no answer to the fragmented write")
 
 
 def blocks_of(payload):
@@ -652,6 +694,18 @@ def main():
                 f"output FrameID 0x{res.output_frame_id:04X}, ARServerBlockRes station {name!r}; "
                 f"PrmEnd; ApplicationReady confirmed",
             )
+            # (l) records of MaxSupportedRecordSize and one byte more, in fragments
+            def big_records():
+                for n, want in [(4068, 0xDF80B000), (4069, 0xDF80B100)]:
+                    status, res = fragmented_write(con, 1, 1, 0x7FF0, bytes(k % 251 for k in range(n)))
+                    report(
+                        "l",
+                        status & 0xFFFFFF00 == want and res is not None and res & 0xFFFFFF00 == want,
+                        f"{n}-byte record in 1,024-byte RPC fragments: PNIO status 0x{status:08X}, "
+                        f"IODWriteRes status 0x{res:08X}",
+                    )
+
+            run("l", big_records)
             status, block = release(con)
             if status != 0:
                 report("k", False, f"Release refused: 0x{status:08X}")
