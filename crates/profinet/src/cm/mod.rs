@@ -365,6 +365,14 @@ impl<H: RecordHook> Cm<H> {
                 ok.ok_or(RecordError::ReadError)?;
                 Ok(w.pos())
             }
+            index::IM0_FILTER_DATA => {
+                // device scope: at any submodule there is
+                if !exists(addr.slot, addr.subslot) {
+                    return Err(RecordError::InvalidSlotSubslot);
+                }
+                record::emit_im0_filter(&mut w).ok_or(RecordError::ReadError)?;
+                Ok(w.pos())
+            }
             index::MODULE_DIFF => {
                 let ar = ar.ok_or(RecordError::StateConflict)?;
                 emit_module_diff(&mut w, ar).ok_or(RecordError::ReadError)?;
@@ -421,7 +429,7 @@ impl<H: RecordHook> Cm<H> {
                     RecordError::InvalidSlotSubslot
                 })
             }
-            index::IM0 | index::MODULE_DIFF => Err(RecordError::AccessDenied),
+            index::IM0 | index::MODULE_DIFF | index::IM0_FILTER_DATA => Err(RecordError::AccessDenied),
             index::IM1..=index::IM4 => {
                 let rec = record::write_im(addr.index, data, &mut self.im)?;
                 self.event(CmEvent::ImWritten(rec));

@@ -412,3 +412,31 @@ fn p040_pdev_answers_dissect_without_malformed_packets() {
     }
     assert!(text.contains("sw-1") && text.contains("port-003"));
 }
+
+#[test]
+fn p039_im0_filter_data_names_the_dap_submodule_and_dissects() {
+    let mut r = rig();
+    let (status, data) = r.read(1, crate::cm::record::index::IM0_FILTER_DATA);
+    assert_eq!(status, OK);
+    // I&M0FilterDataSubmodule and I&M0FilterDataDevice: API 0, slot 0 (DAP
+    // module ident 1), subslot 1 (submodule ident 1)
+    let one = "0001 00000000 0001 0000 00000001 0001 0001 00000001";
+    let mut want = hex(&std::format!("0030 0018 0100 {one}"));
+    want.extend(hex(&std::format!("0032 0018 0100 {one}")));
+    assert_eq!(data, want);
+    // device scope: the same at the interface; a missing subslot: invalid slot/subslot
+    assert_eq!(r.read(0x8000, crate::cm::record::index::IM0_FILTER_DATA).1, want);
+    assert_eq!(
+        r.read(0x9000, crate::cm::record::index::IM0_FILTER_DATA).0,
+        rw(0xB2, false)
+    );
+    // read only
+    let w = r.record(true, 0, 1, crate::cm::record::index::IM0_FILTER_DATA, &want);
+    assert_eq!(w.0, rw(0xB6, true));
+    let text = crate::tests_tshark::dissect(&r.frames, "dcerpc && ip.src == 192.168.0.50");
+    let Some(text) = text else { return };
+    assert!(
+        text.contains("I&M0FilterData") || text.contains("IM0FilterData"),
+        "not dissected"
+    );
+}
