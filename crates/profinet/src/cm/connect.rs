@@ -7,7 +7,7 @@
 use heapless::Vec;
 
 use super::ar::*;
-use super::ndr::{emit_block, Block, BlockError, Blocks};
+use super::ndr::{emit_block, emit_block_v, Block, BlockError, Blocks};
 use super::status::{cmrpc, error_code, error_code1 as b, PnioStatus};
 use crate::ip::Endpoint;
 use crate::model::{self, DataModule, Direction};
@@ -402,6 +402,49 @@ pub fn real_submodule(slot: u16, subslot: u16) -> Option<u32> {
         _ => None,
     }
 }
+
+/// RealIdentificationData (block 0x0013, version 1.1): the DAP with its
+/// four subslots and, in an AR, each data slot with the module really
+/// plugged there (the data slots adapt to the expected modules, P-029; a
+/// slot without one is left out); without an AR (implicit read) the DAP
+/// only.
+pub fn emit_real_identification(w: &mut Writer<'_>, ar: Option<&Ar>) -> Option<()> {
+    let mut slots: Vec<(u16, u32), { MAX_DATA_SLOTS as usize }> = Vec::new();
+    for s in ar
+        .iter()
+        .flat_map(|a| a.submodules.iter())
+        .filter(|s| s.slot != 0)
+    {
+        let (fit, ident) = real_module(s.slot, s.module_ident);
+        if fit != Fit::NoModule && !slots.iter().any(|x| x.0 == s.slot) {
+            let _ = slots.push((s.slot, ident));
+        }
+    }
+    slots.sort_unstable_by_key(|x| x.0);
+    emit_block_v(w, REAL_IDENTIFICATION_DATA, 1, |w| {
+        w.u16(1)?; // NumberOfAPIs
+        w.u32(0)?;
+        w.u16(u16::try_from(slots.len() + 1).ok()?)?;
+        w.u16(0)?;
+        w.u32(model::DAP_MODULE_IDENT)?;
+        w.u16(u16::try_from(model::DAP_SUBSLOTS.len()).ok()?)?;
+        for sub in model::DAP_SUBSLOTS {
+            w.u16(sub)?;
+            w.u32(real_submodule(0, sub)?)?;
+        }
+        for &(slot, ident) in &slots {
+            w.u16(slot)?;
+            w.u32(ident)?;
+            w.u16(1)?;
+            w.u16(1)?;
+            w.u32(model::DATA_SUBMODULE_IDENT)?;
+        }
+        Some(())
+    })
+}
+
+/// Block type of RealIdentificationData.
+const REAL_IDENTIFICATION_DATA: u16 = 0x0013;
 
 /// True if `slot`/`subslot` exists in the real model.
 pub fn exists(slot: u16, subslot: u16) -> bool {

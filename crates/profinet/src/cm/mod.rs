@@ -365,6 +365,13 @@ impl<H: RecordHook> Cm<H> {
                 ok.ok_or(RecordError::ReadError)?;
                 Ok(w.pos())
             }
+            index::REAL_IDENTIFICATION_DATA => {
+                if !exists(addr.slot, addr.subslot) {
+                    return Err(RecordError::InvalidSlotSubslot);
+                }
+                connect::emit_real_identification(&mut w, ar).ok_or(RecordError::ReadError)?;
+                Ok(w.pos())
+            }
             index::IM0_FILTER_DATA => {
                 // device scope: at any submodule there is
                 if !exists(addr.slot, addr.subslot) {
@@ -429,7 +436,9 @@ impl<H: RecordHook> Cm<H> {
                     RecordError::InvalidSlotSubslot
                 })
             }
-            index::IM0 | index::MODULE_DIFF | index::IM0_FILTER_DATA => Err(RecordError::AccessDenied),
+            index::IM0 | index::MODULE_DIFF | index::IM0_FILTER_DATA | index::REAL_IDENTIFICATION_DATA => {
+                Err(RecordError::AccessDenied)
+            }
             index::IM1..=index::IM4 => {
                 let rec = record::write_im(addr.index, data, &mut self.im)?;
                 self.event(CmEvent::ImWritten(rec));

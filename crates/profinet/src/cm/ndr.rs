@@ -178,11 +178,21 @@ pub fn emit_block(
     block_type: u16,
     body: impl FnOnce(&mut Writer<'_>) -> Option<()>,
 ) -> Option<()> {
+    emit_block_v(w, block_type, 0, body)
+}
+
+/// [`emit_block`] with BlockVersionLow `version_low` (high 1).
+pub fn emit_block_v(
+    w: &mut Writer<'_>,
+    block_type: u16,
+    version_low: u8,
+    body: impl FnOnce(&mut Writer<'_>) -> Option<()>,
+) -> Option<()> {
     let start = w.pos();
     w.u16(block_type)?;
     w.u16(0)?;
     w.u8(1)?;
-    w.u8(0)?;
+    w.u8(version_low)?;
     body(w)?;
     let len = u16::try_from(w.pos().checked_sub(start)?.checked_sub(4)?).ok()?;
     w.patch_u16(start.checked_add(2)?, len)

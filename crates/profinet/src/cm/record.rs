@@ -36,6 +36,8 @@ pub mod index {
     pub const WRITE_MULTIPLE: u16 = 0xE040;
     /// I&M0FilterData (read only, device scope).
     pub const IM0_FILTER_DATA: u16 = 0xF840;
+    /// RealIdentificationData (read only, device scope).
+    pub const REAL_IDENTIFICATION_DATA: u16 = 0xF000;
 }
 
 /// Where a record lives.

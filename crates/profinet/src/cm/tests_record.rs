@@ -174,3 +174,18 @@ fn p041_other_records_go_to_the_hook() {
         (PnioStatus::OK, &hex("8104 0004 0100 0000")[..])
     );
 }
+
+#[test]
+fn p040_real_identification_data_without_an_ar_is_the_dap() {
+    let mut d = dev();
+    let mut r = hex(&patch(READ_IM0, INDEX_AT, &[0xF0, 0x00]));
+    r[68..70].copy_from_slice(&5u16.to_be_bytes()); // opnum: implicit read
+    let r: std::string::String = r.iter().map(|x| std::format!("{x:02x}")).collect();
+    let (status, args) = d.call(&r);
+    assert_eq!(status, PnioStatus::OK);
+    assert_eq!(
+        &args[64..],
+        &hex("0013 002a 0101 0001 00000000 0001
+              0000 00000001 0004 0001 00000001 8000 00008000 8001 00008001 8002 00008002")[..]
+    );
+}

@@ -440,3 +440,31 @@ fn p039_im0_filter_data_names_the_dap_submodule_and_dissects() {
         "not dissected"
     );
 }
+
+#[test]
+fn p029_p040_real_identification_data_lists_the_dap_and_the_plugged_modules() {
+    let mut r = rig();
+    let (status, data) = r.read(1, crate::cm::record::index::REAL_IDENTIFICATION_DATA);
+    assert_eq!(status, OK);
+    // version 1.1: API 0, 3 slots; the DAP with its subslots (each port its
+    // own ident), slot 1 OUT 18 words (0x212), slot 2 IN 18 words (0x112)
+    let body = "0001 00000000 0003
+        0000 00000001 0004 0001 00000001 8000 00008000 8001 00008001 8002 00008002
+        0001 00000212 0001 0001 00000001
+        0002 00000112 0001 0001 00000001";
+    let mut want = hex(&std::format!("0013 0000 0101 {body}"));
+    let len = (want.len() - 4) as u16;
+    want[2..4].copy_from_slice(&len.to_be_bytes());
+    assert_eq!(data, want);
+    let w = r.record(
+        true,
+        0,
+        1,
+        crate::cm::record::index::REAL_IDENTIFICATION_DATA,
+        &want,
+    );
+    assert_eq!(w.0, rw(0xB6, true));
+    let text = crate::tests_tshark::dissect(&r.frames, "dcerpc && ip.src == 192.168.0.50");
+    let Some(text) = text else { return };
+    assert!(text.contains("RealIdentificationData"), "not dissected");
+}
