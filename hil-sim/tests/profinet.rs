@@ -14,7 +14,12 @@
 //!   read), a drive fault (raised through serve's control channel) as
 //!   a diagnosis alarm that profinet-py acknowledges and that disappears
 //!   after the fault reset, and the AR's abort when the controller stops
-//!   sending. The figure "DCP identify to first valid cyclic data" goes to
+//!   sending; the cyclic AR in advanced startup (RTClass 2 IOCRs, FrameIDs
+//!   0x8000–0xBBFF, as an S7-1500 connects; profinet-py's block builders
+//!   wrapped for it), and one more Connect, PrmEnd, ApplicationReady,
+//!   Release in advanced startup, in which a 4,068-byte record goes in
+//!   DCE/RPC fragments (answered for its index) and a 4,069-byte one gets
+//!   "write length error". The figure "DCP identify to first valid cyclic data" goes to
 //!   `target/tmp/profinet-py/figures.txt` (`.ci/run` prints it).
 //!
 //! The test asserts on the script's step lines and on the events `serve`
@@ -76,7 +81,7 @@ fn step_lines<'a>(lines: &'a [String], step: &str) -> Vec<&'a str> {
 
 /// P-008 (Identify), P-007/P-010 (DCP Set name and IP), P-039 (I&M0), P-027
 /// (Connect, PrmEnd, ApplicationReady, Release), P-029 (ModuleDiff), P-042
-/// (cyclic data), P-110…P-114 and P-223 (the profile's telegram 1: the
+/// (cyclic data; legacy and advanced startup), P-110…P-114 and P-223 (the profile's telegram 1: the
 /// enable sequence answered in ZSW1, a speed set-point seen in PNU 1101),
 /// P-191 (a PKW read), P-030/P-035/P-085 (a drive fault as a diagnosis
 /// alarm, acknowledged by CW1 bit 7), P-036 and Q-07 (the AR aborted when the
@@ -141,6 +146,8 @@ fn p008_p027_p029_p030_p035_p036_p042_p085_p110_p191_p223_profinet_py_names_conn
         &fault_event,
         "--fault-cause",
         &fault_cause,
+        "--startup",
+        "advanced",
     ];
     let args: Vec<&OsStr> = words.iter().map(OsStr::new).collect();
     let (status, lines) = line.run(&python, &script, &args, SCRIPT_LIMIT);
@@ -148,7 +155,7 @@ fn p008_p027_p029_p030_p035_p036_p042_p085_p110_p191_p223_profinet_py_names_conn
     line.stop_server();
     let serve = line.serve_output();
     println!("--- hil-sim serve ({}):\n{serve}", line.serve_log.display());
-    for step in ["a", "b", "c", "d", "e", "f", "g", "h", "i", "j"] {
+    for step in ["a", "b", "c", "d", "e", "f", "g", "h", "i", "j", "k", "l"] {
         let got = step_lines(&lines, step);
         assert!(
             got.iter().any(|l| l.starts_with("ok: ")) && !got.iter().any(|l| l.starts_with("FAIL: ")),
@@ -167,6 +174,28 @@ fn p008_p027_p029_p030_p035_p036_p042_p085_p110_p191_p223_profinet_py_names_conn
         a.iter()
             .any(|l| l.contains(&line.device_mac) && l.contains("name ''") && l.contains("ip 0.0.0.0")),
         "{a:?}"
+    );
+    // P-042: legacy startup (step e) and advanced startup (step k and the
+    // cyclic AR of step h) both connect, with FrameIDs of their RTClass
+    let e = step_lines(&lines, "e");
+    assert!(e.iter().any(|l| l.contains("input FrameID 0xC")), "{e:?}");
+    let k = step_lines(&lines, "k");
+    assert!(
+        k.iter()
+            .any(|l| l.contains("output FrameID 0x81") && l.contains(&format!("station b'{NAME}'"))),
+        "{k:?}"
+    );
+    assert!(
+        lines
+            .iter()
+            .any(|l| l.contains("advanced startup: input FrameID 0x80")),
+        "step h did not connect in advanced startup"
+    );
+    // P-041: records of MaxSupportedRecordSize in fragments
+    let l = step_lines(&lines, "l");
+    assert!(
+        l.iter().any(|x| x.starts_with("ok: 4068-byte")) && l.iter().any(|x| x.starts_with("ok: 4069-byte")),
+        "{l:?}"
     );
     let d = step_lines(&lines, "d");
     assert!(

@@ -31,6 +31,11 @@
 //!   server raises the matching permanent Sets); mode "All" restores every
 //!   parameter default first; mode 1 ("application data") restores every
 //!   default except the PROFINET parameters A270…A278. Each is saved.
+//!   The communication modes and "All" also blank I&M1…4.
+//!
+//! I&M1…4 (P-039) written by a controller are saved at once, behind the
+//! parameter image in the same store record ([`settings::im_trailer`]), and
+//! come back at the next start ([`PnParamFlash`] holds both).
 //!
 //! PROFINET active (A270, P-012/P-013) is read at start: with 0 the drive
 //! is silent from power-on. Switched off while running it takes effect at
@@ -61,7 +66,7 @@ use drive_core::params::{A00, A150, A150_FALLBACK_US, A270, A271, A275, E43, E82
 use drive_core::{DriveObjects, PERSISTENT_IMAGE_BYTES};
 use nanos::Nanos;
 use profinet::cm::CmEvent;
-use profinet::cm::{NoRecords, RecordHook};
+use profinet::cm::{ImData, NoRecords, RecordHook};
 use profinet::dcp::{Event as DcpEvent, IpSuite, NameOfStation, ResetMode};
 use profinet::device::{Device, DeviceEvent, RtEvent};
 use profinet::profienergy::ProfiEnergy;
@@ -147,8 +152,12 @@ impl<F: Flash, H: RecordHook> PnDrive<F, H> {
     pub fn with_hook(flash: F, hw: Hardware, hook: H) -> PnDrive<F, H> {
         let mut objects = DriveObjects::new();
         let mut store = ParamStore::new(flash);
-        let startup = load(&mut store, &mut objects);
+        let (startup, im) = load(&mut store, &mut objects);
         let active = objects.get(A270, 0) != Ok(0);
+        let hw = Hardware {
+            im: im.unwrap_or(hw.im),
+            ..hw
+        };
         let config = settings::device_config(&mut objects, hw);
         let axes_a = Axis::new(0);
         let profile = profile::Profile::new(&mut objects, &axes_a);
@@ -273,8 +282,13 @@ impl<F: Flash, H: RecordHook> PnDrive<F, H> {
         } else {
             None
         };
-        let mut image = [0u8; PERSISTENT_IMAGE_BYTES];
-        let len = self.objects.persistent_image(&mut image).ok();
+        let mut image = [0u8; STORED_BYTES];
+        // the parameter image, then I&M1…4 (P-039)
+        let trailer = settings::im_trailer(self.device.cm().im_data());
+        let len = self.objects.persistent_image(&mut image).ok().and_then(|n| {
+            image.get_mut(n..n + trailer.len())?.copy_from_slice(&trailer);
+            Some(n + trailer.len())
+        });
         if let Some(n) = name_len {
             let _ = self.objects.set_bytes(A271, 0, name.get(..n).unwrap_or(&[]));
         }
@@ -364,6 +378,8 @@ impl<F: Flash, H: RecordHook> PnDrive<F, H> {
                     pe.clear_response();
                 }
                 DeviceEvent::Dcp(d) => save |= self.apply_dcp(d),
+                // I&M1…4 are kept with the parameters (P-039)
+                DeviceEvent::Cm(CmEvent::ImWritten(_)) => save = true,
                 _ => {}
             }
             on_event(&e);
@@ -407,14 +423,19 @@ impl<F: Flash, H: RecordHook> PnDrive<F, H> {
             DcpEvent::ResetToFactory(ResetMode::All) => {
                 self.objects.restore_defaults();
                 self.temporary = Temporary::default();
+                self.device.set_im_data(ImData::default());
+                true
+            }
+            // name and IP follow as permanent Sets; I&M1…4 are cleared here
+            DcpEvent::ResetToFactory(ResetMode::Communication) => {
+                self.device.set_im_data(ImData::default());
                 true
             }
             DcpEvent::ResetToFactory(ResetMode::ApplicationData) => {
                 self.restore_application_defaults();
                 true
             }
-            // name and IP follow as permanent Sets
-            DcpEvent::ResetToFactory(ResetMode::Communication) | DcpEvent::Signal { .. } => false,
+            DcpEvent::Signal { .. } => false,
         }
     }
 
@@ -581,13 +602,25 @@ impl<F: Flash, H: RecordHook> PnDrive<F, H> {
 
 /// Loads the newest saved set into `objects` (defaults stay when there is
 /// none, it is from another declaration or does not load).
-fn load<F: Flash>(store: &mut ParamStore<F>, objects: &mut DriveObjects) -> Startup {
-    let mut image = [0u8; PERSISTENT_IMAGE_BYTES];
-    match store.load(LAYOUT_HASH, &mut image) {
-        Ok(n) => match image.get(..n).map(|img| objects.load_persistent(img)) {
-            Some(Ok(())) => Startup::Loaded,
-            _ => Startup::Defaults,
-        },
-        Err(_) => Startup::Defaults,
+/// The store's record: the parameter image and I&M1…4 behind it.
+pub const STORED_BYTES: usize = PERSISTENT_IMAGE_BYTES + settings::IM_TRAILER;
+
+/// The parameter flash of the PROFINET images: two slots of two 2 KiB
+/// sectors, as the parameter image with I&M1…4 behind it
+/// ([`STORED_BYTES`]) no longer fits one 2 KiB sector (the EtherCAT
+/// images' `node::ParamFlash`). In RAM until the board's PFLASH driver is
+/// used, like that one.
+pub type PnParamFlash = store::RamFlash<2048, 4>;
+
+/// The newest saved set into `objects`, and the I&M1…4 saved with it.
+fn load<F: Flash>(store: &mut ParamStore<F>, objects: &mut DriveObjects) -> (Startup, Option<ImData>) {
+    let mut image = [0u8; STORED_BYTES];
+    let Ok(n) = store.load(LAYOUT_HASH, &mut image) else {
+        return (Startup::Defaults, None);
+    };
+    let (params, im) = settings::split_stored(image.get(..n).unwrap_or(&[]));
+    match objects.load_persistent(params) {
+        Ok(()) => (Startup::Loaded, im),
+        Err(_) => (Startup::Defaults, None),
     }
 }

@@ -38,10 +38,69 @@ pub struct Hardware {
     pub port_macs: [MacAddr; model::PORTS as usize],
     /// I&M0 (identity).
     pub im0: Im0,
-    /// The stored I&M1–4 (kept by the board; not in the parameter image yet).
+    /// I&M1–4 of a board whose parameter store holds none yet (the store's
+    /// take precedence: [`crate::PnDrive`] keeps them behind the parameter
+    /// image, [`im_trailer`]).
     pub im: ImData,
     /// The RPC server boot time: different after every start.
     pub boot_time: u32,
+}
+
+/// Length of I&M1…4 in the store: IM_Tag_Function (32), IM_Tag_Location
+/// (22), IM_Date (16), IM_Descriptor (54), IM_Signature (54).
+pub const IM_BYTES: usize = 32 + 22 + 16 + 54 + 54;
+/// What follows the parameter image in the store: I&M1…4, then this tag.
+pub const IM_TAG: [u8; 4] = *b"IM14";
+/// Length of that trailer.
+pub const IM_TRAILER: usize = IM_BYTES + IM_TAG.len();
+
+/// I&M1…4 as the trailer stored behind the parameter image.
+pub fn im_trailer(im: &ImData) -> [u8; IM_TRAILER] {
+    let mut out = [0u8; IM_TRAILER];
+    let parts: [&[u8]; 6] = [
+        &im.tag_function,
+        &im.tag_location,
+        &im.date,
+        &im.descriptor,
+        &im.signature,
+        &IM_TAG,
+    ];
+    let mut at = 0;
+    for p in parts {
+        if let Some(dst) = out.get_mut(at..at + p.len()) {
+            dst.copy_from_slice(p);
+        }
+        at += p.len();
+    }
+    out
+}
+
+/// Splits a stored record into the parameter image and I&M1…4 (`None`: a
+/// record saved before I&M were kept, or without the tag).
+pub fn split_stored(record: &[u8]) -> (&[u8], Option<ImData>) {
+    let Some(at) = record.len().checked_sub(IM_TRAILER) else {
+        return (record, None);
+    };
+    let (params, trailer) = record.split_at(at);
+    if trailer.get(IM_BYTES..) != Some(&IM_TAG[..]) {
+        return (record, None);
+    }
+    let mut im = ImData::default();
+    let mut at = 0;
+    for dst in [
+        &mut im.tag_function[..],
+        &mut im.tag_location[..],
+        &mut im.date[..],
+        &mut im.descriptor[..],
+        &mut im.signature[..],
+    ] {
+        let n = dst.len();
+        if let Some(src) = trailer.get(at..at + n) {
+            dst.copy_from_slice(src);
+        }
+        at += n;
+    }
+    (params, Some(im))
 }
 
 /// The name of station in A271 into `buf`; returns its length (0 when the

@@ -24,7 +24,7 @@ fn hex(s: &str) -> Vec<u8> {
 }
 
 /// The flash of these tests (the board's parameter flash: 2 × 2 KiB).
-pub(crate) type TestFlash = store::RamFlash<2048, 2>;
+pub(crate) type TestFlash = PnParamFlash;
 
 /// The board's data of the test device.
 pub(crate) fn hardware() -> Hardware {

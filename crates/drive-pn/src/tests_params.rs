@@ -388,3 +388,77 @@ fn p007_p009_reset_to_factory_clears_name_and_ip_and_mode_all_every_default() {
 fn parameter(line: u16) -> u16 {
     drive_core::parameter_index(0, line)
 }
+
+/// Sends profinet-py's RPC request `req` (vectors, sequence number `seq`)
+/// over UDP to the commissioned drive at 192.168.0.50; returns whether an
+/// answer went out.
+fn rpc(d: &mut PnDrive<TestFlash>, req: &str, seq: u32) -> bool {
+    use profinet::ip::{Endpoint, IpConfig, Stack, UdpTx, RPC_PORT, UDP_PAYLOAD_OFFSET};
+    let mut ctrl = Stack::new(
+        PLC,
+        IpConfig {
+            addr: Ipv4Addr::new(192, 168, 0, 10),
+            netmask: Ipv4Addr::new(255, 255, 255, 0),
+            gateway: Ipv4Addr::UNSPECIFIED,
+        },
+    );
+    let ep = Endpoint {
+        ip: Ipv4Addr::new(192, 168, 0, 50),
+        port: RPC_PORT,
+    };
+    ctrl.learn(Nanos::ZERO, ep.ip, OUR);
+    let mut req = profinet::testing::hex(req).to_vec();
+    req[64..68].copy_from_slice(&seq.to_be_bytes());
+    let mut tx = std::vec![0u8; 1600];
+    tx[UDP_PAYLOAD_OFFSET..UDP_PAYLOAD_OFFSET + req.len()].copy_from_slice(&req);
+    let Ok(UdpTx::Frame(n)) = ctrl.emit_udp(Nanos::ZERO, &mut tx, 0xC000, ep, req.len()) else {
+        panic!("no frame")
+    };
+    !send(d, &tx[..n]).is_empty()
+}
+
+#[test]
+fn p039_im1_to_im4_written_by_a_controller_survive_a_restart_and_reset_to_factory_clears_them() {
+    use super::tests::vectors::{CONNECT, WRITE_IM1, WRITE_IM2};
+    // the PROFINET images' parameter flash holds the image and I&M1…4
+    assert!(STORED_BYTES <= store::ParamStore::<PnParamFlash>::new(PnParamFlash::new()).capacity());
+    let mut d = super::tests::commissioned();
+    assert!(rpc(&mut d, CONNECT, 10));
+    assert!(rpc(&mut d, WRITE_IM1, 11));
+    assert!(rpc(&mut d, WRITE_IM2, 12));
+    let im = *d.device().cm().im_data();
+    assert_eq!(&im.tag_location[..9], b"Cabinet 3");
+    assert_eq!(&im.date, b"2024-05-28 10:30");
+    // power off and on: the board's hardware data carries no I&M, the store does
+    let mut d = restart(d);
+    assert_eq!(*d.device().cm().im_data(), im);
+    assert_eq!(name(&mut d), "drive-1", "the parameters came back with them");
+    // a restart without a new write keeps them (they are saved with every save)
+    assert!(d.save());
+    let mut d = restart(d);
+    assert_eq!(*d.device().cm().im_data(), im);
+    // DCP Reset to factory, mode 2 (communication): I&M1…4 blank, saved so
+    send(&mut d, &reset(2));
+    assert_eq!(*d.device().cm().im_data(), ImData::default());
+    let d = restart(d);
+    assert_eq!(*d.device().cm().im_data(), ImData::default());
+}
+
+#[test]
+fn p039_a_store_saved_before_i_m_was_kept_loads_with_the_boards_i_m() {
+    // the parameter image alone (as saved before I&M1…4 were kept) loads as it did
+    let mut img = std::vec![0u8; PERSISTENT_IMAGE_BYTES];
+    let mut d = fresh();
+    settings::write_name(d.objects_mut(), &"old-1".parse().unwrap());
+    let n = d.objects_mut().persistent_image(&mut img).unwrap();
+    let mut store = store::ParamStore::new(d.into_flash());
+    store.save(&img[..n], drive_core::objects::LAYOUT_HASH).unwrap();
+    let mut hw = hardware();
+    hw.im.tag_function[..5].copy_from_slice(b"board");
+    let mut d = PnDrive::new(store.into_inner(), hw);
+    assert_eq!(name(&mut d), "old-1");
+    assert_eq!(&d.device().cm().im_data().tag_function[..5], b"board");
+    // split_stored: a record without the tag is all parameters
+    let (params, im) = settings::split_stored(&img[..n]);
+    assert_eq!((params.len(), im), (n, None));
+}

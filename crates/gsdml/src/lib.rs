@@ -25,8 +25,12 @@
 //!   order); `IOConfigData` allows one 19-word module per CR
 //!   ([`max_cr_length`]).
 //! - Timing: `MinDeviceInterval` [`model::MIN_DEVICE_INTERVAL`] = 32 (1 ms),
-//!   send clock 32, reduction ratios 1…512; RT_CLASS_1 only, CC-B, startup
-//!   mode "Advanced".
+//!   send clock 32, reduction ratios 1…512; RT_CLASS_1 frames only, CC-B,
+//!   startup modes "Legacy;Advanced" (IOCRs of RTClass 1 or 2).
+//! - `MaxSupportedRecordSize` [`model::MAX_RECORD_SIZE`] (4,068, the schema's
+//!   minimum); each port submodule has its own ident
+//!   ([`model::port_submodule_ident`]); the catalogue's device symbol is the
+//!   bitmap [`bitmap_file_name`] beside the file ([`device_bitmap`]).
 //! - Diagnosis: one `ChannelDiagItem` per drive fault (main error HH = its
 //!   E82 event, ErrorType [`model::channel_error_type`]), each with an
 //!   `ExtChannelDiagList` of the sub errors S = 0…15 (its E43 cause,
@@ -34,7 +38,10 @@
 //!
 //! A host tool: it uses `std` (`String`, `BTreeMap`).
 
+mod bitmap;
 mod xml;
+
+pub use bitmap::device_bitmap;
 
 use std::collections::BTreeMap;
 use std::fmt;
@@ -195,6 +202,10 @@ pub fn generate() -> Result<String, Error> {
     x.close();
     module_list(&mut x, &mut t)?;
     channel_diag_list(&mut x, &mut t)?;
+    x.open("GraphicsList", &[]);
+    let graphic = bitmap_stem();
+    x.empty("GraphicItem", &[("ID", GRAPHIC_ID), ("GraphicFile", &graphic)]);
+    x.close();
     x.open("ExternalTextList", &[]);
     x.open("PrimaryLanguage", &[]);
     for (id, value) in &t.0 {
@@ -206,6 +217,25 @@ pub fn generate() -> Result<String, Error> {
     x.close(); // ProfileBody
     x.close(); // ISO15745Profile
     x.finish().ok_or(Error::Unbalanced)
+}
+
+/// The `ID` of the device symbol's `GraphicItem`.
+const GRAPHIC_ID: &str = "G_DeviceSymbol";
+
+/// The device symbol's file name without extension (the GSDML's
+/// `GraphicFile`), by PI's convention `GSDML-<vendor ID>-<device ID>-<name>`.
+pub fn bitmap_stem() -> String {
+    format!(
+        "GSDML-{:04X}-{:04X}-{}",
+        model::VENDOR_ID,
+        model::DEVICE_ID,
+        token(model::STATION_TYPE)
+    )
+}
+
+/// The device symbol's file name, [`bitmap_stem`]`.bmp`.
+pub fn bitmap_file_name() -> String {
+    format!("{}.bmp", bitmap_stem())
 }
 
 /// Every generated file under `gsdml/`: (file name, contents).
@@ -274,6 +304,7 @@ fn dap(x: &mut Xml, t: &mut Texts) -> Result<(), Error> {
     let ident = format!("0x{:08X}", model::DAP_MODULE_IDENT);
     let mdi = model::MIN_DEVICE_INTERVAL.to_string();
     let dns = dns_compatible_name();
+    let record_size = model::MAX_RECORD_SIZE.to_string();
     x.open(
         "DeviceAccessPointItem",
         &[
@@ -292,8 +323,8 @@ fn dap(x: &mut Xml, t: &mut Texts) -> Result<(), Error> {
             ("NameOfStationNotTransferable", "false"),
             ("LLDP_NoD_Supported", "true"),
             ("ResetToFactoryModes", "2"),
-            ("IM5_Supported", "false"),
             ("AddressAssignment", "DCP"),
+            ("MaxSupportedRecordSize", &record_size),
         ],
     );
     let name = t.def("T_DAP_Name", model::DAP_NAME)?;
@@ -365,6 +396,12 @@ fn dap(x: &mut Xml, t: &mut Texts) -> Result<(), Error> {
     x.close();
     x.close();
     system_defined_submodules(x, t)?;
+    x.open("Graphics", &[]);
+    x.empty(
+        "GraphicItemRef",
+        &[("Type", "DeviceSymbol"), ("GraphicItemTarget", GRAPHIC_ID)],
+    );
+    x.close();
     x.close();
     Ok(())
 }
@@ -385,7 +422,7 @@ fn system_defined_submodules(x: &mut Xml, t: &mut Texts) -> Result<(), Error> {
             ("SupportedProtocols", "LLDP"),
         ],
     );
-    x.open("ApplicationRelations", &[("StartupMode", "Advanced")]);
+    x.open("ApplicationRelations", &[("StartupMode", "Legacy;Advanced")]);
     let clock = model::SEND_CLOCK_FACTOR.to_string();
     let ratios: Vec<String> = model::REDUCTION_RATIOS.iter().map(u16::to_string).collect();
     let ratios = ratios.join(" ");

@@ -15,5 +15,8 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
         std::fs::write(&path, text)?;
         println!("wrote {}", path.display());
     }
+    let path = dir.join(gsdml::bitmap_file_name());
+    std::fs::write(&path, gsdml::device_bitmap())?;
+    println!("wrote {}", path.display());
     Ok(())
 }

@@ -172,7 +172,9 @@ fn p025_gsdml_has_the_dap_smartservo_bl_4000_in_slot_0() {
     );
     // I&M: I&M1…4 writable on subslot 1, no I&M5
     assert_eq!(attr(virt[0], "Writeable_IM_Records"), "1 2 3 4");
-    assert_eq!(attr(dap, "IM5_Supported"), "false");
+    // IM5_Supported belongs to submodules in V2.44, not to the DAP item
+    assert!(dap.attribute("IM5_Supported").is_none());
+    assert_eq!(num(attr(dap, "MaxSupportedRecordSize")), 4068);
     let sys = child(dap, "SystemDefinedSubmoduleList");
     let ifs: Vec<_> = children(sys, "InterfaceSubmoduleItem").collect();
     assert_eq!(ifs.len(), 1);
@@ -184,6 +186,11 @@ fn p025_gsdml_has_the_dap_smartservo_bl_4000_in_slot_0() {
     );
     assert_eq!(attr(itf, "SupportedRT_Classes"), "RT_CLASS_1");
     let timing = child(child(itf, "ApplicationRelations"), "TimingProperties");
+    // P-042: legacy (RTClass 1 IOCRs) and advanced startup (RTClass 2)
+    assert_eq!(
+        attr(child(itf, "ApplicationRelations"), "StartupMode"),
+        "Legacy;Advanced"
+    );
     assert_eq!(attr(timing, "SendClock"), "32");
     assert_eq!(attr(timing, "ReductionRatio"), "1 2 4 8 16 32 64 128 256 512");
     // MinDeviceInterval is reachable: send clock × smallest reduction ratio
@@ -199,8 +206,8 @@ fn p025_gsdml_has_the_dap_smartservo_bl_4000_in_slot_0() {
             )
         })
         .collect();
-    let ident = u64::from(model::PORT_SUBMODULE_IDENT);
-    assert_eq!(ports, [(0x8001, ident), (0x8002, ident)]);
+    // each port its own ident
+    assert_eq!(ports, [(0x8001, 0x8001), (0x8002, 0x8002)]);
     assert_eq!(ports.len(), usize::from(model::PORTS));
 }
 
@@ -356,6 +363,84 @@ fn p034_gsdml_every_text_id_is_defined_once_and_used() {
     }
     // ModuleInfo names everywhere, data items and diagnosis included
     assert!(!descendants(doc.root_element(), "DataItem").is_empty());
+}
+
+#[test]
+fn gsdml_device_bitmap_is_current() {
+    let path = gsdml_dir().join(gsdml::bitmap_file_name());
+    let want = gsdml::device_bitmap();
+    if std::env::var_os("UPDATE_GSDML").is_some() {
+        std::fs::write(&path, &want).unwrap();
+    }
+    let got = std::fs::read(&path).unwrap_or_default();
+    assert!(
+        got == want,
+        "{} is out of date: run UPDATE_GSDML=1 cargo test -p gsdml",
+        path.display()
+    );
+}
+
+#[test]
+fn p025_gsdml_device_symbol_is_a_70_by_40_bitmap_beside_the_file() {
+    let text = xml();
+    let doc = Document::parse(&text).unwrap();
+    let graphics: Vec<_> = descendants(app(&doc), "GraphicItem");
+    assert_eq!(graphics.len(), 1);
+    let id = attr(graphics[0], "ID");
+    // GraphicFile names the file without its extension, beside the GSDML
+    assert_eq!(
+        format!("{}.bmp", attr(graphics[0], "GraphicFile")),
+        gsdml::bitmap_file_name()
+    );
+    let refs = descendants(child(dap(&doc), "Graphics"), "GraphicItemRef");
+    assert_eq!(
+        refs.iter()
+            .map(|r| (attr(*r, "Type"), attr(*r, "GraphicItemTarget")))
+            .collect::<Vec<_>>(),
+        [("DeviceSymbol", id)]
+    );
+    let bmp = std::fs::read(gsdml_dir().join(gsdml::bitmap_file_name())).unwrap();
+    let u32le = |at: usize| u32::from_le_bytes(bmp[at..at + 4].try_into().unwrap());
+    assert_eq!(&bmp[0..2], b"BM");
+    assert_eq!(u32le(2) as usize, bmp.len());
+    assert_eq!((u32le(18), u32le(22)), (70, 40));
+    assert!(bmp.len() < 2048, "keep the symbol tiny: {} bytes", bmp.len());
+}
+
+/// PI's schema set: `GSDML_SCHEMA_DIR`, else `../shared/schemas/gsdml` beside
+/// the workspace (as CI lays it out).
+fn schema() -> Option<PathBuf> {
+    let dir = std::env::var_os("GSDML_SCHEMA_DIR")
+        .map(PathBuf::from)
+        .unwrap_or_else(|| gsdml_dir().join("../../shared/schemas/gsdml"));
+    let xsd = dir.join("GSDML-DeviceProfile-v2.44.xsd");
+    xsd.is_file().then_some(xsd)
+}
+
+/// P-025: the file validates against PI's GSDML schema (V2.44), which TIA
+/// Portal applies at import.
+#[test]
+fn p025_gsdml_file_validates_against_pis_schema() {
+    let Some(xsd) = schema() else {
+        println!("skipped: no GSDML schema (set GSDML_SCHEMA_DIR or lay ../shared beside the workspace)");
+        return;
+    };
+    let path = gsdml_dir().join(gsdml::file_name());
+    match std::process::Command::new("xmllint")
+        .arg("--noout")
+        .arg("--schema")
+        .arg(&xsd)
+        .arg(&path)
+        .output()
+    {
+        Ok(out) => assert!(
+            out.status.success(),
+            "xmllint --schema {}: {}",
+            xsd.display(),
+            String::from_utf8_lossy(&out.stderr)
+        ),
+        Err(e) => println!("skipped: xmllint not runnable ({e}; Debian package libxml2-utils)"),
+    }
 }
 
 #[test]

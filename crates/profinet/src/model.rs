@@ -25,17 +25,23 @@ pub const DAP_MODULE_IDENT: u32 = 0x0000_0001;
 pub const DAP_SUBMODULE_IDENT: u32 = 0x0000_0001;
 /// Submodule ident of the interface subslot 0x8000.
 pub const INTERFACE_SUBMODULE_IDENT: u32 = 0x0000_8000;
-/// Submodule ident of a port subslot 0x8001/0x8002 (both ports are alike).
+/// Submodule ident of port 1's subslot 0x8001 (port 2's is 0x8002, see
+/// [`port_submodule_ident`]).
 pub const PORT_SUBMODULE_IDENT: u32 = 0x0000_8001;
 /// Number of Ethernet ports (P-003, P-006).
 pub const PORTS: u16 = 2;
 
-/// Submodule ident of port `port` (1 or 2): the same [`PORT_SUBMODULE_IDENT`]
-/// for both, as their hardware is the same (the GSDML's two
-/// PortSubmoduleItems differ in ID and subslot, not in ident).
-pub const fn port_submodule_ident(_port: u16) -> u32 {
-    PORT_SUBMODULE_IDENT
+/// Submodule ident of port `port` (1 or 2): 0x8000 + port, one ident per
+/// port (an engineering tool tells the GSDML's PortSubmoduleItems apart by
+/// their idents; the ports' hardware is alike).
+pub const fn port_submodule_ident(port: u16) -> u32 {
+    PORT_SUBMODULE_IDENT - 1 + port as u32
 }
+
+/// The largest record the device reads or writes (GSDML
+/// `MaxSupportedRecordSize`): 4,068 bytes, the least every device must take.
+/// The RPC buffers hold an IODWriteMultiple with one record this big.
+pub const MAX_RECORD_SIZE: usize = 4068;
 
 /// Vendor name of the GSDML and of I&M0's manufacturer text. A placeholder,
 /// like [`VENDOR_ID`].
@@ -211,8 +217,8 @@ mod tests {
         assert_eq!(ext_channel_error_type(6), Some(0x1006));
         assert_eq!(ext_channel_error_type(15), Some(0x100F));
         assert_eq!(ext_channel_error_type(16), None);
-        assert_eq!(port_submodule_ident(1), PORT_SUBMODULE_IDENT);
-        assert_eq!(port_submodule_ident(2), PORT_SUBMODULE_IDENT);
+        assert_eq!(port_submodule_ident(1), 0x8001);
+        assert_eq!(port_submodule_ident(2), 0x8002);
         assert!(ORDER_NUMBER.len() <= 20);
     }
 }

@@ -21,7 +21,7 @@
 //! its wraps counted by `tick`, the count within a wrap read from the
 //! counter. Run without `-icount` QEMU's virtual clock follows the host's,
 //! so the device's cycle (the input frame every 1 ms) is roughly real time.
-//! The parameter store is `firmware::ParamFlash` (RAM): a name and IP set
+//! The parameter store is `drive_pn::PnParamFlash` (RAM): a name and IP set
 //! permanently by DCP last until QEMU exits. Logging: defmt over
 //! semihosting.
 #![no_std]
@@ -134,7 +134,7 @@ impl TickClock {
 }
 
 /// The drive on PROFINET as this image runs it.
-pub type Drive = drive_pn::PnDrive<firmware::ParamFlash>;
+pub type Drive = drive_pn::PnDrive<drive_pn::PnParamFlash>;
 
 /// The identity of this image: the station address the LAN9118 reports
 /// (QEMU's `macaddr=`), the port MACs next to it.
@@ -176,7 +176,7 @@ mod app {
     use cortex_m::peripheral::syst::SystClkSource;
     use drive::axis::{AxisCommand, AxisIo};
     use firmware::pn_log::log_event;
-    use firmware::ParamFlash;
+    use drive_pn::PnParamFlash as ParamFlash;
     use nanos::Nanos;
 
     #[shared]

@@ -12,8 +12,8 @@
 //! As on the EtherCAT image, the CCU4 compare is not programmed yet: `idle`
 //! pends the control interrupt when [`PnCycle::next_at`] has passed; the
 //! device's next deadline (the input frame of each cycle, watchdogs) is
-//! kept the same way. The parameter store is `firmware::ParamFlash` (two
-//! 2 KiB sectors in RAM: the PFLASH driver is not used by the images yet,
+//! kept the same way. The parameter store is `drive_pn::PnParamFlash` (two
+//! slots of 2 × 2 KiB in RAM, the parameters and I&M1…4: the PFLASH driver is not used by the images yet,
 //! as on the EtherCAT image). Board bring-up that needs the hardware to verify — ETH0 pins,
 //! PHY address, RMII clock, the MAC address — is listed in docs/hardware.md.
 #![no_std]
@@ -46,7 +46,7 @@ pub const TX: usize = 4;
 /// The MAC on ETH0 with its rings in DSRAM2.
 pub type Eth = gmac::Eth<'static, gmac::Mmio, RX, TX>;
 /// The drive on PROFINET as this image runs it.
-pub type Drive = drive_pn::PnDrive<firmware::ParamFlash>;
+pub type Drive = drive_pn::PnDrive<drive_pn::PnParamFlash>;
 
 /// The control-cycle timer of the PROFINET image: free-running at A150
 /// (no SYNC0 on PROFINET RT_CLASS_1), first cycle at `firmware::cycle::CYCLE`.
@@ -89,9 +89,9 @@ mod app {
     use crate::{board, Drive, Eth, PnCycle, CPU_HZ};
     use cortex_m::peripheral::DWT;
     use drive::axis::{AxisCommand, AxisIo};
+    use drive_pn::PnParamFlash as ParamFlash;
     use firmware::clock::Clock;
     use firmware::pn_log::log_event;
-    use firmware::ParamFlash;
     use gmac::phy;
     use nanos::Nanos;
 

@@ -35,7 +35,23 @@ both bind UDP 34964) and goes step by step, one line per result:
     (skipped without --control: a device without a control channel, such
     as the firmware image in QEMU, `scripts/cross qemu-net`);
 (j) the controller stops sending output frames: the device aborts the AR
-    (RTA ERR PDU) and stops its input frames.
+    (RTA ERR PDU) and stops its input frames;
+(k) Connect in advanced startup as an S7-1500 sends it (ARProperties
+    StartupMode = 1, IOCRs of RTClass 2 with FrameIDs 0x8000-0xBBFF), PrmEnd,
+    ApplicationReady, Release: the device assigns the output CR's FrameID in
+    that range and answers with an ARServerBlockRes naming itself;
+(l) in that AR, a write of a 4,068-byte record (MaxSupportedRecordSize)
+    to an index the drive does not have, sent in DCE/RPC fragments of 1,024
+    bytes (profinet-py sends a request as one datagram, which IP would have
+    to fragment; the fragmenting sender is ours): the device reassembles it
+    and answers the record's header with "invalid index" (DF 80 B0), not an
+    RPC fault; a 4,069-byte one gets "write length error" (DF 80 B1).
+
+Steps (a)-(g) use legacy startup (profinet-py's own Connect: RTClass 1,
+FrameIDs 0xC000-0xF7FF); with --startup advanced, step (h) connects in
+advanced startup (profinet-py 0.6.6 cannot: its AR and IOCR block builders
+are wrapped to set StartupMode and RTClass 2 and to propose the input CR's
+FrameID 0x8000 + reference).
 """
 
 import argparse
@@ -116,6 +132,76 @@ def release(con):
     return nrd.args_maximum_status, block_type
 
 
+class AdvancedStartup:
+    """profinet-py's Connect in advanced startup while active: its ARBlockReq
+    gets StartupMode (ARProperties bit 30), its IOCRBlockReqs RTClass 2 and,
+    for the input CR, FrameID 0x8000 + reference instead of 0xC000 +
+    reference (the output CR stays 0xFFFF: the device assigns it)."""
+
+    def __enter__(self):
+        self.ar, self.iocr = rpc.PNARBlockRequest, rpc.PNIOCRBlockReqHeader
+        ar, iocr = self.ar, self.iocr
+
+        # subclasses, so that the builders' class attributes (fmt_size, …) stay
+        class ar_block(ar):
+            def __new__(cls, *args, **kw):
+                if len(args) > 6:  # building, not parsing
+                    args = list(args)
+                    args[6] |= 1 << 30  # ARProperties: StartupMode advanced
+                return ar.__new__(cls, *args, **kw)
+
+        class iocr_block(iocr):
+            def __new__(cls, *args, **kw):
+                if "iocr_properties" in kw:
+                    kw["iocr_properties"] = (kw["iocr_properties"] & ~0xF) | 2  # RTClass 2
+                    if kw["frame_id"] != 0xFFFF:
+                        kw["frame_id"] = 0x8000 + kw["iocr_reference"]
+                return iocr.__new__(cls, *args, **kw)
+
+        rpc.PNARBlockRequest, rpc.PNIOCRBlockReqHeader = ar_block, iocr_block
+        return self
+
+    def __exit__(self, *exc):
+        rpc.PNARBlockRequest, rpc.PNIOCRBlockReqHeader = self.ar, self.iocr
+        return False
+
+
+def fragmented_write(con, slot, subslot, index, data, frag=1024, timeout=5.0):
+    """An IODWrite in DCE/RPC fragments of `frag` body bytes over profinet-py's
+    AR and socket; returns (NDR PNIO status, the IODWriteRes's status)."""
+    block = rpc.PNBlockHeader(0x0008, 60, 0x01, 0x00)
+    iod = rpc.PNIODHeader(
+        bytes(block), 0, con.ar_uuid, 0, slot, subslot, 0, index, len(data), bytes(16), bytes(8),
+        payload=bytes(data),
+    )
+    whole = bytes(con._create_rpc(rpc.PNRPCHeader.WRITE, bytes(con._create_nrd(bytes(iod)))))
+    head, body = whole[:80], whole[80:]  # big-endian drep (profinet-py's)
+    seq = head[64:68]
+    chunks = [body[k : k + frag] for k in range(0, len(body), frag)]
+    for n, c in enumerate(chunks):
+        h = bytearray(head)
+        h[2] = 0x20 | 0x04 | (0x02 if n == len(chunks) - 1 else 0)  # idempotent, frag, last
+        h[74:76] = len(c).to_bytes(2, "big")
+        h[76:78] = n.to_bytes(2, "big")
+        con._socket.sendto(bytes(h) + c, con.peer)
+    end = time.monotonic() + timeout
+    while time.monotonic() < end:
+        con._socket.settimeout(max(0.01, end - time.monotonic()))
+        try:
+            d = con._socket.recvfrom(65535)[0]
+        except TimeoutError:
+            break
+        if len(d) < 80 or d[64:68] != seq:
+            continue
+        if d[1] == 3:  # fault
+            raise RuntimeError(f"RPC fault 0x{int.from_bytes(d[80:84], 'big'):08X}")
+        if d[1] == 2:  # response
+            b = d[80:]
+            res = b[20:]
+            return int.from_bytes(b[0:4], "big"), int.from_bytes(res[44:48], "big") if len(res) >= 48 else None
+    raise RuntimeError("no answer to the fragmented write")
+
+
 def blocks_of(payload):
     """The PNIO blocks of an NRD payload: [(type, bytes with header)]."""
     out = []
@@ -154,6 +240,12 @@ def main():
     )
     ap.add_argument("--fault-event", type=int, default=44)
     ap.add_argument("--fault-cause", type=int, default=1)
+    ap.add_argument(
+        "--startup",
+        choices=["legacy", "advanced"],
+        default="legacy",
+        help="startup mode of step (h)'s AR (steps (a)-(g) use legacy startup)",
+    )
     a = ap.parse_args()
 
     records = Records()
@@ -366,8 +458,17 @@ def main():
         dev.on_alarm(on_alarm)
         ctl = None
         try:
-            ctl = dev.start_cyclic(setup)
+            if a.startup == "advanced":
+                with AdvancedStartup():
+                    ctl = dev.start_cyclic(setup)
+            else:
+                ctl = dev.start_cyclic(setup)
             t_connected = time.monotonic()
+            print(
+                f"  {a.startup} startup: input FrameID 0x{ctl.input_iocr.frame_id:04X}, "
+                f"output FrameID 0x{ctl.output_iocr.frame_id:04X}",
+                flush=True,
+            )
             while ctl.get_input_data(in_slot.slot, in_slot.subslot) is None:
                 if time.monotonic() - t_connected > 5.0:
                     raise RuntimeError("no valid input data within 5 s of the connect")
@@ -557,6 +658,61 @@ def main():
             dev.close()
 
     run("h", cyclic)
+
+    # (k) advanced startup: Connect, PrmEnd, ApplicationReady, Release
+    def advanced_startup():
+        con = RPCCon(info, timeout=5.0)
+        answers = []
+        plain = con._send_receive
+
+        def keep(pkt):
+            r = plain(pkt)
+            answers.append(r)
+            return r
+
+        con._send_receive = keep
+        try:
+            with AdvancedStartup():
+                res = con.connect(src, iocr_setup=IOCRSetup(slots=slots))
+            nrd = rpc.PNNRDData(answers[0].payload)
+            server = [b for t, b in blocks_of(bytes(nrd.payload)) if t == 0x8106]
+            name = b""
+            if server:
+                n = int.from_bytes(server[0][6:8], "big")
+                name = server[0][8 : 8 + n]
+            con.prm_end()
+            con.application_ready(timeout=10.0)
+            ok = (
+                0x8000 <= res.input_frame_id <= 0xBBFF
+                and 0x8000 <= res.output_frame_id <= 0xBBFF
+                and name == a.name.encode()
+            )
+            report(
+                "k",
+                ok,
+                f"advanced startup Connect (RTClass 2): input FrameID 0x{res.input_frame_id:04X}, "
+                f"output FrameID 0x{res.output_frame_id:04X}, ARServerBlockRes station {name!r}; "
+                f"PrmEnd; ApplicationReady confirmed",
+            )
+            # (l) records of MaxSupportedRecordSize and one byte more, in fragments
+            def big_records():
+                for n, want in [(4068, 0xDF80B000), (4069, 0xDF80B100)]:
+                    status, res = fragmented_write(con, 1, 1, 0x7FF0, bytes(k % 251 for k in range(n)))
+                    report(
+                        "l",
+                        status & 0xFFFFFF00 == want and res is not None and res & 0xFFFFFF00 == want,
+                        f"{n}-byte record in 1,024-byte RPC fragments: PNIO status 0x{status:08X}, "
+                        f"IODWriteRes status 0x{res:08X}",
+                    )
+
+            run("l", big_records)
+            status, block = release(con)
+            if status != 0:
+                report("k", False, f"Release refused: 0x{status:08X}")
+        finally:
+            con.close()
+
+    run("k", advanced_startup)
 
     if failures:
         print(f"failed steps: {' '.join(failures)}", flush=True)

@@ -81,6 +81,10 @@ pub struct Iocr {
     pub iocr_type: IocrType,
     /// IOCRReference (the controller's name for it).
     pub reference: u16,
+    /// RTClass of IOCRProperties: 1 (legacy startup) or 2 (advanced startup;
+    /// the frames are RT_CLASS_1 frames either way, only the FrameID range
+    /// differs).
+    pub rt_class: u8,
     /// FrameID of its frames (assigned by the device when the request left it
     /// to the device with 0xFFFF).
     pub frame_id: u16,
@@ -256,12 +260,22 @@ pub struct Ar {
     pub state: ArState,
 }
 
+/// ARProperties bit 30, StartupMode: 0 legacy, 1 advanced.
+pub const AR_PROPERTIES_STARTUP_MODE: u32 = 1 << 30;
+
 impl Ar {
     /// The submodule at `slot`/`subslot`.
     pub fn submodule(&self, slot: u16, subslot: u16) -> Option<&Submodule> {
         self.submodules
             .iter()
             .find(|s| s.slot == slot && s.subslot == subslot)
+    }
+
+    /// True if the controller asked for advanced startup (ARProperties
+    /// bit 30, StartupMode): its IOCRs are RTClass 2 and the Connect
+    /// response carries an ARServerBlockRes.
+    pub fn advanced_startup(&self) -> bool {
+        self.properties & AR_PROPERTIES_STARTUP_MODE != 0
     }
 
     /// True if any expected submodule differs from the real one.

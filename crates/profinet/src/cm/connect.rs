@@ -7,13 +7,13 @@
 use heapless::Vec;
 
 use super::ar::*;
-use super::ndr::{emit_block, Block, BlockError, Blocks};
+use super::ndr::{emit_block, emit_block_v, Block, BlockError, Blocks};
 use super::status::{cmrpc, error_code, error_code1 as b, PnioStatus};
 use crate::ip::Endpoint;
 use crate::model::{self, DataModule, Direction};
 use crate::rpc::cursor::{Endian, Reader, Writer};
 use crate::rpc::Uuid;
-use crate::wire::{FrameKind, MacAddr};
+use crate::wire::MacAddr;
 
 /// Block types of the Connect.
 pub mod block_type {
@@ -33,6 +33,8 @@ pub mod block_type {
     pub const ALARM_CR_RES: u16 = 0x8103;
     /// ModuleDiffBlock.
     pub const MODULE_DIFF: u16 = 0x8104;
+    /// ARServerBlockRes (advanced startup).
+    pub const AR_SERVER_RES: u16 = 0x8106;
 }
 
 /// The largest alarm payload the device takes and sends.
@@ -42,6 +44,19 @@ const LT_PROFINET: u16 = 0x8892;
 /// Base of the FrameIDs the device assigns (output CR: 0xC100 + reference,
 /// input CR: 0xC200 + reference, low byte of the reference).
 pub const ASSIGNED_FRAME_ID_BASE: u16 = 0xC100;
+/// The same for RTClass 2 IOCRs (advanced startup): 0x8100 + reference
+/// (output CR), 0x8200 + reference (input CR).
+pub const ASSIGNED_FRAME_ID_BASE_RT_CLASS_2: u16 = 0x8100;
+
+/// The unicast FrameIDs of an RTClass: 0xC000…0xF7FF for RTClass 1 (legacy
+/// startup), 0x8000…0xBBFF for RTClass 2 (advanced startup; RT_CLASS_1
+/// frames in the former RT_CLASS_2 numbering), IEC 61158-6-10.
+pub fn frame_ids(rt_class: u8) -> core::ops::RangeInclusive<u16> {
+    match rt_class {
+        2 => 0x8000..=0xBBFF,
+        _ => 0xC000..=0xF7FF,
+    }
+}
 
 /// Field reader of one block: a short body is a BlockLength error (field 1).
 struct F<'a> {
@@ -165,14 +180,16 @@ fn parse_iocr(blk: &Block<'_>) -> Result<Iocr, PnioStatus> {
         f.check(v == LT_PROFINET, 6)?;
     }
     let props = f.u32()?;
-    f.check(props == 1, 7)?; // RT_CLASS_1, no reserved bits
+    // RTClass (bits 0-3): 1 or 2, both RT_CLASS_1 frames (IRT and RT over UDP
+    // are not offered); whether it fits the startup mode is checked once the
+    // ARBlockReq is known. Reserved_1 (bits 4-12) and reserved_3 (24-31)
+    // must be 0; reserved_2 may carry anything and is not checked.
+    let rt_class = (props & 0xF) as u8;
+    f.check(matches!(rt_class, 1 | 2) && props & 0xFF00_1FF0 == 0, 7)?;
     let data_length = f.u16()?;
     f.check((40..=1440).contains(&data_length), 8)?;
     let frame_id = f.u16()?;
-    f.check(
-        frame_id == 0xFFFF || matches!(FrameKind::of(frame_id), FrameKind::Cyclic(_)),
-        9,
-    )?;
+    f.check(frame_id == 0xFFFF || frame_ids(rt_class).contains(&frame_id), 9)?;
     let send_clock_factor = f.u16()?;
     f.check(matches!(send_clock_factor, 32 | 64 | 128), 10)?;
     let reduction_ratio = f.u16()?;
@@ -231,6 +248,7 @@ fn parse_iocr(blk: &Block<'_>) -> Result<Iocr, PnioStatus> {
     Ok(Iocr {
         iocr_type,
         reference,
+        rt_class,
         frame_id,
         data_length,
         send_clock_factor,
@@ -385,6 +403,49 @@ pub fn real_submodule(slot: u16, subslot: u16) -> Option<u32> {
     }
 }
 
+/// RealIdentificationData (block 0x0013, version 1.1): the DAP with its
+/// four subslots and, in an AR, each data slot with the module really
+/// plugged there (the data slots adapt to the expected modules, P-029; a
+/// slot without one is left out); without an AR (implicit read) the DAP
+/// only.
+pub fn emit_real_identification(w: &mut Writer<'_>, ar: Option<&Ar>) -> Option<()> {
+    let mut slots: Vec<(u16, u32), { MAX_DATA_SLOTS as usize }> = Vec::new();
+    for s in ar
+        .iter()
+        .flat_map(|a| a.submodules.iter())
+        .filter(|s| s.slot != 0)
+    {
+        let (fit, ident) = real_module(s.slot, s.module_ident);
+        if fit != Fit::NoModule && !slots.iter().any(|x| x.0 == s.slot) {
+            let _ = slots.push((s.slot, ident));
+        }
+    }
+    slots.sort_unstable_by_key(|x| x.0);
+    emit_block_v(w, REAL_IDENTIFICATION_DATA, 1, |w| {
+        w.u16(1)?; // NumberOfAPIs
+        w.u32(0)?;
+        w.u16(u16::try_from(slots.len() + 1).ok()?)?;
+        w.u16(0)?;
+        w.u32(model::DAP_MODULE_IDENT)?;
+        w.u16(u16::try_from(model::DAP_SUBSLOTS.len()).ok()?)?;
+        for sub in model::DAP_SUBSLOTS {
+            w.u16(sub)?;
+            w.u32(real_submodule(0, sub)?)?;
+        }
+        for &(slot, ident) in &slots {
+            w.u16(slot)?;
+            w.u32(ident)?;
+            w.u16(1)?;
+            w.u16(1)?;
+            w.u32(model::DATA_SUBMODULE_IDENT)?;
+        }
+        Some(())
+    })
+}
+
+/// Block type of RealIdentificationData.
+const REAL_IDENTIFICATION_DATA: u16 = 0x0013;
+
 /// True if `slot`/`subslot` exists in the real model.
 pub fn exists(slot: u16, subslot: u16) -> bool {
     real_submodule(slot, subslot).is_some()
@@ -475,6 +536,10 @@ pub fn parse_connect(args: &[u8], ctx: &ConnectContext) -> Result<Ar, PnioStatus
         }
     }
     let mut ar = ar.ok_or(PnioStatus::connect(b::AR_BLOCK_REQ, 0))?;
+    // Advanced startup takes RTClass 2 only; legacy startup RTClass 1 or 2.
+    if ar.advanced_startup() && crs.iter().any(|c| c.rt_class != 2) {
+        return Err(PnioStatus::connect(b::IOCR_BLOCK_REQ, 7));
+    }
     match ar.ar_type {
         ArType::IoCarSingle => {
             if crs.len() != 2 {
@@ -502,9 +567,13 @@ pub fn parse_connect(args: &[u8], ctx: &ConnectContext) -> Result<Ar, PnioStatus
     while let Some(mut cr) = crs.pop() {
         resolve(&mut cr, &subs)?;
         if cr.frame_id == 0xFFFF {
+            let first = match cr.rt_class {
+                2 => ASSIGNED_FRAME_ID_BASE_RT_CLASS_2,
+                _ => ASSIGNED_FRAME_ID_BASE,
+            };
             let base = match cr.iocr_type {
-                IocrType::Output => ASSIGNED_FRAME_ID_BASE,
-                IocrType::Input => ASSIGNED_FRAME_ID_BASE + 0x100,
+                IocrType::Output => first,
+                IocrType::Input => first + 0x100,
             };
             cr.frame_id = base | (cr.reference & 0xFF);
         }
@@ -555,7 +624,10 @@ fn resolve(cr: &mut Iocr, subs: &[Submodule]) -> Result<(), PnioStatus> {
 
 /// Writes the Connect response blocks for `ar` (ARBlockRes, IOCRBlockRes
 /// input then output, AlarmCRBlockRes, ModuleDiffBlock if anything differs).
-pub fn emit_connect_response(w: &mut Writer<'_>, ar: &Ar, our_mac: MacAddr) -> Option<()> {
+///
+/// In advanced startup an ARServerBlockRes with our name of station
+/// (`station`, CMResponderStationName) follows, padded to 32 bits.
+pub fn emit_connect_response(w: &mut Writer<'_>, ar: &Ar, our_mac: MacAddr, station: &[u8]) -> Option<()> {
     emit_block(w, block_type::AR_RES, |w| {
         w.u16(ar.ar_type.to_u16())?;
         w.bytes(&ar.ar_uuid.0)?;
@@ -582,6 +654,16 @@ pub fn emit_connect_response(w: &mut Writer<'_>, ar: &Ar, our_mac: MacAddr) -> O
     }
     if ar.has_diff() {
         emit_module_diff(w, ar)?;
+    }
+    if ar.advanced_startup() {
+        emit_block(w, block_type::AR_SERVER_RES, |w| {
+            let n = u16::try_from(station.len()).ok()?;
+            w.u16(n)?;
+            w.bytes(station)?;
+            // block header (6) + length (2) + name, padded to a multiple of 4
+            let pad = (4 - (8 + station.len()) % 4) % 4;
+            w.bytes([0u8; 3].get(..pad)?)
+        })?;
     }
     Some(())
 }

@@ -31,6 +31,10 @@ mod tests_pcap;
 #[cfg(test)]
 mod tests_record;
 #[cfg(test)]
+mod tests_record_size;
+#[cfg(test)]
+mod tests_startup;
+#[cfg(test)]
 pub(crate) use crate::testing::vectors as tests_vectors;
 
 pub use ar::{AlarmCr, Ar, ArState, ArType, Fit, IoObject, Iocr, IocrType, Submodule, SubmoduleData};
@@ -144,6 +148,11 @@ impl<H: RecordHook> Cm<H> {
         &self.im
     }
 
+    /// Replaces I&M1…4 (e.g. cleared by a reset to factory).
+    pub fn set_im_data(&mut self, im: ImData) {
+        self.im = im;
+    }
+
     /// The record hook.
     pub fn hook(&self) -> &H {
         &self.hook
@@ -232,7 +241,7 @@ impl<H: RecordHook> Cm<H> {
             let old = old.ar_uuid;
             self.remove(old, Some(AbortReason::Superseded));
         }
-        if emit_connect_response(w, &ar, self.config.mac).is_none() {
+        if emit_connect_response(w, &ar, self.config.mac, self.pdev.name.as_bytes()).is_none() {
             return PnioStatus::cmrpc(ec::IOD_CONNECT_RES, cmrpc::OUT_OF_RESOURCES);
         }
         self.next_alarm_ref = self.next_alarm_ref.wrapping_add(1).max(1);
@@ -356,6 +365,21 @@ impl<H: RecordHook> Cm<H> {
                 ok.ok_or(RecordError::ReadError)?;
                 Ok(w.pos())
             }
+            index::REAL_IDENTIFICATION_DATA => {
+                if !exists(addr.slot, addr.subslot) {
+                    return Err(RecordError::InvalidSlotSubslot);
+                }
+                connect::emit_real_identification(&mut w, ar).ok_or(RecordError::ReadError)?;
+                Ok(w.pos())
+            }
+            index::IM0_FILTER_DATA => {
+                // device scope: at any submodule there is
+                if !exists(addr.slot, addr.subslot) {
+                    return Err(RecordError::InvalidSlotSubslot);
+                }
+                record::emit_im0_filter(&mut w).ok_or(RecordError::ReadError)?;
+                Ok(w.pos())
+            }
             index::MODULE_DIFF => {
                 let ar = ar.ok_or(RecordError::StateConflict)?;
                 emit_module_diff(&mut w, ar).ok_or(RecordError::ReadError)?;
@@ -376,7 +400,12 @@ impl<H: RecordHook> Cm<H> {
         } else {
             match self.find(req.ar_uuid) {
                 Some(a) => Some(a.clone()),
-                None => return PnioStatus::cmrpc(code, cmrpc::AR_UUID_UNKNOWN),
+                None => {
+                    // refused with the header that names the record (an
+                    // answer without blocks is malformed to Wireshark)
+                    let _ = record::emit_read_res(w, &req, 0);
+                    return PnioStatus::cmrpc(code, cmrpc::AR_UUID_UNKNOWN);
+                }
             }
         };
         // the whole header or nothing: an answer never ends in half a block
@@ -411,7 +440,9 @@ impl<H: RecordHook> Cm<H> {
                     RecordError::InvalidSlotSubslot
                 })
             }
-            index::IM0 | index::MODULE_DIFF => Err(RecordError::AccessDenied),
+            index::IM0 | index::MODULE_DIFF | index::IM0_FILTER_DATA | index::REAL_IDENTIFICATION_DATA => {
+                Err(RecordError::AccessDenied)
+            }
             index::IM1..=index::IM4 => {
                 let rec = record::write_im(addr.index, data, &mut self.im)?;
                 self.event(CmEvent::ImWritten(rec));
@@ -460,6 +491,8 @@ impl<H: RecordHook> Cm<H> {
             }
             let status = if req.addr.index == index::WRITE_MULTIPLE {
                 RecordError::InvalidIndex.status(ec::IOD_WRITE_RES)
+            } else if len > crate::model::MAX_RECORD_SIZE {
+                RecordError::WriteLength.status(ec::IOD_WRITE_RES)
             } else {
                 match self.write_one(req.addr, sub) {
                     Ok(()) => PnioStatus::OK,
@@ -477,7 +510,9 @@ impl<H: RecordHook> Cm<H> {
             return PnioStatus::pnio(code, error_code1::RECORD, 0);
         };
         if self.find(req.ar_uuid).is_none() {
-            return PnioStatus::cmrpc(code, cmrpc::AR_UUID_UNKNOWN);
+            let s = PnioStatus::cmrpc(code, cmrpc::AR_UUID_UNKNOWN);
+            let _ = record::emit_write_res(w, &req, req.record_len, s);
+            return s;
         }
         // room for the answer's header (and, below, each sub-write's) before
         // anything is written: a write refused for want of room changes nothing
@@ -485,7 +520,11 @@ impl<H: RecordHook> Cm<H> {
             return PnioStatus::cmrpc(code, cmrpc::OUT_OF_RESOURCES);
         }
         let len = usize::try_from(req.record_len).unwrap_or(usize::MAX);
-        let Some(data) = rest.get(..len).filter(|_| rest.len() == len) else {
+        // A record above MaxSupportedRecordSize (a multiple write may be
+        // longer by its sub-headers), or a request cut short because it did
+        // not fit the RPC buffer: write length error, with the header.
+        let too_long = req.addr.index != index::WRITE_MULTIPLE && len > crate::model::MAX_RECORD_SIZE;
+        let Some(data) = rest.get(..len).filter(|_| rest.len() == len && !too_long) else {
             let s = RecordError::WriteLength.status(code);
             let _ = record::emit_write_res(w, &req, req.record_len, s);
             return s;
@@ -534,7 +573,12 @@ fn service(op: u16) -> u8 {
 impl<H: RecordHook> rpc::Handler for Cm<H> {
     fn call(&mut self, _now: Nanos, call: &Call, body: &[u8], out: &mut [u8]) -> Result<usize, CallError> {
         let too_big = CallError::Fault(rpc::nca::OUT_ARGS_TOO_BIG);
-        let Some(ndr) = NdrRequest::parse(body, call.endian) else {
+        let ndr = if call.truncated {
+            NdrRequest::parse_truncated(body, call.endian)
+        } else {
+            NdrRequest::parse(body, call.endian)
+        };
+        let Some(ndr) = ndr else {
             let s = PnioStatus::cmrpc(service(call.opnum), cmrpc::ARGS_LENGTH_INVALID);
             return ndr::emit_response(out, call.endian, s, 0, 0).ok_or(too_big);
         };

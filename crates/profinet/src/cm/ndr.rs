@@ -44,6 +44,27 @@ impl<'a> NdrRequest<'a> {
             args,
         })
     }
+
+    /// The same checks for the beginning of a request that was longer than
+    /// the buffer ([`crate::rpc::Call::truncated`]): `args` are the
+    /// arguments that arrived, shorter than ArgsLength.
+    pub fn parse_truncated(body: &'a [u8], endian: Endian) -> Option<NdrRequest<'a>> {
+        let mut r = Reader::new(body, endian);
+        let args_maximum = r.u32()?;
+        let args_length = r.u32()?;
+        let maximum_count = r.u32()?;
+        let offset = r.u32()?;
+        let actual_count = r.u32()?;
+        if offset != 0 || actual_count != args_length || args_length > maximum_count {
+            return None;
+        }
+        let args = r.rest();
+        (args.len() < usize::try_from(args_length).ok()?).then_some(NdrRequest {
+            args_maximum,
+            maximum_count,
+            args,
+        })
+    }
 }
 
 /// Writes a response NDR header in front of `args_len` bytes already at
@@ -157,11 +178,21 @@ pub fn emit_block(
     block_type: u16,
     body: impl FnOnce(&mut Writer<'_>) -> Option<()>,
 ) -> Option<()> {
+    emit_block_v(w, block_type, 0, body)
+}
+
+/// [`emit_block`] with BlockVersionLow `version_low` (high 1).
+pub fn emit_block_v(
+    w: &mut Writer<'_>,
+    block_type: u16,
+    version_low: u8,
+    body: impl FnOnce(&mut Writer<'_>) -> Option<()>,
+) -> Option<()> {
     let start = w.pos();
     w.u16(block_type)?;
     w.u16(0)?;
     w.u8(1)?;
-    w.u8(0)?;
+    w.u8(version_low)?;
     body(w)?;
     let len = u16::try_from(w.pos().checked_sub(start)?.checked_sub(4)?).ok()?;
     w.patch_u16(start.checked_add(2)?, len)

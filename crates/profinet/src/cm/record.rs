@@ -34,6 +34,10 @@ pub mod index {
     pub const MODULE_DIFF: u16 = 0xE002;
     /// Multiple write.
     pub const WRITE_MULTIPLE: u16 = 0xE040;
+    /// I&M0FilterData (read only, device scope).
+    pub const IM0_FILTER_DATA: u16 = 0xF840;
+    /// RealIdentificationData (read only, device scope).
+    pub const REAL_IDENTIFICATION_DATA: u16 = 0xF000;
 }
 
 /// Where a record lives.
@@ -239,6 +243,29 @@ pub enum ImRecord {
     Im3,
     /// I&M4.
     Im4,
+}
+
+/// I&M0FilterData (index 0xF840): which submodules carry I&M data — the
+/// DAP's subslot 1 only, the one submodule with I&M0 — as
+/// I&M0FilterDataSubmodule (block 0x0030) and I&M0FilterDataDevice (0x0032,
+/// the submodule that answers for the device); no module of its own carries
+/// I&M, so no I&M0FilterDataModule block. Each: NumberOfAPIs, API,
+/// NumberOfSlots, slot, module ident, NumberOfSubslots, subslot, submodule
+/// ident.
+pub fn emit_im0_filter(w: &mut Writer<'_>) -> Option<()> {
+    for block in [0x0030u16, 0x0032] {
+        emit_block(w, block, |w| {
+            w.u16(1)?;
+            w.u32(0)?;
+            w.u16(1)?;
+            w.u16(0)?;
+            w.u32(crate::model::DAP_MODULE_IDENT)?;
+            w.u16(1)?;
+            w.u16(1)?;
+            w.u32(crate::model::DAP_SUBMODULE_IDENT)
+        })?;
+    }
+    Some(())
 }
 
 /// Writes the I&M0 record (block 0x0020) into `w`.

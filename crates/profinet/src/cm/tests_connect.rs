@@ -32,7 +32,7 @@ pub(crate) fn im0() -> Im0 {
 
 /// The device's RPC and CM, wired like the firmware does.
 pub(crate) struct Dev<H: RecordHook = NoRecords> {
-    pub server: Server<4096>,
+    pub server: Server,
     pub cm: Cm<H>,
     /// Sequence number given to the next request fed by [`Dev::call`].
     pub seq: u32,

@@ -32,8 +32,24 @@ fn p039_im0_implicit_read_needs_no_ar_and_other_subslots_have_none() {
     let r: std::string::String = r.iter().map(|x| std::format!("{x:02x}")).collect();
     let (status, args) = d.call(&r);
     assert_eq!((status, &args[64..]), (PnioStatus::OK, &hex(IM0)[..]));
-    // A normal read without the AR: AR UUID unknown.
-    assert_eq!(d.call(READ_IM0).0, PnioStatus::cmrpc(0xDE, 5));
+    // A normal read without the AR: AR UUID unknown, answered with the
+    // IODReadRes header naming the record (no record data).
+    let (status, args) = d.call(READ_IM0);
+    assert_eq!(status, PnioStatus::cmrpc(0xDE, 5));
+    assert_eq!(
+        (args.len(), &args[..2], &args[34..36]),
+        (64, &[0x80, 0x09][..], &[0xAF, 0xF0][..])
+    );
+    // A write without the AR: the IODWriteRes header with the status in it.
+    let (status, args) = d.call(WRITE_IM1);
+    assert_eq!(status, PnioStatus::cmrpc(0xDF, 5));
+    assert_eq!(args.len(), 64);
+    assert_eq!(
+        (&args[..2], &args[34..36]),
+        (&[0x80, 0x08][..], &[0xAF, 0xF1][..])
+    );
+    assert_eq!(&args[44..48], &PnioStatus::cmrpc(0xDF, 5).to_bytes());
+    assert_eq!(d.cm.im_data(), &ImData::default());
     d.call(CONNECT);
     // I&M0 at the interface subslot: invalid index; at a missing subslot: invalid slot/subslot.
     let at_if = patch(READ_IM0, 30, &[0x80, 0x00]);
@@ -226,4 +242,19 @@ fn p041_a_small_args_maximum_gets_whole_blocks_or_none_and_changes_nothing() {
     let (status, args) = call_with(&mut d, WRITE_IM1, 3, 192, &multi);
     assert_eq!((status, args.len()), (PnioStatus::OK, 192));
     assert_ne!(d.cm.im_data(), &ImData::default());
+}
+
+#[test]
+fn p040_real_identification_data_without_an_ar_is_the_dap() {
+    let mut d = dev();
+    let mut r = hex(&patch(READ_IM0, INDEX_AT, &[0xF0, 0x00]));
+    r[68..70].copy_from_slice(&5u16.to_be_bytes()); // opnum: implicit read
+    let r: std::string::String = r.iter().map(|x| std::format!("{x:02x}")).collect();
+    let (status, args) = d.call(&r);
+    assert_eq!(status, PnioStatus::OK);
+    assert_eq!(
+        &args[64..],
+        &hex("0013 002a 0101 0001 00000000 0001
+              0000 00000001 0004 0001 00000001 8000 00008000 8001 00008001 8002 00008002")[..]
+    );
 }

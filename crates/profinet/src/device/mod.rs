@@ -212,6 +212,11 @@ impl<H: RecordHook> Device<H> {
         &self.cm
     }
 
+    /// Replaces I&M1…4 (a reset to factory clears them).
+    pub fn set_im_data(&mut self, im: crate::cm::ImData) {
+        self.cm.set_im_data(im);
+    }
+
     /// The RPC server (counters).
     pub fn rpc(&self) -> &Server {
         &self.rpc

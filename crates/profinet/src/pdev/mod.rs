@@ -46,6 +46,8 @@ pub mod index {
     pub const PD_PORT_DATA_REAL: u16 = 0x802A;
     /// PDPortDataAdjust (port subslots).
     pub const PD_PORT_DATA_ADJUST: u16 = 0x802F;
+    /// PDPortDataCheck (port subslots): read empty, no check is configured.
+    pub const PD_PORT_DATA_CHECK: u16 = 0x802B;
     /// PDInterfaceDataReal (interface subslot).
     pub const PD_INTERFACE_DATA_REAL: u16 = 0x8080;
 }
@@ -255,7 +257,10 @@ impl Pdev {
     pub fn serves(index: u16) -> bool {
         matches!(
             index,
-            index::PD_PORT_DATA_REAL | index::PD_PORT_DATA_ADJUST | index::PD_INTERFACE_DATA_REAL
+            index::PD_PORT_DATA_REAL
+                | index::PD_PORT_DATA_ADJUST
+                | index::PD_PORT_DATA_CHECK
+                | index::PD_INTERFACE_DATA_REAL
         )
     }
 
@@ -264,10 +269,13 @@ impl Pdev {
         let mut w = Writer::new(out, Endian::Big);
         let ok = match (addr.slot, addr.index) {
             (0, index::PD_INTERFACE_DATA_REAL) if addr.subslot == 0x8000 => self.emit_interface_real(&mut w),
-            (0, index::PD_PORT_DATA_REAL | index::PD_PORT_DATA_ADJUST) => {
+            (0, index::PD_PORT_DATA_REAL | index::PD_PORT_DATA_ADJUST | index::PD_PORT_DATA_CHECK) => {
                 let i = port_of(addr.subslot).ok_or(misplaced(addr))?;
                 let p = self.ports.get(i).ok_or(RecordError::InvalidSlotSubslot)?;
-                if addr.index == index::PD_PORT_DATA_REAL {
+                if addr.index == index::PD_PORT_DATA_CHECK {
+                    // no check configured (a write is not taken): empty
+                    Some(())
+                } else if addr.index == index::PD_PORT_DATA_REAL {
                     emit_port_real(&mut w, addr.subslot, i, p)
                 } else if p.adjust.is_empty() {
                     Some(())
@@ -293,6 +301,10 @@ impl Pdev {
             }
             (0, index::PD_PORT_DATA_REAL) if port_of(addr.subslot).is_some() => {
                 Err(RecordError::AccessDenied)
+            }
+            // neighbour, MAU type and link state checks are not offered yet
+            (0, index::PD_PORT_DATA_CHECK) if port_of(addr.subslot).is_some() => {
+                Err(RecordError::FeatureNotSupported)
             }
             (0, index::PD_INTERFACE_DATA_REAL) if addr.subslot == 0x8000 => Err(RecordError::AccessDenied),
             _ => Err(misplaced(addr)),

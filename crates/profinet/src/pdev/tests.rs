@@ -412,3 +412,74 @@ fn p040_pdev_answers_dissect_without_malformed_packets() {
     }
     assert!(text.contains("sw-1") && text.contains("port-003"));
 }
+
+#[test]
+fn p039_im0_filter_data_names_the_dap_submodule_and_dissects() {
+    let mut r = rig();
+    let (status, data) = r.read(1, crate::cm::record::index::IM0_FILTER_DATA);
+    assert_eq!(status, OK);
+    // I&M0FilterDataSubmodule and I&M0FilterDataDevice: API 0, slot 0 (DAP
+    // module ident 1), subslot 1 (submodule ident 1)
+    let one = "0001 00000000 0001 0000 00000001 0001 0001 00000001";
+    let mut want = hex(&std::format!("0030 0018 0100 {one}"));
+    want.extend(hex(&std::format!("0032 0018 0100 {one}")));
+    assert_eq!(data, want);
+    // device scope: the same at the interface; a missing subslot: invalid slot/subslot
+    assert_eq!(r.read(0x8000, crate::cm::record::index::IM0_FILTER_DATA).1, want);
+    assert_eq!(
+        r.read(0x9000, crate::cm::record::index::IM0_FILTER_DATA).0,
+        rw(0xB2, false)
+    );
+    // read only
+    let w = r.record(true, 0, 1, crate::cm::record::index::IM0_FILTER_DATA, &want);
+    assert_eq!(w.0, rw(0xB6, true));
+    let text = crate::tests_tshark::dissect(&r.frames, "dcerpc && ip.src == 192.168.0.50");
+    let Some(text) = text else { return };
+    assert!(
+        text.contains("I&M0FilterData") || text.contains("IM0FilterData"),
+        "not dissected"
+    );
+}
+
+#[test]
+fn p029_p040_real_identification_data_lists_the_dap_and_the_plugged_modules() {
+    let mut r = rig();
+    let (status, data) = r.read(1, crate::cm::record::index::REAL_IDENTIFICATION_DATA);
+    assert_eq!(status, OK);
+    // version 1.1: API 0, 3 slots; the DAP with its subslots (each port its
+    // own ident), slot 1 OUT 18 words (0x212), slot 2 IN 18 words (0x112)
+    let body = "0001 00000000 0003
+        0000 00000001 0004 0001 00000001 8000 00008000 8001 00008001 8002 00008002
+        0001 00000212 0001 0001 00000001
+        0002 00000112 0001 0001 00000001";
+    let mut want = hex(&std::format!("0013 0000 0101 {body}"));
+    let len = (want.len() - 4) as u16;
+    want[2..4].copy_from_slice(&len.to_be_bytes());
+    assert_eq!(data, want);
+    let w = r.record(
+        true,
+        0,
+        1,
+        crate::cm::record::index::REAL_IDENTIFICATION_DATA,
+        &want,
+    );
+    assert_eq!(w.0, rw(0xB6, true));
+    let text = crate::tests_tshark::dissect(&r.frames, "dcerpc && ip.src == 192.168.0.50");
+    let Some(text) = text else { return };
+    assert!(text.contains("RealIdentificationData"), "not dissected");
+}
+
+#[test]
+fn p040_pd_port_data_check_reads_empty_and_a_check_is_not_taken() {
+    let mut r = rig();
+    for sub in [0x8001, 0x8002] {
+        assert_eq!(r.read(sub, index::PD_PORT_DATA_CHECK), (OK, Vec::new()));
+    }
+    // at the interface: invalid index; a write (CheckPeers): feature not supported, still empty
+    assert_eq!(r.read(0x8000, index::PD_PORT_DATA_CHECK).0, rw(0xB0, false));
+    let check = hex("0200 0010 0100 0000 0001 08 706f72742d303031 00");
+    let w = r.record(true, 0, 0x8001, index::PD_PORT_DATA_CHECK, &check);
+    assert_eq!(w.0, rw(0xA9, true));
+    assert_eq!(r.read(0x8001, index::PD_PORT_DATA_CHECK), (OK, Vec::new()));
+    crate::tests_tshark::dissect(&r.frames, "dcerpc && ip.src == 192.168.0.50");
+}

@@ -80,6 +80,10 @@ pub struct Call {
     pub activity: Uuid,
     /// Sequence number of the request.
     pub seq: u32,
+    /// The request was longer than the reassembly buffer and the body handed
+    /// over is its beginning only (a PNIO Write: the handler answers the
+    /// record's header with "write length error").
+    pub truncated: bool,
 }
 
 /// A call refused by the handler at the RPC level (PNIO errors travel in a

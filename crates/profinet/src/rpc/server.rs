@@ -26,6 +26,14 @@ pub const CLIENT_RETRY: Nanos = Nanos::from_ms(1000);
 pub const CLIENT_ATTEMPTS: u8 = 5;
 /// Largest UDP payload that fits one untagged Ethernet frame.
 const MAX_UDP_PAYLOAD: usize = 1472;
+/// The longest PNIO Write request received (and answered with "write length
+/// error") beyond the buffer: 64 KiB, the largest RecordDataLength a
+/// controller's IODWriteReq can need in practice; longer ones are faults.
+const MAX_TRUNCATED_WRITE: usize = 65_536;
+/// Request and response buffer size of the device: an IODWriteMultiple
+/// carrying one record of [`crate::model::MAX_RECORD_SIZE`] (NDR header,
+/// two IODWriteReqHeaders, the record) fits whole.
+pub const BUF: usize = crate::model::MAX_RECORD_SIZE + 2 * 64 + 20;
 
 /// Static settings of the server.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
@@ -104,7 +112,7 @@ struct Control {
 /// The RPC engine, with a request reassembly buffer and a response buffer of
 /// `N` bytes each (bodies, without headers).
 #[derive(Debug)]
-pub struct Server<const N: usize = 4096> {
+pub struct Server<const N: usize = BUF> {
     config: ServerConfig,
     call: Option<ServerCall>,
     req_buf: [u8; N],
@@ -273,15 +281,27 @@ impl<const N: usize> Server<N> {
             return;
         }
         let end = start.saturating_add(body.len());
-        let Some(dst) = self.req_buf.get_mut(start..end) else {
-            self.counters.too_big = self.counters.too_big.saturating_add(1);
-            self.call = None;
-            let hdr = reply_header(h, PacketType::Fault, self.config.boot_time);
-            self.queue(peer, hdr, Body::Status(nca::FAULT_REMOTE_NO_MEMORY));
-            return;
-        };
-        for (d, s) in dst.iter_mut().zip(body) {
-            *d = *s;
+        // A PNIO Write longer than the buffer is still received to its last
+        // fragment (the excess dropped), so that the CM can answer the
+        // record's header with "write length error"; any other request too
+        // long is a fault (nca_s_fault_remote_no_memory).
+        let write = !epm && h.opnum == crate::rpc::opnum::WRITE;
+        if end > N {
+            if !write || end > MAX_TRUNCATED_WRITE {
+                self.counters.too_big = self.counters.too_big.saturating_add(1);
+                self.call = None;
+                let hdr = reply_header(h, PacketType::Fault, self.config.boot_time);
+                self.queue(peer, hdr, Body::Status(nca::FAULT_REMOTE_NO_MEMORY));
+                return;
+            }
+            if start <= N {
+                self.counters.too_big = self.counters.too_big.saturating_add(1);
+            }
+        }
+        if let Some(dst) = self.req_buf.get_mut(start.min(N)..end.min(N)) {
+            for (d, s) in dst.iter_mut().zip(body) {
+                *d = *s;
+            }
         }
         // The answer's fragment size: the request's own when it came in fragments
         // (the client evidently handles PDUs that big), else MustRecvFragSize.
@@ -316,7 +336,7 @@ impl<const N: usize> Server<N> {
         // Execute.
         self.counters.calls = self.counters.calls.saturating_add(1);
         let endian = h.drep.endian();
-        let req = self.req_buf.get(..end).unwrap_or(&[]);
+        let req = self.req_buf.get(..end.min(N)).unwrap_or(&[]);
         let result = if epm {
             epm::answer(&self.config.epm, h.opnum, endian, req, &mut self.resp_buf)
                 .ok_or(CallError::Reject(nca::PROTO_ERROR))
@@ -328,6 +348,7 @@ impl<const N: usize> Server<N> {
                 object: h.object,
                 activity: h.activity,
                 seq: h.seq,
+                truncated: end > N,
             };
             handler.call(now, &info, req, &mut self.resp_buf)
         };
