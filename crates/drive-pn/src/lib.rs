@@ -135,6 +135,13 @@ pub struct PnDrive<F: Flash, H: RecordHook = NoRecords> {
     powered: [bool; 2],
     /// The PROFIdrive-style profile on axis A (issue 17).
     profile: profile::Profile,
+    /// A frame arrived since the profile last took the receive telegram:
+    /// the next control cycle decodes and applies it and builds the
+    /// response (issue 36: the profile per telegram, not per cycle).
+    telegram_new: bool,
+    /// Axis A's mode display (6061h) when the profile last ran: a change
+    /// (the core took the mode a telegram bound) runs it again (P-086).
+    profile_mode: Option<i64>,
 }
 
 impl<F: Flash> PnDrive<F, NoRecords> {
@@ -185,6 +192,8 @@ impl<F: Flash, H: RecordHook> PnDrive<F, H> {
             exchanged: false,
             powered: [false; 2],
             profile,
+            telegram_new: true,
+            profile_mode: None,
         }
     }
 
@@ -320,6 +329,9 @@ impl<F: Flash, H: RecordHook> PnDrive<F, H> {
         }
         self.energy_inputs();
         self.device.receive(now, frame, tx);
+        // any frame may be the new receive telegram (or a record that
+        // changed what the profile reads): the profile runs once more
+        self.telegram_new = true;
         self.serve_bmp();
         self.events(on_event);
     }
@@ -482,7 +494,18 @@ impl<F: Flash, H: RecordHook> PnDrive<F, H> {
             io
         });
         let new = core::mem::take(&mut self.exchanged) || !self.device.exchanging();
-        self.profile_receive();
+        // the profile per telegram: decoded and applied when a frame
+        // arrived, when the mode the core shows changed since (the CW1
+        // context, P-086) and while a homing run it started is active;
+        // the cycles in between run the core only
+        let [axis_a, _] = &self.axes;
+        let mode = self.profile.mode_display(&self.objects, axis_a);
+        let run_profile = core::mem::take(&mut self.telegram_new)
+            || self.profile_mode != Some(mode)
+            || self.profile.homing();
+        if run_profile {
+            self.profile_receive();
+        }
         let mut commands = [AxisCommand::OFF; 2];
         for (i, ((axis, cache), io)) in self
             .axes
@@ -524,7 +547,12 @@ impl<F: Flash, H: RecordHook> PnDrive<F, H> {
             *command = report.command;
         }
         self.powered = commands.map(|c| c.power_stage);
-        self.profile_respond();
+        if run_profile {
+            // once per telegram: the response the device sends next
+            self.profile_respond();
+            let [axis_a, _] = &self.axes;
+            self.profile_mode = Some(self.profile.mode_display(&self.objects, axis_a));
+        }
         commands
     }
 

@@ -44,6 +44,9 @@ fn panic(info: &core::panic::PanicInfo) -> ! {
 /// Cyclic frames measured.
 const FRAMES: u32 = 1000;
 
+/// A150 of the telegram runs, us: the fastest control cycle.
+const A150_FAST_US: u32 = 250;
+
 type Drive = PnDrive<ParamFlash>;
 
 fn hardware() -> Hardware {
@@ -157,6 +160,7 @@ fn run(insn: impl Fn(u32) -> u32) -> bool {
     let io = [AxisIo::ready(0); 2];
     let (mut rx, mut tx_poll, mut ctl) = (Figure::default(), Figure::default(), Figure::default());
     let mut inputs = 0u32;
+    let (mut first, mut after_first) = (0u32, 0u32);
     for k in 1..=FRAMES {
         let now = cycle.saturating_mul(u64::from(k));
         let counter = (k as u16).wrapping_mul(256);
@@ -178,7 +182,13 @@ fn run(insn: impl Fn(u32) -> u32) -> bool {
         }
         let t0 = now_ticks();
         let _ = d.control_cycle(now, &io);
-        ctl.add(insn(ticks(t0, now_ticks())));
+        let t = insn(ticks(t0, now_ticks()));
+        if k == 1 {
+            first = t;
+        } else {
+            after_first = after_first.max(t);
+        }
+        ctl.add(t);
     }
     let valid = d.device().output_data(2).is_some();
     // the PROFIdrive profile's cyclic path per receive telegram of the
@@ -200,8 +210,14 @@ fn run(insn: impl Fn(u32) -> u32) -> bool {
     t1_speed[2..4].copy_from_slice(&0x0406u16.to_be_bytes());
     t1_speed[4..8].copy_from_slice(&100i32.to_be_bytes());
     t1_speed[16..20].copy_from_slice(&10_000u32.to_be_bytes());
+    // the telegram runs at the fastest settings: A150 = 250 us, four
+    // control cycles per 1 ms send cycle, one of them with a new telegram
+    let _ = d
+        .objects_mut()
+        .set(drive::params::A150, 0, i64::from(A150_FAST_US));
+    let per_frame = (cycle.as_ns() / (u64::from(A150_FAST_US) * 1000)).max(1);
     let mut k = FRAMES;
-    let mut figures = [Figure::default(); 3];
+    let mut figures = [(Figure::default(), Figure::default()); 3];
     for (n_tel, telegram) in [(0usize, &t0_pos), (2, &t2_torque), (1, &t1_speed)] {
         if let Some(cr) = ar.output_cr.as_ref() {
             let csdu = n.saturating_sub(4 + usize::from(cr.data_length));
@@ -216,7 +232,7 @@ fn run(insn: impl Fn(u32) -> u32) -> bool {
                 }
             }
         }
-        let mut profiled = Figure::default();
+        let (mut profiled, mut between) = (Figure::default(), Figure::default());
         for _ in 0..FRAMES {
             k += 1;
             let now = cycle.saturating_mul(u64::from(k));
@@ -229,9 +245,15 @@ fn run(insn: impl Fn(u32) -> u32) -> bool {
             let t0 = now_ticks();
             let _ = d.control_cycle(now, &io);
             profiled.add(insn(ticks(t0, now_ticks())));
+            for i in 1..per_frame {
+                let at = now.saturating_add(Nanos::from_us(i * u64::from(A150_FAST_US)));
+                let t0 = now_ticks();
+                let _ = d.control_cycle(at, &io);
+                between.add(insn(ticks(t0, now_ticks())));
+            }
         }
         if let Some(f) = figures.get_mut(n_tel) {
-            *f = profiled;
+            *f = (profiled, between);
         }
     }
     let zsw1 = d.profile().own().zsw1;
@@ -264,13 +286,26 @@ fn run(insn: impl Fn(u32) -> u32) -> bool {
         ctl.mean(),
         ctl.max
     );
-    for (n_tel, f) in figures.iter().enumerate() {
+    defmt::info!(
+        "figure: PnDrive control cycle at rest: the first {=u32} instructions (the caches built on the first cycle), the max of the others {=u32}",
+        first,
+        after_first
+    );
+    for (n_tel, (f, b)) in figures.iter().enumerate() {
         defmt::info!(
-            "figure: PnDrive control cycle with the PROFIdrive telegram {=usize} (receive, CW1, response): mean {=u32} max {=u32} instructions, {=i32} more than at rest",
+            "figure: PnDrive control cycle with the PROFIdrive telegram {=usize}, the cycle a new telegram arrived (receive, CW1, response): mean {=u32} max {=u32} instructions, {=i32} more than at rest",
             n_tel,
             f.mean(),
             f.max,
             f.mean() as i32 - ctl.mean() as i32
+        );
+        defmt::info!(
+            "figure: PnDrive control cycle with the PROFIdrive telegram {=usize}, the cycles between telegrams (A150 = {=u32} us): mean {=u32} max {=u32} instructions over {=u32} cycles",
+            n_tel,
+            A150_FAST_US,
+            b.mean(),
+            b.max,
+            b.n
         );
     }
     defmt::info!(

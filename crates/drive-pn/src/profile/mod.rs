@@ -2,7 +2,11 @@
 //! 17): the thin personality spec §16 describes, over the drive core that
 //! the CiA 402 side uses too.
 //!
-//! Each control cycle, with valid output data from the controller:
+//! Once per receive telegram (issue 36: the control cycle after a frame
+//! arrived, after axis A's mode display 6061h changed, and every cycle while
+//! a homing run the profile started is active; the cycles between run the
+//! core only, `PnDrive::control_cycle`), with valid output data from the
+//! controller:
 //! 1. the receive telegram ([`profidrive::telegram`]) writes its entries
 //!    into the objects (RAM only, P-067) through [`access::DriveAccess`]
 //!    (PNUs with their PROFINET units, CANopen objects as they are);
@@ -129,6 +133,16 @@ impl Profile {
     /// The profile's own values (CW1, ZSW1, the homing method, …).
     pub fn own(&self) -> &OwnValues {
         &self.own
+    }
+
+    /// Axis A's mode display (6061h) as the core shows it.
+    pub fn mode_display(&self, objects: &DriveObjects, axis: &Axis) -> i64 {
+        self.core.get(objects, axis, Core::ModeDisplay)
+    }
+
+    /// A homing run the profile started (CW1 bit 11) is active.
+    pub fn homing(&self) -> bool {
+        self.homing
     }
 
     /// Frames that raised a warning (unknown identifier, length, refused
