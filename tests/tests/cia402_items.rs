@@ -285,12 +285,11 @@ fn c040_csp_csv_cst_need_no_mode_specific_controlword_bits() {
         m.set_controlword(CW_ENABLED);
         m.run(50).await;
 
-        // cst: the torque acts with and without the bits (speed limit G472 lifted)
-        with_drive(&sim, |d| {
-            let c = &mut d.drive.axes_mut()[0].params_mut().cascade;
-            c.torque_mode_velocity_limit_positive_inc_per_s = 5.0 * REV as f32;
-            c.torque_mode_velocity_limit_negative_inc_per_s = 5.0 * REV as f32;
-        });
+        // cst: the torque acts with and without the bits (speed limits
+        // G472/G475 lifted by SDO to 10 % of I10, 5 rev/s)
+        let sd = group.subdevice(md, 0).unwrap();
+        sd.sdo_write(drive::params::G472, 0, 100u16).await.unwrap();
+        sd.sdo_write(drive::params::G475, 0, 100u16).await.unwrap();
         m.set_mode(10);
         m.run(20).await;
         for cw in [CW_ENABLED, CW_ENABLED | CW_BIT4 | CW_BIT5 | CW_BIT6 | CW_HALT] {

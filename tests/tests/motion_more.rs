@@ -210,7 +210,7 @@ fn c057_pt_ramps_6071_with_6087_limited_by_6072_and_g472() {
         // back to 0, then G472 = 20 rev/s: 0 → 10 % along 6087h (100 ms)
         m.set_target_torque(0);
         m.run(200).await;
-        torque_mode_speed_limit(&sim, 20.0);
+        torque_mode_speed_limit(&sd, 20.0).await;
         m.run(5).await;
         assert!(m.tx.bit(10), "torque 0 reached: {:#06x}", m.tx.statusword);
         m.set_target_torque(100);

@@ -76,6 +76,12 @@ pub const A310: u16 = parameter_index(0, 310);
 /// A311 decimal places of the acceleration, deceleration and jerk objects
 /// (per axis).
 pub const A311: u16 = parameter_index(0, 311);
+/// G472 positive velocity limit of the torque modes, 0.1 % of I10 (per
+/// axis, C-039).
+pub const G472: u16 = parameter_index(6, 472);
+/// G475 negative velocity limit of the torque modes, 0.1 % of I10 (per
+/// axis, C-039).
+pub const G475: u16 = parameter_index(6, 475);
 /// I02 position encoder (per axis).
 pub const I02: u16 = parameter_index(8, 2);
 /// A279 PROFINET units (the PROFIdrive personality's unit choices).

@@ -62,11 +62,17 @@ impl Axis {
         };
         let per_mille = per_mille.min(self.torque_limit_per_mille);
         let max_nm = p.rated_torque_nm * f32::from(per_mille) * 0.001;
+        // G472/G475 (C-039): 0.1 % of the maximum speed I10
+        let [g472, g475] = o
+            .torque_mode_speed_limit
+            .map(|l| p.cascade.max_velocity_inc_per_s * f32::from(l) * 0.001);
         let mut cfg = CascadeConfig {
             torque_limit_positive_nm: max_nm,
             torque_limit_negative_nm: max_nm,
             velocity_feedforward_percent: 100.0,
             position_dead_band_inc: o.dead_band,
+            torque_mode_velocity_limit_positive_inc_per_s: g472,
+            torque_mode_velocity_limit_negative_inc_per_s: g475,
             ..scaled_gains(&p.cascade, dt_ns)
         };
         if !self.torque_mode_speed_limit.is_nan() {

@@ -13,8 +13,10 @@ pub struct AxisParams {
     /// Rated motor current, mA (motor data, at the rated torque): current
     /// limits in mA become torque limits through it (PROFINET's 2415h.02).
     pub rated_current_ma: u32,
-    /// Cascade gains and limits. The torque limits are replaced by 6072h, the
-    /// speed feedforward weight is applied by the interpolator (I25 below);
+    /// Cascade gains and limits. The torque limits are replaced by 6072h,
+    /// the torque modes' speed limits by G472/G475 (0.1 % of
+    /// `max_velocity_inc_per_s`, I10), the speed feedforward weight is
+    /// applied by the interpolator (I25 below);
     /// the inertia (motor data) turns the generators' acceleration into
     /// torque feedforward.
     pub cascade: CascadeConfig,
