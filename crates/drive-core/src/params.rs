@@ -76,6 +76,12 @@ pub const A310: u16 = parameter_index(0, 310);
 /// A311 decimal places of the acceleration, deceleration and jerk objects
 /// (per axis).
 pub const A311: u16 = parameter_index(0, 311);
+/// C31 velocity controller Kp, µN·m per rad/s (per axis).
+pub const C31: u16 = parameter_index(2, 31);
+/// C32 velocity controller Ti, µs; 0 = no integral part (per axis).
+pub const C32: u16 = parameter_index(2, 32);
+/// I20 position controller Kv, 0.1 /s (per axis).
+pub const I20: u16 = parameter_index(8, 20);
 /// G472 positive velocity limit of the torque modes, 0.1 % of I10 (per
 /// axis, C-039).
 pub const G472: u16 = parameter_index(6, 472);

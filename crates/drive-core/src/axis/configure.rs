@@ -73,7 +73,7 @@ impl Axis {
             position_dead_band_inc: o.dead_band,
             torque_mode_velocity_limit_positive_inc_per_s: g472,
             torque_mode_velocity_limit_negative_inc_per_s: g475,
-            ..scaled_gains(&p.cascade, dt_ns)
+            ..scaled_gains(&declared_gains(&p.cascade, o), dt_ns)
         };
         if !self.torque_mode_speed_limit.is_nan() {
             cfg.torque_mode_velocity_limit_positive_inc_per_s = self.torque_mode_speed_limit;
@@ -149,5 +149,17 @@ impl Axis {
         if let Some(v) = self.vinterp.as_mut() {
             v.start(self.sp_vel);
         }
+    }
+}
+
+/// The cascade of the parameters with the gains of the dictionary: I20 Kv,
+/// C31 Kp, C32 Ti (issue 40).
+fn declared_gains(c: &CascadeConfig, o: &Snapshot) -> CascadeConfig {
+    let (kv, kp, ti) = o.gains;
+    CascadeConfig {
+        position_gain_per_s: f32::from(kv) * 0.1,
+        velocity_gain_nm_per_rad_per_s: kp as f32 * 1e-6,
+        velocity_integral_time_ns: ti.saturating_mul(1000),
+        ..*c
     }
 }

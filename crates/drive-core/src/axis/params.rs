@@ -14,6 +14,7 @@ pub struct AxisParams {
     /// limits in mA become torque limits through it (PROFINET's 2415h.02).
     pub rated_current_ma: u32,
     /// Cascade gains and limits. The torque limits are replaced by 6072h,
+    /// the gains Kv, Kp, Ti by I20, C31, C32 (issue 40),
     /// the torque modes' speed limits by G472/G475 (0.1 % of
     /// `max_velocity_inc_per_s`, I10), the speed feedforward weight is
     /// applied by the interpolator (I25 below);

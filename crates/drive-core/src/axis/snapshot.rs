@@ -14,8 +14,8 @@ use crate::{AXIS_B_CIA402, AXIS_B_MANUFACTURER};
 use motion::scaling::AxisScaling;
 
 pub(crate) use crate::params::{
-    A150, A213, A291, A310, A311, A340, A66, A67, E47, E48, E49, E80, G472, G475, I02, I101, I21, I210, I22,
-    I23, I46,
+    A150, A213, A291, A310, A311, A340, A66, A67, C31, C32, E47, E48, E49, E80, G472, G475, I02, I101, I20,
+    I21, I210, I22, I23, I46,
 };
 
 /// Entry `index`:`sub`, or 0 with `misses` counted: the dictionary declares
@@ -303,6 +303,9 @@ pub(crate) struct Snapshot {
     pub a66: [u32; 16],
     /// Whether any A66 element names a source (else A67 is 0 without a look).
     pub a66_used: bool,
+    /// The cascade's gains: I20 Kv (0.1 /s), C31 Kp (µN·m·s/rad), C32 Ti
+    /// (µs).
+    pub gains: (u16, u32, u32),
     /// G472 / G475 velocity limits of the torque modes, 0.1 % of I10
     /// (C-039).
     pub torque_mode_speed_limit: [u16; 2],
@@ -418,6 +421,11 @@ impl Snapshot {
             override_percent: sat(w.param(od, A340, 0, m), 0u16, u16::MAX),
             a66: core::array::from_fn(|k| sat(w.param(od, A66, k as u8 + 1, m), 0u32, u32::MAX)),
             a66_used: (1..=16).any(|sub| w.param(od, A66, sub, m) != 0),
+            gains: (
+                sat(w.param(od, I20, 0, m), 0u16, u16::MAX),
+                sat(w.param(od, C31, 0, m), 0u32, u32::MAX),
+                sat(w.param(od, C32, 0, m), 0u32, u32::MAX),
+            ),
             torque_mode_speed_limit: [
                 sat(w.param(od, G472, 0, m), 0u16, u16::MAX),
                 sat(w.param(od, G475, 0, m), 0u16, u16::MAX),

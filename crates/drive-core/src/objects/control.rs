@@ -10,12 +10,20 @@
 
 use super::{Object, Value};
 use crate::parameter_index;
-use od::DataType::U16;
+use od::DataType::{U16, U32};
 use od::{Access, DataType, EntryInfo};
 
 const RW: Access = Access::RW;
 const fn e(sub: u8, name: &'static str, t: DataType, a: Access) -> EntryInfo {
     EntryInfo::new(sub, name, t, a)
+}
+/// Group C parameter `line`.
+const fn c(line: u16) -> u16 {
+    parameter_index(2, line)
+}
+/// Group I parameter `line`.
+const fn i_(line: u16) -> u16 {
+    parameter_index(8, line)
 }
 /// Group G parameter `line`.
 const fn g(line: u16) -> u16 {
@@ -23,7 +31,31 @@ const fn g(line: u16) -> u16 {
 }
 
 /// The control settings of axis A, sorted by index.
-pub const PARAMS: [Object; 2] = [
+pub const PARAMS: [Object; 5] = [
+    Object::var(
+        c(31),
+        Value::Ram,
+        entries![e(0, "Speed controller Kp", U32, RW)
+            .range(0, 10_000_000)
+            .default_value(60_000)
+            .unit("µNm·s/rad")
+            .saved()],
+    )
+    .axis()
+    .level(1)
+    .note("C31 (line assumed; the seeds name no cascade parameter): proportional gain of the velocity controller, torque per speed error; default 0.06 N·m per rad/s (about 100 Hz bandwidth on the simulated 1e-4 kg·m² servo); effective at once; the gains are for A150 ≤ 250 µs and scaled down for longer cycles"),
+    Object::var(
+        c(32),
+        Value::Ram,
+        entries![e(0, "Speed controller Ti", U32, RW)
+            .range(0, 10_000_000)
+            .default_value(8_000)
+            .unit("µs")
+            .saved()],
+    )
+    .axis()
+    .level(1)
+    .note("C32 (line assumed): integral time of the velocity controller; 0 = no integral part; effective at once"),
     Object::var(
         g(472),
         Value::Ram,
@@ -46,4 +78,16 @@ pub const PARAMS: [Object; 2] = [
     .axis()
     .level(1)
     .note("G475 (C-039); as G472 in the negative direction (magnitude)"),
+    Object::var(
+        i_(20),
+        Value::Ram,
+        entries![e(0, "Position controller Kv", U16, RW)
+            .range(0, 10_000)
+            .default_value(1_000)
+            .unit("0.1 /s")
+            .saved()],
+    )
+    .axis()
+    .level(1)
+    .note("I20 (line assumed): gain of the position controller, velocity command per following error; default 100 /s; effective at once"),
 ];
