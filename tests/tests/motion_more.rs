@@ -317,12 +317,19 @@ fn c088_c089_c090_jog_bits_4_and_5() {
         );
         assert_eq!(m.tx.state(), sw::OE);
 
-        // I12/I13 from the parameters: 3 rev/s at 60 rev/s² (50 ms)
-        with_drive(&sim, |d| {
-            let p = d.drive.axes_mut()[0].params_mut();
-            p.jog_velocity = 3.0 * REV as f32;
-            p.jog_acceleration = 60.0 * REV as f32;
-        });
+        // I12/I13 by SDO: 3 rev/s at 60 rev/s² (50 ms)
+        group
+            .subdevice(md, 0)
+            .unwrap()
+            .sdo_write(drive::params::I12, 0, 3 * REV as u32)
+            .await
+            .unwrap();
+        group
+            .subdevice(md, 0)
+            .unwrap()
+            .sdo_write(drive::params::I13, 0, 60 * REV as u32)
+            .await
+            .unwrap();
         m.set_controlword(CW_ENABLED | CW_BIT4);
         let t = m
             .run_until(400, |t| t.velocity > 3 * REV * 97 / 100)
@@ -381,9 +388,7 @@ fn c091_c092_jog_at_the_software_limits() {
         );
 
         // I26 = 0: past −0.5 rev a quick stop, no fault; the negative direction locked (C-091)
-        with_drive(&sim, |d| {
-            d.drive.axes_mut()[0].params_mut().jog_position_control = false
-        });
+        sd.sdo_write(drive::params::I26, 0, 0u8).await.unwrap();
         m.set_controlword(CW_ENABLED);
         m.run(200).await;
         m.set_controlword(CW_ENABLED | CW_BIT5);

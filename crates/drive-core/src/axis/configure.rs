@@ -7,6 +7,13 @@ use super::*;
 impl Axis {
     /// Applies the configuration objects and parameters.
     pub(super) fn configure(&mut self, od: &mut DriveObjects, slots: &CyclicSlots, o: &Snapshot, dt_ns: u32) {
+        // the settings of the dictionary (issue 40), in increments
+        let [v, a, d, j] = o.jog.map(|x| x as f32);
+        self.params.jog_velocity = v;
+        self.params.jog_acceleration = a;
+        self.params.jog_deceleration = d;
+        self.params.jog_jerk = if j > 0.0 { j } else { f32::INFINITY };
+        self.params.jog_position_control = o.i26 != 0;
         let p = self.params;
         self.modulo = if p.limits.endless_axis && o.modulo_length > 0 {
             ModuloAxis::new(i64::from(o.modulo_length)).ok()

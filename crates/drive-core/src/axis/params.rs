@@ -46,6 +46,8 @@ pub struct AxisParams {
     /// the previous one than twice 607Fh over the time between them trips
     /// event 78 cause 4 "excessive set value jump".
     pub set_value_monitoring: bool,
+    /// Jog (I12, I13, I45, I18, I26): taken from the dictionary at every
+    /// configuration change (issue 40); what is set here is overwritten.
     /// I12 jog velocity, inc/s.
     pub jog_velocity: f32,
     /// I13 jog acceleration, inc/s².

@@ -10,7 +10,7 @@
 
 use super::{Object, Value};
 use crate::parameter_index;
-use od::DataType::{U16, U32};
+use od::DataType::{U16, U32, U8};
 use od::{Access, DataType, EntryInfo};
 
 const RW: Access = Access::RW;
@@ -30,8 +30,11 @@ const fn g(line: u16) -> u16 {
     parameter_index(6, line)
 }
 
+/// One revolution, increments (the native user unit).
+const REV_INC: i64 = 1 << 20;
+
 /// The control settings of axis A, sorted by index.
-pub const PARAMS: [Object; 5] = [
+pub const PARAMS: [Object; 10] = [
     Object::var(
         c(31),
         Value::Ram,
@@ -79,6 +82,36 @@ pub const PARAMS: [Object; 5] = [
     .level(1)
     .note("G475 (C-039); as G472 in the negative direction (magnitude)"),
     Object::var(
+        i_(12),
+        Value::Ram,
+        entries![e(0, "Jog velocity", U32, RW)
+            .default_value(REV_INC)
+            .unit("inc/s")
+            .saved()],
+    )
+    .axis()
+    .level(1)
+    .note("I12 (C-089): jog speed in user units/s (6091h/6092h, decimals A310 as 6081h); default 1 rev/s; effective at the next jog command"),
+    Object::var(
+        i_(13),
+        Value::Ram,
+        entries![e(0, "Jog acceleration", U32, RW)
+            .default_value(10 * REV_INC)
+            .unit("inc/s²")
+            .saved()],
+    )
+    .axis()
+    .level(1)
+    .note("I13: jog acceleration in user units/s² (decimals A311); default 10 rev/s²"),
+    Object::var(
+        i_(18),
+        Value::Ram,
+        entries![e(0, "Jog jerk", U32, RW).unit("inc/s³").saved()],
+    )
+    .axis()
+    .level(1)
+    .note("I18: jog jerk in user units/s³ (decimals A311); 0 = no jerk limit (default)"),
+    Object::var(
         i_(20),
         Value::Ram,
         entries![e(0, "Position controller Kv", U16, RW)
@@ -90,4 +123,26 @@ pub const PARAMS: [Object; 5] = [
     .axis()
     .level(1)
     .note("I20 (line assumed): gain of the position controller, velocity command per following error; default 100 /s; effective at once"),
+    Object::var(
+        i_(26),
+        Value::Ram,
+        entries![e(0, "Jog control type", U8, RW)
+            .range(0, 1)
+            .default_value(1)
+            .saved()],
+    )
+    .axis()
+    .level(1)
+    .note("I26 (C-091, C-092): 0 velocity control (past a software limit a quick stop), 1 position control (stops before it, default)"),
+    Object::var(
+        i_(45),
+        Value::Ram,
+        entries![e(0, "Jog deceleration", U32, RW)
+            .default_value(10 * REV_INC)
+            .unit("inc/s²")
+            .saved()],
+    )
+    .axis()
+    .level(1)
+    .note("I45: jog deceleration in user units/s² (decimals A311); default 10 rev/s²"),
 ];
