@@ -76,6 +76,10 @@ pub const A310: u16 = parameter_index(0, 310);
 /// A311 decimal places of the acceleration, deceleration and jerk objects
 /// (per axis).
 pub const A311: u16 = parameter_index(0, 311);
+/// A44 quick stop on the loss of A60 (per axis).
+pub const A44: u16 = parameter_index(0, 44);
+/// I00 position range: 0 limited, 1 endless (per axis).
+pub const I00: u16 = parameter_index(8, 0);
 /// C31 velocity controller Kp, µN·m per rad/s (per axis).
 pub const C31: u16 = parameter_index(2, 31);
 /// C32 velocity controller Ti, µs; 0 = no integral part (per axis).

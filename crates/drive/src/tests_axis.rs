@@ -215,6 +215,21 @@ fn c003_enable_refused_without_additional_enable() {
     assert_eq!(rig.state(0), State::ReadyToSwitchOn);
 }
 
+/// A44 (issue 40, spec cia402.md transitions 9 and 11): losing A60 in
+/// Operation enabled switches the power stage off with A44 = 0 (the
+/// default) and quick-stops with A44 = 1, set in the dictionary.
+#[test]
+fn c003_a44_decides_what_losing_a60_does() {
+    for (a44, want) in [(0, State::SwitchOnDisabled), (1, State::QuickStopActive)] {
+        let mut rig = Rig::new();
+        rig.set(0, crate::params::A44, 0, a44);
+        rig.enable(0);
+        rig.io[0].additional_enable = false;
+        rig.run(2);
+        assert_eq!(rig.state(0), want, "A44 = {a44}");
+    }
+}
+
 /// A master trajectory at 1 ms: 100 ms at 20 rev/s² to 2 rev/s, 300 ms
 /// at 2 rev/s, 100 ms braking; increments at cycle `k`.
 fn trajectory(k: i64) -> i64 {

@@ -14,6 +14,8 @@ impl Axis {
         self.params.jog_deceleration = d;
         self.params.jog_jerk = if j > 0.0 { j } else { f32::INFINITY };
         self.params.jog_position_control = o.i26 != 0;
+        self.params.quick_stop_on_enable_loss = o.a44 == 1;
+        self.params.limits.endless_axis = o.i00 == 1;
         let p = self.params;
         self.modulo = if p.limits.endless_axis && o.modulo_length > 0 {
             ModuloAxis::new(i64::from(o.modulo_length)).ok()

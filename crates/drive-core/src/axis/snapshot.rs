@@ -14,8 +14,8 @@ use crate::{AXIS_B_CIA402, AXIS_B_MANUFACTURER};
 use motion::scaling::AxisScaling;
 
 pub(crate) use crate::params::{
-    A150, A213, A291, A310, A311, A340, A66, A67, C31, C32, E47, E48, E49, E80, G472, G475, I02, I101, I12,
-    I13, I18, I20, I21, I210, I22, I23, I26, I45, I46,
+    A150, A213, A291, A310, A311, A340, A44, A66, A67, C31, C32, E47, E48, E49, E80, G472, G475, I00, I02,
+    I101, I12, I13, I18, I20, I21, I210, I22, I23, I26, I45, I46,
 };
 
 /// Entry `index`:`sub`, or 0 with `misses` counted: the dictionary declares
@@ -311,6 +311,10 @@ pub(crate) struct Snapshot {
     pub jog: [u32; 4],
     /// I26 jog control type (1 = position control).
     pub i26: u8,
+    /// A44 quick stop on the loss of A60 (1 = active).
+    pub a44: u8,
+    /// I00 position range (1 = endless).
+    pub i00: u8,
     /// G472 / G475 velocity limits of the torque modes, 0.1 % of I10
     /// (C-039).
     pub torque_mode_speed_limit: [u16; 2],
@@ -433,6 +437,8 @@ impl Snapshot {
                 sat(w.param(od, I18, 0, m), 0u32, u32::MAX),
             ],
             i26: sat(w.param(od, I26, 0, m), 0u8, u8::MAX),
+            a44: sat(w.param(od, A44, 0, m), 0u8, u8::MAX),
+            i00: sat(w.param(od, I00, 0, m), 0u8, u8::MAX),
             gains: (
                 sat(w.param(od, I20, 0, m), 0u16, u16::MAX),
                 sat(w.param(od, C31, 0, m), 0u32, u32::MAX),

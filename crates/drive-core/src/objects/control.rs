@@ -14,8 +14,13 @@ use od::DataType::{U16, U32, U8};
 use od::{Access, DataType, EntryInfo};
 
 const RW: Access = Access::RW;
+const RW_PREOP: Access = Access::RW_PREOP;
 const fn e(sub: u8, name: &'static str, t: DataType, a: Access) -> EntryInfo {
     EntryInfo::new(sub, name, t, a)
+}
+/// Group A parameter `line`.
+const fn a(line: u16) -> u16 {
+    parameter_index(0, line)
 }
 /// Group C parameter `line`.
 const fn c(line: u16) -> u16 {
@@ -34,7 +39,15 @@ const fn g(line: u16) -> u16 {
 const REV_INC: i64 = 1 << 20;
 
 /// The control settings of axis A, sorted by index.
-pub const PARAMS: [Object; 10] = [
+pub const PARAMS: [Object; 12] = [
+    Object::var(
+        a(44),
+        Value::Ram,
+        entries![e(0, "Quick stop", U8, RW).range(0, 1).saved()],
+    )
+    .axis()
+    .level(1)
+    .note("A44: 1 = active: losing the additional enable A60 in Operation enabled gives a quick stop (transition 11) instead of switching the power stage off (transition 9); default 0; effective at once"),
     Object::var(
         c(31),
         Value::Ram,
@@ -81,6 +94,14 @@ pub const PARAMS: [Object; 10] = [
     .axis()
     .level(1)
     .note("G475 (C-039); as G472 in the negative direction (magnitude)"),
+    Object::var(
+        i_(0),
+        Value::Ram,
+        entries![e(0, "Position range", U8, RW_PREOP).range(0, 1).saved()],
+    )
+    .axis()
+    .level(1)
+    .note("I00 (C-099, C-111): 0 limited (software limits act), 1 endless (positions wrap at 607Bh:02); default 0; writable in Pre-Op only (0800 0022h in Safe-Op and Op: the coordinate system must not change under a running axis)"),
     Object::var(
         i_(12),
         Value::Ram,
