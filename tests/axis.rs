@@ -30,15 +30,18 @@ pub fn motor_position(sim: &RefCell<Simulation>, axis: usize) -> i64 {
     sim.borrow().drives()[0].motors[axis].position_inc_i64()
 }
 
-/// The speed limit of the torque modes (G472/G475) of axis A, rev/s, set
-/// through the axis parameters.
-pub fn torque_mode_speed_limit(sim: &RefCell<Simulation>, rev_s: f32) {
-    with_drive(sim, |d| {
-        let c = &mut d.drive.axes_mut()[0].params_mut().cascade;
-        let v = rev_s * crate::REV as f32;
-        c.torque_mode_velocity_limit_positive_inc_per_s = v;
-        c.torque_mode_velocity_limit_negative_inc_per_s = v;
-    });
+/// The speed limits of the torque modes (G472/G475) of axis A raised to
+/// `rev_s` by SDO, as a master does (0.1 % of I10, the declared default
+/// maximum speed).
+pub async fn torque_mode_speed_limit<S>(sd: &ethercrab::SubDeviceRef<'_, S>, rev_s: f32)
+where
+    S: std::ops::Deref<Target = ethercrab::SubDevice>,
+{
+    let i10 = drive::axis::AxisParams::default().cascade.max_velocity_inc_per_s;
+    let per_mille = (rev_s * crate::REV as f32 / i10 * 1000.0).round() as u16;
+    for index in [drive::params::G472, drive::params::G475] {
+        sd.sdo_write(index, 0, per_mille).await.expect("G472/G475 by SDO");
+    }
 }
 
 /// Homing method 37 (reference here, no motion) through the standard PDO:

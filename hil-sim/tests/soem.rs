@@ -400,3 +400,33 @@ fn e046_e021_soem_a_master_stopped_in_init_and_a_new_master_under_dc() {
     };
     hil_sim::fault_row!(row, seen_in(&rows, "64"));
 }
+
+/// C-039 through SOEM (issue 40): the velocity limits of the torque modes
+/// G472/G475 (2DD8h/2DDBh) default to 0 % and keep the axis still in cst
+/// (statusword bit 11); a value beyond 100 % is refused with 0609 0031h;
+/// raised by SDO in Op to 40 % of I10, 6071h = 10 % of the rated torque
+/// moves the axis in cst forward and in pt back, 6077h follows 6071h while
+/// it accelerates, and the speed settles at ±40 % of I10 (`torque.py`).
+#[test]
+fn c039_soem_raises_g472_g475_by_sdo_and_cst_pt_move_the_axis() {
+    let python = match pysoem_python() {
+        Ok(p) => p,
+        Err(why) => {
+            eprintln!("soem torque-mode test: skipped, {why}");
+            return;
+        }
+    };
+    let _one = ONE_AT_A_TIME.lock().unwrap_or_else(|e| e.into_inner());
+    let dir = scratch("soem-torque");
+    // I10, the reference of G472/G475's percentages, as a fresh drive has it
+    let i10 = drive::axis::AxisParams::default().cascade.max_velocity_inc_per_s;
+    let line = Line::new("t", 1, 120, &dir);
+    let status = line.run(
+        &python,
+        "torque.py",
+        &["--limit", "400", "--i10", &i10.to_string()],
+    );
+    if !status.success() {
+        fail_with(&line, &format!("torque.py through SOEM failed: {status}"));
+    }
+}

@@ -285,12 +285,11 @@ fn c040_csp_csv_cst_need_no_mode_specific_controlword_bits() {
         m.set_controlword(CW_ENABLED);
         m.run(50).await;
 
-        // cst: the torque acts with and without the bits (speed limit G472 lifted)
-        with_drive(&sim, |d| {
-            let c = &mut d.drive.axes_mut()[0].params_mut().cascade;
-            c.torque_mode_velocity_limit_positive_inc_per_s = 5.0 * REV as f32;
-            c.torque_mode_velocity_limit_negative_inc_per_s = 5.0 * REV as f32;
-        });
+        // cst: the torque acts with and without the bits (speed limits
+        // G472/G475 lifted by SDO to 10 % of I10, 5 rev/s)
+        let sd = group.subdevice(md, 0).unwrap();
+        sd.sdo_write(drive::params::G472, 0, 100u16).await.unwrap();
+        sd.sdo_write(drive::params::G475, 0, 100u16).await.unwrap();
         m.set_mode(10);
         m.run(20).await;
         for cw in [CW_ENABLED, CW_ENABLED | CW_BIT4 | CW_BIT5 | CW_BIT6 | CW_HALT] {
@@ -473,11 +472,14 @@ fn c107_e80_shows_illegal_direction_on_an_endless_axis() {
     let sim = line(1);
     with_drive(&sim, |d| {
         let l = &mut d.drive.axes_mut()[0].params_mut().limits;
-        l.endless_axis = true;
         l.permitted_direction = drive::axis::PermittedDirection::PositiveOnly;
     });
     with_master(&sim, async |md, clock| {
-        let group = init(md, clock).await.into_op(md).await.expect("OP");
+        // I00 = 1 "endless" by SDO in Pre-Op (issue 40)
+        let group = init(md, clock).await;
+        let sd = group.subdevice(md, 0).unwrap();
+        sd.sdo_write(drive::params::I00, 0, 1u8).await.unwrap();
+        let group = group.into_op(md).await.expect("OP");
         let sd = group.subdevice(md, 0).unwrap();
         let mut m = Cyclic::new(md, &group, &sim, 0);
         m.set_mode(9);
@@ -820,13 +822,29 @@ fn c109_gear_and_feed_scale_positions_and_velocities_through_the_master() {
 #[test]
 fn c111_endless_axis_wraps_at_607b_through_the_master() {
     let sim = line(1);
-    with_drive(&sim, |d| {
-        d.drive.axes_mut()[0].params_mut().limits.endless_axis = true
-    });
     const L: i32 = 360_000; // 0.001° per motor revolution
     with_master(&sim, async |md, clock| {
-        let group = init(md, clock).await.into_op(md).await.expect("OP");
+        // I00 = 1 "endless" by SDO, in Pre-Op (issue 40)
+        let group = init(md, clock).await;
         let sd = group.subdevice(md, 0).unwrap();
+        sd.sdo_write(drive::params::I00, 0, 1u8).await.unwrap();
+        let group = group.into_op(md).await.expect("OP");
+        let sd = group.subdevice(md, 0).unwrap();
+        // not in Op: 0800 0022h, unchanged
+        let refused = sd.sdo_write(drive::params::I00, 0, 0u8).await;
+        assert!(
+            matches!(
+                refused,
+                Err(ethercrab::error::Error::Mailbox(
+                    ethercrab::error::MailboxError::Aborted {
+                        code: ethercrab::error::CoeAbortCode::InvalidState,
+                        ..
+                    }
+                ))
+            ),
+            "I00 in Op: {refused:?}"
+        );
+        assert_eq!(sd.sdo_read::<u8>(drive::params::I00, 0).await.unwrap(), 1);
         sd.sdo_write(0x6092, 1, L as u32).await.unwrap();
         sd.sdo_write(0x607B, 2, L).await.unwrap();
         sd.sdo_write(0x607B, 1, -5i32).await.unwrap(); // no function

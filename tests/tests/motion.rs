@@ -251,6 +251,7 @@ fn c038_c039_cst_torque_with_and_without_speed_limit() {
     let sim = line(1);
     with_master(&sim, async |md, clock| {
         let group = init(md, clock).await.into_op(md).await.expect("OP");
+        let sd = group.subdevice(md, 0).unwrap();
         let mut m = Cyclic::new(md, &group, &sim, 0);
         m.set_mode(10);
         m.run(3).await;
@@ -274,7 +275,7 @@ fn c038_c039_cst_torque_with_and_without_speed_limit() {
         );
 
         // G472/G475 = 10 rev/s: the torque accelerates the axis up to the limit
-        torque_mode_speed_limit(&sim, 10.0);
+        torque_mode_speed_limit(&sd, 10.0).await;
         m.set_target_torque(100); // 0.13 N·m on 1e-4 kg·m² ≈ 207 rev/s²
         let tx = m.run(5).await;
         assert_eq!(tx.torque, 100, "6077h follows 6071h at once (C-038)");

@@ -210,7 +210,7 @@ fn c057_pt_ramps_6071_with_6087_limited_by_6072_and_g472() {
         // back to 0, then G472 = 20 rev/s: 0 → 10 % along 6087h (100 ms)
         m.set_target_torque(0);
         m.run(200).await;
-        torque_mode_speed_limit(&sim, 20.0);
+        torque_mode_speed_limit(&sd, 20.0).await;
         m.run(5).await;
         assert!(m.tx.bit(10), "torque 0 reached: {:#06x}", m.tx.statusword);
         m.set_target_torque(100);
@@ -317,12 +317,19 @@ fn c088_c089_c090_jog_bits_4_and_5() {
         );
         assert_eq!(m.tx.state(), sw::OE);
 
-        // I12/I13 from the parameters: 3 rev/s at 60 rev/s² (50 ms)
-        with_drive(&sim, |d| {
-            let p = d.drive.axes_mut()[0].params_mut();
-            p.jog_velocity = 3.0 * REV as f32;
-            p.jog_acceleration = 60.0 * REV as f32;
-        });
+        // I12/I13 by SDO: 3 rev/s at 60 rev/s² (50 ms)
+        group
+            .subdevice(md, 0)
+            .unwrap()
+            .sdo_write(drive::params::I12, 0, 3 * REV as u32)
+            .await
+            .unwrap();
+        group
+            .subdevice(md, 0)
+            .unwrap()
+            .sdo_write(drive::params::I13, 0, 60 * REV as u32)
+            .await
+            .unwrap();
         m.set_controlword(CW_ENABLED | CW_BIT4);
         let t = m
             .run_until(400, |t| t.velocity > 3 * REV * 97 / 100)
@@ -381,9 +388,7 @@ fn c091_c092_jog_at_the_software_limits() {
         );
 
         // I26 = 0: past −0.5 rev a quick stop, no fault; the negative direction locked (C-091)
-        with_drive(&sim, |d| {
-            d.drive.axes_mut()[0].params_mut().jog_position_control = false
-        });
+        sd.sdo_write(drive::params::I26, 0, 0u8).await.unwrap();
         m.set_controlword(CW_ENABLED);
         m.run(200).await;
         m.set_controlword(CW_ENABLED | CW_BIT5);

@@ -76,6 +76,32 @@ pub const A310: u16 = parameter_index(0, 310);
 /// A311 decimal places of the acceleration, deceleration and jerk objects
 /// (per axis).
 pub const A311: u16 = parameter_index(0, 311);
+/// A44 quick stop on the loss of A60 (per axis).
+pub const A44: u16 = parameter_index(0, 44);
+/// I00 position range: 0 limited, 1 endless (per axis).
+pub const I00: u16 = parameter_index(8, 0);
+/// C31 velocity controller Kp, µN·m per rad/s (per axis).
+pub const C31: u16 = parameter_index(2, 31);
+/// C32 velocity controller Ti, µs; 0 = no integral part (per axis).
+pub const C32: u16 = parameter_index(2, 32);
+/// I12 jog velocity, user units/s (per axis).
+pub const I12: u16 = parameter_index(8, 12);
+/// I13 jog acceleration, user units/s² (per axis).
+pub const I13: u16 = parameter_index(8, 13);
+/// I18 jog jerk, user units/s³, 0 = none (per axis).
+pub const I18: u16 = parameter_index(8, 18);
+/// I26 jog control type: 0 velocity, 1 position (per axis).
+pub const I26: u16 = parameter_index(8, 26);
+/// I45 jog deceleration, user units/s² (per axis).
+pub const I45: u16 = parameter_index(8, 45);
+/// I20 position controller Kv, 0.1 /s (per axis).
+pub const I20: u16 = parameter_index(8, 20);
+/// G472 positive velocity limit of the torque modes, 0.1 % of I10 (per
+/// axis, C-039).
+pub const G472: u16 = parameter_index(6, 472);
+/// G475 negative velocity limit of the torque modes, 0.1 % of I10 (per
+/// axis, C-039).
+pub const G475: u16 = parameter_index(6, 475);
 /// I02 position encoder (per axis).
 pub const I02: u16 = parameter_index(8, 2);
 /// A279 PROFINET units (the PROFIdrive personality's unit choices).

@@ -9,8 +9,6 @@ use cia402::{State, SW_INTERNAL_LIMIT, SW_MODE_BIT12, SW_MODE_BIT13, SW_TARGET_R
 use motion::{Event, INCREMENTS_PER_REVOLUTION};
 use nanos::Nanos;
 
-/// Increments per revolution as `f32`.
-const REV: f32 = INCREMENTS_PER_REVOLUTION as f32;
 use store::RamFlash;
 
 type Flash = RamFlash<4096, 2>;
@@ -217,6 +215,21 @@ fn c003_enable_refused_without_additional_enable() {
     assert_eq!(rig.state(0), State::ReadyToSwitchOn);
 }
 
+/// A44 (issue 40, spec cia402.md transitions 9 and 11): losing A60 in
+/// Operation enabled switches the power stage off with A44 = 0 (the
+/// default) and quick-stops with A44 = 1, set in the dictionary.
+#[test]
+fn c003_a44_decides_what_losing_a60_does() {
+    for (a44, want) in [(0, State::SwitchOnDisabled), (1, State::QuickStopActive)] {
+        let mut rig = Rig::new();
+        rig.set(0, crate::params::A44, 0, a44);
+        rig.enable(0);
+        rig.io[0].additional_enable = false;
+        rig.run(2);
+        assert_eq!(rig.state(0), want, "A44 = {a44}");
+    }
+}
+
 /// A master trajectory at 1 ms: 100 ms at 20 rev/s² to 2 rev/s, 300 ms
 /// at 2 rev/s, 100 ms braking; increments at cycle `k`.
 fn trajectory(k: i64) -> i64 {
@@ -294,15 +307,9 @@ fn c037_csv_velocity_reached() {
 #[test]
 fn c038_cst_torque_produced() {
     let mut rig = Rig::new();
-    // G472/G475: let the axis run up to 20 rev/s in the torque modes
-    for a in rig.drive.axes_mut() {
-        a.params_mut()
-            .cascade
-            .torque_mode_velocity_limit_positive_inc_per_s = 20.0 * REV;
-        a.params_mut()
-            .cascade
-            .torque_mode_velocity_limit_negative_inc_per_s = 20.0 * REV;
-    }
+    // G472/G475: let the axis run up to 40 % of I10 (20 rev/s) in the torque modes
+    rig.set(0, crate::params::G472, 0, 400);
+    rig.set(0, crate::params::G475, 0, 400);
     rig.set(0, 0x6060, 0, 10);
     rig.enable(0);
     rig.set(0, 0x6071, 0, 100); // 10 % of 1.3 N·m
@@ -333,6 +340,17 @@ fn c039_cst_default_speed_limit_keeps_the_axis_still() {
         rig.velocity(0)
     );
     // the speed limiter is an internal limit (bit 11)
+    assert_ne!(rig.sw(0) & SW_INTERNAL_LIMIT, 0);
+    // a raised G472 lets the same torque move the axis, up to G472 · I10
+    // (the refusal of a value beyond 100 % is checked through SOEM)
+    rig.set(0, crate::params::G472, 0, 100); // 10 % of 50 rev/s
+    rig.run(400);
+    let limit = 5 * REV_I as i32;
+    assert!(
+        (rig.velocity(0) - limit).abs() < limit / 50,
+        "velocity {} at the limit {limit}",
+        rig.velocity(0)
+    );
     assert_ne!(rig.sw(0) & SW_INTERNAL_LIMIT, 0);
 }
 

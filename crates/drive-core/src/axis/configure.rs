@@ -7,6 +7,15 @@ use super::*;
 impl Axis {
     /// Applies the configuration objects and parameters.
     pub(super) fn configure(&mut self, od: &mut DriveObjects, slots: &CyclicSlots, o: &Snapshot, dt_ns: u32) {
+        // the settings of the dictionary (issue 40), in increments
+        let [v, a, d, j] = o.jog.map(|x| x as f32);
+        self.params.jog_velocity = v;
+        self.params.jog_acceleration = a;
+        self.params.jog_deceleration = d;
+        self.params.jog_jerk = if j > 0.0 { j } else { f32::INFINITY };
+        self.params.jog_position_control = o.i26 != 0;
+        self.params.quick_stop_on_enable_loss = o.a44 == 1;
+        self.params.limits.endless_axis = o.i00 == 1;
         let p = self.params;
         self.modulo = if p.limits.endless_axis && o.modulo_length > 0 {
             ModuloAxis::new(i64::from(o.modulo_length)).ok()
@@ -62,12 +71,18 @@ impl Axis {
         };
         let per_mille = per_mille.min(self.torque_limit_per_mille);
         let max_nm = p.rated_torque_nm * f32::from(per_mille) * 0.001;
+        // G472/G475 (C-039): 0.1 % of the maximum speed I10
+        let [g472, g475] = o
+            .torque_mode_speed_limit
+            .map(|l| p.cascade.max_velocity_inc_per_s * f32::from(l) * 0.001);
         let mut cfg = CascadeConfig {
             torque_limit_positive_nm: max_nm,
             torque_limit_negative_nm: max_nm,
             velocity_feedforward_percent: 100.0,
             position_dead_band_inc: o.dead_band,
-            ..scaled_gains(&p.cascade, dt_ns)
+            torque_mode_velocity_limit_positive_inc_per_s: g472,
+            torque_mode_velocity_limit_negative_inc_per_s: g475,
+            ..scaled_gains(&declared_gains(&p.cascade, o), dt_ns)
         };
         if !self.torque_mode_speed_limit.is_nan() {
             cfg.torque_mode_velocity_limit_positive_inc_per_s = self.torque_mode_speed_limit;
@@ -143,5 +158,17 @@ impl Axis {
         if let Some(v) = self.vinterp.as_mut() {
             v.start(self.sp_vel);
         }
+    }
+}
+
+/// The cascade of the parameters with the gains of the dictionary: I20 Kv,
+/// C31 Kp, C32 Ti (issue 40).
+fn declared_gains(c: &CascadeConfig, o: &Snapshot) -> CascadeConfig {
+    let (kv, kp, ti) = o.gains;
+    CascadeConfig {
+        position_gain_per_s: f32::from(kv) * 0.1,
+        velocity_gain_nm_per_rad_per_s: kp as f32 * 1e-6,
+        velocity_integral_time_ns: ti.saturating_mul(1000),
+        ..*c
     }
 }

@@ -13,8 +13,11 @@ pub struct AxisParams {
     /// Rated motor current, mA (motor data, at the rated torque): current
     /// limits in mA become torque limits through it (PROFINET's 2415h.02).
     pub rated_current_ma: u32,
-    /// Cascade gains and limits. The torque limits are replaced by 6072h, the
-    /// speed feedforward weight is applied by the interpolator (I25 below);
+    /// Cascade gains and limits. The torque limits are replaced by 6072h,
+    /// the gains Kv, Kp, Ti by I20, C31, C32 (issue 40),
+    /// the torque modes' speed limits by G472/G475 (0.1 % of
+    /// `max_velocity_inc_per_s`, I10), the speed feedforward weight is
+    /// applied by the interpolator (I25 below);
     /// the inertia (motor data) turns the generators' acceleration into
     /// torque feedforward.
     pub cascade: CascadeConfig,
@@ -43,6 +46,8 @@ pub struct AxisParams {
     /// the previous one than twice 607Fh over the time between them trips
     /// event 78 cause 4 "excessive set value jump".
     pub set_value_monitoring: bool,
+    /// Jog (I12, I13, I45, I18, I26): taken from the dictionary at every
+    /// configuration change (issue 40); what is set here is overwritten.
     /// I12 jog velocity, inc/s.
     pub jog_velocity: f32,
     /// I13 jog acceleration, inc/s².

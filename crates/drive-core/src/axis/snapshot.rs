@@ -14,7 +14,8 @@ use crate::{AXIS_B_CIA402, AXIS_B_MANUFACTURER};
 use motion::scaling::AxisScaling;
 
 pub(crate) use crate::params::{
-    A150, A213, A291, A310, A311, A340, A66, A67, E47, E48, E49, E80, I02, I101, I21, I210, I22, I23, I46,
+    A150, A213, A291, A310, A311, A340, A44, A66, A67, C31, C32, E47, E48, E49, E80, G472, G475, I00, I02,
+    I101, I12, I13, I18, I20, I21, I210, I22, I23, I26, I45, I46,
 };
 
 /// Entry `index`:`sub`, or 0 with `misses` counted: the dictionary declares
@@ -302,6 +303,21 @@ pub(crate) struct Snapshot {
     pub a66: [u32; 16],
     /// Whether any A66 element names a source (else A67 is 0 without a look).
     pub a66_used: bool,
+    /// The cascade's gains: I20 Kv (0.1 /s), C31 Kp (µN·m·s/rad), C32 Ti
+    /// (µs).
+    pub gains: (u16, u32, u32),
+    /// Jog: I12 velocity (user units/s), I13 acceleration, I45
+    /// deceleration, I18 jerk (user units/s², /s³; 0 = none).
+    pub jog: [u32; 4],
+    /// I26 jog control type (1 = position control).
+    pub i26: u8,
+    /// A44 quick stop on the loss of A60 (1 = active).
+    pub a44: u8,
+    /// I00 position range (1 = endless).
+    pub i00: u8,
+    /// G472 / G475 velocity limits of the torque modes, 0.1 % of I10
+    /// (C-039).
+    pub torque_mode_speed_limit: [u16; 2],
     /// I02 position encoder (0 = motor encoder).
     pub i02: u8,
     /// I46 reference retaining (5 = direct absolute).
@@ -414,6 +430,24 @@ impl Snapshot {
             override_percent: sat(w.param(od, A340, 0, m), 0u16, u16::MAX),
             a66: core::array::from_fn(|k| sat(w.param(od, A66, k as u8 + 1, m), 0u32, u32::MAX)),
             a66_used: (1..=16).any(|sub| w.param(od, A66, sub, m) != 0),
+            jog: [
+                sat(w.param(od, I12, 0, m), 0u32, u32::MAX),
+                sat(w.param(od, I13, 0, m), 0u32, u32::MAX),
+                sat(w.param(od, I45, 0, m), 0u32, u32::MAX),
+                sat(w.param(od, I18, 0, m), 0u32, u32::MAX),
+            ],
+            i26: sat(w.param(od, I26, 0, m), 0u8, u8::MAX),
+            a44: sat(w.param(od, A44, 0, m), 0u8, u8::MAX),
+            i00: sat(w.param(od, I00, 0, m), 0u8, u8::MAX),
+            gains: (
+                sat(w.param(od, I20, 0, m), 0u16, u16::MAX),
+                sat(w.param(od, C31, 0, m), 0u32, u32::MAX),
+                sat(w.param(od, C32, 0, m), 0u32, u32::MAX),
+            ),
+            torque_mode_speed_limit: [
+                sat(w.param(od, G472, 0, m), 0u16, u16::MAX),
+                sat(w.param(od, G475, 0, m), 0u16, u16::MAX),
+            ],
             i02: sat(w.param(od, I02, 0, m), 0u8, u8::MAX),
             i46: sat(w.param(od, I46, 0, m), 0u8, u8::MAX),
             switch_source: [
@@ -507,6 +541,10 @@ impl Snapshot {
                 mag(self.position_error_limit)
             },
             dead_band: mag(self.dead_band),
+            jog: {
+                let [v, a, d, j] = self.jog;
+                [vel(v), acc(a), acc(d), acc(j)]
+            },
             ..self
         }
     }

@@ -62,6 +62,7 @@ macro_rules! numbered {
 
 pub mod cia402;
 pub mod comm;
+pub mod control;
 pub mod manufacturer;
 mod pack;
 pub mod records;
@@ -375,6 +376,30 @@ pub const fn axis_copies<const N: usize>(objs: &[Object], by: u16) -> [Object; N
     out
 }
 
+/// Two lists sorted by index merged into one sorted list of `N` =
+/// `a.len() + b.len()` objects (an index in both stays twice: the table's
+/// `sorted` check refuses it).
+const fn merge<const N: usize>(a: &[Object], b: &[Object]) -> [Object; N] {
+    let mut out = [FILLER; N];
+    let (mut i, mut j) = (0, 0);
+    while i + j < N {
+        // i < a.len() or j < b.len() while i + j < N (compile-time evaluation)
+        #[allow(clippy::indexing_slicing)]
+        {
+            let at = i + j;
+            if j >= b.len() || (i < a.len() && a[i].info.index <= b[j].info.index) {
+                out[at] = a[i];
+                i += 1;
+            } else {
+                out[at] = b[j];
+                j += 1;
+            }
+        }
+    }
+    assert!(i == a.len() && j == b.len(), "merged object count");
+    out
+}
+
 /// The areas joined into one array of `N` objects.
 const fn join<const N: usize>(parts: &[&[Object]]) -> [Object; N] {
     let mut out = [FILLER; N];
@@ -427,16 +452,19 @@ const fn entries_sorted(objs: &[Object]) -> bool {
     true
 }
 
-const AXIS_B_PARAMS: usize = count_axis(&manufacturer::PARAMS);
-const MANUFACTURER_B: [Object; AXIS_B_PARAMS] =
-    axis_copies(&manufacturer::PARAMS, crate::AXIS_B_MANUFACTURER);
+/// The global and axis-A manufacturer parameters: those of [`manufacturer`]
+/// and the control settings of [`control`], merged by index.
+pub const MANUFACTURER_A: [Object; manufacturer::PARAMS.len() + control::PARAMS.len()] =
+    merge(&manufacturer::PARAMS, &control::PARAMS);
+const AXIS_B_PARAMS: usize = count_axis(&MANUFACTURER_A);
+const MANUFACTURER_B: [Object; AXIS_B_PARAMS] = axis_copies(&MANUFACTURER_A, crate::AXIS_B_MANUFACTURER);
 const AXIS_B_RECORDS: usize = count_axis(&records::PARAMS);
 const RECORDS_B: [Object; AXIS_B_RECORDS] = axis_copies(&records::PARAMS, crate::AXIS_B_MANUFACTURER);
 const CIA402_B: [Object; cia402::AXIS_A.len()] = offset(cia402::AXIS_A, crate::AXIS_B_CIA402);
 
 /// Number of objects.
 pub const COUNT: usize = comm::COMM.len()
-    + manufacturer::PARAMS.len()
+    + MANUFACTURER_A.len()
     + records::PARAMS.len()
     + cia402::AXIS_A.len()
     + CIA402_B.len()
@@ -449,7 +477,7 @@ pub const COUNT: usize = comm::COMM.len()
 #[allow(clippy::large_const_arrays)]
 const TABLE: [Object; COUNT] = join(&[
     &comm::COMM,
-    &manufacturer::PARAMS,
+    &MANUFACTURER_A,
     &records::PARAMS,
     &cia402::AXIS_A,
     &CIA402_B,

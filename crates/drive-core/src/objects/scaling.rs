@@ -20,6 +20,7 @@
 //! converts exactly these entries): `tests_scaling.rs`.
 
 use super::records::{J401, J404};
+use crate::params::{I12, I13, I18, I45};
 
 /// Which decimal places an entry takes.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
@@ -35,7 +36,11 @@ use Quantity::{Acceleration as ACC, Velocity as VEL};
 /// The scaled entries of axis A: index, subindex in the "EtherCAT Rx SDO
 /// Info" numbering (J401 element k at k + 1), quantity. Axis B's are at
 /// +800h (CiA 402) and +8000h (J401, J404). Sorted by index.
-pub const SCALED: [(u16, u8, Quantity); 20] = [
+pub const SCALED: [(u16, u8, Quantity); 24] = [
+    (I12, 0, VEL),    // jog velocity
+    (I13, 0, ACC),    // jog acceleration
+    (I18, 0, ACC),    // jog jerk
+    (I45, 0, ACC),    // jog deceleration
     (J401, 2, VEL),   // record data [1] profile velocity
     (J401, 3, VEL),   // record data [2] end velocity
     (J401, 4, ACC),   // record data [3] acceleration

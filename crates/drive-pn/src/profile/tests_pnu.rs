@@ -436,3 +436,30 @@ fn p147_p148_pnu_1003_profile_type() {
     assert_eq!(pkw2(&mut b, 0x42, 1003, 0, 2), (0xC2, 0x02));
     assert_eq!(pkw2(&mut b, 0x41, 1003, 0, 0), (0x41, 0));
 }
+
+/// The axis settings of the one declaration through PKW in the
+/// manufacturer range (PNU = index, issue 40): G472 (2DD8h) and the
+/// velocity controller's C31 (241Fh) written and read back; a value beyond
+/// G472's range gets PKW error 2 (limit exceeded) and changes nothing;
+/// PNU 971 saves them and a new drive over the same flash starts with them.
+#[test]
+fn p045_issue40_g472_and_c31_through_pkw_saved_and_read_after_a_restart() {
+    use drive_core::params::{C31, G472};
+    let mut b = Bench::new();
+    assert_eq!(b.pkw0(0x41, G472, 0, 0), (0x41, 0), "0 % by default");
+    assert_eq!(
+        b.pkw0(0x42, G472, 0, 1001),
+        (0xC2, 2),
+        "beyond 100 %: limit exceeded"
+    );
+    assert_eq!(b.d.objects().get(G472, 0), Ok(0), "unchanged");
+    assert_eq!(b.pkw0(0x42, G472, 0, 300).0, 0x42);
+    assert_eq!(b.pkw0(0x42, C31, 0, 45_000).0, 0x42);
+    assert_eq!(b.pkw0(0x41, G472, 0, 0), (0x41, 300));
+    assert_eq!(b.pkw0(0x41, C31, 0, 0), (0x41, 45_000));
+    assert_eq!(b.pkw0(0x42, 971, 0, 1).0, 0x42, "saved");
+    let flash = core::mem::replace(&mut b.d, crate::tests::commissioned()).into_flash();
+    let again = PnDrive::new(flash, crate::tests::hardware());
+    assert_eq!(again.objects().get(G472, 0), Ok(300));
+    assert_eq!(again.objects().get(C31, 0), Ok(45_000));
+}

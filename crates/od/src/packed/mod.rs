@@ -26,9 +26,26 @@ pub use build::*;
 
 /// The units an entry of a packed table may have (index 0: none); in the
 /// image as [`UNITS`].
-pub const UNIT_NAMES: [&str; 17] = [
-    "", "inc", "inc/s", "inc/s²", "inc/s³", "0.1 %", "0.1 %/s", "0.1 kW", "%", "‰", "rpm", "s", "ms", "µs",
-    "ns", "mNm", "mV",
+pub const UNIT_NAMES: [&str; 19] = [
+    "",
+    "inc",
+    "inc/s",
+    "inc/s²",
+    "inc/s³",
+    "0.1 %",
+    "0.1 %/s",
+    "0.1 kW",
+    "%",
+    "‰",
+    "rpm",
+    "s",
+    "ms",
+    "µs",
+    "ns",
+    "mNm",
+    "mV",
+    "0.1 /s",
+    "µNm·s/rad",
 ];
 
 /// Bytes of the unit names.

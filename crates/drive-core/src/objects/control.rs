@@ -1,0 +1,169 @@
+//! The axis' control settings in the one declaration (issue 40): the
+//! manufacturer parameters of the motion functions and the cascade that a
+//! master sets (groups C, G and I at `parameter_index(group, line)`, axis B
+//! at +8000h). The axis reads them when the configuration generation moves
+//! (`axis/settings.rs`), never per cycle. The motor data (group B) of the
+//! current control will join them here.
+//!
+//! Merged with [`super::manufacturer::PARAMS`] into one sorted list
+//! ([`super::MANUFACTURER_A`]).
+
+use super::{Object, Value};
+use crate::parameter_index;
+use od::DataType::{U16, U32, U8};
+use od::{Access, DataType, EntryInfo};
+
+const RW: Access = Access::RW;
+const RW_PREOP: Access = Access::RW_PREOP;
+const fn e(sub: u8, name: &'static str, t: DataType, a: Access) -> EntryInfo {
+    EntryInfo::new(sub, name, t, a)
+}
+/// Group A parameter `line`.
+const fn a(line: u16) -> u16 {
+    parameter_index(0, line)
+}
+/// Group C parameter `line`.
+const fn c(line: u16) -> u16 {
+    parameter_index(2, line)
+}
+/// Group I parameter `line`.
+const fn i_(line: u16) -> u16 {
+    parameter_index(8, line)
+}
+/// Group G parameter `line`.
+const fn g(line: u16) -> u16 {
+    parameter_index(6, line)
+}
+
+/// One revolution, increments (the native user unit).
+const REV_INC: i64 = 1 << 20;
+
+/// The control settings of axis A, sorted by index.
+pub const PARAMS: [Object; 12] = [
+    Object::var(
+        a(44),
+        Value::Ram,
+        entries![e(0, "Quick stop", U8, RW).range(0, 1).saved()],
+    )
+    .axis()
+    .level(1)
+    .note("A44: 1 = active: losing the additional enable A60 in Operation enabled gives a quick stop (transition 11) instead of switching the power stage off (transition 9); default 0; effective at once"),
+    Object::var(
+        c(31),
+        Value::Ram,
+        entries![e(0, "Speed controller Kp", U32, RW)
+            .range(0, 10_000_000)
+            .default_value(60_000)
+            .unit("µNm·s/rad")
+            .saved()],
+    )
+    .axis()
+    .level(1)
+    .note("C31 (line assumed; the seeds name no cascade parameter): proportional gain of the velocity controller, torque per speed error; default 0.06 N·m per rad/s (about 100 Hz bandwidth on the simulated 1e-4 kg·m² servo); effective at once; the gains are for A150 ≤ 250 µs and scaled down for longer cycles"),
+    Object::var(
+        c(32),
+        Value::Ram,
+        entries![e(0, "Speed controller Ti", U32, RW)
+            .range(0, 10_000_000)
+            .default_value(8_000)
+            .unit("µs")
+            .saved()],
+    )
+    .axis()
+    .level(1)
+    .note("C32 (line assumed): integral time of the velocity controller; 0 = no integral part; effective at once"),
+    Object::var(
+        g(472),
+        Value::Ram,
+        entries![e(0, "Positive velocity limit torque mode", U16, RW)
+            .range(0, 1000)
+            .unit("0.1 %")
+            .saved()],
+    )
+    .axis()
+    .level(1)
+    .note("G472 (C-039); cst and pt: the speed up to which the torque set-point drives the axis in the positive direction, in 0.1 % of the maximum speed I10; default 0 %: the axis does not move until it is raised; effective at once; not mappable (a configuration value)"),
+    Object::var(
+        g(475),
+        Value::Ram,
+        entries![e(0, "Negative velocity limit torque mode", U16, RW)
+            .range(0, 1000)
+            .unit("0.1 %")
+            .saved()],
+    )
+    .axis()
+    .level(1)
+    .note("G475 (C-039); as G472 in the negative direction (magnitude)"),
+    Object::var(
+        i_(0),
+        Value::Ram,
+        entries![e(0, "Position range", U8, RW_PREOP).range(0, 1).saved()],
+    )
+    .axis()
+    .level(1)
+    .note("I00 (C-099, C-111): 0 limited (software limits act), 1 endless (positions wrap at 607Bh:02); default 0; writable in Pre-Op only (0800 0022h in Safe-Op and Op: the coordinate system must not change under a running axis)"),
+    Object::var(
+        i_(12),
+        Value::Ram,
+        entries![e(0, "Jog velocity", U32, RW)
+            .default_value(REV_INC)
+            .unit("inc/s")
+            .saved()],
+    )
+    .axis()
+    .level(1)
+    .note("I12 (C-089): jog speed in user units/s (6091h/6092h, decimals A310 as 6081h); default 1 rev/s; effective at the next jog command"),
+    Object::var(
+        i_(13),
+        Value::Ram,
+        entries![e(0, "Jog acceleration", U32, RW)
+            .default_value(10 * REV_INC)
+            .unit("inc/s²")
+            .saved()],
+    )
+    .axis()
+    .level(1)
+    .note("I13: jog acceleration in user units/s² (decimals A311); default 10 rev/s²"),
+    Object::var(
+        i_(18),
+        Value::Ram,
+        entries![e(0, "Jog jerk", U32, RW).unit("inc/s³").saved()],
+    )
+    .axis()
+    .level(1)
+    .note("I18: jog jerk in user units/s³ (decimals A311); 0 = no jerk limit (default)"),
+    Object::var(
+        i_(20),
+        Value::Ram,
+        entries![e(0, "Position controller Kv", U16, RW)
+            .range(0, 10_000)
+            .default_value(1_000)
+            .unit("0.1 /s")
+            .saved()],
+    )
+    .axis()
+    .level(1)
+    .note("I20 (line assumed): gain of the position controller, velocity command per following error; default 100 /s; effective at once"),
+    Object::var(
+        i_(26),
+        Value::Ram,
+        entries![e(0, "Jog control type", U8, RW)
+            .range(0, 1)
+            .default_value(1)
+            .saved()],
+    )
+    .axis()
+    .level(1)
+    .note("I26 (C-091, C-092): 0 velocity control (past a software limit a quick stop), 1 position control (stops before it, default)"),
+    Object::var(
+        i_(45),
+        Value::Ram,
+        entries![e(0, "Jog deceleration", U32, RW)
+            .default_value(10 * REV_INC)
+            .unit("inc/s²")
+            .saved()],
+    )
+    .axis()
+    .level(1)
+    .note("I45: jog deceleration in user units/s² (decimals A311); default 10 rev/s²"),
+];
