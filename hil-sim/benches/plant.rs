@@ -105,7 +105,6 @@ fn run(model: PlantModel) -> Figures {
         max = max.max(ferr.abs());
         sq += ferr * ferr;
     }
-    drop(step);
     let seconds = now.as_ns() as f64 * 1e-9;
     let (iq_max, id_max) = el
         .first()
