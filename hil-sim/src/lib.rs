@@ -7,6 +7,7 @@
 //! ([`master`]), raw Ethernet ([`raw`]) and pcap recording ([`pcap`]).
 #![cfg_attr(not(feature = "std"), no_std)]
 
+pub mod electrical;
 pub mod esc;
 pub mod frame;
 pub mod motor;

@@ -1,8 +1,9 @@
 //! `hil-sim`: the simulated drive on a PC.
 //!
-//! - `hil-sim demo [--pcap FILE] [--plot FILE.svg]` (the default): a real
-//!   EtherCAT master (ethercrab, in-process) brings one simulated drive to OP,
-//!   enables axis A, homes it, runs a csp profile and plots the run.
+//! - `hil-sim demo [--pcap FILE] [--plot FILE.svg] [--plant rigid|electrical]`
+//!   (the default): a real EtherCAT master (ethercrab, in-process) brings one
+//!   simulated drive to OP, enables axis A, homes it, runs a csp profile and
+//!   plots the run (`--plant electrical`: through the 16 kHz current loop).
 //! - `hil-sim demo --fieldbus profinet [--pcap FILE] [--plot FILE.svg]`: a
 //!   scripted IO controller (in-process) runs the Example Function block's
 //!   sequence against one simulated PROFINET drive and plots the run.
@@ -17,13 +18,16 @@
 mod cli;
 
 use clap::Parser;
-use cli::args::{Cli, Command, DemoArgs, Fieldbus};
+use cli::args::{Cli, Command, DemoArgs, Fieldbus, Plant};
 use std::process::ExitCode;
 
 fn main() -> ExitCode {
     let cli = Cli::parse();
     let result = match &cli.command {
         None => cli::demo::demo(&DemoArgs::default()),
+        Some(Command::Demo(a)) if a.fieldbus == Fieldbus::Profinet && a.plant != Plant::Rigid => {
+            Err("--plant electrical: the EtherCAT demo only, so far".to_string())
+        }
         Some(Command::Demo(a)) if a.fieldbus == Fieldbus::Profinet => cli::demo_pn::demo(a),
         Some(Command::Demo(a)) => cli::demo::demo(a),
         Some(Command::Serve(a)) => cli::serve::serve(a),

@@ -461,6 +461,17 @@ impl Motor {
         }
     }
 
+    /// [`Self::step`] with `torque_nm` and `brake_engaged` acting during this
+    /// step already (no actuation delay): for a caller that models the delay
+    /// itself (the electrical axis, [`crate::electrical`], one PWM period per call).
+    pub fn step_applied(&mut self, torque_nm: f64, brake_engaged: bool, dt: Nanos) -> MotorOutputs {
+        self.pending = Actuation {
+            torque_nm: self.params.clamp_torque(torque_nm),
+            brake: brake_engaged,
+        };
+        self.step(torque_nm, brake_engaged, dt)
+    }
+
     /// [`Self::step`] with the torque in 0.1 % of the rated torque (6071h).
     pub fn step_permille(
         &mut self,

@@ -29,6 +29,15 @@ pub struct Trace {
     pub state_name: String,
     /// Optional: phases (start time in ms, name), marked in every panel.
     pub phases: Vec<(f64, String)>,
+    /// Optional ([`Trace::push_currents`]): measured d current, A; with it two
+    /// more panels (dq currents, phase currents).
+    pub id_a: Vec<f64>,
+    /// Measured q current, A.
+    pub iq_a: Vec<f64>,
+    /// q current reference, A.
+    pub iq_ref_a: Vec<f64>,
+    /// Phase currents a, b, c, A.
+    pub phase_a: [Vec<f64>; 3],
 }
 
 /// One line of a panel: values, colour, legend.
@@ -93,6 +102,17 @@ impl Trace {
         self.state.push(state);
     }
 
+    /// Appends one sample's currents (the electrical plant): measured id and
+    /// iq, the iq reference, the phase currents a, b, c, A.
+    pub fn push_currents(&mut self, id: f64, iq: f64, iq_ref: f64, phases: [f64; 3]) {
+        self.id_a.push(id);
+        self.iq_a.push(iq);
+        self.iq_ref_a.push(iq_ref);
+        for (v, x) in self.phase_a.iter_mut().zip(phases) {
+            v.push(x);
+        }
+    }
+
     /// Marks the start of a phase at `t`.
     pub fn mark_phase(&mut self, t: Nanos, name: &str) {
         self.phases.push((t.as_ns() as f64 / 1e6, name.to_string()));
@@ -109,13 +129,19 @@ impl Trace {
     /// The four-panel SVG plot.
     pub fn svg(&self, title: &str) -> Result<String, String> {
         let mut svg = String::new();
+        // the two current panels add their height
+        let size = if self.iq_a.is_empty() {
+            SIZE
+        } else {
+            (SIZE.0, SIZE.1 + SIZE.1 / 2)
+        };
         self.draw(
-            SVGBackend::with_string(&mut svg, (fine(SIZE.0), fine(SIZE.1))),
+            SVGBackend::with_string(&mut svg, (fine(size.0), fine(size.1))),
             title,
         )?;
-        // shown at SIZE: the root's width and height (its first attributes)
-        let drawn = format!("width=\"{}\" height=\"{}\"", fine(SIZE.0), fine(SIZE.1));
-        let shown = format!("width=\"{}\" height=\"{}\"", SIZE.0, SIZE.1);
+        // shown at its size: the root's width and height (its first attributes)
+        let drawn = format!("width=\"{}\" height=\"{}\"", fine(size.0), fine(size.1));
+        let shown = format!("width=\"{}\" height=\"{}\"", size.0, size.1);
         if !svg.contains(&drawn) {
             return Err("the SVG root has no width and height to set".into());
         }
@@ -129,7 +155,9 @@ impl Trace {
             .titled(title, ("sans-serif", fine(22)))
             .map_err(|e| e.to_string())?;
         let with_state = !self.state.is_empty();
-        let panels = root.split_evenly((if with_state { 5 } else { 4 }, 1));
+        let with_currents = !self.iq_a.is_empty();
+        let n = 4 + usize::from(with_state) + 2 * usize::from(with_currents);
+        let panels = root.split_evenly((n, 1));
         let set_name = if self.set_name.is_empty() {
             "set 607Ah"
         } else {
@@ -154,6 +182,21 @@ impl Trace {
         ];
         if with_state {
             series.push((self.state_name.as_str(), vec![(&self.state, CYAN, "state")]));
+        }
+        if with_currents {
+            series.push((
+                "current dq [A]",
+                vec![
+                    (&self.iq_ref_a, BLUE, "iq reference"),
+                    (&self.iq_a, RED, "iq measured"),
+                    (&self.id_a, GREEN, "id measured"),
+                ],
+            ));
+            let [a, b, c] = &self.phase_a;
+            series.push((
+                "phase currents [A]",
+                vec![(a, RED, "a"), (b, GREEN, "b"), (c, BLUE, "c")],
+            ));
         }
         for (k, (area, (label, lines))) in panels.iter().zip(series.iter()).enumerate() {
             let (lo, hi) = lines

@@ -2,6 +2,7 @@
 //! with the real slave stack (`ecat`) and the drive's objects (`drive`) behind
 //! its PDI. Frames from any master go through [`Simulation::exchange`].
 
+use crate::electrical::{ElectricalAxis, PlantModel};
 use crate::esc::{Esc, EscConfig, LineTiming};
 use crate::frame::process_frame;
 use crate::motor::{Motor, MotorOutputs};
@@ -112,6 +113,9 @@ pub struct SimDrive {
     /// The PLL's phase lock over the whole run (every gain and loss counted).
     pub pll_lock: PllLock,
     feedback: [Option<MotorOutputs>; 2],
+    /// Axis A's and B's current loop and PMSM ([`SimDrive::set_plant`]);
+    /// `None`: the rigid motor model.
+    electrical: [Option<Box<ElectricalAxis>>; 2],
     next_cycle: Nanos,
     /// Next start of the PLL-driven timer, ticks of the MCU clock (`None`: free-running).
     next_tick: Option<u64>,
@@ -176,6 +180,7 @@ impl SimDrive {
             cycle_log: VecDeque::with_capacity(CYCLE_LOG_LEN),
             pll_lock: PllLock::default(),
             feedback: [None, None],
+            electrical: [None, None],
             next_cycle: CONTROL_CYCLE,
             next_tick: None,
             sm2_event: false,
@@ -399,13 +404,17 @@ impl SimDrive {
         if !dt.is_zero() {
             self.cycle = dt;
         }
-        for ((motor, fb), c) in self.motors.iter_mut().zip(self.feedback.iter_mut()).zip(cmd) {
+        let axes = self.motors.iter_mut().zip(self.feedback.iter_mut());
+        for (((motor, fb), c), el) in axes.zip(cmd).zip(self.electrical.iter_mut()) {
             let torque = if c.power_stage {
                 f64::from(c.torque_nm)
             } else {
                 0.0
             };
-            *fb = Some(motor.step(torque, !c.brake_release, self.cycle));
+            *fb = Some(match el {
+                Some(el) => el.step(motor, torque, c.power_stage, !c.brake_release, self.cycle),
+                None => motor.step(torque, !c.brake_release, self.cycle),
+            });
         }
     }
 
@@ -430,6 +439,26 @@ impl SimDrive {
 }
 
 impl SimDrive {
+    /// Runs both axes on `model` from the next control cycle on (the motors'
+    /// mechanics and position stay; an electrical axis starts with zero current).
+    /// `seed` seeds the ADC noise (axis B gets `seed + 1`).
+    pub fn set_plant(&mut self, model: PlantModel, seed: u64) -> Result<(), foc::ParamError> {
+        for (k, el) in self.electrical.iter_mut().enumerate() {
+            *el = match model {
+                PlantModel::Rigid => None,
+                PlantModel::Electrical => Some(Box::new(ElectricalAxis::default_servo(
+                    seed.wrapping_add(k as u64),
+                )?)),
+            };
+        }
+        Ok(())
+    }
+
+    /// Axis `axis`' current loop and PMSM, if it runs the electrical model.
+    pub fn electrical(&self, axis: usize) -> Option<&ElectricalAxis> {
+        self.electrical.get(axis).and_then(|e| e.as_deref())
+    }
+
     /// What motor `axis` (0 = A, 1 = B) did in the last control cycle
     /// (torque applied, brake applied, …), `None` before the first cycle.
     pub fn motor_outputs(&self, axis: usize) -> Option<&MotorOutputs> {

@@ -167,6 +167,22 @@ impl Plant {
         }
     }
 
+    /// Puts the motor shaft at `angle_rad` turning at `speed_rad_s` (mechanical),
+    /// currents kept: for a co-simulation whose mechanics live elsewhere (hil-sim's
+    /// motor with [`Shaft::Driven`]: this plant then contributes the currents and
+    /// the torque, the other model the motion).
+    pub fn set_rotor(&mut self, angle_rad: f64, speed_rad_s: f64) {
+        self.x.theta_m = angle_rad;
+        self.x.omega_m = speed_rad_s;
+        if self.p.mech.two_mass.is_none() {
+            self.x.theta_l = angle_rad;
+            self.x.omega_l = speed_rad_s;
+        }
+        if let Shaft::Driven { .. } = self.p.mech.shaft {
+            self.p.mech.shaft = Shaft::Driven { speed_rad_s };
+        }
+    }
+
     /// Time since start, s.
     pub fn time_s(&self) -> f64 {
         self.periods as f64 * self.p.period_s()

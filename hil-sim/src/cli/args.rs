@@ -48,6 +48,31 @@ pub struct DemoArgs {
     /// [default: target/hil-sim-demo.svg, PROFINET: target/hil-sim-demo-pn.svg].
     #[arg(long, value_name = "FILE.svg")]
     pub plot: Option<PathBuf>,
+    /// EtherCAT only: the motor model. `rigid`: the commanded torque acts one
+    /// control cycle later (cheap); `electrical`: the current loop at 16 kHz on
+    /// a PMSM behind an inverter, the same mechanics (the summary adds
+    /// current-loop figures, the plot id/iq and the phase currents).
+    #[arg(long, value_enum, value_name = "MODEL", default_value_t = Plant::Rigid)]
+    pub plant: Plant,
+}
+
+/// The motor model of `demo --plant` (`hil_sim::electrical::PlantModel`).
+#[derive(Debug, Clone, Copy, Default, PartialEq, Eq, ValueEnum)]
+pub enum Plant {
+    /// The rigid rotor, torque in.
+    #[default]
+    Rigid,
+    /// The current loop on the PMSM plant.
+    Electrical,
+}
+
+impl From<Plant> for hil_sim::electrical::PlantModel {
+    fn from(p: Plant) -> Self {
+        match p {
+            Plant::Rigid => Self::Rigid,
+            Plant::Electrical => Self::Electrical,
+        }
+    }
 }
 
 /// The fieldbus `serve` and `demo` speak.

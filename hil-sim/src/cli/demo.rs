@@ -2,7 +2,7 @@
 //! time) brings one simulated drive to OP, enables axis A in csp, homes it on
 //! its reference switch, runs a csp profile and writes a plot of the run.
 
-use super::args::{create_output, DemoArgs, DEFAULT_PLOT};
+use super::args::{create_output, DemoArgs, Plant, DEFAULT_PLOT};
 use super::print_new_changes;
 use hil_sim::motor::PositionInput;
 use hil_sim::sim::Simulation;
@@ -183,13 +183,46 @@ async fn motion_demo(
         write_outputs(group, md, 0x0F, 8, target)?;
         i = cycle(group, md, sim).await?;
         trace.push(sim.borrow().now(), target, i.pos, i.vel, i.torque, i.ferr);
+        if let Some(e) = sim.borrow_mut().drives_mut()[0].electrical(0) {
+            let c = e.last();
+            trace.push_currents(c.id_a, c.iq_a, c.iq_ref_a, c.phases_a);
+        }
         bar.inc(1);
     }
     bar.finish_and_clear();
+    // settled: where the axis stands against its final target (the start)
+    for _ in 0..100 {
+        write_outputs(group, md, 0x0F, 8, p0)?;
+        i = cycle(group, md, sim).await?;
+    }
+    println!(
+        "  at rest after the profile: position {} inc, target {p0} inc (error {} inc)",
+        i.pos,
+        i.pos.wrapping_sub(p0)
+    );
     // Disable operation, then Shutdown
     until(group, md, sim, (0x06, 8, i.pos), 200, |i| i.sw & 0x6F == 0x21).await?;
     println!("  axis A: Ready to switch on again");
     Ok(trace)
+}
+
+/// Seed of the electrical plant's ADC noise.
+const PLANT_SEED: u64 = 0x5eed_f0c0_0000_0034;
+
+/// The current loop's figures over the whole run (axis A, gates on).
+fn print_current_figures(e: &hil_sim::electrical::ElectricalAxis) {
+    let s = e.stats();
+    let kt = e.foc().gains().kt_nm_per_a;
+    println!(
+        "  current loop (axis A, {} PWM periods with the gates on): iq rms {:.3} A, max |iq| {:.3} A ({:.2} N·m at kt {kt:.3} N·m/A), max |id| {:.3} A measured, {:.3} A in the motor; voltage-limited in {} periods",
+        s.enabled_periods,
+        s.iq_mean_square().sqrt(),
+        s.iq_max_abs,
+        s.iq_max_abs * f64::from(kt),
+        s.id_max_abs,
+        s.id_true_max_abs,
+        s.voltage_limited_periods,
+    );
 }
 
 /// Runs the demo. Both output files are created before the run: a path that
@@ -218,8 +251,17 @@ pub fn demo(args: &DemoArgs) -> Result<(), String> {
         // the reference switch of axis A, a quarter revolution out
         let mut s = sim.borrow_mut();
         s.drives_mut()[0].motors[0].switches_mut().reference = PositionInput::above(REFERENCE_SWITCH_INC);
+        s.drives_mut()[0]
+            .set_plant(args.plant.into(), PLANT_SEED)
+            .map_err(|e| format!("the electrical plant's parameters: {e:?}"))?;
     }
-    println!("hil-sim demo: ethercrab (in-process) -> simulated ESC -> drive firmware -> simulated motor");
+    println!(
+        "hil-sim demo: ethercrab (in-process) -> simulated ESC -> drive firmware -> {}",
+        match args.plant {
+            Plant::Rigid => "simulated motor (rigid, torque in)",
+            Plant::Electrical => "current loop (16 kHz) -> simulated PMSM and inverter",
+        }
+    );
     let mut printed = Vec::new();
     let result = hil_sim::master::run(&sim, hil_sim::master::in_process_timeouts(), async |md, clock| {
         let group = md
@@ -260,6 +302,9 @@ pub fn demo(args: &DemoArgs) -> Result<(), String> {
             trace.len(),
             max / 1_048_576.0 * 360.0
         );
+        if let Some(e) = sim.borrow().drives()[0].electrical(0) {
+            print_current_figures(e);
+        }
         if let Some(mut f) = plot_file.take() {
             if let Err(e) = trace.write_svg(&mut f, "hil-sim demo: csp profile from the master, axis A") {
                 drop(f);

@@ -336,6 +336,19 @@ impl EdgeList {
         }
     }
 
+    /// Appends `other`'s edges `offset` later (the steps of a control cycle
+    /// split into sub-steps, merged into one list; sorted if `other` is and
+    /// `offset` is past every edge already here).
+    pub(crate) fn append_shifted(&mut self, other: &EdgeList, offset: Nanos) {
+        for e in other {
+            self.push(Edge {
+                time_offset: e.time_offset.saturating_add(offset),
+                ..*e
+            });
+        }
+        self.lost = self.lost.saturating_add(other.lost);
+    }
+
     /// Stable insertion sort by time (the list is short and nearly sorted).
     pub(super) fn sort_by_time(&mut self) {
         let n = self.len.min(MAX_EDGES_PER_STEP);

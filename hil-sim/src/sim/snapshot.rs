@@ -21,6 +21,7 @@ impl SimDrive {
             cycle_log: self.cycle_log.clone(),
             pll_lock: self.pll_lock,
             feedback: self.feedback,
+            electrical: self.electrical.clone(),
             next_cycle: self.next_cycle,
             next_tick: self.next_tick,
             sm2_event: self.sm2_event,
