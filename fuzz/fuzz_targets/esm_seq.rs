@@ -30,12 +30,12 @@ use nanos::Nanos;
 // each is checked only when its constant is `true`; the lead sets them to
 // `true` when merging `ecat33` (every other rule is checked always).
 /// A repeated Op request while S→O waits does not restart the 200 ms wait.
-const ECAT33_OP_WAIT_NOT_RESTARTED: bool = false;
+const ECAT33_OP_WAIT_NOT_RESTARTED: bool = true;
 /// Deactivating a mailbox SM in Pre-Op (or higher) falls back to Init with
 /// 0016h; deactivating SM2/SM3 in Safe-Op/Op to Pre-Op with 001Dh/001Eh.
 const ECAT33_SM_DEACTIVATION_FALLS_BACK: bool = false;
 /// A mailbox request of a reserved type is answered with mailbox error 0002h.
-const ECAT33_RESERVED_MAILBOX_TYPE_0002: bool = false;
+const ECAT33_RESERVED_MAILBOX_TYPE_0002: bool = true;
 /// The device-identification request (AL control bit 5) is honoured.
 const ECAT33_DEVICE_IDENTIFICATION: bool = false;
 

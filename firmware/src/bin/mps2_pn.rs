@@ -175,8 +175,8 @@ mod app {
     use core::sync::atomic::Ordering;
     use cortex_m::peripheral::syst::SystClkSource;
     use drive::axis::{AxisCommand, AxisIo};
-    use firmware::pn_log::log_event;
     use drive_pn::PnParamFlash as ParamFlash;
+    use firmware::pn_log::log_event;
     use nanos::Nanos;
 
     #[shared]
