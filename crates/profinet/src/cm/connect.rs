@@ -420,7 +420,15 @@ pub fn emit_real_identification(w: &mut Writer<'_>, ar: Option<&Ar>) -> Option<(
             let _ = slots.push((s.slot, ident));
         }
     }
-    slots.sort_unstable_by_key(|x| x.0);
+    // In slot order without a sort: core's sort keeps a panic path
+    // (quicksort's bounds assertion) that the reference board must not have.
+    let mut ordered: Vec<(u16, u32), { MAX_DATA_SLOTS as usize }> = Vec::new();
+    for slot in 1..=MAX_DATA_SLOTS {
+        if let Some(&x) = slots.iter().find(|x| x.0 == slot) {
+            let _ = ordered.push(x);
+        }
+    }
+    let slots = ordered;
     emit_block_v(w, REAL_IDENTIFICATION_DATA, 1, |w| {
         w.u16(1)?; // NumberOfAPIs
         w.u32(0)?;
