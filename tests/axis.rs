@@ -37,9 +37,11 @@ pub async fn torque_mode_speed_limit<S>(sd: &ethercrab::SubDeviceRef<'_, S>, rev
 where
     S: std::ops::Deref<Target = ethercrab::SubDevice>,
 {
-    let i10 = drive::axis::AxisParams::default().cascade.max_velocity_inc_per_s;
+    let i10 = drive_ecat::axis::AxisParams::default()
+        .cascade
+        .max_velocity_inc_per_s;
     let per_mille = (rev_s * crate::REV as f32 / i10 * 1000.0).round() as u16;
-    for index in [drive::params::G472, drive::params::G475] {
+    for index in [drive_ecat::params::G472, drive_ecat::params::G475] {
         sd.sdo_write(index, 0, per_mille).await.expect("G472/G475 by SDO");
     }
 }

@@ -50,10 +50,10 @@ pub const REV_F: f64 = REV as f64;
 pub const VARIANT_ENV: &str = "DRIVE_TESTS_VARIANT";
 
 /// The device this run of the end-to-end tests is about ([`VARIANT_ENV`]).
-pub fn variant() -> drive::Variant {
+pub fn variant() -> drive_ecat::Variant {
     match std::env::var(VARIANT_ENV).as_deref() {
-        Ok("single") => drive::Variant::Single,
-        _ => drive::Variant::Double,
+        Ok("single") => drive_ecat::Variant::Single,
+        _ => drive_ecat::Variant::Double,
     }
 }
 
@@ -65,14 +65,14 @@ pub fn line(n: usize) -> RefCell<Simulation> {
 /// The device description (identity, SII name, order code) of this run's
 /// [`variant`].
 pub fn device() -> &'static ecat::Device {
-    drive::device(variant())
+    drive_ecat::device(variant())
 }
 
 /// The object dictionary of this run's [`variant`]: the objects the device
 /// has, each as the device declares it, in index order.
-pub fn objects() -> impl Iterator<Item = &'static drive::objects::Object> + Clone {
+pub fn objects() -> impl Iterator<Item = &'static drive_ecat::objects::Object> + Clone {
     let v = variant();
-    drive::objects::OBJECTS
+    drive_ecat::objects::OBJECTS
         .iter()
         .filter(move |o| v.has_object(o.info.index))
         .map(move |o| v.declared(o))
@@ -887,7 +887,7 @@ impl<'a> Cyclic<'a> {
 
 /// Writes the mode map `layout` of axis A into 1600h/1A00h by SDO (Pre-Op),
 /// the CiA 301 sequence a master's start-up list uses.
-pub async fn map_layout<S>(sd: &SubDeviceRef<'_, S>, layout: drive::PdoLayout)
+pub async fn map_layout<S>(sd: &SubDeviceRef<'_, S>, layout: drive_ecat::PdoLayout)
 where
     S: std::ops::Deref<Target = ethercrab::SubDevice>,
 {
@@ -1054,16 +1054,16 @@ impl<'a> RawCyclic<'a> {
 pub use hil_sim::sim::FirmwareFlash as FwFlash;
 
 /// The firmware slots of a [`FwNode`].
-pub type FwSlots = drive::boot::BootSlots<FwFlash>;
+pub type FwSlots = drive_ecat::boot::BootSlots<FwFlash>;
 
 /// The secret seed of the development key pair (`keys/dev-ed25519.key`),
 /// whose public key the drive trusts in the simulator.
 pub fn dev_seed() -> [u8; 32] {
-    drive::boot::parse_key_hex(include_str!("../keys/dev-ed25519.key")).expect("keys/dev-ed25519.key")
+    drive_ecat::boot::parse_key_hex(include_str!("../keys/dev-ed25519.key")).expect("keys/dev-ed25519.key")
 }
 
 /// The load address of `slot` of a [`FwNode`]'s firmware flash.
-pub fn fw_load_address(slot: drive::boot::Slot) -> u32 {
+pub fn fw_load_address(slot: drive_ecat::boot::Slot) -> u32 {
     FwSlots::new(FwFlash::new()).load_address(slot)
 }
 
@@ -1072,12 +1072,12 @@ pub fn fw_load_address(slot: drive::boot::Slot) -> u32 {
 /// development key's signature) and a body of `len` bytes derived from
 /// `version`. Slot B is where a [`FwNode::factory`] drive downloads to.
 pub fn firmware_file(version: u32, len: usize) -> Vec<u8> {
-    signed_file(drive::boot::Slot::B, version, 1, len, &dev_seed())
+    signed_file(drive_ecat::boot::Slot::B, version, 1, len, &dev_seed())
 }
 
 /// [`firmware_file`] for `slot` with security counter `counter`, signed with `seed`.
 pub fn signed_file(
-    slot: drive::boot::Slot,
+    slot: drive_ecat::boot::Slot,
     version: u32,
     counter: u32,
     len: usize,
@@ -1091,7 +1091,7 @@ pub fn signed_file(
                 .to_le_bytes()[3]
         })
         .collect();
-    let mut h = drive::boot::ImageHeader::for_body(&body, version, fw_load_address(slot), counter);
+    let mut h = drive_ecat::boot::ImageHeader::for_body(&body, version, fw_load_address(slot), counter);
     h.sign(&body, seed);
     let mut f = h.to_bytes().to_vec();
     f.extend_from_slice(&body);
@@ -1104,9 +1104,9 @@ pub struct FwNode {
     /// The simulated ESC.
     pub esc: hil_sim::esc::Esc,
     /// The drive runtime with its firmware slots.
-    pub drive: drive::runtime::Drive<hil_sim::sim::SimFlash, FwFlash>,
+    pub drive: drive_ecat::runtime::Drive<hil_sim::sim::SimFlash, FwFlash>,
     /// What the last boot started.
-    pub boot: Option<drive::boot::Decision>,
+    pub boot: Option<drive_ecat::boot::Decision>,
 }
 
 impl FwNode {
@@ -1115,13 +1115,13 @@ impl FwNode {
     pub fn power_on(param: hil_sim::sim::SimFlash, fw: FwFlash) -> Self {
         let mut slots = FwSlots::new(fw);
         let boot = slots
-            .boot_verified(&drive::runtime::FIRMWARE_PUBLIC_KEY, 0)
+            .boot_verified(&drive_ecat::runtime::FIRMWARE_PUBLIC_KEY, 0)
             .expect("boot: read the slots");
         let mut sii = [0u8; ecat::sii::EEPROM_BYTES];
-        let n = ecat::build_sii(&drive::DEVICE, &mut sii).expect("SII");
+        let n = ecat::build_sii(&drive_ecat::DEVICE, &mut sii).expect("SII");
         Self {
             esc: hil_sim::esc::Esc::new(hil_sim::esc::EscConfig::default(), &sii[..n]),
-            drive: drive::runtime::Drive::with_boot(param, Some(slots)),
+            drive: drive_ecat::runtime::Drive::with_boot(param, Some(slots)),
             boot,
         }
     }
@@ -1132,10 +1132,10 @@ impl FwNode {
         let mut slots = FwSlots::new(FwFlash::new());
         slots.boot().expect("boot");
         slots.begin().expect("begin");
-        let file = signed_file(drive::boot::Slot::A, 1, 1, factory_len, &dev_seed());
+        let file = signed_file(drive_ecat::boot::Slot::A, 1, 1, factory_len, &dev_seed());
         slots.write(&file).expect("write");
         slots
-            .finish_verified(&drive::runtime::FIRMWARE_PUBLIC_KEY)
+            .finish_verified(&drive_ecat::runtime::FIRMWARE_PUBLIC_KEY)
             .expect("finish");
         let mut slots = FwSlots::new(slots.into_inner());
         slots.boot().expect("boot");
@@ -1149,7 +1149,7 @@ impl FwNode {
             self,
             Self {
                 esc: hil_sim::esc::Esc::new(hil_sim::esc::EscConfig::default(), &[]),
-                drive: drive::runtime::Drive::with_boot(hil_sim::sim::SimFlash::new(), None),
+                drive: drive_ecat::runtime::Drive::with_boot(hil_sim::sim::SimFlash::new(), None),
                 boot: None,
             },
         );

@@ -53,7 +53,7 @@ mod app {
     use crate::pac::Interrupt;
     use crate::CPU_HZ;
     use cortex_m::peripheral::DWT;
-    use drive::axis::{AxisCommand, AxisIo};
+    use drive_ecat::axis::{AxisCommand, AxisIo};
     use firmware::clock::Clock;
     use firmware::cycle::CycleTimer;
     #[cfg(not(feature = "net"))]
@@ -114,10 +114,10 @@ mod app {
     /// The device this image is: the double-axis drive (SC6A062), or with
     /// the feature `single-axis` the single-axis drive (SI6A061: its own
     /// identity and SII, no axis-B objects or PDOs, axis B idle).
-    const VARIANT: drive::Variant = if cfg!(feature = "single-axis") {
-        drive::Variant::Single
+    const VARIANT: drive_ecat::Variant = if cfg!(feature = "single-axis") {
+        drive_ecat::Variant::Single
     } else {
-        drive::Variant::Double
+        drive_ecat::Variant::Double
     };
 
     /// The drive in its static, built in this function's own frame.

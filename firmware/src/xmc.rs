@@ -39,7 +39,7 @@ pub mod power {
     /// The gate enable after a control cycle: high while any axis' command
     /// wants its power stage on (one enable for both axes on this board).
     #[inline]
-    pub fn follow(cmd: &[drive::axis::AxisCommand; 2]) {
+    pub fn follow(cmd: &[drive_ecat::axis::AxisCommand; 2]) {
         set(cmd.iter().any(|c| c.power_stage));
     }
 }

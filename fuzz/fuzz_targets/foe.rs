@@ -17,22 +17,22 @@
 #[path = "mbx_esc.rs"]
 mod mbx_esc;
 
-use drive::boot::{BootSlots, ImageHeader, Slot, SlotState};
+use drive_ecat::boot::{BootSlots, ImageHeader, Slot, SlotState};
 use ecat::foe::opcode;
 use libfuzzer_sys::fuzz_target;
 use mbx_esc::{MailboxEsc, LEN};
 use nanos::Nanos;
 
 /// The firmware flash of the target: 2 × 32 sectors of 256 bytes (8 KiB a slot).
-type Small = drive::boot::RamFlash<256, 64>;
-type Drive = drive::runtime::Drive<hil_sim::sim::SimFlash, Small>;
+type Small = drive_ecat::boot::RamFlash<256, 64>;
+type Drive = drive_ecat::runtime::Drive<hil_sim::sim::SimFlash, Small>;
 
 /// FoE data bytes per full packet (a 256-byte mailbox).
 const SEGMENT: usize = LEN - 12;
 
 /// The signed update file of `len` body bytes for `slot` of `slots`.
 fn image(slots: &BootSlots<Small>, slot: Slot, version: u32, len: usize) -> Vec<u8> {
-    let seed = drive::boot::parse_key_hex(include_str!("../../keys/dev-ed25519.key")).unwrap_or([0; 32]);
+    let seed = drive_ecat::boot::parse_key_hex(include_str!("../../keys/dev-ed25519.key")).unwrap_or([0; 32]);
     let body: Vec<u8> = (0..len).map(|i| (i as u32).wrapping_mul(2_654_435_761).to_le_bytes()[3]).collect();
     let mut h = ImageHeader::for_body(&body, version, slots.load_address(slot), 1);
     h.sign(&body, &seed);
@@ -50,13 +50,13 @@ fn build() -> (Drive, Vec<u8>) {
     let factory = image(&slots, Slot::A, 1, 1000);
     let _ = slots.begin();
     let _ = slots.write(&factory);
-    let _ = slots.finish_verified(&drive::runtime::FIRMWARE_PUBLIC_KEY);
+    let _ = slots.finish_verified(&drive_ecat::runtime::FIRMWARE_PUBLIC_KEY);
     let mut slots = BootSlots::new(slots.into_inner());
     let _ = slots.boot();
     let _ = slots.confirm();
     let update = image(&slots, Slot::B, 2, 1200);
     let mut slots = BootSlots::new(slots.into_inner());
-    let _ = slots.boot_verified(&drive::runtime::FIRMWARE_PUBLIC_KEY, 0);
+    let _ = slots.boot_verified(&drive_ecat::runtime::FIRMWARE_PUBLIC_KEY, 0);
     let mut drive = Drive::with_boot(hil_sim::sim::SimFlash::new(), Some(slots));
     // the master's Init → Bootstrap request, with the bootstrap mailbox set up
     let mut esc = MailboxEsc::new();
@@ -113,7 +113,7 @@ fuzz_target!(|input: &[u8]| {
                 foe.extend_from_slice(&[opcode::WRITE, 0]);
                 foe.extend_from_slice(&u32_of(&mut data).to_le_bytes()); // password
                 if op & 0x80 == 0 {
-                    foe.extend_from_slice(drive::runtime::FIRMWARE_FILE);
+                    foe.extend_from_slice(drive_ecat::runtime::FIRMWARE_FILE);
                 } else {
                     let n = usize::from(byte(&mut data) % 24);
                     foe.extend_from_slice(take(&mut data, n));
@@ -146,7 +146,7 @@ fuzz_target!(|input: &[u8]| {
                     foe.extend_from_slice(&u32_of(&mut data).to_le_bytes());
                 } else {
                     foe.extend_from_slice(&[opcode::READ, 0, 0, 0, 0, 0]);
-                    foe.extend_from_slice(drive::runtime::FIRMWARE_FILE);
+                    foe.extend_from_slice(drive_ecat::runtime::FIRMWARE_FILE);
                 }
                 last_sent = None;
             }

@@ -18,7 +18,7 @@ use crate::mbx_esc::{MailboxEsc, LEN};
 use hil_sim::sim::{FirmwareFlash, SimFlash};
 use nanos::Nanos;
 
-type Drive = drive::runtime::Drive<SimFlash, FirmwareFlash>;
+type Drive = drive_ecat::runtime::Drive<SimFlash, FirmwareFlash>;
 
 thread_local! {
     /// The drive of [`common::build_preop_line`], once per process.

@@ -9,7 +9,7 @@
 //! from a copy of one powered-up drive.
 #![no_main]
 
-use drive::runtime::Drive;
+use drive_ecat::runtime::Drive;
 use ecat::eoe::{EthernetPort, IpParams};
 use hil_sim::eoe::net_settings;
 use hil_sim::sim::SimFlash;

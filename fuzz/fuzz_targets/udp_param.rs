@@ -9,7 +9,7 @@
 //!   lookup (`M`).
 #![no_main]
 
-use drive::DriveObjects;
+use drive_ecat::DriveObjects;
 use ecat::CommState;
 use libfuzzer_sys::fuzz_target;
 use net::param::{handle, Outcome, Policy, MAX_MESSAGE};

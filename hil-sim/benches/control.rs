@@ -9,7 +9,7 @@
 //! `Drive::control_cycle` and each motor takes one step.
 #![allow(clippy::unwrap_used, clippy::expect_used, clippy::indexing_slicing)]
 
-use drive::axis::AxisIo;
+use drive_ecat::axis::AxisIo;
 use hil_sim::motor::Motor;
 use hil_sim::sim::{SimFlash, CONTROL_CYCLE};
 use nanos::Nanos;
@@ -34,11 +34,11 @@ fn profile(k: usize, t_move: usize) -> f64 {
 }
 
 fn main() {
-    let mut drive = drive::runtime::Drive::new(SimFlash::new());
+    let mut drive = drive_ecat::runtime::Drive::new(SimFlash::new());
     let mut motors = [Motor::default_servo(), Motor::default_servo()];
     let mut pos = [0i32; 2];
     let mut now = Nanos::ZERO;
-    let step = |drive: &mut drive::runtime::Drive<SimFlash>,
+    let step = |drive: &mut drive_ecat::runtime::Drive<SimFlash>,
                 motors: &mut [Motor; 2],
                 pos: &mut [i32; 2],
                 now: &mut Nanos| {

@@ -15,8 +15,8 @@
     clippy::panic
 )]
 
-use drive::boot::{BootSlots, ImageHeader, IMAGE_HEADER_LEN};
-use drive::runtime::Drive;
+use drive_ecat::boot::{BootSlots, ImageHeader, IMAGE_HEADER_LEN};
+use drive_ecat::runtime::Drive;
 use ethercrab::SubDeviceRef;
 use hil_sim::esc::{Esc, EscConfig};
 use hil_sim::sim::{FirmwareFlash, Node, SimFlash, Simulation};
@@ -84,8 +84,8 @@ fn file(version: u32) -> Vec<u8> {
         .collect();
     // signed with the development key for slot A, where the download goes
     // (the flash is empty); the drive verifies it at the end (issue 18)
-    let seed = drive::boot::parse_key_hex(include_str!("../../keys/dev-ed25519.key")).expect("dev key");
-    let load = BootSlots::new(FirmwareFlash::new()).load_address(drive::boot::Slot::A);
+    let seed = drive_ecat::boot::parse_key_hex(include_str!("../../keys/dev-ed25519.key")).expect("dev key");
+    let load = BootSlots::new(FirmwareFlash::new()).load_address(drive_ecat::boot::Slot::A);
     let mut h = ImageHeader::for_body(&body, version, load, 1);
     h.sign(&body, &seed);
     let mut f = h.to_bytes().to_vec();
@@ -102,10 +102,10 @@ fn main() {
         .and_then(|s| s.parse().ok())
         .unwrap_or(3);
     let mut sii = [0u8; ecat::sii::EEPROM_BYTES];
-    let n = ecat::build_sii(&drive::DEVICE, &mut sii).expect("SII");
+    let n = ecat::build_sii(&drive_ecat::DEVICE, &mut sii).expect("SII");
     let mut slots = BootSlots::new(FirmwareFlash::new());
     slots
-        .boot_verified(&drive::runtime::FIRMWARE_PUBLIC_KEY, 0)
+        .boot_verified(&drive_ecat::runtime::FIRMWARE_PUBLIC_KEY, 0)
         .expect("boot");
     let node = FwNode {
         esc: Esc::new(EscConfig::default(), &sii[..n]),
@@ -164,7 +164,7 @@ fn main() {
         let slots = s.drives_mut()[0].drive.boot_slots_mut().expect("slots");
         let state = slots.state(slots.inactive()).expect("state");
         assert!(
-            matches!(state, drive::boot::SlotState::Pending { .. }),
+            matches!(state, drive_ecat::boot::SlotState::Pending { .. }),
             "{state:?}"
         );
     }

@@ -11,7 +11,7 @@
 //! would, every 1 ms (= the control cycle).
 #![allow(clippy::unwrap_used, clippy::expect_used, clippy::indexing_slicing)]
 
-use drive::axis::AxisIo;
+use drive_ecat::axis::AxisIo;
 use hil_sim::electrical::{ElectricalAxis, PlantModel};
 use hil_sim::motor::Motor;
 use hil_sim::sim::{SimFlash, CONTROL_CYCLE};
@@ -46,7 +46,7 @@ struct Figures {
 }
 
 fn run(model: PlantModel) -> Figures {
-    let mut drive = drive::runtime::Drive::new(SimFlash::new());
+    let mut drive = drive_ecat::runtime::Drive::new(SimFlash::new());
     let mut motors = [Motor::default_servo(), Motor::default_servo()];
     let mut el: Vec<ElectricalAxis> = match model {
         PlantModel::Rigid => Vec::new(),
@@ -57,7 +57,7 @@ fn run(model: PlantModel) -> Figures {
     let mut pos = [0i32; 2];
     let mut now = Nanos::ZERO;
     let mut spent = Duration::ZERO;
-    let mut step = |drive: &mut drive::runtime::Drive<SimFlash>, pos: &mut [i32; 2], now: &mut Nanos| {
+    let mut step = |drive: &mut drive_ecat::runtime::Drive<SimFlash>, pos: &mut [i32; 2], now: &mut Nanos| {
         *now += CONTROL_CYCLE;
         let io = [AxisIo::ready(pos[0]), AxisIo::ready(pos[1])];
         let cmd = drive.control_cycle_with(*now, &io, [true, true]);

@@ -7,7 +7,7 @@
 //! moves the mailbox through a real master (ethercrab register accesses).
 
 use crate::sim::SimDrive;
-use drive::runtime::Drive;
+use drive_ecat::runtime::Drive;
 use ecat::eoe::{frame_type, EoeHeader, Fragmenter, Reassembly, HEADER_LEN, MAX_FRAME};
 use ethercrab::SubDeviceRef;
 use nanos::Nanos;

@@ -10,7 +10,7 @@ use std::collections::VecDeque;
 
 use crate::motor::{Motor, MotorOutputs};
 use crate::sim::{axis_io, AxisConditions, SimFlash};
-use drive::params::{E43, E82};
+use drive_ecat::params::{E43, E82};
 use drive_pn::Hardware;
 use nanos::Nanos;
 use profinet::cm::{CmEvent, Im0, ImData, RecordHook};

@@ -44,7 +44,7 @@ pub const CONTROL_CYCLE: Nanos = Nanos::from_ms(1);
 /// Control-cycle starts kept in [`SimDrive::cycle_log`].
 pub const CYCLE_LOG_LEN: usize = 256;
 /// Tick frequency of the simulated control-cycle timer, Hz.
-const TIMER_HZ: u64 = drive::runtime::TIMER_HZ as u64;
+const TIMER_HZ: u64 = drive_ecat::runtime::TIMER_HZ as u64;
 const NS_PER_S: u128 = 1_000_000_000;
 
 /// The conditions of one axis that are not the motor's: additional enable
@@ -59,7 +59,7 @@ pub struct AxisConditions {
     /// Safe torque off active.
     pub sto_active: bool,
     /// The motor encoder delivers its position (false: an encoder fault,
-    /// the drive sees [`drive::axis::AxisIo::encoder_ok`] false).
+    /// the drive sees [`drive_ecat::axis::AxisIo::encoder_ok`] false).
     pub encoder_ok: bool,
 }
 
@@ -78,7 +78,7 @@ impl AxisConditions {
 ///
 /// # Control-cycle timing
 ///
-/// The MCU's control-cycle timer counts ticks of [`drive::runtime::TIMER_HZ`]
+/// The MCU's control-cycle timer counts ticks of [`drive_ecat::runtime::TIMER_HZ`]
 /// of the MCU's local time. The MCU runs from the same crystal as the ESC
 /// ([`SimDrive::set_clock`]: `local(t) = offset + t · (1 + drift)`), but
 /// its timer is *not* corrected by the ESC's drift-control loop: that loop
@@ -87,7 +87,7 @@ impl AxisConditions {
 ///
 /// - Without SYNC0: a free-running [`CONTROL_CYCLE`] cycle in simulation
 ///   time, run when [`SimDrive::poll`] finds it due (as before DC-Sync).
-/// - From the first SYNC0 pulse the PLL runs ([`drive::runtime::Drive::pll`]):
+/// - From the first SYNC0 pulse the PLL runs ([`drive_ecat::runtime::Drive::pll`]):
 ///   the next start is the PLL's `start + period_ticks`, converted to
 ///   simulation time through the MCU clock; [`Node::next_timer_at`] makes
 ///   the [`Simulation`] stop at each start, so cycles run at their exact time.
@@ -95,7 +95,7 @@ pub struct SimDrive {
     /// The simulated ESC (what the master sees).
     pub esc: Esc,
     /// The drive firmware's communication runtime.
-    pub drive: drive::runtime::Drive<SimFlash, FirmwareFlash>,
+    pub drive: drive_ecat::runtime::Drive<SimFlash, FirmwareFlash>,
     /// State changes with their simulated time, oldest first.
     pub state_log: Vec<(Nanos, ecat::StateChange)>,
     /// Motor and load of axis A and B.
@@ -126,10 +126,10 @@ pub struct SimDrive {
 }
 
 /// The SII image generated from the description of `variant`
-/// ([`drive::device`]).
-fn sii_image(variant: drive::Variant) -> ([u8; ecat::sii::EEPROM_BYTES], usize) {
+/// ([`drive_ecat::device`]).
+fn sii_image(variant: drive_ecat::Variant) -> ([u8; ecat::sii::EEPROM_BYTES], usize) {
     let mut sii = [0u8; ecat::sii::EEPROM_BYTES];
-    let len = ecat::build_sii(drive::device(variant), &mut sii).unwrap_or(0);
+    let len = ecat::build_sii(drive_ecat::device(variant), &mut sii).unwrap_or(0);
     (sii, len)
 }
 
@@ -154,24 +154,28 @@ impl SimDrive {
     /// A drive powered on with the given parameter flash and, if any,
     /// firmware flash (the boot decision runs first).
     pub fn power_on_with(flash: SimFlash, firmware: Option<FirmwareFlash>) -> Self {
-        Self::power_on_for(drive::Variant::Double, flash, firmware)
+        Self::power_on_for(drive_ecat::Variant::Double, flash, firmware)
     }
 
     /// [`power_on_with`](Self::power_on_with) for the device `variant`: its
     /// SII in the ESC's EEPROM, its dictionary and axes.
-    pub fn power_on_for(variant: drive::Variant, flash: SimFlash, firmware: Option<FirmwareFlash>) -> Self {
+    pub fn power_on_for(
+        variant: drive_ecat::Variant,
+        flash: SimFlash,
+        firmware: Option<FirmwareFlash>,
+    ) -> Self {
         let (sii, len) = sii_image(variant);
         let esc = Esc::new(EscConfig::default(), sii.get(..len).unwrap_or(&[]));
         let boot = firmware.map(|f| {
             let mut slots = FirmwareSlots::new(f);
             // a flash in RAM does not fail; nothing to start is "no image";
             // only images signed with the drive's key start (issue 18)
-            let _ = slots.boot_verified(&drive::runtime::FIRMWARE_PUBLIC_KEY, 0);
+            let _ = slots.boot_verified(&drive_ecat::runtime::FIRMWARE_PUBLIC_KEY, 0);
             slots
         });
         Self {
             esc,
-            drive: drive::runtime::Drive::with_boot_for(variant, flash, boot),
+            drive: drive_ecat::runtime::Drive::with_boot_for(variant, flash, boot),
             state_log: Vec::new(),
             motors: [Motor::default_servo(), Motor::default_servo()],
             conditions: [AxisConditions::READY; 2],
@@ -203,7 +207,7 @@ impl SimDrive {
         self.esc.set_clock(drift, offset);
     }
 
-    /// The device restarts (A09, [`drive::runtime::Drive::restart_due`]):
+    /// The device restarts (A09, [`drive_ecat::runtime::Drive::restart_due`]):
     /// a [`power_cycle`](Self::power_cycle) of the electronics; the motors,
     /// the axes' conditions, the state log and a bound IP stack stay (the
     /// machine did not move, the line did not change).
@@ -356,7 +360,7 @@ impl SimDrive {
     /// One control cycle starting at `t`: the PLL's command (when it runs)
     /// programs the next start and gives the cycle's steps (Rx, application,
     /// Tx in the A149 order, Rx/Tx in the aligned cycle only:
-    /// [`drive::runtime::Drive::sync_cycle`]); then one motor step.
+    /// [`drive_ecat::runtime::Drive::sync_cycle`]); then one motor step.
     fn run_cycle(&mut self, t: Nanos) {
         let mut command = None;
         match self.next_tick {
@@ -466,9 +470,9 @@ impl SimDrive {
     }
 
     /// The drive's four EtherCAT LEDs at `now` (E-132…E-134): the
-    /// firmware's patterns ([`drive::runtime::Drive::leds`]) with the port
+    /// firmware's patterns ([`drive_ecat::runtime::Drive::leds`]) with the port
     /// activity the simulated ESC saw.
-    pub fn leds(&self, now: Nanos) -> drive::runtime::Leds {
+    pub fn leds(&self, now: Nanos) -> drive_ecat::runtime::Leds {
         let activity = [self.esc.port_activity(0, now), self.esc.port_activity(1, now)];
         self.drive.leds(activity)
     }

@@ -13,7 +13,7 @@
 use crate::esc::{Esc, EscConfig};
 use crate::motor::{Motor, MotorOutputs};
 use crate::script::{EscLink, Progress, Script, CYCLE};
-use drive::axis::{AxisCommand, AxisIo};
+use drive_ecat::axis::{AxisCommand, AxisIo};
 use nanos::Nanos;
 
 /// What happens next in the world.
@@ -48,7 +48,7 @@ impl Default for World {
 /// description, its clock without drift (local time = simulation time).
 pub fn new_esc() -> Esc {
     let mut sii = [0u8; ecat::sii::EEPROM_BYTES];
-    let len = ecat::build_sii(&drive::DEVICE, &mut sii).unwrap_or(0);
+    let len = ecat::build_sii(&drive_ecat::DEVICE, &mut sii).unwrap_or(0);
     let mut esc = Esc::new(EscConfig::default(), sii.get(..len).unwrap_or(&[]));
     esc.set_clock(0, 0);
     esc

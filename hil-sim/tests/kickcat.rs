@@ -49,7 +49,7 @@ fn e080_e082_e078_e056_e021_e034_kickcat_line_of_two_drives() {
             return;
         }
     };
-    let od = drive::DriveObjects::default();
+    let od = drive_ecat::DriveObjects::default();
     let name = |index: u16| od.object(index).expect("declared").name.to_string();
     let dir = Path::new(env!("CARGO_TARGET_TMPDIR")).join("kickcat-line");
     std::fs::create_dir_all(&dir).expect("scratch dir");

@@ -53,7 +53,7 @@ impl Rig {
         m.params_mut().end_stops_inc = Some((-STOP, STOP));
         if limits {
             let objects = sim.drive_mut().objects_mut();
-            for index in [drive::params::I101, drive::params::I101 + 1] {
+            for index in [drive_ecat::params::I101, drive_ecat::params::I101 + 1] {
                 objects.set(index, 0, 1).expect("I101/I102");
             }
         }
@@ -88,8 +88,8 @@ impl Rig {
                 panic!(
                     "method {method}: fault {:#06x}, E82 {:?} E43 {:?} at {} inc",
                     r.o.zsw1,
-                    o.get(drive::params::E82, 0),
-                    o.get(drive::params::E43, 0),
+                    o.get(drive_ecat::params::E82, 0),
+                    o.get(drive_ecat::params::E43, 0),
                     r.encoder()
                 );
             }

@@ -14,7 +14,7 @@
 //! `scripts/fault-matrix`).
 //!
 //! The expected values come from the drive's own declarations: the SII image
-//! `ecat::build_sii(&drive::DEVICE, …)` and the objects a fresh dictionary
+//! `ecat::build_sii(&drive_ecat::DEVICE, …)` and the objects a fresh dictionary
 //! shows, written to files the scripts compare SOEM's readings with.
 //!
 //! Needs root (network namespaces, raw sockets) and pysoem: `PYSOEM_PYTHON`
@@ -43,7 +43,7 @@ const OP_SECONDS: u32 = 12;
 /// The SII image the simulated drives carry.
 fn sii_image() -> Vec<u8> {
     let mut sii = vec![0u8; ecat::sii::EEPROM_BYTES];
-    ecat::build_sii(&drive::DEVICE, &mut sii).expect("SII");
+    ecat::build_sii(&drive_ecat::DEVICE, &mut sii).expect("SII");
     sii
 }
 
@@ -54,7 +54,7 @@ fn sii_image() -> Vec<u8> {
 /// max_sub, bits and default. The object's data type is given for VAR and
 /// ARRAY objects (the type of their entries).
 fn od_listing() -> String {
-    let dict = drive::DriveObjects::default();
+    let dict = drive_ecat::DriveObjects::default();
     let mut out = String::new();
     let mut after = None;
     while let Some(o) = dict.next_object(after) {
@@ -182,8 +182,8 @@ fn e096_e095_e098_soem_set_ip_ping_and_udp_through_a_tap_bridge() {
     let _one = ONE_AT_A_TIME.lock().unwrap_or_else(|e| e.into_inner());
     let dir = scratch("soem-eoe");
     // A166 "IP address reference" as a fresh drive declares it (the UDP read's answer)
-    let a166 = drive::DriveObjects::default()
-        .object(drive::parameter_index(0, 166))
+    let a166 = drive_ecat::DriveObjects::default()
+        .object(drive_ecat::parameter_index(0, 166))
         .and_then(|o| o.entry(0))
         .expect("A166")
         .default;
@@ -222,16 +222,16 @@ fn foe_image_through_soem_firm_update() {
         .collect();
     // signed with the development key for slot A, where `serve`'s empty
     // drive downloads to (issue 18)
-    let seed = drive::boot::parse_key_hex(include_str!("../../keys/dev-ed25519.key")).unwrap();
+    let seed = drive_ecat::boot::parse_key_hex(include_str!("../../keys/dev-ed25519.key")).unwrap();
     let info = foe_image::ImageInfo {
         version: 2,
         load_address: hil_sim::sim::FirmwareSlots::new(hil_sim::sim::FirmwareFlash::new())
-            .load_address(drive::boot::Slot::A),
+            .load_address(drive_ecat::boot::Slot::A),
         security_counter: 1,
     };
     let good = foe_image::update_file(&body, info, &seed).unwrap();
     let mut flipped = good.clone();
-    flipped[drive::boot::IMAGE_HEADER_LEN + 20_000] ^= 0x04;
+    flipped[drive_ecat::boot::IMAGE_HEADER_LEN + 20_000] ^= 0x04;
     let truncated = good[..good.len() - 100].to_vec();
     let path = |name: &str| dir.join(name);
     for (name, data) in [("good", &good), ("flipped", &flipped), ("truncated", &truncated)] {
@@ -419,7 +419,9 @@ fn c039_soem_raises_g472_g475_by_sdo_and_cst_pt_move_the_axis() {
     let _one = ONE_AT_A_TIME.lock().unwrap_or_else(|e| e.into_inner());
     let dir = scratch("soem-torque");
     // I10, the reference of G472/G475's percentages, as a fresh drive has it
-    let i10 = drive::axis::AxisParams::default().cascade.max_velocity_inc_per_s;
+    let i10 = drive_ecat::axis::AxisParams::default()
+        .cascade
+        .max_velocity_inc_per_s;
     let line = Line::new("t", 1, 120, &dir);
     let status = line.run(
         &python,

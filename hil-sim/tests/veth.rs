@@ -103,7 +103,7 @@ fn e002_e005_serve_axes_1_is_the_single_axis_device() {
         assert_eq!(group.len(), 1);
         let sd = group.subdevice(&md, 0).expect("subdevice");
         assert_eq!(sd.identity().vendor_id, 0xB9);
-        assert_eq!(sd.identity().product_id, drive::PRODUCT_CODE_SINGLE);
+        assert_eq!(sd.identity().product_id, drive_ecat::PRODUCT_CODE_SINGLE);
         for index in [0x6841u16, 0x6840] {
             match sd.sdo_read::<u16>(index, 0).await {
                 Err(Error::Mailbox(MailboxError::Aborted { code, .. })) => {

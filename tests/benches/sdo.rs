@@ -10,7 +10,7 @@
 //! (its `CoeCommand` has no value for scs = 0).
 #![allow(clippy::unwrap_used, clippy::expect_used, clippy::indexing_slicing)]
 
-use drive::DriveObjects;
+use drive_ecat::DriveObjects;
 use drive_tests::CoeClient;
 use hil_sim::esc::{Esc, EscConfig};
 use hil_sim::sim::{Node, Simulation};
@@ -94,10 +94,10 @@ fn main() {
         .and_then(|s| s.parse().ok())
         .unwrap_or(200);
     let mut sii = [0u8; ecat::sii::EEPROM_BYTES];
-    let n = ecat::build_sii(&drive::DEVICE, &mut sii).expect("SII");
+    let n = ecat::build_sii(&drive_ecat::DEVICE, &mut sii).expect("SII");
     let node = BenchNode {
         esc: Esc::new(EscConfig::default(), &sii[..n]),
-        slave: ecat::Slave::new(&drive::DEVICE),
+        slave: ecat::Slave::new(&drive_ecat::DEVICE),
         dict: BenchDict(DriveObjects::new()),
     };
     let sim = RefCell::new(Simulation::with_nodes(vec![node]));

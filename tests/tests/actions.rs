@@ -8,7 +8,7 @@
     clippy::indexing_slicing
 )]
 
-use drive::actions::{state, A69, A75};
+use drive_ecat::actions::{state, A69, A75};
 use drive_tests::al::OP;
 use drive_tests::{al_status, init, line, with_master};
 
@@ -112,7 +112,7 @@ fn e141_test_winding_refused_outside_ready_to_switch_on() {
         let (a75, a69) = map_actions(&sd).await;
         let group = group.into_op(md).await.expect("Op");
         let sd = group.subdevice(md, 0).unwrap();
-        let e48 = sd.sdo_read::<u8>(drive::params::E48, 0).await.unwrap();
+        let e48 = sd.sdo_read::<u8>(drive_ecat::params::E48, 0).await.unwrap();
         assert_ne!(e48, 2, "the axis is not ready to switch on");
         sd.outputs_raw_mut()[a75] = 0b1101 << 1 | 1;
         cycles(&sim, &group, md, 5).await;
@@ -126,7 +126,7 @@ fn e141_test_winding_refused_outside_ready_to_switch_on() {
             out[a75] = 0;
         }
         cycles(&sim, &group, md, 20).await;
-        assert_eq!(sd.sdo_read::<u8>(drive::params::E48, 0).await.unwrap(), 2);
+        assert_eq!(sd.sdo_read::<u8>(drive_ecat::params::E48, 0).await.unwrap(), 2);
         sd.outputs_raw_mut()[a75] = 0b1101 << 1 | 1;
         cycles(&sim, &group, md, 5).await;
         let s = a69_of(sd.io_raw().inputs(), a69);

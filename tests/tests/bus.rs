@@ -62,8 +62,8 @@ fn e005_slave_count_addresses_identity_and_name_from_sii() {
             let id = sd.identity();
             assert_eq!(id.vendor_id, 0xB9, "E-005 vendor ID");
             assert_eq!(id.product_id, drive_tests::variant().product_code());
-            assert_eq!(id.revision, drive::SOFTWARE_BUILD);
-            assert_eq!(id.serial, drive::SERIAL);
+            assert_eq!(id.revision, drive_ecat::SOFTWARE_BUILD);
+            assert_eq!(id.serial, drive_ecat::SERIAL);
             assert_eq!(sd.name(), drive_tests::device().order_code);
         }
         // the configured addresses really are in the ESCs
@@ -196,8 +196,8 @@ fn e025_invalid_mailbox_sm_stays_init_with_0016() {
 
 #[test]
 fn e028_e045_sm2_sm3_length_checked_on_preop_to_safeop() {
-    let rx = drive::DEVICE.output_bytes() as u16;
-    let tx = drive::DEVICE.input_bytes() as u16;
+    let rx = drive_ecat::DEVICE.output_bytes() as u16;
+    let tx = drive_ecat::DEVICE.input_bytes() as u16;
     assert_eq!(
         (rx, tx),
         (23, 29),
@@ -236,7 +236,7 @@ fn e037_back_to_init_stops_mailbox() {
         let group = init(md, clock).await;
         let sd = group.subdevice(md, 0).unwrap();
         let dt: u32 = sd.sdo_read(0x1000, 0).await.expect("1000h in PRE-OP");
-        assert_eq!(dt, drive::DEVICE_TYPE, "E-004");
+        assert_eq!(dt, drive_ecat::DEVICE_TYPE, "E-004");
         request(&sd, INIT).await;
         assert_eq!(al_status(&sd).await, (INIT, 0));
         assert!(sd.sdo_read::<u32>(0x1000, 0).await.is_err(), "no mailbox in INIT");
@@ -291,7 +291,7 @@ fn e144_e146_refused_transition_lands_in_the_diagnosis_history() {
         let code = u32::from_le_bytes(msg[0..4].try_into().unwrap());
         assert_eq!(
             code,
-            drive::runtime::DIAG_AL_STATUS | 0x0011,
+            drive_ecat::runtime::DIAG_AL_STATUS | 0x0011,
             "diag code carries the AL status code"
         );
         assert_eq!(u16::from_le_bytes([msg[4], msg[5]]) & 0x0F, 2, "type: error");

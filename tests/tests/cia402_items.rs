@@ -12,7 +12,7 @@
     clippy::indexing_slicing
 )]
 
-use drive::parameter_index;
+use drive_ecat::parameter_index;
 use drive_tests::axis::*;
 use drive_tests::{init, line, sw, with_master, Cyclic};
 use drive_tests::{REV, REV_F};
@@ -288,8 +288,8 @@ fn c040_csp_csv_cst_need_no_mode_specific_controlword_bits() {
         // cst: the torque acts with and without the bits (speed limits
         // G472/G475 lifted by SDO to 10 % of I10, 5 rev/s)
         let sd = group.subdevice(md, 0).unwrap();
-        sd.sdo_write(drive::params::G472, 0, 100u16).await.unwrap();
-        sd.sdo_write(drive::params::G475, 0, 100u16).await.unwrap();
+        sd.sdo_write(drive_ecat::params::G472, 0, 100u16).await.unwrap();
+        sd.sdo_write(drive_ecat::params::G475, 0, 100u16).await.unwrap();
         m.set_mode(10);
         m.run(20).await;
         for cw in [CW_ENABLED, CW_ENABLED | CW_BIT4 | CW_BIT5 | CW_BIT6 | CW_HALT] {
@@ -433,7 +433,7 @@ fn c104_c107_limit_switches_from_i210_and_e80() {
         let code: u16 = sd.sdo_read(0x603F, 0).await.unwrap();
         assert_eq!(
             Some(code),
-            drive::faults::fault_code_for_event(53).map(|(c, _)| c),
+            drive_ecat::faults::fault_code_for_event(53).map(|(c, _)| c),
             "event 53"
         );
         m.set_target_velocity(0);
@@ -472,13 +472,13 @@ fn c107_e80_shows_illegal_direction_on_an_endless_axis() {
     let sim = line(1);
     with_drive(&sim, |d| {
         let l = &mut d.drive.axes_mut()[0].params_mut().limits;
-        l.permitted_direction = drive::axis::PermittedDirection::PositiveOnly;
+        l.permitted_direction = drive_ecat::axis::PermittedDirection::PositiveOnly;
     });
     with_master(&sim, async |md, clock| {
         // I00 = 1 "endless" by SDO in Pre-Op (issue 40)
         let group = init(md, clock).await;
         let sd = group.subdevice(md, 0).unwrap();
-        sd.sdo_write(drive::params::I00, 0, 1u8).await.unwrap();
+        sd.sdo_write(drive_ecat::params::I00, 0, 1u8).await.unwrap();
         let group = group.into_op(md).await.expect("OP");
         let sd = group.subdevice(md, 0).unwrap();
         let mut m = Cyclic::new(md, &group, &sim, 0);
@@ -827,11 +827,11 @@ fn c111_endless_axis_wraps_at_607b_through_the_master() {
         // I00 = 1 "endless" by SDO, in Pre-Op (issue 40)
         let group = init(md, clock).await;
         let sd = group.subdevice(md, 0).unwrap();
-        sd.sdo_write(drive::params::I00, 0, 1u8).await.unwrap();
+        sd.sdo_write(drive_ecat::params::I00, 0, 1u8).await.unwrap();
         let group = group.into_op(md).await.expect("OP");
         let sd = group.subdevice(md, 0).unwrap();
         // not in Op: 0800 0022h, unchanged
-        let refused = sd.sdo_write(drive::params::I00, 0, 0u8).await;
+        let refused = sd.sdo_write(drive_ecat::params::I00, 0, 0u8).await;
         assert!(
             matches!(
                 refused,
@@ -844,7 +844,7 @@ fn c111_endless_axis_wraps_at_607b_through_the_master() {
             ),
             "I00 in Op: {refused:?}"
         );
-        assert_eq!(sd.sdo_read::<u8>(drive::params::I00, 0).await.unwrap(), 1);
+        assert_eq!(sd.sdo_read::<u8>(drive_ecat::params::I00, 0).await.unwrap(), 1);
         sd.sdo_write(0x6092, 1, L as u32).await.unwrap();
         sd.sdo_write(0x607B, 2, L).await.unwrap();
         sd.sdo_write(0x607B, 1, -5i32).await.unwrap(); // no function

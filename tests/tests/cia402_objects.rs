@@ -11,7 +11,7 @@
     clippy::indexing_slicing
 )]
 
-use drive::{parameter_index, Template};
+use drive_ecat::{parameter_index, Template};
 use drive_tests::al::{ERR, OP, SAFEOP};
 use drive_tests::{al_status, init, line, map_layout, variant, with_master, CoeClient, Cyclic, REV};
 use ecat::SdoAbort;
@@ -570,7 +570,11 @@ fn c146_changes_are_volatile_until_a00_saves_them() {
         done.expect("A00[1] reaches 100 %")
     });
     println!("A00: progress {progress} %, result {result}");
-    assert_eq!(i64::from(result), drive::runtime::save_result::OK, "A00[2] ok");
+    assert_eq!(
+        i64::from(result),
+        drive_ecat::runtime::save_result::OK,
+        "A00[2] ok"
+    );
     power_cycle(&sim);
     assert_eq!(read(&sim), 5, "saved: kept over power-off");
 }
@@ -582,7 +586,7 @@ fn c147_changed_mapping_kept_over_a_restart_only_when_saved() {
         with_master(sim, async |md, clock| {
             let group = init(md, clock).await;
             let sd = group.subdevice(md, 0).unwrap();
-            map_layout(&sd, drive::PdoLayout::Ip).await;
+            map_layout(&sd, drive_ecat::PdoLayout::Ip).await;
             if save {
                 sd.sdo_write(A00, 1, 1u8).await.unwrap();
                 for _ in 0..100 {

@@ -10,8 +10,8 @@
     clippy::indexing_slicing
 )]
 
-use drive::objects::{enumeration, Object, Value, OBJECTS};
-use drive::{revision, DriveObjects, Template};
+use drive_ecat::objects::{enumeration, Object, Value, OBJECTS};
+use drive_ecat::{revision, DriveObjects, Template};
 use drive_tests::objects as device_objects;
 use drive_tests::{init, line, variant, with_master, CoeClient, UploadKind, MAILBOX_LEN};
 use ecat::{CommState, DataType, Dictionary, SdoAbort};
@@ -73,7 +73,7 @@ fn objects(sim: &RefCell<Simulation>) -> DriveObjects {
 /// What a bus write may change and the runtime does not: every integer entry
 /// of the RAM image outside the live objects, the persistent image (strings
 /// included), the template and the pending requests.
-fn settled(sim: &RefCell<Simulation>) -> (Vec<i64>, Vec<u8>, Template, drive::Requests) {
+fn settled(sim: &RefCell<Simulation>) -> (Vec<i64>, Vec<u8>, Template, drive_ecat::Requests) {
     let o = objects(sim);
     let values = device_objects()
         .filter(|obj| obj.value == Value::Ram)
@@ -81,7 +81,7 @@ fn settled(sim: &RefCell<Simulation>) -> (Vec<i64>, Vec<u8>, Template, drive::Re
         .filter(|(_, e)| e.data_type.is_integer())
         .map(|(i, e)| o.get(i, e.sub).unwrap())
         .collect();
-    let mut image = vec![0u8; drive::PERSISTENT_IMAGE_BYTES];
+    let mut image = vec![0u8; drive_ecat::PERSISTENT_IMAGE_BYTES];
     o.persistent_image(&mut image).unwrap();
     (values, image, o.template(), o.requests())
 }
@@ -385,7 +385,7 @@ fn local_value(sim: &RefCell<Simulation>, index: u16, sub: u8, readable: bool) -
         local_read(sim, index, sub)
     } else {
         let o = objects(sim);
-        let t = drive::objects::find(index)
+        let t = drive_ecat::objects::find(index)
             .unwrap()
             .1
             .info
@@ -533,7 +533,7 @@ fn e080_e081_e082_e084_sdo_info_lists_and_descriptions_match_the_dictionary() {
         let d = c.entry_desc(&sd, 0x6041, 0, 0x07, 2).await.unwrap();
         assert_eq!((d.data_type, d.bit_len, d.access), (6, 16, 0x0087), "ro, Tx");
         // A10 access level: an array, element e at subindex e + 1 (E-013)
-        let a10 = drive::parameter_index(0, 10);
+        let a10 = drive_ecat::parameter_index(0, 10);
         let d = c.object_desc(&sd, a10).await.unwrap();
         assert_eq!(
             (d.data_type, d.max_sub, d.code, d.name.as_str()),
@@ -570,7 +570,7 @@ fn e080_e081_e082_e084_sdo_info_lists_and_descriptions_match_the_dictionary() {
 #[test]
 fn e083_a268_selects_the_listed_objects() {
     let sim = line(1);
-    let a268 = drive::parameter_index(0, 268);
+    let a268 = drive_ecat::parameter_index(0, 268);
     with_master(&sim, async |md, clock| {
         let group = init(md, clock).await;
         let sd = group.subdevice(md, 0).unwrap();
@@ -610,7 +610,7 @@ fn e083_a268_selects_the_listed_objects() {
         let chosen = c.od_list(&sd, 1).await;
         let in_a_or_i = |i: &u16| manufacturer(i) && matches!(((i & 0x7FFF) - 0x2000) >> 9, 0 | 8);
         assert_eq!(chosen, all.iter().copied().filter(in_a_or_i).collect::<Vec<_>>());
-        assert!(chosen.contains(&a268) && chosen.contains(&drive::parameter_index(8, 22)));
+        assert!(chosen.contains(&a268) && chosen.contains(&drive_ecat::parameter_index(8, 22)));
         // all, groups as chosen: the standard area again beside A and I
         c.download(&sd, a268, 1, &[2]).await.unwrap();
         let mixed = c.od_list(&sd, 1).await;
@@ -637,7 +637,7 @@ fn e083_a268_selects_the_listed_objects() {
 #[test]
 fn e012_e013_e079_manufacturer_array_in_both_templates() {
     let sim = line(1);
-    let a10 = drive::parameter_index(0, 10);
+    let a10 = drive_ecat::parameter_index(0, 10);
     with_master(&sim, async |md, clock| {
         let group = init(md, clock).await;
         let sd = group.subdevice(md, 0).unwrap();
@@ -682,7 +682,7 @@ fn e012_e013_e079_manufacturer_array_in_both_templates() {
 }
 
 /// E72 "User configuration identification": a writable VISIBLE_STRING(16).
-const E72: u16 = drive::parameter_index(4, 72);
+const E72: u16 = drive_ecat::parameter_index(4, 72);
 
 #[test]
 fn e065_e067_e068_segmented_download_byte_for_byte_and_toggle_error() {
@@ -786,7 +786,12 @@ fn e066_e068_e078_segmented_complete_upload_of_10f3h_and_toggle_error() {
         let mut expected = vec![25, 0];
         for sub in 1..=25u8 {
             let mut v = local_read(&sim, 0x10F3, sub);
-            let e = drive::objects::find(0x10F3).unwrap().1.info.entry(sub).unwrap();
+            let e = drive_ecat::objects::find(0x10F3)
+                .unwrap()
+                .1
+                .info
+                .entry(sub)
+                .unwrap();
             v.resize(e.data_type.bytes(), 0);
             expected.extend_from_slice(&v);
         }
@@ -818,10 +823,10 @@ fn e078_complete_access_upload_1018h_1600h_and_download_1c12h_in_cia301_order() 
         // 1018h from sub 0 and from sub 1
         let mut identity = vec![4, 0];
         for v in [
-            drive::VENDOR_ID,
+            drive_ecat::VENDOR_ID,
             variant().product_code(),
             revision(Template::SdoInfo),
-            drive::SERIAL,
+            drive_ecat::SERIAL,
         ] {
             identity.extend_from_slice(&v.to_le_bytes());
         }
@@ -963,9 +968,9 @@ fn e078_ethercrab_complete_access_from_subindex_1_to_assignment_and_mapping() {
 #[test]
 fn e016_e017_e084_access_level_a10_2_decides_what_coe_sees() {
     let sim = line(1);
-    let a10 = drive::parameter_index(0, 10);
-    let a293 = drive::parameter_index(0, 293); // PLL gain, level 3
-    let a150 = drive::parameter_index(0, 150); // cycle time, level 1
+    let a10 = drive_ecat::parameter_index(0, 10);
+    let a293 = drive_ecat::parameter_index(0, 293); // PLL gain, level 3
+    let a150 = drive_ecat::parameter_index(0, 150); // cycle time, level 1
     with_master(&sim, async |md, clock| {
         let group = init(md, clock).await;
         let sd = group.subdevice(md, 0).unwrap();

@@ -11,8 +11,8 @@
     clippy::indexing_slicing
 )]
 
-use drive::runtime::dcsync;
-use drive::runtime::dcsync::{PllStatus, SyncFault};
+use drive_ecat::runtime::dcsync;
+use drive_ecat::runtime::dcsync::{PllStatus, SyncFault};
 use drive_tests::al::{OP, SAFEOP};
 use ethercrab::subdevice_group::DcConfiguration;
 use ethercrab::{DcSync, MainDevice, MainDeviceConfig, SubDeviceGroup};
@@ -31,7 +31,7 @@ const SYNC0_NS: u64 = 1_000_000;
 const A292_US: i32 = -100;
 /// Frames arrive 100 µs before SYNC0 (ethercrab sends at SYNC0 + shift).
 const FRAME_LEAD_NS: u64 = 100_000;
-const A261: u16 = drive::parameter_index(0, 261);
+const A261: u16 = drive_ecat::parameter_index(0, 261);
 
 /// SYNC0 every `sync0_ns`, starting 20 ms out, frames arriving
 /// [`FRAME_LEAD_NS`] before each SYNC0.
@@ -42,10 +42,10 @@ fn dc_config(sync0_ns: u64) -> DcConfiguration {
         sync0_shift: Duration::from_nanos(sync0_ns - FRAME_LEAD_NS),
     }
 }
-const A292: u16 = drive::parameter_index(0, 292);
-const A264: u16 = drive::parameter_index(0, 264);
-const A296: u16 = drive::parameter_index(0, 296);
-const A298: u16 = drive::parameter_index(0, 298);
+const A292: u16 = drive_ecat::parameter_index(0, 292);
+const A264: u16 = drive_ecat::parameter_index(0, 264);
+const A296: u16 = drive_ecat::parameter_index(0, 296);
+const A298: u16 = drive_ecat::parameter_index(0, 298);
 
 fn line() -> RefCell<Simulation> {
     let mut sim = Simulation::new(2);
@@ -365,7 +365,7 @@ fn e117_e118_e119_a_late_frame_counts_in_a261_and_1c32h() {
 #[test]
 fn e116_a_sync0_cycle_the_pll_cannot_run_is_refused() {
     // the PLL's configuration check (the P→S check is the slave stack's)
-    let bad = dcsync::Config::new(1_100_000, 1_000_000, drive::runtime::TIMER_HZ);
+    let bad = dcsync::Config::new(1_100_000, 1_000_000, drive_ecat::runtime::TIMER_HZ);
     assert!(dcsync::Pll::new(bad).is_err());
     let sim = line();
     let a261_0: u8 = with_master(&sim, async |md, clock| {
@@ -474,7 +474,7 @@ async fn dc_cycles<'a>(
 /// 7 and an unsolicited state change; acknowledge + SYNC0 back: Op again.
 #[test]
 fn e046_e131_e129_e038_dc_op_waits_for_pll_lock_and_sync0_loss_drops_to_safeop() {
-    use drive::runtime::dcsync::al;
+    use drive_ecat::runtime::dcsync::al;
     use drive_tests::{al_status, request, CoeClient};
     use esc::AlStatusCode;
     let sim = line();
@@ -552,7 +552,7 @@ fn e046_e131_e129_e038_dc_op_waits_for_pll_lock_and_sync0_loss_drops_to_safeop()
             assert_eq!(n, 1, "one EMCY 7500h: {:02x?}", c.emergencies);
             // E-038: A257[0] Er3 "unsolicited state change", ERR single flash
             let a257 = c
-                .upload(&sd, drive::parameter_index(0, 257), 1)
+                .upload(&sd, drive_ecat::parameter_index(0, 257), 1)
                 .await
                 .expect("A257[0]");
             assert!(a257.starts_with(b"Er3 "), "A257[0] {a257:02x?}");
@@ -571,7 +571,11 @@ fn e046_e131_e129_e038_dc_op_waits_for_pll_lock_and_sync0_loss_drops_to_safeop()
                 );
                 assert_eq!(axis.error_code(), 0x7500);
             }
-            assert_eq!(d.objects().get(drive::parameter_index(4, 43), 0), Ok(7), "E43");
+            assert_eq!(
+                d.objects().get(drive_ecat::parameter_index(4, 43), 0),
+                Ok(7),
+                "E43"
+            );
             let (_, last) = s.drives()[i].state_log.last().copied().expect("state change");
             println!("drive {i}: {last}");
             assert!(last.unsolicited, "E-038: {last}");
@@ -648,9 +652,9 @@ fn e046_e131_e129_e038_dc_op_waits_for_pll_lock_and_sync0_loss_drops_to_safeop()
     drive_tests::fault_row!(row, seen);
 }
 
-const A149: u16 = drive::parameter_index(0, 149);
-const A150: u16 = drive::parameter_index(0, 150);
-const A287: u16 = drive::parameter_index(0, 287);
+const A149: u16 = drive_ecat::parameter_index(0, 149);
+const A150: u16 = drive_ecat::parameter_index(0, 150);
+const A287: u16 = drive_ecat::parameter_index(0, 287);
 
 /// Brings the line to OP with DC (SYNC0 every `sync0_ns`, frames
 /// [`FRAME_LEAD_NS`] before SYNC0, A292 = [`A292_US`]) after `pre_op` ran in
@@ -1010,12 +1014,12 @@ fn e115_a298_bits_through_the_master() {
     let (bit4, bit5): (u16, u16) = dc_op(&sim, SYNC0_NS, pre_op, 200, async |md, group| {
         let sd = group.subdevice(md, 0).expect("drive");
         let a291: u32 = sd
-            .sdo_read(drive::parameter_index(0, 291), 0)
+            .sdo_read(drive_ecat::parameter_index(0, 291), 0)
             .await
             .expect("A291");
         assert_eq!(a291, 500, "60C2h copied into A291");
         let bit4 = sd.sdo_read(A298, 0).await.expect("A298");
-        sd.sdo_write(drive::parameter_index(0, 290), 0, 0u8)
+        sd.sdo_write(drive_ecat::parameter_index(0, 290), 0, 0u8)
             .await
             .expect("A290");
         dc_cycles(md, group, &sim, 5, |_, _, _| {}).await;
@@ -1062,7 +1066,7 @@ async fn a287_measurement<'a>(
 }
 
 /// E-121, E-122, E-123 (spec §11.8) through the master, with the drive's
-/// measured Rx/Tx offsets ([`drive::runtime::Drive::set_step_offsets`]) and
+/// measured Rx/Tx offsets ([`drive_ecat::runtime::Drive::set_step_offsets`]) and
 /// the frame jitter injected: Rx…Tx over 995 µs of the 1 ms cycle leaves no
 /// room for the frame (5: application runtime); Rx/Tx moving by 30 µs from
 /// cycle to cycle (4: drive jitter); ±20 µs frame jitter (3: master jitter);

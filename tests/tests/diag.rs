@@ -15,11 +15,11 @@ use esc::AlStatusCode;
 use hil_sim::sim::Simulation;
 use std::cell::RefCell;
 
-const A254: u16 = drive::parameter_index(0, 254);
-const A255: u16 = drive::parameter_index(0, 255);
-const A256: u16 = drive::parameter_index(0, 256);
-const A257: u16 = drive::parameter_index(0, 257);
-const A258: u16 = drive::parameter_index(0, 258);
+const A254: u16 = drive_ecat::parameter_index(0, 254);
+const A255: u16 = drive_ecat::parameter_index(0, 255);
+const A256: u16 = drive_ecat::parameter_index(0, 256);
+const A257: u16 = drive_ecat::parameter_index(0, 257);
+const A258: u16 = drive_ecat::parameter_index(0, 258);
 
 fn advance(sim: &RefCell<Simulation>, ns: u64) {
     let mut s = sim.borrow_mut();
@@ -48,7 +48,7 @@ where
     CoeClient::new().upload(sd, A255, 0).await.expect("A255")[0]
 }
 
-fn leds(sim: &RefCell<Simulation>, i: usize) -> drive::runtime::Leds {
+fn leds(sim: &RefCell<Simulation>, i: usize) -> drive_ecat::runtime::Leds {
     let s = sim.borrow();
     s.drives()[i].leds(nanos::Nanos::from_ns(s.now().as_ns()))
 }
@@ -207,8 +207,8 @@ fn e134_e135_e136_e137_e138_ports_addresses_and_counters() {
 /// AL codes) and Er0 again after the acknowledge.
 #[test]
 fn e025_e033_e136_a257_0_error_codes_of_refused_transitions() {
-    let rx = drive::DEVICE.output_bytes() as u16;
-    let tx = drive::DEVICE.input_bytes() as u16;
+    let rx = drive_ecat::DEVICE.output_bytes() as u16;
+    let tx = drive_ecat::DEVICE.input_bytes() as u16;
     let sim = line(1);
     with_master(&sim, async |md, clock| {
         let group = init(md, clock).await;
@@ -266,7 +266,7 @@ fn e025_e033_e136_a257_0_error_codes_of_refused_transitions() {
 #[test]
 fn e139_parameter_versions_follow_the_s_layout() {
     assert_eq!(
-        drive::runtime::PARAMETER_VERSIONS,
+        drive_ecat::runtime::PARAMETER_VERSIONS,
         [
             (254, 0),
             (255, 3),
@@ -286,7 +286,7 @@ fn e139_parameter_versions_follow_the_s_layout() {
         let mut count = Vec::new();
         for line in [257, 259, 261, 287] {
             count.push(
-                sd.sdo_read::<u8>(drive::parameter_index(0, line), 0)
+                sd.sdo_read::<u8>(drive_ecat::parameter_index(0, line), 0)
                     .await
                     .unwrap(),
             );
@@ -307,7 +307,7 @@ fn e139_parameter_versions_follow_the_s_layout() {
 #[test]
 fn e026_station_alias_from_the_eeprom_in_a254() {
     let mut img = [0u8; ecat::sii::EEPROM_BYTES];
-    let len = ecat::build_sii(&drive::DEVICE, &mut img).unwrap();
+    let len = ecat::build_sii(&drive_ecat::DEVICE, &mut img).unwrap();
     img[8..10].copy_from_slice(&0x0777u16.to_le_bytes());
     img[14] = esc::sii::config_checksum(&img[..14]);
     let sim = line(1);
@@ -340,7 +340,7 @@ fn e024_init_loads_the_saved_values_no_mailbox_no_process_data() {
     {
         let s = sim.borrow();
         let d = &s.drives()[0].drive;
-        assert_eq!(d.startup(), drive::runtime::Startup::Loaded);
+        assert_eq!(d.startup(), drive_ecat::runtime::Startup::Loaded);
         assert_eq!(d.objects().get(A258, 0), Ok(77), "loaded in Init");
         assert_eq!(d.slave().state(), esc::AlState::Init);
     }

@@ -15,10 +15,10 @@ use esc::AlStatusCode;
 use hil_sim::sim::Simulation;
 use std::cell::RefCell;
 
-const A258: u16 = drive::parameter_index(0, 258);
-const E43: u16 = drive::parameter_index(4, 43);
-const E59: u16 = drive::parameter_index(4, 59);
-const E82: u16 = drive::parameter_index(4, 82);
+const A258: u16 = drive_ecat::parameter_index(0, 258);
+const E43: u16 = drive_ecat::parameter_index(4, 43);
+const E59: u16 = drive_ecat::parameter_index(4, 59);
+const E82: u16 = drive_ecat::parameter_index(4, 82);
 
 /// One sample per millisecond while the master is silent.
 #[derive(Debug, Clone, Copy)]
@@ -214,7 +214,7 @@ fn e130_projected_fieldbus_mismatch_raises_event52_cause_15() {
     let sim = line(1);
     sim.borrow_mut().drives_mut()[0]
         .drive
-        .set_projected_fieldbus(drive::runtime::FIELDBUS_ID + 7);
+        .set_projected_fieldbus(drive_ecat::runtime::FIELDBUS_ID + 7);
     with_master(&sim, async |md, clock| {
         let group = init(md, clock).await;
         let sd = group.subdevice(md, 0).unwrap();
@@ -228,7 +228,7 @@ fn e130_projected_fieldbus_mismatch_raises_event52_cause_15() {
         let e59: u16 = sd.sdo_read(E59, 3).await.unwrap();
         assert_eq!(
             e59,
-            drive::runtime::FIELDBUS_ID + 7,
+            drive_ecat::runtime::FIELDBUS_ID + 7,
             "E59[2] shows the projection"
         );
         assert_eq!(emcys.len(), 1, "{emcys:02x?}");
@@ -255,7 +255,7 @@ fn e130_projected_fieldbus_mismatch_raises_event52_cause_15() {
         // the projection fixed: a fault reset works
         sim.borrow_mut().drives_mut()[0]
             .drive
-            .set_projected_fieldbus(drive::runtime::FIELDBUS_ID);
+            .set_projected_fieldbus(drive_ecat::runtime::FIELDBUS_ID);
         let mut c = CoeClient::new();
         c.download(&sd, 0x6040, 0, &0x80u16.to_le_bytes()).await.unwrap();
         let mut s = sim.borrow_mut();

@@ -10,7 +10,7 @@
     clippy::indexing_slicing
 )]
 
-use drive::runtime::Drive;
+use drive_ecat::runtime::Drive;
 use drive_tests::{al_status, init, line, with_master, CoeClient};
 use ethercrab::SubDeviceRef;
 use hil_sim::eoe::{get_ip_request, set_ip_request, DriveNet, HostNet};
@@ -103,7 +103,9 @@ fn e096_e095_ping_and_parameters_over_udp() {
         assert_eq!(ask(&mut host, &sd, clock, "W A269 1").await, "ERR 06010002");
         let mut coe = CoeClient::new();
         coe.hand_over(&sd).await;
-        coe.download(&sd, drive::params::A269, 0, &[1]).await.unwrap();
+        coe.download(&sd, drive_ecat::params::A269, 0, &[1])
+            .await
+            .unwrap();
         coe.hand_over(&sd).await;
         assert_eq!(ask(&mut host, &sd, clock, "W A150 2000").await, "OK");
         assert_eq!(ask(&mut host, &sd, clock, "R A150").await, "OK 2000");
@@ -390,7 +392,7 @@ struct NetNode {
 impl NetNode {
     fn new() -> Self {
         let mut sii = [0u8; ecat::sii::EEPROM_BYTES];
-        let n = ecat::build_sii(&drive::DEVICE, &mut sii).unwrap();
+        let n = ecat::build_sii(&drive_ecat::DEVICE, &mut sii).unwrap();
         let mut drive = Drive::new(SimFlash::new());
         let net = DriveNet::new(&mut drive, DRIVE_MAC, 0x5EED, nanos::Nanos::ZERO);
         Self {
@@ -522,7 +524,7 @@ fn e105_e106_e102_sntp_over_eoe_in_simulated_time() {
         assert_eq!(set_ip(&mut host, &sd, clock).await, vec![0x03, 0x01, 0x00, 0x00]);
         // A199: on, servers 10.0.0.1 and 10.0.0.2 (written by the master;
         // the UDP service only reads while A269 = 0)
-        let a199 = drive::parameter_index(0, 199);
+        let a199 = drive_ecat::parameter_index(0, 199);
         let mut coe = CoeClient::new();
         coe.hand_over(&sd).await;
         coe.download(&sd, a199, 1, &[1]).await.unwrap();

@@ -77,7 +77,7 @@ where
         1 => "warning",
         _ => "error",
     };
-    if code & 0xFFFF == drive::runtime::DIAG_EMCY {
+    if code & 0xFFFF == drive_ecat::runtime::DIAG_EMCY {
         // parameters: flags u16 + u32 each, after the 16 fixed bytes
         let param = |k: usize| u32::from_le_bytes(msg[18 + 6 * k..22 + 6 * k].try_into().unwrap());
         let (axis, ev) = (param(0), param(1));
@@ -88,7 +88,7 @@ where
             ev >> 8,
             ev & 0xFF
         )
-    } else if code & 0xFFFF_0000 == drive::runtime::DIAG_AL_STATUS {
+    } else if code & 0xFFFF_0000 == drive_ecat::runtime::DIAG_AL_STATUS {
         format!("history: {kind} AL {:04X}h", code & 0xFFFF)
     } else {
         format!("history: {kind} {code:08X}h")

@@ -9,7 +9,7 @@
     clippy::indexing_slicing
 )]
 
-use drive::parameter_index;
+use drive_ecat::parameter_index;
 use drive_tests::{init, line, with_master, CoeClient, Cyclic, REV};
 use ecat::SdoAbort;
 use hil_sim::sim::Simulation;

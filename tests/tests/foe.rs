@@ -12,8 +12,8 @@
     clippy::indexing_slicing
 )]
 
-use drive::boot::{ImageHeader, IMAGE_HEADER_LEN};
-use drive::boot::{Slot, SlotState};
+use drive_ecat::boot::{ImageHeader, IMAGE_HEADER_LEN};
+use drive_ecat::boot::{Slot, SlotState};
 use drive_tests::al::{ACK, BOOT, ERR, INIT, PREOP};
 use drive_tests::{
     al_status, dev_seed, firmware_file, in_boot, init, request, signed_file, to_boot, with_master_on,
@@ -83,7 +83,7 @@ fn e022_e023_bootstrap_only_through_init_when_foe_is_declared() {
 fn foe_256k_image_switches_on_next_power_cycle_and_confirms() {
     let sim = line();
     assert_eq!(node(&sim).boot.map(|d| d.slot), Some(Slot::A));
-    let file = firmware_file(2, IMAGE_FILE_LEN - drive::boot::IMAGE_HEADER_LEN);
+    let file = firmware_file(2, IMAGE_FILE_LEN - drive_ecat::boot::IMAGE_HEADER_LEN);
     assert_eq!(file.len(), IMAGE_FILE_LEN);
     let packets = in_boot(&sim, async |_, sd| {
         FoeClient::new()
@@ -325,7 +325,7 @@ fn foe_signature_refuses_changed_images_other_keys_wrong_slots_and_downgrades() 
     refused(&sim, "body byte", &flipped, FoeError::CHECKSUM);
     // the same body with its CRC mended: the signature fails (800Ch)
     let mut h = ImageHeader::parse(&flipped).unwrap();
-    h.crc = drive::boot::crc32(&flipped[IMAGE_HEADER_LEN..]);
+    h.crc = drive_ecat::boot::crc32(&flipped[IMAGE_HEADER_LEN..]);
     flipped[..IMAGE_HEADER_LEN].copy_from_slice(&h.to_bytes());
     refused(&sim, "body byte, CRC mended", &flipped, FoeError::CHECKSUM);
     // one flipped header byte (the version): signature (800Ch)
@@ -400,7 +400,7 @@ fn foe_signature_counter_floor_follows_the_running_image() {
 /// restart A09 asks for starts it on trial.
 #[test]
 fn e019_e140_a09_restart_starts_a_pending_firmware_image() {
-    const A09: u16 = drive::parameter_index(0, 9);
+    const A09: u16 = drive_ecat::parameter_index(0, 9);
     let sim = line();
     let file = firmware_file(2, 5000);
     in_boot(&sim, async |_, sd| {
@@ -418,7 +418,7 @@ fn e019_e140_a09_restart_starts_a_pending_firmware_image() {
     });
     let t = sim.borrow().now().as_ns();
     sim.borrow_mut().advance_to(nanos::Nanos::from_ns(
-        t + drive::runtime::RESTART_DELAY.as_ns() + 1_000_000,
+        t + drive_ecat::runtime::RESTART_DELAY.as_ns() + 1_000_000,
     ));
     let d = node(&sim).boot.expect("a slot starts");
     assert_eq!(

@@ -45,7 +45,7 @@ fn e003_unsupported_protocol_gets_mailbox_error_0002() {
         assert_eq!(resp[2], 0x43, "expedited upload response, 4 bytes");
         assert_eq!(
             u32::from_le_bytes(resp[6..10].try_into().unwrap()),
-            drive::DEVICE_TYPE
+            drive_ecat::DEVICE_TYPE
         );
     });
 }

@@ -64,7 +64,7 @@ fn c002_c004_c005_c018_enable_sequence_through_pdo() {
         }
         // E48 agrees (C-019)
         let sd = group.subdevice(md, 0).unwrap();
-        let e48_index = drive::parameter_index(4, 48);
+        let e48_index = drive_ecat::parameter_index(4, 48);
         let e48: u8 = sd.sdo_read(e48_index, 0).await.expect("E48");
         assert_eq!(e48, 4, "E48 = operation enabled");
 
@@ -472,7 +472,7 @@ fn c055_c056_pv_reaches_velocity_and_reports_zero_speed() {
 }
 
 /// A150 (application cycle, U16 µs).
-const A150: u16 = drive::parameter_index(0, 150);
+const A150: u16 = drive_ecat::parameter_index(0, 150);
 
 /// E-125 / C-144 in free run (no SYNC0): the control cycle runs at A150,
 /// whatever its value, so a ramp takes the time its acceleration says and

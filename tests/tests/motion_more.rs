@@ -16,7 +16,7 @@ use hil_sim::motor::{PositionInput, Switches};
 
 /// 603Fh of event 53 (limit switch).
 fn event_53() -> Option<u16> {
-    drive::faults::fault_code_for_event(53).map(|(c, _)| c)
+    drive_ecat::faults::fault_code_for_event(53).map(|(c, _)| c)
 }
 
 // ---------------------------------------------------------------------------
@@ -29,7 +29,7 @@ fn c031_c032_c033_c034_ip_follows_60c1_only_while_bit_4() {
     with_master(&sim, async |md, clock| {
         let group = init(md, clock).await;
         let sd = group.subdevice(md, 0).unwrap();
-        map_layout(&sd, drive::PdoLayout::Ip).await;
+        map_layout(&sd, drive_ecat::PdoLayout::Ip).await;
         // profile ramps of 0.1 rev/s² that ip must not apply (C-033)
         sd.sdo_write(0x6083, 0, (REV / 10) as u32).await.unwrap();
         sd.sdo_write(0x6084, 0, (REV / 10) as u32).await.unwrap();
@@ -112,7 +112,7 @@ fn c051_c052_c053_c054_vl_bits_4_5_6_ramp_and_limit() {
     with_master(&sim, async |md, clock| {
         let group = init(md, clock).await;
         let sd = group.subdevice(md, 0).unwrap();
-        map_layout(&sd, drive::PdoLayout::Vl).await;
+        map_layout(&sd, drive_ecat::PdoLayout::Vl).await;
         // 6046h:02 max 600 rpm; 6048h 3000 rpm per 1 s (the default)
         sd.sdo_write(0x6046, 2, 600u32).await.unwrap();
         let group = group.into_op(md).await.expect("OP with the vl map");
@@ -321,13 +321,13 @@ fn c088_c089_c090_jog_bits_4_and_5() {
         group
             .subdevice(md, 0)
             .unwrap()
-            .sdo_write(drive::params::I12, 0, 3 * REV as u32)
+            .sdo_write(drive_ecat::params::I12, 0, 3 * REV as u32)
             .await
             .unwrap();
         group
             .subdevice(md, 0)
             .unwrap()
-            .sdo_write(drive::params::I13, 0, 60 * REV as u32)
+            .sdo_write(drive_ecat::params::I13, 0, 60 * REV as u32)
             .await
             .unwrap();
         m.set_controlword(CW_ENABLED | CW_BIT4);
@@ -388,7 +388,7 @@ fn c091_c092_jog_at_the_software_limits() {
         );
 
         // I26 = 0: past −0.5 rev a quick stop, no fault; the negative direction locked (C-091)
-        sd.sdo_write(drive::params::I26, 0, 0u8).await.unwrap();
+        sd.sdo_write(drive_ecat::params::I26, 0, 0u8).await.unwrap();
         m.set_controlword(CW_ENABLED);
         m.run(200).await;
         m.set_controlword(CW_ENABLED | CW_BIT5);

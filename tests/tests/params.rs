@@ -9,7 +9,7 @@
     clippy::indexing_slicing
 )]
 
-use drive::params::{C31, C32, G472, G475, I20};
+use drive_ecat::params::{C31, C32, G472, G475, I20};
 use drive_tests::axis::{with_drive, CW_ENABLED};
 use drive_tests::{init, line, with_master, Cyclic};
 use ethercrab::error::CoeAbortCode::ValueTooLarge;
@@ -145,7 +145,7 @@ fn e018_issue40_settings_saved_with_the_parameter_set_and_restored() {
         sd.sdo_write(C32, 0, 12_000u32).await.unwrap();
         sd.sdo_write(I20, 0, 800u16).await.unwrap();
         if axis_b {
-            sd.sdo_write(G472 + drive::AXIS_B_MANUFACTURER, 0, 330u16)
+            sd.sdo_write(G472 + drive_ecat::AXIS_B_MANUFACTURER, 0, 330u16)
                 .await
                 .unwrap();
         }
@@ -167,7 +167,10 @@ fn e018_issue40_settings_saved_with_the_parameter_set_and_restored() {
         assert_eq!(sd.sdo_read::<u32>(C32, 0).await.unwrap(), 12_000);
         assert_eq!(sd.sdo_read::<u16>(I20, 0).await.unwrap(), 800);
         if axis_b {
-            let b: u16 = sd.sdo_read(G472 + drive::AXIS_B_MANUFACTURER, 0).await.unwrap();
+            let b: u16 = sd
+                .sdo_read(G472 + drive_ecat::AXIS_B_MANUFACTURER, 0)
+                .await
+                .unwrap();
             assert_eq!(b, 330);
         }
     });

@@ -98,7 +98,7 @@ fn e048_e049_e054_remap_in_preop_and_run_op_with_the_new_layout() {
 #[test]
 fn e061_a250_new_messages_flag_in_the_txpdo() {
     let sim = line(1);
-    let a250 = drive::parameter_index(0, 250);
+    let a250 = drive_ecat::parameter_index(0, 250);
     with_master(&sim, async |md, clock| {
         let group = init(md, clock).await;
         let sd = group.subdevice(md, 0).unwrap();
@@ -152,7 +152,7 @@ fn e058_e075_mapping_refusals_0604_0041_0604_0042_0604_0043() {
             STATUSWORD,
             m(0x1000, 0, 32),
             m(0x5555, 0, 16),
-            m(drive::parameter_index(0, 293), 0, 16),
+            m(drive_ecat::parameter_index(0, 293), 0, 16),
         ] {
             assert_eq!(
                 c.download(&sd, 0x1600, 1, &put(bad)).await,
@@ -336,7 +336,10 @@ fn e048_e049_slave_process_image_follows_a_remapped_layout() {
 /// startup list in Pre-Op, then OP with the new process image.
 #[test]
 fn e048_e049_ip_and_vl_maps_from_a_startup_list_reach_op() {
-    for (layout, bytes) in [(drive::PdoLayout::Ip, 7usize), (drive::PdoLayout::Vl, 5)] {
+    for (layout, bytes) in [
+        (drive_ecat::PdoLayout::Ip, 7usize),
+        (drive_ecat::PdoLayout::Vl, 5),
+    ] {
         let sim = drive_tests::line(1);
         drive_tests::with_master(&sim, async |md, clock| {
             let group = drive_tests::init(md, clock).await;
@@ -360,7 +363,7 @@ fn e048_e049_ip_and_vl_maps_from_a_startup_list_reach_op() {
             }
         });
         // the drive side computes the same layout from its own declaration
-        let mut objects = drive::DriveObjects::new();
+        let mut objects = drive_ecat::DriveObjects::new();
         objects.apply_map(layout).expect("apply_map");
         use od::Dictionary as _;
         assert_eq!(objects.process_data_bytes(), Some((bytes, bytes)));

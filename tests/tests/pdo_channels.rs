@@ -200,9 +200,9 @@ fn e148_f050_reports_the_module_ident_per_axis() {
     with_master(&sim, async |md, clock| {
         let group = init(md, clock).await;
         let sd = group.subdevice(md, 0).unwrap();
-        let standard = drive::module_ident(drive::PdoLayout::Standard, 0);
-        let standard_b = drive::module_ident(drive::PdoLayout::Standard, 1);
-        let ip = drive::module_ident(drive::PdoLayout::Ip, 0);
+        let standard = drive_ecat::module_ident(drive_ecat::PdoLayout::Standard, 0);
+        let standard_b = drive_ecat::module_ident(drive_ecat::PdoLayout::Standard, 1);
+        let ip = drive_ecat::module_ident(drive_ecat::PdoLayout::Ip, 0);
         assert_ne!(standard, standard_b, "axis B's modules have their own idents");
         assert_eq!(sd.sdo_read::<u8>(0xF050, 0).await.unwrap(), 2);
         assert_eq!(sd.sdo_read::<u32>(0xF050, 1).await.unwrap(), standard, "axis A");
@@ -215,7 +215,7 @@ fn e148_f050_reports_the_module_ident_per_axis() {
             sd.sdo_write(pdo, 0, entries.len() as u8).await.unwrap();
         };
         // the ip layout (cia402.md §6.5.1) in channel 1
-        let (rx, tx) = drive::PdoLayout::Ip.entries();
+        let (rx, tx) = drive_ecat::PdoLayout::Ip.entries();
         let rx: Vec<u32> = rx.iter().map(|e| e.mapping_value()).collect();
         let tx: Vec<u32> = tx.iter().map(|e| e.mapping_value()).collect();
         remap(0x1600, &rx).await;
@@ -227,14 +227,14 @@ fn e148_f050_reports_the_module_ident_per_axis() {
             "axis B unchanged"
         );
         // axis B's ip layout (objects at +800h) in channel 2
-        let (rx_b, tx_b) = drive::PdoLayout::Ip.axis_entries(1);
+        let (rx_b, tx_b) = drive_ecat::PdoLayout::Ip.axis_entries(1);
         let rx_b: Vec<u32> = rx_b.iter().map(|e| e.mapping_value()).collect();
         let tx_b: Vec<u32> = tx_b.iter().map(|e| e.mapping_value()).collect();
         remap(0x1601, &rx_b).await;
         remap(0x1A01, &tx_b).await;
         assert_eq!(
             sd.sdo_read::<u32>(0xF050, 2).await.unwrap(),
-            drive::module_ident(drive::PdoLayout::Ip, 1),
+            drive_ecat::module_ident(drive_ecat::PdoLayout::Ip, 1),
             "axis B in ip"
         );
         assert_eq!(
@@ -246,8 +246,8 @@ fn e148_f050_reports_the_module_ident_per_axis() {
         remap(0x1A00, &[m(0x6041, 0, 16), m(0x606C, 0, 32)]).await;
         let user = sd.sdo_read::<u32>(0xF050, 1).await.unwrap();
         assert_eq!(
-            user & drive::USER_MODULE,
-            drive::USER_MODULE,
+            user & drive_ecat::USER_MODULE,
+            drive_ecat::USER_MODULE,
             "{user:08X}h is a user module"
         );
         remap(0x1A00, &[m(0x6041, 0, 16), m(0x6064, 0, 32)]).await;

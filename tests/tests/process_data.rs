@@ -9,7 +9,7 @@
     clippy::indexing_slicing
 )]
 
-use drive::DriveObjects;
+use drive_ecat::DriveObjects;
 use drive_tests::al::{OP, SAFEOP};
 use drive_tests::{al_status, init, line, with_master};
 use hil_sim::sim::Simulation;

@@ -13,9 +13,9 @@ use hil_sim::sim::Simulation;
 use std::cell::RefCell;
 
 /// A258 PDO timeout (ms): a saved UINT16 parameter, writable in every state.
-const A258: u16 = drive::parameter_index(0, 258);
+const A258: u16 = drive_ecat::parameter_index(0, 258);
 /// A00 Save values: [0] start = sub 1, [2] result = sub 3 (SDO-Info template).
-const A00: u16 = drive::parameter_index(0, 0);
+const A00: u16 = drive_ecat::parameter_index(0, 0);
 const SAVE: u32 = u32::from_le_bytes(*b"save");
 
 fn read_a258(sim: &RefCell<Simulation>) -> u16 {
@@ -66,7 +66,7 @@ fn e018_written_values_stay_in_ram_until_saved() {
         let sd = group.subdevice(md, 0).unwrap();
         sd.sdo_read::<u8>(A00, 3).await.expect("A00[2]")
     });
-    assert_eq!(i64::from(result), drive::runtime::save_result::OK);
+    assert_eq!(i64::from(result), drive_ecat::runtime::save_result::OK);
     power_cycle(&sim);
     assert_eq!(read_a258(&sim), 4321, "saved through A00 survives power-off");
 }
@@ -104,7 +104,7 @@ fn e020_power_cut_at_every_step_of_a_save_keeps_a_usable_set() {
         write_a258(&sim, 700, Some((0x1010, 1, SAVE)));
         power_cycle(&sim);
         let again = read_a258(&sim);
-        if (startup, loaded, again) != (drive::runtime::Startup::Loaded, 500, 700) {
+        if (startup, loaded, again) != (drive_ecat::runtime::Startup::Loaded, 500, 700) {
             bad.push(format!(
                 "cut after {cut} of {per_save} operations: {startup:?}, A258 {loaded}, saved again {again}"
             ));
@@ -135,7 +135,7 @@ fn e020_power_cut_at_every_step_of_a_save_keeps_a_usable_set() {
 #[test]
 fn e019_e140_e145_a09_restart_starts_again_with_the_saved_values() {
     use drive_tests::al_status;
-    const A09: u16 = drive::parameter_index(0, 9);
+    const A09: u16 = drive_ecat::parameter_index(0, 9);
     let sim = line(1);
     let before = with_master(&sim, async |md, clock| {
         let group = init(md, clock).await;
@@ -165,7 +165,7 @@ fn e019_e140_e145_a09_restart_starts_again_with_the_saved_values() {
         assert_eq!(d.drive.slave().state(), esc::AlState::Init, "restarted: Init");
         assert_eq!(
             d.drive.startup(),
-            drive::runtime::Startup::Loaded,
+            drive_ecat::runtime::Startup::Loaded,
             "the saved set"
         );
     }

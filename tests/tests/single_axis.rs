@@ -11,7 +11,7 @@
     clippy::indexing_slicing
 )]
 
-use drive::Variant;
+use drive_ecat::Variant;
 use drive_tests::{init, sw, with_master, CoeClient, Cyclic, REV, REV_F};
 use hil_sim::sim::{SimDrive, Simulation};
 use std::cell::RefCell;
@@ -43,16 +43,16 @@ fn e005_e006_the_single_axis_identity_from_the_sii_and_1018h() {
         let ids: Vec<_> = group.iter(md).map(|sd| sd.identity()).collect();
         assert_eq!(ids.len(), 2);
         assert_eq!((ids[0].vendor_id, ids[1].vendor_id), (0xB9, 0xB9));
-        assert_eq!(ids[0].product_id, drive::PRODUCT_CODE);
-        assert_eq!(ids[1].product_id, drive::PRODUCT_CODE_SINGLE);
-        assert_eq!(ids[1].revision, drive::SOFTWARE_BUILD);
+        assert_eq!(ids[0].product_id, drive_ecat::PRODUCT_CODE);
+        assert_eq!(ids[1].product_id, drive_ecat::PRODUCT_CODE_SINGLE);
+        assert_eq!(ids[1].revision, drive_ecat::SOFTWARE_BUILD);
         let names: Vec<String> = group.iter(md).map(|sd| sd.name().to_string()).collect();
         assert!(names[1].contains("SI6"), "SII name {names:?}");
         assert!(names[0].contains("SC6"), "SII name {names:?}");
         // the dictionary says the same (E-005, E-006)
         let sd = group.subdevice(md, 1).unwrap();
         let code: u32 = sd.sdo_read(0x1018, 2).await.expect("1018h:02");
-        assert_eq!(code, drive::PRODUCT_CODE_SINGLE);
+        assert_eq!(code, drive_ecat::PRODUCT_CODE_SINGLE);
         let mut c = CoeClient::new();
         assert_eq!(c.upload(&sd, 0x1008, 0).await, Ok(b"SI6".to_vec()));
     });
@@ -85,7 +85,7 @@ fn e080_e084_the_single_axis_od_lists_have_no_axis_b_object() {
         assert!(rx.contains(&0x6040) && tx.contains(&0x6041));
         // the same list as the double-axis device's without axis B
         let expected: Vec<u16> = {
-            let d = drive::DriveObjects::for_variant(Variant::Single);
+            let d = drive_ecat::DriveObjects::for_variant(Variant::Single);
             let mut out = Vec::new();
             let mut after = None;
             while let Some(o) = od::Dictionary::next_object(&d, after) {

@@ -318,7 +318,7 @@ fn e110_a292_applies_to_the_sm2_event_in_sm_sync() {
         let group = init(md, clock).await;
         let sd = group.subdevice(md, 0).unwrap();
         sd.sdo_write(0x1C32, 1, 1u16).await.unwrap();
-        sd.sdo_write(drive::parameter_index(0, 292), 0, -200i32)
+        sd.sdo_write(drive_ecat::parameter_index(0, 292), 0, -200i32)
             .await
             .unwrap();
         let group = group.into_safe_op(md).await.expect("SAFE-OP");

@@ -42,7 +42,7 @@ pub const DEV_PUBLIC_KEY: [u8; KEY_LEN] = match parse_key_hex(include_str!("../.
 /// `SC6_FIRMWARE_PUBLIC_KEY`, else the **development** key ([`DEV_PUBLIC_KEY`]),
 /// which the simulator and the QEMU images use. One constant for the boot
 /// loader (`bootloader::PUBLIC_KEY`) and the application's FoE path
-/// (`drive::runtime::FIRMWARE_PUBLIC_KEY`). A malformed value does not build.
+/// (`drive_ecat::runtime::FIRMWARE_PUBLIC_KEY`). A malformed value does not build.
 pub const FIRMWARE_PUBLIC_KEY: [u8; KEY_LEN] = match option_env!("SC6_FIRMWARE_PUBLIC_KEY") {
     Some(hex) => match parse_key_hex(hex) {
         Some(k) => k,

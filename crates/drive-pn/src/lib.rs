@@ -50,7 +50,7 @@
 //!
 //! Saving is synchronous here ([`PnDrive::save`]: the image is built and
 //! the flash written in one call). The EtherCAT runtime's save job
-//! (`drive::runtime::Drive::begin_save` / `SaveJob::write` / `end_save`,
+//! (`drive_ecat::runtime::Drive::begin_save` / `SaveJob::write` / `end_save`,
 //! the flash written without holding the drive) is the model for the board.
 //!
 //! The telegram mapping of the profile (CW1/ZSW1, PNU) is the next layer

@@ -1,24 +1,24 @@
 //! The drive's ESI (EtherCAT Slave Information, ETG.2000 `EtherCATInfo` XML),
-//! generated from the one declaration: [`drive::DEVICE`] (identity,
+//! generated from the one declaration: [`drive_ecat::DEVICE`] (identity,
 //! SyncManagers, FMMUs, PDOs, DC op modes, mailbox), the object dictionary
-//! [`drive::objects::OBJECTS`] (through [`drive::DriveObjects`], so the ESI
+//! [`drive_ecat::objects::OBJECTS`] (through [`drive_ecat::DriveObjects`], so the ESI
 //! lists exactly what the device shows in each subindex template) and the SII
 //! builder [`ecat::build_sii`] (EEPROM size, ConfigData, bootstrap mailbox).
 //!
 //! One file per device and subindex template (E-150): the double-axis device
-//! ([`drive::DEVICE`], SC6A062) and the single-axis device
-//! ([`drive::DEVICE_SINGLE`], SI6A061, [`Variant::Single`]: no axis-B
+//! ([`drive_ecat::DEVICE`], SC6A062) and the single-axis device
+//! ([`drive_ecat::DEVICE_SINGLE`], SI6A061, [`Variant::Single`]: no axis-B
 //! objects or PDOs), each in "EtherCAT Rx SDO Info" (the default) and
 //! "EtherCAT Rx", each with the revision number 1018h:03 of its template
-//! (E-151, [`drive::revision`]). The checked-in files under `esi/`
+//! (E-151, [`drive_ecat::revision`]). The checked-in files under `esi/`
 //! are kept equal to [`files`] by the test `esi_files_are_current`
 //! (`UPDATE_ESI=1 cargo test -p esi` rewrites them; `cargo run -p esi` too).
 //!
 //! Each ESI is modular (E-149): one slot per axis ([`slots`]), each allowing
 //! the system modules of that axis, one per application layout
-//! ([`drive::PdoLayout::ALL`], the standard layout the default), with their
+//! ([`drive_ecat::PdoLayout::ALL`], the standard layout the default), with their
 //! own PDO indexes and entries ([`Module`]) and the idents F050h reports
-//! ([`drive::module_ident`], E-148). The device-level PDOs stay the default
+//! ([`drive_ecat::module_ident`], E-148). The device-level PDOs stay the default
 //! configuration the SII carries, marked `OverwrittenByModule` where a
 //! slot's module describes the same PDO (docs/esi.md).
 //!
@@ -27,7 +27,7 @@
 use std::collections::BTreeMap;
 use std::fmt::Write;
 
-use drive::{revision, DriveObjects, PdoLayout, Template, Variant};
+use drive_ecat::{revision, DriveObjects, PdoLayout, Template, Variant};
 use ecat::desc::{coe_details, DcOpMode, Device};
 use ecat::sii::EEPROM_BYTES;
 use esc::sii::{mailbox_protocol, word};
@@ -62,16 +62,16 @@ pub fn file_name(variant: Variant, template: Template) -> String {
         Template::SdoInfo => "rx-sdo-info",
         Template::Rx => "rx",
     };
-    format!("{}-{suffix}.xml", drive::device(variant).order_code)
+    format!("{}-{suffix}.xml", drive_ecat::device(variant).order_code)
 }
 
-/// The description of `variant` in `template`: [`drive::device`] with the
+/// The description of `variant` in `template`: [`drive_ecat::device`] with the
 /// template's revision number (E-151) and, for "EtherCAT Rx", without SDO
-/// Information. In the default template this is [`drive::device`] itself
+/// Information. In the default template this is [`drive_ecat::device`] itself
 /// (the SII the drive carries); the SII of the "EtherCAT Rx" template is
 /// `build_sii` of this.
 pub fn device(variant: Variant, template: Template) -> Device {
-    let mut d = *drive::device(variant);
+    let mut d = *drive_ecat::device(variant);
     d.identity.revision = revision(template);
     if template == Template::Rx {
         d.coe_details &= !coe_details::SDO_INFO;
@@ -111,7 +111,7 @@ impl Module {
     /// The ident (`Type@ModuleIdent`), as F050h reports it for this axis
     /// when its channel carries the layout (E-148).
     pub const fn ident(&self) -> u32 {
-        drive::module_ident(self.layout, self.axis)
+        drive_ecat::module_ident(self.layout, self.axis)
     }
 
     /// The RxPDO (channel 1 + axis) and TxPDO indexes.
@@ -186,8 +186,8 @@ pub fn generate(variant: Variant, template: Template) -> Result<String, Error> {
     let image = sii(variant, template).map_err(Error::Sii)?;
     let od = dictionary(variant, template);
     let source = match variant {
-        Variant::Double => "drive::DEVICE",
-        Variant::Single => "drive::DEVICE_SINGLE",
+        Variant::Double => "drive_ecat::DEVICE",
+        Variant::Single => "drive_ecat::DEVICE_SINGLE",
     };
     let mut x = Xml::default();
     x.raw("<?xml version=\"1.0\" encoding=\"UTF-8\"?>\n");
@@ -660,7 +660,7 @@ fn default_value(x: &mut Xml, od: &DriveObjects, o: &ObjectInfo, e: &EntryInfo, 
 /// the device declares it.
 fn constant_text(od: &DriveObjects, index: u16) -> Option<&'static str> {
     match od.declared_object(index)?.value {
-        drive::objects::Value::Text(s) => Some(s),
+        drive_ecat::objects::Value::Text(s) => Some(s),
         _ => None,
     }
 }

@@ -11,7 +11,7 @@
 use std::collections::{BTreeMap, BTreeSet};
 use std::path::PathBuf;
 
-use drive::{revision, Template, Variant};
+use drive_ecat::{revision, Template, Variant};
 use ecat::sii::{categories, find_category, records, sii_string, sii_word};
 use esc::sii::{category, word};
 use od::{CommState, DataType, Dictionary};
@@ -137,7 +137,7 @@ fn e150_one_esi_per_template_with_its_own_revision() {
             assert_eq!(coe.attribute("SdoInfo"), Some(if sdo_info { "1" } else { "0" }));
             // the template's subindex numbering: A10 (2000h + 10) has sub 0 =
             // element count in SDO Info, sub 0 = element 0 in Rx
-            let a10 = drive::parameter_index(0, 10);
+            let a10 = drive_ecat::parameter_index(0, 10);
             let dt = data_type(child(dev, "Profile"), &format!("DT{a10:04X}"));
             let sub0 = children(dt, "SubItem").next().unwrap();
             let name = text(sub0, "Name");
@@ -185,9 +185,9 @@ fn e151_esi_revision_equals_1018_03() {
         let default = hex_bytes(text(child(info, "Info"), "DefaultData"));
         assert_eq!(default, od_rev.to_le_bytes());
     }
-    // the default template's SII is the one the drive carries (drive::device)
+    // the default template's SII is the one the drive carries (drive_ecat::device)
     for v in esi::VARIANTS {
-        assert_eq!(esi::device(v, Template::SdoInfo), *drive::device(v));
+        assert_eq!(esi::device(v, Template::SdoInfo), *drive_ecat::device(v));
     }
 }
 
@@ -217,7 +217,7 @@ fn e108_dc_sync0_is_the_default_op_mode() {
         }
     }
     // the SII's DC category follows the declaration order: SYNC0 first there too
-    let first = drive::DEVICE
+    let first = drive_ecat::DEVICE
         .dc_modes
         .first()
         .map(|m| (m.assign_activate, m.sync0_cycle_factor));
@@ -231,7 +231,7 @@ fn esi_matches_sii_image() {
         let w = |n: u16| u64::from(sii_word(&img, n).unwrap());
         let w32 = |n: u16| w(n) | w(n + 1) << 16;
         let xml = esi(v, t);
-        let declared = drive::device(v);
+        let declared = drive_ecat::device(v);
         let doc = Document::parse(&xml).unwrap();
         let root = doc.root_element();
         let dev = device_node(&doc);
@@ -455,7 +455,7 @@ fn esi_dictionary_matches_od() {
         let profile = child(dev, "Profile");
         assert_eq!(
             num(text(profile, "ProfileNo")),
-            u64::from(drive::device(v).device_type & 0xFFFF)
+            u64::from(drive_ecat::device(v).device_type & 0xFFFF)
         );
         let dict = child(profile, "Dictionary");
         let types: BTreeMap<&str, Node> = children(child(dict, "DataTypes"), "DataType")
@@ -549,12 +549,12 @@ fn esi_pdo_entries_are_mappable_objects() {
         for tag in ["RxPdo", "TxPdo"] {
             for pdo in children(dev, tag) {
                 let index = num(text(pdo, "Index")) as u16;
-                let declared = drive::device(v).pdo(index).unwrap();
+                let declared = drive_ecat::device(v).pdo(index).unwrap();
                 pdos.push((pdo, declared.entries, format!("device {index:04X}h")));
             }
         }
-        let system: Vec<(u32, u16, drive::PdoLayout)> = (0..v.axes() as u16)
-            .flat_map(|axis| drive::PdoLayout::ALL.map(|l| (drive::module_ident(l, axis), axis, l)))
+        let system: Vec<(u32, u16, drive_ecat::PdoLayout)> = (0..v.axes() as u16)
+            .flat_map(|axis| drive_ecat::PdoLayout::ALL.map(|l| (drive_ecat::module_ident(l, axis), axis, l)))
             .collect();
         let mut in_modules = 0;
         for m in modules(&doc) {
@@ -619,10 +619,10 @@ fn defaults_of(profile: Node, index: u16) -> Vec<u64> {
 #[test]
 fn esi_pdos_match_mapping_and_assignment_objects() {
     // the standard layout of axis A is what 1600h/1A00h carry (PdoLayout::Standard)
-    let (rx_a, tx_a) = drive::PdoLayout::Standard.entries();
+    let (rx_a, tx_a) = drive_ecat::PdoLayout::Standard.entries();
     for (v, t) in each() {
-        assert_eq!(drive::device(v).pdo(0x1600).unwrap().entries, rx_a);
-        assert_eq!(drive::device(v).pdo(0x1A00).unwrap().entries, tx_a);
+        assert_eq!(drive_ecat::device(v).pdo(0x1600).unwrap().entries, rx_a);
+        assert_eq!(drive_ecat::device(v).pdo(0x1A00).unwrap().entries, tx_a);
         let xml = esi(v, t);
         let doc = Document::parse(&xml).unwrap();
         let dev = device_node(&doc);
@@ -681,7 +681,7 @@ fn e005_e084_e150_the_single_axis_esi_has_no_axis_b() {
             Variant::Single => {
                 assert_eq!(
                     num(ty.attribute("ProductCode").unwrap()),
-                    u64::from(drive::PRODUCT_CODE_SINGLE)
+                    u64::from(drive_ecat::PRODUCT_CODE_SINGLE)
                 );
                 assert_eq!(ty.text(), Some("SI6A061"));
                 assert!(text(dev, "Name").starts_with("SI6 SI6A061"), "{t:?}");
@@ -698,7 +698,7 @@ fn e005_e084_e150_the_single_axis_esi_has_no_axis_b() {
                     defaults_of(profile, 0xF050),
                     [
                         2,
-                        u64::from(drive::module_ident(drive::PdoLayout::Standard, 0)),
+                        u64::from(drive_ecat::module_ident(drive_ecat::PdoLayout::Standard, 0)),
                         0
                     ]
                 );
@@ -708,7 +708,7 @@ fn e005_e084_e150_the_single_axis_esi_has_no_axis_b() {
             Variant::Double => {
                 assert_eq!(
                     num(ty.attribute("ProductCode").unwrap()),
-                    u64::from(drive::PRODUCT_CODE)
+                    u64::from(drive_ecat::PRODUCT_CODE)
                 );
                 assert!(objects.iter().any(|&i| (0x6800..=0x6FFF).contains(&i)));
                 assert!(objects.iter().any(|&i| (0xA000..=0xDFFF).contains(&i)));
@@ -748,7 +748,11 @@ fn e056_e149_one_slot_per_axis_with_a_module_per_layout() {
         let slots = slots(dev);
         assert_eq!(slots.len(), v.axes(), "{what}: a slot per axis");
         let modules = modules(&doc);
-        assert_eq!(modules.len(), drive::PdoLayout::ALL.len() * v.axes(), "{what}");
+        assert_eq!(
+            modules.len(),
+            drive_ecat::PdoLayout::ALL.len() * v.axes(),
+            "{what}"
+        );
         let by_ident: BTreeMap<u32, Node> = modules.iter().map(|m| (module_ident(*m), *m)).collect();
         assert_eq!(by_ident.len(), modules.len(), "{what}: idents unique");
         let mut slotted = BTreeSet::new();
@@ -760,7 +764,7 @@ fn e056_e149_one_slot_per_axis_with_a_module_per_layout() {
             assert_eq!(num(slot.attribute("MaxInstances").unwrap()), 1, "{what}");
             let idents: Vec<Node> = children(*slot, "ModuleIdent").collect();
             let listed: Vec<u32> = idents.iter().map(|i| num(i.text().unwrap()) as u32).collect();
-            let layouts = drive::PdoLayout::ALL.map(|l| drive::module_ident(l, axis));
+            let layouts = drive_ecat::PdoLayout::ALL.map(|l| drive_ecat::module_ident(l, axis));
             assert_eq!(listed, layouts, "{what}: axis {letter}");
             let defaults: Vec<u32> = idents
                 .iter()
@@ -769,15 +773,15 @@ fn e056_e149_one_slot_per_axis_with_a_module_per_layout() {
                 .collect();
             assert_eq!(
                 defaults,
-                [drive::module_ident(drive::PdoLayout::Standard, axis)],
+                [drive_ecat::module_ident(drive_ecat::PdoLayout::Standard, axis)],
                 "{what}: axis {letter} defaults to the standard layout"
             );
-            for (layout, ident) in drive::PdoLayout::ALL.iter().zip(listed) {
+            for (layout, ident) in drive_ecat::PdoLayout::ALL.iter().zip(listed) {
                 assert!(slotted.insert(ident), "{what}: {ident:08X}h in one slot only");
                 let m = by_ident
                     .get(&ident)
                     .unwrap_or_else(|| panic!("{what}: no module {ident:08X}h"));
-                assert_eq!(ident & drive::AXIS_B_MODULE != 0, axis == 1, "{what}");
+                assert_eq!(ident & drive_ecat::AXIS_B_MODULE != 0, axis == 1, "{what}");
                 assert_eq!(
                     text(*m, "Name"),
                     format!("Axis {letter}: {}", layout.name()),
@@ -812,7 +816,7 @@ fn e056_e149_one_slot_per_axis_with_a_module_per_layout() {
         }
         for index in &module_pdos {
             assert!(
-                drive::device(v).pdo(*index).is_some(),
+                drive_ecat::device(v).pdo(*index).is_some(),
                 "{what}: {index:04X}h has a device-level default"
             );
         }
@@ -833,7 +837,7 @@ fn e148_e149_f050_reports_the_ident_of_the_esi_module() {
         let xml = esi(v, t);
         let doc = Document::parse(&xml).unwrap();
         let dev = device_node(&doc);
-        let read_f050 = |od: &mut drive::DriveObjects, sub: u8| {
+        let read_f050 = |od: &mut drive_ecat::DriveObjects, sub: u8| {
             let mut buf = [0u8; 4];
             assert_eq!(od.read(0xF050, sub, &mut buf, CommState::PreOp), Ok(4));
             u32::from_le_bytes(buf)

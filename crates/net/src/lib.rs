@@ -9,7 +9,7 @@
 //! [`SocketSlots`]); time is always an argument (local µs since power-on);
 //! randomness comes from a seed. The drive itself does not depend on this
 //! crate: it owns the queue and lends it with its dictionary through
-//! `drive::runtime::Drive::with_eoe`.
+//! `drive_ecat::runtime::Drive::with_eoe`.
 #![no_std]
 
 pub mod device;

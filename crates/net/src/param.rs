@@ -368,7 +368,7 @@ mod tests {
     #![allow(clippy::unwrap_used, clippy::indexing_slicing)]
     extern crate std;
     use super::*;
-    use drive::dictionary::DriveObjects;
+    use drive_ecat::dictionary::DriveObjects;
     use std::string::String;
 
     const OPEN: Policy = Policy {
@@ -531,7 +531,7 @@ mod tests {
         assert_eq!(ask(&mut double, "M A199[9]", pre), "ERR 06090011");
         assert_eq!(ask(&mut double, "M 2.A150", pre), "ERR 06020000");
         // the single-axis device has no axis-B window (issue 20)
-        let mut single = DriveObjects::for_variant(drive::Variant::Single);
+        let mut single = DriveObjects::for_variant(drive_ecat::Variant::Single);
         assert_eq!(ask(&mut single, "M E200[0]", pre), "OK 28C8:01");
         assert_eq!(ask(&mut single, "M 2.E200[0]", pre), "ERR 06020000");
         assert_eq!(ask(&mut single, "R 2.E200[0]", pre), "ERR 06020000");

@@ -540,7 +540,7 @@ pub use sntp::message_time_stamp;
 mod tests {
     #![allow(clippy::unwrap_used, clippy::indexing_slicing)]
     use super::*;
-    use drive::dictionary::DriveObjects;
+    use drive_ecat::dictionary::DriveObjects;
 
     /// The parameter service's rate: a burst of 16, then one request per
     /// 10 ms, never more than 16 saved up.

@@ -7,7 +7,7 @@
 //! ICMP errors carrying a truncated header, the port-unreachable answer).
 #![allow(clippy::unwrap_used, clippy::indexing_slicing, missing_docs)]
 
-use drive::dictionary::DriveObjects;
+use drive_ecat::dictionary::DriveObjects;
 use ecat::eoe::{EthernetPort, IpParams};
 use ecat::eoe_queue::EoeQueue;
 use nanos::Nanos;

@@ -6,7 +6,7 @@
 //! so two readings are never a whole wrap apart and the wraps can be counted.
 //! Time is an argument to the core crates: only the RTIC shell reads this.
 
-use drive::runtime::dcsync::{div_rem_u64, gcd};
+use drive_ecat::runtime::dcsync::{div_rem_u64, gcd};
 use nanos::Nanos;
 
 /// Extends a wrapping 32-bit tick counter of `hz` to monotonic ns.

@@ -1,15 +1,15 @@
 //! The control-cycle timer.
 //!
 //! Without SYNC0 the control cycle runs free at A150
-//! ([`Drive::free_run_period`](drive::runtime::Drive::free_run_period);
+//! ([`Drive::free_run_period`](drive_ecat::runtime::Drive::free_run_period);
 //! the first cycle at [`CYCLE`]). Once
-//! the drive's DC-Sync PLL exists, each cycle's [`CycleCommand`](drive::runtime::dcsync::CycleCommand) gives the
+//! the drive's DC-Sync PLL exists, each cycle's [`CycleCommand`](drive_ecat::runtime::dcsync::CycleCommand) gives the
 //! length of the next one in timer ticks ([`TIMER_HZ`]): the board programs
 //! its compare register from [`CycleTimer::next_at`] (the QEMU world pends
 //! the control interrupt at that time).
 
-use drive::axis::{AxisCommand, AxisIo};
-use drive::runtime::TIMER_HZ;
+use drive_ecat::axis::{AxisCommand, AxisIo};
+use drive_ecat::runtime::TIMER_HZ;
 
 use nanos::Nanos;
 
@@ -18,13 +18,13 @@ use crate::Drive;
 
 /// The first free-running control cycle starts at this local time (A150's
 /// default); the next ones follow A150.
-pub const CYCLE: Nanos = Nanos::from_us(drive::params::A150_FALLBACK_US as u64);
+pub const CYCLE: Nanos = Nanos::from_us(drive_ecat::params::A150_FALLBACK_US as u64);
 
 const NS_PER_S: u64 = 1_000_000_000;
 
 /// Timer ticks per ns as a reduced fraction (144 MHz: 18/125), so the
 /// conversions stay in 64 bits for centuries of uptime.
-const G: u64 = drive::runtime::dcsync::gcd(TIMER_HZ as u64, NS_PER_S);
+const G: u64 = drive_ecat::runtime::dcsync::gcd(TIMER_HZ as u64, NS_PER_S);
 const TICK_NUM: u64 = TIMER_HZ as u64 / G;
 const NS_DEN: u64 = NS_PER_S / G;
 

@@ -25,4 +25,4 @@ pub mod tasks;
 pub type ParamFlash = store::RamFlash<2048, 2>;
 
 /// The drive as the firmware runs it.
-pub type Drive = drive::runtime::Drive<ParamFlash>;
+pub type Drive = drive_ecat::runtime::Drive<ParamFlash>;

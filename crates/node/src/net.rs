@@ -6,7 +6,7 @@
 //!
 //! The simulator binds the same stack to its drives (`hil_sim::eoe`).
 
-use drive::runtime::Drive;
+use drive_ecat::runtime::Drive;
 use nanos::Nanos;
 use net::{NetConfig, NetSettings, NetStack};
 use store::Flash;
@@ -39,7 +39,7 @@ pub fn net_settings<F: Flash, B: Flash>(drive: &Drive<F, B>) -> NetSettings {
         tunnel_open: s.tunnel_open,
         param_policy: net::param::Policy {
             writes: s.udp_writes,
-            guard: Some(drive::params::A269),
+            guard: Some(drive_ecat::params::A269),
         },
     }
 }

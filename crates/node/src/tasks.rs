@@ -15,7 +15,7 @@
 
 use core::borrow::BorrowMut;
 
-use drive::axis::{AxisCommand, AxisIo};
+use drive_ecat::axis::{AxisCommand, AxisIo};
 use ecat::StateChange;
 use esc::{regs, Pdi, PdiExt};
 use nanos::Nanos;
@@ -94,7 +94,7 @@ pub fn mailbox_net<P: Pdi, N: NetPoll>(
 /// Background work from the idle loop: a save requested over the bus (A00,
 /// 1010h) is written to the parameter store. The drive is locked only to
 /// take the values and the store out
-/// ([`Drive::begin_save`](drive::runtime::Drive::begin_save)) and to hand
+/// ([`Drive::begin_save`](drive_ecat::runtime::Drive::begin_save)) and to hand
 /// the store back with the result; the flash is erased and programmed
 /// without the lock, so the control and ESC tasks keep running.
 /// (The resource holds the drive or, in the firmware, a `&'static mut` to
@@ -111,7 +111,7 @@ pub fn background<D: BorrowMut<Drive>>(drive: &mut impl Mutex<T = D>) {
 /// time the EtherCAT state machine is in Op — a master configured the drive and
 /// exchanges process data with this image, so the image runs and can be reached
 /// for the next update — the image confirms itself
-/// ([`Drive::confirm_firmware`](drive::runtime::Drive::confirm_firmware)): an
+/// ([`Drive::confirm_firmware`](drive_ecat::runtime::Drive::confirm_firmware)): an
 /// image on trial is kept from then on instead of being rolled back at the next
 /// reset. A drive without firmware slots has nothing to confirm (still `true`
 /// once in Op).

@@ -166,7 +166,7 @@ fn e107_e125_free_run_cycle_at_a150_without_sync0() {
     let mut drive = Drive::new(ParamFlash::new());
     let mut timer = CycleTimer::new();
     assert_eq!(timer.next_at(), CYCLE);
-    let io = [drive::axis::AxisIo::ready(0); 2];
+    let io = [drive_ecat::axis::AxisIo::ready(0); 2];
     tasks::control(&mut drive, &mut timer, CYCLE, &io);
     assert_eq!(timer.next_at(), 2 * CYCLE);
     tasks::control(&mut drive, &mut timer, 2 * CYCLE + Nanos::from_ns(10), &io);
@@ -175,7 +175,7 @@ fn e107_e125_free_run_cycle_at_a150_without_sync0() {
     for a150_us in [250, 500, 2000, 4000, 8000] {
         drive
             .objects_mut()
-            .set(drive::parameter_index(0, 150), 0, a150_us)
+            .set(drive_ecat::parameter_index(0, 150), 0, a150_us)
             .unwrap();
         let now = timer.next_at();
         tasks::control(&mut drive, &mut timer, now, &io);
@@ -195,7 +195,7 @@ fn save_fits_the_parameter_flash() {
     drive.objects_mut().set(0x6065, 0, 1234).unwrap();
     assert!(drive.save(), "save into {} bytes", 2 * 2048);
     let drive = Drive::new(drive.into_flash().unwrap());
-    assert_eq!(drive.startup(), drive::runtime::Startup::Loaded);
+    assert_eq!(drive.startup(), drive_ecat::runtime::Startup::Loaded);
     assert_eq!(drive.objects().get(0x6065, 0), Ok(1234));
 }
 
@@ -207,7 +207,7 @@ fn e018_save_is_written_by_the_background_task() {
     use od::Dictionary as _;
     let mut b = Board::new();
     b.drive.objects_mut().set(0x6065, 0, 4321).unwrap();
-    let save = drive::SAVE_SIGNATURE.to_le_bytes();
+    let save = drive_ecat::SAVE_SIGNATURE.to_le_bytes();
     b.drive
         .objects_mut()
         .write(0x1010, 1, &save, od::CommState::PreOp)
@@ -217,7 +217,7 @@ fn e018_save_is_written_by_the_background_task() {
     tasks::background(&mut Exclusive(&mut b.drive));
     assert!(!b.drive.objects().requests().save);
     let drive = Drive::new(b.drive.into_flash().unwrap());
-    assert_eq!(drive.startup(), drive::runtime::Startup::Loaded);
+    assert_eq!(drive.startup(), drive_ecat::runtime::Startup::Loaded);
     assert_eq!(drive.objects().get(0x6065, 0), Ok(4321));
 }
 
@@ -238,7 +238,7 @@ fn e018_save_job_writes_the_flash_outside_the_drive() {
     assert_eq!(b.drive.objects().get(A00, 1), Ok(1), "running");
     assert!(b.drive.flash_mut().is_none(), "the job has the store");
     // the drive runs on meanwhile; a new value and a new request wait
-    let io = [drive::axis::AxisIo::ready(0); 2];
+    let io = [drive_ecat::axis::AxisIo::ready(0); 2];
     for k in 1..=3u64 {
         tasks::control(&mut b.drive, &mut b.timer, Nanos::from_ms(k), &io);
     }
@@ -247,13 +247,16 @@ fn e018_save_job_writes_the_flash_outside_the_drive() {
     assert!(b.drive.begin_save().is_none(), "one job at a time");
     job.write();
     assert!(b.drive.end_save(job));
-    assert_eq!(b.drive.objects().get(A00, 3), Ok(drive::runtime::save_result::OK));
+    assert_eq!(
+        b.drive.objects().get(A00, 3),
+        Ok(drive_ecat::runtime::save_result::OK)
+    );
     assert!(
         b.drive.objects().requests().save,
         "the second request is still pending"
     );
     let drive = Drive::new(b.drive.into_flash().unwrap());
-    assert_eq!(drive.startup(), drive::runtime::Startup::Loaded);
+    assert_eq!(drive.startup(), drive_ecat::runtime::Startup::Loaded);
     assert_eq!(
         drive.objects().get(0x6065, 0),
         Ok(1234),

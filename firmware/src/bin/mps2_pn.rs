@@ -174,7 +174,7 @@ mod app {
     use crate::{Drive, PnCycle, TickClock, TICKS, TICK_CYCLES};
     use core::sync::atomic::Ordering;
     use cortex_m::peripheral::syst::SystClkSource;
-    use drive::axis::{AxisCommand, AxisIo};
+    use drive_ecat::axis::{AxisCommand, AxisIo};
     use drive_pn::PnParamFlash as ParamFlash;
     use firmware::pn_log::log_event;
     use nanos::Nanos;

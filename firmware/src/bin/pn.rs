@@ -76,8 +76,8 @@ impl PnCycle {
         &mut self,
         drive: &mut Drive,
         now: nanos::Nanos,
-        io: &[drive::axis::AxisIo; 2],
-    ) -> [drive::axis::AxisCommand; 2] {
+        io: &[drive_ecat::axis::AxisIo; 2],
+    ) -> [drive_ecat::axis::AxisCommand; 2] {
         self.next = now.saturating_add(drive.control_period());
         drive.control_cycle(now, io)
     }
@@ -88,7 +88,7 @@ mod app {
     use crate::pac::Interrupt;
     use crate::{board, Drive, Eth, PnCycle, CPU_HZ};
     use cortex_m::peripheral::DWT;
-    use drive::axis::{AxisCommand, AxisIo};
+    use drive_ecat::axis::{AxisCommand, AxisIo};
     use drive_pn::PnParamFlash as ParamFlash;
     use firmware::clock::Clock;
     use firmware::pn_log::log_event;

@@ -131,7 +131,7 @@ mod app {
     use super::{measure, Figure};
     use cortex_m::peripheral::syst::SystClkSource;
     use cortex_m_semihosting::debug;
-    use drive::axis::{AxisCommand, AxisIo};
+    use drive_ecat::axis::{AxisCommand, AxisIo};
     use firmware::cycle::{CycleTimer, CYCLE};
     use firmware::net::NodeNet;
     use firmware::once::Once;

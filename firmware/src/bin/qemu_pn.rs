@@ -26,7 +26,7 @@ use cortex_m::peripheral::syst::SystClkSource;
 use cortex_m_rt::entry;
 use cortex_m_semihosting::debug;
 use defmt_semihosting as _;
-use drive::axis::AxisIo;
+use drive_ecat::axis::AxisIo;
 use drive_pn::PnParamFlash as ParamFlash;
 use drive_pn::{Hardware, PnDrive};
 use firmware::systick::{calibrate, now as now_ticks, ticks};
@@ -214,7 +214,7 @@ fn run(insn: impl Fn(u32) -> u32) -> bool {
     // control cycles per 1 ms send cycle, one of them with a new telegram
     let _ = d
         .objects_mut()
-        .set(drive::params::A150, 0, i64::from(A150_FAST_US));
+        .set(drive_ecat::params::A150, 0, i64::from(A150_FAST_US));
     let per_frame = (cycle.as_ns() / (u64::from(A150_FAST_US) * 1000)).max(1);
     let mut k = FRAMES;
     let mut figures = [(Figure::default(), Figure::default()); 3];

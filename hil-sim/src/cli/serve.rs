@@ -75,8 +75,8 @@ pub fn serve(args: &ServeArgs) -> Result<(), String> {
     }
     let slaves = usize::from(args.slaves);
     let variant = match args.axes {
-        Some(1) => drive::Variant::Single,
-        _ => drive::Variant::Double,
+        Some(1) => drive_ecat::Variant::Single,
+        _ => drive_ecat::Variant::Double,
     };
     // drives with firmware slots: an FoE download in Bootstrap is accepted
     let mut sim = Simulation::with_nodes(
@@ -98,10 +98,10 @@ pub fn serve(args: &ServeArgs) -> Result<(), String> {
         let [hi, lo] = k.to_be_bytes();
         d.bind_net([0x02, 0x00, 0x00, 0x00, hi, lo], u64::from(k), Nanos::ZERO);
     }
-    let device = drive::device(variant);
+    let device = drive_ecat::device(variant);
     let kind = match variant {
-        drive::Variant::Double => "double-axis",
-        drive::Variant::Single => "single-axis",
+        drive_ecat::Variant::Double => "double-axis",
+        drive_ecat::Variant::Single => "single-axis",
     };
     println!(
         "hil-sim serve: {slaves} simulated {kind} drive(s) {} (product code {}) on {iface}",

@@ -423,7 +423,7 @@ impl Script {
 
     /// Reads the SM1 mailbox when full: the whole mailbox buffer.
     fn mailbox_in(&mut self, link: &mut impl Link) -> Result<Option<[u8; MAX_DATA]>, Failure> {
-        let dev = &drive::DEVICE;
+        let dev = &drive_ecat::DEVICE;
         let mut st = [0u8; 1];
         self.read(link, regs::sm(1) + 5, &mut st)?;
         if st.first().copied().unwrap_or(0) & 0x08 == 0 {
@@ -437,7 +437,7 @@ impl Script {
 
     /// Writes `body` as a mailbox message of type `kind` into SM0.
     fn mailbox_out(&mut self, link: &mut impl Link, kind: u8, body: &[u8]) -> Result<(), Failure> {
-        let dev = &drive::DEVICE;
+        let dev = &drive_ecat::DEVICE;
         self.mbx_counter = ecat::mailbox::next_counter(self.mbx_counter);
         let mut m = [0u8; MAX_DATA];
         let n = usize::from(dev.mailbox_out.length).min(MAX_DATA);
@@ -538,7 +538,7 @@ impl Script {
     }
 
     fn run(&mut self, link: &mut impl Link, stage: Stage) -> Result<(Stage, Progress), Failure> {
-        let dev = &drive::DEVICE;
+        let dev = &drive_ecat::DEVICE;
         if matches!(
             stage,
             Stage::WaitOp | Stage::Enable(_) | Stage::Move(_) | Stage::Settle(_) | Stage::Disable

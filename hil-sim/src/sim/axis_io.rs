@@ -3,7 +3,7 @@
 
 use super::AxisConditions;
 use crate::motor::{Input, Motor, MotorOutputs};
-use drive::axis::{AxisIo, IndexLatch, ProbeEdge, SwitchEdge, SwitchId};
+use drive_ecat::axis::{AxisIo, IndexLatch, ProbeEdge, SwitchEdge, SwitchId};
 
 /// What the axis runtime reads from the motor's last step.
 pub(crate) fn axis_io(out: Option<&MotorOutputs>, motor: &Motor, c: AxisConditions) -> AxisIo {

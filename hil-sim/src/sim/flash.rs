@@ -10,12 +10,12 @@ pub type SimFlash = store::RamFlash<4096, 2>;
 /// of a line, [`Simulation::try_clone`](super::Simulation::try_clone)) shares the 528 KiB until one of
 /// them erases or writes, so a snapshot costs what it changes.
 #[derive(Clone)]
-pub struct FirmwareFlash(pub std::sync::Arc<drive::boot::RamFlash<4096, 132>>);
+pub struct FirmwareFlash(pub std::sync::Arc<drive_ecat::boot::RamFlash<4096, 132>>);
 
 impl FirmwareFlash {
     /// An erased flash.
     pub fn new() -> Self {
-        Self(std::sync::Arc::new(drive::boot::RamFlash::new()))
+        Self(std::sync::Arc::new(drive_ecat::boot::RamFlash::new()))
     }
 }
 
@@ -25,21 +25,21 @@ impl Default for FirmwareFlash {
     }
 }
 
-impl drive::boot::Flash for FirmwareFlash {
+impl drive_ecat::boot::Flash for FirmwareFlash {
     const SECTOR: usize = 4096;
     const SECTORS: usize = 132;
     const WRITE: usize = 8;
-    fn read(&mut self, addr: u32, buf: &mut [u8]) -> Result<(), drive::boot::FlashError> {
+    fn read(&mut self, addr: u32, buf: &mut [u8]) -> Result<(), drive_ecat::boot::FlashError> {
         // a read changes nothing: only erase and write copy a shared flash
         self.0.read_shared(addr, buf)
     }
-    fn erase(&mut self, sector: u32) -> Result<(), drive::boot::FlashError> {
-        drive::boot::Flash::erase(std::sync::Arc::make_mut(&mut self.0), sector)
+    fn erase(&mut self, sector: u32) -> Result<(), drive_ecat::boot::FlashError> {
+        drive_ecat::boot::Flash::erase(std::sync::Arc::make_mut(&mut self.0), sector)
     }
-    fn write(&mut self, addr: u32, data: &[u8]) -> Result<(), drive::boot::FlashError> {
-        drive::boot::Flash::write(std::sync::Arc::make_mut(&mut self.0), addr, data)
+    fn write(&mut self, addr: u32, data: &[u8]) -> Result<(), drive_ecat::boot::FlashError> {
+        drive_ecat::boot::Flash::write(std::sync::Arc::make_mut(&mut self.0), addr, data)
     }
 }
 
 /// The firmware slots of a simulated drive.
-pub type FirmwareSlots = drive::boot::BootSlots<FirmwareFlash>;
+pub type FirmwareSlots = drive_ecat::boot::BootSlots<FirmwareFlash>;

@@ -228,7 +228,7 @@ fn e002_line_of_128_drives_scans_and_goes_to_pre_op() {
         activate: ::esc::sm::activate::ENABLE,
         pdi_control: 0,
     };
-    let d = &drive::DEVICE;
+    let d = &drive_ecat::DEVICE;
     let init = [
         (
             Command::Bwr,

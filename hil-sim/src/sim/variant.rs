@@ -1,9 +1,9 @@
-//! The single-axis device in the simulator ([`drive::Variant::Single`],
+//! The single-axis device in the simulator ([`drive_ecat::Variant::Single`],
 //! issue 20): drives and lines of it. The motor of axis B is still there,
 //! unpowered (the drive leaves axis B idle).
 
 use super::{FirmwareFlash, SimDrive, SimFlash, Simulation};
-use drive::Variant;
+use drive_ecat::Variant;
 
 impl SimDrive {
     /// A single-axis drive (SI6A061: its SII, no axis-B objects or PDOs,
@@ -49,7 +49,7 @@ mod tests {
         assert_eq!(d.variant(), Variant::Single);
         assert_eq!(
             d.drive.slave().device().identity.product_code,
-            drive::PRODUCT_CODE_SINGLE
+            drive_ecat::PRODUCT_CODE_SINGLE
         );
         let line = Simulation::of(Variant::Single, 2);
         assert!(line.drives().iter().all(|d| d.variant() == Variant::Single));

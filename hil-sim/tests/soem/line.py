@@ -5,7 +5,7 @@ Run by `hil-sim/tests/soem.rs` as root inside a network namespace whose veth
 end leads to `hil-sim serve`. Everything goes through SOEM's own calls; the
 expected values come from the drive's declarations, written by the Rust test:
 
-  --sii FILE  the SII image `ecat::build_sii(&drive::DEVICE, ..)` generates
+  --sii FILE  the SII image `ecat::build_sii(&drive_ecat::DEVICE, ..)` generates
   --od FILE   the visible objects and entries of a fresh dictionary (SDO Info
               template), tab-separated, with the entries' default values
 

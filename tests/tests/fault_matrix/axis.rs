@@ -9,7 +9,7 @@ use hil_sim::motor::{PositionInput, Switches};
 use hil_sim::sim::AxisConditions;
 
 /// E47: the first cause of Switch on disabled (C-015).
-const E47: u16 = drive::parameter_index(4, 47);
+const E47: u16 = drive_ecat::parameter_index(4, 47);
 
 /// Axis A at 2 rev/s in csv; `cause` happens to it; after 100 ms the end
 /// is read (state, power stage, EMCY, 603Fh, E47, the history, AL); then

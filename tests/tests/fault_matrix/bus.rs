@@ -9,7 +9,7 @@ use ethercrab::subdevice_group::DcConfiguration;
 use ethercrab::DcSync;
 use std::time::Duration;
 
-const A258: u16 = drive::parameter_index(0, 258);
+const A258: u16 = drive_ecat::parameter_index(0, 258);
 
 /// The CiA 402 state of axis A from 6041h (read by SDO: the process data
 /// may have stopped).

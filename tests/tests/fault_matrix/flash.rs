@@ -1,6 +1,6 @@
 //! Power cut during an FoE download, at every flash operation it makes.
 
-use drive::boot::{Slot, SlotState};
+use drive_ecat::boot::{Slot, SlotState};
 use drive_tests::matrix::Row;
 use drive_tests::{fault_row, firmware_file, in_boot, FoeClient, FwNode};
 use hil_sim::sim::Simulation;

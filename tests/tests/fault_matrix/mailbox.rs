@@ -3,7 +3,7 @@
 //! during an FoE download.
 
 use super::advance;
-use drive::boot::{Slot, SlotState};
+use drive_ecat::boot::{Slot, SlotState};
 use drive_tests::matrix::{al, Row};
 use drive_tests::{
     al_status, fault_row, firmware_file, in_boot, init, line, to_boot, with_master, with_master_on,
@@ -12,7 +12,7 @@ use drive_tests::{
 use hil_sim::sim::Simulation;
 use std::cell::RefCell;
 
-const E72: u16 = drive::parameter_index(4, 72);
+const E72: u16 = drive_ecat::parameter_index(4, 72);
 
 /// A CoE SDO upload request of `index`:`sub` as one SM0 buffer with
 /// mailbox counter `counter`.

@@ -19,7 +19,7 @@ use object::{elf, Endianness};
 use std::path::{Path, PathBuf};
 
 /// The name a file must start with for the drive to take it
-/// (`drive::runtime::FIRMWARE_FILE`); masters send the file name they are given.
+/// (`drive_ecat::runtime::FIRMWARE_FILE`); masters send the file name they are given.
 pub const FILE_PREFIX: &str = "firmware";
 
 /// Largest body the tool writes (a slot of the reference board is smaller;

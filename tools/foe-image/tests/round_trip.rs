@@ -12,7 +12,7 @@
     clippy::indexing_slicing
 )]
 
-use drive::boot::{Slot, SlotState};
+use drive_ecat::boot::{Slot, SlotState};
 use drive_tests::{fw_load_address, in_boot, FoeClient, FoeReply, FwNode};
 use ecat::foe::FoeError;
 use hil_sim::sim::Simulation;
@@ -148,7 +148,7 @@ fn foe_image_of_an_elf_boots_from_the_inactive_slot() {
     );
     assert_eq!(
         u32::from_le_bytes(file[8..12].try_into().unwrap()),
-        drive::boot::crc32(&body)
+        drive_ecat::boot::crc32(&body)
     );
     assert_eq!(u32::from_le_bytes(file[12..16].try_into().unwrap()), 7);
     assert_eq!(u32::from_le_bytes(file[16..20].try_into().unwrap()), 2);
@@ -158,9 +158,9 @@ fn foe_image_of_an_elf_boots_from_the_inactive_slot() {
         "the ELF's lowest load address"
     );
     assert_eq!(u32::from_le_bytes(file[24..28].try_into().unwrap()), 1);
-    assert!(drive::boot::verify_file(&file, &drive::boot::DEV_PUBLIC_KEY).is_ok());
+    assert!(drive_ecat::boot::verify_file(&file, &drive_ecat::boot::DEV_PUBLIC_KEY).is_ok());
     assert_eq!(
-        &file[drive::boot::IMAGE_HEADER_LEN..],
+        &file[drive_ecat::boot::IMAGE_HEADER_LEN..],
         &body[..],
         "segments at their load addresses, gap FFh"
     );
@@ -205,7 +205,7 @@ fn foe_image_truncated_or_flipped_is_refused_and_changes_nothing() {
     let (elf, _) = board_elf();
     let file = make(&dir, &elf, 7);
     let mut flipped = file.clone();
-    flipped[drive::boot::IMAGE_HEADER_LEN + 4321] ^= 0x10;
+    flipped[drive_ecat::boot::IMAGE_HEADER_LEN + 4321] ^= 0x10;
     let truncated = &file[..file.len() - 100];
     for (what, bad) in [("flipped", &flipped[..]), ("truncated", truncated)] {
         // the tool says what the drive will say
@@ -314,14 +314,15 @@ fn foe_signature_keygen_sign_check_and_the_drive_refuses_another_key() {
     let key = dir.join("prod.key");
     let out = tool(&["keygen", "--out", key.to_str().unwrap()]);
     assert!(out.status.success(), "{}", String::from_utf8_lossy(&out.stderr));
-    let seed = drive::boot::parse_key_hex(&std::fs::read_to_string(&key).unwrap()).unwrap();
-    let public = drive::boot::parse_key_hex(&std::fs::read_to_string(dir.join("prod.pub")).unwrap()).unwrap();
+    let seed = drive_ecat::boot::parse_key_hex(&std::fs::read_to_string(&key).unwrap()).unwrap();
+    let public =
+        drive_ecat::boot::parse_key_hex(&std::fs::read_to_string(dir.join("prod.pub")).unwrap()).unwrap();
     assert_eq!(
-        drive::boot::public_key(&seed),
+        drive_ecat::boot::public_key(&seed),
         public,
         "the pair belongs together"
     );
-    assert_ne!(public, drive::boot::DEV_PUBLIC_KEY);
+    assert_ne!(public, drive_ecat::boot::DEV_PUBLIC_KEY);
     #[cfg(unix)]
     {
         use std::os::unix::fs::PermissionsExt;
