@@ -378,4 +378,6 @@ impl Profile {
 }
 
 #[cfg(test)]
+mod pnu_doc;
+#[cfg(test)]
 mod tests;
