@@ -37,7 +37,7 @@ const ECAT33_SM_DEACTIVATION_FALLS_BACK: bool = false;
 /// A mailbox request of a reserved type is answered with mailbox error 0002h.
 const ECAT33_RESERVED_MAILBOX_TYPE_0002: bool = true;
 /// The device-identification request (AL control bit 5) is honoured.
-const ECAT33_DEVICE_IDENTIFICATION: bool = false;
+const ECAT33_DEVICE_IDENTIFICATION: bool = true;
 
 /// Operations per input at most.
 const OPS: usize = 16;
@@ -269,10 +269,16 @@ fn op(line: &mut Line, u: &mut Unstructured<'_>) {
             line.write(regs::AL_CONTROL, &value.to_le_bytes());
             line.wait(Nanos::from_ms(1));
             let got = line.status();
-            if ECAT33_DEVICE_IDENTIFICATION && id && !(line.model.error && !ack) {
+            // ETG.1000.6: a processed request with bit 5 loads the ID (shown
+            // while no error is indicated); one without it unloads it; a
+            // request ignored (error shown, no acknowledge) changes nothing
+            if ECAT33_DEVICE_IDENTIFICATION && !(line.model.error && !ack) {
+                let (_, error, _, loaded) = got;
                 assert!(
-                    got.3,
-                    "device identification requested, AL status without ID loaded"
+                    loaded == (id && !error),
+                    "device identification {}requested: AL status {} ID loaded (error {error})",
+                    if id { "" } else { "not " },
+                    if loaded { "with" } else { "without" }
                 );
             }
             // with the ID loaded the code register holds the identification value
@@ -399,13 +405,20 @@ fn op(line: &mut Line, u: &mut Unstructured<'_>) {
                 m[0] = 10;
                 m[6..16].copy_from_slice(&[0x00, 0x20, 0x40, 0x00, 0x10, 0x00, 0, 0, 0, 0]);
             }
+            // an answer still waiting in SM1 (to an earlier request) is read
+            // out first, so the answer read below is this request's
+            let _ = line.read(SM1.0, 256);
+            line.wait(Nanos::from_ms(1));
             line.write(SM0.0, &m);
             line.wait(Nanos::from_ms(1));
             let answer = line.read(SM1.0, 256);
             let mailbox_up =
                 line.model.state != INIT && line.model.sm[0] == Cfg::Valid && line.model.sm[1] == Cfg::Valid;
+            // a header that is well-formed otherwise (data length above 0,
+            // channel 0): the header's own errors (0006h, 0003h) come first
             if ECAT33_RESERVED_MAILBOX_TYPE_0002
                 && mailbox_up
+                && len > 0
                 && (6..=14).contains(&ty)
                 && answer[5] & 0x0F == 0
             {
