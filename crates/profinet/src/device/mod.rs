@@ -21,7 +21,7 @@
 use heapless::{Deque, Vec};
 use nanos::Nanos;
 
-use crate::alarm::{AbortCode, AlarmEvent, DiagList, DriveError, Maintenance, Output, Priority};
+use crate::alarm::{AbortCode, AlarmEvent, DiagList, DriveError, Location, Maintenance, Output, Priority};
 use crate::cm::{Cm, CmConfig, CmEvent, Im0, ImData, NoRecords, RecordHook};
 use crate::dcp::server::{DcpServer, Event as DcpEvent, Identity};
 use crate::dcp::{IpSuite, NameOfStation};
@@ -29,7 +29,7 @@ use crate::ip::{IpConfig, Received, Stack, UdpTx, RPC_PORT, UDP_PAYLOAD_OFFSET};
 use crate::led::LedInputs;
 use crate::lldp::{self, PortIdForm, PortInfo, Schedule};
 use crate::model;
-use crate::pdev::{Pdev, Peer};
+use crate::pdev::{Mismatch, Pdev, Peer};
 use crate::rpc::epm::{self, EpmInfo};
 use crate::rpc::server::{Server, ServerConfig};
 use crate::rpc::uuid;
@@ -440,6 +440,7 @@ impl<H: RecordHook> Device<H> {
             }
             self.lldp.sent(port, now);
         }
+        self.check_topology();
         self.drain_rpc(now, tx);
         self.run_cyclic(now, tx);
         self.run_alarms(now, tx);
@@ -516,6 +517,31 @@ impl<H: RecordHook> Device<H> {
         self.diag
             .raise(Cyclic::drive_location(), e, Maintenance::Fault, 0)
             .is_ok()
+    }
+
+    /// The ports' topology against their PDPortDataCheck (P-040): each
+    /// difference is a diagnosis on the port's subslot (an "appears" alarm in
+    /// an AR), gone ("disappears") once the neighbour, MAU type or link
+    /// matches again or the check is withdrawn.
+    fn check_topology(&mut self) {
+        for port in 1..=model::PORTS {
+            let loc = Location {
+                api: 0,
+                slot: 0,
+                subslot: 0x8000 | port,
+                module_ident: model::DAP_MODULE_IDENT,
+                submodule_ident: model::port_submodule_ident(port),
+            };
+            for kind in Mismatch::ALL {
+                let (t, x) = kind.error_types();
+                let e = DriveError::port(t, x);
+                if self.cm.pdev().mismatch(port, kind) {
+                    let _ = self.diag.raise(loc, e, Maintenance::Fault, 0);
+                } else {
+                    self.diag.clear(&loc, e);
+                }
+            }
+        }
     }
 
     /// The drive error HH-S is gone (acknowledged, P-035): a "disappears"

@@ -6,6 +6,7 @@
 //! |---|---|---|---|
 //! | 0x802A | 0x8001, 0x8002 | PDPortDataReal (block 0x020F) | own port name `port-00n`, the LLDP neighbour (peer port and station name, its MAC; line delay 0: not measured) or no peer, MAU type 100BASE-TX FD (0 while the link is down), the adjusted domain and multicast boundaries, link state up/down, media type copper |
 //! | 0x802F | 0x8001, 0x8002 | PDPortDataAdjust (block 0x0202) | read: empty while nothing is adjusted, else the adjusted sub-blocks; write: see below |
+//! | 0x802B | 0x8001, 0x8002 | PDPortDataCheck (block 0x0200) | read: empty while nothing is checked, else the check as written; write: CheckPeers, CheckMAUType, CheckLinkState ([`check`]); a difference is a diagnosis on the port's subslot |
 //! | 0x8080 | 0x8000 | PDInterfaceDataReal (block 0x0240) | the name of station (the chassis ID LLDP sends; empty while unnamed), the interface MAC, IP, subnet mask, gateway |
 //!
 //! A write of PDPortDataAdjust may carry the sub-blocks a controller sets
@@ -37,8 +38,13 @@ use crate::model;
 use crate::rpc::cursor::{Endian, Reader, Writer};
 use crate::wire::MacAddr;
 
+pub mod check;
 #[cfg(test)]
 pub(crate) mod tests;
+#[cfg(test)]
+pub(crate) mod tests_check;
+
+pub use check::{Mismatch, PortCheck};
 
 /// Record indices of the PDev.
 pub mod index {
@@ -46,7 +52,7 @@ pub mod index {
     pub const PD_PORT_DATA_REAL: u16 = 0x802A;
     /// PDPortDataAdjust (port subslots).
     pub const PD_PORT_DATA_ADJUST: u16 = 0x802F;
-    /// PDPortDataCheck (port subslots): read empty, no check is configured.
+    /// PDPortDataCheck (port subslots): the topology check ([`super::check`]).
     pub const PD_PORT_DATA_CHECK: u16 = 0x802B;
     /// PDInterfaceDataReal (interface subslot).
     pub const PD_INTERFACE_DATA_REAL: u16 = 0x8080;
@@ -157,6 +163,8 @@ pub struct PortState {
     pub peer: Option<Peer>,
     /// The adjusted values.
     pub adjust: PortAdjust,
+    /// The checked topology (PDPortDataCheck).
+    pub check: PortCheck,
 }
 
 /// The PDev of the interface X1 and its ports: what the records report.
@@ -212,6 +220,7 @@ impl Pdev {
             link_up,
             peer: None,
             adjust: PortAdjust::default(),
+            check: PortCheck::default(),
         };
         Pdev {
             mac,
@@ -244,6 +253,12 @@ impl Pdev {
             .is_none_or(|(b, _)| b & 1 == 0)
     }
 
+    /// Whether port `port` (1-based) differs in `kind` from its
+    /// PDPortDataCheck (false without a check).
+    pub fn mismatch(&self, port: u16, kind: Mismatch) -> bool {
+        self.port(port).is_some_and(|p| p.check.mismatch(p, kind))
+    }
+
     /// Forgets the neighbours whose TTL ran out at `now`.
     pub fn expire(&mut self, now: Nanos) {
         for p in self.ports.iter_mut() {
@@ -273,8 +288,7 @@ impl Pdev {
                 let i = port_of(addr.subslot).ok_or(misplaced(addr))?;
                 let p = self.ports.get(i).ok_or(RecordError::InvalidSlotSubslot)?;
                 if addr.index == index::PD_PORT_DATA_CHECK {
-                    // no check configured (a write is not taken): empty
-                    Some(())
+                    check::emit(&mut w, addr.subslot, &p.check)
                 } else if addr.index == index::PD_PORT_DATA_REAL {
                     emit_port_real(&mut w, addr.subslot, i, p)
                 } else if p.adjust.is_empty() {
@@ -289,7 +303,7 @@ impl Pdev {
         Ok(w.pos())
     }
 
-    /// Writes record `addr` (only PDPortDataAdjust is writable).
+    /// Writes record `addr` (PDPortDataAdjust and PDPortDataCheck are writable).
     pub fn write(&mut self, addr: RecordAddr, data: &[u8]) -> Result<(), RecordError> {
         match (addr.slot, addr.index) {
             (0, index::PD_PORT_DATA_ADJUST) => {
@@ -302,9 +316,12 @@ impl Pdev {
             (0, index::PD_PORT_DATA_REAL) if port_of(addr.subslot).is_some() => {
                 Err(RecordError::AccessDenied)
             }
-            // neighbour, MAU type and link state checks are not offered yet
-            (0, index::PD_PORT_DATA_CHECK) if port_of(addr.subslot).is_some() => {
-                Err(RecordError::FeatureNotSupported)
+            (0, index::PD_PORT_DATA_CHECK) => {
+                let i = port_of(addr.subslot).ok_or(misplaced(addr))?;
+                let c = check::parse(addr.subslot, data)?;
+                let p = self.ports.get_mut(i).ok_or(RecordError::InvalidSlotSubslot)?;
+                p.check = c;
+                Ok(())
             }
             (0, index::PD_INTERFACE_DATA_REAL) if addr.subslot == 0x8000 => Err(RecordError::AccessDenied),
             _ => Err(misplaced(addr)),

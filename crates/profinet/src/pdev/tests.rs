@@ -120,14 +120,14 @@ impl<H: crate::cm::RecordHook> Rig<H> {
     }
 }
 
-fn rig() -> Rig<crate::cm::NoRecords> {
+pub(crate) fn rig() -> Rig<crate::cm::NoRecords> {
     let mut r = Rig::new(Device::plain(testing::device_config()));
     r.connect();
     r
 }
 
 /// An LLDPDU from a switch `sw-1` port `port-003` (V2.3 form), TTL 20 s.
-fn lldp_from_switch() -> Vec<u8> {
+pub(crate) fn lldp_from_switch() -> Vec<u8> {
     let mut f = Vec::new();
     f.extend_from_slice(&MacAddr::LLDP.0);
     f.extend_from_slice(&[0x02, 0, 0, 0, 0, 0x77]);
@@ -467,19 +467,4 @@ fn p029_p040_real_identification_data_lists_the_dap_and_the_plugged_modules() {
     let text = crate::tests_tshark::dissect(&r.frames, "dcerpc && ip.src == 192.168.0.50");
     let Some(text) = text else { return };
     assert!(text.contains("RealIdentificationData"), "not dissected");
-}
-
-#[test]
-fn p040_pd_port_data_check_reads_empty_and_a_check_is_not_taken() {
-    let mut r = rig();
-    for sub in [0x8001, 0x8002] {
-        assert_eq!(r.read(sub, index::PD_PORT_DATA_CHECK), (OK, Vec::new()));
-    }
-    // at the interface: invalid index; a write (CheckPeers): feature not supported, still empty
-    assert_eq!(r.read(0x8000, index::PD_PORT_DATA_CHECK).0, rw(0xB0, false));
-    let check = hex("0200 0010 0100 0000 0001 08 706f72742d303031 00");
-    let w = r.record(true, 0, 0x8001, index::PD_PORT_DATA_CHECK, &check);
-    assert_eq!(w.0, rw(0xA9, true));
-    assert_eq!(r.read(0x8001, index::PD_PORT_DATA_CHECK), (OK, Vec::new()));
-    crate::tests_tshark::dissect(&r.frames, "dcerpc && ip.src == 192.168.0.50");
 }

@@ -1,0 +1,110 @@
+//! PDPortDataCheck (0x802B) through the whole device: written per port, read
+//! back as written, bad records refused with nothing stored.
+
+use super::tests::{rig, Rig};
+use super::*;
+use crate::cm::{NoRecords, PnioStatus};
+use crate::rpc::tests::hex;
+use std::vec::Vec;
+
+/// A PDPortDataCheck for `subslot` with the given sub-blocks.
+pub(crate) fn check(subslot: u16, subblocks: &[u8]) -> Vec<u8> {
+    let mut v = hex("0200 0000 0100 0000 0000");
+    v.extend_from_slice(&subslot.to_be_bytes());
+    v.extend_from_slice(subblocks);
+    let len = (v.len() - 4) as u16;
+    v[2..4].copy_from_slice(&len.to_be_bytes());
+    v
+}
+
+/// CheckPeers: port-003 of sw-1 (6 + 1 + 9 + 5 = 21 octets, 3 of padding).
+pub(crate) const PEERS_SW1: &str = "020a 0014 0100 01 08 706f72742d303033 04 73772d31 000000";
+/// CheckMAUType 100BASE-TX FD.
+pub(crate) const MAU_TX_FD: &str = "020c 0004 0100 0010";
+/// CheckLinkState up.
+pub(crate) const LINK_UP_CHECK: &str = "021c 0004 0100 0001";
+
+fn write(r: &mut Rig<NoRecords>, subslot: u16, data: &[u8]) -> PnioStatus {
+    r.record(true, 0, subslot, index::PD_PORT_DATA_CHECK, data).0
+}
+
+#[test]
+fn p040_pd_port_data_check_is_stored_per_port_and_read_back_as_written() {
+    let mut r = rig();
+    for sub in [0x8001, 0x8002] {
+        assert_eq!(
+            r.read(sub, index::PD_PORT_DATA_CHECK),
+            (PnioStatus::OK, Vec::new())
+        );
+    }
+    let mut subs = hex(PEERS_SW1);
+    subs.extend_from_slice(&hex(MAU_TX_FD));
+    subs.extend_from_slice(&hex(LINK_UP_CHECK));
+    let rec = check(0x8001, &subs);
+    assert_eq!(write(&mut r, 0x8001, &rec), PnioStatus::OK);
+    assert_eq!(
+        r.read(0x8001, index::PD_PORT_DATA_CHECK),
+        (PnioStatus::OK, rec.clone())
+    );
+    // port 2 keeps its own (none)
+    assert_eq!(
+        r.read(0x8002, index::PD_PORT_DATA_CHECK),
+        (PnioStatus::OK, Vec::new())
+    );
+    let link_only = check(0x8002, &hex(LINK_UP_CHECK));
+    assert_eq!(write(&mut r, 0x8002, &link_only), PnioStatus::OK);
+    assert_eq!(r.read(0x8002, index::PD_PORT_DATA_CHECK).1, link_only);
+    assert_eq!(r.read(0x8001, index::PD_PORT_DATA_CHECK).1, rec);
+    // a record with no sub-block withdraws the check
+    assert_eq!(write(&mut r, 0x8002, &check(0x8002, &[])), PnioStatus::OK);
+    assert_eq!(r.read(0x8002, index::PD_PORT_DATA_CHECK).1, Vec::<u8>::new());
+    // at the interface: invalid index; tshark dissects the blocks
+    assert_eq!(
+        r.read(0x8000, index::PD_PORT_DATA_CHECK).0,
+        PnioStatus::rw(0xDE, 0xB0)
+    );
+    let text = crate::tests_tshark::dissect(&r.frames, "dcerpc && ip.src == 192.168.0.50");
+    let Some(text) = text else { return };
+    assert!(text.contains("CheckPeers"), "not dissected");
+}
+
+#[test]
+fn p040_bad_pd_port_data_check_blocks_are_refused_and_nothing_is_stored() {
+    let mut r = rig();
+    let good = check(0x8001, &hex(MAU_TX_FD));
+    assert_eq!(write(&mut r, 0x8001, &good), PnioStatus::OK);
+    let invalid = PnioStatus::rw(0xDF, 0xB8);
+    let length = PnioStatus::rw(0xDF, 0xB1);
+    let mut peers2 = hex(PEERS_SW1);
+    peers2[6] = 2; // NumberOfPeers 2
+    let mut peers_long = hex(PEERS_SW1);
+    peers_long[7] = 9; // PeerPortID runs into the chassis ID
+    let mut dup = hex(MAU_TX_FD);
+    dup.extend_from_slice(&hex(MAU_TX_FD));
+    let mut wrong_outer = check(0x8001, &hex(MAU_TX_FD));
+    wrong_outer[1] = 0x02; // PDPortDataAdjust's block type
+    let mut cut = check(0x8001, &hex(MAU_TX_FD));
+    cut[3] += 2; // block length beyond the record
+    let cases: [(Vec<u8>, PnioStatus); 9] = [
+        (check(0x8002, &hex(MAU_TX_FD)), invalid), // another port's block
+        (check(0x8001, &peers2), invalid),         // NumberOfPeers 2
+        (check(0x8001, &hex("020c 0004 0100 0000")), invalid), // MAU type 0
+        (check(0x8001, &hex("021c 0004 0100 0002")), invalid), // link down
+        (check(0x8001, &hex("020b 0008 0100 0000 00000010")), invalid), // CheckLineDelay
+        (check(0x8001, &dup), invalid),            // repeated
+        (wrong_outer, invalid),
+        (check(0x8001, &peers_long), length),
+        (cut, length),
+    ];
+    for (k, (rec, want)) in cases.iter().enumerate() {
+        assert_eq!(write(&mut r, 0x8001, rec), *want, "case {k}");
+        assert_eq!(
+            r.read(0x8001, index::PD_PORT_DATA_CHECK).1,
+            good,
+            "case {k} changed the check"
+        );
+    }
+    // a write to the interface subslot or a missing port
+    assert_eq!(write(&mut r, 0x8000, &good), PnioStatus::rw(0xDF, 0xB0));
+    assert_eq!(write(&mut r, 0x8003, &good), PnioStatus::rw(0xDF, 0xB2));
+}
