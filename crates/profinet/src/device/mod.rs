@@ -27,7 +27,7 @@ use crate::dcp::server::{DcpServer, Event as DcpEvent, Identity};
 use crate::dcp::{IpSuite, NameOfStation};
 use crate::ip::{IpConfig, Received, Stack, UdpTx, RPC_PORT, UDP_PAYLOAD_OFFSET};
 use crate::led::LedInputs;
-use crate::lldp::{self, PortIdForm, PortInfo, Schedule};
+use crate::lldp::{self, PortInfo, Schedule};
 use crate::model;
 use crate::pdev::{Mismatch, Pdev, Peer};
 use crate::rpc::epm::{self, EpmInfo};
@@ -427,7 +427,7 @@ impl<H: RecordHook> Device<H> {
                 name: self.dcp.name_of_station(),
                 interface_mac: self.dcp.mac(),
                 ip: Some(self.dcp.ip_suite().ip).filter(|ip| !ip.is_unspecified()),
-                port_id_form: PortIdForm::default(),
+                port_id_form: crate::pdev::interface::port_id_form(self.cm.pdev().interface_mode),
             };
             let mac = self
                 .port_macs

@@ -7,6 +7,7 @@
 //! | 0x802A | 0x8001, 0x8002 | PDPortDataReal (block 0x020F) | own port name `port-00n`, the LLDP neighbour (peer port and station name, its MAC; line delay 0: not measured) or no peer, MAU type 100BASE-TX FD (0 while the link is down), the adjusted domain and multicast boundaries, link state up/down, media type copper |
 //! | 0x802F | 0x8001, 0x8002 | PDPortDataAdjust (block 0x0202) | read: empty while nothing is adjusted, else the adjusted sub-blocks; write: see below |
 //! | 0x802B | 0x8001, 0x8002 | PDPortDataCheck (block 0x0200) | read: empty while nothing is checked, else the check as written; write: CheckPeers, CheckMAUType, CheckLinkState ([`check`]); a difference is a diagnosis on the port's subslot |
+//! | 0x8071 | 0x8000 | PDInterfaceAdjust (block 0x0250) | MultipleInterfaceMode as written (empty while not adjusted); NameOfDevice sets LLDP's Port ID form ([`interface`]) |
 //! | 0x8080 | 0x8000 | PDInterfaceDataReal (block 0x0240) | the name of station (the chassis ID LLDP sends; empty while unnamed), the interface MAC, IP, subnet mask, gateway |
 //!
 //! A write of PDPortDataAdjust may carry the sub-blocks a controller sets
@@ -39,6 +40,7 @@ use crate::rpc::cursor::{Endian, Reader, Writer};
 use crate::wire::MacAddr;
 
 pub mod check;
+pub mod interface;
 #[cfg(test)]
 pub(crate) mod tests;
 #[cfg(test)]
@@ -56,6 +58,8 @@ pub mod index {
     pub const PD_PORT_DATA_CHECK: u16 = 0x802B;
     /// PDInterfaceDataReal (interface subslot).
     pub const PD_INTERFACE_DATA_REAL: u16 = 0x8080;
+    /// PDInterfaceAdjust (interface subslot, [`super::interface`]).
+    pub const PD_INTERFACE_ADJUST: u16 = 0x8071;
 }
 
 /// Block types of the PDev records.
@@ -179,6 +183,8 @@ pub struct Pdev {
     pub ip: IpSuite,
     /// Port 1 and 2.
     pub ports: [PortState; model::PORTS as usize],
+    /// PDInterfaceAdjust's MultipleInterfaceMode; `None`: not adjusted.
+    pub interface_mode: Option<u32>,
 }
 
 fn port_of(subslot: u16) -> Option<usize> {
@@ -227,6 +233,7 @@ impl Pdev {
             name,
             ip,
             ports: [port(p1, true), port(p2, false)],
+            interface_mode: None,
         }
     }
 
@@ -276,6 +283,7 @@ impl Pdev {
                 | index::PD_PORT_DATA_ADJUST
                 | index::PD_PORT_DATA_CHECK
                 | index::PD_INTERFACE_DATA_REAL
+                | index::PD_INTERFACE_ADJUST
         )
     }
 
@@ -284,6 +292,9 @@ impl Pdev {
         let mut w = Writer::new(out, Endian::Big);
         let ok = match (addr.slot, addr.index) {
             (0, index::PD_INTERFACE_DATA_REAL) if addr.subslot == 0x8000 => self.emit_interface_real(&mut w),
+            (0, index::PD_INTERFACE_ADJUST) if addr.subslot == 0x8000 => {
+                interface::emit(&mut w, self.interface_mode)
+            }
             (0, index::PD_PORT_DATA_REAL | index::PD_PORT_DATA_ADJUST | index::PD_PORT_DATA_CHECK) => {
                 let i = port_of(addr.subslot).ok_or(misplaced(addr))?;
                 let p = self.ports.get(i).ok_or(RecordError::InvalidSlotSubslot)?;
@@ -324,6 +335,10 @@ impl Pdev {
                 Ok(())
             }
             (0, index::PD_INTERFACE_DATA_REAL) if addr.subslot == 0x8000 => Err(RecordError::AccessDenied),
+            (0, index::PD_INTERFACE_ADJUST) if addr.subslot == 0x8000 => {
+                self.interface_mode = Some(interface::parse(data)?);
+                Ok(())
+            }
             _ => Err(misplaced(addr)),
         }
     }

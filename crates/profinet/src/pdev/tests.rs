@@ -212,7 +212,7 @@ fn p040_pdev_records_at_the_wrong_subslot_are_refused_and_other_indices_stay_inv
     assert_eq!(r.read(0x8000, index::PD_PORT_DATA_REAL).0, rw(0xB0, false));
     assert_eq!(r.read(0x8001, index::PD_INTERFACE_DATA_REAL).0, rw(0xB0, false));
     assert_eq!(r.read(0x8003, index::PD_PORT_DATA_REAL).0, rw(0xB2, false));
-    // PDPortStatistic, PDInterfaceAdjust: not served (PDPortDataCheck reads back empty: pn32)
+    // PDPortStatistic: not served; PDInterfaceAdjust only at the interface
     for i in [0x8072, 0x8071] {
         assert_eq!(r.read(0x8001, i).0, rw(0xB0, false), "{i:#x}");
     }

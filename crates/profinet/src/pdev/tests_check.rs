@@ -108,3 +108,59 @@ fn p040_bad_pd_port_data_check_blocks_are_refused_and_nothing_is_stored() {
     assert_eq!(write(&mut r, 0x8000, &good), PnioStatus::rw(0xDF, 0xB0));
     assert_eq!(write(&mut r, 0x8003, &good), PnioStatus::rw(0xDF, 0xB2));
 }
+
+/// The LLDP frames `poll` sends at `now`.
+fn lldp_at(r: &mut Rig<NoRecords>, now: nanos::Nanos) -> Vec<Vec<u8>> {
+    let mut out = Vec::new();
+    r.d.poll(now, &mut |f: &[u8]| out.push(f.to_vec()));
+    out.into_iter().filter(|f| f[12..14] == [0x88, 0xCC]).collect()
+}
+
+fn has(f: &[u8], s: &[u8]) -> bool {
+    f.windows(s.len()).any(|w| w == s)
+}
+
+#[test]
+fn p037_p040_pd_interface_adjust_name_of_device_puts_the_name_into_the_lldp_port_id() {
+    let mut r = rig();
+    assert_eq!(
+        r.read(0x8000, index::PD_INTERFACE_ADJUST),
+        (PnioStatus::OK, Vec::new())
+    );
+    let f = lldp_at(&mut r, nanos::Nanos::ZERO);
+    assert_eq!(f.len(), 2);
+    assert!(has(&f[0], b"\x07port-001\x06") && !has(&f[0], b"port-001.drive-1"));
+    // NameOfDevice: the Port ID becomes port-00n.<name of station>
+    let rec = hex("0250 0008 0100 0000 00000001");
+    let w = r.record(true, 0, 0x8000, index::PD_INTERFACE_ADJUST, &rec);
+    assert_eq!(w.0, PnioStatus::OK);
+    assert_eq!(r.read(0x8000, index::PD_INTERFACE_ADJUST).1, rec);
+    let f = lldp_at(&mut r, nanos::Nanos::from_secs(5));
+    assert_eq!(f.len(), 2);
+    assert!(has(&f[0], b"port-001.drive-1") && has(&f[1], b"port-002.drive-1"));
+    assert!(has(&f[0], b"\x07drive-1"), "chassis ID stays the name");
+    // refused: a reserved bit, another block, a wrong length, a port subslot; nothing changes
+    for (data, code1) in [
+        (hex("0250 0008 0100 0000 00000002"), 0xB8),
+        (hex("0251 0008 0100 0000 00000000"), 0xB8),
+        (hex("0250 000a 0100 0000 00000000 0000"), 0xB1),
+        (hex("0250 0008 0100 0000 0000"), 0xB1),
+    ] {
+        let w = r.record(true, 0, 0x8000, index::PD_INTERFACE_ADJUST, &data);
+        assert_eq!(w.0, PnioStatus::rw(0xDF, code1));
+    }
+    let w = r.record(true, 0, 0x8001, index::PD_INTERFACE_ADJUST, &rec);
+    assert_eq!(w.0, PnioStatus::rw(0xDF, 0xB0));
+    assert_eq!(r.read(0x8000, index::PD_INTERFACE_ADJUST).1, rec);
+    // back to NameOfDevice 0: port-001 again
+    let zero = hex("0250 0008 0100 0000 00000000");
+    assert_eq!(
+        r.record(true, 0, 0x8000, index::PD_INTERFACE_ADJUST, &zero).0,
+        PnioStatus::OK
+    );
+    let f = lldp_at(&mut r, nanos::Nanos::from_secs(10));
+    assert!(!has(&f[0], b"port-001.drive-1"));
+    let text = crate::tests_tshark::dissect(&r.frames, "dcerpc && ip.src == 192.168.0.50");
+    let Some(text) = text else { return };
+    assert!(text.contains("PDInterfaceAdjust"), "not dissected");
+}
