@@ -8,6 +8,7 @@
 //! | 0x802F | 0x8001, 0x8002 | PDPortDataAdjust (block 0x0202) | read: empty while nothing is adjusted, else the adjusted sub-blocks; write: see below |
 //! | 0x802B | 0x8001, 0x8002 | PDPortDataCheck (block 0x0200) | read: empty while nothing is checked, else the check as written; write: CheckPeers, CheckMAUType, CheckLinkState ([`check`]); a difference is a diagnosis on the port's subslot |
 //! | 0x8071 | 0x8000 | PDInterfaceAdjust (block 0x0250) | MultipleInterfaceMode as written (empty while not adjusted); NameOfDevice sets LLDP's Port ID form ([`interface`]) |
+//! | 0xF841 | any submodule | PDRealData: MultipleBlockHeader (0x0400) for 0x8000 around PDInterfaceDataReal, then one per port around its PDPortDataReal |
 //! | 0x8080 | 0x8000 | PDInterfaceDataReal (block 0x0240) | the name of station (the chassis ID LLDP sends; empty while unnamed), the interface MAC, IP, subnet mask, gateway |
 //!
 //! A write of PDPortDataAdjust may carry the sub-blocks a controller sets
@@ -58,6 +59,9 @@ pub mod index {
     pub const PD_PORT_DATA_CHECK: u16 = 0x802B;
     /// PDInterfaceDataReal (interface subslot).
     pub const PD_INTERFACE_DATA_REAL: u16 = 0x8080;
+    /// PDRealData (device scope: at any submodule): the real data of the
+    /// interface and its ports, one MultipleBlockHeader each.
+    pub const PD_REAL_DATA: u16 = 0xF841;
     /// PDInterfaceAdjust (interface subslot, [`super::interface`]).
     pub const PD_INTERFACE_ADJUST: u16 = 0x8071;
 }
@@ -70,6 +74,8 @@ pub mod block_type {
     pub const PD_PORT_DATA_ADJUST: u16 = 0x0202;
     /// PDInterfaceDataReal.
     pub const PD_INTERFACE_DATA_REAL: u16 = 0x0240;
+    /// MultipleBlockHeader (PDRealData: one per submodule).
+    pub const MULTIPLE_BLOCK_HEADER: u16 = 0x0400;
     /// AdjustDomainBoundary.
     pub const ADJUST_DOMAIN_BOUNDARY: u16 = 0x0209;
     /// AdjustMulticastBoundary.
@@ -284,12 +290,20 @@ impl Pdev {
                 | index::PD_PORT_DATA_CHECK
                 | index::PD_INTERFACE_DATA_REAL
                 | index::PD_INTERFACE_ADJUST
+                | index::PD_REAL_DATA
         )
     }
 
     /// Reads record `addr` (one of [`Pdev::serves`]) into `out`; its length.
     pub fn read(&self, addr: RecordAddr, out: &mut [u8]) -> Result<usize, RecordError> {
         let mut w = Writer::new(out, Endian::Big);
+        if addr.index == index::PD_REAL_DATA {
+            if !crate::cm::connect::exists(addr.slot, addr.subslot) {
+                return Err(RecordError::InvalidSlotSubslot);
+            }
+            self.emit_real_data(&mut w).ok_or(RecordError::ReadError)?;
+            return Ok(w.pos());
+        }
         let ok = match (addr.slot, addr.index) {
             (0, index::PD_INTERFACE_DATA_REAL) if addr.subslot == 0x8000 => self.emit_interface_real(&mut w),
             (0, index::PD_INTERFACE_ADJUST) if addr.subslot == 0x8000 => {
@@ -335,12 +349,39 @@ impl Pdev {
                 Ok(())
             }
             (0, index::PD_INTERFACE_DATA_REAL) if addr.subslot == 0x8000 => Err(RecordError::AccessDenied),
+            _ if addr.index == index::PD_REAL_DATA => {
+                if crate::cm::connect::exists(addr.slot, addr.subslot) {
+                    Err(RecordError::AccessDenied)
+                } else {
+                    Err(RecordError::InvalidSlotSubslot)
+                }
+            }
             (0, index::PD_INTERFACE_ADJUST) if addr.subslot == 0x8000 => {
                 self.interface_mode = Some(interface::parse(data)?);
                 Ok(())
             }
             _ => Err(misplaced(addr)),
         }
+    }
+
+    /// PDRealData: MultipleBlockHeader (API 0, slot 0, subslot) around
+    /// PDInterfaceDataReal of 0x8000, then around PDPortDataReal of each port.
+    fn emit_real_data(&self, w: &mut Writer<'_>) -> Option<()> {
+        let multiple = |w: &mut Writer<'_>, subslot: u16, body: &dyn Fn(&mut Writer<'_>) -> Option<()>| {
+            emit_block(w, block_type::MULTIPLE_BLOCK_HEADER, |w| {
+                w.zeros(2)?;
+                w.u32(0)?;
+                w.u16(0)?;
+                w.u16(subslot)?;
+                body(w)
+            })
+        };
+        multiple(w, 0x8000, &|w| self.emit_interface_real(w))?;
+        for (i, p) in self.ports.iter().enumerate() {
+            let subslot = 0x8001u16.checked_add(u16::try_from(i).ok()?)?;
+            multiple(w, subslot, &|w| emit_port_real(w, subslot, i, p))?;
+        }
+        Some(())
     }
 
     fn emit_interface_real(&self, w: &mut Writer<'_>) -> Option<()> {

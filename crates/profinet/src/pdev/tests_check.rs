@@ -164,3 +164,34 @@ fn p037_p040_pd_interface_adjust_name_of_device_puts_the_name_into_the_lldp_port
     let Some(text) = text else { return };
     assert!(text.contains("PDInterfaceAdjust"), "not dissected");
 }
+
+#[test]
+fn p040_pd_real_data_holds_the_interface_and_each_port_real_data() {
+    let mut r = rig();
+    r.rx(nanos::Nanos::ZERO, &super::tests::lldp_from_switch());
+    let (status, data) = r.read(1, index::PD_REAL_DATA);
+    assert_eq!(status, PnioStatus::OK);
+    let iface = r.read(0x8000, index::PD_INTERFACE_DATA_REAL).1;
+    let p1 = r.read(0x8001, index::PD_PORT_DATA_REAL).1;
+    let p2 = r.read(0x8002, index::PD_PORT_DATA_REAL).1;
+    let mut want = Vec::new();
+    for (sub, inner) in [(0x8000u16, &iface), (0x8001, &p1), (0x8002, &p2)] {
+        let len = (12 + inner.len()) as u16;
+        want.extend_from_slice(&hex("0400"));
+        want.extend_from_slice(&len.to_be_bytes());
+        want.extend_from_slice(&hex("0100 0000 00000000 0000"));
+        want.extend_from_slice(&sub.to_be_bytes());
+        want.extend_from_slice(inner);
+    }
+    assert_eq!(data, want);
+    assert!(has(&data, b"sw-1"), "port 1's neighbour is in it");
+    // device scope: at the interface too; a missing submodule; read only
+    assert_eq!(r.read(0x8000, index::PD_REAL_DATA).1, want);
+    assert_eq!(r.read(0x8009, index::PD_REAL_DATA).0, PnioStatus::rw(0xDE, 0xB2));
+    let w = r.record(true, 0, 1, index::PD_REAL_DATA, &want);
+    assert_eq!(w.0, PnioStatus::rw(0xDF, 0xB6));
+    let text = crate::tests_tshark::dissect(&r.frames, "dcerpc && ip.src == 192.168.0.50");
+    let Some(text) = text else { return };
+    assert!(text.contains("MultipleBlockHeader"), "not dissected");
+    assert!(!text.contains("Malformed"), "{text}");
+}
