@@ -251,6 +251,19 @@ impl<H: RecordHook> Device<H> {
     /// Takes one received Ethernet frame (without FCS) at `now`; answers due
     /// at once go out through `tx`.
     pub fn receive(&mut self, now: Nanos, frame: &[u8], tx: &mut impl FnMut(&[u8])) {
+        let mut sent = 0usize;
+        let mut counted = |f: &[u8]| {
+            sent = sent.wrapping_add(f.len());
+            tx(f);
+        };
+        self.cm
+            .pdev_mut()
+            .count_in(frame.len(), EthFrame::parse(frame).is_none());
+        self.receive_frame(now, frame, &mut counted);
+        self.cm.pdev_mut().count_out(sent);
+    }
+
+    fn receive_frame(&mut self, now: Nanos, frame: &[u8], tx: &mut impl FnMut(&[u8])) {
         let Some(f) = EthFrame::parse(frame) else {
             self.counters.runt = self.counters.runt.saturating_add(1);
             return;
@@ -405,6 +418,17 @@ impl<H: RecordHook> Device<H> {
     /// ApplicationReady call and its retries), LLDP. Returns when to call
     /// again at the latest.
     pub fn poll(&mut self, now: Nanos, tx: &mut impl FnMut(&[u8])) -> Nanos {
+        let mut sent = 0usize;
+        let mut counted = |f: &[u8]| {
+            sent = sent.wrapping_add(f.len());
+            tx(f);
+        };
+        let next = self.poll_timers(now, &mut counted);
+        self.cm.pdev_mut().count_out(sent);
+        next
+    }
+
+    fn poll_timers(&mut self, now: Nanos, tx: &mut impl FnMut(&[u8])) -> Nanos {
         if !self.started {
             self.started = true;
             self.lldp.kick(now);
@@ -437,6 +461,7 @@ impl<H: RecordHook> Device<H> {
             let mut out = [0u8; 512];
             if let Some(n) = lldp::build_frame(&station, port, &PortInfo::fast_ethernet(mac), &mut out) {
                 tx(out.get(..n).unwrap_or(&[]));
+                self.cm.pdev_mut().count_lldp(port, n);
             }
             self.lldp.sent(port, now);
         }

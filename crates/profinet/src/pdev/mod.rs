@@ -9,6 +9,7 @@
 //! | 0x802B | 0x8001, 0x8002 | PDPortDataCheck (block 0x0200) | read: empty while nothing is checked, else the check as written; write: CheckPeers, CheckMAUType, CheckLinkState ([`check`]); a difference is a diagnosis on the port's subslot |
 //! | 0x8071 | 0x8000 | PDInterfaceAdjust (block 0x0250) | MultipleInterfaceMode as written (empty while not adjusted); NameOfDevice sets LLDP's Port ID form ([`interface`]) |
 //! | 0xF841 | any submodule | PDRealData: MultipleBlockHeader (0x0400) for 0x8000 around PDInterfaceDataReal, then one per port around its PDPortDataReal |
+//! | 0x8072 | 0x8000, 0x8001, 0x8002 | PDPortStatistic (block 0x0251): octet, discard and error counters ([`statistic`]) |
 //! | 0x8080 | 0x8000 | PDInterfaceDataReal (block 0x0240) | the name of station (the chassis ID LLDP sends; empty while unnamed), the interface MAC, IP, subnet mask, gateway |
 //!
 //! A write of PDPortDataAdjust may carry the sub-blocks a controller sets
@@ -42,6 +43,7 @@ use crate::wire::MacAddr;
 
 pub mod check;
 pub mod interface;
+pub mod statistic;
 #[cfg(test)]
 pub(crate) mod tests;
 #[cfg(test)]
@@ -62,6 +64,8 @@ pub mod index {
     /// PDRealData (device scope: at any submodule): the real data of the
     /// interface and its ports, one MultipleBlockHeader each.
     pub const PD_REAL_DATA: u16 = 0xF841;
+    /// PDPortStatistic (interface and port subslots, [`super::statistic`]).
+    pub const PD_PORT_STATISTIC: u16 = 0x8072;
     /// PDInterfaceAdjust (interface subslot, [`super::interface`]).
     pub const PD_INTERFACE_ADJUST: u16 = 0x8071;
 }
@@ -191,6 +195,8 @@ pub struct Pdev {
     pub ports: [PortState; model::PORTS as usize],
     /// PDInterfaceAdjust's MultipleInterfaceMode; `None`: not adjusted.
     pub interface_mode: Option<u32>,
+    /// The counters of PDPortStatistic.
+    pub stats: statistic::Statistics,
 }
 
 fn port_of(subslot: u16) -> Option<usize> {
@@ -240,6 +246,7 @@ impl Pdev {
             ip,
             ports: [port(p1, true), port(p2, false)],
             interface_mode: None,
+            stats: statistic::Statistics::default(),
         }
     }
 
@@ -291,6 +298,7 @@ impl Pdev {
                 | index::PD_INTERFACE_DATA_REAL
                 | index::PD_INTERFACE_ADJUST
                 | index::PD_REAL_DATA
+                | index::PD_PORT_STATISTIC
         )
     }
 
@@ -308,6 +316,10 @@ impl Pdev {
             (0, index::PD_INTERFACE_DATA_REAL) if addr.subslot == 0x8000 => self.emit_interface_real(&mut w),
             (0, index::PD_INTERFACE_ADJUST) if addr.subslot == 0x8000 => {
                 interface::emit(&mut w, self.interface_mode)
+            }
+            (0, index::PD_PORT_STATISTIC) => {
+                let c = self.counters(addr.subslot).ok_or(misplaced(addr))?;
+                statistic::emit(&mut w, &c)
             }
             (0, index::PD_PORT_DATA_REAL | index::PD_PORT_DATA_ADJUST | index::PD_PORT_DATA_CHECK) => {
                 let i = port_of(addr.subslot).ok_or(misplaced(addr))?;
@@ -349,6 +361,9 @@ impl Pdev {
                 Ok(())
             }
             (0, index::PD_INTERFACE_DATA_REAL) if addr.subslot == 0x8000 => Err(RecordError::AccessDenied),
+            (0, index::PD_PORT_STATISTIC) if self.counters(addr.subslot).is_some() => {
+                Err(RecordError::AccessDenied)
+            }
             _ if addr.index == index::PD_REAL_DATA => {
                 if crate::cm::connect::exists(addr.slot, addr.subslot) {
                     Err(RecordError::AccessDenied)

@@ -195,3 +195,45 @@ fn p040_pd_real_data_holds_the_interface_and_each_port_real_data() {
     assert!(text.contains("MultipleBlockHeader"), "not dissected");
     assert!(!text.contains("Malformed"), "{text}");
 }
+
+fn counters(data: &[u8]) -> [u32; 6] {
+    assert_eq!(&data[..8], &hex("0251 001c 0100 0000")[..]);
+    core::array::from_fn(|k| u32::from_be_bytes(data[8 + 4 * k..12 + 4 * k].try_into().unwrap()))
+}
+
+#[test]
+fn p040_pd_port_statistic_counts_the_octets_and_errors_of_the_interface_and_ports() {
+    let mut r = rig();
+    let lldp = lldp_at(&mut r, nanos::Nanos::ZERO);
+    let (status, data) = r.read(0x8000, index::PD_PORT_STATISTIC);
+    assert_eq!(status, PnioStatus::OK);
+    let c0 = counters(&data);
+    let n = r.frames.len();
+    r.rx(nanos::Nanos::ZERO, &super::tests::lldp_from_switch());
+    r.rx(nanos::Nanos::ZERO, &[0u8; 10]); // too short for Ethernet: an input error
+    let c1 = counters(&r.read(0x8000, index::PD_PORT_STATISTIC).1);
+    // frames since: the answer to the first read, the LLDP frame, the runt, the second read
+    let f = &r.frames[n - 1..];
+    let (resp0, neighbour, runt, req1) = (f[0].len(), f[1].len(), f[2].len(), f[3].len());
+    assert_eq!(c1[0] - c0[0], (neighbour + runt + req1) as u32, "ifInOctets");
+    assert_eq!(c1[1] - c0[1], resp0 as u32, "ifOutOctets");
+    assert_eq!(c1[4] - c0[4], 1, "ifInErrors");
+    assert_eq!((c1[2], c1[3], c1[5]), (0, 0, 0), "no discards, no output errors");
+    // port 2 sent only its LLDP frame and received nothing; port 1 the rest
+    let p2 = counters(&r.read(0x8002, index::PD_PORT_STATISTIC).1);
+    assert_eq!(p2, [0, lldp[1].len() as u32, 0, 0, 0, 0]);
+    let pdev = r.d.cm().pdev();
+    let (i, p1) = (pdev.counters(0x8000).unwrap(), pdev.counters(0x8001).unwrap());
+    assert_eq!(p1.in_octets, i.in_octets);
+    assert_eq!(p1.out_octets + lldp[1].len() as u32, i.out_octets);
+    // read only; not on other subslots
+    let w = r.record(true, 0, 0x8001, index::PD_PORT_STATISTIC, &data);
+    assert_eq!(w.0, PnioStatus::rw(0xDF, 0xB6));
+    assert_eq!(
+        r.read(0x8003, index::PD_PORT_STATISTIC).0,
+        PnioStatus::rw(0xDE, 0xB2)
+    );
+    let text = crate::tests_tshark::dissect(&r.frames, "dcerpc && ip.src == 192.168.0.50");
+    let Some(text) = text else { return };
+    assert!(text.contains("PDPortStatistic"), "not dissected");
+}
