@@ -49,8 +49,9 @@ both bind UDP 34964) and goes step by step, one line per result:
 (m) in that AR, the PDev records TIA uses: PDPortDataCheck written to port 1
     and read back as written, PDRealData with a MultipleBlockHeader for the
     interface and each port, PDPortStatistic of the interface counting, and
-    an IODWriteMultiple with one bad sub-write answered with an error
-    ("write length error", DF 80 B1) as the outer status.
+    an IODWriteMultiple with one refused sub-write (CheckLinkState "down")
+    answered with its error ("invalid parameter", DF 80 B8) as the outer
+    status and OK for the good one.
 
 Steps (a)-(g) use legacy startup (profinet-py's own Connect: RTClass 1,
 FrameIDs 0xC000-0xF7FF); with --startup advanced, step (h) connects in
@@ -738,14 +739,29 @@ def main():
                 )
                 # a multiple write with one bad sub-write: the whole answer is an error
                 try:
-                    con.write_multiple([(0, 0x8001, 0x802B, check, 0), (0, 0x8001, 0x802B, bytes(4), 0)])
+                    down = check[:-2] + b"\x00\x02"  # CheckLinkState "down": the device refuses it
+                    con.write_multiple([(0, 0x8001, 0x802B, check, 0), (0, 0x8001, 0x802B, down, 0)])
                     report("m", False, "IODWriteMultiple with a bad sub-write answered OK")
-                except profinet.exceptions.PNIOError as e:
-                    code = (e.error_code << 24) | (e.error_decode << 16) | (e.error_code1 << 8)
+                except profinet.exceptions.PNIOError:
+                    # profinet-py 0.6.6 byte-swaps a big-endian status in its
+                    # exception: read the answer itself (NDR header, outer
+                    # IODWriteResHeader, one per sub-write)
+                    raw = bytes(answers[-1].payload)
+                    status, res = int.from_bytes(raw[0:4], "big"), raw[20:]
+                    outer = int.from_bytes(res[44:48], "big")
+                    subs = [int.from_bytes(b[44:48], "big") for t, b in blocks_of(res[64:]) if t == 0x8008]
+                    ok = (
+                        status & 0xFFFFFF00 == 0xDF80B800
+                        and outer == status
+                        and len(subs) == 2
+                        and subs[0] == 0
+                        and subs[1] & 0xFFFFFF00 == 0xDF80B800
+                    )
                     report(
                         "m",
-                        code == 0xDF80B100,
-                        f"IODWriteMultiple with a bad sub-write: PNIO status 0x{code:08X} (write length error)",
+                        ok,
+                        f"IODWriteMultiple with a bad sub-write: PNIO status 0x{status:08X}, outer header "
+                        f"0x{outer:08X}, sub-writes {' '.join(f'0x{x:08X}' for x in subs)}",
                     )
 
             run("m", pdev_records)
