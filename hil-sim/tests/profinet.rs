@@ -19,7 +19,9 @@
 //!   wrapped for it), and one more Connect, PrmEnd, ApplicationReady,
 //!   Release in advanced startup, in which a 4,068-byte record goes in
 //!   DCE/RPC fragments (answered for its index) and a 4,069-byte one gets
-//!   "write length error". The figure "DCP identify to first valid cyclic data" goes to
+//!   "write length error", and the PDev records TIA uses (PDPortDataCheck
+//!   written and read back, PDRealData, PDPortStatistic) and an
+//!   IODWriteMultiple with a bad sub-write answered with an error. The figure "DCP identify to first valid cyclic data" goes to
 //!   `target/tmp/profinet-py/figures.txt` (`.ci/run` prints it).
 //!
 //! The test asserts on the script's step lines and on the events `serve`
@@ -88,7 +90,7 @@ fn step_lines<'a>(lines: &'a [String], step: &str) -> Vec<&'a str> {
 /// controller goes silent), all with profinet-py as the controller; every
 /// frame of the device dissected by Wireshark without a warning.
 #[test]
-fn p008_p027_p029_p030_p035_p036_p042_p085_p110_p191_p223_profinet_py_names_connects_drives_and_loses_the_drive(
+fn p008_p027_p029_p030_p035_p036_p040_p041_p042_p085_p110_p191_p223_profinet_py_names_connects_drives_and_loses_the_drive(
 ) {
     let python = match common::profinet_py_python() {
         Ok(p) => p,
@@ -155,7 +157,7 @@ fn p008_p027_p029_p030_p035_p036_p042_p085_p110_p191_p223_profinet_py_names_conn
     line.stop_server();
     let serve = line.serve_output();
     println!("--- hil-sim serve ({}):\n{serve}", line.serve_log.display());
-    for step in ["a", "b", "c", "d", "e", "f", "g", "h", "i", "j", "k", "l"] {
+    for step in ["a", "b", "c", "d", "e", "f", "g", "h", "i", "j", "k", "l", "m"] {
         let got = step_lines(&lines, step);
         assert!(
             got.iter().any(|l| l.starts_with("ok: ")) && !got.iter().any(|l| l.starts_with("FAIL: ")),
@@ -197,6 +199,9 @@ fn p008_p027_p029_p030_p035_p036_p042_p085_p110_p191_p223_profinet_py_names_conn
         l.iter().any(|x| x.starts_with("ok: 4068-byte")) && l.iter().any(|x| x.starts_with("ok: 4069-byte")),
         "{l:?}"
     );
+    // P-040, P-041: the PDev records and IODWriteMultiple's outer status (issue 32)
+    let m = step_lines(&lines, "m");
+    assert_eq!(m.iter().filter(|x| x.starts_with("ok: ")).count(), 4, "{m:?}");
     let d = step_lines(&lines, "d");
     assert!(
         d.iter()

@@ -33,8 +33,11 @@ pub(crate) fn dissect(frames: &[Vec<u8>], filter: &str) -> Option<String> {
 /// [`dissect`], where `undecoded` lets record data the dissector does not
 /// know pass (its one "Undecoded" warning per frame).
 pub(crate) fn dissect_with(frames: &[Vec<u8>], filter: &str, undecoded: bool) -> Option<String> {
+    // one file per call: tests run in parallel (the frame count alone collided)
+    static CALLS: core::sync::atomic::AtomicUsize = core::sync::atomic::AtomicUsize::new(0);
+    let call = CALLS.fetch_add(1, core::sync::atomic::Ordering::Relaxed);
     let path = std::env::temp_dir().join(std::format!(
-        "profinet-tshark-{}-{}.pcap",
+        "profinet-tshark-{}-{}-{call}.pcap",
         std::process::id(),
         frames.len()
     ));

@@ -45,7 +45,13 @@ both bind UDP 34964) and goes step by step, one line per result:
     bytes (profinet-py sends a request as one datagram, which IP would have
     to fragment; the fragmenting sender is ours): the device reassembles it
     and answers the record's header with "invalid index" (DF 80 B0), not an
-    RPC fault; a 4,069-byte one gets "write length error" (DF 80 B1).
+    RPC fault; a 4,069-byte one gets "write length error" (DF 80 B1);
+(m) in that AR, the PDev records TIA uses: PDPortDataCheck written to port 1
+    and read back as written, PDRealData with a MultipleBlockHeader for the
+    interface and each port, PDPortStatistic of the interface counting, and
+    an IODWriteMultiple with one refused sub-write (CheckLinkState "down")
+    answered with its error ("invalid parameter", DF 80 B8) as the outer
+    status and OK for the good one.
 
 Steps (a)-(g) use legacy startup (profinet-py's own Connect: RTClass 1,
 FrameIDs 0xC000-0xF7FF); with --startup advanced, step (h) connects in
@@ -706,6 +712,59 @@ def main():
                     )
 
             run("l", big_records)
+
+            # (m) the PDev records TIA writes at start-up and reads online
+            def pdev_records():
+                body = bytes.fromhex("01000000" "0000" "8001") + bytes.fromhex(
+                    "020c00040100" "0010" "021c00040100" "0001"
+                )
+                check = (0x0200).to_bytes(2, "big") + len(body).to_bytes(2, "big") + body
+                con.write(0, 0, 0x8001, 0x802B, check)
+                back = bytes(con.read(0, 0, 0x8001, 0x802B).payload)
+                report(
+                    "m",
+                    back == check,
+                    f"PDPortDataCheck (CheckMAUType 100BASE-TX FD, CheckLinkState up) "
+                    f"written to port 1 and read back: {len(back)} bytes",
+                )
+                real = blocks_of(bytes(con.read(0, 0, 1, 0xF841).payload))
+                subslots = [int.from_bytes(b[14:16], "big") for t, b in real if t == 0x0400]
+                report("m", subslots == [0x8000, 0x8001, 0x8002], f"PDRealData: MultipleBlockHeaders for {[hex(x) for x in subslots]}")
+                stat = bytes(con.read(0, 0, 0x8000, 0x8072).payload)
+                ins, outs = int.from_bytes(stat[8:12], "big"), int.from_bytes(stat[12:16], "big")
+                report(
+                    "m",
+                    stat[:2] == b"\x02\x51" and ins > 0 and outs > 0,
+                    f"PDPortStatistic of the interface: ifInOctets {ins}, ifOutOctets {outs}",
+                )
+                # a multiple write with one bad sub-write: the whole answer is an error
+                try:
+                    down = check[:-2] + b"\x00\x02"  # CheckLinkState "down": the device refuses it
+                    con.write_multiple([(0, 0x8001, 0x802B, check, 0), (0, 0x8001, 0x802B, down, 0)])
+                    report("m", False, "IODWriteMultiple with a bad sub-write answered OK")
+                except profinet.exceptions.PNIOError:
+                    # profinet-py 0.6.6 byte-swaps a big-endian status in its
+                    # exception: read the answer itself (NDR header, outer
+                    # IODWriteResHeader, one per sub-write)
+                    raw = bytes(answers[-1].payload)
+                    status, res = int.from_bytes(raw[0:4], "big"), raw[20:]
+                    outer = int.from_bytes(res[44:48], "big")
+                    subs = [int.from_bytes(b[44:48], "big") for t, b in blocks_of(res[64:]) if t == 0x8008]
+                    ok = (
+                        status & 0xFFFFFF00 == 0xDF80B800
+                        and outer == status
+                        and len(subs) == 2
+                        and subs[0] == 0
+                        and subs[1] & 0xFFFFFF00 == 0xDF80B800
+                    )
+                    report(
+                        "m",
+                        ok,
+                        f"IODWriteMultiple with a bad sub-write: PNIO status 0x{status:08X}, outer header "
+                        f"0x{outer:08X}, sub-writes {' '.join(f'0x{x:08X}' for x in subs)}",
+                    )
+
+            run("m", pdev_records)
             status, block = release(con)
             if status != 0:
                 report("k", False, f"Release refused: 0x{status:08X}")

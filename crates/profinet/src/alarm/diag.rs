@@ -29,38 +29,48 @@ use super::Priority;
 
 /// A drive error HH-S (spec §2.7): main index 1…96; sub-index 0…15
 /// ([`crate::model::SUB_ERRORS`]: the manual's S is 0…9, the drive's event
-/// causes, which S carries, go to 15 — the GSDML's ExtChannelDiagList).
+/// causes, which S carries, go to 15 — the GSDML's ExtChannelDiagList); or
+/// one of the standard's port diagnoses ([`DriveError::port`]: a topology
+/// mismatch of PDPortDataCheck).
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]
 pub struct DriveError {
-    main: u8,
-    sub: u8,
+    error_type: u16,
+    ext: u16,
 }
 
 impl DriveError {
     /// The error HH-S, if HH is 1…96 and S 0…15.
     pub const fn new(main: u8, sub: u8) -> Option<DriveError> {
         if main >= 1 && main <= 96 && sub <= *crate::model::SUB_ERRORS.end() {
-            Some(DriveError { main, sub })
+            Some(DriveError {
+                error_type: 0x1000 + main as u16,
+                ext: 0x1000 + sub as u16,
+            })
         } else {
             None
         }
     }
-    /// HH.
-    pub const fn main(self) -> u8 {
-        self.main
+    /// A diagnosis of the standard's ChannelErrorType range (0x8000…,
+    /// IEC 61158-6-10) with its ExtChannelErrorType, as a port raises it.
+    pub const fn port(error_type: u16, ext: u16) -> DriveError {
+        DriveError { error_type, ext }
     }
-    /// S.
+    /// HH (the low octet of ChannelErrorType).
+    pub const fn main(self) -> u8 {
+        (self.error_type & 0xFF) as u8
+    }
+    /// S (the low octet of ExtChannelErrorType).
     pub const fn sub(self) -> u8 {
-        self.sub
+        (self.ext & 0xFF) as u8
     }
     /// ChannelErrorType = 0x1000 + HH, HH as a binary number (Q-13: 22 →
-    /// 0x1016, not 0x1022).
+    /// 0x1016, not 0x1022); a port's as given.
     pub const fn channel_error_type(self) -> u16 {
-        0x1000 + self.main as u16
+        self.error_type
     }
-    /// ExtChannelErrorType = 0x1000 + S.
+    /// ExtChannelErrorType = 0x1000 + S; a port's as given.
     pub const fn ext_channel_error_type(self) -> u16 {
-        0x1000 + self.sub as u16
+        self.ext
     }
 }
 

@@ -476,8 +476,16 @@ impl<H: RecordHook> Cm<H> {
 
     /// The sub-writes of a multiple write (`depth` 0 for the outer one). A
     /// multiple write nested inside one (as profinet-py 0.6.6 sends) is
-    /// flattened once; deeper nesting is refused.
-    fn write_multiple(&mut self, data: &[u8], w: &mut Writer<'_>, depth: u8) -> Option<()> {
+    /// flattened once; deeper nesting is refused. Each sub-write is done on
+    /// its own and answered with its own status; `failed` keeps the first
+    /// refusal's status (the outer status of the IODWriteMultipleRes).
+    fn write_multiple(
+        &mut self,
+        data: &[u8],
+        w: &mut Writer<'_>,
+        depth: u8,
+        failed: &mut Option<PnioStatus>,
+    ) -> Option<()> {
         let mut r = Reader::new(data, Endian::Big);
         while r.remaining() > 0 {
             let (req, rest) = RwRequest::parse(r.rest()).filter(|(q, _)| q.write)?;
@@ -486,7 +494,7 @@ impl<H: RecordHook> Cm<H> {
             r.skip(RW_HEADER_LEN.checked_add(len)?)?;
             r.align(4).or(Some(()))?;
             if req.addr.index == index::WRITE_MULTIPLE && depth == 0 {
-                self.write_multiple(sub, w, 1)?;
+                self.write_multiple(sub, w, 1, failed)?;
                 continue;
             }
             let status = if req.addr.index == index::WRITE_MULTIPLE {
@@ -499,6 +507,9 @@ impl<H: RecordHook> Cm<H> {
                     Err(e) => e.status(ec::IOD_WRITE_RES),
                 }
             };
+            if !status.is_ok() && failed.is_none() {
+                *failed = Some(status);
+            }
             record::emit_write_res(w, &req, req.record_len, status)?;
         }
         Some(())
@@ -531,7 +542,11 @@ impl<H: RecordHook> Cm<H> {
         };
         if req.addr.index == index::WRITE_MULTIPLE {
             let Some(n) = Self::count_writes(data, 0) else {
-                return PnioStatus::pnio(code, error_code1::RECORD, 0);
+                // a sub-header that does not parse or a sub-record running
+                // past the end: the outer header with "write length error"
+                let s = RecordError::WriteLength.status(code);
+                let _ = record::emit_write_res(w, &req, req.record_len, s);
+                return s;
             };
             let room = n.checked_add(1).and_then(|k| k.checked_mul(RW_HEADER_LEN));
             if room.is_none_or(|r| w.rest_mut().len() < r) {
@@ -542,12 +557,19 @@ impl<H: RecordHook> Cm<H> {
                 return PnioStatus::cmrpc(code, cmrpc::OUT_OF_RESOURCES);
             }
             let body = w.pos();
-            if self.write_multiple(data, w, 0).is_none() {
+            let mut failed = None;
+            if self.write_multiple(data, w, 0, &mut failed).is_none() {
                 return PnioStatus::pnio(code, error_code1::RECORD, 0);
             }
             let n = w.pos().saturating_sub(body);
             let _ = w.patch_u32(at + 36, u32::try_from(n).unwrap_or(0));
-            return PnioStatus::OK;
+            // A refused sub-write makes the whole answer an error: the outer
+            // header and the NDR status carry the first refusal's status
+            // (its own header names it); the good sub-writes stay done with
+            // status OK in theirs.
+            let status = failed.unwrap_or(PnioStatus::OK);
+            let _ = w.patch_u32(at + 44, u32::from_be_bytes(status.to_bytes()));
+            return status;
         }
         let status = match self.write_one(req.addr, data) {
             Ok(()) => PnioStatus::OK,

@@ -116,12 +116,13 @@ fn p039_im_writes_of_wrong_length_or_to_im0_are_refused() {
 fn p041_write_multiple_answers_each_write() {
     // profinet-py wraps its multiple write into a second E040 header; the
     // nested one is flattened and each sub-write answered: raw bytes are no
-    // I&M block, so both get "write length error".
+    // I&M block, so both get "write length error", and so does the whole.
     let mut d = dev();
     d.call(CONNECT);
     let (status, args) = d.call(WRITE_MULTIPLE);
-    assert_eq!(status, PnioStatus::OK);
+    assert_eq!(status, PnioStatus::rw(0xDF, 0xB1));
     assert_eq!(&args[INDEX_AT..INDEX_AT + 6], &hex("e040 00000080")[..]);
+    assert_eq!(&args[44..48], &[0xDF, 0x80, 0xB1, 0x00]);
     assert_eq!(args.len(), 64 * 3);
     for (k, index) in [(1, 0xAFF3u16), (2, 0xAFF2)] {
         let r = &args[64 * k..64 * (k + 1)];
@@ -242,6 +243,93 @@ fn p041_a_small_args_maximum_gets_whole_blocks_or_none_and_changes_nothing() {
     let (status, args) = call_with(&mut d, WRITE_IM1, 3, 192, &multi);
     assert_eq!((status, args.len()), (PnioStatus::OK, 192));
     assert_ne!(d.cm.im_data(), &ImData::default());
+}
+
+/// An IODWriteMultipleReq (args) of the given sub-writes (each a whole
+/// IODWriteReq: header and record), padded to 4 bytes between them.
+fn multiple(subs: &[&[u8]]) -> std::vec::Vec<u8> {
+    let mut body = std::vec::Vec::new();
+    for s in subs {
+        while body.len() % 4 != 0 {
+            body.push(0);
+        }
+        body.extend_from_slice(s);
+    }
+    let mut multi = subs[0][..64].to_vec();
+    multi[INDEX_AT..INDEX_AT + 2].copy_from_slice(&index::WRITE_MULTIPLE.to_be_bytes());
+    multi[36..40].copy_from_slice(&(body.len() as u32).to_be_bytes());
+    multi.extend_from_slice(&body);
+    multi
+}
+
+#[test]
+fn p041_write_multiple_with_a_refused_sub_write_is_an_error_and_keeps_the_good_ones() {
+    // I&M1 (good), I&M0 (read only: access denied), I&M2 (good): each is
+    // answered with its own status; the outer header and the NDR status carry
+    // the refusal, and the good ones are written.
+    let mut d = dev();
+    d.call(CONNECT);
+    let im1 = hex(WRITE_IM1)[100..].to_vec();
+    let im2 = hex(WRITE_IM2)[100..].to_vec();
+    let mut im0 = im1.clone();
+    im0[INDEX_AT..INDEX_AT + 2].copy_from_slice(&[0xAF, 0xF0]);
+    let (status, args) = call_with(&mut d, WRITE_IM1, 3, 1024, &multiple(&[&im1, &im0, &im2]));
+    let denied = PnioStatus::rw(0xDF, 0xB6);
+    assert_eq!(status, denied);
+    assert_eq!(args.len(), 64 * 4);
+    assert_eq!(&args[INDEX_AT..INDEX_AT + 2], &[0xE0, 0x40]);
+    assert_eq!(&args[44..48], &denied.to_bytes());
+    assert_eq!(&args[36..40], &(64u32 * 3).to_be_bytes());
+    let sub = |k: usize| &args[64 * k..64 * (k + 1)];
+    assert_eq!(
+        (&sub(1)[INDEX_AT..INDEX_AT + 2], &sub(1)[44..48]),
+        (&[0xAF, 0xF1][..], &[0u8; 4][..])
+    );
+    assert_eq!(
+        (&sub(2)[INDEX_AT..INDEX_AT + 2], &sub(2)[44..48]),
+        (&[0xAF, 0xF0][..], &denied.to_bytes()[..])
+    );
+    assert_eq!(
+        (&sub(3)[INDEX_AT..INDEX_AT + 2], &sub(3)[44..48]),
+        (&[0xAF, 0xF2][..], &[0u8; 4][..])
+    );
+    assert_eq!(&d.cm.im_data().tag_function[..8], b"Axis 1  ");
+    assert_eq!(&d.cm.im_data().date, b"2024-05-28 10:30");
+    // all good: the outer status is OK
+    let (status, args) = call_with(&mut d, WRITE_IM1, 3, 1024, &multiple(&[&im1, &im2]));
+    assert_eq!((status, &args[44..48]), (PnioStatus::OK, &[0u8; 4][..]));
+}
+
+#[test]
+fn p041_refused_writes_answer_with_a_full_iod_write_res_header() {
+    // Wireshark marks an IODWriteRes with ArgsLength 0 malformed: every
+    // refusal of a write whose header parses names the record in a header.
+    let mut d = dev();
+    d.call(CONNECT);
+    let im1 = hex(WRITE_IM1)[100..].to_vec();
+    // a multiple write whose sub-record runs past its end
+    let mut cut = multiple(&[&im1]);
+    let n = cut.len() as u32 - 64;
+    cut[64 + 36..64 + 40].copy_from_slice(&(n + 8).to_be_bytes());
+    let (status, args) = call_with(&mut d, WRITE_IM1, 3, 1024, &cut);
+    assert_eq!(status, PnioStatus::rw(0xDF, 0xB1));
+    assert_eq!(args.len(), 64);
+    assert_eq!(
+        (&args[..2], &args[INDEX_AT..INDEX_AT + 2], &args[44..48]),
+        (&[0x80, 0x08][..], &[0xE0, 0x40][..], &status.to_bytes()[..])
+    );
+    // a write to an unknown index, one too long for its data, one to a missing subslot
+    for (patched, want) in [
+        (patch(WRITE_IM1, INDEX_AT, &[0x12, 0x34]), 0xB0),
+        (patch(WRITE_IM1, 36, &[0, 0, 0x10, 0]), 0xB1),
+        (patch(WRITE_IM1, 28, &[0, 9]), 0xB2),
+    ] {
+        let (status, args) = d.call(&patched);
+        assert_eq!(status, PnioStatus::rw(0xDF, want), "{want:#x}");
+        assert_eq!((args.len(), &args[..2]), (64, &[0x80, 0x08][..]));
+        assert_eq!(&args[44..48], &status.to_bytes());
+    }
+    assert_eq!(d.cm.im_data(), &ImData::default());
 }
 
 #[test]

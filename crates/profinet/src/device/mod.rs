@@ -21,15 +21,15 @@
 use heapless::{Deque, Vec};
 use nanos::Nanos;
 
-use crate::alarm::{AbortCode, AlarmEvent, DiagList, DriveError, Maintenance, Output, Priority};
+use crate::alarm::{AbortCode, AlarmEvent, DiagList, DriveError, Location, Maintenance, Output, Priority};
 use crate::cm::{Cm, CmConfig, CmEvent, Im0, ImData, NoRecords, RecordHook};
 use crate::dcp::server::{DcpServer, Event as DcpEvent, Identity};
 use crate::dcp::{IpSuite, NameOfStation};
 use crate::ip::{IpConfig, Received, Stack, UdpTx, RPC_PORT, UDP_PAYLOAD_OFFSET};
 use crate::led::LedInputs;
-use crate::lldp::{self, PortIdForm, PortInfo, Schedule};
+use crate::lldp::{self, PortInfo, Schedule};
 use crate::model;
-use crate::pdev::{Pdev, Peer};
+use crate::pdev::{Mismatch, Pdev, Peer};
 use crate::rpc::epm::{self, EpmInfo};
 use crate::rpc::server::{Server, ServerConfig};
 use crate::rpc::uuid;
@@ -251,6 +251,19 @@ impl<H: RecordHook> Device<H> {
     /// Takes one received Ethernet frame (without FCS) at `now`; answers due
     /// at once go out through `tx`.
     pub fn receive(&mut self, now: Nanos, frame: &[u8], tx: &mut impl FnMut(&[u8])) {
+        let mut sent = 0usize;
+        let mut counted = |f: &[u8]| {
+            sent = sent.wrapping_add(f.len());
+            tx(f);
+        };
+        self.cm
+            .pdev_mut()
+            .count_in(frame.len(), EthFrame::parse(frame).is_none());
+        self.receive_frame(now, frame, &mut counted);
+        self.cm.pdev_mut().count_out(sent);
+    }
+
+    fn receive_frame(&mut self, now: Nanos, frame: &[u8], tx: &mut impl FnMut(&[u8])) {
         let Some(f) = EthFrame::parse(frame) else {
             self.counters.runt = self.counters.runt.saturating_add(1);
             return;
@@ -405,6 +418,17 @@ impl<H: RecordHook> Device<H> {
     /// ApplicationReady call and its retries), LLDP. Returns when to call
     /// again at the latest.
     pub fn poll(&mut self, now: Nanos, tx: &mut impl FnMut(&[u8])) -> Nanos {
+        let mut sent = 0usize;
+        let mut counted = |f: &[u8]| {
+            sent = sent.wrapping_add(f.len());
+            tx(f);
+        };
+        let next = self.poll_timers(now, &mut counted);
+        self.cm.pdev_mut().count_out(sent);
+        next
+    }
+
+    fn poll_timers(&mut self, now: Nanos, tx: &mut impl FnMut(&[u8])) -> Nanos {
         if !self.started {
             self.started = true;
             self.lldp.kick(now);
@@ -427,7 +451,7 @@ impl<H: RecordHook> Device<H> {
                 name: self.dcp.name_of_station(),
                 interface_mac: self.dcp.mac(),
                 ip: Some(self.dcp.ip_suite().ip).filter(|ip| !ip.is_unspecified()),
-                port_id_form: PortIdForm::default(),
+                port_id_form: crate::pdev::interface::port_id_form(self.cm.pdev().interface_mode),
             };
             let mac = self
                 .port_macs
@@ -437,9 +461,11 @@ impl<H: RecordHook> Device<H> {
             let mut out = [0u8; 512];
             if let Some(n) = lldp::build_frame(&station, port, &PortInfo::fast_ethernet(mac), &mut out) {
                 tx(out.get(..n).unwrap_or(&[]));
+                self.cm.pdev_mut().count_lldp(port, n);
             }
             self.lldp.sent(port, now);
         }
+        self.check_topology();
         self.drain_rpc(now, tx);
         self.run_cyclic(now, tx);
         self.run_alarms(now, tx);
@@ -516,6 +542,31 @@ impl<H: RecordHook> Device<H> {
         self.diag
             .raise(Cyclic::drive_location(), e, Maintenance::Fault, 0)
             .is_ok()
+    }
+
+    /// The ports' topology against their PDPortDataCheck (P-040): each
+    /// difference is a diagnosis on the port's subslot (an "appears" alarm in
+    /// an AR), gone ("disappears") once the neighbour, MAU type or link
+    /// matches again or the check is withdrawn.
+    fn check_topology(&mut self) {
+        for port in 1..=model::PORTS {
+            let loc = Location {
+                api: 0,
+                slot: 0,
+                subslot: 0x8000 | port,
+                module_ident: model::DAP_MODULE_IDENT,
+                submodule_ident: model::port_submodule_ident(port),
+            };
+            for kind in Mismatch::ALL {
+                let (t, x) = kind.error_types();
+                let e = DriveError::port(t, x);
+                if self.cm.pdev().mismatch(port, kind) {
+                    let _ = self.diag.raise(loc, e, Maintenance::Fault, 0);
+                } else {
+                    self.diag.clear(&loc, e);
+                }
+            }
+        }
     }
 
     /// The drive error HH-S is gone (acknowledged, P-035): a "disappears"

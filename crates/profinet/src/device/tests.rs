@@ -202,3 +202,126 @@ fn p030_a_drive_error_goes_out_as_a_diagnosis_alarm_with_0x1000_plus_hh_s() {
     assert!(d.diagnosis_present());
     assert!(!d.raise_diagnosis(97, 0), "HH outside 1…96");
 }
+
+/// The low-priority alarm frames among `frames`.
+fn alarms(frames: &[Vec<u8>]) -> Vec<Vec<u8>> {
+    frames
+        .iter()
+        .filter(|f| frame_id(f) == Some(0xFE01) && f.len() > 40)
+        .cloned()
+        .collect()
+}
+
+/// Whether an alarm frame carries AlarmType `ty` for subslot `subslot` with
+/// (ChannelErrorType, ExtChannelErrorType) `types`.
+fn alarm_is(f: &[u8], ty: u16, subslot: u16, types: (u16, u16)) -> bool {
+    let mut at = std::vec::Vec::new();
+    at.extend_from_slice(&ty.to_be_bytes());
+    let mut e = std::vec::Vec::new();
+    e.extend_from_slice(&types.0.to_be_bytes());
+    e.extend_from_slice(&types.1.to_be_bytes());
+    f.windows(2).any(|w| w == at)
+        && f.windows(2).any(|w| w == subslot.to_be_bytes())
+        && f.windows(4).any(|w| w == e)
+}
+
+/// The controller's answer to our alarm frame `ours` as profinet-py sends
+/// it: a transport ACK, then an AlarmAck (DATA, its send sequence number
+/// `seq`) naming the alarm, with status OK.
+fn ack_alarm(d: &mut Device, ours: &[u8], seq: u16, now: Nanos) {
+    let e = EthFrame::parse(ours).unwrap();
+    let (h, v) = crate::alarm::RtaHeader::parse(&e.payload[2..]).unwrap();
+    let frame = |pdu: u8, flags: u8, send: u16, var: &[u8]| {
+        let mut f = std::vec::Vec::new();
+        f.extend_from_slice(&OUR_MAC.0);
+        f.extend_from_slice(&CTRL_MAC.0);
+        f.extend_from_slice(&[0x81, 0x00, 0xA0, 0x00, 0x88, 0x92, 0xFE, 0x01]);
+        for x in [h.src_endpoint, h.dst_endpoint] {
+            f.extend_from_slice(&x.to_be_bytes());
+        }
+        f.extend_from_slice(&[pdu, flags]);
+        for x in [send, h.send_seq, var.len() as u16] {
+            f.extend_from_slice(&x.to_be_bytes());
+        }
+        f.extend_from_slice(var);
+        f.resize(f.len().max(60), 0);
+        f
+    };
+    // its last DATA's number (0xFFFF before the first)
+    let last = if seq == 0xFFFF || seq == 0 {
+        0xFFFF
+    } else {
+        seq - 1
+    };
+    sent(d, now, &frame(0x13, 0x01, last, &[]));
+    // AlarmAck-Low: AlarmType, API, slot, subslot of the notification, its specifier, OK
+    let mut ack = std::vec![0x80, 0x02, 0x00, 0x12, 0x01, 0x00];
+    ack.extend_from_slice(&v[6..16]);
+    ack.extend_from_slice(&v[24..26]);
+    ack.extend_from_slice(&[0; 4]);
+    sent(d, now, &frame(0x11, 0x11, seq, &ack));
+    poll(d, now);
+}
+
+#[test]
+fn p040_a_topology_mismatch_raises_a_port_diagnosis_alarm_that_disappears_when_it_matches() {
+    use crate::pdev::tests::{lldp_from_switch, record_rpc};
+    use crate::pdev::tests_check::{check, LINK_UP_CHECK, PEERS_SW1};
+    let mut d = connected();
+    let f = output_frame(&d, 0, 1);
+    sent(&mut d, Nanos::ZERO, &f);
+    poll(&mut d, Nanos::ZERO);
+    assert!(!d.diagnosis_present());
+    // TIA's check: port-003 of sw-1 on port 1, link up; port 1 has no neighbour yet
+    let mut subs = crate::rpc::tests::hex(PEERS_SW1);
+    subs.extend_from_slice(&crate::rpc::tests::hex(LINK_UP_CHECK));
+    let rpc = record_rpc(
+        true,
+        300,
+        0,
+        0x8001,
+        crate::pdev::index::PD_PORT_DATA_CHECK,
+        &check(0x8001, &subs),
+    );
+    let out = sent(&mut d, Nanos::ZERO, &testing::udp_to_device(&rpc));
+    assert_eq!(out.len(), 1);
+    let a = alarms(&poll(&mut d, Nanos::from_ms(1)));
+    assert_eq!(a.len(), 1, "one appears alarm");
+    assert!(
+        alarm_is(&a[0], 0x0001, 0x8001, (0x8001, 0x8005)),
+        "no peer detected"
+    );
+    assert!(d.diagnosis_present());
+    ack_alarm(&mut d, &a[0], 0xFFFF, Nanos::from_ms(1));
+    // the expected neighbour answers: the diagnosis disappears
+    sent(&mut d, Nanos::from_ms(2), &lldp_from_switch());
+    let a = alarms(&poll(&mut d, Nanos::from_ms(2)));
+    assert_eq!(a.len(), 1, "one disappears alarm");
+    assert!(alarm_is(&a[0], 0x000C, 0x8001, (0x8001, 0x8005)));
+    ack_alarm(&mut d, &a[0], 0, Nanos::from_ms(2));
+    assert!(!d.diagnosis_present());
+    // another station on port 1: peer name of station mismatch
+    let mut other = lldp_from_switch();
+    let at = other.windows(4).position(|w| w == b"sw-1").unwrap();
+    other[at + 3] = b'2';
+    sent(&mut d, Nanos::from_ms(3), &other);
+    let a = alarms(&poll(&mut d, Nanos::from_ms(3)));
+    assert!(
+        alarm_is(&a[0], 0x0001, 0x8001, (0x8001, 0x8000)),
+        "station mismatch"
+    );
+    ack_alarm(&mut d, &a[0], 1, Nanos::from_ms(3));
+    sent(&mut d, Nanos::from_ms(4), &lldp_from_switch());
+    let a = alarms(&poll(&mut d, Nanos::from_ms(4)));
+    assert!(alarm_is(&a[0], 0x000C, 0x8001, (0x8001, 0x8000)));
+    ack_alarm(&mut d, &a[0], 2, Nanos::from_ms(4));
+    // the link goes down: link state mismatch on port 1's subslot
+    d.set_port_link(1, false);
+    let a = alarms(&poll(&mut d, Nanos::from_ms(5)));
+    assert!(alarm_is(&a[0], 0x0001, 0x8001, (0x8000, 0x8000)), "link down");
+    ack_alarm(&mut d, &a[0], 3, Nanos::from_ms(5));
+    assert!(d.diagnosis_present());
+    // port 2 has no check: its link changes raise nothing
+    d.set_port_link(2, true);
+    assert!(alarms(&poll(&mut d, Nanos::from_ms(6))).is_empty());
+}

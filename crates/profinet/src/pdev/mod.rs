@@ -6,6 +6,10 @@
 //! |---|---|---|---|
 //! | 0x802A | 0x8001, 0x8002 | PDPortDataReal (block 0x020F) | own port name `port-00n`, the LLDP neighbour (peer port and station name, its MAC; line delay 0: not measured) or no peer, MAU type 100BASE-TX FD (0 while the link is down), the adjusted domain and multicast boundaries, link state up/down, media type copper |
 //! | 0x802F | 0x8001, 0x8002 | PDPortDataAdjust (block 0x0202) | read: empty while nothing is adjusted, else the adjusted sub-blocks; write: see below |
+//! | 0x802B | 0x8001, 0x8002 | PDPortDataCheck (block 0x0200) | read: empty while nothing is checked, else the check as written; write: CheckPeers, CheckMAUType, CheckLinkState ([`check`]); a difference is a diagnosis on the port's subslot |
+//! | 0x8071 | 0x8000 | PDInterfaceAdjust (block 0x0250) | MultipleInterfaceMode as written (empty while not adjusted); NameOfDevice sets LLDP's Port ID form ([`interface`]) |
+//! | 0xF841 | any submodule | PDRealData: MultipleBlockHeader (0x0400) for 0x8000 around PDInterfaceDataReal, then one per port around its PDPortDataReal |
+//! | 0x8072 | 0x8000, 0x8001, 0x8002 | PDPortStatistic (block 0x0251): octet, discard and error counters ([`statistic`]) |
 //! | 0x8080 | 0x8000 | PDInterfaceDataReal (block 0x0240) | the name of station (the chassis ID LLDP sends; empty while unnamed), the interface MAC, IP, subnet mask, gateway |
 //!
 //! A write of PDPortDataAdjust may carry the sub-blocks a controller sets
@@ -37,8 +41,15 @@ use crate::model;
 use crate::rpc::cursor::{Endian, Reader, Writer};
 use crate::wire::MacAddr;
 
+pub mod check;
+pub mod interface;
+pub mod statistic;
 #[cfg(test)]
 pub(crate) mod tests;
+#[cfg(test)]
+pub(crate) mod tests_check;
+
+pub use check::{Mismatch, PortCheck};
 
 /// Record indices of the PDev.
 pub mod index {
@@ -46,10 +57,17 @@ pub mod index {
     pub const PD_PORT_DATA_REAL: u16 = 0x802A;
     /// PDPortDataAdjust (port subslots).
     pub const PD_PORT_DATA_ADJUST: u16 = 0x802F;
-    /// PDPortDataCheck (port subslots): read empty, no check is configured.
+    /// PDPortDataCheck (port subslots): the topology check ([`super::check`]).
     pub const PD_PORT_DATA_CHECK: u16 = 0x802B;
     /// PDInterfaceDataReal (interface subslot).
     pub const PD_INTERFACE_DATA_REAL: u16 = 0x8080;
+    /// PDRealData (device scope: at any submodule): the real data of the
+    /// interface and its ports, one MultipleBlockHeader each.
+    pub const PD_REAL_DATA: u16 = 0xF841;
+    /// PDPortStatistic (interface and port subslots, [`super::statistic`]).
+    pub const PD_PORT_STATISTIC: u16 = 0x8072;
+    /// PDInterfaceAdjust (interface subslot, [`super::interface`]).
+    pub const PD_INTERFACE_ADJUST: u16 = 0x8071;
 }
 
 /// Block types of the PDev records.
@@ -60,6 +78,8 @@ pub mod block_type {
     pub const PD_PORT_DATA_ADJUST: u16 = 0x0202;
     /// PDInterfaceDataReal.
     pub const PD_INTERFACE_DATA_REAL: u16 = 0x0240;
+    /// MultipleBlockHeader (PDRealData: one per submodule).
+    pub const MULTIPLE_BLOCK_HEADER: u16 = 0x0400;
     /// AdjustDomainBoundary.
     pub const ADJUST_DOMAIN_BOUNDARY: u16 = 0x0209;
     /// AdjustMulticastBoundary.
@@ -157,6 +177,8 @@ pub struct PortState {
     pub peer: Option<Peer>,
     /// The adjusted values.
     pub adjust: PortAdjust,
+    /// The checked topology (PDPortDataCheck).
+    pub check: PortCheck,
 }
 
 /// The PDev of the interface X1 and its ports: what the records report.
@@ -171,6 +193,10 @@ pub struct Pdev {
     pub ip: IpSuite,
     /// Port 1 and 2.
     pub ports: [PortState; model::PORTS as usize],
+    /// PDInterfaceAdjust's MultipleInterfaceMode; `None`: not adjusted.
+    pub interface_mode: Option<u32>,
+    /// The counters of PDPortStatistic.
+    pub stats: statistic::Statistics,
 }
 
 fn port_of(subslot: u16) -> Option<usize> {
@@ -212,12 +238,15 @@ impl Pdev {
             link_up,
             peer: None,
             adjust: PortAdjust::default(),
+            check: PortCheck::default(),
         };
         Pdev {
             mac,
             name,
             ip,
             ports: [port(p1, true), port(p2, false)],
+            interface_mode: None,
+            stats: statistic::Statistics::default(),
         }
     }
 
@@ -244,6 +273,12 @@ impl Pdev {
             .is_none_or(|(b, _)| b & 1 == 0)
     }
 
+    /// Whether port `port` (1-based) differs in `kind` from its
+    /// PDPortDataCheck (false without a check).
+    pub fn mismatch(&self, port: u16, kind: Mismatch) -> bool {
+        self.port(port).is_some_and(|p| p.check.mismatch(p, kind))
+    }
+
     /// Forgets the neighbours whose TTL ran out at `now`.
     pub fn expire(&mut self, now: Nanos) {
         for p in self.ports.iter_mut() {
@@ -261,20 +296,36 @@ impl Pdev {
                 | index::PD_PORT_DATA_ADJUST
                 | index::PD_PORT_DATA_CHECK
                 | index::PD_INTERFACE_DATA_REAL
+                | index::PD_INTERFACE_ADJUST
+                | index::PD_REAL_DATA
+                | index::PD_PORT_STATISTIC
         )
     }
 
     /// Reads record `addr` (one of [`Pdev::serves`]) into `out`; its length.
     pub fn read(&self, addr: RecordAddr, out: &mut [u8]) -> Result<usize, RecordError> {
         let mut w = Writer::new(out, Endian::Big);
+        if addr.index == index::PD_REAL_DATA {
+            if !crate::cm::connect::exists(addr.slot, addr.subslot) {
+                return Err(RecordError::InvalidSlotSubslot);
+            }
+            self.emit_real_data(&mut w).ok_or(RecordError::ReadError)?;
+            return Ok(w.pos());
+        }
         let ok = match (addr.slot, addr.index) {
             (0, index::PD_INTERFACE_DATA_REAL) if addr.subslot == 0x8000 => self.emit_interface_real(&mut w),
+            (0, index::PD_INTERFACE_ADJUST) if addr.subslot == 0x8000 => {
+                interface::emit(&mut w, self.interface_mode)
+            }
+            (0, index::PD_PORT_STATISTIC) => {
+                let c = self.counters(addr.subslot).ok_or(misplaced(addr))?;
+                statistic::emit(&mut w, &c)
+            }
             (0, index::PD_PORT_DATA_REAL | index::PD_PORT_DATA_ADJUST | index::PD_PORT_DATA_CHECK) => {
                 let i = port_of(addr.subslot).ok_or(misplaced(addr))?;
                 let p = self.ports.get(i).ok_or(RecordError::InvalidSlotSubslot)?;
                 if addr.index == index::PD_PORT_DATA_CHECK {
-                    // no check configured (a write is not taken): empty
-                    Some(())
+                    check::emit(&mut w, addr.subslot, &p.check)
                 } else if addr.index == index::PD_PORT_DATA_REAL {
                     emit_port_real(&mut w, addr.subslot, i, p)
                 } else if p.adjust.is_empty() {
@@ -289,7 +340,7 @@ impl Pdev {
         Ok(w.pos())
     }
 
-    /// Writes record `addr` (only PDPortDataAdjust is writable).
+    /// Writes record `addr` (PDPortDataAdjust and PDPortDataCheck are writable).
     pub fn write(&mut self, addr: RecordAddr, data: &[u8]) -> Result<(), RecordError> {
         match (addr.slot, addr.index) {
             (0, index::PD_PORT_DATA_ADJUST) => {
@@ -302,13 +353,50 @@ impl Pdev {
             (0, index::PD_PORT_DATA_REAL) if port_of(addr.subslot).is_some() => {
                 Err(RecordError::AccessDenied)
             }
-            // neighbour, MAU type and link state checks are not offered yet
-            (0, index::PD_PORT_DATA_CHECK) if port_of(addr.subslot).is_some() => {
-                Err(RecordError::FeatureNotSupported)
+            (0, index::PD_PORT_DATA_CHECK) => {
+                let i = port_of(addr.subslot).ok_or(misplaced(addr))?;
+                let c = check::parse(addr.subslot, data)?;
+                let p = self.ports.get_mut(i).ok_or(RecordError::InvalidSlotSubslot)?;
+                p.check = c;
+                Ok(())
             }
             (0, index::PD_INTERFACE_DATA_REAL) if addr.subslot == 0x8000 => Err(RecordError::AccessDenied),
+            (0, index::PD_PORT_STATISTIC) if self.counters(addr.subslot).is_some() => {
+                Err(RecordError::AccessDenied)
+            }
+            _ if addr.index == index::PD_REAL_DATA => {
+                if crate::cm::connect::exists(addr.slot, addr.subslot) {
+                    Err(RecordError::AccessDenied)
+                } else {
+                    Err(RecordError::InvalidSlotSubslot)
+                }
+            }
+            (0, index::PD_INTERFACE_ADJUST) if addr.subslot == 0x8000 => {
+                self.interface_mode = Some(interface::parse(data)?);
+                Ok(())
+            }
             _ => Err(misplaced(addr)),
         }
+    }
+
+    /// PDRealData: MultipleBlockHeader (API 0, slot 0, subslot) around
+    /// PDInterfaceDataReal of 0x8000, then around PDPortDataReal of each port.
+    fn emit_real_data(&self, w: &mut Writer<'_>) -> Option<()> {
+        let multiple = |w: &mut Writer<'_>, subslot: u16, body: &dyn Fn(&mut Writer<'_>) -> Option<()>| {
+            emit_block(w, block_type::MULTIPLE_BLOCK_HEADER, |w| {
+                w.zeros(2)?;
+                w.u32(0)?;
+                w.u16(0)?;
+                w.u16(subslot)?;
+                body(w)
+            })
+        };
+        multiple(w, 0x8000, &|w| self.emit_interface_real(w))?;
+        for (i, p) in self.ports.iter().enumerate() {
+            let subslot = 0x8001u16.checked_add(u16::try_from(i).ok()?)?;
+            multiple(w, subslot, &|w| emit_port_real(w, subslot, i, p))?;
+        }
+        Some(())
     }
 
     fn emit_interface_real(&self, w: &mut Writer<'_>) -> Option<()> {
