@@ -94,6 +94,16 @@ pub const I18: u16 = parameter_index(8, 18);
 pub const I26: u16 = parameter_index(8, 26);
 /// I45 jog deceleration, user units/s² (per axis).
 pub const I45: u16 = parameter_index(8, 45);
+/// I28 torque limit while homing, 0.1 % of 6076h (per axis).
+pub const I28: u16 = parameter_index(8, 28);
+/// I29 time at the homing torque limit, ms (per axis).
+pub const I29: u16 = parameter_index(8, 29);
+/// I30 reference switch type: 2 = the limit switches (per axis).
+pub const I30: u16 = parameter_index(8, 30);
+/// I43 move to the reference position after homing (per axis).
+pub const I43: u16 = parameter_index(8, 43);
+/// I53 index search offset, user position units (per axis).
+pub const I53: u16 = parameter_index(8, 53);
 /// I20 position controller Kv, 0.1 /s (per axis).
 pub const I20: u16 = parameter_index(8, 20);
 /// G472 positive velocity limit of the torque modes, 0.1 % of I10 (per

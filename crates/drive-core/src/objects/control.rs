@@ -11,6 +11,7 @@
 use super::{Object, Value};
 use crate::parameter_index;
 use od::DataType::{U16, U32, U8};
+
 use od::{Access, DataType, EntryInfo};
 
 const RW: Access = Access::RW;
@@ -39,7 +40,7 @@ const fn g(line: u16) -> u16 {
 const REV_INC: i64 = 1 << 20;
 
 /// The control settings of axis A, sorted by index.
-pub const PARAMS: [Object; 12] = [
+pub const PARAMS: [Object; 17] = [
     Object::var(
         a(44),
         Value::Ram,
@@ -156,6 +157,45 @@ pub const PARAMS: [Object; 12] = [
     .level(1)
     .note("I26 (C-091, C-092): 0 velocity control (past a software limit a quick stop), 1 position control (stops before it, default)"),
     Object::var(
+        i_(28),
+        Value::Ram,
+        entries![e(0, "Torque/force limit homing", U16, RW)
+            .range(0, 3000)
+            .default_value(1000)
+            .unit("0.1 %")
+            .saved()],
+    )
+    .axis()
+    .level(1)
+    .note("I28 (C-083 torque methods): torque limit while referencing, 0.1 % of the rated torque 6076h (6072h caps it), also the threshold the torque methods look for; default 100 %; effective at the next homing start"),
+    Object::var(
+        i_(29),
+        Value::Ram,
+        entries![e(0, "Time torque/force limit homing", U16, RW)
+            .default_value(100)
+            .unit("ms")
+            .saved()],
+    )
+    .axis()
+    .level(1)
+    .note("I29: how long the torque must stay at I28 continuously before a torque method takes the reference; default 100 ms"),
+    Object::var(
+        i_(30),
+        Value::Ram,
+        entries![e(0, "Reference switch type", U8, RW).range(0, 2).saved()],
+    )
+    .axis()
+    .level(1)
+    .note("I30 (C-086): 0 reference switch (I103), 2 the limit switches act as reference switch (methods 17-20 on ±LS without a limit-switch fault); 1 is the manual's 'other' and is taken as 0 (docs/conformance.md); effective at the next homing start"),
+    Object::var(
+        i_(43),
+        Value::Ram,
+        entries![e(0, "Move to reference position", U8, RW).range(0, 1).saved()],
+    )
+    .axis()
+    .level(1)
+    .note("I43: 1 = after referencing the axis positions on the reference position 607Ch (A569); default 0: it stops with 609Ah"),
+    Object::var(
         i_(45),
         Value::Ram,
         entries![e(0, "Jog deceleration", U32, RW)
@@ -166,4 +206,12 @@ pub const PARAMS: [Object; 12] = [
     .axis()
     .level(1)
     .note("I45: jog deceleration in user units/s² (decimals A311); default 10 rev/s²"),
+    Object::var(
+        i_(53),
+        Value::Ram,
+        entries![e(0, "Index search offset", U32, RW).unit("inc").saved()],
+    )
+    .axis()
+    .level(1)
+    .note("I53: after the switch edge the zero-pulse search starts this far on, in user position units (6091h/6092h); default 0"),
 ];
