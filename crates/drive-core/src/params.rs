@@ -80,6 +80,9 @@ pub const A311: u16 = parameter_index(0, 311);
 pub const A44: u16 = parameter_index(0, 44);
 /// I00 position range: 0 limited, 1 endless (per axis).
 pub const I00: u16 = parameter_index(8, 0);
+/// I04 permitted direction of an endless axis: 0 both, 1 positive, 2
+/// negative (per axis).
+pub const I04: u16 = parameter_index(8, 4);
 /// C31 velocity controller Kp, µN·m per rad/s (per axis).
 pub const C31: u16 = parameter_index(2, 31);
 /// C32 velocity controller Ti, µs; 0 = no integral part (per axis).

@@ -16,6 +16,11 @@ impl Axis {
         self.params.jog_position_control = o.i26 != 0;
         self.params.quick_stop_on_enable_loss = o.a44 == 1;
         self.params.limits.endless_axis = o.i00 == 1;
+        self.params.limits.permitted_direction = match o.i04 {
+            1 => PermittedDirection::PositiveOnly,
+            2 => PermittedDirection::NegativeOnly,
+            _ => PermittedDirection::Both,
+        };
         self.params.homing_torque_limit_per_mille = o.homing_torque.0;
         self.params.homing_torque_hold_ns = ms_to_ns(o.homing_torque.1);
         self.params.homing_limit_as_reference = o.i30_i43.0 == 2;

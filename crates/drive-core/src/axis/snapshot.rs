@@ -15,7 +15,7 @@ use motion::scaling::AxisScaling;
 
 pub(crate) use crate::params::{
     A150, A213, A291, A310, A311, A340, A44, A66, A67, C31, C32, E47, E48, E49, E80, G472, G475, I00, I02,
-    I101, I12, I13, I18, I20, I21, I210, I22, I23, I26, I28, I29, I30, I43, I45, I46, I53,
+    I04, I101, I12, I13, I18, I20, I21, I210, I22, I23, I26, I28, I29, I30, I43, I45, I46, I53,
 };
 
 /// Entry `index`:`sub`, or 0 with `misses` counted: the dictionary declares
@@ -322,6 +322,8 @@ pub(crate) struct Snapshot {
     pub a44: u8,
     /// I00 position range (1 = endless).
     pub i00: u8,
+    /// I04 permitted direction (0 both, 1 positive, 2 negative).
+    pub i04: u8,
     /// G472 / G475 velocity limits of the torque modes, 0.1 % of I10
     /// (C-039).
     pub torque_mode_speed_limit: [u16; 2],
@@ -455,6 +457,7 @@ impl Snapshot {
             i53: sat(w.param(od, I53, 0, m), 0u32, u32::MAX),
             a44: sat(w.param(od, A44, 0, m), 0u8, u8::MAX),
             i00: sat(w.param(od, I00, 0, m), 0u8, u8::MAX),
+            i04: sat(w.param(od, I04, 0, m), 0u8, u8::MAX),
             gains: (
                 sat(w.param(od, I20, 0, m), 0u16, u16::MAX),
                 sat(w.param(od, C31, 0, m), 0u32, u32::MAX),

@@ -40,7 +40,7 @@ const fn g(line: u16) -> u16 {
 const REV_INC: i64 = 1 << 20;
 
 /// The control settings of axis A, sorted by index.
-pub const PARAMS: [Object; 17] = [
+pub const PARAMS: [Object; 18] = [
     Object::var(
         a(44),
         Value::Ram,
@@ -103,6 +103,14 @@ pub const PARAMS: [Object; 17] = [
     .axis()
     .level(1)
     .note("I00 (C-099, C-111): 0 limited (software limits act), 1 endless (positions wrap at 607Bh:02); default 0; writable in Pre-Op only (0800 0022h in Safe-Op and Op: the coordinate system must not change under a running axis)"),
+    Object::var(
+        i_(4),
+        Value::Ram,
+        entries![e(0, "Permitted direction", U8, RW).range(0, 2).saved()],
+    )
+    .axis()
+    .level(1)
+    .note("I04 (C-105, C-107): endless axes only: 0 both directions (default), 1 positive only, 2 negative only; a move the other way is refused and shown in E80 = 15; effective at once"),
     Object::var(
         i_(12),
         Value::Ram,
