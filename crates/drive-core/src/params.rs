@@ -107,6 +107,14 @@ pub const I30: u16 = parameter_index(8, 30);
 pub const I43: u16 = parameter_index(8, 43);
 /// I53 index search offset, user position units (per axis).
 pub const I53: u16 = parameter_index(8, 53);
+/// I25 speed feedforward, % (per axis).
+pub const I25: u16 = parameter_index(8, 25);
+/// I87 time in the position window, ms (per axis).
+pub const I87: u16 = parameter_index(8, 87);
+/// I423 maximum extrapolation period, ms (per axis).
+pub const I423: u16 = parameter_index(8, 423);
+/// I425 speed feedforward interpolation: 0, 1, 3, 4, 5 (per axis).
+pub const I425: u16 = parameter_index(8, 425);
 /// I20 position controller Kv, 0.1 /s (per axis).
 pub const I20: u16 = parameter_index(8, 20);
 /// G472 positive velocity limit of the torque modes, 0.1 % of I10 (per

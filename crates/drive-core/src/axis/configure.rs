@@ -26,6 +26,11 @@ impl Axis {
         self.params.homing_limit_as_reference = o.i30_i43.0 == 2;
         self.params.homing_move_to_home = o.i30_i43.1 == 1;
         self.params.homing_index_offset = o.i53;
+        let (i25, i425, i423) = o.interpolation;
+        self.params.feedforward_percent = f32::from(i25);
+        self.params.interpolation_i425 = i425;
+        self.params.max_extrapolation_ns = ms_to_ns(i423);
+        self.params.position_window_time_ns = ms_to_ns(o.i87);
         let p = self.params;
         self.modulo = if p.limits.endless_axis && o.modulo_length > 0 {
             ModuloAxis::new(i64::from(o.modulo_length)).ok()

@@ -15,7 +15,8 @@ use motion::scaling::AxisScaling;
 
 pub(crate) use crate::params::{
     A150, A213, A291, A310, A311, A340, A44, A66, A67, C31, C32, E47, E48, E49, E80, G472, G475, I00, I02,
-    I04, I101, I12, I13, I18, I20, I21, I210, I22, I23, I26, I28, I29, I30, I43, I45, I46, I53,
+    I04, I101, I12, I13, I18, I20, I21, I210, I22, I23, I25, I26, I28, I29, I30, I423, I425, I43, I45, I46,
+    I53, I87,
 };
 
 /// Entry `index`:`sub`, or 0 with `misses` counted: the dictionary declares
@@ -318,6 +319,11 @@ pub(crate) struct Snapshot {
     pub i30_i43: (u8, u8),
     /// I53 index search offset (user position units).
     pub i53: u32,
+    /// Interpolation: I25 speed feedforward (%), I425 its interpolation,
+    /// I423 maximum extrapolation (ms).
+    pub interpolation: (u8, u8, u16),
+    /// I87 time in the position window (ms).
+    pub i87: u16,
     /// A44 quick stop on the loss of A60 (1 = active).
     pub a44: u8,
     /// I00 position range (1 = endless).
@@ -455,6 +461,12 @@ impl Snapshot {
                 sat(w.param(od, I43, 0, m), 0u8, u8::MAX),
             ),
             i53: sat(w.param(od, I53, 0, m), 0u32, u32::MAX),
+            interpolation: (
+                sat(w.param(od, I25, 0, m), 0u8, u8::MAX),
+                sat(w.param(od, I425, 0, m), 0u8, u8::MAX),
+                sat(w.param(od, I423, 0, m), 0u16, u16::MAX),
+            ),
+            i87: sat(w.param(od, I87, 0, m), 0u16, u16::MAX),
             a44: sat(w.param(od, A44, 0, m), 0u8, u8::MAX),
             i00: sat(w.param(od, I00, 0, m), 0u8, u8::MAX),
             i04: sat(w.param(od, I04, 0, m), 0u8, u8::MAX),

@@ -40,7 +40,7 @@ const fn g(line: u16) -> u16 {
 const REV_INC: i64 = 1 << 20;
 
 /// The control settings of axis A, sorted by index.
-pub const PARAMS: [Object; 18] = [
+pub const PARAMS: [Object; 22] = [
     Object::var(
         a(44),
         Value::Ram,
@@ -154,6 +154,18 @@ pub const PARAMS: [Object; 18] = [
     .level(1)
     .note("I20 (line assumed): gain of the position controller, velocity command per following error; default 100 /s; effective at once"),
     Object::var(
+        i_(25),
+        Value::Ram,
+        entries![e(0, "Speed feedforward", U8, RW)
+            .range(0, 100)
+            .default_value(100)
+            .unit("%")
+            .saved()],
+    )
+    .axis()
+    .level(1)
+    .note("I25 (C-117 area, ip/csp): weight of the speed feedforward the interpolator derives or takes (I425), %; 0 = none; default 100 %; effective at once (the interpolator restarts from the present set-point)"),
+    Object::var(
         i_(26),
         Value::Ram,
         entries![e(0, "Jog control type", U8, RW)
@@ -222,4 +234,34 @@ pub const PARAMS: [Object; 18] = [
     .axis()
     .level(1)
     .note("I53: after the switch edge the zero-pulse search starts this far on, in user position units (6091h/6092h); default 0"),
+    Object::var(
+        i_(87),
+        Value::Ram,
+        entries![e(0, "Actual position in window time", U16, RW)
+            .unit("ms")
+            .saved()],
+    )
+    .axis()
+    .level(1)
+    .note("I87 (C-048): how long the actual position must stay in the target window I22 before target reached (statusword bit 10) and in position; default 0 ms; effective at once"),
+    Object::var(
+        i_(423),
+        Value::Ram,
+        entries![e(0, "Max extrapolation period", U16, RW)
+            .range(0, 10_000)
+            .default_value(10)
+            .unit("ms")
+            .saved()],
+    )
+    .axis()
+    .level(1)
+    .note("I423 (C-117): the longest the cyclic modes extrapolate a missing set value before event 78 cause 3; default 10 ms; effective at once"),
+    Object::var(
+        i_(425),
+        Value::Ram,
+        entries![e(0, "Speed feed forward interpolation", U8, RW).range(0, 5).saved()],
+    )
+    .axis()
+    .level(1)
+    .note("I425: 0 linear, 4 quadratic, 5 cubic (internal: the drive derives the speed feedforward), 1 and 3 external (60B1h); 2 is refused (0609 0030h); default 0; effective at once"),
 ];
