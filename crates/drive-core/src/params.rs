@@ -107,6 +107,12 @@ pub const I30: u16 = parameter_index(8, 30);
 pub const I43: u16 = parameter_index(8, 43);
 /// I53 index search offset, user position units (per axis).
 pub const I53: u16 = parameter_index(8, 53);
+/// C40 velocity window, user units/s (per axis).
+pub const C40: u16 = parameter_index(2, 40);
+/// I10 maximal speed, user units/s (per axis).
+pub const I10: u16 = parameter_index(8, 10);
+/// I44 referencing jerk, user units/s³, 0 = none (per axis).
+pub const I44: u16 = parameter_index(8, 44);
 /// I25 speed feedforward, % (per axis).
 pub const I25: u16 = parameter_index(8, 25);
 /// I87 time in the position window, ms (per axis).

@@ -31,6 +31,10 @@ impl Axis {
         self.params.interpolation_i425 = i425;
         self.params.max_extrapolation_ns = ms_to_ns(i423);
         self.params.position_window_time_ns = ms_to_ns(o.i87);
+        let [i10, c40, i44] = o.speeds.map(|x| x as f32);
+        self.params.cascade.max_velocity_inc_per_s = i10;
+        self.params.velocity_window_inc_per_s = c40;
+        self.params.homing_jerk = if i44 > 0.0 { i44 } else { f32::INFINITY };
         let p = self.params;
         self.modulo = if p.limits.endless_axis && o.modulo_length > 0 {
             ModuloAxis::new(i64::from(o.modulo_length)).ok()

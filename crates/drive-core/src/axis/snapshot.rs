@@ -14,9 +14,9 @@ use crate::{AXIS_B_CIA402, AXIS_B_MANUFACTURER};
 use motion::scaling::AxisScaling;
 
 pub(crate) use crate::params::{
-    A150, A213, A291, A310, A311, A340, A44, A66, A67, C31, C32, E47, E48, E49, E80, G472, G475, I00, I02,
-    I04, I101, I12, I13, I18, I20, I21, I210, I22, I23, I25, I26, I28, I29, I30, I423, I425, I43, I45, I46,
-    I53, I87,
+    A150, A213, A291, A310, A311, A340, A44, A66, A67, C31, C32, C40, E47, E48, E49, E80, G472, G475, I00,
+    I02, I04, I10, I101, I12, I13, I18, I20, I21, I210, I22, I23, I25, I26, I28, I29, I30, I423, I425, I43,
+    I44, I45, I46, I53, I87,
 };
 
 /// Entry `index`:`sub`, or 0 with `misses` counted: the dictionary declares
@@ -324,6 +324,9 @@ pub(crate) struct Snapshot {
     pub interpolation: (u8, u8, u16),
     /// I87 time in the position window (ms).
     pub i87: u16,
+    /// I10 maximal speed and C40 velocity window (user units/s), I44
+    /// referencing jerk (user units/s³, 0 = none).
+    pub speeds: [u32; 3],
     /// A44 quick stop on the loss of A60 (1 = active).
     pub a44: u8,
     /// I00 position range (1 = endless).
@@ -467,6 +470,11 @@ impl Snapshot {
                 sat(w.param(od, I423, 0, m), 0u16, u16::MAX),
             ),
             i87: sat(w.param(od, I87, 0, m), 0u16, u16::MAX),
+            speeds: [
+                sat(w.param(od, I10, 0, m), 0u32, u32::MAX),
+                sat(w.param(od, C40, 0, m), 0u32, u32::MAX),
+                sat(w.param(od, I44, 0, m), 0u32, u32::MAX),
+            ],
             a44: sat(w.param(od, A44, 0, m), 0u8, u8::MAX),
             i00: sat(w.param(od, I00, 0, m), 0u8, u8::MAX),
             i04: sat(w.param(od, I04, 0, m), 0u8, u8::MAX),
@@ -573,6 +581,10 @@ impl Snapshot {
             },
             dead_band: mag(self.dead_band),
             i53: mag(self.i53),
+            speeds: {
+                let [i10, c40, i44] = self.speeds;
+                [vel(i10), vel(c40), acc(i44)]
+            },
             jog: {
                 let [v, a, d, j] = self.jog;
                 [vel(v), acc(a), acc(d), acc(j)]

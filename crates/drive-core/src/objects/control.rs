@@ -40,7 +40,7 @@ const fn g(line: u16) -> u16 {
 const REV_INC: i64 = 1 << 20;
 
 /// The control settings of axis A, sorted by index.
-pub const PARAMS: [Object; 22] = [
+pub const PARAMS: [Object; 25] = [
     Object::var(
         a(44),
         Value::Ram,
@@ -73,6 +73,17 @@ pub const PARAMS: [Object; 22] = [
     .axis()
     .level(1)
     .note("C32 (line assumed): integral time of the velocity controller; 0 = no integral part; effective at once"),
+    Object::var(
+        c(40),
+        Value::Ram,
+        entries![e(0, "Velocity window", U32, RW)
+            .default_value(REV_INC / 10)
+            .unit("inc/s")
+            .saved()],
+    )
+    .axis()
+    .level(1)
+    .note("C40 (C-061 area): velocity window in user units/s (decimals A310): standstill I199 below it, the pv velocity-reached window; default 0.1 rev/s; effective at once"),
     Object::var(
         g(472),
         Value::Ram,
@@ -111,6 +122,17 @@ pub const PARAMS: [Object; 22] = [
     .axis()
     .level(1)
     .note("I04 (C-105, C-107): endless axes only: 0 both directions (default), 1 positive only, 2 negative only; a move the other way is refused and shown in E80 = 15; effective at once"),
+    Object::var(
+        i_(10),
+        Value::Ram,
+        entries![e(0, "Maximal speed", U32, RW)
+            .default_value(50 * REV_INC)
+            .unit("inc/s")
+            .saved()],
+    )
+    .axis()
+    .level(1)
+    .note("I10: the highest speed of the axis in user units/s (decimals A310): the cascade's speed command is limited to it and G472/G475 are per mille of it; default 50 rev/s; effective at once; not yet checked against the motor's B83 (motor data)"),
     Object::var(
         i_(12),
         Value::Ram,
@@ -215,6 +237,14 @@ pub const PARAMS: [Object; 22] = [
     .axis()
     .level(1)
     .note("I43: 1 = after referencing the axis positions on the reference position 607Ch (A569); default 0: it stops with 609Ah"),
+    Object::var(
+        i_(44),
+        Value::Ram,
+        entries![e(0, "Referencing jerk", U32, RW).unit("inc/s³").saved()],
+    )
+    .axis()
+    .level(1)
+    .note("I44: jerk of the homing moves in user units/s³ (decimals A311); 0 = no jerk limit (default); effective at the next homing start"),
     Object::var(
         i_(45),
         Value::Ram,
