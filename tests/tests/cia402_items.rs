@@ -470,15 +470,16 @@ fn c104_c107_limit_switches_from_i210_and_e80() {
 #[test]
 fn c107_e80_shows_illegal_direction_on_an_endless_axis() {
     let sim = line(1);
-    with_drive(&sim, |d| {
-        let l = &mut d.drive.axes_mut()[0].params_mut().limits;
-        l.permitted_direction = drive_ecat::axis::PermittedDirection::PositiveOnly;
-    });
     with_master(&sim, async |md, clock| {
-        // I00 = 1 "endless" by SDO in Pre-Op (issue 40)
+        // I00 = 1 "endless" by SDO in Pre-Op, I04 = 1 positive only (issue 40)
         let group = init(md, clock).await;
         let sd = group.subdevice(md, 0).unwrap();
         sd.sdo_write(drive_ecat::params::I00, 0, 1u8).await.unwrap();
+        sd.sdo_write(drive_ecat::params::I04, 0, 1u8).await.unwrap();
+        assert!(
+            sd.sdo_write(drive_ecat::params::I04, 0, 3u8).await.is_err(),
+            "I04 = 3 is out of range"
+        );
         let group = group.into_op(md).await.expect("OP");
         let sd = group.subdevice(md, 0).unwrap();
         let mut m = Cyclic::new(md, &group, &sim, 0);

@@ -19,6 +19,15 @@ use drive_tests::{REV, REV_F};
 use hil_sim::motor::{PositionInput, Switches};
 use std::cell::RefCell;
 
+/// I101 / I102 sources of the limit switches (1 = input), I28 / I29 homing
+/// torque limit (0.1 %) and time (ms), I30 reference switch type: the
+/// manual's parameters at 2000h + group·200h + line.
+const I101: u16 = 0x3065;
+const I102: u16 = 0x3066;
+const I28: u16 = 0x301C;
+const I29: u16 = 0x301D;
+const I30: u16 = 0x301E;
+
 /// One revolution, increments, as i64.
 const R: i64 = REV as i64;
 /// Where the encoder's index pulse sits within a revolution.
@@ -115,17 +124,19 @@ fn home(case: Case) -> Run {
         m.params_mut().index_offset_inc = INDEX_AT;
         m.params_mut().end_stops_inc = case.end_stops;
         m.set_position_inc(case.start);
-        let p = d.drive.axes_mut()[0].params_mut();
-        p.limits.positive_switch = case.limits;
-        p.limits.negative_switch = case.limits;
-        // torque methods: 40 % of the rated torque for 50 ms is the stop (I28/I29)
-        p.homing_torque_limit_per_mille = 400;
-        p.homing_torque_hold_ns = nanos::Nanos::from_ms(50);
     }
     let run = RefCell::new(None);
     with_master(&sim, async |md, clock| {
         let group = init(md, clock).await.into_op(md).await.expect("OP");
         let sd = group.subdevice(md, 0).unwrap();
+        // the settings as a master sets them (issue 40): I101/I102 = 1 the
+        // limit switches from the inputs; torque methods: 40 % of the rated
+        // torque for 50 ms is the stop (I28/I29)
+        let ls = u8::from(case.limits);
+        sd.sdo_write(I101, 0, ls).await.unwrap();
+        sd.sdo_write(I102, 0, ls).await.unwrap();
+        sd.sdo_write(I28, 0, 400u16).await.unwrap();
+        sd.sdo_write(I29, 0, 50u16).await.unwrap();
         sd.sdo_write(0x6098, 0, case.method).await.unwrap();
         sd.sdo_write(0x607C, 0, HOME_OFFSET).await.unwrap();
         let mut m = Cyclic::new(md, &group, &sim, 0);
@@ -436,14 +447,14 @@ fn c086_limit_switch_as_reference_switch() {
         let mut s = sim.borrow_mut();
         let d = &mut s.drives_mut()[0];
         *d.motors[0].switches_mut() = sim_case.switches;
-        let p = d.drive.axes_mut()[0].params_mut();
-        p.limits.positive_switch = true;
-        p.limits.negative_switch = true;
-        p.homing_limit_as_reference = true;
     }
     with_master(&sim, async |md, clock| {
         let group = init(md, clock).await.into_op(md).await.expect("OP");
         let sd = group.subdevice(md, 0).unwrap();
+        // by SDO (issue 40): limit switches from the inputs, I30 = 2
+        sd.sdo_write(I101, 0, 1u8).await.unwrap();
+        sd.sdo_write(I102, 0, 1u8).await.unwrap();
+        sd.sdo_write(I30, 0, 2u8).await.unwrap();
         sd.sdo_write(0x6098, 0, 19i8).await.unwrap();
         sd.sdo_write(0x607C, 0, HOME_OFFSET).await.unwrap();
         let mut m = Cyclic::new(md, &group, &sim, 0);

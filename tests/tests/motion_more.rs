@@ -488,11 +488,14 @@ fn c093_c094_c095_hardware_limit_switch_faults_and_locks_the_direction() {
         m.run(200).await;
 
         // I101/I102 set: hitting +1 rev at 2 rev/s faults at once (event 53 cause 1)
-        with_drive(&sim, |d| {
-            let l = &mut d.drive.axes_mut()[0].params_mut().limits;
-            l.positive_switch = true;
-            l.negative_switch = true;
-        });
+        // (by SDO as a master does, issue 40: 1 = from the inputs)
+        let sd = group.subdevice(md, 0).unwrap();
+        sd.sdo_write(drive_ecat::parameter_index(8, 101), 0, 1u8)
+            .await
+            .unwrap();
+        sd.sdo_write(drive_ecat::parameter_index(8, 102), 0, 1u8)
+            .await
+            .unwrap();
         m.run(5).await;
         assert_eq!(m.tx.state(), sw::OE, "inside the range: {:#06x}", m.tx.statusword);
         m.set_target_velocity(2 * REV);

@@ -9,10 +9,10 @@
     clippy::indexing_slicing
 )]
 
-use drive_ecat::params::{C31, C32, G472, G475, I20};
+use drive_ecat::params::{C31, C32, G472, G475, I04, I20, I25, I28, I29, I30, I423, I425, I43, I53, I87};
 use drive_tests::axis::{with_drive, CW_ENABLED};
 use drive_tests::{init, line, with_master, Cyclic};
-use ethercrab::error::CoeAbortCode::ValueTooLarge;
+use ethercrab::error::CoeAbortCode::{ValueOutOfRange, ValueTooLarge};
 use hil_sim::sim::Simulation;
 use std::cell::RefCell;
 
@@ -173,5 +173,59 @@ fn e018_issue40_settings_saved_with_the_parameter_set_and_restored() {
                 .unwrap();
             assert_eq!(b, 330);
         }
+    });
+}
+
+/// E-018 with the homing, interpolation and window settings of issue 40
+/// (I28, I29, I30, I43, I53, I04, I25, I425, I423, I87): out of range
+/// refused (0609 0031h, I425 = 2 with 0609 0030h) and unchanged; saved with
+/// 1010h:01 and read back after a power cycle.
+#[test]
+fn e018_issue40_homing_and_interpolation_settings_saved_and_restored() {
+    let sim = line(1);
+    with_master(&sim, async |md, clock| {
+        let group = init(md, clock).await;
+        let sd = group.subdevice(md, 0).unwrap();
+        let e = sd.sdo_write(I28, 0, 3001u16).await.unwrap_err();
+        assert_eq!(abort_code(e), ValueTooLarge, "I28 above 300 % (0609 0031h)");
+        let e = sd.sdo_write(I25, 0, 101u8).await.unwrap_err();
+        assert_eq!(abort_code(e), ValueTooLarge, "I25 above 100 % (0609 0031h)");
+        let e = sd.sdo_write(I425, 0, 2u8).await.unwrap_err();
+        assert_eq!(abort_code(e), ValueOutOfRange, "I425 = 2 (0609 0030h)");
+        assert_eq!(sd.sdo_read::<u16>(I28, 0).await.unwrap(), 1000, "unchanged");
+        assert_eq!(sd.sdo_read::<u8>(I25, 0).await.unwrap(), 100, "unchanged");
+        assert_eq!(sd.sdo_read::<u8>(I425, 0).await.unwrap(), 0, "unchanged");
+        sd.sdo_write(I28, 0, 400u16).await.unwrap();
+        sd.sdo_write(I29, 0, 50u16).await.unwrap();
+        sd.sdo_write(I30, 0, 2u8).await.unwrap();
+        sd.sdo_write(I43, 0, 1u8).await.unwrap();
+        sd.sdo_write(I53, 0, 12_345u32).await.unwrap();
+        sd.sdo_write(I04, 0, 2u8).await.unwrap();
+        sd.sdo_write(I25, 0, 80u8).await.unwrap();
+        sd.sdo_write(I425, 0, 4u8).await.unwrap();
+        sd.sdo_write(I423, 0, 20u16).await.unwrap();
+        sd.sdo_write(I87, 0, 5u16).await.unwrap();
+        sd.sdo_write(0x1010, 1, SAVE).await.unwrap();
+        // written after the save: RAM only
+        sd.sdo_write(I29, 0, 999u16).await.unwrap();
+    });
+    power_cycle(&sim);
+    with_master(&sim, async |md, clock| {
+        let group = init(md, clock).await;
+        let sd = group.subdevice(md, 0).unwrap();
+        assert_eq!(sd.sdo_read::<u16>(I28, 0).await.unwrap(), 400);
+        assert_eq!(
+            sd.sdo_read::<u16>(I29, 0).await.unwrap(),
+            50,
+            "the saved value, not 999"
+        );
+        assert_eq!(sd.sdo_read::<u8>(I30, 0).await.unwrap(), 2);
+        assert_eq!(sd.sdo_read::<u8>(I43, 0).await.unwrap(), 1);
+        assert_eq!(sd.sdo_read::<u32>(I53, 0).await.unwrap(), 12_345);
+        assert_eq!(sd.sdo_read::<u8>(I04, 0).await.unwrap(), 2);
+        assert_eq!(sd.sdo_read::<u8>(I25, 0).await.unwrap(), 80);
+        assert_eq!(sd.sdo_read::<u8>(I425, 0).await.unwrap(), 4);
+        assert_eq!(sd.sdo_read::<u16>(I423, 0).await.unwrap(), 20);
+        assert_eq!(sd.sdo_read::<u16>(I87, 0).await.unwrap(), 5);
     });
 }

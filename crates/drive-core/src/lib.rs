@@ -95,4 +95,6 @@ mod tests_records_od;
 #[cfg(test)]
 mod tests_scaling;
 #[cfg(test)]
+mod tests_spec_walk;
+#[cfg(test)]
 mod tests_variant;

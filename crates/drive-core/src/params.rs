@@ -80,6 +80,9 @@ pub const A311: u16 = parameter_index(0, 311);
 pub const A44: u16 = parameter_index(0, 44);
 /// I00 position range: 0 limited, 1 endless (per axis).
 pub const I00: u16 = parameter_index(8, 0);
+/// I04 permitted direction of an endless axis: 0 both, 1 positive, 2
+/// negative (per axis).
+pub const I04: u16 = parameter_index(8, 4);
 /// C31 velocity controller Kp, µN·m per rad/s (per axis).
 pub const C31: u16 = parameter_index(2, 31);
 /// C32 velocity controller Ti, µs; 0 = no integral part (per axis).
@@ -94,6 +97,30 @@ pub const I18: u16 = parameter_index(8, 18);
 pub const I26: u16 = parameter_index(8, 26);
 /// I45 jog deceleration, user units/s² (per axis).
 pub const I45: u16 = parameter_index(8, 45);
+/// I28 torque limit while homing, 0.1 % of 6076h (per axis).
+pub const I28: u16 = parameter_index(8, 28);
+/// I29 time at the homing torque limit, ms (per axis).
+pub const I29: u16 = parameter_index(8, 29);
+/// I30 reference switch type: 2 = the limit switches (per axis).
+pub const I30: u16 = parameter_index(8, 30);
+/// I43 move to the reference position after homing (per axis).
+pub const I43: u16 = parameter_index(8, 43);
+/// I53 index search offset, user position units (per axis).
+pub const I53: u16 = parameter_index(8, 53);
+/// C40 velocity window, user units/s (per axis).
+pub const C40: u16 = parameter_index(2, 40);
+/// I10 maximal speed, user units/s (per axis).
+pub const I10: u16 = parameter_index(8, 10);
+/// I44 referencing jerk, user units/s³, 0 = none (per axis).
+pub const I44: u16 = parameter_index(8, 44);
+/// I25 speed feedforward, % (per axis).
+pub const I25: u16 = parameter_index(8, 25);
+/// I87 time in the position window, ms (per axis).
+pub const I87: u16 = parameter_index(8, 87);
+/// I423 maximum extrapolation period, ms (per axis).
+pub const I423: u16 = parameter_index(8, 423);
+/// I425 speed feedforward interpolation: 0, 1, 3, 4, 5 (per axis).
+pub const I425: u16 = parameter_index(8, 425);
 /// I20 position controller Kv, 0.1 /s (per axis).
 pub const I20: u16 = parameter_index(8, 20);
 /// G472 positive velocity limit of the torque modes, 0.1 % of I10 (per

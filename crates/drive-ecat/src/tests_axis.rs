@@ -276,8 +276,9 @@ fn c035_csp_follows_target_position() {
 fn c035_csp_with_acceleration_feedforward_tracks_closely() {
     let mut rig = Rig::new();
     rig.drive.axes_mut()[0].params_mut().cascade.inertia_kg_m2 = 1e-4;
-    // I425 = 4: quadratic, internal feedforward (acceleration from ∇²)
-    rig.drive.axes_mut()[0].params_mut().interpolation_i425 = 4;
+    // I425 = 4: quadratic, internal feedforward (acceleration from ∇²),
+    // written as a master does (issue 40)
+    rig.set(0, crate::params::I425, 0, 4);
     rig.enable(0);
     let mut max_fe = 0i64;
     for k in 1..=500 {

@@ -132,13 +132,17 @@ fn c084_limit_switch_against_the_travel_during_homing_is_a_homing_error() {
             negative_limit: PositionInput::never().active_low(),
             ..Switches::linear_axis(-10 * R, 10 * R, PositionInput::never())
         };
-        let p = d.drive.axes_mut()[0].params_mut();
-        p.limits.positive_switch = true;
-        p.limits.negative_switch = true;
     }
     let seen = with_master(&sim, async |md, clock| {
         let group = init(md, clock).await.into_op(md).await.expect("OP");
+        // I101/I102 = 1: the limit switches from the inputs, by SDO (issue 40)
         let sd = group.subdevice(md, 0).unwrap();
+        sd.sdo_write(drive_ecat::parameter_index(8, 101), 0, 1u8)
+            .await
+            .unwrap();
+        sd.sdo_write(drive_ecat::parameter_index(8, 102), 0, 1u8)
+            .await
+            .unwrap();
         sd.sdo_write(0x6098, 0, 1i8).await.unwrap();
         let mut m = Cyclic::new(md, &group, &sim, 0);
         m.set_mode(6);

@@ -16,6 +16,25 @@ impl Axis {
         self.params.jog_position_control = o.i26 != 0;
         self.params.quick_stop_on_enable_loss = o.a44 == 1;
         self.params.limits.endless_axis = o.i00 == 1;
+        self.params.limits.permitted_direction = match o.i04 {
+            1 => PermittedDirection::PositiveOnly,
+            2 => PermittedDirection::NegativeOnly,
+            _ => PermittedDirection::Both,
+        };
+        self.params.homing_torque_limit_per_mille = o.homing_torque.0;
+        self.params.homing_torque_hold_ns = ms_to_ns(o.homing_torque.1);
+        self.params.homing_limit_as_reference = o.i30_i43.0 == 2;
+        self.params.homing_move_to_home = o.i30_i43.1 == 1;
+        self.params.homing_index_offset = o.i53;
+        let (i25, i425, i423) = o.interpolation;
+        self.params.feedforward_percent = f32::from(i25);
+        self.params.interpolation_i425 = i425;
+        self.params.max_extrapolation_ns = ms_to_ns(i423);
+        self.params.position_window_time_ns = ms_to_ns(o.i87);
+        let [i10, c40, i44] = o.speeds.map(|x| x as f32);
+        self.params.cascade.max_velocity_inc_per_s = i10;
+        self.params.velocity_window_inc_per_s = c40;
+        self.params.homing_jerk = if i44 > 0.0 { i44 } else { f32::INFINITY };
         let p = self.params;
         self.modulo = if p.limits.endless_axis && o.modulo_length > 0 {
             ModuloAxis::new(i64::from(o.modulo_length)).ok()

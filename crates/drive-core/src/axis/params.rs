@@ -3,9 +3,15 @@
 
 use super::*;
 
-/// Parameters of the axis that the dictionary does not (yet) declare
-/// (manufacturer groups B–I), with their defaults. Change them through
-/// [`Axis::params_mut`]; they take effect in the next cycle.
+/// The axis' working settings, with their defaults. Those the dictionary
+/// declares (issue 40: A44, I00, I04, jog I12/I13/I45/I18/I26, homing
+/// I28/I29/I30/I43/I44/I53, I25/I425/I423, I87, I10, C40; the gains and
+/// G472/G475 go straight into the cascade) are overwritten from it at every
+/// configuration change: set them by SDO/PNU. The rest (rated torque and
+/// current: motor data; the following error as a fault, set-value
+/// monitoring, the limit-switch evaluation and reactions, the stop settle
+/// time) are not declared yet: [`Axis::params_mut`] changes them, effective
+/// in the next cycle.
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct AxisParams {
     /// 6076h rated torque, N·m (motor data); 0.1 % torque objects refer to it.

@@ -14,8 +14,9 @@ use crate::{AXIS_B_CIA402, AXIS_B_MANUFACTURER};
 use motion::scaling::AxisScaling;
 
 pub(crate) use crate::params::{
-    A150, A213, A291, A310, A311, A340, A44, A66, A67, C31, C32, E47, E48, E49, E80, G472, G475, I00, I02,
-    I101, I12, I13, I18, I20, I21, I210, I22, I23, I26, I45, I46,
+    A150, A213, A291, A310, A311, A340, A44, A66, A67, C31, C32, C40, E47, E48, E49, E80, G472, G475, I00,
+    I02, I04, I10, I101, I12, I13, I18, I20, I21, I210, I22, I23, I25, I26, I28, I29, I30, I423, I425, I43,
+    I44, I45, I46, I53, I87,
 };
 
 /// Entry `index`:`sub`, or 0 with `misses` counted: the dictionary declares
@@ -311,10 +312,27 @@ pub(crate) struct Snapshot {
     pub jog: [u32; 4],
     /// I26 jog control type (1 = position control).
     pub i26: u8,
+    /// Homing: I28 torque limit (0.1 % of 6076h), I29 time at it (ms).
+    pub homing_torque: (u16, u16),
+    /// I30 reference switch type (2 = the limit switches), I43 move to
+    /// the reference position after homing (1 = on).
+    pub i30_i43: (u8, u8),
+    /// I53 index search offset (user position units).
+    pub i53: u32,
+    /// Interpolation: I25 speed feedforward (%), I425 its interpolation,
+    /// I423 maximum extrapolation (ms).
+    pub interpolation: (u8, u8, u16),
+    /// I87 time in the position window (ms).
+    pub i87: u16,
+    /// I10 maximal speed and C40 velocity window (user units/s), I44
+    /// referencing jerk (user units/s³, 0 = none).
+    pub speeds: [u32; 3],
     /// A44 quick stop on the loss of A60 (1 = active).
     pub a44: u8,
     /// I00 position range (1 = endless).
     pub i00: u8,
+    /// I04 permitted direction (0 both, 1 positive, 2 negative).
+    pub i04: u8,
     /// G472 / G475 velocity limits of the torque modes, 0.1 % of I10
     /// (C-039).
     pub torque_mode_speed_limit: [u16; 2],
@@ -437,8 +455,29 @@ impl Snapshot {
                 sat(w.param(od, I18, 0, m), 0u32, u32::MAX),
             ],
             i26: sat(w.param(od, I26, 0, m), 0u8, u8::MAX),
+            homing_torque: (
+                sat(w.param(od, I28, 0, m), 0u16, u16::MAX),
+                sat(w.param(od, I29, 0, m), 0u16, u16::MAX),
+            ),
+            i30_i43: (
+                sat(w.param(od, I30, 0, m), 0u8, u8::MAX),
+                sat(w.param(od, I43, 0, m), 0u8, u8::MAX),
+            ),
+            i53: sat(w.param(od, I53, 0, m), 0u32, u32::MAX),
+            interpolation: (
+                sat(w.param(od, I25, 0, m), 0u8, u8::MAX),
+                sat(w.param(od, I425, 0, m), 0u8, u8::MAX),
+                sat(w.param(od, I423, 0, m), 0u16, u16::MAX),
+            ),
+            i87: sat(w.param(od, I87, 0, m), 0u16, u16::MAX),
+            speeds: [
+                sat(w.param(od, I10, 0, m), 0u32, u32::MAX),
+                sat(w.param(od, C40, 0, m), 0u32, u32::MAX),
+                sat(w.param(od, I44, 0, m), 0u32, u32::MAX),
+            ],
             a44: sat(w.param(od, A44, 0, m), 0u8, u8::MAX),
             i00: sat(w.param(od, I00, 0, m), 0u8, u8::MAX),
+            i04: sat(w.param(od, I04, 0, m), 0u8, u8::MAX),
             gains: (
                 sat(w.param(od, I20, 0, m), 0u16, u16::MAX),
                 sat(w.param(od, C31, 0, m), 0u32, u32::MAX),
@@ -541,6 +580,11 @@ impl Snapshot {
                 mag(self.position_error_limit)
             },
             dead_band: mag(self.dead_band),
+            i53: mag(self.i53),
+            speeds: {
+                let [i10, c40, i44] = self.speeds;
+                [vel(i10), vel(c40), acc(i44)]
+            },
             jog: {
                 let [v, a, d, j] = self.jog;
                 [vel(v), acc(a), acc(d), acc(j)]

@@ -11,6 +11,7 @@
 use super::{Object, Value};
 use crate::parameter_index;
 use od::DataType::{U16, U32, U8};
+
 use od::{Access, DataType, EntryInfo};
 
 const RW: Access = Access::RW;
@@ -39,7 +40,7 @@ const fn g(line: u16) -> u16 {
 const REV_INC: i64 = 1 << 20;
 
 /// The control settings of axis A, sorted by index.
-pub const PARAMS: [Object; 12] = [
+pub const PARAMS: [Object; 25] = [
     Object::var(
         a(44),
         Value::Ram,
@@ -73,6 +74,17 @@ pub const PARAMS: [Object; 12] = [
     .level(1)
     .note("C32 (line assumed): integral time of the velocity controller; 0 = no integral part; effective at once"),
     Object::var(
+        c(40),
+        Value::Ram,
+        entries![e(0, "Velocity window", U32, RW)
+            .default_value(REV_INC / 10)
+            .unit("inc/s")
+            .saved()],
+    )
+    .axis()
+    .level(1)
+    .note("C40 (C-061 area): velocity window in user units/s (decimals A310): standstill I199 below it, the pv velocity-reached window; default 0.1 rev/s; effective at once"),
+    Object::var(
         g(472),
         Value::Ram,
         entries![e(0, "Positive velocity limit torque mode", U16, RW)
@@ -102,6 +114,25 @@ pub const PARAMS: [Object; 12] = [
     .axis()
     .level(1)
     .note("I00 (C-099, C-111): 0 limited (software limits act), 1 endless (positions wrap at 607Bh:02); default 0; writable in Pre-Op only (0800 0022h in Safe-Op and Op: the coordinate system must not change under a running axis)"),
+    Object::var(
+        i_(4),
+        Value::Ram,
+        entries![e(0, "Permitted direction", U8, RW).range(0, 2).saved()],
+    )
+    .axis()
+    .level(1)
+    .note("I04 (C-105, C-107): endless axes only: 0 both directions (default), 1 positive only, 2 negative only; a move the other way is refused and shown in E80 = 15; effective at once"),
+    Object::var(
+        i_(10),
+        Value::Ram,
+        entries![e(0, "Maximal speed", U32, RW)
+            .default_value(50 * REV_INC)
+            .unit("inc/s")
+            .saved()],
+    )
+    .axis()
+    .level(1)
+    .note("I10: the highest speed of the axis in user units/s (decimals A310): the cascade's speed command is limited to it and G472/G475 are per mille of it; default 50 rev/s; effective at once; not yet checked against the motor's B83 (motor data)"),
     Object::var(
         i_(12),
         Value::Ram,
@@ -145,6 +176,18 @@ pub const PARAMS: [Object; 12] = [
     .level(1)
     .note("I20 (line assumed): gain of the position controller, velocity command per following error; default 100 /s; effective at once"),
     Object::var(
+        i_(25),
+        Value::Ram,
+        entries![e(0, "Speed feedforward", U8, RW)
+            .range(0, 100)
+            .default_value(100)
+            .unit("%")
+            .saved()],
+    )
+    .axis()
+    .level(1)
+    .note("I25 (C-117 area, ip/csp): weight of the speed feedforward the interpolator derives or takes (I425), %; 0 = none; default 100 %; effective at once (the interpolator restarts from the present set-point)"),
+    Object::var(
         i_(26),
         Value::Ram,
         entries![e(0, "Jog control type", U8, RW)
@@ -156,6 +199,53 @@ pub const PARAMS: [Object; 12] = [
     .level(1)
     .note("I26 (C-091, C-092): 0 velocity control (past a software limit a quick stop), 1 position control (stops before it, default)"),
     Object::var(
+        i_(28),
+        Value::Ram,
+        entries![e(0, "Torque/force limit homing", U16, RW)
+            .range(0, 3000)
+            .default_value(1000)
+            .unit("0.1 %")
+            .saved()],
+    )
+    .axis()
+    .level(1)
+    .note("I28 (C-083 torque methods): torque limit while referencing, 0.1 % of the rated torque 6076h (6072h caps it), also the threshold the torque methods look for; default 100 %; effective at the next homing start"),
+    Object::var(
+        i_(29),
+        Value::Ram,
+        entries![e(0, "Time torque/force limit homing", U16, RW)
+            .default_value(100)
+            .unit("ms")
+            .saved()],
+    )
+    .axis()
+    .level(1)
+    .note("I29: how long the torque must stay at I28 continuously before a torque method takes the reference; default 100 ms"),
+    Object::var(
+        i_(30),
+        Value::Ram,
+        entries![e(0, "Reference switch type", U8, RW).range(0, 2).saved()],
+    )
+    .axis()
+    .level(1)
+    .note("I30 (C-086): 0 reference switch (I103), 2 the limit switches act as reference switch (methods 17-20 on ±LS without a limit-switch fault); 1 is the manual's 'other' and is taken as 0 (docs/conformance.md); effective at the next homing start"),
+    Object::var(
+        i_(43),
+        Value::Ram,
+        entries![e(0, "Move to reference position", U8, RW).range(0, 1).saved()],
+    )
+    .axis()
+    .level(1)
+    .note("I43: 1 = after referencing the axis positions on the reference position 607Ch (A569); default 0: it stops with 609Ah"),
+    Object::var(
+        i_(44),
+        Value::Ram,
+        entries![e(0, "Referencing jerk", U32, RW).unit("inc/s³").saved()],
+    )
+    .axis()
+    .level(1)
+    .note("I44: jerk of the homing moves in user units/s³ (decimals A311); 0 = no jerk limit (default); effective at the next homing start"),
+    Object::var(
         i_(45),
         Value::Ram,
         entries![e(0, "Jog deceleration", U32, RW)
@@ -166,4 +256,42 @@ pub const PARAMS: [Object; 12] = [
     .axis()
     .level(1)
     .note("I45: jog deceleration in user units/s² (decimals A311); default 10 rev/s²"),
+    Object::var(
+        i_(53),
+        Value::Ram,
+        entries![e(0, "Index search offset", U32, RW).unit("inc").saved()],
+    )
+    .axis()
+    .level(1)
+    .note("I53: after the switch edge the zero-pulse search starts this far on, in user position units (6091h/6092h); default 0"),
+    Object::var(
+        i_(87),
+        Value::Ram,
+        entries![e(0, "Actual position in window time", U16, RW)
+            .unit("ms")
+            .saved()],
+    )
+    .axis()
+    .level(1)
+    .note("I87 (C-048): how long the actual position must stay in the target window I22 before target reached (statusword bit 10) and in position; default 0 ms; effective at once"),
+    Object::var(
+        i_(423),
+        Value::Ram,
+        entries![e(0, "Max extrapolation period", U16, RW)
+            .range(0, 10_000)
+            .default_value(10)
+            .unit("ms")
+            .saved()],
+    )
+    .axis()
+    .level(1)
+    .note("I423 (C-117): the longest the cyclic modes extrapolate a missing set value before event 78 cause 3; default 10 ms; effective at once"),
+    Object::var(
+        i_(425),
+        Value::Ram,
+        entries![e(0, "Speed feed forward interpolation", U8, RW).range(0, 5).saved()],
+    )
+    .axis()
+    .level(1)
+    .note("I425: 0 linear, 4 quadratic, 5 cubic (internal: the drive derives the speed feedforward), 1 and 3 external (60B1h); 2 is refused (0609 0030h); default 0; effective at once"),
 ];

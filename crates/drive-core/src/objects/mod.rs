@@ -687,6 +687,8 @@ pub const ENUMS: &[(u16, u8, &[i64])] = &[
     // 6060h modes of operation: -1 jog, 0 none, 1 pp, 2 vl, 3 pv, 4 pt, 6 hm,
     // 7 ip, 8 csp, 9 csv, 10 cst (od-cia402.md A-033)
     (0x6060, 0, &[-1, 0, 1, 2, 3, 4, 6, 7, 8, 9, 10]),
+    // I425 speed feedforward interpolation (2 has no meaning, issue 40)
+    (crate::params::I425, 0, &[0, 1, 3, 4, 5]),
     // 6098h homing method: the supported methods
     (0x6098, 0, &cia402::HOMING_METHODS_I64),
     // 605Ah quick stop option code (CiA 402: 0..8), 605Eh fault reaction (0..4)

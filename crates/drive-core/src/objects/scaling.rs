@@ -20,7 +20,7 @@
 //! converts exactly these entries): `tests_scaling.rs`.
 
 use super::records::{J401, J404};
-use crate::params::{I12, I13, I18, I45};
+use crate::params::{C40, I10, I12, I13, I18, I44, I45};
 
 /// Which decimal places an entry takes.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
@@ -36,10 +36,13 @@ use Quantity::{Acceleration as ACC, Velocity as VEL};
 /// The scaled entries of axis A: index, subindex in the "EtherCAT Rx SDO
 /// Info" numbering (J401 element k at k + 1), quantity. Axis B's are at
 /// +800h (CiA 402) and +8000h (J401, J404). Sorted by index.
-pub const SCALED: [(u16, u8, Quantity); 24] = [
+pub const SCALED: [(u16, u8, Quantity); 27] = [
+    (C40, 0, VEL),    // velocity window
+    (I10, 0, VEL),    // maximal speed
     (I12, 0, VEL),    // jog velocity
     (I13, 0, ACC),    // jog acceleration
     (I18, 0, ACC),    // jog jerk
+    (I44, 0, ACC),    // referencing jerk
     (I45, 0, ACC),    // jog deceleration
     (J401, 2, VEL),   // record data [1] profile velocity
     (J401, 3, VEL),   // record data [2] end velocity

@@ -463,3 +463,30 @@ fn p045_issue40_g472_and_c31_through_pkw_saved_and_read_after_a_restart() {
     assert_eq!(again.objects().get(G472, 0), Ok(300));
     assert_eq!(again.objects().get(C31, 0), Ok(45_000));
 }
+
+/// The homing, interpolation and speed settings of issue 40 through PKW
+/// (PNU = index): I28, I53, I425, I10 written and read back; I28 beyond
+/// 300 % and I425 = 2 get PKW error 2 and change nothing; PNU 971 saves
+/// them and a new drive over the same flash starts with them.
+#[test]
+fn p045_issue40_homing_and_speed_settings_through_pkw_saved_and_read_after_a_restart() {
+    use drive_core::params::{I10, I28, I425, I53};
+    let mut b = Bench::new();
+    assert_eq!(b.pkw0(0x41, I28, 0, 0), (0x41, 1000), "100 % by default");
+    assert_eq!(b.pkw0(0x42, I28, 0, 3001), (0xC2, 2), "beyond 300 %");
+    assert_eq!(b.pkw0(0x42, I425, 0, 2).0, 0xC2, "I425 = 2 refused");
+    assert_eq!(b.d.objects().get(I28, 0), Ok(1000), "unchanged");
+    assert_eq!(b.d.objects().get(I425, 0), Ok(0), "unchanged");
+    assert_eq!(b.pkw0(0x42, I28, 0, 400).0, 0x42);
+    assert_eq!(b.pkw0(0x42, I425, 0, 4).0, 0x42);
+    assert_eq!(b.pkw0(0x42, I53, 0, 4096).0, 0x42);
+    assert_eq!(b.pkw0(0x42, I10, 0, 20 << 20).0, 0x42);
+    assert_eq!(b.pkw0(0x41, I28, 0, 0), (0x41, 400));
+    assert_eq!(b.pkw0(0x42, 971, 0, 1).0, 0x42, "saved");
+    let flash = core::mem::replace(&mut b.d, crate::tests::commissioned()).into_flash();
+    let again = PnDrive::new(flash, crate::tests::hardware());
+    assert_eq!(again.objects().get(I28, 0), Ok(400));
+    assert_eq!(again.objects().get(I425, 0), Ok(4));
+    assert_eq!(again.objects().get(I53, 0), Ok(4096));
+    assert_eq!(again.objects().get(I10, 0), Ok(20 << 20));
+}
