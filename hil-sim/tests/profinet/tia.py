@@ -36,6 +36,7 @@ scapy (tia_lib.py), not profinet-py; one line per result:
 """
 
 import argparse
+import atexit
 import os
 import random
 import signal
@@ -150,6 +151,7 @@ def main():
     if a.pcap:
         rec = subprocess.Popen(["dumpcap", "-q", "-i", a.iface, "-w", a.pcap], stdout=subprocess.DEVNULL,
                                stderr=subprocess.DEVNULL)
+        atexit.register(rec.terminate)  # also when a step raises past its runner
         time.sleep(1.0)
     t.tx_checksum_offload_off(a.iface)
     link = t.Link(a.iface)
