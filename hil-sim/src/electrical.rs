@@ -20,12 +20,18 @@
 //! stays the simulation's exactly (under the DC PLL the cycle differs from a
 //! whole number of PWM periods by ppm: the plant's periods stretch by as much).
 //!
-//! What this does not do yet: the drive core still reports the commanded torque
-//! as 6077h (the actual torque from the measured iq comes with the drive core's
-//! current seam), and a trip of the current loop's protection (over-current,
-//! encoder) switches the gates off without the drive core hearing of it.
+//! The drive core's current seam ([`CurrentControl`]): the simulated drive
+//! hands each cycle's [`AxisCommand`] to [`CurrentControl::command`] and puts
+//! [`CurrentControl::actual`] (the loop's measured iq and kt·iq, from the last
+//! PWM period's sample) into the next cycle's `AxisIo::current`, so 6077h and
+//! 6078h show the measurement, as the board's do.
+//!
+//! What this does not do yet: a trip of the current loop's protection
+//! (over-current, encoder) switches the gates off without the drive core
+//! hearing of it.
 
 use crate::motor::{EdgeList, IndexEvent, Motor, MotorOutputs, INC_PER_RAD};
+use drive_ecat::axis::{AxisCommand, CurrentActual, CurrentControl};
 use foc::{FocAxis, LoopParams, MotorData, PowerStage, Protection};
 use nanos::Nanos;
 use plant::{Plant, PlantParams, Shaft};
@@ -114,6 +120,23 @@ pub struct ElectricalAxis {
     period: Nanos,
     stats: CurrentStats,
     last: CurrentSnapshot,
+    command: AxisCommand,
+}
+
+impl CurrentControl for ElectricalAxis {
+    fn command(&mut self, command: &AxisCommand) {
+        self.command = *command;
+    }
+
+    /// The loop's last measured iq (with the ADC's quantisation and noise) and
+    /// the torque it makes by the loop's kt.
+    fn actual(&self) -> Option<CurrentActual> {
+        let iq = self.foc.measured().current.q;
+        Some(CurrentActual {
+            torque_nm: self.foc.gains().kt_nm_per_a * iq,
+            current_a: iq,
+        })
+    }
 }
 
 impl ElectricalAxis {
@@ -144,6 +167,7 @@ impl ElectricalAxis {
             period,
             stats: CurrentStats::default(),
             last: CurrentSnapshot::default(),
+            command: AxisCommand::OFF,
         })
     }
 
@@ -165,6 +189,19 @@ impl ElectricalAxis {
     /// The last PWM period.
     pub fn last(&self) -> &CurrentSnapshot {
         &self.last
+    }
+
+    /// One control cycle of length `dt` under the command last given
+    /// ([`CurrentControl::command`]): [`ElectricalAxis::step`] with its torque
+    /// (none with the power stage off), power stage and brake.
+    pub fn run(&mut self, motor: &mut Motor, dt: Nanos) -> MotorOutputs {
+        let c = self.command;
+        let torque = if c.power_stage {
+            f64::from(c.torque_nm)
+        } else {
+            0.0
+        };
+        self.step(motor, torque, c.power_stage, !c.brake_release, dt)
     }
 
     /// One control cycle of length `dt`: the current loop runs with iq =
