@@ -74,6 +74,7 @@ fn serve_help_lists_its_options_not_the_test_ones() {
         "--axes <1|2>",
         "--pcap <FILE>",
         "--seconds <S>",
+        "--plant <MODEL>",
     ] {
         assert!(out.contains(want), "`{want}` missing in:\n{out}");
     }
@@ -99,6 +100,24 @@ fn an_unknown_flag_is_refused() {
         );
         assert!(o.stdout.is_empty(), "{args:?}: nothing ran: {}", text(&o.stdout));
     }
+}
+
+#[test]
+fn serve_plant_electrical_is_ethercat_only_and_an_unknown_plant_is_refused() {
+    let o = hil_sim(&[
+        "serve",
+        "--iface",
+        "lo",
+        "--fieldbus",
+        "profinet",
+        "--plant",
+        "electrical",
+    ]);
+    assert!(!o.status.success(), "{o:?}");
+    assert!(text(&o.stderr).contains("EtherCAT-only"), "{}", text(&o.stderr));
+    let o = hil_sim(&["serve", "--iface", "lo", "--plant", "bogus"]);
+    assert_eq!(o.status.code(), Some(2), "{o:?}");
+    assert!(text(&o.stderr).contains("--plant"), "{}", text(&o.stderr));
 }
 
 #[test]
