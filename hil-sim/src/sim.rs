@@ -6,6 +6,7 @@ use crate::electrical::{ElectricalAxis, PlantModel};
 use crate::esc::{Esc, EscConfig, LineTiming};
 use crate::frame::process_frame;
 use crate::motor::{Motor, MotorOutputs};
+use drive_ecat::axis::CurrentControl;
 mod axis_io;
 mod flash;
 mod snapshot;
@@ -392,10 +393,17 @@ impl SimDrive {
             // free run: the cycle the axes integrate with (A150, E-125)
             None => self.next_cycle = t.saturating_add(self.drive.free_run_period()),
         }
-        let io = [
+        let mut io = [
             axis_io(self.feedback[0].as_ref(), &self.motors[0], self.conditions[0]),
             axis_io(self.feedback[1].as_ref(), &self.motors[1], self.conditions[1]),
         ];
+        // the current seam: the electrical axes' measured iq (the rigid
+        // model measures nothing: the axes show their demand)
+        for (io, el) in io.iter_mut().zip(&self.electrical) {
+            if let Some(el) = el {
+                io.current = el.actual();
+            }
+        }
         let cmd = match command {
             Some(c) => self.drive.sync_cycle(&c, t, &io),
             None => self.drive.control_cycle(t, &io),
@@ -410,14 +418,19 @@ impl SimDrive {
         }
         let axes = self.motors.iter_mut().zip(self.feedback.iter_mut());
         for (((motor, fb), c), el) in axes.zip(cmd).zip(self.electrical.iter_mut()) {
-            let torque = if c.power_stage {
-                f64::from(c.torque_nm)
-            } else {
-                0.0
-            };
             *fb = Some(match el {
-                Some(el) => el.step(motor, torque, c.power_stage, !c.brake_release, self.cycle),
-                None => motor.step(torque, !c.brake_release, self.cycle),
+                Some(el) => {
+                    el.command(&c);
+                    el.run(motor, self.cycle)
+                }
+                None => {
+                    let torque = if c.power_stage {
+                        f64::from(c.torque_nm)
+                    } else {
+                        0.0
+                    };
+                    motor.step(torque, !c.brake_release, self.cycle)
+                }
             });
         }
     }

@@ -17,7 +17,10 @@
 //! processed at once, and counted in the summary when that was more than
 //! [`LATE_NOTE`] late.
 
-use super::args::{Fieldbus, ServeArgs};
+use super::args::{Fieldbus, Plant, ServeArgs};
+
+/// Seed of the electrical plant's ADC noise under `serve --plant electrical`.
+const PLANT_SEED: u64 = 0x5E12_0034;
 use super::print_new_changes;
 use hil_sim::raw::{monotonic, RawSocket};
 use hil_sim::sim::{SimDrive, Simulation};
@@ -65,6 +68,12 @@ const FLUSH_EVERY: Nanos = Nanos::from_secs(1);
 /// Runs `serve` until `--seconds` have passed (or forever).
 pub fn serve(args: &ServeArgs) -> Result<(), String> {
     if args.fieldbus == Fieldbus::Profinet {
+        if args.plant != Plant::Rigid {
+            return Err(
+                "--plant electrical is EtherCAT-only for now (the PROFINET drive runs the rigid model)"
+                    .into(),
+            );
+        }
         return super::serve_pn::serve(args);
     }
     if args.name.is_some() {
@@ -84,6 +93,12 @@ pub fn serve(args: &ServeArgs) -> Result<(), String> {
             .map(|_| SimDrive::with_firmware_slots_for(variant))
             .collect(),
     );
+    // the motor model: the seed per drive k (from 0) is PLANT_SEED + 2k
+    // (axis B takes + 1), so runs are reproducible and axes independent
+    for (k, d) in (0u64..).zip(sim.drives_mut()) {
+        d.set_plant(args.plant.into(), PLANT_SEED.wrapping_add(2 * k))
+            .map_err(|e| format!("the electrical plant's parameters: {e:?}"))?;
+    }
     // the recording first: an unwritable path fails before anything else
     if let Some(p) = &args.pcap {
         sim.record_pcap(p)
@@ -107,6 +122,9 @@ pub fn serve(args: &ServeArgs) -> Result<(), String> {
         "hil-sim serve: {slaves} simulated {kind} drive(s) {} (product code {}) on {iface}",
         device.order_code, device.identity.product_code
     );
+    if args.plant == Plant::Electrical {
+        println!("plant: current loop (16 kHz) -> simulated PMSM and inverter on every axis");
+    }
     println!(
         "EoE: ping and the UDP parameter service (port {}) answer at the IP address the master sets",
         net::param::PARAM_PORT

@@ -108,3 +108,47 @@ fn an_idle_axis_comes_back_with_its_torque() {
         "torque {t} N·m after enabling while turning"
     );
 }
+
+/// C-038, P-187 at the drive core's current seam ([`CurrentControl`]): the
+/// commands of 10 %, 50 % and 100 % of the rated torque (1.3 N·m), rotor held
+/// by the brake (2 N·m), give after 20 ms (≫ 1/ω_c) an `actual()` whose torque
+/// (the measured iq's mean over the cycle) is within 2 % of the command and
+/// equals kt·iq with kt = 1.5·p·ψ (closed form), and the motor's own
+/// instantaneous torque within 2 % of the rated torque; before
+/// the first cycle under the command `actual()` shows no current.
+#[test]
+fn c038_p187_the_seam_reports_the_measured_torque_at_10_50_100_percent() {
+    for share in [0.1, 0.5, 1.0] {
+        let t = 1.3 * share;
+        let mut el = ElectricalAxis::default_servo(11).unwrap();
+        let mut motor = Motor::default_servo();
+        el.command(&AxisCommand {
+            torque_nm: t as f32,
+            power_stage: true,
+            brake_release: false,
+        });
+        let before = el.actual().unwrap();
+        assert!(before.current_a.abs() < 0.02, "{share}: {before:?}");
+        for _ in 0..20 {
+            el.run(&mut motor, Nanos::from_ms(1));
+        }
+        let a = el.actual().unwrap();
+        assert_eq!(motor.velocity_rad_s(), 0.0, "{share}: the brake holds");
+        let closed = torque_of_iq(f64::from(a.current_a));
+        assert!(
+            (f64::from(a.torque_nm) - closed).abs() < 1e-4,
+            "{share}: {a:?} vs kt·iq {closed}"
+        );
+        assert!(
+            (f64::from(a.torque_nm) - t).abs() <= 0.02 * t,
+            "{share}: {a:?}, command {t}"
+        );
+        // the motor's instantaneous torque: the loop regulates the noisy
+        // sample (σ ≈ 7 mA = 0.35 % of the rated current), so 2 % of rated
+        let motor_t = el.plant().torque_nm();
+        assert!(
+            (motor_t - t).abs() <= 0.02 * 1.3,
+            "{share}: motor torque {motor_t}"
+        );
+    }
+}

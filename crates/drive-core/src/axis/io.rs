@@ -1,6 +1,6 @@
 //! The axis' hardware seam: what the board or simulator hands to a control
-//! cycle ([`AxisIo`]: encoder, latched edges, switches, enables) and what
-//! it gets back ([`AxisCommand`], [`AxisReport`]).
+//! cycle ([`AxisIo`]: encoder, latched edges, switches, enables, the measured
+//! current) and what it gets back ([`AxisCommand`], [`AxisReport`]).
 
 use super::*;
 
@@ -54,7 +54,7 @@ pub struct SwitchEdge {
 
 /// What the hardware (board driver or simulated motor) reports for one axis
 /// at the start of a control cycle.
-#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+#[derive(Debug, Clone, Copy, PartialEq)]
 pub struct AxisIo {
     /// Encoder position, increments (2^20 per revolution, wrapping), motor
     /// coordinates.
@@ -84,12 +84,15 @@ pub struct AxisIo {
     /// own check: signal, communication, plausibility). While `false`,
     /// `position_inc` is not used and the axis faults (event 37).
     pub encoder_ok: bool,
+    /// The current loop's latest measurement ([`CurrentControl::actual`]):
+    /// 6077h and 6078h show it. `None`: no measurement, they show the demand.
+    pub current: Option<CurrentActual>,
 }
 
 impl AxisIo {
     /// A ready axis at `position_inc`: enable A60 on, supply present, STO
-    /// off, encoder valid, no switches or edges (what the simulator passes
-    /// by default).
+    /// off, encoder valid, no switches or edges, no current measurement (what
+    /// the simulator passes by default).
     pub const fn ready(position_inc: i32) -> Self {
         Self {
             position_inc,
@@ -103,6 +106,7 @@ impl AxisIo {
             supply_ok: true,
             sto_active: false,
             encoder_ok: true,
+            current: None,
         }
     }
 }

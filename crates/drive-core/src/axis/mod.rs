@@ -85,6 +85,7 @@
 
 mod cache;
 mod configure;
+mod current;
 mod fault;
 mod feedback;
 mod io;
@@ -97,6 +98,8 @@ mod running;
 mod snapshot;
 #[cfg(test)]
 mod tests;
+#[cfg(test)]
+mod tests_current;
 #[cfg(test)]
 mod tests_records;
 mod units;
@@ -133,6 +136,7 @@ pub(crate) use snapshot::{CyclicSlots, Snapshot, Window};
 
 pub use cache::AxisCache;
 use cache::CachedSnapshot;
+pub use current::{CurrentActual, CurrentControl};
 pub use io::{AxisCommand, AxisIo, AxisReport, IndexLatch, ProbeEdge, SwitchEdge, SwitchId};
 pub use monitor::{LOW_VOLTAGE, MOTOR_ENCODER};
 pub use params::AxisParams;
@@ -470,7 +474,8 @@ impl Axis {
     /// 9. **control**: the cascade turns the demand into a torque and the
     ///    mode's status bits;
     /// 10. **write-back**: statusword and actual values, A67, E47/E49,
-    ///     60FDh (`write_back.rs`).
+    ///     60FDh (`write_back.rs`); 6077h/6078h from the current loop's
+    ///     measurement ([`AxisIo::current`], `current.rs`), else the demand.
     pub fn cycle_cached(
         &mut self,
         cache: &mut AxisCache,
@@ -602,12 +607,18 @@ impl Axis {
         let (torque, bits, fe) = self.control(demand, actual, now_ns, dt_ns);
 
         self.prev_cw = o.controlword;
-        self.write_back(od, slots, &out, (bits, actual, torque, fe));
+        let sign = if o.polarity & 0x80 != 0 { -1.0 } else { 1.0 };
+        // 6077h/6078h: the current loop's measurement (motor coordinates,
+        // turned like the command), or the demand where nothing is measured
+        let measured = io.current.map(|m| CurrentActual {
+            torque_nm: sign * m.torque_nm,
+            current_a: sign * m.current_a,
+        });
+        self.write_back(od, slots, &out, (bits, actual, torque, fe), measured);
         self.user_statusword(od, slots, o);
         self.switch_on_disabled_causes(od, slots, &out, io, o.controlword);
         self.digital_inputs(od, slots, io);
 
-        let sign = if o.polarity & 0x80 != 0 { -1.0 } else { 1.0 };
         AxisReport {
             command: AxisCommand {
                 torque_nm: sign * torque,

@@ -1,5 +1,6 @@
 //! The actual values of a cycle back into the dictionary: statusword and
-//! the values of the mode (6041h, 6064h, 606Ch, 6077h, …), user units,
+//! the values of the mode (6041h, 6064h, 606Ch, 6077h/6078h from the
+//! measured current, …), user units,
 //! the causes of Switch on disabled (E47/E49), A67 and 60FDh.
 
 use super::*;
@@ -11,6 +12,7 @@ impl Axis {
         c: &CyclicSlots,
         out: &Outputs,
         (bits, actual, torque, fe): (u16, i32, f32, i32),
+        measured: Option<CurrentActual>,
     ) {
         let mut sw =
             out.statusword & !(SW_TARGET_REACHED | SW_MODE_BIT12 | SW_MODE_BIT13 | SW_INTERNAL_LIMIT);
@@ -41,11 +43,26 @@ impl Axis {
         od.write_typed(c.position, sat_i32(position));
         let v = self.scaling.velocity_to_user(self.velocity) * self.velocity_decimals;
         od.write_typed(c.velocity, round_i32(v));
-        let rated = self.params.rated_torque_nm;
-        let per_mille = if rated > 0.0 { torque / rated * 1000.0 } else { 0.0 };
-        let t = round_i32(per_mille).clamp(i32::from(i16::MIN), i32::from(i16::MAX)) as i16;
+        // 6077h in 0.1 % of the rated torque, 6078h in 0.1 % of the rated
+        // current (CiA 402: 6076h, 6075h); without a measurement both show the
+        // demand (an ideal current loop: the same fraction of either)
+        let per_mille = |v: f32, rated: f32| {
+            let x = if rated > 0.0 { v / rated * 1000.0 } else { 0.0 };
+            round_i32(x).clamp(i32::from(i16::MIN), i32::from(i16::MAX)) as i16
+        };
+        let rated_a = self.params.rated_current_ma as f32 * 0.001;
+        let (t, i) = match measured {
+            Some(m) => (
+                per_mille(m.torque_nm, self.params.rated_torque_nm),
+                per_mille(m.current_a, rated_a),
+            ),
+            None => {
+                let t = per_mille(torque, self.params.rated_torque_nm);
+                (t, t)
+            }
+        };
         od.write_typed(c.torque, t);
-        od.write_typed(c.current, t);
+        od.write_typed(c.current, i);
         od.write_typed(c.following_error, sat_i32(self.user(fe)));
         od.write_typed(c.probe_status, self.probe.status());
         if !self.probe_shown {

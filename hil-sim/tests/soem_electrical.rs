@@ -1,0 +1,52 @@
+//! SOEM (through pysoem) against `hil-sim serve --plant electrical`: the
+//! torque modes on the current loop and the PMSM plant (issue 34). Needs root
+//! and `PYSOEM_PYTHON` (`.ci/run` sets it to target/pysoem-venv/bin/python);
+//! skipped otherwise, like `soem.rs`.
+#![allow(clippy::unwrap_used, clippy::expect_used, clippy::panic)]
+
+mod common;
+
+use common::soem_line::{pysoem_python, Line};
+use std::path::{Path, PathBuf};
+
+fn scratch(test: &str) -> PathBuf {
+    let dir = Path::new(env!("CARGO_TARGET_TMPDIR")).join(test);
+    std::fs::create_dir_all(&dir).expect("scratch dir");
+    dir
+}
+
+fn fail_with(line: &Line, what: &str) -> ! {
+    let serve = line.serve_output();
+    let tail: Vec<&str> = serve.lines().rev().take(60).collect();
+    let tail: Vec<&str> = tail.into_iter().rev().collect();
+    panic!(
+        "{what}\n--- hil-sim serve ({}), last lines:\n{}",
+        line.serve_log.display(),
+        tail.join("\n")
+    );
+}
+
+/// C-038, P-187 through SOEM on the electrical plant (`cst_electrical.py`):
+/// 6071h steps of ±10 %, ±50 %, ±100 % of the rated torque in cst give a
+/// 6077h (kt times the measured iq, averaged over the control cycle) within
+/// 2 % of 6071h in every frame from the fourth after the step while the free
+/// rotor is below half the speed limit (G472/G475 = 100 % of I10).
+#[test]
+fn c038_p187_soem_cst_steps_on_the_electrical_plant_give_6077h_within_2_percent() {
+    let python = match pysoem_python() {
+        Ok(p) => p,
+        Err(why) => {
+            eprintln!("soem electrical test: skipped, {why}");
+            return;
+        }
+    };
+    let dir = scratch("soem-cst-electrical");
+    let i10 = drive_ecat::axis::AxisParams::default()
+        .cascade
+        .max_velocity_inc_per_s;
+    let line = Line::with_serve_args("e", 1, 120, &dir, &["--plant", "electrical"]);
+    let status = line.run(&python, "cst_electrical.py", &["--i10", &i10.to_string()]);
+    if !status.success() {
+        fail_with(&line, &format!("cst_electrical.py through SOEM failed: {status}"));
+    }
+}
