@@ -68,7 +68,8 @@ def report(step, ok, text):
 
 
 def expected_fail(step, text):
-    print(f"step {step}: expected-fail: {text}", flush=True)
+    # issue 32.4 is served now: what was an expected failure is a failure
+    report(step, False, text.replace(NOT_SERVED, "issue 32.4 says the device serves it"))
 
 
 def run(step, fn):
@@ -336,7 +337,9 @@ def main():
         # the device may fold a change into an alarm still queued: every one
         # acknowledged, numbered in sequence, the last one "disappears"
         seqs = [x[3] for x in got]
-        ok = (len(got) >= 3 and all(x[4] for x in got) and got[-1][0] == 0x000C
+        # (with the port's topology diagnosis sharing the low-priority alarm
+        # channel, as few as two remain: the first "appears", the last "disappears")
+        ok = (len(got) >= 2 and got[0][0] == 0x0001 and all(x[4] for x in got) and got[-1][0] == 0x000C
               and all(b > a for a, b in zip(seqs, seqs[1:])) and ar.abort is None)
         report("j", ok, f"alarm burst: {len(got)} alarms acknowledged 500 ms late each: {', '.join(types)}; "
                f"AR {'aborted ' + ar.abort if ar.abort else 'up'}")

@@ -600,8 +600,12 @@ class AR:
             self.max_gap = max(self.max_gap, gap)
         self.last_rx = now
         good = True
-        # DataStatus: primary (0x01), valid (0x04), run (0x10), no problem (0x20)
-        if status & 0x35 != 0x35:
+        # DataStatus: primary (0x01), valid (0x04), run (0x10); the station
+        # problem indicator (0x20 = no problem) is not judged here: the
+        # topology check written in step e (0x802B, a neighbour this
+        # controller does not play) leaves a port diagnosis pending, and the
+        # device then rightly shows "problem detected"
+        if status & 0x15 != 0x15:
             self.stats["bad_status"] += 1
             good = False
         for s, o in l.in_data:

@@ -518,7 +518,11 @@ impl<H: RecordHook> Cm<H> {
     fn write(&mut self, args: &[u8], w: &mut Writer<'_>) -> PnioStatus {
         let code = ec::IOD_WRITE_RES;
         let Some((req, rest)) = RwRequest::parse(args).filter(|(r, _)| r.write) else {
-            return PnioStatus::pnio(code, error_code1::RECORD, 0);
+            // the answer still carries an IODWriteResHeader (all zero: the
+            // request's is unreadable), as Wireshark and controllers expect
+            let s = PnioStatus::pnio(code, error_code1::RECORD, 0);
+            let _ = record::emit_write_res(w, &UNKNOWN_WRITE, 0, s);
+            return s;
         };
         if self.find(req.ar_uuid).is_none() {
             let s = PnioStatus::cmrpc(code, cmrpc::AR_UUID_UNKNOWN);
@@ -592,6 +596,22 @@ fn service(op: u16) -> u8 {
     }
 }
 
+/// The request an IODWriteRes names when the write's own header could not
+/// be read: every field zero.
+const UNKNOWN_WRITE: RwRequest = RwRequest {
+    write: true,
+    seq: 0,
+    ar_uuid: Uuid([0; 16]),
+    addr: RecordAddr {
+        api: 0,
+        slot: 0,
+        subslot: 0,
+        index: 0,
+    },
+    record_len: 0,
+    target_ar_uuid: Uuid([0; 16]),
+};
+
 impl<H: RecordHook> rpc::Handler for Cm<H> {
     fn call(&mut self, _now: Nanos, call: &Call, body: &[u8], out: &mut [u8]) -> Result<usize, CallError> {
         let too_big = CallError::Fault(rpc::nca::OUT_ARGS_TOO_BIG);
@@ -602,7 +622,18 @@ impl<H: RecordHook> rpc::Handler for Cm<H> {
         };
         let Some(ndr) = ndr else {
             let s = PnioStatus::cmrpc(service(call.opnum), cmrpc::ARGS_LENGTH_INVALID);
-            return ndr::emit_response(out, call.endian, s, 0, 0).ok_or(too_big);
+            // a write is answered with an IODWriteResHeader even when its NDR
+            // header does not parse (nothing of the request known: all zero),
+            // as Wireshark and controllers expect of an IODWriteRes (issue 32)
+            let len = if call.opnum == opnum::WRITE {
+                let args_out = out.get_mut(NDR_LEN..).ok_or(too_big)?;
+                let mut w = Writer::new(args_out, Endian::Big);
+                record::emit_write_res(&mut w, &UNKNOWN_WRITE, 0, s).ok_or(too_big)?;
+                w.pos()
+            } else {
+                0
+            };
+            return ndr::emit_response(out, call.endian, s, 0, len).ok_or(too_big);
         };
         let (status, len) = {
             let args_out = out.get_mut(NDR_LEN..).ok_or(too_big)?;
