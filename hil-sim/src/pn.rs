@@ -136,6 +136,7 @@ pub fn describe(e: &DeviceEvent) -> String {
         DeviceEvent::Rt(RtEvent::ArLost(u)) => {
             format!("AR {}: lost (cyclic watchdog or alarm channel)", uuid_text(u))
         }
+        DeviceEvent::SnmpChanged => "SNMP sysContact/sysName/sysLocation set (saved)".to_string(),
     }
 }
 
