@@ -413,6 +413,8 @@ impl Agent {
         None
     }
 
+    /// Applies a checked set; whether the kept strings differ afterwards (a set that writes an
+    /// object twice, back to what it was, changed nothing).
     fn apply_set(&mut self, req: &Req) -> bool {
         let dev = Device {
             descr: &[],
@@ -421,7 +423,7 @@ impl Agent {
             links: [false; 2],
             neighbors: [None, None],
         };
-        let mut changed = false;
+        let before = (self.sys_contact, self.sys_name, self.sys_location);
         for (oid, _, v) in varbinds(req.vbl) {
             let Some(t) = Text::new(v) else { continue };
             let slot = match mib::find(oid.arcs(), &dev) {
@@ -430,10 +432,9 @@ impl Agent {
                 Lookup::Found(mib::Id::SysLocation, _) => &mut self.sys_location,
                 _ => continue,
             };
-            changed |= *slot != t;
             *slot = t;
         }
-        changed
+        before != (self.sys_contact, self.sys_name, self.sys_location)
     }
 }
 

@@ -264,3 +264,20 @@ fn p038_malformed_is_dropped() {
     assert!(a.handle(&q[..n], &dev(), &mut [0u8; 1500]).is_none());
     assert_eq!(a.sys_name.get(), b"");
 }
+
+#[test]
+fn p038_a_set_that_writes_back_the_old_value_reports_no_change() {
+    let mut a = Agent::default();
+    let (q, n) = req(
+        1,
+        b"private",
+        SET,
+        3,
+        0,
+        0,
+        &[(SYSNAME, 4, b"x"), (SYSNAME, 4, b"")],
+    );
+    let (r, ch) = run(&mut a, &q[..n]).unwrap();
+    assert_eq!((r.status, ch), (0, false));
+    assert_eq!(a.sys_name.get(), b"");
+}
