@@ -136,6 +136,7 @@ pub fn describe(e: &DeviceEvent) -> String {
         DeviceEvent::Rt(RtEvent::ArLost(u)) => {
             format!("AR {}: lost (cyclic watchdog or alarm channel)", uuid_text(u))
         }
+        DeviceEvent::SnmpChanged => "SNMP sysContact/sysName/sysLocation set (saved)".to_string(),
     }
 }
 
@@ -168,6 +169,9 @@ pub enum Command {
     },
     /// Report the axes' state.
     Status,
+    /// Power the drive off and on again over the same parameter flash (what
+    /// was saved comes back; what was not is lost).
+    Restart,
 }
 
 impl Command {
@@ -201,8 +205,9 @@ impl Command {
                 axis: axis(rest.first())?,
             }),
             ["status"] => Ok(Command::Status),
+            ["restart"] => Ok(Command::Restart),
             _ => Err(format!(
-                "{:?}: commands are `fault A|B EVENT CAUSE`, `reset A|B`, `status`",
+                "{:?}: commands are `fault A|B EVENT CAUSE`, `reset A|B`, `status`, `restart`",
                 line.trim()
             )),
         }
@@ -226,6 +231,8 @@ pub struct PnSim {
     acknowledge: [u8; 2],
     /// The personality's events, oldest first.
     events: VecDeque<DeviceEvent>,
+    /// What the drive was powered on with (a restart powers it on again).
+    hw: Hardware,
 }
 
 impl PnSim {
@@ -247,7 +254,8 @@ impl PnSim {
             boot_time,
         };
         PnSim {
-            drive: drive_pn::PnDrive::new(flash, hw),
+            drive: drive_pn::PnDrive::new(flash, hw.clone()),
+            hw,
             motors: [Motor::default_servo(), Motor::default_servo()],
             feedback: [None, None],
             conditions: [AxisConditions::READY; 2],
@@ -366,6 +374,20 @@ impl PnSim {
                 format!("axis {}: fault acknowledged (controlword bit 7)", axis_name(axis))
             }
             Command::Status => self.status(),
+            Command::Restart => {
+                let hw = Hardware {
+                    boot_time: self.hw.boot_time.wrapping_add(1),
+                    ..self.hw.clone()
+                };
+                let old = std::mem::replace(
+                    &mut self.drive,
+                    drive_pn::PnDrive::new(SimFlash::new(), hw.clone()),
+                );
+                self.drive = drive_pn::PnDrive::new(old.into_flash(), hw.clone());
+                self.hw = hw;
+                self.events.clear();
+                "restarted over the same parameter flash".to_string()
+            }
         }
     }
 

@@ -90,6 +90,8 @@ mod tests_bmp;
 mod tests_energy;
 #[cfg(test)]
 mod tests_params;
+#[cfg(test)]
+mod tests_snmp;
 
 /// The event a lost AR raises on both axes: event 52 (communication).
 pub const AR_LOST_EVENT: u8 = 52;
@@ -159,7 +161,7 @@ impl<F: Flash, H: RecordHook> PnDrive<F, H> {
     pub fn with_hook(flash: F, hw: Hardware, hook: H) -> PnDrive<F, H> {
         let mut objects = DriveObjects::new();
         let mut store = ParamStore::new(flash);
-        let (startup, im) = load(&mut store, &mut objects);
+        let (startup, im, kept) = load(&mut store, &mut objects);
         let active = objects.get(A270, 0) != Ok(0);
         let hw = Hardware {
             im: im.unwrap_or(hw.im),
@@ -168,7 +170,7 @@ impl<F: Flash, H: RecordHook> PnDrive<F, H> {
         let config = settings::device_config(&mut objects, hw);
         let axes_a = Axis::new(0);
         let profile = profile::Profile::new(&mut objects, &axes_a);
-        PnDrive {
+        let mut drive = PnDrive {
             device: Device::new(
                 config,
                 PnRecords {
@@ -194,7 +196,11 @@ impl<F: Flash, H: RecordHook> PnDrive<F, H> {
             profile,
             telegram_new: true,
             profile_mode: None,
+        };
+        if let Some(k) = kept {
+            drive.device.set_snmp(k);
         }
+        drive
     }
 
     /// The PROFINET device.
@@ -294,7 +300,11 @@ impl<F: Flash, H: RecordHook> PnDrive<F, H> {
         let mut image = [0u8; STORED_BYTES];
         // the parameter image, then I&M1…4 (P-039)
         let trailer = settings::im_trailer(self.device.cm().im_data());
+        // then the SNMP agent's sysContact/sysName/sysLocation (P-038)
+        let block = settings::snmp_block(self.device.snmp());
         let len = self.objects.persistent_image(&mut image).ok().and_then(|n| {
+            image.get_mut(n..n + block.len())?.copy_from_slice(&block);
+            let n = n + block.len();
             image.get_mut(n..n + trailer.len())?.copy_from_slice(&trailer);
             Some(n + trailer.len())
         });
@@ -392,6 +402,8 @@ impl<F: Flash, H: RecordHook> PnDrive<F, H> {
                 DeviceEvent::Dcp(d) => save |= self.apply_dcp(d),
                 // I&M1…4 are kept with the parameters (P-039)
                 DeviceEvent::Cm(CmEvent::ImWritten(_)) => save = true,
+                // so are the SNMP agent's writable strings (P-038)
+                DeviceEvent::SnmpChanged => save = true,
                 _ => {}
             }
             on_event(&e);
@@ -436,11 +448,13 @@ impl<F: Flash, H: RecordHook> PnDrive<F, H> {
                 self.objects.restore_defaults();
                 self.temporary = Temporary::default();
                 self.device.set_im_data(ImData::default());
+                self.device.set_snmp(snmp::Agent::default());
                 true
             }
             // name and IP follow as permanent Sets; I&M1…4 are cleared here
             DcpEvent::ResetToFactory(ResetMode::Communication) => {
                 self.device.set_im_data(ImData::default());
+                self.device.set_snmp(snmp::Agent::default());
                 true
             }
             DcpEvent::ResetToFactory(ResetMode::ApplicationData) => {
@@ -631,7 +645,7 @@ impl<F: Flash, H: RecordHook> PnDrive<F, H> {
 /// Loads the newest saved set into `objects` (defaults stay when there is
 /// none, it is from another declaration or does not load).
 /// The store's record: the parameter image and I&M1…4 behind it.
-pub const STORED_BYTES: usize = PERSISTENT_IMAGE_BYTES + settings::IM_TRAILER;
+pub const STORED_BYTES: usize = PERSISTENT_IMAGE_BYTES + settings::SNMP_BLOCK + settings::IM_TRAILER;
 
 /// The parameter flash of the PROFINET images: two slots of two 2 KiB
 /// sectors, as the parameter image with I&M1…4 behind it
@@ -641,14 +655,18 @@ pub const STORED_BYTES: usize = PERSISTENT_IMAGE_BYTES + settings::IM_TRAILER;
 pub type PnParamFlash = store::RamFlash<2048, 4>;
 
 /// The newest saved set into `objects`, and the I&M1…4 saved with it.
-fn load<F: Flash>(store: &mut ParamStore<F>, objects: &mut DriveObjects) -> (Startup, Option<ImData>) {
+fn load<F: Flash>(
+    store: &mut ParamStore<F>,
+    objects: &mut DriveObjects,
+) -> (Startup, Option<ImData>, Option<snmp::Agent>) {
     let mut image = [0u8; STORED_BYTES];
     let Ok(n) = store.load(LAYOUT_HASH, &mut image) else {
-        return (Startup::Defaults, None);
+        return (Startup::Defaults, None, None);
     };
     let (params, im) = settings::split_stored(image.get(..n).unwrap_or(&[]));
+    let (params, kept) = settings::split_snmp(params);
     match objects.load_persistent(params) {
-        Ok(()) => (Startup::Loaded, im),
-        Err(_) => (Startup::Defaults, None),
+        Ok(()) => (Startup::Loaded, im, kept),
+        Err(_) => (Startup::Defaults, None, None),
     }
 }

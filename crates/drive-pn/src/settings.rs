@@ -171,3 +171,51 @@ pub fn device_config(objects: &mut DriveObjects, hw: Hardware) -> DeviceConfig {
         boot_time: hw.boot_time,
     }
 }
+
+/// What sits between the parameter image and I&M1…4 in the store: sysContact,
+/// sysName and sysLocation of the SNMP agent (P-038), each a length byte and
+/// 255 bytes, then this tag.
+pub const SNMP_TAG: [u8; 4] = *b"SNMP";
+/// Length of that block.
+pub const SNMP_BLOCK: usize = 3 * (1 + snmp::TEXT_MAX) + SNMP_TAG.len();
+
+/// The SNMP agent's kept strings as the block stored behind the parameter image.
+pub fn snmp_block(a: &snmp::Agent) -> [u8; SNMP_BLOCK] {
+    let mut out = [0u8; SNMP_BLOCK];
+    let mut at = 0;
+    for t in [&a.sys_contact, &a.sys_name, &a.sys_location] {
+        let s = t.get();
+        if let Some(l) = out.get_mut(at) {
+            *l = s.len() as u8;
+        }
+        if let Some(dst) = out.get_mut(at + 1..at + 1 + s.len()) {
+            dst.copy_from_slice(s);
+        }
+        at += 1 + snmp::TEXT_MAX;
+    }
+    if let Some(dst) = out.get_mut(at..) {
+        dst.copy_from_slice(&SNMP_TAG);
+    }
+    out
+}
+
+/// Splits the SNMP block off the end of `params` (`None`: saved before it was kept).
+pub fn split_snmp(params: &[u8]) -> (&[u8], Option<snmp::Agent>) {
+    let Some(at) = params.len().checked_sub(SNMP_BLOCK) else {
+        return (params, None);
+    };
+    let (rest, block) = params.split_at(at);
+    if block.get(SNMP_BLOCK - SNMP_TAG.len()..) != Some(&SNMP_TAG[..]) {
+        return (params, None);
+    }
+    let mut a = snmp::Agent::default();
+    let mut at = 0;
+    for dst in [&mut a.sys_contact, &mut a.sys_name, &mut a.sys_location] {
+        let n = usize::from(block.get(at).copied().unwrap_or(0));
+        if let Some(t) = block.get(at + 1..at + 1 + n).and_then(snmp::Text::new) {
+            *dst = t;
+        }
+        at += 1 + snmp::TEXT_MAX;
+    }
+    (rest, Some(a))
+}

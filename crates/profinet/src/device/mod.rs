@@ -81,6 +81,8 @@ pub enum DeviceEvent {
     Cm(CmEvent),
     /// The real-time side of the AR.
     Rt(RtEvent),
+    /// An SNMP set changed sysContact, sysName or sysLocation (persist them, P-038).
+    SnmpChanged,
 }
 
 /// What the cyclic and alarm channels report.
@@ -130,7 +132,11 @@ pub struct Device<H: RecordHook = NoRecords> {
     cyclic: Option<Cyclic>,
     diag: DiagList<MAX_DIAGNOSES>,
     watchdog_expired: bool,
+    snmp: snmp::Agent,
 }
+
+/// The SNMP agent's UDP port (P-038).
+pub const SNMP_PORT: u16 = 161;
 
 fn ip_config(s: IpSuite) -> IpConfig {
     IpConfig {
@@ -182,6 +188,7 @@ impl<H: RecordHook> Device<H> {
             cyclic: None,
             diag: DiagList::new(),
             watchdog_expired: false,
+            snmp: snmp::Agent::default(),
         }
         .with_pdev(config.port_macs, name, config.ip)
     }
@@ -368,8 +375,72 @@ impl<H: RecordHook> Device<H> {
         match self.ip.receive(now, frame, &mut out) {
             Received::Replied(n) => tx(out.get(..n).unwrap_or(&[])),
             Received::Rpc(dg) => self.rpc.receive(now, dg.src, dg.payload, &mut self.cm),
+            Received::Udp(dg) if dg.dst_port == SNMP_PORT => self.snmp_request(now, dg.src, dg.payload, tx),
             Received::Consumed | Received::Udp(_) | Received::Dropped(_) => {}
         }
+    }
+
+    /// One SNMP request: answered from port 161 or dropped (P-038).
+    fn snmp_request(
+        &mut self,
+        now: Nanos,
+        from: crate::ip::Endpoint,
+        req: &[u8],
+        tx: &mut impl FnMut(&[u8]),
+    ) {
+        let mut out = [0u8; MAX_FRAME];
+        let mac = self.dcp.mac();
+        let mut neighbors = [None, None];
+        let pdev = self.cm.pdev();
+        for (p, slot) in neighbors.iter_mut().enumerate() {
+            *slot = pdev
+                .port(p as u16 + 1)
+                .and_then(|port| port.peer.as_ref())
+                .map(|peer| snmp::Neighbor {
+                    // locallyAssigned (7): the station name and the port name as LLDP sent them
+                    chassis_subtype: 7,
+                    chassis_id: &peer.station,
+                    port_subtype: 7,
+                    port_id: &peer.port,
+                    sys_name: &peer.station,
+                });
+        }
+        let dev = snmp::Device {
+            descr: model::STATION_TYPE.as_bytes(),
+            uptime_cs: u32::try_from(now.as_ms() / 10).unwrap_or(u32::MAX),
+            macs: [
+                mac.0,
+                self.port_macs.first().map_or([0; 6], |m| m.0),
+                self.port_macs.get(1).map_or([0; 6], |m| m.0),
+            ],
+            links: [
+                pdev.port(1).is_some_and(|p| p.link_up),
+                pdev.port(2).is_some_and(|p| p.link_up),
+            ],
+            neighbors,
+        };
+        let Some(payload) = out.get_mut(UDP_PAYLOAD_OFFSET..) else {
+            return;
+        };
+        let Some(ans) = self.snmp.handle(req, &dev, payload) else {
+            return;
+        };
+        if ans.changed {
+            self.push(DeviceEvent::SnmpChanged);
+        }
+        if let Ok(UdpTx::Frame(len)) = self.ip.emit_udp(now, &mut out, SNMP_PORT, from, ans.len) {
+            tx(out.get(..len).unwrap_or(&[]));
+        }
+    }
+
+    /// The SNMP agent's kept state (communities, sysContact/sysName/sysLocation).
+    pub fn snmp(&self) -> &snmp::Agent {
+        &self.snmp
+    }
+
+    /// Restores the SNMP agent's kept state (from the parameter store at start).
+    pub fn set_snmp(&mut self, agent: snmp::Agent) {
+        self.snmp = agent;
     }
 
     /// Sends what the RPC server has queued and takes connection events.

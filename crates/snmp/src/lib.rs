@@ -1,0 +1,484 @@
+//! SNMPv1/v2c agent of the PROFINET interface (spec P-038).
+//!
+//! `#![no_std]`, heap-free, panic-free: a request is read through the checked BER views of
+//! [`ber`], answered into a caller's buffer, and any malformed, oversized or wrong-community
+//! request is dropped (`None`) and changes nothing. The view ([`mib`]) is MIB-II `system` and
+//! `interfaces` (the interface and its two ports) and LLDP-MIB local and remote data.
+//! Communities: read `public`, write `private` by default.
+//! sysContact, sysName and sysLocation are writable (OCTET STRING, at most 255 bytes); the
+//! caller persists them when [`Answer::changed`] is set. Time (sysUpTime) is an argument.
+#![no_std]
+#![deny(missing_docs)]
+
+pub mod ber;
+pub mod mib;
+
+use ber::{Reader, Writer};
+use mib::{Lookup, Val};
+
+/// Longest writable string.
+pub const TEXT_MAX: usize = 255;
+
+/// A fixed-capacity byte string.
+#[derive(Clone, Copy, PartialEq, Eq, Debug)]
+pub struct Text<const N: usize> {
+    b: [u8; N],
+    len: usize,
+}
+
+impl<const N: usize> Text<N> {
+    /// From bytes; `None` if longer than `N`.
+    pub fn new(s: &[u8]) -> Option<Self> {
+        let mut t = Self { b: [0; N], len: 0 };
+        t.b.get_mut(..s.len())?.copy_from_slice(s);
+        t.len = s.len();
+        Some(t)
+    }
+    /// The bytes.
+    pub fn get(&self) -> &[u8] {
+        self.b.get(..self.len).unwrap_or(&[])
+    }
+}
+
+/// A neighbour seen by LLDP on one port.
+#[derive(Clone, Copy, Debug)]
+pub struct Neighbor<'a> {
+    /// LLDP chassis ID subtype.
+    pub chassis_subtype: u8,
+    /// Chassis ID.
+    pub chassis_id: &'a [u8],
+    /// LLDP port ID subtype.
+    pub port_subtype: u8,
+    /// Port ID.
+    pub port_id: &'a [u8],
+    /// System name (empty when not sent).
+    pub sys_name: &'a [u8],
+}
+
+/// What the device contributes per request: identity, time and what LLDP has seen.
+pub struct Device<'a> {
+    /// sysDescr / lldpLocSysDesc.
+    pub descr: &'a [u8],
+    /// sysUpTime in centiseconds (the caller's time argument).
+    pub uptime_cs: u32,
+    /// MAC of the interface, port 1, port 2.
+    pub macs: [[u8; 6]; 3],
+    /// Link up on port 1, port 2.
+    pub links: [bool; 2],
+    /// LLDP neighbours on port 1, port 2.
+    pub neighbors: [Option<Neighbor<'a>>; 2],
+}
+
+impl<'a> Device<'a> {
+    fn mac(&self, i: u32) -> &[u8] {
+        self.macs.get(i as usize).map(|m| &m[..]).unwrap_or(&[])
+    }
+    fn link(&self, port: u32) -> bool {
+        port.checked_sub(1)
+            .and_then(|p| self.links.get(p as usize))
+            .copied()
+            .unwrap_or(false)
+    }
+    fn neighbor(&self, port: u32) -> Option<&Neighbor<'a>> {
+        port.checked_sub(1)
+            .and_then(|p| self.neighbors.get(p as usize))
+            .and_then(|n| n.as_ref())
+    }
+}
+
+/// The agent's kept state: communities and the writable system strings.
+#[derive(Clone, Debug)]
+pub struct Agent {
+    /// Read community.
+    pub read_community: Text<32>,
+    /// Write community (also allows reads).
+    pub write_community: Text<32>,
+    /// sysContact.
+    pub sys_contact: Text<TEXT_MAX>,
+    /// sysName.
+    pub sys_name: Text<TEXT_MAX>,
+    /// sysLocation.
+    pub sys_location: Text<TEXT_MAX>,
+}
+
+impl Default for Agent {
+    fn default() -> Self {
+        let e = Text {
+            b: [0; TEXT_MAX],
+            len: 0,
+        };
+        let mut r = Text { b: [0; 32], len: 0 };
+        let mut w = r;
+        r.b[..6].copy_from_slice(b"public");
+        r.len = 6;
+        w.b[..7].copy_from_slice(b"private");
+        w.len = 7;
+        Self {
+            read_community: r,
+            write_community: w,
+            sys_contact: e,
+            sys_name: e,
+            sys_location: e,
+        }
+    }
+}
+
+/// A response ready to send.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub struct Answer {
+    /// Bytes of the response in the output buffer.
+    pub len: usize,
+    /// A set changed a writable object (persist the agent's strings).
+    pub changed: bool,
+}
+
+/// Largest request accepted and largest response sent (an SNMP message over UDP on Ethernet).
+pub const MAX_MSG: usize = 1472;
+/// Most variable bindings in one request.
+pub const MAX_VARBINDS: usize = 32;
+
+const GET: u8 = 0xa0;
+const GET_NEXT: u8 = 0xa1;
+const RESPONSE: u8 = 0xa2;
+const SET: u8 = 0xa3;
+const GET_BULK: u8 = 0xa5;
+
+/// Error statuses (RFC 1157, RFC 3416).
+pub mod err {
+    /// tooBig
+    pub const TOO_BIG: i32 = 1;
+    /// noSuchName (v1)
+    pub const NO_SUCH_NAME: i32 = 2;
+    /// badValue (v1)
+    pub const BAD_VALUE: i32 = 3;
+    /// readOnly (v1)
+    pub const READ_ONLY: i32 = 4;
+    /// wrongType
+    pub const WRONG_TYPE: i32 = 7;
+    /// wrongLength
+    pub const WRONG_LENGTH: i32 = 8;
+    /// noCreation
+    pub const NO_CREATION: i32 = 11;
+    /// notWritable
+    pub const NOT_WRITABLE: i32 = 17;
+}
+
+struct Req<'a> {
+    version: i32,
+    pdu: u8,
+    id: i32,
+    a: i32,
+    b: i32,
+    vbl: &'a [u8],
+}
+
+fn parse(msg: &[u8]) -> Option<(Req<'_>, &[u8])> {
+    if msg.len() > MAX_MSG {
+        return None;
+    }
+    let mut top = Reader::new(msg);
+    let body = top.expect(0x30)?;
+    if !top.is_empty() {
+        return None;
+    }
+    let mut r = Reader::new(body);
+    let version = r.int()?;
+    if version != 0 && version != 1 {
+        return None;
+    }
+    let community = r.expect(0x04)?;
+    let (pdu, p) = r.tlv()?;
+    if !r.is_empty() || !matches!(pdu, GET | GET_NEXT | SET | GET_BULK) || (pdu == GET_BULK && version == 0) {
+        return None;
+    }
+    let mut p = Reader::new(p);
+    let id = p.int()?;
+    let a = p.int()?;
+    let b = p.int()?;
+    let vbl = p.expect(0x30)?;
+    if !p.is_empty() {
+        return None;
+    }
+    // every binding well-formed: SEQUENCE { OID, value }
+    let mut v = Reader::new(vbl);
+    let mut n = 0;
+    while !v.is_empty() {
+        let mut vb = Reader::new(v.expect(0x30)?);
+        vb.oid()?;
+        vb.tlv()?;
+        if !vb.is_empty() {
+            return None;
+        }
+        n += 1;
+        if n > MAX_VARBINDS {
+            return None;
+        }
+    }
+    Some((
+        Req {
+            version,
+            pdu,
+            id,
+            a,
+            b,
+            vbl,
+        },
+        community,
+    ))
+}
+
+fn put_val(w: &mut Writer, v: Val) {
+    match v {
+        Val::Int(x) => w.int(0x02, x),
+        Val::Str(s) => w.prim(0x04, s),
+        Val::Oid(o) => w.oid(o),
+        Val::Ticks(x) => w.uint(0x43, x),
+        Val::Counter(x) => w.uint(0x41, x),
+        Val::Gauge(x) => w.uint(0x42, x),
+    }
+}
+
+fn varbinds(vbl: &[u8]) -> impl Iterator<Item = (ber::Oid, u8, &[u8])> {
+    let mut r = Reader::new(vbl);
+    core::iter::from_fn(move || {
+        let mut vb = Reader::new(r.expect(0x30)?);
+        let oid = vb.oid()?;
+        let (t, v) = vb.tlv()?;
+        Some((oid, t, v))
+    })
+}
+
+impl Agent {
+    /// Answer one request datagram into `out`; `None` drops it (malformed, oversized, wrong
+    /// community, or a version/PDU this agent does not speak).
+    pub fn handle(&mut self, msg: &[u8], dev: &Device, out: &mut [u8]) -> Option<Answer> {
+        let (req, community) = parse(msg)?;
+        let write = community == self.write_community.get();
+        if !write && community != self.read_community.get() {
+            return None;
+        }
+        if req.pdu == SET && !write {
+            // RFC 3584: an unauthorised set is dropped (authenticationFailure), not answered
+            return None;
+        }
+        let cap = out.len().min(MAX_MSG);
+        let out = out.get_mut(..cap)?;
+        let mut changed = false;
+        let status = if req.pdu == SET {
+            self.check_set(&req)
+        } else {
+            None
+        };
+        if req.pdu == SET && status.is_none() {
+            changed = self.apply_set(&req);
+        }
+        let len = match status {
+            Some((e, i)) => encode(out, &req, community, e, i, |w| echo(w, req.vbl)),
+            None => {
+                let mut fail = None;
+                let len = encode(out, &req, community, 0, 0, |w| {
+                    fail = self.fill(w, &req, dev);
+                });
+                match fail {
+                    Some((e, i)) => encode(out, &req, community, e, i, |w| echo(w, req.vbl)),
+                    None => len,
+                }
+            }
+        };
+        let len = match len {
+            Some(l) => l,
+            None => encode(out, &req, community, err::TOO_BIG, 0, |_| {})?,
+        };
+        Some(Answer { len, changed })
+    }
+
+    /// Fill the varbind list; `Some((status, index))` for a v1 error.
+    fn fill(&self, w: &mut Writer, req: &Req, dev: &Device) -> Option<(i32, i32)> {
+        let v1 = req.version == 0;
+        if req.pdu == GET_BULK {
+            let nonrep = req.a.max(0) as usize;
+            let reps = req.b.max(0) as usize;
+            let mut last: [Option<ber::Oid>; MAX_VARBINDS] = [None; MAX_VARBINDS];
+            let mut nrep = 0;
+            for (i, (oid, _, _)) in varbinds(req.vbl).enumerate() {
+                if i >= nonrep && reps == 0 {
+                    break;
+                }
+                let l = w.len();
+                let got = self.next_vb(w, oid.arcs(), dev);
+                if !w.ok() {
+                    w.truncate(l);
+                    return None;
+                }
+                if i >= nonrep {
+                    if let Some(s) = last.get_mut(nrep) {
+                        *s = Some(got.unwrap_or(oid));
+                        nrep += 1;
+                    }
+                }
+            }
+            for _ in 1..reps {
+                let mut any = false;
+                for s in last.iter_mut().take(nrep) {
+                    let Some(o) = s else { continue };
+                    let l = w.len();
+                    let got = self.next_vb(w, o.arcs(), dev);
+                    if !w.ok() {
+                        // RFC 3416 4.2.3: a get-bulk response is truncated, not tooBig
+                        w.truncate(l);
+                        return None;
+                    }
+                    any |= got.is_some();
+                    if let Some(g) = got {
+                        *o = g;
+                    }
+                }
+                if !any {
+                    break;
+                }
+            }
+            return None;
+        }
+        for (i, (oid, _, _)) in varbinds(req.vbl).enumerate() {
+            let idx = i as i32 + 1;
+            if req.pdu == GET_NEXT {
+                if self.next_vb(w, oid.arcs(), dev).is_none() && v1 {
+                    return Some((err::NO_SUCH_NAME, idx));
+                }
+                continue;
+            }
+            let m = w.open(0x30);
+            w.oid(oid.arcs());
+            match mib::find(oid.arcs(), dev) {
+                Lookup::Found(id, r) => put_val(w, mib::value(id, r, self, dev)),
+                _ if v1 => return Some((err::NO_SUCH_NAME, idx)),
+                Lookup::NoInstance => w.prim(0x81, &[]),
+                Lookup::NoObject => w.prim(0x80, &[]),
+            }
+            w.close(m);
+        }
+        None
+    }
+
+    /// One get-next binding; returns the OID answered, or `None` at the end of the view.
+    fn next_vb(&self, w: &mut Writer, oid: &[u32], dev: &Device) -> Option<ber::Oid> {
+        let m = w.open(0x30);
+        let r = match mib::next(oid, dev) {
+            Some((id, row, full)) => {
+                w.oid(full.arcs());
+                put_val(w, mib::value(id, row, self, dev));
+                Some(full)
+            }
+            None => {
+                w.oid(oid);
+                w.prim(0x82, &[]);
+                None
+            }
+        };
+        w.close(m);
+        r
+    }
+
+    /// Validate a set (RFC 3416 4.2.5); the first failing binding's status and index.
+    fn check_set(&self, req: &Req) -> Option<(i32, i32)> {
+        let v1 = req.version == 0;
+        let dev = Device {
+            descr: &[],
+            uptime_cs: 0,
+            macs: [[0; 6]; 3],
+            links: [false; 2],
+            neighbors: [None, None],
+        };
+        for (i, (oid, t, v)) in varbinds(req.vbl).enumerate() {
+            let idx = i as i32 + 1;
+            let e = match mib::find(oid.arcs(), &dev) {
+                Lookup::Found(id, _) if id.writable() => {
+                    if t != 0x04 {
+                        Some(if v1 { err::BAD_VALUE } else { err::WRONG_TYPE })
+                    } else if v.len() > TEXT_MAX {
+                        Some(if v1 { err::BAD_VALUE } else { err::WRONG_LENGTH })
+                    } else {
+                        None
+                    }
+                }
+                Lookup::Found(..) => Some(if v1 { err::READ_ONLY } else { err::NOT_WRITABLE }),
+                Lookup::NoInstance if !v1 => Some(err::NO_CREATION),
+                Lookup::NoObject if !v1 => Some(err::NOT_WRITABLE),
+                _ => Some(err::NO_SUCH_NAME),
+            };
+            if let Some(e) = e {
+                return Some((e, idx));
+            }
+        }
+        None
+    }
+
+    /// Applies a checked set; whether the kept strings differ afterwards (a set that writes an
+    /// object twice, back to what it was, changed nothing).
+    fn apply_set(&mut self, req: &Req) -> bool {
+        let dev = Device {
+            descr: &[],
+            uptime_cs: 0,
+            macs: [[0; 6]; 3],
+            links: [false; 2],
+            neighbors: [None, None],
+        };
+        let before = (self.sys_contact, self.sys_name, self.sys_location);
+        for (oid, _, v) in varbinds(req.vbl) {
+            let Some(t) = Text::new(v) else { continue };
+            let slot = match mib::find(oid.arcs(), &dev) {
+                Lookup::Found(mib::Id::SysContact, _) => &mut self.sys_contact,
+                Lookup::Found(mib::Id::SysName, _) => &mut self.sys_name,
+                Lookup::Found(mib::Id::SysLocation, _) => &mut self.sys_location,
+                _ => continue,
+            };
+            *slot = t;
+        }
+        before != (self.sys_contact, self.sys_name, self.sys_location)
+    }
+}
+
+fn echo(w: &mut Writer, vbl: &[u8]) {
+    let m = w.open(0x30);
+    for (oid, t, v) in varbinds(vbl) {
+        let s = w.open(0x30);
+        w.oid(oid.arcs());
+        w.prim(t, v);
+        w.close(s);
+    }
+    w.close(m);
+}
+
+fn encode(
+    out: &mut [u8],
+    req: &Req,
+    community: &[u8],
+    status: i32,
+    index: i32,
+    body: impl FnOnce(&mut Writer),
+) -> Option<usize> {
+    let mut w = Writer::new(out);
+    let top = w.open(0x30);
+    w.int(0x02, req.version);
+    w.prim(0x04, community);
+    let pdu = w.open(RESPONSE);
+    w.int(0x02, req.id);
+    w.int(0x02, status);
+    w.int(0x02, index);
+    if status == 0 {
+        let m = w.open(0x30);
+        body(&mut w);
+        w.close(m);
+    } else if status == err::TOO_BIG {
+        let m = w.open(0x30);
+        w.close(m);
+    } else {
+        body(&mut w);
+    }
+    w.close(pdu);
+    w.close(top);
+    w.finish()
+}
+
+#[cfg(test)]
+mod tests;
