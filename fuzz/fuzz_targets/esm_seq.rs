@@ -405,10 +405,13 @@ fn op(line: &mut Line, u: &mut Unstructured<'_>) {
                 m[0] = 10;
                 m[6..16].copy_from_slice(&[0x00, 0x20, 0x40, 0x00, 0x10, 0x00, 0, 0, 0, 0]);
             }
-            // an answer still waiting in SM1 (to an earlier request) is read
-            // out first, so the answer read below is this request's
-            let _ = line.read(SM1.0, 256);
-            line.wait(Nanos::from_ms(1));
+            // answers still waiting (in SM1 and queued behind it, to earlier
+            // requests) are read out first, so the answer read below is this
+            // request's
+            for _ in 0..4 {
+                let _ = line.read(SM1.0, 256);
+                line.wait(Nanos::from_ms(1));
+            }
             line.write(SM0.0, &m);
             line.wait(Nanos::from_ms(1));
             let answer = line.read(SM1.0, 256);
