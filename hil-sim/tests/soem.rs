@@ -26,11 +26,11 @@
 
 mod common;
 
-use common::soem_line::{pysoem_python, Line, SCRIPT_LIMIT};
+use common::soem_line::{pysoem_python, scratch, Line, SCRIPT_LIMIT};
 use ecat::Dictionary;
 use hil_sim::matrix::Row;
 use std::fmt::Write as _;
-use std::path::{Path, PathBuf};
+use std::path::Path;
 use std::sync::Mutex;
 
 /// One SOEM run at a time: each needs the cores for its 1 ms cycle.
@@ -96,24 +96,6 @@ fn od_listing() -> String {
     out
 }
 
-/// A scratch directory for one test's files.
-fn scratch(test: &str) -> PathBuf {
-    let dir = Path::new(env!("CARGO_TARGET_TMPDIR")).join(test);
-    std::fs::create_dir_all(&dir).expect("scratch dir");
-    dir
-}
-
-fn fail_with(line: &Line, what: &str) -> ! {
-    let serve = line.serve_output();
-    let tail: Vec<&str> = serve.lines().rev().take(60).collect();
-    let tail: Vec<&str> = tail.into_iter().rev().collect();
-    panic!(
-        "{what}\n--- hil-sim serve ({}), last lines:\n{}\n(SOEM_PCAP=1 records serve's frames next to its log)",
-        line.serve_log.display(),
-        tail.join("\n")
-    );
-}
-
 /// SOEM on a line of 3 drives: scan, identity (1000h, 1018h, the SII's
 /// identity and name) and the SII read back through SOEM byte for byte
 /// (E-002, E-004, E-005, E-151); the object list and every object and entry
@@ -158,7 +140,7 @@ fn e002_e005_e080_e082_e045_e029_e015_soem_line_scan_sdo_info_pdo_dc_cia402() {
         ],
     );
     if !status.success() {
-        fail_with(&line, &format!("line.py through SOEM failed: {status}"));
+        line.fail_with(&format!("line.py through SOEM failed: {status}"));
     }
 }
 
@@ -194,7 +176,7 @@ fn e096_e095_e098_soem_set_ip_ping_and_udp_through_a_tap_bridge() {
         &["--slaves", &SLAVES.to_string(), "--a166", &a166.to_string()],
     );
     if !status.success() {
-        fail_with(&line, &format!("eoe.py through SOEM failed: {status}"));
+        line.fail_with(&format!("eoe.py through SOEM failed: {status}"));
     }
 }
 
@@ -246,7 +228,7 @@ fn foe_image_through_soem_firm_update() {
         &["--good", &g, "--flipped", &f, "--truncated", &t],
     );
     if !status.success() {
-        fail_with(&line, &format!("foe.py through SOEM failed: {status}"));
+        line.fail_with(&format!("foe.py through SOEM failed: {status}"));
     }
 }
 
@@ -268,10 +250,7 @@ fn fault_rows(python: &Path, tag: &str, case: &[&str]) -> Vec<(String, String)> 
     let (child, script) = line.spawn(python, "faults.py", &args);
     let (status, lines) = common::watch_script(child, &script, SCRIPT_LIMIT);
     if !status.success() {
-        fail_with(
-            &line,
-            &format!("faults.py {case:?} through SOEM failed: {status}"),
-        );
+        line.fail_with(&format!("faults.py {case:?} through SOEM failed: {status}"));
     }
     lines
         .iter()
@@ -429,6 +408,6 @@ fn c039_soem_raises_g472_g475_by_sdo_and_cst_pt_move_the_axis() {
         &["--limit", "400", "--i10", &i10.to_string()],
     );
     if !status.success() {
-        fail_with(&line, &format!("torque.py through SOEM failed: {status}"));
+        line.fail_with(&format!("torque.py through SOEM failed: {status}"));
     }
 }

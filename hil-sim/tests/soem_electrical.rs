@@ -6,25 +6,7 @@
 
 mod common;
 
-use common::soem_line::{pysoem_python, Line};
-use std::path::{Path, PathBuf};
-
-fn scratch(test: &str) -> PathBuf {
-    let dir = Path::new(env!("CARGO_TARGET_TMPDIR")).join(test);
-    std::fs::create_dir_all(&dir).expect("scratch dir");
-    dir
-}
-
-fn fail_with(line: &Line, what: &str) -> ! {
-    let serve = line.serve_output();
-    let tail: Vec<&str> = serve.lines().rev().take(60).collect();
-    let tail: Vec<&str> = tail.into_iter().rev().collect();
-    panic!(
-        "{what}\n--- hil-sim serve ({}), last lines:\n{}",
-        line.serve_log.display(),
-        tail.join("\n")
-    );
-}
+use common::soem_line::{pysoem_python, scratch, Line};
 
 /// C-038, P-187 through SOEM on the electrical plant (`cst_electrical.py`):
 /// 6071h steps of ±10 %, ±50 %, ±100 % of the rated torque in cst give a
@@ -47,6 +29,6 @@ fn c038_p187_soem_cst_steps_on_the_electrical_plant_give_6077h_within_2_percent(
     let line = Line::with_serve_args("e", 1, 120, &dir, &["--plant", "electrical"]);
     let status = line.run(&python, "cst_electrical.py", &["--i10", &i10.to_string()]);
     if !status.success() {
-        fail_with(&line, &format!("cst_electrical.py through SOEM failed: {status}"));
+        line.fail_with(&format!("cst_electrical.py through SOEM failed: {status}"));
     }
 }

@@ -15,6 +15,13 @@ pub const SCRIPT_LIMIT: Duration = Duration::from_secs(240);
 /// The python with pysoem, or why the test cannot run (not root, or
 /// `PYSOEM_PYTHON` not set). A `PYSOEM_PYTHON` that cannot import pysoem is
 /// a failure, not a skip: whoever set it wants the test to run.
+/// A scratch directory for one test's files (under cargo's target tmp).
+pub fn scratch(test: &str) -> PathBuf {
+    let dir = Path::new(env!("CARGO_TARGET_TMPDIR")).join(test);
+    std::fs::create_dir_all(&dir).expect("scratch dir");
+    dir
+}
+
 pub fn pysoem_python() -> Result<PathBuf, String> {
     if !super::is_root() {
         return Err("needs root for network namespaces and raw sockets".into());
@@ -158,6 +165,18 @@ impl Line {
     }
 
     /// What `serve` printed (state changes of every drive, with AL codes).
+    /// Ends a test with `what` and the last 60 lines serve printed.
+    pub fn fail_with(&self, what: &str) -> ! {
+        let serve = self.serve_output();
+        let tail: Vec<&str> = serve.lines().rev().take(60).collect();
+        let tail: Vec<&str> = tail.into_iter().rev().collect();
+        panic!(
+            "{what}\n--- hil-sim serve ({}), last lines:\n{}\n(SOEM_PCAP=1 records serve's frames next to its log)",
+            self.serve_log.display(),
+            tail.join("\n")
+        );
+    }
+
     pub fn serve_output(&self) -> String {
         std::fs::read_to_string(&self.serve_log).unwrap_or_default()
     }

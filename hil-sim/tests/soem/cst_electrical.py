@@ -26,7 +26,6 @@ import sys
 
 sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
 import line as L  # noqa: E402
-import pysoem  # noqa: E402
 import torque as T  # noqa: E402  (its Axis and PDO layout)
 
 say, check = L.say, L.check
@@ -94,24 +93,7 @@ def main():
     ap.add_argument("--iface", required=True)
     ap.add_argument("--i10", type=float, required=True, help="I10 maximum speed, inc/s")
     args = ap.parse_args()
-    L.priority()
-    m = pysoem.Master()
-    m.open(args.iface)
-    try:
-        run(m, args)
-    except L.Fatal as e:
-        check(False, f"stopped: {e}")
-    except L.SOEM_ERRORS as e:
-        check(False, f"stopped by SOEM: {type(e).__name__} {vars(e)}")
-    finally:
-        m.close()
-    if L.failures:
-        say(f"\n{len(L.failures)} check(s) failed:")
-        for f in L.failures:
-            say(f"  {f}")
-        return 1
-    say("\ncst on the electrical plant: all checks passed")
-    return 0
+    return L.master_main(args, run, "cst on the electrical plant: all checks passed")
 
 
 if __name__ == "__main__":

@@ -551,6 +551,29 @@ def real_time(on):
         say(f"master: no real-time priority ({e}); cycles may be left out under load")
 
 
+def master_main(args, run, done):
+    """Opens SOEM on args.iface, calls run(master, args), closes it; prints the
+    failed checks (exit code 1) or `done` (exit code 0)."""
+    priority()
+    m = pysoem.Master()
+    m.open(args.iface)
+    try:
+        run(m, args)
+    except Fatal as e:
+        check(False, f"stopped: {e}")
+    except SOEM_ERRORS as e:
+        check(False, f"stopped by SOEM: {type(e).__name__} {vars(e)}")
+    finally:
+        m.close()
+    if failures:
+        say(f"\n{len(failures)} check(s) failed:")
+        for f in failures:
+            say(f"  {f}")
+        return 1
+    say(f"\n{done}")
+    return 0
+
+
 def priority():
     """Timer slack 1 ns; nice -20 where permitted, so that the compile jobs of
     a shared machine do not hold up SOEM's mailbox exchanges (it waits for a

@@ -174,28 +174,9 @@ fn id(r: &mut Reader<'_>) -> Result<Vec<u8, MAX_PEER_ID>, RecordError> {
 /// Checks a PDPortDataCheck record for `subslot` whole; the check it sets.
 /// Nothing is applied here.
 pub fn parse(subslot: u16, data: &[u8]) -> Result<PortCheck, RecordError> {
-    let mut outer = Blocks::new(data);
-    let blk = match outer.next_block() {
-        Some(Ok(b)) => b,
-        Some(Err(_)) | None => return Err(RecordError::WriteLength),
-    };
-    if outer.remaining() != 0 {
-        return Err(RecordError::WriteLength);
-    }
-    if blk.block_type != check_block::PD_PORT_DATA_CHECK || (blk.version_high, blk.version_low) != (1, 0) {
-        return Err(RecordError::InvalidParameter);
-    }
-    let mut r = Reader::new(blk.body, Endian::Big);
-    let (slot, sub) = (|| {
-        r.skip(2)?;
-        Some((r.u16()?, r.u16()?))
-    })()
-    .ok_or(RecordError::WriteLength)?;
-    if (slot, sub) != (0, subslot) {
-        return Err(RecordError::InvalidParameter);
-    }
+    let body = super::single_block(data, check_block::PD_PORT_DATA_CHECK)?;
     let mut c = PortCheck::default();
-    let mut subs = Blocks::new(r.rest());
+    let mut subs = Blocks::new(super::port_body(body, subslot)?);
     while let Some(b) = subs.next_block() {
         let b = b.map_err(|_| RecordError::WriteLength)?;
         if (b.version_high, b.version_low) != (1, 0) {

@@ -13,7 +13,7 @@
 //! error" (0xB1); nothing changes on a refusal. Read back as written (empty
 //! while nothing is adjusted); it holds until the next start.
 
-use crate::cm::ndr::{emit_block, Blocks};
+use crate::cm::ndr::emit_block;
 use crate::cm::RecordError;
 use crate::lldp::PortIdForm;
 use crate::rpc::cursor::{Endian, Reader, Writer};
@@ -45,18 +45,8 @@ pub fn emit(w: &mut Writer<'_>, mode: Option<u32>) -> Option<()> {
 
 /// Checks a PDInterfaceAdjust record whole; the MultipleInterfaceMode.
 pub fn parse(data: &[u8]) -> Result<u32, RecordError> {
-    let mut outer = Blocks::new(data);
-    let blk = match outer.next_block() {
-        Some(Ok(b)) => b,
-        Some(Err(_)) | None => return Err(RecordError::WriteLength),
-    };
-    if outer.remaining() != 0 {
-        return Err(RecordError::WriteLength);
-    }
-    if blk.block_type != PD_INTERFACE_ADJUST || (blk.version_high, blk.version_low) != (1, 0) {
-        return Err(RecordError::InvalidParameter);
-    }
-    let mut r = Reader::new(blk.body, Endian::Big);
+    let body = super::single_block(data, PD_INTERFACE_ADJUST)?;
+    let mut r = Reader::new(body, Endian::Big);
     let m = (|| {
         r.skip(2)?;
         r.u32()

@@ -517,9 +517,10 @@ fn value_props(body: &[u8]) -> Result<(u32, u16), RecordError> {
     Ok(v)
 }
 
-/// Checks a PDPortDataAdjust record for `subslot` whole; the adjusted values
-/// it sets. Nothing is applied here.
-pub fn parse_port_adjust(subslot: u16, data: &[u8]) -> Result<PortAdjust, RecordError> {
+/// The body of a record that must be exactly one block of `block_type`,
+/// version 1.0: the bytes not adding up are "write length error", another
+/// block or version "invalid parameter".
+pub(crate) fn single_block(data: &[u8], block_type: u16) -> Result<&[u8], RecordError> {
     let mut outer = Blocks::new(data);
     let blk = match outer.next_block() {
         Some(Ok(b)) => b,
@@ -528,10 +529,16 @@ pub fn parse_port_adjust(subslot: u16, data: &[u8]) -> Result<PortAdjust, Record
     if outer.remaining() != 0 {
         return Err(RecordError::WriteLength);
     }
-    if blk.block_type != block_type::PD_PORT_DATA_ADJUST || (blk.version_high, blk.version_low) != (1, 0) {
+    if blk.block_type != block_type || (blk.version_high, blk.version_low) != (1, 0) {
         return Err(RecordError::InvalidParameter);
     }
-    let mut r = Reader::new(blk.body, Endian::Big);
+    Ok(blk.body)
+}
+
+/// The sub-blocks of a port record's body (padding, SlotNumber 0,
+/// SubslotNumber `subslot`, then the sub-blocks).
+pub(crate) fn port_body(body: &[u8], subslot: u16) -> Result<&[u8], RecordError> {
+    let mut r = Reader::new(body, Endian::Big);
     let (slot, sub) = (|| {
         r.skip(2)?;
         Some((r.u16()?, r.u16()?))
@@ -540,8 +547,15 @@ pub fn parse_port_adjust(subslot: u16, data: &[u8]) -> Result<PortAdjust, Record
     if (slot, sub) != (0, subslot) {
         return Err(RecordError::InvalidParameter);
     }
+    Ok(r.rest())
+}
+
+/// Checks a PDPortDataAdjust record for `subslot` whole; the adjusted values
+/// it sets. Nothing is applied here.
+pub fn parse_port_adjust(subslot: u16, data: &[u8]) -> Result<PortAdjust, RecordError> {
+    let body = single_block(data, block_type::PD_PORT_DATA_ADJUST)?;
     let mut a = PortAdjust::default();
-    let mut subs = Blocks::new(r.rest());
+    let mut subs = Blocks::new(port_body(body, subslot)?);
     while let Some(b) = subs.next_block() {
         let b = b.map_err(|_| RecordError::WriteLength)?;
         if b.version_high != 1 {
