@@ -96,7 +96,7 @@ fn make_drive() -> Option<&'static mut Drive> {
     }
     // SAFETY: the flag hands out the static once.
     let slot = unsafe { &mut *core::ptr::addr_of_mut!(DRIVE) };
-    let first = slot.write(Drive::new(ParamFlash::new(), hardware()));
+    let first = build(&mut *slot, ParamFlash::new());
     let c = testing::device_config();
     drive_pn::settings::write_name(first.objects_mut(), &c.name);
     drive_pn::settings::write_ip(first.objects_mut(), c.ip);
@@ -106,7 +106,15 @@ fn make_drive() -> Option<&'static mut Drive> {
     // the power cycle keeps the flash: taken out of the first drive (not the
     // whole drive read out onto the stack: two drives do not fit it)
     let flash = core::mem::replace(first.flash_mut(), ParamFlash::new());
-    Some(slot.write(Drive::new(flash, hardware())))
+    Some(build(slot, flash))
+}
+
+/// One drive built into `slot`: a function of its own, so the drive built by
+/// value on the stack (tens of KiB) is there once, not once per call site in
+/// `make_drive`'s frame (two of them ran past the stack's end into `.bss`).
+#[inline(never)]
+fn build(slot: &mut core::mem::MaybeUninit<Drive>, flash: ParamFlash) -> &mut Drive {
+    slot.write(Drive::new(flash, hardware()))
 }
 
 #[entry]
