@@ -651,8 +651,14 @@ impl<H: RecordHook> rpc::Handler for Cm<H> {
             };
             // Read and write answers keep their header (it names the record);
             // other refusals carry no blocks.
-            let keep =
-                status.is_ok() || matches!(call.opnum, opnum::READ | opnum::READ_IMPLICIT | opnum::WRITE);
+            // (a header cut short by a small ArgsMaximum is no header: then
+            // the NDR status alone)
+            let record = matches!(call.opnum, opnum::READ | opnum::READ_IMPLICIT | opnum::WRITE);
+            let keep = if record {
+                w.pos() >= RW_HEADER_LEN
+            } else {
+                status.is_ok()
+            };
             (status, if keep { w.pos() } else { 0 })
         };
         ndr::emit_response(out, call.endian, status, ndr.maximum_count, len).ok_or(too_big)

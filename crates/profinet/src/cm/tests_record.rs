@@ -215,6 +215,13 @@ fn p041_a_small_args_maximum_gets_whole_blocks_or_none_and_changes_nothing() {
         call_with(&mut d, READ_IM0, 2, 40, read_args),
         (no_room, std::vec![])
     );
+    // the same for a refusal with a header (a read on an unknown AR; found
+    // again by pn_seq after the unknown-AR answers got their header)
+    let mut unknown_ar = read_args.to_vec();
+    unknown_ar[8] ^= 0xFF;
+    let (status, args) = call_with(&mut d, READ_IM0, 2, 40, &unknown_ar);
+    assert!(!status.is_ok());
+    assert_eq!(args.len(), 0, "half an IODReadResHeader: {args:02x?}");
     let im1 = hex(WRITE_IM1)[100..].to_vec();
     let (status, args) = call_with(&mut d, WRITE_IM1, 3, 40, &im1);
     assert_eq!(
