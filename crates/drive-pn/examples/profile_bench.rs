@@ -30,7 +30,7 @@ use profinet::testing;
 use std::hint::black_box;
 use std::time::Instant;
 
-type Flash = store::RamFlash<2048, 2>;
+type Flash = drive_pn::PnParamFlash;
 
 /// Rounds per figure (the best mean counts).
 const ROUNDS: usize = 15;
