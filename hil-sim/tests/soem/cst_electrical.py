@@ -64,19 +64,7 @@ def run(m, args):
     for a, pdo in ((0x1C12, 0x1600), (0x1C13, 0x1A00)):
         s.sdo_write(a, 1, pdo.to_bytes(2, "little"))
         s.sdo_write(a, 0, b"\x01")
-    m.config_map()
-    axis = T.Axis(m)
-    m.state = L.SAFEOP
-    m.write_state()
-    axis.cycle(50)
-    m.state = L.OP
-    m.write_state()
-    for _ in range(300):
-        axis.cycle(10)
-        if m.read_state() == L.OP:
-            break
-    else:
-        raise L.Fatal(f"Op not reached: {L.state_report(m)}")
+    axis = T.to_op(m)
     axis.enable(T.CST)
     limit = args.i10
     for share in (100, 500, 1000):

@@ -1020,25 +1020,7 @@ def main():
     args = ap.parse_args()
     sii = open(args.sii, "rb").read()
     od = load_od(args.od)
-    priority()
-
-    m = pysoem.Master()
-    m.open(args.iface)
-    try:
-        run(m, args, sii, od)
-    except Fatal as e:
-        check(False, f"stopped: {e}")
-    except SOEM_ERRORS as e:
-        check(False, f"stopped by SOEM: {type(e).__name__} {vars(e)}")
-    finally:
-        m.close()
-    if failures:
-        say(f"\n{len(failures)} check(s) failed:")
-        for f in failures:
-            say(f"  {f}")
-        return 1
-    say("\nall checks passed")
-    return 0
+    return master_main(args, lambda m, a: run(m, a, sii, od), "all checks passed")
 
 
 def run(m, args, sii, od):

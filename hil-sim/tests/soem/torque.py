@@ -122,19 +122,7 @@ def run(m, args):
         s.sdo_write(a, 1, pdo.to_bytes(2, "little"))
         s.sdo_write(a, 0, b"\x01")
     i10 = args.i10
-    m.config_map()
-    axis = Axis(m)
-    m.state = L.SAFEOP
-    m.write_state()
-    axis.cycle(50)
-    m.state = L.OP
-    m.write_state()
-    for _ in range(300):
-        axis.cycle(10)
-        if m.read_state() == L.OP:
-            break
-    else:
-        raise L.Fatal(f"Op not reached: {L.state_report(m)}")
+    axis = to_op(m)
 
     # 2. the 0 % default keeps the axis still
     axis.enable(CST)
@@ -167,6 +155,25 @@ def run(m, args):
     axis.run_torque(-100, limit, "pt, 6071h = -10 %")
     axis.cw = 0
     axis.cycle(20)
+
+
+def to_op(m):
+    """The mapping taken over (config_map), Safe-Op, then Op with the
+    process data running; the axis."""
+    m.config_map()
+    axis = Axis(m)
+    m.state = L.SAFEOP
+    m.write_state()
+    axis.cycle(50)
+    m.state = L.OP
+    m.write_state()
+    for _ in range(300):
+        axis.cycle(10)
+        if m.read_state() == L.OP:
+            break
+    else:
+        raise L.Fatal(f"Op not reached: {L.state_report(m)}")
+    return axis
 
 
 def main():
