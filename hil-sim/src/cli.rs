@@ -7,6 +7,7 @@ pub mod demo_pn;
 pub mod realtime;
 pub mod serve;
 pub mod serve_pn;
+mod serve_stats;
 
 use hil_sim::sim::Simulation;
 

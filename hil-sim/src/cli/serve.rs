@@ -22,6 +22,7 @@ use super::args::{Fieldbus, Plant, ServeArgs};
 /// Seed of the electrical plant's ADC noise under `serve --plant electrical`.
 const PLANT_SEED: u64 = 0x5E12_0034;
 use super::print_new_changes;
+use super::serve_stats::{describe, thread_cpu, Answer, Stats};
 use hil_sim::raw::{monotonic, RawSocket};
 use hil_sim::sim::{SimDrive, Simulation};
 use nanos::Nanos;
@@ -166,75 +167,19 @@ pub fn serve(args: &ServeArgs) -> Result<(), String> {
             stats.answer.summary(),
             stats.work.summary()
         );
+        println!(
+            "CPU time of serve's thread: per frame (catch-up and frame) {}; per idle step {} \
+             (wall {})",
+            stats.work_cpu.summary(),
+            stats.idle_cpu.summary(),
+            stats.idle_wall.summary()
+        );
+        println!("slowest answers:");
+        for l in stats.slowest.lines() {
+            println!("{l}");
+        }
     }
     Ok(())
-}
-
-/// What the loop saw.
-#[derive(Debug, Default)]
-struct Stats {
-    /// Frames without a kernel timestamp (processed at the time they were read).
-    unstamped: u64,
-    /// Frames whose receive time the simulation had passed by more than [`LATE_NOTE`].
-    late: u64,
-    /// The most the simulation had passed a frame's receive time.
-    worst_late: Nanos,
-    /// From the kernel's receive timestamp to the answer sent (without `--delay-us`'s hold).
-    answer: Histogram,
-    /// Of that, catching the simulation up and processing the frame.
-    work: Histogram,
-}
-
-/// Durations in 1 µs buckets up to 10 ms (longer ones in the last).
-#[derive(Debug)]
-struct Histogram {
-    counts: Vec<u32>,
-    max: Nanos,
-}
-
-impl Default for Histogram {
-    fn default() -> Self {
-        Self {
-            counts: vec![0; 10_001],
-            max: Nanos::ZERO,
-        }
-    }
-}
-
-impl Histogram {
-    fn add(&mut self, span: Nanos) {
-        let i = usize::try_from(span.as_us())
-            .unwrap_or(usize::MAX)
-            .min(self.counts.len() - 1);
-        if let Some(c) = self.counts.get_mut(i) {
-            *c = c.saturating_add(1);
-        }
-        self.max = self.max.max(span);
-    }
-
-    /// The `p` quantile (0..=1), µs (bucket upper edge).
-    fn quantile_us(&self, p: f64) -> u64 {
-        let total: u64 = self.counts.iter().map(|&c| u64::from(c)).sum();
-        let want = ((total as f64) * p).ceil().max(1.0) as u64;
-        let mut seen = 0;
-        for (i, &c) in self.counts.iter().enumerate() {
-            seen += u64::from(c);
-            if seen >= want {
-                return i as u64 + 1;
-            }
-        }
-        0
-    }
-
-    /// "p50 a, p99 b, max c µs".
-    fn summary(&self) -> String {
-        format!(
-            "p50 {}, p99 {}, max {:.0} µs",
-            self.quantile_us(0.5),
-            self.quantile_us(0.99),
-            self.max.as_ns() as f64 / 1e3
-        )
-    }
 }
 
 /// The serve loop (see the module's Timing section).
@@ -248,6 +193,8 @@ fn run(sim: &mut Simulation, sock: &RawSocket, args: &ServeArgs) -> Result<Stats
     let mut printed = Vec::new();
     let mut locks = Vec::new();
     let mut buf = [0u8; 1600];
+    // the last idle step's wall and CPU time
+    let mut last_idle = (Nanos::ZERO, Nanos::ZERO);
     let mut next_flush = start + FLUSH_EVERY;
     loop {
         // the clock is read before the socket: a frame not there yet arrives later
@@ -269,21 +216,43 @@ fn run(sim: &mut Simulation, sock: &RawSocket, args: &ServeArgs) -> Result<Stats
                 stats.late += 1;
             }
             stats.worst_late = stats.worst_late.max(behind);
+            let cpu0 = thread_cpu();
             sim.catch_up(t);
+            let cpu1 = thread_cpu();
             let frame = buf.get_mut(..rx.len).unwrap_or_default();
+            // the datagram headers before the drives change them (APxx addresses count up)
+            let mut head = [0u8; 256];
+            let head_len = frame.len().min(head.len());
+            if let (Some(h), Some(f)) = (head.get_mut(..head_len), frame.get(..head_len)) {
+                h.copy_from_slice(f);
+            }
             sim.exchange(frame);
             sock.send(frame).map_err(|e| format!("send: {e}"))?;
             let sent = monotonic();
+            let cpu2 = thread_cpu();
             stats.work.add(sent.saturating_sub(begin));
-            stats
-                .answer
-                .add(sent.saturating_sub(rx_time).saturating_sub(held));
+            stats.work_cpu.add(cpu2.saturating_sub(cpu0));
+            let answer = sent.saturating_sub(rx_time).saturating_sub(held);
+            stats.answer.add(answer);
+            if stats.slowest.wants(answer) {
+                stats.slowest.add(Answer {
+                    n: sim.frames(),
+                    at: t,
+                    answer,
+                    waited: picked.saturating_sub(rx_time),
+                    catch_up_cpu: cpu1.saturating_sub(cpu0),
+                    exchange_cpu: cpu2.saturating_sub(cpu1),
+                    idle_before: last_idle,
+                    frame: describe(head.get(..head_len).unwrap_or_default()),
+                });
+            }
             if let Some(e) = sim.recording_error() {
                 return Err(format!("the pcap recording failed: {e}"));
             }
             // drain what queued up before simulating further
             continue;
         }
+        let cpu0 = thread_cpu();
         sim.catch_up(now.saturating_sub(start + IDLE_LAG));
         print_new_changes(sim, &mut printed);
         // printed is done with: serve keeps no log, its memory stays the
@@ -297,6 +266,11 @@ fn run(sim: &mut Simulation, sock: &RawSocket, args: &ServeArgs) -> Result<Stats
             next_flush = now + FLUSH_EVERY;
             flush_recording(sim, args)?;
         }
+        // the idle step (catch-up, printing, flushing): a frame that
+        // arrives meanwhile waits for it
+        last_idle = (monotonic().saturating_sub(now), thread_cpu().saturating_sub(cpu0));
+        stats.idle_cpu.add(last_idle.1);
+        stats.idle_wall.add(last_idle.0);
         if end.is_some_and(|e| now >= e) || STOP.load(Ordering::Relaxed) {
             return Ok(stats);
         }
