@@ -5,12 +5,13 @@
 //! identify, set name and IP; the implicit read of I&M0 and 0xF000; Connect
 //! in advanced startup (RTClass 2, FrameIDs 0x8000–0xBBFF) with the PDev
 //! IODWriteMultiple TIA sends, PrmEnd, ApplicationReady; 10 s of cyclic data
-//! with DataStatus, IOPS and IOCS checked; the records TIA reads online;
-//! I&M1–4; a 4,068-byte record in RPC fragments; an alarm burst acknowledged
-//! late; a second controller refused; a netload run (DCP, ARP, LLDP, RPC,
+//! with DataStatus, IOPS and IOCS checked; the records TIA reads online
+//! (the diagnosis records among them); I&M1–4; a 4,068-byte record in RPC
+//! fragments; alarm bursts acknowledged late (drive faults through serve's
+//! control FIFO, port topology alarms); a second controller refused; a netload run (DCP, ARP, LLDP, RPC,
 //! malformed UDP); Release; legacy startup; release/reconnect rounds; the
-//! recording through tshark. What the device does not serve yet (issue 32.4)
-//! the script reports as `expected-fail`, not as a failure.
+//! recording through tshark. `scripts/cross qemu-net` runs the same script
+//! against the firmware image in QEMU.
 //!
 //! Needs root and scapy: `SCAPY_PYTHON` names a python that imports it
 //! (`.ci/run` sets it to target/scapy-venv/bin/python). Without root or the

@@ -119,4 +119,6 @@ mod tests_cr;
 #[cfg(test)]
 mod tests_diag;
 #[cfg(test)]
+mod tests_records;
+#[cfg(test)]
 mod tests_vectors;

@@ -44,6 +44,7 @@ pub use status::{PnioStatus, RecordError};
 use heapless::Deque;
 use nanos::Nanos;
 
+use crate::alarm::{DiagList, DiagScope};
 use crate::pdev::Pdev;
 use crate::rpc::cursor::{Endian, Reader, Writer};
 use crate::rpc::{self, opnum, uuid::PNIO_CONTROLLER_INTERFACE, Call, CallError, ClientError, Request, Uuid};
@@ -103,6 +104,10 @@ pub struct Cm<H: RecordHook = NoRecords> {
     im: ImData,
     hook: H,
     pdev: Pdev,
+    /// The device's diagnoses (P-030, P-040): the device raises and clears
+    /// them and sends their alarms; the CM serves them as the diagnosis
+    /// records 0x800A…0xF00C.
+    pub(crate) diag: DiagList<{ crate::device::MAX_DIAGNOSES }>,
     io_ar: Option<Ar>,
     sv_ar: Option<Ar>,
     events: Deque<CmEvent, 8>,
@@ -124,6 +129,7 @@ impl<H: RecordHook> Cm<H> {
                 crate::dcp::NameOfStation::EMPTY,
                 crate::dcp::IpSuite::UNSET,
             ),
+            diag: DiagList::new(),
             io_ar: None,
             sv_ar: None,
             events: Deque::new(),
@@ -347,6 +353,13 @@ impl<H: RecordHook> Cm<H> {
         if addr.api != 0 {
             return Err(RecordError::InvalidApi);
         }
+        if let Some((scope, filter)) = DiagScope::for_record(addr.index, addr.api, addr.slot, addr.subslot) {
+            diag_scope_exists(scope, addr)?;
+            return self
+                .diag
+                .write_record(scope, filter, out)
+                .map_err(|_| RecordError::ReadError);
+        }
         let mut w = Writer::new(out, Endian::Big);
         match addr.index {
             index::IM0..=index::IM4 => {
@@ -431,6 +444,10 @@ impl<H: RecordHook> Cm<H> {
     fn write_one(&mut self, addr: RecordAddr, data: &[u8]) -> Result<(), RecordError> {
         if addr.api != 0 {
             return Err(RecordError::InvalidApi);
+        }
+        if let Some((scope, _)) = DiagScope::for_record(addr.index, addr.api, addr.slot, addr.subslot) {
+            diag_scope_exists(scope, addr)?;
+            return Err(RecordError::AccessDenied);
         }
         match addr.index {
             index::IM0..=index::IM4 if (addr.slot, addr.subslot) != (0, 1) => {
@@ -611,6 +628,23 @@ const UNKNOWN_WRITE: RwRequest = RwRequest {
     record_len: 0,
     target_ar_uuid: Uuid([0; 16]),
 };
+
+/// A diagnosis record's submodule (0x800x) or slot (0xC00x) must exist
+/// ("invalid slot/subslot" else); the AR's (0xE00x) and the API's (0xF00x)
+/// are the device's whole list: it has one AR.
+fn diag_scope_exists(scope: DiagScope, addr: RecordAddr) -> Result<(), RecordError> {
+    let there = match scope {
+        DiagScope::Subslot { .. } => exists(addr.slot, addr.subslot),
+        // every slot there is has a subslot 1
+        DiagScope::Slot { .. } => exists(addr.slot, 1),
+        DiagScope::Ar | DiagScope::Api { .. } => true,
+    };
+    if there {
+        Ok(())
+    } else {
+        Err(RecordError::InvalidSlotSubslot)
+    }
+}
 
 impl<H: RecordHook> rpc::Handler for Cm<H> {
     fn call(&mut self, _now: Nanos, call: &Call, body: &[u8], out: &mut [u8]) -> Result<usize, CallError> {

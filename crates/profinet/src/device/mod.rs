@@ -21,7 +21,7 @@
 use heapless::{Deque, Vec};
 use nanos::Nanos;
 
-use crate::alarm::{AbortCode, AlarmEvent, DiagList, DriveError, Location, Maintenance, Output, Priority};
+use crate::alarm::{AbortCode, AlarmEvent, DriveError, Location, Maintenance, Output, Priority};
 use crate::cm::{Cm, CmConfig, CmEvent, Im0, ImData, NoRecords, RecordHook};
 use crate::dcp::server::{DcpServer, Event as DcpEvent, Identity};
 use crate::dcp::{IpSuite, NameOfStation};
@@ -131,7 +131,6 @@ pub struct Device<H: RecordHook = NoRecords> {
     counters: DeviceCounters,
     started: bool,
     cyclic: Option<Cyclic>,
-    diag: DiagList<MAX_DIAGNOSES>,
     watchdog_expired: bool,
     snmp: snmp::Agent,
 }
@@ -187,7 +186,6 @@ impl<H: RecordHook> Device<H> {
             counters: DeviceCounters::default(),
             started: false,
             cyclic: None,
-            diag: DiagList::new(),
             watchdog_expired: false,
             snmp: snmp::Agent::default(),
         }
@@ -405,7 +403,8 @@ impl<H: RecordHook> Device<H> {
                         .ar()
                         .filter(|ar| ar.ar_uuid == uuid)
                         .map(|ar| Cyclic::new(ar, self.dcp.mac(), now));
-                    self.diag
+                    self.cm
+                        .diag
                         .set_alarms(cyclic.as_ref().is_some_and(|c| c.alarm.is_some()));
                     self.watchdog_expired = false;
                     self.cyclic = cyclic;
@@ -414,7 +413,7 @@ impl<H: RecordHook> Device<H> {
                     self.dcp.set_in_operation(self.cm.ar().is_some());
                     if self.cyclic.as_ref().is_some_and(|c| c.ar == uuid) {
                         self.cyclic = None;
-                        self.diag.set_alarms(false);
+                        self.cm.diag.set_alarms(false);
                     }
                 }
                 _ => {}
@@ -548,7 +547,8 @@ impl<H: RecordHook> Device<H> {
         let Some(e) = DriveError::new(main, sub) else {
             return false;
         };
-        self.diag
+        self.cm
+            .diag
             .raise(Cyclic::drive_location(), e, Maintenance::Fault, 0)
             .is_ok()
     }
@@ -570,9 +570,9 @@ impl<H: RecordHook> Device<H> {
                 let (t, x) = kind.error_types();
                 let e = DriveError::port(t, x);
                 if self.cm.pdev().mismatch(port, kind) {
-                    let _ = self.diag.raise(loc, e, Maintenance::Fault, 0);
+                    let _ = self.cm.diag.raise(loc, e, Maintenance::Fault, 0);
                 } else {
-                    self.diag.clear(&loc, e);
+                    self.cm.diag.clear(&loc, e);
                 }
             }
         }
@@ -581,7 +581,7 @@ impl<H: RecordHook> Device<H> {
     /// The drive error HH-S is gone (acknowledged, P-035): a "disappears"
     /// alarm follows.
     pub fn clear_diagnosis(&mut self, main: u8, sub: u8) -> bool {
-        DriveError::new(main, sub).is_some_and(|e| self.diag.clear(&Cyclic::drive_location(), e))
+        DriveError::new(main, sub).is_some_and(|e| self.cm.diag.clear(&Cyclic::drive_location(), e))
     }
 
     /// The alarm channel's counters of the AR in data exchange (sent,
@@ -595,7 +595,7 @@ impl<H: RecordHook> Device<H> {
 
     /// Whether any diagnosis is present.
     pub fn diagnosis_present(&self) -> bool {
-        self.diag.any_present()
+        self.cm.diag.any_present()
     }
 
     /// Whether an AR exchanges valid cyclic data now.
@@ -630,7 +630,7 @@ impl<H: RecordHook> Device<H> {
             ar_established: self.cyclic.is_some(),
             cyclic_exchange: self.exchanging(),
             watchdog_expired: self.watchdog_expired,
-            diagnosis: self.diag.any_present(),
+            diagnosis: self.cm.diag.any_present(),
             system_error: false,
             dcp_signal_until: signal.until(now),
         };
@@ -693,7 +693,7 @@ impl<H: RecordHook> Device<H> {
             AlarmEvent::Acked {
                 priority: Priority::Low,
                 ..
-            } => self.diag.acked(),
+            } => self.cm.diag.acked(),
             AlarmEvent::Acked { .. } => {}
             AlarmEvent::Abort(_) | AlarmEvent::ErrReceived(_) => self.lose_ar(None),
         }
@@ -716,7 +716,7 @@ impl<H: RecordHook> Device<H> {
             }
             None => {}
         }
-        let problem = self.diag.any_present();
+        let problem = self.cm.diag.any_present();
         let Some(c) = self.cyclic.as_mut() else {
             return;
         };
@@ -735,14 +735,14 @@ impl<H: RecordHook> Device<H> {
 
     fn run_alarms(&mut self, now: Nanos, tx: &mut impl FnMut(&[u8])) {
         if self.cyclic.as_ref().is_some_and(|c| c.alarm_free()) {
-            if let Some(n) = self.diag.next_alarm() {
+            if let Some(n) = self.cm.diag.next_alarm() {
                 let sent = self
                     .cyclic
                     .as_mut()
                     .and_then(|c| c.alarm.as_mut())
                     .is_some_and(|a| a.send(now, &n).is_ok());
                 if sent {
-                    self.diag.sent();
+                    self.cm.diag.sent();
                 }
             }
         }
@@ -765,7 +765,7 @@ impl<H: RecordHook> Device<H> {
             .is_some_and(|c| c.lost && c.alarm.as_ref().is_none_or(|a| a.is_closed()))
         {
             self.cyclic = None;
-            self.diag.set_alarms(false);
+            self.cm.diag.set_alarms(false);
         }
     }
 }
