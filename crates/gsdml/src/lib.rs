@@ -418,8 +418,8 @@ fn system_defined_submodules(x: &mut Xml, t: &mut Texts) -> Result<(), Error> {
             ("SubslotNumber", "32768"),
             ("TextId", &text),
             ("SupportedRT_Classes", "RT_CLASS_1"),
-            // no SNMP agent (P-038, docs/conformance.md), no PTP/IRT
-            ("SupportedProtocols", "LLDP"),
+            // the SNMP agent on UDP 161 (P-038, crates/snmp) and LLDP; no PTP/IRT
+            ("SupportedProtocols", "SNMP;LLDP"),
         ],
     );
     x.open("ApplicationRelations", &[("StartupMode", "Legacy;Advanced")]);

@@ -185,6 +185,8 @@ fn p025_gsdml_has_the_dap_smartservo_bl_4000_in_slot_0() {
         u64::from(model::INTERFACE_SUBMODULE_IDENT)
     );
     assert_eq!(attr(itf, "SupportedRT_Classes"), "RT_CLASS_1");
+    // P-038: conformance class B's SNMP agent is declared next to LLDP
+    assert_eq!(attr(itf, "SupportedProtocols"), "SNMP;LLDP");
     let timing = child(child(itf, "ApplicationRelations"), "TimingProperties");
     // P-042: legacy (RTClass 1 IOCRs) and advanced startup (RTClass 2)
     assert_eq!(
