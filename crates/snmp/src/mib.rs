@@ -1,5 +1,8 @@
-//! The MIB view: MIB-II system and interfaces, LLDP-MIB local and remote data, as an ordered
-//! list of objects whose instances are enumerated in lexicographic order.
+//! The MIB view: MIB-II system and interfaces, LLDP-MIB local and remote data with the
+//! management address tables, LLDP-EXT-PNO-MIB (lldpXPnoMIB, 1.0.8802.1.1.2.1.5.3791) and
+//! LLDP-EXT-DOT3-MIB (lldpXdot3MIB, 1.0.8802.1.1.2.1.5.4623) local and remote port tables, as
+//! an ordered list of objects (table columns) whose instances are enumerated in lexicographic
+//! order; a remote row exists only while the neighbour's LLDPDU carried what fills it.
 
 use crate::ber::Oid;
 use crate::{Agent, Device};
@@ -54,6 +57,18 @@ pub enum Id {
     LocPort(u32),
     /// lldpRemTable column (4 chassis subtype, 5 chassis id, 6 port subtype, 7 port id, 9 sys name)
     Rem(u32),
+    /// lldpLocManAddrTable column (3 len, 4 if subtype, 5 if id, 6 OID), index subtype.address
+    LocManAddr(u32),
+    /// lldpRemManAddrTable column (3 if subtype, 4 if id, 5 OID)
+    RemManAddr(u32),
+    /// lldpXPnoLocTable column (1 LPD, 2 port Tx delay, 3 port Rx delay, 4 RT2, 5 RT3, 6 NoS)
+    PnoLoc(u32),
+    /// lldpXPnoRemTable column (as [`Id::PnoLoc`])
+    PnoRem(u32),
+    /// lldpXdot3LocPortTable column (1 auto-neg supported, 2 enabled, 3 advertised, 4 MAU type)
+    Dot3Loc(u32),
+    /// lldpXdot3RemPortTable column (as [`Id::Dot3Loc`])
+    Dot3Rem(u32),
 }
 
 const SYS: [u32; 7] = [1, 3, 6, 1, 2, 1, 1];
@@ -80,11 +95,38 @@ pub static OBJECTS: &[Obj] = &[
     o!(Id::LocPort(2), 1, 0, 8802, 1, 1, 2, 1, 3, 7, 1, 2),
     o!(Id::LocPort(3), 1, 0, 8802, 1, 1, 2, 1, 3, 7, 1, 3),
     o!(Id::LocPort(4), 1, 0, 8802, 1, 1, 2, 1, 3, 7, 1, 4),
+    o!(Id::LocManAddr(3), 1, 0, 8802, 1, 1, 2, 1, 3, 8, 1, 3),
+    o!(Id::LocManAddr(4), 1, 0, 8802, 1, 1, 2, 1, 3, 8, 1, 4),
+    o!(Id::LocManAddr(5), 1, 0, 8802, 1, 1, 2, 1, 3, 8, 1, 5),
+    o!(Id::LocManAddr(6), 1, 0, 8802, 1, 1, 2, 1, 3, 8, 1, 6),
     o!(Id::Rem(4), 1, 0, 8802, 1, 1, 2, 1, 4, 1, 1, 4),
     o!(Id::Rem(5), 1, 0, 8802, 1, 1, 2, 1, 4, 1, 1, 5),
     o!(Id::Rem(6), 1, 0, 8802, 1, 1, 2, 1, 4, 1, 1, 6),
     o!(Id::Rem(7), 1, 0, 8802, 1, 1, 2, 1, 4, 1, 1, 7),
     o!(Id::Rem(9), 1, 0, 8802, 1, 1, 2, 1, 4, 1, 1, 9),
+    o!(Id::RemManAddr(3), 1, 0, 8802, 1, 1, 2, 1, 4, 2, 1, 3),
+    o!(Id::RemManAddr(4), 1, 0, 8802, 1, 1, 2, 1, 4, 2, 1, 4),
+    o!(Id::RemManAddr(5), 1, 0, 8802, 1, 1, 2, 1, 4, 2, 1, 5),
+    o!(Id::PnoLoc(1), 1, 0, 8802, 1, 1, 2, 1, 5, 3791, 1, 2, 1, 1, 1),
+    o!(Id::PnoLoc(2), 1, 0, 8802, 1, 1, 2, 1, 5, 3791, 1, 2, 1, 1, 2),
+    o!(Id::PnoLoc(3), 1, 0, 8802, 1, 1, 2, 1, 5, 3791, 1, 2, 1, 1, 3),
+    o!(Id::PnoLoc(4), 1, 0, 8802, 1, 1, 2, 1, 5, 3791, 1, 2, 1, 1, 4),
+    o!(Id::PnoLoc(5), 1, 0, 8802, 1, 1, 2, 1, 5, 3791, 1, 2, 1, 1, 5),
+    o!(Id::PnoLoc(6), 1, 0, 8802, 1, 1, 2, 1, 5, 3791, 1, 2, 1, 1, 6),
+    o!(Id::PnoRem(1), 1, 0, 8802, 1, 1, 2, 1, 5, 3791, 1, 3, 1, 1, 1),
+    o!(Id::PnoRem(2), 1, 0, 8802, 1, 1, 2, 1, 5, 3791, 1, 3, 1, 1, 2),
+    o!(Id::PnoRem(3), 1, 0, 8802, 1, 1, 2, 1, 5, 3791, 1, 3, 1, 1, 3),
+    o!(Id::PnoRem(4), 1, 0, 8802, 1, 1, 2, 1, 5, 3791, 1, 3, 1, 1, 4),
+    o!(Id::PnoRem(5), 1, 0, 8802, 1, 1, 2, 1, 5, 3791, 1, 3, 1, 1, 5),
+    o!(Id::PnoRem(6), 1, 0, 8802, 1, 1, 2, 1, 5, 3791, 1, 3, 1, 1, 6),
+    o!(Id::Dot3Loc(1), 1, 0, 8802, 1, 1, 2, 1, 5, 4623, 1, 2, 1, 1, 1),
+    o!(Id::Dot3Loc(2), 1, 0, 8802, 1, 1, 2, 1, 5, 4623, 1, 2, 1, 1, 2),
+    o!(Id::Dot3Loc(3), 1, 0, 8802, 1, 1, 2, 1, 5, 4623, 1, 2, 1, 1, 3),
+    o!(Id::Dot3Loc(4), 1, 0, 8802, 1, 1, 2, 1, 5, 4623, 1, 2, 1, 1, 4),
+    o!(Id::Dot3Rem(1), 1, 0, 8802, 1, 1, 2, 1, 5, 4623, 1, 3, 1, 1, 1),
+    o!(Id::Dot3Rem(2), 1, 0, 8802, 1, 1, 2, 1, 5, 4623, 1, 3, 1, 1, 2),
+    o!(Id::Dot3Rem(3), 1, 0, 8802, 1, 1, 2, 1, 5, 4623, 1, 3, 1, 1, 3),
+    o!(Id::Dot3Rem(4), 1, 0, 8802, 1, 1, 2, 1, 5, 4623, 1, 3, 1, 1, 4),
     o!(Id::SysDescr, 1, 3, 6, 1, 2, 1, 1, 1),
     o!(Id::SysObjectId, 1, 3, 6, 1, 2, 1, 1, 2),
     o!(Id::SysUpTime, 1, 3, 6, 1, 2, 1, 1, 3),
@@ -117,19 +159,107 @@ impl Id {
     fn rows(self) -> u32 {
         match self {
             Id::If(_) => IFS,
-            Id::LocPort(_) | Id::Rem(_) => PORTS,
+            Id::LocPort(_)
+            | Id::Rem(_)
+            | Id::RemManAddr(_)
+            | Id::PnoLoc(_)
+            | Id::PnoRem(_)
+            | Id::Dot3Loc(_)
+            | Id::Dot3Rem(_) => PORTS,
             _ => 1,
         }
     }
     /// Instance suffix of row `r` (0-based), or `None` when that row does not exist.
-    fn instance(self, r: u32, dev: &Device) -> Option<([u32; 3], usize)> {
-        match self {
-            Id::If(_) => Some(([r + 1, 0, 0], 1)),
-            Id::LocPort(_) => Some(([r + 1, 0, 0], 1)),
+    fn instance(self, r: u32, dev: &Device) -> Option<([u32; INST], usize)> {
+        let port = r + 1;
+        let mut i = [0; INST];
+        let n = match self {
+            Id::If(_) | Id::LocPort(_) | Id::PnoLoc(_) | Id::Dot3Loc(_) => {
+                i[0] = port;
+                1
+            }
+            // lldpLocManAddrSubtype ipV4 (1), then the address as a length-prefixed string
+            Id::LocManAddr(_) => {
+                let m = dev.man_addr?;
+                addr_index(&mut i, 0, &m);
+                6
+            }
             // lldpRemTimeMark 0, lldpRemLocalPortNum, lldpRemIndex 1
-            Id::Rem(_) => dev.neighbor(r + 1).map(|_| ([0, r + 1, 1], 3)),
-            _ => Some(([0, 0, 0], 1)),
+            Id::Rem(_) | Id::PnoRem(_) | Id::Dot3Rem(_) | Id::RemManAddr(_) => {
+                let n = dev.neighbor(port)?;
+                let has = match self {
+                    Id::PnoRem(_) => n.pno.is_some(),
+                    Id::Dot3Rem(_) => n.mac_phy.is_some(),
+                    _ => true,
+                };
+                if !has {
+                    return None;
+                }
+                i[1] = port;
+                i[2] = 1;
+                if let Id::RemManAddr(_) = self {
+                    addr_index(&mut i, 3, &n.man_addr?);
+                    9
+                } else {
+                    3
+                }
+            }
+            _ => 1,
+        };
+        Some((i, n))
+    }
+}
+
+/// Longest instance suffix (lldpRemManAddrTable: time mark, port, index, subtype, length, 4 octets).
+const INST: usize = 9;
+
+/// `1.4.a.b.c.d` (ipV4, length 4, the address) at `at`.
+fn addr_index(i: &mut [u32; INST], at: usize, m: &crate::ManAddr) {
+    let [a, b, c, d] = m.ipv4;
+    for (k, v) in [1, 4, a.into(), b.into(), c.into(), d.into()]
+        .into_iter()
+        .enumerate()
+    {
+        if let Some(x) = i.get_mut(at + k) {
+            *x = v;
         }
+    }
+}
+
+/// zeroDotZero: the Management Address TLV this device sends and keeps carries no OID.
+const ZERO_DOT_ZERO: [u32; 2] = [0, 0];
+
+/// TruthValue: true (1), false (2).
+fn truth(b: bool) -> Val<'static> {
+    Val::Int(if b { 1 } else { 2 })
+}
+
+fn pno_val<'a>(c: u32, p: &crate::Pno, nos: &'a [u8]) -> Val<'a> {
+    match c {
+        1 => Val::Gauge(p.delay.line),
+        2 => Val::Gauge(p.delay.tx),
+        3 => Val::Gauge(p.delay.rx),
+        4 => Val::Int(i32::from(p.rt2 & 0x3)),
+        5 => Val::Int(i32::from(p.rt3 & 0x7)),
+        _ => Val::Str(nos),
+    }
+}
+
+fn dot3_val(c: u32, m: &crate::MacPhy) -> Val<'_> {
+    match c {
+        1 => truth(m.autoneg & 1 != 0),
+        2 => truth(m.autoneg & 2 != 0),
+        3 => Val::Str(&m.advertised),
+        _ => Val::Int(i32::from(m.mau_type)),
+    }
+}
+
+fn man_addr_val(c: u32, m: Option<&crate::ManAddr>) -> Val<'static> {
+    match (c, m) {
+        (_, None) => Val::Int(0),
+        (1, Some(m)) => Val::Int(i32::from(m.if_subtype)),
+        (2, Some(m)) => Val::Int(i32::try_from(m.if_id).unwrap_or(i32::MAX)),
+        _ => Val::Oid(&ZERO_DOT_ZERO),
     }
 }
 
@@ -238,6 +368,29 @@ pub fn value<'a>(id: Id, r: u32, agent: &'a Agent, dev: &'a Device<'a>) -> Val<'
                 7 => Val::Str(n.port_id),
                 _ => Val::Str(n.sys_name),
             },
+        },
+        // lldpLocManAddrLen: subtype and address octets (5)
+        Id::LocManAddr(3) => Val::Int(5),
+        Id::LocManAddr(c) => man_addr_val(c.saturating_sub(3), dev.man_addr.as_ref()),
+        Id::RemManAddr(c) => man_addr_val(
+            c.saturating_sub(2),
+            dev.neighbor(port).and_then(|n| n.man_addr.as_ref()),
+        ),
+        Id::PnoLoc(c) => match dev.port(port) {
+            Some(p) => pno_val(c, &p.pno, dev.name_of_station),
+            None => Val::Int(0),
+        },
+        Id::PnoRem(c) => match dev.neighbor(port) {
+            Some(n) => pno_val(c, &n.pno.unwrap_or_default(), n.sys_name),
+            None => Val::Int(0),
+        },
+        Id::Dot3Loc(c) => match dev.port(port) {
+            Some(p) => dot3_val(c, &p.mac_phy),
+            None => Val::Int(0),
+        },
+        Id::Dot3Rem(c) => match dev.neighbor(port).and_then(|n| n.mac_phy.as_ref()) {
+            Some(m) => dot3_val(c, m),
+            None => Val::Int(0),
         },
     }
 }
