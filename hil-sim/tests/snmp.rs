@@ -80,6 +80,13 @@ fn lldp_extensions(line: &PnLine, mau: &str, peer_station: &str) {
     has(&walk, &format!(".1.0.8802.1.1.2.1.3.8.1.5.1.4.{ip} = INTEGER: 1"));
     has(&walk, &format!(".1.0.8802.1.1.2.1.3.8.1.6.1.4.{ip} = OID: .0.0"));
     assert_eq!(walk.lines().count(), 4, "{walk}");
+    // lldpConfigManAddrTable: both ports send the address (LldpPortList: ports 1, 2)
+    let (ok, walk) = snmp(line, "snmpwalk", &v2c("public", &[".1.0.8802.1.1.2.1.1.7"]));
+    assert!(ok, "{walk}");
+    has(
+        &walk,
+        &format!(".1.0.8802.1.1.2.1.1.7.1.1.1.4.{ip} = Hex-STRING: C0"),
+    );
     // lldpRemManAddrTable: the neighbour's address on port 1 (time mark 0, index 1)
     let (ok, walk) = snmp(line, "snmpwalk", &v2c("public", &[".1.0.8802.1.1.2.1.4.2"]));
     assert!(ok, "{walk}");

@@ -133,6 +133,9 @@ pub struct Device<'a> {
     pub name_of_station: &'a [u8],
     /// The interface's management address while it has an IP (lldpLocManAddrTable).
     pub man_addr: Option<ManAddr>,
+    /// The ports whose LLDPDUs carry it (lldpConfigManAddrPortsTxEnable, an LldpPortList:
+    /// bit 7 of the octet is port 1, bit 6 port 2).
+    pub man_addr_ports: [u8; 1],
     /// What LLDP sends on port 1, port 2.
     pub ports: [LocalPort; 2],
 }
@@ -148,6 +151,7 @@ impl<'a> Device<'a> {
             neighbors: [None, None],
             name_of_station: &[],
             man_addr: None,
+            man_addr_ports: [0],
             ports: [LocalPort {
                 pno: Pno {
                     delay: Delays {

@@ -1,5 +1,5 @@
 //! The MIB view: MIB-II system and interfaces, LLDP-MIB local and remote data with the
-//! management address tables, LLDP-EXT-PNO-MIB (lldpXPnoMIB, 1.0.8802.1.1.2.1.5.3791) and
+//! management address tables (and lldpConfigManAddrTable, the ports that send the address), LLDP-EXT-PNO-MIB (lldpXPnoMIB, 1.0.8802.1.1.2.1.5.3791) and
 //! LLDP-EXT-DOT3-MIB (lldpXdot3MIB, 1.0.8802.1.1.2.1.5.4623) local and remote port tables, as
 //! an ordered list of objects (table columns) whose instances are enumerated in lexicographic
 //! order; a remote row exists only while the neighbour's LLDPDU carried what fills it.
@@ -57,6 +57,8 @@ pub enum Id {
     LocPort(u32),
     /// lldpRemTable column (4 chassis subtype, 5 chassis id, 6 port subtype, 7 port id, 9 sys name)
     Rem(u32),
+    /// lldpConfigManAddrPortsTxEnable (lldpConfigManAddrTable, indexed as lldpLocManAddrTable)
+    ConfigManAddrPorts,
     /// lldpLocManAddrTable column (3 len, 4 if subtype, 5 if id, 6 OID), index subtype.address
     LocManAddr(u32),
     /// lldpRemManAddrTable column (3 if subtype, 4 if id, 5 OID)
@@ -88,6 +90,7 @@ macro_rules! o {
 
 /// Every object, in OID order (checked by a unit test).
 pub static OBJECTS: &[Obj] = &[
+    o!(Id::ConfigManAddrPorts, 1, 0, 8802, 1, 1, 2, 1, 1, 7, 1, 1),
     o!(Id::LocChassisIdSubtype, 1, 0, 8802, 1, 1, 2, 1, 3, 1),
     o!(Id::LocChassisId, 1, 0, 8802, 1, 1, 2, 1, 3, 2),
     o!(Id::LocSysName, 1, 0, 8802, 1, 1, 2, 1, 3, 3),
@@ -179,7 +182,7 @@ impl Id {
                 1
             }
             // lldpLocManAddrSubtype ipV4 (1), then the address as a length-prefixed string
-            Id::LocManAddr(_) => {
+            Id::LocManAddr(_) | Id::ConfigManAddrPorts => {
                 let m = dev.man_addr?;
                 addr_index(&mut i, 0, &m);
                 6
@@ -369,6 +372,7 @@ pub fn value<'a>(id: Id, r: u32, agent: &'a Agent, dev: &'a Device<'a>) -> Val<'
                 _ => Val::Str(n.sys_name),
             },
         },
+        Id::ConfigManAddrPorts => Val::Str(&dev.man_addr_ports),
         // lldpLocManAddrLen: subtype and address octets (5)
         Id::LocManAddr(3) => Val::Int(5),
         Id::LocManAddr(c) => man_addr_val(c.saturating_sub(3), dev.man_addr.as_ref()),

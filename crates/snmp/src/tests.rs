@@ -66,6 +66,7 @@ fn dev() -> Device<'static> {
             if_subtype: 2,
             if_id: 1,
         }),
+        man_addr_ports: [0xc0],
         ports: local_ports(),
     }
 }
@@ -217,10 +218,11 @@ fn p038_walk_is_strictly_increasing_and_ends_with_end_of_mib_view() {
         cur = r.vbs[0].0;
         count += 1;
     }
-    // 4 local LLDP scalars, 3x2 local port cells, 4 local management address cells,
+    // lldpConfigManAddrPortsTxEnable, 4 local LLDP scalars, 3x2 local port cells, 4 local
+    // management address cells,
     // 5 remote cells (one neighbour), 3 remote management address cells, 6x2 local and 6
     // remote PROFINET cells, 4x2 local and 4 remote 802.3 cells, 7 system, ifNumber, 8x3 ifTable
-    assert_eq!(count, 4 + 6 + 4 + 5 + 3 + 12 + 6 + 8 + 4 + 7 + 1 + 24);
+    assert_eq!(count, 1 + 4 + 6 + 4 + 5 + 3 + 12 + 6 + 8 + 4 + 7 + 1 + 24);
     let (q, n) = req(0, b"public", GET_NEXT, 9, 0, 0, &[(cur.arcs(), 5, &[])]);
     let (r, _) = run(&mut a, &q[..n]).unwrap();
     assert_eq!((r.status, r.index), (err::NO_SUCH_NAME, 1));

@@ -121,6 +121,10 @@ impl<H: RecordHook> Device<H> {
                 if_subtype: lldp::MAN_ADDR_IF_SUBTYPE,
                 if_id: lldp::MAN_ADDR_IF_ID,
             }),
+            // the Management Address TLV goes out on every port that sends LLDP
+            man_addr_ports: [(1..=model::PORTS)
+                .filter(|&p| pdev.lldp_allowed(p))
+                .fold(0u8, |bits, p| bits | (0x80 >> (p - 1)))],
             ports,
         };
         let Some(payload) = out.get_mut(UDP_PAYLOAD_OFFSET..) else {

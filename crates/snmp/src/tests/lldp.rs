@@ -5,6 +5,7 @@
 use super::*;
 
 const LLDP: [u32; 7] = [1, 0, 8802, 1, 1, 2, 1];
+const CONFIG_MAN: [u32; 11] = [1, 0, 8802, 1, 1, 2, 1, 1, 7, 1, 1];
 const LOC_MAN: [u32; 11] = [1, 0, 8802, 1, 1, 2, 1, 3, 8, 1, 3];
 const REM_MAN: [u32; 11] = [1, 0, 8802, 1, 1, 2, 1, 4, 2, 1, 3];
 const PNO_LOC: [u32; 14] = [1, 0, 8802, 1, 1, 2, 1, 5, 3791, 1, 2, 1, 1, 1];
@@ -94,6 +95,12 @@ fn p038_loc_man_addr_table_is_the_interface_ipv4() {
     // another address is no instance
     let v = one(&d, GET, oid(&LOC_MAN, 3, &[1, 4, 192, 168, 0, 51]).arcs());
     assert_eq!(v.1, 0x81);
+    // lldpConfigManAddrPortsTxEnable, same index: both ports send it (ports 1 and 2: 0xC0)
+    let (s, n) = get_str(&d, &[&CONFIG_MAN[..], &inst].concat());
+    assert_eq!(&s[..n], &[0xc0]);
+    // the LLDP walk starts there
+    let v = one(&d, GET_NEXT, &LLDP);
+    assert_eq!(v.0.arcs(), &[&CONFIG_MAN[..], &inst].concat()[..]);
 }
 
 #[test]
@@ -101,6 +108,7 @@ fn p038_without_ip_the_loc_man_addr_table_is_empty_and_getnext_skips_it() {
     let mut d = dev();
     d.man_addr = None;
     assert_eq!(walk(&d, &[1, 0, 8802, 1, 1, 2, 1, 3, 8]), 0);
+    assert_eq!(walk(&d, &[1, 0, 8802, 1, 1, 2, 1, 1]), 0);
     // the last lldpLocPortDesc is followed by the first lldpRemTable cell
     let v = one(&d, GET_NEXT, &[1, 0, 8802, 1, 1, 2, 1, 3, 7, 1, 4, 2]);
     assert_eq!(v.0.arcs(), &[1, 0, 8802, 1, 1, 2, 1, 4, 1, 1, 4, 0, 1, 1]);
@@ -198,6 +206,7 @@ fn p038_without_neighbours_no_remote_rows_and_getnext_crosses_tables() {
         &[1, 0, 8802, 1, 1, 2, 1, 5, 3791, 1, 3],
         &[1, 0, 8802, 1, 1, 2, 1, 5, 4623, 1, 3],
         &[1, 0, 8802, 1, 1, 2, 1, 3, 8],
+        &[1, 0, 8802, 1, 1, 2, 1, 1, 7],
     ] {
         assert_eq!(walk(&d, t), 0, "{t:?}");
     }
@@ -227,6 +236,6 @@ fn p038_whole_lldp_walk_with_neighbours_on_both_ports_never_repeats() {
         oid(&REM_MAN, 3, &[0, 1, 1, 1, 4, 10, 0, 0, 1]).arcs(),
     );
     assert_eq!(v.0.arcs(), oid(&REM_MAN, 3, &[0, 2, 1, 1, 4, 10, 0, 0, 1]).arcs());
-    // 4 + 6 + 4 local; 2x(5 + 3) remote; 12 + 2x6 PROFINET; 8 + 2x4 802.3
-    assert_eq!(walk(&d, &LLDP), 4 + 6 + 4 + 16 + 12 + 12 + 8 + 8);
+    // 1 config, 4 + 6 + 4 local; 2x(5 + 3) remote; 12 + 2x6 PROFINET; 8 + 2x4 802.3
+    assert_eq!(walk(&d, &LLDP), 1 + 4 + 6 + 4 + 16 + 12 + 12 + 8 + 8);
 }
