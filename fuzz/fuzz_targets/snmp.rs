@@ -130,7 +130,7 @@ fuzz_target!(|data: &[u8]| {
     let l = w.open(0x30);
     for _ in 0..usize::from(next() % 6) {
         let sel = next();
-        let mut oid = [0u32; 16];
+        let mut oid = [0u32; 24];
         let pre = PREFIXES[usize::from(sel) % PREFIXES.len()];
         oid[..pre.len()].copy_from_slice(pre);
         let extra = usize::from(next() % 4);
