@@ -73,79 +73,111 @@ pub enum Id {
     Dot3Rem(u32),
 }
 
-const SYS: [u32; 7] = [1, 3, 6, 1, 2, 1, 1];
-const LLDP_LOC: [u32; 8] = [1, 0, 8802, 1, 1, 2, 1, 3];
+/// MIB-II system (scalars).
+static SYS: [u32; 7] = [1, 3, 6, 1, 2, 1, 1];
+/// MIB-II interfaces (ifNumber).
+static IFACES: [u32; 7] = [1, 3, 6, 1, 2, 1, 2];
+/// ifEntry.
+static IF_ENTRY: [u32; 9] = [1, 3, 6, 1, 2, 1, 2, 2, 1];
+/// lldpConfigManAddrEntry.
+static LLDP_CONFIG_MAN: [u32; 10] = [1, 0, 8802, 1, 1, 2, 1, 1, 7, 1];
+/// lldpLocalSystemData (scalars).
+static LLDP_LOC: [u32; 8] = [1, 0, 8802, 1, 1, 2, 1, 3];
+/// lldpLocPortEntry.
+static LLDP_LOC_PORT: [u32; 10] = [1, 0, 8802, 1, 1, 2, 1, 3, 7, 1];
+/// lldpLocManAddrEntry.
+static LLDP_LOC_MAN: [u32; 10] = [1, 0, 8802, 1, 1, 2, 1, 3, 8, 1];
+/// lldpRemEntry.
+static LLDP_REM: [u32; 10] = [1, 0, 8802, 1, 1, 2, 1, 4, 1, 1];
+/// lldpRemManAddrEntry.
+static LLDP_REM_MAN: [u32; 10] = [1, 0, 8802, 1, 1, 2, 1, 4, 2, 1];
+/// lldpXPnoLocEntry (LLDP-EXT-PNO-MIB).
+static PNO_LOC: [u32; 13] = [1, 0, 8802, 1, 1, 2, 1, 5, 3791, 1, 2, 1, 1];
+/// lldpXPnoRemEntry.
+static PNO_REM: [u32; 13] = [1, 0, 8802, 1, 1, 2, 1, 5, 3791, 1, 3, 1, 1];
+/// lldpXdot3LocPortEntry (LLDP-EXT-DOT3-MIB).
+static DOT3_LOC: [u32; 13] = [1, 0, 8802, 1, 1, 2, 1, 5, 4623, 1, 2, 1, 1];
+/// lldpXdot3RemPortEntry.
+static DOT3_REM: [u32; 13] = [1, 0, 8802, 1, 1, 2, 1, 5, 4623, 1, 3, 1, 1];
 
-/// One object: its OID (without instance) and identity.
+/// One object: the OID of its group or table entry, its arc under it, and its identity.
 pub struct Obj {
-    /// OID prefix.
-    pub base: &'static [u32],
+    /// OID of the scalar group or table entry.
+    pub entry: &'static [u32],
+    /// The object's arc under `entry` (the scalar or the column).
+    pub col: u32,
     /// Identity.
     pub id: Id,
 }
 
 macro_rules! o {
-    ($id:expr, $($a:expr),*) => { Obj { base: &[$($a),*], id: $id } };
+    ($id:expr, $entry:ident, $col:expr) => {
+        Obj {
+            entry: &$entry,
+            col: $col,
+            id: $id,
+        }
+    };
 }
 
 /// Every object, in OID order (checked by a unit test).
 pub static OBJECTS: &[Obj] = &[
-    o!(Id::ConfigManAddrPorts, 1, 0, 8802, 1, 1, 2, 1, 1, 7, 1, 1),
-    o!(Id::LocChassisIdSubtype, 1, 0, 8802, 1, 1, 2, 1, 3, 1),
-    o!(Id::LocChassisId, 1, 0, 8802, 1, 1, 2, 1, 3, 2),
-    o!(Id::LocSysName, 1, 0, 8802, 1, 1, 2, 1, 3, 3),
-    o!(Id::LocSysDesc, 1, 0, 8802, 1, 1, 2, 1, 3, 4),
-    o!(Id::LocPort(2), 1, 0, 8802, 1, 1, 2, 1, 3, 7, 1, 2),
-    o!(Id::LocPort(3), 1, 0, 8802, 1, 1, 2, 1, 3, 7, 1, 3),
-    o!(Id::LocPort(4), 1, 0, 8802, 1, 1, 2, 1, 3, 7, 1, 4),
-    o!(Id::LocManAddr(3), 1, 0, 8802, 1, 1, 2, 1, 3, 8, 1, 3),
-    o!(Id::LocManAddr(4), 1, 0, 8802, 1, 1, 2, 1, 3, 8, 1, 4),
-    o!(Id::LocManAddr(5), 1, 0, 8802, 1, 1, 2, 1, 3, 8, 1, 5),
-    o!(Id::LocManAddr(6), 1, 0, 8802, 1, 1, 2, 1, 3, 8, 1, 6),
-    o!(Id::Rem(4), 1, 0, 8802, 1, 1, 2, 1, 4, 1, 1, 4),
-    o!(Id::Rem(5), 1, 0, 8802, 1, 1, 2, 1, 4, 1, 1, 5),
-    o!(Id::Rem(6), 1, 0, 8802, 1, 1, 2, 1, 4, 1, 1, 6),
-    o!(Id::Rem(7), 1, 0, 8802, 1, 1, 2, 1, 4, 1, 1, 7),
-    o!(Id::Rem(9), 1, 0, 8802, 1, 1, 2, 1, 4, 1, 1, 9),
-    o!(Id::RemManAddr(3), 1, 0, 8802, 1, 1, 2, 1, 4, 2, 1, 3),
-    o!(Id::RemManAddr(4), 1, 0, 8802, 1, 1, 2, 1, 4, 2, 1, 4),
-    o!(Id::RemManAddr(5), 1, 0, 8802, 1, 1, 2, 1, 4, 2, 1, 5),
-    o!(Id::PnoLoc(1), 1, 0, 8802, 1, 1, 2, 1, 5, 3791, 1, 2, 1, 1, 1),
-    o!(Id::PnoLoc(2), 1, 0, 8802, 1, 1, 2, 1, 5, 3791, 1, 2, 1, 1, 2),
-    o!(Id::PnoLoc(3), 1, 0, 8802, 1, 1, 2, 1, 5, 3791, 1, 2, 1, 1, 3),
-    o!(Id::PnoLoc(4), 1, 0, 8802, 1, 1, 2, 1, 5, 3791, 1, 2, 1, 1, 4),
-    o!(Id::PnoLoc(5), 1, 0, 8802, 1, 1, 2, 1, 5, 3791, 1, 2, 1, 1, 5),
-    o!(Id::PnoLoc(6), 1, 0, 8802, 1, 1, 2, 1, 5, 3791, 1, 2, 1, 1, 6),
-    o!(Id::PnoRem(1), 1, 0, 8802, 1, 1, 2, 1, 5, 3791, 1, 3, 1, 1, 1),
-    o!(Id::PnoRem(2), 1, 0, 8802, 1, 1, 2, 1, 5, 3791, 1, 3, 1, 1, 2),
-    o!(Id::PnoRem(3), 1, 0, 8802, 1, 1, 2, 1, 5, 3791, 1, 3, 1, 1, 3),
-    o!(Id::PnoRem(4), 1, 0, 8802, 1, 1, 2, 1, 5, 3791, 1, 3, 1, 1, 4),
-    o!(Id::PnoRem(5), 1, 0, 8802, 1, 1, 2, 1, 5, 3791, 1, 3, 1, 1, 5),
-    o!(Id::PnoRem(6), 1, 0, 8802, 1, 1, 2, 1, 5, 3791, 1, 3, 1, 1, 6),
-    o!(Id::Dot3Loc(1), 1, 0, 8802, 1, 1, 2, 1, 5, 4623, 1, 2, 1, 1, 1),
-    o!(Id::Dot3Loc(2), 1, 0, 8802, 1, 1, 2, 1, 5, 4623, 1, 2, 1, 1, 2),
-    o!(Id::Dot3Loc(3), 1, 0, 8802, 1, 1, 2, 1, 5, 4623, 1, 2, 1, 1, 3),
-    o!(Id::Dot3Loc(4), 1, 0, 8802, 1, 1, 2, 1, 5, 4623, 1, 2, 1, 1, 4),
-    o!(Id::Dot3Rem(1), 1, 0, 8802, 1, 1, 2, 1, 5, 4623, 1, 3, 1, 1, 1),
-    o!(Id::Dot3Rem(2), 1, 0, 8802, 1, 1, 2, 1, 5, 4623, 1, 3, 1, 1, 2),
-    o!(Id::Dot3Rem(3), 1, 0, 8802, 1, 1, 2, 1, 5, 4623, 1, 3, 1, 1, 3),
-    o!(Id::Dot3Rem(4), 1, 0, 8802, 1, 1, 2, 1, 5, 4623, 1, 3, 1, 1, 4),
-    o!(Id::SysDescr, 1, 3, 6, 1, 2, 1, 1, 1),
-    o!(Id::SysObjectId, 1, 3, 6, 1, 2, 1, 1, 2),
-    o!(Id::SysUpTime, 1, 3, 6, 1, 2, 1, 1, 3),
-    o!(Id::SysContact, 1, 3, 6, 1, 2, 1, 1, 4),
-    o!(Id::SysName, 1, 3, 6, 1, 2, 1, 1, 5),
-    o!(Id::SysLocation, 1, 3, 6, 1, 2, 1, 1, 6),
-    o!(Id::SysServices, 1, 3, 6, 1, 2, 1, 1, 7),
-    o!(Id::IfNumber, 1, 3, 6, 1, 2, 1, 2, 1),
-    o!(Id::If(1), 1, 3, 6, 1, 2, 1, 2, 2, 1, 1),
-    o!(Id::If(2), 1, 3, 6, 1, 2, 1, 2, 2, 1, 2),
-    o!(Id::If(3), 1, 3, 6, 1, 2, 1, 2, 2, 1, 3),
-    o!(Id::If(4), 1, 3, 6, 1, 2, 1, 2, 2, 1, 4),
-    o!(Id::If(5), 1, 3, 6, 1, 2, 1, 2, 2, 1, 5),
-    o!(Id::If(6), 1, 3, 6, 1, 2, 1, 2, 2, 1, 6),
-    o!(Id::If(7), 1, 3, 6, 1, 2, 1, 2, 2, 1, 7),
-    o!(Id::If(8), 1, 3, 6, 1, 2, 1, 2, 2, 1, 8),
+    o!(Id::ConfigManAddrPorts, LLDP_CONFIG_MAN, 1),
+    o!(Id::LocChassisIdSubtype, LLDP_LOC, 1),
+    o!(Id::LocChassisId, LLDP_LOC, 2),
+    o!(Id::LocSysName, LLDP_LOC, 3),
+    o!(Id::LocSysDesc, LLDP_LOC, 4),
+    o!(Id::LocPort(2), LLDP_LOC_PORT, 2),
+    o!(Id::LocPort(3), LLDP_LOC_PORT, 3),
+    o!(Id::LocPort(4), LLDP_LOC_PORT, 4),
+    o!(Id::LocManAddr(3), LLDP_LOC_MAN, 3),
+    o!(Id::LocManAddr(4), LLDP_LOC_MAN, 4),
+    o!(Id::LocManAddr(5), LLDP_LOC_MAN, 5),
+    o!(Id::LocManAddr(6), LLDP_LOC_MAN, 6),
+    o!(Id::Rem(4), LLDP_REM, 4),
+    o!(Id::Rem(5), LLDP_REM, 5),
+    o!(Id::Rem(6), LLDP_REM, 6),
+    o!(Id::Rem(7), LLDP_REM, 7),
+    o!(Id::Rem(9), LLDP_REM, 9),
+    o!(Id::RemManAddr(3), LLDP_REM_MAN, 3),
+    o!(Id::RemManAddr(4), LLDP_REM_MAN, 4),
+    o!(Id::RemManAddr(5), LLDP_REM_MAN, 5),
+    o!(Id::PnoLoc(1), PNO_LOC, 1),
+    o!(Id::PnoLoc(2), PNO_LOC, 2),
+    o!(Id::PnoLoc(3), PNO_LOC, 3),
+    o!(Id::PnoLoc(4), PNO_LOC, 4),
+    o!(Id::PnoLoc(5), PNO_LOC, 5),
+    o!(Id::PnoLoc(6), PNO_LOC, 6),
+    o!(Id::PnoRem(1), PNO_REM, 1),
+    o!(Id::PnoRem(2), PNO_REM, 2),
+    o!(Id::PnoRem(3), PNO_REM, 3),
+    o!(Id::PnoRem(4), PNO_REM, 4),
+    o!(Id::PnoRem(5), PNO_REM, 5),
+    o!(Id::PnoRem(6), PNO_REM, 6),
+    o!(Id::Dot3Loc(1), DOT3_LOC, 1),
+    o!(Id::Dot3Loc(2), DOT3_LOC, 2),
+    o!(Id::Dot3Loc(3), DOT3_LOC, 3),
+    o!(Id::Dot3Loc(4), DOT3_LOC, 4),
+    o!(Id::Dot3Rem(1), DOT3_REM, 1),
+    o!(Id::Dot3Rem(2), DOT3_REM, 2),
+    o!(Id::Dot3Rem(3), DOT3_REM, 3),
+    o!(Id::Dot3Rem(4), DOT3_REM, 4),
+    o!(Id::SysDescr, SYS, 1),
+    o!(Id::SysObjectId, SYS, 2),
+    o!(Id::SysUpTime, SYS, 3),
+    o!(Id::SysContact, SYS, 4),
+    o!(Id::SysName, SYS, 5),
+    o!(Id::SysLocation, SYS, 6),
+    o!(Id::SysServices, SYS, 7),
+    o!(Id::IfNumber, IFACES, 1),
+    o!(Id::If(1), IF_ENTRY, 1),
+    o!(Id::If(2), IF_ENTRY, 2),
+    o!(Id::If(3), IF_ENTRY, 3),
+    o!(Id::If(4), IF_ENTRY, 4),
+    o!(Id::If(5), IF_ENTRY, 5),
+    o!(Id::If(6), IF_ENTRY, 6),
+    o!(Id::If(7), IF_ENTRY, 7),
+    o!(Id::If(8), IF_ENTRY, 8),
 ];
 
 /// Number of interfaces: the PROFINET interface (ifIndex 1) and its ports (2, 3).
@@ -266,8 +298,10 @@ fn man_addr_val(c: u32, m: Option<&crate::ManAddr>) -> Val<'static> {
     }
 }
 
-fn full(o: &Obj, inst: &[u32]) -> Option<Oid> {
-    let mut x = Oid::from_arcs(o.base)?;
+/// The OID of object `o` with instance suffix `inst`.
+pub fn full(o: &Obj, inst: &[u32]) -> Option<Oid> {
+    let mut x = Oid::from_arcs(o.entry)?;
+    x.push(o.col)?;
     for &a in inst {
         x.push(a)?;
     }
@@ -277,7 +311,11 @@ fn full(o: &Obj, inst: &[u32]) -> Option<Oid> {
 /// Exact lookup: (object, row) for an OID.
 pub fn find(oid: &[u32], dev: &Device) -> Lookup {
     for o in OBJECTS {
-        if let Some(rest) = oid.strip_prefix(o.base) {
+        let rest = oid
+            .strip_prefix(o.entry)
+            .and_then(|r| r.split_first())
+            .and_then(|(&c, rest)| (c == o.col).then_some(rest));
+        if let Some(rest) = rest {
             for r in 0..o.id.rows() {
                 if let Some((i, n)) = o.id.instance(r, dev) {
                     if i.get(..n) == Some(rest) {
@@ -399,7 +437,7 @@ pub fn value<'a>(id: Id, r: u32, agent: &'a Agent, dev: &'a Device<'a>) -> Val<'
     }
 }
 
-/// sysContact's OID prefix etc. (for tests and callers).
-pub const SYS_PREFIX: &[u32] = &SYS;
-/// lldpLocalSystemData prefix.
-pub const LLDP_LOC_PREFIX: &[u32] = &LLDP_LOC;
+/// MIB-II system's OID (for tests and callers).
+pub const SYS_PREFIX: &[u32] = &[1, 3, 6, 1, 2, 1, 1];
+/// lldpLocalSystemData's OID.
+pub const LLDP_LOC_PREFIX: &[u32] = &[1, 0, 8802, 1, 1, 2, 1, 3];

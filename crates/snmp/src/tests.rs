@@ -151,7 +151,10 @@ const SYSNAME: &[u32] = &[1, 3, 6, 1, 2, 1, 1, 5, 0];
 #[test]
 fn p038_objects_are_in_oid_order() {
     for w in mib::OBJECTS.windows(2) {
-        assert!(w[0].base < w[1].base, "{:?} !< {:?}", w[0].base, w[1].base);
+        let (a, b) = (mib::full(&w[0], &[]).unwrap(), mib::full(&w[1], &[]).unwrap());
+        assert!(a.arcs() < b.arcs(), "{:?} !< {:?}", a.arcs(), b.arcs());
+        // no object's OID is a prefix of another's (instances could collide)
+        assert!(!b.arcs().starts_with(a.arcs()));
     }
 }
 
