@@ -14,7 +14,7 @@
 
 use libfuzzer_sys::fuzz_target;
 use snmp::ber::{Reader, Writer};
-use snmp::{Agent, Device, Neighbor};
+use snmp::{Agent, Delays, Device, LocalPort, MacPhy, ManAddr, Neighbor, Pno};
 
 const PREFIXES: &[&[u32]] = &[
     &[1, 3, 6, 1, 2, 1, 1],
@@ -25,6 +25,13 @@ const PREFIXES: &[&[u32]] = &[
     &[1, 3, 6, 1, 2, 1, 2],
     &[1, 0, 8802, 1, 1, 2, 1, 3],
     &[1, 0, 8802, 1, 1, 2, 1, 4, 1, 1],
+    &[1, 0, 8802, 1, 1, 2, 1, 1, 7, 1, 1, 1, 4],
+    &[1, 0, 8802, 1, 1, 2, 1, 3, 8, 1, 3, 1, 4],
+    &[1, 0, 8802, 1, 1, 2, 1, 4, 2, 1, 3, 0, 2, 1],
+    &[1, 0, 8802, 1, 1, 2, 1, 5, 3791, 1, 2, 1, 1],
+    &[1, 0, 8802, 1, 1, 2, 1, 5, 3791, 1, 3, 1, 1, 6, 0],
+    &[1, 0, 8802, 1, 1, 2, 1, 5, 4623, 1, 2, 1, 1],
+    &[1, 0, 8802, 1, 1, 2, 1, 5, 4623, 1, 3, 1, 1, 4, 0, 2],
     &[1, 3, 6, 1, 2, 1, 3],
     &[1, 3, 6, 1, 4, 1],
     &[0],
@@ -42,8 +49,21 @@ fn device() -> Device<'static> {
         links: [true, false],
         neighbors: [
             None,
-            Some(Neighbor { chassis_subtype: 7, chassis_id: b"plc", port_subtype: 7, port_id: b"port-001", sys_name: b"plc" }),
+            Some(Neighbor {
+                chassis_subtype: 7,
+                chassis_id: b"plc",
+                port_subtype: 7,
+                port_id: b"port-001",
+                sys_name: b"plc",
+                pno: Some(Pno { delay: Delays { line: 9, tx: 1, rx: 2 }, rt2: 2, rt3: 4 }),
+                mac_phy: Some(MacPhy { autoneg: 3, advertised: [0x6c, 0], mau_type: 16 }),
+                man_addr: Some(ManAddr { ipv4: [192, 168, 0, 10], if_subtype: 2, if_id: 1 }),
+            }),
         ],
+        name_of_station: b"drive-1",
+        man_addr: Some(ManAddr { ipv4: [192, 168, 0, 50], if_subtype: 2, if_id: 1 }),
+        man_addr_ports: [0xc0],
+        ports: [LocalPort::default(); 2],
     }
 }
 
@@ -110,7 +130,7 @@ fuzz_target!(|data: &[u8]| {
     let l = w.open(0x30);
     for _ in 0..usize::from(next() % 6) {
         let sel = next();
-        let mut oid = [0u32; 16];
+        let mut oid = [0u32; 24];
         let pre = PREFIXES[usize::from(sel) % PREFIXES.len()];
         oid[..pre.len()].copy_from_slice(pre);
         let extra = usize::from(next() % 4);

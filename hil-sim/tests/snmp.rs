@@ -1,7 +1,11 @@
 //! net-snmp (Debian package `snmp`) reads and writes the SNMP agent of
 //! `hil-sim serve --fieldbus profinet` over a veth pair (spec P-038): the
-//! device gets its IP by DCP Set (tests/snmp/dcp_set_ip.py, plain sockets),
-//! then `snmpwalk` of system, interfaces and LLDP-MIB, `snmpget`, `snmpset`
+//! device gets its IP and name by DCP Set (tests/snmp/dcp_set_ip.py, plain
+//! sockets), a neighbour sends it an LLDPDU and reads PDPortDataReal
+//! (tests/snmp/pn_peer.py), then `snmpwalk` of system, interfaces, LLDP-MIB
+//! with the management address tables and the PROFINET (…5.3791) and 802.3
+//! (…5.4623) extensions checked against the DCP name, the neighbour's TLVs
+//! and PDPortDataReal, `snmpget`, `snmpset`
 //! of sysName/sysContact/sysLocation that are still there after the device
 //! restarts (serve's `restart` command: powered on again over the same
 //! parameter flash), and a set with the read community that is refused.
@@ -19,6 +23,7 @@ use std::process::Command;
 use std::time::{Duration, Instant};
 
 const DEVICE_IP: &str = "192.168.0.50";
+const DEVICE_NAME: &str = "drive-7";
 
 /// A net-snmp tool run in the controller's namespace: (success, stdout + stderr).
 fn snmp(line: &PnLine, tool: &str, args: &[&str]) -> (bool, String) {
@@ -56,6 +61,85 @@ fn control(line: &PnLine, command: &str, expect: &str) {
     }
 }
 
+/// The controller's own address, which its LLDPDU announces as management address.
+const CONTROLLER_ADDR: &str = "192.168.0.10";
+
+fn has(walk: &str, line: &str) {
+    assert!(walk.contains(line), "{line:?} missing:\n{walk}");
+}
+
+/// `snmpwalk -v2c -On` of the management address tables and the PROFINET and
+/// 802.3 extensions: what the device sends and what the neighbour sent.
+fn lldp_extensions(line: &PnLine, mau: &str, peer_station: &str) {
+    let ip = DEVICE_IP;
+    let (ok, walk) = snmp(line, "snmpwalk", &v2c("public", &[".1.0.8802.1.1.2.1.3.8"]));
+    assert!(ok, "{walk}");
+    // lldpLocManAddrTable: index ipV4(1).4.<address>; length 5, ifIndex(2) 1
+    has(&walk, &format!(".1.0.8802.1.1.2.1.3.8.1.3.1.4.{ip} = INTEGER: 5"));
+    has(&walk, &format!(".1.0.8802.1.1.2.1.3.8.1.4.1.4.{ip} = INTEGER: 2"));
+    has(&walk, &format!(".1.0.8802.1.1.2.1.3.8.1.5.1.4.{ip} = INTEGER: 1"));
+    has(&walk, &format!(".1.0.8802.1.1.2.1.3.8.1.6.1.4.{ip} = OID: .0.0"));
+    assert_eq!(walk.lines().count(), 4, "{walk}");
+    // lldpConfigManAddrTable: both ports send the address (LldpPortList: ports 1, 2)
+    let (ok, walk) = snmp(line, "snmpwalk", &v2c("public", &[".1.0.8802.1.1.2.1.1.7"]));
+    assert!(ok, "{walk}");
+    has(
+        &walk,
+        &format!(".1.0.8802.1.1.2.1.1.7.1.1.1.4.{ip} = Hex-STRING: C0"),
+    );
+    // lldpRemManAddrTable: the neighbour's address on port 1 (time mark 0, index 1)
+    let (ok, walk) = snmp(line, "snmpwalk", &v2c("public", &[".1.0.8802.1.1.2.1.4.2"]));
+    assert!(ok, "{walk}");
+    let c = CONTROLLER_ADDR;
+    has(
+        &walk,
+        &format!(".1.0.8802.1.1.2.1.4.2.1.3.0.1.1.1.4.{c} = INTEGER: 2"),
+    );
+    has(
+        &walk,
+        &format!(".1.0.8802.1.1.2.1.4.2.1.4.0.1.1.1.4.{c} = INTEGER: 1"),
+    );
+
+    // LLDP-EXT-PNO-MIB: NameOfStation as DCP set it on both ports, RT2/RT3 off;
+    // the neighbour's delays, port status and name as its LLDPDU carried them
+    let (ok, walk) = snmp(line, "snmpwalk", &v2c("public", &[".1.0.8802.1.1.2.1.5.3791"]));
+    assert!(ok, "{walk}");
+    let loc = ".1.0.8802.1.1.2.1.5.3791.1.2.1.1";
+    for port in [1, 2] {
+        has(&walk, &format!("{loc}.6.{port} = STRING: \"{DEVICE_NAME}\""));
+        has(&walk, &format!("{loc}.4.{port} = INTEGER: 0"));
+        has(&walk, &format!("{loc}.5.{port} = INTEGER: 0"));
+        has(&walk, &format!("{loc}.1.{port} = Gauge32: 0"));
+    }
+    let rem = ".1.0.8802.1.1.2.1.5.3791.1.3.1.1";
+    has(&walk, &format!("{rem}.1.0.1.1 = Gauge32: 55"));
+    has(&walk, &format!("{rem}.2.0.1.1 = Gauge32: 1123"));
+    has(&walk, &format!("{rem}.3.0.1.1 = Gauge32: 444"));
+    has(&walk, &format!("{rem}.4.0.1.1 = INTEGER: 2"));
+    has(&walk, &format!("{rem}.6.0.1.1 = STRING: \"{peer_station}\""));
+    // 6 columns x 2 local ports + 6 for the one neighbour
+    assert_eq!(walk.lines().count(), 18, "{walk}");
+
+    // LLDP-EXT-DOT3-MIB: auto-negotiation on, 10/100 advertised, the MAU type
+    // PDPortDataReal reports on port 1; the neighbour's MAC/PHY TLV
+    let (ok, walk) = snmp(line, "snmpwalk", &v2c("public", &[".1.0.8802.1.1.2.1.5.4623"]));
+    assert!(ok, "{walk}");
+    let loc = ".1.0.8802.1.1.2.1.5.4623.1.2.1.1";
+    has(&walk, &format!("{loc}.1.1 = INTEGER: 1"));
+    has(&walk, &format!("{loc}.2.1 = INTEGER: 1"));
+    has(&walk, &format!("{loc}.3.1 = Hex-STRING: 6C 00"));
+    has(&walk, &format!("{loc}.4.1 = INTEGER: {mau}"));
+    let rem = ".1.0.8802.1.1.2.1.5.4623.1.3.1.1";
+    has(&walk, &format!("{rem}.1.0.1.1 = INTEGER: 1"));
+    has(&walk, &format!("{rem}.2.0.1.1 = INTEGER: 2"));
+    has(&walk, &format!("{rem}.4.0.1.1 = INTEGER: 16"));
+    assert_eq!(walk.lines().count(), 4 * 2 + 4, "{walk}");
+    assert_eq!(
+        mau, "16",
+        "PDPortDataReal: 100BASE-TX FD while port 1's link is up"
+    );
+}
+
 #[test]
 fn p038_net_snmp_walks_gets_and_sets_the_agent_and_the_settings_survive_a_restart() {
     if !common::is_root() {
@@ -73,13 +157,37 @@ fn p038_net_snmp_walks_gets_and_sets_the_agent_and_the_settings_survive_a_restar
     let dcp = Command::new("ip")
         .args(["netns", "exec", &line.ctl_ns, "python3"])
         .arg(&script)
-        .args([&line.ctl_if, &line.device_mac, DEVICE_IP])
+        .args([&line.ctl_if, &line.device_mac, DEVICE_IP, DEVICE_NAME])
         .output()
         .expect("python3");
     assert!(
         dcp.status.success(),
-        "DCP Set IP: {}",
+        "DCP Set IP and name: {}",
         String::from_utf8_lossy(&dcp.stdout)
+    );
+    // the neighbour: its LLDPDU, then what PDPortDataReal of port 1 reports
+    let peer = Command::new("ip")
+        .args(["netns", "exec", &line.ctl_ns, "python3"])
+        .arg(Path::new(env!("CARGO_MANIFEST_DIR")).join("tests/snmp/pn_peer.py"))
+        .args([&line.ctl_if, DEVICE_IP, CONTROLLER_ADDR])
+        .output()
+        .expect("python3");
+    let peer_out = String::from_utf8_lossy(&peer.stdout).into_owned();
+    assert!(peer.status.success(), "pn_peer.py: {peer_out}");
+    let real = peer_out
+        .lines()
+        .find_map(|l| l.strip_prefix("pdportdatareal: "))
+        .unwrap_or_else(|| panic!("no PDPortDataReal: {peer_out}"));
+    let field = |k: &str| -> String {
+        real.split(' ')
+            .find_map(|kv| kv.strip_prefix(&format!("{k}=")))
+            .unwrap_or_else(|| panic!("{k} in {real}"))
+            .to_string()
+    };
+    let (mau, peer_station) = (field("mau"), field("peer_station"));
+    assert_eq!(
+        peer_station, "plc-1",
+        "PDPortDataReal names the neighbour: {real}"
     );
 
     // system: sysDescr … sysServices, sysUpTime as Timeticks
@@ -112,6 +220,9 @@ fn p038_net_snmp_walks_gets_and_sets_the_agent_and_the_settings_survive_a_restar
         walk.contains(".1.0.8802.1.1.2.1.3.7.1.3.2 = STRING: \"port-002\""),
         "{walk}"
     );
+    // the whole LLDP-MIB walk ends and never repeats (snmpwalk checks the order itself)
+    assert!(!walk.contains("not increasing"), "{walk}");
+    lldp_extensions(&line, &mau, &peer_station);
 
     // set the three writable strings with the write community
     let (ok, out) = snmp(

@@ -3,7 +3,9 @@
 //! `#![no_std]`, heap-free, panic-free: a request is read through the checked BER views of
 //! [`ber`], answered into a caller's buffer, and any malformed, oversized or wrong-community
 //! request is dropped (`None`) and changes nothing. The view ([`mib`]) is MIB-II `system` and
-//! `interfaces` (the interface and its two ports) and LLDP-MIB local and remote data.
+//! `interfaces` (the interface and its two ports), LLDP-MIB local and remote data with the
+//! management address tables, and the PROFINET (LLDP-EXT-PNO-MIB) and IEEE 802.3
+//! (LLDP-EXT-DOT3-MIB) extensions, local and as the neighbour's LLDPDU told them.
 //! Communities: read `public`, write `private` by default.
 //! sysContact, sysName and sysLocation are writable (OCTET STRING, at most 255 bytes); the
 //! caller persists them when [`Answer::changed`] is set. Time (sysUpTime) is an argument.
@@ -40,6 +42,50 @@ impl<const N: usize> Text<N> {
     }
 }
 
+/// PROFINET delays of a port in nanoseconds (LLDP_PNIO_DELAY; 0: not measured).
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+pub struct Delays {
+    /// Line propagation delay (CableDelayLocal): lldpXPno…LPDValue.
+    pub line: u32,
+    /// PortTxDelayLocal: lldpXPno…PortTxDValue.
+    pub tx: u32,
+    /// PortRxDelayLocal: lldpXPno…PortRxDValue.
+    pub rx: u32,
+}
+
+/// The PROFINET part of a port's LLDPDU (LLDP_PNIO_DELAY and LLDP_PNIO_PORTSTATUS).
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+pub struct Pno {
+    /// Delays.
+    pub delay: Delays,
+    /// RTClass2_PortStatus as sent (low two bits: off 0, configured 1, up/running 2).
+    pub rt2: u16,
+    /// RTClass3_PortStatus as sent (low three bits: off 0, up 2, down 3, run 4).
+    pub rt3: u16,
+}
+
+/// The IEEE 802.3 MAC/PHY configuration/status of a port.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+pub struct MacPhy {
+    /// Auto-negotiation support/status (bit 0 supported, bit 1 enabled).
+    pub autoneg: u8,
+    /// PMD auto-negotiation advertised capability, as sent (big-endian).
+    pub advertised: [u8; 2],
+    /// Operational MAU type (RFC 4836 dot3MauType; 0: unknown, link down).
+    pub mau_type: u16,
+}
+
+/// An IPv4 management address (LLDP Management Address TLV).
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub struct ManAddr {
+    /// The address.
+    pub ipv4: [u8; 4],
+    /// Interface numbering subtype (1 unknown, 2 ifIndex, 3 system port number).
+    pub if_subtype: u8,
+    /// Interface number.
+    pub if_id: u32,
+}
+
 /// A neighbour seen by LLDP on one port.
 #[derive(Clone, Copy, Debug)]
 pub struct Neighbor<'a> {
@@ -51,8 +97,24 @@ pub struct Neighbor<'a> {
     pub port_subtype: u8,
     /// Port ID.
     pub port_id: &'a [u8],
-    /// System name (empty when not sent).
+    /// System name (empty when not sent); also the neighbour's NameOfStation
+    /// (lldpXPnoRemPortNoS).
     pub sys_name: &'a [u8],
+    /// The PROFINET TLVs, if it sent any (a row of lldpXPnoRemTable).
+    pub pno: Option<Pno>,
+    /// The MAC/PHY TLV, if sent (a row of lldpXdot3RemPortTable).
+    pub mac_phy: Option<MacPhy>,
+    /// Its IPv4 management address, if sent (a row of lldpRemManAddrTable).
+    pub man_addr: Option<ManAddr>,
+}
+
+/// One local port as this device's LLDP transmitter describes it.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+pub struct LocalPort {
+    /// The PROFINET TLVs sent.
+    pub pno: Pno,
+    /// The MAC/PHY TLV (operational MAU type as PDPortDataReal reports it).
+    pub mac_phy: MacPhy,
 }
 
 /// What the device contributes per request: identity, time and what LLDP has seen.
@@ -67,9 +129,50 @@ pub struct Device<'a> {
     pub links: [bool; 2],
     /// LLDP neighbours on port 1, port 2.
     pub neighbors: [Option<Neighbor<'a>>; 2],
+    /// NameOfStation (lldpXPnoLocPortNoS; empty while unnamed).
+    pub name_of_station: &'a [u8],
+    /// The interface's management address while it has an IP (lldpLocManAddrTable).
+    pub man_addr: Option<ManAddr>,
+    /// The ports whose LLDPDUs carry it (lldpConfigManAddrPortsTxEnable, an LldpPortList:
+    /// bit 7 of the octet is port 1, bit 6 port 2).
+    pub man_addr_ports: [u8; 1],
+    /// What LLDP sends on port 1, port 2.
+    pub ports: [LocalPort; 2],
 }
 
 impl<'a> Device<'a> {
+    /// A device with nothing to tell (the view's shape for set checks).
+    pub const fn empty() -> Device<'static> {
+        Device {
+            descr: &[],
+            uptime_cs: 0,
+            macs: [[0; 6]; 3],
+            links: [false; 2],
+            neighbors: [None, None],
+            name_of_station: &[],
+            man_addr: None,
+            man_addr_ports: [0],
+            ports: [LocalPort {
+                pno: Pno {
+                    delay: Delays {
+                        line: 0,
+                        tx: 0,
+                        rx: 0,
+                    },
+                    rt2: 0,
+                    rt3: 0,
+                },
+                mac_phy: MacPhy {
+                    autoneg: 0,
+                    advertised: [0; 2],
+                    mau_type: 0,
+                },
+            }; 2],
+        }
+    }
+    fn port(&self, port: u32) -> Option<&LocalPort> {
+        port.checked_sub(1).and_then(|p| self.ports.get(p as usize))
+    }
     fn mac(&self, i: u32) -> &[u8] {
         self.macs.get(i as usize).map(|m| &m[..]).unwrap_or(&[])
     }
@@ -382,13 +485,7 @@ impl Agent {
     /// Validate a set (RFC 3416 4.2.5); the first failing binding's status and index.
     fn check_set(&self, req: &Req) -> Option<(i32, i32)> {
         let v1 = req.version == 0;
-        let dev = Device {
-            descr: &[],
-            uptime_cs: 0,
-            macs: [[0; 6]; 3],
-            links: [false; 2],
-            neighbors: [None, None],
-        };
+        let dev = Device::empty();
         for (i, (oid, t, v)) in varbinds(req.vbl).enumerate() {
             let idx = i as i32 + 1;
             let e = match mib::find(oid.arcs(), &dev) {
@@ -416,13 +513,7 @@ impl Agent {
     /// Applies a checked set; whether the kept strings differ afterwards (a set that writes an
     /// object twice, back to what it was, changed nothing).
     fn apply_set(&mut self, req: &Req) -> bool {
-        let dev = Device {
-            descr: &[],
-            uptime_cs: 0,
-            macs: [[0; 6]; 3],
-            links: [false; 2],
-            neighbors: [None, None],
-        };
+        let dev = Device::empty();
         let before = (self.sys_contact, self.sys_name, self.sys_location);
         for (oid, _, v) in varbinds(req.vbl) {
             let Some(t) = Text::new(v) else { continue };

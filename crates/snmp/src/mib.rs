@@ -1,5 +1,8 @@
-//! The MIB view: MIB-II system and interfaces, LLDP-MIB local and remote data, as an ordered
-//! list of objects whose instances are enumerated in lexicographic order.
+//! The MIB view: MIB-II system and interfaces, LLDP-MIB local and remote data with the
+//! management address tables (and lldpConfigManAddrTable, the ports that send the address), LLDP-EXT-PNO-MIB (lldpXPnoMIB, 1.0.8802.1.1.2.1.5.3791) and
+//! LLDP-EXT-DOT3-MIB (lldpXdot3MIB, 1.0.8802.1.1.2.1.5.4623) local and remote port tables, as
+//! an ordered list of objects (table columns) whose instances are enumerated in lexicographic
+//! order; a remote row exists only while the neighbour's LLDPDU carried what fills it.
 
 use crate::ber::Oid;
 use crate::{Agent, Device};
@@ -54,53 +57,127 @@ pub enum Id {
     LocPort(u32),
     /// lldpRemTable column (4 chassis subtype, 5 chassis id, 6 port subtype, 7 port id, 9 sys name)
     Rem(u32),
+    /// lldpConfigManAddrPortsTxEnable (lldpConfigManAddrTable, indexed as lldpLocManAddrTable)
+    ConfigManAddrPorts,
+    /// lldpLocManAddrTable column (3 len, 4 if subtype, 5 if id, 6 OID), index subtype.address
+    LocManAddr(u32),
+    /// lldpRemManAddrTable column (3 if subtype, 4 if id, 5 OID)
+    RemManAddr(u32),
+    /// lldpXPnoLocTable column (1 LPD, 2 port Tx delay, 3 port Rx delay, 4 RT2, 5 RT3, 6 NoS)
+    PnoLoc(u32),
+    /// lldpXPnoRemTable column (as [`Id::PnoLoc`])
+    PnoRem(u32),
+    /// lldpXdot3LocPortTable column (1 auto-neg supported, 2 enabled, 3 advertised, 4 MAU type)
+    Dot3Loc(u32),
+    /// lldpXdot3RemPortTable column (as [`Id::Dot3Loc`])
+    Dot3Rem(u32),
 }
 
-const SYS: [u32; 7] = [1, 3, 6, 1, 2, 1, 1];
-const LLDP_LOC: [u32; 8] = [1, 0, 8802, 1, 1, 2, 1, 3];
+/// MIB-II system (scalars).
+static SYS: [u32; 7] = [1, 3, 6, 1, 2, 1, 1];
+/// MIB-II interfaces (ifNumber).
+static IFACES: [u32; 7] = [1, 3, 6, 1, 2, 1, 2];
+/// ifEntry.
+static IF_ENTRY: [u32; 9] = [1, 3, 6, 1, 2, 1, 2, 2, 1];
+/// lldpConfigManAddrEntry.
+static LLDP_CONFIG_MAN: [u32; 10] = [1, 0, 8802, 1, 1, 2, 1, 1, 7, 1];
+/// lldpLocalSystemData (scalars).
+static LLDP_LOC: [u32; 8] = [1, 0, 8802, 1, 1, 2, 1, 3];
+/// lldpLocPortEntry.
+static LLDP_LOC_PORT: [u32; 10] = [1, 0, 8802, 1, 1, 2, 1, 3, 7, 1];
+/// lldpLocManAddrEntry.
+static LLDP_LOC_MAN: [u32; 10] = [1, 0, 8802, 1, 1, 2, 1, 3, 8, 1];
+/// lldpRemEntry.
+static LLDP_REM: [u32; 10] = [1, 0, 8802, 1, 1, 2, 1, 4, 1, 1];
+/// lldpRemManAddrEntry.
+static LLDP_REM_MAN: [u32; 10] = [1, 0, 8802, 1, 1, 2, 1, 4, 2, 1];
+/// lldpXPnoLocEntry (LLDP-EXT-PNO-MIB).
+static PNO_LOC: [u32; 13] = [1, 0, 8802, 1, 1, 2, 1, 5, 3791, 1, 2, 1, 1];
+/// lldpXPnoRemEntry.
+static PNO_REM: [u32; 13] = [1, 0, 8802, 1, 1, 2, 1, 5, 3791, 1, 3, 1, 1];
+/// lldpXdot3LocPortEntry (LLDP-EXT-DOT3-MIB).
+static DOT3_LOC: [u32; 13] = [1, 0, 8802, 1, 1, 2, 1, 5, 4623, 1, 2, 1, 1];
+/// lldpXdot3RemPortEntry.
+static DOT3_REM: [u32; 13] = [1, 0, 8802, 1, 1, 2, 1, 5, 4623, 1, 3, 1, 1];
 
-/// One object: its OID (without instance) and identity.
+/// One object: the OID of its group or table entry, its arc under it, and its identity.
 pub struct Obj {
-    /// OID prefix.
-    pub base: &'static [u32],
+    /// OID of the scalar group or table entry.
+    pub entry: &'static [u32],
+    /// The object's arc under `entry` (the scalar or the column).
+    pub col: u32,
     /// Identity.
     pub id: Id,
 }
 
 macro_rules! o {
-    ($id:expr, $($a:expr),*) => { Obj { base: &[$($a),*], id: $id } };
+    ($id:expr, $entry:ident, $col:expr) => {
+        Obj {
+            entry: &$entry,
+            col: $col,
+            id: $id,
+        }
+    };
 }
 
 /// Every object, in OID order (checked by a unit test).
 pub static OBJECTS: &[Obj] = &[
-    o!(Id::LocChassisIdSubtype, 1, 0, 8802, 1, 1, 2, 1, 3, 1),
-    o!(Id::LocChassisId, 1, 0, 8802, 1, 1, 2, 1, 3, 2),
-    o!(Id::LocSysName, 1, 0, 8802, 1, 1, 2, 1, 3, 3),
-    o!(Id::LocSysDesc, 1, 0, 8802, 1, 1, 2, 1, 3, 4),
-    o!(Id::LocPort(2), 1, 0, 8802, 1, 1, 2, 1, 3, 7, 1, 2),
-    o!(Id::LocPort(3), 1, 0, 8802, 1, 1, 2, 1, 3, 7, 1, 3),
-    o!(Id::LocPort(4), 1, 0, 8802, 1, 1, 2, 1, 3, 7, 1, 4),
-    o!(Id::Rem(4), 1, 0, 8802, 1, 1, 2, 1, 4, 1, 1, 4),
-    o!(Id::Rem(5), 1, 0, 8802, 1, 1, 2, 1, 4, 1, 1, 5),
-    o!(Id::Rem(6), 1, 0, 8802, 1, 1, 2, 1, 4, 1, 1, 6),
-    o!(Id::Rem(7), 1, 0, 8802, 1, 1, 2, 1, 4, 1, 1, 7),
-    o!(Id::Rem(9), 1, 0, 8802, 1, 1, 2, 1, 4, 1, 1, 9),
-    o!(Id::SysDescr, 1, 3, 6, 1, 2, 1, 1, 1),
-    o!(Id::SysObjectId, 1, 3, 6, 1, 2, 1, 1, 2),
-    o!(Id::SysUpTime, 1, 3, 6, 1, 2, 1, 1, 3),
-    o!(Id::SysContact, 1, 3, 6, 1, 2, 1, 1, 4),
-    o!(Id::SysName, 1, 3, 6, 1, 2, 1, 1, 5),
-    o!(Id::SysLocation, 1, 3, 6, 1, 2, 1, 1, 6),
-    o!(Id::SysServices, 1, 3, 6, 1, 2, 1, 1, 7),
-    o!(Id::IfNumber, 1, 3, 6, 1, 2, 1, 2, 1),
-    o!(Id::If(1), 1, 3, 6, 1, 2, 1, 2, 2, 1, 1),
-    o!(Id::If(2), 1, 3, 6, 1, 2, 1, 2, 2, 1, 2),
-    o!(Id::If(3), 1, 3, 6, 1, 2, 1, 2, 2, 1, 3),
-    o!(Id::If(4), 1, 3, 6, 1, 2, 1, 2, 2, 1, 4),
-    o!(Id::If(5), 1, 3, 6, 1, 2, 1, 2, 2, 1, 5),
-    o!(Id::If(6), 1, 3, 6, 1, 2, 1, 2, 2, 1, 6),
-    o!(Id::If(7), 1, 3, 6, 1, 2, 1, 2, 2, 1, 7),
-    o!(Id::If(8), 1, 3, 6, 1, 2, 1, 2, 2, 1, 8),
+    o!(Id::ConfigManAddrPorts, LLDP_CONFIG_MAN, 1),
+    o!(Id::LocChassisIdSubtype, LLDP_LOC, 1),
+    o!(Id::LocChassisId, LLDP_LOC, 2),
+    o!(Id::LocSysName, LLDP_LOC, 3),
+    o!(Id::LocSysDesc, LLDP_LOC, 4),
+    o!(Id::LocPort(2), LLDP_LOC_PORT, 2),
+    o!(Id::LocPort(3), LLDP_LOC_PORT, 3),
+    o!(Id::LocPort(4), LLDP_LOC_PORT, 4),
+    o!(Id::LocManAddr(3), LLDP_LOC_MAN, 3),
+    o!(Id::LocManAddr(4), LLDP_LOC_MAN, 4),
+    o!(Id::LocManAddr(5), LLDP_LOC_MAN, 5),
+    o!(Id::LocManAddr(6), LLDP_LOC_MAN, 6),
+    o!(Id::Rem(4), LLDP_REM, 4),
+    o!(Id::Rem(5), LLDP_REM, 5),
+    o!(Id::Rem(6), LLDP_REM, 6),
+    o!(Id::Rem(7), LLDP_REM, 7),
+    o!(Id::Rem(9), LLDP_REM, 9),
+    o!(Id::RemManAddr(3), LLDP_REM_MAN, 3),
+    o!(Id::RemManAddr(4), LLDP_REM_MAN, 4),
+    o!(Id::RemManAddr(5), LLDP_REM_MAN, 5),
+    o!(Id::PnoLoc(1), PNO_LOC, 1),
+    o!(Id::PnoLoc(2), PNO_LOC, 2),
+    o!(Id::PnoLoc(3), PNO_LOC, 3),
+    o!(Id::PnoLoc(4), PNO_LOC, 4),
+    o!(Id::PnoLoc(5), PNO_LOC, 5),
+    o!(Id::PnoLoc(6), PNO_LOC, 6),
+    o!(Id::PnoRem(1), PNO_REM, 1),
+    o!(Id::PnoRem(2), PNO_REM, 2),
+    o!(Id::PnoRem(3), PNO_REM, 3),
+    o!(Id::PnoRem(4), PNO_REM, 4),
+    o!(Id::PnoRem(5), PNO_REM, 5),
+    o!(Id::PnoRem(6), PNO_REM, 6),
+    o!(Id::Dot3Loc(1), DOT3_LOC, 1),
+    o!(Id::Dot3Loc(2), DOT3_LOC, 2),
+    o!(Id::Dot3Loc(3), DOT3_LOC, 3),
+    o!(Id::Dot3Loc(4), DOT3_LOC, 4),
+    o!(Id::Dot3Rem(1), DOT3_REM, 1),
+    o!(Id::Dot3Rem(2), DOT3_REM, 2),
+    o!(Id::Dot3Rem(3), DOT3_REM, 3),
+    o!(Id::Dot3Rem(4), DOT3_REM, 4),
+    o!(Id::SysDescr, SYS, 1),
+    o!(Id::SysObjectId, SYS, 2),
+    o!(Id::SysUpTime, SYS, 3),
+    o!(Id::SysContact, SYS, 4),
+    o!(Id::SysName, SYS, 5),
+    o!(Id::SysLocation, SYS, 6),
+    o!(Id::SysServices, SYS, 7),
+    o!(Id::IfNumber, IFACES, 1),
+    o!(Id::If(1), IF_ENTRY, 1),
+    o!(Id::If(2), IF_ENTRY, 2),
+    o!(Id::If(3), IF_ENTRY, 3),
+    o!(Id::If(4), IF_ENTRY, 4),
+    o!(Id::If(5), IF_ENTRY, 5),
+    o!(Id::If(6), IF_ENTRY, 6),
+    o!(Id::If(7), IF_ENTRY, 7),
+    o!(Id::If(8), IF_ENTRY, 8),
 ];
 
 /// Number of interfaces: the PROFINET interface (ifIndex 1) and its ports (2, 3).
@@ -117,24 +194,114 @@ impl Id {
     fn rows(self) -> u32 {
         match self {
             Id::If(_) => IFS,
-            Id::LocPort(_) | Id::Rem(_) => PORTS,
+            Id::LocPort(_)
+            | Id::Rem(_)
+            | Id::RemManAddr(_)
+            | Id::PnoLoc(_)
+            | Id::PnoRem(_)
+            | Id::Dot3Loc(_)
+            | Id::Dot3Rem(_) => PORTS,
             _ => 1,
         }
     }
     /// Instance suffix of row `r` (0-based), or `None` when that row does not exist.
-    fn instance(self, r: u32, dev: &Device) -> Option<([u32; 3], usize)> {
-        match self {
-            Id::If(_) => Some(([r + 1, 0, 0], 1)),
-            Id::LocPort(_) => Some(([r + 1, 0, 0], 1)),
+    fn instance(self, r: u32, dev: &Device) -> Option<([u32; INST], usize)> {
+        let port = r + 1;
+        let mut i = [0; INST];
+        let n = match self {
+            Id::If(_) | Id::LocPort(_) | Id::PnoLoc(_) | Id::Dot3Loc(_) => {
+                i[0] = port;
+                1
+            }
+            // lldpLocManAddrSubtype ipV4 (1), then the address as a length-prefixed string
+            Id::LocManAddr(_) | Id::ConfigManAddrPorts => {
+                let m = dev.man_addr?;
+                addr_index(&mut i, 0, &m);
+                6
+            }
             // lldpRemTimeMark 0, lldpRemLocalPortNum, lldpRemIndex 1
-            Id::Rem(_) => dev.neighbor(r + 1).map(|_| ([0, r + 1, 1], 3)),
-            _ => Some(([0, 0, 0], 1)),
+            Id::Rem(_) | Id::PnoRem(_) | Id::Dot3Rem(_) | Id::RemManAddr(_) => {
+                let n = dev.neighbor(port)?;
+                let has = match self {
+                    Id::PnoRem(_) => n.pno.is_some(),
+                    Id::Dot3Rem(_) => n.mac_phy.is_some(),
+                    _ => true,
+                };
+                if !has {
+                    return None;
+                }
+                i[1] = port;
+                i[2] = 1;
+                if let Id::RemManAddr(_) = self {
+                    addr_index(&mut i, 3, &n.man_addr?);
+                    9
+                } else {
+                    3
+                }
+            }
+            _ => 1,
+        };
+        Some((i, n))
+    }
+}
+
+/// Longest instance suffix (lldpRemManAddrTable: time mark, port, index, subtype, length, 4 octets).
+const INST: usize = 9;
+
+/// `1.4.a.b.c.d` (ipV4, length 4, the address) at `at`.
+fn addr_index(i: &mut [u32; INST], at: usize, m: &crate::ManAddr) {
+    let [a, b, c, d] = m.ipv4;
+    for (k, v) in [1, 4, a.into(), b.into(), c.into(), d.into()]
+        .into_iter()
+        .enumerate()
+    {
+        if let Some(x) = i.get_mut(at + k) {
+            *x = v;
         }
     }
 }
 
-fn full(o: &Obj, inst: &[u32]) -> Option<Oid> {
-    let mut x = Oid::from_arcs(o.base)?;
+/// zeroDotZero: the Management Address TLV this device sends and keeps carries no OID.
+const ZERO_DOT_ZERO: [u32; 2] = [0, 0];
+
+/// TruthValue: true (1), false (2).
+fn truth(b: bool) -> Val<'static> {
+    Val::Int(if b { 1 } else { 2 })
+}
+
+fn pno_val<'a>(c: u32, p: &crate::Pno, nos: &'a [u8]) -> Val<'a> {
+    match c {
+        1 => Val::Gauge(p.delay.line),
+        2 => Val::Gauge(p.delay.tx),
+        3 => Val::Gauge(p.delay.rx),
+        4 => Val::Int(i32::from(p.rt2 & 0x3)),
+        5 => Val::Int(i32::from(p.rt3 & 0x7)),
+        _ => Val::Str(nos),
+    }
+}
+
+fn dot3_val(c: u32, m: &crate::MacPhy) -> Val<'_> {
+    match c {
+        1 => truth(m.autoneg & 1 != 0),
+        2 => truth(m.autoneg & 2 != 0),
+        3 => Val::Str(&m.advertised),
+        _ => Val::Int(i32::from(m.mau_type)),
+    }
+}
+
+fn man_addr_val(c: u32, m: Option<&crate::ManAddr>) -> Val<'static> {
+    match (c, m) {
+        (_, None) => Val::Int(0),
+        (1, Some(m)) => Val::Int(i32::from(m.if_subtype)),
+        (2, Some(m)) => Val::Int(i32::try_from(m.if_id).unwrap_or(i32::MAX)),
+        _ => Val::Oid(&ZERO_DOT_ZERO),
+    }
+}
+
+/// The OID of object `o` with instance suffix `inst`.
+pub fn full(o: &Obj, inst: &[u32]) -> Option<Oid> {
+    let mut x = Oid::from_arcs(o.entry)?;
+    x.push(o.col)?;
     for &a in inst {
         x.push(a)?;
     }
@@ -144,7 +311,11 @@ fn full(o: &Obj, inst: &[u32]) -> Option<Oid> {
 /// Exact lookup: (object, row) for an OID.
 pub fn find(oid: &[u32], dev: &Device) -> Lookup {
     for o in OBJECTS {
-        if let Some(rest) = oid.strip_prefix(o.base) {
+        let rest = oid
+            .strip_prefix(o.entry)
+            .and_then(|r| r.split_first())
+            .and_then(|(&c, rest)| (c == o.col).then_some(rest));
+        if let Some(rest) = rest {
             for r in 0..o.id.rows() {
                 if let Some((i, n)) = o.id.instance(r, dev) {
                     if i.get(..n) == Some(rest) {
@@ -239,10 +410,34 @@ pub fn value<'a>(id: Id, r: u32, agent: &'a Agent, dev: &'a Device<'a>) -> Val<'
                 _ => Val::Str(n.sys_name),
             },
         },
+        Id::ConfigManAddrPorts => Val::Str(&dev.man_addr_ports),
+        // lldpLocManAddrLen: subtype and address octets (5)
+        Id::LocManAddr(3) => Val::Int(5),
+        Id::LocManAddr(c) => man_addr_val(c.saturating_sub(3), dev.man_addr.as_ref()),
+        Id::RemManAddr(c) => man_addr_val(
+            c.saturating_sub(2),
+            dev.neighbor(port).and_then(|n| n.man_addr.as_ref()),
+        ),
+        Id::PnoLoc(c) => match dev.port(port) {
+            Some(p) => pno_val(c, &p.pno, dev.name_of_station),
+            None => Val::Int(0),
+        },
+        Id::PnoRem(c) => match dev.neighbor(port) {
+            Some(n) => pno_val(c, &n.pno.unwrap_or_default(), n.sys_name),
+            None => Val::Int(0),
+        },
+        Id::Dot3Loc(c) => match dev.port(port) {
+            Some(p) => dot3_val(c, &p.mac_phy),
+            None => Val::Int(0),
+        },
+        Id::Dot3Rem(c) => match dev.neighbor(port).and_then(|n| n.mac_phy.as_ref()) {
+            Some(m) => dot3_val(c, m),
+            None => Val::Int(0),
+        },
     }
 }
 
-/// sysContact's OID prefix etc. (for tests and callers).
-pub const SYS_PREFIX: &[u32] = &SYS;
-/// lldpLocalSystemData prefix.
-pub const LLDP_LOC_PREFIX: &[u32] = &LLDP_LOC;
+/// MIB-II system's OID (for tests and callers).
+pub const SYS_PREFIX: &[u32] = &[1, 3, 6, 1, 2, 1, 1];
+/// lldpLocalSystemData's OID.
+pub const LLDP_LOC_PREFIX: &[u32] = &[1, 0, 8802, 1, 1, 2, 1, 3];

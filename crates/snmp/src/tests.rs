@@ -3,6 +3,28 @@
 
 use super::*;
 
+mod lldp;
+
+/// The local ports as the LLDP transmitter describes them: port 1 up (100BASE-TX FD), port 2
+/// down (MAU type 0), auto-negotiation supported and on, 10/100 half/full advertised.
+fn local_ports() -> [LocalPort; 2] {
+    let port = |tx, mau_type| LocalPort {
+        pno: Pno {
+            delay: Delays { line: 0, tx, rx: 7 },
+            rt2: 0,
+            rt3: 0,
+        },
+        mac_phy: MacPhy {
+            autoneg: 3,
+            advertised: [0x6c, 0x00],
+            mau_type,
+        },
+    };
+    [port(11, 16), port(12, 0)]
+}
+
+/// A device named `drive-1` at 192.168.0.50 whose port 1 has a neighbour that sent the
+/// PROFINET, MAC/PHY and management address TLVs; port 2 has none.
 fn dev() -> Device<'static> {
     Device {
         descr: b"drive",
@@ -16,9 +38,36 @@ fn dev() -> Device<'static> {
                 port_subtype: 7,
                 port_id: b"port-003",
                 sys_name: b"plc",
+                pno: Some(Pno {
+                    delay: Delays {
+                        line: 55,
+                        tx: 1123,
+                        rx: 444,
+                    },
+                    rt2: 2,
+                    rt3: 0,
+                }),
+                mac_phy: Some(MacPhy {
+                    autoneg: 1,
+                    advertised: [0x04, 0x00],
+                    mau_type: 30,
+                }),
+                man_addr: Some(ManAddr {
+                    ipv4: [10, 0, 0, 1],
+                    if_subtype: 3,
+                    if_id: 9,
+                }),
             }),
             None,
         ],
+        name_of_station: b"drive-1",
+        man_addr: Some(ManAddr {
+            ipv4: [192, 168, 0, 50],
+            if_subtype: 2,
+            if_id: 1,
+        }),
+        man_addr_ports: [0xc0],
+        ports: local_ports(),
     }
 }
 
@@ -102,7 +151,10 @@ const SYSNAME: &[u32] = &[1, 3, 6, 1, 2, 1, 1, 5, 0];
 #[test]
 fn p038_objects_are_in_oid_order() {
     for w in mib::OBJECTS.windows(2) {
-        assert!(w[0].base < w[1].base, "{:?} !< {:?}", w[0].base, w[1].base);
+        let (a, b) = (mib::full(&w[0], &[]).unwrap(), mib::full(&w[1], &[]).unwrap());
+        assert!(a.arcs() < b.arcs(), "{:?} !< {:?}", a.arcs(), b.arcs());
+        // no object's OID is a prefix of another's (instances could collide)
+        assert!(!b.arcs().starts_with(a.arcs()));
     }
 }
 
@@ -169,9 +221,11 @@ fn p038_walk_is_strictly_increasing_and_ends_with_end_of_mib_view() {
         cur = r.vbs[0].0;
         count += 1;
     }
-    // 4 local LLDP scalars, 3x2 local port cells, 5 remote cells (one neighbour),
-    // 7 system, ifNumber, 8x3 ifTable cells
-    assert_eq!(count, 4 + 6 + 5 + 7 + 1 + 24);
+    // lldpConfigManAddrPortsTxEnable, 4 local LLDP scalars, 3x2 local port cells, 4 local
+    // management address cells,
+    // 5 remote cells (one neighbour), 3 remote management address cells, 6x2 local and 6
+    // remote PROFINET cells, 4x2 local and 4 remote 802.3 cells, 7 system, ifNumber, 8x3 ifTable
+    assert_eq!(count, 1 + 4 + 6 + 4 + 5 + 3 + 12 + 6 + 8 + 4 + 7 + 1 + 24);
     let (q, n) = req(0, b"public", GET_NEXT, 9, 0, 0, &[(cur.arcs(), 5, &[])]);
     let (r, _) = run(&mut a, &q[..n]).unwrap();
     assert_eq!((r.status, r.index), (err::NO_SUCH_NAME, 1));

@@ -27,7 +27,7 @@ use crate::dcp::server::{DcpServer, Event as DcpEvent, Identity};
 use crate::dcp::{IpSuite, NameOfStation};
 use crate::ip::{IpConfig, Received, Stack, UdpTx, RPC_PORT, UDP_PAYLOAD_OFFSET};
 use crate::led::LedInputs;
-use crate::lldp::{self, PortInfo, Schedule};
+use crate::lldp::{self, Schedule};
 use crate::model;
 use crate::pdev::{Mismatch, Pdev, Peer};
 use crate::rpc::epm::{self, EpmInfo};
@@ -461,13 +461,8 @@ impl<H: RecordHook> Device<H> {
                 ip: Some(self.dcp.ip_suite().ip).filter(|ip| !ip.is_unspecified()),
                 port_id_form: crate::pdev::interface::port_id_form(self.cm.pdev().interface_mode),
             };
-            let mac = self
-                .port_macs
-                .get(usize::from(port).wrapping_sub(1))
-                .copied()
-                .unwrap_or(self.dcp.mac());
             let mut out = [0u8; 512];
-            if let Some(n) = lldp::build_frame(&station, port, &PortInfo::fast_ethernet(mac), &mut out) {
+            if let Some(n) = lldp::build_frame(&station, port, &self.lldp_port_info(port), &mut out) {
                 tx(out.get(..n).unwrap_or(&[]));
                 self.cm.pdev_mut().count_lldp(port, n);
             }

@@ -1,15 +1,78 @@
 //! The SNMP agent (P-038) on the device's UDP port 161: what the agent
-//! reads of the device (its MACs, the ports' links, the LLDP neighbours the
-//! PDev holds) gathered per request, and the kept state in and out.
+//! reads of the device (its MACs, the ports' links, name and IP, what LLDP
+//! sends on each port and the LLDP neighbours the PDev holds) gathered per
+//! request, and the kept state in and out.
 
 use nanos::Nanos;
 
 use super::{Device, DeviceEvent, MAX_FRAME, SNMP_PORT};
 use crate::cm::RecordHook;
 use crate::ip::{UdpTx, UDP_PAYLOAD_OFFSET};
+use crate::lldp::{self, PortInfo};
 use crate::model;
+use crate::pdev::Peer;
+
+fn pno(delay: lldp::PnioDelay, (rt2, rt3): (u16, u16)) -> snmp::Pno {
+    snmp::Pno {
+        delay: snmp::Delays {
+            line: delay.cable_local,
+            tx: delay.tx_local,
+            rx: delay.rx_local,
+        },
+        rt2,
+        rt3,
+    }
+}
+
+fn mac_phy(m: lldp::MacPhy) -> snmp::MacPhy {
+    snmp::MacPhy {
+        autoneg: m.autoneg,
+        advertised: m.advertised.to_be_bytes(),
+        mau_type: m.mau_type,
+    }
+}
+
+fn man_addr(m: lldp::ManAddr) -> snmp::ManAddr {
+    snmp::ManAddr {
+        ipv4: m.ip.octets(),
+        if_subtype: m.if_subtype,
+        if_id: m.if_id,
+    }
+}
+
+/// The neighbour as the agent shows it: the IDs as PDPortDataReal has them
+/// and the optional TLVs as its last LLDPDU carried them.
+fn neighbor(peer: &Peer) -> snmp::Neighbor<'_> {
+    snmp::Neighbor {
+        // locallyAssigned (7): the station name and the port name as LLDP sent them
+        chassis_subtype: 7,
+        chassis_id: &peer.station,
+        port_subtype: 7,
+        port_id: &peer.port,
+        sys_name: &peer.station,
+        pno: (peer.delay.is_some() || peer.port_status.is_some()).then(|| {
+            pno(
+                peer.delay.unwrap_or_default(),
+                peer.port_status.unwrap_or_default(),
+            )
+        }),
+        mac_phy: peer.mac_phy.map(mac_phy),
+        man_addr: peer.man_addr.map(man_addr),
+    }
+}
 
 impl<H: RecordHook> Device<H> {
+    /// What LLDP sends on `port` (1-based): the port's MAC, MAC/PHY and
+    /// PROFINET delays and status. The SNMP agent's local tables read the same.
+    pub(super) fn lldp_port_info(&self, port: u16) -> PortInfo {
+        let mac = self
+            .port_macs
+            .get(usize::from(port).wrapping_sub(1))
+            .copied()
+            .unwrap_or(self.dcp.mac());
+        PortInfo::fast_ethernet(mac)
+    }
+
     /// One SNMP request: answered from port 161 or dropped (P-038).
     pub(super) fn snmp_request(
         &mut self,
@@ -22,19 +85,22 @@ impl<H: RecordHook> Device<H> {
         let mac = self.dcp.mac();
         let mut neighbors = [None, None];
         let pdev = self.cm.pdev();
-        for (p, slot) in neighbors.iter_mut().enumerate() {
-            *slot = pdev
-                .port(p as u16 + 1)
-                .and_then(|port| port.peer.as_ref())
-                .map(|peer| snmp::Neighbor {
-                    // locallyAssigned (7): the station name and the port name as LLDP sent them
-                    chassis_subtype: 7,
-                    chassis_id: &peer.station,
-                    port_subtype: 7,
-                    port_id: &peer.port,
-                    sys_name: &peer.station,
-                });
+        let mut ports = [snmp::LocalPort::default(); 2];
+        for (p, (slot, local)) in neighbors.iter_mut().zip(ports.iter_mut()).enumerate() {
+            let state = pdev.port(p as u16 + 1);
+            *slot = state.and_then(|port| port.peer.as_ref()).map(neighbor);
+            let info = self.lldp_port_info(p as u16 + 1);
+            *local = snmp::LocalPort {
+                pno: pno(info.delay, info.rt_status),
+                mac_phy: mac_phy(lldp::MacPhy {
+                    autoneg: info.autoneg,
+                    advertised: info.advertised,
+                    // as PDPortDataReal reports it (no LLDPDU while the link is down)
+                    mau_type: state.map_or(0, |s| s.oper_mau_type()),
+                }),
+            };
         }
+        let ip = self.dcp.ip_suite().ip;
         let dev = snmp::Device {
             descr: model::STATION_TYPE.as_bytes(),
             uptime_cs: u32::try_from(now.as_ms() / 10).unwrap_or(u32::MAX),
@@ -48,6 +114,18 @@ impl<H: RecordHook> Device<H> {
                 pdev.port(2).is_some_and(|p| p.link_up),
             ],
             neighbors,
+            name_of_station: self.dcp.name_of_station().as_bytes(),
+            // as LLDP's Management Address TLV: ifIndex numbering, interface 1
+            man_addr: (!ip.is_unspecified()).then(|| snmp::ManAddr {
+                ipv4: ip.octets(),
+                if_subtype: lldp::MAN_ADDR_IF_SUBTYPE,
+                if_id: lldp::MAN_ADDR_IF_ID,
+            }),
+            // the Management Address TLV goes out on every port that sends LLDP
+            man_addr_ports: [(1..=model::PORTS)
+                .filter(|&p| pdev.lldp_allowed(p))
+                .fold(0u8, |bits, p| bits | (0x80 >> (p - 1)))],
+            ports,
         };
         let Some(payload) = out.get_mut(UDP_PAYLOAD_OFFSET..) else {
             return;

@@ -1,6 +1,8 @@
 //! LLDP transmit with the TLVs a PROFINET device sends on each port (P-037),
-//! and the little of a received LLDPDU that DCP needs (the neighbour's chassis
-//! and port ID, which make the alias name).
+//! and what a received LLDPDU says: the neighbour's chassis and port ID (DCP's
+//! alias name, PDPortDataReal's peer) and, when sent, its PROFINET delay and
+//! port status TLVs, its 802.3 MAC/PHY TLV and its IPv4 management address
+//! (the SNMP agent's remote tables, P-038).
 //!
 //! Every [`TX_INTERVAL`] (5 s) each port sends, from its own MAC to
 //! 01:80:c2:00:00:0e ([`build_frame`]):
@@ -43,6 +45,10 @@ pub const MAU_100BASE_TX_FD: u16 = 16;
 /// Advertised capabilities 10BASE-T and 100BASE-TX, half and full duplex
 /// (ifMauAutoNegCapAdvertisedBits, bit 0 = most significant).
 pub const ADVERTISE_10_100: u16 = 0x6C00;
+/// The interface numbering of the Management Address TLV sent: ifIndex (2)…
+pub const MAN_ADDR_IF_SUBTYPE: u8 = 2;
+/// …and the interface, the PROFINET interface (ifIndex 1 of the SNMP agent).
+pub const MAN_ADDR_IF_ID: u32 = 1;
 /// Longest Port ID this device sends ("port-001." and a name of station).
 pub const MAX_PORT_ID_LEN: usize = 9 + crate::dcp::name::MAX_LEN;
 
@@ -80,6 +86,28 @@ pub struct PnioDelay {
     pub cable_local: u32,
 }
 
+/// The IEEE 802.3 MAC/PHY configuration/status TLV.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+pub struct MacPhy {
+    /// Auto-negotiation support/status bits (bit 0 supported, bit 1 enabled).
+    pub autoneg: u8,
+    /// Advertised capabilities (ifMauAutoNegCapAdvertisedBits).
+    pub advertised: u16,
+    /// Operational MAU type.
+    pub mau_type: u16,
+}
+
+/// An IPv4 Management Address TLV.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub struct ManAddr {
+    /// The address.
+    pub ip: Ipv4Addr,
+    /// Interface numbering subtype (1 unknown, 2 ifIndex, 3 system port number).
+    pub if_subtype: u8,
+    /// Interface number.
+    pub if_id: u32,
+}
+
 /// What one port reports.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub struct PortInfo {
@@ -93,6 +121,8 @@ pub struct PortInfo {
     pub mau_type: u16,
     /// PROFINET delays.
     pub delay: PnioDelay,
+    /// RTClass2 and RTClass3 port status (LLDP_PNIO_PORTSTATUS).
+    pub rt_status: (u16, u16),
 }
 
 impl PortInfo {
@@ -110,6 +140,8 @@ impl PortInfo {
                 tx_remote: 0,
                 cable_local: 0,
             },
+            // RT_CLASS_1 only: no RTClass2/3 (off)
+            rt_status: (0, 0),
         }
     }
 }
@@ -200,8 +232,11 @@ pub fn build_frame(station: &Station<'_>, port: u16, info: &PortInfo, out: &mut 
         chunk.copy_from_slice(&v.to_be_bytes());
     }
     w.tlv(tlv_type::ORG, &[&OUI_PROFINET, &[1], &delay])?;
-    // RTClass2 and RTClass3 port status: off (RT_CLASS_1 only).
-    w.tlv(tlv_type::ORG, &[&OUI_PROFINET, &[2], &[0, 0, 0, 0]])?;
+    let (rt2, rt3) = info.rt_status;
+    w.tlv(
+        tlv_type::ORG,
+        &[&OUI_PROFINET, &[2], &rt2.to_be_bytes(), &rt3.to_be_bytes()],
+    )?;
     w.tlv(tlv_type::ORG, &[&OUI_PROFINET, &[5], &station.interface_mac.0])?;
     w.tlv(
         tlv_type::ORG,
@@ -217,7 +252,13 @@ pub fn build_frame(station: &Station<'_>, port: u16, info: &PortInfo, out: &mut 
         // numbering (2), interface 1, no OID.
         w.tlv(
             tlv_type::MANAGEMENT_ADDRESS,
-            &[&[5, 1], &ip.octets(), &[2, 0, 0, 0, 1, 0]],
+            &[
+                &[5, 1],
+                &ip.octets(),
+                &[MAN_ADDR_IF_SUBTYPE],
+                &MAN_ADDR_IF_ID.to_be_bytes(),
+                &[0],
+            ],
         )?;
     }
     w.tlv(tlv_type::END, &[])?;
@@ -287,6 +328,41 @@ pub struct Neighbor<'a> {
     pub port_id: &'a [u8],
     /// TTL in seconds.
     pub ttl: u16,
+    /// LLDP_PNIO_DELAY, if sent.
+    pub delay: Option<PnioDelay>,
+    /// LLDP_PNIO_PORTSTATUS (RTClass2, RTClass3), if sent.
+    pub port_status: Option<(u16, u16)>,
+    /// The 802.3 MAC/PHY TLV, if sent.
+    pub mac_phy: Option<MacPhy>,
+    /// The first IPv4 management address, if one was sent.
+    pub man_addr: Option<ManAddr>,
+}
+
+fn be16(v: &[u8], at: usize) -> Option<u16> {
+    Some(u16::from_be_bytes(v.get(at..at + 2)?.try_into().ok()?))
+}
+
+fn be32(v: &[u8], at: usize) -> Option<u32> {
+    Some(u32::from_be_bytes(v.get(at..at + 4)?.try_into().ok()?))
+}
+
+/// An IPv4 Management Address TLV's value (string length 5, subtype 1, the
+/// address, interface subtype and number, OID); `None` for any other address.
+fn parse_man_addr(v: &[u8]) -> Option<ManAddr> {
+    let (&[5, 1], rest) = v.split_first_chunk::<2>()? else {
+        return None;
+    };
+    let (ip, rest) = rest.split_first_chunk::<4>()?;
+    let (&if_subtype, rest) = rest.split_first()?;
+    let if_id = be32(rest, 0)?;
+    // the OID string must fit what is left
+    let oid_len = usize::from(*rest.get(4)?);
+    rest.get(5..5 + oid_len)?;
+    Some(ManAddr {
+        ip: Ipv4Addr::from(*ip),
+        if_subtype,
+        if_id,
+    })
 }
 
 impl<'a> Neighbor<'a> {
@@ -315,13 +391,49 @@ impl<'a> Neighbor<'a> {
         if chassis_id.is_empty() || port_id.is_empty() || ttl.len() != 2 {
             return None;
         }
-        Some(Neighbor {
+        let mut n = Neighbor {
             chassis_subtype,
             chassis_id,
             port_subtype,
             port_id,
             ttl: u16::from_be_bytes([*ttl.first()?, *ttl.get(1)?]),
-        })
+            delay: None,
+            port_status: None,
+            mac_phy: None,
+            man_addr: None,
+        };
+        // the optional TLVs up to End or the first that does not fit the frame;
+        // one with a wrong length is skipped
+        while let Some((t, v)) = next() {
+            match t {
+                tlv_type::END => break,
+                tlv_type::MANAGEMENT_ADDRESS if n.man_addr.is_none() => n.man_addr = parse_man_addr(v),
+                tlv_type::ORG => match (v.get(..3), v.get(3), v.get(4..).unwrap_or(&[])) {
+                    (Some(oui), Some(1), d) if oui == OUI_PROFINET && d.len() == 20 => {
+                        n.delay = Some(PnioDelay {
+                            rx_local: be32(d, 0)?,
+                            rx_remote: be32(d, 4)?,
+                            tx_local: be32(d, 8)?,
+                            tx_remote: be32(d, 12)?,
+                            cable_local: be32(d, 16)?,
+                        });
+                    }
+                    (Some(oui), Some(2), d) if oui == OUI_PROFINET && d.len() >= 4 => {
+                        n.port_status = Some((be16(d, 0)?, be16(d, 2)?));
+                    }
+                    (Some(oui), Some(1), d) if oui == OUI_IEEE_802_3 && d.len() == 5 => {
+                        n.mac_phy = Some(MacPhy {
+                            autoneg: *d.first()?,
+                            advertised: be16(d, 1)?,
+                            mau_type: be16(d, 3)?,
+                        });
+                    }
+                    _ => {}
+                },
+                _ => {}
+            }
+        }
+        Some(n)
     }
 
     /// The alias name DCP answers to for this neighbour: `<port ID>.<chassis

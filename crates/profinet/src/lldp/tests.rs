@@ -164,6 +164,130 @@ fn neighbor_gives_the_alias_name() {
     assert!(Neighbor::parse(&EthFrame::parse(&other).unwrap()).is_none());
 }
 
+/// An LLDPDU as a neighbour (a controller port) would send it, written byte by
+/// byte: chassis "plc-1", port "port-002", TTL 20, then `extra` TLVs, End.
+fn peer_frame(extra: &[u8]) -> Vec<u8> {
+    let mut f = std::vec![0x01, 0x80, 0xC2, 0, 0, 0x0E, 2, 0, 0, 0, 0, 0xC0, 0x88, 0xCC];
+    f.extend_from_slice(&[0x02, 0x06, 7, b'p', b'l', b'c', b'-', b'1']);
+    f.extend_from_slice(&[0x04, 0x09, 7]);
+    f.extend_from_slice(b"port-002");
+    f.extend_from_slice(&[0x06, 0x02, 0, 20]);
+    f.extend_from_slice(extra);
+    f.extend_from_slice(&[0, 0]);
+    f
+}
+
+const PEER_DELAY: [u8; 26] = [
+    0xFE, 24, 0x00, 0x0E, 0xCF, 1, // PNIO delay
+    0, 0, 0x01, 0xBC, // PortRxDelayLocal 444
+    0, 0, 0, 0, // PortRxDelayRemote
+    0, 0, 0x04, 0x63, // PortTxDelayLocal 1123
+    0, 0, 0, 0, // PortTxDelayRemote
+    0, 0, 0, 55, // CableDelayLocal
+];
+const PEER_STATUS: [u8; 10] = [0xFE, 8, 0x00, 0x0E, 0xCF, 2, 0, 2, 0, 4];
+const PEER_MAC_PHY: [u8; 11] = [0xFE, 9, 0x00, 0x12, 0x0F, 1, 0x01, 0x04, 0x00, 0, 30];
+const PEER_MAN_ADDR: [u8; 14] = [0x10, 12, 5, 1, 10, 0, 0, 1, 3, 0, 0, 0, 9, 0];
+
+#[test]
+fn p038_received_lldpdu_gives_the_neighbours_pnio_mac_phy_and_management_address() {
+    let f = peer_frame(&[&PEER_DELAY[..], &PEER_STATUS, &PEER_MAC_PHY, &PEER_MAN_ADDR].concat());
+    let n = Neighbor::parse(&EthFrame::parse(&f).unwrap()).unwrap();
+    assert_eq!(
+        (n.chassis_id, n.port_id, n.ttl),
+        (&b"plc-1"[..], &b"port-002"[..], 20)
+    );
+    assert_eq!(
+        n.delay,
+        Some(PnioDelay {
+            rx_local: 444,
+            rx_remote: 0,
+            tx_local: 1123,
+            tx_remote: 0,
+            cable_local: 55
+        })
+    );
+    assert_eq!(n.port_status, Some((2, 4)));
+    assert_eq!(
+        n.mac_phy,
+        Some(MacPhy {
+            autoneg: 1,
+            advertised: 0x0400,
+            mau_type: 30
+        })
+    );
+    assert_eq!(
+        n.man_addr,
+        Some(ManAddr {
+            ip: Ipv4Addr::new(10, 0, 0, 1),
+            if_subtype: 3,
+            if_id: 9
+        })
+    );
+    // a plain switch: the mandatory TLVs only
+    let f = peer_frame(&[]);
+    let n = Neighbor::parse(&EthFrame::parse(&f).unwrap()).unwrap();
+    assert_eq!(
+        (n.delay, n.port_status, n.mac_phy, n.man_addr),
+        (None, None, None, None)
+    );
+}
+
+#[test]
+fn p038_our_own_lldpdu_parses_back_to_what_was_sent() {
+    let f = build(
+        "drive-1",
+        1,
+        P1_MAC,
+        Some(Ipv4Addr::new(192, 168, 0, 86)),
+        PortIdForm::Short,
+    );
+    let n = Neighbor::parse(&EthFrame::parse(&f).unwrap()).unwrap();
+    let info = PortInfo::fast_ethernet(P1_MAC);
+    assert_eq!(n.delay, Some(info.delay));
+    assert_eq!(n.port_status, Some(info.rt_status));
+    assert_eq!(
+        n.mac_phy,
+        Some(MacPhy {
+            autoneg: info.autoneg,
+            advertised: info.advertised,
+            mau_type: info.mau_type
+        })
+    );
+    assert_eq!(
+        n.man_addr,
+        Some(ManAddr {
+            ip: Ipv4Addr::new(192, 168, 0, 86),
+            if_subtype: MAN_ADDR_IF_SUBTYPE,
+            if_id: MAN_ADDR_IF_ID
+        })
+    );
+}
+
+#[test]
+fn p038_odd_optional_tlvs_are_skipped_and_the_neighbour_kept() {
+    // wrong lengths, an IPv6 management address, a truncated last TLV: nothing taken,
+    // the mandatory part still parsed, never a panic
+    let odd = [
+        &[0xFE, 5, 0x00, 0x0E, 0xCF, 1, 0][..],
+        &[0xFE, 6, 0x00, 0x12, 0x0F, 1, 0, 0],
+        &[0x10, 24, 17, 2],
+        &[0; 16],
+        &[0, 0, 0, 1, 0, 0],
+        &[0x10, 12, 5, 1, 10, 0, 0, 1, 3, 0, 0, 0, 9, 1], // OID length past the TLV
+    ]
+    .concat();
+    let f = peer_frame(&odd);
+    let n = Neighbor::parse(&EthFrame::parse(&f).unwrap()).unwrap();
+    assert_eq!((n.delay, n.mac_phy, n.man_addr), (None, None, None));
+    let full = peer_frame(&[&PEER_DELAY[..], &PEER_STATUS, &PEER_MAC_PHY, &PEER_MAN_ADDR].concat());
+    let end = full.len() - 2;
+    for cut in 37..end {
+        let n = Neighbor::parse(&EthFrame::parse(&full[..cut]).unwrap()).unwrap();
+        assert_eq!(n.chassis_id, b"plc-1", "cut {cut}");
+    }
+}
+
 /// Prints both ports' frames as hex for a tshark check (`cargo test -p
 /// profinet lldp_dump -- --ignored --nocapture`).
 #[test]

@@ -111,6 +111,14 @@ pub struct Peer {
     pub mac: MacAddr,
     /// When its TTL runs out.
     pub expires: Nanos,
+    /// Its PROFINET delays, if it sent them.
+    pub delay: Option<lldp::PnioDelay>,
+    /// Its RTClass2/RTClass3 port status, if sent.
+    pub port_status: Option<(u16, u16)>,
+    /// Its 802.3 MAC/PHY TLV, if sent.
+    pub mac_phy: Option<lldp::MacPhy>,
+    /// Its IPv4 management address, if sent.
+    pub man_addr: Option<lldp::ManAddr>,
 }
 
 impl Peer {
@@ -140,6 +148,10 @@ impl Peer {
             station,
             mac: src,
             expires: now.saturating_add(Nanos::from_secs(u64::from(n.ttl))),
+            delay: n.delay,
+            port_status: n.port_status,
+            mac_phy: n.mac_phy,
+            man_addr: n.man_addr,
         })
     }
 }
@@ -158,6 +170,18 @@ pub struct PortAdjust {
     pub peer_to_peer_boundary: Option<(u32, u16)>,
     /// AdjustDCPBoundary and AdjustProperties.
     pub dcp_boundary: Option<(u32, u16)>,
+}
+
+impl PortState {
+    /// The operational MAU type PDPortDataReal and the SNMP agent report:
+    /// 100BASE-TX FD while the link is up, 0 (unknown) while it is down.
+    pub fn oper_mau_type(&self) -> u16 {
+        if self.link_up {
+            MAU_100BASE_TX_FD
+        } else {
+            0
+        }
+    }
 }
 
 impl PortAdjust {
@@ -432,7 +456,7 @@ fn emit_port_real(w: &mut Writer<'_>, subslot: u16, i: usize, p: &PortState) -> 
             w.bytes(&peer.mac.0)?;
             w.zeros(2)?;
         }
-        w.u16(if p.link_up { MAU_100BASE_TX_FD } else { 0 })?;
+        w.u16(p.oper_mau_type())?;
         w.zeros(2)?;
         let domain = p.adjust.domain_boundary.map_or(0, |((ingress, _), _, _)| ingress);
         w.u32(domain)?;
