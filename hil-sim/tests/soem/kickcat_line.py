@@ -10,18 +10,27 @@ root in the master's network namespace (or by hand against `serve`).
   3. complete access of 1A00h, KickCAT's and its emulated one compared
      [E-078]; 1018h:01 the vendor ID B9h [E-005];
   4. a remap by SDO: axis A only (1600h: 6040h, 6060h, 607Ah; 1A00h: 6041h,
-     6061h, 6064h, 60F4h, 606Ch, 603Fh), read back [E-056];
+     6061h, 6064h, 60F4h, 606Ch, 603Fh), read back [E-056]; I423 (the
+     longest the drive extrapolates a missing cyclic set-point, C-117)
+     raised by SDO from its 10 ms to --i423-ms, read back: a master's
+     setting for its own jitter, as a user sets it for a Python master;
   5. Safe-Op, Op with process data [E-021], the sizes the remap gives;
   6. the CiA 402 enable in csp (6060h = 8, 607Ah = 6064h) 6/7/15 with the
-     statusword patterns [E-034]; then profile position (6060h = 1: no
-     cyclic set-point within I423 needed from a python master, C-117) and
-     --seconds of process data, the cycles with a wrong working counter
-     and the longest gap between cycles printed;
-  7. Init.
+     statusword patterns [E-034];
+  7. csp for --seconds of process data: a move of one revolution on axis A
+     of every drive, a cosine S-curve over --move-seconds whose set-point
+     (607Ah) the script computes each cycle from the master's clock, then
+     the target held [C-116, C-117]: 6064h within --tolerance increments of
+     the set-point sent in every cycle, the end within --end-tolerance of
+     the target, the drives still enabled without a fault; the cycles with
+     a wrong working counter, the longest gap between cycles and the
+     largest deviation printed;
+  8. Init.
 KickCAT 2.5 does not report the abort of an SDO write (it times out), so no
 check here relies on one.
 """
 import argparse
+import math
 import struct
 import sys
 import time
@@ -74,6 +83,12 @@ def main():
     p.add_argument("--seconds", type=float, default=10)
     p.add_argument("--name-1018", required=True)
     p.add_argument("--name-6040", required=True)
+    p.add_argument("--i423-index", type=lambda v: int(v, 0), required=True)
+    p.add_argument("--i423-ms", type=int, default=100)
+    p.add_argument("--inc-per-rev", type=int, default=1 << 20)
+    p.add_argument("--move-seconds", type=float, default=2.0)
+    p.add_argument("--tolerance", type=int, required=True, help="6064h against the set-point, increments")
+    p.add_argument("--end-tolerance", type=int, required=True, help="6064h against the target at the end, increments")
     args = p.parse_args()
     link = kickcat.create_link(args.iface, "")
     link.set_timeout(0.01)
@@ -123,6 +138,13 @@ def main():
             sdo_write(bus, s, a, 0, b"\x01")
         back = [struct.unpack("<I", sdo_read(bus, s, 0x1600, k)[:4])[0] for k in range(1, 4)]
         check(back == RX, f"drive {i + 1}: 1600h read back {[hex(x) for x in back]}")
+        # I423: 10 ms by default, shorter than a Python master's stalls on a
+        # loaded machine (the drive then faults with C-117, rightly)
+        old = struct.unpack("<H", sdo_read(bus, s, args.i423_index, 0)[:2])[0]
+        sdo_write(bus, s, args.i423_index, 0, struct.pack("<H", args.i423_ms))
+        new = struct.unpack("<H", sdo_read(bus, s, args.i423_index, 0)[:2])[0]
+        say(f"drive {i + 1}: I423 ({args.i423_index:04X}h) {old} ms -> {new} ms")
+        check(new == args.i423_ms, f"drive {i + 1}: I423 read back {new}, {args.i423_ms} written")
     bus.create_mapping()
     for i, s in enumerate(slaves):
         check((s.output_size, s.input_size) == (OUT_BYTES, IN_BYTES), f"drive {i + 1}: mapped {s.output_size}/{s.input_size} bytes")
@@ -177,26 +199,55 @@ def main():
         got = [hex(sw(s)) for s in slaves]
         say(f"controlword {cw}: statusword {got}")
         check(all(sw(s) & mask == want for s in slaves), f"controlword {cw}: statusword {got}, {want:#x} expected")
-    # csp asks a new set-point within I423 (10 ms, C-117) of the last, or the
-    # drive faults with event 78 cause 3 (603Fh 8612h): a python master on a
-    # loaded machine does not keep that (gaps of 20 ms seen). The drive stays
-    # enabled for the long run in profile position (6060h = 1), which holds
-    # the position without a cyclic set-point; the mode change is checked.
-    outs = [struct.pack("<HBi", 15, 1, p) for p in positions]
-    run(20, outs)
-    modes = [s.input_data[2] for s in slaves]
-    check(modes == [1] * len(slaves), f"6061h after the change to profile position: {modes}")
+    # csp: one revolution as a cosine S-curve on the master's clock (a slot
+    # the master missed, descheduled, advances the curve too, as a real
+    # master's trajectory does: the drive extrapolates over the gap, C-116,
+    # for up to I423, and meets the next set-point), then the target held
+    def curve(t):
+        x = (1 - math.cos(math.pi * min(t / args.move_seconds, 1.0))) / 2
+        return round(x * args.inc_per_rev)
+
+    starts = positions
+    targets = [p + args.inc_per_rev for p in starts]
     t0 = time.monotonic()
     n0 = wkc_errors[0]
     last[1] = 0.0
     cycles = 0
-    while time.monotonic() - t0 < args.seconds:
-        run(100, outs)
-        cycles += 100
+    worst = [0] * len(slaves)
+    faults = []
+    while True:
+        t = time.monotonic() - t0
+        if t >= args.seconds:
+            break
+        sp = [p + curve(t) for p in starts]
+        for s, x in zip(slaves, sp):
+            s.set_output_bytes(struct.pack("<HBi", 15, 8, x))
+        cycle()
+        cycles += 1
+        for k, (s, x) in enumerate(zip(slaves, sp)):
+            if sw(s) & 0x6F != 0x27 and not faults:
+                faults.append(f"drive {k + 1} left Operation enabled at {t:.3f} s: statusword {sw(s):#06x}, "
+                              f"603Fh {struct.unpack_from('<H', s.input_data, 15)[0]:#06x}")
+            worst[k] = max(worst[k], abs(struct.unpack_from("<i", s.input_data, 3)[0] - x))
+        time.sleep(0.001)
     say(
-        f"{cycles} cycles in Op, {wkc_errors[0] - n0} with a wrong working counter or a timeout; "
-        f"longest gap between two cycles {last[1] * 1e3:.1f} ms (I423 10 ms)"
+        f"{cycles} cycles in Op in csp, {wkc_errors[0] - n0} with a wrong working counter or a timeout; "
+        f"longest gap between two cycles {last[1] * 1e3:.1f} ms (I423 {args.i423_ms} ms)"
     )
+    check(not faults, "; ".join(faults) or "no fault")
+    ends = [struct.unpack_from("<i", s.input_data, 3)[0] for s in slaves]
+    for k in range(len(slaves)):
+        moved = ends[k] - starts[k]
+        say(
+            f"drive {k + 1}: moved {moved} inc ({moved / args.inc_per_rev:.5f} rev) in {args.move_seconds} s, "
+            f"end {ends[k] - targets[k]:+d} inc from the target, 6064h at most {worst[k]} inc "
+            f"({worst[k] / args.inc_per_rev:.5f} rev) from the set-point sent"
+        )
+        check(worst[k] <= args.tolerance, f"drive {k + 1}: 6064h {worst[k]} inc from the set-point, tolerance {args.tolerance}")
+        check(abs(ends[k] - targets[k]) <= args.end_tolerance,
+              f"drive {k + 1}: end {ends[k] - targets[k]:+d} inc from the target, tolerance {args.end_tolerance}")
+    modes = [s.input_data[2] for s in slaves]
+    check(modes == [8] * len(slaves), f"6061h still csp (8) at the end: {modes}")
     end = [(hex(sw(s)), hex(struct.unpack_from("<H", s.input_data, 15)[0])) for s in slaves]
     check(all(sw(s) & 0x6F == 0x27 for s in slaves), f"still enabled after the process data: statusword, 603Fh {end}")
     bus.request_state(kickcat.State.INIT)
