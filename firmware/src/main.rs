@@ -231,6 +231,14 @@ mod app {
             if tasks::mailbox_net(drive, &mut **net, pdi, now).is_err() {
                 defmt::warn!("mailbox: PDI access failed");
             }
+            if let Some(s) = drive.take_firmware_stored() {
+                let slot = if s.slot.index() == 0 { "A" } else { "B" };
+                defmt::info!(
+                    "foe: image version {=u32} verified and stored in slot {=str}; it starts at the next power-on",
+                    s.version,
+                    slot
+                );
+            }
         });
     }
 }

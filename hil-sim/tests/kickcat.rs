@@ -35,13 +35,41 @@ fn kickcat_python() -> Result<PathBuf, String> {
     Ok(PathBuf::from(py))
 }
 
+/// Increments per revolution of the drive's position (6064h, 607Ah) with
+/// the default scaling (`hil-sim/tests/soem/line.py` moves by the same).
+const INC_PER_REV: u32 = 1 << 20;
+
+/// I423 as KickCAT sets it by SDO before Op: the longest the drive
+/// extrapolates a missing csp set-point (C-117). The default 10 ms is shorter
+/// than the stalls of a Python master on a loaded machine (gaps of 20 to
+/// 170 ms seen with a load of 12 on 2 cores: the drive faulted, rightly),
+/// so the master sets what its own jitter needs.
+const I423_MS: u16 = 500;
+
+/// How far 6064h may be from the csp set-point sent in the same cycle during
+/// the move (1/16 rev): the position loop's lag at the move's 0.79 rev/s and
+/// the set-point's advance over one cycle of the master (the inputs of a
+/// frame are read as its outputs are written). The script adds twice what
+/// the drive's linear extrapolation (C-116) over the longest gap between the
+/// master's cycles (g) misses of the curve, a/2 · g² with the curve's
+/// largest acceleration a = π²/(2 T²) rev/s² (T = 2 s: 1/160 rev for
+/// g = 100 ms).
+const TOLERANCE_INC: u32 = INC_PER_REV / 16;
+
+/// How far 6064h may end from the target once the move is over (≈ 0.07°).
+const END_TOLERANCE_INC: u32 = 200;
+
 /// KickCAT on a line of 2 drives: scan, SDO Info descriptions of 1018h and
 /// 6040h (E-080, E-082), complete access of 1A00h against KickCAT's
-/// emulated one (E-078), 1018h:01 (E-005), a remap by SDO (E-056),
-/// Safe-Op, Op with process data (E-021), the CiA 402 enable in csp and 10 s
-/// of process data (E-034), Init.
+/// emulated one (E-078), 1018h:01 (E-005), a remap by SDO (E-056), I423
+/// raised by SDO (C-117), Safe-Op, Op with process data (E-021), the CiA 402
+/// enable in csp (E-034), 10 s of process data in csp with a move of one
+/// revolution of axis A on both drives, its set-points computed by the
+/// script each cycle, 6064h following within [`TOLERANCE_INC`] (plus the
+/// curve's bend over the master's longest gap) and ending within
+/// [`END_TOLERANCE_INC`] of the target (C-116, C-117), Init.
 #[test]
-fn e080_e082_e078_e056_e021_e034_kickcat_line_of_two_drives() {
+fn e080_e082_e078_e056_e021_e034_c116_c117_kickcat_line_of_two_drives_csp_move() {
     let python = match kickcat_python() {
         Ok(p) => p,
         Err(why) => {
@@ -55,6 +83,13 @@ fn e080_e082_e078_e056_e021_e034_kickcat_line_of_two_drives() {
     std::fs::create_dir_all(&dir).expect("scratch dir");
     let line = Line::new("k", 2, 120, &dir);
     let (n1018, n6040) = (name(0x1018), name(0x6040));
+    let i423 = format!("{:#06x}", drive_ecat::params::I423);
+    let (i423_ms, inc, tol, end_tol) = (
+        I423_MS.to_string(),
+        INC_PER_REV.to_string(),
+        TOLERANCE_INC.to_string(),
+        END_TOLERANCE_INC.to_string(),
+    );
     let status = line.run(
         &python,
         "kickcat_line.py",
@@ -67,6 +102,18 @@ fn e080_e082_e078_e056_e021_e034_kickcat_line_of_two_drives() {
             &n1018,
             "--name-6040",
             &n6040,
+            "--i423-index",
+            &i423,
+            "--i423-ms",
+            &i423_ms,
+            "--inc-per-rev",
+            &inc,
+            "--move-seconds",
+            "2",
+            "--tolerance",
+            &tol,
+            "--end-tolerance",
+            &end_tol,
         ],
     );
     if !status.success() {

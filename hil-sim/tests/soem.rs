@@ -182,14 +182,19 @@ fn e096_e095_e098_soem_set_ip_ping_and_udp_through_a_tap_bridge() {
 
 /// The firmware update as SOEM's `firm_update` sample does it (Init, the
 /// bootstrap mailbox from the SII, Bootstrap, `ecx_FOEwrite`, Init) with the
-/// update file of `tools/foe-image` (docs/flashing.md): a bit-flipped and a
-/// truncated file are refused (SOEM reports the FoE error answer as −5), a
-/// name that does not start with `firmware` gets 8001h (−10), the tool's
-/// file is taken, and the drive returns to Pre-Op. (That the file lands in
-/// the inactive slot and boots is checked in-process, where the slots can be
-/// seen: `tools/foe-image/tests/round_trip.rs`.)
+/// update files `foe-image make` writes by default, one per slot and named
+/// for it (`firmware-slot-a.sc6f`, `firmware-slot-b.sc6f`, issue 33;
+/// docs/flashing.md): the master reads the drive's update slot E54 by SDO
+/// and sends that slot's file, the other slot's file is refused (the drive:
+/// 8004h; SOEM reports an FoE error answer as −5), a bit-flipped and a
+/// truncated file too, a name that does not start with `firmware` gets 8001h
+/// (−10), the right file is taken, `serve` prints that the download was
+/// verified and stored in that slot, and the drive returns to Pre-Op. The
+/// new image starts only at the next power-on (E-019; the power cycle and the
+/// boot from the new slot are checked in-process, where the slots can be
+/// seen: `tools/foe-image/tests/round_trip.rs`).
 #[test]
-fn foe_image_through_soem_firm_update() {
+fn e019_foe_file_for_the_update_slot_through_soem_firm_update() {
     let python = match pysoem_python() {
         Ok(p) => p,
         Err(why) => {
@@ -202,33 +207,57 @@ fn foe_image_through_soem_firm_update() {
     let body: Vec<u8> = (0..64 * 1024u32)
         .map(|i| (i.wrapping_mul(2_654_435_761) >> 24) as u8)
         .collect();
-    // signed with the development key for slot A, where `serve`'s empty
-    // drive downloads to (issue 18)
+    // the image linked for each slot of `serve`'s drive, signed with the
+    // development key (issue 18), written under the tool's default name
     let seed = drive_ecat::boot::parse_key_hex(include_str!("../../keys/dev-ed25519.key")).unwrap();
-    let info = foe_image::ImageInfo {
-        version: 2,
-        load_address: hil_sim::sim::FirmwareSlots::new(hil_sim::sim::FirmwareFlash::new())
-            .load_address(drive_ecat::boot::Slot::A),
-        security_counter: 1,
-    };
-    let good = foe_image::update_file(&body, info, &seed).unwrap();
-    let mut flipped = good.clone();
+    let slots = hil_sim::sim::FirmwareSlots::new(hil_sim::sim::FirmwareFlash::new());
+    let mut good = Vec::new();
+    for slot in [drive_ecat::boot::Slot::A, drive_ecat::boot::Slot::B] {
+        let info = foe_image::ImageInfo {
+            version: 2,
+            load_address: slots.load_address(slot),
+            security_counter: 1,
+        };
+        let file = foe_image::update_file(&body, info, &seed).unwrap();
+        let name = foe_image::default_file_name(info.load_address);
+        assert_eq!(name, foe_image::slot_file_name(slot.index()));
+        std::fs::write(dir.join(&name), &file).unwrap();
+        good.push(file);
+    }
+    // a flipped and a truncated copy of the file for slot A, the update slot
+    // of `serve`'s empty drives (foe.py checks the drive says so in E54)
+    let mut flipped = good[0].clone();
     flipped[drive_ecat::boot::IMAGE_HEADER_LEN + 20_000] ^= 0x04;
-    let truncated = good[..good.len() - 100].to_vec();
+    let truncated = good[0][..good[0].len() - 100].to_vec();
     let path = |name: &str| dir.join(name);
-    for (name, data) in [("good", &good), ("flipped", &flipped), ("truncated", &truncated)] {
+    for (name, data) in [("flipped", &flipped), ("truncated", &truncated)] {
         std::fs::write(path(name), data).unwrap();
     }
     let line = Line::new("f", 1, 120, &dir);
     let arg = |name: &str| path(name).to_str().unwrap().to_string();
-    let (g, f, t) = (arg("good"), arg("flipped"), arg("truncated"));
+    let (d, f, t) = (
+        dir.to_str().unwrap().to_string(),
+        arg("flipped"),
+        arg("truncated"),
+    );
+    let e54 = format!("{:#06x}", drive_ecat::params::E54);
     let status = line.run(
         &python,
         "foe.py",
-        &["--good", &g, "--flipped", &f, "--truncated", &t],
+        &["--files", &d, "--e54", &e54, "--flipped", &f, "--truncated", &t],
     );
     if !status.success() {
         line.fail_with(&format!("foe.py through SOEM failed: {status}"));
+    }
+    let serve = line.serve_output();
+    let stored: Vec<&str> = serve
+        .lines()
+        .filter(|l| l.contains("FoE download verified"))
+        .collect();
+    if stored.len() != 1 || !stored[0].contains("stored in slot A (version 2)") {
+        line.fail_with(&format!(
+            "serve should print one stored download, in slot A (version 2): {stored:?}"
+        ));
     }
 }
 

@@ -47,6 +47,8 @@ pub const A298: u16 = parameter_index(0, 298);
 
 /// E43 event cause.
 pub const E43: u16 = parameter_index(4, 43);
+/// E54 firmware update slot: 1 = A, 2 = B, 0 = no firmware slots.
+pub const E54: u16 = parameter_index(4, 54);
 /// E59 projected fieldbus identification (\[2\]).
 pub const E59: u16 = parameter_index(4, 59);
 /// E82 event type.

@@ -255,6 +255,7 @@ fn run(sim: &mut Simulation, sock: &RawSocket, args: &ServeArgs) -> Result<Stats
         let cpu0 = thread_cpu();
         sim.catch_up(now.saturating_sub(start + IDLE_LAG));
         print_new_changes(sim, &mut printed);
+        print_firmware_stored(sim);
         // printed is done with: serve keeps no log, its memory stays the
         // same however long it runs (the soak benchmark checks it)
         for d in sim.drives_mut() {
@@ -390,5 +391,19 @@ impl Delay {
             std::thread::sleep(Duration::from_nanos((until - now).as_ns()));
         }
         monotonic().saturating_sub(now)
+    }
+}
+
+/// Prints each FoE download a drive verified and stored since the last call
+/// (issue 33: the user sees the image landed, and in which slot).
+fn print_firmware_stored(sim: &mut Simulation) {
+    for (i, d) in sim.drives_mut().iter_mut().enumerate() {
+        if let Some(s) = d.drive.take_firmware_stored() {
+            println!(
+                "slave {i}: FoE download verified and stored in slot {:?} (version {}); \
+                 it starts at the next power-on",
+                s.slot, s.version
+            );
+        }
     }
 }

@@ -1,16 +1,20 @@
 #!/usr/bin/env python3
 """The firmware update as SOEM's `firm_update` sample does it, with the
-update file `tools/foe-image` writes (docs/flashing.md).
+update files `tools/foe-image` writes by default: one per firmware slot,
+named for it (firmware-slot-a.sc6f, firmware-slot-b.sc6f; docs/flashing.md).
 
-For drive 1 of the line: Init, the SyncManagers set to the bootstrap
-mailbox read from the SII (as firm_update and pysoem's
+For drive 1 of the line: in Pre-Op the master reads the drive's update slot,
+object E54 (1 = A, 2 = B: the slot a download goes to, the one the drive did
+not start from), and picks that slot's file; then Init, the SyncManagers set
+to the bootstrap mailbox read from the SII (as firm_update and pysoem's
 examples/firmware_update.py do), Bootstrap, `ecx_FOEwrite` of a file, Init.
 SOEM reports an FoE error answer as -5 (EC_ERR_TYPE_FOE_ERROR) and the
 error 8001h "not found" as -10 (EC_ERR_TYPE_FOE_FILE_NOTFOUND); a positive
 result is the accepted download. Checks:
+  - the file for the other slot is refused (the drive: 8004h, at the header);
   - a bit-flipped file and a truncated one are refused (the drive: 800Ch);
   - a file name that does not start with "firmware" is refused (8001h);
-  - the tool's file itself is taken;
+  - the file for the update slot is taken, under its own name;
   - the drive comes back to Pre-Op through Init afterwards.
 
 Run by `hil-sim/tests/soem.rs` as root inside the master's namespace.
@@ -52,11 +56,12 @@ def to_state(s, state, what):
 def main():
     ap = argparse.ArgumentParser(description=__doc__.split("\n")[0])
     ap.add_argument("--iface", required=True)
-    ap.add_argument("--good", required=True, help="the update file foe-image wrote")
-    ap.add_argument("--flipped", required=True, help="the same with one bit of the body flipped")
+    ap.add_argument("--files", required=True, help="the directory with firmware-slot-a.sc6f and firmware-slot-b.sc6f")
+    ap.add_argument("--e54", required=True, type=lambda v: int(v, 0), help="the index of E54, the update slot")
+    ap.add_argument("--flipped", required=True, help="the update slot's file with one bit of the body flipped")
     ap.add_argument("--truncated", required=True, help="the same without its last 100 bytes")
     args = ap.parse_args()
-    files = {k: open(getattr(args, k), "rb").read() for k in ("good", "flipped", "truncated")}
+    files = {k: open(getattr(args, k), "rb").read() for k in ("flipped", "truncated")}
     m = pysoem.Master()
     m.open(args.iface)
     try:
@@ -68,7 +73,19 @@ def main():
         if not check(n > 0, "config_init found no slave"):
             return 1
         s = m.slaves[0]
-        say(f"drive 1: {s.name!r}, update file {len(files['good'])} bytes")
+        # which file: the drive's update slot, as a user reads it (TwinCAT's
+        # CoE online tab, or an SDO upload)
+        if not to_state(s, pysoem.PREOP_STATE, "Pre-Op"):
+            return 1
+        slot = s.sdo_read(args.e54, 0)[0]
+        say(f"drive 1: {s.name!r}, update slot E54 ({args.e54:04X}h) = {slot}")
+        if not check(slot in (1, 2), f"E54 = {slot}, 1 (A) or 2 (B) expected"):
+            return 1
+        ours, other = ("firmware-slot-a.sc6f", "firmware-slot-b.sc6f")[:: 1 if slot == 1 else -1]
+        files["good"] = open(f"{args.files}/{ours}", "rb").read()
+        files["other"] = open(f"{args.files}/{other}", "rb").read()
+        check(slot == 1, f"serve's empty drive downloads to slot A, E54 says {slot}")
+        say(f"sending {ours} ({len(files['good'])} bytes); {other} must be refused")
         if not to_state(s, pysoem.INIT_STATE, "Init"):
             return 1
         # the bootstrap mailbox from the SII, as firm_update does
@@ -80,10 +97,11 @@ def main():
         if not to_state(s, pysoem.BOOT_STATE, "Init -> Bootstrap"):
             return 1
         for name, data, want, what in [
-            ("firmware.sc6f", files["flipped"], -EC_ERR_TYPE_FOE_ERROR, "bit-flipped file (800Ch)"),
-            ("firmware.sc6f", files["truncated"], -EC_ERR_TYPE_FOE_ERROR, "truncated file (800Ch)"),
+            (other, files["other"], -EC_ERR_TYPE_FOE_ERROR, "the other slot's file (8004h)"),
+            (ours, files["flipped"], -EC_ERR_TYPE_FOE_ERROR, "bit-flipped file (800Ch)"),
+            (ours, files["truncated"], -EC_ERR_TYPE_FOE_ERROR, "truncated file (800Ch)"),
             ("image.sc6f", files["good"], -EC_ERR_TYPE_FOE_FILE_NOTFOUND, "name without 'firmware' (8001h)"),
-            ("firmware.sc6f", files["good"], None, "the tool's file"),
+            (ours, files["good"], None, "the update slot's file"),
         ]:
             for attempt in range(1, 4):
                 t = time.monotonic()

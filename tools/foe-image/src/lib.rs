@@ -22,6 +22,44 @@ use std::path::{Path, PathBuf};
 /// (`drive_ecat::runtime::FIRMWARE_FILE`); masters send the file name they are given.
 pub const FILE_PREFIX: &str = "firmware";
 
+/// The firmware slots the tool knows, by the CPU address of each slot's body
+/// (the load address an image linked for the slot has): the reference board
+/// (XMC4800, cached alias; `bootloader::xmc4800::LAYOUT`), QEMU's mps2-an386
+/// (`bootloader::mps2::LAYOUT`) and the simulated drive of `hil-sim`
+/// (`hil_sim::sim::FirmwareSlots`). An image runs only from the slot it is
+/// linked for; the drive refuses one for the other slot with FoE 8004h.
+pub const KNOWN_SLOTS: &[(&str, [u32; 2])] = &[
+    ("board XMC4800", [0x0804_0400, 0x080C_0400]),
+    ("QEMU mps2-an386", [0x0000_8400, 0x0001_8400]),
+    ("hil-sim", [0x0000_0400, 0x0004_2400]),
+];
+
+/// The slot (0 = A, 1 = B) an image with this load address is linked for,
+/// and the layout it belongs to; `None`: no known slot (a standalone link).
+pub fn slot_of(load_address: u32) -> Option<(&'static str, usize)> {
+    KNOWN_SLOTS.iter().find_map(|(layout, bodies)| {
+        bodies
+            .iter()
+            .position(|&b| b == load_address)
+            .map(|slot| (*layout, slot))
+    })
+}
+
+/// The update file's name for slot `slot` (0 = A, 1 = B):
+/// `firmware-slot-a.sc6f` / `firmware-slot-b.sc6f` (it starts with
+/// [`FILE_PREFIX`], so it is also the FoE name the drive takes).
+pub fn slot_file_name(slot: usize) -> String {
+    let letter = if slot == 0 { 'a' } else { 'b' };
+    format!("{FILE_PREFIX}-slot-{letter}.sc6f")
+}
+
+/// The name `foe-image make` gives an update file by default: named for
+/// the slot its load address is in ([`slot_file_name`]), else
+/// `firmware.sc6f` (an image linked for no known slot).
+pub fn default_file_name(load_address: u32) -> String {
+    slot_of(load_address).map_or_else(|| format!("{FILE_PREFIX}.sc6f"), |(_, s)| slot_file_name(s))
+}
+
 /// Largest body the tool writes (a slot of the reference board is smaller;
 /// the drive refuses what does not fit with FoE 8003h).
 pub const MAX_BODY: usize = 4 << 20;

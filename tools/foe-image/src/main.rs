@@ -7,21 +7,32 @@
 //! foe-image keygen --out FILE          # FILE: the secret seed; FILE.pub (or NAME.pub for NAME.key)
 //! ```
 //!
-//! INPUT is the firmware ELF or a flat binary. The drive takes a download
-//! whose FoE file name starts with `firmware` (docs/flashing.md), so the
-//! default output is `firmware.sc6f` beside the input. `keys/dev-ed25519.key`
-//! is the development key (never for a production drive).
+//! INPUT is the firmware ELF or a flat binary. An image runs from the slot it
+//! is linked for, and the drive takes only the file for the slot it did not
+//! start from (the other one: FoE 8004h), so the default output is named
+//! for the slot of its load address, `firmware-slot-a.sc6f` or
+//! `firmware-slot-b.sc6f` beside the input (`firmware.sc6f` for an image
+//! linked for no known slot, with a warning); the drive takes FoE file names
+//! starting with `firmware` (docs/flashing.md). `keys/dev-ed25519.key` is
+//! the development key (never for a production drive).
 #![forbid(unsafe_code)]
 
 use clap::{Parser, Subcommand};
 use foe_image::{
-    body_from_elf, check, generate_seed, is_elf, key_hex, pub_path, public_key, read_key, update_file,
-    ImageInfo, FILE_PREFIX,
+    body_from_elf, check, default_file_name, generate_seed, is_elf, key_hex, pub_path, public_key, read_key,
+    slot_of, update_file, ImageInfo, FILE_PREFIX,
 };
 use std::path::PathBuf;
 use std::process::ExitCode;
 
 /// Firmware update files for the drive's FoE download (docs/flashing.md).
+///
+/// A drive has two firmware slots (A, B) and runs its image in place, so an
+/// image is linked for one slot, and a download goes to the slot the drive
+/// did not start from: the file for the other slot is refused (FoE 8004h).
+/// Build the image once per slot (`scripts/cross foe-image` does: both files,
+/// firmware-slot-a.sc6f and firmware-slot-b.sc6f) and send the file for the
+/// drive's update slot, object E54 (2836h: 1 = A, 2 = B).
 #[derive(Parser)]
 #[command(name = "foe-image", version)]
 struct Cli {
@@ -57,6 +68,8 @@ enum Command {
         #[arg(long, value_parser = number)]
         load_addr: Option<u32>,
         /// Output file; its name must start with "firmware" for the drive to take it.
+        /// Default: named for the slot of the load address, firmware-slot-a.sc6f or
+        /// firmware-slot-b.sc6f beside INPUT (firmware.sc6f for an image linked for no slot).
         #[arg(long, short)]
         out: Option<PathBuf>,
         /// The firmware ELF (its loadable segments) or a flat binary.
@@ -108,7 +121,7 @@ fn make(
         security_counter,
     };
     let file = update_file(&body, info, &seed).map_err(|e| format!("{}: {e}", input.display()))?;
-    let out = out.unwrap_or_else(|| input.with_file_name(format!("{FILE_PREFIX}.sc6f")));
+    let out = out.unwrap_or_else(|| input.with_file_name(default_file_name(load_address)));
     let named_ok = out
         .file_name()
         .and_then(|n| n.to_str())
@@ -127,6 +140,18 @@ fn make(
         h.security_counter,
         key.display()
     );
+    match slot_of(load_address) {
+        Some((layout, slot)) => println!(
+            "{}: linked for slot {} ({layout}): the drive takes it when its update slot E54 is {}",
+            out.display(),
+            if slot == 0 { 'A' } else { 'B' },
+            slot + 1
+        ),
+        None => eprintln!(
+            "foe-image: warning: load address {load_address:#010x} is in no firmware slot the tool knows: \
+             a drive refuses it (FoE 8004h); link the image for a slot (FIRMWARE_SLOT=a|b)"
+        ),
+    }
     if seed_is_dev(&seed) {
         eprintln!("foe-image: note: signed with the DEVELOPMENT key: never for a production drive");
     }

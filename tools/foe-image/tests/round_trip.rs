@@ -13,6 +13,7 @@
 )]
 
 use drive_ecat::boot::{Slot, SlotState};
+use drive_ecat::params::E54;
 use drive_tests::{fw_load_address, in_boot, FoeClient, FoeReply, FwNode};
 use ecat::foe::FoeError;
 use hil_sim::sim::Simulation;
@@ -119,9 +120,17 @@ fn make_with(dir: &Path, input: &[u8], version: u32, key: &str, extra: &[&str]) 
         "foe-image make: {}",
         String::from_utf8_lossy(&out.stderr)
     );
-    assert!(stdout.contains("firmware.sc6f"), "{stdout}");
-    // the default name beside the input: one the drive takes
-    std::fs::read(dir.join("firmware.sc6f")).unwrap()
+    // the default name beside the input, named for the slot of the load
+    // address (issue 33): one the drive takes
+    let written = stdout.split(": ").next().unwrap();
+    let file = std::fs::read(written).unwrap();
+    let load = u32::from_le_bytes(file[20..24].try_into().unwrap());
+    assert_eq!(
+        Path::new(written),
+        dir.join(foe_image::default_file_name(load)),
+        "{stdout}"
+    );
+    file
 }
 
 fn line() -> RefCell<Simulation<FwNode>> {
@@ -165,13 +174,13 @@ fn foe_image_of_an_elf_boots_from_the_inactive_slot() {
         "segments at their load addresses, gap FFh"
     );
     // the tool's own check agrees, with and without the public key
-    let out = tool(&["check", dir.join("firmware.sc6f").to_str().unwrap()]);
+    let out = tool(&["check", dir.join("firmware-slot-b.sc6f").to_str().unwrap()]);
     assert!(out.status.success());
     let out = tool(&[
         "check",
         "--pub",
         &dev_pub(),
-        dir.join("firmware.sc6f").to_str().unwrap(),
+        dir.join("firmware-slot-b.sc6f").to_str().unwrap(),
     ]);
     assert!(out.status.success());
     assert!(String::from_utf8_lossy(&out.stdout).contains("signature verified"));
@@ -335,7 +344,7 @@ fn foe_signature_keygen_sign_check_and_the_drive_refuses_another_key() {
     // sign with the new key: its public key verifies, the development key does not
     let (elf, _) = board_elf();
     let file = make_with(&dir, &elf, 8, key.to_str().unwrap(), &["--security-counter", "3"]);
-    let f = dir.join("firmware.sc6f");
+    let f = dir.join("firmware-slot-b.sc6f");
     let pubfile = dir.join("prod.pub");
     let out = tool(&["check", "--pub", pubfile.to_str().unwrap(), f.to_str().unwrap()]);
     assert!(out.status.success(), "{}", String::from_utf8_lossy(&out.stderr));
@@ -380,5 +389,63 @@ fn foe_signature_load_address_and_security_counter_from_the_tool() {
     assert_eq!(download(&sim, &file), Err(FoeReply::Error(FoeError::NO_RIGHTS.0)));
     let mut n = std::cell::RefMut::map(sim.borrow_mut(), |s| &mut s.drives_mut()[0]);
     assert_eq!(n.slots().state(Slot::B).unwrap(), SlotState::Empty);
+    std::fs::remove_dir_all(dir).unwrap();
+}
+
+/// The slot table of the tool (default file names, issue 33) is the
+/// simulated drive's: each slot's body address is its `load_address`.
+/// (The board's and mps2's are asserted in `crates/bootloader`'s tests.)
+#[test]
+fn e019_default_file_names_follow_the_slot_of_the_load_address() {
+    let sim = hil_sim::sim::FirmwareSlots::new(hil_sim::sim::FirmwareFlash::new());
+    let (_, bodies) = foe_image::KNOWN_SLOTS
+        .iter()
+        .find(|(layout, _)| *layout == "hil-sim")
+        .unwrap();
+    assert_eq!(bodies[0], sim.load_address(Slot::A));
+    assert_eq!(bodies[1], sim.load_address(Slot::B));
+    assert_eq!(
+        foe_image::default_file_name(sim.load_address(Slot::A)),
+        "firmware-slot-a.sc6f"
+    );
+    assert_eq!(
+        foe_image::default_file_name(sim.load_address(Slot::B)),
+        "firmware-slot-b.sc6f"
+    );
+    assert_eq!(foe_image::default_file_name(0x0804_0400), "firmware-slot-a.sc6f");
+    assert_eq!(foe_image::default_file_name(0x080C_0400), "firmware-slot-b.sc6f");
+    // the standalone board link (whole flash from 0x0800_0000): no slot
+    assert_eq!(foe_image::default_file_name(0x0800_0000), "firmware.sc6f");
+    // the tool writes one file per slot by its default name; a drive running
+    // from A shows update slot 2 in E54, takes the slot-B file, refuses the
+    // slot-A one with 8004h at the header, and reports the stored slot;
+    // after the power cycle it runs B and shows update slot 1
+    let dir = temp_dir("slots");
+    let mut files = Vec::new();
+    for slot in [Slot::A, Slot::B] {
+        let (elf, _) = board_elf_at(fw_load_address(slot));
+        let d = dir.join(format!("{slot:?}"));
+        std::fs::create_dir_all(&d).unwrap();
+        files.push(make(&d, &elf, 9));
+        assert!(d.join(foe_image::slot_file_name(slot.index())).exists());
+    }
+    let e54 =
+        |sim: &RefCell<Simulation<FwNode>>| sim.borrow().drives()[0].drive.objects().get(E54, 0).unwrap();
+    let sim = line();
+    assert_eq!(e54(&sim), 2, "running from A: the update slot is B");
+    assert_eq!(
+        download(&sim, &files[0]),
+        Err(FoeReply::Error(FoeError::ILLEGAL.0))
+    );
+    assert_eq!(
+        sim.borrow_mut().drives_mut()[0].drive.take_firmware_stored(),
+        None
+    );
+    assert_eq!(download(&sim, &files[1]).map(|_| ()), Ok(()));
+    let stored = sim.borrow_mut().drives_mut()[0].drive.take_firmware_stored();
+    assert_eq!(stored.map(|s| (s.slot, s.version)), Some((Slot::B, 9)));
+    sim.borrow_mut().drives_mut()[0].power_cycle();
+    assert_eq!(sim.borrow().drives()[0].boot.map(|d| d.slot), Some(Slot::B));
+    assert_eq!(e54(&sim), 1, "running from B: the update slot is A");
     std::fs::remove_dir_all(dir).unwrap();
 }

@@ -162,7 +162,7 @@ const fn string(s: &str) -> DataType {
 }
 
 /// Global and axis-A manufacturer parameters, sorted by index.
-pub const PARAMS: [Object; 80] = [
+pub const PARAMS: [Object; 81] = [
     param_array!(a(0), "Save values", Record, Value::Ram, from ACTION)
         .note("A00; [0] = 1 requests saving (E-018); progress/result set by the store"),
     param_array!(a(9), "Restart", Record, Value::Ram, from ACTION)
@@ -652,6 +652,9 @@ pub const PARAMS: [Object; 80] = [
         ]
     )
     .note("E52; [1] = 1009h, [2] = 1018h:04, [3] = 100Ah; [0] not described (0)"),
+    Object::var(e_(54), Value::Live, entries![e(0, "Firmware update slot", U8, RO)])
+        .level(1)
+        .note("E54 (number ours, issue 33): the slot an FoE download goes to, 1 = A, 2 = B (send firmware-slot-a/-b.sc6f); 0 = no firmware slots"),
     param_array!(
         e_(59),
         "Projected fieldbus identification",

@@ -20,15 +20,39 @@ pub const FIRMWARE_KEY_IS_DEVELOPMENT: bool = boot::FIRMWARE_KEY_IS_DEVELOPMENT;
 /// FoE file names (prefix) of the firmware image; other names: 8001h.
 pub const FIRMWARE_FILE: &[u8] = b"firmware";
 
+/// A download the drive verified and stored (issue 33): the slot it went
+/// to (the next power-on starts it on trial) and the version its header
+/// names. [`Drive::take_firmware_stored`] hands it to the firmware's log and
+/// to `hil-sim serve`'s console.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub struct FirmwareStored {
+    /// The slot the image is stored in (the one the drive did not start from).
+    pub slot: boot::Slot,
+    /// The version field of the image's header (informational).
+    pub version: u32,
+}
+
+/// The value of the firmware-update-slot object (E54, [`crate::params::E54`])
+/// for `slot`: 1 = A, 2 = B; 0 = the drive has no firmware slots.
+pub fn update_slot_value(slot: Option<boot::Slot>) -> i64 {
+    slot.map_or(0, |s| s.index() as i64 + 1)
+}
+
 /// The FoE handler of the drive: firmware images into the boot slots.
 pub struct FirmwareFoe<'a, B: Flash> {
     pub(super) slots: Option<&'a mut BootSlots<B>>,
+    stored: Option<FirmwareStored>,
 }
 
 impl<'a, B: Flash> FirmwareFoe<'a, B> {
     /// The handler over `slots` (`None`: every write is refused with 8002h).
     pub fn new(slots: Option<&'a mut BootSlots<B>>) -> Self {
-        Self { slots }
+        Self { slots, stored: None }
+    }
+
+    /// The download this handler verified and stored, if one ended through it.
+    pub fn stored(&self) -> Option<FirmwareStored> {
+        self.stored
     }
 }
 
@@ -61,10 +85,12 @@ impl<B: Flash> FoeHandler for FirmwareFoe<'_, B> {
 
     fn end_write(&mut self) -> Result<(), FoeError> {
         let slots = self.slots.as_deref_mut().ok_or(FoeError::ILLEGAL)?;
-        slots
-            .finish_verified(&FIRMWARE_PUBLIC_KEY)
-            .map(|_| ())
-            .map_err(foe_error)
+        let slot = slots.finish_verified(&FIRMWARE_PUBLIC_KEY).map_err(foe_error)?;
+        // the header was just verified in flash: a read failure now only
+        // loses the version of the report, not the stored image
+        let version = slots.header(slot).ok().flatten().map_or(0, |h| h.version);
+        self.stored = Some(FirmwareStored { slot, version });
+        Ok(())
     }
 
     fn abort(&mut self) {

@@ -72,7 +72,10 @@ use crate::faults::FaultChange;
 use diag::{is_event52, PortDiag, Text};
 pub use diag::{Leds, DIAG_AL_STATUS, DIAG_EMCY};
 pub use eoe::IpSettings;
-pub use foe::{foe_error, FirmwareFoe, FIRMWARE_FILE, FIRMWARE_KEY_IS_DEVELOPMENT, FIRMWARE_PUBLIC_KEY};
+pub use foe::{
+    foe_error, update_slot_value, FirmwareFoe, FirmwareStored, FIRMWARE_FILE, FIRMWARE_KEY_IS_DEVELOPMENT,
+    FIRMWARE_PUBLIC_KEY,
+};
 pub use save::{save_result, SaveJob, RESTART_DELAY};
 use slots::RuntimeSlots;
 use sync::PllSettings;
@@ -98,7 +101,7 @@ use dcsync::CycleSequence;
 pub use dcsync::{CycleCommand, FrameTiming, Pll, Step, SyncError};
 
 use crate::params::{
-    A00, A149, A150, A254, A255, A256, A257, A261, A287, A290, A291, A292, A296, A298, E43, E59, E82,
+    A00, A149, A150, A254, A255, A256, A257, A261, A287, A290, A291, A292, A296, A298, E43, E54, E59, E82,
 };
 
 /// This firmware's fieldbus identification (EtherCAT), compared with the
@@ -172,6 +175,9 @@ pub struct Drive<F: Flash, B: Flash = NoFlash> {
     store: Option<ParamStore<F>>,
     /// The firmware slots (FoE firmware update), if the drive has them.
     boot: Option<BootSlots<B>>,
+    /// The last FoE download verified and stored, until
+    /// [`take_firmware_stored`](Drive::take_firmware_stored).
+    firmware_stored: Option<FirmwareStored>,
     /// Diagnosis history 10F3h (volatile, E-145).
     diag: DiagHistory,
     startup: Startup,
@@ -346,7 +352,14 @@ impl<F: Flash, B: Flash> Drive<F, B> {
             &mut self.eoe,
             now,
         )?;
+        self.firmware_stored = foe.stored().or(self.firmware_stored);
         Ok(())
+    }
+
+    /// The FoE download verified and stored since the last call (issue 33):
+    /// the slot it is in and its version, for the log ("the image landed").
+    pub fn take_firmware_stored(&mut self) -> Option<FirmwareStored> {
+        self.firmware_stored.take()
     }
 
     /// The SNTP time now, ns since 2000-01-01 (the DC epoch), from the IP
@@ -386,13 +399,15 @@ impl<F: Flash, B: Flash> Drive<F, B> {
         let mut live = Live { diag: &mut self.diag };
         let mut foe = FirmwareFoe::new(self.boot.as_mut());
         let change = if mailbox {
-            self.slave.poll_with_eoe(
+            let change = self.slave.poll_with_eoe(
                 pdi,
                 &mut EcatApp(self.objects.parameter_channel(&mut live)),
                 &mut foe,
                 &mut self.eoe,
                 now,
-            )?
+            )?;
+            self.firmware_stored = foe.stored().or(self.firmware_stored);
+            change
         } else {
             self.slave
                 .poll_esc(pdi, &mut EcatApp(self.objects.parameter_channel(&mut live)), now)?

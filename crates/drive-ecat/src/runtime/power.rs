@@ -67,6 +67,7 @@ impl<F: Flash, B: Flash> Drive<F, B> {
             objects: DriveObjects::for_variant(variant),
             store: Some(ParamStore::new(flash)),
             boot,
+            firmware_stored: None,
             diag: DiagHistory::new(),
             startup: Startup::Defaults,
             last_code: AlStatusCode(0xFFFF),
@@ -107,6 +108,9 @@ impl<F: Flash, B: Flash> Drive<F, B> {
         self.startup = self.load_saved();
         self.compile_pdo_image();
         self.update_live();
+        // E54: the slot a download goes to (the boot decision is made)
+        let update_slot = update_slot_value(self.boot.as_ref().map(BootSlots::inactive));
+        let _ = self.objects.set(E54, 0, update_slot);
     }
 
     /// Loads the saved parameter set into the dictionary (defaults stay when
