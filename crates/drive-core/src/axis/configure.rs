@@ -15,6 +15,7 @@ impl Axis {
         self.params.jog_jerk = if j > 0.0 { j } else { f32::INFINITY };
         self.params.jog_position_control = o.i26 != 0;
         self.params.quick_stop_on_enable_loss = o.a44 == 1;
+        self.configure_brake(o);
         self.params.limits.endless_axis = o.i00 == 1;
         self.params.limits.permitted_direction = match o.i04 {
             1 => PermittedDirection::PositiveOnly,

@@ -31,6 +31,10 @@ const fn c(line: u16) -> u16 {
 const fn i_(line: u16) -> u16 {
     parameter_index(8, line)
 }
+/// Group F parameter `line`.
+const fn f(line: u16) -> u16 {
+    parameter_index(5, line)
+}
 /// Group G parameter `line`.
 const fn g(line: u16) -> u16 {
     parameter_index(6, line)
@@ -40,7 +44,7 @@ const fn g(line: u16) -> u16 {
 const REV_INC: i64 = 1 << 20;
 
 /// The control settings of axis A, sorted by index.
-pub const PARAMS: [Object; 25] = [
+pub const PARAMS: [Object; 27] = [
     Object::var(
         a(44),
         Value::Ram,
@@ -84,6 +88,25 @@ pub const PARAMS: [Object; 25] = [
     .axis()
     .level(1)
     .note("C40 (C-061 area): velocity window in user units/s (decimals A310): standstill I199 below it, the pv velocity-reached window; default 0.1 rev/s; effective at once"),
+    Object::var(
+        f(0),
+        Value::Ram,
+        entries![e(0, "Brake", U8, RW)
+            .range(0, 1)
+            .default_value(1)
+            .saved()],
+    )
+    .axis()
+    .level(1)
+    .note("F00 (spec cia402.md §14, C-020…C-022): 1 = active: the drive releases and applies the holding brake by the device state (released in Operation enabled on the first motion command, applied in the de-energised states, per fault reaction); 0 = inactive: the brake output stays off, the brake stays applied in every state and F06 has no effect; default 1 (ours: the manual gives none and every simulated motor carries a brake, docs/conformance.md); effective at once"),
+    Object::var(
+        f(6),
+        Value::Ram,
+        entries![e(0, "Release override", U8, RW).range(0, 1).saved()],
+    )
+    .axis()
+    .level(1)
+    .note("F06 (C-020, E-129): 1 = active: the brake is released in every state, also in Switch on disabled, Ready to switch on, Switched on, Fault and after a fault reaction (to move the axis by hand); only with brake control F00 = 1; default 0; effective at once"),
     Object::var(
         g(472),
         Value::Ram,
