@@ -16,6 +16,8 @@ impl Axis {
         self.params.jog_position_control = o.i26 != 0;
         self.params.quick_stop_on_enable_loss = o.a44 == 1;
         self.configure_brake(o);
+        self.params.following_error_fault = o.monitors.0 == 1;
+        self.params.set_value_monitoring = o.monitors.1 == 1;
         self.params.limits.endless_axis = o.i00 == 1;
         self.params.limits.permitted_direction = match o.i04 {
             1 => PermittedDirection::PositiveOnly,

@@ -75,7 +75,7 @@
 //!
 //! # Faults
 //!
-//! Following error (6065h/6066h with [`AxisParams::following_error_fault`]),
+//! Following error (6065h/6066h with the reaction I470 = 1, or beyond I21),
 //! limit switches (event 53), the extrapolation overrun of the interpolators
 //! (event 78 cause 3) and an excessive set-value jump of the master (event 78
 //! cause 4, C-148) raise a fault in the device control; on T13 the axis

@@ -1,6 +1,6 @@
 //! The axis' control settings in the one declaration (issue 40): the
 //! manufacturer parameters of the motion functions and the cascade that a
-//! master sets (groups C, G and I at `parameter_index(group, line)`, axis B
+//! master sets (groups A, C, F, G and I at `parameter_index(group, line)`, axis B
 //! at +8000h). The axis reads them when the configuration generation moves
 //! (`axis/settings.rs`), never per cycle. The motor data (group B) of the
 //! current control will join them here.
@@ -44,7 +44,7 @@ const fn g(line: u16) -> u16 {
 const REV_INC: i64 = 1 << 20;
 
 /// The control settings of axis A, sorted by index.
-pub const PARAMS: [Object; 27] = [
+pub const PARAMS: [Object; 29] = [
     Object::var(
         a(44),
         Value::Ram,
@@ -317,4 +317,23 @@ pub const PARAMS: [Object; 27] = [
     .axis()
     .level(1)
     .note("I425: 0 linear, 4 quadratic, 5 cubic (internal: the drive derives the speed feedforward), 1 and 3 external (60B1h); 2 is refused (0609 0030h); default 0; effective at once"),
+    Object::var(
+        i_(470),
+        Value::Ram,
+        entries![e(0, "Following error reaction", U8, RW).range(0, 1).saved()],
+    )
+    .axis()
+    .level(1)
+    .note("I470 (line ours: the spec names the configurable reaction of the following error window, P-159, not its parameter): what a following error beyond 6065h for 6066h does: 0 = a message, statusword bit 13 (PROFINET ZSW1 bit 8) only (default); 1 = a fault, event 54 cause 1 (603Fh 8611h) with the fault reaction 605Eh; I21 (event 54 cause 2) faults regardless; effective at once"),
+    Object::var(
+        i_(471),
+        Value::Ram,
+        entries![e(0, "Set value monitoring", U8, RW)
+            .range(0, 1)
+            .default_value(1)
+            .saved()],
+    )
+    .axis()
+    .level(1)
+    .note("I471 (line ours: the spec gives the function, on by default, not its parameter; C-148): 1 = on (default): a cyclic position set-point further from the previous one than twice 607Fh over the time between them trips event 78 cause 4 'excessive set value jump'; 0 = off; effective at once"),
 ];
