@@ -8,9 +8,13 @@ use super::*;
 /// I28/I29/I30/I43/I44/I53, I25/I425/I423, I87, I10, C40, the following
 /// error reaction I470, the set-value monitoring I471; the gains and
 /// G472/G475 go straight into the cascade, F00/F06 to the brake output) are
-/// overwritten from it at every configuration change: set them by SDO/PNU.
-/// The rest (rated torque and current: motor data; the limit-switch
-/// evaluation and reactions, the stop settle time) are not declared yet:
+/// overwritten from it at every configuration change, and so are the
+/// limit-switch evaluation flags (I101/I102 ≠ 0): set them by SDO/PNU, a
+/// [`Axis::params_mut`] change of them lasts only until the next
+/// configuration change. The rest (rated torque and current and the
+/// inertia: motor data, issue 34; the velocity filter, 606Eh's time, the
+/// software-limit reaction, C-050's reference rule, the stop settle time)
+/// are not declared (docs/conformance.md, "AxisParams after issue 40"):
 /// [`Axis::params_mut`] changes them, effective in the next cycle.
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct AxisParams {
