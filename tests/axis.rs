@@ -31,15 +31,14 @@ pub fn motor_position(sim: &RefCell<Simulation>, axis: usize) -> i64 {
 }
 
 /// The speed limits of the torque modes (G472/G475) of axis A raised to
-/// `rev_s` by SDO, as a master does (0.1 % of I10, the declared default
-/// maximum speed).
+/// `rev_s` by SDO, as a master does (0.1 % of I10, the maximum speed, read
+/// by SDO).
 pub async fn torque_mode_speed_limit<S>(sd: &ethercrab::SubDeviceRef<'_, S>, rev_s: f32)
 where
     S: std::ops::Deref<Target = ethercrab::SubDevice>,
 {
-    let i10 = drive_ecat::axis::AxisParams::default()
-        .cascade
-        .max_velocity_inc_per_s;
+    let i10: u32 = sd.sdo_read(drive_ecat::params::I10, 0).await.expect("I10 by SDO");
+    let i10 = i10 as f32;
     let per_mille = (rev_s * crate::REV as f32 / i10 * 1000.0).round() as u16;
     for index in [drive_ecat::params::G472, drive_ecat::params::G475] {
         sd.sdo_write(index, 0, per_mille).await.expect("G472/G475 by SDO");

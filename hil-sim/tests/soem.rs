@@ -427,9 +427,9 @@ fn c039_soem_raises_g472_g475_by_sdo_and_cst_pt_move_the_axis() {
     let _one = ONE_AT_A_TIME.lock().unwrap_or_else(|e| e.into_inner());
     let dir = scratch("soem-torque");
     // I10, the reference of G472/G475's percentages, as a fresh drive has it
-    let i10 = drive_ecat::axis::AxisParams::default()
-        .cascade
-        .max_velocity_inc_per_s;
+    let i10 = drive_ecat::DriveObjects::new()
+        .get(drive_ecat::params::I10, 0)
+        .expect("I10 declared");
     let line = Line::new("t", 1, 120, &dir);
     let status = line.run(
         &python,

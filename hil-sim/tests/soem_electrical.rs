@@ -23,9 +23,9 @@ fn c038_p187_soem_cst_steps_on_the_electrical_plant_give_6077h_within_2_percent(
         }
     };
     let dir = scratch("soem-cst-electrical");
-    let i10 = drive_ecat::axis::AxisParams::default()
-        .cascade
-        .max_velocity_inc_per_s;
+    let i10 = drive_ecat::DriveObjects::new()
+        .get(drive_ecat::params::I10, 0)
+        .expect("I10 declared");
     let line = Line::with_serve_args("e", 1, 120, &dir, &["--plant", "electrical"]);
     let status = line.run(&python, "cst_electrical.py", &["--i10", &i10.to_string()]);
     if !status.success() {

@@ -663,10 +663,8 @@ fn c148_set_value_jump_trips_the_monitor() {
             "stayed near {p}: {}",
             motor_position(&sim, 0)
         );
-        // monitoring off (AxisParams): the same jump is followed
-        with_drive(&sim, |d| {
-            d.drive.axes_mut()[0].params_mut().set_value_monitoring = false
-        });
+        // monitoring off (I471 = 0 by SDO): the same jump is followed
+        sd.sdo_write(parameter_index(8, 471), 0, 0u8).await.unwrap();
         m.set_controlword(CW_FAULT_RESET);
         m.run_until(20, |t| t.state() == sw::SOD).await.expect("reset");
         m.set_controlword(0);

@@ -745,11 +745,14 @@ fn c016_c017_e007_e087_e088_following_error_fault_emcy_and_reset() {
     // a rigid end stop at +0.5 rev blocks the motor
     with_drive(&sim, |d| {
         d.motors[0].params_mut().end_stops_inc = Some((-10 * i64::from(REV), i64::from(REV / 2)));
-        d.drive.axes_mut()[0].params_mut().following_error_fault = true;
     });
     with_master(&sim, async |md, clock| {
         let group = init(md, clock).await.into_op(md).await.expect("OP");
         let sd = group.subdevice(md, 0).unwrap();
+        // I470 = 1: the following error reaction is a fault (event 54)
+        sd.sdo_write(drive_ecat::parameter_index(8, 470), 0, 1u8)
+            .await
+            .unwrap();
         // following error window 0.05 rev, 10 ms (6065h, 6066h)
         sd.sdo_write(0x6065, 0, (REV / 20) as u32).await.unwrap();
         sd.sdo_write(0x6066, 0, 10u16).await.unwrap();

@@ -125,6 +125,15 @@ pub const I423: u16 = parameter_index(8, 423);
 pub const I425: u16 = parameter_index(8, 425);
 /// I20 position controller Kv, 0.1 /s (per axis).
 pub const I20: u16 = parameter_index(8, 20);
+/// I470 following error reaction: 0 message (statusword bit 13), 1 fault
+/// (event 54 cause 1) (per axis; line ours).
+pub const I470: u16 = parameter_index(8, 470);
+/// I471 set-value monitoring, C-148 (1 = on; per axis; line ours).
+pub const I471: u16 = parameter_index(8, 471);
+/// F00 brake control (1 = active, per axis).
+pub const F00: u16 = parameter_index(5, 0);
+/// F06 brake release override (1 = active, per axis).
+pub const F06: u16 = parameter_index(5, 6);
 /// G472 positive velocity limit of the torque modes, 0.1 % of I10 (per
 /// axis, C-039).
 pub const G472: u16 = parameter_index(6, 472);

@@ -468,7 +468,8 @@ fn c010_c011_quick_stop_to_standstill_then_switch_on_disabled() {
 #[test]
 fn c036_following_error_fault_goes_to_fault_and_queues_emcy() {
     let mut rig = Rig::new();
-    rig.drive.axes_mut()[0].params_mut().following_error_fault = true;
+    // I470 = 1: a following error is a fault
+    rig.set(0, crate::params::I470, 0, 1);
     rig.set(0, 0x6065, 0, 1000);
     rig.set(0, 0x6066, 0, 2);
     rig.enable(0);
@@ -685,10 +686,12 @@ fn objects_a291() -> u16 {
 fn arbitrary_object_values_do_not_panic() {
     let mut rig = Rig::new();
     rig.set(1, 0x6040, 0, 0x0F);
-    for a in rig.drive.axes_mut() {
-        a.params_mut().limits.positive_switch = true;
-        a.params_mut().limits.negative_switch = true;
-        a.params_mut().following_error_fault = true;
+    // both limit switches evaluated (I101/I102 = 1, the inputs), a
+    // following error a fault (I470 = 1)
+    for axis in 0..2 {
+        rig.set(axis, crate::params::I101, 0, 1);
+        rig.set(axis, crate::params::I101 + 1, 0, 1);
+        rig.set(axis, crate::params::I470, 0, 1);
     }
     let mut seed: u64 = 0x1234_5678_9ABC_DEF0;
     let mut next = move || {
@@ -761,7 +764,8 @@ fn axis_memory_footprint() {
 #[test]
 fn c094_c095_hardware_limit_switch_faults_and_locks_the_direction() {
     let mut rig = Rig::new();
-    rig.drive.axes_mut()[0].params_mut().limits.positive_switch = true;
+    // I101 = 1: +LS from its input
+    rig.set(0, crate::params::I101, 0, 1);
     rig.set(0, 0x6060, 0, 9);
     rig.enable(0);
     rig.set(0, 0x60FF, 0, REV_I);

@@ -317,6 +317,8 @@ impl<F: Flash, H: RecordHook> PnDrive<F, H> {
         let saved = len
             .and_then(|n| image.get(..n))
             .is_some_and(|img| self.store.save(img, LAYOUT_HASH).is_ok());
+        // A00[0] back to 0 (done), [1] 100 %, [2] the result, as on EtherCAT
+        let _ = self.objects.set(A00, 1, 0);
         let _ = self.objects.set(A00, 2, 100);
         let _ = self.objects.set(A00, 3, if saved { 0 } else { 1 });
         saved
@@ -362,6 +364,8 @@ impl<F: Flash, H: RecordHook> PnDrive<F, H> {
             .inner
             .bmp
             .set_response(out.get(..len).unwrap_or(&[]));
+        // a save asked by this request is done before its response is read
+        self.serve_saves();
     }
 
     /// The device's timers at `now`; returns when to call again at the
@@ -609,11 +613,29 @@ impl<F: Flash, H: RecordHook> PnDrive<F, H> {
         };
         let [axis, _] = &mut self.axes;
         self.profile.receive(data, &mut self.objects, axis);
-        if self.profile.take_save_request() {
-            // PNU 971: the parameters and the records (one image)
-            let _ = self.save();
-            self.profile.save_done();
+        self.serve_saves();
+    }
+
+    /// The saves asked through the parameter access, PKW or record 0xB02E:
+    /// PNU 971 = 1 or 256 (the profile's), A00\[0\] = 1 and 1010h:01 "save"
+    /// (the dictionary's, reached as PNU = index). Saving is synchronous
+    /// here, so the save is done before the request is answered or the
+    /// next telegram is read: PNU 971 reads 0 again at once. The parameters
+    /// and the records are one image (P-199, P-200).
+    fn serve_saves(&mut self) {
+        let profile = self.profile.take_save_request();
+        let requests = self.objects.requests();
+        if !profile && !requests.save {
+            return;
         }
+        if requests.save {
+            // a restart asked as well stays asked
+            if self.objects.take_requests().restart {
+                self.objects.request_restart();
+            }
+        }
+        let _ = self.save();
+        self.profile.save_done();
     }
 
     /// The response telegram into the input data (after the axes' cycle).

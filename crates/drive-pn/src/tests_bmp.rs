@@ -75,3 +75,95 @@ fn p206_record_0xb02e_refusals() {
     let (s, _) = record_at(&mut d, 24, false, RECORD_INDEX, &[]);
     assert_ne!(s, PnioStatus::OK, "read once");
 }
+
+/// A change request of (PNU, subindex, format, big-endian value) in one
+/// request: the addresses first, then the values.
+fn change_req(reference: u8, params: &[(u16, u16, u8, &[u8])]) -> std::vec::Vec<u8> {
+    let mut v = std::vec![reference, 0x02, 0x01, params.len() as u8];
+    for &(pnu, sub, _, _) in params {
+        v.extend_from_slice(&[0x10, 1]);
+        v.extend_from_slice(&pnu.to_be_bytes());
+        v.extend_from_slice(&sub.to_be_bytes());
+    }
+    for &(_, _, format, value) in params {
+        v.extend_from_slice(&[format, 1]);
+        v.extend_from_slice(value);
+    }
+    v
+}
+
+/// One request written and its response read.
+fn exchange(d: &mut super::PnDrive<super::tests::TestFlash>, seq: u32, req: &[u8]) -> std::vec::Vec<u8> {
+    assert_eq!(record_at(d, seq, true, RECORD_INDEX, req).0, PnioStatus::OK);
+    let (s, r) = record_at(d, seq + 1, false, RECORD_INDEX, &[]);
+    assert_eq!(s, PnioStatus::OK);
+    r
+}
+
+const G472: u16 = drive_core::parameter_index(6, 472);
+const C31: u16 = drive_core::parameter_index(2, 31);
+
+/// P-199 through record 0xB02E alone (a device-access AR, no cyclic
+/// data): G472 and the speed controller's Kp C31 changed, PNU 971 = 1
+/// saves at once (PNU 971 reads 0 in the next request), a change after
+/// the save is lost at the restart, the saved values come back.
+#[test]
+fn p199_p206_pnu_971_through_0xb02e_saves_without_cyclic_data() {
+    let mut d = drive();
+    let r = exchange(
+        &mut d,
+        30,
+        &change_req(
+            1,
+            &[
+                (G472, 0, 0x06, &500u16.to_be_bytes()),
+                (C31, 0, 0x07, &90_000u32.to_be_bytes()),
+            ],
+        ),
+    );
+    assert_eq!(r, [1, 0x02, 0x01, 2], "both changed");
+    let r = exchange(&mut d, 32, &change_req(2, &[(971, 0, 0x06, &1u16.to_be_bytes())]));
+    assert_eq!(r, [2, 0x02, 0x01, 1], "save taken");
+    let r = exchange(&mut d, 34, &read_req(3, &[(971, 0)]));
+    assert_eq!(
+        r,
+        [3, 0x01, 0x01, 1, 0x06, 1, 0, 0],
+        "PNU 971 reads 0: the save is over"
+    );
+    assert_eq!(
+        d.objects().get(drive_core::params::A00, 3),
+        Ok(0),
+        "A00[2]: saved"
+    );
+    // not saved: gone at the restart
+    exchange(
+        &mut d,
+        36,
+        &change_req(4, &[(C31, 0, 0x07, &70_000u32.to_be_bytes())]),
+    );
+    let mut d = super::tests::connected(super::PnDrive::new(d.into_flash(), super::tests::hardware()));
+    let r = exchange(&mut d, 40, &read_req(5, &[(G472, 0), (C31, 0)]));
+    let (g, c) = (500u16.to_be_bytes(), 90_000u32.to_be_bytes());
+    assert_eq!(
+        r,
+        [5, 0x01, 0x01, 2, 0x06, 1, g[0], g[1], 0x07, 1, c[0], c[1], c[2], c[3]]
+    );
+}
+
+/// The dictionary's save (A00\[0\] = 1, PNU = index 2000h sub 1) through
+/// 0xB02E saves as PNU 971 does; A00\[0\] reads 0 afterwards.
+#[test]
+fn p199_a00_through_0xb02e_saves() {
+    let mut d = drive();
+    exchange(
+        &mut d,
+        50,
+        &change_req(1, &[(G472, 0, 0x06, &300u16.to_be_bytes())]),
+    );
+    let a00 = drive_core::params::A00;
+    let r = exchange(&mut d, 52, &change_req(2, &[(a00, 1, 0x05, &[1, 0])]));
+    assert_eq!(r, [2, 0x02, 0x01, 1], "save taken");
+    assert_eq!(d.objects().get(a00, 1), Ok(0), "A00[0]: done");
+    let d = super::PnDrive::new(d.into_flash(), super::tests::hardware());
+    assert_eq!(d.objects().get(G472, 0), Ok(300));
+}

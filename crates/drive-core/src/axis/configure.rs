@@ -15,7 +15,13 @@ impl Axis {
         self.params.jog_jerk = if j > 0.0 { j } else { f32::INFINITY };
         self.params.jog_position_control = o.i26 != 0;
         self.params.quick_stop_on_enable_loss = o.a44 == 1;
+        self.configure_brake(o);
+        self.params.following_error_fault = o.monitors.0 == 1;
+        self.params.set_value_monitoring = o.monitors.1 == 1;
         self.params.limits.endless_axis = o.i00 == 1;
+        // I101/I102 (C-104): 0 off, 1 the input, 2 I210
+        self.params.limits.positive_switch = o.switch_source[0] != 0;
+        self.params.limits.negative_switch = o.switch_source[1] != 0;
         self.params.limits.permitted_direction = match o.i04 {
             1 => PermittedDirection::PositiveOnly,
             2 => PermittedDirection::NegativeOnly,
@@ -141,9 +147,6 @@ impl Axis {
             window_inc: o.target_window,
             switch_polarity: SwitchPolarity::HighActive,
             soft_limit_reaction,
-            // I101/I102 (C-104) switch the evaluation on as well
-            positive_switch: p.limits.positive_switch || o.switch_source[0] != 0,
-            negative_switch: p.limits.negative_switch || o.switch_source[1] != 0,
             ..p.limits
         });
     }

@@ -75,7 +75,7 @@
 //!
 //! # Faults
 //!
-//! Following error (6065h/6066h with [`AxisParams::following_error_fault`]),
+//! Following error (6065h/6066h with the reaction I470 = 1, or beyond I21),
 //! limit switches (event 53), the extrapolation overrun of the interpolators
 //! (event 78 cause 3) and an excessive set-value jump of the master (event 78
 //! cause 4, C-148) raise a fault in the device control; on T13 the axis
@@ -83,6 +83,7 @@
 //! [`fault_code_for_event`]) and sets 603Fh and its error register, on T15
 //! it reports [`FaultChange::Cleared`].
 
+mod brake;
 mod cache;
 mod configure;
 mod current;
@@ -283,6 +284,8 @@ pub struct Axis {
     torque_limit_per_mille: u16,
     /// The record status of the last cycle, packed.
     record_status: u32,
+    /// F00 brake control active, F06 release override active (`brake.rs`).
+    brake: (bool, bool),
 }
 
 impl Axis {
@@ -347,6 +350,7 @@ impl Axis {
             torque_mode_speed_limit: f32::NAN,
             torque_limit_per_mille: u16::MAX,
             record_status: 0,
+            brake: (true, false),
         }
     }
 
@@ -589,7 +593,7 @@ impl Axis {
             // a faulty encoder (event 37) as well
             fault_present: self.limits.both_switches_hit() || !io.encoder_ok,
             motion_command: self.motion_command(o),
-            brake_override: false,
+            brake_override: self.brake_override(),
             target_reached: false,
             mode_bit12: false,
             mode_bit13: false,
@@ -623,21 +627,10 @@ impl Axis {
             command: AxisCommand {
                 torque_nm: sign * torque,
                 power_stage: out.power_stage,
-                brake_release: out.brake_release,
+                brake_release: self.brake_output(out.brake_release),
             },
             transition: out.transition,
             fault,
-        }
-    }
-
-    /// Whether the mode has an active motion command (brake release, C-021).
-    fn motion_command(&self, o: &Snapshot) -> bool {
-        match self.dc.mode() {
-            Mode::CyclicPosition | Mode::CyclicVelocity | Mode::CyclicTorque => true,
-            Mode::ProfileVelocity => o.target_velocity != 0,
-            Mode::ProfileTorque => o.target_torque != 0,
-            Mode::Velocity => o.vl_target != 0,
-            _ => false,
         }
     }
 

@@ -5,13 +5,17 @@ use super::*;
 
 /// The axis' working settings, with their defaults. Those the dictionary
 /// declares (issue 40: A44, I00, I04, jog I12/I13/I45/I18/I26, homing
-/// I28/I29/I30/I43/I44/I53, I25/I425/I423, I87, I10, C40; the gains and
-/// G472/G475 go straight into the cascade) are overwritten from it at every
-/// configuration change: set them by SDO/PNU. The rest (rated torque and
-/// current: motor data; the following error as a fault, set-value
-/// monitoring, the limit-switch evaluation and reactions, the stop settle
-/// time) are not declared yet: [`Axis::params_mut`] changes them, effective
-/// in the next cycle.
+/// I28/I29/I30/I43/I44/I53, I25/I425/I423, I87, I10, C40, the following
+/// error reaction I470, the set-value monitoring I471; the gains and
+/// G472/G475 go straight into the cascade, F00/F06 to the brake output) are
+/// overwritten from it at every configuration change, and so are the
+/// limit-switch evaluation flags (I101/I102 ≠ 0): set them by SDO/PNU, a
+/// [`Axis::params_mut`] change of them lasts only until the next
+/// configuration change. The rest (rated torque and current and the
+/// inertia: motor data, issue 34; the velocity filter, 606Eh's time, the
+/// software-limit reaction, C-050's reference rule, the stop settle time)
+/// are not declared (docs/conformance.md, "AxisParams after issue 40"):
+/// [`Axis::params_mut`] changes them, effective in the next cycle.
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct AxisParams {
     /// 6076h rated torque, N·m (motor data); 0.1 % torque objects refer to it.
@@ -39,8 +43,8 @@ pub struct AxisParams {
     pub velocity_window_time_ns: Nanos,
     /// I87 time in the position window.
     pub position_window_time_ns: Nanos,
-    /// Following error (6065h/6066h) is a fault (event 54), not only
-    /// statusword bit 13.
+    /// I470 = 1: a following error (6065h/6066h) is a fault (event 54
+    /// cause 1), not only statusword bit 13 (from the dictionary).
     pub following_error_fault: bool,
     /// Limit switches and axis type (I101/I102, I00, I04, software-limit
     /// reaction). The software limits come from 607Dh, the window from I22;
@@ -48,9 +52,10 @@ pub struct AxisParams {
     pub limits: LimitConfig,
     /// C-050: absolute pp moves need a referenced axis.
     pub absolute_needs_reference: bool,
-    /// C-148 set-value monitoring: a cyclic position set-point further from
-    /// the previous one than twice 607Fh over the time between them trips
-    /// event 78 cause 4 "excessive set value jump".
+    /// I471, C-148 set-value monitoring (from the dictionary): a cyclic
+    /// position set-point further from the previous one than twice 607Fh
+    /// over the time between them trips event 78 cause 4 "excessive set
+    /// value jump".
     pub set_value_monitoring: bool,
     /// Jog (I12, I13, I45, I18, I26): taken from the dictionary at every
     /// configuration change (issue 40); what is set here is overwritten.

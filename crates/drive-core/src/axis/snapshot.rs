@@ -14,9 +14,9 @@ use crate::{AXIS_B_CIA402, AXIS_B_MANUFACTURER};
 use motion::scaling::AxisScaling;
 
 pub(crate) use crate::params::{
-    A150, A213, A291, A310, A311, A340, A44, A66, A67, C31, C32, C40, E47, E48, E49, E80, G472, G475, I00,
-    I02, I04, I10, I101, I12, I13, I18, I20, I21, I210, I22, I23, I25, I26, I28, I29, I30, I423, I425, I43,
-    I44, I45, I46, I53, I87,
+    A150, A213, A291, A310, A311, A340, A44, A66, A67, C31, C32, C40, E47, E48, E49, E80, F00, F06, G472,
+    G475, I00, I02, I04, I10, I101, I12, I13, I18, I20, I21, I210, I22, I23, I25, I26, I28, I29, I30, I423,
+    I425, I43, I44, I45, I46, I470, I471, I53, I87,
 };
 
 /// Entry `index`:`sub`, or 0 with `misses` counted: the dictionary declares
@@ -329,6 +329,11 @@ pub(crate) struct Snapshot {
     pub speeds: [u32; 3],
     /// A44 quick stop on the loss of A60 (1 = active).
     pub a44: u8,
+    /// F00 brake control (1 = active), F06 release override (1 = active).
+    pub brake: (u8, u8),
+    /// I470 following error reaction (1 = fault), I471 set-value
+    /// monitoring (1 = on).
+    pub monitors: (u8, u8),
     /// I00 position range (1 = endless).
     pub i00: u8,
     /// I04 permitted direction (0 both, 1 positive, 2 negative).
@@ -476,6 +481,14 @@ impl Snapshot {
                 sat(w.param(od, I44, 0, m), 0u32, u32::MAX),
             ],
             a44: sat(w.param(od, A44, 0, m), 0u8, u8::MAX),
+            brake: (
+                sat(w.param(od, F00, 0, m), 0u8, u8::MAX),
+                sat(w.param(od, F06, 0, m), 0u8, u8::MAX),
+            ),
+            monitors: (
+                sat(w.param(od, I470, 0, m), 0u8, u8::MAX),
+                sat(w.param(od, I471, 0, m), 0u8, u8::MAX),
+            ),
             i00: sat(w.param(od, I00, 0, m), 0u8, u8::MAX),
             i04: sat(w.param(od, I04, 0, m), 0u8, u8::MAX),
             gains: (

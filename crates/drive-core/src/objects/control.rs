@@ -1,6 +1,6 @@
 //! The axis' control settings in the one declaration (issue 40): the
 //! manufacturer parameters of the motion functions and the cascade that a
-//! master sets (groups C, G and I at `parameter_index(group, line)`, axis B
+//! master sets (groups A, C, F, G and I at `parameter_index(group, line)`, axis B
 //! at +8000h). The axis reads them when the configuration generation moves
 //! (`axis/settings.rs`), never per cycle. The motor data (group B) of the
 //! current control will join them here.
@@ -31,6 +31,10 @@ const fn c(line: u16) -> u16 {
 const fn i_(line: u16) -> u16 {
     parameter_index(8, line)
 }
+/// Group F parameter `line`.
+const fn f(line: u16) -> u16 {
+    parameter_index(5, line)
+}
 /// Group G parameter `line`.
 const fn g(line: u16) -> u16 {
     parameter_index(6, line)
@@ -40,7 +44,7 @@ const fn g(line: u16) -> u16 {
 const REV_INC: i64 = 1 << 20;
 
 /// The control settings of axis A, sorted by index.
-pub const PARAMS: [Object; 25] = [
+pub const PARAMS: [Object; 29] = [
     Object::var(
         a(44),
         Value::Ram,
@@ -84,6 +88,25 @@ pub const PARAMS: [Object; 25] = [
     .axis()
     .level(1)
     .note("C40 (C-061 area): velocity window in user units/s (decimals A310): standstill I199 below it, the pv velocity-reached window; default 0.1 rev/s; effective at once"),
+    Object::var(
+        f(0),
+        Value::Ram,
+        entries![e(0, "Brake", U8, RW)
+            .range(0, 1)
+            .default_value(1)
+            .saved()],
+    )
+    .axis()
+    .level(1)
+    .note("F00 (spec cia402.md §14, C-020…C-022): 1 = active: the drive releases and applies the holding brake by the device state (released in Operation enabled on the first motion command, applied in the de-energised states, per fault reaction); 0 = inactive: the brake output stays off, the brake stays applied in every state and F06 has no effect; default 1 (ours: the manual gives none and every simulated motor carries a brake, docs/conformance.md); effective at once"),
+    Object::var(
+        f(6),
+        Value::Ram,
+        entries![e(0, "Release override", U8, RW).range(0, 1).saved()],
+    )
+    .axis()
+    .level(1)
+    .note("F06 (C-020, E-129): 1 = active: the brake is released in every state, also in Switch on disabled, Ready to switch on, Switched on, Fault and after a fault reaction (to move the axis by hand); only with brake control F00 = 1; default 0; effective at once"),
     Object::var(
         g(472),
         Value::Ram,
@@ -294,4 +317,23 @@ pub const PARAMS: [Object; 25] = [
     .axis()
     .level(1)
     .note("I425: 0 linear, 4 quadratic, 5 cubic (internal: the drive derives the speed feedforward), 1 and 3 external (60B1h); 2 is refused (0609 0030h); default 0; effective at once"),
+    Object::var(
+        i_(470),
+        Value::Ram,
+        entries![e(0, "Following error reaction", U8, RW).range(0, 1).saved()],
+    )
+    .axis()
+    .level(1)
+    .note("I470 (line ours: the spec names the configurable reaction of the following error window, P-159, not its parameter): what a following error beyond 6065h for 6066h does: 0 = a message, statusword bit 13 (PROFINET ZSW1 bit 8) only (default); 1 = a fault, event 54 cause 1 (603Fh 8611h) with the fault reaction 605Eh; I21 (event 54 cause 2) faults regardless; effective at once"),
+    Object::var(
+        i_(471),
+        Value::Ram,
+        entries![e(0, "Set value monitoring", U8, RW)
+            .range(0, 1)
+            .default_value(1)
+            .saved()],
+    )
+    .axis()
+    .level(1)
+    .note("I471 (line ours: the spec gives the function, on by default, not its parameter; C-148): 1 = on (default): a cyclic position set-point further from the previous one than twice 607Fh over the time between them trips event 78 cause 4 'excessive set value jump'; 0 = off; effective at once"),
 ];
