@@ -417,9 +417,13 @@ impl SimDrive {
             self.cycle = dt;
         }
         let axes = self.motors.iter_mut().zip(self.feedback.iter_mut());
-        for (((motor, fb), c), el) in axes.zip(cmd).zip(self.electrical.iter_mut()) {
+        let data = self.drive.axes().each_ref().map(|a| *a.motor());
+        for ((((motor, fb), c), el), data) in axes.zip(cmd).zip(self.electrical.iter_mut()).zip(data) {
             *fb = Some(match el {
                 Some(el) => {
+                    // the motor data as the drive has them (applied when
+                    // they changed; a refused set keeps the loop's)
+                    let _ = el.set_motor_data(&data);
                     el.command(&c);
                     el.run(motor, self.cycle)
                 }
