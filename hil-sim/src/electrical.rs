@@ -26,13 +26,15 @@
 //! PWM period's sample) into the next cycle's `AxisIo::current`, so 6077h and
 //! 6078h show the measurement, as the board's do.
 //!
-//! What this does not do yet: a trip of the current loop's protection
-//! (over-current, encoder) switches the gates off without the drive core
-//! hearing of it.
+//! A trip of the current loop's protection (over-current, phase sum, DC link,
+//! encoder) switches the gates off in its PWM period and reaches the drive
+//! core in [`CurrentActual::trip`]: the axis faults with the manual's event
+//! (over-current: 33, 2310h). The loop's gains and limits come from the
+//! dictionary's motor data ([`ElectricalAxis::set_motor_data`]).
 
 use crate::motor::{EdgeList, IndexEvent, Motor, MotorOutputs, INC_PER_RAD};
-use drive_ecat::axis::{AxisCommand, CurrentActual, CurrentControl};
-use foc::{FocAxis, LoopParams, MotorData, PowerStage, Protection};
+use drive_ecat::axis::{AxisCommand, CurrentActual, CurrentControl, CurrentTrip};
+use foc::{FocAxis, LoopParams, MotorData, PowerStage, Protection, Trip};
 use nanos::Nanos;
 use plant::{Plant, PlantParams, Shaft};
 
@@ -123,10 +125,19 @@ pub struct ElectricalAxis {
     command: AxisCommand,
     /// Mean of the measured iq over the last control cycle's PWM periods, A.
     iq_cycle_mean: f32,
+    /// The motor data and loop parameters the loop runs with.
+    motor: MotorData,
+    params: LoopParams,
 }
 
 impl CurrentControl for ElectricalAxis {
+    /// A latched trip clears when the axis switches the power stage on again
+    /// (it does so only after the trip's fault was acknowledged); a cause
+    /// still present trips again in the next PWM period.
     fn command(&mut self, command: &AxisCommand) {
+        if command.power_stage && !self.command.power_stage {
+            self.foc.reset_trip();
+        }
         self.command = *command;
     }
 
@@ -139,6 +150,14 @@ impl CurrentControl for ElectricalAxis {
         Some(CurrentActual {
             torque_nm: self.foc.gains().kt_nm_per_a * iq,
             current_a: iq,
+            trip: self.foc.trip().map(|t| match t {
+                Trip::OverCurrent => CurrentTrip::OverCurrent,
+                Trip::PhaseSum => CurrentTrip::PhaseSum,
+                Trip::DcUnderVoltage => CurrentTrip::DcUnderVoltage,
+                Trip::DcOverVoltage => CurrentTrip::DcOverVoltage,
+                Trip::EncoderLost => CurrentTrip::EncoderLost,
+                Trip::MotorI2t => CurrentTrip::MotorI2t,
+            }),
         })
     }
 }
@@ -163,7 +182,14 @@ impl ElectricalAxis {
 
     /// An axis of this plant and current loop, or the loop parameter refused.
     pub fn new(p: PlantParams, motor: MotorData, params: LoopParams) -> Result<Self, foc::ParamError> {
-        let foc = FocAxis::new(motor, params, p.scaling(), Protection::default_stage())?;
+        // the drive core owns the motor protection (its i²t with U10/U11
+        // limits the torque it commands): the loop's own i²t is the backstop
+        let stage = Protection {
+            i2t_limits: false,
+            ..Protection::default_stage()
+        };
+        let foc = FocAxis::new(motor, params, p.scaling(), stage)?;
+        let (motor_data, loop_params) = (motor, params);
         let period = Nanos::from_ns((1.0e9 / p.inverter.pwm_hz + 0.5) as u64);
         Ok(Self {
             plant: Plant::new(p),
@@ -173,7 +199,42 @@ impl ElectricalAxis {
             last: CurrentSnapshot::default(),
             command: AxisCommand::OFF,
             iq_cycle_mean: 0.0,
+            motor: motor_data,
+            params: loop_params,
         })
+    }
+
+    /// The motor data of the drive's dictionary (issue 34) for the current
+    /// loop: its gains by pole-zero cancellation (Kp = ω_c·L, Ki = ω_c·R with
+    /// ω_c = 2π·B64), kt, the rated and the maximum current and the thermal
+    /// time constant of its own i²t backstop. Applied when they changed; a set
+    /// the loop refuses (ω_c above a fifth of the PWM rate) leaves the loop as
+    /// it was. The plant (the motor itself) keeps its own data: motor data
+    /// that do not match it detune the loop, as on a real drive.
+    pub fn set_motor_data(&mut self, m: &drive_ecat::axis::MotorData) -> Result<(), foc::ParamError> {
+        let kt = m.torque_constant_nm_per_a;
+        let p = u32::from(m.pole_pairs.max(1));
+        let motor = MotorData {
+            r_ohm: m.r_ohm,
+            ld_h: m.ld_h,
+            lq_h: m.lq_h,
+            psi_vs: kt / (1.5 * p as f32),
+            pole_pairs: p,
+            rated_current_a: m.rated_current_a,
+            max_current_a: m.rated_current_a * f32::from(m.max_current_per_mille) * 1e-3,
+            thermal_time_constant_s: m.thermal_time_constant_s,
+        };
+        let params = LoopParams {
+            omega_c_rad_s: core::f32::consts::TAU * m.bandwidth_hz,
+            ..self.params
+        };
+        if motor == self.motor && params == self.params {
+            return Ok(());
+        }
+        self.foc.set_params(motor, params)?;
+        self.motor = motor;
+        self.params = params;
+        Ok(())
     }
 
     /// The plant.

@@ -2,13 +2,13 @@
 //! with the real slave stack (`ecat`) and the drive's objects (`drive`) behind
 //! its PDI. Frames from any master go through [`Simulation::exchange`].
 
-use crate::electrical::{ElectricalAxis, PlantModel};
+use crate::electrical::ElectricalAxis;
 use crate::esc::{Esc, EscConfig, LineTiming};
 use crate::frame::process_frame;
 use crate::motor::{Motor, MotorOutputs};
-use drive_ecat::axis::CurrentControl;
 mod axis_io;
 mod flash;
+mod plant;
 mod snapshot;
 mod stamps;
 mod variant;
@@ -397,13 +397,7 @@ impl SimDrive {
             axis_io(self.feedback[0].as_ref(), &self.motors[0], self.conditions[0]),
             axis_io(self.feedback[1].as_ref(), &self.motors[1], self.conditions[1]),
         ];
-        // the current seam: the electrical axes' measured iq (the rigid
-        // model measures nothing: the axes show their demand)
-        for (io, el) in io.iter_mut().zip(&self.electrical) {
-            if let Some(el) = el {
-                io.current = el.actual();
-            }
-        }
+        self.measure_currents(&mut io);
         let cmd = match command {
             Some(c) => self.drive.sync_cycle(&c, t, &io),
             None => self.drive.control_cycle(t, &io),
@@ -416,23 +410,7 @@ impl SimDrive {
         if !dt.is_zero() {
             self.cycle = dt;
         }
-        let axes = self.motors.iter_mut().zip(self.feedback.iter_mut());
-        for (((motor, fb), c), el) in axes.zip(cmd).zip(self.electrical.iter_mut()) {
-            *fb = Some(match el {
-                Some(el) => {
-                    el.command(&c);
-                    el.run(motor, self.cycle)
-                }
-                None => {
-                    let torque = if c.power_stage {
-                        f64::from(c.torque_nm)
-                    } else {
-                        0.0
-                    };
-                    motor.step(torque, !c.brake_release, self.cycle)
-                }
-            });
-        }
+        self.step_motors(cmd);
     }
 
     /// Runs the drive firmware up to `now`: every control cycle that is due
@@ -456,26 +434,6 @@ impl SimDrive {
 }
 
 impl SimDrive {
-    /// Runs both axes on `model` from the next control cycle on (the motors'
-    /// mechanics and position stay; an electrical axis starts with zero current).
-    /// `seed` seeds the ADC noise (axis B gets `seed + 1`).
-    pub fn set_plant(&mut self, model: PlantModel, seed: u64) -> Result<(), foc::ParamError> {
-        for (k, el) in self.electrical.iter_mut().enumerate() {
-            *el = match model {
-                PlantModel::Rigid => None,
-                PlantModel::Electrical => Some(Box::new(ElectricalAxis::default_servo(
-                    seed.wrapping_add(k as u64),
-                )?)),
-            };
-        }
-        Ok(())
-    }
-
-    /// Axis `axis`' current loop and PMSM, if it runs the electrical model.
-    pub fn electrical(&self, axis: usize) -> Option<&ElectricalAxis> {
-        self.electrical.get(axis).and_then(|e| e.as_deref())
-    }
-
     /// What motor `axis` (0 = A, 1 = B) did in the last control cycle
     /// (torque applied, brake applied, …), `None` before the first cycle.
     pub fn motor_outputs(&self, axis: usize) -> Option<&MotorOutputs> {

@@ -32,3 +32,30 @@ fn c038_p187_soem_cst_steps_on_the_electrical_plant_give_6077h_within_2_percent(
         line.fail_with(&format!("cst_electrical.py through SOEM failed: {status}"));
     }
 }
+
+/// C-038 and E-089 through SOEM on the electrical plant
+/// (`motor_protection.py`, issue 34): the motor data by SDO (6076h = kt ×
+/// 6075h; zero pole pairs, zero rated current and a bandwidth above a fifth
+/// of the PWM rate refused with 0609 0032h/0031h); 6073h lowered to 50 %
+/// limits 6077h and the measured current 6078h in cst to ±500 ‰ (within 2 %,
+/// statusword bit 11); 200 % of the rated current gives the i²t warning
+/// (bit 7) at the first-order thermal model's t = −τ·ln(1 − (I_r/I)²) (within
+/// 3 % + 20 ms, with the mean of the measured (I/I_r)²), the current held at
+/// the rated current (bit 11), and U11 later the fault 4380h (603Fh and EMCY,
+/// event 45).
+#[test]
+fn c038_e089_soem_max_current_and_motor_i2t_on_the_electrical_plant() {
+    let python = match pysoem_python() {
+        Ok(p) => p,
+        Err(why) => {
+            eprintln!("soem motor protection test: skipped, {why}");
+            return;
+        }
+    };
+    let dir = scratch("soem-motor-protection");
+    let line = Line::with_serve_args("m", 1, 120, &dir, &["--plant", "electrical"]);
+    let status = line.run(&python, "motor_protection.py", &[]);
+    if !status.success() {
+        line.fail_with(&format!("motor_protection.py through SOEM failed: {status}"));
+    }
+}

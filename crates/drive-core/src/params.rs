@@ -185,3 +185,21 @@ pub const A277: u16 = parameter_index(0, 277);
 pub const A278: u16 = parameter_index(0, 278);
 /// The PROFINET personality's persistent parameters, A270…A278.
 pub const PROFINET_PARAMS: [u16; 9] = [A270, A271, A272, A273, A274, A275, A276, A277, A278];
+/// B10 pole pair number (per axis, motor data; issue 34).
+pub const B10: u16 = parameter_index(1, 10);
+/// B17 torque constant, mN·m/A (per axis, motor data).
+pub const B17: u16 = parameter_index(1, 17);
+/// B52 d-axis inductance Ld, µH (per axis, motor data).
+pub const B52: u16 = parameter_index(1, 52);
+/// B53 phase resistance, mΩ (per axis, motor data).
+pub const B53: u16 = parameter_index(1, 53);
+/// B62 q-axis inductance Lq, µH (per axis, motor data).
+pub const B62: u16 = parameter_index(1, 62);
+/// B64 current-controller bandwidth, Hz (per axis).
+pub const B64: u16 = parameter_index(1, 64);
+/// B73 thermal time constant of the winding, ms (per axis, motor data).
+pub const B73: u16 = parameter_index(1, 73);
+/// U10 i²t level (0 inactive, 1 message, 2 warning, 3 fault; per axis).
+pub const U10: u16 = parameter_index(20, 10);
+/// U11 i²t warning time, ms (per axis).
+pub const U11: u16 = parameter_index(20, 11);

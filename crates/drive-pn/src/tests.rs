@@ -109,8 +109,13 @@ fn output_frame(d: &PnDrive<TestFlash>, counter: u16) -> Vec<u8> {
 /// Runs 1 ms steps from `from` to `to`: output frames every 8 ms while
 /// `frames`, a control cycle every ms; returns the alarm frames sent.
 pub(crate) fn run(d: &mut PnDrive<TestFlash>, from: u64, to: u64, frames: bool) -> Vec<Vec<u8>> {
+    run_io(d, from, to, frames, &[AxisIo::ready(0), AxisIo::ready(0)])
+}
+
+/// [`run`] with the axes' inputs `io`.
+fn run_io(d: &mut PnDrive<TestFlash>, from: u64, to: u64, frames: bool, io: &[AxisIo; 2]) -> Vec<Vec<u8>> {
     let mut alarms = Vec::new();
-    let io = [AxisIo::ready(0), AxisIo::ready(0)];
+    let io = *io;
     for ms in from..to {
         let now = Nanos::from_ms(ms);
         let mut tx = |f: &[u8]| {
@@ -145,6 +150,32 @@ fn p030_p035_a_drive_fault_is_a_diagnosis_alarm_and_goes_with_the_reset() {
     assert!(d.device().diagnosis_present());
     assert_eq!(d.objects().get(E82, 0).unwrap(), 54);
     // fault reset: controlword 0x80 on axis A
+    d.objects_mut().set(0x6040, 0, 0x80).unwrap();
+    run(&mut d, 60, 70, true);
+    assert!(!d.device().diagnosis_present(), "the reset clears the diagnosis");
+}
+
+/// E-089's event table on PROFINET (issue 34): an over-current trip of
+/// axis A's current loop is the PROFIdrive fault of event 33: a diagnosis
+/// alarm, E82 = 33, 603Fh = 2310h; the acknowledge clears it once the loop
+/// reports no trip.
+#[test]
+fn p030_e089_a_current_loop_over_current_trip_is_a_diagnosis_alarm_with_event_33() {
+    use drive_core::axis::{CurrentActual, CurrentTrip};
+    let mut d = drive();
+    run(&mut d, 0, 50, true);
+    let mut tripped = AxisIo::ready(0);
+    tripped.current = Some(CurrentActual {
+        torque_nm: 0.0,
+        current_a: 0.0,
+        trip: Some(CurrentTrip::OverCurrent),
+    });
+    let alarms = run_io(&mut d, 50, 60, true, &[tripped, AxisIo::ready(0)]);
+    assert_eq!(alarms.len(), 1, "one appears alarm");
+    assert!(d.device().diagnosis_present());
+    assert_eq!(d.objects().get(E82, 0).unwrap(), 33);
+    assert_eq!(d.objects().get(0x603F, 0).unwrap(), 0x2310);
+    assert!(d.axes()[0].state().is_fault());
     d.objects_mut().set(0x6040, 0, 0x80).unwrap();
     run(&mut d, 60, 70, true);
     assert!(!d.device().diagnosis_present(), "the reset clears the diagnosis");

@@ -23,11 +23,17 @@ pub struct Protection {
     pub dc_link: DcLink,
     /// The power stage's current limit, A.
     pub stage_current_a: f32,
+    /// The loop's own i²t model limits the current to the rated current at
+    /// 100 %. Off where the control cycle above owns the motor protection
+    /// (the drive core's i²t with U10/U11 limits through the torque it
+    /// commands): the loop's model is then only the fault backstop at
+    /// [`I2t::fault_level`](crate::protect::I2t::fault_level).
+    pub i2t_limits: bool,
 }
 
 impl Protection {
     /// Trip at 9 A, phase sum within 0.3 A, DC link 400…800 V (400 V mains,
-    /// 565 V nominal), power stage 8 A.
+    /// 565 V nominal), power stage 8 A, the i²t model limiting.
     pub const fn default_stage() -> Self {
         Self {
             over_current: OverCurrent { threshold_a: 9.0 },
@@ -37,6 +43,7 @@ impl Protection {
                 max_v: 800.0,
             },
             stage_current_a: 8.0,
+            i2t_limits: true,
         }
     }
 }
@@ -239,7 +246,8 @@ impl FocAxis {
                 None
             };
         }
-        let i2t_limit = if i2t == I2tState::Normal || i2t == I2tState::Warning {
+        let i2t_limit = if !self.protection.i2t_limits || i2t == I2tState::Normal || i2t == I2tState::Warning
+        {
             f32::INFINITY
         } else {
             self.motor.rated_current_a

@@ -38,7 +38,11 @@ impl Axis {
         self.params.max_extrapolation_ns = ms_to_ns(i423);
         self.params.position_window_time_ns = ms_to_ns(o.i87);
         let [i10, c40, i44] = o.speeds.map(|x| x as f32);
-        self.params.cascade.max_velocity_inc_per_s = i10;
+        // the motor data (issue 34), prepared for the cycle: I10 is capped
+        // by the motor's 6080h
+        self.motor = o.motor;
+        self.i2t.configure(&o.motor, dt_ns);
+        self.params.cascade.max_velocity_inc_per_s = i10.min(o.motor.max_speed_inc_per_s());
         self.params.velocity_window_inc_per_s = c40;
         self.params.homing_jerk = if i44 > 0.0 { i44 } else { f32::INFINITY };
         let p = self.params;
@@ -47,10 +51,10 @@ impl Axis {
         } else {
             None
         };
-        // 6076h from the motor data, and the probe values in the (new) units
+        // 6076h = kt × 6075h, and the probe values in the (new) units
         od.write_typed(
-            slots.rated_current,
-            round_i32(p.rated_torque_nm * 1000.0).max(0) as u32,
+            slots.rated_torque,
+            round_i32(self.motor.rated_torque_nm() * 1000.0).max(0) as u32,
         );
         self.probe_shown = false;
         let opts = self.dc.options_mut();
@@ -94,8 +98,10 @@ impl Axis {
         } else {
             o.max_torque
         };
-        let per_mille = per_mille.min(self.torque_limit_per_mille);
-        let max_nm = p.rated_torque_nm * f32::from(per_mille) * 0.001;
+        // the current limit (6073h, 2415h.02, i²t: motor.rs) in ‰ of the
+        // rated current is the same ‰ of the rated torque (T = kt·i)
+        let per_mille = per_mille.min(self.current_limit_per_mille());
+        let max_nm = self.motor.rated_torque_nm() * f32::from(per_mille) * 0.001;
         // G472/G475 (C-039): 0.1 % of the maximum speed I10
         let [g472, g475] = o
             .torque_mode_speed_limit

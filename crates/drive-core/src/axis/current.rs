@@ -16,6 +16,7 @@
 //! shows its own demand, as an ideal current loop would.
 
 use super::AxisCommand;
+use motion::Event;
 
 /// What the current loop measured, motor coordinates.
 #[derive(Debug, Clone, Copy, PartialEq)]
@@ -25,6 +26,48 @@ pub struct CurrentActual {
     /// The measured torque-forming current iq, A (amplitude-invariant dq: the
     /// phase current's peak).
     pub current_a: f32,
+    /// The loop's latched protection trip, if any (its gates are off): the
+    /// axis faults with the trip's event ([`CurrentTrip::event`]). The loop
+    /// clears it when the axis switches the power stage on again, which it
+    /// does only after the fault was acknowledged.
+    pub trip: Option<CurrentTrip>,
+}
+
+/// A trip of the current loop's protection (the power stage is off within
+/// the PWM period that saw it).
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum CurrentTrip {
+    /// A phase current beyond the trip threshold (software, or the PWM
+    /// unit's trap input): event 33 "Overcurrent" (2310h).
+    OverCurrent,
+    /// The three phase currents do not sum to zero (a current to earth, a
+    /// broken shunt): event 31 "Short/ground" (2110h).
+    PhaseSum,
+    /// DC link below its minimum with the gates on: event 46 "Low voltage"
+    /// (3120h).
+    DcUnderVoltage,
+    /// DC link above its maximum: event 36 "High voltage" (3110h).
+    DcOverVoltage,
+    /// The encoder stopped answering the fast task: event 37 "Motor
+    /// encoder" (7303h).
+    EncoderLost,
+    /// The loop's own i²t backstop: event 45 "Overtemp.motor i2t" (4380h).
+    MotorI2t,
+}
+
+impl CurrentTrip {
+    /// The drive event (E82 number, cause) of the trip (spec §8.3, S Tab. 23).
+    pub const fn event(self) -> Event {
+        let number = match self {
+            Self::OverCurrent => 33,
+            Self::PhaseSum => 31,
+            Self::DcUnderVoltage => 46,
+            Self::DcOverVoltage => 36,
+            Self::EncoderLost => 37,
+            Self::MotorI2t => 45,
+        };
+        Event { number, cause: 2 }
+    }
 }
 
 /// One axis' current control as the drive core sees it: a reference in, a

@@ -92,6 +92,7 @@ mod feedback;
 mod io;
 mod modes;
 mod monitor;
+mod motor;
 mod params;
 mod record_state;
 mod records;
@@ -137,9 +138,10 @@ pub(crate) use snapshot::{CyclicSlots, Snapshot, Window};
 
 pub use cache::AxisCache;
 use cache::CachedSnapshot;
-pub use current::{CurrentActual, CurrentControl};
+pub use current::{CurrentActual, CurrentControl, CurrentTrip};
 pub use io::{AxisCommand, AxisIo, AxisReport, IndexLatch, ProbeEdge, SwitchEdge, SwitchId};
 pub use monitor::{LOW_VOLTAGE, MOTOR_ENCODER};
+pub use motor::{MotorData, MOTOR_I2T};
 pub use params::AxisParams;
 pub(crate) use records::RecordTasks;
 pub use records::{RecordCommand, RecordStatus, StartRefusal};
@@ -282,6 +284,9 @@ pub struct Axis {
     /// ([`Axis::set_torque_limit_per_mille`]), ‰ of the rated torque;
     /// `u16::MAX`: none.
     torque_limit_per_mille: u16,
+    /// The motor data (`motor.rs`) and its i²t model.
+    motor: MotorData,
+    i2t: motor::MotorI2t,
     /// The record status of the last cycle, packed.
     record_status: u32,
     /// F00 brake control active, F06 release override active (`brake.rs`).
@@ -349,25 +354,11 @@ impl Axis {
             record_command: 0,
             torque_mode_speed_limit: f32::NAN,
             torque_limit_per_mille: u16::MAX,
+            motor: MotorData::default(),
+            i2t: motor::MotorI2t::default(),
             record_status: 0,
             brake: (true, false),
         }
-    }
-
-    /// 0 = axis A, 1 = axis B.
-    pub fn index(&self) -> u8 {
-        self.window.axis
-    }
-
-    /// This axis' index of CiA 402 object `index` (given in axis-A numbering).
-    pub fn cia402_index(&self, index: u16) -> u16 {
-        self.window.cia402(index)
-    }
-
-    /// This axis' index of per-axis manufacturer parameter `index` (axis-A
-    /// numbering).
-    pub fn manufacturer_index(&self, index: u16) -> u16 {
-        self.window.manufacturer(index)
     }
 
     /// The parameters not in the dictionary.
@@ -541,7 +532,7 @@ impl Axis {
         };
 
         let mut actual = self.feedback(io, o.polarity, dt_ns, now_ns);
-        self.monitor(io);
+        self.monitor(io, now_ns);
         let i199 = is_standstill(self.velocity, self.params.velocity_window_inc_per_s);
 
         // limits first: the lock of this cycle filters the set-points
@@ -597,7 +588,7 @@ impl Axis {
             target_reached: false,
             mode_bit12: false,
             mode_bit13: false,
-            warning: false,
+            warning: self.i2t.limiting(),
             remote: true,
             internal_limit: false,
             manufacturer_bits: 0,
@@ -617,6 +608,7 @@ impl Axis {
         let measured = io.current.map(|m| CurrentActual {
             torque_nm: sign * m.torque_nm,
             current_a: sign * m.current_a,
+            ..m
         });
         self.write_back(od, slots, &out, (bits, actual, torque, fe), measured);
         self.user_statusword(od, slots, o);

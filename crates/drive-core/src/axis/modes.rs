@@ -584,6 +584,6 @@ impl Axis {
 
     /// 0.1 % of the rated torque → N·m.
     pub(super) fn per_mille(&self, v: i32) -> f32 {
-        self.params.rated_torque_nm * v as f32 * 0.001
+        self.motor.rated_torque_nm() * v as f32 * 0.001
     }
 }

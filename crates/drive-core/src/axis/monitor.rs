@@ -11,7 +11,11 @@
 //!   stage off a missing supply is only a cause of Switch on disabled
 //!   (C-015, E47/E49).
 //!
-//! Both coast (the power stage off at once, the brake engages): without
+//! - The current loop tripped ([`CurrentActual::trip`]): its event
+//!   ([`CurrentTrip::event`]: over-current 33, earth fault 31, DC link 36/46,
+//!   encoder 37, motor i²t 45), in every state.
+//!
+//! All coast (the power stage off at once, the brake engages): without
 //! the DC link or the position there is no controlled stop to make.
 
 use super::*;
@@ -24,9 +28,14 @@ pub const MOTOR_ENCODER: Event = Event { number: 37, cause: 1 };
 pub const LOW_VOLTAGE: Event = Event { number: 46, cause: 1 };
 
 impl Axis {
-    /// Raises [`MOTOR_ENCODER`] or [`LOW_VOLTAGE`] for this cycle's `io`.
-    pub(super) fn monitor(&mut self, io: &AxisIo) {
-        if !io.encoder_ok {
+    /// Raises [`MOTOR_ENCODER`] or [`LOW_VOLTAGE`] for this cycle's `io`, a
+    /// trip of the current loop as its event ([`CurrentTrip::event`]), and
+    /// steps the motor protection (`motor.rs`).
+    pub(super) fn monitor(&mut self, io: &AxisIo, now: Nanos) {
+        self.protect_motor(io, now);
+        if let Some(trip) = io.current.and_then(|c| c.trip) {
+            self.raise_with(trip.event(), Some(FaultReaction::Coast));
+        } else if !io.encoder_ok {
             self.raise_with(MOTOR_ENCODER, Some(FaultReaction::Coast));
         } else if !io.supply_ok && matches!(self.dc.state(), State::OperationEnabled | State::QuickStopActive)
         {

@@ -11,18 +11,14 @@ use super::*;
 /// overwritten from it at every configuration change, and so are the
 /// limit-switch evaluation flags (I101/I102 ≠ 0): set them by SDO/PNU, a
 /// [`Axis::params_mut`] change of them lasts only until the next
-/// configuration change. The rest (rated torque and current and the
-/// inertia: motor data, issue 34; the velocity filter, 606Eh's time, the
-/// software-limit reaction, C-050's reference rule, the stop settle time)
-/// are not declared (docs/conformance.md, "AxisParams after issue 40"):
-/// [`Axis::params_mut`] changes them, effective in the next cycle.
+/// configuration change. The motor data (rated torque and current, issue 34)
+/// are the dictionary's alone ([`Axis::motor`]). The rest (the inertia, the
+/// velocity filter, 606Eh's time, the software-limit reaction, C-050's
+/// reference rule, the stop settle time) are not declared
+/// (docs/conformance.md, "AxisParams after issue 40"): [`Axis::params_mut`]
+/// changes them, effective in the next cycle.
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct AxisParams {
-    /// 6076h rated torque, N·m (motor data); 0.1 % torque objects refer to it.
-    pub rated_torque_nm: f32,
-    /// Rated motor current, mA (motor data, at the rated torque): current
-    /// limits in mA become torque limits through it (PROFINET's 2415h.02).
-    pub rated_current_ma: u32,
     /// Cascade gains and limits. The torque limits are replaced by 6072h,
     /// the gains Kv, Kp, Ti by I20, C31, C32 (issue 40),
     /// the torque modes' speed limits by G472/G475 (0.1 % of
@@ -90,15 +86,13 @@ pub struct AxisParams {
 }
 
 impl Default for AxisParams {
-    /// Rated torque 1.3 N·m, the cascade defaults with an inertia of 1e-4
+    /// The cascade defaults with an inertia of 1e-4
     /// kg·m² (the simulated servo), I25 = 100 %, I425 = 0,
-    /// I423 = 10 ms, C40 = 0.1 rev/s, a 1.3 N·m / 2 A motor, following error as
+    /// I423 = 10 ms, C40 = 0.1 rev/s, following error as
     /// bit 13 only, no limit switches, jog 1 rev/s with 10 rev/s², I26 = 1,
     /// no jerk limits, stops settle 10 ms.
     fn default() -> Self {
         Self {
-            rated_torque_nm: 1.3,
-            rated_current_ma: 2000,
             cascade: CascadeConfig {
                 inertia_kg_m2: 1.0e-4,
                 ..CascadeConfig::DEFAULT

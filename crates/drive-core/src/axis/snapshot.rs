@@ -103,7 +103,7 @@ pub(crate) struct CyclicSlots {
     pub velocity: Option<Typed<i32>>,
     pub torque: Option<Typed<i16>>,
     pub current: Option<Typed<i16>>,
-    pub rated_current: Option<Typed<u32>>,
+    pub rated_torque: Option<Typed<u32>>,
     pub following_error: Option<Typed<i32>>,
     pub probe_status: Option<Typed<u16>>,
     pub probe_values: [Option<Typed<i32>>; 4],
@@ -146,7 +146,7 @@ impl CyclicSlots {
             velocity: t(c(0x606C, 0)),
             torque: t(c(0x6077, 0)),
             current: t(c(0x6078, 0)),
-            rated_current: t(c(0x6076, 0)),
+            rated_torque: t(c(0x6076, 0)),
             following_error: t(c(0x60F4, 0)),
             probe_status: t(c(0x60B9, 0)),
             probe_values: [t(c(0x60BA, 0)), t(c(0x60BB, 0)), t(c(0x60BC, 0)), t(c(0x60BD, 0))],
@@ -188,7 +188,7 @@ impl CyclicSlots {
             at(self.velocity),
             at(self.torque),
             at(self.current),
-            at(self.rated_current),
+            at(self.rated_torque),
             at(self.following_error),
             at(self.probe_status),
             p0,
@@ -363,10 +363,30 @@ pub(crate) struct Snapshot {
     /// Decimal places of velocities (A310) and of accelerations and jerk
     /// (A311) when A213[0] = 0 "integer with decimal places"; (0, 0) native.
     pub decimals: (u8, u8),
+    /// The motor data (group B, 6073h/6075h/6080h, U10/U11), prepared.
+    pub motor: super::MotorData,
 }
 
 fn sat<T: TryFrom<i64> + Copy>(v: i64, lo: T, hi: T) -> T {
     T::try_from(v).unwrap_or(if v < 0 { lo } else { hi })
+}
+
+impl super::Axis {
+    /// 0 = axis A, 1 = axis B.
+    pub fn index(&self) -> u8 {
+        self.window.axis
+    }
+
+    /// This axis' index of CiA 402 object `index` (given in axis-A numbering).
+    pub fn cia402_index(&self, index: u16) -> u16 {
+        self.window.cia402(index)
+    }
+
+    /// This axis' index of per-axis manufacturer parameter `index` (axis-A
+    /// numbering).
+    pub fn manufacturer_index(&self, index: u16) -> u16 {
+        self.window.manufacturer(index)
+    }
 }
 
 impl Snapshot {
@@ -521,6 +541,7 @@ impl Snapshot {
             } else {
                 (0, 0)
             },
+            motor: super::MotorData::read(od, w, m),
         };
         (snapshot, misses.get())
     }

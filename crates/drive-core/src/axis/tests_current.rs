@@ -15,6 +15,7 @@ struct LagLoop {
     tau_s: f64,
     iq: f64,
     iq_ref: f64,
+    trip: Option<CurrentTrip>,
 }
 
 impl CurrentControl for LagLoop {
@@ -29,6 +30,7 @@ impl CurrentControl for LagLoop {
         Some(CurrentActual {
             torque_nm: KT * self.iq as f32,
             current_a: self.iq as f32,
+            trip: self.trip,
         })
     }
 }
@@ -61,6 +63,7 @@ impl Rig {
                 tau_s,
                 iq: 0.0,
                 iq_ref: 0.0,
+                trip: None,
             },
             measure,
             now: Nanos::ZERO,
@@ -167,4 +170,189 @@ fn c038_without_a_measurement_the_demand_is_shown() {
     r.cycle();
     assert_eq!(r.get(0x6077), 500);
     assert_eq!(r.get(0x6078), 500);
+}
+
+/// Statusword bit 7 (warning) and bit 11 (internal limit active).
+const SW_WARNING: i64 = 1 << 7;
+const SW_LIMIT: i64 = 1 << 11;
+
+/// C-038 with 6073h (issue 34): max current lowered to 50 % of 6075h limits
+/// a 100 % cst demand to 50 %: the loop's measured current (6078h) and 6077h
+/// settle at 500 ‰, statusword bit 11 (internal limit) is set.
+#[test]
+fn c038_max_current_6073h_limits_cst_torque_with_bit_11() {
+    let mut r = Rig::new(1.0e-3, true, 0);
+    r.od.set(0x6073, 0, 500).unwrap();
+    r.od.set(0x6071, 0, 1000).unwrap();
+    for _ in 0..30 {
+        r.cycle();
+    }
+    assert_eq!(r.get(0x6077), 500);
+    assert_eq!(r.get(0x6078), 500);
+    assert_ne!(r.get(0x6041) & SW_LIMIT, 0, "bit 11");
+    // raised again: the demand passes
+    r.od.set(0x6073, 0, 3000).unwrap();
+    for _ in 0..30 {
+        r.cycle();
+    }
+    assert_eq!(r.get(0x6077), 1000);
+    assert_eq!(r.get(0x6041) & SW_LIMIT, 0);
+}
+
+/// E-089 (event 45 → 4380h), the motor i²t of issue 34 against the closed
+/// form of the first-order thermal model: 200 % of the rated current from
+/// cold reaches 100 % at t = −τ·ln(1 − (I_r/I)²) = −τ·ln(3/4) = 287.7 ms
+/// for τ = 1 s. Then the warning (bit 7), the current held at the rated
+/// current (6078h 1000 ‰, bit 11), and after U11 = 200 ms the fault 4380h.
+#[test]
+fn e089_motor_i2t_warning_limit_then_fault_4380h_at_the_closed_form_time() {
+    let mut r = Rig::new(0.2e-3, true, 0);
+    r.od.set(crate::params::B73, 0, 1000).unwrap();
+    // the torque modes' speed limiter at I10 (at 40 % it allows 1.9 N·m at
+    // standstill: below the 2.6 N·m asked for)
+    r.od.set(crate::params::G472, 0, 1000).unwrap();
+    r.od.set(crate::params::G475, 0, 1000).unwrap();
+    r.od.set(crate::params::U11, 0, 200).unwrap();
+    // the parameters take effect; the model is cold (no current so far)
+    r.cycle();
+    r.od.set(0x6071, 0, 2000).unwrap();
+    let t100_ms = -1000.0 * (1.0f64 - 0.25).ln();
+    let mut warned = None;
+    for n in 1..=400u32 {
+        r.cycle();
+        if warned.is_none() && r.get(0x6041) & SW_WARNING != 0 {
+            warned = Some(n);
+        }
+    }
+    let n = f64::from(warned.expect("i²t warning"));
+    // the model steps every 4 ms: the warning comes at the first step at or
+    // after 100 %; the measurement enters one cycle late (and the lag's
+    // 0.2 ms): from −1 to +6 cycles
+    assert!(
+        (-1.0..=6.0).contains(&(n - t100_ms)),
+        "warning after {n} ms, closed form {t100_ms:.1} ms"
+    );
+    assert_eq!(r.axis.state(), State::OperationEnabled);
+    assert!(
+        (r.get(0x6078) - 1000).abs() <= 2,
+        "limited to 6075h: {}",
+        r.get(0x6078)
+    );
+    assert_ne!(r.get(0x6041) & SW_LIMIT, 0, "bit 11");
+    // U11 = 200 ms after the warning: the fault
+    let mut fault_at = None;
+    for k in 1..=300u32 {
+        r.cycle();
+        if r.axis.state() == State::Fault {
+            fault_at = Some(k);
+            break;
+        }
+    }
+    let k = fault_at.expect("i²t fault");
+    let since_warning = f64::from(k) + 400.0 - n;
+    assert!(
+        (since_warning - 200.0).abs() <= 5.0,
+        "fault {since_warning} ms after the warning (4 ms model steps)"
+    );
+    assert_eq!(r.get(0x603F), 0x4380);
+}
+
+/// U10 = 0: the model runs (the closed form of the cold start) but neither
+/// warns, limits nor faults.
+#[test]
+fn e089_motor_i2t_inactive_with_u10_0() {
+    let mut r = Rig::new(0.2e-3, true, 0);
+    r.od.set(crate::params::B73, 0, 1000).unwrap();
+    // the torque modes' speed limiter at I10 (at 40 % it allows 1.9 N·m at
+    // standstill: below the 2.6 N·m asked for)
+    r.od.set(crate::params::G472, 0, 1000).unwrap();
+    r.od.set(crate::params::G475, 0, 1000).unwrap();
+    r.od.set(crate::params::U10, 0, 0).unwrap();
+    r.od.set(0x6071, 0, 2000).unwrap();
+    for _ in 0..1500 {
+        r.cycle();
+    }
+    // x(t) = (I/I_r)²·(1 − e^(−t/τ)) = 4·(1 − e^(−1.5)) after 1.5 s (the
+    // current steps one cycle late and rises with the 0.2 ms lag: 0.1 %)
+    let closed = 4.0 * (1.0 - (-1.5f64).exp());
+    let x = f64::from(r.axis.motor_i2t());
+    assert!((x / closed - 1.0).abs() < 0.005, "x {x}, closed form {closed:.4}");
+    assert_eq!(r.axis.state(), State::OperationEnabled);
+    assert_eq!(r.get(0x6078), 2000);
+    assert_eq!(r.get(0x6041) & SW_WARNING, 0);
+}
+
+/// E-089: an over-current trip of the current loop faults the axis with
+/// event 33 "Overcurrent": 603Fh = 2310h, error register bit 1 (current);
+/// the power stage is off in the same cycle.
+#[test]
+fn e089_current_loop_over_current_trip_faults_2310h() {
+    let mut r = Rig::new(1.0e-3, true, 0);
+    r.od.set(0x6071, 0, 500).unwrap();
+    for _ in 0..5 {
+        r.cycle();
+    }
+    r.seam.trip = Some(CurrentTrip::OverCurrent);
+    let mut off = false;
+    for _ in 0..3 {
+        off |= !r.cycle().power_stage;
+    }
+    assert!(off, "power stage off");
+    assert_eq!(r.axis.state(), State::Fault);
+    assert_eq!(r.get(0x603F), 0x2310);
+    assert_ne!(r.axis.error_register() & 0x02, 0, "current bit");
+}
+
+/// Issue 34: 6076h = kt (B17) × 6075h; the motor data refuse zero with
+/// 0609 0032h (value too low) and change nothing.
+#[test]
+fn rated_torque_6076h_is_kt_times_6075h_and_zero_motor_data_is_refused() {
+    let mut r = Rig::new(1.0e-3, true, 0);
+    assert_eq!(r.get(0x6076), 1300);
+    r.od.set(crate::params::B17, 0, 800).unwrap();
+    r.od.set(0x6075, 0, 3000).unwrap();
+    r.cycle();
+    assert_eq!(r.get(0x6076), 2400);
+    for (index, v) in [
+        (0x6075, 0),
+        (crate::params::B10, 0),
+        (crate::params::B53, 0),
+        (crate::params::B52, 0),
+    ] {
+        let before = r.get(index);
+        let width = if index == crate::params::B10 { 1 } else { 4 };
+        let data = (v as u32).to_le_bytes();
+        let e = od::Dictionary::write(&mut r.od, index, 0, &data[..width], od::CommState::PreOp).unwrap_err();
+        assert_eq!(e.0, 0x0609_0032, "{index:04X}h");
+        assert_eq!(r.get(index), before);
+    }
+}
+
+/// The i²t model alone at the default τ = 600 s in 1 ms cycles (α ≈ 7·10⁻⁶
+/// per 4 ms step, below an f32's resolution at 1): 100 s at twice the
+/// rated current give the closed form x = 4·(1 − e^(−100/600)) = 0.6141
+/// to 10⁻⁵, and 4·(1 − e^(−2000/600)) = 3.857 after 2000 s.
+#[test]
+fn motor_i2t_model_meets_the_closed_form_at_a_long_time_constant() {
+    let mut m = super::motor::MotorI2t::default();
+    let data = MotorData {
+        i2t_level: 0,
+        ..MotorData::default()
+    };
+    m.configure(&data, 1_000_000);
+    let mut now = Nanos::ZERO;
+    for (until_s, closed) in [
+        (100u64, 4.0 * (1.0 - (-100.0f64 / 600.0).exp())),
+        (2000, 4.0 * (1.0 - (-2000.0f64 / 600.0).exp())),
+    ] {
+        while now < Nanos::from_ms(until_s * 1000) {
+            now = now.saturating_add(Nanos::from_ms(1));
+            m.step(4.0, now);
+        }
+        let x = f64::from(m.level());
+        assert!(
+            (x - closed).abs() < 1e-5 * closed.max(1.0),
+            "after {until_s} s: x {x}, closed form {closed}"
+        );
+    }
 }

@@ -50,14 +50,11 @@ impl Axis {
             let x = if rated > 0.0 { v / rated * 1000.0 } else { 0.0 };
             round_i32(x).clamp(i32::from(i16::MIN), i32::from(i16::MAX)) as i16
         };
-        let rated_a = self.params.rated_current_ma as f32 * 0.001;
+        let (rated_a, rated_nm) = (self.motor.rated_current_a, self.motor.rated_torque_nm());
         let (t, i) = match measured {
-            Some(m) => (
-                per_mille(m.torque_nm, self.params.rated_torque_nm),
-                per_mille(m.current_a, rated_a),
-            ),
+            Some(m) => (per_mille(m.torque_nm, rated_nm), per_mille(m.current_a, rated_a)),
             None => {
-                let t = per_mille(torque, self.params.rated_torque_nm);
+                let t = per_mille(torque, rated_nm);
                 (t, t)
             }
         };

@@ -102,7 +102,7 @@ macro_rules! pair {
 }
 
 /// The CiA 402 objects of axis A, sorted by index.
-pub const AXIS_A: [Object; 67] = [
+pub const AXIS_A: [Object; 70] = [
     Object::var(0x603F, Value::Live, entries![ro_tx(0, "Error code", U16)]).note("A514"),
     Object::var(0x6040, Value::Ram, entries![rt(0, "Controlword", U16)]).note("A515"),
     Object::var(0x6041, Value::Live, entries![ro_tx(0, "Statusword", U16)]).note("A516"),
@@ -233,11 +233,27 @@ pub const AXIS_A: [Object; 67] = [
     )
     .note("A559; default: placeholder until the motion core"),
     Object::var(
+        0x6073,
+        Value::Ram,
+        entries![rt(0, "Max current", U16).default_value(3000).unit("0.1 %").saved()],
+    )
+    .note("issue 34 (not in the source's list, CiA 402): the motor's peak current in ‰ of 6075h; the current limit is the lowest of it, 2415h.02 (P-133) and the i²t limit (U10); default 300 % (6 A of 2 A)"),
+    Object::var(
+        0x6075,
+        Value::Ram,
+        entries![e(0, "Motor rated current", U32, RW)
+            .range(1, 1_000_000)
+            .default_value(2000)
+            .unit("mA")
+            .saved()],
+    )
+    .note("issue 34 (CiA 402): the motor's rated current (dq amplitude, the phase current's peak): 6073h and 6078h (PNU 1102) are ‰ of it, the i²t model's 100 %; 0 refused; default 2 A"),
+    Object::var(
         0x6076,
         Value::Live,
         entries![ro_tx(0, "Rated torque", U32).unit("mNm")],
     )
-    .note("A563; ro (the source lists it TxPDO only), from the motor data"),
+    .note("A563; ro (the source lists it TxPDO only): kt (B17) × rated current (6075h), from the motor data"),
     Object::var(
         0x6077,
         Value::Live,
@@ -305,6 +321,16 @@ pub const AXIS_A: [Object; 67] = [
             .saved()],
     )
     .note("A572; default 50 rev/s: placeholder until the motion core"),
+    Object::var(
+        0x6080,
+        Value::Ram,
+        entries![e(0, "Max motor speed", U32, RW)
+            .range(1, 100_000)
+            .default_value(6000)
+            .unit("rpm")
+            .saved()],
+    )
+    .note("issue 34 (CiA 402; the manual's B83 \"v-max motor\", declared once here): the motor's highest speed; the cascade's speed limit is the lower of it and I10; default 6000 rpm"),
     Object::var(
         0x6081,
         Value::Ram,

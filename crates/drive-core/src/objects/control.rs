@@ -2,8 +2,8 @@
 //! manufacturer parameters of the motion functions and the cascade that a
 //! master sets (groups A, C, F, G and I at `parameter_index(group, line)`, axis B
 //! at +8000h). The axis reads them when the configuration generation moves
-//! (`axis/settings.rs`), never per cycle. The motor data (group B) of the
-//! current control will join them here.
+//! (`axis/settings.rs`), never per cycle. The motor data (group B) and the
+//! motor protection (U10/U11) are in [`super::motor`].
 //!
 //! Merged with [`super::manufacturer::PARAMS`] into one sorted list
 //! ([`super::MANUFACTURER_A`]).
@@ -155,7 +155,7 @@ pub const PARAMS: [Object; 29] = [
     )
     .axis()
     .level(1)
-    .note("I10: the highest speed of the axis in user units/s (decimals A310): the cascade's speed command is limited to it and G472/G475 are per mille of it; default 50 rev/s; effective at once; not yet checked against the motor's B83 (motor data)"),
+    .note("I10: the highest speed of the axis in user units/s (decimals A310): the cascade's speed command is limited to it and G472/G475 are per mille of it; default 50 rev/s; effective at once; the cascade's speed limit is the lower of I10 and the motor's 6080h (the manual's B83)"),
     Object::var(
         i_(12),
         Value::Ram,

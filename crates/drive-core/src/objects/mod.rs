@@ -4,6 +4,7 @@
 //!   objects F0xxh (ETG.1000.6, ETG.1020, ETG.5000.1; `od-ethercat.md`).
 //! - [`manufacturer`]: the manufacturer parameters at 2000h + group·200h + line
 //!   (axis-B copies of axis parameters at +8000h; spec §2.6).
+//! - [`motor`]: the motor data (group B) and the i²t settings (U10/U11).
 //! - [`records`]: the position records, their selector, start number,
 //!   override and set-up speed in group J (3390h…339Bh, per-axis ones also
 //!   at +8000h).
@@ -64,6 +65,7 @@ pub mod cia402;
 pub mod comm;
 pub mod control;
 pub mod manufacturer;
+pub mod motor;
 mod pack;
 pub mod records;
 pub mod scaling;
@@ -452,24 +454,31 @@ const fn entries_sorted(objs: &[Object]) -> bool {
     true
 }
 
-/// The global and axis-A manufacturer parameters: those of [`manufacturer`]
-/// and the control settings of [`control`], merged by index.
-pub const MANUFACTURER_A: [Object; manufacturer::PARAMS.len() + control::PARAMS.len()] =
-    merge(&manufacturer::PARAMS, &control::PARAMS);
+const SETTINGS_A: [Object; control::PARAMS.len() + motor::PARAMS.len()] =
+    merge(&control::PARAMS, &motor::PARAMS);
+/// The global and axis-A manufacturer parameters: those of [`manufacturer`],
+/// the control settings of [`control`] and the motor data of [`motor`],
+/// merged by index.
+pub const MANUFACTURER_A: [Object; manufacturer::PARAMS.len() + SETTINGS_A.len()] =
+    merge(&manufacturer::PARAMS, &SETTINGS_A);
 const AXIS_B_PARAMS: usize = count_axis(&MANUFACTURER_A);
 const MANUFACTURER_B: [Object; AXIS_B_PARAMS] = axis_copies(&MANUFACTURER_A, crate::AXIS_B_MANUFACTURER);
 const AXIS_B_RECORDS: usize = count_axis(&records::PARAMS);
 const RECORDS_B: [Object; AXIS_B_RECORDS] = axis_copies(&records::PARAMS, crate::AXIS_B_MANUFACTURER);
+const PROTECTION_B: [Object; motor::PROTECTION.len()] =
+    axis_copies(&motor::PROTECTION, crate::AXIS_B_MANUFACTURER);
 const CIA402_B: [Object; cia402::AXIS_A.len()] = offset(cia402::AXIS_A, crate::AXIS_B_CIA402);
 
 /// Number of objects.
 pub const COUNT: usize = comm::COMM.len()
     + MANUFACTURER_A.len()
     + records::PARAMS.len()
+    + motor::PROTECTION.len()
     + cia402::AXIS_A.len()
     + CIA402_B.len()
     + MANUFACTURER_B.len()
     + RECORDS_B.len()
+    + PROTECTION_B.len()
     + comm::MDP.len();
 
 // Only used in const evaluation (the offsets, the initial image, the layout
@@ -479,10 +488,12 @@ const TABLE: [Object; COUNT] = join(&[
     &comm::COMM,
     &MANUFACTURER_A,
     &records::PARAMS,
+    &motor::PROTECTION,
     &cia402::AXIS_A,
     &CIA402_B,
     &MANUFACTURER_B,
     &RECORDS_B,
+    &PROTECTION_B,
     &comm::MDP,
 ]);
 const _: () = assert!(sorted(&TABLE), "objects must be sorted by index, each index once");

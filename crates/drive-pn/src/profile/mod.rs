@@ -309,7 +309,7 @@ impl Profile {
         // rated current (P-133); 0 sets no limit
         let current = access.own.current_limit_ma;
         let torque_limit = (matches!(display, 2 | 3) && current > 0).then(|| {
-            let rated = u64::from(axis.params().rated_current_ma.max(1));
+            let rated = u64::from(axis.motor().rated_current_ma().max(1));
             (u64::from(current.unsigned_abs()) * 1000 / rated).min(u64::from(u16::MAX - 1)) as u16
         });
         axis.set_torque_mode_speed_limit(speed_limit);

@@ -490,3 +490,32 @@ fn p045_issue40_homing_and_speed_settings_through_pkw_saved_and_read_after_a_res
     assert_eq!(again.objects().get(I53, 0), Ok(4096));
     assert_eq!(again.objects().get(I10, 0), Ok(20 << 20));
 }
+
+/// The motor data of issue 34 through PKW (PNU = index): B10 pole pairs,
+/// B73 thermal time constant, U11 i²t warning time and 6075h rated current
+/// written and read back; B10 = 0 and 6075h = 0 get PKW error 2 (limit
+/// exceeded: below the range) and change nothing; PNU 971 saves them and a
+/// new drive over the same flash starts with them (P-133's mA limit refers
+/// to the rated current read from there).
+#[test]
+fn p045_issue34_motor_data_through_pkw_saved_and_read_after_a_restart() {
+    use drive_core::params::{B10, B73, U11};
+    let mut b = Bench::new();
+    assert_eq!(b.pkw0(0x41, B10, 0, 0), (0x41, 4), "4 pole pairs by default");
+    assert_eq!(b.pkw0(0x42, B10, 0, 0), (0xC2, 2), "0 pole pairs refused");
+    assert_eq!(b.pkw0(0x42, 0x6075, 0, 0), (0xC2, 2), "0 mA refused");
+    assert_eq!(b.d.objects().get(B10, 0), Ok(4), "unchanged");
+    assert_eq!(b.d.objects().get(0x6075, 0), Ok(2000), "unchanged");
+    assert_eq!(b.pkw0(0x42, B10, 0, 5).0, 0x42);
+    assert_eq!(b.pkw0(0x42, B73, 0, 900_000).0, 0x42);
+    assert_eq!(b.pkw0(0x42, U11, 0, 2_000).0, 0x42);
+    assert_eq!(b.pkw0(0x42, 0x6075, 0, 2_500).0, 0x42);
+    assert_eq!(b.pkw0(0x41, B10, 0, 0), (0x41, 5));
+    assert_eq!(b.pkw0(0x42, 971, 0, 1).0, 0x42, "saved");
+    let flash = core::mem::replace(&mut b.d, crate::tests::commissioned()).into_flash();
+    let again = PnDrive::new(flash, crate::tests::hardware());
+    assert_eq!(again.objects().get(B10, 0), Ok(5));
+    assert_eq!(again.objects().get(B73, 0), Ok(900_000));
+    assert_eq!(again.objects().get(U11, 0), Ok(2_000));
+    assert_eq!(again.objects().get(0x6075, 0), Ok(2_500));
+}

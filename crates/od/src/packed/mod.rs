@@ -26,7 +26,7 @@ pub use build::*;
 
 /// The units an entry of a packed table may have (index 0: none); in the
 /// image as [`UNITS`].
-pub const UNIT_NAMES: [&str; 19] = [
+pub const UNIT_NAMES: [&str; 24] = [
     "",
     "inc",
     "inc/s",
@@ -46,6 +46,11 @@ pub const UNIT_NAMES: [&str; 19] = [
     "mV",
     "0.1 /s",
     "µNm·s/rad",
+    "mA",
+    "mNm/A",
+    "µH",
+    "mΩ",
+    "Hz",
 ];
 
 /// Bytes of the unit names.

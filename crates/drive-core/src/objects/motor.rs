@@ -1,0 +1,136 @@
+//! The motor data and the motor protection in the one declaration (issue 34):
+//! group B "Motor" at `parameter_index(1, line)` = 2200h + line (axis B at
+//! A200h + line) and the i²t settings U10/U11 of group U (4800h + line).
+//! The CiA 402 motor objects 6073h max current, 6075h rated current, 6076h
+//! rated torque and 6080h max motor speed are in [`super::cia402`]; together
+//! they are all the motor data there is: the axis reads them when the
+//! configuration generation moves (`axis/motor.rs`), never per cycle, and the
+//! simulated current loop takes its gains from them (Kp = ω_c·L, Ki = ω_c·R).
+//!
+//! The seeds name only B26, B83 and B101 of group B: the lines here are
+//! assumed (each note says so). The rated and the maximum current and speed
+//! live once, in the CiA 402 objects: a B copy of them would be a second
+//! declaration of one value (B83 "v-max motor" is 6080h here).
+//!
+//! Merged with the other manufacturer parameters into one sorted list
+//! ([`super::MANUFACTURER_A`]).
+
+use super::{Object, Value};
+use crate::params::{B10, B17, B52, B53, B62, B64, B73, U10, U11};
+use od::DataType::{U16, U32, U8};
+
+use od::{Access, DataType, EntryInfo};
+
+const RW: Access = Access::RW;
+const fn e(sub: u8, name: &'static str, t: DataType) -> EntryInfo {
+    EntryInfo::new(sub, name, t, RW)
+}
+
+/// The motor data of axis A (group B), sorted by index.
+pub const PARAMS: [Object; 7] = [
+    Object::var(
+        B10,
+        Value::Ram,
+        entries![e(0, "Pole pair number", U8).range(1, 64).default_value(4).saved()],
+    )
+    .axis()
+    .level(1)
+    .note("B10 (line assumed): pole pairs p of the motor; electrical angle = p × mechanical; 0 is refused (0609 0032h: the current loop cannot commutate); default 4 (the simulated servo)"),
+    Object::var(
+        B17,
+        Value::Ram,
+        entries![e(0, "Torque constant", U32)
+            .range(1, 100_000)
+            .default_value(650)
+            .unit("mNm/A")
+            .saved()],
+    )
+    .axis()
+    .level(1)
+    .note("B17 (line assumed): kt = 1.5·p·ψ per A of the dq amplitude (the phase current's peak); the torque command becomes iq = T/kt; 6076h = kt × 6075h; default 0.65 N·m/A"),
+    Object::var(
+        B52,
+        Value::Ram,
+        entries![e(0, "Inductance Ld", U32)
+            .range(1, 10_000_000)
+            .default_value(12_000)
+            .unit("µH")
+            .saved()],
+    )
+    .axis()
+    .level(1)
+    .note("B52 (line assumed): d-axis inductance per phase (star equivalent); the d controller's Kp = ω_c·Ld; 0 refused (0609 0032h); default 12 mH"),
+    Object::var(
+        B53,
+        Value::Ram,
+        entries![e(0, "Winding resistance", U32)
+            .range(1, 1_000_000)
+            .default_value(3_600)
+            .unit("mΩ")
+            .saved()],
+    )
+    .axis()
+    .level(1)
+    .note("B53 (line assumed): phase resistance (star equivalent); the controllers' Ki = ω_c·R; 0 refused (0609 0032h); default 3.6 Ω"),
+    Object::var(
+        B62,
+        Value::Ram,
+        entries![e(0, "Inductance Lq", U32)
+            .range(1, 10_000_000)
+            .default_value(12_000)
+            .unit("µH")
+            .saved()],
+    )
+    .axis()
+    .level(1)
+    .note("B62 (line assumed): q-axis inductance per phase; the q controller's Kp = ω_c·Lq; default 12 mH"),
+    Object::var(
+        B64,
+        Value::Ram,
+        entries![e(0, "Current controller bandwidth", U16)
+            .range(1, 3_200)
+            .default_value(1_000)
+            .unit("Hz")
+            .saved()],
+    )
+    .axis()
+    .level(1)
+    .note("B64 (line assumed): ω_c/2π of both current controllers (pole-zero cancellation: first order with ω_c); at most a fifth of the 16 kHz PWM (0609 0031h above)"),
+    Object::var(
+        B73,
+        Value::Ram,
+        entries![e(0, "Thermal time constant", U32)
+            .range(100, 36_000_000)
+            .default_value(600_000)
+            .unit("ms")
+            .saved()],
+    )
+    .axis()
+    .level(1)
+    .note("B73 (line assumed): τ of the winding's first-order thermal model (motor i²t, U10): the rated current 6075h held forever gives 100 %; default 600 s"),
+];
+
+/// The motor protection settings of axis A (group U, after the records of
+/// group J in the table), sorted by index.
+pub const PROTECTION: [Object; 2] = [
+    Object::var(
+        U10,
+        Value::Ram,
+        entries![e(0, "i2t level", U8).range(0, 3).default_value(2).saved()],
+    )
+    .axis()
+    .level(1)
+    .note("U10 (spec §14): what the motor's i²t model does at 100 %: 0 inactive, 1 message (statusword bit 7 and the current limited to 6075h), 2 warning (as 1, and event 45 after U11 at or above 100 %), 3 fault (event 45 at once); default 2, the manual's recommendation (its preset differs: this model has no motor temperature sensor)"),
+    Object::var(
+        U11,
+        Value::Ram,
+        entries![e(0, "i2t warning time", U16)
+            .range(0, 60_000)
+            .default_value(1000)
+            .unit("ms")
+            .saved()],
+    )
+    .axis()
+    .level(1)
+    .note("U11 (spec §14): with U10 = 2, how long the i²t model may stay at or above 100 % (the current held at 6075h) before event 45 \"Overtemp.motor i2t\" (4380h) faults the axis; default 1.00 s"),
+];
