@@ -220,25 +220,36 @@ mod app {
     }
 
     /// The mailbox (CoE, EoE, FoE, EMCY, save) below the ESC task, and the
-    /// IP stack behind EoE: the drive is locked for one request and the
-    /// stack's poll. A hardware task on a spare interrupt, not an async
-    /// software task: an `async fn` carries a "resumed after completion"
-    /// panic path.
+    /// IP stack behind EoE: `tasks::mailbox_net`'s steps (the request, the
+    /// stack's poll, the answer's first fragment), each under the drive's
+    /// lock for itself only, so the control cycle and the ESC task wait for
+    /// one step at most, not the whole run (docs/architecture.md, CPU load).
+    /// A hardware task on a spare interrupt, not an async software task: an
+    /// `async fn` carries a "resumed after completion" panic path.
     #[task(binds = CCU42_0, priority = 1, shared = [drive, pdi, clock, net])]
-    fn mailbox(cx: mailbox::Context) {
-        (cx.shared.drive, cx.shared.pdi, cx.shared.clock, cx.shared.net).lock(|drive, pdi, clock, net| {
-            let now = clock.now(DWT::cycle_count());
-            if tasks::mailbox_net(drive, &mut **net, pdi, now).is_err() {
-                defmt::warn!("mailbox: PDI access failed");
-            }
-            if let Some(s) = drive.take_firmware_stored() {
-                let slot = if s.slot.index() == 0 { "A" } else { "B" };
-                defmt::info!(
-                    "foe: image version {=u32} verified and stored in slot {=str}; it starts at the next power-on",
-                    s.version,
-                    slot
-                );
-            }
-        });
+    fn mailbox(mut cx: mailbox::Context) {
+        let now = { &mut cx.shared.clock }.lock(|clock| clock.now(DWT::cycle_count()));
+        let request = |cx: &mut mailbox::Context| {
+            (&mut cx.shared.drive, &mut cx.shared.pdi).lock(|drive, pdi| tasks::mailbox(drive, pdi, now))
+        };
+        let mut ok = request(&mut cx).is_ok();
+        if <Net as tasks::NetPoll>::ACTIVE {
+            (&mut cx.shared.drive, &mut cx.shared.net)
+                .lock(|drive, net| tasks::NetPoll::poll(&mut **net, drive, now));
+            ok &= request(&mut cx).is_ok();
+        }
+        if !ok {
+            defmt::warn!("mailbox: PDI access failed");
+        }
+        // the drive reports a verified FoE download once (issue 33 point 7)
+        let stored = { &mut cx.shared.drive }.lock(|drive| drive.take_firmware_stored());
+        if let Some(s) = stored {
+            let slot = if s.slot.index() == 0 { "A" } else { "B" };
+            defmt::info!(
+                "foe: image version {=u32} verified and stored in slot {=str}; it starts at the next power-on",
+                s.version,
+                slot
+            );
+        }
     }
 }

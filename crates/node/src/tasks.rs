@@ -10,7 +10,8 @@
 //!
 //! `sync0` and `control` share the priority so they never preempt each
 //! other (both touch the PLL); `esc` locks the drive for one poll without
-//! the mailbox, `mailbox` for one request. See docs/architecture.md for the
+//! the mailbox, `mailbox` for one request, then for the IP stack's poll,
+//! then for the answer's first fragment. See docs/architecture.md for the
 //! worst-case paths.
 
 use core::borrow::BorrowMut;
@@ -77,6 +78,14 @@ pub fn mailbox<P: Pdi>(drive: &mut Drive, pdi: &mut P, now: Nanos) -> Result<(),
 /// raises the next ESC event, which pends this task again for the rest).
 /// Also run when the stack's own timers are due ([`NetPoll::poll_at`]).
 /// With [`NoNet`](crate::net::NoNet) it is [`mailbox`].
+///
+/// The firmware's mailbox task runs the same three steps with the drive
+/// locked for each on its own ([`mailbox`], [`NetPoll::poll`], [`mailbox`]):
+/// the control cycle and the ESC task, which lock the drive too, then wait
+/// for one step at most (the stack's poll with a UDP parameter request, about
+/// 11,000 instructions on QEMU) instead of the whole run (about 15,000;
+/// docs/architecture.md, CPU load). The steps touch nothing the higher tasks
+/// hand over between them: the mailbox, the EoE queue and the stack.
 pub fn mailbox_net<P: Pdi, N: NetPoll>(
     drive: &mut Drive,
     net: &mut N,

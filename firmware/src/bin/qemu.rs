@@ -154,8 +154,12 @@ mod app {
         /// Hardware inputs of the next control cycle / its power-stage commands.
         io: [AxisIo; 2],
         cmd: [AxisCommand; 2],
-        /// SysTick ticks of the last run of `control`, `esc` and `mailbox`.
-        cost: [u32; 3],
+        /// SysTick ticks of the last run of `control`, `esc` and `mailbox`,
+        /// and of the mailbox run's longest hold of the drive's lock
+        /// without the simulated ESC's register model.
+        cost: [u32; 4],
+        /// SysTick ticks of the last `mailbox` run spent in the simulated ESC.
+        mailbox_model: u32,
         /// SysTick ticks of the last `esc` run spent in the simulated ESC.
         esc_model: u32,
         /// The IP stack on the EoE interface, polled by `mailbox`.
@@ -201,8 +205,9 @@ mod app {
                 clock: Nanos::ZERO,
                 io: [AxisIo::ready(0); 2],
                 cmd: [AxisCommand::OFF; 2],
-                cost: [0; 3],
+                cost: [0; 4],
                 esc_model: 0,
+                mailbox_model: 0,
                 net,
             },
             Local { world, per_kilo_tick },
@@ -239,12 +244,13 @@ mod app {
 
     /// The simulated world: advances time event by event and pends the task
     /// of each event; logs the master's progress and the figures.
-    #[idle(shared = [drive, timer, esc, clock, io, cmd, cost, esc_model], local = [world, per_kilo_tick])]
+    #[idle(shared = [drive, timer, esc, clock, io, cmd, cost, esc_model, mailbox_model], local = [world, per_kilo_tick])]
     fn idle(mut cx: idle::Context) -> ! {
         let world = &mut **cx.local.world;
         let insn = |ticks: u32| (u64::from(ticks) * u64::from(*cx.local.per_kilo_tick) / 1000) as u32;
         let (mut control, mut esc_cost) = (Figure::default(), Figure::default());
-        let mut mailbox_cost = Figure::default();
+        let (mut mailbox_cost, mut mailbox_own, mut mailbox_hold) =
+            (Figure::default(), Figure::default(), Figure::default());
         let mut esc_own = Figure::default();
         let mut stack = [0u32; 3];
         let mut moving = false;
@@ -290,6 +296,9 @@ mod app {
                     let mbx = cx.shared.cost.lock(|c| c[2]);
                     if mbx != 0 && !moving {
                         mailbox_cost.add(insn(mbx));
+                        let model = cx.shared.mailbox_model.lock(|m| *m);
+                        mailbox_own.add(insn(mbx.saturating_sub(model)));
+                        mailbox_hold.add(insn(cx.shared.cost.lock(|c| c[3])));
                     }
                     tasks::background(&mut cx.shared.drive);
                     if moving {
@@ -367,6 +376,16 @@ mod app {
             mailbox_cost.n
         );
         defmt::info!(
+            "figure: mailbox task with the IP stack without the simulated ESC's register model (the task's own part): mean {=u32} max {=u32} instructions",
+            mailbox_own.mean(),
+            mailbox_own.max
+        );
+        defmt::info!(
+            "figure: mailbox task's longest hold of the drive's lock (the request, the IP stack's poll or the answer's first fragment; own part): mean {=u32} max {=u32} instructions",
+            mailbox_hold.mean(),
+            mailbox_hold.max
+        );
+        defmt::info!(
             "figure: stack use sync0 {=u32} control {=u32} esc {=u32} bytes (measured, incl. exception frame)",
             stack[0],
             stack[1],
@@ -430,15 +449,37 @@ mod app {
     }
 
     /// The mailbox (CoE, EoE, FoE, EMCY, save) below the ESC task, and the
-    /// IP stack behind EoE.
-    #[task(binds = USART1, priority = 1, shared = [drive, esc, clock, net, cost])]
-    fn mailbox(cx: mailbox::Context) {
-        let now = { cx.shared.clock }.lock(|c| *c);
+    /// IP stack behind EoE: `tasks::mailbox_net`'s three steps (the request,
+    /// the stack's poll, the answer's first fragment), each under the drive's
+    /// lock for itself only, as on the board (`firmware/src/main.rs`).
+    #[task(binds = USART1, priority = 1, shared = [drive, esc, clock, net, cost, mailbox_model])]
+    fn mailbox(mut cx: mailbox::Context) {
+        let now = { &mut cx.shared.clock }.lock(|c| *c);
+        let (mut model, mut hold) = (0u32, 0u32);
         let t0 = measure::now();
-        (cx.shared.drive, cx.shared.esc, cx.shared.net).lock(|drive, esc, net| {
-            let _ = tasks::mailbox_net(drive, &mut **net, &mut esc.pdi(), now);
-        });
+        for step in 0..3 {
+            let before = model;
+            let s0 = measure::now();
+            if step == 1 {
+                (&mut cx.shared.drive, &mut cx.shared.net)
+                    .lock(|drive, net| tasks::NetPoll::poll(&mut **net, drive, now));
+            } else {
+                (&mut cx.shared.drive, &mut cx.shared.esc).lock(|drive, esc| {
+                    let mut pdi = super::TimedPdi {
+                        inner: esc.pdi(),
+                        ticks: &mut model,
+                    };
+                    let _ = tasks::mailbox(drive, &mut pdi, now);
+                });
+            }
+            let own = measure::ticks(s0, measure::now()).saturating_sub(model.wrapping_sub(before));
+            hold = hold.max(own);
+        }
         let t = measure::ticks(t0, measure::now());
-        { cx.shared.cost }.lock(|c| c[2] = t.max(1));
+        { &mut cx.shared.cost }.lock(|c| {
+            c[2] = t.max(1);
+            c[3] = hold;
+        });
+        { &mut cx.shared.mailbox_model }.lock(|m| *m = model);
     }
 }
