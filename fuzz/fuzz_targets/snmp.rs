@@ -14,7 +14,7 @@
 
 use libfuzzer_sys::fuzz_target;
 use snmp::ber::{Reader, Writer};
-use snmp::{Agent, Delays, Device, LocalPort, MacPhy, ManAddr, Neighbor, Pno};
+use snmp::{Agent, Delays, Device, LldpAgent, LocalPort, MacPhy, ManAddr, Neighbor, Pno};
 
 const PREFIXES: &[&[u32]] = &[
     &[1, 3, 6, 1, 2, 1, 1],
@@ -64,6 +64,7 @@ fn device() -> Device<'static> {
         man_addr: Some(ManAddr { ipv4: [192, 168, 0, 50], if_subtype: 2, if_id: 1 }),
         man_addr_ports: [0xc0],
         ports: [LocalPort::default(); 2],
+        lldp: LldpAgent { tx_interval: 5, hold: 4, ..LldpAgent::default() },
     }
 }
 

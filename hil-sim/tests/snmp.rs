@@ -140,6 +140,60 @@ fn lldp_extensions(line: &PnLine, mau: &str, peer_station: &str) {
     );
 }
 
+/// The counter in `walk`'s line starting with `oid = ` (`Counter32: n`, `Gauge32: n`).
+fn counter(walk: &str, oid: &str) -> u64 {
+    let l = walk
+        .lines()
+        .find(|l| l.starts_with(&format!("{oid} = ")))
+        .unwrap_or_else(|| panic!("{oid} missing:\n{walk}"));
+    l.rsplit(' ')
+        .next()
+        .and_then(|v| v.parse().ok())
+        .unwrap_or_else(|| panic!("{l}"))
+}
+
+/// `snmpwalk -v2c -On` of lldpConfiguration and lldpStatistics: the timing the
+/// transmitter uses, and counters that saw the neighbour's LLDPDU on port 1.
+fn lldp_config_and_statistics(line: &PnLine) {
+    let (ok, walk) = snmp(line, "snmpwalk", &v2c("public", &[".1.0.8802.1.1.2.1.1"]));
+    assert!(ok, "{walk}");
+    let interval = profinet::lldp::TX_INTERVAL.as_secs();
+    let c = ".1.0.8802.1.1.2.1.1";
+    has(&walk, &format!("{c}.1.0 = INTEGER: {interval}"));
+    // TTL sent = interval x hold multiplier
+    let hold = u64::from(profinet::lldp::TTL_SECS) / interval;
+    has(&walk, &format!("{c}.2.0 = INTEGER: {hold}"));
+    for port in [1, 2] {
+        // txAndRx, no notifications, no optional basic TLV (an empty BITS octet)
+        has(&walk, &format!("{c}.6.1.2.{port} = INTEGER: 3"));
+        has(&walk, &format!("{c}.6.1.3.{port} = INTEGER: 2"));
+        has(&walk, &format!("{c}.6.1.4.{port} = Hex-STRING: 00"));
+    }
+    // 5 scalars, 3 x 2 port config cells, the management address row
+    assert_eq!(walk.lines().count(), 5 + 6 + 1, "{walk}");
+    // read-only: the device cannot change its interval
+    let (ok, out) = snmp(
+        line,
+        "snmpset",
+        &v2c("private", &[&format!("{c}.1.0"), "i", "30"]),
+    );
+    assert!(!ok && out.contains("notWritable"), "{out}");
+
+    let (ok, walk) = snmp(line, "snmpwalk", &v2c("public", &[".1.0.8802.1.1.2.1.2"]));
+    assert!(ok, "{walk}");
+    let s = ".1.0.8802.1.1.2.1.2";
+    assert!(walk.contains(&format!("{s}.1.0 = Timeticks:")), "{walk}");
+    assert!(counter(&walk, &format!("{s}.2.0")) >= 1, "inserts:\n{walk}");
+    assert!(counter(&walk, &format!("{s}.6.1.2.1")) >= 1, "tx port 1:\n{walk}");
+    assert!(
+        counter(&walk, &format!("{s}.7.1.4.1")) >= 1,
+        "rx frames port 1:\n{walk}"
+    );
+    assert_eq!(counter(&walk, &format!("{s}.7.1.2.1")), 0, "{walk}");
+    // 5 scalars, 2 tx cells, 6 x 2 rx cells
+    assert_eq!(walk.lines().count(), 5 + 2 + 12, "{walk}");
+}
+
 #[test]
 fn p038_net_snmp_walks_gets_and_sets_the_agent_and_the_settings_survive_a_restart() {
     if !common::is_root() {
@@ -223,6 +277,7 @@ fn p038_net_snmp_walks_gets_and_sets_the_agent_and_the_settings_survive_a_restar
     // the whole LLDP-MIB walk ends and never repeats (snmpwalk checks the order itself)
     assert!(!walk.contains("not increasing"), "{walk}");
     lldp_extensions(&line, &mau, &peer_station);
+    lldp_config_and_statistics(&line);
 
     // set the three writable strings with the write community
     let (ok, out) = snmp(

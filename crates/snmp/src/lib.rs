@@ -138,7 +138,73 @@ pub struct Device<'a> {
     pub man_addr_ports: [u8; 1],
     /// What LLDP sends on port 1, port 2.
     pub ports: [LocalPort; 2],
+    /// The LLDP agent's timing and counters (lldpConfiguration, lldpStatistics).
+    pub lldp: LldpAgent,
 }
+
+/// The LLDP agent's configuration (as the transmitter uses it) and counters.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+pub struct LldpAgent {
+    /// lldpMessageTxInterval, seconds.
+    pub tx_interval: u32,
+    /// lldpMessageTxHoldMultiplier (TTL = interval × this).
+    pub hold: u32,
+    /// lldpReinitDelay, seconds.
+    pub reinit_delay: u32,
+    /// lldpTxDelay, seconds.
+    pub tx_delay: u32,
+    /// lldpNotificationInterval, seconds.
+    pub notification_interval: u32,
+    /// lldpPortConfigTLVsTxEnable (BITS: portDesc 0x80, sysName 0x40, sysDesc 0x20, sysCap 0x10).
+    pub tlvs_tx: u8,
+    /// lldpStatistics.
+    pub stats: LldpStats,
+}
+
+/// LLDP counters (IEEE 802.1AB-2005 10.5.2), saturating.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+pub struct LldpStats {
+    /// sysUpTime (centiseconds) of the last change of the remote tables.
+    pub last_change_cs: u32,
+    /// lldpStatsRemTablesInserts.
+    pub inserts: u32,
+    /// lldpStatsRemTablesDeletes.
+    pub deletes: u32,
+    /// lldpStatsRemTablesDrops.
+    pub drops: u32,
+    /// lldpStatsRemTablesAgeouts.
+    pub ageouts: u32,
+    /// lldpStatsTxPortFramesTotal of port 1, port 2.
+    pub tx: [u32; 2],
+    /// lldpStatsRxPortTable rows of port 1, port 2.
+    pub rx: [RxStats; 2],
+}
+
+/// lldpStatsRxPortEntry.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+pub struct RxStats {
+    /// lldpStatsRxPortFramesDiscardedTotal.
+    pub discarded: u32,
+    /// lldpStatsRxPortFramesInErrors.
+    pub errors: u32,
+    /// lldpStatsRxPortFramesTotal.
+    pub frames: u32,
+    /// lldpStatsRxPortTLVsDiscardedTotal.
+    pub tlvs_discarded: u32,
+    /// lldpStatsRxPortTLVsUnrecognizedTotal.
+    pub tlvs_unrecognized: u32,
+    /// lldpStatsRxPortAgeoutsTotal.
+    pub ageouts: u32,
+}
+
+const RX_ZERO: RxStats = RxStats {
+    discarded: 0,
+    errors: 0,
+    frames: 0,
+    tlvs_discarded: 0,
+    tlvs_unrecognized: 0,
+    ageouts: 0,
+};
 
 impl<'a> Device<'a> {
     /// A device with nothing to tell (the view's shape for set checks).
@@ -168,6 +234,23 @@ impl<'a> Device<'a> {
                     mau_type: 0,
                 },
             }; 2],
+            lldp: LldpAgent {
+                tx_interval: 0,
+                hold: 0,
+                reinit_delay: 0,
+                tx_delay: 0,
+                notification_interval: 0,
+                tlvs_tx: 0,
+                stats: LldpStats {
+                    last_change_cs: 0,
+                    inserts: 0,
+                    deletes: 0,
+                    drops: 0,
+                    ageouts: 0,
+                    tx: [0; 2],
+                    rx: [RX_ZERO; 2],
+                },
+            },
         }
     }
     fn port(&self, port: u32) -> Option<&LocalPort> {

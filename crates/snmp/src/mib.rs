@@ -1,4 +1,5 @@
-//! The MIB view: MIB-II system and interfaces, LLDP-MIB local and remote data with the
+//! The MIB view: MIB-II system and interfaces, LLDP-MIB configuration (read-only: the
+//! transmitter's fixed PROFINET timing) and statistics, local and remote data with the
 //! management address tables (and lldpConfigManAddrTable, the ports that send the address), LLDP-EXT-PNO-MIB (lldpXPnoMIB, 1.0.8802.1.1.2.1.5.3791) and
 //! LLDP-EXT-DOT3-MIB (lldpXdot3MIB, 1.0.8802.1.1.2.1.5.4623) local and remote port tables, as
 //! an ordered list of objects (table columns) whose instances are enumerated in lexicographic
@@ -57,6 +58,18 @@ pub enum Id {
     LocPort(u32),
     /// lldpRemTable column (4 chassis subtype, 5 chassis id, 6 port subtype, 7 port id, 9 sys name)
     Rem(u32),
+    /// lldpConfiguration scalar (1 tx interval, 2 hold multiplier, 3 reinit delay, 4 tx delay,
+    /// 5 notification interval)
+    Config(u32),
+    /// lldpPortConfigTable column (2 admin status, 3 notification enable, 4 TLVs tx enable)
+    PortConfig(u32),
+    /// lldpStatistics scalar (1 last change time, 2 inserts, 3 deletes, 4 drops, 5 ageouts)
+    Stats(u32),
+    /// lldpStatsTxPortFramesTotal
+    StatsTx,
+    /// lldpStatsRxPortTable column (2 discarded, 3 errors, 4 frames, 5 TLVs discarded,
+    /// 6 TLVs unrecognized, 7 ageouts)
+    StatsRx(u32),
     /// lldpConfigManAddrPortsTxEnable (lldpConfigManAddrTable, indexed as lldpLocManAddrTable)
     ConfigManAddrPorts,
     /// lldpLocManAddrTable column (3 len, 4 if subtype, 5 if id, 6 OID), index subtype.address
@@ -79,6 +92,16 @@ static SYS: [u32; 7] = [1, 3, 6, 1, 2, 1, 1];
 static IFACES: [u32; 7] = [1, 3, 6, 1, 2, 1, 2];
 /// ifEntry.
 static IF_ENTRY: [u32; 9] = [1, 3, 6, 1, 2, 1, 2, 2, 1];
+/// lldpConfiguration (scalars).
+static LLDP_CONFIG: [u32; 8] = [1, 0, 8802, 1, 1, 2, 1, 1];
+/// lldpPortConfigEntry.
+static LLDP_PORT_CONFIG: [u32; 10] = [1, 0, 8802, 1, 1, 2, 1, 1, 6, 1];
+/// lldpStatistics (scalars).
+static LLDP_STATS: [u32; 8] = [1, 0, 8802, 1, 1, 2, 1, 2];
+/// lldpStatsTxPortEntry.
+static LLDP_STATS_TX: [u32; 10] = [1, 0, 8802, 1, 1, 2, 1, 2, 6, 1];
+/// lldpStatsRxPortEntry.
+static LLDP_STATS_RX: [u32; 10] = [1, 0, 8802, 1, 1, 2, 1, 2, 7, 1];
 /// lldpConfigManAddrEntry.
 static LLDP_CONFIG_MAN: [u32; 10] = [1, 0, 8802, 1, 1, 2, 1, 1, 7, 1];
 /// lldpLocalSystemData (scalars).
@@ -122,7 +145,27 @@ macro_rules! o {
 
 /// Every object, in OID order (checked by a unit test).
 pub static OBJECTS: &[Obj] = &[
+    o!(Id::Config(1), LLDP_CONFIG, 1),
+    o!(Id::Config(2), LLDP_CONFIG, 2),
+    o!(Id::Config(3), LLDP_CONFIG, 3),
+    o!(Id::Config(4), LLDP_CONFIG, 4),
+    o!(Id::Config(5), LLDP_CONFIG, 5),
+    o!(Id::PortConfig(2), LLDP_PORT_CONFIG, 2),
+    o!(Id::PortConfig(3), LLDP_PORT_CONFIG, 3),
+    o!(Id::PortConfig(4), LLDP_PORT_CONFIG, 4),
     o!(Id::ConfigManAddrPorts, LLDP_CONFIG_MAN, 1),
+    o!(Id::Stats(1), LLDP_STATS, 1),
+    o!(Id::Stats(2), LLDP_STATS, 2),
+    o!(Id::Stats(3), LLDP_STATS, 3),
+    o!(Id::Stats(4), LLDP_STATS, 4),
+    o!(Id::Stats(5), LLDP_STATS, 5),
+    o!(Id::StatsTx, LLDP_STATS_TX, 2),
+    o!(Id::StatsRx(2), LLDP_STATS_RX, 2),
+    o!(Id::StatsRx(3), LLDP_STATS_RX, 3),
+    o!(Id::StatsRx(4), LLDP_STATS_RX, 4),
+    o!(Id::StatsRx(5), LLDP_STATS_RX, 5),
+    o!(Id::StatsRx(6), LLDP_STATS_RX, 6),
+    o!(Id::StatsRx(7), LLDP_STATS_RX, 7),
     o!(Id::LocChassisIdSubtype, LLDP_LOC, 1),
     o!(Id::LocChassisId, LLDP_LOC, 2),
     o!(Id::LocSysName, LLDP_LOC, 3),
@@ -195,6 +238,9 @@ impl Id {
         match self {
             Id::If(_) => IFS,
             Id::LocPort(_)
+            | Id::PortConfig(_)
+            | Id::StatsTx
+            | Id::StatsRx(_)
             | Id::Rem(_)
             | Id::RemManAddr(_)
             | Id::PnoLoc(_)
@@ -209,7 +255,13 @@ impl Id {
         let port = r + 1;
         let mut i = [0; INST];
         let n = match self {
-            Id::If(_) | Id::LocPort(_) | Id::PnoLoc(_) | Id::Dot3Loc(_) => {
+            Id::If(_)
+            | Id::LocPort(_)
+            | Id::PnoLoc(_)
+            | Id::Dot3Loc(_)
+            | Id::PortConfig(_)
+            | Id::StatsTx
+            | Id::StatsRx(_) => {
                 i[0] = port;
                 1
             }
@@ -410,6 +462,47 @@ pub fn value<'a>(id: Id, r: u32, agent: &'a Agent, dev: &'a Device<'a>) -> Val<'
                 _ => Val::Str(n.sys_name),
             },
         },
+        Id::Config(c) => {
+            let l = &dev.lldp;
+            let v = match c {
+                1 => l.tx_interval,
+                2 => l.hold,
+                3 => l.reinit_delay,
+                4 => l.tx_delay,
+                _ => l.notification_interval,
+            };
+            Val::Int(i32::try_from(v).unwrap_or(i32::MAX))
+        }
+        Id::PortConfig(c) => match c {
+            // txAndRx(3)
+            2 => Val::Int(3),
+            // no notifications
+            3 => truth(false),
+            _ => Val::Str(core::slice::from_ref(&dev.lldp.tlvs_tx)),
+        },
+        Id::Stats(c) => {
+            let s = &dev.lldp.stats;
+            match c {
+                1 => Val::Ticks(s.last_change_cs),
+                // ZeroBasedCounter32 (a Gauge32)
+                2 => Val::Gauge(s.inserts),
+                3 => Val::Gauge(s.deletes),
+                4 => Val::Gauge(s.drops),
+                _ => Val::Gauge(s.ageouts),
+            }
+        }
+        Id::StatsTx => Val::Counter(dev.lldp.stats.tx.get(r as usize).copied().unwrap_or(0)),
+        Id::StatsRx(c) => {
+            let x = dev.lldp.stats.rx.get(r as usize).copied().unwrap_or_default();
+            match c {
+                2 => Val::Counter(x.discarded),
+                3 => Val::Counter(x.errors),
+                4 => Val::Counter(x.frames),
+                5 => Val::Counter(x.tlvs_discarded),
+                6 => Val::Counter(x.tlvs_unrecognized),
+                _ => Val::Gauge(x.ageouts),
+            }
+        }
         Id::ConfigManAddrPorts => Val::Str(&dev.man_addr_ports),
         // lldpLocManAddrLen: subtype and address octets (5)
         Id::LocManAddr(3) => Val::Int(5),

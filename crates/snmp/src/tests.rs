@@ -4,6 +4,7 @@
 use super::*;
 
 mod lldp;
+mod lldp_config;
 
 /// The local ports as the LLDP transmitter describes them: port 1 up (100BASE-TX FD), port 2
 /// down (MAU type 0), auto-negotiation supported and on, 10/100 half/full advertised.
@@ -68,6 +69,33 @@ fn dev() -> Device<'static> {
         }),
         man_addr_ports: [0xc0],
         ports: local_ports(),
+        lldp: LldpAgent {
+            tx_interval: 5,
+            hold: 4,
+            reinit_delay: 2,
+            tx_delay: 1,
+            notification_interval: 5,
+            tlvs_tx: 0,
+            stats: LldpStats {
+                last_change_cs: 1200,
+                inserts: 3,
+                deletes: 1,
+                drops: 0,
+                ageouts: 1,
+                tx: [17, 0],
+                rx: [
+                    RxStats {
+                        discarded: 2,
+                        errors: 2,
+                        frames: 9,
+                        tlvs_discarded: 0,
+                        tlvs_unrecognized: 4,
+                        ageouts: 1,
+                    },
+                    RxStats::default(),
+                ],
+            },
+        },
     }
 }
 
@@ -221,11 +249,15 @@ fn p038_walk_is_strictly_increasing_and_ends_with_end_of_mib_view() {
         cur = r.vbs[0].0;
         count += 1;
     }
-    // lldpConfigManAddrPortsTxEnable, 4 local LLDP scalars, 3x2 local port cells, 4 local
+    // 5 lldpConfiguration scalars, 3x2 port config cells, lldpConfigManAddrPortsTxEnable,
+    // 5 lldpStatistics scalars, 2 tx and 6x2 rx port counters, 4 local LLDP scalars, 3x2 local port cells, 4 local
     // management address cells,
     // 5 remote cells (one neighbour), 3 remote management address cells, 6x2 local and 6
     // remote PROFINET cells, 4x2 local and 4 remote 802.3 cells, 7 system, ifNumber, 8x3 ifTable
-    assert_eq!(count, 1 + 4 + 6 + 4 + 5 + 3 + 12 + 6 + 8 + 4 + 7 + 1 + 24);
+    assert_eq!(
+        count,
+        5 + 6 + 1 + 5 + 2 + 12 + 4 + 6 + 4 + 5 + 3 + 12 + 6 + 8 + 4 + 7 + 1 + 24
+    );
     let (q, n) = req(0, b"public", GET_NEXT, 9, 0, 0, &[(cur.arcs(), 5, &[])]);
     let (r, _) = run(&mut a, &q[..n]).unwrap();
     assert_eq!((r.status, r.index), (err::NO_SUCH_NAME, 1));

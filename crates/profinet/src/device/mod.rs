@@ -124,6 +124,7 @@ pub struct Device<H: RecordHook = NoRecords> {
     rpc: Server,
     cm: Cm<H>,
     lldp: Schedule,
+    lldp_stats: lldp::Stats,
     port_macs: [MacAddr; model::PORTS as usize],
     /// A delayed DCP Identify answer and when to send it.
     identify: Option<(Nanos, Vec<u8, 1500>)>,
@@ -180,6 +181,7 @@ impl<H: RecordHook> Device<H> {
                 hook,
             ),
             lldp: Schedule::default(),
+            lldp_stats: lldp::Stats::default(),
             port_macs: config.port_macs,
             identify: None,
             events: Deque::new(),
@@ -282,16 +284,21 @@ impl<H: RecordHook> Device<H> {
             ethertype::PROFINET => self.profinet(now, &f, tx),
             ethertype::ARP | ethertype::IPV4 => self.ip_frame(now, frame, tx),
             ethertype::LLDP => {
-                if let Some(n) = lldp::Neighbor::parse(&f) {
+                let n = lldp::Neighbor::parse(&f);
+                let mut inserted = false;
+                if let Some(n) = &n {
                     let mut alias = Vec::new();
                     if n.alias(&mut alias).is_some() {
                         self.dcp.set_alias(0, Some(&alias));
                     }
                     // one receive path: the neighbour is port 1's (P-040)
                     if let Some(p) = self.cm.pdev_mut().port_mut(1) {
-                        p.peer = Peer::from_lldp(&n, f.src, now);
+                        let had = p.peer.is_some();
+                        p.peer = Peer::from_lldp(n, f.src, now);
+                        inserted = !had && p.peer.is_some();
                     }
                 }
+                self.lldp_stats.received(1, f.payload, n.is_some(), inserted, now);
             }
             _ => self.counters.other_ethertype = self.counters.other_ethertype.saturating_add(1),
         }
@@ -448,7 +455,8 @@ impl<H: RecordHook> Device<H> {
                 }
             }
         }
-        self.cm.pdev_mut().expire(now);
+        let aged = self.cm.pdev_mut().expire(now);
+        self.lldp_stats.aged_out(aged, now);
         while let Some(port) = self.lldp.due(now) {
             if !self.cm.pdev().lldp_allowed(port) {
                 // stopped by the controller's peer-to-peer boundary
@@ -465,6 +473,7 @@ impl<H: RecordHook> Device<H> {
             if let Some(n) = lldp::build_frame(&station, port, &self.lldp_port_info(port), &mut out) {
                 tx(out.get(..n).unwrap_or(&[]));
                 self.cm.pdev_mut().count_lldp(port, n);
+                self.lldp_stats.sent(port);
             }
             self.lldp.sent(port, now);
         }

@@ -73,6 +73,45 @@ impl<H: RecordHook> Device<H> {
         PortInfo::fast_ethernet(mac)
     }
 
+    /// The LLDP agent as LLDP-MIB shows it: the transmitter's fixed timing and the counters.
+    pub(super) fn lldp_agent(&self) -> snmp::LldpAgent {
+        let cs = |t: Nanos| u32::try_from(t.as_ms() / 10).unwrap_or(u32::MAX);
+        let s = &self.lldp_stats;
+        let interval = u32::try_from(lldp::TX_INTERVAL.as_ms() / 1000).unwrap_or(u32::MAX);
+        let rx = |p: usize| {
+            let r = s.rx.get(p).copied().unwrap_or_default();
+            snmp::RxStats {
+                discarded: r.discarded,
+                errors: r.errors,
+                frames: r.frames,
+                tlvs_discarded: 0,
+                tlvs_unrecognized: r.tlvs_unrecognized,
+                ageouts: r.ageouts,
+            }
+        };
+        snmp::LldpAgent {
+            tx_interval: interval,
+            hold: u32::from(lldp::TTL_SECS) / interval.max(1),
+            reinit_delay: lldp::REINIT_DELAY_SECS,
+            tx_delay: lldp::TX_DELAY_SECS,
+            notification_interval: lldp::NOTIFICATION_INTERVAL_SECS,
+            // no Port Description, System Name, System Description or Capabilities TLV
+            tlvs_tx: 0,
+            stats: snmp::LldpStats {
+                last_change_cs: s.last_change.map_or(0, cs),
+                inserts: s.inserts,
+                deletes: 0,
+                drops: 0,
+                ageouts: s.ageouts,
+                tx: [
+                    s.tx.first().copied().unwrap_or(0),
+                    s.tx.get(1).copied().unwrap_or(0),
+                ],
+                rx: [rx(0), rx(1)],
+            },
+        }
+    }
+
     /// One SNMP request: answered from port 161 or dropped (P-038).
     pub(super) fn snmp_request(
         &mut self,
@@ -126,6 +165,7 @@ impl<H: RecordHook> Device<H> {
                 .filter(|&p| pdev.lldp_allowed(p))
                 .fold(0u8, |bits, p| bits | (0x80 >> (p - 1)))],
             ports,
+            lldp: self.lldp_agent(),
         };
         let Some(payload) = out.get_mut(UDP_PAYLOAD_OFFSET..) else {
             return;

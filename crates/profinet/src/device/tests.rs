@@ -325,3 +325,48 @@ fn p040_a_topology_mismatch_raises_a_port_diagnosis_alarm_that_disappears_when_i
     d.set_port_link(2, true);
     assert!(alarms(&poll(&mut d, Nanos::from_ms(6))).is_empty());
 }
+
+#[test]
+fn p038_lldp_counters_move_when_lldpdus_go_out_and_come_in() {
+    use crate::pdev::tests::lldp_from_switch;
+    let mut d = device();
+    let a = d.lldp_agent();
+    // the timing LLDP-MIB shows is what the transmitter uses: 5 s, TTL 20 s = 4 x 5 s
+    assert_eq!((a.tx_interval, a.hold), (5, 4));
+    assert_eq!(a.stats, snmp::LldpStats::default());
+    // two polls 5 s apart: two LLDPDUs on each port
+    poll(&mut d, Nanos::ZERO);
+    let out = poll(&mut d, Nanos::from_secs(5));
+    let ttl = EthFrame::parse(&out[0]).unwrap().payload;
+    // chassis, port ID TLVs, then the TTL TLV's value = interval x hold
+    let skip = 2 + usize::from(ttl[1]);
+    let skip = skip + 2 + usize::from(ttl[skip + 1]);
+    let ttl = u32::from(u16::from_be_bytes([ttl[skip + 2], ttl[skip + 3]]));
+    assert_eq!(ttl, a.tx_interval * a.hold);
+    assert_eq!(d.lldp_agent().stats.tx, [2, 2]);
+    // a neighbour's LLDPDU with a reserved TLV type (9) before End: inserted once
+    let mut f = lldp_from_switch();
+    let end = 14 + 7 + 11 + 4;
+    f.splice(end..end, [9 << 1, 1, 0xAA]);
+    f.truncate(60);
+    sent(&mut d, Nanos::from_secs(6), &f);
+    sent(&mut d, Nanos::from_secs(7), &lldp_from_switch());
+    let s = d.lldp_agent().stats;
+    assert_eq!((s.rx[0].frames, s.rx[0].discarded, s.rx[0].errors), (2, 0, 0));
+    assert_eq!(s.rx[0].tlvs_unrecognized, 1);
+    assert_eq!((s.inserts, s.last_change_cs), (1, 600));
+    // a malformed LLDPDU (TTL TLV missing): counted as discarded and in error, nothing else
+    let mut bad = lldp_from_switch();
+    bad[14 + 7 + 11] = 0;
+    sent(&mut d, Nanos::from_secs(8), &bad);
+    let s = d.lldp_agent().stats;
+    assert_eq!((s.rx[0].frames, s.rx[0].discarded, s.rx[0].errors), (3, 1, 1));
+    assert_eq!((s.inserts, s.ageouts), (1, 0));
+    assert!(d.cm().pdev().port(1).unwrap().peer.is_some());
+    // the TTL (20 s) runs out: one ageout on port 1, and the table changed then
+    poll(&mut d, Nanos::from_secs(28));
+    let s = d.lldp_agent().stats;
+    assert_eq!((s.ageouts, s.rx[0].ageouts, s.rx[1].ageouts), (1, 1, 0));
+    assert_eq!(s.last_change_cs, 2800);
+    assert!(d.cm().pdev().port(1).unwrap().peer.is_none());
+}

@@ -29,13 +29,22 @@ use crate::dcp::NameOfStation;
 use crate::model;
 use crate::wire::{emit_header, ethertype, EthFrame, MacAddr};
 
+mod stats;
 #[cfg(test)]
 mod tests;
+
+pub use stats::{Rx as RxStats, Stats};
 
 /// The transmit interval (msgTxInterval).
 pub const TX_INTERVAL: Nanos = Nanos::from_secs(5);
 /// TTL sent: msgTxHold (4) × the interval, in seconds.
 pub const TTL_SECS: u16 = 20;
+/// lldpReinitDelay (s): the 802.1AB default; a port sends again when its link comes back.
+pub const REINIT_DELAY_SECS: u32 = 2;
+/// lldpTxDelay (s): the smallest the MIB allows; a change (name, IP, link) is sent at once.
+pub const TX_DELAY_SECS: u32 = 1;
+/// lldpNotificationInterval (s): the 802.1AB default (this device sends no notifications).
+pub const NOTIFICATION_INTERVAL_SECS: u32 = 5;
 /// The PROFINET OUI.
 pub const OUI_PROFINET: [u8; 3] = [0x00, 0x0E, 0xCF];
 /// The IEEE 802.3 OUI.

@@ -303,13 +303,16 @@ impl Pdev {
         self.port(port).is_some_and(|p| p.check.mismatch(p, kind))
     }
 
-    /// Forgets the neighbours whose TTL ran out at `now`.
-    pub fn expire(&mut self, now: Nanos) {
-        for p in self.ports.iter_mut() {
+    /// Forgets the neighbours whose TTL ran out at `now`; the ports that lost one (bit 0 port 1).
+    pub fn expire(&mut self, now: Nanos) -> u8 {
+        let mut aged = 0;
+        for (i, p) in self.ports.iter_mut().enumerate() {
             if p.peer.as_ref().is_some_and(|n| n.expires <= now) {
                 p.peer = None;
+                aged |= 1u8.checked_shl(i as u32).unwrap_or(0);
             }
         }
+        aged
     }
 
     /// Whether `index` is one of the PDev records.

@@ -14,7 +14,7 @@ const DOT3_LOC: [u32; 14] = [1, 0, 8802, 1, 1, 2, 1, 5, 4623, 1, 2, 1, 1, 1];
 const DOT3_REM: [u32; 14] = [1, 0, 8802, 1, 1, 2, 1, 5, 4623, 1, 3, 1, 1, 1];
 
 /// `base` with its last arc (the column) replaced by `col`, then `inst`.
-fn oid(base: &[u32], col: u32, inst: &[u32]) -> ber::Oid {
+pub(super) fn oid(base: &[u32], col: u32, inst: &[u32]) -> ber::Oid {
     let mut o = ber::Oid::from_arcs(&base[..base.len() - 1]).unwrap();
     o.push(col).unwrap();
     for &a in inst {
@@ -24,7 +24,7 @@ fn oid(base: &[u32], col: u32, inst: &[u32]) -> ber::Oid {
 }
 
 /// A get-next (or get) of one OID against `d`: (answered OID, tag, value).
-fn one(d: &Device, pdu: u8, o: &[u32]) -> (ber::Oid, u8, [u8; 64], usize) {
+pub(super) fn one(d: &Device, pdu: u8, o: &[u32]) -> (ber::Oid, u8, [u8; 64], usize) {
     let mut a = Agent::default();
     let (q, n) = req(1, b"public", pdu, 1, 0, 0, &[(o, 5, &[])]);
     let mut out = [0u8; 1500];
@@ -34,26 +34,26 @@ fn one(d: &Device, pdu: u8, o: &[u32]) -> (ber::Oid, u8, [u8; 64], usize) {
     r.vbs[0]
 }
 
-fn get_int(d: &Device, o: &[u32]) -> i32 {
+pub(super) fn get_int(d: &Device, o: &[u32]) -> i32 {
     let v = one(d, GET, o);
     assert_eq!(v.1, 2, "INTEGER at {o:?}");
     ber::decode_int(&v.2[..v.3]).unwrap()
 }
 
-fn get_gauge(d: &Device, o: &[u32]) -> u32 {
+pub(super) fn get_gauge(d: &Device, o: &[u32]) -> u32 {
     let v = one(d, GET, o);
     assert_eq!(v.1, 0x42, "Unsigned32 at {o:?}");
     ber::decode_uint(&v.2[..v.3]).unwrap()
 }
 
-fn get_str(d: &Device, o: &[u32]) -> ([u8; 64], usize) {
+pub(super) fn get_str(d: &Device, o: &[u32]) -> ([u8; 64], usize) {
     let v = one(d, GET, o);
     assert_eq!(v.1, 4, "OCTET STRING at {o:?}");
     (v.2, v.3)
 }
 
 /// Every instance under `prefix` by get-next, strictly increasing.
-fn walk(d: &Device, prefix: &[u32]) -> usize {
+pub(super) fn walk(d: &Device, prefix: &[u32]) -> usize {
     let mut cur = ber::Oid::from_arcs(prefix).unwrap();
     let mut n = 0;
     loop {
@@ -68,7 +68,7 @@ fn walk(d: &Device, prefix: &[u32]) -> usize {
 }
 
 /// No IP, no neighbours.
-fn lonely() -> Device<'static> {
+pub(super) fn lonely() -> Device<'static> {
     let mut d = dev();
     d.neighbors = [None, None];
     d.man_addr = None;
@@ -98,8 +98,8 @@ fn p038_loc_man_addr_table_is_the_interface_ipv4() {
     // lldpConfigManAddrPortsTxEnable, same index: both ports send it (ports 1 and 2: 0xC0)
     let (s, n) = get_str(&d, &[&CONFIG_MAN[..], &inst].concat());
     assert_eq!(&s[..n], &[0xc0]);
-    // the LLDP walk starts there
-    let v = one(&d, GET_NEXT, &LLDP);
+    // the walk reaches it from the end of lldpPortConfigTable
+    let v = one(&d, GET_NEXT, &[1, 0, 8802, 1, 1, 2, 1, 1, 6, 1, 4, 2]);
     assert_eq!(v.0.arcs(), &[&CONFIG_MAN[..], &inst].concat()[..]);
 }
 
@@ -108,7 +108,7 @@ fn p038_without_ip_the_loc_man_addr_table_is_empty_and_getnext_skips_it() {
     let mut d = dev();
     d.man_addr = None;
     assert_eq!(walk(&d, &[1, 0, 8802, 1, 1, 2, 1, 3, 8]), 0);
-    assert_eq!(walk(&d, &[1, 0, 8802, 1, 1, 2, 1, 1]), 0);
+    assert_eq!(walk(&d, &[1, 0, 8802, 1, 1, 2, 1, 1, 7]), 0);
     // the last lldpLocPortDesc is followed by the first lldpRemTable cell
     let v = one(&d, GET_NEXT, &[1, 0, 8802, 1, 1, 2, 1, 3, 7, 1, 4, 2]);
     assert_eq!(v.0.arcs(), &[1, 0, 8802, 1, 1, 2, 1, 4, 1, 1, 4, 0, 1, 1]);
@@ -210,8 +210,9 @@ fn p038_without_neighbours_no_remote_rows_and_getnext_crosses_tables() {
     ] {
         assert_eq!(walk(&d, t), 0, "{t:?}");
     }
+    // 5 config scalars, 6 port config, 5 stats scalars, 2 tx and 12 rx stats cells;
     // 4 scalars, 6 local port, 12 PROFINET and 8 802.3 local cells
-    assert_eq!(walk(&d, &LLDP), 4 + 6 + 12 + 8);
+    assert_eq!(walk(&d, &LLDP), 5 + 6 + 5 + 2 + 12 + 4 + 6 + 12 + 8);
     // from the local port table straight into the PROFINET local table
     let v = one(&d, GET_NEXT, &[1, 0, 8802, 1, 1, 2, 1, 3, 7, 1, 4, 2]);
     assert_eq!(v.0.arcs(), oid(&PNO_LOC, 1, &[1]).arcs());
@@ -236,6 +237,10 @@ fn p038_whole_lldp_walk_with_neighbours_on_both_ports_never_repeats() {
         oid(&REM_MAN, 3, &[0, 1, 1, 1, 4, 10, 0, 0, 1]).arcs(),
     );
     assert_eq!(v.0.arcs(), oid(&REM_MAN, 3, &[0, 2, 1, 1, 4, 10, 0, 0, 1]).arcs());
-    // 1 config, 4 + 6 + 4 local; 2x(5 + 3) remote; 12 + 2x6 PROFINET; 8 + 2x4 802.3
-    assert_eq!(walk(&d, &LLDP), 1 + 4 + 6 + 4 + 16 + 12 + 12 + 8 + 8);
+    // 5 + 6 config, 1 config man addr, 5 + 2 + 12 statistics, 4 + 6 + 4 local;
+    // 2x(5 + 3) remote; 12 + 2x6 PROFINET; 8 + 2x4 802.3
+    assert_eq!(
+        walk(&d, &LLDP),
+        5 + 6 + 1 + 5 + 2 + 12 + 4 + 6 + 4 + 16 + 12 + 12 + 8 + 8
+    );
 }
