@@ -17,12 +17,14 @@ pub mod cycle;
 pub mod net;
 pub mod tasks;
 
-/// The parameter flash of the images: two 2 KiB sectors, one per slot (the
-/// saved set is 1109 bytes; `save_fits_the_parameter_flash` checks it).
+/// The parameter flash of the images: two 3 KiB sectors, one per slot (the
+/// saved set is 2,079 bytes since the motor data, F00/F06, I470/I471 and E54
+/// joined it: 2 KiB sectors no longer held it; `save_fits_the_parameter_flash`
+/// checks it).
 ///
 /// The QEMU image keeps them in RAM; on the reference board the same layout
 /// goes on two sectors of the on-chip flash (board bring-up, docs/flashing.md).
-pub type ParamFlash = store::RamFlash<2048, 2>;
+pub type ParamFlash = store::RamFlash<3072, 2>;
 
 /// The drive as the firmware runs it.
 pub type Drive = drive_ecat::runtime::Drive<ParamFlash>;

@@ -193,7 +193,7 @@ fn e107_e125_free_run_cycle_at_a150_without_sync0() {
 fn save_fits_the_parameter_flash() {
     let mut drive = Drive::new(ParamFlash::new());
     drive.objects_mut().set(0x6065, 0, 1234).unwrap();
-    assert!(drive.save(), "save into {} bytes", 2 * 2048);
+    assert!(drive.save(), "save into {} bytes", 2 * 3072);
     let drive = Drive::new(drive.into_flash().unwrap());
     assert_eq!(drive.startup(), drive_ecat::runtime::Startup::Loaded);
     assert_eq!(drive.objects().get(0x6065, 0), Ok(1234));
