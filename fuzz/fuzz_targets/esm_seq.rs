@@ -181,7 +181,8 @@ impl Model {
             ok,
             "{what}: AL status {state:#x} error {error} code {code:#06x}; the model allows {allowed:x?} (from {self:x?})"
         );
-        if self.state != state {
+        // Op reached, another state, or the request refused: no longer waiting
+        if self.state != state || error {
             self.op_wait = None;
         }
         static SEEN: std::sync::atomic::AtomicU32 = std::sync::atomic::AtomicU32::new(0);
@@ -200,6 +201,8 @@ struct Line {
     model: Model,
     /// The drive's RxPDO and TxPDO lengths (its mapping at power-on).
     pd_bytes: (usize, usize),
+    /// The last AL control value written.
+    last_control: u16,
 }
 
 thread_local! {
@@ -250,9 +253,69 @@ impl Line {
     }
 }
 
+/// Writes AL control `value` (requested state, acknowledge 0x10, device
+/// identification 0x20), reads the AL status back and checks it against the
+/// model; keeps the model's S→O wait (E-033): started by the first Op
+/// request from Safe-Op, kept by a repeated one, ended by any other
+/// processed request, a state change or an error.
+fn al_control(line: &mut Line, value: u16) {
+    let now = line.sim.now();
+    let req = (value & 0x0F) as u8;
+    let ack = value & 0x10 != 0;
+    let id = value & 0x20 != 0;
+    let allowed = line.model.request(req, ack, now);
+    let processed = !(line.model.error && !ack);
+    let repeat_op = req == OP && line.model.state == SAFEOP && line.model.op_wait.is_some();
+    line.write(regs::AL_CONTROL, &value.to_le_bytes());
+    line.wait(Nanos::from_ms(1));
+    let got = line.status();
+    // ETG.1000.6: a processed request with bit 5 loads the ID (shown
+    // while no error is indicated); one without it unloads it; a
+    // request ignored (error shown, no acknowledge) changes nothing
+    if ECAT33_DEVICE_IDENTIFICATION && processed {
+        let (_, error, _, loaded) = got;
+        assert!(
+            loaded == (id && !error),
+            "device identification {}requested: AL status {} ID loaded (error {error})",
+            if id { "" } else { "not " },
+            if loaded { "with" } else { "without" }
+        );
+    }
+    // with the ID loaded the code register holds the identification value
+    let mut checked = got;
+    if got.3 {
+        checked.2 = 0;
+    }
+    line.model
+        .check(&allowed, checked, &format!("AL control {value:#06x}"));
+    line.last_control = value;
+    if !processed {
+        return;
+    }
+    if req == OP && line.model.state == SAFEOP && !line.model.error {
+        if !(repeat_op && ECAT33_OP_WAIT_NOT_RESTARTED) || line.model.op_wait.is_none() {
+            line.model.op_wait = Some(now);
+        }
+    } else {
+        // any other processed request replaces the waiting one
+        line.model.op_wait = None;
+    }
+}
+
+/// E-033: no Op request waits longer than 200 ms (plus the polling slack)
+/// from the first request: by then the device is in Op or refused it.
+fn e033_wait_ended(line: &Line) {
+    if let Some(t) = line.model.op_wait {
+        assert!(
+            line.sim.now() <= t + Nanos::from_ms(260) || line.model.state != SAFEOP || line.model.error,
+            "S→O still waiting {} ms after the Op request",
+            (line.sim.now() - t).as_ns() / 1_000_000
+        );
+    }
+}
+
 fn op(line: &mut Line, u: &mut Unstructured<'_>) {
     let kind: u8 = u.arbitrary().unwrap_or(0);
-    let now = line.sim.now();
     match kind % 8 {
         // AL control: a state (mostly a defined one), acknowledge, device identification
         0 | 1 | 2 => {
@@ -264,35 +327,7 @@ fn op(line: &mut Line, u: &mut Unstructured<'_>) {
             let ack = sel & 0x40 != 0 || !line.model.error && sel & 0x20 != 0;
             let id = u.ratio(1, 8).unwrap_or(false);
             let value = u16::from(req) | if ack { 0x10 } else { 0 } | if id { 0x20 } else { 0 };
-            let allowed = line.model.request(req, ack, now);
-            let repeat_op = req == OP && line.model.state == SAFEOP && line.model.op_wait.is_some();
-            line.write(regs::AL_CONTROL, &value.to_le_bytes());
-            line.wait(Nanos::from_ms(1));
-            let got = line.status();
-            // ETG.1000.6: a processed request with bit 5 loads the ID (shown
-            // while no error is indicated); one without it unloads it; a
-            // request ignored (error shown, no acknowledge) changes nothing
-            if ECAT33_DEVICE_IDENTIFICATION && !(line.model.error && !ack) {
-                let (_, error, _, loaded) = got;
-                assert!(
-                    loaded == (id && !error),
-                    "device identification {}requested: AL status {} ID loaded (error {error})",
-                    if id { "" } else { "not " },
-                    if loaded { "with" } else { "without" }
-                );
-            }
-            // with the ID loaded the code register holds the identification value
-            let mut checked = got;
-            if got.3 {
-                checked.2 = 0;
-            }
-            line.model
-                .check(&allowed, checked, &format!("AL control {value:#06x}"));
-            if req == OP && line.model.state == SAFEOP && !line.model.error {
-                if !(repeat_op && ECAT33_OP_WAIT_NOT_RESTARTED) || line.model.op_wait.is_none() {
-                    line.model.op_wait = Some(now);
-                }
-            }
+            al_control(line, value);
         }
         // SyncManager configuration: valid, certainly not, or any bytes
         3 => {
@@ -454,7 +489,10 @@ fn op(line: &mut Line, u: &mut Unstructured<'_>) {
             line.model.check(&allowed, got, "process data");
         }
         // time passes: a few ms, or past the SM watchdog's default 100 ms or
-        // the 200 ms S→O wait (simulated time is what an input costs)
+        // the 200 ms S→O wait (simulated time is what an input costs); with
+        // the long waits' top bit the master rewrites its last AL control
+        // request every 10 ms meanwhile, as masters that write AL control
+        // cyclically do (E-033: a repeated Op request keeps the wait's start)
         _ => {
             let sel: u8 = u.arbitrary().unwrap_or(0);
             let ms = match sel % 8 {
@@ -463,23 +501,24 @@ fn op(line: &mut Line, u: &mut Unstructured<'_>) {
                 2 => 330,
                 _ => u64::from(sel >> 3) + 1,
             };
-            let start = line.model.op_wait;
-            line.wait(Nanos::from_ms(ms));
+            let repeat = sel % 8 <= 2 && sel & 0x80 != 0;
+            let end = line.sim.now() + Nanos::from_ms(ms);
+            if repeat {
+                while line.sim.now() + Nanos::from_ms(10) <= end {
+                    line.wait(Nanos::from_ms(9));
+                    let got = line.status();
+                    let allowed = line.model.autonomous();
+                    line.model.check(&allowed, got, "time passing");
+                    al_control(line, line.last_control);
+                    e033_wait_ended(line);
+                }
+            }
+            let rest = end.saturating_sub(line.sim.now());
+            line.wait(rest);
             let got = line.status();
             let allowed = line.model.autonomous();
             line.model.check(&allowed, got, &format!("{ms} ms later"));
-            // E-033: no Op request waits longer than 200 ms (plus the polling slack)
-            if let Some(t) = start {
-                {
-                    if line.sim.now() > t + Nanos::from_ms(260) {
-                        assert!(
-                            line.model.state != SAFEOP || line.model.error || line.model.op_wait.is_none(),
-                            "S→O still waiting {} ms after the Op request",
-                            (line.sim.now() - t).as_ns() / 1_000_000
-                        );
-                    }
-                }
-            }
+            e033_wait_ended(line);
         }
     }
 }
@@ -504,6 +543,7 @@ fuzz_target!(|data: &[u8]| {
             boot,
         },
         pd_bytes,
+        last_control: u16::from(INIT),
     };
     let got = line.status();
     line.model.check(&vec![(INIT, false, vec![0])], got, "power-on");
