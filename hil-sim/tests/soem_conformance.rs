@@ -79,3 +79,12 @@ fn e027_soem_reserved_mailbox_type_unsupported_protocol() {
 fn e026_soem_explicit_device_identification_through_registers() {
     run_case("i", "id-request");
 }
+
+/// E-002 (issue 33.3): frames as libethercat sends them (EtherCAT header
+/// length 16 bytes larger than the datagrams, unpadded on veth), a shorter
+/// header length, a trailer: `serve` answers each datagram as an ESC does;
+/// a frame ending inside its datagram is dropped.
+#[test]
+fn e002_soem_libethercat_style_frames_answered_by_serve() {
+    run_case("f", "frames");
+}

@@ -25,11 +25,20 @@ as root inside the master's network namespace (or by hand against `serve`).
                     + ID request (bit 5) -> AL status 0x21 with the alias in
                     0x0134; Pre-Op + ID -> 0x22, the alias; a request without
                     bit 5 clears both; a refused request shows its error.
+  --case frames     E-002 (issue 33.3): frames as libethercat and other
+                    masters send them, written to the raw socket beside
+                    SOEM's: EtherCAT header length 16 bytes larger than the
+                    datagrams and unpadded (veth does not pad), smaller than
+                    the datagrams, a trailer after the last datagram: `serve`
+                    processes each datagram as an ESC does (WKC 1, the AL
+                    status); a frame that ends inside a datagram gets no
+                    answer (silicon drops it too).
 
 Exit status 0 when every check passed; each failed check is printed.
 """
 import argparse
 import os
+import socket
 import struct
 import sys
 import time
@@ -257,17 +266,73 @@ def case_id_request(m):
         check((st, code) == want, f"{what}: {want[0]:#04x}/{want[1]:#06x} expected")
 
 
+def raw_frame(sock, mac, ado_station, delta, trailer=b"", cut=0):
+    """One FPRD of AL status (0x0130, 2 bytes) of `ado_station` with the
+    EtherCAT header's length field off by `delta`, `trailer` appended, `cut`
+    bytes removed from the end; the answer's (WKC, data) or None."""
+    index = 0x5A
+    body = struct.pack("<BBHHHH", 0x04, index, ado_station, AL_STATUS, 2, 0) + bytes(2) + b"\x00\x00"
+    length = (len(body) + delta) & 0x07FF
+    frame = b"\xff" * 6 + mac + b"\x88\xa4" + struct.pack("<H", length | 0x1000) + body + trailer
+    frame = frame[: len(frame) - cut]
+    sock.send(frame)
+    end = time.monotonic() + 0.3
+    while time.monotonic() < end:
+        try:
+            data, addr = sock.recvfrom(2048)
+        except socket.timeout:
+            return None
+        if addr[2] == socket.PACKET_OUTGOING or data[12:14] != b"\x88\xa4" or len(data) < 16 + 14:
+            continue
+        if data[16] != 0x04 or data[17] != index:
+            continue  # SOEM's own traffic
+        return struct.unpack_from("<H", data, 16 + 12)[0], data[16 + 10 : 16 + 12]
+    return None
+
+
+def case_frames(m, iface):
+    s = m.slaves[0]
+    station = struct.unpack("<H", rd(s, 0x0010, 2))[0]  # as SOEM configured it
+    want = rd(s, AL_STATUS, 2)
+    sock = socket.socket(socket.AF_PACKET, socket.SOCK_RAW, socket.htons(0x88A4))
+    sock.bind((iface, 0))
+    sock.settimeout(0.3)
+    mac = sock.getsockname()[4]
+    try:
+        for what, delta, trailer in [
+            ("header length +16, unpadded (libethercat)", 16, b""),
+            ("header length +1, unpadded", 1, b""),
+            ("header length -4, padded to 60 bytes", -4, bytes(30)),
+            ("a 24-byte trailer after the last datagram", 0, b"\xaa" * 24),
+        ]:
+            got = None
+            for _ in range(3):  # a frame lost on a loaded machine
+                got = raw_frame(sock, mac, station, delta, trailer)
+                if got is not None:
+                    break
+            say(f"{what}: answer {got}")
+            check(got == (1, want), f"{what}: WKC 1 and AL status {want.hex()} expected")
+        got = raw_frame(sock, mac, station, 0, cut=3)
+        say(f"frame ending inside its datagram: answer {got}")
+        check(got is None, "a frame that ends inside a datagram is dropped")
+    finally:
+        sock.close()
+
+
 def main():
     p = argparse.ArgumentParser()
     p.add_argument("--iface", required=True)
-    p.add_argument("--case", required=True, choices=["op-repeat", "sm-off", "mbx-type", "id-request"])
+    p.add_argument("--case", required=True, choices=["op-repeat", "sm-off", "mbx-type", "id-request", "frames"])
     args = p.parse_args()
     m = pysoem.Master()
     m.open(args.iface)
     try:
         L.scan(m, 1)
         check(m.read_state() == PREOP, f"Pre-Op after the scan: {L.state_report(m)}")
-        {"op-repeat": case_op_repeat, "sm-off": case_sm_off, "mbx-type": case_mbx_type, "id-request": case_id_request}[args.case](m)
+        if args.case == "frames":
+            case_frames(m, args.iface)
+        else:
+            {"op-repeat": case_op_repeat, "sm-off": case_sm_off, "mbx-type": case_mbx_type, "id-request": case_id_request}[args.case](m)
     except L.Fatal as e:
         check(False, str(e))
     finally:
