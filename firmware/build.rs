@@ -12,14 +12,6 @@ use std::{env, fs, path::PathBuf};
 /// over the whole flash) and of `qemu-mps2/memory.x`.
 const BOARD_FLASH: &str = "FLASH : ORIGIN = 0x08000000, LENGTH = 2048K";
 const MPS2_FLASH: &str = "FLASH : ORIGIN = 0x00000000, LENGTH = 256K";
-/// The RAM line of `qemu-mps2/memory.x` and the PROFINET image's (`mps2-pn`): `make_drive`
-/// builds the 51 KiB PnDrive on the stack and moves it into its static, an 86 KiB frame, more
-/// than the 74 KiB that 128K leave above the statics (the stack ran into the static and the
-/// image faulted after its first log line). The statics stay gated at the board's figures
-/// (size-budget.toml); the board image has the same frame: building the drive in place is the
-/// real fix (open). The boot loader's images keep 128K (it checks the initial stack pointer).
-const MPS2_RAM: &str = "RAM   : ORIGIN = 0x20000000, LENGTH = 128K";
-const MPS2_PN_RAM: &str = "RAM   : ORIGIN = 0x20000000, LENGTH = 192K";
 
 /// The FLASH region of a linked-for-a-slot or boot-loader image (the layout of
 /// docs/flashing.md and crates/bootloader: a slot's body starts 1 KiB after its
@@ -103,10 +95,6 @@ fn main() {
         ("../memory.x", slot.map(|s| format!("board-{s}")))
     };
     let mut layout = fs::read_to_string(src).expect("read memory layout");
-    if mps2 {
-        assert!(layout.contains(MPS2_RAM), "{src} has no line `{MPS2_RAM}`");
-        layout = layout.replace(MPS2_RAM, MPS2_PN_RAM);
-    }
     if let Some(image) = image {
         let from = if src.contains("mps2") {
             MPS2_FLASH

@@ -59,6 +59,8 @@
 #![no_std]
 #![deny(missing_docs)]
 
+use core::mem::MaybeUninit;
+use core::ptr::addr_of_mut;
 use drive_core::axis::{Axis, AxisCache, AxisCommand, AxisIo};
 use drive_core::faults::{FaultChange, E82_INACTIVE};
 use drive_core::objects::LAYOUT_HASH;
@@ -153,25 +155,71 @@ impl<F: Flash> PnDrive<F, NoRecords> {
     pub fn new(flash: F, hw: Hardware) -> PnDrive<F, NoRecords> {
         PnDrive::with_hook(flash, hw, NoRecords)
     }
+
+    /// [`new`](PnDrive::new) built in `slot` (a board's static): see
+    /// [`init_with_hook`](PnDrive::init_with_hook).
+    pub fn init(
+        slot: &mut MaybeUninit<PnDrive<F, NoRecords>>,
+        flash: F,
+        hw: Hardware,
+    ) -> &mut PnDrive<F, NoRecords> {
+        PnDrive::init_with_hook(slot, flash, hw, NoRecords)
+    }
 }
 
 impl<F: Flash, H: RecordHook> PnDrive<F, H> {
     /// [`new`](PnDrive::new) with a device that serves the profile's
     /// records through `hook`.
     pub fn with_hook(flash: F, hw: Hardware, hook: H) -> PnDrive<F, H> {
-        let mut objects = DriveObjects::new();
-        let mut store = ParamStore::new(flash);
-        let (startup, im, kept) = load(&mut store, &mut objects);
+        let mut slot = MaybeUninit::uninit();
+        PnDrive::init_with_hook(&mut slot, flash, hw, hook);
+        // SAFETY: `init_with_hook` wrote every field of `slot`.
+        #[allow(unsafe_code)]
+        unsafe {
+            slot.assume_init()
+        }
+    }
+
+    /// [`with_hook`](PnDrive::with_hook) built in place: each part is
+    /// written into `slot`'s field as it is made, so the caller's frame
+    /// never holds a whole drive (about 50 KiB) beside its parts. The board
+    /// images build their static drive with it: built by value and moved,
+    /// the drive took an 86 KiB frame in `init`, more than the stack a
+    /// board leaves (issue 36).
+    #[allow(unsafe_code)]
+    pub fn init_with_hook(
+        slot: &mut MaybeUninit<PnDrive<F, H>>,
+        flash: F,
+        hw: Hardware,
+        hook: H,
+    ) -> &mut PnDrive<F, H> {
+        let p = slot.as_mut_ptr();
+        // SAFETY (every block below): `p` points to `slot`'s storage, valid
+        // for writes and aligned; each field is written exactly once through
+        // `addr_of_mut!` (no reference to uninitialised memory is made), and
+        // a reference to a field is taken only after that field was written.
+        // Every field is written before `assume_init_mut`.
+        let (objects, store) = unsafe {
+            addr_of_mut!((*p).objects).write(DriveObjects::new());
+            addr_of_mut!((*p).store).write(ParamStore::new(flash));
+            (&mut *addr_of_mut!((*p).objects), &mut *addr_of_mut!((*p).store))
+        };
+        let (startup, im, kept) = load(store, objects);
         let active = objects.get(A270, 0) != Ok(0);
         let hw = Hardware {
             im: im.unwrap_or(hw.im),
             ..hw
         };
-        let config = settings::device_config(&mut objects, hw);
-        let axes_a = Axis::new(0);
-        let profile = profile::Profile::new(&mut objects, &axes_a);
-        let mut drive = PnDrive {
-            device: Device::new(
+        let config = settings::device_config(objects, hw);
+        let axes = unsafe {
+            addr_of_mut!((*p).axes).write([Axis::new(0), Axis::new(1)]);
+            &*addr_of_mut!((*p).axes)
+        };
+        let [axis_a, _] = axes;
+        let profile = profile::Profile::new(objects, axis_a);
+        unsafe {
+            addr_of_mut!((*p).profile).write(profile);
+            addr_of_mut!((*p).device).write(Device::new(
                 config,
                 PnRecords {
                     pe: ProfiEnergy::default(),
@@ -181,22 +229,20 @@ impl<F: Flash, H: RecordHook> PnDrive<F, H> {
                         inner: hook,
                     },
                 },
-            ),
-            objects,
-            store,
-            startup,
-            active,
-            dropped_inactive: 0,
-            temporary: Temporary::default(),
-            axes: [axes_a, Axis::new(1)],
-            caches: [AxisCache::new(), AxisCache::new()],
-            raised: [None; 2],
-            exchanged: false,
-            powered: [false; 2],
-            profile,
-            telegram_new: true,
-            profile_mode: None,
-        };
+            ));
+            addr_of_mut!((*p).startup).write(startup);
+            addr_of_mut!((*p).active).write(active);
+            addr_of_mut!((*p).dropped_inactive).write(0);
+            addr_of_mut!((*p).temporary).write(Temporary::default());
+            addr_of_mut!((*p).caches).write([AxisCache::new(), AxisCache::new()]);
+            addr_of_mut!((*p).raised).write([None; 2]);
+            addr_of_mut!((*p).exchanged).write(false);
+            addr_of_mut!((*p).powered).write([false; 2]);
+            addr_of_mut!((*p).telegram_new).write(true);
+            addr_of_mut!((*p).profile_mode).write(None);
+        }
+        // SAFETY: every field of `PnDrive` was written above.
+        let drive = unsafe { slot.assume_init_mut() };
         if let Some(k) = kept {
             drive.device.set_snmp(k);
         }

@@ -251,15 +251,16 @@ mod app {
         )
     }
 
-    /// The drive in its static, built in this function's own frame.
+    /// The drive in its static, built in place (`PnDrive::init`: this
+    /// frame never holds a whole drive).
     #[inline(never)]
     fn make_drive(mac: [u8; 6]) -> Option<&'static mut Drive> {
         static DRIVE: firmware::once::Once<Drive> = firmware::once::Once::new();
-        Some(
-            DRIVE
-                .take()?
-                .write(Drive::new(ParamFlash::new(), crate::hardware(mac))),
-        )
+        Some(Drive::init(
+            DRIVE.take()?,
+            ParamFlash::new(),
+            crate::hardware(mac),
+        ))
     }
 
     /// Background: fires the control cycle and the device's timers when

@@ -154,15 +154,12 @@ mod app {
         )
     }
 
-    /// The drive in its static, built in this function's own frame.
+    /// The drive in its static, built in place (`PnDrive::init`: this
+    /// frame never holds a whole drive).
     #[inline(never)]
     fn make_drive() -> Option<&'static mut Drive> {
         static DRIVE: firmware::once::Once<Drive> = firmware::once::Once::new();
-        Some(
-            DRIVE
-                .take()?
-                .write(Drive::new(ParamFlash::new(), board::hardware())),
-        )
+        Some(Drive::init(DRIVE.take()?, ParamFlash::new(), board::hardware()))
     }
 
     /// ETH0's clock, reset, pins and RMII selection, the MAC with its rings
