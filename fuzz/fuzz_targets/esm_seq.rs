@@ -439,6 +439,12 @@ fn op(line: &mut Line, u: &mut Unstructured<'_>) {
                 // a CoE SDO upload of 1000h
                 m[0] = 10;
                 m[6..16].copy_from_slice(&[0x00, 0x20, 0x40, 0x00, 0x10, 0x00, 0, 0, 0, 0]);
+            } else if ty == 3 && sel & 0x40 != 0 {
+                // a CoE SDO download of A258 (2102h, the process-data
+                // monitoring time) = 100 ms: with it S→O waits for RxPDOs
+                // (E-033), which random mailbox bytes almost never write
+                m[0] = 10;
+                m[6..16].copy_from_slice(&[0x00, 0x20, 0x2B, 0x02, 0x21, 0x00, 100, 0, 0, 0]);
             }
             // answers still waiting (in SM1 and queued behind it, to earlier
             // requests) are read out first, so the answer read below is this
