@@ -86,8 +86,7 @@ impl Figure {
 #[inline(never)]
 #[allow(unsafe_code)]
 fn make_drive() -> Option<&'static mut Drive> {
-    // in the CCM RAM (qemu/memory.x): the start builds two drives by value on
-    // the stack (about 100 KiB), which must not run into this one or `.bss`
+    // in the CCM RAM (qemu/memory.x), away from the stack and `.bss`
     #[link_section = ".ccmram"]
     static mut DRIVE: core::mem::MaybeUninit<Drive> = core::mem::MaybeUninit::uninit();
     static TAKEN: core::sync::atomic::AtomicBool = core::sync::atomic::AtomicBool::new(false);
@@ -109,12 +108,12 @@ fn make_drive() -> Option<&'static mut Drive> {
     Some(build(slot, flash))
 }
 
-/// One drive built into `slot`: a function of its own, so the drive built by
-/// value on the stack (tens of KiB) is there once, not once per call site in
-/// `make_drive`'s frame (two of them ran past the stack's end into `.bss`).
+/// One drive built in place into `slot` (`PnDrive::init`: no whole drive on
+/// the stack), in a function of its own so its parts' temporaries are in one
+/// frame, not once per call site in `make_drive`'s.
 #[inline(never)]
 fn build(slot: &mut core::mem::MaybeUninit<Drive>, flash: ParamFlash) -> &mut Drive {
-    slot.write(Drive::new(flash, hardware()))
+    Drive::init(slot, flash, hardware())
 }
 
 #[entry]
