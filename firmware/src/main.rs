@@ -15,8 +15,9 @@
 //! window; the clock is the DWT cycle counter at the CPU clock.
 //!
 //! The power stage's peripherals (`firmware::xmc::motor`, crate `xmc-motor`)
-//! are programmed in `init`: CCU8 PWM (pins low, gate enable low until a
-//! control cycle commands an axis on), the VADC on the PWM centre, the POSIF
+//! are programmed in `init`: CCU8 PWM (gate enable low, and with the
+//! feature `power-pins` the PWM pins low, until a control cycle commands an
+//! axis on), the VADC on the PWM centre, the POSIF
 //! encoders, the CCU4 control-cycle timer whose compare fires `control`, and
 //! ERU1's route of SYNC0 to `sync0`. What stays unverified without a board,
 //! and the bring-up order, is in docs/hardware.md. The axes still get

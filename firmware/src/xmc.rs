@@ -89,10 +89,18 @@ pub mod motor {
         }
     }
 
+    /// The PWM pins of axes A and B: driven only with the feature
+    /// `power-pins` (on the development kit they are the ESC's MII pins).
+    const PWM_PINS: Option<[&[pins::Pin; 6]; 2]> = if cfg!(feature = "power-pins") {
+        Some([&pins::AXIS_A, &pins::AXIS_B])
+    } else {
+        None
+    };
+
     /// One axis' PWM, its pins' state and its encoder.
     struct Axis {
         pwm: Pwm,
-        pins: &'static [pins::Pin; 6],
+        pins: Option<&'static [pins::Pin; 6]>,
         on: bool,
         enc: Encoder,
     }
@@ -107,15 +115,18 @@ pub mod motor {
     impl Motor {
         /// Follows a control cycle's commands: an axis commanded on gets
         /// its pins to the CCU8 at 50 % (zero voltage: no current loop runs
-        /// yet), an axis commanded off its pins low as plain outputs; the
-        /// gate enable high while any axis is on (`power::follow`).
+        /// yet), an axis commanded off its pins low as plain outputs (pins
+        /// only with `power-pins`); the gate enable high while any axis is
+        /// on (`power::follow`).
         pub fn follow(&mut self, cmd: &[AxisCommand; 2]) {
             for (axis, c) in self.axes.iter_mut().zip(cmd) {
                 if c.power_stage != axis.on {
                     if c.power_stage {
                         axis.pwm.set_duties(&mut self.regs, [DUTY_HALF; 3]);
                     }
-                    pins::set_axis(&mut self.regs, axis.pins, c.power_stage);
+                    if let Some(p) = axis.pins {
+                        pins::set_axis(&mut self.regs, p, c.power_stage);
+                    }
                     axis.on = c.power_stage;
                 }
             }
@@ -141,7 +152,7 @@ pub mod motor {
     }
 
     /// Clocks and resets of the power-stage peripherals, then: PWM pins low
-    /// (before the CCU8 drives them), both CCU8 units (CCU80 triggering the
+    /// (before the CCU8 drives them; `power-pins` only), both CCU8 units (CCU80 triggering the
     /// VADC at the PWM centre), the VADC, both encoders, the control timer;
     /// the PWM timers started together by SCU_GENERAL.CCUCON.
     #[allow(unsafe_code)]
@@ -180,14 +191,20 @@ pub mod motor {
         // and `ctimer` resources are their only users, each touching its own
         // registers (the timer CCU40 slice 3, the rest the others).
         let (mut regs, timer_regs) = unsafe { (Mmio::new(), Mmio::new()) };
-        pins::set_axis(&mut regs, &pins::AXIS_A, false);
-        pins::set_axis(&mut regs, &pins::AXIS_B, false);
+        let [pins_a, pins_b] = match PWM_PINS {
+            Some([a, b]) => {
+                pins::set_axis(&mut regs, a, false);
+                pins::set_axis(&mut regs, b, false);
+                [Some(a), Some(b)]
+            }
+            None => [None, None],
+        };
         let pwm_a = Pwm::init(&mut regs, regs::CCU80, PWM, true);
         let pwm_b = Pwm::init(&mut regs, regs::CCU81, PWM, false);
         let adc = Adc::init(&mut regs);
-        let [pins_a, pins_b] = ENCODER_PINS;
-        let enc_a = Encoder::init(&mut regs, regs::POSIF0, regs::CCU40, pins_a);
-        let enc_b = Encoder::init(&mut regs, regs::POSIF1, regs::CCU41, pins_b);
+        let [enc_pins_a, enc_pins_b] = ENCODER_PINS;
+        let enc_a = Encoder::init(&mut regs, regs::POSIF0, regs::CCU40, enc_pins_a);
+        let enc_b = Encoder::init(&mut regs, regs::POSIF1, regs::CCU41, enc_pins_b);
         let mut timer_regs = timer_regs;
         let timer = timer::CycleTimer::init(&mut timer_regs);
         general.ccucon().write(|w| w.gsc80().set_bit().gsc81().set_bit());
@@ -200,13 +217,13 @@ pub mod motor {
                 axes: [
                     Axis {
                         pwm: pwm_a,
-                        pins: &pins::AXIS_A,
+                        pins: pins_a,
                         on: false,
                         enc: enc_a,
                     },
                     Axis {
                         pwm: pwm_b,
-                        pins: &pins::AXIS_B,
+                        pins: pins_b,
                         on: false,
                         enc: enc_b,
                     },

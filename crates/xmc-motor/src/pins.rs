@@ -1,7 +1,9 @@
 //! The PWM pins: a disabled axis' six outputs are general-purpose outputs
 //! held low (the passive level: both switches of every phase off), an
-//! enabled axis' are the CCU8's (alternate function 3). Pin assignment
-//! ASSUMED (docs/hardware.md): check against the power board's schematic.
+//! enabled axis' are the CCU8's (alternate function 3). The pins are those
+//! XMClib's XMC4 pin maps give for CCU80/CCU81.OUTy0/OUTy1 on ALT3; on the
+//! KIT_XMC48_RELAX_ECAT_V1 several of them are the ESC's MII pins, so a
+//! power board must be laid out around them (docs/hardware.md).
 
 use crate::regs::*;
 use crate::Regs;
@@ -23,7 +25,14 @@ pub const fn pin(port: u32, pin: u32) -> Pin {
 /// Axis A: CCU80.OUT00/01, OUT10/11, OUT20/21 (U high/low, V, W).
 pub const AXIS_A: [Pin; 6] = [pin(0, 5), pin(0, 2), pin(0, 4), pin(0, 1), pin(0, 3), pin(0, 0)];
 /// Axis B: CCU81.OUT00/01, OUT10/11, OUT20/21.
-pub const AXIS_B: [Pin; 6] = [pin(5, 7), pin(5, 6), pin(5, 5), pin(5, 4), pin(5, 3), pin(5, 2)];
+pub const AXIS_B: [Pin; 6] = [
+    pin(1, 15),
+    pin(1, 12),
+    pin(1, 14),
+    pin(1, 11),
+    pin(1, 13),
+    pin(1, 10),
+];
 
 /// Sets a pin's 5-bit control field.
 fn set_pc<R: Regs>(r: &mut R, p: Pin, pc: u32) {

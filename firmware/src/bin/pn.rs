@@ -10,8 +10,9 @@
 //! | `idle` | — | 0 | fires `eth` when the device's timers are due, follows the PHY's link |
 //!
 //! As on the EtherCAT image, `init` programs the power stage's peripherals
-//! (`firmware::xmc::motor`: PWM with pins low and the gate enable low until
-//! a control cycle commands an axis on, ADC, encoders) and the CCU4 compare
+//! (`firmware::xmc::motor`: PWM with the gate enable low, and with
+//! `power-pins` its pins low, until a control cycle commands an axis on,
+//! ADC, encoders) and the CCU4 compare
 //! (CCU40 slice 3) that fires `control` at [`PnCycle::next_at`]; the
 //! device's next deadline (the input frame of each cycle, watchdogs) is
 //! still pended by `idle`. The parameter store is `drive_pn::PnParamFlash` (two
