@@ -1,7 +1,10 @@
 //! VADC: both axes' phase currents (U and V; W = −U − V) and the DC-link
-//! voltage, converted by the scan sources of groups 0…2 on one trigger,
+//! voltage, converted by the scan sources of groups 0 and 1 on one trigger,
 //! CCU80.SR2 (the PWM centre, see [`crate::pwm::Pwm::init`]), so the two
-//! phases of an axis are sampled at the same instant in two converters.
+//! phases of an axis are sampled at the same instant in two converters. The
+//! DC link is group 0's third conversion, the last of the five (group 1
+//! converts two): its result raises group 0's service request 0
+//! (VADC0_G0_0), the interrupt a current-loop task binds to.
 //!
 //! | group | channel | result | signal |
 //! |---|---|---|---|
@@ -9,7 +12,7 @@
 //! | 0 | 1 | 1 | axis B, phase U current |
 //! | 1 | 0 | 0 | axis A, phase V current |
 //! | 1 | 1 | 1 | axis B, phase V current |
-//! | 2 | 0 | 0 | DC-link voltage |
+//! | 0 | 2 | 2 | DC-link voltage (service request VADC0_G0_0) |
 
 use crate::regs::*;
 use crate::Regs;
@@ -20,7 +23,10 @@ pub const DIVA: u32 = 4;
 
 /// (group, channel, result register) of each conversion, in [`Samples`] order:
 /// A iU, B iU, A iV, B iV, DC link.
-pub const MAP: [(u32, u32, u32); 5] = [(0, 0, 0), (0, 1, 1), (1, 0, 0), (1, 1, 1), (2, 0, 0)];
+pub const MAP: [(u32, u32, u32); 5] = [(0, 0, 0), (0, 1, 1), (1, 0, 0), (1, 1, 1), (0, 2, 2)];
+
+/// The group whose result ends a trigger's conversions, and its result register.
+pub const LAST: (u32, u32) = (0, 2);
 
 /// One trigger's raw 12-bit results.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
@@ -38,13 +44,14 @@ pub struct Samples {
 pub struct Adc(());
 
 impl Adc {
-    /// Module on, clock divider, groups 0…2 powered, their scan sources
+    /// Module on, clock divider, groups 0 and 1 powered, their scan sources
     /// armed on trigger input I (CCU80.SR2, rising edge) with the channels
-    /// of [`MAP`], start-up calibration started.
+    /// of [`MAP`], the [`LAST`] result raising the group's service request 0,
+    /// start-up calibration started.
     pub fn init<R: Regs>(r: &mut R) -> Adc {
         r.write(VADC + CLC, 0);
         r.write(VADC + GLOBCFG, GLOBCFG_DIVWC | DIVA);
-        for g in 0..3 {
+        for g in 0..2 {
             let base = vadc_group(g);
             let mut sel = 0;
             for &(mg, ch, res_reg) in MAP.iter() {
@@ -63,6 +70,9 @@ impl Adc {
             r.write(base + ASSEL, sel);
             r.write(base + ASMR, ASMR_ENGT_PENDING | ASMR_ENTR);
         }
+        let (g, last) = LAST;
+        r.write(vadc_group(g) + rcr(last), RCR_SRGEN);
+        r.modify(vadc_group(g) + REVNP0, 0xF << (4 * last), 0);
         r.write(VADC + GLOBCFG, GLOBCFG_SUCAL);
         Adc(())
     }

@@ -191,6 +191,10 @@ impl Model {
                     let v = u32::from(*self.analog.get(&(g, ch)).unwrap_or(&0)) & 0xFFF;
                     let reg = (self.get(b + chctr(ch)) >> CHCTR_RESREG_SHIFT) & 0xF;
                     self.set(b + res(reg), RES_VF | (ch << RES_CHNR_SHIFT) | v);
+                    if self.get(b + rcr(reg)) & RCR_SRGEN != 0 {
+                        let node = (self.get(b + REVNP0) >> (4 * reg)) & 0xF;
+                        self.sr.push((b, node));
+                    }
                 }
             }
         }

@@ -239,6 +239,15 @@ pub const fn chctr(ch: u32) -> u32 {
 }
 /// CHCTR: result register shift (bits 16…19).
 pub const CHCTR_RESREG_SHIFT: u32 = 16;
+/// Group: result control of result register `n`.
+pub const fn rcr(n: u32) -> u32 {
+    0x280 + 4 * n
+}
+/// RCR: service request on a new result.
+pub const RCR_SRGEN: u32 = 1 << 31;
+/// Group: result event node pointers of result registers 0…7 (4 bits each;
+/// 0…3: the group's service request lines 0…3).
+pub const REVNP0: u32 = 0x1B0;
 /// Group: result register `n`.
 pub const fn res(n: u32) -> u32 {
     0x300 + 4 * n

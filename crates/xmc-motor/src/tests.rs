@@ -132,7 +132,8 @@ fn the_adc_converts_all_five_signals_on_the_pwm_centre_and_each_result_reads_onc
     m.boundary(CCU80, false); // period match: no trigger
     assert_eq!(adc.read(&mut m), None);
     m.boundary(CCU80, true); // one match: CCU80.SR2 → trigger I
-    assert_eq!(m.sr, [(CCU80, 2)]);
+                             // the trigger, then the DC link's result (group 0's last) → VADC0_G0_0
+    assert_eq!(m.sr, [(CCU80, 2), (vadc_group(0), 0)]);
     assert_eq!(
         adc.read(&mut m),
         Some(Samples {
