@@ -143,7 +143,8 @@ impl Model {
         }
     }
 
-    /// `ticks` clocks of a CCU4 slice's prescaled counter (edge aligned).
+    /// `ticks` clocks of a CCU4 slice's prescaled counter (edge aligned: the
+    /// period match when the counter, counting from 0, reaches PR).
     pub fn advance(&mut self, module: u32, y: u32, ticks: u32) {
         if !self.running(module, y) {
             return;
@@ -151,7 +152,7 @@ impl Model {
         let s = slice(module, y);
         let pr = self.get(s + PR);
         let t = self.get(s + TIMER) + ticks;
-        if t > pr {
+        if t >= pr {
             self.set(s + INTS, self.get(s + INTS) | INTS_PMUS);
             if self.get(s + INTE) & INTE_PME != 0 {
                 self.sr

@@ -36,20 +36,22 @@ impl CycleTimer {
         CycleTimer(())
     }
 
-    /// The ticks of a delay in ns, rounded up, at least 1 and at most one
-    /// shot (65536 ticks): a longer delay fires early and the task re-arms.
+    /// The ticks of a delay in ns, rounded up (the interrupt never comes
+    /// before the time asked for), at least 1 and at most one shot (65535
+    /// ticks): a longer delay fires early and the task re-arms.
     pub fn ticks(delay_ns: u64) -> u32 {
         let t = (delay_ns.saturating_mul(u64::from(TICK_HZ))).div_ceil(1_000_000_000);
-        t.clamp(1, 0x1_0000) as u32
+        t.clamp(1, 0xFFFF) as u32
     }
 
     /// Fires the interrupt `delay_ns` from now: stops and clears the timer,
-    /// loads the period (transferred at once: the timer is stopped), clears
-    /// a stale period-match flag and starts it.
+    /// loads the period (transferred at once: the timer is stopped; the
+    /// period match comes when the counter, started at 0, reaches it),
+    /// clears a stale period-match flag and starts it.
     pub fn arm<R: Regs>(&self, r: &mut R, delay_ns: u64) {
         let s = slice(CCU40, SLICE);
         r.write(s + TCCLR, TRBC | TCC);
-        r.write(s + PRS, Self::ticks(delay_ns) - 1);
+        r.write(s + PRS, Self::ticks(delay_ns));
         r.write(CCU40 + GCSS, gcss_se(SLICE));
         r.write(s + SWR, INTS_PMUS);
         r.write(s + TCSET, TRBS);
