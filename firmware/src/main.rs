@@ -6,7 +6,7 @@
 //! | task | interrupt | priority | body |
 //! |---|---|---|---|
 //! | `sync0` | ERU1_0 (ESC SYNC0 routed through ERU1) | 3 | `node::tasks::sync0` |
-//! | `control` | CCU40_0 (control-cycle timer compare) | 3 | `node::tasks::control` |
+//! | `control` | CCU40_0 (control-cycle timer compare, CCU40 slice 3) | 3 | `node::tasks::control`, the power stage following |
 //! | `esc` | ECAT0_0 (ESC PDI interrupt: AL events, SM2/SM3, mailbox) | 2 | `node::tasks::esc_event` |
 //! | `mailbox` | CCU42_0 (a spare interrupt, pended by `esc` and by `idle` when the IP stack's timers are due) | 1 | `node::tasks::mailbox_net` (mailbox request, IP stack over EoE) |
 //! | `idle` | — | 0 | `node::tasks::background` (a requested save) |
@@ -14,12 +14,14 @@
 //! The ESC is reached through `pdi::mmio::OnChip` over ECAT0's register
 //! window; the clock is the DWT cycle counter at the CPU clock.
 //!
-//! Board bring-up that needs the hardware to verify — the ECAT0 clock and
-//! reset release, the port pin functions, the ERU1 routing of SYNC0 and the
-//! CCU4 compare programming from `CycleTimer::next_at_ns`, the ADC/encoder
-//! inputs and PWM outputs of the power stage — is listed in docs/flashing.md
-//! and not done here: this image pends its timer interrupt from the idle loop
-//! and feeds the axes "ready, at rest" inputs.
+//! The power stage's peripherals (`firmware::xmc::motor`, crate `xmc-motor`)
+//! are programmed in `init`: CCU8 PWM (gate enable low, and with the
+//! feature `power-pins` the PWM pins low, until a control cycle commands an
+//! axis on), the VADC on the PWM centre, the POSIF
+//! encoders, the CCU4 control-cycle timer whose compare fires `control`, and
+//! ERU1's route of SYNC0 to `sync0`. What stays unverified without a board,
+//! and the bring-up order, is in docs/hardware.md. The axes still get
+//! "ready, at rest" inputs: no current loop runs yet (issue 34).
 #![no_std]
 #![no_main]
 
@@ -61,6 +63,7 @@ mod app {
     #[cfg(feature = "net")]
     use firmware::net::NodeNet as Net;
     use firmware::once::Once;
+    use firmware::xmc::motor::{self, ControlTimer, Motor};
     use firmware::{tasks, Drive, ParamFlash};
     use pdi::mmio::{OnChip, VolatileWindow};
 
@@ -75,10 +78,15 @@ mod app {
         /// The IP stack on the EoE interface (docs/eoe.md), polled by
         /// `mailbox` (feature `net`; without it EoE frames are counted and dropped).
         net: &'static mut Net,
+        /// The CCU4 compare that fires `control` at `timer.next_at()`.
+        ctimer: ControlTimer,
     }
 
     #[local]
-    struct Local {}
+    struct Local {
+        /// PWM, ADC and encoders of both axes.
+        motor: Motor,
+    }
 
     #[init]
     fn init(cx: init::Context) -> (Shared, Local) {
@@ -86,7 +94,9 @@ mod app {
         core.DCB.enable_trace();
         core.DWT.enable_cycle_counter();
         crate::power::init();
-        defmt::info!("init: firmware (XMC4800), SYNC0 on ERU1_0, ESC on ECAT0_0");
+        let (motor, mut ctimer) = motor::init();
+        motor::route_sync0();
+        defmt::info!("init: firmware (XMC4800), SYNC0 on ERU1_0, ESC on ECAT0_0, control on CCU40_0");
         // SAFETY: ECAT0 is this chip's ESC; the window is owned by the `pdi`
         // resource alone, so RTIC serialises every access to it.
         #[allow(unsafe_code)]
@@ -98,16 +108,20 @@ mod app {
                 cortex_m::asm::bkpt();
             }
         };
+        let timer = CycleTimer::new();
+        let mut clock = Clock::new(CPU_HZ);
+        ctimer.arm(timer.next_at(), clock.now(DWT::cycle_count()));
         (
             Shared {
                 drive,
-                timer: CycleTimer::new(),
+                timer,
                 pdi: OnChip::new(window),
-                clock: Clock::new(CPU_HZ),
+                clock,
                 cmd: [AxisCommand::OFF; 2],
                 net,
+                ctimer,
             },
-            Local {},
+            Local { motor },
         )
     }
 
@@ -146,10 +160,10 @@ mod app {
     /// Background: a requested save (`tasks::background`), the image's
     /// confirmation point (`tasks::confirm_point`: the first Op; this image's
     /// drive has no firmware slots yet, docs/flashing.md), a restart A09
-    /// requested (`Drive::restart_due`: a system reset), and firing the
-    /// control cycle when its time has come (until the CCU4 compare does it
-    /// in hardware).
-    #[idle(shared = [drive, timer, clock, net])]
+    /// requested (`Drive::restart_due`: a system reset), and pending the
+    /// mailbox task when the IP stack's timers are due. The control cycle
+    /// is the CCU4 compare's (`control`).
+    #[idle(shared = [drive, clock, net])]
     fn idle(mut cx: idle::Context) -> ! {
         let mut confirmed = false;
         loop {
@@ -163,9 +177,6 @@ mod app {
                 defmt::info!("restart requested (A09)");
                 cortex_m::peripheral::SCB::sys_reset();
             }
-            if cx.shared.timer.lock(|t| t.next_at()) <= now {
-                rtic::pend(Interrupt::CCU40_0);
-            }
             // the IP stack's own timers (DHCP, ARP, SNTP) without a frame
             if cx.shared.net.lock(|n| tasks::NetPoll::poll_at(&**n)) <= now {
                 rtic::pend(Interrupt::CCU42_0);
@@ -174,40 +185,66 @@ mod app {
     }
 
     /// SYNC0 from the ESC (via ERU1): acknowledge, PLL measurement.
-    #[task(binds = ERU1_0, priority = 3, shared = [drive, timer, pdi, clock])]
+    /// The PLL may move the next cycle start: the compare follows.
+    #[task(binds = ERU1_0, priority = 3, shared = [drive, timer, pdi, clock, ctimer])]
     fn sync0(cx: sync0::Context) {
-        (cx.shared.drive, cx.shared.timer, cx.shared.pdi, cx.shared.clock).lock(
-            |drive, timer, pdi, clock| {
+        (
+            cx.shared.drive,
+            cx.shared.timer,
+            cx.shared.pdi,
+            cx.shared.clock,
+            cx.shared.ctimer,
+        )
+            .lock(|drive, timer, pdi, clock, ctimer| {
                 let now = clock.now(DWT::cycle_count());
                 if tasks::sync0(drive, timer, pdi, now).is_err() {
                     defmt::warn!("sync0: PDI access failed");
                 }
-            },
-        );
+                ctimer.arm(timer.next_at(), clock.now(DWT::cycle_count()));
+            });
     }
 
-    /// The control-cycle timer: one cycle of both axes.
-    #[task(binds = CCU40_0, priority = 3, shared = [drive, timer, clock, cmd])]
+    /// The control-cycle timer's compare (CCU40 slice 3): one cycle of both
+    /// axes when its time has come (a compare short of a far start only
+    /// arms again), the power stage following the commands, the next
+    /// compare armed.
+    #[task(binds = CCU40_0, priority = 3, shared = [drive, timer, clock, cmd, ctimer], local = [motor])]
     fn control(cx: control::Context) {
-        (cx.shared.drive, cx.shared.timer, cx.shared.clock, cx.shared.cmd).lock(
-            |drive, timer, clock, cmd| {
+        let motor = cx.local.motor;
+        (
+            cx.shared.drive,
+            cx.shared.timer,
+            cx.shared.clock,
+            cx.shared.cmd,
+            cx.shared.ctimer,
+        )
+            .lock(|drive, timer, clock, cmd, ctimer| {
                 let now = clock.now(DWT::cycle_count());
                 if timer.next_at() <= now {
                     *cmd = tasks::control(drive, timer, now, &[AxisIo::ready(0); 2]);
-                    crate::power::follow(cmd);
+                    motor.follow(cmd);
                 }
-            },
-        );
+                ctimer.arm(timer.next_at(), clock.now(DWT::cycle_count()));
+            });
     }
 
     /// The ESC's PDI interrupt: ESM, process data; the mailbox below it.
-    #[task(binds = ECAT0_0, priority = 2, shared = [drive, timer, pdi, clock])]
+    /// The ESC task may move the next cycle start (PLL lost or found): the
+    /// compare follows.
+    #[task(binds = ECAT0_0, priority = 2, shared = [drive, timer, pdi, clock, ctimer])]
     fn esc(cx: esc::Context) {
         // a pended mailbox task runs once more after this one
         rtic::pend(Interrupt::CCU42_0);
-        (cx.shared.drive, cx.shared.timer, cx.shared.pdi, cx.shared.clock).lock(
-            |drive, timer, pdi, clock| {
+        (
+            cx.shared.drive,
+            cx.shared.timer,
+            cx.shared.pdi,
+            cx.shared.clock,
+            cx.shared.ctimer,
+        )
+            .lock(|drive, timer, pdi, clock, ctimer| {
                 let now = clock.now(DWT::cycle_count());
+                let next = timer.next_at();
                 match tasks::esc_event(drive, timer, pdi, now) {
                     Ok(Some(c)) => {
                         defmt::info!("esc: AL state {=u8} (code {=u16:04X})", c.to.code(), c.code.0)
@@ -215,8 +252,10 @@ mod app {
                     Ok(None) => {}
                     Err(_) => defmt::warn!("esc: PDI access failed"),
                 }
-            },
-        );
+                if timer.next_at() != next {
+                    ctimer.arm(timer.next_at(), clock.now(DWT::cycle_count()));
+                }
+            });
     }
 
     /// The mailbox (CoE, EoE, FoE, EMCY, save) below the ESC task, and the

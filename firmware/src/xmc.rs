@@ -1,6 +1,7 @@
 //! What the reference board's images (`firmware` on EtherCAT, `firmware-pn`
 //! on PROFINET) share: the PAC as RTIC wants it, the power stage's gate
-//! enable and the panic stop.
+//! enable, the power-stage peripherals (`motor`: PWM, ADC, encoders, the
+//! control-cycle timer; crate `xmc-motor`) and the panic stop.
 
 /// The XMC4800 PAC as RTIC expects a device crate: svd2rust 0.14 output lacks
 /// the `interrupt` alias of the `Interrupt` enum, so it is added here.
@@ -41,6 +42,208 @@ pub mod power {
     #[inline]
     pub fn follow(cmd: &[drive_ecat::axis::AxisCommand; 2]) {
         set(cmd.iter().any(|c| c.power_stage));
+    }
+}
+
+/// The power stage's peripherals as the images program them (crate
+/// `xmc-motor`; pins, channels and what is unverified: docs/hardware.md).
+pub mod motor {
+    use drive_ecat::axis::AxisCommand;
+    use nanos::Nanos;
+    use xmc_motor::adc::Adc;
+    use xmc_motor::enc::{Encoder, EncoderPins};
+    use xmc_motor::pwm::{Pwm, PwmConfig, DUTY_HALF};
+    use xmc_motor::{pins, regs, timer, Mmio};
+
+    /// PWM rate (issue 34: 16 kHz default).
+    pub const PWM_HZ: u32 = 16_000;
+    /// Dead time of the gate drivers, ns (a placeholder until the power
+    /// board's switches are known: docs/hardware.md).
+    pub const DEAD_NS: u32 = 500;
+    /// POSIF input selections (phase A, phase B, index) of axes A and B.
+    pub const ENCODER_PINS: [EncoderPins; 2] = [EncoderPins([0, 0, 0]), EncoderPins([1, 1, 1])];
+    /// The PWM settings (checked at compile time).
+    const PWM: PwmConfig = match PwmConfig::new(xmc_motor::F_CCU_HZ, PWM_HZ, DEAD_NS) {
+        Some(c) => c,
+        None => PwmConfig {
+            period: 0,
+            dead_time: 0,
+        },
+    };
+    const _: () = assert!(PWM.period != 0, "PWM rate or dead time out of range");
+
+    /// The control-cycle timer (CCU40 slice 3 → CCU40_0), shared by the
+    /// tasks that move the next cycle start.
+    pub struct ControlTimer {
+        regs: Mmio,
+        timer: timer::CycleTimer,
+    }
+
+    impl ControlTimer {
+        /// Fires CCU40_0 at local time `next` (`now` is the time now); a
+        /// start more than one timer shot away fires early and the task
+        /// arms again.
+        #[inline]
+        pub fn arm(&mut self, next: Nanos, now: Nanos) {
+            self.timer.arm(&mut self.regs, next.saturating_sub(now).as_ns());
+        }
+    }
+
+    /// The PWM pins of axes A and B: driven only with the feature
+    /// `power-pins` (on the development kit they are the ESC's MII pins).
+    const PWM_PINS: Option<[&[pins::Pin; 6]; 2]> = if cfg!(feature = "power-pins") {
+        Some([&pins::AXIS_A, &pins::AXIS_B])
+    } else {
+        None
+    };
+
+    /// One axis' PWM, its pins' state and its encoder.
+    struct Axis {
+        pwm: Pwm,
+        pins: Option<&'static [pins::Pin; 6]>,
+        on: bool,
+        enc: Encoder,
+    }
+
+    /// The power stage: both axes' PWM and encoders, the ADC.
+    pub struct Motor {
+        regs: Mmio,
+        axes: [Axis; 2],
+        adc: Adc,
+    }
+
+    impl Motor {
+        /// Follows a control cycle's commands: an axis commanded on gets
+        /// its pins to the CCU8 at 50 % (zero voltage: no current loop runs
+        /// yet), an axis commanded off its pins low as plain outputs (pins
+        /// only with `power-pins`); the gate enable high while any axis is
+        /// on (`power::follow`).
+        pub fn follow(&mut self, cmd: &[AxisCommand; 2]) {
+            for (axis, c) in self.axes.iter_mut().zip(cmd) {
+                if c.power_stage != axis.on {
+                    if c.power_stage {
+                        axis.pwm.set_duties(&mut self.regs, [DUTY_HALF; 3]);
+                    }
+                    if let Some(p) = axis.pins {
+                        pins::set_axis(&mut self.regs, p, c.power_stage);
+                    }
+                    axis.on = c.power_stage;
+                }
+            }
+            super::power::follow(cmd);
+        }
+
+        /// Both encoders' positions in counts since start.
+        pub fn positions(&mut self) -> [i32; 2] {
+            let regs = &mut self.regs;
+            [0, 1].map(|i| self.axes.get_mut(i).map_or(0, |a| a.enc.position(regs)))
+        }
+
+        /// Whether either PWM unit is in its trap state (over-current input).
+        pub fn trapped(&mut self) -> bool {
+            let regs = &mut self.regs;
+            self.axes.iter().any(|a| a.pwm.trapped(regs))
+        }
+
+        /// The last PWM centre's samples, if fresh.
+        pub fn samples(&mut self) -> Option<xmc_motor::adc::Samples> {
+            self.adc.read(&mut self.regs)
+        }
+    }
+
+    /// Clocks and resets of the power-stage peripherals, then: PWM pins low
+    /// (before the CCU8 drives them; `power-pins` only), both CCU8 units (CCU80 triggering the
+    /// VADC at the PWM centre), the VADC, both encoders, the control timer;
+    /// the PWM timers started together by SCU_GENERAL.CCUCON.
+    #[allow(unsafe_code)]
+    pub fn init() -> (Motor, ControlTimer) {
+        // SAFETY: fixed SCU addresses, used only here at start (before any
+        // task runs); the bits written are this module's peripherals'.
+        let (clk, reset, general) = unsafe {
+            (
+                &*xmc4800::SCU_CLK::ptr(),
+                &*xmc4800::SCU_RESET::ptr(),
+                &*xmc4800::SCU_GENERAL::ptr(),
+            )
+        };
+        clk.clkset().write(|w| w.ccucen().set_bit());
+        clk.cgatclr0().write(|w| {
+            w.vadc().set_bit();
+            w.ccu40().set_bit();
+            w.ccu41().set_bit();
+            w.ccu80().set_bit();
+            w.ccu81().set_bit();
+            w.posif0().set_bit();
+            w.posif1().set_bit();
+            w.eru1().set_bit()
+        });
+        reset.prclr0().write(|w| {
+            w.vadcrs().set_bit();
+            w.ccu40rs().set_bit();
+            w.ccu41rs().set_bit();
+            w.ccu80rs().set_bit();
+            w.ccu81rs().set_bit();
+            w.posif0rs().set_bit();
+            w.posif1rs().set_bit();
+            w.eru1rs().set_bit()
+        });
+        // SAFETY: the peripherals are clocked and out of reset; the `motor`
+        // and `ctimer` resources are their only users, each touching its own
+        // registers (the timer CCU40 slice 3, the rest the others).
+        let (mut regs, timer_regs) = unsafe { (Mmio::new(), Mmio::new()) };
+        let [pins_a, pins_b] = match PWM_PINS {
+            Some([a, b]) => {
+                pins::set_axis(&mut regs, a, false);
+                pins::set_axis(&mut regs, b, false);
+                [Some(a), Some(b)]
+            }
+            None => [None, None],
+        };
+        let pwm_a = Pwm::init(&mut regs, regs::CCU80, PWM, true);
+        let pwm_b = Pwm::init(&mut regs, regs::CCU81, PWM, false);
+        let adc = Adc::init(&mut regs);
+        let [enc_pins_a, enc_pins_b] = ENCODER_PINS;
+        let enc_a = Encoder::init(&mut regs, regs::POSIF0, regs::CCU40, enc_pins_a);
+        let enc_b = Encoder::init(&mut regs, regs::POSIF1, regs::CCU41, enc_pins_b);
+        let mut timer_regs = timer_regs;
+        let timer = timer::CycleTimer::init(&mut timer_regs);
+        general.ccucon().write(|w| w.gsc80().set_bit().gsc81().set_bit());
+        general
+            .ccucon()
+            .write(|w| w.gsc80().clear_bit().gsc81().clear_bit());
+        (
+            Motor {
+                regs,
+                axes: [
+                    Axis {
+                        pwm: pwm_a,
+                        pins: pins_a,
+                        on: false,
+                        enc: enc_a,
+                    },
+                    Axis {
+                        pwm: pwm_b,
+                        pins: pins_b,
+                        on: false,
+                        enc: enc_b,
+                    },
+                ],
+                adc,
+            },
+            ControlTimer {
+                regs: timer_regs,
+                timer,
+            },
+        )
+    }
+
+    /// The ESC's SYNC0 to ERU1.SR0 (the `sync0` task's ERU1_0): the
+    /// EtherCAT image only.
+    #[allow(unsafe_code)]
+    pub fn route_sync0() {
+        // SAFETY: ERU1 is clocked (`init`) and only written here, at start.
+        let mut regs = unsafe { Mmio::new() };
+        timer::route_sync0(&mut regs);
     }
 }
 

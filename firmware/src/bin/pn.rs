@@ -5,14 +5,17 @@
 //!
 //! | task | interrupt | priority | body |
 //! |---|---|---|---|
-//! | `control` | CCU40_0 (control-cycle timer compare) | 3 | `PnDrive::control_cycle` |
+//! | `control` | CCU40_0 (control-cycle timer compare, CCU40 slice 3) | 3 | `PnDrive::control_cycle`, the power stage following |
 //! | `eth` | ETH0_0 (MAC DMA: frame received; pended by `idle` when the device's timers are due) | 2 | `PnDrive::receive` per frame, then `PnDrive::poll` |
-//! | `idle` | — | 0 | fires `control` and `eth` when their time has come, follows the PHY's link |
+//! | `idle` | — | 0 | fires `eth` when the device's timers are due, follows the PHY's link |
 //!
-//! As on the EtherCAT image, the CCU4 compare is not programmed yet: `idle`
-//! pends the control interrupt when [`PnCycle::next_at`] has passed; the
+//! As on the EtherCAT image, `init` programs the power stage's peripherals
+//! (`firmware::xmc::motor`: PWM with the gate enable low, and with
+//! `power-pins` its pins low, until a control cycle commands an axis on,
+//! ADC, encoders) and the CCU4 compare
+//! (CCU40 slice 3) that fires `control` at [`PnCycle::next_at`]; the
 //! device's next deadline (the input frame of each cycle, watchdogs) is
-//! kept the same way. The parameter store is `drive_pn::PnParamFlash` (two
+//! still pended by `idle`. The parameter store is `drive_pn::PnParamFlash` (two
 //! slots of 2 × 2 KiB in RAM, the parameters and I&M1…4: the PFLASH driver is not used by the images yet,
 //! as on the EtherCAT image). Board bring-up that needs the hardware to verify — ETH0 pins,
 //! PHY address, RMII clock, the MAC address — is listed in docs/hardware.md.
@@ -92,6 +95,7 @@ mod app {
     use drive_pn::PnParamFlash as ParamFlash;
     use firmware::clock::Clock;
     use firmware::pn_log::log_event;
+    use firmware::xmc::motor::{self, ControlTimer, Motor};
     use gmac::phy;
     use nanos::Nanos;
 
@@ -111,6 +115,11 @@ mod app {
 
     #[local]
     struct Local {
+        /// PWM, ADC and encoders of both axes.
+        motor: Motor,
+        /// The CCU4 compare that fires `control` (only `control` moves the
+        /// next cycle start on this image).
+        ctimer: ControlTimer,
         /// The PHY's MDIO address as found at start.
         phy: Option<u8>,
         link: Option<gmac::Link>,
@@ -123,6 +132,7 @@ mod app {
         core.DCB.enable_trace();
         core.DWT.enable_cycle_counter();
         firmware::xmc::power::init();
+        let (motor, mut ctimer) = motor::init();
         defmt::info!("init: firmware-pn (XMC4800), PROFINET on ETH0 (RMII), control on CCU40_0");
         let Some(drive) = make_drive() else {
             defmt::error!("init: drive already taken");
@@ -137,16 +147,21 @@ mod app {
                 (None, None)
             }
         };
+        let timer = PnCycle::new();
+        let mut clock = Clock::new(CPU_HZ);
+        ctimer.arm(timer.next_at(), clock.now(DWT::cycle_count()));
         (
             Shared {
                 drive,
                 eth,
-                timer: PnCycle::new(),
+                timer,
                 deadline: Nanos::ZERO,
-                clock: Clock::new(CPU_HZ),
+                clock,
                 cmd: [AxisCommand::OFF; 2],
             },
             Local {
+                motor,
+                ctimer,
                 phy,
                 link: None,
                 next_link_check: Nanos::ZERO,
@@ -192,16 +207,13 @@ mod app {
         Ok((Some(eth), Some(addr)))
     }
 
-    /// Background: fires the control cycle and the device's timers when
-    /// their time has come (until the CCU4 compare does it in hardware),
-    /// follows the PHY's link every 100 ms.
-    #[idle(shared = [eth, timer, deadline, clock], local = [phy, link, next_link_check])]
+    /// Background: fires the device's timers when their time has come,
+    /// follows the PHY's link every 100 ms (the control cycle is the CCU4
+    /// compare's).
+    #[idle(shared = [eth, deadline, clock], local = [phy, link, next_link_check])]
     fn idle(mut cx: idle::Context) -> ! {
         loop {
             let now = cx.shared.clock.lock(|c| c.now(DWT::cycle_count()));
-            if cx.shared.timer.lock(|t| t.next_at()) <= now {
-                rtic::pend(Interrupt::CCU40_0);
-            }
             if cx.shared.deadline.lock(|d| *d) <= now {
                 rtic::pend(Interrupt::ETH0_0);
             }
@@ -232,16 +244,20 @@ mod app {
         }
     }
 
-    /// The control-cycle timer: one cycle of both axes.
-    #[task(binds = CCU40_0, priority = 3, shared = [drive, timer, clock, cmd])]
+    /// The control-cycle timer's compare (CCU40 slice 3): one cycle of both
+    /// axes when its time has come, the power stage following the
+    /// commands, the next compare armed.
+    #[task(binds = CCU40_0, priority = 3, shared = [drive, timer, clock, cmd], local = [motor, ctimer])]
     fn control(cx: control::Context) {
+        let (motor, ctimer) = (cx.local.motor, cx.local.ctimer);
         (cx.shared.drive, cx.shared.timer, cx.shared.clock, cx.shared.cmd).lock(
             |drive, timer, clock, cmd| {
                 let now = clock.now(DWT::cycle_count());
                 if timer.next_at() <= now {
                     *cmd = timer.run(drive, now, &[AxisIo::ready(0); 2]);
-                    firmware::xmc::power::follow(cmd);
+                    motor.follow(cmd);
                 }
+                ctimer.arm(timer.next_at(), clock.now(DWT::cycle_count()));
             },
         );
     }
