@@ -131,11 +131,14 @@ pub struct ElectricalAxis {
 }
 
 impl CurrentControl for ElectricalAxis {
-    /// A latched trip clears when the axis switches the power stage on again
-    /// (it does so only after the trip's fault was acknowledged); a cause
-    /// still present trips again in the next PWM period.
+    /// A latched trip clears once the axis commands the power stage off (it
+    /// saw the trip in the cycle before and coasts in Fault): a cause that
+    /// shows with the gates off (an encoder loss, an over-voltage) trips again
+    /// in the next PWM period and keeps the axis in Fault; one that needs the
+    /// gates (a short, an over-current, an under-voltage) shows again when
+    /// they go on, as a board's latched trip acknowledged with the fault.
     fn command(&mut self, command: &AxisCommand) {
-        if command.power_stage && !self.command.power_stage {
+        if !command.power_stage {
             self.foc.reset_trip();
         }
         self.command = *command;
@@ -240,6 +243,13 @@ impl ElectricalAxis {
     /// The plant.
     pub fn plant(&self) -> &Plant {
         &self.plant
+    }
+
+    /// The plant, for its settings ([`Plant::set_faults`],
+    /// [`Plant::set_dc_link`]): what a test does to the motor, its wiring or
+    /// the DC link, never to the drive.
+    pub fn plant_mut(&mut self) -> &mut Plant {
+        &mut self.plant
     }
 
     /// The current loop.

@@ -236,7 +236,13 @@ impl FocAxis {
                 Some(Trip::OverCurrent)
             } else if sc.shunts == Shunts::Three && p.phase_sum.implausible(phases) {
                 Some(Trip::PhaseSum)
-            } else if let Some(t) = p.dc_link.check(vdc) {
+            } else if let Some(t) = p
+                .dc_link
+                .check(vdc)
+                // a low DC link with the gates off is no fault: the stage
+                // is only not ready (it trips when they go on)
+                .filter(|&t| self.enabled || t != Trip::DcUnderVoltage)
+            {
                 Some(t)
             } else if !s.encoder_ok {
                 Some(Trip::EncoderLost)

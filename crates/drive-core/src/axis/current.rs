@@ -27,9 +27,12 @@ pub struct CurrentActual {
     /// phase current's peak).
     pub current_a: f32,
     /// The loop's latched protection trip, if any (its gates are off): the
-    /// axis faults with the trip's event ([`CurrentTrip::event`]). The loop
-    /// clears it when the axis switches the power stage on again, which it
-    /// does only after the fault was acknowledged.
+    /// axis faults with the trip's event ([`CurrentTrip::event`]) and
+    /// coasts. The loop clears it once the axis commands the power stage
+    /// off: a cause that lasts with the gates off (an encoder loss, an
+    /// over-voltage) trips again at once and holds the Fault, one that
+    /// needs the gates (a short, an under-voltage) trips again when the
+    /// acknowledged axis switches them on.
     pub trip: Option<CurrentTrip>,
 }
 
