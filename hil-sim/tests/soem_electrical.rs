@@ -59,3 +59,33 @@ fn c038_e089_soem_max_current_and_motor_i2t_on_the_electrical_plant() {
         line.fail_with(&format!("motor_protection.py through SOEM failed: {status}"));
     }
 }
+
+/// E-089 and C-017 through SOEM on the electrical plant (`overcurrent.py`,
+/// issue 34): `serve --plant-fault short` shorts leg a of axis A to the DC
+/// link's negative rail through 1 Ω behind its current sensor; the enable
+/// faults the axis once Switch on puts the power stage on (the first PWM
+/// period with the gates on trips the over-current protection): statusword Fault, 603Fh and EMCY
+/// 2310h (error register bit 1, event 33 cause 2), 6077h/6078h 0 after it;
+/// a fault reset gives Switch on disabled and the next enable faults again.
+#[test]
+fn e089_c017_soem_over_current_trip_on_the_electrical_plant() {
+    let python = match pysoem_python() {
+        Ok(p) => p,
+        Err(why) => {
+            eprintln!("soem over-current test: skipped, {why}");
+            return;
+        }
+    };
+    let dir = scratch("soem-over-current");
+    let line = Line::with_serve_args(
+        "o",
+        1,
+        60,
+        &dir,
+        &["--plant", "electrical", "--plant-fault", "short"],
+    );
+    let status = line.run(&python, "overcurrent.py", &[]);
+    if !status.success() {
+        line.fail_with(&format!("overcurrent.py through SOEM failed: {status}"));
+    }
+}

@@ -75,6 +75,9 @@ pub fn serve(args: &ServeArgs) -> Result<(), String> {
                     .into(),
             );
         }
+        if args.plant_fault.is_some() {
+            return Err("--plant-fault needs --plant electrical".into());
+        }
         return super::serve_pn::serve(args);
     }
     if args.name.is_some() {
@@ -99,6 +102,12 @@ pub fn serve(args: &ServeArgs) -> Result<(), String> {
     for (k, d) in (0u64..).zip(sim.drives_mut()) {
         d.set_plant(args.plant.into(), PLANT_SEED.wrapping_add(2 * k))
             .map_err(|e| format!("the electrical plant's parameters: {e:?}"))?;
+        if let Some(f) = args.plant_fault {
+            f.apply(
+                d.electrical_mut(0)
+                    .ok_or("--plant-fault needs --plant electrical")?,
+            );
+        }
     }
     // the recording first: an unwritable path fails before anything else
     if let Some(p) = &args.pcap {
@@ -125,6 +134,9 @@ pub fn serve(args: &ServeArgs) -> Result<(), String> {
     );
     if args.plant == Plant::Electrical {
         println!("plant: current loop (16 kHz) -> simulated PMSM and inverter on every axis");
+        if let Some(f) = args.plant_fault {
+            println!("plant fault on axis A of every drive: {f:?}");
+        }
     }
     println!(
         "EoE: ping and the UDP parameter service (port {}) answer at the IP address the master sets",
