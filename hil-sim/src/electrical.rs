@@ -150,9 +150,15 @@ impl CurrentControl for ElectricalAxis {
     /// above 2 % of a 10 % current), and the torque it makes by the loop's kt.
     fn actual(&self) -> Option<CurrentActual> {
         let iq = self.iq_cycle_mean;
+        let m = self.foc.measured();
+        // before the loop's first step its measurement is empty: no limit yet
+        let stage = m.stage_i2t.map_or(f32::INFINITY, |_| m.stage_limit_a);
+        let warning = matches!(m.stage_i2t, Some(s) if s != foc::I2tState::Normal);
         Some(CurrentActual {
             torque_nm: self.foc.gains().kt_nm_per_a * iq,
             current_a: iq,
+            stage_limit_a: stage,
+            stage_warning: warning,
             trip: self.foc.trip().map(|t| match t {
                 Trip::OverCurrent => CurrentTrip::OverCurrent,
                 Trip::PhaseSum => CurrentTrip::PhaseSum,
@@ -160,6 +166,7 @@ impl CurrentControl for ElectricalAxis {
                 Trip::DcOverVoltage => CurrentTrip::DcOverVoltage,
                 Trip::EncoderLost => CurrentTrip::EncoderLost,
                 Trip::MotorI2t => CurrentTrip::MotorI2t,
+                Trip::StageI2t => CurrentTrip::StageI2t,
             }),
         })
     }
