@@ -165,13 +165,13 @@ pub struct ServeArgs {
     /// since the start) to this pcap file.
     #[arg(long, value_name = "FILE")]
     pub pcap: Option<PathBuf>,
-    /// EtherCAT only: the motor model of every axis (`rigid`: torque in, the
+    /// The motor model of every axis, both fieldbuses (`rigid`: torque in, the
     /// default, cheap enough for 128 moving drives; `electrical`: the current
-    /// loop at 16 kHz on the PMSM plant, 6077h/6078h from the measured iq,
+    /// loop at 16 kHz on the PMSM plant, 6077h/6078h (PNU 1102) from the measured iq,
     /// about 36 ms of host time per moving axis and simulated second).
     #[arg(long, value_enum, value_name = "MODEL", default_value_t = Plant::Rigid)]
     pub plant: Plant,
-    /// EtherCAT, `--plant electrical` only: a fault of axis A's plant on
+    /// `--plant electrical` only: a fault of axis A's plant on
     /// every drive, from the start (the power stage shows it when its gates
     /// go on, or at once): `short` leg a shorted to the DC link's negative
     /// rail through 1 Ω (the over-current trip, event 33), `earth` the same

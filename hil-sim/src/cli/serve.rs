@@ -20,7 +20,7 @@
 use super::args::{Fieldbus, Plant, ServeArgs};
 
 /// Seed of the electrical plant's ADC noise under `serve --plant electrical`.
-const PLANT_SEED: u64 = 0x5E12_0034;
+pub(super) const PLANT_SEED: u64 = 0x5E12_0034;
 use super::print_new_changes;
 use super::serve_stats::{describe, thread_cpu, Answer, Stats};
 use hil_sim::raw::{monotonic, RawSocket};
@@ -69,13 +69,7 @@ const FLUSH_EVERY: Nanos = Nanos::from_secs(1);
 /// Runs `serve` until `--seconds` have passed (or forever).
 pub fn serve(args: &ServeArgs) -> Result<(), String> {
     if args.fieldbus == Fieldbus::Profinet {
-        if args.plant != Plant::Rigid {
-            return Err(
-                "--plant electrical is EtherCAT-only for now (the PROFINET drive runs the rigid model)"
-                    .into(),
-            );
-        }
-        if args.plant_fault.is_some() {
+        if args.plant_fault.is_some() && args.plant != Plant::Electrical {
             return Err("--plant-fault needs --plant electrical".into());
         }
         return super::serve_pn::serve(args);
