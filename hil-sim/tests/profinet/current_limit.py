@@ -18,6 +18,19 @@ control, PNU 1500 = 0x04 through PKW).
      2 %).
 
 One line:  scenario C-038: ok|FAIL: ...
+
+With --short (serve's `--plant-fault short`: leg a of axis A shorted to
+the DC link's negative rail through 1 ohm behind its current sensor) the
+scenario is the over-current trip instead (P-030, E-089):
+
+  1. The enable in torque control faults the axis once the power stage is
+     on (ZSW1 bit 3, not enabled); PNU 1600 (the last error, event x 16 +
+     cause) = 33 x 16 + 2: event 33 "Overcurrent" from the current loop;
+     the torque actual value 0 in the samples after it (the gates off).
+  2. fault_reset (CW1 bit 7's rising edge) clears the fault (the short shows
+     only with the gates on); drive_enable again faults again.
+
+One line:  scenario P-030: ok|FAIL: ...
 """
 
 import argparse
@@ -106,6 +119,32 @@ def run(fb, sc):
     fb.until(lambda o: o.zsw1 & 0x47 != OP, 2.0)
 
 
+def short(fb, sc):
+    def enable_into_it(what):
+        fb.i.drive_enable = True
+        dt = fb.until(lambda o: o.fault, 3.0)
+        sc.check(dt is not None and not fb.o.drive_is_enabled,
+                 f"{what}: fault (ZSW1 bit 3) after {ms(dt)}, ZSW1 {fb.o.zsw1:#06x}")
+        after = [o.current_actual_value for o in fb.run_for(0.05)][10:]
+        sc.check(after and all(abs(v) <= 10 for v in after),
+                 f"{what}: torque actual value after the trip {min(after, default=None)}..{max(after, default=None)} "
+                 f"(want 0 within 1 %: the gates off)")
+        r = fb.pkw(PKW_READ, 1600, 0)
+        sc.check(r == (PKW_READ, 33 * 16 + 2), f"{what}: PNU 1600 last error {r} (want 33 x 16 + 2 = {33 * 16 + 2})")
+
+    fb.i.operation_mode = OPMODE_TORQUE
+    fb.i.target_torque = 0
+    enable_into_it("enable into the shorted leg")
+    fb.i.drive_enable = False
+    fb.i.fault_reset = True
+    dt = fb.until(lambda o: not o.fault, 3.0)
+    sc.check(dt is not None, f"fault_reset: fault cleared after {ms(dt)} (the short needs the gates to show)")
+    fb.i.fault_reset = False
+    fb.run_for(0.05)
+    enable_into_it("enable again, the short still there")
+    fb.i.drive_enable = False
+
+
 def main():
     ap = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
     ap.add_argument("--iface", required=True)
@@ -115,6 +154,7 @@ def main():
     ap.add_argument("--in-module", required=True, help="GSDML module ID for slot 2")
     ap.add_argument("--name", default="drive-el")
     ap.add_argument("--ip", default="192.168.0.52")
+    ap.add_argument("--short", action="store_true", help="serve runs --plant-fault short: the over-current trip")
     a = ap.parse_args()
     gc.disable()  # as fb.py: a full collection would stall the cyclic thread
     logging.getLogger("profinet").addHandler(pnctl.Records())
@@ -124,12 +164,12 @@ def main():
     slots = pnctl.io_slots(a.gsdml, a.out_module, a.in_module)
     info = pnctl.name_and_address(a.iface, src, a.device_mac.lower(), a.name, a.ip)
     dev, ctl, out_slot, in_slot = pnctl.start_cyclic(info, a.iface, src, slots, watchdog=100)
-    sc = Scenario("C-038")
+    sc = Scenario("P-030" if a.short else "C-038")
     try:
         fb = ExampleFB(ctl, out_slot, in_slot)
         if fb.until(lambda o: o.identifier == 0xF0, 5.0) is None:
             raise RuntimeError("no response telegram 0xF0 within 5 s")
-        run(fb, sc)
+        (short if a.short else run)(fb, sc)
     except Exception as e:  # noqa: BLE001 - the scenario's failure
         sc.check(False, f"{type(e).__name__}: {e}")
     finally:
