@@ -131,11 +131,14 @@ pub struct ElectricalAxis {
 }
 
 impl CurrentControl for ElectricalAxis {
-    /// A latched trip clears when the axis switches the power stage on again
-    /// (it does so only after the trip's fault was acknowledged); a cause
-    /// still present trips again in the next PWM period.
+    /// A latched trip clears once the axis commands the power stage off (it
+    /// saw the trip in the cycle before and coasts in Fault): a cause that
+    /// shows with the gates off (an encoder loss, an over-voltage) trips again
+    /// in the next PWM period and keeps the axis in Fault; one that needs the
+    /// gates (a short, an over-current, an under-voltage) shows again when
+    /// they go on, as a board's latched trip acknowledged with the fault.
     fn command(&mut self, command: &AxisCommand) {
-        if command.power_stage && !self.command.power_stage {
+        if !command.power_stage {
             self.foc.reset_trip();
         }
         self.command = *command;
@@ -147,9 +150,15 @@ impl CurrentControl for ElectricalAxis {
     /// above 2 % of a 10 % current), and the torque it makes by the loop's kt.
     fn actual(&self) -> Option<CurrentActual> {
         let iq = self.iq_cycle_mean;
+        let m = self.foc.measured();
+        // before the loop's first step its measurement is empty: no limit yet
+        let stage = m.stage_i2t.map_or(f32::INFINITY, |_| m.stage_limit_a);
+        let warning = matches!(m.stage_i2t, Some(s) if s != foc::I2tState::Normal);
         Some(CurrentActual {
             torque_nm: self.foc.gains().kt_nm_per_a * iq,
             current_a: iq,
+            stage_limit_a: stage,
+            stage_warning: warning,
             trip: self.foc.trip().map(|t| match t {
                 Trip::OverCurrent => CurrentTrip::OverCurrent,
                 Trip::PhaseSum => CurrentTrip::PhaseSum,
@@ -157,6 +166,7 @@ impl CurrentControl for ElectricalAxis {
                 Trip::DcOverVoltage => CurrentTrip::DcOverVoltage,
                 Trip::EncoderLost => CurrentTrip::EncoderLost,
                 Trip::MotorI2t => CurrentTrip::MotorI2t,
+                Trip::StageI2t => CurrentTrip::StageI2t,
             }),
         })
     }
@@ -240,6 +250,13 @@ impl ElectricalAxis {
     /// The plant.
     pub fn plant(&self) -> &Plant {
         &self.plant
+    }
+
+    /// The plant, for its settings ([`Plant::set_faults`],
+    /// [`Plant::set_dc_link`]): what a test does to the motor, its wiring or
+    /// the DC link, never to the drive.
+    pub fn plant_mut(&mut self) -> &mut Plant {
+        &mut self.plant
     }
 
     /// The current loop.

@@ -8,8 +8,10 @@
 
 use std::collections::VecDeque;
 
+use crate::electrical::{ElectricalAxis, PlantModel};
 use crate::motor::{Motor, MotorOutputs};
 use crate::sim::{axis_io, AxisConditions, SimFlash};
+use drive_ecat::axis::CurrentControl;
 use drive_ecat::params::{E43, E82};
 use drive_pn::Hardware;
 use nanos::Nanos;
@@ -221,6 +223,9 @@ impl Command {
 pub struct PnSim {
     drive: drive_pn::PnDrive<SimFlash>,
     motors: [Motor; 2],
+    /// The axes' current loops on the PMSM plant (`set_plant`), or none:
+    /// the rigid torque-in model.
+    electrical: [Option<Box<ElectricalAxis>>; 2],
     feedback: [Option<MotorOutputs>; 2],
     conditions: [AxisConditions; 2],
     /// When the next control cycle starts.
@@ -257,6 +262,7 @@ impl PnSim {
             drive: drive_pn::PnDrive::new(flash, hw.clone()),
             hw,
             motors: [Motor::default_servo(), Motor::default_servo()],
+            electrical: [None, None],
             feedback: [None, None],
             conditions: [AxisConditions::READY; 2],
             next_cycle: Nanos::ZERO,
@@ -305,6 +311,33 @@ impl PnSim {
     /// The drive personality, mutable.
     pub fn drive_mut(&mut self) -> &mut drive_pn::PnDrive<SimFlash> {
         &mut self.drive
+    }
+
+    /// Runs both axes on `model` from the next control cycle on, as
+    /// [`SimDrive::set_plant`](crate::sim::SimDrive::set_plant) does: the
+    /// electrical model's current loop at 16 kHz on the PMSM plant, 6077h
+    /// and 6078h (PNU 1102) from its measured iq, its trips the axes'
+    /// faults. `seed` seeds the ADC noise (axis B gets `seed + 1`).
+    pub fn set_plant(&mut self, model: PlantModel, seed: u64) -> Result<(), foc::ParamError> {
+        for (k, el) in self.electrical.iter_mut().enumerate() {
+            *el = match model {
+                PlantModel::Rigid => None,
+                PlantModel::Electrical => Some(Box::new(ElectricalAxis::default_servo(
+                    seed.wrapping_add(k as u64),
+                )?)),
+            };
+        }
+        Ok(())
+    }
+
+    /// Axis `axis`' current loop and PMSM, if it runs the electrical model.
+    pub fn electrical(&self, axis: usize) -> Option<&ElectricalAxis> {
+        self.electrical.get(axis).and_then(|e| e.as_deref())
+    }
+
+    /// The same, for plant settings (faults, the DC link).
+    pub fn electrical_mut(&mut self, axis: usize) -> Option<&mut ElectricalAxis> {
+        self.electrical.get_mut(axis).and_then(|e| e.as_deref_mut())
     }
 
     /// The motor of `axis` (0 = A).
@@ -425,19 +458,38 @@ impl PnSim {
                 return;
             }
             self.acknowledge_step();
-            let io = [
+            let mut io = [
                 axis_io(self.feedback[0].as_ref(), &self.motors[0], self.conditions[0]),
                 axis_io(self.feedback[1].as_ref(), &self.motors[1], self.conditions[1]),
             ];
+            // the current seam: the loops' measurement in, their commands down
+            for (io, el) in io.iter_mut().zip(&self.electrical) {
+                if let Some(el) = el {
+                    io.current = el.actual();
+                }
+            }
             let commands = self.drive.control_cycle(t, &io);
             let period = self.drive.control_period();
-            for ((motor, fb), c) in self.motors.iter_mut().zip(self.feedback.iter_mut()).zip(commands) {
-                let torque = if c.power_stage {
-                    f64::from(c.torque_nm)
-                } else {
-                    0.0
-                };
-                *fb = Some(motor.step(torque, !c.brake_release, period));
+            let data = self.drive.axes().each_ref().map(|a| *a.motor());
+            let axes = self.motors.iter_mut().zip(self.feedback.iter_mut());
+            for ((((motor, fb), c), el), data) in axes.zip(commands).zip(self.electrical.iter_mut()).zip(data)
+            {
+                *fb = Some(match el {
+                    Some(el) => {
+                        // the dictionary's motor data (a refused set keeps the loop's)
+                        let _ = el.set_motor_data(&data);
+                        el.command(&c);
+                        el.run(motor, period)
+                    }
+                    None => {
+                        let torque = if c.power_stage {
+                            f64::from(c.torque_nm)
+                        } else {
+                            0.0
+                        };
+                        motor.step(torque, !c.brake_release, period)
+                    }
+                });
             }
             self.cycles += 1;
             self.next_cycle = t + period;

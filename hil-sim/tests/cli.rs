@@ -75,6 +75,7 @@ fn serve_help_lists_its_options_not_the_test_ones() {
         "--pcap <FILE>",
         "--seconds <S>",
         "--plant <MODEL>",
+        "--plant-fault <FAULT>",
     ] {
         assert!(out.contains(want), "`{want}` missing in:\n{out}");
     }
@@ -103,18 +104,24 @@ fn an_unknown_flag_is_refused() {
 }
 
 #[test]
-fn serve_plant_electrical_is_ethercat_only_and_an_unknown_plant_is_refused() {
-    let o = hil_sim(&[
-        "serve",
-        "--iface",
-        "lo",
-        "--fieldbus",
-        "profinet",
-        "--plant",
-        "electrical",
-    ]);
-    assert!(!o.status.success(), "{o:?}");
-    assert!(text(&o.stderr).contains("EtherCAT-only"), "{}", text(&o.stderr));
+fn serve_plant_fault_needs_the_electrical_plant_and_an_unknown_plant_is_refused() {
+    for bus in ["ethercat", "profinet"] {
+        let o = hil_sim(&[
+            "serve",
+            "--iface",
+            "lo",
+            "--fieldbus",
+            bus,
+            "--plant-fault",
+            "short",
+        ]);
+        assert!(!o.status.success(), "{bus}: {o:?}");
+        assert!(
+            text(&o.stderr).contains("--plant-fault needs --plant electrical"),
+            "{bus}: {}",
+            text(&o.stderr)
+        );
+    }
     let o = hil_sim(&["serve", "--iface", "lo", "--plant", "bogus"]);
     assert_eq!(o.status.code(), Some(2), "{o:?}");
     assert!(text(&o.stderr).contains("--plant"), "{}", text(&o.stderr));

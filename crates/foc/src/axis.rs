@@ -12,6 +12,10 @@ use crate::trig::{sin_cos, Angle, RAD_PER_ANGLE};
 /// PWM periods per step of the i²t model (16 ms at 16 kHz).
 pub const I2T_DECIMATION: u32 = 256;
 
+/// The power stage's i²t level below which a limit reached at 100 % is
+/// lifted again.
+pub const STAGE_I2T_RELEASE: f32 = 0.95;
+
 /// Protection thresholds of one axis (the drive's own limits).
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct Protection {
@@ -21,8 +25,14 @@ pub struct Protection {
     pub phase_sum: PhaseSum,
     /// DC-link window.
     pub dc_link: DcLink,
-    /// The power stage's current limit, A.
+    /// The power stage's current limit (its maximum current), A.
     pub stage_current_a: f32,
+    /// The power stage's rated (continuous) current, A: its i²t model's
+    /// 100 %, to which the current is limited at 100 % (below
+    /// `stage_current_a`).
+    pub stage_rated_a: f32,
+    /// The power stage's thermal time constant (its i²t model), s.
+    pub stage_tau_s: f32,
     /// The loop's own i²t model limits the current to the rated current at
     /// 100 %. Off where the control cycle above owns the motor protection
     /// (the drive core's i²t with U10/U11 limits through the torque it
@@ -33,7 +43,8 @@ pub struct Protection {
 
 impl Protection {
     /// Trip at 9 A, phase sum within 0.3 A, DC link 400…800 V (400 V mains,
-    /// 565 V nominal), power stage 8 A, the i²t model limiting.
+    /// 565 V nominal), power stage 8 A maximum and 4 A rated with a thermal
+    /// time constant of 5 s, the motor's i²t model limiting.
     pub const fn default_stage() -> Self {
         Self {
             over_current: OverCurrent { threshold_a: 9.0 },
@@ -43,6 +54,8 @@ impl Protection {
                 max_v: 800.0,
             },
             stage_current_a: 8.0,
+            stage_rated_a: 4.0,
+            stage_tau_s: 5.0,
             i2t_limits: true,
         }
     }
@@ -70,6 +83,12 @@ pub struct Measured {
     pub current_limit_a: f32,
     /// The i²t model's verdict.
     pub i2t: Option<I2tState>,
+    /// The power stage's i²t model's verdict.
+    pub stage_i2t: Option<I2tState>,
+    /// The power stage's own current limit in force, A: its maximum
+    /// current, its rated current from its i²t model's 100 % until it falls
+    /// below [`STAGE_I2T_RELEASE`].
+    pub stage_limit_a: f32,
 }
 
 /// The current loop of one axis with its protection.
@@ -85,6 +104,13 @@ pub struct FocAxis {
     i2t_sum: f32,
     i2t_count: u32,
     i2t_state: I2tState,
+    stage_i2t: I2t,
+    stage_i2t_alpha: f64,
+    stage_i2t_state: I2tState,
+    /// The stage's i²t limits: from 100 % until it falls below
+    /// [`STAGE_I2T_RELEASE`] (without the hysteresis the limit would toggle
+    /// around 100 % every model step).
+    stage_limiting: bool,
     last_angle: Option<Angle>,
     trip: Option<Trip>,
     enabled: bool,
@@ -103,6 +129,10 @@ impl FocAxis {
     ) -> Result<Self, ParamError> {
         let gains = Gains::from_motor(&motor, &params)?;
         let i2t = I2t::new(motor.rated_current_a, motor.thermal_time_constant_s);
+        let stage_i2t = I2t::new(
+            fmath::max(protection.stage_rated_a, 1e-3),
+            fmath::max(protection.stage_tau_s, 1e-3),
+        );
         Ok(Self {
             gains,
             motor,
@@ -114,6 +144,10 @@ impl FocAxis {
             i2t_sum: 0.0,
             i2t_count: 0,
             i2t_state: I2tState::Normal,
+            stage_i2t_alpha: stage_i2t.alpha(gains.ts_s * I2T_DECIMATION as f32),
+            stage_i2t,
+            stage_i2t_state: I2tState::Normal,
+            stage_limiting: false,
             last_angle: None,
             trip: None,
             enabled: false,
@@ -133,6 +167,7 @@ impl FocAxis {
         self.i2t = I2t::new(motor.rated_current_a, motor.thermal_time_constant_s);
         self.i2t.set_level(x);
         self.i2t_alpha = self.i2t.alpha(gains.ts_s * I2T_DECIMATION as f32);
+        self.stage_i2t_alpha = self.stage_i2t.alpha(gains.ts_s * I2T_DECIMATION as f32);
         self.pi.reset();
         Ok(())
     }
@@ -175,6 +210,11 @@ impl FocAxis {
     /// The i²t model.
     pub fn i2t(&self) -> &I2t {
         &self.i2t
+    }
+
+    /// The power stage's i²t model.
+    pub fn stage_i2t(&self) -> &I2t {
+        &self.stage_i2t
     }
 
     /// The current reference of a torque command: iq = torque / kt, id = 0 (no field
@@ -223,9 +263,14 @@ impl FocAxis {
         self.i2t_sum += current.d * current.d + current.q * current.q;
         self.i2t_count += 1;
         if self.i2t_count >= I2T_DECIMATION {
-            self.i2t_state = self
-                .i2t
-                .step_alpha(self.i2t_sum * (1.0 / I2T_DECIMATION as f32), self.i2t_alpha);
+            let mean_sq = self.i2t_sum * (1.0 / I2T_DECIMATION as f32);
+            self.i2t_state = self.i2t.step_alpha(mean_sq, self.i2t_alpha);
+            self.stage_i2t_state = self.stage_i2t.step_alpha(mean_sq, self.stage_i2t_alpha);
+            if matches!(self.stage_i2t_state, I2tState::Limiting | I2tState::Fault) {
+                self.stage_limiting = true;
+            } else if self.stage_i2t.level() < STAGE_I2T_RELEASE {
+                self.stage_limiting = false;
+            }
             self.i2t_sum = 0.0;
             self.i2t_count = 0;
         }
@@ -236,12 +281,20 @@ impl FocAxis {
                 Some(Trip::OverCurrent)
             } else if sc.shunts == Shunts::Three && p.phase_sum.implausible(phases) {
                 Some(Trip::PhaseSum)
-            } else if let Some(t) = p.dc_link.check(vdc) {
+            } else if let Some(t) = p
+                .dc_link
+                .check(vdc)
+                // a low DC link with the gates off is no fault: the stage
+                // is only not ready (it trips when they go on)
+                .filter(|&t| self.enabled || t != Trip::DcUnderVoltage)
+            {
                 Some(t)
             } else if !s.encoder_ok {
                 Some(Trip::EncoderLost)
             } else if i2t == I2tState::Fault {
                 Some(Trip::MotorI2t)
+            } else if self.stage_i2t_state == I2tState::Fault {
+                Some(Trip::StageI2t)
             } else {
                 None
             };
@@ -252,10 +305,17 @@ impl FocAxis {
         } else {
             self.motor.rated_current_a
         };
+        // the power stage: its maximum, its rated current while its i²t
+        // model is at or above 100 %
+        let stage_limit = if self.stage_limiting {
+            fmath::min(self.protection.stage_rated_a, self.protection.stage_current_a)
+        } else {
+            self.protection.stage_current_a
+        };
         // the lowest of the limits (`protect::current_limit`, unrolled: all are
         // validated positive, the external one sanitised where it is set)
         let limit = fmath::min(
-            fmath::min(self.motor.max_current_a, self.protection.stage_current_a),
+            fmath::min(self.motor.max_current_a, stage_limit),
             fmath::min(self.external_limit_a, i2t_limit),
         );
         self.measured = Measured {
@@ -268,6 +328,8 @@ impl FocAxis {
             voltage_limited: false,
             current_limit_a: limit,
             i2t: Some(i2t),
+            stage_i2t: Some(self.stage_i2t_state),
+            stage_limit_a: stage_limit,
         };
         let half = sc.pwm_period_counts / 2;
         if self.trip.is_some() || !self.enabled {

@@ -21,6 +21,9 @@ pub enum Trip {
     EncoderLost,
     /// The motor's i²t model reached its fault level.
     MotorI2t,
+    /// The power stage's i²t model reached its fault level (its current
+    /// limit was not obeyed).
+    StageI2t,
 }
 
 /// Over-current: trips when any phase current's magnitude exceeds the threshold.

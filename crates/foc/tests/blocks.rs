@@ -423,3 +423,73 @@ fn torque_reference_is_iq_through_the_torque_constant_with_id_zero() {
     assert_eq!(r.d, 0.0);
     assert!(close(r.q, 2.0, 1e-5));
 }
+
+/// The power stage's i²t (its own rated current and thermal time constant):
+/// 6 A held on a stage rated 4 A (u = (i/I_r)² ≈ 2.25), τ = 0.1 s, gives the
+/// warning at 80 %, the current limited to the stage's rated current at
+/// 100 % and the trip at 110 % (the limit not obeyed: the sample keeps 6 A)
+/// at the first model step (16 ms) at or after the first-order model's
+/// t = −τ·ln(1 − x/u); before that the stage's limit is its maximum (8 A).
+#[test]
+fn stage_i2t_warns_then_limits_to_its_rated_current_then_trips() {
+    let sc = Scaling::default_board();
+    let protection = Protection {
+        stage_rated_a: 4.0,
+        stage_tau_s: 0.1,
+        ..Protection::default_stage()
+    };
+    let mut a = FocAxis::new(
+        MotorData::default_servo(),
+        LoopParams::default_16k(),
+        sc,
+        protection,
+    )
+    .unwrap();
+    a.enable(true);
+    // 6 A along phase a at electrical angle 0: id ≈ 6 A, iq 0
+    let s = sample([2048 + 1228, 2048 - 614, 2048 - 614], 2260);
+    let q = foc::Dq { d: 0.0, q: 0.0 };
+    let period_s = 1.0 / 16_000.0;
+    let step_s = period_s * f64::from(foc::axis::I2T_DECIMATION);
+    let (mut warned, mut limited, mut tripped) = (None, None, None);
+    for k in 1..=4000u32 {
+        let out = a.step(&s, q);
+        let t = f64::from(k) * period_s;
+        let m = *a.measured();
+        match m.stage_i2t {
+            Some(I2tState::Warning) if warned.is_none() => warned = Some(t),
+            Some(I2tState::Limiting) if limited.is_none() => {
+                limited = Some(t);
+                assert_eq!(m.stage_limit_a, 4.0, "limited to the stage's rated current");
+            }
+            Some(I2tState::Normal | I2tState::Warning) => {
+                assert_eq!(m.stage_limit_a, 8.0, "the stage's maximum below 100 %")
+            }
+            _ => {}
+        }
+        if a.trip().is_some() {
+            assert!(!out.gate_enable);
+            tripped = Some(t);
+            break;
+        }
+    }
+    let i = f64::from(a.measured().current.d);
+    let u = (i / 4.0) * (i / 4.0);
+    let at = |x: f64| {
+        let t = -0.1 * (1.0 - x / u).ln();
+        (t / step_s).ceil() * step_s
+    };
+    for (what, seen, x) in [
+        ("warning", warned, 0.8),
+        ("limit", limited, 1.0),
+        ("trip", tripped, 1.1),
+    ] {
+        let seen = seen.unwrap_or_else(|| panic!("stage i²t {what} never came"));
+        assert!(
+            (seen - at(x)).abs() < 1.5 * period_s,
+            "stage i²t {what} at {seen:.4} s, closed form (next model step) {:.4} s",
+            at(x)
+        );
+    }
+    assert_eq!(a.trip(), Some(Trip::StageI2t));
+}

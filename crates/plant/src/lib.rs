@@ -29,7 +29,9 @@
 //! - Faults ([`FaultOptions`]): an open phase (its current held at zero: the
 //!   current vector's derivative loses its component along that phase's axis;
 //!   exact for Ld = Lq), phases b and c swapped at the inverter, an unbalanced
-//!   winding (per-phase resistance), an encoder loss.
+//!   winding (per-phase resistance), an encoder loss, a leg shorted to the DC
+//!   link's negative rail behind its current sensor (a short or an earth fault:
+//!   the sensor reads the fault's current too), a broken current sensor.
 //!
 //! The default motor is `foc::MotorData::default_servo` (hil-sim's servo with
 //! electrical data, the numbers' source written there) over hil-sim's mechanics.
@@ -406,6 +408,23 @@ impl Plant {
         } else {
             i
         };
+        let mut legs = legs;
+        let f = self.p.faults;
+        if let (Some((ph, r)), true) = (f.leg_to_dc_minus, self.pwm.gate_enable) {
+            let k = phase_index(ph);
+            let period = f64::from(self.p.inverter.pwm_period_counts.max(1));
+            let d = self
+                .pwm
+                .compare
+                .get(k)
+                .map_or(0.0, |&c| (f64::from(c) / period).clamp(0.0, 1.0));
+            if let Some(l) = legs.get_mut(k) {
+                *l += d * self.p.inverter.vdc_v / r.max(1e-3);
+            }
+        }
+        if let Some(l) = f.broken_sensor.and_then(|ph| legs.get_mut(phase_index(ph))) {
+            *l = 0.0;
+        }
         let mut counts = [0u16; 3];
         for (c, il) in counts.iter_mut().zip(legs) {
             let x = adc.zero_count + il / adc.amps_per_count + adc.current_noise_counts * self.rng.normal();
@@ -422,6 +441,15 @@ impl Plant {
             position_inc: self.held_position,
             encoder_ok,
         }
+    }
+}
+
+/// The index of a phase (leg) in the a, b, c arrays.
+fn phase_index(ph: Phase) -> usize {
+    match ph {
+        Phase::A => 0,
+        Phase::B => 1,
+        Phase::C => 2,
     }
 }
 

@@ -199,6 +199,18 @@ pub struct FaultOptions {
     pub r_scale: [f64; 3],
     /// The encoder reports an error and its position stops.
     pub encoder_lost: bool,
+    /// An insulation fault: this inverter leg's output (between its current
+    /// sensor and the motor) is connected to the DC link's negative rail
+    /// through this resistance, Ω. With the gates on the leg's sensor carries
+    /// the motor's phase current plus the fault's d·Vdc/R (the inverter is a
+    /// stiff voltage source: the motor's currents are unchanged); the three
+    /// measured currents no longer sum to zero. A low resistance (1 Ω: some
+    /// 280 A at half duty) is a short: the over-current trip; a high one
+    /// (100 Ω: some 2.8 A) an earth fault: the phase-sum plausibility.
+    pub leg_to_dc_minus: Option<(Phase, f64)>,
+    /// This leg's current sensor (shunt or amplifier) is broken: it reads
+    /// zero current (its zero count and noise) whatever flows.
+    pub broken_sensor: Option<Phase>,
 }
 
 impl FaultOptions {
@@ -208,6 +220,8 @@ impl FaultOptions {
         swapped_bc: false,
         r_scale: [1.0; 3],
         encoder_lost: false,
+        leg_to_dc_minus: None,
+        broken_sensor: None,
     };
 }
 

@@ -392,3 +392,73 @@ fn two_mass_load_resonates_at_its_closed_form_frequency() {
     let period = (crossings[n - 1] - crossings[0]) / (n - 1) as f64;
     assert!((TAU / period - w).abs() < 0.01 * w, "{} vs {w}", TAU / period);
 }
+
+/// The faults that only the measured phase currents show, each set while the
+/// loop runs 1 A: the PWM period after the fault appeared carries it in the
+/// sample and the loop's step on that sample switches the gates off (the power
+/// stage is off within one PWM period), with the trip the fault must give.
+#[test]
+fn leg_short_earth_fault_and_broken_sensor_trip_within_one_period() {
+    let cases = [
+        (
+            "leg a shorted to DC- (1 Ω)",
+            FaultOptions {
+                leg_to_dc_minus: Some((Phase::A, 1.0)),
+                ..FaultOptions::NONE
+            },
+            Trip::OverCurrent,
+        ),
+        (
+            "earth fault of leg a (100 Ω)",
+            FaultOptions {
+                leg_to_dc_minus: Some((Phase::A, 100.0)),
+                ..FaultOptions::NONE
+            },
+            Trip::PhaseSum,
+        ),
+        (
+            "broken sensor of leg b",
+            FaultOptions {
+                broken_sensor: Some(Phase::B),
+                ..FaultOptions::NONE
+            },
+            Trip::PhaseSum,
+        ),
+    ];
+    for (what, faults, trip) in cases {
+        let p = PlantParams::default_servo();
+        let mut pl = Plant::new(p);
+        let mut axis = axis_for(&p);
+        let q = Dq { d: 0.0, q: 1.0 };
+        run(&mut pl, &mut axis, q, 100);
+        assert_eq!(axis.trip(), None, "{what}: healthy before");
+        pl.set_faults(faults);
+        pl.advance(); // the period in which the fault appears, gates on
+        let out = axis.step(&pl.sample(), q);
+        assert!(!out.gate_enable, "{what}: gates off in the step that sees it");
+        assert_eq!(axis.trip(), Some(trip), "{what}");
+        pl.apply(&out);
+        pl.advance();
+        let [a, b, c] = pl.phase_currents();
+        assert!(a.abs() + b.abs() + c.abs() < 0.05, "{what}: the current is gone");
+    }
+}
+
+/// A leg short shows only with the gates on: an axis switched on into it trips
+/// in its first PWM period (no sample with the gates off carries it).
+#[test]
+fn a_leg_short_trips_in_the_first_period_with_the_gates_on() {
+    let mut p = PlantParams::default_servo();
+    p.faults.leg_to_dc_minus = Some((Phase::A, 1.0));
+    let mut pl = Plant::new(p);
+    let mut axis = axis_for(&p);
+    axis.enable(false);
+    let q = Dq { d: 0.0, q: 0.0 };
+    run(&mut pl, &mut axis, q, 10);
+    assert_eq!(axis.trip(), None, "gates off: nothing to see");
+    axis.enable(true);
+    run(&mut pl, &mut axis, q, 1);
+    assert_eq!(axis.trip(), None, "the first period with the gates on");
+    assert!(!axis.step(&pl.sample(), q).gate_enable);
+    assert_eq!(axis.trip(), Some(Trip::OverCurrent));
+}

@@ -56,6 +56,52 @@ pub struct DemoArgs {
     pub plant: Plant,
 }
 
+/// A fault of the electrical plant (`serve --plant-fault`).
+#[derive(Debug, Clone, Copy, PartialEq, Eq, ValueEnum)]
+pub enum PlantFault {
+    /// Leg a shorted to DC− through 1 Ω.
+    Short,
+    /// Leg a to DC− through 100 Ω (an earth fault).
+    Earth,
+    /// Leg b's current sensor reads zero.
+    BrokenSensor,
+    /// DC link 300 V (below 400 V).
+    DcLow,
+    /// DC link 850 V (above 800 V).
+    DcHigh,
+    /// The encoder lost.
+    Encoder,
+}
+
+impl PlantFault {
+    /// Applies the fault to an electrical axis' plant.
+    pub fn apply(self, el: &mut hil_sim::electrical::ElectricalAxis) {
+        use plant::{FaultOptions, Phase};
+        let f = FaultOptions::NONE;
+        let pl = el.plant_mut();
+        match self {
+            Self::Short => pl.set_faults(FaultOptions {
+                leg_to_dc_minus: Some((Phase::A, 1.0)),
+                ..f
+            }),
+            Self::Earth => pl.set_faults(FaultOptions {
+                leg_to_dc_minus: Some((Phase::A, 100.0)),
+                ..f
+            }),
+            Self::BrokenSensor => pl.set_faults(FaultOptions {
+                broken_sensor: Some(Phase::B),
+                ..f
+            }),
+            Self::DcLow => pl.set_dc_link(300.0),
+            Self::DcHigh => pl.set_dc_link(850.0),
+            Self::Encoder => pl.set_faults(FaultOptions {
+                encoder_lost: true,
+                ..f
+            }),
+        }
+    }
+}
+
 /// The motor model of `demo --plant` (`hil_sim::electrical::PlantModel`).
 #[derive(Debug, Clone, Copy, Default, PartialEq, Eq, ValueEnum)]
 pub enum Plant {
@@ -119,12 +165,21 @@ pub struct ServeArgs {
     /// since the start) to this pcap file.
     #[arg(long, value_name = "FILE")]
     pub pcap: Option<PathBuf>,
-    /// EtherCAT only: the motor model of every axis (`rigid`: torque in, the
+    /// The motor model of every axis, both fieldbuses (`rigid`: torque in, the
     /// default, cheap enough for 128 moving drives; `electrical`: the current
-    /// loop at 16 kHz on the PMSM plant, 6077h/6078h from the measured iq,
+    /// loop at 16 kHz on the PMSM plant, 6077h/6078h (PNU 1102) from the measured iq,
     /// about 36 ms of host time per moving axis and simulated second).
     #[arg(long, value_enum, value_name = "MODEL", default_value_t = Plant::Rigid)]
     pub plant: Plant,
+    /// `--plant electrical` only: a fault of axis A's plant on
+    /// every drive, from the start (the power stage shows it when its gates
+    /// go on, or at once): `short` leg a shorted to the DC link's negative
+    /// rail through 1 Ω (the over-current trip, event 33), `earth` the same
+    /// through 100 Ω (the phase-sum trip, event 31), `broken-sensor` leg b's
+    /// current sensor reads zero (phase sum), `dc-low` / `dc-high` a DC link
+    /// of 300 V / 850 V (events 46 / 36), `encoder` the encoder lost (37).
+    #[arg(long, value_enum, value_name = "FAULT")]
+    pub plant_fault: Option<PlantFault>,
     /// Stop after this many seconds (default: run until killed).
     #[arg(long, value_name = "S")]
     pub seconds: Option<f64>,

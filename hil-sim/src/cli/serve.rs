@@ -20,7 +20,7 @@
 use super::args::{Fieldbus, Plant, ServeArgs};
 
 /// Seed of the electrical plant's ADC noise under `serve --plant electrical`.
-const PLANT_SEED: u64 = 0x5E12_0034;
+pub(super) const PLANT_SEED: u64 = 0x5E12_0034;
 use super::print_new_changes;
 use super::serve_stats::{describe, thread_cpu, Answer, Stats};
 use hil_sim::raw::{monotonic, RawSocket};
@@ -69,11 +69,8 @@ const FLUSH_EVERY: Nanos = Nanos::from_secs(1);
 /// Runs `serve` until `--seconds` have passed (or forever).
 pub fn serve(args: &ServeArgs) -> Result<(), String> {
     if args.fieldbus == Fieldbus::Profinet {
-        if args.plant != Plant::Rigid {
-            return Err(
-                "--plant electrical is EtherCAT-only for now (the PROFINET drive runs the rigid model)"
-                    .into(),
-            );
+        if args.plant_fault.is_some() && args.plant != Plant::Electrical {
+            return Err("--plant-fault needs --plant electrical".into());
         }
         return super::serve_pn::serve(args);
     }
@@ -99,6 +96,12 @@ pub fn serve(args: &ServeArgs) -> Result<(), String> {
     for (k, d) in (0u64..).zip(sim.drives_mut()) {
         d.set_plant(args.plant.into(), PLANT_SEED.wrapping_add(2 * k))
             .map_err(|e| format!("the electrical plant's parameters: {e:?}"))?;
+        if let Some(f) = args.plant_fault {
+            f.apply(
+                d.electrical_mut(0)
+                    .ok_or("--plant-fault needs --plant electrical")?,
+            );
+        }
     }
     // the recording first: an unwritable path fails before anything else
     if let Some(p) = &args.pcap {
@@ -125,6 +128,9 @@ pub fn serve(args: &ServeArgs) -> Result<(), String> {
     );
     if args.plant == Plant::Electrical {
         println!("plant: current loop (16 kHz) -> simulated PMSM and inverter on every axis");
+        if let Some(f) = args.plant_fault {
+            println!("plant fault on axis A of every drive: {f:?}");
+        }
     }
     println!(
         "EoE: ping and the UDP parameter service (port {}) answer at the IP address the master sets",

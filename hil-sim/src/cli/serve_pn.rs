@@ -240,11 +240,28 @@ pub fn serve(args: &ServeArgs) -> Result<(), String> {
             )
         })
         .collect();
+    // the motor model: the seed per drive k (from 0) as EtherCAT's serve
+    for (k, d) in (0u64..).zip(drives.iter_mut()) {
+        d.set_plant(args.plant.into(), super::serve::PLANT_SEED.wrapping_add(2 * k))
+            .map_err(|e| format!("the electrical plant's parameters: {e:?}"))?;
+        if let Some(f) = args.plant_fault {
+            f.apply(
+                d.electrical_mut(0)
+                    .ok_or("--plant-fault needs --plant electrical")?,
+            );
+        }
+    }
     let mut control = args.control.as_deref().map(Control::create).transpose()?;
     println!(
         "hil-sim serve: {} simulated drive(s) as PROFINET IO devices on {iface}",
         drives.len()
     );
+    if args.plant == super::args::Plant::Electrical {
+        println!("plant: current loop (16 kHz) -> simulated PMSM and inverter on every axis");
+        if let Some(f) = args.plant_fault {
+            println!("plant fault on axis A of every drive: {f:?}");
+        }
+    }
     for (k, d) in (0u16..).zip(&drives) {
         let m = pn::device_mac(mac, k);
         let ports = pn::port_macs(m);

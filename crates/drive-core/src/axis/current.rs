@@ -27,10 +27,34 @@ pub struct CurrentActual {
     /// phase current's peak).
     pub current_a: f32,
     /// The loop's latched protection trip, if any (its gates are off): the
-    /// axis faults with the trip's event ([`CurrentTrip::event`]). The loop
-    /// clears it when the axis switches the power stage on again, which it
-    /// does only after the fault was acknowledged.
+    /// axis faults with the trip's event ([`CurrentTrip::event`]) and
+    /// coasts. The loop clears it once the axis commands the power stage
+    /// off: a cause that lasts with the gates off (an encoder loss, an
+    /// over-voltage) trips again at once and holds the Fault, one that
+    /// needs the gates (a short, an under-voltage) trips again when the
+    /// acknowledged axis switches them on.
     pub trip: Option<CurrentTrip>,
+    /// The power stage's own current limit in force, A (its maximum
+    /// current, or its rated current while its i²t model is at or above
+    /// 100 %); infinite where the loop has none. The axis' current limit is
+    /// the lowest of it, 6073h, 2415h and the motor's i²t limit.
+    pub stage_limit_a: f32,
+    /// The power stage's i²t model at or above its warning level
+    /// (statusword bit 7).
+    pub stage_warning: bool,
+}
+
+impl CurrentActual {
+    /// A measurement without a trip and without a power-stage limit.
+    pub const fn measured(torque_nm: f32, current_a: f32) -> Self {
+        Self {
+            torque_nm,
+            current_a,
+            trip: None,
+            stage_limit_a: f32::INFINITY,
+            stage_warning: false,
+        }
+    }
 }
 
 /// A trip of the current loop's protection (the power stage is off within
@@ -53,6 +77,9 @@ pub enum CurrentTrip {
     EncoderLost,
     /// The loop's own i²t backstop: event 45 "Overtemp.motor i2t" (4380h).
     MotorI2t,
+    /// The power stage's i²t model at its fault level (its limit not
+    /// obeyed): event 39 "Overtemperature drive controller i2t" (4280h).
+    StageI2t,
 }
 
 impl CurrentTrip {
@@ -65,6 +92,7 @@ impl CurrentTrip {
             Self::DcOverVoltage => 36,
             Self::EncoderLost => 37,
             Self::MotorI2t => 45,
+            Self::StageI2t => 39,
         };
         Event { number, cause: 2 }
     }

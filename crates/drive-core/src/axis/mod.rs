@@ -287,6 +287,10 @@ pub struct Axis {
     /// The motor data (`motor.rs`) and its i²t model.
     motor: MotorData,
     i2t: motor::MotorI2t,
+    /// The power stage's current limit (‰ of 6075h) and i²t warning, as the
+    /// current loop last reported them (`motor.rs`).
+    stage_limit_per_mille: u16,
+    stage_warning: bool,
     /// The record status of the last cycle, packed.
     record_status: u32,
     /// F00 brake control active, F06 release override active (`brake.rs`).
@@ -356,6 +360,8 @@ impl Axis {
             torque_limit_per_mille: u16::MAX,
             motor: MotorData::default(),
             i2t: motor::MotorI2t::default(),
+            stage_limit_per_mille: u16::MAX,
+            stage_warning: false,
             record_status: 0,
             brake: (true, false),
         }
@@ -588,7 +594,7 @@ impl Axis {
             target_reached: false,
             mode_bit12: false,
             mode_bit13: false,
-            warning: self.i2t.limiting(),
+            warning: self.i2t.limiting() || self.stage_warning,
             remote: true,
             internal_limit: false,
             manufacturer_bits: 0,

@@ -26,9 +26,12 @@
 //! 08h temperature).
 //!
 //! **Current limit**: the lowest of 6073h (‰ of 6075h), 2415h.02 (P-133:
-//! [`Axis::set_torque_limit_per_mille`]) and the i²t limit (1000 ‰), as a
-//! torque limit through kt (configure.rs), below 6072h; the power stage's own
-//! limit is the current loop's (`foc::Protection`).
+//! [`Axis::set_torque_limit_per_mille`]), the i²t limit (1000 ‰) and the
+//! power stage's as the current loop reports it
+//! ([`CurrentActual::stage_limit_a`]: its maximum current, its rated current
+//! while its own i²t model limits; `foc::Protection`), as a torque limit
+//! through kt (configure.rs), below 6072h. The stage's i²t warning sets
+//! statusword bit 7 as the motor's does.
 //!
 //! **Trips of the current loop** ([`CurrentActual::trip`]) become the
 //! manual's events in `monitor.rs`.
@@ -278,21 +281,36 @@ impl Axis {
             None => self.last_out.map_or(0.0, |c| c.torque_nm) / self.motor.torque_constant_nm_per_a,
         };
         let (changed, fault) = self.i2t.step(i, now);
-        if changed {
+        // the power stage's limit in ‰ of 6075h (a NaN reads 0: no licence)
+        let (stage, warning) = io.current.map_or((u16::MAX, false), |m| {
+            let pm = m.stage_limit_a / self.motor.rated_current_a * 1000.0;
+            let pm = if pm >= f32::from(u16::MAX) {
+                u16::MAX
+            } else {
+                pm as u16
+            };
+            (pm, m.stage_warning)
+        });
+        if changed || stage != self.stage_limit_per_mille {
             self.configured = None;
         }
+        self.stage_limit_per_mille = stage;
+        self.stage_warning = warning;
         if let Some(ev) = fault {
             self.raise(ev);
         }
     }
 
     /// The current limit in ‰ of the rated current (= of the rated torque):
-    /// the lowest of 6073h, 2415h.02 (P-133) and the i²t limit.
+    /// the lowest of 6073h, 2415h.02 (P-133), the motor's i²t limit and the
+    /// power stage's (its maximum, or its rated current while its own i²t
+    /// model limits: [`CurrentActual::stage_limit_a`]).
     pub(super) fn current_limit_per_mille(&self) -> u16 {
         let i2t = if self.i2t.limiting() { 1000 } else { u16::MAX };
         self.motor
             .max_current_per_mille
             .min(self.torque_limit_per_mille)
             .min(i2t)
+            .min(self.stage_limit_per_mille)
     }
 }

@@ -16,6 +16,9 @@ struct LagLoop {
     iq: f64,
     iq_ref: f64,
     trip: Option<CurrentTrip>,
+    /// The power stage's limit and i²t warning the loop reports.
+    stage_limit_a: f32,
+    stage_warning: bool,
 }
 
 impl CurrentControl for LagLoop {
@@ -28,9 +31,10 @@ impl CurrentControl for LagLoop {
     }
     fn actual(&self) -> Option<CurrentActual> {
         Some(CurrentActual {
-            torque_nm: KT * self.iq as f32,
-            current_a: self.iq as f32,
             trip: self.trip,
+            stage_limit_a: self.stage_limit_a,
+            stage_warning: self.stage_warning,
+            ..CurrentActual::measured(KT * self.iq as f32, self.iq as f32)
         })
     }
 }
@@ -64,6 +68,8 @@ impl Rig {
                 iq: 0.0,
                 iq_ref: 0.0,
                 trip: None,
+                stage_limit_a: f32::INFINITY,
+                stage_warning: false,
             },
             measure,
             now: Nanos::ZERO,
@@ -355,4 +361,48 @@ fn motor_i2t_model_meets_the_closed_form_at_a_long_time_constant() {
             "after {until_s} s: x {x}, closed form {closed}"
         );
     }
+}
+
+/// The current limit is the lowest of 6073h, 2415h, the motor's i²t and the
+/// power stage's (issue 34): a 140 % cst demand with 6073h = 300 % goes
+/// through until the loop reports its power stage's limit of 2.4 A (1200 ‰ of
+/// the 2 A rated current): then 6077h/6078h settle at 1200 ‰ with bit 11;
+/// its i²t warning sets bit 7; its rated current 1 A while its i²t limits
+/// (500 ‰); 6073h lowered to 40 % is the lowest again (400 ‰); the stage's
+/// limit gone, 6073h raised: the demand passes, bits 7 and 11 clear.
+#[test]
+fn c038_the_current_limit_is_the_lowest_of_6073h_and_the_power_stages() {
+    let mut r = Rig::new(1.0e-3, true, 0);
+    r.od.set(0x6071, 0, 1400).unwrap();
+    let settle = |r: &mut Rig| {
+        for _ in 0..30 {
+            r.cycle();
+        }
+        (
+            r.get(0x6077),
+            r.get(0x6078),
+            r.get(0x6041) & (SW_LIMIT | SW_WARNING),
+        )
+    };
+    assert_eq!(settle(&mut r), (1400, 1400, 0));
+    r.seam.stage_limit_a = 2.4;
+    assert_eq!(settle(&mut r), (1200, 1200, SW_LIMIT), "the stage's maximum");
+    r.seam.stage_warning = true;
+    assert_eq!(
+        settle(&mut r),
+        (1200, 1200, SW_LIMIT | SW_WARNING),
+        "its i²t warning"
+    );
+    r.seam.stage_limit_a = 1.0;
+    assert_eq!(settle(&mut r), (500, 500, SW_LIMIT | SW_WARNING), "its i²t limit");
+    r.od.set(0x6073, 0, 400).unwrap();
+    assert_eq!(
+        settle(&mut r),
+        (400, 400, SW_LIMIT | SW_WARNING),
+        "6073h the lowest"
+    );
+    r.seam.stage_limit_a = f32::INFINITY;
+    r.seam.stage_warning = false;
+    r.od.set(0x6073, 0, 3000).unwrap();
+    assert_eq!(settle(&mut r), (1400, 1400, 0));
 }

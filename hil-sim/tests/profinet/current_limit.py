@@ -1,0 +1,183 @@
+"""The current limit through the PROFIdrive parameter access on the
+electrical plant (issue 34; C-038, P-186): profinet-py (0.6.6) as the IO
+controller of `hil-sim serve --fieldbus profinet --plant electrical`, the
+Example Function block of fb.py on its cyclic data (telegram 2, torque
+control, PNU 1500 = 0x04 through PKW).
+
+  1. Enable in torque control; 6087h (torque slope) = 0 through PKW (the
+     demand steps); 6073h (max current, per mille of 6075h) is
+     written to 250 through PKW (PNU = the object's index, docs/pnu.md) and
+     read back.
+  2. target_torque = +-1000 per mille (flipped every 20 ms, so the free
+     rotor stays slow): the torque actual value of the response telegram
+     (6077h = kt x the measured iq, per mille of 6076h) never above 250 + 2 %
+     and |6077h| within 2 % of 250 in 95 % of the settled samples; PNU 1102
+     (6078h, the measured current) read through PKW while +1000 is
+     commanded: 250 within 2 %.
+  3. 6073h back to 3000 through PKW: the same demand reaches +-1000 (within
+     2 %).
+
+One line:  scenario C-038: ok|FAIL: ...
+
+With --short (serve's `--plant-fault short`: leg a of axis A shorted to
+the DC link's negative rail through 1 ohm behind its current sensor) the
+scenario is the over-current trip instead (P-030, E-089):
+
+  1. The enable in torque control faults the axis once the power stage is
+     on (ZSW1 bit 3, not enabled); PNU 1600 (the last error, event x 16 +
+     cause) = 33 x 16 + 2: event 33 "Overcurrent" from the current loop;
+     the torque actual value 0 in the samples after it (the gates off).
+  2. fault_reset (CW1 bit 7's rising edge) clears the fault (the short shows
+     only with the gates on); drive_enable again faults again.
+
+One line:  scenario P-030: ok|FAIL: ...
+"""
+
+import argparse
+import gc
+import logging
+import sys
+import time
+
+import profinet
+from profinet.util import get_mac
+
+import pnctl
+from fb import OPMODE_TORQUE, OP, PKW_READ, PKW_WRITE, ExampleFB
+from pnctl import Scenario, ms
+
+FLIP_S = 0.020
+SETTLE_S = 0.006
+SETTLE_SAMPLES = 4
+MAX_CURRENT = 0x6073
+TORQUE_SLOPE = 0x6087
+
+
+def square(fb, per_mille, seconds):
+    """target_torque = +-per_mille flipped every FLIP_S; (6077h, the sign
+    commanded) of the samples at least SETTLE_S after a flip."""
+    t0 = time.monotonic()
+    flip_at, sign, out, since = t0, 1, [], 0
+    while time.monotonic() - t0 < seconds:
+        now = time.monotonic()
+        if now - flip_at >= FLIP_S:
+            flip_at, sign, since = now, -sign, 0
+        fb.i.target_torque = sign * per_mille
+        n = len(fb.samples)
+        fb.cycle()
+        if len(fb.samples) > n:
+            since += 1
+            # settled: SETTLE_S and SETTLE_SAMPLES since the flip (a sample
+            # delayed on a loaded machine carries an older value)
+            if time.monotonic() - flip_at >= SETTLE_S and since > SETTLE_SAMPLES:
+                out.append((fb.o.current_actual_value, sign))
+        time.sleep(0.0005)
+    fb.i.target_torque = 0
+    return out
+
+
+def limited(sc, frames, target, what):
+    over = [v for v, _ in frames if abs(v) > 1.02 * target]
+    # the magnitude: a sample delayed by a stall of the controller's
+    # threads may carry the other sign's value
+    off = [v for v, _ in frames if abs(abs(v) - target) > 0.02 * target]
+    sc.check(len(frames) > 50, f"{what}: {len(frames)} settled samples")
+    sc.check(not over, f"{what}: |6077h| never above {target} + 2 %: above in {len(over)}: {over[:6]}")
+    sc.check(len(off) <= 0.05 * len(frames),
+             f"{what}: |6077h| within 2 % of {target} in {len(frames) - len(off)} of {len(frames)} settled samples "
+             f"(range {min(v for v, _ in frames)}..{max(v for v, _ in frames)}); off: {off[:6]}")
+
+
+def run(fb, sc):
+    fb.i.operation_mode = OPMODE_TORQUE
+    fb.i.target_torque = 0
+    fb.i.drive_enable = True
+    dt = fb.until(lambda o: o.operation_mode_actual == OPMODE_TORQUE and o.zsw1 & 0x47 == OP, 5.0)
+    sc.check(dt is not None, f"enabled in torque control after {ms(dt)}")
+    # the torque slope 6087h = 0: a step (its default ramps 1000 %/s)
+    r = fb.pkw(PKW_WRITE, TORQUE_SLOPE, 0, 0)
+    sc.check(r == (PKW_WRITE, 0), f"PKW write 6087h = 0 (torque steps): {r}")
+    r = fb.pkw(PKW_WRITE, MAX_CURRENT, 0, 250)
+    sc.check(r == (PKW_WRITE, 250), f"PKW write 6073h = 250: {r}")
+    r = fb.pkw(PKW_READ, MAX_CURRENT, 0)
+    sc.check(r == (PKW_READ, 250), f"PKW read 6073h: {r}")
+    limited(sc, square(fb, 1000, 0.4), 250, "6073h = 250, target_torque +-1000")
+    # PNU 1102 while +1000 is commanded (then as long negative: the rotor back)
+    fb.i.target_torque = 1000
+    fb.run_for(0.01)
+    r = fb.pkw(PKW_READ, 1102, 0)
+    fb.i.target_torque = -1000
+    fb.run_for(0.02)
+    fb.i.target_torque = 0
+    sc.check(r is not None and r[0] == PKW_READ and abs(r[1] - 250) <= 5, f"PKW read PNU 1102 (6078h) at +1000: {r} (want 250 +- 2 %)")
+    r = fb.pkw(PKW_WRITE, MAX_CURRENT, 0, 3000)
+    sc.check(r == (PKW_WRITE, 3000), f"PKW write 6073h = 3000: {r}")
+    frames = square(fb, 1000, 0.3)
+    top = max((abs(v) for v, _ in frames), default=0)
+    sc.check(abs(top - 1000) <= 20, f"6073h = 3000: target_torque +-1000 reaches |6077h| {top} (want 1000 +- 2 %)")
+    fb.i.drive_enable = False
+    fb.until(lambda o: o.zsw1 & 0x47 != OP, 2.0)
+
+
+def short(fb, sc):
+    def enable_into_it(what):
+        fb.i.drive_enable = True
+        dt = fb.until(lambda o: o.fault, 3.0)
+        sc.check(dt is not None and not fb.o.drive_is_enabled,
+                 f"{what}: fault (ZSW1 bit 3) after {ms(dt)}, ZSW1 {fb.o.zsw1:#06x}")
+        after = [o.current_actual_value for o in fb.run_for(0.05)][10:]
+        sc.check(after and all(abs(v) <= 10 for v in after),
+                 f"{what}: torque actual value after the trip {min(after, default=None)}..{max(after, default=None)} "
+                 f"(want 0 within 1 %: the gates off)")
+        r = fb.pkw(PKW_READ, 1600, 0)
+        sc.check(r == (PKW_READ, 33 * 16 + 2), f"{what}: PNU 1600 last error {r} (want 33 x 16 + 2 = {33 * 16 + 2})")
+
+    fb.i.operation_mode = OPMODE_TORQUE
+    fb.i.target_torque = 0
+    enable_into_it("enable into the shorted leg")
+    fb.i.drive_enable = False
+    fb.i.fault_reset = True
+    dt = fb.until(lambda o: not o.fault, 3.0)
+    sc.check(dt is not None, f"fault_reset: fault cleared after {ms(dt)} (the short needs the gates to show)")
+    fb.i.fault_reset = False
+    fb.run_for(0.05)
+    enable_into_it("enable again, the short still there")
+    fb.i.drive_enable = False
+
+
+def main():
+    ap = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
+    ap.add_argument("--iface", required=True)
+    ap.add_argument("--device-mac", required=True)
+    ap.add_argument("--gsdml", required=True)
+    ap.add_argument("--out-module", required=True, help="GSDML module ID for slot 1")
+    ap.add_argument("--in-module", required=True, help="GSDML module ID for slot 2")
+    ap.add_argument("--name", default="drive-el")
+    ap.add_argument("--ip", default="192.168.0.52")
+    ap.add_argument("--short", action="store_true", help="serve runs --plant-fault short: the over-current trip")
+    a = ap.parse_args()
+    gc.disable()  # as fb.py: a full collection would stall the cyclic thread
+    logging.getLogger("profinet").addHandler(pnctl.Records())
+    print(f"profinet-py {profinet.__version__} on {a.iface}", flush=True)
+    pnctl.tx_checksum_offload_off(a.iface)
+    src = get_mac(a.iface)
+    slots = pnctl.io_slots(a.gsdml, a.out_module, a.in_module)
+    info = pnctl.name_and_address(a.iface, src, a.device_mac.lower(), a.name, a.ip)
+    dev, ctl, out_slot, in_slot = pnctl.start_cyclic(info, a.iface, src, slots, watchdog=100)
+    sc = Scenario("P-030" if a.short else "C-038")
+    try:
+        fb = ExampleFB(ctl, out_slot, in_slot)
+        if fb.until(lambda o: o.identifier == 0xF0, 5.0) is None:
+            raise RuntimeError("no response telegram 0xF0 within 5 s")
+        (short if a.short else run)(fb, sc)
+    except Exception as e:  # noqa: BLE001 - the scenario's failure
+        sc.check(False, f"{type(e).__name__}: {e}")
+    finally:
+        ctl.stop()
+        dev.close()
+    print(sc.line(), flush=True)
+    return 1 if sc.failed else 0
+
+
+if __name__ == "__main__":
+    sys.exit(main())
