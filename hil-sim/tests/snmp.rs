@@ -264,12 +264,15 @@ fn p038_net_snmp_walks_gets_and_sets_the_agent_and_the_settings_survive_a_restar
             "{walk}"
         );
     }
-    // LLDP-MIB: chassis ID is the interface MAC, the local port table names both ports
+    // LLDP-MIB: the chassis ID is what the LLDPDU sends, the NameOfStation
+    // (local, 7) once named; the local port table names both ports
     let (ok, walk) = snmp(&line, "snmpwalk", &v2c("public", &[".1.0.8802.1.1.2"]));
     assert!(ok, "{walk}");
-    assert!(walk.contains(".1.0.8802.1.1.2.1.3.1.0 = INTEGER: 4"), "{walk}");
-    let mac_hex = line.device_mac.replace(':', " ").to_uppercase();
-    assert!(walk.contains(&mac_hex), "lldpLocChassisId {mac_hex}:\n{walk}");
+    assert!(walk.contains(".1.0.8802.1.1.2.1.3.1.0 = INTEGER: 7"), "{walk}");
+    assert!(
+        walk.contains(&format!(".1.0.8802.1.1.2.1.3.2.0 = STRING: \"{DEVICE_NAME}\"")),
+        "lldpLocChassisId {DEVICE_NAME}:\n{walk}"
+    );
     assert!(
         walk.contains(".1.0.8802.1.1.2.1.3.7.1.3.2 = STRING: \"port-002\""),
         "{walk}"

@@ -443,9 +443,12 @@ pub fn value<'a>(id: Id, r: u32, agent: &'a Agent, dev: &'a Device<'a>) -> Val<'
             7 => Val::Int(1),
             _ => Val::Int(if port == 1 || dev.link(port - 1) { 1 } else { 2 }),
         },
-        // macAddress(4)
-        Id::LocChassisIdSubtype => Val::Int(4),
-        Id::LocChassisId => Val::Str(dev.mac(0)),
+        // what the LLDPDU's chassis ID TLV sends (profinet::lldp::build_frame,
+        // IEC 61158-6-10): local(7), the NameOfStation, once named; before,
+        // macAddress(4), the interface MAC
+        Id::LocChassisIdSubtype => Val::Int(if dev.name_of_station.is_empty() { 4 } else { 7 }),
+        Id::LocChassisId if dev.name_of_station.is_empty() => Val::Str(dev.mac(0)),
+        Id::LocChassisId => Val::Str(dev.name_of_station),
         Id::LocPort(c) => match c {
             // locallyAssigned(7): the PROFINET port name
             2 => Val::Int(7),

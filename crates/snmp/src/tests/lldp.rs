@@ -244,3 +244,24 @@ fn p038_whole_lldp_walk_with_neighbours_on_both_ports_never_repeats() {
         5 + 6 + 1 + 5 + 2 + 12 + 4 + 6 + 4 + 16 + 12 + 12 + 8 + 8
     );
 }
+
+/// P-038: lldpLocChassisIdSubtype/lldpLocChassisId say what the LLDPDU's
+/// chassis ID TLV sends: the NameOfStation as local(7) once the device is
+/// named, the interface MAC as macAddress(4) before (a topology tool compares
+/// the neighbours' LLDPDUs with these).
+#[test]
+fn p038_loc_chassis_id_is_what_the_lldpdu_sends() {
+    let named = dev();
+    let subtype = [1, 0, 8802, 1, 1, 2, 1, 3, 1, 0];
+    let id = [1, 0, 8802, 1, 1, 2, 1, 3, 2, 0];
+    assert_eq!(get_int(&named, &subtype), 7);
+    let v = one(&named, GET, &id);
+    assert_eq!((v.1, &v.2[..v.3]), (4, &b"drive-1"[..]));
+    let unnamed = Device {
+        name_of_station: b"",
+        ..dev()
+    };
+    assert_eq!(get_int(&unnamed, &subtype), 4);
+    let v = one(&unnamed, GET, &id);
+    assert_eq!((v.1, &v.2[..v.3]), (4, &[2u8, 0, 0, 0, 0, 1][..]));
+}
