@@ -21,6 +21,12 @@ pub(super) fn server(name: &str) -> DcpServer {
     )
 }
 
+/// `ev` is exactly the one IpSuite event of `suite`, `permanent` or not.
+#[track_caller]
+pub(super) fn assert_suite_event(ev: &[Event], suite: IpSuite, permanent: bool) {
+    assert_eq!(ev, [Event::IpSuite { suite, permanent }]);
+}
+
 pub(super) fn suite(ip: [u8; 4], mask: [u8; 4], gw: [u8; 4]) -> IpSuite {
     IpSuite {
         ip: Ipv4Addr::from(ip),
@@ -293,13 +299,7 @@ fn p009_set_ip_permanent_overwrites_the_stored_static_ip() {
         (PLC, 0xFEFD, ServiceId::Set)
     );
     assert_eq!(a.errors(), [(BlockType::IpParameter, BlockError::NoError)]);
-    assert_eq!(
-        &ev[..],
-        [Event::IpSuite {
-            suite: new,
-            permanent: true
-        }]
-    );
+    assert_suite_event(&ev, new, true);
     assert_eq!(s.ip_suite(), new);
     // Temporary: applied, reported as temporary (the store clears its copy).
     let tmp = suite([10, 0, 0, 8], [255, 0, 0, 0], [10, 0, 0, 1]);
@@ -308,13 +308,7 @@ fn p009_set_ip_permanent_overwrites_the_stored_static_ip() {
         Nanos::ZERO,
         &set(&[set_block(BlockType::IpParameter, 0, Value::IpParameter(tmp))]),
     );
-    assert_eq!(
-        &ev[..],
-        [Event::IpSuite {
-            suite: tmp,
-            permanent: false
-        }]
-    );
+    assert_suite_event(&ev, tmp, false);
     assert_eq!(s.ip_suite(), tmp);
     // All zero clears the address.
     let (_, ev) = run(
@@ -326,13 +320,7 @@ fn p009_set_ip_permanent_overwrites_the_stored_static_ip() {
             Value::IpParameter(IpSuite::UNSET),
         )]),
     );
-    assert_eq!(
-        &ev[..],
-        [Event::IpSuite {
-            suite: IpSuite::UNSET,
-            permanent: true
-        }]
-    );
+    assert_suite_event(&ev, IpSuite::UNSET, true);
 }
 
 #[test]

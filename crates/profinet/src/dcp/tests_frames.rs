@@ -13,7 +13,7 @@
 use std::vec::Vec;
 
 use super::pdu::*;
-use super::tests::{server, suite, PLC};
+use super::tests::{assert_suite_event, server, suite, PLC};
 use super::*;
 use nanos::Nanos;
 
@@ -166,24 +166,12 @@ fn p009_profinet_py_set_ip_overwrites_the_static_ip() {
     let (f, _, ev) = answer(&mut s, Nanos::ZERO, SET_IP_PERM);
     assert_eq!(pnpy_set_result(&f), 0);
     let new = suite([192, 168, 0, 50], [255, 255, 255, 0], [192, 168, 0, 1]);
-    assert_eq!(
-        &ev[..],
-        [Event::IpSuite {
-            suite: new,
-            permanent: true
-        }]
-    );
+    assert_suite_event(&ev, new, true);
     assert_eq!(s.ip_suite(), new);
     let (f, _, ev) = answer(&mut s, Nanos::ZERO, SET_IP_TEMP);
     assert_eq!(pnpy_set_result(&f), 0);
     let tmp = suite([10, 0, 0, 7], [255, 0, 0, 0], [0, 0, 0, 0]);
-    assert_eq!(
-        &ev[..],
-        [Event::IpSuite {
-            suite: tmp,
-            permanent: false
-        }]
-    );
+    assert_suite_event(&ev, tmp, false);
 }
 
 #[test]

@@ -403,8 +403,9 @@ fn p040_pdev_answers_dissect_without_malformed_packets() {
     ] {
         assert_eq!(r.read(sub, i).0, OK);
     }
-    let text = crate::tests_tshark::dissect(&r.frames, "dcerpc && ip.src == 192.168.0.50");
-    let Some(text) = text else { return };
+    let Some(text) = crate::tests_tshark::device_rpc(&r.frames) else {
+        return;
+    };
     for name in [
         "PDPortDataReal",
         "PDPortDataAdjust",
@@ -436,8 +437,9 @@ fn p039_im0_filter_data_names_the_dap_submodule_and_dissects() {
     // read only
     let w = r.record(true, 0, 1, crate::cm::record::index::IM0_FILTER_DATA, &want);
     assert_eq!(w.0, rw(0xB6, true));
-    let text = crate::tests_tshark::dissect(&r.frames, "dcerpc && ip.src == 192.168.0.50");
-    let Some(text) = text else { return };
+    let Some(text) = crate::tests_tshark::device_rpc(&r.frames) else {
+        return;
+    };
     assert!(
         text.contains("I&M0FilterData") || text.contains("IM0FilterData"),
         "not dissected"
@@ -467,8 +469,9 @@ fn p029_p040_real_identification_data_lists_the_dap_and_the_plugged_modules() {
         &want,
     );
     assert_eq!(w.0, rw(0xB6, true));
-    let text = crate::tests_tshark::dissect(&r.frames, "dcerpc && ip.src == 192.168.0.50");
-    let Some(text) = text else { return };
+    let Some(text) = crate::tests_tshark::device_rpc(&r.frames) else {
+        return;
+    };
     assert!(text.contains("RealIdentificationData"), "not dissected");
 }
 
