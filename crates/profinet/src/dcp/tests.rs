@@ -155,6 +155,16 @@ impl Answer {
     }
 }
 
+/// A Set of the one block `kind` with `qualifier` and `value` at time zero.
+fn set_one(
+    s: &mut DcpServer,
+    kind: BlockType,
+    qualifier: u16,
+    value: Value<'_>,
+) -> (Option<(Answer, Nanos)>, Events) {
+    run(s, Nanos::ZERO, &set(&[set_block(kind, qualifier, value)]))
+}
+
 fn run(s: &mut DcpServer, now: Nanos, frame: &[u8]) -> (Option<(Answer, Nanos)>, Events) {
     let mut out = [0u8; 1514];
     let o = s.handle_frame(now, frame, &mut out);
@@ -288,11 +298,7 @@ fn p008_identify_response_delay_is_spread_by_the_mac() {
 fn p009_set_ip_permanent_overwrites_the_stored_static_ip() {
     let mut s = server("drive-1");
     let new = suite([10, 0, 0, 7], [255, 0, 0, 0], [0, 0, 0, 0]);
-    let (a, ev) = run(
-        &mut s,
-        Nanos::ZERO,
-        &set(&[set_block(BlockType::IpParameter, 1, Value::IpParameter(new))]),
-    );
+    let (a, ev) = set_one(&mut s, BlockType::IpParameter, 1, Value::IpParameter(new));
     let a = a.unwrap().0;
     assert_eq!(
         (a.eth_dst, a.frame_id, a.header.service),
@@ -303,22 +309,15 @@ fn p009_set_ip_permanent_overwrites_the_stored_static_ip() {
     assert_eq!(s.ip_suite(), new);
     // Temporary: applied, reported as temporary (the store clears its copy).
     let tmp = suite([10, 0, 0, 8], [255, 0, 0, 0], [10, 0, 0, 1]);
-    let (_, ev) = run(
-        &mut s,
-        Nanos::ZERO,
-        &set(&[set_block(BlockType::IpParameter, 0, Value::IpParameter(tmp))]),
-    );
+    let (_, ev) = set_one(&mut s, BlockType::IpParameter, 0, Value::IpParameter(tmp));
     assert_suite_event(&ev, tmp, false);
     assert_eq!(s.ip_suite(), tmp);
     // All zero clears the address.
-    let (_, ev) = run(
+    let (_, ev) = set_one(
         &mut s,
-        Nanos::ZERO,
-        &set(&[set_block(
-            BlockType::IpParameter,
-            1,
-            Value::IpParameter(IpSuite::UNSET),
-        )]),
+        BlockType::IpParameter,
+        1,
+        Value::IpParameter(IpSuite::UNSET),
     );
     assert_suite_event(&ev, IpSuite::UNSET, true);
 }
@@ -339,11 +338,7 @@ fn p009_invalid_ip_suites_are_refused_and_change_nothing() {
         suite([0; 4], [255, 255, 255, 0], [0; 4]),
     ] {
         assert!(!server::ip_suite_valid(&bad), "{bad:?}");
-        let (a, ev) = run(
-            &mut s,
-            Nanos::ZERO,
-            &set(&[set_block(BlockType::IpParameter, 1, Value::IpParameter(bad))]),
-        );
+        let (a, ev) = set_one(&mut s, BlockType::IpParameter, 1, Value::IpParameter(bad));
         assert_eq!(
             a.unwrap().0.errors(),
             [(BlockType::IpParameter, BlockError::SuboptionNotSet)]
@@ -372,11 +367,7 @@ fn p009_invalid_ip_suites_are_refused_and_change_nothing() {
 #[test]
 fn p007_set_name_of_station_permanent_and_temporary() {
     let mut s = server("drive-1");
-    let (a, ev) = run(
-        &mut s,
-        Nanos::ZERO,
-        &set(&[set_block(BlockType::NameOfStation, 1, Value::Bytes(b"axis-a"))]),
-    );
+    let (a, ev) = set_one(&mut s, BlockType::NameOfStation, 1, Value::Bytes(b"axis-a"));
     assert_eq!(
         a.unwrap().0.errors(),
         [(BlockType::NameOfStation, BlockError::NoError)]
@@ -390,11 +381,7 @@ fn p007_set_name_of_station_permanent_and_temporary() {
         }]
     );
     assert_eq!(s.name_of_station(), &name);
-    let (_, ev) = run(
-        &mut s,
-        Nanos::ZERO,
-        &set(&[set_block(BlockType::NameOfStation, 0, Value::Bytes(b""))]),
-    );
+    let (_, ev) = set_one(&mut s, BlockType::NameOfStation, 0, Value::Bytes(b""));
     assert_eq!(
         &ev[..],
         [Event::NameOfStation {
@@ -409,11 +396,7 @@ fn p007_set_name_of_station_permanent_and_temporary() {
 fn p007_invalid_name_is_refused_with_suboption_not_set() {
     let mut s = server("drive-1");
     for bad in [&b"Drive-1"[..], b"1.2.3.4", b"port-001", b"a..b", &[b'a'; 241]] {
-        let (a, ev) = run(
-            &mut s,
-            Nanos::ZERO,
-            &set(&[set_block(BlockType::NameOfStation, 1, Value::Bytes(bad))]),
-        );
+        let (a, ev) = set_one(&mut s, BlockType::NameOfStation, 1, Value::Bytes(bad));
         assert_eq!(
             a.unwrap().0.errors(),
             [(BlockType::NameOfStation, BlockError::SuboptionNotSet)]
@@ -527,15 +510,7 @@ fn reset_to_factory_modes() {
         (0x0010, ResetMode::All, true),
     ] {
         let mut s = server("drive-1");
-        let (a, ev) = run(
-            &mut s,
-            Nanos::ZERO,
-            &set(&[set_block(
-                BlockType::ControlResetToFactory,
-                qualifier,
-                Value::Empty,
-            )]),
-        );
+        let (a, ev) = set_one(&mut s, BlockType::ControlResetToFactory, qualifier, Value::Empty);
         assert_eq!(
             a.unwrap().0.errors(),
             [(BlockType::ControlResetToFactory, BlockError::NoError)]
@@ -557,11 +532,7 @@ fn reset_to_factory_modes() {
         }
     }
     let mut s = server("drive-1");
-    let (_, ev) = run(
-        &mut s,
-        Nanos::ZERO,
-        &set(&[set_block(BlockType::ControlFactoryReset, 0, Value::Empty)]),
-    );
+    let (_, ev) = set_one(&mut s, BlockType::ControlFactoryReset, 0, Value::Empty);
     assert_eq!(ev[0], Event::ResetToFactory(ResetMode::All));
     assert!(s.name_of_station().is_empty());
 }
