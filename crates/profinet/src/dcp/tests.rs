@@ -21,6 +21,12 @@ pub(super) fn server(name: &str) -> DcpServer {
     )
 }
 
+/// `ev` is exactly the one NameOfStation event of `name`, `permanent` or not.
+#[track_caller]
+pub(super) fn assert_name_event(ev: &[Event], name: NameOfStation, permanent: bool) {
+    assert_eq!(ev, [Event::NameOfStation { name, permanent }]);
+}
+
 /// `ev` is exactly the one IpSuite event of `suite`, `permanent` or not.
 #[track_caller]
 pub(super) fn assert_suite_event(ev: &[Event], suite: IpSuite, permanent: bool) {
@@ -373,22 +379,10 @@ fn p007_set_name_of_station_permanent_and_temporary() {
         [(BlockType::NameOfStation, BlockError::NoError)]
     );
     let name: NameOfStation = "axis-a".parse().unwrap();
-    assert_eq!(
-        &ev[..],
-        [Event::NameOfStation {
-            name: name.clone(),
-            permanent: true
-        }]
-    );
+    assert_name_event(&ev, name.clone(), true);
     assert_eq!(s.name_of_station(), &name);
     let (_, ev) = set_one(&mut s, BlockType::NameOfStation, 0, Value::Bytes(b""));
-    assert_eq!(
-        &ev[..],
-        [Event::NameOfStation {
-            name: NameOfStation::EMPTY,
-            permanent: false
-        }]
-    );
+    assert_name_event(&ev, NameOfStation::EMPTY, false);
     assert!(s.name_of_station().is_empty());
 }
 

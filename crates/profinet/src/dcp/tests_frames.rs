@@ -13,7 +13,7 @@
 use std::vec::Vec;
 
 use super::pdu::*;
-use super::tests::{assert_suite_event, server, suite, PLC};
+use super::tests::{assert_name_event, assert_suite_event, server, suite, PLC};
 use super::*;
 use nanos::Nanos;
 
@@ -140,23 +140,11 @@ fn p007_profinet_py_set_name_permanent_and_temporary() {
     let (f, _, ev) = answer(&mut s, Nanos::ZERO, SET_NAME_PERM);
     assert_eq!(pnpy_set_result(&f), 0);
     let name: NameOfStation = "drive-1".parse().unwrap();
-    assert_eq!(
-        &ev[..],
-        [Event::NameOfStation {
-            name,
-            permanent: true
-        }]
-    );
+    assert_name_event(&ev, name, true);
     let (f, _, ev) = answer(&mut s, Nanos::ZERO, SET_NAME_TEMP);
     assert_eq!(pnpy_set_result(&f), 0);
     let name: NameOfStation = "axis-a".parse().unwrap();
-    assert_eq!(
-        &ev[..],
-        [Event::NameOfStation {
-            name,
-            permanent: false
-        }]
-    );
+    assert_name_event(&ev, name, false);
     assert_eq!(s.name_of_station().as_str(), "axis-a");
 }
 
