@@ -426,8 +426,9 @@ pub struct Rec {
     pub index: u16,
 }
 
-/// An IODWriteReqHeader (64 bytes) for `len` bytes of record data.
-pub fn write_header(w: &mut W, seq: u16, ar: Uuid, r: Rec, len: u32) {
+/// What a read and a write request header share: SeqNumber, ARUUID, API 0,
+/// the address, RecordDataLength.
+fn rw_head(seq: u16, ar: Uuid, r: Rec, len: u32) -> W {
     let mut b = W::default();
     b.u16(seq)
         .bytes(&ar.0)
@@ -436,24 +437,21 @@ pub fn write_header(w: &mut W, seq: u16, ar: Uuid, r: Rec, len: u32) {
         .u16(r.subslot)
         .u16(0)
         .u16(r.index)
-        .u32(len)
-        .bytes(&[0; 24]);
+        .u32(len);
+    b
+}
+
+/// An IODWriteReqHeader (64 bytes) for `len` bytes of record data.
+pub fn write_header(w: &mut W, seq: u16, ar: Uuid, r: Rec, len: u32) {
+    let mut b = rw_head(seq, ar, r, len);
+    b.bytes(&[0; 24]);
     w.block(0x0008, &b.0);
 }
 
 /// An IODReadReqHeader (64 bytes) asking for at most `len` bytes.
 pub fn read_header(seq: u16, ar: Uuid, r: Rec, len: u32) -> Vec<u8> {
-    let mut b = W::default();
-    b.u16(seq)
-        .bytes(&ar.0)
-        .u32(0)
-        .u16(r.slot)
-        .u16(r.subslot)
-        .u16(0)
-        .u16(r.index)
-        .u32(len)
-        .bytes(&Uuid::NIL.0)
-        .bytes(&[0; 8]);
+    let mut b = rw_head(seq, ar, r, len);
+    b.bytes(&Uuid::NIL.0).bytes(&[0; 8]);
     let mut w = W::default();
     w.block(0x0009, &b.0);
     w.0

@@ -15,6 +15,7 @@
     clippy::panic
 )]
 
+mod line;
 use drive_ecat::boot::{BootSlots, ImageHeader, IMAGE_HEADER_LEN};
 use drive_ecat::runtime::Drive;
 use ethercrab::SubDeviceRef;
@@ -22,7 +23,6 @@ use hil_sim::esc::{Esc, EscConfig};
 use hil_sim::sim::{FirmwareFlash, Node, SimFlash, Simulation};
 use nanos::Nanos;
 use std::cell::RefCell;
-use std::sync::atomic::Ordering;
 use std::time::Instant;
 
 const FILE_LEN: usize = 256 * 1024;
@@ -94,13 +94,7 @@ fn file(version: u32) -> Vec<u8> {
 }
 
 fn main() {
-    let args: Vec<String> = std::env::args().collect();
-    let runs: usize = args
-        .iter()
-        .position(|a| a == "--runs")
-        .and_then(|i| args.get(i + 1))
-        .and_then(|s| s.parse().ok())
-        .unwrap_or(3);
+    let runs = line::runs_arg(3);
     let mut sii = [0u8; ecat::sii::EEPROM_BYTES];
     let n = ecat::build_sii(&drive_ecat::DEVICE, &mut sii).expect("SII");
     let mut slots = BootSlots::new(FirmwareFlash::new());
@@ -113,52 +107,38 @@ fn main() {
     };
     let sim = RefCell::new(Simulation::with_nodes(vec![node]));
     let image = file(2);
-    let config = ethercrab::MainDeviceConfig {
-        dc_static_sync_iterations: 100,
-        ..Default::default()
-    };
-    let results = hil_sim::master::run_with(
-        &sim,
-        hil_sim::master::in_process_timeouts(),
-        config,
-        async |md, clock| {
-            let group = md
-                .init_single_group::<2, 64>(|| clock.load(Ordering::Relaxed))
+    let results = line::with_first_subdevice(&sim, async |sd, _clock| {
+        for state in [1u16, 3] {
+            sd.register_write(esc::regs::AL_CONTROL, state)
                 .await
-                .expect("init");
-            let sd = group.subdevice(md, 0).expect("slave");
-            for state in [1u16, 3] {
-                sd.register_write(esc::regs::AL_CONTROL, state)
-                    .await
-                    .expect("AL control");
-                let _: u16 = sd.register_read(esc::regs::AL_STATUS).await.expect("AL status");
-            }
-            let st: u16 = sd.register_read(esc::regs::AL_STATUS).await.expect("AL status");
-            assert_eq!(st, 3, "Bootstrap");
-            let mut mbx = Mbx { counter: 0 };
-            let mut results = Vec::new();
-            for _ in 0..runs {
-                let (t0, f0) = {
-                    let s = sim.borrow();
-                    (s.now().as_ns(), s.frames())
-                };
-                let start = Instant::now();
-                assert_eq!(mbx.foe(&sd, 2, 0, b"firmware.efw").await, (4, 0), "WRQ acked");
-                let mut chunks: Vec<&[u8]> = image.chunks(SEGMENT).collect();
-                if image.len() % SEGMENT == 0 {
-                    chunks.push(&[]);
-                }
-                for (i, c) in chunks.iter().enumerate() {
-                    let k = i as u32 + 1;
-                    assert_eq!(mbx.foe(&sd, 3, k, c).await, (4, k), "packet {k}");
-                }
-                let wall = start.elapsed();
+                .expect("AL control");
+            let _: u16 = sd.register_read(esc::regs::AL_STATUS).await.expect("AL status");
+        }
+        let st: u16 = sd.register_read(esc::regs::AL_STATUS).await.expect("AL status");
+        assert_eq!(st, 3, "Bootstrap");
+        let mut mbx = Mbx { counter: 0 };
+        let mut results = Vec::new();
+        for _ in 0..runs {
+            let (t0, f0) = {
                 let s = sim.borrow();
-                results.push((wall, s.now().as_ns() - t0, s.frames() - f0, chunks.len()));
+                (s.now().as_ns(), s.frames())
+            };
+            let start = Instant::now();
+            assert_eq!(mbx.foe(&sd, 2, 0, b"firmware.efw").await, (4, 0), "WRQ acked");
+            let mut chunks: Vec<&[u8]> = image.chunks(SEGMENT).collect();
+            if image.len() % SEGMENT == 0 {
+                chunks.push(&[]);
             }
-            results
-        },
-    );
+            for (i, c) in chunks.iter().enumerate() {
+                let k = i as u32 + 1;
+                assert_eq!(mbx.foe(&sd, 3, k, c).await, (4, k), "packet {k}");
+            }
+            let wall = start.elapsed();
+            let s = sim.borrow();
+            results.push((wall, s.now().as_ns() - t0, s.frames() - f0, chunks.len()));
+        }
+        results
+    });
     {
         let mut s = sim.borrow_mut();
         let slots = s.drives_mut()[0].drive.boot_slots_mut().expect("slots");

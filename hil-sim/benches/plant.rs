@@ -18,23 +18,8 @@ use hil_sim::sim::{SimFlash, CONTROL_CYCLE};
 use nanos::Nanos;
 use std::time::{Duration, Instant};
 
-const INC_PER_REV: f64 = 1_048_576.0;
-
-/// The demo's profile: 10 revolutions out and back, cosine S-curves of
-/// `t_move` cycles each, 150 cycles dwell between and after.
-fn profile(k: usize, t_move: usize) -> f64 {
-    let phase = |k: usize| (1.0 - (std::f64::consts::PI * k as f64 / t_move as f64).cos()) / 2.0;
-    let x = if k < t_move {
-        phase(k)
-    } else if k < t_move + 150 {
-        1.0
-    } else if k < 2 * t_move + 150 {
-        1.0 - phase(k - t_move - 150)
-    } else {
-        0.0
-    };
-    x * 10.0 * INC_PER_REV
-}
+mod common;
+use common::{enable_csp, follow_profile, SimDrive};
 
 struct Figures {
     ferr_max: f64,
@@ -57,7 +42,7 @@ fn run(model: PlantModel) -> Figures {
     let mut pos = [0i32; 2];
     let mut now = Nanos::ZERO;
     let mut spent = Duration::ZERO;
-    let mut step = |drive: &mut drive_ecat::runtime::Drive<SimFlash>, pos: &mut [i32; 2], now: &mut Nanos| {
+    let mut step = |drive: &mut SimDrive, pos: &mut [i32; 2], now: &mut Nanos| {
         *now += CONTROL_CYCLE;
         let io = [AxisIo::ready(pos[0]), AxisIo::ready(pos[1])];
         let cmd = drive.control_cycle_with(*now, &io, [true, true]);
@@ -83,28 +68,10 @@ fn run(model: PlantModel) -> Figures {
         }
         spent += t0.elapsed();
     };
-    for cw in [0x06, 0x07, 0x0F, 0x0F, 0x0F] {
-        for axis in 0..2u16 {
-            drive.objects_mut().set(0x6040 + 0x800 * axis, 0, cw).unwrap();
-            drive.objects_mut().set(0x607A + 0x800 * axis, 0, 0).unwrap();
-        }
-        for _ in 0..5 {
-            step(&mut drive, &mut pos, &mut now);
-        }
-    }
-    let t_move = 1500;
-    let total = 2 * t_move + 300;
-    let (mut max, mut sq) = (0.0f64, 0.0f64);
-    for k in 0..total {
-        let target = profile(k, t_move).round() as i64;
-        for axis in 0..2u16 {
-            drive.objects_mut().set(0x607A + 0x800 * axis, 0, target).unwrap();
-        }
-        step(&mut drive, &mut pos, &mut now);
-        let ferr = drive.objects().get(0x60F4, 0).unwrap() as f64;
-        max = max.max(ferr.abs());
-        sq += ferr * ferr;
-    }
+    enable_csp(&mut drive, |d| {
+        step(d, &mut pos, &mut now);
+    });
+    let (max, sq, total) = follow_profile(&mut drive, 1500, |d| step(d, &mut pos, &mut now));
     let seconds = now.as_ns() as f64 * 1e-9;
     let (iq_max, id_max) = el
         .first()

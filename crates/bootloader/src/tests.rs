@@ -87,6 +87,11 @@ fn update(mem: &mut [u8], running: Slot, f: &[u8]) -> Result<Slot, boot::UpdateE
     install(&mut app, f)
 }
 
+/// The running A downloads version 2 into B (5000 bytes of 0xB2).
+fn update_to_b(mem: &mut [u8]) -> Result<Slot, boot::UpdateError> {
+    update(mem, Slot::A, &file(Slot::B, &body_for(Slot::B, 5000, 0xB2), 2))
+}
+
 fn boot(mem: &mut [u8]) -> Outcome {
     select(&mut slots(Mem::new(mem, NoMirror)), &L, &PUBLIC_KEY)
 }
@@ -143,14 +148,7 @@ fn a_confirmed_image_starts_with_its_vector_table() {
 fn a_new_image_starts_on_trial_and_stays_once_confirmed() {
     let mut mem = region();
     factory(&mut mem);
-    assert_eq!(
-        update(
-            &mut mem,
-            Slot::A,
-            &file(Slot::B, &body_for(Slot::B, 5000, 0xB2), 2)
-        ),
-        Ok(Slot::B)
-    );
+    assert_eq!(update_to_b(&mut mem), Ok(Slot::B));
     let st = start_of(boot(&mut mem));
     assert_eq!((st.slot, st.decision.trial, st.version), (Slot::B, true, 2));
     assert_eq!(st.entry.vtor, 0x1_8400);
@@ -167,12 +165,7 @@ fn a_new_image_starts_on_trial_and_stays_once_confirmed() {
 fn an_unconfirmed_image_is_rolled_back_at_the_next_reset() {
     let mut mem = region();
     factory(&mut mem);
-    update(
-        &mut mem,
-        Slot::A,
-        &file(Slot::B, &body_for(Slot::B, 5000, 0xB2), 2),
-    )
-    .unwrap();
+    update_to_b(&mut mem).unwrap();
     assert_eq!(start_of(boot(&mut mem)).slot, Slot::B);
     // B never confirms
     let st = start_of(boot(&mut mem));
@@ -184,12 +177,7 @@ fn an_unconfirmed_image_is_rolled_back_at_the_next_reset() {
 fn a_body_byte_flipped_after_the_download_is_never_started() {
     let mut mem = region();
     factory(&mut mem);
-    update(
-        &mut mem,
-        Slot::A,
-        &file(Slot::B, &body_for(Slot::B, 5000, 0xB2), 2),
-    )
-    .unwrap();
+    update_to_b(&mut mem).unwrap();
     let at = BootSlots::<Mem>::slot_len() + BootSlots::<Mem>::body_offset() + 1234;
     mem[at] ^= 0x10;
     for _ in 0..2 {
@@ -377,12 +365,7 @@ impl<F: Flash> Flash for ReadOnly<F> {
 fn without_marks_a_pending_image_is_not_started() {
     let mut mem = region();
     factory(&mut mem);
-    update(
-        &mut mem,
-        Slot::A,
-        &file(Slot::B, &body_for(Slot::B, 5000, 0xB2), 2),
-    )
-    .unwrap();
+    update_to_b(&mut mem).unwrap();
     let mut s = slots(ReadOnly(Mem::new(&mut mem, NoMirror)));
     let st = start_of(select(&mut s, &L, &PUBLIC_KEY));
     assert_eq!((st.slot, st.decision.trial), (Slot::A, false));

@@ -41,6 +41,14 @@ impl Rig {
         }
     }
 
+    /// In Operation enabled with `opts`, the motor turning (not at standstill).
+    fn moving(opts: Options) -> Rig {
+        let mut r = Rig::with(opts);
+        r.goto(State::OperationEnabled);
+        r.inp.standstill = false;
+        r
+    }
+
     /// One control cycle of 1 ms.
     fn step(&mut self) -> Outputs {
         self.t += Nanos::from_ms(1);
@@ -242,9 +250,7 @@ fn c005_enable_operation_gives_operation_enabled() {
 
 #[test]
 fn c006_disable_operation_gives_switched_on() {
-    let mut r = Rig::new();
-    r.goto(State::OperationEnabled);
-    r.inp.standstill = false; // default 605Ch = 0: no ramp, at once
+    let mut r = Rig::moving(Options::default()); // default 605Ch = 0: no ramp, at once
     let out = r.cw(SWITCH_ON);
     assert_eq!(tr(&out), Some((5, State::OperationEnabled, State::SwitchedOn)));
     assert!(out.power_stage && !out.drive_function && !out.motion_enabled);
@@ -259,12 +265,10 @@ fn c006_disable_operation_option_codes() {
     assert_eq!(DisableOption::SlowDown.code(), 1);
 
     // 605Ch = 1: ramp in Operation enabled, T5 at standstill.
-    let mut r = Rig::with(Options {
+    let mut r = Rig::moving(Options {
         disable_operation: DisableOption::SlowDown,
         ..Options::default()
     });
-    r.goto(State::OperationEnabled);
-    r.inp.standstill = false;
     for _ in 0..3 {
         let out = r.cw(SWITCH_ON);
         assert_eq!(out.state, State::OperationEnabled);
@@ -292,9 +296,7 @@ fn c007_shutdown_from_switched_on_powers_off() {
 
 #[test]
 fn c008_shutdown_from_operation_enabled() {
-    let mut r = Rig::new();
-    r.goto(State::OperationEnabled);
-    r.inp.standstill = false;
+    let mut r = Rig::moving(Options::default());
     let out = r.cw(SHUTDOWN);
     assert_eq!(
         tr(&out),
@@ -305,12 +307,10 @@ fn c008_shutdown_from_operation_enabled() {
 
 #[test]
 fn c008_shutdown_option_codes() {
-    let mut r = Rig::with(Options {
+    let mut r = Rig::moving(Options {
         shutdown: DisableOption::SlowDown,
         ..Options::default()
     });
-    r.goto(State::OperationEnabled);
-    r.inp.standstill = false;
     let out = r.cw(SHUTDOWN);
     assert_eq!(out.state, State::OperationEnabled);
     assert_eq!(out.ramp, Ramp::Disable(Decel::SlowDown));
@@ -347,9 +347,7 @@ fn c009_disable_voltage_gives_switch_on_disabled() {
 #[test]
 fn c010_quick_stop_from_operation_enabled() {
     for cw in [QUICK_STOP, 0x000B, 0x0003] {
-        let mut r = Rig::new();
-        r.goto(State::OperationEnabled);
-        r.inp.standstill = false;
+        let mut r = Rig::moving(Options::default());
         let out = r.cw(cw);
         assert_eq!(
             tr(&out),
@@ -389,12 +387,10 @@ fn c010_quick_stop_option_codes() {
     assert_eq!(Options::default().quick_stop.code(), 2);
 
     // 0: coast. Power off at once, then Switch on disabled.
-    let mut r = Rig::with(Options {
+    let mut r = Rig::moving(Options {
         quick_stop: QuickStopOption::Coast,
         ..Options::default()
     });
-    r.goto(State::OperationEnabled);
-    r.inp.standstill = false;
     let out = r.cw(QUICK_STOP);
     assert_eq!(out.state, State::QuickStopActive);
     assert!(!out.power_stage && !out.brake_release);
@@ -403,12 +399,10 @@ fn c010_quick_stop_option_codes() {
 
     // 1..4: ramp with the deceleration, then T12 at standstill.
     for (i, d) in decels.iter().enumerate() {
-        let mut r = Rig::with(Options {
+        let mut r = Rig::moving(Options {
             quick_stop: QuickStopOption::try_from(i as i16 + 1).unwrap(),
             ..Options::default()
         });
-        r.goto(State::OperationEnabled);
-        r.inp.standstill = false;
         let out = r.cw(QUICK_STOP);
         assert_eq!(out.ramp, Ramp::QuickStop(*d));
         assert_eq!(r.step().state, State::QuickStopActive);
@@ -424,12 +418,10 @@ fn c010_quick_stop_option_codes() {
     // 5..8: ramp, then stay in Quick stop active holding; Enable operation does not
     // return (no T16); Disable voltage ends it.
     for (i, d) in decels.iter().enumerate() {
-        let mut r = Rig::with(Options {
+        let mut r = Rig::moving(Options {
             quick_stop: QuickStopOption::try_from(i as i16 + 5).unwrap(),
             ..Options::default()
         });
-        r.goto(State::OperationEnabled);
-        r.inp.standstill = false;
         r.cw(QUICK_STOP);
         r.inp.standstill = true;
         for cw in [QUICK_STOP, ENABLE, SHUTDOWN, SWITCH_ON] {
@@ -501,9 +493,7 @@ fn c013_losing_additional_enable() {
     }
 
     // A44 ≠ 1: Operation enabled → Switch on disabled at once (T9).
-    let mut r = Rig::new();
-    r.goto(State::OperationEnabled);
-    r.inp.standstill = false;
+    let mut r = Rig::moving(Options::default());
     r.inp.additional_enable = false;
     let out = r.step();
     assert_eq!(
@@ -513,12 +503,10 @@ fn c013_losing_additional_enable() {
     assert!(!out.power_stage);
 
     // A44 = 1: quick stop (T11) that runs to standstill although A60 stays off.
-    let mut r = Rig::with(Options {
+    let mut r = Rig::moving(Options {
         quick_stop_on_enable_loss: true,
         ..Options::default()
     });
-    r.goto(State::OperationEnabled);
-    r.inp.standstill = false;
     r.inp.additional_enable = false;
     let out = r.step();
     assert_eq!(
@@ -548,12 +536,10 @@ fn c014_losing_additional_enable_in_quick_stop() {
     assert!(!out.power_stage);
 
     // A44 = 1 quick stop: A60 back and lost again also ends it at once.
-    let mut r = Rig::with(Options {
+    let mut r = Rig::moving(Options {
         quick_stop_on_enable_loss: true,
         ..Options::default()
     });
-    r.goto(State::OperationEnabled);
-    r.inp.standstill = false;
     r.inp.additional_enable = false;
     assert_eq!(r.step().state, State::QuickStopActive);
     r.inp.additional_enable = true;
@@ -614,9 +600,7 @@ fn c015_supply_and_sto_force_switch_on_disabled() {
 #[test]
 fn c016_fault_reaction_then_fault() {
     // From Operation enabled with the 605Eh default (quick-stop ramp).
-    let mut r = Rig::new();
-    r.goto(State::OperationEnabled);
-    r.inp.standstill = false;
+    let mut r = Rig::moving(Options::default());
     let ev = FaultEvent {
         code: 0x4210,
         reaction: None,
@@ -689,12 +673,10 @@ fn c016_fault_reaction_option_codes() {
     // Each 605Eh value from Operation enabled.
     for v in 0i16..=4 {
         let reaction = FaultReaction::try_from(v).unwrap();
-        let mut r = Rig::with(Options {
+        let mut r = Rig::moving(Options {
             fault_reaction: reaction,
             ..Options::default()
         });
-        r.goto(State::OperationEnabled);
-        r.inp.standstill = false;
         r.dc.raise_fault(FaultEvent {
             code: 0x5000,
             reaction: None,
@@ -718,9 +700,7 @@ fn c016_fault_reaction_option_codes() {
     }
 
     // The event's own reaction wins over 605Eh.
-    let mut r = Rig::new();
-    r.goto(State::OperationEnabled);
-    r.inp.standstill = false;
+    let mut r = Rig::moving(Options::default());
     r.dc.raise_fault(FaultEvent {
         code: 0x2310,
         reaction: Some(FaultReaction::Coast),

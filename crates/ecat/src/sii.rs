@@ -356,6 +356,7 @@ mod tests {
         name: "Out",
         entries: &ENTRIES,
     }];
+    /// The crate's test device with another identity, names and PDOs.
     static DEV: Device = Device {
         identity: Identity {
             vendor_id: 0xB9,
@@ -363,38 +364,15 @@ mod tests {
             revision: 7,
             serial: 9,
         },
-        device_type: 0x0002_0192,
         name: "Dev",
         order_code: "ORD",
-        group: "Drives",
-        mailbox_out: MailboxSm {
-            start: 0x1000,
-            length: 128,
-            control: 0x26,
-        },
-        mailbox_in: MailboxSm {
-            start: 0x1080,
-            length: 128,
-            control: 0x22,
-        },
-        outputs: ProcessSm {
-            start: 0x1100,
-            control: 0x64,
-        },
-        inputs: ProcessSm {
-            start: 0x1180,
-            control: 0x20,
-        },
-        fmmus: &[FmmuUsage::Outputs, FmmuUsage::Inputs, FmmuUsage::MailboxStatus],
         mailbox_protocols: mailbox_protocol::COE,
-        coe_details: coe_details::SDO,
-        ports: 2,
         process_ram_end: 0x2000,
-        dc_modes: &[],
         rx_pdos: &RX,
         tx_pdos: &[],
         rx_assign: &[0x1600],
         tx_assign: &[],
+        ..crate::tests::DEV_DESC
     };
 
     #[test]

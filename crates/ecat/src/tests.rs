@@ -29,7 +29,7 @@ static TX: [Pdo; 1] = [Pdo {
     name: "Inputs",
     entries: &TX_ENTRIES,
 }];
-const DEV_DESC: Device = Device {
+pub(crate) const DEV_DESC: Device = Device {
     identity: Identity {
         vendor_id: 0xB9,
         product_code: 1,
@@ -952,18 +952,11 @@ fn eth_frame(n: usize) -> Vec<u8> {
 
 /// EoE fragments of `f` in `chunk`-byte pieces (EoE header + data each).
 fn eoe_fragments(f: &[u8], chunk: usize, frame_no: u8) -> Vec<Vec<u8>> {
-    let n = f.len().div_ceil(chunk);
-    f.chunks(chunk)
-        .enumerate()
-        .map(|(i, c)| {
-            let so = if i == 0 {
-                f.len().div_ceil(32)
-            } else {
-                i * chunk / 32
-            };
-            let h = crate::eoe::EoeHeader::fragment(i + 1 == n, i as u8, so as u8, frame_no);
+    crate::eoe::tests::fragments(f, chunk, frame_no)
+        .into_iter()
+        .map(|(h, c)| {
             let mut m = h.to_bytes().to_vec();
-            m.extend_from_slice(c);
+            m.extend_from_slice(&c);
             m
         })
         .collect()

@@ -51,7 +51,8 @@ struct Stats {
     max_rounded: f64,
 }
 
-fn measure(order: InterpolationOrder, ratio: CycleRatio, traj: &Trajectory) -> Stats {
+/// An interpolator of `order` at `ratio`, internal feedforward at 100 %.
+fn interpolator(order: InterpolationOrder, ratio: CycleRatio) -> FineInterpolator {
     let cfg = InterpolatorConfig {
         ratio,
         order,
@@ -59,7 +60,11 @@ fn measure(order: InterpolationOrder, ratio: CycleRatio, traj: &Trajectory) -> S
         velocity_feedforward_percent: 100.0,
         max_extrapolation: nanos::Nanos::from_ms(10),
     };
-    let mut ip = FineInterpolator::new(cfg).expect("config");
+    FineInterpolator::new(cfg).expect("config")
+}
+
+fn measure(order: InterpolationOrder, ratio: CycleRatio, traj: &Trajectory) -> Stats {
+    let mut ip = interpolator(order, ratio);
     let n = ratio.n() as usize;
     let tm = f64::from(ratio.master_ns()) * 1e-9;
     let tc = f64::from(ratio.control_ns()) * 1e-9;
@@ -92,14 +97,7 @@ fn measure(order: InterpolationOrder, ratio: CycleRatio, traj: &Trajectory) -> S
 }
 
 fn ns_per_cycle(order: InterpolationOrder, ratio: CycleRatio) -> f64 {
-    let cfg = InterpolatorConfig {
-        ratio,
-        order,
-        feedforward: FeedforwardSource::Internal,
-        velocity_feedforward_percent: 100.0,
-        max_extrapolation: nanos::Nanos::from_ms(10),
-    };
-    let mut ip = FineInterpolator::new(cfg).expect("config");
+    let mut ip = interpolator(order, ratio);
     ip.start(0);
     let n = ratio.n() as usize;
     let calls = 5_000_000usize;

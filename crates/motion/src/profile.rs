@@ -347,15 +347,7 @@ fn plan_pass(d: f64, v: f64, a: f64, target: i32, ve: f64, limits: ProfileLimits
     let mut plan = if dist(l.v) <= dn {
         direct_plan_to(vn, an, l.v, (dn - dist(l.v)) / l.v, ve, &l)
     } else {
-        let (mut lo, mut hi) = (ve, l.v);
-        for _ in 0..BISECTION_STEPS {
-            let mid = 0.5 * (lo + hi);
-            if dist(mid) <= dn {
-                lo = mid;
-            } else {
-                hi = mid;
-            }
-        }
+        let lo = bisect(&dist, ve, l.v, dn);
         direct_plan_to(vn, an, lo, ((dn - dist(lo)) / lo).max(0.0), ve, &l)
     };
     plan.dir = dir;
@@ -366,6 +358,20 @@ fn plan_pass(d: f64, v: f64, a: f64, target: i32, ve: f64, limits: ProfileLimits
 
 /// Bisection steps for the cruise velocity (2^-40 of the velocity limit).
 const BISECTION_STEPS: u32 = 40;
+
+/// The largest cruise velocity between `lo` and `hi` whose distance `dist` stays
+/// within `dn` (`dist` rising; `dist(lo) ≤ dn < dist(hi)`).
+fn bisect(dist: &impl Fn(f64) -> f64, mut lo: f64, mut hi: f64, dn: f64) -> f64 {
+    for _ in 0..BISECTION_STEPS {
+        let mid = 0.5 * (lo + hi);
+        if dist(mid) <= dn {
+            lo = mid;
+        } else {
+            hi = mid;
+        }
+    }
+    lo
+}
 
 /// Plans a position move from (`v`, `a`) (increments/s, /s²) over the
 /// distance `d` (increments) to `target`. `None`: nothing to do.
@@ -394,15 +400,7 @@ fn plan_move(d: f64, v: f64, a: f64, target: i32, limits: ProfileLimits) -> Opti
         direct_plan(vn, an, 0.0, 0.0, &l)
     } else {
         // f(lo) ≤ dn < f(hi); the rest of the distance is cruised at lo.
-        let (mut lo, mut hi) = (0.0, l.v);
-        for _ in 0..BISECTION_STEPS {
-            let mid = 0.5 * (lo + hi);
-            if dist(mid) <= dn {
-                lo = mid;
-            } else {
-                hi = mid;
-            }
-        }
+        let lo = bisect(&dist, 0.0, l.v, dn);
         let cruise = if lo > 0.0 {
             ((dn - dist(lo)) / lo).max(0.0)
         } else {

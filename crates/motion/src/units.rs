@@ -359,6 +359,14 @@ impl UnitProfile {
 mod tests {
     use super::*;
 
+    /// Metres times 10^`exponent`.
+    fn metres(exponent: i8) -> Distance {
+        Distance {
+            dimension: Dimension::Metre,
+            exponent,
+        }
+    }
+
     /// The 64-bit scaling gives exactly what the 128-bit form gives
     /// (where that fits i64), over edge and pseudo-random arguments.
     #[test]
@@ -463,23 +471,14 @@ mod tests {
         // rotational position: a feed of 5 mm/rev is ignored
         s.feed = Feed {
             value: 5,
-            unit: Some(Distance {
-                dimension: Dimension::Metre,
-                exponent: -3,
-            }),
+            unit: Some(metres(-3)),
         };
         assert_eq!(UnitProfile::new(s).unwrap().position.to_bus(REV).unwrap(), 1000);
         // position in mm, feed in µm/rev: 5000 µm = 5 mm per revolution (factor 1000)
-        s.position = Distance {
-            dimension: Dimension::Metre,
-            exponent: -3,
-        };
+        s.position = metres(-3);
         s.feed = Feed {
             value: 5000,
-            unit: Some(Distance {
-                dimension: Dimension::Metre,
-                exponent: -6,
-            }),
+            unit: Some(metres(-6)),
         };
         assert_eq!(UnitProfile::new(s).unwrap().position.to_bus(2 * REV).unwrap(), 10);
         // position in mm, unitless feed 7: used like a gear factor (7 mm per revolution)
@@ -492,16 +491,10 @@ mod tests {
         let mut s = UnitSettings::DEFAULT;
         // nanometres against a feed of 4 294 967 291 µm (a prime) per
         // revolution and a prime gear: the fraction cannot be reduced to 32 bits
-        s.position = Distance {
-            dimension: Dimension::Metre,
-            exponent: -9,
-        };
+        s.position = metres(-9);
         s.feed = Feed {
             value: 4_294_967_291,
-            unit: Some(Distance {
-                dimension: Dimension::Metre,
-                exponent: -6,
-            }),
+            unit: Some(metres(-6)),
         };
         s.gear_in = 4_294_967_279;
         assert_eq!(UnitProfile::new(s), Err(UnitError::Overflow));

@@ -214,12 +214,7 @@ impl TargetReachedMonitor {
             return true;
         }
         let inside = target_inc.wrapping_sub(actual_position_inc).unsigned_abs() <= self.config.window_inc;
-        if !inside {
-            self.inside_since = None;
-            return false;
-        }
-        let since = *self.inside_since.get_or_insert(now);
-        now.since(since) >= self.config.time
+        held(&mut self.inside_since, inside, now, self.config.time)
     }
 }
 
@@ -293,19 +288,24 @@ impl VelocityWindowMonitor {
         let w = self.config.window_inc_per_s;
         let slip = (setpoint_inc_per_s - actual_inc_per_s).abs();
         let inside = (target_inc_per_s - actual_inc_per_s).abs() <= w;
-        let target_reached = if inside {
-            let since = *self.inside_since.get_or_insert(now);
-            now.since(since) >= self.config.time
-        } else {
-            self.inside_since = None;
-            false
-        };
+        let target_reached = held(&mut self.inside_since, inside, now, self.config.time);
         ProfileVelocityStatus {
             target_reached,
             zero_speed: is_standstill(actual_inc_per_s, w),
             slippage_error: slip > w || slip.is_nan(),
         }
     }
+}
+
+/// A window time: `true` once `inside` has held without a break for at
+/// least `time` up to `now` (`since`: when it began; cleared outside).
+fn held(since: &mut Option<Nanos>, inside: bool, now: Nanos, time: Nanos) -> bool {
+    if !inside {
+        *since = None;
+        return false;
+    }
+    let start = *since.get_or_insert(now);
+    now.since(start) >= time
 }
 
 /// I199 standstill: |actual velocity 606Ch| < C40 velocity window (both

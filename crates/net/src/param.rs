@@ -442,22 +442,18 @@ mod tests {
         assert_eq!(c.address(true), Some((0x20C7, 2)));
         assert_eq!(c.address(false), Some((0x20C7, 1)));
         // E200[0] -> 28C8h / A8C8h (spec §2.6 example)
-        assert_eq!(
-            Coordinate::parse("E200[0]").unwrap().address(false),
-            Some((0x28C8, 0))
-        );
-        assert_eq!(
-            Coordinate::parse("2.E200[0]").unwrap().address(true),
-            Some((0xA8C8, 1))
-        );
-        assert_eq!(
-            Coordinate::parse("2.I10").unwrap().address(true),
-            Some((0xB00A, 0))
-        );
-        assert_eq!(
-            Coordinate::parse("1.z511").unwrap().address(true),
-            Some((0x53FF, 0))
-        );
+        for (text, sdo_info, address) in [
+            ("E200[0]", false, (0x28C8, 0)),
+            ("2.E200[0]", true, (0xA8C8, 1)),
+            ("2.I10", true, (0xB00A, 0)),
+            ("1.z511", true, (0x53FF, 0)),
+        ] {
+            assert_eq!(
+                Coordinate::parse(text).unwrap().address(sdo_info),
+                Some(address),
+                "{text}"
+            );
+        }
         assert_eq!(Coordinate::parse("A1[255]").unwrap().address(true), None);
         for bad in [
             "", "A", "3.A1", "A512", "AA1", "A1[", "A1[256]", "A1[]", "A1x", "1A1", "A-1", "é1", "A1[1]x",

@@ -90,24 +90,21 @@ pub fn parse_f32(s: &str) -> Option<f32> {
             *exp += 1;
         }
     }
-    while let Some(&c) = b.get(i) {
-        if !c.is_ascii_digit() {
-            break;
-        }
-        take(c - b'0', false, &mut mantissa, &mut digits, &mut exp);
-        any = true;
-        i += 1;
-    }
-    if b.get(i) == Some(&b'.') {
-        i += 1;
-        while let Some(&c) = b.get(i) {
+    // the digits from `i` on, integer part or fraction (`frac`)
+    let mut run = |i: &mut usize, frac: bool| {
+        while let Some(&c) = b.get(*i) {
             if !c.is_ascii_digit() {
                 break;
             }
-            take(c - b'0', true, &mut mantissa, &mut digits, &mut exp);
+            take(c - b'0', frac, &mut mantissa, &mut digits, &mut exp);
             any = true;
-            i += 1;
+            *i += 1;
         }
+    };
+    run(&mut i, false);
+    if b.get(i) == Some(&b'.') {
+        i += 1;
+        run(&mut i, true);
     }
     if !any {
         return None;

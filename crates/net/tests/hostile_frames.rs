@@ -58,6 +58,17 @@ fn ipv4(src: [u8; 4], dst: [u8; 4], proto: u8, payload: &[u8], edit: impl FnOnce
     h
 }
 
+/// An IPv4 packet of protocol `proto` from the host to the drive, in its
+/// Ethernet frame.
+fn to_drive(proto: u8, payload: &[u8]) -> Vec<u8> {
+    eth(
+        DRIVE_MAC,
+        HOST_MAC,
+        0x0800,
+        &ipv4(HOST_IP, DRIVE_IP, proto, payload, |_| {}),
+    )
+}
+
 fn icmp(kind: u8, code: u8, rest: [u8; 4], data: &[u8]) -> Vec<u8> {
     let mut m = vec![kind, code, 0, 0];
     m.extend_from_slice(&rest);
@@ -167,12 +178,7 @@ impl<'a> Rig<'a> {
     /// Echo request from the host; the echo reply's payload if one came.
     fn ping(&mut self, seq: u16, data: &[u8]) -> Option<Vec<u8>> {
         let m = icmp(8, 0, [0x12, 0x34, (seq >> 8) as u8, seq as u8], data);
-        let out = self.send(&eth(
-            DRIVE_MAC,
-            HOST_MAC,
-            0x0800,
-            &ipv4(HOST_IP, DRIVE_IP, 1, &m, |_| {}),
-        ));
+        let out = self.send(&to_drive(1, &m));
         out.iter().find_map(|f| {
             let ip = &f[14..];
             let icmp = &ip[20..];
@@ -243,50 +249,21 @@ fn e095_e096_hostile_frames_are_dropped_and_ping_still_answers() {
         ),
         (
             "UDP length 65535 in a short datagram",
-            eth(
-                DRIVE_MAC,
-                HOST_MAC,
-                0x0800,
-                &ipv4(HOST_IP, DRIVE_IP, 17, &udp(5000, 6000, 0xFFFF, b"R A150"), |_| {}),
-            ),
+            to_drive(17, &udp(5000, 6000, 0xFFFF, b"R A150")),
         ),
         (
             "UDP length below its header",
-            eth(
-                DRIVE_MAC,
-                HOST_MAC,
-                0x0800,
-                &ipv4(HOST_IP, DRIVE_IP, 17, &udp(5000, 6000, 3, b"R A150"), |_| {}),
-            ),
+            to_drive(17, &udp(5000, 6000, 3, b"R A150")),
         ),
         (
             "ICMP destination unreachable with 8 bytes of the original header",
-            eth(
-                DRIVE_MAC,
-                HOST_MAC,
-                0x0800,
-                &ipv4(
-                    HOST_IP,
-                    DRIVE_IP,
-                    1,
-                    &icmp(3, 3, [0; 4], &[0x45, 0, 0, 28, 0, 0, 0, 0]),
-                    |_| {},
-                ),
-            ),
+            to_drive(1, &icmp(3, 3, [0; 4], &[0x45, 0, 0, 28, 0, 0, 0, 0])),
         ),
         (
             "ICMP time exceeded with an original header of length 60 and 20 bytes",
-            eth(
-                DRIVE_MAC,
-                HOST_MAC,
-                0x0800,
-                &ipv4(
-                    HOST_IP,
-                    DRIVE_IP,
-                    1,
-                    &icmp(11, 0, [0; 4], &ipv4(DRIVE_IP, HOST_IP, 17, &[], |h| h[0] = 0x4F)),
-                    |_| {},
-                ),
+            to_drive(
+                1,
+                &icmp(11, 0, [0; 4], &ipv4(DRIVE_IP, HOST_IP, 17, &[], |h| h[0] = 0x4F)),
             ),
         ),
         (
@@ -353,12 +330,7 @@ fn e095_arp_flood_replaces_the_oldest_neighbour() {
     }
     // the host's entry was the oldest: the drive asks for it before answering
     let m = icmp(8, 0, [0x12, 0x34, 0, 2], b"y");
-    let out = r.send(&eth(
-        DRIVE_MAC,
-        HOST_MAC,
-        0x0800,
-        &ipv4(HOST_IP, DRIVE_IP, 1, &m, |_| {}),
-    ));
+    let out = r.send(&to_drive(1, &m));
     assert_eq!(out.len(), 1);
     assert_eq!(&out[0][12..14], &[8, 6], "an ARP request");
     assert_eq!(&out[0][14 + 24..14 + 28], &HOST_IP, "for the host");

@@ -5,7 +5,8 @@
 use std::string::String;
 use std::vec::Vec;
 
-fn pcap(frames: &[Vec<u8>]) -> Vec<u8> {
+/// A pcap file (Ethernet link type) of `frames`, one a second.
+pub(crate) fn pcap(frames: &[Vec<u8>]) -> Vec<u8> {
     let mut p = Vec::new();
     p.extend_from_slice(&0xa1b2_c3d4u32.to_le_bytes());
     p.extend_from_slice(&2u16.to_le_bytes());
@@ -28,6 +29,12 @@ fn pcap(frames: &[Vec<u8>]) -> Vec<u8> {
 /// warning or error among the selected frames, or when none is selected.
 pub(crate) fn dissect(frames: &[Vec<u8>], filter: &str) -> Option<String> {
     dissect_with(frames, filter, false)
+}
+
+/// [`dissect`] of the device's DCE/RPC frames (the rigs' device is at
+/// 192.168.0.50).
+pub(crate) fn device_rpc(frames: &[Vec<u8>]) -> Option<String> {
+    dissect(frames, "dcerpc && ip.src == 192.168.0.50")
 }
 
 /// [`dissect`], where `undecoded` lets record data the dissector does not

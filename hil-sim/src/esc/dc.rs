@@ -179,27 +179,18 @@ impl LocalClock {
     #[cfg(test)]
     pub(super) fn now_for_local_wide(&self, local: u64) -> Nanos {
         let dl = local.wrapping_sub(self.anchor_local) as i64;
-        let mut t = clamp_u64(i128::from(self.anchor_now.as_ns()) + self.first_now_wide(dl));
-        let reached = |c: &Self, t: u64| c.local_at_wide(Nanos::from_ns(t)).wrapping_sub(local) as i64 >= 0;
-        for _ in 0..4 {
-            if reached(self, t) {
-                break;
-            }
-            t = t.saturating_add(1);
-        }
-        for _ in 0..4 {
-            if t > 0 && reached(self, t - 1) {
-                t -= 1;
-            } else {
-                break;
-            }
-        }
-        Nanos::from_ns(t)
+        let t = clamp_u64(i128::from(self.anchor_now.as_ns()) + self.first_now_wide(dl));
+        self.settle_by(local, t, Self::local_at_wide)
     }
 
     /// The earliest time at or near `t` at which the local time reaches `local`.
-    fn settle(&self, local: u64, mut t: u64) -> Nanos {
-        let reached = |c: &Self, t: u64| c.local_at(Nanos::from_ns(t)).wrapping_sub(local) as i64 >= 0;
+    fn settle(&self, local: u64, t: u64) -> Nanos {
+        self.settle_by(local, t, Self::local_at)
+    }
+
+    /// [`Self::settle`] with the local time `local_at` gives.
+    fn settle_by(&self, local: u64, mut t: u64, local_at: impl Fn(&Self, Nanos) -> u64) -> Nanos {
+        let reached = |c: &Self, t: u64| local_at(c, Nanos::from_ns(t)).wrapping_sub(local) as i64 >= 0;
         for _ in 0..4 {
             if reached(self, t) {
                 break;

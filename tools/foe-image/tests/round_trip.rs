@@ -247,13 +247,25 @@ fn foe_image_truncated_or_flipped_is_refused_and_changes_nothing() {
 #[test]
 fn foe_image_refuses_what_it_cannot_make() {
     let dir = temp_dir("refuse");
+    let key = dev_key();
+    // `make` of `input`, version 1, the development key, `extra` options
+    let make = |extra: &[&str], input: &std::path::Path| {
+        let mut args = vec!["make", "--version", "1", "--key", &key];
+        args.extend_from_slice(extra);
+        args.push(input.to_str().unwrap());
+        tool(&args)
+    };
+    // `make` of `input` fails, says `why`, writes nothing
+    let refused = |input: &std::path::Path, why: &str| {
+        let out = make(&[], input);
+        assert!(!out.status.success(), "{why}");
+        assert!(String::from_utf8_lossy(&out.stderr).contains(why), "{why}");
+        assert!(!dir.join("firmware.sc6f").exists(), "nothing written");
+    };
     // an ELF without loadable contents
     let p = dir.join("empty.elf");
     std::fs::write(&p, elf32(&[(0x2000_0000, 0x2000_0000, Vec::new(), 64)])).unwrap();
-    let out = tool(&["make", "--version", "1", "--key", &dev_key(), p.to_str().unwrap()]);
-    assert!(!out.status.success());
-    assert!(String::from_utf8_lossy(&out.stderr).contains("no loadable segment"));
-    assert!(!dir.join("firmware.sc6f").exists(), "nothing written");
+    refused(&p, "no loadable segment");
     // overlapping segments: no sensible flash contents
     let p2 = dir.join("overlap.elf");
     let two = [
@@ -261,28 +273,9 @@ fn foe_image_refuses_what_it_cannot_make() {
         (0x0800_0040, 0x0800_0040, pattern(100, 2), 100),
     ];
     std::fs::write(&p2, elf32(&two)).unwrap();
-    let out = tool(&[
-        "make",
-        "--version",
-        "1",
-        "--key",
-        &dev_key(),
-        p2.to_str().unwrap(),
-    ]);
-    assert!(!out.status.success());
-    assert!(String::from_utf8_lossy(&out.stderr).contains("overlap at 0x08000040"));
-    assert!(!dir.join("firmware.sc6f").exists(), "nothing written");
+    refused(&p2, "overlap at 0x08000040");
     // an output that cannot be written
-    let out = tool(&[
-        "make",
-        "--version",
-        "1",
-        "--key",
-        &dev_key(),
-        "--out",
-        "/nonexistent/firmware.sc6f",
-        p.to_str().unwrap(),
-    ]);
+    let out = make(&["--out", "/nonexistent/firmware.sc6f"], &p);
     assert!(!out.status.success());
     // a missing version, a missing key
     let out = tool(&["make", "--key", &dev_key(), p.to_str().unwrap()]);
@@ -292,17 +285,7 @@ fn foe_image_refuses_what_it_cannot_make() {
     // a flat binary without --load-addr: no address to put into the header
     let bin = dir.join("flat.bin");
     std::fs::write(&bin, pattern(100, 3)).unwrap();
-    let out = tool(&[
-        "make",
-        "--version",
-        "1",
-        "--key",
-        &dev_key(),
-        bin.to_str().unwrap(),
-    ]);
-    assert!(!out.status.success());
-    assert!(String::from_utf8_lossy(&out.stderr).contains("--load-addr"));
-    assert!(!dir.join("firmware.sc6f").exists(), "nothing written");
+    refused(&bin, "--load-addr");
     // a key file that is no key
     let out = tool(&[
         "make",

@@ -10,17 +10,7 @@ use crate::sdo_info::opcode;
 use od::{Access, DataType, EntryInfo, ObjectCode, ObjectInfo};
 
 const fn entry(sub: u8, name: &'static str, data_type: DataType, access: Access) -> EntryInfo {
-    EntryInfo {
-        sub,
-        name,
-        data_type,
-        access,
-        min: None,
-        max: None,
-        default: 0,
-        unit: "",
-        persistent: false,
-    }
+    EntryInfo::new(sub, name, data_type, access)
 }
 
 const fn ranged(e: EntryInfo, min: i64, max: i64, default: i64) -> EntryInfo {

@@ -71,7 +71,7 @@ pub mod result {
 mod frag;
 mod ip;
 #[cfg(test)]
-mod tests;
+pub(crate) mod tests;
 
 pub use frag::{FragmentError, Fragmenter, Reassembly};
 pub use ip::*;

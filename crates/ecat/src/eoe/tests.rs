@@ -7,7 +7,7 @@ fn frame(n: usize) -> Vec<u8> {
 }
 
 /// Splits `f` as a master would: fragments of `chunk` bytes (a multiple of 32).
-fn fragments(f: &[u8], chunk: usize, frame_no: u8) -> Vec<(EoeHeader, Vec<u8>)> {
+pub(crate) fn fragments(f: &[u8], chunk: usize, frame_no: u8) -> Vec<(EoeHeader, Vec<u8>)> {
     let chunks: Vec<&[u8]> = f.chunks(chunk).collect();
     let n = chunks.len();
     chunks

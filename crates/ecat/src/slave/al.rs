@@ -83,6 +83,22 @@ impl Slave {
         }))
     }
 
+    /// The outcome of a transition: the new state with the error cleared,
+    /// or the old state with the error flag and `code`.
+    fn settle(&mut self, result: Result<AlState, AlStatusCode>) {
+        match result {
+            Ok(to) => {
+                self.state = to;
+                self.error = false;
+                self.code = AlStatusCode::NO_ERROR;
+            }
+            Err(code) => {
+                self.error = true;
+                self.code = code;
+            }
+        }
+    }
+
     pub(super) fn write_status<P: Pdi>(&self, pdi: &mut P) -> Result<(), P::Error> {
         // explicit device identification: the ID stands in the status code
         // register while no error is shown
@@ -154,17 +170,7 @@ impl Slave {
             }
             Ok(Some(to)) => self.transition(pdi, app, from, to, now)?.map(|()| to),
         };
-        match result {
-            Ok(to) => {
-                self.state = to;
-                self.error = false;
-                self.code = AlStatusCode::NO_ERROR;
-            }
-            Err(code) => {
-                self.error = true;
-                self.code = code;
-            }
-        }
+        self.settle(result);
         self.write_status(pdi)?;
         let change = StateChange {
             from,
@@ -369,17 +375,7 @@ impl Slave {
             return Ok(None);
         };
         self.pending_op = None;
-        match result {
-            Ok(()) => {
-                self.state = AlState::Op;
-                self.error = false;
-                self.code = AlStatusCode::NO_ERROR;
-            }
-            Err(code) => {
-                self.error = true;
-                self.code = code;
-            }
-        }
+        self.settle(result.map(|()| AlState::Op));
         self.write_status(pdi)?;
         Ok(Some(StateChange {
             from: AlState::SafeOp,

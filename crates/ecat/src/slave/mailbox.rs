@@ -54,24 +54,6 @@ impl Mailbox {
 }
 
 impl Slave {
-    pub(super) fn mailbox_step<P: Pdi, A: Application, H: FoeHandler, E: EthernetPort>(
-        &mut self,
-        pdi: &mut P,
-        app: &mut A,
-        foe: &mut H,
-        eth: &mut E,
-        events: u32,
-        now: Nanos,
-    ) -> Result<(), P::Error> {
-        if self.state != AlState::Bootstrap {
-            self.foe.reset(foe);
-        }
-        if esm::mailbox_on(self.state) {
-            self.poll_mailbox(pdi, app, foe, eth, events, now)?;
-        }
-        Ok(())
-    }
-
     pub(super) fn start_mailbox(&mut self, sm0: &SyncManager, sm1: &SyncManager) {
         let m = &mut self.mbx;
         m.rx_start = sm0.start;
@@ -85,7 +67,10 @@ impl Slave {
         self.coe.reset();
     }
 
-    pub(super) fn poll_mailbox<P: Pdi, A: Application, H: FoeHandler, E: EthernetPort>(
+    /// One mailbox step: an FoE transfer ends outside Bootstrap; in the
+    /// mailbox states, a request from SM0 is answered into SM1, then the
+    /// EMCY queue, SDO Info fragments and outgoing EoE fragments.
+    pub(super) fn mailbox_step<P: Pdi, A: Application, H: FoeHandler, E: EthernetPort>(
         &mut self,
         pdi: &mut P,
         app: &mut A,
@@ -94,6 +79,12 @@ impl Slave {
         events: u32,
         now: Nanos,
     ) -> Result<(), P::Error> {
+        if self.state != AlState::Bootstrap {
+            self.foe.reset(foe);
+        }
+        if !esm::mailbox_on(self.state) {
+            return Ok(());
+        }
         let sm1 = pdi.read_sm(1)?;
         let mut full = sm1.status & status::MAILBOX_FULL != 0;
         let repeat = sm1.activate & activate::REPEAT != 0;

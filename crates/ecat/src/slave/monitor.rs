@@ -79,21 +79,9 @@ impl Slave {
         if !expired {
             return Ok(None);
         }
-        self.state = AlState::SafeOp;
-        self.error = true;
-        self.code = AlStatusCode::SM_WATCHDOG;
         self.sync.triggered = true;
         self.sync.trigger_count = self.sync.trigger_count.saturating_add(1);
-        self.sync.unsolicited = true;
-        self.op_loss = Some(OpLoss::PdoTimeout);
-        self.write_status(pdi)?;
-        Ok(Some(StateChange {
-            from: AlState::Op,
-            to: AlState::SafeOp,
-            requested: AlState::Op.code(),
-            code: self.code,
-            unsolicited: true,
-        }))
+        self.leave_op(pdi, AlStatusCode::SM_WATCHDOG, OpLoss::PdoTimeout)
     }
 
     /// The synchronisation is supervised: DC SYNC0 accepted at P→S and the
@@ -124,11 +112,22 @@ impl Slave {
         let Some(code) = self.sync_state.fault else {
             return Ok(None);
         };
+        self.leave_op(pdi, code, OpLoss::Sync)
+    }
+
+    /// Op → Safe-Op on the device's own account: the error indication with
+    /// `code`, the reason kept, an unsolicited state change (E-038).
+    fn leave_op<P: Pdi>(
+        &mut self,
+        pdi: &mut P,
+        code: AlStatusCode,
+        loss: OpLoss,
+    ) -> Result<Option<StateChange>, P::Error> {
         self.state = AlState::SafeOp;
         self.error = true;
         self.code = code;
         self.sync.unsolicited = true;
-        self.op_loss = Some(OpLoss::Sync);
+        self.op_loss = Some(loss);
         self.write_status(pdi)?;
         Ok(Some(StateChange {
             from: AlState::Op,

@@ -2,6 +2,14 @@ use super::*;
 extern crate std;
 use std::vec::Vec;
 
+/// The error status once the axis stands still.
+fn stopped_error(error: HomingError) -> HomingStatus {
+    HomingStatus::Error {
+        error,
+        standstill: true,
+    }
+}
+
 const REV: i64 = 1 << 20;
 const DT: u32 = 250_000; // 250 µs
 const FAST: f32 = 4.0 * (1 << 20) as f32; // 4 rev/s
@@ -553,13 +561,7 @@ fn c060_supported_methods_are_the_20_codes() {
     for code in [0, 4, 6, 36, 38, -5] {
         let mut sim = Sim::new(config(code), Axis::new(0));
         let out = sim.home();
-        assert_eq!(
-            out.status,
-            HomingStatus::Error {
-                error: HomingError::InvalidMethod,
-                standstill: true
-            }
-        );
+        assert_eq!(out.status, stopped_error(HomingError::InvalidMethod));
         assert_eq!(out.status.statusword_bits(), ERR_STILL);
         assert!(sim.events.is_empty());
     }
@@ -640,13 +642,7 @@ fn c084_limit_switch_against_travel_is_an_error() {
     };
     let mut sim = Sim::new(config(1), a);
     let out = sim.home();
-    assert_eq!(
-        out.status,
-        HomingStatus::Error {
-            error: HomingError::LimitAgainstTravel,
-            standstill: true
-        }
-    );
+    assert_eq!(out.status, stopped_error(HomingError::LimitAgainstTravel));
     assert_eq!(sim.bits, [NOT_STARTED, RUN, ERR_MOVING, ERR_STILL]);
     assert!(sim.events.is_empty());
     assert!(!sim.h.is_referenced());
@@ -659,13 +655,7 @@ fn c084_limit_switch_against_travel_is_an_error() {
 fn c083_missing_home_switch_is_an_error_after_one_reversal() {
     let mut sim = Sim::new(config(23), Axis::new(0));
     let out = sim.home();
-    assert_eq!(
-        out.status,
-        HomingStatus::Error {
-            error: HomingError::SwitchNotFound,
-            standstill: true
-        }
-    );
+    assert_eq!(out.status, stopped_error(HomingError::SwitchNotFound));
     assert!(sim.max_raw >= 10 * REV && sim.min_raw <= -10 * REV);
     assert!(sim.events.is_empty());
     assert_eq!(out.status.statusword_bits(), ERR_STILL);
@@ -681,13 +671,7 @@ fn c083_limit_while_creeping_or_searching_index_is_an_error() {
     };
     let mut sim = Sim::new(config(34), a);
     let out = sim.home();
-    assert_eq!(
-        out.status,
-        HomingStatus::Error {
-            error: HomingError::UnexpectedLimit,
-            standstill: true
-        }
-    );
+    assert_eq!(out.status, stopped_error(HomingError::UnexpectedLimit));
 }
 
 #[test]
@@ -699,13 +683,7 @@ fn c084_both_limits_active_is_an_error() {
     };
     let mut sim = Sim::new(config(17), a);
     let out = sim.home();
-    assert_eq!(
-        out.status,
-        HomingStatus::Error {
-            error: HomingError::BothLimits,
-            standstill: true
-        }
-    );
+    assert_eq!(out.status, stopped_error(HomingError::BothLimits));
     assert_eq!(sim.axis.raw, 0);
     assert_eq!(sim.bits, [NOT_STARTED, ERR_STILL]);
 }
@@ -723,13 +701,7 @@ fn c083_switch_not_found_within_travel_limit() {
     };
     let mut sim = Sim::new(cfg, a);
     let out = sim.home();
-    assert_eq!(
-        out.status,
-        HomingStatus::Error {
-            error: HomingError::TravelExceeded,
-            standstill: true
-        }
-    );
+    assert_eq!(out.status, stopped_error(HomingError::TravelExceeded));
     let travelled = -sim.min_raw;
     assert!(
         travelled > 3 * REV && travelled < 3 * REV + REV / 10,
@@ -755,13 +727,7 @@ fn c063_invalid_speeds_are_an_error() {
     ] {
         let mut sim = Sim::new(cfg, Axis::new(0));
         let out = sim.home();
-        assert_eq!(
-            out.status,
-            HomingStatus::Error {
-                error: HomingError::InvalidParameters,
-                standstill: true
-            }
-        );
+        assert_eq!(out.status, stopped_error(HomingError::InvalidParameters));
         assert_eq!(sim.axis.raw, 0);
     }
     // 33 needs only the slow speed.

@@ -453,17 +453,7 @@ pub const fn range_count<const MAX: usize>(es: &[EntryInfo]) -> usize {
 pub const fn ranges<const MAX: usize, const R: usize>(es: &[EntryInfo]) -> [[u32; 2]; R] {
     let (all, n) = collect_ranges::<MAX>(es);
     assert!(n == R && R < NO_RANGE as usize, "range count");
-    let mut out = [[0u32; 2]; R];
-    let mut i = 0;
-    while i < R {
-        // i < R <= MAX (compile-time evaluation)
-        #[allow(clippy::indexing_slicing)]
-        {
-            out[i] = all[i];
-        }
-        i += 1;
-    }
-    out
+    first(&all, [0u32; 2])
 }
 
 /// Number of distinct defaults of `es` that are `wide` (32 bits), else of
@@ -489,14 +479,13 @@ pub const fn small_defaults<const MAX: usize, const D: usize>(es: &[EntryInfo]) 
     out
 }
 
-/// The distinct defaults of `es` that need 32 bits. `D` = [`default_count`].
-pub const fn wide_defaults<const MAX: usize, const D: usize>(es: &[EntryInfo]) -> [u32; D] {
-    let (all, n) = collect_defaults::<MAX>(es, true);
-    assert!(n == D, "default count");
-    let mut out = [0u32; D];
+/// The first `N` of `all` (`N ≤ MAX`; evaluated at compile time, where an
+/// index past `MAX` stops the build).
+const fn first<T: Copy, const MAX: usize, const N: usize>(all: &[T; MAX], zero: T) -> [T; N] {
+    let mut out = [zero; N];
     let mut i = 0;
-    while i < D {
-        // i < D <= MAX (compile-time evaluation)
+    while i < N {
+        // i < N <= MAX (compile-time evaluation)
         #[allow(clippy::indexing_slicing)]
         {
             out[i] = all[i];
@@ -504,6 +493,13 @@ pub const fn wide_defaults<const MAX: usize, const D: usize>(es: &[EntryInfo]) -
         i += 1;
     }
     out
+}
+
+/// The distinct defaults of `es` that need 32 bits. `D` = [`default_count`].
+pub const fn wide_defaults<const MAX: usize, const D: usize>(es: &[EntryInfo]) -> [u32; D] {
+    let (all, n) = collect_defaults::<MAX>(es, true);
+    assert!(n == D, "default count");
+    first(&all, 0u32)
 }
 
 const fn unit_index(unit: &str) -> u32 {
@@ -598,17 +594,7 @@ pub const fn access_count<const MAX: usize>(es: &[EntryInfo]) -> usize {
 pub const fn details<const MAX: usize, const X: usize>(es: &[EntryInfo]) -> [u16; X] {
     let (all, n, _) = collect_details::<MAX>(es);
     assert!(n == X, "detail count");
-    let mut out = [0u16; X];
-    let mut i = 0;
-    while i < X {
-        // i < X <= MAX (compile-time evaluation)
-        #[allow(clippy::indexing_slicing)]
-        {
-            out[i] = all[i];
-        }
-        i += 1;
-    }
-    out
+    first(&all, 0u16)
 }
 
 /// The kind of `e` against the details `details` of which the first
@@ -668,17 +654,7 @@ pub const fn kinds<const MAX: usize, const K: usize>(
 ) -> [u16; K] {
     let (all, n) = collect_kinds::<MAX>(es, details, accesses);
     assert!(n == K && K <= MAX_KINDS, "at most 128 distinct kinds");
-    let mut out = [0u16; K];
-    let mut i = 0;
-    while i < K {
-        // i < K <= MAX (compile-time evaluation)
-        #[allow(clippy::indexing_slicing)]
-        {
-            out[i] = all[i];
-        }
-        i += 1;
-    }
-    out
+    first(&all, 0u16)
 }
 
 /// The records of `es` against the tables built from the same `es`.

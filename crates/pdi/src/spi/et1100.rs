@@ -79,9 +79,7 @@ impl<D: SpiDevice> esc::Pdi for Et1100<D> {
     type Error = Error<D::Error>;
 
     fn read(&mut self, addr: u16, buf: &mut [u8]) -> Result<(), Self::Error> {
-        if !crate::in_esc_space(addr, buf.len()) {
-            return Err(Error::OutOfRange { addr, len: buf.len() });
-        }
+        super::check_range(addr, buf.len())?;
         if buf.is_empty() {
             return Ok(());
         }
@@ -104,12 +102,7 @@ impl<D: SpiDevice> esc::Pdi for Et1100<D> {
     }
 
     fn write(&mut self, addr: u16, data: &[u8]) -> Result<(), Self::Error> {
-        if !crate::in_esc_space(addr, data.len()) {
-            return Err(Error::OutOfRange {
-                addr,
-                len: data.len(),
-            });
-        }
+        super::check_range(addr, data.len())?;
         if data.is_empty() {
             return Ok(());
         }

@@ -296,13 +296,32 @@ impl<D: SpiDevice> Lan9252<D> {
         Ok(())
     }
 
-    fn pram_read(&mut self, addr: u16, buf: &mut [u8]) -> Result<(), Error<D::Error>> {
-        if self.rd_dirty {
-            self.pram_abort(regs::ECAT_PRAM_RD_CMD)?;
+    /// Starts a process RAM command: aborts the one left unfinished
+    /// (`dirty`), then writes address and length and sets the busy bit.
+    fn pram_start(
+        &mut self,
+        cmd_reg: u16,
+        addr_len_reg: u16,
+        dirty: bool,
+        addr: u16,
+        len: usize,
+    ) -> Result<(), Error<D::Error>> {
+        if dirty {
+            self.pram_abort(cmd_reg)?;
         }
-        self.rd_dirty = true;
-        self.write_register(regs::ECAT_PRAM_RD_ADDR_LEN, addr_len(addr, buf.len()))?;
-        self.write_register(regs::ECAT_PRAM_RD_CMD, regs::PRAM_BUSY)?;
+        self.write_register(addr_len_reg, addr_len(addr, len))?;
+        self.write_register(cmd_reg, regs::PRAM_BUSY)
+    }
+
+    fn pram_read(&mut self, addr: u16, buf: &mut [u8]) -> Result<(), Error<D::Error>> {
+        let dirty = core::mem::replace(&mut self.rd_dirty, true);
+        self.pram_start(
+            regs::ECAT_PRAM_RD_CMD,
+            regs::ECAT_PRAM_RD_ADDR_LEN,
+            dirty,
+            addr,
+            buf.len(),
+        )?;
 
         // Byte position in the DWORD stream, which starts at the DWORD that
         // holds `addr`; the first `lead` bytes are padding.
@@ -331,12 +350,14 @@ impl<D: SpiDevice> Lan9252<D> {
     }
 
     fn pram_write(&mut self, addr: u16, data: &[u8]) -> Result<(), Error<D::Error>> {
-        if self.wr_dirty {
-            self.pram_abort(regs::ECAT_PRAM_WR_CMD)?;
-        }
-        self.wr_dirty = true;
-        self.write_register(regs::ECAT_PRAM_WR_ADDR_LEN, addr_len(addr, data.len()))?;
-        self.write_register(regs::ECAT_PRAM_WR_CMD, regs::PRAM_BUSY)?;
+        let dirty = core::mem::replace(&mut self.wr_dirty, true);
+        self.pram_start(
+            regs::ECAT_PRAM_WR_CMD,
+            regs::ECAT_PRAM_WR_ADDR_LEN,
+            dirty,
+            addr,
+            data.len(),
+        )?;
 
         let lead = usize::from(addr & 3);
         let mut dwords_left = (lead + data.len()).div_ceil(4);
@@ -392,9 +413,7 @@ impl<D: SpiDevice> esc::Pdi for Lan9252<D> {
     type Error = Error<D::Error>;
 
     fn read(&mut self, addr: u16, buf: &mut [u8]) -> Result<(), Self::Error> {
-        if !crate::in_esc_space(addr, buf.len()) {
-            return Err(Error::OutOfRange { addr, len: buf.len() });
-        }
+        super::check_range(addr, buf.len())?;
         // Registers below 0x1000 through the CSR window, the rest through
         // the process RAM FIFO; an access across 0x1000 is split.
         let below = usize::from(PROCESS_RAM.saturating_sub(addr)).min(buf.len());
@@ -409,12 +428,7 @@ impl<D: SpiDevice> esc::Pdi for Lan9252<D> {
     }
 
     fn write(&mut self, addr: u16, data: &[u8]) -> Result<(), Self::Error> {
-        if !crate::in_esc_space(addr, data.len()) {
-            return Err(Error::OutOfRange {
-                addr,
-                len: data.len(),
-            });
-        }
+        super::check_range(addr, data.len())?;
         let below = usize::from(PROCESS_RAM.saturating_sub(addr)).min(data.len());
         let (regs_part, ram_part) = data.split_at_checked(below).unwrap_or_default();
         if !regs_part.is_empty() {

@@ -150,34 +150,7 @@ impl SpiDevice for MockEt1100 {
             return Err(BusFault);
         }
         let mut phase = Phase::Header(Vec::new());
-        for op in operations.iter_mut() {
-            match op {
-                Operation::Read(buf) => {
-                    for b in buf.iter_mut() {
-                        *b = self.exchange(&mut phase, 0x00);
-                    }
-                }
-                Operation::Write(data) => {
-                    for b in data.iter() {
-                        self.exchange(&mut phase, *b);
-                    }
-                }
-                Operation::Transfer(rx, tx) => {
-                    for i in 0..rx.len().max(tx.len()) {
-                        let miso = self.exchange(&mut phase, tx.get(i).copied().unwrap_or(0));
-                        if let Some(r) = rx.get_mut(i) {
-                            *r = miso;
-                        }
-                    }
-                }
-                Operation::TransferInPlace(buf) => {
-                    for b in buf.iter_mut() {
-                        *b = self.exchange(&mut phase, *b);
-                    }
-                }
-                Operation::DelayNs(_) => {}
-            }
-        }
+        super::clock_operations(operations, &mut phase, |p, b| self.exchange(p, b));
         self.end_frame(&phase);
         Ok(())
     }

@@ -46,3 +46,52 @@ pub enum Error<E> {
         byte_test: u32,
     },
 }
+
+/// [`Error::OutOfRange`] unless `len` bytes from `addr` stay inside the ESC
+/// address space.
+fn check_range<E>(addr: u16, len: usize) -> Result<(), Error<E>> {
+    if crate::in_esc_space(addr, len) {
+        Ok(())
+    } else {
+        Err(Error::OutOfRange { addr, len })
+    }
+}
+
+/// Clocks the bytes of a mock's SPI `operations` through `exchange` (MOSI
+/// in, MISO out; 0x00 sent while reading, missing bytes as 0x00).
+#[cfg(test)]
+fn clock_operations<P>(
+    operations: &mut [embedded_hal::spi::Operation<'_, u8>],
+    phase: &mut P,
+    mut exchange: impl FnMut(&mut P, u8) -> u8,
+) {
+    use embedded_hal::spi::Operation;
+    for op in operations.iter_mut() {
+        match op {
+            Operation::Read(buf) => {
+                for b in buf.iter_mut() {
+                    *b = exchange(phase, 0x00);
+                }
+            }
+            Operation::Write(data) => {
+                for b in data.iter() {
+                    exchange(phase, *b);
+                }
+            }
+            Operation::Transfer(rx, tx) => {
+                for i in 0..rx.len().max(tx.len()) {
+                    let miso = exchange(phase, tx.get(i).copied().unwrap_or(0));
+                    if let Some(r) = rx.get_mut(i) {
+                        *r = miso;
+                    }
+                }
+            }
+            Operation::TransferInPlace(buf) => {
+                for b in buf.iter_mut() {
+                    *b = exchange(phase, *b);
+                }
+            }
+            Operation::DelayNs(_) => {}
+        }
+    }
+}

@@ -83,6 +83,19 @@ pub(super) fn ctl_rta(
     f
 }
 
+/// The controller's DATA-RTA (with TACK) carrying an AlarmAck of `n` (status
+/// OK) as SendSeqNum `send`, AckSeqNum 0xFFFF.
+pub(super) fn ctl_alarm_ack(n: &Notification, send: u16) -> std::vec::Vec<u8> {
+    ctl_rta(
+        Priority::Low,
+        1,
+        0x11,
+        send,
+        0xFFFF,
+        &ack_block(n, PnioStatus::OK),
+    )
+}
+
 /// The controller's AlarmAck for `n` as a var part.
 pub(super) fn ack_block(n: &Notification, status: PnioStatus) -> std::vec::Vec<u8> {
     let a = AlarmAck {
@@ -177,14 +190,7 @@ fn p043_alarm_goes_out_with_tack_and_is_done_by_the_controllers_ack() {
     assert_eq!(cr.poll_at(ms(5)), Nanos::MAX, "no retransmission after TACK");
     assert!(!cr.can_send(Priority::Low), "outstanding until the AlarmAck");
     // the AlarmAck in a DATA of the controller
-    let data = ctl_rta(
-        Priority::Low,
-        1,
-        0x11,
-        0xFFFF,
-        0xFFFF,
-        &ack_block(&sent, PnioStatus::OK),
-    );
+    let data = ctl_alarm_ack(&sent, 0xFFFF);
     let ev = cr
         .receive(ms(6), &EthFrame::parse(&data).unwrap())
         .unwrap()
@@ -265,14 +271,7 @@ fn p043_receiver_acks_repeats_and_nacks_wrong_numbers() {
     let sent = cr.send(ms(0), &diag_notification()).unwrap();
     frame(&mut cr, ms(0));
     // an AlarmAck piggybacking the transport ACK (AckSeqNum = ours)
-    let data = ctl_rta(
-        Priority::Low,
-        1,
-        0x11,
-        0xFFFF,
-        0xFFFF,
-        &ack_block(&sent, PnioStatus::OK),
-    );
+    let data = ctl_alarm_ack(&sent, 0xFFFF);
     assert!(matches!(
         cr.receive(ms(1), &EthFrame::parse(&data).unwrap()),
         Ok(Some(AlarmEvent::Acked { .. }))
@@ -283,14 +282,7 @@ fn p043_receiver_acks_repeats_and_nacks_wrong_numbers() {
     let (h, _) = rta_of(&frame(&mut cr, ms(2)));
     assert_eq!((h.pdu_type, h.ack_seq), (PduType::Ack, 0xFFFF));
     // out of sequence: NACK
-    let wrong = ctl_rta(
-        Priority::Low,
-        1,
-        0x11,
-        7,
-        0xFFFF,
-        &ack_block(&sent, PnioStatus::OK),
-    );
+    let wrong = ctl_alarm_ack(&sent, 7);
     assert_eq!(
         cr.receive(ms(3), &EthFrame::parse(&wrong).unwrap()),
         Err(RtaError::Sequence)
@@ -301,14 +293,7 @@ fn p043_receiver_acks_repeats_and_nacks_wrong_numbers() {
         (PduType::Nack, 0xFFFF, 0xFFFF)
     );
     // an AlarmAck for nothing outstanding: ACKed, refused
-    let stray = ctl_rta(
-        Priority::Low,
-        1,
-        0x11,
-        0,
-        0xFFFF,
-        &ack_block(&sent, PnioStatus::OK),
-    );
+    let stray = ctl_alarm_ack(&sent, 0);
     assert_eq!(
         cr.receive(ms(4), &EthFrame::parse(&stray).unwrap()),
         Err(RtaError::UnexpectedAck)
@@ -411,14 +396,7 @@ fn p043_alarm_cr_never_panics_on_mutated_or_truncated_frames() {
     let n = diag_notification();
     let valid = [
         ctl_rta(Priority::Low, 3, 0x01, 0xFFFE, 0xFFFF, &[]),
-        ctl_rta(
-            Priority::Low,
-            1,
-            0x11,
-            0xFFFF,
-            0xFFFF,
-            &ack_block(&n, PnioStatus::OK),
-        ),
+        ctl_alarm_ack(&n, 0xFFFF),
         ctl_rta(Priority::High, 4, 0x01, 0xFFFF, 0xFFFE, &[0xCF, 0x81, 0xFD, 0x0F]),
     ];
     let mut seed = 0x0F0F_1234_5678_9ABCu64;

@@ -72,7 +72,8 @@ fn p030_p040_diagnosis_records_report_the_drive_error_and_the_port_mismatch() {
     // the drive error acknowledged (P-035): gone from the record
     assert!(r.d.clear_diagnosis(54, 3));
     assert_eq!(r.read(1, 0x800A), (OK, std::vec![]));
-    let text = crate::tests_tshark::dissect(&r.frames, "dcerpc && ip.src == 192.168.0.50");
-    let Some(text) = text else { return };
+    let Some(text) = crate::tests_tshark::device_rpc(&r.frames) else {
+        return;
+    };
     assert!(text.contains("DiagnosisData"), "DiagnosisData not dissected");
 }

@@ -477,11 +477,7 @@ impl<H: RecordHook> Cm<H> {
         let mut r = Reader::new(data, Endian::Big);
         let mut n = 0usize;
         while r.remaining() > 0 {
-            let (req, rest) = RwRequest::parse(r.rest()).filter(|(q, _)| q.write)?;
-            let len = usize::try_from(req.record_len).ok()?;
-            let sub = rest.get(..len)?;
-            r.skip(RW_HEADER_LEN.checked_add(len)?)?;
-            r.align(4).or(Some(()))?;
+            let (req, sub) = next_write(&mut r)?;
             n = n.checked_add(if req.addr.index == index::WRITE_MULTIPLE && depth == 0 {
                 Self::count_writes(sub, 1)?
             } else {
@@ -505,18 +501,14 @@ impl<H: RecordHook> Cm<H> {
     ) -> Option<()> {
         let mut r = Reader::new(data, Endian::Big);
         while r.remaining() > 0 {
-            let (req, rest) = RwRequest::parse(r.rest()).filter(|(q, _)| q.write)?;
-            let len = usize::try_from(req.record_len).ok()?;
-            let sub = rest.get(..len)?;
-            r.skip(RW_HEADER_LEN.checked_add(len)?)?;
-            r.align(4).or(Some(()))?;
+            let (req, sub) = next_write(&mut r)?;
             if req.addr.index == index::WRITE_MULTIPLE && depth == 0 {
                 self.write_multiple(sub, w, 1, failed)?;
                 continue;
             }
             let status = if req.addr.index == index::WRITE_MULTIPLE {
                 RecordError::InvalidIndex.status(ec::IOD_WRITE_RES)
-            } else if len > crate::model::MAX_RECORD_SIZE {
+            } else if sub.len() > crate::model::MAX_RECORD_SIZE {
                 RecordError::WriteLength.status(ec::IOD_WRITE_RES)
             } else {
                 match self.write_one(req.addr, sub) {
@@ -601,6 +593,17 @@ impl<H: RecordHook> Cm<H> {
         }
         status
     }
+}
+
+/// The next sub-write of a multiple write at `r`: its header and its record
+/// data; `r` moves past both and the padding to 4 bytes.
+fn next_write<'a>(r: &mut Reader<'a>) -> Option<(RwRequest, &'a [u8])> {
+    let (req, rest) = RwRequest::parse(r.rest()).filter(|(q, _)| q.write)?;
+    let len = usize::try_from(req.record_len).ok()?;
+    let sub = rest.get(..len)?;
+    r.skip(RW_HEADER_LEN.checked_add(len)?)?;
+    r.align(4).or(Some(()))?;
+    Some((req, sub))
 }
 
 fn service(op: u16) -> u8 {

@@ -28,16 +28,8 @@ impl<'a> NdrRequest<'a> {
     /// Parses and checks the header: ArgsLength fits the body, Offset 0,
     /// ActualCount = ArgsLength, ArgsLength ≤ MaximumCount.
     pub fn parse(body: &'a [u8], endian: Endian) -> Option<NdrRequest<'a>> {
-        let mut r = Reader::new(body, endian);
-        let args_maximum = r.u32()?;
-        let args_length = r.u32()?;
-        let maximum_count = r.u32()?;
-        let offset = r.u32()?;
-        let actual_count = r.u32()?;
-        if offset != 0 || actual_count != args_length || args_length > maximum_count {
-            return None;
-        }
-        let args = r.bytes(usize::try_from(args_length).ok()?)?;
+        let (mut r, args_maximum, args_length, maximum_count) = Self::header(body, endian)?;
+        let args = r.bytes(args_length)?;
         Some(NdrRequest {
             args_maximum,
             maximum_count,
@@ -49,6 +41,18 @@ impl<'a> NdrRequest<'a> {
     /// the buffer ([`crate::rpc::Call::truncated`]): `args` are the
     /// arguments that arrived, shorter than ArgsLength.
     pub fn parse_truncated(body: &'a [u8], endian: Endian) -> Option<NdrRequest<'a>> {
+        let (r, args_maximum, args_length, maximum_count) = Self::header(body, endian)?;
+        let args = r.rest();
+        (args.len() < args_length).then_some(NdrRequest {
+            args_maximum,
+            maximum_count,
+            args,
+        })
+    }
+
+    /// Reads and checks the five header words; returns the reader past them,
+    /// ArgsMaximum, ArgsLength and MaximumCount.
+    fn header(body: &'a [u8], endian: Endian) -> Option<(Reader<'a>, u32, usize, u32)> {
         let mut r = Reader::new(body, endian);
         let args_maximum = r.u32()?;
         let args_length = r.u32()?;
@@ -58,12 +62,7 @@ impl<'a> NdrRequest<'a> {
         if offset != 0 || actual_count != args_length || args_length > maximum_count {
             return None;
         }
-        let args = r.rest();
-        (args.len() < usize::try_from(args_length).ok()?).then_some(NdrRequest {
-            args_maximum,
-            maximum_count,
-            args,
-        })
+        Some((r, args_maximum, usize::try_from(args_length).ok()?, maximum_count))
     }
 }
 

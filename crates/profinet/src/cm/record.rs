@@ -115,18 +115,24 @@ impl RwRequest {
 /// Writes an IODReadResHeader (`record_len` bytes of data follow).
 pub fn emit_read_res(w: &mut Writer<'_>, req: &RwRequest, record_len: u32) -> Option<()> {
     emit_block(w, IOD_READ_RES, |w| {
-        w.u16(req.seq)?;
-        w.bytes(&req.ar_uuid.0)?;
-        w.u32(req.addr.api)?;
-        w.u16(req.addr.slot)?;
-        w.u16(req.addr.subslot)?;
-        w.zeros(2)?;
-        w.u16(req.addr.index)?;
-        w.u32(record_len)?;
-        w.u16(0)?; // AdditionalValue1
-        w.u16(0)?; // AdditionalValue2
+        emit_res_head(w, req, record_len)?;
         w.zeros(20)
     })
+}
+
+/// The fields a read and a write response header share: SeqNumber, ARUUID,
+/// the address, RecordDataLength, AdditionalValue1 and 2 (zero).
+fn emit_res_head(w: &mut Writer<'_>, req: &RwRequest, record_len: u32) -> Option<()> {
+    w.u16(req.seq)?;
+    w.bytes(&req.ar_uuid.0)?;
+    w.u32(req.addr.api)?;
+    w.u16(req.addr.slot)?;
+    w.u16(req.addr.subslot)?;
+    w.zeros(2)?;
+    w.u16(req.addr.index)?;
+    w.u32(record_len)?;
+    w.u16(0)?; // AdditionalValue1
+    w.u16(0) // AdditionalValue2
 }
 
 /// Writes an IODWriteResHeader carrying `status`.
@@ -137,16 +143,7 @@ pub fn emit_write_res(
     status: PnioStatus,
 ) -> Option<()> {
     emit_block(w, IOD_WRITE_RES, |w| {
-        w.u16(req.seq)?;
-        w.bytes(&req.ar_uuid.0)?;
-        w.u32(req.addr.api)?;
-        w.u16(req.addr.slot)?;
-        w.u16(req.addr.subslot)?;
-        w.zeros(2)?;
-        w.u16(req.addr.index)?;
-        w.u32(record_len)?;
-        w.u16(0)?;
-        w.u16(0)?;
+        emit_res_head(w, req, record_len)?;
         w.bytes(&status.to_bytes())?;
         w.zeros(16)
     })

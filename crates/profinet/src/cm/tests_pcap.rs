@@ -8,6 +8,7 @@ use super::tests_connect::{ccontrol_response, dev, CTRL, CTRL_MAC, OUR_MAC};
 use super::tests_vectors::*;
 use crate::ip::{Endpoint, IpConfig, Ipv4Addr, Received, Stack, UdpTx, RPC_PORT, UDP_PAYLOAD_OFFSET};
 use crate::rpc::tests::hex;
+use crate::tests_tshark::pcap;
 use nanos::Nanos;
 use std::vec::Vec;
 
@@ -37,23 +38,6 @@ fn frame(s: &mut Stack, src_port: u16, dst: Endpoint, payload: &[u8]) -> Vec<u8>
         UdpTx::Frame(n) => tx[..n].to_vec(),
         UdpTx::ArpRequest(_) => panic!("neighbour unknown"),
     }
-}
-
-fn pcap(frames: &[Vec<u8>]) -> Vec<u8> {
-    let mut p = Vec::new();
-    p.extend_from_slice(&0xa1b2_c3d4u32.to_le_bytes());
-    p.extend_from_slice(&2u16.to_le_bytes());
-    p.extend_from_slice(&4u16.to_le_bytes());
-    for v in [0u32, 0, 65535, 1] {
-        p.extend_from_slice(&v.to_le_bytes());
-    }
-    for (i, f) in frames.iter().enumerate() {
-        for v in [i as u32, 0, f.len() as u32, f.len() as u32] {
-            p.extend_from_slice(&v.to_le_bytes());
-        }
-        p.extend_from_slice(f);
-    }
-    p
 }
 
 #[test]

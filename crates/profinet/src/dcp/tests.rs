@@ -21,6 +21,18 @@ pub(super) fn server(name: &str) -> DcpServer {
     )
 }
 
+/// `ev` is exactly the one NameOfStation event of `name`, `permanent` or not.
+#[track_caller]
+pub(super) fn assert_name_event(ev: &[Event], name: NameOfStation, permanent: bool) {
+    assert_eq!(ev, [Event::NameOfStation { name, permanent }]);
+}
+
+/// `ev` is exactly the one IpSuite event of `suite`, `permanent` or not.
+#[track_caller]
+pub(super) fn assert_suite_event(ev: &[Event], suite: IpSuite, permanent: bool) {
+    assert_eq!(ev, [Event::IpSuite { suite, permanent }]);
+}
+
 pub(super) fn suite(ip: [u8; 4], mask: [u8; 4], gw: [u8; 4]) -> IpSuite {
     IpSuite {
         ip: Ipv4Addr::from(ip),
@@ -147,6 +159,16 @@ impl Answer {
             )
             .collect()
     }
+}
+
+/// A Set of the one block `kind` with `qualifier` and `value` at time zero.
+fn set_one(
+    s: &mut DcpServer,
+    kind: BlockType,
+    qualifier: u16,
+    value: Value<'_>,
+) -> (Option<(Answer, Nanos)>, Events) {
+    run(s, Nanos::ZERO, &set(&[set_block(kind, qualifier, value)]))
 }
 
 fn run(s: &mut DcpServer, now: Nanos, frame: &[u8]) -> (Option<(Answer, Nanos)>, Events) {
@@ -282,57 +304,28 @@ fn p008_identify_response_delay_is_spread_by_the_mac() {
 fn p009_set_ip_permanent_overwrites_the_stored_static_ip() {
     let mut s = server("drive-1");
     let new = suite([10, 0, 0, 7], [255, 0, 0, 0], [0, 0, 0, 0]);
-    let (a, ev) = run(
-        &mut s,
-        Nanos::ZERO,
-        &set(&[set_block(BlockType::IpParameter, 1, Value::IpParameter(new))]),
-    );
+    let (a, ev) = set_one(&mut s, BlockType::IpParameter, 1, Value::IpParameter(new));
     let a = a.unwrap().0;
     assert_eq!(
         (a.eth_dst, a.frame_id, a.header.service),
         (PLC, 0xFEFD, ServiceId::Set)
     );
     assert_eq!(a.errors(), [(BlockType::IpParameter, BlockError::NoError)]);
-    assert_eq!(
-        &ev[..],
-        [Event::IpSuite {
-            suite: new,
-            permanent: true
-        }]
-    );
+    assert_suite_event(&ev, new, true);
     assert_eq!(s.ip_suite(), new);
     // Temporary: applied, reported as temporary (the store clears its copy).
     let tmp = suite([10, 0, 0, 8], [255, 0, 0, 0], [10, 0, 0, 1]);
-    let (_, ev) = run(
-        &mut s,
-        Nanos::ZERO,
-        &set(&[set_block(BlockType::IpParameter, 0, Value::IpParameter(tmp))]),
-    );
-    assert_eq!(
-        &ev[..],
-        [Event::IpSuite {
-            suite: tmp,
-            permanent: false
-        }]
-    );
+    let (_, ev) = set_one(&mut s, BlockType::IpParameter, 0, Value::IpParameter(tmp));
+    assert_suite_event(&ev, tmp, false);
     assert_eq!(s.ip_suite(), tmp);
     // All zero clears the address.
-    let (_, ev) = run(
+    let (_, ev) = set_one(
         &mut s,
-        Nanos::ZERO,
-        &set(&[set_block(
-            BlockType::IpParameter,
-            1,
-            Value::IpParameter(IpSuite::UNSET),
-        )]),
+        BlockType::IpParameter,
+        1,
+        Value::IpParameter(IpSuite::UNSET),
     );
-    assert_eq!(
-        &ev[..],
-        [Event::IpSuite {
-            suite: IpSuite::UNSET,
-            permanent: true
-        }]
-    );
+    assert_suite_event(&ev, IpSuite::UNSET, true);
 }
 
 #[test]
@@ -351,11 +344,7 @@ fn p009_invalid_ip_suites_are_refused_and_change_nothing() {
         suite([0; 4], [255, 255, 255, 0], [0; 4]),
     ] {
         assert!(!server::ip_suite_valid(&bad), "{bad:?}");
-        let (a, ev) = run(
-            &mut s,
-            Nanos::ZERO,
-            &set(&[set_block(BlockType::IpParameter, 1, Value::IpParameter(bad))]),
-        );
+        let (a, ev) = set_one(&mut s, BlockType::IpParameter, 1, Value::IpParameter(bad));
         assert_eq!(
             a.unwrap().0.errors(),
             [(BlockType::IpParameter, BlockError::SuboptionNotSet)]
@@ -384,36 +373,16 @@ fn p009_invalid_ip_suites_are_refused_and_change_nothing() {
 #[test]
 fn p007_set_name_of_station_permanent_and_temporary() {
     let mut s = server("drive-1");
-    let (a, ev) = run(
-        &mut s,
-        Nanos::ZERO,
-        &set(&[set_block(BlockType::NameOfStation, 1, Value::Bytes(b"axis-a"))]),
-    );
+    let (a, ev) = set_one(&mut s, BlockType::NameOfStation, 1, Value::Bytes(b"axis-a"));
     assert_eq!(
         a.unwrap().0.errors(),
         [(BlockType::NameOfStation, BlockError::NoError)]
     );
     let name: NameOfStation = "axis-a".parse().unwrap();
-    assert_eq!(
-        &ev[..],
-        [Event::NameOfStation {
-            name: name.clone(),
-            permanent: true
-        }]
-    );
+    assert_name_event(&ev, name.clone(), true);
     assert_eq!(s.name_of_station(), &name);
-    let (_, ev) = run(
-        &mut s,
-        Nanos::ZERO,
-        &set(&[set_block(BlockType::NameOfStation, 0, Value::Bytes(b""))]),
-    );
-    assert_eq!(
-        &ev[..],
-        [Event::NameOfStation {
-            name: NameOfStation::EMPTY,
-            permanent: false
-        }]
-    );
+    let (_, ev) = set_one(&mut s, BlockType::NameOfStation, 0, Value::Bytes(b""));
+    assert_name_event(&ev, NameOfStation::EMPTY, false);
     assert!(s.name_of_station().is_empty());
 }
 
@@ -421,11 +390,7 @@ fn p007_set_name_of_station_permanent_and_temporary() {
 fn p007_invalid_name_is_refused_with_suboption_not_set() {
     let mut s = server("drive-1");
     for bad in [&b"Drive-1"[..], b"1.2.3.4", b"port-001", b"a..b", &[b'a'; 241]] {
-        let (a, ev) = run(
-            &mut s,
-            Nanos::ZERO,
-            &set(&[set_block(BlockType::NameOfStation, 1, Value::Bytes(bad))]),
-        );
+        let (a, ev) = set_one(&mut s, BlockType::NameOfStation, 1, Value::Bytes(bad));
         assert_eq!(
             a.unwrap().0.errors(),
             [(BlockType::NameOfStation, BlockError::SuboptionNotSet)]
@@ -539,15 +504,7 @@ fn reset_to_factory_modes() {
         (0x0010, ResetMode::All, true),
     ] {
         let mut s = server("drive-1");
-        let (a, ev) = run(
-            &mut s,
-            Nanos::ZERO,
-            &set(&[set_block(
-                BlockType::ControlResetToFactory,
-                qualifier,
-                Value::Empty,
-            )]),
-        );
+        let (a, ev) = set_one(&mut s, BlockType::ControlResetToFactory, qualifier, Value::Empty);
         assert_eq!(
             a.unwrap().0.errors(),
             [(BlockType::ControlResetToFactory, BlockError::NoError)]
@@ -569,11 +526,7 @@ fn reset_to_factory_modes() {
         }
     }
     let mut s = server("drive-1");
-    let (_, ev) = run(
-        &mut s,
-        Nanos::ZERO,
-        &set(&[set_block(BlockType::ControlFactoryReset, 0, Value::Empty)]),
-    );
+    let (_, ev) = set_one(&mut s, BlockType::ControlFactoryReset, 0, Value::Empty);
     assert_eq!(ev[0], Event::ResetToFactory(ResetMode::All));
     assert!(s.name_of_station().is_empty());
 }

@@ -13,7 +13,7 @@
 use std::vec::Vec;
 
 use super::pdu::*;
-use super::tests::{server, suite, PLC};
+use super::tests::{assert_name_event, assert_suite_event, server, suite, PLC};
 use super::*;
 use nanos::Nanos;
 
@@ -140,23 +140,11 @@ fn p007_profinet_py_set_name_permanent_and_temporary() {
     let (f, _, ev) = answer(&mut s, Nanos::ZERO, SET_NAME_PERM);
     assert_eq!(pnpy_set_result(&f), 0);
     let name: NameOfStation = "drive-1".parse().unwrap();
-    assert_eq!(
-        &ev[..],
-        [Event::NameOfStation {
-            name,
-            permanent: true
-        }]
-    );
+    assert_name_event(&ev, name, true);
     let (f, _, ev) = answer(&mut s, Nanos::ZERO, SET_NAME_TEMP);
     assert_eq!(pnpy_set_result(&f), 0);
     let name: NameOfStation = "axis-a".parse().unwrap();
-    assert_eq!(
-        &ev[..],
-        [Event::NameOfStation {
-            name,
-            permanent: false
-        }]
-    );
+    assert_name_event(&ev, name, false);
     assert_eq!(s.name_of_station().as_str(), "axis-a");
 }
 
@@ -166,24 +154,12 @@ fn p009_profinet_py_set_ip_overwrites_the_static_ip() {
     let (f, _, ev) = answer(&mut s, Nanos::ZERO, SET_IP_PERM);
     assert_eq!(pnpy_set_result(&f), 0);
     let new = suite([192, 168, 0, 50], [255, 255, 255, 0], [192, 168, 0, 1]);
-    assert_eq!(
-        &ev[..],
-        [Event::IpSuite {
-            suite: new,
-            permanent: true
-        }]
-    );
+    assert_suite_event(&ev, new, true);
     assert_eq!(s.ip_suite(), new);
     let (f, _, ev) = answer(&mut s, Nanos::ZERO, SET_IP_TEMP);
     assert_eq!(pnpy_set_result(&f), 0);
     let tmp = suite([10, 0, 0, 7], [255, 0, 0, 0], [0, 0, 0, 0]);
-    assert_eq!(
-        &ev[..],
-        [Event::IpSuite {
-            suite: tmp,
-            permanent: false
-        }]
-    );
+    assert_suite_event(&ev, tmp, false);
 }
 
 #[test]

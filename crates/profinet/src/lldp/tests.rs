@@ -36,16 +36,21 @@ fn build(name: &str, port: u16, mac: MacAddr, ip: Option<Ipv4Addr>, form: PortId
     out[..n].to_vec()
 }
 
+/// "drive-1" at 192.168.0.86, short port IDs: the frame of `port`.
+fn build_drive1(port: u16, mac: MacAddr) -> Vec<u8> {
+    build(
+        "drive-1",
+        port,
+        mac,
+        Some(Ipv4Addr::new(192, 168, 0, 86)),
+        PortIdForm::Short,
+    )
+}
+
 #[test]
 fn p037_lldp_frame_per_port_carries_the_profinet_tlvs() {
     for (port, mac, pid) in [(1, P1_MAC, b"port-001"), (2, P2_MAC, b"port-002")] {
-        let f = build(
-            "drive-1",
-            port,
-            mac,
-            Some(Ipv4Addr::new(192, 168, 0, 86)),
-            PortIdForm::Short,
-        );
+        let f = build_drive1(port, mac);
         assert_eq!(&f[..6], &MacAddr::LLDP.0);
         assert_eq!(&f[6..12], &mac.0, "source is the port MAC (P-006)");
         assert_eq!(&f[12..14], &[0x88, 0xCC]);
@@ -235,13 +240,7 @@ fn p038_received_lldpdu_gives_the_neighbours_pnio_mac_phy_and_management_address
 
 #[test]
 fn p038_our_own_lldpdu_parses_back_to_what_was_sent() {
-    let f = build(
-        "drive-1",
-        1,
-        P1_MAC,
-        Some(Ipv4Addr::new(192, 168, 0, 86)),
-        PortIdForm::Short,
-    );
+    let f = build_drive1(1, P1_MAC);
     let n = Neighbor::parse(&EthFrame::parse(&f).unwrap()).unwrap();
     let info = PortInfo::fast_ethernet(P1_MAC);
     assert_eq!(n.delay, Some(info.delay));
@@ -294,13 +293,7 @@ fn p038_odd_optional_tlvs_are_skipped_and_the_neighbour_kept() {
 #[ignore]
 fn lldp_dump() {
     for (port, mac) in [(1, P1_MAC), (2, P2_MAC)] {
-        let f = build(
-            "drive-1",
-            port,
-            mac,
-            Some(Ipv4Addr::new(192, 168, 0, 86)),
-            PortIdForm::Short,
-        );
+        let f = build_drive1(port, mac);
         let h: Vec<std::string::String> = f.iter().map(|b| std::format!("{b:02x}")).collect();
         std::println!("{}", h.concat());
     }

@@ -150,17 +150,28 @@ fn rw(code1: u8, write: bool) -> PnioStatus {
     PnioStatus::rw(if write { 0xDF } else { 0xDE }, code1)
 }
 
+/// A block of `head` (hex, from the block type on), the name, then `tail`
+/// (hex), with its BlockLength filled in.
+fn named_block(head: &str, name: &[u8], tail: &str) -> Vec<u8> {
+    let mut b = hex(head);
+    b.extend_from_slice(name);
+    b.extend_from_slice(&hex(tail));
+    let len = (b.len() - 4) as u16;
+    b[2..4].copy_from_slice(&len.to_be_bytes());
+    b
+}
+
 #[test]
 fn p040_pd_port_data_real_reports_port_mac_link_mau_and_no_peer() {
     let mut r = rig();
     let (status, data) = r.read(0x8001, index::PD_PORT_DATA_REAL);
     assert_eq!(status, OK);
-    let mut want = hex("020f 0000 0100 0000 0000 8001 08");
-    want.extend_from_slice(b"port-001");
     // no peer, padding to 4, MAU type 16, padding, boundaries 0, link up, padding, copper
-    want.extend_from_slice(&hex("00 0000 0010 0000 00000000 00000000 0001 0000 00000001"));
-    let len = (want.len() - 4) as u16;
-    want[2..4].copy_from_slice(&len.to_be_bytes());
+    let want = named_block(
+        "020f 0000 0100 0000 0000 8001 08",
+        b"port-001",
+        "00 0000 0010 0000 00000000 00000000 0001 0000 00000001",
+    );
     assert_eq!(data, want);
     // port 2: link down, MAU type 0
     let (status, data) = r.read(0x8002, index::PD_PORT_DATA_REAL);
@@ -198,11 +209,11 @@ fn p040_pd_interface_data_real_has_the_name_mac_and_ip_in_force() {
     let mut r = rig();
     let (status, data) = r.read(0x8000, index::PD_INTERFACE_DATA_REAL);
     assert_eq!(status, OK);
-    let mut want = hex("0240 0000 0100 07");
-    want.extend_from_slice(b"drive-1");
-    want.extend_from_slice(&hex("0000 020000000050 0000 c0a80032 ffffff00 00000000"));
-    let len = (want.len() - 4) as u16;
-    want[2..4].copy_from_slice(&len.to_be_bytes());
+    let want = named_block(
+        "0240 0000 0100 07",
+        b"drive-1",
+        "0000 020000000050 0000 c0a80032 ffffff00 00000000",
+    );
     assert_eq!(data, want);
 }
 
@@ -403,8 +414,9 @@ fn p040_pdev_answers_dissect_without_malformed_packets() {
     ] {
         assert_eq!(r.read(sub, i).0, OK);
     }
-    let text = crate::tests_tshark::dissect(&r.frames, "dcerpc && ip.src == 192.168.0.50");
-    let Some(text) = text else { return };
+    let Some(text) = crate::tests_tshark::device_rpc(&r.frames) else {
+        return;
+    };
     for name in [
         "PDPortDataReal",
         "PDPortDataAdjust",
@@ -436,8 +448,9 @@ fn p039_im0_filter_data_names_the_dap_submodule_and_dissects() {
     // read only
     let w = r.record(true, 0, 1, crate::cm::record::index::IM0_FILTER_DATA, &want);
     assert_eq!(w.0, rw(0xB6, true));
-    let text = crate::tests_tshark::dissect(&r.frames, "dcerpc && ip.src == 192.168.0.50");
-    let Some(text) = text else { return };
+    let Some(text) = crate::tests_tshark::device_rpc(&r.frames) else {
+        return;
+    };
     assert!(
         text.contains("I&M0FilterData") || text.contains("IM0FilterData"),
         "not dissected"
@@ -467,8 +480,9 @@ fn p029_p040_real_identification_data_lists_the_dap_and_the_plugged_modules() {
         &want,
     );
     assert_eq!(w.0, rw(0xB6, true));
-    let text = crate::tests_tshark::dissect(&r.frames, "dcerpc && ip.src == 192.168.0.50");
-    let Some(text) = text else { return };
+    let Some(text) = crate::tests_tshark::device_rpc(&r.frames) else {
+        return;
+    };
     assert!(text.contains("RealIdentificationData"), "not dissected");
 }
 

@@ -63,8 +63,9 @@ fn p040_pd_port_data_check_is_stored_per_port_and_read_back_as_written() {
         r.read(0x8000, index::PD_PORT_DATA_CHECK).0,
         PnioStatus::rw(0xDE, 0xB0)
     );
-    let text = crate::tests_tshark::dissect(&r.frames, "dcerpc && ip.src == 192.168.0.50");
-    let Some(text) = text else { return };
+    let Some(text) = crate::tests_tshark::device_rpc(&r.frames) else {
+        return;
+    };
     assert!(text.contains("CheckPeers"), "not dissected");
 }
 
@@ -160,8 +161,9 @@ fn p037_p040_pd_interface_adjust_name_of_device_puts_the_name_into_the_lldp_port
     );
     let f = lldp_at(&mut r, nanos::Nanos::from_secs(10));
     assert!(!has(&f[0], b"port-001.drive-1"));
-    let text = crate::tests_tshark::dissect(&r.frames, "dcerpc && ip.src == 192.168.0.50");
-    let Some(text) = text else { return };
+    let Some(text) = crate::tests_tshark::device_rpc(&r.frames) else {
+        return;
+    };
     assert!(text.contains("PDInterfaceAdjust"), "not dissected");
 }
 
@@ -190,8 +192,9 @@ fn p040_pd_real_data_holds_the_interface_and_each_port_real_data() {
     assert_eq!(r.read(0x8009, index::PD_REAL_DATA).0, PnioStatus::rw(0xDE, 0xB2));
     let w = r.record(true, 0, 1, index::PD_REAL_DATA, &want);
     assert_eq!(w.0, PnioStatus::rw(0xDF, 0xB6));
-    let text = crate::tests_tshark::dissect(&r.frames, "dcerpc && ip.src == 192.168.0.50");
-    let Some(text) = text else { return };
+    let Some(text) = crate::tests_tshark::device_rpc(&r.frames) else {
+        return;
+    };
     assert!(text.contains("MultipleBlockHeader"), "not dissected");
     assert!(!text.contains("Malformed"), "{text}");
 }
@@ -233,7 +236,8 @@ fn p040_pd_port_statistic_counts_the_octets_and_errors_of_the_interface_and_port
         r.read(0x8003, index::PD_PORT_STATISTIC).0,
         PnioStatus::rw(0xDE, 0xB2)
     );
-    let text = crate::tests_tshark::dissect(&r.frames, "dcerpc && ip.src == 192.168.0.50");
-    let Some(text) = text else { return };
+    let Some(text) = crate::tests_tshark::device_rpc(&r.frames) else {
+        return;
+    };
     assert!(text.contains("PDPortStatistic"), "not dissected");
 }

@@ -208,30 +208,21 @@ fn p041_epm_lookup_returns_the_pnio_tower_then_no_more_entries() {
 fn p041_unknown_interfaces_opnums_and_boot_times_are_rejected() {
     let mut s = server();
     let mut h = Echo::default();
-    let status = |s: &mut Server<4096>| {
+    // `r` is rejected; the reject's status
+    let rejected = |s: &mut Server<4096>, h: &mut Echo, r: &[u8]| {
+        s.receive(Nanos::ZERO, PEER, r, h);
         let out = drain(s);
         let (hdr, body) = Header::parse(&out[0].1).unwrap();
         assert_eq!(hdr.ptype, PacketType::Reject);
         u32::from_be_bytes(body.try_into().unwrap())
     };
-    s.receive(
-        Nanos::ZERO,
-        PEER,
-        &request(PNIO_CONTROLLER_INTERFACE, 0, Drep::BIG, 0, None, &[]),
-        &mut h,
-    );
-    assert_eq!(status(&mut s), nca::UNK_IF);
-    s.receive(
-        Nanos::ZERO,
-        PEER,
-        &request(PNIO_DEVICE_INTERFACE, 6, Drep::BIG, 1, None, &[]),
-        &mut h,
-    );
-    assert_eq!(status(&mut s), nca::OP_RNG_ERROR);
+    let r = request(PNIO_CONTROLLER_INTERFACE, 0, Drep::BIG, 0, None, &[]);
+    assert_eq!(rejected(&mut s, &mut h, &r), nca::UNK_IF);
+    let r = request(PNIO_DEVICE_INTERFACE, 6, Drep::BIG, 1, None, &[]);
+    assert_eq!(rejected(&mut s, &mut h, &r), nca::OP_RNG_ERROR);
     let mut r = request(PNIO_DEVICE_INTERFACE, 0, Drep::BIG, 2, None, &[]);
     r[56..60].copy_from_slice(&7u32.to_be_bytes());
-    s.receive(Nanos::ZERO, PEER, &r, &mut h);
-    assert_eq!(status(&mut s), nca::WRONG_BOOT_TIME);
+    assert_eq!(rejected(&mut s, &mut h, &r), nca::WRONG_BOOT_TIME);
     assert!(h.calls.is_empty());
     assert_eq!(s.counters().rejects, 3);
     // A handler's fault travels as a fault PDU.

@@ -103,18 +103,8 @@ impl Provider {
     /// The IOPS of a submodule's data from now on; `false` if the CR has no
     /// such object.
     pub fn set_iops(&mut self, slot: u16, subslot: u16, iops: Ioxs) -> bool {
-        let at = self
-            .cfg
-            .objects
-            .iter()
-            .position(|o| o.slot == slot && o.subslot == subslot);
-        match at.and_then(|i| self.iops.get_mut(i)) {
-            Some(v) => {
-                *v = iops;
-                true
-            }
-            None => false,
-        }
+        let addrs = self.cfg.objects.iter().map(|o| (o.slot, o.subslot));
+        set_at(addrs, &mut self.iops, (slot, subslot), iops)
     }
 
     /// Every IOPS.
@@ -125,18 +115,8 @@ impl Provider {
     /// The IOCS we send for a submodule of the controller's outputs; `false`
     /// if the CR has no such entry.
     pub fn set_iocs(&mut self, slot: u16, subslot: u16, iocs: Ioxs) -> bool {
-        let at = self
-            .cfg
-            .iocs
-            .iter()
-            .position(|o| o.slot == slot && o.subslot == subslot);
-        match at.and_then(|i| self.iocs.get_mut(i)) {
-            Some(v) => {
-                *v = iocs;
-                true
-            }
-            None => false,
-        }
+        let addrs = self.cfg.iocs.iter().map(|o| (o.slot, o.subslot));
+        set_at(addrs, &mut self.iocs, (slot, subslot), iocs)
     }
 
     /// Every IOCS.
@@ -278,5 +258,17 @@ impl TxFrame<'_, '_> {
 fn put(dst: &mut [u8], src: &[u8]) {
     for (d, s) in dst.iter_mut().zip(src) {
         *d = *s;
+    }
+}
+
+/// Sets the status in `vals` at the position of `at` among `addrs` (slot,
+/// subslot); `false` if `at` is not there.
+fn set_at(mut addrs: impl Iterator<Item = (u16, u16)>, vals: &mut [Ioxs], at: (u16, u16), v: Ioxs) -> bool {
+    match addrs.position(|a| a == at).and_then(|i| vals.get_mut(i)) {
+        Some(x) => {
+            *x = v;
+            true
+        }
+        None => false,
     }
 }

@@ -90,36 +90,42 @@ fn p042_config_cycle_and_validation() {
     assert_eq!(c.cycle_units(), 1024);
     assert_eq!(c.validate(), Ok(()));
     assert_eq!(c.frame_len(), 18 + 2 + 42 + 4);
-    let mut bad = c.clone();
-    bad.frame_id = 0xFC01;
-    assert_eq!(bad.validate(), Err(ConfigError::FrameId));
-    let mut bad = c.clone();
-    bad.data_length = 39;
-    assert_eq!(bad.validate(), Err(ConfigError::DataLength));
-    let mut bad = c.clone();
-    bad.reduction_ratio = 3;
-    assert_eq!(bad.validate(), Err(ConfigError::ReductionRatio));
-    let mut bad = c.clone();
-    bad.reduction_ratio = 512; // 32 × 512 units = 512 ms: the longest
-    bad.phase = 1;
-    assert_eq!(bad.validate(), Ok(()));
-    bad.send_clock_factor = 64; // 1024 ms: too long
-    assert_eq!(bad.validate(), Err(ConfigError::ReductionRatio));
-    let mut bad = c.clone();
-    bad.phase = 33;
-    assert_eq!(bad.validate(), Err(ConfigError::Phase));
-    let mut bad = c.clone();
-    bad.watchdog_factor = 0;
-    assert_eq!(bad.validate(), Err(ConfigError::WatchdogFactor));
-    let mut bad = c.clone();
-    bad.data_hold_factor = 0x1E01;
-    assert_eq!(bad.validate(), Err(ConfigError::DataHoldFactor));
-    let mut bad = c.clone();
-    bad.iocs.push(iocs(9, 9, 36)).unwrap(); // on the IOPS of slot 2
-    assert_eq!(bad.validate(), Err(ConfigError::Layout));
-    let mut bad = c;
-    bad.objects[0].len = 42; // IOPS past the end
-    assert_eq!(bad.validate(), Err(ConfigError::Layout));
+    // each case: one change to the good configuration, and its verdict
+    type Edit = fn(&mut CrConfig);
+    let cases: [(Edit, Result<(), ConfigError>); 10] = [
+        (|b| b.frame_id = 0xFC01, Err(ConfigError::FrameId)),
+        (|b| b.data_length = 39, Err(ConfigError::DataLength)),
+        (|b| b.reduction_ratio = 3, Err(ConfigError::ReductionRatio)),
+        // 32 × 512 units = 512 ms: the longest
+        (
+            |b| {
+                b.reduction_ratio = 512;
+                b.phase = 1;
+            },
+            Ok(()),
+        ),
+        // 1024 ms: too long
+        (
+            |b| {
+                b.reduction_ratio = 512;
+                b.phase = 1;
+                b.send_clock_factor = 64;
+            },
+            Err(ConfigError::ReductionRatio),
+        ),
+        (|b| b.phase = 33, Err(ConfigError::Phase)),
+        (|b| b.watchdog_factor = 0, Err(ConfigError::WatchdogFactor)),
+        (|b| b.data_hold_factor = 0x1E01, Err(ConfigError::DataHoldFactor)),
+        // on the IOPS of slot 2
+        (|b| b.iocs.push(iocs(9, 9, 36)).unwrap(), Err(ConfigError::Layout)),
+        // IOPS past the end
+        (|b| b.objects[0].len = 42, Err(ConfigError::Layout)),
+    ];
+    for (i, (edit, verdict)) in cases.into_iter().enumerate() {
+        let mut bad = c.clone();
+        edit(&mut bad);
+        assert_eq!(bad.validate(), verdict, "case {i}");
+    }
 }
 
 #[test]

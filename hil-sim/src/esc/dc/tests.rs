@@ -25,6 +25,38 @@ fn u32_of(d: &[u8]) -> u32 {
     u32::from_le_bytes(d[..4].try_into().unwrap())
 }
 
+/// How far `a`'s system time is ahead of `b`'s at `t` (ns).
+fn sync_offset(a: &Esc, b: &Esc, t: u64) -> i64 {
+    a.system_time_ns(Nanos::from_ns(t))
+        .wrapping_sub(b.system_time_ns(Nanos::from_ns(t))) as i64
+}
+
+/// Station addresses 0x1000 and 0x1001 for `a` and `b` (APWR) at `t`.
+fn address_pair(a: &mut Esc, b: &mut Esc, t: u64) {
+    for (p, addr) in [(0u16, 0x1000u16), (1, 0x1001)] {
+        xfer(
+            &mut [&mut *a, &mut *b],
+            Command::Apwr,
+            phys(pos(p), ::esc::regs::STATION_ADDRESS),
+            &addr.to_le_bytes(),
+            t,
+        );
+    }
+}
+
+/// The line timing of the two-ESC tests: `a` first (loop time 500 ns),
+/// `b` 250 ns after it.
+fn on_a_line(a: &mut Esc, b: &mut Esc) {
+    a.set_line_timing(LineTiming {
+        arrival: Nanos::from_ns(0),
+        loop_time: Nanos::from_ns(500),
+    });
+    b.set_line_timing(LineTiming {
+        arrival: Nanos::from_ns(250),
+        loop_time: Nanos::from_ns(0),
+    });
+}
+
 /// The signed value of the system time difference register (sign bit 31).
 fn difference(e: &Esc) -> i64 {
     let mut b = [0u8; 4];
@@ -107,14 +139,7 @@ fn esc_local_and_system_time_follow_the_configured_clock() {
 fn receive_times_per_port_follow_the_line() {
     let mut a = esc_with_clock(0, 0);
     let mut b = esc_with_clock(20_000, 1_000_000); // +20 ppm, another phase
-    a.set_line_timing(LineTiming {
-        arrival: Nanos::from_ns(0),
-        loop_time: Nanos::from_ns(500),
-    });
-    b.set_line_timing(LineTiming {
-        arrival: Nanos::from_ns(250),
-        loop_time: Nanos::from_ns(0),
-    });
+    on_a_line(&mut a, &mut b);
     let t = 10_000_000u64;
     let (_, wkc) = xfer(
         &mut [&mut a, &mut b],
@@ -177,24 +202,9 @@ fn drift_run(
 ) -> (Esc, Esc, u64) {
     let mut a = esc_with_clock(drift_a, 3_000_000);
     let mut b = esc_with_clock(drift_b, 987_654_321);
-    a.set_line_timing(LineTiming {
-        arrival: Nanos::from_ns(0),
-        loop_time: Nanos::from_ns(500),
-    });
-    b.set_line_timing(LineTiming {
-        arrival: Nanos::from_ns(250),
-        loop_time: Nanos::from_ns(0),
-    });
+    on_a_line(&mut a, &mut b);
     let mut t = 1_000_000u64;
-    for (p, addr) in [(0u16, 0x1000u16), (1, 0x1001)] {
-        xfer(
-            &mut [&mut a, &mut b],
-            Command::Apwr,
-            phys(pos(p), ::esc::regs::STATION_ADDRESS),
-            &addr.to_le_bytes(),
-            t,
-        );
-    }
+    address_pair(&mut a, &mut b, t);
     // ethercrab's reset of the loop parameters
     xfer(
         &mut [&mut a, &mut b],
@@ -269,16 +279,12 @@ fn drift_control_converges_for_plus_minus_100_ppm() {
         let mut worst_late = 0i64;
         let (a, b, t) = drift_run(da, db, 10_000, 8_000, 1_000, 1_000_000, |a, b, t| {
             if t > 500_000_000 {
-                let d = a
-                    .system_time_ns(Nanos::from_ns(t))
-                    .wrapping_sub(b.system_time_ns(Nanos::from_ns(t))) as i64;
+                let d = sync_offset(a, b, t);
                 worst_late = worst_late.max(d.abs());
             }
         });
         let d = difference(&b);
-        let sync = a
-            .system_time_ns(Nanos::from_ns(t))
-            .wrapping_sub(b.system_time_ns(Nanos::from_ns(t))) as i64;
+        let sync = sync_offset(&a, &b, t);
         std::println!(
             "drifts {da}/{db} ppb: 0x092C {d} ns, true offset {sync} ns, worst after 0.5 s {worst_late} ns, rate a {} b {} ppb",
             a.clock_rate_ppb(),
@@ -303,15 +309,11 @@ fn drift_control_converges_for_plus_minus_100_ppm() {
 fn drift_control_after_static_sync_alone_and_with_slow_cycles() {
     // after the static drift compensation alone
     let (a, b, t) = drift_run(50_000, -80_000, 10_000, 8_000, 0, 0, |_, _, _| {});
-    let sync = a
-        .system_time_ns(Nanos::from_ns(t))
-        .wrapping_sub(b.system_time_ns(Nanos::from_ns(t))) as i64;
+    let sync = sync_offset(&a, &b, t);
     assert!(sync.abs() <= 2 && difference(&b).abs() <= 2, "{sync}");
     // 10 ms cycles only (gains reduced): still converges
     let (a, b, t) = drift_run(50_000, -80_000, 0, 0, 1_000, 10_000_000, |_, _, _| {});
-    let sync = a
-        .system_time_ns(Nanos::from_ns(t))
-        .wrapping_sub(b.system_time_ns(Nanos::from_ns(t))) as i64;
+    let sync = sync_offset(&a, &b, t);
     assert!(sync.abs() <= 5, "{sync}");
 }
 
@@ -319,15 +321,7 @@ fn drift_control_after_static_sync_alone_and_with_slow_cycles() {
 fn drift_control_with_time_filter_depth_stays_stable() {
     let mut a = esc_with_clock(0, 0);
     let mut b = esc_with_clock(100_000, 0);
-    for (p, addr) in [(0u16, 0x1000u16), (1, 0x1001)] {
-        xfer(
-            &mut [&mut a, &mut b],
-            Command::Apwr,
-            phys(pos(p), ::esc::regs::STATION_ADDRESS),
-            &addr.to_le_bytes(),
-            0,
-        );
-    }
+    address_pair(&mut a, &mut b, 0);
     // power-on filter depth 4
     let mut t = 0;
     for _ in 0..2_000 {
@@ -340,9 +334,7 @@ fn drift_control_with_time_filter_depth_stays_stable() {
             t,
         );
     }
-    let sync = a
-        .system_time_ns(Nanos::from_ns(t))
-        .wrapping_sub(b.system_time_ns(Nanos::from_ns(t))) as i64;
+    let sync = sync_offset(&a, &b, t);
     assert!(sync.abs() <= 2, "{sync}");
     assert!(difference(&b).abs() <= 2);
     // speed counter difference shows the frequency correction (-100 ppm, 0.1 ppm units)
