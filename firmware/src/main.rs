@@ -66,7 +66,7 @@ mod app {
     #[cfg(feature = "net")]
     use firmware::net::NodeNet as Net;
     use firmware::once::Once;
-    use firmware::xmc::fast::{FastLoop, Link};
+    use firmware::xmc::fast::{guard, FastLoop, Link};
     use firmware::xmc::motor::{self, ControlTimer};
     use firmware::{tasks, Drive, ParamFlash};
     use pdi::mmio::{OnChip, VolatileWindow};
@@ -248,6 +248,7 @@ mod app {
                 let now = clock.now(DWT::cycle_count());
                 if timer.next_at() <= now {
                     let io = seam.lock(|l| l.each_mut().map(|l| l.io()));
+                    guard(&io);
                     *cmd = tasks::control(drive, timer, now, &io);
                     seam.lock(|l| {
                         for (l, c) in l.iter_mut().zip(cmd.iter()) {

@@ -97,7 +97,7 @@ mod app {
     use drive_pn::PnParamFlash as ParamFlash;
     use firmware::clock::Clock;
     use firmware::pn_log::log_event;
-    use firmware::xmc::fast::{FastLoop, Link};
+    use firmware::xmc::fast::{guard, FastLoop, Link};
     use firmware::xmc::motor::{self, ControlTimer};
     use gmac::phy;
     use nanos::Nanos;
@@ -282,6 +282,7 @@ mod app {
                 let now = clock.now(DWT::cycle_count());
                 if timer.next_at() <= now {
                     let io = seam.lock(|l| l.each_mut().map(|l| l.io()));
+                    guard(&io);
                     *cmd = timer.run(drive, now, &io);
                     seam.lock(|l| {
                         for (l, c) in l.iter_mut().zip(cmd.iter()) {

@@ -145,12 +145,18 @@ impl Link {
     /// The control cycle's inputs: the encoder position, its and the DC
     /// link's state, the mean measured iq since the last call (the last
     /// period's when none ran) and the torque kt·iq, the latched trip.
+    ///
+    /// No PWM period since the last call (the ADC's interrupt stopped: a
+    /// control cycle spans at least four) reads as the supply missing: the
+    /// DC link is no longer measured ([`guard`] then cuts the gate enable,
+    /// and an enabled axis faults).
     #[inline]
     pub fn io(&mut self) -> AxisIo {
-        let iq = if self.periods == 0 {
-            self.iq_last_a
-        } else {
+        let fresh = self.periods > 0;
+        let iq = if fresh {
             self.iq_sum_a / self.periods as f32
+        } else {
+            self.iq_last_a
         };
         let encoder_ok = self.encoder_ok;
         self.iq_sum_a = 0.0;
@@ -158,7 +164,7 @@ impl Link {
         self.encoder_ok = true;
         AxisIo {
             encoder_ok,
-            supply_ok: self.supply_ok,
+            supply_ok: self.supply_ok && fresh,
             current: Some(CurrentActual {
                 torque_nm: self.kt * iq,
                 current_a: iq,
@@ -166,6 +172,18 @@ impl Link {
             }),
             ..AxisIo::ready(self.position_inc)
         }
+    }
+}
+
+/// The control cycle's guard of the fast task: with either axis' supply
+/// missing ([`Link::io`]: the DC link out of its window, or no PWM period
+/// since the last cycle) the gate enable goes low. Where the fast task
+/// runs it has switched such an axis off already (its loop trips on the
+/// DC link); where it stopped, nothing else would.
+#[inline]
+pub fn guard(io: &[AxisIo; 2]) {
+    if io.iter().any(|a| !a.supply_ok) {
+        super::power::set(false);
     }
 }
 
