@@ -18,11 +18,14 @@
 //! cycle hands in its command ([`Link::command`]: iq = torque/kt, id = 0,
 //! the power stage) and takes the measurement for its next cycle
 //! ([`Link::io`]: the position, the mean iq since the last cycle, the
-//! latched trip), as the simulator's `CurrentControl` seam does
-//! (hil-sim `electrical`). A trip (the loop's, or the trap as over-current)
-//! stays latched and reported until the axis is commanded on again, which
-//! the drive does only after the fault was acknowledged; a cause still
-//! present trips again in the first period.
+//! trip), as the simulator's `CurrentControl` seam does (hil-sim
+//! `electrical`). A trip (the loop's, or the trap as over-current) keeps the
+//! axis off until it is commanded on again, which the drive does only after
+//! the fault was acknowledged; a cause still present trips again in the
+//! first period. The control cycle is told of a trip once (the axis latches
+//! the fault itself): a trip still reported after the fault reset would
+//! fault the axis again at once (the drive core's monitor raises it on
+//! every cycle that carries it), and the axis could never be enabled again.
 //!
 //! The board's scaling and the motor are the constants of [`board`]: all
 //! assumptions until a power board is at hand (docs/hardware.md).
@@ -114,6 +117,8 @@ pub struct Link {
     supply_ok: bool,
     /// The latched trip (cleared when the axis is commanded on again).
     trip: Option<CurrentTrip>,
+    /// `trip` was handed to the control cycle.
+    trip_reported: bool,
 }
 
 impl Link {
@@ -131,6 +136,7 @@ impl Link {
             encoder_ok: true,
             supply_ok: false,
             trip: None,
+            trip_reported: false,
         }
     }
 
@@ -144,7 +150,7 @@ impl Link {
 
     /// The control cycle's inputs: the encoder position, its and the DC
     /// link's state, the mean measured iq since the last call (the last
-    /// period's when none ran) and the torque kt·iq, the latched trip.
+    /// period's when none ran) and the torque kt·iq, a new trip (once).
     ///
     /// No PWM period since the last call (the ADC's interrupt stopped: a
     /// control cycle spans at least four) reads as the supply missing: the
@@ -159,6 +165,8 @@ impl Link {
             self.iq_last_a
         };
         let encoder_ok = self.encoder_ok;
+        let trip = if self.trip_reported { None } else { self.trip };
+        self.trip_reported = self.trip.is_some();
         self.iq_sum_a = 0.0;
         self.periods = 0;
         self.encoder_ok = true;
@@ -168,7 +176,7 @@ impl Link {
             current: Some(CurrentActual {
                 torque_nm: self.kt * iq,
                 current_a: iq,
-                trip: self.trip,
+                trip,
             }),
             ..AxisIo::ready(self.position_inc)
         }
@@ -240,6 +248,7 @@ impl FastLoop {
                 foc.reset_trip();
                 self.motor.clear_trap(i);
                 link.trip = None;
+                link.trip_reported = false;
             }
             *was_on = on;
             let trapped = self.motor.trapped(i);
