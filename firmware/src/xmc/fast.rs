@@ -286,10 +286,12 @@ impl FastLoop {
                 foc.reset_trip();
             }
             let run = on && link.trip.is_none() && out.gate_enable;
+            // the pins first (switching on writes 50 % to the shadow
+            // registers), then this step's duties over them for the next period
+            self.motor.set_on(i, run);
             if run {
                 self.motor.set_duties(i, out.compare.map(duty));
             }
-            self.motor.set_on(i, run);
             any_on |= run;
             let m = foc.measured();
             link.iq_last_a = m.current.q;
