@@ -5,8 +5,9 @@
 //!
 //! | task | interrupt | priority | body |
 //! |---|---|---|---|
+//! | `fast` | VADC0_G0_0 (the DC-link result, last of the conversions CCU80 triggers at the PWM centre: 16 kHz) | 4 | `firmware::xmc::fast::FastLoop::period`: both axes' current loops, PWM compare values, trips |
 //! | `sync0` | ERU1_0 (ESC SYNC0 routed through ERU1) | 3 | `node::tasks::sync0` |
-//! | `control` | CCU40_0 (control-cycle timer compare, CCU40 slice 3) | 3 | `node::tasks::control`, the power stage following |
+//! | `control` | CCU40_0 (control-cycle timer compare, CCU40 slice 3) | 3 | `node::tasks::control` on the fast task's measurements, its commands to the fast task |
 //! | `esc` | ECAT0_0 (ESC PDI interrupt: AL events, SM2/SM3, mailbox) | 2 | `node::tasks::esc_event` |
 //! | `mailbox` | CCU42_0 (a spare interrupt, pended by `esc` and by `idle` when the IP stack's timers are due) | 1 | `node::tasks::mailbox_net` (mailbox request, IP stack over EoE) |
 //! | `idle` | — | 0 | `node::tasks::background` (a requested save) |
@@ -16,12 +17,14 @@
 //!
 //! The power stage's peripherals (`firmware::xmc::motor`, crate `xmc-motor`)
 //! are programmed in `init`: CCU8 PWM (gate enable low, and with the
-//! feature `power-pins` the PWM pins low, until a control cycle commands an
-//! axis on), the VADC on the PWM centre, the POSIF
-//! encoders, the CCU4 control-cycle timer whose compare fires `control`, and
-//! ERU1's route of SYNC0 to `sync0`. What stays unverified without a board,
-//! and the bring-up order, is in docs/hardware.md. The axes still get
-//! "ready, at rest" inputs: no current loop runs yet (issue 34).
+//! feature `power-pins` the PWM pins low, until the fast task runs an axis
+//! commanded on), the VADC on the PWM centre, the POSIF encoders, the CCU4
+//! control-cycle timer whose compare fires `control`, and ERU1's route of
+//! SYNC0 to `sync0`. The fast task (`firmware::xmc::fast`) runs both axes'
+//! current loops (crate `foc`) on every PWM period; the control cycle hands
+//! it the iq references and takes the positions, the measured iq and the
+//! trips (`fast::Link`). What stays unverified without a board, and the
+//! bring-up order, is in docs/hardware.md.
 #![no_std]
 #![no_main]
 
@@ -55,7 +58,7 @@ mod app {
     use crate::pac::Interrupt;
     use crate::CPU_HZ;
     use cortex_m::peripheral::DWT;
-    use drive_ecat::axis::{AxisCommand, AxisIo};
+    use drive_ecat::axis::AxisCommand;
     use firmware::clock::Clock;
     use firmware::cycle::CycleTimer;
     #[cfg(not(feature = "net"))]
@@ -63,7 +66,8 @@ mod app {
     #[cfg(feature = "net")]
     use firmware::net::NodeNet as Net;
     use firmware::once::Once;
-    use firmware::xmc::motor::{self, ControlTimer, Motor};
+    use firmware::xmc::fast::{guard, FastLoop, Link};
+    use firmware::xmc::motor::{self, ControlTimer};
     use firmware::{tasks, Drive, ParamFlash};
     use pdi::mmio::{OnChip, VolatileWindow};
 
@@ -80,12 +84,14 @@ mod app {
         net: &'static mut Net,
         /// The CCU4 compare that fires `control` at `timer.next_at()`.
         ctimer: ControlTimer,
+        /// Between `control` and `fast`: the commands in, the measurements out.
+        seam: [Link; 2],
     }
 
     #[local]
     struct Local {
-        /// PWM, ADC and encoders of both axes.
-        motor: Motor,
+        /// PWM, ADC and encoders of both axes and their current loops.
+        fast: FastLoop,
     }
 
     #[init]
@@ -96,6 +102,13 @@ mod app {
         crate::power::init();
         let (motor, mut ctimer) = motor::init();
         motor::route_sync0();
+        let Some(fast) = FastLoop::new(motor) else {
+            defmt::error!("init: current-loop parameters refused");
+            loop {
+                cortex_m::asm::bkpt();
+            }
+        };
+        let seam = [Link::new(fast.kt()); 2];
         defmt::info!("init: firmware (XMC4800), SYNC0 on ERU1_0, ESC on ECAT0_0, control on CCU40_0");
         // SAFETY: ECAT0 is this chip's ESC; the window is owned by the `pdi`
         // resource alone, so RTIC serialises every access to it.
@@ -120,8 +133,9 @@ mod app {
                 cmd: [AxisCommand::OFF; 2],
                 net,
                 ctimer,
+                seam,
             },
-            Local { motor },
+            Local { fast },
         )
     }
 
@@ -204,13 +218,25 @@ mod app {
             });
     }
 
+    /// The current loops of both axes, once per PWM period: the VADC's
+    /// DC-link result (the last conversion of the PWM centre's trigger).
+    /// Above every other task: nothing delays it but `control`'s short
+    /// locks of `seam`.
+    #[task(binds = VADC0_G0_0, priority = 4, shared = [seam], local = [fast])]
+    fn fast(mut cx: fast::Context) {
+        let fast = cx.local.fast;
+        cx.shared.seam.lock(|seam| fast.period(seam));
+    }
+
     /// The control-cycle timer's compare (CCU40 slice 3): one cycle of both
     /// axes when its time has come (a compare short of a far start only
-    /// arms again), the power stage following the commands, the next
-    /// compare armed.
-    #[task(binds = CCU40_0, priority = 3, shared = [drive, timer, clock, cmd, ctimer], local = [motor])]
+    /// arms again) on the fast task's positions and measured currents, its
+    /// commands handed to the fast task, the next compare armed.
+    #[task(binds = CCU40_0, priority = 3, shared = [drive, timer, clock, cmd, ctimer, seam])]
     fn control(cx: control::Context) {
-        let motor = cx.local.motor;
+        // `seam` under its own short locks: the fast task waits for a copy,
+        // never for the control cycle
+        let mut seam = cx.shared.seam;
         (
             cx.shared.drive,
             cx.shared.timer,
@@ -221,8 +247,14 @@ mod app {
             .lock(|drive, timer, clock, cmd, ctimer| {
                 let now = clock.now(DWT::cycle_count());
                 if timer.next_at() <= now {
-                    *cmd = tasks::control(drive, timer, now, &[AxisIo::ready(0); 2]);
-                    motor.follow(cmd);
+                    let io = seam.lock(|l| l.each_mut().map(|l| l.io()));
+                    guard(&io);
+                    *cmd = tasks::control(drive, timer, now, &io);
+                    seam.lock(|l| {
+                        for (l, c) in l.iter_mut().zip(cmd.iter()) {
+                            l.command(c);
+                        }
+                    });
                 }
                 ctimer.arm(timer.next_at(), clock.now(DWT::cycle_count()));
             });

@@ -1,7 +1,8 @@
 //! What the reference board's images (`firmware` on EtherCAT, `firmware-pn`
 //! on PROFINET) share: the PAC as RTIC wants it, the power stage's gate
 //! enable, the power-stage peripherals (`motor`: PWM, ADC, encoders, the
-//! control-cycle timer; crate `xmc-motor`) and the panic stop.
+//! control-cycle timer; crate `xmc-motor`), the current-loop fast task's body
+//! and its board constants (`fast`) and the panic stop.
 
 /// The XMC4800 PAC as RTIC expects a device crate: svd2rust 0.14 output lacks
 /// the `interrupt` alias of the `Interrupt` enum, so it is added here.
@@ -11,8 +12,9 @@ pub mod pac {
 }
 
 /// The power stage's gate-driver enable: P5.9, push-pull, active high
-/// (docs/flashing.md, wiring). Low from `init` until a control cycle
-/// commands an axis' power stage on; the panic stop drives it low.
+/// (docs/flashing.md, wiring). Low from `init` until the fast task
+/// (`fast`) runs an axis commanded on; the fast task drives it low when no
+/// axis is on (trips included), the panic stop drives it low.
 pub mod power {
     /// Port 5 (only its output-modification register, whose set/reset
     /// writes are atomic, and at `init` its pin 8–11 control register).
@@ -36,23 +38,17 @@ pub mod power {
             .omr()
             .write(|w| if on { w.ps9().set_bit() } else { w.pr9().set_bit() });
     }
-
-    /// The gate enable after a control cycle: high while any axis' command
-    /// wants its power stage on (one enable for both axes on this board).
-    #[inline]
-    pub fn follow(cmd: &[drive_ecat::axis::AxisCommand; 2]) {
-        set(cmd.iter().any(|c| c.power_stage));
-    }
 }
+
+pub mod fast;
 
 /// The power stage's peripherals as the images program them (crate
 /// `xmc-motor`; pins, channels and what is unverified: docs/hardware.md).
 pub mod motor {
-    use drive_ecat::axis::AxisCommand;
     use nanos::Nanos;
     use xmc_motor::adc::Adc;
     use xmc_motor::enc::{Encoder, EncoderPins};
-    use xmc_motor::pwm::{Pwm, PwmConfig, DUTY_HALF};
+    use xmc_motor::pwm::{Duty, Pwm, PwmConfig, DUTY_HALF};
     use xmc_motor::{pins, regs, timer, Mmio};
 
     /// PWM rate (issue 34: 16 kHz default).
@@ -113,39 +109,61 @@ pub mod motor {
     }
 
     impl Motor {
-        /// Follows a control cycle's commands: an axis commanded on gets
-        /// its pins to the CCU8 at 50 % (zero voltage: no current loop runs
-        /// yet), an axis commanded off its pins low as plain outputs (pins
-        /// only with `power-pins`); the gate enable high while any axis is
-        /// on (`power::follow`).
-        pub fn follow(&mut self, cmd: &[AxisCommand; 2]) {
-            for (axis, c) in self.axes.iter_mut().zip(cmd) {
-                if c.power_stage != axis.on {
-                    if c.power_stage {
+        /// Axis `i`'s power stage on (`on`: its pins to the CCU8, which
+        /// starts from 50 %, zero voltage) or off (its pins low as plain
+        /// outputs: both switches of every phase off, whatever the CCU8
+        /// does; pins only with `power-pins`). A change only.
+        pub fn set_on(&mut self, i: usize, on: bool) {
+            if let Some(axis) = self.axes.get_mut(i) {
+                if on != axis.on {
+                    if on {
                         axis.pwm.set_duties(&mut self.regs, [DUTY_HALF; 3]);
                     }
                     if let Some(p) = axis.pins {
-                        pins::set_axis(&mut self.regs, p, c.power_stage);
+                        pins::set_axis(&mut self.regs, p, on);
                     }
-                    axis.on = c.power_stage;
+                    axis.on = on;
                 }
             }
-            super::power::follow(cmd);
         }
 
-        /// Both encoders' positions in counts since start.
-        pub fn positions(&mut self) -> [i32; 2] {
-            let regs = &mut self.regs;
-            [0, 1].map(|i| self.axes.get_mut(i).map_or(0, |a| a.enc.position(regs)))
+        /// Axis `i`'s duty cycles for the next PWM period (compare shadow
+        /// registers, transferred at the period boundary).
+        #[inline]
+        pub fn set_duties(&mut self, i: usize, duty: [Duty; 3]) {
+            if let Some(axis) = self.axes.get(i) {
+                axis.pwm.set_duties(&mut self.regs, duty);
+            }
         }
 
-        /// Whether either PWM unit is in its trap state (over-current input).
-        pub fn trapped(&mut self) -> bool {
+        /// Axis `i`'s encoder: its position in counts since start and
+        /// whether POSIF saw a phase error since the last call.
+        #[inline]
+        pub fn encoder(&mut self, i: usize) -> (i32, bool) {
+            match self.axes.get_mut(i) {
+                Some(a) => (a.enc.position(&mut self.regs), a.enc.take_error(&mut self.regs)),
+                None => (0, true),
+            }
+        }
+
+        /// Whether axis `i`'s PWM unit is in its trap state (over-current
+        /// input: its outputs held passive by the CCU8 itself).
+        #[inline]
+        pub fn trapped(&mut self, i: usize) -> bool {
             let regs = &mut self.regs;
-            self.axes.iter().any(|a| a.pwm.trapped(regs))
+            self.axes.get(i).is_none_or(|a| a.pwm.trapped(regs))
+        }
+
+        /// Clears axis `i`'s trap flags (the outputs leave the passive level
+        /// at the next period if the trap input is inactive by then).
+        pub fn clear_trap(&mut self, i: usize) {
+            if let Some(a) = self.axes.get(i) {
+                a.pwm.clear_trap(&mut self.regs);
+            }
         }
 
         /// The last PWM centre's samples, if fresh.
+        #[inline]
         pub fn samples(&mut self) -> Option<xmc_motor::adc::Samples> {
             self.adc.read(&mut self.regs)
         }

@@ -5,14 +5,16 @@
 //!
 //! | task | interrupt | priority | body |
 //! |---|---|---|---|
-//! | `control` | CCU40_0 (control-cycle timer compare, CCU40 slice 3) | 3 | `PnDrive::control_cycle`, the power stage following |
+//! | `fast` | VADC0_G0_0 (the DC-link result, last of the conversions CCU80 triggers at the PWM centre: 16 kHz) | 4 | `firmware::xmc::fast::FastLoop::period`: both axes' current loops, PWM compare values, trips |
+//! | `control` | CCU40_0 (control-cycle timer compare, CCU40 slice 3) | 3 | `PnDrive::control_cycle` on the fast task's measurements, its commands to the fast task |
 //! | `eth` | ETH0_0 (MAC DMA: frame received; pended by `idle` when the device's timers are due) | 2 | `PnDrive::receive` per frame, then `PnDrive::poll` |
 //! | `idle` | — | 0 | fires `eth` when the device's timers are due, follows the PHY's link |
 //!
 //! As on the EtherCAT image, `init` programs the power stage's peripherals
 //! (`firmware::xmc::motor`: PWM with the gate enable low, and with
-//! `power-pins` its pins low, until a control cycle commands an axis on,
-//! ADC, encoders) and the CCU4 compare
+//! `power-pins` its pins low, until the fast task runs an axis commanded
+//! on, ADC, encoders; the fast task's current loops, `firmware::xmc::fast`)
+//! and the CCU4 compare
 //! (CCU40 slice 3) that fires `control` at [`PnCycle::next_at`]; the
 //! device's next deadline (the input frame of each cycle, watchdogs) is
 //! still pended by `idle`. The parameter store is `drive_pn::PnParamFlash` (two
@@ -91,11 +93,12 @@ mod app {
     use crate::pac::Interrupt;
     use crate::{board, Drive, Eth, PnCycle, CPU_HZ};
     use cortex_m::peripheral::DWT;
-    use drive_ecat::axis::{AxisCommand, AxisIo};
+    use drive_ecat::axis::AxisCommand;
     use drive_pn::PnParamFlash as ParamFlash;
     use firmware::clock::Clock;
     use firmware::pn_log::log_event;
-    use firmware::xmc::motor::{self, ControlTimer, Motor};
+    use firmware::xmc::fast::{guard, FastLoop, Link};
+    use firmware::xmc::motor::{self, ControlTimer};
     use gmac::phy;
     use nanos::Nanos;
 
@@ -111,12 +114,14 @@ mod app {
         deadline: Nanos,
         clock: Clock,
         cmd: [AxisCommand; 2],
+        /// Between `control` and `fast`: the commands in, the measurements out.
+        seam: [Link; 2],
     }
 
     #[local]
     struct Local {
-        /// PWM, ADC and encoders of both axes.
-        motor: Motor,
+        /// PWM, ADC and encoders of both axes and their current loops.
+        fast: FastLoop,
         /// The CCU4 compare that fires `control` (only `control` moves the
         /// next cycle start on this image).
         ctimer: ControlTimer,
@@ -133,6 +138,13 @@ mod app {
         core.DWT.enable_cycle_counter();
         firmware::xmc::power::init();
         let (motor, mut ctimer) = motor::init();
+        let Some(fast) = FastLoop::new(motor) else {
+            defmt::error!("init: current-loop parameters refused");
+            loop {
+                cortex_m::asm::bkpt();
+            }
+        };
+        let seam = [Link::new(fast.kt()); 2];
         defmt::info!("init: firmware-pn (XMC4800), PROFINET on ETH0 (RMII), control on CCU40_0");
         let Some(drive) = make_drive() else {
             defmt::error!("init: drive already taken");
@@ -158,9 +170,10 @@ mod app {
                 deadline: Nanos::ZERO,
                 clock,
                 cmd: [AxisCommand::OFF; 2],
+                seam,
             },
             Local {
-                motor,
+                fast,
                 ctimer,
                 phy,
                 link: None,
@@ -244,18 +257,38 @@ mod app {
         }
     }
 
+    /// The current loops of both axes, once per PWM period: the VADC's
+    /// DC-link result (the last conversion of the PWM centre's trigger).
+    /// Above every other task: nothing delays it but `control`'s short
+    /// locks of `seam`.
+    #[task(binds = VADC0_G0_0, priority = 4, shared = [seam], local = [fast])]
+    fn fast(mut cx: fast::Context) {
+        let fast = cx.local.fast;
+        cx.shared.seam.lock(|seam| fast.period(seam));
+    }
+
     /// The control-cycle timer's compare (CCU40 slice 3): one cycle of both
-    /// axes when its time has come, the power stage following the
-    /// commands, the next compare armed.
-    #[task(binds = CCU40_0, priority = 3, shared = [drive, timer, clock, cmd], local = [motor, ctimer])]
+    /// axes when its time has come on the fast task's positions and measured
+    /// currents, its commands handed to the fast task, the next compare
+    /// armed.
+    #[task(binds = CCU40_0, priority = 3, shared = [drive, timer, clock, cmd, seam], local = [ctimer])]
     fn control(cx: control::Context) {
-        let (motor, ctimer) = (cx.local.motor, cx.local.ctimer);
+        let ctimer = cx.local.ctimer;
+        // `seam` under its own short locks: the fast task waits for a copy,
+        // never for the control cycle
+        let mut seam = cx.shared.seam;
         (cx.shared.drive, cx.shared.timer, cx.shared.clock, cx.shared.cmd).lock(
             |drive, timer, clock, cmd| {
                 let now = clock.now(DWT::cycle_count());
                 if timer.next_at() <= now {
-                    *cmd = timer.run(drive, now, &[AxisIo::ready(0); 2]);
-                    motor.follow(cmd);
+                    let io = seam.lock(|l| l.each_mut().map(|l| l.io()));
+                    guard(&io);
+                    *cmd = timer.run(drive, now, &io);
+                    seam.lock(|l| {
+                        for (l, c) in l.iter_mut().zip(cmd.iter()) {
+                            l.command(c);
+                        }
+                    });
                 }
                 ctimer.arm(timer.next_at(), clock.now(DWT::cycle_count()));
             },

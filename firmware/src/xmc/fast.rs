@@ -1,0 +1,325 @@
+//! The current-loop fast task of the board images (issue 34): both axes'
+//! `foc::FocAxis` once per PWM period, on the VADC's "conversions done"
+//! interrupt (VADC0_G0_0, raised by the DC-link result, the last of the five
+//! conversions CCU80 triggers at the PWM centre).
+//!
+//! Per axis and period ([`FastLoop::period`]): the phase currents U and V
+//! (W = −U − V, two shunts) and the DC link from the ADC, the encoder
+//! position and phase-error flag from POSIF, the CCU8's trap flag; the
+//! current loop's step with the iq reference the control cycle set; the
+//! compare values to the CCU8's shadow registers (transferred at the period
+//! boundary). An axis runs (pins to the CCU8, gate enable high) only while
+//! the control cycle commands it on and neither the loop nor the trap has
+//! tripped; otherwise its pins are held low (`power-pins`) and the gate
+//! enable is low once no axis runs: within the period that saw the trip.
+//!
+//! The control cycle and this task meet in [`Link`] (one per axis, an RTIC
+//! resource the control cycle locks for a few instructions): the control
+//! cycle hands in its command ([`Link::command`]: iq = torque/kt, id = 0,
+//! the power stage) and takes the measurement for its next cycle
+//! ([`Link::io`]: the position, the mean iq since the last cycle, the
+//! trip), as the simulator's `CurrentControl` seam does (hil-sim
+//! `electrical`). A trip (the loop's, or the trap as over-current) keeps the
+//! axis off until it is commanded on again, which the drive does only after
+//! the fault was acknowledged; a cause still present trips again in the
+//! first period. The control cycle is told of a trip once (the axis latches
+//! the fault itself): a trip still reported after the fault reset would
+//! fault the axis again at once (the drive core's monitor raises it on
+//! every cycle that carries it), and the axis could never be enabled again.
+//!
+//! The board's scaling and the motor are the constants of [`board`]: all
+//! assumptions until a power board is at hand (docs/hardware.md).
+
+use super::motor::{Motor, DEAD_NS, PWM_HZ};
+use drive_ecat::axis::{AxisCommand, AxisIo, CurrentActual, CurrentTrip};
+use foc::{Dq, FocAxis, Sample, Trip};
+use xmc_motor::pwm::Duty;
+
+/// The board's constants of the current loop, declared once. None is
+/// checked against a power board (docs/hardware.md, "Power stage").
+pub mod board {
+    use foc::{LoopParams, MotorData, Protection, Scaling, Shunts};
+
+    /// Amperes per ADC count of a phase current: a 12-bit conversion over
+    /// ±10 A (4.88 mA per count; the current-sense amplifier's gain and the
+    /// shunt decide it). Positive: current into the motor (the amplifier's
+    /// polarity is assumed so).
+    pub const AMPS_PER_COUNT: f32 = 20.0 / 4096.0;
+    /// ADC count of zero current: mid-scale (no offset calibration yet).
+    pub const ZERO_COUNT: f32 = 2048.0;
+    /// Volts per DC-link ADC count: 0.25 V (1023 V full scale: the divider
+    /// of a 400 V-mains stage).
+    pub const VOLTS_PER_COUNT: f32 = 0.25;
+    /// Encoder lines per revolution (four counts per line): 4096, a power of
+    /// two so the position scales to 2^20 increments per turn exactly.
+    pub const ENCODER_LINES: u32 = 4096;
+    /// Increments (2^20 per revolution) per encoder count.
+    pub const INC_PER_COUNT: i32 = ((1u32 << 20) / (4 * ENCODER_LINES)) as i32;
+    const _: () = assert!(INC_PER_COUNT as u32 * 4 * ENCODER_LINES == 1 << 20);
+    /// Encoder increments of the d axis (the commutation offset): 0, i.e.
+    /// the rotor assumed aligned with phase U at power-on. An incremental
+    /// encoder needs a phasing procedure before the loop can commutate
+    /// (docs/hardware.md: not done yet).
+    pub const COMMUTATION_OFFSET_INC: u32 = 0;
+    /// Compare value of a full PWM period as the loop computes it: 2^15, so
+    /// the CCU8's Q16 duty is twice the loop's compare value (the CCU8
+    /// itself resolves 1/4500 of the period at 16 kHz).
+    pub const LOOP_PERIOD_COUNTS: u16 = 1 << 15;
+    /// The loop's scaling of the board's integers.
+    pub const SCALING: Scaling = Scaling {
+        amps_per_count: AMPS_PER_COUNT,
+        zero_counts: [ZERO_COUNT; 3],
+        volts_per_count: VOLTS_PER_COUNT,
+        pwm_period_counts: LOOP_PERIOD_COUNTS,
+        shunts: Shunts::Two,
+        commutation_offset_inc: COMMUTATION_OFFSET_INC,
+    };
+    /// The motor: the simulator's default servo (`foc::MotorData::default_servo`:
+    /// 3.6 Ω, 12 mH, 4 pole pairs, kt 0.65 N·m/A, 2 A rated, 6 A max). The
+    /// dictionary's motor data do not reach the board's loop yet.
+    pub const MOTOR: MotorData = MotorData::default_servo();
+    /// The loop at the image's PWM rate with ω_c = 2π·1 kHz, dead time as
+    /// the CCU8's.
+    pub const LOOP: LoopParams = LoopParams {
+        pwm_hz: super::PWM_HZ as f32,
+        dead_time_s: super::DEAD_NS as f32 * 1.0e-9,
+        ..LoopParams::default_16k()
+    };
+    /// The stage's protection (`foc::Protection::default_stage`: trip at
+    /// 9 A, DC link 400…800 V, stage 8 A); the loop's i²t only as the
+    /// backstop: the drive core's i²t limits the torque it commands.
+    pub const PROTECTION: Protection = Protection {
+        i2t_limits: false,
+        ..Protection::default_stage()
+    };
+}
+
+/// One axis between the control cycle and the fast task.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct Link {
+    /// Torque constant of the loop, N·m/A.
+    kt: f32,
+    /// Control → fast: power stage commanded on.
+    on: bool,
+    /// Control → fast: iq reference, A.
+    iq_ref_a: f32,
+    /// Fast → control: sum of the measured iq since the last [`Link::io`], A.
+    iq_sum_a: f32,
+    /// PWM periods in `iq_sum_a`.
+    periods: u32,
+    /// The last period's measured iq, A.
+    iq_last_a: f32,
+    /// Encoder position, increments.
+    position_inc: i32,
+    /// POSIF reported no phase error since the last [`Link::io`].
+    encoder_ok: bool,
+    /// The DC link within the stage's window at the last period.
+    supply_ok: bool,
+    /// The latched trip (cleared when the axis is commanded on again).
+    trip: Option<CurrentTrip>,
+    /// `trip` was handed to the control cycle.
+    trip_reported: bool,
+}
+
+impl Link {
+    /// An axis commanded off with nothing measured yet (supply missing
+    /// until the first period says otherwise).
+    pub const fn new(kt: f32) -> Link {
+        Link {
+            kt,
+            on: false,
+            iq_ref_a: 0.0,
+            iq_sum_a: 0.0,
+            periods: 0,
+            iq_last_a: 0.0,
+            position_inc: 0,
+            encoder_ok: true,
+            supply_ok: false,
+            trip: None,
+            trip_reported: false,
+        }
+    }
+
+    /// The control cycle's command: iq = torque/kt (id = 0), the power
+    /// stage; no current with the power stage off.
+    #[inline]
+    pub fn command(&mut self, c: &AxisCommand) {
+        self.on = c.power_stage;
+        self.iq_ref_a = if c.power_stage { c.torque_nm / self.kt } else { 0.0 };
+    }
+
+    /// The control cycle's inputs: the encoder position, its and the DC
+    /// link's state, the mean measured iq since the last call (the last
+    /// period's when none ran) and the torque kt·iq, a new trip (once).
+    ///
+    /// No PWM period since the last call (the ADC's interrupt stopped: a
+    /// control cycle spans at least four) reads as the supply missing: the
+    /// DC link is no longer measured ([`guard`] then cuts the gate enable,
+    /// and an enabled axis faults).
+    #[inline]
+    pub fn io(&mut self) -> AxisIo {
+        let fresh = self.periods > 0;
+        let iq = if fresh {
+            self.iq_sum_a / self.periods as f32
+        } else {
+            self.iq_last_a
+        };
+        let encoder_ok = self.encoder_ok;
+        let trip = if self.trip_reported { None } else { self.trip };
+        self.trip_reported = self.trip.is_some();
+        self.iq_sum_a = 0.0;
+        self.periods = 0;
+        self.encoder_ok = true;
+        AxisIo {
+            encoder_ok,
+            supply_ok: self.supply_ok && fresh,
+            current: Some(CurrentActual {
+                torque_nm: self.kt * iq,
+                current_a: iq,
+                trip,
+            }),
+            ..AxisIo::ready(self.position_inc)
+        }
+    }
+}
+
+/// The control cycle's guard of the fast task: with either axis' supply
+/// missing ([`Link::io`]: the DC link out of its window, or no PWM period
+/// since the last cycle) the gate enable goes low. Where the fast task
+/// runs it has switched such an axis off already (its loop trips on the
+/// DC link); where it stopped, nothing else would.
+#[inline]
+pub fn guard(io: &[AxisIo; 2]) {
+    if io.iter().any(|a| !a.supply_ok) {
+        super::power::set(false);
+    }
+}
+
+/// The fast task's state: the power stage and both current loops.
+pub struct FastLoop {
+    motor: Motor,
+    foc: [FocAxis; 2],
+    /// The command of the last period (a rising edge clears the trips).
+    was_on: [bool; 2],
+    /// Interrupts without a complete set of conversions (none stepped).
+    missed: u32,
+}
+
+impl FastLoop {
+    /// Both loops with [`board`]'s constants, disabled; `None` when `foc`
+    /// refuses them (it does not: its tests check the defaults).
+    pub fn new(motor: Motor) -> Option<FastLoop> {
+        let foc = FocAxis::new(board::MOTOR, board::LOOP, board::SCALING, board::PROTECTION).ok()?;
+        Some(FastLoop {
+            motor,
+            foc: [foc; 2],
+            was_on: [false; 2],
+            missed: 0,
+        })
+    }
+
+    /// The loops' torque constant, N·m/A (for [`Link::new`]).
+    pub fn kt(&self) -> f32 {
+        let [a, _] = &self.foc;
+        a.gains().kt_nm_per_a
+    }
+
+    /// Interrupts that found the conversions incomplete.
+    pub fn missed(&self) -> u32 {
+        self.missed
+    }
+
+    /// One PWM period of both axes (the body of the fast task).
+    pub fn period(&mut self, links: &mut [Link; 2]) {
+        let Some(s) = self.motor.samples() else {
+            self.missed = self.missed.wrapping_add(1);
+            return;
+        };
+        let mut any_on = false;
+        let axes = self
+            .foc
+            .iter_mut()
+            .zip(links.iter_mut())
+            .zip(self.was_on.iter_mut());
+        for (i, ((foc, link), was_on)) in axes.enumerate() {
+            let on = link.on;
+            if on && !*was_on {
+                // commanded on again (after the fault was acknowledged)
+                foc.reset_trip();
+                self.motor.clear_trap(i);
+                link.trip = None;
+                link.trip_reported = false;
+            }
+            *was_on = on;
+            let trapped = self.motor.trapped(i);
+            let (counts, phase_error) = self.motor.encoder(i);
+            let position_inc = counts.wrapping_mul(board::INC_PER_COUNT);
+            let (iu, iv) = (
+                s.iu.get(i).copied().unwrap_or(0),
+                s.iv.get(i).copied().unwrap_or(0),
+            );
+            let sample = Sample {
+                phase_counts: [iu, iv, 0],
+                dc_link_count: s.udc,
+                position_inc: position_inc as u32,
+                encoder_ok: !phase_error,
+            };
+            foc.enable(on && !trapped && link.trip.is_none());
+            let out = foc.step(
+                &sample,
+                Dq {
+                    d: 0.0,
+                    q: link.iq_ref_a,
+                },
+            );
+            if on {
+                if link.trip.is_none() {
+                    link.trip = if trapped {
+                        Some(CurrentTrip::OverCurrent)
+                    } else {
+                        foc.trip().map(current_trip)
+                    };
+                }
+            } else {
+                // gates off: a DC link out of its window is "supply
+                // missing", not a fault; nothing else can trip
+                foc.reset_trip();
+            }
+            let run = on && link.trip.is_none() && out.gate_enable;
+            // the pins first (switching on writes 50 % to the shadow
+            // registers), then this step's duties over them for the next period
+            self.motor.set_on(i, run);
+            if run {
+                self.motor.set_duties(i, out.compare.map(duty));
+            }
+            any_on |= run;
+            let m = foc.measured();
+            link.iq_last_a = m.current.q;
+            link.iq_sum_a += m.current.q;
+            link.periods = link.periods.saturating_add(1);
+            link.position_inc = position_inc;
+            link.encoder_ok &= !phase_error;
+            let dc = board::PROTECTION.dc_link;
+            link.supply_ok = m.vdc >= dc.min_v && m.vdc <= dc.max_v;
+        }
+        super::power::set(any_on);
+    }
+}
+
+/// The CCU8's Q16 duty of a loop compare value (0 ..= [`board::LOOP_PERIOD_COUNTS`]).
+#[inline]
+fn duty(compare: u16) -> Duty {
+    (u32::from(compare) << 1).min(u32::from(Duty::MAX)) as Duty
+}
+
+/// The drive core's name of a loop trip (as hil-sim's `ElectricalAxis` maps it).
+fn current_trip(t: Trip) -> CurrentTrip {
+    match t {
+        Trip::OverCurrent => CurrentTrip::OverCurrent,
+        Trip::PhaseSum => CurrentTrip::PhaseSum,
+        Trip::DcUnderVoltage => CurrentTrip::DcUnderVoltage,
+        Trip::DcOverVoltage => CurrentTrip::DcOverVoltage,
+        Trip::EncoderLost => CurrentTrip::EncoderLost,
+        Trip::MotorI2t => CurrentTrip::MotorI2t,
+    }
+}
