@@ -119,6 +119,11 @@ pub struct Link {
     trip: Option<CurrentTrip>,
     /// `trip` was handed to the control cycle.
     trip_reported: bool,
+    /// The power stage's current limit in force at the last period, A
+    /// (infinite while the loop models no stage i²t).
+    stage_limit_a: f32,
+    /// The power stage's i²t at or above its warning level.
+    stage_warning: bool,
 }
 
 impl Link {
@@ -137,6 +142,8 @@ impl Link {
             supply_ok: false,
             trip: None,
             trip_reported: false,
+            stage_limit_a: f32::INFINITY,
+            stage_warning: false,
         }
     }
 
@@ -174,9 +181,10 @@ impl Link {
             encoder_ok,
             supply_ok: self.supply_ok && fresh,
             current: Some(CurrentActual {
-                torque_nm: self.kt * iq,
-                current_a: iq,
                 trip,
+                stage_limit_a: self.stage_limit_a,
+                stage_warning: self.stage_warning,
+                ..CurrentActual::measured(self.kt * iq, iq)
             }),
             ..AxisIo::ready(self.position_inc)
         }
@@ -301,6 +309,8 @@ impl FastLoop {
             link.encoder_ok &= !phase_error;
             let dc = board::PROTECTION.dc_link;
             link.supply_ok = m.vdc >= dc.min_v && m.vdc <= dc.max_v;
+            link.stage_limit_a = m.stage_i2t.map_or(f32::INFINITY, |_| m.stage_limit_a);
+            link.stage_warning = matches!(m.stage_i2t, Some(st) if st != foc::I2tState::Normal);
         }
         super::power::set(any_on);
     }
@@ -321,5 +331,6 @@ fn current_trip(t: Trip) -> CurrentTrip {
         Trip::DcOverVoltage => CurrentTrip::DcOverVoltage,
         Trip::EncoderLost => CurrentTrip::EncoderLost,
         Trip::MotorI2t => CurrentTrip::MotorI2t,
+        Trip::StageI2t => CurrentTrip::StageI2t,
     }
 }
