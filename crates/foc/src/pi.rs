@@ -15,7 +15,7 @@ pub fn limit_voltage_circle(v: Dq, v_max: f32) -> (Dq, bool) {
         return (v, false);
     }
     let d = fmath::clamp(v.d, -v_max, v_max);
-    let q_max = libm::sqrtf(fmath::max(vm2 - d * d, 0.0));
+    let q_max = fmath::sqrt(fmath::max(vm2 - d * d, 0.0));
     (
         Dq {
             d,
