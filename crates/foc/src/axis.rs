@@ -5,7 +5,7 @@ use crate::params::{Gains, LoopParams, MotorData, ParamError};
 use crate::pi::CurrentPi;
 use crate::protect::{DcLink, I2t, I2tState, OverCurrent, PhaseSum, Trip};
 use crate::seam::{PwmOut, Sample, Scaling, Shunts};
-use crate::svm::{compensate_dead_time, svm};
+use crate::svm::{compare_values, PwmCounts};
 use crate::transform::{clarke, inverse_park, park, Abc, AlphaBeta, Dq};
 use crate::trig::{sin_cos, Angle, RAD_PER_ANGLE};
 
@@ -95,6 +95,7 @@ pub struct Measured {
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct FocAxis {
     gains: Gains,
+    counts: PwmCounts,
     motor: MotorData,
     scaling: Scaling,
     protection: Protection,
@@ -135,6 +136,11 @@ impl FocAxis {
         );
         Ok(Self {
             gains,
+            counts: PwmCounts::new(
+                scaling.pwm_period_counts,
+                gains.dead_time_duty,
+                gains.inv_dead_time_band,
+            ),
             motor,
             scaling,
             protection,
@@ -163,6 +169,11 @@ impl FocAxis {
         // keep the winding's heat: the new model starts at the present level
         let x = self.i2t.level();
         self.gains = gains;
+        self.counts = PwmCounts::new(
+            self.scaling.pwm_period_counts,
+            gains.dead_time_duty,
+            gains.inv_dead_time_band,
+        );
         self.motor = motor;
         self.i2t = I2t::new(motor.rated_current_a, motor.thermal_time_constant_s);
         self.i2t.set_level(x);
@@ -356,12 +367,8 @@ impl FocAxis {
         let k = 1.0 - 0.5 * delta * delta;
         let (so, co) = (sin * k + cos * delta, cos * k - sin * delta);
         let v_ab: AlphaBeta = inverse_park(v, so, co);
-        let (duty, _) = svm(v_ab, vdc, 1.0 / fmath::max(vdc, 1.0));
-        let duty = compensate_dead_time(duty, phases, g.dead_time_duty, g.inv_dead_time_band);
-        let period = f32::from(sc.pwm_period_counts);
-        let cmp = |d: f32| (d * period + 0.5) as u16;
         PwmOut {
-            compare: [cmp(duty.a), cmp(duty.b), cmp(duty.c)],
+            compare: compare_values(v_ab, vdc, phases, &self.counts),
             gate_enable: true,
         }
     }

@@ -63,3 +63,65 @@ pub fn compensate_dead_time(d: Duty, i: Abc, dead_time_duty: f32, inv_band: f32)
         c: fmath::clamp(d.c + c(i.c), 0.0, 1.0),
     }
 }
+
+/// The PWM unit's counts the fused modulator ([`compare_values`]) needs, from the
+/// board's period and the loop's dead time: computed once when the parameters are
+/// set, never per step.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct PwmCounts {
+    /// The period, counts.
+    pub period: f32,
+    /// The period as the largest compare value.
+    pub max: u32,
+    /// Half the period plus the rounding's 0.5, counts.
+    pub centre: f32,
+    /// The dead time's duty, counts (`dead_time_duty`·period).
+    pub dead_time: f32,
+    /// 1 / dead-time band, 1/A.
+    pub inv_band: f32,
+}
+
+impl PwmCounts {
+    /// For a period of `period` counts, the dead time as a fraction of the period
+    /// and 1/band (1/A).
+    pub fn new(period: u16, dead_time_duty: f32, inv_band: f32) -> Self {
+        let p = f32::from(period);
+        Self {
+            period: p,
+            max: u32::from(period),
+            centre: 0.5 * p + 0.5,
+            dead_time: dead_time_duty * p,
+            inv_band,
+        }
+    }
+}
+
+/// [`svm`], then [`compensate_dead_time`], then the compare values
+/// (duty·period rounded, within 0 ..= period), in one pass at the counts' scale:
+/// the scale period/Vdc (or period/span when over-modulating) taken once, the
+/// centring and the dead time added in counts, and the clamp to [0, 1] done on the
+/// integer (`as u32` saturates at 0 and maps NaN to 0 in the FPU's conversion, the
+/// period caps it). The same compare values as the three steps apart up to the
+/// rounding of the reordered products (at most one count, where a value falls on
+/// a half count; `fused_compare_values_match_the_blocks`).
+#[inline]
+pub fn compare_values(v: AlphaBeta, vdc: f32, i: Abc, k: &PwmCounts) -> [u16; 3] {
+    let p = inverse_clarke(v);
+    let max = fmath::max(fmath::max(p.a, p.b), p.c);
+    let min = fmath::min(fmath::min(p.a, p.b), p.c);
+    let span = max - min;
+    // over-modulation: onto the hexagon; else the DC link (at least 1 V)
+    let denom = if span > vdc { span } else { fmath::max(vdc, 1.0) };
+    let scale = k.period / denom;
+    let off = k.centre - 0.5 * (max + min) * scale;
+    let dt = |x: f32| fmath::clamp(x * k.inv_band, -1.0, 1.0) * k.dead_time;
+    let cmp = |x: f32| {
+        let n = x as u32;
+        (if n > k.max { k.max } else { n }) as u16
+    };
+    [
+        cmp(off + p.a * scale + dt(i.a)),
+        cmp(off + p.b * scale + dt(i.b)),
+        cmp(off + p.c * scale + dt(i.c)),
+    ]
+}
