@@ -116,6 +116,13 @@ pub struct FocAxis {
     trip: Option<Trip>,
     enabled: bool,
     external_limit_a: f32,
+    /// The lowest of the limits, A: recomputed where one of them changes
+    /// ([`FocAxis::refresh_limits`]), not per step.
+    limit_a: f32,
+    /// The power stage's own limit in force, A.
+    stage_limit_a: f32,
+    /// The trip the i²t models ask for (motor first, then the stage).
+    i2t_trip: Option<Trip>,
     measured: Measured,
 }
 
@@ -158,8 +165,66 @@ impl FocAxis {
             trip: None,
             enabled: false,
             external_limit_a: f32::INFINITY,
+            limit_a: 0.0,
+            stage_limit_a: 0.0,
+            i2t_trip: None,
             measured: Measured::default(),
         })
+        .map(|mut axis| {
+            axis.refresh_limits();
+            axis
+        })
+    }
+
+    /// One step of both i²t models with the mean square current of the last
+    /// I2T_DECIMATION periods (out of line: once per 256 steps).
+    #[inline(never)]
+    fn i2t_model_step(&mut self) {
+        let mean_sq = self.i2t_sum * (1.0 / I2T_DECIMATION as f32);
+        self.i2t_state = self.i2t.step_alpha(mean_sq, self.i2t_alpha);
+        self.stage_i2t_state = self.stage_i2t.step_alpha(mean_sq, self.stage_i2t_alpha);
+        if matches!(self.stage_i2t_state, I2tState::Limiting | I2tState::Fault) {
+            self.stage_limiting = true;
+        } else if self.stage_i2t.level() < STAGE_I2T_RELEASE {
+            self.stage_limiting = false;
+        }
+        self.i2t_sum = 0.0;
+        self.i2t_count = 0;
+        self.refresh_limits();
+    }
+
+    /// The current limit in force and the i²t models' trip, from the limits and
+    /// the models' states: after each i²t model step, new motor data and a new
+    /// external limit (the step only reads them).
+    fn refresh_limits(&mut self) {
+        let i2t = self.i2t_state;
+        let i2t_limit = if !self.protection.i2t_limits || i2t == I2tState::Normal || i2t == I2tState::Warning
+        {
+            f32::INFINITY
+        } else {
+            self.motor.rated_current_a
+        };
+        // the power stage: its maximum, its rated current while its i²t
+        // model is at or above 100 %
+        let stage_limit = if self.stage_limiting {
+            fmath::min(self.protection.stage_rated_a, self.protection.stage_current_a)
+        } else {
+            self.protection.stage_current_a
+        };
+        // the lowest of the limits (`protect::current_limit`, unrolled: all are
+        // validated positive, the external one sanitised where it is set)
+        self.limit_a = fmath::min(
+            fmath::min(self.motor.max_current_a, stage_limit),
+            fmath::min(self.external_limit_a, i2t_limit),
+        );
+        self.stage_limit_a = stage_limit;
+        self.i2t_trip = if i2t == I2tState::Fault {
+            Some(Trip::MotorI2t)
+        } else if self.stage_i2t_state == I2tState::Fault {
+            Some(Trip::StageI2t)
+        } else {
+            None
+        };
     }
 
     /// New motor data and loop parameters; on a refusal nothing changes. The
@@ -180,6 +245,7 @@ impl FocAxis {
         self.i2t_alpha = self.i2t.alpha(gains.ts_s * I2T_DECIMATION as f32);
         self.stage_i2t_alpha = self.stage_i2t.alpha(gains.ts_s * I2T_DECIMATION as f32);
         self.pi.reset();
+        self.refresh_limits();
         Ok(())
     }
 
@@ -200,6 +266,7 @@ impl FocAxis {
     pub fn set_external_limit(&mut self, limit_a: f32) {
         // a NaN limit is no licence: 0 A; negative likewise
         self.external_limit_a = if limit_a >= 0.0 { limit_a } else { 0.0 };
+        self.refresh_limits();
     }
 
     /// The latched trip, if any.
@@ -274,17 +341,9 @@ impl FocAxis {
         self.i2t_sum += current.d * current.d + current.q * current.q;
         self.i2t_count += 1;
         if self.i2t_count >= I2T_DECIMATION {
-            let mean_sq = self.i2t_sum * (1.0 / I2T_DECIMATION as f32);
-            self.i2t_state = self.i2t.step_alpha(mean_sq, self.i2t_alpha);
-            self.stage_i2t_state = self.stage_i2t.step_alpha(mean_sq, self.stage_i2t_alpha);
-            if matches!(self.stage_i2t_state, I2tState::Limiting | I2tState::Fault) {
-                self.stage_limiting = true;
-            } else if self.stage_i2t.level() < STAGE_I2T_RELEASE {
-                self.stage_limiting = false;
-            }
-            self.i2t_sum = 0.0;
-            self.i2t_count = 0;
+            self.i2t_model_step();
         }
+        let (sc, g) = (&self.scaling, &self.gains);
         let i2t = self.i2t_state;
         if self.trip.is_none() {
             let p = &self.protection;
@@ -302,33 +361,11 @@ impl FocAxis {
                 Some(t)
             } else if !s.encoder_ok {
                 Some(Trip::EncoderLost)
-            } else if i2t == I2tState::Fault {
-                Some(Trip::MotorI2t)
-            } else if self.stage_i2t_state == I2tState::Fault {
-                Some(Trip::StageI2t)
             } else {
-                None
+                self.i2t_trip
             };
         }
-        let i2t_limit = if !self.protection.i2t_limits || i2t == I2tState::Normal || i2t == I2tState::Warning
-        {
-            f32::INFINITY
-        } else {
-            self.motor.rated_current_a
-        };
-        // the power stage: its maximum, its rated current while its i²t
-        // model is at or above 100 %
-        let stage_limit = if self.stage_limiting {
-            fmath::min(self.protection.stage_rated_a, self.protection.stage_current_a)
-        } else {
-            self.protection.stage_current_a
-        };
-        // the lowest of the limits (`protect::current_limit`, unrolled: all are
-        // validated positive, the external one sanitised where it is set)
-        let limit = fmath::min(
-            fmath::min(self.motor.max_current_a, stage_limit),
-            fmath::min(self.external_limit_a, i2t_limit),
-        );
+        let (limit, stage_limit) = (self.limit_a, self.stage_limit_a);
         self.measured = Measured {
             phases,
             current,
