@@ -347,18 +347,22 @@ impl FocAxis {
         let i2t = self.i2t_state;
         if self.trip.is_none() {
             let p = &self.protection;
+            // the DC link inside its window (the ordinary case) asks no more
+            let dc = if vdc >= p.dc_link.min_v && vdc <= p.dc_link.max_v {
+                None
+            } else {
+                // a low DC link with the gates off is no fault: the stage
+                // is only not ready (it trips when they go on)
+                p.dc_link
+                    .check(vdc)
+                    .filter(|&t| self.enabled || t != Trip::DcUnderVoltage)
+            };
             self.trip = if p.over_current.tripped(phases) {
                 Some(Trip::OverCurrent)
             } else if sc.shunts == Shunts::Three && p.phase_sum.implausible(phases) {
                 Some(Trip::PhaseSum)
-            } else if let Some(t) = p
-                .dc_link
-                .check(vdc)
-                // a low DC link with the gates off is no fault: the stage
-                // is only not ready (it trips when they go on)
-                .filter(|&t| self.enabled || t != Trip::DcUnderVoltage)
-            {
-                Some(t)
+            } else if dc.is_some() {
+                dc
             } else if !s.encoder_ok {
                 Some(Trip::EncoderLost)
             } else {
