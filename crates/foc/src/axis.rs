@@ -7,7 +7,7 @@ use crate::protect::{DcLink, I2t, I2tState, OverCurrent, PhaseSum, Trip};
 use crate::seam::{PwmOut, Sample, Scaling, Shunts};
 use crate::svm::{compare_values, PwmCounts};
 use crate::transform::{clarke, inverse_park, park, Abc, AlphaBeta, Dq};
-use crate::trig::{sin_cos, Angle, RAD_PER_ANGLE};
+use crate::trig::{sin_cos, Angle};
 
 /// PWM periods per step of the i²t model (16 ms at 16 kHz).
 pub const I2T_DECIMATION: u32 = 256;
@@ -330,7 +330,7 @@ impl FocAxis {
             .wrapping_mul(g.pole_pairs)
             << 12;
         let omega_e = match self.last_angle {
-            Some(last) => (angle.wrapping_sub(last) as i32) as f32 * (RAD_PER_ANGLE * g.inv_ts),
+            Some(last) => (angle.wrapping_sub(last) as i32) as f32 * g.omega_per_angle,
             None => 0.0,
         };
         self.last_angle = Some(angle);

@@ -77,9 +77,13 @@ impl CurrentPi {
         let eq = reference.q - measured.q;
         let (ffd, ffq) = if g.decoupling {
             // the currents the voltage will meet: half-way to the reference
-            let pd = 0.5 * (measured.d + reference.d);
-            let pq = 0.5 * (measured.q + reference.q);
-            (-omega_e * g.lq_h * pq, omega_e * (g.ld_h * pd + g.psi_vs))
+            // (the halves in half_ld_h/half_lq_h)
+            let sd = measured.d + reference.d;
+            let sq = measured.q + reference.q;
+            (
+                -omega_e * g.half_lq_h * sq,
+                omega_e * (g.half_ld_h * sd + g.psi_vs),
+            )
         } else {
             (0.0, 0.0)
         };
