@@ -392,10 +392,8 @@ impl FocAxis {
             };
         }
 
-        let reference = Dq {
-            d: fmath::clamp(reference.d, -limit, limit),
-            q: fmath::clamp(reference.q, -limit, limit),
-        };
+        let (d, q) = fmath::clamp_sym2(reference.d, reference.q, limit);
+        let reference = Dq { d, q };
         let v_max = g.v_limit_per_vdc * vdc;
         let (v, cut) = self.pi.step(g, reference, current, omega_e, v_max);
         self.measured.voltage = v;

@@ -120,6 +120,18 @@ pub mod fmath {
         fn __foc_vsqrtf(x: f32) -> f32;
     }
 
+    /// `(clamp(a, -l, l), clamp(b, -l, l))`, the same values: one test each
+    /// (|x| ≤ l) in the ordinary case that both are within, the compare-and-selects
+    /// only otherwise (a NaN or a negative l also takes that way).
+    #[inline(always)]
+    pub fn clamp_sym2(a: f32, b: f32, l: f32) -> (f32, f32) {
+        if a.abs() <= l && b.abs() <= l {
+            (a, b)
+        } else {
+            (clamp(a, -l, l), clamp(b, -l, l))
+        }
+    }
+
     /// x limited to [lo, hi] (no panic when lo > hi: hi wins).
     #[inline(always)]
     pub fn clamp(x: f32, lo: f32, hi: f32) -> f32 {

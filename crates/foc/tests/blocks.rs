@@ -541,3 +541,34 @@ fn stage_i2t_warns_then_limits_to_its_rated_current_then_trips() {
     }
     assert_eq!(a.trip(), Some(Trip::StageI2t));
 }
+
+#[test]
+fn clamp_sym2_is_two_clamps() {
+    // the axis' fast path for its reference and integrator limits gives what two
+    // clamps give, NaN, infinities and a negative limit included
+    let xs = [
+        0.0,
+        -0.0,
+        1.0,
+        -1.0,
+        2.5,
+        -2.5,
+        3.0,
+        -3.0,
+        1e30,
+        f32::INFINITY,
+        f32::NEG_INFINITY,
+        f32::NAN,
+    ];
+    let ls = [0.0, 2.5, 3.0, -1.0, f32::INFINITY, f32::NAN];
+    let same = |x: f32, y: f32| x == y || (x.is_nan() && y.is_nan());
+    for &l in &ls {
+        for &a in &xs {
+            for &b in &xs {
+                let (p, q) = foc::fmath::clamp_sym2(a, b, l);
+                let (r, s) = (foc::fmath::clamp(a, -l, l), foc::fmath::clamp(b, -l, l));
+                assert!(same(p, r) && same(q, s), "{a} {b} {l}: {p} {q} vs {r} {s}");
+            }
+        }
+    }
+}
