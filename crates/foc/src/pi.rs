@@ -87,8 +87,8 @@ impl CurrentPi {
         } else {
             (0.0, 0.0)
         };
-        let int_d = fmath::clamp(self.int_d + g.ki_ts_d * ed, -v_max, v_max);
-        let int_q = fmath::clamp(self.int_q + g.ki_ts_q * eq, -v_max, v_max);
+        let (int_d, int_q) =
+            fmath::clamp_sym2(self.int_d + g.ki_ts_d * ed, self.int_q + g.ki_ts_q * eq, v_max);
         let v = Dq {
             d: g.kp_d * ed + int_d + ffd,
             q: g.kp_q * eq + int_q + ffq,
