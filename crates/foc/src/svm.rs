@@ -122,14 +122,8 @@ pub fn compare_values(v: AlphaBeta, vdc: f32, i: Abc, k: &PwmCounts) -> [u16; 3]
     let scale = k.period / denom;
     let off = k.centre - 0.5 * (max + min) * scale;
     let dt = |x: f32| {
-        let q = (x * k.inv_band_q15) as i32;
-        let q = if q > 32_767 {
-            32_767
-        } else if q < -32_768 {
-            -32_768
-        } else {
-            q
-        };
+        // constant bounds: no panic path, one ssat
+        let q = ((x * k.inv_band_q15) as i32).clamp(-32_768, 32_767);
         q as f32 * k.dead_time_q15
     };
     let cmp = |x: f32| {
