@@ -5,9 +5,9 @@ use crate::params::{Gains, LoopParams, MotorData, ParamError};
 use crate::pi::CurrentPi;
 use crate::protect::{DcLink, I2t, I2tState, OverCurrent, PhaseSum, Trip};
 use crate::seam::{PwmOut, Sample, Scaling, Shunts};
-use crate::svm::{compensate_dead_time, svm};
+use crate::svm::{compare_values, PwmCounts};
 use crate::transform::{clarke, inverse_park, park, Abc, AlphaBeta, Dq};
-use crate::trig::{sin_cos, Angle, RAD_PER_ANGLE};
+use crate::trig::{sin_cos, Angle};
 
 /// PWM periods per step of the i²t model (16 ms at 16 kHz).
 pub const I2T_DECIMATION: u32 = 256;
@@ -95,6 +95,7 @@ pub struct Measured {
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct FocAxis {
     gains: Gains,
+    counts: PwmCounts,
     motor: MotorData,
     scaling: Scaling,
     protection: Protection,
@@ -115,6 +116,13 @@ pub struct FocAxis {
     trip: Option<Trip>,
     enabled: bool,
     external_limit_a: f32,
+    /// The lowest of the limits, A: recomputed where one of them changes
+    /// ([`FocAxis::refresh_limits`]), not per step.
+    limit_a: f32,
+    /// The power stage's own limit in force, A.
+    stage_limit_a: f32,
+    /// The trip the i²t models ask for (motor first, then the stage).
+    i2t_trip: Option<Trip>,
     measured: Measured,
 }
 
@@ -135,6 +143,11 @@ impl FocAxis {
         );
         Ok(Self {
             gains,
+            counts: PwmCounts::new(
+                scaling.pwm_period_counts,
+                gains.dead_time_duty,
+                gains.inv_dead_time_band,
+            ),
             motor,
             scaling,
             protection,
@@ -152,8 +165,66 @@ impl FocAxis {
             trip: None,
             enabled: false,
             external_limit_a: f32::INFINITY,
+            limit_a: 0.0,
+            stage_limit_a: 0.0,
+            i2t_trip: None,
             measured: Measured::default(),
         })
+        .map(|mut axis| {
+            axis.refresh_limits();
+            axis
+        })
+    }
+
+    /// One step of both i²t models with the mean square current of the last
+    /// I2T_DECIMATION periods (out of line: once per 256 steps).
+    #[inline(never)]
+    fn i2t_model_step(&mut self) {
+        let mean_sq = self.i2t_sum * (1.0 / I2T_DECIMATION as f32);
+        self.i2t_state = self.i2t.step_alpha(mean_sq, self.i2t_alpha);
+        self.stage_i2t_state = self.stage_i2t.step_alpha(mean_sq, self.stage_i2t_alpha);
+        if matches!(self.stage_i2t_state, I2tState::Limiting | I2tState::Fault) {
+            self.stage_limiting = true;
+        } else if self.stage_i2t.level() < STAGE_I2T_RELEASE {
+            self.stage_limiting = false;
+        }
+        self.i2t_sum = 0.0;
+        self.i2t_count = 0;
+        self.refresh_limits();
+    }
+
+    /// The current limit in force and the i²t models' trip, from the limits and
+    /// the models' states: after each i²t model step, new motor data and a new
+    /// external limit (the step only reads them).
+    fn refresh_limits(&mut self) {
+        let i2t = self.i2t_state;
+        let i2t_limit = if !self.protection.i2t_limits || i2t == I2tState::Normal || i2t == I2tState::Warning
+        {
+            f32::INFINITY
+        } else {
+            self.motor.rated_current_a
+        };
+        // the power stage: its maximum, its rated current while its i²t
+        // model is at or above 100 %
+        let stage_limit = if self.stage_limiting {
+            fmath::min(self.protection.stage_rated_a, self.protection.stage_current_a)
+        } else {
+            self.protection.stage_current_a
+        };
+        // the lowest of the limits (`protect::current_limit`, unrolled: all are
+        // validated positive, the external one sanitised where it is set)
+        self.limit_a = fmath::min(
+            fmath::min(self.motor.max_current_a, stage_limit),
+            fmath::min(self.external_limit_a, i2t_limit),
+        );
+        self.stage_limit_a = stage_limit;
+        self.i2t_trip = if i2t == I2tState::Fault {
+            Some(Trip::MotorI2t)
+        } else if self.stage_i2t_state == I2tState::Fault {
+            Some(Trip::StageI2t)
+        } else {
+            None
+        };
     }
 
     /// New motor data and loop parameters; on a refusal nothing changes. The
@@ -163,12 +234,18 @@ impl FocAxis {
         // keep the winding's heat: the new model starts at the present level
         let x = self.i2t.level();
         self.gains = gains;
+        self.counts = PwmCounts::new(
+            self.scaling.pwm_period_counts,
+            gains.dead_time_duty,
+            gains.inv_dead_time_band,
+        );
         self.motor = motor;
         self.i2t = I2t::new(motor.rated_current_a, motor.thermal_time_constant_s);
         self.i2t.set_level(x);
         self.i2t_alpha = self.i2t.alpha(gains.ts_s * I2T_DECIMATION as f32);
         self.stage_i2t_alpha = self.stage_i2t.alpha(gains.ts_s * I2T_DECIMATION as f32);
         self.pi.reset();
+        self.refresh_limits();
         Ok(())
     }
 
@@ -189,6 +266,7 @@ impl FocAxis {
     pub fn set_external_limit(&mut self, limit_a: f32) {
         // a NaN limit is no licence: 0 A; negative likewise
         self.external_limit_a = if limit_a >= 0.0 { limit_a } else { 0.0 };
+        self.refresh_limits();
     }
 
     /// The latched trip, if any.
@@ -252,7 +330,7 @@ impl FocAxis {
             .wrapping_mul(g.pole_pairs)
             << 12;
         let omega_e = match self.last_angle {
-            Some(last) => (angle.wrapping_sub(last) as i32) as f32 * (RAD_PER_ANGLE * g.inv_ts),
+            Some(last) => (angle.wrapping_sub(last) as i32) as f32 * g.omega_per_angle,
             None => 0.0,
         };
         self.last_angle = Some(angle);
@@ -263,61 +341,35 @@ impl FocAxis {
         self.i2t_sum += current.d * current.d + current.q * current.q;
         self.i2t_count += 1;
         if self.i2t_count >= I2T_DECIMATION {
-            let mean_sq = self.i2t_sum * (1.0 / I2T_DECIMATION as f32);
-            self.i2t_state = self.i2t.step_alpha(mean_sq, self.i2t_alpha);
-            self.stage_i2t_state = self.stage_i2t.step_alpha(mean_sq, self.stage_i2t_alpha);
-            if matches!(self.stage_i2t_state, I2tState::Limiting | I2tState::Fault) {
-                self.stage_limiting = true;
-            } else if self.stage_i2t.level() < STAGE_I2T_RELEASE {
-                self.stage_limiting = false;
-            }
-            self.i2t_sum = 0.0;
-            self.i2t_count = 0;
+            self.i2t_model_step();
         }
+        let (sc, g) = (&self.scaling, &self.gains);
         let i2t = self.i2t_state;
         if self.trip.is_none() {
             let p = &self.protection;
+            // the DC link inside its window (the ordinary case) asks no more
+            let dc = if vdc >= p.dc_link.min_v && vdc <= p.dc_link.max_v {
+                None
+            } else {
+                // a low DC link with the gates off is no fault: the stage
+                // is only not ready (it trips when they go on)
+                p.dc_link
+                    .check(vdc)
+                    .filter(|&t| self.enabled || t != Trip::DcUnderVoltage)
+            };
             self.trip = if p.over_current.tripped(phases) {
                 Some(Trip::OverCurrent)
             } else if sc.shunts == Shunts::Three && p.phase_sum.implausible(phases) {
                 Some(Trip::PhaseSum)
-            } else if let Some(t) = p
-                .dc_link
-                .check(vdc)
-                // a low DC link with the gates off is no fault: the stage
-                // is only not ready (it trips when they go on)
-                .filter(|&t| self.enabled || t != Trip::DcUnderVoltage)
-            {
-                Some(t)
+            } else if dc.is_some() {
+                dc
             } else if !s.encoder_ok {
                 Some(Trip::EncoderLost)
-            } else if i2t == I2tState::Fault {
-                Some(Trip::MotorI2t)
-            } else if self.stage_i2t_state == I2tState::Fault {
-                Some(Trip::StageI2t)
             } else {
-                None
+                self.i2t_trip
             };
         }
-        let i2t_limit = if !self.protection.i2t_limits || i2t == I2tState::Normal || i2t == I2tState::Warning
-        {
-            f32::INFINITY
-        } else {
-            self.motor.rated_current_a
-        };
-        // the power stage: its maximum, its rated current while its i²t
-        // model is at or above 100 %
-        let stage_limit = if self.stage_limiting {
-            fmath::min(self.protection.stage_rated_a, self.protection.stage_current_a)
-        } else {
-            self.protection.stage_current_a
-        };
-        // the lowest of the limits (`protect::current_limit`, unrolled: all are
-        // validated positive, the external one sanitised where it is set)
-        let limit = fmath::min(
-            fmath::min(self.motor.max_current_a, stage_limit),
-            fmath::min(self.external_limit_a, i2t_limit),
-        );
+        let (limit, stage_limit) = (self.limit_a, self.stage_limit_a);
         self.measured = Measured {
             phases,
             current,
@@ -340,10 +392,8 @@ impl FocAxis {
             };
         }
 
-        let reference = Dq {
-            d: fmath::clamp(reference.d, -limit, limit),
-            q: fmath::clamp(reference.q, -limit, limit),
-        };
+        let (d, q) = fmath::clamp_sym2(reference.d, reference.q, limit);
+        let reference = Dq { d, q };
         let v_max = g.v_limit_per_vdc * vdc;
         let (v, cut) = self.pi.step(g, reference, current, omega_e, v_max);
         self.measured.voltage = v;
@@ -356,12 +406,8 @@ impl FocAxis {
         let k = 1.0 - 0.5 * delta * delta;
         let (so, co) = (sin * k + cos * delta, cos * k - sin * delta);
         let v_ab: AlphaBeta = inverse_park(v, so, co);
-        let (duty, _) = svm(v_ab, vdc, 1.0 / fmath::max(vdc, 1.0));
-        let duty = compensate_dead_time(duty, phases, g.dead_time_duty, g.inv_dead_time_band);
-        let period = f32::from(sc.pwm_period_counts);
-        let cmp = |d: f32| (d * period + 0.5) as u16;
         PwmOut {
-            compare: [cmp(duty.a), cmp(duty.b), cmp(duty.c)],
+            compare: compare_values(v_ab, vdc, phases, &self.counts),
             gate_enable: true,
         }
     }

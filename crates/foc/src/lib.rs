@@ -74,6 +74,64 @@ pub mod fmath {
         }
     }
 
+    /// √x, correctly rounded (IEEE 754) like `libm::sqrtf`: on a hard-float Arm
+    /// (the Cortex-M4F) the FPU's `vsqrt.f32`, one instruction (14 cycles) in a
+    /// leaf function, instead of libm's integer digit-by-digit root (about 60
+    /// instructions on the M4F: there is no stable way to reach LLVM's `sqrt` from
+    /// `core`, and `asm!` cannot name an FPU register on this target); libm
+    /// elsewhere (host tests). The same result on both.
+    #[inline(always)]
+    pub fn sqrt(x: f32) -> f32 {
+        #[cfg(all(target_arch = "arm", target_abi = "eabihf"))]
+        {
+            // SAFETY: `__foc_vsqrtf` (global_asm below) reads s0, writes s0 and
+            // returns: an AAPCS-VFP function f32 -> f32 that touches no memory.
+            #[allow(unsafe_code)]
+            unsafe {
+                __foc_vsqrtf(x)
+            }
+        }
+        #[cfg(not(all(target_arch = "arm", target_abi = "eabihf")))]
+        {
+            libm::sqrtf(x)
+        }
+    }
+
+    // the leaf function: two instructions, no stack, no memory
+    #[cfg(all(target_arch = "arm", target_abi = "eabihf"))]
+    #[allow(unsafe_code)]
+    mod vsqrt {
+        core::arch::global_asm!(
+            ".section .text.__foc_vsqrtf,\"ax\",%progbits",
+            ".global __foc_vsqrtf",
+            ".type __foc_vsqrtf,%function",
+            ".fpu fpv4-sp-d16",
+            ".thumb_func",
+            "__foc_vsqrtf:",
+            "vsqrt.f32 s0, s0",
+            "bx lr",
+            ".size __foc_vsqrtf, . - __foc_vsqrtf",
+        );
+    }
+
+    #[cfg(all(target_arch = "arm", target_abi = "eabihf"))]
+    #[allow(unsafe_code)]
+    unsafe extern "C" {
+        fn __foc_vsqrtf(x: f32) -> f32;
+    }
+
+    /// `(clamp(a, -l, l), clamp(b, -l, l))`, the same values: one test each
+    /// (|x| ≤ l) in the ordinary case that both are within, the compare-and-selects
+    /// only otherwise (a NaN or a negative l also takes that way).
+    #[inline(always)]
+    pub fn clamp_sym2(a: f32, b: f32, l: f32) -> (f32, f32) {
+        if a.abs() <= l && b.abs() <= l {
+            (a, b)
+        } else {
+            (clamp(a, -l, l), clamp(b, -l, l))
+        }
+    }
+
     /// x limited to [lo, hi] (no panic when lo > hi: hi wins).
     #[inline(always)]
     pub fn clamp(x: f32, lo: f32, hi: f32) -> f32 {

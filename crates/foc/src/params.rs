@@ -191,6 +191,14 @@ pub struct Gains {
     pub lq_h: f32,
     /// ψ, V·s (back-EMF feed forward).
     pub psi_vs: f32,
+    /// Ld/2, H: the decoupling's current is the mean of measurement and
+    /// reference, the halving folded in here (exact: a power of two).
+    pub half_ld_h: f32,
+    /// Lq/2, H.
+    pub half_lq_h: f32,
+    /// Electrical speed per angle difference over one period, rad/s per
+    /// [`Angle`](crate::trig::Angle) unit: 2π/2³² · f_pwm.
+    pub omega_per_angle: f32,
     /// PWM period, s.
     pub ts_s: f32,
     /// 1/Ts, 1/s.
@@ -283,6 +291,9 @@ impl Gains {
             ld_h: m.ld_h,
             lq_h: m.lq_h,
             psi_vs: m.psi_vs,
+            half_ld_h: 0.5 * m.ld_h,
+            half_lq_h: 0.5 * m.lq_h,
+            omega_per_angle: crate::trig::RAD_PER_ANGLE * l.pwm_hz,
             ts_s: ts,
             inv_ts: l.pwm_hz,
             pole_pairs: m.pole_pairs,

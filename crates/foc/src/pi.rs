@@ -15,7 +15,7 @@ pub fn limit_voltage_circle(v: Dq, v_max: f32) -> (Dq, bool) {
         return (v, false);
     }
     let d = fmath::clamp(v.d, -v_max, v_max);
-    let q_max = libm::sqrtf(fmath::max(vm2 - d * d, 0.0));
+    let q_max = fmath::sqrt(fmath::max(vm2 - d * d, 0.0));
     (
         Dq {
             d,
@@ -77,14 +77,18 @@ impl CurrentPi {
         let eq = reference.q - measured.q;
         let (ffd, ffq) = if g.decoupling {
             // the currents the voltage will meet: half-way to the reference
-            let pd = 0.5 * (measured.d + reference.d);
-            let pq = 0.5 * (measured.q + reference.q);
-            (-omega_e * g.lq_h * pq, omega_e * (g.ld_h * pd + g.psi_vs))
+            // (the halves in half_ld_h/half_lq_h)
+            let sd = measured.d + reference.d;
+            let sq = measured.q + reference.q;
+            (
+                -omega_e * g.half_lq_h * sq,
+                omega_e * (g.half_ld_h * sd + g.psi_vs),
+            )
         } else {
             (0.0, 0.0)
         };
-        let int_d = fmath::clamp(self.int_d + g.ki_ts_d * ed, -v_max, v_max);
-        let int_q = fmath::clamp(self.int_q + g.ki_ts_q * eq, -v_max, v_max);
+        let (int_d, int_q) =
+            fmath::clamp_sym2(self.int_d + g.ki_ts_d * ed, self.int_q + g.ki_ts_q * eq, v_max);
         let v = Dq {
             d: g.kp_d * ed + int_d + ffd,
             q: g.kp_q * eq + int_q + ffq,

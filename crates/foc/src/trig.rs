@@ -5,11 +5,12 @@
 //! times pole pairs, scaled to a `u32` turn), so the table index is the angle's top
 //! 9 bits and the interpolation fraction its low 23 bits: no range reduction, no
 //! division, no branch, one table for sin and cos (cos = sin a quarter turn on).
-//! That is about 12 instructions per pair on the M4F against ~40 for `libm::sinf`
+//! That is about 10 instructions per pair on the M4F against ~40 for `libm::sinf`
 //! plus `cosf` each. The worst-case error of linear interpolation is
 //! (2π/512)²/8 ≈ 1.9·10⁻⁵ (measured by `sin_cos_table_accuracy`), far below the
-//! 12-bit ADC's 2.4·10⁻⁴ resolution. The table (2 KiB of flash) is built at compile
-//! time by a Taylor series in `const fn`.
+//! 12-bit ADC's 2.4·10⁻⁴ resolution. The table (rows of sin, cos and their
+//! differences to the next row: 8 KiB of flash) is built at compile time by a Taylor
+//! series in `const fn`.
 
 use core::f64::consts::{PI, TAU};
 
@@ -35,9 +36,9 @@ const fn taylor_sin(x: f64) -> f64 {
 }
 
 /// One turn of sin, N + 1 entries (the last repeats the first, so entry i + 1
-/// exists for every index i < N).
+/// exists for every index i < N). Compile time only: [`SIN_COS`] is built from it.
 #[allow(clippy::indexing_slicing)] // compile time: an index out of range fails the build
-static SIN: [f32; N + 1] = {
+const SIN: [f32; N + 1] = {
     let mut t = [0.0f32; N + 1];
     let mut i = 0;
     while i <= N {
@@ -46,6 +47,24 @@ static SIN: [f32; N + 1] = {
             x -= TAU;
         }
         t[i] = taylor_sin(x) as f32;
+        i += 1;
+    }
+    t
+};
+
+/// Per table step i: sin and cos at its start and their f32 differences to the
+/// next step, `[sin, cos, Δsin, Δcos]` (cos = sin a quarter turn on). One row
+/// holds all the interpolation needs: one index, four adjacent loads, two
+/// multiply-adds per (sin, cos) pair, the differences not subtracted per step
+/// (the same f32 subtraction, done at compile time: the same results). 8 KiB of
+/// flash.
+#[allow(clippy::indexing_slicing)] // compile time: an index out of range fails the build
+static SIN_COS: [[f32; 4]; N] = {
+    let mut t = [[0.0f32; 4]; N];
+    let mut i = 0;
+    while i < N {
+        let ic = (i + N / 4) & (N - 1);
+        t[i] = [SIN[i], SIN[ic], SIN[i + 1] - SIN[i], SIN[ic + 1] - SIN[ic]];
         i += 1;
     }
     t
@@ -60,21 +79,15 @@ pub const RAD_PER_ANGLE: f32 = core::f32::consts::TAU / 4_294_967_296.0;
 /// [`Angle`] units per radian.
 pub const ANGLE_PER_RAD: f32 = 4_294_967_296.0 / core::f32::consts::TAU;
 
-#[inline(always)]
-fn lerp(i: usize, f: f32) -> f32 {
-    let a = SIN.get(i).copied().unwrap_or(0.0);
-    let b = SIN.get(i + 1).copied().unwrap_or(0.0);
-    a + (b - a) * f
-}
-
 /// (sin, cos) of an electrical angle, interpolated from the table
 /// (error ≤ 2·10⁻⁵).
 #[inline]
 pub fn sin_cos(angle: Angle) -> (f32, f32) {
     let i = (angle >> FRAC_BITS) as usize;
     let f = (angle & ((1 << FRAC_BITS) - 1)) as f32 * (1.0 / (1u32 << FRAC_BITS) as f32);
-    let ic = (i + N / 4) & (N - 1);
-    (lerp(i, f), lerp(ic, f))
+    // i < N by construction: the check folds away
+    let [s, c, ds, dc] = SIN_COS.get(i).copied().unwrap_or([0.0; 4]);
+    (s + ds * f, c + dc * f)
 }
 
 /// The angle of `rad` radians (any value; wraps).

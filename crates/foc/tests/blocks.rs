@@ -3,7 +3,7 @@
 use foc::params::{Gains, LoopParams, MotorData, Param, Violation};
 use foc::pi::limit_voltage_circle;
 use foc::protect::{current_limit, DcLink, I2t, I2tState, OverCurrent, PhaseSum, Trip};
-use foc::svm::{compensate_dead_time, svm, Duty};
+use foc::svm::{compare_values, compensate_dead_time, svm, Duty, PwmCounts};
 use foc::transform::*;
 use foc::trig::{angle_from_rad, sin_cos};
 use foc::{FocAxis, Protection, PwmOut, Sample, Scaling};
@@ -151,6 +151,54 @@ fn dead_time_compensation_adds_duty_in_the_current_direction() {
     );
     assert!(close(out.a, 0.516, 1e-6) && close(out.b, 0.484, 1e-6));
     assert!(close(out.c, 1.0, 1e-6), "clamped to [0, 1]: {}", out.c);
+}
+
+#[test]
+fn fused_compare_values_match_the_blocks() {
+    // the axis' one-pass modulator against svm, dead-time compensation and the
+    // rounding to counts done apart: within one count (reordered products), over
+    // the linear range, over-modulation, currents inside and beyond the band, a
+    // DC link below 1 V and NaN
+    let k = PwmCounts::new(4500, 0.016, 1.0 / 0.05);
+    let mut seed = 0x2545_f491_u32;
+    let mut rnd = |lo: f32, hi: f32| {
+        seed = seed.wrapping_mul(1_664_525).wrapping_add(1_013_904_223);
+        lo + (hi - lo) * (seed >> 8) as f32 / (1u32 << 24) as f32
+    };
+    let (mut differ, mut n) = (0, 0);
+    for _ in 0..200_000 {
+        let vdc = if rnd(0.0, 1.0) < 0.02 {
+            rnd(0.0, 1.0)
+        } else {
+            rnd(300.0, 800.0)
+        };
+        let r = rnd(0.0, 0.8) * vdc;
+        let th = rnd(-4.0, 4.0);
+        let v = AlphaBeta {
+            alpha: r * th.cos(),
+            beta: r * th.sin(),
+        };
+        let i = Abc {
+            a: rnd(-0.2, 0.2),
+            b: rnd(-8.0, 8.0),
+            c: rnd(-0.02, 0.02),
+        };
+        let (duty, _) = svm(v, vdc, 1.0 / vdc.max(1.0));
+        let duty = compensate_dead_time(duty, i, 0.016, 1.0 / 0.05);
+        let blocks = [duty.a, duty.b, duty.c].map(|d| (d * 4500.0 + 0.5) as u16);
+        let fused = compare_values(v, vdc, i, &k);
+        for (b, f) in blocks.iter().zip(fused) {
+            assert!(b.abs_diff(f) <= 1, "{blocks:?} {fused:?} {v:?} {vdc} {i:?}");
+            differ += usize::from(*b != f);
+            n += 1;
+        }
+    }
+    println!("fused compare values: {differ} of {n} differ by one count");
+    let nan = AlphaBeta {
+        alpha: f32::NAN,
+        beta: 0.0,
+    };
+    assert_eq!(compare_values(nan, 565.0, Abc::default(), &k), [0; 3]);
 }
 
 #[test]
@@ -492,4 +540,35 @@ fn stage_i2t_warns_then_limits_to_its_rated_current_then_trips() {
         );
     }
     assert_eq!(a.trip(), Some(Trip::StageI2t));
+}
+
+#[test]
+fn clamp_sym2_is_two_clamps() {
+    // the axis' fast path for its reference and integrator limits gives what two
+    // clamps give, NaN, infinities and a negative limit included
+    let xs = [
+        0.0,
+        -0.0,
+        1.0,
+        -1.0,
+        2.5,
+        -2.5,
+        3.0,
+        -3.0,
+        1e30,
+        f32::INFINITY,
+        f32::NEG_INFINITY,
+        f32::NAN,
+    ];
+    let ls = [0.0, 2.5, 3.0, -1.0, f32::INFINITY, f32::NAN];
+    let same = |x: f32, y: f32| x == y || (x.is_nan() && y.is_nan());
+    for &l in &ls {
+        for &a in &xs {
+            for &b in &xs {
+                let (p, q) = foc::fmath::clamp_sym2(a, b, l);
+                let (r, s) = (foc::fmath::clamp(a, -l, l), foc::fmath::clamp(b, -l, l));
+                assert!(same(p, r) && same(q, s), "{a} {b} {l}: {p} {q} vs {r} {s}");
+            }
+        }
+    }
 }
