@@ -49,10 +49,12 @@ def parse(elf, objdump=None):
     subtracts from sp, and function name by start address."""
     out = subprocess.run([objdump_tool(objdump), "-d", "-C", "--no-show-raw-insn", elf],
                          capture_output=True, text=True, check=True).stdout
+    ends = function_ends(elf, objdump)
     calls = collections.defaultdict(set)
     frames = collections.Counter()
     addr_of = {}
     cur = None
+    end = None
     in_data = False
     for line in out.splitlines():
         m = re.match(r"^([0-9a-f]+) <(.*)>:$", line)
@@ -65,10 +67,18 @@ def parse(elf, objdump=None):
                 continue
             cur = strip_hash(name)
             in_data = False
-            addr_of[int(m.group(1), 16) & ~1] = cur
+            start = int(m.group(1), 16) & ~1
+            addr_of[start] = cur
+            end = ends.get(start)
             continue
         if cur is None or in_data:
             continue
+        if end is not None:
+            a = re.match(r"^\s*([0-9a-f]+):", line)
+            if a and int(a.group(1), 16) >= end:
+                # past the function's size: alignment padding (a hand-written
+                # function has no $d symbol over it) decoded as instructions
+                continue
         m = BRANCH.search(line)
         if m:
             target = strip_hash(m.group(2))
@@ -87,6 +97,19 @@ def parse(elf, objdump=None):
         if m:
             frames[cur] += int(m.group(1), 0)
     return calls, frames, addr_of
+
+
+def function_ends(elf, objdump=None):
+    """End address of each function symbol with a size, by start address
+    (the symbol table: `objdump -t`)."""
+    out = subprocess.run([objdump_tool(objdump), "-t", elf], capture_output=True, text=True).stdout
+    ends = {}
+    for line in out.splitlines():
+        m = re.match(r"^([0-9a-f]+)\s.*\sF\s+\S+\s+([0-9a-f]+)\s", line)
+        if m and int(m.group(2), 16) > 0:
+            start = int(m.group(1), 16) & ~1
+            ends[start] = start + int(m.group(2), 16)
+    return ends
 
 
 def vector_entries(elf, addr_of, objdump=None):
