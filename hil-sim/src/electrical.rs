@@ -33,7 +33,7 @@
 //! dictionary's motor data ([`ElectricalAxis::set_motor_data`]).
 
 use crate::motor::{EdgeList, IndexEvent, Motor, MotorOutputs, INC_PER_RAD};
-use drive_ecat::axis::{AxisCommand, CurrentActual, CurrentControl, CurrentTrip};
+use drive_ecat::axis::{AxisCommand, CurrentActual, CurrentControl, CurrentTrip, DAxisMeans};
 use foc::{FocAxis, LoopParams, MotorData, PowerStage, Protection, Trip};
 use nanos::Nanos;
 use plant::{Plant, PlantParams, Shaft};
@@ -125,6 +125,10 @@ pub struct ElectricalAxis {
     command: AxisCommand,
     /// Mean of the measured iq over the last control cycle's PWM periods, A.
     iq_cycle_mean: f32,
+    /// The d axis over the last control cycle (voltage and current means).
+    d_cycle: Option<DAxisMeans>,
+    /// The d voltage of the last PWM period, V (it acts until the next sample).
+    prev_ud: f32,
     /// The motor data and loop parameters the loop runs with.
     motor: MotorData,
     params: LoopParams,
@@ -150,6 +154,7 @@ impl CurrentControl for ElectricalAxis {
         Some(CurrentActual {
             torque_nm: self.foc.gains().kt_nm_per_a * iq,
             current_a: iq,
+            d_axis: self.d_cycle,
             trip: self.foc.trip().map(|t| match t {
                 Trip::OverCurrent => CurrentTrip::OverCurrent,
                 Trip::PhaseSum => CurrentTrip::PhaseSum,
@@ -199,6 +204,8 @@ impl ElectricalAxis {
             last: CurrentSnapshot::default(),
             command: AxisCommand::OFF,
             iq_cycle_mean: 0.0,
+            d_cycle: None,
+            prev_ud: 0.0,
             motor: motor_data,
             params: loop_params,
         })
@@ -240,6 +247,12 @@ impl ElectricalAxis {
     /// The plant.
     pub fn plant(&self) -> &Plant {
         &self.plant
+    }
+
+    /// The plant's settings, for a test or `serve` (the motor the drive does
+    /// not know: its resistance, inductances, faults), before the run.
+    pub fn plant_mut(&mut self) -> &mut Plant {
+        &mut self.plant
     }
 
     /// The current loop.
@@ -292,11 +305,22 @@ impl ElectricalAxis {
         let mut merged: Option<MotorOutputs> = None;
         let mut t_prev = 0u64;
         let mut iq_sum = 0.0f32;
+        let (mut ud_sum, mut id_sum) = (0.0f32, 0.0f32);
+        let injection = self.command.injection.filter(|_| power_stage);
         for k in 1..=n {
             let t_next = (u128::from(dt.as_ns()) * u128::from(k) / u128::from(n)) as u64;
             let h = Nanos::from_ns(t_next - t_prev);
             let sample = self.plant.sample();
-            let out = self.foc.step(&sample, reference);
+            let out = match injection {
+                Some(j) => self.foc.step_voltage(&sample, foc::Dq { d: j.ud_v, q: 0.0 }),
+                None => self.foc.step(&sample, reference),
+            };
+            // the sample at this period's start is the centre of the last
+            // period: its current pairs with the last period's voltage
+            let m = self.foc.measured();
+            ud_sum += self.prev_ud;
+            id_sum += m.current.d;
+            self.prev_ud = m.voltage.d;
             self.plant.apply(&out);
             self.plant
                 .set_rotor(motor.position_inc_f64() / INC_PER_RAD, motor.velocity_rad_s());
@@ -323,6 +347,11 @@ impl ElectricalAxis {
             }
         }
         self.iq_cycle_mean = iq_sum / n as f32;
+        self.d_cycle = Some(DAxisMeans {
+            voltage_v: ud_sum / n as f32,
+            current_a: id_sum / n as f32,
+            interval_s: dt.as_ns() as f32 * 1e-9,
+        });
         // n ≥ 1: the loop ran; the fallback only satisfies the types
         merged.unwrap_or_else(|| motor.step_applied(0.0, brake, dt))
     }
@@ -344,6 +373,8 @@ impl ElectricalAxis {
         self.plant.apply(&pwm_out);
         let m = self.foc.measured();
         self.iq_cycle_mean = m.current.q;
+        self.d_cycle = None;
+        self.prev_ud = 0.0;
         self.last = CurrentSnapshot {
             id_a: f64::from(m.current.d),
             iq_a: f64::from(m.current.q),

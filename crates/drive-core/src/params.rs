@@ -189,6 +189,9 @@ pub const PROFINET_PARAMS: [u16; 9] = [A270, A271, A272, A273, A274, A275, A276,
 pub const B10: u16 = parameter_index(1, 10);
 /// B17 torque constant, mN·m/A (per axis, motor data).
 pub const B17: u16 = parameter_index(1, 17);
+/// B42 optimise current controller: the action's result and figures (per
+/// axis; started through A75, `crate::tuning`).
+pub const B42: u16 = parameter_index(1, 42);
 /// B52 d-axis inductance Ld, µH (per axis, motor data).
 pub const B52: u16 = parameter_index(1, 52);
 /// B53 phase resistance, mΩ (per axis, motor data).

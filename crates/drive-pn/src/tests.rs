@@ -169,6 +169,7 @@ fn p030_e089_a_current_loop_over_current_trip_is_a_diagnosis_alarm_with_event_33
         torque_nm: 0.0,
         current_a: 0.0,
         trip: Some(CurrentTrip::OverCurrent),
+        d_axis: None,
     });
     let alarms = run_io(&mut d, 50, 60, true, &[tripped, AxisIo::ready(0)]);
     assert_eq!(alarms.len(), 1, "one appears alarm");

@@ -72,6 +72,14 @@ pub struct Measured {
     pub i2t: Option<I2tState>,
 }
 
+/// What a PWM period applies: the current controllers' output for a current
+/// reference, or a voltage open loop.
+#[derive(Debug, Clone, Copy)]
+enum Command {
+    Current(Dq),
+    Voltage(Dq),
+}
+
 /// The current loop of one axis with its protection.
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct FocAxis {
@@ -190,6 +198,18 @@ impl FocAxis {
     /// One PWM period: the sample of this period's centre in, the compare values of
     /// the next period out. Trips latch and switch the gates off in the same step.
     pub fn step(&mut self, s: &Sample, reference: Dq) -> PwmOut {
+        self.step_with(s, Command::Current(reference))
+    }
+
+    /// One PWM period with `voltage` applied open loop (dq, V; clamped to the
+    /// voltage circle) instead of the current controllers' output: the motor
+    /// actions' measurement (identifying R and L). Measurement, protection and
+    /// modulation as in [`FocAxis::step`]; the integrators stay reset.
+    pub fn step_voltage(&mut self, s: &Sample, voltage: Dq) -> PwmOut {
+        self.step_with(s, Command::Voltage(voltage))
+    }
+
+    fn step_with(&mut self, s: &Sample, command: Command) -> PwmOut {
         let sc = &self.scaling;
         let g = &self.gains;
         let [ca, cb, cc] = s.phase_counts;
@@ -278,12 +298,28 @@ impl FocAxis {
             };
         }
 
-        let reference = Dq {
-            d: fmath::clamp(reference.d, -limit, limit),
-            q: fmath::clamp(reference.q, -limit, limit),
-        };
         let v_max = g.v_limit_per_vdc * vdc;
-        let (v, cut) = self.pi.step(g, reference, current, omega_e, v_max);
+        let (v, cut) = match command {
+            Command::Current(reference) => {
+                let reference = Dq {
+                    d: fmath::clamp(reference.d, -limit, limit),
+                    q: fmath::clamp(reference.q, -limit, limit),
+                };
+                self.pi.step(g, reference, current, omega_e, v_max)
+            }
+            Command::Voltage(v) => {
+                self.pi.reset();
+                let clamp = |x: f32| fmath::clamp(x, -v_max, v_max);
+                let cut = v.d.abs() > v_max || v.q.abs() > v_max;
+                (
+                    Dq {
+                        d: clamp(v.d),
+                        q: clamp(v.q),
+                    },
+                    cut,
+                )
+            }
+        };
         self.measured.voltage = v;
         self.measured.voltage_limited = cut;
 
@@ -295,11 +331,25 @@ impl FocAxis {
         let (so, co) = (sin * k + cos * delta, cos * k - sin * delta);
         let v_ab: AlphaBeta = inverse_park(v, so, co);
         let (duty, _) = svm(v_ab, vdc, 1.0 / fmath::max(vdc, 1.0));
-        let duty = compensate_dead_time(duty, phases, g.dead_time_duty, g.inv_dead_time_band);
+        let comp = compensate_dead_time(duty, phases, g.dead_time_duty, g.inv_dead_time_band);
         let period = f32::from(sc.pwm_period_counts);
         let cmp = |d: f32| (d * period + 0.5) as u16;
+        let compare = [cmp(comp.a), cmp(comp.b), cmp(comp.c)];
+        if let Command::Voltage(_) = command {
+            // the voltage the compare values realise (their rounding to
+            // counts is up to 60 mV per leg at 565 V: a constant voltage's
+            // rounding would bias a measurement), less the dead time's share
+            let realised = |c: u16, with: f32, without: f32| (f32::from(c) / period - with + without) * vdc;
+            let [ca, cb, cc] = compare;
+            let v_abc = Abc {
+                a: realised(ca, comp.a, duty.a),
+                b: realised(cb, comp.b, duty.b),
+                c: realised(cc, comp.c, duty.c),
+            };
+            self.measured.voltage = park(clarke(v_abc), so, co);
+        }
         PwmOut {
-            compare: [cmp(duty.a), cmp(duty.b), cmp(duty.c)],
+            compare,
             gate_enable: true,
         }
     }

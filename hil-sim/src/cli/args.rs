@@ -125,6 +125,15 @@ pub struct ServeArgs {
     /// about 36 ms of host time per moving axis and simulated second).
     #[arg(long, value_enum, value_name = "MODEL", default_value_t = Plant::Rigid)]
     pub plant: Plant,
+    /// With `--plant electrical`: the plant motor's phase resistance, Ω, on
+    /// every axis (default: the simulated servo's 3.6 Ω). The drive's motor
+    /// data keep their own values (a motor it does not know: B42 measures it).
+    #[arg(long, value_name = "OHM")]
+    pub plant_r: Option<f64>,
+    /// With `--plant electrical`: the plant motor's inductance Ld = Lq, H
+    /// (default: 12 mH).
+    #[arg(long, value_name = "H")]
+    pub plant_l: Option<f64>,
     /// Stop after this many seconds (default: run until killed).
     #[arg(long, value_name = "S")]
     pub seconds: Option<f64>,

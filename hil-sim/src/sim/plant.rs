@@ -30,6 +30,12 @@ impl SimDrive {
         self.electrical.get(axis).and_then(|e| e.as_deref())
     }
 
+    /// Axis `axis`' current loop and PMSM to set up (the plant's motor for a
+    /// test: [`ElectricalAxis::plant_mut`]).
+    pub fn electrical_mut(&mut self, axis: usize) -> Option<&mut ElectricalAxis> {
+        self.electrical.get_mut(axis).and_then(|e| e.as_deref_mut())
+    }
+
     /// The current seam: the electrical axes' measured iq (and a trip of
     /// their loop) into the axes' inputs; the rigid model measures nothing
     /// (the axes show their demand).

@@ -31,6 +31,7 @@ impl CurrentControl for LagLoop {
             torque_nm: KT * self.iq as f32,
             current_a: self.iq as f32,
             trip: self.trip,
+            d_axis: None,
         })
     }
 }

@@ -16,7 +16,7 @@
 //! ([`super::MANUFACTURER_A`]).
 
 use super::{Object, Value};
-use crate::params::{B10, B17, B52, B53, B62, B64, B73, U10, U11};
+use crate::params::{B10, B17, B42, B52, B53, B62, B64, B73, U10, U11};
 use od::DataType::{U16, U32, U8};
 
 use od::{Access, DataType, EntryInfo};
@@ -27,7 +27,7 @@ const fn e(sub: u8, name: &'static str, t: DataType) -> EntryInfo {
 }
 
 /// The motor data of axis A (group B), sorted by index.
-pub const PARAMS: [Object; 7] = [
+pub const PARAMS: [Object; 8] = [
     Object::var(
         B10,
         Value::Ram,
@@ -48,6 +48,14 @@ pub const PARAMS: [Object; 7] = [
     .axis()
     .level(1)
     .note("B17 (line assumed): kt = 1.5·p·ψ per A of the dq amplitude (the phase current's peak); the torque command becomes iq = T/kt; 6076h = kt × 6075h; default 0.65 N·m/A"),
+    param_array!(B42, "Optimize current controller", Record, Value::Ram, [
+        EntryInfo::new(0, "Result", U8, Access::RO),
+        EntryInfo::new(1, "Identified R", U32, Access::RO).unit("mΩ"),
+        EntryInfo::new(2, "Identified Ld", U32, Access::RO).unit("µH"),
+    ])
+    .axis()
+    .level(1)
+    .note("B42 (line assumed): the action \"optimise current controller\" (and B49, at standstill: the same measurement with the brake applied), started through A75 (E-140), progress in A69: [0] its result (0 identified and written, 1 aborted: the enable went away, 2 no current: an open winding, 3 the current did not settle, 4 implausible figures, 5 the current loop measures no d axis), [1] the identified phase resistance and [2] d-axis inductance of the last run; identified, they are written to B53 and B52/B62 (the current gains follow by pole-zero cancellation); not saved themselves (B52/B53/B62 are)"),
     Object::var(
         B52,
         Value::Ram,

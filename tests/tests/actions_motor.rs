@@ -1,0 +1,192 @@
+//! The motor actions through a real master on the electrical plant (spec
+//! §14; E-140, E-141; issue 35): A75 and A69 in axis A's process data, the
+//! action started in Ready to switch on, the axis enabled for it, its result
+//! in A69 and its objects, read back by SDO. The plant's motor is one the
+//! drive does not know.
+#![allow(
+    clippy::unwrap_used,
+    clippy::expect_used,
+    clippy::panic,
+    clippy::indexing_slicing
+)]
+
+use drive_ecat::actions::{state, A69, A75};
+use drive_ecat::params::{B42, B52, B53, B62, E48};
+use drive_tests::{init, line, with_master, MASTER_CYCLE};
+use hil_sim::electrical::PlantModel;
+
+/// A75 (8 bits) appended to 1600h, A69 (16 bits) to 1A00h; the byte offsets
+/// of A75 in the outputs and A69 in the inputs.
+async fn map_actions(sd: &ethercrab::SubDeviceRef<'_, &ethercrab::SubDevice>) -> (usize, usize) {
+    let mut offsets = [0usize; 2];
+    for (i, (pdo, entry)) in [
+        (0x1600u16, u32::from(A75) << 16 | 8),
+        (0x1A00, u32::from(A69) << 16 | 16),
+    ]
+    .into_iter()
+    .enumerate()
+    {
+        let n = sd.sdo_read::<u8>(pdo, 0).await.unwrap();
+        for s in 1..=n {
+            offsets[i] += (sd.sdo_read::<u32>(pdo, s).await.unwrap() & 0xFF) as usize / 8;
+        }
+        sd.sdo_write(pdo, 0, 0u8).await.unwrap();
+        sd.sdo_write(pdo, n + 1, entry).await.unwrap();
+        sd.sdo_write(pdo, 0, n + 1).await.expect("A75/A69 mapped");
+    }
+    (offsets[0], offsets[1])
+}
+
+/// A line of one drive whose axis A runs the electrical plant with a motor of
+/// `r_ohm` and `l_h` (the drive's dictionary keeps its defaults: 3.6 Ω, 12 mH).
+fn electrical_line(r_ohm: f64, l_h: f64) -> std::cell::RefCell<hil_sim::sim::Simulation> {
+    let sim = line(1);
+    {
+        let mut s = sim.borrow_mut();
+        let d = &mut s.drives_mut()[0];
+        d.set_plant(PlantModel::Electrical, 0x35).unwrap();
+        let plant = d.electrical_mut(0).unwrap().plant_mut();
+        let mut m = plant.params().motor;
+        (m.r_ohm, m.ld_h, m.lq_h) = (r_ohm, l_h, l_h);
+        plant.set_motor(m);
+    }
+    sim
+}
+
+/// `n` process-data cycles, the simulated time advanced one master cycle before each;
+/// A69 of the last.
+async fn cycles<S: ethercrab::subdevice_group::HasPdi>(
+    sim: &std::cell::RefCell<hil_sim::sim::Simulation>,
+    group: &ethercrab::SubDeviceGroup<8, 512, ethercrab::DefaultLock, S>,
+    md: &ethercrab::MainDevice<'_>,
+    n: usize,
+) {
+    for _ in 0..n {
+        {
+            let mut sim = sim.borrow_mut();
+            let t = sim.now() + MASTER_CYCLE;
+            sim.advance_to(t);
+        }
+        group.tx_rx(md).await.expect("cycle");
+    }
+}
+
+fn a69_of(inputs: &[u8], at: usize) -> u16 {
+    u16::from_le_bytes([inputs[at], inputs[at + 1]])
+}
+
+/// E-140, E-141 (B42 and B49): against plants with R and L the drive does
+/// not know, "optimise current controller" started by A75 in Ready to switch
+/// on waits (running, 0 %) for the enable, then identifies R and L within
+/// 5 % of the plant's, writes them to B53 and B52/B62 and ends at 100 %;
+/// Execute low and the enable removed, A69 is idle again.
+#[test]
+fn e140_b42_b49_optimise_current_controller_identifies_the_plants_r_and_l() {
+    for (selector, r, l) in [(0b1100u8, 2.2, 0.0065), (0b1110, 6.0, 0.021)] {
+        let sim = electrical_line(r, l);
+        with_master(&sim, async |md, clock| {
+            let group = init(md, clock).await;
+            let sd = group.subdevice(md, 0).unwrap();
+            let (a75, a69) = map_actions(&sd).await;
+            let group = group.into_op(md).await.expect("Op with A75/A69 mapped");
+            let sd = group.subdevice(md, 0).unwrap();
+            sd.outputs_raw_mut()[0..2].copy_from_slice(&6u16.to_le_bytes());
+            cycles(&sim, &group, md, 20).await;
+            assert_eq!(sd.sdo_read::<u8>(E48, 0).await.unwrap(), 2, "ready to switch on");
+            sd.outputs_raw_mut()[a75] = selector << 1 | 1;
+            cycles(&sim, &group, md, 5).await;
+            let s = a69_of(sd.io_raw().inputs(), a69);
+            assert_eq!(
+                s,
+                u16::from(selector) << 8 | state::RUNNING << 12,
+                "waits for the enable: {s:04X}h"
+            );
+            // the enable: switch on, enable operation
+            for cw in [7u16, 0xF] {
+                sd.outputs_raw_mut()[0..2].copy_from_slice(&cw.to_le_bytes());
+                cycles(&sim, &group, md, 5).await;
+            }
+            let mut seen = Vec::new();
+            for _ in 0..3000 {
+                cycles(&sim, &group, md, 1).await;
+                let s = a69_of(sd.io_raw().inputs(), a69);
+                if seen.last() != Some(&s) {
+                    seen.push(s);
+                }
+                if s >> 12 != state::RUNNING {
+                    break;
+                }
+            }
+            let done = 100 | u16::from(selector) << 8 | state::DONE << 12;
+            assert_eq!(seen.last(), Some(&done), "A69 over the cycles: {seen:04X?}");
+            assert!(
+                seen.windows(2).all(|w| w[0] & 0xFF <= w[1] & 0xFF),
+                "progress rises: {seen:04X?}"
+            );
+            assert_eq!(
+                sd.sdo_read::<u8>(B42, 1).await.unwrap(),
+                0,
+                "B42[0] result: identified"
+            );
+            let r_id = f64::from(sd.sdo_read::<u32>(B53, 0).await.unwrap()) * 1e-3;
+            let l_id = f64::from(sd.sdo_read::<u32>(B52, 0).await.unwrap()) * 1e-6;
+            let lq = f64::from(sd.sdo_read::<u32>(B62, 0).await.unwrap()) * 1e-6;
+            assert_eq!(
+                sd.sdo_read::<u32>(B42, 2).await.unwrap(),
+                (r_id * 1e3).round() as u32
+            );
+            let (er, el) = ((r_id - r) / r, (l_id - l) / l);
+            println!("B42/B49 sel {selector:04b}: plant R {r} Ω L {l} H; identified {r_id:.3} Ω ({:+.2} %), {:.3} mH ({:+.2} %)", er * 100.0, l_id * 1e3, el * 100.0);
+            assert!(er.abs() < 0.05, "R {r_id} Ω vs the plant's {r} Ω");
+            assert!(el.abs() < 0.05, "L {l_id} H vs the plant's {l} H");
+            assert_eq!(lq, l_id, "Lq = Ld");
+            // the master ends it: Execute low, the enable removed
+            sd.outputs_raw_mut()[a75] = 0;
+            sd.outputs_raw_mut()[0..2].copy_from_slice(&6u16.to_le_bytes());
+            cycles(&sim, &group, md, 10).await;
+            assert_eq!(a69_of(sd.io_raw().inputs(), a69), 0);
+            assert_eq!(sd.sdo_read::<u8>(E48, 0).await.unwrap(), 2);
+        });
+    }
+}
+
+/// E-141, E-140: B42 started outside Ready to switch on (switch-on disabled)
+/// is refused and changes nothing (B53, B52 stay); started, then the enable
+/// never given but the axis shut off (disable voltage): failed, result 1
+/// (aborted), the motor data as they were.
+#[test]
+fn e141_b42_refused_in_the_wrong_state_and_aborted_without_its_enable() {
+    let sim = electrical_line(2.2, 0.0065);
+    with_master(&sim, async |md, clock| {
+        let group = init(md, clock).await;
+        let sd = group.subdevice(md, 0).unwrap();
+        let (a75, a69) = map_actions(&sd).await;
+        let group = group.into_op(md).await.expect("Op");
+        let sd = group.subdevice(md, 0).unwrap();
+        let before = (
+            sd.sdo_read::<u32>(B53, 0).await.unwrap(),
+            sd.sdo_read::<u32>(B52, 0).await.unwrap(),
+        );
+        assert_ne!(sd.sdo_read::<u8>(E48, 0).await.unwrap(), 2);
+        sd.outputs_raw_mut()[a75] = 0b1100 << 1 | 1;
+        cycles(&sim, &group, md, 5).await;
+        let s = a69_of(sd.io_raw().inputs(), a69);
+        assert_eq!(s, 0b1100 << 8 | state::REFUSED << 12, "{s:04X}h");
+        sd.outputs_raw_mut()[a75] = 0;
+        sd.outputs_raw_mut()[0..2].copy_from_slice(&6u16.to_le_bytes());
+        cycles(&sim, &group, md, 20).await;
+        sd.outputs_raw_mut()[a75] = 0b1100 << 1 | 1;
+        cycles(&sim, &group, md, 5).await;
+        // disable voltage instead of the enable: back to switch-on disabled
+        sd.outputs_raw_mut()[0..2].copy_from_slice(&0u16.to_le_bytes());
+        cycles(&sim, &group, md, 10).await;
+        let s = a69_of(sd.io_raw().inputs(), a69);
+        assert_eq!(s, 0b1100 << 8 | state::FAILED << 12, "{s:04X}h");
+        assert_eq!(sd.sdo_read::<u8>(B42, 1).await.unwrap(), 1, "B42[0]: aborted");
+        let after = (
+            sd.sdo_read::<u32>(B53, 0).await.unwrap(),
+            sd.sdo_read::<u32>(B52, 0).await.unwrap(),
+        );
+        assert_eq!(after, before, "nothing changed");
+    });
+}
