@@ -214,7 +214,8 @@ impl ElectricalAxis {
     /// The motor data of the drive's dictionary (issue 34) for the current
     /// loop: its gains by pole-zero cancellation (Kp = ω_c·L, Ki = ω_c·R with
     /// ω_c = 2π·B64), kt, the rated and the maximum current and the thermal
-    /// time constant of its own i²t backstop. Applied when they changed; a set
+    /// time constant of its own i²t backstop, and the commutation offset
+    /// (B05). Applied when they changed; a set
     /// the loop refuses (ω_c above a fifth of the PWM rate) leaves the loop as
     /// it was. The plant (the motor itself) keeps its own data: motor data
     /// that do not match it detune the loop, as on a real drive.
@@ -235,6 +236,8 @@ impl ElectricalAxis {
             omega_c_rad_s: core::f32::consts::TAU * m.bandwidth_hz,
             ..self.params
         };
+        // B05: the encoder position of the d axis along phase a
+        self.foc.set_commutation_offset(m.commutation_offset_inc);
         if motor == self.motor && params == self.params {
             return Ok(());
         }
@@ -312,7 +315,13 @@ impl ElectricalAxis {
             let h = Nanos::from_ns(t_next - t_prev);
             let sample = self.plant.sample();
             let out = match injection {
-                Some(j) => self.foc.step_voltage(&sample, foc::Dq { d: j.ud_v, q: 0.0 }),
+                Some(j) => {
+                    let v = foc::Dq { d: j.ud_v, q: 0.0 };
+                    match j.angle {
+                        Some(a) => self.foc.step_voltage_at(&sample, v, a),
+                        None => self.foc.step_voltage(&sample, v),
+                    }
+                }
                 None => self.foc.step(&sample, reference),
             };
             // the sample at this period's start is the centre of the last

@@ -65,9 +65,11 @@ fn c038_e089_soem_max_current_and_motor_i2t_on_the_electrical_plant() {
 /// switch-on disabled (nothing changes); B42 and B49 started in Ready to
 /// switch on, run after the enable, identify the plant's R and L (2.2 Ω,
 /// 6.5 mH: `serve --plant-r/--plant-l`, the drive's B53/B52 say 3.6 Ω,
-/// 12 mH) within 5 % into B53 and B52/B62.
+/// 12 mH) within 5 % into B53 and B52/B62; B41 finds the plant's
+/// commutation offset (0.3 rad: `--plant-offset`) within 0.5° electrical
+/// into B05.
 #[test]
-fn e140_e141_soem_optimise_current_controller_identifies_the_plants_r_and_l() {
+fn e140_e141_soem_motor_actions_identify_the_plants_r_l_and_commutation_offset() {
     let python = match pysoem_python() {
         Ok(p) => p,
         Err(why) => {
@@ -76,15 +78,28 @@ fn e140_e141_soem_optimise_current_controller_identifies_the_plants_r_and_l() {
         }
     };
     let dir = scratch("soem-motor-actions");
-    let (r, l) = ("2.2", "0.0065");
+    let (r, l, offset) = ("2.2", "0.0065", "0.3");
     let line = Line::with_serve_args(
         "a",
         1,
         120,
         &dir,
-        &["--plant", "electrical", "--plant-r", r, "--plant-l", l],
+        &[
+            "--plant",
+            "electrical",
+            "--plant-r",
+            r,
+            "--plant-l",
+            l,
+            "--plant-offset",
+            offset,
+        ],
     );
-    let status = line.run(&python, "motor_actions.py", &["--r", r, "--l", l]);
+    let status = line.run(
+        &python,
+        "motor_actions.py",
+        &["--r", r, "--l", l, "--offset", offset],
+    );
     if !status.success() {
         line.fail_with(&format!("motor_actions.py through SOEM failed: {status}"));
     }

@@ -11,7 +11,7 @@
 )]
 
 use drive_ecat::actions::{state, A69, A75};
-use drive_ecat::params::{B42, B52, B53, B62, E48};
+use drive_ecat::params::{B05, B41, B42, B52, B53, B62, E48};
 use drive_tests::{init, line, with_master, MASTER_CYCLE};
 use hil_sim::electrical::PlantModel;
 
@@ -148,6 +148,97 @@ fn e140_b42_b49_optimise_current_controller_identifies_the_plants_r_and_l() {
             assert_eq!(sd.sdo_read::<u8>(E48, 0).await.unwrap(), 2);
         });
     }
+}
+
+/// Starts action `selector` in Ready to switch on, enables the axis and
+/// runs until A69 leaves "running"; A69 over the run.
+async fn run_action<S: ethercrab::subdevice_group::HasPdi>(
+    sim: &std::cell::RefCell<hil_sim::sim::Simulation>,
+    group: &ethercrab::SubDeviceGroup<8, 512, ethercrab::DefaultLock, S>,
+    md: &ethercrab::MainDevice<'_>,
+    (a75, a69): (usize, usize),
+    selector: u8,
+    max_cycles: usize,
+) -> Vec<u16> {
+    let sd = group.subdevice(md, 0).unwrap();
+    sd.outputs_raw_mut()[0..2].copy_from_slice(&6u16.to_le_bytes());
+    cycles(sim, group, md, 20).await;
+    assert_eq!(sd.sdo_read::<u8>(E48, 0).await.unwrap(), 2, "ready to switch on");
+    sd.outputs_raw_mut()[a75] = selector << 1 | 1;
+    cycles(sim, group, md, 5).await;
+    for cw in [7u16, 0xF] {
+        sd.outputs_raw_mut()[0..2].copy_from_slice(&cw.to_le_bytes());
+        cycles(sim, group, md, 5).await;
+    }
+    let mut seen = Vec::new();
+    for _ in 0..max_cycles {
+        cycles(sim, group, md, 1).await;
+        let s = a69_of(sd.io_raw().inputs(), a69);
+        if seen.last() != Some(&s) {
+            seen.push(s);
+        }
+        if s >> 12 != state::RUNNING {
+            break;
+        }
+    }
+    seen
+}
+
+/// E-140 (B41): "calibrate motor" on a plant whose commutation offset the
+/// drive does not know (B05 = 0, the plant's d axis at 0.3 rad mechanical =
+/// 50,066 increments): after the alignment B05 holds the plant's offset
+/// within 0.5° electrical (modulo an electrical revolution, 2^20/4 inc);
+/// saved (1010h:01) it is there again after a power cycle.
+#[test]
+fn e140_b41_calibrate_motor_finds_the_plants_commutation_offset() {
+    let offset_rad = 0.3;
+    let sim = electrical_line(3.6, 0.012);
+    {
+        let mut s = sim.borrow_mut();
+        let plant = s.drives_mut()[0].electrical_mut(0).unwrap().plant_mut();
+        let mut m = plant.params().motor;
+        m.commutation_offset_rad = offset_rad;
+        plant.set_motor(m);
+    }
+    let per_el = (1u32 << 20) / 4;
+    let truth = (offset_rad / std::f64::consts::TAU * f64::from(1u32 << 20)).round() as i64;
+    let b05 = with_master(&sim, async |md, clock| {
+        let group = init(md, clock).await;
+        let sd = group.subdevice(md, 0).unwrap();
+        let (a75, a69) = map_actions(&sd).await;
+        let group = group.into_op(md).await.expect("Op with A75/A69 mapped");
+        let sd = group.subdevice(md, 0).unwrap();
+        assert_eq!(sd.sdo_read::<u32>(B05, 0).await.unwrap(), 0);
+        let seen = run_action(&sim, &group, md, (a75, a69), 0b1011, 20_000).await;
+        let done = 100 | 0b1011 << 8 | state::DONE << 12;
+        assert_eq!(seen.last(), Some(&done), "A69 over the cycles: {seen:04X?}");
+        assert_eq!(sd.sdo_read::<u8>(B41, 1).await.unwrap(), 0, "B41[0] result");
+        let b05 = i64::from(sd.sdo_read::<u32>(B05, 0).await.unwrap());
+        let spread = sd.sdo_read::<u32>(B41, 2).await.unwrap();
+        let err = (b05 - truth).rem_euclid(i64::from(per_el));
+        let err = err.min(i64::from(per_el) - err);
+        let err_deg = err as f64 / f64::from(per_el) * 360.0;
+        println!("B41: plant offset {truth} inc, B05 {b05} inc: {err_deg:.3}° electrical off, alignments {spread} inc apart");
+        assert!(
+            err_deg < 0.5,
+            "B05 {b05} vs the plant's {truth} (mod {per_el}): {err_deg}° el"
+        );
+        sd.outputs_raw_mut()[a75] = 0;
+        sd.outputs_raw_mut()[0..2].copy_from_slice(&6u16.to_le_bytes());
+        cycles(&sim, &group, md, 10).await;
+        sd.sdo_write(0x1010, 1, u32::from_le_bytes(*b"save"))
+            .await
+            .expect("save");
+        cycles(&sim, &group, md, 200).await;
+        b05
+    });
+    sim.borrow_mut().drives_mut()[0].power_cycle();
+    let again = with_master(&sim, async |md, clock| {
+        let group = init(md, clock).await;
+        let sd = group.subdevice(md, 0).unwrap();
+        sd.sdo_read::<u32>(B05, 0).await.unwrap()
+    });
+    assert_eq!(i64::from(again), b05, "B05 saved with the parameter set");
 }
 
 /// E-141, E-140: B42 started outside Ready to switch on (switch-on disabled)

@@ -22,8 +22,9 @@
 //! 1601h for axis B), which is what that option sets up. A75 written over SDO,
 //! or mapped in another channel, starts nothing ([`state::NOT_ACTIVATED`]).
 
-use crate::axis::{AxisCommand, CurrentActual};
-use crate::params::{B42, B52, B53, B62, E48};
+use crate::axis::{AxisCommand, AxisIo};
+use crate::params::{B05, B10, B41, B42, B52, B53, B62, E48};
+use crate::tuning::align::{AlignOutcome, Alignment};
 use crate::tuning::{CurrentTuning, Outcome};
 use crate::{parameter_index, DriveObjects, AXIS_B_CIA402, AXIS_B_MANUFACTURER};
 
@@ -148,9 +149,18 @@ struct AxisActions {
     execute: bool,
     running: Option<Running>,
     status: u16,
-    /// The B42/B49 measurement, started here and stepped by the control
-    /// cycle ([`Actions::control`]).
-    tuning: Option<CurrentTuning>,
+    /// The motor action's measurement, started here and stepped by the
+    /// control cycle ([`Actions::control`]).
+    tuning: Option<Measurement>,
+}
+
+/// A motor action's part in the control cycle.
+#[derive(Debug, Clone, Copy)]
+enum Measurement {
+    /// B42/B49.
+    Current(CurrentTuning),
+    /// B41.
+    Align(Alignment),
 }
 
 /// The action unit of both axes: the last Execute bits and what runs.
@@ -197,13 +207,16 @@ impl Actions {
         objects.mapping(channel).any(|m| m >> 16 == a75)
     }
 
-    /// The control cycle's part of a running motor action on `axis` (B42,
-    /// B49): the axis' device state `e48` after its cycle and the current
-    /// loop's last report in; the command that replaces the axis' out
-    /// (`None`: the axis' own). Call it once per control cycle after the
-    /// axis' cycle.
-    pub fn control(&mut self, axis: usize, e48: u8, actual: Option<&CurrentActual>) -> Option<AxisCommand> {
-        self.axes.get_mut(axis)?.tuning.as_mut()?.cycle(e48, actual)
+    /// The control cycle's part of a running motor action on `axis` (B41,
+    /// B42, B49): the axis' device state `e48` after its cycle and the
+    /// cycle's inputs (the current loop's last report, the encoder) in; the
+    /// command that replaces the axis' out (`None`: the axis' own). Call it
+    /// once per control cycle after the axis' cycle.
+    pub fn control(&mut self, axis: usize, e48: u8, io: &AxisIo) -> Option<AxisCommand> {
+        match self.axes.get_mut(axis)?.tuning.as_mut()? {
+            Measurement::Current(t) => t.cycle(e48, io.current.as_ref()),
+            Measurement::Align(a) => a.cycle(e48, io.position_inc),
+        }
     }
 
     /// One pass after the RxPDO was decoded into `objects`: starts the
@@ -235,7 +248,11 @@ impl Actions {
                 a.status = start(a, objects, axis, selector, clear);
             } else if let Some(r) = a.running {
                 a.status = match r {
-                    Running::Tuning => follow_tuning(objects, a.tuning.as_ref(), axis, selector),
+                    Running::Tuning => match a.tuning.as_ref() {
+                        Some(Measurement::Current(t)) => follow_tuning(objects, t, axis, selector),
+                        Some(Measurement::Align(al)) => follow_alignment(objects, al, axis, selector),
+                        None => None,
+                    },
                     _ => follow(objects, r, selector),
                 }
                 .unwrap_or(a.status);
@@ -291,11 +308,20 @@ fn start(
             let rated_ma = objects.get(0x6075 + cia(axis), 0).unwrap_or(0);
             let r_mohm = objects.get(B53 + offset(axis), 0).unwrap_or(0);
             let standstill = action == Action::OptimiseCurrentStandstill;
-            a.tuning = Some(CurrentTuning::new(
+            a.tuning = Some(Measurement::Current(CurrentTuning::new(
                 rated_ma as f32 * 1e-3,
                 r_mohm as f32 * 1e-3,
                 standstill,
-            ));
+            )));
+            a.running = Some(Running::Tuning);
+            status(0, selector, state::RUNNING)
+        }
+        Action::CalibrateMotor => {
+            let rated_ma = objects.get(0x6075 + cia(axis), 0).unwrap_or(0);
+            let r_mohm = objects.get(B53 + offset(axis), 0).unwrap_or(0);
+            let ud = (rated_ma as f32 * 1e-3) * (r_mohm as f32 * 1e-3);
+            let pole_pairs = objects.get(B10 + offset(axis), 0).unwrap_or(4);
+            a.tuning = Some(Measurement::Align(Alignment::new(ud, pole_pairs as u8)));
             a.running = Some(Running::Tuning);
             status(0, selector, state::RUNNING)
         }
@@ -320,12 +346,12 @@ fn cia(axis: usize) -> u16 {
 /// Kp = ω_c·L, Ki = ω_c·R).
 fn follow_tuning(
     objects: &mut DriveObjects,
-    tuning: Option<&CurrentTuning>,
+    tuning: &CurrentTuning,
     axis: usize,
     selector: u8,
 ) -> Option<u16> {
     let off = offset(axis);
-    match tuning?.outcome() {
+    match tuning.outcome() {
         Outcome::Running(p) => Some(status(u16::from(p), selector, state::RUNNING)),
         Outcome::Done(id) => {
             let r_mohm = (id.r_ohm * 1e3 + 0.5) as i64;
@@ -349,6 +375,36 @@ fn follow_tuning(
         }
         Outcome::Failed(code) => {
             let _ = objects.set(B42 + off, 1, i64::from(code));
+            Some(status(0, selector, state::FAILED))
+        }
+    }
+}
+
+/// A69 of a running B41; at its end its result in B41 and the offset in B05.
+fn follow_alignment(objects: &mut DriveObjects, al: &Alignment, axis: usize, selector: u8) -> Option<u16> {
+    let off = offset(axis);
+    match al.outcome() {
+        AlignOutcome::Running(p) => Some(status(u16::from(p), selector, state::RUNNING)),
+        AlignOutcome::Done {
+            offset_inc,
+            spread_inc,
+        } => {
+            let _ = objects.set(B41 + off, 2, i64::from(spread_inc));
+            let written = objects.set(B05 + off, 0, i64::from(offset_inc)).is_ok();
+            let code = if written {
+                crate::tuning::result::OK
+            } else {
+                crate::tuning::result::IMPLAUSIBLE
+            };
+            let _ = objects.set(B41 + off, 1, i64::from(code));
+            Some(status(
+                100,
+                selector,
+                if written { state::DONE } else { state::FAILED },
+            ))
+        }
+        AlignOutcome::Failed(code) => {
+            let _ = objects.set(B41 + off, 1, i64::from(code));
             Some(status(0, selector, state::FAILED))
         }
     }

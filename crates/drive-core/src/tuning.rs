@@ -49,6 +49,9 @@ pub mod result {
     pub const IMPLAUSIBLE: u8 = 4;
     /// The current loop reports no d-axis measurement.
     pub const NO_MEASUREMENT: u8 = 5;
+    /// B41: the rotor did not come to rest (the same code as
+    /// [`NOT_SETTLED`]: the measurement did not settle).
+    pub const NOT_AT_REST: u8 = NOT_SETTLED;
 }
 
 /// Cycles per settle block.
@@ -323,7 +326,10 @@ impl CurrentTuning {
             torque_nm: 0.0,
             power_stage: true,
             brake_release: !self.standstill,
-            injection: Some(Injection { ud_v: self.ud }),
+            injection: Some(Injection {
+                ud_v: self.ud,
+                angle: None,
+            }),
         }
     }
 
@@ -341,6 +347,8 @@ fn abs(x: f32) -> f32 {
         x
     }
 }
+
+pub mod align;
 
 #[cfg(test)]
 mod tests;

@@ -77,7 +77,7 @@ pub struct Measured {
 #[derive(Debug, Clone, Copy)]
 enum Command {
     Current(Dq),
-    Voltage(Dq),
+    Voltage(Dq, Option<Angle>),
 }
 
 /// The current loop of one axis with its protection.
@@ -206,7 +206,21 @@ impl FocAxis {
     /// actions' measurement (identifying R and L). Measurement, protection and
     /// modulation as in [`FocAxis::step`]; the integrators stay reset.
     pub fn step_voltage(&mut self, s: &Sample, voltage: Dq) -> PwmOut {
-        self.step_with(s, Command::Voltage(voltage))
+        self.step_with(s, Command::Voltage(voltage, None))
+    }
+
+    /// [`FocAxis::step_voltage`] in a frame at the fixed electrical angle
+    /// `frame` instead of the encoder's (a current vector the rotor aligns to,
+    /// a voltage along one phase's axis): the measured dq current and the
+    /// voltage are in that frame for this period.
+    pub fn step_voltage_at(&mut self, s: &Sample, voltage: Dq, frame: Angle) -> PwmOut {
+        self.step_with(s, Command::Voltage(voltage, Some(frame)))
+    }
+
+    /// The commutation offset (encoder increments at which the rotor's d axis
+    /// points along phase a) from now on.
+    pub fn set_commutation_offset(&mut self, offset_inc: u32) {
+        self.scaling.commutation_offset_inc = offset_inc;
     }
 
     fn step_with(&mut self, s: &Sample, command: Command) -> PwmOut {
@@ -236,7 +250,11 @@ impl FocAxis {
             None => 0.0,
         };
         self.last_angle = Some(angle);
-        let (sin, cos) = sin_cos(angle);
+        let frame = match command {
+            Command::Voltage(_, Some(f)) => f,
+            _ => angle,
+        };
+        let (sin, cos) = sin_cos(frame);
         let current = park(clarke(phases), sin, cos);
 
         // i²t: the mean square current of I2T_DECIMATION periods, one model step
@@ -307,7 +325,7 @@ impl FocAxis {
                 };
                 self.pi.step(g, reference, current, omega_e, v_max)
             }
-            Command::Voltage(v) => {
+            Command::Voltage(v, _) => {
                 self.pi.reset();
                 let clamp = |x: f32| fmath::clamp(x, -v_max, v_max);
                 let cut = v.d.abs() > v_max || v.q.abs() > v_max;
@@ -326,7 +344,11 @@ impl FocAxis {
         // the voltage acts over the next period, centred one period after the sample
         // rotating (sin, cos) by δ = ω·Ts to second order (|δ| ≤ 0.08 rad at
         // 3000 rpm and 16 kHz: error δ³/6 < 10⁻⁴) instead of a second table lookup
-        let delta = omega_e * g.ts_s;
+        // (a fixed frame does not turn)
+        let delta = match command {
+            Command::Voltage(_, Some(_)) => 0.0,
+            _ => omega_e * g.ts_s,
+        };
         let k = 1.0 - 0.5 * delta * delta;
         let (so, co) = (sin * k + cos * delta, cos * k - sin * delta);
         let v_ab: AlphaBeta = inverse_park(v, so, co);
@@ -335,7 +357,7 @@ impl FocAxis {
         let period = f32::from(sc.pwm_period_counts);
         let cmp = |d: f32| (d * period + 0.5) as u16;
         let compare = [cmp(comp.a), cmp(comp.b), cmp(comp.c)];
-        if let Command::Voltage(_) = command {
+        if let Command::Voltage(..) = command {
             // the voltage the compare values realise (their rounding to
             // counts is up to 60 mV per leg at 565 V: a constant voltage's
             // rounding would bias a measurement), less the dead time's share

@@ -134,6 +134,11 @@ pub struct ServeArgs {
     /// (default: 12 mH).
     #[arg(long, value_name = "H")]
     pub plant_l: Option<f64>,
+    /// With `--plant electrical`: the mechanical angle (rad) at which the
+    /// plant motor's d axis points along phase a, its commutation offset
+    /// (default 0; the drive's B05 says 0 until B41 finds it).
+    #[arg(long, value_name = "RAD")]
+    pub plant_offset: Option<f64>,
     /// Stop after this many seconds (default: run until killed).
     #[arg(long, value_name = "S")]
     pub seconds: Option<f64>,

@@ -66,13 +66,17 @@ const LATE_NOTE: Nanos = Nanos::from_us(20);
 /// How often the pcap recording is flushed (a write error then ends `serve`).
 const FLUSH_EVERY: Nanos = Nanos::from_secs(1);
 
-/// `--plant-r`/`--plant-l`: the plant's motor on every electrical axis.
+/// `--plant-r`/`--plant-l`/`--plant-offset`: the plant's motor on every
+/// electrical axis.
 fn set_plant_motor(sim: &mut Simulation, args: &ServeArgs) -> Result<(), String> {
-    if args.plant_r.is_none() && args.plant_l.is_none() {
+    if args.plant_r.is_none() && args.plant_l.is_none() && args.plant_offset.is_none() {
         return Ok(());
     }
     if args.plant != Plant::Electrical {
-        return Err("--plant-r/--plant-l need --plant electrical".into());
+        return Err("--plant-r/--plant-l/--plant-offset need --plant electrical".into());
+    }
+    if args.plant_offset.is_some_and(|o| !o.is_finite()) {
+        return Err("--plant-offset must be a finite angle".into());
     }
     let positive = |x: Option<f64>| x.is_none_or(|v| v.is_finite() && v > 0.0);
     if !positive(args.plant_r) || !positive(args.plant_l) {
@@ -87,6 +91,7 @@ fn set_plant_motor(sim: &mut Simulation, args: &ServeArgs) -> Result<(), String>
                 if let Some(l) = args.plant_l {
                     (m.ld_h, m.lq_h) = (l, l);
                 }
+                m.commutation_offset_rad = args.plant_offset.unwrap_or(m.commutation_offset_rad);
                 plant.set_motor(m);
             }
         }

@@ -6,11 +6,15 @@ Run by `hil-sim/tests/soem_electrical.rs` as root inside the master's network
 namespace against `hil-sim serve --plant electrical --plant-r R --plant-l L
 --slaves 1` (or by hand), with the same --r and --l: the plant's motor, which
 the drive's dictionary does not know (it keeps B53 = 3.6 ohm, B52 = 12 mH).
-Free run, one drive, axis A; RxPDO 6040h, 6060h, A75; TxPDO 6041h, A69.
+Free run, one drive, axis A in cst; RxPDO 6040h, 6060h, A75; TxPDO 6041h, A69.
 
   1. Op, the axis switch-on disabled: A75 = Execute | 1100b (B42, optimise
      current controller) is refused (A69 state 3), B53/B52 unchanged.
-  2. Execute low, shutdown (6040h = 6): ready to switch on (E48 = 2). For
+  2. B41 (1011b, calibrate motor), as below: B05 (commutation offset, 0
+     before) within 0.5 degrees electrical of the plant's --offset (rad,
+     mechanical; modulo an electrical revolution, 2^20 / B10 increments),
+     B41[0] = 0. B42 needs it: it injects in the rotor's frame.
+  3. Execute low, shutdown (6040h = 6): ready to switch on (E48 = 2). For
      B42 (1100b) and then B49 (1110b, at standstill): Execute; A69 shows it
      running at 0 % until the enable (6040h = 7, 15); then the progress
      rises to 100 %, state done; B42[0] (sub 1) = 0, B53 and B52/B62 within
@@ -36,13 +40,17 @@ def b(line):
 
 
 A75, A69 = 0x2000 + 75, 0x2000 + 69
-B42, B52, B53, B62 = b(42), b(52), b(53), b(62)
+B05, B10, B41, B42, B52, B53, B62 = b(5), b(10), b(41), b(42), b(52), b(53), b(62)
 E48 = 0x2000 + 4 * 0x200 + 48
 RX = [L.entry(0x6040, 0, 16), L.entry(0x6060, 0, 8), L.entry(A75, 0, 8)]
 TX = [L.entry(0x6041, 0, 16), L.entry(A69, 0, 16)]
 OUT, IN = "<HbB", "<HH"
 RUNNING, DONE, REFUSED = 1, 2, 3
-B42_SEL, B49_SEL = 0b1100, 0b1110
+# cst with 6071h = 0 (not mapped): the axis holds no position, so the one B41
+# turns the rotor to needs no cyclic target (csp would: a master there sends
+# the actual position as the target, as before any enable)
+CST = 10
+B41_SEL, B42_SEL, B49_SEL = 0b1011, 0b1100, 0b1110
 
 
 class Axis:
@@ -55,7 +63,7 @@ class Axis:
 
     def cycle(self, k=1):
         for _ in range(k):
-            self.s.output = struct.pack(OUT, self.cw, 8, self.a75)
+            self.s.output = struct.pack(OUT, self.cw, CST, self.a75)
             self.m.send_processdata()
             self.m.receive_processdata(4000)
             n = struct.calcsize(IN)
@@ -86,6 +94,45 @@ def refused(axis):
     axis.cycle(5)
 
 
+def start(axis, sel):
+    """Starts `sel` in Ready to switch on, enables; A69 until it leaves running."""
+    axis.cw = 6
+    check(axis.until(lambda: L.sw_is(axis.sw, L.READY), 300), f"ready to switch on: statusword {axis.sw:#06x}")
+    axis.a75 = sel << 1 | 1
+    axis.cycle(10)
+    for cw in (7, 0xF):
+        axis.cw = cw
+        axis.cycle(10)
+    seen = []
+    start_t = time.monotonic()
+    while time.monotonic() - start_t < 30.0:
+        axis.cycle()
+        if not seen or seen[-1] != axis.a69:
+            seen.append(axis.a69)
+        if axis.a69 >> 12 != RUNNING:
+            break
+    return seen, time.monotonic() - start_t
+
+
+def calibrate(axis, offset_rad):
+    pp = L.sdo_u(axis.s, B10, 0)
+    per_el = (1 << 20) // pp
+    truth = round(offset_rad / (2 * 3.141592653589793) * (1 << 20))
+    check(L.sdo_u(axis.s, B05, 0) == 0, "B05 = 0 before")
+    seen, took = start(axis, B41_SEL)
+    done = 100 | B41_SEL << 8 | DONE << 12
+    check(seen[-1] == done, f"B41: A69 ends {seen[-1]:04X}h, expected {done:04X}h; seen {[f'{s:04X}' for s in seen]}")
+    check(L.sdo_u(axis.s, B41, 1) == 0, f"B41[0] result {L.sdo_u(axis.s, B41, 1)}, expected 0")
+    b05 = L.sdo_u(axis.s, B05, 0)
+    err = (b05 - truth) % per_el
+    err = min(err, per_el - err) / per_el * 360.0
+    say(f"B41: plant offset {truth} inc, B05 {b05} inc: {err:.3} deg electrical off, alignments {L.sdo_u(axis.s, B41, 2)} inc apart, in {took:.2f} s")
+    check(err < 0.5, f"B41: B05 {b05} vs the plant's {truth} (mod {per_el}): {err} deg el")
+    axis.a75 = 0
+    axis.cw = 6
+    axis.cycle(20)
+
+
 def optimise(axis, sel, r, l):
     axis.cw = 6
     check(axis.until(lambda: L.sw_is(axis.sw, L.READY), 300), f"ready to switch on: statusword {axis.sw:#06x}")
@@ -107,7 +154,7 @@ def optimise(axis, sel, r, l):
             break
     took = time.monotonic() - start
     done = 100 | sel << 8 | DONE << 12
-    check(seen[-1] == done, f"{sel:04b}: A69 ends {seen[-1]:04X}h, expected {done:04X}h; seen {[f'{s:04X}' for s in seen]}")
+    check(seen[-1] == done, f"{sel:04b}: A69 ends {seen[-1]:04X}h, expected {done:04X}h; seen {[f'{s:04X}' for s in seen]}; B42[0] {L.sdo_u(axis.s, B42, 1)}, statusword {axis.sw:#06x}")
     check(all((a & 0xFF) <= (b_ & 0xFF) for a, b_ in zip(seen, seen[1:])), f"{sel:04b}: progress rises: {[f'{s:04X}' for s in seen]}")
     check(L.sdo_u(axis.s, B42, 1) == 0, f"{sel:04b}: B42[0] result {L.sdo_u(axis.s, B42, 1)}, expected 0")
     r_mohm, l_uh, lq_uh = motor_data(axis.s)
@@ -148,6 +195,8 @@ def run(m, args):
     else:
         raise L.Fatal(f"Op not reached: {L.state_report(m)}")
     refused(axis)
+    # the commutation offset first: B42 injects in the rotor's frame
+    calibrate(axis, args.offset)
     for sel in (B42_SEL, B49_SEL):
         optimise(axis, sel, args.r, args.l)
     axis.cw = 0
@@ -159,6 +208,7 @@ def main():
     ap.add_argument("--iface", required=True)
     ap.add_argument("--r", type=float, required=True, help="the plant's phase resistance, ohm")
     ap.add_argument("--l", type=float, required=True, help="the plant's inductance, H")
+    ap.add_argument("--offset", type=float, required=True, help="the plant's commutation offset, rad (mechanical)")
     args = ap.parse_args()
     return L.master_main(args, run, "motor actions on the electrical plant: all checks passed")
 

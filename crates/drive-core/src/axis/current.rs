@@ -52,14 +52,18 @@ pub struct DAxisMeans {
     pub interval_s: f32,
 }
 
-/// A motor action's injection (B42/B49, `crate::actions`): the loop applies
-/// this d-axis voltage open loop (q voltage 0) at the electrical angle of its
-/// encoder and commutation offset, instead of the output of its current
-/// controllers, with its protection as always.
+/// A motor action's injection (B41, B42/B49, `crate::actions`): the loop
+/// applies this d-axis voltage open loop (q voltage 0) instead of the output
+/// of its current controllers, with its protection as always: in the frame
+/// of its encoder and commutation offset, or at a fixed electrical angle
+/// (then [`DAxisMeans`] are in that frame too).
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct Injection {
     /// d voltage, V.
     pub ud_v: f32,
+    /// The frame's electrical angle (a full turn = 2^32, 0 = along phase a);
+    /// `None`: the rotor's, from the encoder.
+    pub angle: Option<u32>,
 }
 
 /// A trip of the current loop's protection (the power stage is off within

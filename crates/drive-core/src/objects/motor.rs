@@ -16,7 +16,7 @@
 //! ([`super::MANUFACTURER_A`]).
 
 use super::{Object, Value};
-use crate::params::{B10, B17, B42, B52, B53, B62, B64, B73, U10, U11};
+use crate::params::{B05, B10, B17, B41, B42, B52, B53, B62, B64, B73, U10, U11};
 use od::DataType::{U16, U32, U8};
 
 use od::{Access, DataType, EntryInfo};
@@ -27,7 +27,19 @@ const fn e(sub: u8, name: &'static str, t: DataType) -> EntryInfo {
 }
 
 /// The motor data of axis A (group B), sorted by index.
-pub const PARAMS: [Object; 8] = [
+pub const PARAMS: [Object; 10] = [
+    Object::var(
+        B05,
+        Value::Ram,
+        entries![e(0, "Commutation offset", U32)
+            .range(0, (1 << 20) - 1)
+            .default_value(0)
+            .unit("inc")
+            .saved()],
+    )
+    .axis()
+    .level(1)
+    .note("B05 (line assumed): the encoder position (2^20 increments per revolution) at which the rotor's d axis points along phase a: the current loop's electrical angle is p·(position − B05); found by B41 \"calibrate motor\" (alignment), saved with the parameter set; default 0"),
     Object::var(
         B10,
         Value::Ram,
@@ -48,6 +60,13 @@ pub const PARAMS: [Object; 8] = [
     .axis()
     .level(1)
     .note("B17 (line assumed): kt = 1.5·p·ψ per A of the dq amplitude (the phase current's peak); the torque command becomes iq = T/kt; 6076h = kt × 6075h; default 0.65 N·m/A"),
+    param_array!(B41, "Calibrate motor", Record, Value::Ram, [
+        EntryInfo::new(0, "Result", U8, Access::RO),
+        EntryInfo::new(1, "Alignment spread", U32, Access::RO).unit("inc"),
+    ])
+    .axis()
+    .level(1)
+    .note("B41 (line assumed): the action \"calibrate motor\", started through A75 (E-140), progress in A69: the rotor (brake released, free to turn) aligned by a d current along phase a, approached from both sides; the mean of the two positions is the commutation offset, written to B05. [0] its result (0 written, 1 aborted: the enable went away, 2 the rotor did not come to rest, 5 the current loop reports no measurement), [1] the two alignments' difference (friction's share)"),
     param_array!(B42, "Optimize current controller", Record, Value::Ram, [
         EntryInfo::new(0, "Result", U8, Access::RO),
         EntryInfo::new(1, "Identified R", U32, Access::RO).unit("mΩ"),

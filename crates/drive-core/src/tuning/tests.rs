@@ -117,3 +117,80 @@ fn e140_b42_open_winding_and_no_measurement_fail_with_their_codes() {
     }
     assert_eq!(t.outcome(), Outcome::Failed(result::NO_MEASUREMENT));
 }
+
+/// A rotor that turns its d axis towards the injected frame: torque
+/// K·sin(frame − θe), Coulomb friction with stick, inertia J; 4 pole pairs,
+/// its d axis along phase a at `offset_inc`. Stepped in 0.1 ms.
+fn align_run(offset_inc: i32, start_el: f64) -> (align::AlignOutcome, u32) {
+    use align::{AlignOutcome, Alignment};
+    let (k, tc, j, p) = (5.2f64, 0.02f64, 1e-4f64, 4.0f64);
+    let (mut th, mut w) = (start_el / p, 0.0f64); // mechanical, from the offset
+    let pos = |th: f64| offset_inc.wrapping_add((th / core::f64::consts::TAU * 1_048_576.0).round() as i32);
+    let mut a = Alignment::new(7.2, 4);
+    let mut cmd = a.cycle(4, pos(th));
+    for n in 0..40_000 {
+        let frame = cmd.and_then(|c| c.injection).and_then(|i| i.angle);
+        for _ in 0..10 {
+            let drive = frame.map_or(0.0, |f| {
+                let fe = f64::from(f) / 4_294_967_296.0 * core::f64::consts::TAU;
+                k * (fe - p * th).sin()
+            });
+            let torque = if w == 0.0 && drive.abs() <= tc {
+                0.0
+            } else {
+                drive - tc * if w != 0.0 { w.signum() } else { drive.signum() }
+            };
+            let w1 = w + torque / j * 1e-4;
+            th += 0.5 * (w + w1) * 1e-4;
+            w = if w != 0.0 && w * w1 < 0.0 { 0.0 } else { w1 };
+        }
+        cmd = a.cycle(4, pos(th));
+        if !matches!(a.outcome(), AlignOutcome::Running(_)) {
+            return (a.outcome(), n);
+        }
+    }
+    panic!("no end");
+}
+
+/// E-140 (B41): the alignment finds a rotor's commutation offset from any
+/// start (up to 170° electrical away) within 0.2° electrical, friction
+/// notwithstanding (its two approaches straddle the offset).
+#[test]
+fn e140_b41_alignment_finds_the_offset_of_a_rotor_with_friction() {
+    let per_el = 262_144i64;
+    for (offset, start) in [
+        (50_066, 0.0),
+        (1_000_000, 0.0),
+        (50_066, 2.9),
+        (1_000_000, 2.9),
+        (7, -2.0),
+    ] {
+        let (o, n) = align_run(offset, start);
+        let align::AlignOutcome::Done {
+            offset_inc,
+            spread_inc,
+        } = o
+        else {
+            panic!("{offset}: {o:?}");
+        };
+        let err = (i64::from(offset_inc) - i64::from(offset)).rem_euclid(per_el);
+        let err = err.min(per_el - err) as f64 / per_el as f64 * 360.0;
+        assert!(
+            err < 0.2,
+            "{offset} from {start}: B05 {offset_inc}, {err}° el off, spread {spread_inc}, {n} cycles"
+        );
+        assert!(spread_inc > 0, "friction parts the approaches");
+    }
+}
+
+/// E-141 (B41): the enable removed mid-run aborts the calibration.
+#[test]
+fn e141_b41_aborted_when_the_enable_goes() {
+    let mut a = align::Alignment::new(7.2, 4);
+    assert!(a.cycle(2, 0).is_none(), "waits for the enable");
+    assert!(a
+        .cycle(4, 0)
+        .is_some_and(|c| c.brake_release && c.injection.is_some_and(|i| i.angle == Some(0))));
+    assert!(a.cycle(2, 0).is_none());
+    assert_eq!(a.outcome(), align::AlignOutcome::Failed(result::ABORTED));
+}
