@@ -11,7 +11,7 @@
 )]
 
 use drive_ecat::actions::{state, A69, A75};
-use drive_ecat::params::{B05, B41, B42, B52, B53, B62, E48};
+use drive_ecat::params::{B05, B41, B42, B43, B52, B53, B62, E48};
 use drive_tests::{init, line, with_master, MASTER_CYCLE};
 use hil_sim::electrical::PlantModel;
 
@@ -280,4 +280,98 @@ fn e141_b42_refused_in_the_wrong_state_and_aborted_without_its_enable() {
         );
         assert_eq!(after, before, "nothing changed");
     });
+}
+
+/// E-140, E-141 (B43): "test winding" started in Ready to switch on runs
+/// without an enable (the axis stays in E48 = 2); a balanced winding passes
+/// (the three resistances within 3 % of the plant's R, result 0, done); one
+/// phase's resistance 10 % high (the plant's unbalanced winding) fails with
+/// result 6 and A69 "failed", its resistances those of the closed form
+/// (R_x + R_y‖R_z)/1.5 within 1 %; an open phase fails
+/// with result 2 (no current).
+#[test]
+fn e140_b43_test_winding_passes_a_balanced_and_fails_an_unbalanced_or_open_winding() {
+    use plant::{FaultOptions, Phase};
+    let r = 3.6;
+    let cases: [(Option<FaultOptions>, u8, u16); 3] = [
+        (None, 0, state::DONE),
+        (
+            Some(FaultOptions {
+                r_scale: [1.0, 1.1, 1.0],
+                ..FaultOptions::NONE
+            }),
+            6,
+            state::FAILED,
+        ),
+        (
+            Some(FaultOptions {
+                open_phase: Some(Phase::C),
+                ..FaultOptions::NONE
+            }),
+            2,
+            state::FAILED,
+        ),
+    ];
+    for (fault, code, end) in cases {
+        let sim = electrical_line(r, 0.012);
+        if let Some(f) = fault {
+            let mut s = sim.borrow_mut();
+            s.drives_mut()[0]
+                .electrical_mut(0)
+                .unwrap()
+                .plant_mut()
+                .set_faults(f);
+        }
+        with_master(&sim, async |md, clock| {
+            let group = init(md, clock).await;
+            let sd = group.subdevice(md, 0).unwrap();
+            let (a75, a69) = map_actions(&sd).await;
+            let group = group.into_op(md).await.expect("Op with A75/A69 mapped");
+            let sd = group.subdevice(md, 0).unwrap();
+            sd.outputs_raw_mut()[0..2].copy_from_slice(&6u16.to_le_bytes());
+            cycles(&sim, &group, md, 20).await;
+            assert_eq!(sd.sdo_read::<u8>(E48, 0).await.unwrap(), 2, "ready to switch on");
+            sd.outputs_raw_mut()[a75] = 0b1101 << 1 | 1;
+            let mut seen = Vec::new();
+            for _ in 0..5000 {
+                cycles(&sim, &group, md, 1).await;
+                let s = a69_of(sd.io_raw().inputs(), a69);
+                if seen.last() != Some(&s) {
+                    seen.push(s);
+                }
+                if s >> 12 != state::RUNNING && s >> 12 != state::IDLE {
+                    break;
+                }
+            }
+            assert_eq!(
+                sd.sdo_read::<u8>(E48, 0).await.unwrap(),
+                2,
+                "no enable: still ready to switch on"
+            );
+            let last = *seen.last().unwrap();
+            assert_eq!(last >> 12, end, "{fault:?}: A69 {seen:04X?}");
+            assert_eq!(
+                sd.sdo_read::<u8>(B43, 1).await.unwrap(),
+                code,
+                "{fault:?}: B43[0]"
+            );
+            if code != 2 {
+                let mut rs = [0.0; 3];
+                for (k, x) in rs.iter_mut().enumerate() {
+                    *x = f64::from(sd.sdo_read::<u32>(B43, k as u8 + 2).await.unwrap()) * 1e-3;
+                }
+                println!("B43 {fault:?}: U {:.3} V {:.3} W {:.3} Ω", rs[0], rs[1], rs[2]);
+                if code == 0 {
+                    assert!(rs.iter().all(|x| (x - r).abs() < 0.03 * r), "{rs:?} vs {r} Ω");
+                } else {
+                    // 10 % on V: (1.1 R + R/2)/1.5 = 1.067 R along V,
+                    // (R + 1.1 R‖R)/1.5 = 1.016 R along U and W
+                    assert!((rs[1] - 1.0667 * r).abs() < 0.01 * r, "{rs:?}");
+                    for x in [rs[0], rs[2]] {
+                        assert!((x - 1.0159 * r).abs() < 0.01 * r, "{rs:?}");
+                    }
+                }
+            }
+        });
+    }
 }

@@ -11,9 +11,10 @@
 //! progress in % (100 at the end), bits 8–11 the selector of the action shown,
 //! bits 12–15 its [`state`].
 //!
-//! The motor actions that need the power stage (B42/B49 optimise current
-//! controller, [`crate::tuning`]) start in Ready to switch on and run once
-//! the master enabled the axis (E-141): their measurement runs in the
+//! The motor actions that need the power stage (B41 calibrate motor, B42/B49
+//! optimise current controller, B43 test winding: [`crate::tuning`]) start
+//! in Ready to switch on and run once the master enabled the axis (E-141;
+//! B43 at once, without an enable): their measurement runs in the
 //! control cycle ([`Actions::control`], which replaces the axis' command),
 //! their progress and end show here; Execute low stops them.
 //!
@@ -23,8 +24,9 @@
 //! or mapped in another channel, starts nothing ([`state::NOT_ACTIVATED`]).
 
 use crate::axis::{AxisCommand, AxisIo};
-use crate::params::{B05, B10, B41, B42, B52, B53, B62, E48};
+use crate::params::{B05, B10, B41, B42, B43, B52, B53, B62, E48};
 use crate::tuning::align::{AlignOutcome, Alignment};
+use crate::tuning::winding::{WindingOutcome, WindingTest};
 use crate::tuning::{CurrentTuning, Outcome};
 use crate::{parameter_index, DriveObjects, AXIS_B_CIA402, AXIS_B_MANUFACTURER};
 
@@ -46,8 +48,7 @@ pub mod state {
     /// The precondition on E48 does not hold (E-141): not started.
     pub const REFUSED: u16 = 3;
     /// This drive cannot run the action (A37, I52: nothing to reset; test
-    /// phase, calibrate motor, test winding and the brake actions: not
-    /// built): not started.
+    /// phase and the brake actions: not built): not started.
     pub const NOT_AVAILABLE: u16 = 4;
     /// Started and failed (e.g. the save found the store broken).
     pub const FAILED: u16 = 5;
@@ -161,6 +162,8 @@ enum Measurement {
     Current(CurrentTuning),
     /// B41.
     Align(Alignment),
+    /// B43.
+    Winding(WindingTest),
 }
 
 /// The action unit of both axes: the last Execute bits and what runs.
@@ -216,6 +219,7 @@ impl Actions {
         match self.axes.get_mut(axis)?.tuning.as_mut()? {
             Measurement::Current(t) => t.cycle(e48, io.current.as_ref()),
             Measurement::Align(a) => a.cycle(e48, io.position_inc),
+            Measurement::Winding(w) => w.cycle(e48, io.current.as_ref()),
         }
     }
 
@@ -251,6 +255,7 @@ impl Actions {
                     Running::Tuning => match a.tuning.as_ref() {
                         Some(Measurement::Current(t)) => follow_tuning(objects, t, axis, selector),
                         Some(Measurement::Align(al)) => follow_alignment(objects, al, axis, selector),
+                        Some(Measurement::Winding(w)) => follow_winding(objects, w, axis, selector),
                         None => None,
                     },
                     _ => follow(objects, r, selector),
@@ -316,6 +321,16 @@ fn start(
             a.running = Some(Running::Tuning);
             status(0, selector, state::RUNNING)
         }
+        Action::TestWinding => {
+            let rated_ma = objects.get(0x6075 + cia(axis), 0).unwrap_or(0);
+            let r_mohm = objects.get(B53 + offset(axis), 0).unwrap_or(0);
+            a.tuning = Some(Measurement::Winding(WindingTest::new(
+                rated_ma as f32 * 1e-3,
+                r_mohm as f32 * 1e-3,
+            )));
+            a.running = Some(Running::Tuning);
+            status(0, selector, state::RUNNING)
+        }
         Action::CalibrateMotor => {
             let rated_ma = objects.get(0x6075 + cia(axis), 0).unwrap_or(0);
             let r_mohm = objects.get(B53 + offset(axis), 0).unwrap_or(0);
@@ -326,8 +341,8 @@ fn start(
             status(0, selector, state::RUNNING)
         }
         // A37 (the memorised extreme values) and I52 (the limit-switch
-        // memory) hold nothing in this drive; B40, B41, B43 and the brake
-        // actions are not built
+        // memory) hold nothing in this drive; B40 and the brake actions are
+        // not built
         _ => status(0, selector, state::NOT_AVAILABLE),
     }
 }
@@ -375,6 +390,31 @@ fn follow_tuning(
         }
         Outcome::Failed(code) => {
             let _ = objects.set(B42 + off, 1, i64::from(code));
+            Some(status(0, selector, state::FAILED))
+        }
+    }
+}
+
+/// A69 of a running B43; at its end the resistances and the result in B43.
+fn follow_winding(objects: &mut DriveObjects, w: &WindingTest, axis: usize, selector: u8) -> Option<u16> {
+    let off = offset(axis);
+    match w.outcome() {
+        WindingOutcome::Running(p) => Some(status(u16::from(p), selector, state::RUNNING)),
+        WindingOutcome::Done(r) => {
+            for (sub, x) in (2u8..).zip(r) {
+                let _ = objects.set(B43 + off, sub, (x * 1e3 + 0.5) as i64);
+            }
+            let code = WindingTest::code(&r);
+            let _ = objects.set(B43 + off, 1, i64::from(code));
+            let st = if code == crate::tuning::result::OK {
+                state::DONE
+            } else {
+                state::FAILED
+            };
+            Some(status(100, selector, st))
+        }
+        WindingOutcome::Failed(code) => {
+            let _ = objects.set(B43 + off, 1, i64::from(code));
             Some(status(0, selector, state::FAILED))
         }
     }
@@ -521,9 +561,9 @@ mod tests {
         }
         execute(&mut od, 0, 0, false);
         a.serve(&mut od);
-        execute(&mut od, 0, 0b1101, true);
+        execute(&mut od, 0, 0b1010, true);
         od.set(E48, 0, 2).unwrap();
         a.serve(&mut od);
-        assert_eq!(a.status(0) >> 12, state::NOT_AVAILABLE, "test winding in E48 = 2");
+        assert_eq!(a.status(0) >> 12, state::NOT_AVAILABLE, "test phase in E48 = 2");
     }
 }

@@ -196,6 +196,9 @@ pub const B17: u16 = parameter_index(1, 17);
 /// B42 optimise current controller: the action's result and figures (per
 /// axis; started through A75, `crate::tuning`).
 pub const B42: u16 = parameter_index(1, 42);
+/// B43 test winding: the action's result and the three phases' resistances
+/// (per axis; started through A75, `crate::tuning::winding`).
+pub const B43: u16 = parameter_index(1, 43);
 /// B52 d-axis inductance Ld, µH (per axis, motor data).
 pub const B52: u16 = parameter_index(1, 52);
 /// B53 phase resistance, mΩ (per axis, motor data).

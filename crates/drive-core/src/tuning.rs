@@ -49,6 +49,9 @@ pub mod result {
     pub const IMPLAUSIBLE: u8 = 4;
     /// The current loop reports no d-axis measurement.
     pub const NO_MEASUREMENT: u8 = 5;
+    /// B43: the three phases' resistances differ by more than the
+    /// tolerance ([`super::winding::TOLERANCE`]).
+    pub const UNBALANCED: u8 = 6;
     /// B41: the rotor did not come to rest (the same code as
     /// [`NOT_SETTLED`]: the measurement did not settle).
     pub const NOT_AT_REST: u8 = NOT_SETTLED;
@@ -162,6 +165,12 @@ pub struct CurrentTuning {
     before_a: f32,
     /// Enabled cycles without a d-axis report.
     unmeasured: u8,
+    /// The frame's fixed electrical angle (B43: along one phase), or the
+    /// rotor's (`None`).
+    frame: Option<u32>,
+    /// Waits for the master's enable (B42/B49); else runs in Ready to switch
+    /// on (B43: the drive switches the power stage on itself).
+    needs_enable: bool,
     outcome: Outcome,
 }
 
@@ -182,7 +191,21 @@ impl CurrentTuning {
             steps: [(0.0, 0.0, 0.0); LEVELS.len()],
             before_a: 0.0,
             unmeasured: 0,
+            frame: None,
+            needs_enable: true,
             outcome: Outcome::Running(0),
+        }
+    }
+
+    /// The measurement in a frame at the fixed electrical angle `frame`
+    /// (2^32 a turn), brake applied, run in Ready to switch on without an
+    /// enable (B43, [`winding`]): its R is the resistance seen along that
+    /// frame.
+    pub fn in_frame(rated_a: f32, r_prior_ohm: f32, frame: u32) -> Self {
+        Self {
+            frame: Some(frame),
+            needs_enable: false,
+            ..Self::new(rated_a, r_prior_ohm, true)
         }
     }
 
@@ -199,8 +222,9 @@ impl CurrentTuning {
         if self.phase == Phase::End {
             return None;
         }
-        if e48 != 4 {
-            if self.phase != Phase::WaitEnable {
+        let run_state = if self.needs_enable { 4 } else { 2 };
+        if e48 != run_state {
+            if self.phase != Phase::WaitEnable || !self.needs_enable {
                 return self.fail(result::ABORTED);
             }
             // still waiting; a disable or a fault before the enable ends it too
@@ -328,7 +352,7 @@ impl CurrentTuning {
             brake_release: !self.standstill,
             injection: Some(Injection {
                 ud_v: self.ud,
-                angle: None,
+                angle: self.frame,
             }),
         }
     }
@@ -349,6 +373,7 @@ fn abs(x: f32) -> f32 {
 }
 
 pub mod align;
+pub mod winding;
 
 #[cfg(test)]
 mod tests;

@@ -20,6 +20,8 @@ Free run, one drive, axis A in cst; RxPDO 6040h, 6060h, A75; TxPDO 6041h, A69.
      rises to 100 %, state done; B42[0] (sub 1) = 0, B53 and B52/B62 within
      5 % of --r/--l, B42[1]/[2] the same figures. Execute low and shutdown:
      A69 idle.
+  4. B43 (1101b, test winding) in ready to switch on, no enable: done,
+     B43[0] = 0, the three resistances within 3 % of --r, E48 still 2.
 
 Prints `FAIL: ...` for every check that failed; exit status 0 when none did.
 """
@@ -40,7 +42,7 @@ def b(line):
 
 
 A75, A69 = 0x2000 + 75, 0x2000 + 69
-B05, B10, B41, B42, B52, B53, B62 = b(5), b(10), b(41), b(42), b(52), b(53), b(62)
+B05, B10, B41, B42, B43, B52, B53, B62 = b(5), b(10), b(41), b(42), b(43), b(52), b(53), b(62)
 E48 = 0x2000 + 4 * 0x200 + 48
 RX = [L.entry(0x6040, 0, 16), L.entry(0x6060, 0, 8), L.entry(A75, 0, 8)]
 TX = [L.entry(0x6041, 0, 16), L.entry(A69, 0, 16)]
@@ -50,7 +52,7 @@ RUNNING, DONE, REFUSED = 1, 2, 3
 # turns the rotor to needs no cyclic target (csp would: a master there sends
 # the actual position as the target, as before any enable)
 CST = 10
-B41_SEL, B42_SEL, B49_SEL = 0b1011, 0b1100, 0b1110
+B41_SEL, B42_SEL, B43_SEL, B49_SEL = 0b1011, 0b1100, 0b1101, 0b1110
 
 
 class Axis:
@@ -133,6 +135,29 @@ def calibrate(axis, offset_rad):
     axis.cycle(20)
 
 
+def winding(axis, r):
+    axis.cw = 6
+    check(axis.until(lambda: L.sw_is(axis.sw, L.READY), 300), f"ready to switch on: statusword {axis.sw:#06x}")
+    axis.a75 = B43_SEL << 1 | 1
+    seen = []
+    start_t = time.monotonic()
+    while time.monotonic() - start_t < 10.0:
+        axis.cycle()
+        if not seen or seen[-1] != axis.a69:
+            seen.append(axis.a69)
+        if axis.a69 >> 12 not in (0, RUNNING):
+            break
+    done = 100 | B43_SEL << 8 | DONE << 12
+    check(seen[-1] == done, f"B43: A69 ends {seen[-1]:04X}h, expected {done:04X}h; seen {[f'{s:04X}' for s in seen]}")
+    check(L.sdo_u(axis.s, E48, 0) == 2, "B43 runs without the enable: E48 = 2")
+    check(L.sdo_u(axis.s, B43, 1) == 0, f"B43[0] result {L.sdo_u(axis.s, B43, 1)}, expected 0")
+    rs = [L.sdo_u(axis.s, B43, k) * 1e-3 for k in (2, 3, 4)]
+    say(f"B43: resistances along U, V, W {rs} ohm (plant {r} ohm) in {time.monotonic() - start_t:.2f} s")
+    check(all(abs(x - r) <= 0.03 * r for x in rs), f"B43: {rs} not within 3 % of {r} ohm")
+    axis.a75 = 0
+    axis.cycle(10)
+
+
 def optimise(axis, sel, r, l):
     axis.cw = 6
     check(axis.until(lambda: L.sw_is(axis.sw, L.READY), 300), f"ready to switch on: statusword {axis.sw:#06x}")
@@ -199,6 +224,7 @@ def run(m, args):
     calibrate(axis, args.offset)
     for sel in (B42_SEL, B49_SEL):
         optimise(axis, sel, args.r, args.l)
+    winding(axis, args.r)
     axis.cw = 0
     axis.cycle(20)
 

@@ -16,7 +16,7 @@
 //! ([`super::MANUFACTURER_A`]).
 
 use super::{Object, Value};
-use crate::params::{B05, B10, B17, B41, B42, B52, B53, B62, B64, B73, U10, U11};
+use crate::params::{B05, B10, B17, B41, B42, B43, B52, B53, B62, B64, B73, U10, U11};
 use od::DataType::{U16, U32, U8};
 
 use od::{Access, DataType, EntryInfo};
@@ -27,7 +27,7 @@ const fn e(sub: u8, name: &'static str, t: DataType) -> EntryInfo {
 }
 
 /// The motor data of axis A (group B), sorted by index.
-pub const PARAMS: [Object; 10] = [
+pub const PARAMS: [Object; 11] = [
     Object::var(
         B05,
         Value::Ram,
@@ -75,6 +75,15 @@ pub const PARAMS: [Object; 10] = [
     .axis()
     .level(1)
     .note("B42 (line assumed): the action \"optimise current controller\" (and B49, at standstill: the same measurement with the brake applied), started through A75 (E-140), progress in A69: [0] its result (0 identified and written, 1 aborted: the enable went away, 2 no current: an open winding, 3 the current did not settle, 4 implausible figures, 5 the current loop measures no d axis), [1] the identified phase resistance and [2] d-axis inductance of the last run; identified, they are written to B53 and B52/B62 (the current gains follow by pole-zero cancellation); not saved themselves (B52/B53/B62 are)"),
+    param_array!(B43, "Test winding", Record, Value::Ram, [
+        EntryInfo::new(0, "Result", U8, Access::RO),
+        EntryInfo::new(1, "Resistance U", U32, Access::RO).unit("mΩ"),
+        EntryInfo::new(2, "Resistance V", U32, Access::RO).unit("mΩ"),
+        EntryInfo::new(3, "Resistance W", U32, Access::RO).unit("mΩ"),
+    ])
+    .axis()
+    .level(1)
+    .note("B43 (line assumed): the action \"test winding\", started through A75 in Ready to switch on (no enable: the drive switches the power stage on itself, brake applied), progress in A69: the resistance measured along each phase's axis ((R_x + R_y‖R_z)/1.5, R when balanced) in [1]..[3]; [0] the result: 0 the three agree within 3 % of their mean, 6 unbalanced (A69: failed), 1 aborted (the state changed), 2 no current (an open phase), 3 not settled"),
     Object::var(
         B52,
         Value::Ram,
