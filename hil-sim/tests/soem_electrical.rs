@@ -67,7 +67,8 @@ fn c038_e089_soem_max_current_and_motor_i2t_on_the_electrical_plant() {
 /// 6.5 mH: `serve --plant-r/--plant-l`, the drive's B53/B52 say 3.6 Ω,
 /// 12 mH) within 5 % into B53 and B52/B62; B41 finds the plant's
 /// commutation offset (0.3 rad: `--plant-offset`) within 0.5° electrical
-/// into B05; B43 (no enable) measures the three phases within 3 % of R.
+/// into B05; B43 (no enable) measures the three phases within 3 % of R;
+/// B40 passes the plant as wired (the pole pairs seen = B10).
 #[test]
 fn e140_e141_soem_motor_actions_identify_the_plants_r_l_and_commutation_offset() {
     let python = match pysoem_python() {

@@ -11,7 +11,7 @@
 )]
 
 use drive_ecat::actions::{state, A69, A75};
-use drive_ecat::params::{B05, B41, B42, B43, B52, B53, B62, E48};
+use drive_ecat::params::{B05, B40, B41, B42, B43, B52, B53, B62, E48};
 use drive_tests::{init, line, with_master, MASTER_CYCLE};
 use hil_sim::electrical::PlantModel;
 
@@ -371,6 +371,85 @@ fn e140_b43_test_winding_passes_a_balanced_and_fails_an_unbalanced_or_open_windi
                         assert!((x - 1.0159 * r).abs() < 0.01 * r, "{rs:?}");
                     }
                 }
+            }
+        });
+    }
+}
+
+/// E-140, E-141 (B40): "test phase" started in Ready to switch on runs after
+/// the enable: on the plant as wired it passes (the encoder counts
+/// 2^20/4 = 262,144 increments, within 1 %, for one electrical turn of the
+/// field: 4 pole pairs, B10); phases V and W swapped make the rotor turn
+/// backwards (result 7), an open phase carries no current (result 2), a motor
+/// of 5 pole pairs where B10 says 4 counts 2^20/5 (result 8). A69 says done
+/// or failed.
+#[test]
+fn e140_b40_test_phase_passes_the_wiring_and_fails_swapped_or_open_phases_and_wrong_pole_pairs() {
+    use plant::{FaultOptions, Phase};
+    let none = FaultOptions::NONE;
+    let cases: [(&str, FaultOptions, u32, u8); 4] = [
+        ("as wired", none, 4, 0),
+        (
+            "V and W swapped",
+            FaultOptions {
+                swapped_bc: true,
+                ..none
+            },
+            4,
+            7,
+        ),
+        (
+            "W open",
+            FaultOptions {
+                open_phase: Some(Phase::C),
+                ..none
+            },
+            4,
+            2,
+        ),
+        ("5 pole pairs", none, 5, 8),
+    ];
+    for (what, fault, pole_pairs, code) in cases {
+        let sim = electrical_line(3.6, 0.012);
+        {
+            let mut s = sim.borrow_mut();
+            let plant = s.drives_mut()[0].electrical_mut(0).unwrap().plant_mut();
+            plant.set_faults(fault);
+            let mut m = plant.params().motor;
+            m.pole_pairs = pole_pairs;
+            plant.set_motor(m);
+        }
+        with_master(&sim, async |md, clock| {
+            let group = init(md, clock).await;
+            let sd = group.subdevice(md, 0).unwrap();
+            let (a75, a69) = map_actions(&sd).await;
+            let group = group.into_op(md).await.expect("Op with A75/A69 mapped");
+            let sd = group.subdevice(md, 0).unwrap();
+            // cst (10): the rotor turns, no position is held
+            sd.outputs_raw_mut()[2] = 10;
+            let seen = run_action(&sim, &group, md, (a75, a69), 0b1010, 10_000).await;
+            let last = *seen.last().unwrap();
+            let want = if code == 0 { state::DONE } else { state::FAILED };
+            let b40 = sd.sdo_read::<u8>(B40, 1).await.unwrap();
+            assert_eq!(
+                last >> 12,
+                want,
+                "{what}: A69 {seen:04X?}, B40[0] {b40} {}",
+                sd.sdo_read::<i32>(B40, 2).await.unwrap()
+            );
+            assert_eq!(sd.sdo_read::<u8>(B40, 1).await.unwrap(), code, "{what}: B40[0]");
+            let per_turn = sd.sdo_read::<i32>(B40, 2).await.unwrap();
+            println!("B40 {what}: result {code}, {per_turn} inc per electrical turn");
+            match code {
+                0 | 8 => {
+                    let expected = f64::from(1u32 << 20) / f64::from(pole_pairs);
+                    assert!(
+                        (f64::from(per_turn) - expected).abs() < 0.01 * expected,
+                        "{what}: {per_turn} vs {expected}"
+                    );
+                }
+                7 => assert!(per_turn < 0, "{what}: {per_turn}"),
+                _ => {}
             }
         });
     }

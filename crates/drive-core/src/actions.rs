@@ -11,7 +11,8 @@
 //! progress in % (100 at the end), bits 8–11 the selector of the action shown,
 //! bits 12–15 its [`state`].
 //!
-//! The motor actions that need the power stage (B41 calibrate motor, B42/B49
+//! The motor actions that need the power stage (B40 test phase, B41
+//! calibrate motor, B42/B49
 //! optimise current controller, B43 test winding: [`crate::tuning`]) start
 //! in Ready to switch on and run once the master enabled the axis (E-141;
 //! B43 at once, without an enable): their measurement runs in the
@@ -24,8 +25,9 @@
 //! or mapped in another channel, starts nothing ([`state::NOT_ACTIVATED`]).
 
 use crate::axis::{AxisCommand, AxisIo};
-use crate::params::{B05, B10, B41, B42, B43, B52, B53, B62, E48};
+use crate::params::{B05, B10, B40, B41, B42, B43, B52, B53, B62, E48};
 use crate::tuning::align::{AlignOutcome, Alignment};
+use crate::tuning::phase::{PhaseOutcome, PhaseTest};
 use crate::tuning::winding::{WindingOutcome, WindingTest};
 use crate::tuning::{CurrentTuning, Outcome};
 use crate::{parameter_index, DriveObjects, AXIS_B_CIA402, AXIS_B_MANUFACTURER};
@@ -47,8 +49,8 @@ pub mod state {
     pub const DONE: u16 = 2;
     /// The precondition on E48 does not hold (E-141): not started.
     pub const REFUSED: u16 = 3;
-    /// This drive cannot run the action (A37, I52: nothing to reset; test
-    /// phase and the brake actions: not built): not started.
+    /// This drive cannot run the action (A37, I52: nothing to reset; the
+    /// brake actions: not built): not started.
     pub const NOT_AVAILABLE: u16 = 4;
     /// Started and failed (e.g. the save found the store broken).
     pub const FAILED: u16 = 5;
@@ -164,6 +166,8 @@ enum Measurement {
     Align(Alignment),
     /// B43.
     Winding(WindingTest),
+    /// B40.
+    Phase(PhaseTest),
 }
 
 /// The action unit of both axes: the last Execute bits and what runs.
@@ -220,6 +224,7 @@ impl Actions {
             Measurement::Current(t) => t.cycle(e48, io.current.as_ref()),
             Measurement::Align(a) => a.cycle(e48, io.position_inc),
             Measurement::Winding(w) => w.cycle(e48, io.current.as_ref()),
+            Measurement::Phase(p) => p.cycle(e48, io.position_inc, io.current.as_ref()),
         }
     }
 
@@ -256,6 +261,7 @@ impl Actions {
                         Some(Measurement::Current(t)) => follow_tuning(objects, t, axis, selector),
                         Some(Measurement::Align(al)) => follow_alignment(objects, al, axis, selector),
                         Some(Measurement::Winding(w)) => follow_winding(objects, w, axis, selector),
+                        Some(Measurement::Phase(p)) => follow_phase(objects, p, axis, selector),
                         None => None,
                     },
                     _ => follow(objects, r, selector),
@@ -321,6 +327,18 @@ fn start(
             a.running = Some(Running::Tuning);
             status(0, selector, state::RUNNING)
         }
+        Action::TestPhase => {
+            let rated_ma = objects.get(0x6075 + cia(axis), 0).unwrap_or(0);
+            let r_mohm = objects.get(B53 + offset(axis), 0).unwrap_or(0);
+            let pole_pairs = objects.get(B10 + offset(axis), 0).unwrap_or(4);
+            a.tuning = Some(Measurement::Phase(PhaseTest::new(
+                rated_ma as f32 * 1e-3,
+                r_mohm as f32 * 1e-3,
+                pole_pairs as u8,
+            )));
+            a.running = Some(Running::Tuning);
+            status(0, selector, state::RUNNING)
+        }
         Action::TestWinding => {
             let rated_ma = objects.get(0x6075 + cia(axis), 0).unwrap_or(0);
             let r_mohm = objects.get(B53 + offset(axis), 0).unwrap_or(0);
@@ -341,8 +359,8 @@ fn start(
             status(0, selector, state::RUNNING)
         }
         // A37 (the memorised extreme values) and I52 (the limit-switch
-        // memory) hold nothing in this drive; B40 and the brake actions are
-        // not built
+        // memory) hold nothing in this drive; the brake actions are not
+        // built
         _ => status(0, selector, state::NOT_AVAILABLE),
     }
 }
@@ -393,6 +411,23 @@ fn follow_tuning(
             Some(status(0, selector, state::FAILED))
         }
     }
+}
+
+/// A69 of a running B40; at its end its result and figures in B40.
+fn follow_phase(objects: &mut DriveObjects, p: &PhaseTest, axis: usize, selector: u8) -> Option<u16> {
+    let off = offset(axis);
+    let (code, per_turn, pole_pairs, st) = match p.outcome() {
+        PhaseOutcome::Running(pr) => return Some(status(u16::from(pr), selector, state::RUNNING)),
+        PhaseOutcome::Done {
+            per_turn_inc,
+            pole_pairs,
+        } => (0, per_turn_inc, pole_pairs, state::DONE),
+        PhaseOutcome::Failed(code, per_turn) => (code, per_turn, 0, state::FAILED),
+    };
+    let _ = objects.set(B40 + off, 2, i64::from(per_turn));
+    let _ = objects.set(B40 + off, 3, i64::from(pole_pairs));
+    let _ = objects.set(B40 + off, 1, i64::from(code));
+    Some(status(if st == state::DONE { 100 } else { 0 }, selector, st))
 }
 
 /// A69 of a running B43; at its end the resistances and the result in B43.
@@ -561,9 +596,9 @@ mod tests {
         }
         execute(&mut od, 0, 0, false);
         a.serve(&mut od);
-        execute(&mut od, 0, 0b1010, true);
+        execute(&mut od, 0, 0b0100, true);
         od.set(E48, 0, 2).unwrap();
         a.serve(&mut od);
-        assert_eq!(a.status(0) >> 12, state::NOT_AVAILABLE, "test phase in E48 = 2");
+        assert_eq!(a.status(0) >> 12, state::NOT_AVAILABLE, "test brake in E48 = 2");
     }
 }

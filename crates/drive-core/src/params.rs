@@ -187,6 +187,9 @@ pub const A278: u16 = parameter_index(0, 278);
 pub const PROFINET_PARAMS: [u16; 9] = [A270, A271, A272, A273, A274, A275, A276, A277, A278];
 /// B05 commutation offset, increments (per axis, motor data; B41 finds it).
 pub const B05: u16 = parameter_index(1, 5);
+/// B40 test phase: the action's result and what it saw (per axis; started
+/// through A75, `crate::tuning::phase`).
+pub const B40: u16 = parameter_index(1, 40);
 /// B41 calibrate motor: the action's result (per axis; started through A75).
 pub const B41: u16 = parameter_index(1, 41);
 /// B10 pole pair number (per axis, motor data; issue 34).

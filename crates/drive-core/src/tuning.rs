@@ -373,6 +373,7 @@ fn abs(x: f32) -> f32 {
 }
 
 pub mod align;
+pub mod phase;
 pub mod winding;
 
 #[cfg(test)]

@@ -10,7 +10,9 @@ Free run, one drive, axis A in cst; RxPDO 6040h, 6060h, A75; TxPDO 6041h, A69.
 
   1. Op, the axis switch-on disabled: A75 = Execute | 1100b (B42, optimise
      current controller) is refused (A69 state 3), B53/B52 unchanged.
-  2. B41 (1011b, calibrate motor), as below: B05 (commutation offset, 0
+  2. B40 (1010b, test phase), as below: done, B40[0] = 0, B40[2] (the pole
+     pairs the encoder's count over one electrical turn means) = B10.
+     B41 (1011b, calibrate motor), as below: B05 (commutation offset, 0
      before) within 0.5 degrees electrical of the plant's --offset (rad,
      mechanical; modulo an electrical revolution, 2^20 / B10 increments),
      B41[0] = 0. B42 needs it: it injects in the rotor's frame.
@@ -42,7 +44,7 @@ def b(line):
 
 
 A75, A69 = 0x2000 + 75, 0x2000 + 69
-B05, B10, B41, B42, B43, B52, B53, B62 = b(5), b(10), b(41), b(42), b(43), b(52), b(53), b(62)
+B05, B10, B40, B41, B42, B43, B52, B53, B62 = b(5), b(10), b(40), b(41), b(42), b(43), b(52), b(53), b(62)
 E48 = 0x2000 + 4 * 0x200 + 48
 RX = [L.entry(0x6040, 0, 16), L.entry(0x6060, 0, 8), L.entry(A75, 0, 8)]
 TX = [L.entry(0x6041, 0, 16), L.entry(A69, 0, 16)]
@@ -52,7 +54,7 @@ RUNNING, DONE, REFUSED = 1, 2, 3
 # turns the rotor to needs no cyclic target (csp would: a master there sends
 # the actual position as the target, as before any enable)
 CST = 10
-B41_SEL, B42_SEL, B43_SEL, B49_SEL = 0b1011, 0b1100, 0b1101, 0b1110
+B40_SEL, B41_SEL, B42_SEL, B43_SEL, B49_SEL = 0b1010, 0b1011, 0b1100, 0b1101, 0b1110
 
 
 class Axis:
@@ -114,6 +116,21 @@ def start(axis, sel):
         if axis.a69 >> 12 != RUNNING:
             break
     return seen, time.monotonic() - start_t
+
+
+def phase_test(axis):
+    seen, took = start(axis, B40_SEL)
+    done = 100 | B40_SEL << 8 | DONE << 12
+    result = L.sdo_u(axis.s, B40, 1)
+    check(seen[-1] == done, f"B40: A69 ends {seen[-1]:04X}h, expected {done:04X}h; seen {[f'{s:04X}' for s in seen]}; B40[0] {result}")
+    check(result == 0, f"B40[0] result {result}, expected 0")
+    per_turn = int.from_bytes(axis.s.sdo_read(B40, 2), "little", signed=True)
+    pp = L.sdo_u(axis.s, B40, 3)
+    say(f"B40: {per_turn} inc per electrical turn, {pp} pole pairs seen, in {took:.2f} s")
+    check(pp == L.sdo_u(axis.s, B10, 0), f"B40: pole pairs seen {pp} vs B10")
+    axis.a75 = 0
+    axis.cw = 6
+    axis.cycle(20)
 
 
 def calibrate(axis, offset_rad):
@@ -220,7 +237,8 @@ def run(m, args):
     else:
         raise L.Fatal(f"Op not reached: {L.state_report(m)}")
     refused(axis)
-    # the commutation offset first: B42 injects in the rotor's frame
+    # the wiring, then the commutation offset: B42 injects in the rotor's frame
+    phase_test(axis)
     calibrate(axis, args.offset)
     for sel in (B42_SEL, B49_SEL):
         optimise(axis, sel, args.r, args.l)

@@ -16,7 +16,7 @@
 //! ([`super::MANUFACTURER_A`]).
 
 use super::{Object, Value};
-use crate::params::{B05, B10, B17, B41, B42, B43, B52, B53, B62, B64, B73, U10, U11};
+use crate::params::{B05, B10, B17, B40, B41, B42, B43, B52, B53, B62, B64, B73, U10, U11};
 use od::DataType::{U16, U32, U8};
 
 use od::{Access, DataType, EntryInfo};
@@ -27,7 +27,7 @@ const fn e(sub: u8, name: &'static str, t: DataType) -> EntryInfo {
 }
 
 /// The motor data of axis A (group B), sorted by index.
-pub const PARAMS: [Object; 11] = [
+pub const PARAMS: [Object; 12] = [
     Object::var(
         B05,
         Value::Ram,
@@ -60,6 +60,14 @@ pub const PARAMS: [Object; 11] = [
     .axis()
     .level(1)
     .note("B17 (line assumed): kt = 1.5·p·ψ per A of the dq amplitude (the phase current's peak); the torque command becomes iq = T/kt; 6076h = kt × 6075h; default 0.65 N·m/A"),
+    param_array!(B40, "Test phase", Record, Value::Ram, [
+        EntryInfo::new(0, "Result", U8, Access::RO),
+        EntryInfo::new(1, "Increments per electrical turn", od::DataType::I32, Access::RO).unit("inc"),
+        EntryInfo::new(2, "Pole pairs seen", U8, Access::RO),
+    ])
+    .axis()
+    .level(1)
+    .note("B40 (line assumed): the action \"test phase\", started through A75 in Ready to switch on, run after the enable (brake released, the rotor turns one electrical revolution): each phase must carry current (else result 2), a field turned forward must make the encoder count up (else 7: phase order and encoder direction do not match) by 2^20/B10 per electrical turn (else 8); [0] the result (0 passed, 1 aborted), [1] the increments the encoder counted over the turn, [2] 2^20 divided by them"),
     param_array!(B41, "Calibrate motor", Record, Value::Ram, [
         EntryInfo::new(0, "Result", U8, Access::RO),
         EntryInfo::new(1, "Alignment spread", U32, Access::RO).unit("inc"),
