@@ -33,7 +33,7 @@
 //! dictionary's motor data ([`ElectricalAxis::set_motor_data`]).
 
 use crate::motor::{EdgeList, IndexEvent, Motor, MotorOutputs, INC_PER_RAD};
-use drive_ecat::axis::{AxisCommand, CurrentActual, CurrentControl, CurrentTrip};
+use drive_ecat::axis::{AxisCommand, CurrentActual, CurrentControl, CurrentTrip, DAxisMeans};
 use foc::{FocAxis, LoopParams, MotorData, PowerStage, Protection, Trip};
 use nanos::Nanos;
 use plant::{Plant, PlantParams, Shaft};
@@ -125,6 +125,10 @@ pub struct ElectricalAxis {
     command: AxisCommand,
     /// Mean of the measured iq over the last control cycle's PWM periods, A.
     iq_cycle_mean: f32,
+    /// The d axis over the last control cycle (voltage and current means).
+    d_cycle: Option<DAxisMeans>,
+    /// The d voltage of the last PWM period, V (it acts until the next sample).
+    prev_ud: f32,
     /// The motor data and loop parameters the loop runs with.
     motor: MotorData,
     params: LoopParams,
@@ -159,6 +163,7 @@ impl CurrentControl for ElectricalAxis {
             current_a: iq,
             stage_limit_a: stage,
             stage_warning: warning,
+            d_axis: self.d_cycle,
             trip: self.foc.trip().map(|t| match t {
                 Trip::OverCurrent => CurrentTrip::OverCurrent,
                 Trip::PhaseSum => CurrentTrip::PhaseSum,
@@ -209,6 +214,8 @@ impl ElectricalAxis {
             last: CurrentSnapshot::default(),
             command: AxisCommand::OFF,
             iq_cycle_mean: 0.0,
+            d_cycle: None,
+            prev_ud: 0.0,
             motor: motor_data,
             params: loop_params,
         })
@@ -217,7 +224,8 @@ impl ElectricalAxis {
     /// The motor data of the drive's dictionary (issue 34) for the current
     /// loop: its gains by pole-zero cancellation (Kp = ω_c·L, Ki = ω_c·R with
     /// ω_c = 2π·B64), kt, the rated and the maximum current and the thermal
-    /// time constant of its own i²t backstop. Applied when they changed; a set
+    /// time constant of its own i²t backstop, and the commutation offset
+    /// (B05). Applied when they changed; a set
     /// the loop refuses (ω_c above a fifth of the PWM rate) leaves the loop as
     /// it was. The plant (the motor itself) keeps its own data: motor data
     /// that do not match it detune the loop, as on a real drive.
@@ -238,6 +246,8 @@ impl ElectricalAxis {
             omega_c_rad_s: core::f32::consts::TAU * m.bandwidth_hz,
             ..self.params
         };
+        // B05: the encoder position of the d axis along phase a
+        self.foc.set_commutation_offset(m.commutation_offset_inc);
         if motor == self.motor && params == self.params {
             return Ok(());
         }
@@ -309,11 +319,28 @@ impl ElectricalAxis {
         let mut merged: Option<MotorOutputs> = None;
         let mut t_prev = 0u64;
         let mut iq_sum = 0.0f32;
+        let (mut ud_sum, mut id_sum) = (0.0f32, 0.0f32);
+        let injection = self.command.injection.filter(|_| power_stage);
         for k in 1..=n {
             let t_next = (u128::from(dt.as_ns()) * u128::from(k) / u128::from(n)) as u64;
             let h = Nanos::from_ns(t_next - t_prev);
             let sample = self.plant.sample();
-            let out = self.foc.step(&sample, reference);
+            let out = match injection {
+                Some(j) => {
+                    let v = foc::Dq { d: j.ud_v, q: 0.0 };
+                    match j.angle {
+                        Some(a) => self.foc.step_voltage_at(&sample, v, a),
+                        None => self.foc.step_voltage(&sample, v),
+                    }
+                }
+                None => self.foc.step(&sample, reference),
+            };
+            // the sample at this period's start is the centre of the last
+            // period: its current pairs with the last period's voltage
+            let m = self.foc.measured();
+            ud_sum += self.prev_ud;
+            id_sum += m.current.d;
+            self.prev_ud = m.voltage.d;
             self.plant.apply(&out);
             self.plant
                 .set_rotor(motor.position_inc_f64() / INC_PER_RAD, motor.velocity_rad_s());
@@ -340,6 +367,11 @@ impl ElectricalAxis {
             }
         }
         self.iq_cycle_mean = iq_sum / n as f32;
+        self.d_cycle = Some(DAxisMeans {
+            voltage_v: ud_sum / n as f32,
+            current_a: id_sum / n as f32,
+            interval_s: dt.as_ns() as f32 * 1e-9,
+        });
         // n ≥ 1: the loop ran; the fallback only satisfies the types
         merged.unwrap_or_else(|| motor.step_applied(0.0, brake, dt))
     }
@@ -361,6 +393,8 @@ impl ElectricalAxis {
         self.plant.apply(&pwm_out);
         let m = self.foc.measured();
         self.iq_cycle_mean = m.current.q;
+        self.d_cycle = None;
+        self.prev_ud = 0.0;
         self.last = CurrentSnapshot {
             id_a: f64::from(m.current.d),
             iq_a: f64::from(m.current.q),

@@ -114,3 +114,49 @@ fn c038_e089_soem_current_limit_and_power_stage_i2t_on_the_electrical_plant() {
         line.fail_with(&format!("stage_i2t.py through SOEM failed: {status}"));
     }
 }
+
+/// E-140, E-141 through SOEM on the electrical plant (`motor_actions.py`,
+/// issue 35): A75/A69 in the process data; B42 refused while the axis is
+/// switch-on disabled (nothing changes); B42 and B49 started in Ready to
+/// switch on, run after the enable, identify the plant's R and L (2.2 Ω,
+/// 6.5 mH: `serve --plant-r/--plant-l`, the drive's B53/B52 say 3.6 Ω,
+/// 12 mH) within 5 % into B53 and B52/B62; B41 finds the plant's
+/// commutation offset (0.3 rad: `--plant-offset`) within 0.5° electrical
+/// into B05; B43 (no enable) measures the three phases within 3 % of R;
+/// B40 passes the plant as wired (the pole pairs seen = B10).
+#[test]
+fn e140_e141_soem_motor_actions_identify_the_plants_r_l_and_commutation_offset() {
+    let python = match pysoem_python() {
+        Ok(p) => p,
+        Err(why) => {
+            eprintln!("soem motor actions test: skipped, {why}");
+            return;
+        }
+    };
+    let dir = scratch("soem-motor-actions");
+    let (r, l, offset) = ("2.2", "0.0065", "0.3");
+    let line = Line::with_serve_args(
+        "a",
+        1,
+        120,
+        &dir,
+        &[
+            "--plant",
+            "electrical",
+            "--plant-r",
+            r,
+            "--plant-l",
+            l,
+            "--plant-offset",
+            offset,
+        ],
+    );
+    let status = line.run(
+        &python,
+        "motor_actions.py",
+        &["--r", r, "--l", l, "--offset", offset],
+    );
+    if !status.success() {
+        line.fail_with(&format!("motor_actions.py through SOEM failed: {status}"));
+    }
+}

@@ -11,13 +11,26 @@
 //! progress in % (100 at the end), bits 8–11 the selector of the action shown,
 //! bits 12–15 its [`state`].
 //!
+//! The motor actions that need the power stage (B40 test phase, B41
+//! calibrate motor, B42/B49
+//! optimise current controller, B43 test winding: [`crate::tuning`]) start
+//! in Ready to switch on and run once the master enabled the axis (E-141;
+//! B43 at once, without an enable): their measurement runs in the
+//! control cycle ([`Actions::control`], which replaces the axis' command),
+//! their progress and end show here; Execute low stops them.
+//!
 //! Action activation (E-142) is the commissioning option "action activation"
 //! of the axis: here, A75 mapped in the axis's RxPDO channel (1600h for axis A,
 //! 1601h for axis B), which is what that option sets up. A75 written over SDO,
 //! or mapped in another channel, starts nothing ([`state::NOT_ACTIVATED`]).
 
-use crate::params::E48;
-use crate::{parameter_index, DriveObjects, AXIS_B_MANUFACTURER};
+use crate::axis::{AxisCommand, AxisIo};
+use crate::params::{B05, B10, B40, B41, B42, B43, B52, B53, B62, E48};
+use crate::tuning::align::{AlignOutcome, Alignment};
+use crate::tuning::phase::{PhaseOutcome, PhaseTest};
+use crate::tuning::winding::{WindingOutcome, WindingTest};
+use crate::tuning::{CurrentTuning, Outcome};
+use crate::{parameter_index, DriveObjects, AXIS_B_CIA402, AXIS_B_MANUFACTURER};
 
 /// A75 control byte for actions (axis A; axis B + 8000h).
 pub const A75: u16 = parameter_index(0, 75);
@@ -36,8 +49,8 @@ pub mod state {
     pub const DONE: u16 = 2;
     /// The precondition on E48 does not hold (E-141): not started.
     pub const REFUSED: u16 = 3;
-    /// This drive cannot run the action (the motor and brake tests need the
-    /// power stage's measurement functions, not built): not started.
+    /// This drive cannot run the action (A37, I52: nothing to reset; the
+    /// brake actions: not built): not started.
     pub const NOT_AVAILABLE: u16 = 4;
     /// Started and failed (e.g. the save found the store broken).
     pub const FAILED: u16 = 5;
@@ -129,6 +142,8 @@ enum Running {
     Save,
     /// The restart requested; it ends with the restart.
     Restart,
+    /// B42/B49 ([`AxisActions::tuning`]): runs in the control cycles.
+    Tuning,
 }
 
 /// One axis's part: its last Execute bit, the running action, A69.
@@ -137,6 +152,22 @@ struct AxisActions {
     execute: bool,
     running: Option<Running>,
     status: u16,
+    /// The motor action's measurement, started here and stepped by the
+    /// control cycle ([`Actions::control`]).
+    tuning: Option<Measurement>,
+}
+
+/// A motor action's part in the control cycle.
+#[derive(Debug, Clone, Copy)]
+enum Measurement {
+    /// B42/B49.
+    Current(CurrentTuning),
+    /// B41.
+    Align(Alignment),
+    /// B43.
+    Winding(WindingTest),
+    /// B40.
+    Phase(PhaseTest),
 }
 
 /// The action unit of both axes: the last Execute bits and what runs.
@@ -165,6 +196,7 @@ impl Actions {
             execute: false,
             running: None,
             status: 0,
+            tuning: None,
         };
         Self { axes: [IDLE; 2] }
     }
@@ -180,6 +212,20 @@ impl Actions {
         let a75 = u32::from(A75 + offset(axis));
         let channel = 0x1600 + axis as u16;
         objects.mapping(channel).any(|m| m >> 16 == a75)
+    }
+
+    /// The control cycle's part of a running motor action on `axis` (B41,
+    /// B42, B49): the axis' device state `e48` after its cycle and the
+    /// cycle's inputs (the current loop's last report, the encoder) in; the
+    /// command that replaces the axis' out (`None`: the axis' own). Call it
+    /// once per control cycle after the axis' cycle.
+    pub fn control(&mut self, axis: usize, e48: u8, io: &AxisIo) -> Option<AxisCommand> {
+        match self.axes.get_mut(axis)?.tuning.as_mut()? {
+            Measurement::Current(t) => t.cycle(e48, io.current.as_ref()),
+            Measurement::Align(a) => a.cycle(e48, io.position_inc),
+            Measurement::Winding(w) => w.cycle(e48, io.current.as_ref()),
+            Measurement::Phase(p) => p.cycle(e48, io.position_inc, io.current.as_ref()),
+        }
     }
 
     /// One pass after the RxPDO was decoded into `objects`: starts the
@@ -200,12 +246,27 @@ impl Actions {
             let before = a.status;
             if !execute {
                 // the master ended it (or never started one); a running save
-                // goes on, its result is no longer shown
+                // goes on, its result is no longer shown; a motor action
+                // stops (its injection with it)
                 a.status = status(0, 0, state::IDLE);
+                if a.running == Some(Running::Tuning) {
+                    a.running = None;
+                }
+                a.tuning = None;
             } else if rising {
                 a.status = start(a, objects, axis, selector, clear);
             } else if let Some(r) = a.running {
-                a.status = follow(objects, r, selector).unwrap_or(a.status);
+                a.status = match r {
+                    Running::Tuning => match a.tuning.as_ref() {
+                        Some(Measurement::Current(t)) => follow_tuning(objects, t, axis, selector),
+                        Some(Measurement::Align(al)) => follow_alignment(objects, al, axis, selector),
+                        Some(Measurement::Winding(w)) => follow_winding(objects, w, axis, selector),
+                        Some(Measurement::Phase(p)) => follow_phase(objects, p, axis, selector),
+                        None => None,
+                    },
+                    _ => follow(objects, r, selector),
+                }
+                .unwrap_or(a.status);
                 if a.status >> 12 != state::RUNNING {
                     a.running = None;
                 }
@@ -254,10 +315,173 @@ fn start(
             *clear = true;
             status(100, selector, state::DONE)
         }
+        Action::OptimiseCurrent | Action::OptimiseCurrentStandstill => {
+            let rated_ma = objects.get(0x6075 + cia(axis), 0).unwrap_or(0);
+            let r_mohm = objects.get(B53 + offset(axis), 0).unwrap_or(0);
+            let standstill = action == Action::OptimiseCurrentStandstill;
+            a.tuning = Some(Measurement::Current(CurrentTuning::new(
+                rated_ma as f32 * 1e-3,
+                r_mohm as f32 * 1e-3,
+                standstill,
+            )));
+            a.running = Some(Running::Tuning);
+            status(0, selector, state::RUNNING)
+        }
+        Action::TestPhase => {
+            let rated_ma = objects.get(0x6075 + cia(axis), 0).unwrap_or(0);
+            let r_mohm = objects.get(B53 + offset(axis), 0).unwrap_or(0);
+            let pole_pairs = objects.get(B10 + offset(axis), 0).unwrap_or(4);
+            a.tuning = Some(Measurement::Phase(PhaseTest::new(
+                rated_ma as f32 * 1e-3,
+                r_mohm as f32 * 1e-3,
+                pole_pairs as u8,
+            )));
+            a.running = Some(Running::Tuning);
+            status(0, selector, state::RUNNING)
+        }
+        Action::TestWinding => {
+            let rated_ma = objects.get(0x6075 + cia(axis), 0).unwrap_or(0);
+            let r_mohm = objects.get(B53 + offset(axis), 0).unwrap_or(0);
+            a.tuning = Some(Measurement::Winding(WindingTest::new(
+                rated_ma as f32 * 1e-3,
+                r_mohm as f32 * 1e-3,
+            )));
+            a.running = Some(Running::Tuning);
+            status(0, selector, state::RUNNING)
+        }
+        Action::CalibrateMotor => {
+            let rated_ma = objects.get(0x6075 + cia(axis), 0).unwrap_or(0);
+            let r_mohm = objects.get(B53 + offset(axis), 0).unwrap_or(0);
+            let ud = (rated_ma as f32 * 1e-3) * (r_mohm as f32 * 1e-3);
+            let pole_pairs = objects.get(B10 + offset(axis), 0).unwrap_or(4);
+            a.tuning = Some(Measurement::Align(Alignment::new(ud, pole_pairs as u8)));
+            a.running = Some(Running::Tuning);
+            status(0, selector, state::RUNNING)
+        }
         // A37 (the memorised extreme values) and I52 (the limit-switch
-        // memory) hold nothing in this drive; the tests need the power
-        // stage's measurement functions
+        // memory) hold nothing in this drive; the brake actions are not
+        // built
         _ => status(0, selector, state::NOT_AVAILABLE),
+    }
+}
+
+/// The CiA 402 window offset of `axis`.
+fn cia(axis: usize) -> u16 {
+    if axis == 0 {
+        0
+    } else {
+        AXIS_B_CIA402
+    }
+}
+
+/// A69 of a running B42/B49; at its end its results in B42 and, identified,
+/// R in B53 and L in B52 and B62 (the current loop's gains follow:
+/// Kp = ω_c·L, Ki = ω_c·R).
+fn follow_tuning(
+    objects: &mut DriveObjects,
+    tuning: &CurrentTuning,
+    axis: usize,
+    selector: u8,
+) -> Option<u16> {
+    let off = offset(axis);
+    match tuning.outcome() {
+        Outcome::Running(p) => Some(status(u16::from(p), selector, state::RUNNING)),
+        Outcome::Done(id) => {
+            let r_mohm = (id.r_ohm * 1e3 + 0.5) as i64;
+            let l_uh = (id.l_h * 1e6 + 0.5) as i64;
+            let _ = objects.set(B42 + off, 2, r_mohm);
+            let _ = objects.set(B42 + off, 3, l_uh);
+            let written = objects.set(B53 + off, 0, r_mohm).is_ok()
+                && objects.set(B52 + off, 0, l_uh).is_ok()
+                && objects.set(B62 + off, 0, l_uh).is_ok();
+            let code = if written {
+                crate::tuning::result::OK
+            } else {
+                crate::tuning::result::IMPLAUSIBLE
+            };
+            let _ = objects.set(B42 + off, 1, i64::from(code));
+            Some(if written {
+                status(100, selector, state::DONE)
+            } else {
+                status(100, selector, state::FAILED)
+            })
+        }
+        Outcome::Failed(code) => {
+            let _ = objects.set(B42 + off, 1, i64::from(code));
+            Some(status(0, selector, state::FAILED))
+        }
+    }
+}
+
+/// A69 of a running B40; at its end its result and figures in B40.
+fn follow_phase(objects: &mut DriveObjects, p: &PhaseTest, axis: usize, selector: u8) -> Option<u16> {
+    let off = offset(axis);
+    let (code, per_turn, pole_pairs, st) = match p.outcome() {
+        PhaseOutcome::Running(pr) => return Some(status(u16::from(pr), selector, state::RUNNING)),
+        PhaseOutcome::Done {
+            per_turn_inc,
+            pole_pairs,
+        } => (0, per_turn_inc, pole_pairs, state::DONE),
+        PhaseOutcome::Failed(code, per_turn) => (code, per_turn, 0, state::FAILED),
+    };
+    let _ = objects.set(B40 + off, 2, i64::from(per_turn));
+    let _ = objects.set(B40 + off, 3, i64::from(pole_pairs));
+    let _ = objects.set(B40 + off, 1, i64::from(code));
+    Some(status(if st == state::DONE { 100 } else { 0 }, selector, st))
+}
+
+/// A69 of a running B43; at its end the resistances and the result in B43.
+fn follow_winding(objects: &mut DriveObjects, w: &WindingTest, axis: usize, selector: u8) -> Option<u16> {
+    let off = offset(axis);
+    match w.outcome() {
+        WindingOutcome::Running(p) => Some(status(u16::from(p), selector, state::RUNNING)),
+        WindingOutcome::Done(r) => {
+            for (sub, x) in (2u8..).zip(r) {
+                let _ = objects.set(B43 + off, sub, (x * 1e3 + 0.5) as i64);
+            }
+            let code = WindingTest::code(&r);
+            let _ = objects.set(B43 + off, 1, i64::from(code));
+            let st = if code == crate::tuning::result::OK {
+                state::DONE
+            } else {
+                state::FAILED
+            };
+            Some(status(100, selector, st))
+        }
+        WindingOutcome::Failed(code) => {
+            let _ = objects.set(B43 + off, 1, i64::from(code));
+            Some(status(0, selector, state::FAILED))
+        }
+    }
+}
+
+/// A69 of a running B41; at its end its result in B41 and the offset in B05.
+fn follow_alignment(objects: &mut DriveObjects, al: &Alignment, axis: usize, selector: u8) -> Option<u16> {
+    let off = offset(axis);
+    match al.outcome() {
+        AlignOutcome::Running(p) => Some(status(u16::from(p), selector, state::RUNNING)),
+        AlignOutcome::Done {
+            offset_inc,
+            spread_inc,
+        } => {
+            let _ = objects.set(B41 + off, 2, i64::from(spread_inc));
+            let written = objects.set(B05 + off, 0, i64::from(offset_inc)).is_ok();
+            let code = if written {
+                crate::tuning::result::OK
+            } else {
+                crate::tuning::result::IMPLAUSIBLE
+            };
+            let _ = objects.set(B41 + off, 1, i64::from(code));
+            Some(status(
+                100,
+                selector,
+                if written { state::DONE } else { state::FAILED },
+            ))
+        }
+        AlignOutcome::Failed(code) => {
+            let _ = objects.set(B41 + off, 1, i64::from(code));
+            Some(status(0, selector, state::FAILED))
+        }
     }
 }
 
@@ -276,7 +500,7 @@ fn follow(objects: &DriveObjects, r: Running, selector: u8) -> Option<u16> {
                 status(100, selector, state::DONE)
             })
         }
-        Running::Restart => None,
+        Running::Restart | Running::Tuning => None,
     }
 }
 
@@ -372,9 +596,9 @@ mod tests {
         }
         execute(&mut od, 0, 0, false);
         a.serve(&mut od);
-        execute(&mut od, 0, 0b1101, true);
+        execute(&mut od, 0, 0b0100, true);
         od.set(E48, 0, 2).unwrap();
         a.serve(&mut od);
-        assert_eq!(a.status(0) >> 12, state::NOT_AVAILABLE, "test winding in E48 = 2");
+        assert_eq!(a.status(0) >> 12, state::NOT_AVAILABLE, "test brake in E48 = 2");
     }
 }

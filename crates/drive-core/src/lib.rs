@@ -35,6 +35,7 @@ pub mod objects;
 pub mod params;
 pub mod pdo_image;
 pub mod pdo_maps;
+pub mod tuning;
 pub mod user_units;
 pub mod variant;
 

@@ -185,10 +185,23 @@ pub const A277: u16 = parameter_index(0, 277);
 pub const A278: u16 = parameter_index(0, 278);
 /// The PROFINET personality's persistent parameters, A270…A278.
 pub const PROFINET_PARAMS: [u16; 9] = [A270, A271, A272, A273, A274, A275, A276, A277, A278];
+/// B05 commutation offset, increments (per axis, motor data; B41 finds it).
+pub const B05: u16 = parameter_index(1, 5);
+/// B40 test phase: the action's result and what it saw (per axis; started
+/// through A75, `crate::tuning::phase`).
+pub const B40: u16 = parameter_index(1, 40);
+/// B41 calibrate motor: the action's result (per axis; started through A75).
+pub const B41: u16 = parameter_index(1, 41);
 /// B10 pole pair number (per axis, motor data; issue 34).
 pub const B10: u16 = parameter_index(1, 10);
 /// B17 torque constant, mN·m/A (per axis, motor data).
 pub const B17: u16 = parameter_index(1, 17);
+/// B42 optimise current controller: the action's result and figures (per
+/// axis; started through A75, `crate::tuning`).
+pub const B42: u16 = parameter_index(1, 42);
+/// B43 test winding: the action's result and the three phases' resistances
+/// (per axis; started through A75, `crate::tuning::winding`).
+pub const B43: u16 = parameter_index(1, 43);
 /// B52 d-axis inductance Ld, µH (per axis, motor data).
 pub const B52: u16 = parameter_index(1, 52);
 /// B53 phase resistance, mΩ (per axis, motor data).

@@ -5,7 +5,7 @@ use crate::params::{Gains, LoopParams, MotorData, ParamError};
 use crate::pi::CurrentPi;
 use crate::protect::{DcLink, I2t, I2tState, OverCurrent, PhaseSum, Trip};
 use crate::seam::{PwmOut, Sample, Scaling, Shunts};
-use crate::svm::{compare_values, PwmCounts};
+use crate::svm::{compare_values, compensate_dead_time, svm, PwmCounts};
 use crate::transform::{clarke, inverse_park, park, Abc, AlphaBeta, Dq};
 use crate::trig::{sin_cos, Angle};
 
@@ -89,6 +89,14 @@ pub struct Measured {
     /// current, its rated current from its i²t model's 100 % until it falls
     /// below [`STAGE_I2T_RELEASE`].
     pub stage_limit_a: f32,
+}
+
+/// What a PWM period applies: the current controllers' output for a current
+/// reference, or a voltage open loop.
+#[derive(Debug, Clone, Copy)]
+enum Command {
+    Current(Dq),
+    Voltage(Dq, Option<Angle>),
 }
 
 /// The current loop of one axis with its protection.
@@ -308,6 +316,32 @@ impl FocAxis {
     /// One PWM period: the sample of this period's centre in, the compare values of
     /// the next period out. Trips latch and switch the gates off in the same step.
     pub fn step(&mut self, s: &Sample, reference: Dq) -> PwmOut {
+        self.step_with(s, Command::Current(reference))
+    }
+
+    /// One PWM period with `voltage` applied open loop (dq, V; clamped to the
+    /// voltage circle) instead of the current controllers' output: the motor
+    /// actions' measurement (identifying R and L). Measurement, protection and
+    /// modulation as in [`FocAxis::step`]; the integrators stay reset.
+    pub fn step_voltage(&mut self, s: &Sample, voltage: Dq) -> PwmOut {
+        self.step_with(s, Command::Voltage(voltage, None))
+    }
+
+    /// [`FocAxis::step_voltage`] in a frame at the fixed electrical angle
+    /// `frame` instead of the encoder's (a current vector the rotor aligns to,
+    /// a voltage along one phase's axis): the measured dq current and the
+    /// voltage are in that frame for this period.
+    pub fn step_voltage_at(&mut self, s: &Sample, voltage: Dq, frame: Angle) -> PwmOut {
+        self.step_with(s, Command::Voltage(voltage, Some(frame)))
+    }
+
+    /// The commutation offset (encoder increments at which the rotor's d axis
+    /// points along phase a) from now on.
+    pub fn set_commutation_offset(&mut self, offset_inc: u32) {
+        self.scaling.commutation_offset_inc = offset_inc;
+    }
+
+    fn step_with(&mut self, s: &Sample, command: Command) -> PwmOut {
         let sc = &self.scaling;
         let g = &self.gains;
         let [ca, cb, cc] = s.phase_counts;
@@ -334,7 +368,11 @@ impl FocAxis {
             None => 0.0,
         };
         self.last_angle = Some(angle);
-        let (sin, cos) = sin_cos(angle);
+        let frame = match command {
+            Command::Voltage(_, Some(f)) => f,
+            _ => angle,
+        };
+        let (sin, cos) = sin_cos(frame);
         let current = park(clarke(phases), sin, cos);
 
         // i²t: the mean square current of I2T_DECIMATION periods, one model step
@@ -392,22 +430,66 @@ impl FocAxis {
             };
         }
 
-        let (d, q) = fmath::clamp_sym2(reference.d, reference.q, limit);
-        let reference = Dq { d, q };
         let v_max = g.v_limit_per_vdc * vdc;
-        let (v, cut) = self.pi.step(g, reference, current, omega_e, v_max);
+        let (v, cut) = match command {
+            Command::Current(reference) => {
+                let (d, q) = fmath::clamp_sym2(reference.d, reference.q, limit);
+                self.pi.step(g, Dq { d, q }, current, omega_e, v_max)
+            }
+            Command::Voltage(v, _) => {
+                self.pi.reset();
+                let clamp = |x: f32| fmath::clamp(x, -v_max, v_max);
+                let cut = v.d.abs() > v_max || v.q.abs() > v_max;
+                (
+                    Dq {
+                        d: clamp(v.d),
+                        q: clamp(v.q),
+                    },
+                    cut,
+                )
+            }
+        };
         self.measured.voltage = v;
         self.measured.voltage_limited = cut;
 
         // the voltage acts over the next period, centred one period after the sample
         // rotating (sin, cos) by δ = ω·Ts to second order (|δ| ≤ 0.08 rad at
         // 3000 rpm and 16 kHz: error δ³/6 < 10⁻⁴) instead of a second table lookup
-        let delta = omega_e * g.ts_s;
+        // (a fixed frame does not turn)
+        let delta = match command {
+            Command::Voltage(_, Some(_)) => 0.0,
+            _ => omega_e * g.ts_s,
+        };
         let k = 1.0 - 0.5 * delta * delta;
         let (so, co) = (sin * k + cos * delta, cos * k - sin * delta);
         let v_ab: AlphaBeta = inverse_park(v, so, co);
+        let compare = match command {
+            // the current loop: modulator, dead-time compensation and counts fused
+            Command::Current(_) => compare_values(v_ab, vdc, phases, &self.counts),
+            // a motor action's voltage: the separate blocks, and the voltage
+            // the compare values realise (their rounding to counts is up to
+            // 60 mV per leg at 565 V: a constant voltage's rounding would
+            // bias a measurement), less the dead time's share
+            Command::Voltage(..) => {
+                let (duty, _) = svm(v_ab, vdc, 1.0 / fmath::max(vdc, 1.0));
+                let comp = compensate_dead_time(duty, phases, g.dead_time_duty, g.inv_dead_time_band);
+                let period = f32::from(sc.pwm_period_counts);
+                let cmp = |d: f32| (d * period + 0.5) as u16;
+                let compare = [cmp(comp.a), cmp(comp.b), cmp(comp.c)];
+                let realised =
+                    |c: u16, with: f32, without: f32| (f32::from(c) / period - with + without) * vdc;
+                let [ca, cb, cc] = compare;
+                let v_abc = Abc {
+                    a: realised(ca, comp.a, duty.a),
+                    b: realised(cb, comp.b, duty.b),
+                    c: realised(cc, comp.c, duty.c),
+                };
+                self.measured.voltage = park(clarke(v_abc), so, co);
+                compare
+            }
+        };
         PwmOut {
-            compare: compare_values(v_ab, vdc, phases, &self.counts),
+            compare,
             gate_enable: true,
         }
     }

@@ -128,6 +128,13 @@ impl Plant {
         &self.p
     }
 
+    /// Sets the motor's electrical data from now on (a test's motor that the
+    /// drive does not know: R, L, ψ, pole pairs, commutation offset); the
+    /// currents keep their values.
+    pub fn set_motor(&mut self, m: PmsmParams) {
+        self.p.motor = m;
+    }
+
     /// Sets faults from now on (an open phase takes effect with the currents'
     /// next derivative; the phase's current is forced to zero at once).
     pub fn set_faults(&mut self, f: FaultOptions) {

@@ -180,6 +180,20 @@ pub struct ServeArgs {
     /// of 300 V / 850 V (events 46 / 36), `encoder` the encoder lost (37).
     #[arg(long, value_enum, value_name = "FAULT")]
     pub plant_fault: Option<PlantFault>,
+    /// With `--plant electrical`: the plant motor's phase resistance, Ω, on
+    /// every axis (default: the simulated servo's 3.6 Ω). The drive's motor
+    /// data keep their own values (a motor it does not know: B42 measures it).
+    #[arg(long, value_name = "OHM")]
+    pub plant_r: Option<f64>,
+    /// With `--plant electrical`: the plant motor's inductance Ld = Lq, H
+    /// (default: 12 mH).
+    #[arg(long, value_name = "H")]
+    pub plant_l: Option<f64>,
+    /// With `--plant electrical`: the mechanical angle (rad) at which the
+    /// plant motor's d axis points along phase a, its commutation offset
+    /// (default 0; the drive's B05 says 0 until B41 finds it).
+    #[arg(long, value_name = "RAD")]
+    pub plant_offset: Option<f64>,
     /// Stop after this many seconds (default: run until killed).
     #[arg(long, value_name = "S")]
     pub seconds: Option<f64>,

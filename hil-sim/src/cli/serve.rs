@@ -66,6 +66,39 @@ const LATE_NOTE: Nanos = Nanos::from_us(20);
 /// How often the pcap recording is flushed (a write error then ends `serve`).
 const FLUSH_EVERY: Nanos = Nanos::from_secs(1);
 
+/// `--plant-r`/`--plant-l`/`--plant-offset`: the plant's motor on every
+/// electrical axis.
+fn set_plant_motor(sim: &mut Simulation, args: &ServeArgs) -> Result<(), String> {
+    if args.plant_r.is_none() && args.plant_l.is_none() && args.plant_offset.is_none() {
+        return Ok(());
+    }
+    if args.plant != Plant::Electrical {
+        return Err("--plant-r/--plant-l/--plant-offset need --plant electrical".into());
+    }
+    if args.plant_offset.is_some_and(|o| !o.is_finite()) {
+        return Err("--plant-offset must be a finite angle".into());
+    }
+    let positive = |x: Option<f64>| x.is_none_or(|v| v.is_finite() && v > 0.0);
+    if !positive(args.plant_r) || !positive(args.plant_l) {
+        return Err("--plant-r and --plant-l must be positive".into());
+    }
+    for d in sim.drives_mut() {
+        for axis in 0..2 {
+            if let Some(el) = d.electrical_mut(axis) {
+                let plant = el.plant_mut();
+                let mut m = plant.params().motor;
+                m.r_ohm = args.plant_r.unwrap_or(m.r_ohm);
+                if let Some(l) = args.plant_l {
+                    (m.ld_h, m.lq_h) = (l, l);
+                }
+                m.commutation_offset_rad = args.plant_offset.unwrap_or(m.commutation_offset_rad);
+                plant.set_motor(m);
+            }
+        }
+    }
+    Ok(())
+}
+
 /// Runs `serve` until `--seconds` have passed (or forever).
 pub fn serve(args: &ServeArgs) -> Result<(), String> {
     if args.fieldbus == Fieldbus::Profinet {
@@ -103,6 +136,7 @@ pub fn serve(args: &ServeArgs) -> Result<(), String> {
             );
         }
     }
+    set_plant_motor(&mut sim, args)?;
     // the recording first: an unwritable path fails before anything else
     if let Some(p) = &args.pcap {
         sim.record_pcap(p)

@@ -126,6 +126,7 @@ fn c038_p187_the_seam_reports_the_measured_torque_at_10_50_100_percent() {
             torque_nm: t as f32,
             power_stage: true,
             brake_release: false,
+            injection: None,
         });
         let before = el.actual().unwrap();
         assert!(before.current_a.abs() < 0.02, "{share}: {before:?}");

@@ -42,6 +42,9 @@ pub struct CurrentActual {
     /// The power stage's i²t model at or above its warning level
     /// (statusword bit 7).
     pub stage_warning: bool,
+    /// The d axis over the last control cycle (the motor actions' measurement,
+    /// [`DAxisMeans`]); `None` where the loop does not report it.
+    pub d_axis: Option<DAxisMeans>,
 }
 
 impl CurrentActual {
@@ -53,8 +56,39 @@ impl CurrentActual {
             trip: None,
             stage_limit_a: f32::INFINITY,
             stage_warning: false,
+            d_axis: None,
         }
     }
+}
+
+/// The d-axis voltage the loop applied and the d current it measured, each
+/// the time mean over the same interval of (about) one control cycle, and that
+/// interval's length: ∫u·dt and ∫i·dt of the winding equation
+/// u = R·i + L·di/dt (at standstill), as far as the loop can tell (the board
+/// and the simulator pair each PWM period's voltage with the current sampled
+/// at its centre, the period's mean to second order).
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct DAxisMeans {
+    /// Mean d voltage, V (amplitude-invariant dq).
+    pub voltage_v: f32,
+    /// Mean measured d current, A.
+    pub current_a: f32,
+    /// The interval, s.
+    pub interval_s: f32,
+}
+
+/// A motor action's injection (B41, B42/B49, `crate::actions`): the loop
+/// applies this d-axis voltage open loop (q voltage 0) instead of the output
+/// of its current controllers, with its protection as always: in the frame
+/// of its encoder and commutation offset, or at a fixed electrical angle
+/// (then [`DAxisMeans`] are in that frame too).
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct Injection {
+    /// d voltage, V.
+    pub ud_v: f32,
+    /// The frame's electrical angle (a full turn = 2^32, 0 = along phase a);
+    /// `None`: the rotor's, from the encoder.
+    pub angle: Option<u32>,
 }
 
 /// A trip of the current loop's protection (the power stage is off within

@@ -120,6 +120,9 @@ pub struct AxisCommand {
     pub power_stage: bool,
     /// Release (open) the holding brake.
     pub brake_release: bool,
+    /// A motor action's measurement voltage instead of the torque's current
+    /// (`None` in normal operation; [`Injection`]).
+    pub injection: Option<Injection>,
 }
 
 impl AxisCommand {
@@ -128,6 +131,7 @@ impl AxisCommand {
         torque_nm: 0.0,
         power_stage: false,
         brake_release: false,
+        injection: None,
     };
 }
 

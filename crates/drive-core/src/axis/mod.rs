@@ -138,7 +138,7 @@ pub(crate) use snapshot::{CyclicSlots, Snapshot, Window};
 
 pub use cache::AxisCache;
 use cache::CachedSnapshot;
-pub use current::{CurrentActual, CurrentControl, CurrentTrip};
+pub use current::{CurrentActual, CurrentControl, CurrentTrip, DAxisMeans, Injection};
 pub use io::{AxisCommand, AxisIo, AxisReport, IndexLatch, ProbeEdge, SwitchEdge, SwitchId};
 pub use monitor::{LOW_VOLTAGE, MOTOR_ENCODER};
 pub use motor::{MotorData, MOTOR_I2T};
@@ -626,6 +626,7 @@ impl Axis {
                 torque_nm: sign * torque,
                 power_stage: out.power_stage,
                 brake_release: self.brake_output(out.brake_release),
+                injection: None,
             },
             transition: out.transition,
             fault,

@@ -37,7 +37,7 @@
 //! manual's events in `monitor.rs`.
 
 use super::*;
-use crate::params::{B10, B17, B52, B53, B62, B64, B73, U10, U11};
+use crate::params::{B05, B10, B17, B52, B53, B62, B64, B73, U10, U11};
 use core::cell::Cell;
 
 /// Event 45 "Overtemp.motor i2t", cause 1: the motor's i²t model stayed at
@@ -52,6 +52,8 @@ const I2T_RELEASE: f32 = 0.95;
 pub struct MotorData {
     /// B10 pole pairs.
     pub pole_pairs: u8,
+    /// B05 commutation offset, increments (2^20 per revolution).
+    pub commutation_offset_inc: u32,
     /// B17 torque constant, N·m/A (dq amplitude).
     pub torque_constant_nm_per_a: f32,
     /// B53 phase resistance, Ω.
@@ -83,6 +85,7 @@ impl Default for MotorData {
     fn default() -> Self {
         Self {
             pole_pairs: 4,
+            commutation_offset_inc: 0,
             torque_constant_nm_per_a: 0.65,
             r_ohm: 3.6,
             ld_h: 0.012,
@@ -108,6 +111,7 @@ impl MotorData {
         let pos = |v: i64, scale: f32, fallback: f32| if v > 0 { v as f32 * scale } else { fallback };
         Self {
             pole_pairs: u8::try_from(p(B10)).unwrap_or(d.pole_pairs),
+            commutation_offset_inc: u32::try_from(p(B05)).unwrap_or(0),
             torque_constant_nm_per_a: pos(p(B17), 1e-3, d.torque_constant_nm_per_a),
             r_ohm: pos(p(B53), 1e-3, d.r_ohm),
             ld_h: pos(p(B52), 1e-6, d.ld_h),

@@ -16,7 +16,7 @@
 //! ([`super::MANUFACTURER_A`]).
 
 use super::{Object, Value};
-use crate::params::{B10, B17, B52, B53, B62, B64, B73, U10, U11};
+use crate::params::{B05, B10, B17, B40, B41, B42, B43, B52, B53, B62, B64, B73, U10, U11};
 use od::DataType::{U16, U32, U8};
 
 use od::{Access, DataType, EntryInfo};
@@ -27,7 +27,19 @@ const fn e(sub: u8, name: &'static str, t: DataType) -> EntryInfo {
 }
 
 /// The motor data of axis A (group B), sorted by index.
-pub const PARAMS: [Object; 7] = [
+pub const PARAMS: [Object; 12] = [
+    Object::var(
+        B05,
+        Value::Ram,
+        entries![e(0, "Commutation offset", U32)
+            .range(0, (1 << 20) - 1)
+            .default_value(0)
+            .unit("inc")
+            .saved()],
+    )
+    .axis()
+    .level(1)
+    .note("B05 (line assumed): the encoder position (2^20 increments per revolution) at which the rotor's d axis points along phase a: the current loop's electrical angle is p·(position − B05); found by B41 \"calibrate motor\" (alignment), saved with the parameter set; default 0"),
     Object::var(
         B10,
         Value::Ram,
@@ -48,6 +60,38 @@ pub const PARAMS: [Object; 7] = [
     .axis()
     .level(1)
     .note("B17 (line assumed): kt = 1.5·p·ψ per A of the dq amplitude (the phase current's peak); the torque command becomes iq = T/kt; 6076h = kt × 6075h; default 0.65 N·m/A"),
+    param_array!(B40, "Test phase", Record, Value::Ram, [
+        EntryInfo::new(0, "Result", U8, Access::RO),
+        EntryInfo::new(1, "Increments per electrical turn", od::DataType::I32, Access::RO).unit("inc"),
+        EntryInfo::new(2, "Pole pairs seen", U8, Access::RO),
+    ])
+    .axis()
+    .level(1)
+    .note("B40 (line assumed): the action \"test phase\", started through A75 in Ready to switch on, run after the enable (brake released, the rotor turns one electrical revolution): each phase must carry current (else result 2), a field turned forward must make the encoder count up (else 7: phase order and encoder direction do not match) by 2^20/B10 per electrical turn (else 8); [0] the result (0 passed, 1 aborted), [1] the increments the encoder counted over the turn, [2] 2^20 divided by them"),
+    param_array!(B41, "Calibrate motor", Record, Value::Ram, [
+        EntryInfo::new(0, "Result", U8, Access::RO),
+        EntryInfo::new(1, "Alignment spread", U32, Access::RO).unit("inc"),
+    ])
+    .axis()
+    .level(1)
+    .note("B41 (line assumed): the action \"calibrate motor\", started through A75 (E-140), progress in A69: the rotor (brake released, free to turn) aligned by a d current along phase a, approached from both sides; the mean of the two positions is the commutation offset, written to B05. [0] its result (0 written, 1 aborted: the enable went away, 2 the rotor did not come to rest, 5 the current loop reports no measurement), [1] the two alignments' difference (friction's share)"),
+    param_array!(B42, "Optimize current controller", Record, Value::Ram, [
+        EntryInfo::new(0, "Result", U8, Access::RO),
+        EntryInfo::new(1, "Identified R", U32, Access::RO).unit("mΩ"),
+        EntryInfo::new(2, "Identified Ld", U32, Access::RO).unit("µH"),
+    ])
+    .axis()
+    .level(1)
+    .note("B42 (line assumed): the action \"optimise current controller\" (and B49, at standstill: the same measurement with the brake applied), started through A75 (E-140), progress in A69: [0] its result (0 identified and written, 1 aborted: the enable went away, 2 no current: an open winding, 3 the current did not settle, 4 implausible figures, 5 the current loop measures no d axis), [1] the identified phase resistance and [2] d-axis inductance of the last run; identified, they are written to B53 and B52/B62 (the current gains follow by pole-zero cancellation); not saved themselves (B52/B53/B62 are)"),
+    param_array!(B43, "Test winding", Record, Value::Ram, [
+        EntryInfo::new(0, "Result", U8, Access::RO),
+        EntryInfo::new(1, "Resistance U", U32, Access::RO).unit("mΩ"),
+        EntryInfo::new(2, "Resistance V", U32, Access::RO).unit("mΩ"),
+        EntryInfo::new(3, "Resistance W", U32, Access::RO).unit("mΩ"),
+    ])
+    .axis()
+    .level(1)
+    .note("B43 (line assumed): the action \"test winding\", started through A75 in Ready to switch on (no enable: the drive switches the power stage on itself, brake applied), progress in A69: the resistance measured along each phase's axis ((R_x + R_y‖R_z)/1.5, R when balanced) in [1]..[3]; [0] the result: 0 the three agree within 3 % of their mean, 6 unbalanced (A69: failed), 1 aborted (the state changed), 2 no current (an open phase), 3 not settled"),
     Object::var(
         B52,
         Value::Ram,

@@ -51,6 +51,10 @@ impl<F: Flash, B: Flash> Drive<F, B> {
         } else {
             AxisCommand::OFF
         };
+        // a running motor action (B42/B49) replaces the axis' command
+        let e48 = drive_core::axis::e48;
+        let a = self.actions.control(0, e48(axis_a.state()), io_a).unwrap_or(a);
+        let b = self.actions.control(1, e48(axis_b.state()), io_b).unwrap_or(b);
         let register = axis_a.error_register() | axis_b.error_register();
         write_slot(&mut self.objects, self.slots.error_register, i64::from(register));
         [a, b]

@@ -1,0 +1,194 @@
+#![allow(clippy::unwrap_used, clippy::panic, clippy::indexing_slicing)]
+use super::*;
+use crate::axis::DAxisMeans;
+
+/// A winding u = R·i + L·di/dt behind a loop that applies each PWM
+/// period's voltage less a constant error (the dead time's remainder) and
+/// reports the means of the voltage it meant and the current at the periods'
+/// centres, as the seam says; the rotor stands. Exact per period
+/// (exponential), 16 PWM periods per 1 ms control cycle.
+struct Winding {
+    r: f64,
+    l: f64,
+    offset_v: f64,
+    i: f64,
+    report: Option<CurrentActual>,
+}
+
+impl Winding {
+    fn run(&mut self, cmd: Option<AxisCommand>) {
+        let Some(c) = cmd else {
+            self.report = None;
+            return;
+        };
+        let u = f64::from(c.injection.map_or(0.0, |j| j.ud_v));
+        let ts = 1.0 / 16_000.0;
+        let (mut su, mut si) = (0.0, 0.0);
+        for _ in 0..16 {
+            let ue = u - self.offset_v;
+            let inf = ue / self.r;
+            let k = (-ts * self.r / self.l).exp();
+            let mid = inf + (self.i - inf) * (-0.5 * ts * self.r / self.l).exp();
+            self.i = inf + (self.i - inf) * k;
+            su += u;
+            si += mid;
+        }
+        self.report = Some(CurrentActual {
+            d_axis: Some(DAxisMeans {
+                voltage_v: (su / 16.0) as f32,
+                current_a: (si / 16.0) as f32,
+                interval_s: 1e-3,
+            }),
+            ..CurrentActual::measured(0.0, 0.0)
+        });
+    }
+}
+
+fn run(r: f64, l: f64, offset_v: f64) -> (Outcome, u32) {
+    let mut w = Winding {
+        r,
+        l,
+        offset_v,
+        i: 0.0,
+        report: None,
+    };
+    let mut t = CurrentTuning::new(2.0, 3.6, false);
+    assert_eq!(t.cycle(2, None), None, "waits for the enable");
+    for n in 0..20_000 {
+        let cmd = t.cycle(4, w.report.as_ref());
+        if !matches!(t.outcome(), Outcome::Running(_)) {
+            return (t.outcome(), n);
+        }
+        w.run(cmd);
+    }
+    panic!("no end");
+}
+
+/// E-140 (B42): R and L of windings the tuning does not know (the prior R is
+/// 3.6 Ω) come out within 1 % of the model's, with a constant voltage error.
+#[test]
+fn e140_b42_identifies_r_and_l_of_an_unknown_winding() {
+    for (r, l, off) in [
+        (3.6, 0.012, 0.0),
+        (1.2, 0.003, 0.8),
+        (9.0, 0.040, -1.5),
+        (0.5, 0.0008, 0.3),
+    ] {
+        let (o, cycles) = run(r, l, off);
+        let Outcome::Done(id) = o else {
+            panic!("{r} Ω {l} H: {o:?}");
+        };
+        let er = (f64::from(id.r_ohm) - r) / r;
+        let el = (f64::from(id.l_h) - l) / l;
+        assert!(
+            er.abs() < 0.01 && el.abs() < 0.01,
+            "{r} Ω {l} H: {id:?} ({er:+.4}, {el:+.4}) in {cycles} cycles"
+        );
+    }
+}
+
+/// E-141: the enable removed mid-run aborts it (result 1) and gives the axis
+/// its own command back; a disable before the enable ends it as well.
+#[test]
+fn e141_b42_aborted_when_the_enable_goes() {
+    let mut t = CurrentTuning::new(2.0, 3.6, true);
+    assert!(t
+        .cycle(4, None)
+        .is_some_and(|c| c.injection.is_some() && !c.brake_release));
+    assert_eq!(t.cycle(2, None), None);
+    assert_eq!(t.outcome(), Outcome::Failed(result::ABORTED));
+    assert_eq!(t.cycle(4, None), None, "ended: the axis' own command");
+    let mut t = CurrentTuning::new(2.0, 3.6, false);
+    assert_eq!(t.cycle(1, None), None);
+    assert_eq!(t.outcome(), Outcome::Failed(result::ABORTED));
+}
+
+/// An open winding (no current at any probe voltage): result 2; a loop that
+/// reports no d axis: result 5.
+#[test]
+fn e140_b42_open_winding_and_no_measurement_fail_with_their_codes() {
+    let (o, _) = run(1.0e9, 0.01, 0.0);
+    assert_eq!(o, Outcome::Failed(result::NO_CURRENT));
+    let mut t = CurrentTuning::new(2.0, 3.6, false);
+    for _ in 0..6 {
+        let _ = t.cycle(4, None);
+    }
+    assert_eq!(t.outcome(), Outcome::Failed(result::NO_MEASUREMENT));
+}
+
+/// A rotor that turns its d axis towards the injected frame: torque
+/// K·sin(frame − θe), Coulomb friction with stick, inertia J; 4 pole pairs,
+/// its d axis along phase a at `offset_inc`. Stepped in 0.1 ms.
+fn align_run(offset_inc: i32, start_el: f64) -> (align::AlignOutcome, u32) {
+    use align::{AlignOutcome, Alignment};
+    let (k, tc, j, p) = (5.2f64, 0.02f64, 1e-4f64, 4.0f64);
+    let (mut th, mut w) = (start_el / p, 0.0f64); // mechanical, from the offset
+    let pos = |th: f64| offset_inc.wrapping_add((th / core::f64::consts::TAU * 1_048_576.0).round() as i32);
+    let mut a = Alignment::new(7.2, 4);
+    let mut cmd = a.cycle(4, pos(th));
+    for n in 0..40_000 {
+        let frame = cmd.and_then(|c| c.injection).and_then(|i| i.angle);
+        for _ in 0..10 {
+            let drive = frame.map_or(0.0, |f| {
+                let fe = f64::from(f) / 4_294_967_296.0 * core::f64::consts::TAU;
+                k * (fe - p * th).sin()
+            });
+            let torque = if w == 0.0 && drive.abs() <= tc {
+                0.0
+            } else {
+                drive - tc * if w != 0.0 { w.signum() } else { drive.signum() }
+            };
+            let w1 = w + torque / j * 1e-4;
+            th += 0.5 * (w + w1) * 1e-4;
+            w = if w != 0.0 && w * w1 < 0.0 { 0.0 } else { w1 };
+        }
+        cmd = a.cycle(4, pos(th));
+        if !matches!(a.outcome(), AlignOutcome::Running(_)) {
+            return (a.outcome(), n);
+        }
+    }
+    panic!("no end");
+}
+
+/// E-140 (B41): the alignment finds a rotor's commutation offset from any
+/// start (up to 170° electrical away) within 0.2° electrical, friction
+/// notwithstanding (its two approaches straddle the offset).
+#[test]
+fn e140_b41_alignment_finds_the_offset_of_a_rotor_with_friction() {
+    let per_el = 262_144i64;
+    for (offset, start) in [
+        (50_066, 0.0),
+        (1_000_000, 0.0),
+        (50_066, 2.9),
+        (1_000_000, 2.9),
+        (7, -2.0),
+    ] {
+        let (o, n) = align_run(offset, start);
+        let align::AlignOutcome::Done {
+            offset_inc,
+            spread_inc,
+        } = o
+        else {
+            panic!("{offset}: {o:?}");
+        };
+        let err = (i64::from(offset_inc) - i64::from(offset)).rem_euclid(per_el);
+        let err = err.min(per_el - err) as f64 / per_el as f64 * 360.0;
+        assert!(
+            err < 0.2,
+            "{offset} from {start}: B05 {offset_inc}, {err}° el off, spread {spread_inc}, {n} cycles"
+        );
+        assert!(spread_inc > 0, "friction parts the approaches");
+    }
+}
+
+/// E-141 (B41): the enable removed mid-run aborts the calibration.
+#[test]
+fn e141_b41_aborted_when_the_enable_goes() {
+    let mut a = align::Alignment::new(7.2, 4);
+    assert!(a.cycle(2, 0).is_none(), "waits for the enable");
+    assert!(a
+        .cycle(4, 0)
+        .is_some_and(|c| c.brake_release && c.injection.is_some_and(|i| i.angle == Some(0))));
+    assert!(a.cycle(2, 0).is_none());
+    assert_eq!(a.outcome(), align::AlignOutcome::Failed(result::ABORTED));
+}

@@ -1,0 +1,261 @@
+#!/usr/bin/env python3
+"""The motor actions through SOEM on the electrical plant (issue 35; E-140,
+E-141): A75 in the RxPDO, A69 in the TxPDO, the motor data by SDO.
+
+Run by `hil-sim/tests/soem_electrical.rs` as root inside the master's network
+namespace against `hil-sim serve --plant electrical --plant-r R --plant-l L
+--slaves 1` (or by hand), with the same --r and --l: the plant's motor, which
+the drive's dictionary does not know (it keeps B53 = 3.6 ohm, B52 = 12 mH).
+Free run, one drive, axis A in cst; RxPDO 6040h, 6060h, A75; TxPDO 6041h, A69.
+
+  1. Op, the axis switch-on disabled: A75 = Execute | 1100b (B42, optimise
+     current controller) is refused (A69 state 3), B53/B52 unchanged.
+  2. B40 (1010b, test phase), as below: done, B40[0] = 0, B40[2] (the pole
+     pairs the encoder's count over one electrical turn means) = B10.
+     B41 (1011b, calibrate motor), as below: B05 (commutation offset, 0
+     before) within 0.5 degrees electrical of the plant's --offset (rad,
+     mechanical; modulo an electrical revolution, 2^20 / B10 increments),
+     B41[0] = 0. B42 needs it: it injects in the rotor's frame.
+  3. Execute low, shutdown (6040h = 6): ready to switch on (E48 = 2). For
+     B42 (1100b) and then B49 (1110b, at standstill): Execute; A69 shows it
+     running at 0 % until the enable (6040h = 7, 15); then the progress
+     rises to 100 %, state done; B42[0] (sub 1) = 0, B53 and B52/B62 within
+     5 % of --r/--l, B42[1]/[2] the same figures. Execute low and shutdown:
+     A69 idle.
+  4. B43 (1101b, test winding) in ready to switch on, no enable: done,
+     B43[0] = 0, the three resistances within 3 % of --r, E48 still 2.
+
+Prints `FAIL: ...` for every check that failed; exit status 0 when none did.
+"""
+import argparse
+import os
+import struct
+import sys
+import time
+
+sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
+import line as L  # noqa: E402
+
+say, check = L.say, L.check
+
+
+def b(line):
+    return 0x2000 + 1 * 0x200 + line
+
+
+A75, A69 = 0x2000 + 75, 0x2000 + 69
+B05, B10, B40, B41, B42, B43, B52, B53, B62 = b(5), b(10), b(40), b(41), b(42), b(43), b(52), b(53), b(62)
+E48 = 0x2000 + 4 * 0x200 + 48
+RX = [L.entry(0x6040, 0, 16), L.entry(0x6060, 0, 8), L.entry(A75, 0, 8)]
+TX = [L.entry(0x6041, 0, 16), L.entry(A69, 0, 16)]
+OUT, IN = "<HbB", "<HH"
+RUNNING, DONE, REFUSED = 1, 2, 3
+# cst with 6071h = 0 (not mapped): the axis holds no position, so the one B41
+# turns the rotor to needs no cyclic target (csp would: a master there sends
+# the actual position as the target, as before any enable)
+CST = 10
+B40_SEL, B41_SEL, B42_SEL, B43_SEL, B49_SEL = 0b1010, 0b1011, 0b1100, 0b1101, 0b1110
+
+
+class Axis:
+    """Axis A of drive 1 in free run, about 1 ms per frame."""
+
+    def __init__(self, m):
+        self.m, self.s = m, m.slaves[0]
+        self.cw, self.a75 = 0, 0
+        self.sw = self.a69 = 0
+
+    def cycle(self, k=1):
+        for _ in range(k):
+            self.s.output = struct.pack(OUT, self.cw, CST, self.a75)
+            self.m.send_processdata()
+            self.m.receive_processdata(4000)
+            n = struct.calcsize(IN)
+            if len(self.s.input) >= n:
+                self.sw, self.a69 = struct.unpack(IN, bytes(self.s.input[:n]))
+            time.sleep(0.001)
+
+    def until(self, pred, frames):
+        for _ in range(frames):
+            self.cycle()
+            if pred():
+                return True
+        return False
+
+
+def motor_data(s):
+    return L.sdo_u(s, B53, 0), L.sdo_u(s, B52, 0), L.sdo_u(s, B62, 0)
+
+
+def refused(axis):
+    before = motor_data(axis.s)
+    axis.a75 = B42_SEL << 1 | 1
+    axis.cycle(10)
+    want = B42_SEL << 8 | REFUSED << 12
+    check(axis.a69 == want, f"B42 switch-on disabled: A69 {axis.a69:04X}h, expected {want:04X}h (refused)")
+    check(motor_data(axis.s) == before, f"refused B42 changed nothing: {motor_data(axis.s)} vs {before}")
+    axis.a75 = 0
+    axis.cycle(5)
+
+
+def start(axis, sel):
+    """Starts `sel` in Ready to switch on, enables; A69 until it leaves running."""
+    axis.cw = 6
+    check(axis.until(lambda: L.sw_is(axis.sw, L.READY), 300), f"ready to switch on: statusword {axis.sw:#06x}")
+    axis.a75 = sel << 1 | 1
+    axis.cycle(10)
+    for cw in (7, 0xF):
+        axis.cw = cw
+        axis.cycle(10)
+    seen = []
+    start_t = time.monotonic()
+    while time.monotonic() - start_t < 30.0:
+        axis.cycle()
+        if not seen or seen[-1] != axis.a69:
+            seen.append(axis.a69)
+        if axis.a69 >> 12 != RUNNING:
+            break
+    return seen, time.monotonic() - start_t
+
+
+def phase_test(axis):
+    seen, took = start(axis, B40_SEL)
+    done = 100 | B40_SEL << 8 | DONE << 12
+    result = L.sdo_u(axis.s, B40, 1)
+    check(seen[-1] == done, f"B40: A69 ends {seen[-1]:04X}h, expected {done:04X}h; seen {[f'{s:04X}' for s in seen]}; B40[0] {result}")
+    check(result == 0, f"B40[0] result {result}, expected 0")
+    per_turn = int.from_bytes(axis.s.sdo_read(B40, 2), "little", signed=True)
+    pp = L.sdo_u(axis.s, B40, 3)
+    say(f"B40: {per_turn} inc per electrical turn, {pp} pole pairs seen, in {took:.2f} s")
+    check(pp == L.sdo_u(axis.s, B10, 0), f"B40: pole pairs seen {pp} vs B10")
+    axis.a75 = 0
+    axis.cw = 6
+    axis.cycle(20)
+
+
+def calibrate(axis, offset_rad):
+    pp = L.sdo_u(axis.s, B10, 0)
+    per_el = (1 << 20) // pp
+    truth = round(offset_rad / (2 * 3.141592653589793) * (1 << 20))
+    check(L.sdo_u(axis.s, B05, 0) == 0, "B05 = 0 before")
+    seen, took = start(axis, B41_SEL)
+    done = 100 | B41_SEL << 8 | DONE << 12
+    check(seen[-1] == done, f"B41: A69 ends {seen[-1]:04X}h, expected {done:04X}h; seen {[f'{s:04X}' for s in seen]}")
+    check(L.sdo_u(axis.s, B41, 1) == 0, f"B41[0] result {L.sdo_u(axis.s, B41, 1)}, expected 0")
+    b05 = L.sdo_u(axis.s, B05, 0)
+    err = (b05 - truth) % per_el
+    err = min(err, per_el - err) / per_el * 360.0
+    say(f"B41: plant offset {truth} inc, B05 {b05} inc: {err:.3} deg electrical off, alignments {L.sdo_u(axis.s, B41, 2)} inc apart, in {took:.2f} s")
+    check(err < 0.5, f"B41: B05 {b05} vs the plant's {truth} (mod {per_el}): {err} deg el")
+    axis.a75 = 0
+    axis.cw = 6
+    axis.cycle(20)
+
+
+def winding(axis, r):
+    axis.cw = 6
+    check(axis.until(lambda: L.sw_is(axis.sw, L.READY), 300), f"ready to switch on: statusword {axis.sw:#06x}")
+    axis.a75 = B43_SEL << 1 | 1
+    seen = []
+    start_t = time.monotonic()
+    while time.monotonic() - start_t < 10.0:
+        axis.cycle()
+        if not seen or seen[-1] != axis.a69:
+            seen.append(axis.a69)
+        if axis.a69 >> 12 not in (0, RUNNING):
+            break
+    done = 100 | B43_SEL << 8 | DONE << 12
+    check(seen[-1] == done, f"B43: A69 ends {seen[-1]:04X}h, expected {done:04X}h; seen {[f'{s:04X}' for s in seen]}")
+    check(L.sdo_u(axis.s, E48, 0) == 2, "B43 runs without the enable: E48 = 2")
+    check(L.sdo_u(axis.s, B43, 1) == 0, f"B43[0] result {L.sdo_u(axis.s, B43, 1)}, expected 0")
+    rs = [L.sdo_u(axis.s, B43, k) * 1e-3 for k in (2, 3, 4)]
+    say(f"B43: resistances along U, V, W {rs} ohm (plant {r} ohm) in {time.monotonic() - start_t:.2f} s")
+    check(all(abs(x - r) <= 0.03 * r for x in rs), f"B43: {rs} not within 3 % of {r} ohm")
+    axis.a75 = 0
+    axis.cycle(10)
+
+
+def optimise(axis, sel, r, l):
+    axis.cw = 6
+    check(axis.until(lambda: L.sw_is(axis.sw, L.READY), 300), f"ready to switch on: statusword {axis.sw:#06x}")
+    check(L.sdo_u(axis.s, E48, 0) == 2, "E48 = 2")
+    axis.a75 = sel << 1 | 1
+    axis.cycle(10)
+    want = sel << 8 | RUNNING << 12
+    check(axis.a69 == want, f"{sel:04b}: A69 {axis.a69:04X}h before the enable, expected {want:04X}h (running, 0 %)")
+    for cw in (7, 0xF):
+        axis.cw = cw
+        axis.cycle(10)
+    seen = []
+    start = time.monotonic()
+    while time.monotonic() - start < 10.0:
+        axis.cycle()
+        if not seen or seen[-1] != axis.a69:
+            seen.append(axis.a69)
+        if axis.a69 >> 12 != RUNNING:
+            break
+    took = time.monotonic() - start
+    done = 100 | sel << 8 | DONE << 12
+    check(seen[-1] == done, f"{sel:04b}: A69 ends {seen[-1]:04X}h, expected {done:04X}h; seen {[f'{s:04X}' for s in seen]}; B42[0] {L.sdo_u(axis.s, B42, 1)}, statusword {axis.sw:#06x}")
+    check(all((a & 0xFF) <= (b_ & 0xFF) for a, b_ in zip(seen, seen[1:])), f"{sel:04b}: progress rises: {[f'{s:04X}' for s in seen]}")
+    check(L.sdo_u(axis.s, B42, 1) == 0, f"{sel:04b}: B42[0] result {L.sdo_u(axis.s, B42, 1)}, expected 0")
+    r_mohm, l_uh, lq_uh = motor_data(axis.s)
+    r_id, l_id = r_mohm * 1e-3, l_uh * 1e-6
+    say(f"{sel:04b}: plant R {r} ohm L {l * 1e3} mH; identified R {r_id:.3f} ohm ({(r_id - r) / r * 100:+.2f} %), L {l_id * 1e3:.3f} mH ({(l_id - l) / l * 100:+.2f} %) in {took:.2f} s")
+    check(abs(r_id - r) <= 0.05 * r, f"{sel:04b}: B53 {r_id} ohm not within 5 % of the plant's {r} ohm")
+    check(abs(l_id - l) <= 0.05 * l, f"{sel:04b}: B52 {l_id} H not within 5 % of the plant's {l} H")
+    check(lq_uh == l_uh, f"{sel:04b}: B62 {lq_uh} = B52 {l_uh}")
+    check((L.sdo_u(axis.s, B42, 2), L.sdo_u(axis.s, B42, 3)) == (r_mohm, l_uh), f"{sel:04b}: B42[1]/[2] = B53/B52")
+    axis.a75 = 0
+    axis.cw = 6
+    axis.cycle(20)
+    check(axis.a69 == 0, f"{sel:04b}: A69 {axis.a69:04X}h after Execute low, expected idle")
+
+
+def run(m, args):
+    L.scan(m, 1)
+    check(m.read_state() == L.PREOP, f"Pre-Op: {L.state_report(m)}")
+    s = m.slaves[0]
+    for a in (0x1C12, 0x1C13):
+        s.sdo_write(a, 0, b"\x00")
+    L.write_map(s, 0x1600, RX)
+    L.write_map(s, 0x1A00, TX)
+    for a, pdo in ((0x1C12, 0x1600), (0x1C13, 0x1A00)):
+        s.sdo_write(a, 1, pdo.to_bytes(2, "little"))
+        s.sdo_write(a, 0, b"\x01")
+    m.config_map()
+    axis = Axis(m)
+    m.state = L.SAFEOP
+    m.write_state()
+    axis.cycle(50)
+    m.state = L.OP
+    m.write_state()
+    for _ in range(300):
+        axis.cycle(10)
+        if m.read_state() == L.OP:
+            break
+    else:
+        raise L.Fatal(f"Op not reached: {L.state_report(m)}")
+    refused(axis)
+    # the wiring, then the commutation offset: B42 injects in the rotor's frame
+    phase_test(axis)
+    calibrate(axis, args.offset)
+    for sel in (B42_SEL, B49_SEL):
+        optimise(axis, sel, args.r, args.l)
+    winding(axis, args.r)
+    axis.cw = 0
+    axis.cycle(20)
+
+
+def main():
+    ap = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
+    ap.add_argument("--iface", required=True)
+    ap.add_argument("--r", type=float, required=True, help="the plant's phase resistance, ohm")
+    ap.add_argument("--l", type=float, required=True, help="the plant's inductance, H")
+    ap.add_argument("--offset", type=float, required=True, help="the plant's commutation offset, rad (mechanical)")
+    args = ap.parse_args()
+    return L.master_main(args, run, "motor actions on the electrical plant: all checks passed")
+
+
+if __name__ == "__main__":
+    sys.exit(main())
