@@ -246,7 +246,27 @@ impl<F: Flash, H: RecordHook> PnDrive<F, H> {
         if let Some(k) = kept {
             drive.device.set_snmp(k);
         }
+        drive.prepare_axes();
         drive
+    }
+
+    /// The axes' caches of the control cycle built here, outside it, when
+    /// the configuration moved (start-up; a record, I&M or DCP write in the
+    /// frame just received): the next control cycle reads only the
+    /// set-points (issue 36). Cheap when nothing changed.
+    fn prepare_axes(&mut self) {
+        for (axis, cache) in self.axes.iter_mut().zip(self.caches.iter_mut()) {
+            axis.prepare(cache, &self.objects);
+        }
+        // the profile's part where it runs (a receive telegram is there)
+        let has_telegram = match self.data_slots() {
+            (Some(slot), _) => self.device.output_data(slot).is_some(),
+            _ => false,
+        };
+        if has_telegram {
+            let [axis, _] = &mut self.axes;
+            self.profile.prepare(&self.objects, axis);
+        }
     }
 
     /// The PROFINET device.
@@ -392,6 +412,7 @@ impl<F: Flash, H: RecordHook> PnDrive<F, H> {
         self.telegram_new = true;
         self.serve_bmp();
         self.events(on_event);
+        self.prepare_axes();
     }
 
     /// A parameter request written to record 0xB02E in the frame just

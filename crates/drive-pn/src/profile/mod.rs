@@ -162,15 +162,28 @@ impl Profile {
         self.own.saving = false;
     }
 
-    /// Step 1–3 of a cycle: the received OUT module's data `frame`.
-    pub fn receive(&mut self, frame: &[u8], objects: &mut DriveObjects, axis: &mut Axis) {
-        // the unit choices A279 (P-212): new units once they convert; a
-        // setting that does not raises 22-4 and the units stay
+    /// What [`receive`](Self::receive) builds on a configuration change
+    /// (the entries it resolves, the unit choices A279 read again and
+    /// applied), done where the configuration changed, outside the control
+    /// cycle (issue 36); the next `receive` finds them current.
+    pub fn prepare(&mut self, objects: &DriveObjects, axis: &mut Axis) {
+        self.refresh_units(objects, axis);
+        self.core.resolve(objects, axis);
+    }
+
+    /// The unit choices A279 (P-212): new units once they convert; a
+    /// setting that does not raises 22-4 and the units stay.
+    fn refresh_units(&mut self, objects: &DriveObjects, axis: &mut Axis) {
         match self.unit_choice.refresh(objects) {
             Ok(Some(u)) => self.units = u,
             Ok(None) => {}
             Err(_) => axis.raise_event(unit_choice::UNIT_OVERFLOW),
         }
+    }
+
+    /// Step 1–3 of a cycle: the received OUT module's data `frame`.
+    pub fn receive(&mut self, frame: &[u8], objects: &mut DriveObjects, axis: &mut Axis) {
+        self.refresh_units(objects, axis);
         let Some(telegrams) = self.telegrams.as_mut() else {
             return;
         };
