@@ -247,25 +247,20 @@ impl<F: Flash, H: RecordHook> PnDrive<F, H> {
             drive.device.set_snmp(k);
         }
         drive.prepare_axes();
+        let [axis, _] = &drive.axes;
+        drive.profile.warm_up(&drive.objects, axis);
         drive
     }
 
     /// The axes' caches of the control cycle built here, outside it, when
     /// the configuration moved (start-up; a record, I&M or DCP write in the
     /// frame just received): the next control cycle reads only the
-    /// set-points (issue 36). Cheap when nothing changed.
+    /// set-points (issue 36). Cheap when nothing changed (a compare per
+    /// axis: this runs in the eth task, whose hold of the drive blocks the
+    /// control cycle).
     fn prepare_axes(&mut self) {
         for (axis, cache) in self.axes.iter_mut().zip(self.caches.iter_mut()) {
             axis.prepare(cache, &self.objects);
-        }
-        // the profile's part where it runs (a receive telegram is there)
-        let has_telegram = match self.data_slots() {
-            (Some(slot), _) => self.device.output_data(slot).is_some(),
-            _ => false,
-        };
-        if has_telegram {
-            let [axis, _] = &mut self.axes;
-            self.profile.prepare(&self.objects, axis);
         }
     }
 

@@ -162,12 +162,11 @@ impl Profile {
         self.own.saving = false;
     }
 
-    /// What [`receive`](Self::receive) builds on a configuration change
-    /// (the entries it resolves, the unit choices A279 read again and
-    /// applied), done where the configuration changed, outside the control
-    /// cycle (issue 36); the next `receive` finds them current.
-    pub fn prepare(&mut self, objects: &DriveObjects, axis: &mut Axis) {
-        self.refresh_units(objects, axis);
+    /// At start-up, outside the control cycle (issue 36): the core
+    /// entries resolved (the A279 unit choices are not read ahead: reading
+    /// them here moved which entries the dictionary's lookup memo holds and
+    /// cost telegram 0 about 8,000 instructions per frame on QEMU).
+    pub fn warm_up(&mut self, objects: &DriveObjects, axis: &Axis) {
         self.core.resolve(objects, axis);
     }
 
