@@ -97,6 +97,7 @@ impl Profile {
             prepared: &mut p.prepared,
             core: &p.core,
             own: &mut p.own,
+            pending: None,
         };
         // the stored configuration (A280, P-069), else the FB's
         if let Some(set) = stored {
@@ -108,6 +109,7 @@ impl Profile {
         if p.telegrams.is_none() {
             p.telegrams = Telegrams::with_defaults(&access).ok();
         }
+        drop(access);
         if let Some(t) = &p.telegrams {
             p.own.edit = telegram_config::TelegramEdit::of(t.set());
         }
@@ -196,8 +198,11 @@ impl Profile {
             prepared: &mut self.prepared,
             core,
             own: &mut self.own,
+            pending: None,
         };
         let rx = telegrams.apply_receive(frame, &mut access);
+        // the telegram's record fields stored before anything reads them
+        access.flush_record();
         if !rx.warnings.is_empty() {
             self.warnings = self.warnings.saturating_add(1);
         }
@@ -324,6 +329,7 @@ impl Profile {
             let rated = u64::from(axis.motor().rated_current_ma().max(1));
             (u64::from(current.unsigned_abs()) * 1000 / rated).min(u64::from(u16::MAX - 1)) as u16
         });
+        drop(access);
         axis.set_torque_mode_speed_limit(speed_limit);
         axis.set_torque_limit_per_mille(torque_limit);
         axis.set_record_command(record_command);
@@ -348,6 +354,7 @@ impl Profile {
             prepared: &mut self.prepared,
             core: &self.core,
             own: &mut self.own,
+            pending: None,
         };
         profidrive::bmp::serve(req, &mut access, out).unwrap_or(0)
     }
@@ -377,6 +384,7 @@ impl Profile {
             prepared: &mut self.prepared,
             core: &self.core,
             own: &mut self.own,
+            pending: None,
         };
         // straight into the module's data (the telegram is cut to it or
         // zero-padded up to it)
