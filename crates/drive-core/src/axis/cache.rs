@@ -13,8 +13,6 @@ use super::*;
 pub struct AxisCache {
     pub(super) snapshot: Option<CachedSnapshot>,
     pub(super) slots: Option<CyclicSlots>,
-    /// The snapshot's reads resolved (`read_slots.rs`).
-    pub(super) reads: read_slots::ReadSlots,
 }
 
 /// The snapshot with the configuration generation it was read at and what
@@ -36,7 +34,6 @@ impl AxisCache {
         Self {
             snapshot: None,
             slots: None,
-            reads: read_slots::ReadSlots::new(),
         }
     }
 }
@@ -56,19 +53,14 @@ impl Axis {
         }
         let generation = od.config_generation();
         if !matches!(&cache.snapshot, Some(c) if c.generation == generation) {
-            cache.snapshot = Some(self.read_snapshot(od, &cache.reads, generation));
+            cache.snapshot = Some(self.read_snapshot(od, generation));
         }
     }
 
     /// The whole snapshot of this axis at `generation`, with what follows
     /// from it alone (the scaling in force from here on).
-    pub(super) fn read_snapshot(
-        &mut self,
-        od: &DriveObjects,
-        reads: &read_slots::ReadSlots,
-        generation: u32,
-    ) -> CachedSnapshot {
-        let fresh = Snapshot::read_with(od, self.window, reads);
+    pub(super) fn read_snapshot(&mut self, od: &DriveObjects, generation: u32) -> CachedSnapshot {
+        let fresh = Snapshot::read(od, self.window);
         // C-109: user units at the objects, increments inside
         self.scaling = fresh.scaling();
         self.velocity_decimals = fresh.decimal_factors().0 as f32;

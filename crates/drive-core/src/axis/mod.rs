@@ -94,7 +94,6 @@ mod modes;
 mod monitor;
 mod motor;
 mod params;
-mod read_slots;
 mod record_state;
 mod records;
 mod running;
@@ -220,6 +219,9 @@ pub struct Axis {
     offset: i32,
     /// Last encoder reading (motor coordinates) for the velocity filter.
     last_raw: Option<i32>,
+    /// The cache of [`Axis::cycle`]; the drive keeps its own next to the
+    /// axes and calls [`Axis::cycle_cached`], which reads it in place.
+    cache: AxisCache,
     /// What [`Self::configure`] last ran for: the configuration generation,
     /// the cycle and the mode class (homing, jog, other); it runs again
     /// only when one of them (or the parameters) changed.
@@ -331,6 +333,7 @@ impl Axis {
             homing: Homing::new(0),
             offset: 0,
             last_raw: None,
+            cache: AxisCache::new(),
             velocity: 0.0,
             last_sample: None,
             sp_pos: 0,
@@ -431,9 +434,7 @@ impl Axis {
     }
 
     /// One control cycle at `now_ns`: reads the objects, steps the device
-    /// control, runs the mode and the cascade, writes the actual values
-    /// (the whole snapshot each time: the drives call
-    /// [`cycle_cached`](Self::cycle_cached) with their caches).
+    /// control, runs the mode and the cascade, writes the actual values.
     /// `new_setpoint`: a new cyclic set-point (RxPDO) arrived since the last
     /// cycle; without one the interpolators extrapolate (C-116).
     pub fn cycle(
@@ -443,10 +444,10 @@ impl Axis {
         now_ns: Nanos,
         new_setpoint: bool,
     ) -> AxisReport {
-        // no cache kept in the axis (a drive keeps one per axis beside the
-        // axes): everything read again, as the cache's first cycle would
-        let mut cache = AxisCache::new();
-        self.cycle_cached(&mut cache, od, io, now_ns, new_setpoint)
+        let mut cache = core::mem::take(&mut self.cache);
+        let report = self.cycle_cached(&mut cache, od, io, now_ns, new_setpoint);
+        self.cache = cache;
+        report
     }
 
     /// [`cycle`](Self::cycle) with the snapshot and slots in `cache`, kept
@@ -494,7 +495,7 @@ impl Axis {
                 cached.snapshot.refresh_setpoints(od, slots);
                 cached
             }
-            stale => stale.insert(self.read_snapshot(od, &cache.reads, generation)),
+            stale => stale.insert(self.read_snapshot(od, generation)),
         };
         let (raw, dt_ns) = (&cached.snapshot, cached.dt_ns);
         // converted (a copy) only when user units are not increments

@@ -38,6 +38,7 @@
 
 use super::*;
 use crate::params::{B10, B17, B52, B53, B62, B64, B73, U10, U11};
+use core::cell::Cell;
 
 /// Event 45 "Overtemp.motor i2t", cause 1: the motor's i²t model stayed at
 /// or above 100 % for U11 (U10 = 2) or reached it (U10 = 3).
@@ -101,7 +102,7 @@ impl MotorData {
     /// Reads the motor data of axis `w` (a missing entry counts in `m` and
     /// reads 0; zeroes the ranges refuse fall back to the defaults' meaning
     /// where a division needs them).
-    pub(crate) fn read(od: &DriveObjects, w: Window, m: &super::read_slots::Reads<'_>) -> Self {
+    pub(crate) fn read(od: &DriveObjects, w: Window, m: &Cell<u32>) -> Self {
         let p = |index: u16| w.param(od, index, 0, m);
         let d = Self::default();
         let pos = |v: i64, scale: f32, fallback: f32| if v > 0 { v as f32 * scale } else { fallback };

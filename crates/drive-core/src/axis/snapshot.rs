@@ -7,7 +7,8 @@
 //! cycle. Units are the objects' (increments, inc/s, inc/s², inc/s³, 0.1 % of
 //! the rated torque, ms, µs).
 
-use super::read_slots::{ReadSlots, Reads};
+use core::cell::Cell;
+
 use crate::dictionary::{DriveObjects, Slot, SlotValue, Typed};
 use crate::{AXIS_B_CIA402, AXIS_B_MANUFACTURER};
 use motion::scaling::AxisScaling;
@@ -18,12 +19,15 @@ pub(crate) use crate::params::{
     I425, I43, I44, I45, I46, I470, I471, I53, I87,
 };
 
-/// Entry `index`:`sub`, or 0 with the miss counted in `m`: the dictionary
-/// declares every entry the snapshot reads, with its default
+/// Entry `index`:`sub`, or 0 with `misses` counted: the dictionary declares
+/// every entry the snapshot reads, with its default
 /// (`snapshot_reads_only_declared_entries`), so no value of the
 /// snapshot is written down twice.
-fn read_or_miss(od: &DriveObjects, index: u16, sub: u8, m: &Reads<'_>) -> i64 {
-    m.read(od, index, sub)
+fn read_or_miss(od: &DriveObjects, index: u16, sub: u8, misses: &Cell<u32>) -> i64 {
+    od.get(index, sub).unwrap_or_else(|_| {
+        misses.set(misses.get().saturating_add(1));
+        0
+    })
 }
 
 /// The object window of one axis: CiA 402 objects at +800h, per-axis
@@ -56,13 +60,13 @@ impl Window {
 
     /// Per-axis manufacturer entry `index`:`sub` ("SDO Info" numbering) of
     /// this axis; 0 when it cannot be read (counted in `misses`).
-    pub fn param(self, od: &DriveObjects, index: u16, sub: u8, misses: &Reads<'_>) -> i64 {
+    pub fn param(self, od: &DriveObjects, index: u16, sub: u8, misses: &Cell<u32>) -> i64 {
         read_or_miss(od, self.manufacturer(index), sub, misses)
     }
 
     /// CiA 402 entry `index`:`sub` of this axis; 0 when it cannot be read
     /// (counted in `misses`).
-    pub fn get(self, od: &DriveObjects, index: u16, sub: u8, misses: &Reads<'_>) -> i64 {
+    pub fn get(self, od: &DriveObjects, index: u16, sub: u8, misses: &Cell<u32>) -> i64 {
         read_or_miss(od, self.cia402(index), sub, misses)
     }
 
@@ -406,29 +410,15 @@ impl Snapshot {
     }
 
     /// Reads the snapshot of axis `w`.
-    #[cfg(test)]
     pub fn read(od: &DriveObjects, w: Window) -> Self {
         Self::read_counting(od, w).0
     }
 
     /// [`read`](Self::read) and how many entries could not be read (they
     /// count as 0; none with the drive's dictionary).
-    #[cfg(test)]
     pub fn read_counting(od: &DriveObjects, w: Window) -> (Self, u32) {
-        let m = Reads::plain();
-        let snapshot = Self::read_from(od, w, &m);
-        (snapshot, m.misses())
-    }
-
-    /// [`read`](Self::read) with the slots recorded in `slots` (recorded
-    /// at the first read): a load per entry (`read_slots.rs`).
-    pub fn read_with(od: &DriveObjects, w: Window, slots: &ReadSlots) -> Self {
-        Reads::run(slots, |m| Self::read_from(od, w, m)).0
-    }
-
-    /// The snapshot's reads, always the same entries in the same order
-    /// (`read_slots.rs` replays them by position).
-    fn read_from(od: &DriveObjects, w: Window, m: &Reads<'_>) -> Self {
+        let misses = Cell::new(0);
+        let m = &misses;
         let i32_ = |index: u16, sub: u8| sat(w.get(od, index, sub, m), i32::MIN, i32::MAX);
         let u32_ = |index: u16, sub: u8| sat(w.get(od, index, sub, m), 0u32, u32::MAX);
         let u16_ = |index: u16, sub: u8| sat(w.get(od, index, sub, m), 0u16, u16::MAX);
@@ -436,7 +426,7 @@ impl Snapshot {
         let i8_ = |index: u16, sub: u8| sat(w.get(od, index, sub, m), i8::MIN, i8::MAX);
         let u8_ = |index: u16, sub: u8| sat(w.get(od, index, sub, m), 0u8, u8::MAX);
         let ramp = |index: u16| (u32_(index, 1), u16_(index, 2));
-        Snapshot {
+        let snapshot = Snapshot {
             controlword: u16_(0x6040, 0),
             mode: i8_(0x6060, 0),
             target_position: i32_(0x607A, 0),
@@ -482,14 +472,7 @@ impl Snapshot {
             period_index: i8_(0x60C2, 2),
             override_percent: sat(w.param(od, A340, 0, m), 0u16, u16::MAX),
             a66: core::array::from_fn(|k| sat(w.param(od, A66, k as u8 + 1, m), 0u32, u32::MAX)),
-            // every subindex read (no early stop): the same reads each time
-            a66_used: {
-                let mut used = false;
-                for sub in 1..=16 {
-                    used |= w.param(od, A66, sub, m) != 0;
-                }
-                used
-            },
+            a66_used: (1..=16).any(|sub| w.param(od, A66, sub, m) != 0),
             jog: [
                 sat(w.param(od, I12, 0, m), 0u32, u32::MAX),
                 sat(w.param(od, I13, 0, m), 0u32, u32::MAX),
@@ -550,21 +533,17 @@ impl Snapshot {
             modulo_length: i32_(0x607B, 2),
             target_position_user: i32_(0x607A, 0),
             ip_setpoint_user: i32_(0x60C1, 1),
-            decimals: {
-                // both read whatever A213 says: the same reads each time
-                let own = read_or_miss(od, A213, 1, m) == 0;
-                let d = (
+            decimals: if read_or_miss(od, A213, 1, m) == 0 {
+                (
                     sat(w.param(od, A310, 0, m), 0u8, 9),
                     sat(w.param(od, A311, 0, m), 0u8, 9),
-                );
-                if own {
-                    d
-                } else {
-                    (0, 0)
-                }
+                )
+            } else {
+                (0, 0)
             },
             motor: super::MotorData::read(od, w, m),
-        }
+        };
+        (snapshot, misses.get())
     }
 
     /// The scaling of 6091h/6092h (polarity is applied separately); the

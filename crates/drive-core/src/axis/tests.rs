@@ -81,53 +81,6 @@ fn cached_snapshot_equals_a_fresh_read_after_any_write() {
     assert!(checked > 300, "{checked} writes");
 }
 
-/// The snapshot read through the slots its first read recorded
-/// (`read_slots.rs`) equals a read through the dictionary after a write of
-/// any integer entry (the configuration's included), on both axes, and
-/// every read is recorded (no more reads than places).
-#[test]
-fn snapshot_through_recorded_slots_equals_a_fresh_read_after_any_write() {
-    use crate::axis::read_slots::{ReadSlots, READS};
-    use crate::axis::snapshot::{Snapshot, Window};
-    use crate::objects::OBJECTS;
-    let windows = [Window { axis: 0 }, Window { axis: 1 }];
-    let mut od = DriveObjects::new();
-    let slots = windows.map(|w| {
-        let s = ReadSlots::new();
-        assert_eq!(Snapshot::read_with(&od, w, &s), Snapshot::read(&od, w));
-        let (_, n) = s.recorded().expect("recorded");
-        assert!(usize::from(n) <= READS, "{n} reads, {READS} places");
-        s
-    });
-    let mut checked = 0;
-    for o in OBJECTS.iter() {
-        for e in o.info.entries {
-            if !e.data_type.is_integer() {
-                continue;
-            }
-            let Ok(v) = od.get(o.info.index, e.sub) else {
-                continue;
-            };
-            let v = if v < e.data_type.max_value() { v + 1 } else { v - 1 };
-            if od.set(o.info.index, e.sub, v).is_err() {
-                continue;
-            }
-            checked += 1;
-            for (w, s) in windows.iter().zip(&slots) {
-                assert_eq!(
-                    Snapshot::read_with(&od, *w, s),
-                    Snapshot::read(&od, *w),
-                    "{:04X}:{} axis {}",
-                    o.info.index,
-                    e.sub,
-                    w.axis
-                );
-            }
-        }
-    }
-    assert!(checked > 300, "{checked} writes");
-}
-
 /// Every entry the control cycle reads or writes each cycle has a RAM slot
 /// of the type the cycle uses on both axes (a missing or differently typed
 /// one would silently read the default or drop an actual value), and no two
