@@ -37,3 +37,39 @@ impl AxisCache {
         }
     }
 }
+
+impl Axis {
+    /// Builds what [`cycle_cached`](Self::cycle_cached) keeps in `cache`
+    /// (the resolved slots; the snapshot when the configuration generation
+    /// moved) outside the control cycle: where the configuration changes
+    /// (start-up, a record or parameter write in the bus task), so the next
+    /// cycle reads only the set-points (issue 36: no long first or
+    /// reconfiguration cycle). Nothing the cycle computes differs: it would
+    /// read the same snapshot at the same generation.
+    pub fn prepare(&mut self, cache: &mut AxisCache, od: &DriveObjects) {
+        let window = self.window;
+        if cache.slots.is_none() {
+            cache.slots = Some(CyclicSlots::resolve(od, window));
+        }
+        let generation = od.config_generation();
+        if !matches!(&cache.snapshot, Some(c) if c.generation == generation) {
+            cache.snapshot = Some(self.read_snapshot(od, generation));
+        }
+    }
+
+    /// The whole snapshot of this axis at `generation`, with what follows
+    /// from it alone (the scaling in force from here on).
+    pub(super) fn read_snapshot(&mut self, od: &DriveObjects, generation: u32) -> CachedSnapshot {
+        let fresh = Snapshot::read(od, self.window);
+        // C-109: user units at the objects, increments inside
+        self.scaling = fresh.scaling();
+        self.velocity_decimals = fresh.decimal_factors().0 as f32;
+        CachedSnapshot {
+            generation,
+            in_increments: fresh.in_increments(&self.scaling),
+            dt_ns: application_cycle_ns(u32::from(fresh.control_cycle_us).saturating_mul(1000))
+                .unwrap_or(crate::params::A150_FALLBACK_US * 1000),
+            snapshot: fresh,
+        }
+    }
+}

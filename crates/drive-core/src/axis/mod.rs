@@ -495,19 +495,7 @@ impl Axis {
                 cached.snapshot.refresh_setpoints(od, slots);
                 cached
             }
-            stale => {
-                let fresh = Snapshot::read(od, window);
-                // C-109: user units at the objects, increments inside
-                self.scaling = fresh.scaling();
-                self.velocity_decimals = fresh.decimal_factors().0 as f32;
-                stale.insert(CachedSnapshot {
-                    generation,
-                    in_increments: fresh.in_increments(&self.scaling),
-                    dt_ns: application_cycle_ns(u32::from(fresh.control_cycle_us).saturating_mul(1000))
-                        .unwrap_or(crate::params::A150_FALLBACK_US * 1000),
-                    snapshot: fresh,
-                })
-            }
+            stale => stale.insert(self.read_snapshot(od, generation)),
         };
         let (raw, dt_ns) = (&cached.snapshot, cached.dt_ns);
         // converted (a copy) only when user units are not increments

@@ -128,6 +128,18 @@ pub struct DriveAccess<'a> {
     pub core: &'a CoreSlots,
     /// The profile's own values.
     pub own: &'a mut OwnValues,
+    /// A record a telegram's fields wrote, not yet stored: the fields of
+    /// one record that follow each other in a telegram (target, velocities,
+    /// accelerations) store it and show it in the window J401 once, not
+    /// once per field (issue 36). Stored before any other access and when
+    /// the access ends ([`flush_record`](DriveAccess::flush_record)).
+    pub(super) pending: Option<(u8, u16, Record)>,
+}
+
+impl Drop for DriveAccess<'_> {
+    fn drop(&mut self) {
+        self.flush_record();
+    }
 }
 
 impl DriveAccess<'_> {
@@ -293,7 +305,17 @@ impl DriveAccess<'_> {
         }
     }
 
+    /// Stores the record the last field writes left pending (and shows it
+    /// when the window J401 shows it), as each of those writes did before.
+    pub fn flush_record(&mut self) {
+        if let Some((axis, n, r)) = self.pending.take() {
+            // record `n` was read just before: it is there to store
+            let _ = self.objects.set_record(axis, n, &r);
+        }
+    }
+
     fn read_record(&mut self, jog: Option<Jog>, field: RecordField, unit: Unit) -> Result<i64, PdError> {
+        self.flush_record();
         let n = self.record_number(jog);
         let r = self
             .objects
@@ -324,7 +346,13 @@ impl DriveAccess<'_> {
         let axis = self.axis.index();
         for &k in numbers {
             let n = if k == 0 { self.record_number(jog) } else { k };
-            let mut r: Record = self.objects.record(axis, n).ok_or(PdError::NOT_IN_STATE)?;
+            let mut r: Record = match self.pending {
+                Some((a, m, r)) if (a, m) == (axis, n) => r,
+                _ => {
+                    self.flush_record();
+                    self.objects.record(axis, n).ok_or(PdError::NOT_IN_STATE)?
+                }
+            };
             let as_u32 = || u32::try_from(value).map_err(|_| PdError::LIMIT_EXCEEDED);
             match field {
                 RecordField::Target => {
@@ -339,9 +367,9 @@ impl DriveAccess<'_> {
                     r.deceleration = r.acceleration;
                 }
             }
-            if !self.objects.set_record(axis, n, &r) {
-                return Err(PdError::NOT_IN_STATE);
-            }
+            // stored at the next other access (a record that was read is
+            // there to store: set_record cannot refuse it)
+            self.pending = Some((axis, n, r));
         }
         Ok(())
     }
@@ -406,6 +434,7 @@ impl ParamAccess for DriveAccess<'_> {
     }
 
     fn read(&mut self, addr: Addr) -> Result<i64, PdError> {
+        self.flush_record();
         if !lookup::is_catalogue_index(addr.index) {
             let index = self.index(addr.index);
             return self.read_object(index, addr.sub);
@@ -448,11 +477,15 @@ impl ParamAccess for DriveAccess<'_> {
     fn write(&mut self, addr: Addr, value: i64, _cyclic: bool) -> Result<Completion, PdError> {
         // every write here is a RAM write: the store is written only by a save
         if !lookup::is_catalogue_index(addr.index) {
+            self.flush_record();
             let index = self.index(addr.index);
             self.write_object(index, addr.sub, value)?;
             return Ok(Completion::Done);
         }
         let p = lookup::find(addr)?;
+        if !matches!(p.source, Source::SelectedRecord(_) | Source::JogRecord(..)) {
+            self.flush_record();
+        }
         if !p.writable {
             return Err(PdError::CANNOT_CHANGE);
         }

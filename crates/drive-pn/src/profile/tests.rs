@@ -433,3 +433,42 @@ fn p086_p052_jog_right_after_the_telegram_switched_to_positioning() {
     let s = b.d.axes()[0].record_status();
     assert!(s.jogging, "jog bit 8 one frame after the switch: {s:?}");
 }
+
+/// P-071 (telegram 0's record fields: target, profile velocity, end
+/// velocity, both accelerations): one telegram stores them in the selected
+/// record, and the window J401 shows that record afterwards as it did after
+/// each field's own write; the next frame with other values moves both.
+#[test]
+fn p071_telegram_0_stores_its_record_fields_and_the_window_shows_them() {
+    use drive_core::axis::Axis;
+    use drive_core::objects::records::J401;
+    use drive_core::DriveObjects;
+    let mut od = DriveObjects::new();
+    let mut axis = Axis::new(0);
+    let mut profile = super::Profile::new(&mut od, &axis);
+    let mut seen = Vec::new();
+    for (target, velocity, end, acc) in [(10_000i32, 5_000i32, 0i32, 10_000u32), (-2_000, 700, 100, 300)] {
+        let mut t = [0u8; 36];
+        t[0] = 0xE0;
+        t[2..4].copy_from_slice(&0x0406u16.to_be_bytes());
+        t[4..8].copy_from_slice(&target.to_be_bytes());
+        t[8..12].copy_from_slice(&velocity.to_be_bytes());
+        t[12..16].copy_from_slice(&end.to_be_bytes());
+        t[16..20].copy_from_slice(&acc.to_be_bytes());
+        profile.receive(&t, &mut od, &mut axis);
+        let n = od.record_selector(0);
+        let r = od.record(0, n).unwrap();
+        let window: Vec<i64> = (0..5).map(|k| od.get(J401, k + 1).unwrap()).collect();
+        let record = [
+            i64::from(r.target),
+            i64::from(r.profile_velocity),
+            i64::from(r.end_velocity),
+            i64::from(r.acceleration),
+            i64::from(r.deceleration),
+        ];
+        assert_eq!(window, record, "the window shows the record");
+        assert_eq!(r.acceleration, r.deceleration, "both accelerations");
+        seen.push(record);
+    }
+    assert!(seen[0].iter().zip(&seen[1]).all(|(a, b)| a != b), "{seen:?}");
+}
