@@ -25,7 +25,7 @@ fn main() -> ExitCode {
     let cli = Cli::parse();
     let result = match &cli.command {
         None => cli::demo::demo(&DemoArgs::default()),
-        Some(Command::Demo(a)) if a.fieldbus == Fieldbus::Profinet && a.plant != Plant::Rigid => {
+        Some(Command::Demo(a)) if a.fieldbus == Fieldbus::Profinet && a.plant() != Plant::Rigid => {
             Err("--plant electrical: the EtherCAT demo only, so far".to_string())
         }
         Some(Command::Demo(a)) if a.fieldbus == Fieldbus::Profinet => cli::demo_pn::demo(a),

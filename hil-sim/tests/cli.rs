@@ -112,6 +112,8 @@ fn serve_plant_fault_needs_the_electrical_plant_and_an_unknown_plant_is_refused(
             "lo",
             "--fieldbus",
             bus,
+            "--plant",
+            "rigid",
             "--plant-fault",
             "short",
         ]);

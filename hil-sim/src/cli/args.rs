@@ -48,12 +48,26 @@ pub struct DemoArgs {
     /// [default: target/hil-sim-demo.svg, PROFINET: target/hil-sim-demo-pn.svg].
     #[arg(long, value_name = "FILE.svg")]
     pub plot: Option<PathBuf>,
-    /// EtherCAT only: the motor model. `rigid`: the commanded torque acts one
-    /// control cycle later (cheap); `electrical`: the current loop at 16 kHz on
-    /// a PMSM behind an inverter, the same mechanics (the summary adds
-    /// current-loop figures, the plot id/iq and the phase currents).
-    #[arg(long, value_enum, value_name = "MODEL", default_value_t = Plant::Rigid)]
-    pub plant: Plant,
+    /// EtherCAT only: the motor model. `electrical` (the default): the current
+    /// loop at 16 kHz on a PMSM behind an inverter (the summary adds
+    /// current-loop figures, the plot id/iq and the phase currents);
+    /// `rigid`: the same mechanics with the commanded torque acting one
+    /// control cycle later (torque in, cheap). The PROFINET demo runs the
+    /// rigid model (and refuses `electrical`, so far) [default: electrical
+    /// on EtherCAT].
+    #[arg(long, value_enum, value_name = "MODEL")]
+    pub plant: Option<Plant>,
+}
+
+impl DemoArgs {
+    /// The motor model the demo runs: `--plant`, else the electrical plant
+    /// on EtherCAT and the rigid model on PROFINET.
+    pub fn plant(&self) -> Plant {
+        self.plant.unwrap_or(match self.fieldbus {
+            Fieldbus::Ethercat => Plant::Electrical,
+            Fieldbus::Profinet => Plant::Rigid,
+        })
+    }
 }
 
 /// A fault of the electrical plant (`serve --plant-fault`).
@@ -102,13 +116,14 @@ impl PlantFault {
     }
 }
 
-/// The motor model of `demo --plant` (`hil_sim::electrical::PlantModel`).
+/// The motor model of `demo --plant` and `serve --plant`
+/// (`hil_sim::electrical::PlantModel`).
 #[derive(Debug, Clone, Copy, Default, PartialEq, Eq, ValueEnum)]
 pub enum Plant {
-    /// The rigid rotor, torque in.
-    #[default]
+    /// The rigid rotor, torque in (where a test needs its speed).
     Rigid,
-    /// The current loop on the PMSM plant.
+    /// The current loop on the PMSM plant (the default).
+    #[default]
     Electrical,
 }
 
@@ -165,11 +180,12 @@ pub struct ServeArgs {
     /// since the start) to this pcap file.
     #[arg(long, value_name = "FILE")]
     pub pcap: Option<PathBuf>,
-    /// The motor model of every axis, both fieldbuses (`rigid`: torque in, the
-    /// default, cheap enough for 128 moving drives; `electrical`: the current
-    /// loop at 16 kHz on the PMSM plant, 6077h/6078h (PNU 1102) from the measured iq,
-    /// about 36 ms of host time per moving axis and simulated second).
-    #[arg(long, value_enum, value_name = "MODEL", default_value_t = Plant::Rigid)]
+    /// The motor model of every axis, both fieldbuses (`electrical`, the
+    /// default: the current loop at 16 kHz on the PMSM plant, 6077h/6078h
+    /// (PNU 1102) from the measured iq, about 36 ms of host time per moving
+    /// axis and simulated second; `rigid`: torque in, cheap enough for 128
+    /// moving drives).
+    #[arg(long, value_enum, value_name = "MODEL", default_value_t = Plant::Electrical)]
     pub plant: Plant,
     /// `--plant electrical` only: a fault of axis A's plant on
     /// every drive, from the start (the power stage shows it when its gates

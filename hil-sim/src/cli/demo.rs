@@ -252,12 +252,12 @@ pub fn demo(args: &DemoArgs) -> Result<(), String> {
         let mut s = sim.borrow_mut();
         s.drives_mut()[0].motors[0].switches_mut().reference = PositionInput::above(REFERENCE_SWITCH_INC);
         s.drives_mut()[0]
-            .set_plant(args.plant.into(), PLANT_SEED)
+            .set_plant(args.plant().into(), PLANT_SEED)
             .map_err(|e| format!("the electrical plant's parameters: {e:?}"))?;
     }
     println!(
         "hil-sim demo: ethercrab (in-process) -> simulated ESC -> drive firmware -> {}",
-        match args.plant {
+        match args.plant() {
             Plant::Rigid => "simulated motor (rigid, torque in)",
             Plant::Electrical => "current loop (16 kHz) -> simulated PMSM and inverter",
         }

@@ -65,6 +65,10 @@ ABORT_TOO_LOW, ABORT_TOO_HIGH = 0x06090032, 0x06090031
 FLIP_S = 0.010
 SETTLE_S = 0.004
 SETTLE_FRAMES = 4
+# a half period has at least this many frames (SETTLE_FRAMES + 6 settled)
+FLIP_FRAMES = 10
+# settled frames the fixed-length square waves collect at least
+MIN_SETTLED = 60
 
 
 class Axis:
@@ -101,23 +105,30 @@ class Axis:
         L.write(self.m, 0, index, sub, value.to_bytes(n, "little"))
         self.cycle(2)
 
-    def square(self, per_mille, seconds, stop=None):
+    def square(self, per_mille, seconds, stop=None, min_settled=0):
         """6071h = +-per_mille, the sign flipped every FLIP_S (the first half
-        period FLIP_S/2); frames as (t since start, 6077h, 6078h, 6041h,
-        ms since the last flip) until `seconds` or stop(frame)."""
+        period FLIP_S/2) but after FLIP_FRAMES frames at the earliest; frames
+        as (t since start, 6077h, 6078h, 6041h, s since the last flip) until
+        `seconds` and min_settled settled frames (at most 20 x `seconds`), or
+        stop(frame). Counting frames too keeps the settled frames of a half
+        period when a loaded machine stretches the master's cycle (9 settled
+        frames in 0.2 s were seen with 1 ms frames taking 5 ms)."""
         start = time.monotonic()
         frames = []
         flipped = 0
+        flip_t = -FLIP_S / 2
+        n_settled = 0
+        want = per_mille
         while True:
             t = time.monotonic() - start
-            if t >= seconds:
+            if t >= seconds and (n_settled >= min_settled or t >= 20 * seconds):
                 break
-            k = int((t + FLIP_S / 2) / FLIP_S)
-            want = per_mille if k % 2 == 0 else -per_mille
-            if want != self.torque:
+            if t - flip_t >= FLIP_S and len(frames) - flipped >= FLIP_FRAMES:
+                want = -want
+                flip_t = t
                 flipped = len(frames)
             self.torque = want
-            since_flip = t + FLIP_S / 2 - k * FLIP_S
+            since_flip = t - flip_t
             self.cycle()
             # settled: SETTLE_S since the flip and SETTLE_FRAMES frames (a
             # frame delayed on a loaded machine carries an older value)
@@ -125,6 +136,7 @@ class Axis:
                 since_flip = 0.0
             f = (time.monotonic() - start, self.actual_torque, self.current, self.sw, since_flip, self.torque)
             frames.append(f)
+            n_settled += len(settled([f]))
             if stop and stop(f):
                 break
         self.torque = 0
@@ -155,7 +167,7 @@ def motor_data(s, tau_ms, u11_ms):
 
 def current_limit(axis):
     axis.sdo(0x6073, 0, 500, 2)
-    frames = settled(axis.square(1000, 0.2))
+    frames = settled(axis.square(1000, 0.2, min_settled=MIN_SETTLED))
     bad = [(t, c) for _, t, c, _, _, d in frames if abs(t - 500 * (1 if d > 0 else -1)) > 10 or abs(c - 500 * (1 if d > 0 else -1)) > 10]
     over = [(t, c) for _, t, c, _, _, _ in frames if max(abs(t), abs(c)) > 510]
     check(len(frames) > 30, f"6073h = 50 %: {len(frames)} settled frames")

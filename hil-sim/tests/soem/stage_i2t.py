@@ -85,7 +85,7 @@ def run(m, args):
     axis.enable()
     # 1. 6073h lowered
     axis.sdo(0x6073, 0, 250, 2)
-    peak(MP.settled(axis.square(1000, 0.2)), 250, "6073h = 25 %")
+    peak(MP.settled(axis.square(1000, 0.2, min_settled=MP.MIN_SETTLED)), 250, "6073h = 25 %")
     # 2. and 3. 6073h (and 6072h, the max torque) raised above the power stage's maximum
     axis.sdo(0x6072, 0, 5000, 2)
     axis.sdo(0x6073, 0, 5000, 2)
@@ -108,7 +108,7 @@ def run(m, args):
     check(abs(warn[0] - t80) <= 0.03 * t80 + 0.036, f"stage i2t: warning at {warn[0]:.3f} s, closed form {t80:.3f} s")
     check(abs(limited[0] - t100) <= 0.03 * t100 + 0.036, f"stage i2t: limit at {limited[0]:.3f} s, closed form {t100:.3f} s")
     # held at the stage's rated current
-    held = MP.settled(axis.square(5000, 0.3))
+    held = MP.settled(axis.square(5000, 0.3, min_settled=MP.MIN_SETTLED))
     peak(held, STAGE_RATED, "stage i2t limiting: its rated current")
     nowarn = [f for f in held if not f[3] & WARNING]
     check(not nowarn, f"stage i2t: bit 7 while limited: missing in {len(nowarn)}")

@@ -14,10 +14,11 @@ extrapolate nothing), one drive, axis A:
   2. cst (6060h = 10) with the defaults: 6071h = 10 % of the rated torque
      leaves the axis still, statusword bit 11 (internal limit) set.
   3. G472 = G475 = --limit (0.1 % of I10) by SDO in Op: the same 6071h now
-     moves the axis forward; 6077h follows 6071h while the axis accelerates;
+     moves the axis forward; 6077h follows 6071h within 2 % (the measured
+     iq times kt on the electrical plant) while the axis accelerates;
      the speed settles at the limit (G472 x I10, within 5 %).
   4. pt (6060h = 4, 6087h = 0: a step): 6071h = -10 % moves it back and 6077h
-     follows; the speed settles at -G475 x I10.
+     follows (within 2 %); the speed settles at -G475 x I10.
 
 Prints `FAIL: …` for every check that failed; exit status 0 when none did.
 """
@@ -93,7 +94,12 @@ class Axis:
             seen.append((self.actual_torque, self.velocity))
         # the first frames see the set-point arrive; then the drive delivers it
         followed = [t for t, v in seen[10:50] if abs(v) < 0.8 * limit_inc_per_s]
-        check(followed and all(t == per_mille for t in followed), f"{what}: 6077h follows 6071h = {per_mille} while accelerating: {followed[:8]}")
+        # 6077h is kt times the current loop's measured iq on the electrical
+        # plant (the rigid model shows the demand): within 2 % of 6071h, as
+        # cst_electrical.py checks (the ADC's noise and count)
+        bad = [t for t in followed if abs(t - per_mille) > 0.02 * abs(per_mille)]
+        check(followed and not bad, f"{what}: 6077h follows 6071h = {per_mille} within 2 % while accelerating: "
+              f"off in {len(bad)} of {len(followed)}: {followed[:8]}")
         self.cycle(1500)
         moved = (self.position - start + (1 << 31)) % (1 << 32) - (1 << 31)
         direction = 1 if per_mille > 0 else -1
