@@ -24,6 +24,10 @@ ITEM = re.compile(r"^- (?:\[[ x]\] )?\*{0,2}([CEP])-(\d{3})\*{0,2}\s*(?:—\s*)?
 
 
 def items():
+    if not any(spec.glob("features-*.md")):
+        # a worktree or clone without ../shared beside it: say so rather
+        # than write an empty table over the real one
+        sys.exit(f"conformance.py: no spec checklists in {spec} (features-*.md); set up ../shared first")
     out = []
     for f in sorted(spec.glob("features-*.md")):
         for line in f.read_text().splitlines():

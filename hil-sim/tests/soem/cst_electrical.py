@@ -57,13 +57,7 @@ def run(m, args):
     s = m.slaves[0]
     for index in (T.G472, T.G475):
         s.sdo_write(index, 0, (1000).to_bytes(2, "little"))
-    for a in (0x1C12, 0x1C13):
-        s.sdo_write(a, 0, b"\x00")
-    L.write_map(s, 0x1600, T.RX)
-    L.write_map(s, 0x1A00, T.TX)
-    for a, pdo in ((0x1C12, 0x1600), (0x1C13, 0x1A00)):
-        s.sdo_write(a, 1, pdo.to_bytes(2, "little"))
-        s.sdo_write(a, 0, b"\x01")
+    L.map_one_pdo_each(s, T.RX, T.TX)
     axis = T.to_op(m)
     axis.enable(T.CST)
     limit = args.i10

@@ -421,6 +421,37 @@ def write_map(s, pdo, entries):
     s.sdo_write(pdo, 0, bytes([len(entries)]))
 
 
+def map_one_pdo_each(s, rx, tx):
+    """Axis A's process data as one RxPDO (1600h = `rx`) and one TxPDO
+    (1A00h = `tx`), assigned alone in 1C12h/1C13h."""
+    for a in (0x1C12, 0x1C13):
+        s.sdo_write(a, 0, b"\x00")
+    write_map(s, 0x1600, rx)
+    write_map(s, 0x1A00, tx)
+    for a, pdo in ((0x1C12, 0x1600), (0x1C13, 0x1A00)):
+        s.sdo_write(a, 1, pdo.to_bytes(2, "little"))
+        s.sdo_write(a, 0, b"\x01")
+
+
+def to_op(m, axis_class):
+    """The mapping taken over (config_map), Safe-Op, then Op with the
+    process data running: the axis (`axis_class(m)`, cycling the frames)."""
+    m.config_map()
+    axis = axis_class(m)
+    m.state = SAFEOP
+    m.write_state()
+    axis.cycle(50)
+    m.state = OP
+    m.write_state()
+    for _ in range(300):
+        axis.cycle(10)
+        if m.read_state() == OP:
+            break
+    else:
+        raise Fatal(f"Op not reached: {state_report(m)}")
+    return axis
+
+
 def remap(s):
     for a in ASSIGN:
         s.sdo_write(a, 0, b"\x00")

@@ -216,26 +216,8 @@ def run(m, args):
     L.scan(m, 1)
     check(m.read_state() == L.PREOP, f"Pre-Op: {L.state_report(m)}")
     s = m.slaves[0]
-    for a in (0x1C12, 0x1C13):
-        s.sdo_write(a, 0, b"\x00")
-    L.write_map(s, 0x1600, RX)
-    L.write_map(s, 0x1A00, TX)
-    for a, pdo in ((0x1C12, 0x1600), (0x1C13, 0x1A00)):
-        s.sdo_write(a, 1, pdo.to_bytes(2, "little"))
-        s.sdo_write(a, 0, b"\x01")
-    m.config_map()
-    axis = Axis(m)
-    m.state = L.SAFEOP
-    m.write_state()
-    axis.cycle(50)
-    m.state = L.OP
-    m.write_state()
-    for _ in range(300):
-        axis.cycle(10)
-        if m.read_state() == L.OP:
-            break
-    else:
-        raise L.Fatal(f"Op not reached: {L.state_report(m)}")
+    L.map_one_pdo_each(s, RX, TX)
+    axis = L.to_op(m, Axis)
     refused(axis)
     # the wiring, then the commutation offset: B42 injects in the rotor's frame
     phase_test(axis)

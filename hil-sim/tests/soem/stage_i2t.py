@@ -62,26 +62,8 @@ def run(m, args):
     s = m.slaves[0]
     for index in (T.G472, T.G475):
         s.sdo_write(index, 0, (1000).to_bytes(2, "little"))
-    for a in (0x1C12, 0x1C13):
-        s.sdo_write(a, 0, b"\x00")
-    L.write_map(s, 0x1600, T.RX)
-    L.write_map(s, 0x1A00, MP.TX)
-    for a, pdo in ((0x1C12, 0x1600), (0x1C13, 0x1A00)):
-        s.sdo_write(a, 1, pdo.to_bytes(2, "little"))
-        s.sdo_write(a, 0, b"\x01")
-    m.config_map()
-    axis = MP.Axis(m)
-    m.state = L.SAFEOP
-    m.write_state()
-    axis.cycle(50)
-    m.state = L.OP
-    m.write_state()
-    for _ in range(300):
-        axis.cycle(10)
-        if m.read_state() == L.OP:
-            break
-    else:
-        raise L.Fatal(f"Op not reached: {L.state_report(m)}")
+    L.map_one_pdo_each(s, T.RX, MP.TX)
+    axis = L.to_op(m, MP.Axis)
     axis.enable()
     # 1. 6073h lowered
     axis.sdo(0x6073, 0, 250, 2)

@@ -120,13 +120,7 @@ def run(m, args):
         code = L.sdo_abort(lambda: s.sdo_write(index, 0, (1001).to_bytes(2, "little")))
         check(code == ABORT_VALUE_TOO_HIGH, f"{index:04X}h = 1001 refused with 0609 0031h: {code}")
         check(L.sdo_u(s, index, 0) == 0, f"{index:04X}h unchanged after the refusal")
-    for a in (0x1C12, 0x1C13):
-        s.sdo_write(a, 0, b"\x00")
-    L.write_map(s, 0x1600, RX)
-    L.write_map(s, 0x1A00, TX)
-    for a, pdo in ((0x1C12, 0x1600), (0x1C13, 0x1A00)):
-        s.sdo_write(a, 1, pdo.to_bytes(2, "little"))
-        s.sdo_write(a, 0, b"\x01")
+    L.map_one_pdo_each(s, RX, TX)
     i10 = args.i10
     axis = to_op(m)
 
@@ -166,20 +160,7 @@ def run(m, args):
 def to_op(m):
     """The mapping taken over (config_map), Safe-Op, then Op with the
     process data running; the axis."""
-    m.config_map()
-    axis = Axis(m)
-    m.state = L.SAFEOP
-    m.write_state()
-    axis.cycle(50)
-    m.state = L.OP
-    m.write_state()
-    for _ in range(300):
-        axis.cycle(10)
-        if m.read_state() == L.OP:
-            break
-    else:
-        raise L.Fatal(f"Op not reached: {L.state_report(m)}")
-    return axis
+    return L.to_op(m, Axis)
 
 
 def main():
