@@ -7,7 +7,7 @@
 //! the axis commands a d-axis voltage open loop ([`Injection`]); a d current
 //! makes no torque, the rotor stays where it is. The loop reports per cycle
 //! the mean d voltage it applied and the mean d current it measured over the
-//! same interval ([`DAxisMeans`]). The steps:
+//! same interval ([`DAxisMeans`](crate::axis::DAxisMeans)). The steps:
 //!
 //! 1. **probe**: a small voltage (a tenth of the rated current through the
 //!    dictionary's R), four times larger each time until the current reaches
