@@ -270,6 +270,10 @@ fn startup_phase(cpu: Option<&str>) {
     eprintln!("  start-up phase: KickCAT brings 2 drives to Op ...");
     let mut line = common::soem_line::Line::with_serve_args("u", 2, 120, &dir, &more);
     let (n1018, n6040) = (name(0x1018), name(0x6040));
+    // the arguments hil-sim/tests/kickcat.rs gives the script (I423 raised
+    // for the csp move, its tolerances: 1/16 rev tracking, I22's 1/360 rev end)
+    let i423 = format!("{:#06x}", drive_ecat::params::I423);
+    let (tol, end_tol) = (((1u32 << 20) / 16).to_string(), ((1u32 << 20) / 360).to_string());
     let (child, script) = line.spawn(
         std::path::Path::new(&py),
         "kickcat_line.py",
@@ -282,6 +286,14 @@ fn startup_phase(cpu: Option<&str>) {
             &n1018,
             "--name-6040",
             &n6040,
+            "--i423-index",
+            &i423,
+            "--i423-ms",
+            "500",
+            "--tolerance",
+            &tol,
+            "--end-tolerance",
+            &end_tol,
         ],
     );
     let (status, _) = common::watch_script(child, &script, Duration::from_secs(90));
