@@ -251,8 +251,8 @@ mod app {
                     guard(&io);
                     *cmd = tasks::control(drive, timer, now, &io);
                     seam.lock(|l| {
-                        for (l, c) in l.iter_mut().zip(cmd.iter()) {
-                            l.command(c);
+                        for ((l, c), a) in l.iter_mut().zip(cmd.iter()).zip(drive.axes()) {
+                            l.command(c, a.motor());
                         }
                     });
                 }

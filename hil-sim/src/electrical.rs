@@ -230,22 +230,8 @@ impl ElectricalAxis {
     /// it was. The plant (the motor itself) keeps its own data: motor data
     /// that do not match it detune the loop, as on a real drive.
     pub fn set_motor_data(&mut self, m: &drive_ecat::axis::MotorData) -> Result<(), foc::ParamError> {
-        let kt = m.torque_constant_nm_per_a;
-        let p = u32::from(m.pole_pairs.max(1));
-        let motor = MotorData {
-            r_ohm: m.r_ohm,
-            ld_h: m.ld_h,
-            lq_h: m.lq_h,
-            psi_vs: kt / (1.5 * p as f32),
-            pole_pairs: p,
-            rated_current_a: m.rated_current_a,
-            max_current_a: m.rated_current_a * f32::from(m.max_current_per_mille) * 1e-3,
-            thermal_time_constant_s: m.thermal_time_constant_s,
-        };
-        let params = LoopParams {
-            omega_c_rad_s: core::f32::consts::TAU * m.bandwidth_hz,
-            ..self.params
-        };
+        let motor = m.current_loop();
+        let params = m.loop_params(self.params);
         // B05: the encoder position of the d axis along phase a
         self.foc.set_commutation_offset(m.commutation_offset_inc);
         if motor == self.motor && params == self.params {

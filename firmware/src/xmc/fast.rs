@@ -27,11 +27,16 @@
 //! fault the axis again at once (the drive core's monitor raises it on
 //! every cycle that carries it), and the axis could never be enabled again.
 //!
-//! The board's scaling and the motor are the constants of [`board`]: all
-//! assumptions until a power board is at hand (docs/hardware.md).
+//! The motor is the dictionary's (group B, 6073h/6075h: the drive core's
+//! `MotorData`, converted once by `MotorData::current_loop`): the control
+//! cycle hands it over with its command, and the fast task applies a changed
+//! set before its next step (gains by pole-zero cancellation, the commutation
+//! offset B05, the torque constant the command divides by). The board's
+//! scaling and protection are the constants of [`board`]: all assumptions
+//! until a power board is at hand (docs/hardware.md).
 
 use super::motor::{Motor, DEAD_NS, PWM_HZ};
-use drive_ecat::axis::{AxisCommand, AxisIo, CurrentActual, CurrentTrip};
+use drive_ecat::axis::{AxisCommand, AxisIo, CurrentActual, CurrentTrip, MotorData};
 use foc::{Dq, FocAxis, Sample, Trip};
 use xmc_motor::pwm::Duty;
 
@@ -56,10 +61,11 @@ pub mod board {
     /// Increments (2^20 per revolution) per encoder count.
     pub const INC_PER_COUNT: i32 = ((1u32 << 20) / (4 * ENCODER_LINES)) as i32;
     const _: () = assert!(INC_PER_COUNT as u32 * 4 * ENCODER_LINES == 1 << 20);
-    /// Encoder increments of the d axis (the commutation offset): 0, i.e.
-    /// the rotor assumed aligned with phase U at power-on. An incremental
-    /// encoder needs a phasing procedure before the loop can commutate
-    /// (docs/hardware.md: not done yet).
+    /// Encoder increments of the d axis (the commutation offset) until the
+    /// dictionary's B05 arrives with the first control cycle: 0, i.e. the
+    /// rotor assumed aligned with phase U at power-on. An incremental
+    /// encoder needs B41 "calibrate motor" after each power-on before the
+    /// loop can commutate (docs/hardware.md).
     pub const COMMUTATION_OFFSET_INC: u32 = 0;
     /// Compare value of a full PWM period as the loop computes it: 2^15, so
     /// the CCU8's Q16 duty is twice the loop's compare value (the CCU8
@@ -74,9 +80,11 @@ pub mod board {
         shunts: Shunts::Two,
         commutation_offset_inc: COMMUTATION_OFFSET_INC,
     };
-    /// The motor: the simulator's default servo (`foc::MotorData::default_servo`:
-    /// 3.6 Ω, 12 mH, 4 pole pairs, kt 0.65 N·m/A, 2 A rated, 6 A max). The
-    /// dictionary's motor data do not reach the board's loop yet.
+    /// The motor until the dictionary's data arrive with the first control
+    /// cycle ([`super::Link::command`]): the simulator's default servo
+    /// (`foc::MotorData::default_servo`: 3.6 Ω, 12 mH, 4 pole pairs, kt
+    /// 0.65 N·m/A, 2 A rated, 6 A max), which is also what the dictionary
+    /// declares by default.
     pub const MOTOR: MotorData = MotorData::default_servo();
     /// The loop at the image's PWM rate with ω_c = 2π·1 kHz, dead time as
     /// the CCU8's.
@@ -97,8 +105,13 @@ pub mod board {
 /// One axis between the control cycle and the fast task.
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct Link {
-    /// Torque constant of the loop, N·m/A.
+    /// Torque constant of the loop, N·m/A (the motor data's B17 once the
+    /// fast task applied them).
     kt: f32,
+    /// Control → fast: the motor data last handed over.
+    motor: Option<MotorData>,
+    /// `motor` changed and the fast task has not applied it yet.
+    motor_new: bool,
     /// Control → fast: power stage commanded on.
     on: bool,
     /// Control → fast: iq reference, A.
@@ -132,6 +145,8 @@ impl Link {
     pub const fn new(kt: f32) -> Link {
         Link {
             kt,
+            motor: None,
+            motor_new: false,
             on: false,
             iq_ref_a: 0.0,
             iq_sum_a: 0.0,
@@ -148,9 +163,16 @@ impl Link {
     }
 
     /// The control cycle's command: iq = torque/kt (id = 0), the power
-    /// stage; no current with the power stage off.
+    /// stage; no current with the power stage off. `motor`: the axis'
+    /// motor data in force (the dictionary's); a change is applied by the
+    /// fast task before its next step (a set the loop refuses leaves it as
+    /// it was; the dictionary refuses such values where they are written).
     #[inline]
-    pub fn command(&mut self, c: &AxisCommand) {
+    pub fn command(&mut self, c: &AxisCommand, motor: &MotorData) {
+        if self.motor.as_ref() != Some(motor) {
+            self.motor = Some(*motor);
+            self.motor_new = true;
+        }
         self.on = c.power_stage;
         self.iq_ref_a = if c.power_stage { c.torque_nm / self.kt } else { 0.0 };
     }
@@ -259,6 +281,19 @@ impl FastLoop {
                 link.trip_reported = false;
             }
             *was_on = on;
+            if link.motor_new {
+                link.motor_new = false;
+                if let Some(m) = &link.motor {
+                    // gains by pole-zero cancellation, kt, the currents
+                    if foc
+                        .set_params(m.current_loop(), m.loop_params(board::LOOP))
+                        .is_ok()
+                    {
+                        link.kt = m.torque_constant_nm_per_a;
+                    }
+                    foc.set_commutation_offset(m.commutation_offset_inc);
+                }
+            }
             let trapped = self.motor.trapped(i);
             let (counts, phase_error) = self.motor.encoder(i);
             let position_inc = counts.wrapping_mul(board::INC_PER_COUNT);

@@ -126,6 +126,33 @@ impl MotorData {
         }
     }
 
+    /// The current loop's motor data (crate `foc`, the layer below): the
+    /// flux linkage ψ = kt/(1.5·p) from B17 and B10, the maximum current
+    /// 6075h × 6073h. One conversion for every shell that runs the loop
+    /// (the simulator's electrical axis, the board's fast task).
+    pub fn current_loop(&self) -> foc::MotorData {
+        let p = u32::from(self.pole_pairs.max(1));
+        foc::MotorData {
+            r_ohm: self.r_ohm,
+            ld_h: self.ld_h,
+            lq_h: self.lq_h,
+            psi_vs: self.torque_constant_nm_per_a / (1.5 * p as f32),
+            pole_pairs: p,
+            rated_current_a: self.rated_current_a,
+            max_current_a: self.rated_current_a * f32::from(self.max_current_per_mille) * 1e-3,
+            thermal_time_constant_s: self.thermal_time_constant_s,
+        }
+    }
+
+    /// The current loop's parameters: `base` (the shell's PWM rate and dead
+    /// time) with ω_c = 2π·B64.
+    pub fn loop_params(&self, base: foc::LoopParams) -> foc::LoopParams {
+        foc::LoopParams {
+            omega_c_rad_s: core::f32::consts::TAU * self.bandwidth_hz,
+            ..base
+        }
+    }
+
     /// 6076h rated torque = kt × 6075h, N·m.
     pub fn rated_torque_nm(&self) -> f32 {
         self.torque_constant_nm_per_a * self.rated_current_a
