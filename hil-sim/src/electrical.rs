@@ -312,13 +312,7 @@ impl ElectricalAxis {
             let h = Nanos::from_ns(t_next - t_prev);
             let sample = self.plant.sample();
             let out = match injection {
-                Some(j) => {
-                    let v = foc::Dq { d: j.ud_v, q: 0.0 };
-                    match j.angle {
-                        Some(a) => self.foc.step_voltage_at(&sample, v, a),
-                        None => self.foc.step_voltage(&sample, v),
-                    }
-                }
+                Some(j) => j.step(&mut self.foc, &sample),
                 None => self.foc.step(&sample, reference),
             };
             // the sample at this period's start is the centre of the last

@@ -6,8 +6,10 @@
 //! Per axis and period ([`FastLoop::period`]): the phase currents U and V
 //! (W = −U − V, two shunts) and the DC link from the ADC, the encoder
 //! position and phase-error flag from POSIF, the CCU8's trap flag; the
-//! current loop's step with the iq reference the control cycle set; the
-//! compare values to the CCU8's shadow registers (transferred at the period
+//! current loop's step with the iq reference the control cycle set (or a
+//! motor action's d voltage, whose d-axis means go back with the
+//! measurement: B41 "calibrate motor" phases the encoder on the board as in
+//! the simulator); the compare values to the CCU8's shadow registers (transferred at the period
 //! boundary). An axis runs (pins to the CCU8, gate enable high) only while
 //! the control cycle commands it on and neither the loop nor the trap has
 //! tripped; otherwise its pins are held low (`power-pins`) and the gate
@@ -36,7 +38,7 @@
 //! until a power board is at hand (docs/hardware.md).
 
 use super::motor::{Motor, DEAD_NS, PWM_HZ};
-use drive_ecat::axis::{AxisCommand, AxisIo, CurrentActual, CurrentTrip, MotorData};
+use drive_ecat::axis::{AxisCommand, AxisIo, CurrentActual, CurrentTrip, DAxisMeans, Injection, MotorData};
 use foc::{Dq, FocAxis, Sample, Trip};
 use xmc_motor::pwm::Duty;
 
@@ -116,6 +118,17 @@ pub struct Link {
     on: bool,
     /// Control → fast: iq reference, A.
     iq_ref_a: f32,
+    /// Control → fast: a motor action's d voltage instead of the current
+    /// controllers (B41 calibrate, B42 optimise, …; only with the power
+    /// stage on).
+    injection: Option<Injection>,
+    /// Fast → control: sums of the applied d voltage and the measured d
+    /// current over the periods in `periods` (the actions' measurement).
+    ud_sum_v: f32,
+    id_sum_a: f32,
+    /// The d voltage of the last period: the current sampled at this
+    /// period's centre pairs with it.
+    prev_ud_v: f32,
     /// Fast → control: sum of the measured iq since the last [`Link::io`], A.
     iq_sum_a: f32,
     /// PWM periods in `iq_sum_a`.
@@ -149,6 +162,10 @@ impl Link {
             motor_new: false,
             on: false,
             iq_ref_a: 0.0,
+            injection: None,
+            ud_sum_v: 0.0,
+            id_sum_a: 0.0,
+            prev_ud_v: 0.0,
             iq_sum_a: 0.0,
             periods: 0,
             iq_last_a: 0.0,
@@ -175,6 +192,7 @@ impl Link {
         }
         self.on = c.power_stage;
         self.iq_ref_a = if c.power_stage { c.torque_nm / self.kt } else { 0.0 };
+        self.injection = c.injection.filter(|_| c.power_stage);
     }
 
     /// The control cycle's inputs: the encoder position, its and the DC
@@ -196,6 +214,14 @@ impl Link {
         let encoder_ok = self.encoder_ok;
         let trip = if self.trip_reported { None } else { self.trip };
         self.trip_reported = self.trip.is_some();
+        let n = self.periods as f32;
+        let d_axis = fresh.then(|| DAxisMeans {
+            voltage_v: self.ud_sum_v / n,
+            current_a: self.id_sum_a / n,
+            interval_s: n / PWM_HZ as f32,
+        });
+        self.ud_sum_v = 0.0;
+        self.id_sum_a = 0.0;
         self.iq_sum_a = 0.0;
         self.periods = 0;
         self.encoder_ok = true;
@@ -206,6 +232,7 @@ impl Link {
                 trip,
                 stage_limit_a: self.stage_limit_a,
                 stage_warning: self.stage_warning,
+                d_axis,
                 ..CurrentActual::measured(self.kt * iq, iq)
             }),
             ..AxisIo::ready(self.position_inc)
@@ -308,13 +335,16 @@ impl FastLoop {
                 encoder_ok: !phase_error,
             };
             foc.enable(on && !trapped && link.trip.is_none());
-            let out = foc.step(
-                &sample,
-                Dq {
-                    d: 0.0,
-                    q: link.iq_ref_a,
-                },
-            );
+            let out = match &link.injection {
+                Some(j) => j.step(foc, &sample),
+                None => foc.step(
+                    &sample,
+                    Dq {
+                        d: 0.0,
+                        q: link.iq_ref_a,
+                    },
+                ),
+            };
             if on {
                 if link.trip.is_none() {
                     link.trip = if trapped {
@@ -337,6 +367,9 @@ impl FastLoop {
             }
             any_on |= run;
             let m = foc.measured();
+            link.ud_sum_v += link.prev_ud_v;
+            link.id_sum_a += m.current.d;
+            link.prev_ud_v = m.voltage.d;
             link.iq_last_a = m.current.q;
             link.iq_sum_a += m.current.q;
             link.periods = link.periods.saturating_add(1);

@@ -91,6 +91,20 @@ pub struct Injection {
     pub angle: Option<u32>,
 }
 
+impl Injection {
+    /// One PWM period of `foc` with this injection: the d voltage open loop
+    /// in the encoder's frame or at the fixed angle (the shells' fast loops,
+    /// board and simulator, all apply it so).
+    #[inline]
+    pub fn step(&self, foc: &mut foc::FocAxis, s: &foc::Sample) -> foc::PwmOut {
+        let v = foc::Dq { d: self.ud_v, q: 0.0 };
+        match self.angle {
+            Some(a) => foc.step_voltage_at(s, v, a),
+            None => foc.step_voltage(s, v),
+        }
+    }
+}
+
 /// A trip of the current loop's protection (the power stage is off within
 /// the PWM period that saw it).
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
