@@ -18,16 +18,13 @@
 mod cli;
 
 use clap::Parser;
-use cli::args::{Cli, Command, DemoArgs, Fieldbus, Plant};
+use cli::args::{Cli, Command, DemoArgs, Fieldbus};
 use std::process::ExitCode;
 
 fn main() -> ExitCode {
     let cli = Cli::parse();
     let result = match &cli.command {
         None => cli::demo::demo(&DemoArgs::default()),
-        Some(Command::Demo(a)) if a.fieldbus == Fieldbus::Profinet && a.plant() != Plant::Rigid => {
-            Err("--plant electrical: the EtherCAT demo only, so far".to_string())
-        }
         Some(Command::Demo(a)) if a.fieldbus == Fieldbus::Profinet => cli::demo_pn::demo(a),
         Some(Command::Demo(a)) => cli::demo::demo(a),
         Some(Command::Serve(a)) => cli::serve::serve(a),

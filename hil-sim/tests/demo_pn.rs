@@ -4,6 +4,7 @@
 //! one test runs it a second time and compares).
 #![allow(clippy::unwrap_used, clippy::expect_used, clippy::panic)]
 
+use hil_sim::electrical::PlantModel;
 use hil_sim::fb::pkw::Outcome;
 use hil_sim::fb::sequence::{self, milli_rev_to_inc, Observer, Phase, Report, Sample, CHAIN, SPEED_RPM};
 use nanos::Nanos;
@@ -35,9 +36,10 @@ impl Observer for Collect {
     }
 }
 
+/// The demo's run: the current loop on the electrical plant (its default).
 fn run() -> (Report, Collect) {
     let mut c = Collect::default();
-    let (report, _) = sequence::run(&mut c, None).expect("the exchange runs");
+    let (report, _) = sequence::run(&mut c, None, PlantModel::Electrical).expect("the exchange runs");
     (report, c)
 }
 

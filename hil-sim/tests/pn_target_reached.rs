@@ -10,6 +10,7 @@
 //! follows the window as C-048 / P-104 say; the test pins that down.
 #![allow(clippy::unwrap_used, clippy::expect_used, clippy::panic)]
 
+use hil_sim::electrical::PlantModel;
 use hil_sim::fb::sequence::{self, milli_rev_to_inc, Observer, Phase, Sample, CHAIN};
 use hil_sim::fb::zsw1_bits::{REACHED, TASK_ACK};
 use nanos::Nanos;
@@ -38,7 +39,7 @@ impl Observer for Collect {
 #[test]
 fn p104_p105_target_reached_holds_in_the_window_at_the_end_of_the_chain() {
     let mut c = Collect::default();
-    sequence::run(&mut c, None).expect("the exchange runs");
+    sequence::run(&mut c, None, PlantModel::Electrical).expect("the exchange runs");
     let last = milli_rev_to_inc(i64::from(CHAIN[2].0));
     let error = |s: &Sample| i64::from(s.pos_inc) - last;
     let start = c

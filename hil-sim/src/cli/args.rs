@@ -48,25 +48,20 @@ pub struct DemoArgs {
     /// [default: target/hil-sim-demo.svg, PROFINET: target/hil-sim-demo-pn.svg].
     #[arg(long, value_name = "FILE.svg")]
     pub plot: Option<PathBuf>,
-    /// EtherCAT only: the motor model. `electrical` (the default): the current
-    /// loop at 16 kHz on a PMSM behind an inverter (the summary adds
+    /// The motor model. `electrical` (the default): the current loop at
+    /// 16 kHz on a PMSM behind an inverter (on EtherCAT the summary adds
     /// current-loop figures, the plot id/iq and the phase currents);
     /// `rigid`: the same mechanics with the commanded torque acting one
-    /// control cycle later (torque in, cheap). The PROFINET demo runs the
-    /// rigid model (and refuses `electrical`, so far) [default: electrical
-    /// on EtherCAT].
+    /// control cycle later (torque in, cheap) [default: electrical].
     #[arg(long, value_enum, value_name = "MODEL")]
     pub plant: Option<Plant>,
 }
 
 impl DemoArgs {
     /// The motor model the demo runs: `--plant`, else the electrical plant
-    /// on EtherCAT and the rigid model on PROFINET.
+    /// (both fieldbuses).
     pub fn plant(&self) -> Plant {
-        self.plant.unwrap_or(match self.fieldbus {
-            Fieldbus::Ethercat => Plant::Electrical,
-            Fieldbus::Profinet => Plant::Rigid,
-        })
+        self.plant.unwrap_or(Plant::Electrical)
     }
 }
 

@@ -7,7 +7,7 @@
 //! the plot shows position, velocity, torque, following error and the ZSW1
 //! state with the phases marked.
 
-use super::args::{create_output, DemoArgs, DEFAULT_PLOT_PN};
+use super::args::{create_output, DemoArgs, Plant, DEFAULT_PLOT_PN};
 use hil_sim::fb::sequence::{self, Observer, Phase, Report, Sample, INC_PER_REV};
 use hil_sim::fb::{state_name, zsw1_state};
 use hil_sim::pcap::Recording;
@@ -143,7 +143,11 @@ pub fn demo(args: &DemoArgs) -> Result<(), String> {
     let mut plot_file = create_output(&plot_path, "plot")?;
     println!(
         "hil-sim demo --fieldbus profinet: Example Function block (in-process IO controller, 1 ms) -> \
-         simulated PROFINET drive -> simulated motor"
+         simulated PROFINET drive -> {}",
+        match args.plant() {
+            Plant::Rigid => "simulated motor (rigid, torque in)",
+            Plant::Electrical => "current loop (16 kHz) -> simulated PMSM and inverter",
+        }
     );
     let bar = indicatif::ProgressBar::new(Phase::ALL.len() as u64);
     if let Ok(style) = indicatif::ProgressStyle::with_template("  phase [{bar:21}] {pos}/{len} {msg}") {
@@ -157,7 +161,7 @@ pub fn demo(args: &DemoArgs) -> Result<(), String> {
             ..Trace::default()
         },
     };
-    let result = sequence::run(&mut printer, pcap);
+    let result = sequence::run(&mut printer, pcap, args.plant().into());
     printer.bar.finish_and_clear();
     let (report, pcap) = match result {
         Ok(r) => r,

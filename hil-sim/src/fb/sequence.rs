@@ -25,6 +25,7 @@ use super::controller::PnController;
 use super::pkw::{Access, Outcome, PkwClient};
 pub use super::report::{Observer, Phase, PhaseResult, Report, Sample, TargetResult};
 use super::{state_name, ExampleFb, FbInputs, FbOutputs, OPMODE_POS, OPMODE_VELO};
+use crate::electrical::PlantModel;
 use crate::pcap::Recording;
 use crate::pn::Command;
 use nanos::Nanos;
@@ -587,12 +588,24 @@ impl<O: Observer> Run<'_, O> {
     }
 }
 
-/// Runs the whole sequence against a fresh simulated drive; `obs` hears
-/// every change; with `pcap` every frame is recorded (returned at the end
-/// for the caller to flush). Errors only when the exchange itself fails;
-/// what the drive does wrong is a deviation in the report.
-pub fn run(obs: &mut impl Observer, pcap: Option<Recording>) -> Result<(Report, Option<Recording>), String> {
-    let ctl = PnController::connect(PnController::drive(), Nanos::from_ms(10), pcap)?;
+/// Seed of the electrical plant's ADC noise in the sequence's drive.
+pub const PLANT_SEED: u64 = 0x5EED_0F00;
+
+/// Runs the whole sequence against a fresh simulated drive whose axes run
+/// `plant`; `obs` hears every change; with `pcap` every frame is recorded
+/// (returned at the end for the caller to flush). Errors only when the
+/// exchange itself fails; what the drive does wrong is a deviation in the
+/// report.
+pub fn run(
+    obs: &mut impl Observer,
+    pcap: Option<Recording>,
+    plant: PlantModel,
+) -> Result<(Report, Option<Recording>), String> {
+    let mut drive = PnController::drive();
+    drive
+        .set_plant(plant, PLANT_SEED)
+        .map_err(|e| format!("the electrical plant's parameters: {e:?}"))?;
+    let ctl = PnController::connect(drive, Nanos::from_ms(10), pcap)?;
     let mut run = Run {
         ctl,
         fb: ExampleFb::new(),
