@@ -5,7 +5,9 @@
 //! `fb.py` in torque control, lowers the max current 6073h through the
 //! parameter access (PKW, PNU = the object's index) and sees the measured
 //! current limited: the response telegram's torque actual value (6077h,
-//! kt × the measured iq) and PNU 1102 (6078h).
+//! kt × the measured iq) and PNU 1102 (6078h); with `--i2t` the motor's i²t
+//! model (limit at 100 %, then the fault) and with `--short` the
+//! over-current trip.
 //!
 //! Needs root and `PROFINET_PY_PYTHON` as `tests/profinet.rs`; without
 //! either the test prints why and passes without running.
@@ -102,4 +104,17 @@ fn p030_e089_profinet_py_over_current_trip_of_a_shorted_leg_on_the_electrical_pl
         serve.contains("alarms: 1 sent, 1 acknowledged"),
         "its diagnosis alarm sent and acknowledged by the controller"
     );
+}
+
+/// C-038 and E-089 through profinet-py on the electrical plant
+/// (`current_limit.py --i2t`): B73 = 2 s and U11 = 0.4 s written by PKW;
+/// ±200 % of the rated torque gives the warning (ZSW1 bit 7) when the
+/// motor's thermal model reaches 100 %, at the first-order closed form
+/// t = −τ·ln(1 − 1/u) with the measured mean u of (i/I_r)² (within 10 % +
+/// 60 ms: the Python controller's cycle jitters), the current then held at
+/// the rated current (6077h within 3 % of 1000 ‰), and U11 later the fault
+/// with PNU 1600 = event 45 cause 1 ("Overtemp.motor i2t").
+#[test]
+fn c038_e089_profinet_py_motor_i2t_warning_limit_and_fault_on_the_electrical_plant() {
+    run_script("ei", &[], &["--i2t"], "C-038-i2t");
 }
