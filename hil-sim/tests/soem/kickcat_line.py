@@ -122,8 +122,11 @@ def main():
     # on a loaded machine `serve`'s answers took longer than 10 ms at times
     # (issue 33 point 6), KickCAT then failed its scan
     link.set_timeout(0.05)
-    bus = kickcat.Bus(link)
     for k in range(5):
+        # a fresh Bus for every try: after an init that failed half-way
+        # (a timeout on a loaded machine) KickCAT 2.5's create_mapping on the
+        # same Bus crashed the interpreter (a segmentation fault in CI)
+        bus = kickcat.Bus(link)
         try:
             bus.init(0.1)
             if len(bus.slaves()) == args.slaves and all(bus.get_state(s) == kickcat.State.PREOP for s in bus.slaves()):
