@@ -34,7 +34,7 @@
 
 use crate::motor::{EdgeList, IndexEvent, Motor, MotorOutputs, INC_PER_RAD};
 use drive_ecat::axis::{AxisCommand, CurrentActual, CurrentControl, CurrentTrip, DAxisMeans};
-use foc::{FocAxis, LoopParams, MotorData, PowerStage, Protection, Trip};
+use foc::{FocAxis, LoopParams, MotorData, PowerStage, Protection};
 use nanos::Nanos;
 use plant::{Plant, PlantParams, Shaft};
 
@@ -164,15 +164,7 @@ impl CurrentControl for ElectricalAxis {
             stage_limit_a: stage,
             stage_warning: warning,
             d_axis: self.d_cycle,
-            trip: self.foc.trip().map(|t| match t {
-                Trip::OverCurrent => CurrentTrip::OverCurrent,
-                Trip::PhaseSum => CurrentTrip::PhaseSum,
-                Trip::DcUnderVoltage => CurrentTrip::DcUnderVoltage,
-                Trip::DcOverVoltage => CurrentTrip::DcOverVoltage,
-                Trip::EncoderLost => CurrentTrip::EncoderLost,
-                Trip::MotorI2t => CurrentTrip::MotorI2t,
-                Trip::StageI2t => CurrentTrip::StageI2t,
-            }),
+            trip: self.foc.trip().map(CurrentTrip::from),
         })
     }
 }

@@ -108,10 +108,11 @@ fn p030_e089_profinet_py_over_current_trip_of_a_shorted_leg_on_the_electrical_pl
 
 /// C-038 and E-089 through profinet-py on the electrical plant
 /// (`current_limit.py --i2t`): B73 = 2 s and U11 = 0.4 s written by PKW;
-/// ±200 % of the rated torque gives the warning (ZSW1 bit 7) when the
+/// ±200 % of the rated torque is limited to the rated current when the
 /// motor's thermal model reaches 100 %, at the first-order closed form
 /// t = −τ·ln(1 − 1/u) with the measured mean u of (i/I_r)² (within 10 % +
-/// 60 ms: the Python controller's cycle jitters), the current then held at
+/// 60 ms: the Python controller's cycle stalls on a loaded machine; the
+/// mean over every response, the flips included), the current then held at
 /// the rated current (6077h within 3 % of 1000 ‰), and U11 later the fault
 /// with PNU 1600 = event 45 cause 1 ("Overtemp.motor i2t").
 #[test]

@@ -3,7 +3,7 @@
 use crate::fmath;
 use crate::params::{Gains, LoopParams, MotorData, ParamError};
 use crate::pi::CurrentPi;
-use crate::protect::{DcLink, I2t, I2tState, OverCurrent, PhaseSum, Trip};
+use crate::protect::{CurrentDeviation, DcLink, I2t, I2tState, OverCurrent, PhaseSum, Trip};
 use crate::seam::{PwmOut, Sample, Scaling, Shunts};
 use crate::svm::{compare_values, compensate_dead_time, svm, PwmCounts};
 use crate::transform::{clarke, inverse_park, park, Abc, AlphaBeta, Dq};
@@ -25,6 +25,8 @@ pub struct Protection {
     pub phase_sum: PhaseSum,
     /// DC-link window.
     pub dc_link: DcLink,
+    /// The current following its reference (an open phase).
+    pub deviation: CurrentDeviation,
     /// The power stage's current limit (its maximum current), A.
     pub stage_current_a: f32,
     /// The power stage's rated (continuous) current, A: its i²t model's
@@ -43,7 +45,8 @@ pub struct Protection {
 
 impl Protection {
     /// Trip at 9 A, phase sum within 0.3 A, DC link 400…800 V (400 V mains,
-    /// 565 V nominal), power stage 8 A maximum and 4 A rated with a thermal
+    /// 565 V nominal), the current error's mean square within a quarter of
+    /// the reference's + (0.1 A)² per i²t window, power stage 8 A maximum and 4 A rated with a thermal
     /// time constant of 5 s, the motor's i²t model limiting.
     pub const fn default_stage() -> Self {
         Self {
@@ -52,6 +55,10 @@ impl Protection {
             dc_link: DcLink {
                 min_v: 400.0,
                 max_v: 800.0,
+            },
+            deviation: CurrentDeviation {
+                share: 0.25,
+                floor_a: 0.1,
             },
             stage_current_a: 8.0,
             stage_rated_a: 4.0,
@@ -131,6 +138,12 @@ pub struct FocAxis {
     stage_limit_a: f32,
     /// The trip the i²t models ask for (motor first, then the stage).
     i2t_trip: Option<Trip>,
+    /// The current error's and the reference's squares summed over the
+    /// i²t window's periods with the current loop closed below half the
+    /// back-EMF's speed limit, and their count ([`CurrentDeviation`]).
+    deviation_sums: (f32, f32, u32),
+    /// The last window's current deviated.
+    deviation_trip: bool,
     measured: Measured,
 }
 
@@ -176,6 +189,8 @@ impl FocAxis {
             limit_a: 0.0,
             stage_limit_a: 0.0,
             i2t_trip: None,
+            deviation_sums: (0.0, 0.0, 0),
+            deviation_trip: false,
             measured: Measured::default(),
         })
         .map(|mut axis| {
@@ -198,6 +213,14 @@ impl FocAxis {
         }
         self.i2t_sum = 0.0;
         self.i2t_count = 0;
+        // the current's plausibility: judged when at least half the window
+        // counted (a window mostly at the voltage limit or open loop is not)
+        let (e, r, n) = self.deviation_sums;
+        if n >= I2T_DECIMATION / 2 {
+            let k = 1.0 / n as f32;
+            self.deviation_trip = self.protection.deviation.deviates(e * k, r * k);
+        }
+        self.deviation_sums = (0.0, 0.0, 0);
         self.refresh_limits();
     }
 
@@ -286,6 +309,8 @@ impl FocAxis {
     /// the next step).
     pub fn reset_trip(&mut self) {
         self.trip = None;
+        self.deviation_trip = false;
+        self.deviation_sums = (0.0, 0.0, 0);
     }
 
     /// What the last step measured.
@@ -403,6 +428,8 @@ impl FocAxis {
                 dc
             } else if !s.encoder_ok {
                 Some(Trip::EncoderLost)
+            } else if self.deviation_trip {
+                Some(Trip::MotorConnection)
             } else {
                 self.i2t_trip
             };
@@ -434,7 +461,19 @@ impl FocAxis {
         let (v, cut) = match command {
             Command::Current(reference) => {
                 let (d, q) = fmath::clamp_sym2(reference.d, reference.q, limit);
-                self.pi.step(g, Dq { d, q }, current, omega_e, v_max)
+                let out = self.pi.step(g, Dq { d, q }, current, omega_e, v_max);
+                // judged below half the speed at which the back-EMF takes
+                // the whole voltage: there a healthy winding always takes the
+                // current (R·I ≪ the voltage), even with the voltage at its
+                // limit, which is where an open phase drives the integrators
+                if omega_e.abs() * self.motor.psi_vs < 0.5 * v_max {
+                    let (ed, eq) = (d - current.d, q - current.q);
+                    let (e, r, n) = &mut self.deviation_sums;
+                    *e += ed * ed + eq * eq;
+                    *r += d * d + q * q;
+                    *n += 1;
+                }
+                out
             }
             Command::Voltage(v, _) => {
                 self.pi.reset();

@@ -24,6 +24,36 @@ pub enum Trip {
     /// The power stage's i²t model reached its fault level (its current
     /// limit was not obeyed).
     StageI2t,
+    /// The current does not follow its reference although the voltage has
+    /// room ([`CurrentDeviation`]): an open motor phase or a lost motor
+    /// connection.
+    MotorConnection,
+}
+
+/// Current-control plausibility: over a window, the mean square of the
+/// current error (reference − measured, dq) against the mean square of the
+/// reference, counted only in periods below half the speed at which the
+/// back-EMF takes the whole voltage (above it the loop may rightly not
+/// follow). A healthy first-order loop with
+/// ω_c ≫ the reference's changes leaves a small share (a step's error decays
+/// with 1/ω_c: 0.16 ms of a 16 ms window at 1 kHz); an open phase leaves the
+/// reference's component along the missing phase, half of its mean square
+/// on a turning rotor.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct CurrentDeviation {
+    /// Largest share of the reference's mean square the error's may reach.
+    pub share: f32,
+    /// Error (rms) that never trips, A: the ADC's noise and small references.
+    pub floor_a: f32,
+}
+
+impl CurrentDeviation {
+    /// True when the window's mean squares (error, reference; A²) are
+    /// implausible.
+    #[inline]
+    pub fn deviates(&self, error_sq: f32, reference_sq: f32) -> bool {
+        error_sq > self.share * reference_sq + self.floor_a * self.floor_a
+    }
 }
 
 /// Over-current: trips when any phase current's magnitude exceeds the threshold.

@@ -2,7 +2,7 @@
 
 use foc::params::{Gains, LoopParams, MotorData, Param, Violation};
 use foc::pi::limit_voltage_circle;
-use foc::protect::{current_limit, DcLink, I2t, I2tState, OverCurrent, PhaseSum, Trip};
+use foc::protect::{current_limit, CurrentDeviation, DcLink, I2t, I2tState, OverCurrent, PhaseSum, Trip};
 use foc::svm::{compare_values, compensate_dead_time, svm, Duty, PwmCounts};
 use foc::transform::*;
 use foc::trig::{angle_from_rad, sin_cos};
@@ -481,9 +481,16 @@ fn torque_reference_is_iq_through_the_torque_constant_with_id_zero() {
 #[test]
 fn stage_i2t_warns_then_limits_to_its_rated_current_then_trips() {
     let sc = Scaling::default_board();
+    // the sample below is fixed whatever the loop applies: a current that
+    // does not follow its reference, which the deviation check would trip
+    // on first (its own test below); off here
     let protection = Protection {
         stage_rated_a: 4.0,
         stage_tau_s: 0.1,
+        deviation: CurrentDeviation {
+            share: f32::INFINITY,
+            floor_a: f32::INFINITY,
+        },
         ..Protection::default_stage()
     };
     let mut a = FocAxis::new(
@@ -571,4 +578,53 @@ fn clamp_sym2_is_two_clamps() {
             }
         }
     }
+}
+
+/// The current-deviation check (`CurrentDeviation`, the open phase's
+/// witness): a healthy first-order step's error is a small share of the
+/// reference's mean square; a current that stays off its reference by half
+/// of it (the missing phase's component, a turning rotor) is beyond the
+/// quarter. Through the axis: a measured current that never follows a 2 A
+/// reference trips `MotorConnection` at the end of the first full window,
+/// the gates off in that period; one that follows never does.
+#[test]
+fn e089_a_current_that_does_not_follow_its_reference_trips_motor_connection() {
+    let d = Protection::default_stage().deviation;
+    // first order with ω_c = 2π·1 kHz over a 16 ms window, a 1 A step at
+    // its start: ∫e² = 1/(2ω_c) of 16 ms: 1 % of the reference's
+    let healthy = 1.0 / (2.0 * TAU as f32 * 1000.0) / 0.016;
+    assert!(!d.deviates(healthy, 1.0), "a healthy step");
+    assert!(d.deviates(0.5 * 4.0, 4.0), "half the mean square off (2 A)");
+    assert!(!d.deviates(0.5 * 0.01, 0.01), "0.1 A references: below the floor");
+    let run = |follows: bool| {
+        let mut a = FocAxis::new(
+            MotorData::default_servo(),
+            LoopParams::default_16k(),
+            Scaling::default_board(),
+            Protection::default_stage(),
+        )
+        .unwrap();
+        a.enable(true);
+        // at electrical angle 0: 2 A of id reads a = +2 A, b = c = −1 A
+        let s = if follows {
+            sample([2048 + 409, 2048 - 205, 2048 - 204], 2260)
+        } else {
+            sample([2048, 2048, 2048], 2260)
+        };
+        let reference = foc::Dq { d: 2.0, q: 0.0 };
+        for k in 1..=3 * foc::axis::I2T_DECIMATION {
+            let out = a.step(&s, reference);
+            if a.trip().is_some() {
+                assert!(!out.gate_enable, "gates off in the period of the verdict");
+                return Some(k);
+            }
+        }
+        None
+    };
+    assert_eq!(run(true), None, "a current that follows");
+    assert_eq!(
+        run(false),
+        Some(foc::axis::I2T_DECIMATION),
+        "the first full window's verdict"
+    );
 }

@@ -39,7 +39,7 @@
 
 use super::motor::{Motor, DEAD_NS, PWM_HZ};
 use drive_ecat::axis::{AxisCommand, AxisIo, CurrentActual, CurrentTrip, DAxisMeans, Injection, MotorData};
-use foc::{Dq, FocAxis, Sample, Trip};
+use foc::{Dq, FocAxis, Sample};
 use xmc_motor::pwm::Duty;
 
 /// The board's constants of the current loop, declared once. None is
@@ -350,7 +350,7 @@ impl FastLoop {
                     link.trip = if trapped {
                         Some(CurrentTrip::OverCurrent)
                     } else {
-                        foc.trip().map(current_trip)
+                        foc.trip().map(CurrentTrip::from)
                     };
                 }
             } else {
@@ -388,17 +388,4 @@ impl FastLoop {
 #[inline]
 fn duty(compare: u16) -> Duty {
     (u32::from(compare) << 1).min(u32::from(Duty::MAX)) as Duty
-}
-
-/// The drive core's name of a loop trip (as hil-sim's `ElectricalAxis` maps it).
-fn current_trip(t: Trip) -> CurrentTrip {
-    match t {
-        Trip::OverCurrent => CurrentTrip::OverCurrent,
-        Trip::PhaseSum => CurrentTrip::PhaseSum,
-        Trip::DcUnderVoltage => CurrentTrip::DcUnderVoltage,
-        Trip::DcOverVoltage => CurrentTrip::DcOverVoltage,
-        Trip::EncoderLost => CurrentTrip::EncoderLost,
-        Trip::MotorI2t => CurrentTrip::MotorI2t,
-        Trip::StageI2t => CurrentTrip::StageI2t,
-    }
 }

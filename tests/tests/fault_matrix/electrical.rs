@@ -30,10 +30,23 @@ fn enabled_periods(d: &mut SimDrive) -> u64 {
 /// fault reset while the cause lasts, and after `clear` ended it a reset
 /// and the enable sequence again.
 fn during_motion(cause: fn(&mut ElectricalAxis), clear: fn(&mut ElectricalAxis)) -> String {
+    during_loaded_motion(None, cause, clear)
+}
+
+/// [`during_motion`] against `friction_nm` of sliding friction on the
+/// motor's shaft (a load the current must carry), else the motor's own.
+fn during_loaded_motion(
+    friction_nm: Option<f64>,
+    cause: fn(&mut ElectricalAxis),
+    clear: fn(&mut ElectricalAxis),
+) -> String {
     let sim = line(1);
     with_drive(&sim, |d| {
         d.set_plant(PlantModel::Electrical, 34)
             .expect("the default servo");
+        if let Some(f) = friction_nm {
+            d.motors[0].params_mut().coulomb_friction_nm = f;
+        }
     });
     with_master(&sim, async |md, clock| {
         let group = init(md, clock).await.into_op(md).await.expect("OP");
@@ -207,6 +220,68 @@ fn e089_c017_the_current_loops_encoder_lost_mid_move_is_event_37() {
         |el| {
             el.plant_mut().set_faults(FaultOptions {
                 encoder_lost: true,
+                ..FaultOptions::NONE
+            })
+        },
+        |el| el.plant_mut().set_faults(FaultOptions::NONE),
+    );
+    fault_row!(row, seen);
+}
+
+/// The load of rows 49a/49b: half the default servo's rated torque (1.3
+/// N·m) as sliding friction, so the current (about 1 A) is far above the
+/// ADC's noise: a broken sensor or an open phase at no load shows in no
+/// measurement (and harms nothing). The broken sensor shows at once (the
+/// three currents no longer sum to zero); the open phase only as a current
+/// that does not follow its reference, judged per i²t window of 256 PWM
+/// periods (`foc::protect::CurrentDeviation`): the gates go off in the
+/// period of the verdict, here the second window after the wire broke.
+const HALF_RATED_NM: f64 = 0.65;
+
+#[test]
+fn e089_a_broken_current_sensor_under_load_on_the_electrical_plant_is_the_phase_sum_event_31() {
+    let row = Row {
+        order: "49a",
+        case: "electrical plant: leg b's current sensor breaks (reads zero whatever flows) while axis A \
+               turns at 2 rev/s (csv) against 0.65 N·m of friction (50 % of the rated torque)",
+        spec: "E-089",
+        peer: "ethercrab",
+        expected: "Fault, power stage off, brake engaged, the gates on for 1 PWM period(s) after the fault; EMCY \
+                   2110h/02h event 31 cause 2; 603Fh 2110h; E47 0; history: error 2110h axis A event 31/2; Op, AL \
+                   0000h; while the cause lasts a reset gives Switch on disabled (E47 4), the enable into it: \
+                   Fault; after it: Operation enabled",
+    };
+    let seen = during_loaded_motion(
+        Some(HALF_RATED_NM),
+        |el| {
+            el.plant_mut().set_faults(FaultOptions {
+                broken_sensor: Some(Phase::B),
+                ..FaultOptions::NONE
+            })
+        },
+        |el| el.plant_mut().set_faults(FaultOptions::NONE),
+    );
+    fault_row!(row, seen);
+}
+
+#[test]
+fn e089_an_open_motor_phase_under_load_on_the_electrical_plant_is_event_69() {
+    let row = Row {
+        order: "49b",
+        case: "electrical plant: motor phase a opens (its wire broken) while axis A turns at 2 rev/s (csv) \
+               against 0.65 N·m of friction (50 % of the rated torque)",
+        spec: "E-089",
+        peer: "ethercrab",
+        expected: "Fault, power stage off, brake engaged, the gates on for 470 PWM period(s) after the fault; \
+                   EMCY 7120h/01h event 69 cause 2; 603Fh 7120h; E47 0; history: error 7120h axis A event 69/2; \
+                   Op, AL 0000h; while the cause lasts a reset gives Switch on disabled (E47 4), the enable into \
+                   it: Fault; after it: Operation enabled",
+    };
+    let seen = during_loaded_motion(
+        Some(HALF_RATED_NM),
+        |el| {
+            el.plant_mut().set_faults(FaultOptions {
+                open_phase: Some(Phase::A),
                 ..FaultOptions::NONE
             })
         },

@@ -128,6 +128,26 @@ pub enum CurrentTrip {
     /// The power stage's i²t model at its fault level (its limit not
     /// obeyed): event 39 "Overtemperature drive controller i2t" (4280h).
     StageI2t,
+    /// The current does not follow its reference although the voltage has
+    /// room (an open motor phase): event 69 "Motor connection" (7120h).
+    MotorConnection,
+}
+
+impl From<foc::Trip> for CurrentTrip {
+    /// The drive core's name of the current loop's trip (every shell that
+    /// runs `foc` reports it so).
+    fn from(t: foc::Trip) -> Self {
+        match t {
+            foc::Trip::OverCurrent => Self::OverCurrent,
+            foc::Trip::PhaseSum => Self::PhaseSum,
+            foc::Trip::DcUnderVoltage => Self::DcUnderVoltage,
+            foc::Trip::DcOverVoltage => Self::DcOverVoltage,
+            foc::Trip::EncoderLost => Self::EncoderLost,
+            foc::Trip::MotorI2t => Self::MotorI2t,
+            foc::Trip::StageI2t => Self::StageI2t,
+            foc::Trip::MotorConnection => Self::MotorConnection,
+        }
+    }
 }
 
 impl CurrentTrip {
@@ -141,6 +161,7 @@ impl CurrentTrip {
             Self::EncoderLost => 37,
             Self::MotorI2t => 45,
             Self::StageI2t => 39,
+            Self::MotorConnection => 69,
         };
         Event { number, cause: 2 }
     }
