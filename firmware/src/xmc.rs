@@ -51,8 +51,8 @@ pub mod motor {
     use xmc_motor::pwm::{Duty, Pwm, PwmConfig, DUTY_HALF};
     use xmc_motor::{pins, regs, timer, Mmio};
 
-    /// PWM rate (issue 34: 16 kHz default).
-    pub const PWM_HZ: u32 = 16_000;
+    /// PWM rate (issue 34): 16 kHz, 8 kHz with the feature `pwm-8k`.
+    pub const PWM_HZ: u32 = if cfg!(feature = "pwm-8k") { 8_000 } else { 16_000 };
     /// Dead time of the gate drivers, ns (a placeholder until the power
     /// board's switches are known: docs/hardware.md).
     pub const DEAD_NS: u32 = 500;

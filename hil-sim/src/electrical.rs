@@ -176,7 +176,14 @@ impl ElectricalAxis {
     /// keeps runs reproducible and axes independent). The defaults are valid
     /// (`foc`'s tests check them); a refusal is returned, never a panic.
     pub fn default_servo(seed: u64) -> Result<Self, foc::ParamError> {
+        Self::default_servo_at(seed, 16_000.0)
+    }
+
+    /// [`Self::default_servo`] with the inverter and the loop at `pwm_hz`
+    /// (8 kHz: the other rate the board offers, feature `pwm-8k`).
+    pub fn default_servo_at(seed: u64, pwm_hz: f32) -> Result<Self, foc::ParamError> {
         let mut p = PlantParams::default_servo();
+        p.inverter.pwm_hz = f64::from(pwm_hz);
         p.mech.shaft = Shaft::Driven { speed_rad_s: 0.0 };
         // τ = L/R = 3.3 ms, ω_e·h ≤ 0.04 at 3000 rpm: two RK4 steps per half
         // period are exact to well below the ADC's count (4 cost twice as
@@ -184,7 +191,11 @@ impl ElectricalAxis {
         // needs h ≤ 2.7·τ for RK4 to stay stable
         p.substeps_per_half = 2;
         p.seed = seed;
-        Self::new(p, MotorData::default_servo(), LoopParams::default_16k())
+        let params = LoopParams {
+            pwm_hz,
+            ..LoopParams::default_16k()
+        };
+        Self::new(p, MotorData::default_servo(), params)
     }
 
     /// An axis of this plant and current loop, or the loop parameter refused.

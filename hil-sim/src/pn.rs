@@ -319,11 +319,18 @@ impl PnSim {
     /// and 6078h (PNU 1102) from its measured iq, its trips the axes'
     /// faults. `seed` seeds the ADC noise (axis B gets `seed + 1`).
     pub fn set_plant(&mut self, model: PlantModel, seed: u64) -> Result<(), foc::ParamError> {
+        self.set_plant_at(model, seed, 16_000.0)
+    }
+
+    /// [`Self::set_plant`] with the electrical model's PWM and current loop
+    /// at `pwm_hz` (16 kHz by default; 8 kHz selectable, issue 34).
+    pub fn set_plant_at(&mut self, model: PlantModel, seed: u64, pwm_hz: f32) -> Result<(), foc::ParamError> {
         for (k, el) in self.electrical.iter_mut().enumerate() {
             *el = match model {
                 PlantModel::Rigid => None,
-                PlantModel::Electrical => Some(Box::new(ElectricalAxis::default_servo(
+                PlantModel::Electrical => Some(Box::new(ElectricalAxis::default_servo_at(
                     seed.wrapping_add(k as u64),
+                    pwm_hz,
                 )?)),
             };
         }

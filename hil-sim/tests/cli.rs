@@ -76,6 +76,7 @@ fn serve_help_lists_its_options_not_the_test_ones() {
         "--seconds <S>",
         "--plant <MODEL>",
         "--plant-fault <FAULT>",
+        "--pwm-khz <KHZ>",
     ] {
         assert!(out.contains(want), "`{want}` missing in:\n{out}");
     }
@@ -127,6 +128,14 @@ fn serve_plant_fault_needs_the_electrical_plant_and_an_unknown_plant_is_refused(
     let o = hil_sim(&["serve", "--iface", "lo", "--plant", "bogus"]);
     assert_eq!(o.status.code(), Some(2), "{o:?}");
     assert!(text(&o.stderr).contains("--plant"), "{}", text(&o.stderr));
+    // the current loop runs at 16 or 8 kHz, nothing else
+    let o = hil_sim(&["serve", "--iface", "lo", "--pwm-khz", "12"]);
+    assert_eq!(o.status.code(), Some(2), "{o:?}");
+    let err = text(&o.stderr);
+    assert!(
+        err.contains("12") && err.contains("16") && err.contains('8'),
+        "{err}"
+    );
 }
 
 #[test]

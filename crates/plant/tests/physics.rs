@@ -129,20 +129,22 @@ fn rise_and_overshoot(wc: f64, td: f64) -> (f64, f64) {
 }
 
 fn check_step(shaft: Shaft) {
+    check_step_at(shaft, 16_000.0, 1_000.0);
+}
+
+/// The step at `pwm_hz` (the loop and the inverter) with ω_c = 2π·`fc_hz`.
+fn check_step_at(shaft: Shaft, pwm_hz: f32, fc_hz: f32) {
     let motor = MotorData::default_servo();
-    let params = LoopParams::default_16k();
+    let params = LoopParams {
+        pwm_hz,
+        omega_c_rad_s: core::f32::consts::TAU * fc_hz,
+        ..LoopParams::default_16k()
+    };
+    let mut plant = PlantParams::default_servo();
+    plant.inverter.pwm_hz = f64::from(pwm_hz);
     let wc = f64::from(params.omega_c_rad_s);
     let ts = 1.0 / f64::from(params.pwm_hz);
-    let f = current_step(
-        PlantParams::default_servo(),
-        motor,
-        params,
-        shaft,
-        motor.rated_current_a,
-        200,
-        400,
-    )
-    .unwrap();
+    let f = current_step(plant, motor, params, shaft, motor.rated_current_a, 200, 400).unwrap();
     // the voltage computed from the sample at the PWM centre acts over the next
     // period: its centre is one period after the sample, the loop's delay Td = Ts
     let (rise_cf, over_cf) = rise_and_overshoot(wc, ts);
@@ -174,6 +176,17 @@ fn current_step_locked_rotor_is_first_order_with_omega_c() {
 #[test]
 fn current_step_free_rotor_is_first_order_with_omega_c() {
     check_step(Shaft::Free);
+}
+
+/// The 8 kHz option (issue 34): the loop's delay is one period, 125 µs, so
+/// ω_c·Td, which sets the overshoot of the delayed first order, doubles with
+/// the same ω_c (1 kHz at 8 kHz: 29 % in the closed form and the plant
+/// alike); with B64 = 500 Hz (ω_c·Td as at 16 kHz and 1 kHz) the step is the
+/// closed form again, overshoot ≤ 15 %, rise twice as long.
+#[test]
+fn current_step_at_8_khz_is_first_order_with_omega_c_and_its_longer_delay() {
+    check_step_at(Shaft::Locked, 8_000.0, 500.0);
+    check_step_at(Shaft::Free, 8_000.0, 500.0);
 }
 
 #[test]

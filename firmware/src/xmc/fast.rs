@@ -200,7 +200,7 @@ impl Link {
     /// period's when none ran) and the torque kt·iq, a new trip (once).
     ///
     /// No PWM period since the last call (the ADC's interrupt stopped: a
-    /// control cycle spans at least four) reads as the supply missing: the
+    /// control cycle spans at least two, four at 16 kHz) reads as the supply missing: the
     /// DC link is no longer measured ([`guard`] then cuts the gate enable,
     /// and an enabled axis faults).
     #[inline]

@@ -111,6 +111,28 @@ impl PlantFault {
     }
 }
 
+/// The PWM rate of `serve --pwm-khz`.
+#[derive(Debug, Clone, Copy, Default, PartialEq, Eq, ValueEnum)]
+pub enum PwmKhz {
+    /// 16 kHz (the default).
+    #[default]
+    #[value(name = "16")]
+    Sixteen,
+    /// 8 kHz.
+    #[value(name = "8")]
+    Eight,
+}
+
+impl PwmKhz {
+    /// The rate, Hz.
+    pub fn hz(self) -> f32 {
+        match self {
+            Self::Sixteen => 16_000.0,
+            Self::Eight => 8_000.0,
+        }
+    }
+}
+
 /// The motor model of `demo --plant` and `serve --plant`
 /// (`hil_sim::electrical::PlantModel`).
 #[derive(Debug, Clone, Copy, Default, PartialEq, Eq, ValueEnum)]
@@ -182,6 +204,11 @@ pub struct ServeArgs {
     /// moving drives).
     #[arg(long, value_enum, value_name = "MODEL", default_value_t = Plant::Electrical)]
     pub plant: Plant,
+    /// With `--plant electrical`: the PWM and current-loop rate, 16 or 8
+    /// kHz (issue 34; at 8 kHz the loop's delay doubles: B64 = 500 Hz keeps
+    /// the 16 kHz step's overshoot).
+    #[arg(long, value_enum, value_name = "KHZ", default_value_t = PwmKhz::Sixteen)]
+    pub pwm_khz: PwmKhz,
     /// `--plant electrical` only: a fault of axis A's plant on
     /// every drive, from the start (the power stage shows it when its gates
     /// go on, or at once): `short` leg a shorted to the DC link's negative

@@ -127,8 +127,12 @@ pub fn serve(args: &ServeArgs) -> Result<(), String> {
     // the motor model: the seed per drive k (from 0) is PLANT_SEED + 2k
     // (axis B takes + 1), so runs are reproducible and axes independent
     for (k, d) in (0u64..).zip(sim.drives_mut()) {
-        d.set_plant(args.plant.into(), PLANT_SEED.wrapping_add(2 * k))
-            .map_err(|e| format!("the electrical plant's parameters: {e:?}"))?;
+        d.set_plant_at(
+            args.plant.into(),
+            PLANT_SEED.wrapping_add(2 * k),
+            args.pwm_khz.hz(),
+        )
+        .map_err(|e| format!("the electrical plant's parameters: {e:?}"))?;
         if let Some(f) = args.plant_fault {
             f.apply(
                 d.electrical_mut(0)
@@ -161,7 +165,10 @@ pub fn serve(args: &ServeArgs) -> Result<(), String> {
         device.order_code, device.identity.product_code
     );
     if args.plant == Plant::Electrical {
-        println!("plant: current loop (16 kHz) -> simulated PMSM and inverter on every axis");
+        println!(
+            "plant: current loop ({} kHz) -> simulated PMSM and inverter on every axis",
+            args.pwm_khz.hz() / 1000.0
+        );
         if let Some(f) = args.plant_fault {
             println!("plant fault on axis A of every drive: {f:?}");
         }

@@ -242,8 +242,12 @@ pub fn serve(args: &ServeArgs) -> Result<(), String> {
         .collect();
     // the motor model: the seed per drive k (from 0) as EtherCAT's serve
     for (k, d) in (0u64..).zip(drives.iter_mut()) {
-        d.set_plant(args.plant.into(), super::serve::PLANT_SEED.wrapping_add(2 * k))
-            .map_err(|e| format!("the electrical plant's parameters: {e:?}"))?;
+        d.set_plant_at(
+            args.plant.into(),
+            super::serve::PLANT_SEED.wrapping_add(2 * k),
+            args.pwm_khz.hz(),
+        )
+        .map_err(|e| format!("the electrical plant's parameters: {e:?}"))?;
         if let Some(f) = args.plant_fault {
             f.apply(
                 d.electrical_mut(0)
@@ -257,7 +261,10 @@ pub fn serve(args: &ServeArgs) -> Result<(), String> {
         drives.len()
     );
     if args.plant == super::args::Plant::Electrical {
-        println!("plant: current loop (16 kHz) -> simulated PMSM and inverter on every axis");
+        println!(
+            "plant: current loop ({} kHz) -> simulated PMSM and inverter on every axis",
+            args.pwm_khz.hz() / 1000.0
+        );
         if let Some(f) = args.plant_fault {
             println!("plant fault on axis A of every drive: {f:?}");
         }
