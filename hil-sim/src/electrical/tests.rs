@@ -31,7 +31,13 @@ fn run_at(torque_nm: f64, brake: bool, cycles: u32, pwm_hz: f32) -> (ElectricalA
 /// torque T = 1.5·p·ψ·iq from the measured iq and in the motor within 2 %, and id ≈ 0.
 #[test]
 fn c038_a_torque_command_gives_its_torque_through_the_current_loop_locked() {
-    let (el, motor, iq) = run(1.3, true, 20);
+    locked_at(16_000.0);
+}
+
+/// 1.3 N·m against the brake at `pwm_hz` for 20 cycles of 1 ms: the
+/// measured iq's torque and the motor's within 2 %, id ≈ 0.
+fn locked_at(pwm_hz: f32) -> ElectricalAxis {
+    let (el, motor, iq) = run_at(1.3, true, 20, pwm_hz);
     assert_eq!(motor.velocity_rad_s(), 0.0, "the brake (2 N·m) holds 1.3 N·m");
     let measured = torque_of_iq(iq);
     assert!(
@@ -41,6 +47,7 @@ fn c038_a_torque_command_gives_its_torque_through_the_current_loop_locked() {
     let true_t = el.plant().torque_nm();
     assert!((true_t - 1.3).abs() <= 0.02 * 1.3, "motor torque {true_t} N·m");
     assert!(el.plant().id().abs() < 0.05 * 2.0, "id {} A", el.plant().id());
+    el
 }
 
 /// C-038 at the 8 kHz option (`serve --pwm-khz 8`, the board's `pwm-8k`):
@@ -48,16 +55,8 @@ fn c038_a_torque_command_gives_its_torque_through_the_current_loop_locked() {
 /// measured iq's as at 16 kHz, within 2 %.
 #[test]
 fn c038_a_torque_command_gives_its_torque_through_the_8_khz_current_loop() {
-    let (el, motor, iq) = run_at(1.3, true, 20, 8_000.0);
+    let el = locked_at(8_000.0);
     assert_eq!(el.stats().periods, 20 * 8, "8 PWM periods per 1 ms cycle");
-    assert_eq!(motor.velocity_rad_s(), 0.0);
-    let measured = torque_of_iq(iq);
-    assert!(
-        (measured - 1.3).abs() <= 0.02 * 1.3,
-        "measured-iq torque {measured} N·m"
-    );
-    let true_t = el.plant().torque_nm();
-    assert!((true_t - 1.3).abs() <= 0.02 * 1.3, "motor torque {true_t} N·m");
 }
 
 /// C-038 with the rotor free: 1.0 N·m accelerates the default servo

@@ -33,11 +33,20 @@ fn during_motion(cause: fn(&mut ElectricalAxis), clear: fn(&mut ElectricalAxis))
     during_loaded_motion(None, cause, clear)
 }
 
+/// [`during_loaded_motion`] with `faults` in axis A's plant (cleared after).
+fn during_plant_fault(friction_nm: Option<f64>, faults: FaultOptions) -> String {
+    during_loaded_motion(
+        friction_nm,
+        |el| el.plant_mut().set_faults(faults),
+        |el| el.plant_mut().set_faults(FaultOptions::NONE),
+    )
+}
+
 /// [`during_motion`] against `friction_nm` of sliding friction on the
 /// motor's shaft (a load the current must carry), else the motor's own.
 fn during_loaded_motion(
     friction_nm: Option<f64>,
-    cause: fn(&mut ElectricalAxis),
+    cause: impl Fn(&mut ElectricalAxis),
     clear: fn(&mut ElectricalAxis),
 ) -> String {
     let sim = line(1);
@@ -128,14 +137,12 @@ fn e089_over_current_of_a_shorted_leg_on_the_electrical_plant_is_event_33() {
                    A event 33/2; Op, AL 0000h; while the cause lasts a reset gives Switch on disabled \
                    (E47 4), the enable into it: Fault; after it: Operation enabled",
     };
-    let seen = during_motion(
-        |el| {
-            el.plant_mut().set_faults(FaultOptions {
-                leg_to_dc_minus: Some((Phase::A, 1.0)),
-                ..FaultOptions::NONE
-            })
+    let seen = during_plant_fault(
+        None,
+        FaultOptions {
+            leg_to_dc_minus: Some((Phase::A, 1.0)),
+            ..FaultOptions::NONE
         },
-        |el| el.plant_mut().set_faults(FaultOptions::NONE),
     );
     fault_row!(row, seen);
 }
@@ -153,14 +160,12 @@ fn e089_an_earth_fault_on_the_electrical_plant_is_the_phase_sum_event_31() {
                    0000h; while the cause lasts a reset gives Switch on disabled (E47 4), the enable into it: \
                    Fault; after it: Operation enabled",
     };
-    let seen = during_motion(
-        |el| {
-            el.plant_mut().set_faults(FaultOptions {
-                leg_to_dc_minus: Some((Phase::A, 100.0)),
-                ..FaultOptions::NONE
-            })
+    let seen = during_plant_fault(
+        None,
+        FaultOptions {
+            leg_to_dc_minus: Some((Phase::A, 100.0)),
+            ..FaultOptions::NONE
         },
-        |el| el.plant_mut().set_faults(FaultOptions::NONE),
     );
     fault_row!(row, seen);
 }
@@ -216,14 +221,12 @@ fn e089_c017_the_current_loops_encoder_lost_mid_move_is_event_37() {
                    7303h/01h event 37 cause 2; 603Fh 7303h; E47 0; history: error 7303h axis A event 37/2; Op, AL \
                    0000h; while the cause lasts a reset gives Fault (E47 0); after it: Operation enabled",
     };
-    let seen = during_motion(
-        |el| {
-            el.plant_mut().set_faults(FaultOptions {
-                encoder_lost: true,
-                ..FaultOptions::NONE
-            })
+    let seen = during_plant_fault(
+        None,
+        FaultOptions {
+            encoder_lost: true,
+            ..FaultOptions::NONE
         },
-        |el| el.plant_mut().set_faults(FaultOptions::NONE),
     );
     fault_row!(row, seen);
 }
@@ -251,15 +254,12 @@ fn e089_a_broken_current_sensor_under_load_on_the_electrical_plant_is_the_phase_
                    0000h; while the cause lasts a reset gives Switch on disabled (E47 4), the enable into it: \
                    Fault; after it: Operation enabled",
     };
-    let seen = during_loaded_motion(
+    let seen = during_plant_fault(
         Some(HALF_RATED_NM),
-        |el| {
-            el.plant_mut().set_faults(FaultOptions {
-                broken_sensor: Some(Phase::B),
-                ..FaultOptions::NONE
-            })
+        FaultOptions {
+            broken_sensor: Some(Phase::B),
+            ..FaultOptions::NONE
         },
-        |el| el.plant_mut().set_faults(FaultOptions::NONE),
     );
     fault_row!(row, seen);
 }
@@ -277,15 +277,12 @@ fn e089_an_open_motor_phase_under_load_on_the_electrical_plant_is_event_69() {
                    Op, AL 0000h; while the cause lasts a reset gives Switch on disabled (E47 4), the enable into \
                    it: Fault; after it: Operation enabled",
     };
-    let seen = during_loaded_motion(
+    let seen = during_plant_fault(
         Some(HALF_RATED_NM),
-        |el| {
-            el.plant_mut().set_faults(FaultOptions {
-                open_phase: Some(Phase::A),
-                ..FaultOptions::NONE
-            })
+        FaultOptions {
+            open_phase: Some(Phase::A),
+            ..FaultOptions::NONE
         },
-        |el| el.plant_mut().set_faults(FaultOptions::NONE),
     );
     fault_row!(row, seen);
 }
