@@ -123,7 +123,8 @@ fn c038_e089_soem_current_limit_and_power_stage_i2t_on_the_electrical_plant() {
 /// 12 mH) within 5 % into B53 and B52/B62; B41 finds the plant's
 /// commutation offset (0.3 rad: `--plant-offset`) within 0.5° electrical
 /// into B05; B43 (no enable) measures the three phases within 3 % of R;
-/// B40 passes the plant as wired (the pole pairs seen = B10).
+/// B40 passes the plant as wired (the pole pairs seen = B10); B300 (test
+/// brake) holds the rated torque both ways within 1/360 rev.
 #[test]
 fn e140_e141_soem_motor_actions_identify_the_plants_r_l_and_commutation_offset() {
     let python = match pysoem_python() {

@@ -454,3 +454,48 @@ fn e140_b40_test_phase_passes_the_wiring_and_fails_swapped_or_open_phases_and_wr
         });
     }
 }
+
+/// E-140, E-141 (B300): "test brake" started in Ready to switch on runs after
+/// the enable: the brake applied, the rated torque 6076h (1.3 N·m) forward
+/// then backward. The plant's brake holds 2 N·m: the shaft stays within
+/// 1/360 rev (result 0, done, B300[1] the play seen, B300[2] 1300 mN·m); a
+/// worn brake holding 1.0 N·m slips under the test torque: result 9, failed,
+/// the movement beyond 1/360 rev, and the axis back under its own control
+/// (Operation enabled, the brake released).
+#[test]
+fn e140_b300_test_brake_holds_the_rated_torque_or_fails_on_a_worn_brake() {
+    use drive_ecat::params::B300;
+    const TOLERANCE_INC: u32 = (1 << 20) / 360;
+    for (holding_nm, code, end) in [(2.0, 0u8, state::DONE), (1.0, 9, state::FAILED)] {
+        let sim = electrical_line(3.6, 0.012);
+        sim.borrow_mut().drives_mut()[0].motors[0]
+            .params_mut()
+            .brake_holding_torque_nm = holding_nm;
+        with_master(&sim, async |md, clock| {
+            let group = init(md, clock).await;
+            let sd = group.subdevice(md, 0).unwrap();
+            let io = map_actions(&sd).await;
+            let group = group.into_op(md).await.expect("Op with A75/A69 mapped");
+            let sd = group.subdevice(md, 0).unwrap();
+            let seen = run_action(&sim, &group, md, io, 0b0100, 3000).await;
+            let last = *seen.last().unwrap();
+            assert_eq!(last >> 12, end, "brake {holding_nm} N·m: A69 {seen:04X?}");
+            assert_eq!(last >> 8 & 0xF, 0b0100, "the selector shown");
+            assert_eq!(sd.sdo_read::<u8>(B300, 1).await.unwrap(), code, "B300[0]");
+            let moved = sd.sdo_read::<u32>(B300, 2).await.unwrap();
+            assert_eq!(
+                sd.sdo_read::<u32>(B300, 3).await.unwrap(),
+                1300,
+                "the test torque, mN·m"
+            );
+            println!("B300 brake holding {holding_nm} N·m: result {code}, largest movement {moved} inc");
+            if code == 0 {
+                assert!(moved <= TOLERANCE_INC, "held: {moved} inc");
+            } else {
+                assert!(moved > TOLERANCE_INC, "slipped: {moved} inc");
+            }
+            // the axis' own control again: enabled
+            assert_eq!(sd.sdo_read::<u8>(E48, 0).await.unwrap(), 4, "Operation enabled");
+        });
+    }
+}

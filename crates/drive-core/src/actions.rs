@@ -25,8 +25,9 @@
 //! or mapped in another channel, starts nothing ([`state::NOT_ACTIVATED`]).
 
 use crate::axis::{AxisCommand, AxisIo};
-use crate::params::{B05, B10, B40, B41, B42, B43, B52, B53, B62, E48};
+use crate::params::{B05, B10, B300, B40, B41, B42, B43, B52, B53, B62, E48};
 use crate::tuning::align::{AlignOutcome, Alignment};
+use crate::tuning::brake::{BrakeOutcome, BrakeTest};
 use crate::tuning::phase::{PhaseOutcome, PhaseTest};
 use crate::tuning::winding::{WindingOutcome, WindingTest};
 use crate::tuning::{CurrentTuning, Outcome};
@@ -168,6 +169,8 @@ enum Measurement {
     Winding(WindingTest),
     /// B40.
     Phase(PhaseTest),
+    /// B300.
+    Brake(BrakeTest),
 }
 
 /// The action unit of both axes: the last Execute bits and what runs.
@@ -225,6 +228,7 @@ impl Actions {
             Measurement::Align(a) => a.cycle(e48, io.position_inc),
             Measurement::Winding(w) => w.cycle(e48, io.current.as_ref()),
             Measurement::Phase(p) => p.cycle(e48, io.position_inc, io.current.as_ref()),
+            Measurement::Brake(b) => b.cycle(e48, io.position_inc),
         }
     }
 
@@ -262,6 +266,7 @@ impl Actions {
                         Some(Measurement::Align(al)) => follow_alignment(objects, al, axis, selector),
                         Some(Measurement::Winding(w)) => follow_winding(objects, w, axis, selector),
                         Some(Measurement::Phase(p)) => follow_phase(objects, p, axis, selector),
+                        Some(Measurement::Brake(b)) => follow_brake(objects, b, axis, selector),
                         None => None,
                     },
                     _ => follow(objects, r, selector),
@@ -358,9 +363,16 @@ fn start(
             a.running = Some(Running::Tuning);
             status(0, selector, state::RUNNING)
         }
+        Action::TestBrake => {
+            let rated_mnm = objects.get(0x6076 + cia(axis), 0).unwrap_or(0);
+            let _ = objects.set(B300 + offset(axis), 3, rated_mnm);
+            a.tuning = Some(Measurement::Brake(BrakeTest::new(rated_mnm as f32 * 1e-3)));
+            a.running = Some(Running::Tuning);
+            status(0, selector, state::RUNNING)
+        }
         // A37 (the memorised extreme values) and I52 (the limit-switch
-        // memory) hold nothing in this drive; the brake actions are not
-        // built
+        // memory) hold nothing in this drive; grinding the brake (B301,
+        // B302) and the safety's brake test (S18) are not built
         _ => status(0, selector, state::NOT_AVAILABLE),
     }
 }
@@ -453,6 +465,19 @@ fn follow_winding(objects: &mut DriveObjects, w: &WindingTest, axis: usize, sele
             Some(status(0, selector, state::FAILED))
         }
     }
+}
+
+/// A69 of a running B300; at its end its result and the movement in B300.
+fn follow_brake(objects: &mut DriveObjects, b: &BrakeTest, axis: usize, selector: u8) -> Option<u16> {
+    let off = offset(axis);
+    let (code, moved, st) = match b.outcome() {
+        BrakeOutcome::Running(p) => return Some(status(u16::from(p), selector, state::RUNNING)),
+        BrakeOutcome::Held(moved) => (crate::tuning::result::OK, moved, state::DONE),
+        BrakeOutcome::Failed(code, moved) => (code, moved, state::FAILED),
+    };
+    let _ = objects.set(B300 + off, 2, i64::from(moved));
+    let _ = objects.set(B300 + off, 1, i64::from(code));
+    Some(status(if st == state::DONE { 100 } else { 0 }, selector, st))
 }
 
 /// A69 of a running B41; at its end its result in B41 and the offset in B05.
@@ -596,9 +621,9 @@ mod tests {
         }
         execute(&mut od, 0, 0, false);
         a.serve(&mut od);
-        execute(&mut od, 0, 0b0100, true);
+        execute(&mut od, 0, 0b0101, true);
         od.set(E48, 0, 2).unwrap();
         a.serve(&mut od);
-        assert_eq!(a.status(0) >> 12, state::NOT_AVAILABLE, "test brake in E48 = 2");
+        assert_eq!(a.status(0) >> 12, state::NOT_AVAILABLE, "grind brake in E48 = 2");
     }
 }

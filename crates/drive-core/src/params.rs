@@ -204,6 +204,9 @@ pub const B42: u16 = parameter_index(1, 42);
 pub const B43: u16 = parameter_index(1, 43);
 /// B52 d-axis inductance Ld, µH (per axis, motor data).
 pub const B52: u16 = parameter_index(1, 52);
+/// B300 test brake: the action's result, the largest movement seen and the
+/// test torque (per axis, spec §14).
+pub const B300: u16 = parameter_index(1, 300);
 /// B53 phase resistance, mΩ (per axis, motor data).
 pub const B53: u16 = parameter_index(1, 53);
 /// B62 q-axis inductance Lq, µH (per axis, motor data).

@@ -55,6 +55,9 @@ pub mod result {
     /// B41: the rotor did not come to rest (the same code as
     /// [`NOT_SETTLED`]: the measurement did not settle).
     pub const NOT_AT_REST: u8 = NOT_SETTLED;
+    /// B300: the shaft turned against the applied brake (beyond
+    /// [`super::brake::TOLERANCE_INC`]); 7 and 8 are B40's.
+    pub const SLIPPED: u8 = 9;
 }
 
 /// Cycles per settle block.
@@ -373,6 +376,7 @@ fn abs(x: f32) -> f32 {
 }
 
 pub mod align;
+pub mod brake;
 pub mod phase;
 pub mod winding;
 

@@ -24,6 +24,9 @@ Free run, one drive, axis A in cst; RxPDO 6040h, 6060h, A75; TxPDO 6041h, A69.
      A69 idle.
   4. B43 (1101b, test winding) in ready to switch on, no enable: done,
      B43[0] = 0, the three resistances within 3 % of --r, E48 still 2.
+  5. B300 (0100b, test brake), as B40: the brake applied against the rated
+     torque both ways: done, B300[0] = 0, B300[1] (the largest movement)
+     within 1/360 rev, B300[2] = 6076h (the test torque, mN m).
 
 Prints `FAIL: ...` for every check that failed; exit status 0 when none did.
 """
@@ -45,6 +48,7 @@ def b(line):
 
 A75, A69 = 0x2000 + 75, 0x2000 + 69
 B05, B10, B40, B41, B42, B43, B52, B53, B62 = b(5), b(10), b(40), b(41), b(42), b(43), b(52), b(53), b(62)
+B300 = b(300)
 E48 = 0x2000 + 4 * 0x200 + 48
 RX = [L.entry(0x6040, 0, 16), L.entry(0x6060, 0, 8), L.entry(A75, 0, 8)]
 TX = [L.entry(0x6041, 0, 16), L.entry(A69, 0, 16)]
@@ -55,6 +59,7 @@ RUNNING, DONE, REFUSED = 1, 2, 3
 # the actual position as the target, as before any enable)
 CST = 10
 B40_SEL, B41_SEL, B42_SEL, B43_SEL, B49_SEL = 0b1010, 0b1011, 0b1100, 0b1101, 0b1110
+B300_SEL = 0b0100
 
 
 class Axis:
@@ -152,6 +157,21 @@ def calibrate(axis, offset_rad):
     axis.cycle(20)
 
 
+def test_brake(axis):
+    seen, took = start(axis, B300_SEL)
+    done = 100 | B300_SEL << 8 | DONE << 12
+    result, moved, torque = (L.sdo_u(axis.s, B300, k) for k in (1, 2, 3))
+    check(seen[-1] == done, f"B300: A69 ends {seen[-1]:04X}h, expected {done:04X}h; seen {[f'{s:04X}' for s in seen]}; B300[0] {result}")
+    check(result == 0, f"B300[0] result {result}, expected 0 (held)")
+    check(moved <= (1 << 20) // 360, f"B300: the shaft moved {moved} inc under the test torque")
+    rated = L.sdo_u(axis.s, 0x6076, 0)
+    check(torque == rated, f"B300: test torque {torque} mN m, 6076h {rated}")
+    say(f"B300: the brake held {torque} mN m both ways, largest movement {moved} inc, in {took:.2f} s")
+    axis.a75 = 0
+    axis.cw = 6
+    axis.cycle(20)
+
+
 def winding(axis, r):
     axis.cw = 6
     check(axis.until(lambda: L.sw_is(axis.sw, L.READY), 300), f"ready to switch on: statusword {axis.sw:#06x}")
@@ -225,6 +245,7 @@ def run(m, args):
     for sel in (B42_SEL, B49_SEL):
         optimise(axis, sel, args.r, args.l)
     winding(axis, args.r)
+    test_brake(axis)
     axis.cw = 0
     axis.cycle(20)
 

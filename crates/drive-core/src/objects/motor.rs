@@ -16,7 +16,7 @@
 //! ([`super::MANUFACTURER_A`]).
 
 use super::{Object, Value};
-use crate::params::{B05, B10, B17, B40, B41, B42, B43, B52, B53, B62, B64, B73, U10, U11};
+use crate::params::{B05, B10, B17, B300, B40, B41, B42, B43, B52, B53, B62, B64, B73, U10, U11};
 use od::DataType::{U16, U32, U8};
 
 use od::{Access, DataType, EntryInfo};
@@ -27,7 +27,7 @@ const fn e(sub: u8, name: &'static str, t: DataType) -> EntryInfo {
 }
 
 /// The motor data of axis A (group B), sorted by index.
-pub const PARAMS: [Object; 12] = [
+pub const PARAMS: [Object; 13] = [
     Object::var(
         B05,
         Value::Ram,
@@ -152,6 +152,14 @@ pub const PARAMS: [Object; 12] = [
     .axis()
     .level(1)
     .note("B73 (line assumed): τ of the winding's first-order thermal model (motor i²t, U10): the rated current 6075h held forever gives 100 %; default 600 s"),
+    param_array!(B300, "Test brake", Record, Value::Ram, [
+        EntryInfo::new(0, "Result", U8, Access::RO),
+        EntryInfo::new(1, "Largest movement", U32, Access::RO).unit("inc"),
+        EntryInfo::new(2, "Test torque", U32, Access::RO).unit("mNm"),
+    ])
+    .axis()
+    .level(1)
+    .note("B300 (spec §14): the action \"test brake\", started through A75 in Ready to switch on, run after the enable: the brake stays applied while the drive commands the rated torque 6076h forward, then backward (a 0.1 s ramp and 0.5 s hold each, at 1 ms); the shaft must not move more than 1/360 rev from where it stood. [0] the result (0 held, 9 slipped: the torque dropped at once, 1 aborted: the enable went away), [1] the largest movement seen, [2] the test torque"),
 ];
 
 /// The motor protection settings of axis A (group U, after the records of

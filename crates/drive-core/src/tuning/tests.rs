@@ -192,3 +192,45 @@ fn e141_b41_aborted_when_the_enable_goes() {
     assert!(a.cycle(2, 0).is_none());
     assert_eq!(a.outcome(), align::AlignOutcome::Failed(result::ABORTED));
 }
+
+/// E-140 (B300): the test torque ramps to the rated torque forward, then
+/// backward, with the brake applied and the power stage on; a shaft that
+/// stays put passes, one that moves beyond 1/360 rev fails at once (9), and
+/// the enable going away mid-test aborts it (1).
+#[test]
+fn e140_b300_test_brake_torque_profile_slip_and_abort() {
+    use super::brake::{BrakeOutcome, BrakeTest, HOLD_CYCLES, RAMP_CYCLES, TOLERANCE_INC};
+    // waiting for the enable: nothing commanded, still running
+    let mut t = BrakeTest::new(1.3);
+    assert_eq!(t.cycle(2, 0), None);
+    assert_eq!(t.outcome(), BrakeOutcome::Running(0));
+    let (mut lo, mut hi) = (0.0f32, 0.0f32);
+    let mut n = 0;
+    while let Some(c) = t.cycle(4, 1000) {
+        assert!(c.power_stage && !c.brake_release && c.injection.is_none());
+        lo = lo.min(c.torque_nm);
+        hi = hi.max(c.torque_nm);
+        n += 1;
+    }
+    assert_eq!(n, 2 * (RAMP_CYCLES + HOLD_CYCLES));
+    assert_eq!((lo, hi), (-1.3, 1.3));
+    assert_eq!(t.outcome(), BrakeOutcome::Held(0));
+    // a slipping shaft
+    let mut t = BrakeTest::new(1.3);
+    let mut pos = 0;
+    while t.cycle(4, pos).is_some() {
+        pos += 50;
+    }
+    match t.outcome() {
+        BrakeOutcome::Failed(code, moved) => {
+            assert_eq!(code, super::result::SLIPPED);
+            assert!(moved > TOLERANCE_INC && moved <= TOLERANCE_INC + 50, "{moved}");
+        }
+        o => panic!("{o:?}"),
+    }
+    // the enable goes away
+    let mut t = BrakeTest::new(1.3);
+    assert!(t.cycle(4, 0).is_some());
+    assert_eq!(t.cycle(2, 0), None);
+    assert_eq!(t.outcome(), BrakeOutcome::Failed(super::result::ABORTED, 0));
+}
