@@ -119,7 +119,7 @@ fn e141_test_winding_refused_outside_ready_to_switch_on() {
         let s = a69_of(sd.io_raw().inputs(), a69);
         assert_eq!(s, 0b1101 << 8 | state::REFUSED << 12, "{s:04X}h");
         // shutdown (6040h = 6): ready to switch on; the precondition holds, and
-        // test brake (0100b) is not available on this drive
+        // grind brake (0101b) is not available on this drive
         {
             let mut out = sd.outputs_raw_mut();
             out[0..2].copy_from_slice(&6u16.to_le_bytes());
@@ -127,10 +127,10 @@ fn e141_test_winding_refused_outside_ready_to_switch_on() {
         }
         cycles(&sim, &group, md, 20).await;
         assert_eq!(sd.sdo_read::<u8>(drive_ecat::params::E48, 0).await.unwrap(), 2);
-        sd.outputs_raw_mut()[a75] = 0b0100 << 1 | 1;
+        sd.outputs_raw_mut()[a75] = 0b0101 << 1 | 1;
         cycles(&sim, &group, md, 5).await;
         let s = a69_of(sd.io_raw().inputs(), a69);
-        assert_eq!(s, 0b0100 << 8 | state::NOT_AVAILABLE << 12, "{s:04X}h");
+        assert_eq!(s, 0b0101 << 8 | state::NOT_AVAILABLE << 12, "{s:04X}h");
     });
 }
 
