@@ -280,6 +280,31 @@ impl FocAxis {
         Ok(())
     }
 
+    /// New protection thresholds from now on (the power stage's data and the
+    /// DC-link window of the dictionary: its maximum and rated current,
+    /// thermal time constant, over-voltage trip and under-voltage limit). The
+    /// stage's heat (its i²t level) stays; a latched trip stays. Applied only
+    /// when they changed (cheap to call every control cycle).
+    pub fn set_protection(&mut self, protection: Protection) {
+        if protection == self.protection {
+            return;
+        }
+        let x = self.stage_i2t.level();
+        self.stage_i2t = I2t::new(
+            fmath::max(protection.stage_rated_a, 1e-3),
+            fmath::max(protection.stage_tau_s, 1e-3),
+        );
+        self.stage_i2t.set_level(x);
+        self.stage_i2t_alpha = self.stage_i2t.alpha(self.gains.ts_s * I2T_DECIMATION as f32);
+        self.protection = protection;
+        self.refresh_limits();
+    }
+
+    /// The protection thresholds in force.
+    pub fn protection(&self) -> &Protection {
+        &self.protection
+    }
+
     /// The gains in force.
     pub fn gains(&self) -> &Gains {
         &self.gains
