@@ -86,7 +86,11 @@ impl BrakeChopper {
     /// Non-positive or NaN data are taken as "no resistor" (the dictionary's
     /// ranges refuse them where they are written).
     pub fn new(p: ChopperParams, period_s: f32) -> Self {
-        let rated = if p.rated_power_w > 0.0 { p.rated_power_w } else { 1.0 };
+        let rated = if p.rated_power_w > 0.0 {
+            p.rated_power_w
+        } else {
+            1.0
+        };
         let tau = if p.tau_s > 0.0 { p.tau_s } else { 1.0 };
         // the i²t model's "current" is √P: (√P)² / (√P_rated)² = P / P_rated
         let mut model = I2t::new(crate::fmath::sqrt(rated), tau);

@@ -48,7 +48,8 @@ pub mod params;
 pub mod rng;
 
 pub use params::{
-    AdcParams, DcLinkParams, FaultOptions, InverterParams, MechParams, Phase, PlantParams, PmsmParams, Shaft, TwoMass,
+    AdcParams, DcLinkParams, FaultOptions, InverterParams, MechParams, Phase, PlantParams, PmsmParams, Shaft,
+    TwoMass,
 };
 
 use core::f64::consts::TAU;

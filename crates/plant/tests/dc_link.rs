@@ -130,7 +130,10 @@ fn e090_the_chopper_holds_the_link_within_its_hysteresis() {
         pl.brake_energy_j()
     );
     assert!(hi < f64::from(cp.on_v) + 2.0, "peak {hi} V");
-    assert!(lo_after_on > f64::from(cp.on_v - cp.hysteresis_v) - 2.0, "low {lo_after_on} V");
+    assert!(
+        lo_after_on > f64::from(cp.on_v - cp.hysteresis_v) - 2.0,
+        "low {lo_after_on} V"
+    );
     let w2 = pl.speed_rad_s();
     let v2 = pl.dc_link_v();
     let lhs = 0.5 * j * (w1 * w1 - w2 * w2) - e_cu;
@@ -163,6 +166,12 @@ fn the_link_stays_at_565_v_at_rest_and_sags_by_the_source_resistance_when_motori
     let v = pl.dc_link_v();
     let i = (p_mech + p_cu) / v;
     let expected = 565.0 - 1.0 * i;
-    println!("motoring {:.0} W: link {v:.2} V, closed form {expected:.2} V", p_mech + p_cu);
-    assert!((v - expected).abs() < 0.05 * (565.0 - expected), "{v} vs {expected}");
+    println!(
+        "motoring {:.0} W: link {v:.2} V, closed form {expected:.2} V",
+        p_mech + p_cu
+    );
+    assert!(
+        (v - expected).abs() < 0.05 * (565.0 - expected),
+        "{v} vs {expected}"
+    );
 }
