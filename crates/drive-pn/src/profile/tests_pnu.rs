@@ -531,7 +531,11 @@ fn p045_issue34_dc_link_window_through_pkw_refused_where_written() {
     let mut b = Bench::new();
     assert_eq!(b.pkw0(0x41, A40, 0, 0), (0x41, 800), "800 V over-voltage trip");
     assert_eq!(b.pkw0(0x42, A38, 0, 800), (0xC2, 2), "threshold at the trip");
-    assert_eq!(b.pkw0(0x42, A35, 0, 745), (0xC2, 2), "limit above threshold − hysteresis");
+    assert_eq!(
+        b.pkw0(0x42, A35, 0, 745),
+        (0xC2, 2),
+        "limit above threshold − hysteresis"
+    );
     assert_eq!(b.pkw0(0x42, A40, 0, 900), (0xC2, 1), "read only");
     assert_eq!(b.d.objects().get(A38, 0), Ok(760), "unchanged");
     assert_eq!(b.d.objects().get(A35, 0), Ok(400), "unchanged");
