@@ -369,7 +369,11 @@ impl ElectricalAxis {
         dt: Nanos,
     ) -> MotorOutputs {
         self.foc.enable(power_stage);
-        if !power_stage && abs(self.plant.id()) + abs(self.plant.iq()) < IDLE_A {
+        // the shortcut only while the link needs no chopper either (its
+        // resistor discharges the link period by period)
+        let chopping = self.chopper.params().resistor_ohm > 0.0
+            && (self.chopper.is_on() || self.foc.measured().vdc >= self.chopper.params().on_v);
+        if !power_stage && !chopping && abs(self.plant.id()) + abs(self.plant.iq()) < IDLE_A {
             return self.idle(motor, brake, dt);
         }
         let reference = self.foc.current_reference(torque_nm as f32);
@@ -432,9 +436,11 @@ impl ElectricalAxis {
 }
 
 impl ElectricalAxis {
-    /// A cycle with the gates off and no current left: no torque, so the motor
-    /// alone; one PWM period of the plant and the (disabled) loop at its end
-    /// keep the sample and the loop's last angle fresh for the next enable.
+    /// A cycle with the gates off, no current left and the DC link below the
+    /// chopper's threshold: no torque, so the motor alone; one PWM period of
+    /// the plant and the (disabled) loop at its end keep the sample and the
+    /// loop's last angle fresh for the next enable (the link changes only
+    /// through the chopper, which is off and stays off).
     fn idle(&mut self, motor: &mut Motor, brake: bool, dt: Nanos) -> MotorOutputs {
         let out = motor.step_applied(0.0, brake, dt);
         let pwm = self.period.as_ns().max(1);

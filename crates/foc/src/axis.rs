@@ -46,8 +46,12 @@ pub struct Protection {
 impl Protection {
     /// Trip at 9 A, phase sum within 0.3 A, DC link 400…800 V (400 V mains,
     /// 565 V nominal), the current error's mean square within a quarter of
-    /// the reference's + (0.1 A)² per i²t window, power stage 8 A maximum and 4 A rated with a thermal
-    /// time constant of 5 s, the motor's i²t model limiting.
+    /// the reference's + (0.1 A)² per i²t window, power stage 8 A maximum and
+    /// 4 A rated with a thermal time constant of 5 s, the motor's i²t model
+    /// limiting: the declared defaults of the drive's dictionary (A35, A40,
+    /// A41…A43, `drive_core::stage`), for a loop without one; where the
+    /// dictionary exists its values are applied with
+    /// [`FocAxis::set_protection`].
     pub const fn default_stage() -> Self {
         Self {
             over_current: OverCurrent { threshold_a: 9.0 },
