@@ -30,11 +30,26 @@
 //! encoder) switches the gates off in its PWM period and reaches the drive
 //! core in [`CurrentActual::trip`]: the axis faults with the manual's event
 //! (over-current: 33, 2310h). The loop's gains and limits come from the
-//! dictionary's motor data ([`ElectricalAxis::set_motor_data`]).
+//! dictionary's motor data ([`ElectricalAxis::set_motor_data`]), the power
+//! stage's data and the DC-link window from its A21…A43
+//! ([`ElectricalAxis::set_stage_data`]).
+//!
+//! **The DC link and the brake chopper, per axis.** The plant's DC link is a
+//! state (`plant::DcLinkParams`: capacitor, rectifier, brake resistor); each
+//! axis' plant has its own, and each axis runs its own brake chopper
+//! ([`foc::BrakeChopper`]) on its own link. The SC6 shares one link and one
+//! chopper between its two axes; the simulator steps the axes' plants one
+//! after the other per control cycle (each over its PWM periods), so a shared
+//! link would need the two interleaved period by period. The simplification
+//! is exact while one axis brakes and the other's current is zero (what the
+//! tests do); with both moving, each axis sees only its own regenerated energy
+//! (a real shared link would net motoring against braking). A resistor fault
+//! (event 42) is reported by the axis whose chopper saw it.
 
 use crate::motor::{EdgeList, IndexEvent, Motor, MotorOutputs, INC_PER_RAD};
 use drive_ecat::axis::{AxisCommand, CurrentActual, CurrentControl, CurrentTrip, DAxisMeans};
-use foc::{FocAxis, LoopParams, MotorData, PowerStage, Protection};
+use drive_ecat::stage::StageData;
+use foc::{BrakeChopper, ChopperParams, FocAxis, LoopParams, MotorData, PowerStage, Protection};
 use nanos::Nanos;
 use plant::{Plant, PlantParams, Shaft};
 
@@ -132,6 +147,10 @@ pub struct ElectricalAxis {
     /// The motor data and loop parameters the loop runs with.
     motor: MotorData,
     params: LoopParams,
+    /// The brake chopper on this axis' DC link.
+    chopper: BrakeChopper,
+    /// The stage's data last applied.
+    stage: StageData,
 }
 
 impl CurrentControl for ElectricalAxis {
@@ -144,6 +163,7 @@ impl CurrentControl for ElectricalAxis {
     fn command(&mut self, command: &AxisCommand) {
         if !command.power_stage {
             self.foc.reset_trip();
+            self.chopper.reset_fault();
         }
         self.command = *command;
     }
@@ -157,14 +177,18 @@ impl CurrentControl for ElectricalAxis {
         let m = self.foc.measured();
         // before the loop's first step its measurement is empty: no limit yet
         let stage = m.stage_i2t.map_or(f32::INFINITY, |_| m.stage_limit_a);
-        let warning = matches!(m.stage_i2t, Some(s) if s != foc::I2tState::Normal);
+        let warning = matches!(m.stage_i2t, Some(s) if s != foc::I2tState::Normal) || self.chopper.warning();
         Some(CurrentActual {
             torque_nm: self.foc.gains().kt_nm_per_a * iq,
             current_a: iq,
             stage_limit_a: stage,
             stage_warning: warning,
             d_axis: self.d_cycle,
-            trip: self.foc.trip().map(CurrentTrip::from),
+            trip: self
+                .foc
+                .trip()
+                .map(CurrentTrip::from)
+                .or(self.chopper.fault().then_some(CurrentTrip::BrakeResistor)),
         })
     }
 }
@@ -207,6 +231,7 @@ impl ElectricalAxis {
             ..Protection::default_stage()
         };
         let foc = FocAxis::new(motor, params, p.scaling(), stage)?;
+        let chopper = BrakeChopper::new(ChopperParams::default_stage(), p.period_s() as f32);
         let (motor_data, loop_params) = (motor, params);
         let period = Nanos::from_ns((1.0e9 / p.inverter.pwm_hz + 0.5) as u64);
         Ok(Self {
@@ -221,6 +246,8 @@ impl ElectricalAxis {
             prev_ud: 0.0,
             motor: motor_data,
             params: loop_params,
+            chopper,
+            stage: StageData::default(),
         })
     }
 
@@ -244,6 +271,49 @@ impl ElectricalAxis {
         self.motor = motor;
         self.params = params;
         Ok(())
+    }
+
+    /// The power stage's data and the DC-link window of the drive's
+    /// dictionary (A21…A43, `drive_core::stage`) for the current loop (its
+    /// window: A35 under-voltage, A40 over-voltage; the stage's current
+    /// A41/A42 and τ A43) and the brake chopper (A21 R, A22 rated power, A23
+    /// τ, A38 threshold); the plant's brake resistor is the one A21 names
+    /// (0: none fitted). Applied when they changed; the stage's and the
+    /// resistor's heat stay.
+    pub fn set_stage_data(&mut self, s: &StageData) {
+        if *s == self.stage {
+            return;
+        }
+        let p = *self.foc.protection();
+        self.foc.set_protection(Protection {
+            dc_link: foc::protect::DcLink {
+                min_v: s.under_voltage_v,
+                max_v: s.over_voltage_v,
+            },
+            stage_current_a: s.max_current_a,
+            stage_rated_a: s.rated_current_a,
+            stage_tau_s: s.tau_s,
+            ..p
+        });
+        self.chopper.set_params(ChopperParams {
+            resistor_ohm: s.brake_resistor_ohm,
+            rated_power_w: s.brake_resistor_rated_w,
+            tau_s: s.brake_resistor_tau_s,
+            on_v: s.chopper_on_v,
+            hysteresis_v: s.chopper_hysteresis_v,
+        });
+        self.plant.set_brake_resistor(f64::from(s.brake_resistor_ohm));
+        self.stage = *s;
+    }
+
+    /// The brake chopper on this axis' DC link.
+    pub fn chopper(&self) -> &BrakeChopper {
+        &self.chopper
+    }
+
+    /// The DC link as the loop measured it last, mV (6079h).
+    pub fn dc_link_mv(&self) -> u32 {
+        (self.foc.measured().vdc * 1000.0 + 0.5) as u32
     }
 
     /// The plant.
@@ -299,7 +369,11 @@ impl ElectricalAxis {
         dt: Nanos,
     ) -> MotorOutputs {
         self.foc.enable(power_stage);
-        if !power_stage && abs(self.plant.id()) + abs(self.plant.iq()) < IDLE_A {
+        // the shortcut only while the link needs no chopper either (its
+        // resistor discharges the link period by period)
+        let chopping = self.chopper.params().resistor_ohm > 0.0
+            && (self.chopper.is_on() || self.foc.measured().vdc >= self.chopper.params().on_v);
+        if !power_stage && !chopping && abs(self.plant.id()) + abs(self.plant.iq()) < IDLE_A {
             return self.idle(motor, brake, dt);
         }
         let reference = self.foc.current_reference(torque_nm as f32);
@@ -325,6 +399,7 @@ impl ElectricalAxis {
             id_sum += m.current.d;
             self.prev_ud = m.voltage.d;
             self.plant.apply(&out);
+            self.plant.set_chopper(self.chopper.step(m.vdc));
             self.plant
                 .set_rotor(motor.position_inc_f64() / INC_PER_RAD, motor.velocity_rad_s());
             let t0 = self.plant.torque_nm();
@@ -361,9 +436,11 @@ impl ElectricalAxis {
 }
 
 impl ElectricalAxis {
-    /// A cycle with the gates off and no current left: no torque, so the motor
-    /// alone; one PWM period of the plant and the (disabled) loop at its end
-    /// keep the sample and the loop's last angle fresh for the next enable.
+    /// A cycle with the gates off, no current left and the DC link below the
+    /// chopper's threshold: no torque, so the motor alone; one PWM period of
+    /// the plant and the (disabled) loop at its end keep the sample and the
+    /// loop's last angle fresh for the next enable (the link changes only
+    /// through the chopper, which is off and stays off).
     fn idle(&mut self, motor: &mut Motor, brake: bool, dt: Nanos) -> MotorOutputs {
         let out = motor.step_applied(0.0, brake, dt);
         let pwm = self.period.as_ns().max(1);
@@ -374,6 +451,8 @@ impl ElectricalAxis {
         let sample = self.plant.sample();
         let pwm_out = self.foc.step(&sample, foc::Dq::default());
         self.plant.apply(&pwm_out);
+        let vdc = self.foc.measured().vdc;
+        self.plant.set_chopper(self.chopper.step(vdc));
         let m = self.foc.measured();
         self.iq_cycle_mean = m.current.q;
         self.d_cycle = None;

@@ -478,6 +478,7 @@ impl PnSim {
             let commands = self.drive.control_cycle(t, &io);
             let period = self.drive.control_period();
             let data = self.drive.axes().each_ref().map(|a| *a.motor());
+            let stage = drive_ecat::stage::StageData::read(self.drive.objects());
             let axes = self.motors.iter_mut().zip(self.feedback.iter_mut());
             for ((((motor, fb), c), el), data) in axes.zip(commands).zip(self.electrical.iter_mut()).zip(data)
             {
@@ -485,6 +486,7 @@ impl PnSim {
                     Some(el) => {
                         // the dictionary's motor data (a refused set keeps the loop's)
                         let _ = el.set_motor_data(&data);
+                        el.set_stage_data(&stage);
                         el.command(&c);
                         el.run(motor, period)
                     }
@@ -497,6 +499,9 @@ impl PnSim {
                         motor.step(torque, !c.brake_release, period)
                     }
                 });
+            }
+            if let Some(mv) = self.electrical[0].as_ref().map(|e| e.dc_link_mv()) {
+                drive_ecat::stage::set_dc_link_voltage(self.drive.objects_mut(), mv);
             }
             self.cycles += 1;
             self.next_cycle = t + period;

@@ -398,6 +398,7 @@ impl SimDrive {
             axis_io(self.feedback[1].as_ref(), &self.motors[1], self.conditions[1]),
         ];
         self.measure_currents(&mut io);
+        self.show_dc_link();
         let cmd = match command {
             Some(c) => self.drive.sync_cycle(&c, t, &io),
             None => self.drive.control_cycle(t, &io),

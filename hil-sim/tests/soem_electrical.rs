@@ -161,3 +161,33 @@ fn e140_e141_soem_motor_actions_identify_the_plants_r_l_and_commutation_offset()
         line.fail_with(&format!("motor_actions.py through SOEM failed: {status}"));
     }
 }
+
+/// E-090 and E-089 through SOEM on the electrical plant (`chopper.py`, issue
+/// 34): the DC-link window refused where it is written (A38 at the
+/// over-voltage trip and A35 above A38 − 20 V: 0609 0031h; A38 too close to
+/// A35: 0609 0032h; A40 read only), then a 0.01 kg·m² flywheel (`serve
+/// --flywheel`) braked from 40 rev/s at −200 % in cst without a brake
+/// resistor (A21 = 0): the link (6079h) climbs from 565 V to the 800 V trip
+/// by the energy balance (within 5 %), 603Fh and EMCY 3110h (event 36).
+#[test]
+fn e090_e089_soem_braking_a_flywheel_without_brake_resistor_trips_over_voltage() {
+    let python = match pysoem_python() {
+        Ok(p) => p,
+        Err(why) => {
+            eprintln!("soem chopper test: skipped, {why}");
+            return;
+        }
+    };
+    let dir = scratch("soem-chopper");
+    let line = Line::with_serve_args(
+        "v",
+        1,
+        120,
+        &dir,
+        &["--plant", "electrical", "--flywheel", "0.01"],
+    );
+    let status = line.run(&python, "chopper.py", &[]);
+    if !status.success() {
+        line.fail_with(&format!("chopper.py through SOEM failed: {status}"));
+    }
+}

@@ -20,6 +20,8 @@
 mod axis;
 #[path = "fault_matrix/bus.rs"]
 mod bus;
+#[path = "fault_matrix/chopper.rs"]
+mod chopper;
 #[path = "fault_matrix/electrical.rs"]
 mod electrical;
 #[path = "fault_matrix/flash.rs"]

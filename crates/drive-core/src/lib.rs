@@ -35,6 +35,7 @@ pub mod objects;
 pub mod params;
 pub mod pdo_image;
 pub mod pdo_maps;
+pub mod stage;
 pub mod tuning;
 pub mod user_units;
 pub mod variant;
@@ -97,5 +98,7 @@ mod tests_records_od;
 mod tests_scaling;
 #[cfg(test)]
 mod tests_spec_walk;
+#[cfg(test)]
+mod tests_stage;
 #[cfg(test)]
 mod tests_variant;

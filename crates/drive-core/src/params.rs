@@ -219,3 +219,22 @@ pub const B73: u16 = parameter_index(1, 73);
 pub const U10: u16 = parameter_index(20, 10);
 /// U11 i²t warning time, ms (per axis).
 pub const U11: u16 = parameter_index(20, 11);
+
+/// A21 brake resistor R, Ω (0 = none; device).
+pub const A21: u16 = parameter_index(0, 21);
+/// A22 brake resistor rated power, W (device; line assumed).
+pub const A22: u16 = parameter_index(0, 22);
+/// A23 brake resistor thermal time constant, ms (device; line assumed).
+pub const A23: u16 = parameter_index(0, 23);
+/// A35 DC-link low voltage limit, V (device; line assumed).
+pub const A35: u16 = parameter_index(0, 35);
+/// A38 brake chopper switch-on threshold, V (device; line assumed).
+pub const A38: u16 = parameter_index(0, 38);
+/// A40 power stage over-voltage trip, V (read only; line assumed).
+pub const A40: u16 = parameter_index(0, 40);
+/// A41 power stage maximum current, mA (read only; line assumed).
+pub const A41: u16 = parameter_index(0, 41);
+/// A42 power stage rated current, mA (read only; line assumed).
+pub const A42: u16 = parameter_index(0, 42);
+/// A43 power stage thermal time constant, ms (read only; line assumed).
+pub const A43: u16 = parameter_index(0, 43);

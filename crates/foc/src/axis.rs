@@ -46,8 +46,12 @@ pub struct Protection {
 impl Protection {
     /// Trip at 9 A, phase sum within 0.3 A, DC link 400…800 V (400 V mains,
     /// 565 V nominal), the current error's mean square within a quarter of
-    /// the reference's + (0.1 A)² per i²t window, power stage 8 A maximum and 4 A rated with a thermal
-    /// time constant of 5 s, the motor's i²t model limiting.
+    /// the reference's + (0.1 A)² per i²t window, power stage 8 A maximum and
+    /// 4 A rated with a thermal time constant of 5 s, the motor's i²t model
+    /// limiting: the declared defaults of the drive's dictionary (A35, A40,
+    /// A41…A43, `drive_core::stage`), for a loop without one; where the
+    /// dictionary exists its values are applied with
+    /// [`FocAxis::set_protection`].
     pub const fn default_stage() -> Self {
         Self {
             over_current: OverCurrent { threshold_a: 9.0 },
@@ -278,6 +282,31 @@ impl FocAxis {
         self.pi.reset();
         self.refresh_limits();
         Ok(())
+    }
+
+    /// New protection thresholds from now on (the power stage's data and the
+    /// DC-link window of the dictionary: its maximum and rated current,
+    /// thermal time constant, over-voltage trip and under-voltage limit). The
+    /// stage's heat (its i²t level) stays; a latched trip stays. Applied only
+    /// when they changed (cheap to call every control cycle).
+    pub fn set_protection(&mut self, protection: Protection) {
+        if protection == self.protection {
+            return;
+        }
+        let x = self.stage_i2t.level();
+        self.stage_i2t = I2t::new(
+            fmath::max(protection.stage_rated_a, 1e-3),
+            fmath::max(protection.stage_tau_s, 1e-3),
+        );
+        self.stage_i2t.set_level(x);
+        self.stage_i2t_alpha = self.stage_i2t.alpha(self.gains.ts_s * I2T_DECIMATION as f32);
+        self.protection = protection;
+        self.refresh_limits();
+    }
+
+    /// The protection thresholds in force.
+    pub fn protection(&self) -> &Protection {
+        &self.protection
     }
 
     /// The gains in force.

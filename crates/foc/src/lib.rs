@@ -11,6 +11,9 @@
 //!   onto the hexagon, dead-time compensation.
 //! - [`protect`]: over-current, phase-sum plausibility, DC-link window, motor i²t,
 //!   current limit = the lowest of several.
+//! - [`chopper`]: the brake chopper (device-level: on above its threshold, off
+//!   below threshold − hysteresis) and its resistor's thermal model (P = V²/R
+//!   against the rated power, τ): warning, then event 42.
 //! - [`seam`]: what a power board (or the simulated plant, crate `plant`) gives and
 //!   takes per axis: [`Sample`] in (ADC counts, encoder), [`PwmOut`] out (compare
 //!   values, gate enable), the [`PowerStage`] trait, the [`Scaling`] applied once.
@@ -35,6 +38,7 @@
 )]
 
 pub mod axis;
+pub mod chopper;
 pub mod params;
 pub mod pi;
 pub mod protect;
@@ -44,6 +48,7 @@ pub mod transform;
 pub mod trig;
 
 pub use axis::{FocAxis, Measured, Protection};
+pub use chopper::{BrakeChopper, ChopperParams};
 pub use params::{Gains, LoopParams, MotorData, Param, ParamError, Violation};
 pub use protect::{I2tState, Trip};
 pub use seam::{PowerStage, PwmOut, Sample, Scaling, Shunts};

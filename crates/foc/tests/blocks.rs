@@ -628,3 +628,97 @@ fn e089_a_current_that_does_not_follow_its_reference_trips_motor_connection() {
         "the first full window's verdict"
     );
 }
+
+/// E-090 (the brake chopper's thermal model behind event 42): the chopper
+/// switches on at its threshold and off only below threshold − hysteresis;
+/// held on at 780 V over 100 Ω (P = V²/R = 6084 W) against a 600 W resistor
+/// with τ = 2 s (u = P/P_rated ≈ 10.1), the model warns at 80 % and faults at
+/// 100 % at the first model step (16 ms) at or after t = −τ·ln(1 − x/u).
+#[test]
+fn e090_chopper_hysteresis_and_resistor_thermal_model() {
+    use foc::chopper::{BrakeChopper, ChopperParams, DECIMATION};
+    let period_s = 1.0f32 / 16_000.0;
+    let p = ChopperParams {
+        resistor_ohm: 100.0,
+        rated_power_w: 600.0,
+        tau_s: 2.0,
+        on_v: 760.0,
+        hysteresis_v: 20.0,
+    };
+    let mut c = BrakeChopper::new(p, period_s);
+    // the two-point controller
+    assert!(!c.step(759.0));
+    assert!(c.step(760.0));
+    assert!(c.step(745.0), "inside the hysteresis: stays on");
+    assert!(c.step(740.0), "at threshold − hysteresis: still on");
+    assert!(!c.step(739.9), "below: off");
+    assert!(!c.step(755.0), "below the threshold: stays off");
+    // no resistor: never on
+    let mut none = BrakeChopper::new(
+        ChopperParams {
+            resistor_ohm: 0.0,
+            ..p
+        },
+        period_s,
+    );
+    assert!(!none.step(900.0));
+    // the thermal model against its closed form
+    let mut c = BrakeChopper::new(p, period_s);
+    let u = 780.0f64 * 780.0 / 100.0 / 600.0;
+    let step_s = f64::from(period_s) * f64::from(DECIMATION);
+    let (mut warned, mut faulted) = (None, None);
+    for k in 1..=200_000u32 {
+        assert!(c.step(780.0));
+        let t = f64::from(k) * f64::from(period_s);
+        if c.warning() && warned.is_none() {
+            warned = Some(t);
+        }
+        if c.fault() {
+            faulted = Some(t);
+            break;
+        }
+    }
+    let at = |x: f64| {
+        let t = -2.0 * (1.0 - x / u).ln();
+        (t / step_s).ceil() * step_s
+    };
+    for (what, seen, x) in [("warning", warned, 0.8), ("fault", faulted, 1.0)] {
+        let seen = seen.unwrap_or_else(|| panic!("resistor {what} never came"));
+        println!("brake resistor {what}: {seen:.4} s, closed form {:.4} s", at(x));
+        assert!(
+            (seen - at(x)).abs() < 1.5 * f64::from(period_s),
+            "resistor {what} at {seen:.4} s, closed form {:.4} s",
+            at(x)
+        );
+    }
+    // latched while hot: a reset does not clear it until below the warning
+    c.reset_fault();
+    assert!(c.fault());
+    for _ in 0..(16_000 * 4) {
+        c.step(700.0);
+    }
+    c.reset_fault();
+    assert!(!c.fault(), "cooled for 2 τ: the fault can be acknowledged");
+}
+
+/// The power stage's data reach a running axis (`set_protection`): a lower
+/// over-voltage trip trips at once, the stage's heat stays.
+#[test]
+fn stage_data_apply_at_run_time() {
+    let mut a = FocAxis::new(
+        MotorData::default_servo(),
+        LoopParams::default_16k(),
+        Scaling::default_board(),
+        Protection::default_stage(),
+    )
+    .unwrap();
+    let s = sample([2048; 3], 2600); // 650 V
+    a.step(&s, foc::Dq::default());
+    assert_eq!(a.trip(), None);
+    let mut p = Protection::default_stage();
+    p.dc_link.max_v = 640.0;
+    a.set_protection(p);
+    assert_eq!(a.protection().dc_link.max_v, 640.0);
+    a.step(&s, foc::Dq::default());
+    assert_eq!(a.trip(), Some(Trip::DcOverVoltage));
+}

@@ -9,6 +9,11 @@
 //! Lq·diq/dt = vq − R·iq − ω·Ld·id − ω·ψ    J·dωm/dt = Te − b·ωm − Tc·sign(ωm) − Tbrake·sign(ωm) + Tg (− Tshaft)
 //! ```
 //!
+//! - DC link ([`DcLinkParams`], optional): a capacitor fed by a diode rectifier
+//!   (current only into the link, through the source's resistance), discharged
+//!   by the inverter's averaged power Σ v_x·i_x and by the brake resistor while
+//!   the chopper conducts ([`Plant::set_chopper`]): regenerative braking raises
+//!   the voltage. `None`: a stiff source.
 //! - Inverter (averaged over a PWM period): leg x puts `d_x·Vdc` on its terminal,
 //!   less `Vdc·t_dead/Ts·sign(i_x)` (linear within ±`dead_time_band_a`); the star
 //!   point floats, so only the phase voltages' differential part (Clarke) acts.
@@ -43,7 +48,8 @@ pub mod params;
 pub mod rng;
 
 pub use params::{
-    AdcParams, FaultOptions, InverterParams, MechParams, Phase, PlantParams, PmsmParams, Shaft, TwoMass,
+    AdcParams, DcLinkParams, FaultOptions, InverterParams, MechParams, Phase, PlantParams, PmsmParams, Shaft,
+    TwoMass,
 };
 
 use core::f64::consts::TAU;
@@ -65,6 +71,12 @@ struct State {
     omega_m: f64,
     theta_l: f64,
     omega_l: f64,
+    /// DC-link voltage, V.
+    vdc: f64,
+    /// Energy the rectifier fed into the link, J.
+    e_mains: f64,
+    /// Energy the brake resistor dissipated, J.
+    e_brake: f64,
 }
 
 impl State {
@@ -76,6 +88,9 @@ impl State {
             omega_m: self.omega_m + k.omega_m * h,
             theta_l: self.theta_l + k.theta_l * h,
             omega_l: self.omega_l + k.omega_l * h,
+            vdc: self.vdc + k.vdc * h,
+            e_mains: self.e_mains + k.e_mains * h,
+            e_brake: self.e_brake + k.e_brake * h,
         }
     }
 }
@@ -91,6 +106,7 @@ pub struct Plant {
     periods: u64,
     brake_engaged: bool,
     held_position: u32,
+    chopper_on: bool,
 }
 
 impl Plant {
@@ -99,6 +115,7 @@ impl Plant {
         let mut x = State {
             theta_m: p.mech.initial_angle_rad,
             theta_l: p.mech.initial_angle_rad,
+            vdc: p.inverter.vdc_v,
             ..State::default()
         };
         if let Shaft::Driven { speed_rad_s } = p.mech.shaft {
@@ -117,6 +134,7 @@ impl Plant {
             periods: 0,
             brake_engaged: false,
             held_position: 0,
+            chopper_on: false,
         };
         plant.held_position = plant.encoder_count();
         plant.sample = plant.take_sample();
@@ -150,9 +168,50 @@ impl Plant {
         }
     }
 
-    /// Changes the DC-link voltage (a mains drop, a regenerating load), V.
+    /// Changes the DC-link voltage at once (a mains drop or surge), V: the
+    /// capacitor's voltage and, with the DC link a state, the mains' peak
+    /// from now on (so the link stays there at rest).
     pub fn set_dc_link(&mut self, vdc_v: f64) {
         self.p.inverter.vdc_v = vdc_v;
+        self.x.vdc = vdc_v;
+        if let Some(dc) = self.p.dc_link.as_mut() {
+            dc.mains_peak_v = vdc_v;
+        }
+    }
+
+    /// The brake chopper's gate from the next period on (true = the brake
+    /// resistor across the link): the chopper block's output
+    /// (`foc::BrakeChopper`). Without a resistor in [`PlantParams::dc_link`]
+    /// it changes nothing.
+    pub fn set_chopper(&mut self, on: bool) {
+        self.chopper_on = on;
+    }
+
+    /// The chopper's gate in force.
+    pub fn chopper_on(&self) -> bool {
+        self.chopper_on
+    }
+
+    /// Sets the brake resistor fitted on the chopper, Ω (0 = none).
+    pub fn set_brake_resistor(&mut self, ohm: f64) {
+        if let Some(dc) = self.p.dc_link.as_mut() {
+            dc.brake_resistor_ohm = ohm;
+        }
+    }
+
+    /// The DC link's voltage, V (without ADC noise).
+    pub fn dc_link_v(&self) -> f64 {
+        self.x.vdc
+    }
+
+    /// Energy the rectifier fed into the link since start, J.
+    pub fn mains_energy_j(&self) -> f64 {
+        self.x.e_mains
+    }
+
+    /// Energy the brake resistor dissipated since start, J.
+    pub fn brake_energy_j(&self) -> f64 {
+        self.x.e_brake
     }
 
     /// Engages (true) or releases the brake.
@@ -283,14 +342,12 @@ impl Plant {
         let k2 = self.deriv(&x0.add(&k1, 0.5 * h), duty, gate);
         let k3 = self.deriv(&x0.add(&k2, 0.5 * h), duty, gate);
         let k4 = self.deriv(&x0.add(&k3, h), duty, gate);
-        let mut x = State {
-            id: x0.id + h / 6.0 * (k1.id + 2.0 * k2.id + 2.0 * k3.id + k4.id),
-            iq: x0.iq + h / 6.0 * (k1.iq + 2.0 * k2.iq + 2.0 * k3.iq + k4.iq),
-            theta_m: x0.theta_m + h / 6.0 * (k1.theta_m + 2.0 * k2.theta_m + 2.0 * k3.theta_m + k4.theta_m),
-            omega_m: x0.omega_m + h / 6.0 * (k1.omega_m + 2.0 * k2.omega_m + 2.0 * k3.omega_m + k4.omega_m),
-            theta_l: x0.theta_l + h / 6.0 * (k1.theta_l + 2.0 * k2.theta_l + 2.0 * k3.theta_l + k4.theta_l),
-            omega_l: x0.omega_l + h / 6.0 * (k1.omega_l + 2.0 * k2.omega_l + 2.0 * k3.omega_l + k4.omega_l),
-        };
+        // x0 + h/6·(k1 + 2·k2 + 2·k3 + k4)
+        let mut x = x0
+            .add(&k1, h / 6.0)
+            .add(&k2, h / 3.0)
+            .add(&k3, h / 3.0)
+            .add(&k4, h / 6.0);
         if self.p.mech.shaft == Shaft::Free {
             // stick: a rotor whose speed crosses zero stops there; the next
             // derivative decides whether the drive torque breaks it loose
@@ -325,7 +382,7 @@ impl Plant {
         let f = &self.p.faults;
         let pp = f64::from(m.pole_pairs);
         let we = pp * x.omega_m;
-        let (did, diq) = if gate {
+        let (did, diq, p_inv) = if gate {
             let (s, c) = self.sin_cos_e(x.theta_m);
             let (ia, ib) = (c * x.id - s * x.iq, s * x.id + c * x.iq);
             let i_abc = [ia, -0.5 * ia + SQRT_3_2 * ib, -0.5 * ia - SQRT_3_2 * ib];
@@ -341,8 +398,11 @@ impl Plant {
                 let leg = leg_of.get(k).copied().unwrap_or(k);
                 let d = duty.get(leg).copied().unwrap_or(0.5);
                 let i = i_abc.get(k).copied().unwrap_or(0.0);
-                *vk = inv.vdc_v * (d - dt * (i / inv.dead_time_band_a).clamp(-1.0, 1.0));
+                *vk = x.vdc * (d - dt * (i / inv.dead_time_band_a).clamp(-1.0, 1.0));
             }
+            // the power the inverter draws from the link (the star point
+            // floats: Σi = 0, so the common mode of v carries none)
+            let p_inv: f64 = v.iter().zip(i_abc).map(|(v, i)| v * i).sum();
             let drop: [f64; 3] = core::array::from_fn(|k| {
                 m.r_ohm * f.r_scale.get(k).copied().unwrap_or(1.0) * i_abc.get(k).copied().unwrap_or(0.0)
             });
@@ -363,11 +423,12 @@ impl Plant {
                 did = c * da + s * db + we * x.iq;
                 diq = -s * da + c * db - we * x.id;
             }
-            (did, diq)
+            (did, diq, p_inv)
         } else {
             (
                 -x.id / 1.0e-6_f64.max(self.p.period_s() / 8.0),
                 -x.iq / 1.0e-6_f64.max(self.p.period_s() / 8.0),
+                0.0,
             )
         };
         let te = 1.5 * pp * (m.psi_vs * x.iq + (m.ld_h - m.lq_h) * x.id * x.iq);
@@ -377,6 +438,18 @@ impl Plant {
             iq: diq,
             ..State::default()
         };
+        if let Some(dc) = &self.p.dc_link {
+            let v = x.vdc.max(1.0);
+            let i_rect = ((dc.mains_peak_v - x.vdc) / dc.source_ohm.max(1e-6)).max(0.0);
+            let i_brake = if self.chopper_on && dc.brake_resistor_ohm > 0.0 {
+                x.vdc.max(0.0) / dc.brake_resistor_ohm
+            } else {
+                0.0
+            };
+            dx.vdc = (i_rect - p_inv / v - i_brake) / dc.capacitance_f.max(1e-9);
+            dx.e_mains = i_rect * x.vdc;
+            dx.e_brake = i_brake * x.vdc;
+        }
         match mech.shaft {
             Shaft::Locked => {}
             Shaft::Driven { .. } => {
@@ -426,7 +499,7 @@ impl Plant {
                 .get(k)
                 .map_or(0.0, |&c| (f64::from(c) / period).clamp(0.0, 1.0));
             if let Some(l) = legs.get_mut(k) {
-                *l += d * self.p.inverter.vdc_v / r.max(1e-3);
+                *l += d * self.x.vdc / r.max(1e-3);
             }
         }
         if let Some(l) = f.broken_sensor.and_then(|ph| legs.get_mut(phase_index(ph))) {
@@ -437,7 +510,7 @@ impl Plant {
             let x = adc.zero_count + il / adc.amps_per_count + adc.current_noise_counts * self.rng.normal();
             *c = libm::round(x).clamp(0.0, full) as u16;
         }
-        let vdc = self.p.inverter.vdc_v / adc.volts_per_count + adc.dc_noise_counts * self.rng.normal();
+        let vdc = self.x.vdc / adc.volts_per_count + adc.dc_noise_counts * self.rng.normal();
         let encoder_ok = !self.p.faults.encoder_lost;
         if encoder_ok {
             self.held_position = self.encoder_count();

@@ -42,7 +42,8 @@ impl PmsmParams {
 /// The averaged two-level inverter.
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct InverterParams {
-    /// DC-link voltage, V.
+    /// DC-link voltage at start, V (with [`PlantParams::dc_link`] `None` the
+    /// stiff source's, always).
     pub vdc_v: f64,
     /// Dead time, s.
     pub dead_time_s: f64,
@@ -66,6 +67,50 @@ impl InverterParams {
             pwm_hz: 16_000.0,
             pwm_period_counts: 4500,
         }
+    }
+}
+
+/// The DC link as a state: a capacitor fed by a diode rectifier from the mains
+/// (current only into the link, through the source's resistance), discharged
+/// by the inverter's power and by the brake resistor while the chopper
+/// conducts:
+///
+/// ```text
+/// C·dV/dt = max(0, (V_mains − V) / R_source) − p_inv / V − (chopper ? V / R_brake : 0)
+/// p_inv = Σ_k v_k·i_k   (the legs' averaged terminal voltages times the phase currents)
+/// ```
+///
+/// The rectifier is averaged (a stiff source at the mains' peak behind its
+/// resistance; no 300 Hz ripple).
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct DcLinkParams {
+    /// Capacitance, F.
+    pub capacitance_f: f64,
+    /// The rectified mains' peak, V (the link's voltage at rest).
+    pub mains_peak_v: f64,
+    /// The mains' and rectifier's resistance, Ω.
+    pub source_ohm: f64,
+    /// The brake resistor on the chopper, Ω (0 = none fitted: the chopper's
+    /// gate changes nothing).
+    pub brake_resistor_ohm: f64,
+}
+
+impl DcLinkParams {
+    /// 470 µF (assumed: the SC6's capacitance is not in the sources), 565 V
+    /// (400 V mains: √2·400 V), 1 Ω source, the 100 Ω brake resistor of the
+    /// manual's example (A21).
+    pub const fn default_400v() -> Self {
+        Self {
+            capacitance_f: 470.0e-6,
+            mains_peak_v: 565.0,
+            source_ohm: 1.0,
+            brake_resistor_ohm: 100.0,
+        }
+    }
+
+    /// Energy in the capacitor at `v`, J: ½·C·V².
+    pub fn energy_j(&self, v: f64) -> f64 {
+        0.5 * self.capacitance_f * v * v
     }
 }
 
@@ -238,6 +283,10 @@ pub struct PlantParams {
     pub mech: MechParams,
     /// Faults.
     pub faults: FaultOptions,
+    /// The DC link as a state ([`DcLinkParams`]), or `None`: a stiff source at
+    /// [`InverterParams::vdc_v`] (nothing raises or lowers it but
+    /// [`crate::Plant::set_dc_link`]).
+    pub dc_link: Option<DcLinkParams>,
     /// RK4 sub-steps per half PWM period (the sample is taken between the halves).
     pub substeps_per_half: u32,
     /// Seed of the ADC noise.
@@ -246,7 +295,8 @@ pub struct PlantParams {
 
 impl PlantParams {
     /// The default servo ([`foc::MotorData::default_servo`] and hil-sim's mechanics)
-    /// behind the default inverter and ADCs, 4 sub-steps per half period.
+    /// behind the default inverter and ADCs, the DC link a state
+    /// ([`DcLinkParams::default_400v`]), 4 sub-steps per half period.
     pub fn default_servo() -> Self {
         Self {
             motor: PmsmParams::from_motor_data(&foc::MotorData::default_servo()),
@@ -254,6 +304,7 @@ impl PlantParams {
             adc: AdcParams::default_board(),
             mech: MechParams::default_servo(),
             faults: FaultOptions::NONE,
+            dc_link: Some(DcLinkParams::default_400v()),
             substeps_per_half: 4,
             seed: 0x5eed_f0c0_0000_0001,
         }

@@ -232,6 +232,12 @@ pub struct ServeArgs {
     /// (default 0; the drive's B05 says 0 until B41 finds it).
     #[arg(long, value_name = "RAD")]
     pub plant_offset: Option<f64>,
+    /// EtherCAT only: axis A of every drive drives a flywheel of this
+    /// inertia, kg·m², frictionless and without a holding brake (a load the
+    /// drive does not know: its motor data stay the servo's), e.g. to brake
+    /// it into the DC link (issue 34, the brake chopper).
+    #[arg(long, value_name = "KG_M2")]
+    pub flywheel: Option<f64>,
     /// Stop after this many seconds (default: run until killed).
     #[arg(long, value_name = "S")]
     pub seconds: Option<f64>,

@@ -105,6 +105,9 @@ pub fn serve(args: &ServeArgs) -> Result<(), String> {
         if args.plant_fault.is_some() && args.plant != Plant::Electrical {
             return Err("--plant-fault needs --plant electrical".into());
         }
+        if args.flywheel.is_some() {
+            return Err("--flywheel is EtherCAT-only".into());
+        }
         return super::serve_pn::serve(args);
     }
     if args.name.is_some() {
@@ -141,6 +144,19 @@ pub fn serve(args: &ServeArgs) -> Result<(), String> {
         }
     }
     set_plant_motor(&mut sim, args)?;
+    if let Some(j) = args.flywheel {
+        if !(j.is_finite() && j > 0.0) {
+            return Err("--flywheel must be a positive inertia".into());
+        }
+        for d in sim.drives_mut() {
+            let m = d.motors[0].params_mut();
+            m.inertia_kg_m2 = j;
+            m.viscous_friction_nm_s_per_rad = 0.0;
+            m.coulomb_friction_nm = 0.0;
+            m.static_friction_nm = 0.0;
+            m.brake_holding_torque_nm = 0.0;
+        }
+    }
     // the recording first: an unwritable path fails before anything else
     if let Some(p) = &args.pcap {
         sim.record_pcap(p)

@@ -54,17 +54,28 @@ impl SimDrive {
         }
     }
 
+    /// 6079h "DC link circuit voltage" (A566): axis A's measured link (each
+    /// axis' plant has its own, `crate::electrical`); nothing with the rigid
+    /// model (it has no DC link).
+    pub(super) fn show_dc_link(&mut self) {
+        if let Some(mv) = self.electrical(0).map(|e| e.dc_link_mv()) {
+            drive_ecat::stage::set_dc_link_voltage(self.drive.objects_mut(), mv);
+        }
+    }
+
     /// One control cycle of both motors under the axes' commands `cmd`
     /// (length `self.cycle`).
     pub(super) fn step_motors(&mut self, cmd: [AxisCommand; 2]) {
         let axes = self.motors.iter_mut().zip(self.feedback.iter_mut());
         let data = self.drive.axes().each_ref().map(|a| *a.motor());
+        let stage = drive_ecat::stage::StageData::read(self.drive.objects());
         for ((((motor, fb), c), el), data) in axes.zip(cmd).zip(self.electrical.iter_mut()).zip(data) {
             *fb = Some(match el {
                 Some(el) => {
                     // the motor data as the drive has them (applied when
                     // they changed; a refused set keeps the loop's)
                     let _ = el.set_motor_data(&data);
+                    el.set_stage_data(&stage);
                     el.command(&c);
                     el.run(motor, self.cycle)
                 }

@@ -39,8 +39,8 @@ pub struct CurrentActual {
     /// 100 %); infinite where the loop has none. The axis' current limit is
     /// the lowest of it, 6073h, 2415h and the motor's i²t limit.
     pub stage_limit_a: f32,
-    /// The power stage's i²t model at or above its warning level
-    /// (statusword bit 7).
+    /// The power stage's i²t model, or the brake resistor's thermal model,
+    /// at or above its warning level (statusword bit 7).
     pub stage_warning: bool,
     /// The d axis over the last control cycle (the motor actions' measurement,
     /// [`DAxisMeans`]); `None` where the loop does not report it.
@@ -131,6 +131,10 @@ pub enum CurrentTrip {
     /// The current does not follow its reference although the voltage has
     /// room (an open motor phase): event 69 "Motor connection" (7120h).
     MotorConnection,
+    /// The brake resistor's thermal model at 100 % (`foc::BrakeChopper`, the
+    /// device's: the shell reports it on each axis): event 42
+    /// "TempBrakeRes" (7110h, error register 08h temperature, E-090).
+    BrakeResistor,
 }
 
 impl From<foc::Trip> for CurrentTrip {
@@ -162,6 +166,7 @@ impl CurrentTrip {
             Self::MotorI2t => 45,
             Self::StageI2t => 39,
             Self::MotorConnection => 69,
+            Self::BrakeResistor => 42,
         };
         Event { number, cause: 2 }
     }

@@ -10,6 +10,9 @@ impl DriveObjects {
     /// signatures.
     pub(super) fn check_consistency(&self, o: &Object, e: &EntryInfo, v: i64) -> Result<(), SdoAbort> {
         let index = o.info.index;
+        if let Some(abort) = crate::stage::window_violation(self, index, v) {
+            return Err(abort);
+        }
         match (index, o.value) {
             (0x1010, Value::Command) if v != i64::from(SAVE_SIGNATURE) => Err(SdoAbort::TRANSFER),
             (0x1011, Value::Command) if v != i64::from(LOAD_SIGNATURE) => Err(SdoAbort::TRANSFER),

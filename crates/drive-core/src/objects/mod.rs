@@ -70,6 +70,7 @@ mod pack;
 pub mod records;
 pub mod scaling;
 pub mod single;
+pub mod stage;
 
 pub use pack::{EntryRecord, ENTRY_TABLE};
 
@@ -454,11 +455,12 @@ const fn entries_sorted(objs: &[Object]) -> bool {
     true
 }
 
-const SETTINGS_A: [Object; control::PARAMS.len() + motor::PARAMS.len()] =
-    merge(&control::PARAMS, &motor::PARAMS);
+const MOTOR_STAGE: [Object; motor::PARAMS.len() + stage::PARAMS.len()] =
+    merge(&motor::PARAMS, &stage::PARAMS);
+const SETTINGS_A: [Object; control::PARAMS.len() + MOTOR_STAGE.len()] = merge(&control::PARAMS, &MOTOR_STAGE);
 /// The global and axis-A manufacturer parameters: those of [`manufacturer`],
-/// the control settings of [`control`] and the motor data of [`motor`],
-/// merged by index.
+/// the control settings of [`control`], the motor data of [`motor`] and the
+/// power stage's data of [`stage`], merged by index.
 pub const MANUFACTURER_A: [Object; manufacturer::PARAMS.len() + SETTINGS_A.len()] =
     merge(&manufacturer::PARAMS, &SETTINGS_A);
 const AXIS_B_PARAMS: usize = count_axis(&MANUFACTURER_A);

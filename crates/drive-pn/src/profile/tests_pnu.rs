@@ -519,3 +519,26 @@ fn p045_issue34_motor_data_through_pkw_saved_and_read_after_a_restart() {
     assert_eq!(again.objects().get(U11, 0), Ok(2_000));
     assert_eq!(again.objects().get(0x6075, 0), Ok(2_500));
 }
+
+/// The power stage's data and the DC-link window of issue 34 through PKW
+/// (PNU = index): A38 (chopper threshold) at or above the over-voltage trip
+/// A40 and A35 (low voltage limit) at or above A38 − 20 V get PKW error 2
+/// (limit exceeded) and change nothing; A40 (the stage's hardware) is read
+/// only (error 1); a consistent A38 is taken.
+#[test]
+fn p045_issue34_dc_link_window_through_pkw_refused_where_written() {
+    use drive_core::params::{A35, A38, A40};
+    let mut b = Bench::new();
+    assert_eq!(b.pkw0(0x41, A40, 0, 0), (0x41, 800), "800 V over-voltage trip");
+    assert_eq!(b.pkw0(0x42, A38, 0, 800), (0xC2, 2), "threshold at the trip");
+    assert_eq!(
+        b.pkw0(0x42, A35, 0, 745),
+        (0xC2, 2),
+        "limit above threshold − hysteresis"
+    );
+    assert_eq!(b.pkw0(0x42, A40, 0, 900), (0xC2, 1), "read only");
+    assert_eq!(b.d.objects().get(A38, 0), Ok(760), "unchanged");
+    assert_eq!(b.d.objects().get(A35, 0), Ok(400), "unchanged");
+    assert_eq!(b.pkw0(0x42, A38, 0, 700).0, 0x42);
+    assert_eq!(b.d.objects().get(A38, 0), Ok(700));
+}

@@ -26,7 +26,7 @@ pub use build::*;
 
 /// The units an entry of a packed table may have (index 0: none); in the
 /// image as [`UNITS`].
-pub const UNIT_NAMES: [&str; 24] = [
+pub const UNIT_NAMES: [&str; 27] = [
     "",
     "inc",
     "inc/s",
@@ -51,6 +51,9 @@ pub const UNIT_NAMES: [&str; 24] = [
     "µH",
     "mΩ",
     "Hz",
+    "Ω",
+    "V",
+    "W",
 ];
 
 /// Bytes of the unit names.
