@@ -2,6 +2,7 @@
 //! master (ethercrab) talks to the simulated line in-process, in simulated time.
 
 pub mod axis;
+pub mod step;
 
 /// The fault matrix's rows (`hil_sim::matrix`, docs/fault-matrix.md).
 pub use hil_sim::{fault_row, matrix};
@@ -96,13 +97,7 @@ pub fn with_master<T>(
     sim: &RefCell<Simulation>,
     body: impl for<'a> AsyncFnOnce(&'a MainDevice<'a>, &'a AtomicU64) -> T,
 ) -> T {
-    // 100 instead of 10 000 DC static-sync frames: the simulated clocks run without drift
-    // unless a test sets one (hil-sim/tests/dc.rs uses the full static sync)
-    let config = ethercrab::MainDeviceConfig {
-        dc_static_sync_iterations: 100,
-        ..Default::default()
-    };
-    hil_sim::master::run_with(sim, timeouts(), config, body)
+    with_master_on(sim, body)
 }
 
 /// Discovers the line and brings it to PRE-OP (ethercrab's init).
@@ -462,9 +457,29 @@ impl CoeClient {
         let cmd = 0x23 | (((4 - data.len()) as u8) << 2);
         let mut req = vec![cmd, i0, i1, sub, 0, 0, 0, 0];
         req[4..4 + data.len()].copy_from_slice(data);
-        let r = self.sdo(sd, &req).await?;
-        assert_eq!(&r[..4], &[0x60, i0, i1, sub], "initiate download response");
+        self.initiate_download(sd, &req).await
+    }
+
+    /// Sends the initiate download request `req` (command, index, sub, …)
+    /// and checks the initiate download response (60h, index, sub).
+    async fn initiate_download<S>(&mut self, sd: &SubDeviceRef<'_, S>, req: &[u8]) -> Result<(), Abort> {
+        let r = self.sdo(sd, req).await?;
+        assert_eq!(
+            r[..4],
+            [0x60, req[1], req[2], req[3]],
+            "initiate download response"
+        );
         Ok(())
+    }
+
+    /// The initiate download request of a normal or segmented download
+    /// (command 21h, 31h with complete access) announcing `size` bytes.
+    fn initiate_sized(index: u16, sub: u8, size: usize, ca: bool) -> Vec<u8> {
+        let [i0, i1] = index.to_le_bytes();
+        let cmd = if ca { 0x31 } else { 0x21 };
+        let mut req = vec![cmd, i0, i1, sub];
+        req.extend_from_slice(&(size as u32).to_le_bytes());
+        req
     }
 
     /// Normal download with the data in the initiate request (command 21h, or
@@ -477,14 +492,9 @@ impl CoeClient {
         data: &[u8],
         ca: bool,
     ) -> Result<(), Abort> {
-        let [i0, i1] = index.to_le_bytes();
-        let cmd = if ca { 0x31 } else { 0x21 };
-        let mut req = vec![cmd, i0, i1, sub];
-        req.extend_from_slice(&(data.len() as u32).to_le_bytes());
+        let mut req = Self::initiate_sized(index, sub, data.len(), ca);
         req.extend_from_slice(data);
-        let r = self.sdo(sd, &req).await?;
-        assert_eq!(&r[..4], &[0x60, i0, i1, sub], "initiate download response");
-        Ok(())
+        self.initiate_download(sd, &req).await
     }
 
     /// Expedited download for 1..=4 bytes, normal otherwise.
@@ -513,10 +523,7 @@ impl CoeClient {
         data: &[u8],
         ca: bool,
     ) -> Result<Vec<Vec<u8>>, Abort> {
-        let [i0, i1] = index.to_le_bytes();
-        let cmd = if ca { 0x31 } else { 0x21 };
-        let mut req = vec![cmd, i0, i1, sub];
-        req.extend_from_slice(&(data.len() as u32).to_le_bytes());
+        let req = Self::initiate_sized(index, sub, data.len(), ca);
         let mut replies = vec![self.sdo(sd, &req).await?];
         let mut toggle = false;
         let chunks: Vec<&[u8]> = data.chunks(7).collect();
@@ -875,6 +882,13 @@ impl<'a> Cyclic<'a> {
         self.command(0x000F, sw::OE, 20).await
     }
 
+    /// Mode `mode` (6060h) for three cycles, then [`Self::enable`].
+    pub async fn enable_in(&mut self, mode: i8) -> TxPdo {
+        self.set_mode(mode);
+        self.run(3).await;
+        self.enable().await
+    }
+
     /// Simulated time.
     pub fn now(&self) -> Nanos {
         self.sim.borrow().now()
@@ -1206,6 +1220,8 @@ pub fn with_master_on<N: hil_sim::sim::Node, T>(
     sim: &RefCell<Simulation<N>>,
     body: impl for<'a> AsyncFnOnce(&'a MainDevice<'a>, &'a AtomicU64) -> T,
 ) -> T {
+    // 100 instead of 10 000 DC static-sync frames: the simulated clocks run without drift
+    // unless a test sets one (hil-sim/tests/dc.rs uses the full static sync)
     let config = ethercrab::MainDeviceConfig {
         dc_static_sync_iterations: 100,
         ..Default::default()

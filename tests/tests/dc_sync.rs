@@ -4,21 +4,16 @@
 //! control-cycle timer to SYNC0 − A292 (E-107, E-109, E-113, E-114); loss of
 //! SYNC0 is reported (A298, PLL fault); a late frame counts in A261[2]
 //! (E-117, E-118); a SYNC0 cycle the PLL cannot run is refused (A261[0], E-116).
-#![allow(
-    clippy::unwrap_used,
-    clippy::expect_used,
-    clippy::panic,
-    clippy::indexing_slicing
-)]
 
 use drive_ecat::runtime::dcsync;
 use drive_ecat::runtime::dcsync::{PllStatus, SyncFault};
 use drive_tests::al::{OP, SAFEOP};
+use drive_tests::init;
 use ethercrab::subdevice_group::DcConfiguration;
 use ethercrab::{DcSync, MainDevice, MainDeviceConfig, SubDeviceGroup};
 use hil_sim::sim::Simulation;
 use std::cell::RefCell;
-use std::sync::atomic::{AtomicU64, Ordering};
+use std::sync::atomic::AtomicU64;
 use std::time::Duration;
 
 /// Oscillator drift of drive 0 (the DC reference) and drive 1, ppm.
@@ -67,11 +62,14 @@ fn with_master<T>(
     )
 }
 
-async fn init<'a>(md: &'a MainDevice<'a>, clock: &'a AtomicU64) -> SubDeviceGroup<8, 512> {
-    md.init_single_group::<8, 512>(|| clock.load(Ordering::Relaxed))
-        .await
-        .expect("ethercrab init")
-}
+/// The line in Op with DC.
+type DcOpGroup = SubDeviceGroup<
+    8,
+    512,
+    ethercrab::DefaultLock,
+    ethercrab::subdevice_group::Op,
+    ethercrab::subdevice_group::HasDc,
+>;
 
 /// What to do to the line during the DC cycles.
 #[derive(Clone, Copy, PartialEq, Eq)]
@@ -445,13 +443,7 @@ async fn dc_requested_op<'a>(
 
 async fn dc_cycles<'a>(
     md: &'a MainDevice<'a>,
-    group: &SubDeviceGroup<
-        8,
-        512,
-        ethercrab::DefaultLock,
-        ethercrab::subdevice_group::Op,
-        ethercrab::subdevice_group::HasDc,
-    >,
+    group: &DcOpGroup,
     sim: &RefCell<Simulation>,
     n: usize,
     mut probe: impl FnMut(usize, bool, &Simulation),
@@ -1037,13 +1029,7 @@ fn e115_a298_bits_through_the_master() {
 /// the dictionary holds them.
 async fn a287_measurement<'a>(
     md: &'a MainDevice<'a>,
-    group: &SubDeviceGroup<
-        8,
-        512,
-        ethercrab::DefaultLock,
-        ethercrab::subdevice_group::Op,
-        ethercrab::subdevice_group::HasDc,
-    >,
+    group: &DcOpGroup,
     sim: &RefCell<Simulation>,
     mut each: impl FnMut(usize, &mut Simulation),
 ) -> (i64, i64, i64) {

@@ -9,12 +9,6 @@
 //! [`drive_tests::fault_row!`], which leaves its row for the printed table
 //! (`scripts/fault-matrix`). Cases elsewhere join the table the same way:
 //! SYNC0 loss (dc_sync.rs), power cut during a save (save.rs).
-#![allow(
-    clippy::unwrap_used,
-    clippy::expect_used,
-    clippy::panic,
-    clippy::indexing_slicing
-)]
 
 #[path = "fault_matrix/axis.rs"]
 mod axis;
@@ -27,16 +21,27 @@ mod flash;
 #[path = "fault_matrix/mailbox.rs"]
 mod mailbox;
 
+use drive_tests::matrix::Row;
+pub use drive_tests::step::advance;
 use drive_tests::CoeClient;
 use ethercrab::SubDeviceRef;
 use hil_sim::sim::Simulation;
 use std::cell::RefCell;
 
-/// Runs the line `ns` of simulated time on, without frames.
-pub fn advance<N: hil_sim::sim::Node>(sim: &RefCell<Simulation<N>>, ns: u64) {
-    let mut s = sim.borrow_mut();
-    let t = s.now().as_ns() + ns;
-    s.advance_to(nanos::Nanos::from_ns(t));
+/// A row of the table run by the in-process ethercrab master.
+pub fn ethercrab(
+    order: &'static str,
+    case: &'static str,
+    spec: &'static str,
+    expected: &'static str,
+) -> Row<'static> {
+    Row {
+        order,
+        case,
+        spec,
+        peer: "ethercrab",
+        expected,
+    }
 }
 
 /// An object of the first drive, read locally.

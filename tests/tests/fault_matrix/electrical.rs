@@ -5,9 +5,9 @@
 //! The faults are the plant's (`plant::FaultOptions`, the DC link): a test
 //! changes the motor, its wiring or the supply, never the drive.
 
-use super::{emcys, get, newest_diag};
+use super::{emcys, ethercrab, get, newest_diag};
 use drive_tests::axis::{with_drive, CW_FAULT_RESET};
-use drive_tests::matrix::{al, cia402_state, emcys as show_emcys, Row};
+use drive_tests::matrix::{al, cia402_state, emcys as show_emcys};
 use drive_tests::{al_status, fault_row, init, line, with_master, Cyclic, REV};
 use hil_sim::electrical::{ElectricalAxis, PlantModel};
 use hil_sim::sim::SimDrive;
@@ -39,9 +39,7 @@ fn during_motion(cause: fn(&mut ElectricalAxis), clear: fn(&mut ElectricalAxis))
         let group = init(md, clock).await.into_op(md).await.expect("OP");
         let sd = group.subdevice(md, 0).unwrap();
         let mut m = Cyclic::new(md, &group, &sim, 0);
-        m.set_mode(9);
-        m.run(3).await;
-        m.enable().await;
+        m.enable_in(9).await;
         m.set_target_velocity(2 * REV);
         m.run(300).await;
         let mut before = 0;
@@ -104,17 +102,16 @@ fn during_motion(cause: fn(&mut ElectricalAxis), clear: fn(&mut ElectricalAxis))
 
 #[test]
 fn e089_over_current_of_a_shorted_leg_on_the_electrical_plant_is_event_33() {
-    let row = Row {
-        order: "45",
-        case: "electrical plant: leg a shorted to the DC link's negative rail (1 Ω) while axis A turns \
-               at 2 rev/s (csv)",
-        spec: "E-089",
-        peer: "ethercrab",
-        expected: "Fault, power stage off, brake engaged, the gates on for 1 PWM period(s) after the \
-                   fault; EMCY 2310h/02h event 33 cause 2; 603Fh 2310h; E47 0; history: error 2310h axis \
-                   A event 33/2; Op, AL 0000h; while the cause lasts a reset gives Switch on disabled \
-                   (E47 4), the enable into it: Fault; after it: Operation enabled",
-    };
+    let row = ethercrab(
+        "45",
+        "electrical plant: leg a shorted to the DC link's negative rail (1 Ω) while axis A turns \
+         at 2 rev/s (csv)",
+        "E-089",
+        "Fault, power stage off, brake engaged, the gates on for 1 PWM period(s) after the \
+         fault; EMCY 2310h/02h event 33 cause 2; 603Fh 2310h; E47 0; history: error 2310h axis \
+         A event 33/2; Op, AL 0000h; while the cause lasts a reset gives Switch on disabled \
+         (E47 4), the enable into it: Fault; after it: Operation enabled",
+    );
     let seen = during_motion(
         |el| {
             el.plant_mut().set_faults(FaultOptions {
@@ -129,17 +126,16 @@ fn e089_over_current_of_a_shorted_leg_on_the_electrical_plant_is_event_33() {
 
 #[test]
 fn e089_an_earth_fault_on_the_electrical_plant_is_the_phase_sum_event_31() {
-    let row = Row {
-        order: "46",
-        case: "electrical plant: an earth fault of leg a (100 Ω to the DC link's negative rail: the three \
-               measured currents no longer sum to zero) while axis A turns at 2 rev/s (csv)",
-        spec: "E-089",
-        peer: "ethercrab",
-        expected: "Fault, power stage off, brake engaged, the gates on for 1 PWM period(s) after the fault; EMCY \
-                   2110h/02h event 31 cause 2; 603Fh 2110h; E47 0; history: error 2110h axis A event 31/2; Op, AL \
-                   0000h; while the cause lasts a reset gives Switch on disabled (E47 4), the enable into it: \
-                   Fault; after it: Operation enabled",
-    };
+    let row = ethercrab(
+        "46",
+        "electrical plant: an earth fault of leg a (100 Ω to the DC link's negative rail: the three \
+         measured currents no longer sum to zero) while axis A turns at 2 rev/s (csv)",
+        "E-089",
+        "Fault, power stage off, brake engaged, the gates on for 1 PWM period(s) after the fault; EMCY \
+         2110h/02h event 31 cause 2; 603Fh 2110h; E47 0; history: error 2110h axis A event 31/2; Op, AL \
+         0000h; while the cause lasts a reset gives Switch on disabled (E47 4), the enable into it: \
+         Fault; after it: Operation enabled",
+    );
     let seen = during_motion(
         |el| {
             el.plant_mut().set_faults(FaultOptions {
@@ -154,17 +150,16 @@ fn e089_an_earth_fault_on_the_electrical_plant_is_the_phase_sum_event_31() {
 
 #[test]
 fn e089_a_dc_link_drop_on_the_electrical_plant_is_event_46() {
-    let row = Row {
-        order: "47",
-        case: "electrical plant: the DC link drops from 565 V to 300 V (below 400 V) while axis A turns \
-               at 2 rev/s (csv)",
-        spec: "E-089",
-        peer: "ethercrab",
-        expected: "Fault, power stage off, brake engaged, the gates on for 1 PWM period(s) after the fault; EMCY \
-                   3120h/04h event 46 cause 2; 603Fh 3120h; E47 0; history: error 3120h axis A event 46/2; Op, AL \
-                   0000h; while the cause lasts a reset gives Switch on disabled (E47 4), the enable into it: \
-                   Fault; after it: Operation enabled",
-    };
+    let row = ethercrab(
+        "47",
+        "electrical plant: the DC link drops from 565 V to 300 V (below 400 V) while axis A turns \
+         at 2 rev/s (csv)",
+        "E-089",
+        "Fault, power stage off, brake engaged, the gates on for 1 PWM period(s) after the fault; EMCY \
+         3120h/04h event 46 cause 2; 603Fh 3120h; E47 0; history: error 3120h axis A event 46/2; Op, AL \
+         0000h; while the cause lasts a reset gives Switch on disabled (E47 4), the enable into it: \
+         Fault; after it: Operation enabled",
+    );
     let seen = during_motion(
         |el| el.plant_mut().set_dc_link(300.0),
         |el| el.plant_mut().set_dc_link(565.0),
@@ -174,16 +169,15 @@ fn e089_a_dc_link_drop_on_the_electrical_plant_is_event_46() {
 
 #[test]
 fn e089_a_dc_link_over_voltage_on_the_electrical_plant_is_event_36() {
-    let row = Row {
-        order: "48",
-        case: "electrical plant: the DC link rises from 565 V to 850 V (above 800 V) while axis A turns \
-               at 2 rev/s (csv)",
-        spec: "E-089",
-        peer: "ethercrab",
-        expected: "Fault, power stage off, brake engaged, the gates on for 1 PWM period(s) after the fault; EMCY \
-                   3110h/04h event 36 cause 2; 603Fh 3110h; E47 0; history: error 3110h axis A event 36/2; Op, AL \
-                   0000h; while the cause lasts a reset gives Fault (E47 0); after it: Operation enabled",
-    };
+    let row = ethercrab(
+        "48",
+        "electrical plant: the DC link rises from 565 V to 850 V (above 800 V) while axis A turns \
+         at 2 rev/s (csv)",
+        "E-089",
+        "Fault, power stage off, brake engaged, the gates on for 1 PWM period(s) after the fault; EMCY \
+         3110h/04h event 36 cause 2; 603Fh 3110h; E47 0; history: error 3110h axis A event 36/2; Op, AL \
+         0000h; while the cause lasts a reset gives Fault (E47 0); after it: Operation enabled",
+    );
     let seen = during_motion(
         |el| el.plant_mut().set_dc_link(850.0),
         |el| el.plant_mut().set_dc_link(565.0),
@@ -193,16 +187,15 @@ fn e089_a_dc_link_over_voltage_on_the_electrical_plant_is_event_36() {
 
 #[test]
 fn e089_c017_the_current_loops_encoder_lost_mid_move_is_event_37() {
-    let row = Row {
-        order: "49",
-        case: "electrical plant: the encoder the current loop commutates with fails while axis A turns \
-               at 2 rev/s (csv)",
-        spec: "E-089, C-017",
-        peer: "ethercrab",
-        expected: "Fault, power stage off, brake engaged, the gates on for 1 PWM period(s) after the fault; EMCY \
-                   7303h/01h event 37 cause 2; 603Fh 7303h; E47 0; history: error 7303h axis A event 37/2; Op, AL \
-                   0000h; while the cause lasts a reset gives Fault (E47 0); after it: Operation enabled",
-    };
+    let row = ethercrab(
+        "49",
+        "electrical plant: the encoder the current loop commutates with fails while axis A turns \
+         at 2 rev/s (csv)",
+        "E-089, C-017",
+        "Fault, power stage off, brake engaged, the gates on for 1 PWM period(s) after the fault; EMCY \
+         7303h/01h event 37 cause 2; 603Fh 7303h; E47 0; history: error 7303h axis A event 37/2; Op, AL \
+         0000h; while the cause lasts a reset gives Fault (E47 0); after it: Operation enabled",
+    );
     let seen = during_motion(
         |el| {
             el.plant_mut().set_faults(FaultOptions {
