@@ -44,6 +44,33 @@ pub fn ethercrab(
     }
 }
 
+/// E47: the first cause of Switch on disabled (C-015).
+pub const E47: u16 = drive_ecat::parameter_index(4, 47);
+
+/// The end of a fault as the master reads it: "EMCYs; 603Fh; E47; the
+/// newest diagnosis message; AL state" (the EMCYs first: an SDO read of the
+/// master would take them out of the mailbox).
+pub async fn fault_end<S>(sd: &SubDeviceRef<'_, S>, sim: &RefCell<Simulation>) -> String
+where
+    S: std::ops::Deref<Target = ethercrab::SubDevice>,
+{
+    let em = drive_tests::matrix::emcys(&emcys(sd).await);
+    let code: u16 = sd.sdo_read(0x603F, 0).await.unwrap();
+    let e47 = get(sim, E47, 0);
+    let diag = newest_diag(sd).await;
+    let al = drive_tests::matrix::al(drive_tests::al_status(sd).await);
+    format!("{em}; 603Fh {code:04X}h; E47 {e47}; {diag}; {al}")
+}
+
+/// Controlword 0 for 2 cycles, then a fault reset (bit 7) for 10; the last
+/// TxPDO.
+pub async fn fault_reset(m: &mut drive_tests::Cyclic<'_>) -> drive_tests::TxPdo {
+    m.set_controlword(0);
+    m.run(2).await;
+    m.set_controlword(drive_tests::axis::CW_FAULT_RESET);
+    m.run(10).await
+}
+
 /// An object of the first drive, read locally.
 pub fn get(sim: &RefCell<Simulation>, index: u16, sub: u8) -> i64 {
     sim.borrow().drives()[0].drive.objects().get(index, sub).unwrap()

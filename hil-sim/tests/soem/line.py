@@ -605,6 +605,17 @@ def master_main(args, run, done):
     return 0
 
 
+def script_main(doc, run, done, *options):
+    """The main of a script against the line: --iface and `options`
+    ((name, add_argument's keywords) each) from the command line, then
+    master_main(args, run, done)."""
+    ap = argparse.ArgumentParser(description=doc, formatter_class=argparse.RawDescriptionHelpFormatter)
+    ap.add_argument("--iface", required=True)
+    for name, kw in options:
+        ap.add_argument(name, **kw)
+    return master_main(ap.parse_args(), run, done)
+
+
 def priority():
     """Timer slack 1 ns; nice -20 where permitted, so that the compile jobs of
     a shared machine do not hold up SOEM's mailbox exchanges (it waits for a

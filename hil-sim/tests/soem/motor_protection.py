@@ -33,7 +33,6 @@ Free run, one drive, axis A; RxPDO 6040h, 6060h, 6071h; TxPDO 6041h, 6061h,
 
 Prints `FAIL: ...` for every check that failed; exit status 0 when none did.
 """
-import argparse
 import math
 import os
 import struct
@@ -229,12 +228,9 @@ def run(m, args):
 
 
 def main():
-    ap = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
-    ap.add_argument("--iface", required=True)
-    ap.add_argument("--tau-ms", type=int, default=4000, help="B73 thermal time constant, ms")
-    ap.add_argument("--u11-ms", type=int, default=500, help="U11 i2t warning time, ms")
-    args = ap.parse_args()
-    return L.master_main(args, run, "motor protection on the electrical plant: all checks passed")
+    return L.script_main(__doc__, run, "motor protection on the electrical plant: all checks passed",
+                         ("--tau-ms", dict(type=int, default=4000, help="B73 thermal time constant, ms")),
+                         ("--u11-ms", dict(type=int, default=500, help="U11 i2t warning time, ms")))
 
 
 if __name__ == "__main__":

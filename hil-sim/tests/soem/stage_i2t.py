@@ -26,7 +26,6 @@ rated, thermal time constant 5 s; the motor: 2 A rated (6075h), tau 600 s.
 
 Prints `FAIL: ...` for every check that failed; exit status 0 when none did.
 """
-import argparse
 import math
 import os
 import sys
@@ -100,10 +99,7 @@ def run(m, args):
 
 
 def main():
-    ap = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
-    ap.add_argument("--iface", required=True)
-    args = ap.parse_args()
-    return L.master_main(args, run, "current limit and power-stage i2t on the electrical plant: all checks passed")
+    return L.script_main(__doc__, run, "current limit and power-stage i2t on the electrical plant: all checks passed")
 
 
 if __name__ == "__main__":

@@ -22,7 +22,6 @@ extrapolate nothing), one drive, axis A:
 
 Prints `FAIL: …` for every check that failed; exit status 0 when none did.
 """
-import argparse
 import os
 import sys
 import time
@@ -164,12 +163,9 @@ def to_op(m):
 
 
 def main():
-    ap = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
-    ap.add_argument("--iface", required=True)
-    ap.add_argument("--limit", type=int, default=400, help="G472 = G475, 0.1 %% of I10")
-    ap.add_argument("--i10", type=float, required=True, help="I10 maximum speed, inc/s")
-    args = ap.parse_args()
-    return L.master_main(args, run, "torque modes: all checks passed")
+    return L.script_main(__doc__, run, "torque modes: all checks passed",
+                         ("--limit", dict(type=int, default=400, help="G472 = G475, 0.1 %% of I10")),
+                         ("--i10", dict(type=float, required=True, help="I10 maximum speed, inc/s")))
 
 
 if __name__ == "__main__":

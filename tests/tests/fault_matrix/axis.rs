@@ -1,15 +1,12 @@
 //! Faults at the axis: encoder fault, STO and supply undervoltage during
 //! motion, a limit switch against the travel during homing.
 
-use super::{emcys, ethercrab, get, newest_diag};
-use drive_tests::axis::{with_drive, CW_BIT4, CW_ENABLED, CW_FAULT_RESET};
+use super::{emcys, ethercrab, fault_end, fault_reset, get, E47};
+use drive_tests::axis::{with_drive, CW_BIT4, CW_ENABLED};
 use drive_tests::matrix::{al, cia402_state, emcys as show_emcys};
 use drive_tests::{al_status, fault_row, init, line, with_master, Cyclic, REV};
 use hil_sim::motor::{PositionInput, Switches};
 use hil_sim::sim::AxisConditions;
-
-/// E47: the first cause of Switch on disabled (C-015).
-const E47: u16 = drive_ecat::parameter_index(4, 47);
 
 /// Axis A at 2 rev/s in csv; `cause` happens to it; after 100 ms the end
 /// is read (state, power stage, EMCY, 603Fh, E47, the history, AL); then
@@ -36,29 +33,18 @@ fn during_motion(cause: fn(&mut AxisConditions), clear: fn(&mut AxisConditions))
             }
         };
         let state = cia402_state(tx.statusword);
-        // the EMCYs first: an SDO read of the master would take them out of the mailbox
-        let em = show_emcys(&emcys(&sd).await);
-        let code: u16 = sd.sdo_read(0x603F, 0).await.unwrap();
-        let e47 = get(&sim, E47, 0);
-        let diag = newest_diag(&sd).await;
-        let al = al(al_status(&sd).await);
+        let end = fault_end(&sd, &sim).await;
         // a fault reset while the cause lasts
-        m.set_controlword(0);
-        m.run(2).await;
-        m.set_controlword(CW_FAULT_RESET);
-        let tx = m.run(10).await;
+        let tx = fault_reset(&mut m).await;
         let lasting = format!("{} (E47 {})", cia402_state(tx.statusword), get(&sim, E47, 0));
         // the cause ends: reset, enable
         with_drive(&sim, |d| clear(&mut d.conditions[0]));
-        m.set_controlword(0);
-        m.run(2).await;
-        m.set_controlword(CW_FAULT_RESET);
-        m.run(10).await;
+        fault_reset(&mut m).await;
         m.set_controlword(0);
         m.run(2).await;
         let after = cia402_state(m.enable().await.statusword);
         format!(
-            "{state}, {stage}; {em}; 603Fh {code:04X}h; E47 {e47}; {diag}; {al}; \
+            "{state}, {stage}; {end}; \
              while the cause lasts a reset gives {lasting}; after it: {after}"
         )
     })

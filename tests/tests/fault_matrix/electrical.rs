@@ -5,16 +5,13 @@
 //! The faults are the plant's (`plant::FaultOptions`, the DC link): a test
 //! changes the motor, its wiring or the supply, never the drive.
 
-use super::{emcys, ethercrab, get, newest_diag};
-use drive_tests::axis::{with_drive, CW_FAULT_RESET};
-use drive_tests::matrix::{al, cia402_state, emcys as show_emcys};
-use drive_tests::{al_status, fault_row, init, line, with_master, Cyclic, REV};
+use super::{ethercrab, fault_end, fault_reset, get, E47};
+use drive_tests::axis::with_drive;
+use drive_tests::matrix::cia402_state;
+use drive_tests::{fault_row, init, line, with_master, Cyclic, REV};
 use hil_sim::electrical::{ElectricalAxis, PlantModel};
 use hil_sim::sim::SimDrive;
 use plant::{FaultOptions, Phase};
-
-/// E47: the first cause of Switch on disabled (C-015).
-const E47: u16 = drive_ecat::parameter_index(4, 47);
 
 fn axis_a(d: &mut SimDrive) -> &mut ElectricalAxis {
     d.electrical_mut(0).expect("axis A runs the electrical plant")
@@ -62,17 +59,9 @@ fn during_motion(cause: fn(&mut ElectricalAxis), clear: fn(&mut ElectricalAxis))
             };
         });
         let state = cia402_state(tx.statusword);
-        // the EMCYs first: an SDO read of the master would take them out of the mailbox
-        let em = show_emcys(&emcys(&sd).await);
-        let code: u16 = sd.sdo_read(0x603F, 0).await.unwrap();
-        let e47 = get(&sim, E47, 0);
-        let diag = newest_diag(&sd).await;
-        let al = al(al_status(&sd).await);
+        let end = fault_end(&sd, &sim).await;
         // a fault reset while the cause lasts, and the enable into it
-        m.set_controlword(0);
-        m.run(2).await;
-        m.set_controlword(CW_FAULT_RESET);
-        let tx = m.run(10).await;
+        let tx = fault_reset(&mut m).await;
         let mut lasting = format!("{} (E47 {})", cia402_state(tx.statusword), get(&sim, E47, 0));
         if cia402_state(tx.statusword) != "Fault" {
             m.set_controlword(0);
@@ -85,16 +74,13 @@ fn during_motion(cause: fn(&mut ElectricalAxis), clear: fn(&mut ElectricalAxis))
         }
         // the cause ends: reset, enable
         with_drive(&sim, |d| clear(axis_a(d)));
-        m.set_controlword(0);
-        m.run(2).await;
-        m.set_controlword(CW_FAULT_RESET);
-        m.run(10).await;
+        fault_reset(&mut m).await;
         m.set_controlword(0);
         m.run(2).await;
         let after = cia402_state(m.enable().await.statusword);
         format!(
-            "{state}, {stage}, the gates on for {gated} PWM period(s) after the fault; {em}; \
-             603Fh {code:04X}h; E47 {e47}; {diag}; {al}; while the cause lasts a reset gives \
+            "{state}, {stage}, the gates on for {gated} PWM period(s) after the fault; {end}; \
+             while the cause lasts a reset gives \
              {lasting}; after it: {after}"
         )
     })
