@@ -757,6 +757,30 @@ pub struct Cyclic<'a> {
     pub cycles: u64,
 }
 
+/// One master cycle of drive `slave` of `group`: `out` written to its
+/// outputs, the simulated time one master cycle on, the frame exchanged (both
+/// its outputs written and inputs read, WKC 3); `read` of its inputs.
+async fn exchange<R>(
+    md: &MainDevice<'_>,
+    group: &OpGroup,
+    sim: &RefCell<Simulation>,
+    slave: usize,
+    out: &[u8],
+    read: impl FnOnce(&[u8]) -> R,
+) -> R {
+    let sd = group.subdevice(md, slave).expect("subdevice");
+    sd.outputs_raw_mut().copy_from_slice(out);
+    {
+        let mut sim = sim.borrow_mut();
+        let t = sim.now() + MASTER_CYCLE;
+        sim.advance_to(t);
+    }
+    let r = group.tx_rx(md).await.expect("process data cycle");
+    assert_eq!(r.working_counter, 3, "outputs written and inputs read");
+    let io = sd.io_raw();
+    read(io.inputs())
+}
+
 impl<'a> Cyclic<'a> {
     /// A master on drive `slave` of `group`; the outputs start all zero
     /// (controlword 0, mode 0).
@@ -827,16 +851,15 @@ impl<'a> Cyclic<'a> {
 
     /// One master cycle; returns the TxPDO received.
     pub async fn cycle(&mut self) -> TxPdo {
-        let sd = self.group.subdevice(self.md, self.slave).expect("subdevice");
-        sd.outputs_raw_mut().copy_from_slice(&self.out);
-        {
-            let mut sim = self.sim.borrow_mut();
-            let t = sim.now() + MASTER_CYCLE;
-            sim.advance_to(t);
-        }
-        let r = self.group.tx_rx(self.md).await.expect("process data cycle");
-        assert_eq!(r.working_counter, 3, "outputs written and inputs read");
-        self.tx = TxPdo::decode(sd.io_raw().inputs());
+        self.tx = exchange(
+            self.md,
+            self.group,
+            self.sim,
+            self.slave,
+            &self.out,
+            TxPdo::decode,
+        )
+        .await;
         self.cycles += 1;
         self.tx
     }
@@ -880,6 +903,14 @@ impl<'a> Cyclic<'a> {
         self.command(0x0006, sw::RTSO, 20).await;
         self.command(0x0007, sw::SO, 20).await;
         self.command(0x000F, sw::OE, 20).await
+    }
+
+    /// Enabled in csv ([`Self::enable_in`] 9), then `n` cycles at the target
+    /// velocity `v` (inc/s).
+    pub async fn csv_at(&mut self, v: i32, n: usize) -> TxPdo {
+        self.enable_in(9).await;
+        self.set_target_velocity(v);
+        self.run(n).await
     }
 
     /// Mode `mode` (6060h) for three cycles, then [`Self::enable`].
@@ -1013,16 +1044,11 @@ impl<'a> RawCyclic<'a> {
 
     /// One master cycle (see [`Cyclic::cycle`]).
     pub async fn cycle(&mut self) {
-        let sd = self.group.subdevice(self.md, self.slave).expect("subdevice");
-        sd.outputs_raw_mut().copy_from_slice(&self.out);
-        {
-            let mut sim = self.sim.borrow_mut();
-            let t = sim.now() + MASTER_CYCLE;
-            sim.advance_to(t);
-        }
-        let r = self.group.tx_rx(self.md).await.expect("process data cycle");
-        assert_eq!(r.working_counter, 3, "outputs written and inputs read");
-        self.inputs.copy_from_slice(sd.io_raw().inputs());
+        let inputs = &mut self.inputs;
+        exchange(self.md, self.group, self.sim, self.slave, &self.out, |i| {
+            inputs.copy_from_slice(i)
+        })
+        .await;
         self.cycles += 1;
     }
 

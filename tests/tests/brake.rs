@@ -76,9 +76,7 @@ fn c021_f00_brake_control_inactive_keeps_the_brake_applied_while_enabled() {
         let group = init(md, clock).await.into_op(md).await.expect("OP");
         let sd = group.subdevice(md, 0).unwrap();
         let mut m = Cyclic::new(md, &group, &sim, 0);
-        m.enable_in(9).await;
-        m.set_target_velocity(2 * REV);
-        m.run(300).await;
+        m.csv_at(2 * REV, 300).await;
         assert!(!applied(&sim), "F00 = 1, moving: released");
         let v = velocity_rev_s(&sim);
         assert!((v - 2.0).abs() < 0.1, "2 rev/s: {v}");

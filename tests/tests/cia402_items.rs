@@ -399,9 +399,7 @@ fn c104_c107_limit_switches_from_i210_and_e80() {
         sd.sdo_write(I101, 0, 2u8).await.unwrap();
         sd.sdo_write(I102, 0, 2u8).await.unwrap();
         let mut m = Cyclic::new(md, &group, &sim, 0);
-        m.enable_in(9).await;
-        m.set_target_velocity(REV);
-        m.run(200).await;
+        m.csv_at(REV, 200).await;
         assert_eq!(m.tx.state(), sw::OE);
         let e80: u8 = sd.sdo_read(E80, 0).await.unwrap();
         assert_eq!(e80, 0, "E80 without limitation");
@@ -463,9 +461,7 @@ fn c107_e80_shows_illegal_direction_on_an_endless_axis() {
         let group = group.into_op(md).await.expect("OP");
         let sd = group.subdevice(md, 0).unwrap();
         let mut m = Cyclic::new(md, &group, &sim, 0);
-        m.enable_in(9).await;
-        m.set_target_velocity(REV / 2);
-        m.run(300).await;
+        m.csv_at(REV / 2, 300).await;
         let e80: u8 = sd.sdo_read(E80, 0).await.unwrap();
         assert_eq!(e80, 15, "E80 = 15 illegal direction (negative locked)");
         assert!(m.tx.velocity > REV / 4, "the permitted direction moves");
@@ -740,9 +736,8 @@ fn c109_gear_and_feed_scale_positions_and_velocities_through_the_master() {
         sd.sdo_write(0x6092, 1, 360_000u32).await.unwrap();
         sd.sdo_write(0x6091, 1, 2u32).await.unwrap();
         sd.sdo_write(0x6091, 2, 1u32).await.unwrap();
-        sd.sdo_write(0x6081, 0, 180_000u32).await.unwrap(); // 0.5 shaft rev/s
-        sd.sdo_write(0x6083, 0, 3_600_000u32).await.unwrap(); // 10 shaft rev/s²
-        sd.sdo_write(0x6084, 0, 3_600_000u32).await.unwrap();
+        // 0.5 shaft rev/s, 10 shaft rev/s²
+        set_profile(&sd, Some(180_000u32), 3_600_000u32).await;
         sd.sdo_write(0x607F, 0, 18_000_000u32).await.unwrap(); // 50 shaft rev/s
         let mut m = Cyclic::new(md, &group, &sim, 0);
         m.set_mode(9);

@@ -49,9 +49,7 @@ fn c017_c021_c041_pp_after_fault_reset_and_enable_follows_as_before() {
     with_master(&sim, async |md, clock| {
         let group = init(md, clock).await.into_op(md).await.expect("OP");
         let sd = group.subdevice(md, 0).unwrap();
-        sd.sdo_write(0x6081, 0, 5 * REV as u32).await.unwrap();
-        sd.sdo_write(0x6083, 0, 50 * REV as u32).await.unwrap();
-        sd.sdo_write(0x6084, 0, 50 * REV as u32).await.unwrap();
+        set_profile(&sd, Some(5 * REV as u32), 50 * REV as u32).await;
         let mut m = Cyclic::new(md, &group, &sim, 0);
         m.enable_in(1).await;
         home_here(&mut m).await;

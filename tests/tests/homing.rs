@@ -434,12 +434,7 @@ fn c082_method_minus_4_negative_torque_stop_then_index() {
 fn c086_limit_switch_as_reference_switch() {
     // I30 = 2: method 19 takes +LS as its home switch; no limit-switch fault
     let sim_case = Case::new(19, axis(PositionInput::never()), POS_LS, EDGE_TOL);
-    let sim = line(1);
-    {
-        let mut s = sim.borrow_mut();
-        let d = &mut s.drives_mut()[0];
-        *d.motors[0].switches_mut() = sim_case.switches;
-    }
+    let sim = line_with_switches(sim_case.switches);
     with_master(&sim, async |md, clock| {
         let group = init(md, clock).await.into_op(md).await.expect("OP");
         let sd = group.subdevice(md, 0).unwrap();
@@ -483,12 +478,7 @@ fn c086_limit_switch_as_reference_switch() {
 
 #[test]
 fn c059_halt_interrupts_homing_then_restart_completes() {
-    let sim = line(1);
-    {
-        let mut s = sim.borrow_mut();
-        let d = &mut s.drives_mut()[0];
-        *d.motors[0].switches_mut() = axis(PositionInput::above(RS_POS));
-    }
+    let sim = line_with_switches(axis(PositionInput::above(RS_POS)));
     with_master(&sim, async |md, clock| {
         let group = init(md, clock).await.into_op(md).await.expect("OP");
         let sd = group.subdevice(md, 0).unwrap();

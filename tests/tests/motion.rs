@@ -324,9 +324,7 @@ fn c041_c048_pp_moves_to_target_and_sets_target_reached() {
         let group = init(md, clock).await.into_op(md).await.expect("OP");
         let sd = group.subdevice(md, 0).unwrap();
         // 5 rev/s, 50 rev/s² (6081h, 6083h, 6084h by SDO in Op)
-        sd.sdo_write(0x6081, 0, 5 * REV as u32).await.unwrap();
-        sd.sdo_write(0x6083, 0, 50 * REV as u32).await.unwrap();
-        sd.sdo_write(0x6084, 0, 50 * REV as u32).await.unwrap();
+        set_profile(&sd, Some(5 * REV as u32), 50 * REV as u32).await;
         let mut m = Cyclic::new(md, &group, &sim, 0);
         let tx = m.enable_in(1).await;
         assert_eq!(tx.mode_display, 1);
@@ -418,8 +416,7 @@ fn c055_c056_pv_reaches_velocity_and_reports_zero_speed() {
     with_master(&sim, async |md, clock| {
         let group = init(md, clock).await.into_op(md).await.expect("OP");
         let sd = group.subdevice(md, 0).unwrap();
-        sd.sdo_write(0x6083, 0, 40 * REV as u32).await.unwrap();
-        sd.sdo_write(0x6084, 0, 40 * REV as u32).await.unwrap();
+        set_profile(&sd, None, 40 * REV as u32).await;
         let mut m = Cyclic::new(md, &group, &sim, 0);
         let tx = m.enable_in(3).await;
         assert_eq!(tx.mode_display, 3);
@@ -475,8 +472,7 @@ fn e125_c144_free_run_moves_at_the_commanded_speed_at_every_a150() {
             sd.sdo_write(A150, 0, a150_us).await.expect("A150 in Pre-Op");
             let group = group.into_op(md).await.expect("OP");
             let sd = group.subdevice(md, 0).unwrap();
-            sd.sdo_write(0x6083, 0, 40 * REV as u32).await.unwrap();
-            sd.sdo_write(0x6084, 0, 40 * REV as u32).await.unwrap();
+            set_profile(&sd, None, 40 * REV as u32).await;
             let mut m = Cyclic::new(md, &group, &sim, 0);
             m.enable_in(3).await;
             m.run(20).await;

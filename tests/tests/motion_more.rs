@@ -25,8 +25,7 @@ fn c031_c032_c033_c034_ip_follows_60c1_only_while_bit_4() {
         let sd = group.subdevice(md, 0).unwrap();
         map_layout(&sd, drive_ecat::PdoLayout::Ip).await;
         // profile ramps of 0.1 rev/s² that ip must not apply (C-033)
-        sd.sdo_write(0x6083, 0, (REV / 10) as u32).await.unwrap();
-        sd.sdo_write(0x6084, 0, (REV / 10) as u32).await.unwrap();
+        set_profile(&sd, None, (REV / 10) as u32).await;
         let group = group.into_op(md).await.expect("OP with the ip map");
         let sd = group.subdevice(md, 0).unwrap();
         assert_eq!(
@@ -447,12 +446,12 @@ async fn fault_and_reset(m: &mut Cyclic<'_>, what: &str) -> u16 {
 
 #[test]
 fn c093_c094_c095_hardware_limit_switch_faults_and_locks_the_direction() {
-    let sim = line(1);
     let plus = i64::from(REV); // positive switch from +1 rev on, negative below −10 rev
-    with_drive(&sim, |d| {
-        *d.motors[0].switches_mut() =
-            Switches::linear_axis(-10 * i64::from(REV), plus, PositionInput::never());
-    });
+    let sim = line_with_switches(Switches::linear_axis(
+        -10 * i64::from(REV),
+        plus,
+        PositionInput::never(),
+    ));
     with_master(&sim, async |md, clock| {
         let group = init(md, clock).await.into_op(md).await.expect("OP");
         let mut m = Cyclic::new(md, &group, &sim, 0);

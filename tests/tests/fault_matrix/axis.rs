@@ -2,7 +2,7 @@
 //! motion, a limit switch against the travel during homing.
 
 use super::{emcys, ethercrab, fault_end, fault_reset, get, E47};
-use drive_tests::axis::{with_drive, CW_BIT4, CW_ENABLED};
+use drive_tests::axis::{line_with_switches, with_drive, CW_BIT4, CW_ENABLED};
 use drive_tests::matrix::{al, cia402_state, emcys as show_emcys};
 use drive_tests::{al_status, fault_row, init, line, with_master, Cyclic, REV};
 use hil_sim::motor::{PositionInput, Switches};
@@ -18,9 +18,7 @@ fn during_motion(cause: fn(&mut AxisConditions), clear: fn(&mut AxisConditions))
         let group = init(md, clock).await.into_op(md).await.expect("OP");
         let sd = group.subdevice(md, 0).unwrap();
         let mut m = Cyclic::new(md, &group, &sim, 0);
-        m.enable_in(9).await;
-        m.set_target_velocity(2 * REV);
-        m.run(300).await;
+        m.csv_at(2 * REV, 300).await;
         with_drive(&sim, |d| cause(&mut d.conditions[0]));
         let tx = m.run(100).await;
         let stage = {
@@ -102,17 +100,12 @@ fn c084_limit_switch_against_the_travel_during_homing_is_a_homing_error() {
          603Fh 0000h; Op, AL 0000h",
     );
     const R: i64 = REV as i64;
-    let sim = line(1);
-    {
-        let mut s = sim.borrow_mut();
-        let d = &mut s.drives_mut()[0];
-        // the switch the axis meets moving negative reads as the positive one
-        *d.motors[0].switches_mut() = Switches {
-            positive_limit: PositionInput::below(-2 * R).active_low(),
-            negative_limit: PositionInput::never().active_low(),
-            ..Switches::linear_axis(-10 * R, 10 * R, PositionInput::never())
-        };
-    }
+    // the switch the axis meets moving negative reads as the positive one
+    let sim = line_with_switches(Switches {
+        positive_limit: PositionInput::below(-2 * R).active_low(),
+        negative_limit: PositionInput::never().active_low(),
+        ..Switches::linear_axis(-10 * R, 10 * R, PositionInput::never())
+    });
     let seen = with_master(&sim, async |md, clock| {
         let group = init(md, clock).await.into_op(md).await.expect("OP");
         // I101/I102 = 1: the limit switches from the inputs, by SDO (issue 40)

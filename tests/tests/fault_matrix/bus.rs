@@ -38,9 +38,7 @@ fn burst_free_run(a258: u16, lost: u64) -> String {
         let group = group.into_op(md).await.expect("OP");
         let sd = group.subdevice(md, 0).unwrap();
         let mut m = Cyclic::new(md, &group, &sim, 0);
-        m.enable_in(9).await;
-        m.set_target_velocity(REV);
-        m.run(200).await;
+        m.csv_at(REV, 200).await;
         advance(&sim, lost * 1_000_000);
         let mut full = 0;
         for _ in 0..50 {
@@ -301,9 +299,7 @@ fn e021_e023_e037_a_second_master_with_conflicting_al_control() {
         let group = group.into_op(md).await.expect("OP");
         let sd = group.subdevice(md, 0).unwrap();
         let mut m = Cyclic::new(md, &group, &sim, 0);
-        m.enable_in(9).await;
-        m.set_target_velocity(REV);
-        m.run(100).await;
+        m.csv_at(REV, 100).await;
         // master 2: Init
         assert_eq!(second_master_write(&sim, station, 0x0120, &INIT.to_le_bytes()), 1);
         for _ in 0..20 {

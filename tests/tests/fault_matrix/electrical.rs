@@ -36,9 +36,7 @@ fn during_motion(cause: fn(&mut ElectricalAxis), clear: fn(&mut ElectricalAxis))
         let group = init(md, clock).await.into_op(md).await.expect("OP");
         let sd = group.subdevice(md, 0).unwrap();
         let mut m = Cyclic::new(md, &group, &sim, 0);
-        m.enable_in(9).await;
-        m.set_target_velocity(2 * REV);
-        m.run(300).await;
+        m.csv_at(2 * REV, 300).await;
         let mut before = 0;
         with_drive(&sim, |d| {
             before = enabled_periods(d);

@@ -62,9 +62,7 @@ fn e062_e094_a_master_that_stops_reading_the_mailbox_loses_nothing() {
         let group = group.into_op(md).await.expect("OP");
         let sd = group.subdevice(md, 0).unwrap();
         let mut m = Cyclic::new(md, &group, &sim, 0);
-        m.enable_in(9).await;
-        m.set_target_velocity(REV);
-        m.run(100).await;
+        m.csv_at(REV, 100).await;
         let mut mbx = RawMailbox::new();
         mbx.send_raw(&sd, upload_request(1, 0x1018, 2)).await;
         sim.borrow_mut().drives_mut()[0].drive.axes_mut()[0]
