@@ -596,6 +596,11 @@ def master_main(args, run, done):
         check(False, f"stopped by SOEM: {type(e).__name__} {vars(e)}")
     finally:
         m.close()
+    return report(done)
+
+
+def report(done):
+    """Prints the failed checks (returns exit code 1) or `done` (0)."""
     if failures:
         say(f"\n{len(failures)} check(s) failed:")
         for f in failures:
