@@ -599,6 +599,27 @@ def master_main(args, run, done):
     return report(done)
 
 
+def one_drive_in_preop(m):
+    """Scans a line of one drive and checks that it is in Pre-Op; the drive."""
+    scan(m, 1)
+    check(m.read_state() == PREOP, f"Pre-Op: {state_report(m)}")
+    return m.slaves[0]
+
+
+def enable_sequence(axis):
+    """Fault reset, shutdown, switch on, enable operation: each controlword
+    on `axis` (its cw, cycle() and sw) until the statusword shows the state
+    it leads to, 300 cycles at most (Fatal otherwise)."""
+    for cw, want in ((0x80, None), (0x06, READY), (0x07, SWITCHED_ON), (0x0F, ENABLED)):
+        axis.cw = cw
+        for _ in range(300):
+            axis.cycle()
+            if want is None or sw_is(axis.sw, want):
+                break
+        else:
+            raise Fatal(f"controlword {cw:#04x}: statusword {axis.sw:#06x}")
+
+
 def report(done):
     """Prints the failed checks (returns exit code 1) or `done` (0)."""
     if failures:

@@ -212,9 +212,7 @@ def optimise(axis, sel, r, l):
 
 
 def run(m, args):
-    L.scan(m, 1)
-    check(m.read_state() == L.PREOP, f"Pre-Op: {L.state_report(m)}")
-    s = m.slaves[0]
+    s = L.one_drive_in_preop(m)
     L.map_one_pdo_each(s, RX, TX)
     axis = L.to_op(m, Axis)
     refused(axis)

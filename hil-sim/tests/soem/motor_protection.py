@@ -89,14 +89,7 @@ class Axis:
             time.sleep(0.001)
 
     def enable(self):
-        for cw, want in ((0x80, None), (0x06, L.READY), (0x07, L.SWITCHED_ON), (0x0F, L.ENABLED)):
-            self.cw = cw
-            for _ in range(300):
-                self.cycle()
-                if want is None or L.sw_is(self.sw, want):
-                    break
-            else:
-                raise L.Fatal(f"controlword {cw:#04x}: statusword {self.sw:#06x}")
+        L.enable_sequence(self)
         self.cycle(5)
         check(self.display == T.CST, f"6061h shows {self.display} in cst")
 
@@ -213,9 +206,7 @@ def i2t(m, axis, emcys, tau_s, u11_s):
 
 
 def run(m, args):
-    L.scan(m, 1)
-    check(m.read_state() == L.PREOP, f"Pre-Op: {L.state_report(m)}")
-    s = m.slaves[0]
+    s = L.one_drive_in_preop(m)
     emcys = L.Emcys(m)
     motor_data(s, args.tau_ms, args.u11_ms)
     L.map_one_pdo_each(s, T.RX, TX)

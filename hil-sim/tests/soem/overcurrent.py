@@ -75,9 +75,7 @@ def enable_into_the_short(m, axis, emcys, what):
 
 
 def run(m, args):
-    L.scan(m, 1)
-    check(m.read_state() == L.PREOP, f"Pre-Op: {L.state_report(m)}")
-    s = m.slaves[0]
+    s = L.one_drive_in_preop(m)
     emcys = L.Emcys(m)
     L.map_one_pdo_each(s, T.RX, MP.TX)
     axis = L.to_op(m, MP.Axis)

@@ -56,9 +56,7 @@ def peak(frames, target, what):
 
 
 def run(m, args):
-    L.scan(m, 1)
-    check(m.read_state() == L.PREOP, f"Pre-Op: {L.state_report(m)}")
-    s = m.slaves[0]
+    s = L.one_drive_in_preop(m)
     for index in (T.G472, T.G475):
         s.sdo_write(index, 0, (1000).to_bytes(2, "little"))
     L.map_one_pdo_each(s, T.RX, MP.TX)

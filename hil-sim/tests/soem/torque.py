@@ -66,14 +66,7 @@ class Axis:
 
     def enable(self, mode):
         self.mode = mode
-        for cw, want in ((0x80, None), (0x06, L.READY), (0x07, L.SWITCHED_ON), (0x0F, L.ENABLED)):
-            self.cw = cw
-            for _ in range(300):
-                self.cycle()
-                if want is None or L.sw_is(self.sw, want):
-                    break
-            else:
-                raise L.Fatal(f"controlword {cw:#04x}: statusword {self.sw:#06x}")
+        L.enable_sequence(self)
         self.cw = 0x0F
         self.cycle(5)
         check(self.display == mode, f"6061h shows {self.display}, mode {mode} set")
@@ -111,9 +104,7 @@ class Axis:
 
 
 def run(m, args):
-    L.scan(m, 1)
-    check(m.read_state() == L.PREOP, f"Pre-Op: {L.state_report(m)}")
-    s = m.slaves[0]
+    s = L.one_drive_in_preop(m)
     for index in (G472, G475):
         check(L.sdo_u(s, index, 0) == 0, f"{index:04X}h default 0 %")
         code = L.sdo_abort(lambda: s.sdo_write(index, 0, (1001).to_bytes(2, "little")))
