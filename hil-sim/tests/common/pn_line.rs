@@ -10,6 +10,26 @@ use std::path::{Path, PathBuf};
 use std::process::{Child, Command, ExitStatus, Stdio};
 use std::time::{Duration, Instant};
 
+/// The arguments that tell a controller script the device: `--gsdml` (the
+/// generated GSDML file), `--out-module` and `--in-module` (the manual's
+/// example: slot 1 "18 Word Output Data", slot 2 "18 Word Input Data").
+pub fn module_args() -> Vec<std::ffi::OsString> {
+    use profinet::model::{DataModule, Direction};
+    let gsdml = Path::new(env!("CARGO_MANIFEST_DIR"))
+        .join("../gsdml")
+        .join(gsdml::file_name());
+    let module = |direction, words| gsdml::module_id(DataModule { direction, words });
+    [
+        "--gsdml".into(),
+        gsdml.into_os_string(),
+        "--out-module".into(),
+        module(Direction::FromDrive, 18).into(),
+        "--in-module".into(),
+        module(Direction::ToDrive, 18).into(),
+    ]
+    .into()
+}
+
 /// The controller's address (in its own namespace only).
 pub const CONTROLLER_IP: &str = "192.168.0.10/24";
 
