@@ -40,9 +40,7 @@ fn run_script(tag: &str, serve_more: &[&str], script_args: &[&str], item: &str) 
         .collect();
     let mut line = PnLine::new(tag, &dir, &serve);
     let script = Path::new(env!("CARGO_MANIFEST_DIR")).join("tests/profinet/current_limit.py");
-    let modules = module_args();
-    let mut args: Vec<&OsStr> = modules.iter().map(|a| a.as_os_str()).collect();
-    args.extend(script_args.iter().map(|s| -> &OsStr { s.as_ref() }));
+    let args = module_args(script_args);
     let (status, lines) = line.run(&python, &script, &args, SCRIPT_LIMIT);
     line.stop_server();
     let serve = line.serve_output();

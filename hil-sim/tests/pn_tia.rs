@@ -22,7 +22,6 @@
 mod common;
 
 use common::pn_line::{module_args, PnLine};
-use std::ffi::OsStr;
 use std::path::{Path, PathBuf};
 use std::process::Command;
 use std::time::Duration;
@@ -89,12 +88,7 @@ fn p002_p026_p027_p040_p041_p042_p043_scapy_controller_plays_tia_startup() {
         "--pcap",
         pcap.to_str().unwrap(),
     ];
-    let modules = module_args();
-    let args: Vec<&OsStr> = modules
-        .iter()
-        .map(|a| a.as_os_str())
-        .chain(words.iter().map(OsStr::new))
-        .collect();
+    let args = module_args(&words);
     let (status, lines) = line.run(&python, &script, &args, SCRIPT_LIMIT);
     line.stop_server();
     println!("--- hil-sim serve:\n{}", line.serve_output());

@@ -39,7 +39,6 @@ mod common;
 
 use common::pn_line::{module_args, PnLine};
 use profinet::model;
-use std::ffi::OsStr;
 use std::path::Path;
 use std::process::Command;
 use std::time::Duration;
@@ -139,12 +138,7 @@ fn p008_p027_p029_p030_p035_p036_p040_p041_p042_p085_p110_p191_p223_profinet_py_
         "--startup",
         "advanced",
     ];
-    let modules = module_args();
-    let args: Vec<&OsStr> = modules
-        .iter()
-        .map(|a| a.as_os_str())
-        .chain(words.iter().map(OsStr::new))
-        .collect();
+    let args = module_args(&words);
     let (status, lines) = line.run(&python, &script, &args, SCRIPT_LIMIT);
     let ok = status.success();
     line.stop_server();

@@ -23,7 +23,6 @@
 mod common;
 
 use common::pn_line::{module_args, PnLine};
-use std::ffi::OsStr;
 use std::path::Path;
 use std::time::Duration;
 
@@ -64,9 +63,7 @@ fn p160_p206_p208_p219_p220_p221_p222_p223_p224_p225_p226_p227_the_example_funct
     std::fs::create_dir_all(&dir).expect("scratch dir");
     let mut line = PnLine::new("fb", &dir, &[]);
     let script = Path::new(env!("CARGO_MANIFEST_DIR")).join("tests/profinet/fb.py");
-    let modules = module_args();
-    let mut args: Vec<&OsStr> = modules.iter().map(|a| a.as_os_str()).collect();
-    args.extend(["--control".as_ref(), line.control.as_os_str()]);
+    let args = module_args(&["--control".as_ref(), line.control.as_os_str()]);
     let (status, lines) = line.run(&python, &script, &args, SCRIPT_LIMIT);
     line.stop_server();
     println!(
