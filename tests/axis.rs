@@ -72,3 +72,24 @@ where
     let falling: i32 = sd.sdo_read(0x60BB, 0).await.expect("60BBh");
     (status, rising, falling)
 }
+
+/// The profile of pp and pv (by SDO): 6081h profile velocity = `velocity`
+/// (unless `None`), 6083h acceleration and 6084h deceleration = `accel`.
+pub async fn set_profile<S>(sd: &ethercrab::SubDeviceRef<'_, S>, velocity: Option<u32>, accel: u32)
+where
+    S: std::ops::Deref<Target = ethercrab::SubDevice>,
+{
+    if let Some(v) = velocity {
+        sd.sdo_write(0x6081, 0, v).await.expect("6081h");
+    }
+    sd.sdo_write(0x6083, 0, accel).await.expect("6083h");
+    sd.sdo_write(0x6084, 0, accel).await.expect("6084h");
+}
+
+/// A line of one drive ([`crate::line`]) whose axis A has the inputs
+/// `switches` (limit, home and probe switches).
+pub fn line_with_switches(switches: hil_sim::motor::Switches) -> RefCell<Simulation> {
+    let sim = crate::line(1);
+    with_drive(&sim, |d| *d.motors[0].switches_mut() = switches);
+    sim
+}

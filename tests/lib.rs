@@ -2,6 +2,7 @@
 //! master (ethercrab) talks to the simulated line in-process, in simulated time.
 
 pub mod axis;
+pub mod step;
 
 /// The fault matrix's rows (`hil_sim::matrix`, docs/fault-matrix.md).
 pub use hil_sim::{fault_row, matrix};
@@ -96,13 +97,7 @@ pub fn with_master<T>(
     sim: &RefCell<Simulation>,
     body: impl for<'a> AsyncFnOnce(&'a MainDevice<'a>, &'a AtomicU64) -> T,
 ) -> T {
-    // 100 instead of 10 000 DC static-sync frames: the simulated clocks run without drift
-    // unless a test sets one (hil-sim/tests/dc.rs uses the full static sync)
-    let config = ethercrab::MainDeviceConfig {
-        dc_static_sync_iterations: 100,
-        ..Default::default()
-    };
-    hil_sim::master::run_with(sim, timeouts(), config, body)
+    with_master_on(sim, body)
 }
 
 /// Discovers the line and brings it to PRE-OP (ethercrab's init).
@@ -462,9 +457,29 @@ impl CoeClient {
         let cmd = 0x23 | (((4 - data.len()) as u8) << 2);
         let mut req = vec![cmd, i0, i1, sub, 0, 0, 0, 0];
         req[4..4 + data.len()].copy_from_slice(data);
-        let r = self.sdo(sd, &req).await?;
-        assert_eq!(&r[..4], &[0x60, i0, i1, sub], "initiate download response");
+        self.initiate_download(sd, &req).await
+    }
+
+    /// Sends the initiate download request `req` (command, index, sub, …)
+    /// and checks the initiate download response (60h, index, sub).
+    async fn initiate_download<S>(&mut self, sd: &SubDeviceRef<'_, S>, req: &[u8]) -> Result<(), Abort> {
+        let r = self.sdo(sd, req).await?;
+        assert_eq!(
+            r[..4],
+            [0x60, req[1], req[2], req[3]],
+            "initiate download response"
+        );
         Ok(())
+    }
+
+    /// The initiate download request of a normal or segmented download
+    /// (command 21h, 31h with complete access) announcing `size` bytes.
+    fn initiate_sized(index: u16, sub: u8, size: usize, ca: bool) -> Vec<u8> {
+        let [i0, i1] = index.to_le_bytes();
+        let cmd = if ca { 0x31 } else { 0x21 };
+        let mut req = vec![cmd, i0, i1, sub];
+        req.extend_from_slice(&(size as u32).to_le_bytes());
+        req
     }
 
     /// Normal download with the data in the initiate request (command 21h, or
@@ -477,14 +492,9 @@ impl CoeClient {
         data: &[u8],
         ca: bool,
     ) -> Result<(), Abort> {
-        let [i0, i1] = index.to_le_bytes();
-        let cmd = if ca { 0x31 } else { 0x21 };
-        let mut req = vec![cmd, i0, i1, sub];
-        req.extend_from_slice(&(data.len() as u32).to_le_bytes());
+        let mut req = Self::initiate_sized(index, sub, data.len(), ca);
         req.extend_from_slice(data);
-        let r = self.sdo(sd, &req).await?;
-        assert_eq!(&r[..4], &[0x60, i0, i1, sub], "initiate download response");
-        Ok(())
+        self.initiate_download(sd, &req).await
     }
 
     /// Expedited download for 1..=4 bytes, normal otherwise.
@@ -513,10 +523,7 @@ impl CoeClient {
         data: &[u8],
         ca: bool,
     ) -> Result<Vec<Vec<u8>>, Abort> {
-        let [i0, i1] = index.to_le_bytes();
-        let cmd = if ca { 0x31 } else { 0x21 };
-        let mut req = vec![cmd, i0, i1, sub];
-        req.extend_from_slice(&(data.len() as u32).to_le_bytes());
+        let req = Self::initiate_sized(index, sub, data.len(), ca);
         let mut replies = vec![self.sdo(sd, &req).await?];
         let mut toggle = false;
         let chunks: Vec<&[u8]> = data.chunks(7).collect();
@@ -750,6 +757,30 @@ pub struct Cyclic<'a> {
     pub cycles: u64,
 }
 
+/// One master cycle of drive `slave` of `group`: `out` written to its
+/// outputs, the simulated time one master cycle on, the frame exchanged (both
+/// its outputs written and inputs read, WKC 3); `read` of its inputs.
+async fn exchange<R>(
+    md: &MainDevice<'_>,
+    group: &OpGroup,
+    sim: &RefCell<Simulation>,
+    slave: usize,
+    out: &[u8],
+    read: impl FnOnce(&[u8]) -> R,
+) -> R {
+    let sd = group.subdevice(md, slave).expect("subdevice");
+    sd.outputs_raw_mut().copy_from_slice(out);
+    {
+        let mut sim = sim.borrow_mut();
+        let t = sim.now() + MASTER_CYCLE;
+        sim.advance_to(t);
+    }
+    let r = group.tx_rx(md).await.expect("process data cycle");
+    assert_eq!(r.working_counter, 3, "outputs written and inputs read");
+    let io = sd.io_raw();
+    read(io.inputs())
+}
+
 impl<'a> Cyclic<'a> {
     /// A master on drive `slave` of `group`; the outputs start all zero
     /// (controlword 0, mode 0).
@@ -820,16 +851,15 @@ impl<'a> Cyclic<'a> {
 
     /// One master cycle; returns the TxPDO received.
     pub async fn cycle(&mut self) -> TxPdo {
-        let sd = self.group.subdevice(self.md, self.slave).expect("subdevice");
-        sd.outputs_raw_mut().copy_from_slice(&self.out);
-        {
-            let mut sim = self.sim.borrow_mut();
-            let t = sim.now() + MASTER_CYCLE;
-            sim.advance_to(t);
-        }
-        let r = self.group.tx_rx(self.md).await.expect("process data cycle");
-        assert_eq!(r.working_counter, 3, "outputs written and inputs read");
-        self.tx = TxPdo::decode(sd.io_raw().inputs());
+        self.tx = exchange(
+            self.md,
+            self.group,
+            self.sim,
+            self.slave,
+            &self.out,
+            TxPdo::decode,
+        )
+        .await;
         self.cycles += 1;
         self.tx
     }
@@ -873,6 +903,21 @@ impl<'a> Cyclic<'a> {
         self.command(0x0006, sw::RTSO, 20).await;
         self.command(0x0007, sw::SO, 20).await;
         self.command(0x000F, sw::OE, 20).await
+    }
+
+    /// Enabled in csv ([`Self::enable_in`] 9), then `n` cycles at the target
+    /// velocity `v` (inc/s).
+    pub async fn csv_at(&mut self, v: i32, n: usize) -> TxPdo {
+        self.enable_in(9).await;
+        self.set_target_velocity(v);
+        self.run(n).await
+    }
+
+    /// Mode `mode` (6060h) for three cycles, then [`Self::enable`].
+    pub async fn enable_in(&mut self, mode: i8) -> TxPdo {
+        self.set_mode(mode);
+        self.run(3).await;
+        self.enable().await
     }
 
     /// Simulated time.
@@ -999,16 +1044,11 @@ impl<'a> RawCyclic<'a> {
 
     /// One master cycle (see [`Cyclic::cycle`]).
     pub async fn cycle(&mut self) {
-        let sd = self.group.subdevice(self.md, self.slave).expect("subdevice");
-        sd.outputs_raw_mut().copy_from_slice(&self.out);
-        {
-            let mut sim = self.sim.borrow_mut();
-            let t = sim.now() + MASTER_CYCLE;
-            sim.advance_to(t);
-        }
-        let r = self.group.tx_rx(self.md).await.expect("process data cycle");
-        assert_eq!(r.working_counter, 3, "outputs written and inputs read");
-        self.inputs.copy_from_slice(sd.io_raw().inputs());
+        let inputs = &mut self.inputs;
+        exchange(self.md, self.group, self.sim, self.slave, &self.out, |i| {
+            inputs.copy_from_slice(i)
+        })
+        .await;
         self.cycles += 1;
     }
 
@@ -1206,6 +1246,8 @@ pub fn with_master_on<N: hil_sim::sim::Node, T>(
     sim: &RefCell<Simulation<N>>,
     body: impl for<'a> AsyncFnOnce(&'a MainDevice<'a>, &'a AtomicU64) -> T,
 ) -> T {
+    // 100 instead of 10 000 DC static-sync frames: the simulated clocks run without drift
+    // unless a test sets one (hil-sim/tests/dc.rs uses the full static sync)
     let config = ethercrab::MainDeviceConfig {
         dc_static_sync_iterations: 100,
         ..Default::default()

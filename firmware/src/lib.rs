@@ -28,7 +28,12 @@ pub mod once;
 #[cfg(any(feature = "board", feature = "board-pn"))]
 pub mod xmc;
 
-#[cfg(any(feature = "qemu", feature = "qemu-pn", feature = "boot-mps2"))]
+#[cfg(any(
+    feature = "qemu",
+    feature = "qemu-pn",
+    feature = "boot-mps2",
+    feature = "mps2-foc"
+))]
 pub mod systick;
 
 #[cfg(any(
@@ -36,7 +41,8 @@ pub mod systick;
     feature = "qemu-pn",
     feature = "mps2-pn",
     feature = "boot-mps2",
-    feature = "mps2-slot"
+    feature = "mps2-slot",
+    feature = "mps2-foc"
 ))]
 pub mod semihost;
 

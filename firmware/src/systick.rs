@@ -17,6 +17,16 @@ pub fn ticks(start: u32, end: u32) -> u32 {
     start.wrapping_sub(end) & 0x00FF_FFFF
 }
 
+/// SysTick started as the instruction counter: the core clock, the full 24
+/// bits; returns its [`calibrate`]d instructions per 1000 ticks.
+pub fn start(syst: &mut SYST) -> u32 {
+    syst.set_clock_source(cortex_m::peripheral::syst::SystClkSource::Core);
+    syst.set_reload(0x00FF_FFFF);
+    syst.clear_current();
+    syst.enable_counter();
+    calibrate()
+}
+
 /// Instructions per 1000 SysTick ticks, from a loop of `2 · n`
 /// instructions (`subs` + `bne`).
 #[allow(unsafe_code)]

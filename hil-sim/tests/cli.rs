@@ -36,6 +36,30 @@ impl Scratch {
     }
 }
 
+/// `hil-sim demo <args> --pcap run.pcap --plot run.svg` in a scratch
+/// directory `name`: it succeeds, names the plot it writes, the plot is a
+/// whole SVG and the recording a pcap; its stdout, the SVG, the pcap's bytes
+/// and its path.
+fn demo_recorded(name: &str, args: &[&str]) -> (String, String, Vec<u8>, String) {
+    let s = Scratch::new(name);
+    let (pcap, plot) = (s.0.join("run.pcap"), s.0.join("run.svg"));
+    let mut all = vec!["demo"];
+    all.extend_from_slice(args);
+    all.extend(["--pcap", pcap.to_str().unwrap(), "--plot", plot.to_str().unwrap()]);
+    let o = hil_sim(&all);
+    assert!(o.status.success(), "{o:?}");
+    let out = text(&o.stdout);
+    assert!(out.contains(&format!("plot: {}", plot.display())), "{out}");
+    let svg = std::fs::read_to_string(&plot).unwrap();
+    assert!(
+        svg.contains("<svg") && svg.trim_end().ends_with("</svg>"),
+        "a whole SVG"
+    );
+    let p = std::fs::read(&pcap).unwrap();
+    assert_eq!(p.get(..4), Some(&0xA1B2_3C4Du32.to_le_bytes()[..]), "pcap magic");
+    (out, svg, p, pcap.display().to_string())
+}
+
 impl Drop for Scratch {
     fn drop(&mut self) {
         let _ = std::fs::remove_dir_all(&self.0);
@@ -211,29 +235,8 @@ fn serve_needs_an_interface() {
 
 #[test]
 fn demo_writes_the_plot_and_the_pcap_it_names() {
-    let s = Scratch::new("demo");
-    let (pcap, plot) = (s.0.join("run.pcap"), s.0.join("run.svg"));
-    let o = hil_sim(&[
-        "demo",
-        "--pcap",
-        pcap.to_str().unwrap(),
-        "--plot",
-        plot.to_str().unwrap(),
-    ]);
-    assert!(o.status.success(), "{o:?}");
-    let out = text(&o.stdout);
-    assert!(out.contains(&format!("plot: {}", plot.display())), "{out}");
-    assert!(
-        out.contains(&format!("recording frames to {}", pcap.display())),
-        "{out}"
-    );
-    let svg = std::fs::read_to_string(&plot).unwrap();
-    assert!(
-        svg.contains("<svg") && svg.trim_end().ends_with("</svg>"),
-        "a whole SVG"
-    );
-    let p = std::fs::read(&pcap).unwrap();
-    assert_eq!(p.get(..4), Some(&0xA1B2_3C4Du32.to_le_bytes()[..]), "pcap magic");
+    let (out, _, p, pcap) = demo_recorded("demo", &[]);
+    assert!(out.contains(&format!("recording frames to {pcap}")), "{out}");
     assert!(p.len() > 100_000, "frames recorded: {} bytes", p.len());
 }
 
@@ -291,19 +294,7 @@ fn demo_profinet_refuses_an_unwritable_plot_before_the_run() {
 /// records the PROFINET frames.
 #[test]
 fn p219_p227_demo_profinet_writes_the_plot_and_the_pcap_it_names() {
-    let s = Scratch::new("demo-pn");
-    let (pcap, plot) = (s.0.join("run.pcap"), s.0.join("run.svg"));
-    let o = hil_sim(&[
-        "demo",
-        "--fieldbus",
-        "profinet",
-        "--pcap",
-        pcap.to_str().unwrap(),
-        "--plot",
-        plot.to_str().unwrap(),
-    ]);
-    assert!(o.status.success(), "{o:?}");
-    let out = text(&o.stdout);
+    let (out, svg, p, _) = demo_recorded("demo-pn", &["--fieldbus", "profinet"]);
     for want in [
         "state SOI -> RTSO",
         "drive_is_enabled 0->1",
@@ -318,12 +309,7 @@ fn p219_p227_demo_profinet_writes_the_plot_and_the_pcap_it_names() {
     ] {
         assert!(out.contains(want), "`{want}` missing in:\n{out}");
     }
-    assert!(out.contains(&format!("plot: {}", plot.display())), "{out}");
-    let svg = std::fs::read_to_string(&plot).unwrap();
-    assert!(svg.contains("<svg") && svg.trim_end().ends_with("</svg>"));
     assert!(svg.contains("ZSW1 state"), "the state panel");
-    let p = std::fs::read(&pcap).unwrap();
-    assert_eq!(p.get(..4), Some(&0xA1B2_3C4Du32.to_le_bytes()[..]), "pcap magic");
     assert!(p.len() > 1_000_000, "both directions every ms: {} bytes", p.len());
 }
 

@@ -5,27 +5,15 @@
 //! aborts it.
 #![allow(clippy::unwrap_used, clippy::expect_used, clippy::panic)]
 
+mod common;
+
 use hil_sim::fb::controller::PnController;
 use hil_sim::fb::rig::FbRig;
 use hil_sim::fb::FbOutputs;
 use hil_sim::pcap::Recording;
 use hil_sim::pn::Command;
 
-/// The FB rig ([`FbRig`]) with this test's steps.
-struct Rig(FbRig);
-
-impl std::ops::Deref for Rig {
-    type Target = FbRig;
-    fn deref(&self) -> &FbRig {
-        &self.0
-    }
-}
-
-impl std::ops::DerefMut for Rig {
-    fn deref_mut(&mut self) -> &mut FbRig {
-        &mut self.0
-    }
-}
+common::fb_rig!(Rig);
 
 impl Rig {
     fn new(pcap: Option<Recording>) -> Rig {

@@ -15,8 +15,7 @@
 
 mod common;
 
-use common::pn_line::PnLine;
-use profinet::model::{DataModule, Direction};
+use common::pn_line::{module_args, PnLine};
 use std::ffi::OsStr;
 use std::path::Path;
 use std::time::Duration;
@@ -42,21 +41,8 @@ fn run_script(tag: &str, serve_more: &[&str], script_args: &[&str], item: &str) 
         .map(|s| s.as_ref())
         .collect();
     let mut line = PnLine::new(tag, &dir, &serve);
-    let gsdml = Path::new(env!("CARGO_MANIFEST_DIR"))
-        .join("../gsdml")
-        .join(gsdml::file_name());
-    let module = |direction, words| gsdml::module_id(DataModule { direction, words });
-    let (out18, in18) = (module(Direction::FromDrive, 18), module(Direction::ToDrive, 18));
     let script = Path::new(env!("CARGO_MANIFEST_DIR")).join("tests/profinet/current_limit.py");
-    let mut args: Vec<&OsStr> = vec![
-        "--gsdml".as_ref(),
-        gsdml.as_os_str(),
-        "--out-module".as_ref(),
-        out18.as_ref(),
-        "--in-module".as_ref(),
-        in18.as_ref(),
-    ];
-    args.extend(script_args.iter().map(|s| -> &OsStr { s.as_ref() }));
+    let args = module_args(script_args);
     let (status, lines) = line.run(&python, &script, &args, SCRIPT_LIMIT);
     line.stop_server();
     let serve = line.serve_output();

@@ -8,6 +8,8 @@
 //! itself follows the actual position while the drive function is off.
 #![allow(clippy::unwrap_used, clippy::expect_used, clippy::panic)]
 
+mod common;
+
 use hil_sim::fb::controller::PnController;
 use hil_sim::fb::rig::FbRig;
 use hil_sim::fb::{FbOutputs, OPMODE_POS};
@@ -15,21 +17,7 @@ use hil_sim::pn::Command;
 
 const REV: i64 = 1 << 20;
 
-/// The FB rig ([`FbRig`]) with this test's steps.
-struct Rig(FbRig);
-
-impl std::ops::Deref for Rig {
-    type Target = FbRig;
-    fn deref(&self) -> &FbRig {
-        &self.0
-    }
-}
-
-impl std::ops::DerefMut for Rig {
-    fn deref_mut(&mut self) -> &mut FbRig {
-        &mut self.0
-    }
-}
+common::fb_rig!(Rig);
 
 impl Rig {
     fn new() -> Rig {

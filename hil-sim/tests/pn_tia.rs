@@ -21,9 +21,7 @@
 
 mod common;
 
-use common::pn_line::PnLine;
-use profinet::model::{DataModule, Direction};
-use std::ffi::OsStr;
+use common::pn_line::{module_args, PnLine};
 use std::path::{Path, PathBuf};
 use std::process::Command;
 use std::time::Duration;
@@ -79,19 +77,8 @@ fn p002_p026_p027_p040_p041_p042_p043_scapy_controller_plays_tia_startup() {
     let pcap = dir.join("tia.pcap");
     let _ = std::fs::remove_file(&pcap);
     let mut line = PnLine::new("tia", &dir, &[]);
-    let gsdml = Path::new(env!("CARGO_MANIFEST_DIR"))
-        .join("../gsdml")
-        .join(gsdml::file_name());
-    let module = |direction, words| gsdml::module_id(DataModule { direction, words });
-    let (out18, in18) = (module(Direction::FromDrive, 18), module(Direction::ToDrive, 18));
     let script = Path::new(env!("CARGO_MANIFEST_DIR")).join("tests/profinet/tia.py");
     let words = [
-        "--gsdml",
-        gsdml.to_str().unwrap(),
-        "--out-module",
-        &out18,
-        "--in-module",
-        &in18,
         "--cyclic-seconds",
         "10",
         "--netload-seconds",
@@ -101,7 +88,7 @@ fn p002_p026_p027_p040_p041_p042_p043_scapy_controller_plays_tia_startup() {
         "--pcap",
         pcap.to_str().unwrap(),
     ];
-    let args: Vec<&OsStr> = words.iter().map(OsStr::new).collect();
+    let args = module_args(&words);
     let (status, lines) = line.run(&python, &script, &args, SCRIPT_LIMIT);
     line.stop_server();
     println!("--- hil-sim serve:\n{}", line.serve_output());

@@ -37,9 +37,8 @@
 
 mod common;
 
-use common::pn_line::PnLine;
-use profinet::model::{self, DataModule, Direction};
-use std::ffi::OsStr;
+use common::pn_line::{module_args, PnLine};
+use profinet::model;
 use std::path::Path;
 use std::process::Command;
 use std::time::Duration;
@@ -113,22 +112,10 @@ fn p008_p027_p029_p030_p035_p036_p040_p041_p042_p085_p110_p191_p223_profinet_py_
             pcap.as_os_str(),
         ],
     );
-    let gsdml = Path::new(env!("CARGO_MANIFEST_DIR"))
-        .join("../gsdml")
-        .join(gsdml::file_name());
-    let module = |direction, words| gsdml::module_id(DataModule { direction, words });
-    // the manual's example: slot 1 "18 Word Output Data", slot 2 "18 Word Input Data"
-    let (out18, in18) = (module(Direction::FromDrive, 18), module(Direction::ToDrive, 18));
     let vendor = format!("{:#06x}", model::VENDOR_ID);
     let script = Path::new(env!("CARGO_MANIFEST_DIR")).join("tests/profinet/controller.py");
     let (fault_event, fault_cause) = (FAULT_EVENT.to_string(), FAULT_CAUSE.to_string());
     let words = [
-        "--gsdml",
-        gsdml.to_str().unwrap(),
-        "--out-module",
-        &out18,
-        "--in-module",
-        &in18,
         "--vendor-id",
         &vendor,
         "--order",
@@ -151,7 +138,7 @@ fn p008_p027_p029_p030_p035_p036_p040_p041_p042_p085_p110_p191_p223_profinet_py_
         "--startup",
         "advanced",
     ];
-    let args: Vec<&OsStr> = words.iter().map(OsStr::new).collect();
+    let args = module_args(&words);
     let (status, lines) = line.run(&python, &script, &args, SCRIPT_LIMIT);
     let ok = status.success();
     line.stop_server();

@@ -22,9 +22,7 @@
 
 mod common;
 
-use common::pn_line::PnLine;
-use profinet::model::{DataModule, Direction};
-use std::ffi::OsStr;
+use common::pn_line::{module_args, PnLine};
 use std::path::Path;
 use std::time::Duration;
 
@@ -64,22 +62,8 @@ fn p160_p206_p208_p219_p220_p221_p222_p223_p224_p225_p226_p227_the_example_funct
     let dir = Path::new(env!("CARGO_TARGET_TMPDIR")).join("profinet-py");
     std::fs::create_dir_all(&dir).expect("scratch dir");
     let mut line = PnLine::new("fb", &dir, &[]);
-    let gsdml = Path::new(env!("CARGO_MANIFEST_DIR"))
-        .join("../gsdml")
-        .join(gsdml::file_name());
-    let module = |direction, words| gsdml::module_id(DataModule { direction, words });
-    let (out18, in18) = (module(Direction::FromDrive, 18), module(Direction::ToDrive, 18));
     let script = Path::new(env!("CARGO_MANIFEST_DIR")).join("tests/profinet/fb.py");
-    let args: [&OsStr; 8] = [
-        "--gsdml".as_ref(),
-        gsdml.as_os_str(),
-        "--out-module".as_ref(),
-        out18.as_ref(),
-        "--in-module".as_ref(),
-        in18.as_ref(),
-        "--control".as_ref(),
-        line.control.as_os_str(),
-    ];
+    let args = module_args(&["--control".as_ref(), line.control.as_os_str()]);
     let (status, lines) = line.run(&python, &script, &args, SCRIPT_LIMIT);
     line.stop_server();
     println!(

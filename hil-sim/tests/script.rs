@@ -6,24 +6,30 @@ use hil_sim::script::{Progress, Script, SimLink, CYCLE, MOVE_INC};
 use hil_sim::sim::Simulation;
 use nanos::Nanos;
 
-/// E-107 (DC-Sync selected by the master) through the scripted master: Pre-Op SDOs, DC SYNC0, Op,
-/// enable, a csp move on both axes, disable and back to Init.
-#[test]
-fn e107_scripted_master_selects_dc_sync_and_runs_csp_on_both_axes() {
-    let mut sim = Simulation::new(1);
-    let mut script = Script::new();
+/// Runs `script` against `sim` (at most 5 s of simulated time) until it
+/// finishes, which must be with success; what it reported on the way.
+fn run(sim: &mut Simulation, mut script: Script) -> Vec<Progress> {
     let mut log = Vec::new();
     // frames half a cycle away from SYNC0 (which the script puts on whole cycles)
     let mut t = Nanos::from_ns(CYCLE.as_ns() / 2);
     while !script.finished() && t < Nanos::from_secs(5) {
         t += CYCLE;
         sim.advance_to(t);
-        let p = script.step(&mut SimLink(&mut sim));
+        let p = script.step(&mut SimLink(sim));
         if p != Progress::Busy {
             log.push(p);
         }
     }
     assert!(script.succeeded(), "{log:?}");
+    log
+}
+
+/// E-107 (DC-Sync selected by the master) through the scripted master: Pre-Op SDOs, DC SYNC0, Op,
+/// enable, a csp move on both axes, disable and back to Init.
+#[test]
+fn e107_scripted_master_selects_dc_sync_and_runs_csp_on_both_axes() {
+    let mut sim = Simulation::new(1);
+    let log = run(&mut sim, Script::new());
     assert_eq!(log.last(), Some(&Progress::State(1)), "{log:?}");
     assert!(log.contains(&Progress::State(8)), "{log:?}");
     assert!(log.contains(&Progress::Enabled), "{log:?}");
@@ -53,18 +59,7 @@ fn e095_e096_scripted_master_pings_and_reads_a_parameter_over_eoe() {
     let mut sim = Simulation::new(1);
     let mac = [0x02, 0x5C, 0x06, 0, 0, 0x01];
     sim.drives_mut()[0].bind_net(mac, 7, Nanos::ZERO);
-    let mut script = Script::with_eoe();
-    let mut log = Vec::new();
-    let mut t = Nanos::from_ns(CYCLE.as_ns() / 2);
-    while !script.finished() && t < Nanos::from_secs(5) {
-        t += CYCLE;
-        sim.advance_to(t);
-        let p = script.step(&mut SimLink(&mut sim));
-        if p != Progress::Busy {
-            log.push(p);
-        }
-    }
-    assert!(script.succeeded(), "{log:?}");
+    let log = run(&mut sim, Script::with_eoe());
     let eoe: Vec<Progress> = log
         .iter()
         .copied()

@@ -14,20 +14,22 @@ use ethercrab::{MainDevice, MainDeviceConfig, PduStorage, Timeouts};
 /// sockets at once on a loaded 2-core machine miss ethercrab's PDU timeout.
 static ONE_AT_A_TIME: std::sync::Mutex<()> = std::sync::Mutex::new(());
 
-#[test]
-fn e002_raw_ethernet_veth_master_reaches_op() {
-    let _one = ONE_AT_A_TIME
+/// Holding [`ONE_AT_A_TIME`]: `hil-sim serve args` in a network namespace
+/// (`tag` names its veth pair) and ethercrab's raw-socket master on the host
+/// end. `None`, with a message that `test` is skipped, without root.
+fn serve_and_master(
+    test: &str,
+    tag: char,
+    args: &[&str],
+) -> Option<(std::sync::MutexGuard<'static, ()>, Netns, MainDevice<'static>)> {
+    let one = ONE_AT_A_TIME
         .lock()
         .unwrap_or_else(std::sync::PoisonError::into_inner);
     if !common::is_root() {
-        eprintln!("e002_raw_ethernet_veth: skipped, needs root for network namespaces and raw sockets");
-        return;
+        eprintln!("{test}: skipped, needs root for network namespaces and raw sockets");
+        return None;
     }
-    let net = Netns::new(
-        env!("CARGO_BIN_EXE_hil-sim"),
-        'v',
-        &["--slaves", "2", "--seconds", "60"],
-    );
+    let net = Netns::new(env!("CARGO_BIN_EXE_hil-sim"), tag, args);
     let storage: &'static PduStorage<16, { PduStorage::element_size(1100) }> =
         Box::leak(Box::new(PduStorage::new()));
     let (tx, rx, pdu_loop) = storage.try_split().expect("split");
@@ -37,14 +39,35 @@ fn e002_raw_ethernet_veth_master_reaches_op() {
     let timeouts = Timeouts {
         pdu: std::time::Duration::from_millis(500),
         eeprom: std::time::Duration::from_millis(500),
+        mailbox_echo: std::time::Duration::from_millis(2000),
+        mailbox_response: std::time::Duration::from_millis(2000),
         ..Timeouts::default()
     };
-    let md = MainDevice::new(pdu_loop, timeouts, MainDeviceConfig::default());
+    Some((
+        one,
+        net,
+        MainDevice::new(pdu_loop, timeouts, MainDeviceConfig::default()),
+    ))
+}
+
+/// ethercrab's init over the veth pair: the line discovered, in Pre-Op.
+async fn init(md: &MainDevice<'static>) -> ethercrab::SubDeviceGroup<4, 256> {
+    md.init_single_group::<4, 256>(ethercrab::std::ethercat_now)
+        .await
+        .expect("init over veth")
+}
+
+#[test]
+fn e002_raw_ethernet_veth_master_reaches_op() {
+    let Some((_one, net, md)) = serve_and_master(
+        "e002_raw_ethernet_veth",
+        'v',
+        &["--slaves", "2", "--seconds", "60"],
+    ) else {
+        return;
+    };
     futures_lite::future::block_on(async {
-        let group = md
-            .init_single_group::<4, 256>(ethercrab::std::ethercat_now)
-            .await
-            .expect("init over veth");
+        let group = init(&md).await;
         assert_eq!(group.len(), 2, "two simulated drives on the line");
         for sd in group.iter(&md) {
             assert_eq!(sd.identity().vendor_id, 0xB9);
@@ -70,36 +93,13 @@ fn e002_raw_ethernet_veth_master_reaches_op() {
 #[test]
 fn e002_e005_serve_axes_1_is_the_single_axis_device() {
     use ethercrab::error::{CoeAbortCode, Error, MailboxError};
-    let _one = ONE_AT_A_TIME
-        .lock()
-        .unwrap_or_else(std::sync::PoisonError::into_inner);
-    if !common::is_root() {
-        eprintln!("e002_e005_serve_axes_1: skipped, needs root for network namespaces and raw sockets");
+    let Some((_one, net, md)) =
+        serve_and_master("e002_e005_serve_axes_1", 'w', &["--axes", "1", "--seconds", "60"])
+    else {
         return;
-    }
-    let net = Netns::new(
-        env!("CARGO_BIN_EXE_hil-sim"),
-        'w',
-        &["--axes", "1", "--seconds", "60"],
-    );
-    let storage: &'static PduStorage<16, { PduStorage::element_size(1100) }> =
-        Box::leak(Box::new(PduStorage::new()));
-    let (tx, rx, pdu_loop) = storage.try_split().expect("split");
-    let task = ethercrab::std::tx_rx_task(&net.host_if, tx, rx).expect("raw socket on the veth end");
-    std::thread::spawn(move || futures_lite::future::block_on(task));
-    let timeouts = Timeouts {
-        pdu: std::time::Duration::from_millis(500),
-        eeprom: std::time::Duration::from_millis(500),
-        mailbox_echo: std::time::Duration::from_millis(2000),
-        mailbox_response: std::time::Duration::from_millis(2000),
-        ..Timeouts::default()
     };
-    let md = MainDevice::new(pdu_loop, timeouts, MainDeviceConfig::default());
     futures_lite::future::block_on(async {
-        let group = md
-            .init_single_group::<4, 256>(ethercrab::std::ethercat_now)
-            .await
-            .expect("init over veth");
+        let group = init(&md).await;
         assert_eq!(group.len(), 1);
         let sd = group.subdevice(&md, 0).expect("subdevice");
         assert_eq!(sd.identity().vendor_id, 0xB9);

@@ -1,38 +1,11 @@
 //! Actions over the fieldbus through a real master (spec §14; E-060,
 //! E-140…E-142): A75 appended to axis A's RxPDO, A69 to its TxPDO, the
 //! action started by Execute in the cyclic data and followed in A69.
-#![allow(
-    clippy::unwrap_used,
-    clippy::expect_used,
-    clippy::panic,
-    clippy::indexing_slicing
-)]
 
 use drive_ecat::actions::{state, A69, A75};
 use drive_tests::al::OP;
+use drive_tests::step::{a69_of, cycles, op_with_actions};
 use drive_tests::{al_status, init, line, with_master};
-
-/// Appends A75 (8 bits) to 1600h and A69 (16 bits) to 1A00h; returns the
-/// byte offsets of A75 in the outputs and A69 in the inputs.
-async fn map_actions(sd: &ethercrab::SubDeviceRef<'_, &ethercrab::SubDevice>) -> (usize, usize) {
-    let mut offsets = [0usize; 2];
-    for (i, (pdo, entry)) in [
-        (0x1600u16, u32::from(A75) << 16 | 8),
-        (0x1A00, u32::from(A69) << 16 | 16),
-    ]
-    .into_iter()
-    .enumerate()
-    {
-        let n = sd.sdo_read::<u8>(pdo, 0).await.unwrap();
-        for s in 1..=n {
-            offsets[i] += (sd.sdo_read::<u32>(pdo, s).await.unwrap() & 0xFF) as usize / 8;
-        }
-        sd.sdo_write(pdo, 0, 0u8).await.unwrap();
-        sd.sdo_write(pdo, n + 1, entry).await.unwrap();
-        sd.sdo_write(pdo, 0, n + 1).await.expect("A75/A69 mapped");
-    }
-    (offsets[0], offsets[1])
-}
 
 /// E-060, E-140: A75 = Execute | save (0001b) in the RxPDO; A69 in the
 /// TxPDO shows the save running, then done at 100 % with the selector; A00's
@@ -41,10 +14,7 @@ async fn map_actions(sd: &ethercrab::SubDeviceRef<'_, &ethercrab::SubDevice>) ->
 fn e060_e140_save_values_through_a75_and_a69_in_the_process_data() {
     let sim = line(1);
     with_master(&sim, async |md, clock| {
-        let group = init(md, clock).await;
-        let sd = group.subdevice(md, 0).unwrap();
-        let (a75, a69) = map_actions(&sd).await;
-        let group = group.into_op(md).await.expect("Op with A75/A69 mapped");
+        let (group, (a75, a69)) = op_with_actions(md, clock).await;
         let sd = group.subdevice(md, 0).unwrap();
         assert_eq!(al_status(&sd).await, (OP, 0));
         sd.outputs_raw_mut()[a75] = 0b0001 << 1 | 1;
@@ -79,43 +49,18 @@ fn e060_e140_save_values_through_a75_and_a69_in_the_process_data() {
     });
 }
 
-/// A69 at byte `at` of the inputs.
-fn a69_of(inputs: &[u8], at: usize) -> u16 {
-    u16::from_le_bytes([inputs[at], inputs[at + 1]])
-}
-
-/// `n` process-data cycles, the simulated time advanced one master cycle before each.
-async fn cycles<S: ethercrab::subdevice_group::HasPdi>(
-    sim: &std::cell::RefCell<hil_sim::sim::Simulation>,
-    group: &ethercrab::SubDeviceGroup<8, 512, ethercrab::DefaultLock, S>,
-    md: &ethercrab::MainDevice<'_>,
-    n: usize,
-) {
-    for _ in 0..n {
-        {
-            let mut sim = sim.borrow_mut();
-            let t = sim.now() + drive_tests::MASTER_CYCLE;
-            sim.advance_to(t);
-        }
-        group.tx_rx(md).await.expect("cycle");
-    }
-}
-
 /// E-141: a motor test (test winding, 1101b) needs E48 = 2 (ready to switch
 /// on): with the axis switch-on disabled it is refused and A69 says so.
 #[test]
 fn e141_test_winding_refused_outside_ready_to_switch_on() {
     let sim = line(1);
     with_master(&sim, async |md, clock| {
-        let group = init(md, clock).await;
-        let sd = group.subdevice(md, 0).unwrap();
-        let (a75, a69) = map_actions(&sd).await;
-        let group = group.into_op(md).await.expect("Op");
+        let (group, (a75, a69)) = op_with_actions(md, clock).await;
         let sd = group.subdevice(md, 0).unwrap();
         let e48 = sd.sdo_read::<u8>(drive_ecat::params::E48, 0).await.unwrap();
         assert_ne!(e48, 2, "the axis is not ready to switch on");
         sd.outputs_raw_mut()[a75] = 0b1101 << 1 | 1;
-        cycles(&sim, &group, md, 5).await;
+        cycles(md, &group, &sim, 5).await;
         let s = a69_of(sd.io_raw().inputs(), a69);
         assert_eq!(s, 0b1101 << 8 | state::REFUSED << 12, "{s:04X}h");
         // shutdown (6040h = 6): ready to switch on; the precondition holds, and
@@ -125,10 +70,10 @@ fn e141_test_winding_refused_outside_ready_to_switch_on() {
             out[0..2].copy_from_slice(&6u16.to_le_bytes());
             out[a75] = 0;
         }
-        cycles(&sim, &group, md, 20).await;
+        cycles(md, &group, &sim, 20).await;
         assert_eq!(sd.sdo_read::<u8>(drive_ecat::params::E48, 0).await.unwrap(), 2);
         sd.outputs_raw_mut()[a75] = 0b0101 << 1 | 1;
-        cycles(&sim, &group, md, 5).await;
+        cycles(md, &group, &sim, 5).await;
         let s = a69_of(sd.io_raw().inputs(), a69);
         assert_eq!(s, 0b0101 << 8 | state::NOT_AVAILABLE << 12, "{s:04X}h");
     });

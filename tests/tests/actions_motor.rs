@@ -3,39 +3,12 @@
 //! action started in Ready to switch on, the axis enabled for it, its result
 //! in A69 and its objects, read back by SDO. The plant's motor is one the
 //! drive does not know.
-#![allow(
-    clippy::unwrap_used,
-    clippy::expect_used,
-    clippy::panic,
-    clippy::indexing_slicing
-)]
 
-use drive_ecat::actions::{state, A69, A75};
+use drive_ecat::actions::state;
 use drive_ecat::params::{B05, B40, B41, B42, B43, B52, B53, B62, E48};
-use drive_tests::{init, line, with_master, MASTER_CYCLE};
+use drive_tests::step::{a69_of, cycles, follow_a69, op_with_actions};
+use drive_tests::{init, line, with_master};
 use hil_sim::electrical::PlantModel;
-
-/// A75 (8 bits) appended to 1600h, A69 (16 bits) to 1A00h; the byte offsets
-/// of A75 in the outputs and A69 in the inputs.
-async fn map_actions(sd: &ethercrab::SubDeviceRef<'_, &ethercrab::SubDevice>) -> (usize, usize) {
-    let mut offsets = [0usize; 2];
-    for (i, (pdo, entry)) in [
-        (0x1600u16, u32::from(A75) << 16 | 8),
-        (0x1A00, u32::from(A69) << 16 | 16),
-    ]
-    .into_iter()
-    .enumerate()
-    {
-        let n = sd.sdo_read::<u8>(pdo, 0).await.unwrap();
-        for s in 1..=n {
-            offsets[i] += (sd.sdo_read::<u32>(pdo, s).await.unwrap() & 0xFF) as usize / 8;
-        }
-        sd.sdo_write(pdo, 0, 0u8).await.unwrap();
-        sd.sdo_write(pdo, n + 1, entry).await.unwrap();
-        sd.sdo_write(pdo, 0, n + 1).await.expect("A75/A69 mapped");
-    }
-    (offsets[0], offsets[1])
-}
 
 /// A line of one drive whose axis A runs the electrical plant with a motor of
 /// `r_ohm` and `l_h` (the drive's dictionary keeps its defaults: 3.6 Ω, 12 mH).
@@ -53,28 +26,6 @@ fn electrical_line(r_ohm: f64, l_h: f64) -> std::cell::RefCell<hil_sim::sim::Sim
     sim
 }
 
-/// `n` process-data cycles, the simulated time advanced one master cycle before each;
-/// A69 of the last.
-async fn cycles<S: ethercrab::subdevice_group::HasPdi>(
-    sim: &std::cell::RefCell<hil_sim::sim::Simulation>,
-    group: &ethercrab::SubDeviceGroup<8, 512, ethercrab::DefaultLock, S>,
-    md: &ethercrab::MainDevice<'_>,
-    n: usize,
-) {
-    for _ in 0..n {
-        {
-            let mut sim = sim.borrow_mut();
-            let t = sim.now() + MASTER_CYCLE;
-            sim.advance_to(t);
-        }
-        group.tx_rx(md).await.expect("cycle");
-    }
-}
-
-fn a69_of(inputs: &[u8], at: usize) -> u16 {
-    u16::from_le_bytes([inputs[at], inputs[at + 1]])
-}
-
 /// E-140, E-141 (B42 and B49): against plants with R and L the drive does
 /// not know, "optimise current controller" started by A75 in Ready to switch
 /// on waits (running, 0 %) for the enable, then identifies R and L within
@@ -85,16 +36,11 @@ fn e140_b42_b49_optimise_current_controller_identifies_the_plants_r_and_l() {
     for (selector, r, l) in [(0b1100u8, 2.2, 0.0065), (0b1110, 6.0, 0.021)] {
         let sim = electrical_line(r, l);
         with_master(&sim, async |md, clock| {
-            let group = init(md, clock).await;
+            let (group, (a75, a69)) = op_with_actions(md, clock).await;
             let sd = group.subdevice(md, 0).unwrap();
-            let (a75, a69) = map_actions(&sd).await;
-            let group = group.into_op(md).await.expect("Op with A75/A69 mapped");
-            let sd = group.subdevice(md, 0).unwrap();
-            sd.outputs_raw_mut()[0..2].copy_from_slice(&6u16.to_le_bytes());
-            cycles(&sim, &group, md, 20).await;
-            assert_eq!(sd.sdo_read::<u8>(E48, 0).await.unwrap(), 2, "ready to switch on");
+            ready_to_switch_on(md, &group, &sim).await;
             sd.outputs_raw_mut()[a75] = selector << 1 | 1;
-            cycles(&sim, &group, md, 5).await;
+            cycles(md, &group, &sim, 5).await;
             let s = a69_of(sd.io_raw().inputs(), a69);
             assert_eq!(
                 s,
@@ -104,19 +50,9 @@ fn e140_b42_b49_optimise_current_controller_identifies_the_plants_r_and_l() {
             // the enable: switch on, enable operation
             for cw in [7u16, 0xF] {
                 sd.outputs_raw_mut()[0..2].copy_from_slice(&cw.to_le_bytes());
-                cycles(&sim, &group, md, 5).await;
+                cycles(md, &group, &sim, 5).await;
             }
-            let mut seen = Vec::new();
-            for _ in 0..3000 {
-                cycles(&sim, &group, md, 1).await;
-                let s = a69_of(sd.io_raw().inputs(), a69);
-                if seen.last() != Some(&s) {
-                    seen.push(s);
-                }
-                if s >> 12 != state::RUNNING {
-                    break;
-                }
-            }
+            let seen = follow_a69(md, &group, &sim, a69, 3000, |s| s >> 12 == state::RUNNING).await;
             let done = 100 | u16::from(selector) << 8 | state::DONE << 12;
             assert_eq!(seen.last(), Some(&done), "A69 over the cycles: {seen:04X?}");
             assert!(
@@ -143,11 +79,23 @@ fn e140_b42_b49_optimise_current_controller_identifies_the_plants_r_and_l() {
             // the master ends it: Execute low, the enable removed
             sd.outputs_raw_mut()[a75] = 0;
             sd.outputs_raw_mut()[0..2].copy_from_slice(&6u16.to_le_bytes());
-            cycles(&sim, &group, md, 10).await;
+            cycles(md, &group, &sim, 10).await;
             assert_eq!(a69_of(sd.io_raw().inputs(), a69), 0);
             assert_eq!(sd.sdo_read::<u8>(E48, 0).await.unwrap(), 2);
         });
     }
+}
+
+/// Shutdown (6040h = 6) for 20 cycles: axis A in Ready to switch on (E48 = 2).
+async fn ready_to_switch_on<S: ethercrab::subdevice_group::HasPdi>(
+    md: &ethercrab::MainDevice<'_>,
+    group: &ethercrab::SubDeviceGroup<8, 512, ethercrab::DefaultLock, S>,
+    sim: &std::cell::RefCell<hil_sim::sim::Simulation>,
+) {
+    let sd = group.subdevice(md, 0).unwrap();
+    sd.outputs_raw_mut()[0..2].copy_from_slice(&6u16.to_le_bytes());
+    cycles(md, group, sim, 20).await;
+    assert_eq!(sd.sdo_read::<u8>(E48, 0).await.unwrap(), 2, "ready to switch on");
 }
 
 /// Starts action `selector` in Ready to switch on, enables the axis and
@@ -160,28 +108,15 @@ async fn run_action<S: ethercrab::subdevice_group::HasPdi>(
     selector: u8,
     max_cycles: usize,
 ) -> Vec<u16> {
+    ready_to_switch_on(md, group, sim).await;
     let sd = group.subdevice(md, 0).unwrap();
-    sd.outputs_raw_mut()[0..2].copy_from_slice(&6u16.to_le_bytes());
-    cycles(sim, group, md, 20).await;
-    assert_eq!(sd.sdo_read::<u8>(E48, 0).await.unwrap(), 2, "ready to switch on");
     sd.outputs_raw_mut()[a75] = selector << 1 | 1;
-    cycles(sim, group, md, 5).await;
+    cycles(md, group, sim, 5).await;
     for cw in [7u16, 0xF] {
         sd.outputs_raw_mut()[0..2].copy_from_slice(&cw.to_le_bytes());
-        cycles(sim, group, md, 5).await;
+        cycles(md, group, sim, 5).await;
     }
-    let mut seen = Vec::new();
-    for _ in 0..max_cycles {
-        cycles(sim, group, md, 1).await;
-        let s = a69_of(sd.io_raw().inputs(), a69);
-        if seen.last() != Some(&s) {
-            seen.push(s);
-        }
-        if s >> 12 != state::RUNNING {
-            break;
-        }
-    }
-    seen
+    follow_a69(md, group, sim, a69, max_cycles, |s| s >> 12 == state::RUNNING).await
 }
 
 /// E-140 (B41): "calibrate motor" on a plant whose commutation offset the
@@ -203,10 +138,7 @@ fn e140_b41_calibrate_motor_finds_the_plants_commutation_offset() {
     let per_el = (1u32 << 20) / 4;
     let truth = (offset_rad / std::f64::consts::TAU * f64::from(1u32 << 20)).round() as i64;
     let b05 = with_master(&sim, async |md, clock| {
-        let group = init(md, clock).await;
-        let sd = group.subdevice(md, 0).unwrap();
-        let (a75, a69) = map_actions(&sd).await;
-        let group = group.into_op(md).await.expect("Op with A75/A69 mapped");
+        let (group, (a75, a69)) = op_with_actions(md, clock).await;
         let sd = group.subdevice(md, 0).unwrap();
         assert_eq!(sd.sdo_read::<u32>(B05, 0).await.unwrap(), 0);
         let seen = run_action(&sim, &group, md, (a75, a69), 0b1011, 20_000).await;
@@ -225,11 +157,11 @@ fn e140_b41_calibrate_motor_finds_the_plants_commutation_offset() {
         );
         sd.outputs_raw_mut()[a75] = 0;
         sd.outputs_raw_mut()[0..2].copy_from_slice(&6u16.to_le_bytes());
-        cycles(&sim, &group, md, 10).await;
+        cycles(md, &group, &sim, 10).await;
         sd.sdo_write(0x1010, 1, u32::from_le_bytes(*b"save"))
             .await
             .expect("save");
-        cycles(&sim, &group, md, 200).await;
+        cycles(md, &group, &sim, 200).await;
         b05
     });
     sim.borrow_mut().drives_mut()[0].power_cycle();
@@ -249,10 +181,7 @@ fn e140_b41_calibrate_motor_finds_the_plants_commutation_offset() {
 fn e141_b42_refused_in_the_wrong_state_and_aborted_without_its_enable() {
     let sim = electrical_line(2.2, 0.0065);
     with_master(&sim, async |md, clock| {
-        let group = init(md, clock).await;
-        let sd = group.subdevice(md, 0).unwrap();
-        let (a75, a69) = map_actions(&sd).await;
-        let group = group.into_op(md).await.expect("Op");
+        let (group, (a75, a69)) = op_with_actions(md, clock).await;
         let sd = group.subdevice(md, 0).unwrap();
         let before = (
             sd.sdo_read::<u32>(B53, 0).await.unwrap(),
@@ -260,17 +189,17 @@ fn e141_b42_refused_in_the_wrong_state_and_aborted_without_its_enable() {
         );
         assert_ne!(sd.sdo_read::<u8>(E48, 0).await.unwrap(), 2);
         sd.outputs_raw_mut()[a75] = 0b1100 << 1 | 1;
-        cycles(&sim, &group, md, 5).await;
+        cycles(md, &group, &sim, 5).await;
         let s = a69_of(sd.io_raw().inputs(), a69);
         assert_eq!(s, 0b1100 << 8 | state::REFUSED << 12, "{s:04X}h");
         sd.outputs_raw_mut()[a75] = 0;
         sd.outputs_raw_mut()[0..2].copy_from_slice(&6u16.to_le_bytes());
-        cycles(&sim, &group, md, 20).await;
+        cycles(md, &group, &sim, 20).await;
         sd.outputs_raw_mut()[a75] = 0b1100 << 1 | 1;
-        cycles(&sim, &group, md, 5).await;
+        cycles(md, &group, &sim, 5).await;
         // disable voltage instead of the enable: back to switch-on disabled
         sd.outputs_raw_mut()[0..2].copy_from_slice(&0u16.to_le_bytes());
-        cycles(&sim, &group, md, 10).await;
+        cycles(md, &group, &sim, 10).await;
         let s = a69_of(sd.io_raw().inputs(), a69);
         assert_eq!(s, 0b1100 << 8 | state::FAILED << 12, "{s:04X}h");
         assert_eq!(sd.sdo_read::<u8>(B42, 1).await.unwrap(), 1, "B42[0]: aborted");
@@ -323,26 +252,14 @@ fn e140_b43_test_winding_passes_a_balanced_and_fails_an_unbalanced_or_open_windi
                 .set_faults(f);
         }
         with_master(&sim, async |md, clock| {
-            let group = init(md, clock).await;
+            let (group, (a75, a69)) = op_with_actions(md, clock).await;
             let sd = group.subdevice(md, 0).unwrap();
-            let (a75, a69) = map_actions(&sd).await;
-            let group = group.into_op(md).await.expect("Op with A75/A69 mapped");
-            let sd = group.subdevice(md, 0).unwrap();
-            sd.outputs_raw_mut()[0..2].copy_from_slice(&6u16.to_le_bytes());
-            cycles(&sim, &group, md, 20).await;
-            assert_eq!(sd.sdo_read::<u8>(E48, 0).await.unwrap(), 2, "ready to switch on");
+            ready_to_switch_on(md, &group, &sim).await;
             sd.outputs_raw_mut()[a75] = 0b1101 << 1 | 1;
-            let mut seen = Vec::new();
-            for _ in 0..5000 {
-                cycles(&sim, &group, md, 1).await;
-                let s = a69_of(sd.io_raw().inputs(), a69);
-                if seen.last() != Some(&s) {
-                    seen.push(s);
-                }
-                if s >> 12 != state::RUNNING && s >> 12 != state::IDLE {
-                    break;
-                }
-            }
+            let seen = follow_a69(md, &group, &sim, a69, 5000, |s| {
+                s >> 12 == state::RUNNING || s >> 12 == state::IDLE
+            })
+            .await;
             assert_eq!(
                 sd.sdo_read::<u8>(E48, 0).await.unwrap(),
                 2,
@@ -420,10 +337,7 @@ fn e140_b40_test_phase_passes_the_wiring_and_fails_swapped_or_open_phases_and_wr
             plant.set_motor(m);
         }
         with_master(&sim, async |md, clock| {
-            let group = init(md, clock).await;
-            let sd = group.subdevice(md, 0).unwrap();
-            let (a75, a69) = map_actions(&sd).await;
-            let group = group.into_op(md).await.expect("Op with A75/A69 mapped");
+            let (group, (a75, a69)) = op_with_actions(md, clock).await;
             let sd = group.subdevice(md, 0).unwrap();
             // cst (10): the rotor turns, no position is held
             sd.outputs_raw_mut()[2] = 10;
@@ -472,10 +386,7 @@ fn e140_b300_test_brake_holds_the_rated_torque_or_fails_on_a_worn_brake() {
             .params_mut()
             .brake_holding_torque_nm = holding_nm;
         with_master(&sim, async |md, clock| {
-            let group = init(md, clock).await;
-            let sd = group.subdevice(md, 0).unwrap();
-            let io = map_actions(&sd).await;
-            let group = group.into_op(md).await.expect("Op with A75/A69 mapped");
+            let (group, io) = op_with_actions(md, clock).await;
             let sd = group.subdevice(md, 0).unwrap();
             let seen = run_action(&sim, &group, md, io, 0b0100, 3000).await;
             let last = *seen.last().unwrap();

@@ -1,11 +1,5 @@
 //! AL status codes of E-047 through a real master: 0051h when the ESC could
 //! not load its configuration from the SII EEPROM.
-#![allow(
-    clippy::unwrap_used,
-    clippy::expect_used,
-    clippy::panic,
-    clippy::indexing_slicing
-)]
 
 use drive_tests::al::{ERR, INIT, PREOP};
 use drive_tests::{line, with_master};

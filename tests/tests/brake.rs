@@ -2,12 +2,6 @@
 //! §5.1 and §14): F00 brake control and F06 release override written by
 //! SDO from ethercrab, the brake seen at the simulated motor (its brake
 //! input, one cycle after the drive's output) and the rotor's motion.
-#![allow(
-    clippy::unwrap_used,
-    clippy::expect_used,
-    clippy::panic,
-    clippy::indexing_slicing
-)]
 
 use drive_tests::{init, line, sw, with_master, Cyclic, REV};
 use hil_sim::sim::Simulation;
@@ -82,11 +76,7 @@ fn c021_f00_brake_control_inactive_keeps_the_brake_applied_while_enabled() {
         let group = init(md, clock).await.into_op(md).await.expect("OP");
         let sd = group.subdevice(md, 0).unwrap();
         let mut m = Cyclic::new(md, &group, &sim, 0);
-        m.set_mode(9);
-        m.run(3).await;
-        m.enable().await;
-        m.set_target_velocity(2 * REV);
-        m.run(300).await;
+        m.csv_at(2 * REV, 300).await;
         assert!(!applied(&sim), "F00 = 1, moving: released");
         let v = velocity_rev_s(&sim);
         assert!((v - 2.0).abs() < 0.1, "2 rev/s: {v}");

@@ -1,11 +1,5 @@
 //! The bus through a real master: ethercrab drives the simulated ESC in-process
 //! (no root, no network), the slave stack runs its real code in simulated time.
-#![allow(
-    clippy::unwrap_used,
-    clippy::expect_used,
-    clippy::panic,
-    clippy::indexing_slicing
-)]
 
 use drive_tests::al::{ACK, BOOT, ERR, INIT, OP, PREOP, SAFEOP};
 use drive_tests::{al_status, init, line, request, with_master, write_sm};

@@ -5,12 +5,6 @@
 //! from I210, E80, reference retaining I46, the position encoder I02, the
 //! user status word A66/A67 and the set-value monitor. Every check reads
 //! what the master received (TxPDO or SDO) or the plant's encoder.
-#![allow(
-    clippy::unwrap_used,
-    clippy::expect_used,
-    clippy::panic,
-    clippy::indexing_slicing
-)]
 
 use drive_ecat::parameter_index;
 use drive_tests::axis::*;
@@ -55,9 +49,7 @@ fn c028_mode_0_generates_no_motion() {
     with_master(&sim, async |md, clock| {
         let group = init(md, clock).await.into_op(md).await.expect("OP");
         let mut m = Cyclic::new(md, &group, &sim, 0);
-        m.set_mode(0);
-        m.run(3).await;
-        let tx = m.enable().await;
+        let tx = m.enable_in(0).await;
         assert_eq!(tx.mode_display, 0, "6061h shows mode 0");
         let p0 = motor_position(&sim, 0);
         // every set-point of every mode and all mode bits: nothing moves
@@ -89,9 +81,7 @@ fn c029_running_move_is_replaced_but_not_during_a_stop() {
         // 605Ah = 6: quick stop ramp, then stay in Quick stop active
         sd.sdo_write(0x605A, 0, 6i16).await.unwrap();
         let mut m = Cyclic::new(md, &group, &sim, 0);
-        m.set_mode(1);
-        m.run(3).await;
-        m.enable().await;
+        m.enable_in(1).await;
         // relative move +5 rev, replaced after 0.4 s by −1 rev (bit 5: at once)
         assert!(pp_edge(&mut m, 5 * REV, CW_BIT6).await, "first move taken");
         m.run(400).await;
@@ -152,9 +142,7 @@ fn c030_velocity_override_a340_in_pv_pp_and_vl() {
         let ovr: u16 = sd.sdo_read(A340, 0).await.unwrap();
         assert_eq!(ovr, 100, "A340 default 100 %");
         let mut m = Cyclic::new(md, &group, &sim, 0);
-        m.set_mode(3);
-        m.run(3).await;
-        m.enable().await;
+        m.enable_in(3).await;
 
         // pv: 60FFh = 2 rev/s at 50 % → 1 rev/s, back to 100 % → 2 rev/s
         sd.sdo_write(A340, 0, 50u16).await.unwrap();
@@ -236,9 +224,7 @@ fn c040_csp_csv_cst_need_no_mode_specific_controlword_bits() {
     with_master(&sim, async |md, clock| {
         let group = init(md, clock).await.into_op(md).await.expect("OP");
         let mut m = Cyclic::new(md, &group, &sim, 0);
-        m.set_mode(9);
-        m.run(3).await;
-        m.enable().await;
+        m.enable_in(9).await;
         // csv: the same velocity with controlword 000Fh and with bits 4, 5, 6, 8, 9
         let mut speeds = Vec::new();
         for cw in [
@@ -316,9 +302,7 @@ fn c042_c050_setpoint_acknowledge_only_for_accepted_targets() {
         let sd = group.subdevice(md, 0).unwrap();
         sd.sdo_write(0x6081, 0, REV as u32).await.unwrap();
         let mut m = Cyclic::new(md, &group, &sim, 0);
-        m.set_mode(1);
-        m.run(3).await;
-        m.enable().await;
+        m.enable_in(1).await;
         let p0 = motor_position(&sim, 0);
         // not referenced: an absolute target is refused, no acknowledge, no motion (C-050)
         assert!(
@@ -368,9 +352,7 @@ fn c045_bit_6_clear_moves_to_the_absolute_position() {
         let sd = group.subdevice(md, 0).unwrap();
         sd.sdo_write(0x6081, 0, (2 * REV) as u32).await.unwrap();
         let mut m = Cyclic::new(md, &group, &sim, 0);
-        m.set_mode(6);
-        m.run(3).await;
-        m.enable().await;
+        m.enable_in(6).await;
         home_here(&mut m).await;
         m.set_mode(1);
         m.run(10).await;
@@ -417,11 +399,7 @@ fn c104_c107_limit_switches_from_i210_and_e80() {
         sd.sdo_write(I101, 0, 2u8).await.unwrap();
         sd.sdo_write(I102, 0, 2u8).await.unwrap();
         let mut m = Cyclic::new(md, &group, &sim, 0);
-        m.set_mode(9);
-        m.run(3).await;
-        m.enable().await;
-        m.set_target_velocity(REV);
-        m.run(200).await;
+        m.csv_at(REV, 200).await;
         assert_eq!(m.tx.state(), sw::OE);
         let e80: u8 = sd.sdo_read(E80, 0).await.unwrap();
         assert_eq!(e80, 0, "E80 without limitation");
@@ -483,11 +461,7 @@ fn c107_e80_shows_illegal_direction_on_an_endless_axis() {
         let group = group.into_op(md).await.expect("OP");
         let sd = group.subdevice(md, 0).unwrap();
         let mut m = Cyclic::new(md, &group, &sim, 0);
-        m.set_mode(9);
-        m.run(3).await;
-        m.enable().await;
-        m.set_target_velocity(REV / 2);
-        m.run(300).await;
+        m.csv_at(REV / 2, 300).await;
         let e80: u8 = sd.sdo_read(E80, 0).await.unwrap();
         assert_eq!(e80, 15, "E80 = 15 illegal direction (negative locked)");
         assert!(m.tx.velocity > REV / 4, "the permitted direction moves");
@@ -559,9 +533,7 @@ fn c113_the_motor_encoder_closes_the_position_loop() {
             "no position encoder on this hardware: I02 = 1 refused"
         );
         let mut m = Cyclic::new(md, &group, &sim, 0);
-        m.set_mode(8);
-        m.run(3).await;
-        m.enable().await;
+        m.enable_in(8).await;
         let mut p = m.tx.position;
         for _ in 0..1000 {
             p += REV / 1000;
@@ -632,9 +604,7 @@ fn c148_set_value_jump_trips_the_monitor() {
         // 607Fh = 10 rev/s: 2 × 10 rev/s × 1 ms = 0.02 rev per cycle is feasible
         sd.sdo_write(0x607F, 0, (10 * REV) as u32).await.unwrap();
         let mut m = Cyclic::new(md, &group, &sim, 0);
-        m.set_mode(8);
-        m.run(3).await;
-        m.enable().await;
+        m.enable_in(8).await;
         // steps of 0.015 rev per cycle (9 rev/s) are followed
         let mut p = m.tx.position;
         for _ in 0..100 {
@@ -766,9 +736,8 @@ fn c109_gear_and_feed_scale_positions_and_velocities_through_the_master() {
         sd.sdo_write(0x6092, 1, 360_000u32).await.unwrap();
         sd.sdo_write(0x6091, 1, 2u32).await.unwrap();
         sd.sdo_write(0x6091, 2, 1u32).await.unwrap();
-        sd.sdo_write(0x6081, 0, 180_000u32).await.unwrap(); // 0.5 shaft rev/s
-        sd.sdo_write(0x6083, 0, 3_600_000u32).await.unwrap(); // 10 shaft rev/s²
-        sd.sdo_write(0x6084, 0, 3_600_000u32).await.unwrap();
+        // 0.5 shaft rev/s, 10 shaft rev/s²
+        set_profile(&sd, Some(180_000u32), 3_600_000u32).await;
         sd.sdo_write(0x607F, 0, 18_000_000u32).await.unwrap(); // 50 shaft rev/s
         let mut m = Cyclic::new(md, &group, &sim, 0);
         m.set_mode(9);
@@ -848,9 +817,7 @@ fn c111_endless_axis_wraps_at_607b_through_the_master() {
         sd.sdo_write(0x607B, 2, L).await.unwrap();
         sd.sdo_write(0x607B, 1, -5i32).await.unwrap(); // no function
         let mut m = Cyclic::new(md, &group, &sim, 0);
-        m.set_mode(9);
-        m.run(3).await;
-        m.enable().await;
+        m.enable_in(9).await;
         // csv 1 rev/s for 1.6 s: 6064h stays in 0 … L − 1 and wraps once
         m.set_target_velocity(L);
         let p0 = motor_position(&sim, 0);

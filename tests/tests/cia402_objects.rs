@@ -4,15 +4,10 @@
 //! manufacturer parameter addressing, the PDO timeout A258, hidden
 //! parameters, native fieldbus scaling, synchronisation, saving, the mapping
 //! after a restart and the station alias.
-#![allow(
-    clippy::unwrap_used,
-    clippy::expect_used,
-    clippy::panic,
-    clippy::indexing_slicing
-)]
 
 use drive_ecat::{parameter_index, Template};
 use drive_tests::al::{ERR, OP, SAFEOP};
+use drive_tests::step::advance;
 use drive_tests::{al_status, init, line, map_layout, variant, with_master, CoeClient, Cyclic, REV};
 use ecat::SdoAbort;
 use esc::AlStatusCode;
@@ -33,12 +28,6 @@ fn offsets(entries: &[u32]) -> (Vec<usize>, usize) {
         at += (e & 0xFF) as usize / 8;
     }
     (out, at)
-}
-
-fn advance(sim: &RefCell<Simulation>, ns: u64) {
-    let mut s = sim.borrow_mut();
-    let t = s.now().as_ns() + ns;
-    s.advance_to(nanos::Nanos::from_ns(t));
 }
 
 // ---------------------------------------------------------------------------
@@ -455,9 +444,7 @@ fn csv_at(setup: &[(u16, u8, u8)], v: i32) -> (i32, i32, f64) {
         let group = group.into_op(md).await.expect("OP");
         let sd = group.subdevice(md, 0).unwrap();
         let mut c = Cyclic::new(md, &group, &sim, 0);
-        c.set_mode(9);
-        c.run(3).await;
-        c.enable().await;
+        c.enable_in(9).await;
         c.set_target_velocity(v);
         let t = c.run(600).await;
         let shown = sd.sdo_read::<i32>(0x60FF, 0).await.unwrap();

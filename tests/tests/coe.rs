@@ -3,12 +3,6 @@
 //! `CoeClient` builds them from the spec's byte layouts), the abort codes of
 //! spec §6.5 for every kind of bad input, SDO Information (§7), segmented
 //! transfers and complete access.
-#![allow(
-    clippy::unwrap_used,
-    clippy::expect_used,
-    clippy::panic,
-    clippy::indexing_slicing
-)]
 
 use drive_ecat::objects::{enumeration, Object, Value, OBJECTS};
 use drive_ecat::{revision, DriveObjects, Template};

@@ -4,21 +4,16 @@
 //! control-cycle timer to SYNC0 − A292 (E-107, E-109, E-113, E-114); loss of
 //! SYNC0 is reported (A298, PLL fault); a late frame counts in A261[2]
 //! (E-117, E-118); a SYNC0 cycle the PLL cannot run is refused (A261[0], E-116).
-#![allow(
-    clippy::unwrap_used,
-    clippy::expect_used,
-    clippy::panic,
-    clippy::indexing_slicing
-)]
 
 use drive_ecat::runtime::dcsync;
 use drive_ecat::runtime::dcsync::{PllStatus, SyncFault};
 use drive_tests::al::{OP, SAFEOP};
+use drive_tests::init;
 use ethercrab::subdevice_group::DcConfiguration;
 use ethercrab::{DcSync, MainDevice, MainDeviceConfig, SubDeviceGroup};
 use hil_sim::sim::Simulation;
 use std::cell::RefCell;
-use std::sync::atomic::{AtomicU64, Ordering};
+use std::sync::atomic::AtomicU64;
 use std::time::Duration;
 
 /// Oscillator drift of drive 0 (the DC reference) and drive 1, ppm.
@@ -67,11 +62,14 @@ fn with_master<T>(
     )
 }
 
-async fn init<'a>(md: &'a MainDevice<'a>, clock: &'a AtomicU64) -> SubDeviceGroup<8, 512> {
-    md.init_single_group::<8, 512>(|| clock.load(Ordering::Relaxed))
-        .await
-        .expect("ethercrab init")
-}
+/// The line in Op with DC.
+type DcOpGroup = SubDeviceGroup<
+    8,
+    512,
+    ethercrab::DefaultLock,
+    ethercrab::subdevice_group::Op,
+    ethercrab::subdevice_group::HasDc,
+>;
 
 /// What to do to the line during the DC cycles.
 #[derive(Clone, Copy, PartialEq, Eq)]
@@ -105,21 +103,10 @@ fn run(
     mut probe: impl FnMut(usize, &Simulation),
 ) -> [Seen; 2] {
     with_master(sim, async |md, clock| {
-        let mut group = init(md, clock).await;
-        for mut sd in group.iter_mut(md) {
-            sd.set_dc_sync(DcSync::Sync0);
-        }
-        let group = group.into_pre_op_pdi(md).await.expect("PRE-OP with PDI");
-        for sd in group.iter(md) {
+        let group = dc_requested_op_after(md, clock, SYNC0_NS, async |sd| {
             sd.sdo_write(A292, 0, A292_US).await.expect("A292");
-        }
-        let group = group
-            .configure_dc_sync(md, dc_config(SYNC0_NS))
-            .await
-            .expect("DC configuration")
-            .request_into_op(md)
-            .await
-            .expect("request OP");
+        })
+        .await;
         let mut op = false;
         for i in 0..cycles {
             if inject == Inject::StopSync0(i) {
@@ -412,30 +399,30 @@ fn e116_a_sync0_cycle_the_pll_cannot_run_is_refused() {
 
 const ERR_ACK: u16 = 0x10;
 
-/// Runs `n` `tx_rx_dc` cycles, the clock advanced as ethercrab computes it;
-/// calls `probe` after each with the cycle number, whether the group is in
-/// OP, and the simulation.
 /// The line with DC SYNC0 at [`SYNC0_NS`] on every drive and Op requested
 /// (ethercrab's init, Pre-Op with PDI, the DC configuration).
-async fn dc_requested_op<'a>(
+async fn dc_requested_op<'a>(md: &'a MainDevice<'a>, clock: &'a AtomicU64) -> DcOpGroup {
+    dc_requested_op_after(md, clock, SYNC0_NS, async |_| {}).await
+}
+
+/// [`dc_requested_op`] with SYNC0 every `sync0_ns`, `pre_op` run on every
+/// drive in Pre-Op.
+async fn dc_requested_op_after<'a>(
     md: &'a MainDevice<'a>,
     clock: &'a AtomicU64,
-) -> SubDeviceGroup<
-    8,
-    512,
-    ethercrab::DefaultLock,
-    ethercrab::subdevice_group::Op,
-    ethercrab::subdevice_group::HasDc,
-> {
+    sync0_ns: u64,
+    pre_op: impl for<'b> AsyncFn(&'b Sd<'b>),
+) -> DcOpGroup {
     let mut group = init(md, clock).await;
     for mut sd in group.iter_mut(md) {
         sd.set_dc_sync(DcSync::Sync0);
     }
+    let group = group.into_pre_op_pdi(md).await.expect("PRE-OP with PDI");
+    for sd in group.iter(md) {
+        pre_op(&sd).await;
+    }
     group
-        .into_pre_op_pdi(md)
-        .await
-        .expect("PRE-OP with PDI")
-        .configure_dc_sync(md, dc_config(SYNC0_NS))
+        .configure_dc_sync(md, dc_config(sync0_ns))
         .await
         .expect("DC configuration")
         .request_into_op(md)
@@ -443,15 +430,12 @@ async fn dc_requested_op<'a>(
         .expect("request OP")
 }
 
+/// Runs `n` `tx_rx_dc` cycles, the clock advanced as ethercrab computes it;
+/// calls `probe` after each with the cycle number, whether the group is in
+/// OP, and the simulation.
 async fn dc_cycles<'a>(
     md: &'a MainDevice<'a>,
-    group: &SubDeviceGroup<
-        8,
-        512,
-        ethercrab::DefaultLock,
-        ethercrab::subdevice_group::Op,
-        ethercrab::subdevice_group::HasDc,
-    >,
+    group: &DcOpGroup,
     sim: &RefCell<Simulation>,
     n: usize,
     mut probe: impl FnMut(usize, bool, &Simulation),
@@ -664,34 +648,14 @@ fn dc_op<T>(
     sync0_ns: u64,
     pre_op: impl for<'a> AsyncFn(&'a Sd<'a>),
     n: usize,
-    body: impl for<'a> AsyncFnOnce(
-        &'a MainDevice<'a>,
-        &'a SubDeviceGroup<
-            8,
-            512,
-            ethercrab::DefaultLock,
-            ethercrab::subdevice_group::Op,
-            ethercrab::subdevice_group::HasDc,
-        >,
-    ) -> T,
+    body: impl for<'a> AsyncFnOnce(&'a MainDevice<'a>, &'a DcOpGroup) -> T,
 ) -> T {
     with_master(sim, async |md, clock| {
-        let mut group = init(md, clock).await;
-        for mut sd in group.iter_mut(md) {
-            sd.set_dc_sync(DcSync::Sync0);
-        }
-        let group = group.into_pre_op_pdi(md).await.expect("PRE-OP with PDI");
-        for sd in group.iter(md) {
+        let group = dc_requested_op_after(md, clock, sync0_ns, async |sd| {
             sd.sdo_write(A292, 0, A292_US).await.expect("A292");
-            pre_op(&sd).await;
-        }
-        let group = group
-            .configure_dc_sync(md, dc_config(sync0_ns))
-            .await
-            .expect("DC configuration")
-            .request_into_op(md)
-            .await
-            .expect("request OP");
+            pre_op(sd).await;
+        })
+        .await;
         let mut op = None;
         dc_cycles(md, &group, sim, n, |i, all_op, _| {
             if all_op && op.is_none() {
@@ -1037,13 +1001,7 @@ fn e115_a298_bits_through_the_master() {
 /// the dictionary holds them.
 async fn a287_measurement<'a>(
     md: &'a MainDevice<'a>,
-    group: &SubDeviceGroup<
-        8,
-        512,
-        ethercrab::DefaultLock,
-        ethercrab::subdevice_group::Op,
-        ethercrab::subdevice_group::HasDc,
-    >,
+    group: &DcOpGroup,
     sim: &RefCell<Simulation>,
     mut each: impl FnMut(usize, &mut Simulation),
 ) -> (i64, i64, i64) {

@@ -1,14 +1,9 @@
 //! EtherCAT diagnosis through a real master (spec §13.3, §13.5, §13.6): the
 //! LEDs, A254–A257 and the parameter versions; the ESM's data rules that
 //! the diagnosis shows (E-024, E-036, E-040).
-#![allow(
-    clippy::unwrap_used,
-    clippy::expect_used,
-    clippy::panic,
-    clippy::indexing_slicing
-)]
 
 use drive_tests::al::{ACK, BOOT, ERR, INIT, OP, PREOP, SAFEOP};
+use drive_tests::step::{advance, cycles};
 use drive_tests::{al_status, init, line, request, with_master, write_sm, CoeClient};
 use ecat::led::Pattern;
 use esc::AlStatusCode;
@@ -20,12 +15,6 @@ const A255: u16 = drive_ecat::parameter_index(0, 255);
 const A256: u16 = drive_ecat::parameter_index(0, 256);
 const A257: u16 = drive_ecat::parameter_index(0, 257);
 const A258: u16 = drive_ecat::parameter_index(0, 258);
-
-fn advance(sim: &RefCell<Simulation>, ns: u64) {
-    let mut s = sim.borrow_mut();
-    let t = s.now().as_ns() + ns;
-    s.advance_to(nanos::Nanos::from_ns(t));
-}
 
 /// A257[`element`] by SDO (SDO Info numbering: sub = element + 1), without
 /// the zero padding.
@@ -51,19 +40,6 @@ where
 fn leds(sim: &RefCell<Simulation>, i: usize) -> drive_ecat::runtime::Leds {
     let s = sim.borrow();
     s.drives()[i].leds(nanos::Nanos::from_ns(s.now().as_ns()))
-}
-
-/// `n` process-data cycles of 1 ms.
-async fn cycles<S: ethercrab::subdevice_group::HasPdi>(
-    md: &ethercrab::MainDevice<'_>,
-    group: &ethercrab::SubDeviceGroup<8, 512, ethercrab::DefaultLock, S>,
-    sim: &RefCell<Simulation>,
-    n: usize,
-) {
-    for _ in 0..n {
-        advance(sim, 1_000_000);
-        group.tx_rx(md).await.expect("process data cycle");
-    }
 }
 
 /// The fraction of `span_ns` (sampled every 10 ms of simulated time) in

@@ -2,12 +2,6 @@
 //! reaction per A540 (605Eh) to a PDO timeout in Op (cause 6, E-128/E-129),
 //! the fieldbus identification check (cause 15, E-130), one EMCY per event
 //! and the fault reset afterwards.
-#![allow(
-    clippy::unwrap_used,
-    clippy::expect_used,
-    clippy::panic,
-    clippy::indexing_slicing
-)]
 
 use drive_tests::al::{ACK, ERR, OP, SAFEOP};
 use drive_tests::{al_status, init, line, request, sw, with_master, CoeClient, Cyclic, REV};
@@ -77,9 +71,7 @@ fn pdo_timeout_reaction(a540: i16) -> Vec<Sample> {
         let group = group.into_op(md).await.expect("OP");
         let sd = group.subdevice(md, 0).unwrap();
         let mut m = Cyclic::new(md, &group, &sim, 0);
-        m.set_mode(9);
-        m.run(3).await;
-        m.enable().await;
+        m.enable_in(9).await;
         m.set_target_velocity(5 * REV);
         m.run_until(500, |t| (t.velocity - 5 * REV).abs() < REV / 20)
             .await

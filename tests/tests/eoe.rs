@@ -2,12 +2,6 @@
 //! E-093): a fragmented Ethernet frame reaches the drive's EoE interface,
 //! the set-IP-parameter request is answered and a refused address sends
 //! EMCY FFF0h.
-#![allow(
-    clippy::unwrap_used,
-    clippy::expect_used,
-    clippy::panic,
-    clippy::indexing_slicing
-)]
 
 use drive_tests::{init, line, with_master, RawMailbox};
 use ecat::eoe::{fnv1a, EoeHeader};

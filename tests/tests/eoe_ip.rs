@@ -3,12 +3,6 @@
 //! service, pings it, reads and writes parameters over the UDP parameter
 //! service and serves SNTP to it, all in simulated time through
 //! hil-sim's master-side EoE tunnel (`hil_sim::eoe::HostNet`).
-#![allow(
-    clippy::unwrap_used,
-    clippy::expect_used,
-    clippy::panic,
-    clippy::indexing_slicing
-)]
 
 use drive_ecat::runtime::Drive;
 use drive_tests::{al_status, init, line, with_master, CoeClient};
@@ -51,13 +45,26 @@ async fn set_ip<S>(host: &mut HostNet, sd: &SubDeviceRef<'_, S>, clock: &AtomicU
     panic!("no set-IP response")
 }
 
-/// The master-side host at 10.0.0.1 with the drive's address set over EoE.
-async fn addressed_host<S>(sd: &SubDeviceRef<'_, S>, clock: &AtomicU64) -> HostNet {
-    let mut host = HostNet::new(
+/// The master-side host at 10.0.0.1, the drive's address not set.
+fn new_host(clock: &AtomicU64) -> HostNet {
+    HostNet::new(
         HOST_MAC,
         &[(HOST_IP, 24)],
         nanos::Nanos::from_ns(clock.load(Ordering::Relaxed)),
-    );
+    )
+}
+
+/// 1.1 s of simulated time on: the host repeats an unanswered ARP request
+/// only 1 s after the last.
+fn past_arp_retry(sim: &RefCell<Simulation>) {
+    let now = sim.borrow().now().as_ns();
+    sim.borrow_mut()
+        .catch_up(nanos::Nanos::from_ns(now + 1_100_000_000));
+}
+
+/// The master-side host at 10.0.0.1 with the drive's address set over EoE.
+async fn addressed_host<S>(sd: &SubDeviceRef<'_, S>, clock: &AtomicU64) -> HostNet {
+    let mut host = new_host(clock);
     assert_eq!(set_ip(&mut host, sd, clock).await, vec![0x03, 0x01, 0x00, 0x00]);
     host
 }
@@ -75,17 +82,11 @@ fn e096_e095_ping_and_parameters_over_udp() {
     with_master(&sim, async |md, clock| {
         let group = init(md, clock).await;
         let sd = group.subdevice(md, 0).unwrap();
-        let mut host = HostNet::new(
-            HOST_MAC,
-            &[(HOST_IP, 24)],
-            nanos::Nanos::from_ns(clock.load(Ordering::Relaxed)),
-        );
+        let mut host = new_host(clock);
         // no address yet: no answer
         assert_eq!(host.ping(&sd, clock, DRIVE_IP, 1, 60).await, None);
         // (the host repeats its unanswered ARP request only after 1 s)
-        let now = sim.borrow().now().as_ns();
-        sim.borrow_mut()
-            .catch_up(nanos::Nanos::from_ns(now + 1_100_000_000));
+        past_arp_retry(&sim);
         // E-096: the address from the master
         assert_eq!(set_ip(&mut host, &sd, clock).await, vec![0x03, 0x01, 0x00, 0x00]);
         let rtt = host
@@ -285,11 +286,7 @@ fn e098_dhcp_while_a166_is_2_until_the_master_sets_an_address() {
     with_master(&sim, async |md, clock| {
         let group = init(md, clock).await;
         let sd = group.subdevice(md, 0).unwrap();
-        let mut host = HostNet::new(
-            HOST_MAC,
-            &[(HOST_IP, 24)],
-            nanos::Nanos::from_ns(clock.load(Ordering::Relaxed)),
-        );
+        let mut host = new_host(clock);
         let server = host.add_udp(67);
         // E-098: nothing before the master has used EoE
         for _ in 0..100 {
@@ -334,9 +331,7 @@ fn e098_dhcp_while_a166_is_2_until_the_master_sets_an_address() {
         // the master's address wins and DHCP stops
         assert_eq!(set_ip(&mut host, &sd, clock).await, vec![0x03, 0x01, 0x00, 0x00]);
         // (the host sends its next ARP request only 1 s after the last)
-        let now = sim.borrow().now().as_ns();
-        sim.borrow_mut()
-            .catch_up(nanos::Nanos::from_ns(now + 1_100_000_000));
+        past_arp_retry(&sim);
         assert!(host.ping(&sd, clock, DRIVE_IP, 2, STEPS).await.is_some());
         assert_eq!(
             host.ping(&sd, clock, leased, 3, 60).await,
@@ -362,11 +357,7 @@ fn e098_no_dhcp_when_a166_is_not_2() {
     with_master(&sim, async |md, clock| {
         let group = init(md, clock).await;
         let sd = group.subdevice(md, 0).unwrap();
-        let mut host = HostNet::new(
-            HOST_MAC,
-            &[(HOST_IP, 24)],
-            nanos::Nanos::from_ns(clock.load(Ordering::Relaxed)),
-        );
+        let mut host = new_host(clock);
         let server = host.add_udp(67);
         // the master uses EoE (E-098): DHCP could start now, but A166 says no
         assert!(host.tunnel.request(&sd, &get_ip_request()).await);
@@ -653,11 +644,7 @@ fn e098_coe_only_master_gets_only_coe_answers_on_a_line() {
         );
         // the master starts to use EoE on drive 0: its DHCP client starts
         let sd = group.subdevice(md, 0).unwrap();
-        let mut host = HostNet::new(
-            HOST_MAC,
-            &[(HOST_IP, 24)],
-            nanos::Nanos::from_ns(clock.load(Ordering::Relaxed)),
-        );
+        let mut host = new_host(clock);
         let server = host.add_udp(67);
         assert!(host.tunnel.request(&sd, &get_ip_request()).await);
         let mut answered = Vec::new();

@@ -9,12 +9,6 @@
 //! [`drive_tests::fault_row!`], which leaves its row for the printed table
 //! (`scripts/fault-matrix`). Cases elsewhere join the table the same way:
 //! SYNC0 loss (dc_sync.rs), power cut during a save (save.rs).
-#![allow(
-    clippy::unwrap_used,
-    clippy::expect_used,
-    clippy::panic,
-    clippy::indexing_slicing
-)]
 
 #[path = "fault_matrix/axis.rs"]
 mod axis;
@@ -29,16 +23,54 @@ mod flash;
 #[path = "fault_matrix/mailbox.rs"]
 mod mailbox;
 
+use drive_tests::matrix::Row;
+pub use drive_tests::step::advance;
 use drive_tests::CoeClient;
 use ethercrab::SubDeviceRef;
 use hil_sim::sim::Simulation;
 use std::cell::RefCell;
 
-/// Runs the line `ns` of simulated time on, without frames.
-pub fn advance<N: hil_sim::sim::Node>(sim: &RefCell<Simulation<N>>, ns: u64) {
-    let mut s = sim.borrow_mut();
-    let t = s.now().as_ns() + ns;
-    s.advance_to(nanos::Nanos::from_ns(t));
+/// A row of the table run by the in-process ethercrab master.
+pub fn ethercrab(
+    order: &'static str,
+    case: &'static str,
+    spec: &'static str,
+    expected: &'static str,
+) -> Row<'static> {
+    Row {
+        order,
+        case,
+        spec,
+        peer: "ethercrab",
+        expected,
+    }
+}
+
+/// E47: the first cause of Switch on disabled (C-015).
+pub const E47: u16 = drive_ecat::parameter_index(4, 47);
+
+/// The end of a fault as the master reads it: "EMCYs; 603Fh; E47; the
+/// newest diagnosis message; AL state" (the EMCYs first: an SDO read of the
+/// master would take them out of the mailbox).
+pub async fn fault_end<S>(sd: &SubDeviceRef<'_, S>, sim: &RefCell<Simulation>) -> String
+where
+    S: std::ops::Deref<Target = ethercrab::SubDevice>,
+{
+    let em = drive_tests::matrix::emcys(&emcys(sd).await);
+    let code: u16 = sd.sdo_read(0x603F, 0).await.unwrap();
+    let e47 = get(sim, E47, 0);
+    let diag = newest_diag(sd).await;
+    let al = drive_tests::matrix::al(drive_tests::al_status(sd).await);
+    format!("{em}; 603Fh {code:04X}h; E47 {e47}; {diag}; {al}")
+}
+
+/// Controlword 0 for 2 cycles, then a fault reset (bit 7) for 10; the last
+/// TxPDO.
+pub async fn fault_reset(m: &mut drive_tests::Cyclic<'_>) -> drive_tests::TxPdo {
+    m.set_controlword(0);
+    m.run(2).await;
+    m.set_controlword(drive_tests::axis::CW_FAULT_RESET);
+    m.run(10).await
 }
 
 /// An object of the first drive, read locally.

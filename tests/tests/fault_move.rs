@@ -4,12 +4,6 @@
 //! through both. The PROFINET twin (record tasks, where the brake stayed
 //! engaged after a fault) is hil-sim/tests/pn_fault_move.rs; on EtherCAT pp
 //! the first set-point (bit 4) after the enable opens the brake.
-#![allow(
-    clippy::unwrap_used,
-    clippy::expect_used,
-    clippy::panic,
-    clippy::indexing_slicing
-)]
 
 use drive_tests::axis::*;
 use drive_tests::{init, line, sw, with_master, Cyclic};
@@ -55,13 +49,9 @@ fn c017_c021_c041_pp_after_fault_reset_and_enable_follows_as_before() {
     with_master(&sim, async |md, clock| {
         let group = init(md, clock).await.into_op(md).await.expect("OP");
         let sd = group.subdevice(md, 0).unwrap();
-        sd.sdo_write(0x6081, 0, 5 * REV as u32).await.unwrap();
-        sd.sdo_write(0x6083, 0, 50 * REV as u32).await.unwrap();
-        sd.sdo_write(0x6084, 0, 50 * REV as u32).await.unwrap();
+        set_profile(&sd, Some(5 * REV as u32), 50 * REV as u32).await;
         let mut m = Cyclic::new(md, &group, &sim, 0);
-        m.set_mode(1);
-        m.run(3).await;
-        m.enable().await;
+        m.enable_in(1).await;
         home_here(&mut m).await;
         m.set_mode(1);
         m.run(3).await;

@@ -2,12 +2,6 @@
 //! `ethercat.md` §5.4, §15): the representation set in Pre-Op, scaled
 //! process data in Op, the parameter channel's own representation, and the
 //! refusals. The dictionary side: `crates/drive-core/src/tests_scaling.rs`.
-#![allow(
-    clippy::unwrap_used,
-    clippy::expect_used,
-    clippy::panic,
-    clippy::indexing_slicing
-)]
 
 use drive_ecat::parameter_index;
 use drive_tests::{init, line, with_master, CoeClient, Cyclic, REV};
@@ -81,9 +75,7 @@ fn e059_e143_integer_process_data_in_op_and_the_parameter_channel() {
         c.hand_over(&sd).await;
 
         let mut cy = Cyclic::new(md, &group, &sim, 0);
-        cy.set_mode(9);
-        cy.run(3).await;
-        cy.enable().await;
+        cy.enable_in(9).await;
         // 0.5 rev/s in 0.01 inc/s
         let v = REV * 50;
         cy.set_target_velocity(v);

@@ -5,12 +5,6 @@
 //! header, another key, a wrong load address or a lower security counter are
 //! refused through the real FoE path. ethercrab has no FoE: the FoE packets
 //! go through [`drive_tests::RawMailbox`] ([`FoeClient`]).
-#![allow(
-    clippy::unwrap_used,
-    clippy::expect_used,
-    clippy::panic,
-    clippy::indexing_slicing
-)]
 
 use drive_ecat::boot::{ImageHeader, IMAGE_HEADER_LEN};
 use drive_ecat::boot::{Slot, SlotState};

@@ -6,12 +6,6 @@
 //! 13/12/10 of Tab. 26 in every TxPDO and, at the end, that the reference
 //! point the method defines (switch edge, index pulse, end stop) reads 607Ch
 //! in 6064h; the plant's encoder is the independent ruler.
-#![allow(
-    clippy::unwrap_used,
-    clippy::expect_used,
-    clippy::panic,
-    clippy::indexing_slicing
-)]
 
 use drive_tests::axis::*;
 use drive_tests::{init, line, sw, with_master, Cyclic};
@@ -140,9 +134,7 @@ fn home(case: Case) -> Run {
         sd.sdo_write(0x6098, 0, case.method).await.unwrap();
         sd.sdo_write(0x607C, 0, HOME_OFFSET).await.unwrap();
         let mut m = Cyclic::new(md, &group, &sim, 0);
-        m.set_mode(6);
-        m.run(3).await;
-        let tx = m.enable().await;
+        let tx = m.enable_in(6).await;
         assert_eq!(tx.mode_display, 6);
         // 001 before the start (not started)
         assert!(
@@ -442,12 +434,7 @@ fn c082_method_minus_4_negative_torque_stop_then_index() {
 fn c086_limit_switch_as_reference_switch() {
     // I30 = 2: method 19 takes +LS as its home switch; no limit-switch fault
     let sim_case = Case::new(19, axis(PositionInput::never()), POS_LS, EDGE_TOL);
-    let sim = line(1);
-    {
-        let mut s = sim.borrow_mut();
-        let d = &mut s.drives_mut()[0];
-        *d.motors[0].switches_mut() = sim_case.switches;
-    }
+    let sim = line_with_switches(sim_case.switches);
     with_master(&sim, async |md, clock| {
         let group = init(md, clock).await.into_op(md).await.expect("OP");
         let sd = group.subdevice(md, 0).unwrap();
@@ -458,9 +445,7 @@ fn c086_limit_switch_as_reference_switch() {
         sd.sdo_write(0x6098, 0, 19i8).await.unwrap();
         sd.sdo_write(0x607C, 0, HOME_OFFSET).await.unwrap();
         let mut m = Cyclic::new(md, &group, &sim, 0);
-        m.set_mode(6);
-        m.run(3).await;
-        m.enable().await;
+        m.enable_in(6).await;
         m.set_controlword(CW_ENABLED | CW_BIT4);
         let done = m
             .run_until(10_000, |t| {
@@ -493,20 +478,13 @@ fn c086_limit_switch_as_reference_switch() {
 
 #[test]
 fn c059_halt_interrupts_homing_then_restart_completes() {
-    let sim = line(1);
-    {
-        let mut s = sim.borrow_mut();
-        let d = &mut s.drives_mut()[0];
-        *d.motors[0].switches_mut() = axis(PositionInput::above(RS_POS));
-    }
+    let sim = line_with_switches(axis(PositionInput::above(RS_POS)));
     with_master(&sim, async |md, clock| {
         let group = init(md, clock).await.into_op(md).await.expect("OP");
         let sd = group.subdevice(md, 0).unwrap();
         sd.sdo_write(0x6098, 0, 19i8).await.unwrap();
         let mut m = Cyclic::new(md, &group, &sim, 0);
-        m.set_mode(6);
-        m.run(3).await;
-        m.enable().await;
+        m.enable_in(6).await;
         m.set_controlword(CW_ENABLED | CW_BIT4);
         m.run_until(2000, |t| t.velocity > REV).await.expect("searching");
         // halt (bit 8): the axis brakes, 000 while braking, then 001 interrupted at standstill

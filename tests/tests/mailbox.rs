@@ -1,11 +1,5 @@
 //! The mailbox data-link layer through a real master's frames: error replies
 //! for unsupported protocols and bad headers, the repeat request.
-#![allow(
-    clippy::unwrap_used,
-    clippy::expect_used,
-    clippy::panic,
-    clippy::indexing_slicing
-)]
 
 use drive_tests::{init, line, with_master, RawMailbox, MAILBOX_LEN};
 use ecat::mailbox::MailboxError;

@@ -3,12 +3,6 @@
 //! every simulated millisecond against the simulated drive and motor; every
 //! check reads what the master received in the TxPDO (or by SDO), not the
 //! drive's internals.
-#![allow(
-    clippy::unwrap_used,
-    clippy::expect_used,
-    clippy::panic,
-    clippy::indexing_slicing
-)]
 
 use drive_tests::axis::*;
 use drive_tests::{init, line, sw, with_master, CoeClient, Cyclic, RawMailbox};
@@ -207,9 +201,7 @@ fn c037_csv_reaches_target_velocity() {
     with_master(&sim, async |md, clock| {
         let group = init(md, clock).await.into_op(md).await.expect("OP");
         let mut m = Cyclic::new(md, &group, &sim, 0);
-        m.set_mode(9);
-        m.run(3).await;
-        let tx = m.enable().await;
+        let tx = m.enable_in(9).await;
         assert_eq!(tx.mode_display, 9);
         assert!(tx.bit(12), "csv bit 12 'drive follows': {:#06x}", tx.statusword);
         let v = 5 * REV; // 5 rev/s, no ramp from the drive (C-037)
@@ -253,9 +245,7 @@ fn c038_c039_cst_torque_with_and_without_speed_limit() {
         let group = init(md, clock).await.into_op(md).await.expect("OP");
         let sd = group.subdevice(md, 0).unwrap();
         let mut m = Cyclic::new(md, &group, &sim, 0);
-        m.set_mode(10);
-        m.run(3).await;
-        let tx = m.enable().await;
+        let tx = m.enable_in(10).await;
         assert_eq!(tx.mode_display, 10);
         assert!(tx.bit(12), "cst bit 12 'drive follows': {:#06x}", tx.statusword);
 
@@ -334,13 +324,9 @@ fn c041_c048_pp_moves_to_target_and_sets_target_reached() {
         let group = init(md, clock).await.into_op(md).await.expect("OP");
         let sd = group.subdevice(md, 0).unwrap();
         // 5 rev/s, 50 rev/s² (6081h, 6083h, 6084h by SDO in Op)
-        sd.sdo_write(0x6081, 0, 5 * REV as u32).await.unwrap();
-        sd.sdo_write(0x6083, 0, 50 * REV as u32).await.unwrap();
-        sd.sdo_write(0x6084, 0, 50 * REV as u32).await.unwrap();
+        set_profile(&sd, Some(5 * REV as u32), 50 * REV as u32).await;
         let mut m = Cyclic::new(md, &group, &sim, 0);
-        m.set_mode(1);
-        m.run(3).await;
-        let tx = m.enable().await;
+        let tx = m.enable_in(1).await;
         assert_eq!(tx.mode_display, 1);
 
         // C-050: an absolute move is refused before the axis is referenced
@@ -430,12 +416,9 @@ fn c055_c056_pv_reaches_velocity_and_reports_zero_speed() {
     with_master(&sim, async |md, clock| {
         let group = init(md, clock).await.into_op(md).await.expect("OP");
         let sd = group.subdevice(md, 0).unwrap();
-        sd.sdo_write(0x6083, 0, 40 * REV as u32).await.unwrap();
-        sd.sdo_write(0x6084, 0, 40 * REV as u32).await.unwrap();
+        set_profile(&sd, None, 40 * REV as u32).await;
         let mut m = Cyclic::new(md, &group, &sim, 0);
-        m.set_mode(3);
-        m.run(3).await;
-        let tx = m.enable().await;
+        let tx = m.enable_in(3).await;
         assert_eq!(tx.mode_display, 3);
         let tx = m.run(20).await;
         assert!(tx.bit(12), "bit 12 velocity zero at rest: {:#06x}", tx.statusword);
@@ -489,12 +472,9 @@ fn e125_c144_free_run_moves_at_the_commanded_speed_at_every_a150() {
             sd.sdo_write(A150, 0, a150_us).await.expect("A150 in Pre-Op");
             let group = group.into_op(md).await.expect("OP");
             let sd = group.subdevice(md, 0).unwrap();
-            sd.sdo_write(0x6083, 0, 40 * REV as u32).await.unwrap();
-            sd.sdo_write(0x6084, 0, 40 * REV as u32).await.unwrap();
+            set_profile(&sd, None, 40 * REV as u32).await;
             let mut m = Cyclic::new(md, &group, &sim, 0);
-            m.set_mode(3);
-            m.run(3).await;
-            m.enable().await;
+            m.enable_in(3).await;
             m.run(20).await;
             // 0 → 4 rev/s at 40 rev/s² takes about 0.1 s of (simulated) time
             let v = 4 * REV;
@@ -543,9 +523,7 @@ fn c058_c061_c078_homing_method_37_through_pdo() {
         sd.sdo_write(0x6098, 0, 37i8).await.unwrap();
         sd.sdo_write(0x607C, 0, 123_456i32).await.unwrap();
         let mut m = Cyclic::new(md, &group, &sim, 0);
-        m.set_mode(6);
-        m.run(3).await;
-        let tx = m.enable().await;
+        let tx = m.enable_in(6).await;
         assert_eq!(tx.mode_display, 6);
         let before = tx.position;
         // a steady bit 4 from enable on is no start: nothing happens (C-058)
@@ -584,9 +562,7 @@ fn c058_c059_c071_homing_method_19_on_a_reference_switch() {
         let fast: u32 = sd.sdo_read(0x6099, 1).await.unwrap();
         let slow: u32 = sd.sdo_read(0x6099, 2).await.unwrap();
         let mut m = Cyclic::new(md, &group, &sim, 0);
-        m.set_mode(6);
-        m.run(3).await;
-        m.enable().await;
+        m.enable_in(6).await;
         m.set_controlword(CW_ENABLED | CW_BIT4);
         let t0 = m.now().as_ns();
         let mut saw_switch = false;
@@ -654,9 +630,7 @@ fn c010_c011_quick_stop_through_pdo() {
         let qs_option: i16 = sd.sdo_read(0x605A, 0).await.unwrap();
         assert_eq!(qs_option, 2, "605Ah default: quick stop ramp, then SOD");
         let mut m = Cyclic::new(md, &group, &sim, 0);
-        m.set_mode(9);
-        m.run(3).await;
-        m.enable().await;
+        m.enable_in(9).await;
         m.set_target_velocity(5 * REV);
         m.run_until(500, |t| (t.velocity - 5 * REV).abs() < REV / 20)
             .await
@@ -983,9 +957,7 @@ fn c071_homing_method_19_started_on_the_switch() {
         sd.sdo_write(0x6098, 0, 19i8).await.unwrap();
         sd.sdo_write(0x607C, 0, 0i32).await.unwrap();
         let mut m = Cyclic::new(md, &group, &sim, 0);
-        m.set_mode(6);
-        m.run(3).await;
-        let tx = m.enable().await;
+        let tx = m.enable_in(6).await;
         assert!(
             tx.digital_inputs & 0b100 != 0,
             "on the switch: 60FDh {:#x}",
@@ -1026,9 +998,7 @@ fn c036_csp_following_error_bit_13_without_fault() {
         sd.sdo_write(0x6065, 0, (REV / 50) as u32).await.unwrap();
         sd.sdo_write(0x6066, 0, 20u16).await.unwrap();
         let mut m = Cyclic::new(md, &group, &sim, 0);
-        m.set_mode(8);
-        m.run(3).await;
-        m.enable().await;
+        m.enable_in(8).await;
         // 1 rev/s ramp; blocked at 0.25 rev
         let mut first_bit13 = None;
         for k in 1..=600 {
@@ -1066,9 +1036,7 @@ fn c027_mode_change_between_pv_and_csv_only_at_standstill() {
     with_master(&sim, async |md, clock| {
         let group = init(md, clock).await.into_op(md).await.expect("OP");
         let mut m = Cyclic::new(md, &group, &sim, 0);
-        m.set_mode(3);
-        m.run(3).await;
-        m.enable().await;
+        m.enable_in(3).await;
         m.set_target_velocity(2 * REV);
         m.run_until(500, |t| t.bit(10) && t.velocity > REV)
             .await

@@ -2,12 +2,6 @@
 //! features-cia402.md C-items): ip and vl with their own PDO maps, pt, jog,
 //! hardware and software limit switches, touch-probe examples 2 and 3.
 //! Every check reads what the master received (TxPDO or SDO).
-#![allow(
-    clippy::unwrap_used,
-    clippy::expect_used,
-    clippy::panic,
-    clippy::indexing_slicing
-)]
 
 use drive_tests::axis::*;
 use drive_tests::{init, line, map_layout, sw, with_master, Cyclic, RawCyclic};
@@ -31,8 +25,7 @@ fn c031_c032_c033_c034_ip_follows_60c1_only_while_bit_4() {
         let sd = group.subdevice(md, 0).unwrap();
         map_layout(&sd, drive_ecat::PdoLayout::Ip).await;
         // profile ramps of 0.1 rev/s² that ip must not apply (C-033)
-        sd.sdo_write(0x6083, 0, (REV / 10) as u32).await.unwrap();
-        sd.sdo_write(0x6084, 0, (REV / 10) as u32).await.unwrap();
+        set_profile(&sd, None, (REV / 10) as u32).await;
         let group = group.into_op(md).await.expect("OP with the ip map");
         let sd = group.subdevice(md, 0).unwrap();
         assert_eq!(
@@ -196,9 +189,7 @@ fn c057_pt_ramps_6071_with_6087_limited_by_6072_and_g472() {
         let sd = group.subdevice(md, 0).unwrap();
         sd.sdo_write(0x6087, 0, 1000u32).await.unwrap(); // 100 %/s
         let mut m = Cyclic::new(md, &group, &sim, 0);
-        m.set_mode(4);
-        m.run(3).await;
-        let tx = m.enable().await;
+        let tx = m.enable_in(4).await;
         assert_eq!(tx.mode_display, 4);
 
         // default G472/G475 = 0: no motion (spec §6.5.8)
@@ -259,9 +250,7 @@ fn c088_c089_c090_jog_bits_4_and_5() {
     with_master(&sim, async |md, clock| {
         let group = init(md, clock).await.into_op(md).await.expect("OP");
         let mut m = Cyclic::new(md, &group, &sim, 0);
-        m.set_mode(-1);
-        m.run(3).await;
-        let tx = m.enable().await;
+        let tx = m.enable_in(-1).await;
         assert_eq!(tx.mode_display, -1, "6061h = jog");
         let tx = m.run(20).await;
         assert!(tx.velocity.abs() < REV / 100);
@@ -346,9 +335,7 @@ fn c091_c092_jog_at_the_software_limits() {
         let group = init(md, clock).await.into_op(md).await.expect("OP");
         let sd = group.subdevice(md, 0).unwrap();
         let mut m = Cyclic::new(md, &group, &sim, 0);
-        m.set_mode(6);
-        m.run(3).await;
-        m.enable().await;
+        m.enable_in(6).await;
         home_here(&mut m).await;
         let limit = REV / 2;
         sd.sdo_write(0x607D, 1, -limit).await.unwrap();
@@ -459,12 +446,12 @@ async fn fault_and_reset(m: &mut Cyclic<'_>, what: &str) -> u16 {
 
 #[test]
 fn c093_c094_c095_hardware_limit_switch_faults_and_locks_the_direction() {
-    let sim = line(1);
     let plus = i64::from(REV); // positive switch from +1 rev on, negative below −10 rev
-    with_drive(&sim, |d| {
-        *d.motors[0].switches_mut() =
-            Switches::linear_axis(-10 * i64::from(REV), plus, PositionInput::never());
-    });
+    let sim = line_with_switches(Switches::linear_axis(
+        -10 * i64::from(REV),
+        plus,
+        PositionInput::never(),
+    ));
     with_master(&sim, async |md, clock| {
         let group = init(md, clock).await.into_op(md).await.expect("OP");
         let mut m = Cyclic::new(md, &group, &sim, 0);
@@ -546,9 +533,7 @@ fn c099_c101_c102_c103_software_limits_fault_and_lock_the_direction() {
         sd.sdo_write(0x607D, 1, -limit).await.unwrap();
         sd.sdo_write(0x607D, 2, limit).await.unwrap();
         let mut m = Cyclic::new(md, &group, &sim, 0);
-        m.set_mode(9);
-        m.run(3).await;
-        m.enable().await;
+        m.enable_in(9).await;
         // not referenced: the software limits do not act (C-099)
         m.set_target_velocity(2 * REV);
         m.run_until(1000, |t| t.position > REV)
@@ -617,6 +602,28 @@ fn c099_c101_c102_c103_software_limits_fault_and_lock_the_direction() {
 // Touch probe examples 2 and 3 (C-124, C-127)
 // ---------------------------------------------------------------------------
 
+/// A stored touch-probe position within 1 inc of the edge `mark`.
+#[track_caller]
+fn at_mark(value: i32, mark: i64, what: &str) {
+    assert!(
+        (i64::from(value) - mark).abs() <= 1,
+        "{what}: {value} (the edge at {mark})"
+    );
+}
+
+/// Runs on at the set target velocity until the position has passed `to`
+/// (upwards for a positive velocity, downwards for a negative one) within
+/// `max` cycles, then stops and waits 100 ms.
+async fn pass_and_stop(m: &mut Cyclic<'_>, max: usize, to: i64, what: &str) {
+    let up = i64::from(m.tx.position) <= to;
+    let past = |p: i64| if up { p > to } else { p < to };
+    m.run_until(max, |t| past(i64::from(t.position)))
+        .await
+        .expect(what);
+    m.set_target_velocity(0);
+    m.run(100).await;
+}
+
 #[test]
 fn c124_c127_touch_probe_single_shot_falling_only_and_rearm() {
     let sim = line(1);
@@ -634,15 +641,9 @@ fn c124_c127_touch_probe_single_shot_falling_only_and_rearm() {
         // example 2: enabled, first event, falling edge only (bit 5)
         sd.sdo_write(0x60B8, 0, 0x0021u16).await.unwrap();
         let mut m = Cyclic::new(md, &group, &sim, 0);
-        m.set_mode(9);
-        m.run(3).await;
-        m.enable().await;
+        m.enable_in(9).await;
         m.set_target_velocity(REV);
-        m.run_until(2000, |t| i64::from(t.position) > marks[3] + i64::from(REV / 20))
-            .await
-            .expect("past p4");
-        m.set_target_velocity(0);
-        m.run(100).await;
+        pass_and_stop(&mut m, 2000, marks[3] + i64::from(REV / 20), "past p4").await;
         let (status, rising, falling) = probe1(&sd).await;
         println!(
             "example 2: 60B9h {status:#06x}, 60BAh {rising}, 60BBh {falling} (p2 {})",
@@ -653,10 +654,7 @@ fn c124_c127_touch_probe_single_shot_falling_only_and_rearm() {
             0x05,
             "enabled + falling stored only: {status:#06x}"
         );
-        assert!(
-            (i64::from(falling) - marks[1]).abs() <= 1,
-            "first falling edge p2: {falling}"
-        );
+        at_mark(falling, marks[1], "first falling edge p2");
         assert_eq!(rising, 0, "no rising edge stored");
 
         // example 3: both edges, first event; re-enabled (bit 0 0→1) between p4 and p5
@@ -671,25 +669,15 @@ fn c124_c127_touch_probe_single_shot_falling_only_and_rearm() {
         let kept: i32 = sd.sdo_read(0x60BB, 0).await.unwrap();
         assert_eq!(kept, falling, "values survive the disable");
         m.set_target_velocity(REV);
-        m.run_until(2000, |t| i64::from(t.position) > marks[5] + i64::from(REV / 20))
-            .await
-            .expect("past p6");
-        m.set_target_velocity(0);
-        m.run(100).await;
+        pass_and_stop(&mut m, 2000, marks[5] + i64::from(REV / 20), "past p6").await;
         let (status, rising, falling) = probe1(&sd).await;
         println!(
             "example 3: 60B9h {status:#06x}, 60BAh {rising} (p5 {}), 60BBh {falling} (p6 {})",
             marks[4], marks[5]
         );
         assert_eq!(status & 0x07, 0x07, "both stored: {status:#06x}");
-        assert!(
-            (i64::from(rising) - marks[4]).abs() <= 1,
-            "next rising edge p5: {rising}"
-        );
-        assert!(
-            (i64::from(falling) - marks[5]).abs() <= 1,
-            "next falling edge p6: {falling}"
-        );
+        at_mark(rising, marks[4], "next rising edge p5");
+        at_mark(falling, marks[5], "next falling edge p6");
     });
 }
 
@@ -710,9 +698,7 @@ fn c125_c126_touch_probe_example_1_continuous_both_edges() {
         // example 1: enabled (bit 0), continuous (bit 1), rising (bit 4) and falling (bit 5)
         sd.sdo_write(0x60B8, 0, 0x0033u16).await.unwrap();
         let mut m = Cyclic::new(md, &group, &sim, 0);
-        m.set_mode(9);
-        m.run(3).await;
-        m.enable().await;
+        m.enable_in(9).await;
         m.set_target_velocity(REV / 2);
         // past p2: the first pair is stored, both status bits on
         m.run_until(3000, |t| i64::from(t.position) > marks[1] + i64::from(REV / 40))
@@ -725,28 +711,18 @@ fn c125_c126_touch_probe_example_1_continuous_both_edges() {
             0x07,
             "enabled, rising and falling stored: {status:#06x}"
         );
-        assert!((i64::from(rising) - marks[0]).abs() <= 1, "p1: {rising}");
-        assert!((i64::from(falling) - marks[1]).abs() <= 1, "p2: {falling}");
+        at_mark(rising, marks[0], "p1");
+        at_mark(falling, marks[1], "p2");
         // past p4: every edge overwrote its value (continuous, C-125)
-        m.run_until(3000, |t| i64::from(t.position) > marks[3] + i64::from(REV / 40))
-            .await
-            .expect("past p4");
-        m.set_target_velocity(0);
-        m.run(100).await;
+        pass_and_stop(&mut m, 3000, marks[3] + i64::from(REV / 40), "past p4").await;
         let (status, rising, falling) = probe1(&sd).await;
         println!(
             "example 1 after p4: 60B9h {status:#06x}, 60BAh {rising} (p3 {}), 60BBh {falling} (p4 {})",
             marks[2], marks[3]
         );
         assert_eq!(status & 0x07, 0x07, "still both stored: {status:#06x}");
-        assert!(
-            (i64::from(rising) - marks[2]).abs() <= 1,
-            "overwritten by p3: {rising}"
-        );
-        assert!(
-            (i64::from(falling) - marks[3]).abs() <= 1,
-            "overwritten by p4: {falling}"
-        );
+        at_mark(rising, marks[2], "overwritten by p3");
+        at_mark(falling, marks[3], "overwritten by p4");
         // disabling clears the status bits, the values stay (C-126)
         sd.sdo_write(0x60B8, 0, 0x0032u16).await.unwrap();
         m.run(3).await;
@@ -757,11 +733,7 @@ fn c125_c126_touch_probe_example_1_continuous_both_edges() {
         assert_eq!((kept_r, kept_f), (rising, falling), "60BAh/60BBh kept");
         // disabled: passing the edges again stores nothing
         m.set_target_velocity(-REV / 2);
-        m.run_until(3000, |t| i64::from(t.position) < marks[0] - i64::from(REV / 40))
-            .await
-            .expect("back below p1");
-        m.set_target_velocity(0);
-        m.run(100).await;
+        pass_and_stop(&mut m, 3000, marks[0] - i64::from(REV / 40), "back below p1").await;
         let status: u16 = sd.sdo_read(0x60B9, 0).await.unwrap();
         let still: i32 = sd.sdo_read(0x60BA, 0).await.unwrap();
         assert_eq!(status & 0x07, 0, "nothing latched while disabled: {status:#06x}");

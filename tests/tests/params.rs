@@ -2,12 +2,6 @@
 //! and the torque modes' speed limits by SDO through ethercrab, their
 //! effect on the plant, their refusal out of range, and their place in the
 //! saved parameter set.
-#![allow(
-    clippy::unwrap_used,
-    clippy::expect_used,
-    clippy::panic,
-    clippy::indexing_slicing
-)]
 
 use drive_ecat::params::{C31, C32, G472, G475, I04, I20, I25, I28, I29, I30, I423, I425, I43, I53, I87};
 use drive_tests::axis::{with_drive, CW_ENABLED};
@@ -42,9 +36,7 @@ fn velocity_step(kp: u32, step: i32, cycles: usize) -> Vec<f64> {
         sd.sdo_write(C31, 0, kp).await.unwrap();
         assert_eq!(sd.sdo_read::<u32>(C31, 0).await.unwrap(), kp);
         let mut m = Cyclic::new(md, &group, &sim, 0);
-        m.set_mode(9);
-        m.run(3).await;
-        m.enable().await;
+        m.enable_in(9).await;
         m.set_controlword(CW_ENABLED);
         m.run(20).await;
         m.set_velocity_offset(step);

@@ -2,12 +2,6 @@
 //! remapped in Pre-Op with ethercrab's expedited SDO writes, the new layout
 //! runs in Op; refusals with the abort codes of §5.3; an SM2 length that no
 //! longer matches the mapping refuses Safe-Op with AL 001Dh.
-#![allow(
-    clippy::unwrap_used,
-    clippy::expect_used,
-    clippy::panic,
-    clippy::indexing_slicing
-)]
 
 use drive_tests::al::{ACK, ERR, OP, PREOP, SAFEOP};
 use drive_tests::{al_status, init, line, request, with_master, write_sm, CoeClient};
@@ -344,16 +338,7 @@ fn e048_e049_ip_and_vl_maps_from_a_startup_list_reach_op() {
         drive_tests::with_master(&sim, async |md, clock| {
             let group = drive_tests::init(md, clock).await;
             let sd = group.subdevice(md, 0).unwrap();
-            let (rx, tx) = layout.entries();
-            for (pdo, entries) in [(0x1600u16, rx), (0x1A00, tx)] {
-                sd.sdo_write(pdo, 0, 0u8).await.expect("sub 0 = 0");
-                for (sub, e) in (1u8..).zip(entries) {
-                    sd.sdo_write(pdo, sub, e.mapping_value()).await.expect("entry");
-                }
-                sd.sdo_write(pdo, 0, entries.len() as u8)
-                    .await
-                    .expect("sub 0 = n");
-            }
+            drive_tests::map_layout(&sd, layout).await;
             let group = group.into_op(md).await.expect("OP with the mode map");
             let sd = group.subdevice(md, 0).unwrap();
             assert_eq!(sd.io_raw().outputs().len(), bytes, "{layout:?} RxPDO");

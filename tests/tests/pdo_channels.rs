@@ -1,12 +1,6 @@
 //! PDO channels through a real master (spec §5.1, E-051…E-053): the default
 //! channels per axis, the FSoE channel kept from users, and four channels per
 //! direction in Op at once.
-#![allow(
-    clippy::unwrap_used,
-    clippy::expect_used,
-    clippy::panic,
-    clippy::indexing_slicing
-)]
 
 use drive_tests::al::OP;
 use drive_tests::{al_status, init, line, with_master, CoeClient};

@@ -2,15 +2,10 @@
 //! master writes reaches the drive's objects in Op only, the TxPDO follows the
 //! drive's objects in Safe-Op and Op, leaving Op falls back to the declared
 //! defaults, and a remapped layout is decoded and encoded as mapped.
-#![allow(
-    clippy::unwrap_used,
-    clippy::expect_used,
-    clippy::panic,
-    clippy::indexing_slicing
-)]
 
 use drive_ecat::DriveObjects;
 use drive_tests::al::{OP, SAFEOP};
+use drive_tests::step::set;
 use drive_tests::{al_status, init, line, with_master};
 use hil_sim::sim::Simulation;
 use std::cell::RefCell;
@@ -37,14 +32,6 @@ fn get(sim: &RefCell<Simulation>, index: u16, sub: u8) -> i64 {
         .objects()
         .get(index, sub)
         .unwrap_or_else(|e| panic!("{index:04X}h:{sub}: {e:?}"))
-}
-
-fn set(sim: &RefCell<Simulation>, index: u16, sub: u8, value: i64) {
-    sim.borrow_mut().drives_mut()[0]
-        .drive
-        .objects_mut()
-        .set(index, sub, value)
-        .unwrap_or_else(|e| panic!("{index:04X}h:{sub}: {e:?}"));
 }
 
 fn default_of(index: u16, sub: u8) -> i64 {

@@ -1,12 +1,6 @@
 //! Save values and power loss through the real master (E-018, E-020): written
 //! values live in RAM until "save values"; a save cut short by a power loss
 //! leaves the previous set intact.
-#![allow(
-    clippy::unwrap_used,
-    clippy::expect_used,
-    clippy::panic,
-    clippy::indexing_slicing
-)]
 
 use drive_tests::{init, line, with_master};
 use hil_sim::sim::Simulation;

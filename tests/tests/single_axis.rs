@@ -4,12 +4,6 @@
 //! does not list them, an SDO gets 0602 0000h, a mapping 0604 0041h), only
 //! channel 1 assigned, and Op with axis A's standard process data: enable
 //! and a csp move, axis B's motor unpowered.
-#![allow(
-    clippy::unwrap_used,
-    clippy::expect_used,
-    clippy::panic,
-    clippy::indexing_slicing
-)]
 
 use drive_ecat::Variant;
 use drive_tests::{init, sw, with_master, CoeClient, Cyclic, REV, REV_F};

@@ -2,20 +2,16 @@
 //! §11, §13.1–13.4): the P→S checks of the sync mode (DC SYNC0 cycle vs
 //! A150, free run needs a 3-buffer SM2, SM watchdog settings), the S→O wait
 //! for stable RxPDO and the PDO timeout in Op.
-#![allow(
-    clippy::unwrap_used,
-    clippy::expect_used,
-    clippy::panic,
-    clippy::indexing_slicing
-)]
 
 use drive_tests::al::{ACK, ERR, OP, PREOP, SAFEOP};
-use drive_tests::{al_status, init, line, request, with_master, write_sm, CoeClient};
+use drive_tests::step::{advance, cycles, set};
+use drive_tests::{al_status, init, line, request, with_master, write_sm, CoeClient, OpGroup};
 use esc::regs::{self, dc};
 use esc::AlStatusCode;
-use ethercrab::{MainDevice, SubDeviceGroup};
+use ethercrab::MainDevice;
 use hil_sim::sim::Simulation;
 use std::cell::RefCell;
+use std::sync::atomic::AtomicU64;
 
 /// A258 PDO timeout (ms), parameter 2000h + 258.
 const A258: u16 = 0x2102;
@@ -24,31 +20,18 @@ const SM2_START: u16 = 0x1200;
 const SM2_LEN: u16 = 23;
 const SM2_CONTROL: u8 = 0x64;
 
-fn set(sim: &RefCell<Simulation>, index: u16, sub: u8, value: i64) {
-    sim.borrow_mut().drives_mut()[0]
-        .drive
-        .objects_mut()
-        .set(index, sub, value)
-        .unwrap_or_else(|e| panic!("{index:04X}h:{sub}: {e:?}"));
-}
-
-fn advance(sim: &RefCell<Simulation>, ns: u64) {
-    let mut s = sim.borrow_mut();
-    let t = s.now().as_ns() + ns;
-    s.advance_to(nanos::Nanos::from_ns(t));
-}
-
-/// `n` process-data cycles of 1 ms (the master writes the RxPDO).
-async fn cycles<S: ethercrab::subdevice_group::HasPdi>(
-    md: &MainDevice<'_>,
-    group: &SubDeviceGroup<8, 512, ethercrab::DefaultLock, S>,
+/// A258 = `a258`, then Safe-Op, five cycles of process data and Op
+/// (process data just ran: ethercrab's `into_op` gets Op at once).
+async fn op_with_a258<'a>(
+    md: &'a MainDevice<'a>,
+    clock: &'a AtomicU64,
     sim: &RefCell<Simulation>,
-    n: usize,
-) {
-    for _ in 0..n {
-        advance(sim, 1_000_000);
-        group.tx_rx(md).await.expect("process data cycle");
-    }
+    a258: i64,
+) -> OpGroup {
+    set(sim, A258, 0, a258);
+    let group = init(md, clock).await.into_safe_op(md).await.expect("SAFE-OP");
+    cycles(md, &group, sim, 5).await;
+    group.into_op(md).await.expect("OP")
 }
 
 /// SYNC0 configured with plain register writes, as a master's DC set-up does.
@@ -231,12 +214,7 @@ fn e033_e047_safeop_to_op_waits_for_steady_rxpdo_and_refuses_after_200ms() {
 fn e044_e126_e128_op_without_rxpdo_longer_than_a258_falls_to_safeop() {
     let sim = line(1);
     with_master(&sim, async |md, clock| {
-        set(&sim, A258, 0, 50);
-        let group = init(md, clock).await;
-        let group = group.into_safe_op(md).await.expect("SAFE-OP");
-        cycles(md, &group, &sim, 5).await;
-        // process data just ran: ethercrab's into_op gets Op at once
-        let group = group.into_op(md).await.expect("OP");
+        let group = op_with_a258(md, clock, &sim, 50).await;
         let sd = group.subdevice(md, 0).unwrap();
         cycles(md, &group, &sim, 20).await;
         assert_eq!(al_status(&sd).await, (OP, 0), "RxPDO every 1 ms");
@@ -272,11 +250,7 @@ fn e044_e126_e128_op_without_rxpdo_longer_than_a258_falls_to_safeop() {
 fn e128_master_leaving_op_does_not_trigger_the_pdo_timeout() {
     let sim = line(1);
     with_master(&sim, async |md, clock| {
-        set(&sim, A258, 0, 50);
-        let group = init(md, clock).await;
-        let group = group.into_safe_op(md).await.expect("SAFE-OP");
-        cycles(md, &group, &sim, 5).await;
-        let group = group.into_op(md).await.expect("OP");
+        let group = op_with_a258(md, clock, &sim, 50).await;
         cycles(md, &group, &sim, 5).await;
         let group = group.into_safe_op(md).await.expect("back to SAFE-OP");
         let sd = group.subdevice(md, 0).unwrap();
@@ -289,11 +263,7 @@ fn e128_master_leaving_op_does_not_trigger_the_pdo_timeout() {
 fn e127_sm_watchdog_mode_uses_the_escs_watchdog() {
     let sim = line(1);
     with_master(&sim, async |md, clock| {
-        set(&sim, A258, 0, 65534);
-        let group = init(md, clock).await;
-        let group = group.into_safe_op(md).await.expect("SAFE-OP");
-        cycles(md, &group, &sim, 5).await;
-        let group = group.into_op(md).await.expect("OP");
+        let group = op_with_a258(md, clock, &sim, 65534).await;
         let sd = group.subdevice(md, 0).unwrap();
         cycles(md, &group, &sim, 5).await;
         // the ESC's default SM watchdog: 1000 × 100 µs

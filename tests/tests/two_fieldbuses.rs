@@ -44,14 +44,10 @@ fn over_ethercat() -> Vec<i64> {
     with_master(&sim, async |md, clock| {
         let group = init(md, clock).await.into_op(md).await.expect("OP");
         let sd = group.subdevice(md, 0).unwrap();
-        sd.sdo_write(0x6081, 0, INC_PER_S).await.unwrap();
-        sd.sdo_write(0x6083, 0, INC_PER_S2).await.unwrap();
-        sd.sdo_write(0x6084, 0, INC_PER_S2).await.unwrap();
+        set_profile(&sd, Some(INC_PER_S), INC_PER_S2).await;
         sd.sdo_write(0x60A4, 1, 0u32).await.unwrap();
         let mut m = Cyclic::new(md, &group, &sim, 0);
-        m.set_mode(1);
-        m.run(3).await;
-        m.enable().await;
+        m.enable_in(1).await;
         home_here(&mut m).await;
         m.set_mode(1);
         m.run(50).await;

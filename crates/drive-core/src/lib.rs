@@ -97,6 +97,8 @@ mod tests_records_od;
 #[cfg(test)]
 mod tests_scaling;
 #[cfg(test)]
+mod tests_sdo;
+#[cfg(test)]
 mod tests_spec_walk;
 #[cfg(test)]
 mod tests_stage;

@@ -2,25 +2,11 @@
 //! tests named after the spec items they check.
 
 use crate::objects::{self, single, Object, Value, OBJECTS};
+use crate::tests_sdo::{rd, rd_u, PREOP};
 use crate::variant::is_axis_b;
 use crate::*;
-use od::{CommState, Dictionary as _, SdoAbort};
+use od::{Dictionary as _, SdoAbort};
 use std::vec::Vec;
-
-const PREOP: CommState = CommState::PreOp;
-
-fn rd(d: &mut DriveObjects, index: u16, sub: u8) -> Result<Vec<u8>, SdoAbort> {
-    let mut buf = [0u8; 64];
-    let n = d.read(index, sub, &mut buf, PREOP)?;
-    Ok(buf[..n].to_vec())
-}
-
-fn rd_u(d: &mut DriveObjects, index: u16, sub: u8) -> u64 {
-    let v = rd(d, index, sub).unwrap();
-    let mut b = [0u8; 8];
-    b[..v.len()].copy_from_slice(&v);
-    u64::from_le_bytes(b)
-}
 
 fn single() -> DriveObjects {
     DriveObjects::for_variant(Variant::Single)

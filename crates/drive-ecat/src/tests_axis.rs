@@ -79,6 +79,17 @@ struct Rig {
 }
 
 impl Rig {
+    /// A rising edge of touch-probe input 1 of axis A now, latched at
+    /// `position_inc` (None: no position with it).
+    fn probe1_rising(&mut self, position_inc: Option<i32>) {
+        self.io[0].probe_edges[0] = Some(ProbeEdge {
+            input: 1,
+            rising: true,
+            time_ns: self.now,
+            position_inc,
+        });
+    }
+
     fn new() -> Self {
         Self {
             drive: Drive::new(Flash::new()),
@@ -554,22 +565,12 @@ fn c122_touch_probe_latches_the_rising_edge() {
     rig.run(1);
     assert_eq!(rig.get(0, 0x60B9, 0), 0x01);
     rig.motors[0].theta = TAU; // one revolution
-    rig.io[0].probe_edges[0] = Some(ProbeEdge {
-        input: 1,
-        rising: true,
-        time_ns: rig.now,
-        position_inc: Some(777),
-    });
+    rig.probe1_rising(Some(777));
     rig.cycle();
     assert_eq!(rig.get(0, 0x60BA, 0), 777);
     assert_eq!(rig.get(0, 0x60B9, 0), 0x03);
     // a second edge is ignored in first-event mode (C-124)
-    rig.io[0].probe_edges[0] = Some(ProbeEdge {
-        input: 1,
-        rising: true,
-        time_ns: rig.now,
-        position_inc: None,
-    });
+    rig.probe1_rising(None);
     rig.cycle();
     assert_eq!(rig.get(0, 0x60BA, 0), 777);
 }
@@ -583,12 +584,7 @@ fn c109_c122_probe_value_follows_a_new_feed_constant() {
     rig.run(2);
     rig.set(0, 0x60B8, 0, 0x11);
     rig.run(1);
-    rig.io[0].probe_edges[0] = Some(ProbeEdge {
-        input: 1,
-        rising: true,
-        time_ns: rig.now,
-        position_inc: Some(1000),
-    });
+    rig.probe1_rising(Some(1000));
     rig.cycle();
     rig.io[0].probe_edges[0] = None;
     assert_eq!(rig.get(0, 0x60BA, 0), 1000);

@@ -30,7 +30,7 @@ use cortex_m_rt::entry;
 // SysTick ticks and their calibration, as `firmware-qemu` measures (one wrap
 // at most: 2^24 ticks are about 670 million instructions on this machine)
 use cortex_m_semihosting::{debug, hprintln};
-use firmware::systick::{calibrate, now, ticks};
+use firmware::systick::{now, ticks};
 
 #[path = "../semiflash.rs"]
 mod semiflash;
@@ -165,11 +165,7 @@ fn bench() {
         return;
     };
     let mut syst = cp.SYST;
-    syst.set_clock_source(cortex_m::peripheral::syst::SystClkSource::Core);
-    syst.set_reload(0x00FF_FFFF);
-    syst.clear_current();
-    syst.enable_counter();
-    let per_1000 = calibrate();
+    let per_1000 = firmware::systick::start(&mut syst);
     let t0 = now();
     let r = verify_image(
         head,

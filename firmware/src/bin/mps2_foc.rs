@@ -17,7 +17,9 @@
 
 use core::hint::black_box;
 use cortex_m_rt::entry;
-use cortex_m_semihosting::{debug, hprintln};
+use cortex_m_semihosting::hprintln;
+use firmware::semihost::exit as stop;
+use firmware::systick::{start, ticks};
 use foc::{Dq, FocAxis, LoopParams, MotorData, Protection, PwmOut, Sample, Scaling};
 
 #[panic_handler]
@@ -26,36 +28,8 @@ fn panic(_info: &core::panic::PanicInfo) -> ! {
     stop(false)
 }
 
-fn stop(ok: bool) -> ! {
-    debug::exit(if ok {
-        debug::EXIT_SUCCESS
-    } else {
-        debug::EXIT_FAILURE
-    });
-    loop {
-        cortex_m::asm::wfi();
-    }
-}
-
 /// Steps per measurement (each: both axes).
 const STEPS: u32 = 4096;
-
-fn ticks(start: u32, end: u32) -> u32 {
-    start.wrapping_sub(end) & 0x00FF_FFFF
-}
-
-/// Instructions per 1000 SysTick ticks (`subs` + `bne` loop).
-fn calibrate() -> u32 {
-    let n: u32 = 200_000;
-    let t0 = cortex_m::peripheral::SYST::get_current();
-    // SAFETY: a register-only countdown loop, no memory access.
-    #[allow(unsafe_code)]
-    unsafe {
-        core::arch::asm!("1:", "subs {0}, {0}, #1", "bne 1b", inout(reg) n => _, options(nomem, nostack));
-    }
-    let t = ticks(t0, cortex_m::peripheral::SYST::get_current()).max(1);
-    (u64::from(2 * n) * 1000 / u64::from(t)) as u32
-}
 
 /// A rotating current of iq = 1.5 A (id = 0) at the encoder's angle, sampled as
 /// the default board would: phase a = −iq·sin θ, b = −iq·sin(θ − 120°),
@@ -85,11 +59,7 @@ fn main() -> ! {
         stop(false)
     };
     let mut syst = cp.SYST;
-    syst.set_clock_source(cortex_m::peripheral::syst::SystClkSource::Core);
-    syst.set_reload(0x00FF_FFFF);
-    syst.clear_current();
-    syst.enable_counter();
-    let per_1000 = calibrate();
+    let per_1000 = start(&mut syst);
 
     let mk = || {
         FocAxis::new(

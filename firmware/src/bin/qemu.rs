@@ -38,7 +38,7 @@ fn panic(info: &core::panic::PanicInfo) -> ! {
 /// Measurement helpers: SysTick (`firmware::systick`, shared with the other
 /// QEMU images) and stack painting, the only `unsafe` code of the image.
 mod measure {
-    pub use firmware::systick::{calibrate, now, ticks};
+    pub use firmware::systick::{now, ticks};
 
     extern "C" {
         static _stack_end: u32;
@@ -129,8 +129,6 @@ impl Figure {
 #[rtic::app(device = stm32f4::stm32f405)]
 mod app {
     use super::{measure, Figure};
-    use cortex_m::peripheral::syst::SystClkSource;
-    use cortex_m_semihosting::debug;
     use drive_ecat::axis::{AxisCommand, AxisIo};
     use firmware::cycle::{CycleTimer, CYCLE};
     use firmware::net::NodeNet;
@@ -175,27 +173,17 @@ mod app {
     #[init]
     fn init(cx: init::Context) -> (Shared, Local) {
         let mut syst = cx.core.SYST;
-        syst.set_clock_source(SystClkSource::Core);
-        syst.set_reload(0x00FF_FFFF);
-        syst.clear_current();
-        syst.enable_counter();
-        let per_kilo_tick = measure::calibrate();
+        let per_kilo_tick = firmware::systick::start(&mut syst);
         defmt::info!("init: firmware-qemu (STM32F405): drive + simulated ESC, motors and master");
         // the large resources go straight to their statics: built by value in
         // `init`'s frame they would need several copies of ~50 KiB of stack
         let (Some(drive), Some(esc), Some(world)) = (make_drive(), make_esc(), make_world()) else {
             defmt::error!("init: resources already taken");
-            debug::exit(debug::EXIT_FAILURE);
-            loop {
-                cortex_m::asm::wfi();
-            }
+            firmware::semihost::exit(false)
         };
         let Some(net) = firmware::make_net(drive) else {
             defmt::error!("init: resources already taken");
-            debug::exit(debug::EXIT_FAILURE);
-            loop {
-                cortex_m::asm::wfi();
-            }
+            firmware::semihost::exit(false)
         };
         (
             Shared {

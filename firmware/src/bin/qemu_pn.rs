@@ -22,14 +22,12 @@
 #![no_std]
 #![no_main]
 
-use cortex_m::peripheral::syst::SystClkSource;
 use cortex_m_rt::entry;
-use cortex_m_semihosting::debug;
 use defmt_semihosting as _;
 use drive_ecat::axis::AxisIo;
 use drive_pn::PnParamFlash as ParamFlash;
 use drive_pn::{Hardware, PnDrive};
-use firmware::systick::{calibrate, now as now_ticks, ticks};
+use firmware::systick::{now as now_ticks, ticks};
 use nanos::Nanos;
 use profinet::cm::{CmEvent, ImData};
 use profinet::device::{DeviceEvent, RtEvent};
@@ -119,16 +117,9 @@ fn build(slot: &mut core::mem::MaybeUninit<Drive>, flash: ParamFlash) -> &mut Dr
 #[entry]
 fn main() -> ! {
     let Some(mut cp) = cortex_m::Peripherals::take() else {
-        debug::exit(debug::EXIT_FAILURE);
-        loop {
-            cortex_m::asm::wfi();
-        }
+        firmware::semihost::exit(false)
     };
-    cp.SYST.set_clock_source(SystClkSource::Core);
-    cp.SYST.set_reload(0x00FF_FFFF);
-    cp.SYST.clear_current();
-    cp.SYST.enable_counter();
-    let per_kilo_tick = calibrate();
+    let per_kilo_tick = firmware::systick::start(&mut cp.SYST);
     let insn = |t: u32| (u64::from(t) * u64::from(per_kilo_tick) / 1000) as u32;
     defmt::info!("init: firmware-qemu-pn (STM32F405): PnDrive + scripted PROFINET controller");
     let ok = run(insn);

@@ -9,6 +9,31 @@ use std::time::Duration;
 pub mod pn_line;
 pub mod soem_line;
 
+/// `fb_rig!(Rig)`: `struct Rig(FbRig)`, the FB rig
+/// ([`hil_sim::fb::rig::FbRig`]) with a test's own steps, dereferencing to it.
+#[allow(unused_macros)] // used by some of the tests that include this module
+macro_rules! fb_rig {
+    ($name:ident) => {
+        /// The FB rig ([`FbRig`](hil_sim::fb::rig::FbRig)) with this test's steps.
+        struct $name(hil_sim::fb::rig::FbRig);
+
+        impl std::ops::Deref for $name {
+            type Target = hil_sim::fb::rig::FbRig;
+            fn deref(&self) -> &hil_sim::fb::rig::FbRig {
+                &self.0
+            }
+        }
+
+        impl std::ops::DerefMut for $name {
+            fn deref_mut(&mut self) -> &mut hil_sim::fb::rig::FbRig {
+                &mut self.0
+            }
+        }
+    };
+}
+#[allow(unused_imports)]
+pub(crate) use fb_rig;
+
 /// This process runs as root (network namespaces and raw sockets work).
 pub fn is_root() -> bool {
     // SAFETY: geteuid has no preconditions.

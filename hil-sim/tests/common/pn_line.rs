@@ -10,6 +10,28 @@ use std::path::{Path, PathBuf};
 use std::process::{Child, Command, ExitStatus, Stdio};
 use std::time::{Duration, Instant};
 
+/// The arguments that tell a controller script the device: `--gsdml` (the
+/// generated GSDML file), `--out-module` and `--in-module` (the manual's
+/// example: slot 1 "18 Word Output Data", slot 2 "18 Word Input Data"),
+/// then `more`.
+pub fn module_args(more: &[impl AsRef<OsStr>]) -> Vec<std::ffi::OsString> {
+    use profinet::model::{DataModule, Direction};
+    let gsdml = Path::new(env!("CARGO_MANIFEST_DIR"))
+        .join("../gsdml")
+        .join(gsdml::file_name());
+    let module = |direction, words| gsdml::module_id(DataModule { direction, words });
+    let mut args: Vec<std::ffi::OsString> = vec![
+        "--gsdml".into(),
+        gsdml.into_os_string(),
+        "--out-module".into(),
+        module(Direction::FromDrive, 18).into(),
+        "--in-module".into(),
+        module(Direction::ToDrive, 18).into(),
+    ];
+    args.extend(more.iter().map(|a| a.as_ref().to_os_string()));
+    args
+}
+
 /// The controller's address (in its own namespace only).
 pub const CONTROLLER_IP: &str = "192.168.0.10/24";
 
@@ -123,7 +145,7 @@ impl PnLine {
         &self,
         python: &Path,
         script: &Path,
-        args: &[&OsStr],
+        args: &[impl AsRef<OsStr>],
         limit: Duration,
     ) -> (ExitStatus, Vec<String>) {
         let child = Command::new("ip")

@@ -20,7 +20,6 @@ Free run, one drive, axis A, the PDOs of torque.py (6040h, 6060h, 6071h out;
 
 Prints `FAIL: ...` for every check that failed; exit status 0 when none did.
 """
-import argparse
 import os
 import sys
 
@@ -52,9 +51,7 @@ def step(axis, per_mille, limit, what):
 
 
 def run(m, args):
-    L.scan(m, 1)
-    check(m.read_state() == L.PREOP, f"Pre-Op: {L.state_report(m)}")
-    s = m.slaves[0]
+    s = L.one_drive_in_preop(m)
     for index in (T.G472, T.G475):
         s.sdo_write(index, 0, (1000).to_bytes(2, "little"))
     L.map_one_pdo_each(s, T.RX, T.TX)
@@ -71,11 +68,8 @@ def run(m, args):
 
 
 def main():
-    ap = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
-    ap.add_argument("--iface", required=True)
-    ap.add_argument("--i10", type=float, required=True, help="I10 maximum speed, inc/s")
-    args = ap.parse_args()
-    return L.master_main(args, run, "cst on the electrical plant: all checks passed")
+    return L.script_main(__doc__, run, "cst on the electrical plant: all checks passed",
+                         ("--i10", dict(type=float, required=True, help="I10 maximum speed, inc/s")))
 
 
 if __name__ == "__main__":

@@ -42,6 +42,11 @@ import time
 
 import pysoem
 
+sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
+import line as L  # noqa: E402  (line.py beside this file: check, say, the report)
+
+check, say = L.check, L.say
+
 PREOP = 0x02
 MBX_EOE = 0x02
 EOE_FRAG_DATA, EOE_INIT_REQ, EOE_INIT_RESP = 0, 2, 3
@@ -52,19 +57,6 @@ EC_TIMEOUTRXM = 700_000
 NET = "10.77.0"
 TAP = "eoe0"
 PARAM_PORT = 5011
-
-failures = []
-
-
-def check(ok, what):
-    if not ok:
-        failures.append(what)
-        print(f"FAIL: {what}", flush=True)
-    return ok
-
-
-def say(*a):
-    print(*a, flush=True)
 
 
 def ip_le(addr):
@@ -410,13 +402,7 @@ def main():
         if tap is not None:
             os.close(tap)
         m.close()
-    if failures:
-        say(f"\n{len(failures)} check(s) failed:")
-        for f in failures:
-            say(f"  {f}")
-        return 1
-    say("\nall checks passed")
-    return 0
+    return L.report("all checks passed")
 
 
 if __name__ == "__main__":

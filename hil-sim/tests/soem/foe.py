@@ -20,30 +20,23 @@ result is the accepted download. Checks:
 Run by `hil-sim/tests/soem.rs` as root inside the master's namespace.
 """
 import argparse
+import os
 import struct
 import sys
 import time
 
 import pysoem
 
-failures = []
+sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
+import line as L  # noqa: E402  (line.py beside this file: check, say, the report)
+
+check, say = L.check, L.say
 
 # SOEM's FoE results (ethercattype.h)
 EC_ERR_TYPE_FOE_ERROR = 5
 EC_ERR_TYPE_FOE_FILE_NOTFOUND = 10
 # ecx_srconfirm found no answer to a frame in time (SOEM's EC_NOFRAME)
 EC_NOFRAME = -1
-
-
-def check(ok, what):
-    if not ok:
-        failures.append(what)
-        print(f"FAIL: {what}", flush=True)
-    return ok
-
-
-def say(*a):
-    print(*a, flush=True)
 
 
 def to_state(s, state, what):
@@ -135,11 +128,7 @@ def main():
         to_state(m.slaves[0], pysoem.PREOP_STATE, "Init -> Pre-Op after the download")
     finally:
         m.close()
-    if failures:
-        say(f"\n{len(failures)} check(s) failed")
-        return 1
-    say("\nall checks passed")
-    return 0
+    return L.report("all checks passed")
 
 
 if __name__ == "__main__":

@@ -596,6 +596,32 @@ def master_main(args, run, done):
         check(False, f"stopped by SOEM: {type(e).__name__} {vars(e)}")
     finally:
         m.close()
+    return report(done)
+
+
+def one_drive_in_preop(m):
+    """Scans a line of one drive and checks that it is in Pre-Op; the drive."""
+    scan(m, 1)
+    check(m.read_state() == PREOP, f"Pre-Op: {state_report(m)}")
+    return m.slaves[0]
+
+
+def enable_sequence(axis):
+    """Fault reset, shutdown, switch on, enable operation: each controlword
+    on `axis` (its cw, cycle() and sw) until the statusword shows the state
+    it leads to, 300 cycles at most (Fatal otherwise)."""
+    for cw, want in ((0x80, None), (0x06, READY), (0x07, SWITCHED_ON), (0x0F, ENABLED)):
+        axis.cw = cw
+        for _ in range(300):
+            axis.cycle()
+            if want is None or sw_is(axis.sw, want):
+                break
+        else:
+            raise Fatal(f"controlword {cw:#04x}: statusword {axis.sw:#06x}")
+
+
+def report(done):
+    """Prints the failed checks (returns exit code 1) or `done` (0)."""
     if failures:
         say(f"\n{len(failures)} check(s) failed:")
         for f in failures:
@@ -603,6 +629,17 @@ def master_main(args, run, done):
         return 1
     say(f"\n{done}")
     return 0
+
+
+def script_main(doc, run, done, *options):
+    """The main of a script against the line: --iface and `options`
+    ((name, add_argument's keywords) each) from the command line, then
+    master_main(args, run, done)."""
+    ap = argparse.ArgumentParser(description=doc, formatter_class=argparse.RawDescriptionHelpFormatter)
+    ap.add_argument("--iface", required=True)
+    for name, kw in options:
+        ap.add_argument(name, **kw)
+    return master_main(ap.parse_args(), run, done)
 
 
 def priority():

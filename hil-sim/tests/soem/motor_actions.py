@@ -30,7 +30,6 @@ Free run, one drive, axis A in cst; RxPDO 6040h, 6060h, A75; TxPDO 6041h, A69.
 
 Prints `FAIL: ...` for every check that failed; exit status 0 when none did.
 """
-import argparse
 import os
 import struct
 import sys
@@ -233,9 +232,7 @@ def optimise(axis, sel, r, l):
 
 
 def run(m, args):
-    L.scan(m, 1)
-    check(m.read_state() == L.PREOP, f"Pre-Op: {L.state_report(m)}")
-    s = m.slaves[0]
+    s = L.one_drive_in_preop(m)
     L.map_one_pdo_each(s, RX, TX)
     axis = L.to_op(m, Axis)
     refused(axis)
@@ -251,13 +248,10 @@ def run(m, args):
 
 
 def main():
-    ap = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
-    ap.add_argument("--iface", required=True)
-    ap.add_argument("--r", type=float, required=True, help="the plant's phase resistance, ohm")
-    ap.add_argument("--l", type=float, required=True, help="the plant's inductance, H")
-    ap.add_argument("--offset", type=float, required=True, help="the plant's commutation offset, rad (mechanical)")
-    args = ap.parse_args()
-    return L.master_main(args, run, "motor actions on the electrical plant: all checks passed")
+    return L.script_main(__doc__, run, "motor actions on the electrical plant: all checks passed",
+                         ("--r", dict(type=float, required=True, help="the plant's phase resistance, ohm")),
+                         ("--l", dict(type=float, required=True, help="the plant's inductance, H")),
+                         ("--offset", dict(type=float, required=True, help="the plant's commutation offset, rad (mechanical)")))
 
 
 if __name__ == "__main__":

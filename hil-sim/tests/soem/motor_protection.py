@@ -33,7 +33,6 @@ Free run, one drive, axis A; RxPDO 6040h, 6060h, 6071h; TxPDO 6041h, 6061h,
 
 Prints `FAIL: ...` for every check that failed; exit status 0 when none did.
 """
-import argparse
 import math
 import os
 import struct
@@ -90,14 +89,7 @@ class Axis:
             time.sleep(0.001)
 
     def enable(self):
-        for cw, want in ((0x80, None), (0x06, L.READY), (0x07, L.SWITCHED_ON), (0x0F, L.ENABLED)):
-            self.cw = cw
-            for _ in range(300):
-                self.cycle()
-                if want is None or L.sw_is(self.sw, want):
-                    break
-            else:
-                raise L.Fatal(f"controlword {cw:#04x}: statusword {self.sw:#06x}")
+        L.enable_sequence(self)
         self.cycle(5)
         check(self.display == T.CST, f"6061h shows {self.display} in cst")
 
@@ -214,9 +206,7 @@ def i2t(m, axis, emcys, tau_s, u11_s):
 
 
 def run(m, args):
-    L.scan(m, 1)
-    check(m.read_state() == L.PREOP, f"Pre-Op: {L.state_report(m)}")
-    s = m.slaves[0]
+    s = L.one_drive_in_preop(m)
     emcys = L.Emcys(m)
     motor_data(s, args.tau_ms, args.u11_ms)
     L.map_one_pdo_each(s, T.RX, TX)
@@ -229,12 +219,9 @@ def run(m, args):
 
 
 def main():
-    ap = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
-    ap.add_argument("--iface", required=True)
-    ap.add_argument("--tau-ms", type=int, default=4000, help="B73 thermal time constant, ms")
-    ap.add_argument("--u11-ms", type=int, default=500, help="U11 i2t warning time, ms")
-    args = ap.parse_args()
-    return L.master_main(args, run, "motor protection on the electrical plant: all checks passed")
+    return L.script_main(__doc__, run, "motor protection on the electrical plant: all checks passed",
+                         ("--tau-ms", dict(type=int, default=4000, help="B73 thermal time constant, ms")),
+                         ("--u11-ms", dict(type=int, default=500, help="U11 i2t warning time, ms")))
 
 
 if __name__ == "__main__":

@@ -25,7 +25,6 @@ PWM period with the gates on carries some 280 A in that leg (the trip is at
 
 Prints `FAIL: ...` for every check that failed; exit status 0 when none did.
 """
-import argparse
 import os
 import sys
 
@@ -76,9 +75,7 @@ def enable_into_the_short(m, axis, emcys, what):
 
 
 def run(m, args):
-    L.scan(m, 1)
-    check(m.read_state() == L.PREOP, f"Pre-Op: {L.state_report(m)}")
-    s = m.slaves[0]
+    s = L.one_drive_in_preop(m)
     emcys = L.Emcys(m)
     L.map_one_pdo_each(s, T.RX, MP.TX)
     axis = L.to_op(m, MP.Axis)
@@ -101,10 +98,7 @@ def run(m, args):
 
 
 def main():
-    ap = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
-    ap.add_argument("--iface", required=True)
-    args = ap.parse_args()
-    return L.master_main(args, run, "over-current on the electrical plant: all checks passed")
+    return L.script_main(__doc__, run, "over-current on the electrical plant: all checks passed")
 
 
 if __name__ == "__main__":

@@ -26,7 +26,6 @@ rated, thermal time constant 5 s; the motor: 2 A rated (6075h), tau 600 s.
 
 Prints `FAIL: ...` for every check that failed; exit status 0 when none did.
 """
-import argparse
 import math
 import os
 import sys
@@ -57,9 +56,7 @@ def peak(frames, target, what):
 
 
 def run(m, args):
-    L.scan(m, 1)
-    check(m.read_state() == L.PREOP, f"Pre-Op: {L.state_report(m)}")
-    s = m.slaves[0]
+    s = L.one_drive_in_preop(m)
     for index in (T.G472, T.G475):
         s.sdo_write(index, 0, (1000).to_bytes(2, "little"))
     L.map_one_pdo_each(s, T.RX, MP.TX)
@@ -100,10 +97,7 @@ def run(m, args):
 
 
 def main():
-    ap = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
-    ap.add_argument("--iface", required=True)
-    args = ap.parse_args()
-    return L.master_main(args, run, "current limit and power-stage i2t on the electrical plant: all checks passed")
+    return L.script_main(__doc__, run, "current limit and power-stage i2t on the electrical plant: all checks passed")
 
 
 if __name__ == "__main__":

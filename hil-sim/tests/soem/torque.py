@@ -22,7 +22,6 @@ extrapolate nothing), one drive, axis A:
 
 Prints `FAIL: …` for every check that failed; exit status 0 when none did.
 """
-import argparse
 import os
 import sys
 import time
@@ -67,14 +66,7 @@ class Axis:
 
     def enable(self, mode):
         self.mode = mode
-        for cw, want in ((0x80, None), (0x06, L.READY), (0x07, L.SWITCHED_ON), (0x0F, L.ENABLED)):
-            self.cw = cw
-            for _ in range(300):
-                self.cycle()
-                if want is None or L.sw_is(self.sw, want):
-                    break
-            else:
-                raise L.Fatal(f"controlword {cw:#04x}: statusword {self.sw:#06x}")
+        L.enable_sequence(self)
         self.cw = 0x0F
         self.cycle(5)
         check(self.display == mode, f"6061h shows {self.display}, mode {mode} set")
@@ -112,9 +104,7 @@ class Axis:
 
 
 def run(m, args):
-    L.scan(m, 1)
-    check(m.read_state() == L.PREOP, f"Pre-Op: {L.state_report(m)}")
-    s = m.slaves[0]
+    s = L.one_drive_in_preop(m)
     for index in (G472, G475):
         check(L.sdo_u(s, index, 0) == 0, f"{index:04X}h default 0 %")
         code = L.sdo_abort(lambda: s.sdo_write(index, 0, (1001).to_bytes(2, "little")))
@@ -164,12 +154,9 @@ def to_op(m):
 
 
 def main():
-    ap = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
-    ap.add_argument("--iface", required=True)
-    ap.add_argument("--limit", type=int, default=400, help="G472 = G475, 0.1 %% of I10")
-    ap.add_argument("--i10", type=float, required=True, help="I10 maximum speed, inc/s")
-    args = ap.parse_args()
-    return L.master_main(args, run, "torque modes: all checks passed")
+    return L.script_main(__doc__, run, "torque modes: all checks passed",
+                         ("--limit", dict(type=int, default=400, help="G472 = G475, 0.1 %% of I10")),
+                         ("--i10", dict(type=float, required=True, help="I10 maximum speed, inc/s")))
 
 
 if __name__ == "__main__":

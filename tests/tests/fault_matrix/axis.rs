@@ -1,15 +1,12 @@
 //! Faults at the axis: encoder fault, STO and supply undervoltage during
 //! motion, a limit switch against the travel during homing.
 
-use super::{emcys, get, newest_diag};
-use drive_tests::axis::{with_drive, CW_BIT4, CW_ENABLED, CW_FAULT_RESET};
-use drive_tests::matrix::{al, cia402_state, emcys as show_emcys, Row};
+use super::{emcys, ethercrab, fault_end, fault_reset, get, E47};
+use drive_tests::axis::{line_with_switches, with_drive, CW_BIT4, CW_ENABLED};
+use drive_tests::matrix::{al, cia402_state, emcys as show_emcys};
 use drive_tests::{al_status, fault_row, init, line, with_master, Cyclic, REV};
 use hil_sim::motor::{PositionInput, Switches};
 use hil_sim::sim::AxisConditions;
-
-/// E47: the first cause of Switch on disabled (C-015).
-const E47: u16 = drive_ecat::parameter_index(4, 47);
 
 /// Axis A at 2 rev/s in csv; `cause` happens to it; after 100 ms the end
 /// is read (state, power stage, EMCY, 603Fh, E47, the history, AL); then
@@ -21,11 +18,7 @@ fn during_motion(cause: fn(&mut AxisConditions), clear: fn(&mut AxisConditions))
         let group = init(md, clock).await.into_op(md).await.expect("OP");
         let sd = group.subdevice(md, 0).unwrap();
         let mut m = Cyclic::new(md, &group, &sim, 0);
-        m.set_mode(9);
-        m.run(3).await;
-        m.enable().await;
-        m.set_target_velocity(2 * REV);
-        m.run(300).await;
+        m.csv_at(2 * REV, 300).await;
         with_drive(&sim, |d| cause(&mut d.conditions[0]));
         let tx = m.run(100).await;
         let stage = {
@@ -38,29 +31,18 @@ fn during_motion(cause: fn(&mut AxisConditions), clear: fn(&mut AxisConditions))
             }
         };
         let state = cia402_state(tx.statusword);
-        // the EMCYs first: an SDO read of the master would take them out of the mailbox
-        let em = show_emcys(&emcys(&sd).await);
-        let code: u16 = sd.sdo_read(0x603F, 0).await.unwrap();
-        let e47 = get(&sim, E47, 0);
-        let diag = newest_diag(&sd).await;
-        let al = al(al_status(&sd).await);
+        let end = fault_end(&sd, &sim).await;
         // a fault reset while the cause lasts
-        m.set_controlword(0);
-        m.run(2).await;
-        m.set_controlword(CW_FAULT_RESET);
-        let tx = m.run(10).await;
+        let tx = fault_reset(&mut m).await;
         let lasting = format!("{} (E47 {})", cia402_state(tx.statusword), get(&sim, E47, 0));
         // the cause ends: reset, enable
         with_drive(&sim, |d| clear(&mut d.conditions[0]));
-        m.set_controlword(0);
-        m.run(2).await;
-        m.set_controlword(CW_FAULT_RESET);
-        m.run(10).await;
+        fault_reset(&mut m).await;
         m.set_controlword(0);
         m.run(2).await;
         let after = cia402_state(m.enable().await.statusword);
         format!(
-            "{state}, {stage}; {em}; 603Fh {code:04X}h; E47 {e47}; {diag}; {al}; \
+            "{state}, {stage}; {end}; \
              while the cause lasts a reset gives {lasting}; after it: {after}"
         )
     })
@@ -68,71 +50,62 @@ fn during_motion(cause: fn(&mut AxisConditions), clear: fn(&mut AxisConditions))
 
 #[test]
 fn e089_c017_encoder_fault_during_motion_is_event_37_and_holds_the_fault() {
-    let row = Row {
-        order: "41",
-        case: "motor encoder fails while axis A turns at 2 rev/s (csv)",
-        spec: "E-089, C-017",
-        peer: "ethercrab",
-        expected: "Fault, power stage off, brake engaged; EMCY 7303h/01h event 37 cause 1; 603Fh 7303h; \
-                   E47 0; history: error 7303h axis A event 37/1; Op, AL 0000h; while the cause lasts a \
-                   reset gives Fault (E47 0); after it: Operation enabled",
-    };
+    let row = ethercrab(
+        "41",
+        "motor encoder fails while axis A turns at 2 rev/s (csv)",
+        "E-089, C-017",
+        "Fault, power stage off, brake engaged; EMCY 7303h/01h event 37 cause 1; 603Fh 7303h; \
+         E47 0; history: error 7303h axis A event 37/1; Op, AL 0000h; while the cause lasts a \
+         reset gives Fault (E47 0); after it: Operation enabled",
+    );
     let seen = during_motion(|c| c.encoder_ok = false, |c| c.encoder_ok = true);
     fault_row!(row, seen);
 }
 
 #[test]
 fn c015_sto_during_motion_switches_the_power_stage_off_without_a_fault() {
-    let row = Row {
-        order: "42",
-        case: "STO while axis A turns at 2 rev/s (csv)",
-        spec: "C-015",
-        peer: "ethercrab",
-        expected: "Switch on disabled, power stage off, brake engaged; no EMCY; 603Fh 0000h; E47 1; \
-                   history empty; Op, AL 0000h; while the cause lasts a reset gives Switch on disabled \
-                   (E47 1); after it: Operation enabled",
-    };
+    let row = ethercrab(
+        "42",
+        "STO while axis A turns at 2 rev/s (csv)",
+        "C-015",
+        "Switch on disabled, power stage off, brake engaged; no EMCY; 603Fh 0000h; E47 1; \
+         history empty; Op, AL 0000h; while the cause lasts a reset gives Switch on disabled \
+         (E47 1); after it: Operation enabled",
+    );
     let seen = during_motion(|c| c.sto_active = true, |c| c.sto_active = false);
     fault_row!(row, seen);
 }
 
 #[test]
 fn e089_c015_supply_undervoltage_during_motion_is_event_46() {
-    let row = Row {
-        order: "43",
-        case: "supply drops while axis A turns at 2 rev/s (csv)",
-        spec: "E-089, C-015",
-        peer: "ethercrab",
-        expected: "Fault, power stage off, brake engaged; EMCY 3120h/04h event 46 cause 1; 603Fh 3120h; \
-                   E47 0; history: error 3120h axis A event 46/1; Op, AL 0000h; while the cause lasts a \
-                   reset gives Switch on disabled (E47 2); after it: Operation enabled",
-    };
+    let row = ethercrab(
+        "43",
+        "supply drops while axis A turns at 2 rev/s (csv)",
+        "E-089, C-015",
+        "Fault, power stage off, brake engaged; EMCY 3120h/04h event 46 cause 1; 603Fh 3120h; \
+         E47 0; history: error 3120h axis A event 46/1; Op, AL 0000h; while the cause lasts a \
+         reset gives Switch on disabled (E47 2); after it: Operation enabled",
+    );
     let seen = during_motion(|c| c.supply_ok = false, |c| c.supply_ok = true);
     fault_row!(row, seen);
 }
 
 #[test]
 fn c084_limit_switch_against_the_travel_during_homing_is_a_homing_error() {
-    let row = Row {
-        order: "44",
-        case: "homing method 1 (negative limit switch) runs into a limit switch wired as the positive one",
-        spec: "C-084",
-        peer: "ethercrab",
-        expected: "Operation enabled, homing error, velocity 0 (bits 13, 12 set, 10 clear); no EMCY; \
-                   603Fh 0000h; Op, AL 0000h",
-    };
+    let row = ethercrab(
+        "44",
+        "homing method 1 (negative limit switch) runs into a limit switch wired as the positive one",
+        "C-084",
+        "Operation enabled, homing error, velocity 0 (bits 13, 12 set, 10 clear); no EMCY; \
+         603Fh 0000h; Op, AL 0000h",
+    );
     const R: i64 = REV as i64;
-    let sim = line(1);
-    {
-        let mut s = sim.borrow_mut();
-        let d = &mut s.drives_mut()[0];
-        // the switch the axis meets moving negative reads as the positive one
-        *d.motors[0].switches_mut() = Switches {
-            positive_limit: PositionInput::below(-2 * R).active_low(),
-            negative_limit: PositionInput::never().active_low(),
-            ..Switches::linear_axis(-10 * R, 10 * R, PositionInput::never())
-        };
-    }
+    // the switch the axis meets moving negative reads as the positive one
+    let sim = line_with_switches(Switches {
+        positive_limit: PositionInput::below(-2 * R).active_low(),
+        negative_limit: PositionInput::never().active_low(),
+        ..Switches::linear_axis(-10 * R, 10 * R, PositionInput::never())
+    });
     let seen = with_master(&sim, async |md, clock| {
         let group = init(md, clock).await.into_op(md).await.expect("OP");
         // I101/I102 = 1: the limit switches from the inputs, by SDO (issue 40)
@@ -145,9 +118,7 @@ fn c084_limit_switch_against_the_travel_during_homing_is_a_homing_error() {
             .unwrap();
         sd.sdo_write(0x6098, 0, 1i8).await.unwrap();
         let mut m = Cyclic::new(md, &group, &sim, 0);
-        m.set_mode(6);
-        m.run(3).await;
-        m.enable().await;
+        m.enable_in(6).await;
         m.set_controlword(CW_ENABLED | CW_BIT4);
         let ended = m
             .run_until(20_000, |t| t.bit(13) && t.bit(12) || t.state() != 0x27)

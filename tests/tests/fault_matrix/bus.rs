@@ -1,7 +1,7 @@
 //! Faults on the bus: bursts of lost frames in Op (free run and DC), the
 //! SM watchdog, a second master on the line with conflicting AL control.
 
-use super::{advance, emcys, newest_diag};
+use super::{advance, emcys, ethercrab, newest_diag};
 use drive_tests::al::{ACK, INIT, OP, PREOP};
 use drive_tests::matrix::{al, cia402_state, emcys as show_emcys, Row};
 use drive_tests::{al_status, fault_row, init, line, request, with_master, Cyclic, REV};
@@ -38,11 +38,7 @@ fn burst_free_run(a258: u16, lost: u64) -> String {
         let group = group.into_op(md).await.expect("OP");
         let sd = group.subdevice(md, 0).unwrap();
         let mut m = Cyclic::new(md, &group, &sim, 0);
-        m.set_mode(9);
-        m.run(3).await;
-        m.enable().await;
-        m.set_target_velocity(REV);
-        m.run(200).await;
+        m.csv_at(REV, 200).await;
         advance(&sim, lost * 1_000_000);
         let mut full = 0;
         for _ in 0..50 {
@@ -89,83 +85,90 @@ const TIMED_OUT: &str = "Safe-Op + ERR, AL 001Bh; axis A Fault; EMCY 7500h/10h e
 
 #[test]
 fn e126_e128_e129_lost_frames_with_a258_65532_one_tolerated_two_not() {
-    let one = Row {
-        order: "01",
-        case: "1 lost frame in Op, free run, A258 = 65532 (tolerate 1), axis A moving",
-        spec: "E-126",
-        peer: "ethercrab",
-        expected: KEPT,
-    };
-    fault_row!(one, burst_free_run(65532, 1));
-    let two = Row {
-        order: "02",
-        case: "2 lost frames in a row, free run, A258 = 65532",
-        spec: "E-126, E-128, E-129",
-        peer: "ethercrab",
-        expected: TIMED_OUT,
-    };
-    fault_row!(two, burst_free_run(65532, 2));
+    fault_row!(
+        ethercrab(
+            "01",
+            "1 lost frame in Op, free run, A258 = 65532 (tolerate 1), axis A moving",
+            "E-126",
+            KEPT
+        ),
+        burst_free_run(65532, 1)
+    );
+    fault_row!(
+        ethercrab(
+            "02",
+            "2 lost frames in a row, free run, A258 = 65532",
+            "E-126, E-128, E-129",
+            TIMED_OUT
+        ),
+        burst_free_run(65532, 2)
+    );
 }
 
 #[test]
 fn e126_e128_e129_lost_frames_with_a258_65533_three_tolerated_four_not() {
-    let three = Row {
-        order: "03",
-        case: "3 lost frames in a row, free run, A258 = 65533 (tolerate 3), axis A moving",
-        spec: "E-126",
-        peer: "ethercrab",
-        expected: KEPT,
-    };
-    fault_row!(three, burst_free_run(65533, 3));
-    let four = Row {
-        order: "04",
-        case: "4 lost frames in a row, free run, A258 = 65533",
-        spec: "E-126, E-128, E-129",
-        peer: "ethercrab",
-        expected: TIMED_OUT,
-    };
-    fault_row!(four, burst_free_run(65533, 4));
+    fault_row!(
+        ethercrab(
+            "03",
+            "3 lost frames in a row, free run, A258 = 65533 (tolerate 3), axis A moving",
+            "E-126",
+            KEPT
+        ),
+        burst_free_run(65533, 3)
+    );
+    fault_row!(
+        ethercrab(
+            "04",
+            "4 lost frames in a row, free run, A258 = 65533",
+            "E-126, E-128, E-129",
+            TIMED_OUT
+        ),
+        burst_free_run(65533, 4)
+    );
 }
 
 #[test]
 fn e126_c117_lost_frames_with_a258_20_ms() {
-    let within = Row {
-        order: "05",
-        case: "15 lost frames in a row, free run, A258 = 20 ms, axis A moving (longer than I423 = 10 cycles)",
-        spec: "E-126, C-117",
-        peer: "ethercrab",
-        expected: EXTRAPOLATION,
-    };
-    fault_row!(within, burst_free_run(20, 15));
-    let beyond = Row {
-        order: "06",
-        case: "30 lost frames in a row, free run, A258 = 20 ms, axis A moving",
-        spec: "E-126, E-128, C-117",
-        peer: "ethercrab",
-        expected: EXTRAPOLATION_THEN_TIMED_OUT,
-    };
-    fault_row!(beyond, burst_free_run(20, 30));
+    fault_row!(
+        ethercrab(
+            "05",
+            "15 lost frames in a row, free run, A258 = 20 ms, axis A moving (longer than I423 = 10 cycles)",
+            "E-126, C-117",
+            EXTRAPOLATION
+        ),
+        burst_free_run(20, 15)
+    );
+    fault_row!(
+        ethercrab(
+            "06",
+            "30 lost frames in a row, free run, A258 = 20 ms, axis A moving",
+            "E-126, E-128, C-117",
+            EXTRAPOLATION_THEN_TIMED_OUT
+        ),
+        burst_free_run(20, 30)
+    );
 }
 
 #[test]
 fn e127_c117_lost_frames_with_the_masters_sm_watchdog() {
-    let within = Row {
-        order: "07",
-        case:
+    fault_row!(
+        ethercrab(
+            "07",
             "50 lost frames in a row, free run, A258 = 65534 (the ESC's SM watchdog, 100 ms), axis A moving",
-        spec: "E-127, C-117",
-        peer: "ethercrab",
-        expected: EXTRAPOLATION,
-    };
-    fault_row!(within, burst_free_run(65534, 50));
-    let beyond = Row {
-        order: "08",
-        case: "150 lost frames in a row, free run, A258 = 65534, axis A moving",
-        spec: "E-127, E-128, C-117",
-        peer: "ethercrab",
-        expected: EXTRAPOLATION_THEN_TIMED_OUT,
-    };
-    fault_row!(beyond, burst_free_run(65534, 150));
+            "E-127, C-117",
+            EXTRAPOLATION
+        ),
+        burst_free_run(65534, 50)
+    );
+    fault_row!(
+        ethercrab(
+            "08",
+            "150 lost frames in a row, free run, A258 = 65534, axis A moving",
+            "E-127, E-128, C-117",
+            EXTRAPOLATION_THEN_TIMED_OUT
+        ),
+        burst_free_run(65534, 150)
+    );
 }
 
 /// The line in Op under DC (SYNC0 1 ms) with A258 = `a258`, then `lost`
@@ -228,23 +231,25 @@ fn burst_dc(a258: u16, lost: u64) -> String {
 
 #[test]
 fn e126_e107_lost_frames_under_dc_sync0_with_a258_65533() {
-    let three = Row {
-        order: "09",
-        case: "3 lost frames in a row under DC (SYNC0 1 ms goes on), A258 = 65533",
-        spec: "E-126, E-107",
-        peer: "ethercrab",
-        expected: "Op, AL 0000h; no EMCY; 603Fh 0000h; history empty; Op in 50 of 50 cycles after it",
-    };
-    fault_row!(three, burst_dc(65533, 3));
-    let four = Row {
-        order: "10",
-        case: "4 lost frames in a row under DC, A258 = 65533",
-        spec: "E-126, E-128, E-129",
-        peer: "ethercrab",
-        expected: "Safe-Op + ERR, AL 001Bh; EMCY 7500h/10h event 52 cause 6; 603Fh 7500h; \
-                   history: error AL 001Bh; Op in 0 of 50 cycles after it",
-    };
-    fault_row!(four, burst_dc(65533, 4));
+    fault_row!(
+        ethercrab(
+            "09",
+            "3 lost frames in a row under DC (SYNC0 1 ms goes on), A258 = 65533",
+            "E-126, E-107",
+            "Op, AL 0000h; no EMCY; 603Fh 0000h; history empty; Op in 50 of 50 cycles after it"
+        ),
+        burst_dc(65533, 3)
+    );
+    fault_row!(
+        ethercrab(
+            "10",
+            "4 lost frames in a row under DC, A258 = 65533",
+            "E-126, E-128, E-129",
+            "Safe-Op + ERR, AL 001Bh; EMCY 7500h/10h event 52 cause 6; 603Fh 7500h; \
+         history: error AL 001Bh; Op in 0 of 50 cycles after it"
+        ),
+        burst_dc(65533, 4)
+    );
 }
 
 /// One datagram from another master straight onto the line: FPWR of
@@ -294,11 +299,7 @@ fn e021_e023_e037_a_second_master_with_conflicting_al_control() {
         let group = group.into_op(md).await.expect("OP");
         let sd = group.subdevice(md, 0).unwrap();
         let mut m = Cyclic::new(md, &group, &sim, 0);
-        m.set_mode(9);
-        m.run(3).await;
-        m.enable().await;
-        m.set_target_velocity(REV);
-        m.run(100).await;
+        m.csv_at(REV, 100).await;
         // master 2: Init
         assert_eq!(second_master_write(&sim, station, 0x0120, &INIT.to_le_bytes()), 1);
         for _ in 0..20 {

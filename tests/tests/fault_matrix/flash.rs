@@ -1,7 +1,7 @@
 //! Power cut during an FoE download, at every flash operation it makes.
 
+use super::ethercrab;
 use drive_ecat::boot::{Slot, SlotState};
-use drive_tests::matrix::Row;
 use drive_tests::{fault_row, firmware_file, in_boot, FoeClient, FwNode};
 use hil_sim::sim::Simulation;
 use std::cell::RefCell;
@@ -27,14 +27,13 @@ fn download(sim: &RefCell<Simulation<FwNode>>, file: &[u8]) -> bool {
 
 #[test]
 fn e020_power_cut_at_every_flash_operation_of_an_foe_download_keeps_the_image() {
-    let row = Row {
-        order: "32",
-        case: "power cut during an FoE download (1 KB image), at each of its flash operations",
-        spec: "E-020",
-        peer: "ethercrab",
-        expected: "at every cut: image A starts confirmed at the next power-on, slot B not pending, a new \
-                   download is taken and B starts on trial",
-    };
+    let row = ethercrab(
+        "32",
+        "power cut during an FoE download (1 KB image), at each of its flash operations",
+        "E-020",
+        "at every cut: image A starts confirmed at the next power-on, slot B not pending, a new \
+         download is taken and B starts on trial",
+    );
     let file = firmware_file(2, 1_000);
     let fresh = || RefCell::new(Simulation::with_nodes(vec![FwNode::factory(20_000)]));
     let sim = fresh();

@@ -2,9 +2,9 @@
 //! full mailbox, a master restarted during a segmented SDO download and
 //! during an FoE download.
 
-use super::advance;
+use super::{advance, ethercrab};
 use drive_ecat::boot::{Slot, SlotState};
-use drive_tests::matrix::{al, Row};
+use drive_tests::matrix::al;
 use drive_tests::{
     al_status, fault_row, firmware_file, in_boot, init, line, to_boot, with_master, with_master_on,
     CoeClient, Cyclic, FoeClient, FoeReply, FwNode, RawMailbox, MAILBOX_LEN, REV,
@@ -47,15 +47,14 @@ fn describe(kind: u8, data: &[u8]) -> String {
 
 #[test]
 fn e062_e094_a_master_that_stops_reading_the_mailbox_loses_nothing() {
-    let row = Row {
-        order: "21",
-        case: "the master sends an SDO upload, then reads no mailbox for 2 s while axis A faults \
-               (external fault, event 44); process data goes on",
-        spec: "E-062, E-094",
-        peer: "ethercrab",
-        expected: "Op, AL 0000h; 2000 of 2000 cycles with WKC 3 while the mailbox went unread; then, in \
-                   order: SDO 1018h:02 = the product code; EMCY FF09h/01h event 44 cause 1; nothing more",
-    };
+    let row = ethercrab(
+        "21",
+        "the master sends an SDO upload, then reads no mailbox for 2 s while axis A faults \
+         (external fault, event 44); process data goes on",
+        "E-062, E-094",
+        "Op, AL 0000h; 2000 of 2000 cycles with WKC 3 while the mailbox went unread; then, in \
+         order: SDO 1018h:02 = the product code; EMCY FF09h/01h event 44 cause 1; nothing more",
+    );
     let sim = line(1);
     let seen = with_master(&sim, async |md, clock| {
         let group = init(md, clock).await;
@@ -63,11 +62,7 @@ fn e062_e094_a_master_that_stops_reading_the_mailbox_loses_nothing() {
         let group = group.into_op(md).await.expect("OP");
         let sd = group.subdevice(md, 0).unwrap();
         let mut m = Cyclic::new(md, &group, &sim, 0);
-        m.set_mode(9);
-        m.run(3).await;
-        m.enable().await;
-        m.set_target_velocity(REV);
-        m.run(100).await;
+        m.csv_at(REV, 100).await;
         let mut mbx = RawMailbox::new();
         mbx.send_raw(&sd, upload_request(1, 0x1018, 2)).await;
         sim.borrow_mut().drives_mut()[0].drive.axes_mut()[0]
@@ -99,17 +94,16 @@ fn e062_e094_a_master_that_stops_reading_the_mailbox_loses_nothing() {
 
 #[test]
 fn e027_requests_into_a_full_mailbox_are_refused_and_nothing_is_lost() {
-    let row = Row {
-        order: "22",
-        case: "the master writes six SDO uploads (1018h:01…04, 01, 02) back to back without reading an \
-               answer, then reads and repeats each refused write",
-        spec: "E-027",
-        peer: "ethercrab",
-        expected: "writes: taken, taken, taken, refused, refused, refused (WKC 0: SM0 still full); then, in \
-                   order: SDO 1018h:01 = the vendor; SDO 1018h:02 = the product code; SDO 1018h:03 = the \
-                   revision; SDO 1018h:04 = the serial number; SDO 1018h:01 = the vendor; SDO 1018h:02 = \
-                   the product code; nothing more; Pre-Op, AL 0000h",
-    };
+    let row = ethercrab(
+        "22",
+        "the master writes six SDO uploads (1018h:01…04, 01, 02) back to back without reading an \
+         answer, then reads and repeats each refused write",
+        "E-027",
+        "writes: taken, taken, taken, refused, refused, refused (WKC 0: SM0 still full); then, in \
+         order: SDO 1018h:01 = the vendor; SDO 1018h:02 = the product code; SDO 1018h:03 = the \
+         revision; SDO 1018h:04 = the serial number; SDO 1018h:01 = the vendor; SDO 1018h:02 = \
+         the product code; nothing more; Pre-Op, AL 0000h",
+    );
     let sim = line(1);
     let seen = with_master(&sim, async |md, clock| {
         let group = init(md, clock).await;
@@ -178,15 +172,14 @@ fn e027_requests_into_a_full_mailbox_are_refused_and_nothing_is_lost() {
 
 #[test]
 fn e037_e065_a_master_restarted_during_a_segmented_download_leaves_the_object_as_it_was() {
-    let row = Row {
-        order: "23",
-        case: "the master restarts after the initiate and the first of three segments of a 16-byte \
-               download of E72 (axis name)",
-        spec: "E-037, E-065",
-        peer: "ethercrab",
-        expected: "the new master reads the old E72; its own segmented download is taken and reads back; \
-                   Pre-Op, AL 0000h",
-    };
+    let row = ethercrab(
+        "23",
+        "the master restarts after the initiate and the first of three segments of a 16-byte \
+         download of E72 (axis name)",
+        "E-037, E-065",
+        "the new master reads the old E72; its own segmented download is taken and reads back; \
+         Pre-Op, AL 0000h",
+    );
     let sim = line(1);
     let old = with_master(&sim, async |md, clock| {
         let group = init(md, clock).await;
@@ -232,14 +225,13 @@ fn node(sim: &RefCell<Simulation<FwNode>>) -> std::cell::RefMut<'_, FwNode> {
 
 #[test]
 fn e037_a_master_restarted_during_an_foe_download_keeps_the_running_image() {
-    let row = Row {
-        order: "24",
-        case: "the master restarts after 40 of 124 packets of an FoE firmware download",
-        spec: "E-037",
-        peer: "ethercrab",
-        expected: "slot B not pending, image A runs; the new master's download is taken; slot B pending; \
-                   the next power-on starts B on trial",
-    };
+    let row = ethercrab(
+        "24",
+        "the master restarts after 40 of 124 packets of an FoE firmware download",
+        "E-037",
+        "slot B not pending, image A runs; the new master's download is taken; slot B pending; \
+         the next power-on starts B on trial",
+    );
     let sim = RefCell::new(Simulation::with_nodes(vec![FwNode::factory(20_000)]));
     let file = firmware_file(2, 30_000);
     with_master_on(&sim, async |md, clock| {
