@@ -613,7 +613,7 @@ impl<S: AsRef<[u32]> + AsMut<[u32]>> Recorder<S> {
         let total = self.trace_bytes();
         let from = usize::from(k) * BLOCK_BYTES;
         if from >= total {
-            return Err(SdoAbort(0x0800_0024));
+            return Err(SdoAbort::NO_DATA);
         }
         let len = (total - from).min(BLOCK_BYTES);
         let out = buf.get_mut(..len).ok_or(SdoAbort::OUT_OF_MEMORY)?;

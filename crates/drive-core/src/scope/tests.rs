@@ -252,7 +252,7 @@ fn issue35_scope_objects_refuse_bad_input_and_incomplete_reads() {
         r.sample(od, || signals(t));
     }
     assert_eq!(read(od, r, T11, 1).unwrap().len(), 32);
-    assert_eq!(read(od, r, T11, 2), Err(SdoAbort(0x0800_0024)));
+    assert_eq!(read(od, r, T11, 2), Err(SdoAbort::NO_DATA));
     assert_eq!(read(od, r, T00, 0).unwrap(), [3], "single mode stays complete");
     assert_eq!(write(od, r, T00, 0, &[2]), Err(SdoAbort::INVALID_VALUE));
     // a drive without a recorder answers 0800 0022h
