@@ -5,6 +5,7 @@ pub mod args;
 pub mod demo;
 pub mod demo_pn;
 pub mod realtime;
+pub mod scope;
 pub mod serve;
 pub mod serve_pn;
 mod serve_stats;

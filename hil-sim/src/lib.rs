@@ -31,4 +31,6 @@ pub mod pn;
 #[cfg(feature = "std")]
 pub mod raw;
 #[cfg(feature = "std")]
+pub mod scope_plot;
+#[cfg(feature = "std")]
 pub mod sim;

@@ -12,6 +12,9 @@
 //!   (`--axes 1`: single-axis drives, SI6A061).
 //! - `hil-sim serve --fieldbus profinet --iface IF [--name NAME] [--pcap FILE]`:
 //!   one simulated drive answers as a PROFINET IO device on the interface.
+//! - `hil-sim scope-plot TRACE.csv [--svg FILE] [--png FILE]`: plots a
+//!   trace of the drive's scope (group T) that `hil-sim/tests/soem/scope.py`
+//!   read through SOEM.
 //!
 //! `hil-sim --help` and `hil-sim SUBCOMMAND --help` list every option.
 
@@ -28,6 +31,7 @@ fn main() -> ExitCode {
         Some(Command::Demo(a)) if a.fieldbus == Fieldbus::Profinet => cli::demo_pn::demo(a),
         Some(Command::Demo(a)) => cli::demo::demo(a),
         Some(Command::Serve(a)) => cli::serve::serve(a),
+        Some(Command::ScopePlot(a)) => cli::scope::plot(a),
     };
     match result {
         Ok(()) => ExitCode::SUCCESS,

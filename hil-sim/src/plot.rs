@@ -41,7 +41,7 @@ pub struct Trace {
 }
 
 /// One line of a panel: values, colour, legend.
-type Line<'a> = (&'a [f64], RGBColor, &'a str);
+pub type Line<'a> = (&'a [f64], RGBColor, &'a str);
 
 /// Increments per revolution (2^20).
 const INC_PER_REV: f64 = 1_048_576.0;
@@ -128,43 +128,23 @@ impl Trace {
 
     /// The four-panel SVG plot.
     pub fn svg(&self, title: &str) -> Result<String, String> {
-        let mut svg = String::new();
         // the two current panels add their height
         let size = if self.iq_a.is_empty() {
             SIZE
         } else {
             (SIZE.0, SIZE.1 + SIZE.1 / 2)
         };
-        self.draw(
-            SVGBackend::with_string(&mut svg, (fine(size.0), fine(size.1))),
-            title,
-        )?;
-        // shown at its size: the root's width and height (its first attributes)
-        let drawn = format!("width=\"{}\" height=\"{}\"", fine(size.0), fine(size.1));
-        let shown = format!("width=\"{}\" height=\"{}\"", size.0, size.1);
-        if !svg.contains(&drawn) {
-            return Err("the SVG root has no width and height to set".into());
-        }
-        Ok(svg.replacen(&drawn, &shown, 1))
+        shown_at(size, |backend| self.draw(backend, title))
     }
 
     fn draw(&self, backend: SVGBackend<'_>, title: &str) -> Result<(), String> {
-        let root = backend.into_drawing_area();
-        root.fill(&WHITE).map_err(|e| e.to_string())?;
-        let root = root
-            .titled(title, ("sans-serif", fine(22)))
-            .map_err(|e| e.to_string())?;
         let with_state = !self.state.is_empty();
         let with_currents = !self.iq_a.is_empty();
-        let n = 4 + usize::from(with_state) + 2 * usize::from(with_currents);
-        let panels = root.split_evenly((n, 1));
         let set_name = if self.set_name.is_empty() {
             "set 607Ah"
         } else {
             self.set_name.as_str()
         };
-        let t_end = self.t_ms.last().copied().unwrap_or(1.0).max(1e-3);
-        let t0 = self.t_ms.first().copied().unwrap_or(0.0);
         let mut series: Vec<(&str, Vec<Line>)> = vec![
             (
                 "position [rev]",
@@ -198,71 +178,109 @@ impl Trace {
                 vec![(a, RED, "a"), (b, GREEN, "b"), (c, BLUE, "c")],
             ));
         }
-        for (k, (area, (label, lines))) in panels.iter().zip(series.iter()).enumerate() {
-            let (lo, hi) = lines
-                .iter()
-                .flat_map(|(v, _, _)| v.iter())
-                .fold((f64::MAX, f64::MIN), |(lo, hi), &v| (lo.min(v), hi.max(v)));
-            let (lo, hi) = if lo > hi { (-1.0, 1.0) } else { (lo, hi) };
-            let pad = ((hi - lo) * 0.08).max(1e-9);
-            let mut chart = ChartBuilder::on(area)
-                .margin(fine(8))
-                .x_label_area_size(fine(30))
-                .y_label_area_size(fine(70))
-                .build_cartesian_2d(t0..t_end, (lo - pad)..(hi + pad))
-                .map_err(|e| e.to_string())?;
-            chart
-                .configure_mesh()
-                .x_desc("time [ms]")
-                .y_desc(*label)
-                .label_style(("sans-serif", fine(12)))
-                .axis_desc_style(("sans-serif", fine(12)))
-                .axis_style(BLACK.stroke_width(FINE))
-                .bold_line_style(BLACK.mix(0.2).stroke_width(FINE))
-                .light_line_style(BLACK.mix(0.08).stroke_width(FINE))
-                .draw()
-                .map_err(|e| e.to_string())?;
-            for (n, (at, name)) in self.phases.iter().enumerate() {
-                let (lo, hi) = (lo - pad, hi + pad);
-                // alternate rows: names of phases close together stay apart
-                let y = hi - (hi - lo) * 0.08 * (n % 2) as f64;
-                chart
-                    .draw_series(LineSeries::new(
-                        [(*at, lo), (*at, hi)],
-                        BLACK.mix(0.3).stroke_width(FINE),
-                    ))
-                    .map_err(|e| e.to_string())?;
-                if k == 0 {
-                    chart
-                        .draw_series([Text::new(name.clone(), (*at, y), ("sans-serif", fine(12)))])
-                        .map_err(|e| e.to_string())?;
-                }
-            }
-            for (values, color, name) in lines {
-                let color = *color;
-                chart
-                    .draw_series(LineSeries::new(
-                        self.t_ms.iter().copied().zip(values.iter().copied()),
-                        color.stroke_width(FINE),
-                    ))
-                    .map_err(|e| e.to_string())?
-                    .label(*name)
-                    .legend(move |(x, y)| {
-                        PathElement::new(vec![(x, y), (x + fine(18) as i32, y)], color.stroke_width(FINE))
-                    });
-            }
-            chart
-                .configure_series_labels()
-                .label_font(("sans-serif", fine(12)))
-                .legend_area_size(fine(30))
-                .margin(fine(10))
-                .background_style(WHITE.mix(0.8))
-                .border_style(BLACK.stroke_width(FINE))
-                .draw()
-                .map_err(|e| e.to_string())?;
-        }
-        root.present().map_err(|e| e.to_string())
+        draw_panels(backend, title, &self.t_ms, &series, &self.phases)
     }
+}
+
+/// The SVG `draw` makes, drawn `FINE` times finer and shown at `size`
+/// (pixels).
+pub fn shown_at(
+    size: (u32, u32),
+    draw: impl FnOnce(SVGBackend<'_>) -> Result<(), String>,
+) -> Result<String, String> {
+    let mut svg = String::new();
+    draw(SVGBackend::with_string(&mut svg, (fine(size.0), fine(size.1))))?;
+    // shown at its size: the root's width and height (its first attributes)
+    let drawn = format!("width=\"{}\" height=\"{}\"", fine(size.0), fine(size.1));
+    let shown = format!("width=\"{}\" height=\"{}\"", size.0, size.1);
+    if !svg.contains(&drawn) {
+        return Err("the SVG root has no width and height to set".into());
+    }
+    Ok(svg.replacen(&drawn, &shown, 1))
+}
+
+/// Panels one above the other over the time axis `t_ms` (ms), each with its
+/// label and lines, the `phases` (start ms, name) marked in every panel and
+/// named in the first: the demo's plot and the scope's (`scope_plot`).
+pub fn draw_panels(
+    backend: SVGBackend<'_>,
+    title: &str,
+    t_ms: &[f64],
+    series: &[(&str, Vec<Line>)],
+    phases: &[(f64, String)],
+) -> Result<(), String> {
+    let root = backend.into_drawing_area();
+    root.fill(&WHITE).map_err(|e| e.to_string())?;
+    let root = root
+        .titled(title, ("sans-serif", fine(22)))
+        .map_err(|e| e.to_string())?;
+    let panels = root.split_evenly((series.len().max(1), 1));
+    let t_end = t_ms.last().copied().unwrap_or(1.0).max(1e-3);
+    let t0 = t_ms.first().copied().unwrap_or(0.0);
+    for (k, (area, (label, lines))) in panels.iter().zip(series.iter()).enumerate() {
+        let (lo, hi) = lines
+            .iter()
+            .flat_map(|(v, _, _)| v.iter())
+            .fold((f64::MAX, f64::MIN), |(lo, hi), &v| (lo.min(v), hi.max(v)));
+        let (lo, hi) = if lo > hi { (-1.0, 1.0) } else { (lo, hi) };
+        let pad = ((hi - lo) * 0.08).max(1e-9);
+        let mut chart = ChartBuilder::on(area)
+            .margin(fine(8))
+            .x_label_area_size(fine(30))
+            .y_label_area_size(fine(70))
+            .build_cartesian_2d(t0..t_end, (lo - pad)..(hi + pad))
+            .map_err(|e| e.to_string())?;
+        chart
+            .configure_mesh()
+            .x_desc("time [ms]")
+            .y_desc(*label)
+            .label_style(("sans-serif", fine(12)))
+            .axis_desc_style(("sans-serif", fine(12)))
+            .axis_style(BLACK.stroke_width(FINE))
+            .bold_line_style(BLACK.mix(0.2).stroke_width(FINE))
+            .light_line_style(BLACK.mix(0.08).stroke_width(FINE))
+            .draw()
+            .map_err(|e| e.to_string())?;
+        for (n, (at, name)) in phases.iter().enumerate() {
+            let (lo, hi) = (lo - pad, hi + pad);
+            // alternate rows: names of phases close together stay apart
+            let y = hi - (hi - lo) * 0.08 * (n % 2) as f64;
+            chart
+                .draw_series(LineSeries::new(
+                    [(*at, lo), (*at, hi)],
+                    BLACK.mix(0.3).stroke_width(FINE),
+                ))
+                .map_err(|e| e.to_string())?;
+            if k == 0 {
+                chart
+                    .draw_series([Text::new(name.clone(), (*at, y), ("sans-serif", fine(12)))])
+                    .map_err(|e| e.to_string())?;
+            }
+        }
+        for (values, color, name) in lines {
+            let color = *color;
+            chart
+                .draw_series(LineSeries::new(
+                    t_ms.iter().copied().zip(values.iter().copied()),
+                    color.stroke_width(FINE),
+                ))
+                .map_err(|e| e.to_string())?
+                .label(*name)
+                .legend(move |(x, y)| {
+                    PathElement::new(vec![(x, y), (x + fine(18) as i32, y)], color.stroke_width(FINE))
+                });
+        }
+        chart
+            .configure_series_labels()
+            .label_font(("sans-serif", fine(12)))
+            .legend_area_size(fine(30))
+            .margin(fine(10))
+            .background_style(WHITE.mix(0.8))
+            .border_style(BLACK.stroke_width(FINE))
+            .draw()
+            .map_err(|e| e.to_string())?;
+    }
+    root.present().map_err(|e| e.to_string())
 }
 
 #[cfg(test)]

@@ -124,7 +124,16 @@ pub struct SimDrive {
     sm2_event: bool,
     /// The IP stack on the EoE interface, if bound ([`SimDrive::bind_net`]).
     pub net: Option<Box<crate::eoe::DriveNet>>,
+    /// The scope (group T, issue 35) over [`SCOPE_WORDS`] words: sampled
+    /// after each control cycle, its objects answered through
+    /// [`Drive::poll_with`](drive_ecat::runtime::Drive::poll_with). Volatile:
+    /// a power cycle empties it.
+    pub scope: drive_ecat::scope::Recorder<Vec<u32>>,
 }
+
+/// Words of the simulated drive's scope buffer: 64 KiB, the most the trace
+/// data object T11 reads (16 blocks of 4096 bytes).
+pub const SCOPE_WORDS: usize = 16 * 1024;
 
 /// The SII image generated from the description of `variant`
 /// ([`drive_ecat::device`]).
@@ -190,6 +199,7 @@ impl SimDrive {
             next_tick: None,
             sm2_event: false,
             net: None,
+            scope: drive_ecat::scope::Recorder::new(vec![0; SCOPE_WORDS]),
         }
     }
 
@@ -403,6 +413,12 @@ impl SimDrive {
             Some(c) => self.drive.sync_cycle(&c, t, &io),
             None => self.drive.control_cycle(t, &io),
         };
+        let (drive, scope) = (&self.drive, &mut self.scope);
+        scope.sample(drive.objects(), || {
+            let [a, b] = drive.axes();
+            let s = drive_ecat::scope::Signals::of;
+            [s(a, &io[0]), s(b, &io[1])]
+        });
         let locked = self.drive.pll().is_some_and(|p| p.is_locked());
         self.pll_lock.follow(locked, t, self.drive.slave().state());
         // the torque holds until the next cycle starts (a broken timer that
@@ -421,7 +437,7 @@ impl SimDrive {
         self.esc.tick(now);
         self.run_due_cycles(now);
         let mut pdi = self.esc.pdi();
-        if let Ok(Some(change)) = self.drive.poll(&mut pdi, now) {
+        if let Ok(Some(change)) = self.drive.poll_with(&mut pdi, now, &mut self.scope) {
             self.state_log.push((now, change));
         }
         if self.drive.restart_due(now) {

@@ -231,6 +231,7 @@ impl fmt::Display for Notes<'_> {
             Value::Identity => f.write_str("const")?,
             Value::Ram => f.write_str("RAM")?,
             Value::Live => f.write_str("live")?,
+            Value::Provided => f.write_str("runtime")?,
             Value::Command => f.write_str("command")?,
             Value::Mirror { index, .. } => write!(f, "= {index:04X}h")?,
             Value::Alias(list) => {

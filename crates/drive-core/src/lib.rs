@@ -35,14 +35,15 @@ pub mod objects;
 pub mod params;
 pub mod pdo_image;
 pub mod pdo_maps;
+pub mod scope;
 pub mod stage;
 pub mod tuning;
 pub mod user_units;
 pub mod variant;
 
 pub use dictionary::{
-    revision, DriveObjects, ImageError, LiveValues, NoLive, Prepared, Requests, Slot, Template, WithLive,
-    LOAD_SIGNATURE, PERSISTENT_IMAGE_BYTES, SAVE_SIGNATURE,
+    revision, scope_mappable, DriveObjects, ImageError, LiveValues, NoLive, Prepared, Requests, Slot,
+    Template, WithLive, LOAD_SIGNATURE, PERSISTENT_IMAGE_BYTES, SAVE_SIGNATURE,
 };
 pub use pdo_maps::{module_ident, PdoLayout, AXIS_B_MODULE, IP_RX, IP_TX, USER_MODULE, VL_RX, VL_TX};
 pub use variant::Variant;

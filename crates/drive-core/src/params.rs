@@ -238,3 +238,33 @@ pub const A41: u16 = parameter_index(0, 41);
 pub const A42: u16 = parameter_index(0, 42);
 /// A43 power stage thermal time constant, ms (read only; line assumed).
 pub const A43: u16 = parameter_index(0, 43);
+
+/// T00 scope state: 0 idle, 1 armed, 2 triggered, 3 complete; a write of 1
+/// arms, 0 stops (global; `crate::scope`).
+pub const T00: u16 = parameter_index(19, 0);
+/// T01 scope channels: 8 elements, each a mapping entry (index << 16 | sub
+/// << 8 | bits) or an internal signal (index 0).
+pub const T01: u16 = parameter_index(19, 1);
+/// T02 number of scope channels in use (0…8).
+pub const T02: u16 = parameter_index(19, 2);
+/// T03 sample divider: one sample every T03 control cycles.
+pub const T03: u16 = parameter_index(19, 3);
+/// T04 samples per channel (0 = as many as the buffer holds).
+pub const T04: u16 = parameter_index(19, 4);
+/// T05 trigger source: 0 none, 1…8 a channel, 10h + n statusword bit n of
+/// axis A, 20h + n of axis B.
+pub const T05: u16 = parameter_index(19, 5);
+/// T06 trigger condition: 0 level ≥, 1 level <, 2 rising edge, 3 falling
+/// edge, 4 either edge.
+pub const T06: u16 = parameter_index(19, 6);
+/// T07 trigger level (the channel's value).
+pub const T07: u16 = parameter_index(19, 7);
+/// T08 pre-trigger share, %.
+pub const T08: u16 = parameter_index(19, 8);
+/// T09 scope mode: 0 single, 1 normal.
+pub const T09: u16 = parameter_index(19, 9);
+/// T10 trace information: \[0\] samples per channel, \[1\] trigger index,
+/// \[2\] completed traces, \[3\] buffer words.
+pub const T10: u16 = parameter_index(19, 10);
+/// T11 trace data: element k = bytes k·4096… of the complete trace.
+pub const T11: u16 = parameter_index(19, 11);

@@ -57,4 +57,6 @@ impl SdoAbort {
     pub const DEVICE_STATE: Self = Self(0x0800_0022);
     /// 0800 0023h Object dictionary not present / dynamic generation failed.
     pub const NO_DICTIONARY: Self = Self(0x0800_0023);
+    /// 0800 0024h No data available.
+    pub const NO_DATA: Self = Self(0x0800_0024);
 }

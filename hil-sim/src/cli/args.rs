@@ -1,4 +1,4 @@
-//! The command line: `hil-sim [demo|serve] [OPTIONS]` (clap, derive). Every
+//! The command line: `hil-sim [demo|serve|scope-plot] [OPTIONS]` (clap, derive). Every
 //! subcommand has `--help`; unknown arguments are refused with exit code 2.
 
 use clap::{Args, Parser, Subcommand, ValueEnum};
@@ -30,6 +30,29 @@ pub enum Command {
     /// with `--fieldbus profinet` a simulated PROFINET IO device answers
     /// instead, for any IO controller.
     Serve(ServeArgs),
+    /// Plots a trace the drive's scope recorded (group T), as
+    /// `hil-sim/tests/soem/scope.py` read it back through SOEM and wrote it
+    /// as CSV: one panel per channel, SVG and (with `rsvg-convert` or
+    /// ImageMagick's `convert`) PNG.
+    ScopePlot(ScopePlotArgs),
+}
+
+/// Options of `scope-plot`.
+#[derive(Debug, Clone, Args)]
+pub struct ScopePlotArgs {
+    /// The trace (CSV: time relative to the trigger in ms, then one column per channel).
+    #[arg(value_name = "TRACE.csv")]
+    pub csv: PathBuf,
+    /// Where the SVG goes (default: beside the CSV, `.svg`).
+    #[arg(long, value_name = "FILE")]
+    pub svg: Option<PathBuf>,
+    /// Where the PNG goes (default: beside the CSV, `.png`; skipped with a
+    /// note when neither `rsvg-convert` nor `convert` runs).
+    #[arg(long, value_name = "FILE")]
+    pub png: Option<PathBuf>,
+    /// The plot's title.
+    #[arg(long, default_value = "Scope trace")]
+    pub title: String,
 }
 
 /// Options of `demo`.

@@ -26,6 +26,7 @@ impl SimDrive {
             next_tick: self.next_tick,
             sm2_event: self.sm2_event,
             net: None,
+            scope: self.scope.clone(),
         })
     }
 }

@@ -824,6 +824,40 @@ def sw_is(sw, pattern):
     return sw & pattern[0] == pattern[1]
 
 
+class FreeRunAxis:
+    """Axis A of drive 1 in free run, about 1 ms per frame: each frame sends
+    `outputs()` packed as the struct format OUT and gives the TxPDO,
+    unpacked as IN, to `inputs(*values)` (a subclass sets the three)."""
+
+    OUT = IN = ""
+
+    def __init__(self, m):
+        self.m, self.s = m, m.slaves[0]
+
+    def outputs(self):
+        raise NotImplementedError
+
+    def inputs(self, *values):
+        raise NotImplementedError
+
+    def cycle(self, k=1):
+        n = struct.calcsize(self.IN)
+        for _ in range(k):
+            self.s.output = struct.pack(self.OUT, *self.outputs())
+            self.m.send_processdata()
+            self.m.receive_processdata(4000)
+            if len(self.s.input) >= n:
+                self.inputs(*struct.unpack(self.IN, bytes(self.s.input[:n])))
+            time.sleep(0.001)
+
+    def until(self, pred, frames):
+        """Cycles until `pred()` holds (True) or `frames` frames went by (False)."""
+        for _ in range(frames):
+            self.cycle()
+            if pred():
+                return True
+        return False
+
 class Axis:
     """One CiA 402 axis of one slave in the process data."""
 

@@ -31,7 +31,6 @@ Free run, one drive, axis A in cst; RxPDO 6040h, 6060h, A75; TxPDO 6041h, A69.
 Prints `FAIL: ...` for every check that failed; exit status 0 when none did.
 """
 import os
-import struct
 import sys
 import time
 
@@ -61,30 +60,21 @@ B40_SEL, B41_SEL, B42_SEL, B43_SEL, B49_SEL = 0b1010, 0b1011, 0b1100, 0b1101, 0b
 B300_SEL = 0b0100
 
 
-class Axis:
+class Axis(L.FreeRunAxis):
     """Axis A of drive 1 in free run, about 1 ms per frame."""
 
+    OUT, IN = OUT, IN
+
     def __init__(self, m):
-        self.m, self.s = m, m.slaves[0]
+        super().__init__(m)
         self.cw, self.a75 = 0, 0
         self.sw = self.a69 = 0
 
-    def cycle(self, k=1):
-        for _ in range(k):
-            self.s.output = struct.pack(OUT, self.cw, CST, self.a75)
-            self.m.send_processdata()
-            self.m.receive_processdata(4000)
-            n = struct.calcsize(IN)
-            if len(self.s.input) >= n:
-                self.sw, self.a69 = struct.unpack(IN, bytes(self.s.input[:n]))
-            time.sleep(0.001)
+    def outputs(self):
+        return self.cw, CST, self.a75
 
-    def until(self, pred, frames):
-        for _ in range(frames):
-            self.cycle()
-            if pred():
-                return True
-        return False
+    def inputs(self, sw, a69):
+        self.sw, self.a69 = sw, a69
 
 
 def motor_data(s):

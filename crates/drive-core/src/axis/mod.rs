@@ -427,6 +427,14 @@ impl Axis {
         self.velocity
     }
 
+    /// The cascade's outputs of the last control cycle (the speed
+    /// controller's set-point and actual value, the following error);
+    /// `None` while the cascade does not run. The scope's internal signals
+    /// ([`crate::scope::Signals`]).
+    pub fn cascade_output(&self) -> Option<&CascadeOutput> {
+        self.last_out.as_ref()
+    }
+
     /// Raises a fault from outside the motion core (e.g. a drive event of
     /// the power stage): T13 in the next cycle, with the EMCY of `event`.
     pub fn raise_event(&mut self, event: Event) {

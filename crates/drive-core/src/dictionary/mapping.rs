@@ -181,3 +181,19 @@ impl DriveObjects {
         }
     }
 }
+
+/// Whether `index`:`sub` ("EtherCAT Rx SDO Info" numbering) is an integer
+/// entry of at most 32 bits that a PDO may map (either direction): what the
+/// scope may record ([`crate::scope`]). `Err(0604 0041h)` for anything
+/// else (unknown entries included).
+pub fn scope_mappable(index: u16, sub: u8) -> Result<DataType, SdoAbort> {
+    let e = canonical(index, sub)
+        .and_then(|l| l.entry())
+        .map_err(|_| SdoAbort::NOT_MAPPABLE)?;
+    let mappable = e.access.rx_mappable() || e.access.tx_mappable();
+    if mappable && e.data_type.is_integer() && e.data_type.bytes() <= 4 {
+        Ok(e.data_type)
+    } else {
+        Err(SdoAbort::NOT_MAPPABLE)
+    }
+}

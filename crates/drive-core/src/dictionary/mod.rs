@@ -25,6 +25,7 @@ mod resolve;
 mod scaling;
 mod slot;
 
+pub use mapping::scope_mappable;
 pub use persist::{ImageError, PERSISTENT_IMAGE_BYTES};
 pub use prepared::Prepared;
 use resolve::*;
@@ -96,6 +97,14 @@ pub trait LiveValues {
     fn write(&mut self, index: u16, sub: u8, data: &[u8]) -> Result<(), SdoAbort> {
         let _ = (index, sub, data);
         Ok(())
+    }
+
+    /// A checked write (access, size, range, value list) to an entry only
+    /// the provider keeps ([`Value::Provided`]): the provider takes it or
+    /// refuses it; one it does not own answers 0800 0022h.
+    fn provide(&mut self, index: u16, sub: u8, data: &[u8]) -> Result<(), SdoAbort> {
+        let _ = (index, sub, data);
+        Err(SdoAbort::DEVICE_STATE)
     }
 }
 
@@ -334,6 +343,8 @@ impl DriveObjects {
                 put(buf, raw.get(..len).ok_or(SdoAbort::GENERAL)?)
             }
             Value::Text(s) => put(buf, s.as_bytes()),
+            // only a provider has these (`read_with` asked it)
+            Value::Provided => Err(SdoAbort::DEVICE_STATE),
             Value::Identity if e.sub == 3 => e.data_type.encode(i64::from(revision(self.template)), buf),
             _ if e.data_type.is_string() => Ok(0),
             _ => e.data_type.encode(e.default, buf),
@@ -468,7 +479,7 @@ impl DriveObjects {
         let target = follow(loc)?;
         let o = target.object()?;
         let owned = match o.value {
-            Value::Live => live.read(o.info.index, target.record()?.sub(), buf),
+            Value::Live | Value::Provided => live.read(o.info.index, target.record()?.sub(), buf),
             _ => None,
         };
         let n = match owned {
@@ -534,6 +545,10 @@ impl DriveObjects {
         }
         if o.value == Value::Live {
             live.write(o.info.index, e.sub, data)?;
+        }
+        if o.value == Value::Provided {
+            // the provider keeps the value; nothing in the RAM image
+            return live.provide(o.info.index, e.sub, data);
         }
         match (o.value, o.info.index) {
             (Value::Command, 0x1010) => self.requests.save = true,

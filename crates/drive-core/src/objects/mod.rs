@@ -10,6 +10,8 @@
 //!   at +8000h).
 //! - [`cia402`]: the CiA 402 objects of axis A (6000h–65FFh); axis B is
 //!   derived at +800h (`od-cia402.md`).
+//! - [`scope`]: the scope's configuration and trace (group T, 4600h…,
+//!   answered by the recorder).
 //! - [`scaling`]: the entries fieldbus scaling A213 acts on and their
 //!   decimal places (A310 velocities, A311 accelerations).
 //! - [`single`]: the objects the single-axis device declares differently
@@ -69,6 +71,7 @@ pub mod motor;
 mod pack;
 pub mod records;
 pub mod scaling;
+pub mod scope;
 pub mod single;
 pub mod stage;
 
@@ -106,6 +109,11 @@ pub enum Value {
     /// Entry position k is the target entry `(index, sub)` of the list; `(0, 0)`
     /// = the parameter's own constant (behind a reference, as [`Value::Text`]).
     Alias(&'static &'static [(u16, u8)]),
+    /// Values only a [`crate::LiveValues`] provider has (the scope's
+    /// configuration and trace, [`crate::scope`]): no place in the RAM image,
+    /// not saved; without a provider that owns them a read or write answers
+    /// 0800 0022h (docs/conformance.md).
+    Provided,
 }
 
 /// The "EtherCAT Rx" template view of an object (manufacturer arrays and
@@ -475,6 +483,7 @@ const CIA402_B: [Object; cia402::AXIS_A.len()] = offset(cia402::AXIS_A, crate::A
 pub const COUNT: usize = comm::COMM.len()
     + MANUFACTURER_A.len()
     + records::PARAMS.len()
+    + scope::PARAMS.len()
     + motor::PROTECTION.len()
     + cia402::AXIS_A.len()
     + CIA402_B.len()
@@ -490,6 +499,7 @@ const TABLE: [Object; COUNT] = join(&[
     &comm::COMM,
     &MANUFACTURER_A,
     &records::PARAMS,
+    &scope::PARAMS,
     &motor::PROTECTION,
     &cia402::AXIS_A,
     &CIA402_B,

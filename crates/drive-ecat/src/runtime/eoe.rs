@@ -36,7 +36,10 @@ impl<F: Flash, B: Flash> Drive<F, B> {
         f: impl FnOnce(&mut ecat::eoe_queue::EoeQueue, &mut dyn od::Dictionary, od::CommState) -> R,
     ) -> R {
         let state = ecat::coe::comm_state(self.slave.state());
-        let mut live = Live { diag: &mut self.diag };
+        let mut live = Live {
+            diag: &mut self.diag,
+            extra: &mut NoLive,
+        };
         let mut dict = self.objects.parameter_channel(&mut live);
         f(&mut self.eoe, &mut dict, state)
     }

@@ -81,7 +81,9 @@ use slots::RuntimeSlots;
 use sync::PllSettings;
 
 use crate::axis::{Axis, AxisCache, AxisCommand, AxisIo};
-use crate::dictionary::{read_slot, write_slot, DriveObjects, LiveValues, Slot, PERSISTENT_IMAGE_BYTES};
+use crate::dictionary::{
+    read_slot, write_slot, DriveObjects, LiveValues, NoLive, Slot, PERSISTENT_IMAGE_BYTES,
+};
 use crate::ecat_app::{event52, event52_cause, EcatApp};
 use crate::pdo_image::{PdoImage, PdoImageError};
 use boot::{BootSlots, NoFlash, UpdateError};
@@ -131,22 +133,33 @@ pub const TIMER_HZ: u32 = 144_000_000;
 /// master's frame when it proposes the A292 range, ns (our choice).
 pub const OPTIMIZE_GUARD_NS: u32 = 5_000;
 
-/// The live objects the runtime owns: 10F3h from the diagnosis history.
-struct Live<'a> {
+/// The live objects the runtime owns: 10F3h from the diagnosis history;
+/// the rest asked of the shell's provider `extra` (the scope's objects,
+/// [`drive_core::scope`]; [`NoLive`] where the shell has none).
+struct Live<'a, L: LiveValues> {
     diag: &'a mut DiagHistory,
+    extra: &'a mut L,
 }
 
-impl LiveValues for Live<'_> {
+impl<L: LiveValues> LiveValues for Live<'_, L> {
     fn read(&mut self, index: u16, sub: u8, buf: &mut [u8]) -> Option<Result<usize, SdoAbort>> {
-        (index == 0x10F3).then(|| self.diag.read(sub, buf))
+        if index == 0x10F3 {
+            Some(self.diag.read(sub, buf))
+        } else {
+            self.extra.read(index, sub, buf)
+        }
     }
 
     fn write(&mut self, index: u16, sub: u8, data: &[u8]) -> Result<(), SdoAbort> {
         if index == 0x10F3 {
             self.diag.write(sub, data)
         } else {
-            Ok(())
+            self.extra.write(index, sub, data)
         }
+    }
+
+    fn provide(&mut self, index: u16, sub: u8, data: &[u8]) -> Result<(), SdoAbort> {
+        self.extra.provide(index, sub, data)
     }
 }
 
@@ -325,7 +338,19 @@ impl<F: Flash, B: Flash> Drive<F, B> {
     /// Runs the slave stack once at `now`, then process data, the live
     /// objects and the dictionary's requests.
     pub fn poll<P: Pdi>(&mut self, pdi: &mut P, now: Nanos) -> Result<Option<StateChange>, P::Error> {
-        let change = self.poll_parts(pdi, now, true)?;
+        self.poll_with(pdi, now, &mut NoLive)
+    }
+
+    /// [`poll`](Self::poll) with the shell's provider of further live
+    /// objects (the scope's recorder: its objects are answered by it, the
+    /// mailbox reads and writes them through it).
+    pub fn poll_with<P: Pdi, L: LiveValues>(
+        &mut self,
+        pdi: &mut P,
+        now: Nanos,
+        extra: &mut L,
+    ) -> Result<Option<StateChange>, P::Error> {
+        let change = self.poll_parts(pdi, now, true, extra)?;
         let _ = self.serve_requests();
         Ok(change)
     }
@@ -334,7 +359,7 @@ impl<F: Flash, B: Flash> Drive<F, B> {
     /// AL control, process data, monitoring, live values; the mailbox
     /// waits for [`poll_mailbox`](Self::poll_mailbox).
     pub fn poll_esc<P: Pdi>(&mut self, pdi: &mut P, now: Nanos) -> Result<Option<StateChange>, P::Error> {
-        self.poll_parts(pdi, now, false)
+        self.poll_parts(pdi, now, false, &mut NoLive)
     }
 
     /// The mailbox part of [`poll`](Self::poll) for the low-priority task:
@@ -343,7 +368,10 @@ impl<F: Flash, B: Flash> Drive<F, B> {
     /// [`begin_save`](Self::begin_save).
     pub fn poll_mailbox<P: Pdi>(&mut self, pdi: &mut P, now: Nanos) -> Result<(), P::Error> {
         self.update_live();
-        let mut live = Live { diag: &mut self.diag };
+        let mut live = Live {
+            diag: &mut self.diag,
+            extra: &mut NoLive,
+        };
         let mut foe = FirmwareFoe::new(self.boot.as_mut());
         self.slave.poll_mailbox_only(
             pdi,
@@ -386,17 +414,21 @@ impl<F: Flash, B: Flash> Drive<F, B> {
         }))
     }
 
-    fn poll_parts<P: Pdi>(
+    fn poll_parts<P: Pdi, L: LiveValues>(
         &mut self,
         pdi: &mut P,
         now: Nanos,
         mailbox: bool,
+        extra: &mut L,
     ) -> Result<Option<StateChange>, P::Error> {
         if !self.cycle_owns_pdo() {
             self.process_inputs();
         }
         self.slave.set_sync_state(self.sync_state());
-        let mut live = Live { diag: &mut self.diag };
+        let mut live = Live {
+            diag: &mut self.diag,
+            extra,
+        };
         let mut foe = FirmwareFoe::new(self.boot.as_mut());
         let change = if mailbox {
             let change = self.slave.poll_with_eoe(
@@ -543,7 +575,10 @@ impl<F: Flash, B: Flash> Drive<F, B> {
         state: od::CommState,
     ) -> Result<usize, SdoAbort> {
         use od::Dictionary as _;
-        let mut live = Live { diag: &mut self.diag };
+        let mut live = Live {
+            diag: &mut self.diag,
+            extra: &mut NoLive,
+        };
         self.objects
             .parameter_channel(&mut live)
             .read(index, sub, buf, state)
