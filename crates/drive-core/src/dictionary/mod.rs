@@ -234,34 +234,33 @@ impl DriveObjects {
     /// B) leaves it (issue 36: a telegram's ramp write on axis A does not
     /// make axis B read its snapshot again). Changes whose entry is not
     /// known here (a slot store, a load, a template switch) move both.
+    #[inline(always)]
     pub fn axis_config_generation(&self, axis: usize) -> u32 {
-        self.axis_generation
-            .get(axis)
-            .copied()
-            .unwrap_or(self.config_generation)
+        let [a, b] = self.axis_generation;
+        if axis == 0 {
+            a
+        } else {
+            b
+        }
     }
 
     fn config_changed(&mut self) {
         self.config_generation = self.config_generation.wrapping_add(1);
-        for g in &mut self.axis_generation {
-            *g = g.wrapping_add(1);
-        }
+        let [a, b] = self.axis_generation;
+        self.axis_generation = [a.wrapping_add(1), b.wrapping_add(1)];
     }
 
     /// A configuration change of entry `index` (the dictionary's numbering):
     /// the axes whose objects it can be.
     fn config_changed_at(&mut self, index: u16) {
         self.config_generation = self.config_generation.wrapping_add(1);
-        let axes: &[usize] = match index {
-            0x6000..=0x67FF => &[0],
-            0x6800..=0x6FFF | 0xA000..=0xFFFF => &[1],
-            _ => &[0, 1],
+        let (to_a, to_b) = match index {
+            0x6000..=0x67FF => (1, 0),
+            0x6800..=0x6FFF | 0xA000..=0xFFFF => (0, 1),
+            _ => (1, 1),
         };
-        for &a in axes {
-            if let Some(g) = self.axis_generation.get_mut(a) {
-                *g = g.wrapping_add(1);
-            }
-        }
+        let [a, b] = self.axis_generation;
+        self.axis_generation = [a.wrapping_add(to_a), b.wrapping_add(to_b)];
     }
 
     /// This dictionary with `live` answering the live entries; values as
