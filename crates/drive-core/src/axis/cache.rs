@@ -51,7 +51,7 @@ impl Axis {
         if cache.slots.is_none() {
             cache.slots = Some(CyclicSlots::resolve(od, window));
         }
-        let generation = od.config_generation();
+        let generation = od.axis_config_generation(usize::from(window.axis));
         if !matches!(&cache.snapshot, Some(c) if c.generation == generation) {
             cache.snapshot = Some(self.read_snapshot(od, generation));
         }

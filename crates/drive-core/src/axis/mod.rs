@@ -493,8 +493,8 @@ impl Axis {
         now_ns: Nanos,
         new_setpoint: bool,
     ) -> AxisReport {
-        let generation = od.config_generation();
         let window = self.window;
+        let generation = od.axis_config_generation(usize::from(window.axis));
         let slots: &CyclicSlots = cache
             .slots
             .get_or_insert_with(|| CyclicSlots::resolve(od, window));

@@ -135,6 +135,9 @@ pub struct DriveObjects {
     requests: Requests,
     /// Counts configuration changes ([`Self::config_generation`]).
     config_generation: u32,
+    /// Counts the configuration changes each axis reads
+    /// ([`Self::axis_config_generation`]).
+    axis_generation: [u32; 2],
     /// The SyncManager lengths of the mapping (RxPDO, TxPDO bytes) with the
     /// configuration generation they were summed at: the slave asks every
     /// poll, the mapping changes only with the generation.
@@ -201,6 +204,7 @@ impl DriveObjects {
                 defaults_restored: false,
             },
             config_generation: 0,
+            axis_generation: [0; 2],
             pdo_bytes: Cell::new(None),
             all_accelerations: [records::ALL_ACCELERATIONS_DEFAULT; 2],
             variant,
@@ -232,8 +236,40 @@ impl DriveObjects {
         self.config_generation
     }
 
+    /// The configuration generation of axis `axis` (0 = A, 1 = B): as
+    /// [`config_generation`](Self::config_generation), but a changed value
+    /// of the other axis' own objects (CiA 402 objects at 6000h…67FFh for
+    /// axis A, 6800h…6FFFh and the manufacturer window from A000h for axis
+    /// B) leaves it (issue 36: a telegram's ramp write on axis A does not
+    /// make axis B read its snapshot again). Changes whose entry is not
+    /// known here (a slot store, a load, a template switch) move both.
+    #[inline(always)]
+    pub fn axis_config_generation(&self, axis: usize) -> u32 {
+        let [a, b] = self.axis_generation;
+        if axis == 0 {
+            a
+        } else {
+            b
+        }
+    }
+
     fn config_changed(&mut self) {
         self.config_generation = self.config_generation.wrapping_add(1);
+        let [a, b] = self.axis_generation;
+        self.axis_generation = [a.wrapping_add(1), b.wrapping_add(1)];
+    }
+
+    /// A configuration change of entry `index` (the dictionary's numbering):
+    /// the axes whose objects it can be.
+    fn config_changed_at(&mut self, index: u16) {
+        self.config_generation = self.config_generation.wrapping_add(1);
+        let (to_a, to_b) = match index {
+            0x6000..=0x67FF => (1, 0),
+            0x6800..=0x6FFF | 0xA000..=0xFFFF => (0, 1),
+            _ => (1, 1),
+        };
+        let [a, b] = self.axis_generation;
+        self.axis_generation = [a.wrapping_add(to_a), b.wrapping_add(to_b)];
     }
 
     /// This dictionary with `live` answering the live entries; values as
@@ -401,7 +437,7 @@ impl DriveObjects {
                     *d = *s;
                 }
                 if r.config {
-                    self.config_changed();
+                    self.config_changed_at(index);
                 }
             }
             return Ok(());
@@ -431,7 +467,7 @@ impl DriveObjects {
                         *d = *s;
                     }
                     if config {
-                        self.config_changed();
+                        self.config_changed_at(index);
                     }
                 }
                 return Ok(());
@@ -446,7 +482,8 @@ impl DriveObjects {
     }
 
     fn store(&mut self, loc: Loc, data: &[u8]) -> Result<(), SdoAbort> {
-        let config = is_config(loc.object()?);
+        let object = loc.object()?;
+        let config = is_config(object);
         let slot = self.image.get_mut(loc.slot()?).ok_or(SdoAbort::GENERAL)?;
         if data.len() > slot.len() {
             return Err(SdoAbort::LENGTH_TOO_HIGH);
@@ -458,7 +495,7 @@ impl DriveObjects {
             *d = v;
         }
         if changed && config {
-            self.config_changed();
+            self.config_changed_at(object.info.index);
         }
         Ok(())
     }

@@ -115,7 +115,19 @@ impl DriveObjects {
             }
         });
         Some(check.map(|v| {
-            self.store_slot(p.slot, v);
+            // a changed configuration value counted for the axes whose
+            // entry it is (`config_changed_at`), not for both
+            let changed = p.slot.config && self.load_slot(p.slot) != v;
+            self.store_slot(
+                Slot {
+                    config: false,
+                    ..p.slot
+                },
+                v,
+            );
+            if changed {
+                self.config_changed_at(p.index);
+            }
         }))
     }
 }
