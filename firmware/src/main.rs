@@ -59,6 +59,7 @@ mod app {
     use crate::CPU_HZ;
     use cortex_m::peripheral::DWT;
     use drive_ecat::axis::AxisCommand;
+    use drive_ecat::stage::{set_dc_link_voltage, StageData};
     use firmware::clock::Clock;
     use firmware::cycle::CycleTimer;
     #[cfg(not(feature = "net"))]
@@ -232,8 +233,9 @@ mod app {
     /// axes when its time has come (a compare short of a far start only
     /// arms again) on the fast task's positions and measured currents, its
     /// commands handed to the fast task, the next compare armed.
-    #[task(binds = CCU40_0, priority = 3, shared = [drive, timer, clock, cmd, ctimer, seam])]
+    #[task(binds = CCU40_0, priority = 3, shared = [drive, timer, clock, cmd, ctimer, seam], local = [stage_gen: u32 = u32::MAX])]
     fn control(cx: control::Context) {
+        let stage_gen = cx.local.stage_gen;
         // `seam` under its own short locks: the fast task waits for a copy,
         // never for the control cycle
         let mut seam = cx.shared.seam;
@@ -250,11 +252,19 @@ mod app {
                     let io = seam.lock(|l| l.each_mut().map(|l| l.io()));
                     guard(&io);
                     *cmd = tasks::control(drive, timer, now, &io);
-                    seam.lock(|l| {
-                        for ((l, c), a) in l.iter_mut().zip(cmd.iter()).zip(drive.axes()) {
-                            l.command(c, a.motor());
-                        }
+                    // the power stage's data when the configuration moved
+                    let gen = drive.objects().config_generation();
+                    let stage = (gen != *stage_gen).then(|| {
+                        *stage_gen = gen;
+                        StageData::read(drive.objects())
                     });
+                    let mv = seam.lock(|l| {
+                        for ((l, c), a) in l.iter_mut().zip(cmd.iter()).zip(drive.axes()) {
+                            l.command(c, a.motor(), stage.as_ref());
+                        }
+                        l[0].dc_link_mv()
+                    });
+                    set_dc_link_voltage(drive.objects_mut(), mv);
                 }
                 ctimer.arm(timer.next_at(), clock.now(DWT::cycle_count()));
             });

@@ -284,24 +284,8 @@ impl ElectricalAxis {
         if *s == self.stage {
             return;
         }
-        let p = *self.foc.protection();
-        self.foc.set_protection(Protection {
-            dc_link: foc::protect::DcLink {
-                min_v: s.under_voltage_v,
-                max_v: s.over_voltage_v,
-            },
-            stage_current_a: s.max_current_a,
-            stage_rated_a: s.rated_current_a,
-            stage_tau_s: s.tau_s,
-            ..p
-        });
-        self.chopper.set_params(ChopperParams {
-            resistor_ohm: s.brake_resistor_ohm,
-            rated_power_w: s.brake_resistor_rated_w,
-            tau_s: s.brake_resistor_tau_s,
-            on_v: s.chopper_on_v,
-            hysteresis_v: s.chopper_hysteresis_v,
-        });
+        self.foc.set_protection(s.protection(*self.foc.protection()));
+        self.chopper.set_params(s.chopper());
         self.plant.set_brake_resistor(f64::from(s.brake_resistor_ohm));
         self.stage = *s;
     }

@@ -84,6 +84,36 @@ impl StageData {
     }
 }
 
+impl StageData {
+    /// The current loop's protection with this stage (the DC-link window,
+    /// the stage's maximum and rated current and its thermal time
+    /// constant); the rest (trip threshold, phase sum, deviation, the i²t
+    /// policy) as in `base`. One conversion for every shell.
+    pub fn protection(&self, base: foc::Protection) -> foc::Protection {
+        foc::Protection {
+            dc_link: foc::protect::DcLink {
+                min_v: self.under_voltage_v,
+                max_v: self.over_voltage_v,
+            },
+            stage_current_a: self.max_current_a,
+            stage_rated_a: self.rated_current_a,
+            stage_tau_s: self.tau_s,
+            ..base
+        }
+    }
+
+    /// The brake chopper's parameters.
+    pub fn chopper(&self) -> foc::ChopperParams {
+        foc::ChopperParams {
+            resistor_ohm: self.brake_resistor_ohm,
+            rated_power_w: self.brake_resistor_rated_w,
+            tau_s: self.brake_resistor_tau_s,
+            on_v: self.chopper_on_v,
+            hysteresis_v: self.chopper_hysteresis_v,
+        }
+    }
+}
+
 /// The measured DC link (mV) into 6079h "DC link circuit voltage" (A566) of
 /// both axes (the SC6's two axes share one DC link).
 pub fn set_dc_link_voltage(od: &mut DriveObjects, millivolts: u32) {

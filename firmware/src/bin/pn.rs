@@ -94,6 +94,7 @@ mod app {
     use crate::{board, Drive, Eth, PnCycle, CPU_HZ};
     use cortex_m::peripheral::DWT;
     use drive_ecat::axis::AxisCommand;
+    use drive_ecat::stage::{set_dc_link_voltage, StageData};
     use drive_pn::PnParamFlash as ParamFlash;
     use firmware::clock::Clock;
     use firmware::pn_log::log_event;
@@ -271,9 +272,10 @@ mod app {
     /// axes when its time has come on the fast task's positions and measured
     /// currents, its commands handed to the fast task, the next compare
     /// armed.
-    #[task(binds = CCU40_0, priority = 3, shared = [drive, timer, clock, cmd, seam], local = [ctimer])]
+    #[task(binds = CCU40_0, priority = 3, shared = [drive, timer, clock, cmd, seam], local = [ctimer, stage_gen: u32 = u32::MAX])]
     fn control(cx: control::Context) {
         let ctimer = cx.local.ctimer;
+        let stage_gen = cx.local.stage_gen;
         // `seam` under its own short locks: the fast task waits for a copy,
         // never for the control cycle
         let mut seam = cx.shared.seam;
@@ -284,11 +286,19 @@ mod app {
                     let io = seam.lock(|l| l.each_mut().map(|l| l.io()));
                     guard(&io);
                     *cmd = timer.run(drive, now, &io);
-                    seam.lock(|l| {
-                        for ((l, c), a) in l.iter_mut().zip(cmd.iter()).zip(drive.axes()) {
-                            l.command(c, a.motor());
-                        }
+                    // the power stage's data when the configuration moved
+                    let gen = drive.objects().config_generation();
+                    let stage = (gen != *stage_gen).then(|| {
+                        *stage_gen = gen;
+                        StageData::read(drive.objects())
                     });
+                    let mv = seam.lock(|l| {
+                        for ((l, c), a) in l.iter_mut().zip(cmd.iter()).zip(drive.axes()) {
+                            l.command(c, a.motor(), stage.as_ref());
+                        }
+                        l[0].dc_link_mv()
+                    });
+                    set_dc_link_voltage(drive.objects_mut(), mv);
                 }
                 ctimer.arm(timer.next_at(), clock.now(DWT::cycle_count()));
             },

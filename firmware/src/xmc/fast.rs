@@ -33,12 +33,17 @@
 //! `MotorData`, converted once by `MotorData::current_loop`): the control
 //! cycle hands it over with its command, and the fast task applies a changed
 //! set before its next step (gains by pole-zero cancellation, the commutation
-//! offset B05, the torque constant the command divides by). The board's
-//! scaling and protection are the constants of [`board`]: all assumptions
-//! until a power board is at hand (docs/hardware.md).
+//! offset B05, the torque constant the command divides by). The power
+//! stage's data (A35 under-voltage limit, A40 over-voltage trip, A41/A42/A43
+//! its currents and thermal time constant: `drive_ecat::stage::StageData`)
+//! reach the loops the same way when the dictionary's configuration moved.
+//! The board's scaling and the rest of the protection are the constants of
+//! [`board`]: all assumptions until a power board is at hand
+//! (docs/hardware.md; the brake chopper's output is not wired).
 
 use super::motor::{Motor, DEAD_NS, PWM_HZ};
 use drive_ecat::axis::{AxisCommand, AxisIo, CurrentActual, CurrentTrip, DAxisMeans, Injection, MotorData};
+use drive_ecat::stage::StageData;
 use foc::{Dq, FocAxis, Sample};
 use xmc_motor::pwm::Duty;
 
@@ -114,6 +119,11 @@ pub struct Link {
     motor: Option<MotorData>,
     /// `motor` changed and the fast task has not applied it yet.
     motor_new: bool,
+    /// Control → fast: the power stage's data last handed over, not yet
+    /// applied when `Some`.
+    stage: Option<StageData>,
+    /// Fast → control: the DC link at the last period, V.
+    vdc_v: f32,
     /// Control → fast: power stage commanded on.
     on: bool,
     /// Control → fast: iq reference, A.
@@ -160,6 +170,8 @@ impl Link {
             kt,
             motor: None,
             motor_new: false,
+            stage: None,
+            vdc_v: 0.0,
             on: false,
             iq_ref_a: 0.0,
             injection: None,
@@ -184,8 +196,13 @@ impl Link {
     /// motor data in force (the dictionary's); a change is applied by the
     /// fast task before its next step (a set the loop refuses leaves it as
     /// it was; the dictionary refuses such values where they are written).
+    /// `stage`: the power stage's data when the dictionary's configuration
+    /// moved (`None`: unchanged).
     #[inline]
-    pub fn command(&mut self, c: &AxisCommand, motor: &MotorData) {
+    pub fn command(&mut self, c: &AxisCommand, motor: &MotorData, stage: Option<&StageData>) {
+        if let Some(st) = stage {
+            self.stage = Some(*st);
+        }
         if self.motor.as_ref() != Some(motor) {
             self.motor = Some(*motor);
             self.motor_new = true;
@@ -193,6 +210,12 @@ impl Link {
         self.on = c.power_stage;
         self.iq_ref_a = if c.power_stage { c.torque_nm / self.kt } else { 0.0 };
         self.injection = c.injection.filter(|_| c.power_stage);
+    }
+
+    /// The DC link at the last PWM period, mV (6079h).
+    #[inline]
+    pub fn dc_link_mv(&self) -> u32 {
+        (self.vdc_v * 1000.0) as u32
     }
 
     /// The control cycle's inputs: the encoder position, its and the DC
@@ -308,6 +331,11 @@ impl FastLoop {
                 link.trip_reported = false;
             }
             *was_on = on;
+            if let Some(st) = link.stage.take() {
+                // the DC-link window and the stage's currents; the trip
+                // threshold and the rest of `board::PROTECTION` stay
+                foc.set_protection(st.protection(*foc.protection()));
+            }
             if link.motor_new {
                 link.motor_new = false;
                 if let Some(m) = &link.motor {
@@ -375,8 +403,9 @@ impl FastLoop {
             link.periods = link.periods.saturating_add(1);
             link.position_inc = position_inc;
             link.encoder_ok &= !phase_error;
-            let dc = board::PROTECTION.dc_link;
+            let dc = foc.protection().dc_link;
             link.supply_ok = m.vdc >= dc.min_v && m.vdc <= dc.max_v;
+            link.vdc_v = m.vdc;
             link.stage_limit_a = m.stage_i2t.map_or(f32::INFINITY, |_| m.stage_limit_a);
             link.stage_warning = matches!(m.stage_i2t, Some(st) if st != foc::I2tState::Normal);
         }
