@@ -59,7 +59,7 @@ mod app {
     use crate::CPU_HZ;
     use cortex_m::peripheral::DWT;
     use drive_ecat::axis::AxisCommand;
-    use drive_ecat::stage::{set_dc_link_voltage, StageData};
+    use drive_ecat::stage::set_dc_link_voltage;
     use firmware::clock::Clock;
     use firmware::cycle::CycleTimer;
     #[cfg(not(feature = "net"))]
@@ -67,7 +67,7 @@ mod app {
     #[cfg(feature = "net")]
     use firmware::net::NodeNet as Net;
     use firmware::once::Once;
-    use firmware::xmc::fast::{guard, FastLoop, Link};
+    use firmware::xmc::fast::{guard, hand_over, stage_if_moved, FastLoop, Link};
     use firmware::xmc::motor::{self, ControlTimer};
     use firmware::{tasks, Drive, ParamFlash};
     use pdi::mmio::{OnChip, VolatileWindow};
@@ -252,18 +252,8 @@ mod app {
                     let io = seam.lock(|l| l.each_mut().map(|l| l.io()));
                     guard(&io);
                     *cmd = tasks::control(drive, timer, now, &io);
-                    // the power stage's data when the configuration moved
-                    let gen = drive.objects().config_generation();
-                    let stage = (gen != *stage_gen).then(|| {
-                        *stage_gen = gen;
-                        StageData::read(drive.objects())
-                    });
-                    let mv = seam.lock(|l| {
-                        for ((l, c), a) in l.iter_mut().zip(cmd.iter()).zip(drive.axes()) {
-                            l.command(c, a.motor(), stage.as_ref());
-                        }
-                        l[0].dc_link_mv()
-                    });
+                    let stage = stage_if_moved(drive.objects(), stage_gen);
+                    let mv = seam.lock(|l| hand_over(l, cmd, drive.axes(), stage.as_ref()));
                     set_dc_link_voltage(drive.objects_mut(), mv);
                 }
                 ctimer.arm(timer.next_at(), clock.now(DWT::cycle_count()));

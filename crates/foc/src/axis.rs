@@ -262,6 +262,18 @@ impl FocAxis {
         };
     }
 
+    /// The simulated servo's loop (`MotorData::default_servo`,
+    /// `LoopParams::default_16k`, `Protection::default_stage`) on `scaling`,
+    /// disabled.
+    pub fn default_servo(scaling: Scaling) -> Result<Self, ParamError> {
+        Self::new(
+            MotorData::default_servo(),
+            LoopParams::default_16k(),
+            scaling,
+            Protection::default_stage(),
+        )
+    }
+
     /// New motor data and loop parameters; on a refusal nothing changes. The
     /// integrators restart from zero on success.
     pub fn set_params(&mut self, motor: MotorData, params: LoopParams) -> Result<(), ParamError> {

@@ -407,13 +407,7 @@ fn sample(counts: [u16; 3], vdc_count: u16) -> Sample {
 fn axis_trips_switch_the_gates_off_in_the_same_step() {
     let sc = Scaling::default_board();
     let mk = || {
-        let mut a = FocAxis::new(
-            MotorData::default_servo(),
-            LoopParams::default_16k(),
-            sc,
-            Protection::default_stage(),
-        )
-        .unwrap();
+        let mut a = FocAxis::default_servo(sc).unwrap();
         a.enable(true);
         a
     };
@@ -460,13 +454,7 @@ fn axis_trips_switch_the_gates_off_in_the_same_step() {
 
 #[test]
 fn torque_reference_is_iq_through_the_torque_constant_with_id_zero() {
-    let a = FocAxis::new(
-        MotorData::default_servo(),
-        LoopParams::default_16k(),
-        Scaling::default_board(),
-        Protection::default_stage(),
-    )
-    .unwrap();
+    let a = FocAxis::default_servo(Scaling::default_board()).unwrap();
     let r = a.current_reference(1.3);
     assert_eq!(r.d, 0.0);
     assert!(close(r.q, 2.0, 1e-5));
@@ -597,13 +585,7 @@ fn e089_a_current_that_does_not_follow_its_reference_trips_motor_connection() {
     assert!(d.deviates(0.5 * 4.0, 4.0), "half the mean square off (2 A)");
     assert!(!d.deviates(0.5 * 0.01, 0.01), "0.1 A references: below the floor");
     let run = |follows: bool| {
-        let mut a = FocAxis::new(
-            MotorData::default_servo(),
-            LoopParams::default_16k(),
-            Scaling::default_board(),
-            Protection::default_stage(),
-        )
-        .unwrap();
+        let mut a = FocAxis::default_servo(Scaling::default_board()).unwrap();
         a.enable(true);
         // at electrical angle 0: 2 A of id reads a = +2 A, b = c = −1 A
         let s = if follows {
@@ -705,13 +687,7 @@ fn e090_chopper_hysteresis_and_resistor_thermal_model() {
 /// over-voltage trip trips at once, the stage's heat stays.
 #[test]
 fn stage_data_apply_at_run_time() {
-    let mut a = FocAxis::new(
-        MotorData::default_servo(),
-        LoopParams::default_16k(),
-        Scaling::default_board(),
-        Protection::default_stage(),
-    )
-    .unwrap();
+    let mut a = FocAxis::default_servo(Scaling::default_board()).unwrap();
     let s = sample([2048; 3], 2600); // 650 V
     a.step(&s, foc::Dq::default());
     assert_eq!(a.trip(), None);

@@ -4,7 +4,7 @@
 #![allow(clippy::unwrap_used)] // a test helper that fails is a failed test
 
 use foc::chopper::{BrakeChopper, ChopperParams};
-use foc::{Dq, FocAxis, LoopParams, MotorData, PowerStage, Protection, Trip};
+use foc::{Dq, FocAxis, PowerStage, Trip};
 use plant::{Plant, PlantParams, Shaft};
 
 /// A flywheel of J = 0.01 kg·m² (100 × the servo's rotor), frictionless,
@@ -20,13 +20,7 @@ fn flywheel(speed: f64, r_brake: f64) -> (Plant, FocAxis) {
     }
     let mut pl = Plant::new(p);
     pl.set_shaft(Shaft::Free);
-    let mut a = FocAxis::new(
-        MotorData::default_servo(),
-        LoopParams::default_16k(),
-        p.scaling(),
-        Protection::default_stage(),
-    )
-    .unwrap();
+    let mut a = FocAxis::default_servo(p.scaling()).unwrap();
     a.enable(true);
     (pl, a)
 }

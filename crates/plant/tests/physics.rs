@@ -1,7 +1,7 @@
 //! The plant and the closed current loop against closed-form physics.
 #![allow(clippy::unwrap_used)] // a test helper that fails is a failed test
 
-use foc::{Dq, FocAxis, LoopParams, MotorData, PowerStage, Protection, PwmOut, Trip};
+use foc::{Dq, FocAxis, LoopParams, MotorData, PowerStage, PwmOut, Trip};
 use plant::closed_loop::current_step;
 use plant::{FaultOptions, Phase, Plant, PlantParams, Shaft};
 use std::f64::consts::TAU;
@@ -217,13 +217,7 @@ fn run(pl: &mut Plant, axis: &mut FocAxis, reference: Dq, n: u32) {
 }
 
 fn axis_for(p: &PlantParams) -> FocAxis {
-    let mut a = FocAxis::new(
-        MotorData::default_servo(),
-        LoopParams::default_16k(),
-        p.scaling(),
-        Protection::default_stage(),
-    )
-    .unwrap();
+    let mut a = FocAxis::default_servo(p.scaling()).unwrap();
     a.enable(true);
     a
 }

@@ -263,6 +263,33 @@ impl Link {
     }
 }
 
+/// The power stage's data when the dictionary's configuration generation
+/// moved since `seen` (updated), else `None`: read once per change, not per
+/// cycle.
+pub fn stage_if_moved(objects: &drive_ecat::DriveObjects, seen: &mut u32) -> Option<StageData> {
+    let generation = objects.config_generation();
+    (generation != *seen).then(|| {
+        *seen = generation;
+        StageData::read(objects)
+    })
+}
+
+/// The control cycle's hand-over to the fast task: each axis' command with
+/// its motor data (and the stage's data when they moved); the DC link the
+/// fast task last measured, mV (for 6079h).
+pub fn hand_over(
+    links: &mut [Link; 2],
+    commands: &[AxisCommand; 2],
+    axes: &[drive_ecat::axis::Axis; 2],
+    stage: Option<&StageData>,
+) -> u32 {
+    for ((l, c), a) in links.iter_mut().zip(commands).zip(axes) {
+        l.command(c, a.motor(), stage);
+    }
+    let [a, _] = links;
+    a.dc_link_mv()
+}
+
 /// The control cycle's guard of the fast task: with either axis' supply
 /// missing ([`Link::io`]: the DC link out of its window, or no PWM period
 /// since the last cycle) the gate enable goes low. Where the fast task
