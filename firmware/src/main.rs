@@ -7,9 +7,9 @@
 //! |---|---|---|---|
 //! | `fast` | VADC0_G0_0 (the DC-link result, last of the conversions CCU80 triggers at the PWM centre: 16 kHz) | 4 | `firmware::xmc::fast::FastLoop::period`: both axes' current loops, PWM compare values, trips |
 //! | `sync0` | ERU1_0 (ESC SYNC0 routed through ERU1) | 3 | `node::tasks::sync0` |
-//! | `control` | CCU40_0 (control-cycle timer compare, CCU40 slice 3) | 3 | `node::tasks::control` on the fast task's measurements, its commands to the fast task |
+//! | `control` | CCU40_0 (control-cycle timer compare, CCU40 slice 3) | 3 | `node::tasks::control` on the fast task's measurements, its commands to the fast task; `node::tasks::scope` (one sample when armed) |
 //! | `esc` | ECAT0_0 (ESC PDI interrupt: AL events, SM2/SM3, mailbox) | 2 | `node::tasks::esc_event` |
-//! | `mailbox` | CCU42_0 (a spare interrupt, pended by `esc` and by `idle` when the IP stack's timers are due) | 1 | `node::tasks::mailbox_net` (mailbox request, IP stack over EoE) |
+//! | `mailbox` | CCU42_0 (a spare interrupt, pended by `esc` and by `idle` when the IP stack's timers are due) | 1 | `node::tasks::mailbox_scoped` and the IP stack over EoE (`mailbox_net`'s steps; group T through the scope) |
 //! | `idle` | — | 0 | `node::tasks::background` (a requested save) |
 //!
 //! The ESC is reached through `pdi::mmio::OnChip` over ECAT0's register
@@ -87,6 +87,9 @@ mod app {
         ctimer: ControlTimer,
         /// Between `control` and `fast`: the commands in, the measurements out.
         seam: [Link; 2],
+        /// The scope (group T): sampled by `control`, configured and read
+        /// out by `mailbox`; its buffer is 64 KiB of DSRAM2.
+        scope: tasks::Scope,
     }
 
     #[local]
@@ -110,6 +113,12 @@ mod app {
             }
         };
         let seam = [Link::new(fast.kt()); 2];
+        let Some(words) = firmware::xmc::scope_buffer() else {
+            defmt::error!("init: scope buffer already taken");
+            loop {
+                cortex_m::asm::bkpt();
+            }
+        };
         defmt::info!("init: firmware (XMC4800), SYNC0 on ERU1_0, ESC on ECAT0_0, control on CCU40_0");
         // SAFETY: ECAT0 is this chip's ESC; the window is owned by the `pdi`
         // resource alone, so RTIC serialises every access to it.
@@ -135,6 +144,7 @@ mod app {
                 net,
                 ctimer,
                 seam,
+                scope: tasks::Scope::new(words),
             },
             Local { fast },
         )
@@ -233,7 +243,7 @@ mod app {
     /// axes when its time has come (a compare short of a far start only
     /// arms again) on the fast task's positions and measured currents, its
     /// commands handed to the fast task, the next compare armed.
-    #[task(binds = CCU40_0, priority = 3, shared = [drive, timer, clock, cmd, ctimer, seam], local = [stage_gen: u32 = u32::MAX])]
+    #[task(binds = CCU40_0, priority = 3, shared = [drive, timer, clock, cmd, ctimer, seam, scope], local = [stage_gen: u32 = u32::MAX])]
     fn control(cx: control::Context) {
         let stage_gen = cx.local.stage_gen;
         // `seam` under its own short locks: the fast task waits for a copy,
@@ -245,13 +255,15 @@ mod app {
             cx.shared.clock,
             cx.shared.cmd,
             cx.shared.ctimer,
+            cx.shared.scope,
         )
-            .lock(|drive, timer, clock, cmd, ctimer| {
+            .lock(|drive, timer, clock, cmd, ctimer, scope| {
                 let now = clock.now(DWT::cycle_count());
                 if timer.next_at() <= now {
                     let io = seam.lock(|l| l.each_mut().map(|l| l.io()));
                     guard(&io);
                     *cmd = tasks::control(drive, timer, now, &io);
+                    tasks::scope(drive, scope, &io);
                     let stage = stage_if_moved(drive.objects(), stage_gen);
                     let mv = seam.lock(|l| hand_over(l, cmd, drive.axes(), stage.as_ref()));
                     set_dc_link_voltage(drive.objects_mut(), mv);
@@ -297,11 +309,12 @@ mod app {
     /// one step at most, not the whole run (docs/architecture.md, CPU load).
     /// A hardware task on a spare interrupt, not an async software task: an
     /// `async fn` carries a "resumed after completion" panic path.
-    #[task(binds = CCU42_0, priority = 1, shared = [drive, pdi, clock, net])]
+    #[task(binds = CCU42_0, priority = 1, shared = [drive, pdi, clock, net, scope])]
     fn mailbox(mut cx: mailbox::Context) {
         let now = { &mut cx.shared.clock }.lock(|clock| clock.now(DWT::cycle_count()));
         let request = |cx: &mut mailbox::Context| {
-            (&mut cx.shared.drive, &mut cx.shared.pdi).lock(|drive, pdi| tasks::mailbox(drive, pdi, now))
+            (&mut cx.shared.drive, &mut cx.shared.pdi, &mut cx.shared.scope)
+                .lock(|drive, pdi, scope| tasks::mailbox_scoped(drive, scope, pdi, now))
         };
         let mut ok = request(&mut cx).is_ok();
         if <Net as tasks::NetPoll>::ACTIVE {

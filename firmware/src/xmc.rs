@@ -2,7 +2,8 @@
 //! on PROFINET) share: the PAC as RTIC wants it, the power stage's gate
 //! enable, the power-stage peripherals (`motor`: PWM, ADC, encoders, the
 //! control-cycle timer; crate `xmc-motor`), the current-loop fast task's body
-//! and its board constants (`fast`) and the panic stop.
+//! and its board constants (`fast`), the scope's buffer in DSRAM2 and the
+//! panic stop.
 
 /// The XMC4800 PAC as RTIC expects a device crate: svd2rust 0.14 output lacks
 /// the `interrupt` alias of the `Interrupt` enum, so it is added here.
@@ -262,6 +263,32 @@ pub mod motor {
         // SAFETY: ERU1 is clocked (`init`) and only written here, at start.
         let mut regs = unsafe { Mmio::new() };
         timer::route_sync0(&mut regs);
+    }
+}
+
+/// Words of the scope's trace buffer on the board: 64 KiB, the most group T
+/// reads out (T11: 16 blocks of 4096 bytes).
+pub const SCOPE_WORDS: usize = 16 * 1024;
+
+/// The scope's trace buffer (issue 35), once: 64 KiB of DSRAM2 (section
+/// `.scope_ram` in memory.x, `scope_ram_bytes` in firmware/size-budget.toml),
+/// beside the drive's data in DSRAM1 rather than in it. Zeroed here (the
+/// section is not loaded), so no word is read before it was written.
+#[allow(unsafe_code)]
+pub fn scope_buffer() -> Option<&'static mut [u32]> {
+    use core::sync::atomic::{AtomicBool, Ordering};
+    #[link_section = ".scope_ram"]
+    static mut RAM: core::mem::MaybeUninit<[u32; SCOPE_WORDS]> = core::mem::MaybeUninit::uninit();
+    static TAKEN: AtomicBool = AtomicBool::new(false);
+    if TAKEN.swap(true, Ordering::AcqRel) {
+        return None;
+    }
+    let words = core::ptr::addr_of_mut!(RAM).cast::<u32>();
+    // SAFETY: the flag hands the bank out once, so this is the only
+    // reference to it; every word is written (zeroed) before the slice is made.
+    unsafe {
+        core::ptr::write_bytes(words, 0, SCOPE_WORDS);
+        Some(core::slice::from_raw_parts_mut(words, SCOPE_WORDS))
     }
 }
 

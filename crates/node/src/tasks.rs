@@ -3,9 +3,9 @@
 //! | task | trigger | priority | body |
 //! |---|---|---|---|
 //! | `sync0` | ESC SYNC0 output | 3 | [`sync0`]: acknowledge, PLL measurement |
-//! | `control` | control-cycle timer | 3 | [`control`]: one cycle of both axes |
+//! | `control` | control-cycle timer | 3 | [`control`]: one cycle of both axes, then [`scope`]: the scope's sample |
 //! | `esc` | ESC PDI interrupt (AL event) | 2 | [`esc_event`]: ESM, process data, monitoring |
-//! | `mailbox` | pended by `esc`, and by `idle` when the IP stack's timers are due | 1 | [`mailbox_net`]: one CoE/EoE/FoE request, EMCY, the IP stack ([`mailbox`] without it) |
+//! | `mailbox` | pended by `esc`, and by `idle` when the IP stack's timers are due | 1 | [`mailbox_net`]: one CoE/EoE/FoE request, EMCY, the IP stack ([`mailbox`] without it; the board answers group T through its recorder, [`mailbox_scoped`]) |
 //! | `idle` | — | 0 | [`background`]: a requested save, the flash written outside the drive's lock (QEMU: also the simulated world) |
 //!
 //! `sync0` and `control` share the priority so they never preempt each
@@ -98,6 +98,37 @@ pub fn mailbox_net<P: Pdi, N: NetPoll>(
         drive.poll_mailbox(pdi, now)?;
     }
     Ok(())
+}
+
+/// The drive's scope (group T, issue 35) as the firmware holds it: the
+/// recorder over a buffer in a RAM bank of its own (the board's DSRAM2,
+/// section `.scope_ram`).
+pub type Scope = drive_ecat::scope::Recorder<&'static mut [u32]>;
+
+/// After the control cycle: one scope sample of the cycle just run (the
+/// objects' values and both axes' internal signals on the inputs `io`).
+/// One compare and branch while the recorder is idle or complete.
+pub fn scope<S: AsRef<[u32]> + AsMut<[u32]>>(
+    drive: &Drive,
+    scope: &mut drive_ecat::scope::Recorder<S>,
+    io: &[AxisIo; 2],
+) {
+    scope.sample(drive.objects(), || {
+        let [a, b] = drive.axes();
+        let s = drive_ecat::scope::Signals::of;
+        [s(a, &io[0]), s(b, &io[1])]
+    });
+}
+
+/// [`mailbox`] with the scope: its objects (group T) are read and written
+/// through the recorder (without it they answer 0800 0022h).
+pub fn mailbox_scoped<P: Pdi, S: AsRef<[u32]> + AsMut<[u32]>>(
+    drive: &mut Drive,
+    scope: &mut drive_ecat::scope::Recorder<S>,
+    pdi: &mut P,
+    now: Nanos,
+) -> Result<(), P::Error> {
+    drive.poll_mailbox_with(pdi, now, scope)
 }
 
 /// Background work from the idle loop: a save requested over the bus (A00,

@@ -263,3 +263,109 @@ fn e018_save_job_writes_the_flash_outside_the_drive() {
         "the values at the start of the job"
     );
 }
+
+/// Issue 35, the scope on the firmware's tasks: the recorder the board
+/// holds (`tasks::Scope`'s shape, here over a leaked buffer) is configured
+/// and armed through its objects as the mailbox task would
+/// (`tasks::mailbox_scoped` hands it to the parameter channel), sampled by
+/// `tasks::scope` after each control cycle of the scripted move, and read
+/// back: axis A's following error and speed set-point over the move, the
+/// trigger at the pre-trigger share once the speed set-point passed the level.
+#[test]
+fn issue35_scope_records_the_move_through_the_task_bodies() {
+    use drive_ecat::scope::{Signal, State};
+    use od::Dictionary as _;
+    let words: &'static mut [u32] = Box::leak(vec![0u32; 2048].into_boxed_slice());
+    let mut scope: drive_ecat::scope::Recorder<&'static mut [u32]> = drive_ecat::scope::Recorder::new(words);
+    let mut b = Board::new();
+    // as the mailbox writes them: the dictionary's checks, then the recorder
+    let write = |b: &mut Board, scope: &mut drive_ecat::scope::Recorder<_>, index, sub, v: &[u8]| {
+        b.drive
+            .objects_mut()
+            .with_live(scope)
+            .write(index, sub, v, od::CommState::PreOp)
+            .unwrap()
+    };
+    use drive_ecat::params::{T00, T01, T02, T04, T05, T06, T07, T08, T11};
+    write(
+        &mut b,
+        &mut scope,
+        T01,
+        1,
+        &Signal::SpeedSetpoint.code(0).to_le_bytes(),
+    );
+    write(
+        &mut b,
+        &mut scope,
+        T01,
+        2,
+        &Signal::FollowingError.code(0).to_le_bytes(),
+    );
+    write(&mut b, &mut scope, T02, 0, &[2]);
+    write(&mut b, &mut scope, T04, 0, &100u32.to_le_bytes());
+    write(&mut b, &mut scope, T05, 0, &1u16.to_le_bytes()); // channel 1
+    write(&mut b, &mut scope, T06, 0, &[2]); // rising through the level
+    write(&mut b, &mut scope, T07, 0, &100_000i32.to_le_bytes());
+    write(&mut b, &mut scope, T08, 0, &[25]);
+    write(&mut b, &mut scope, T00, 0, &[1]);
+    assert_eq!(scope.state(), State::Armed);
+    for _ in 0..100_000 {
+        if b.world.finished().is_some() || scope.state() == State::Complete {
+            break;
+        }
+        let event = b.world.next(b.esc.next_sync0_at(), b.timer.next_at());
+        let now = b.world.now();
+        match event {
+            Event::Sync0 => {
+                let _ = b.esc.take_sync0_events(now);
+                tasks::sync0(&mut b.drive, &mut b.timer, &mut b.esc.pdi(), now).unwrap();
+            }
+            Event::Control => {
+                let io = b.world.io();
+                let cmd = tasks::control(&mut b.drive, &mut b.timer, now, &io);
+                tasks::scope(&b.drive, &mut scope, &io);
+                b.world.actuate(&cmd, CYCLE);
+            }
+            Event::Frame => {
+                let _ = b.world.frame(&mut b.esc);
+                tasks::esc_event(&mut b.drive, &mut b.timer, &mut b.esc.pdi(), now).unwrap();
+                tasks::mailbox_scoped(&mut b.drive, &mut scope, &mut b.esc.pdi(), now).unwrap();
+            }
+        }
+    }
+    assert_eq!(
+        scope.state(),
+        State::Complete,
+        "the move's speed set-point passed the level"
+    );
+    assert_eq!((scope.frames(), scope.trigger_index()), (100, 25));
+    let before = scope.value(24, 0).unwrap();
+    let at = scope.value(25, 0).unwrap();
+    assert!(
+        before < 100_000 && at >= 100_000,
+        "trigger sample: {before} then {at}"
+    );
+    let fe_max = (0..100)
+        .filter_map(|i| scope.value(i, 1))
+        .map(i32::unsigned_abs)
+        .max()
+        .unwrap();
+    assert!(
+        fe_max > 0,
+        "the following error of the accelerating axis was recorded"
+    );
+    // the block read the mailbox answers T11 with: sample 0's two channels first
+    let mut buf = [0u8; 4096];
+    let n = b
+        .drive
+        .objects_mut()
+        .with_live(&mut scope)
+        .read(T11, 1, &mut buf, od::CommState::Op)
+        .unwrap();
+    assert_eq!(n, 100 * 2 * 4, "the whole trace: 100 samples of 2 channels");
+    let word = |k: usize| i32::from_le_bytes(buf[4 * k..4 * k + 4].try_into().unwrap());
+    assert_eq!(
+        (word(0), word(2 * 25 + 1)),
+        (scope.value(0, 0).unwrap(), scope.value(25, 1).unwrap())
+    );
+}

@@ -41,7 +41,12 @@ mod measure {
     pub use firmware::systick::{now, ticks};
 
     extern "C" {
-        static _stack_end: u32;
+        /// The end of the statics in SRAM (cortex-m-rt: after `.uninit`). Not
+        /// `_stack_end`: qemu/memory.x inserts `.ccmram` after `.uninit`, so the
+        /// location counter cortex-m-rt takes `_stack_end` from is in the CCM
+        /// RAM (0x1000_0000), and a window bounded by it reached into the
+        /// statics once they grew (the scope's buffer: the ESC pointer painted).
+        static __euninit: u32;
     }
 
     const PAINT: u32 = 0x5A5A_A5A5;
@@ -50,7 +55,7 @@ mod measure {
 
     fn window() -> (usize, usize) {
         // only the address of the linker symbol is taken
-        let end = core::ptr::addr_of!(_stack_end) as usize;
+        let end = core::ptr::addr_of!(__euninit) as usize;
         let sp = cortex_m::register::msp::read() as usize;
         let top = sp.saturating_sub(64) & !3;
         (top.saturating_sub(WINDOW).max(end), top)
@@ -162,7 +167,17 @@ mod app {
         esc_model: u32,
         /// The IP stack on the EoE interface, polled by `mailbox`.
         net: &'static mut NodeNet,
+        /// The scope (group T, issue 35) over [`SCOPE_WORDS`] words, armed
+        /// by the world for the move, sampled after each control cycle.
+        scope: tasks::Scope,
+        /// SysTick ticks of the last scope sample, and whether the recorder
+        /// was recording (armed or triggered) when it was taken.
+        scope_cost: (u32, bool),
     }
+
+    /// Words of this image's scope buffer (the board's is 64 KiB of DSRAM2;
+    /// the cost per sample does not depend on it): 128 samples of 8 channels.
+    const SCOPE_WORDS: usize = 1024;
 
     #[local]
     struct Local {
@@ -181,7 +196,7 @@ mod app {
             defmt::error!("init: resources already taken");
             firmware::semihost::exit(false)
         };
-        let Some(net) = firmware::make_net(drive) else {
+        let (Some(net), Some(words)) = (firmware::make_net(drive), make_scope_buffer()) else {
             defmt::error!("init: resources already taken");
             firmware::semihost::exit(false)
         };
@@ -197,6 +212,8 @@ mod app {
                 esc_model: 0,
                 mailbox_model: 0,
                 net,
+                scope: tasks::Scope::new(words),
+                scope_cost: (0, false),
             },
             Local { world, per_kilo_tick },
         )
@@ -222,6 +239,36 @@ mod app {
         cortex_m::singleton!(: World = World::with_eoe())
     }
 
+    #[inline(never)]
+    fn make_scope_buffer() -> Option<&'static mut [u32]> {
+        static WORDS: Once<[u32; SCOPE_WORDS]> = Once::new();
+        Some(WORDS.take()?.write([0; SCOPE_WORDS]))
+    }
+
+    /// The trace the world arms when the move starts: 8 channels, 4 objects
+    /// of axis A (position actual value 6064h, following error actual value
+    /// 60F4h, torque actual value 6077h, statusword 6041h) and 4 internal
+    /// signals (axis A's speed set-point, speed actual value and iq, axis B's
+    /// following error), every control cycle, at once, single.
+    fn scope_config() -> drive_ecat::scope::Config {
+        use drive_ecat::scope::{Config, Signal};
+        let entry = |index: u32, bits: u32| index << 16 | bits;
+        Config {
+            channels: [
+                entry(0x6064, 32),
+                entry(0x60F4, 32),
+                entry(0x6077, 16),
+                entry(0x6041, 16),
+                Signal::SpeedSetpoint.code(0),
+                Signal::SpeedActual.code(0),
+                Signal::Iq.code(0),
+                Signal::FollowingError.code(1),
+            ],
+            count: 8,
+            ..Config::default()
+        }
+    }
+
     /// Pends `irq` and lets it run (QEMU takes a pended interrupt only
     /// after a barrier).
     fn run(irq: Interrupt) {
@@ -232,7 +279,7 @@ mod app {
 
     /// The simulated world: advances time event by event and pends the task
     /// of each event; logs the master's progress and the figures.
-    #[idle(shared = [drive, timer, esc, clock, io, cmd, cost, esc_model, mailbox_model], local = [world, per_kilo_tick])]
+    #[idle(shared = [drive, timer, esc, clock, io, cmd, cost, esc_model, mailbox_model, scope, scope_cost], local = [world, per_kilo_tick])]
     fn idle(mut cx: idle::Context) -> ! {
         let world = &mut **cx.local.world;
         let insn = |ticks: u32| (u64::from(ticks) * u64::from(*cx.local.per_kilo_tick) / 1000) as u32;
@@ -240,6 +287,7 @@ mod app {
         let (mut mailbox_cost, mut mailbox_own, mut mailbox_hold) =
             (Figure::default(), Figure::default(), Figure::default());
         let mut esc_own = Figure::default();
+        let (mut scope_armed, mut scope_idle) = (Figure::default(), Figure::default());
         let mut stack = [0u32; 3];
         let mut moving = false;
         let mut events: u32 = 0;
@@ -274,6 +322,10 @@ mod app {
                     if moving {
                         control.add(insn(cx.shared.cost.lock(|c| c[0])));
                     }
+                    match cx.shared.scope_cost.lock(|c| *c) {
+                        (t, true) => scope_armed.add(insn(t)),
+                        (t, false) => scope_idle.add(insn(t)),
+                    }
                 }
                 Event::Frame => {
                     let progress = cx.shared.esc.lock(|e| world.frame(e));
@@ -304,6 +356,12 @@ mod app {
                         Progress::Sync0(ns) => defmt::info!("master: SYNC0 every {=u32} ns", ns),
                         Progress::Enabled => {
                             moving = true;
+                            let armed = cx.shared.scope.lock(|s| {
+                                s.configure(scope_config()).and_then(|()| s.arm()).is_ok()
+                            });
+                            if !armed {
+                                defmt::error!("scope: configuration refused");
+                            }
                             defmt::info!("master: both axes Operation enabled (csp), moving")
                         }
                         Progress::Moved {
@@ -379,6 +437,18 @@ mod app {
             stack[1],
             stack[2]
         );
+        defmt::info!(
+            "figure: scope sample (8 channels: 4 objects, 4 signals) while recording: mean {=u32} max {=u32} instructions over {=u32} samples",
+            scope_armed.mean(),
+            scope_armed.max,
+            scope_armed.n
+        );
+        defmt::info!(
+            "figure: scope sample while idle or complete: mean {=u32} max {=u32} instructions over {=u32} cycles",
+            scope_idle.mean(),
+            scope_idle.max,
+            scope_idle.n
+        );
         defmt::info!("figure: control cycles run {=u32}", world.cycles);
         if ok {
             defmt::info!("done: end-to-end sequence complete, exit 0");
@@ -398,14 +468,28 @@ mod app {
     }
 
     /// The control-cycle timer: one cycle of both axes.
-    #[task(binds = EXTI1, priority = 3, shared = [drive, timer, clock, io, cmd, cost])]
+    /// Then the scope's sample (its cost measured on its own, less the
+    /// measurement's: the control figure stays the cycle's).
+    #[task(binds = EXTI1, priority = 3, shared = [drive, timer, clock, io, cmd, cost, scope, scope_cost])]
     fn control(cx: control::Context) {
+        use drive_ecat::scope::State;
         let now = { cx.shared.clock }.lock(|c| *c);
         let t0 = measure::now();
-        let cmd = (cx.shared.drive, cx.shared.timer, cx.shared.io)
-            .lock(|drive, timer, io| tasks::control(drive, timer, now, io));
-        let t = measure::ticks(t0, measure::now());
+        let (cmd, sample) = (cx.shared.drive, cx.shared.timer, cx.shared.io, cx.shared.scope).lock(
+            |drive, timer, io, scope| {
+                let cmd = tasks::control(drive, timer, now, io);
+                let recording = matches!(scope.state(), State::Armed | State::Triggered);
+                let s0 = measure::now();
+                let s1 = measure::now();
+                tasks::scope(drive, scope, io);
+                let s2 = measure::now();
+                let t = measure::ticks(s1, s2).saturating_sub(measure::ticks(s0, s1));
+                (cmd, (t, recording, measure::ticks(s0, s2)))
+            },
+        );
+        let t = measure::ticks(t0, measure::now()).saturating_sub(sample.2);
         { cx.shared.cost }.lock(|c| c[0] = t);
+        { cx.shared.scope_cost }.lock(|c| *c = (sample.0, sample.1));
         { cx.shared.cmd }.lock(|c| *c = cmd);
     }
 

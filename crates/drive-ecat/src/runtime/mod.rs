@@ -367,10 +367,22 @@ impl<F: Flash, B: Flash> Drive<F, B> {
     /// sent. A save it requests waits for the idle loop's
     /// [`begin_save`](Self::begin_save).
     pub fn poll_mailbox<P: Pdi>(&mut self, pdi: &mut P, now: Nanos) -> Result<(), P::Error> {
+        self.poll_mailbox_with(pdi, now, &mut NoLive)
+    }
+
+    /// [`poll_mailbox`](Self::poll_mailbox) with the shell's provider of
+    /// further live objects (the board's scope recorder: group T is read and
+    /// written through it, as [`poll_with`](Self::poll_with) does in one poll).
+    pub fn poll_mailbox_with<P: Pdi, L: LiveValues>(
+        &mut self,
+        pdi: &mut P,
+        now: Nanos,
+        extra: &mut L,
+    ) -> Result<(), P::Error> {
         self.update_live();
         let mut live = Live {
             diag: &mut self.diag,
-            extra: &mut NoLive,
+            extra,
         };
         let mut foe = FirmwareFoe::new(self.boot.as_mut());
         self.slave.poll_mailbox_only(
