@@ -38,6 +38,12 @@
 //! - a released phase short of it: [`result::NOT_RELEASED`] (11): the brake
 //!   stays closed when commanded open (a stuck brake, no brake supply).
 //!
+//! The commanded torque changes by at most a twentieth of the peak torque
+//! a cycle; the brake opens for a released phase only once the torque is
+//! within its limit (the shaft stands on the brake meanwhile), and after a
+//! failed phase the torque winds down to 0 on the applied brake before the
+//! failure shows and the axis' own control takes over.
+//!
 //! The enable going away before the end aborts it ([`result::ABORTED`]).
 //! The result, the smallest travel of a grind and of a released phase and
 //! the largest grinding torque land in B301.
@@ -65,6 +71,11 @@ const P_SHARE: f32 = 0.5;
 /// The speed rule's I, N·m per cycle at 100 % speed error, as a share of the
 /// peak torque.
 const I_SHARE: f32 = 0.01;
+/// Cycles over which the commanded torque may change by the peak torque:
+/// its changes are slewed (a step of several amperes to nothing would leave
+/// a current-deviation window, `foc::CurrentDeviation`, with the step's
+/// error and hardly any reference: event 69).
+const SLEW_CYCLES: f32 = 20.0;
 /// Cycles of one round.
 const ROUND_CYCLES: u32 = GRIND_CYCLES + RELEASE_CYCLES;
 /// Cycles of the whole action.
@@ -106,6 +117,10 @@ pub struct GrindBrake {
     cycles: u32,
     /// The speed rule's integral part, N·m.
     integral_nm: f32,
+    /// The torque commanded last, N·m.
+    torque_nm: f32,
+    /// A phase failed with this code: the torque winds down, then the end.
+    failing: Option<u8>,
     /// The sum of the torques over the grind phase's second half, N·m.
     sum_nm: f32,
     /// The running phase's travel, increments.
@@ -151,6 +166,8 @@ impl GrindBrake {
             last_inc: None,
             cycles: 0,
             integral_nm: 0.0,
+            torque_nm: 0.0,
+            failing: None,
             sum_nm: 0.0,
             travel_inc: 0,
             figures: GrindFigures {
@@ -197,7 +214,7 @@ impl GrindBrake {
         };
         *slot = (*slot).min(travel);
         if (travel as f32) < min {
-            self.outcome = GrindOutcome::Failed(code, self.figures());
+            self.failing = Some(code);
             return true;
         }
         false
@@ -220,6 +237,10 @@ impl GrindBrake {
         let delta = position_inc.wrapping_sub(self.last_inc.unwrap_or(position_inc));
         self.last_inc = Some(position_inc);
         self.travel_inc = self.travel_inc.saturating_add(i64::from(delta));
+        let step = self.peak_nm / SLEW_CYCLES;
+        if let Some(code) = self.failing {
+            return self.wind_down(code, step);
+        }
         let k = self.cycles;
         // the phase that ended with the last cycle
         if k > 0 && part(k) != part(k - 1) {
@@ -229,7 +250,7 @@ impl GrindBrake {
                 Part::Stop => (Part::Stop, STOP_CYCLES),
             };
             if self.end_phase(ended, len) {
-                return None;
+                return self.failing.and_then(|code| self.wind_down(code, step));
             }
         }
         if k >= TOTAL_CYCLES {
@@ -246,9 +267,13 @@ impl GrindBrake {
         let e = (SPEED_INC as f32 - delta as f32) / SPEED_INC as f32;
         let integral = self.integral_nm + self.peak_nm * I_SHARE * e;
         self.integral_nm = integral.max(0.0).min(limit);
-        let torque = (self.integral_nm + self.free_nm * P_SHARE * e)
+        let target = (self.integral_nm + self.free_nm * P_SHARE * e)
             .max(0.0)
             .min(limit);
+        let torque = target.max(self.torque_nm - step).min(self.torque_nm + step);
+        self.torque_nm = torque;
+        // the brake opens once the torque is within the released limit
+        let release = release && torque <= self.free_nm;
         if now == Part::Grind && k % ROUND_CYCLES >= GRIND_CYCLES / 2 {
             self.sum_nm += torque;
         }
@@ -258,6 +283,23 @@ impl GrindBrake {
             torque_nm: torque,
             power_stage: true,
             brake_release: release,
+            injection: None,
+        })
+    }
+
+    /// A cycle of the wind-down after a failed phase: the brake applied, the
+    /// torque towards 0 by `step`; at 0 the failure (`code`) shows.
+    fn wind_down(&mut self, code: u8, step: f32) -> Option<AxisCommand> {
+        if self.torque_nm <= 0.0 {
+            self.failing = None;
+            self.outcome = GrindOutcome::Failed(code, self.figures());
+            return None;
+        }
+        self.torque_nm = (self.torque_nm - step).max(0.0);
+        Some(AxisCommand {
+            torque_nm: self.torque_nm,
+            power_stage: true,
+            brake_release: false,
             injection: None,
         })
     }

@@ -288,11 +288,14 @@ fn e140_b301_grind_brake_sequence_and_its_failures() {
     // the brake pattern: closed 500, open 250, ×4, closed 100
     let edges = releases.windows(2).filter(|w| w[0] != w[1]).count();
     assert_eq!(edges as u32, 2 * ROUNDS, "{ROUNDS} releases: {edges} edges");
-    assert_eq!(
-        releases.iter().filter(|r| **r).count() as u32,
-        ROUNDS * RELEASE_CYCLES
+    // the brake opens once the torque is down to the released limit
+    let open = releases.iter().filter(|r| **r).count() as u32;
+    assert!(
+        (ROUNDS * (RELEASE_CYCLES - 12)..=ROUNDS * RELEASE_CYCLES).contains(&open),
+        "{open}"
     );
-    assert!(!releases[0] && releases[GRIND_CYCLES as usize] && !releases[n as usize - 1]);
+    assert!(!releases[0] && releases[GRIND_CYCLES as usize + 12] && !releases[n as usize - 1]);
+    assert!(!releases[GRIND_CYCLES as usize], "the torque first");
     let GrindOutcome::Done(f) = o else { panic!("{o:?}") };
     let full = |cycles: u32| (SPEED_INC as u32 * cycles) as f32;
     std::println!("B301 healthy: {f:?}");
@@ -308,7 +311,9 @@ fn e140_b301_grind_brake_sequence_and_its_failures() {
     let GrindOutcome::Failed(code, f) = o else {
         panic!("{o:?}")
     };
-    assert_eq!((code, n), (result::STALLED, GRIND_CYCLES), "{f:?}");
+    // then 20 cycles (21: rounding) winding 3.9 N·m down on the brake
+    assert_eq!(code, result::STALLED, "{f:?}");
+    assert!((GRIND_CYCLES + 20..=GRIND_CYCLES + 21).contains(&n), "{n}");
     assert_eq!(f.grind_travel_inc, 0);
     assert!((f.grind_torque_nm - 3.9).abs() < 1e-3, "the peak: {f:?}");
     // a stuck brake: ground, but not released
@@ -316,11 +321,9 @@ fn e140_b301_grind_brake_sequence_and_its_failures() {
     let GrindOutcome::Failed(code, f) = o else {
         panic!("{o:?}")
     };
-    assert_eq!(
-        (code, n),
-        (result::NOT_RELEASED, GRIND_CYCLES + RELEASE_CYCLES),
-        "{f:?}"
-    );
+    assert_eq!(code, result::NOT_RELEASED, "{f:?}");
+    let wound = n - (GRIND_CYCLES + RELEASE_CYCLES);
+    assert!(wound <= 2, "at most 0.33 N·m to wind down: {wound}");
     assert!(f.release_travel_inc < SPEED_INC as u32 * 10, "{f:?}");
 }
 
