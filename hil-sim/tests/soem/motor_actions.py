@@ -171,9 +171,9 @@ def test_brake(axis):
 def grind_brake(axis):
     seen, took = start(axis, B301_SEL)
     done = 100 | B301_SEL << 8 | DONE << 12
-    say(f"B301: A69 {[f'{s:04X}' for s in seen]}, statusword {axis.sw:#06x}")
+    # A69 first: a fault's EMCY would come with the first SDO read
+    check(seen[-1] == done, f"B301: A69 ends {seen[-1]:04X}h, expected {done:04X}h; seen {[f'{s:04X}' for s in seen]}; statusword {axis.sw:#06x}")
     result, grind, released, torque = (L.sdo_u(axis.s, B301, k) for k in (1, 2, 3, 4))
-    check(seen[-1] == done, f"B301: A69 ends {seen[-1]:04X}h, expected {done:04X}h; seen {[f'{s:04X}' for s in seen]}; B301[0] {result}")
     check(result == 0, f"B301[0] result {result}, expected 0 (ground in)")
     check(grind >= 0.8 * (1 << 19), f"B301: a grind phase turned the shaft {grind} inc only")
     check(released >= 0.8 * (1 << 18), f"B301: a released phase turned the shaft {released} inc only")
