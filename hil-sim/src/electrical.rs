@@ -329,7 +329,10 @@ impl ElectricalAxis {
 
     /// One control cycle of length `dt` under the command last given
     /// ([`CurrentControl::command`]): [`ElectricalAxis::step`] with its torque
-    /// (none with the power stage off), power stage and brake.
+    /// (none with the power stage off), power stage and brake. With the
+    /// plant's `encoder_reversed` fault the position and velocity the drive
+    /// reads count the other way too (as the current loop's sample does; the
+    /// switch and probe edges keep the rotor's own positions).
     pub fn run(&mut self, motor: &mut Motor, dt: Nanos) -> MotorOutputs {
         let c = self.command;
         let torque = if c.power_stage {
@@ -337,7 +340,12 @@ impl ElectricalAxis {
         } else {
             0.0
         };
-        self.step(motor, torque, c.power_stage, !c.brake_release, dt)
+        let mut out = self.step(motor, torque, c.power_stage, !c.brake_release, dt);
+        if self.plant.params().faults.encoder_reversed {
+            out.position_inc = out.position_inc.wrapping_neg();
+            out.velocity_inc_per_s = -out.velocity_inc_per_s;
+        }
+        out
     }
 
     /// One control cycle of length `dt`: the current loop runs with iq =

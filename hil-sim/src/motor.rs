@@ -132,6 +132,9 @@ pub struct MotorParams {
     pub brake_holding_torque_nm: f64,
     /// Brake state before the first command has taken effect.
     pub initial_brake_engaged: bool,
+    /// A fault: the brake stays closed whatever is commanded (a stuck
+    /// armature, no brake supply); it brakes with its holding torque.
+    pub brake_stuck: bool,
     /// Index pulse position within a revolution, increments (taken modulo 2^20).
     pub index_offset_inc: i64,
     /// Encoder count at start, increments (absolute, unwrapped).
@@ -174,6 +177,7 @@ impl MotorParams {
             max_torque_nm: 3.9,
             brake_holding_torque_nm: 2.0,
             initial_brake_engaged: false,
+            brake_stuck: false,
             index_offset_inc: 0,
             initial_position_inc: 0,
             end_stops_inc: None,
@@ -506,7 +510,7 @@ impl Motor {
         let p = &self.params;
         let j = p.inertia_kg_m2.max(1.0e-9);
         let b = p.viscous_friction_nm_s_per_rad.max(0.0);
-        let brake = if act.brake {
+        let brake = if act.brake || p.brake_stuck {
             p.brake_holding_torque_nm.max(0.0)
         } else {
             0.0

@@ -124,7 +124,10 @@ fn c038_e089_soem_current_limit_and_power_stage_i2t_on_the_electrical_plant() {
 /// commutation offset (0.3 rad: `--plant-offset`) within 0.5° electrical
 /// into B05; B43 (no enable) measures the three phases within 3 % of R;
 /// B40 passes the plant as wired (the pole pairs seen = B10); B300 (test
-/// brake) holds the rated torque both ways within 1/360 rev.
+/// brake) holds the rated torque both ways within 1/360 rev; B301 (grind
+/// brake) turns the shaft at 60 rpm against the applied brake and released,
+/// each phase at least 0.8 of what that speed gives, its grinding torque
+/// the plant's brake (2 N·m, unknown to the drive) plus friction.
 #[test]
 fn e140_e141_soem_motor_actions_identify_the_plants_r_l_and_commutation_offset() {
     let python = match pysoem_python() {

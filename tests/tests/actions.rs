@@ -51,8 +51,13 @@ fn e060_e140_save_values_through_a75_and_a69_in_the_process_data() {
 
 /// E-141: a motor test (test winding, 1101b) needs E48 = 2 (ready to switch
 /// on): with the axis switch-on disabled it is refused and A69 says so.
+/// E-140: in Ready to switch on, the actions this drive does not have answer
+/// "not available" with their selector: grind brake 2 (B302, 0110b: one
+/// brake per axis), the safety's brake test (S18, 1001b: no safety module),
+/// reset memorised values (A37, 0011b) and delete limit-switch memory (I52,
+/// 1000b: nothing memorised).
 #[test]
-fn e141_test_winding_refused_outside_ready_to_switch_on() {
+fn e141_e140_test_winding_refused_and_b302_s18_a37_i52_not_available() {
     let sim = line(1);
     with_master(&sim, async |md, clock| {
         let (group, (a75, a69)) = op_with_actions(md, clock).await;
@@ -64,7 +69,7 @@ fn e141_test_winding_refused_outside_ready_to_switch_on() {
         let s = a69_of(sd.io_raw().inputs(), a69);
         assert_eq!(s, 0b1101 << 8 | state::REFUSED << 12, "{s:04X}h");
         // shutdown (6040h = 6): ready to switch on; the precondition holds, and
-        // grind brake (0101b) is not available on this drive
+        // grind brake 2 (0110b) and the others are not available on this drive
         {
             let mut out = sd.outputs_raw_mut();
             out[0..2].copy_from_slice(&6u16.to_le_bytes());
@@ -72,10 +77,16 @@ fn e141_test_winding_refused_outside_ready_to_switch_on() {
         }
         cycles(md, &group, &sim, 20).await;
         assert_eq!(sd.sdo_read::<u8>(drive_ecat::params::E48, 0).await.unwrap(), 2);
-        sd.outputs_raw_mut()[a75] = 0b0101 << 1 | 1;
-        cycles(md, &group, &sim, 5).await;
-        let s = a69_of(sd.io_raw().inputs(), a69);
-        assert_eq!(s, 0b0101 << 8 | state::NOT_AVAILABLE << 12, "{s:04X}h");
+        for selector in [0b0110u8, 0b1001, 0b0011, 0b1000] {
+            sd.outputs_raw_mut()[a75] = selector << 1 | 1;
+            cycles(md, &group, &sim, 5).await;
+            let s = a69_of(sd.io_raw().inputs(), a69);
+            let want = u16::from(selector) << 8 | state::NOT_AVAILABLE << 12;
+            assert_eq!(s, want, "{selector:04b}: {s:04X}h");
+            sd.outputs_raw_mut()[a75] = 0;
+            cycles(md, &group, &sim, 3).await;
+            assert_eq!(a69_of(sd.io_raw().inputs(), a69), 0, "idle");
+        }
     });
 }
 

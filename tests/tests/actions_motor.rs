@@ -297,15 +297,26 @@ fn e140_b43_test_winding_passes_a_balanced_and_fails_an_unbalanced_or_open_windi
 /// the enable: on the plant as wired it passes (the encoder counts
 /// 2^20/4 = 262,144 increments, within 1 %, for one electrical turn of the
 /// field: 4 pole pairs, B10); phases V and W swapped make the rotor turn
-/// backwards (result 7), an open phase carries no current (result 2), a motor
-/// of 5 pole pairs where B10 says 4 counts 2^20/5 (result 8). A69 says done
-/// or failed.
+/// backwards (result 7), an encoder counting the other way (the plant's
+/// `encoder_reversed`: the rotor turns forward, the count goes down) fails
+/// the same (7, the count about −2^20/4), an open phase carries no current
+/// (result 2), a motor of 5 pole pairs where B10 says 4 counts 2^20/5
+/// (result 8). A69 says done or failed.
 #[test]
 fn e140_b40_test_phase_passes_the_wiring_and_fails_swapped_or_open_phases_and_wrong_pole_pairs() {
     use plant::{FaultOptions, Phase};
     let none = FaultOptions::NONE;
-    let cases: [(&str, FaultOptions, u32, u8); 4] = [
+    let cases: [(&str, FaultOptions, u32, u8); 5] = [
         ("as wired", none, 4, 0),
+        (
+            "encoder reversed",
+            FaultOptions {
+                encoder_reversed: true,
+                ..none
+            },
+            4,
+            7,
+        ),
         (
             "V and W swapped",
             FaultOptions {
@@ -362,7 +373,17 @@ fn e140_b40_test_phase_passes_the_wiring_and_fails_swapped_or_open_phases_and_wr
                         "{what}: {per_turn} vs {expected}"
                     );
                 }
-                7 => assert!(per_turn < 0, "{what}: {per_turn}"),
+                7 => {
+                    assert!(per_turn < 0, "{what}: {per_turn}");
+                    if fault.encoder_reversed {
+                        // the rotor did its electrical turn, counted backwards
+                        let expected = -f64::from(1u32 << 20) / 4.0;
+                        assert!(
+                            (f64::from(per_turn) - expected).abs() < 0.01 * -expected,
+                            "{what}: {per_turn} vs {expected}"
+                        );
+                    }
+                }
                 _ => {}
             }
         });
@@ -375,16 +396,25 @@ fn e140_b40_test_phase_passes_the_wiring_and_fails_swapped_or_open_phases_and_wr
 /// 1/360 rev (result 0, done, B300[1] the play seen, B300[2] 1300 mN·m); a
 /// worn brake holding 1.0 N·m slips under the test torque: result 9, failed,
 /// the movement beyond 1/360 rev, and the axis back under its own control
-/// (Operation enabled, the brake released).
+/// (Operation enabled, the brake released). A stuck brake (the plant's
+/// `brake_stuck`) holds as a good one does: B300 keeps the brake applied
+/// throughout, so it passes (result 0); B301's released phases find it.
 #[test]
 fn e140_b300_test_brake_holds_the_rated_torque_or_fails_on_a_worn_brake() {
     use drive_ecat::params::B300;
     const TOLERANCE_INC: u32 = (1 << 20) / 360;
-    for (holding_nm, code, end) in [(2.0, 0u8, state::DONE), (1.0, 9, state::FAILED)] {
+    for (holding_nm, stuck, code, end) in [
+        (2.0, false, 0u8, state::DONE),
+        (1.0, false, 9, state::FAILED),
+        (2.0, true, 0, state::DONE),
+    ] {
         let sim = electrical_line(3.6, 0.012);
-        sim.borrow_mut().drives_mut()[0].motors[0]
-            .params_mut()
-            .brake_holding_torque_nm = holding_nm;
+        {
+            let mut s = sim.borrow_mut();
+            let p = s.drives_mut()[0].motors[0].params_mut();
+            p.brake_holding_torque_nm = holding_nm;
+            p.brake_stuck = stuck;
+        }
         with_master(&sim, async |md, clock| {
             let (group, io) = op_with_actions(md, clock).await;
             let sd = group.subdevice(md, 0).unwrap();
@@ -399,11 +429,96 @@ fn e140_b300_test_brake_holds_the_rated_torque_or_fails_on_a_worn_brake() {
                 1300,
                 "the test torque, mN·m"
             );
-            println!("B300 brake holding {holding_nm} N·m: result {code}, largest movement {moved} inc");
+            println!("B300 brake holding {holding_nm} N·m (stuck: {stuck}): result {code}, largest movement {moved} inc");
             if code == 0 {
                 assert!(moved <= TOLERANCE_INC, "held: {moved} inc");
             } else {
                 assert!(moved > TOLERANCE_INC, "slipped: {moved} inc");
+            }
+            // the axis' own control again: enabled
+            assert_eq!(sd.sdo_read::<u8>(E48, 0).await.unwrap(), 4, "Operation enabled");
+        });
+    }
+}
+
+/// E-140, E-141 (B301): "grind brake" started in Ready to switch on runs
+/// after the enable: 4 rounds of 0.5 s grinding (the brake applied, 60 rpm
+/// against it) and 0.25 s released, then 0.1 s stopped on the brake. The
+/// plant's brake slides at 2 N·m (a figure the drive does not know): done,
+/// every grind phase turning the shaft at least 0.8 of 60 rpm × 0.5 s
+/// (2^19 inc), every released one 0.8 of its 2^18, the grinding torque
+/// B301[3] the brake's 2 N·m plus the friction (within 2.0…2.3 N·m), and the
+/// rotor's own travel (the mechanics, not the encoder) at least
+/// 0.8 × 3 revolutions. A brake holding 5 N·m, beyond the 3.9 N·m peak
+/// torque, stalls the first grind phase: result 10, the shaft not turned,
+/// the grinding torque the peak. A stuck brake (the plant's `brake_stuck`:
+/// closed whatever is commanded) is ground but fails the first released
+/// phase: result 11, its travel below a tenth of what the healthy brake's
+/// was. A69 says done or failed; the axis is back under its own control.
+#[test]
+fn e140_b301_grind_brake_grinds_a_healthy_brake_and_fails_a_stalled_or_stuck_one() {
+    use drive_ecat::params::B301;
+    let full_grind = f64::from(1u32 << 19);
+    let full_released = f64::from(1u32 << 18);
+    let cases: [(&str, f64, bool, u8); 3] = [
+        ("healthy", 2.0, false, 0),
+        ("holding 5 N·m", 5.0, false, 10),
+        ("stuck", 2.0, true, 11),
+    ];
+    for (what, holding_nm, stuck, code) in cases {
+        let sim = electrical_line(3.6, 0.012);
+        {
+            let mut s = sim.borrow_mut();
+            let p = s.drives_mut()[0].motors[0].params_mut();
+            p.brake_holding_torque_nm = holding_nm;
+            p.brake_stuck = stuck;
+        }
+        let rotor_before = sim.borrow().drives()[0].motors[0].position_inc_i64();
+        with_master(&sim, async |md, clock| {
+            let (group, io) = op_with_actions(md, clock).await;
+            let sd = group.subdevice(md, 0).unwrap();
+            // cst (10): the rotor turns, no position is held
+            sd.outputs_raw_mut()[2] = 10;
+            let seen = run_action(&sim, &group, md, io, 0b0101, 5000).await;
+            let last = *seen.last().unwrap();
+            let want = if code == 0 { state::DONE } else { state::FAILED };
+            let b301: Vec<u32> = {
+                let mut v = Vec::new();
+                for k in 2..=4 {
+                    v.push(sd.sdo_read::<u32>(B301, k).await.unwrap());
+                }
+                v
+            };
+            let (grind, released, torque_mnm) = (b301[0], b301[1], b301[2]);
+            let rotor = sim.borrow().drives()[0].motors[0].position_inc_i64() - rotor_before;
+            println!(
+                "B301 {what}: result {code}, smallest grind travel {grind} inc, released {released} inc, grinding torque {torque_mnm} mN·m, rotor travel {rotor} inc"
+            );
+            assert_eq!(last >> 12, want, "{what}: A69 {seen:04X?}");
+            assert_eq!(last >> 8 & 0xF, 0b0101, "the selector shown");
+            assert_eq!(sd.sdo_read::<u8>(B301, 1).await.unwrap(), code, "{what}: B301[0]");
+            match code {
+                0 => {
+                    assert!(f64::from(grind) >= 0.8 * full_grind, "{what}: {grind}");
+                    assert!(f64::from(released) >= 0.8 * full_released, "{what}: {released}");
+                    assert!((2000..=2300).contains(&torque_mnm), "{what}: {torque_mnm} mN·m");
+                    assert!(
+                        rotor as f64 >= 0.8 * 3.0 * f64::from(1u32 << 20),
+                        "{what}: the rotor turned {rotor} inc"
+                    );
+                }
+                10 => {
+                    assert!(f64::from(grind) < 0.25 * full_grind, "{what}: {grind}");
+                    assert!(rotor.abs() < 1 << 12, "{what}: the rotor turned {rotor} inc");
+                    assert!((3800..=3900).contains(&torque_mnm), "{what}: {torque_mnm} mN·m");
+                }
+                _ => {
+                    assert!(f64::from(grind) >= 0.8 * full_grind, "{what}: ground: {grind}");
+                    assert!(
+                        f64::from(released) < 0.1 * full_released,
+                        "{what}: not released: {released}"
+                    );
+                }
             }
             // the axis' own control again: enabled
             assert_eq!(sd.sdo_read::<u8>(E48, 0).await.unwrap(), 4, "Operation enabled");

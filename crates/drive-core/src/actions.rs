@@ -12,8 +12,8 @@
 //! bits 12–15 its [`state`].
 //!
 //! The motor actions that need the power stage (B40 test phase, B41
-//! calibrate motor, B42/B49
-//! optimise current controller, B43 test winding: [`crate::tuning`]) start
+//! calibrate motor, B42/B49 optimise current controller, B43 test winding,
+//! B300 test brake, B301 grind brake: [`crate::tuning`]) start
 //! in Ready to switch on and run once the master enabled the axis (E-141;
 //! B43 at once, without an enable): their measurement runs in the
 //! control cycle ([`Actions::control`], which replaces the axis' command),
@@ -25,9 +25,10 @@
 //! or mapped in another channel, starts nothing ([`state::NOT_ACTIVATED`]).
 
 use crate::axis::{AxisCommand, AxisIo};
-use crate::params::{B05, B10, B300, B40, B41, B42, B43, B52, B53, B62, E48};
+use crate::params::{B05, B10, B300, B301, B40, B41, B42, B43, B52, B53, B62, E48};
 use crate::tuning::align::{AlignOutcome, Alignment};
 use crate::tuning::brake::{BrakeOutcome, BrakeTest};
+use crate::tuning::grind::{GrindBrake, GrindFigures, GrindOutcome};
 use crate::tuning::phase::{PhaseOutcome, PhaseTest};
 use crate::tuning::winding::{WindingOutcome, WindingTest};
 use crate::tuning::{CurrentTuning, Outcome};
@@ -50,8 +51,9 @@ pub mod state {
     pub const DONE: u16 = 2;
     /// The precondition on E48 does not hold (E-141): not started.
     pub const REFUSED: u16 = 3;
-    /// This drive cannot run the action (A37, I52: nothing to reset; the
-    /// brake actions: not built): not started.
+    /// This drive cannot run the action (A37, I52: nothing to reset; B302:
+    /// a second brake, S18: a safety module, neither of which it has): not
+    /// started.
     pub const NOT_AVAILABLE: u16 = 4;
     /// Started and failed (e.g. the save found the store broken).
     pub const FAILED: u16 = 5;
@@ -171,6 +173,8 @@ enum Measurement {
     Phase(PhaseTest),
     /// B300.
     Brake(BrakeTest),
+    /// B301.
+    Grind(GrindBrake),
 }
 
 /// The action unit of both axes: the last Execute bits and what runs.
@@ -229,6 +233,7 @@ impl Actions {
             Measurement::Winding(w) => w.cycle(e48, io.current.as_ref()),
             Measurement::Phase(p) => p.cycle(e48, io.position_inc, io.current.as_ref()),
             Measurement::Brake(b) => b.cycle(e48, io.position_inc),
+            Measurement::Grind(g) => g.cycle(e48, io.position_inc),
         }
     }
 
@@ -267,6 +272,7 @@ impl Actions {
                         Some(Measurement::Winding(w)) => follow_winding(objects, w, axis, selector),
                         Some(Measurement::Phase(p)) => follow_phase(objects, p, axis, selector),
                         Some(Measurement::Brake(b)) => follow_brake(objects, b, axis, selector),
+                        Some(Measurement::Grind(g)) => follow_grind(objects, g, axis, selector),
                         None => None,
                     },
                     _ => follow(objects, r, selector),
@@ -370,9 +376,21 @@ fn start(
             a.running = Some(Running::Tuning);
             status(0, selector, state::RUNNING)
         }
+        Action::GrindBrake => {
+            let rated_mnm = objects.get(0x6076 + cia(axis), 0).unwrap_or(0);
+            let max_permille = objects.get(0x6072 + cia(axis), 0).unwrap_or(0);
+            let rated_nm = rated_mnm as f32 * 1e-3;
+            a.tuning = Some(Measurement::Grind(GrindBrake::new(
+                rated_nm,
+                rated_nm * max_permille as f32 * 1e-3,
+            )));
+            a.running = Some(Running::Tuning);
+            status(0, selector, state::RUNNING)
+        }
         // A37 (the memorised extreme values) and I52 (the limit-switch
-        // memory) hold nothing in this drive; grinding the brake (B301,
-        // B302) and the safety's brake test (S18) are not built
+        // memory) hold nothing in this drive; a second brake (B302) it does
+        // not have (one brake per axis), and the safety's brake test (S18)
+        // belongs to a safety module it does not have
         _ => status(0, selector, state::NOT_AVAILABLE),
     }
 }
@@ -477,6 +495,22 @@ fn follow_brake(objects: &mut DriveObjects, b: &BrakeTest, axis: usize, selector
     };
     let _ = objects.set(B300 + off, 2, i64::from(moved));
     let _ = objects.set(B300 + off, 1, i64::from(code));
+    Some(status(if st == state::DONE { 100 } else { 0 }, selector, st))
+}
+
+/// A69 of a running B301; at its end its result and figures in B301.
+fn follow_grind(objects: &mut DriveObjects, g: &GrindBrake, axis: usize, selector: u8) -> Option<u16> {
+    let off = offset(axis);
+    let (code, f, st): (u8, GrindFigures, u16) = match g.outcome() {
+        GrindOutcome::Running(p) => return Some(status(u16::from(p), selector, state::RUNNING)),
+        GrindOutcome::Done(f) => (crate::tuning::result::OK, f, state::DONE),
+        GrindOutcome::Failed(code, f) => (code, f, state::FAILED),
+    };
+    let _ = objects.set(B301 + off, 2, i64::from(f.grind_travel_inc));
+    let _ = objects.set(B301 + off, 3, i64::from(f.release_travel_inc));
+    let torque_mnm = (f.grind_torque_nm * 1e3 + 0.5) as i64;
+    let _ = objects.set(B301 + off, 4, torque_mnm);
+    let _ = objects.set(B301 + off, 1, i64::from(code));
     Some(status(if st == state::DONE { 100 } else { 0 }, selector, st))
 }
 
@@ -621,9 +655,13 @@ mod tests {
         }
         execute(&mut od, 0, 0, false);
         a.serve(&mut od);
-        execute(&mut od, 0, 0b0101, true);
+        execute(&mut od, 0, 0b0110, true);
         od.set(E48, 0, 2).unwrap();
         a.serve(&mut od);
-        assert_eq!(a.status(0) >> 12, state::NOT_AVAILABLE, "grind brake in E48 = 2");
+        assert_eq!(
+            a.status(0) >> 12,
+            state::NOT_AVAILABLE,
+            "grind brake 2 in E48 = 2"
+        );
     }
 }

@@ -207,6 +207,10 @@ pub const B52: u16 = parameter_index(1, 52);
 /// B300 test brake: the action's result, the largest movement seen and the
 /// test torque (per axis, spec §14).
 pub const B300: u16 = parameter_index(1, 300);
+/// B301 grind brake: the action's result, the smallest travels of its grind
+/// and released phases and the largest grinding torque (per axis, spec §14,
+/// `crate::tuning::grind`).
+pub const B301: u16 = parameter_index(1, 301);
 /// B53 phase resistance, mΩ (per axis, motor data).
 pub const B53: u16 = parameter_index(1, 53);
 /// B62 q-axis inductance Lq, µH (per axis, motor data).

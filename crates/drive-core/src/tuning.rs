@@ -58,6 +58,12 @@ pub mod result {
     /// B300: the shaft turned against the applied brake (beyond
     /// [`super::brake::TOLERANCE_INC`]); 7 and 8 are B40's.
     pub const SLIPPED: u8 = 9;
+    /// B301: a grind phase did not turn the shaft (the peak torque cannot
+    /// move it against the applied brake, [`super::grind::MIN_SHARE`]).
+    pub const STALLED: u8 = 10;
+    /// B301: a released phase did not turn the shaft with a quarter of the
+    /// rated torque: the brake stays closed when commanded open.
+    pub const NOT_RELEASED: u8 = 11;
 }
 
 /// Cycles per settle block.
@@ -377,6 +383,7 @@ fn abs(x: f32) -> f32 {
 
 pub mod align;
 pub mod brake;
+pub mod grind;
 pub mod phase;
 pub mod winding;
 

@@ -513,7 +513,12 @@ impl Plant {
         let vdc = self.x.vdc / adc.volts_per_count + adc.dc_noise_counts * self.rng.normal();
         let encoder_ok = !self.p.faults.encoder_lost;
         if encoder_ok {
-            self.held_position = self.encoder_count();
+            let count = self.encoder_count();
+            self.held_position = if self.p.faults.encoder_reversed {
+                count.wrapping_neg()
+            } else {
+                count
+            };
         }
         Sample {
             phase_counts: counts,

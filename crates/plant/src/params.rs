@@ -244,6 +244,10 @@ pub struct FaultOptions {
     pub r_scale: [f64; 3],
     /// The encoder reports an error and its position stops.
     pub encoder_lost: bool,
+    /// The encoder counts the other way (mounted or wired reversed): its
+    /// position is the negated rotor angle. hil-sim's electrical axis gives
+    /// the drive's cycle (`AxisIo::position_inc`) the same reversed count.
+    pub encoder_reversed: bool,
     /// An insulation fault: this inverter leg's output (between its current
     /// sensor and the motor) is connected to the DC link's negative rail
     /// through this resistance, Ω. With the gates on the leg's sensor carries
@@ -265,6 +269,7 @@ impl FaultOptions {
         swapped_bc: false,
         r_scale: [1.0; 3],
         encoder_lost: false,
+        encoder_reversed: false,
         leg_to_dc_minus: None,
         broken_sensor: None,
     };

@@ -269,6 +269,21 @@ fn encoder_loss_trips() {
     assert_eq!(axis.trip(), Some(Trip::EncoderLost));
 }
 
+/// The reversed encoder counts the rotor's angle negated: a quarter turn
+/// forward reads −2^18 increments (the healthy encoder +2^18).
+#[test]
+fn reversed_encoder_counts_the_other_way() {
+    for (reversed, want) in [(false, 1i64 << 18), (true, -(1i64 << 18))] {
+        let mut p = quiet();
+        p.faults.encoder_reversed = reversed;
+        let mut pl = Plant::new(p);
+        pl.set_rotor(core::f64::consts::FRAC_PI_2 + 1e-9, 0.0);
+        pl.advance();
+        let seen = i64::from(pl.sample().position_inc as i32);
+        assert!((seen - want).abs() <= 1, "reversed {reversed}: {seen}");
+    }
+}
+
 #[test]
 fn open_phase_carries_no_current_and_the_loop_cannot_hold_iq() {
     let mut p = quiet();

@@ -139,6 +139,25 @@ fn brake_holds_below_holding_torque_and_slips_above() {
     assert_eq!(out.position_inc, held);
 }
 
+/// A stuck brake (`brake_stuck`) brakes with its holding torque although
+/// released: 1 N·m does not turn the shaft; released, a healthy brake lets
+/// the same torque accelerate it by (1 − 0.02)/1e-4 rad/s² (98 rad/s in
+/// 10 ms).
+#[test]
+fn a_stuck_brake_holds_although_released() {
+    let mut p = MotorParams::default_servo();
+    p.viscous_friction_nm_s_per_rad = 0.0;
+    for (stuck, v_want) in [(true, 0.0), (false, 98.0)] {
+        p.brake_stuck = stuck;
+        let mut m = Motor::new(p, Switches::default());
+        m.step(1.0, false, Nanos::from_ns(MS));
+        let out = run(&mut m, 1.0, false, MS, 10);
+        let v = out.velocity_inc_per_s / INC_PER_RAD;
+        assert!(close(v, v_want, 1e-6), "stuck {stuck}: v {v}");
+        assert!(!out.brake_applied, "the command: released");
+    }
+}
+
 #[test]
 fn gravity_load_falls_without_torque_and_brake() {
     let mut p = MotorParams::default_servo();

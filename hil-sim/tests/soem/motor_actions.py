@@ -27,6 +27,13 @@ Free run, one drive, axis A in cst; RxPDO 6040h, 6060h, A75; TxPDO 6041h, A69.
   5. B300 (0100b, test brake), as B40: the brake applied against the rated
      torque both ways: done, B300[0] = 0, B300[1] (the largest movement)
      within 1/360 rev, B300[2] = 6076h (the test torque, mN m).
+  6. B301 (0101b, grind brake), as B40: 4 rounds of 0.5 s grinding against
+     the applied brake and 0.25 s released at 60 rpm, then 0.1 s stopped on
+     the brake: done, B301[0] = 0, each grind phase turned the shaft by at
+     least 0.8 of 60 rpm x 0.5 s (2^19 inc), each released phase by 0.8 of
+     its 2^18, and the grinding torque B301[3] is the plant's brake (its
+     default 2 N m holding and sliding torque, which the drive does not know)
+     plus friction, within 2.0 ... 2.3 N m.
 
 Prints `FAIL: ...` for every check that failed; exit status 0 when none did.
 """
@@ -46,7 +53,7 @@ def b(line):
 
 A75, A69 = 0x2000 + 75, 0x2000 + 69
 B05, B10, B40, B41, B42, B43, B52, B53, B62 = b(5), b(10), b(40), b(41), b(42), b(43), b(52), b(53), b(62)
-B300 = b(300)
+B300, B301 = b(300), b(301)
 E48 = 0x2000 + 4 * 0x200 + 48
 RX = [L.entry(0x6040, 0, 16), L.entry(0x6060, 0, 8), L.entry(A75, 0, 8)]
 TX = [L.entry(0x6041, 0, 16), L.entry(A69, 0, 16)]
@@ -57,7 +64,7 @@ RUNNING, DONE, REFUSED = 1, 2, 3
 # the actual position as the target, as before any enable)
 CST = 10
 B40_SEL, B41_SEL, B42_SEL, B43_SEL, B49_SEL = 0b1010, 0b1011, 0b1100, 0b1101, 0b1110
-B300_SEL = 0b0100
+B300_SEL, B301_SEL = 0b0100, 0b0101
 
 
 class Axis(L.FreeRunAxis):
@@ -161,6 +168,22 @@ def test_brake(axis):
     axis.cycle(20)
 
 
+def grind_brake(axis):
+    seen, took = start(axis, B301_SEL)
+    done = 100 | B301_SEL << 8 | DONE << 12
+    # A69 first: a fault's EMCY would come with the first SDO read
+    check(seen[-1] == done, f"B301: A69 ends {seen[-1]:04X}h, expected {done:04X}h; seen {[f'{s:04X}' for s in seen]}; statusword {axis.sw:#06x}")
+    result, grind, released, torque = (L.sdo_u(axis.s, B301, k) for k in (1, 2, 3, 4))
+    check(result == 0, f"B301[0] result {result}, expected 0 (ground in)")
+    check(grind >= 0.8 * (1 << 19), f"B301: a grind phase turned the shaft {grind} inc only")
+    check(released >= 0.8 * (1 << 18), f"B301: a released phase turned the shaft {released} inc only")
+    check(2000 <= torque <= 2300, f"B301: grinding torque {torque} mN m, the plant's brake slides at 2000")
+    say(f"B301: smallest grind travel {grind} inc, released {released} inc, grinding torque {torque} mN m, in {took:.2f} s")
+    axis.a75 = 0
+    axis.cw = 6
+    axis.cycle(20)
+
+
 def winding(axis, r):
     axis.cw = 6
     check(axis.until(lambda: L.sw_is(axis.sw, L.READY), 300), f"ready to switch on: statusword {axis.sw:#06x}")
@@ -233,6 +256,7 @@ def run(m, args):
         optimise(axis, sel, args.r, args.l)
     winding(axis, args.r)
     test_brake(axis)
+    grind_brake(axis)
     axis.cw = 0
     axis.cycle(20)
 

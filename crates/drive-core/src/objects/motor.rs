@@ -16,7 +16,7 @@
 //! ([`super::MANUFACTURER_A`]).
 
 use super::{Object, Value};
-use crate::params::{B05, B10, B17, B300, B40, B41, B42, B43, B52, B53, B62, B64, B73, U10, U11};
+use crate::params::{B05, B10, B17, B300, B301, B40, B41, B42, B43, B52, B53, B62, B64, B73, U10, U11};
 use od::DataType::{U16, U32, U8};
 
 use od::{Access, DataType, EntryInfo};
@@ -27,7 +27,7 @@ const fn e(sub: u8, name: &'static str, t: DataType) -> EntryInfo {
 }
 
 /// The motor data of axis A (group B), sorted by index.
-pub const PARAMS: [Object; 13] = [
+pub const PARAMS: [Object; 14] = [
     Object::var(
         B05,
         Value::Ram,
@@ -160,6 +160,15 @@ pub const PARAMS: [Object; 13] = [
     .axis()
     .level(1)
     .note("B300 (spec §14): the action \"test brake\", started through A75 in Ready to switch on, run after the enable: the brake stays applied while the drive commands the rated torque 6076h forward, then backward (a 0.1 s ramp and 0.5 s hold each, at 1 ms); the shaft must not move more than 1/360 rev from where it stood. [0] the result (0 held, 9 slipped: the torque dropped at once, 1 aborted: the enable went away), [1] the largest movement seen, [2] the test torque"),
+    param_array!(B301, "Grind brake", Record, Value::Ram, [
+        EntryInfo::new(0, "Result", U8, Access::RO),
+        EntryInfo::new(1, "Grinding travel", U32, Access::RO).unit("inc"),
+        EntryInfo::new(2, "Released travel", U32, Access::RO).unit("inc"),
+        EntryInfo::new(3, "Grinding torque", U32, Access::RO).unit("mNm"),
+    ])
+    .axis()
+    .level(1)
+    .note("B301 (spec §14; the sequence is ours, the manual gives none): the action \"grind brake\", started through A75 in Ready to switch on, run after the enable: 4 rounds of 0.5 s grinding (the brake applied, the motor turning the shaft at 60 rpm against it with up to the peak torque 6076h × 6072h) and 0.25 s released (the brake released, the same speed with at most a quarter of 6076h), then 0.1 s stop on the brake; each phase must turn the shaft by a quarter of what 60 rpm gives. [0] the result (0 ground in, 10 stalled: the peak torque did not turn the shaft against the brake, 11 not released: the shaft did not turn with the brake commanded open, 1 aborted: the enable went away), [1] the smallest travel of a grind phase, [2] of a released phase, [3] the largest grinding torque (the brake's sliding torque)"),
 ];
 
 /// The motor protection settings of axis A (group U, after the records of

@@ -234,3 +234,112 @@ fn e140_b300_test_brake_torque_profile_slip_and_abort() {
     assert_eq!(t.cycle(2, 0), None);
     assert_eq!(t.outcome(), BrakeOutcome::Failed(super::result::ABORTED, 0));
 }
+
+/// A shaft of 1e-4 kg·m² with 0.02 N·m friction behind a brake of
+/// `holding_nm` (its sliding torque too) that closes when commanded, or
+/// always if `stuck`; stick–slip at 10 µs steps, the command acting in the
+/// cycle after it. Runs B301 to its end: the outcome, the cycles, the brake
+/// commands over the cycles.
+fn grind_run(holding_nm: f64, stuck: bool) -> (grind::GrindOutcome, u32, std::vec::Vec<bool>) {
+    let (j, friction, h) = (1.0e-4, 0.02, 1.0e-5);
+    let (mut theta, mut omega) = (0.0f64, 0.0f64);
+    let mut g = grind::GrindBrake::new(1.3, 3.9);
+    assert_eq!(g.cycle(2, 0), None, "waits for the enable");
+    let mut releases = std::vec::Vec::new();
+    let inc = |theta: f64| (theta / core::f64::consts::TAU * f64::from(1u32 << 20)).floor() as i32;
+    let mut n = 0;
+    while let Some(c) = g.cycle(4, inc(theta)) {
+        assert!(c.power_stage && c.injection.is_none());
+        releases.push(c.brake_release);
+        let brake = if stuck || !c.brake_release {
+            holding_nm
+        } else {
+            0.0
+        };
+        let stat = friction + brake;
+        let t = f64::from(c.torque_nm);
+        for _ in 0..100 {
+            if omega == 0.0 && t.abs() <= stat {
+                continue;
+            }
+            let dir = if omega != 0.0 { omega.signum() } else { t.signum() };
+            let w = omega + h * (t - stat * dir) / j;
+            omega = if w * dir < 0.0 { 0.0 } else { w };
+            theta += omega * h;
+        }
+        n += 1;
+        assert!(n < 10_000, "ends");
+    }
+    (g.outcome(), n, releases)
+}
+
+/// E-140 (B301): the sequence — after the enable 4 rounds of 500 cycles
+/// grinding (brake applied) and 250 released, then 100 cycles stopped on the
+/// brake — on a shaft whose 2 N·m brake the 3.9 N·m peak turns: done, each
+/// grind phase turning the shaft most of 60 rpm × 0.5 s (2^19 inc), the
+/// grinding torque settling at the brake's sliding torque; a brake that
+/// holds 5 N·m stalls it (10) after the first grind phase, one that never
+/// releases fails the first released phase (11).
+#[test]
+fn e140_b301_grind_brake_sequence_and_its_failures() {
+    use grind::{GrindOutcome, GRIND_CYCLES, RELEASE_CYCLES, ROUNDS, SPEED_INC, STOP_CYCLES};
+    let (o, n, releases) = grind_run(2.0, false);
+    assert_eq!(n, ROUNDS * (GRIND_CYCLES + RELEASE_CYCLES) + STOP_CYCLES);
+    // the brake pattern: closed 500, open 250, ×4, closed 100
+    let edges = releases.windows(2).filter(|w| w[0] != w[1]).count();
+    assert_eq!(edges as u32, 2 * ROUNDS, "{ROUNDS} releases: {edges} edges");
+    // the brake opens once the torque is down to the released limit
+    let open = releases.iter().filter(|r| **r).count() as u32;
+    assert!(
+        (ROUNDS * (RELEASE_CYCLES - 12)..=ROUNDS * RELEASE_CYCLES).contains(&open),
+        "{open}"
+    );
+    assert!(!releases[0] && releases[GRIND_CYCLES as usize + 12] && !releases[n as usize - 1]);
+    assert!(!releases[GRIND_CYCLES as usize], "the torque first");
+    let GrindOutcome::Done(f) = o else { panic!("{o:?}") };
+    let full = |cycles: u32| (SPEED_INC as u32 * cycles) as f32;
+    std::println!("B301 healthy: {f:?}");
+    assert!(f.grind_travel_inc as f32 > 0.8 * full(GRIND_CYCLES), "{f:?}");
+    assert!(
+        f.grind_travel_inc as f32 <= 1.1 * full(GRIND_CYCLES),
+        "slow: {f:?}"
+    );
+    assert!(f.release_travel_inc as f32 > 0.8 * full(RELEASE_CYCLES), "{f:?}");
+    assert!((2.0..2.1).contains(&f.grind_torque_nm), "{f:?}");
+    // a brake beyond the peak torque: the first grind phase stalls
+    let (o, n, _) = grind_run(5.0, false);
+    let GrindOutcome::Failed(code, f) = o else {
+        panic!("{o:?}")
+    };
+    // then 20 cycles (21: rounding) winding 3.9 N·m down on the brake
+    assert_eq!(code, result::STALLED, "{f:?}");
+    assert!((GRIND_CYCLES + 20..=GRIND_CYCLES + 21).contains(&n), "{n}");
+    assert_eq!(f.grind_travel_inc, 0);
+    assert!((f.grind_torque_nm - 3.9).abs() < 1e-3, "the peak: {f:?}");
+    // a stuck brake: ground, but not released
+    let (o, n, _) = grind_run(2.0, true);
+    let GrindOutcome::Failed(code, f) = o else {
+        panic!("{o:?}")
+    };
+    assert_eq!(code, result::NOT_RELEASED, "{f:?}");
+    let wound = n - (GRIND_CYCLES + RELEASE_CYCLES);
+    assert!(wound <= 2, "at most 0.33 N·m to wind down: {wound}");
+    assert!(f.release_travel_inc < SPEED_INC as u32 * 10, "{f:?}");
+}
+
+/// E-141 (B301): the enable going away mid-sequence aborts it (1): no
+/// command after that.
+#[test]
+fn e141_b301_aborted_when_the_enable_goes() {
+    let mut g = grind::GrindBrake::new(1.3, 3.9);
+    assert!(g
+        .cycle(4, 0)
+        .is_some_and(|c| !c.brake_release && c.torque_nm > 0.0));
+    assert!(g.cycle(4, 10).is_some());
+    assert_eq!(g.cycle(5, 20), None);
+    assert!(matches!(
+        g.outcome(),
+        grind::GrindOutcome::Failed(result::ABORTED, _)
+    ));
+    assert_eq!(g.cycle(4, 20), None);
+}
