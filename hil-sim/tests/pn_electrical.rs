@@ -26,6 +26,17 @@ const SCRIPT_LIMIT: Duration = Duration::from_secs(90);
 /// Runs `current_limit.py` (with `script_args`) against serve with
 /// `--plant electrical` and `serve_more`; serve's output, the scenario line.
 fn run_script(tag: &str, serve_more: &[&str], script_args: &[&str], item: &str) -> Option<(String, String)> {
+    run_named("current_limit.py", tag, serve_more, script_args, item)
+}
+
+/// Runs `tests/profinet/<script>` as [`run_script`] does.
+fn run_named(
+    script: &str,
+    tag: &str,
+    serve_more: &[&str],
+    script_args: &[&str],
+    item: &str,
+) -> Option<(String, String)> {
     let python = match common::profinet_py_python() {
         Ok(p) => p,
         Err(why) => {
@@ -41,7 +52,9 @@ fn run_script(tag: &str, serve_more: &[&str], script_args: &[&str], item: &str) 
         .map(|s| s.as_ref())
         .collect();
     let mut line = PnLine::new(tag, &dir, &serve);
-    let script = Path::new(env!("CARGO_MANIFEST_DIR")).join("tests/profinet/current_limit.py");
+    let script = Path::new(env!("CARGO_MANIFEST_DIR"))
+        .join("tests/profinet")
+        .join(script);
     let args = module_args(script_args);
     let (status, lines) = line.run(&python, &script, &args, SCRIPT_LIMIT);
     line.stop_server();
@@ -55,7 +68,7 @@ fn run_script(tag: &str, serve_more: &[&str], script_args: &[&str], item: &str) 
     let verdict: Vec<&String> = lines.iter().filter(|l| l.starts_with(&prefix)).collect();
     assert_eq!(verdict.len(), 1, "one scenario line expected: {lines:?}");
     assert!(verdict[0].starts_with(&format!("{prefix}ok: ")), "{}", verdict[0]);
-    assert!(status.success(), "current_limit.py failed ({status})");
+    assert!(status.success(), "{} failed ({status})", script.display());
     Some((serve, verdict[0].clone()))
 }
 
@@ -104,4 +117,27 @@ fn p030_e089_profinet_py_over_current_trip_of_a_shorted_leg_on_the_electrical_pl
 #[test]
 fn c038_e089_profinet_py_motor_i2t_warning_limit_and_fault_on_the_electrical_plant() {
     run_script("ei", &[], &["--i2t"], "C-038-i2t");
+}
+
+/// E-140 and E-141 on PROFINET (issue 35) through profinet-py on the
+/// electrical plant (`serve --plant-r 2.2 --plant-l 0.008`, a motor the
+/// drive's dictionary does not know; the script also writes wrong motor
+/// data first): `tests/profinet/motor_actions.py` writes A75 and reads A69
+/// through PKW. B42 refused while enabled (A69 state 3, B53 unchanged);
+/// B43 in ready to switch on: done, the three phase resistances within 3 %
+/// of 2.2 Ω; B42: running at 0 % until the enable, then done with R within
+/// 5 % of 2.2 Ω and L within 5 % of 8 mH; B300 against the applied brake:
+/// held within 1/360 rev.
+#[test]
+fn e140_e141_profinet_py_motor_actions_by_pkw_on_the_electrical_plant() {
+    let Some((_, line)) = run_named(
+        "motor_actions.py",
+        "ma",
+        &["--plant-r", "2.2", "--plant-l", "0.008"],
+        &["--r", "2.2", "--l", "0.008"],
+        "E-140",
+    ) else {
+        return;
+    };
+    println!("{line}");
 }

@@ -23,6 +23,9 @@
 //! of the axis: here, A75 mapped in the axis's RxPDO channel (1600h for axis A,
 //! 1601h for axis B), which is what that option sets up. A75 written over SDO,
 //! or mapped in another channel, starts nothing ([`state::NOT_ACTIVATED`]).
+//! On PROFINET ([`Actions::by_parameter_access`]) there is no such option and
+//! no RxPDO: A75 is written through the parameter access (PKW in the
+//! telegram, record 0xB02E), which is itself the activation.
 
 use crate::axis::{AxisCommand, AxisIo};
 use crate::params::{B05, B10, B300, B301, B40, B41, B42, B43, B52, B53, B62, E48};
@@ -177,10 +180,23 @@ enum Measurement {
     Grind(GrindBrake),
 }
 
+/// What activates the actions of an axis (E-142).
+#[derive(Debug, Clone, Copy, Default, PartialEq, Eq)]
+pub enum Activation {
+    /// EtherCAT: A75 mapped in the axis's RxPDO channel (the commissioning
+    /// option "action activation").
+    #[default]
+    RxPdo,
+    /// PROFINET: A75 written through the parameter access (PKW, record
+    /// 0xB02E); always active.
+    ParameterAccess,
+}
+
 /// The action unit of both axes: the last Execute bits and what runs.
 #[derive(Debug, Clone, Copy, Default)]
 pub struct Actions {
     axes: [AxisActions; 2],
+    activation: Activation,
 }
 
 fn offset(axis: usize) -> u16 {
@@ -205,7 +221,24 @@ impl Actions {
             status: 0,
             tuning: None,
         };
-        Self { axes: [IDLE; 2] }
+        Self {
+            axes: [IDLE; 2],
+            activation: Activation::RxPdo,
+        }
+    }
+
+    /// Idle on both axes, A75 taken from the parameter access (PROFINET:
+    /// [`Activation::ParameterAccess`]).
+    pub const fn by_parameter_access() -> Self {
+        let mut a = Self::new();
+        a.activation = Activation::ParameterAccess;
+        a
+    }
+
+    /// Whether a motor action runs in the control cycle on either axis (the
+    /// caller then serves A69 every cycle, [`serve`](Self::serve)).
+    pub fn measuring(&self) -> bool {
+        self.axes.iter().any(|a| a.tuning.is_some())
     }
 
     /// A69 of `axis` as last set.
@@ -241,6 +274,7 @@ impl Actions {
     /// action of a rising Execute, follows a running one, shows A69.
     pub fn serve(&mut self, objects: &mut DriveObjects) -> Effects {
         let mut fx = Effects::default();
+        let activation = self.activation;
         for ((axis, a), clear) in self
             .axes
             .iter_mut()
@@ -263,7 +297,7 @@ impl Actions {
                 }
                 a.tuning = None;
             } else if rising {
-                a.status = start(a, objects, axis, selector, clear);
+                a.status = start(a, objects, axis, selector, clear, activation);
             } else if let Some(r) = a.running {
                 a.status = match r {
                     Running::Tuning => match a.tuning.as_ref() {
@@ -299,11 +333,12 @@ fn start(
     axis: usize,
     selector: u8,
     clear: &mut bool,
+    activation: Activation,
 ) -> u16 {
     let Some(action) = Action::from_selector(selector) else {
         return status(0, selector, state::UNKNOWN);
     };
-    if !Actions::activated(objects, axis) {
+    if activation == Activation::RxPdo && !Actions::activated(objects, axis) {
         return status(0, selector, state::NOT_ACTIVATED);
     }
     let e48 = objects.get(E48 + offset(axis), 0).unwrap_or(0);
@@ -663,5 +698,24 @@ mod tests {
             state::NOT_AVAILABLE,
             "grind brake 2 in E48 = 2"
         );
+    }
+
+    /// E-142 on PROFINET: with [`Actions::by_parameter_access`] A75 written
+    /// (as PKW does) starts an action without any RxPDO mapping — I38 clear
+    /// reference, done at once, its effect returned — while the EtherCAT
+    /// unit ([`Actions::new`]) refuses the same write as not activated.
+    #[test]
+    fn e142_parameter_access_is_the_activation_on_profinet() {
+        let mut od = DriveObjects::new();
+        execute(&mut od, 0, 0b0111, true);
+        let mut ecat = Actions::new();
+        let fx = ecat.serve(&mut od);
+        assert_eq!(ecat.status(0), status(0, 0b0111, state::NOT_ACTIVATED));
+        assert!(!fx.clear_reference[0]);
+        let mut pn = Actions::by_parameter_access();
+        let fx = pn.serve(&mut od);
+        assert_eq!(pn.status(0), status(100, 0b0111, state::DONE));
+        assert_eq!(fx.clear_reference, [true, false]);
+        assert!(!pn.measuring());
     }
 }

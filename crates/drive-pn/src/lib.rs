@@ -61,6 +61,7 @@
 
 use core::mem::MaybeUninit;
 use core::ptr::addr_of_mut;
+use drive_core::actions::Actions;
 use drive_core::axis::{Axis, AxisCache, AxisCommand, AxisIo};
 use drive_core::faults::{FaultChange, E82_INACTIVE};
 use drive_core::objects::LAYOUT_HASH;
@@ -146,6 +147,9 @@ pub struct PnDrive<F: Flash, H: RecordHook = NoRecords> {
     /// Axis A's mode display (6061h) when the profile last ran: a change
     /// (the core took the mode a telegram bound) runs it again (P-086).
     profile_mode: Option<i64>,
+    /// The A75/A69 actions (E-140), A75 written through the parameter
+    /// access (PKW, record 0xB02E): the motor actions on PROFINET (issue 35).
+    actions: Actions,
 }
 
 impl<F: Flash> PnDrive<F, NoRecords> {
@@ -240,6 +244,7 @@ impl<F: Flash, H: RecordHook> PnDrive<F, H> {
             addr_of_mut!((*p).powered).write([false; 2]);
             addr_of_mut!((*p).telegram_new).write(true);
             addr_of_mut!((*p).profile_mode).write(None);
+            addr_of_mut!((*p).actions).write(Actions::by_parameter_access());
         }
         // SAFETY: every field of `PnDrive` was written above.
         let drive = unsafe { slot.assume_init_mut() };
@@ -426,8 +431,21 @@ impl<F: Flash, H: RecordHook> PnDrive<F, H> {
             .inner
             .bmp
             .set_response(out.get(..len).unwrap_or(&[]));
+        self.serve_actions();
         // a save asked by this request is done before its response is read
         self.serve_saves();
+    }
+
+    /// The actions after a parameter access (A75 written: an action starts
+    /// or stops) and every control cycle while a motor action measures
+    /// (A69's progress and result): E-140 on PROFINET.
+    fn serve_actions(&mut self) {
+        let fx = self.actions.serve(&mut self.objects);
+        for (axis, clear) in self.axes.iter_mut().zip(fx.clear_reference) {
+            if clear {
+                axis.clear_reference();
+            }
+        }
     }
 
     /// The device's timers at `now`; returns when to call again at the
@@ -626,6 +644,15 @@ impl<F: Flash, H: RecordHook> PnDrive<F, H> {
             }
             *command = report.command;
         }
+        // a running motor action replaces the axis' command (B40…B43, B300)
+        if self.actions.measuring() {
+            for ((i, axis), (command, io)) in self.axes.iter().enumerate().zip(commands.iter_mut().zip(&io)) {
+                if let Some(c) = self.actions.control(i, drive_core::axis::e48(axis.state()), io) {
+                    *command = c;
+                }
+            }
+            self.serve_actions();
+        }
         self.powered = commands.map(|c| c.power_stage);
         if run_profile {
             // once per telegram: the response the device sends next
@@ -675,6 +702,7 @@ impl<F: Flash, H: RecordHook> PnDrive<F, H> {
         };
         let [axis, _] = &mut self.axes;
         self.profile.receive(data, &mut self.objects, axis);
+        self.serve_actions();
         self.serve_saves();
     }
 

@@ -69,8 +69,26 @@ const FLUSH_EVERY: Nanos = Nanos::from_secs(1);
 /// `--plant-r`/`--plant-l`/`--plant-offset`: the plant's motor on every
 /// electrical axis.
 fn set_plant_motor(sim: &mut Simulation, args: &ServeArgs) -> Result<(), String> {
-    if args.plant_r.is_none() && args.plant_l.is_none() && args.plant_offset.is_none() {
+    let Some(apply) = plant_motor(args)? else {
         return Ok(());
+    };
+    for d in sim.drives_mut() {
+        for axis in 0..2 {
+            if let Some(el) = d.electrical_mut(axis) {
+                apply(el);
+            }
+        }
+    }
+    Ok(())
+}
+
+/// The change `--plant-r`/`--plant-l`/`--plant-offset` make to an
+/// electrical axis' plant (both fieldbuses); `None` without them.
+pub(super) fn plant_motor(
+    args: &ServeArgs,
+) -> Result<Option<impl Fn(&mut hil_sim::electrical::ElectricalAxis) + '_>, String> {
+    if args.plant_r.is_none() && args.plant_l.is_none() && args.plant_offset.is_none() {
+        return Ok(None);
     }
     if args.plant != Plant::Electrical {
         return Err("--plant-r/--plant-l/--plant-offset need --plant electrical".into());
@@ -82,21 +100,16 @@ fn set_plant_motor(sim: &mut Simulation, args: &ServeArgs) -> Result<(), String>
     if !positive(args.plant_r) || !positive(args.plant_l) {
         return Err("--plant-r and --plant-l must be positive".into());
     }
-    for d in sim.drives_mut() {
-        for axis in 0..2 {
-            if let Some(el) = d.electrical_mut(axis) {
-                let plant = el.plant_mut();
-                let mut m = plant.params().motor;
-                m.r_ohm = args.plant_r.unwrap_or(m.r_ohm);
-                if let Some(l) = args.plant_l {
-                    (m.ld_h, m.lq_h) = (l, l);
-                }
-                m.commutation_offset_rad = args.plant_offset.unwrap_or(m.commutation_offset_rad);
-                plant.set_motor(m);
-            }
+    Ok(Some(move |el: &mut hil_sim::electrical::ElectricalAxis| {
+        let plant = el.plant_mut();
+        let mut m = plant.params().motor;
+        m.r_ohm = args.plant_r.unwrap_or(m.r_ohm);
+        if let Some(l) = args.plant_l {
+            (m.ld_h, m.lq_h) = (l, l);
         }
-    }
-    Ok(())
+        m.commutation_offset_rad = args.plant_offset.unwrap_or(m.commutation_offset_rad);
+        plant.set_motor(m);
+    }))
 }
 
 /// Runs `serve` until `--seconds` have passed (or forever).

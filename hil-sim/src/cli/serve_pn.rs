@@ -241,6 +241,7 @@ pub fn serve(args: &ServeArgs) -> Result<(), String> {
         })
         .collect();
     // the motor model: the seed per drive k (from 0) as EtherCAT's serve
+    let plant_motor = super::serve::plant_motor(args)?;
     for (k, d) in (0u64..).zip(drives.iter_mut()) {
         d.set_plant_at(
             args.plant.into(),
@@ -253,6 +254,13 @@ pub fn serve(args: &ServeArgs) -> Result<(), String> {
                 d.electrical_mut(0)
                     .ok_or("--plant-fault needs --plant electrical")?,
             );
+        }
+        if let Some(apply) = &plant_motor {
+            for axis in 0..2 {
+                if let Some(el) = d.electrical_mut(axis) {
+                    apply(el);
+                }
+            }
         }
     }
     let mut control = args.control.as_deref().map(Control::create).transpose()?;

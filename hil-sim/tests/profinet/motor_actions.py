@@ -1,0 +1,184 @@
+"""The motor actions through the PROFIdrive parameter access on the
+electrical plant (issue 35; E-140, E-141 on PROFINET): profinet-py (0.6.6)
+as the IO controller of `hil-sim serve --fieldbus profinet --plant
+electrical --plant-r R --plant-l L`, the Example Function block of fb.py on
+its cyclic data (telegram 0xE0), A75 written and A69 read through PKW (PNU =
+the object's index, docs/pnu.md). On PROFINET the parameter access is the
+action activation (docs/conformance.md, E-142).
+
+  1. The drive's motor data made wrong through PKW (B53 = 1,000 mOhm,
+     B52 = B62 = 4,000 uH): the plant's --r/--l are unknown to it.
+  2. Enabled (operation enabled, E48 = 4): A75 = Execute | 1100b (B42) is
+     refused, A69 state 3, B53 unchanged. Execute low, disabled.
+  3. B43 (1101b, test winding) in ready to switch on, no enable: A69 done
+     (100 %), B43[0] = 0, the three resistances within 3 % of --r.
+  4. B42 (1100b, optimise current controller): A69 running at 0 % until the
+     enable, then done; B42[0] = 0, B53 within 5 % of --r, B52 within 5 % of
+     --l. Execute low, disabled: A69 idle.
+  5. B300 (0100b, test brake) with the enable: done, B300[0] = 0 (held),
+     the largest movement within 1/360 rev.
+
+One line:  scenario E-140: ok|FAIL: ...
+"""
+
+import argparse
+import gc
+import logging
+import sys
+import time
+
+import profinet
+from profinet.util import get_mac
+
+import pnctl
+from fb import OP, PKW_READ, PKW_WRITE, ExampleFB
+from pnctl import Scenario, ms
+
+
+def b(line):
+    return 0x2200 + line
+
+
+A75, A69 = 0x2000 + 75, 0x2000 + 69
+B42, B43, B52, B53, B62, B300 = b(42), b(43), b(52), b(53), b(62), b(300)
+E48 = 0x2800 + 48
+RUNNING, DONE, REFUSED = 1, 2, 3
+B42_SEL, B43_SEL, B300_SEL = 0b1100, 0b1101, 0b0100
+
+
+def read(fb, sc, index, sub=0):
+    """A PKW read; a refusal or no answer is a failed check (the many reads
+    that succeed are not listed)."""
+    r = fb.pkw(PKW_READ, index, sub, timeout=3.0)
+    if r is None or r[0] != PKW_READ:
+        sc.check(False, f"PKW read {index:04X}h:{sub}: {r}")
+        return None
+    return r[1]
+
+
+def write(fb, sc, index, value, sub=0):
+    r = fb.pkw(PKW_WRITE, index, sub, value, timeout=3.0)
+    if r != (PKW_WRITE, value):
+        sc.check(False, f"PKW write {index:04X}h:{sub} = {value}: {r}")
+
+
+def a69_until(fb, sc, pred, timeout):
+    """Reads A69 through PKW until pred(A69) holds: (A69, seconds) or (last, None)."""
+    t0 = time.monotonic()
+    last = None
+    while time.monotonic() - t0 < timeout:
+        last = read(fb, sc, A69)
+        if last is not None and pred(last):
+            return last, time.monotonic() - t0
+        fb.run_for(0.05)
+    return last, None
+
+
+def enable(fb, sc, what):
+    fb.i.drive_enable = True
+    dt = fb.until(lambda o: o.zsw1 & 0x47 == OP, 5.0)
+    sc.check(dt is not None, f"{what}: operation enabled after {ms(dt)}")
+
+
+def disable(fb):
+    fb.i.drive_enable = False
+    fb.until(lambda o: o.zsw1 & 0x47 != OP, 2.0)
+    fb.run_for(0.05)
+
+
+def stop(fb, sc):
+    write(fb, sc, A75, 0)
+    a69, dt = a69_until(fb, sc, lambda v: v == 0, 2.0)
+    sc.check(dt is not None, f"Execute low: A69 idle ({a69})")
+
+
+def run(fb, sc, r, l):
+    for index, value in ((B53, 1000), (B52, 4000), (B62, 4000)):
+        write(fb, sc, index, value)
+    # 2. refused while enabled
+    enable(fb, sc, "refusal")
+    sc.check(read(fb, sc, E48) == 4, "enabled: E48 = 4")
+    write(fb, sc, A75, B42_SEL << 1 | 1)
+    a69, _ = a69_until(fb, sc, lambda v: v >> 12 != 0, 2.0)
+    sc.check(a69 == (B42_SEL << 8 | REFUSED << 12), f"B42 while enabled: A69 {a69} (want refused)")
+    sc.check(read(fb, sc, B53) == 1000, "the refused B42 changed nothing (B53 = 1000)")
+    stop(fb, sc)
+    disable(fb)
+    # 3. B43 in ready to switch on
+    sc.check(read(fb, sc, E48) == 2, "disabled: E48 = 2 (ready to switch on)")
+    t0 = time.monotonic()
+    write(fb, sc, A75, B43_SEL << 1 | 1)
+    a69, dt = a69_until(fb, sc, lambda v: v >> 12 not in (0, RUNNING), 10.0)
+    sc.check(a69 == (100 | B43_SEL << 8 | DONE << 12), f"B43: A69 {a69} after {ms(dt)} (want done, 100 %)")
+    sc.check(read(fb, sc, B43, 1) == 0, "B43[0] = 0")
+    rs = [(read(fb, sc, B43, k) or 0) * 1e-3 for k in (2, 3, 4)]
+    sc.note(f"B43: phase resistances {rs} ohm against the plant's {r} ohm in {time.monotonic() - t0:.2f} s")
+    sc.check(all(abs(x - r) <= 0.03 * r for x in rs), f"B43: {rs} within 3 % of {r} ohm")
+    stop(fb, sc)
+    # 4. B42: started in ready to switch on, runs once enabled
+    write(fb, sc, A75, B42_SEL << 1 | 1)
+    fb.run_for(0.05)
+    a69 = read(fb, sc, A69)
+    sc.check(a69 == (B42_SEL << 8 | RUNNING << 12), f"B42 before the enable: A69 {a69} (want running, 0 %)")
+    t0 = time.monotonic()
+    enable(fb, sc, "B42")
+    a69, dt = a69_until(fb, sc, lambda v: v >> 12 not in (0, RUNNING), 20.0)
+    sc.check(a69 == (100 | B42_SEL << 8 | DONE << 12), f"B42: A69 {a69} after {ms(dt)} (want done, 100 %)")
+    sc.check(read(fb, sc, B42, 1) == 0, "B42[0] = 0")
+    r_id, l_id = (read(fb, sc, B53) or 0) * 1e-3, (read(fb, sc, B52) or 0) * 1e-6
+    sc.note(f"B42: R {r_id:.4f} ohm (plant {r}), L {l_id * 1e3:.4f} mH (plant {l * 1e3}) in {time.monotonic() - t0:.2f} s")
+    sc.check(abs(r_id - r) <= 0.05 * r, f"B53 {r_id} ohm within 5 % of the plant's {r} ohm")
+    sc.check(abs(l_id - l) <= 0.05 * l, f"B52 {l_id} H within 5 % of the plant's {l} H")
+    stop(fb, sc)
+    disable(fb)
+    # 5. B300 against the applied brake
+    write(fb, sc, A75, B300_SEL << 1 | 1)
+    fb.run_for(0.05)
+    enable(fb, sc, "B300")
+    a69, dt = a69_until(fb, sc, lambda v: v >> 12 not in (0, RUNNING), 10.0)
+    sc.check(a69 == (100 | B300_SEL << 8 | DONE << 12), f"B300: A69 {a69} after {ms(dt)} (want done, 100 %)")
+    result, moved = read(fb, sc, B300, 1), read(fb, sc, B300, 2)
+    sc.note(f"B300: result {result}, largest movement {moved} inc")
+    sc.check(result == 0 and moved is not None and moved <= (1 << 20) // 360,
+             f"B300: held (result {result}), moved {moved} inc within 1/360 rev")
+    stop(fb, sc)
+    disable(fb)
+
+
+def main():
+    ap = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
+    ap.add_argument("--iface", required=True)
+    ap.add_argument("--device-mac", required=True)
+    ap.add_argument("--gsdml", required=True)
+    ap.add_argument("--out-module", required=True, help="GSDML module ID for slot 1")
+    ap.add_argument("--in-module", required=True, help="GSDML module ID for slot 2")
+    ap.add_argument("--name", default="drive-ma")
+    ap.add_argument("--ip", default="192.168.0.53")
+    ap.add_argument("--r", type=float, required=True, help="the plant's phase resistance (serve --plant-r), ohm")
+    ap.add_argument("--l", type=float, required=True, help="the plant's inductance (serve --plant-l), H")
+    a = ap.parse_args()
+    gc.disable()  # as fb.py: a full collection would stall the cyclic thread
+    logging.getLogger("profinet").addHandler(pnctl.Records())
+    print(f"profinet-py {profinet.__version__} on {a.iface}", flush=True)
+    pnctl.tx_checksum_offload_off(a.iface)
+    src = get_mac(a.iface)
+    slots = pnctl.io_slots(a.gsdml, a.out_module, a.in_module)
+    info = pnctl.name_and_address(a.iface, src, a.device_mac.lower(), a.name, a.ip)
+    dev, ctl, out_slot, in_slot = pnctl.start_cyclic(info, a.iface, src, slots, watchdog=100)
+    sc = Scenario("E-140")
+    try:
+        fb = ExampleFB(ctl, out_slot, in_slot)
+        if fb.until(lambda o: o.identifier == 0xF0, 5.0) is None:
+            raise RuntimeError("no response telegram 0xF0 within 5 s")
+        run(fb, sc, a.r, a.l)
+    except Exception as e:  # noqa: BLE001 - the scenario's failure
+        sc.check(False, f"{type(e).__name__}: {e}")
+    finally:
+        ctl.stop()
+        dev.close()
+    print(sc.line(), flush=True)
+    return 1 if sc.failed else 0
+
+
+if __name__ == "__main__":
+    sys.exit(main())
