@@ -148,6 +148,16 @@ pub struct FocAxis {
     deviation_sums: (f32, f32, u32),
     /// The last window's current deviated.
     deviation_trip: bool,
+    /// The reference's mean square of the last window judged (A²): a
+    /// window is judged against the larger of its own and this one, so a
+    /// reference that fell to zero at a window's start (a torque step to
+    /// nothing) leaves the decay of the current it had as the error against
+    /// the reference that current followed.
+    deviation_last_ref: f32,
+    /// Windows left unjudged after an open-loop (voltage-commanded) period:
+    /// the current a motor action's injection left decays against the
+    /// closed loop's reference (the window of the change and the next).
+    deviation_hold: u8,
     measured: Measured,
 }
 
@@ -195,6 +205,8 @@ impl FocAxis {
             i2t_trip: None,
             deviation_sums: (0.0, 0.0, 0),
             deviation_trip: false,
+            deviation_last_ref: 0.0,
+            deviation_hold: 0,
             measured: Measured::default(),
         })
         .map(|mut axis| {
@@ -219,10 +231,19 @@ impl FocAxis {
         self.i2t_count = 0;
         // the current's plausibility: judged when at least half the window
         // counted (a window mostly at the voltage limit or open loop is not)
+        // (not the windows of and after open-loop periods, and each against
+        // the larger reference of its own and the last judged window's)
         let (e, r, n) = self.deviation_sums;
-        if n >= I2T_DECIMATION / 2 {
-            let k = 1.0 / n as f32;
-            self.deviation_trip = self.protection.deviation.deviates(e * k, r * k);
+        let k = 1.0 / fmath::max(n as f32, 1.0);
+        if self.deviation_hold > 0 {
+            self.deviation_hold -= 1;
+            self.deviation_last_ref = 0.0;
+        } else if n >= I2T_DECIMATION / 2 {
+            let reference = fmath::max(r * k, self.deviation_last_ref);
+            self.deviation_trip = self.protection.deviation.deviates(e * k, reference);
+            self.deviation_last_ref = r * k;
+        } else {
+            self.deviation_last_ref = r * k;
         }
         self.deviation_sums = (0.0, 0.0, 0);
         self.refresh_limits();
@@ -518,6 +539,7 @@ impl FocAxis {
             }
             Command::Voltage(v, _) => {
                 self.pi.reset();
+                self.deviation_hold = 2;
                 let clamp = |x: f32| fmath::clamp(x, -v_max, v_max);
                 let cut = v.d.abs() > v_max || v.q.abs() > v_max;
                 (

@@ -611,6 +611,56 @@ fn e089_a_current_that_does_not_follow_its_reference_trips_motor_connection() {
     );
 }
 
+/// The current-deviation check against its false trip (issue 35: event 69
+/// at the end of a motor action, issue 34's "noticed" list): a d current of
+/// 4 A that falls to nothing at a window's start — the reference stepped to
+/// zero after two windows at 4 A, or the open-loop injection of a motor
+/// action (B42) handed back to the current loop with reference 0 — decays
+/// first order (ω_c = 1 kHz) against a reference of nothing; judged against
+/// the last window's reference, and the injection's windows not judged, it
+/// trips nothing. A current that never follows a later 2 A reference still
+/// trips (the open phase).
+#[test]
+fn e089_a_current_decaying_after_its_reference_fell_does_not_trip_motor_connection() {
+    // at electrical angle 0: i A of id reads a = +i, b = c = −i/2 (204.5 counts per A)
+    let at = |i: f32| {
+        let a = (204.5 * i).round() as i32;
+        let bc = (102.25 * i).round() as i32;
+        sample([(2048 + a) as u16, (2048 - bc) as u16, (2048 - bc) as u16], 2260)
+    };
+    let decay = |k: usize| 4.0 * (-(k as f32) * TAU as f32 * 1000.0 / 16_000.0).exp();
+    let w = foc::axis::I2T_DECIMATION as usize;
+    for injection in [false, true] {
+        let mut a = FocAxis::default_servo(Scaling::default_board()).unwrap();
+        a.enable(true);
+        let four = foc::Dq { d: 4.0, q: 0.0 };
+        for _ in 0..2 * w {
+            if injection {
+                a.step_voltage(&at(4.0), foc::Dq { d: 4.0 * 3.6, q: 0.0 });
+            } else {
+                a.step(&at(4.0), four);
+            }
+        }
+        for k in 0..3 * w {
+            a.step(&at(decay(k)), foc::Dq::default());
+            assert_eq!(a.trip(), None, "injection {injection}: period {k} after the fall");
+        }
+        // the open phase is still seen: nothing follows a 2 A reference
+        let mut tripped = None;
+        for k in 0..3 * w {
+            a.step(&at(0.0), foc::Dq { d: 2.0, q: 0.0 });
+            if a.trip().is_some() {
+                tripped = Some(k);
+                break;
+            }
+        }
+        assert!(
+            tripped.is_some_and(|k| k < 2 * w),
+            "injection {injection}: {tripped:?}"
+        );
+    }
+}
+
 /// E-090 (the brake chopper's thermal model behind event 42): the chopper
 /// switches on at its threshold and off only below threshold − hysteresis;
 /// held on at 780 V over 100 Ω (P = V²/R = 6084 W) against a 600 W resistor
