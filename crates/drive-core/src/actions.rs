@@ -235,6 +235,16 @@ impl Actions {
         a
     }
 
+    /// Whether anything is shown or runs on either axis: Execute set, an
+    /// action running or A69 not idle. A caller that serves A75 only after
+    /// it was written (PROFINET: a PKW write) serves it every time while
+    /// this holds.
+    pub fn busy(&self) -> bool {
+        self.axes
+            .iter()
+            .any(|a| a.execute || a.running.is_some() || a.tuning.is_some() || a.status != 0)
+    }
+
     /// Whether a motor action runs in the control cycle on either axis (the
     /// caller then serves A69 every cycle, [`serve`](Self::serve)).
     pub fn measuring(&self) -> bool {

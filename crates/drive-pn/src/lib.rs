@@ -150,6 +150,8 @@ pub struct PnDrive<F: Flash, H: RecordHook = NoRecords> {
     /// The A75/A69 actions (E-140), A75 written through the parameter
     /// access (PKW, record 0xB02E): the motor actions on PROFINET (issue 35).
     actions: Actions,
+    /// The profile's PKW write count when the actions last looked at A75.
+    actions_seen_writes: u32,
 }
 
 impl<F: Flash> PnDrive<F, NoRecords> {
@@ -245,6 +247,7 @@ impl<F: Flash, H: RecordHook> PnDrive<F, H> {
             addr_of_mut!((*p).telegram_new).write(true);
             addr_of_mut!((*p).profile_mode).write(None);
             addr_of_mut!((*p).actions).write(Actions::by_parameter_access());
+            addr_of_mut!((*p).actions_seen_writes).write(0);
         }
         // SAFETY: every field of `PnDrive` was written above.
         let drive = unsafe { slot.assume_init_mut() };
@@ -702,7 +705,14 @@ impl<F: Flash, H: RecordHook> PnDrive<F, H> {
         };
         let [axis, _] = &mut self.axes;
         self.profile.receive(data, &mut self.objects, axis);
-        self.serve_actions();
+        // A75 only changes by a parameter write: looked at after one, and
+        // every telegram while an action is shown (issue 36: two lookups of
+        // A75 per telegram cost some 580 instructions on QEMU)
+        let writes = self.profile.parameter_writes();
+        if writes != self.actions_seen_writes || self.actions.busy() {
+            self.actions_seen_writes = writes;
+            self.serve_actions();
+        }
         self.serve_saves();
     }
 

@@ -45,6 +45,8 @@ pub struct Pkw {
     /// A write still running.
     pending: Option<(Addr, [u8; 8])>,
     reserved: u32,
+    /// Write requests served so far (wrapping).
+    writes: u32,
 }
 
 impl Default for Pkw {
@@ -61,6 +63,7 @@ impl Pkw {
             last_code: NONE,
             pending: None,
             reserved: 0,
+            writes: 0,
         }
     }
 
@@ -97,12 +100,20 @@ impl Pkw {
         self.pending.is_some()
     }
 
+    /// Write requests served so far (wrapping): a caller that acts on
+    /// written values only when one was written compares it with the last
+    /// count it saw.
+    pub fn writes(&self) -> u32 {
+        self.writes
+    }
+
     /// Requests with a reserved code so far.
     pub fn reserved_requests(&self) -> u32 {
         self.reserved
     }
 
     fn write(&mut self, req: [u8; 8], access: &mut impl ParamAccess) {
+        self.writes = self.writes.wrapping_add(1);
         let addr = address(&req);
         let result = access
             .describe(addr)

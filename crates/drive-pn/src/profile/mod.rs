@@ -159,6 +159,11 @@ impl Profile {
         core::mem::take(&mut self.own.save_requested)
     }
 
+    /// PKW write requests served so far (wrapping; [`Pkw::writes`]).
+    pub fn parameter_writes(&self) -> u32 {
+        self.pkw.writes()
+    }
+
     /// The save asked through PNU 971 is over (PNU 971 reads 0 again).
     pub fn save_done(&mut self) {
         self.own.saving = false;
