@@ -53,18 +53,11 @@ thermal model in drive-core axis/motor.rs):
 One line:  scenario C-038-i2t: ok|FAIL: ...
 """
 
-import argparse
-import gc
-import logging
 import math
 import sys
 import time
 
-import profinet
-from profinet.util import get_mac
-
-import pnctl
-from fb import OPMODE_TORQUE, OP, PKW_READ, PKW_WRITE, ExampleFB
+from fb import OPMODE_TORQUE, OP, PKW_READ, PKW_WRITE, fb_arguments, run_fb_scenario
 from pnctl import Scenario, ms
 
 FLIP_S = 0.020
@@ -241,43 +234,21 @@ def i2t(fb, sc, tau_s, u11_s):
 
 
 def main():
-    ap = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
-    ap.add_argument("--iface", required=True)
-    ap.add_argument("--device-mac", required=True)
-    ap.add_argument("--gsdml", required=True)
-    ap.add_argument("--out-module", required=True, help="GSDML module ID for slot 1")
-    ap.add_argument("--in-module", required=True, help="GSDML module ID for slot 2")
-    ap.add_argument("--name", default="drive-el")
-    ap.add_argument("--ip", default="192.168.0.52")
+    ap = fb_arguments(__doc__, "drive-el", "192.168.0.52")
     ap.add_argument("--short", action="store_true", help="serve runs --plant-fault short: the over-current trip")
     ap.add_argument("--i2t", action="store_true", help="the motor's i2t model: warning, limit, fault")
     ap.add_argument("--tau-ms", type=int, default=2000, help="with --i2t: B73 thermal time constant, ms")
     ap.add_argument("--u11-ms", type=int, default=400, help="with --i2t: U11 i2t warning time, ms")
     a = ap.parse_args()
-    gc.disable()  # as fb.py: a full collection would stall the cyclic thread
-    logging.getLogger("profinet").addHandler(pnctl.Records())
-    print(f"profinet-py {profinet.__version__} on {a.iface}", flush=True)
-    pnctl.tx_checksum_offload_off(a.iface)
-    src = get_mac(a.iface)
-    slots = pnctl.io_slots(a.gsdml, a.out_module, a.in_module)
-    info = pnctl.name_and_address(a.iface, src, a.device_mac.lower(), a.name, a.ip)
-    dev, ctl, out_slot, in_slot = pnctl.start_cyclic(info, a.iface, src, slots, watchdog=100)
     sc = Scenario("P-030" if a.short else "C-038-i2t" if a.i2t else "C-038")
-    try:
-        fb = ExampleFB(ctl, out_slot, in_slot)
-        if fb.until(lambda o: o.identifier == 0xF0, 5.0) is None:
-            raise RuntimeError("no response telegram 0xF0 within 5 s")
+
+    def body(fb):
         if a.i2t:
             i2t(fb, sc, a.tau_ms / 1000.0, a.u11_ms / 1000.0)
         else:
             (short if a.short else run)(fb, sc)
-    except Exception as e:  # noqa: BLE001 - the scenario's failure
-        sc.check(False, f"{type(e).__name__}: {e}")
-    finally:
-        ctl.stop()
-        dev.close()
-    print(sc.line(), flush=True)
-    return 1 if sc.failed else 0
+
+    return run_fb_scenario(a, sc, body)
 
 
 if __name__ == "__main__":

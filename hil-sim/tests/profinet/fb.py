@@ -302,6 +302,47 @@ class ExampleFB:
         return job["result"]
 
 
+def fb_arguments(doc, name, ip):
+    """The command line of a script that runs one scenario on the Example
+    Function block: serve's interface and device, the GSDML and its modules,
+    the name and IP it gives the device (more arguments may be added)."""
+    ap = argparse.ArgumentParser(description=doc.split("\n\n")[0])
+    ap.add_argument("--iface", required=True)
+    ap.add_argument("--device-mac", required=True)
+    ap.add_argument("--gsdml", required=True)
+    ap.add_argument("--out-module", required=True, help="GSDML module ID for slot 1")
+    ap.add_argument("--in-module", required=True, help="GSDML module ID for slot 2")
+    ap.add_argument("--name", default=name)
+    ap.add_argument("--ip", default=ip)
+    return ap
+
+
+def run_fb_scenario(a, sc, body):
+    """profinet-py as the IO controller of the device `a` names (fb_arguments),
+    the Example Function block on its cyclic data, `body(fb)` once the first
+    response telegram came; prints the scenario line, returns the exit status."""
+    gc.disable()  # a full collection would stall the cyclic thread
+    logging.getLogger("profinet").addHandler(pnctl.Records())
+    print(f"profinet-py {profinet.__version__} on {a.iface}", flush=True)
+    pnctl.tx_checksum_offload_off(a.iface)
+    src = get_mac(a.iface)
+    slots = pnctl.io_slots(a.gsdml, a.out_module, a.in_module)
+    info = pnctl.name_and_address(a.iface, src, a.device_mac.lower(), a.name, a.ip)
+    dev, ctl, out_slot, in_slot = pnctl.start_cyclic(info, a.iface, src, slots, watchdog=100)
+    try:
+        fb = ExampleFB(ctl, out_slot, in_slot)
+        if fb.until(lambda o: o.identifier == 0xF0, 5.0) is None:
+            raise RuntimeError("no response telegram 0xF0 within 5 s")
+        body(fb)
+    except Exception as e:  # noqa: BLE001 - the scenario's failure
+        sc.check(False, f"{type(e).__name__}: {e}")
+    finally:
+        ctl.stop()
+        dev.close()
+    print(sc.line(), flush=True)
+    return 1 if sc.failed else 0
+
+
 def state_name(z):
     return {SOI: "SOI", RTSO: "RTSO", SO: "SO", OP: "OP"}.get(z & 0x47, f"{z & 0x47:#04x}")
 

@@ -21,17 +21,10 @@ action activation (docs/conformance.md, E-142).
 One line:  scenario E-140: ok|FAIL: ...
 """
 
-import argparse
-import gc
-import logging
 import sys
 import time
 
-import profinet
-from profinet.util import get_mac
-
-import pnctl
-from fb import OP, PKW_READ, PKW_WRITE, ExampleFB
+from fb import OP, PKW_READ, PKW_WRITE, fb_arguments, run_fb_scenario
 from pnctl import Scenario, ms
 
 
@@ -146,38 +139,12 @@ def run(fb, sc, r, l):
 
 
 def main():
-    ap = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
-    ap.add_argument("--iface", required=True)
-    ap.add_argument("--device-mac", required=True)
-    ap.add_argument("--gsdml", required=True)
-    ap.add_argument("--out-module", required=True, help="GSDML module ID for slot 1")
-    ap.add_argument("--in-module", required=True, help="GSDML module ID for slot 2")
-    ap.add_argument("--name", default="drive-ma")
-    ap.add_argument("--ip", default="192.168.0.53")
+    ap = fb_arguments(__doc__, "drive-ma", "192.168.0.53")
     ap.add_argument("--r", type=float, required=True, help="the plant's phase resistance (serve --plant-r), ohm")
     ap.add_argument("--l", type=float, required=True, help="the plant's inductance (serve --plant-l), H")
     a = ap.parse_args()
-    gc.disable()  # as fb.py: a full collection would stall the cyclic thread
-    logging.getLogger("profinet").addHandler(pnctl.Records())
-    print(f"profinet-py {profinet.__version__} on {a.iface}", flush=True)
-    pnctl.tx_checksum_offload_off(a.iface)
-    src = get_mac(a.iface)
-    slots = pnctl.io_slots(a.gsdml, a.out_module, a.in_module)
-    info = pnctl.name_and_address(a.iface, src, a.device_mac.lower(), a.name, a.ip)
-    dev, ctl, out_slot, in_slot = pnctl.start_cyclic(info, a.iface, src, slots, watchdog=100)
     sc = Scenario("E-140")
-    try:
-        fb = ExampleFB(ctl, out_slot, in_slot)
-        if fb.until(lambda o: o.identifier == 0xF0, 5.0) is None:
-            raise RuntimeError("no response telegram 0xF0 within 5 s")
-        run(fb, sc, a.r, a.l)
-    except Exception as e:  # noqa: BLE001 - the scenario's failure
-        sc.check(False, f"{type(e).__name__}: {e}")
-    finally:
-        ctl.stop()
-        dev.close()
-    print(sc.line(), flush=True)
-    return 1 if sc.failed else 0
+    return run_fb_scenario(a, sc, lambda fb: run(fb, sc, a.r, a.l))
 
 
 if __name__ == "__main__":
