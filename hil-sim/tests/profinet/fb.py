@@ -317,18 +317,31 @@ def fb_arguments(doc, name, ip):
     return ap
 
 
-def run_fb_scenario(a, sc, body):
-    """profinet-py as the IO controller of the device `a` names (fb_arguments),
-    the Example Function block on its cyclic data, `body(fb)` once the first
-    response telegram came; prints the scenario line, returns the exit status."""
-    gc.disable()  # a full collection would stall the cyclic thread
+def start_controller(a, real_time=False):
+    """profinet-py as the IO controller of the device `a` names (fb_arguments):
+    name and IP set by DCP, the AR connected, cyclic data running (watchdog
+    and data hold 100 ms: the machine running the test may be busy); with
+    `real_time` its threads on a real-time priority. (dev, ctl, out, in)."""
+    # the samples kept are many small objects without cycles: a full
+    # collection among them would hold the GIL, and profinet-py's sending
+    # thread, for tens of ms (the device's data hold is 50 ms)
+    gc.disable()
     logging.getLogger("profinet").addHandler(pnctl.Records())
     print(f"profinet-py {profinet.__version__} on {a.iface}", flush=True)
     pnctl.tx_checksum_offload_off(a.iface)
     src = get_mac(a.iface)
     slots = pnctl.io_slots(a.gsdml, a.out_module, a.in_module)
     info = pnctl.name_and_address(a.iface, src, a.device_mac.lower(), a.name, a.ip)
-    dev, ctl, out_slot, in_slot = pnctl.start_cyclic(info, a.iface, src, slots, watchdog=100)
+    if real_time:
+        print(f"controller threads: {pnctl.real_time()}", flush=True)
+    return pnctl.start_cyclic(info, a.iface, src, slots, watchdog=100)
+
+
+def run_fb_scenario(a, sc, body):
+    """profinet-py as the IO controller of the device `a` names (fb_arguments),
+    the Example Function block on its cyclic data, `body(fb)` once the first
+    response telegram came; prints the scenario line, returns the exit status."""
+    dev, ctl, out_slot, in_slot = start_controller(a)
     try:
         fb = ExampleFB(ctl, out_slot, in_slot)
         if fb.until(lambda o: o.identifier == 0xF0, 5.0) is None:
@@ -847,30 +860,11 @@ def p227_fault(fb, sc, fifo):
 
 
 def main():
-    ap = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
-    ap.add_argument("--iface", required=True)
-    ap.add_argument("--device-mac", required=True)
-    ap.add_argument("--gsdml", required=True)
-    ap.add_argument("--out-module", required=True, help="GSDML module ID for slot 1")
-    ap.add_argument("--in-module", required=True, help="GSDML module ID for slot 2")
-    ap.add_argument("--name", default="drive-fb")
-    ap.add_argument("--ip", default="192.168.0.51")
+    ap = fb_arguments(__doc__, "drive-fb", "192.168.0.51")
     ap.add_argument("--control", help="serve's control FIFO (P-227's fault); without it P-227 is n/a")
     ap.add_argument("--only", nargs="*", help="run these scenarios only (e.g. P-219 P-226)")
     a = ap.parse_args()
-    # the samples kept are many small objects without cycles: a full
-    # collection among them would hold the GIL, and profinet-py's sending
-    # thread, for tens of ms (the device's data hold is 50 ms)
-    gc.disable()
-    logging.getLogger("profinet").addHandler(pnctl.Records())
-    print(f"profinet-py {profinet.__version__} on {a.iface}", flush=True)
-    pnctl.tx_checksum_offload_off(a.iface)
-    src = get_mac(a.iface)
-    slots = pnctl.io_slots(a.gsdml, a.out_module, a.in_module)
-    info = pnctl.name_and_address(a.iface, src, a.device_mac.lower(), a.name, a.ip)
-    print(f"controller threads: {pnctl.real_time()}", flush=True)
-    # watchdog and data hold 100 ms: the machine running the test may be busy
-    dev, ctl, out_slot, in_slot = pnctl.start_cyclic(info, a.iface, src, slots, watchdog=100)
+    dev, ctl, out_slot, in_slot = start_controller(a, real_time=True)
     failed = []
     try:
         fb = ExampleFB(ctl, out_slot, in_slot)
