@@ -58,6 +58,11 @@ pub mod result {
     /// B300: the shaft turned against the applied brake (beyond
     /// [`super::brake::TOLERANCE_INC`]); 7 and 8 are B40's.
     pub const SLIPPED: u8 = 9;
+    /// B44: the test move would pass a software limit (607Dh), or a limit
+    /// switch is active: refused before it moves.
+    pub const LIMIT: u8 = 10;
+    /// B44: the axis left the stated travel of the test move.
+    pub const OUT_OF_TRAVEL: u8 = 11;
 }
 
 /// Cycles per settle block.
@@ -377,8 +382,11 @@ fn abs(x: f32) -> f32 {
 
 pub mod align;
 pub mod brake;
+pub mod mechanics;
 pub mod phase;
 pub mod winding;
 
 #[cfg(test)]
 mod tests;
+#[cfg(test)]
+mod tests_mechanics;
