@@ -412,8 +412,9 @@ fn start_mechanics(a: &mut AxisActions, objects: &mut DriveObjects, axis: usize,
             1.0
         }
     };
-    let travel = (f64::from(TRAVEL_INC) * per_inc) as i64 + 1;
-    let back = (f64::from(BACK_INC) * per_inc) as i64 + 1;
+    // (the casts saturate; + 1 rounds up)
+    let travel = ((f64::from(TRAVEL_INC) * per_inc) as i64).saturating_add(1);
+    let back = ((f64::from(BACK_INC) * per_inc) as i64).saturating_add(1);
     let inputs = get(0x60FD, 0);
     let within = MechanicsTest::travel_allowed(get(0x6064, 0), get(0x607D, 1), get(0x607D, 2), travel, back);
     if !within || inputs & 0b11 != 0 {

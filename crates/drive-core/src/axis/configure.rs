@@ -157,6 +157,17 @@ impl Axis {
         });
     }
 
+    /// A motor action replaced this cycle's command (`crate::actions`): the
+    /// cascade's integral part and the following-error monitor start from
+    /// rest, so that the axis takes over without the torque its velocity
+    /// controller wound up against the action's movement.
+    pub fn overridden(&mut self) {
+        self.following.reset();
+        if let Some(c) = self.cascade.as_mut() {
+            c.reset(self.sp_pos);
+        }
+    }
+
     pub(super) fn rebuild_interpolators(&mut self) {
         let p = self.params;
         let (interp, vinterp) = match (self.ratio, from_i425(p.interpolation_i425)) {

@@ -629,17 +629,6 @@ impl Axis {
         }
     }
 
-    /// A motor action replaced this cycle's command (`crate::actions`): the
-    /// cascade's integral part and the following-error monitor start from
-    /// rest, so that the axis takes over without the torque its velocity
-    /// controller wound up against the action's movement.
-    pub fn overridden(&mut self) {
-        self.following.reset();
-        if let Some(c) = self.cascade.as_mut() {
-            c.reset(self.sp_pos);
-        }
-    }
-
     /// Drive function off: the set-point state follows the actual position.
     fn disengage(&mut self, actual: i32) {
         self.sp_pos = actual;

@@ -77,12 +77,12 @@ pub const TRAVEL_INC: i32 = 12 << 20;
 pub const BACK_INC: i32 = 1 << 20;
 /// The largest kinetic energy of the test move, J: the speeds are scaled
 /// down for a large inertia (J₀ from the kick) so that ½·J·v² stays below
-/// it, what a DC link without a brake chopper takes back (470 µF at 565 V
-/// rise by ~7 V), and the constant speeds last longer (at most
-/// [`MAX_HOLD_S`]) so that the travel is about the same.
+/// it, what a DC link without a brake chopper takes back (the simulated
+/// 470 µF at 565 V rise by ~9 V). (Longer constant speeds at the lower
+/// speeds would narrow B's error; on the electrical plant a second-long
+/// hold at a tenth of an ampere tripped the current loop's plausibility
+/// check, `foc::CurrentDeviation`, so the holds stay at [`HOLD_S`].)
 pub const MAX_ENERGY_J: f32 = 2.5;
-/// The longest constant speed, s.
-pub const MAX_HOLD_S: f32 = 1.0;
 /// The test loop's bandwidth, Hz (at most 0.15 / cycle).
 const LOOP_HZ: f32 = 15.0;
 /// The return's top speed, rev/s.
@@ -99,8 +99,6 @@ const LEG_STAGES: u16 = 4;
 const LEGS: u16 = 2 * SPEEDS_REV_S.len() as u16;
 /// The return stage.
 const RETURN_STAGE: u16 = FIRST_LEG_STAGE + LEGS * LEG_STAGES;
-/// Ramp windows (two per leg).
-const RAMPS: usize = 2 * LEGS as usize;
 
 /// What was identified (SI units).
 #[derive(Debug, Clone, Copy, PartialEq)]
@@ -164,8 +162,47 @@ struct Window {
     time: f32,
 }
 
-/// A closed ramp window: Δv, ∫T, ∫sign, Δx, T.
-type Ramp = (f32, f32, f32, f32, f32);
+/// One direction's constant speeds: the sums of the straight line T̄ = a +
+/// B·v̄ through them (count, Σv̄, ΣT̄, Σv̄², Σv̄·T̄).
+#[derive(Debug, Clone, Copy, PartialEq, Default)]
+struct LineSums {
+    n: f32,
+    v: f32,
+    t: f32,
+    vv: f32,
+    vt: f32,
+}
+
+impl LineSums {
+    fn add(&mut self, v: f32, t: f32) {
+        self.n += 1.0;
+        self.v += v;
+        self.t += t;
+        self.vv += v * v;
+        self.vt += v * t;
+    }
+
+    /// (a, B) of the least-squares line; `None` below two points.
+    fn line(&self) -> Option<(f32, f32)> {
+        if self.n < 2.0 {
+            return None;
+        }
+        let (mv, mt) = (self.v / self.n, self.t / self.n);
+        let b = (self.vt - self.n * mv * mt) / (self.vv - self.n * mv * mv);
+        Some((mt - b * mv, b))
+    }
+}
+
+/// The ramps' sums for J (the windows themselves are not kept): Σ Δv·∫T,
+/// Σ Δv·∫sign, Σ Δv·Δx, Σ Δv·t, Σ Δv², over the closed ramp windows.
+#[derive(Debug, Clone, Copy, PartialEq, Default)]
+struct RampSums {
+    torque: f32,
+    sign: f32,
+    dx: f32,
+    time: f32,
+    dv2: f32,
+}
 
 /// The B44 test of one axis.
 #[derive(Debug, Clone, Copy, PartialEq)]
@@ -184,10 +221,8 @@ pub struct MechanicsTest {
     stage_cycles: u32,
     /// The first inertia (kick), kg·m².
     j0: f32,
-    /// The speeds' scale (≤ 1, [`MAX_ENERGY_J`]) and the constant speeds'
-    /// time, s.
+    /// The speeds' scale (≤ 1, [`MAX_ENERGY_J`]).
     speed_scale: f32,
-    hold_s: f32,
     /// The test loop: speed PI integral, N·m; references.
     integral_nm: f32,
     x_ref: f32,
@@ -197,10 +232,9 @@ pub struct MechanicsTest {
     returned: bool,
     ramp: Window,
     plateau: Window,
-    ramps: [Ramp; RAMPS],
-    ramp_count: usize,
+    ramps: RampSums,
     /// (mean speed rad/s, mean torque N·m) per leg's constant speed.
-    plateaus: [(f32, f32); LEGS as usize],
+    plateaus: [LineSums; 2],
     result: Option<Mechanics>,
     excursion_inc: u32,
     outcome: MechanicsOutcome,
@@ -224,7 +258,6 @@ impl MechanicsTest {
             stage_cycles: 0,
             j0: 0.0,
             speed_scale: 1.0,
-            hold_s: HOLD_S,
             integral_nm: 0.0,
             x_ref: 0.0,
             v_ref: 0.0,
@@ -232,9 +265,8 @@ impl MechanicsTest {
             returned: false,
             ramp: Window::default(),
             plateau: Window::default(),
-            ramps: [(0.0, 0.0, 0.0, 0.0, 0.0); RAMPS],
-            ramp_count: 0,
-            plateaus: [(0.0, 0.0); LEGS as usize],
+            ramps: RampSums::default(),
+            plateaus: [LineSums::default(); 2],
             result: None,
             excursion_inc: 0,
             outcome: MechanicsOutcome::Running(0, 0),
@@ -345,7 +377,6 @@ impl MechanicsTest {
                     let top = SPEEDS_REV_S.iter().fold(0.0f32, |m, &s| m.max(s)) * TAU;
                     let allowed = sqrt(2.0 * MAX_ENERGY_J / self.j0);
                     self.speed_scale = clamp(allowed / top, 0.05, 1.0);
-                    self.hold_s = HOLD_S;
                     (self.x_ref, self.v_ref, self.integral_nm) = (x, v, 0.0);
                     self.next_stage();
                 } else {
@@ -410,7 +441,7 @@ impl MechanicsTest {
                         // constant speed (1) or rest (3): the ramp's window
                         // closes after the settle time, the speed's is
                         // measured from there to the end
-                        let hold = if part == 1 { self.hold_s } else { REST_S };
+                        let hold = if part == 1 { HOLD_S } else { REST_S };
                         // a deceleration's window closes where the shaft
                         // stops (from there a breakaway friction holds what
                         // the model does not know), at the latest then
@@ -419,10 +450,13 @@ impl MechanicsTest {
                             let w = self.ramp;
                             self.ramp.open = false;
                             let v_end = if part == 3 { v } else { v_mean };
-                            if let Some(r) = self.ramps.get_mut(self.ramp_count) {
-                                *r = (v_end - w.v0, w.torque, w.sign, x - w.x0, w.time);
-                                self.ramp_count += 1;
-                            }
+                            let dv = v_end - w.v0;
+                            let r = &mut self.ramps;
+                            r.torque += dv * w.torque;
+                            r.sign += dv * w.sign;
+                            r.dx += dv * (x - w.x0);
+                            r.time += dv * w.time;
+                            r.dv2 += dv * dv;
                             if part == 1 {
                                 self.plateau = Window {
                                     open: true,
@@ -438,8 +472,9 @@ impl MechanicsTest {
                                 if w.time <= 0.0 {
                                     return Err(result::NOT_SETTLED);
                                 }
-                                if let Some(p) = self.plateaus.get_mut(usize::from(leg)) {
-                                    *p = ((x - w.x0) / w.time, w.torque / w.time);
+                                let (v_mean, t_mean) = ((x - w.x0) / w.time, w.torque / w.time);
+                                if let Some(p) = self.plateaus.get_mut(usize::from(leg % 2)) {
+                                    p.add(v_mean, t_mean);
                                 }
                             }
                             self.next_stage();
@@ -497,36 +532,14 @@ impl MechanicsTest {
 
     /// The figures from the windows (see the module docs).
     fn identify(&self) -> Option<Mechanics> {
-        let line = |dir: f32| {
-            let pts = self.plateaus.iter().filter(|(v, _)| v * dir > 0.0);
-            let (mut n, mut sv, mut st) = (0.0f32, 0.0f32, 0.0f32);
-            for &(v, t) in pts.clone() {
-                (n, sv, st) = (n + 1.0, sv + v, st + t);
-            }
-            if n < 2.0 {
-                return None;
-            }
-            let (mv, mt) = (sv / n, st / n);
-            let (mut svv, mut svt) = (0.0f32, 0.0f32);
-            for &(v, t) in pts {
-                svv += (v - mv) * (v - mv);
-                svt += (v - mv) * (t - mt);
-            }
-            let b = svt / svv;
-            Some((mt - b * mv, b))
-        };
-        let (ap, bp) = line(1.0)?;
-        let (an, bn) = line(-1.0)?;
+        let [forward, backward] = self.plateaus;
+        let (ap, bp) = forward.line()?;
+        let (an, bn) = backward.line()?;
         let coulomb = 0.5 * (ap - an);
         let load = 0.5 * (ap + an);
         let viscous = 0.5 * (bp + bn);
-        let (mut num, mut den) = (0.0f32, 0.0f32);
-        for &(dv, torque, sign, dx, time) in self.ramps.iter().take(self.ramp_count) {
-            let rest = torque - coulomb * sign - viscous * dx - load * time;
-            num += dv * rest;
-            den += dv * dv;
-        }
-        let j = num / den;
+        let r = self.ramps;
+        let j = (r.torque - coulomb * r.sign - viscous * r.dx - load * r.time) / r.dv2;
         let ok = |x: f32| x.is_finite();
         (ok(j) && j > 0.0 && ok(coulomb) && ok(viscous) && ok(load)).then_some(Mechanics {
             inertia_kg_m2: j,
