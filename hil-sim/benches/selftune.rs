@@ -14,7 +14,7 @@
 //! No master: the set-points and A75 are written into the dictionary as a
 //! decoded RxPDO would (A75 mapped in 1600h: action activation, E-142), the
 //! drive polls an ESC without a master (the actions' pass) and runs its
-//! control cycle every 1 ms; `hil-sim/tests/soem/motor_actions.py` runs the
+//! control cycle every 1 ms; `hil-sim/tests/soem/mechanics.py` runs the
 //! action through SOEM.
 #![allow(
     clippy::unwrap_used,
