@@ -194,3 +194,32 @@ fn e090_e089_soem_braking_a_flywheel_without_brake_resistor_trips_over_voltage()
         line.fail_with(&format!("chopper.py through SOEM failed: {status}"));
     }
 }
+
+/// E-140, E-141 through SOEM on the electrical plant (`mechanics.py`, issue
+/// 35): B44 "identify mechanics" (A75 selector 1111b, ours) refused while
+/// the axis is switch-on disabled (nothing changes) and, before it moves,
+/// when its travel would pass the software limits 607Dh (B44[0] = 12); then
+/// started in Ready to switch on and run after the enable it identifies the
+/// simulated servo's inertia within 5 % and its Coulomb and viscous friction
+/// within 10 % (1e-4 kg·m², 0.02 N·m, 2e-5 N·m·s/rad: the drive's B45…B47
+/// are 0) and writes the speed controller's gain for B48.
+#[test]
+fn e140_e141_soem_b44_identify_mechanics_refused_beyond_the_limits_then_identifies_the_plant() {
+    let python = match pysoem_python() {
+        Ok(p) => p,
+        Err(why) => {
+            eprintln!("soem B44 test: skipped, {why}");
+            return;
+        }
+    };
+    let dir = scratch("soem-mechanics");
+    let line = Line::with_serve_args("b4", 1, 120, &dir, &["--plant", "electrical"]);
+    let status = line.run(
+        &python,
+        "mechanics.py",
+        &["--j", "1e-4", "--fc", "0.02", "--b", "2e-5"],
+    );
+    if !status.success() {
+        line.fail_with(&format!("mechanics.py through SOEM failed: {status}"));
+    }
+}

@@ -13,7 +13,8 @@
 //!
 //! The motor actions that need the power stage (B40 test phase, B41
 //! calibrate motor, B42/B49 optimise current controller, B43 test winding,
-//! B300 test brake, B301 grind brake: [`crate::tuning`]) start
+//! B300 test brake, B301 grind brake, B44 identify mechanics:
+//! [`crate::tuning`]) start
 //! in Ready to switch on and run once the master enabled the axis (E-141;
 //! B43 at once, without an enable): their measurement runs in the
 //! control cycle ([`Actions::control`], which replaces the axis' command),
@@ -28,10 +29,14 @@
 //! telegram, record 0xB02E), which is itself the activation.
 
 use crate::axis::{AxisCommand, AxisIo};
-use crate::params::{B05, B10, B300, B301, B40, B41, B42, B43, B52, B53, B62, E48};
+use crate::params::{
+    A150, A150_FALLBACK_US, B05, B10, B300, B301, B40, B41, B42, B43, B44, B45, B46, B47, B48, B52, B53, B62,
+    C31, C32, E48, I20,
+};
 use crate::tuning::align::{AlignOutcome, Alignment};
 use crate::tuning::brake::{BrakeOutcome, BrakeTest};
 use crate::tuning::grind::{GrindBrake, GrindFigures, GrindOutcome};
+use crate::tuning::mechanics::{MechanicsOutcome, MechanicsTest, BACK_INC, TRAVEL_INC};
 use crate::tuning::phase::{PhaseOutcome, PhaseTest};
 use crate::tuning::winding::{WindingOutcome, WindingTest};
 use crate::tuning::{CurrentTuning, Outcome};
@@ -62,7 +67,7 @@ pub mod state {
     pub const FAILED: u16 = 5;
     /// Action activation is off for the axis (E-142): not started.
     pub const NOT_ACTIVATED: u16 = 6;
-    /// The selector names no action (0000b, 1111b).
+    /// The selector names no action (0000b).
     pub const UNKNOWN: u16 = 7;
 }
 
@@ -97,10 +102,13 @@ pub enum Action {
     TestWinding,
     /// 1110b, B49 optimise current controller at standstill.
     OptimiseCurrentStandstill,
+    /// 1111b (unused in the manual's table, ours), B44 identify mechanics
+    /// ([`crate::tuning::mechanics`]).
+    IdentifyMechanics,
 }
 
 impl Action {
-    /// The action of selector `s` (bits 1–4 of A75); `None` for 0000b, 1111b.
+    /// The action of selector `s` (bits 1–4 of A75); `None` for 0000b.
     pub const fn from_selector(s: u8) -> Option<Self> {
         Some(match s {
             0b0001 => Action::Save,
@@ -117,6 +125,7 @@ impl Action {
             0b1100 => Action::OptimiseCurrent,
             0b1101 => Action::TestWinding,
             0b1110 => Action::OptimiseCurrentStandstill,
+            0b1111 => Action::IdentifyMechanics,
             _ => return None,
         })
     }
@@ -163,7 +172,10 @@ struct AxisActions {
     tuning: Option<Measurement>,
 }
 
-/// A motor action's part in the control cycle.
+/// A motor action's part in the control cycle. (B44's windows make its
+/// variant the largest; the unit lives in a static either way, one per
+/// axis, no heap to box it in.)
+#[allow(clippy::large_enum_variant)]
 #[derive(Debug, Clone, Copy)]
 enum Measurement {
     /// B42/B49.
@@ -178,6 +190,8 @@ enum Measurement {
     Brake(BrakeTest),
     /// B301.
     Grind(GrindBrake),
+    /// B44.
+    Mechanics(MechanicsTest),
 }
 
 /// What activates the actions of an axis (E-142).
@@ -277,6 +291,7 @@ impl Actions {
             Measurement::Phase(p) => p.cycle(e48, io.position_inc, io.current.as_ref()),
             Measurement::Brake(b) => b.cycle(e48, io.position_inc),
             Measurement::Grind(g) => g.cycle(e48, io.position_inc),
+            Measurement::Mechanics(m) => m.cycle(e48, io.position_inc),
         }
     }
 
@@ -317,6 +332,7 @@ impl Actions {
                         Some(Measurement::Phase(p)) => follow_phase(objects, p, axis, selector),
                         Some(Measurement::Brake(b)) => follow_brake(objects, b, axis, selector),
                         Some(Measurement::Grind(g)) => follow_grind(objects, g, axis, selector),
+                        Some(Measurement::Mechanics(m)) => follow_mechanics(objects, m, axis, selector),
                         None => None,
                     },
                     _ => follow(objects, r, selector),
@@ -432,12 +448,110 @@ fn start(
             a.running = Some(Running::Tuning);
             status(0, selector, state::RUNNING)
         }
+        Action::IdentifyMechanics => start_mechanics(a, objects, axis, selector),
         // A37 (the memorised extreme values) and I52 (the limit-switch
         // memory) hold nothing in this drive; a second brake (B302) it does
         // not have (one brake per axis), and the safety's brake test (S18)
         // belongs to a safety module it does not have
         _ => status(0, selector, state::NOT_AVAILABLE),
     }
+}
+
+/// Starts B44 on `axis` unless its test move would pass a software limit
+/// (607Dh, against 6064h) or a limit switch is active (60FDh bits 0, 1):
+/// then refused before anything moves, B44\[0\] = 10.
+fn start_mechanics(a: &mut AxisActions, objects: &mut DriveObjects, axis: usize, selector: u8) -> u16 {
+    let (off, c) = (offset(axis), cia(axis));
+    let get = |i: u16, s: u8| objects.get(i + c, s).unwrap_or(0);
+    // the travel in the position unit of 6064h/607Dh: increments × 6092h
+    // feed / (6091h gear ratio × 2^20 per revolution, 6092h:02 shaft revs)
+    let per_inc = {
+        let (motor, shaft) = (get(0x6091, 1) as f64, get(0x6091, 2) as f64);
+        let (feed, revs) = (get(0x6092, 1) as f64, get(0x6092, 2) as f64);
+        let k = feed * shaft / (revs * motor * f64::from(1u32 << 20));
+        if k.is_finite() && k > 0.0 {
+            k
+        } else {
+            1.0
+        }
+    };
+    // (the casts saturate; + 1 rounds up)
+    let travel = ((f64::from(TRAVEL_INC) * per_inc) as i64).saturating_add(1);
+    let back = ((f64::from(BACK_INC) * per_inc) as i64).saturating_add(1);
+    let inputs = get(0x60FD, 0);
+    let within = MechanicsTest::travel_allowed(get(0x6064, 0), get(0x607D, 1), get(0x607D, 2), travel, back);
+    if !within || inputs & 0b11 != 0 {
+        let _ = objects.set(B44 + off, 1, i64::from(crate::tuning::result::LIMIT));
+        return status(0, selector, state::REFUSED);
+    }
+    let cycle_us = match objects.get(A150, 0) {
+        Ok(us) if us > 0 => us as f32,
+        _ => A150_FALLBACK_US as f32,
+    };
+    let rated_nm = get(0x6076, 0) as f32 * 1e-3;
+    let max_nm = rated_nm * get(0x6072, 0) as f32 * 1e-3;
+    let _ = objects.set(B44 + off, 1, 0);
+    let _ = objects.set(B44 + off, 2, 0);
+    a.tuning = Some(Measurement::Mechanics(MechanicsTest::new(
+        cycle_us * 1e-6,
+        rated_nm,
+        max_nm,
+    )));
+    a.running = Some(Running::Tuning);
+    status(0, selector, state::RUNNING)
+}
+
+/// A69 of a running B44; at its end the figures in B45…B47, the gains for
+/// B48's bandwidth in C31/C32/I20 (for the 250 µs reference cycle of the
+/// gains, which the axis scales to A150), the result in B44.
+fn follow_mechanics(objects: &mut DriveObjects, m: &MechanicsTest, axis: usize, selector: u8) -> Option<u16> {
+    let off = offset(axis);
+    let (code, excursion, st) = match m.outcome() {
+        MechanicsOutcome::Running(p, _) => return Some(status(u16::from(p), selector, state::RUNNING)),
+        MechanicsOutcome::Failed(code, excursion) => (code, excursion, state::FAILED),
+        MechanicsOutcome::Done(id, excursion) => {
+            let round = |x: f32| (x + 0.5) as i64;
+            let cycle_us = match objects.get(A150, 0) {
+                Ok(us) if us > 0 => us as f32,
+                _ => A150_FALLBACK_US as f32,
+            };
+            // the reference cycle's gains scale by r = 250 µs / A150 (Kp),
+            // 1/r (Ti), √r (Kv) above it
+            let r = (250.0 / cycle_us).min(1.0);
+            let bandwidth = objects.get(B48 + off, 0).unwrap_or(30) as f32;
+            let g = id.gains(bandwidth);
+            let written = objects.set(B45 + off, 0, round(id.inertia_kg_m2 * 1e7)).is_ok()
+                && objects.set(B46 + off, 0, round(id.coulomb_nm * 1e6)).is_ok()
+                && objects
+                    .set(B47 + off, 0, round(id.viscous_nm_s_per_rad * 1e9))
+                    .is_ok()
+                && objects
+                    .set(C31 + off, 0, round(g.kp_nm_s_per_rad / r * 1e6))
+                    .is_ok()
+                && objects.set(C32 + off, 0, round(g.ti_s * r * 1e6)).is_ok()
+                && objects
+                    .set(I20 + off, 0, round(g.kv_per_s / sqrt(r) * 10.0))
+                    .is_ok();
+            let _ = objects.set(B44 + off, 3, (id.load_nm * 1e6) as i64);
+            if written {
+                (crate::tuning::result::OK, excursion, state::DONE)
+            } else {
+                (crate::tuning::result::IMPLAUSIBLE, excursion, state::FAILED)
+            }
+        }
+    };
+    let _ = objects.set(B44 + off, 2, i64::from(excursion));
+    let _ = objects.set(B44 + off, 1, i64::from(code));
+    Some(status(if st == state::DONE { 100 } else { 0 }, selector, st))
+}
+
+/// √x for 0 < x ≤ 1 (Newton's method, no `std`).
+fn sqrt(x: f32) -> f32 {
+    let mut y = 1.0;
+    for _ in 0..20 {
+        y = 0.5 * (y + x / y);
+    }
+    y
 }
 
 /// The CiA 402 window offset of `axis`.
@@ -691,13 +805,12 @@ mod tests {
         assert_eq!(a.status(0), status(100, 7, state::DONE));
         // held high: no second start
         assert_eq!(a.serve(&mut od), Effects::default());
-        for s in [0b0000, 0b1111] {
-            execute(&mut od, 0, s, false);
-            a.serve(&mut od);
-            execute(&mut od, 0, s, true);
-            a.serve(&mut od);
-            assert_eq!(a.status(0) >> 12, state::UNKNOWN, "selector {s:04b}");
-        }
+        // 1111b is B44 (ours): 0000b is the one selector without an action
+        execute(&mut od, 0, 0, false);
+        a.serve(&mut od);
+        execute(&mut od, 0, 0, true);
+        a.serve(&mut od);
+        assert_eq!(a.status(0) >> 12, state::UNKNOWN, "selector 0000b");
         execute(&mut od, 0, 0, false);
         a.serve(&mut od);
         execute(&mut od, 0, 0b0110, true);

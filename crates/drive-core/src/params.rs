@@ -202,6 +202,18 @@ pub const B42: u16 = parameter_index(1, 42);
 /// B43 test winding: the action's result and the three phases' resistances
 /// (per axis; started through A75, `crate::tuning::winding`).
 pub const B43: u16 = parameter_index(1, 43);
+/// B44 identify mechanics: the action's result, excursion and constant
+/// load (per axis; started through A75 selector 1111b,
+/// `crate::tuning::mechanics`).
+pub const B44: u16 = parameter_index(1, 44);
+/// B45 total inertia, 10⁻⁷ kg·m² (g·cm²; per axis; 0 = not identified).
+pub const B45: u16 = parameter_index(1, 45);
+/// B46 Coulomb friction, µN·m (per axis).
+pub const B46: u16 = parameter_index(1, 46);
+/// B47 viscous friction, nN·m·s/rad (per axis).
+pub const B47: u16 = parameter_index(1, 47);
+/// B48 speed-loop bandwidth for the gains of B44, Hz (per axis).
+pub const B48: u16 = parameter_index(1, 48);
 /// B52 d-axis inductance Ld, µH (per axis, motor data).
 pub const B52: u16 = parameter_index(1, 52);
 /// B300 test brake: the action's result, the largest movement seen and the

@@ -64,6 +64,11 @@ pub mod result {
     /// B301: a released phase did not turn the shaft with a quarter of the
     /// rated torque: the brake stays closed when commanded open.
     pub const NOT_RELEASED: u8 = 11;
+    /// B44: the test move would pass a software limit (607Dh), or a limit
+    /// switch is active: refused before it moves.
+    pub const LIMIT: u8 = 12;
+    /// B44: the axis left the stated travel of the test move.
+    pub const OUT_OF_TRAVEL: u8 = 13;
 }
 
 /// Cycles per settle block.
@@ -384,8 +389,11 @@ fn abs(x: f32) -> f32 {
 pub mod align;
 pub mod brake;
 pub mod grind;
+pub mod mechanics;
 pub mod phase;
 pub mod winding;
 
 #[cfg(test)]
 mod tests;
+#[cfg(test)]
+mod tests_mechanics;

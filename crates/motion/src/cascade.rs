@@ -110,7 +110,24 @@ pub struct CascadeConfig {
     /// Moment of inertia in kg·m² for the acceleration (torque) feedforward
     /// J·a; 0 disables it.
     pub inertia_kg_m2: f32,
+    /// Coulomb friction feedforward, N·m: `Fc·s(v_ref)` added to the torque
+    /// in the position and velocity entries, with s a sign smoothed over
+    /// ±[`FRICTION_BAND_INC_PER_S`] (no chatter at standstill); 0 disables it.
+    pub coulomb_friction_nm: f32,
+    /// Viscous friction feedforward, N·m per rad/s: `B·v_ref`; 0 disables it.
+    pub viscous_friction_nm_per_rad_per_s: f32,
+    /// Derive the acceleration feedforward from the change of the velocity
+    /// feedforward when the set-point generator supplies none (csp/ip with
+    /// linear interpolation: a = Δv_ff/Δt of successive cycles, from the
+    /// third cycle after a reset on: the first carries the jump from the
+    /// actual position to the set-point). Off: only the generator's
+    /// acceleration feeds J·a.
+    pub derive_acceleration: bool,
 }
+
+/// The band of the smoothed sign of the Coulomb friction feedforward,
+/// increments/s (0.02 rev/s): below it the feedforward shrinks linearly to 0.
+pub const FRICTION_BAND_INC_PER_S: f32 = 0.02 * INCREMENTS_PER_REVOLUTION as f32;
 
 impl CascadeConfig {
     /// Defaults for a small servo: Kv = 100 /s, I25 = 100 %, Kp = 0.06 N·m
@@ -131,6 +148,9 @@ impl CascadeConfig {
         torque_mode_velocity_limit_positive_inc_per_s: 0.0,
         torque_mode_velocity_limit_negative_inc_per_s: 0.0,
         inertia_kg_m2: 0.0,
+        coulomb_friction_nm: 0.0,
+        viscous_friction_nm_per_rad_per_s: 0.0,
+        derive_acceleration: false,
     };
 
     /// Checks that every gain and limit is finite and not negative and that
@@ -145,6 +165,8 @@ impl CascadeConfig {
             self.torque_mode_velocity_limit_positive_inc_per_s,
             self.torque_mode_velocity_limit_negative_inc_per_s,
             self.inertia_kg_m2,
+            self.coulomb_friction_nm,
+            self.viscous_friction_nm_per_rad_per_s,
         ];
         if values.iter().any(|v| !(v.is_finite() && *v >= 0.0)) {
             return Err(CascadeError::InvalidValue);
@@ -227,6 +249,12 @@ pub struct Cascade {
     last_position: Option<i32>,
     /// Filtered actual velocity, increments/s.
     velocity_inc_per_s: f32,
+    /// The last cycle's velocity feedforward, increments/s
+    /// ([`CascadeConfig::derive_acceleration`]), and the cycles since the
+    /// reset (the first feedforward after an enable carries the jump from
+    /// the actual position to the set-point: not differentiated).
+    last_feedforward: Option<f32>,
+    feedforward_cycles: u8,
 }
 
 impl Cascade {
@@ -238,6 +266,8 @@ impl Cascade {
             integral_nm: 0.0,
             last_position: None,
             velocity_inc_per_s: 0.0,
+            last_feedforward: None,
+            feedforward_cycles: 0,
         };
         c.reset(actual_position_inc);
         Ok(c)
@@ -269,6 +299,8 @@ impl Cascade {
         self.integral_nm = 0.0;
         self.last_position = Some(actual_position_inc);
         self.velocity_inc_per_s = 0.0;
+        self.last_feedforward = None;
+        self.feedforward_cycles = 0;
     }
 
     /// The velocity controller's integral part in N·m.
@@ -297,12 +329,23 @@ impl Cascade {
 
         let (velocity_command, torque_unlimited) = match input.entry {
             ControlEntry::Position | ControlEntry::Velocity => {
+                let v_in = finite_or_zero(input.velocity_inc_per_s);
+                let mut acceleration = finite_or_zero(input.acceleration_feedforward_inc_per_s2);
+                let v_ref = v_in;
+                if cfg.derive_acceleration {
+                    let last = self.last_feedforward.replace(v_in);
+                    self.feedforward_cycles = self.feedforward_cycles.saturating_add(1);
+                    if acceleration == 0.0 && dt_s > 0.0 && self.feedforward_cycles > 2 {
+                        if let Some(l) = last {
+                            acceleration = (v_in - l) / dt_s;
+                        }
+                    }
+                }
                 let raw_command = if input.entry == ControlEntry::Position {
                     following_error_inc = input
                         .position_setpoint_inc
                         .wrapping_sub(input.actual_position_inc);
-                    let ff =
-                        finite_or_zero(input.velocity_inc_per_s) * cfg.velocity_feedforward_percent * 0.01;
+                    let ff = v_ref * cfg.velocity_feedforward_percent * 0.01;
                     // P-157: no correction inside the dead band (|0| ≤ 0 when off)
                     let corrected = if following_error_inc.unsigned_abs() <= cfg.position_dead_band_inc {
                         0
@@ -311,7 +354,7 @@ impl Cascade {
                     };
                     cfg.position_gain_per_s * corrected as f32 + ff
                 } else {
-                    finite_or_zero(input.velocity_inc_per_s)
+                    v_ref
                 };
                 let vmax = cfg.max_velocity_inc_per_s;
                 let command = clamp(raw_command, -vmax, vmax);
@@ -320,9 +363,8 @@ impl Cascade {
                 let error_rad_per_s = (command - actual_velocity) * RAD_PER_INCREMENT;
                 let proportional = kp * error_rad_per_s;
                 let feedforward = finite_or_zero(input.torque_nm)
-                    + cfg.inertia_kg_m2
-                        * finite_or_zero(input.acceleration_feedforward_inc_per_s2)
-                        * RAD_PER_INCREMENT;
+                    + cfg.inertia_kg_m2 * acceleration * RAD_PER_INCREMENT
+                    + friction_feedforward(&cfg, v_ref);
                 let unsaturated = proportional + self.integral_nm + feedforward;
 
                 // Anti-windup: conditional integration (no integration further
@@ -402,6 +444,15 @@ impl Cascade {
         self.velocity_inc_per_s += alpha * (raw - self.velocity_inc_per_s);
         self.velocity_inc_per_s
     }
+}
+
+/// The friction feedforward of `cfg` at the reference velocity `v_ref`
+/// (increments/s), N·m: `Fc·s + B·v_ref`, s = v_ref/band within ±1
+/// ([`FRICTION_BAND_INC_PER_S`]).
+pub fn friction_feedforward(cfg: &CascadeConfig, v_ref: f32) -> f32 {
+    let s = clamp(v_ref / FRICTION_BAND_INC_PER_S, -1.0, 1.0);
+    let t = cfg.coulomb_friction_nm * s + cfg.viscous_friction_nm_per_rad_per_s * v_ref * RAD_PER_INCREMENT;
+    finite_or_zero(t)
 }
 
 fn finite_or_zero(v: f32) -> f32 {

@@ -157,6 +157,17 @@ impl Axis {
         });
     }
 
+    /// A motor action replaced this cycle's command (`crate::actions`): the
+    /// cascade's integral part and the following-error monitor start from
+    /// rest, so that the axis takes over without the torque its velocity
+    /// controller wound up against the action's movement.
+    pub fn overridden(&mut self) {
+        self.following.reset();
+        if let Some(c) = self.cascade.as_mut() {
+            c.reset(self.sp_pos);
+        }
+    }
+
     pub(super) fn rebuild_interpolators(&mut self) {
         let p = self.params;
         let (interp, vinterp) = match (self.ratio, from_i425(p.interpolation_i425)) {
@@ -190,13 +201,25 @@ impl Axis {
 }
 
 /// The cascade of the parameters with the gains of the dictionary: I20 Kv,
-/// C31 Kp, C32 Ti (issue 40).
+/// C31 Kp, C32 Ti (issue 40); with identified mechanics (B45 ≠ 0, issue 35)
+/// its inertia for the acceleration feedforward (derived from the set-points
+/// where the generator gives none) and the friction feedforward of B46/B47.
 fn declared_gains(c: &CascadeConfig, o: &Snapshot) -> CascadeConfig {
     let (kv, kp, ti) = o.gains;
-    CascadeConfig {
+    let gains = CascadeConfig {
         position_gain_per_s: f32::from(kv) * 0.1,
         velocity_gain_nm_per_rad_per_s: kp as f32 * 1e-6,
         velocity_integral_time_ns: ti.saturating_mul(1000),
         ..*c
+    };
+    match o.mechanics {
+        (0, _, _) => gains,
+        (j, fc, b) => CascadeConfig {
+            inertia_kg_m2: j as f32 * 1e-7,
+            coulomb_friction_nm: fc as f32 * 1e-6,
+            viscous_friction_nm_per_rad_per_s: b as f32 * 1e-9,
+            derive_acceleration: true,
+            ..gains
+        },
     }
 }

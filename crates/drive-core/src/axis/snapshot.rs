@@ -14,9 +14,9 @@ use crate::{AXIS_B_CIA402, AXIS_B_MANUFACTURER};
 use motion::scaling::AxisScaling;
 
 pub(crate) use crate::params::{
-    A150, A213, A291, A310, A311, A340, A44, A66, A67, C31, C32, C40, E47, E48, E49, E80, F00, F06, G472,
-    G475, I00, I02, I04, I10, I101, I12, I13, I18, I20, I21, I210, I22, I23, I25, I26, I28, I29, I30, I423,
-    I425, I43, I44, I45, I46, I470, I471, I53, I87,
+    A150, A213, A291, A310, A311, A340, A44, A66, A67, B45, B46, B47, C31, C32, C40, E47, E48, E49, E80, F00,
+    F06, G472, G475, I00, I02, I04, I10, I101, I12, I13, I18, I20, I21, I210, I22, I23, I25, I26, I28, I29,
+    I30, I423, I425, I43, I44, I45, I46, I470, I471, I53, I87,
 };
 
 /// Entry `index`:`sub`, or 0 with `misses` counted: the dictionary declares
@@ -307,6 +307,10 @@ pub(crate) struct Snapshot {
     /// The cascade's gains: I20 Kv (0.1 /s), C31 Kp (µN·m·s/rad), C32 Ti
     /// (µs).
     pub gains: (u16, u32, u32),
+    /// The identified mechanics (B44): B45 inertia (10⁻⁷ kg·m², 0 = not
+    /// identified), B46 Coulomb friction (µN·m), B47 viscous friction
+    /// (nN·m·s/rad).
+    pub mechanics: (u32, u32, u32),
     /// Jog: I12 velocity (user units/s), I13 acceleration, I45
     /// deceleration, I18 jerk (user units/s², /s³; 0 = none).
     pub jog: [u32; 4],
@@ -515,6 +519,11 @@ impl Snapshot {
                 sat(w.param(od, I20, 0, m), 0u16, u16::MAX),
                 sat(w.param(od, C31, 0, m), 0u32, u32::MAX),
                 sat(w.param(od, C32, 0, m), 0u32, u32::MAX),
+            ),
+            mechanics: (
+                sat(w.param(od, B45, 0, m), 0u32, u32::MAX),
+                sat(w.param(od, B46, 0, m), 0u32, u32::MAX),
+                sat(w.param(od, B47, 0, m), 0u32, u32::MAX),
             ),
             torque_mode_speed_limit: [
                 sat(w.param(od, G472, 0, m), 0u16, u16::MAX),

@@ -16,7 +16,9 @@
 //! ([`super::MANUFACTURER_A`]).
 
 use super::{Object, Value};
-use crate::params::{B05, B10, B17, B300, B301, B40, B41, B42, B43, B52, B53, B62, B64, B73, U10, U11};
+use crate::params::{
+    B05, B10, B17, B300, B301, B40, B41, B42, B43, B44, B45, B46, B47, B48, B52, B53, B62, B64, B73, U10, U11,
+};
 use od::DataType::{U16, U32, U8};
 
 use od::{Access, DataType, EntryInfo};
@@ -27,7 +29,7 @@ const fn e(sub: u8, name: &'static str, t: DataType) -> EntryInfo {
 }
 
 /// The motor data of axis A (group B), sorted by index.
-pub const PARAMS: [Object; 14] = [
+pub const PARAMS: [Object; 19] = [
     Object::var(
         B05,
         Value::Ram,
@@ -92,6 +94,62 @@ pub const PARAMS: [Object; 14] = [
     .axis()
     .level(1)
     .note("B43 (line assumed): the action \"test winding\", started through A75 in Ready to switch on (no enable: the drive switches the power stage on itself, brake applied), progress in A69: the resistance measured along each phase's axis ((R_x + R_y‖R_z)/1.5, R when balanced) in [1]..[3]; [0] the result: 0 the three agree within 3 % of their mean, 6 unbalanced (A69: failed), 1 aborted (the state changed), 2 no current (an open phase), 3 not settled"),
+    param_array!(B44, "Identify mechanics", Record, Value::Ram, [
+        EntryInfo::new(0, "Result", U8, Access::RO),
+        EntryInfo::new(1, "Largest excursion", U32, Access::RO).unit("inc"),
+        EntryInfo::new(2, "Constant load torque", od::DataType::I32, Access::RO).unit("µNm"),
+    ])
+    .axis()
+    .level(1)
+    .note("B44 (line assumed; A75 selector 1111b, ours): the action \"identify mechanics\", started through A75 in Ready to switch on, run after the enable: a bounded test move (brake released; at most 12 revolutions forward of where the axis stands, back to it at the end) at four constant speeds in both directions between acceleration ramps identifies the total inertia (B45), the Coulomb (B46) and viscous (B47) friction, and the speed and position controllers' gains for the bandwidth B48 are written to C31, C32 and I20. Refused before it moves (A69 refused, [0] = 10) when the travel would pass a software limit 607Dh or a limit switch is active. [0] the result (0 identified and written, 1 aborted: the enable went away, 3 a speed did not settle, 4 implausible figures, 10 the travel would pass a limit, 11 the move left the stated travel), [1] the largest excursion from the start, [2] the constant load torque seen (gravity, not fed forward)"),
+    Object::var(
+        B45,
+        Value::Ram,
+        entries![e(0, "Total inertia", U32)
+            .range(0, 10_000_000)
+            .default_value(0)
+            .unit("g·cm²")
+            .saved()],
+    )
+    .axis()
+    .level(1)
+    .note("B45 (line assumed): the total inertia on the motor shaft (rotor + load), 10⁻⁷ kg·m²; B44 identifies it. Non-zero: the cascade's acceleration feedforward J·a uses it (in csp/ip with linear interpolation from the change of the set-points' speed), with the friction feedforward of B46/B47; 0 (default): not identified, the built-in 1e-4 kg·m² for the profile modes' acceleration feedforward, no friction feedforward"),
+    Object::var(
+        B46,
+        Value::Ram,
+        entries![e(0, "Coulomb friction", U32)
+            .range(0, 10_000_000)
+            .default_value(0)
+            .unit("µNm")
+            .saved()],
+    )
+    .axis()
+    .level(1)
+    .note("B46 (line assumed): Coulomb (sliding) friction torque; B44 identifies it; with B45 ≠ 0 fed forward as Fc·sign(v_ref), the sign smoothed linearly over ±0.02 rev/s"),
+    Object::var(
+        B47,
+        Value::Ram,
+        entries![e(0, "Viscous friction", U32)
+            .range(0, 10_000_000)
+            .default_value(0)
+            .unit("nNm·s/rad")
+            .saved()],
+    )
+    .axis()
+    .level(1)
+    .note("B47 (line assumed): viscous friction, torque per speed; B44 identifies it; with B45 ≠ 0 fed forward as B·v_ref"),
+    Object::var(
+        B48,
+        Value::Ram,
+        entries![e(0, "Speed loop bandwidth", U16)
+            .range(1, 3_200)
+            .default_value(30)
+            .unit("Hz")
+            .saved()],
+    )
+    .axis()
+    .level(1)
+    .note("B48 (line assumed): the bandwidth f_v the gains B44 writes are chosen for, ω_v = 2π·f_v: C31 Kp = J·ω_v, C32 Ti = 4/ω_v, I20 Kv = ω_v/4, each written for the 250 µs reference cycle of the gains (so that the scaling to A150 gives these values); default 30 Hz"),
     Object::var(
         B52,
         Value::Ram,

@@ -53,8 +53,20 @@ impl<F: Flash, B: Flash> Drive<F, B> {
         };
         // a running motor action (B42/B49) replaces the axis' command
         let e48 = drive_core::axis::e48;
-        let a = self.actions.control(0, e48(axis_a.state()), io_a).unwrap_or(a);
-        let b = self.actions.control(1, e48(axis_b.state()), io_b).unwrap_or(b);
+        let a = match self.actions.control(0, e48(axis_a.state()), io_a) {
+            Some(cmd) => {
+                axis_a.overridden();
+                cmd
+            }
+            None => a,
+        };
+        let b = match self.actions.control(1, e48(axis_b.state()), io_b) {
+            Some(cmd) => {
+                axis_b.overridden();
+                cmd
+            }
+            None => b,
+        };
         let register = axis_a.error_register() | axis_b.error_register();
         write_slot(&mut self.objects, self.slots.error_register, i64::from(register));
         [a, b]

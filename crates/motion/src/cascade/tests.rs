@@ -421,3 +421,69 @@ fn differentiating_filter_estimates_velocity() {
     }
     assert!((est - v).abs() < 0.001 * v, "estimate {est}");
 }
+
+/// Issue 35: the friction feedforward Fc·s(v_ref) + B·v_ref, s smoothed
+/// over ±[`FRICTION_BAND_INC_PER_S`] (0 at standstill: no chatter), and the
+/// acceleration derived from the change of the velocity feedforward (from
+/// the third cycle after a reset) when the generator gives none.
+#[test]
+fn friction_feedforward_and_derived_acceleration() {
+    let cfg = CascadeConfig {
+        coulomb_friction_nm: 0.02,
+        viscous_friction_nm_per_rad_per_s: 2e-5,
+        ..CascadeConfig::DEFAULT
+    };
+    assert_eq!(friction_feedforward(&cfg, 0.0), 0.0);
+    let half = friction_feedforward(&cfg, 0.5 * FRICTION_BAND_INC_PER_S);
+    assert!((half - 0.01).abs() < 1e-4, "{half}");
+    let v = 10.0 * REV;
+    let full = friction_feedforward(&cfg, -v);
+    let expect = -0.02 - 2e-5 * v * RAD_PER_INCREMENT;
+    assert!((full - expect).abs() < 1e-6, "{full} {expect}");
+    assert_eq!(friction_feedforward(&cfg, f32::NAN), 0.0);
+
+    // with the inertia and derive_acceleration: a constant velocity
+    // feedforward gives no acceleration torque, a ramp of 1000 rev/s² gives
+    // J·a (Kp = 0, Ti = 0: the feedforward alone)
+    let cfg = CascadeConfig {
+        inertia_kg_m2: 1e-4,
+        derive_acceleration: true,
+        velocity_gain_nm_per_rad_per_s: 0.0,
+        velocity_integral_time_ns: 0,
+        ..CascadeConfig::DEFAULT
+    };
+    let mut c = Cascade::new(cfg, 0).unwrap();
+    let dt = 1_000_000;
+    let mut torque = [0.0f32; 6];
+    for (k, t) in torque.iter_mut().enumerate() {
+        let v = if k < 3 { 0.0 } else { (k - 2) as f32 * REV };
+        let input = CascadeInput {
+            entry: ControlEntry::Velocity,
+            position_setpoint_inc: 0,
+            velocity_inc_per_s: v,
+            acceleration_feedforward_inc_per_s2: 0.0,
+            torque_nm: 0.0,
+            actual_position_inc: 0,
+            actual_velocity_inc_per_s: Some(0.0),
+        };
+        *t = c.cycle(&input, dt).torque_nm;
+    }
+    let ja = 1e-4 * 1000.0 * core::f32::consts::TAU;
+    assert_eq!(&torque[..3], &[0.0; 3]);
+    for t in &torque[3..] {
+        assert!((t - ja).abs() < 1e-4, "{torque:?}");
+    }
+    // after a reset the first two cycles take no difference (the enable's jump)
+    c.reset(0);
+    let input = CascadeInput {
+        entry: ControlEntry::Velocity,
+        position_setpoint_inc: 0,
+        velocity_inc_per_s: 100.0 * REV,
+        acceleration_feedforward_inc_per_s2: 0.0,
+        torque_nm: 0.0,
+        actual_position_inc: 0,
+        actual_velocity_inc_per_s: Some(0.0),
+    };
+    assert_eq!(c.cycle(&input, dt).torque_nm, 0.0);
+    assert_eq!(c.cycle(&input, dt).torque_nm, 0.0);
+}

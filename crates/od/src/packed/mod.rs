@@ -26,7 +26,7 @@ pub use build::*;
 
 /// The units an entry of a packed table may have (index 0: none); in the
 /// image as [`UNITS`].
-pub const UNIT_NAMES: [&str; 27] = [
+pub const UNIT_NAMES: [&str; 30] = [
     "",
     "inc",
     "inc/s",
@@ -54,6 +54,9 @@ pub const UNIT_NAMES: [&str; 27] = [
     "Ω",
     "V",
     "W",
+    "g·cm²",
+    "µNm",
+    "nNm·s/rad",
 ];
 
 /// Bytes of the unit names.
