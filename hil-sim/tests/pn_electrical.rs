@@ -127,14 +127,18 @@ fn c038_e089_profinet_py_motor_i2t_warning_limit_and_fault_on_the_electrical_pla
 /// B43 in ready to switch on: done, the three phase resistances within 3 %
 /// of 2.2 Ω; B42: running at 0 % until the enable, then done with R within
 /// 5 % of 2.2 Ω and L within 5 % of 8 mH; B300 against the applied brake:
-/// held within 1/360 rev.
+/// held within 1/360 rev; B44 (1111b, identify mechanics): J within 5 %,
+/// Coulomb and viscous friction within 10 % of the simulated servo's
+/// (1e-4 kg·m², 0.02 N·m, 2e-5 N·m·s/rad), which the drive does not know.
 #[test]
 fn e140_e141_profinet_py_motor_actions_by_pkw_on_the_electrical_plant() {
     let Some((_, line)) = run_named(
         "motor_actions.py",
         "ma",
         &["--plant-r", "2.2", "--plant-l", "0.008"],
-        &["--r", "2.2", "--l", "0.008"],
+        &[
+            "--r", "2.2", "--l", "0.008", "--j", "1e-4", "--fc", "0.02", "--b", "2e-5",
+        ],
         "E-140",
     ) else {
         return;

@@ -17,6 +17,9 @@ action activation (docs/conformance.md, E-142).
      --l. Execute low, disabled: A69 idle.
   5. B300 (0100b, test brake) with the enable: done, B300[0] = 0 (held),
      the largest movement within 1/360 rev.
+  6. B44 (1111b, identify mechanics, ours) with the enable: done, B44[0] = 0,
+     B45 (J) within 5 % of --j, B46/B47 (Coulomb, viscous friction) within
+     10 % of --fc/--b (the plant's, which the drive does not know).
 
 One line:  scenario E-140: ok|FAIL: ...
 """
@@ -34,9 +37,10 @@ def b(line):
 
 A75, A69 = 0x2000 + 75, 0x2000 + 69
 B42, B43, B52, B53, B62, B300 = b(42), b(43), b(52), b(53), b(62), b(300)
+B44, B45, B46, B47 = b(44), b(45), b(46), b(47)
 E48 = 0x2800 + 48
 RUNNING, DONE, REFUSED = 1, 2, 3
-B42_SEL, B43_SEL, B300_SEL = 0b1100, 0b1101, 0b0100
+B42_SEL, B43_SEL, B300_SEL, B44_SEL = 0b1100, 0b1101, 0b0100, 0b1111
 
 
 def read(fb, sc, index, sub=0):
@@ -83,6 +87,28 @@ def stop(fb, sc):
     write(fb, sc, A75, 0)
     a69, dt = a69_until(fb, sc, lambda v: v == 0, 2.0)
     sc.check(dt is not None, f"Execute low: A69 idle ({a69})")
+
+
+def mechanics(fb, sc, j, fc, visc):
+    write(fb, sc, A75, B44_SEL << 1 | 1)
+    fb.run_for(0.05)
+    t0 = time.monotonic()
+    enable(fb, sc, "B44")
+    a69, dt = a69_until(fb, sc, lambda v: v >> 12 not in (0, RUNNING), 30.0)
+    sc.check(a69 == (100 | B44_SEL << 8 | DONE << 12), f"B44: A69 {a69} after {ms(dt)} (want done, 100 %)")
+    sc.check(read(fb, sc, B44, 1) == 0, "B44[0] = 0")
+    # B45 in 1e-7 kg m^2, B46 in uN m, B47 in nN m s/rad
+    j_id = (read(fb, sc, B45) or 0) * 1e-7
+    fc_id = (read(fb, sc, B46) or 0) * 1e-6
+    b_id = (read(fb, sc, B47) or 0) * 1e-9
+    sc.note(f"B44: J {j_id:.4e} kg m^2 ({100 * (j_id / j - 1):+.1f} %), Fc {fc_id:.4f} N m "
+            f"({100 * (fc_id / fc - 1):+.1f} %), B {b_id:.3e} N m s/rad ({100 * (b_id / visc - 1):+.1f} %) "
+            f"in {time.monotonic() - t0:.2f} s")
+    sc.check(abs(j_id - j) <= 0.05 * j, f"B45 {j_id} within 5 % of the plant's {j}")
+    sc.check(abs(fc_id - fc) <= 0.10 * fc, f"B46 {fc_id} within 10 % of the plant's {fc}")
+    sc.check(abs(b_id - visc) <= 0.10 * visc, f"B47 {b_id} within 10 % of the plant's {visc}")
+    stop(fb, sc)
+    disable(fb)
 
 
 def run(fb, sc, r, l):
@@ -142,9 +168,17 @@ def main():
     ap = fb_arguments(__doc__, "drive-ma", "192.168.0.53")
     ap.add_argument("--r", type=float, required=True, help="the plant's phase resistance (serve --plant-r), ohm")
     ap.add_argument("--l", type=float, required=True, help="the plant's inductance (serve --plant-l), H")
+    ap.add_argument("--j", type=float, required=True, help="the plant's inertia, kg m^2")
+    ap.add_argument("--fc", type=float, required=True, help="the plant's Coulomb friction, N m")
+    ap.add_argument("--b", type=float, required=True, help="the plant's viscous friction, N m s/rad")
     a = ap.parse_args()
     sc = Scenario("E-140")
-    return run_fb_scenario(a, sc, lambda fb: run(fb, sc, a.r, a.l))
+
+    def body(fb):
+        run(fb, sc, a.r, a.l)
+        mechanics(fb, sc, a.j, a.fc, a.b)
+
+    return run_fb_scenario(a, sc, body)
 
 
 if __name__ == "__main__":
