@@ -25,6 +25,8 @@ pub mod matrix;
 #[cfg(feature = "std")]
 pub mod pcap;
 #[cfg(feature = "std")]
+pub mod plants;
+#[cfg(feature = "std")]
 pub mod plot;
 #[cfg(feature = "std")]
 pub mod pn;

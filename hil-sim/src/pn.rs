@@ -11,7 +11,6 @@ use std::collections::VecDeque;
 use crate::electrical::{ElectricalAxis, PlantModel};
 use crate::motor::{Motor, MotorOutputs};
 use crate::sim::{axis_io, AxisConditions, SimFlash};
-use drive_ecat::axis::CurrentControl;
 use drive_ecat::params::{E43, E82};
 use drive_pn::Hardware;
 use nanos::Nanos;
@@ -225,7 +224,7 @@ pub struct PnSim {
     motors: [Motor; 2],
     /// The axes' current loops on the PMSM plant (`set_plant`), or none:
     /// the rigid torque-in model.
-    electrical: [Option<Box<ElectricalAxis>>; 2],
+    electrical: crate::plants::Plants,
     feedback: [Option<MotorOutputs>; 2],
     conditions: [AxisConditions; 2],
     /// When the next control cycle starts.
@@ -262,7 +261,7 @@ impl PnSim {
             drive: drive_pn::PnDrive::new(flash, hw.clone()),
             hw,
             motors: [Motor::default_servo(), Motor::default_servo()],
-            electrical: [None, None],
+            electrical: crate::plants::Plants::default(),
             feedback: [None, None],
             conditions: [AxisConditions::READY; 2],
             next_cycle: Nanos::ZERO,
@@ -325,26 +324,17 @@ impl PnSim {
     /// [`Self::set_plant`] with the electrical model's PWM and current loop
     /// at `pwm_hz` (16 kHz by default; 8 kHz selectable, issue 34).
     pub fn set_plant_at(&mut self, model: PlantModel, seed: u64, pwm_hz: f32) -> Result<(), foc::ParamError> {
-        for (k, el) in self.electrical.iter_mut().enumerate() {
-            *el = match model {
-                PlantModel::Rigid => None,
-                PlantModel::Electrical => Some(Box::new(ElectricalAxis::default_servo_at(
-                    seed.wrapping_add(k as u64),
-                    pwm_hz,
-                )?)),
-            };
-        }
-        Ok(())
+        self.electrical.set(model, seed, pwm_hz)
     }
 
     /// Axis `axis`' current loop and PMSM, if it runs the electrical model.
     pub fn electrical(&self, axis: usize) -> Option<&ElectricalAxis> {
-        self.electrical.get(axis).and_then(|e| e.as_deref())
+        self.electrical.get(axis)
     }
 
     /// The same, for plant settings (faults, the DC link).
     pub fn electrical_mut(&mut self, axis: usize) -> Option<&mut ElectricalAxis> {
-        self.electrical.get_mut(axis).and_then(|e| e.as_deref_mut())
+        self.electrical.get_mut(axis)
     }
 
     /// The motor of `axis` (0 = A).
@@ -470,37 +460,20 @@ impl PnSim {
                 axis_io(self.feedback[1].as_ref(), &self.motors[1], self.conditions[1]),
             ];
             // the current seam: the loops' measurement in, their commands down
-            for (io, el) in io.iter_mut().zip(&self.electrical) {
-                if let Some(el) = el {
-                    io.current = el.actual();
-                }
-            }
+            self.electrical.measure(&mut io);
             let commands = self.drive.control_cycle(t, &io);
             let period = self.drive.control_period();
             let data = self.drive.axes().each_ref().map(|a| *a.motor());
             let stage = drive_ecat::stage::StageData::read(self.drive.objects());
-            let axes = self.motors.iter_mut().zip(self.feedback.iter_mut());
-            for ((((motor, fb), c), el), data) in axes.zip(commands).zip(self.electrical.iter_mut()).zip(data)
-            {
-                *fb = Some(match el {
-                    Some(el) => {
-                        // the dictionary's motor data (a refused set keeps the loop's)
-                        let _ = el.set_motor_data(&data);
-                        el.set_stage_data(&stage);
-                        el.command(&c);
-                        el.run(motor, period)
-                    }
-                    None => {
-                        let torque = if c.power_stage {
-                            f64::from(c.torque_nm)
-                        } else {
-                            0.0
-                        };
-                        motor.step(torque, !c.brake_release, period)
-                    }
-                });
-            }
-            if let Some(mv) = self.electrical[0].as_ref().map(|e| e.dc_link_mv()) {
+            self.electrical.step(
+                &mut self.motors,
+                &mut self.feedback,
+                commands,
+                data,
+                &stage,
+                period,
+            );
+            if let Some(mv) = self.electrical.dc_link_mv() {
                 drive_ecat::stage::set_dc_link_voltage(self.drive.objects_mut(), mv);
             }
             self.cycles += 1;

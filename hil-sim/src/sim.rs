@@ -2,7 +2,6 @@
 //! with the real slave stack (`ecat`) and the drive's objects (`drive`) behind
 //! its PDI. Frames from any master go through [`Simulation::exchange`].
 
-use crate::electrical::ElectricalAxis;
 use crate::esc::{Esc, EscConfig, LineTiming};
 use crate::frame::process_frame;
 use crate::motor::{Motor, MotorOutputs};
@@ -116,7 +115,7 @@ pub struct SimDrive {
     feedback: [Option<MotorOutputs>; 2],
     /// Axis A's and B's current loop and PMSM ([`SimDrive::set_plant`]);
     /// `None`: the rigid motor model.
-    electrical: [Option<Box<ElectricalAxis>>; 2],
+    electrical: crate::plants::Plants,
     next_cycle: Nanos,
     /// Next start of the PLL-driven timer, ticks of the MCU clock (`None`: free-running).
     next_tick: Option<u64>,
@@ -194,7 +193,7 @@ impl SimDrive {
             cycle_log: VecDeque::with_capacity(CYCLE_LOG_LEN),
             pll_lock: PllLock::default(),
             feedback: [None, None],
-            electrical: [None, None],
+            electrical: crate::plants::Plants::default(),
             next_cycle: CONTROL_CYCLE,
             next_tick: None,
             sm2_event: false,
