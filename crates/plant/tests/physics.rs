@@ -269,10 +269,10 @@ fn encoder_loss_trips() {
     assert_eq!(axis.trip(), Some(Trip::EncoderLost));
 }
 
-/// The reversed encoder counts the rotor's angle negated: a quarter turn
+/// E-140 (B40 fails on it): the reversed encoder counts the rotor's angle negated: a quarter turn
 /// forward reads −2^18 increments (the healthy encoder +2^18).
 #[test]
-fn reversed_encoder_counts_the_other_way() {
+fn e140_b40_reversed_encoder_counts_the_other_way() {
     for (reversed, want) in [(false, 1i64 << 18), (true, -(1i64 << 18))] {
         let mut p = quiet();
         p.faults.encoder_reversed = reversed;

@@ -139,12 +139,12 @@ fn brake_holds_below_holding_torque_and_slips_above() {
     assert_eq!(out.position_inc, held);
 }
 
-/// A stuck brake (`brake_stuck`) brakes with its holding torque although
+/// E-140 (B301 finds it): a stuck brake (`brake_stuck`) brakes with its holding torque although
 /// released: 1 N·m does not turn the shaft; released, a healthy brake lets
 /// the same torque accelerate it by (1 − 0.02)/1e-4 rad/s² (98 rad/s in
 /// 10 ms).
 #[test]
-fn a_stuck_brake_holds_although_released() {
+fn e140_b301_a_stuck_brake_holds_although_released() {
     let mut p = MotorParams::default_servo();
     p.viscous_friction_nm_s_per_rad = 0.0;
     for (stuck, v_want) in [(true, 0.0), (false, 98.0)] {

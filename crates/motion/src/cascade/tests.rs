@@ -422,12 +422,12 @@ fn differentiating_filter_estimates_velocity() {
     assert!((est - v).abs() < 0.001 * v, "estimate {est}");
 }
 
-/// Issue 35: the friction feedforward Fc·s(v_ref) + B·v_ref, s smoothed
+/// E-140 B44 (issue 35), what its results feed: the friction feedforward Fc·s(v_ref) + B·v_ref, s smoothed
 /// over ±[`FRICTION_BAND_INC_PER_S`] (0 at standstill: no chatter), and the
 /// acceleration derived from the change of the velocity feedforward (from
 /// the third cycle after a reset) when the generator gives none.
 #[test]
-fn friction_feedforward_and_derived_acceleration() {
+fn e140_b44_friction_feedforward_and_derived_acceleration() {
     let cfg = CascadeConfig {
         coulomb_friction_nm: 0.02,
         viscous_friction_nm_per_rad_per_s: 2e-5,
