@@ -28,7 +28,7 @@
 //! no RxPDO: A75 is written through the parameter access (PKW in the
 //! telegram, record 0xB02E), which is itself the activation.
 
-use crate::axis::{AxisCommand, AxisIo};
+use crate::axis::{sqrt, AxisCommand, AxisIo};
 use crate::params::{
     A150, A150_FALLBACK_US, B05, B10, B300, B301, B40, B41, B42, B43, B44, B45, B46, B47, B48, B52, B53, B62,
     C31, C32, E48, I20,
@@ -543,15 +543,6 @@ fn follow_mechanics(objects: &mut DriveObjects, m: &MechanicsTest, axis: usize, 
     let _ = objects.set(B44 + off, 2, i64::from(excursion));
     let _ = objects.set(B44 + off, 1, i64::from(code));
     Some(status(if st == state::DONE { 100 } else { 0 }, selector, st))
-}
-
-/// √x for 0 < x ≤ 1 (Newton's method, no `std`).
-fn sqrt(x: f32) -> f32 {
-    let mut y = 1.0;
-    for _ in 0..20 {
-        y = 0.5 * (y + x / y);
-    }
-    y
 }
 
 /// The CiA 402 window offset of `axis`.

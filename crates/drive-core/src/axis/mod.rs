@@ -105,6 +105,7 @@ mod tests_current;
 #[cfg(test)]
 mod tests_records;
 mod units;
+pub(crate) use units::sqrt;
 mod write_back;
 
 use crate::dictionary::DriveObjects;

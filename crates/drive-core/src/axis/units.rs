@@ -115,8 +115,8 @@ pub const fn e48(state: State) -> u8 {
 }
 
 /// Square root without `std` (Newton steps from a bit-level first guess);
-/// `x` ≤ 0 or not finite gives 0.
-fn sqrt(x: f32) -> f32 {
+/// `x` ≤ 0 or not finite gives 0. The crate's one (the actions and tuning use it too).
+pub(crate) fn sqrt(x: f32) -> f32 {
     if !(x.is_finite() && x > 0.0) {
         return 0.0;
     }

@@ -51,7 +51,7 @@
 //! ±0.02 rev/s.
 
 use super::result;
-use crate::axis::AxisCommand;
+use crate::axis::{sqrt, AxisCommand};
 use motion::cascade::RAD_PER_INCREMENT;
 use motion::float::clamp;
 
@@ -570,16 +570,4 @@ fn sign_of(d: i32) -> f32 {
         d if d < 0 => -1.0,
         _ => 0.0,
     }
-}
-
-/// √x for x ≥ 0 (Newton's method: no `std`), 0 otherwise.
-fn sqrt(x: f32) -> f32 {
-    if x.is_nan() || x <= 0.0 || !x.is_finite() {
-        return 0.0;
-    }
-    let mut y = if x > 1.0 { x * 0.5 } else { 1.0 };
-    for _ in 0..30 {
-        y = 0.5 * (y + x / y);
-    }
-    y
 }
