@@ -257,8 +257,13 @@ impl PnSim {
             im: ImData::default(),
             boot_time,
         };
+        let mut drive = drive_pn::PnDrive::new(flash, hw.clone());
+        // the scope over as many words as the EtherCAT drive's (the board's
+        // 64 KiB of DSRAM2); kept for the drive's life and handed to the
+        // next one at a restart
+        drive.attach_scope(Vec::leak(vec![0; crate::sim::SCOPE_WORDS]));
         PnSim {
-            drive: drive_pn::PnDrive::new(flash, hw.clone()),
+            drive,
             hw,
             motors: [Motor::default_servo(), Motor::default_servo()],
             electrical: crate::plants::Plants::default(),
@@ -409,11 +414,16 @@ impl PnSim {
                     boot_time: self.hw.boot_time.wrapping_add(1),
                     ..self.hw.clone()
                 };
-                let old = std::mem::replace(
+                let mut old = std::mem::replace(
                     &mut self.drive,
                     drive_pn::PnDrive::new(SimFlash::new(), hw.clone()),
                 );
+                let words = old.detach_scope();
                 self.drive = drive_pn::PnDrive::new(old.into_flash(), hw.clone());
+                if let Some(words) = words {
+                    words.fill(0);
+                    self.drive.attach_scope(words);
+                }
                 self.hw = hw;
                 self.events.clear();
                 "restarted over the same parameter flash".to_string()

@@ -9,7 +9,6 @@
 mod common;
 
 use common::soem_line::{pysoem_python, scratch, Line};
-use hil_sim::scope_plot::{svg_to_png, ScopeTrace};
 
 const SAMPLES: usize = 2000;
 const PRE: usize = 20;
@@ -54,53 +53,11 @@ fn issue35_soem_scope_trace_of_a_move_matches_the_physics() {
     if !status.success() {
         line.fail_with(&format!("scope.py through SOEM failed: {status}"));
     }
-    let trace = ScopeTrace::from_csv(&std::fs::read_to_string(&csv).expect("the CSV")).unwrap();
-    assert_eq!(trace.t_ms.len(), SAMPLES);
-    let set = trace.channel("speed set-point [inc/s]").unwrap();
-    let vel = trace.channel("speed actual [inc/s]").unwrap();
-    let pos = trace.channel("6064h position actual [inc]").unwrap();
-    // the trigger sample: t = 0 at the pre-trigger share, on the edge
-    let trig = trace.t_ms.iter().position(|&t| t == 0.0).expect("t = 0");
-    assert_eq!(trig, SAMPLES * PRE / 100, "the trigger index");
-    assert!(
-        set[trig] >= LEVEL && set[trig - 1] < LEVEL,
-        "the edge: {} -> {}",
-        set[trig - 1],
-        set[trig]
+    common::scope_check::check_move(
+        &csv,
+        SAMPLES,
+        PRE,
+        LEVEL,
+        "Scope: pv move to 2,000,000 inc/s (SOEM, hil-sim serve)",
     );
-    assert!(set[..trig].iter().all(|&v| v < LEVEL), "no earlier crossing");
-    let dt = (trace.t_ms[1] - trace.t_ms[0]) * 1e-3;
-    assert!((dt - 1e-3).abs() < 1e-9, "1 ms samples: {dt}");
-    // velocity integrates to the position's change
-    let integral: f64 = vel.windows(2).map(|w| (w[0] + w[1]) / 2.0 * dt).sum();
-    let moved = pos[SAMPLES - 1] - pos[0];
-    println!(
-        "scope trace: trigger at sample {trig} ({} ms), speed set-point {} -> {} inc/s at the edge; \
-         integral of the speed actual value {integral:.0} inc, 6064h moved {moved:.0} inc ({:+.3} %)",
-        trace.t_ms[trig],
-        set[trig - 1],
-        set[trig],
-        (integral - moved) / moved * 100.0
-    );
-    assert!(moved > f64::from(1 << 20), "the drive moved: {moved} inc");
-    assert!(
-        (integral - moved).abs() <= 0.01 * moved.abs() + 2000.0,
-        "integral {integral} vs 6064h {moved}"
-    );
-    let svg = dir.join("scope-trace.svg");
-    std::fs::write(
-        &svg,
-        trace
-            .svg("Scope: pv move to 2,000,000 inc/s (SOEM, hil-sim serve)")
-            .unwrap(),
-    )
-    .unwrap();
-    match svg_to_png(&svg, &dir.join("scope-trace.png")) {
-        Ok(()) => println!(
-            "plot: {}, {}",
-            svg.display(),
-            dir.join("scope-trace.png").display()
-        ),
-        Err(e) => println!("plot: {} (no PNG: {e})", svg.display()),
-    }
 }

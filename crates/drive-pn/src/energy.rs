@@ -59,6 +59,7 @@ impl PeApplication for DriveEnergy {
 }
 
 /// The records the drive's device serves beyond the CM's own: PROFIenergy,
-/// the PROFIdrive parameter record 0xB02E ([`crate::bmp_record`]), then
-/// the application's `H`.
-pub type PnRecords<H> = WithProfiEnergy<DriveEnergy, crate::bmp_record::WithBmp<H>>;
+/// the PROFIdrive parameter record 0xB02E ([`crate::bmp_record`]), the
+/// scope's trace ([`crate::scope_record`]), then the application's `H`.
+pub type PnRecords<H> =
+    WithProfiEnergy<DriveEnergy, crate::bmp_record::WithBmp<crate::scope_record::WithScope<H>>>;

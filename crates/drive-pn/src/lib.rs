@@ -66,7 +66,7 @@ use drive_core::axis::{Axis, AxisCache, AxisCommand, AxisIo};
 use drive_core::faults::{FaultChange, E82_INACTIVE};
 use drive_core::objects::LAYOUT_HASH;
 use drive_core::params::{A00, A150, A150_FALLBACK_US, A270, A271, A275, E43, E82, PROFINET_PARAMS};
-use drive_core::{DriveObjects, PERSISTENT_IMAGE_BYTES};
+use drive_core::DriveObjects;
 use nanos::Nanos;
 use profinet::cm::CmEvent;
 use profinet::cm::{ImData, NoRecords, RecordHook};
@@ -78,10 +78,11 @@ use store::{Flash, ParamStore};
 pub mod bmp_record;
 pub mod energy;
 pub mod profile;
+pub mod scope_record;
 pub mod settings;
 pub use energy::{DriveEnergy, PnRecords};
-pub use settings::Hardware;
 use settings::NAME_LEN;
+pub use settings::{Hardware, PnParamFlash, STORED_BYTES};
 
 #[cfg(test)]
 extern crate std;
@@ -93,6 +94,8 @@ mod tests_bmp;
 mod tests_energy;
 #[cfg(test)]
 mod tests_params;
+#[cfg(test)]
+mod tests_scope;
 #[cfg(test)]
 mod tests_snmp;
 
@@ -210,7 +213,7 @@ impl<F: Flash, H: RecordHook> PnDrive<F, H> {
             addr_of_mut!((*p).store).write(ParamStore::new(flash));
             (&mut *addr_of_mut!((*p).objects), &mut *addr_of_mut!((*p).store))
         };
-        let (startup, im, kept) = load(store, objects);
+        let (startup, im, kept) = settings::load(store, objects);
         let active = objects.get(A270, 0) != Ok(0);
         let hw = Hardware {
             im: im.unwrap_or(hw.im),
@@ -232,7 +235,10 @@ impl<F: Flash, H: RecordHook> PnDrive<F, H> {
                     app: DriveEnergy::default(),
                     inner: bmp_record::WithBmp {
                         bmp: bmp_record::BmpRecord::default(),
-                        inner: hook,
+                        inner: scope_record::WithScope {
+                            scope: None,
+                            inner: hook,
+                        },
                     },
                 },
             ));
@@ -426,14 +432,15 @@ impl<F: Flash, H: RecordHook> PnDrive<F, H> {
         };
         let mut out = [0u8; bmp_record::MAX_BYTES];
         let [a, _] = &mut self.axes;
-        let len = self
-            .profile
-            .serve_bmp(req.get(..n).unwrap_or(&[]), &mut self.objects, a, &mut out);
-        self.device
-            .hook_mut()
-            .inner
-            .bmp
-            .set_response(out.get(..len).unwrap_or(&[]));
+        let hook = &mut self.device.hook_mut().inner;
+        let len = self.profile.serve_bmp(
+            req.get(..n).unwrap_or(&[]),
+            &mut self.objects,
+            a,
+            &mut hook.inner,
+            &mut out,
+        );
+        hook.bmp.set_response(out.get(..len).unwrap_or(&[]));
         self.serve_actions();
         // a save asked by this request is done before its response is read
         self.serve_saves();
@@ -657,6 +664,8 @@ impl<F: Flash, H: RecordHook> PnDrive<F, H> {
             self.serve_actions();
         }
         self.powered = commands.map(|c| c.power_stage);
+        // the scope's sample of this cycle (one branch while not recording)
+        self.sample_scope(&io);
         if run_profile {
             // once per telegram: the response the device sends next
             self.profile_respond();
@@ -704,7 +713,8 @@ impl<F: Flash, H: RecordHook> PnDrive<F, H> {
             return;
         };
         let [axis, _] = &mut self.axes;
-        self.profile.receive(data, &mut self.objects, axis);
+        let live = &mut self.device.hook_mut().inner.inner;
+        self.profile.receive_with(data, &mut self.objects, axis, live);
         // A75 only changes by a parameter write: looked at after one, and
         // every telegram while an action is shown (issue 36: two lookups of
         // A75 per telegram cost some 580 instructions on QEMU)
@@ -761,34 +771,5 @@ impl<F: Flash, H: RecordHook> PnDrive<F, H> {
                 self.device.set_input_data(slot, data);
             }
         }
-    }
-}
-
-/// Loads the newest saved set into `objects` (defaults stay when there is
-/// none, it is from another declaration or does not load).
-/// The store's record: the parameter image and I&M1…4 behind it.
-pub const STORED_BYTES: usize = PERSISTENT_IMAGE_BYTES + settings::SNMP_BLOCK + settings::IM_TRAILER;
-
-/// The parameter flash of the PROFINET images: two slots of two 2 KiB
-/// sectors, as the parameter image with I&M1…4 behind it
-/// ([`STORED_BYTES`]) no longer fits one 2 KiB sector (the EtherCAT
-/// images' `node::ParamFlash`). In RAM until the board's PFLASH driver is
-/// used, like that one.
-pub type PnParamFlash = store::RamFlash<2048, 4>;
-
-/// The newest saved set into `objects`, and the I&M1…4 saved with it.
-fn load<F: Flash>(
-    store: &mut ParamStore<F>,
-    objects: &mut DriveObjects,
-) -> (Startup, Option<ImData>, Option<snmp::Agent>) {
-    let mut image = [0u8; STORED_BYTES];
-    let Ok(n) = store.load(LAYOUT_HASH, &mut image) else {
-        return (Startup::Defaults, None, None);
-    };
-    let (params, im) = settings::split_stored(image.get(..n).unwrap_or(&[]));
-    let (params, kept) = settings::split_snmp(params);
-    match objects.load_persistent(params) {
-        Ok(()) => (Startup::Loaded, im, kept),
-        Err(_) => (Startup::Defaults, None, None),
     }
 }

@@ -15,8 +15,10 @@
 
 use core::net::Ipv4Addr;
 
+use crate::Startup;
+use drive_core::objects::LAYOUT_HASH;
 use drive_core::params::{A271, A272, A273, A274};
-use drive_core::DriveObjects;
+use drive_core::{DriveObjects, PERSISTENT_IMAGE_BYTES};
 use od::{CommState, Dictionary};
 use profinet::cm::{Im0, ImData};
 use profinet::dcp::server::ip_suite_valid;
@@ -24,6 +26,7 @@ use profinet::dcp::{IpSuite, NameOfStation};
 use profinet::device::DeviceConfig;
 use profinet::model;
 use profinet::wire::MacAddr;
+use store::{Flash, ParamStore};
 
 /// The longest name of station in A271, bytes.
 pub const NAME_LEN: usize = drive_core::objects::manufacturer::PN_NAME_LEN as usize;
@@ -218,4 +221,33 @@ pub fn split_snmp(params: &[u8]) -> (&[u8], Option<snmp::Agent>) {
         at += 1 + snmp::TEXT_MAX;
     }
     (rest, Some(a))
+}
+
+/// The store's record: the parameter image and I&M1…4 behind it.
+pub const STORED_BYTES: usize = PERSISTENT_IMAGE_BYTES + SNMP_BLOCK + IM_TRAILER;
+
+/// The parameter flash of the PROFINET images: two slots of two 2 KiB
+/// sectors, as the parameter image with I&M1…4 behind it
+/// ([`STORED_BYTES`]) no longer fits one 2 KiB sector (the EtherCAT
+/// images' `node::ParamFlash`). In RAM until the board's PFLASH driver is
+/// used, like that one.
+pub type PnParamFlash = store::RamFlash<2048, 4>;
+
+/// Loads the newest saved set into `objects` (defaults stay when there is
+/// none, it is from another declaration or does not load); the I&M1…4 and
+/// the SNMP agent's values saved with it.
+pub(crate) fn load<F: Flash>(
+    store: &mut ParamStore<F>,
+    objects: &mut DriveObjects,
+) -> (Startup, Option<ImData>, Option<snmp::Agent>) {
+    let mut image = [0u8; STORED_BYTES];
+    let Ok(n) = store.load(LAYOUT_HASH, &mut image) else {
+        return (Startup::Defaults, None, None);
+    };
+    let (params, im) = split_stored(image.get(..n).unwrap_or(&[]));
+    let (params, kept) = split_snmp(params);
+    match objects.load_persistent(params) {
+        Ok(()) => (Startup::Loaded, im, kept),
+        Err(_) => (Startup::Defaults, None, None),
+    }
 }

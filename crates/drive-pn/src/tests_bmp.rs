@@ -8,7 +8,7 @@ use profidrive::bmp::RECORD_INDEX;
 use profinet::cm::PnioStatus;
 
 /// A read request of (PNU, subindex) values.
-fn read_req(reference: u8, params: &[(u16, u16)]) -> std::vec::Vec<u8> {
+pub(crate) fn read_req(reference: u8, params: &[(u16, u16)]) -> std::vec::Vec<u8> {
     let mut v = std::vec![reference, 0x01, 0x01, params.len() as u8];
     for &(pnu, sub) in params {
         v.extend_from_slice(&[0x10, 1]);
@@ -78,7 +78,7 @@ fn p206_record_0xb02e_refusals() {
 
 /// A change request of (PNU, subindex, format, big-endian value) in one
 /// request: the addresses first, then the values.
-fn change_req(reference: u8, params: &[(u16, u16, u8, &[u8])]) -> std::vec::Vec<u8> {
+pub(crate) fn change_req(reference: u8, params: &[(u16, u16, u8, &[u8])]) -> std::vec::Vec<u8> {
     let mut v = std::vec![reference, 0x02, 0x01, params.len() as u8];
     for &(pnu, sub, _, _) in params {
         v.extend_from_slice(&[0x10, 1]);
@@ -93,7 +93,11 @@ fn change_req(reference: u8, params: &[(u16, u16, u8, &[u8])]) -> std::vec::Vec<
 }
 
 /// One request written and its response read.
-fn exchange(d: &mut super::PnDrive<super::tests::TestFlash>, seq: u32, req: &[u8]) -> std::vec::Vec<u8> {
+pub(crate) fn exchange(
+    d: &mut super::PnDrive<super::tests::TestFlash>,
+    seq: u32,
+    req: &[u8],
+) -> std::vec::Vec<u8> {
     assert_eq!(record_at(d, seq, true, RECORD_INDEX, req).0, PnioStatus::OK);
     let (s, r) = record_at(d, seq + 1, false, RECORD_INDEX, &[]);
     assert_eq!(s, PnioStatus::OK);

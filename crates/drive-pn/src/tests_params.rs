@@ -5,6 +5,7 @@ use super::tests::{drive, hardware, run, TestFlash};
 use super::*;
 use core::net::Ipv4Addr;
 use drive_core::params::{A272, A273, A274, A275, A276, A277, A278};
+use drive_core::PERSISTENT_IMAGE_BYTES;
 use od::{CommState, Dictionary, SdoAbort};
 use profinet::dcp::pdu::{
     service_type, BlockRepr, BlockType, BlockWriter, Header, ServiceId, Value, HEADER_LEN,

@@ -188,7 +188,12 @@ mod app {
     #[inline(never)]
     fn make_drive() -> Option<&'static mut Drive> {
         static DRIVE: firmware::once::Once<Drive> = firmware::once::Once::new();
-        Some(Drive::init(DRIVE.take()?, ParamFlash::new(), board::hardware()))
+        let drive = Drive::init(DRIVE.take()?, ParamFlash::new(), board::hardware());
+        // the scope's trace buffer: 64 KiB of DSRAM2 beside the Ethernet rings
+        if let Some(words) = firmware::xmc::scope_buffer() {
+            drive.attach_scope(words);
+        }
+        Some(drive)
     }
 
     /// ETH0's clock, reset, pins and RMII selection, the MAC with its rings

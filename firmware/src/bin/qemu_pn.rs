@@ -103,7 +103,12 @@ fn make_drive() -> Option<&'static mut Drive> {
     // the power cycle keeps the flash: taken out of the first drive (not the
     // whole drive read out onto the stack: two drives do not fit it)
     let flash = core::mem::replace(first.flash_mut(), ParamFlash::new());
-    Some(build(slot, flash))
+    let drive = build(slot, flash);
+    // the scope as on the board (its buffer smaller: the STM32F405 has no
+    // DSRAM2), idle: the figures include what an idle scope costs a cycle
+    static WORDS: firmware::once::Once<[u32; 1024]> = firmware::once::Once::new();
+    drive.attach_scope(WORDS.take()?.write([0; 1024]));
+    Some(drive)
 }
 
 /// One drive built in place into `slot` (`PnDrive::init`: no whole drive on

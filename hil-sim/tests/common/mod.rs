@@ -7,6 +7,7 @@ use std::process::{Child, Command, Stdio};
 use std::time::Duration;
 
 pub mod pn_line;
+pub mod scope_check;
 pub mod soem_line;
 
 /// `fb_rig!(Rig)`: `struct Rig(FbRig)`, the FB rig

@@ -344,6 +344,7 @@ def run_fb_scenario(a, sc, body):
     dev, ctl, out_slot, in_slot = start_controller(a)
     try:
         fb = ExampleFB(ctl, out_slot, in_slot)
+        fb.dev = dev  # the record channel of the same AR (scope.py reads records)
         if fb.until(lambda o: o.identifier == 0xF0, 5.0) is None:
             raise RuntimeError("no response telegram 0xF0 within 5 s")
         body(fb)
@@ -868,6 +869,7 @@ def main():
     failed = []
     try:
         fb = ExampleFB(ctl, out_slot, in_slot)
+        fb.dev = dev  # the record channel of the same AR (scope.py reads records)
         if fb.until(lambda o: o.identifier == 0xF0, 5.0) is None:
             raise RuntimeError("no response telegram 0xF0 within 5 s")
         # the manual's default target window, 10 degrees (spec §10.2), as the test's tolerance; this

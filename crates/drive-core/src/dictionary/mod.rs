@@ -172,7 +172,7 @@ impl Default for DriveObjects {
 /// from [`DriveObjects::parameter_channel`] the A213-scaled entries in the
 /// parameter channel's representation (A213\[1\], `scaling.rs`).
 #[derive(Debug)]
-pub struct WithLive<'a, L: LiveValues> {
+pub struct WithLive<'a, L: LiveValues + ?Sized> {
     /// The dictionary.
     pub objects: &'a mut DriveObjects,
     /// The provider of live values.
@@ -275,7 +275,7 @@ impl DriveObjects {
     /// This dictionary with `live` answering the live entries; values as
     /// the dictionary keeps them (the A213-scaled entries in the process
     /// data's representation, A213\[0\]).
-    pub fn with_live<'a, L: LiveValues>(&'a mut self, live: &'a mut L) -> WithLive<'a, L> {
+    pub fn with_live<'a, L: LiveValues + ?Sized>(&'a mut self, live: &'a mut L) -> WithLive<'a, L> {
         WithLive {
             objects: self,
             live,
@@ -289,7 +289,7 @@ impl DriveObjects {
     /// write in the representation of A213\[1\] (E-143, E-086;
     /// [`DriveObjects::channel_shift`]). With A213\[1\] = A213\[0\] (both
     /// native by default) the same as [`with_live`](Self::with_live).
-    pub fn parameter_channel<'a, L: LiveValues>(&'a mut self, live: &'a mut L) -> WithLive<'a, L> {
+    pub fn parameter_channel<'a, L: LiveValues + ?Sized>(&'a mut self, live: &'a mut L) -> WithLive<'a, L> {
         WithLive {
             objects: self,
             live,
@@ -501,7 +501,7 @@ impl DriveObjects {
     }
 
     /// A bus read; `channel`: in the parameter channel's representation.
-    fn read_with<L: LiveValues>(
+    fn read_with<L: LiveValues + ?Sized>(
         &self,
         live: &mut L,
         index: u16,
@@ -533,7 +533,7 @@ impl DriveObjects {
     }
 
     /// A bus write; `channel`: in the parameter channel's representation.
-    fn write_with<L: LiveValues>(
+    fn write_with<L: LiveValues + ?Sized>(
         &mut self,
         live: &mut L,
         index: u16,
@@ -685,7 +685,7 @@ fn sdo_info_selection(
     }
 }
 
-impl<L: LiveValues> Dictionary for WithLive<'_, L> {
+impl<L: LiveValues + ?Sized> Dictionary for WithLive<'_, L> {
     fn object(&self, index: u16) -> Option<&'static ObjectInfo> {
         self.objects.object(index)
     }

@@ -370,6 +370,12 @@ impl<S: AsRef<[u32]> + AsMut<[u32]>> Recorder<S> {
         }
     }
 
+    /// The buffer back (the recorder ends: a drive restarted in the
+    /// simulator hands its buffer to the next one).
+    pub fn into_storage(self) -> S {
+        self.storage
+    }
+
     /// The state (T00).
     pub fn state(&self) -> State {
         self.state
@@ -607,15 +613,23 @@ impl<S: AsRef<[u32]> + AsMut<[u32]>> Recorder<S> {
     /// available") beyond the trace's end. In normal mode, reading the last
     /// block arms the next trace.
     pub fn read_block(&mut self, k: u8, buf: &mut [u8]) -> Result<usize, SdoAbort> {
+        self.read_piece(usize::from(k), BLOCK_BYTES, buf)
+    }
+
+    /// Piece `k` of `piece` bytes (a multiple of 4) of the complete trace
+    /// into `buf` (at least `piece` bytes), as [`read_block`](Self::read_block)
+    /// does for pieces of [`BLOCK_BYTES`]: the trace in the pieces a
+    /// fieldbus carries (a PROFINET record, `drive_pn::scope_record`).
+    pub fn read_piece(&mut self, k: usize, piece: usize, buf: &mut [u8]) -> Result<usize, SdoAbort> {
         if self.state != State::Complete {
             return Err(SdoAbort::DEVICE_STATE);
         }
         let total = self.trace_bytes();
-        let from = usize::from(k) * BLOCK_BYTES;
+        let from = k.saturating_mul(piece & !3);
         if from >= total {
             return Err(SdoAbort::NO_DATA);
         }
-        let len = (total - from).min(BLOCK_BYTES);
+        let len = (total - from).min(piece & !3);
         let out = buf.get_mut(..len).ok_or(SdoAbort::OUT_OF_MEMORY)?;
         let n = self.n.max(1) as u32;
         for (w, chunk) in (from / 4..).zip(out.chunks_exact_mut(4)) {

@@ -12,7 +12,7 @@ use drive_core::faults::E82_INACTIVE;
 use drive_core::objects::records::{Record, JOG_NEGATIVE, JOG_POSITIVE};
 use drive_core::params::{E43, E82};
 use drive_core::user_units::UserUnits;
-use drive_core::DriveObjects;
+use drive_core::{DriveObjects, LiveValues};
 use motion::units::UnitProfile;
 use od::{CommState, DataType, Dictionary, SdoAbort};
 use profidrive::{Addr, Completion, Describe, ParamAccess, PdError};
@@ -128,6 +128,9 @@ pub struct DriveAccess<'a> {
     pub core: &'a CoreSlots,
     /// The profile's own values.
     pub own: &'a mut OwnValues,
+    /// The provider of the live entries a parameter access reaches (the
+    /// scope's group T); [`NoLive`](drive_core::NoLive) where none can be.
+    pub live: &'a mut dyn LiveValues,
     /// A record a telegram's fields wrote, not yet stored: the fields of
     /// one record that follow each other in a telegram (target, velocities,
     /// accelerations) store it and show it in the window J401 once, not
@@ -195,6 +198,7 @@ impl DriveAccess<'_> {
 
     fn read_full(&mut self, index: u16, sub: u8, buf: &mut [u8]) -> Result<usize, PdError> {
         self.objects
+            .with_live(self.live)
             .read(index, sub, buf, CommState::Op)
             .map_err(pd_error)
     }
@@ -228,6 +232,7 @@ impl DriveAccess<'_> {
         fits(t)?;
         let data = bytes.get(..size(t)).ok_or(PdError::INCORRECT_DATA_TYPE)?;
         self.objects
+            .with_live(self.live)
             .write(index, sub, data, CommState::Op)
             .map_err(pd_error)
     }

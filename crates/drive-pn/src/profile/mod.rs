@@ -33,7 +33,7 @@ pub mod units;
 
 use access::{DriveAccess, OwnValues};
 use drive_core::axis::{Axis, RecordCommand};
-use drive_core::DriveObjects;
+use drive_core::{DriveObjects, LiveValues, NoLive};
 use lookup::{Core, CoreSlots, PreparedCache};
 use motion::units::UnitProfile;
 use profidrive::cw1::{Context, Cw1Decoder, Mode, ModeCommands};
@@ -97,6 +97,7 @@ impl Profile {
             prepared: &mut p.prepared,
             core: &p.core,
             own: &mut p.own,
+            live: &mut NoLive,
             pending: None,
         };
         // the stored configuration (A280, P-069), else the FB's
@@ -189,6 +190,19 @@ impl Profile {
 
     /// Step 1–3 of a cycle: the received OUT module's data `frame`.
     pub fn receive(&mut self, frame: &[u8], objects: &mut DriveObjects, axis: &mut Axis) {
+        self.receive_with(frame, objects, axis, &mut NoLive);
+    }
+
+    /// [`receive`](Self::receive) with `live` answering the live entries
+    /// the telegram's PKW reaches (the scope's group T,
+    /// [`crate::scope_record`]).
+    pub fn receive_with(
+        &mut self,
+        frame: &[u8],
+        objects: &mut DriveObjects,
+        axis: &mut Axis,
+        live: &mut dyn LiveValues,
+    ) {
         self.refresh_units(objects, axis);
         let Some(telegrams) = self.telegrams.as_mut() else {
             return;
@@ -203,6 +217,7 @@ impl Profile {
             prepared: &mut self.prepared,
             core,
             own: &mut self.own,
+            live,
             pending: None,
         };
         let rx = telegrams.apply_receive(frame, &mut access);
@@ -343,12 +358,14 @@ impl Profile {
     /// Serves a PROFIdrive parameter request (record 0xB02E, P-206) over
     /// the same parameter access as the PKW channel; the response goes
     /// into `out`, its length is returned (0: nothing to answer, the
-    /// request shorter than its header).
+    /// request shorter than its header); `live` answers the live entries
+    /// (the scope's group T, [`crate::scope_record`]).
     pub fn serve_bmp(
         &mut self,
         req: &[u8],
         objects: &mut DriveObjects,
         axis: &Axis,
+        live: &mut dyn LiveValues,
         out: &mut [u8],
     ) -> usize {
         let mut access = DriveAccess {
@@ -359,6 +376,7 @@ impl Profile {
             prepared: &mut self.prepared,
             core: &self.core,
             own: &mut self.own,
+            live,
             pending: None,
         };
         profidrive::bmp::serve(req, &mut access, out).unwrap_or(0)
@@ -389,6 +407,7 @@ impl Profile {
             prepared: &mut self.prepared,
             core: &self.core,
             own: &mut self.own,
+            live: &mut NoLive,
             pending: None,
         };
         // straight into the module's data (the telegram is cut to it or
