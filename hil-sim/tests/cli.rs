@@ -162,6 +162,49 @@ fn serve_plant_fault_needs_the_electrical_plant_and_an_unknown_plant_is_refused(
     );
 }
 
+/// Issue 35: `--plant-fault` offers the faults the motor actions (A75) find,
+/// besides the trips' ones, each described in `--help`; a brake fault with
+/// `--flywheel` (which has no brake) is refused before anything runs.
+#[test]
+fn serve_plant_fault_offers_the_motor_actions_faults() {
+    let o = hil_sim(&["serve", "--help"]);
+    assert!(o.status.success(), "{o:?}");
+    let out = text(&o.stdout);
+    for want in [
+        "short",
+        "encoder",
+        "swapped-phases",
+        "open-phase",
+        "unbalanced-winding",
+        "reversed-encoder",
+        "slipping-brake",
+        "stuck-brake",
+    ] {
+        assert!(
+            out.contains(&format!("{want}:")),
+            "`{want}` not described in:\n{out}"
+        );
+    }
+    for fault in ["slipping-brake", "stuck-brake"] {
+        let o = hil_sim(&[
+            "serve",
+            "--iface",
+            "lo",
+            "--flywheel",
+            "0.01",
+            "--plant-fault",
+            fault,
+        ]);
+        assert!(!o.status.success(), "{fault}: {o:?}");
+        assert!(
+            text(&o.stderr).contains("--flywheel has no holding brake"),
+            "{fault}: {}",
+            text(&o.stderr)
+        );
+        assert!(o.stdout.is_empty(), "{fault}: nothing ran: {}", text(&o.stdout));
+    }
+}
+
 #[test]
 fn an_out_of_range_value_is_refused() {
     let o = hil_sim(&["serve", "--iface", "lo", "--slaves", "129"]);

@@ -88,7 +88,9 @@ impl DemoArgs {
     }
 }
 
-/// A fault of the electrical plant (`serve --plant-fault`).
+/// A fault of the electrical plant (`serve --plant-fault`): of the power
+/// stage, the DC link and the encoder (the protection trips), or of the
+/// motor, its wiring and its brake (what the motor actions A75 find).
 #[derive(Debug, Clone, Copy, PartialEq, Eq, ValueEnum)]
 pub enum PlantFault {
     /// Leg a shorted to DC− through 1 Ω.
@@ -103,10 +105,37 @@ pub enum PlantFault {
     DcHigh,
     /// The encoder lost.
     Encoder,
+    /// Motor phases V and W wired to legs c and b (wrong phase order: B40
+    /// fails with 7).
+    SwappedPhases,
+    /// Motor phase W's wire open (B40 and B43 fail with 2, no current).
+    OpenPhase,
+    /// Phase V's resistance 10 % high (an unbalanced winding: B43 fails
+    /// with 6).
+    UnbalancedWinding,
+    /// The encoder counts the other way (B40 fails with 7).
+    ReversedEncoder,
+    /// The holding brake worn to 1.0 N·m, below the rated torque 1.3 N·m
+    /// (B300 fails with 9).
+    SlippingBrake,
+    /// The holding brake stays closed whatever is commanded (B301 fails
+    /// with 11).
+    StuckBrake,
 }
 
 impl PlantFault {
-    /// Applies the fault to an electrical axis' plant.
+    /// The holding torque of [`Self::SlippingBrake`], N·m: below the
+    /// simulated servo's rated torque (1.3 N·m, B300's test torque).
+    pub const WORN_BRAKE_NM: f64 = 1.0;
+
+    /// Whether the fault is the holding brake's (the motor's mechanics, not
+    /// the electrical plant).
+    pub fn is_brake(self) -> bool {
+        matches!(self, Self::SlippingBrake | Self::StuckBrake)
+    }
+
+    /// Applies the fault to an electrical axis' plant (the brake's: nothing,
+    /// see [`Self::apply_to_motor`]).
     pub fn apply(self, el: &mut hil_sim::electrical::ElectricalAxis) {
         use plant::{FaultOptions, Phase};
         let f = FaultOptions::NONE;
@@ -130,6 +159,33 @@ impl PlantFault {
                 encoder_lost: true,
                 ..f
             }),
+            Self::SwappedPhases => pl.set_faults(FaultOptions {
+                swapped_bc: true,
+                ..f
+            }),
+            Self::OpenPhase => pl.set_faults(FaultOptions {
+                open_phase: Some(Phase::C),
+                ..f
+            }),
+            Self::UnbalancedWinding => pl.set_faults(FaultOptions {
+                r_scale: [1.0, 1.1, 1.0],
+                ..f
+            }),
+            Self::ReversedEncoder => pl.set_faults(FaultOptions {
+                encoder_reversed: true,
+                ..f
+            }),
+            Self::SlippingBrake | Self::StuckBrake => {}
+        }
+    }
+
+    /// Applies a fault of the holding brake to the motor's mechanics (the
+    /// others: nothing, see [`Self::apply`]).
+    pub fn apply_to_motor(self, m: &mut hil_sim::motor::MotorParams) {
+        match self {
+            Self::SlippingBrake => m.brake_holding_torque_nm = Self::WORN_BRAKE_NM,
+            Self::StuckBrake => m.brake_stuck = true,
+            _ => {}
         }
     }
 }
@@ -238,7 +294,11 @@ pub struct ServeArgs {
     /// rail through 1 Ω (the over-current trip, event 33), `earth` the same
     /// through 100 Ω (the phase-sum trip, event 31), `broken-sensor` leg b's
     /// current sensor reads zero (phase sum), `dc-low` / `dc-high` a DC link
-    /// of 300 V / 850 V (events 46 / 36), `encoder` the encoder lost (37).
+    /// of 300 V / 850 V (events 46 / 36), `encoder` the encoder lost (37);
+    /// the others are faults of the motor, its wiring and its holding brake
+    /// that the motor actions (A75, issue 35) find, each below with the
+    /// action that fails and its result code (in B40, B43, B300, B301 sub 1).
+    /// The brake's are not with `--flywheel` (it has no brake).
     #[arg(long, value_enum, value_name = "FAULT")]
     pub plant_fault: Option<PlantFault>,
     /// With `--plant electrical`: the plant motor's phase resistance, Ω, on

@@ -17,7 +17,7 @@
 //! processed at once, and counted in the summary when that was more than
 //! [`LATE_NOTE`] late.
 
-use super::args::{Fieldbus, Plant, ServeArgs};
+use super::args::{Fieldbus, Plant, PlantFault, ServeArgs};
 
 /// Seed of the electrical plant's ADC noise under `serve --plant electrical`.
 pub(super) const PLANT_SEED: u64 = 0x5E12_0034;
@@ -154,12 +154,16 @@ pub fn serve(args: &ServeArgs) -> Result<(), String> {
                 d.electrical_mut(0)
                     .ok_or("--plant-fault needs --plant electrical")?,
             );
+            f.apply_to_motor(d.motors[0].params_mut());
         }
     }
     set_plant_motor(&mut sim, args)?;
     if let Some(j) = args.flywheel {
         if !(j.is_finite() && j > 0.0) {
             return Err("--flywheel must be a positive inertia".into());
+        }
+        if args.plant_fault.is_some_and(PlantFault::is_brake) {
+            return Err("--flywheel has no holding brake: no brake fault with it".into());
         }
         for d in sim.drives_mut() {
             let m = d.motors[0].params_mut();

@@ -254,6 +254,9 @@ pub fn serve(args: &ServeArgs) -> Result<(), String> {
                 d.electrical_mut(0)
                     .ok_or("--plant-fault needs --plant electrical")?,
             );
+            if let Some(m) = d.motor_mut(0) {
+                f.apply_to_motor(m.params_mut());
+            }
         }
         if let Some(apply) = &plant_motor {
             for axis in 0..2 {
