@@ -130,14 +130,18 @@ fn c038_e089_profinet_py_motor_i2t_warning_limit_and_fault_on_the_electrical_pla
 /// held within 1/360 rev; B44 (1111b, identify mechanics): J within 5 %,
 /// Coulomb and viscous friction within 10 % of the simulated servo's
 /// (1e-4 kg·m², 0.02 N·m, 2e-5 N·m·s/rad), which the drive does not know.
+/// With the plant's commutation offset (0.3 rad, `--plant-offset`) as well:
+/// B40 (the pole pairs seen = B10) and B41 (B05 within 0.5° electrical)
+/// before the actions that inject in the rotor's frame, B49 (R, L within
+/// 5 %) and B301 (grinding torque the plant's brake plus friction) after.
 #[test]
 fn e140_e141_profinet_py_motor_actions_by_pkw_on_the_electrical_plant() {
     let Some((_, line)) = run_named(
         "motor_actions.py",
         "ma",
-        &["--plant-r", "2.2", "--plant-l", "0.008"],
+        &["--plant-r", "2.2", "--plant-l", "0.008", "--plant-offset", "0.3"],
         &[
-            "--r", "2.2", "--l", "0.008", "--j", "1e-4", "--fc", "0.02", "--b", "2e-5",
+            "--r", "2.2", "--l", "0.008", "--j", "1e-4", "--fc", "0.02", "--b", "2e-5", "--offset", "0.3",
         ],
         "E-140",
     ) else {

@@ -21,6 +21,18 @@ action activation (docs/conformance.md, E-142).
      B45 (J) within 5 % of --j, B46/B47 (Coulomb, viscous friction) within
      10 % of --fc/--b (the plant's, which the drive does not know).
 
+With --offset (serve --plant-offset, the plant's commutation offset, rad,
+which the drive does not know), first, before any action that injects in
+the rotor's frame, and then after B42 and B300:
+  3a. B40 (1010b, test phase) with the enable: done, B40[0] = 0, the pole
+      pairs seen B40[2] = B10. B41 (1011b, calibrate motor): done, B41[0] =
+      0, B05 within 0.5 degrees electrical of --offset.
+  4a. B49 (1110b, optimise the current controller at standstill): done,
+      B42[0] = 0 (B49 reports in B42), B53 within 5 % of --r, B52 within 5 % of --l.
+  5a. B301 (0101b, grind brake): done, B301[0] = 0, each grind phase turned
+      the shaft by at least 0.8 of 60 rpm x 0.5 s (2^19 inc), the grinding
+      torque B301[3] the plant's brake (2 N m) plus friction, 2.0 ... 2.3 N m.
+
 One line:  scenario E-140: ok|FAIL: ...
 """
 
@@ -38,6 +50,8 @@ def b(line):
 A75, A69 = 0x2000 + 75, 0x2000 + 69
 B42, B43, B52, B53, B62, B300 = b(42), b(43), b(52), b(53), b(62), b(300)
 B44, B45, B46, B47 = b(44), b(45), b(46), b(47)
+B05, B10, B40, B41, B301 = b(5), b(10), b(40), b(41), b(301)
+B40_SEL, B41_SEL, B49_SEL, B301_SEL = 0b1010, 0b1011, 0b1110, 0b0101
 E48 = 0x2800 + 48
 RUNNING, DONE, REFUSED = 1, 2, 3
 B42_SEL, B43_SEL, B300_SEL, B44_SEL = 0b1100, 0b1101, 0b0100, 0b1111
@@ -111,7 +125,59 @@ def mechanics(fb, sc, j, fc, visc):
     disable(fb)
 
 
-def run(fb, sc, r, l):
+def action(fb, sc, sel, name, timeout=20.0):
+    """Starts `sel` in ready to switch on, enables, waits for its end:
+    checks done (100 %); Execute low and disabled afterwards by the caller."""
+    write(fb, sc, A75, sel << 1 | 1)
+    fb.run_for(0.05)
+    t0 = time.monotonic()
+    enable(fb, sc, name)
+    a69, dt = a69_until(fb, sc, lambda v: v >> 12 not in (0, RUNNING), timeout)
+    sc.check(a69 == (100 | sel << 8 | DONE << 12), f"{name}: A69 {a69} after {ms(dt)} (want done, 100 %)")
+    return time.monotonic() - t0
+
+
+def end(fb, sc):
+    stop(fb, sc)
+    disable(fb)
+
+
+def phase_and_offset(fb, sc, offset):
+    took = action(fb, sc, B40_SEL, "B40")
+    pp, b10 = read(fb, sc, B40, 3), read(fb, sc, B10)
+    sc.check(read(fb, sc, B40, 1) == 0 and pp == b10, f"B40: done in {took:.2f} s, pole pairs seen {pp} = B10 {b10}")
+    end(fb, sc)
+    per_el = (1 << 20) // max(b10 or 1, 1)
+    truth = round(offset / (2 * 3.141592653589793) * (1 << 20))
+    took = action(fb, sc, B41_SEL, "B41")
+    b05 = read(fb, sc, B05) or 0
+    err = (b05 - truth) % per_el
+    err = min(err, per_el - err) / per_el * 360.0
+    sc.check(read(fb, sc, B41, 1) == 0 and err < 0.5,
+             f"B41: B05 {b05} inc against the plant's {truth}: {err:.3f} deg electrical, in {took:.2f} s")
+    end(fb, sc)
+
+
+def optimise_at_standstill(fb, sc, r, l):
+    for index, value in ((B53, 1000), (B52, 4000), (B62, 4000)):
+        write(fb, sc, index, value)
+    took = action(fb, sc, B49_SEL, "B49")
+    r_id, l_id = (read(fb, sc, B53) or 0) * 1e-3, (read(fb, sc, B52) or 0) * 1e-6
+    sc.check(read(fb, sc, B42, 1) == 0 and abs(r_id - r) <= 0.05 * r and abs(l_id - l) <= 0.05 * l,
+             f"B49: R {r_id:.4f} ohm (plant {r}), L {l_id * 1e3:.4f} mH (plant {l * 1e3}) in {took:.2f} s")
+    end(fb, sc)
+
+
+def grind_brake(fb, sc):
+    took = action(fb, sc, B301_SEL, "B301")
+    result, grind, released, torque = (read(fb, sc, B301, k) for k in (1, 2, 3, 4))
+    sc.check(result == 0 and (grind or 0) >= 0.8 * (1 << 19) and 2000 <= (torque or 0) <= 2300,
+             f"B301: result {result}, smallest grind travel {grind} inc, released {released} inc, "
+             f"grinding torque {torque} mN m (the plant's brake slides at 2000), in {took:.2f} s")
+    end(fb, sc)
+
+
+def run(fb, sc, r, l, offset=None):
     for index, value in ((B53, 1000), (B52, 4000), (B62, 4000)):
         write(fb, sc, index, value)
     # 2. refused while enabled
@@ -134,6 +200,8 @@ def run(fb, sc, r, l):
     sc.note(f"B43: phase resistances {rs} ohm against the plant's {r} ohm in {time.monotonic() - t0:.2f} s")
     sc.check(all(abs(x - r) <= 0.03 * r for x in rs), f"B43: {rs} within 3 % of {r} ohm")
     stop(fb, sc)
+    if offset is not None:
+        phase_and_offset(fb, sc, offset)
     # 4. B42: started in ready to switch on, runs once enabled
     write(fb, sc, A75, B42_SEL << 1 | 1)
     fb.run_for(0.05)
@@ -162,6 +230,9 @@ def run(fb, sc, r, l):
              f"B300: held (result {result}), moved {moved} inc within 1/360 rev")
     stop(fb, sc)
     disable(fb)
+    if offset is not None:
+        optimise_at_standstill(fb, sc, r, l)
+        grind_brake(fb, sc)
 
 
 def main():
@@ -171,11 +242,13 @@ def main():
     ap.add_argument("--j", type=float, required=True, help="the plant's inertia, kg m^2")
     ap.add_argument("--fc", type=float, required=True, help="the plant's Coulomb friction, N m")
     ap.add_argument("--b", type=float, required=True, help="the plant's viscous friction, N m s/rad")
+    ap.add_argument("--offset", type=float, help="the plant's commutation offset (serve --plant-offset), rad: "
+                    "B40, B41, B49 and B301 run as well")
     a = ap.parse_args()
     sc = Scenario("E-140")
 
     def body(fb):
-        run(fb, sc, a.r, a.l)
+        run(fb, sc, a.r, a.l, a.offset)
         mechanics(fb, sc, a.j, a.fc, a.b)
 
     return run_fb_scenario(a, sc, body)
