@@ -9,6 +9,14 @@
 //! its friction (goal of issue 35: following error max ≤ 500 inc, rms ≤
 //! 100 inc; J within 5 %, the friction within 10 %).
 //!
+//! The same on PROFINET: the demo's sequence (`hil_sim::fb::sequence`, the
+//! Example Function block's telegrams against the simulated PROFINET drive,
+//! `demo --fieldbus profinet`) on both plants, without and with its
+//! self-tuning phase (B44 started and read through the telegram's PKW
+//! channel, `--self-tune`): the positioning moves' following error (the
+//! appended chain T1…T3 and the relative move; goal of issue 35: max ≤ 500
+//! inc per move).
+//!
 //! `cargo bench -p hil-sim --bench selftune`
 //!
 //! No master: the set-points and A75 are written into the dictionary as a
@@ -25,8 +33,9 @@
 
 use drive_ecat::axis::AxisIo;
 use drive_ecat::params::{B44, B45, B46, B47, C31, C32, I20};
-use hil_sim::electrical::ElectricalAxis;
+use hil_sim::electrical::{ElectricalAxis, PlantModel};
 use hil_sim::esc::{Esc, EscConfig};
+use hil_sim::fb::sequence::{self, MoveFe, Observer, Options, Report};
 use hil_sim::motor::Motor;
 use hil_sim::sim::{SimFlash, CONTROL_CYCLE};
 use nanos::Nanos;
@@ -146,6 +155,71 @@ impl World {
     }
 }
 
+/// Hears nothing: the figures are in the report.
+struct Quiet;
+
+impl Observer for Quiet {
+    fn line(&mut self, _t: Nanos, _text: &str) {}
+}
+
+/// The PROFINET demo's sequence on the servo with `mechanics` (J, friction
+/// factors), with or without self-tuning.
+fn pn_run(mechanics: (f64, f64), self_tune: bool, bandwidth_hz: Option<u16>) -> Report {
+    let options = Options {
+        plant: PlantModel::Electrical,
+        self_tune,
+        mechanics,
+        bandwidth_hz,
+    };
+    let (r, _) = sequence::run_with(&mut Quiet, None, options).unwrap();
+    assert_eq!(r.moves.len(), 2, "{:?}", r.deviations);
+    r
+}
+
+fn moves(m: &[MoveFe]) -> String {
+    m.iter()
+        .map(|m| format!("{:>6} {:>6.1}", m.max_inc, m.rms_inc))
+        .collect::<Vec<_>>()
+        .join(" | ")
+}
+
+fn profinet() {
+    println!();
+    println!("PROFINET: the demo's sequence (Example FB telegrams, 1 ms), its positioning moves (the chain T1…T3 to 8 rev, the relative move -2 rev): FE max / rms inc, before and after B44 through PKW (B48 as the drive has it, 30 Hz, or written first)");
+    println!(
+        "{:<26} | {:>13} | {:>13} | {:>8} {:>8} {:>8} | {:>13} | {:>13}",
+        "plant", "chain before", "rel. before", "J err %", "Fc err %", "B err %", "chain after", "rel. after"
+    );
+    for (name, jf, ff, bw) in [
+        ("servo", 1.0, 1.0, None),
+        ("servo, 5× J, 3× friction", 5.0, 3.0, None),
+        ("servo, B48 60 Hz", 1.0, 1.0, Some(60)),
+        ("5× J, 3× fr., B48 60 Hz", 5.0, 3.0, Some(60)),
+    ] {
+        let before = pn_run((jf, ff), false, None);
+        let after = pn_run((jf, ff), true, bw);
+        let t = after.self_tune.unwrap();
+        assert_eq!(
+            (t.a69 >> 12, t.code),
+            (2, 0),
+            "{name}: {t:?} {:?}",
+            after.deviations
+        );
+        let p = *Motor::default_servo().params();
+        let err = |v: u32, scale: f64, truth: f64| (f64::from(v) * scale - truth) / truth * 100.0;
+        let ej = err(t.inertia, 1e-7, p.inertia_kg_m2 * jf);
+        let ec = err(t.coulomb, 1e-6, p.coulomb_friction_nm * ff);
+        let eb = err(t.viscous, 1e-9, p.viscous_friction_nm_s_per_rad * ff);
+        println!(
+            "{name:<26} | {} | {ej:>+8.2} {ec:>+8.2} {eb:>+8.2} | {}   (B44 {} ms; deviations {})",
+            moves(&before.moves),
+            moves(&after.moves),
+            t.ms,
+            after.deviations.len()
+        );
+    }
+}
+
 fn main() {
     println!("B44 identify mechanics on the electrical plant; the demo's csp profile (10 rev out and back, 1.5 s each), 1 ms, before and after");
     println!(
@@ -177,4 +251,5 @@ fn main() {
             gains[0], gains[1], gains[2]
         );
     }
+    profinet();
 }

@@ -332,6 +332,23 @@ fn demo_profinet_refuses_an_unwritable_plot_before_the_run() {
     assert!(!out.contains("AR "), "refused before the run: {out}");
 }
 
+/// The self-tuning options are PROFINET's (the EtherCAT figures are the
+/// selftune bench's); a factor out of range is refused before the run.
+#[test]
+fn demo_self_tune_options_are_profinet_only_and_checked() {
+    let o = hil_sim(&["demo", "--self-tune"]);
+    assert!(!o.status.success(), "{o:?}");
+    assert!(text(&o.stderr).contains("PROFINET-only"), "{}", text(&o.stderr));
+    let o = hil_sim(&["demo", "--fieldbus", "profinet", "--plant-j-factor", "0"]);
+    assert!(!o.status.success(), "{o:?}");
+    assert!(
+        text(&o.stderr).contains("--plant-j-factor 0"),
+        "{}",
+        text(&o.stderr)
+    );
+    assert!(!text(&o.stdout).contains("AR "), "refused before the run");
+}
+
 /// P-219…P-227 through the binary: the FB's sequence prints its state
 /// changes and a summary, writes the plot (with the ZSW1 state panel) and
 /// records the PROFINET frames.

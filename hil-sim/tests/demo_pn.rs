@@ -320,3 +320,55 @@ fn p221_change_immediately_replaces_the_running_task() {
     );
     assert!(b.fb.outputs().target_reached);
 }
+
+/// The demo's sequence on a plant the drive does not know (5× the servo's
+/// inertia, 3× its friction), without and with its self-tuning phase.
+fn mechanics_run(self_tune: bool) -> Report {
+    let mut c = Collect::default();
+    let options = sequence::Options {
+        self_tune,
+        mechanics: (5.0, 3.0),
+        ..PlantModel::Electrical.into()
+    };
+    let (report, _) = sequence::run_with(&mut c, None, options).expect("the exchange runs");
+    report
+}
+
+/// Issue 35 on PROFINET: B44 started and read through the telegram's PKW
+/// channel (A75 = 1Fh in ready to switch on, A69 polled, B45…B47 read;
+/// E-140/E-141) identifies the unknown plant, and the positioning moves
+/// after it follow far closer than with the hand-set defaults. Bound: 1,500
+/// inc per move (the figures, `cargo bench -p hil-sim --bench selftune`:
+/// about 1,100 / 830 inc at B48's 30 Hz; the issue's goal of 500 inc is not
+/// reached yet), against about 76,000 / 86,000 inc untuned.
+#[test]
+fn e140_b44_through_pkw_before_the_positioning_moves_cuts_their_following_error() {
+    let untuned = mechanics_run(false);
+    let tuned = mechanics_run(true);
+    assert!(untuned.self_tune.is_none());
+    let t = tuned.self_tune.expect("the self-tuning phase ran");
+    assert_eq!(t.a69, 0b1111 << 8 | 2 << 12 | 100, "A69 done, 100 %: {t:?}");
+    assert_eq!(t.code, 0, "B44[0] = 0: identified and written");
+    let j = f64::from(t.inertia) * 1e-7;
+    assert!((j / 5e-4 - 1.0).abs() < 0.05, "J {j} within 5 % of 5e-4");
+    let fc = f64::from(t.coulomb) * 1e-6;
+    assert!((fc / 0.06 - 1.0).abs() < 0.10, "Fc {fc} within 10 % of 0.06");
+    let ran: Vec<Phase> = tuned.phases.iter().map(|p| p.phase).collect();
+    assert_eq!(ran, Phase::of_run(true));
+    assert_eq!(untuned.moves.len(), 2);
+    assert_eq!(tuned.moves.len(), 2);
+    for (before, after) in untuned.moves.iter().zip(&tuned.moves) {
+        assert!(after.max_inc <= 1_500, "{after:?} (untuned {before:?})");
+        assert!(
+            after.max_inc * 20 < before.max_inc,
+            "{after:?} against {before:?}"
+        );
+        assert!(
+            after.rms_inc * 20.0 < before.rms_inc,
+            "{after:?} against {before:?}"
+        );
+    }
+    for t in &tuned.targets {
+        assert!(t.error_inc().abs() <= END_POSITION_TOLERANCE_INC, "{t:?}");
+    }
+}

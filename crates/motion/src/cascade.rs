@@ -123,6 +123,14 @@ pub struct CascadeConfig {
     /// actual position to the set-point). Off: only the generator's
     /// acceleration feeds J·a.
     pub derive_acceleration: bool,
+    /// Compare the speed set-point with the measured speed advanced by the
+    /// generator's acceleration feedforward (the input's, not one derived
+    /// from the set-points) over the measurement's lag (half a cycle of
+    /// the difference plus the velocity filter's time constant): with an
+    /// accurate J·a the shaft's speed is the set-point's, the measured one
+    /// lags it by a·lag, and the uncompensated controller would make a
+    /// following error of a·lag/Kv out of that lag.
+    pub compensate_velocity_lag: bool,
 }
 
 /// The band of the smoothed sign of the Coulomb friction feedforward,
@@ -151,6 +159,7 @@ impl CascadeConfig {
         coulomb_friction_nm: 0.0,
         viscous_friction_nm_per_rad_per_s: 0.0,
         derive_acceleration: false,
+        compensate_velocity_lag: false,
     };
 
     /// Checks that every gain and limit is finite and not negative and that
@@ -330,7 +339,8 @@ impl Cascade {
         let (velocity_command, torque_unlimited) = match input.entry {
             ControlEntry::Position | ControlEntry::Velocity => {
                 let v_in = finite_or_zero(input.velocity_inc_per_s);
-                let mut acceleration = finite_or_zero(input.acceleration_feedforward_inc_per_s2);
+                let given = finite_or_zero(input.acceleration_feedforward_inc_per_s2);
+                let mut acceleration = given;
                 let v_ref = v_in;
                 if cfg.derive_acceleration {
                     let last = self.last_feedforward.replace(v_in);
@@ -360,7 +370,18 @@ impl Cascade {
                 let command = clamp(raw_command, -vmax, vmax);
                 velocity_limited = command != raw_command;
 
-                let error_rad_per_s = (command - actual_velocity) * RAD_PER_INCREMENT;
+                // the measured speed lags the shaft's by half a cycle (the
+                // difference) and the filter's time constant: with the
+                // generator's acceleration fed forward the controller
+                // compares with the speed that lag predicts (else it would
+                // fight J·a); a derived acceleration is a cycle late itself
+                let predicted = if cfg.compensate_velocity_lag {
+                    let lag_s = 0.5 * dt_s + cfg.velocity_filter_time_ns as f32 * 1e-9;
+                    actual_velocity + given * lag_s
+                } else {
+                    actual_velocity
+                };
+                let error_rad_per_s = (command - predicted) * RAD_PER_INCREMENT;
                 let proportional = kp * error_rad_per_s;
                 let feedforward = finite_or_zero(input.torque_nm)
                     + cfg.inertia_kg_m2 * acceleration * RAD_PER_INCREMENT

@@ -78,6 +78,21 @@ pub struct DemoArgs {
     /// control cycle later (torque in, cheap) [default: electrical].
     #[arg(long, value_enum, value_name = "MODEL")]
     pub plant: Option<Plant>,
+    /// PROFINET only: self-tune before the positioning moves, as a PLC
+    /// would: B44 identify mechanics started through the telegram's PKW
+    /// channel (A75 = 1Fh in ready to switch on, then drive_enable), A69
+    /// polled until done, B45/B46/B47 read; the moves then run on the gains
+    /// and feedforward B44 set.
+    #[arg(long)]
+    pub self_tune: bool,
+    /// PROFINET only: the plant's inertia times this, a load the drive does
+    /// not know [default: 1, the simulated servo its defaults are set for].
+    #[arg(long, value_name = "FACTOR")]
+    pub plant_j_factor: Option<f64>,
+    /// PROFINET only: the plant's friction (Coulomb, breakaway, viscous)
+    /// times this [default: 1].
+    #[arg(long, value_name = "FACTOR")]
+    pub plant_friction_factor: Option<f64>,
 }
 
 impl DemoArgs {
@@ -85,6 +100,25 @@ impl DemoArgs {
     /// (both fieldbuses).
     pub fn plant(&self) -> Plant {
         self.plant.unwrap_or(Plant::Electrical)
+    }
+
+    /// The plant's inertia and friction factors (PROFINET), each finite
+    /// and within 0.1 … 100.
+    pub fn mechanics(&self) -> Result<(f64, f64), String> {
+        let f = |v: Option<f64>, name: &str| match v {
+            None => Ok(1.0),
+            Some(x) if x.is_finite() && (0.1..=100.0).contains(&x) => Ok(x),
+            Some(x) => Err(format!("--{name} {x}: a factor within 0.1 … 100")),
+        };
+        Ok((
+            f(self.plant_j_factor, "plant-j-factor")?,
+            f(self.plant_friction_factor, "plant-friction-factor")?,
+        ))
+    }
+
+    /// Whether a PROFINET-only option is given.
+    pub fn profinet_only(&self) -> bool {
+        self.self_tune || self.plant_j_factor.is_some() || self.plant_friction_factor.is_some()
     }
 }
 

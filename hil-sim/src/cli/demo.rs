@@ -228,6 +228,13 @@ fn print_current_figures(e: &hil_sim::electrical::ElectricalAxis) {
 /// Runs the demo. Both output files are created before the run: a path that
 /// cannot be written fails at once, never after the run claiming a file.
 pub fn demo(args: &DemoArgs) -> Result<(), String> {
+    if args.profinet_only() {
+        return Err(
+            "--self-tune, --plant-j-factor and --plant-friction-factor are PROFINET-only (--fieldbus profinet; \
+             on EtherCAT: cargo bench -p hil-sim --bench selftune)"
+                .into(),
+        );
+    }
     let sim = RefCell::new(Simulation::new(1));
     if let Some(p) = &args.pcap {
         sim.borrow_mut()

@@ -8,7 +8,7 @@
 //! state with the phases marked.
 
 use super::args::{create_output, DemoArgs, Plant, DEFAULT_PLOT_PN};
-use hil_sim::fb::sequence::{self, Observer, Phase, Report, Sample, INC_PER_REV};
+use hil_sim::fb::sequence::{self, Observer, Options, Phase, Report, Sample, INC_PER_REV};
 use hil_sim::fb::{state_name, zsw1_state};
 use hil_sim::pcap::Recording;
 use hil_sim::plot::Trace;
@@ -21,6 +21,8 @@ use std::path::PathBuf;
 struct Printer {
     bar: indicatif::ProgressBar,
     trace: Trace,
+    /// The run's phases, in order (the bar's steps).
+    phases: Vec<Phase>,
 }
 
 /// The ZSW1 state as a number for the plot: −1 fault, 0 SOI, 1 RTSO,
@@ -49,7 +51,7 @@ impl Observer for Printer {
     }
 
     fn phase(&mut self, t: Nanos, phase: Phase) {
-        let k = Phase::ALL.iter().position(|p| *p == phase).unwrap_or(0);
+        let k = self.phases.iter().position(|p| *p == phase).unwrap_or(0);
         self.bar.set_position(k as u64);
         self.bar.set_message(phase.name());
         self.trace.mark_phase(t, phase.name());
@@ -99,6 +101,26 @@ fn summary(r: &Report) {
             t.error_inc()
         );
     }
+    if let Some(t) = &r.self_tune {
+        println!(
+            "  self-tuning (B44 through PKW): A69 {:#06x}, B44[0] {}, J {:.4e} kg·m², Fc {:.4} N·m, \
+             B {:.3e} N·m·s/rad; C31 {} µN·m·s/rad, C32 {} µs, I20 {} × 0.1/s",
+            t.a69,
+            t.code,
+            f64::from(t.inertia) * 1e-7,
+            f64::from(t.coulomb) * 1e-6,
+            f64::from(t.viscous) * 1e-9,
+            t.gains[0],
+            t.gains[1],
+            t.gains[2]
+        );
+    }
+    for m in &r.moves {
+        println!(
+            "  positioning move {}: following error max {} inc, rms {:.1} inc",
+            m.label, m.max_inc, m.rms_inc
+        );
+    }
     println!(
         "  following error max {} inc ({:.3}°)",
         r.max_following_error_inc,
@@ -140,6 +162,12 @@ pub fn demo(args: &DemoArgs) -> Result<(), String> {
             p
         }
     };
+    let options = Options {
+        plant: args.plant().into(),
+        self_tune: args.self_tune,
+        mechanics: args.mechanics()?,
+        bandwidth_hz: None,
+    };
     let mut plot_file = create_output(&plot_path, "plot")?;
     println!(
         "hil-sim demo --fieldbus profinet: Example Function block (in-process IO controller, 1 ms) -> \
@@ -149,7 +177,8 @@ pub fn demo(args: &DemoArgs) -> Result<(), String> {
             Plant::Electrical => "current loop (16 kHz) -> simulated PMSM and inverter",
         }
     );
-    let bar = indicatif::ProgressBar::new(Phase::ALL.len() as u64);
+    let phases = Phase::of_run(options.self_tune);
+    let bar = indicatif::ProgressBar::new(phases.len() as u64);
     if let Ok(style) = indicatif::ProgressStyle::with_template("  phase [{bar:21}] {pos}/{len} {msg}") {
         bar.set_style(style);
     }
@@ -160,8 +189,9 @@ pub fn demo(args: &DemoArgs) -> Result<(), String> {
             state_name: "ZSW1 state (-1 fault, 0 SOI, 1 RTSO, 2 SO, 3 OP)".into(),
             ..Trace::default()
         },
+        phases,
     };
-    let result = sequence::run(&mut printer, pcap, args.plant().into());
+    let result = sequence::run_with(&mut printer, pcap, options);
     printer.bar.finish_and_clear();
     let (report, pcap) = match result {
         Ok(r) => r,

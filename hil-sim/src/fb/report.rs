@@ -22,6 +22,9 @@ pub enum Phase {
     Pkw,
     /// The provoked fault and its acknowledgement.
     Fault,
+    /// B44 identify mechanics through PKW (only with
+    /// [`super::sequence::Options::self_tune`]: between enable and home).
+    SelfTune,
 }
 
 impl Phase {
@@ -46,7 +49,18 @@ impl Phase {
             Phase::Jog => "jog",
             Phase::Pkw => "PKW",
             Phase::Fault => "fault",
+            Phase::SelfTune => "self-tune",
         }
+    }
+
+    /// The phases of a run, in order: [`Self::ALL`], with `self_tune` the
+    /// self-tuning after the enable.
+    pub fn of_run(self_tune: bool) -> Vec<Phase> {
+        let mut v = Phase::ALL.to_vec();
+        if self_tune {
+            v.insert(1, Phase::SelfTune);
+        }
+        v
     }
 }
 
@@ -99,6 +113,40 @@ impl TargetResult {
     pub fn error_inc(&self) -> i64 {
         self.reached_inc - self.commanded_inc
     }
+}
+
+/// The following error (|60F4h|) of one positioning move, from the start
+/// of its task until it settled at its target.
+#[derive(Debug, Clone, PartialEq)]
+pub struct MoveFe {
+    /// Which move ("chain T1…T3", "relative −2000").
+    pub label: String,
+    /// max |60F4h|, increments.
+    pub max_inc: i64,
+    /// rms of 60F4h, increments.
+    pub rms_inc: f64,
+    /// Controller cycles the move took (with its 200 ms settling).
+    pub cycles: u64,
+}
+
+/// What B44 (identify mechanics) found through PKW, as read back: the raw
+/// dictionary values.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub struct SelfTuneResult {
+    /// A69 at the end (state in bits 12–15, 2 = done).
+    pub a69: u32,
+    /// B44\[0\]: the result code (0 = written).
+    pub code: u32,
+    /// B45 J, 10⁻⁷ kg·m².
+    pub inertia: u32,
+    /// B46 Fc, µN·m.
+    pub coulomb: u32,
+    /// B47 B, nN·m·s/rad.
+    pub viscous: u32,
+    /// C31 Kp (µN·m·s/rad), C32 Ti (µs), I20 Kv (0.1/s) as set by B44.
+    pub gains: [u32; 3],
+    /// Simulated time from Execute to done, ms.
+    pub ms: u64,
 }
 
 /// How long a phase took and what it found.
@@ -156,6 +204,10 @@ pub struct Report {
     pub fault_cleared: bool,
     /// `drive_is_enabled` again after the acknowledgement.
     pub re_enabled: bool,
+    /// The positioning moves' following error: the chain, the relative move.
+    pub moves: Vec<MoveFe>,
+    /// B44 through PKW, when the run self-tuned.
+    pub self_tune: Option<SelfTuneResult>,
     /// max |60F4h| over the run, increments.
     pub max_following_error_inc: i64,
     /// Controller cycles run.

@@ -18,17 +18,24 @@
 //!    channel, `fault` (ZSW1 bit 3), `fault_reset` (CW1 bit 7 rising edge),
 //!    the fault gone, the FB's enable sequence again.
 //!
+//! With [`Options::self_tune`] a self-tuning phase (B44 identify mechanics
+//! through PKW, [`self_tune`]) runs between 1 and 2, so that the
+//! positioning moves run on the gains and feedforward B44 set; the
+//! positioning moves' following error is in [`Report::moves`] either way.
+//!
 //! Where the drive does what the spec says it should not, the run goes on
 //! and says so in [`Report::deviations`] ("P-xxx: …").
 
 use super::controller::PnController;
 use super::pkw::{Access, Outcome, PkwClient};
-pub use super::report::{Observer, Phase, PhaseResult, Report, Sample, TargetResult};
+pub use super::report::{MoveFe, Observer, Phase, PhaseResult, Report, Sample, SelfTuneResult, TargetResult};
 use super::{state_name, ExampleFb, FbInputs, FbOutputs, OPMODE_POS, OPMODE_VELO};
 use crate::electrical::PlantModel;
 use crate::pcap::Recording;
 use crate::pn::Command;
 use nanos::Nanos;
+
+mod self_tune;
 
 /// Increments per revolution.
 pub const INC_PER_REV: i64 = 1 << 20;
@@ -69,6 +76,17 @@ struct Run<'a, O: Observer> {
     obs: &'a mut O,
     report: Report,
     phase_start: Nanos,
+    /// The PLC program's own CW1 state command OFF (0x..06, ready to switch
+    /// on) in place of the FB's while `drive_enable` is 0: the self-tuning
+    /// phase starts B44 in ready to switch on (E-141).
+    hold_ready: bool,
+    /// The running move's |60F4h| max, Σ 60F4h², cycles.
+    move_fe: Option<(i64, f64, u64)>,
+    /// In the self-tuning phase: B44's own loop moves the axis, 60F4h is
+    /// no following error of the cascade (not in the run's maximum).
+    in_self_tune: bool,
+    /// [`Options::bandwidth_hz`].
+    bandwidth_hz: Option<u16>,
 }
 
 fn bit(b: bool) -> u8 {
@@ -115,13 +133,19 @@ impl<O: Observer> Run<'_, O> {
     /// One controller cycle; prints what changed.
     fn cycle(&mut self) -> Result<(), String> {
         self.pkw.inputs(&mut self.i);
-        let cw1 = self.fb.cw1(&self.i);
+        let mut telegram = self.fb.receive_telegram(&self.i);
+        let mut cw1 = self.fb.cw1(&self.i);
+        if self.hold_ready && !self.i.drive_enable {
+            cw1 = cw1 & !0x000F | super::CMD_OFF;
+            if let Some(w) = telegram.get_mut(2..4) {
+                w.copy_from_slice(&cw1.to_be_bytes());
+            }
+        }
         if self.last_cw1 != Some(cw1) {
             let was = self.last_cw1.map_or("-".to_string(), |c| format!("{c:#06x}"));
             self.line(&format!("CW1 {was} -> {cw1:#06x}"));
             self.last_cw1 = Some(cw1);
         }
-        let telegram = self.fb.receive_telegram(&self.i);
         let response = self.ctl.exchange(&telegram)?.map(<[u8]>::to_vec);
         for (t, e) in self.ctl.take_events() {
             self.obs.line(t, &e);
@@ -131,7 +155,14 @@ impl<O: Observer> Run<'_, O> {
             self.take_response(&r)?;
         }
         let ferr = self.axis_value(0x60F4);
-        self.report.max_following_error_inc = self.report.max_following_error_inc.max(ferr.abs());
+        if !self.in_self_tune {
+            self.report.max_following_error_inc = self.report.max_following_error_inc.max(ferr.abs());
+        }
+        if let Some((max, sq, n)) = self.move_fe.as_mut() {
+            *max = (*max).max(ferr.abs());
+            *sq += (ferr as f64).powi(2);
+            *n += 1;
+        }
         let s = Sample {
             t: self.ctl.now(),
             zsw1: self.o.zsw1,
@@ -333,12 +364,29 @@ impl<O: Observer> Run<'_, O> {
         Ok(())
     }
 
+    /// Ends the running move's following-error record as `label`.
+    fn end_move(&mut self, label: &str) {
+        if let Some((max_inc, sq, cycles)) = self.move_fe.take() {
+            let rms_inc = (sq / cycles.max(1) as f64).sqrt();
+            self.line(&format!(
+                "{label}: following error max {max_inc} inc, rms {rms_inc:.1} inc"
+            ));
+            self.report.moves.push(MoveFe {
+                label: label.to_string(),
+                max_inc,
+                rms_inc,
+                cycles,
+            });
+        }
+    }
+
     fn positioning(&mut self) -> Result<(), String> {
         self.begin(Phase::Positioning);
         self.i.operation_mode = OPMODE_POS;
         self.i.change_immediatly = false;
         self.i.relative = false;
         let mut passing = Vec::new();
+        self.move_fe = Some((0, 0.0, 0));
         for (k, (target, velocity, end)) in CHAIN.iter().copied().enumerate() {
             self.i.target_position = target;
             self.i.profile_velocity = velocity;
@@ -390,11 +438,13 @@ impl<O: Observer> Run<'_, O> {
             }
         }
         self.settle("T3 (end of chain)".into(), last)?;
+        self.end_move("chain T1…T3");
         // the relative move, relative to the position set-point
         self.i.relative = true;
         self.i.target_position = RELATIVE_MOVE;
         self.i.profile_velocity = 500;
         self.i.end_velocity = 0;
+        self.move_fe = Some((0, 0.0, 0));
         if !self.start_task()? {
             self.deviation("P-221: the relative task was not acknowledged".into());
         }
@@ -403,6 +453,7 @@ impl<O: Observer> Run<'_, O> {
         self.set_inc = commanded as i32;
         self.line(&format!("relative move {RELATIVE_MOVE} (1/1000 rev) started"));
         self.settle(format!("relative {RELATIVE_MOVE}"), commanded)?;
+        self.end_move(&format!("relative {RELATIVE_MOVE}"));
         let worst = self
             .report
             .targets
@@ -508,6 +559,7 @@ impl<O: Observer> Run<'_, O> {
 
     fn pkw_phase(&mut self) -> Result<(), String> {
         self.begin(Phase::Pkw);
+        let before = self.report.pkw.len();
         let m = self.pkw_access("read 964.0", Access::Read { index: 964, sub: 0 })?;
         if m == Outcome::Done(u32::from(profinet::model::VENDOR_ID)) {
             self.deviation(format!(
@@ -540,7 +592,7 @@ impl<O: Observer> Run<'_, O> {
         if !matches!(bad, Outcome::Refused(_)) {
             self.deviation(format!("P-226: an unknown PNU read {bad:?}"));
         }
-        let n = self.report.pkw.len();
+        let n = self.report.pkw.len() - before;
         self.end(Phase::Pkw, format!("{n} accesses"));
         Ok(())
     }
@@ -591,6 +643,36 @@ impl<O: Observer> Run<'_, O> {
 /// Seed of the electrical plant's ADC noise in the sequence's drive.
 pub const PLANT_SEED: u64 = 0x5EED_0F00;
 
+/// How to run the sequence.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct Options {
+    /// The axes' motor model.
+    pub plant: PlantModel,
+    /// B44 identify mechanics through PKW between enable and home
+    /// (`demo --fieldbus profinet --self-tune`).
+    pub self_tune: bool,
+    /// The plant's inertia and its friction (Coulomb, breakaway, viscous)
+    /// times these, both axes: mechanics the drive does not know. (1, 1):
+    /// the simulated servo the drive's defaults are set for.
+    pub mechanics: (f64, f64),
+    /// With `self_tune`: B48, the speed-loop bandwidth B44 chooses the
+    /// gains for, written through PKW before A75 (Hz); `None` leaves the
+    /// drive's (30 Hz by default).
+    pub bandwidth_hz: Option<u16>,
+}
+
+impl From<PlantModel> for Options {
+    /// The demo's run: no self-tuning, the simulated servo.
+    fn from(plant: PlantModel) -> Self {
+        Options {
+            plant,
+            self_tune: false,
+            mechanics: (1.0, 1.0),
+            bandwidth_hz: None,
+        }
+    }
+}
+
 /// Runs the whole sequence against a fresh simulated drive whose axes run
 /// `plant`; `obs` hears every change; with `pcap` every frame is recorded
 /// (returned at the end for the caller to flush). Errors only when the
@@ -601,10 +683,29 @@ pub fn run(
     pcap: Option<Recording>,
     plant: PlantModel,
 ) -> Result<(Report, Option<Recording>), String> {
+    run_with(obs, pcap, plant.into())
+}
+
+/// [`run`] with [`Options`]: self-tuning, the plant's mechanics.
+pub fn run_with(
+    obs: &mut impl Observer,
+    pcap: Option<Recording>,
+    options: Options,
+) -> Result<(Report, Option<Recording>), String> {
     let mut drive = PnController::drive();
     drive
-        .set_plant(plant, PLANT_SEED)
+        .set_plant(options.plant, PLANT_SEED)
         .map_err(|e| format!("the electrical plant's parameters: {e:?}"))?;
+    let (jf, ff) = options.mechanics;
+    for axis in 0..2 {
+        if let Some(m) = drive.motor_mut(axis) {
+            let p = m.params_mut();
+            p.inertia_kg_m2 *= jf;
+            p.coulomb_friction_nm *= ff;
+            p.static_friction_nm *= ff;
+            p.viscous_friction_nm_s_per_rad *= ff;
+        }
+    }
     let ctl = PnController::connect(drive, Nanos::from_ms(10), pcap)?;
     let mut run = Run {
         ctl,
@@ -619,11 +720,18 @@ pub fn run(
         obs,
         report: Report::default(),
         phase_start: Nanos::ZERO,
+        hold_ready: false,
+        move_fe: None,
+        in_self_tune: false,
+        bandwidth_hz: options.bandwidth_hz,
     };
     for (t, e) in run.ctl.take_events() {
         run.obs.line(t, &e);
     }
     run.enable()?;
+    if options.self_tune {
+        run.self_tune()?;
+    }
     run.home()?;
     run.positioning()?;
     run.speed()?;

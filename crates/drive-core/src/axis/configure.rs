@@ -203,7 +203,8 @@ impl Axis {
 /// The cascade of the parameters with the gains of the dictionary: I20 Kv,
 /// C31 Kp, C32 Ti (issue 40); with identified mechanics (B45 ≠ 0, issue 35)
 /// its inertia for the acceleration feedforward (derived from the set-points
-/// where the generator gives none) and the friction feedforward of B46/B47.
+/// where the generator gives none), the friction feedforward of B46/B47 and
+/// the speed measurement's lag compensated with J·a's acceleration.
 fn declared_gains(c: &CascadeConfig, o: &Snapshot) -> CascadeConfig {
     let (kv, kp, ti) = o.gains;
     let gains = CascadeConfig {
@@ -219,6 +220,7 @@ fn declared_gains(c: &CascadeConfig, o: &Snapshot) -> CascadeConfig {
             coulomb_friction_nm: fc as f32 * 1e-6,
             viscous_friction_nm_per_rad_per_s: b as f32 * 1e-9,
             derive_acceleration: true,
+            compensate_velocity_lag: true,
             ..gains
         },
     }

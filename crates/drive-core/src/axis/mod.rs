@@ -97,6 +97,7 @@ mod params;
 mod record_state;
 mod records;
 mod running;
+mod shift;
 mod snapshot;
 #[cfg(test)]
 mod tests;
@@ -249,6 +250,8 @@ pub struct Axis {
     last_out: Option<CascadeOutput>,
     /// Last cascade entry.
     last_entry: Option<ControlEntry>,
+    /// The last drive-generated position set-point and speed ([`shift`]).
+    last_setpoint: Option<(i32, f32)>,
     /// Since when I199 (standstill) holds, ns.
     standstill_since: Option<Nanos>,
     /// Direction lock of this cycle.
@@ -344,6 +347,7 @@ impl Axis {
             prev_cw: 0,
             last_out: None,
             last_entry: None,
+            last_setpoint: None,
             standstill_since: None,
             lock: DirectionLock::default(),
             event: None,
@@ -739,6 +743,7 @@ impl Axis {
     /// The cascade and the monitors; returns (torque N·m user coordinates,
     /// mode bits incl. bit 11, following error inc).
     fn control(&mut self, demand: Option<Demand>, actual: i32, now_ns: Nanos, dt_ns: u32) -> (f32, u16, i32) {
+        let fed = self.shifted(demand, dt_ns);
         let (Some(d), Some(cascade)) = (demand, self.cascade.as_mut()) else {
             self.last_out = None;
             self.last_entry = None;
@@ -747,9 +752,9 @@ impl Axis {
         };
         let input = CascadeInput {
             entry: d.entry,
-            position_setpoint_inc: d.position,
-            velocity_inc_per_s: d.velocity,
-            acceleration_feedforward_inc_per_s2: d.acceleration,
+            position_setpoint_inc: fed.position,
+            velocity_inc_per_s: fed.velocity,
+            acceleration_feedforward_inc_per_s2: fed.acceleration,
             torque_nm: d.torque,
             actual_position_inc: actual,
             actual_velocity_inc_per_s: Some(self.velocity),
@@ -761,7 +766,7 @@ impl Axis {
         if d.entry == ControlEntry::Position {
             self.sp_pos = d.position;
             self.sp_vel = d.velocity;
-            let fe = self.following.update(d.position, actual, now_ns);
+            let fe = self.following.update(fed.position, actual, now_ns);
             if let Some(ev) = fe.event {
                 self.raise(ev);
             }
