@@ -185,7 +185,7 @@ fn moves(m: &[MoveFe]) -> String {
 
 fn profinet() {
     println!();
-    println!("PROFINET: the demo's sequence (Example FB telegrams, 1 ms), its positioning moves (the chain T1…T3 to 8 rev, the relative move -2 rev): FE max / rms inc, before and after B44 through PKW (B48 as the drive has it, 30 Hz, or written first)");
+    println!("PROFINET: the demo's sequence (Example FB telegrams, 1 ms), its positioning moves (the chain T1…T3 to 8 rev, the relative move -2 rev): FE max / rms inc, before and after B44 through PKW (B48 as the drive has it, 60 Hz, or written first)");
     println!(
         "{:<26} | {:>13} | {:>13} | {:>8} {:>8} {:>8} | {:>13} | {:>13}",
         "plant", "chain before", "rel. before", "J err %", "Fc err %", "B err %", "chain after", "rel. after"
@@ -193,8 +193,8 @@ fn profinet() {
     for (name, jf, ff, bw) in [
         ("servo", 1.0, 1.0, None),
         ("servo, 5× J, 3× friction", 5.0, 3.0, None),
-        ("servo, B48 60 Hz", 1.0, 1.0, Some(60)),
-        ("5× J, 3× fr., B48 60 Hz", 5.0, 3.0, Some(60)),
+        ("servo, B48 30 Hz", 1.0, 1.0, Some(30)),
+        ("5× J, 3× fr., B48 30 Hz", 5.0, 3.0, Some(30)),
     ] {
         let before = pn_run((jf, ff), false, None);
         let after = pn_run((jf, ff), true, bw);

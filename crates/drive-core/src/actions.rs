@@ -518,7 +518,7 @@ fn follow_mechanics(objects: &mut DriveObjects, m: &MechanicsTest, axis: usize, 
             // the reference cycle's gains scale by r = 250 µs / A150 (Kp),
             // 1/r (Ti), √r (Kv) above it
             let r = (250.0 / cycle_us).min(1.0);
-            let bandwidth = objects.get(B48 + off, 0).unwrap_or(30) as f32;
+            let bandwidth = objects.get(B48 + off, 0).unwrap_or(60) as f32;
             let g = id.gains(bandwidth);
             let written = objects.set(B45 + off, 0, round(id.inertia_kg_m2 * 1e7)).is_ok()
                 && objects.set(B46 + off, 0, round(id.coulomb_nm * 1e6)).is_ok()

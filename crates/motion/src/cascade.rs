@@ -264,6 +264,13 @@ pub struct Cascade {
     /// the actual position to the set-point: not differentiated).
     last_feedforward: Option<f32>,
     feedforward_cycles: u8,
+    /// How far the measured speed lags the set-point's by the given
+    /// acceleration: τ·a through a first-order lag of τ (half a cycle plus
+    /// the velocity filter's time constant), increments/s
+    /// ([`CascadeConfig::compensate_velocity_lag`]).
+    velocity_lag: f32,
+    /// The given acceleration of the cycle before, increments/s².
+    last_given: f32,
 }
 
 impl Cascade {
@@ -277,6 +284,8 @@ impl Cascade {
             velocity_inc_per_s: 0.0,
             last_feedforward: None,
             feedforward_cycles: 0,
+            velocity_lag: 0.0,
+            last_given: 0.0,
         };
         c.reset(actual_position_inc);
         Ok(c)
@@ -309,6 +318,8 @@ impl Cascade {
         self.last_position = Some(actual_position_inc);
         self.velocity_inc_per_s = 0.0;
         self.last_feedforward = None;
+        self.velocity_lag = 0.0;
+        self.last_given = 0.0;
         self.feedforward_cycles = 0;
     }
 
@@ -371,13 +382,29 @@ impl Cascade {
                 velocity_limited = command != raw_command;
 
                 // the measured speed lags the shaft's by half a cycle (the
-                // difference) and the filter's time constant: with the
+                // difference) and the filter's time constant τ: with the
                 // generator's acceleration fed forward the controller
                 // compares with the speed that lag predicts (else it would
-                // fight J·a); a derived acceleration is a cycle late itself
+                // fight J·a). The lag is τ·a through a first-order lag of τ
+                // (the set-point's speed less its own lagged value): τ·a
+                // while the acceleration holds, decaying as the measurement
+                // catches up once it ends (taken away at once, it would push
+                // the shaft past the set-point's speed). The acceleration
+                // given leads the set-point's speed by a cycle (the drive's
+                // own profiles, `drive_core` axis/shift.rs): the lag follows
+                // the speed, so the last cycle's acceleration. A derived
+                // acceleration (csp, ip) is a cycle late itself: only the
+                // given one counts
                 let predicted = if cfg.compensate_velocity_lag {
                     let lag_s = 0.5 * dt_s + cfg.velocity_filter_time_ns as f32 * 1e-9;
-                    actual_velocity + given * lag_s
+                    let alpha = if lag_s + dt_s > 0.0 {
+                        dt_s / (lag_s + dt_s)
+                    } else {
+                        1.0
+                    };
+                    let last = core::mem::replace(&mut self.last_given, given);
+                    self.velocity_lag += alpha * (last * lag_s - self.velocity_lag);
+                    actual_velocity + self.velocity_lag
                 } else {
                     actual_velocity
                 };
