@@ -742,7 +742,15 @@ fn e120_e123_e124_a287_optimisation_through_the_master() {
 /// the TxPDO image the drive's Tx step wrote (what the next frame carries).
 fn actual_and_txpdo(d: &mut hil_sim::sim::SimDrive) -> (i64, i64) {
     let obj = d.drive.objects().get(0x6064, 0).expect("6064h");
-    let e = *d
+    let at = txpdo_6064_at(d);
+    let img = d.drive.slave_mut().inputs_mut();
+    let tx = i32::from_le_bytes(img[at..at + 4].try_into().unwrap());
+    (obj, i64::from(tx))
+}
+
+/// The byte offset of 6064h (axis A) in the drive's TxPDO image.
+fn txpdo_6064_at(d: &hil_sim::sim::SimDrive) -> usize {
+    let e = d
         .drive
         .pdo_image()
         .tx()
@@ -750,10 +758,7 @@ fn actual_and_txpdo(d: &mut hil_sim::sim::SimDrive) -> (i64, i64) {
         .iter()
         .find(|e| e.index == 0x6064)
         .expect("6064h mapped");
-    let at = usize::from(e.bit_offset / 8);
-    let img = d.drive.slave_mut().inputs_mut();
-    let tx = i32::from_le_bytes(img[at..at + 4].try_into().unwrap());
-    (obj, i64::from(tx))
+    usize::from(e.bit_offset / 8)
 }
 
 /// E-111 (spec §11.5): the motor of axis A moves by a new position every
@@ -785,18 +790,7 @@ fn e111_a149_orders_rx_app_tx() {
                 images.push(tx);
                 let sd = group.subdevice(md, 0).expect("drive");
                 let inputs = sd.inputs_raw();
-                let at = usize::from(
-                    sim.borrow().drives()[0]
-                        .drive
-                        .pdo_image()
-                        .tx()
-                        .entries()
-                        .iter()
-                        .find(|e| e.index == 0x6064)
-                        .expect("6064h")
-                        .bit_offset
-                        / 8,
-                );
+                let at = txpdo_6064_at(&sim.borrow().drives()[0]);
                 master.push(i64::from(i32::from_le_bytes(
                     inputs[at..at + 4].try_into().unwrap(),
                 )));
