@@ -86,6 +86,20 @@ where
     sd.sdo_write(0x6084, 0, accel).await.expect("6084h");
 }
 
+/// I101/I102 = 1 by SDO, as a master does (issue 40): axis A's limit
+/// switches from the inputs.
+pub async fn limit_switches_from_inputs<S>(sd: &ethercrab::SubDeviceRef<'_, S>)
+where
+    S: std::ops::Deref<Target = ethercrab::SubDevice>,
+{
+    sd.sdo_write(drive_ecat::parameter_index(8, 101), 0, 1u8)
+        .await
+        .unwrap();
+    sd.sdo_write(drive_ecat::parameter_index(8, 102), 0, 1u8)
+        .await
+        .unwrap();
+}
+
 /// A line of one drive ([`crate::line`]) whose axis A has the inputs
 /// `switches` (limit, home and probe switches).
 pub fn line_with_switches(switches: hil_sim::motor::Switches) -> RefCell<Simulation> {

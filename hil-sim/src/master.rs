@@ -91,6 +91,16 @@ where
     run_with(sim, timeouts, ethercrab::MainDeviceConfig::default(), body)
 }
 
+/// [`run`] with the [`in_process_timeouts`] and ethercrab's default
+/// configuration (its DC start-up sends 10 000 static drift-compensation
+/// frames).
+pub fn run_in_process<N: Node, T, F>(sim: &RefCell<Simulation<N>>, body: F) -> T
+where
+    F: for<'a> AsyncFnOnce(&'a ethercrab::MainDevice<'a>, &'a AtomicU64) -> T,
+{
+    run(sim, in_process_timeouts(), body)
+}
+
 /// [`run`] with a master configuration (e.g. fewer DC static-sync frames in tests).
 pub fn run_with<N: Node, T, F>(
     sim: &RefCell<Simulation<N>>,

@@ -564,6 +564,16 @@ impl Simulation<SimDrive> {
     pub fn new(n: usize) -> Self {
         Self::with_nodes((0..n).map(|_| SimDrive::new()).collect())
     }
+
+    /// A line of drives whose oscillators drift: drive `i` with
+    /// `drifts_ppm[i]` and `offsets_ns[i]` ([`SimDrive::set_clock`]).
+    pub fn with_clocks(drifts_ppm: &[f64], offsets_ns: &[u64]) -> Self {
+        let mut sim = Self::new(drifts_ppm.len().min(offsets_ns.len()));
+        for (d, (drift, offset)) in sim.drives_mut().iter_mut().zip(drifts_ppm.iter().zip(offsets_ns)) {
+            d.set_clock(*drift, *offset);
+        }
+        sim
+    }
 }
 
 impl<N: Node> Simulation<N> {

@@ -6,7 +6,8 @@
 //! the configured period (E-107 DC-Sync; E-113 frame jitter).
 
 use ethercrab::subdevice_group::DcConfiguration;
-use ethercrab::{DcSync, MainDevice, MainDeviceConfig, SubDeviceGroup};
+use ethercrab::{DcSync, MainDevice, SubDeviceGroup};
+use hil_sim::master::run_in_process;
 use hil_sim::sim::{SimDrive, Simulation};
 use nanos::Nanos;
 use std::cell::RefCell;
@@ -22,25 +23,7 @@ const SYNC0_NS: u64 = 1_000_000;
 
 /// Two drifting drives.
 fn line() -> RefCell<Simulation> {
-    let mut sim = Simulation::new(2);
-    for (d, (drift, offset)) in sim.drives_mut().iter_mut().zip(DRIFTS.iter().zip(OFFSETS)) {
-        d.set_clock(*drift, offset);
-    }
-    RefCell::new(sim)
-}
-
-/// Runs `body` against `sim` with ethercrab's default DC start-up (10 000
-/// static drift-compensation frames).
-fn with_master<T>(
-    sim: &RefCell<Simulation>,
-    body: impl for<'a> AsyncFnOnce(&'a MainDevice<'a>, &'a AtomicU64) -> T,
-) -> T {
-    hil_sim::master::run_with(
-        sim,
-        hil_sim::master::in_process_timeouts(),
-        MainDeviceConfig::default(),
-        body,
-    )
+    RefCell::new(Simulation::with_clocks(&DRIFTS, &OFFSETS))
 }
 
 async fn init<'a>(md: &'a MainDevice<'a>, clock: &'a AtomicU64) -> SubDeviceGroup<8, 512> {
@@ -70,7 +53,7 @@ fn skew(sim: &RefCell<Simulation>) -> i64 {
 #[test]
 fn e107_dc_start_up_synchronises_drifting_clocks() {
     let sim = line();
-    let (diff, skew_after_init) = with_master(&sim, async |md, clock| {
+    let (diff, skew_after_init) = run_in_process(&sim, async |md, clock| {
         let group = init(md, clock).await;
         let sd = group.subdevice(md, 1).expect("second drive");
         let diff: u32 = sd
@@ -102,7 +85,7 @@ fn e107_dc_start_up_synchronises_drifting_clocks() {
 /// computes it); returns the worst |0x092C| of drive 1 and the worst system
 /// time skew seen over the last half of the cycles.
 fn run_sync0(sim: &RefCell<Simulation>, cycles: usize) -> (i64, i64) {
-    with_master(sim, async |md, clock| {
+    run_in_process(sim, async |md, clock| {
         let mut group = init(md, clock).await;
         for mut sd in group.iter_mut(md) {
             sd.set_dc_sync(DcSync::Sync0);

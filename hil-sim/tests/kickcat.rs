@@ -14,25 +14,10 @@ mod common;
 use common::soem_line::Line;
 use ecat::Dictionary;
 use std::path::{Path, PathBuf};
-use std::process::Command;
 
 /// The python with kickcat, or why the test cannot run.
 fn kickcat_python() -> Result<PathBuf, String> {
-    if !common::is_root() {
-        return Err("needs root for network namespaces and raw sockets".into());
-    }
-    let py = std::env::var_os("KICKCAT_PYTHON").ok_or("KICKCAT_PYTHON is not set")?;
-    let out = Command::new(&py)
-        .args(["-c", "import kickcat"])
-        .output()
-        .unwrap_or_else(|e| panic!("KICKCAT_PYTHON={}: {e}", Path::new(&py).display()));
-    assert!(
-        out.status.success(),
-        "KICKCAT_PYTHON={} cannot import kickcat: {}",
-        Path::new(&py).display(),
-        String::from_utf8_lossy(&out.stderr).trim()
-    );
-    Ok(PathBuf::from(py))
+    common::peer_python("KICKCAT_PYTHON", "kickcat", "import kickcat", "kickcat-venv")
 }
 
 /// Increments per revolution of the drive's position (6064h, 607Ah) with

@@ -23,7 +23,6 @@ mod common;
 
 use common::pn_line::{module_args, PnLine};
 use std::path::{Path, PathBuf};
-use std::process::Command;
 use std::time::Duration;
 
 /// A script that has not finished after this long has hung.
@@ -31,24 +30,12 @@ const SCRIPT_LIMIT: Duration = Duration::from_secs(300);
 
 /// The python with scapy, or why the test cannot run.
 fn scapy_python() -> Result<PathBuf, String> {
-    if !common::is_root() {
-        return Err("needs root for network namespaces and raw sockets".into());
-    }
-    let py = std::env::var_os("SCAPY_PYTHON").ok_or(
-        "SCAPY_PYTHON is not set (`.ci/run` installs scapy into target/scapy-venv and sets it to \
-         target/scapy-venv/bin/python)",
-    )?;
-    let out = Command::new(&py)
-        .args(["-c", "import scapy; print(scapy.VERSION)"])
-        .output()
-        .expect("run SCAPY_PYTHON");
-    assert!(
-        out.status.success(),
-        "SCAPY_PYTHON cannot import scapy: {}",
-        String::from_utf8_lossy(&out.stderr)
-    );
-    println!("scapy {}", String::from_utf8_lossy(&out.stdout).trim());
-    Ok(PathBuf::from(py))
+    common::peer_python(
+        "SCAPY_PYTHON",
+        "scapy",
+        "import scapy; print(scapy.VERSION)",
+        "scapy-venv",
+    )
 }
 
 /// The steps' lines of the script: `step X: ok|FAIL|expected-fail: …`.

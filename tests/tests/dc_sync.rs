@@ -10,7 +10,8 @@ use drive_ecat::runtime::dcsync::{PllStatus, SyncFault};
 use drive_tests::al::{OP, SAFEOP};
 use drive_tests::init;
 use ethercrab::subdevice_group::DcConfiguration;
-use ethercrab::{DcSync, MainDevice, MainDeviceConfig, SubDeviceGroup};
+use ethercrab::{DcSync, MainDevice, SubDeviceGroup};
+use hil_sim::master::run_in_process;
 use hil_sim::sim::Simulation;
 use std::cell::RefCell;
 use std::sync::atomic::AtomicU64;
@@ -43,23 +44,7 @@ const A296: u16 = drive_ecat::parameter_index(0, 296);
 const A298: u16 = drive_ecat::parameter_index(0, 298);
 
 fn line() -> RefCell<Simulation> {
-    let mut sim = Simulation::new(2);
-    for (d, (drift, offset)) in sim.drives_mut().iter_mut().zip(DRIFTS.iter().zip(OFFSETS)) {
-        d.set_clock(*drift, offset);
-    }
-    RefCell::new(sim)
-}
-
-fn with_master<T>(
-    sim: &RefCell<Simulation>,
-    body: impl for<'a> AsyncFnOnce(&'a MainDevice<'a>, &'a AtomicU64) -> T,
-) -> T {
-    hil_sim::master::run_with(
-        sim,
-        hil_sim::master::in_process_timeouts(),
-        MainDeviceConfig::default(),
-        body,
-    )
+    RefCell::new(Simulation::with_clocks(&DRIFTS, &OFFSETS))
 }
 
 /// The line in Op with DC.
@@ -102,7 +87,7 @@ fn run(
     inject: Inject,
     mut probe: impl FnMut(usize, &Simulation),
 ) -> [Seen; 2] {
-    with_master(sim, async |md, clock| {
+    run_in_process(sim, async |md, clock| {
         let group = dc_requested_op_after(md, clock, SYNC0_NS, async |sd| {
             sd.sdo_write(A292, 0, A292_US).await.expect("A292");
         })
@@ -355,7 +340,7 @@ fn e116_a_sync0_cycle_the_pll_cannot_run_is_refused() {
     let bad = dcsync::Config::new(1_100_000, 1_000_000, drive_ecat::runtime::TIMER_HZ);
     assert!(dcsync::Pll::new(bad).is_err());
     let sim = line();
-    let a261_0: u8 = with_master(&sim, async |md, clock| {
+    let a261_0: u8 = run_in_process(&sim, async |md, clock| {
         let mut group = init(md, clock).await;
         for mut sd in group.iter_mut(md) {
             sd.set_dc_sync(DcSync::Sync0);
@@ -462,7 +447,7 @@ fn e046_e131_e129_e038_dc_op_waits_for_pll_lock_and_sync0_loss_drops_to_safeop()
     use drive_tests::{al_status, request, CoeClient};
     use esc::AlStatusCode;
     let sim = line();
-    let seen = with_master(&sim, async |md, clock| {
+    let seen = run_in_process(&sim, async |md, clock| {
         let group = dc_requested_op(md, clock).await;
 
         // S→O waits for the lock: Safe-Op without error, 002Dh then 0032h
@@ -650,7 +635,7 @@ fn dc_op<T>(
     n: usize,
     body: impl for<'a> AsyncFnOnce(&'a MainDevice<'a>, &'a DcOpGroup) -> T,
 ) -> T {
-    with_master(sim, async |md, clock| {
+    run_in_process(sim, async |md, clock| {
         let group = dc_requested_op_after(md, clock, sync0_ns, async |sd| {
             sd.sdo_write(A292, 0, A292_US).await.expect("A292");
             pre_op(sd).await;
@@ -757,7 +742,15 @@ fn e120_e123_e124_a287_optimisation_through_the_master() {
 /// the TxPDO image the drive's Tx step wrote (what the next frame carries).
 fn actual_and_txpdo(d: &mut hil_sim::sim::SimDrive) -> (i64, i64) {
     let obj = d.drive.objects().get(0x6064, 0).expect("6064h");
-    let e = *d
+    let at = txpdo_6064_at(d);
+    let img = d.drive.slave_mut().inputs_mut();
+    let tx = i32::from_le_bytes(img[at..at + 4].try_into().unwrap());
+    (obj, i64::from(tx))
+}
+
+/// The byte offset of 6064h (axis A) in the drive's TxPDO image.
+fn txpdo_6064_at(d: &hil_sim::sim::SimDrive) -> usize {
+    let e = d
         .drive
         .pdo_image()
         .tx()
@@ -765,10 +758,7 @@ fn actual_and_txpdo(d: &mut hil_sim::sim::SimDrive) -> (i64, i64) {
         .iter()
         .find(|e| e.index == 0x6064)
         .expect("6064h mapped");
-    let at = usize::from(e.bit_offset / 8);
-    let img = d.drive.slave_mut().inputs_mut();
-    let tx = i32::from_le_bytes(img[at..at + 4].try_into().unwrap());
-    (obj, i64::from(tx))
+    usize::from(e.bit_offset / 8)
 }
 
 /// E-111 (spec §11.5): the motor of axis A moves by a new position every
@@ -800,18 +790,7 @@ fn e111_a149_orders_rx_app_tx() {
                 images.push(tx);
                 let sd = group.subdevice(md, 0).expect("drive");
                 let inputs = sd.inputs_raw();
-                let at = usize::from(
-                    sim.borrow().drives()[0]
-                        .drive
-                        .pdo_image()
-                        .tx()
-                        .entries()
-                        .iter()
-                        .find(|e| e.index == 0x6064)
-                        .expect("6064h")
-                        .bit_offset
-                        / 8,
-                );
+                let at = txpdo_6064_at(&sim.borrow().drives()[0]);
                 master.push(i64::from(i32::from_le_bytes(
                     inputs[at..at + 4].try_into().unwrap(),
                 )));
@@ -1078,7 +1057,7 @@ fn e121_e122_e123_a287_failures_through_the_master() {
 
     // SM-Sync (no DC): not executable
     let sim = RefCell::new(Simulation::new(1));
-    let result: u8 = with_master(&sim, async |md, clock| {
+    let result: u8 = run_in_process(&sim, async |md, clock| {
         let group = init(md, clock).await.into_op(md).await.expect("OP");
         let sd = group.subdevice(md, 0).expect("drive");
         sd.sdo_write(A287, 1, 1u8).await.expect("A287[0]");
@@ -1140,7 +1119,7 @@ fn e147_message_time_stamp_is_the_dc_system_time_when_synchronised() {
 fn e046_a_sync0_stop_below_safe_op_does_not_refuse_the_next_op() {
     use drive_tests::{al_status, request};
     let sim = line();
-    let first_op = with_master(&sim, async |md, clock| {
+    let first_op = run_in_process(&sim, async |md, clock| {
         let group = dc_requested_op(md, clock).await;
         let mut op = false;
         dc_cycles(md, &group, &sim, 300, |_, all_op, _| op |= all_op).await;
@@ -1175,7 +1154,7 @@ fn e046_a_sync0_stop_below_safe_op_does_not_refuse_the_next_op() {
     });
     assert!(first_op, "the first master reached Op");
     // a new master: its start-up, DC, Op
-    let (op, status) = with_master(&sim, async |md, clock| {
+    let (op, status) = run_in_process(&sim, async |md, clock| {
         let group = dc_requested_op(md, clock).await;
         let mut op = false;
         dc_cycles(md, &group, &sim, 300, |_, all_op, _| op |= all_op).await;

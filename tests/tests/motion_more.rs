@@ -477,12 +477,7 @@ fn c093_c094_c095_hardware_limit_switch_faults_and_locks_the_direction() {
         // I101/I102 set: hitting +1 rev at 2 rev/s faults at once (event 53 cause 1)
         // (by SDO as a master does, issue 40: 1 = from the inputs)
         let sd = group.subdevice(md, 0).unwrap();
-        sd.sdo_write(drive_ecat::parameter_index(8, 101), 0, 1u8)
-            .await
-            .unwrap();
-        sd.sdo_write(drive_ecat::parameter_index(8, 102), 0, 1u8)
-            .await
-            .unwrap();
+        limit_switches_from_inputs(&sd).await;
         m.run(5).await;
         assert_eq!(m.tx.state(), sw::OE, "inside the range: {:#06x}", m.tx.statusword);
         m.set_target_velocity(2 * REV);

@@ -60,6 +60,18 @@ pub(crate) fn drive() -> PnDrive<TestFlash> {
 
 /// `d` (commissioned as "drive-1") with profinet-py's AR connected.
 pub(crate) fn connected(mut d: PnDrive<TestFlash>) -> PnDrive<TestFlash> {
+    let frame = rpc_frame(&hex(vectors::CONNECT));
+    let mut connected = false;
+    d.receive(Nanos::ZERO, &frame, &mut |_: &[u8]| {}, &mut |e| {
+        connected |= matches!(e, DeviceEvent::Cm(CmEvent::Connected(_)))
+    });
+    assert!(connected);
+    d
+}
+
+/// The frame carrying the RPC request `req` over UDP from the controller
+/// (192.168.0.10, port C000h) to the commissioned drive at 192.168.0.50.
+pub(crate) fn rpc_frame(req: &[u8]) -> Vec<u8> {
     let mut ctrl = Stack::new(
         CTRL,
         IpConfig {
@@ -73,18 +85,25 @@ pub(crate) fn connected(mut d: PnDrive<TestFlash>) -> PnDrive<TestFlash> {
         port: RPC_PORT,
     };
     ctrl.learn(Nanos::ZERO, ep.ip, OUR);
-    let req = hex(vectors::CONNECT);
     let mut tx = std::vec![0u8; 1600];
-    tx[UDP_PAYLOAD_OFFSET..UDP_PAYLOAD_OFFSET + req.len()].copy_from_slice(&req);
+    tx[UDP_PAYLOAD_OFFSET..UDP_PAYLOAD_OFFSET + req.len()].copy_from_slice(req);
     let Ok(UdpTx::Frame(n)) = ctrl.emit_udp(Nanos::ZERO, &mut tx, 0xC000, ep, req.len()) else {
         panic!("no frame")
     };
-    let mut connected = false;
-    d.receive(Nanos::ZERO, &tx[..n], &mut |_: &[u8]| {}, &mut |e| {
-        connected |= matches!(e, DeviceEvent::Cm(CmEvent::Connected(_)))
-    });
-    assert!(connected);
-    d
+    tx.truncate(n);
+    tx
+}
+
+/// The frames the drive sends for `frame` (received at 1 ms).
+pub(crate) fn send(d: &mut PnDrive<TestFlash>, frame: &[u8]) -> Vec<Vec<u8>> {
+    let mut out = Vec::new();
+    d.receive(
+        Nanos::from_ms(1),
+        frame,
+        &mut |f: &[u8]| out.push(f.to_vec()),
+        &mut |_| {},
+    );
+    out
 }
 
 fn output_frame(d: &PnDrive<TestFlash>, counter: u16) -> Vec<u8> {

@@ -1,7 +1,7 @@
 //! The PROFINET operating parameters A270…A278 (spec §2.4) through DCP
 //! frames, the dictionary and restarts over the same flash.
 
-use super::tests::{drive, hardware, run, TestFlash};
+use super::tests::{drive, hardware, rpc_frame, run, send, TestFlash};
 use super::*;
 use core::net::Ipv4Addr;
 use drive_core::params::{A272, A273, A274, A275, A276, A277, A278};
@@ -80,18 +80,6 @@ fn set_ip(suite: IpSuite, qualifier: u16) -> Vec<u8> {
 /// Reset to factory with BlockQualifier mode `mode` (1, 2, 4 or 8).
 fn reset(mode: u16) -> Vec<u8> {
     set(BlockType::ControlResetToFactory, mode << 1, Value::Empty)
-}
-
-/// The frames the drive sends for `frame`.
-fn send(d: &mut PnDrive<TestFlash>, frame: &[u8]) -> Vec<Vec<u8>> {
-    let mut out = Vec::new();
-    d.receive(
-        Nanos::from_ms(1),
-        frame,
-        &mut |f: &[u8]| out.push(f.to_vec()),
-        &mut |_| {},
-    );
-    out
 }
 
 /// The Identify answer, if the drive gives one.
@@ -394,28 +382,9 @@ fn parameter(line: u16) -> u16 {
 /// over UDP to the commissioned drive at 192.168.0.50; returns whether an
 /// answer went out.
 fn rpc(d: &mut PnDrive<TestFlash>, req: &str, seq: u32) -> bool {
-    use profinet::ip::{Endpoint, IpConfig, Stack, UdpTx, RPC_PORT, UDP_PAYLOAD_OFFSET};
-    let mut ctrl = Stack::new(
-        PLC,
-        IpConfig {
-            addr: Ipv4Addr::new(192, 168, 0, 10),
-            netmask: Ipv4Addr::new(255, 255, 255, 0),
-            gateway: Ipv4Addr::UNSPECIFIED,
-        },
-    );
-    let ep = Endpoint {
-        ip: Ipv4Addr::new(192, 168, 0, 50),
-        port: RPC_PORT,
-    };
-    ctrl.learn(Nanos::ZERO, ep.ip, OUR);
     let mut req = profinet::testing::hex(req).to_vec();
     req[64..68].copy_from_slice(&seq.to_be_bytes());
-    let mut tx = std::vec![0u8; 1600];
-    tx[UDP_PAYLOAD_OFFSET..UDP_PAYLOAD_OFFSET + req.len()].copy_from_slice(&req);
-    let Ok(UdpTx::Frame(n)) = ctrl.emit_udp(Nanos::ZERO, &mut tx, 0xC000, ep, req.len()) else {
-        panic!("no frame")
-    };
-    !send(d, &tx[..n]).is_empty()
+    !send(d, &rpc_frame(&req)).is_empty()
 }
 
 #[test]

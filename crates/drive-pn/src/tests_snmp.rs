@@ -77,14 +77,8 @@ fn request_oids(community: &[u8], pdu: u8, bindings: &[(&[u32], &[u8])]) -> Vec<
 
 /// The SNMP answers (UDP payloads from port 161) to one frame.
 fn send(d: &mut PnDrive<TestFlash>, frame: &[u8]) -> Vec<Vec<u8>> {
-    let mut out = Vec::new();
-    d.receive(
-        Nanos::from_ms(1),
-        frame,
-        &mut |f: &[u8]| out.push(f.to_vec()),
-        &mut |_| {},
-    );
-    out.into_iter()
+    super::tests::send(d, frame)
+        .into_iter()
         .filter(|f| EthFrame::parse(f).is_some_and(|e| e.dst == PLC))
         .filter(|f| f.get(34..36) == Some(&[0, 161]))
         .map(|f| f[UDP_PAYLOAD_OFFSET..].to_vec())

@@ -19,6 +19,21 @@ pub fn apply(priority: Option<i32>, cpu: Option<usize>) -> String {
     format!("real-time: {fifo}, {pin}")
 }
 
+/// [`apply`] as `serve` (both fieldbuses) asks for it: nothing with
+/// `--no-rt`; no SCHED_FIFO with `--busy-poll` (a spinning SCHED_FIFO
+/// process is throttled by the kernel (sched_rt_runtime_us) for tens of ms
+/// every second and starves its CPU's softirqs); else SCHED_FIFO at
+/// `--fifo-priority`. Returns the line to print.
+pub fn apply_for_serve(args: &super::args::ServeArgs) -> String {
+    if args.no_rt {
+        "real-time: not asked for (--no-rt)".to_string()
+    } else if args.busy_poll {
+        apply(None, args.cpu)
+    } else {
+        apply(Some(args.fifo_priority), args.cpu)
+    }
+}
+
 fn set_fifo(priority: i32) -> std::io::Result<i32> {
     let p = libc::sched_param {
         sched_priority: priority,

@@ -213,15 +213,7 @@ pub fn serve(args: &ServeArgs) -> Result<(), String> {
     if let Some(p) = &args.pcap {
         println!("recording frames to {}", p.display());
     }
-    if args.no_rt {
-        println!("real-time: not asked for (--no-rt)");
-    } else if args.busy_poll {
-        // a spinning SCHED_FIFO process is throttled by the kernel (sched_rt_runtime_us)
-        // for tens of ms every second and starves its CPU's softirqs: no FIFO
-        println!("{}", super::realtime::apply(None, args.cpu));
-    } else {
-        println!("{}", super::realtime::apply(Some(args.fifo_priority), args.cpu));
-    }
+    println!("{}", super::realtime::apply_for_serve(args));
     if let Some(max) = args.delay_us {
         println!(
             "test: every frame held 0..={max} µs after its arrival (seed {})",

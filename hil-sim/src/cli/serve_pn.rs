@@ -311,13 +311,7 @@ pub fn serve(args: &ServeArgs) -> Result<(), String> {
     if let Some(p) = &args.pcap {
         println!("recording frames to {}", p.display());
     }
-    if args.no_rt {
-        println!("real-time: not asked for (--no-rt)");
-    } else if args.busy_poll {
-        println!("{}", super::realtime::apply(None, args.cpu));
-    } else {
-        println!("{}", super::realtime::apply(Some(args.fifo_priority), args.cpu));
-    }
+    println!("{}", super::realtime::apply_for_serve(args));
     stop_on_signals();
     let mut out = Out {
         sock: &sock,

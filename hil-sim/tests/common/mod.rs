@@ -175,31 +175,43 @@ pub fn watch_script(
     (status, lines)
 }
 
-/// The python with profinet-py (`PROFINET_PY_PYTHON`, `.ci/run` sets it to
-/// target/profinet-venv/bin/python), or why a profinet-py test cannot run
-/// (not root, the variable unset); a python that cannot import profinet
-/// fails the test.
-pub fn profinet_py_python() -> Result<std::path::PathBuf, String> {
+/// The python a peer written by others runs in, from the variable `var`
+/// (`.ci/run` installs the peer into target/`venv` and sets `var` to
+/// target/`venv`/bin/python), or why the test cannot run (not root, `var`
+/// unset). `check` is python code that imports the peer and prints its
+/// version (or nothing); a python it fails in fails the test. Prints
+/// "`peer` version (python)".
+pub fn peer_python(var: &str, peer: &str, check: &str, venv: &str) -> Result<std::path::PathBuf, String> {
     if !is_root() {
         return Err("needs root for network namespaces and raw sockets".into());
     }
-    let py = std::env::var_os("PROFINET_PY_PYTHON").ok_or(
-        "PROFINET_PY_PYTHON is not set (`.ci/run` installs profinet-py into target/profinet-venv and sets \
-         it to target/profinet-venv/bin/python)",
-    )?;
+    let py = std::env::var_os(var).ok_or(format!(
+        "{var} is not set (`.ci/run` installs {peer} into target/{venv} and sets it to \
+         target/{venv}/bin/python)"
+    ))?;
     let show = std::path::Path::new(&py).display().to_string();
     let out = Command::new(&py)
-        .args(["-c", "import profinet; print(profinet.__version__)"])
+        .args(["-c", check])
         .output()
-        .unwrap_or_else(|e| panic!("PROFINET_PY_PYTHON={show}: {e}"));
+        .unwrap_or_else(|e| panic!("{var}={show}: {e}"));
     assert!(
         out.status.success(),
-        "PROFINET_PY_PYTHON={show} cannot import profinet: {}",
+        "{var}={show} cannot import {peer}: {}",
         String::from_utf8_lossy(&out.stderr).trim()
     );
-    println!(
-        "profinet-py {} ({show})",
-        String::from_utf8_lossy(&out.stdout).trim()
-    );
+    match String::from_utf8_lossy(&out.stdout).trim() {
+        "" => println!("{peer} ({show})"),
+        version => println!("{peer} {version} ({show})"),
+    }
     Ok(std::path::PathBuf::from(py))
+}
+
+/// The python with profinet-py ([`peer_python`], `PROFINET_PY_PYTHON`).
+pub fn profinet_py_python() -> Result<std::path::PathBuf, String> {
+    peer_python(
+        "PROFINET_PY_PYTHON",
+        "profinet-py",
+        "import profinet; print(profinet.__version__)",
+        "profinet-venv",
+    )
 }

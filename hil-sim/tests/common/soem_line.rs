@@ -22,30 +22,14 @@ pub fn scratch(test: &str) -> PathBuf {
     dir
 }
 
+/// The python with pysoem ([`super::peer_python`], `PYSOEM_PYTHON`).
 pub fn pysoem_python() -> Result<PathBuf, String> {
-    if !super::is_root() {
-        return Err("needs root for network namespaces and raw sockets".into());
-    }
-    let py = std::env::var_os("PYSOEM_PYTHON").ok_or(
-        "PYSOEM_PYTHON is not set (`.ci/run` installs pysoem into target/pysoem-venv and sets it to \
-         target/pysoem-venv/bin/python)",
-    )?;
-    let out = Command::new(&py)
-        .args(["-c", "import pysoem; print(pysoem.__version__)"])
-        .output()
-        .unwrap_or_else(|e| panic!("PYSOEM_PYTHON={}: {e}", Path::new(&py).display()));
-    assert!(
-        out.status.success(),
-        "PYSOEM_PYTHON={} cannot import pysoem: {}",
-        Path::new(&py).display(),
-        String::from_utf8_lossy(&out.stderr).trim()
-    );
-    println!(
-        "pysoem {} ({})",
-        String::from_utf8_lossy(&out.stdout).trim(),
-        Path::new(&py).display()
-    );
-    Ok(PathBuf::from(py))
+    super::peer_python(
+        "PYSOEM_PYTHON",
+        "pysoem",
+        "import pysoem; print(pysoem.__version__)",
+        "pysoem-venv",
+    )
 }
 
 /// SCHED_FIFO priority of `serve`: the simulated drives stand for hardware

@@ -87,6 +87,7 @@ from profinet.dcp import (
 from profinet.exceptions import DCPDeviceNotFoundError
 from profinet.util import ethernet_socket, get_mac, mac2s, s2mac
 
+from pnargs import device_arguments
 from pnctl import Records, tx_checksum_offload_off
 
 
@@ -220,17 +221,25 @@ def blocks_of(payload):
     return out
 
 
+def keep_answers(con):
+    """The list `con` (an RPCCon) appends each RPC answer it receives to, from
+    now on: the raw answers (profinet-py parses only part of them)."""
+    answers = []
+    plain = con._send_receive
+
+    def keep(pkt):
+        r = plain(pkt)
+        answers.append(r)
+        return r
+
+    con._send_receive = keep
+    return answers
+
+
 def main():
-    ap = argparse.ArgumentParser()
-    ap.add_argument("--iface", required=True)
-    ap.add_argument("--device-mac", required=True)
-    ap.add_argument("--gsdml", required=True)
-    ap.add_argument("--out-module", required=True, help="GSDML module ID for slot 1")
-    ap.add_argument("--in-module", required=True, help="GSDML module ID for slot 2")
+    ap = device_arguments(argparse.ArgumentParser())
     ap.add_argument("--vendor-id", type=lambda s: int(s, 0), required=True)
     ap.add_argument("--order", required=True)
-    ap.add_argument("--name", default="drive-1")
-    ap.add_argument("--ip", default="192.168.0.50")
     ap.add_argument("--mask", default="255.255.255.0")
     ap.add_argument("--cyclic-seconds", type=float, default=12.0)
     ap.add_argument(
@@ -377,15 +386,7 @@ def main():
             for s in slots
         ]
         con = RPCCon(info, timeout=5.0)
-        answers = []
-        plain = con._send_receive
-
-        def keep(pkt):
-            r = plain(pkt)
-            answers.append(r)
-            return r
-
-        con._send_receive = keep
+        answers = keep_answers(con)
         try:
             con.connect(src, iocr_setup=IOCRSetup(slots=wrong))
             nrd = rpc.PNNRDData(answers[-1].payload)
@@ -668,15 +669,7 @@ def main():
     # (k) advanced startup: Connect, PrmEnd, ApplicationReady, Release
     def advanced_startup():
         con = RPCCon(info, timeout=5.0)
-        answers = []
-        plain = con._send_receive
-
-        def keep(pkt):
-            r = plain(pkt)
-            answers.append(r)
-            return r
-
-        con._send_receive = keep
+        answers = keep_answers(con)
         try:
             with AdvancedStartup():
                 res = con.connect(src, iocr_setup=IOCRSetup(slots=slots))

@@ -36,6 +36,7 @@ import profinet
 from profinet.util import get_mac
 
 import pnctl
+from pnargs import device_arguments
 from pnctl import Scenario, ms
 
 OPMODE_POS, OPMODE_VELO, OPMODE_TORQUE = 0x10, 0x08, 0x04
@@ -306,15 +307,7 @@ def fb_arguments(doc, name, ip):
     """The command line of a script that runs one scenario on the Example
     Function block: serve's interface and device, the GSDML and its modules,
     the name and IP it gives the device (more arguments may be added)."""
-    ap = argparse.ArgumentParser(description=doc.split("\n\n")[0])
-    ap.add_argument("--iface", required=True)
-    ap.add_argument("--device-mac", required=True)
-    ap.add_argument("--gsdml", required=True)
-    ap.add_argument("--out-module", required=True, help="GSDML module ID for slot 1")
-    ap.add_argument("--in-module", required=True, help="GSDML module ID for slot 2")
-    ap.add_argument("--name", default=name)
-    ap.add_argument("--ip", default=ip)
-    return ap
+    return device_arguments(argparse.ArgumentParser(description=doc.split("\n\n")[0]), name, ip)
 
 
 def start_controller(a, real_time=False):

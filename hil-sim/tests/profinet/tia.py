@@ -59,6 +59,7 @@ from scapy.layers.inet import IP, UDP
 from scapy.layers.l2 import ARP, Ether
 
 import tia_lib as t
+from pnargs import device_arguments
 
 failures = []
 NETLOAD_MAC = "02:4e:4c:00:00:01"
@@ -138,14 +139,7 @@ def dcp_set(link, mac, option, sub, value, xid):
 
 
 def main():
-    ap = argparse.ArgumentParser()
-    ap.add_argument("--iface", required=True)
-    ap.add_argument("--device-mac", required=True)
-    ap.add_argument("--gsdml", required=True)
-    ap.add_argument("--out-module", required=True, help="GSDML module ID for slot 1")
-    ap.add_argument("--in-module", required=True, help="GSDML module ID for slot 2")
-    ap.add_argument("--name", default="drive-1")
-    ap.add_argument("--ip", default="192.168.0.50")
+    ap = device_arguments(argparse.ArgumentParser())
     ap.add_argument("--cyclic-seconds", type=float, default=10.0)
     ap.add_argument("--rounds", type=int, default=5)
     ap.add_argument("--netload-seconds", type=float, default=10.0)

@@ -2,7 +2,7 @@
 //! motion, a limit switch against the travel during homing.
 
 use super::{emcys, ethercrab, fault_end, fault_reset, get, E47};
-use drive_tests::axis::{line_with_switches, with_drive, CW_BIT4, CW_ENABLED};
+use drive_tests::axis::{limit_switches_from_inputs, line_with_switches, with_drive, CW_BIT4, CW_ENABLED};
 use drive_tests::matrix::{al, cia402_state, emcys as show_emcys};
 use drive_tests::{al_status, fault_row, init, line, with_master, Cyclic, REV};
 use hil_sim::motor::{PositionInput, Switches};
@@ -110,12 +110,7 @@ fn c084_limit_switch_against_the_travel_during_homing_is_a_homing_error() {
         let group = init(md, clock).await.into_op(md).await.expect("OP");
         // I101/I102 = 1: the limit switches from the inputs, by SDO (issue 40)
         let sd = group.subdevice(md, 0).unwrap();
-        sd.sdo_write(drive_ecat::parameter_index(8, 101), 0, 1u8)
-            .await
-            .unwrap();
-        sd.sdo_write(drive_ecat::parameter_index(8, 102), 0, 1u8)
-            .await
-            .unwrap();
+        limit_switches_from_inputs(&sd).await;
         sd.sdo_write(0x6098, 0, 1i8).await.unwrap();
         let mut m = Cyclic::new(md, &group, &sim, 0);
         m.enable_in(6).await;

@@ -190,18 +190,7 @@ impl<F: Flash, B: Flash> Drive<F, B> {
         let current = self.pll.as_ref().map(|p| p.config().sync0_cycle_ns);
         if current != Some(cycle) || self.pll_from_sm {
             self.pll_from_sm = false;
-            match Pll::new(self.pll_config(cycle)) {
-                Ok(pll) => {
-                    self.pll = Some(pll);
-                    self.sync_shown = None;
-                    self.sync_error = None;
-                }
-                Err(e) => {
-                    self.pll = None;
-                    self.sync_shown = None;
-                    self.sync_error = Some(e);
-                }
-            }
+            self.build_pll(cycle);
         }
         if let Some(pll) = self.pll.as_mut() {
             pll.on_sync0(t_local);
@@ -283,24 +272,29 @@ impl<F: Flash, B: Flash> Drive<F, B> {
         let cycle = self.slave.sync_status().cycle_ns;
         let current = self.pll.as_ref().map(|p| p.config().sync0_cycle_ns);
         if current != Some(cycle) || !self.pll_from_sm {
-            match Pll::new(self.pll_config(cycle)) {
-                Ok(pll) => {
-                    self.pll = Some(pll);
-                    self.sync_shown = None;
-                    self.sync_error = None;
-                }
-                Err(e) => {
-                    self.pll = None;
-                    self.sync_shown = None;
-                    self.sync_error = Some(e);
-                }
-            }
+            self.build_pll(cycle);
             self.pll_from_sm = true;
         }
         if let Some(pll) = self.pll.as_mut() {
             pll.on_sync0(t_local);
         }
         self.update_sync_live();
+    }
+
+    /// A new PLL for a sync pulse every `cycle` ns; a refused configuration
+    /// leaves the PLL off and its error in [`Drive::sync_error`] (`A261[0]`).
+    fn build_pll(&mut self, cycle: u32) {
+        self.sync_shown = None;
+        match Pll::new(self.pll_config(cycle)) {
+            Ok(pll) => {
+                self.pll = Some(pll);
+                self.sync_error = None;
+            }
+            Err(e) => {
+                self.pll = None;
+                self.sync_error = Some(e);
+            }
+        }
     }
 
     /// A296, A298 and A261 from the PLL (A261[0] also from a refused
