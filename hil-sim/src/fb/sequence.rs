@@ -19,7 +19,7 @@
 //!    the fault gone, the FB's enable sequence again.
 //!
 //! With [`Options::self_tune`] a self-tuning phase (B44 identify mechanics
-//! through PKW, [`self_tune`]) runs between 1 and 2, so that the
+//! through PKW, `sequence/self_tune.rs`) runs between 1 and 2, so that the
 //! positioning moves run on the gains and feedforward B44 set; the
 //! positioning moves' following error is in [`Report::moves`] either way.
 //!

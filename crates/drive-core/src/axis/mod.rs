@@ -743,13 +743,14 @@ impl Axis {
     /// The cascade and the monitors; returns (torque N·m user coordinates,
     /// mode bits incl. bit 11, following error inc).
     fn control(&mut self, demand: Option<Demand>, actual: i32, now_ns: Nanos, dt_ns: u32) -> (f32, u16, i32) {
-        let fed = self.shifted(demand, dt_ns);
+        let shifted = self.shift(demand, dt_ns);
         let (Some(d), Some(cascade)) = (demand, self.cascade.as_mut()) else {
             self.last_out = None;
             self.last_entry = None;
             self.following.reset();
             return (0.0, 0, 0);
         };
+        let fed = shifted.unwrap_or(d);
         let input = CascadeInput {
             entry: d.entry,
             position_setpoint_inc: fed.position,

@@ -21,25 +21,38 @@
 use super::*;
 
 impl Axis {
-    /// The demand the cascade gets for `demand`: shifted as above when the
-    /// mechanics are identified and a drive-generated position demand
-    /// follows another; else `demand` itself.
-    pub(super) fn shifted(&mut self, demand: Option<Demand>, dt_ns: u32) -> Demand {
-        let d = demand.unwrap_or(Demand::hold(self.sp_pos));
-        let generated = demand.is_some()
-            && d.entry == ControlEntry::Position
-            && !matches!(self.running, Running::CyclicPosition { .. });
+    /// With identified mechanics the demand the cascade gets instead of
+    /// `demand` ([`shifted`](Self::shifted)); else `None`, the demand as
+    /// it is (one compare on the cycle's path).
+    #[inline(always)]
+    pub(super) fn shift(&mut self, demand: Option<Demand>, dt_ns: u32) -> Option<Demand> {
         let identified = self
             .cascade
             .as_ref()
             .is_some_and(|c| c.config().compensate_velocity_lag);
+        if identified {
+            Some(self.shifted(demand, dt_ns))
+        } else {
+            self.last_setpoint = None;
+            None
+        }
+    }
+
+    /// The demand the cascade gets for `demand` with identified mechanics
+    /// (the caller checks): shifted as above when a drive-generated
+    /// position demand follows another; else `demand` itself.
+    fn shifted(&mut self, demand: Option<Demand>, dt_ns: u32) -> Demand {
+        let d = demand.unwrap_or(Demand::hold(self.sp_pos));
+        let generated = demand.is_some()
+            && d.entry == ControlEntry::Position
+            && !matches!(self.running, Running::CyclicPosition { .. });
         let last = if generated {
             self.last_setpoint.replace((d.position, d.velocity))
         } else {
             self.last_setpoint.take()
         };
         match last {
-            Some((position, velocity)) if identified && dt_ns > 0 => Demand {
+            Some((position, velocity)) if dt_ns > 0 => Demand {
                 position,
                 velocity,
                 // the set-point's change of speed over this cycle: what the
