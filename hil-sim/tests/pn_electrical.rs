@@ -133,7 +133,7 @@ fn c038_e089_profinet_py_motor_i2t_warning_limit_and_fault_on_the_electrical_pla
 /// With the plant's commutation offset (0.3 rad, `--plant-offset`) as well:
 /// B40 (the pole pairs seen = B10) and B41 (B05 within 0.5° electrical)
 /// before the actions that inject in the rotor's frame, B49 (R, L within
-/// 5 %) and B301 (grinding torque the plant's brake plus friction) after.
+/// 5 %) after.
 #[test]
 fn e140_e141_profinet_py_motor_actions_by_pkw_on_the_electrical_plant() {
     let Some((_, line)) = run_named(
