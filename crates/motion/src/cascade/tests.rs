@@ -487,3 +487,52 @@ fn e140_b44_friction_feedforward_and_derived_acceleration() {
     assert_eq!(c.cycle(&input, dt).torque_nm, 0.0);
     assert_eq!(c.cycle(&input, dt).torque_nm, 0.0);
 }
+
+/// C-037 with identified mechanics (`compensate_velocity_lag`, issue 35):
+/// the speed controller compares with the measured speed advanced by its
+/// lag under the given acceleration, τ·a through a first-order lag of τ
+/// (half a cycle plus the velocity filter). At a measured speed equal to
+/// the command the proportional part is −Kp·τ·a once the acceleration has
+/// held; when it ends the allowance decays over the following cycles (the
+/// measurement catching up) instead of vanishing at once; a derived
+/// acceleration (csp: none given) gets none.
+#[test]
+fn c037_velocity_lag_allowance_follows_the_given_acceleration_and_decays() {
+    let cfg = CascadeConfig {
+        velocity_integral_time_ns: 0,
+        compensate_velocity_lag: true,
+        ..CascadeConfig::DEFAULT
+    };
+    let mut c = Cascade::new(cfg, 0).unwrap();
+    let v = 0.0;
+    let at = |a: f32| CascadeInput {
+        entry: ControlEntry::Velocity,
+        position_setpoint_inc: 0,
+        velocity_inc_per_s: v,
+        acceleration_feedforward_inc_per_s2: a,
+        torque_nm: 0.0,
+        actual_position_inc: 0,
+        actual_velocity_inc_per_s: Some(v),
+    };
+    let a = 50.0 * REV;
+    let mut held = 0.0;
+    for _ in 0..200 {
+        held = c.cycle(&at(a), DT_NS).torque_nm;
+    }
+    let tau = 0.5 * DT_NS as f32 * 1e-9 + cfg.velocity_filter_time_ns as f32 * 1e-9;
+    let want = -cfg.velocity_gain_nm_per_rad_per_s * tau * a * RAD_PER_INCREMENT;
+    assert!((held - want).abs() <= 0.02 * want.abs(), "{held} vs {want}");
+    let mut after = [0.0f32; 40];
+    for t in after.iter_mut() {
+        *t = c.cycle(&at(0.0), DT_NS).torque_nm;
+    }
+    assert!(
+        want < 0.0 && after[0] <= 0.5 * want,
+        "decays, not gone at once: {after:?}"
+    );
+    assert!(after.windows(2).all(|w| w[1] >= w[0]), "monotonic: {after:?}");
+    assert!(after[39].abs() < 0.01 * want.abs(), "caught up: {after:?}");
+    // no given acceleration: no allowance (the csp path)
+    let mut fresh = Cascade::new(cfg, 0).unwrap();
+    assert_eq!(fresh.cycle(&at(0.0), DT_NS).torque_nm, 0.0);
+}
