@@ -525,3 +525,41 @@ fn e140_b301_grind_brake_grinds_a_healthy_brake_and_fails_a_stalled_or_stuck_one
         });
     }
 }
+
+/// E-140, E-141 (B301, the hand-back): in profile position mode (6060h = 1,
+/// the drive's own set-point) with no move commanded, "grind brake" turns
+/// the shaft by some three revolutions; afterwards, the enable and Execute
+/// still on, the axis' own control holds the shaft where the action left
+/// it: no drive back to where it stood before (the set-point followed the
+/// shaft while the action ran, `Axis::overridden`), no fault, for 0.5 s.
+#[test]
+fn e140_b301_hands_the_axis_back_where_it_left_the_shaft() {
+    let sim = electrical_line(3.6, 0.012);
+    with_master(&sim, async |md, clock| {
+        let (group, io) = op_with_actions(md, clock).await;
+        let sd = group.subdevice(md, 0).unwrap();
+        sd.outputs_raw_mut()[2] = 1;
+        let rotor = || sim.borrow().drives()[0].motors[0].position_inc_i64();
+        let before = rotor();
+        let seen = run_action(&sim, &group, md, io, 0b0101, 5000).await;
+        assert_eq!(*seen.last().unwrap() >> 12, state::DONE, "A69 {seen:04X?}");
+        let left = rotor();
+        assert!(
+            left - before >= 2 << 20,
+            "B301 turned the shaft {} inc",
+            left - before
+        );
+        cycles(md, &group, &sim, 500).await;
+        let moved = rotor() - left;
+        println!("B301 handed back in pp: the rotor moved {moved} inc in 500 cycles");
+        assert!(
+            moved.abs() <= 1 << 11,
+            "the axis holds where B301 left it: moved {moved} inc"
+        );
+        assert_eq!(
+            sd.sdo_read::<u8>(E48, 0).await.unwrap(),
+            4,
+            "Operation enabled, no fault"
+        );
+    });
+}

@@ -654,10 +654,14 @@ impl<F: Flash, H: RecordHook> PnDrive<F, H> {
             }
             *command = report.command;
         }
-        // a running motor action replaces the axis' command (B40…B43, B300)
+        // a running motor action replaces the axis' command (B40…B44, B49, B300, B301); the axis
+        // follows the shaft meanwhile (`Axis::overridden`)
         if self.actions.measuring() {
-            for ((i, axis), (command, io)) in self.axes.iter().enumerate().zip(commands.iter_mut().zip(&io)) {
+            for ((i, axis), (command, io)) in
+                self.axes.iter_mut().enumerate().zip(commands.iter_mut().zip(&io))
+            {
                 if let Some(c) = self.actions.control(i, drive_core::axis::e48(axis.state()), io) {
+                    axis.overridden();
                     *command = c;
                 }
             }

@@ -29,9 +29,11 @@ the rotor's frame, and then after B42 and B300:
       0, B05 within 0.5 degrees electrical of --offset.
   4a. B49 (1110b, optimise the current controller at standstill): done,
       B42[0] = 0 (B49 reports in B42), B53 within 5 % of --r, B52 within 5 % of --l.
-B301 (grind brake) is not run here: once in CI, with the FB still enabled
-after B301 handed the axis back, the current-deviation check tripped
-(event 69 cause 2); through SOEM, which disables at once, it passes.
+  5a. B301 (0101b, grind brake): done, B301[0] = 0, each grind phase turned
+      the shaft by at least 0.8 of 60 rpm x 0.5 s (2^19 inc), the grinding
+      torque B301[3] the plant's brake (2 N m) plus friction, 2.0 ... 2.3 N m.
+      Then, with the enable and Execute still on for 0.5 s, the axis' own
+      control holds the shaft where B301 left it (within 3/1000 rev, no fault).
 
 One line:  scenario E-140: ok|FAIL: ...
 """
@@ -50,8 +52,8 @@ def b(line):
 A75, A69 = 0x2000 + 75, 0x2000 + 69
 B42, B43, B52, B53, B62, B300 = b(42), b(43), b(52), b(53), b(62), b(300)
 B44, B45, B46, B47 = b(44), b(45), b(46), b(47)
-B05, B10, B40, B41 = b(5), b(10), b(40), b(41)
-B40_SEL, B41_SEL, B49_SEL = 0b1010, 0b1011, 0b1110
+B05, B10, B40, B41, B301 = b(5), b(10), b(40), b(41), b(301)
+B40_SEL, B41_SEL, B49_SEL, B301_SEL = 0b1010, 0b1011, 0b1110, 0b0101
 E48 = 0x2800 + 48
 RUNNING, DONE, REFUSED = 1, 2, 3
 B42_SEL, B43_SEL, B300_SEL, B44_SEL = 0b1100, 0b1101, 0b0100, 0b1111
@@ -168,6 +170,28 @@ def optimise_at_standstill(fb, sc, r, l):
     end(fb, sc)
 
 
+def grind_brake(fb, sc):
+    took = action(fb, sc, B301_SEL, "B301")
+    result, grind, released, torque = (read(fb, sc, B301, k) for k in (1, 2, 3, 4))
+    sc.check(result == 0 and (grind or 0) >= 0.8 * (1 << 19) and 2000 <= (torque or 0) <= 2300,
+             f"B301: result {result}, smallest grind travel {grind} inc, released {released} inc, "
+             f"grinding torque {torque} mN m (the plant's brake slides at 2000), in {took:.2f} s")
+    hand_back(fb, sc, "B301")
+    end(fb, sc)
+
+
+def hand_back(fb, sc, name):
+    """After an action that turned the shaft, with the enable still on: the
+    axis' own control holds the shaft where the action left it (no jump back
+    to where it stood before, no fault)."""
+    p0 = fb.o.position_actual_value
+    fb.run_for(0.5)
+    moved = abs(fb.o.position_actual_value - p0)
+    sc.check(not fb.o.fault and fb.o.zsw1 & 0x47 == OP and moved <= 3,
+             f"{name} handed back with the enable on: the axis holds ({moved}/1000 rev in 0.5 s, "
+             f"fault {fb.o.fault})")
+
+
 def run(fb, sc, r, l, offset=None):
     for index, value in ((B53, 1000), (B52, 4000), (B62, 4000)):
         write(fb, sc, index, value)
@@ -223,6 +247,7 @@ def run(fb, sc, r, l, offset=None):
     disable(fb)
     if offset is not None:
         optimise_at_standstill(fb, sc, r, l)
+        grind_brake(fb, sc)
 
 
 def main():
@@ -233,7 +258,7 @@ def main():
     ap.add_argument("--fc", type=float, required=True, help="the plant's Coulomb friction, N m")
     ap.add_argument("--b", type=float, required=True, help="the plant's viscous friction, N m s/rad")
     ap.add_argument("--offset", type=float, help="the plant's commutation offset (serve --plant-offset), rad: "
-                    "B40, B41 and B49 run as well")
+                    "B40, B41, B49 and B301 run as well")
     a = ap.parse_args()
     sc = Scenario("E-140")
 

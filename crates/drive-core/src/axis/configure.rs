@@ -158,13 +158,24 @@ impl Axis {
     }
 
     /// A motor action replaced this cycle's command (`crate::actions`): the
-    /// cascade's integral part and the following-error monitor start from
-    /// rest, so that the axis takes over without the torque its velocity
-    /// controller wound up against the action's movement.
+    /// drive's own set-point follows the actual position (as with the drive
+    /// function off), the profile generator stands there, and the cascade's
+    /// integral part and the following-error monitor start from rest, so
+    /// that the axis takes over where the action left the shaft, without
+    /// the torque its velocity controller wound up against the action's
+    /// movement (B301 turns the shaft by some three revolutions, B44 by up
+    /// to twelve). The mode stays active; a cyclic mode's set-point is the
+    /// master's again from the next cycle on (it follows 6064h meanwhile, as
+    /// a master does while the drive does not follow it).
     pub fn overridden(&mut self) {
+        let actual = self.last_sample.map_or(self.sp_pos, |s| s.position_inc);
+        self.sp_pos = actual;
+        self.sp_vel = 0.0;
+        self.vl_demand = 0.0;
+        self.profile.reset(actual);
         self.following.reset();
         if let Some(c) = self.cascade.as_mut() {
-            c.reset(self.sp_pos);
+            c.reset(actual);
         }
     }
 
