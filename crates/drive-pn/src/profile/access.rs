@@ -136,7 +136,13 @@ pub struct DriveAccess<'a> {
     /// accelerations) store it and show it in the window J401 once, not
     /// once per field (issue 36). Stored before any other access and when
     /// the access ends ([`flush_record`](DriveAccess::flush_record)).
-    pub(super) pending: Option<(u8, u16, Record)>,
+    /// With it the record as it was read: a telegram that sends the same
+    /// values every cycle stores nothing (the window J401 shows the stored
+    /// record already: every write of J401 or the selector keeps the two
+    /// alike). The flag: `n` is the selected record (J400), which cannot
+    /// change while the record is pending (any other access stores it
+    /// first), so the next field of it does not read J400 again.
+    pub(super) pending: Option<(u8, u16, bool, Record, Record)>,
 }
 
 impl Drop for DriveAccess<'_> {
@@ -313,9 +319,11 @@ impl DriveAccess<'_> {
     /// Stores the record the last field writes left pending (and shows it
     /// when the window J401 shows it), as each of those writes did before.
     pub fn flush_record(&mut self) {
-        if let Some((axis, n, r)) = self.pending.take() {
+        if let Some((axis, n, _, r, read)) = self.pending.take() {
             // record `n` was read just before: it is there to store
-            let _ = self.objects.set_record(axis, n, &r);
+            if r != read {
+                let _ = self.objects.set_record(axis, n, &r);
+            }
         }
     }
 
@@ -350,12 +358,18 @@ impl DriveAccess<'_> {
         };
         let axis = self.axis.index();
         for &k in numbers {
-            let n = if k == 0 { self.record_number(jog) } else { k };
-            let mut r: Record = match self.pending {
-                Some((a, m, r)) if (a, m) == (axis, n) => r,
+            let selected = k == 0 && jog.is_none();
+            let n = match self.pending {
+                Some((a, m, true, ..)) if selected && a == axis => m,
+                _ if k == 0 => self.record_number(jog),
+                _ => k,
+            };
+            let (mut r, read): (Record, Record) = match self.pending {
+                Some((a, m, _, r, read)) if (a, m) == (axis, n) => (r, read),
                 _ => {
                     self.flush_record();
-                    self.objects.record(axis, n).ok_or(PdError::NOT_IN_STATE)?
+                    let read = self.objects.record(axis, n).ok_or(PdError::NOT_IN_STATE)?;
+                    (read, read)
                 }
             };
             let as_u32 = || u32::try_from(value).map_err(|_| PdError::LIMIT_EXCEEDED);
@@ -374,7 +388,7 @@ impl DriveAccess<'_> {
             }
             // stored at the next other access (a record that was read is
             // there to store: set_record cannot refuse it)
-            self.pending = Some((axis, n, r));
+            self.pending = Some((axis, n, selected, r, read));
         }
         Ok(())
     }
