@@ -272,9 +272,15 @@ impl DriveAccess<'_> {
     /// be written back although its rounding lands just beyond the type
     /// (PNU 1273's default `u32::MAX` increments reads 4 096 000/1000 rev,
     /// which converts to 2^32 increments).
-    fn to_object_read_back(&self, unit: Unit, bus: i64, index: u16, sub: u8) -> Result<i64, PdError> {
+    fn object_value_read_back(&mut self, unit: Unit, bus: i64, index: u16, sub: u8) -> Result<i64, PdError> {
         let v = self.to_object(unit, bus)?;
-        let (min, max) = type_limits(self.entry(index, sub)?.data_type);
+        // the data type from the prepared access where there is one (the
+        // write after this uses it): no lookup in the dictionary's tables
+        let t = match self.prepared.get(self.objects, index, sub) {
+            Some(p) => p.data_type(),
+            None => self.entry(index, sub)?.data_type,
+        };
+        let (min, max) = type_limits(t);
         if v > max && self.to_bus(unit, max) == Ok(bus) {
             return Ok(max);
         }
@@ -511,7 +517,7 @@ impl ParamAccess for DriveAccess<'_> {
         match p.source {
             Source::Object { index, sub } => {
                 let index = self.index(index);
-                let v = self.to_object_read_back(p.unit, value, index, sub)?;
+                let v = self.object_value_read_back(p.unit, value, index, sub)?;
                 self.write_object(index, sub, v)?;
             }
             Source::SelectedRecord(f) => self.write_record(None, f, p.unit, value)?,
