@@ -531,7 +531,8 @@ fn e140_b301_grind_brake_grinds_a_healthy_brake_and_fails_a_stalled_or_stuck_one
 /// the shaft by some three revolutions; afterwards, the enable and Execute
 /// still on, the axis' own control holds the shaft where the action left
 /// it: no drive back to where it stood before (the set-point followed the
-/// shaft while the action ran, `Axis::overridden`), no fault, for 0.5 s.
+/// shaft while the action ran, `Axis::overridden`), no fault, for 0.5 s;
+/// while the action ran, 60F4h read 0 (not the shaft's travel per cycle).
 #[test]
 fn e140_b301_hands_the_axis_back_where_it_left_the_shaft() {
     let sim = electrical_line(3.6, 0.012);
@@ -541,7 +542,14 @@ fn e140_b301_hands_the_axis_back_where_it_left_the_shaft() {
         sd.outputs_raw_mut()[2] = 1;
         let rotor = || sim.borrow().drives()[0].motors[0].position_inc_i64();
         let before = rotor();
-        let seen = run_action(&sim, &group, md, io, 0b0101, 5000).await;
+        // a second into it (a released phase at 60 rpm, 1,049 inc a cycle):
+        // the axis' following error reads 0, its set-point is the shaft's
+        let seen = run_action(&sim, &group, md, io, 0b0101, 1000).await;
+        assert_eq!(*seen.last().unwrap() >> 12, state::RUNNING, "A69 {seen:04X?}");
+        let fe = sd.sdo_read::<i32>(0x60F4, 0).await.unwrap();
+        println!("B301 running: 60F4h {fe} inc");
+        assert!(fe.abs() <= 16, "60F4h while B301 moves the shaft: {fe} inc");
+        let seen = follow_a69(md, &group, &sim, io.1, 5000, |s| s >> 12 == state::RUNNING).await;
         assert_eq!(*seen.last().unwrap() >> 12, state::DONE, "A69 {seen:04X?}");
         let left = rotor();
         assert!(

@@ -166,9 +166,16 @@ impl Axis {
     /// movement (B301 turns the shaft by some three revolutions, B44 by up
     /// to twelve). The mode stays active; a cyclic mode's set-point is the
     /// master's again from the next cycle on (it follows 6064h meanwhile, as
-    /// a master does while the drive does not follow it).
+    /// a master does while the drive does not follow it). Done at the start
+    /// of the next cycle, from its actual position, before its set-point is
+    /// made: while an action moves the shaft, 60F4h reads 0.
     pub fn overridden(&mut self) {
-        let actual = self.last_sample.map_or(self.sp_pos, |s| s.position_inc);
+        self.follow_actual = true;
+    }
+
+    /// The set-point state, the profile generator, the speed integral and
+    /// the following-error monitor at `actual` (the mode stays active).
+    pub(super) fn follow(&mut self, actual: i32) {
         self.sp_pos = actual;
         self.sp_vel = 0.0;
         self.vl_demand = 0.0;

@@ -233,6 +233,10 @@ pub struct Axis {
     /// then converted and written again (no compare of the four values
     /// per cycle).
     probe_shown: bool,
+    /// A motor action replaced the last cycle's command
+    /// ([`overridden`](Self::overridden)): this cycle's set-point starts at
+    /// the actual position (60F4h 0 while an action moves the shaft).
+    follow_actual: bool,
     /// Filtered actual velocity, inc/s (user coordinates).
     velocity: f32,
     /// Last cycle's actual position sample (user coordinates).
@@ -325,6 +329,7 @@ impl Axis {
             interp_master_ns: 0,
             configured: None,
             probe_shown: false,
+            follow_actual: false,
             profile: ProfileGenerator::new(0),
             cascade: Cascade::new(params.cascade, 0)
                 .or_else(|_| Cascade::new(CascadeConfig::DEFAULT, 0))
@@ -539,6 +544,10 @@ impl Axis {
         };
 
         let mut actual = self.feedback(io, o.polarity, dt_ns, now_ns);
+        if self.follow_actual {
+            self.follow_actual = false;
+            self.follow(actual);
+        }
         self.monitor(io, now_ns);
         let i199 = is_standstill(self.velocity, self.params.velocity_window_inc_per_s);
 
