@@ -134,10 +134,18 @@ pub enum Core {
     ModeDisplay,
     /// 60FDh digital inputs.
     Inputs,
+    /// 6041h statusword.
+    Statusword,
 }
 
 impl Core {
-    const ALL: [Core; 4] = [Core::Controlword, Core::Mode, Core::ModeDisplay, Core::Inputs];
+    const ALL: [Core; 5] = [
+        Core::Controlword,
+        Core::Mode,
+        Core::ModeDisplay,
+        Core::Inputs,
+        Core::Statusword,
+    ];
 
     /// The axis-A index.
     const fn index(self) -> u16 {
@@ -146,6 +154,7 @@ impl Core {
             Core::Mode => 0x6060,
             Core::ModeDisplay => 0x6061,
             Core::Inputs => 0x60FD,
+            Core::Statusword => 0x6041,
         }
     }
 }
@@ -156,7 +165,7 @@ impl Core {
 #[derive(Debug, Clone, Copy, Default)]
 pub struct CoreSlots {
     axis: Option<u8>,
-    slots: [Option<Slot>; 4],
+    slots: [Option<Slot>; 5],
 }
 
 impl CoreSlots {
@@ -164,7 +173,7 @@ impl CoreSlots {
     pub const fn new() -> Self {
         Self {
             axis: None,
-            slots: [None; 4],
+            slots: [None; 5],
         }
     }
 

@@ -386,19 +386,19 @@ impl Profile {
     /// and builds the response telegram into `buf` (the IN module's
     /// length); returns the bytes written, `None` before any telegram.
     pub fn respond(&mut self, objects: &mut DriveObjects, axis: &Axis, buf: &mut [u8]) -> Option<usize> {
+        self.core.resolve(objects, axis);
         if self.homing {
-            let sw = objects.get(axis.cia402_index(0x6041), 0).unwrap_or(0);
-            let mode = objects.get(axis.cia402_index(0x6061), 0).unwrap_or(0);
+            let sw = self.core.get(objects, axis, Core::Statusword);
+            let mode = self.core.get(objects, axis, Core::ModeDisplay);
             // homing attained (bit 12) or an error (bit 13): the run is over
             if mode == 6 && sw & 0x3000 != 0 {
                 self.homing = false;
                 let _ = objects.set(axis.cia402_index(0x6060), 0, 1);
             }
         }
-        self.own.zsw1 = status::zsw1(objects, axis, self.cw1.last(), self.homing);
+        self.own.zsw1 = status::zsw1(objects, &self.core, axis, self.cw1.last(), self.homing);
         let n = self.response?;
         let telegrams = self.telegrams.as_mut()?;
-        self.core.resolve(objects, axis);
         let mut access = DriveAccess {
             objects,
             axis,

@@ -1,6 +1,7 @@
 //! ZSW1 from the core's state (P-095…P-109): the device state, the CiA 402
 //! statusword 6041h of the axis and its record positioning.
 
+use super::lookup::{Core, CoreSlots};
 use cia402::State as Cia;
 use drive_core::axis::Axis;
 use drive_core::DriveObjects;
@@ -49,10 +50,10 @@ fn state(s: Cia) -> State {
 }
 
 /// ZSW1 of `axis` with `cw1` the last evaluated CW1 and `homing` a homing
-/// run the profile started.
-pub fn zsw1(objects: &DriveObjects, axis: &Axis, cw1: u16, homing: bool) -> u16 {
-    let sw = objects.get(axis.cia402_index(0x6041), 0).unwrap_or(0);
-    let mode = objects.get(axis.cia402_index(0x6061), 0).unwrap_or(0);
+/// run the profile started; 6041h and 6061h through `core`'s slots.
+pub fn zsw1(objects: &DriveObjects, core: &CoreSlots, axis: &Axis, cw1: u16, homing: bool) -> u16 {
+    let sw = core.get(objects, axis, Core::Statusword);
+    let mode = core.get(objects, axis, Core::ModeDisplay);
     let speed = matches!(mode, 2 | 3);
     let records = axis.record_status();
     let velocity = axis.actual_velocity();
