@@ -161,7 +161,7 @@ async fn motion_demo(
     i = until(group, md, sim, (0x0F, 8, hold), 50, |i| i.mode == 8).await?;
     // the profile: 10 revolutions out and back, cosine S-curves of 1.5 s each
     let (p0, dist, t_move) = (i.pos, 10.0 * INC_PER_REV, 1500usize);
-    let total = 2 * t_move + 300;
+    let total = hil_sim::sim::profile::cycles(t_move);
     let bar = indicatif::ProgressBar::new(total as u64);
     bar.set_style(
         indicatif::ProgressStyle::with_template("  csp profile [{bar:40}] {pos}/{len} cycles")
@@ -169,16 +169,7 @@ async fn motion_demo(
     );
     let mut trace = hil_sim::plot::Trace::default();
     for k in 0..total {
-        let phase = |k: usize| (1.0 - (std::f64::consts::PI * k as f64 / t_move as f64).cos()) / 2.0;
-        let x = if k < t_move {
-            phase(k)
-        } else if k < t_move + 150 {
-            1.0
-        } else if k < 2 * t_move + 150 {
-            1.0 - phase(k - t_move - 150)
-        } else {
-            0.0
-        };
+        let x = hil_sim::sim::profile::fraction(k, t_move);
         let target = p0.wrapping_add((x * dist).round() as i32);
         write_outputs(group, md, 0x0F, 8, target)?;
         i = cycle(group, md, sim).await?;
