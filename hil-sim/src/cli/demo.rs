@@ -87,18 +87,9 @@ async fn cycle(
     read_inputs(group, md)
 }
 
+/// The CiA 402 state name of a statusword, "?" for none.
 fn state_name(sw: u16) -> &'static str {
-    match sw & 0x6F {
-        0x00 | 0x20 => "Not ready to switch on",
-        0x40 | 0x60 => "Switch on disabled",
-        0x21 => "Ready to switch on",
-        0x23 => "Switched on",
-        0x27 => "Operation enabled",
-        0x07 => "Quick stop active",
-        0x0F | 0x2F => "Fault reaction active",
-        0x08 | 0x28 => "Fault",
-        _ => "?",
-    }
+    cia402::State::from_statusword(sw).map_or("?", cia402::State::name)
 }
 
 /// Runs master cycles with `cw` until `done(inputs)` or `max` cycles.
