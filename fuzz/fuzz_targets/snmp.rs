@@ -14,7 +14,7 @@
 
 use libfuzzer_sys::fuzz_target;
 use snmp::ber::{Reader, Writer};
-use snmp::{Agent, Delays, Device, LldpAgent, LocalPort, MacPhy, ManAddr, Neighbor, Pno};
+use snmp::{message, Agent, Delays, Device, LldpAgent, LocalPort, MacPhy, ManAddr, Neighbor, Pno};
 
 const PREFIXES: &[&[u32]] = &[
     &[1, 3, 6, 1, 2, 1, 1],
@@ -121,38 +121,31 @@ fuzz_target!(|data: &[u8]| {
     };
     let mut msg = [0u8; 1600];
     let mut w = Writer::new(&mut msg);
-    let t = w.open(0x30);
-    w.int(2, version);
-    w.prim(4, c);
-    let p = w.open(pdu);
-    w.int(2, id);
-    w.int(2, a);
-    w.int(2, b);
-    let l = w.open(0x30);
-    for _ in 0..usize::from(next() % 6) {
-        let sel = next();
-        let mut oid = [0u32; 24];
-        let pre = PREFIXES[usize::from(sel) % PREFIXES.len()];
-        oid[..pre.len()].copy_from_slice(pre);
-        let extra = usize::from(next() % 4);
-        for k in 0..extra {
-            let x = next();
-            oid[pre.len() + k] = if x > 250 { u32::from_le_bytes([next(), next(), next(), next()]) } else { u32::from(x % 12) };
+    message(&mut w, version, c, pdu, [id, a, b], |w| {
+        let l = w.open(0x30);
+        for _ in 0..usize::from(next() % 6) {
+            let sel = next();
+            let mut oid = [0u32; 24];
+            let pre = PREFIXES[usize::from(sel) % PREFIXES.len()];
+            oid[..pre.len()].copy_from_slice(pre);
+            let extra = usize::from(next() % 4);
+            for k in 0..extra {
+                let x = next();
+                oid[pre.len() + k] = if x > 250 { u32::from_le_bytes([next(), next(), next(), next()]) } else { u32::from(x % 12) };
+            }
+            let m = w.open(0x30);
+            w.oid(&oid[..pre.len() + extra]);
+            let tag = [4u8, 5, 2, 6, 0x40, 0x43, 4, 4][usize::from(next() % 8)];
+            let len = usize::from(next()) + if next() & 1 == 1 { 200 } else { 0 };
+            let mut v = [0u8; 512];
+            for x in v.iter_mut().take(len.min(8)) {
+                *x = next();
+            }
+            w.prim(tag, &v[..len]);
+            w.close(m);
         }
-        let m = w.open(0x30);
-        w.oid(&oid[..pre.len() + extra]);
-        let tag = [4u8, 5, 2, 6, 0x40, 0x43, 4, 4][usize::from(next() % 8)];
-        let len = usize::from(next()) + if next() & 1 == 1 { 200 } else { 0 };
-        let mut v = [0u8; 512];
-        for x in v.iter_mut().take(len.min(8)) {
-            *x = next();
-        }
-        w.prim(tag, &v[..len]);
-        w.close(m);
-    }
-    w.close(l);
-    w.close(p);
-    w.close(t);
+        w.close(l);
+    });
     let Some(n) = w.finish() else { return };
     let (pos, flip) = (u16::from_le_bytes([next(), next()]), next());
     if flip != 0 {

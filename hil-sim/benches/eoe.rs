@@ -40,53 +40,55 @@ fn main() {
     let sim = RefCell::new(Simulation::new(1));
     sim.borrow_mut().drives_mut()[0].bind_net([2, 0, 0, 0, 0, 0x14], 1, Nanos::ZERO);
     let wall = std::time::Instant::now();
-    let (mut ping, mut big, mut read, frames) = line::with_first_subdevice(&sim, async |sd, clock| {
-        let mut host = HostNet::new(
-            [2, 0, 0, 0, 0, 1],
-            &[(HOST_IP, 24)],
-            Nanos::from_ns(clock.load(Ordering::Relaxed)),
-        );
-        assert!(
-            host.tunnel
-                .request(&sd, &set_ip_request(DRIVE_IP, [255, 255, 255, 0], HOST_IP))
-                .await
-        );
-        while host.tunnel.responses.pop_front().is_none() {
-            host.step(&sd, clock).await;
-        }
-        // the first ping resolves the addresses (ARP both ways): not counted
-        host.ping(&sd, clock, DRIVE_IP, 0, 1000)
-            .await
-            .expect("first ping");
-        let f0 = sim.borrow().frames();
-        let mut ping = Vec::new();
-        let mut big = Vec::new();
-        let mut read = Vec::new();
-        for i in 1..=runs {
-            ping.push(
-                host.ping(&sd, clock, DRIVE_IP, i as u16, 1000)
-                    .await
-                    .expect("ping"),
+    let (mut ping, mut big, mut read, frames) =
+        hil_sim::master::with_first_subdevice(&sim, async |sd, clock| {
+            let mut host = HostNet::new(
+                [2, 0, 0, 0, 0, 1],
+                &[(HOST_IP, 24)],
+                Nanos::from_ns(clock.load(Ordering::Relaxed)),
             );
-            big.push(
-                host.ping_with(&sd, clock, DRIVE_IP, 0x8000 | i as u16, 1472, 1000)
+            assert!(
+                host.tunnel
+                    .request(&sd, &set_ip_request(DRIVE_IP, [255, 255, 255, 0], HOST_IP))
                     .await
-                    .expect("ping 1472"),
             );
-            // the service takes one request per 10 ms beyond a burst of 16
-            // (docs/eoe.md): each read after a refill, so none is dropped
-            let now = sim.borrow().now();
-            sim.borrow_mut().catch_up(now + net::PARAM_REFILL);
-            host.step(&sd, clock).await; // the master's clock follows
-            let (answer, ns) = host
-                .param_request(&sd, clock, DRIVE_IP, "R A150", 1000)
+            while host.tunnel.responses.pop_front().is_none() {
+                host.step(&sd, clock).await;
+            }
+            // the first ping resolves the addresses (ARP both ways): not counted
+            host.ping(&sd, clock, DRIVE_IP, 0, 1000)
                 .await
-                .expect("answer");
-            assert_eq!(answer, "OK 1000");
-            read.push(ns);
-        }
-        (ping, big, read, sim.borrow().frames() - f0)
-    });
+                .expect("first ping");
+            let f0 = sim.borrow().frames();
+            let mut ping = Vec::new();
+            let mut big = Vec::new();
+            let mut read = Vec::new();
+            for i in 1..=runs {
+                ping.push(
+                    host.ping(&sd, clock, DRIVE_IP, i as u16, 1000)
+                        .await
+                        .expect("ping"),
+                );
+                big.push(
+                    host.ping_with(&sd, clock, DRIVE_IP, 0x8000 | i as u16, 1472, 1000)
+                        .await
+                        .expect("ping 1472"),
+                );
+                // the service takes one request per 10 ms beyond a burst of 16
+                // (docs/eoe.md): each read after a refill, so none is dropped
+                let now = sim.borrow().now();
+                sim.borrow_mut().catch_up(now + net::PARAM_REFILL);
+                host.step(&sd, clock).await; // the master's clock follows
+                let (answer, ns) = host
+                    .param_request(&sd, clock, DRIVE_IP, "R A150", 1000)
+                    .await
+                    .expect("answer");
+                assert_eq!(answer, "OK 1000");
+                read.push(ns);
+            }
+            (ping, big, read, sim.borrow().frames() - f0)
+        })
+        .expect("the line's first SubDevice");
     let wall = wall.elapsed();
     let tunnel_frames = frames as f64 / runs as f64;
     println!("IP over EoE, 1 drive, mailbox 256 bytes, {runs} runs (simulated time)");

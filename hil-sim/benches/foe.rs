@@ -107,7 +107,7 @@ fn main() {
     };
     let sim = RefCell::new(Simulation::with_nodes(vec![node]));
     let image = file(2);
-    let results = line::with_first_subdevice(&sim, async |sd, _clock| {
+    let results = hil_sim::master::with_first_subdevice(&sim, async |sd, _clock| {
         for state in [1u16, 3] {
             sd.register_write(esc::regs::AL_CONTROL, state)
                 .await
@@ -138,7 +138,8 @@ fn main() {
             results.push((wall, s.now().as_ns() - t0, s.frames() - f0, chunks.len()));
         }
         results
-    });
+    })
+    .expect("the line's first SubDevice");
     {
         let mut s = sim.borrow_mut();
         let slots = s.drives_mut()[0].drive.boot_slots_mut().expect("slots");

@@ -126,3 +126,24 @@ where
         body(&md, &clock),
     ))
 }
+
+/// Runs `body` with the first SubDevice of `sim`'s line (brought up as one
+/// group of at most 2 SubDevices and 64 bytes of process data, with 100 DC
+/// static-sync frames and the [`in_process_timeouts`]) and the master's
+/// clock; its result, or the master's error bringing the line up.
+pub fn with_first_subdevice<N: Node, T>(
+    sim: &RefCell<Simulation<N>>,
+    body: impl for<'g> AsyncFnOnce(ethercrab::SubDeviceRef<'g, &'g ethercrab::SubDevice>, &'g AtomicU64) -> T,
+) -> Result<T, ethercrab::error::Error> {
+    let config = ethercrab::MainDeviceConfig {
+        dc_static_sync_iterations: 100,
+        ..Default::default()
+    };
+    run_with(sim, in_process_timeouts(), config, async |md, clock| {
+        let group = md
+            .init_single_group::<2, 64>(|| clock.load(Ordering::Relaxed))
+            .await?;
+        let sd = group.subdevice(md, 0)?;
+        Ok(body(sd, clock).await)
+    })
+}

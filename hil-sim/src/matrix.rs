@@ -78,17 +78,12 @@ pub fn al(status: (u16, u16)) -> String {
     format!("{}, AL {:04X}h", al_state(status.0), status.1)
 }
 
-/// The CiA 402 state name of a statusword.
+/// The CiA 402 state name of a statusword ([`cia402::State::name`]);
+/// "Not ready" for Not ready to switch on and a statusword of no state.
 pub fn cia402_state(sw: u16) -> &'static str {
-    match sw & 0x6F {
-        0x40 | 0x60 => "Switch on disabled",
-        0x21 => "Ready to switch on",
-        0x23 => "Switched on",
-        0x27 => "Operation enabled",
-        0x07 => "Quick stop active",
-        0x0F | 0x2F => "Fault reaction active",
-        0x08 | 0x28 => "Fault",
-        _ => "Not ready",
+    match cia402::State::from_statusword(sw) {
+        None | Some(cia402::State::NotReadyToSwitchOn) => "Not ready",
+        Some(s) => s.name(),
     }
 }
 

@@ -8,9 +8,56 @@
 
 use crate::electrical::{ElectricalAxis, PlantModel};
 use crate::motor::{Motor, MotorOutputs};
-use drive_ecat::axis::{AxisCommand, AxisIo, CurrentControl, MotorData};
+use drive_ecat::axis::{Axis, AxisCommand, AxisIo, CurrentControl};
 use drive_ecat::stage::StageData;
+use drive_ecat::DriveObjects;
 use nanos::Nanos;
+
+/// The plant methods of a simulated drive over its `electrical: Plants`
+/// field, the same on either fieldbus ([`crate::sim::SimDrive`],
+/// [`crate::pn::PnSim`]): `set_plant`, `set_plant_at`, `electrical`,
+/// `electrical_mut`.
+macro_rules! plant_methods {
+    () => {
+        /// Runs both axes on `model` from the next control cycle on (the
+        /// motors' mechanics and position stay; an electrical axis starts
+        /// with zero current): the electrical model's current loop at 16 kHz
+        /// on the PMSM plant, 6077h and 6078h (PNU 1102 on PROFINET) from its
+        /// measured iq, its trips the axes' faults. `seed` seeds the ADC
+        /// noise (axis B gets `seed + 1`).
+        pub fn set_plant(
+            &mut self,
+            model: $crate::electrical::PlantModel,
+            seed: u64,
+        ) -> Result<(), foc::ParamError> {
+            self.set_plant_at(model, seed, 16_000.0)
+        }
+
+        /// [`Self::set_plant`] with the electrical model's PWM and current loop
+        /// at `pwm_hz` (16 kHz by default; 8 kHz selectable, issue 34).
+        pub fn set_plant_at(
+            &mut self,
+            model: $crate::electrical::PlantModel,
+            seed: u64,
+            pwm_hz: f32,
+        ) -> Result<(), foc::ParamError> {
+            self.electrical.set(model, seed, pwm_hz)
+        }
+
+        /// Axis `axis`' current loop and PMSM, if it runs the electrical model.
+        pub fn electrical(&self, axis: usize) -> Option<&$crate::electrical::ElectricalAxis> {
+            self.electrical.get(axis)
+        }
+
+        /// Axis `axis`' current loop and PMSM, for plant settings (a fault of
+        /// the motor, its wiring or the DC link:
+        /// [`ElectricalAxis::plant_mut`](crate::electrical::ElectricalAxis::plant_mut)).
+        pub fn electrical_mut(&mut self, axis: usize) -> Option<&mut $crate::electrical::ElectricalAxis> {
+            self.electrical.get_mut(axis)
+        }
+    };
+}
+pub(crate) use plant_methods;
 
 /// Each axis' electrical model, or `None`: the rigid model.
 #[derive(Clone, Default)]
@@ -62,19 +109,21 @@ impl Plants {
     }
 
     /// One control cycle of length `dt` of both motors under the axes'
-    /// commands `cmd`, each electrical axis with the motor data `data` as the
-    /// drive has them (applied when they changed; a refused set keeps the
-    /// loop's) and the power stage's `stage`; the motors' outputs into
-    /// `feedback`.
+    /// commands `cmd`, each electrical axis with the motor data of the
+    /// drive's `axes` (applied when they changed; a refused set keeps the
+    /// loop's) and the power stage's data in its `objects`; the motors'
+    /// outputs into `feedback`.
     pub fn step(
         &mut self,
         motors: &mut [Motor; 2],
         feedback: &mut [Option<MotorOutputs>; 2],
         cmd: [AxisCommand; 2],
-        data: [MotorData; 2],
-        stage: &StageData,
+        axes: &[Axis; 2],
+        objects: &DriveObjects,
         dt: Nanos,
     ) {
+        let data = axes.each_ref().map(|a| *a.motor());
+        let stage = &StageData::read(objects);
         let axes = motors.iter_mut().zip(feedback.iter_mut());
         for ((((motor, fb), c), el), data) in axes.zip(cmd).zip(self.0.iter_mut()).zip(data) {
             *fb = Some(match el {

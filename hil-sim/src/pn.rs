@@ -8,7 +8,6 @@
 
 use std::collections::VecDeque;
 
-use crate::electrical::{ElectricalAxis, PlantModel};
 use crate::motor::{Motor, MotorOutputs};
 use crate::sim::{axis_io, AxisConditions, SimFlash};
 use drive_ecat::params::{E43, E82};
@@ -317,30 +316,7 @@ impl PnSim {
         &mut self.drive
     }
 
-    /// Runs both axes on `model` from the next control cycle on, as
-    /// [`SimDrive::set_plant`](crate::sim::SimDrive::set_plant) does: the
-    /// electrical model's current loop at 16 kHz on the PMSM plant, 6077h
-    /// and 6078h (PNU 1102) from its measured iq, its trips the axes'
-    /// faults. `seed` seeds the ADC noise (axis B gets `seed + 1`).
-    pub fn set_plant(&mut self, model: PlantModel, seed: u64) -> Result<(), foc::ParamError> {
-        self.set_plant_at(model, seed, 16_000.0)
-    }
-
-    /// [`Self::set_plant`] with the electrical model's PWM and current loop
-    /// at `pwm_hz` (16 kHz by default; 8 kHz selectable, issue 34).
-    pub fn set_plant_at(&mut self, model: PlantModel, seed: u64, pwm_hz: f32) -> Result<(), foc::ParamError> {
-        self.electrical.set(model, seed, pwm_hz)
-    }
-
-    /// Axis `axis`' current loop and PMSM, if it runs the electrical model.
-    pub fn electrical(&self, axis: usize) -> Option<&ElectricalAxis> {
-        self.electrical.get(axis)
-    }
-
-    /// The same, for plant settings (faults, the DC link).
-    pub fn electrical_mut(&mut self, axis: usize) -> Option<&mut ElectricalAxis> {
-        self.electrical.get_mut(axis)
-    }
+    crate::plants::plant_methods!();
 
     /// The motor of `axis` (0 = A).
     pub fn motor(&self, axis: usize) -> Option<&Motor> {
@@ -473,14 +449,12 @@ impl PnSim {
             self.electrical.measure(&mut io);
             let commands = self.drive.control_cycle(t, &io);
             let period = self.drive.control_period();
-            let data = self.drive.axes().each_ref().map(|a| *a.motor());
-            let stage = drive_ecat::stage::StageData::read(self.drive.objects());
             self.electrical.step(
                 &mut self.motors,
                 &mut self.feedback,
                 commands,
-                data,
-                &stage,
+                self.drive.axes(),
+                self.drive.objects(),
                 period,
             );
             if let Some(mv) = self.electrical.dc_link_mv() {

@@ -8,6 +8,7 @@ use crate::motor::{Motor, MotorOutputs};
 mod axis_io;
 mod flash;
 mod plant;
+pub mod profile;
 mod snapshot;
 mod stamps;
 mod variant;

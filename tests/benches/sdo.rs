@@ -16,7 +16,6 @@ use hil_sim::esc::{Esc, EscConfig};
 use hil_sim::sim::{Node, Simulation};
 use od::{Access, CommState, DataType, Dictionary, EntryInfo, ObjectCode, ObjectInfo, SdoAbort};
 use std::cell::RefCell;
-use std::sync::atomic::Ordering;
 use std::time::Instant;
 
 const BIG: u16 = 0x5FFF;
@@ -101,39 +100,26 @@ fn main() {
         dict: BenchDict(DriveObjects::new()),
     };
     let sim = RefCell::new(Simulation::with_nodes(vec![node]));
-    let config = ethercrab::MainDeviceConfig {
-        dc_static_sync_iterations: 100,
-        ..Default::default()
-    };
-    let (wall, sim_ns, frames) = hil_sim::master::run_with(
-        &sim,
-        hil_sim::master::in_process_timeouts(),
-        config,
-        async |md, clock| {
-            let group = md
-                .init_single_group::<2, 64>(|| clock.load(Ordering::Relaxed))
-                .await
-                .expect("init");
-            let sd = group.subdevice(md, 0).expect("slave");
-            let mut coe = CoeClient::new();
-            let first = coe.upload(&sd, BIG, 0).await.expect("4 KiB upload");
-            assert!(first.iter().enumerate().all(|(i, &b)| b == i as u8), "content");
-            let (t0, f0) = {
-                let s = sim.borrow();
-                (s.now().as_ns(), s.frames())
-            };
-            let start = Instant::now();
-            for _ in 0..reads {
-                assert_eq!(
-                    coe.upload(&sd, BIG, 0).await.expect("4 KiB upload").len(),
-                    BIG_LEN
-                );
-            }
-            let wall = start.elapsed();
+    let (wall, sim_ns, frames) = hil_sim::master::with_first_subdevice(&sim, async |sd, _clock| {
+        let mut coe = CoeClient::new();
+        let first = coe.upload(&sd, BIG, 0).await.expect("4 KiB upload");
+        assert!(first.iter().enumerate().all(|(i, &b)| b == i as u8), "content");
+        let (t0, f0) = {
             let s = sim.borrow();
-            (wall, s.now().as_ns() - t0, s.frames() - f0)
-        },
-    );
+            (s.now().as_ns(), s.frames())
+        };
+        let start = Instant::now();
+        for _ in 0..reads {
+            assert_eq!(
+                coe.upload(&sd, BIG, 0).await.expect("4 KiB upload").len(),
+                BIG_LEN
+            );
+        }
+        let wall = start.elapsed();
+        let s = sim.borrow();
+        (wall, s.now().as_ns() - t0, s.frames() - f0)
+    })
+    .expect("the line's first SubDevice");
     let bytes = (reads * BIG_LEN) as f64;
     println!("segmented SDO upload of a {BIG_LEN}-byte object, {reads} uploads, mailbox 256 bytes");
     println!("{:<34} {:>14}", "frames per upload", frames as f64 / reads as f64);

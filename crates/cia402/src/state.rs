@@ -106,6 +106,20 @@ impl State {
         }
     }
 
+    /// The state's name as the spec writes it ("Switch on disabled").
+    pub const fn name(self) -> &'static str {
+        match self {
+            State::NotReadyToSwitchOn => "Not ready to switch on",
+            State::SwitchOnDisabled => "Switch on disabled",
+            State::ReadyToSwitchOn => "Ready to switch on",
+            State::SwitchedOn => "Switched on",
+            State::OperationEnabled => "Operation enabled",
+            State::QuickStopActive => "Quick stop active",
+            State::FaultReactionActive => "Fault reaction active",
+            State::Fault => "Fault",
+        }
+    }
+
     /// `true` in the two fault states.
     pub const fn is_fault(self) -> bool {
         matches!(self, State::FaultReactionActive | State::Fault)

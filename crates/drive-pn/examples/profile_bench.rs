@@ -25,7 +25,6 @@ use drive_core::DriveObjects;
 use drive_pn::profile::Profile;
 use drive_pn::{settings, Hardware, PnDrive};
 use nanos::Nanos;
-use profinet::cm::ImData;
 use profinet::testing;
 use std::hint::black_box;
 use std::time::Instant;
@@ -109,15 +108,9 @@ fn profile_alone(telegram: &[u8]) -> (f64, f64) {
     (rx, tx)
 }
 
+/// The board data of the scripted controller's device.
 fn hardware() -> Hardware {
-    let c = testing::device_config();
-    Hardware {
-        mac: c.mac,
-        port_macs: c.port_macs,
-        im0: c.im0,
-        im: ImData::default(),
-        boot_time: 1,
-    }
+    Hardware::from(testing::device_config())
 }
 
 /// The drive commissioned as the scripted controller expects it, restarted,

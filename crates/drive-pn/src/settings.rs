@@ -49,6 +49,21 @@ pub struct Hardware {
     pub boot_time: u32,
 }
 
+impl From<DeviceConfig> for Hardware {
+    /// The board's part of a device configuration (its MACs, I&M and boot
+    /// time; the name and IP suite are the parameters'): what
+    /// [`device_config`] builds a configuration from again.
+    fn from(c: DeviceConfig) -> Hardware {
+        Hardware {
+            mac: c.mac,
+            port_macs: c.port_macs,
+            im0: c.im0,
+            im: c.im,
+            boot_time: c.boot_time,
+        }
+    }
+}
+
 /// Length of I&M1…4 in the store: IM_Tag_Function (32), IM_Tag_Location
 /// (22), IM_Date (16), IM_Descriptor (54), IM_Signature (54).
 pub const IM_BYTES: usize = 32 + 22 + 16 + 54 + 54;

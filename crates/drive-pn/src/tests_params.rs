@@ -7,10 +7,8 @@ use core::net::Ipv4Addr;
 use drive_core::params::{A272, A273, A274, A275, A276, A277, A278};
 use drive_core::PERSISTENT_IMAGE_BYTES;
 use od::{CommState, Dictionary, SdoAbort};
-use profinet::dcp::pdu::{
-    service_type, BlockRepr, BlockType, BlockWriter, Header, ServiceId, Value, HEADER_LEN,
-};
-use profinet::wire::{emit_header, ethertype, EthFrame, MacAddr};
+use profinet::dcp::pdu::{BlockRepr, BlockType, ServiceId, Value};
+use profinet::wire::{EthFrame, MacAddr};
 use std::vec::Vec;
 
 const OUR: MacAddr = MacAddr([2, 0, 0, 0, 0, 0x50]);
@@ -26,24 +24,8 @@ fn restart(d: PnDrive<TestFlash>) -> PnDrive<TestFlash> {
 }
 
 fn dcp(dst: MacAddr, frame_id: u16, service: ServiceId, blocks: &[BlockRepr<'_>]) -> Vec<u8> {
-    let mut buf = [0u8; 1514];
-    let eth = emit_header(&mut buf, dst, PLC, None, ethertype::PROFINET).unwrap();
-    buf[eth..eth + 2].copy_from_slice(&frame_id.to_be_bytes());
-    let mut w = BlockWriter::new(&mut buf[eth + 2 + HEADER_LEN..]);
-    for b in blocks {
-        w.push(b).unwrap();
-    }
-    let n = w.len();
-    Header {
-        service,
-        service_type: service_type::REQUEST,
-        xid: 7,
-        response_delay: if service == ServiceId::Identify { 1 } else { 0 },
-        data_length: n as u16,
-    }
-    .emit(&mut buf[eth + 2..])
-    .unwrap();
-    let mut f = buf[..eth + 2 + HEADER_LEN + n].to_vec();
+    let delay = if service == ServiceId::Identify { 1 } else { 0 };
+    let mut f = profinet::testing::dcp_request(dst, PLC, frame_id, service, 7, delay, blocks).to_vec();
     f.resize(f.len().max(60), 0);
     f
 }

@@ -12,10 +12,11 @@ use core::net::Ipv4Addr;
 use nanos::Nanos;
 
 use crate::cm::{Ar, Im0, ImData};
+use crate::dcp::pdu::{service_type, BlockRepr, BlockWriter, Header, ServiceId, HEADER_LEN};
 use crate::dcp::IpSuite;
 use crate::device::DeviceConfig;
 use crate::ip::{Endpoint, IpConfig, Stack, UdpTx, RPC_PORT, UDP_PAYLOAD_OFFSET};
-use crate::wire::MacAddr;
+use crate::wire::{emit_header, ethertype, MacAddr};
 
 /// profinet-py 0.6.6's requests (see the module's own documentation).
 #[allow(dead_code)]
@@ -112,6 +113,45 @@ pub fn udp_to_device(payload: &[u8]) -> Frame {
             .unwrap_or_default(),
         _ => Frame::new(),
     }
+}
+
+/// A DCP request frame from `src` to `dst` (no VLAN tag): FrameID
+/// `frame_id`, `service` with transaction `xid` and `response_delay`, then
+/// `blocks`. Empty when the blocks do not fit a frame.
+pub fn dcp_request(
+    dst: MacAddr,
+    src: MacAddr,
+    frame_id: u16,
+    service: ServiceId,
+    xid: u32,
+    response_delay: u16,
+    blocks: &[BlockRepr<'_>],
+) -> Frame {
+    let mut buf = [0u8; 1514];
+    let built = (|| {
+        let eth = emit_header(&mut buf, dst, src, None, ethertype::PROFINET)?;
+        buf.get_mut(eth..eth + 2)?
+            .copy_from_slice(&frame_id.to_be_bytes());
+        let mut w = BlockWriter::new(buf.get_mut(eth + 2 + HEADER_LEN..)?);
+        for b in blocks {
+            w.push(b).ok()?;
+        }
+        let n = w.len();
+        Header {
+            service,
+            service_type: service_type::REQUEST,
+            xid,
+            response_delay,
+            data_length: u16::try_from(n).ok()?,
+        }
+        .emit(buf.get_mut(eth + 2..)?)
+        .ok()?;
+        Some(eth + 2 + HEADER_LEN + n)
+    })();
+    built
+        .and_then(|len| buf.get(..len))
+        .and_then(|f| Frame::from_slice(f).ok())
+        .unwrap_or_default()
 }
 
 /// profinet-py's Connect (slot 1 OUT 18 words, slot 2 IN 18 words; 1 ms × 8,

@@ -632,26 +632,51 @@ fn encode(
     body: impl FnOnce(&mut Writer),
 ) -> Option<usize> {
     let mut w = Writer::new(out);
-    let top = w.open(0x30);
-    w.int(0x02, req.version);
-    w.prim(0x04, community);
-    let pdu = w.open(RESPONSE);
-    w.int(0x02, req.id);
-    w.int(0x02, status);
-    w.int(0x02, index);
-    if status == 0 {
-        let m = w.open(0x30);
-        body(&mut w);
-        w.close(m);
-    } else if status == err::TOO_BIG {
-        let m = w.open(0x30);
-        w.close(m);
-    } else {
-        body(&mut w);
-    }
-    w.close(pdu);
-    w.close(top);
+    message(
+        &mut w,
+        req.version,
+        community,
+        RESPONSE,
+        [req.id, status, index],
+        |w| {
+            if status == 0 {
+                let m = w.open(0x30);
+                body(w);
+                w.close(m);
+            } else if status == err::TOO_BIG {
+                let m = w.open(0x30);
+                w.close(m);
+            } else {
+                body(w);
+            }
+        },
+    );
     w.finish()
+}
+
+/// Writes one SNMP message (RFC 1157, RFC 3416) into `w`: the SEQUENCE of
+/// `version`, `community` and the PDU tagged `pdu`, which holds the three
+/// INTEGERs `ints` (request-id, then error-status and error-index, or
+/// non-repeaters and max-repetitions) and what `bindings` writes after them
+/// (the variable-binding list).
+pub fn message(
+    w: &mut Writer,
+    version: i32,
+    community: &[u8],
+    pdu: u8,
+    ints: [i32; 3],
+    bindings: impl FnOnce(&mut Writer),
+) {
+    let top = w.open(0x30);
+    w.int(0x02, version);
+    w.prim(0x04, community);
+    let p = w.open(pdu);
+    for x in ints {
+        w.int(0x02, x);
+    }
+    bindings(w);
+    w.close(p);
+    w.close(top);
 }
 
 #[cfg(test)]

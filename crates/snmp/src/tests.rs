@@ -111,23 +111,16 @@ fn req(
 ) -> ([u8; 1600], usize) {
     let mut buf = [0u8; 1600];
     let mut w = Writer::new(&mut buf);
-    let t = w.open(0x30);
-    w.int(2, v);
-    w.prim(4, c);
-    let p = w.open(pdu);
-    w.int(2, id);
-    w.int(2, a);
-    w.int(2, b);
-    let l = w.open(0x30);
-    for (o, tag, val) in vbs {
-        let m = w.open(0x30);
-        w.oid(o);
-        w.prim(*tag, val);
-        w.close(m);
-    }
-    w.close(l);
-    w.close(p);
-    w.close(t);
+    message(&mut w, v, c, pdu, [id, a, b], |w| {
+        let l = w.open(0x30);
+        for (o, tag, val) in vbs {
+            let m = w.open(0x30);
+            w.oid(o);
+            w.prim(*tag, val);
+            w.close(m);
+        }
+        w.close(l);
+    });
     let n = w.finish().unwrap();
     (buf, n)
 }

@@ -29,7 +29,7 @@ use drive_pn::PnParamFlash as ParamFlash;
 use drive_pn::{Hardware, PnDrive};
 use firmware::systick::{now as now_ticks, ticks};
 use nanos::Nanos;
-use profinet::cm::{CmEvent, ImData};
+use profinet::cm::CmEvent;
 use profinet::device::{DeviceEvent, RtEvent};
 use profinet::testing;
 use stm32f4 as _; // the interrupt vectors
@@ -47,15 +47,9 @@ const A150_FAST_US: u32 = 250;
 
 type Drive = PnDrive<ParamFlash>;
 
+/// The board data of the scripted controller's device.
 fn hardware() -> Hardware {
-    let c = testing::device_config();
-    Hardware {
-        mac: c.mac,
-        port_macs: c.port_macs,
-        im0: c.im0,
-        im: ImData::default(),
-        boot_time: 1,
-    }
+    Hardware::from(testing::device_config())
 }
 
 /// Running figures of one measurement.

@@ -87,18 +87,9 @@ async fn cycle(
     read_inputs(group, md)
 }
 
+/// The CiA 402 state name of a statusword, "?" for none.
 fn state_name(sw: u16) -> &'static str {
-    match sw & 0x6F {
-        0x00 | 0x20 => "Not ready to switch on",
-        0x40 | 0x60 => "Switch on disabled",
-        0x21 => "Ready to switch on",
-        0x23 => "Switched on",
-        0x27 => "Operation enabled",
-        0x07 => "Quick stop active",
-        0x0F | 0x2F => "Fault reaction active",
-        0x08 | 0x28 => "Fault",
-        _ => "?",
-    }
+    cia402::State::from_statusword(sw).map_or("?", cia402::State::name)
 }
 
 /// Runs master cycles with `cw` until `done(inputs)` or `max` cycles.
@@ -161,7 +152,7 @@ async fn motion_demo(
     i = until(group, md, sim, (0x0F, 8, hold), 50, |i| i.mode == 8).await?;
     // the profile: 10 revolutions out and back, cosine S-curves of 1.5 s each
     let (p0, dist, t_move) = (i.pos, 10.0 * INC_PER_REV, 1500usize);
-    let total = 2 * t_move + 300;
+    let total = hil_sim::sim::profile::cycles(t_move);
     let bar = indicatif::ProgressBar::new(total as u64);
     bar.set_style(
         indicatif::ProgressStyle::with_template("  csp profile [{bar:40}] {pos}/{len} cycles")
@@ -169,16 +160,7 @@ async fn motion_demo(
     );
     let mut trace = hil_sim::plot::Trace::default();
     for k in 0..total {
-        let phase = |k: usize| (1.0 - (std::f64::consts::PI * k as f64 / t_move as f64).cos()) / 2.0;
-        let x = if k < t_move {
-            phase(k)
-        } else if k < t_move + 150 {
-            1.0
-        } else if k < 2 * t_move + 150 {
-            1.0 - phase(k - t_move - 150)
-        } else {
-            0.0
-        };
+        let x = hil_sim::sim::profile::fraction(k, t_move);
         let target = p0.wrapping_add((x * dist).round() as i32);
         write_outputs(group, md, 0x0F, 8, target)?;
         i = cycle(group, md, sim).await?;

@@ -66,7 +66,6 @@ import logging
 import sys
 import threading
 import time
-import traceback
 
 import profinet
 from profinet import dcp, rpc
@@ -89,31 +88,11 @@ from profinet.util import ethernet_socket, get_mac, mac2s, s2mac
 
 from pnargs import device_arguments
 from pnctl import Records, tx_checksum_offload_off
-
-
-failures = []
-
-
-
-def report(step, ok, text):
-    word = "ok" if ok else "FAIL"
-    if not ok:
-        failures.append(step)
-    print(f"step {step}: {word}: {text}", flush=True)
+from steps import failures, report, run
 
 
 def expected_fail(step, text):
     print(f"step {step}: expected-fail: {text}", flush=True)
-
-
-def run(step, fn):
-    """Runs one step; an exception is the step's failure (with its traceback)."""
-    try:
-        return fn()
-    except Exception as e:  # noqa: BLE001 - every failure is reported the same way
-        tb = traceback.format_exc().strip().replace("\n", "\n    ")
-        report(step, False, f"{type(e).__name__}: {e}\n    {tb}")
-        return None
 
 
 def release(con):

@@ -49,7 +49,6 @@ import struct
 import subprocess
 import sys
 import time
-import traceback
 import uuid
 
 from scapy.contrib.pnio import ProfinetIO
@@ -60,31 +59,16 @@ from scapy.layers.l2 import ARP, Ether
 
 import tia_lib as t
 from pnargs import device_arguments
+from steps import failures, report, run
 
-failures = []
 NETLOAD_MAC = "02:4e:4c:00:00:01"
 NETLOAD_IP = "192.168.0.99"
 NOT_SERVED = "not served yet (issue 32.4)"
 
 
-def report(step, ok, text):
-    if not ok:
-        failures.append(step)
-    print(f"step {step}: {'ok' if ok else 'FAIL'}: {text}", flush=True)
-
-
 def expected_fail(step, text):
     # issue 32.4 is served now: what was an expected failure is a failure
     report(step, False, text.replace(NOT_SERVED, "issue 32.4 says the device serves it"))
-
-
-def run(step, fn):
-    try:
-        return fn()
-    except Exception as e:  # noqa: BLE001 - every failure is reported the same way
-        tb = traceback.format_exc().strip().replace("\n", "\n    ")
-        report(step, False, f"{type(e).__name__}: {e}\n    {tb}")
-        return None
 
 
 def dcp_request(link, dst, fid, service, blocks, xid, delay=0):

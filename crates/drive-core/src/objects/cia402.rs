@@ -9,6 +9,7 @@
 //! actual values [`Value::Live`] (fed by the CiA 402 and motion code),
 //! configuration is saved.
 
+use super::shorthand::e;
 use super::{count_entry, repeat, Object, Value};
 use od::DataType::{I16, I32, I8, U16, U32, U8};
 use od::{Access, DataType, EntryInfo, ObjectCode::*};
@@ -16,9 +17,6 @@ use od::{Access, DataType, EntryInfo, ObjectCode::*};
 const RO: Access = Access::RO;
 const RW: Access = Access::RW;
 const WO: Access = Access::WO;
-const fn e(sub: u8, name: &'static str, t: DataType, a: Access) -> EntryInfo {
-    EntryInfo::new(sub, name, t, a)
-}
 /// A read-write, RxPDO- and TxPDO-mappable entry.
 const fn rt(sub: u8, name: &'static str, t: DataType) -> EntryInfo {
     e(sub, name, t, RW).rx().tx()

@@ -1,6 +1,7 @@
 //! Communication area 1000h–1FFFh (ETG.1000.6, ETG.1020) and the modular
 //! device objects F0xxh (ETG.5000.1), as listed in `od-ethercat.md` parts 1–3.
 
+use super::shorthand::e;
 use super::{count_entry, repeat, Object, Value};
 use crate::pdo_maps::{RX_A, RX_B, TX_A, TX_B};
 use crate::{DEVICE_NAME, DEVICE_TYPE, HARDWARE_VERSION, MAPPING_ENTRIES, SERIAL, SOFTWARE_BUILD};
@@ -12,9 +13,6 @@ use od::{Access, EntryInfo, ObjectCode::*};
 const RO: Access = Access::RO;
 const RW: Access = Access::RW;
 const RW_PREOP: Access = Access::RW_PREOP;
-const fn e(sub: u8, name: &'static str, t: od::DataType, a: Access) -> EntryInfo {
-    EntryInfo::new(sub, name, t, a)
-}
 
 /// Entries of a diagnosis message (10F3h:06…): ETG.1020 header (diag code
 /// UINT32, flags UINT16, text ID UINT16, time stamp UINT64) + up to 12 bytes

@@ -8,37 +8,13 @@
 //! Merged with [`super::manufacturer::PARAMS`] into one sorted list
 //! ([`super::MANUFACTURER_A`]).
 
+use super::shorthand::{a, c, e, f, g, i_};
 use super::{Object, Value};
-use crate::parameter_index;
+use od::Access;
 use od::DataType::{U16, U32, U8};
-
-use od::{Access, DataType, EntryInfo};
 
 const RW: Access = Access::RW;
 const RW_PREOP: Access = Access::RW_PREOP;
-const fn e(sub: u8, name: &'static str, t: DataType, a: Access) -> EntryInfo {
-    EntryInfo::new(sub, name, t, a)
-}
-/// Group A parameter `line`.
-const fn a(line: u16) -> u16 {
-    parameter_index(0, line)
-}
-/// Group C parameter `line`.
-const fn c(line: u16) -> u16 {
-    parameter_index(2, line)
-}
-/// Group I parameter `line`.
-const fn i_(line: u16) -> u16 {
-    parameter_index(8, line)
-}
-/// Group F parameter `line`.
-const fn f(line: u16) -> u16 {
-    parameter_index(5, line)
-}
-/// Group G parameter `line`.
-const fn g(line: u16) -> u16 {
-    parameter_index(6, line)
-}
 
 /// One revolution, increments (the native user unit).
 const REV_INC: i64 = 1 << 20;

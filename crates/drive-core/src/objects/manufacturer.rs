@@ -9,29 +9,15 @@
 //! no type or range, the note says what was assumed. Levels: the access level
 //! (A10\[2\]) needed to see a parameter (E-016).
 
+use super::shorthand::{a, e, e_, i_};
 use super::{comm, repeat, Object, Value};
-use crate::{parameter_index, DEVICE_NAME, HARDWARE_VERSION, SOFTWARE_VERSION};
+use crate::{DEVICE_NAME, HARDWARE_VERSION, SOFTWARE_VERSION};
 use od::DataType::{Bool, OctetString, VisibleString, I32, U16, U32, U8};
 use od::{Access, DataType, EntryInfo, ObjectCode::*};
 
 const RO: Access = Access::RO;
 const RW: Access = Access::RW;
 const RW_PREOP: Access = Access::RW_PREOP;
-const fn e(sub: u8, name: &'static str, t: DataType, a: Access) -> EntryInfo {
-    EntryInfo::new(sub, name, t, a)
-}
-/// Group A parameter `line`.
-const fn a(line: u16) -> u16 {
-    parameter_index(0, line)
-}
-/// Group E parameter `line`.
-const fn e_(line: u16) -> u16 {
-    parameter_index(4, line)
-}
-/// Group I parameter `line`.
-const fn i_(line: u16) -> u16 {
-    parameter_index(8, line)
-}
 
 /// A66: the sources of the 16 bits of A67, one per element (C-143).
 const A66_ELEMENTS: [EntryInfo; 16] = repeat(

@@ -72,6 +72,7 @@ mod pack;
 pub mod records;
 pub mod scaling;
 pub mod scope;
+mod shorthand;
 pub mod single;
 pub mod stage;
 

@@ -28,20 +28,13 @@
 //! the rest (docs/conformance.md, decisions). The special records (homing
 //! 256 … 258, jog 259/260, the fieldbus' own record 266) are per axis.
 
+use super::shorthand::{e, j};
 use super::{Object, Value};
-use crate::parameter_index;
 use od::DataType::{OctetString, I32, U16, U32, U8};
-use od::{Access, DataType, EntryInfo};
+use od::{Access, EntryInfo};
 
 const RO: Access = Access::RO;
 const RW: Access = Access::RW;
-const fn e(sub: u8, name: &'static str, t: DataType, a: Access) -> EntryInfo {
-    EntryInfo::new(sub, name, t, a)
-}
-/// Group J parameter `line`.
-const fn j(line: u16) -> u16 {
-    parameter_index(9, line)
-}
 
 /// J400 record selector.
 pub const J400: u16 = j(400);

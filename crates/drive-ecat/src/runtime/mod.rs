@@ -380,20 +380,35 @@ impl<F: Flash, B: Flash> Drive<F, B> {
         extra: &mut L,
     ) -> Result<(), P::Error> {
         self.update_live();
+        self.with_mailbox(extra, |slave, app, foe, eoe| {
+            slave.poll_mailbox_only(pdi, app, foe, eoe, now)
+        })
+    }
+
+    /// `f` on the slave stack with one poll's mailbox services: the
+    /// dictionary's parameter channel (the diagnosis history and `extra` as
+    /// live values), the firmware slots' FoE handler and the EoE queue; an
+    /// image the handler stored is kept for
+    /// [`take_firmware_stored`](Self::take_firmware_stored) when `f` succeeds.
+    fn with_mailbox<L: LiveValues, R, E>(
+        &mut self,
+        extra: &mut L,
+        f: impl FnOnce(
+            &mut Slave,
+            &mut EcatApp<'_, Live<'_, L>>,
+            &mut FirmwareFoe<'_, B>,
+            &mut ecat::eoe_queue::EoeQueue,
+        ) -> Result<R, E>,
+    ) -> Result<R, E> {
         let mut live = Live {
             diag: &mut self.diag,
             extra,
         };
         let mut foe = FirmwareFoe::new(self.boot.as_mut());
-        self.slave.poll_mailbox_only(
-            pdi,
-            &mut EcatApp(self.objects.parameter_channel(&mut live)),
-            &mut foe,
-            &mut self.eoe,
-            now,
-        )?;
+        let app = &mut EcatApp(self.objects.parameter_channel(&mut live));
+        let r = f(&mut self.slave, app, &mut foe, &mut self.eoe)?;
         self.firmware_stored = foe.stored().or(self.firmware_stored);
-        Ok(())
+        Ok(r)
     }
 
     /// The FoE download verified and stored since the last call (issue 33):
@@ -437,25 +452,13 @@ impl<F: Flash, B: Flash> Drive<F, B> {
             self.process_inputs();
         }
         self.slave.set_sync_state(self.sync_state());
-        let mut live = Live {
-            diag: &mut self.diag,
-            extra,
-        };
-        let mut foe = FirmwareFoe::new(self.boot.as_mut());
-        let change = if mailbox {
-            let change = self.slave.poll_with_eoe(
-                pdi,
-                &mut EcatApp(self.objects.parameter_channel(&mut live)),
-                &mut foe,
-                &mut self.eoe,
-                now,
-            )?;
-            self.firmware_stored = foe.stored().or(self.firmware_stored);
-            change
-        } else {
-            self.slave
-                .poll_esc(pdi, &mut EcatApp(self.objects.parameter_channel(&mut live)), now)?
-        };
+        let change = self.with_mailbox(extra, |slave, app, foe, eoe| {
+            if mailbox {
+                slave.poll_with_eoe(pdi, app, foe, eoe, now)
+            } else {
+                slave.poll_esc(pdi, app, now)
+            }
+        })?;
         if self.slave.take_error_ack() {
             // the master acknowledged the error: a latched PLL fault goes
             // (a new one latches again at the next occurrence)

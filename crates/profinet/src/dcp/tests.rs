@@ -4,7 +4,7 @@ use std::vec::Vec;
 
 use super::pdu::*;
 use super::*;
-use crate::wire::{emit_header, ethertype, EthFrame, MacAddr};
+use crate::wire::{EthFrame, MacAddr};
 use core::net::Ipv4Addr;
 use nanos::Nanos;
 
@@ -50,24 +50,7 @@ fn request(
     delay: u16,
     blocks: &[BlockRepr<'_>],
 ) -> Vec<u8> {
-    let mut buf = [0u8; 1514];
-    let eth = emit_header(&mut buf, dst, src, None, ethertype::PROFINET).unwrap();
-    buf[eth..eth + 2].copy_from_slice(&frame_id.to_be_bytes());
-    let mut w = BlockWriter::new(&mut buf[eth + 2 + HEADER_LEN..]);
-    for b in blocks {
-        w.push(b).unwrap();
-    }
-    let n = w.len();
-    Header {
-        service,
-        service_type: service_type::REQUEST,
-        xid: 0x0102_0304,
-        response_delay: delay,
-        data_length: n as u16,
-    }
-    .emit(&mut buf[eth + 2..])
-    .unwrap();
-    buf[..eth + 2 + HEADER_LEN + n].to_vec()
+    crate::testing::dcp_request(dst, src, frame_id, service, 0x0102_0304, delay, blocks).to_vec()
 }
 
 fn filter(kind: BlockType, value: Value<'_>) -> BlockRepr<'_> {
