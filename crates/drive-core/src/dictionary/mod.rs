@@ -390,6 +390,11 @@ impl DriveObjects {
     /// The integer value of `index`:`sub` ("EtherCAT Rx SDO Info" numbering,
     /// aliases followed; live entries as last set in the RAM image).
     pub fn get(&self, index: u16, sub: u8) -> Result<i64, SdoAbort> {
+        // a cached entry straight from its packed words (issue 36: the
+        // snapshot's ~250 reads after a configuration change)
+        if let Some(v) = cached(index, sub).and_then(|(word, value)| load_packed(&self.image, word, value)) {
+            return v;
+        }
         if let Some(r) = resolve(index, sub) {
             return match r.place {
                 Place::Ram(at) => load(&self.image, usize::from(at), r.data_type),
