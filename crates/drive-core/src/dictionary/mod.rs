@@ -413,6 +413,21 @@ impl DriveObjects {
     /// "EtherCAT Rx SDO Info" numbering; entries without a RAM slot
     /// (constants) answer 0601 0002h.
     pub fn set(&mut self, index: u16, sub: u8, value: i64) -> Result<(), SdoAbort> {
+        // a cached RAM integer straight from its packed words (issue 36)
+        if let Some(r) =
+            cached(index, sub).and_then(|(word, at)| store_packed(&mut self.image, word, at, value))
+        {
+            return r.map(|config| {
+                if config {
+                    self.config_changed_at(index);
+                }
+            });
+        }
+        self.set_general(index, sub, value)
+    }
+
+    /// [`set`](Self::set) through the entry's resolution.
+    fn set_general(&mut self, index: u16, sub: u8, value: i64) -> Result<(), SdoAbort> {
         let resolved = resolve(index, sub);
         let t = match resolved {
             Some(r) => r.data_type,

@@ -291,6 +291,61 @@ pub(super) fn load_packed(image: &[u8], word: u32, value: u32) -> Option<Result<
     Some(v.ok_or(SdoAbort::GENERAL))
 }
 
+/// [`DriveObjects::set`] of a cached RAM integer of up to 32 bits (type
+/// codes 1…7) from its packed words: its range check and store, answering
+/// whether a configuration entry changed; `None` for the other entries
+/// (the general path).
+#[inline(always)]
+pub(super) fn store_packed(
+    image: &mut [u8],
+    word: u32,
+    at: u32,
+    value: i64,
+) -> Option<Result<bool, SdoAbort>> {
+    if word & CONST_FLAG != 0 {
+        return None;
+    }
+    // (min, max, bytes) of Bool, I8, I16, I32, U8, U16, U32
+    let (min, max, n) = match word & 0x3F {
+        1 => (0, 1, 1),
+        2 => (i64::from(i8::MIN), i64::from(i8::MAX), 1),
+        3 => (i64::from(i16::MIN), i64::from(i16::MAX), 2),
+        4 => (i64::from(i32::MIN), i64::from(i32::MAX), 4),
+        5 => (0, i64::from(u8::MAX), 1),
+        6 => (0, i64::from(u16::MAX), 2),
+        7 => (0, i64::from(u32::MAX), 4),
+        _ => return None,
+    };
+    if value < min {
+        return Some(Err(SdoAbort::VALUE_TOO_LOW));
+    }
+    if value > max {
+        return Some(Err(SdoAbort::VALUE_TOO_HIGH));
+    }
+    let at = usize::from(u16::try_from(at).ok()?);
+    let [b0, b1, b2, b3, ..] = value.to_le_bytes();
+    let changed = match n {
+        1 => put_if_changed(image, at, [b0]),
+        2 => put_if_changed(image, at, [b0, b1]),
+        _ => put_if_changed(image, at, [b0, b1, b2, b3]),
+    };
+    Some(
+        changed
+            .map(|c| c && word & CONFIG_FLAG != 0)
+            .ok_or(SdoAbort::GENERAL),
+    )
+}
+
+/// Writes `new` at `at` when it differs from the bytes there; whether it
+/// did, `None` outside `image`.
+#[inline(always)]
+fn put_if_changed<const N: usize>(image: &mut [u8], at: usize, new: [u8; N]) -> Option<bool> {
+    let old = <&mut [u8; N]>::try_from(image.get_mut(at..at + N)?).ok()?;
+    let changed = *old != new;
+    *old = new;
+    Some(changed)
+}
+
 /// The packed words of `index`:`sub` when the cache holds them (no
 /// insertion: a miss is [`resolve`]'s).
 #[inline(always)]
@@ -358,6 +413,66 @@ mod tests {
                 DataType::U64,
             ]
         );
+    }
+
+    /// Every cached RAM integer stores from its packed words as the general
+    /// path of [`DriveObjects::set`] does: the same answer, image and
+    /// configuration generations, for values in, at and beyond its range.
+    #[test]
+    fn packed_stores_answer_as_the_general_set() {
+        let base = DriveObjects::new();
+        let mut checked = 0;
+        for o in OBJECTS {
+            for sub in 0..=u8::MAX {
+                let key = (u32::from(o.info.index) << 8) | u32::from(sub);
+                let Some((word, at)) = lookup(key).and_then(Resolved::pack) else {
+                    continue;
+                };
+                for value in [
+                    0,
+                    1,
+                    -1,
+                    127,
+                    128,
+                    -129,
+                    255,
+                    256,
+                    65_535,
+                    65_536,
+                    -32_769,
+                    i64::from(u32::MAX),
+                    1 << 32,
+                    i64::MIN,
+                ] {
+                    let mut fast = base.clone();
+                    let mut general = base.clone();
+                    let Some(r) = store_packed(&mut fast.image, word, at, value) else {
+                        continue;
+                    };
+                    let r = r.map(|config| {
+                        if config {
+                            fast.config_changed_at(o.info.index);
+                        }
+                    });
+                    assert_eq!(
+                        r,
+                        general.set_general(o.info.index, sub, value),
+                        "{key:06X} {value}"
+                    );
+                    assert!(fast == general, "{key:06X} {value}");
+                    assert_eq!(fast.config_generation(), general.config_generation());
+                    assert_eq!(
+                        [fast.axis_config_generation(0), fast.axis_config_generation(1)],
+                        [
+                            general.axis_config_generation(0),
+                            general.axis_config_generation(1)
+                        ]
+                    );
+                    checked += 1;
+                }
+            }
+        }
+        assert!(checked > 5000, "{checked}");
     }
 
     /// Every cacheable entry of the declaration loads from its packed words
