@@ -476,7 +476,14 @@ impl ProfileGenerator {
     /// Standstill at `position` (increments), e.g. the actual position when
     /// the mode becomes active; the last target becomes `position`.
     pub fn reset(&mut self, position: i32) {
-        *self = Self::new(position);
+        // every field as `new` leaves it but the plan: it is read only in
+        // `Mode::Plan`, which `start_plan` enters with a plan of its own (so
+        // does an ended plan, left behind in `Mode::Idle`). Not a whole new
+        // generator: its plan is ~540 bytes, two copies per call, and a
+        // disabled axis resets every control cycle (issue 36: ~1,000
+        // instructions per axis and cycle on QEMU)
+        self.start_plan(position, 0.0, None);
+        self.target = position;
     }
 
     /// Takes over a moving axis at `position` (increments) and `velocity`

@@ -194,8 +194,32 @@ pub(crate) fn int_size(t: DataType) -> Result<usize, PdError> {
 }
 
 /// Big-endian decode of `bytes` (1…8) as `t`: sign-extended for signed
-/// types, zero-extended otherwise.
+/// types, zero-extended otherwise. Two and four bytes (nearly every
+/// telegram entry) without the byte loop's 64-bit shifts (issue 36).
 pub(crate) fn decode_be(t: DataType, bytes: &[u8]) -> i64 {
+    match *bytes {
+        [a, b] => {
+            let v = u16::from_be_bytes([a, b]);
+            if t.signed() {
+                i64::from(v as i16)
+            } else {
+                i64::from(v)
+            }
+        }
+        [a, b, c, d] => {
+            let v = u32::from_be_bytes([a, b, c, d]);
+            if t.signed() {
+                i64::from(v as i32)
+            } else {
+                i64::from(v)
+            }
+        }
+        _ => decode_be_any(t, bytes),
+    }
+}
+
+/// [`decode_be`] of any length, byte by byte.
+fn decode_be_any(t: DataType, bytes: &[u8]) -> i64 {
     let mut v: u64 = 0;
     for b in bytes.iter().take(8) {
         v = (v << 8) | u64::from(*b);
@@ -209,8 +233,20 @@ pub(crate) fn decode_be(t: DataType, bytes: &[u8]) -> i64 {
     }
 }
 
-/// Big-endian encode of `value` into `out` (its low `out.len()` bytes).
+/// Big-endian encode of `value` into `out` (its low `out.len()` bytes);
+/// two and four bytes without the byte loop (issue 36).
 pub(crate) fn encode_be(value: i64, out: &mut [u8]) {
+    if let Ok(o) = <&mut [u8; 2]>::try_from(&mut *out) {
+        *o = (value as u16).to_be_bytes();
+    } else if let Ok(o) = <&mut [u8; 4]>::try_from(&mut *out) {
+        *o = (value as u32).to_be_bytes();
+    } else {
+        encode_be_any(value, out);
+    }
+}
+
+/// [`encode_be`] of any length, byte by byte.
+fn encode_be_any(value: i64, out: &mut [u8]) {
     let n = out.len();
     for (i, b) in out.iter_mut().enumerate() {
         let shift = 8 * (n - 1 - i);
@@ -226,5 +262,57 @@ pub(crate) fn fits(t: DataType, value: i64) -> bool {
         DataType::Bool => value == 0 || value == 1,
         DataType::U64 => true,
         _ => t.is_integer() && value >= t.min_value() && value <= t.max_value(),
+    }
+}
+
+#[cfg(test)]
+mod tests_be {
+    use super::*;
+
+    /// The two- and four-byte paths decode and encode as the byte loop.
+    #[test]
+    fn be_widths_answer_as_the_byte_loop() {
+        let types = [
+            DataType::Bool,
+            DataType::I8,
+            DataType::U8,
+            DataType::I16,
+            DataType::U16,
+            DataType::I32,
+            DataType::U32,
+            DataType::I64,
+            DataType::U64,
+        ];
+        let values = [
+            0i64,
+            1,
+            -1,
+            0x7F,
+            0x80,
+            0x7FFF,
+            0x8000,
+            -0x8000,
+            0xFFFF,
+            0x1234_5678,
+            i64::from(i32::MIN),
+            i64::from(u32::MAX),
+            i64::MIN,
+            i64::MAX,
+        ];
+        for v in values {
+            for n in 1..=8 {
+                let (mut fast, mut slow) = ([0u8; 8], [0u8; 8]);
+                encode_be(v, &mut fast[..n]);
+                encode_be_any(v, &mut slow[..n]);
+                assert_eq!(fast, slow, "{v} in {n}");
+                for t in types {
+                    assert_eq!(
+                        decode_be(t, &fast[..n]),
+                        decode_be_any(t, &fast[..n]),
+                        "{t:?} {n} {v}"
+                    );
+                }
+            }
+        }
     }
 }

@@ -390,6 +390,11 @@ impl DriveObjects {
     /// The integer value of `index`:`sub` ("EtherCAT Rx SDO Info" numbering,
     /// aliases followed; live entries as last set in the RAM image).
     pub fn get(&self, index: u16, sub: u8) -> Result<i64, SdoAbort> {
+        // a cached entry straight from its packed words (issue 36: the
+        // snapshot's ~250 reads after a configuration change)
+        if let Some(v) = cached(index, sub).and_then(|(word, value)| load_packed(&self.image, word, value)) {
+            return v;
+        }
         if let Some(r) = resolve(index, sub) {
             return match r.place {
                 Place::Ram(at) => load(&self.image, usize::from(at), r.data_type),
@@ -408,6 +413,21 @@ impl DriveObjects {
     /// "EtherCAT Rx SDO Info" numbering; entries without a RAM slot
     /// (constants) answer 0601 0002h.
     pub fn set(&mut self, index: u16, sub: u8, value: i64) -> Result<(), SdoAbort> {
+        // a cached RAM integer straight from its packed words (issue 36)
+        if let Some(r) =
+            cached(index, sub).and_then(|(word, at)| store_packed(&mut self.image, word, at, value))
+        {
+            return r.map(|config| {
+                if config {
+                    self.config_changed_at(index);
+                }
+            });
+        }
+        self.set_general(index, sub, value)
+    }
+
+    /// [`set`](Self::set) through the entry's resolution.
+    fn set_general(&mut self, index: u16, sub: u8, value: i64) -> Result<(), SdoAbort> {
         let resolved = resolve(index, sub);
         let t = match resolved {
             Some(r) => r.data_type,

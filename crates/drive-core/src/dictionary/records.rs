@@ -46,6 +46,18 @@ const J411_AT: [usize; 2] = [
 ];
 const _: () = assert!(J410_AT > 0 && J411_AT[0] > 0 && J411_AT[1] > 0);
 
+/// Where the values of the window J401 of axis A and B start in the image
+/// (compile time): sub 0, then the elements \[0\] (INTEGER32), \[1\]…\[5\]
+/// (UNSIGNED32) and \[6\] (UNSIGNED8).
+const J401_AT: [usize; 2] = [
+    objects::image_offset(J401),
+    objects::image_offset(J401 + AXIS_B_MANUFACTURER),
+];
+const _: () = assert!(J401_AT[0] > 0 && J401_AT[1] > 0);
+
+/// Bytes of the window's elements \[0\]…\[6\].
+const WINDOW_BYTES: usize = 6 * 4 + 1;
+
 /// Where J411 of `axis` starts in the image.
 fn j411_at(axis: u8) -> usize {
     if axis == 0 {
@@ -185,8 +197,43 @@ impl DriveObjects {
         }
     }
 
-    /// Shows record `n` of `axis` in the window J401.
+    /// Shows record `n` of `axis` in the window J401: its elements written
+    /// straight into the image, as the `set` of each (set-points: no
+    /// configuration change; every value in its type's range) would, with
+    /// \[3\] and \[5\] synchronised (issue 36: eight `set`s per telegram
+    /// that writes a record's fields).
     fn show_record(&mut self, axis: u8, n: u16) {
+        let Some(r) = self.record(axis, n) else {
+            return;
+        };
+        let mut w = [0u8; WINDOW_BYTES];
+        let words = [
+            r.target as u32,
+            r.profile_velocity,
+            r.end_velocity,
+            r.acceleration,
+            r.deceleration,
+            r.acceleration,
+        ];
+        for (dst, v) in w.chunks_exact_mut(4).zip(words) {
+            copy(dst, &v.to_le_bytes());
+        }
+        if let Some(last) = w.last_mut() {
+            *last = r.options;
+        }
+        let at = if axis == 0 { J401_AT[0] } else { J401_AT[1] } + 1;
+        if let Some(dst) = self.image.get_mut(at..at + WINDOW_BYTES) {
+            copy(dst, &w);
+        }
+        if let Some(seen) = self.all_accelerations.get_mut(usize::from(axis)) {
+            *seen = r.acceleration;
+        }
+    }
+
+    /// [`show_record`](Self::show_record) through `set` (the reference of
+    /// its test).
+    #[cfg(test)]
+    pub(crate) fn show_record_by_set(&mut self, axis: u8, n: u16) {
         let Some(r) = self.record(axis, n) else {
             return;
         };
@@ -252,6 +299,70 @@ impl DriveObjects {
         for axis in [0, 1] {
             let n = self.record_selector(axis);
             self.show_record(axis, n);
+        }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// The window shows a record as the `set`s of its elements did: image,
+    /// synchronised "all accelerations" and generations the same, on both
+    /// axes, for standard and per-axis records.
+    #[test]
+    fn the_window_shows_a_record_as_its_sets_did() {
+        let base = DriveObjects::new();
+        let records = [
+            (
+                0u16,
+                Record {
+                    target: -123_456,
+                    profile_velocity: u32::MAX,
+                    end_velocity: 7,
+                    acceleration: 0x0102_0304,
+                    deceleration: 99,
+                    options: 3,
+                },
+            ),
+            (
+                266,
+                Record {
+                    target: i32::MIN,
+                    profile_velocity: 1,
+                    end_velocity: 0,
+                    acceleration: 0,
+                    deceleration: u32::MAX,
+                    options: 0,
+                },
+            ),
+            (
+                267,
+                Record {
+                    target: i32::MAX,
+                    profile_velocity: 5000,
+                    end_velocity: 400,
+                    acceleration: 10_000,
+                    deceleration: 20_000,
+                    options: 1,
+                },
+            ),
+        ];
+        for axis in [0u8, 1] {
+            for (n, r) in records {
+                let mut od = base.clone();
+                assert!(od.store_record(axis, n, &r));
+                // the window showed something else
+                let _ = od.set(at_axis(J401, axis), data_sub(5), 5);
+                let _ = od.set(at_axis(J401, axis), data_sub(0), -1);
+                let mut reference = od.clone();
+                od.show_record(axis, n);
+                reference.show_record_by_set(axis, n);
+                assert!(od == reference, "axis {axis} record {n}");
+                assert_eq!(od.all_accelerations, reference.all_accelerations);
+                assert_eq!(od.config_generation(), reference.config_generation());
+                assert_eq!(od.record(axis, n).map(|x| x.target), Some(r.target));
+            }
         }
     }
 }

@@ -263,6 +263,106 @@ pub(super) fn resolve(index: u16, sub: u8) -> Option<Resolved> {
     lookup(key)
 }
 
+/// The value of a cached entry straight from its two packed words (what
+/// [`Resolved::unpack`] and [`load`] answer together, without building the
+/// [`Resolved`]): `None` when the words do not unpack.
+#[inline(always)]
+pub(super) fn load_packed(image: &[u8], word: u32, value: u32) -> Option<Result<i64, SdoAbort>> {
+    let code = (word & 0x3F) as usize;
+    if word & CONST_FLAG != 0 {
+        let t = *CACHED_TYPES.get(code.checked_sub(1)?)?;
+        return Some(Ok(match t {
+            DataType::I8 | DataType::I16 | DataType::I32 => i64::from(value as i32),
+            _ => i64::from(value),
+        }));
+    }
+    let at = usize::from(u16::try_from(value).ok()?);
+    // the codes are the positions in `CACHED_TYPES` + 1
+    // (`packed_codes_follow_the_cached_types`)
+    let v = match code {
+        1 | 5 => bytes_at::<1>(image, at).map(|[b]| i64::from(b)),
+        2 => bytes_at::<1>(image, at).map(|[b]| i64::from(b as i8)),
+        3 => bytes_at(image, at).map(|b| i64::from(i16::from_le_bytes(b))),
+        4 => bytes_at(image, at).map(|b| i64::from(i32::from_le_bytes(b))),
+        6 => bytes_at(image, at).map(|b| i64::from(u16::from_le_bytes(b))),
+        7 => bytes_at(image, at).map(|b| i64::from(u32::from_le_bytes(b))),
+        _ => return Some(load(image, at, *CACHED_TYPES.get(code.checked_sub(1)?)?)),
+    };
+    Some(v.ok_or(SdoAbort::GENERAL))
+}
+
+/// [`DriveObjects::set`] of a cached RAM integer of up to 32 bits (type
+/// codes 1…7) from its packed words: its range check and store, answering
+/// whether a configuration entry changed; `None` for the other entries
+/// (the general path).
+#[inline(always)]
+pub(super) fn store_packed(
+    image: &mut [u8],
+    word: u32,
+    at: u32,
+    value: i64,
+) -> Option<Result<bool, SdoAbort>> {
+    if word & CONST_FLAG != 0 {
+        return None;
+    }
+    // (min, max, bytes) of Bool, I8, I16, I32, U8, U16, U32
+    let (min, max, n) = match word & 0x3F {
+        1 => (0, 1, 1),
+        2 => (i64::from(i8::MIN), i64::from(i8::MAX), 1),
+        3 => (i64::from(i16::MIN), i64::from(i16::MAX), 2),
+        4 => (i64::from(i32::MIN), i64::from(i32::MAX), 4),
+        5 => (0, i64::from(u8::MAX), 1),
+        6 => (0, i64::from(u16::MAX), 2),
+        7 => (0, i64::from(u32::MAX), 4),
+        _ => return None,
+    };
+    if value < min {
+        return Some(Err(SdoAbort::VALUE_TOO_LOW));
+    }
+    if value > max {
+        return Some(Err(SdoAbort::VALUE_TOO_HIGH));
+    }
+    let at = usize::from(u16::try_from(at).ok()?);
+    let [b0, b1, b2, b3, ..] = value.to_le_bytes();
+    let changed = match n {
+        1 => put_if_changed(image, at, [b0]),
+        2 => put_if_changed(image, at, [b0, b1]),
+        _ => put_if_changed(image, at, [b0, b1, b2, b3]),
+    };
+    Some(
+        changed
+            .map(|c| c && word & CONFIG_FLAG != 0)
+            .ok_or(SdoAbort::GENERAL),
+    )
+}
+
+/// Writes `new` at `at` when it differs from the bytes there; whether it
+/// did, `None` outside `image`.
+#[inline(always)]
+fn put_if_changed<const N: usize>(image: &mut [u8], at: usize, new: [u8; N]) -> Option<bool> {
+    let old = <&mut [u8; N]>::try_from(image.get_mut(at..at + N)?).ok()?;
+    let changed = *old != new;
+    *old = new;
+    Some(changed)
+}
+
+/// The packed words of `index`:`sub` when the cache holds them (no
+/// insertion: a miss is [`resolve`]'s).
+#[inline(always)]
+pub(super) fn cached(index: u16, sub: u8) -> Option<(u32, u32)> {
+    let key = (u32::from(index) << 8) | u32::from(sub);
+    let mut at = home_slot(key);
+    for _ in 0..MAX_PROBES {
+        let (k, a) = (CACHE_KEYS.get(at)?, CACHE_AT.get(at)?);
+        match k.load(Ordering::Acquire) {
+            0 | BUSY => return None,
+            word if word >> 8 == key => return Some((word, a.load(Ordering::Relaxed))),
+            _ => at = (at + 1) % CACHE_SLOTS,
+        }
+    }
+    None
+}
+
 /// Resolves `key` from the declaration: `None` for entries that are not
 /// an integer/REAL32 in RAM or a constant (strings, 1018h, commands, unknown).
 pub(super) fn lookup(key: u32) -> Option<Resolved> {
@@ -289,4 +389,116 @@ pub(super) fn lookup(key: u32) -> Option<Resolved> {
         data_type,
         config: is_config(o),
     })
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// The codes [`load_packed`] matches on are these positions + 1.
+    #[test]
+    fn packed_codes_follow_the_cached_types() {
+        assert_eq!(
+            CACHED_TYPES,
+            [
+                DataType::Bool,
+                DataType::I8,
+                DataType::I16,
+                DataType::I32,
+                DataType::U8,
+                DataType::U16,
+                DataType::U32,
+                DataType::F32,
+                DataType::I64,
+                DataType::U64,
+            ]
+        );
+    }
+
+    /// Every cached RAM integer stores from its packed words as the general
+    /// path of [`DriveObjects::set`] does: the same answer, image and
+    /// configuration generations, for values in, at and beyond its range.
+    #[test]
+    fn packed_stores_answer_as_the_general_set() {
+        let base = DriveObjects::new();
+        let mut checked = 0;
+        for o in OBJECTS {
+            for sub in 0..=u8::MAX {
+                let key = (u32::from(o.info.index) << 8) | u32::from(sub);
+                let Some((word, at)) = lookup(key).and_then(Resolved::pack) else {
+                    continue;
+                };
+                for value in [
+                    0,
+                    1,
+                    -1,
+                    127,
+                    128,
+                    -129,
+                    255,
+                    256,
+                    65_535,
+                    65_536,
+                    -32_769,
+                    i64::from(u32::MAX),
+                    1 << 32,
+                    i64::MIN,
+                ] {
+                    let mut fast = base.clone();
+                    let mut general = base.clone();
+                    let Some(r) = store_packed(&mut fast.image, word, at, value) else {
+                        continue;
+                    };
+                    let r = r.map(|config| {
+                        if config {
+                            fast.config_changed_at(o.info.index);
+                        }
+                    });
+                    assert_eq!(
+                        r,
+                        general.set_general(o.info.index, sub, value),
+                        "{key:06X} {value}"
+                    );
+                    assert!(fast == general, "{key:06X} {value}");
+                    assert_eq!(fast.config_generation(), general.config_generation());
+                    assert_eq!(
+                        [fast.axis_config_generation(0), fast.axis_config_generation(1)],
+                        [
+                            general.axis_config_generation(0),
+                            general.axis_config_generation(1)
+                        ]
+                    );
+                    checked += 1;
+                }
+            }
+        }
+        assert!(checked > 5000, "{checked}");
+    }
+
+    /// Every cacheable entry of the declaration loads from its packed words
+    /// as its unpacked resolution does (RAM values over varied bytes,
+    /// constants of every type and sign).
+    #[test]
+    fn packed_loads_answer_as_unpack_and_load() {
+        let mut od = DriveObjects::new();
+        for (i, b) in od.image.iter_mut().enumerate() {
+            *b = (i as u8).wrapping_mul(37) ^ 0xA5;
+        }
+        let mut checked = 0;
+        for o in OBJECTS {
+            for sub in 0..=u8::MAX {
+                let key = (u32::from(o.info.index) << 8) | u32::from(sub);
+                let Some((word, value)) = lookup(key).and_then(Resolved::pack) else {
+                    continue;
+                };
+                let unpacked = Resolved::unpack(key, word, value).map(|r| match r.place {
+                    Place::Ram(at) => load(&od.image, usize::from(at), r.data_type),
+                    Place::Const(v) => Ok(v),
+                });
+                assert_eq!(load_packed(&od.image, word, value), unpacked, "{key:06X}");
+                checked += 1;
+            }
+        }
+        assert!(checked > 500, "{checked}");
+    }
 }

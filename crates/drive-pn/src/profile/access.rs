@@ -460,11 +460,17 @@ impl ParamAccess for DriveAccess<'_> {
 
     fn read(&mut self, addr: Addr) -> Result<i64, PdError> {
         self.flush_record();
-        if !lookup::is_catalogue_index(addr.index) {
-            let index = self.index(addr.index);
-            return self.read_object(index, addr.sub);
-        }
-        let p = lookup::find(addr)?;
+        // a catalogue entry the memo holds: no search (its index is one)
+        let p = match lookup::memoised(addr) {
+            Some(p) => p,
+            None => {
+                if !lookup::is_catalogue_index(addr.index) {
+                    let index = self.index(addr.index);
+                    return self.read_object(index, addr.sub);
+                }
+                lookup::find_and_remember(addr)?
+            }
+        };
         match p.source {
             Source::Object { index, sub } => {
                 let index = self.index(index);
@@ -501,13 +507,18 @@ impl ParamAccess for DriveAccess<'_> {
 
     fn write(&mut self, addr: Addr, value: i64, _cyclic: bool) -> Result<Completion, PdError> {
         // every write here is a RAM write: the store is written only by a save
-        if !lookup::is_catalogue_index(addr.index) {
-            self.flush_record();
-            let index = self.index(addr.index);
-            self.write_object(index, addr.sub, value)?;
-            return Ok(Completion::Done);
-        }
-        let p = lookup::find(addr)?;
+        let p = match lookup::memoised(addr) {
+            Some(p) => p,
+            None => {
+                if !lookup::is_catalogue_index(addr.index) {
+                    self.flush_record();
+                    let index = self.index(addr.index);
+                    self.write_object(index, addr.sub, value)?;
+                    return Ok(Completion::Done);
+                }
+                lookup::find_and_remember(addr)?
+            }
+        };
         if !matches!(p.source, Source::SelectedRecord(_) | Source::JogRecord(..)) {
             self.flush_record();
         }

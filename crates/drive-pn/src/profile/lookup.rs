@@ -7,12 +7,14 @@
 //! looked up and checked by the dictionary at each access.
 
 use super::pnu::{self, Pnu};
+use core::sync::atomic::{AtomicU32, Ordering};
 use drive_core::axis::Axis;
 use drive_core::{DriveObjects, Prepared, Slot};
 use od::CommState;
 use profidrive::{Addr, PdError};
 
-/// A catalogue address as one number, in the catalogue's order.
+/// A catalogue address as one number, in the catalogue's order:
+/// `index << 8 | sub` (24 bits).
 const fn key(a: Addr) -> u32 {
     (a.index as u32) << 8 | a.sub as u32
 }
@@ -34,13 +36,19 @@ static KEYS: [u32; pnu::CATALOGUE.len()] = {
 /// [`pnu::find`]: the entry of `addr`, 0x00 without the PNU, 0x03 without
 /// the subindex.
 pub fn find(addr: Addr) -> Result<&'static Pnu, PdError> {
+    let i = find_at(addr)?;
+    pnu::CATALOGUE.get(i).ok_or(PdError::IMPERMISSIBLE_PNU)
+}
+
+/// [`find`]'s position of `addr` in the catalogue.
+fn find_at(addr: Addr) -> Result<usize, PdError> {
     let c = pnu::CATALOGUE;
     // searched in the dense keys (4 bytes an entry, not the entries' own
     // stride): issue 36, some 10 lookups per telegram
     let i = KEYS.partition_point(|&k| k < key(addr));
     let here = c.get(i);
-    if let Some(p) = here.filter(|p| p.addr == addr) {
-        return Ok(p);
+    if here.is_some_and(|p| p.addr == addr) {
+        return Ok(i);
     }
     // the PNU's other subindices sit just before or at `i`
     let known = |p: Option<&Pnu>| p.is_some_and(|p| p.addr.index == addr.index);
@@ -49,6 +57,60 @@ pub fn find(addr: Addr) -> Result<&'static Pnu, PdError> {
     } else {
         PdError::IMPERMISSIBLE_PNU
     })
+}
+
+/// Places of the memo of catalogue entries found (a power of two).
+const MEMO_PLACES: usize = 32;
+
+/// Places a lookup in the memo tries from its home place.
+const MEMO_PROBES: usize = 4;
+
+/// The memo of [`find_and_remember`]: per place one word, the address'
+/// [`key`] in the top 24 bits and its catalogue position + 1 in the low 8
+/// (0 = free). A memo of the constant catalogue, shared by every profile
+/// and task: a word is written whole; an address takes the first free
+/// place of its probes, or its home place when none is (issue 36: the
+/// binary searches of a telegram's entries cost up to ~1,000 instructions
+/// per telegram on QEMU).
+static MEMO: [AtomicU32; MEMO_PLACES] = [const { AtomicU32::new(0) }; MEMO_PLACES];
+
+/// The places `key` may have in the memo, its home place first.
+fn memo_places(key: u32) -> impl Iterator<Item = &'static AtomicU32> {
+    let home = (key.wrapping_mul(0x9E37_79B1) >> 27) as usize;
+    (0..MEMO_PROBES).filter_map(move |j| MEMO.get((home + j) % MEMO_PLACES))
+}
+
+/// The catalogue entry of `addr` when the memo holds it: what [`find`]
+/// answers for an address [`find_and_remember`] found before; `None`
+/// otherwise (the caller takes the full path).
+pub fn memoised(addr: Addr) -> Option<&'static Pnu> {
+    let k = key(addr);
+    for place in memo_places(k) {
+        let word = place.load(Ordering::Relaxed);
+        if word >> 8 == k && word & 0xFF != 0 {
+            return pnu::CATALOGUE.get(usize::from(word as u8).checked_sub(1)?);
+        }
+        if word == 0 {
+            return None;
+        }
+    }
+    None
+}
+
+/// [`find`], the entry found remembered for [`memoised`].
+pub fn find_and_remember(addr: Addr) -> Result<&'static Pnu, PdError> {
+    let i = find_at(addr)?;
+    let k = key(addr);
+    if let Ok(n) = u8::try_from(i + 1) {
+        let free = memo_places(k).find(|p| {
+            let w = p.load(Ordering::Relaxed);
+            w == 0 || w >> 8 == k
+        });
+        if let Some(place) = free.or_else(|| memo_places(k).next()) {
+            place.store(k << 8 | u32::from(n), Ordering::Relaxed);
+        }
+    }
+    pnu::CATALOGUE.get(i).ok_or(PdError::IMPERMISSIBLE_PNU)
 }
 
 /// [`pnu::is_catalogue_index`].
@@ -242,6 +304,33 @@ mod tests {
                 find(Addr::new(index, 255)).map(|p| p.addr),
                 pnu::find(Addr::new(index, 255)).map(|p| p.addr)
             );
+        }
+    }
+
+    /// The memo of catalogue entries answers as [`find`] for every address
+    /// it answers at all, and holds an entry just found.
+    #[test]
+    fn the_memo_answers_as_find() {
+        let mut addrs: std::vec::Vec<Addr> = std::vec::Vec::new();
+        for p in pnu::CATALOGUE {
+            for sub in 0..=8 {
+                addrs.extend([Addr::new(p.addr.index, sub), Addr::new(p.addr.index + 1, sub)]);
+            }
+        }
+        addrs.extend([Addr::new(0, 0), Addr::new(0x6040, 0), Addr::new(u16::MAX, 255)]);
+        for round in 0..2 {
+            for &a in &addrs {
+                let found = find(a).map(|p| p.addr);
+                assert_eq!(find_and_remember(a).map(|p| p.addr), found, "{a:?}");
+                if found.is_ok() && round == 0 {
+                    assert_eq!(memoised(a).map(|p| p.addr), Some(a), "{a:?}");
+                }
+            }
+            for &a in &addrs {
+                if let Some(p) = memoised(a) {
+                    assert_eq!(Ok(p.addr), find(a).map(|p| p.addr), "{a:?}");
+                }
+            }
         }
     }
 

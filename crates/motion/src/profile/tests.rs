@@ -574,3 +574,53 @@ fn p137_unreachable_or_zero_end_velocity_stops_on_the_target() {
         assert!(!g.passed());
     }
 }
+
+#[test]
+fn reset_mid_move_behaves_as_a_new_generator() {
+    // `reset` keeps the old plan's memory (issue 36) but nothing of it may
+    // show: from a reset mid-move, mid-stop or mid-cruise every command and
+    // step gives what a new generator at the same position gives
+    let l = limits();
+    let starts: [fn(&mut ProfileGenerator); 3] = [
+        |g| {
+            g.move_to(PositionTarget::Absolute(900_000), limits(), SetMode::Immediate)
+                .unwrap();
+        },
+        |g| {
+            g.run_velocity(-2.0e6, limits()).unwrap();
+        },
+        |g| {
+            g.move_to(PositionTarget::Absolute(-400_000), limits(), SetMode::Immediate)
+                .unwrap();
+            for _ in 0..40 {
+                g.step(DT);
+            }
+            g.stop(5.0e8, 1.0e11).unwrap();
+        },
+    ];
+    for start in starts {
+        let mut g = ProfileGenerator::new(1000);
+        start(&mut g);
+        for _ in 0..25 {
+            g.step(DT);
+        }
+        g.reset(-7777);
+        let mut fresh = ProfileGenerator::new(-7777);
+        assert!(g.is_standstill());
+        assert_eq!(g.target(), fresh.target());
+        assert_eq!(g.current(), fresh.current());
+        assert_eq!(g.step(DT), fresh.step(DT));
+        g.move_to(PositionTarget::Additive(3000), l, SetMode::Immediate)
+            .unwrap();
+        fresh
+            .move_to(PositionTarget::Additive(3000), l, SetMode::Immediate)
+            .unwrap();
+        for _ in 0..2000 {
+            let (a, b) = (g.step(DT), fresh.step(DT));
+            assert_eq!(a, b);
+            if a.done {
+                break;
+            }
+        }
+    }
+}
