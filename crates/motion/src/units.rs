@@ -147,54 +147,46 @@ pub struct Fraction {
     den: u32,
 }
 
-/// [`gcd`] in 64 bits.
-const fn gcd64(mut a: u64, mut b: u64) -> u64 {
-    if a == 0 {
-        return b;
-    }
-    if b == 0 {
-        return a;
-    }
-    let shift = (a | b).trailing_zeros();
-    a >>= a.trailing_zeros();
-    loop {
-        b >>= b.trailing_zeros();
-        if a > b {
-            let t = a;
-            a = b;
-            b = t;
+/// Binary GCD (Stein) in `$t`: shifts and subtractions only; a 128-bit `%`
+/// is a long library loop on a 32-bit MCU. gcd(0, b) = b.
+macro_rules! binary_gcd {
+    ($(#[$doc:meta])* $name:ident, $t:ty) => {
+        $(#[$doc])*
+        const fn $name(mut a: $t, mut b: $t) -> $t {
+            if a == 0 {
+                return b;
+            }
+            if b == 0 {
+                return a;
+            }
+            let shift = (a | b).trailing_zeros();
+            a >>= a.trailing_zeros();
+            loop {
+                b >>= b.trailing_zeros();
+                if a > b {
+                    let t = a;
+                    a = b;
+                    b = t;
+                }
+                b -= a;
+                if b == 0 {
+                    return a << shift;
+                }
+            }
         }
-        b -= a;
-        if b == 0 {
-            return a << shift;
-        }
-    }
+    };
 }
 
-/// Binary GCD (Stein): shifts and subtractions only; a 128-bit `%` is a
-/// long library loop on a 32-bit MCU. gcd(0, b) = b.
-const fn gcd(mut a: u128, mut b: u128) -> u128 {
-    if a == 0 {
-        return b;
-    }
-    if b == 0 {
-        return a;
-    }
-    let shift = (a | b).trailing_zeros();
-    a >>= a.trailing_zeros();
-    loop {
-        b >>= b.trailing_zeros();
-        if a > b {
-            let t = a;
-            a = b;
-            b = t;
-        }
-        b -= a;
-        if b == 0 {
-            return a << shift;
-        }
-    }
-}
+binary_gcd!(
+    /// [`gcd`] in 64 bits.
+    gcd64,
+    u64
+);
+binary_gcd!(
+    /// Binary GCD (Stein) of two 128-bit values; gcd(0, b) = b.
+    gcd,
+    u128
+);
 
 /// `x · num / den` rounded half away from zero, exactly, in 64-bit
 /// arithmetic (a 128-bit division is a long library routine on the MCU):
