@@ -41,6 +41,24 @@ use profidrive::pkw::Pkw;
 use profidrive::telegram::{ModeBinding, Telegrams, MAX_TELEGRAM_BYTES};
 use units::UnitsCache;
 
+/// The parameter access over the profile `$p`'s own parts (a macro, not a
+/// method: the borrows stay per field, beside `$p.telegrams`).
+macro_rules! drive_access {
+    ($p:expr, $objects:expr, $axis:expr, $live:expr) => {
+        DriveAccess {
+            objects: $objects,
+            axis: $axis,
+            units: &$p.units,
+            user_units: &$p.user_units,
+            prepared: &mut $p.prepared,
+            core: &$p.core,
+            own: &mut $p.own,
+            live: $live,
+            pending: None,
+        }
+    };
+}
+
 /// 6040h bits 4–6: the vl ramp bits, the pp / homing "start" bit.
 const BITS_4_6: u16 = 0x0070;
 /// 6040h bit 4.
@@ -89,17 +107,7 @@ impl Profile {
             homing: false,
             warnings: 0,
         };
-        let access = DriveAccess {
-            objects,
-            axis,
-            units: &p.units,
-            user_units: &p.user_units,
-            prepared: &mut p.prepared,
-            core: &p.core,
-            own: &mut p.own,
-            live: &mut NoLive,
-            pending: None,
-        };
+        let access = drive_access!(p, objects, axis, &mut NoLive);
         // the stored configuration (A280, P-069), else the FB's
         if let Some(set) = stored {
             let mut t = Telegrams::new();
@@ -209,17 +217,7 @@ impl Profile {
         };
         self.core.resolve(objects, axis);
         let core = &self.core;
-        let mut access = DriveAccess {
-            objects,
-            axis,
-            units: &self.units,
-            user_units: &self.user_units,
-            prepared: &mut self.prepared,
-            core,
-            own: &mut self.own,
-            live,
-            pending: None,
-        };
+        let mut access = drive_access!(self, objects, axis, live);
         let rx = telegrams.apply_receive(frame, &mut access);
         // the telegram's record fields stored before anything reads them
         access.flush_record();
@@ -368,17 +366,7 @@ impl Profile {
         live: &mut dyn LiveValues,
         out: &mut [u8],
     ) -> usize {
-        let mut access = DriveAccess {
-            objects,
-            axis,
-            units: &self.units,
-            user_units: &self.user_units,
-            prepared: &mut self.prepared,
-            core: &self.core,
-            own: &mut self.own,
-            live,
-            pending: None,
-        };
+        let mut access = drive_access!(self, objects, axis, live);
         profidrive::bmp::serve(req, &mut access, out).unwrap_or(0)
     }
 
@@ -399,17 +387,7 @@ impl Profile {
         self.own.zsw1 = status::zsw1(objects, &self.core, axis, self.cw1.last(), self.homing);
         let n = self.response?;
         let telegrams = self.telegrams.as_mut()?;
-        let mut access = DriveAccess {
-            objects,
-            axis,
-            units: &self.units,
-            user_units: &self.user_units,
-            prepared: &mut self.prepared,
-            core: &self.core,
-            own: &mut self.own,
-            live: &mut NoLive,
-            pending: None,
-        };
+        let mut access = drive_access!(self, objects, axis, &mut NoLive);
         // straight into the module's data (the telegram is cut to it or
         // zero-padded up to it)
         let len = buf.len().min(MAX_TELEGRAM_BYTES);
