@@ -131,9 +131,14 @@ impl Line {
     /// printed as it comes, the exit status returned (killed after
     /// [`SCRIPT_LIMIT`]).
     pub fn run(&self, python: &Path, script: &str, args: &[&str]) -> ExitStatus {
+        self.run_lines(python, script, args).0
+    }
+
+    /// [`run`](Self::run), with the lines the script printed.
+    pub fn run_lines(&self, python: &Path, script: &str, args: &[&str]) -> (ExitStatus, Vec<String>) {
         let (child, script) = self.spawn(python, script, args);
         // print line by line (println! goes through the test harness's capture)
-        watch_script(child, &script, SCRIPT_LIMIT).0
+        watch_script(child, &script, SCRIPT_LIMIT)
     }
 
     /// The process id of `serve` (`ip netns exec` execs it), while it runs.
