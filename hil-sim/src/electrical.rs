@@ -187,7 +187,6 @@ impl CurrentControl for ElectricalAxis {
             trip: self
                 .foc
                 .trip()
-                .map(CurrentTrip::from)
                 .or(self.chopper.fault().then_some(CurrentTrip::BrakeResistor)),
         })
     }

@@ -28,6 +28,11 @@ pub enum Trip {
     /// room ([`CurrentDeviation`]): an open motor phase or a lost motor
     /// connection.
     MotorConnection,
+    /// The brake resistor's thermal model at 100 %
+    /// ([`BrakeChopper::fault`](crate::BrakeChopper::fault)): the device's,
+    /// which a shell reports on each axis. The current loop never trips
+    /// with it itself.
+    BrakeResistor,
 }
 
 /// Current-control plausibility: over a window, the mean square of the

@@ -405,7 +405,7 @@ impl FastLoop {
                     link.trip = if trapped {
                         Some(CurrentTrip::OverCurrent)
                     } else {
-                        foc.trip().map(CurrentTrip::from)
+                        foc.trip()
                     };
                 }
             } else {

@@ -1,7 +1,7 @@
 //! Faults of the power stage on the electrical plant (issue 34): the current
 //! loop's protection (`foc::protect`) trips on what its samples show, the
 //! gates go off in the PWM period after the fault appeared, and the axis
-//! faults with the manual's event (`drive_core::axis::CurrentTrip::event`).
+//! faults with the manual's event (`drive_core::axis::trip_event`).
 //! The faults are the plant's (`plant::FaultOptions`, the DC link): a test
 //! changes the motor, its wiring or the supply, never the drive.
 

@@ -27,7 +27,7 @@ pub struct CurrentActual {
     /// phase current's peak).
     pub current_a: f32,
     /// The loop's latched protection trip, if any (its gates are off): the
-    /// axis faults with the trip's event ([`CurrentTrip::event`]) and
+    /// axis faults with the trip's event ([`trip_event`]) and
     /// coasts. The loop clears it once the axis commands the power stage
     /// off: a cause that lasts with the gates off (an encoder loss, an
     /// over-voltage) trips again at once and holds the Fault, one that
@@ -106,70 +106,30 @@ impl Injection {
 }
 
 /// A trip of the current loop's protection (the power stage is off within
-/// the PWM period that saw it).
-#[derive(Debug, Clone, Copy, PartialEq, Eq)]
-pub enum CurrentTrip {
-    /// A phase current beyond the trip threshold (software, or the PWM
-    /// unit's trap input): event 33 "Overcurrent" (2310h).
-    OverCurrent,
-    /// The three phase currents do not sum to zero (a current to earth, a
-    /// broken shunt): event 31 "Short/ground" (2110h).
-    PhaseSum,
-    /// DC link below its minimum with the gates on: event 46 "Low voltage"
-    /// (3120h).
-    DcUnderVoltage,
-    /// DC link above its maximum: event 36 "High voltage" (3110h).
-    DcOverVoltage,
-    /// The encoder stopped answering the fast task: event 37 "Motor
-    /// encoder" (7303h).
-    EncoderLost,
-    /// The loop's own i²t backstop: event 45 "Overtemp.motor i2t" (4380h).
-    MotorI2t,
-    /// The power stage's i²t model at its fault level (its limit not
-    /// obeyed): event 39 "Overtemperature drive controller i2t" (4280h).
-    StageI2t,
-    /// The current does not follow its reference although the voltage has
-    /// room (an open motor phase): event 69 "Motor connection" (7120h).
-    MotorConnection,
-    /// The brake resistor's thermal model at 100 % (`foc::BrakeChopper`, the
-    /// device's: the shell reports it on each axis): event 42
-    /// "TempBrakeRes" (7110h, error register 08h temperature, E-090).
-    BrakeResistor,
-}
+/// the PWM period that saw it): [`foc::Trip`], the loop's own name for it,
+/// with [`foc::Trip::BrakeResistor`] for the device's brake resistor; the
+/// drive event of each is [`trip_event`].
+pub use foc::Trip as CurrentTrip;
 
-impl From<foc::Trip> for CurrentTrip {
-    /// The drive core's name of the current loop's trip (every shell that
-    /// runs `foc` reports it so).
-    fn from(t: foc::Trip) -> Self {
-        match t {
-            foc::Trip::OverCurrent => Self::OverCurrent,
-            foc::Trip::PhaseSum => Self::PhaseSum,
-            foc::Trip::DcUnderVoltage => Self::DcUnderVoltage,
-            foc::Trip::DcOverVoltage => Self::DcOverVoltage,
-            foc::Trip::EncoderLost => Self::EncoderLost,
-            foc::Trip::MotorI2t => Self::MotorI2t,
-            foc::Trip::StageI2t => Self::StageI2t,
-            foc::Trip::MotorConnection => Self::MotorConnection,
-        }
-    }
-}
-
-impl CurrentTrip {
-    /// The drive event (E82 number, cause) of the trip (spec §8.3, S Tab. 23).
-    pub const fn event(self) -> Event {
-        let number = match self {
-            Self::OverCurrent => 33,
-            Self::PhaseSum => 31,
-            Self::DcUnderVoltage => 46,
-            Self::DcOverVoltage => 36,
-            Self::EncoderLost => 37,
-            Self::MotorI2t => 45,
-            Self::StageI2t => 39,
-            Self::MotorConnection => 69,
-            Self::BrakeResistor => 42,
-        };
-        Event { number, cause: 2 }
-    }
+/// The drive event (E82 number, cause 2) of a current-loop trip (spec §8.3,
+/// S Tab. 23): over-current 33 (2310h), phase sum 31 "Short/ground" (2110h),
+/// DC link under 46 (3120h) and over 36 (3110h), encoder lost 37 (7303h),
+/// motor i²t 45 (4380h), power stage i²t 39 (4280h), motor connection 69
+/// (7120h), brake resistor 42 "TempBrakeRes" (7110h, error register 08h,
+/// E-090).
+pub const fn trip_event(trip: CurrentTrip) -> Event {
+    let number = match trip {
+        CurrentTrip::OverCurrent => 33,
+        CurrentTrip::PhaseSum => 31,
+        CurrentTrip::DcUnderVoltage => 46,
+        CurrentTrip::DcOverVoltage => 36,
+        CurrentTrip::EncoderLost => 37,
+        CurrentTrip::MotorI2t => 45,
+        CurrentTrip::StageI2t => 39,
+        CurrentTrip::MotorConnection => 69,
+        CurrentTrip::BrakeResistor => 42,
+    };
+    Event { number, cause: 2 }
 }
 
 /// One axis' current control as the drive core sees it: a reference in, a

@@ -141,7 +141,7 @@ pub(crate) use snapshot::{CyclicSlots, Snapshot, Window};
 
 pub use cache::AxisCache;
 use cache::CachedSnapshot;
-pub use current::{CurrentActual, CurrentControl, CurrentTrip, DAxisMeans, Injection};
+pub use current::{trip_event, CurrentActual, CurrentControl, CurrentTrip, DAxisMeans, Injection};
 pub use io::{AxisCommand, AxisIo, AxisReport, IndexLatch, ProbeEdge, SwitchEdge, SwitchId};
 pub use monitor::{LOW_VOLTAGE, MOTOR_ENCODER};
 pub use motor::{MotorData, MOTOR_I2T};

@@ -12,7 +12,7 @@
 //!   (C-015, E47/E49).
 //!
 //! - The current loop tripped ([`CurrentActual::trip`]): its event
-//!   ([`CurrentTrip::event`]: over-current 33, earth fault 31, DC link 36/46,
+//!   ([`trip_event`]: over-current 33, earth fault 31, DC link 36/46,
 //!   encoder 37, motor i²t 45), in every state.
 //!
 //! All coast (the power stage off at once, the brake engages): without
@@ -29,12 +29,12 @@ pub const LOW_VOLTAGE: Event = Event { number: 46, cause: 1 };
 
 impl Axis {
     /// Raises [`MOTOR_ENCODER`] or [`LOW_VOLTAGE`] for this cycle's `io`, a
-    /// trip of the current loop as its event ([`CurrentTrip::event`]), and
+    /// trip of the current loop as its event ([`trip_event`]), and
     /// steps the motor protection (`motor.rs`).
     pub(super) fn monitor(&mut self, io: &AxisIo, now: Nanos) {
         self.protect_motor(io, now);
         if let Some(trip) = io.current.and_then(|c| c.trip) {
-            self.raise_with(trip.event(), Some(FaultReaction::Coast));
+            self.raise_with(trip_event(trip), Some(FaultReaction::Coast));
         } else if !io.encoder_ok {
             self.raise_with(MOTOR_ENCODER, Some(FaultReaction::Coast));
         } else if !io.supply_ok && matches!(self.dc.state(), State::OperationEnabled | State::QuickStopActive)
