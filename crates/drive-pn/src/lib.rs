@@ -276,6 +276,11 @@ impl<F: Flash, H: RecordHook> PnDrive<F, H> {
         for (axis, cache) in self.axes.iter_mut().zip(self.caches.iter_mut()) {
             axis.prepare(cache, &self.objects);
         }
+        // a trace armed by a record write in this frame: its channels'
+        // accesses here, not in the control cycle's first sample
+        if let Some(scope) = self.device.hook_mut().inner.inner.scope.as_mut() {
+            scope.prepare(&self.objects);
+        }
     }
 
     /// The PROFINET device.

@@ -121,14 +121,20 @@ pub fn scope<S: AsRef<[u32]> + AsMut<[u32]>>(
 }
 
 /// [`mailbox`] with the scope: its objects (group T) are read and written
-/// through the recorder (without it they answer 0800 0022h).
+/// through the recorder (without it they answer 0800 0022h); a trace armed
+/// by the request gets its channels' accesses prepared here
+/// ([`Recorder::prepare`](drive_ecat::scope::Recorder::prepare)).
 pub fn mailbox_scoped<P: Pdi, S: AsRef<[u32]> + AsMut<[u32]>>(
     drive: &mut Drive,
     scope: &mut drive_ecat::scope::Recorder<S>,
     pdi: &mut P,
     now: Nanos,
 ) -> Result<(), P::Error> {
-    drive.poll_mailbox_with(pdi, now, scope)
+    drive.poll_mailbox_with(pdi, now, scope)?;
+    // a trace armed by this request: its channels' accesses here, not in
+    // the control cycle's first sample
+    scope.prepare(drive.objects());
+    Ok(())
 }
 
 /// Background work from the idle loop: a save requested over the bus (A00,

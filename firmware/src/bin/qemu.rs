@@ -356,8 +356,12 @@ mod app {
                         Progress::Sync0(ns) => defmt::info!("master: SYNC0 every {=u32} ns", ns),
                         Progress::Enabled => {
                             moving = true;
-                            let armed = cx.shared.scope.lock(|s| {
-                                s.configure(scope_config()).and_then(|()| s.arm()).is_ok()
+                            // armed as a master's SDO write arms it: the
+                            // channels prepared in that (mailbox) context
+                            let armed = (&mut cx.shared.drive, &mut cx.shared.scope).lock(|d, s| {
+                                let armed = s.configure(scope_config()).and_then(|()| s.arm()).is_ok();
+                                s.prepare(d.objects());
+                                armed
                             });
                             if !armed {
                                 defmt::error!("scope: configuration refused");

@@ -344,6 +344,9 @@ pub struct Recorder<S> {
     start: u32,
     /// Completed traces.
     traces: u32,
+    /// Armed, its channels' accesses not prepared yet
+    /// ([`prepare`](Self::prepare)).
+    unprepared: bool,
 }
 
 impl<S: AsRef<[u32]> + AsMut<[u32]>> Recorder<S> {
@@ -367,6 +370,7 @@ impl<S: AsRef<[u32]> + AsMut<[u32]>> Recorder<S> {
             trigger_at: 0,
             start: 0,
             traces: 0,
+            unprepared: false,
         }
     }
 
@@ -488,7 +492,26 @@ impl<S: AsRef<[u32]> + AsMut<[u32]>> Recorder<S> {
         // the trigger sample is the first after the pre-trigger share
         self.pre = ((u64::from(frames) * u64::from(c.pre_percent)) / 100).min(u64::from(frames - 1)) as u32;
         self.restart();
+        self.unprepared = true;
         Ok(())
+    }
+
+    /// Prepares the armed trace's object channels (their accesses to the
+    /// dictionary), in the context that armed it (the mailbox or record
+    /// task after the write of T00 = 1): the control cycle's first sample
+    /// then reads them as every later one does (without this, the first
+    /// sample prepares them: ≈ 3,300 instructions more in the control
+    /// task). One compare when nothing is to do. A channel whose access a
+    /// configuration change made stale is prepared again by the sample.
+    pub fn prepare(&mut self, od: &DriveObjects) {
+        if !core::mem::take(&mut self.unprepared) {
+            return;
+        }
+        for ch in self.chans.iter_mut().take(self.n) {
+            if let Channel::Entry { index, sub, prepared } = ch {
+                *prepared = od.prepare(*index, *sub, CommState::Op);
+            }
+        }
     }
 
     fn restart(&mut self) {

@@ -272,3 +272,51 @@ fn issue35_scope_objects_have_no_ram_image() {
         assert_eq!(o.ram_bytes(), 0, "{index:04X}");
     }
 }
+
+/// Issue 36 (no long first cycle): the context that arms a trace prepares
+/// its object channels' accesses, so the control cycle's first sample finds
+/// them prepared; the trace is the same as one whose first sample prepares
+/// them itself, and a second `prepare` is a no-op until the next arming.
+#[test]
+fn issue36_scope_channels_prepared_where_the_trace_is_armed() {
+    let trace = |prepare_first: bool| {
+        let mut od = DriveObjects::new();
+        let mut r = Rec::new(vec![0; 1000]);
+        let mut c = config(&[0x6064_0020, Signal::Iq.code(0), 0x6041_0010]);
+        c.length = 10;
+        r.configure(c).unwrap();
+        r.arm().unwrap();
+        let prepared = |r: &Rec| {
+            r.chans
+                .iter()
+                .filter(|ch| {
+                    matches!(
+                        ch,
+                        Channel::Entry {
+                            prepared: Some(_),
+                            ..
+                        }
+                    )
+                })
+                .count()
+        };
+        assert_eq!(prepared(&r), 0, "arming decodes, it does not prepare");
+        if prepare_first {
+            r.prepare(&od);
+            assert_eq!(prepared(&r), 2, "both object channels prepared, the signal not");
+            assert!(!r.unprepared);
+        }
+        for t in 0..10 {
+            od.set(0x6064, 0, 1000 + t).unwrap();
+            r.sample(&od, || signals(t as i32));
+        }
+        assert_eq!(r.state(), State::Complete);
+        (0..10)
+            .map(|i| (r.value(i, 0), r.value(i, 1), r.value(i, 2)))
+            .collect::<Vec<_>>()
+    };
+    let (lazy, early) = (trace(false), trace(true));
+    assert_eq!(lazy, early);
+    assert_eq!(early[0], (Some(1000), Some(0), Some(0)));
+    assert_eq!(early[9].0, Some(1009));
+}
