@@ -77,6 +77,10 @@ fn p010_p041_connect_over_udp_to_the_stored_static_ip_establishes_the_ar() {
 fn p006_p037_poll_sends_lldp_from_both_port_macs_then_waits_5_s() {
     let mut d = device();
     let mut out = Vec::new();
+    // one port's LLDPDU per poll (issue 36: a poll stays short); the first
+    // asks to be called again at once for the second port
+    let next = d.poll(Nanos::ZERO, &mut |f: &[u8]| out.push(f.to_vec()));
+    assert_eq!((out.len(), next), (1, Nanos::ZERO));
     let next = d.poll(Nanos::ZERO, &mut |f: &[u8]| out.push(f.to_vec()));
     assert_eq!(out.len(), 2);
     for (f, port_mac) in out.iter().zip([0x51, 0x52]) {
@@ -86,11 +90,11 @@ fn p006_p037_poll_sends_lldp_from_both_port_macs_then_waits_5_s() {
             (MacAddr::LLDP, port_mac, 0x88CC)
         );
     }
-    assert!(next <= Nanos::from_secs(5));
+    assert!(next > Nanos::ZERO && next <= Nanos::from_secs(5));
     out.clear();
     d.poll(Nanos::from_secs(1), &mut |f: &[u8]| out.push(f.to_vec()));
     assert!(out.is_empty());
-    d.poll(Nanos::from_secs(5), &mut |f: &[u8]| out.push(f.to_vec()));
+    out = poll(&mut d, Nanos::from_secs(5));
     assert_eq!(out.len(), 2);
 }
 
@@ -108,9 +112,15 @@ fn output_frame(d: &Device, counter: u16, fill: u8) -> Vec<u8> {
     testing::output_frame(d.cm().ar().unwrap(), counter, fill).to_vec()
 }
 
+/// What the device sends at `now`: polls until nothing more is due then
+/// (one port's LLDPDU per poll; a poll that left one due returns `now`).
 fn poll(d: &mut Device, now: Nanos) -> Vec<Vec<u8>> {
     let mut out = Vec::new();
-    d.poll(now, &mut |f: &[u8]| out.push(f.to_vec()));
+    for _ in 0..4 {
+        if d.poll(now, &mut |f: &[u8]| out.push(f.to_vec())) > now {
+            break;
+        }
+    }
     out
 }
 

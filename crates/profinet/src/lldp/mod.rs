@@ -19,7 +19,11 @@
 //! | Management address | the IPv4 address (ifIndex numbering, interface 1), when one is set |
 //! | End | |
 //!
-//! [`Schedule`] says when a port is due, time as an argument.
+//! [`Schedule`] says when a port is due, time as an argument. The device
+//! sends one port's LLDPDU per poll: when both are due, the second goes out
+//! with the next poll, which the first asks for at once (its deadline is
+//! `now`), so no poll builds two (issue 36: a poll's longest run within twice
+//! its usual one).
 
 use core::net::Ipv4Addr;
 

@@ -111,9 +111,15 @@ fn p040_bad_pd_port_data_check_blocks_are_refused_and_nothing_is_stored() {
 }
 
 /// The LLDP frames `poll` sends at `now`.
+/// The LLDP frames sent at `now`: polls until none is due then (one port's
+/// LLDPDU per poll; each poll that sent one returns `now` as its deadline).
 fn lldp_at(r: &mut Rig<NoRecords>, now: nanos::Nanos) -> Vec<Vec<u8>> {
     let mut out = Vec::new();
-    r.d.poll(now, &mut |f: &[u8]| out.push(f.to_vec()));
+    for _ in 0..4 {
+        if r.d.poll(now, &mut |f: &[u8]| out.push(f.to_vec())) > now {
+            break;
+        }
+    }
     out.into_iter().filter(|f| f[12..14] == [0x88, 0xCC]).collect()
 }
 
