@@ -278,7 +278,7 @@ pub(super) fn load_packed(image: &[u8], word: u32, value: u32) -> Option<Result<
     }
     let at = usize::from(u16::try_from(value).ok()?);
     // the codes are the positions in `CACHED_TYPES` + 1
-    // (`packed_codes_follow_the_cached_types`)
+    // (`packed_loads_answer_as_unpack_and_load` meets each in RAM)
     let v = match code {
         1 | 5 => bytes_at::<1>(image, at).map(|[b]| i64::from(b)),
         2 => bytes_at::<1>(image, at).map(|[b]| i64::from(b as i8)),
@@ -395,26 +395,6 @@ pub(super) fn lookup(key: u32) -> Option<Resolved> {
 mod tests {
     use super::*;
 
-    /// The codes [`load_packed`] matches on are these positions + 1.
-    #[test]
-    fn packed_codes_follow_the_cached_types() {
-        assert_eq!(
-            CACHED_TYPES,
-            [
-                DataType::Bool,
-                DataType::I8,
-                DataType::I16,
-                DataType::I32,
-                DataType::U8,
-                DataType::U16,
-                DataType::U32,
-                DataType::F32,
-                DataType::I64,
-                DataType::U64,
-            ]
-        );
-    }
-
     /// Every cached RAM integer stores from its packed words as the general
     /// path of [`DriveObjects::set`] does: the same answer, image and
     /// configuration generations, for values in, at and beyond its range.
@@ -484,7 +464,7 @@ mod tests {
         for (i, b) in od.image.iter_mut().enumerate() {
             *b = (i as u8).wrapping_mul(37) ^ 0xA5;
         }
-        let mut checked = 0;
+        let (mut checked, mut ram_codes) = (0, 0u64);
         for o in OBJECTS {
             for sub in 0..=u8::MAX {
                 let key = (u32::from(o.info.index) << 8) | u32::from(sub);
@@ -497,8 +477,15 @@ mod tests {
                 });
                 assert_eq!(load_packed(&od.image, word, value), unpacked, "{key:06X}");
                 checked += 1;
+                if word & CONST_FLAG == 0 {
+                    ram_codes |= 1 << (word & 0x3F);
+                }
             }
         }
         assert!(checked > 500, "{checked}");
+        // every code `load_packed` matches on literally (Bool … U32, the
+        // positions in CACHED_TYPES + 1) met in RAM: a reordered table
+        // fails here, with the entry's key
+        assert_eq!(ram_codes & 0xFE, 0xFE, "RAM type codes met: {ram_codes:#b}");
     }
 }
