@@ -121,15 +121,23 @@ fn refusal_of(b: u8) -> Option<StartRefusal> {
 /// [`super::Axis::record_status`]): bits 0…5 flags, 8…10 refusal, 16…31
 /// record.
 pub(super) fn status_bits(s: &RecordStatus) -> u32 {
-    u32::from(flags(&[
+    u32::from(status_flags(s))
+        | (u32::from(refusal_code(s.refused)) << 8)
+        | (u32::from(s.record.unwrap_or(0)) << 16)
+}
+
+/// A status' six flags as bits 0…5 (acknowledge, target reached, stopped,
+/// waiting, jogging, a record selected): the packed word's and the saved
+/// state's.
+fn status_flags(s: &RecordStatus) -> u8 {
+    flags(&[
         s.acknowledge,
         s.target_reached,
         s.stopped,
         s.waiting,
         s.jogging,
         s.record.is_some(),
-    ])) | (u32::from(refusal_code(s.refused)) << 8)
-        | (u32::from(s.record.unwrap_or(0)) << 16)
+    ])
 }
 
 /// The status of [`status_bits`].
@@ -219,14 +227,7 @@ impl RecordTasks {
         w.u16(self.planned_override);
         w.u8(refusal_code(self.refused));
         let s = &self.status;
-        w.u8(flags(&[
-            s.acknowledge,
-            s.target_reached,
-            s.stopped,
-            s.waiting,
-            s.jogging,
-            s.record.is_some(),
-        ]));
+        w.u8(status_flags(s));
         w.u16(s.record.unwrap_or(0));
         w.u8(refusal_code(s.refused));
         out
