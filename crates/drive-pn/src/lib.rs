@@ -266,16 +266,26 @@ impl<F: Flash, H: RecordHook> PnDrive<F, H> {
         drive
     }
 
-    /// The axes' caches of the control cycle built here, outside it, when
-    /// the configuration moved (start-up; a record, I&M or DCP write in the
-    /// frame just received): the next control cycle reads only the
-    /// set-points (issue 36). Cheap when nothing changed (a compare per
-    /// axis: this runs in the eth task, whose hold of the drive blocks the
-    /// control cycle).
+    /// The axes' caches of the control cycle and their configuration built
+    /// here, outside it, when the configuration moved (start-up; a record,
+    /// I&M or DCP write in the frame just received): the next control cycle
+    /// reads only the set-points (issue 36). Cheap when nothing changed (a
+    /// compare per axis: this runs in the eth task, whose hold of the drive
+    /// blocks the control cycle).
     fn prepare_axes(&mut self) {
         for (axis, cache) in self.axes.iter_mut().zip(self.caches.iter_mut()) {
-            axis.prepare(cache, &self.objects);
+            axis.prepare(cache, &mut self.objects);
         }
+    }
+
+    /// The profile's part of [`prepare_axes`](Self::prepare_axes), after a
+    /// frame: the A279 unit choices and the prepared accesses of the
+    /// telegram's entries brought to the configuration in force, so the
+    /// next control cycle finds them current ([`profile::Profile::prepare`],
+    /// issue 36).
+    fn prepare_profile(&mut self) {
+        let [axis, _] = &mut self.axes;
+        self.profile.prepare(&self.objects, axis);
     }
 
     /// The PROFINET device.
@@ -421,6 +431,7 @@ impl<F: Flash, H: RecordHook> PnDrive<F, H> {
         self.telegram_new = true;
         self.serve_bmp();
         self.events(on_event);
+        self.prepare_profile();
         self.prepare_axes();
     }
 

@@ -152,6 +152,23 @@ impl PreparedCache {
         }
     }
 
+    /// Every entry kept prepared again where it went stale (the
+    /// configuration moved): outside the control cycle, so its telegram
+    /// finds the handles current (issue 36). The same handles
+    /// [`get`](Self::get) would prepare at its next access.
+    pub fn refresh(&mut self, objects: &DriveObjects) {
+        for (key, handle) in self.keys.iter_mut().zip(self.handles.iter_mut()) {
+            if *key == 0 || handle.as_ref().is_some_and(|p| objects.is_current(p)) {
+                continue;
+            }
+            let (index, sub) = ((*key >> 8) as u16, *key as u8);
+            *handle = objects.prepare(index, sub, CommState::Op);
+            if handle.is_none() {
+                *key = 0;
+            }
+        }
+    }
+
     /// `index`:`sub` prepared and current, or `None` (not a CiA 402 entry
     /// [`DriveObjects::prepare`] takes: the full path).
     pub fn get(&mut self, objects: &DriveObjects, index: u16, sub: u8) -> Option<&Prepared> {

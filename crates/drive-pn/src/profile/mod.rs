@@ -83,6 +83,9 @@ pub struct Profile {
     homing: bool,
     /// Frames with an unknown identifier or another warning.
     warnings: u32,
+    /// The configuration generation [`prepare`](Self::prepare) last
+    /// brought the units and prepared accesses to.
+    prepared_at: Option<u32>,
 }
 
 impl Profile {
@@ -106,6 +109,7 @@ impl Profile {
             response: None,
             homing: false,
             warnings: 0,
+            prepared_at: None,
         };
         let access = drive_access!(p, objects, axis, &mut NoLive);
         // the stored configuration (A280, P-069), else the FB's
@@ -184,6 +188,25 @@ impl Profile {
     /// cost telegram 0 about 8,000 instructions per frame on QEMU).
     pub fn warm_up(&mut self, objects: &DriveObjects, axis: &Axis) {
         self.core.resolve(objects, axis);
+    }
+
+    /// After a frame, in the bus task (issue 36: outside the control
+    /// cycle), when the configuration moved: the unit choices A279 looked
+    /// at ([`refresh_units`](Self::refresh_units), as the next telegram's
+    /// first step would), the core entries resolved, the axis' user units
+    /// read and the prepared accesses the telegrams used brought to the
+    /// configuration in force. The control cycle's telegram then finds
+    /// them current; what it computes is the same.
+    pub fn prepare(&mut self, objects: &DriveObjects, axis: &mut Axis) {
+        let g = objects.config_generation();
+        if self.prepared_at == Some(g) {
+            return;
+        }
+        self.refresh_units(objects, axis);
+        self.core.resolve(objects, axis);
+        let _ = self.user_units.get(objects, axis);
+        self.prepared.refresh(objects);
+        self.prepared_at = Some(g);
     }
 
     /// The unit choices A279 (P-212): new units once they convert; a
