@@ -279,13 +279,16 @@ impl<F: Flash, H: RecordHook> PnDrive<F, H> {
     }
 
     /// The profile's part of [`prepare_axes`](Self::prepare_axes), after a
-    /// frame: the A279 unit choices and the prepared accesses of the
-    /// telegram's entries brought to the configuration in force, so the
-    /// next control cycle finds them current ([`profile::Profile::prepare`],
-    /// issue 36).
+    /// frame and before it: the configuration values the receive telegram
+    /// carries written ahead, the A279 unit choices and the prepared
+    /// accesses of the telegram's entries brought to the configuration in
+    /// force, so the next control cycle finds them current
+    /// ([`profile::Profile::prepare`], issue 36).
     fn prepare_profile(&mut self) {
+        let (slot, _) = self.data_slots();
+        let frame = slot.and_then(|s| self.device.output_data(s));
         let [axis, _] = &mut self.axes;
-        self.profile.prepare(&self.objects, axis);
+        self.profile.prepare(frame, &mut self.objects, axis);
     }
 
     /// The PROFINET device.

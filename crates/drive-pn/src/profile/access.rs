@@ -162,6 +162,32 @@ impl DriveAccess<'_> {
         }
     }
 
+    /// Whether a changed value written to `addr` (a PNU or an object) is a
+    /// configuration change ([`DriveObjects::config_generation`]): an
+    /// object in RAM that is no cyclic set-point, and the vl ramps of PNU
+    /// 1011.2. Records, the profile's own values and unknown addresses are
+    /// none.
+    pub fn is_config_entry(&self, addr: Addr) -> bool {
+        let config = |index: u16, sub: u8| {
+            self.objects
+                .slot(self.index(index), sub)
+                .is_some_and(|s| s.is_config())
+        };
+        let p = match lookup::memoised(addr) {
+            Some(p) => p,
+            None if !lookup::is_catalogue_index(addr.index) => return config(addr.index, addr.sub),
+            None => match lookup::find_and_remember(addr) {
+                Ok(p) => p,
+                Err(_) => return false,
+            },
+        };
+        match p.source {
+            Source::Object { index, sub } => config(index, sub),
+            Source::VlBothRamps => true,
+            _ => false,
+        }
+    }
+
     fn user_units(&self) -> UserUnits {
         self.user_units.get(self.objects, self.axis)
     }
