@@ -396,13 +396,17 @@ impl DriveAccess<'_> {
                 _ if k == 0 => self.record_number(jog),
                 _ => k,
             };
-            let (mut r, read): (Record, Record) = match self.pending {
-                Some((a, m, _, r, read)) if (a, m) == (axis, n) => (r, read),
-                _ => {
-                    self.flush_record();
-                    let read = self.objects.record(axis, n).ok_or(PdError::NOT_IN_STATE)?;
-                    (read, read)
-                }
+            // the pending record of `n` is edited in place (issue 36: the
+            // two records copied out and back per field cost more than the
+            // edit); another one is stored first and `n` read (a field the
+            // record refuses leaves it as read: nothing to store)
+            if !matches!(self.pending, Some((a, m, ..)) if (a, m) == (axis, n)) {
+                self.flush_record();
+                let read = self.objects.record(axis, n).ok_or(PdError::NOT_IN_STATE)?;
+                self.pending = Some((axis, n, false, read, read));
+            }
+            let Some((_, _, flag, r, _)) = self.pending.as_mut() else {
+                return Err(PdError::NOT_IN_STATE);
             };
             let as_u32 = || u32::try_from(value).map_err(|_| PdError::LIMIT_EXCEEDED);
             match field {
@@ -420,7 +424,7 @@ impl DriveAccess<'_> {
             }
             // stored at the next other access (a record that was read is
             // there to store: set_record cannot refuse it)
-            self.pending = Some((axis, n, selected, r, read));
+            *flag = selected;
         }
         Ok(())
     }
