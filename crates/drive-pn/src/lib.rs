@@ -630,8 +630,15 @@ impl<F: Flash, H: RecordHook> PnDrive<F, H> {
         let run_profile = core::mem::take(&mut self.telegram_new)
             || self.profile_mode != Some(mode)
             || self.profile.homing();
+        // the data modules looked up once for both halves of the telegram
+        // (issue 36: not once in each)
+        let modules = if run_profile {
+            self.data_slots()
+        } else {
+            (None, None)
+        };
         if run_profile {
-            self.profile_receive();
+            self.profile_receive(modules.0);
         }
         let mut commands = [AxisCommand::OFF; 2];
         for (i, ((axis, cache), io)) in self
@@ -691,7 +698,7 @@ impl<F: Flash, H: RecordHook> PnDrive<F, H> {
         self.sample_scope(io);
         if run_profile {
             // once per telegram: the response the device sends next
-            self.profile_respond();
+            self.profile_respond(modules.1);
             let [axis_a, _] = &self.axes;
             self.profile_mode = Some(self.profile.mode_display(&self.objects, axis_a));
         }
@@ -718,8 +725,8 @@ impl<F: Flash, H: RecordHook> PnDrive<F, H> {
 
     /// The received telegram into the objects and axis A (before the axes'
     /// cycle), while the outputs are current.
-    fn profile_receive(&mut self) {
-        let (Some(slot), _) = self.data_slots() else {
+    fn profile_receive(&mut self, to_drive: Option<u16>) {
+        let Some(slot) = to_drive else {
             return;
         };
         let mut frame = [0u8; profinet::device::MAX_MODULE_BYTES];
@@ -772,8 +779,8 @@ impl<F: Flash, H: RecordHook> PnDrive<F, H> {
     }
 
     /// The response telegram into the input data (after the axes' cycle).
-    fn profile_respond(&mut self) {
-        let (_, Some(slot)) = self.data_slots() else {
+    fn profile_respond(&mut self, from_drive: Option<u16>) {
+        let Some(slot) = from_drive else {
             return;
         };
         let Some(len) = self
