@@ -266,21 +266,34 @@ impl<F: Flash, H: RecordHook> PnDrive<F, H> {
         drive
     }
 
-    /// The axes' caches of the control cycle built here, outside it, when
-    /// the configuration moved (start-up; a record, I&M or DCP write in the
-    /// frame just received): the next control cycle reads only the
-    /// set-points (issue 36). Cheap when nothing changed (a compare per
-    /// axis: this runs in the eth task, whose hold of the drive blocks the
-    /// control cycle).
+    /// The axes' caches of the control cycle and their configuration built
+    /// here, outside it, when the configuration moved (start-up; a record,
+    /// I&M or DCP write in the frame just received): the next control cycle
+    /// reads only the set-points (issue 36). Cheap when nothing changed (a
+    /// compare per axis: this runs in the eth task, whose hold of the drive
+    /// blocks the control cycle).
     fn prepare_axes(&mut self) {
         for (axis, cache) in self.axes.iter_mut().zip(self.caches.iter_mut()) {
-            axis.prepare(cache, &self.objects);
+            axis.prepare(cache, &mut self.objects);
         }
         // a trace armed by a record write in this frame: its channels'
         // accesses here, not in the control cycle's first sample
         if let Some(scope) = self.device.hook_mut().inner.inner.scope.as_mut() {
             scope.prepare(&self.objects);
         }
+    }
+
+    /// The profile's part of [`prepare_axes`](Self::prepare_axes), after a
+    /// frame and before it: the configuration values the receive telegram
+    /// carries written ahead, the A279 unit choices and the prepared
+    /// accesses of the telegram's entries brought to the configuration in
+    /// force, so the next control cycle finds them current
+    /// ([`profile::Profile::prepare`], issue 36).
+    fn prepare_profile(&mut self) {
+        let (slot, _) = self.data_slots();
+        let frame = slot.and_then(|s| self.device.output_data(s));
+        let [axis, _] = &mut self.axes;
+        self.profile.prepare(frame, &mut self.objects, axis);
     }
 
     /// The PROFINET device.
@@ -426,6 +439,7 @@ impl<F: Flash, H: RecordHook> PnDrive<F, H> {
         self.telegram_new = true;
         self.serve_bmp();
         self.events(on_event);
+        self.prepare_profile();
         self.prepare_axes();
     }
 
@@ -621,8 +635,15 @@ impl<F: Flash, H: RecordHook> PnDrive<F, H> {
         let run_profile = core::mem::take(&mut self.telegram_new)
             || self.profile_mode != Some(mode)
             || self.profile.homing();
+        // the data modules looked up once for both halves of the telegram
+        // (issue 36: not once in each)
+        let modules = if run_profile {
+            self.data_slots()
+        } else {
+            (None, None)
+        };
         if run_profile {
-            self.profile_receive();
+            self.profile_receive(modules.0);
         }
         let mut commands = [AxisCommand::OFF; 2];
         for (i, ((axis, cache), io)) in self
@@ -682,7 +703,7 @@ impl<F: Flash, H: RecordHook> PnDrive<F, H> {
         self.sample_scope(io);
         if run_profile {
             // once per telegram: the response the device sends next
-            self.profile_respond();
+            self.profile_respond(modules.1);
             let [axis_a, _] = &self.axes;
             self.profile_mode = Some(self.profile.mode_display(&self.objects, axis_a));
         }
@@ -709,8 +730,8 @@ impl<F: Flash, H: RecordHook> PnDrive<F, H> {
 
     /// The received telegram into the objects and axis A (before the axes'
     /// cycle), while the outputs are current.
-    fn profile_receive(&mut self) {
-        let (Some(slot), _) = self.data_slots() else {
+    fn profile_receive(&mut self, to_drive: Option<u16>) {
+        let Some(slot) = to_drive else {
             return;
         };
         let mut frame = [0u8; profinet::device::MAX_MODULE_BYTES];
@@ -763,8 +784,8 @@ impl<F: Flash, H: RecordHook> PnDrive<F, H> {
     }
 
     /// The response telegram into the input data (after the axes' cycle).
-    fn profile_respond(&mut self) {
-        let (_, Some(slot)) = self.data_slots() else {
+    fn profile_respond(&mut self, from_drive: Option<u16>) {
+        let Some(slot) = from_drive else {
             return;
         };
         let Some(len) = self

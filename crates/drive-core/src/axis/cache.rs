@@ -41,19 +41,42 @@ impl AxisCache {
 impl Axis {
     /// Builds what [`cycle_cached`](Self::cycle_cached) keeps in `cache`
     /// (the resolved slots; the snapshot when the configuration generation
-    /// moved) outside the control cycle: where the configuration changes
-    /// (start-up, a record or parameter write in the bus task), so the next
-    /// cycle reads only the set-points (issue 36: no long first or
-    /// reconfiguration cycle). Nothing the cycle computes differs: it would
-    /// read the same snapshot at the same generation.
-    pub fn prepare(&mut self, cache: &mut AxisCache, od: &DriveObjects) {
+    /// moved) and the configuration it applies from them (`configure`, when
+    /// the generation, the cycle or the mode class moved) outside the
+    /// control cycle: where the configuration changes (start-up, a record
+    /// or parameter write in the bus task), so the next cycle reads only the
+    /// set-points (issue 36: no long first or reconfiguration cycle).
+    /// Nothing the cycle computes differs: it would read the same snapshot
+    /// at the same generation and configure with it at its start, before
+    /// anything of the cycle changed the axis (`configure` reads no cyclic
+    /// set-point of the snapshot).
+    pub fn prepare(&mut self, cache: &mut AxisCache, od: &mut DriveObjects) {
         let window = self.window;
-        if cache.slots.is_none() {
-            cache.slots = Some(CyclicSlots::resolve(od, window));
-        }
         let generation = od.axis_config_generation(usize::from(window.axis));
-        if !matches!(&cache.snapshot, Some(c) if c.generation == generation) {
-            cache.snapshot = Some(self.read_snapshot(od, generation));
+        let slots: &CyclicSlots = cache
+            .slots
+            .get_or_insert_with(|| CyclicSlots::resolve(od, window));
+        let cached: &CachedSnapshot = match &mut cache.snapshot {
+            Some(cached) if cached.generation == generation => cached,
+            stale => stale.insert(self.read_snapshot(od, generation)),
+        };
+        // as the cycle's step 2 keys it (`cycle_cached`)
+        let class = match self.running {
+            Running::Homing => 1,
+            Running::Jog(_) => 2,
+            _ => 0,
+        };
+        let dt_ns = cached.dt_ns;
+        if self.configured != Some((generation, dt_ns, class)) {
+            let converted;
+            let o = if cached.in_increments {
+                &cached.snapshot
+            } else {
+                converted = cached.snapshot.to_increments(&self.scaling);
+                &converted
+            };
+            self.configure(od, slots, o, dt_ns);
+            self.configured = Some((generation, dt_ns, class));
         }
     }
 

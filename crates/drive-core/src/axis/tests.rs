@@ -111,3 +111,47 @@ fn cyclic_slots_resolve_every_entry_on_both_axes() {
         seen.push(s);
     }
 }
+
+/// Issue 36 (no long first or reconfiguration cycle): an axis prepared
+/// outside the control cycle ([`Axis::prepare`]: its snapshot and the
+/// configuration from it) cycles exactly as one that builds both at the
+/// start of its cycle: the same reports, objects and axis state, from the
+/// first cycle through configuration changes (A150, the vl ramps, the
+/// position window) and the enable sequence into profile velocity.
+#[test]
+fn a_prepared_axis_cycles_as_one_configured_in_its_cycle() {
+    let mut prepared_od = DriveObjects::new();
+    let mut plain_od = prepared_od.clone();
+    let (mut prepared, mut plain) = (Axis::new(0), Axis::new(0));
+    let (mut prepared_cache, mut plain_cache) = (AxisCache::new(), AxisCache::new());
+    let changes: [(u16, u8, i64); 8] = [
+        (0x6060, 0, 3),
+        (0x6040, 0, 6),
+        (crate::params::A150, 0, 250),
+        (0x6040, 0, 7),
+        (0x6048, 1, 12_345),
+        (0x6040, 0, 0x0F),
+        (0x60FF, 0, 50_000),
+        (0x6065, 0, 77),
+    ];
+    let mut io = AxisIo::ready(0);
+    for k in 0..64u64 {
+        if let Some(&(index, sub, v)) = changes.get((k / 8) as usize).filter(|_| k % 8 == 4) {
+            prepared_od.set(index, sub, v).unwrap();
+            plain_od.set(index, sub, v).unwrap();
+        }
+        io.position_inc = io.position_inc.wrapping_add(100);
+        let now = Nanos::from_us(250 * k);
+        prepared.prepare(&mut prepared_cache, &mut prepared_od);
+        let a = prepared.cycle_cached(&mut prepared_cache, &mut prepared_od, &io, now, true);
+        let b = plain.cycle_cached(&mut plain_cache, &mut plain_od, &io, now, true);
+        assert_eq!(std::format!("{a:?}"), std::format!("{b:?}"), "cycle {k}");
+        assert!(prepared_od == plain_od, "cycle {k}: the objects");
+        assert_eq!(
+            std::format!("{prepared:?}"),
+            std::format!("{plain:?}"),
+            "cycle {k}: the axis"
+        );
+    }
+    assert_eq!(prepared.mode(), Mode::ProfileVelocity, "the sequence ran");
+}

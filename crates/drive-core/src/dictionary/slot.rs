@@ -237,7 +237,7 @@ impl Slot {
 
     /// Whether a changed value is a configuration change
     /// ([`DriveObjects::config_generation`]).
-    pub(crate) fn is_config(self) -> bool {
+    pub fn is_config(self) -> bool {
         self.config
     }
 }

@@ -162,6 +162,32 @@ impl DriveAccess<'_> {
         }
     }
 
+    /// Whether a changed value written to `addr` (a PNU or an object) is a
+    /// configuration change ([`DriveObjects::config_generation`]): an
+    /// object in RAM that is no cyclic set-point, and the vl ramps of PNU
+    /// 1011.2. Records, the profile's own values and unknown addresses are
+    /// none.
+    pub fn is_config_entry(&self, addr: Addr) -> bool {
+        let config = |index: u16, sub: u8| {
+            self.objects
+                .slot(self.index(index), sub)
+                .is_some_and(|s| s.is_config())
+        };
+        let p = match lookup::memoised(addr) {
+            Some(p) => p,
+            None if !lookup::is_catalogue_index(addr.index) => return config(addr.index, addr.sub),
+            None => match lookup::find_and_remember(addr) {
+                Ok(p) => p,
+                Err(_) => return false,
+            },
+        };
+        match p.source {
+            Source::Object { index, sub } => config(index, sub),
+            Source::VlBothRamps => true,
+            _ => false,
+        }
+    }
+
     fn user_units(&self) -> UserUnits {
         self.user_units.get(self.objects, self.axis)
     }
@@ -370,13 +396,17 @@ impl DriveAccess<'_> {
                 _ if k == 0 => self.record_number(jog),
                 _ => k,
             };
-            let (mut r, read): (Record, Record) = match self.pending {
-                Some((a, m, _, r, read)) if (a, m) == (axis, n) => (r, read),
-                _ => {
-                    self.flush_record();
-                    let read = self.objects.record(axis, n).ok_or(PdError::NOT_IN_STATE)?;
-                    (read, read)
-                }
+            // the pending record of `n` is edited in place (issue 36: the
+            // two records copied out and back per field cost more than the
+            // edit); another one is stored first and `n` read (a field the
+            // record refuses leaves it as read: nothing to store)
+            if !matches!(self.pending, Some((a, m, ..)) if (a, m) == (axis, n)) {
+                self.flush_record();
+                let read = self.objects.record(axis, n).ok_or(PdError::NOT_IN_STATE)?;
+                self.pending = Some((axis, n, false, read, read));
+            }
+            let Some((_, _, flag, r, _)) = self.pending.as_mut() else {
+                return Err(PdError::NOT_IN_STATE);
             };
             let as_u32 = || u32::try_from(value).map_err(|_| PdError::LIMIT_EXCEEDED);
             match field {
@@ -394,7 +424,7 @@ impl DriveAccess<'_> {
             }
             // stored at the next other access (a record that was read is
             // there to store: set_record cannot refuse it)
-            self.pending = Some((axis, n, selected, r, read));
+            *flag = selected;
         }
         Ok(())
     }

@@ -113,12 +113,22 @@ pub fn find_and_remember(addr: Addr) -> Result<&'static Pnu, PdError> {
     pnu::CATALOGUE.get(i).ok_or(PdError::IMPERMISSIBLE_PNU)
 }
 
-/// [`pnu::is_catalogue_index`].
+/// The catalogue's last (highest) index: an index above it is none of
+/// the catalogue's (built at compile time from the sorted catalogue).
+const LAST_INDEX: u16 = match pnu::CATALOGUE.last() {
+    Some(p) => p.addr.index,
+    None => 0,
+};
+
+/// [`pnu::is_catalogue_index`]: an index above the catalogue's last (a
+/// CiA 402 object of a telegram, 6071h, 6077h) without the search (issue
+/// 36).
 pub fn is_catalogue_index(index: u16) -> bool {
     let c = pnu::CATALOGUE;
     index < 0x1000
-        || c.get(c.partition_point(|p| p.addr.index < index))
-            .is_some_and(|p| p.addr.index == index)
+        || index <= LAST_INDEX
+            && c.get(c.partition_point(|p| p.addr.index < index))
+                .is_some_and(|p| p.addr.index == index)
 }
 
 /// Entries kept (the default telegrams touch nine CiA 402 entries, eight
@@ -149,6 +159,23 @@ impl PreparedCache {
             keys: [0; ENTRIES],
             handles: [None; ENTRIES],
             next: 0,
+        }
+    }
+
+    /// Every entry kept prepared again where it went stale (the
+    /// configuration moved): outside the control cycle, so its telegram
+    /// finds the handles current (issue 36). The same handles
+    /// [`get`](Self::get) would prepare at its next access.
+    pub fn refresh(&mut self, objects: &DriveObjects) {
+        for (key, handle) in self.keys.iter_mut().zip(self.handles.iter_mut()) {
+            if *key == 0 || handle.as_ref().is_some_and(|p| objects.is_current(p)) {
+                continue;
+            }
+            let (index, sub) = ((*key >> 8) as u16, *key as u8);
+            *handle = objects.prepare(index, sub, CommState::Op);
+            if handle.is_none() {
+                *key = 0;
+            }
         }
     }
 

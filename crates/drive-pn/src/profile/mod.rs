@@ -83,6 +83,9 @@ pub struct Profile {
     homing: bool,
     /// Frames with an unknown identifier or another warning.
     warnings: u32,
+    /// The configuration generation [`prepare`](Self::prepare) last
+    /// brought the units and prepared accesses to.
+    prepared_at: Option<u32>,
 }
 
 impl Profile {
@@ -106,6 +109,7 @@ impl Profile {
             response: None,
             homing: false,
             warnings: 0,
+            prepared_at: None,
         };
         let access = drive_access!(p, objects, axis, &mut NoLive);
         // the stored configuration (A280, P-069), else the FB's
@@ -184,6 +188,43 @@ impl Profile {
     /// cost telegram 0 about 8,000 instructions per frame on QEMU).
     pub fn warm_up(&mut self, objects: &DriveObjects, axis: &Axis) {
         self.core.resolve(objects, axis);
+    }
+
+    /// After a frame, in the bus task (issue 36: outside the control
+    /// cycle), when the configuration moved: the unit choices A279 looked
+    /// at ([`refresh_units`](Self::refresh_units), as the next telegram's
+    /// first step would), the core entries resolved, the axis' user units
+    /// read and the prepared accesses the telegrams used brought to the
+    /// configuration in force. The control cycle's telegram then finds
+    /// them current; what it computes is the same.
+    ///
+    /// With `frame`, the OUT module's data the next control cycle applies:
+    /// its entries whose write is a configuration change (the vl ramps of
+    /// telegram 1, PNU 1011.2 → 6048h/6049h) are written here first, when
+    /// their bytes differ from the frame applied last or the configuration
+    /// moved since (a value changed behind the telegram), so the axes'
+    /// preparation after this reads the snapshot they make and the control
+    /// cycle's telegram writes them unchanged (no new configuration
+    /// generation inside it). Nothing else of the telegram (CW1, PKW, mode,
+    /// set-points, records) is applied ahead.
+    pub fn prepare(&mut self, frame: Option<&[u8]>, objects: &mut DriveObjects, axis: &mut Axis) {
+        let moved = self.prepared_at != Some(objects.config_generation());
+        if moved {
+            self.refresh_units(objects, axis);
+            self.core.resolve(objects, axis);
+        }
+        if let (Some(frame), Some(telegrams)) = (frame, self.telegrams.as_ref()) {
+            let mut access = drive_access!(self, objects, axis, &mut NoLive);
+            telegrams.write_ahead(frame, &mut access, moved, |a, addr| a.is_config_entry(addr));
+        }
+        let g = objects.config_generation();
+        if self.prepared_at != Some(g) {
+            // again after a write ahead (a compare when nothing moved)
+            self.refresh_units(objects, axis);
+            let _ = self.user_units.get(objects, axis);
+            self.prepared.refresh(objects);
+            self.prepared_at = Some(g);
+        }
     }
 
     /// The unit choices A279 (P-212): new units once they convert; a

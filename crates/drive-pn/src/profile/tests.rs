@@ -472,3 +472,49 @@ fn p071_telegram_0_stores_its_record_fields_and_the_window_shows_them() {
     }
     assert!(seen[0].iter().zip(&seen[1]).all(|(a, b)| a != b), "{seen:?}");
 }
+
+/// P-072, P-067 (issue 36: no reconfiguration inside the control cycle):
+/// telegram 1's ramps (PNU 1011.2 → 6048h/6049h, configuration values)
+/// are written where the frame is received, so the control cycle that
+/// applies the telegram finds the configuration generation unchanged and
+/// writes them again unchanged; a ramp changed behind the telegram is
+/// written back there too, as the telegram's next cycle did. CW1, the
+/// target velocity and the mode wait for the control cycle.
+#[test]
+fn p072_p067_telegram_1_ramps_are_written_where_the_frame_is_received() {
+    let mut b = Bench::new();
+    b.run(&speed(0x0406, 0, 1000, [0; 8]), 5);
+    let io = b.io;
+    for (ramps, behind) in [(2500u32, None), (2500, Some(7)), (4000, None)] {
+        if let Some(v) = behind {
+            b.d.objects_mut().set(0x6048, 1, v).unwrap();
+        }
+        b.counter = b.counter.wrapping_add(32);
+        let f = b.frame(&speed(0x0407, 100, ramps, [0; 8]));
+        let now = Nanos::from_ms(b.ms);
+        b.d.receive(now, &f, &mut |_: &[u8]| {}, &mut |_| {});
+        assert_eq!(
+            b.d.objects().get(0x6048, 1),
+            Ok(i64::from(ramps)),
+            "written ahead"
+        );
+        assert_eq!(b.d.objects().get(0x6049, 1), Ok(i64::from(ramps)));
+        assert_eq!(
+            b.d.objects().get(0x6042, 0),
+            Ok(0),
+            "the target waits for the cycle"
+        );
+        assert_eq!(b.d.profile().own().cw1, 0x0406, "CW1 waits for the cycle");
+        let g = b.d.objects().config_generation();
+        b.d.control_cycle(now, &io);
+        assert_eq!(
+            b.d.objects().config_generation(),
+            g,
+            "no configuration change in the cycle"
+        );
+        assert_eq!(b.d.objects().get(0x6042, 0), Ok(100));
+        assert_eq!(b.d.profile().own().cw1, 0x0407);
+        b.ms += 1;
+        b.run(&speed(0x0406, 0, ramps, [0; 8]), 3);
+    }
+}

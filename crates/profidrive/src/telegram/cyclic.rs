@@ -189,6 +189,61 @@ impl Telegrams {
         out
     }
 
+    /// Writes the object entries of `frame` (a receive telegram, as
+    /// [`apply_receive`](Self::apply_receive) writes them) that `pick`
+    /// selects, and nothing else: no CW1, no PKW, no live view, no telegram
+    /// switch. An entry is written when `pick` selects it (it sees the
+    /// access and the entry's address) and, unless `every`, its bytes differ
+    /// from the frame applied last (or the telegram does). For
+    /// a personality that writes the configuration values a telegram
+    /// carries where the configuration changes, ahead of the control cycle
+    /// that applies the telegram and writes them again, unchanged (issue
+    /// 36). Returns the entries written.
+    pub fn write_ahead<A: ParamAccess>(
+        &self,
+        frame: &[u8],
+        access: &mut A,
+        every: bool,
+        mut pick: impl FnMut(&A, Addr) -> bool,
+    ) -> usize {
+        let n = match frame.first() {
+            Some(&id) if self.configured && (0xE0..0xE0 + TELEGRAMS as u8).contains(&id) => id - 0xE0,
+            _ => return 0,
+        };
+        let Some(layout) = self.receive.get(usize::from(n)) else {
+            return 0;
+        };
+        let last = (self.live.last_rx == Some(n)).then(|| self.live_receive());
+        // the frame applied last again (a controller repeats its telegram):
+        // no entry changed
+        if !every && last == Some(frame) {
+            return 0;
+        }
+        let mut written = 0;
+        for s in layout.slots() {
+            let Kind::Object(t) = s.kind else {
+                continue;
+            };
+            let at = usize::from(s.offset);
+            let Some(bytes) = frame.get(at..at + usize::from(s.size)) else {
+                continue;
+            };
+            // a byte loop (two or four bytes), not a slice compare's call
+            let changed = match last.and_then(|l| l.get(at..at + usize::from(s.size))) {
+                Some(l) => l.iter().zip(bytes).any(|(a, b)| a != b),
+                None => true,
+            };
+            if !(changed || every) || !pick(access, s.addr) {
+                continue;
+            }
+            let v = decode_be(t, bytes);
+            if fits(t, v) && access.write(s.addr, v, true).is_ok() {
+                written += 1;
+            }
+        }
+        written
+    }
+
     /// Packs response telegram `n` into `buf` (the IN module; its length is
     /// the module length): identifier, the entries read from `access` in
     /// bus order, placeholders 0, `pkw` in the PKW slot. `None` when `n` is
