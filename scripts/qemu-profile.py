@@ -8,14 +8,18 @@ esc; the idle loop resets it), and prints per task the instructions per run
 and the top functions. Deterministic under `-icount`. About seven minutes for
 the end-to-end run; `scripts/cross profile` runs it.
 
-usage: qemu-system-arm ... -d in_asm,exec,nochain 2>&1 >/dev/null | qemu-profile.py ELF [TASK:FIRST:LAST]
+usage: qemu-system-arm ... -d in_asm,exec,nochain 2>&1 >/dev/null | qemu-profile.py ELF [TASK:FIRST:LAST [LINES]]
 
 TASK:FIRST:LAST (e.g. EXTI1:69:319, the control cycles of the csp move)
 counts only runs FIRST..=LAST (1-based) of that handler; its other runs are
-reported as TASK-other.
+reported as TASK-other. LINES (e.g. 60) also lists that task's costliest
+source lines per run: each instruction charged to the innermost frame in the
+project's crates (llvm-addr2line with inlining, so the lines of functions
+LTO inlined into the task count where they are written).
 """
 import bisect
 import collections
+import json
 import re
 import shutil
 import subprocess
@@ -26,6 +30,7 @@ window = None
 if len(sys.argv) > 2:
     t, a, b = sys.argv[2].split(':')
     window = (t, int(a), int(b))
+lines_wanted = int(sys.argv[3]) if len(sys.argv) > 3 else 0
 # symbols
 syms = []
 nm = shutil.which('llvm-nm-22') or shutil.which('llvm-nm') or 'arm-none-eabi-nm'
@@ -42,6 +47,7 @@ def name(pc):
         return syms[i][2]
     return '?'
 tb_len = {}   # pc -> instruction count (from in_asm)
+tb_ins = {}   # pc -> the block's instruction addresses (for the per-line listing)
 counts = collections.Counter()
 task = 'idle'
 entries = {}
@@ -50,19 +56,20 @@ for a, sz, nm in syms:
         entries[a] = nm
 idle_rng = [(a, a + sz) for a, sz, nm in syms if nm.startswith('firmware_qemu::app::idle')]
 handlers = collections.Counter()
-cur = None; n = 0
+cur = None; n = 0; ins = []
 for line in sys.stdin:
     if line.startswith('IN:'):
-        if cur is not None: tb_len[cur] = n
-        cur = None; n = 0
+        if cur is not None: tb_len[cur] = n; tb_ins[cur] = ins
+        cur = None; n = 0; ins = []
         continue
     m = re.match(r'^0x([0-9a-f]{8}):', line)
     if m:
         if cur is None: cur = int(m.group(1), 16)
         n += 1
+        if lines_wanted: ins.append(int(m.group(1), 16))
         continue
     if line.startswith('Trace'):
-        if cur is not None: tb_len[cur] = n; cur = None; n = 0
+        if cur is not None: tb_len[cur] = n; tb_ins[cur] = ins; cur = None; n = 0; ins = []
         m = re.search(r'\[[0-9a-f]+/([0-9a-f]+)/', line)
         if m:
             pc = int(m.group(1), 16)
@@ -90,3 +97,35 @@ for t in ('EXTI1', 'EXTI2', 'EXTI0'):
     rows = [(c, f) for (tt, f), c in per.items() if tt == t]
     for c, f in sorted(rows, reverse=True)[:45]:
         print(f'{c//max(k, 1):>9} per run {100*c/max(tot[t],1):5.1f}% {f[:110]}')
+
+if lines_wanted and window:
+    # the window task's instructions, each charged to its innermost frame
+    # in the project's crates
+    t = window[0]
+    k = max(min(window[2], handlers[t]) - window[1] + 1, 1)
+    per_ins = collections.Counter()
+    for (tt, pc), c in counts.items():
+        if tt == t:
+            for a in tb_ins.get(pc, [pc]):
+                per_ins[a] += c
+    tool = shutil.which('llvm-addr2line-22') or shutil.which('llvm-addr2line')
+    if not tool:
+        print('(no llvm-addr2line: no per-line listing)')
+        sys.exit(0)
+    addrs = sorted(per_ins)
+    out = subprocess.run([tool, '-e', elf, '-i', '-f', '--output-style=JSON'],
+                         input='\n'.join(hex(a) for a in addrs), capture_output=True, text=True).stdout
+    per_line = collections.Counter()
+    top_dir = elf.split('/firmware/target/')[0] + '/'
+    for a, row in zip(addrs, out.splitlines()):
+        frames = json.loads(row).get('Symbol') or []
+        where = '?'
+        for f in frames:
+            if f['FileName'].startswith(top_dir + 'crates/'):
+                where = f"{f['FileName'][len(top_dir):]}:{f['Line']}"
+                break
+        per_line[where] += per_ins[a]
+    total = max(sum(per_line.values()), 1)
+    print(f'== {t}: the {lines_wanted} costliest source lines per run (innermost frame in crates/)')
+    for where, c in per_line.most_common(lines_wanted):
+        print(f'{c/k:>9.1f} per run {100*c/total:5.1f}% {where}')
