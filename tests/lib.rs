@@ -1123,14 +1123,7 @@ pub fn signed_file(
     len: usize,
     seed: &[u8; 32],
 ) -> Vec<u8> {
-    let body: Vec<u8> = (0..len)
-        .map(|i| {
-            (i as u32)
-                .wrapping_mul(2_654_435_761)
-                .wrapping_add(version)
-                .to_le_bytes()[3]
-        })
-        .collect();
+    let body = hil_sim::sim::firmware_body(len, version);
     let mut h = drive_ecat::boot::ImageHeader::for_body(&body, version, fw_load_address(slot), counter);
     h.sign(&body, seed);
     let mut f = h.to_bytes().to_vec();

@@ -204,9 +204,7 @@ fn e019_foe_file_for_the_update_slot_through_soem_firm_update() {
     };
     let _one = ONE_AT_A_TIME.lock().unwrap_or_else(|e| e.into_inner());
     let dir = scratch("soem-foe");
-    let body: Vec<u8> = (0..64 * 1024u32)
-        .map(|i| (i.wrapping_mul(2_654_435_761) >> 24) as u8)
-        .collect();
+    let body = hil_sim::sim::firmware_body(64 * 1024, 0);
     // the image linked for each slot of `serve`'s drive, signed with the
     // development key (issue 18), written under the tool's default name
     let seed = drive_ecat::boot::parse_key_hex(include_str!("../../keys/dev-ed25519.key")).unwrap();
