@@ -100,6 +100,21 @@ pub fn with_master<T>(
     with_master_on(sim, body)
 }
 
+/// Runs `body` on `sim`'s line brought to Op (ethercrab's init, then
+/// `into_op`) with the master on its first drive ([`Cyclic`], the outputs
+/// all zero) and that drive's SubDevice.
+pub fn with_cyclic<T>(
+    sim: &RefCell<Simulation>,
+    body: impl for<'a> AsyncFnOnce(&mut Cyclic<'a>, &OpSubDevice<'a>) -> T,
+) -> T {
+    with_master(sim, async |md, clock| {
+        let group = init(md, clock).await.into_op(md).await.expect("OP");
+        let sd = group.subdevice(md, 0).unwrap();
+        let mut m = Cyclic::new(md, &group, sim, 0);
+        body(&mut m, &sd).await
+    })
+}
+
 /// Discovers the line and brings it to PRE-OP (ethercrab's init).
 pub async fn init<'a>(md: &'a MainDevice<'a>, clock: &'a AtomicU64) -> SubDeviceGroup<8, 512> {
     match md
@@ -643,6 +658,9 @@ impl CoeClient {
 // ---------------------------------------------------------------------------
 // Cyclic process data with the default PDO layout (tests/tests/motion.rs)
 // ---------------------------------------------------------------------------
+
+/// A SubDevice of an [`OpGroup`].
+pub type OpSubDevice<'a> = SubDeviceRef<'a, ethercrab::SubDevicePdi<'a, 512, ethercrab::DefaultLock>>;
 
 /// A group in Op as [`init`] + `into_op` leave it.
 pub type OpGroup = ethercrab::SubDeviceGroup<
