@@ -931,6 +931,18 @@ impl<'a> Cyclic<'a> {
         self.run(n).await
     }
 
+    /// Enabled in csv ([`Self::enable_in`] 9) at the target velocity `v`
+    /// (inc/s) until the axis runs within 1/20 rev/s of it (500 cycles at
+    /// most; panics otherwise), then 20 cycles more.
+    pub async fn csv_reach(&mut self, v: i32) -> TxPdo {
+        self.enable_in(9).await;
+        self.set_target_velocity(v);
+        self.run_until(500, |t| (t.velocity - v).abs() < REV / 20)
+            .await
+            .unwrap_or_else(|| panic!("running at {v} inc/s"));
+        self.run(20).await
+    }
+
     /// Mode `mode` (6060h) for three cycles, then [`Self::enable`].
     pub async fn enable_in(&mut self, mode: i8) -> TxPdo {
         self.set_mode(mode);

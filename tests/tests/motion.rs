@@ -612,12 +612,7 @@ fn c010_c011_quick_stop_through_pdo() {
         sd.sdo_write(0x6085, 0, 100 * REV as u32).await.unwrap();
         let qs_option: i16 = sd.sdo_read(0x605A, 0).await.unwrap();
         assert_eq!(qs_option, 2, "605Ah default: quick stop ramp, then SOD");
-        m.enable_in(9).await;
-        m.set_target_velocity(5 * REV);
-        m.run_until(500, |t| (t.velocity - 5 * REV).abs() < REV / 20)
-            .await
-            .expect("running at 5 rev/s");
-        m.run(20).await;
+        m.csv_reach(5 * REV).await;
 
         // quick stop: bit 2 = 0 with bits 0, 1, 3 kept (0x000B)
         let t0 = m.now().as_ns();

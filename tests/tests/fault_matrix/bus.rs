@@ -4,6 +4,7 @@
 use super::{advance, emcys, ethercrab, newest_diag};
 use drive_tests::al::{ACK, INIT, OP, PREOP};
 use drive_tests::matrix::{al, cia402_state, emcys as show_emcys, Row};
+use drive_tests::step::op_via_safe_op;
 use drive_tests::{al_status, fault_row, init, line, request, with_master, Cyclic, REV};
 use ethercrab::subdevice_group::DcConfiguration;
 use hil_sim::master::{into_dc_sync0, PdiSubDevice};
@@ -30,12 +31,7 @@ fn burst_free_run(a258: u16, lost: u64) -> String {
         let group = init(md, clock).await;
         let sd = group.subdevice(md, 0).unwrap();
         sd.sdo_write(A258, 0, a258).await.unwrap();
-        let group = group.into_safe_op(md).await.expect("SAFE-OP");
-        for _ in 0..5 {
-            advance(&sim, 1_000_000);
-            group.tx_rx(md).await.unwrap();
-        }
-        let group = group.into_op(md).await.expect("OP");
+        let group = op_via_safe_op(md, group, &sim).await;
         let sd = group.subdevice(md, 0).unwrap();
         let mut m = Cyclic::new(md, &group, &sim, 0);
         m.csv_at(REV, 200).await;
