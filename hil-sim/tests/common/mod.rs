@@ -6,6 +6,7 @@
 use std::process::{Child, Command, Stdio};
 use std::time::Duration;
 
+pub mod kickcat;
 pub mod pn_line;
 pub mod scope_check;
 pub mod soem_line;
