@@ -184,12 +184,7 @@ pub fn serve(args: &ServeArgs) -> Result<(), String> {
             return Err("--flywheel has no holding brake: no brake fault with it".into());
         }
         for d in sim.drives_mut() {
-            let m = d.motors[0].params_mut();
-            m.inertia_kg_m2 = j;
-            m.viscous_friction_nm_s_per_rad = 0.0;
-            m.coulomb_friction_nm = 0.0;
-            m.static_friction_nm = 0.0;
-            m.brake_holding_torque_nm = 0.0;
+            d.motors[0].params_mut().set_flywheel(j);
         }
     }
     // the recording first: an unwritable path fails before anything else

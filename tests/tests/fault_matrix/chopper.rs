@@ -71,14 +71,9 @@ fn balance(d: &SimDrive, a: Books, b: Books) -> (f64, String) {
 fn flywheel(d: &mut SimDrive) {
     d.set_plant(PlantModel::Electrical, 34)
         .expect("the default servo");
-    let m = d.motors[0].params_mut();
-    m.inertia_kg_m2 = J;
-    m.viscous_friction_nm_s_per_rad = 0.0;
-    m.coulomb_friction_nm = 0.0;
-    m.static_friction_nm = 0.0;
-    // no holding brake: the fault's coast engages it, and it would take the
-    // flywheel's energy between the trip and the reading
-    m.brake_holding_torque_nm = 0.0;
+    // no holding brake either: the fault's coast engages it, and it would
+    // take the flywheel's energy between the trip and the reading
+    d.motors[0].params_mut().set_flywheel(J);
 }
 
 /// Runs `m` with `torque` until the speed passes `rev_s` (accelerating) or
