@@ -27,10 +27,7 @@ fn c038_p187_soem_cst_steps_on_the_electrical_plant_give_6077h_within_2_percent(
         .get(drive_ecat::params::I10, 0)
         .expect("I10 declared");
     let line = Line::with_serve_args("e", 1, 120, &dir, &["--plant", "electrical"]);
-    let status = line.run(&python, "cst_electrical.py", &["--i10", &i10.to_string()]);
-    if !status.success() {
-        line.fail_with(&format!("cst_electrical.py through SOEM failed: {status}"));
-    }
+    line.run_passes(&python, "cst_electrical.py", &["--i10", &i10.to_string()]);
 }
 
 /// C-038 and E-089 through SOEM on the electrical plant
@@ -54,10 +51,7 @@ fn c038_e089_soem_max_current_and_motor_i2t_on_the_electrical_plant() {
     };
     let dir = scratch("soem-motor-protection");
     let line = Line::with_serve_args("m", 1, 120, &dir, &["--plant", "electrical"]);
-    let status = line.run(&python, "motor_protection.py", &[]);
-    if !status.success() {
-        line.fail_with(&format!("motor_protection.py through SOEM failed: {status}"));
-    }
+    line.run_passes(&python, "motor_protection.py", &[]);
 }
 
 /// E-089 and C-017 through SOEM on the electrical plant (`overcurrent.py`,
@@ -84,10 +78,7 @@ fn e089_c017_soem_over_current_trip_on_the_electrical_plant() {
         &dir,
         &["--plant", "electrical", "--plant-fault", "short"],
     );
-    let status = line.run(&python, "overcurrent.py", &[]);
-    if !status.success() {
-        line.fail_with(&format!("overcurrent.py through SOEM failed: {status}"));
-    }
+    line.run_passes(&python, "overcurrent.py", &[]);
 }
 
 /// C-038 and E-089 through SOEM on the electrical plant (`stage_i2t.py`,
@@ -155,14 +146,11 @@ fn e140_e141_soem_motor_actions_identify_the_plants_r_l_and_commutation_offset()
             offset,
         ],
     );
-    let status = line.run(
+    line.run_passes(
         &python,
         "motor_actions.py",
         &["--r", r, "--l", l, "--offset", offset],
     );
-    if !status.success() {
-        line.fail_with(&format!("motor_actions.py through SOEM failed: {status}"));
-    }
 }
 
 /// E-090 and E-089 through SOEM on the electrical plant (`chopper.py`, issue
@@ -189,10 +177,7 @@ fn e090_e089_soem_braking_a_flywheel_without_brake_resistor_trips_over_voltage()
         &dir,
         &["--plant", "electrical", "--flywheel", "0.01"],
     );
-    let status = line.run(&python, "chopper.py", &[]);
-    if !status.success() {
-        line.fail_with(&format!("chopper.py through SOEM failed: {status}"));
-    }
+    line.run_passes(&python, "chopper.py", &[]);
 }
 
 /// E-140, E-141 through SOEM on the electrical plant (`mechanics.py`, issue
@@ -214,12 +199,9 @@ fn e140_e141_soem_b44_identify_mechanics_refused_beyond_the_limits_then_identifi
     };
     let dir = scratch("soem-mechanics");
     let line = Line::with_serve_args("b4", 1, 120, &dir, &["--plant", "electrical"]);
-    let status = line.run(
+    line.run_passes(
         &python,
         "mechanics.py",
         &["--j", "1e-4", "--fc", "0.02", "--b", "2e-5"],
     );
-    if !status.success() {
-        line.fail_with(&format!("mechanics.py through SOEM failed: {status}"));
-    }
 }

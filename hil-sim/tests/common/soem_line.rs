@@ -153,6 +153,15 @@ impl Line {
         }
     }
 
+    /// [`run`](Self::run)s `script` with `args`; its failure ends the test
+    /// ([`fail_with`](Self::fail_with) "`script` through SOEM failed").
+    pub fn run_passes(&self, python: &Path, script: &str, args: &[&str]) {
+        let status = self.run(python, script, args);
+        if !status.success() {
+            self.fail_with(&format!("{script} through SOEM failed: {status}"));
+        }
+    }
+
     /// What `serve` printed (state changes of every drive, with AL codes).
     /// Ends a test with `what` and the last 60 lines serve printed.
     pub fn fail_with(&self, what: &str) -> ! {
