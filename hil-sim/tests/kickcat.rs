@@ -31,12 +31,8 @@ fn kickcat_python() -> Result<PathBuf, String> {
 /// [`END_TOLERANCE_INC`](kickcat::END_TOLERANCE_INC) of the target (C-116, C-117), Init.
 #[test]
 fn e080_e082_e078_e056_e021_e034_c116_c117_kickcat_line_of_two_drives_csp_move() {
-    let python = match kickcat_python() {
-        Ok(p) => p,
-        Err(why) => {
-            eprintln!("kickcat test: skipped, {why}");
-            return;
-        }
+    let Some(python) = common::or_skip(kickcat_python(), "kickcat test") else {
+        return;
     };
     let dir = scratch("kickcat-line");
     let line = Line::new("k", 2, 120, &dir);

@@ -111,12 +111,8 @@ fn od_listing() -> String {
 /// data in Op, the cycles with a wrong working counter printed.
 #[test]
 fn e002_e005_e080_e082_e045_e029_e015_soem_line_scan_sdo_info_pdo_dc_cia402() {
-    let python = match pysoem_python() {
-        Ok(p) => p,
-        Err(why) => {
-            eprintln!("soem line test: skipped, {why}");
-            return;
-        }
+    let Some(python) = common::or_skip(pysoem_python(), "soem line test") else {
+        return;
     };
     let _one = ONE_AT_A_TIME.lock().unwrap_or_else(|e| e.into_inner());
     let dir = scratch("soem-line");
@@ -151,12 +147,8 @@ fn e002_e005_e080_e082_e045_e029_e015_soem_line_scan_sdo_info_pdo_dc_cia402() {
 /// the UDP parameter service (port 5011) of every drive (E-095).
 #[test]
 fn e096_e095_e098_soem_set_ip_ping_and_udp_through_a_tap_bridge() {
-    let python = match pysoem_python() {
-        Ok(p) => p,
-        Err(why) => {
-            eprintln!("soem EoE test: skipped, {why}");
-            return;
-        }
+    let Some(python) = common::or_skip(pysoem_python(), "soem EoE test") else {
+        return;
     };
     let _one = ONE_AT_A_TIME.lock().unwrap_or_else(|e| e.into_inner());
     let dir = scratch("soem-eoe");
@@ -189,12 +181,8 @@ fn e096_e095_e098_soem_set_ip_ping_and_udp_through_a_tap_bridge() {
 /// seen: `tools/foe-image/tests/round_trip.rs`).
 #[test]
 fn e019_foe_file_for_the_update_slot_through_soem_firm_update() {
-    let python = match pysoem_python() {
-        Ok(p) => p,
-        Err(why) => {
-            eprintln!("soem FoE test: skipped, {why}");
-            return;
-        }
+    let Some(python) = common::or_skip(pysoem_python(), "soem FoE test") else {
+        return;
     };
     let _one = ONE_AT_A_TIME.lock().unwrap_or_else(|e| e.into_inner());
     let dir = scratch("soem-foe");
@@ -311,12 +299,8 @@ fn seen_in<'a>(rows: &'a [(String, String)], order: &str) -> &'a str {
 /// at least as long as A258 repeats a case (faults.py).
 #[test]
 fn e126_e044_e128_e129_soem_frame_pauses_under_dc_with_a258_100_ms() {
-    let python = match pysoem_python() {
-        Ok(p) => p,
-        Err(why) => {
-            eprintln!("soem fault matrix (frame pauses): skipped, {why}");
-            return;
-        }
+    let Some(python) = common::or_skip(pysoem_python(), "soem fault matrix (frame pauses)") else {
+        return;
     };
     let _one = ONE_AT_A_TIME.lock().unwrap_or_else(|e| e.into_inner());
     let rows = fault_rows(&python, "p", &["pause"]);
@@ -357,12 +341,8 @@ fn e126_e044_e128_e129_soem_frame_pauses_under_dc_with_a258_100_ms() {
 /// SYNC0 (docs/fault-matrix.md, the SYNC0 loss in Init).
 #[test]
 fn e126_e044_e037_e021_soem_master_killed_in_op_and_a_new_master() {
-    let python = match pysoem_python() {
-        Ok(p) => p,
-        Err(why) => {
-            eprintln!("soem fault matrix (master killed): skipped, {why}");
-            return;
-        }
+    let Some(python) = common::or_skip(pysoem_python(), "soem fault matrix (master killed)") else {
+        return;
     };
     let _one = ONE_AT_A_TIME.lock().unwrap_or_else(|e| e.into_inner());
     let rows = fault_rows(&python, "r", &["restart"]);
@@ -390,12 +370,9 @@ fn e126_e044_e037_e021_soem_master_killed_in_op_and_a_new_master() {
 /// cleared a PLL fault latched below Safe-Op).
 #[test]
 fn e046_e021_soem_a_master_stopped_in_init_and_a_new_master_under_dc() {
-    let python = match pysoem_python() {
-        Ok(p) => p,
-        Err(why) => {
-            eprintln!("soem fault matrix (stop and restart under DC): skipped, {why}");
-            return;
-        }
+    let Some(python) = common::or_skip(pysoem_python(), "soem fault matrix (stop and restart under DC)")
+    else {
+        return;
     };
     let _one = ONE_AT_A_TIME.lock().unwrap_or_else(|e| e.into_inner());
     let rows = fault_rows(&python, "s", &["stop-restart"]);
@@ -421,12 +398,8 @@ fn e046_e021_soem_a_master_stopped_in_init_and_a_new_master_under_dc() {
 /// (`torque.py`).
 #[test]
 fn c039_soem_raises_g472_g475_by_sdo_and_cst_pt_move_the_axis() {
-    let python = match pysoem_python() {
-        Ok(p) => p,
-        Err(why) => {
-            eprintln!("soem torque-mode test: skipped, {why}");
-            return;
-        }
+    let Some(python) = common::or_skip(pysoem_python(), "soem torque-mode test") else {
+        return;
     };
     let _one = ONE_AT_A_TIME.lock().unwrap_or_else(|e| e.into_inner());
     let dir = scratch("soem-torque");

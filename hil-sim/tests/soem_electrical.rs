@@ -15,12 +15,8 @@ use common::soem_line::{pysoem_python, scratch, Line};
 /// rotor is below half the speed limit (G472/G475 = 100 % of I10).
 #[test]
 fn c038_p187_soem_cst_steps_on_the_electrical_plant_give_6077h_within_2_percent() {
-    let python = match pysoem_python() {
-        Ok(p) => p,
-        Err(why) => {
-            eprintln!("soem electrical test: skipped, {why}");
-            return;
-        }
+    let Some(python) = common::or_skip(pysoem_python(), "soem electrical test") else {
+        return;
     };
     let dir = scratch("soem-cst-electrical");
     let i10 = drive_ecat::DriveObjects::new()
@@ -42,12 +38,8 @@ fn c038_p187_soem_cst_steps_on_the_electrical_plant_give_6077h_within_2_percent(
 /// event 45).
 #[test]
 fn c038_e089_soem_max_current_and_motor_i2t_on_the_electrical_plant() {
-    let python = match pysoem_python() {
-        Ok(p) => p,
-        Err(why) => {
-            eprintln!("soem motor protection test: skipped, {why}");
-            return;
-        }
+    let Some(python) = common::or_skip(pysoem_python(), "soem motor protection test") else {
+        return;
     };
     let dir = scratch("soem-motor-protection");
     let line = Line::with_serve_args("m", 1, 120, &dir, &["--plant", "electrical"]);
@@ -63,12 +55,8 @@ fn c038_e089_soem_max_current_and_motor_i2t_on_the_electrical_plant() {
 /// a fault reset gives Switch on disabled and the next enable faults again.
 #[test]
 fn e089_c017_soem_over_current_trip_on_the_electrical_plant() {
-    let python = match pysoem_python() {
-        Ok(p) => p,
-        Err(why) => {
-            eprintln!("soem over-current test: skipped, {why}");
-            return;
-        }
+    let Some(python) = common::or_skip(pysoem_python(), "soem over-current test") else {
+        return;
     };
     let dir = scratch("soem-over-current");
     let line = Line::with_serve_args(
@@ -91,12 +79,8 @@ fn e089_c017_soem_over_current_trip_on_the_electrical_plant() {
 /// (i/I_rated)²), without a fault.
 #[test]
 fn c038_e089_soem_current_limit_and_power_stage_i2t_on_the_electrical_plant() {
-    let python = match pysoem_python() {
-        Ok(p) => p,
-        Err(why) => {
-            eprintln!("soem power stage i2t test: skipped, {why}");
-            return;
-        }
+    let Some(python) = common::or_skip(pysoem_python(), "soem power stage i2t test") else {
+        return;
     };
     let dir = scratch("soem-stage-i2t");
     let line = Line::with_serve_args("i", 1, 60, &dir, &["--plant", "electrical"]);
@@ -121,12 +105,8 @@ fn c038_e089_soem_current_limit_and_power_stage_i2t_on_the_electrical_plant() {
 /// the plant's brake (2 N·m, unknown to the drive) plus friction.
 #[test]
 fn e140_e141_soem_motor_actions_identify_the_plants_r_l_and_commutation_offset() {
-    let python = match pysoem_python() {
-        Ok(p) => p,
-        Err(why) => {
-            eprintln!("soem motor actions test: skipped, {why}");
-            return;
-        }
+    let Some(python) = common::or_skip(pysoem_python(), "soem motor actions test") else {
+        return;
     };
     let dir = scratch("soem-motor-actions");
     let (r, l, offset) = ("2.2", "0.0065", "0.3");
@@ -162,12 +142,8 @@ fn e140_e141_soem_motor_actions_identify_the_plants_r_l_and_commutation_offset()
 /// by the energy balance (within 5 %), 603Fh and EMCY 3110h (event 36).
 #[test]
 fn e090_e089_soem_braking_a_flywheel_without_brake_resistor_trips_over_voltage() {
-    let python = match pysoem_python() {
-        Ok(p) => p,
-        Err(why) => {
-            eprintln!("soem chopper test: skipped, {why}");
-            return;
-        }
+    let Some(python) = common::or_skip(pysoem_python(), "soem chopper test") else {
+        return;
     };
     let dir = scratch("soem-chopper");
     let line = Line::with_serve_args(
@@ -190,12 +166,8 @@ fn e090_e089_soem_braking_a_flywheel_without_brake_resistor_trips_over_voltage()
 /// are 0) and writes the speed controller's gain for B48.
 #[test]
 fn e140_e141_soem_b44_identify_mechanics_refused_beyond_the_limits_then_identifies_the_plant() {
-    let python = match pysoem_python() {
-        Ok(p) => p,
-        Err(why) => {
-            eprintln!("soem B44 test: skipped, {why}");
-            return;
-        }
+    let Some(python) = common::or_skip(pysoem_python(), "soem B44 test") else {
+        return;
     };
     let dir = scratch("soem-mechanics");
     let line = Line::with_serve_args("b4", 1, 120, &dir, &["--plant", "electrical"]);

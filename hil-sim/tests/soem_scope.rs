@@ -25,12 +25,8 @@ const LEVEL: f64 = 100_000.0;
 /// the drive moved (more than a revolution).
 #[test]
 fn issue35_soem_scope_trace_of_a_move_matches_the_physics() {
-    let python = match pysoem_python() {
-        Ok(p) => p,
-        Err(why) => {
-            eprintln!("soem scope test: skipped, {why}");
-            return;
-        }
+    let Some(python) = common::or_skip(pysoem_python(), "soem scope test") else {
+        return;
     };
     let dir = scratch("soem-scope");
     let csv = dir.join("scope-trace.csv");

@@ -176,6 +176,12 @@ pub fn watch_script(
     (status, lines)
 }
 
+/// The peer's python, or `None` after saying on stderr that `test` is
+/// skipped and why (the test then passes without running).
+pub fn or_skip(python: Result<std::path::PathBuf, String>, test: &str) -> Option<std::path::PathBuf> {
+    python.map_err(|why| eprintln!("{test}: skipped, {why}")).ok()
+}
+
 /// The python a peer written by others runs in, from the variable `var`
 /// (`.ci/run` installs the peer into target/`venv` and sets `var` to
 /// target/`venv`/bin/python), or why the test cannot run (not root, `var`
