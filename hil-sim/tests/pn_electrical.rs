@@ -37,13 +37,7 @@ fn run_named(
     script_args: &[&str],
     item: &str,
 ) -> Option<(String, String)> {
-    let python = match common::profinet_py_python() {
-        Ok(p) => p,
-        Err(why) => {
-            eprintln!("profinet-py electrical test: skipped, {why}");
-            return None;
-        }
-    };
+    let python = common::or_skip(common::profinet_py_python(), "profinet-py electrical test")?;
     let dir = Path::new(env!("CARGO_TARGET_TMPDIR")).join("profinet-py");
     std::fs::create_dir_all(&dir).expect("scratch dir");
     let serve: Vec<&OsStr> = ["--plant", "electrical"]

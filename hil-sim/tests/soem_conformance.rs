@@ -19,12 +19,8 @@ static ONE_AT_A_TIME: Mutex<()> = Mutex::new(());
 /// Runs `conformance.py --case <case>` on a line of one drive (`tag`: one
 /// letter for the namespaces); fails with serve's log.
 fn run_case(tag: &str, case: &str) {
-    let python = match pysoem_python() {
-        Ok(p) => p,
-        Err(why) => {
-            eprintln!("soem conformance case {case}: skipped, {why}");
-            return;
-        }
+    let Some(python) = common::or_skip(pysoem_python(), &format!("soem conformance case {case}")) else {
+        return;
     };
     let _one = ONE_AT_A_TIME.lock().unwrap_or_else(|e| e.into_inner());
     let dir = Path::new(env!("CARGO_TARGET_TMPDIR")).join(format!("soem-conformance-{case}"));
