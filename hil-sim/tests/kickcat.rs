@@ -41,13 +41,6 @@ fn e080_e082_e078_e056_e021_e034_c116_c117_kickcat_line_of_two_drives_csp_move()
     let args: Vec<&str> = args.iter().map(String::as_str).collect();
     let status = line.run(&python, "kickcat_line.py", &args);
     if !status.success() {
-        let serve = line.serve_output();
-        let tail: Vec<&str> = serve.lines().rev().take(40).collect();
-        let tail: Vec<&str> = tail.into_iter().rev().collect();
-        panic!(
-            "kickcat_line.py failed: {status}\n--- hil-sim serve ({}), last lines:\n{}",
-            line.serve_log.display(),
-            tail.join("\n")
-        );
+        line.fail_with(&format!("kickcat_line.py failed: {status}"));
     }
 }
