@@ -12,7 +12,8 @@
 mod common;
 
 use common::kickcat::{self, INC_PER_REV};
-use common::soem_line::{scratch, Line};
+use common::scratch;
+use common::soem_line::Line;
 use std::path::PathBuf;
 
 /// The python with kickcat, or why the test cannot run.

@@ -26,7 +26,8 @@
 
 mod common;
 
-use common::soem_line::{pysoem_python, scratch, Line, SCRIPT_LIMIT};
+use common::scratch;
+use common::soem_line::{pysoem_python, Line, SCRIPT_LIMIT};
 use ecat::Dictionary;
 use hil_sim::matrix::Row;
 use std::fmt::Write as _;

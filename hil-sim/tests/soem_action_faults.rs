@@ -9,7 +9,8 @@
 
 mod common;
 
-use common::soem_line::{pysoem_python, scratch, Line, SCRIPT_LIMIT};
+use common::scratch;
+use common::soem_line::{pysoem_python, Line, SCRIPT_LIMIT};
 use hil_sim::matrix::Row;
 use std::path::Path;
 use std::sync::Mutex;

@@ -9,7 +9,8 @@
 
 mod common;
 
-use common::soem_line::{pysoem_python, scratch, Line};
+use common::scratch;
+use common::soem_line::{pysoem_python, Line};
 use std::sync::Mutex;
 
 /// One SOEM run at a time.

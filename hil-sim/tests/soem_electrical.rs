@@ -6,7 +6,8 @@
 
 mod common;
 
-use common::soem_line::{pysoem_python, scratch, Line};
+use common::scratch;
+use common::soem_line::{pysoem_python, Line};
 
 /// C-038, P-187 through SOEM on the electrical plant (`cst_electrical.py`):
 /// 6071h steps of ±10 %, ±50 %, ±100 % of the rated torque in cst give a

@@ -8,7 +8,8 @@
 
 mod common;
 
-use common::soem_line::{pysoem_python, scratch, Line};
+use common::scratch;
+use common::soem_line::{pysoem_python, Line};
 
 const SAMPLES: usize = 2000;
 const PRE: usize = 20;

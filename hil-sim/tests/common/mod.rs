@@ -176,6 +176,13 @@ pub fn watch_script(
     (status, lines)
 }
 
+/// A scratch directory for one test's files (under cargo's target tmp).
+pub fn scratch(test: &str) -> std::path::PathBuf {
+    let dir = std::path::Path::new(env!("CARGO_TARGET_TMPDIR")).join(test);
+    std::fs::create_dir_all(&dir).expect("scratch dir");
+    dir
+}
+
 /// The peer's python, or `None` after saying on stderr that `test` is
 /// skipped and why (the test then passes without running).
 pub fn or_skip(python: Result<std::path::PathBuf, String>, test: &str) -> Option<std::path::PathBuf> {
