@@ -100,6 +100,21 @@ pub fn with_master<T>(
     with_master_on(sim, body)
 }
 
+/// Runs `body` on `sim`'s line brought to Op (ethercrab's init, then
+/// `into_op`) with the master on its first drive ([`Cyclic`], the outputs
+/// all zero) and that drive's SubDevice.
+pub fn with_cyclic<T>(
+    sim: &RefCell<Simulation>,
+    body: impl for<'a> AsyncFnOnce(&mut Cyclic<'a>, &OpSubDevice<'a>) -> T,
+) -> T {
+    with_master(sim, async |md, clock| {
+        let group = init(md, clock).await.into_op(md).await.expect("OP");
+        let sd = group.subdevice(md, 0).unwrap();
+        let mut m = Cyclic::new(md, &group, sim, 0);
+        body(&mut m, &sd).await
+    })
+}
+
 /// Discovers the line and brings it to PRE-OP (ethercrab's init).
 pub async fn init<'a>(md: &'a MainDevice<'a>, clock: &'a AtomicU64) -> SubDeviceGroup<8, 512> {
     match md
@@ -644,6 +659,9 @@ impl CoeClient {
 // Cyclic process data with the default PDO layout (tests/tests/motion.rs)
 // ---------------------------------------------------------------------------
 
+/// A SubDevice of an [`OpGroup`].
+pub type OpSubDevice<'a> = SubDeviceRef<'a, ethercrab::SubDevicePdi<'a, 512, ethercrab::DefaultLock>>;
+
 /// A group in Op as [`init`] + `into_op` leave it.
 pub type OpGroup = ethercrab::SubDeviceGroup<
     8,
@@ -913,6 +931,18 @@ impl<'a> Cyclic<'a> {
         self.run(n).await
     }
 
+    /// Enabled in csv ([`Self::enable_in`] 9) at the target velocity `v`
+    /// (inc/s) until the axis runs within 1/20 rev/s of it (500 cycles at
+    /// most; panics otherwise), then 20 cycles more.
+    pub async fn csv_reach(&mut self, v: i32) -> TxPdo {
+        self.enable_in(9).await;
+        self.set_target_velocity(v);
+        self.run_until(500, |t| (t.velocity - v).abs() < REV / 20)
+            .await
+            .unwrap_or_else(|| panic!("running at {v} inc/s"));
+        self.run(20).await
+    }
+
     /// Mode `mode` (6060h) for three cycles, then [`Self::enable`].
     pub async fn enable_in(&mut self, mode: i8) -> TxPdo {
         self.set_mode(mode);
@@ -1123,14 +1153,7 @@ pub fn signed_file(
     len: usize,
     seed: &[u8; 32],
 ) -> Vec<u8> {
-    let body: Vec<u8> = (0..len)
-        .map(|i| {
-            (i as u32)
-                .wrapping_mul(2_654_435_761)
-                .wrapping_add(version)
-                .to_le_bytes()[3]
-        })
-        .collect();
+    let body = hil_sim::sim::firmware_body(len, version);
     let mut h = drive_ecat::boot::ImageHeader::for_body(&body, version, fw_load_address(slot), counter);
     h.sign(&body, seed);
     let mut f = h.to_bytes().to_vec();

@@ -30,6 +30,19 @@ pub async fn cycles<S: HasPdi>(
     }
 }
 
+/// `group` (in PRE-OP, as [`init`](crate::init) leaves it) into SAFE-OP,
+/// five process-data [`cycles`] there (the drive sees its RxPDO running, as
+/// a watchdog A258 wants), then into OP.
+pub async fn op_via_safe_op(
+    md: &MainDevice<'_>,
+    group: SubDeviceGroup<8, 512>,
+    sim: &RefCell<Simulation>,
+) -> OpGroup {
+    let group = group.into_safe_op(md).await.expect("SAFE-OP");
+    cycles(md, &group, sim, 5).await;
+    group.into_op(md).await.expect("OP")
+}
+
 /// Object `index:sub` of the first drive set to `value` locally.
 pub fn set(sim: &RefCell<Simulation>, index: u16, sub: u8, value: i64) {
     sim.borrow_mut().drives_mut()[0]

@@ -74,14 +74,7 @@ impl Mbx {
 }
 
 fn file(version: u32) -> Vec<u8> {
-    let body: Vec<u8> = (0..FILE_LEN - IMAGE_HEADER_LEN)
-        .map(|i| {
-            (i as u32)
-                .wrapping_mul(2_654_435_761)
-                .wrapping_add(version)
-                .to_le_bytes()[3]
-        })
-        .collect();
+    let body = hil_sim::sim::firmware_body(FILE_LEN - IMAGE_HEADER_LEN, version);
     // signed with the development key for slot A, where the download goes
     // (the flash is empty); the drive verifies it at the end (issue 18)
     let seed = drive_ecat::boot::parse_key_hex(include_str!("../../keys/dev-ed25519.key")).expect("dev key");

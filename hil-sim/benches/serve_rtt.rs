@@ -26,8 +26,6 @@
 #[path = "../tests/common/mod.rs"]
 mod common;
 
-use ecat::Dictionary;
-
 use hil_sim::raw::{monotonic, RawSocket};
 
 fn monotonic_ns() -> u64 {
@@ -262,40 +260,16 @@ fn startup_phase(cpu: Option<&str>) {
         println!("start-up phase: skipped, KICKCAT_PYTHON is not set");
         return;
     };
-    let od = drive_ecat::DriveObjects::default();
-    let name = |index: u16| od.object(index).map(|o| o.name.to_string()).unwrap_or_default();
     let dir = std::env::temp_dir().join(format!("serve-rtt-startup-{}", std::process::id()));
     std::fs::create_dir_all(&dir).expect("scratch dir");
     let more: Vec<&str> = cpu.map(|c| vec!["--cpu", c]).unwrap_or_default();
     eprintln!("  start-up phase: KickCAT brings 2 drives to Op ...");
     let mut line = common::soem_line::Line::with_serve_args("u", 2, 120, &dir, &more);
-    let (n1018, n6040) = (name(0x1018), name(0x6040));
     // the arguments hil-sim/tests/kickcat.rs gives the script (I423 raised
     // for the csp move, its tolerances: 1/16 rev tracking, I22's 1/360 rev end)
-    let i423 = format!("{:#06x}", drive_ecat::params::I423);
-    let (tol, end_tol) = (((1u32 << 20) / 16).to_string(), ((1u32 << 20) / 360).to_string());
-    let (child, script) = line.spawn(
-        std::path::Path::new(&py),
-        "kickcat_line.py",
-        &[
-            "--slaves",
-            "2",
-            "--seconds",
-            "2",
-            "--name-1018",
-            &n1018,
-            "--name-6040",
-            &n6040,
-            "--i423-index",
-            &i423,
-            "--i423-ms",
-            "500",
-            "--tolerance",
-            &tol,
-            "--end-tolerance",
-            &end_tol,
-        ],
-    );
+    let args = common::kickcat::line_args("2", &[]);
+    let args: Vec<&str> = args.iter().map(String::as_str).collect();
+    let (child, script) = line.spawn(std::path::Path::new(&py), "kickcat_line.py", &args);
     let (status, _) = common::watch_script(child, &script, Duration::from_secs(90));
     line.stop_server();
     let out = line.serve_output();

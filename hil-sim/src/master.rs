@@ -147,3 +147,36 @@ pub fn with_first_subdevice<N: Node, T>(
         Ok(body(sd, clock).await)
     })
 }
+
+/// A SubDevice of a group in PRE-OP with its process data image.
+pub type PdiSubDevice<'a, const PDI: usize> =
+    ethercrab::SubDeviceRef<'a, ethercrab::SubDevicePdi<'a, PDI, ethercrab::DefaultLock>>;
+
+/// `group` (in PRE-OP, as ethercrab's init leaves it) with SYNC0 on every
+/// SubDevice, brought into PRE-OP with its process data image, `pre_op` run
+/// on each SubDevice there, then the DC configuration `dc` written: the
+/// group ready for its way to OP; the master's error on the way.
+pub async fn into_dc_sync0<const MAX: usize, const PDI: usize>(
+    md: &ethercrab::MainDevice<'_>,
+    mut group: ethercrab::SubDeviceGroup<MAX, PDI>,
+    dc: ethercrab::subdevice_group::DcConfiguration,
+    pre_op: impl for<'b> AsyncFn(&'b PdiSubDevice<'b, PDI>),
+) -> Result<
+    ethercrab::SubDeviceGroup<
+        MAX,
+        PDI,
+        ethercrab::DefaultLock,
+        ethercrab::subdevice_group::PreOpPdi,
+        ethercrab::subdevice_group::HasDc,
+    >,
+    ethercrab::error::Error,
+> {
+    for mut sd in group.iter_mut(md) {
+        sd.set_dc_sync(ethercrab::DcSync::Sync0);
+    }
+    let group = group.into_pre_op_pdi(md).await?;
+    for sd in group.iter(md) {
+        pre_op(&sd).await;
+    }
+    group.configure_dc_sync(md, dc).await
+}

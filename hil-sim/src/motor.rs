@@ -191,13 +191,20 @@ impl MotorParams {
     /// open-loop checks); rated and peak torque as [`Self::default_servo`].
     pub const fn frictionless(inertia_kg_m2: f64) -> Self {
         let mut p = Self::default_servo();
-        p.inertia_kg_m2 = inertia_kg_m2;
-        p.viscous_friction_nm_s_per_rad = 0.0;
-        p.coulomb_friction_nm = 0.0;
-        p.static_friction_nm = 0.0;
+        p.set_flywheel(inertia_kg_m2);
         p.stiction_velocity_rad_s = 0.0;
-        p.brake_holding_torque_nm = 0.0;
         p
+    }
+
+    /// The load made a bare flywheel of inertia `inertia_kg_m2`: no viscous,
+    /// Coulomb or static friction and no holding brake; the other data stay
+    /// (`serve --flywheel`, the chopper's fault-matrix rows).
+    pub const fn set_flywheel(&mut self, inertia_kg_m2: f64) {
+        self.inertia_kg_m2 = inertia_kg_m2;
+        self.viscous_friction_nm_s_per_rad = 0.0;
+        self.coulomb_friction_nm = 0.0;
+        self.static_friction_nm = 0.0;
+        self.brake_holding_torque_nm = 0.0;
     }
 
     /// Torque in N·m from a value in 0.1 % of the rated torque (CiA 402 6071h

@@ -59,6 +59,33 @@ macro_rules! plant_methods {
 }
 pub(crate) use plant_methods;
 
+/// A simulated drive's plants and motors, the same on either fieldbus
+/// ([`crate::sim::SimDrive`], [`crate::pn::PnSim`]): what `serve` sets up on
+/// every drive of its line (the motor model, a plant fault).
+pub trait PlantDrive {
+    /// Both axes' models ([`Plants`]).
+    fn plants_mut(&mut self) -> &mut Plants;
+    /// The motor of `axis` (0 = A).
+    fn motor_mut(&mut self, axis: usize) -> Option<&mut Motor>;
+}
+
+/// [`PlantDrive`] for a simulated drive type with an `electrical: Plants`
+/// and a `motors: [Motor; 2]` field.
+macro_rules! plant_drive {
+    ($drive:ty) => {
+        impl $crate::plants::PlantDrive for $drive {
+            fn plants_mut(&mut self) -> &mut $crate::plants::Plants {
+                &mut self.electrical
+            }
+
+            fn motor_mut(&mut self, axis: usize) -> Option<&mut $crate::motor::Motor> {
+                self.motors.get_mut(axis)
+            }
+        }
+    };
+}
+pub(crate) use plant_drive;
+
 /// Each axis' electrical model, or `None`: the rigid model.
 #[derive(Clone, Default)]
 pub struct Plants([Option<Box<ElectricalAxis>>; 2]);

@@ -238,6 +238,8 @@ pub struct PnSim {
     hw: Hardware,
 }
 
+crate::plants::plant_drive!(PnSim);
+
 impl PnSim {
     /// A drive powered on over `flash` (empty: as shipped) on interface
     /// `mac`, started at `boot_time` (any value that differs after every

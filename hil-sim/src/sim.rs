@@ -15,7 +15,7 @@ mod variant;
 
 use crate::pcap::Recording;
 pub(crate) use axis_io::axis_io;
-pub use flash::{FirmwareFlash, FirmwareSlots, SimFlash};
+pub use flash::{firmware_body, FirmwareFlash, FirmwareSlots, SimFlash};
 use nanos::Nanos;
 pub use stamps::{CycleStamp, LockLoss, PllLock, Sync0Stamp};
 use std::collections::VecDeque;

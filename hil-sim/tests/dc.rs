@@ -6,8 +6,8 @@
 //! the configured period (E-107 DC-Sync; E-113 frame jitter).
 
 use ethercrab::subdevice_group::DcConfiguration;
-use ethercrab::{DcSync, MainDevice, SubDeviceGroup};
-use hil_sim::master::run_in_process;
+use ethercrab::{MainDevice, SubDeviceGroup};
+use hil_sim::master::{into_dc_sync0, run_in_process};
 use hil_sim::sim::{SimDrive, Simulation};
 use nanos::Nanos;
 use std::cell::RefCell;
@@ -86,26 +86,16 @@ fn e107_dc_start_up_synchronises_drifting_clocks() {
 /// time skew seen over the last half of the cycles.
 fn run_sync0(sim: &RefCell<Simulation>, cycles: usize) -> (i64, i64) {
     run_in_process(sim, async |md, clock| {
-        let mut group = init(md, clock).await;
-        for mut sd in group.iter_mut(md) {
-            sd.set_dc_sync(DcSync::Sync0);
-        }
-        let group = group
-            .into_pre_op_pdi(md)
+        let dc = DcConfiguration {
+            start_delay: Duration::from_millis(20),
+            sync0_period: Duration::from_nanos(SYNC0_NS),
+            // frames 250 µs before SYNC0: after it they would be late
+            // (E-118) and the drive would refuse Op with 0033h
+            sync0_shift: Duration::from_nanos(SYNC0_NS - SYNC0_NS / 4),
+        };
+        let group = into_dc_sync0(md, init(md, clock).await, dc, async |_| {})
             .await
-            .expect("PRE-OP with PDI")
-            .configure_dc_sync(
-                md,
-                DcConfiguration {
-                    start_delay: Duration::from_millis(20),
-                    sync0_period: Duration::from_nanos(SYNC0_NS),
-                    // frames 250 µs before SYNC0: after it they would be late
-                    // (E-118) and the drive would refuse Op with 0033h
-                    sync0_shift: Duration::from_nanos(SYNC0_NS - SYNC0_NS / 4),
-                },
-            )
-            .await
-            .expect("DC configuration")
+            .expect("SYNC0, PRE-OP with PDI, DC configuration")
             .request_into_op(md)
             .await
             .expect("request OP");

@@ -29,12 +29,8 @@ impl Rig {
     }
 
     fn enable(&mut self) {
-        self.i.drive_enable = true;
-        assert!(
-            self.until(500, |o| o.drive_is_enabled),
-            "enabled: {:#06x}",
-            self.o.zsw1
-        );
+        let enabled = self.0.enable_within(500).expect("exchange");
+        assert!(enabled, "enabled: {:#06x}", self.o.zsw1);
     }
 
     /// Event 44 cause 1 on axis A, then the FB's fault_reset until the

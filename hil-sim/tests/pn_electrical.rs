@@ -37,15 +37,8 @@ fn run_named(
     script_args: &[&str],
     item: &str,
 ) -> Option<(String, String)> {
-    let python = match common::profinet_py_python() {
-        Ok(p) => p,
-        Err(why) => {
-            eprintln!("profinet-py electrical test: skipped, {why}");
-            return None;
-        }
-    };
-    let dir = Path::new(env!("CARGO_TARGET_TMPDIR")).join("profinet-py");
-    std::fs::create_dir_all(&dir).expect("scratch dir");
+    let python = common::or_skip(common::profinet_py_python(), "profinet-py electrical test")?;
+    let dir = common::scratch("profinet-py");
     let serve: Vec<&OsStr> = ["--plant", "electrical"]
         .iter()
         .chain(serve_more)
@@ -162,8 +155,7 @@ fn e140_e141_profinet_py_motor_actions_by_pkw_on_the_electrical_plant() {
 #[test]
 fn issue35_profinet_py_scope_trace_of_a_move_matches_the_physics() {
     const SAMPLES: usize = 2000;
-    let dir = Path::new(env!("CARGO_TARGET_TMPDIR")).join("profinet-py");
-    std::fs::create_dir_all(&dir).expect("scratch dir");
+    let dir = common::scratch("profinet-py");
     let csv = dir.join("pn-scope-trace.csv");
     let _ = std::fs::remove_file(&csv);
     let path = csv.to_str().unwrap().to_string();

@@ -49,12 +49,8 @@ impl Rig {
     }
 
     fn enable(&mut self) {
-        self.i.drive_enable = true;
-        assert!(
-            self.until(1000, |o| o.drive_is_enabled),
-            "enabled: {:#06x}",
-            self.o.zsw1
-        );
+        let enabled = self.0.enable_within(1000).expect("exchange");
+        assert!(enabled, "enabled: {:#06x}", self.o.zsw1);
     }
 
     /// Event 44 on axis A, fault_reset, the enable sequence again.

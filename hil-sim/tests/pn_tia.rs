@@ -52,15 +52,10 @@ fn step_lines<'a>(lines: &'a [String], step: &str) -> Vec<&'a str> {
 /// Wireshark.
 #[test]
 fn p002_p026_p027_p040_p041_p042_p043_scapy_controller_plays_tia_startup() {
-    let python = match scapy_python() {
-        Ok(p) => p,
-        Err(why) => {
-            eprintln!("scapy TIA test: skipped, {why}");
-            return;
-        }
+    let Some(python) = common::or_skip(scapy_python(), "scapy TIA test") else {
+        return;
     };
-    let dir = Path::new(env!("CARGO_TARGET_TMPDIR")).join("pn-tia");
-    std::fs::create_dir_all(&dir).expect("scratch dir");
+    let dir = common::scratch("pn-tia");
     let pcap = dir.join("tia.pcap");
     let _ = std::fs::remove_file(&pcap);
     let mut line = PnLine::new("tia", &dir, &[]);

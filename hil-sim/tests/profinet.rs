@@ -91,15 +91,10 @@ fn step_lines<'a>(lines: &'a [String], step: &str) -> Vec<&'a str> {
 #[test]
 fn p008_p027_p029_p030_p035_p036_p040_p041_p042_p085_p110_p191_p223_profinet_py_names_connects_drives_and_loses_the_drive(
 ) {
-    let python = match common::profinet_py_python() {
-        Ok(p) => p,
-        Err(why) => {
-            eprintln!("profinet-py test: skipped, {why}");
-            return;
-        }
+    let Some(python) = common::or_skip(common::profinet_py_python(), "profinet-py test") else {
+        return;
     };
-    let dir = Path::new(env!("CARGO_TARGET_TMPDIR")).join("profinet-py");
-    std::fs::create_dir_all(&dir).expect("scratch dir");
+    let dir = common::scratch("profinet-py");
     let pcap = dir.join("serve.pcap");
     let drives = DRIVES.to_string();
     let mut line = PnLine::new(

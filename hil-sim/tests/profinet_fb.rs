@@ -52,15 +52,10 @@ fn verdict(line: &str) -> Option<(&str, &str, &str)> {
 #[test]
 fn p160_p206_p208_p219_p220_p221_p222_p223_p224_p225_p226_p227_the_example_function_block_through_profinet_py(
 ) {
-    let python = match common::profinet_py_python() {
-        Ok(p) => p,
-        Err(why) => {
-            eprintln!("profinet-py FB test: skipped, {why}");
-            return;
-        }
+    let Some(python) = common::or_skip(common::profinet_py_python(), "profinet-py FB test") else {
+        return;
     };
-    let dir = Path::new(env!("CARGO_TARGET_TMPDIR")).join("profinet-py");
-    std::fs::create_dir_all(&dir).expect("scratch dir");
+    let dir = common::scratch("profinet-py");
     let mut line = PnLine::new("fb", &dir, &[]);
     let script = Path::new(env!("CARGO_MANIFEST_DIR")).join("tests/profinet/fb.py");
     let args = module_args(&["--control".as_ref(), line.control.as_os_str()]);

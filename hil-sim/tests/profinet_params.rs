@@ -28,15 +28,10 @@ const SCRIPT_LIMIT: Duration = Duration::from_secs(90);
 /// defaults).
 #[test]
 fn p199_p206_profinet_py_changes_g472_and_the_speed_kp_saves_and_reads_them_after_a_restart() {
-    let python = match common::profinet_py_python() {
-        Ok(p) => p,
-        Err(why) => {
-            eprintln!("profinet-py parameter test: skipped, {why}");
-            return;
-        }
+    let Some(python) = common::or_skip(common::profinet_py_python(), "profinet-py parameter test") else {
+        return;
     };
-    let dir = Path::new(env!("CARGO_TARGET_TMPDIR")).join("profinet-py");
-    std::fs::create_dir_all(&dir).expect("scratch dir");
+    let dir = common::scratch("profinet-py");
     let mut line = PnLine::new("pp", &dir, &[]);
     let script = Path::new(env!("CARGO_MANIFEST_DIR")).join("tests/profinet/params.py");
     let args: [&OsStr; 2] = ["--control".as_ref(), line.control.as_os_str()];

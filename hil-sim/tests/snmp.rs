@@ -204,8 +204,7 @@ fn p038_net_snmp_walks_gets_and_sets_the_agent_and_the_settings_survive_a_restar
         eprintln!("snmp test: skipped, net-snmp's tools are missing (apt-get install snmp)");
         return;
     }
-    let dir = Path::new(env!("CARGO_TARGET_TMPDIR")).join("snmp");
-    std::fs::create_dir_all(&dir).expect("scratch dir");
+    let dir = common::scratch("snmp");
     let line = PnLine::new("sn", &dir, &[]);
     let script = Path::new(env!("CARGO_MANIFEST_DIR")).join("tests/snmp/dcp_set_ip.py");
     let dcp = Command::new("ip")

@@ -26,7 +26,8 @@
 
 mod common;
 
-use common::soem_line::{pysoem_python, scratch, Line, SCRIPT_LIMIT};
+use common::scratch;
+use common::soem_line::{pysoem_python, Line, SCRIPT_LIMIT};
 use ecat::Dictionary;
 use hil_sim::matrix::Row;
 use std::fmt::Write as _;
@@ -111,12 +112,8 @@ fn od_listing() -> String {
 /// data in Op, the cycles with a wrong working counter printed.
 #[test]
 fn e002_e005_e080_e082_e045_e029_e015_soem_line_scan_sdo_info_pdo_dc_cia402() {
-    let python = match pysoem_python() {
-        Ok(p) => p,
-        Err(why) => {
-            eprintln!("soem line test: skipped, {why}");
-            return;
-        }
+    let Some(python) = common::or_skip(pysoem_python(), "soem line test") else {
+        return;
     };
     let _one = ONE_AT_A_TIME.lock().unwrap_or_else(|e| e.into_inner());
     let dir = scratch("soem-line");
@@ -125,7 +122,7 @@ fn e002_e005_e080_e082_e045_e029_e015_soem_line_scan_sdo_info_pdo_dc_cia402() {
     std::fs::write(&sii, sii_image()).unwrap();
     std::fs::write(&od, od_listing()).unwrap();
     let line = Line::new("l", SLAVES, 200, &dir);
-    let status = line.run(
+    line.run_passes(
         &python,
         "line.py",
         &[
@@ -139,9 +136,6 @@ fn e002_e005_e080_e082_e045_e029_e015_soem_line_scan_sdo_info_pdo_dc_cia402() {
             &OP_SECONDS.to_string(),
         ],
     );
-    if !status.success() {
-        line.fail_with(&format!("line.py through SOEM failed: {status}"));
-    }
 }
 
 /// EoE through SOEM as a user would (pysoem has no EoE call; the script uses
@@ -154,12 +148,8 @@ fn e002_e005_e080_e082_e045_e029_e015_soem_line_scan_sdo_info_pdo_dc_cia402() {
 /// the UDP parameter service (port 5011) of every drive (E-095).
 #[test]
 fn e096_e095_e098_soem_set_ip_ping_and_udp_through_a_tap_bridge() {
-    let python = match pysoem_python() {
-        Ok(p) => p,
-        Err(why) => {
-            eprintln!("soem EoE test: skipped, {why}");
-            return;
-        }
+    let Some(python) = common::or_skip(pysoem_python(), "soem EoE test") else {
+        return;
     };
     let _one = ONE_AT_A_TIME.lock().unwrap_or_else(|e| e.into_inner());
     let dir = scratch("soem-eoe");
@@ -170,14 +160,11 @@ fn e096_e095_e098_soem_set_ip_ping_and_udp_through_a_tap_bridge() {
         .expect("A166")
         .default;
     let line = Line::new("e", SLAVES, 200, &dir);
-    let status = line.run(
+    line.run_passes(
         &python,
         "eoe.py",
         &["--slaves", &SLAVES.to_string(), "--a166", &a166.to_string()],
     );
-    if !status.success() {
-        line.fail_with(&format!("eoe.py through SOEM failed: {status}"));
-    }
 }
 
 /// The firmware update as SOEM's `firm_update` sample does it (Init, the
@@ -195,18 +182,12 @@ fn e096_e095_e098_soem_set_ip_ping_and_udp_through_a_tap_bridge() {
 /// seen: `tools/foe-image/tests/round_trip.rs`).
 #[test]
 fn e019_foe_file_for_the_update_slot_through_soem_firm_update() {
-    let python = match pysoem_python() {
-        Ok(p) => p,
-        Err(why) => {
-            eprintln!("soem FoE test: skipped, {why}");
-            return;
-        }
+    let Some(python) = common::or_skip(pysoem_python(), "soem FoE test") else {
+        return;
     };
     let _one = ONE_AT_A_TIME.lock().unwrap_or_else(|e| e.into_inner());
     let dir = scratch("soem-foe");
-    let body: Vec<u8> = (0..64 * 1024u32)
-        .map(|i| (i.wrapping_mul(2_654_435_761) >> 24) as u8)
-        .collect();
+    let body = hil_sim::sim::firmware_body(64 * 1024, 0);
     // the image linked for each slot of `serve`'s drive, signed with the
     // development key (issue 18), written under the tool's default name
     let seed = drive_ecat::boot::parse_key_hex(include_str!("../../keys/dev-ed25519.key")).unwrap();
@@ -319,12 +300,8 @@ fn seen_in<'a>(rows: &'a [(String, String)], order: &str) -> &'a str {
 /// at least as long as A258 repeats a case (faults.py).
 #[test]
 fn e126_e044_e128_e129_soem_frame_pauses_under_dc_with_a258_100_ms() {
-    let python = match pysoem_python() {
-        Ok(p) => p,
-        Err(why) => {
-            eprintln!("soem fault matrix (frame pauses): skipped, {why}");
-            return;
-        }
+    let Some(python) = common::or_skip(pysoem_python(), "soem fault matrix (frame pauses)") else {
+        return;
     };
     let _one = ONE_AT_A_TIME.lock().unwrap_or_else(|e| e.into_inner());
     let rows = fault_rows(&python, "p", &["pause"]);
@@ -365,12 +342,8 @@ fn e126_e044_e128_e129_soem_frame_pauses_under_dc_with_a258_100_ms() {
 /// SYNC0 (docs/fault-matrix.md, the SYNC0 loss in Init).
 #[test]
 fn e126_e044_e037_e021_soem_master_killed_in_op_and_a_new_master() {
-    let python = match pysoem_python() {
-        Ok(p) => p,
-        Err(why) => {
-            eprintln!("soem fault matrix (master killed): skipped, {why}");
-            return;
-        }
+    let Some(python) = common::or_skip(pysoem_python(), "soem fault matrix (master killed)") else {
+        return;
     };
     let _one = ONE_AT_A_TIME.lock().unwrap_or_else(|e| e.into_inner());
     let rows = fault_rows(&python, "r", &["restart"]);
@@ -398,12 +371,9 @@ fn e126_e044_e037_e021_soem_master_killed_in_op_and_a_new_master() {
 /// cleared a PLL fault latched below Safe-Op).
 #[test]
 fn e046_e021_soem_a_master_stopped_in_init_and_a_new_master_under_dc() {
-    let python = match pysoem_python() {
-        Ok(p) => p,
-        Err(why) => {
-            eprintln!("soem fault matrix (stop and restart under DC): skipped, {why}");
-            return;
-        }
+    let Some(python) = common::or_skip(pysoem_python(), "soem fault matrix (stop and restart under DC)")
+    else {
+        return;
     };
     let _one = ONE_AT_A_TIME.lock().unwrap_or_else(|e| e.into_inner());
     let rows = fault_rows(&python, "s", &["stop-restart"]);
@@ -429,12 +399,8 @@ fn e046_e021_soem_a_master_stopped_in_init_and_a_new_master_under_dc() {
 /// (`torque.py`).
 #[test]
 fn c039_soem_raises_g472_g475_by_sdo_and_cst_pt_move_the_axis() {
-    let python = match pysoem_python() {
-        Ok(p) => p,
-        Err(why) => {
-            eprintln!("soem torque-mode test: skipped, {why}");
-            return;
-        }
+    let Some(python) = common::or_skip(pysoem_python(), "soem torque-mode test") else {
+        return;
     };
     let _one = ONE_AT_A_TIME.lock().unwrap_or_else(|e| e.into_inner());
     let dir = scratch("soem-torque");
@@ -443,12 +409,9 @@ fn c039_soem_raises_g472_g475_by_sdo_and_cst_pt_move_the_axis() {
         .get(drive_ecat::params::I10, 0)
         .expect("I10 declared");
     let line = Line::new("t", 1, 120, &dir);
-    let status = line.run(
+    line.run_passes(
         &python,
         "torque.py",
         &["--limit", "400", "--i10", &i10.to_string()],
     );
-    if !status.success() {
-        line.fail_with(&format!("torque.py through SOEM failed: {status}"));
-    }
 }

@@ -9,7 +9,8 @@
 
 mod common;
 
-use common::soem_line::{pysoem_python, scratch, Line, SCRIPT_LIMIT};
+use common::scratch;
+use common::soem_line::{pysoem_python, Line, SCRIPT_LIMIT};
 use hil_sim::matrix::Row;
 use std::path::Path;
 use std::sync::Mutex;
@@ -56,13 +57,7 @@ fn seen_with(python: &Path, tag: &str, fault: &str, order: &str) -> String {
 
 /// The python, or `None` (the test says why it did not run).
 fn python(what: &str) -> Option<std::path::PathBuf> {
-    match pysoem_python() {
-        Ok(p) => Some(p),
-        Err(why) => {
-            eprintln!("soem {what}: skipped, {why}");
-            None
-        }
-    }
+    common::or_skip(pysoem_python(), &format!("soem {what}"))
 }
 
 /// E-140, E-141 (B40 test phase) through SOEM, fault matrix rows 65 and 66:

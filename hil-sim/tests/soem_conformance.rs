@@ -9,8 +9,8 @@
 
 mod common;
 
+use common::scratch;
 use common::soem_line::{pysoem_python, Line};
-use std::path::Path;
 use std::sync::Mutex;
 
 /// One SOEM run at a time.
@@ -19,27 +19,17 @@ static ONE_AT_A_TIME: Mutex<()> = Mutex::new(());
 /// Runs `conformance.py --case <case>` on a line of one drive (`tag`: one
 /// letter for the namespaces); fails with serve's log.
 fn run_case(tag: &str, case: &str) {
-    let python = match pysoem_python() {
-        Ok(p) => p,
-        Err(why) => {
-            eprintln!("soem conformance case {case}: skipped, {why}");
-            return;
-        }
+    let Some(python) = common::or_skip(pysoem_python(), &format!("soem conformance case {case}")) else {
+        return;
     };
     let _one = ONE_AT_A_TIME.lock().unwrap_or_else(|e| e.into_inner());
-    let dir = Path::new(env!("CARGO_TARGET_TMPDIR")).join(format!("soem-conformance-{case}"));
-    std::fs::create_dir_all(&dir).expect("scratch dir");
+    let dir = scratch(&format!("soem-conformance-{case}"));
     let line = Line::new(tag, 1, 90, &dir);
     let status = line.run(&python, "conformance.py", &["--case", case]);
     if !status.success() {
-        let serve = line.serve_output();
-        let tail: Vec<&str> = serve.lines().rev().take(40).collect();
-        let tail: Vec<&str> = tail.into_iter().rev().collect();
-        panic!(
-            "conformance.py --case {case} through SOEM failed: {status}\n--- hil-sim serve ({}), last lines:\n{}",
-            line.serve_log.display(),
-            tail.join("\n")
-        );
+        line.fail_with(&format!(
+            "conformance.py --case {case} through SOEM failed: {status}"
+        ));
     }
 }
 

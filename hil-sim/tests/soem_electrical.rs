@@ -6,7 +6,8 @@
 
 mod common;
 
-use common::soem_line::{pysoem_python, scratch, Line};
+use common::scratch;
+use common::soem_line::{pysoem_python, Line};
 
 /// C-038, P-187 through SOEM on the electrical plant (`cst_electrical.py`):
 /// 6071h steps of ±10 %, ±50 %, ±100 % of the rated torque in cst give a
@@ -15,22 +16,15 @@ use common::soem_line::{pysoem_python, scratch, Line};
 /// rotor is below half the speed limit (G472/G475 = 100 % of I10).
 #[test]
 fn c038_p187_soem_cst_steps_on_the_electrical_plant_give_6077h_within_2_percent() {
-    let python = match pysoem_python() {
-        Ok(p) => p,
-        Err(why) => {
-            eprintln!("soem electrical test: skipped, {why}");
-            return;
-        }
+    let Some(python) = common::or_skip(pysoem_python(), "soem electrical test") else {
+        return;
     };
     let dir = scratch("soem-cst-electrical");
     let i10 = drive_ecat::DriveObjects::new()
         .get(drive_ecat::params::I10, 0)
         .expect("I10 declared");
     let line = Line::with_serve_args("e", 1, 120, &dir, &["--plant", "electrical"]);
-    let status = line.run(&python, "cst_electrical.py", &["--i10", &i10.to_string()]);
-    if !status.success() {
-        line.fail_with(&format!("cst_electrical.py through SOEM failed: {status}"));
-    }
+    line.run_passes(&python, "cst_electrical.py", &["--i10", &i10.to_string()]);
 }
 
 /// C-038 and E-089 through SOEM on the electrical plant
@@ -45,19 +39,12 @@ fn c038_p187_soem_cst_steps_on_the_electrical_plant_give_6077h_within_2_percent(
 /// event 45).
 #[test]
 fn c038_e089_soem_max_current_and_motor_i2t_on_the_electrical_plant() {
-    let python = match pysoem_python() {
-        Ok(p) => p,
-        Err(why) => {
-            eprintln!("soem motor protection test: skipped, {why}");
-            return;
-        }
+    let Some(python) = common::or_skip(pysoem_python(), "soem motor protection test") else {
+        return;
     };
     let dir = scratch("soem-motor-protection");
     let line = Line::with_serve_args("m", 1, 120, &dir, &["--plant", "electrical"]);
-    let status = line.run(&python, "motor_protection.py", &[]);
-    if !status.success() {
-        line.fail_with(&format!("motor_protection.py through SOEM failed: {status}"));
-    }
+    line.run_passes(&python, "motor_protection.py", &[]);
 }
 
 /// E-089 and C-017 through SOEM on the electrical plant (`overcurrent.py`,
@@ -69,12 +56,8 @@ fn c038_e089_soem_max_current_and_motor_i2t_on_the_electrical_plant() {
 /// a fault reset gives Switch on disabled and the next enable faults again.
 #[test]
 fn e089_c017_soem_over_current_trip_on_the_electrical_plant() {
-    let python = match pysoem_python() {
-        Ok(p) => p,
-        Err(why) => {
-            eprintln!("soem over-current test: skipped, {why}");
-            return;
-        }
+    let Some(python) = common::or_skip(pysoem_python(), "soem over-current test") else {
+        return;
     };
     let dir = scratch("soem-over-current");
     let line = Line::with_serve_args(
@@ -84,10 +67,7 @@ fn e089_c017_soem_over_current_trip_on_the_electrical_plant() {
         &dir,
         &["--plant", "electrical", "--plant-fault", "short"],
     );
-    let status = line.run(&python, "overcurrent.py", &[]);
-    if !status.success() {
-        line.fail_with(&format!("overcurrent.py through SOEM failed: {status}"));
-    }
+    line.run_passes(&python, "overcurrent.py", &[]);
 }
 
 /// C-038 and E-089 through SOEM on the electrical plant (`stage_i2t.py`,
@@ -100,12 +80,8 @@ fn e089_c017_soem_over_current_trip_on_the_electrical_plant() {
 /// (i/I_rated)²), without a fault.
 #[test]
 fn c038_e089_soem_current_limit_and_power_stage_i2t_on_the_electrical_plant() {
-    let python = match pysoem_python() {
-        Ok(p) => p,
-        Err(why) => {
-            eprintln!("soem power stage i2t test: skipped, {why}");
-            return;
-        }
+    let Some(python) = common::or_skip(pysoem_python(), "soem power stage i2t test") else {
+        return;
     };
     let dir = scratch("soem-stage-i2t");
     let line = Line::with_serve_args("i", 1, 60, &dir, &["--plant", "electrical"]);
@@ -130,12 +106,8 @@ fn c038_e089_soem_current_limit_and_power_stage_i2t_on_the_electrical_plant() {
 /// the plant's brake (2 N·m, unknown to the drive) plus friction.
 #[test]
 fn e140_e141_soem_motor_actions_identify_the_plants_r_l_and_commutation_offset() {
-    let python = match pysoem_python() {
-        Ok(p) => p,
-        Err(why) => {
-            eprintln!("soem motor actions test: skipped, {why}");
-            return;
-        }
+    let Some(python) = common::or_skip(pysoem_python(), "soem motor actions test") else {
+        return;
     };
     let dir = scratch("soem-motor-actions");
     let (r, l, offset) = ("2.2", "0.0065", "0.3");
@@ -155,14 +127,11 @@ fn e140_e141_soem_motor_actions_identify_the_plants_r_l_and_commutation_offset()
             offset,
         ],
     );
-    let status = line.run(
+    line.run_passes(
         &python,
         "motor_actions.py",
         &["--r", r, "--l", l, "--offset", offset],
     );
-    if !status.success() {
-        line.fail_with(&format!("motor_actions.py through SOEM failed: {status}"));
-    }
 }
 
 /// E-090 and E-089 through SOEM on the electrical plant (`chopper.py`, issue
@@ -174,12 +143,8 @@ fn e140_e141_soem_motor_actions_identify_the_plants_r_l_and_commutation_offset()
 /// by the energy balance (within 5 %), 603Fh and EMCY 3110h (event 36).
 #[test]
 fn e090_e089_soem_braking_a_flywheel_without_brake_resistor_trips_over_voltage() {
-    let python = match pysoem_python() {
-        Ok(p) => p,
-        Err(why) => {
-            eprintln!("soem chopper test: skipped, {why}");
-            return;
-        }
+    let Some(python) = common::or_skip(pysoem_python(), "soem chopper test") else {
+        return;
     };
     let dir = scratch("soem-chopper");
     let line = Line::with_serve_args(
@@ -189,10 +154,7 @@ fn e090_e089_soem_braking_a_flywheel_without_brake_resistor_trips_over_voltage()
         &dir,
         &["--plant", "electrical", "--flywheel", "0.01"],
     );
-    let status = line.run(&python, "chopper.py", &[]);
-    if !status.success() {
-        line.fail_with(&format!("chopper.py through SOEM failed: {status}"));
-    }
+    line.run_passes(&python, "chopper.py", &[]);
 }
 
 /// E-140, E-141 through SOEM on the electrical plant (`mechanics.py`, issue
@@ -205,21 +167,14 @@ fn e090_e089_soem_braking_a_flywheel_without_brake_resistor_trips_over_voltage()
 /// are 0) and writes the speed controller's gain for B48.
 #[test]
 fn e140_e141_soem_b44_identify_mechanics_refused_beyond_the_limits_then_identifies_the_plant() {
-    let python = match pysoem_python() {
-        Ok(p) => p,
-        Err(why) => {
-            eprintln!("soem B44 test: skipped, {why}");
-            return;
-        }
+    let Some(python) = common::or_skip(pysoem_python(), "soem B44 test") else {
+        return;
     };
     let dir = scratch("soem-mechanics");
     let line = Line::with_serve_args("b4", 1, 120, &dir, &["--plant", "electrical"]);
-    let status = line.run(
+    line.run_passes(
         &python,
         "mechanics.py",
         &["--j", "1e-4", "--fc", "0.02", "--b", "2e-5"],
     );
-    if !status.success() {
-        line.fail_with(&format!("mechanics.py through SOEM failed: {status}"));
-    }
 }

@@ -3,7 +3,7 @@
 //! SDO from ethercrab, the brake seen at the simulated motor (its brake
 //! input, one cycle after the drive's output) and the rotor's motion.
 
-use drive_tests::{init, line, sw, with_master, Cyclic, REV};
+use drive_tests::{line, sw, with_cyclic, REV};
 use hil_sim::sim::Simulation;
 use std::cell::RefCell;
 
@@ -30,10 +30,7 @@ fn velocity_rev_s(sim: &RefCell<Simulation>) -> f64 {
 #[test]
 fn c020_e129_f06_release_override_releases_the_brake_in_the_de_energised_states() {
     let sim = line(1);
-    with_master(&sim, async |md, clock| {
-        let group = init(md, clock).await.into_op(md).await.expect("OP");
-        let sd = group.subdevice(md, 0).unwrap();
-        let mut m = Cyclic::new(md, &group, &sim, 0);
+    with_cyclic(&sim, async |m, sd| {
         m.set_mode(9);
         let tx = m.run(5).await;
         assert_eq!(tx.state(), sw::SOD);
@@ -72,10 +69,7 @@ fn c020_e129_f06_release_override_releases_the_brake_in_the_de_energised_states(
 #[test]
 fn c021_f00_brake_control_inactive_keeps_the_brake_applied_while_enabled() {
     let sim = line(1);
-    with_master(&sim, async |md, clock| {
-        let group = init(md, clock).await.into_op(md).await.expect("OP");
-        let sd = group.subdevice(md, 0).unwrap();
-        let mut m = Cyclic::new(md, &group, &sim, 0);
+    with_cyclic(&sim, async |m, sd| {
         m.csv_at(2 * REV, 300).await;
         assert!(!applied(&sim), "F00 = 1, moving: released");
         let v = velocity_rev_s(&sim);

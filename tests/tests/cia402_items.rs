@@ -8,7 +8,7 @@
 
 use drive_ecat::parameter_index;
 use drive_tests::axis::*;
-use drive_tests::{init, line, sw, with_master, Cyclic};
+use drive_tests::{init, line, sw, with_cyclic, with_master, Cyclic};
 use drive_tests::{REV, REV_F};
 
 const A66: u16 = parameter_index(0, 66);
@@ -74,27 +74,24 @@ fn c028_mode_0_generates_no_motion() {
 #[test]
 fn c029_running_move_is_replaced_but_not_during_a_stop() {
     let sim = line(1);
-    with_master(&sim, async |md, clock| {
-        let group = init(md, clock).await.into_op(md).await.expect("OP");
-        let sd = group.subdevice(md, 0).unwrap();
+    with_cyclic(&sim, async |m, sd| {
         sd.sdo_write(0x6081, 0, (2 * REV) as u32).await.unwrap();
         // 605Ah = 6: quick stop ramp, then stay in Quick stop active
         sd.sdo_write(0x605A, 0, 6i16).await.unwrap();
-        let mut m = Cyclic::new(md, &group, &sim, 0);
         m.enable_in(1).await;
         // relative move +5 rev, replaced after 0.4 s by −1 rev (bit 5: at once)
-        assert!(pp_edge(&mut m, 5 * REV, CW_BIT6).await, "first move taken");
+        assert!(pp_edge(m, 5 * REV, CW_BIT6).await, "first move taken");
         m.run(400).await;
         let mid = m.tx.position;
         assert!(mid > REV / 4, "moving: {mid}");
         // 60F2h = 10b: relative to the actual position, −2 rev, at once (bit 5)
         sd.sdo_write(0x60F2, 0, 2u16).await.unwrap();
         assert!(
-            pp_edge(&mut m, -2 * REV, CW_BIT5 | CW_BIT6).await,
+            pp_edge(m, -2 * REV, CW_BIT5 | CW_BIT6).await,
             "replacement acknowledged: {:#06x}",
             m.tx.statusword
         );
-        settle(&mut m, 5000).await.expect("replacement done");
+        settle(m, 5000).await.expect("replacement done");
         let end = m.tx.position;
         println!("C-029: replaced at {mid}, ends at {end} (first target 5 rev)");
         assert!(
@@ -103,7 +100,7 @@ fn c029_running_move_is_replaced_but_not_during_a_stop() {
         );
 
         // during the stop (quick stop, 605Ah = 6) a new command is not taken
-        assert!(pp_edge(&mut m, 4 * REV, CW_BIT6).await, "move taken");
+        assert!(pp_edge(m, 4 * REV, CW_BIT6).await, "move taken");
         m.run(300).await;
         m.set_controlword(0x000B); // quick stop
         let qs = m
@@ -136,12 +133,9 @@ fn c029_running_move_is_replaced_but_not_during_a_stop() {
 #[test]
 fn c030_velocity_override_a340_in_pv_pp_and_vl() {
     let sim = line(1);
-    with_master(&sim, async |md, clock| {
-        let group = init(md, clock).await.into_op(md).await.expect("OP");
-        let sd = group.subdevice(md, 0).unwrap();
+    with_cyclic(&sim, async |m, sd| {
         let ovr: u16 = sd.sdo_read(A340, 0).await.unwrap();
         assert_eq!(ovr, 100, "A340 default 100 %");
-        let mut m = Cyclic::new(md, &group, &sim, 0);
         m.enable_in(3).await;
 
         // pv: 60FFh = 2 rev/s at 50 % → 1 rev/s, back to 100 % → 2 rev/s
@@ -166,7 +160,7 @@ fn c030_velocity_override_a340_in_pv_pp_and_vl() {
         m.run(20).await;
         assert_eq!(m.tx.mode_display, 1, "pp: {:#06x}", m.tx.statusword);
         let start = m.tx.position;
-        assert!(pp_edge(&mut m, 4 * REV, CW_BIT6).await, "move taken");
+        assert!(pp_edge(m, 4 * REV, CW_BIT6).await, "move taken");
         // cruise speed from the travel over 0.2 s
         let p1 = m.run(300).await.position;
         let p2 = m.run(200).await.position;
@@ -195,7 +189,7 @@ fn c030_velocity_override_a340_in_pv_pp_and_vl() {
         );
         assert!(paused_at - start < 4 * REV - REV / 2, "paused before the target");
         sd.sdo_write(A340, 0, 100u16).await.unwrap();
-        settle(&mut m, 5000).await.expect("resumes and arrives");
+        settle(m, 5000).await.expect("resumes and arrives");
         let end = m.tx.position - start;
         assert!((end - 4 * REV).abs() < REV / 300, "arrives at +4 rev: {end}");
 
@@ -297,45 +291,39 @@ fn c040_csp_csv_cst_need_no_mode_specific_controlword_bits() {
 #[test]
 fn c042_c050_setpoint_acknowledge_only_for_accepted_targets() {
     let sim = line(1);
-    with_master(&sim, async |md, clock| {
-        let group = init(md, clock).await.into_op(md).await.expect("OP");
-        let sd = group.subdevice(md, 0).unwrap();
+    with_cyclic(&sim, async |m, sd| {
         sd.sdo_write(0x6081, 0, REV as u32).await.unwrap();
-        let mut m = Cyclic::new(md, &group, &sim, 0);
         m.enable_in(1).await;
         let p0 = motor_position(&sim, 0);
         // not referenced: an absolute target is refused, no acknowledge, no motion (C-050)
         assert!(
-            !pp_edge(&mut m, REV, 0).await,
+            !pp_edge(m, REV, 0).await,
             "absolute refused: {:#06x}",
             m.tx.statusword
         );
         m.run(300).await;
         assert!((motor_position(&sim, 0) - p0).abs() < 100, "no motion");
         // a relative one is accepted and acknowledged (C-042)
-        assert!(pp_edge(&mut m, REV, CW_BIT6).await, "relative taken");
+        assert!(pp_edge(m, REV, CW_BIT6).await, "relative taken");
         m.run(100).await;
         // while it runs, bit 5 = 0: a new target is not accepted, bit 12 stays 0 (C-043)
         assert!(
-            !pp_edge(&mut m, REV, CW_BIT6).await,
+            !pp_edge(m, REV, CW_BIT6).await,
             "not accepted while moving: {:#06x}",
             m.tx.statusword
         );
-        settle(&mut m, 3000).await.expect("arrives");
+        settle(m, 3000).await.expect("arrives");
         let end = motor_position(&sim, 0) - p0;
         assert!(
             (end - i64::from(REV)).abs() < i64::from(REV / 300),
             "one move only: {end}"
         );
         // referenced: the absolute target is now acknowledged and reached (C-050)
-        home_here(&mut m).await;
+        home_here(m).await;
         m.set_mode(1);
         m.run(10).await;
-        assert!(
-            pp_edge(&mut m, REV / 2, 0).await,
-            "absolute taken once referenced"
-        );
-        settle(&mut m, 3000).await.expect("arrives");
+        assert!(pp_edge(m, REV / 2, 0).await, "absolute taken once referenced");
+        settle(m, 3000).await.expect("arrives");
         assert!(
             (m.tx.position - REV / 2).abs() < REV / 300,
             "at 0.5 rev: {}",
@@ -347,27 +335,24 @@ fn c042_c050_setpoint_acknowledge_only_for_accepted_targets() {
 #[test]
 fn c045_bit_6_clear_moves_to_the_absolute_position() {
     let sim = line(1);
-    with_master(&sim, async |md, clock| {
-        let group = init(md, clock).await.into_op(md).await.expect("OP");
-        let sd = group.subdevice(md, 0).unwrap();
+    with_cyclic(&sim, async |m, sd| {
         sd.sdo_write(0x6081, 0, (2 * REV) as u32).await.unwrap();
-        let mut m = Cyclic::new(md, &group, &sim, 0);
         m.enable_in(6).await;
-        home_here(&mut m).await;
+        home_here(m).await;
         m.set_mode(1);
         m.run(10).await;
         // 607Ah = 1.5 rev absolute, twice: the second move goes nowhere
         for k in 0..2 {
-            assert!(pp_edge(&mut m, 3 * REV / 2, 0).await, "taken");
-            settle(&mut m, 3000).await.expect("arrives");
+            assert!(pp_edge(m, 3 * REV / 2, 0).await, "taken");
+            settle(m, 3000).await.expect("arrives");
             m.run(20).await;
             let p = m.tx.position;
             println!("absolute move {k}: 6064h {p}");
             assert!((p - 3 * REV / 2).abs() < REV / 300, "at 1.5 rev: {p}");
         }
         // the same value relative (bit 6) would move on: contrast
-        assert!(pp_edge(&mut m, 3 * REV / 2, CW_BIT6).await, "taken");
-        settle(&mut m, 3000).await.expect("arrives");
+        assert!(pp_edge(m, 3 * REV / 2, CW_BIT6).await, "taken");
+        settle(m, 3000).await.expect("arrives");
         m.run(20).await;
         assert!(
             (m.tx.position - 3 * REV).abs() < REV / 300,
@@ -375,8 +360,8 @@ fn c045_bit_6_clear_moves_to_the_absolute_position() {
             m.tx.position
         );
         // and back to an absolute −0.5 rev
-        assert!(pp_edge(&mut m, -REV / 2, 0).await, "taken");
-        settle(&mut m, 5000).await.expect("arrives");
+        assert!(pp_edge(m, -REV / 2, 0).await, "taken");
+        settle(m, 5000).await.expect("arrives");
         m.run(20).await;
         assert!(
             (m.tx.position + REV / 2).abs() < REV / 300,
@@ -393,12 +378,9 @@ fn c045_bit_6_clear_moves_to_the_absolute_position() {
 #[test]
 fn c104_c107_limit_switches_from_i210_and_e80() {
     let sim = line(1);
-    with_master(&sim, async |md, clock| {
-        let group = init(md, clock).await.into_op(md).await.expect("OP");
-        let sd = group.subdevice(md, 0).unwrap();
+    with_cyclic(&sim, async |m, sd| {
         sd.sdo_write(I101, 0, 2u8).await.unwrap();
         sd.sdo_write(I102, 0, 2u8).await.unwrap();
-        let mut m = Cyclic::new(md, &group, &sim, 0);
         m.csv_at(REV, 200).await;
         assert_eq!(m.tx.state(), sw::OE);
         let e80: u8 = sd.sdo_read(E80, 0).await.unwrap();
@@ -487,10 +469,7 @@ fn c112_direct_absolute_encoder_position_without_homing() {
     let sim = line(1);
     let start = 3 * i64::from(REV) + 123_457;
     with_drive(&sim, |d| d.motors[0].set_position_inc(start));
-    with_master(&sim, async |md, clock| {
-        let group = init(md, clock).await.into_op(md).await.expect("OP");
-        let sd = group.subdevice(md, 0).unwrap();
-        let mut m = Cyclic::new(md, &group, &sim, 0);
+    with_cyclic(&sim, async |m, sd| {
         m.set_mode(1);
         let tx = m.run(3).await;
         println!("power-up: 6064h {} (encoder {start})", tx.position);
@@ -501,15 +480,12 @@ fn c112_direct_absolute_encoder_position_without_homing() {
         );
         m.enable().await;
         // I46 = 0: not referenced, absolute pp refused
-        assert!(
-            !pp_edge(&mut m, 2 * REV, 0).await,
-            "absolute refused with I46 = 0"
-        );
+        assert!(!pp_edge(m, 2 * REV, 0).await, "absolute refused with I46 = 0");
         // I46 = 5 (direct absolute, I02 = 0): referenced as it is
         sd.sdo_write(I46, 0, 5u8).await.unwrap();
         m.run(2).await;
-        assert!(pp_edge(&mut m, 2 * REV, 0).await, "absolute taken with I46 = 5");
-        settle(&mut m, 5000).await.expect("arrives");
+        assert!(pp_edge(m, 2 * REV, 0).await, "absolute taken with I46 = 5");
+        settle(m, 5000).await.expect("arrives");
         m.run(20).await;
         assert!(
             (m.tx.position - 2 * REV).abs() < REV / 300,
@@ -523,16 +499,13 @@ fn c112_direct_absolute_encoder_position_without_homing() {
 #[test]
 fn c113_the_motor_encoder_closes_the_position_loop() {
     let sim = line(1);
-    with_master(&sim, async |md, clock| {
-        let group = init(md, clock).await.into_op(md).await.expect("OP");
-        let sd = group.subdevice(md, 0).unwrap();
+    with_cyclic(&sim, async |m, sd| {
         let i02: u8 = sd.sdo_read(I02, 0).await.unwrap();
         assert_eq!(i02, 0, "I02 = 0: motor encoder");
         assert!(
             sd.sdo_write(I02, 0, 1u8).await.is_err(),
             "no position encoder on this hardware: I02 = 1 refused"
         );
-        let mut m = Cyclic::new(md, &group, &sim, 0);
         m.enable_in(8).await;
         let mut p = m.tx.position;
         for _ in 0..1000 {
@@ -568,16 +541,13 @@ fn c143_a67_is_assembled_from_the_sources_in_a66() {
     with_drive(&sim, |d| {
         d.motors[0].switches_mut().reference = hil_sim::motor::PositionInput::above(i64::from(REV) / 2);
     });
-    with_master(&sim, async |md, clock| {
-        let group = init(md, clock).await.into_op(md).await.expect("OP");
-        let sd = group.subdevice(md, 0).unwrap();
+    with_cyclic(&sim, async |m, sd| {
         let src = |index: u32, sub: u32, bit: u32| index << 16 | sub << 8 | bit;
         // bit 0 = 6041h bit 2 (operation enabled), bit 5 = 60FDh bit 2 (reference switch),
         // bit 15 = 6041h bit 12 (csv follows)
         sd.sdo_write(A66, 1, src(0x6041, 0, 2)).await.unwrap();
         sd.sdo_write(A66, 6, src(0x60FD, 0, 2)).await.unwrap();
         sd.sdo_write(A66, 16, src(0x6041, 0, 12)).await.unwrap();
-        let mut m = Cyclic::new(md, &group, &sim, 0);
         m.set_mode(9);
         let tx = m.run(3).await;
         assert_eq!(tx.a67, 0, "not enabled, off the switch: {:#06x}", tx.a67);
@@ -598,12 +568,9 @@ fn c143_a67_is_assembled_from_the_sources_in_a66() {
 #[test]
 fn c148_set_value_jump_trips_the_monitor() {
     let sim = line(1);
-    with_master(&sim, async |md, clock| {
-        let group = init(md, clock).await.into_op(md).await.expect("OP");
-        let sd = group.subdevice(md, 0).unwrap();
+    with_cyclic(&sim, async |m, sd| {
         // 607Fh = 10 rev/s: 2 × 10 rev/s × 1 ms = 0.02 rev per cycle is feasible
         sd.sdo_write(0x607F, 0, (10 * REV) as u32).await.unwrap();
-        let mut m = Cyclic::new(md, &group, &sim, 0);
         m.enable_in(8).await;
         // steps of 0.015 rev per cycle (9 rev/s) are followed
         let mut p = m.tx.position;
@@ -662,10 +629,7 @@ fn c015_switch_on_disabled_causes_in_e47_and_e49() {
     let e47 = parameter_index(4, 47);
     let e49 = parameter_index(4, 49);
     let sim = line(1);
-    with_master(&sim, async |md, clock| {
-        let group = init(md, clock).await.into_op(md).await.expect("OP");
-        let sd = group.subdevice(md, 0).unwrap();
-        let mut m = Cyclic::new(md, &group, &sim, 0);
+    with_cyclic(&sim, async |m, sd| {
         m.set_mode(8);
         let causes = async |m: &mut Cyclic<'_>| {
             m.run(3).await;
@@ -674,28 +638,28 @@ fn c015_switch_on_disabled_causes_in_e47_and_e49() {
             (first, all)
         };
         // controlword 0: only the missing Shutdown command
-        assert_eq!(causes(&mut m).await, (4, 0b1000), "controlword");
+        assert_eq!(causes(m).await, (4, 0b1000), "controlword");
         // Shutdown with STO and no supply: both block T2, STO is named first
         m.set_controlword(0x0006);
         with_drive(&sim, |d| {
             d.conditions[0].sto_active = true;
             d.conditions[0].supply_ok = false;
         });
-        assert_eq!(causes(&mut m).await, (1, 0b0011), "STO + supply");
+        assert_eq!(causes(m).await, (1, 0b0011), "STO + supply");
         assert_eq!(m.tx.state(), sw::SOD, "T2 blocked");
         with_drive(&sim, |d| d.conditions[0].sto_active = false);
-        assert_eq!(causes(&mut m).await, (2, 0b0010), "supply");
+        assert_eq!(causes(m).await, (2, 0b0010), "supply");
         assert_eq!(m.tx.state(), sw::SOD);
         with_drive(&sim, |d| {
             d.conditions[0] = AxisConditions::READY;
             d.conditions[0].additional_enable = false;
         });
-        assert_eq!(causes(&mut m).await, (3, 0b0100), "A60");
+        assert_eq!(causes(m).await, (3, 0b0100), "A60");
         assert_eq!(m.tx.state(), sw::SOD);
         // all present: Ready to switch on, no cause
         with_drive(&sim, |d| d.conditions[0] = AxisConditions::READY);
         m.run_until(10, |t| t.state() == sw::RTSO).await.expect("T2");
-        assert_eq!(causes(&mut m).await, (0, 0), "not in Switch on disabled");
+        assert_eq!(causes(m).await, (0, 0), "not in Switch on disabled");
         // enabled, then the supply drops: event 46 "Low voltage" (the power
         // stage was on, decisions), and the fault reset, with the supply
         // still missing, leads to SOD with the supply as cause
@@ -713,7 +677,7 @@ fn c015_switch_on_disabled_causes_in_e47_and_e49() {
         m.run_until(50, |t| t.state() == sw::SOD)
             .await
             .expect("forced to SOD");
-        let (first, all) = causes(&mut m).await;
+        let (first, all) = causes(m).await;
         println!("supply lost in OE: E47 {first}, E49 {all:#06b}");
         assert_eq!(first, 2, "E47 names the supply");
         assert_ne!(all & 0b0010, 0, "E49 bit 1");
@@ -729,17 +693,14 @@ fn c109_gear_and_feed_scale_positions_and_velocities_through_the_master() {
     let sim = line(1);
     let start = i64::from(REV) / 8; // the motor at 45°
     with_drive(&sim, |d| d.motors[0].set_position_inc(start));
-    with_master(&sim, async |md, clock| {
-        let group = init(md, clock).await.into_op(md).await.expect("OP");
-        let sd = group.subdevice(md, 0).unwrap();
+    with_cyclic(&sim, async |m, sd| {
         // user unit 0.001° of the output shaft: feed 360 000 per shaft revolution, gear 2 : 1
         sd.sdo_write(0x6092, 1, 360_000u32).await.unwrap();
         sd.sdo_write(0x6091, 1, 2u32).await.unwrap();
         sd.sdo_write(0x6091, 2, 1u32).await.unwrap();
         // 0.5 shaft rev/s, 10 shaft rev/s²
-        set_profile(&sd, Some(180_000u32), 3_600_000u32).await;
+        set_profile(sd, Some(180_000u32), 3_600_000u32).await;
         sd.sdo_write(0x607F, 0, 18_000_000u32).await.unwrap(); // 50 shaft rev/s
-        let mut m = Cyclic::new(md, &group, &sim, 0);
         m.set_mode(9);
         let tx = m.run(3).await;
         // 45° of the motor = 22.5° of the shaft
@@ -766,12 +727,12 @@ fn c109_gear_and_feed_scale_positions_and_velocities_through_the_master() {
         m.set_target_velocity(0);
         m.run(300).await;
         // pp absolute: referenced here (607Ch = 0), then to 90° of the shaft = 0.5 motor rev
-        home_here(&mut m).await;
+        home_here(m).await;
         let p0 = motor_position(&sim, 0);
         m.set_mode(1);
         m.run(5).await;
-        assert!(pp_edge(&mut m, 90_000, 0).await, "taken");
-        settle(&mut m, 5000).await.expect("arrives");
+        assert!(pp_edge(m, 90_000, 0).await, "taken");
+        settle(m, 5000).await.expect("arrives");
         m.run(50).await;
         let moved = motor_position(&sim, 0) - p0;
         println!("pp to 90 000: 6064h {}, motor moved {moved} inc", m.tx.position);

@@ -7,7 +7,7 @@
 
 use drive_ecat::{parameter_index, Template};
 use drive_tests::al::{ERR, OP, SAFEOP};
-use drive_tests::step::advance;
+use drive_tests::step::{advance, op_via_safe_op};
 use drive_tests::{al_status, init, line, map_layout, variant, with_master, CoeClient, Cyclic, REV};
 use ecat::SdoAbort;
 use esc::AlStatusCode;
@@ -381,12 +381,7 @@ fn pdo_gap_times_out(a258: u16, gap_ms: u64) -> bool {
             .sdo_write(parameter_index(0, 258), 0, a258)
             .await
             .unwrap();
-        let group = group.into_safe_op(md).await.expect("SAFE-OP");
-        for _ in 0..5 {
-            advance(&sim, 1_000_000);
-            group.tx_rx(md).await.unwrap();
-        }
-        let group = group.into_op(md).await.expect("OP");
+        let group = op_via_safe_op(md, group, &sim).await;
         let sd = group.subdevice(md, 0).unwrap();
         for _ in 0..20 {
             advance(&sim, 1_000_000);

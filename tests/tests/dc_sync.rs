@@ -10,8 +10,8 @@ use drive_ecat::runtime::dcsync::{PllStatus, SyncFault};
 use drive_tests::al::{OP, SAFEOP};
 use drive_tests::init;
 use ethercrab::subdevice_group::DcConfiguration;
-use ethercrab::{DcSync, MainDevice, SubDeviceGroup};
-use hil_sim::master::run_in_process;
+use ethercrab::{MainDevice, SubDeviceGroup};
+use hil_sim::master::{into_dc_sync0, run_in_process};
 use hil_sim::sim::Simulation;
 use std::cell::RefCell;
 use std::sync::atomic::AtomicU64;
@@ -341,24 +341,14 @@ fn e116_a_sync0_cycle_the_pll_cannot_run_is_refused() {
     assert!(dcsync::Pll::new(bad).is_err());
     let sim = line();
     let a261_0: u8 = run_in_process(&sim, async |md, clock| {
-        let mut group = init(md, clock).await;
-        for mut sd in group.iter_mut(md) {
-            sd.set_dc_sync(DcSync::Sync0);
-        }
-        let group = group
-            .into_pre_op_pdi(md)
+        let dc = DcConfiguration {
+            start_delay: Duration::from_millis(5),
+            sync0_period: Duration::from_nanos(1_100_000),
+            sync0_shift: Duration::ZERO,
+        };
+        let group = into_dc_sync0(md, init(md, clock).await, dc, async |_| {})
             .await
-            .expect("PRE-OP with PDI")
-            .configure_dc_sync(
-                md,
-                DcConfiguration {
-                    start_delay: Duration::from_millis(5),
-                    sync0_period: Duration::from_nanos(1_100_000),
-                    sync0_shift: Duration::ZERO,
-                },
-            )
-            .await
-            .expect("DC configuration");
+            .expect("SYNC0, PRE-OP with PDI, DC configuration");
         {
             let mut s = sim.borrow_mut();
             let t = s.now().as_ns() + 20_000_000;
@@ -398,18 +388,9 @@ async fn dc_requested_op_after<'a>(
     sync0_ns: u64,
     pre_op: impl for<'b> AsyncFn(&'b Sd<'b>),
 ) -> DcOpGroup {
-    let mut group = init(md, clock).await;
-    for mut sd in group.iter_mut(md) {
-        sd.set_dc_sync(DcSync::Sync0);
-    }
-    let group = group.into_pre_op_pdi(md).await.expect("PRE-OP with PDI");
-    for sd in group.iter(md) {
-        pre_op(&sd).await;
-    }
-    group
-        .configure_dc_sync(md, dc_config(sync0_ns))
+    into_dc_sync0(md, init(md, clock).await, dc_config(sync0_ns), pre_op)
         .await
-        .expect("DC configuration")
+        .expect("SYNC0, PRE-OP with PDI, DC configuration")
         .request_into_op(md)
         .await
         .expect("request OP")
@@ -860,7 +841,7 @@ fn e112_sync0_twice_a150() {
 }
 
 /// A drive in the Pre-Op group as the master holds it.
-type Sd<'a> = ethercrab::SubDeviceRef<'a, ethercrab::SubDevicePdi<'a, 512, ethercrab::DefaultLock>>;
+type Sd<'a> = hil_sim::master::PdiSubDevice<'a, 512>;
 
 /// E-109 (spec §11.3): A292 = −1500 µs written by the master with A150 =
 /// 1 ms is limited to one drive cycle: the aligned cycle starts just under

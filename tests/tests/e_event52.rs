@@ -4,6 +4,7 @@
 //! and the fault reset afterwards.
 
 use drive_tests::al::{ACK, ERR, OP, SAFEOP};
+use drive_tests::step::op_via_safe_op;
 use drive_tests::{al_status, init, line, request, sw, with_master, CoeClient, Cyclic, REV};
 use esc::AlStatusCode;
 use hil_sim::sim::Simulation;
@@ -59,24 +60,10 @@ fn pdo_timeout_reaction(a540: i16) -> Vec<Sample> {
         // 6085h = 100 rev/s²: a quick stop from 5 rev/s takes 50 ms
         sd.sdo_write(0x6085, 0, 100 * REV as u32).await.unwrap();
         // with A258 on, S→O needs steady process data (E-033)
-        let group = group.into_safe_op(md).await.expect("SAFE-OP");
-        for _ in 0..5 {
-            {
-                let mut s = sim.borrow_mut();
-                let t = s.now().as_ns() + 1_000_000;
-                s.advance_to(nanos::Nanos::from_ns(t));
-            }
-            group.tx_rx(md).await.expect("process data");
-        }
-        let group = group.into_op(md).await.expect("OP");
+        let group = op_via_safe_op(md, group, &sim).await;
         let sd = group.subdevice(md, 0).unwrap();
         let mut m = Cyclic::new(md, &group, &sim, 0);
-        m.enable_in(9).await;
-        m.set_target_velocity(5 * REV);
-        m.run_until(500, |t| (t.velocity - 5 * REV).abs() < REV / 20)
-            .await
-            .expect("running at 5 rev/s");
-        m.run(20).await;
+        m.csv_reach(5 * REV).await;
         assert_eq!(get(&sim, 0x603F, 0), 0);
 
         // the master stops sending process data

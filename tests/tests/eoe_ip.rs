@@ -237,45 +237,30 @@ fn e099_refused_eoe_configuration_shows_er10() {
 /// address yet). Returns the message types it answered.
 fn dhcp_serve(host: &mut HostNet, server: smoltcp::iface::SocketHandle, offer: [u8; 4]) -> Vec<&'static str> {
     use smoltcp::wire::{DhcpMessageType, DhcpPacket, DhcpRepr, IpAddress, IpEndpoint, Ipv4Address};
+    let lease = net::testing::DhcpLease {
+        server: HOST_IP,
+        offer,
+        mask: MASK,
+        router: Some(HOST_IP),
+        options: &[],
+    };
     let mut answered = Vec::new();
     let sock = host.sockets.get_mut::<udp::Socket>(server);
     while let Ok((data, _)) = sock.recv() {
         let data = data.to_vec();
         let pkt = DhcpPacket::new_checked(&data[..]).unwrap();
         let req = DhcpRepr::parse(&pkt).unwrap();
-        let (kind, name) = match req.message_type {
-            DhcpMessageType::Discover => (DhcpMessageType::Offer, "offer"),
-            DhcpMessageType::Request => (DhcpMessageType::Ack, "ack"),
-            _ => continue,
+        let mut buf = [0u8; 576];
+        let Some((kind, reply)) = lease.answer(&req, &mut buf) else {
+            continue;
         };
-        let repr = DhcpRepr {
-            message_type: kind,
-            transaction_id: req.transaction_id,
-            secs: 0,
-            client_hardware_address: req.client_hardware_address,
-            client_ip: Ipv4Address::UNSPECIFIED,
-            your_ip: Ipv4Address::from(offer),
-            server_ip: Ipv4Address::from(HOST_IP),
-            router: Some(Ipv4Address::from(HOST_IP)),
-            subnet_mask: Some(Ipv4Address::from(MASK)),
-            relay_agent_ip: Ipv4Address::UNSPECIFIED,
-            broadcast: true,
-            requested_ip: None,
-            client_identifier: None,
-            server_identifier: Some(Ipv4Address::from(HOST_IP)),
-            parameter_request_list: None,
-            dns_servers: None,
-            max_size: None,
-            lease_duration: Some(3600),
-            renew_duration: None,
-            rebind_duration: None,
-            additional_options: &[],
-        };
-        let mut buf = vec![0u8; repr.buffer_len()];
-        repr.emit(&mut DhcpPacket::new_unchecked(&mut buf[..])).unwrap();
         let to = IpEndpoint::new(IpAddress::Ipv4(Ipv4Address::BROADCAST), 68);
-        sock.send_slice(&buf, to).unwrap();
-        answered.push(name);
+        sock.send_slice(reply, to).unwrap();
+        answered.push(if kind == DhcpMessageType::Offer {
+            "offer"
+        } else {
+            "ack"
+        });
     }
     answered
 }

@@ -6,7 +6,7 @@
 //! the first set-point (bit 4) after the enable opens the brake.
 
 use drive_tests::axis::*;
-use drive_tests::{init, line, sw, with_master, Cyclic};
+use drive_tests::{line, sw, with_cyclic, Cyclic};
 use drive_tests::{REV, REV_F};
 use std::cell::RefCell;
 
@@ -46,17 +46,14 @@ async fn pp_move(m: &mut Cyclic<'_>, sim: &RefCell<hil_sim::sim::Simulation>, ta
 #[test]
 fn c017_c021_c041_pp_after_fault_reset_and_enable_follows_as_before() {
     let sim = line(1);
-    with_master(&sim, async |md, clock| {
-        let group = init(md, clock).await.into_op(md).await.expect("OP");
-        let sd = group.subdevice(md, 0).unwrap();
-        set_profile(&sd, Some(5 * REV as u32), 50 * REV as u32).await;
-        let mut m = Cyclic::new(md, &group, &sim, 0);
+    with_cyclic(&sim, async |m, sd| {
+        set_profile(sd, Some(5 * REV as u32), 50 * REV as u32).await;
         m.enable_in(1).await;
-        home_here(&mut m).await;
+        home_here(m).await;
         m.set_mode(1);
         m.run(3).await;
 
-        let (before, braked_before) = pp_move(&mut m, &sim, 3 * REV).await;
+        let (before, braked_before) = pp_move(m, &sim, 3 * REV).await;
         // event 44 on axis A (as the power stage would raise it)
         sim.borrow_mut().drives_mut()[0].drive.axes_mut()[0]
             .raise_event(motion::Event { number: 44, cause: 1 });
@@ -70,7 +67,7 @@ fn c017_c021_c041_pp_after_fault_reset_and_enable_follows_as_before() {
         m.set_controlword(0);
         m.run(2).await;
         m.enable().await;
-        let (after, braked_after) = pp_move(&mut m, &sim, 6 * REV).await;
+        let (after, braked_after) = pp_move(m, &sim, 6 * REV).await;
         println!(
             "figure: pp 3 rev at 5 rev/s: max |60F4h| {before} inc before the fault, {after} inc after \
              reset and enable ({:.4} / {:.4} rev)",

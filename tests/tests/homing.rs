@@ -8,7 +8,7 @@
 //! in 6064h; the plant's encoder is the independent ruler.
 
 use drive_tests::axis::*;
-use drive_tests::{init, line, sw, with_master, Cyclic};
+use drive_tests::{init, line, sw, with_cyclic, with_master};
 use drive_tests::{REV, REV_F};
 use hil_sim::motor::{PositionInput, Switches};
 use std::cell::RefCell;
@@ -120,9 +120,7 @@ fn home(case: Case) -> Run {
         m.set_position_inc(case.start);
     }
     let run = RefCell::new(None);
-    with_master(&sim, async |md, clock| {
-        let group = init(md, clock).await.into_op(md).await.expect("OP");
-        let sd = group.subdevice(md, 0).unwrap();
+    with_cyclic(&sim, async |m, sd| {
         // the settings as a master sets them (issue 40): I101/I102 = 1 the
         // limit switches from the inputs; torque methods: 40 % of the rated
         // torque for 50 ms is the stop (I28/I29)
@@ -133,7 +131,6 @@ fn home(case: Case) -> Run {
         sd.sdo_write(I29, 0, 50u16).await.unwrap();
         sd.sdo_write(0x6098, 0, case.method).await.unwrap();
         sd.sdo_write(0x607C, 0, HOME_OFFSET).await.unwrap();
-        let mut m = Cyclic::new(md, &group, &sim, 0);
         let tx = m.enable_in(6).await;
         assert_eq!(tx.mode_display, 6);
         // 001 before the start (not started)
@@ -435,16 +432,13 @@ fn c086_limit_switch_as_reference_switch() {
     // I30 = 2: method 19 takes +LS as its home switch; no limit-switch fault
     let sim_case = Case::new(19, axis(PositionInput::never()), POS_LS, EDGE_TOL);
     let sim = line_with_switches(sim_case.switches);
-    with_master(&sim, async |md, clock| {
-        let group = init(md, clock).await.into_op(md).await.expect("OP");
-        let sd = group.subdevice(md, 0).unwrap();
+    with_cyclic(&sim, async |m, sd| {
         // by SDO (issue 40): limit switches from the inputs, I30 = 2
         sd.sdo_write(I101, 0, 1u8).await.unwrap();
         sd.sdo_write(I102, 0, 1u8).await.unwrap();
         sd.sdo_write(I30, 0, 2u8).await.unwrap();
         sd.sdo_write(0x6098, 0, 19i8).await.unwrap();
         sd.sdo_write(0x607C, 0, HOME_OFFSET).await.unwrap();
-        let mut m = Cyclic::new(md, &group, &sim, 0);
         m.enable_in(6).await;
         m.set_controlword(CW_ENABLED | CW_BIT4);
         let done = m
@@ -479,11 +473,8 @@ fn c086_limit_switch_as_reference_switch() {
 #[test]
 fn c059_halt_interrupts_homing_then_restart_completes() {
     let sim = line_with_switches(axis(PositionInput::above(RS_POS)));
-    with_master(&sim, async |md, clock| {
-        let group = init(md, clock).await.into_op(md).await.expect("OP");
-        let sd = group.subdevice(md, 0).unwrap();
+    with_cyclic(&sim, async |m, sd| {
         sd.sdo_write(0x6098, 0, 19i8).await.unwrap();
-        let mut m = Cyclic::new(md, &group, &sim, 0);
         m.enable_in(6).await;
         m.set_controlword(CW_ENABLED | CW_BIT4);
         m.run_until(2000, |t| t.velocity > REV).await.expect("searching");

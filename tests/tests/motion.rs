@@ -5,7 +5,7 @@
 //! drive's internals.
 
 use drive_tests::axis::*;
-use drive_tests::{init, line, sw, with_master, CoeClient, Cyclic, RawMailbox};
+use drive_tests::{init, line, sw, with_cyclic, with_master, CoeClient, Cyclic, RawMailbox};
 use drive_tests::{REV, REV_F};
 use hil_sim::motor::PositionInput;
 use hil_sim::sim::{AxisConditions, Simulation};
@@ -241,10 +241,7 @@ fn c037_csv_reaches_target_velocity() {
 #[test]
 fn c038_c039_cst_torque_with_and_without_speed_limit() {
     let sim = line(1);
-    with_master(&sim, async |md, clock| {
-        let group = init(md, clock).await.into_op(md).await.expect("OP");
-        let sd = group.subdevice(md, 0).unwrap();
-        let mut m = Cyclic::new(md, &group, &sim, 0);
+    with_cyclic(&sim, async |m, sd| {
         let tx = m.enable_in(10).await;
         assert_eq!(tx.mode_display, 10);
         assert!(tx.bit(12), "cst bit 12 'drive follows': {:#06x}", tx.statusword);
@@ -265,7 +262,7 @@ fn c038_c039_cst_torque_with_and_without_speed_limit() {
         );
 
         // G472/G475 = 10 rev/s: the torque accelerates the axis up to the limit
-        torque_mode_speed_limit(&sd, 10.0).await;
+        torque_mode_speed_limit(sd, 10.0).await;
         m.set_target_torque(100); // 0.13 N·m on 1e-4 kg·m² ≈ 207 rev/s²
         let tx = m.run(5).await;
         assert_eq!(tx.torque, 100, "6077h follows 6071h at once (C-038)");
@@ -320,12 +317,9 @@ async fn pp_start(m: &mut Cyclic<'_>, target: i32, bits: u16) {
 #[test]
 fn c041_c048_pp_moves_to_target_and_sets_target_reached() {
     let sim = line(1);
-    with_master(&sim, async |md, clock| {
-        let group = init(md, clock).await.into_op(md).await.expect("OP");
-        let sd = group.subdevice(md, 0).unwrap();
+    with_cyclic(&sim, async |m, sd| {
         // 5 rev/s, 50 rev/s² (6081h, 6083h, 6084h by SDO in Op)
-        set_profile(&sd, Some(5 * REV as u32), 50 * REV as u32).await;
-        let mut m = Cyclic::new(md, &group, &sim, 0);
+        set_profile(sd, Some(5 * REV as u32), 50 * REV as u32).await;
         let tx = m.enable_in(1).await;
         assert_eq!(tx.mode_display, 1);
 
@@ -343,13 +337,13 @@ fn c041_c048_pp_moves_to_target_and_sets_target_reached() {
         m.run(2).await;
 
         // reference (method 37 at 607Ch = 0), back to pp
-        home_here(&mut m).await;
+        home_here(m).await;
         m.set_mode(1);
         m.run(3).await;
 
         // absolute 0 → 3 rev: 0.25 rev ramps at 50 rev/s² (+ jerk), 2.5 rev at 5 rev/s
         let t0 = m.now().as_ns();
-        pp_start(&mut m, 3 * REV, 0).await;
+        pp_start(m, 3 * REV, 0).await;
         assert!(!m.tx.bit(10), "target reached clears with the new set-point");
         let mut peak = 0i32;
         let mut reached_at = None;
@@ -389,16 +383,16 @@ fn c041_c048_pp_moves_to_target_and_sets_target_reached() {
         assert!(tx.bit(10), "stays in the window");
 
         // a move back to 0, replaced after 200 ms by an immediate (bit 5) set-point to 1 rev (C-044)
-        pp_start(&mut m, 0, 0).await;
+        pp_start(m, 0, 0).await;
         m.run(200).await;
         assert!(m.tx.velocity < -REV, "moving back: {}", m.tx.velocity);
-        pp_start(&mut m, REV, CW_BIT5).await;
+        pp_start(m, REV, CW_BIT5).await;
         m.run_until(1500, |t| t.bit(10)).await.expect("reached 1 rev");
         let min_pos = m.tx.position;
         assert!((REV - min_pos).abs() <= REV / 360, "at 1 rev: {min_pos}");
 
         // relative (bit 6, 60F2h = 0: to the last target) +0.5 rev (C-046)
-        pp_start(&mut m, REV / 2, CW_BIT6).await;
+        pp_start(m, REV / 2, CW_BIT6).await;
         m.run_until(1500, |t| t.bit(10)).await.expect("reached 1.5 rev");
         let tx = m.tx;
         assert!(
@@ -413,11 +407,8 @@ fn c041_c048_pp_moves_to_target_and_sets_target_reached() {
 #[test]
 fn c055_c056_pv_reaches_velocity_and_reports_zero_speed() {
     let sim = line(1);
-    with_master(&sim, async |md, clock| {
-        let group = init(md, clock).await.into_op(md).await.expect("OP");
-        let sd = group.subdevice(md, 0).unwrap();
-        set_profile(&sd, None, 40 * REV as u32).await;
-        let mut m = Cyclic::new(md, &group, &sim, 0);
+    with_cyclic(&sim, async |m, sd| {
+        set_profile(sd, None, 40 * REV as u32).await;
         let tx = m.enable_in(3).await;
         assert_eq!(tx.mode_display, 3);
         let tx = m.run(20).await;
@@ -517,19 +508,16 @@ fn e125_c144_free_run_moves_at_the_commanded_speed_at_every_a150() {
 #[test]
 fn c058_c061_c078_homing_method_37_through_pdo() {
     let sim = line(1);
-    with_master(&sim, async |md, clock| {
-        let group = init(md, clock).await.into_op(md).await.expect("OP");
-        let sd = group.subdevice(md, 0).unwrap();
+    with_cyclic(&sim, async |m, sd| {
         sd.sdo_write(0x6098, 0, 37i8).await.unwrap();
         sd.sdo_write(0x607C, 0, 123_456i32).await.unwrap();
-        let mut m = Cyclic::new(md, &group, &sim, 0);
         let tx = m.enable_in(6).await;
         assert_eq!(tx.mode_display, 6);
         let before = tx.position;
         // a steady bit 4 from enable on is no start: nothing happens (C-058)
         let tx = m.run(10).await;
         assert!(!tx.bit(12), "not referenced yet: {:#06x}", tx.statusword);
-        let tx = home_here(&mut m).await;
+        let tx = home_here(m).await;
         println!("method 37: 6064h {before} → {}", tx.position);
         assert!(
             (tx.position - 123_456).abs() < 10,
@@ -554,14 +542,11 @@ fn c058_c059_c071_homing_method_19_on_a_reference_switch() {
         d.motors[0].switches_mut().reference = PositionInput::above(edge)
     });
     let home_offset = -5000;
-    with_master(&sim, async |md, clock| {
-        let group = init(md, clock).await.into_op(md).await.expect("OP");
-        let sd = group.subdevice(md, 0).unwrap();
+    with_cyclic(&sim, async |m, sd| {
         sd.sdo_write(0x6098, 0, 19i8).await.unwrap();
         sd.sdo_write(0x607C, 0, home_offset).await.unwrap();
         let fast: u32 = sd.sdo_read(0x6099, 1).await.unwrap();
         let slow: u32 = sd.sdo_read(0x6099, 2).await.unwrap();
-        let mut m = Cyclic::new(md, &group, &sim, 0);
         m.enable_in(6).await;
         m.set_controlword(CW_ENABLED | CW_BIT4);
         let t0 = m.now().as_ns();
@@ -622,20 +607,12 @@ fn c058_c059_c071_homing_method_19_on_a_reference_switch() {
 #[test]
 fn c010_c011_quick_stop_through_pdo() {
     let sim = line(1);
-    with_master(&sim, async |md, clock| {
-        let group = init(md, clock).await.into_op(md).await.expect("OP");
-        let sd = group.subdevice(md, 0).unwrap();
+    with_cyclic(&sim, async |m, sd| {
         // 6085h = 100 rev/s²: 5 rev/s stop in 50 ms over 0.125 rev
         sd.sdo_write(0x6085, 0, 100 * REV as u32).await.unwrap();
         let qs_option: i16 = sd.sdo_read(0x605A, 0).await.unwrap();
         assert_eq!(qs_option, 2, "605Ah default: quick stop ramp, then SOD");
-        let mut m = Cyclic::new(md, &group, &sim, 0);
-        m.enable_in(9).await;
-        m.set_target_velocity(5 * REV);
-        m.run_until(500, |t| (t.velocity - 5 * REV).abs() < REV / 20)
-            .await
-            .expect("running at 5 rev/s");
-        m.run(20).await;
+        m.csv_reach(5 * REV).await;
 
         // quick stop: bit 2 = 0 with bits 0, 1, 3 kept (0x000B)
         let t0 = m.now().as_ns();
@@ -720,9 +697,7 @@ fn c016_c017_e007_e087_e088_following_error_fault_emcy_and_reset() {
     with_drive(&sim, |d| {
         d.motors[0].params_mut().end_stops_inc = Some((-10 * i64::from(REV), i64::from(REV / 2)));
     });
-    with_master(&sim, async |md, clock| {
-        let group = init(md, clock).await.into_op(md).await.expect("OP");
-        let sd = group.subdevice(md, 0).unwrap();
+    with_cyclic(&sim, async |m, sd| {
         // I470 = 1: the following error reaction is a fault (event 54)
         sd.sdo_write(drive_ecat::parameter_index(8, 470), 0, 1u8)
             .await
@@ -730,7 +705,6 @@ fn c016_c017_e007_e087_e088_following_error_fault_emcy_and_reset() {
         // following error window 0.05 rev, 10 ms (6065h, 6066h)
         sd.sdo_write(0x6065, 0, (REV / 20) as u32).await.unwrap();
         sd.sdo_write(0x6066, 0, 10u16).await.unwrap();
-        let mut m = Cyclic::new(md, &group, &sim, 0);
         m.set_mode(8);
         m.run(3).await;
         m.set_target_position(m.tx.position);
@@ -766,14 +740,14 @@ fn c016_c017_e007_e087_e088_following_error_fault_emcy_and_reset() {
 
         // the EMCY is in the mailbox, 603Fh and 1001h show the fault
         let mut mbx = RawMailbox::new();
-        let (code, register, raw) = receive_emcy(&mut mbx, &sd).await;
+        let (code, register, raw) = receive_emcy(&mut mbx, sd).await;
         println!("EMCY {raw:02x?}");
         assert_eq!(code, 0x8611, "following error (event 54)");
         assert_ne!(register, 0, "error register in the EMCY");
         let mut coe = CoeClient::new();
-        let reg = coe.upload(&sd, 0x1001, 0).await.unwrap();
+        let reg = coe.upload(sd, 0x1001, 0).await.unwrap();
         assert_ne!(reg[0], 0, "1001h error register");
-        let e603f = coe.upload(&sd, 0x603F, 0).await.unwrap();
+        let e603f = coe.upload(sd, 0x603F, 0).await.unwrap();
         assert_eq!(u16::from_le_bytes([e603f[0], e603f[1]]), 0x8611, "603Fh");
 
         // bit 7 = 0 keeps the fault; its rising edge resets (T15)
@@ -800,10 +774,10 @@ fn c016_c017_e007_e087_e088_following_error_fault_emcy_and_reset() {
             "stays SOD with bit 7 steady: {:#06x}",
             tx.statusword
         );
-        let (code, register, raw) = receive_emcy(&mut mbx, &sd).await;
+        let (code, register, raw) = receive_emcy(&mut mbx, sd).await;
         println!("EMCY {raw:02x?}");
         assert_eq!((code, register), (0, 0), "fault cleared");
-        let reg = coe.upload(&sd, 0x1001, 0).await.unwrap();
+        let reg = coe.upload(sd, 0x1001, 0).await.unwrap();
         assert_eq!(reg[0], 0, "1001h cleared");
         // and the axis can be enabled again (away from the stop)
         m.set_controlword(0);
@@ -827,10 +801,7 @@ fn c134_axis_b_moves_independently_by_sdo() {
         return;
     }
     let sim = line(1);
-    with_master(&sim, async |md, clock| {
-        let group = init(md, clock).await.into_op(md).await.expect("OP");
-        let sd = group.subdevice(md, 0).unwrap();
-        let mut m = Cyclic::new(md, &group, &sim, 0);
+    with_cyclic(&sim, async |m, sd| {
         m.set_mode(9);
         m.run(3).await;
 
@@ -905,14 +876,11 @@ fn c121_c122_c123_touch_probe_latches_the_edges_of_input_1() {
     with_drive(&sim, |d| {
         d.motors[0].switches_mut().probe1 = PositionInput::window(rise, fall)
     });
-    with_master(&sim, async |md, clock| {
-        let group = init(md, clock).await.into_op(md).await.expect("OP");
-        let sd = group.subdevice(md, 0).unwrap();
+    with_cyclic(&sim, async |m, sd| {
         // probe 1 on, single shot, rising (bit 4) and falling (bit 5) edges; source 60D0h:01 = input 1
         sd.sdo_write(0x60B8, 0, 0x0031u16).await.unwrap();
         let source: i16 = sd.sdo_read(0x60D0, 1).await.unwrap();
         assert_eq!(source, 1);
-        let mut m = Cyclic::new(md, &group, &sim, 0);
         m.set_mode(9);
         m.run(3).await;
         let status: u16 = sd.sdo_read(0x60B9, 0).await.unwrap();
@@ -924,7 +892,7 @@ fn c121_c122_c123_touch_probe_latches_the_edges_of_input_1() {
             .expect("past the probe window");
         m.set_target_velocity(0);
         m.run(50).await;
-        let (status, pos, neg) = probe1(&sd).await;
+        let (status, pos, neg) = probe1(sd).await;
         println!("touch probe 1: 60B9h {status:#06x}, 60BAh {pos} (edge {rise}), 60BBh {neg} (edge {fall})");
         assert_eq!(
             status & 0x07,
@@ -951,12 +919,9 @@ fn c071_homing_method_19_started_on_the_switch() {
     with_drive(&sim, |d| {
         d.motors[0].switches_mut().reference = PositionInput::above(edge)
     });
-    with_master(&sim, async |md, clock| {
-        let group = init(md, clock).await.into_op(md).await.expect("OP");
-        let sd = group.subdevice(md, 0).unwrap();
+    with_cyclic(&sim, async |m, sd| {
         sd.sdo_write(0x6098, 0, 19i8).await.unwrap();
         sd.sdo_write(0x607C, 0, 0i32).await.unwrap();
-        let mut m = Cyclic::new(md, &group, &sim, 0);
         let tx = m.enable_in(6).await;
         assert!(
             tx.digital_inputs & 0b100 != 0,
@@ -992,12 +957,9 @@ fn c036_csp_following_error_bit_13_without_fault() {
     with_drive(&sim, |d| {
         d.motors[0].params_mut().end_stops_inc = Some((-i64::from(REV), i64::from(REV / 4)));
     });
-    with_master(&sim, async |md, clock| {
-        let group = init(md, clock).await.into_op(md).await.expect("OP");
-        let sd = group.subdevice(md, 0).unwrap();
+    with_cyclic(&sim, async |m, sd| {
         sd.sdo_write(0x6065, 0, (REV / 50) as u32).await.unwrap();
         sd.sdo_write(0x6066, 0, 20u16).await.unwrap();
-        let mut m = Cyclic::new(md, &group, &sim, 0);
         m.enable_in(8).await;
         // 1 rev/s ramp; blocked at 0.25 rev
         let mut first_bit13 = None;

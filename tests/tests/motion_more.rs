@@ -4,7 +4,7 @@
 //! Every check reads what the master received (TxPDO or SDO).
 
 use drive_tests::axis::*;
-use drive_tests::{init, line, map_layout, sw, with_master, Cyclic, RawCyclic};
+use drive_tests::{init, line, map_layout, sw, with_cyclic, with_master, Cyclic, RawCyclic};
 use drive_tests::{REV, REV_F};
 use hil_sim::motor::{PositionInput, Switches};
 
@@ -184,11 +184,8 @@ fn c051_c052_c053_c054_vl_bits_4_5_6_ramp_and_limit() {
 #[test]
 fn c057_pt_ramps_6071_with_6087_limited_by_6072_and_g472() {
     let sim = line(1);
-    with_master(&sim, async |md, clock| {
-        let group = init(md, clock).await.into_op(md).await.expect("OP");
-        let sd = group.subdevice(md, 0).unwrap();
+    with_cyclic(&sim, async |m, sd| {
         sd.sdo_write(0x6087, 0, 1000u32).await.unwrap(); // 100 %/s
-        let mut m = Cyclic::new(md, &group, &sim, 0);
         let tx = m.enable_in(4).await;
         assert_eq!(tx.mode_display, 4);
 
@@ -201,7 +198,7 @@ fn c057_pt_ramps_6071_with_6087_limited_by_6072_and_g472() {
         // back to 0, then G472 = 20 rev/s: 0 → 10 % along 6087h (100 ms)
         m.set_target_torque(0);
         m.run(200).await;
-        torque_mode_speed_limit(&sd, 20.0).await;
+        torque_mode_speed_limit(sd, 20.0).await;
         m.run(5).await;
         assert!(m.tx.bit(10), "torque 0 reached: {:#06x}", m.tx.statusword);
         m.set_target_torque(100);
@@ -331,12 +328,9 @@ fn c088_c089_c090_jog_bits_4_and_5() {
 #[test]
 fn c091_c092_jog_at_the_software_limits() {
     let sim = line(1);
-    with_master(&sim, async |md, clock| {
-        let group = init(md, clock).await.into_op(md).await.expect("OP");
-        let sd = group.subdevice(md, 0).unwrap();
-        let mut m = Cyclic::new(md, &group, &sim, 0);
+    with_cyclic(&sim, async |m, sd| {
         m.enable_in(6).await;
-        home_here(&mut m).await;
+        home_here(m).await;
         let limit = REV / 2;
         sd.sdo_write(0x607D, 1, -limit).await.unwrap();
         sd.sdo_write(0x607D, 2, limit).await.unwrap();
@@ -521,13 +515,10 @@ fn c093_c094_c095_hardware_limit_switch_faults_and_locks_the_direction() {
 #[test]
 fn c099_c101_c102_c103_software_limits_fault_and_lock_the_direction() {
     let sim = line(1);
-    with_master(&sim, async |md, clock| {
-        let group = init(md, clock).await.into_op(md).await.expect("OP");
-        let sd = group.subdevice(md, 0).unwrap();
+    with_cyclic(&sim, async |m, sd| {
         let limit = REV / 2;
         sd.sdo_write(0x607D, 1, -limit).await.unwrap();
         sd.sdo_write(0x607D, 2, limit).await.unwrap();
-        let mut m = Cyclic::new(md, &group, &sim, 0);
         m.enable_in(9).await;
         // not referenced: the software limits do not act (C-099)
         m.set_target_velocity(2 * REV);
@@ -544,7 +535,7 @@ fn c099_c101_c102_c103_software_limits_fault_and_lock_the_direction() {
         m.run(50).await;
 
         // referenced here (6064h = 0), then csv towards +0.5 rev: fault beyond limit + I22 (C-101)
-        home_here(&mut m).await;
+        home_here(m).await;
         m.set_mode(9);
         m.run(20).await;
         assert_eq!(m.tx.mode_display, 9);
@@ -563,7 +554,7 @@ fn c099_c101_c102_c103_software_limits_fault_and_lock_the_direction() {
             "faults at limit + I22: {max_pos}"
         );
         m.set_target_velocity(0);
-        let code = fault_and_reset(&mut m, "software limit").await;
+        let code = fault_and_reset(m, "software limit").await;
         assert_eq!(Some(code), event_53(), "603Fh of event 53");
         let p = m.tx.position;
         assert!(p > limit, "beyond the limit after the fault reaction: {p}");
@@ -630,16 +621,13 @@ fn c124_c127_touch_probe_single_shot_falling_only_and_rearm() {
     with_drive(&sim, |d| {
         d.motors[0].switches_mut().probe1 = PositionInput::toggles(false, &marks).unwrap();
     });
-    with_master(&sim, async |md, clock| {
-        let group = init(md, clock).await.into_op(md).await.expect("OP");
-        let sd = group.subdevice(md, 0).unwrap();
+    with_cyclic(&sim, async |m, sd| {
         // example 2: enabled, first event, falling edge only (bit 5)
         sd.sdo_write(0x60B8, 0, 0x0021u16).await.unwrap();
-        let mut m = Cyclic::new(md, &group, &sim, 0);
         m.enable_in(9).await;
         m.set_target_velocity(REV);
-        pass_and_stop(&mut m, 2000, marks[3] + i64::from(REV / 20), "past p4").await;
-        let (status, rising, falling) = probe1(&sd).await;
+        pass_and_stop(m, 2000, marks[3] + i64::from(REV / 20), "past p4").await;
+        let (status, rising, falling) = probe1(sd).await;
         println!(
             "example 2: 60B9h {status:#06x}, 60BAh {rising}, 60BBh {falling} (p2 {})",
             marks[1]
@@ -664,8 +652,8 @@ fn c124_c127_touch_probe_single_shot_falling_only_and_rearm() {
         let kept: i32 = sd.sdo_read(0x60BB, 0).await.unwrap();
         assert_eq!(kept, falling, "values survive the disable");
         m.set_target_velocity(REV);
-        pass_and_stop(&mut m, 2000, marks[5] + i64::from(REV / 20), "past p6").await;
-        let (status, rising, falling) = probe1(&sd).await;
+        pass_and_stop(m, 2000, marks[5] + i64::from(REV / 20), "past p6").await;
+        let (status, rising, falling) = probe1(sd).await;
         println!(
             "example 3: 60B9h {status:#06x}, 60BAh {rising} (p5 {}), 60BBh {falling} (p6 {})",
             marks[4], marks[5]
@@ -687,19 +675,16 @@ fn c125_c126_touch_probe_example_1_continuous_both_edges() {
     with_drive(&sim, |d| {
         d.motors[0].switches_mut().probe1 = PositionInput::toggles(false, &marks).unwrap();
     });
-    with_master(&sim, async |md, clock| {
-        let group = init(md, clock).await.into_op(md).await.expect("OP");
-        let sd = group.subdevice(md, 0).unwrap();
+    with_cyclic(&sim, async |m, sd| {
         // example 1: enabled (bit 0), continuous (bit 1), rising (bit 4) and falling (bit 5)
         sd.sdo_write(0x60B8, 0, 0x0033u16).await.unwrap();
-        let mut m = Cyclic::new(md, &group, &sim, 0);
         m.enable_in(9).await;
         m.set_target_velocity(REV / 2);
         // past p2: the first pair is stored, both status bits on
         m.run_until(3000, |t| i64::from(t.position) > marks[1] + i64::from(REV / 40))
             .await
             .expect("past p2");
-        let (status, rising, falling) = probe1(&sd).await;
+        let (status, rising, falling) = probe1(sd).await;
         println!("example 1 after p2: 60B9h {status:#06x}, 60BAh {rising}, 60BBh {falling}");
         assert_eq!(
             status & 0x07,
@@ -709,8 +694,8 @@ fn c125_c126_touch_probe_example_1_continuous_both_edges() {
         at_mark(rising, marks[0], "p1");
         at_mark(falling, marks[1], "p2");
         // past p4: every edge overwrote its value (continuous, C-125)
-        pass_and_stop(&mut m, 3000, marks[3] + i64::from(REV / 40), "past p4").await;
-        let (status, rising, falling) = probe1(&sd).await;
+        pass_and_stop(m, 3000, marks[3] + i64::from(REV / 40), "past p4").await;
+        let (status, rising, falling) = probe1(sd).await;
         println!(
             "example 1 after p4: 60B9h {status:#06x}, 60BAh {rising} (p3 {}), 60BBh {falling} (p4 {})",
             marks[2], marks[3]
@@ -728,7 +713,7 @@ fn c125_c126_touch_probe_example_1_continuous_both_edges() {
         assert_eq!((kept_r, kept_f), (rising, falling), "60BAh/60BBh kept");
         // disabled: passing the edges again stores nothing
         m.set_target_velocity(-REV / 2);
-        pass_and_stop(&mut m, 3000, marks[0] - i64::from(REV / 40), "back below p1").await;
+        pass_and_stop(m, 3000, marks[0] - i64::from(REV / 40), "back below p1").await;
         let status: u16 = sd.sdo_read(0x60B9, 0).await.unwrap();
         let still: i32 = sd.sdo_read(0x60BA, 0).await.unwrap();
         assert_eq!(status & 0x07, 0, "nothing latched while disabled: {status:#06x}");

@@ -5,7 +5,7 @@
 
 use drive_ecat::params::{C31, C32, G472, G475, I04, I20, I25, I28, I29, I30, I423, I425, I43, I53, I87};
 use drive_tests::axis::{with_drive, CW_ENABLED};
-use drive_tests::{init, line, with_master, Cyclic};
+use drive_tests::{init, line, with_cyclic, with_master};
 use ethercrab::error::CoeAbortCode::{ValueOutOfRange, ValueTooLarge};
 use hil_sim::sim::Simulation;
 use std::cell::RefCell;
@@ -29,13 +29,10 @@ fn abort_code(e: ethercrab::error::Error) -> ethercrab::error::CoeAbortCode {
 /// every 1 ms cycle after the step.
 fn velocity_step(kp: u32, step: i32, cycles: usize) -> Vec<f64> {
     let sim = line(1);
-    with_master(&sim, async |md, clock| {
-        let group = init(md, clock).await.into_op(md).await.expect("OP");
-        let sd = group.subdevice(md, 0).unwrap();
+    with_cyclic(&sim, async |m, sd| {
         sd.sdo_write(C32, 0, 0u32).await.unwrap();
         sd.sdo_write(C31, 0, kp).await.unwrap();
         assert_eq!(sd.sdo_read::<u32>(C31, 0).await.unwrap(), kp);
-        let mut m = Cyclic::new(md, &group, &sim, 0);
         m.enable_in(9).await;
         m.set_controlword(CW_ENABLED);
         m.run(20).await;

@@ -4,7 +4,7 @@
 //! for stable RxPDO and the PDO timeout in Op.
 
 use drive_tests::al::{ACK, ERR, OP, PREOP, SAFEOP};
-use drive_tests::step::{advance, cycles, set};
+use drive_tests::step::{advance, cycles, op_via_safe_op, set};
 use drive_tests::{al_status, init, line, request, with_master, write_sm, CoeClient, OpGroup};
 use esc::regs::{self, dc};
 use esc::AlStatusCode;
@@ -29,9 +29,7 @@ async fn op_with_a258<'a>(
     a258: i64,
 ) -> OpGroup {
     set(sim, A258, 0, a258);
-    let group = init(md, clock).await.into_safe_op(md).await.expect("SAFE-OP");
-    cycles(md, &group, sim, 5).await;
-    group.into_op(md).await.expect("OP")
+    op_via_safe_op(md, init(md, clock).await, sim).await
 }
 
 /// SYNC0 configured with plain register writes, as a master's DC set-up does.

@@ -10,7 +10,7 @@
 //! inc), so both sides hand the profile generator the same numbers.
 
 use drive_tests::axis::*;
-use drive_tests::{init, line, with_master, Cyclic, REV};
+use drive_tests::{line, with_cyclic, REV};
 use hil_sim::fb::controller::PnController;
 use hil_sim::fb::rig::FbRig;
 
@@ -41,14 +41,11 @@ fn from_first_motion(trace: &[i64]) -> Vec<i64> {
 /// 0), homed by method 37 at the motor's position first.
 fn over_ethercat() -> Vec<i64> {
     let sim = line(1);
-    with_master(&sim, async |md, clock| {
-        let group = init(md, clock).await.into_op(md).await.expect("OP");
-        let sd = group.subdevice(md, 0).unwrap();
-        set_profile(&sd, Some(INC_PER_S), INC_PER_S2).await;
+    with_cyclic(&sim, async |m, sd| {
+        set_profile(sd, Some(INC_PER_S), INC_PER_S2).await;
         sd.sdo_write(0x60A4, 1, 0u32).await.unwrap();
-        let mut m = Cyclic::new(md, &group, &sim, 0);
         m.enable_in(1).await;
-        home_here(&mut m).await;
+        home_here(m).await;
         m.set_mode(1);
         m.run(50).await;
         m.set_target_position(TARGET_INC);

@@ -17,6 +17,8 @@ pub mod param;
 pub mod real;
 pub mod sntp;
 pub mod stack;
+#[cfg(feature = "testing")]
+pub mod testing;
 
 pub use device::QueueDevice;
 /// smoltcp, as this crate uses it (for the owner's `SocketStorage::EMPTY`).

@@ -348,7 +348,8 @@ fn e095_arp_flood_replaces_the_oldest_neighbour() {
 #[cfg(feature = "patched-smoltcp")]
 #[test]
 fn e098_dhcp_ack_with_renewal_time_beyond_the_lease_is_taken() {
-    use net::smoltcp::wire::{DhcpMessageType, DhcpOption, DhcpPacket, DhcpRepr, Ipv4Address};
+    use net::smoltcp::wire::{DhcpMessageType, DhcpOption, DhcpPacket, DhcpRepr};
+    use net::testing::DhcpLease;
     let mut bufs = NetBuffers::new();
     let mut slots = [SocketStorage::EMPTY; SOCKETS];
     let mut r = Rig::without_ip(&mut bufs, &mut slots);
@@ -358,6 +359,18 @@ fn e098_dhcp_ack_with_renewal_time_beyond_the_lease_is_taken() {
         ..NetSettings::default()
     };
     let offered = [192, 168, 10, 50];
+    let t1 = 7200u32.to_be_bytes();
+    let options = [DhcpOption {
+        kind: 58, // renewal time value
+        data: &t1,
+    }];
+    let lease = DhcpLease {
+        server: HOST_IP,
+        offer: offered,
+        mask: [255, 255, 255, 0],
+        router: None,
+        options: &options,
+    };
     let mut answered = Vec::new();
     for _ in 0..20_000 {
         for f in r.poll_with(&s) {
@@ -367,42 +380,11 @@ fn e098_dhcp_ack_with_renewal_time_beyond_the_lease_is_taken() {
             }
             let pkt = DhcpPacket::new_checked(&f[14 + 28..]).unwrap();
             let req = DhcpRepr::parse(&pkt).unwrap();
-            let kind = match req.message_type {
-                DhcpMessageType::Discover => DhcpMessageType::Offer,
-                DhcpMessageType::Request => DhcpMessageType::Ack,
-                _ => continue,
+            let mut buf = [0u8; 576];
+            let Some((kind, dhcp)) = lease.answer(&req, &mut buf) else {
+                continue;
             };
-            let t1 = 7200u32.to_be_bytes();
-            let options = [DhcpOption {
-                kind: 58, // renewal time value
-                data: &t1,
-            }];
-            let repr = DhcpRepr {
-                message_type: kind,
-                transaction_id: req.transaction_id,
-                secs: 0,
-                client_hardware_address: req.client_hardware_address,
-                client_ip: Ipv4Address::UNSPECIFIED,
-                your_ip: Ipv4Address::from(offered),
-                server_ip: Ipv4Address::from(HOST_IP),
-                router: None,
-                subnet_mask: Some(Ipv4Address::new(255, 255, 255, 0)),
-                relay_agent_ip: Ipv4Address::UNSPECIFIED,
-                broadcast: true,
-                requested_ip: None,
-                client_identifier: None,
-                server_identifier: Some(Ipv4Address::from(HOST_IP)),
-                parameter_request_list: None,
-                dns_servers: None,
-                max_size: None,
-                lease_duration: Some(3600),
-                renew_duration: None,
-                rebind_duration: None,
-                additional_options: &options,
-            };
-            let mut dhcp = vec![0u8; repr.buffer_len()];
-            repr.emit(&mut DhcpPacket::new_unchecked(&mut dhcp[..])).unwrap();
-            let dgram = udp(67, 68, (8 + dhcp.len()) as u16, &dhcp);
+            let dgram = udp(67, 68, (8 + dhcp.len()) as u16, dhcp);
             let frame = eth(
                 [0xFF; 6],
                 HOST_MAC,

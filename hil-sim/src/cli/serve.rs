@@ -23,6 +23,8 @@ use super::args::{Fieldbus, Plant, PlantFault, ServeArgs};
 pub(super) const PLANT_SEED: u64 = 0x5E12_0034;
 use super::print_new_changes;
 use super::serve_stats::{describe, thread_cpu, Answer, Stats};
+use hil_sim::electrical::ElectricalAxis;
+use hil_sim::plants::PlantDrive;
 use hil_sim::raw::{monotonic, RawSocket};
 use hil_sim::sim::{SimDrive, Simulation};
 use nanos::Nanos;
@@ -73,10 +75,40 @@ fn set_plant_motor(sim: &mut Simulation, args: &ServeArgs) -> Result<(), String>
         return Ok(());
     };
     for d in sim.drives_mut() {
-        for axis in 0..2 {
-            if let Some(el) = d.electrical_mut(axis) {
-                apply(el);
-            }
+        apply_plant_motor(d, &apply);
+    }
+    Ok(())
+}
+
+/// `apply` ([`plant_motor`]'s change) on each electrical axis of `d`.
+pub(super) fn apply_plant_motor(d: &mut impl PlantDrive, apply: &impl Fn(&mut ElectricalAxis)) {
+    for axis in 0..2 {
+        if let Some(el) = d.plants_mut().get_mut(axis) {
+            apply(el);
+        }
+    }
+}
+
+/// The motor model of drive `k` (from 0) of either fieldbus as `--plant`
+/// and `--pwm-khz` choose it, seeded with [`PLANT_SEED`] + 2k (axis B with
+/// one more, so runs are reproducible and axes independent), and
+/// `--plant-fault` on its axis A.
+pub(super) fn set_up_plant(d: &mut impl PlantDrive, k: u64, args: &ServeArgs) -> Result<(), String> {
+    d.plants_mut()
+        .set(
+            args.plant.into(),
+            PLANT_SEED.wrapping_add(2 * k),
+            args.pwm_khz.hz(),
+        )
+        .map_err(|e| format!("the electrical plant's parameters: {e:?}"))?;
+    if let Some(f) = args.plant_fault {
+        f.apply(
+            d.plants_mut()
+                .get_mut(0)
+                .ok_or("--plant-fault needs --plant electrical")?,
+        );
+        if let Some(m) = d.motor_mut(0) {
+            f.apply_to_motor(m.params_mut());
         }
     }
     Ok(())
@@ -140,22 +172,8 @@ pub fn serve(args: &ServeArgs) -> Result<(), String> {
             .map(|_| SimDrive::with_firmware_slots_for(variant))
             .collect(),
     );
-    // the motor model: the seed per drive k (from 0) is PLANT_SEED + 2k
-    // (axis B takes + 1), so runs are reproducible and axes independent
     for (k, d) in (0u64..).zip(sim.drives_mut()) {
-        d.set_plant_at(
-            args.plant.into(),
-            PLANT_SEED.wrapping_add(2 * k),
-            args.pwm_khz.hz(),
-        )
-        .map_err(|e| format!("the electrical plant's parameters: {e:?}"))?;
-        if let Some(f) = args.plant_fault {
-            f.apply(
-                d.electrical_mut(0)
-                    .ok_or("--plant-fault needs --plant electrical")?,
-            );
-            f.apply_to_motor(d.motors[0].params_mut());
-        }
+        set_up_plant(d, k, args)?;
     }
     set_plant_motor(&mut sim, args)?;
     if let Some(j) = args.flywheel {
@@ -166,12 +184,7 @@ pub fn serve(args: &ServeArgs) -> Result<(), String> {
             return Err("--flywheel has no holding brake: no brake fault with it".into());
         }
         for d in sim.drives_mut() {
-            let m = d.motors[0].params_mut();
-            m.inertia_kg_m2 = j;
-            m.viscous_friction_nm_s_per_rad = 0.0;
-            m.coulomb_friction_nm = 0.0;
-            m.static_friction_nm = 0.0;
-            m.brake_holding_torque_nm = 0.0;
+            d.motors[0].params_mut().set_flywheel(j);
         }
     }
     // the recording first: an unwritable path fails before anything else

@@ -243,27 +243,9 @@ pub fn serve(args: &ServeArgs) -> Result<(), String> {
     // the motor model: the seed per drive k (from 0) as EtherCAT's serve
     let plant_motor = super::serve::plant_motor(args)?;
     for (k, d) in (0u64..).zip(drives.iter_mut()) {
-        d.set_plant_at(
-            args.plant.into(),
-            super::serve::PLANT_SEED.wrapping_add(2 * k),
-            args.pwm_khz.hz(),
-        )
-        .map_err(|e| format!("the electrical plant's parameters: {e:?}"))?;
-        if let Some(f) = args.plant_fault {
-            f.apply(
-                d.electrical_mut(0)
-                    .ok_or("--plant-fault needs --plant electrical")?,
-            );
-            if let Some(m) = d.motor_mut(0) {
-                f.apply_to_motor(m.params_mut());
-            }
-        }
+        super::serve::set_up_plant(d, k, args)?;
         if let Some(apply) = &plant_motor {
-            for axis in 0..2 {
-                if let Some(el) = d.electrical_mut(axis) {
-                    apply(el);
-                }
-            }
+            super::serve::apply_plant_motor(d, apply);
         }
     }
     let mut control = args.control.as_deref().map(Control::create).transpose()?;

@@ -73,7 +73,13 @@ impl FbRig {
         if !self.until(100, |o| o.identifier != 0)? {
             return Ok(false);
         }
+        self.enable_within(500)
+    }
+
+    /// `drive_enable` set, then cycles until `drive_is_enabled`, at most
+    /// `ms`; whether it came.
+    pub fn enable_within(&mut self, ms: u64) -> Result<bool, String> {
         self.i.drive_enable = true;
-        self.until(500, |o| o.drive_is_enabled)
+        self.until(ms, |o| o.drive_is_enabled)
     }
 }

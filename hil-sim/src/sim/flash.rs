@@ -43,3 +43,18 @@ impl drive_ecat::boot::Flash for FirmwareFlash {
 
 /// The firmware slots of a simulated drive.
 pub type FirmwareSlots = drive_ecat::boot::BootSlots<FirmwareFlash>;
+
+/// A firmware body of `len` bytes for a test download, derived from
+/// `version` (byte 3 of `i·2654435761 + version`, little-endian, for byte
+/// `i`), so that two versions differ throughout: the update files of the FoE
+/// bench, the end-to-end tests and the SOEM FoE test (version 0).
+pub fn firmware_body(len: usize, version: u32) -> Vec<u8> {
+    (0..len)
+        .map(|i| {
+            (i as u32)
+                .wrapping_mul(2_654_435_761)
+                .wrapping_add(version)
+                .to_le_bytes()[3]
+        })
+        .collect()
+}

@@ -8,6 +8,8 @@
 use super::SimDrive;
 use drive_ecat::axis::{AxisCommand, AxisIo};
 
+crate::plants::plant_drive!(SimDrive);
+
 impl SimDrive {
     crate::plants::plant_methods!();
 

@@ -6,6 +6,7 @@
 use std::process::{Child, Command, Stdio};
 use std::time::Duration;
 
+pub mod kickcat;
 pub mod pn_line;
 pub mod scope_check;
 pub mod soem_line;
@@ -173,6 +174,19 @@ pub fn watch_script(
     let lines = t_out.join().unwrap_or_default();
     let _ = t_err.join();
     (status, lines)
+}
+
+/// A scratch directory for one test's files (under cargo's target tmp).
+pub fn scratch(test: &str) -> std::path::PathBuf {
+    let dir = std::path::Path::new(env!("CARGO_TARGET_TMPDIR")).join(test);
+    std::fs::create_dir_all(&dir).expect("scratch dir");
+    dir
+}
+
+/// The peer's python, or `None` after saying on stderr that `test` is
+/// skipped and why (the test then passes without running).
+pub fn or_skip(python: Result<std::path::PathBuf, String>, test: &str) -> Option<std::path::PathBuf> {
+    python.map_err(|why| eprintln!("{test}: skipped, {why}")).ok()
 }
 
 /// The python a peer written by others runs in, from the variable `var`

@@ -12,17 +12,10 @@ use std::time::Duration;
 /// A script that has not finished after this long has hung ([`Line::run`]).
 pub const SCRIPT_LIMIT: Duration = Duration::from_secs(240);
 
-/// The python with pysoem, or why the test cannot run (not root, or
-/// `PYSOEM_PYTHON` not set). A `PYSOEM_PYTHON` that cannot import pysoem is
-/// a failure, not a skip: whoever set it wants the test to run.
-/// A scratch directory for one test's files (under cargo's target tmp).
-pub fn scratch(test: &str) -> PathBuf {
-    let dir = Path::new(env!("CARGO_TARGET_TMPDIR")).join(test);
-    std::fs::create_dir_all(&dir).expect("scratch dir");
-    dir
-}
-
-/// The python with pysoem ([`super::peer_python`], `PYSOEM_PYTHON`).
+/// The python with pysoem ([`super::peer_python`], `PYSOEM_PYTHON`), or why
+/// the test cannot run (not root, or `PYSOEM_PYTHON` not set). A
+/// `PYSOEM_PYTHON` that cannot import pysoem is a failure, not a skip:
+/// whoever set it wants the test to run.
 pub fn pysoem_python() -> Result<PathBuf, String> {
     super::peer_python(
         "PYSOEM_PYTHON",
@@ -150,6 +143,15 @@ impl Line {
     pub fn stop_server(&mut self) {
         if let Some(s) = self.server.take() {
             stop_server(s, Duration::from_secs(5));
+        }
+    }
+
+    /// [`run`](Self::run)s `script` with `args`; its failure ends the test
+    /// ([`fail_with`](Self::fail_with) "`script` through SOEM failed").
+    pub fn run_passes(&self, python: &Path, script: &str, args: &[&str]) {
+        let status = self.run(python, script, args);
+        if !status.success() {
+            self.fail_with(&format!("{script} through SOEM failed: {status}"));
         }
     }
 

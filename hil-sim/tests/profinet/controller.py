@@ -88,7 +88,7 @@ from profinet.util import ethernet_socket, get_mac, mac2s, s2mac
 
 from pnargs import device_arguments
 from pnctl import Records, tx_checksum_offload_off
-from steps import failures, report, run
+from steps import failures, report, run, verdict
 
 
 def expected_fail(step, text):
@@ -745,11 +745,7 @@ def main():
 
     run("k", advanced_startup)
 
-    if failures:
-        print(f"failed steps: {' '.join(failures)}", flush=True)
-        return 1
-    print("all steps passed", flush=True)
-    return 0
+    return verdict(failures, "steps", "all steps passed")
 
 
 if __name__ == "__main__":

@@ -38,6 +38,7 @@ from profinet.util import get_mac
 import pnctl
 from pnargs import device_arguments
 from pnctl import Scenario, ms
+from steps import verdict
 
 OPMODE_POS, OPMODE_VELO, OPMODE_TORQUE = 0x10, 0x08, 0x04
 RECEIVE_ID = {OPMODE_POS: 0xE0, OPMODE_VELO: 0xE1, OPMODE_TORQUE: 0xE2}
@@ -908,11 +909,7 @@ def main():
     finally:
         ctl.stop()
         dev.close()
-    if failed:
-        print(f"failed scenarios: {' '.join(failed)}", flush=True)
-        return 1
-    print("all scenarios passed or failed as expected", flush=True)
-    return 0
+    return verdict(failed, "scenarios", "all scenarios passed or failed as expected")
 
 
 if __name__ == "__main__":

@@ -1,7 +1,8 @@
 """The step lines the controller scripts share (controller.py on
 profinet-py, tia.py on scapy): `step X: ok: ...` or `step X: FAIL: ...`,
-the failed steps kept in `failures`. No import beyond the standard library,
-so that every one of their pythons can load it."""
+the failed steps kept in `failures`; a script's verdict on its steps (or
+fb.py's on its scenarios). No import beyond the standard library, so that
+every one of their pythons can load it."""
 
 import traceback
 
@@ -24,3 +25,13 @@ def run(step, fn):
         tb = traceback.format_exc().strip().replace("\n", "\n    ")
         report(step, False, f"{type(e).__name__}: {e}\n    {tb}")
         return None
+
+
+def verdict(failed, kind, passed):
+    """A script's exit code: 1 after naming the `failed` steps (`kind`: "steps",
+    "scenarios"), 0 after the line `passed` when none failed."""
+    if failed:
+        print(f"failed {kind}: {' '.join(failed)}", flush=True)
+        return 1
+    print(passed, flush=True)
+    return 0

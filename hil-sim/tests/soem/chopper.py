@@ -35,7 +35,7 @@ import sys
 sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
 import line as L  # noqa: E402
 import motor_protection as MP  # noqa: E402  (its Axis and TX layout)
-import torque as T  # noqa: E402  (its RX layout and G472/G475)
+import torque as T  # noqa: E402  (its RX layout, limit_torque)
 
 say, check = L.say, L.check
 
@@ -63,8 +63,7 @@ def window(s):
         check(L.sdo_u(s, index, 0) == before, f"{what}: {index:04X}h unchanged ({before})")
     s.sdo_write(A21, 0, (0).to_bytes(2, "little"))
     check(L.sdo_u(s, A21, 0) == 0, "A21 = 0: no brake resistor")
-    for index in (T.G472, T.G475):
-        s.sdo_write(index, 0, (900).to_bytes(2, "little"))
+    T.limit_torque(s, 900)
 
 
 def brake(m, axis, emcys):

@@ -52,8 +52,7 @@ def step(axis, per_mille, limit, what):
 
 def run(m, args):
     s = L.one_drive_in_preop(m)
-    for index in (T.G472, T.G475):
-        s.sdo_write(index, 0, (1000).to_bytes(2, "little"))
+    T.limit_torque(s, 1000)
     L.map_one_pdo_each(s, T.RX, T.TX)
     axis = T.to_op(m)
     axis.enable(T.CST)

@@ -682,7 +682,7 @@ def main():
     if not args.case:
         ap.error("--case is needed")
     L.priority()
-    try:
+    with L.stops_as_checks():
         if args.case == "pause":
             m = pysoem.Master()
             m.open(args.iface)
@@ -694,17 +694,7 @@ def main():
             case_restart(args)
         else:
             case_stop_restart(args)
-    except L.Fatal as e:
-        L.check(False, f"stopped: {e}")
-    except L.SOEM_ERRORS as e:
-        L.check(False, f"stopped by SOEM: {type(e).__name__} {vars(e)}")
-    if L.failures:
-        say(f"\n{len(L.failures)} check(s) failed:")
-        for f in L.failures:
-            say(f"  {f}")
-        return 1
-    say("\nall cases ran")
-    return 0
+    return L.report("all cases ran")
 
 
 if __name__ == "__main__":

@@ -42,6 +42,7 @@ SOEM_TRACE=FILE every cycle's timing goes to FILE (cycle, time, DC time, phase
 error, PI offset, integral, working counter, wake-up lateness, round trip).
 """
 import argparse
+import contextlib
 import ctypes
 import gc
 import math
@@ -588,15 +589,24 @@ def master_main(args, run, done):
     priority()
     m = pysoem.Master()
     m.open(args.iface)
+    with stops_as_checks():
+        try:
+            run(m, args)
+        finally:
+            m.close()
+    return report(done)
+
+
+@contextlib.contextmanager
+def stops_as_checks():
+    """A Fatal or a SOEM error raised inside: a failed check that says what
+    stopped the script, which goes on to its report."""
     try:
-        run(m, args)
+        yield
     except Fatal as e:
         check(False, f"stopped: {e}")
     except SOEM_ERRORS as e:
         check(False, f"stopped by SOEM: {type(e).__name__} {vars(e)}")
-    finally:
-        m.close()
-    return report(done)
 
 
 def one_drive_in_preop(m):

@@ -41,7 +41,7 @@ import time
 
 sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
 import line as L  # noqa: E402
-import torque as T  # noqa: E402  (its RX layout and G472/G475)
+import torque as T  # noqa: E402  (its RX layout, limit_torque)
 
 say, check = L.say, L.check
 
@@ -153,8 +153,7 @@ def motor_data(s, tau_ms, u11_ms):
     check(L.sdo_u(s, U10, 0) == 2, "U10 = 2 (warning) by default")
     s.sdo_write(B73, 0, tau_ms.to_bytes(4, "little"))
     s.sdo_write(U11, 0, u11_ms.to_bytes(2, "little"))
-    for index in (T.G472, T.G475):
-        s.sdo_write(index, 0, (1000).to_bytes(2, "little"))
+    T.limit_torque(s, 1000)
 
 
 def current_limit(axis):

@@ -57,8 +57,7 @@ def peak(frames, target, what):
 
 def run(m, args):
     s = L.one_drive_in_preop(m)
-    for index in (T.G472, T.G475):
-        s.sdo_write(index, 0, (1000).to_bytes(2, "little"))
+    T.limit_torque(s, 1000)
     L.map_one_pdo_each(s, T.RX, MP.TX)
     axis = L.to_op(m, MP.Axis)
     axis.enable()

@@ -42,6 +42,13 @@ ABORT_VALUE_TOO_HIGH = 0x06090031
 INTERNAL_LIMIT = 1 << 11
 
 
+def limit_torque(s, per_mille):
+    """G472 and G475 (the torque limits, positive and negative, in per mille
+    of I10) of drive `s` both set to `per_mille` by SDO."""
+    for index in (G472, G475):
+        s.sdo_write(index, 0, per_mille.to_bytes(2, "little"))
+
+
 class Axis:
     """Axis A of drive 1 in free run at about 1 ms per frame."""
 

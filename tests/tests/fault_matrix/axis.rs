@@ -4,7 +4,7 @@
 use super::{emcys, ethercrab, fault_end, fault_reset, get, E47};
 use drive_tests::axis::{limit_switches_from_inputs, line_with_switches, with_drive, CW_BIT4, CW_ENABLED};
 use drive_tests::matrix::{al, cia402_state, emcys as show_emcys};
-use drive_tests::{al_status, fault_row, init, line, with_master, Cyclic, REV};
+use drive_tests::{al_status, fault_row, init, line, with_cyclic, with_master, Cyclic, REV};
 use hil_sim::motor::{PositionInput, Switches};
 use hil_sim::sim::AxisConditions;
 
@@ -14,10 +14,7 @@ use hil_sim::sim::AxisConditions;
 /// and the enable sequence again.
 fn during_motion(cause: fn(&mut AxisConditions), clear: fn(&mut AxisConditions)) -> String {
     let sim = line(1);
-    with_master(&sim, async |md, clock| {
-        let group = init(md, clock).await.into_op(md).await.expect("OP");
-        let sd = group.subdevice(md, 0).unwrap();
-        let mut m = Cyclic::new(md, &group, &sim, 0);
+    with_cyclic(&sim, async |m, sd| {
         m.csv_at(2 * REV, 300).await;
         with_drive(&sim, |d| cause(&mut d.conditions[0]));
         let tx = m.run(100).await;
@@ -31,13 +28,13 @@ fn during_motion(cause: fn(&mut AxisConditions), clear: fn(&mut AxisConditions))
             }
         };
         let state = cia402_state(tx.statusword);
-        let end = fault_end(&sd, &sim).await;
+        let end = fault_end(sd, &sim).await;
         // a fault reset while the cause lasts
-        let tx = fault_reset(&mut m).await;
+        let tx = fault_reset(m).await;
         let lasting = format!("{} (E47 {})", cia402_state(tx.statusword), get(&sim, E47, 0));
         // the cause ends: reset, enable
         with_drive(&sim, |d| clear(&mut d.conditions[0]));
-        fault_reset(&mut m).await;
+        fault_reset(m).await;
         m.set_controlword(0);
         m.run(2).await;
         let after = cia402_state(m.enable().await.statusword);

@@ -4,9 +4,10 @@
 use super::{advance, emcys, ethercrab, newest_diag};
 use drive_tests::al::{ACK, INIT, OP, PREOP};
 use drive_tests::matrix::{al, cia402_state, emcys as show_emcys, Row};
+use drive_tests::step::op_via_safe_op;
 use drive_tests::{al_status, fault_row, init, line, request, with_master, Cyclic, REV};
 use ethercrab::subdevice_group::DcConfiguration;
-use ethercrab::DcSync;
+use hil_sim::master::{into_dc_sync0, PdiSubDevice};
 use std::time::Duration;
 
 const A258: u16 = drive_ecat::parameter_index(0, 258);
@@ -30,12 +31,7 @@ fn burst_free_run(a258: u16, lost: u64) -> String {
         let group = init(md, clock).await;
         let sd = group.subdevice(md, 0).unwrap();
         sd.sdo_write(A258, 0, a258).await.unwrap();
-        let group = group.into_safe_op(md).await.expect("SAFE-OP");
-        for _ in 0..5 {
-            advance(&sim, 1_000_000);
-            group.tx_rx(md).await.unwrap();
-        }
-        let group = group.into_op(md).await.expect("OP");
+        let group = op_via_safe_op(md, group, &sim).await;
         let sd = group.subdevice(md, 0).unwrap();
         let mut m = Cyclic::new(md, &group, &sim, 0);
         m.csv_at(REV, 200).await;
@@ -178,24 +174,16 @@ fn e127_c117_lost_frames_with_the_masters_sm_watchdog() {
 fn burst_dc(a258: u16, lost: u64) -> String {
     let sim = line(1);
     with_master(&sim, async |md, clock| {
-        let mut group = init(md, clock).await;
-        for mut sd in group.iter_mut(md) {
-            sd.set_dc_sync(DcSync::Sync0);
-        }
-        let group = group.into_pre_op_pdi(md).await.expect("PRE-OP with PDI");
-        let sd = group.subdevice(md, 0).unwrap();
-        sd.sdo_write(A258, 0, a258).await.unwrap();
-        let group = group
-            .configure_dc_sync(
-                md,
-                DcConfiguration {
-                    start_delay: Duration::from_millis(20),
-                    sync0_period: Duration::from_millis(1),
-                    sync0_shift: Duration::from_micros(900),
-                },
-            )
+        let dc = DcConfiguration {
+            start_delay: Duration::from_millis(20),
+            sync0_period: Duration::from_millis(1),
+            sync0_shift: Duration::from_micros(900),
+        };
+        // the line's one drive: A258 written in Pre-Op
+        let a258_in_pre_op = async |sd: &PdiSubDevice<'_, 512>| sd.sdo_write(A258, 0, a258).await.unwrap();
+        let group = into_dc_sync0(md, init(md, clock).await, dc, a258_in_pre_op)
             .await
-            .expect("DC configuration")
+            .expect("SYNC0, PRE-OP with PDI, DC configuration")
             .request_into_op(md)
             .await
             .expect("request OP");

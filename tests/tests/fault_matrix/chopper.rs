@@ -13,7 +13,7 @@ use super::{emcys, newest_diag};
 use drive_ecat::params::{A21, A22, A23, I10};
 use drive_tests::axis::{torque_mode_speed_limit, with_drive};
 use drive_tests::matrix::{al, cia402_state, emcys as show_emcys, Row};
-use drive_tests::{al_status, fault_row, init, line, with_master, Cyclic, REV};
+use drive_tests::{al_status, fault_row, line, with_cyclic, Cyclic, REV};
 use hil_sim::electrical::PlantModel;
 use hil_sim::sim::SimDrive;
 
@@ -71,14 +71,9 @@ fn balance(d: &SimDrive, a: Books, b: Books) -> (f64, String) {
 fn flywheel(d: &mut SimDrive) {
     d.set_plant(PlantModel::Electrical, 34)
         .expect("the default servo");
-    let m = d.motors[0].params_mut();
-    m.inertia_kg_m2 = J;
-    m.viscous_friction_nm_s_per_rad = 0.0;
-    m.coulomb_friction_nm = 0.0;
-    m.static_friction_nm = 0.0;
-    // no holding brake: the fault's coast engages it, and it would take the
-    // flywheel's energy between the trip and the reading
-    m.brake_holding_torque_nm = 0.0;
+    // no holding brake either: the fault's coast engages it, and it would
+    // take the flywheel's energy between the trip and the reading
+    d.motors[0].params_mut().set_flywheel(J);
 }
 
 /// Runs `m` with `torque` until the speed passes `rev_s` (accelerating) or
@@ -110,19 +105,16 @@ fn e090_braking_a_flywheel_without_brake_resistor_charges_the_link_to_the_over_v
     };
     let sim = line(1);
     with_drive(&sim, flywheel);
-    let seen = with_master(&sim, async |md, clock| {
-        let group = init(md, clock).await.into_op(md).await.expect("OP");
-        let sd = group.subdevice(md, 0).unwrap();
+    let seen = with_cyclic(&sim, async |m, sd| {
         sd.sdo_write(A21, 0, 0u16).await.expect("A21 = 0 by SDO");
-        torque_mode_speed_limit(&sd, 45.0).await;
-        let mut m = Cyclic::new(md, &group, &sim, 0);
+        torque_mode_speed_limit(sd, 45.0).await;
         m.set_mode(10);
         m.run(3).await;
         m.enable().await;
-        until_speed(&mut m, TORQUE, 40.0, 3000).await.expect("40 rev/s");
+        until_speed(m, TORQUE, 40.0, 3000).await.expect("40 rev/s");
         let mut before = None;
         with_drive(&sim, |d| before = Some(books(d)));
-        let braked = until_speed(&mut m, -TORQUE, 0.0, 3000).await.expect("braked");
+        let braked = until_speed(m, -TORQUE, 0.0, 3000).await.expect("braked");
         let state = cia402_state(m.tx.statusword);
         m.set_target_torque(0);
         let mut end = String::new();
@@ -150,10 +142,10 @@ fn e090_braking_a_flywheel_without_brake_resistor_charges_the_link_to_the_over_v
                 if gates_off { "off" } else { "on" }
             );
         });
-        let em = show_emcys(&emcys(&sd).await);
+        let em = show_emcys(&emcys(sd).await);
         let code: u16 = sd.sdo_read(0x603F, 0).await.unwrap();
-        let diag = newest_diag(&sd).await;
-        let al = al(al_status(&sd).await);
+        let diag = newest_diag(sd).await;
+        let al = al(al_status(sd).await);
         let balance = if err.abs() < 0.01 {
             "energy balance within 1 %".to_string()
         } else {
@@ -180,23 +172,20 @@ fn e090_repeated_braking_into_an_undersized_brake_resistor_ends_in_event_42() {
     };
     let sim = line(1);
     with_drive(&sim, flywheel);
-    let seen = with_master(&sim, async |md, clock| {
-        let group = init(md, clock).await.into_op(md).await.expect("OP");
-        let sd = group.subdevice(md, 0).unwrap();
+    let seen = with_cyclic(&sim, async |m, sd| {
         sd.sdo_write(A21, 0, 100u16).await.expect("A21");
         sd.sdo_write(A22, 0, 150u32).await.expect("A22");
         sd.sdo_write(A23, 0, 4000u32).await.expect("A23");
         // I10 (default 50 rev/s) to 70 rev/s, the torque modes' limit to it
         sd.sdo_write(I10, 0, 70 * REV as u32).await.expect("I10");
-        torque_mode_speed_limit(&sd, 70.0).await;
-        let mut m = Cyclic::new(md, &group, &sim, 0);
+        torque_mode_speed_limit(sd, 70.0).await;
         m.set_mode(10);
         m.run(3).await;
         m.enable().await;
         let mut first = String::new();
         let mut brakings = 0;
         for k in 1..=6 {
-            until_speed(&mut m, TORQUE, 60.0, 4000).await.expect("60 rev/s");
+            until_speed(m, TORQUE, 60.0, 4000).await.expect("60 rev/s");
             let mut before = None;
             with_drive(&sim, |d| before = Some(books(d)));
             // the link's highest, and its lowest while the chopper conducts
@@ -252,10 +241,10 @@ fn e090_repeated_braking_into_an_undersized_brake_resistor_ends_in_event_42() {
         }
         let state = cia402_state(m.tx.statusword);
         m.set_target_torque(0);
-        let em = show_emcys(&emcys(&sd).await);
+        let em = show_emcys(&emcys(sd).await);
         let code: u16 = sd.sdo_read(0x603F, 0).await.unwrap();
-        let diag = newest_diag(&sd).await;
-        let al = al(al_status(&sd).await);
+        let diag = newest_diag(sd).await;
+        let al = al(al_status(sd).await);
         format!("{first}; then {state} after {brakings} brakings; {em}; 603Fh {code:04X}h; {diag}; {al}")
     });
     fault_row!(row, seen);

@@ -8,7 +8,7 @@
 use super::{emcys, get, newest_diag};
 use drive_tests::axis::{with_drive, CW_FAULT_RESET};
 use drive_tests::matrix::{al, cia402_state, emcys as show_emcys, Row};
-use drive_tests::{al_status, fault_row, init, line, with_master, Cyclic, REV};
+use drive_tests::{al_status, fault_row, line, with_cyclic, REV};
 use hil_sim::electrical::{ElectricalAxis, PlantModel};
 use hil_sim::sim::SimDrive;
 use plant::{FaultOptions, Phase};
@@ -57,10 +57,7 @@ fn during_loaded_motion(
             d.motors[0].params_mut().coulomb_friction_nm = f;
         }
     });
-    with_master(&sim, async |md, clock| {
-        let group = init(md, clock).await.into_op(md).await.expect("OP");
-        let sd = group.subdevice(md, 0).unwrap();
-        let mut m = Cyclic::new(md, &group, &sim, 0);
+    with_cyclic(&sim, async |m, sd| {
         m.set_mode(9);
         m.run(3).await;
         m.enable().await;
@@ -87,11 +84,11 @@ fn during_loaded_motion(
         });
         let state = cia402_state(tx.statusword);
         // the EMCYs first: an SDO read of the master would take them out of the mailbox
-        let em = show_emcys(&emcys(&sd).await);
+        let em = show_emcys(&emcys(sd).await);
         let code: u16 = sd.sdo_read(0x603F, 0).await.unwrap();
         let e47 = get(&sim, E47, 0);
-        let diag = newest_diag(&sd).await;
-        let al = al(al_status(&sd).await);
+        let diag = newest_diag(sd).await;
+        let al = al(al_status(sd).await);
         // a fault reset while the cause lasts, and the enable into it
         m.set_controlword(0);
         m.run(2).await;

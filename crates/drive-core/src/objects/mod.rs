@@ -633,10 +633,11 @@ pub const INITIAL_IMAGE: [u8; IMAGE_BYTES] = {
     image
 };
 
-/// FNV-1a over the layout of the persistent entries (index, subindex, type,
-/// size): a saved image from another declaration has another hash.
-pub const LAYOUT_HASH: u32 = {
+/// The persistent entries in one walk of the table: FNV-1a over their
+/// layout (index, subindex, type, size) and the bytes of their values.
+const PERSISTENT_LAYOUT: (u32, usize) = {
     let mut h: u32 = 0x811C_9DC5;
+    let mut n = 0;
     let mut i = 0;
     while i < COUNT {
         // i < COUNT (compile-time evaluation)
@@ -667,27 +668,6 @@ pub const LAYOUT_HASH: u32 = {
                         }
                         w += 1;
                     }
-                }
-                rest = tail;
-            }
-        }
-        i += 1;
-    }
-    h
-};
-
-/// Bytes of the persistent values (the payload of a saved image).
-pub const PERSISTENT_BYTES: usize = {
-    let mut n = 0;
-    let mut i = 0;
-    while i < COUNT {
-        // i < COUNT (compile-time evaluation)
-        #[allow(clippy::indexing_slicing)]
-        let o = &TABLE[i];
-        if o.declared_ram_bytes() > 0 {
-            let mut rest = declared(o.info.entries);
-            while let [e, tail @ ..] = rest {
-                if e.persistent {
                     n += e.data_type.bytes();
                 }
                 rest = tail;
@@ -695,8 +675,15 @@ pub const PERSISTENT_BYTES: usize = {
         }
         i += 1;
     }
-    n
+    (h, n)
 };
+
+/// FNV-1a over the layout of the persistent entries (index, subindex, type,
+/// size): a saved image from another declaration has another hash.
+pub const LAYOUT_HASH: u32 = PERSISTENT_LAYOUT.0;
+
+/// Bytes of the persistent values (the payload of a saved image).
+pub const PERSISTENT_BYTES: usize = PERSISTENT_LAYOUT.1;
 
 /// The object at `index` and its position in [`OBJECTS`] (visible or not).
 pub fn find(index: u16) -> Option<(usize, &'static Object)> {
