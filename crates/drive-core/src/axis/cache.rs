@@ -51,23 +51,15 @@ impl Axis {
     /// anything of the cycle changed the axis (`configure` reads no cyclic
     /// set-point of the snapshot).
     pub fn prepare(&mut self, cache: &mut AxisCache, od: &mut DriveObjects) {
-        let window = self.window;
-        let generation = od.axis_config_generation(usize::from(window.axis));
-        let slots: &CyclicSlots = cache
-            .slots
-            .get_or_insert_with(|| CyclicSlots::resolve(od, window));
+        let generation = od.axis_config_generation(usize::from(self.window.axis));
+        let slots = slots_of(&mut cache.slots, od, self.window);
         let cached: &CachedSnapshot = match &mut cache.snapshot {
             Some(cached) if cached.generation == generation => cached,
             stale => stale.insert(self.read_snapshot(od, generation)),
         };
         // as the cycle's step 2 keys it (`cycle_cached`)
-        let class = match self.running {
-            Running::Homing => 1,
-            Running::Jog(_) => 2,
-            _ => 0,
-        };
-        let dt_ns = cached.dt_ns;
-        if self.configured != Some((generation, dt_ns, class)) {
+        let (dt_ns, key) = (cached.dt_ns, self.config_key(generation, cached.dt_ns));
+        if self.configured != Some(key) {
             let converted;
             let o = if cached.in_increments {
                 &cached.snapshot
@@ -76,7 +68,7 @@ impl Axis {
                 &converted
             };
             self.configure(od, slots, o, dt_ns);
-            self.configured = Some((generation, dt_ns, class));
+            self.configured = Some(key);
         }
     }
 
@@ -94,5 +86,31 @@ impl Axis {
                 .unwrap_or(crate::params::A150_FALLBACK_US * 1000),
             snapshot: fresh,
         }
+    }
+}
+
+/// The axis' resolved slots in `slots`, resolved on first use (the cache's
+/// field, so the snapshot beside it stays borrowable).
+#[inline(always)]
+pub(super) fn slots_of<'a>(
+    slots: &'a mut Option<CyclicSlots>,
+    od: &DriveObjects,
+    window: Window,
+) -> &'a CyclicSlots {
+    slots.get_or_insert_with(|| CyclicSlots::resolve(od, window))
+}
+
+impl Axis {
+    /// What [`configure`](Self::configure) last ran for, as the cycle's
+    /// step 2 compares it: the configuration generation, the cycle and the
+    /// mode class (homing, jog, other).
+    #[inline(always)]
+    pub(super) fn config_key(&self, generation: u32, dt_ns: u32) -> (u32, u32, u8) {
+        let class = match self.running {
+            Running::Homing => 1,
+            Running::Jog(_) => 2,
+            _ => 0,
+        };
+        (generation, dt_ns, class)
     }
 }

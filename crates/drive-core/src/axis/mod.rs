@@ -504,11 +504,8 @@ impl Axis {
         now_ns: Nanos,
         new_setpoint: bool,
     ) -> AxisReport {
-        let window = self.window;
-        let generation = od.axis_config_generation(usize::from(window.axis));
-        let slots: &CyclicSlots = cache
-            .slots
-            .get_or_insert_with(|| CyclicSlots::resolve(od, window));
+        let generation = od.axis_config_generation(usize::from(self.window.axis));
+        let slots = cache::slots_of(&mut cache.slots, od, self.window);
         let cached: &CachedSnapshot = match &mut cache.snapshot {
             Some(cached) if cached.generation == generation => {
                 cached.snapshot.refresh_setpoints(od, slots);
@@ -525,14 +522,10 @@ impl Axis {
             converted = raw.to_increments(&self.scaling);
             &converted
         };
-        let class = match self.running {
-            Running::Homing => 1,
-            Running::Jog(_) => 2,
-            _ => 0,
-        };
-        if self.configured != Some((generation, dt_ns, class)) {
+        let key = self.config_key(generation, dt_ns);
+        if self.configured != Some(key) {
             self.configure(od, slots, o, dt_ns);
-            self.configured = Some((generation, dt_ns, class));
+            self.configured = Some(key);
         }
         // the switches from the inputs (I101/I102 ≠ 2, I103 = 1): the
         // hardware inputs as they are, without a copy
