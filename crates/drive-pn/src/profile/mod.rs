@@ -192,7 +192,7 @@ impl Profile {
 
     /// After a frame, in the bus task (issue 36: outside the control
     /// cycle), when the configuration moved: the unit choices A279 looked
-    /// at ([`refresh_units`](Self::refresh_units), as the next telegram's
+    /// at (`refresh_units`, as the next telegram's
     /// first step would), the core entries resolved, the axis' user units
     /// read and the prepared accesses the telegrams used brought to the
     /// configuration in force. The control cycle's telegram then finds
