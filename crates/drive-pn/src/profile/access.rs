@@ -344,7 +344,7 @@ impl DriveAccess<'_> {
         match jog {
             Some(Jog::Negative) => JOG_NEGATIVE,
             Some(_) => JOG_POSITIVE,
-            None => self.objects.record_selector(self.axis.index()),
+            None => self.core.record_selector(self.objects, self.axis),
         }
     }
 
