@@ -105,6 +105,19 @@ impl DriveObjects {
             .map_or(FIELDBUS, |v| u16::try_from(v).unwrap_or(FIELDBUS))
     }
 
+    /// The [`Slot`] of J400 of `axis` (`None` when it has none: then
+    /// [`record_selector`](Self::record_selector) reads it).
+    pub fn record_selector_slot(&self, axis: u8) -> Option<Slot> {
+        self.slot(at_axis(J400, axis), 0)
+    }
+
+    /// [`record_selector`](Self::record_selector) through J400's
+    /// [`record_selector_slot`](Self::record_selector_slot): a load where
+    /// `get` looks J400 up (issue 36: ~170 instructions per telegram 0).
+    pub fn record_selector_at(&self, slot: Slot) -> u16 {
+        u16::try_from(self.load_slot(slot)).unwrap_or(FIELDBUS)
+    }
+
     /// Byte range of record `n` of `axis` in the image and of its options.
     fn record_range(axis: u8, n: u16) -> Option<(core::ops::Range<usize>, usize)> {
         let (object, at, options) = place(n)?;

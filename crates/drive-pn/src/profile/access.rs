@@ -344,19 +344,23 @@ impl DriveAccess<'_> {
         match jog {
             Some(Jog::Negative) => JOG_NEGATIVE,
             Some(_) => JOG_POSITIVE,
-            None => self.objects.record_selector(self.axis.index()),
+            None => self.core.record_selector(self.objects, self.axis),
         }
     }
 
     /// Stores the record the last field writes left pending (and shows it
     /// when the window J401 shows it), as each of those writes did before.
     pub fn flush_record(&mut self) {
-        if let Some((axis, n, _, r, read)) = self.pending.take() {
-            // record `n` was read just before: it is there to store
-            if r != read {
-                let _ = self.objects.set_record(axis, n, &r);
-            }
+        // compared where it is, not moved out (`take`): every read and
+        // every other write asks (issue 36)
+        let Some((axis, n, _, r, read)) = &self.pending else {
+            return;
+        };
+        // record `n` was read just before: it is there to store
+        if r != read {
+            let _ = self.objects.set_record(*axis, *n, r);
         }
+        self.pending = None;
     }
 
     fn read_record(&mut self, jog: Option<Jog>, field: RecordField, unit: Unit) -> Result<i64, PdError> {

@@ -255,6 +255,8 @@ impl Core {
 pub struct CoreSlots {
     axis: Option<u8>,
     slots: [Option<Slot>; 5],
+    /// J400, the record selector (the record fields of telegram 0).
+    selector: Option<Slot>,
 }
 
 impl CoreSlots {
@@ -263,6 +265,7 @@ impl CoreSlots {
         Self {
             axis: None,
             slots: [None; 5],
+            selector: None,
         }
     }
 
@@ -272,6 +275,7 @@ impl CoreSlots {
             for (s, e) in self.slots.iter_mut().zip(Core::ALL) {
                 *s = objects.slot(axis.cia402_index(e.index()), 0);
             }
+            self.selector = objects.record_selector_slot(axis.index());
             self.axis = Some(axis.index());
         }
     }
@@ -281,6 +285,14 @@ impl CoreSlots {
             return None;
         }
         self.slots.get(e as usize).copied().flatten()
+    }
+
+    /// `objects.record_selector(axis)`.
+    pub fn record_selector(&self, objects: &DriveObjects, axis: &Axis) -> u16 {
+        match self.selector {
+            Some(s) if self.axis == Some(axis.index()) => objects.record_selector_at(s),
+            _ => objects.record_selector(axis.index()),
+        }
     }
 
     /// `objects.get(e of axis, 0).unwrap_or(0)`.
@@ -391,6 +403,31 @@ mod tests {
         core.resolve(&od, &Axis::new(0));
         od.set(b.cia402_index(0x6061), 0, 3).unwrap();
         assert_eq!(core.get(&od, &b, Core::ModeDisplay), 3);
+    }
+
+    /// P-141: J400 through its resolved slot reads as
+    /// [`DriveObjects::record_selector`], for both axes and another axis
+    /// than resolved.
+    #[test]
+    fn p141_the_selector_slot_reads_as_record_selector() {
+        use drive_core::objects::records::J400;
+        let mut od = DriveObjects::new();
+        let mut core = CoreSlots::new();
+        for axis in [Axis::new(0), Axis::new(1)] {
+            core.resolve(&od, &axis);
+            assert!(od.record_selector_slot(axis.index()).is_some());
+            for v in [0, 1, 17, 255, 256, 267] {
+                od.set(axis.manufacturer_index(J400), 0, v).unwrap();
+                let full = od.record_selector(axis.index());
+                assert_eq!(full, v as u16);
+                assert_eq!(core.record_selector(&od, &axis), full, "{v}");
+                let other = Axis::new(1 - axis.index());
+                assert_eq!(
+                    core.record_selector(&od, &other),
+                    od.record_selector(other.index())
+                );
+            }
+        }
     }
 
     /// P-067: the cache hands out current handles and prepares stale ones

@@ -54,6 +54,17 @@ fn div_round(m: u128, d: u32) -> Option<u128> {
     }
 }
 
+/// [`div_round`] of `m · k` by `d` where `m` and `m · k + d/2` fit 32 bits
+/// (the telegrams' usual values): a 64-bit product and a 32-bit division,
+/// no 128-bit arguments (issue 36). `None`: not so (the general path);
+/// `Some(None)`: d = 0.
+#[inline(always)]
+fn div_round_32(m: u64, k: u32, d: u32) -> Option<Option<u32>> {
+    let m = u32::try_from(m).ok()?;
+    let n = u32::try_from(u64::from(m) * u64::from(k) + u64::from(d / 2)).ok()?;
+    Some(n.checked_div(d))
+}
+
 /// `q` with the sign of `negative`, if it fits i64.
 fn signed(negative: bool, q: u128) -> Option<i64> {
     let q = i128::try_from(q).ok()?;
@@ -64,6 +75,10 @@ fn signed(negative: bool, q: u128) -> Option<i64> {
 /// argument).
 pub fn from_bus(f: &Fraction, bus: i64) -> Result<i64, UnitError> {
     let (num, den) = f.parts();
+    if let Some(q) = div_round_32(bus.unsigned_abs(), den, num) {
+        let q = i64::from(q.ok_or(UnitError::OutOfRange)?);
+        return Ok(if bus < 0 { -q } else { q });
+    }
     let m = u128::from(bus.unsigned_abs()) * u128::from(den);
     div_round(m, num)
         .and_then(|q| signed(bus < 0, q))
@@ -74,6 +89,10 @@ pub fn from_bus(f: &Fraction, bus: i64) -> Result<i64, UnitError> {
 /// every argument).
 pub fn to_bus(f: &Fraction, internal: i64) -> Result<i32, UnitError> {
     let (num, den) = f.parts();
+    if let Some(q) = div_round_32(internal.unsigned_abs(), num, den) {
+        let q = i64::from(q.ok_or(UnitError::OutOfRange)?);
+        return i32::try_from(if internal < 0 { -q } else { q }).map_err(|_| UnitError::OutOfRange);
+    }
     let m = u128::from(internal.unsigned_abs()) * u128::from(num);
     div_round(m, den)
         .and_then(|q| signed(internal < 0, q))
@@ -185,6 +204,14 @@ mod tests {
             8738, // 8738 · 60 / 2^20 = 0.49999…: rounds down
             8739,
             17_476,
+            // where the fractions' 32-bit forms end (the default units)
+            16_383,
+            16_384,
+            32_767,
+            32_768,
+            32_769,
+            65_535,
+            65_536,
             1 << 19,
             (1 << 40) - 1,
             1 << 40,
