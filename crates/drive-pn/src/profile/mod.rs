@@ -208,7 +208,8 @@ impl Profile {
     /// generation inside it). Nothing else of the telegram (CW1, PKW, mode,
     /// set-points, records) is applied ahead.
     pub fn prepare(&mut self, frame: Option<&[u8]>, objects: &mut DriveObjects, axis: &mut Axis) {
-        let moved = self.prepared_at != Some(objects.config_generation());
+        let before = objects.config_generation();
+        let moved = self.prepared_at != Some(before);
         if moved {
             self.refresh_units(objects, axis);
             self.core.resolve(objects, axis);
@@ -219,8 +220,10 @@ impl Profile {
         }
         let g = objects.config_generation();
         if self.prepared_at != Some(g) {
-            // again after a write ahead (a compare when nothing moved)
-            self.refresh_units(objects, axis);
+            if g != before {
+                // the write ahead moved the configuration: A279 again
+                self.refresh_units(objects, axis);
+            }
             let _ = self.user_units.get(objects, axis);
             self.prepared.refresh(objects);
             self.prepared_at = Some(g);
