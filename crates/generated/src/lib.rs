@@ -66,6 +66,23 @@ pub fn check_current(
     Ok(())
 }
 
+/// A generator's `main`: writes `files` (name, text) into the directory
+/// given as the first argument, else into `default_dir`, and prints each
+/// path written.
+pub fn write_all(default_dir: &Path, files: &[(String, String)]) -> std::io::Result<()> {
+    let dir = std::env::args_os()
+        .nth(1)
+        .map(std::path::PathBuf::from)
+        .unwrap_or_else(|| default_dir.to_path_buf());
+    std::fs::create_dir_all(&dir)?;
+    for (name, text) in files {
+        let path = dir.join(name);
+        std::fs::write(&path, text)?;
+        println!("wrote {}", path.display());
+    }
+    Ok(())
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
