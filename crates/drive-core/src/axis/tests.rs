@@ -119,7 +119,7 @@ fn cyclic_slots_resolve_every_entry_on_both_axes() {
 /// first cycle through configuration changes (A150, the vl ramps, the
 /// position window) and the enable sequence into profile velocity.
 #[test]
-fn a_prepared_axis_cycles_as_one_configured_in_its_cycle() {
+fn issue36_a_prepared_axis_cycles_as_one_configured_in_its_cycle() {
     let mut prepared_od = DriveObjects::new();
     let mut plain_od = prepared_od.clone();
     let (mut prepared, mut plain) = (Axis::new(0), Axis::new(0));

@@ -149,7 +149,7 @@ mod tests {
     /// A slot type answers the data type it was made of (what
     /// [`Prepared::data_type`] relies on), for every integer type.
     #[test]
-    fn slot_types_answer_their_data_type() {
+    fn issue36_slot_types_answer_their_data_type() {
         use DataType::*;
         for t in [Bool, I8, I16, I32, I64, U8, U16, U32, U64] {
             assert_eq!(SlotType::of(t).map(SlotType::data_type), Some(t));
