@@ -2,7 +2,7 @@
 //!
 //! The RTIC apps (`src/main.rs` for the reference board, `src/bin/qemu.rs` for
 //! QEMU) only wire interrupts, priorities and the board's counters; the task
-//! bodies live in the host-tested `node` crate (re-exported here), so both
+//! bodies live in the host-tested `firmware-tasks` crate (re-exported here), so both
 //! images run the same code. `world` (QEMU only, from `hil-sim`) is the
 //! simulated ESC, motors and scripted master that stand in for the bus and
 //! the power stage. What several images share besides (statics built in
@@ -21,7 +21,7 @@
     )
 )]
 
-pub use node::{clock, cycle, net, tasks, Drive, ParamFlash};
+pub use firmware_tasks::{clock, cycle, net, tasks, Drive, ParamFlash};
 
 pub mod once;
 

@@ -6,11 +6,11 @@
 //! | task | interrupt | priority | body |
 //! |---|---|---|---|
 //! | `fast` | VADC0_G0_0 (the DC-link result, last of the conversions CCU80 triggers at the PWM centre: 16 kHz) | 4 | `firmware::xmc::fast::FastLoop::period`: both axes' current loops, PWM compare values, trips |
-//! | `sync0` | ERU1_0 (ESC SYNC0 routed through ERU1) | 3 | `node::tasks::sync0` |
-//! | `control` | CCU40_0 (control-cycle timer compare, CCU40 slice 3) | 3 | `node::tasks::control` on the fast task's measurements, its commands to the fast task; `node::tasks::scope` (one sample when armed) |
-//! | `esc` | ECAT0_0 (ESC PDI interrupt: AL events, SM2/SM3, mailbox) | 2 | `node::tasks::esc_event` |
-//! | `mailbox` | CCU42_0 (a spare interrupt, pended by `esc` and by `idle` when the IP stack's timers are due) | 1 | `node::tasks::mailbox_scoped` and the IP stack over EoE (`mailbox_net`'s steps; group T through the scope) |
-//! | `idle` | — | 0 | `node::tasks::background` (a requested save) |
+//! | `sync0` | ERU1_0 (ESC SYNC0 routed through ERU1) | 3 | `firmware_tasks::tasks::sync0` |
+//! | `control` | CCU40_0 (control-cycle timer compare, CCU40 slice 3) | 3 | `firmware_tasks::tasks::control` on the fast task's measurements, its commands to the fast task; `firmware_tasks::tasks::scope` (one sample when armed) |
+//! | `esc` | ECAT0_0 (ESC PDI interrupt: AL events, SM2/SM3, mailbox) | 2 | `firmware_tasks::tasks::esc_event` |
+//! | `mailbox` | CCU42_0 (a spare interrupt, pended by `esc` and by `idle` when the IP stack's timers are due) | 1 | `firmware_tasks::tasks::mailbox_scoped` and the IP stack over EoE (`mailbox_net`'s steps; group T through the scope) |
+//! | `idle` | — | 0 | `firmware_tasks::tasks::background` (a requested save) |
 //!
 //! The ESC is reached through `pdi::mmio::OnChip` over ECAT0's register
 //! window; the clock is the DWT cycle counter at the CPU clock.

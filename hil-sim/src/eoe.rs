@@ -29,12 +29,12 @@ const MBX_HEADER: usize = 6;
 /// Mailbox type EoE.
 pub const MBX_EOE: u8 = 2;
 
-pub use node::net::net_settings;
+pub use firmware_tasks::net::net_settings;
 
-/// A drive's IP stack in the simulation: the firmware's [`node::net::NodeNet`]
+/// A drive's IP stack in the simulation: the firmware's [`firmware_tasks::net::NodeNet`]
 /// (the same poll the mailbox task runs) on leaked buffers (a few KiB per
 /// drive, for the life of the process).
-pub struct DriveNet(node::net::NodeNet);
+pub struct DriveNet(firmware_tasks::net::NodeNet);
 
 impl DriveNet {
     /// Bound to `drive`'s EoE queue at `now`: MAC `mac` until the master
@@ -48,7 +48,7 @@ impl DriveNet {
         let bufs: &'static mut NetBuffers = Box::leak(Box::new(NetBuffers::new()));
         let slots: &'static mut SocketSlots<'static> =
             Box::leak(Box::new([SocketStorage::EMPTY; net::SOCKETS]));
-        Self(node::net::NodeNet::new(
+        Self(firmware_tasks::net::NodeNet::new(
             drive,
             NetConfig { mac, seed },
             bufs,

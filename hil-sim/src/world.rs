@@ -7,7 +7,7 @@
 //! image it is an RTIC resource). [`World::next`] says which event comes next
 //! (a master frame, a SYNC0 pulse or the control-cycle timer); the caller
 //! advances the clock to it and runs the task that handles it: the QEMU
-//! image's idle loop pends the task's interrupt, the `node` crate's tests
+//! image's idle loop pends the task's interrupt, the `firmware-tasks` crate's tests
 //! call the task body.
 
 use crate::esc::{Esc, EscConfig};

@@ -244,7 +244,7 @@ pub const STORED_BYTES: usize = PERSISTENT_IMAGE_BYTES + SNMP_BLOCK + IM_TRAILER
 /// The parameter flash of the PROFINET images: two slots of two 2 KiB
 /// sectors, as the parameter image with I&M1…4 behind it
 /// ([`STORED_BYTES`]) no longer fits one 2 KiB sector (the EtherCAT
-/// images' `node::ParamFlash`). In RAM until the board's PFLASH driver is
+/// images' `firmware_tasks::ParamFlash`). In RAM until the board's PFLASH driver is
 /// used, like that one.
 pub type PnParamFlash = store::RamFlash<2048, 4>;
 

@@ -751,7 +751,7 @@ impl Xml {
             self.out.push(' ');
             self.out.push_str(k);
             self.out.push_str("=\"");
-            generated::escape_into(&mut self.out, v);
+            desc_xml::escape_into(&mut self.out, v);
             self.out.push('"');
         }
     }
@@ -775,7 +775,7 @@ impl Xml {
     fn leaf(&mut self, tag: &str, attrs: &[(&str, &str)], text: &str) {
         self.start(tag, attrs);
         self.out.push('>');
-        generated::escape_into(&mut self.out, text);
+        desc_xml::escape_into(&mut self.out, text);
         self.out.push_str("</");
         self.out.push_str(tag);
         self.out.push_str(">\n");

@@ -6,6 +6,6 @@ use std::path::Path;
 
 fn main() -> Result<(), Box<dyn std::error::Error>> {
     let default = Path::new(concat!(env!("CARGO_MANIFEST_DIR"), "/../../esi"));
-    generated::write_all(default, &esi::files()?)?;
+    desc_xml::write_all(default, &esi::files()?)?;
     Ok(())
 }

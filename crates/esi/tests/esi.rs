@@ -107,7 +107,7 @@ fn each() -> Vec<(Variant, Template)> {
 #[test]
 fn esi_files_are_current() {
     let files = esi::files().unwrap();
-    let check = generated::check_current(
+    let check = desc_xml::check_current(
         &esi_dir(),
         &files,
         "UPDATE_ESI",

@@ -6,6 +6,6 @@ use std::path::Path;
 
 fn main() -> Result<(), Box<dyn std::error::Error>> {
     let default = Path::new(concat!(env!("CARGO_MANIFEST_DIR"), "/../../gsdml"));
-    generated::write_all(default, &gsdml::files()?)?;
+    desc_xml::write_all(default, &gsdml::files()?)?;
     Ok(())
 }

@@ -13,7 +13,7 @@ pub struct Xml {
     unbalanced: bool,
 }
 
-pub use generated::escape;
+pub use desc_xml::escape;
 
 impl Xml {
     /// A document starting with the XML declaration (UTF-8).

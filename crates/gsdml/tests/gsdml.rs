@@ -78,7 +78,7 @@ fn text_of(doc: &Document, n: Node, tag: &str) -> String {
 #[test]
 fn gsdml_is_current() {
     let files = gsdml::files().unwrap();
-    let check = generated::check_current(
+    let check = desc_xml::check_current(
         &gsdml_dir(),
         &files,
         "UPDATE_GSDML",

@@ -16,7 +16,7 @@
 //!
 //! The scripted master goes INIT → OP (in Pre-Op it sets the drive's IP over
 //! EoE, resolves it by ARP, pings it and reads A150 over the UDP parameter
-//! service: the mailbox task runs the IP stack, `node::tasks::mailbox_net`),
+//! service: the mailbox task runs the IP stack, `firmware_tasks::tasks::mailbox_net`),
 //! enables both axes, moves them in csp and disables them. The log goes out over semihosting; `scripts/cross qemu`
 //! compares it with `firmware/qemu/expected/firmware-qemu.log` (lines with
 //! `figure:` are measurements, printed but not compared). Measured under

@@ -91,7 +91,7 @@ pub const STANDARD_BYTES: usize = STANDARD as usize * (RECORD_BYTES + 1);
 /// Whether the save service keeps the 256 standard records. Off until the
 /// parameter stores have room for them: the saved set is ~1.3 KiB without
 /// and ~6.7 KiB with them, and the stores the images and the simulator use
-/// have 2 KiB (`node::ParamFlash`) and 4 KiB (hil-sim) slots. Turning it on
+/// have 2 KiB (`firmware_tasks::ParamFlash`) and 4 KiB (hil-sim) slots. Turning it on
 /// changes the layout hash (a saved set from before loads as defaults).
 pub const STANDARD_RECORDS_SAVED: bool = false;
 

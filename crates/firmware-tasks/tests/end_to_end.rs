@@ -1,15 +1,15 @@
-//! The firmware's task bodies (`node::tasks`) against the simulated world
+//! The firmware's task bodies (`firmware_tasks::tasks`) against the simulated world
 //! (`hil_sim::world`) on the host: the QEMU image's loop without QEMU, so
 //! the end-to-end sequence can be debugged with `cargo test`.
 
+use firmware_tasks::clock::Clock;
+use firmware_tasks::cycle::{CycleTimer, CYCLE};
+use firmware_tasks::net::{NetBuffers, NodeNet, BOARD_NET, EMPTY_SLOTS};
+use firmware_tasks::{tasks, Drive, ParamFlash};
 use hil_sim::esc::Esc;
 use hil_sim::script::Progress;
 use hil_sim::world::{new_esc, Event, World};
 use nanos::Nanos;
-use node::clock::Clock;
-use node::cycle::{CycleTimer, CYCLE};
-use node::net::{NetBuffers, NodeNet, BOARD_NET, EMPTY_SLOTS};
-use node::{tasks, Drive, ParamFlash};
 use rtic_core::Exclusive;
 
 struct Board {
