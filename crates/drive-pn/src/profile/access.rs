@@ -5,8 +5,9 @@
 //! core's object dictionary with its access, range and state checks.
 
 use super::lookup::{self, Core, CoreSlots, PreparedCache};
-use super::pnu::{Jog, RecordField, Source, Unit};
+use super::pnu::{self, Jog, Pnu, RecordField, Source, Unit};
 use super::units::{self, UnitsCache};
+use core::num::NonZeroU16;
 use drive_core::axis::Axis;
 use drive_core::faults::E82_INACTIVE;
 use drive_core::objects::records::{Record, JOG_NEGATIVE, JOG_POSITIVE};
@@ -15,6 +16,8 @@ use drive_core::user_units::UserUnits;
 use drive_core::{DriveObjects, LiveValues};
 use motion::units::UnitProfile;
 use od::{CommState, DataType, Dictionary, SdoAbort};
+use profidrive::telegram::compiled::SlotAccess;
+use profidrive::telegram::Dir;
 use profidrive::{Addr, Completion, Describe, ParamAccess, PdError};
 use profinet::model;
 
@@ -107,6 +110,40 @@ fn type_limits(t: DataType) -> (i64, i64) {
         (64, _) => (i64::MIN, i64::MAX),
         (b, true) => (-(1i64 << (b - 1)), (1i64 << (b - 1)) - 1),
         (b, false) => (0, (1i64 << b) - 1),
+    }
+}
+
+/// A telegram entry resolved where the telegrams are configured or
+/// prepared for (issue 36, [`profidrive::telegram::compiled`]): the
+/// cyclic path reads and writes it without the catalogue's memo and the
+/// catalogue-index test. Two bytes (80 slots): a catalogue entry's position
+/// in [`pnu::CATALOGUE`] plus one, or `u16::MAX` for a CANopen object
+/// outside the catalogue (its index mapped to the axis at the access, as
+/// the address path does).
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub struct Handle(NonZeroU16);
+
+impl Handle {
+    /// A CANopen object outside the catalogue.
+    const OBJECT: u16 = u16::MAX;
+
+    /// The handle of the catalogue entry at `i`.
+    fn pnu(i: usize) -> Option<Handle> {
+        let v = u16::try_from(i.checked_add(1)?).ok()?;
+        NonZeroU16::new(v).filter(|v| v.get() != Self::OBJECT).map(Handle)
+    }
+
+    /// The handle of an object outside the catalogue.
+    fn object() -> Option<Handle> {
+        NonZeroU16::new(Self::OBJECT).map(Handle)
+    }
+
+    /// The catalogue entry, `None` for an object.
+    fn entry(self) -> Option<&'static Pnu> {
+        match self.0.get() {
+            Self::OBJECT => None,
+            v => pnu::CATALOGUE.get(usize::from(v - 1)),
+        }
     }
 }
 
@@ -505,6 +542,78 @@ impl ParamAccess for DriveAccess<'_> {
                 lookup::find_and_remember(addr)?
             }
         };
+        self.read_pnu(p, addr)
+    }
+
+    fn write(&mut self, addr: Addr, value: i64, _cyclic: bool) -> Result<Completion, PdError> {
+        // every write here is a RAM write: the store is written only by a save
+        let p = match lookup::memoised(addr) {
+            Some(p) => p,
+            None => {
+                if !lookup::is_catalogue_index(addr.index) {
+                    self.flush_record();
+                    let index = self.index(addr.index);
+                    self.write_object(index, addr.sub, value)?;
+                    return Ok(Completion::Done);
+                }
+                lookup::find_and_remember(addr)?
+            }
+        };
+        self.write_pnu(p, addr, value)
+    }
+
+    fn poll_write(&mut self, addr: Addr) -> Result<Completion, PdError> {
+        if addr == Addr::new(971, 0) && self.own.saving {
+            return Ok(Completion::Pending);
+        }
+        if addr.index == super::telegram_config::SELECT || addr.index == super::telegram_config::APPLY {
+            return self.own.edit.poll();
+        }
+        Ok(Completion::Done)
+    }
+}
+
+impl SlotAccess for DriveAccess<'_> {
+    type Handle = Handle;
+
+    fn resolve(&mut self, _dir: Dir, addr: Addr) -> Option<Handle> {
+        if lookup::is_catalogue_index(addr.index) {
+            // an address the catalogue does not hold: the address path
+            // answers its error
+            Handle::pnu(lookup::position(addr).ok()?)
+        } else {
+            Handle::object()
+        }
+    }
+
+    fn write_handle(&mut self, h: Handle, addr: Addr, value: i64) -> Result<Completion, PdError> {
+        match h.entry() {
+            Some(p) => self.write_pnu(p, addr, value),
+            None => {
+                self.flush_record();
+                let index = self.index(addr.index);
+                self.write_object(index, addr.sub, value)?;
+                Ok(Completion::Done)
+            }
+        }
+    }
+
+    fn read_handle(&mut self, h: Handle, addr: Addr) -> Result<i64, PdError> {
+        self.flush_record();
+        match h.entry() {
+            Some(p) => self.read_pnu(p, addr),
+            None => {
+                let index = self.index(addr.index);
+                self.read_object(index, addr.sub)
+            }
+        }
+    }
+}
+
+impl DriveAccess<'_> {
+    /// [`ParamAccess::read`] of the catalogue entry `p` (`addr`), the
+    /// pending record stored.
+    fn read_pnu(&mut self, p: &'static Pnu, addr: Addr) -> Result<i64, PdError> {
         match p.source {
             Source::Object { index, sub } => {
                 let index = self.index(index);
@@ -539,20 +648,8 @@ impl ParamAccess for DriveAccess<'_> {
         }
     }
 
-    fn write(&mut self, addr: Addr, value: i64, _cyclic: bool) -> Result<Completion, PdError> {
-        // every write here is a RAM write: the store is written only by a save
-        let p = match lookup::memoised(addr) {
-            Some(p) => p,
-            None => {
-                if !lookup::is_catalogue_index(addr.index) {
-                    self.flush_record();
-                    let index = self.index(addr.index);
-                    self.write_object(index, addr.sub, value)?;
-                    return Ok(Completion::Done);
-                }
-                lookup::find_and_remember(addr)?
-            }
-        };
+    /// [`ParamAccess::write`] of the catalogue entry `p` (`addr`).
+    fn write_pnu(&mut self, p: &'static Pnu, addr: Addr, value: i64) -> Result<Completion, PdError> {
         if !matches!(p.source, Source::SelectedRecord(_) | Source::JogRecord(..)) {
             self.flush_record();
         }
@@ -625,16 +722,6 @@ impl ParamAccess for DriveAccess<'_> {
             Source::Zsw1 | Source::DigitalInputs | Source::LastError | Source::Identification => {
                 return Err(PdError::CANNOT_CHANGE)
             }
-        }
-        Ok(Completion::Done)
-    }
-
-    fn poll_write(&mut self, addr: Addr) -> Result<Completion, PdError> {
-        if addr == Addr::new(971, 0) && self.own.saving {
-            return Ok(Completion::Pending);
-        }
-        if addr.index == super::telegram_config::SELECT || addr.index == super::telegram_config::APPLY {
-            return self.own.edit.poll();
         }
         Ok(Completion::Done)
     }

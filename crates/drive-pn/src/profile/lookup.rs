@@ -40,6 +40,12 @@ pub fn find(addr: Addr) -> Result<&'static Pnu, PdError> {
     pnu::CATALOGUE.get(i).ok_or(PdError::IMPERMISSIBLE_PNU)
 }
 
+/// [`find`]'s position of `addr` in [`pnu::CATALOGUE`] (a telegram's
+/// handle, issue 36).
+pub fn position(addr: Addr) -> Result<usize, PdError> {
+    find_at(addr)
+}
+
 /// [`find`]'s position of `addr` in the catalogue.
 fn find_at(addr: Addr) -> Result<usize, PdError> {
     let c = pnu::CATALOGUE;

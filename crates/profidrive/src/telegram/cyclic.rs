@@ -125,6 +125,19 @@ impl Telegrams {
     /// Applies a received frame (the OUT module's data): see the
     /// [module](self) for the order of a cycle.
     pub fn apply_receive(&mut self, frame: &[u8], access: &mut impl ParamAccess) -> RxOutcome {
+        self.receive_through(frame, access, |a, _, _, addr, v| a.write(addr, v, true).is_ok())
+    }
+
+    /// [`apply_receive`](Self::apply_receive) with `write(access, n, i,
+    /// addr, value)` writing the object entries (`n` the telegram, `i` the
+    /// slot's position in its layout): the address path or a compiled
+    /// handle's ([`super::compiled`]).
+    pub(super) fn receive_through<A: ParamAccess>(
+        &mut self,
+        frame: &[u8],
+        access: &mut A,
+        mut write: impl FnMut(&mut A, u8, usize, Addr, i64) -> bool,
+    ) -> RxOutcome {
         let mut out = RxOutcome {
             telegram: None,
             mode: ModeBinding::None,
@@ -160,7 +173,7 @@ impl Telegrams {
             dst.copy_from_slice(src);
             self.live.rx_len = keep as u8;
         }
-        for s in layout.slots() {
+        for (i, s) in layout.slots().iter().enumerate() {
             let at = usize::from(s.offset);
             let Some(bytes) = frame.get(at..at + usize::from(s.size)) else {
                 continue;
@@ -179,7 +192,7 @@ impl Telegrams {
                 }
                 Kind::Object(t) => {
                     let v = decode_be(t, bytes);
-                    let ok = fits(t, v) && access.write(s.addr, v, true).is_ok();
+                    let ok = fits(t, v) && write(access, n, i, s.addr, v);
                     if !ok {
                         out.warnings.0 |= Warnings::ACCESS_REFUSED;
                     }
@@ -255,6 +268,20 @@ impl Telegrams {
         pkw: [u8; 8],
         buf: &mut [u8],
     ) -> Option<TxOutcome> {
+        self.respond_through(n, access, pkw, buf, |a, _, addr| a.read(addr))
+    }
+
+    /// [`build_response`](Self::build_response) with `read(access, i,
+    /// addr)` reading the entries (`i` the slot's position in the layout):
+    /// the address path or a compiled handle's ([`super::compiled`]).
+    pub(super) fn respond_through<A: ParamAccess>(
+        &mut self,
+        n: u8,
+        access: &mut A,
+        pkw: [u8; 8],
+        buf: &mut [u8],
+        mut read: impl FnMut(&mut A, usize, Addr) -> Result<i64, crate::PdError>,
+    ) -> Option<TxOutcome> {
         // `layout`'s answer, borrowed from the field (not copied: ~150
         // instructions per telegram; issue 36)
         if !self.configured {
@@ -269,7 +296,7 @@ impl Telegrams {
         if let Some(b) = buf.first_mut() {
             *b = Dir::Response.identifier(n);
         }
-        for s in layout.slots() {
+        for (i, s) in layout.slots().iter().enumerate() {
             let at = usize::from(s.offset);
             let Some(dst) = buf.get_mut(at..at + usize::from(s.size)) else {
                 continue;
@@ -281,7 +308,7 @@ impl Telegrams {
                         *d = b;
                     }
                 }
-                Kind::Cw1 | Kind::Object(_) => match access.read(s.addr) {
+                Kind::Cw1 | Kind::Object(_) => match read(access, i, s.addr) {
                     Ok(v) => encode_be(v, dst),
                     Err(_) => warnings.0 |= Warnings::ACCESS_REFUSED,
                 },

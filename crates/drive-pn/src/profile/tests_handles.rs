@@ -1,0 +1,260 @@
+//! Issue 36: the telegrams compiled into per-slot handles
+//! ([`profidrive::telegram::compiled`], [`super::access::Handle`]) answer as
+//! the address path. Two profiles over two equal drives take the same
+//! frames, one through its handles, one with them forgotten before every
+//! receive and response (the address path): the same response bytes, the
+//! same objects, axis, own values and warnings after every frame, for
+//! telegrams 0, 1 and 2, frames the telegram refuses or does not know, a
+//! unit change (A279) and a telegram configured over PKW between frames.
+
+use super::Profile;
+use drive_core::axis::Axis;
+use drive_core::params::A279;
+use drive_core::DriveObjects;
+use profidrive::telegram::Dir;
+use profidrive::Addr;
+use std::format;
+use std::string::String;
+use std::vec::Vec;
+
+/// One drive with its profile.
+struct Side {
+    od: DriveObjects,
+    axis: Axis,
+    profile: Profile,
+}
+
+impl Side {
+    fn new(axis: u8) -> Side {
+        let mut od = DriveObjects::new();
+        let axis = Axis::new(axis);
+        let profile = Profile::new(&mut od, &axis);
+        Side { od, axis, profile }
+    }
+
+    /// One frame as `PnDrive` takes it: prepared in the bus task, then
+    /// the control cycle's receive and response. `handles`: through the
+    /// compiled handles, else the address path.
+    fn frame(&mut self, frame: &[u8], handles: bool) -> Vec<u8> {
+        self.profile.prepare(Some(frame), &mut self.od, &mut self.axis);
+        if handles {
+            let t = self.profile.telegrams().expect("configured");
+            assert!(self.profile.handles.is_for(t), "the handles are current");
+        } else {
+            self.profile.handles.clear();
+        }
+        self.profile.receive(frame, &mut self.od, &mut self.axis);
+        if !handles {
+            self.profile.handles.clear();
+        }
+        let mut out = std::vec![0u8; 36];
+        let n = self.profile.respond(&mut self.od, &self.axis, &mut out);
+        out.truncate(n.unwrap_or(0));
+        out
+    }
+
+    /// What the two paths must leave alike.
+    fn state(&self) -> String {
+        format!(
+            "{:?} {:?} {} {} {:?} {:?}",
+            self.profile.own(),
+            self.profile.units(),
+            self.profile.warnings(),
+            self.profile.homing(),
+            self.axis,
+            self.od.config_generation(),
+        )
+    }
+}
+
+fn pkw(code: u8, pnu: u16, sub: u8, value: u32) -> [u8; 8] {
+    let i = pnu.to_be_bytes();
+    let v = value.to_be_bytes();
+    [code, i[0], i[1], sub, v[0], v[1], v[2], v[3]]
+}
+
+/// Telegram 0: homing method, CW1, target, profile and end velocity, both
+/// accelerations, jog velocity, PKW, current limit.
+fn t0(cw1: u16, target: i32, v: i32, end: i32, acc: u32, jog: i32, p: [u8; 8]) -> [u8; 36] {
+    let mut t = [0u8; 36];
+    t[0] = 0xE0;
+    t[1] = 34;
+    t[2..4].copy_from_slice(&cw1.to_be_bytes());
+    t[4..8].copy_from_slice(&target.to_be_bytes());
+    t[8..12].copy_from_slice(&v.to_be_bytes());
+    t[12..16].copy_from_slice(&end.to_be_bytes());
+    t[16..20].copy_from_slice(&acc.to_be_bytes());
+    t[20..24].copy_from_slice(&jog.to_be_bytes());
+    t[24..32].copy_from_slice(&p);
+    t[32..36].copy_from_slice(&1500i32.to_be_bytes());
+    t
+}
+
+/// Telegram 1: CW1, target velocity, both ramps, jog velocity, PKW.
+fn t1(cw1: u16, rpm: i32, ramps: u32, p: [u8; 8]) -> [u8; 36] {
+    let mut t = [0u8; 36];
+    t[0] = 0xE1;
+    t[2..4].copy_from_slice(&cw1.to_be_bytes());
+    t[4..8].copy_from_slice(&rpm.to_be_bytes());
+    t[16..20].copy_from_slice(&ramps.to_be_bytes());
+    t[20..24].copy_from_slice(&300i32.to_be_bytes());
+    t[24..32].copy_from_slice(&p);
+    t
+}
+
+/// Telegram 2: CW1, target torque, PKW, speed limit.
+fn t2(cw1: u16, torque: i16, p: [u8; 8]) -> [u8; 36] {
+    let mut t = [0u8; 36];
+    t[0] = 0xE2;
+    t[2..4].copy_from_slice(&cw1.to_be_bytes());
+    t[4..6].copy_from_slice(&torque.to_be_bytes());
+    t[24..32].copy_from_slice(&p);
+    t[32..36].copy_from_slice(&2000i32.to_be_bytes());
+    t
+}
+
+/// Telegram 3 as configured below: CW1, target velocity.
+fn t3(cw1: u16, rpm: i32) -> [u8; 36] {
+    let mut t = [0u8; 36];
+    t[0] = 0xE3;
+    t[1..3].copy_from_slice(&cw1.to_be_bytes());
+    t[3..7].copy_from_slice(&rpm.to_be_bytes());
+    t
+}
+
+/// CANopen-style entry of the telegram editor: index << 16 | sub << 8.
+fn entry(index: u16, sub: u8) -> u32 {
+    u32::from(index) << 16 | u32::from(sub) << 8
+}
+
+/// A frame and the object written on both drives before it (axis A's
+/// CiA 402 index, subindex, value).
+type Step = ([u8; 36], Option<(u16, u8, i64)>);
+
+/// The frames, in order, with what happens to both drives before each.
+fn script() -> Vec<Step> {
+    let none = [0u8; 8];
+    let mut s = Vec::new();
+    // telegram 0: records changed, unchanged, a value the record refuses
+    for (cw1, target, v, end, acc, jog) in [
+        (0x0406, 5000, 1000, 0, 10_000, 100),
+        (0x0407, 5000, 1000, 0, 10_000, 100),
+        (0x040F, 5000, 1000, 0, 10_000, 100),
+        (0x045F, -20_000, 700, 100, 300, -50),
+        (0x041F, -20_000, 700, 100, 300, -50),
+        (0x040F, 1, -5, 0, u32::MAX, 0),
+        (0x0C0F, 1, 10, 0, 1, 0),
+    ] {
+        s.push((t0(cw1, target, v, end, acc, jog, none), None));
+    }
+    // a PKW read and write inside telegram 0 (PNU 1001.0, the target)
+    s.push((t0(0x040F, 77, 10, 0, 100, 0, pkw(0x41, 1001, 0, 0)), None));
+    s.push((t0(0x040F, 77, 10, 0, 100, 0, none), None));
+    s.push((t0(0x040F, 77, 10, 0, 100, 0, pkw(0x42, 1040, 0, 250)), None));
+    // telegram 1, then 2, then 0 again (the mode changes)
+    for (cw1, rpm, ramps) in [(0x0406, 100, 10_000), (0x0407, 100, 10_000), (0x047F, -300, 2500)] {
+        s.push((t1(cw1, rpm, ramps, none), None));
+    }
+    // a ramp changed behind the telegram
+    s.push((t1(0x047F, -300, 2500, none), Some((0x6048, 1, 7))));
+    for (cw1, torque) in [(0x0406, 0), (0x040F, 100), (0x040F, -100)] {
+        s.push((t2(cw1, torque, none), None));
+    }
+    // A279: the position in 1/10 degree, then the velocity
+    s.push((t0(0x040F, 3600, 10, 0, 100, 20, none), Some((A279, 1, 0x0101))));
+    s.push((t0(0x040F, 3601, 10, 0, 100, 20, none), None));
+    s.push((t1(0x047F, 50, 2500, none), Some((A279, 2, 0x1001))));
+    s.push((t1(0x047F, 51, 2500, none), None));
+    // an unknown identifier, then telegram 3 configured over PKW and used
+    let mut unknown = t0(0x040F, 1, 1, 0, 1, 0, none);
+    unknown[0] = 0xE7;
+    s.push((unknown, None));
+    let editor = [
+        (2020, 0, 7),
+        (2021, 0, entry(968, 0)),
+        (2021, 1, entry(1101, 0)),
+        (2021, 2, entry(0x6077, 0)),
+        (2022, 0, 1),
+        (2020, 0, 3),
+        (2021, 0, entry(967, 0)),
+        (2021, 1, entry(1010, 0)),
+        (2022, 0, 1),
+    ];
+    for (pnu, sub, value) in editor {
+        s.push((t2(0x0406, 0, pkw(0x42, pnu, sub, value)), None));
+        s.push((t2(0x0406, 0, none), None));
+    }
+    for (cw1, rpm) in [(0x0406, 10), (0x0407, 20), (0x047F, 30)] {
+        s.push((t3(cw1, rpm), None));
+    }
+    s.push((t1(0x0406, 5, 1000, none), None));
+    s.push((t3(0x0406, 10), None));
+    s
+}
+
+/// Issue 36, P-067, P-071…P-074, P-208 (A279), Q-08: the handle path and
+/// the address path leave the same bytes, objects and state after every
+/// frame, on both axes; the handles are compiled again after the telegram
+/// configured over PKW.
+#[test]
+fn issue36_p067_the_handles_answer_as_the_address_path() {
+    for axis in [0, 1] {
+        let (mut a, mut b) = (Side::new(axis), Side::new(axis));
+        for (k, (frame, before)) in script().into_iter().enumerate() {
+            if let Some((index, sub, v)) = before {
+                for s in [&mut a, &mut b] {
+                    let index = if index >= 0x6000 {
+                        s.axis.cia402_index(index)
+                    } else {
+                        index
+                    };
+                    s.od.set(index, sub, v).unwrap();
+                }
+            }
+            let (ra, rb) = (a.frame(&frame, true), b.frame(&frame, false));
+            assert_eq!(ra, rb, "axis {axis} frame {k}: the response");
+            assert!(a.od == b.od, "axis {axis} frame {k}: the objects");
+            assert_eq!(a.state(), b.state(), "axis {axis} frame {k}");
+        }
+        // the script reached what it is for
+        assert_eq!(a.profile.telegrams().unwrap().active_receive(), Some(3));
+        assert!(a.profile.warnings() > 0, "the unknown identifier counted");
+        let n = a.od.record_selector(axis);
+        // 360.1 degrees in increments: A279's unit was in force
+        let target = i64::from(a.od.record(axis, n).unwrap().target);
+        assert!(
+            (target - (3601 << 20) / 3600).abs() <= 1,
+            "A279: 1/10 degree, {target}"
+        );
+    }
+}
+
+/// Issue 36: a handle holds no axis: the handles compiled with axis A
+/// reach axis B's objects when the profile drives axis B.
+#[test]
+fn issue36_handles_follow_the_axis() {
+    let mut s = Side::new(0);
+    let frame = t2(0x0406, 123, [0; 8]);
+    s.frame(&frame, true);
+    assert_eq!(s.od.get(0x6071, 0), Ok(123));
+    let mut b = Axis::new(1);
+    let frame = t2(0x0406, -9, [0; 8]);
+    assert!(s.profile.handles.is_for(s.profile.telegrams().unwrap()));
+    s.profile.receive(&frame, &mut s.od, &mut b);
+    assert_eq!(s.od.get(b.cia402_index(0x6071), 0), Ok(-9));
+    assert_eq!(s.od.get(0x6071, 0), Ok(123), "axis A's stays");
+    // the response's 6077h (actual torque) is axis B's
+    s.od.set(0x6077, 0, 11).unwrap();
+    s.od.set(b.cia402_index(0x6077), 0, 22).unwrap();
+    let layout = s.profile.telegrams().unwrap().layout(Dir::Response, 2).unwrap();
+    let at = layout
+        .slots()
+        .iter()
+        .find(|x| x.addr == Addr::new(0x6077, 0))
+        .unwrap()
+        .offset;
+    let mut out = [0u8; 36];
+    s.profile.respond(&mut s.od, &b, &mut out);
+    let at = usize::from(at);
+    assert_eq!(i16::from_be_bytes([out[at], out[at + 1]]), 22, "6077h of axis B");
+}
