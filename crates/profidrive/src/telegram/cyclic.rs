@@ -121,6 +121,16 @@ impl Live {
     };
 }
 
+/// [`fits`] of `v`, decoded from a slot of type `t` (the slot is the
+/// type's size, [`super::check_entry`]): every integer type's decode is
+/// in its range by construction, only BOOLEAN's byte may be beyond 0/1
+/// (issue 36: the range test of every entry every telegram;
+/// `issue36_a_decoded_entry_fits_its_type`).
+#[inline]
+fn decoded_fits(t: od::DataType, v: i64) -> bool {
+    t != od::DataType::Bool || fits(t, v)
+}
+
 impl Telegrams {
     /// Applies a received frame (the OUT module's data): see the
     /// [module](self) for the order of a cycle.
@@ -182,17 +192,20 @@ impl Telegrams {
                 Kind::Pad => {}
                 Kind::Cw1 => out.cw1 = Some(decode_be(od::DataType::U16, bytes) as u16),
                 Kind::Pkw => {
-                    // a zip: the slot's size is 8 by construction, which the
-                    // compiler cannot see (no length-mismatch panic path)
-                    let mut p = [0u8; 8];
-                    for (d, b) in p.iter_mut().zip(bytes) {
-                        *d = *b;
-                    }
-                    out.pkw = Some(p);
+                    // the slot's size is 8 by construction, which the
+                    // compiler cannot see: a checked conversion (no panic
+                    // path), one copy instead of a byte loop (issue 36)
+                    out.pkw = Some(<[u8; 8]>::try_from(bytes).unwrap_or_else(|_| {
+                        let mut p = [0u8; 8];
+                        for (d, b) in p.iter_mut().zip(bytes) {
+                            *d = *b;
+                        }
+                        p
+                    }));
                 }
                 Kind::Object(t) => {
                     let v = decode_be(t, bytes);
-                    let ok = fits(t, v) && write(access, n, i, s.addr, v);
+                    let ok = decoded_fits(t, v) && write(access, n, i, s.addr, v);
                     if !ok {
                         out.warnings.0 |= Warnings::ACCESS_REFUSED;
                     }
@@ -250,7 +263,7 @@ impl Telegrams {
                 continue;
             }
             let v = decode_be(t, bytes);
-            if fits(t, v) && access.write(s.addr, v, true).is_ok() {
+            if decoded_fits(t, v) && access.write(s.addr, v, true).is_ok() {
                 written += 1;
             }
         }
@@ -303,11 +316,15 @@ impl Telegrams {
             };
             match s.kind {
                 Kind::Pad => {}
-                Kind::Pkw => {
-                    for (d, b) in dst.iter_mut().zip(pkw) {
-                        *d = b;
+                Kind::Pkw => match <&mut [u8; 8]>::try_from(&mut *dst) {
+                    // one copy instead of a byte loop (issue 36)
+                    Ok(d) => *d = pkw,
+                    Err(_) => {
+                        for (d, b) in dst.iter_mut().zip(pkw) {
+                            *d = b;
+                        }
                     }
-                }
+                },
                 Kind::Cw1 | Kind::Object(_) => match read(access, i, s.addr) {
                     Ok(v) => encode_be(v, dst),
                     Err(_) => warnings.0 |= Warnings::ACCESS_REFUSED,
@@ -369,5 +386,45 @@ impl Telegrams {
                 f(s.addr, s.offset, s.size, decode_be(t, b));
             }
         }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use od::DataType;
+
+    /// Issue 36: a value decoded from a slot of an integer type's size
+    /// fits that type, so only BOOLEAN needs [`fits`]'s test (P-067: a
+    /// BOOLEAN byte beyond 0/1 is refused).
+    #[test]
+    fn issue36_a_decoded_entry_fits_its_type() {
+        let types = [
+            DataType::Bool,
+            DataType::I8,
+            DataType::U8,
+            DataType::I16,
+            DataType::U16,
+            DataType::I32,
+            DataType::U32,
+            DataType::I64,
+            DataType::U64,
+        ];
+        let patterns = [0x00u8, 0x01, 0x02, 0x7F, 0x80, 0xFF, 0x5A];
+        for t in types {
+            let size = crate::int_size(t).unwrap();
+            for &first in &patterns {
+                for &rest in &patterns {
+                    let mut bytes = [rest; 8];
+                    bytes[0] = first;
+                    let v = decode_be(t, &bytes[..size]);
+                    assert_eq!(decoded_fits(t, v), fits(t, v), "{t:?} {bytes:?}");
+                    if t != DataType::Bool {
+                        assert!(fits(t, v), "{t:?} {bytes:?}");
+                    }
+                }
+            }
+        }
+        assert!(!decoded_fits(DataType::Bool, 2));
     }
 }
