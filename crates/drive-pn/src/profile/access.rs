@@ -157,7 +157,7 @@ pub struct DriveAccess<'a> {
     pub units: &'a UnitProfile,
     /// The axis' CiA 402 user units, read once per configuration
     /// generation.
-    pub user_units: &'a UnitsCache,
+    pub user_units: &'a mut UnitsCache,
     /// The CiA 402 entries accessed, prepared once per configuration
     /// generation.
     pub prepared: &'a mut PreparedCache,
@@ -225,7 +225,7 @@ impl DriveAccess<'_> {
         }
     }
 
-    fn user_units(&self) -> UserUnits {
+    fn user_units(&mut self) -> &UserUnits {
         self.user_units.get(self.objects, self.axis)
     }
 
@@ -307,7 +307,7 @@ impl DriveAccess<'_> {
     }
 
     /// Bus units → the object's units.
-    fn to_object(&self, unit: Unit, bus: i64) -> Result<i64, PdError> {
+    fn object_of(&mut self, unit: Unit, bus: i64) -> Result<i64, PdError> {
         let range = PdError::LIMIT_EXCEEDED;
         let p = self.units;
         Ok(match unit {
@@ -319,24 +319,24 @@ impl DriveAccess<'_> {
             // the integer path: exact to the increment (f32 is not, above 2^24)
             Unit::Velocity => {
                 let inc = units::from_bus(&p.velocity, bus).map_err(|_| range)?;
-                units::velocity_from_increments(&self.user_units(), inc)
+                units::velocity_from_increments(self.user_units(), inc)
             }
             Unit::Acceleration => {
                 let inc = units::from_bus(&p.acceleration, bus).map_err(|_| range)?;
-                units::acceleration_from_increments(&self.user_units(), inc)
+                units::acceleration_from_increments(self.user_units(), inc)
             }
             Unit::Rpm => units::rpm_of(units::from_bus(&p.velocity, bus).map_err(|_| range)?),
             Unit::RpmPerSecond => units::rpm_of(units::from_bus(&p.acceleration, bus).map_err(|_| range)?),
         })
     }
 
-    /// [`Self::to_object`] for a write of `index`:`sub`, where the bus value a
+    /// [`Self::object_of`] for a write of `index`:`sub`, where the bus value a
     /// read of the type's limit returns writes that limit: a value read can
     /// be written back although its rounding lands just beyond the type
     /// (PNU 1273's default `u32::MAX` increments reads 4 096 000/1000 rev,
     /// which converts to 2^32 increments).
     fn object_value_read_back(&mut self, unit: Unit, bus: i64, index: u16, sub: u8) -> Result<i64, PdError> {
-        let v = self.to_object(unit, bus)?;
+        let v = self.object_of(unit, bus)?;
         // the data type from the prepared access where there is one (the
         // write after this uses it): no lookup in the dictionary's tables
         let t = match self.prepared.get(self.objects, index, sub) {
@@ -344,17 +344,17 @@ impl DriveAccess<'_> {
             None => self.entry(index, sub)?.data_type,
         };
         let (min, max) = type_limits(t);
-        if v > max && self.to_bus(unit, max) == Ok(bus) {
+        if v > max && self.bus_of(unit, max) == Ok(bus) {
             return Ok(max);
         }
-        if v < min && self.to_bus(unit, min) == Ok(bus) {
+        if v < min && self.bus_of(unit, min) == Ok(bus) {
             return Ok(min);
         }
         Ok(v)
     }
 
     /// The object's units → bus units.
-    fn to_bus(&self, unit: Unit, object: i64) -> Result<i64, PdError> {
+    fn bus_of(&mut self, unit: Unit, object: i64) -> Result<i64, PdError> {
         let range = PdError::LIMIT_EXCEEDED;
         let p = self.units;
         let v = match unit {
@@ -365,11 +365,11 @@ impl DriveAccess<'_> {
             }
             Unit::Velocity => units::to_bus(
                 &p.velocity,
-                units::velocity_to_increments(&self.user_units(), object),
+                units::velocity_to_increments(self.user_units(), object),
             ),
             Unit::Acceleration => units::to_bus(
                 &p.acceleration,
-                units::acceleration_to_increments(&self.user_units(), object),
+                units::acceleration_to_increments(self.user_units(), object),
             ),
             Unit::Rpm => units::to_bus(&p.velocity, units::increments_of_rpm(object)),
             Unit::RpmPerSecond => units::to_bus(&p.acceleration, units::increments_of_rpm(object)),
@@ -414,7 +414,7 @@ impl DriveAccess<'_> {
             RecordField::Acceleration | RecordField::BothAccelerations => i64::from(r.acceleration),
             RecordField::Deceleration => i64::from(r.deceleration),
         };
-        self.to_bus(unit, v)
+        self.bus_of(unit, v)
     }
 
     fn write_record(
@@ -424,7 +424,7 @@ impl DriveAccess<'_> {
         unit: Unit,
         bus: i64,
     ) -> Result<(), PdError> {
-        let value = self.to_object(unit, bus)?;
+        let value = self.object_of(unit, bus)?;
         let numbers: &[u16] = match jog {
             Some(Jog::Both) => &[JOG_POSITIVE, JOG_NEGATIVE],
             _ => &[0],
@@ -618,14 +618,14 @@ impl DriveAccess<'_> {
             Source::Object { index, sub } => {
                 let index = self.index(index);
                 let v = self.read_object(index, sub)?;
-                self.to_bus(p.unit, v)
+                self.bus_of(p.unit, v)
             }
             Source::SelectedRecord(f) => self.read_record(None, f, p.unit),
             Source::JogRecord(j, f) => self.read_record(Some(j), f, p.unit),
             Source::VlBothRamps => {
                 let index = self.index(0x6048);
                 let v = self.read_object(index, 1)?;
-                self.to_bus(p.unit, v)
+                self.bus_of(p.unit, v)
             }
             Source::Cw1 => Ok(i64::from(self.own.cw1)),
             Source::Zsw1 => Ok(i64::from(self.own.zsw1)),
@@ -665,7 +665,7 @@ impl DriveAccess<'_> {
             Source::SelectedRecord(f) => self.write_record(None, f, p.unit, value)?,
             Source::JogRecord(j, f) => self.write_record(Some(j), f, p.unit, value)?,
             Source::VlBothRamps => {
-                let v = self.to_object(p.unit, value)?;
+                let v = self.object_of(p.unit, value)?;
                 for i in [0x6048, 0x6049] {
                     let index = self.index(i);
                     self.write_object(index, 1, v)?;

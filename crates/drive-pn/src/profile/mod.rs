@@ -50,7 +50,7 @@ macro_rules! drive_access {
             objects: $objects,
             axis: $axis,
             units: &$p.units,
-            user_units: &$p.user_units,
+            user_units: &mut $p.user_units,
             prepared: &mut $p.prepared,
             core: &$p.core,
             own: &mut $p.own,

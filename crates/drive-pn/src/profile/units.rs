@@ -7,7 +7,6 @@
 //! the arguments they do not cover). On a Cortex-M4F a 128-bit division or
 //! an `f64` operation is a library call of hundreds of instructions.
 
-use core::cell::Cell;
 use drive_core::axis::Axis;
 use drive_core::user_units::UserUnits;
 use drive_core::DriveObjects;
@@ -18,27 +17,28 @@ use motion::INCREMENTS_PER_REVOLUTION;
 /// ([`DriveObjects::config_generation`]) they were read at: any change of a
 /// factor-group object (6091h, 6092h, 607Eh, A213, A310/A311) moves the
 /// generation, so the next conversion reads them again. One cache serves
-/// one dictionary.
+/// one dictionary. Lent by reference, not copied out (issue 36: the copy
+/// of a `Cell` cost every converted telegram entry some 40 instructions on
+/// QEMU).
 #[derive(Debug, Default)]
-pub struct UnitsCache(Cell<Option<(u32, u8, UserUnits)>>);
+pub struct UnitsCache(Option<(u32, u8, UserUnits)>);
 
 impl UnitsCache {
     /// An empty cache (the first use reads the objects).
     pub const fn new() -> Self {
-        Self(Cell::new(None))
+        Self(None)
     }
 
     /// The user units of `axis` as its objects say now.
-    pub fn get(&self, objects: &DriveObjects, axis: &Axis) -> UserUnits {
+    pub fn get(&mut self, objects: &DriveObjects, axis: &Axis) -> &UserUnits {
         let generation = objects.config_generation();
-        match self.0.get() {
-            Some((g, a, u)) if g == generation && a == axis.index() => u,
-            _ => {
-                let u = UserUnits::read(objects, axis);
-                self.0.set(Some((generation, axis.index(), u)));
-                u
-            }
+        let cached = &mut self.0;
+        if !matches!(cached, Some((g, a, _)) if *g == generation && *a == axis.index()) {
+            *cached = Some((generation, axis.index(), UserUnits::read(objects, axis)));
         }
+        let (_, _, u) =
+            cached.get_or_insert_with(|| (generation, axis.index(), UserUnits::read(objects, axis)));
+        u
     }
 }
 
@@ -317,10 +317,10 @@ mod tests {
     fn p214_the_cache_follows_a_factor_group_change() {
         let mut od = DriveObjects::new();
         let axis = Axis::new(0);
-        let cache = UnitsCache::new();
+        let mut cache = UnitsCache::new();
         assert!(cache.get(&od, &axis).is_identity());
         od.set(0x6092, 1, 1000).unwrap();
-        let u = cache.get(&od, &axis);
+        let u = *cache.get(&od, &axis);
         assert_eq!(u, UserUnits::read(&od, &axis));
         assert!(!u.is_identity());
         od.set(0x6092, 1, 1 << 20).unwrap();
