@@ -4,10 +4,9 @@
 //! (P-045, P-194: in the CiA 402 factor group's units), both through the
 //! core's object dictionary with its access, range and state checks.
 
-use super::lookup::{self, Core, CoreSlots, PreparedCache};
-use super::pnu::{self, Jog, Pnu, RecordField, Source, Unit};
+use super::lookup::{self, Core, CoreSlots, Handle, PreparedCache, WrittenConfig};
+use super::pnu::{Jog, Pnu, RecordField, Source, Unit};
 use super::units::{self, UnitsCache};
-use core::num::NonZeroU16;
 use drive_core::axis::Axis;
 use drive_core::faults::E82_INACTIVE;
 use drive_core::objects::records::{Record, JOG_NEGATIVE, JOG_POSITIVE};
@@ -113,40 +112,6 @@ fn type_limits(t: DataType) -> (i64, i64) {
     }
 }
 
-/// A telegram entry resolved where the telegrams are configured or
-/// prepared for (issue 36, [`profidrive::telegram::compiled`]): the
-/// cyclic path reads and writes it without the catalogue's memo and the
-/// catalogue-index test. Two bytes (80 slots): a catalogue entry's position
-/// in [`pnu::CATALOGUE`] plus one, or `u16::MAX` for a CANopen object
-/// outside the catalogue (its index mapped to the axis at the access, as
-/// the address path does).
-#[derive(Debug, Clone, Copy, PartialEq, Eq)]
-pub struct Handle(NonZeroU16);
-
-impl Handle {
-    /// A CANopen object outside the catalogue.
-    const OBJECT: u16 = u16::MAX;
-
-    /// The handle of the catalogue entry at `i`.
-    fn pnu(i: usize) -> Option<Handle> {
-        let v = u16::try_from(i.checked_add(1)?).ok()?;
-        NonZeroU16::new(v).filter(|v| v.get() != Self::OBJECT).map(Handle)
-    }
-
-    /// The handle of an object outside the catalogue.
-    fn object() -> Option<Handle> {
-        NonZeroU16::new(Self::OBJECT).map(Handle)
-    }
-
-    /// The catalogue entry, `None` for an object.
-    fn entry(self) -> Option<&'static Pnu> {
-        match self.0.get() {
-            Self::OBJECT => None,
-            v => pnu::CATALOGUE.get(usize::from(v - 1)),
-        }
-    }
-}
-
 /// The drive as the profile reaches it, for one cycle or one request.
 pub struct DriveAccess<'a> {
     /// The object dictionary.
@@ -163,6 +128,9 @@ pub struct DriveAccess<'a> {
     pub prepared: &'a mut PreparedCache,
     /// The core entries the profile reads itself, resolved.
     pub core: &'a CoreSlots,
+    /// The configuration entries the telegram wrote last, with the
+    /// configuration generation after the write (issue 36).
+    pub written: &'a mut WrittenConfig,
     /// The profile's own values.
     pub own: &'a mut OwnValues,
     /// The provider of the live entries a parameter access reaches (the
@@ -298,6 +266,7 @@ impl DriveAccess<'_> {
             }
             None => self.entry(index, sub)?.data_type,
         };
+        self.written.unprepared = true;
         fits(t)?;
         let data = bytes.get(..size(t)).ok_or(PdError::INCORRECT_DATA_TYPE)?;
         self.objects
@@ -576,26 +545,22 @@ impl ParamAccess for DriveAccess<'_> {
 impl SlotAccess for DriveAccess<'_> {
     type Handle = Handle;
 
-    fn resolve(&mut self, _dir: Dir, addr: Addr) -> Option<Handle> {
+    fn resolve(&mut self, dir: Dir, addr: Addr) -> Option<Handle> {
+        let config = dir == Dir::Receive && self.is_config_entry(addr);
         if lookup::is_catalogue_index(addr.index) {
             // an address the catalogue does not hold: the address path
             // answers its error
-            Handle::pnu(lookup::position(addr).ok()?)
+            Handle::pnu(lookup::position(addr).ok()?, config)
         } else {
-            Handle::object()
+            Handle::object(config)
         }
     }
 
     fn write_handle(&mut self, h: Handle, addr: Addr, value: i64) -> Result<Completion, PdError> {
-        match h.entry() {
-            Some(p) => self.write_pnu(p, addr, value),
-            None => {
-                self.flush_record();
-                let index = self.index(addr.index);
-                self.write_object(index, addr.sub, value)?;
-                Ok(Completion::Done)
-            }
+        if h.is_config() {
+            return self.write_config(h, addr, value);
         }
+        self.write_resolved(h, addr, value)
     }
 
     fn read_handle(&mut self, h: Handle, addr: Addr) -> Result<i64, PdError> {
@@ -611,6 +576,43 @@ impl SlotAccess for DriveAccess<'_> {
 }
 
 impl DriveAccess<'_> {
+    /// [`SlotAccess::write_handle`] of a configuration entry (out of line:
+    /// the other entries' path stays as short as it was).
+    #[inline(never)]
+    fn write_config(&mut self, h: Handle, addr: Addr, value: i64) -> Result<Completion, PdError> {
+        // a configuration entry (telegram 1's ramps): the same value
+        // written before with no configuration change since left its
+        // objects as this write would (every change of a configuration
+        // value moves the generation) and was taken (the checks of a
+        // prepared write depend on the value and the configuration only)
+        let key = WrittenConfig::key(self.axis.index(), addr);
+        if self.written.holds(key, value, self.objects.config_generation()) {
+            self.flush_record();
+            return Ok(Completion::Done);
+        }
+        self.written.unprepared = false;
+        let r = self.write_resolved(h, addr, value);
+        if r == Ok(Completion::Done) && !self.written.unprepared {
+            self.written.put(key, value, self.objects.config_generation());
+        }
+        r
+    }
+
+    /// [`SlotAccess::write_handle`] without the memo of configuration
+    /// entries.
+    #[inline(always)]
+    fn write_resolved(&mut self, h: Handle, addr: Addr, value: i64) -> Result<Completion, PdError> {
+        match h.entry() {
+            Some(p) => self.write_pnu(p, addr, value),
+            None => {
+                self.flush_record();
+                let index = self.index(addr.index);
+                self.write_object(index, addr.sub, value)?;
+                Ok(Completion::Done)
+            }
+        }
+    }
+
     /// [`ParamAccess::read`] of the catalogue entry `p` (`addr`), the
     /// pending record stored.
     fn read_pnu(&mut self, p: &'static Pnu, addr: Addr) -> Result<i64, PdError> {

@@ -31,10 +31,10 @@ pub mod telegram_config;
 pub mod unit_choice;
 pub mod units;
 
-use access::{DriveAccess, Handle, OwnValues};
+use access::{DriveAccess, OwnValues};
 use drive_core::axis::{Axis, RecordCommand};
 use drive_core::{DriveObjects, LiveValues, NoLive};
-use lookup::{Core, CoreSlots, PreparedCache};
+use lookup::{Core, CoreSlots, Handle, PreparedCache, WrittenConfig};
 use motion::units::UnitProfile;
 use profidrive::cw1::{Context, Cw1Decoder, Mode, ModeCommands};
 use profidrive::pkw::Pkw;
@@ -53,6 +53,7 @@ macro_rules! drive_access {
             user_units: &mut $p.user_units,
             prepared: &mut $p.prepared,
             core: &$p.core,
+            written: &mut $p.written,
             own: &mut $p.own,
             live: $live,
             pending: None,
@@ -91,6 +92,8 @@ pub struct Profile {
     /// where the telegrams are configured and in [`prepare`](Self::prepare)
     /// when the layouts changed.
     handles: Compiled<Handle>,
+    /// The configuration entries the telegram wrote last (issue 36).
+    written: WrittenConfig,
 }
 
 impl Profile {
@@ -116,6 +119,7 @@ impl Profile {
             warnings: 0,
             prepared_at: None,
             handles: Compiled::new(),
+            written: WrittenConfig::new(),
         };
         let access = drive_access!(p, objects, axis, &mut NoLive);
         // the stored configuration (A280, P-069), else the FB's

@@ -35,8 +35,13 @@ impl Side {
     /// One frame as `PnDrive` takes it: prepared in the bus task, then
     /// the control cycle's receive and response. `handles`: through the
     /// compiled handles, else the address path.
-    fn frame(&mut self, frame: &[u8], handles: bool) -> Vec<u8> {
+    fn frame(&mut self, frame: &[u8], handles: bool, between: Option<(u16, u8, i64)>) -> Vec<u8> {
         self.profile.prepare(Some(frame), &mut self.od, &mut self.axis);
+        // a write between the bus task's preparation and the control
+        // cycle (a record in the bus task)
+        if let Some((index, sub, v)) = between {
+            self.set(index, sub, v);
+        }
         if handles {
             let t = self.profile.telegrams().expect("configured");
             assert!(self.profile.handles.is_for(t), "the handles are current");
@@ -51,6 +56,16 @@ impl Side {
         let n = self.profile.respond(&mut self.od, &self.axis, &mut out);
         out.truncate(n.unwrap_or(0));
         out
+    }
+
+    /// `index` (axis A's CiA 402 index: this axis') written.
+    fn set(&mut self, index: u16, sub: u8, v: i64) {
+        let index = if index >= 0x6000 {
+            self.axis.cia402_index(index)
+        } else {
+            index
+        };
+        self.od.set(index, sub, v).unwrap();
     }
 
     /// What the two paths must leave alike.
@@ -127,9 +142,13 @@ fn entry(index: u16, sub: u8) -> u32 {
     u32::from(index) << 16 | u32::from(sub) << 8
 }
 
-/// A frame and the object written on both drives before it (axis A's
-/// CiA 402 index, subindex, value).
-type Step = ([u8; 36], Option<(u16, u8, i64)>);
+/// An object written on both drives (axis A's CiA 402 index, subindex,
+/// value).
+type Write = Option<(u16, u8, i64)>;
+
+/// A frame, the object written on both drives before it and the one
+/// written between the preparation and the control cycle.
+type Step = ([u8; 36], Write, Write);
 
 /// The frames, in order, with what happens to both drives before each.
 fn script() -> Vec<Step> {
@@ -145,30 +164,42 @@ fn script() -> Vec<Step> {
         (0x040F, 1, -5, 0, u32::MAX, 0),
         (0x0C0F, 1, 10, 0, 1, 0),
     ] {
-        s.push((t0(cw1, target, v, end, acc, jog, none), None));
+        s.push((t0(cw1, target, v, end, acc, jog, none), None, None));
     }
     // a PKW read and write inside telegram 0 (PNU 1001.0, the target)
-    s.push((t0(0x040F, 77, 10, 0, 100, 0, pkw(0x41, 1001, 0, 0)), None));
-    s.push((t0(0x040F, 77, 10, 0, 100, 0, none), None));
-    s.push((t0(0x040F, 77, 10, 0, 100, 0, pkw(0x42, 1040, 0, 250)), None));
+    s.push((t0(0x040F, 77, 10, 0, 100, 0, pkw(0x41, 1001, 0, 0)), None, None));
+    s.push((t0(0x040F, 77, 10, 0, 100, 0, none), None, None));
+    s.push((t0(0x040F, 77, 10, 0, 100, 0, pkw(0x42, 1040, 0, 250)), None, None));
     // telegram 1, then 2, then 0 again (the mode changes)
     for (cw1, rpm, ramps) in [(0x0406, 100, 10_000), (0x0407, 100, 10_000), (0x047F, -300, 2500)] {
-        s.push((t1(cw1, rpm, ramps, none), None));
+        s.push((t1(cw1, rpm, ramps, none), None, None));
     }
-    // a ramp changed behind the telegram
-    s.push((t1(0x047F, -300, 2500, none), Some((0x6048, 1, 7))));
+    // a ramp changed behind the telegram, before the frame and between
+    // its preparation and the control cycle, then the same value again
+    s.push((t1(0x047F, -300, 2500, none), Some((0x6048, 1, 7)), None));
+    s.push((t1(0x047F, -300, 2500, none), None, Some((0x6049, 1, 9))));
+    s.push((t1(0x047F, -300, 2500, none), None, Some((0x6048, 2, 3))));
+    s.push((t1(0x047F, -300, 2500, none), None, None));
+    // a ramp the objects refuse (beyond 6048h:01's range), then taken
+    s.push((t1(0x047F, -300, u32::MAX, none), None, None));
+    s.push((t1(0x047F, -300, u32::MAX, none), None, None));
+    s.push((t1(0x047F, -300, 2500, none), None, None));
     for (cw1, torque) in [(0x0406, 0), (0x040F, 100), (0x040F, -100)] {
-        s.push((t2(cw1, torque, none), None));
+        s.push((t2(cw1, torque, none), None, None));
     }
     // A279: the position in 1/10 degree, then the velocity
-    s.push((t0(0x040F, 3600, 10, 0, 100, 20, none), Some((A279, 1, 0x0101))));
-    s.push((t0(0x040F, 3601, 10, 0, 100, 20, none), None));
-    s.push((t1(0x047F, 50, 2500, none), Some((A279, 2, 0x1001))));
-    s.push((t1(0x047F, 51, 2500, none), None));
+    s.push((
+        t0(0x040F, 3600, 10, 0, 100, 20, none),
+        Some((A279, 1, 0x0101)),
+        None,
+    ));
+    s.push((t0(0x040F, 3601, 10, 0, 100, 20, none), None, None));
+    s.push((t1(0x047F, 50, 2500, none), Some((A279, 2, 0x1001)), None));
+    s.push((t1(0x047F, 51, 2500, none), None, None));
     // an unknown identifier, then telegram 3 configured over PKW and used
     let mut unknown = t0(0x040F, 1, 1, 0, 1, 0, none);
     unknown[0] = 0xE7;
-    s.push((unknown, None));
+    s.push((unknown, None, None));
     let editor = [
         (2020, 0, 7),
         (2021, 0, entry(968, 0)),
@@ -181,14 +212,14 @@ fn script() -> Vec<Step> {
         (2022, 0, 1),
     ];
     for (pnu, sub, value) in editor {
-        s.push((t2(0x0406, 0, pkw(0x42, pnu, sub, value)), None));
-        s.push((t2(0x0406, 0, none), None));
+        s.push((t2(0x0406, 0, pkw(0x42, pnu, sub, value)), None, None));
+        s.push((t2(0x0406, 0, none), None, None));
     }
     for (cw1, rpm) in [(0x0406, 10), (0x0407, 20), (0x047F, 30)] {
-        s.push((t3(cw1, rpm), None));
+        s.push((t3(cw1, rpm), None, None));
     }
-    s.push((t1(0x0406, 5, 1000, none), None));
-    s.push((t3(0x0406, 10), None));
+    s.push((t1(0x0406, 5, 1000, none), None, None));
+    s.push((t3(0x0406, 10), None, None));
     s
 }
 
@@ -200,18 +231,12 @@ fn script() -> Vec<Step> {
 fn issue36_p067_the_handles_answer_as_the_address_path() {
     for axis in [0, 1] {
         let (mut a, mut b) = (Side::new(axis), Side::new(axis));
-        for (k, (frame, before)) in script().into_iter().enumerate() {
+        for (k, (frame, before, between)) in script().into_iter().enumerate() {
             if let Some((index, sub, v)) = before {
-                for s in [&mut a, &mut b] {
-                    let index = if index >= 0x6000 {
-                        s.axis.cia402_index(index)
-                    } else {
-                        index
-                    };
-                    s.od.set(index, sub, v).unwrap();
-                }
+                a.set(index, sub, v);
+                b.set(index, sub, v);
             }
-            let (ra, rb) = (a.frame(&frame, true), b.frame(&frame, false));
+            let (ra, rb) = (a.frame(&frame, true, between), b.frame(&frame, false, between));
             assert_eq!(ra, rb, "axis {axis} frame {k}: the response");
             assert!(a.od == b.od, "axis {axis} frame {k}: the objects");
             assert_eq!(a.state(), b.state(), "axis {axis} frame {k}");
@@ -235,7 +260,7 @@ fn issue36_p067_the_handles_answer_as_the_address_path() {
 fn issue36_handles_follow_the_axis() {
     let mut s = Side::new(0);
     let frame = t2(0x0406, 123, [0; 8]);
-    s.frame(&frame, true);
+    s.frame(&frame, true, None);
     assert_eq!(s.od.get(0x6071, 0), Ok(123));
     let mut b = Axis::new(1);
     let frame = t2(0x0406, -9, [0; 8]);
