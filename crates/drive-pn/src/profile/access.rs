@@ -356,9 +356,19 @@ impl DriveAccess<'_> {
 
     /// Stores the record the last field writes left pending (and shows it
     /// when the window J401 shows it), as each of those writes did before.
+    #[inline(always)]
     pub fn flush_record(&mut self) {
-        // compared where it is, not moved out (`take`): every read and
-        // every other write asks (issue 36)
+        // the test inline, the store out of line: every read and every
+        // other write asks, mostly with nothing pending (issue 36)
+        if self.pending.is_some() {
+            self.store_pending();
+        }
+    }
+
+    /// [`flush_record`](Self::flush_record) of a pending record.
+    #[inline(never)]
+    fn store_pending(&mut self) {
+        // compared where it is, not moved out (`take`)
         let Some((axis, n, _, r, read)) = &self.pending else {
             return;
         };
