@@ -164,3 +164,110 @@ impl Telegrams {
         })
     }
 }
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::fake::Fake;
+    use std::vec::Vec;
+
+    /// The fake drive with handles: an entry's position in its object
+    /// list; every handle access counted.
+    struct Handled {
+        f: Fake,
+        by_handle: Vec<Addr>,
+    }
+
+    impl ParamAccess for Handled {
+        fn describe(&self, addr: Addr) -> Result<crate::Describe, PdError> {
+            self.f.describe(addr)
+        }
+        fn read(&mut self, addr: Addr) -> Result<i64, PdError> {
+            self.f.read(addr)
+        }
+        fn write(&mut self, addr: Addr, value: i64, cyclic: bool) -> Result<Completion, PdError> {
+            self.f.write(addr, value, cyclic)
+        }
+    }
+
+    impl SlotAccess for Handled {
+        type Handle = usize;
+        fn resolve(&mut self, _dir: Dir, addr: Addr) -> Option<usize> {
+            self.f.objs.iter().position(|o| o.addr == addr)
+        }
+        fn write_handle(&mut self, h: usize, addr: Addr, value: i64) -> Result<Completion, PdError> {
+            let a = self
+                .f
+                .objs
+                .get(h)
+                .map(|o| o.addr)
+                .ok_or(PdError::IMPERMISSIBLE_PNU)?;
+            assert_eq!(a, addr, "the handle stands for its address");
+            self.by_handle.push(addr);
+            self.f.write(addr, value, true)
+        }
+        fn read_handle(&mut self, h: usize, addr: Addr) -> Result<i64, PdError> {
+            let a = self
+                .f
+                .objs
+                .get(h)
+                .map(|o| o.addr)
+                .ok_or(PdError::IMPERMISSIBLE_PNU)?;
+            assert_eq!(a, addr, "the handle stands for its address");
+            self.by_handle.push(addr);
+            self.f.read(addr)
+        }
+    }
+
+    /// Issue 36, P-067, P-074: the compiled telegrams write and read through
+    /// their handles with the address path's bytes, writes and outcome;
+    /// handles compiled for other layouts (a telegram reconfigured, another
+    /// instance) are not used.
+    #[test]
+    fn issue36_p067_compiled_telegrams_answer_as_the_address_path() {
+        let mut a = Handled {
+            f: Fake::drive(),
+            by_handle: Vec::new(),
+        };
+        let mut b = Fake::drive();
+        let mut ta = Telegrams::with_defaults(&a).unwrap();
+        let mut tb = ta.clone();
+        let mut compiled = Compiled::new();
+        assert!(!compiled.is_for(&ta));
+        compiled.compile(&ta, &mut a);
+        assert!(
+            compiled.is_for(&ta) && compiled.is_for(&tb),
+            "a clone has the same layouts"
+        );
+        let mut frame = [0u8; 36];
+        frame[0] = 0xE0;
+        frame[1] = 3;
+        frame[2..4].copy_from_slice(&0x047Fu16.to_be_bytes());
+        frame[4..8].copy_from_slice(&(-5000i32).to_be_bytes());
+        frame[32..36].copy_from_slice(&77i32.to_be_bytes());
+        let ra = ta.apply_receive_compiled(&frame, &mut a, &compiled);
+        let rb = tb.apply_receive(&frame, &mut b);
+        assert_eq!(ra, rb);
+        assert_eq!(a.f.writes, b.writes);
+        assert!(a.by_handle.contains(&Addr::new(1001, 0)), "{:?}", a.by_handle);
+        let (mut oa, mut ob) = ([0u8; 36], [0u8; 36]);
+        let xa = ta.build_response_compiled(0, &mut a, [1; 8], &mut oa, &compiled);
+        let xb = tb.build_response(0, &mut b, [1; 8], &mut ob);
+        assert_eq!((xa, oa), (xb, ob));
+        assert!(a.by_handle.contains(&Addr::new(1100, 0)));
+        // reconfigured: a new stamp, the handles are stale until compiled
+        ta.configure(&super::super::FB_DEFAULTS, &a).unwrap();
+        assert!(!compiled.is_for(&ta));
+        a.by_handle.clear();
+        let ra = ta.apply_receive_compiled(&frame, &mut a, &compiled);
+        assert_eq!(ra.telegram, Some(0));
+        assert!(a.by_handle.is_empty(), "the address path: {:?}", a.by_handle);
+        // another instance configured alike has its own stamp
+        let other = Telegrams::with_defaults(&b).unwrap();
+        assert!(!compiled.is_for(&other));
+        compiled.compile(&ta, &mut a);
+        assert!(compiled.is_for(&ta));
+        compiled.clear();
+        assert!(!compiled.is_for(&ta));
+    }
+}
