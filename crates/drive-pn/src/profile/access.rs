@@ -275,8 +275,27 @@ impl DriveAccess<'_> {
             .map_err(pd_error)
     }
 
-    /// Bus units → the object's units.
-    fn object_of(&mut self, unit: Unit, bus: i64) -> Result<i64, PdError> {
+    /// Bus units → the object's units (remembered per configuration
+    /// generation, [`UnitsCache::converted`]).
+    pub(super) fn object_of(&mut self, unit: Unit, bus: i64) -> Result<i64, PdError> {
+        if unit == Unit::None {
+            return Ok(bus);
+        }
+        let (g, axis, code) = (
+            self.objects.config_generation(),
+            self.axis.index(),
+            unit as u8 + 1,
+        );
+        if let Some(v) = self.user_units.converted(g, axis, code, bus) {
+            return Ok(v);
+        }
+        let v = self.convert(unit, bus)?;
+        self.user_units.remember(g, axis, code, bus, v);
+        Ok(v)
+    }
+
+    /// [`object_of`](Self::object_of) computed.
+    pub(super) fn convert(&mut self, unit: Unit, bus: i64) -> Result<i64, PdError> {
         let range = PdError::LIMIT_EXCEEDED;
         let p = self.units;
         Ok(match unit {

@@ -259,7 +259,10 @@ impl Profile {
     /// setting that does not raises 22-4 and the units stay.
     fn refresh_units(&mut self, objects: &DriveObjects, axis: &mut Axis) {
         match self.unit_choice.refresh(objects) {
-            Ok(Some(u)) => self.units = u,
+            Ok(Some(u)) => {
+                self.units = u;
+                self.user_units.forget_conversions();
+            }
             Ok(None) => {}
             Err(_) => axis.raise_event(unit_choice::UNIT_OVERFLOW),
         }

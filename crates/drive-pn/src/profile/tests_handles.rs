@@ -283,3 +283,73 @@ fn issue36_handles_follow_the_axis() {
     let at = usize::from(at);
     assert_eq!(i16::from_be_bytes([out[at], out[at + 1]]), 22, "6077h of axis B");
 }
+
+/// Issue 36, P-208…P-213 (A279): a remembered conversion answers as the
+/// conversion computed, for every unit and values around the 32-bit limits,
+/// after a unit change, and when the units change without a configuration
+/// change (A279 stored before the profile was made: its first look at A279
+/// changes the units at the same generation).
+#[test]
+fn issue36_p208_remembered_conversions_answer_as_computed() {
+    use super::access::DriveAccess;
+    use super::pnu::Unit;
+    use drive_core::NoLive;
+    let mut od = DriveObjects::new();
+    od.set(A279, 1, 0x0101).unwrap();
+    let mut axis = Axis::new(0);
+    let mut profile = Profile::new(&mut od, &axis);
+    let values = [
+        0i64,
+        1,
+        -1,
+        5000,
+        -20_000,
+        1 << 20,
+        i64::from(i32::MAX),
+        i64::from(i32::MIN),
+        i64::from(u32::MAX),
+    ];
+    let units = [
+        Unit::Position,
+        Unit::Velocity,
+        Unit::Acceleration,
+        Unit::Rpm,
+        Unit::RpmPerSecond,
+    ];
+    let check = |profile: &mut Profile, od: &mut DriveObjects, axis: &Axis| {
+        let p = profile;
+        let mut access = drive_access!(p, od, axis, &mut NoLive);
+        for round in 0..2 {
+            for unit in units {
+                for &bus in &values {
+                    let computed = access.convert(unit, bus);
+                    assert_eq!(access.object_of(unit, bus), computed, "{unit:?} {bus} {round}");
+                }
+            }
+        }
+    };
+    // the default units until the profile looks at A279
+    check(&mut profile, &mut od, &axis);
+    let one = |profile: &mut Profile, od: &mut DriveObjects, axis: &Axis| {
+        let p = profile;
+        let mut access = drive_access!(p, od, axis, &mut NoLive);
+        (
+            access.object_of(Unit::Position, 3600),
+            access.convert(Unit::Position, 3600),
+        )
+    };
+    let (before, _) = one(&mut profile, &mut od, &axis);
+    let g = od.config_generation();
+    profile.prepare(None, &mut od, &mut axis);
+    assert_eq!(od.config_generation(), g, "no configuration change");
+    assert_ne!(profile.units(), &motion::units::UnitProfile::default_profile());
+    let (remembered, computed) = one(&mut profile, &mut od, &axis);
+    assert_eq!(remembered, computed, "the units changed: forgotten");
+    assert_ne!(remembered, before, "1/10 degree");
+    check(&mut profile, &mut od, &axis);
+    for (sub, code) in [(2, 0x1001), (1, 0x0203), (3, 0x1002)] {
+        od.set(A279, sub, code).unwrap();
+        profile.prepare(None, &mut od, &mut axis);
+        check(&mut profile, &mut od, &axis);
+    }
+}
