@@ -4,8 +4,8 @@
 //! (P-045, P-194: in the CiA 402 factor group's units), both through the
 //! core's object dictionary with its access, range and state checks.
 
-use super::lookup::{self, Core, CoreSlots, PreparedCache};
-use super::pnu::{Jog, RecordField, Source, Unit};
+use super::lookup::{self, Core, CoreSlots, Handle, PreparedCache, WrittenConfig};
+use super::pnu::{Jog, Pnu, RecordField, Source, Unit};
 use super::units::{self, UnitsCache};
 use drive_core::axis::Axis;
 use drive_core::faults::E82_INACTIVE;
@@ -15,6 +15,8 @@ use drive_core::user_units::UserUnits;
 use drive_core::{DriveObjects, LiveValues};
 use motion::units::UnitProfile;
 use od::{CommState, DataType, Dictionary, SdoAbort};
+use profidrive::telegram::compiled::SlotAccess;
+use profidrive::telegram::Dir;
 use profidrive::{Addr, Completion, Describe, ParamAccess, PdError};
 use profinet::model;
 
@@ -120,12 +122,15 @@ pub struct DriveAccess<'a> {
     pub units: &'a UnitProfile,
     /// The axis' CiA 402 user units, read once per configuration
     /// generation.
-    pub user_units: &'a UnitsCache,
+    pub user_units: &'a mut UnitsCache,
     /// The CiA 402 entries accessed, prepared once per configuration
     /// generation.
     pub prepared: &'a mut PreparedCache,
     /// The core entries the profile reads itself, resolved.
     pub core: &'a CoreSlots,
+    /// The configuration entries the telegram wrote last, with the
+    /// configuration generation after the write (issue 36).
+    pub written: &'a mut WrittenConfig,
     /// The profile's own values.
     pub own: &'a mut OwnValues,
     /// The provider of the live entries a parameter access reaches (the
@@ -188,7 +193,7 @@ impl DriveAccess<'_> {
         }
     }
 
-    fn user_units(&self) -> UserUnits {
+    fn user_units(&mut self) -> &UserUnits {
         self.user_units.get(self.objects, self.axis)
     }
 
@@ -261,6 +266,7 @@ impl DriveAccess<'_> {
             }
             None => self.entry(index, sub)?.data_type,
         };
+        self.written.unprepared = true;
         fits(t)?;
         let data = bytes.get(..size(t)).ok_or(PdError::INCORRECT_DATA_TYPE)?;
         self.objects
@@ -269,8 +275,27 @@ impl DriveAccess<'_> {
             .map_err(pd_error)
     }
 
-    /// Bus units → the object's units.
-    fn to_object(&self, unit: Unit, bus: i64) -> Result<i64, PdError> {
+    /// Bus units → the object's units (remembered per configuration
+    /// generation, [`UnitsCache::converted`]).
+    pub(super) fn object_of(&mut self, unit: Unit, bus: i64) -> Result<i64, PdError> {
+        if unit == Unit::None {
+            return Ok(bus);
+        }
+        let (g, axis, code) = (
+            self.objects.config_generation(),
+            self.axis.index(),
+            unit as u8 + 1,
+        );
+        if let Some(v) = self.user_units.converted(g, axis, code, bus) {
+            return Ok(v);
+        }
+        let v = self.convert(unit, bus)?;
+        self.user_units.remember(g, axis, code, bus, v);
+        Ok(v)
+    }
+
+    /// [`object_of`](Self::object_of) computed.
+    pub(super) fn convert(&mut self, unit: Unit, bus: i64) -> Result<i64, PdError> {
         let range = PdError::LIMIT_EXCEEDED;
         let p = self.units;
         Ok(match unit {
@@ -282,24 +307,24 @@ impl DriveAccess<'_> {
             // the integer path: exact to the increment (f32 is not, above 2^24)
             Unit::Velocity => {
                 let inc = units::from_bus(&p.velocity, bus).map_err(|_| range)?;
-                units::velocity_from_increments(&self.user_units(), inc)
+                units::velocity_from_increments(self.user_units(), inc)
             }
             Unit::Acceleration => {
                 let inc = units::from_bus(&p.acceleration, bus).map_err(|_| range)?;
-                units::acceleration_from_increments(&self.user_units(), inc)
+                units::acceleration_from_increments(self.user_units(), inc)
             }
             Unit::Rpm => units::rpm_of(units::from_bus(&p.velocity, bus).map_err(|_| range)?),
             Unit::RpmPerSecond => units::rpm_of(units::from_bus(&p.acceleration, bus).map_err(|_| range)?),
         })
     }
 
-    /// [`Self::to_object`] for a write of `index`:`sub`, where the bus value a
+    /// [`Self::object_of`] for a write of `index`:`sub`, where the bus value a
     /// read of the type's limit returns writes that limit: a value read can
     /// be written back although its rounding lands just beyond the type
     /// (PNU 1273's default `u32::MAX` increments reads 4 096 000/1000 rev,
     /// which converts to 2^32 increments).
     fn object_value_read_back(&mut self, unit: Unit, bus: i64, index: u16, sub: u8) -> Result<i64, PdError> {
-        let v = self.to_object(unit, bus)?;
+        let v = self.object_of(unit, bus)?;
         // the data type from the prepared access where there is one (the
         // write after this uses it): no lookup in the dictionary's tables
         let t = match self.prepared.get(self.objects, index, sub) {
@@ -307,17 +332,17 @@ impl DriveAccess<'_> {
             None => self.entry(index, sub)?.data_type,
         };
         let (min, max) = type_limits(t);
-        if v > max && self.to_bus(unit, max) == Ok(bus) {
+        if v > max && self.bus_of(unit, max) == Ok(bus) {
             return Ok(max);
         }
-        if v < min && self.to_bus(unit, min) == Ok(bus) {
+        if v < min && self.bus_of(unit, min) == Ok(bus) {
             return Ok(min);
         }
         Ok(v)
     }
 
     /// The object's units → bus units.
-    fn to_bus(&self, unit: Unit, object: i64) -> Result<i64, PdError> {
+    fn bus_of(&mut self, unit: Unit, object: i64) -> Result<i64, PdError> {
         let range = PdError::LIMIT_EXCEEDED;
         let p = self.units;
         let v = match unit {
@@ -328,11 +353,11 @@ impl DriveAccess<'_> {
             }
             Unit::Velocity => units::to_bus(
                 &p.velocity,
-                units::velocity_to_increments(&self.user_units(), object),
+                units::velocity_to_increments(self.user_units(), object),
             ),
             Unit::Acceleration => units::to_bus(
                 &p.acceleration,
-                units::acceleration_to_increments(&self.user_units(), object),
+                units::acceleration_to_increments(self.user_units(), object),
             ),
             Unit::Rpm => units::to_bus(&p.velocity, units::increments_of_rpm(object)),
             Unit::RpmPerSecond => units::to_bus(&p.acceleration, units::increments_of_rpm(object)),
@@ -350,9 +375,19 @@ impl DriveAccess<'_> {
 
     /// Stores the record the last field writes left pending (and shows it
     /// when the window J401 shows it), as each of those writes did before.
+    #[inline(always)]
     pub fn flush_record(&mut self) {
-        // compared where it is, not moved out (`take`): every read and
-        // every other write asks (issue 36)
+        // the test inline, the store out of line: every read and every
+        // other write asks, mostly with nothing pending (issue 36)
+        if self.pending.is_some() {
+            self.store_pending();
+        }
+    }
+
+    /// [`flush_record`](Self::flush_record) of a pending record.
+    #[inline(never)]
+    fn store_pending(&mut self) {
+        // compared where it is, not moved out (`take`)
         let Some((axis, n, _, r, read)) = &self.pending else {
             return;
         };
@@ -377,7 +412,7 @@ impl DriveAccess<'_> {
             RecordField::Acceleration | RecordField::BothAccelerations => i64::from(r.acceleration),
             RecordField::Deceleration => i64::from(r.deceleration),
         };
-        self.to_bus(unit, v)
+        self.bus_of(unit, v)
     }
 
     fn write_record(
@@ -387,7 +422,7 @@ impl DriveAccess<'_> {
         unit: Unit,
         bus: i64,
     ) -> Result<(), PdError> {
-        let value = self.to_object(unit, bus)?;
+        let value = self.object_of(unit, bus)?;
         let numbers: &[u16] = match jog {
             Some(Jog::Both) => &[JOG_POSITIVE, JOG_NEGATIVE],
             _ => &[0],
@@ -505,18 +540,123 @@ impl ParamAccess for DriveAccess<'_> {
                 lookup::find_and_remember(addr)?
             }
         };
+        self.read_pnu(p, addr)
+    }
+
+    fn write(&mut self, addr: Addr, value: i64, _cyclic: bool) -> Result<Completion, PdError> {
+        // every write here is a RAM write: the store is written only by a save
+        let p = match lookup::memoised(addr) {
+            Some(p) => p,
+            None => {
+                if !lookup::is_catalogue_index(addr.index) {
+                    self.flush_record();
+                    let index = self.index(addr.index);
+                    self.write_object(index, addr.sub, value)?;
+                    return Ok(Completion::Done);
+                }
+                lookup::find_and_remember(addr)?
+            }
+        };
+        self.write_pnu(p, addr, value)
+    }
+
+    fn poll_write(&mut self, addr: Addr) -> Result<Completion, PdError> {
+        if addr == Addr::new(971, 0) && self.own.saving {
+            return Ok(Completion::Pending);
+        }
+        if addr.index == super::telegram_config::SELECT || addr.index == super::telegram_config::APPLY {
+            return self.own.edit.poll();
+        }
+        Ok(Completion::Done)
+    }
+}
+
+impl SlotAccess for DriveAccess<'_> {
+    type Handle = Handle;
+
+    fn resolve(&mut self, dir: Dir, addr: Addr) -> Option<Handle> {
+        let config = dir == Dir::Receive && self.is_config_entry(addr);
+        if lookup::is_catalogue_index(addr.index) {
+            // an address the catalogue does not hold: the address path
+            // answers its error
+            Handle::pnu(lookup::position(addr).ok()?, config)
+        } else {
+            Handle::object(config)
+        }
+    }
+
+    fn write_handle(&mut self, h: Handle, addr: Addr, value: i64) -> Result<Completion, PdError> {
+        if h.is_config() {
+            return self.write_config(h, addr, value);
+        }
+        self.write_resolved(h, addr, value)
+    }
+
+    fn read_handle(&mut self, h: Handle, addr: Addr) -> Result<i64, PdError> {
+        self.flush_record();
+        match h.entry() {
+            Some(p) => self.read_pnu(p, addr),
+            None => {
+                let index = self.index(addr.index);
+                self.read_object(index, addr.sub)
+            }
+        }
+    }
+}
+
+impl DriveAccess<'_> {
+    /// [`SlotAccess::write_handle`] of a configuration entry (out of line:
+    /// the other entries' path stays as short as it was).
+    #[inline(never)]
+    fn write_config(&mut self, h: Handle, addr: Addr, value: i64) -> Result<Completion, PdError> {
+        // a configuration entry (telegram 1's ramps): the same value
+        // written before with no configuration change since left its
+        // objects as this write would (every change of a configuration
+        // value moves the generation) and was taken (the checks of a
+        // prepared write depend on the value and the configuration only)
+        let key = WrittenConfig::key(self.axis.index(), addr);
+        if self.written.holds(key, value, self.objects.config_generation()) {
+            self.flush_record();
+            return Ok(Completion::Done);
+        }
+        self.written.unprepared = false;
+        let r = self.write_resolved(h, addr, value);
+        if r == Ok(Completion::Done) && !self.written.unprepared {
+            self.written.put(key, value, self.objects.config_generation());
+        }
+        r
+    }
+
+    /// [`SlotAccess::write_handle`] without the memo of configuration
+    /// entries.
+    #[inline(always)]
+    fn write_resolved(&mut self, h: Handle, addr: Addr, value: i64) -> Result<Completion, PdError> {
+        match h.entry() {
+            Some(p) => self.write_pnu(p, addr, value),
+            None => {
+                self.flush_record();
+                let index = self.index(addr.index);
+                self.write_object(index, addr.sub, value)?;
+                Ok(Completion::Done)
+            }
+        }
+    }
+
+    /// [`ParamAccess::read`] of the catalogue entry `p` (`addr`), the
+    /// pending record stored.
+    fn read_pnu(&mut self, p: &'static Pnu, addr: Addr) -> Result<i64, PdError> {
         match p.source {
             Source::Object { index, sub } => {
                 let index = self.index(index);
                 let v = self.read_object(index, sub)?;
-                self.to_bus(p.unit, v)
+                self.bus_of(p.unit, v)
             }
             Source::SelectedRecord(f) => self.read_record(None, f, p.unit),
             Source::JogRecord(j, f) => self.read_record(Some(j), f, p.unit),
             Source::VlBothRamps => {
                 let index = self.index(0x6048);
                 let v = self.read_object(index, 1)?;
-                self.to_bus(p.unit, v)
+                self.bus_of(p.unit, v)
             }
             Source::Cw1 => Ok(i64::from(self.own.cw1)),
             Source::Zsw1 => Ok(i64::from(self.own.zsw1)),
@@ -539,20 +679,8 @@ impl ParamAccess for DriveAccess<'_> {
         }
     }
 
-    fn write(&mut self, addr: Addr, value: i64, _cyclic: bool) -> Result<Completion, PdError> {
-        // every write here is a RAM write: the store is written only by a save
-        let p = match lookup::memoised(addr) {
-            Some(p) => p,
-            None => {
-                if !lookup::is_catalogue_index(addr.index) {
-                    self.flush_record();
-                    let index = self.index(addr.index);
-                    self.write_object(index, addr.sub, value)?;
-                    return Ok(Completion::Done);
-                }
-                lookup::find_and_remember(addr)?
-            }
-        };
+    /// [`ParamAccess::write`] of the catalogue entry `p` (`addr`).
+    fn write_pnu(&mut self, p: &'static Pnu, addr: Addr, value: i64) -> Result<Completion, PdError> {
         if !matches!(p.source, Source::SelectedRecord(_) | Source::JogRecord(..)) {
             self.flush_record();
         }
@@ -568,7 +696,7 @@ impl ParamAccess for DriveAccess<'_> {
             Source::SelectedRecord(f) => self.write_record(None, f, p.unit, value)?,
             Source::JogRecord(j, f) => self.write_record(Some(j), f, p.unit, value)?,
             Source::VlBothRamps => {
-                let v = self.to_object(p.unit, value)?;
+                let v = self.object_of(p.unit, value)?;
                 for i in [0x6048, 0x6049] {
                     let index = self.index(i);
                     self.write_object(index, 1, v)?;
@@ -625,16 +753,6 @@ impl ParamAccess for DriveAccess<'_> {
             Source::Zsw1 | Source::DigitalInputs | Source::LastError | Source::Identification => {
                 return Err(PdError::CANNOT_CHANGE)
             }
-        }
-        Ok(Completion::Done)
-    }
-
-    fn poll_write(&mut self, addr: Addr) -> Result<Completion, PdError> {
-        if addr == Addr::new(971, 0) && self.own.saving {
-            return Ok(Completion::Pending);
-        }
-        if addr.index == super::telegram_config::SELECT || addr.index == super::telegram_config::APPLY {
-            return self.own.edit.poll();
         }
         Ok(Completion::Done)
     }

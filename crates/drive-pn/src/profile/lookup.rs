@@ -7,6 +7,7 @@
 //! looked up and checked by the dictionary at each access.
 
 use super::pnu::{self, Pnu};
+use core::num::NonZeroU16;
 use core::sync::atomic::{AtomicU32, Ordering};
 use drive_core::axis::Axis;
 use drive_core::{DriveObjects, Prepared, Slot};
@@ -40,6 +41,12 @@ pub fn find(addr: Addr) -> Result<&'static Pnu, PdError> {
     pnu::CATALOGUE.get(i).ok_or(PdError::IMPERMISSIBLE_PNU)
 }
 
+/// [`find`]'s position of `addr` in [`pnu::CATALOGUE`] (a telegram's
+/// handle, issue 36).
+pub fn position(addr: Addr) -> Result<usize, PdError> {
+    find_at(addr)
+}
+
 /// [`find`]'s position of `addr` in the catalogue.
 fn find_at(addr: Addr) -> Result<usize, PdError> {
     let c = pnu::CATALOGUE;
@@ -57,6 +64,111 @@ fn find_at(addr: Addr) -> Result<usize, PdError> {
     } else {
         PdError::IMPERMISSIBLE_PNU
     })
+}
+
+/// A telegram entry resolved where the telegrams are configured or
+/// prepared for (issue 36, [`profidrive::telegram::compiled`]): the
+/// cyclic path reads and writes it without the catalogue's memo and the
+/// catalogue-index test. Two bytes (80 slots): the low 15 bits a catalogue
+/// entry's position in [`pnu::CATALOGUE`] plus one, or all ones for a
+/// CANopen object outside the catalogue (its index mapped to the axis at
+/// the access, as the address path does); bit 15 set for an entry of a
+/// receive telegram whose write is a configuration change
+/// ([`super::access::DriveAccess::is_config_entry`]).
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub struct Handle(NonZeroU16);
+
+impl Handle {
+    /// A CANopen object outside the catalogue.
+    const OBJECT: u16 = 0x7FFF;
+    /// The configuration-entry flag.
+    const CONFIG: u16 = 0x8000;
+
+    fn new(v: u16, config: bool) -> Option<Handle> {
+        NonZeroU16::new(if config { v | Self::CONFIG } else { v }).map(Handle)
+    }
+
+    /// The handle of the catalogue entry at `i`.
+    pub fn pnu(i: usize, config: bool) -> Option<Handle> {
+        let v = u16::try_from(i.checked_add(1)?).ok()?;
+        if v >= Self::OBJECT {
+            return None;
+        }
+        Self::new(v, config)
+    }
+
+    /// The handle of an object outside the catalogue.
+    pub fn object(config: bool) -> Option<Handle> {
+        Self::new(Self::OBJECT, config)
+    }
+
+    /// The catalogue entry, `None` for an object.
+    pub fn entry(self) -> Option<&'static Pnu> {
+        match self.0.get() & Self::OBJECT {
+            Self::OBJECT => None,
+            v => pnu::CATALOGUE.get(usize::from(v).checked_sub(1)?),
+        }
+    }
+
+    /// A receive entry whose write is a configuration change.
+    pub fn is_config(self) -> bool {
+        self.0.get() & Self::CONFIG != 0
+    }
+}
+
+/// Places of [`WrittenConfig`] (telegram 1 has one configuration entry).
+const WRITTEN: usize = 2;
+
+/// The configuration entries a receive telegram wrote last through their
+/// handles, each with the bus value and the configuration generation after
+/// the write (issue 36): the same value again at the same generation is
+/// written already (telegram 1's ramps, four prepared writes, every
+/// telegram).
+#[derive(Debug, Clone, Copy, Default)]
+pub struct WrittenConfig {
+    /// `(key, value, generation)`, key 0 = free.
+    places: [(u32, i64, u32); WRITTEN],
+    next: u8,
+    /// A write since this was cleared took the dictionary's full path (no
+    /// prepared access): its answer may depend on more than the value and
+    /// the configuration, it is not remembered.
+    pub unprepared: bool,
+}
+
+impl WrittenConfig {
+    /// Empty.
+    pub const fn new() -> Self {
+        Self {
+            places: [(0, 0, 0); WRITTEN],
+            next: 0,
+            unprepared: false,
+        }
+    }
+
+    /// The key of `addr` on axis `axis` (never 0).
+    pub fn key(axis: u8, addr: Addr) -> u32 {
+        1 << 31 | u32::from(axis & 0x7F) << 24 | key(addr)
+    }
+
+    /// `value` was written to `key` and the generation is still `g`.
+    pub fn holds(&self, key: u32, value: i64, g: u32) -> bool {
+        self.places.contains(&(key, value, g))
+    }
+
+    /// `value` written to `key`, the generation `g` after it.
+    pub fn put(&mut self, key: u32, value: i64, g: u32) {
+        let at = match self.places.iter().position(|p| p.0 == key) {
+            Some(at) => at,
+            None => {
+                let at = usize::from(self.next) % WRITTEN;
+                self.next = (at + 1) as u8;
+                at
+            }
+        };
+        if let Some(p) = self.places.get_mut(at) {
+            *p = (key, value, g);
+        }
+    }
 }
 
 /// Places of the memo of catalogue entries found (a power of two).

@@ -34,10 +34,11 @@ pub mod units;
 use access::{DriveAccess, OwnValues};
 use drive_core::axis::{Axis, RecordCommand};
 use drive_core::{DriveObjects, LiveValues, NoLive};
-use lookup::{Core, CoreSlots, PreparedCache};
+use lookup::{Core, CoreSlots, Handle, PreparedCache, WrittenConfig};
 use motion::units::UnitProfile;
 use profidrive::cw1::{Context, Cw1Decoder, Mode, ModeCommands};
 use profidrive::pkw::Pkw;
+use profidrive::telegram::compiled::Compiled;
 use profidrive::telegram::{ModeBinding, Telegrams, MAX_TELEGRAM_BYTES};
 use units::UnitsCache;
 
@@ -49,9 +50,10 @@ macro_rules! drive_access {
             objects: $objects,
             axis: $axis,
             units: &$p.units,
-            user_units: &$p.user_units,
+            user_units: &mut $p.user_units,
             prepared: &mut $p.prepared,
             core: &$p.core,
+            written: &mut $p.written,
             own: &mut $p.own,
             live: $live,
             pending: None,
@@ -86,6 +88,12 @@ pub struct Profile {
     /// The configuration generation [`prepare`](Self::prepare) last
     /// brought the units and prepared accesses to.
     prepared_at: Option<u32>,
+    /// The telegrams' entries resolved into handles (issue 36), compiled
+    /// where the telegrams are configured and in [`prepare`](Self::prepare)
+    /// when the layouts changed.
+    handles: Compiled<Handle>,
+    /// The configuration entries the telegram wrote last (issue 36).
+    written: WrittenConfig,
 }
 
 impl Profile {
@@ -110,6 +118,8 @@ impl Profile {
             homing: false,
             warnings: 0,
             prepared_at: None,
+            handles: Compiled::new(),
+            written: WrittenConfig::new(),
         };
         let access = drive_access!(p, objects, axis, &mut NoLive);
         // the stored configuration (A280, P-069), else the FB's
@@ -126,7 +136,24 @@ impl Profile {
         if let Some(t) = &p.telegrams {
             p.own.edit = telegram_config::TelegramEdit::of(t.set());
         }
+        p.compile_handles(objects, axis);
         p
+    }
+
+    /// The telegrams' entries resolved into handles when the layouts
+    /// changed since they were (a compare otherwise): where the telegrams
+    /// are configured and where the next cycle is prepared, not in the
+    /// control cycle (issue 36). A handle holds no axis (an object's index
+    /// is mapped at the access, as on the address path).
+    fn compile_handles(&mut self, objects: &mut DriveObjects, axis: &Axis) {
+        let Some(telegrams) = self.telegrams.as_ref() else {
+            return;
+        };
+        if self.handles.is_for(telegrams) {
+            return;
+        }
+        let mut access = drive_access!(self, objects, axis, &mut NoLive);
+        self.handles.compile(telegrams, &mut access);
     }
 
     /// Whether the telegram configuration took (the catalogue holds every
@@ -228,13 +255,17 @@ impl Profile {
             self.prepared.refresh(objects);
             self.prepared_at = Some(g);
         }
+        self.compile_handles(objects, axis);
     }
 
     /// The unit choices A279 (P-212): new units once they convert; a
     /// setting that does not raises 22-4 and the units stay.
     fn refresh_units(&mut self, objects: &DriveObjects, axis: &mut Axis) {
         match self.unit_choice.refresh(objects) {
-            Ok(Some(u)) => self.units = u,
+            Ok(Some(u)) => {
+                self.units = u;
+                self.user_units.forget_conversions();
+            }
             Ok(None) => {}
             Err(_) => axis.raise_event(unit_choice::UNIT_OVERFLOW),
         }
@@ -262,7 +293,7 @@ impl Profile {
         self.core.resolve(objects, axis);
         let core = &self.core;
         let mut access = drive_access!(self, objects, axis, live);
-        let rx = telegrams.apply_receive(frame, &mut access);
+        let rx = telegrams.apply_receive_compiled(frame, &mut access, &self.handles);
         // the telegram's record fields stored before anything reads them
         access.flush_record();
         if !rx.warnings.is_empty() {
@@ -435,7 +466,8 @@ impl Profile {
         // straight into the module's data (the telegram is cut to it or
         // zero-padded up to it)
         let len = buf.len().min(MAX_TELEGRAM_BYTES);
-        let tx = telegrams.build_response(n, &mut access, self.pkw_response, buf.get_mut(..len)?)?;
+        let out = buf.get_mut(..len)?;
+        let tx = telegrams.build_response_compiled(n, &mut access, self.pkw_response, out, &self.handles)?;
         if !tx.warnings.is_empty() {
             self.warnings = self.warnings.saturating_add(1);
         }
@@ -447,3 +479,5 @@ impl Profile {
 mod pnu_doc;
 #[cfg(test)]
 mod tests;
+#[cfg(test)]
+mod tests_handles;

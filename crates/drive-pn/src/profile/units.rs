@@ -7,7 +7,6 @@
 //! the arguments they do not cover). On a Cortex-M4F a 128-bit division or
 //! an `f64` operation is a library call of hundreds of instructions.
 
-use core::cell::Cell;
 use drive_core::axis::Axis;
 use drive_core::user_units::UserUnits;
 use drive_core::DriveObjects;
@@ -18,27 +17,75 @@ use motion::INCREMENTS_PER_REVOLUTION;
 /// ([`DriveObjects::config_generation`]) they were read at: any change of a
 /// factor-group object (6091h, 6092h, 607Eh, A213, A310/A311) moves the
 /// generation, so the next conversion reads them again. One cache serves
-/// one dictionary.
+/// one dictionary. Lent by reference, not copied out (issue 36: the copy
+/// of a `Cell` cost every converted telegram entry some 40 instructions on
+/// QEMU).
+///
+/// With them a memo of the bus → object conversions done
+/// ([`converted`](Self::converted)): a conversion depends on the PROFINET
+/// units, which change with the configuration generation only (and are
+/// forgotten when they do, [`forget_conversions`](Self::forget_conversions)),
+/// the user units and the value (issue 36: telegram 0 converts the same five
+/// record values every telegram).
 #[derive(Debug, Default)]
-pub struct UnitsCache(Cell<Option<(u32, u8, UserUnits)>>);
+pub struct UnitsCache {
+    cached: Option<(u32, u8, UserUnits)>,
+    /// `(generation, bus, object, axis, unit code)`, unit code 0 = free;
+    /// values that fit 32 bits only.
+    converted: [(u32, i32, i32, u8, u8); CONVERTED],
+    next: u8,
+}
+
+/// Places of the conversion memo (telegram 0 converts five values).
+const CONVERTED: usize = 5;
 
 impl UnitsCache {
     /// An empty cache (the first use reads the objects).
     pub const fn new() -> Self {
-        Self(Cell::new(None))
+        Self {
+            cached: None,
+            converted: [(0, 0, 0, 0, 0); CONVERTED],
+            next: 0,
+        }
+    }
+
+    /// The object value `bus` converted to, in unit `unit` (a code, never
+    /// 0) on `axis` at generation `g`, when remembered.
+    pub fn converted(&self, g: u32, axis: u8, unit: u8, bus: i64) -> Option<i64> {
+        let bus = i32::try_from(bus).ok()?;
+        self.converted
+            .iter()
+            .find(|c| c.0 == g && c.1 == bus && c.3 == axis && c.4 == unit)
+            .map(|c| i64::from(c.2))
+    }
+
+    /// Remembers a conversion ([`converted`](Self::converted)).
+    pub fn remember(&mut self, g: u32, axis: u8, unit: u8, bus: i64, object: i64) {
+        let (Ok(bus), Ok(object)) = (i32::try_from(bus), i32::try_from(object)) else {
+            return;
+        };
+        let at = usize::from(self.next) % CONVERTED;
+        self.next = (at + 1) as u8;
+        if let Some(c) = self.converted.get_mut(at) {
+            *c = (g, bus, object, axis, unit);
+        }
+    }
+
+    /// Forgets the conversions (the PROFINET units changed).
+    pub fn forget_conversions(&mut self) {
+        self.converted = [(0, 0, 0, 0, 0); CONVERTED];
     }
 
     /// The user units of `axis` as its objects say now.
-    pub fn get(&self, objects: &DriveObjects, axis: &Axis) -> UserUnits {
+    pub fn get(&mut self, objects: &DriveObjects, axis: &Axis) -> &UserUnits {
         let generation = objects.config_generation();
-        match self.0.get() {
-            Some((g, a, u)) if g == generation && a == axis.index() => u,
-            _ => {
-                let u = UserUnits::read(objects, axis);
-                self.0.set(Some((generation, axis.index(), u)));
-                u
-            }
+        let cached = &mut self.cached;
+        if !matches!(cached, Some((g, a, _)) if *g == generation && *a == axis.index()) {
+            *cached = Some((generation, axis.index(), UserUnits::read(objects, axis)));
         }
+        let (_, _, u) =
+            cached.get_or_insert_with(|| (generation, axis.index(), UserUnits::read(objects, axis)));
+        u
     }
 }
 
@@ -317,10 +364,10 @@ mod tests {
     fn p214_the_cache_follows_a_factor_group_change() {
         let mut od = DriveObjects::new();
         let axis = Axis::new(0);
-        let cache = UnitsCache::new();
+        let mut cache = UnitsCache::new();
         assert!(cache.get(&od, &axis).is_identity());
         od.set(0x6092, 1, 1000).unwrap();
-        let u = cache.get(&od, &axis);
+        let u = *cache.get(&od, &axis);
         assert_eq!(u, UserUnits::read(&od, &axis));
         assert!(!u.is_identity());
         od.set(0x6092, 1, 1 << 20).unwrap();

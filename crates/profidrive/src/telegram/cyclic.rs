@@ -121,10 +121,33 @@ impl Live {
     };
 }
 
+/// [`fits`] of `v`, decoded from a slot of type `t` (the slot is the
+/// type's size, [`super::check_entry`]): every integer type's decode is
+/// in its range by construction, only BOOLEAN's byte may be beyond 0/1
+/// (issue 36: the range test of every entry every telegram;
+/// `issue36_a_decoded_entry_fits_its_type`).
+#[inline]
+fn decoded_fits(t: od::DataType, v: i64) -> bool {
+    t != od::DataType::Bool || fits(t, v)
+}
+
 impl Telegrams {
     /// Applies a received frame (the OUT module's data): see the
     /// [module](self) for the order of a cycle.
     pub fn apply_receive(&mut self, frame: &[u8], access: &mut impl ParamAccess) -> RxOutcome {
+        self.receive_through(frame, access, |a, _, _, addr, v| a.write(addr, v, true).is_ok())
+    }
+
+    /// [`apply_receive`](Self::apply_receive) with `write(access, n, i,
+    /// addr, value)` writing the object entries (`n` the telegram, `i` the
+    /// slot's position in its layout): the address path or a compiled
+    /// handle's ([`super::compiled`]).
+    pub(super) fn receive_through<A: ParamAccess>(
+        &mut self,
+        frame: &[u8],
+        access: &mut A,
+        mut write: impl FnMut(&mut A, u8, usize, Addr, i64) -> bool,
+    ) -> RxOutcome {
         let mut out = RxOutcome {
             telegram: None,
             mode: ModeBinding::None,
@@ -160,7 +183,7 @@ impl Telegrams {
             dst.copy_from_slice(src);
             self.live.rx_len = keep as u8;
         }
-        for s in layout.slots() {
+        for (i, s) in layout.slots().iter().enumerate() {
             let at = usize::from(s.offset);
             let Some(bytes) = frame.get(at..at + usize::from(s.size)) else {
                 continue;
@@ -169,17 +192,20 @@ impl Telegrams {
                 Kind::Pad => {}
                 Kind::Cw1 => out.cw1 = Some(decode_be(od::DataType::U16, bytes) as u16),
                 Kind::Pkw => {
-                    // a zip: the slot's size is 8 by construction, which the
-                    // compiler cannot see (no length-mismatch panic path)
-                    let mut p = [0u8; 8];
-                    for (d, b) in p.iter_mut().zip(bytes) {
-                        *d = *b;
-                    }
-                    out.pkw = Some(p);
+                    // the slot's size is 8 by construction, which the
+                    // compiler cannot see: a checked conversion (no panic
+                    // path), one copy instead of a byte loop (issue 36)
+                    out.pkw = Some(<[u8; 8]>::try_from(bytes).unwrap_or_else(|_| {
+                        let mut p = [0u8; 8];
+                        for (d, b) in p.iter_mut().zip(bytes) {
+                            *d = *b;
+                        }
+                        p
+                    }));
                 }
                 Kind::Object(t) => {
                     let v = decode_be(t, bytes);
-                    let ok = fits(t, v) && access.write(s.addr, v, true).is_ok();
+                    let ok = decoded_fits(t, v) && write(access, n, i, s.addr, v);
                     if !ok {
                         out.warnings.0 |= Warnings::ACCESS_REFUSED;
                     }
@@ -237,7 +263,7 @@ impl Telegrams {
                 continue;
             }
             let v = decode_be(t, bytes);
-            if fits(t, v) && access.write(s.addr, v, true).is_ok() {
+            if decoded_fits(t, v) && access.write(s.addr, v, true).is_ok() {
                 written += 1;
             }
         }
@@ -255,6 +281,20 @@ impl Telegrams {
         pkw: [u8; 8],
         buf: &mut [u8],
     ) -> Option<TxOutcome> {
+        self.respond_through(n, access, pkw, buf, |a, _, addr| a.read(addr))
+    }
+
+    /// [`build_response`](Self::build_response) with `read(access, i,
+    /// addr)` reading the entries (`i` the slot's position in the layout):
+    /// the address path or a compiled handle's ([`super::compiled`]).
+    pub(super) fn respond_through<A: ParamAccess>(
+        &mut self,
+        n: u8,
+        access: &mut A,
+        pkw: [u8; 8],
+        buf: &mut [u8],
+        mut read: impl FnMut(&mut A, usize, Addr) -> Result<i64, crate::PdError>,
+    ) -> Option<TxOutcome> {
         // `layout`'s answer, borrowed from the field (not copied: ~150
         // instructions per telegram; issue 36)
         if !self.configured {
@@ -269,19 +309,23 @@ impl Telegrams {
         if let Some(b) = buf.first_mut() {
             *b = Dir::Response.identifier(n);
         }
-        for s in layout.slots() {
+        for (i, s) in layout.slots().iter().enumerate() {
             let at = usize::from(s.offset);
             let Some(dst) = buf.get_mut(at..at + usize::from(s.size)) else {
                 continue;
             };
             match s.kind {
                 Kind::Pad => {}
-                Kind::Pkw => {
-                    for (d, b) in dst.iter_mut().zip(pkw) {
-                        *d = b;
+                Kind::Pkw => match <&mut [u8; 8]>::try_from(&mut *dst) {
+                    // one copy instead of a byte loop (issue 36)
+                    Ok(d) => *d = pkw,
+                    Err(_) => {
+                        for (d, b) in dst.iter_mut().zip(pkw) {
+                            *d = b;
+                        }
                     }
-                }
-                Kind::Cw1 | Kind::Object(_) => match access.read(s.addr) {
+                },
+                Kind::Cw1 | Kind::Object(_) => match read(access, i, s.addr) {
                     Ok(v) => encode_be(v, dst),
                     Err(_) => warnings.0 |= Warnings::ACCESS_REFUSED,
                 },
@@ -342,5 +386,45 @@ impl Telegrams {
                 f(s.addr, s.offset, s.size, decode_be(t, b));
             }
         }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use od::DataType;
+
+    /// Issue 36: a value decoded from a slot of an integer type's size
+    /// fits that type, so only BOOLEAN needs [`fits`]'s test (P-067: a
+    /// BOOLEAN byte beyond 0/1 is refused).
+    #[test]
+    fn issue36_a_decoded_entry_fits_its_type() {
+        let types = [
+            DataType::Bool,
+            DataType::I8,
+            DataType::U8,
+            DataType::I16,
+            DataType::U16,
+            DataType::I32,
+            DataType::U32,
+            DataType::I64,
+            DataType::U64,
+        ];
+        let patterns = [0x00u8, 0x01, 0x02, 0x7F, 0x80, 0xFF, 0x5A];
+        for t in types {
+            let size = crate::int_size(t).unwrap();
+            for &first in &patterns {
+                for &rest in &patterns {
+                    let mut bytes = [rest; 8];
+                    bytes[0] = first;
+                    let v = decode_be(t, &bytes[..size]);
+                    assert_eq!(decoded_fits(t, v), fits(t, v), "{t:?} {bytes:?}");
+                    if t != DataType::Bool {
+                        assert!(fits(t, v), "{t:?} {bytes:?}");
+                    }
+                }
+            }
+        }
+        assert!(!decoded_fits(DataType::Bool, 2));
     }
 }

@@ -28,6 +28,7 @@
 
 use crate::{int_size, Addr, DataType, ParamAccess, PdError};
 
+pub mod compiled;
 pub mod cyclic;
 mod defaults;
 mod serial;
@@ -239,6 +240,10 @@ pub struct Telegrams {
     receive: [Layout; TELEGRAMS],
     response: [Layout; TELEGRAMS],
     live: cyclic::Live,
+    /// The stamp of the layouts in force ([`compiled::stamp`]): a new one
+    /// at every configuration, unique across instances, so handles
+    /// compiled for other layouts are never used (issue 36).
+    stamp: u32,
 }
 
 impl Default for Telegrams {
@@ -256,6 +261,7 @@ impl Telegrams {
             receive: [Layout::EMPTY; TELEGRAMS],
             response: [Layout::EMPTY; TELEGRAMS],
             live: cyclic::Live::NEW,
+            stamp: 0,
         }
     }
 
@@ -306,6 +312,7 @@ impl Telegrams {
         self.response = response;
         self.configured = true;
         self.live = cyclic::Live::NEW;
+        self.stamp = compiled::stamp();
         Ok(())
     }
 
