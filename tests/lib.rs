@@ -151,6 +151,19 @@ pub async fn request<S>(sd: &SubDeviceRef<'_, S>, ctrl: u16) {
         .unwrap_or_else(|e| panic!("read AL status: {e}"));
 }
 
+/// [`request`] `ctrl`, then the AL status and code must be `expected`
+/// (`what`: the case, for the failure's message).
+pub async fn request_gives<S>(sd: &SubDeviceRef<'_, S>, ctrl: u16, expected: (u16, u16), what: &str) {
+    request(sd, ctrl).await;
+    expect_al(sd, expected, what).await;
+}
+
+/// The AL status and code must be `expected` (`what`: the case, for the
+/// failure's message).
+pub async fn expect_al<S>(sd: &SubDeviceRef<'_, S>, expected: (u16, u16), what: &str) {
+    assert_eq!(al_status(sd).await, expected, "{what}");
+}
+
 /// Writes SyncManager `n`'s start, length and control, and enables it.
 pub async fn write_sm<S>(sd: &SubDeviceRef<'_, S>, n: u8, start: u16, len: u16, control: u8) {
     let sm = esc::SyncManager {

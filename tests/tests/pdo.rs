@@ -4,7 +4,8 @@
 //! longer matches the mapping refuses Safe-Op with AL 001Dh.
 
 use drive_tests::al::{ACK, ERR, OP, PREOP, SAFEOP};
-use drive_tests::{al_status, init, line, request, with_master, write_sm, CoeClient};
+use drive_tests::step::sm_set_up;
+use drive_tests::{al_status, init, line, request_gives, with_master, write_sm, CoeClient};
 use ecat::SdoAbort;
 use esc::AlStatusCode;
 
@@ -265,10 +266,8 @@ fn e048_e054_mapping_and_assignment_refused_in_safeop_with_0800_0022() {
 fn e057_remap_behind_the_masters_back_refuses_safeop_with_001d_and_001e() {
     let sim = line(1);
     with_master(&sim, async |md, clock| {
-        let group = init(md, clock).await;
         // the master configures SM2/SM3 for the default layout (23/29 bytes)
-        let group = group.into_safe_op(md).await.expect("PRE-OP -> SAFE-OP");
-        let group = group.into_pre_op(md).await.expect("SAFE-OP -> PRE-OP");
+        let group = sm_set_up(md, init(md, clock).await).await;
         let sd = group.subdevice(md, 0).unwrap();
         let mut c = CoeClient::new();
         // someone else shortens the RxPDO to the controlword
@@ -279,12 +278,13 @@ fn e057_remap_behind_the_masters_back_refuses_safeop_with_001d_and_001e() {
         c.download(&sd, 0x1600, 0, &[1]).await.unwrap();
         write_sm(&sd, 2, 0x1200, 23, 0x64).await;
         write_sm(&sd, 3, 0x1A00, 29, 0x20).await;
-        request(&sd, SAFEOP).await;
-        assert_eq!(
-            al_status(&sd).await,
+        request_gives(
+            &sd,
+            SAFEOP,
             (PREOP | ERR, AlStatusCode::INVALID_OUTPUT_CONFIG.0),
-            "SM2 23 bytes, mapping 2 bytes"
-        );
+            "SM2 23 bytes, mapping 2 bytes",
+        )
+        .await;
         // EMCY A000h, diag code SM2 "PDO length not correct" (4·2 + 2 = Ah)
         let r = c.sdo(&sd, &[0x40, 0x00, 0x10, 0, 0, 0, 0, 0]).await.unwrap();
         assert_eq!(r[0], 0x43, "1000h still readable");
@@ -294,15 +294,15 @@ fn e057_remap_behind_the_masters_back_refuses_safeop_with_001d_and_001e() {
         // SM2 matched to the new mapping: the TxPDO shrinks behind its back too
         write_sm(&sd, 2, 0x1200, 2, 0x64).await;
         c.download(&sd, 0x1A00, 0, &[1]).await.unwrap(); // statusword only
-        request(&sd, SAFEOP | ACK).await;
-        assert_eq!(
-            al_status(&sd).await,
+        request_gives(
+            &sd,
+            SAFEOP | ACK,
             (PREOP | ERR, AlStatusCode::INVALID_INPUT_CONFIG.0),
-            "SM3 29 bytes, mapping 2 bytes"
-        );
+            "SM3 29 bytes, mapping 2 bytes",
+        )
+        .await;
         write_sm(&sd, 3, 0x1A00, 2, 0x20).await;
-        request(&sd, SAFEOP | ACK).await;
-        assert_eq!(al_status(&sd).await, (SAFEOP, 0), "both lengths match");
+        request_gives(&sd, SAFEOP | ACK, (SAFEOP, 0), "both lengths match").await;
     });
 }
 

@@ -4,8 +4,10 @@
 //! for stable RxPDO and the PDO timeout in Op.
 
 use drive_tests::al::{ACK, ERR, OP, PREOP, SAFEOP};
-use drive_tests::step::{advance, cycles, op_via_safe_op, set};
-use drive_tests::{al_status, init, line, request, with_master, write_sm, CoeClient, OpGroup};
+use drive_tests::step::{advance, cycles, op_via_safe_op, set, sm_set_up};
+use drive_tests::{
+    al_status, expect_al, init, line, request_gives, with_master, write_sm, CoeClient, OpGroup,
+};
 use esc::regs::{self, dc};
 use esc::AlStatusCode;
 use ethercrab::MainDevice;
@@ -54,38 +56,37 @@ fn u32_of(d: &[u8]) -> u32 {
 fn e029_sync0_cycle_not_a_multiple_of_a150_or_above_8ms_refused() {
     let sim = line(1);
     with_master(&sim, async |md, clock| {
-        let group = init(md, clock).await;
         // the master's SM set-up, then back to Pre-Op for the DC configuration
-        let group = group.into_safe_op(md).await.expect("SAFE-OP");
-        let group = group.into_pre_op(md).await.expect("PRE-OP");
+        let group = sm_set_up(md, init(md, clock).await).await;
         let sd = group.subdevice(md, 0).unwrap();
         let mut c = CoeClient::new();
 
         // 1C32h:01 = 2 (DC SYNC0) without SYNC0 active: 0030h
         c.download(&sd, 0x1C32, 1, &2u16.to_le_bytes()).await.unwrap();
-        request(&sd, SAFEOP).await;
-        assert_eq!(
-            al_status(&sd).await,
+        request_gives(
+            &sd,
+            SAFEOP,
             (PREOP | ERR, AlStatusCode::INVALID_DC_SYNC_CONFIG.0),
-            "DC selected, SYNC0 inactive"
-        );
+            "DC selected, SYNC0 inactive",
+        )
+        .await;
         c.download(&sd, 0x1C32, 1, &0u16.to_le_bytes()).await.unwrap();
 
         // A150 = 1 ms (default): 1.5 ms is not a multiple, 10 ms is above 8 ms
         for bad in [1_500_000u32, 10_000_000] {
             start_sync0(&sd, bad).await;
-            request(&sd, SAFEOP | ACK).await;
-            assert_eq!(
-                al_status(&sd).await,
+            request_gives(
+                &sd,
+                SAFEOP | ACK,
                 (PREOP | ERR, 0x0036),
-                "SYNC0 {bad} ns: DC SYNC0 cycle time"
-            );
+                &format!("SYNC0 {bad} ns: DC SYNC0 cycle time"),
+            )
+            .await;
             stop_sync0(&sd).await;
         }
         // 2 ms = 2 × A150: accepted; 1C32h/1C33h show DC SYNC0 and the cycle
         start_sync0(&sd, 2_000_000).await;
-        request(&sd, SAFEOP | ACK).await;
-        assert_eq!(al_status(&sd).await, (SAFEOP, 0), "SYNC0 2 ms");
+        request_gives(&sd, SAFEOP | ACK, (SAFEOP, 0), "SYNC0 2 ms").await;
         for index in [0x1C32, 0x1C33] {
             let st = c.upload(&sd, index, 1).await.unwrap();
             assert_eq!(u32_of(&st), 2, "{index:04X}h:01 sync type DC SYNC0");
@@ -103,32 +104,33 @@ fn e029_sync0_cycle_not_a_multiple_of_a150_or_above_8ms_refused() {
 fn e030_free_run_without_3_buffer_sm2_refused_with_0029() {
     let sim = line(1);
     with_master(&sim, async |md, clock| {
-        let group = init(md, clock).await;
-        let group = group.into_safe_op(md).await.expect("SAFE-OP");
-        let group = group.into_pre_op(md).await.expect("PRE-OP");
+        let group = sm_set_up(md, init(md, clock).await).await;
         let sd = group.subdevice(md, 0).unwrap();
         let mut c = CoeClient::new();
         let one_buffer = (SM2_CONTROL & !0x03) | 0x02;
 
         // 1C32h:01 = 0 (free run, the default) with SM2 in 1-buffer mode
         write_sm(&sd, 2, SM2_START, SM2_LEN, one_buffer).await;
-        request(&sd, SAFEOP).await;
-        assert_eq!(
-            al_status(&sd).await,
-            (PREOP | ERR, AlStatusCode::FREERUN_NEEDS_3BUFFER.0)
-        );
+        request_gives(
+            &sd,
+            SAFEOP,
+            (PREOP | ERR, AlStatusCode::FREERUN_NEEDS_3BUFFER.0),
+            "free run, 1-buffer SM2",
+        )
+        .await;
         // SM-synchronous: the device still needs its 3-buffer SM2 (001Dh)
         c.download(&sd, 0x1C32, 1, &1u16.to_le_bytes()).await.unwrap();
-        request(&sd, SAFEOP | ACK).await;
-        assert_eq!(
-            al_status(&sd).await,
-            (PREOP | ERR, AlStatusCode::INVALID_OUTPUT_CONFIG.0)
-        );
+        request_gives(
+            &sd,
+            SAFEOP | ACK,
+            (PREOP | ERR, AlStatusCode::INVALID_OUTPUT_CONFIG.0),
+            "SM-synchronous, 1-buffer SM2",
+        )
+        .await;
         // free run with 3 buffers: fine
         c.download(&sd, 0x1C32, 1, &0u16.to_le_bytes()).await.unwrap();
         write_sm(&sd, 2, SM2_START, SM2_LEN, SM2_CONTROL).await;
-        request(&sd, SAFEOP | ACK).await;
-        assert_eq!(al_status(&sd).await, (SAFEOP, 0));
+        request_gives(&sd, SAFEOP | ACK, (SAFEOP, 0), "free run, 3 buffers").await;
     });
 }
 
@@ -136,32 +138,26 @@ fn e030_free_run_without_3_buffer_sm2_refused_with_0029() {
 fn e031_invalid_sm_watchdog_settings_refused_with_001f() {
     let sim = line(1);
     with_master(&sim, async |md, clock| {
-        let group = init(md, clock).await;
-        let group = group.into_safe_op(md).await.expect("SAFE-OP");
-        let group = group.into_pre_op(md).await.expect("PRE-OP");
+        let group = sm_set_up(md, init(md, clock).await).await;
         let sd = group.subdevice(md, 0).unwrap();
         let code = AlStatusCode::INVALID_WATCHDOG_CONFIG.0;
 
         // divider 0 with the watchdog running
         let divider: u16 = sd.register_read(regs::WATCHDOG_DIVIDER).await.unwrap();
         sd.register_write(regs::WATCHDOG_DIVIDER, 0u16).await.unwrap();
-        request(&sd, SAFEOP).await;
-        assert_eq!(al_status(&sd).await, (PREOP | ERR, code), "divider 0");
+        request_gives(&sd, SAFEOP, (PREOP | ERR, code), "divider 0").await;
         sd.register_write(regs::WATCHDOG_DIVIDER, divider).await.unwrap();
 
         // A258 = 65534 relies on the master's SM watchdog
         set(&sim, A258, 0, 65534);
         sd.register_write(regs::WATCHDOG_TIME_PD, 0u16).await.unwrap();
-        request(&sd, SAFEOP | ACK).await;
-        assert_eq!(al_status(&sd).await, (PREOP | ERR, code), "SM watchdog off");
+        request_gives(&sd, SAFEOP | ACK, (PREOP | ERR, code), "SM watchdog off").await;
         // 5 × 100 µs is shorter than the 1 ms cycle
         sd.register_write(regs::WATCHDOG_TIME_PD, 5u16).await.unwrap();
-        request(&sd, SAFEOP | ACK).await;
-        assert_eq!(al_status(&sd).await, (PREOP | ERR, code), "shorter than a cycle");
+        request_gives(&sd, SAFEOP | ACK, (PREOP | ERR, code), "shorter than a cycle").await;
         // 100 ms: valid
         sd.register_write(regs::WATCHDOG_TIME_PD, 1000u16).await.unwrap();
-        request(&sd, SAFEOP | ACK).await;
-        assert_eq!(al_status(&sd).await, (SAFEOP, 0));
+        request_gives(&sd, SAFEOP | ACK, (SAFEOP, 0), "100 ms").await;
     });
 }
 
@@ -177,32 +173,31 @@ fn e033_e047_safeop_to_op_waits_for_steady_rxpdo_and_refuses_after_200ms() {
         let sd = group.subdevice(md, 0).unwrap();
 
         // no process data: the request waits (Safe-Op, no error)…
-        request(&sd, OP).await;
-        assert_eq!(al_status(&sd).await, (SAFEOP, 0), "pending");
+        request_gives(&sd, OP, (SAFEOP, 0), "pending").await;
         advance(&sim, 100_000_000);
         assert_eq!(al_status(&sd).await, (SAFEOP, 0), "still pending at 100 ms");
         // …and is refused after 200 ms
         advance(&sim, 150_000_000);
-        assert_eq!(
-            al_status(&sd).await,
+        expect_al(
+            &sd,
             (SAFEOP | ERR, AlStatusCode::NO_VALID_IO.0),
-            "no RxPDO within 200 ms"
-        );
+            "no RxPDO within 200 ms",
+        )
+        .await;
 
         // one frame, then none: RxPDO, but not steady: 001Bh
-        request(&sd, OP | ACK).await;
-        assert_eq!(al_status(&sd).await, (SAFEOP, 0), "pending");
+        request_gives(&sd, OP | ACK, (SAFEOP, 0), "pending").await;
         cycles(md, &group, &sim, 1).await;
         advance(&sim, 250_000_000);
-        assert_eq!(
-            al_status(&sd).await,
+        expect_al(
+            &sd,
             (SAFEOP | ERR, AlStatusCode::SM_WATCHDOG.0),
-            "RxPDO not steady within 200 ms"
-        );
+            "RxPDO not steady within 200 ms",
+        )
+        .await;
 
         // a waiting request is granted once the RxPDO runs
-        request(&sd, OP | ACK).await;
-        assert_eq!(al_status(&sd).await, (SAFEOP, 0), "pending again");
+        request_gives(&sd, OP | ACK, (SAFEOP, 0), "pending again").await;
         cycles(md, &group, &sim, 5).await;
         assert_eq!(al_status(&sd).await, (OP, 0), "steady RxPDO: Op");
     });
@@ -223,11 +218,7 @@ fn e044_e126_e128_op_without_rxpdo_longer_than_a258_falls_to_safeop() {
         cycles(md, &group, &sim, 1).await;
         // 60 ms without: PDO timeout
         advance(&sim, 60_000_000);
-        assert_eq!(
-            al_status(&sd).await,
-            (SAFEOP | ERR, AlStatusCode::SM_WATCHDOG.0),
-            "PDO timeout"
-        );
+        expect_al(&sd, (SAFEOP | ERR, AlStatusCode::SM_WATCHDOG.0), "PDO timeout").await;
         // EMCY 7500h, error register 10h, event 52 cause 6
         let mut c = CoeClient::new();
         c.upload(&sd, 0x1000, 0).await.unwrap();
@@ -268,11 +259,12 @@ fn e127_sm_watchdog_mode_uses_the_escs_watchdog() {
         advance(&sim, 90_000_000);
         assert_eq!(al_status(&sd).await, (OP, 0));
         advance(&sim, 20_000_000);
-        assert_eq!(
-            al_status(&sd).await,
+        expect_al(
+            &sd,
             (SAFEOP | ERR, AlStatusCode::SM_WATCHDOG.0),
-            "SM watchdog expired"
-        );
+            "SM watchdog expired",
+        )
+        .await;
     });
 }
 
