@@ -115,6 +115,22 @@ pub fn with_cyclic<T>(
     })
 }
 
+/// A SubDevice of a group in PRE-OP, as [`init`] leaves it.
+pub type PreOpSubDevice<'a> = SubDeviceRef<'a, &'a ethercrab::SubDevice>;
+
+/// Runs `body` on `sim`'s line in PRE-OP ([`init`]) with its first drive's
+/// SubDevice and a [`CoeClient`] for it.
+pub fn with_sdo<T>(
+    sim: &RefCell<Simulation>,
+    body: impl for<'a> AsyncFnOnce(&PreOpSubDevice<'a>, &mut CoeClient) -> T,
+) -> T {
+    with_master(sim, async |md, clock| {
+        let group = init(md, clock).await;
+        let sd = group.subdevice(md, 0).unwrap();
+        body(&sd, &mut CoeClient::new()).await
+    })
+}
+
 /// Discovers the line and brings it to PRE-OP (ethercrab's init).
 pub async fn init<'a>(md: &'a MainDevice<'a>, clock: &'a AtomicU64) -> SubDeviceGroup<8, 512> {
     match md

@@ -5,7 +5,7 @@
 
 use drive_tests::al::{ACK, ERR, OP, PREOP, SAFEOP};
 use drive_tests::step::sm_set_up;
-use drive_tests::{al_status, init, line, request_gives, with_master, write_sm, CoeClient};
+use drive_tests::{al_status, init, line, request_gives, with_master, with_sdo, write_sm, CoeClient};
 use ecat::SdoAbort;
 use esc::AlStatusCode;
 
@@ -136,12 +136,9 @@ fn e061_a250_new_messages_flag_in_the_txpdo() {
 #[test]
 fn e058_e075_mapping_refusals_0604_0041_0604_0042_0604_0043() {
     let sim = line(1);
-    with_master(&sim, async |md, clock| {
-        let group = init(md, clock).await;
-        let sd = group.subdevice(md, 0).unwrap();
-        let mut c = CoeClient::new();
+    with_sdo(&sim, async |sd, c| {
         let put = |v: u32| v.to_le_bytes();
-        c.download(&sd, 0x1600, 0, &[0]).await.unwrap();
+        c.download(sd, 0x1600, 0, &[0]).await.unwrap();
         // not RxPDO-mappable: statusword (Tx only), device type, unknown, hidden (A293)
         for bad in [
             STATUSWORD,
@@ -150,78 +147,74 @@ fn e058_e075_mapping_refusals_0604_0041_0604_0042_0604_0043() {
             m(drive_ecat::parameter_index(0, 293), 0, 16),
         ] {
             assert_eq!(
-                c.download(&sd, 0x1600, 1, &put(bad)).await,
+                c.download(sd, 0x1600, 1, &put(bad)).await,
                 Err(SdoAbort::NOT_MAPPABLE.0),
                 "{bad:08X}h in an RxPDO"
             );
         }
         // not TxPDO-mappable: quick stop option code (Rx only)
-        c.download(&sd, 0x1A00, 0, &[0]).await.unwrap();
+        c.download(sd, 0x1A00, 0, &[0]).await.unwrap();
         assert_eq!(
-            c.download(&sd, 0x1A00, 1, &put(m(0x605A, 0, 16))).await,
+            c.download(sd, 0x1A00, 1, &put(m(0x605A, 0, 16))).await,
             Err(SdoAbort::NOT_MAPPABLE.0)
         );
         // mappable, but with the wrong bit length
         assert_eq!(
-            c.download(&sd, 0x1600, 1, &put(m(0x6040, 0, 8))).await,
+            c.download(sd, 0x1600, 1, &put(m(0x6040, 0, 8))).await,
             Err(SdoAbort::PARAMETER_INCOMPATIBLE.0)
         );
         assert_eq!(
-            c.upload(&sd, 0x1600, 1).await,
+            c.upload(sd, 0x1600, 1).await,
             Ok(put(CONTROLWORD).to_vec()),
             "unchanged"
         );
         // too many entries: sub 0 above 24
         assert_eq!(
-            c.download(&sd, 0x1600, 0, &[25]).await,
+            c.download(sd, 0x1600, 0, &[25]).await,
             Err(SdoAbort::PDO_LENGTH.0)
         );
         // too long: 24 × 32 bits is the limit, gaps of 255 bits exceed it
         for s in 1..=24u8 {
-            c.download(&sd, 0x1600, s, &put(TARGET_VELOCITY)).await.unwrap();
+            c.download(sd, 0x1600, s, &put(TARGET_VELOCITY)).await.unwrap();
         }
-        c.download(&sd, 0x1600, 0, &[24]).await.expect("24 × 32 bits fit");
-        c.download(&sd, 0x1600, 0, &[0]).await.unwrap();
+        c.download(sd, 0x1600, 0, &[24]).await.expect("24 × 32 bits fit");
+        c.download(sd, 0x1600, 0, &[0]).await.unwrap();
         for s in 1..=4u8 {
-            c.download(&sd, 0x1600, s, &put(0x0000_00FF)).await.unwrap();
+            c.download(sd, 0x1600, s, &put(0x0000_00FF)).await.unwrap();
         }
         assert_eq!(
-            c.download(&sd, 0x1600, 0, &[4]).await,
+            c.download(sd, 0x1600, 0, &[4]).await,
             Err(SdoAbort::PDO_LENGTH.0),
             "4 × 255 bits > 768"
         );
-        assert_eq!(c.upload(&sd, 0x1600, 0).await, Ok(vec![0]), "sub 0 unchanged");
+        assert_eq!(c.upload(sd, 0x1600, 0).await, Ok(vec![0]), "sub 0 unchanged");
         // an entry while sub 0 != 0 (CiA 301 step b)
-        c.download(&sd, 0x1600, 1, &put(CONTROLWORD)).await.unwrap();
-        c.download(&sd, 0x1600, 0, &[1]).await.unwrap();
+        c.download(sd, 0x1600, 1, &put(CONTROLWORD)).await.unwrap();
+        c.download(sd, 0x1600, 0, &[1]).await.unwrap();
         assert_eq!(
-            c.download(&sd, 0x1600, 2, &put(TARGET_VELOCITY)).await,
+            c.download(sd, 0x1600, 2, &put(TARGET_VELOCITY)).await,
             Err(SdoAbort::DEVICE_STATE.0)
         );
         // E-052: the FSoE channel is not configurable
-        assert_eq!(c.download(&sd, 0x1603, 0, &[0]).await, Err(SdoAbort::READ_ONLY.0));
+        assert_eq!(c.download(sd, 0x1603, 0, &[0]).await, Err(SdoAbort::READ_ONLY.0));
         assert_eq!(
-            c.download(&sd, 0x1A03, 1, &put(STATUSWORD)).await,
+            c.download(sd, 0x1A03, 1, &put(STATUSWORD)).await,
             Err(SdoAbort::READ_ONLY.0)
         );
         // assignment: only the direction's PDOs, no duplicates
-        c.download(&sd, 0x1C12, 0, &[0]).await.unwrap();
+        c.download(sd, 0x1C12, 0, &[0]).await.unwrap();
         assert_eq!(
-            c.download(&sd, 0x1C12, 1, &0x1A00u16.to_le_bytes()).await,
+            c.download(sd, 0x1C12, 1, &0x1A00u16.to_le_bytes()).await,
             Err(SdoAbort::PARAMETER_INCOMPATIBLE.0)
         );
-        c.download(&sd, 0x1C12, 1, &0x1600u16.to_le_bytes())
-            .await
-            .unwrap();
-        c.download(&sd, 0x1C12, 2, &0x1600u16.to_le_bytes())
-            .await
-            .unwrap();
+        c.download(sd, 0x1C12, 1, &0x1600u16.to_le_bytes()).await.unwrap();
+        c.download(sd, 0x1C12, 2, &0x1600u16.to_le_bytes()).await.unwrap();
         assert_eq!(
-            c.download(&sd, 0x1C12, 0, &[2]).await,
+            c.download(sd, 0x1C12, 0, &[2]).await,
             Err(SdoAbort::PARAMETER_INCOMPATIBLE.0),
             "1600h assigned twice"
         );
-        c.download(&sd, 0x1C12, 0, &[1]).await.unwrap();
+        c.download(sd, 0x1C12, 0, &[1]).await.unwrap();
         assert_eq!(
             pdo_bytes(&sim),
             Some((2, 0)),
