@@ -160,20 +160,19 @@ fn c002_shutdown_gives_ready_to_switch_on() {
 
 #[test]
 fn c002_controlword_decoding_masks() {
+    // the command patterns of CiA 402 (mask, value), the first that matches
+    let patterns = [
+        (0x0082, 0x0000, Command::DisableVoltage),
+        (0x0086, 0x0002, Command::QuickStop),
+        (0x0087, 0x0006, Command::Shutdown),
+        (0x008F, 0x0007, Command::SwitchOn),
+        (0x008F, 0x000F, Command::EnableOperation),
+    ];
     for cw in 0u16..=0x01FF {
-        let expect = if cw & 0x0082 == 0 {
-            Some(Command::DisableVoltage)
-        } else if cw & 0x0086 == 0x0002 {
-            Some(Command::QuickStop)
-        } else if cw & 0x0087 == 0x0006 {
-            Some(Command::Shutdown)
-        } else if cw & 0x008F == 0x0007 {
-            Some(Command::SwitchOn)
-        } else if cw & 0x008F == 0x000F {
-            Some(Command::EnableOperation)
-        } else {
-            None
-        };
+        let expect = patterns
+            .iter()
+            .find(|&&(mask, value, _)| cw & mask == value)
+            .map(|&(_, _, command)| command);
         assert_eq!(Command::decode(cw), expect, "cw {cw:#06x}");
         // Every controlword with bit 7 clear is exactly one command; bit 7 set is none.
         assert_eq!(Command::decode(cw).is_some(), cw & 0x80 == 0, "cw {cw:#06x}");
