@@ -200,16 +200,10 @@ def run(m, args):
         check(a69 >> 12 == FAILED, f"{args.fault}: {name} A69 {a69:04X}h, expected failed")
         check(got == code, f"{args.fault}: {name}[0] {got}, expected {code}")
         afterwards(axis, words, before, history)
-    axis.cw = 0
-    axis.cycle(20)
+    L.stop(axis)
     print(f"ROW {ORDER[args.fault]} " + "; ".join(words), flush=True)
 
 
-def main():
-    return L.script_main(__doc__, run, "motor actions against the plant's fault: all checks passed",
-                         ("--fault", dict(required=True, choices=sorted(CASES), help="serve's --plant-fault")),
-                         ("--r", dict(type=float, default=3.6, help="the plant's phase resistance, ohm")))
-
-
-if __name__ == "__main__":
-    sys.exit(main())
+L.script(__name__, __doc__, run, "motor actions against the plant's fault: all checks passed",
+         ("--fault", dict(required=True, choices=sorted(CASES), help="serve's --plant-fault")),
+         ("--r", dict(type=float, default=3.6, help="the plant's phase resistance, ohm")))

@@ -108,16 +108,10 @@ def run(m, args):
     refused_switch_on_disabled(axis)
     refused_beyond_the_limits(axis)
     identify(axis, args.j, args.fc, args.b)
-    axis.cw = 0
-    axis.cycle(20)
+    L.stop(axis)
 
 
-def main():
-    return L.script_main(__doc__, run, "B44 identify mechanics on the electrical plant: all checks passed",
-                         ("--j", dict(type=float, required=True, help="the plant's inertia, kg m2")),
-                         ("--fc", dict(type=float, required=True, help="the plant's Coulomb friction, N m")),
-                         ("--b", dict(type=float, required=True, help="the plant's viscous friction, N m s/rad")))
-
-
-if __name__ == "__main__":
-    sys.exit(main())
+L.script(__name__, __doc__, run, "B44 identify mechanics on the electrical plant: all checks passed",
+         L.required_float("--j", "the plant's inertia, kg m2"),
+         L.required_float("--fc", "the plant's Coulomb friction, N m"),
+         L.required_float("--b", "the plant's viscous friction, N m s/rad"))

@@ -257,16 +257,10 @@ def run(m, args):
     winding(axis, args.r)
     test_brake(axis)
     grind_brake(axis)
-    axis.cw = 0
-    axis.cycle(20)
+    L.stop(axis)
 
 
-def main():
-    return L.script_main(__doc__, run, "motor actions on the electrical plant: all checks passed",
-                         ("--r", dict(type=float, required=True, help="the plant's phase resistance, ohm")),
-                         ("--l", dict(type=float, required=True, help="the plant's inductance, H")),
-                         ("--offset", dict(type=float, required=True, help="the plant's commutation offset, rad (mechanical)")))
-
-
-if __name__ == "__main__":
-    sys.exit(main())
+L.script(__name__, __doc__, run, "motor actions on the electrical plant: all checks passed",
+         L.required_float("--r", "the plant's phase resistance, ohm"),
+         L.required_float("--l", "the plant's inductance, H"),
+         L.required_float("--offset", "the plant's commutation offset, rad (mechanical)"))
