@@ -788,14 +788,8 @@ pub mod sw {
 /// master cycle (1 ms: the drive's control cycle and polls), then exchanges
 /// the process data (one LRW) and decodes the drive's TxPDO.
 pub struct Cyclic<'a> {
-    /// The master.
-    pub md: &'a MainDevice<'a>,
-    /// The group in Op.
-    pub group: &'a OpGroup,
-    /// The simulated line.
-    pub sim: &'a RefCell<Simulation>,
-    /// Position of the drive in the group.
-    pub slave: usize,
+    /// The drive, its group and master.
+    pub link: Link<'a>,
     /// The RxPDO image sent every cycle.
     pub out: [u8; RXPDO_LEN],
     /// The last TxPDO received.
@@ -804,28 +798,46 @@ pub struct Cyclic<'a> {
     pub cycles: u64,
 }
 
-/// One master cycle of drive `slave` of `group`: `out` written to its
-/// outputs, the simulated time one master cycle on, the frame exchanged (both
-/// its outputs written and inputs read, WKC 3); `read` of its inputs.
-async fn exchange<R>(
-    md: &MainDevice<'_>,
-    group: &OpGroup,
-    sim: &RefCell<Simulation>,
-    slave: usize,
-    out: &[u8],
-    read: impl FnOnce(&[u8]) -> R,
-) -> R {
-    let sd = group.subdevice(md, slave).expect("subdevice");
-    sd.outputs_raw_mut().copy_from_slice(out);
-    {
-        let mut sim = sim.borrow_mut();
-        let t = sim.now() + MASTER_CYCLE;
-        sim.advance_to(t);
+/// Drive `slave` of `group` (in Op) on the simulated line `sim` with the
+/// master `md`: what [`Cyclic`] and [`RawCyclic`] exchange process data
+/// with.
+#[derive(Clone, Copy)]
+pub struct Link<'a> {
+    /// The master.
+    pub md: &'a MainDevice<'a>,
+    /// The group in Op.
+    pub group: &'a OpGroup,
+    /// The simulated line.
+    pub sim: &'a RefCell<Simulation>,
+    /// Position of the drive in the group.
+    pub slave: usize,
+}
+
+impl Link<'_> {
+    /// The lengths of the drive's outputs and inputs as ethercrab configured
+    /// them.
+    fn lengths(&self) -> (usize, usize) {
+        let sd = self.group.subdevice(self.md, self.slave).expect("subdevice");
+        let io = sd.io_raw();
+        (io.outputs().len(), io.inputs().len())
     }
-    let r = group.tx_rx(md).await.expect("process data cycle");
-    assert_eq!(r.working_counter, 3, "outputs written and inputs read");
-    let io = sd.io_raw();
-    read(io.inputs())
+
+    /// One master cycle of the drive: `out` written to its outputs, the
+    /// simulated time one master cycle on, the frame exchanged (both its
+    /// outputs written and inputs read, WKC 3); `read` of its inputs.
+    async fn exchange<R>(&self, out: &[u8], read: impl FnOnce(&[u8]) -> R) -> R {
+        let sd = self.group.subdevice(self.md, self.slave).expect("subdevice");
+        sd.outputs_raw_mut().copy_from_slice(out);
+        {
+            let mut sim = self.sim.borrow_mut();
+            let t = sim.now() + MASTER_CYCLE;
+            sim.advance_to(t);
+        }
+        let r = self.group.tx_rx(self.md).await.expect("process data cycle");
+        assert_eq!(r.working_counter, 3, "outputs written and inputs read");
+        let io = sd.io_raw();
+        read(io.inputs())
+    }
 }
 
 impl<'a> Cyclic<'a> {
@@ -837,15 +849,17 @@ impl<'a> Cyclic<'a> {
         sim: &'a RefCell<Simulation>,
         slave: usize,
     ) -> Self {
-        let sd = group.subdevice(md, slave).expect("subdevice");
-        let io = sd.io_raw();
-        assert_eq!(io.outputs().len(), RXPDO_LEN, "standard RxPDO length");
-        assert_eq!(io.inputs().len(), TXPDO_LEN, "standard TxPDO length");
-        Self {
+        let link = Link {
             md,
             group,
             sim,
             slave,
+        };
+        let (o, i) = link.lengths();
+        assert_eq!(o, RXPDO_LEN, "standard RxPDO length");
+        assert_eq!(i, TXPDO_LEN, "standard TxPDO length");
+        Self {
+            link,
             out: [0; RXPDO_LEN],
             tx: TxPdo::default(),
             cycles: 0,
@@ -898,15 +912,7 @@ impl<'a> Cyclic<'a> {
 
     /// One master cycle; returns the TxPDO received.
     pub async fn cycle(&mut self) -> TxPdo {
-        self.tx = exchange(
-            self.md,
-            self.group,
-            self.sim,
-            self.slave,
-            &self.out,
-            TxPdo::decode,
-        )
-        .await;
+        self.tx = self.link.exchange(&self.out, TxPdo::decode).await;
         self.cycles += 1;
         self.tx
     }
@@ -981,7 +987,7 @@ impl<'a> Cyclic<'a> {
 
     /// Simulated time.
     pub fn now(&self) -> Nanos {
-        self.sim.borrow().now()
+        self.link.sim.borrow().now()
     }
 }
 
@@ -1012,14 +1018,8 @@ where
 /// controlword sits at byte 0 and 6060h at byte 2 of the RxPDO, the
 /// statusword at byte 0 of the TxPDO in every map.
 pub struct RawCyclic<'a> {
-    /// The master.
-    pub md: &'a MainDevice<'a>,
-    /// The group in Op.
-    pub group: &'a OpGroup,
-    /// The simulated line.
-    pub sim: &'a RefCell<Simulation>,
-    /// Position of the drive in the group.
-    pub slave: usize,
+    /// The drive, its group and master.
+    pub link: Link<'a>,
     /// The RxPDO image sent every cycle.
     pub out: Vec<u8>,
     /// The last TxPDO received.
@@ -1029,22 +1029,12 @@ pub struct RawCyclic<'a> {
 }
 
 impl<'a> RawCyclic<'a> {
-    /// A master on drive `slave` of `group` with the lengths ethercrab
+    /// A master on the drive of `link` with the lengths ethercrab
     /// configured; the outputs start all zero.
-    pub fn new(
-        md: &'a MainDevice<'a>,
-        group: &'a OpGroup,
-        sim: &'a RefCell<Simulation>,
-        slave: usize,
-    ) -> Self {
-        let sd = group.subdevice(md, slave).expect("subdevice");
-        let io = sd.io_raw();
-        let (o, i) = (io.outputs().len(), io.inputs().len());
+    pub fn new(link: Link<'a>) -> Self {
+        let (o, i) = link.lengths();
         Self {
-            md,
-            group,
-            sim,
-            slave,
+            link,
             out: vec![0; o],
             inputs: vec![0; i],
             cycles: 0,
@@ -1104,10 +1094,7 @@ impl<'a> RawCyclic<'a> {
     /// One master cycle (see [`Cyclic::cycle`]).
     pub async fn cycle(&mut self) {
         let inputs = &mut self.inputs;
-        exchange(self.md, self.group, self.sim, self.slave, &self.out, |i| {
-            inputs.copy_from_slice(i)
-        })
-        .await;
+        self.link.exchange(&self.out, |i| inputs.copy_from_slice(i)).await;
         self.cycles += 1;
     }
 

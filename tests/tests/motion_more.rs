@@ -4,7 +4,7 @@
 //! Every check reads what the master received (TxPDO or SDO).
 
 use drive_tests::axis::*;
-use drive_tests::{init, line, map_layout, sw, with_cyclic, with_master, Cyclic, RawCyclic};
+use drive_tests::{init, line, map_layout, sw, with_cyclic, with_master, Cyclic, Link, RawCyclic};
 use drive_tests::{REV, REV_F};
 use hil_sim::motor::{PositionInput, Switches};
 
@@ -33,7 +33,12 @@ fn c031_c032_c033_c034_ip_follows_60c1_only_while_bit_4() {
             (7, 7),
             "ip map: 7 bytes each way (C-034)"
         );
-        let mut m = RawCyclic::new(md, &group, &sim, 0);
+        let mut m = RawCyclic::new(Link {
+            md,
+            group: &group,
+            sim: &sim,
+            slave: 0,
+        });
         let pos = |m: &RawCyclic<'_>| m.i32_at(3);
         let set = |m: &mut RawCyclic<'_>, p: i32| m.put(3, &p.to_le_bytes());
         m.set_mode(7);
@@ -115,7 +120,12 @@ fn c051_c052_c053_c054_vl_bits_4_5_6_ramp_and_limit() {
             (5, 5),
             "vl map: 5 bytes each way (C-054)"
         );
-        let mut m = RawCyclic::new(md, &group, &sim, 0);
+        let mut m = RawCyclic::new(Link {
+            md,
+            group: &group,
+            sim: &sim,
+            slave: 0,
+        });
         let actual = |m: &RawCyclic<'_>| m.i16_at(3);
         let set = |m: &mut RawCyclic<'_>, rpm: i16| m.put(3, &rpm.to_le_bytes());
         let all = CW_ENABLED | CW_BIT4 | CW_BIT5 | CW_BIT6;
@@ -425,7 +435,7 @@ async fn fault_and_reset(m: &mut Cyclic<'_>, what: &str) -> u16 {
         "{what}: fault, statusword {:#06x}",
         m.tx.statusword
     );
-    let sd = m.group.subdevice(m.md, m.slave).unwrap();
+    let sd = m.link.group.subdevice(m.link.md, m.link.slave).unwrap();
     let code: u16 = sd.sdo_read(0x603F, 0).await.unwrap();
     m.set_controlword(0);
     m.run(2).await;
