@@ -46,9 +46,7 @@ async fn settle(m: &mut Cyclic<'_>, max: usize) -> Option<usize> {
 #[test]
 fn c028_mode_0_generates_no_motion() {
     let sim = line(1);
-    with_master(&sim, async |md, clock| {
-        let group = init(md, clock).await.into_op(md).await.expect("OP");
-        let mut m = Cyclic::new(md, &group, &sim, 0);
+    with_cyclic(&sim, async |m, _| {
         let tx = m.enable_in(0).await;
         assert_eq!(tx.mode_display, 0, "6061h shows mode 0");
         let p0 = motor_position(&sim, 0);

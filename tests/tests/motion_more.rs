@@ -640,22 +640,31 @@ async fn pass_and_stop(m: &mut Cyclic<'_>, max: usize, to: i64, what: &str) {
     m.run(100).await;
 }
 
-#[test]
-fn c124_c127_touch_probe_single_shot_falling_only_and_rearm() {
+/// A line whose probe input 1 toggles (low first) at `k`/20 rev + `k` ·
+/// `extra` inc for each `k` of `ks`; those positions.
+fn probe_line(ks: &[i64], extra: i64) -> (RefCell<Simulation>, Vec<i64>) {
     let sim = line(1);
-    // probe input 1 toggles at six positions: ↑p1 ↓p2 ↑p3 ↓p4 ↑p5 ↓p6
-    let marks: Vec<i64> = [2, 4, 6, 8, 14, 16]
-        .iter()
-        .map(|k| i64::from(REV) * k / 20 + 111 * k)
-        .collect();
+    let marks: Vec<i64> = ks.iter().map(|k| i64::from(REV) * k / 20 + extra * k).collect();
     with_drive(&sim, |d| {
         d.motors[0].switches_mut().probe1 = PositionInput::toggles(false, &marks).unwrap();
     });
+    (sim, marks)
+}
+
+/// 60B8h = `function` (the probe's function), then enabled in csv at `v`.
+async fn probe_in_csv(m: &mut Cyclic<'_>, sd: &OpSubDevice<'_>, function: u16, v: i32) {
+    sd.sdo_write(0x60B8, 0, function).await.unwrap();
+    m.enable_in(9).await;
+    m.set_target_velocity(v);
+}
+
+#[test]
+fn c124_c127_touch_probe_single_shot_falling_only_and_rearm() {
+    // probe input 1 toggles at six positions: ↑p1 ↓p2 ↑p3 ↓p4 ↑p5 ↓p6
+    let (sim, marks) = probe_line(&[2, 4, 6, 8, 14, 16], 111);
     with_cyclic(&sim, async |m, sd| {
         // example 2: enabled, first event, falling edge only (bit 5)
-        sd.sdo_write(0x60B8, 0, 0x0021u16).await.unwrap();
-        m.enable_in(9).await;
-        m.set_target_velocity(REV);
+        probe_in_csv(m, sd, 0x0021, REV).await;
         pass_and_stop(m, 2000, marks[3] + i64::from(REV / 20), "past p4").await;
         let (status, rising, falling) = probe1(sd).await;
         println!(
@@ -696,20 +705,11 @@ fn c124_c127_touch_probe_single_shot_falling_only_and_rearm() {
 
 #[test]
 fn c125_c126_touch_probe_example_1_continuous_both_edges() {
-    let sim = line(1);
     // probe input 1 toggles at four positions: ↑p1 ↓p2 ↑p3 ↓p4
-    let marks: Vec<i64> = [2, 4, 6, 8]
-        .iter()
-        .map(|k| i64::from(REV) * k / 20 + 97 * k)
-        .collect();
-    with_drive(&sim, |d| {
-        d.motors[0].switches_mut().probe1 = PositionInput::toggles(false, &marks).unwrap();
-    });
+    let (sim, marks) = probe_line(&[2, 4, 6, 8], 97);
     with_cyclic(&sim, async |m, sd| {
         // example 1: enabled (bit 0), continuous (bit 1), rising (bit 4) and falling (bit 5)
-        sd.sdo_write(0x60B8, 0, 0x0033u16).await.unwrap();
-        m.enable_in(9).await;
-        m.set_target_velocity(REV / 2);
+        probe_in_csv(m, sd, 0x0033, REV / 2).await;
         // past p2: the first pair is stored, both status bits on
         m.run_until(3000, |t| i64::from(t.position) > marks[1] + i64::from(REV / 40))
             .await

@@ -6,7 +6,7 @@
 //! and a csp move, axis B's motor unpowered.
 
 use drive_ecat::Variant;
-use drive_tests::{init, sw, with_master, with_sdo, CoeClient, Cyclic, REV, REV_F};
+use drive_tests::{init, sw, with_cyclic, with_master, with_sdo, CoeClient, REV, REV_F};
 use hil_sim::sim::{SimDrive, Simulation};
 use std::cell::RefCell;
 
@@ -189,9 +189,7 @@ fn e058_mapping_an_axis_b_object_gets_0604_0041_and_changes_nothing() {
 #[test]
 fn e034_op_with_axis_a_standard_pdo_enable_and_a_csp_move() {
     let sim = single_axis_line(1);
-    with_master(&sim, async |md, clock| {
-        let group = init(md, clock).await.into_op(md).await.expect("OP");
-        let mut m = Cyclic::new(md, &group, &sim, 0);
+    with_cyclic(&sim, async |m, _| {
         m.set_mode(8);
         let tx = m.run(3).await;
         assert_eq!(tx.state(), sw::SOD);
