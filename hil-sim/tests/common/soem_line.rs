@@ -5,9 +5,37 @@
 //! ([`pysoem_python`]).
 
 use super::{ip, stop_server, watch_script};
+use hil_sim::matrix::Row;
 use std::path::{Path, PathBuf};
 use std::process::{Child, Command, ExitStatus, Stdio};
+use std::sync::{Mutex, MutexGuard};
 use std::time::Duration;
+
+/// One SOEM run at a time in a test binary: each needs the cores for its
+/// 1 ms cycle.
+static ONE_AT_A_TIME: Mutex<()> = Mutex::new(());
+
+/// The peer of the SOEM rows of the fault matrix (`scripts/fault-matrix`
+/// lets them be missing when no SOEM test ran, and checks them when one did).
+pub const SOEM_PEER: &str = "SOEM (pysoem) over veth";
+
+/// A row of the fault matrix run by SOEM.
+pub fn soem_row<'a>(order: &'a str, case: &'a str, spec: &'a str, expected: &'a str) -> Row<'a> {
+    Row {
+        order,
+        case,
+        spec,
+        peer: SOEM_PEER,
+        expected,
+    }
+}
+
+/// The python with pysoem ([`pysoem_python`]) and the test's turn (one SOEM
+/// run at a time), or `None` after saying why the test `what` does not run.
+pub fn pysoem_turn(what: &str) -> Option<(PathBuf, MutexGuard<'static, ()>)> {
+    let python = super::or_skip(pysoem_python(), what)?;
+    Some((python, ONE_AT_A_TIME.lock().unwrap_or_else(|e| e.into_inner())))
+}
 
 /// A script that has not finished after this long has hung ([`Line::run`]).
 pub const SCRIPT_LIMIT: Duration = Duration::from_secs(240);
