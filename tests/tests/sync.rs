@@ -17,6 +17,12 @@ use std::sync::atomic::AtomicU64;
 
 /// A258 PDO timeout (ms), parameter 2000h + 258.
 const A258: u16 = 0x2102;
+/// Safe-Op + ERR with 001Bh: the RxPDO not steady, or gone in Op (the SM
+/// watchdog or the PDO timeout).
+const SAFEOP_001B: (u16, u16) = (SAFEOP | ERR, AlStatusCode::SM_WATCHDOG.0);
+/// Safe-Op + ERR with 002Bh: no RxPDO at all.
+const SAFEOP_002B: (u16, u16) = (SAFEOP | ERR, AlStatusCode::NO_VALID_IO.0);
+
 /// SM2 as the drive's SII describes it.
 const SM2_START: u16 = 0x1200;
 const SM2_LEN: u16 = 23;
@@ -178,23 +184,13 @@ fn e033_e047_safeop_to_op_waits_for_steady_rxpdo_and_refuses_after_200ms() {
         assert_eq!(al_status(&sd).await, (SAFEOP, 0), "still pending at 100 ms");
         // …and is refused after 200 ms
         advance(&sim, 150_000_000);
-        expect_al(
-            &sd,
-            (SAFEOP | ERR, AlStatusCode::NO_VALID_IO.0),
-            "no RxPDO within 200 ms",
-        )
-        .await;
+        expect_al(&sd, SAFEOP_002B, "no RxPDO within 200 ms").await;
 
         // one frame, then none: RxPDO, but not steady: 001Bh
         request_gives(&sd, OP | ACK, (SAFEOP, 0), "pending").await;
         cycles(md, &group, &sim, 1).await;
         advance(&sim, 250_000_000);
-        expect_al(
-            &sd,
-            (SAFEOP | ERR, AlStatusCode::SM_WATCHDOG.0),
-            "RxPDO not steady within 200 ms",
-        )
-        .await;
+        expect_al(&sd, SAFEOP_001B, "RxPDO not steady within 200 ms").await;
 
         // a waiting request is granted once the RxPDO runs
         request_gives(&sd, OP | ACK, (SAFEOP, 0), "pending again").await;
@@ -218,7 +214,7 @@ fn e044_e126_e128_op_without_rxpdo_longer_than_a258_falls_to_safeop() {
         cycles(md, &group, &sim, 1).await;
         // 60 ms without: PDO timeout
         advance(&sim, 60_000_000);
-        expect_al(&sd, (SAFEOP | ERR, AlStatusCode::SM_WATCHDOG.0), "PDO timeout").await;
+        expect_al(&sd, SAFEOP_001B, "PDO timeout").await;
         // EMCY 7500h, error register 10h, event 52 cause 6
         let mut c = CoeClient::new();
         c.upload(&sd, 0x1000, 0).await.unwrap();
@@ -259,12 +255,7 @@ fn e127_sm_watchdog_mode_uses_the_escs_watchdog() {
         advance(&sim, 90_000_000);
         assert_eq!(al_status(&sd).await, (OP, 0));
         advance(&sim, 20_000_000);
-        expect_al(
-            &sd,
-            (SAFEOP | ERR, AlStatusCode::SM_WATCHDOG.0),
-            "SM watchdog expired",
-        )
-        .await;
+        expect_al(&sd, SAFEOP_001B, "SM watchdog expired").await;
     });
 }
 
