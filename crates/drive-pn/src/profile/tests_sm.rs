@@ -145,7 +145,7 @@ fn p124_an_error_in_any_state_ends_in_soi_with_bit_3() {
 fn p127_p128_p055_pnu_1500_reports_and_switches_the_mode() {
     let mut b = Bench::new();
     b.run(&positioning(0x0400, 0, 100, 10_000), 10);
-    assert_eq!(b.pkw_positioning(0x41, 1500, 0, 0), (0x41, 0x10));
+    assert_eq!(b.pkw0(0x41, 1500, 0, 0), (0x41, 0x10));
     assert_eq!(b.pkw_read(1500, 0, 0x0400), (0x41, 0x08));
     // telegram 2 keeps the mode; PKW writes 0x04
     let mut t = [0u8; 36];
@@ -165,18 +165,6 @@ fn p127_p128_p055_pnu_1500_reports_and_switches_the_mode() {
     b.run(&t, 10);
     assert_eq!((b.response[24], b.i32_at(28)), (0xC2, 0x14), "0x20 is no mode");
     assert_eq!(b.d.objects().get(0x6060, 0), Ok(4), "unchanged");
-}
-
-impl Bench {
-    /// A PKW request in receive telegram 0 (after the 0x00 toggle): the
-    /// response's code and value.
-    fn pkw_positioning(&mut self, code: u8, pnu: u16, sub: u8, value: u32) -> (u8, i32) {
-        let mut t = positioning(0x0400, 0, 100, 10_000);
-        self.run(&t, 5);
-        t[24..32].copy_from_slice(&pkw_request(code, pnu, sub, value));
-        self.run(&t, 10);
-        (self.response[24], self.i32_at(28))
-    }
 }
 
 /// PNU 967 reads the CW1 the telegram carries (default 0 before any);
@@ -203,25 +191,17 @@ fn p179_p180_pnu_1011_ramps() {
     let mut b = Bench::new();
     // the one declaration's default (6048h/6049h: 3 000 rpm per 1 s), not
     // the Metronix drive's 14 100 rpm/s (docs/conformance.md, P-182)
-    assert_eq!(
-        b.pkw_positioning(0x41, 1011, 0, 0),
-        (0x41, 3_000),
-        "default acceleration"
-    );
-    assert_eq!(
-        b.pkw_positioning(0x41, 1011, 1, 0),
-        (0x41, 3_000),
-        "default deceleration"
-    );
-    assert_eq!(b.pkw_positioning(0x42, 1011, 0, 2_000).0, 0x42);
+    assert_eq!(b.pkw0(0x41, 1011, 0, 0), (0x41, 3_000), "default acceleration");
+    assert_eq!(b.pkw0(0x41, 1011, 1, 0), (0x41, 3_000), "default deceleration");
+    assert_eq!(b.pkw0(0x42, 1011, 0, 2_000).0, 0x42);
     assert_eq!(b.d.objects().get(0x6048, 1), Ok(2_000));
     assert_eq!(b.d.objects().get(0x6048, 2), Ok(1), "per 1 s");
     assert_eq!(b.d.objects().get(0x6049, 1), Ok(3_000), "deceleration kept");
-    assert_eq!(b.pkw_positioning(0x41, 1011, 0, 0), (0x41, 2_000));
-    assert_eq!(b.pkw_positioning(0x42, 1011, 1, 3_000).0, 0x42);
+    assert_eq!(b.pkw0(0x41, 1011, 0, 0), (0x41, 2_000));
+    assert_eq!(b.pkw0(0x42, 1011, 1, 3_000).0, 0x42);
     assert_eq!(b.d.objects().get(0x6049, 1), Ok(3_000));
     assert_eq!(b.d.objects().get(0x6048, 1), Ok(2_000), "acceleration kept");
-    assert_eq!(b.pkw_positioning(0x41, 1011, 1, 0), (0x41, 3_000));
+    assert_eq!(b.pkw0(0x41, 1011, 1, 0), (0x41, 3_000));
 }
 
 /// PNU 1101 is the actual velocity in the velocity unit (rpm): the encoder
