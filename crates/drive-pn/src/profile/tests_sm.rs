@@ -81,13 +81,30 @@ fn p116_off_returns_switched_on_to_ready() {
 /// on → switching on inhibited at once, ZSW1 bit 4 = 0 while commanded.
 #[test]
 fn p117_p118_p119_coast_stop_from_each_state() {
-    for from in [RTSO, OP, SO] {
+    stops_from_each_state([RTSO, OP, SO], (0x040D, 20), (0x0010, "coast stop"), 0x0020);
+}
+
+/// From each state of `states` CW1 `stop` (for its ms) gives switching on
+/// inhibited with ZSW1's bit `active` 0 (the stop, named `what`, active)
+/// and bit `other` 1 (the other stop not); OFF then leaves it for ready.
+fn stops_from_each_state(states: [u16; 3], (stop, ms): (u16, u64), (active, what): (u16, &str), other: u16) {
+    for from in states {
         let mut b = Bench::new();
         b.reach(from);
-        assert_eq!(b.cw(0x040D, 20), SOI, "from {from:#06x}: {:#06x}", b.zsw1());
-        assert_eq!(b.zsw1() & 0x0010, 0, "bit 4: coast stop active");
-        assert_ne!(b.zsw1() & 0x0020, 0, "bit 5: no quick stop");
-        assert_eq!(b.cw(0x0406, 20), RTSO, "OFF leaves the coast stop");
+        assert_eq!(b.cw(stop, ms), SOI, "from {from:#06x}: {:#06x}", b.zsw1());
+        assert_eq!(
+            b.zsw1() & active,
+            0,
+            "bit {}: {what} active",
+            active.trailing_zeros()
+        );
+        assert_ne!(
+            b.zsw1() & other,
+            0,
+            "bit {}: only the {what}",
+            other.trailing_zeros()
+        );
+        assert_eq!(b.cw(0x0406, 20), RTSO, "OFF leaves the {what}");
     }
 }
 
@@ -95,14 +112,7 @@ fn p117_p118_p119_coast_stop_from_each_state() {
 /// switched on and ready → switching on inhibited; bit 5 = 0 meanwhile.
 #[test]
 fn p120_p121_p123_quick_stop_from_each_state() {
-    for from in [OP, SO, RTSO] {
-        let mut b = Bench::new();
-        b.reach(from);
-        assert_eq!(b.cw(0x040B, 50), SOI, "from {from:#06x}: {:#06x}", b.zsw1());
-        assert_eq!(b.zsw1() & 0x0020, 0, "bit 5: quick stop active");
-        assert_ne!(b.zsw1() & 0x0010, 0, "bit 4: no coast stop");
-        assert_eq!(b.cw(0x0406, 20), RTSO);
-    }
+    stops_from_each_state([OP, SO, RTSO], (0x040B, 50), (0x0020, "quick stop"), 0x0010);
 }
 
 /// T11: OFF (x110) in operation → ready.
