@@ -144,15 +144,17 @@ pub async fn init<'a>(md: &'a MainDevice<'a>, clock: &'a AtomicU64) -> SubDevice
 
 /// AL status (0x0130) and AL status code (0x0134), read by the master.
 pub async fn al_status<S>(sd: &SubDeviceRef<'_, S>) -> (u16, u16) {
-    let st: u16 = sd
-        .register_read(esc::regs::AL_STATUS)
-        .await
-        .unwrap_or_else(|e| panic!("read AL status: {e}"));
-    let code: u16 = sd
-        .register_read(esc::regs::AL_STATUS_CODE)
-        .await
-        .unwrap_or_else(|e| panic!("read AL code: {e}"));
+    let st = register_u16(sd, esc::regs::AL_STATUS, "AL status").await;
+    let code = register_u16(sd, esc::regs::AL_STATUS_CODE, "AL code").await;
     (st, code)
+}
+
+/// The 16-bit register `reg`, read by the master (`what`: its name, for
+/// the failure's message).
+async fn register_u16<S>(sd: &SubDeviceRef<'_, S>, reg: u16, what: &str) -> u16 {
+    sd.register_read(reg)
+        .await
+        .unwrap_or_else(|e| panic!("read {what}: {e}"))
 }
 
 /// Writes AL control (a raw state request, as a master's start-up would), then
@@ -161,10 +163,7 @@ pub async fn request<S>(sd: &SubDeviceRef<'_, S>, ctrl: u16) {
     sd.register_write(esc::regs::AL_CONTROL, ctrl)
         .await
         .unwrap_or_else(|e| panic!("write AL control: {e}"));
-    let _: u16 = sd
-        .register_read(esc::regs::AL_STATUS)
-        .await
-        .unwrap_or_else(|e| panic!("read AL status: {e}"));
+    register_u16(sd, esc::regs::AL_STATUS, "AL status").await;
 }
 
 /// [`request`] `ctrl`, then the AL status and code must be `expected`

@@ -10,7 +10,7 @@ use drive_tests::{
 };
 use esc::regs::{self, dc};
 use esc::AlStatusCode;
-use ethercrab::MainDevice;
+use ethercrab::{MainDevice, SubDeviceRef};
 use hil_sim::sim::Simulation;
 use std::cell::RefCell;
 use std::sync::atomic::AtomicU64;
@@ -50,6 +50,19 @@ async fn start_sync0<S>(sd: &ethercrab::SubDeviceRef<'_, S>, cycle_ns: u32) {
 
 async fn stop_sync0<S>(sd: &ethercrab::SubDeviceRef<'_, S>) {
     sd.register_write(dc::ACTIVATION, 0x00u8).await.unwrap();
+}
+
+/// `ns` of simulated time without process data; then the AL status and
+/// code must be `expected` (`what`: the case).
+async fn quiet_for<S>(
+    sim: &RefCell<Simulation>,
+    sd: &SubDeviceRef<'_, S>,
+    ns: u64,
+    expected: (u16, u16),
+    what: &str,
+) {
+    advance(sim, ns);
+    expect_al(sd, expected, what).await;
 }
 
 fn u32_of(d: &[u8]) -> u32 {
@@ -180,17 +193,21 @@ fn e033_e047_safeop_to_op_waits_for_steady_rxpdo_and_refuses_after_200ms() {
 
         // no process data: the request waits (Safe-Op, no error)…
         request_gives(&sd, OP, (SAFEOP, 0), "pending").await;
-        advance(&sim, 100_000_000);
-        assert_eq!(al_status(&sd).await, (SAFEOP, 0), "still pending at 100 ms");
+        quiet_for(&sim, &sd, 100_000_000, (SAFEOP, 0), "still pending at 100 ms").await;
         // …and is refused after 200 ms
-        advance(&sim, 150_000_000);
-        expect_al(&sd, SAFEOP_002B, "no RxPDO within 200 ms").await;
+        quiet_for(&sim, &sd, 150_000_000, SAFEOP_002B, "no RxPDO within 200 ms").await;
 
         // one frame, then none: RxPDO, but not steady: 001Bh
         request_gives(&sd, OP | ACK, (SAFEOP, 0), "pending").await;
         cycles(md, &group, &sim, 1).await;
-        advance(&sim, 250_000_000);
-        expect_al(&sd, SAFEOP_001B, "RxPDO not steady within 200 ms").await;
+        quiet_for(
+            &sim,
+            &sd,
+            250_000_000,
+            SAFEOP_001B,
+            "RxPDO not steady within 200 ms",
+        )
+        .await;
 
         // a waiting request is granted once the RxPDO runs
         request_gives(&sd, OP | ACK, (SAFEOP, 0), "pending again").await;
@@ -209,12 +226,10 @@ fn e044_e126_e128_op_without_rxpdo_longer_than_a258_falls_to_safeop() {
         assert_eq!(al_status(&sd).await, (OP, 0), "RxPDO every 1 ms");
 
         // 40 ms without RxPDO: still within A258
-        advance(&sim, 40_000_000);
-        assert_eq!(al_status(&sd).await, (OP, 0));
+        quiet_for(&sim, &sd, 40_000_000, (OP, 0), "40 ms: within A258").await;
         cycles(md, &group, &sim, 1).await;
         // 60 ms without: PDO timeout
-        advance(&sim, 60_000_000);
-        expect_al(&sd, SAFEOP_001B, "PDO timeout").await;
+        quiet_for(&sim, &sd, 60_000_000, SAFEOP_001B, "PDO timeout").await;
         // EMCY 7500h, error register 10h, event 52 cause 6
         let mut c = CoeClient::new();
         c.upload(&sd, 0x1000, 0).await.unwrap();
@@ -239,8 +254,7 @@ fn e128_master_leaving_op_does_not_trigger_the_pdo_timeout() {
         cycles(md, &group, &sim, 5).await;
         let group = group.into_safe_op(md).await.expect("back to SAFE-OP");
         let sd = group.subdevice(md, 0).unwrap();
-        advance(&sim, 200_000_000);
-        assert_eq!(al_status(&sd).await, (SAFEOP, 0), "no timeout outside Op");
+        quiet_for(&sim, &sd, 200_000_000, (SAFEOP, 0), "no timeout outside Op").await;
     });
 }
 
@@ -252,10 +266,8 @@ fn e127_sm_watchdog_mode_uses_the_escs_watchdog() {
         let sd = group.subdevice(md, 0).unwrap();
         cycles(md, &group, &sim, 5).await;
         // the ESC's default SM watchdog: 1000 × 100 µs
-        advance(&sim, 90_000_000);
-        assert_eq!(al_status(&sd).await, (OP, 0));
-        advance(&sim, 20_000_000);
-        expect_al(&sd, SAFEOP_001B, "SM watchdog expired").await;
+        quiet_for(&sim, &sd, 90_000_000, (OP, 0), "90 ms: within the SM watchdog").await;
+        quiet_for(&sim, &sd, 20_000_000, SAFEOP_001B, "SM watchdog expired").await;
     });
 }
 
