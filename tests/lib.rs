@@ -131,6 +131,20 @@ pub fn with_sdo<T>(
     })
 }
 
+/// [`with_sdo`] after the master's SyncManager set-up
+/// ([`step::sm_set_up`]): PRE-OP again, where a test changes what SAFE-OP
+/// checks.
+pub fn with_sdo_set_up<T>(
+    sim: &RefCell<Simulation>,
+    body: impl for<'a> AsyncFnOnce(&PreOpSubDevice<'a>, &mut CoeClient) -> T,
+) -> T {
+    with_master(sim, async |md, clock| {
+        let group = step::sm_set_up(md, init(md, clock).await).await;
+        let sd = group.subdevice(md, 0).unwrap();
+        body(&sd, &mut CoeClient::new()).await
+    })
+}
+
 /// Discovers the line and brings it to PRE-OP (ethercrab's init).
 pub async fn init<'a>(md: &'a MainDevice<'a>, clock: &'a AtomicU64) -> SubDeviceGroup<8, 512> {
     match md

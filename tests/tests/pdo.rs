@@ -4,8 +4,9 @@
 //! longer matches the mapping refuses Safe-Op with AL 001Dh.
 
 use drive_tests::al::{ACK, ERR, OP, PREOP, SAFEOP};
-use drive_tests::step::sm_set_up;
-use drive_tests::{al_status, init, line, request_gives, with_master, with_sdo, write_sm, CoeClient};
+use drive_tests::{
+    al_status, init, line, request_gives, with_master, with_sdo, with_sdo_set_up, write_sm, CoeClient,
+};
 use ecat::SdoAbort;
 use esc::AlStatusCode;
 
@@ -258,44 +259,41 @@ fn e048_e054_mapping_and_assignment_refused_in_safeop_with_0800_0022() {
 #[test]
 fn e057_remap_behind_the_masters_back_refuses_safeop_with_001d_and_001e() {
     let sim = line(1);
-    with_master(&sim, async |md, clock| {
+    with_sdo_set_up(&sim, async |sd, c| {
         // the master configures SM2/SM3 for the default layout (23/29 bytes)
-        let group = sm_set_up(md, init(md, clock).await).await;
-        let sd = group.subdevice(md, 0).unwrap();
-        let mut c = CoeClient::new();
         // someone else shortens the RxPDO to the controlword
-        c.download(&sd, 0x1600, 0, &[0]).await.unwrap();
-        c.download(&sd, 0x1600, 1, &CONTROLWORD.to_le_bytes())
+        c.download(sd, 0x1600, 0, &[0]).await.unwrap();
+        c.download(sd, 0x1600, 1, &CONTROLWORD.to_le_bytes())
             .await
             .unwrap();
-        c.download(&sd, 0x1600, 0, &[1]).await.unwrap();
-        write_sm(&sd, 2, 0x1200, 23, 0x64).await;
-        write_sm(&sd, 3, 0x1A00, 29, 0x20).await;
+        c.download(sd, 0x1600, 0, &[1]).await.unwrap();
+        write_sm(sd, 2, 0x1200, 23, 0x64).await;
+        write_sm(sd, 3, 0x1A00, 29, 0x20).await;
         request_gives(
-            &sd,
+            sd,
             SAFEOP,
             (PREOP | ERR, AlStatusCode::INVALID_OUTPUT_CONFIG.0),
             "SM2 23 bytes, mapping 2 bytes",
         )
         .await;
         // EMCY A000h, diag code SM2 "PDO length not correct" (4·2 + 2 = Ah)
-        let r = c.sdo(&sd, &[0x40, 0x00, 0x10, 0, 0, 0, 0, 0]).await.unwrap();
+        let r = c.sdo(sd, &[0x40, 0x00, 0x10, 0, 0, 0, 0, 0]).await.unwrap();
         assert_eq!(r[0], 0x43, "1000h still readable");
         let emcy = c.emergencies.first().expect("an EMCY before the reply");
         assert_eq!((u16::from_le_bytes([emcy[0], emcy[1]]), emcy[3]), (0xA000, 0x0A));
 
         // SM2 matched to the new mapping: the TxPDO shrinks behind its back too
-        write_sm(&sd, 2, 0x1200, 2, 0x64).await;
-        c.download(&sd, 0x1A00, 0, &[1]).await.unwrap(); // statusword only
+        write_sm(sd, 2, 0x1200, 2, 0x64).await;
+        c.download(sd, 0x1A00, 0, &[1]).await.unwrap(); // statusword only
         request_gives(
-            &sd,
+            sd,
             SAFEOP | ACK,
             (PREOP | ERR, AlStatusCode::INVALID_INPUT_CONFIG.0),
             "SM3 29 bytes, mapping 2 bytes",
         )
         .await;
-        write_sm(&sd, 3, 0x1A00, 2, 0x20).await;
-        request_gives(&sd, SAFEOP | ACK, (SAFEOP, 0), "both lengths match").await;
+        write_sm(sd, 3, 0x1A00, 2, 0x20).await;
+        request_gives(sd, SAFEOP | ACK, (SAFEOP, 0), "both lengths match").await;
     });
 }
 

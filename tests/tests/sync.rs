@@ -4,9 +4,10 @@
 //! for stable RxPDO and the PDO timeout in Op.
 
 use drive_tests::al::{ACK, ERR, OP, PREOP, SAFEOP};
-use drive_tests::step::{advance, cycles, op_via_safe_op, set, sm_set_up};
+use drive_tests::step::{advance, cycles, op_via_safe_op, set};
 use drive_tests::{
-    al_status, expect_al, init, line, request_gives, with_master, write_sm, CoeClient, OpGroup,
+    al_status, expect_al, init, line, request_gives, with_master, with_sdo_set_up, write_sm, CoeClient,
+    OpGroup,
 };
 use esc::regs::{self, dc};
 use esc::AlStatusCode;
@@ -74,47 +75,44 @@ fn u32_of(d: &[u8]) -> u32 {
 #[test]
 fn e029_sync0_cycle_not_a_multiple_of_a150_or_above_8ms_refused() {
     let sim = line(1);
-    with_master(&sim, async |md, clock| {
+    with_sdo_set_up(&sim, async |sd, c| {
         // the master's SM set-up, then back to Pre-Op for the DC configuration
-        let group = sm_set_up(md, init(md, clock).await).await;
-        let sd = group.subdevice(md, 0).unwrap();
-        let mut c = CoeClient::new();
 
         // 1C32h:01 = 2 (DC SYNC0) without SYNC0 active: 0030h
-        c.download(&sd, 0x1C32, 1, &2u16.to_le_bytes()).await.unwrap();
+        c.download(sd, 0x1C32, 1, &2u16.to_le_bytes()).await.unwrap();
         request_gives(
-            &sd,
+            sd,
             SAFEOP,
             (PREOP | ERR, AlStatusCode::INVALID_DC_SYNC_CONFIG.0),
             "DC selected, SYNC0 inactive",
         )
         .await;
-        c.download(&sd, 0x1C32, 1, &0u16.to_le_bytes()).await.unwrap();
+        c.download(sd, 0x1C32, 1, &0u16.to_le_bytes()).await.unwrap();
 
         // A150 = 1 ms (default): 1.5 ms is not a multiple, 10 ms is above 8 ms
         for bad in [1_500_000u32, 10_000_000] {
-            start_sync0(&sd, bad).await;
+            start_sync0(sd, bad).await;
             request_gives(
-                &sd,
+                sd,
                 SAFEOP | ACK,
                 (PREOP | ERR, 0x0036),
                 &format!("SYNC0 {bad} ns: DC SYNC0 cycle time"),
             )
             .await;
-            stop_sync0(&sd).await;
+            stop_sync0(sd).await;
         }
         // 2 ms = 2 × A150: accepted; 1C32h/1C33h show DC SYNC0 and the cycle
-        start_sync0(&sd, 2_000_000).await;
-        request_gives(&sd, SAFEOP | ACK, (SAFEOP, 0), "SYNC0 2 ms").await;
+        start_sync0(sd, 2_000_000).await;
+        request_gives(sd, SAFEOP | ACK, (SAFEOP, 0), "SYNC0 2 ms").await;
         for index in [0x1C32, 0x1C33] {
-            let st = c.upload(&sd, index, 1).await.unwrap();
+            let st = c.upload(sd, index, 1).await.unwrap();
             assert_eq!(u32_of(&st), 2, "{index:04X}h:01 sync type DC SYNC0");
-            let cy = c.upload(&sd, index, 2).await.unwrap();
+            let cy = c.upload(sd, index, 2).await.unwrap();
             assert_eq!(u32_of(&cy), 2_000_000, "{index:04X}h:02 cycle time");
         }
-        let supported = c.upload(&sd, 0x1C32, 4).await.unwrap();
+        let supported = c.upload(sd, 0x1C32, 4).await.unwrap();
         assert_eq!(u32_of(&supported), 0x0007, "free run, SM2, DC SYNC0");
-        let min = c.upload(&sd, 0x1C32, 5).await.unwrap();
+        let min = c.upload(sd, 0x1C32, 5).await.unwrap();
         assert_eq!(u32_of(&min), 250_000, "minimum cycle 250 µs");
     });
 }
@@ -122,61 +120,56 @@ fn e029_sync0_cycle_not_a_multiple_of_a150_or_above_8ms_refused() {
 #[test]
 fn e030_free_run_without_3_buffer_sm2_refused_with_0029() {
     let sim = line(1);
-    with_master(&sim, async |md, clock| {
-        let group = sm_set_up(md, init(md, clock).await).await;
-        let sd = group.subdevice(md, 0).unwrap();
-        let mut c = CoeClient::new();
+    with_sdo_set_up(&sim, async |sd, c| {
         let one_buffer = (SM2_CONTROL & !0x03) | 0x02;
 
         // 1C32h:01 = 0 (free run, the default) with SM2 in 1-buffer mode
-        write_sm(&sd, 2, SM2_START, SM2_LEN, one_buffer).await;
+        write_sm(sd, 2, SM2_START, SM2_LEN, one_buffer).await;
         request_gives(
-            &sd,
+            sd,
             SAFEOP,
             (PREOP | ERR, AlStatusCode::FREERUN_NEEDS_3BUFFER.0),
             "free run, 1-buffer SM2",
         )
         .await;
         // SM-synchronous: the device still needs its 3-buffer SM2 (001Dh)
-        c.download(&sd, 0x1C32, 1, &1u16.to_le_bytes()).await.unwrap();
+        c.download(sd, 0x1C32, 1, &1u16.to_le_bytes()).await.unwrap();
         request_gives(
-            &sd,
+            sd,
             SAFEOP | ACK,
             (PREOP | ERR, AlStatusCode::INVALID_OUTPUT_CONFIG.0),
             "SM-synchronous, 1-buffer SM2",
         )
         .await;
         // free run with 3 buffers: fine
-        c.download(&sd, 0x1C32, 1, &0u16.to_le_bytes()).await.unwrap();
-        write_sm(&sd, 2, SM2_START, SM2_LEN, SM2_CONTROL).await;
-        request_gives(&sd, SAFEOP | ACK, (SAFEOP, 0), "free run, 3 buffers").await;
+        c.download(sd, 0x1C32, 1, &0u16.to_le_bytes()).await.unwrap();
+        write_sm(sd, 2, SM2_START, SM2_LEN, SM2_CONTROL).await;
+        request_gives(sd, SAFEOP | ACK, (SAFEOP, 0), "free run, 3 buffers").await;
     });
 }
 
 #[test]
 fn e031_invalid_sm_watchdog_settings_refused_with_001f() {
     let sim = line(1);
-    with_master(&sim, async |md, clock| {
-        let group = sm_set_up(md, init(md, clock).await).await;
-        let sd = group.subdevice(md, 0).unwrap();
+    with_sdo_set_up(&sim, async |sd, _| {
         let code = AlStatusCode::INVALID_WATCHDOG_CONFIG.0;
 
         // divider 0 with the watchdog running
         let divider: u16 = sd.register_read(regs::WATCHDOG_DIVIDER).await.unwrap();
         sd.register_write(regs::WATCHDOG_DIVIDER, 0u16).await.unwrap();
-        request_gives(&sd, SAFEOP, (PREOP | ERR, code), "divider 0").await;
+        request_gives(sd, SAFEOP, (PREOP | ERR, code), "divider 0").await;
         sd.register_write(regs::WATCHDOG_DIVIDER, divider).await.unwrap();
 
         // A258 = 65534 relies on the master's SM watchdog
         set(&sim, A258, 0, 65534);
         sd.register_write(regs::WATCHDOG_TIME_PD, 0u16).await.unwrap();
-        request_gives(&sd, SAFEOP | ACK, (PREOP | ERR, code), "SM watchdog off").await;
+        request_gives(sd, SAFEOP | ACK, (PREOP | ERR, code), "SM watchdog off").await;
         // 5 × 100 µs is shorter than the 1 ms cycle
         sd.register_write(regs::WATCHDOG_TIME_PD, 5u16).await.unwrap();
-        request_gives(&sd, SAFEOP | ACK, (PREOP | ERR, code), "shorter than a cycle").await;
+        request_gives(sd, SAFEOP | ACK, (PREOP | ERR, code), "shorter than a cycle").await;
         // 100 ms: valid
         sd.register_write(regs::WATCHDOG_TIME_PD, 1000u16).await.unwrap();
-        request_gives(&sd, SAFEOP | ACK, (SAFEOP, 0), "100 ms").await;
+        request_gives(sd, SAFEOP | ACK, (SAFEOP, 0), "100 ms").await;
     });
 }
 
