@@ -92,26 +92,14 @@ fn e003_sii_read_by_master_has_syncmanagers_and_protocols() {
     let sms: Vec<&[u8]> = sii::records(sms, 8).collect();
     assert_eq!(sms.len(), 4);
     let start = |r: &[u8]| u16::from_le_bytes([r[0], r[1]]);
-    assert_eq!(
-        (start(sms[0]), sms[0][4], sms[0][7]),
-        (0x1000, 0x26, 1),
-        "SM0 mailbox out"
-    );
-    assert_eq!(
-        (start(sms[1]), sms[1][4], sms[1][7]),
-        (0x1100, 0x22, 2),
-        "SM1 mailbox in"
-    );
-    assert_eq!(
-        (start(sms[2]), sms[2][4], sms[2][7]),
-        (0x1200, 0x64, 3),
-        "SM2 outputs"
-    );
-    assert_eq!(
-        (start(sms[3]), sms[3][4], sms[3][7]),
-        (0x1A00, 0x20, 4),
-        "SM3 inputs"
-    );
+    for (sm, (want, what)) in sms.iter().zip([
+        ((0x1000, 0x26, 1), "SM0 mailbox out"),
+        ((0x1100, 0x22, 2), "SM1 mailbox in"),
+        ((0x1200, 0x64, 3), "SM2 outputs"),
+        ((0x1A00, 0x20, 4), "SM3 inputs"),
+    ]) {
+        assert_eq!((start(sm), sm[4], sm[7]), want, "{what}");
+    }
     // the master read the same image the ESC was loaded with
     assert_eq!(&image[..], &sim.borrow().drives()[0].esc.sii()[..image.len()]);
 }
