@@ -25,6 +25,15 @@ fn stdout_of(args: &[&str]) -> String {
     text(&o.stdout)
 }
 
+/// `hil-sim args` refused with a message naming `path`; its stdout.
+fn refused_naming(args: &[&str], path: &str) -> String {
+    let o = hil_sim(args);
+    assert!(!o.status.success(), "{o:?}");
+    let (out, err) = (text(&o.stdout), text(&o.stderr));
+    assert!(err.contains(path), "the message names the path: {err}");
+    out
+}
+
 /// Each of `wants` must stand in `out`.
 fn assert_lists(out: &str, wants: &[&str]) {
     for want in wants {
@@ -223,10 +232,7 @@ fn demo_refuses_an_unwritable_plot_before_the_run() {
     let s = Scratch::new("plot");
     let plot = s.unwritable("x.svg");
     let plot = plot.to_str().unwrap();
-    let o = hil_sim(&["demo", "--plot", plot]);
-    assert!(!o.status.success(), "{o:?}");
-    let (out, err) = (text(&o.stdout), text(&o.stderr));
-    assert!(err.contains(plot), "the message names the path: {err}");
+    let out = refused_naming(&["demo", "--plot", plot], plot);
     assert!(!out.contains("plot:"), "no plot claimed: {out}");
     assert!(!out.contains("found"), "refused before the run: {out}");
 }
@@ -237,10 +243,7 @@ fn demo_refuses_an_unwritable_pcap_before_the_run() {
     let pcap = s.unwritable("a.pcap");
     let pcap = pcap.to_str().unwrap();
     let plot = s.0.join("x.svg");
-    let o = hil_sim(&["demo", "--pcap", pcap, "--plot", plot.to_str().unwrap()]);
-    assert!(!o.status.success(), "{o:?}");
-    let (out, err) = (text(&o.stdout), text(&o.stderr));
-    assert!(err.contains(pcap), "the message names the path: {err}");
+    let out = refused_naming(&["demo", "--pcap", pcap, "--plot", plot.to_str().unwrap()], pcap);
     assert!(!out.contains("recording"), "no recording claimed: {out}");
     assert!(!plot.exists(), "nothing ran, no plot");
 }
@@ -260,18 +263,18 @@ fn serve_refuses_an_unwritable_pcap_before_opening_the_interface() {
     let pcap = s.unwritable("a.pcap");
     let pcap = pcap.to_str().unwrap();
     // the interface does not exist either: the pcap is checked first
-    let o = hil_sim(&[
-        "serve",
-        "--iface",
-        "nonexistent0",
-        "--pcap",
+    let out = refused_naming(
+        &[
+            "serve",
+            "--iface",
+            "nonexistent0",
+            "--pcap",
+            pcap,
+            "--seconds",
+            "1",
+        ],
         pcap,
-        "--seconds",
-        "1",
-    ]);
-    assert!(!o.status.success(), "{o:?}");
-    let (out, err) = (text(&o.stdout), text(&o.stderr));
-    assert!(err.contains(pcap), "the message names the path: {err}");
+    );
     assert!(!out.contains("recording"), "no recording claimed: {out}");
 }
 
@@ -329,10 +332,7 @@ fn demo_profinet_refuses_an_unwritable_plot_before_the_run() {
     let s = Scratch::new("pn-plot");
     let plot = s.unwritable("x.svg");
     let plot = plot.to_str().unwrap();
-    let o = hil_sim(&["demo", "--fieldbus", "profinet", "--plot", plot]);
-    assert!(!o.status.success(), "{o:?}");
-    let (out, err) = (text(&o.stdout), text(&o.stderr));
-    assert!(err.contains(plot), "the message names the path: {err}");
+    let out = refused_naming(&["demo", "--fieldbus", "profinet", "--plot", plot], plot);
     assert!(!out.contains("plot:"), "no plot claimed: {out}");
     assert!(!out.contains("AR "), "refused before the run: {out}");
 }
