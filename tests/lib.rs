@@ -171,6 +171,20 @@ async fn register_u16<S>(sd: &SubDeviceRef<'_, S>, reg: u16, what: &str) -> u16 
         .unwrap_or_else(|e| panic!("read {what}: {e}"))
 }
 
+/// Object `index:sub` as the master's SDO upload reads it must be `want`
+/// (`what`: the case, for the failure's message).
+pub async fn sdo_is<S, T>(sd: &SubDeviceRef<'_, S>, index: u16, sub: u8, want: T, what: &str)
+where
+    S: std::ops::Deref<Target = ethercrab::SubDevice>,
+    T: ethercrab::EtherCrabWireReadSized + PartialEq + std::fmt::Debug,
+{
+    let got: T = sd
+        .sdo_read(index, sub)
+        .await
+        .unwrap_or_else(|e| panic!("{what}: {index:04X}h:{sub}: {e}"));
+    assert_eq!(got, want, "{what}");
+}
+
 /// Writes AL control (a raw state request, as a master's start-up would), then
 /// reads AL status once more so the slave firmware has polled after the write.
 pub async fn request<S>(sd: &SubDeviceRef<'_, S>, ctrl: u16) {

@@ -8,7 +8,7 @@
 use drive_ecat::{parameter_index, Template};
 use drive_tests::al::{ERR, OP, SAFEOP};
 use drive_tests::step::{advance, op_via_safe_op};
-use drive_tests::{al_status, init, line, map_layout, variant, with_master, with_sdo, Cyclic, REV};
+use drive_tests::{al_status, init, line, map_layout, sdo_is, variant, with_master, with_sdo, Cyclic, REV};
 use ecat::SdoAbort;
 use esc::AlStatusCode;
 use hil_sim::sim::Simulation;
@@ -99,48 +99,16 @@ fn c130_c131_c132_standard_pdo_layout_byte_packed_through_the_master() {
         c.set_target_torque(777);
         c.out[19..23].copy_from_slice(&0x8000_0005u32.to_le_bytes());
         let t = c.run(5).await;
-        assert_eq!(
-            sd.sdo_read::<i32>(0x607A, 0).await.unwrap(),
-            0x0102_0304,
-            "607Ah @3"
-        );
-        assert_eq!(
-            sd.sdo_read::<i32>(0x60FF, 0).await.unwrap(),
-            -0x0A0B_0C0D,
-            "60FFh @7"
-        );
-        assert_eq!(
-            sd.sdo_read::<i32>(0x60B1, 0).await.unwrap(),
-            0x1122_3344,
-            "60B1h @11"
-        );
-        assert_eq!(sd.sdo_read::<i16>(0x60B2, 0).await.unwrap(), -1234, "60B2h @15");
-        assert_eq!(sd.sdo_read::<i16>(0x6071, 0).await.unwrap(), 777, "6071h @17");
-        assert_eq!(
-            sd.sdo_read::<u32>(0x60FE, 1).await.unwrap(),
-            0x8000_0005,
-            "60FEh:01 @19"
-        );
-        assert_eq!(
-            sd.sdo_read::<u16>(0x6041, 0).await.unwrap(),
-            t.statusword,
-            "6041h @0"
-        );
-        assert_eq!(
-            sd.sdo_read::<i8>(0x6061, 0).await.unwrap(),
-            t.mode_display,
-            "6061h @2"
-        );
-        assert_eq!(
-            sd.sdo_read::<i32>(0x6064, 0).await.unwrap(),
-            t.position,
-            "6064h @3"
-        );
-        assert_eq!(
-            sd.sdo_read::<i32>(0x60E4, 1).await.unwrap(),
-            t.additional_position,
-            "60E4h:01 @21"
-        );
+        sdo_is(&sd, 0x607A, 0, 0x0102_0304i32, "607Ah @3").await;
+        sdo_is(&sd, 0x60FF, 0, -0x0A0B_0C0Di32, "60FFh @7").await;
+        sdo_is(&sd, 0x60B1, 0, 0x1122_3344i32, "60B1h @11").await;
+        sdo_is(&sd, 0x60B2, 0, -1234i16, "60B2h @15").await;
+        sdo_is(&sd, 0x6071, 0, 777i16, "6071h @17").await;
+        sdo_is(&sd, 0x60FE, 1, 0x8000_0005u32, "60FEh:01 @19").await;
+        sdo_is(&sd, 0x6041, 0, t.statusword, "6041h @0").await;
+        sdo_is(&sd, 0x6061, 0, t.mode_display, "6061h @2").await;
+        sdo_is(&sd, 0x6064, 0, t.position, "6064h @3").await;
+        sdo_is(&sd, 0x60E4, 1, t.additional_position, "60E4h:01 @21").await;
         assert_eq!(t.state(), drive_tests::sw::SOD);
         assert_eq!(t.a67 & 1, 1, "A67 @27 carries 6041h bit 6: {:#06x}", t.a67);
     });
