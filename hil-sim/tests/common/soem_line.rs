@@ -4,7 +4,7 @@
 //! is removed on drop. Needs root and a python with pysoem
 //! ([`pysoem_python`]).
 
-use super::{ip, stop_server, watch_script};
+use super::{ip, netns_add, netns_del, stop_server, watch_script};
 use hil_sim::matrix::Row;
 use std::path::{Path, PathBuf};
 use std::process::{Child, Command, ExitStatus, Stdio};
@@ -84,14 +84,8 @@ impl Line {
         let sim_ns = format!("soem{tag}{id}s");
         let master_if = format!("so{tag}{id}m");
         let sim_if = format!("so{tag}{id}s");
-        for ns in [&master_ns, &sim_ns] {
-            let _ = Command::new("ip")
-                .args(["netns", "del", ns])
-                .stderr(Stdio::null())
-                .status();
-            ip(&["netns", "add", ns]);
-            ip(&["-n", ns, "link", "set", "lo", "up"]);
-        }
+        netns_del(&[&master_ns, &sim_ns]);
+        netns_add(&[&master_ns, &sim_ns]);
         ip(&[
             "link", "add", &master_if, "netns", &master_ns, "type", "veth", "peer", "name", &sim_if, "netns",
             &sim_ns,
