@@ -153,31 +153,22 @@ fn c138_only_mappable_objects_in_their_direction() {
         c.download(sd, 0x1600, 0, &[0]).await.unwrap();
         c.download(sd, 0x1A00, 0, &[0]).await.unwrap();
         let not = Err(SdoAbort::NOT_MAPPABLE.0);
-        // 6098h: not mappable at all
-        assert_eq!(
-            c.download(sd, 0x1600, 1, &m(0x6098, 0, 8).to_le_bytes()).await,
-            not
-        );
-        assert_eq!(
-            c.download(sd, 0x1A00, 1, &m(0x6098, 0, 8).to_le_bytes()).await,
-            not
-        );
-        // 605Ah: Rx only
-        assert_eq!(
-            c.download(sd, 0x1A00, 1, &m(0x605A, 0, 16).to_le_bytes()).await,
-            not
-        );
-        c.download(sd, 0x1600, 1, &m(0x605A, 0, 16).to_le_bytes())
-            .await
-            .expect("605Ah in an RxPDO");
-        // 6041h: Tx only
-        assert_eq!(
-            c.download(sd, 0x1600, 2, &m(0x6041, 0, 16).to_le_bytes()).await,
-            not
-        );
-        c.download(sd, 0x1A00, 1, &m(0x6041, 0, 16).to_le_bytes())
-            .await
-            .expect("6041h in a TxPDO");
+        // (PDO, subindex, entry, taken): in the order written
+        for (pdo, sub, entry, taken) in [
+            // 6098h: not mappable at all
+            (0x1600, 1, m(0x6098, 0, 8), false),
+            (0x1A00, 1, m(0x6098, 0, 8), false),
+            // 605Ah: Rx only
+            (0x1A00, 1, m(0x605A, 0, 16), false),
+            (0x1600, 1, m(0x605A, 0, 16), true),
+            // 6041h: Tx only
+            (0x1600, 2, m(0x6041, 0, 16), false),
+            (0x1A00, 1, m(0x6041, 0, 16), true),
+        ] {
+            let r = c.download(sd, pdo, sub, &entry.to_le_bytes()).await;
+            let want = if taken { Ok(()) } else { not };
+            assert_eq!(r, want, "{entry:08X}h into {pdo:04X}h:{sub}");
+        }
         // the axis-B window follows the same flags
         c.download(sd, 0x1601, 0, &[0]).await.unwrap();
         assert_eq!(
