@@ -115,6 +115,36 @@ pub fn with_cyclic<T>(
     })
 }
 
+/// A SubDevice of a group in PRE-OP, as [`init`] leaves it.
+pub type PreOpSubDevice<'a> = SubDeviceRef<'a, &'a ethercrab::SubDevice>;
+
+/// Runs `body` on `sim`'s line in PRE-OP ([`init`]) with its first drive's
+/// SubDevice and a [`CoeClient`] for it.
+pub fn with_sdo<T>(
+    sim: &RefCell<Simulation>,
+    body: impl for<'a> AsyncFnOnce(&PreOpSubDevice<'a>, &mut CoeClient) -> T,
+) -> T {
+    with_master(sim, async |md, clock| {
+        let group = init(md, clock).await;
+        let sd = group.subdevice(md, 0).unwrap();
+        body(&sd, &mut CoeClient::new()).await
+    })
+}
+
+/// [`with_sdo`] after the master's SyncManager set-up
+/// ([`step::sm_set_up`]): PRE-OP again, where a test changes what SAFE-OP
+/// checks.
+pub fn with_sdo_set_up<T>(
+    sim: &RefCell<Simulation>,
+    body: impl for<'a> AsyncFnOnce(&PreOpSubDevice<'a>, &mut CoeClient) -> T,
+) -> T {
+    with_master(sim, async |md, clock| {
+        let group = step::sm_set_up(md, init(md, clock).await).await;
+        let sd = group.subdevice(md, 0).unwrap();
+        body(&sd, &mut CoeClient::new()).await
+    })
+}
+
 /// Discovers the line and brings it to PRE-OP (ethercrab's init).
 pub async fn init<'a>(md: &'a MainDevice<'a>, clock: &'a AtomicU64) -> SubDeviceGroup<8, 512> {
     match md
@@ -128,15 +158,31 @@ pub async fn init<'a>(md: &'a MainDevice<'a>, clock: &'a AtomicU64) -> SubDevice
 
 /// AL status (0x0130) and AL status code (0x0134), read by the master.
 pub async fn al_status<S>(sd: &SubDeviceRef<'_, S>) -> (u16, u16) {
-    let st: u16 = sd
-        .register_read(esc::regs::AL_STATUS)
-        .await
-        .unwrap_or_else(|e| panic!("read AL status: {e}"));
-    let code: u16 = sd
-        .register_read(esc::regs::AL_STATUS_CODE)
-        .await
-        .unwrap_or_else(|e| panic!("read AL code: {e}"));
+    let st = register_u16(sd, esc::regs::AL_STATUS, "AL status").await;
+    let code = register_u16(sd, esc::regs::AL_STATUS_CODE, "AL code").await;
     (st, code)
+}
+
+/// The 16-bit register `reg`, read by the master (`what`: its name, for
+/// the failure's message).
+async fn register_u16<S>(sd: &SubDeviceRef<'_, S>, reg: u16, what: &str) -> u16 {
+    sd.register_read(reg)
+        .await
+        .unwrap_or_else(|e| panic!("read {what}: {e}"))
+}
+
+/// Object `index:sub` as the master's SDO upload reads it must be `want`
+/// (`what`: the case, for the failure's message).
+pub async fn sdo_is<S, T>(sd: &SubDeviceRef<'_, S>, index: u16, sub: u8, want: T, what: &str)
+where
+    S: std::ops::Deref<Target = ethercrab::SubDevice>,
+    T: ethercrab::EtherCrabWireReadSized + PartialEq + std::fmt::Debug,
+{
+    let got: T = sd
+        .sdo_read(index, sub)
+        .await
+        .unwrap_or_else(|e| panic!("{what}: {index:04X}h:{sub}: {e}"));
+    assert_eq!(got, want, "{what}");
 }
 
 /// Writes AL control (a raw state request, as a master's start-up would), then
@@ -145,10 +191,20 @@ pub async fn request<S>(sd: &SubDeviceRef<'_, S>, ctrl: u16) {
     sd.register_write(esc::regs::AL_CONTROL, ctrl)
         .await
         .unwrap_or_else(|e| panic!("write AL control: {e}"));
-    let _: u16 = sd
-        .register_read(esc::regs::AL_STATUS)
-        .await
-        .unwrap_or_else(|e| panic!("read AL status: {e}"));
+    register_u16(sd, esc::regs::AL_STATUS, "AL status").await;
+}
+
+/// [`request`] `ctrl`, then the AL status and code must be `expected`
+/// (`what`: the case, for the failure's message).
+pub async fn request_gives<S>(sd: &SubDeviceRef<'_, S>, ctrl: u16, expected: (u16, u16), what: &str) {
+    request(sd, ctrl).await;
+    expect_al(sd, expected, what).await;
+}
+
+/// The AL status and code must be `expected` (`what`: the case, for the
+/// failure's message).
+pub async fn expect_al<S>(sd: &SubDeviceRef<'_, S>, expected: (u16, u16), what: &str) {
+    assert_eq!(al_status(sd).await, expected, "{what}");
 }
 
 /// Writes SyncManager `n`'s start, length and control, and enables it.
@@ -759,14 +815,8 @@ pub mod sw {
 /// master cycle (1 ms: the drive's control cycle and polls), then exchanges
 /// the process data (one LRW) and decodes the drive's TxPDO.
 pub struct Cyclic<'a> {
-    /// The master.
-    pub md: &'a MainDevice<'a>,
-    /// The group in Op.
-    pub group: &'a OpGroup,
-    /// The simulated line.
-    pub sim: &'a RefCell<Simulation>,
-    /// Position of the drive in the group.
-    pub slave: usize,
+    /// The drive, its group and master.
+    pub link: Link<'a>,
     /// The RxPDO image sent every cycle.
     pub out: [u8; RXPDO_LEN],
     /// The last TxPDO received.
@@ -775,28 +825,46 @@ pub struct Cyclic<'a> {
     pub cycles: u64,
 }
 
-/// One master cycle of drive `slave` of `group`: `out` written to its
-/// outputs, the simulated time one master cycle on, the frame exchanged (both
-/// its outputs written and inputs read, WKC 3); `read` of its inputs.
-async fn exchange<R>(
-    md: &MainDevice<'_>,
-    group: &OpGroup,
-    sim: &RefCell<Simulation>,
-    slave: usize,
-    out: &[u8],
-    read: impl FnOnce(&[u8]) -> R,
-) -> R {
-    let sd = group.subdevice(md, slave).expect("subdevice");
-    sd.outputs_raw_mut().copy_from_slice(out);
-    {
-        let mut sim = sim.borrow_mut();
-        let t = sim.now() + MASTER_CYCLE;
-        sim.advance_to(t);
+/// Drive `slave` of `group` (in Op) on the simulated line `sim` with the
+/// master `md`: what [`Cyclic`] and [`RawCyclic`] exchange process data
+/// with.
+#[derive(Clone, Copy)]
+pub struct Link<'a> {
+    /// The master.
+    pub md: &'a MainDevice<'a>,
+    /// The group in Op.
+    pub group: &'a OpGroup,
+    /// The simulated line.
+    pub sim: &'a RefCell<Simulation>,
+    /// Position of the drive in the group.
+    pub slave: usize,
+}
+
+impl Link<'_> {
+    /// The lengths of the drive's outputs and inputs as ethercrab configured
+    /// them.
+    fn lengths(&self) -> (usize, usize) {
+        let sd = self.group.subdevice(self.md, self.slave).expect("subdevice");
+        let io = sd.io_raw();
+        (io.outputs().len(), io.inputs().len())
     }
-    let r = group.tx_rx(md).await.expect("process data cycle");
-    assert_eq!(r.working_counter, 3, "outputs written and inputs read");
-    let io = sd.io_raw();
-    read(io.inputs())
+
+    /// One master cycle of the drive: `out` written to its outputs, the
+    /// simulated time one master cycle on, the frame exchanged (both its
+    /// outputs written and inputs read, WKC 3); `read` of its inputs.
+    async fn exchange<R>(&self, out: &[u8], read: impl FnOnce(&[u8]) -> R) -> R {
+        let sd = self.group.subdevice(self.md, self.slave).expect("subdevice");
+        sd.outputs_raw_mut().copy_from_slice(out);
+        {
+            let mut sim = self.sim.borrow_mut();
+            let t = sim.now() + MASTER_CYCLE;
+            sim.advance_to(t);
+        }
+        let r = self.group.tx_rx(self.md).await.expect("process data cycle");
+        assert_eq!(r.working_counter, 3, "outputs written and inputs read");
+        let io = sd.io_raw();
+        read(io.inputs())
+    }
 }
 
 impl<'a> Cyclic<'a> {
@@ -808,15 +876,17 @@ impl<'a> Cyclic<'a> {
         sim: &'a RefCell<Simulation>,
         slave: usize,
     ) -> Self {
-        let sd = group.subdevice(md, slave).expect("subdevice");
-        let io = sd.io_raw();
-        assert_eq!(io.outputs().len(), RXPDO_LEN, "standard RxPDO length");
-        assert_eq!(io.inputs().len(), TXPDO_LEN, "standard TxPDO length");
-        Self {
+        let link = Link {
             md,
             group,
             sim,
             slave,
+        };
+        let (o, i) = link.lengths();
+        assert_eq!(o, RXPDO_LEN, "standard RxPDO length");
+        assert_eq!(i, TXPDO_LEN, "standard TxPDO length");
+        Self {
+            link,
             out: [0; RXPDO_LEN],
             tx: TxPdo::default(),
             cycles: 0,
@@ -869,15 +939,7 @@ impl<'a> Cyclic<'a> {
 
     /// One master cycle; returns the TxPDO received.
     pub async fn cycle(&mut self) -> TxPdo {
-        self.tx = exchange(
-            self.md,
-            self.group,
-            self.sim,
-            self.slave,
-            &self.out,
-            TxPdo::decode,
-        )
-        .await;
+        self.tx = self.link.exchange(&self.out, TxPdo::decode).await;
         self.cycles += 1;
         self.tx
     }
@@ -952,7 +1014,7 @@ impl<'a> Cyclic<'a> {
 
     /// Simulated time.
     pub fn now(&self) -> Nanos {
-        self.sim.borrow().now()
+        self.link.sim.borrow().now()
     }
 }
 
@@ -983,14 +1045,8 @@ where
 /// controlword sits at byte 0 and 6060h at byte 2 of the RxPDO, the
 /// statusword at byte 0 of the TxPDO in every map.
 pub struct RawCyclic<'a> {
-    /// The master.
-    pub md: &'a MainDevice<'a>,
-    /// The group in Op.
-    pub group: &'a OpGroup,
-    /// The simulated line.
-    pub sim: &'a RefCell<Simulation>,
-    /// Position of the drive in the group.
-    pub slave: usize,
+    /// The drive, its group and master.
+    pub link: Link<'a>,
     /// The RxPDO image sent every cycle.
     pub out: Vec<u8>,
     /// The last TxPDO received.
@@ -1000,22 +1056,12 @@ pub struct RawCyclic<'a> {
 }
 
 impl<'a> RawCyclic<'a> {
-    /// A master on drive `slave` of `group` with the lengths ethercrab
+    /// A master on the drive of `link` with the lengths ethercrab
     /// configured; the outputs start all zero.
-    pub fn new(
-        md: &'a MainDevice<'a>,
-        group: &'a OpGroup,
-        sim: &'a RefCell<Simulation>,
-        slave: usize,
-    ) -> Self {
-        let sd = group.subdevice(md, slave).expect("subdevice");
-        let io = sd.io_raw();
-        let (o, i) = (io.outputs().len(), io.inputs().len());
+    pub fn new(link: Link<'a>) -> Self {
+        let (o, i) = link.lengths();
         Self {
-            md,
-            group,
-            sim,
-            slave,
+            link,
             out: vec![0; o],
             inputs: vec![0; i],
             cycles: 0,
@@ -1075,10 +1121,7 @@ impl<'a> RawCyclic<'a> {
     /// One master cycle (see [`Cyclic::cycle`]).
     pub async fn cycle(&mut self) {
         let inputs = &mut self.inputs;
-        exchange(self.md, self.group, self.sim, self.slave, &self.out, |i| {
-            inputs.copy_from_slice(i)
-        })
-        .await;
+        self.link.exchange(&self.out, |i| inputs.copy_from_slice(i)).await;
         self.cycles += 1;
     }
 

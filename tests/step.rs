@@ -43,6 +43,14 @@ pub async fn op_via_safe_op(
     group.into_op(md).await.expect("OP")
 }
 
+/// `group` (in PRE-OP, as [`init`](crate::init) leaves it) into SAFE-OP
+/// and back: the master's SyncManager set-up done, PRE-OP again (where a
+/// test changes what SAFE-OP checks).
+pub async fn sm_set_up(md: &MainDevice<'_>, group: SubDeviceGroup<8, 512>) -> SubDeviceGroup<8, 512> {
+    let group = group.into_safe_op(md).await.expect("SAFE-OP");
+    group.into_pre_op(md).await.expect("PRE-OP")
+}
+
 /// Object `index:sub` of the first drive set to `value` locally.
 pub fn set(sim: &RefCell<Simulation>, index: u16, sub: u8, value: i64) {
     sim.borrow_mut().drives_mut()[0]

@@ -18,6 +18,29 @@ fn text(b: &[u8]) -> String {
     String::from_utf8_lossy(b).into_owned()
 }
 
+/// What `hil-sim args` printed on stdout; it must succeed.
+fn stdout_of(args: &[&str]) -> String {
+    let o = hil_sim(args);
+    assert!(o.status.success(), "{o:?}");
+    text(&o.stdout)
+}
+
+/// `hil-sim args` refused with a message naming `path`; its stdout.
+fn refused_naming(args: &[&str], path: &str) -> String {
+    let o = hil_sim(args);
+    assert!(!o.status.success(), "{o:?}");
+    let (out, err) = (text(&o.stdout), text(&o.stderr));
+    assert!(err.contains(path), "the message names the path: {err}");
+    out
+}
+
+/// Each of `wants` must stand in `out`.
+fn assert_lists(out: &str, wants: &[&str]) {
+    for want in wants {
+        assert!(out.contains(want), "`{want}` missing in:\n{out}");
+    }
+}
+
 /// A directory of this test's own, removed at the end.
 struct Scratch(PathBuf);
 
@@ -68,42 +91,36 @@ impl Drop for Scratch {
 
 #[test]
 fn help_lists_the_subcommands() {
-    let o = hil_sim(&["--help"]);
-    assert!(o.status.success(), "{o:?}");
-    let out = text(&o.stdout);
-    for want in ["demo", "serve", "Usage: hil-sim"] {
-        assert!(out.contains(want), "`{want}` missing in:\n{out}");
-    }
+    let out = stdout_of(&["--help"]);
+    assert_lists(&out, &["demo", "serve", "Usage: hil-sim"]);
     assert!(out.ends_with('\n'), "help ends with a newline");
 }
 
 #[test]
 fn demo_help_lists_its_options() {
-    let o = hil_sim(&["demo", "--help"]);
-    assert!(o.status.success(), "{o:?}");
-    let out = text(&o.stdout);
-    for want in ["--pcap <FILE>", "--plot <FILE.svg>", "target/hil-sim-demo.svg"] {
-        assert!(out.contains(want), "`{want}` missing in:\n{out}");
-    }
+    let out = stdout_of(&["demo", "--help"]);
+    assert_lists(
+        &out,
+        &["--pcap <FILE>", "--plot <FILE.svg>", "target/hil-sim-demo.svg"],
+    );
 }
 
 #[test]
 fn serve_help_lists_its_options_not_the_test_ones() {
-    let o = hil_sim(&["serve", "--help"]);
-    assert!(o.status.success(), "{o:?}");
-    let out = text(&o.stdout);
-    for want in [
-        "--iface <IF>",
-        "--slaves <N>",
-        "--axes <1|2>",
-        "--pcap <FILE>",
-        "--seconds <S>",
-        "--plant <MODEL>",
-        "--plant-fault <FAULT>",
-        "--pwm-khz <KHZ>",
-    ] {
-        assert!(out.contains(want), "`{want}` missing in:\n{out}");
-    }
+    let out = stdout_of(&["serve", "--help"]);
+    assert_lists(
+        &out,
+        &[
+            "--iface <IF>",
+            "--slaves <N>",
+            "--axes <1|2>",
+            "--pcap <FILE>",
+            "--seconds <S>",
+            "--plant <MODEL>",
+            "--plant-fault <FAULT>",
+            "--pwm-khz <KHZ>",
+        ],
+    );
     assert!(
         !out.contains("--delay-us"),
         "test-only options stay hidden:\n{out}"
@@ -167,9 +184,7 @@ fn serve_plant_fault_needs_the_electrical_plant_and_an_unknown_plant_is_refused(
 /// `--flywheel` (which has no brake) is refused before anything runs.
 #[test]
 fn serve_plant_fault_offers_the_motor_actions_faults() {
-    let o = hil_sim(&["serve", "--help"]);
-    assert!(o.status.success(), "{o:?}");
-    let out = text(&o.stdout);
+    let out = stdout_of(&["serve", "--help"]);
     for want in [
         "short",
         "encoder",
@@ -217,10 +232,7 @@ fn demo_refuses_an_unwritable_plot_before_the_run() {
     let s = Scratch::new("plot");
     let plot = s.unwritable("x.svg");
     let plot = plot.to_str().unwrap();
-    let o = hil_sim(&["demo", "--plot", plot]);
-    assert!(!o.status.success(), "{o:?}");
-    let (out, err) = (text(&o.stdout), text(&o.stderr));
-    assert!(err.contains(plot), "the message names the path: {err}");
+    let out = refused_naming(&["demo", "--plot", plot], plot);
     assert!(!out.contains("plot:"), "no plot claimed: {out}");
     assert!(!out.contains("found"), "refused before the run: {out}");
 }
@@ -231,10 +243,7 @@ fn demo_refuses_an_unwritable_pcap_before_the_run() {
     let pcap = s.unwritable("a.pcap");
     let pcap = pcap.to_str().unwrap();
     let plot = s.0.join("x.svg");
-    let o = hil_sim(&["demo", "--pcap", pcap, "--plot", plot.to_str().unwrap()]);
-    assert!(!o.status.success(), "{o:?}");
-    let (out, err) = (text(&o.stdout), text(&o.stderr));
-    assert!(err.contains(pcap), "the message names the path: {err}");
+    let out = refused_naming(&["demo", "--pcap", pcap, "--plot", plot.to_str().unwrap()], pcap);
     assert!(!out.contains("recording"), "no recording claimed: {out}");
     assert!(!plot.exists(), "nothing ran, no plot");
 }
@@ -254,18 +263,18 @@ fn serve_refuses_an_unwritable_pcap_before_opening_the_interface() {
     let pcap = s.unwritable("a.pcap");
     let pcap = pcap.to_str().unwrap();
     // the interface does not exist either: the pcap is checked first
-    let o = hil_sim(&[
-        "serve",
-        "--iface",
-        "nonexistent0",
-        "--pcap",
+    let out = refused_naming(
+        &[
+            "serve",
+            "--iface",
+            "nonexistent0",
+            "--pcap",
+            pcap,
+            "--seconds",
+            "1",
+        ],
         pcap,
-        "--seconds",
-        "1",
-    ]);
-    assert!(!o.status.success(), "{o:?}");
-    let (out, err) = (text(&o.stdout), text(&o.stderr));
-    assert!(err.contains(pcap), "the message names the path: {err}");
+    );
     assert!(!out.contains("recording"), "no recording claimed: {out}");
 }
 
@@ -298,17 +307,16 @@ fn no_subcommand_runs_the_demo_with_the_default_plot() {
 
 #[test]
 fn demo_help_documents_the_fieldbus_and_its_plot() {
-    let o = hil_sim(&["demo", "--help"]);
-    assert!(o.status.success(), "{o:?}");
-    let out = text(&o.stdout);
-    for want in [
-        "--fieldbus <BUS>",
-        "ethercat",
-        "profinet",
-        "target/hil-sim-demo-pn.svg",
-    ] {
-        assert!(out.contains(want), "`{want}` missing in:\n{out}");
-    }
+    let out = stdout_of(&["demo", "--help"]);
+    assert_lists(
+        &out,
+        &[
+            "--fieldbus <BUS>",
+            "ethercat",
+            "profinet",
+            "target/hil-sim-demo-pn.svg",
+        ],
+    );
 }
 
 #[test]
@@ -324,10 +332,7 @@ fn demo_profinet_refuses_an_unwritable_plot_before_the_run() {
     let s = Scratch::new("pn-plot");
     let plot = s.unwritable("x.svg");
     let plot = plot.to_str().unwrap();
-    let o = hil_sim(&["demo", "--fieldbus", "profinet", "--plot", plot]);
-    assert!(!o.status.success(), "{o:?}");
-    let (out, err) = (text(&o.stdout), text(&o.stderr));
-    assert!(err.contains(plot), "the message names the path: {err}");
+    let out = refused_naming(&["demo", "--fieldbus", "profinet", "--plot", plot], plot);
     assert!(!out.contains("plot:"), "no plot claimed: {out}");
     assert!(!out.contains("AR "), "refused before the run: {out}");
 }
@@ -355,20 +360,21 @@ fn demo_self_tune_options_are_profinet_only_and_checked() {
 #[test]
 fn p219_p227_demo_profinet_writes_the_plot_and_the_pcap_it_names() {
     let (out, svg, p, _) = demo_recorded("demo-pn", &["--fieldbus", "profinet"]);
-    for want in [
-        "state SOI -> RTSO",
-        "drive_is_enabled 0->1",
-        "home_valid 0->1",
-        "target_reached 0->1",
-        "operation_mode_actual 0x10 -> 0x08",
-        "jog_pos: moved",
-        "PKW write 6065h.0: 20000",
-        "state OP -> fault",
-        "summary:",
-        "following error max",
-    ] {
-        assert!(out.contains(want), "`{want}` missing in:\n{out}");
-    }
+    assert_lists(
+        &out,
+        &[
+            "state SOI -> RTSO",
+            "drive_is_enabled 0->1",
+            "home_valid 0->1",
+            "target_reached 0->1",
+            "operation_mode_actual 0x10 -> 0x08",
+            "jog_pos: moved",
+            "PKW write 6065h.0: 20000",
+            "state OP -> fault",
+            "summary:",
+            "following error max",
+        ],
+    );
     assert!(svg.contains("ZSW1 state"), "the state panel");
     assert!(p.len() > 1_000_000, "both directions every ms: {} bytes", p.len());
 }
@@ -385,9 +391,7 @@ fn p219_p227_demo_profinet_writes_the_plot_and_the_pcap_it_names() {
 fn c035_demo_csp_on_the_electrical_plant_lags_less_than_one_cycle_of_travel() {
     let s = Scratch::new("demo-electrical");
     let plot = s.0.join("run.svg");
-    let o = hil_sim(&["demo", "--plant", "electrical", "--plot", plot.to_str().unwrap()]);
-    assert!(o.status.success(), "{o:?}");
-    let out = text(&o.stdout);
+    let out = stdout_of(&["demo", "--plant", "electrical", "--plot", plot.to_str().unwrap()]);
     let max: f64 = out
         .split("following error max ")
         .nth(1)

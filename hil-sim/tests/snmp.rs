@@ -64,6 +64,20 @@ fn control(line: &PnLine, command: &str, expect: &str) {
 /// The controller's own address, which its LLDPDU announces as management address.
 const CONTROLLER_ADDR: &str = "192.168.0.10";
 
+/// `snmpwalk` of `oid` with the community "public"; it must succeed.
+fn walk_public(line: &PnLine, oid: &str) -> String {
+    let (ok, walk) = snmp(line, "snmpwalk", &v2c("public", &[oid]));
+    assert!(ok, "{walk}");
+    walk
+}
+
+/// Each of `rows` ("suffix = value") below the OID `prefix` stands in `walk`.
+fn has_rows(walk: &str, prefix: &str, rows: &[&str]) {
+    for row in rows {
+        has(walk, &format!("{prefix}{row}"));
+    }
+}
+
 fn has(walk: &str, line: &str) {
     assert!(walk.contains(line), "{line:?} missing:\n{walk}");
 }
@@ -72,8 +86,7 @@ fn has(walk: &str, line: &str) {
 /// 802.3 extensions: what the device sends and what the neighbour sent.
 fn lldp_extensions(line: &PnLine, mau: &str, peer_station: &str) {
     let ip = DEVICE_IP;
-    let (ok, walk) = snmp(line, "snmpwalk", &v2c("public", &[".1.0.8802.1.1.2.1.3.8"]));
-    assert!(ok, "{walk}");
+    let walk = walk_public(line, ".1.0.8802.1.1.2.1.3.8");
     // lldpLocManAddrTable: index ipV4(1).4.<address>; length 5, ifIndex(2) 1
     has(&walk, &format!(".1.0.8802.1.1.2.1.3.8.1.3.1.4.{ip} = INTEGER: 5"));
     has(&walk, &format!(".1.0.8802.1.1.2.1.3.8.1.4.1.4.{ip} = INTEGER: 2"));
@@ -81,15 +94,13 @@ fn lldp_extensions(line: &PnLine, mau: &str, peer_station: &str) {
     has(&walk, &format!(".1.0.8802.1.1.2.1.3.8.1.6.1.4.{ip} = OID: .0.0"));
     assert_eq!(walk.lines().count(), 4, "{walk}");
     // lldpConfigManAddrTable: both ports send the address (LldpPortList: ports 1, 2)
-    let (ok, walk) = snmp(line, "snmpwalk", &v2c("public", &[".1.0.8802.1.1.2.1.1.7"]));
-    assert!(ok, "{walk}");
+    let walk = walk_public(line, ".1.0.8802.1.1.2.1.1.7");
     has(
         &walk,
         &format!(".1.0.8802.1.1.2.1.1.7.1.1.1.4.{ip} = Hex-STRING: C0"),
     );
     // lldpRemManAddrTable: the neighbour's address on port 1 (time mark 0, index 1)
-    let (ok, walk) = snmp(line, "snmpwalk", &v2c("public", &[".1.0.8802.1.1.2.1.4.2"]));
-    assert!(ok, "{walk}");
+    let walk = walk_public(line, ".1.0.8802.1.1.2.1.4.2");
     let c = CONTROLLER_ADDR;
     has(
         &walk,
@@ -102,8 +113,7 @@ fn lldp_extensions(line: &PnLine, mau: &str, peer_station: &str) {
 
     // LLDP-EXT-PNO-MIB: NameOfStation as DCP set it on both ports, RT2/RT3 off;
     // the neighbour's delays, port status and name as its LLDPDU carried them
-    let (ok, walk) = snmp(line, "snmpwalk", &v2c("public", &[".1.0.8802.1.1.2.1.5.3791"]));
-    assert!(ok, "{walk}");
+    let walk = walk_public(line, ".1.0.8802.1.1.2.1.5.3791");
     let loc = ".1.0.8802.1.1.2.1.5.3791.1.2.1.1";
     for port in [1, 2] {
         has(&walk, &format!("{loc}.6.{port} = STRING: \"{DEVICE_NAME}\""));
@@ -112,27 +122,44 @@ fn lldp_extensions(line: &PnLine, mau: &str, peer_station: &str) {
         has(&walk, &format!("{loc}.1.{port} = Gauge32: 0"));
     }
     let rem = ".1.0.8802.1.1.2.1.5.3791.1.3.1.1";
-    has(&walk, &format!("{rem}.1.0.1.1 = Gauge32: 55"));
-    has(&walk, &format!("{rem}.2.0.1.1 = Gauge32: 1123"));
-    has(&walk, &format!("{rem}.3.0.1.1 = Gauge32: 444"));
-    has(&walk, &format!("{rem}.4.0.1.1 = INTEGER: 2"));
-    has(&walk, &format!("{rem}.6.0.1.1 = STRING: \"{peer_station}\""));
+    has_rows(
+        &walk,
+        rem,
+        &[
+            ".1.0.1.1 = Gauge32: 55",
+            ".2.0.1.1 = Gauge32: 1123",
+            ".3.0.1.1 = Gauge32: 444",
+            ".4.0.1.1 = INTEGER: 2",
+            &format!(".6.0.1.1 = STRING: \"{peer_station}\""),
+        ],
+    );
     // 6 columns x 2 local ports + 6 for the one neighbour
     assert_eq!(walk.lines().count(), 18, "{walk}");
 
     // LLDP-EXT-DOT3-MIB: auto-negotiation on, 10/100 advertised, the MAU type
     // PDPortDataReal reports on port 1; the neighbour's MAC/PHY TLV
-    let (ok, walk) = snmp(line, "snmpwalk", &v2c("public", &[".1.0.8802.1.1.2.1.5.4623"]));
-    assert!(ok, "{walk}");
+    let walk = walk_public(line, ".1.0.8802.1.1.2.1.5.4623");
     let loc = ".1.0.8802.1.1.2.1.5.4623.1.2.1.1";
-    has(&walk, &format!("{loc}.1.1 = INTEGER: 1"));
-    has(&walk, &format!("{loc}.2.1 = INTEGER: 1"));
-    has(&walk, &format!("{loc}.3.1 = Hex-STRING: 6C 00"));
-    has(&walk, &format!("{loc}.4.1 = INTEGER: {mau}"));
+    has_rows(
+        &walk,
+        loc,
+        &[
+            ".1.1 = INTEGER: 1",
+            ".2.1 = INTEGER: 1",
+            ".3.1 = Hex-STRING: 6C 00",
+            &format!(".4.1 = INTEGER: {mau}"),
+        ],
+    );
     let rem = ".1.0.8802.1.1.2.1.5.4623.1.3.1.1";
-    has(&walk, &format!("{rem}.1.0.1.1 = INTEGER: 1"));
-    has(&walk, &format!("{rem}.2.0.1.1 = INTEGER: 2"));
-    has(&walk, &format!("{rem}.4.0.1.1 = INTEGER: 16"));
+    has_rows(
+        &walk,
+        rem,
+        &[
+            ".1.0.1.1 = INTEGER: 1",
+            ".2.0.1.1 = INTEGER: 2",
+            ".4.0.1.1 = INTEGER: 16",
+        ],
+    );
     assert_eq!(walk.lines().count(), 4 * 2 + 4, "{walk}");
     assert_eq!(
         mau, "16",
@@ -155,8 +182,7 @@ fn counter(walk: &str, oid: &str) -> u64 {
 /// `snmpwalk -v2c -On` of lldpConfiguration and lldpStatistics: the timing the
 /// transmitter uses, and counters that saw the neighbour's LLDPDU on port 1.
 fn lldp_config_and_statistics(line: &PnLine) {
-    let (ok, walk) = snmp(line, "snmpwalk", &v2c("public", &[".1.0.8802.1.1.2.1.1"]));
-    assert!(ok, "{walk}");
+    let walk = walk_public(line, ".1.0.8802.1.1.2.1.1");
     let interval = profinet::lldp::TX_INTERVAL.as_secs();
     let c = ".1.0.8802.1.1.2.1.1";
     has(&walk, &format!("{c}.1.0 = INTEGER: {interval}"));
@@ -179,8 +205,7 @@ fn lldp_config_and_statistics(line: &PnLine) {
     );
     assert!(!ok && out.contains("notWritable"), "{out}");
 
-    let (ok, walk) = snmp(line, "snmpwalk", &v2c("public", &[".1.0.8802.1.1.2.1.2"]));
-    assert!(ok, "{walk}");
+    let walk = walk_public(line, ".1.0.8802.1.1.2.1.2");
     let s = ".1.0.8802.1.1.2.1.2";
     assert!(walk.contains(&format!("{s}.1.0 = Timeticks:")), "{walk}");
     assert!(counter(&walk, &format!("{s}.2.0")) >= 1, "inserts:\n{walk}");

@@ -27,15 +27,10 @@
 mod common;
 
 use common::scratch;
-use common::soem_line::{pysoem_python, Line, SCRIPT_LIMIT};
+use common::soem_line::{pysoem_turn, soem_row, Line, SCRIPT_LIMIT};
 use ecat::Dictionary;
-use hil_sim::matrix::Row;
 use std::fmt::Write as _;
 use std::path::Path;
-use std::sync::Mutex;
-
-/// One SOEM run at a time: each needs the cores for its 1 ms cycle.
-static ONE_AT_A_TIME: Mutex<()> = Mutex::new(());
 
 /// Drives on the line.
 const SLAVES: usize = 3;
@@ -112,10 +107,9 @@ fn od_listing() -> String {
 /// data in Op, the cycles with a wrong working counter printed.
 #[test]
 fn e002_e005_e080_e082_e045_e029_e015_soem_line_scan_sdo_info_pdo_dc_cia402() {
-    let Some(python) = common::or_skip(pysoem_python(), "soem line test") else {
+    let Some((python, _one)) = pysoem_turn("soem line test") else {
         return;
     };
-    let _one = ONE_AT_A_TIME.lock().unwrap_or_else(|e| e.into_inner());
     let dir = scratch("soem-line");
     let sii = dir.join("sii.bin");
     let od = dir.join("od.tsv");
@@ -148,10 +142,9 @@ fn e002_e005_e080_e082_e045_e029_e015_soem_line_scan_sdo_info_pdo_dc_cia402() {
 /// the UDP parameter service (port 5011) of every drive (E-095).
 #[test]
 fn e096_e095_e098_soem_set_ip_ping_and_udp_through_a_tap_bridge() {
-    let Some(python) = common::or_skip(pysoem_python(), "soem EoE test") else {
+    let Some((python, _one)) = pysoem_turn("soem EoE test") else {
         return;
     };
-    let _one = ONE_AT_A_TIME.lock().unwrap_or_else(|e| e.into_inner());
     let dir = scratch("soem-eoe");
     // A166 "IP address reference" as a fresh drive declares it (the UDP read's answer)
     let a166 = drive_ecat::DriveObjects::default()
@@ -182,10 +175,9 @@ fn e096_e095_e098_soem_set_ip_ping_and_udp_through_a_tap_bridge() {
 /// seen: `tools/foe-image/tests/round_trip.rs`).
 #[test]
 fn e019_foe_file_for_the_update_slot_through_soem_firm_update() {
-    let Some(python) = common::or_skip(pysoem_python(), "soem FoE test") else {
+    let Some((python, _one)) = pysoem_turn("soem FoE test") else {
         return;
     };
-    let _one = ONE_AT_A_TIME.lock().unwrap_or_else(|e| e.into_inner());
     let dir = scratch("soem-foe");
     let body = hil_sim::sim::firmware_body(64 * 1024, 0);
     // the image linked for each slot of `serve`'s drive, signed with the
@@ -254,9 +246,6 @@ fn e019_foe_file_for_the_update_slot_through_soem_firm_update() {
 
 /// Drives on the line of the fault cases.
 const FAULT_SLAVES: usize = 2;
-/// The peer of the SOEM rows of the fault matrix (`scripts/fault-matrix`
-/// lets them be missing when no SOEM test ran, and checks them when one did).
-const SOEM_PEER: &str = "SOEM (pysoem) over veth";
 
 /// Runs `faults.py --case <case>` on a line of [`FAULT_SLAVES`] drives
 /// (`tag`: one letter for the namespaces); the rows it printed (`ROW
@@ -300,32 +289,28 @@ fn seen_in<'a>(rows: &'a [(String, String)], order: &str) -> &'a str {
 /// at least as long as A258 repeats a case (faults.py).
 #[test]
 fn e126_e044_e128_e129_soem_frame_pauses_under_dc_with_a258_100_ms() {
-    let Some(python) = common::or_skip(pysoem_python(), "soem fault matrix (frame pauses)") else {
+    let Some((python, _one)) = pysoem_turn("soem fault matrix (frame pauses)") else {
         return;
     };
-    let _one = ONE_AT_A_TIME.lock().unwrap_or_else(|e| e.into_inner());
     let rows = fault_rows(&python, "p", &["pause"]);
-    let short = Row {
-        order: "61",
-        case: "SOEM in Op under DC SYNC0 1 ms (axis A of both drives enabled in pv at standstill), A258 = 100 ms: \
+    let short = soem_row(
+        "61",
+        "SOEM in Op under DC SYNC0 1 ms (axis A of both drives enabled in pv at standstill), A258 = 100 ms: \
                no frame from the master for 20 ms",
-        spec: "E-126",
-        peer: SOEM_PEER,
-        expected: "drives 1, 2: Op, AL 0000h; axis A Operation enabled, axis B Switch on disabled; no EMCY; \
+        "E-126",
+        "drives 1, 2: Op, AL 0000h; axis A Operation enabled, axis B Switch on disabled; no EMCY; \
                    603Fh 0000h, 683Fh 0000h; history: no new message",
-    };
+    );
     hil_sim::fault_row!(short, seen_in(&rows, "61"));
-    let long = Row {
-        order: "62",
-        case: "the same, no frame for 500 ms; then SOEM acknowledges, requests Op and resets the faults",
-        spec: "E-126, E-044, E-128, E-129, C-017",
-        peer: SOEM_PEER,
-        expected:
-            "drives 1, 2: Safe-Op + ERR, AL 001Bh; axis A Fault, axis B Fault; EMCY 7500h/10h event 52 \
+    let long = soem_row(
+        "62",
+        "the same, no frame for 500 ms; then SOEM acknowledges, requests Op and resets the faults",
+        "E-126, E-044, E-128, E-129, C-017",
+        "drives 1, 2: Safe-Op + ERR, AL 001Bh; axis A Fault, axis B Fault; EMCY 7500h/10h event 52 \
                    cause 6; 603Fh 7500h, 683Fh 7500h; history: error AL 001Bh; the master acknowledges and \
                    requests Op: drives 1, 2: Op, AL 0000h; a fault reset: axis A Switch on disabled, axis B \
                    Switch on disabled; 6065h 123456, A258 100",
-    };
+    );
     hil_sim::fault_row!(long, seen_in(&rows, "62"));
 }
 
@@ -342,23 +327,21 @@ fn e126_e044_e128_e129_soem_frame_pauses_under_dc_with_a258_100_ms() {
 /// SYNC0 (docs/fault-matrix.md, the SYNC0 loss in Init).
 #[test]
 fn e126_e044_e037_e021_soem_master_killed_in_op_and_a_new_master() {
-    let Some(python) = common::or_skip(pysoem_python(), "soem fault matrix (master killed)") else {
+    let Some((python, _one)) = pysoem_turn("soem fault matrix (master killed)") else {
         return;
     };
-    let _one = ONE_AT_A_TIME.lock().unwrap_or_else(|e| e.into_inner());
     let rows = fault_rows(&python, "r", &["restart"]);
-    let killed = Row {
-        order: "63",
-        case: "the SOEM master process is killed (SIGKILL) in Op (free run, axis A enabled in pv; it wrote A258 = \
+    let killed = soem_row(
+        "63",
+        "the SOEM master process is killed (SIGKILL) in Op (free run, axis A enabled in pv; it wrote A258 = \
                100 ms and 6065h); 500 ms later a new SOEM master process scans and brings the line to Op",
-        spec: "E-126, E-044, E-037, E-021",
-        peer: SOEM_PEER,
-        expected: "500 ms after the kill (AL status by a raw APRD frame): drives 1, 2: Safe-Op + ERR, AL 001Bh; \
+        "E-126, E-044, E-037, E-021",
+        "500 ms after the kill (AL status by a raw APRD frame): drives 1, 2: Safe-Op + ERR, AL 001Bh; \
                    the new master's scan: drives 1, 2: Pre-Op, AL 0000h; axis A Fault, axis B Fault; no EMCY; \
                    603Fh 7500h, 683Fh 7500h; history: error AL 001Bh; 6065h 654321, A258 100; its maps, \
                    Safe-Op, Op, a fault reset and the enable: drives 1, 2: Op, AL 0000h; axis A Operation \
                    enabled, axis B Switch on disabled",
-    };
+    );
     hil_sim::fault_row!(killed, seen_in(&rows, "63"));
 }
 
@@ -371,21 +354,18 @@ fn e126_e044_e037_e021_soem_master_killed_in_op_and_a_new_master() {
 /// cleared a PLL fault latched below Safe-Op).
 #[test]
 fn e046_e021_soem_a_master_stopped_in_init_and_a_new_master_under_dc() {
-    let Some(python) = common::or_skip(pysoem_python(), "soem fault matrix (stop and restart under DC)")
-    else {
+    let Some((python, _one)) = pysoem_turn("soem fault matrix (stop and restart under DC)") else {
         return;
     };
-    let _one = ONE_AT_A_TIME.lock().unwrap_or_else(|e| e.into_inner());
     let rows = fault_rows(&python, "s", &["stop-restart"]);
-    let row = Row {
-        order: "64",
-        case: "a SOEM master stops as SOEM's samples do (Op, Safe-Op, Init, socket closed, SYNC0 left running); \
+    let row = soem_row(
+        "64",
+        "a SOEM master stops as SOEM's samples do (Op, Safe-Op, Init, socket closed, SYNC0 left running); \
                300 ms later a new SOEM master process scans and brings the line to Op under DC SYNC0",
-        spec: "E-046, E-021",
-        peer: SOEM_PEER,
-        expected: "the new master's scan, maps, DC, Safe-Op and Op request: drives 1, 2: Op, AL 0000h; the \
+        "E-046, E-021",
+        "the new master's scan, maps, DC, Safe-Op and Op request: drives 1, 2: Op, AL 0000h; the \
                    enable: drives 1, 2: axis A Operation enabled; 6065h 654321, A258 100",
-    };
+    );
     hil_sim::fault_row!(row, seen_in(&rows, "64"));
 }
 
@@ -399,10 +379,9 @@ fn e046_e021_soem_a_master_stopped_in_init_and_a_new_master_under_dc() {
 /// (`torque.py`).
 #[test]
 fn c039_soem_raises_g472_g475_by_sdo_and_cst_pt_move_the_axis() {
-    let Some(python) = common::or_skip(pysoem_python(), "soem torque-mode test") else {
+    let Some((python, _one)) = pysoem_turn("soem torque-mode test") else {
         return;
     };
-    let _one = ONE_AT_A_TIME.lock().unwrap_or_else(|e| e.into_inner());
     let dir = scratch("soem-torque");
     // I10, the reference of G472/G475's percentages, as a fresh drive has it
     let i10 = drive_ecat::DriveObjects::new()

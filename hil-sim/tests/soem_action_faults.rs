@@ -10,17 +10,8 @@
 mod common;
 
 use common::scratch;
-use common::soem_line::{pysoem_python, Line, SCRIPT_LIMIT};
-use hil_sim::matrix::Row;
+use common::soem_line::{pysoem_turn, soem_row, Line, SCRIPT_LIMIT};
 use std::path::Path;
-use std::sync::Mutex;
-
-/// One SOEM run at a time: each needs the cores for its 1 ms cycle.
-static ONE_AT_A_TIME: Mutex<()> = Mutex::new(());
-
-/// The peer of the SOEM rows (as `soem.rs`'s: `scripts/fault-matrix` checks
-/// them when any SOEM row was left).
-const SOEM_PEER: &str = "SOEM (pysoem) over veth";
 
 /// What every case ends with besides the action's own words: no fault, no
 /// diagnosis message, the motor data and the commutation offset as before,
@@ -55,11 +46,6 @@ fn seen_with(python: &Path, tag: &str, fault: &str, order: &str) -> String {
         .unwrap_or_else(|| line.fail_with(&format!("action_faults.py printed no row {order}")))
 }
 
-/// The python, or `None` (the test says why it did not run).
-fn python(what: &str) -> Option<std::path::PathBuf> {
-    common::or_skip(pysoem_python(), &format!("soem {what}"))
-}
-
 /// E-140, E-141 (B40 test phase) through SOEM, fault matrix rows 65 and 66:
 /// on a plant with motor phases V and W swapped (`--plant-fault
 /// swapped-phases`) the turning field turns the rotor backwards, and on one
@@ -69,27 +55,26 @@ fn python(what: &str) -> Option<std::path::PathBuf> {
 /// changed.
 #[test]
 fn e140_b40_soem_swapped_phases_and_a_reversed_encoder_fail_test_phase_with_7() {
-    let Some(python) = python("B40 plant faults") else {
+    let Some((python, _one)) = pysoem_turn("soem B40 plant faults") else {
         return;
     };
-    let _one = ONE_AT_A_TIME.lock().unwrap_or_else(|e| e.into_inner());
-    let swapped = Row {
-        order: "65",
-        case: "electrical plant: motor phases V and W swapped (`serve --plant-fault swapped-phases`); \
-               B40 test phase started by A75 in Ready to switch on, then the enable (cst)",
-        spec: "E-140, E-141",
-        peer: SOEM_PEER,
-        expected: &format!("B40: A69 failed (the selector shown), B40[0] 7; the count negative; {UNCHANGED}"),
-    };
+    let expected = format!("B40: A69 failed (the selector shown), B40[0] 7; the count negative; {UNCHANGED}");
+    let swapped = soem_row(
+        "65",
+        "electrical plant: motor phases V and W swapped (`serve --plant-fault swapped-phases`); \
+         B40 test phase started by A75 in Ready to switch on, then the enable (cst)",
+        "E-140, E-141",
+        &expected,
+    );
     hil_sim::fault_row!(swapped, seen_with(&python, "fp", "swapped-phases", "65"));
-    let reversed = Row {
-        order: "66",
-        case: "electrical plant: the encoder counts the other way (`serve --plant-fault \
-               reversed-encoder`); B40 test phase as row 65",
-        spec: "E-140, E-141",
-        peer: SOEM_PEER,
-        expected: &format!("B40: A69 failed (the selector shown), B40[0] 7; the count -2^20/4; {UNCHANGED}"),
-    };
+    let expected = format!("B40: A69 failed (the selector shown), B40[0] 7; the count -2^20/4; {UNCHANGED}");
+    let reversed = soem_row(
+        "66",
+        "electrical plant: the encoder counts the other way (`serve --plant-fault \
+         reversed-encoder`); B40 test phase as row 65",
+        "E-140, E-141",
+        &expected,
+    );
     hil_sim::fault_row!(reversed, seen_with(&python, "fe", "reversed-encoder", "66"));
 }
 
@@ -102,33 +87,32 @@ fn e140_b40_soem_swapped_phases_and_a_reversed_encoder_fail_test_phase_with_7() 
 /// A69 "failed", nothing else changed.
 #[test]
 fn e140_b43_soem_an_open_phase_and_an_unbalanced_winding_fail_with_their_codes() {
-    let Some(python) = python("B43 plant faults") else {
+    let Some((python, _one)) = pysoem_turn("soem B43 plant faults") else {
         return;
     };
-    let _one = ONE_AT_A_TIME.lock().unwrap_or_else(|e| e.into_inner());
-    let open = Row {
-        order: "67",
-        case: "electrical plant: motor phase W open (`serve --plant-fault open-phase`); B43 test \
-               winding started by A75 in Ready to switch on (no enable), then B40 test phase as row 65",
-        spec: "E-140, E-141",
-        peer: SOEM_PEER,
-        expected: &format!(
-            "B43: A69 failed (the selector shown), B43[0] 2, E48 2 throughout; {UNCHANGED}; \
+    let expected = format!(
+        "B43: A69 failed (the selector shown), B43[0] 2, E48 2 throughout; {UNCHANGED}; \
              B40: A69 failed (the selector shown), B40[0] 2; {UNCHANGED}"
-        ),
-    };
+    );
+    let open = soem_row(
+        "67",
+        "electrical plant: motor phase W open (`serve --plant-fault open-phase`); B43 test \
+         winding started by A75 in Ready to switch on (no enable), then B40 test phase as row 65",
+        "E-140, E-141",
+        &expected,
+    );
     hil_sim::fault_row!(open, seen_with(&python, "fo", "open-phase", "67"));
-    let unbalanced = Row {
-        order: "68",
-        case: "electrical plant: phase V's resistance 10 % high (`serve --plant-fault \
-               unbalanced-winding`); B43 test winding as row 67",
-        spec: "E-140, E-141",
-        peer: SOEM_PEER,
-        expected: &format!(
-            "B43: A69 failed (the selector shown), B43[0] 6, E48 2 throughout; \
+    let expected = format!(
+        "B43: A69 failed (the selector shown), B43[0] 6, E48 2 throughout; \
              U, V, W 1.016 R, 1.067 R, 1.016 R; {UNCHANGED}"
-        ),
-    };
+    );
+    let unbalanced = soem_row(
+        "68",
+        "electrical plant: phase V's resistance 10 % high (`serve --plant-fault \
+         unbalanced-winding`); B43 test winding as row 67",
+        "E-140, E-141",
+        &expected,
+    );
     hil_sim::fault_row!(unbalanced, seen_with(&python, "fu", "unbalanced-winding", "68"));
 }
 
@@ -139,20 +123,19 @@ fn e140_b43_soem_an_open_phase_and_an_unbalanced_winding_fail_with_their_codes()
 /// its own control (E48 = 4), nothing else changed.
 #[test]
 fn e140_b300_soem_a_slipping_brake_fails_test_brake_with_9() {
-    let Some(python) = python("B300 plant fault") else {
+    let Some((python, _one)) = pysoem_turn("soem B300 plant fault") else {
         return;
     };
-    let _one = ONE_AT_A_TIME.lock().unwrap_or_else(|e| e.into_inner());
-    let slipping = Row {
-        order: "69",
-        case: "the holding brake worn to 1.0 N·m, below the rated torque (`serve --plant-fault \
-               slipping-brake`); B300 test brake started by A75 in Ready to switch on, then the enable",
-        spec: "E-140, E-141",
-        peer: SOEM_PEER,
-        expected: &format!(
-            "B300: A69 failed (the selector shown), B300[0] 9, moved beyond 1/360 rev, E48 4; {UNCHANGED}"
-        ),
-    };
+    let expected = format!(
+        "B300: A69 failed (the selector shown), B300[0] 9, moved beyond 1/360 rev, E48 4; {UNCHANGED}"
+    );
+    let slipping = soem_row(
+        "69",
+        "the holding brake worn to 1.0 N·m, below the rated torque (`serve --plant-fault \
+         slipping-brake`); B300 test brake started by A75 in Ready to switch on, then the enable",
+        "E-140, E-141",
+        &expected,
+    );
     hil_sim::fault_row!(slipping, seen_with(&python, "fs", "slipping-brake", "69"));
 }
 
@@ -163,19 +146,17 @@ fn e140_b300_soem_a_slipping_brake_fails_test_brake_with_9() {
 /// tenth of 2^18 inc): B301 fails with 11, nothing else changed.
 #[test]
 fn e140_b301_soem_a_stuck_brake_fails_grind_brake_with_11() {
-    let Some(python) = python("B301 plant fault") else {
+    let Some((python, _one)) = pysoem_turn("soem B301 plant fault") else {
         return;
     };
-    let _one = ONE_AT_A_TIME.lock().unwrap_or_else(|e| e.into_inner());
-    let stuck = Row {
-        order: "70",
-        case: "the holding brake stays closed whatever is commanded (`serve --plant-fault stuck-brake`); \
-               B301 grind brake started by A75 in Ready to switch on, then the enable (cst)",
-        spec: "E-140, E-141",
-        peer: SOEM_PEER,
-        expected: &format!(
-            "B301: A69 failed (the selector shown), B301[0] 11, ground, not released; {UNCHANGED}"
-        ),
-    };
+    let expected =
+        format!("B301: A69 failed (the selector shown), B301[0] 11, ground, not released; {UNCHANGED}");
+    let stuck = soem_row(
+        "70",
+        "the holding brake stays closed whatever is commanded (`serve --plant-fault stuck-brake`); \
+         B301 grind brake started by A75 in Ready to switch on, then the enable (cst)",
+        "E-140, E-141",
+        &expected,
+    );
     hil_sim::fault_row!(stuck, seen_with(&python, "fk", "stuck-brake", "70"));
 }

@@ -10,19 +10,14 @@
 mod common;
 
 use common::scratch;
-use common::soem_line::{pysoem_python, Line};
-use std::sync::Mutex;
-
-/// One SOEM run at a time.
-static ONE_AT_A_TIME: Mutex<()> = Mutex::new(());
+use common::soem_line::{pysoem_turn, Line};
 
 /// Runs `conformance.py --case <case>` on a line of one drive (`tag`: one
 /// letter for the namespaces); fails with serve's log.
 fn run_case(tag: &str, case: &str) {
-    let Some(python) = common::or_skip(pysoem_python(), &format!("soem conformance case {case}")) else {
+    let Some((python, _one)) = pysoem_turn(&format!("soem conformance case {case}")) else {
         return;
     };
-    let _one = ONE_AT_A_TIME.lock().unwrap_or_else(|e| e.into_inner());
     let dir = scratch(&format!("soem-conformance-{case}"));
     let line = Line::new(tag, 1, 90, &dir);
     let status = line.run(&python, "conformance.py", &["--case", case]);

@@ -9,6 +9,20 @@ mod common;
 use common::scratch;
 use common::soem_line::{pysoem_python, Line};
 
+/// `script` with `args` through SOEM against one drive on the line `tag`
+/// that `hil-sim serve --plant electrical` runs for `seconds` (with
+/// `serve`'s further arguments); its failure fails the test. Skipped
+/// without pysoem.
+fn on_the_electrical_plant(tag: &str, seconds: u32, serve: &[&str], script: &str, args: &[&str]) {
+    let Some(python) = common::or_skip(pysoem_python(), &format!("soem {script} test")) else {
+        return;
+    };
+    let dir = scratch(&format!("soem-{}", script.trim_end_matches(".py")));
+    let serve = [&["--plant", "electrical"], serve].concat();
+    let line = Line::with_serve_args(tag, 1, seconds, &dir, &serve);
+    line.run_passes(&python, script, args);
+}
+
 /// C-038, P-187 through SOEM on the electrical plant (`cst_electrical.py`):
 /// 6071h steps of ±10 %, ±50 %, ±100 % of the rated torque in cst give a
 /// 6077h (kt times the measured iq, averaged over the control cycle) within
@@ -16,15 +30,10 @@ use common::soem_line::{pysoem_python, Line};
 /// rotor is below half the speed limit (G472/G475 = 100 % of I10).
 #[test]
 fn c038_p187_soem_cst_steps_on_the_electrical_plant_give_6077h_within_2_percent() {
-    let Some(python) = common::or_skip(pysoem_python(), "soem electrical test") else {
-        return;
-    };
-    let dir = scratch("soem-cst-electrical");
     let i10 = drive_ecat::DriveObjects::new()
         .get(drive_ecat::params::I10, 0)
         .expect("I10 declared");
-    let line = Line::with_serve_args("e", 1, 120, &dir, &["--plant", "electrical"]);
-    line.run_passes(&python, "cst_electrical.py", &["--i10", &i10.to_string()]);
+    on_the_electrical_plant("e", 120, &[], "cst_electrical.py", &["--i10", &i10.to_string()]);
 }
 
 /// C-038 and E-089 through SOEM on the electrical plant
@@ -39,12 +48,7 @@ fn c038_p187_soem_cst_steps_on_the_electrical_plant_give_6077h_within_2_percent(
 /// event 45).
 #[test]
 fn c038_e089_soem_max_current_and_motor_i2t_on_the_electrical_plant() {
-    let Some(python) = common::or_skip(pysoem_python(), "soem motor protection test") else {
-        return;
-    };
-    let dir = scratch("soem-motor-protection");
-    let line = Line::with_serve_args("m", 1, 120, &dir, &["--plant", "electrical"]);
-    line.run_passes(&python, "motor_protection.py", &[]);
+    on_the_electrical_plant("m", 120, &[], "motor_protection.py", &[]);
 }
 
 /// E-089 and C-017 through SOEM on the electrical plant (`overcurrent.py`,
@@ -56,18 +60,7 @@ fn c038_e089_soem_max_current_and_motor_i2t_on_the_electrical_plant() {
 /// a fault reset gives Switch on disabled and the next enable faults again.
 #[test]
 fn e089_c017_soem_over_current_trip_on_the_electrical_plant() {
-    let Some(python) = common::or_skip(pysoem_python(), "soem over-current test") else {
-        return;
-    };
-    let dir = scratch("soem-over-current");
-    let line = Line::with_serve_args(
-        "o",
-        1,
-        60,
-        &dir,
-        &["--plant", "electrical", "--plant-fault", "short"],
-    );
-    line.run_passes(&python, "overcurrent.py", &[]);
+    on_the_electrical_plant("o", 60, &["--plant-fault", "short"], "overcurrent.py", &[]);
 }
 
 /// C-038 and E-089 through SOEM on the electrical plant (`stage_i2t.py`,
@@ -80,15 +73,7 @@ fn e089_c017_soem_over_current_trip_on_the_electrical_plant() {
 /// (i/I_rated)²), without a fault.
 #[test]
 fn c038_e089_soem_current_limit_and_power_stage_i2t_on_the_electrical_plant() {
-    let Some(python) = common::or_skip(pysoem_python(), "soem power stage i2t test") else {
-        return;
-    };
-    let dir = scratch("soem-stage-i2t");
-    let line = Line::with_serve_args("i", 1, 60, &dir, &["--plant", "electrical"]);
-    let status = line.run(&python, "stage_i2t.py", &[]);
-    if !status.success() {
-        line.fail_with(&format!("stage_i2t.py through SOEM failed: {status}"));
-    }
+    on_the_electrical_plant("i", 60, &[], "stage_i2t.py", &[]);
 }
 
 /// E-140, E-141 through SOEM on the electrical plant (`motor_actions.py`,
@@ -106,29 +91,11 @@ fn c038_e089_soem_current_limit_and_power_stage_i2t_on_the_electrical_plant() {
 /// the plant's brake (2 N·m, unknown to the drive) plus friction.
 #[test]
 fn e140_e141_soem_motor_actions_identify_the_plants_r_l_and_commutation_offset() {
-    let Some(python) = common::or_skip(pysoem_python(), "soem motor actions test") else {
-        return;
-    };
-    let dir = scratch("soem-motor-actions");
     let (r, l, offset) = ("2.2", "0.0065", "0.3");
-    let line = Line::with_serve_args(
+    on_the_electrical_plant(
         "a",
-        1,
         120,
-        &dir,
-        &[
-            "--plant",
-            "electrical",
-            "--plant-r",
-            r,
-            "--plant-l",
-            l,
-            "--plant-offset",
-            offset,
-        ],
-    );
-    line.run_passes(
-        &python,
+        &["--plant-r", r, "--plant-l", l, "--plant-offset", offset],
         "motor_actions.py",
         &["--r", r, "--l", l, "--offset", offset],
     );
@@ -143,18 +110,7 @@ fn e140_e141_soem_motor_actions_identify_the_plants_r_l_and_commutation_offset()
 /// by the energy balance (within 5 %), 603Fh and EMCY 3110h (event 36).
 #[test]
 fn e090_e089_soem_braking_a_flywheel_without_brake_resistor_trips_over_voltage() {
-    let Some(python) = common::or_skip(pysoem_python(), "soem chopper test") else {
-        return;
-    };
-    let dir = scratch("soem-chopper");
-    let line = Line::with_serve_args(
-        "v",
-        1,
-        120,
-        &dir,
-        &["--plant", "electrical", "--flywheel", "0.01"],
-    );
-    line.run_passes(&python, "chopper.py", &[]);
+    on_the_electrical_plant("v", 120, &["--flywheel", "0.01"], "chopper.py", &[]);
 }
 
 /// E-140, E-141 through SOEM on the electrical plant (`mechanics.py`, issue
@@ -167,13 +123,10 @@ fn e090_e089_soem_braking_a_flywheel_without_brake_resistor_trips_over_voltage()
 /// are 0) and writes the speed controller's gain for B48.
 #[test]
 fn e140_e141_soem_b44_identify_mechanics_refused_beyond_the_limits_then_identifies_the_plant() {
-    let Some(python) = common::or_skip(pysoem_python(), "soem B44 test") else {
-        return;
-    };
-    let dir = scratch("soem-mechanics");
-    let line = Line::with_serve_args("b4", 1, 120, &dir, &["--plant", "electrical"]);
-    line.run_passes(
-        &python,
+    on_the_electrical_plant(
+        "b4",
+        120,
+        &[],
         "mechanics.py",
         &["--j", "1e-4", "--fc", "0.02", "--b", "2e-5"],
     );

@@ -5,7 +5,7 @@
 use drive_ecat::actions::{state, A69, A75};
 use drive_tests::al::OP;
 use drive_tests::step::{a69_of, cycles, op_with_actions};
-use drive_tests::{al_status, init, line, with_master};
+use drive_tests::{al_status, line, with_master, with_sdo};
 
 /// E-060, E-140: A75 = Execute | save (0001b) in the RxPDO; A69 in the
 /// TxPDO shows the save running, then done at 100 % with the selector; A00's
@@ -95,9 +95,7 @@ fn e141_e140_test_winding_refused_and_b302_s18_a37_i52_not_available() {
 #[test]
 fn e142_a75_over_sdo_without_activation_starts_nothing() {
     let sim = line(1);
-    with_master(&sim, async |md, clock| {
-        let group = init(md, clock).await;
-        let sd = group.subdevice(md, 0).unwrap();
+    with_sdo(&sim, async |sd, _| {
         sd.sdo_write(A75, 0, (0b0001u8 << 1) | 1)
             .await
             .expect("A75 over SDO");

@@ -7,7 +7,7 @@
 use drive_ecat::actions::state;
 use drive_ecat::params::{B05, B40, B41, B42, B43, B52, B53, B62, E48};
 use drive_tests::step::{a69_of, cycles, follow_a69, op_with_actions};
-use drive_tests::{init, line, with_master};
+use drive_tests::{line, with_master, with_sdo};
 use hil_sim::electrical::PlantModel;
 
 /// A line of one drive whose axis A runs the electrical plant with a motor of
@@ -165,11 +165,7 @@ fn e140_b41_calibrate_motor_finds_the_plants_commutation_offset() {
         b05
     });
     sim.borrow_mut().drives_mut()[0].power_cycle();
-    let again = with_master(&sim, async |md, clock| {
-        let group = init(md, clock).await;
-        let sd = group.subdevice(md, 0).unwrap();
-        sd.sdo_read::<u32>(B05, 0).await.unwrap()
-    });
+    let again = with_sdo(&sim, async |sd, _| sd.sdo_read::<u32>(B05, 0).await.unwrap());
     assert_eq!(i64::from(again), b05, "B05 saved with the parameter set");
 }
 

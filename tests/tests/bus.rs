@@ -2,7 +2,7 @@
 //! (no root, no network), the slave stack runs its real code in simulated time.
 
 use drive_tests::al::{ACK, BOOT, ERR, INIT, OP, PREOP, SAFEOP};
-use drive_tests::{al_status, init, line, request, with_master, write_sm};
+use drive_tests::{al_status, init, line, request, with_master, with_sdo, write_sm};
 use ecat::sii;
 use esc::{AlState, AlStatusCode};
 
@@ -92,26 +92,14 @@ fn e003_sii_read_by_master_has_syncmanagers_and_protocols() {
     let sms: Vec<&[u8]> = sii::records(sms, 8).collect();
     assert_eq!(sms.len(), 4);
     let start = |r: &[u8]| u16::from_le_bytes([r[0], r[1]]);
-    assert_eq!(
-        (start(sms[0]), sms[0][4], sms[0][7]),
-        (0x1000, 0x26, 1),
-        "SM0 mailbox out"
-    );
-    assert_eq!(
-        (start(sms[1]), sms[1][4], sms[1][7]),
-        (0x1100, 0x22, 2),
-        "SM1 mailbox in"
-    );
-    assert_eq!(
-        (start(sms[2]), sms[2][4], sms[2][7]),
-        (0x1200, 0x64, 3),
-        "SM2 outputs"
-    );
-    assert_eq!(
-        (start(sms[3]), sms[3][4], sms[3][7]),
-        (0x1A00, 0x20, 4),
-        "SM3 inputs"
-    );
+    for (sm, (want, what)) in sms.iter().zip([
+        ((0x1000, 0x26, 1), "SM0 mailbox out"),
+        ((0x1100, 0x22, 2), "SM1 mailbox in"),
+        ((0x1200, 0x64, 3), "SM2 outputs"),
+        ((0x1A00, 0x20, 4), "SM3 inputs"),
+    ]) {
+        assert_eq!((start(sm), sm[4], sm[7]), want, "{what}");
+    }
     // the master read the same image the ESC was loaded with
     assert_eq!(&image[..], &sim.borrow().drives()[0].esc.sii()[..image.len()]);
 }
@@ -226,13 +214,11 @@ fn e028_e045_sm2_sm3_length_checked_on_preop_to_safeop() {
 #[test]
 fn e037_back_to_init_stops_mailbox() {
     let sim = line(1);
-    with_master(&sim, async |md, clock| {
-        let group = init(md, clock).await;
-        let sd = group.subdevice(md, 0).unwrap();
+    with_sdo(&sim, async |sd, _| {
         let dt: u32 = sd.sdo_read(0x1000, 0).await.expect("1000h in PRE-OP");
         assert_eq!(dt, drive_ecat::DEVICE_TYPE, "E-004");
-        request(&sd, INIT).await;
-        assert_eq!(al_status(&sd).await, (INIT, 0));
+        request(sd, INIT).await;
+        assert_eq!(al_status(sd).await, (INIT, 0));
         assert!(sd.sdo_read::<u32>(0x1000, 0).await.is_err(), "no mailbox in INIT");
     });
 }
@@ -240,19 +226,17 @@ fn e037_back_to_init_stops_mailbox() {
 #[test]
 fn e028_e092_failed_preop_to_safeop_sends_emcy_a000_with_diag_code() {
     let sim = line(1);
-    with_master(&sim, async |md, clock| {
-        let group = init(md, clock).await;
-        let sd = group.subdevice(md, 0).unwrap();
+    with_sdo(&sim, async |sd, _| {
         // SM3 one byte short: PDO length not correct on SM3 -> diag code 4*3 + 2 = Eh
-        write_sm(&sd, 2, 0x1200, 23, 0x64).await;
-        write_sm(&sd, 3, 0x1A00, 28, 0x20).await;
-        request(&sd, SAFEOP).await;
+        write_sm(sd, 2, 0x1200, 23, 0x64).await;
+        write_sm(sd, 3, 0x1A00, 28, 0x20).await;
+        request(sd, SAFEOP).await;
         assert_eq!(
-            al_status(&sd).await,
+            al_status(sd).await,
             (PREOP | ERR, AlStatusCode::INVALID_INPUT_CONFIG.0)
         );
         let mut mbx = drive_tests::RawMailbox::new();
-        let (kind, data) = mbx.receive(&sd).await.expect("an EMCY in the mailbox");
+        let (kind, data) = mbx.receive(sd).await.expect("an EMCY in the mailbox");
         assert_eq!(kind, 3, "CoE");
         assert_eq!(
             u16::from_le_bytes([data[0], data[1]]) >> 12,
@@ -269,19 +253,17 @@ fn e028_e092_failed_preop_to_safeop_sends_emcy_a000_with_diag_code() {
 #[test]
 fn e144_e146_refused_transition_lands_in_the_diagnosis_history() {
     let sim = line(1);
-    with_master(&sim, async |md, clock| {
-        let group = init(md, clock).await;
-        let sd = group.subdevice(md, 0).unwrap();
+    with_sdo(&sim, async |sd, _| {
         let fresh: u8 = sd.sdo_read(0x10F3, 4).await.expect("10F3h:04");
         assert_eq!(fresh, 0, "no new messages after power-on (E-145)");
-        request(&sd, BOOT).await; // refused with 0011h (Bootstrap only from Init)
-        assert_eq!(al_status(&sd).await, (PREOP | ERR, 0x0011));
+        request(sd, BOOT).await; // refused with 0011h (Bootstrap only from Init)
+        assert_eq!(al_status(sd).await, (PREOP | ERR, 0x0011));
         let new: u8 = sd.sdo_read(0x10F3, 4).await.expect("10F3h:04");
         assert_eq!(new, 1, "new message available");
         let newest: u8 = sd.sdo_read(0x10F3, 2).await.expect("10F3h:02");
         assert_eq!(newest, 6, "the first message sits at subindex 6");
         let mut coe = drive_tests::CoeClient::new();
-        let msg = coe.upload(&sd, 0x10F3, 6).await.expect("10F3h:06");
+        let msg = coe.upload(sd, 0x10F3, 6).await.expect("10F3h:06");
         let code = u32::from_le_bytes(msg[0..4].try_into().unwrap());
         assert_eq!(
             code,

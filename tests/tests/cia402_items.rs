@@ -33,6 +33,14 @@ async fn pp_edge(m: &mut Cyclic<'_>, target: i32, bits: u16) -> bool {
     ack
 }
 
+/// [`pp_edge`] that must be taken, the move [`settle`]d within `max`
+/// cycles, then 20 cycles more.
+async fn pp_move(m: &mut Cyclic<'_>, target: i32, bits: u16, max: usize) {
+    assert!(pp_edge(m, target, bits).await, "taken");
+    settle(m, max).await.expect("arrives");
+    m.run(20).await;
+}
+
 /// Waits until bit 10 (target reached) and standstill.
 async fn settle(m: &mut Cyclic<'_>, max: usize) -> Option<usize> {
     m.run_until(max, |t| t.bit(10) && t.velocity.abs() < REV / 200)
@@ -46,9 +54,7 @@ async fn settle(m: &mut Cyclic<'_>, max: usize) -> Option<usize> {
 #[test]
 fn c028_mode_0_generates_no_motion() {
     let sim = line(1);
-    with_master(&sim, async |md, clock| {
-        let group = init(md, clock).await.into_op(md).await.expect("OP");
-        let mut m = Cyclic::new(md, &group, &sim, 0);
+    with_cyclic(&sim, async |m, _| {
         let tx = m.enable_in(0).await;
         assert_eq!(tx.mode_display, 0, "6061h shows mode 0");
         let p0 = motor_position(&sim, 0);
@@ -343,26 +349,20 @@ fn c045_bit_6_clear_moves_to_the_absolute_position() {
         m.run(10).await;
         // 607Ah = 1.5 rev absolute, twice: the second move goes nowhere
         for k in 0..2 {
-            assert!(pp_edge(m, 3 * REV / 2, 0).await, "taken");
-            settle(m, 3000).await.expect("arrives");
-            m.run(20).await;
+            pp_move(m, 3 * REV / 2, 0, 3000).await;
             let p = m.tx.position;
             println!("absolute move {k}: 6064h {p}");
             assert!((p - 3 * REV / 2).abs() < REV / 300, "at 1.5 rev: {p}");
         }
         // the same value relative (bit 6) would move on: contrast
-        assert!(pp_edge(m, 3 * REV / 2, CW_BIT6).await, "taken");
-        settle(m, 3000).await.expect("arrives");
-        m.run(20).await;
+        pp_move(m, 3 * REV / 2, CW_BIT6, 3000).await;
         assert!(
             (m.tx.position - 3 * REV).abs() < REV / 300,
             "relative: {}",
             m.tx.position
         );
         // and back to an absolute −0.5 rev
-        assert!(pp_edge(m, -REV / 2, 0).await, "taken");
-        settle(m, 5000).await.expect("arrives");
-        m.run(20).await;
+        pp_move(m, -REV / 2, 0, 5000).await;
         assert!(
             (m.tx.position + REV / 2).abs() < REV / 300,
             "at −0.5 rev: {}",

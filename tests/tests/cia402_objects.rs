@@ -8,7 +8,7 @@
 use drive_ecat::{parameter_index, Template};
 use drive_tests::al::{ERR, OP, SAFEOP};
 use drive_tests::step::{advance, op_via_safe_op};
-use drive_tests::{al_status, init, line, map_layout, variant, with_master, CoeClient, Cyclic, REV};
+use drive_tests::{al_status, init, line, map_layout, sdo_is, variant, with_master, with_sdo, Cyclic, REV};
 use ecat::SdoAbort;
 use esc::AlStatusCode;
 use hil_sim::sim::Simulation;
@@ -99,48 +99,16 @@ fn c130_c131_c132_standard_pdo_layout_byte_packed_through_the_master() {
         c.set_target_torque(777);
         c.out[19..23].copy_from_slice(&0x8000_0005u32.to_le_bytes());
         let t = c.run(5).await;
-        assert_eq!(
-            sd.sdo_read::<i32>(0x607A, 0).await.unwrap(),
-            0x0102_0304,
-            "607Ah @3"
-        );
-        assert_eq!(
-            sd.sdo_read::<i32>(0x60FF, 0).await.unwrap(),
-            -0x0A0B_0C0D,
-            "60FFh @7"
-        );
-        assert_eq!(
-            sd.sdo_read::<i32>(0x60B1, 0).await.unwrap(),
-            0x1122_3344,
-            "60B1h @11"
-        );
-        assert_eq!(sd.sdo_read::<i16>(0x60B2, 0).await.unwrap(), -1234, "60B2h @15");
-        assert_eq!(sd.sdo_read::<i16>(0x6071, 0).await.unwrap(), 777, "6071h @17");
-        assert_eq!(
-            sd.sdo_read::<u32>(0x60FE, 1).await.unwrap(),
-            0x8000_0005,
-            "60FEh:01 @19"
-        );
-        assert_eq!(
-            sd.sdo_read::<u16>(0x6041, 0).await.unwrap(),
-            t.statusword,
-            "6041h @0"
-        );
-        assert_eq!(
-            sd.sdo_read::<i8>(0x6061, 0).await.unwrap(),
-            t.mode_display,
-            "6061h @2"
-        );
-        assert_eq!(
-            sd.sdo_read::<i32>(0x6064, 0).await.unwrap(),
-            t.position,
-            "6064h @3"
-        );
-        assert_eq!(
-            sd.sdo_read::<i32>(0x60E4, 1).await.unwrap(),
-            t.additional_position,
-            "60E4h:01 @21"
-        );
+        sdo_is(&sd, 0x607A, 0, 0x0102_0304i32, "607Ah @3").await;
+        sdo_is(&sd, 0x60FF, 0, -0x0A0B_0C0Di32, "60FFh @7").await;
+        sdo_is(&sd, 0x60B1, 0, 0x1122_3344i32, "60B1h @11").await;
+        sdo_is(&sd, 0x60B2, 0, -1234i16, "60B2h @15").await;
+        sdo_is(&sd, 0x6071, 0, 777i16, "6071h @17").await;
+        sdo_is(&sd, 0x60FE, 1, 0x8000_0005u32, "60FEh:01 @19").await;
+        sdo_is(&sd, 0x6041, 0, t.statusword, "6041h @0").await;
+        sdo_is(&sd, 0x6061, 0, t.mode_display, "6061h @2").await;
+        sdo_is(&sd, 0x6064, 0, t.position, "6064h @3").await;
+        sdo_is(&sd, 0x60E4, 1, t.additional_position, "60E4h:01 @21").await;
         assert_eq!(t.state(), drive_tests::sw::SOD);
         assert_eq!(t.a67 & 1, 1, "A67 @27 carries 6041h bit 6: {:#06x}", t.a67);
     });
@@ -149,32 +117,29 @@ fn c130_c131_c132_standard_pdo_layout_byte_packed_through_the_master() {
 #[test]
 fn c133_up_to_24_entries_per_pdo() {
     let sim = line(1);
-    with_master(&sim, async |md, clock| {
-        let group = init(md, clock).await;
-        let sd = group.subdevice(md, 0).unwrap();
-        let mut c = CoeClient::new();
+    with_sdo(&sim, async |sd, c| {
         for pdo in [0x1600u16, 0x1A00] {
             let entry = if pdo == 0x1600 {
                 m(0x6060, 0, 8)
             } else {
                 m(0x6061, 0, 8)
             };
-            c.download(&sd, pdo, 0, &[0]).await.unwrap();
+            c.download(sd, pdo, 0, &[0]).await.unwrap();
             for s in 1..=24u8 {
-                c.download(&sd, pdo, s, &entry.to_le_bytes()).await.unwrap();
+                c.download(sd, pdo, s, &entry.to_le_bytes()).await.unwrap();
             }
-            c.download(&sd, pdo, 0, &[24])
+            c.download(sd, pdo, 0, &[24])
                 .await
                 .expect("24 entries are accepted");
-            assert_eq!(c.upload(&sd, pdo, 0).await, Ok(vec![24]));
-            c.download(&sd, pdo, 0, &[0]).await.unwrap();
+            assert_eq!(c.upload(sd, pdo, 0).await, Ok(vec![24]));
+            c.download(sd, pdo, 0, &[0]).await.unwrap();
             assert_eq!(
-                c.download(&sd, pdo, 0, &[25]).await,
+                c.download(sd, pdo, 0, &[25]).await,
                 Err(SdoAbort::PDO_LENGTH.0),
                 "{pdo:04X}h: 25 entries refused"
             );
             assert!(
-                c.download(&sd, pdo, 25, &entry.to_le_bytes()).await.is_err(),
+                c.download(sd, pdo, 25, &entry.to_le_bytes()).await.is_err(),
                 "{pdo:04X}h: there is no 25th entry"
             );
         }
@@ -184,45 +149,33 @@ fn c133_up_to_24_entries_per_pdo() {
 #[test]
 fn c138_only_mappable_objects_in_their_direction() {
     let sim = line(1);
-    with_master(&sim, async |md, clock| {
-        let group = init(md, clock).await;
-        let sd = group.subdevice(md, 0).unwrap();
-        let mut c = CoeClient::new();
-        c.download(&sd, 0x1600, 0, &[0]).await.unwrap();
-        c.download(&sd, 0x1A00, 0, &[0]).await.unwrap();
+    with_sdo(&sim, async |sd, c| {
+        c.download(sd, 0x1600, 0, &[0]).await.unwrap();
+        c.download(sd, 0x1A00, 0, &[0]).await.unwrap();
         let not = Err(SdoAbort::NOT_MAPPABLE.0);
-        // 6098h: not mappable at all
-        assert_eq!(
-            c.download(&sd, 0x1600, 1, &m(0x6098, 0, 8).to_le_bytes()).await,
-            not
-        );
-        assert_eq!(
-            c.download(&sd, 0x1A00, 1, &m(0x6098, 0, 8).to_le_bytes()).await,
-            not
-        );
-        // 605Ah: Rx only
-        assert_eq!(
-            c.download(&sd, 0x1A00, 1, &m(0x605A, 0, 16).to_le_bytes()).await,
-            not
-        );
-        c.download(&sd, 0x1600, 1, &m(0x605A, 0, 16).to_le_bytes())
-            .await
-            .expect("605Ah in an RxPDO");
-        // 6041h: Tx only
-        assert_eq!(
-            c.download(&sd, 0x1600, 2, &m(0x6041, 0, 16).to_le_bytes()).await,
-            not
-        );
-        c.download(&sd, 0x1A00, 1, &m(0x6041, 0, 16).to_le_bytes())
-            .await
-            .expect("6041h in a TxPDO");
+        // (PDO, subindex, entry, taken): in the order written
+        for (pdo, sub, entry, taken) in [
+            // 6098h: not mappable at all
+            (0x1600, 1, m(0x6098, 0, 8), false),
+            (0x1A00, 1, m(0x6098, 0, 8), false),
+            // 605Ah: Rx only
+            (0x1A00, 1, m(0x605A, 0, 16), false),
+            (0x1600, 1, m(0x605A, 0, 16), true),
+            // 6041h: Tx only
+            (0x1600, 2, m(0x6041, 0, 16), false),
+            (0x1A00, 1, m(0x6041, 0, 16), true),
+        ] {
+            let r = c.download(sd, pdo, sub, &entry.to_le_bytes()).await;
+            let want = if taken { Ok(()) } else { not };
+            assert_eq!(r, want, "{entry:08X}h into {pdo:04X}h:{sub}");
+        }
         // the axis-B window follows the same flags
-        c.download(&sd, 0x1601, 0, &[0]).await.unwrap();
+        c.download(sd, 0x1601, 0, &[0]).await.unwrap();
         assert_eq!(
-            c.download(&sd, 0x1601, 1, &m(0x6898, 0, 8).to_le_bytes()).await,
+            c.download(sd, 0x1601, 1, &m(0x6898, 0, 8).to_le_bytes()).await,
             not
         );
-        let axis_b = c.download(&sd, 0x1601, 1, &m(0x6840, 0, 16).to_le_bytes()).await;
+        let axis_b = c.download(sd, 0x1601, 1, &m(0x6840, 0, 16).to_le_bytes()).await;
         if variant().axes() == 2 {
             axis_b.expect("6840h in an RxPDO");
         } else {
@@ -234,9 +187,7 @@ fn c138_only_mappable_objects_in_their_direction() {
 #[test]
 fn c139_subindex_0_constants() {
     let sim = line(1);
-    with_master(&sim, async |md, clock| {
-        let group = init(md, clock).await;
-        let sd = group.subdevice(md, 0).unwrap();
+    with_sdo(&sim, async |sd, _| {
         for (index, n) in [
             (0x6046u16, 2u8),
             (0x60A4, 1),
@@ -276,10 +227,7 @@ fn c135_c136_c137_manufacturer_parameter_addresses_and_templates() {
     let a340 = 0x2000 + 340; // group A (0) × 200h + line 340
     let e200 = 0x2000 + 4 * 0x200 + 200;
     assert_eq!((a340, e200), (0x2154, 0x28C8));
-    with_master(&sim, async |md, clock| {
-        let group = init(md, clock).await;
-        let sd = group.subdevice(md, 0).unwrap();
-        let mut c = CoeClient::new();
+    with_sdo(&sim, async |sd, c| {
         // C-135/C-136: A340 of axis A at 2154h, of axis B at A154h, independent
         let axis_b = variant().axes() == 2;
         sd.sdo_write(a340, 0, 70u16).await.unwrap();
@@ -293,38 +241,38 @@ fn c135_c136_c137_manufacturer_parameter_addresses_and_templates() {
         } else {
             assert!(b_write.is_err(), "no A154h on the single-axis device");
             assert_eq!(
-                c.upload(&sd, a340 + 0x8000, 0).await,
+                c.upload(sd, a340 + 0x8000, 0).await,
                 Err(SdoAbort::NO_OBJECT.0),
                 "no A154h on the single-axis device"
             );
         }
         // C-137, "SDO Info" template (default): E200[0] at sub 1, sub 0 = element count
         assert_eq!(
-            c.upload(&sd, e200, 0).await,
+            c.upload(sd, e200, 0).await,
             Ok(vec![2]),
             "E200 sub 0 = 2 elements"
         );
-        assert!(c.upload(&sd, e200, 1).await.is_ok(), "E200[0] at sub 1");
+        assert!(c.upload(sd, e200, 1).await.is_ok(), "E200[0] at sub 1");
         assert_eq!(
-            c.upload(&sd, e200 + 0x8000, 1).await.is_ok(),
+            c.upload(sd, e200 + 0x8000, 1).await.is_ok(),
             axis_b,
             "axis B E200[0] at A8C8h:01"
         );
-        assert!(c.upload(&sd, e200, 3).await.is_err(), "no element 2");
+        assert!(c.upload(sd, e200, 3).await.is_err(), "no element 2");
         // "EtherCAT Rx" template: element = subindex
         sim.borrow_mut().drives_mut()[0]
             .drive
             .objects_mut()
             .set_template(Template::Rx);
         assert_eq!(
-            c.upload(&sd, e200, 0).await.map(|v| v.len()),
+            c.upload(sd, e200, 0).await.map(|v| v.len()),
             Ok(2),
             "E200[0] (WORD) at sub 0"
         );
-        assert!(c.upload(&sd, e200, 1).await.is_ok(), "E200[1] at sub 1");
-        assert!(c.upload(&sd, e200, 2).await.is_err(), "no element 2");
+        assert!(c.upload(sd, e200, 1).await.is_ok(), "E200[1] at sub 1");
+        assert!(c.upload(sd, e200, 2).await.is_err(), "no element 2");
         // A66 (per-axis array of UDINT): element 3 written in the Rx template is element 3 + 1 in SDO Info
-        c.download(&sd, parameter_index(0, 66), 3, &0x6041_0002u32.to_le_bytes())
+        c.download(sd, parameter_index(0, 66), 3, &0x6041_0002u32.to_le_bytes())
             .await
             .unwrap();
         sim.borrow_mut().drives_mut()[0]
@@ -332,7 +280,7 @@ fn c135_c136_c137_manufacturer_parameter_addresses_and_templates() {
             .objects_mut()
             .set_template(Template::SdoInfo);
         assert_eq!(
-            c.upload(&sd, parameter_index(0, 66), 4).await,
+            c.upload(sd, parameter_index(0, 66), 4).await,
             Ok(0x6041_0002u32.to_le_bytes().to_vec())
         );
     });
@@ -343,22 +291,19 @@ fn c141_hidden_parameters_are_not_reachable() {
     let sim = line(1);
     let a10 = parameter_index(0, 10);
     let i46 = parameter_index(8, 46); // level 1
-    with_master(&sim, async |md, clock| {
-        let group = init(md, clock).await;
-        let sd = group.subdevice(md, 0).unwrap();
-        let mut c = CoeClient::new();
-        assert_eq!(c.upload(&sd, i46, 0).await, Ok(vec![0]), "visible at A10[2] = 2");
+    with_sdo(&sim, async |sd, c| {
+        assert_eq!(c.upload(sd, i46, 0).await, Ok(vec![0]), "visible at A10[2] = 2");
         // A10[2] = 0: level-1 parameters are hidden for read and write
-        c.download(&sd, a10, 3, &[0]).await.unwrap();
+        c.download(sd, a10, 3, &[0]).await.unwrap();
         let hidden = SdoAbort::NO_OBJECT.0;
-        assert_eq!(c.upload(&sd, i46, 0).await, Err(hidden));
-        assert_eq!(c.download(&sd, i46, 0, &[5]).await, Err(hidden));
-        assert_eq!(c.upload(&sd, i46 + 0x8000, 0).await, Err(hidden), "axis B too");
+        assert_eq!(c.upload(sd, i46, 0).await, Err(hidden));
+        assert_eq!(c.download(sd, i46, 0, &[5]).await, Err(hidden));
+        assert_eq!(c.upload(sd, i46 + 0x8000, 0).await, Err(hidden), "axis B too");
         // CiA 402 objects stay reachable
-        assert!(c.upload(&sd, 0x6041, 0).await.is_ok());
-        c.download(&sd, a10, 3, &[2]).await.unwrap();
+        assert!(c.upload(sd, 0x6041, 0).await.is_ok());
+        c.download(sd, a10, 3, &[2]).await.unwrap();
         assert_eq!(
-            c.upload(&sd, i46, 0).await,
+            c.upload(sd, i46, 0).await,
             Ok(vec![0]),
             "the write did not happen"
         );
@@ -525,17 +470,13 @@ fn c146_changes_are_volatile_until_a00_saves_them() {
             sd.sdo_read::<u8>(I46, 0).await.unwrap()
         })
     };
-    with_master(&sim, async |md, clock| {
-        let group = init(md, clock).await;
-        let sd = group.subdevice(md, 0).unwrap();
+    with_sdo(&sim, async |sd, _| {
         sd.sdo_write(I46, 0, 5u8).await.unwrap();
     });
     assert_eq!(read(&sim), 5, "in RAM");
     power_cycle(&sim);
     assert_eq!(read(&sim), 0, "not saved: the default after power-off");
-    let (progress, result) = with_master(&sim, async |md, clock| {
-        let group = init(md, clock).await;
-        let sd = group.subdevice(md, 0).unwrap();
+    let (progress, result) = with_sdo(&sim, async |sd, _| {
         sd.sdo_write(I46, 0, 5u8).await.unwrap();
         let before: u8 = sd.sdo_read(A00, 2).await.unwrap();
         assert_ne!(before, 100, "no save done yet: A00[1] {before}");
@@ -618,9 +559,7 @@ fn c151_station_alias_kept_in_the_eeprom_and_shown_in_a254() {
     use esc::sii::control;
     let sim = line(1);
     let alias = 0x0A51u16;
-    with_master(&sim, async |md, clock| {
-        let group = init(md, clock).await;
-        let sd = group.subdevice(md, 0).unwrap();
+    with_sdo(&sim, async |sd, _| {
         let before: u16 = sd.sdo_read(parameter_index(0, 254), 0).await.unwrap();
         assert_ne!(before, alias);
         // the master writes word 4 (alias) and word 7 (checksum) of the SII, then reloads
@@ -641,9 +580,7 @@ fn c151_station_alias_kept_in_the_eeprom_and_shown_in_a254() {
         advance(&sim, 1_000_000);
     });
     // the next start-up (Init → Pre-Op) shows it in A254
-    with_master(&sim, async |md, clock| {
-        let group = init(md, clock).await;
-        let sd = group.subdevice(md, 0).unwrap();
+    with_sdo(&sim, async |sd, _| {
         let a254: u16 = sd.sdo_read(parameter_index(0, 254), 0).await.unwrap();
         println!("A254 {a254:#06x}");
         assert_eq!(a254, alias, "A254 shows the alias from the EEPROM");

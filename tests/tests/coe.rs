@@ -7,7 +7,7 @@
 use drive_ecat::objects::{enumeration, Object, Value, OBJECTS};
 use drive_ecat::{revision, DriveObjects, Template};
 use drive_tests::objects as device_objects;
-use drive_tests::{init, line, variant, with_master, CoeClient, UploadKind, MAILBOX_LEN};
+use drive_tests::{init, line, variant, with_master, with_sdo, CoeClient, UploadKind, MAILBOX_LEN};
 use ecat::{CommState, DataType, Dictionary, SdoAbort};
 use hil_sim::sim::Simulation;
 use std::cell::RefCell;
@@ -302,10 +302,7 @@ fn not_in(list: &[i64], lowest: i64, highest: i64) -> Option<i64> {
 #[test]
 fn e071_e073_e074_e016_bad_writes_get_the_exact_abort_and_change_nothing() {
     let sim = line(1);
-    with_master(&sim, async |md, clock| {
-        let group = init(md, clock).await;
-        let sd = group.subdevice(md, 0).unwrap();
-        let mut c = CoeClient::new();
+    with_sdo(&sim, async |sd, c| {
         let mut cases = 0usize;
         let start = settled(&sim);
         let device = variant();
@@ -319,7 +316,7 @@ fn e071_e073_e074_e016_bad_writes_get_the_exact_abort_and_change_nothing() {
                 // the recorder's answer (a local read has no recorder); T11's
                 // blocks have none without a trace (0800 0022h): zeros of its size
                 let provided = if visible(o) && o.value == Value::Provided {
-                    Some(c.upload(&sd, index, e.sub).await)
+                    Some(c.upload(sd, index, e.sub).await)
                 } else {
                     None
                 };
@@ -377,20 +374,20 @@ fn e071_e073_e074_e016_bad_writes_get_the_exact_abort_and_change_nothing() {
                     let before = settled(&sim);
                     let r = if data.len() > 64 {
                         // longer than one mailbox frame holds: in segments
-                        c.download_segmented(&sd, index, e.sub, &data, false)
+                        c.download_segmented(sd, index, e.sub, &data, false)
                             .await
                             .map(|_| ())
                     } else if data.is_empty() || data.len() > 4 {
-                        c.download_normal(&sd, index, e.sub, &data, false).await
+                        c.download_normal(sd, index, e.sub, &data, false).await
                     } else {
-                        c.download_expedited(&sd, index, e.sub, &data).await
+                        c.download_expedited(sd, index, e.sub, &data).await
                     };
                     let at = format!("{index:04X}h:{:02X}h {} ({what}, {data:02x?})", e.sub, e.name);
                     assert_eq!(r, Err(code), "{at}");
                     assert_eq!(settled(&sim), before, "refused write changed nothing: {at}");
                     if visible(o) && e.access.readable() {
                         let before = provided.clone().unwrap_or_else(|| Ok(current.clone()));
-                        assert_eq!(c.upload(&sd, index, e.sub).await, before, "{at}");
+                        assert_eq!(c.upload(sd, index, e.sub).await, before, "{at}");
                     }
                     cases += 1;
                 }
@@ -398,8 +395,8 @@ fn e071_e073_e074_e016_bad_writes_get_the_exact_abort_and_change_nothing() {
         }
         assert!(cases > 1000, "{cases} refused writes");
         // unknown object and subindex (E-072)
-        assert_eq!(c.download(&sd, 0x5000, 0, &[1]).await, Err(NO_OBJECT));
-        assert_eq!(c.download(&sd, 0x6040, 1, &[1, 0]).await, Err(NO_SUBINDEX));
+        assert_eq!(c.download(sd, 0x5000, 0, &[1]).await, Err(NO_OBJECT));
+        assert_eq!(c.download(sd, 0x6040, 1, &[1, 0]).await, Err(NO_SUBINDEX));
         assert_eq!(settled(&sim), start, "nothing changed");
     });
 }
@@ -597,16 +594,13 @@ fn e080_e081_e082_e084_sdo_info_lists_and_descriptions_match_the_dictionary() {
 fn e083_a268_selects_the_listed_objects() {
     let sim = line(1);
     let a268 = drive_ecat::parameter_index(0, 268);
-    with_master(&sim, async |md, clock| {
-        let group = init(md, clock).await;
-        let sd = group.subdevice(md, 0).unwrap();
-        let mut c = CoeClient::new();
+    with_sdo(&sim, async |sd, c| {
         let manufacturer = |i: &u16| matches!(i & 0x7FFF, 0x2000..=0x5FFF);
-        let all = c.od_list(&sd, 1).await;
+        let all = c.od_list(sd, 1).await;
         assert!(all.iter().any(manufacturer) && all.iter().any(|i| !manufacturer(i)));
         // standard area only
-        c.download(&sd, a268, 1, &[0]).await.unwrap();
-        let standard = c.od_list(&sd, 1).await;
+        c.download(sd, a268, 1, &[0]).await.unwrap();
+        let standard = c.od_list(sd, 1).await;
         assert_eq!(
             standard,
             all.iter()
@@ -614,32 +608,32 @@ fn e083_a268_selects_the_listed_objects() {
                 .filter(|i| !manufacturer(i))
                 .collect::<Vec<_>>()
         );
-        let tx = c.od_list(&sd, 3).await;
+        let tx = c.od_list(sd, 3).await;
         assert!(
             tx.contains(&0x6041) && !tx.iter().any(manufacturer),
             "TxPDO list too"
         );
-        let (_, d) = c.info(&sd, 1, &0u16.to_le_bytes()).await;
+        let (_, d) = c.info(sd, 1, &0u16.to_le_bytes()).await;
         assert_eq!(
             u16::from_le_bytes([d[2], d[3]]) as usize,
             standard.len(),
             "list lengths follow"
         );
         assert_eq!(
-            c.object_desc(&sd, a268).await.unwrap().name,
+            c.object_desc(sd, a268).await.unwrap().name,
             "SDO Info object selection",
             "a left-out object keeps its description"
         );
         // manufacturer area, groups A (bit 0) and I (bit 8) only
-        c.download(&sd, a268, 1, &[1]).await.unwrap();
-        c.download(&sd, a268, 2, &0x0101u32.to_le_bytes()).await.unwrap();
-        let chosen = c.od_list(&sd, 1).await;
+        c.download(sd, a268, 1, &[1]).await.unwrap();
+        c.download(sd, a268, 2, &0x0101u32.to_le_bytes()).await.unwrap();
+        let chosen = c.od_list(sd, 1).await;
         let in_a_or_i = |i: &u16| manufacturer(i) && matches!(((i & 0x7FFF) - 0x2000) >> 9, 0 | 8);
         assert_eq!(chosen, all.iter().copied().filter(in_a_or_i).collect::<Vec<_>>());
         assert!(chosen.contains(&a268) && chosen.contains(&drive_ecat::parameter_index(8, 22)));
         // all, groups as chosen: the standard area again beside A and I
-        c.download(&sd, a268, 1, &[2]).await.unwrap();
-        let mixed = c.od_list(&sd, 1).await;
+        c.download(sd, a268, 1, &[2]).await.unwrap();
+        let mixed = c.od_list(sd, 1).await;
         let want: Vec<u16> = all
             .iter()
             .copied()
@@ -648,15 +642,15 @@ fn e083_a268_selects_the_listed_objects() {
         assert_eq!(mixed, want);
         // out of range: refused, the selection unchanged
         assert_eq!(
-            c.download(&sd, a268, 1, &[3]).await,
+            c.download(sd, a268, 1, &[3]).await,
             Err(0x0609_0031),
             "value too high"
         );
-        assert_eq!(c.od_list(&sd, 1).await, want);
-        c.download(&sd, a268, 2, &0x03FF_FFFFu32.to_le_bytes())
+        assert_eq!(c.od_list(sd, 1).await, want);
+        c.download(sd, a268, 2, &0x03FF_FFFFu32.to_le_bytes())
             .await
             .unwrap();
-        assert_eq!(c.od_list(&sd, 1).await, all, "the defaults list everything");
+        assert_eq!(c.od_list(sd, 1).await, all, "the defaults list everything");
     });
 }
 
@@ -664,40 +658,37 @@ fn e083_a268_selects_the_listed_objects() {
 fn e012_e013_e079_manufacturer_array_in_both_templates() {
     let sim = line(1);
     let a10 = drive_ecat::parameter_index(0, 10);
-    with_master(&sim, async |md, clock| {
-        let group = init(md, clock).await;
-        let sd = group.subdevice(md, 0).unwrap();
-        let mut c = CoeClient::new();
+    with_sdo(&sim, async |sd, c| {
         // "EtherCAT Rx SDO Info": A10[2] at subindex 3, sub 0 = element count
-        assert_eq!(c.upload(&sd, a10, 0).await, Ok(vec![4]));
-        c.download(&sd, a10, 2, &[1]).await.unwrap(); // A10[1] (DS6)
-        assert_eq!(c.upload(&sd, a10, 2).await, Ok(vec![1]));
-        assert_eq!(c.upload(&sd, a10, 3).await, Ok(vec![2]));
-        assert_eq!(c.upload(&sd, a10, 4).await, Ok(vec![2]));
+        assert_eq!(c.upload(sd, a10, 0).await, Ok(vec![4]));
+        c.download(sd, a10, 2, &[1]).await.unwrap(); // A10[1] (DS6)
+        assert_eq!(c.upload(sd, a10, 2).await, Ok(vec![1]));
+        assert_eq!(c.upload(sd, a10, 3).await, Ok(vec![2]));
+        assert_eq!(c.upload(sd, a10, 4).await, Ok(vec![2]));
         assert_eq!(
-            c.upload(&sd, 0x1018, 3).await,
+            c.upload(sd, 0x1018, 3).await,
             Ok(revision(Template::SdoInfo).to_le_bytes().to_vec())
         );
-        assert_eq!(c.entry_desc(&sd, a10, 2, 0, 1).await.unwrap().name, "DS6");
+        assert_eq!(c.entry_desc(sd, a10, 2, 0, 1).await.unwrap().name, "DS6");
 
         // "EtherCAT Rx": element = subindex, no SDO Info, revision bit 0 clear
         sim.borrow_mut().drives_mut()[0]
             .drive
             .objects_mut()
             .set_template(Template::Rx);
-        assert_eq!(c.upload(&sd, a10, 1).await, Ok(vec![1]), "A10[1] at subindex 1");
-        assert_eq!(c.upload(&sd, a10, 2).await, Ok(vec![2]), "A10[2] at subindex 2");
-        assert_eq!(c.upload(&sd, a10, 0).await, Ok(vec![2]), "sub 0 = element 0");
-        assert_eq!(c.upload(&sd, a10, 4).await, Err(NO_SUBINDEX));
-        c.download(&sd, a10, 1, &[2]).await.unwrap();
+        assert_eq!(c.upload(sd, a10, 1).await, Ok(vec![1]), "A10[1] at subindex 1");
+        assert_eq!(c.upload(sd, a10, 2).await, Ok(vec![2]), "A10[2] at subindex 2");
+        assert_eq!(c.upload(sd, a10, 0).await, Ok(vec![2]), "sub 0 = element 0");
+        assert_eq!(c.upload(sd, a10, 4).await, Err(NO_SUBINDEX));
+        c.download(sd, a10, 1, &[2]).await.unwrap();
         assert_eq!(objects(&sim).get(a10, 2), Ok(2), "same value, SDO-Info numbering");
         assert_eq!(
-            c.upload(&sd, 0x1018, 3).await,
+            c.upload(sd, 0x1018, 3).await,
             Ok(revision(Template::Rx).to_le_bytes().to_vec())
         );
         // simple parameters and CiA 402 objects keep subindex 0 (E-011)
-        assert_eq!(c.upload(&sd, 0x6060, 0).await, Ok(vec![8]));
-        let reply = c.try_request(&sd, &[0x00, 0x80, 3, 0, 0, 0, 0x18, 0x10]).await;
+        assert_eq!(c.upload(sd, 0x6060, 0).await, Ok(vec![8]));
+        let reply = c.try_request(sd, &[0x00, 0x80, 3, 0, 0, 0, 0x18, 0x10]).await;
         let (kind, data) = reply.expect_err("E-079: no SDO Info in the Rx template");
         assert_eq!(kind, 0, "mailbox error reply");
         assert_eq!(
@@ -714,13 +705,10 @@ const E72: u16 = drive_ecat::parameter_index(4, 72);
 fn e065_e067_e068_segmented_download_byte_for_byte_and_toggle_error() {
     let sim = line(1);
     let [i0, i1] = E72.to_le_bytes();
-    with_master(&sim, async |md, clock| {
-        let group = init(md, clock).await;
-        let sd = group.subdevice(md, 0).unwrap();
-        let mut c = CoeClient::new();
+    with_sdo(&sim, async |sd, c| {
         // the manual's example: 16 bytes 01h…10h in three 7-byte segments
         let data: Vec<u8> = (1..=16).collect();
-        let replies = c.download_segmented(&sd, E72, 0, &data, false).await.unwrap();
+        let replies = c.download_segmented(sd, E72, 0, &data, false).await.unwrap();
         assert_eq!(
             replies,
             [
@@ -732,82 +720,75 @@ fn e065_e067_e068_segmented_download_byte_for_byte_and_toggle_error() {
             "S §9.3.2.3 download example"
         );
         // read back: the whole value fits the mailbox, so a normal upload
-        let r = c.sdo(&sd, &[0x40, i0, i1, 0, 0, 0, 0, 0]).await.unwrap();
+        let r = c.sdo(sd, &[0x40, i0, i1, 0, 0, 0, 0, 0]).await.unwrap();
         let mut expected = vec![0x41, i0, i1, 0, 16, 0, 0, 0];
         expected.extend_from_slice(&data);
         assert_eq!(r, expected, "normal upload response, size 16");
 
         // a shorter string through segments: read back without padding
-        c.download_segmented(&sd, E72, 0, b"axis cfg 7", false)
+        c.download_segmented(sd, E72, 0, b"axis cfg 7", false)
             .await
             .unwrap();
-        assert_eq!(c.upload(&sd, E72, 0).await, Ok(b"axis cfg 7".to_vec()));
+        assert_eq!(c.upload(sd, E72, 0).await, Ok(b"axis cfg 7".to_vec()));
         // too long for STRING(16), in segments: 0607 0012h, value kept
         let long = [b'y'; 17];
         assert_eq!(
-            c.download_segmented(&sd, E72, 0, &long, false).await,
+            c.download_segmented(sd, E72, 0, &long, false).await,
             Err(LENGTH_TOO_HIGH)
         );
-        assert_eq!(c.upload(&sd, E72, 0).await, Ok(b"axis cfg 7".to_vec()));
+        assert_eq!(c.upload(sd, E72, 0).await, Ok(b"axis cfg 7".to_vec()));
 
         // E-068: the second segment repeats toggle 0
-        let r = c.sdo(&sd, &[0x21, i0, i1, 0, 16, 0, 0, 0]).await.unwrap();
+        let r = c.sdo(sd, &[0x21, i0, i1, 0, 16, 0, 0, 0]).await.unwrap();
         assert_eq!(r[0], 0x60);
         let r = c
-            .sdo(&sd, &[0x00, b'a', b'b', b'c', b'd', b'e', b'f', b'g'])
+            .sdo(sd, &[0x00, b'a', b'b', b'c', b'd', b'e', b'f', b'g'])
             .await
             .unwrap();
         assert_eq!(r[0], 0x20);
-        let r = c
-            .sdo(&sd, &[0x00, b'h', b'i', b'j', b'k', b'l', b'm', b'n'])
-            .await;
+        let r = c.sdo(sd, &[0x00, b'h', b'i', b'j', b'k', b'l', b'm', b'n']).await;
         assert_eq!(r, Err(TOGGLE_BIT));
         assert_eq!(
-            c.upload(&sd, E72, 0).await,
+            c.upload(sd, E72, 0).await,
             Ok(b"axis cfg 7".to_vec()),
             "nothing written"
         );
         // the transfer ended with the abort: a further segment is unknown (0504 0001h)
-        let r = c.sdo(&sd, &[0x10, b'o', b'p', 0, 0, 0, 0, 0]).await;
+        let r = c.sdo(sd, &[0x10, b'o', b'p', 0, 0, 0, 0, 0]).await;
         assert_eq!(r, Err(SdoAbort::INVALID_COMMAND.0));
 
         // a segment longer than 7 bytes (ETG.1000.6): as long as the mailbox data says
-        let r = c.sdo(&sd, &[0x21, i0, i1, 0, 12, 0, 0, 0]).await.unwrap();
+        let r = c.sdo(sd, &[0x21, i0, i1, 0, 12, 0, 0, 0]).await.unwrap();
         assert_eq!(r[0], 0x60);
         let mut seg = vec![0x01];
         seg.extend_from_slice(b"twelve bytes");
-        let r = c.sdo(&sd, &seg).await.unwrap();
+        let r = c.sdo(sd, &seg).await.unwrap();
         assert_eq!(r[0], 0x20, "last segment acknowledged");
-        assert_eq!(c.upload(&sd, E72, 0).await, Ok(b"twelve bytes".to_vec()));
-        c.download_segmented(&sd, E72, 0, b"axis cfg 7", false)
+        assert_eq!(c.upload(sd, E72, 0).await, Ok(b"twelve bytes".to_vec()));
+        c.download_segmented(sd, E72, 0, b"axis cfg 7", false)
             .await
             .unwrap();
 
         // E-069: a segmented download left idle for more than 1 s times out
-        let r = c.sdo(&sd, &[0x21, i0, i1, 0, 16, 0, 0, 0]).await.unwrap();
+        let r = c.sdo(sd, &[0x21, i0, i1, 0, 16, 0, 0, 0]).await.unwrap();
         assert_eq!(r[0], 0x60);
         {
             let mut s = sim.borrow_mut();
             let t = s.now().as_ns() + ecat::coe::SDO_TIMEOUT.as_ns() + 1_000_000;
             s.advance_to(nanos::Nanos::from_ns(t));
         }
-        let r = c
-            .sdo(&sd, &[0x00, b'a', b'b', b'c', b'd', b'e', b'f', b'g'])
-            .await;
+        let r = c.sdo(sd, &[0x00, b'a', b'b', b'c', b'd', b'e', b'f', b'g']).await;
         assert_eq!(r, Err(SdoAbort::TIMEOUT.0));
-        assert_eq!(c.upload(&sd, E72, 0).await, Ok(b"axis cfg 7".to_vec()));
+        assert_eq!(c.upload(sd, E72, 0).await, Ok(b"axis cfg 7".to_vec()));
     });
 }
 
 #[test]
 fn e066_e068_e078_segmented_complete_upload_of_10f3h_and_toggle_error() {
     let sim = line(1);
-    with_master(&sim, async |md, clock| {
-        let group = init(md, clock).await;
-        let sd = group.subdevice(md, 0).unwrap();
-        let mut c = CoeClient::new();
+    with_sdo(&sim, async |sd, c| {
         // 10F3h from sub 0: 2 + 6 + 20 × 28 bytes, more than one mailbox
-        let (data, kind) = c.upload_kind(&sd, 0x10F3, 0, true).await.unwrap();
+        let (data, kind) = c.upload_kind(sd, 0x10F3, 0, true).await.unwrap();
         assert_eq!(kind, UploadKind::Segmented);
         let mut expected = vec![25, 0];
         for sub in 1..=25u8 {
@@ -828,14 +809,14 @@ fn e066_e068_e078_segmented_complete_upload_of_10f3h_and_toggle_error() {
         );
 
         // E-068: an upload segment with the wrong toggle bit
-        let r = c.sdo(&sd, &[0x50, 0xF3, 0x10, 0, 0, 0, 0, 0]).await.unwrap();
+        let r = c.sdo(sd, &[0x50, 0xF3, 0x10, 0, 0, 0, 0, 0]).await.unwrap();
         assert_eq!(r[..8], [0x41, 0xF3, 0x10, 0, 0x38, 0x02, 0, 0], "size only, 568");
-        let r = c.sdo(&sd, &[0x60, 0, 0, 0, 0, 0, 0, 0]).await.unwrap();
+        let r = c.sdo(sd, &[0x60, 0, 0, 0, 0, 0, 0, 0]).await.unwrap();
         assert_eq!(r[0] & 0xF0, 0x00, "first segment, toggle 0");
-        let r = c.sdo(&sd, &[0x60, 0, 0, 0, 0, 0, 0, 0]).await;
+        let r = c.sdo(sd, &[0x60, 0, 0, 0, 0, 0, 0, 0]).await;
         assert_eq!(r, Err(TOGGLE_BIT));
         // the abort ended it: a new upload starts cleanly
-        assert_eq!(c.upload_kind(&sd, 0x10F3, 0, true).await.unwrap().0, expected);
+        assert_eq!(c.upload_kind(sd, 0x10F3, 0, true).await.unwrap().0, expected);
     });
 }
 
@@ -957,17 +938,14 @@ fn e078_ethercrab_complete_access_from_subindex_1_to_assignment_and_mapping() {
     // (sub 0 not in the data): the entries, then sub 0 = their number
     use ethercrab::SubIndex::Complete;
     let sim = line(1);
-    with_master(&sim, async |md, clock| {
-        let group = init(md, clock).await;
-        let sd = group.subdevice(md, 0).unwrap();
-        let mut c = CoeClient::new();
+    with_sdo(&sim, async |sd, c| {
         let assign: [u8; 2] = sd.sdo_read(0x1C12, Complete).await.expect("CA upload from sub 1");
         assert_eq!(assign, [0x00, 0x16]);
         sd.sdo_write(0x1C12, Complete, 0x1602u16)
             .await
             .expect("CA download from sub 1 of 1C12h");
         assert_eq!(
-            c.upload_kind(&sd, 0x1C12, 0, true).await.unwrap().0,
+            c.upload_kind(sd, 0x1C12, 0, true).await.unwrap().0,
             [1, 0, 0x02, 0x16]
         );
         sd.sdo_write(0x1C12, Complete, 0x1600u16).await.unwrap();
@@ -975,17 +953,17 @@ fn e078_ethercrab_complete_access_from_subindex_1_to_assignment_and_mapping() {
         sd.sdo_write(0x1600, Complete, 0x6040_0010u32)
             .await
             .expect("CA download from sub 1 of 1600h");
-        assert_eq!(c.upload(&sd, 0x1600, 0).await, Ok(vec![1]));
+        assert_eq!(c.upload(sd, 0x1600, 0).await, Ok(vec![1]));
         assert_eq!(objects(&sim).process_data_bytes(), Some((2, 29)));
         // a refused entry puts the mapping back, as from sub 0
         assert_eq!(
-            c.download_normal(&sd, 0x1600, 1, &0x6041_0010u32.to_le_bytes(), true)
+            c.download_normal(sd, 0x1600, 1, &0x6041_0010u32.to_le_bytes(), true)
                 .await,
             Err(SdoAbort::NOT_MAPPABLE.0)
         );
-        assert_eq!(c.upload(&sd, 0x1600, 0).await, Ok(vec![1]));
+        assert_eq!(c.upload(sd, 0x1600, 0).await, Ok(vec![1]));
         assert_eq!(
-            c.upload(&sd, 0x1600, 1).await,
+            c.upload(sd, 0x1600, 1).await,
             Ok(0x6040_0010u32.to_le_bytes().to_vec())
         );
     });
@@ -997,19 +975,16 @@ fn e016_e017_e084_access_level_a10_2_decides_what_coe_sees() {
     let a10 = drive_ecat::parameter_index(0, 10);
     let a293 = drive_ecat::parameter_index(0, 293); // PLL gain, level 3
     let a150 = drive_ecat::parameter_index(0, 150); // cycle time, level 1
-    with_master(&sim, async |md, clock| {
-        let group = init(md, clock).await;
-        let sd = group.subdevice(md, 0).unwrap();
-        let mut c = CoeClient::new();
+    with_sdo(&sim, async |sd, c| {
         for level in [0u8, 1, 3, 2] {
-            c.download(&sd, a10, 3, &[level]).await.unwrap();
+            c.download(sd, a10, 3, &[level]).await.unwrap();
             let expected: Vec<u16> = device_objects()
                 .filter(|o| o.level <= level)
                 .map(|o| o.info.index)
                 .collect();
-            assert_eq!(c.od_list(&sd, 1).await, expected, "E-084 at level {level}");
-            let a150_read = c.upload(&sd, a150, 0).await;
-            let a293_write = c.download(&sd, a293, 0, &[0, 0]).await;
+            assert_eq!(c.od_list(sd, 1).await, expected, "E-084 at level {level}");
+            let a150_read = c.upload(sd, a150, 0).await;
+            let a293_write = c.download(sd, a293, 0, &[0, 0]).await;
             if level >= 1 {
                 assert_eq!(a150_read, Ok(1000u16.to_le_bytes().to_vec()));
             } else {

@@ -4,7 +4,7 @@
 
 use drive_tests::al::{ACK, BOOT, ERR, INIT, OP, PREOP, SAFEOP};
 use drive_tests::step::{advance, cycles};
-use drive_tests::{al_status, init, line, request, with_master, write_sm, CoeClient};
+use drive_tests::{al_status, init, line, request, with_master, with_sdo, write_sm, CoeClient};
 use ecat::led::Pattern;
 use esc::AlStatusCode;
 use hil_sim::sim::Simulation;
@@ -254,9 +254,7 @@ fn e139_parameter_versions_follow_the_s_layout() {
         ]
     );
     let sim = line(1);
-    with_master(&sim, async |md, clock| {
-        let group = init(md, clock).await;
-        let sd = group.subdevice(md, 0).unwrap();
+    with_sdo(&sim, async |sd, _| {
         let _: u16 = sd.sdo_read(A254, 0).await.expect("A254 (V0, S only)");
         let _: u16 = sd.sdo_read(A256, 0).await.expect("A256");
         let mut count = Vec::new();
@@ -269,11 +267,11 @@ fn e139_parameter_versions_follow_the_s_layout() {
         }
         assert_eq!(count[..3], [4, 3, 4], "A257 V2, A259 V1, A261 V1: elements");
         assert!(count[3] >= 3, "A287 V3: start, progress, result");
-        let e0 = a257(&sd, 0).await;
+        let e0 = a257(sd, 0).await;
         assert!(e0.starts_with("Er") && !e0.contains("St"), "V2 [0]: {e0}");
-        assert!(a257(&sd, 3).await.starts_with("AL "), "V2 [3]");
-        request(&sd, BOOT).await;
-        let a255 = a255(&sd).await;
+        assert!(a257(sd, 3).await.starts_with("AL "), "V2 [3]");
+        request(sd, BOOT).await;
+        let a255 = a255(sd).await;
         assert_eq!(a255, 0x12, "V3: Pre-Op | 10h (V2 had 17…21)");
     });
 }
@@ -290,9 +288,7 @@ fn e026_station_alias_from_the_eeprom_in_a254() {
     sim.borrow_mut().drives_mut()[0].esc =
         hil_sim::esc::Esc::new(hil_sim::esc::EscConfig::default(), &img[..len]);
     assert_eq!(sim.borrow().drives()[0].esc.station_alias(), 0x0777);
-    with_master(&sim, async |md, clock| {
-        let group = init(md, clock).await;
-        let sd = group.subdevice(md, 0).unwrap();
+    with_sdo(&sim, async |sd, _| {
         let a254: u16 = sd.sdo_read(A254, 0).await.expect("A254");
         assert_eq!(a254, 0x0777, "A254 = the EEPROM's alias");
     });
@@ -304,9 +300,7 @@ fn e026_station_alias_from_the_eeprom_in_a254() {
 #[test]
 fn e024_init_loads_the_saved_values_no_mailbox_no_process_data() {
     let sim = line(1);
-    with_master(&sim, async |md, clock| {
-        let group = init(md, clock).await;
-        let sd = group.subdevice(md, 0).unwrap();
+    with_sdo(&sim, async |sd, _| {
         sd.sdo_write(A258, 0, 77u16).await.unwrap();
         sd.sdo_write(0x1010, 1, u32::from_le_bytes(*b"save"))
             .await
@@ -456,13 +450,11 @@ fn e147_message_time_stamp_zero_then_sntp() {
             .message(d.diag().newest_subindex())
             .map(|(_, t)| t.as_ns())
     };
-    with_master(&sim, async |md, clock| {
-        let group = init(md, clock).await;
-        let sd = group.subdevice(md, 0).unwrap();
-        request(&sd, OP).await;
-        assert_eq!(al_status(&sd).await, (PREOP | ERR, 0x0011));
+    with_sdo(&sim, async |sd, _| {
+        request(sd, OP).await;
+        assert_eq!(al_status(sd).await, (PREOP | ERR, 0x0011));
         assert_eq!(newest(&sim), Some(0), "no DC, no SNTP: 0");
-        request(&sd, PREOP | ACK).await;
+        request(sd, PREOP | ACK).await;
         // an SNTP client's time: 2026-11-22 on the DC epoch (2000-01-01)
         let sntp = 847_584_000_000_000_000u64;
         let local = sim.borrow().now().as_ns();
@@ -470,8 +462,8 @@ fn e147_message_time_stamp_zero_then_sntp() {
             .drive
             .set_sntp_time(Some(nanos::Nanos::from_ns(sntp)), nanos::Nanos::from_ns(local));
         advance(&sim, 5_000_000);
-        request(&sd, OP).await;
-        assert_eq!(al_status(&sd).await, (PREOP | ERR, 0x0011));
+        request(sd, OP).await;
+        assert_eq!(al_status(sd).await, (PREOP | ERR, 0x0011));
         let t = newest(&sim).unwrap();
         let elapsed = sim.borrow().now().as_ns() - local;
         assert!(t > sntp && t <= sntp + elapsed, "{t} vs {sntp} + {elapsed}");

@@ -3,7 +3,7 @@
 //! the set-IP-parameter request is answered and a refused address sends
 //! EMCY FFF0h.
 
-use drive_tests::{init, line, with_master, RawMailbox};
+use drive_tests::{line, with_sdo, RawMailbox};
 use ecat::eoe::{fnv1a, EoeHeader};
 
 /// Mailbox type EoE.
@@ -59,24 +59,22 @@ fn set_ip(ip: [u8; 4]) -> Vec<u8> {
 fn e095_e096_e097_e093_eoe_through_the_simulator() {
     let sim = line(1);
     let f = ethernet_frame();
-    with_master(&sim, async |md, clock| {
-        let group = init(md, clock).await;
-        let sd = group.subdevice(md, 0).unwrap();
+    with_sdo(&sim, async |sd, _| {
         let mut mbx = RawMailbox::new();
         // Pre-Op: a frame in three fragments; fragments have no response
         let frags = fragments(&f, 1);
         assert_eq!(frags.len(), 3);
         for m in &frags {
-            assert_eq!(mbx.exchange(&sd, EOE, m).await, None);
+            assert_eq!(mbx.exchange(sd, EOE, m).await, None);
         }
         // set IP parameter: response type 3, last fragment, result 0
-        let resp = mbx.exchange(&sd, EOE, &set_ip([10, 0, 0, 20])).await;
+        let resp = mbx.exchange(sd, EOE, &set_ip([10, 0, 0, 20])).await;
         assert_eq!(resp, Some((EOE, vec![0x03, 0x01, 0x00, 0x00])));
         // E-097: the subnet's last address is refused (result 0001h) ...
-        let resp = mbx.exchange(&sd, EOE, &set_ip([10, 0, 0, 255])).await;
+        let resp = mbx.exchange(sd, EOE, &set_ip([10, 0, 0, 255])).await;
         assert_eq!(resp, Some((EOE, vec![0x03, 0x01, 0x01, 0x00])));
         // ... and EMCY FFF0h / 23h follows (E-093)
-        let emcy = mbx.receive(&sd).await.expect("EMCY");
+        let emcy = mbx.receive(sd).await.expect("EMCY");
         assert_eq!(emcy.0, 3, "CoE");
         assert_eq!(&emcy.1[..5], &[0x00, 0x10, 0xF0, 0xFF, 0x23]);
     });

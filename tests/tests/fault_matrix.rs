@@ -73,6 +73,38 @@ pub async fn fault_reset(m: &mut drive_tests::Cyclic<'_>) -> drive_tests::TxPdo 
     m.run(10).await
 }
 
+/// The end of a fault in motion after its last TxPDO `tx`: the CiA 402
+/// state and [`fault_end`], then a [`fault_reset`] while the cause lasts:
+/// "its state (E47 n)" and its last TxPDO.
+pub async fn end_then_reset<S>(
+    m: &mut drive_tests::Cyclic<'_>,
+    sd: &SubDeviceRef<'_, S>,
+    sim: &RefCell<Simulation>,
+    tx: drive_tests::TxPdo,
+) -> (&'static str, String, String, drive_tests::TxPdo)
+where
+    S: std::ops::Deref<Target = ethercrab::SubDevice>,
+{
+    let state = drive_tests::matrix::cia402_state(tx.statusword);
+    let end = fault_end(sd, sim).await;
+    let tx = fault_reset(m).await;
+    let lasting = format!(
+        "{} (E47 {})",
+        drive_tests::matrix::cia402_state(tx.statusword),
+        get(sim, E47, 0)
+    );
+    (state, end, lasting, tx)
+}
+
+/// After the cause ended: a [`fault_reset`], controlword 0 for 2 cycles,
+/// the enable sequence; the CiA 402 state it ends in.
+pub async fn reset_and_enable(m: &mut drive_tests::Cyclic<'_>) -> &'static str {
+    fault_reset(m).await;
+    m.set_controlword(0);
+    m.run(2).await;
+    drive_tests::matrix::cia402_state(m.enable().await.statusword)
+}
+
 /// An object of the first drive, read locally.
 pub fn get(sim: &RefCell<Simulation>, index: u16, sub: u8) -> i64 {
     sim.borrow().drives()[0].drive.objects().get(index, sub).unwrap()

@@ -4,7 +4,7 @@
 //! refusals. The dictionary side: `crates/drive-core/src/tests_scaling.rs`.
 
 use drive_ecat::parameter_index;
-use drive_tests::{init, line, with_master, CoeClient, Cyclic, REV};
+use drive_tests::{init, line, with_master, with_sdo, CoeClient, Cyclic, REV};
 use ecat::SdoAbort;
 use hil_sim::sim::Simulation;
 use std::cell::RefCell;
@@ -133,29 +133,26 @@ fn e059_e143_integer_process_data_in_op_and_the_parameter_channel() {
 #[test]
 fn e086_coe_online_edit_lands_in_the_declared_unit_only_with_native() {
     let sim = line(1);
-    with_master(&sim, async |md, clock| {
-        let group = init(md, clock).await;
-        let sd = group.subdevice(md, 0).unwrap();
-        let mut c = CoeClient::new();
-        c.download(&sd, A213, 1, &[0]).await.unwrap();
-        c.download(&sd, A310, 0, &[2]).await.unwrap();
+    with_sdo(&sim, async |sd, c| {
+        c.download(sd, A213, 1, &[0]).await.unwrap();
+        c.download(sd, A310, 0, &[2]).await.unwrap();
         let edit = 5000u32.to_le_bytes();
         // native parameter channel
-        c.download(&sd, 0x6081, 0, &edit).await.unwrap();
-        assert_eq!(c.upload(&sd, 0x6081, 0).await, Ok(edit.to_vec()), "as typed");
+        c.download(sd, 0x6081, 0, &edit).await.unwrap();
+        assert_eq!(c.upload(sd, 0x6081, 0).await, Ok(edit.to_vec()), "as typed");
         assert_eq!(
             kept(&sim, 0x6081, 0),
             500_000,
             "5000 inc/s = 500 000 × 0.01 inc/s"
         );
         // integer parameter channel: the same edit
-        c.download(&sd, A213, 2, &[0]).await.unwrap();
-        c.download(&sd, 0x6081, 0, &edit).await.unwrap();
-        assert_eq!(c.upload(&sd, 0x6081, 0).await, Ok(edit.to_vec()));
+        c.download(sd, A213, 2, &[0]).await.unwrap();
+        c.download(sd, 0x6081, 0, &edit).await.unwrap();
+        assert_eq!(c.upload(sd, 0x6081, 0).await, Ok(edit.to_vec()));
         assert_eq!(kept(&sim, 0x6081, 0), 5000, "50 inc/s, not 5000");
-        c.download(&sd, A213, 2, &[1]).await.unwrap();
+        c.download(sd, A213, 2, &[1]).await.unwrap();
         assert_eq!(
-            c.upload(&sd, 0x6081, 0).await,
+            c.upload(sd, 0x6081, 0).await,
             Ok(50u32.to_le_bytes().to_vec()),
             "what the native view shows of it"
         );

@@ -79,12 +79,7 @@ fn foe_256k_image_switches_on_next_power_cycle_and_confirms() {
     assert_eq!(node(&sim).boot.map(|d| d.slot), Some(Slot::A));
     let file = firmware_file(2, IMAGE_FILE_LEN - drive_ecat::boot::IMAGE_HEADER_LEN);
     assert_eq!(file.len(), IMAGE_FILE_LEN);
-    let packets = in_boot(&sim, async |_, sd| {
-        FoeClient::new()
-            .write_file(&sd, "firmware.efw", &file)
-            .await
-            .expect("download accepted")
-    });
+    let packets = download(&sim, "firmware.efw", &file).expect("download accepted");
     assert_eq!(packets as usize, IMAGE_FILE_LEN / FoeClient::SEGMENT + 1);
     {
         let mut n = node(&sim);
@@ -116,9 +111,7 @@ fn foe_256k_image_switches_on_next_power_cycle_and_confirms() {
 fn foe_unconfirmed_image_rolls_back_at_the_next_boot() {
     let sim = line();
     let file = firmware_file(2, 5000);
-    in_boot(&sim, async |_, sd| {
-        FoeClient::new().write_file(&sd, "firmware", &file).await.unwrap();
-    });
+    download(&sim, "firmware", &file).unwrap();
     power_cycle(&sim);
     assert_eq!(node(&sim).boot.map(|d| (d.slot, d.trial)), Some((Slot::B, true)));
     // no confirmation (the new image did not come up): back to A
@@ -132,9 +125,7 @@ fn foe_corrupt_image_is_rejected_and_the_old_slot_stays_active() {
     let sim = line();
     let mut file = firmware_file(2, 30_000);
     file[12_345] ^= 0x01; // one bit of the body: the CRC no longer matches
-    let r = in_boot(&sim, async |_, sd| {
-        FoeClient::new().write_file(&sd, "firmware.efw", &file).await
-    });
+    let r = download(&sim, "firmware.efw", &file);
     assert_eq!(
         r,
         Err(FoeReply::Error(FoeError::CHECKSUM.0)),
@@ -145,11 +136,7 @@ fn foe_corrupt_image_is_rejected_and_the_old_slot_stays_active() {
     let d = node(&sim).boot.unwrap();
     assert_eq!((d.slot, d.trial), (Slot::A, false));
     // a file that is not an image at all: 8004h at the header
-    let r = in_boot(&sim, async |_, sd| {
-        FoeClient::new()
-            .write_file(&sd, "firmware.efw", &[0x55; 1000])
-            .await
-    });
+    let r = download(&sim, "firmware.efw", &[0x55; 1000]);
     assert_eq!(r, Err(FoeReply::Error(FoeError::ILLEGAL.0)));
 }
 
@@ -290,12 +277,18 @@ fn foe_into_a_simulated_drive_with_firmware_slots() {
     assert_eq!(slots.active(), Some(pending), "the new image starts");
 }
 
+/// Writes `file` as `name` through FoE with the drive in Bootstrap: the
+/// packets it took, or the drive's refusal.
+fn download(sim: &RefCell<Simulation<FwNode>>, name: &str, file: &[u8]) -> Result<u32, FoeReply> {
+    in_boot(sim, async |_, sd| {
+        FoeClient::new().write_file(&sd, name, file).await
+    })
+}
+
 /// Downloads `file` and checks it was refused with `code` and changed nothing:
 /// slot B empty, the next power-on starts A as before.
 fn refused(sim: &RefCell<Simulation<FwNode>>, what: &str, file: &[u8], code: FoeError) {
-    let r = in_boot(sim, async |_, sd| {
-        FoeClient::new().write_file(&sd, "firmware.efw", file).await
-    });
+    let r = download(sim, "firmware.efw", file);
     assert_eq!(r, Err(FoeReply::Error(code.0)), "{what}");
     assert!(!node(sim).slots().downloading(), "{what}");
     assert_eq!(
@@ -341,12 +334,7 @@ fn foe_signature_refuses_changed_images_other_keys_wrong_slots_and_downgrades() 
     v1.extend_from_slice(body);
     refused(&sim, "v1 header", &v1, FoeError::ILLEGAL);
     // and the good file still goes in and starts
-    in_boot(&sim, async |_, sd| {
-        FoeClient::new()
-            .write_file(&sd, "firmware.efw", &good)
-            .await
-            .expect("taken");
-    });
+    download(&sim, "firmware.efw", &good).expect("taken");
     assert_eq!(
         node(&sim).slots().state(Slot::B).unwrap(),
         SlotState::Pending { seq: 2 }
@@ -361,28 +349,16 @@ fn foe_signature_counter_floor_follows_the_running_image() {
     let sim = line();
     // counter 3 over the factory's 1: taken, started, confirmed
     let three = signed_file(Slot::B, 2, 3, 5_000, &dev_seed());
-    in_boot(&sim, async |_, sd| {
-        FoeClient::new()
-            .write_file(&sd, "firmware", &three)
-            .await
-            .expect("taken");
-    });
+    download(&sim, "firmware", &three).expect("taken");
     power_cycle(&sim);
     assert!(node(&sim).drive.confirm_firmware());
     assert_eq!(node(&sim).slots().security_floor(), 3);
     // now an image with counter 2 for slot A is a downgrade; 3 is not
     let two = signed_file(Slot::A, 3, 2, 5_000, &dev_seed());
-    let r = in_boot(&sim, async |_, sd| {
-        FoeClient::new().write_file(&sd, "firmware", &two).await
-    });
+    let r = download(&sim, "firmware", &two);
     assert_eq!(r, Err(FoeReply::Error(FoeError::NO_RIGHTS.0)));
     let same = signed_file(Slot::A, 3, 3, 5_000, &dev_seed());
-    in_boot(&sim, async |_, sd| {
-        FoeClient::new()
-            .write_file(&sd, "firmware", &same)
-            .await
-            .expect("taken");
-    });
+    download(&sim, "firmware", &same).expect("taken");
     assert_eq!(
         node(&sim).slots().state(Slot::A).unwrap(),
         SlotState::Pending { seq: 3 }
@@ -397,9 +373,7 @@ fn e019_e140_a09_restart_starts_a_pending_firmware_image() {
     const A09: u16 = drive_ecat::parameter_index(0, 9);
     let sim = line();
     let file = firmware_file(2, 5000);
-    in_boot(&sim, async |_, sd| {
-        FoeClient::new().write_file(&sd, "firmware", &file).await.unwrap();
-    });
+    download(&sim, "firmware", &file).unwrap();
     assert!(matches!(
         node(&sim).slots().state(Slot::B).unwrap(),
         SlotState::Pending { .. }

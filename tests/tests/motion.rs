@@ -84,9 +84,7 @@ fn c003_c015_enable_refused_without_a60_supply_or_sto() {
         ("STO active", |c| c.sto_active = true),
     ];
     let sim = line(1);
-    with_master(&sim, async |md, clock| {
-        let group = init(md, clock).await.into_op(md).await.expect("OP");
-        let mut m = Cyclic::new(md, &group, &sim, 0);
+    with_cyclic(&sim, async |m, _| {
         m.set_mode(8);
         m.run(3).await;
         for (what, cut) in cuts {
@@ -131,9 +129,7 @@ fn c003_c015_enable_refused_without_a60_supply_or_sto() {
 #[test]
 fn c035_csp_follows_a_profile_from_the_master() {
     let sim = line(1);
-    with_master(&sim, async |md, clock| {
-        let group = init(md, clock).await.into_op(md).await.expect("OP");
-        let mut m = Cyclic::new(md, &group, &sim, 0);
+    with_cyclic(&sim, async |m, _| {
         m.set_mode(8);
         let tx = m.run(3).await;
         // CiA practice: the set-point starts at the actual position
@@ -198,9 +194,7 @@ fn c035_csp_follows_a_profile_from_the_master() {
 #[test]
 fn c037_csv_reaches_target_velocity() {
     let sim = line(1);
-    with_master(&sim, async |md, clock| {
-        let group = init(md, clock).await.into_op(md).await.expect("OP");
-        let mut m = Cyclic::new(md, &group, &sim, 0);
+    with_cyclic(&sim, async |m, _| {
         let tx = m.enable_in(9).await;
         assert_eq!(tx.mode_display, 9);
         assert!(tx.bit(12), "csv bit 12 'drive follows': {:#06x}", tx.statusword);
@@ -995,9 +989,7 @@ fn c036_csp_following_error_bit_13_without_fault() {
 #[test]
 fn c027_mode_change_between_pv_and_csv_only_at_standstill() {
     let sim = line(1);
-    with_master(&sim, async |md, clock| {
-        let group = init(md, clock).await.into_op(md).await.expect("OP");
-        let mut m = Cyclic::new(md, &group, &sim, 0);
+    with_cyclic(&sim, async |m, _| {
         m.enable_in(3).await;
         m.set_target_velocity(2 * REV);
         m.run_until(500, |t| t.bit(10) && t.velocity > REV)

@@ -4,13 +4,51 @@
 //! Every check reads what the master received (TxPDO or SDO).
 
 use drive_tests::axis::*;
-use drive_tests::{init, line, map_layout, sw, with_cyclic, with_master, Cyclic, RawCyclic};
+use drive_tests::{
+    init, line, map_layout, sw, with_cyclic, with_master, Cyclic, Link, OpSubDevice, PreOpSubDevice,
+    RawCyclic,
+};
 use drive_tests::{REV, REV_F};
 use hil_sim::motor::{PositionInput, Switches};
+use hil_sim::sim::Simulation;
+use std::cell::RefCell;
 
 /// 603Fh of event 53 (limit switch).
 fn event_53() -> Option<u16> {
     drive_ecat::faults::fault_code_for_event(53).map(|(c, _)| c)
+}
+
+/// `sim`'s first drive with the mode map `layout` (by SDO in Pre-Op, then
+/// `prepare` there), brought to Op with `len` bytes of process data each
+/// way (`what`: the map and its item); `body` with a [`RawCyclic`] on it
+/// and its SubDevice.
+fn with_raw_map<T>(
+    sim: &RefCell<Simulation>,
+    layout: drive_ecat::PdoLayout,
+    (len, what): (usize, &str),
+    prepare: impl for<'a> AsyncFnOnce(&PreOpSubDevice<'a>),
+    body: impl for<'a> AsyncFnOnce(&mut RawCyclic<'a>, &OpSubDevice<'a>) -> T,
+) -> T {
+    with_master(sim, async |md, clock| {
+        let group = init(md, clock).await;
+        let sd = group.subdevice(md, 0).unwrap();
+        map_layout(&sd, layout).await;
+        prepare(&sd).await;
+        let group = group.into_op(md).await.expect("OP with the map");
+        let sd = group.subdevice(md, 0).unwrap();
+        assert_eq!(
+            (sd.io_raw().outputs().len(), sd.io_raw().inputs().len()),
+            (len, len),
+            "{what}"
+        );
+        let mut m = RawCyclic::new(Link {
+            md,
+            group: &group,
+            sim,
+            slave: 0,
+        });
+        body(&mut m, &sd).await
+    })
 }
 
 // ---------------------------------------------------------------------------
@@ -20,79 +58,75 @@ fn event_53() -> Option<u16> {
 #[test]
 fn c031_c032_c033_c034_ip_follows_60c1_only_while_bit_4() {
     let sim = line(1);
-    with_master(&sim, async |md, clock| {
-        let group = init(md, clock).await;
-        let sd = group.subdevice(md, 0).unwrap();
-        map_layout(&sd, drive_ecat::PdoLayout::Ip).await;
-        // profile ramps of 0.1 rev/s² that ip must not apply (C-033)
-        set_profile(&sd, None, (REV / 10) as u32).await;
-        let group = group.into_op(md).await.expect("OP with the ip map");
-        let sd = group.subdevice(md, 0).unwrap();
-        assert_eq!(
-            (sd.io_raw().outputs().len(), sd.io_raw().inputs().len()),
-            (7, 7),
-            "ip map: 7 bytes each way (C-034)"
-        );
-        let mut m = RawCyclic::new(md, &group, &sim, 0);
-        let pos = |m: &RawCyclic<'_>| m.i32_at(3);
-        let set = |m: &mut RawCyclic<'_>, p: i32| m.put(3, &p.to_le_bytes());
-        m.set_mode(7);
-        m.run(3).await;
-        assert_eq!(m.mode_display(), 7, "6061h = ip");
-        let start = pos(&m);
-        set(&mut m, start);
-        m.enable(0).await;
-        m.run(10).await;
-        assert!(!m.bit(12), "bit 12 = 0 without bit 4: {:#06x}", m.statusword());
+    with_raw_map(
+        &sim,
+        drive_ecat::PdoLayout::Ip,
+        (7, "ip map: 7 bytes each way (C-034)"),
+        async |sd| {
+            // profile ramps of 0.1 rev/s² that ip must not apply (C-033)
+            set_profile(sd, None, (REV / 10) as u32).await;
+        },
+        async |m, _| {
+            let pos = |m: &RawCyclic<'_>| m.i32_at(3);
+            let set = |m: &mut RawCyclic<'_>, p: i32| m.put(3, &p.to_le_bytes());
+            m.set_mode(7);
+            m.run(3).await;
+            assert_eq!(m.mode_display(), 7, "6061h = ip");
+            let start = pos(m);
+            set(m, start);
+            m.enable(0).await;
+            m.run(10).await;
+            assert!(!m.bit(12), "bit 12 = 0 without bit 4: {:#06x}", m.statusword());
 
-        // bit 4 = 0: 60C1h:01 is not followed (C-031)
-        set(&mut m, start + REV);
-        m.run(100).await;
-        assert!((pos(&m) - start).abs() < REV / 100, "holds: 6064h {}", pos(&m));
-        assert!(!m.bit(12), "bit 12 still 0: {:#06x}", m.statusword());
-        assert!(
-            motor_position(&sim, 0).abs() < i64::from(REV / 100),
-            "the motor stands"
-        );
+            // bit 4 = 0: 60C1h:01 is not followed (C-031)
+            set(m, start + REV);
+            m.run(100).await;
+            assert!((pos(m) - start).abs() < REV / 100, "holds: 6064h {}", pos(m));
+            assert!(!m.bit(12), "bit 12 still 0: {:#06x}", m.statusword());
+            assert!(
+                motor_position(&sim, 0).abs() < i64::from(REV / 100),
+                "the motor stands"
+            );
 
-        // bit 4 = 1: a 2 rev/s ramp from standstill, one set-point per cycle
-        set(&mut m, start);
-        m.set_controlword(CW_ENABLED | CW_BIT4);
-        m.run(3).await;
-        assert!(m.bit(12), "bit 12 ip active: {:#06x}", m.statusword());
-        let per_ms = 2 * i64::from(REV) / 1000;
-        let mut at = Vec::new();
-        for k in 1..=300i64 {
-            set(&mut m, start + (per_ms * k) as i32);
-            m.cycle().await;
-            assert_eq!(m.state(), sw::OE, "cycle {k}: {:#06x}", m.statusword());
-            assert!(m.bit(12), "cycle {k}: bit 12");
-            at.push(pos(&m));
-        }
-        // full speed after 50 ms although 6083h would need 20 s (C-033)
-        let v_early = f64::from(at[99] - at[49]) / REV_F / 0.050;
-        let v_late = f64::from(at[299] - at[199]) / REV_F / 0.100;
-        let lag = start + (per_ms * 300) as i32 - at[299];
-        println!(
-            "ip 2 rev/s ramp: v(50..100 ms) {v_early:.3} rev/s, v(200..300 ms) {v_late:.3}, lag {lag} inc"
-        );
-        assert!((v_early - 2.0).abs() < 0.1, "no acceleration limit: {v_early}");
-        assert!((v_late - 2.0).abs() < 0.02, "follows 2 rev/s: {v_late}");
-        assert!(lag.abs() < REV / 50, "lag {lag} inc");
+            // bit 4 = 1: a 2 rev/s ramp from standstill, one set-point per cycle
+            set(m, start);
+            m.set_controlword(CW_ENABLED | CW_BIT4);
+            m.run(3).await;
+            assert!(m.bit(12), "bit 12 ip active: {:#06x}", m.statusword());
+            let per_ms = 2 * i64::from(REV) / 1000;
+            let mut at = Vec::new();
+            for k in 1..=300i64 {
+                set(m, start + (per_ms * k) as i32);
+                m.cycle().await;
+                assert_eq!(m.state(), sw::OE, "cycle {k}: {:#06x}", m.statusword());
+                assert!(m.bit(12), "cycle {k}: bit 12");
+                at.push(pos(m));
+            }
+            // full speed after 50 ms although 6083h would need 20 s (C-033)
+            let v_early = f64::from(at[99] - at[49]) / REV_F / 0.050;
+            let v_late = f64::from(at[299] - at[199]) / REV_F / 0.100;
+            let lag = start + (per_ms * 300) as i32 - at[299];
+            println!(
+                "ip 2 rev/s ramp: v(50..100 ms) {v_early:.3} rev/s, v(200..300 ms) {v_late:.3}, lag {lag} inc"
+            );
+            assert!((v_early - 2.0).abs() < 0.1, "no acceleration limit: {v_early}");
+            assert!((v_late - 2.0).abs() < 0.02, "follows 2 rev/s: {v_late}");
+            assert!(lag.abs() < REV / 50, "lag {lag} inc");
 
-        // hold the last set-point: settles on it
-        let end = start + (per_ms * 300) as i32;
-        m.run(300).await;
-        assert!((pos(&m) - end).abs() <= REV / 360, "6064h {} vs {end}", pos(&m));
+            // hold the last set-point: settles on it
+            let end = start + (per_ms * 300) as i32;
+            m.run(300).await;
+            assert!((pos(m) - end).abs() <= REV / 360, "6064h {} vs {end}", pos(m));
 
-        // bit 4 back to 0: interpolation stops, bit 12 clears, a new 60C1h is ignored
-        m.set_controlword(CW_ENABLED);
-        set(&mut m, end + REV);
-        m.run(100).await;
-        assert!(!m.bit(12), "bit 12 = 0: {:#06x}", m.statusword());
-        assert_eq!(m.state(), sw::OE);
-        assert!((pos(&m) - end).abs() <= REV / 360, "holds {}", pos(&m));
-    });
+            // bit 4 back to 0: interpolation stops, bit 12 clears, a new 60C1h is ignored
+            m.set_controlword(CW_ENABLED);
+            set(m, end + REV);
+            m.run(100).await;
+            assert!(!m.bit(12), "bit 12 = 0: {:#06x}", m.statusword());
+            assert_eq!(m.state(), sw::OE);
+            assert!((pos(m) - end).abs() <= REV / 360, "holds {}", pos(m));
+        },
+    );
 }
 
 // ---------------------------------------------------------------------------
@@ -102,79 +136,75 @@ fn c031_c032_c033_c034_ip_follows_60c1_only_while_bit_4() {
 #[test]
 fn c051_c052_c053_c054_vl_bits_4_5_6_ramp_and_limit() {
     let sim = line(1);
-    with_master(&sim, async |md, clock| {
-        let group = init(md, clock).await;
-        let sd = group.subdevice(md, 0).unwrap();
-        map_layout(&sd, drive_ecat::PdoLayout::Vl).await;
-        // 6046h:02 max 600 rpm; 6048h 3000 rpm per 1 s (the default)
-        sd.sdo_write(0x6046, 2, 600u32).await.unwrap();
-        let group = group.into_op(md).await.expect("OP with the vl map");
-        let sd = group.subdevice(md, 0).unwrap();
-        assert_eq!(
-            (sd.io_raw().outputs().len(), sd.io_raw().inputs().len()),
-            (5, 5),
-            "vl map: 5 bytes each way (C-054)"
-        );
-        let mut m = RawCyclic::new(md, &group, &sim, 0);
-        let actual = |m: &RawCyclic<'_>| m.i16_at(3);
-        let set = |m: &mut RawCyclic<'_>, rpm: i16| m.put(3, &rpm.to_le_bytes());
-        let all = CW_ENABLED | CW_BIT4 | CW_BIT5 | CW_BIT6;
-        m.set_mode(2);
-        set(&mut m, 300);
-        m.run(3).await;
-        m.enable(0).await;
-        assert_eq!(m.mode_display(), 2);
-        // bits 4/5/6 = 0: set value 0
-        m.run(100).await;
-        assert_eq!(actual(&m), 0, "bits 4/5/6 = 0: stands");
+    with_raw_map(
+        &sim,
+        drive_ecat::PdoLayout::Vl,
+        (5, "vl map: 5 bytes each way (C-054)"),
+        async |sd| {
+            // 6046h:02 max 600 rpm; 6048h 3000 rpm per 1 s (the default)
+            sd.sdo_write(0x6046, 2, 600u32).await.unwrap();
+        },
+        async |m, sd| {
+            let actual = |m: &RawCyclic<'_>| m.i16_at(3);
+            let set = |m: &mut RawCyclic<'_>, rpm: i16| m.put(3, &rpm.to_le_bytes());
+            let all = CW_ENABLED | CW_BIT4 | CW_BIT5 | CW_BIT6;
+            m.set_mode(2);
+            set(m, 300);
+            m.run(3).await;
+            m.enable(0).await;
+            assert_eq!(m.mode_display(), 2);
+            // bits 4/5/6 = 0: set value 0
+            m.run(100).await;
+            assert_eq!(actual(m), 0, "bits 4/5/6 = 0: stands");
 
-        // all three: follows 6042h with the 6048h ramp (300 rpm at 3000 rpm/s = 100 ms)
-        m.set_controlword(all);
-        let t = m
-            .run_until(400, |m| actual(m) >= 295)
-            .await
-            .expect("6044h reaches 300 rpm");
-        println!("vl 0 → 300 rpm: 6044h ≥ 295 after {t} ms");
-        assert!((90..200).contains(&t), "ramp time {t} ms");
-        let mut mode_bits = 0u16;
-        for _ in 0..200 {
-            m.cycle().await;
-            mode_bits |= m.statusword() & ((1 << 12) | (1 << 13));
-        }
-        assert!((actual(&m) - 300).abs() <= 3, "6044h {}", actual(&m));
-        let demand: i16 = sd.sdo_read(0x6043, 0).await.unwrap();
-        assert_eq!(demand, 300, "6043h ramp output (C-053)");
-        assert_eq!(mode_bits, 0, "no vl statusword mode bits (C-053)");
+            // all three: follows 6042h with the 6048h ramp (300 rpm at 3000 rpm/s = 100 ms)
+            m.set_controlword(all);
+            let t = m
+                .run_until(400, |m| actual(m) >= 295)
+                .await
+                .expect("6044h reaches 300 rpm");
+            println!("vl 0 → 300 rpm: 6044h ≥ 295 after {t} ms");
+            assert!((90..200).contains(&t), "ramp time {t} ms");
+            let mut mode_bits = 0u16;
+            for _ in 0..200 {
+                m.cycle().await;
+                mode_bits |= m.statusword() & ((1 << 12) | (1 << 13));
+            }
+            assert!((actual(m) - 300).abs() <= 3, "6044h {}", actual(m));
+            let demand: i16 = sd.sdo_read(0x6043, 0).await.unwrap();
+            assert_eq!(demand, 300, "6043h ramp output (C-053)");
+            assert_eq!(mode_bits, 0, "no vl statusword mode bits (C-053)");
 
-        // bit 5 = 0: the last set value is frozen
-        m.set_controlword(all & !CW_BIT5);
-        set(&mut m, 120);
-        m.run(300).await;
-        assert!((actual(&m) - 300).abs() <= 3, "frozen at 300: {}", actual(&m));
-        // bit 5 = 1 again: the new set value
-        m.set_controlword(all);
-        m.run(300).await;
-        assert!((actual(&m) - 120).abs() <= 3, "120 rpm: {}", actual(&m));
+            // bit 5 = 0: the last set value is frozen
+            m.set_controlword(all & !CW_BIT5);
+            set(m, 120);
+            m.run(300).await;
+            assert!((actual(m) - 300).abs() <= 3, "frozen at 300: {}", actual(m));
+            // bit 5 = 1 again: the new set value
+            m.set_controlword(all);
+            m.run(300).await;
+            assert!((actual(m) - 120).abs() <= 3, "120 rpm: {}", actual(m));
 
-        // above 6046h:02: limited to 600 rpm (C-052)
-        set(&mut m, 1200);
-        m.run(500).await;
-        assert!((actual(&m) - 600).abs() <= 5, "limited to 600: {}", actual(&m));
-        let demand: i16 = sd.sdo_read(0x6043, 0).await.unwrap();
-        assert_eq!(demand, 600, "6043h limited");
-
-        // bit 6 = 0: set value 0; back on: 600 again; bit 4 = 0: 0
-        for (cw, rpm) in [(all & !CW_BIT6, 0i16), (all, 600), (all & !CW_BIT4, 0)] {
-            m.set_controlword(cw);
+            // above 6046h:02: limited to 600 rpm (C-052)
+            set(m, 1200);
             m.run(500).await;
-            assert!(
-                (actual(&m) - rpm).abs() <= 5,
-                "controlword {cw:#06x}: 6044h {} vs {rpm}",
-                actual(&m)
-            );
-            assert_eq!(m.state(), sw::OE);
-        }
-    });
+            assert!((actual(m) - 600).abs() <= 5, "limited to 600: {}", actual(m));
+            let demand: i16 = sd.sdo_read(0x6043, 0).await.unwrap();
+            assert_eq!(demand, 600, "6043h limited");
+
+            // bit 6 = 0: set value 0; back on: 600 again; bit 4 = 0: 0
+            for (cw, rpm) in [(all & !CW_BIT6, 0i16), (all, 600), (all & !CW_BIT4, 0)] {
+                m.set_controlword(cw);
+                m.run(500).await;
+                assert!(
+                    (actual(m) - rpm).abs() <= 5,
+                    "controlword {cw:#06x}: 6044h {} vs {rpm}",
+                    actual(m)
+                );
+                assert_eq!(m.state(), sw::OE);
+            }
+        },
+    );
 }
 
 // ---------------------------------------------------------------------------
@@ -425,7 +455,7 @@ async fn fault_and_reset(m: &mut Cyclic<'_>, what: &str) -> u16 {
         "{what}: fault, statusword {:#06x}",
         m.tx.statusword
     );
-    let sd = m.group.subdevice(m.md, m.slave).unwrap();
+    let sd = m.link.group.subdevice(m.link.md, m.link.slave).unwrap();
     let code: u16 = sd.sdo_read(0x603F, 0).await.unwrap();
     m.set_controlword(0);
     m.run(2).await;
@@ -610,22 +640,31 @@ async fn pass_and_stop(m: &mut Cyclic<'_>, max: usize, to: i64, what: &str) {
     m.run(100).await;
 }
 
-#[test]
-fn c124_c127_touch_probe_single_shot_falling_only_and_rearm() {
+/// A line whose probe input 1 toggles (low first) at `k`/20 rev + `k` ·
+/// `extra` inc for each `k` of `ks`; those positions.
+fn probe_line(ks: &[i64], extra: i64) -> (RefCell<Simulation>, Vec<i64>) {
     let sim = line(1);
-    // probe input 1 toggles at six positions: ↑p1 ↓p2 ↑p3 ↓p4 ↑p5 ↓p6
-    let marks: Vec<i64> = [2, 4, 6, 8, 14, 16]
-        .iter()
-        .map(|k| i64::from(REV) * k / 20 + 111 * k)
-        .collect();
+    let marks: Vec<i64> = ks.iter().map(|k| i64::from(REV) * k / 20 + extra * k).collect();
     with_drive(&sim, |d| {
         d.motors[0].switches_mut().probe1 = PositionInput::toggles(false, &marks).unwrap();
     });
+    (sim, marks)
+}
+
+/// 60B8h = `function` (the probe's function), then enabled in csv at `v`.
+async fn probe_in_csv(m: &mut Cyclic<'_>, sd: &OpSubDevice<'_>, function: u16, v: i32) {
+    sd.sdo_write(0x60B8, 0, function).await.unwrap();
+    m.enable_in(9).await;
+    m.set_target_velocity(v);
+}
+
+#[test]
+fn c124_c127_touch_probe_single_shot_falling_only_and_rearm() {
+    // probe input 1 toggles at six positions: ↑p1 ↓p2 ↑p3 ↓p4 ↑p5 ↓p6
+    let (sim, marks) = probe_line(&[2, 4, 6, 8, 14, 16], 111);
     with_cyclic(&sim, async |m, sd| {
         // example 2: enabled, first event, falling edge only (bit 5)
-        sd.sdo_write(0x60B8, 0, 0x0021u16).await.unwrap();
-        m.enable_in(9).await;
-        m.set_target_velocity(REV);
+        probe_in_csv(m, sd, 0x0021, REV).await;
         pass_and_stop(m, 2000, marks[3] + i64::from(REV / 20), "past p4").await;
         let (status, rising, falling) = probe1(sd).await;
         println!(
@@ -666,20 +705,11 @@ fn c124_c127_touch_probe_single_shot_falling_only_and_rearm() {
 
 #[test]
 fn c125_c126_touch_probe_example_1_continuous_both_edges() {
-    let sim = line(1);
     // probe input 1 toggles at four positions: ↑p1 ↓p2 ↑p3 ↓p4
-    let marks: Vec<i64> = [2, 4, 6, 8]
-        .iter()
-        .map(|k| i64::from(REV) * k / 20 + 97 * k)
-        .collect();
-    with_drive(&sim, |d| {
-        d.motors[0].switches_mut().probe1 = PositionInput::toggles(false, &marks).unwrap();
-    });
+    let (sim, marks) = probe_line(&[2, 4, 6, 8], 97);
     with_cyclic(&sim, async |m, sd| {
         // example 1: enabled (bit 0), continuous (bit 1), rising (bit 4) and falling (bit 5)
-        sd.sdo_write(0x60B8, 0, 0x0033u16).await.unwrap();
-        m.enable_in(9).await;
-        m.set_target_velocity(REV / 2);
+        probe_in_csv(m, sd, 0x0033, REV / 2).await;
         // past p2: the first pair is stored, both status bits on
         m.run_until(3000, |t| i64::from(t.position) > marks[1] + i64::from(REV / 40))
             .await

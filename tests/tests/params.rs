@@ -5,7 +5,7 @@
 
 use drive_ecat::params::{C31, C32, G472, G475, I04, I20, I25, I28, I29, I30, I423, I425, I43, I53, I87};
 use drive_tests::axis::{with_drive, CW_ENABLED};
-use drive_tests::{init, line, with_cyclic, with_master};
+use drive_tests::{line, with_cyclic, with_sdo};
 use ethercrab::error::CoeAbortCode::{ValueOutOfRange, ValueTooLarge};
 use hil_sim::sim::Simulation;
 use std::cell::RefCell;
@@ -119,9 +119,7 @@ fn power_cycle(sim: &RefCell<Simulation>) {
 fn e018_issue40_settings_saved_with_the_parameter_set_and_restored() {
     let sim = line(1);
     let axis_b = drive_tests::has_axis_b("e018_issue40_settings_saved");
-    with_master(&sim, async |md, clock| {
-        let group = init(md, clock).await;
-        let sd = group.subdevice(md, 0).unwrap();
+    with_sdo(&sim, async |sd, _| {
         let e = sd.sdo_write(G472, 0, 1001u16).await.unwrap_err();
         assert_eq!(abort_code(e), ValueTooLarge, "G472 above 100 % (0609 0031h)");
         let e = sd.sdo_write(C31, 0, 10_000_001u32).await.unwrap_err();
@@ -143,9 +141,7 @@ fn e018_issue40_settings_saved_with_the_parameter_set_and_restored() {
         sd.sdo_write(G475, 0, 999u16).await.unwrap();
     });
     power_cycle(&sim);
-    with_master(&sim, async |md, clock| {
-        let group = init(md, clock).await;
-        let sd = group.subdevice(md, 0).unwrap();
+    with_sdo(&sim, async |sd, _| {
         assert_eq!(sd.sdo_read::<u16>(G472, 0).await.unwrap(), 250);
         assert_eq!(
             sd.sdo_read::<u16>(G475, 0).await.unwrap(),
@@ -172,9 +168,7 @@ fn e018_issue40_settings_saved_with_the_parameter_set_and_restored() {
 #[test]
 fn e018_issue40_homing_and_interpolation_settings_saved_and_restored() {
     let sim = line(1);
-    with_master(&sim, async |md, clock| {
-        let group = init(md, clock).await;
-        let sd = group.subdevice(md, 0).unwrap();
+    with_sdo(&sim, async |sd, _| {
         let e = sd.sdo_write(I28, 0, 3001u16).await.unwrap_err();
         assert_eq!(abort_code(e), ValueTooLarge, "I28 above 300 % (0609 0031h)");
         let e = sd.sdo_write(I25, 0, 101u8).await.unwrap_err();
@@ -199,9 +193,7 @@ fn e018_issue40_homing_and_interpolation_settings_saved_and_restored() {
         sd.sdo_write(I29, 0, 999u16).await.unwrap();
     });
     power_cycle(&sim);
-    with_master(&sim, async |md, clock| {
-        let group = init(md, clock).await;
-        let sd = group.subdevice(md, 0).unwrap();
+    with_sdo(&sim, async |sd, _| {
         assert_eq!(sd.sdo_read::<u16>(I28, 0).await.unwrap(), 400);
         assert_eq!(
             sd.sdo_read::<u16>(I29, 0).await.unwrap(),

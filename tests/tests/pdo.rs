@@ -4,7 +4,9 @@
 //! longer matches the mapping refuses Safe-Op with AL 001Dh.
 
 use drive_tests::al::{ACK, ERR, OP, PREOP, SAFEOP};
-use drive_tests::{al_status, init, line, request, with_master, write_sm, CoeClient};
+use drive_tests::{
+    al_status, init, line, request_gives, with_master, with_sdo, with_sdo_set_up, write_sm, CoeClient,
+};
 use ecat::SdoAbort;
 use esc::AlStatusCode;
 
@@ -135,12 +137,9 @@ fn e061_a250_new_messages_flag_in_the_txpdo() {
 #[test]
 fn e058_e075_mapping_refusals_0604_0041_0604_0042_0604_0043() {
     let sim = line(1);
-    with_master(&sim, async |md, clock| {
-        let group = init(md, clock).await;
-        let sd = group.subdevice(md, 0).unwrap();
-        let mut c = CoeClient::new();
+    with_sdo(&sim, async |sd, c| {
         let put = |v: u32| v.to_le_bytes();
-        c.download(&sd, 0x1600, 0, &[0]).await.unwrap();
+        c.download(sd, 0x1600, 0, &[0]).await.unwrap();
         // not RxPDO-mappable: statusword (Tx only), device type, unknown, hidden (A293)
         for bad in [
             STATUSWORD,
@@ -149,78 +148,74 @@ fn e058_e075_mapping_refusals_0604_0041_0604_0042_0604_0043() {
             m(drive_ecat::parameter_index(0, 293), 0, 16),
         ] {
             assert_eq!(
-                c.download(&sd, 0x1600, 1, &put(bad)).await,
+                c.download(sd, 0x1600, 1, &put(bad)).await,
                 Err(SdoAbort::NOT_MAPPABLE.0),
                 "{bad:08X}h in an RxPDO"
             );
         }
         // not TxPDO-mappable: quick stop option code (Rx only)
-        c.download(&sd, 0x1A00, 0, &[0]).await.unwrap();
+        c.download(sd, 0x1A00, 0, &[0]).await.unwrap();
         assert_eq!(
-            c.download(&sd, 0x1A00, 1, &put(m(0x605A, 0, 16))).await,
+            c.download(sd, 0x1A00, 1, &put(m(0x605A, 0, 16))).await,
             Err(SdoAbort::NOT_MAPPABLE.0)
         );
         // mappable, but with the wrong bit length
         assert_eq!(
-            c.download(&sd, 0x1600, 1, &put(m(0x6040, 0, 8))).await,
+            c.download(sd, 0x1600, 1, &put(m(0x6040, 0, 8))).await,
             Err(SdoAbort::PARAMETER_INCOMPATIBLE.0)
         );
         assert_eq!(
-            c.upload(&sd, 0x1600, 1).await,
+            c.upload(sd, 0x1600, 1).await,
             Ok(put(CONTROLWORD).to_vec()),
             "unchanged"
         );
         // too many entries: sub 0 above 24
         assert_eq!(
-            c.download(&sd, 0x1600, 0, &[25]).await,
+            c.download(sd, 0x1600, 0, &[25]).await,
             Err(SdoAbort::PDO_LENGTH.0)
         );
         // too long: 24 × 32 bits is the limit, gaps of 255 bits exceed it
         for s in 1..=24u8 {
-            c.download(&sd, 0x1600, s, &put(TARGET_VELOCITY)).await.unwrap();
+            c.download(sd, 0x1600, s, &put(TARGET_VELOCITY)).await.unwrap();
         }
-        c.download(&sd, 0x1600, 0, &[24]).await.expect("24 × 32 bits fit");
-        c.download(&sd, 0x1600, 0, &[0]).await.unwrap();
+        c.download(sd, 0x1600, 0, &[24]).await.expect("24 × 32 bits fit");
+        c.download(sd, 0x1600, 0, &[0]).await.unwrap();
         for s in 1..=4u8 {
-            c.download(&sd, 0x1600, s, &put(0x0000_00FF)).await.unwrap();
+            c.download(sd, 0x1600, s, &put(0x0000_00FF)).await.unwrap();
         }
         assert_eq!(
-            c.download(&sd, 0x1600, 0, &[4]).await,
+            c.download(sd, 0x1600, 0, &[4]).await,
             Err(SdoAbort::PDO_LENGTH.0),
             "4 × 255 bits > 768"
         );
-        assert_eq!(c.upload(&sd, 0x1600, 0).await, Ok(vec![0]), "sub 0 unchanged");
+        assert_eq!(c.upload(sd, 0x1600, 0).await, Ok(vec![0]), "sub 0 unchanged");
         // an entry while sub 0 != 0 (CiA 301 step b)
-        c.download(&sd, 0x1600, 1, &put(CONTROLWORD)).await.unwrap();
-        c.download(&sd, 0x1600, 0, &[1]).await.unwrap();
+        c.download(sd, 0x1600, 1, &put(CONTROLWORD)).await.unwrap();
+        c.download(sd, 0x1600, 0, &[1]).await.unwrap();
         assert_eq!(
-            c.download(&sd, 0x1600, 2, &put(TARGET_VELOCITY)).await,
+            c.download(sd, 0x1600, 2, &put(TARGET_VELOCITY)).await,
             Err(SdoAbort::DEVICE_STATE.0)
         );
         // E-052: the FSoE channel is not configurable
-        assert_eq!(c.download(&sd, 0x1603, 0, &[0]).await, Err(SdoAbort::READ_ONLY.0));
+        assert_eq!(c.download(sd, 0x1603, 0, &[0]).await, Err(SdoAbort::READ_ONLY.0));
         assert_eq!(
-            c.download(&sd, 0x1A03, 1, &put(STATUSWORD)).await,
+            c.download(sd, 0x1A03, 1, &put(STATUSWORD)).await,
             Err(SdoAbort::READ_ONLY.0)
         );
         // assignment: only the direction's PDOs, no duplicates
-        c.download(&sd, 0x1C12, 0, &[0]).await.unwrap();
+        c.download(sd, 0x1C12, 0, &[0]).await.unwrap();
         assert_eq!(
-            c.download(&sd, 0x1C12, 1, &0x1A00u16.to_le_bytes()).await,
+            c.download(sd, 0x1C12, 1, &0x1A00u16.to_le_bytes()).await,
             Err(SdoAbort::PARAMETER_INCOMPATIBLE.0)
         );
-        c.download(&sd, 0x1C12, 1, &0x1600u16.to_le_bytes())
-            .await
-            .unwrap();
-        c.download(&sd, 0x1C12, 2, &0x1600u16.to_le_bytes())
-            .await
-            .unwrap();
+        c.download(sd, 0x1C12, 1, &0x1600u16.to_le_bytes()).await.unwrap();
+        c.download(sd, 0x1C12, 2, &0x1600u16.to_le_bytes()).await.unwrap();
         assert_eq!(
-            c.download(&sd, 0x1C12, 0, &[2]).await,
+            c.download(sd, 0x1C12, 0, &[2]).await,
             Err(SdoAbort::PARAMETER_INCOMPATIBLE.0),
             "1600h assigned twice"
         );
-        c.download(&sd, 0x1C12, 0, &[1]).await.unwrap();
+        c.download(sd, 0x1C12, 0, &[1]).await.unwrap();
         assert_eq!(
             pdo_bytes(&sim),
             Some((2, 0)),
@@ -264,45 +259,41 @@ fn e048_e054_mapping_and_assignment_refused_in_safeop_with_0800_0022() {
 #[test]
 fn e057_remap_behind_the_masters_back_refuses_safeop_with_001d_and_001e() {
     let sim = line(1);
-    with_master(&sim, async |md, clock| {
-        let group = init(md, clock).await;
+    with_sdo_set_up(&sim, async |sd, c| {
         // the master configures SM2/SM3 for the default layout (23/29 bytes)
-        let group = group.into_safe_op(md).await.expect("PRE-OP -> SAFE-OP");
-        let group = group.into_pre_op(md).await.expect("SAFE-OP -> PRE-OP");
-        let sd = group.subdevice(md, 0).unwrap();
-        let mut c = CoeClient::new();
         // someone else shortens the RxPDO to the controlword
-        c.download(&sd, 0x1600, 0, &[0]).await.unwrap();
-        c.download(&sd, 0x1600, 1, &CONTROLWORD.to_le_bytes())
+        c.download(sd, 0x1600, 0, &[0]).await.unwrap();
+        c.download(sd, 0x1600, 1, &CONTROLWORD.to_le_bytes())
             .await
             .unwrap();
-        c.download(&sd, 0x1600, 0, &[1]).await.unwrap();
-        write_sm(&sd, 2, 0x1200, 23, 0x64).await;
-        write_sm(&sd, 3, 0x1A00, 29, 0x20).await;
-        request(&sd, SAFEOP).await;
-        assert_eq!(
-            al_status(&sd).await,
+        c.download(sd, 0x1600, 0, &[1]).await.unwrap();
+        write_sm(sd, 2, 0x1200, 23, 0x64).await;
+        write_sm(sd, 3, 0x1A00, 29, 0x20).await;
+        request_gives(
+            sd,
+            SAFEOP,
             (PREOP | ERR, AlStatusCode::INVALID_OUTPUT_CONFIG.0),
-            "SM2 23 bytes, mapping 2 bytes"
-        );
+            "SM2 23 bytes, mapping 2 bytes",
+        )
+        .await;
         // EMCY A000h, diag code SM2 "PDO length not correct" (4·2 + 2 = Ah)
-        let r = c.sdo(&sd, &[0x40, 0x00, 0x10, 0, 0, 0, 0, 0]).await.unwrap();
+        let r = c.sdo(sd, &[0x40, 0x00, 0x10, 0, 0, 0, 0, 0]).await.unwrap();
         assert_eq!(r[0], 0x43, "1000h still readable");
         let emcy = c.emergencies.first().expect("an EMCY before the reply");
         assert_eq!((u16::from_le_bytes([emcy[0], emcy[1]]), emcy[3]), (0xA000, 0x0A));
 
         // SM2 matched to the new mapping: the TxPDO shrinks behind its back too
-        write_sm(&sd, 2, 0x1200, 2, 0x64).await;
-        c.download(&sd, 0x1A00, 0, &[1]).await.unwrap(); // statusword only
-        request(&sd, SAFEOP | ACK).await;
-        assert_eq!(
-            al_status(&sd).await,
+        write_sm(sd, 2, 0x1200, 2, 0x64).await;
+        c.download(sd, 0x1A00, 0, &[1]).await.unwrap(); // statusword only
+        request_gives(
+            sd,
+            SAFEOP | ACK,
             (PREOP | ERR, AlStatusCode::INVALID_INPUT_CONFIG.0),
-            "SM3 29 bytes, mapping 2 bytes"
-        );
-        write_sm(&sd, 3, 0x1A00, 2, 0x20).await;
-        request(&sd, SAFEOP | ACK).await;
-        assert_eq!(al_status(&sd).await, (SAFEOP, 0), "both lengths match");
+            "SM3 29 bytes, mapping 2 bytes",
+        )
+        .await;
+        write_sm(sd, 3, 0x1A00, 2, 0x20).await;
+        request_gives(sd, SAFEOP | ACK, (SAFEOP, 0), "both lengths match").await;
     });
 }
 

@@ -3,7 +3,7 @@
 //! direction in Op at once.
 
 use drive_tests::al::OP;
-use drive_tests::{al_status, init, line, with_master, CoeClient};
+use drive_tests::{al_status, init, line, with_master, with_sdo, CoeClient};
 use ecat::SdoAbort;
 
 /// Mapping entry: index << 16 | sub << 8 | bit length.
@@ -32,9 +32,7 @@ fn e051_channel_1_is_axis_a_and_channel_2_axis_b() {
         return;
     }
     let sim = line(1);
-    with_master(&sim, async |md, clock| {
-        let group = init(md, clock).await;
-        let sd = group.subdevice(md, 0).unwrap();
+    with_sdo(&sim, async |sd, _| {
         for (a, b) in [(0x1600u16, 0x1601u16), (0x1A00, 0x1A01)] {
             let n = sd.sdo_read::<u8>(a, 0).await.unwrap();
             assert!(n > 0, "{a:04X}h has a default mapping");
@@ -72,10 +70,7 @@ fn e051_channel_1_is_axis_a_and_channel_2_axis_b() {
 #[test]
 fn e052_channel_4_mapping_is_refused_to_the_master() {
     let sim = line(1);
-    with_master(&sim, async |md, clock| {
-        let group = init(md, clock).await;
-        let sd = group.subdevice(md, 0).unwrap();
-        let mut c = CoeClient::new();
+    with_sdo(&sim, async |sd, c| {
         for pdo in [0x1603u16, 0x1A03] {
             let entry = if pdo == 0x1603 {
                 m(0x6040, 0, 16)
@@ -83,17 +78,17 @@ fn e052_channel_4_mapping_is_refused_to_the_master() {
                 m(0x6041, 0, 16)
             };
             assert_eq!(
-                c.download(&sd, pdo, 0, &[0]).await,
+                c.download(sd, pdo, 0, &[0]).await,
                 Err(SdoAbort::READ_ONLY.0),
                 "{pdo:04X}h:00"
             );
             assert_eq!(
-                c.download(&sd, pdo, 1, &entry.to_le_bytes()).await,
+                c.download(sd, pdo, 1, &entry.to_le_bytes()).await,
                 Err(SdoAbort::READ_ONLY.0),
                 "{pdo:04X}h:01"
             );
-            assert_eq!(c.upload(&sd, pdo, 0).await, Ok(vec![0]), "{pdo:04X}h stays empty");
-            assert_eq!(c.upload(&sd, pdo, 1).await, Ok(vec![0; 4]));
+            assert_eq!(c.upload(sd, pdo, 0).await, Ok(vec![0]), "{pdo:04X}h stays empty");
+            assert_eq!(c.upload(sd, pdo, 1).await, Ok(vec![0; 4]));
         }
     });
 }

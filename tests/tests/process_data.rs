@@ -7,6 +7,8 @@ use drive_ecat::DriveObjects;
 use drive_tests::al::{OP, SAFEOP};
 use drive_tests::step::set;
 use drive_tests::{al_status, init, line, with_master};
+use ethercrab::subdevice_group::HasPdi;
+use ethercrab::{DefaultLock, MainDevice, SubDeviceGroup};
 use hil_sim::sim::Simulation;
 use std::cell::RefCell;
 
@@ -24,6 +26,13 @@ fn default_outputs(controlword: u16, mode: i8, target_position: i32) -> [u8; 23]
     out[7..11].copy_from_slice(&(-5000i32).to_le_bytes()); // 60FFh target velocity
     out[19..23].copy_from_slice(&0x8000_0001u32.to_le_bytes()); // 60FEh:01
     out
+}
+
+/// `n` process-data frames of the master, the simulated time standing.
+async fn frames<S: HasPdi>(md: &MainDevice<'_>, group: &SubDeviceGroup<8, 512, DefaultLock, S>, n: usize) {
+    for _ in 0..n {
+        group.tx_rx(md).await.expect("cycle");
+    }
 }
 
 fn get(sim: &RefCell<Simulation>, index: u16, sub: u8) -> i64 {
@@ -63,9 +72,7 @@ fn e034_op_rxpdo_set_values_reach_the_objects() {
         assert_eq!(al_status(&sd).await, (OP, 0));
         sd.outputs_raw_mut()
             .copy_from_slice(&default_outputs(0x000F, 8, -123_456));
-        for _ in 0..3 {
-            group.tx_rx(md).await.expect("cycle");
-        }
+        frames(md, &group, 3).await;
         assert_eq!(get(&sim, 0x6040, 0), 0x000F, "controlword");
         assert_eq!(get(&sim, 0x6060, 0), 8, "modes of operation csp");
         assert_eq!(get(&sim, 0x607A, 0), -123_456, "target position, signed");
@@ -74,8 +81,7 @@ fn e034_op_rxpdo_set_values_reach_the_objects() {
 
         // every cycle is evaluated (E-034): the next value follows at once
         sd.outputs_raw_mut()[3..7].copy_from_slice(&7i32.to_le_bytes());
-        group.tx_rx(md).await.expect("cycle");
-        group.tx_rx(md).await.expect("cycle");
+        frames(md, &group, 2).await;
         assert_eq!(get(&sim, 0x607A, 0), 7);
     });
 }
@@ -93,9 +99,7 @@ fn e032_e034_txpdo_follows_the_drives_objects_in_safeop_and_op() {
         set(&sim, 0x6061, 0, -1);
         set(&sim, 0x6064, 0, -2_000_000);
         set(&sim, 0x6077, 0, -300);
-        for _ in 0..3 {
-            group.tx_rx(md).await.expect("cycle");
-        }
+        frames(md, &group, 3).await;
         {
             let io = sd.io_raw();
             let inputs = io.inputs();
@@ -111,9 +115,7 @@ fn e032_e034_txpdo_follows_the_drives_objects_in_safeop_and_op() {
         set(&sim, 0x6064, 0, 0x1234_5678);
         set(&sim, 0x606C, 0, -42);
         // within a cycle or two (the drive fills SM3 after the frame)
-        for _ in 0..2 {
-            group.tx_rx(md).await.expect("cycle");
-        }
+        frames(md, &group, 2).await;
         let io = sd.io_raw();
         let inputs = io.inputs();
         assert_eq!(&inputs[3..7], &0x1234_5678i32.to_le_bytes(), "position actual");
@@ -132,9 +134,7 @@ fn e032_safeop_ignores_the_rxpdo() {
         sd.outputs_raw_mut()
             .copy_from_slice(&default_outputs(0x000F, 8, 99_999));
         set(&sim, 0x6064, 0, 555);
-        for _ in 0..5 {
-            group.tx_rx(md).await.expect("cycle");
-        }
+        frames(md, &group, 5).await;
         assert!(
             sim.borrow().drives()[0].drive.slave().outputs_received() > 0,
             "RxPDO frames did reach SM2"
@@ -163,9 +163,7 @@ fn e035_op_to_safeop_falls_back_to_the_defaults() {
         let sd = group.subdevice(md, 0).unwrap();
         sd.outputs_raw_mut()
             .copy_from_slice(&default_outputs(0x000F, 1, 4321));
-        for _ in 0..3 {
-            group.tx_rx(md).await.expect("cycle");
-        }
+        frames(md, &group, 3).await;
         assert_eq!(get(&sim, 0x6040, 0), 0x000F);
         assert_eq!(get(&sim, 0x6060, 0), 1, "pp from the RxPDO");
         assert_eq!(get(&sim, 0x607A, 0), 4321);
@@ -178,9 +176,7 @@ fn e035_op_to_safeop_falls_back_to_the_defaults() {
         assert_eq!(get(&sim, 0x6060, 0), 9, "the configured mode again");
         // the master keeps sending the old outputs: still ignored
         set(&sim, 0x6064, 0, -9);
-        for _ in 0..3 {
-            group.tx_rx(md).await.expect("cycle");
-        }
+        frames(md, &group, 3).await;
         assert_rx_defaults(&sim, "Safe-Op after Op");
         assert_eq!(get(&sim, 0x6060, 0), 9);
         assert_eq!(
@@ -194,9 +190,7 @@ fn e035_op_to_safeop_falls_back_to_the_defaults() {
         let sd = group.subdevice(md, 0).unwrap();
         sd.outputs_raw_mut()
             .copy_from_slice(&default_outputs(0x0006, 8, 77));
-        for _ in 0..3 {
-            group.tx_rx(md).await.expect("cycle");
-        }
+        frames(md, &group, 3).await;
         assert_eq!(get(&sim, 0x6040, 0), 0x0006);
         assert_eq!(get(&sim, 0x607A, 0), 77);
     });
@@ -230,9 +224,7 @@ fn e048_e034_a_remapped_layout_is_decoded_and_encoded_as_mapped() {
         sd.outputs_raw_mut()
             .copy_from_slice(&[0x78, 0x56, 0x34, 0x12, 0x07, 0x00]);
         // the axis runtime owns 606Ch and 6041h now: the TxPDO must carry what it wrote
-        for _ in 0..3 {
-            group.tx_rx(md).await.expect("cycle");
-        }
+        frames(md, &group, 3).await;
         assert_eq!(get(&sim, 0x60FF, 0), 0x1234_5678, "target velocity @0");
         assert_eq!(get(&sim, 0x6040, 0), 7, "controlword @4");
         assert_eq!(get(&sim, 0x607A, 0), default_of(0x607A, 0), "unmapped: untouched");

@@ -2,7 +2,7 @@
 //! values live in RAM until "save values"; a save cut short by a power loss
 //! leaves the previous set intact.
 
-use drive_tests::{init, line, with_master};
+use drive_tests::{init, line, with_master, with_sdo};
 use hil_sim::sim::Simulation;
 use std::cell::RefCell;
 
@@ -55,9 +55,7 @@ fn e018_written_values_stay_in_ram_until_saved() {
 
     // A00[0] = 1 (Save values), result in A00[2]
     write_a258(&sim, 4321, Some((A00, 1, 1)));
-    let result = with_master(&sim, async |md, clock| {
-        let group = init(md, clock).await;
-        let sd = group.subdevice(md, 0).unwrap();
+    let result = with_sdo(&sim, async |sd, _| {
         sd.sdo_read::<u8>(A00, 3).await.expect("A00[2]")
     });
     assert_eq!(i64::from(result), drive_ecat::runtime::save_result::OK);
@@ -131,21 +129,19 @@ fn e019_e140_e145_a09_restart_starts_again_with_the_saved_values() {
     use drive_tests::al_status;
     const A09: u16 = drive_ecat::parameter_index(0, 9);
     let sim = line(1);
-    let before = with_master(&sim, async |md, clock| {
-        let group = init(md, clock).await;
-        let sd = group.subdevice(md, 0).unwrap();
+    let before = with_sdo(&sim, async |sd, _| {
         sd.sdo_write(A258, 0, 777u16).await.unwrap();
         sd.sdo_write(0x1010, 1, SAVE).await.unwrap();
         sd.sdo_write(A258, 0, 888u16).await.unwrap();
         // a refused state change: a message in the history
-        drive_tests::request(&sd, drive_tests::al::BOOT).await;
+        drive_tests::request(sd, drive_tests::al::BOOT).await;
         let history: u8 = sd.sdo_read(0x10F3, 2).await.unwrap();
         sd.sdo_write(A09, 1, 1u8).await.expect("A09[0] = 1 answered");
         // within the delay: still the same device
         let t = sim.borrow().now().as_ns();
         sim.borrow_mut().advance_to(nanos::Nanos::from_ns(t + 50_000_000));
         let still = sd.sdo_read::<u16>(A258, 0).await.unwrap();
-        (history, still, al_status(&sd).await)
+        (history, still, al_status(sd).await)
     });
     assert_ne!(before.0, 0, "a message in the history before the restart");
     assert_eq!(before.1, 888, "no restart within 100 ms");
@@ -163,9 +159,7 @@ fn e019_e140_e145_a09_restart_starts_again_with_the_saved_values() {
             "the saved set"
         );
     }
-    let after = with_master(&sim, async |md, clock| {
-        let group = init(md, clock).await;
-        let sd = group.subdevice(md, 0).unwrap();
+    let after = with_sdo(&sim, async |sd, _| {
         let a258: u16 = sd.sdo_read(A258, 0).await.unwrap();
         let history: u8 = sd.sdo_read(0x10F3, 2).await.unwrap();
         let restart: u8 = sd.sdo_read(A09, 1).await.unwrap();

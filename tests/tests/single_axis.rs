@@ -6,7 +6,7 @@
 //! and a csp move, axis B's motor unpowered.
 
 use drive_ecat::Variant;
-use drive_tests::{init, sw, with_master, CoeClient, Cyclic, REV, REV_F};
+use drive_tests::{init, sw, with_cyclic, with_master, with_sdo, CoeClient, REV, REV_F};
 use hil_sim::sim::{SimDrive, Simulation};
 use std::cell::RefCell;
 
@@ -55,13 +55,10 @@ fn e005_e006_the_single_axis_identity_from_the_sii_and_1018h() {
 #[test]
 fn e080_e084_the_single_axis_od_lists_have_no_axis_b_object() {
     let sim = single_axis_line(1);
-    with_master(&sim, async |md, clock| {
-        let group = init(md, clock).await;
-        let sd = group.subdevice(md, 0).unwrap();
-        let mut c = CoeClient::new();
-        let all = c.od_list(&sd, 1).await;
-        let rx = c.od_list(&sd, 2).await;
-        let tx = c.od_list(&sd, 3).await;
+    with_sdo(&sim, async |sd, c| {
+        let all = c.od_list(sd, 1).await;
+        let rx = c.od_list(sd, 2).await;
+        let tx = c.od_list(sd, 3).await;
         for (what, list) in [("all", &all), ("RxPDO", &rx), ("TxPDO", &tx)] {
             let b: Vec<String> = list
                 .iter()
@@ -90,7 +87,7 @@ fn e080_e084_the_single_axis_od_lists_have_no_axis_b_object() {
         };
         assert_eq!(all, expected);
         // an object description of an axis-B object is refused too
-        let (op, data) = c.info(&sd, 3, &0x6841u16.to_le_bytes()).await;
+        let (op, data) = c.info(sd, 3, &0x6841u16.to_le_bytes()).await;
         assert_eq!(op, 7, "SDO Info error for 6841h: {data:02x?}");
         assert_eq!(u32::from_le_bytes(data[..4].try_into().unwrap()), NO_OBJECT);
     });
@@ -99,27 +96,24 @@ fn e080_e084_the_single_axis_od_lists_have_no_axis_b_object() {
 #[test]
 fn e016_e072_an_sdo_to_axis_b_gets_0602_0000_and_changes_nothing() {
     let sim = single_axis_line(1);
-    with_master(&sim, async |md, clock| {
-        let group = init(md, clock).await;
-        let sd = group.subdevice(md, 0).unwrap();
-        let mut c = CoeClient::new();
+    with_sdo(&sim, async |sd, c| {
         for (index, sub) in [(0x6841, 0), (0x6840, 0), (0x6864, 0), (0xA8C8, 1), (0xA000, 1)] {
             assert_eq!(
-                c.upload(&sd, index, sub).await,
+                c.upload(sd, index, sub).await,
                 Err(NO_OBJECT),
                 "{index:04X}h:{sub}"
             );
         }
         let before = sim.borrow().drives()[0].drive.objects().clone();
-        assert_eq!(c.download(&sd, 0x6840, 0, &[0x0F, 0]).await, Err(NO_OBJECT));
-        assert_eq!(c.download(&sd, 0x6860, 0, &[8]).await, Err(NO_OBJECT));
+        assert_eq!(c.download(sd, 0x6840, 0, &[0x0F, 0]).await, Err(NO_OBJECT));
+        assert_eq!(c.download(sd, 0x6860, 0, &[8]).await, Err(NO_OBJECT));
         assert_eq!(
             sim.borrow().drives()[0].drive.objects(),
             &before,
             "refused downloads change nothing"
         );
         // ethercrab's own SDO read of 6841h fails as well
-        c.hand_over(&sd).await;
+        c.hand_over(sd).await;
         let r: Result<u16, _> = sd.sdo_read(0x6841, 0).await;
         assert!(r.is_err(), "6841h: {r:?}");
         // axis A answers
@@ -161,16 +155,13 @@ fn e051_e054_only_channel_1_is_assigned_and_channel_2_is_empty() {
 #[test]
 fn e058_mapping_an_axis_b_object_gets_0604_0041_and_changes_nothing() {
     let sim = single_axis_line(1);
-    with_master(&sim, async |md, clock| {
-        let group = init(md, clock).await;
-        let sd = group.subdevice(md, 0).unwrap();
-        let mut c = CoeClient::new();
+    with_sdo(&sim, async |sd, c| {
         for pdo in [0x1600u16, 0x1601] {
-            c.download(&sd, pdo, 0, &[0]).await.expect("sub 0 = 0");
+            c.download(sd, pdo, 0, &[0]).await.expect("sub 0 = 0");
             let before = sim.borrow().drives()[0].drive.objects().clone();
             for m in [0x6840_0010u32, 0x687A_0020, 0xA043_0010] {
                 assert_eq!(
-                    c.download(&sd, pdo, 1, &m.to_le_bytes()).await,
+                    c.download(sd, pdo, 1, &m.to_le_bytes()).await,
                     Err(NOT_MAPPABLE),
                     "{pdo:04X}h:01 = {m:08X}h"
                 );
@@ -178,18 +169,18 @@ fn e058_mapping_an_axis_b_object_gets_0604_0041_and_changes_nothing() {
             assert_eq!(sim.borrow().drives()[0].drive.objects(), &before);
         }
         let tx = 0x6841_0010u32;
-        c.download(&sd, 0x1A01, 0, &[0]).await.expect("sub 0 = 0");
+        c.download(sd, 0x1A01, 0, &[0]).await.expect("sub 0 = 0");
         assert_eq!(
-            c.download(&sd, 0x1A01, 1, &tx.to_le_bytes()).await,
+            c.download(sd, 0x1A01, 1, &tx.to_le_bytes()).await,
             Err(NOT_MAPPABLE)
         );
         // axis A's objects map into channel 2; the standard map goes back
-        c.download(&sd, 0x1601, 1, &0x6040_0010u32.to_le_bytes())
+        c.download(sd, 0x1601, 1, &0x6040_0010u32.to_le_bytes())
             .await
             .expect("6040h into channel 2");
-        c.download(&sd, 0x1600, 0, &[8]).await.expect("1600h back");
+        c.download(sd, 0x1600, 0, &[8]).await.expect("1600h back");
         assert_eq!(
-            c.upload(&sd, 0x1600, 1).await,
+            c.upload(sd, 0x1600, 1).await,
             Ok(0x6040_0010u32.to_le_bytes().to_vec())
         );
     });
@@ -198,9 +189,7 @@ fn e058_mapping_an_axis_b_object_gets_0604_0041_and_changes_nothing() {
 #[test]
 fn e034_op_with_axis_a_standard_pdo_enable_and_a_csp_move() {
     let sim = single_axis_line(1);
-    with_master(&sim, async |md, clock| {
-        let group = init(md, clock).await.into_op(md).await.expect("OP");
-        let mut m = Cyclic::new(md, &group, &sim, 0);
+    with_cyclic(&sim, async |m, _| {
         m.set_mode(8);
         let tx = m.run(3).await;
         assert_eq!(tx.state(), sw::SOD);

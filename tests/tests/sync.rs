@@ -5,16 +5,25 @@
 
 use drive_tests::al::{ACK, ERR, OP, PREOP, SAFEOP};
 use drive_tests::step::{advance, cycles, op_via_safe_op, set};
-use drive_tests::{al_status, init, line, request, with_master, write_sm, CoeClient, OpGroup};
+use drive_tests::{
+    al_status, expect_al, init, line, request_gives, with_master, with_sdo_set_up, write_sm, CoeClient,
+    OpGroup,
+};
 use esc::regs::{self, dc};
 use esc::AlStatusCode;
-use ethercrab::MainDevice;
+use ethercrab::{MainDevice, SubDeviceRef};
 use hil_sim::sim::Simulation;
 use std::cell::RefCell;
 use std::sync::atomic::AtomicU64;
 
 /// A258 PDO timeout (ms), parameter 2000h + 258.
 const A258: u16 = 0x2102;
+/// Safe-Op + ERR with 001Bh: the RxPDO not steady, or gone in Op (the SM
+/// watchdog or the PDO timeout).
+const SAFEOP_001B: (u16, u16) = (SAFEOP | ERR, AlStatusCode::SM_WATCHDOG.0);
+/// Safe-Op + ERR with 002Bh: no RxPDO at all.
+const SAFEOP_002B: (u16, u16) = (SAFEOP | ERR, AlStatusCode::NO_VALID_IO.0);
+
 /// SM2 as the drive's SII describes it.
 const SM2_START: u16 = 0x1200;
 const SM2_LEN: u16 = 23;
@@ -44,6 +53,19 @@ async fn stop_sync0<S>(sd: &ethercrab::SubDeviceRef<'_, S>) {
     sd.register_write(dc::ACTIVATION, 0x00u8).await.unwrap();
 }
 
+/// `ns` of simulated time without process data; then the AL status and
+/// code must be `expected` (`what`: the case).
+async fn quiet_for<S>(
+    sim: &RefCell<Simulation>,
+    sd: &SubDeviceRef<'_, S>,
+    ns: u64,
+    expected: (u16, u16),
+    what: &str,
+) {
+    advance(sim, ns);
+    expect_al(sd, expected, what).await;
+}
+
 fn u32_of(d: &[u8]) -> u32 {
     let mut b = [0u8; 4];
     b[..d.len()].copy_from_slice(d);
@@ -53,48 +75,44 @@ fn u32_of(d: &[u8]) -> u32 {
 #[test]
 fn e029_sync0_cycle_not_a_multiple_of_a150_or_above_8ms_refused() {
     let sim = line(1);
-    with_master(&sim, async |md, clock| {
-        let group = init(md, clock).await;
+    with_sdo_set_up(&sim, async |sd, c| {
         // the master's SM set-up, then back to Pre-Op for the DC configuration
-        let group = group.into_safe_op(md).await.expect("SAFE-OP");
-        let group = group.into_pre_op(md).await.expect("PRE-OP");
-        let sd = group.subdevice(md, 0).unwrap();
-        let mut c = CoeClient::new();
 
         // 1C32h:01 = 2 (DC SYNC0) without SYNC0 active: 0030h
-        c.download(&sd, 0x1C32, 1, &2u16.to_le_bytes()).await.unwrap();
-        request(&sd, SAFEOP).await;
-        assert_eq!(
-            al_status(&sd).await,
+        c.download(sd, 0x1C32, 1, &2u16.to_le_bytes()).await.unwrap();
+        request_gives(
+            sd,
+            SAFEOP,
             (PREOP | ERR, AlStatusCode::INVALID_DC_SYNC_CONFIG.0),
-            "DC selected, SYNC0 inactive"
-        );
-        c.download(&sd, 0x1C32, 1, &0u16.to_le_bytes()).await.unwrap();
+            "DC selected, SYNC0 inactive",
+        )
+        .await;
+        c.download(sd, 0x1C32, 1, &0u16.to_le_bytes()).await.unwrap();
 
         // A150 = 1 ms (default): 1.5 ms is not a multiple, 10 ms is above 8 ms
         for bad in [1_500_000u32, 10_000_000] {
-            start_sync0(&sd, bad).await;
-            request(&sd, SAFEOP | ACK).await;
-            assert_eq!(
-                al_status(&sd).await,
+            start_sync0(sd, bad).await;
+            request_gives(
+                sd,
+                SAFEOP | ACK,
                 (PREOP | ERR, 0x0036),
-                "SYNC0 {bad} ns: DC SYNC0 cycle time"
-            );
-            stop_sync0(&sd).await;
+                &format!("SYNC0 {bad} ns: DC SYNC0 cycle time"),
+            )
+            .await;
+            stop_sync0(sd).await;
         }
         // 2 ms = 2 × A150: accepted; 1C32h/1C33h show DC SYNC0 and the cycle
-        start_sync0(&sd, 2_000_000).await;
-        request(&sd, SAFEOP | ACK).await;
-        assert_eq!(al_status(&sd).await, (SAFEOP, 0), "SYNC0 2 ms");
+        start_sync0(sd, 2_000_000).await;
+        request_gives(sd, SAFEOP | ACK, (SAFEOP, 0), "SYNC0 2 ms").await;
         for index in [0x1C32, 0x1C33] {
-            let st = c.upload(&sd, index, 1).await.unwrap();
+            let st = c.upload(sd, index, 1).await.unwrap();
             assert_eq!(u32_of(&st), 2, "{index:04X}h:01 sync type DC SYNC0");
-            let cy = c.upload(&sd, index, 2).await.unwrap();
+            let cy = c.upload(sd, index, 2).await.unwrap();
             assert_eq!(u32_of(&cy), 2_000_000, "{index:04X}h:02 cycle time");
         }
-        let supported = c.upload(&sd, 0x1C32, 4).await.unwrap();
+        let supported = c.upload(sd, 0x1C32, 4).await.unwrap();
         assert_eq!(u32_of(&supported), 0x0007, "free run, SM2, DC SYNC0");
-        let min = c.upload(&sd, 0x1C32, 5).await.unwrap();
+        let min = c.upload(sd, 0x1C32, 5).await.unwrap();
         assert_eq!(u32_of(&min), 250_000, "minimum cycle 250 µs");
     });
 }
@@ -102,66 +120,56 @@ fn e029_sync0_cycle_not_a_multiple_of_a150_or_above_8ms_refused() {
 #[test]
 fn e030_free_run_without_3_buffer_sm2_refused_with_0029() {
     let sim = line(1);
-    with_master(&sim, async |md, clock| {
-        let group = init(md, clock).await;
-        let group = group.into_safe_op(md).await.expect("SAFE-OP");
-        let group = group.into_pre_op(md).await.expect("PRE-OP");
-        let sd = group.subdevice(md, 0).unwrap();
-        let mut c = CoeClient::new();
+    with_sdo_set_up(&sim, async |sd, c| {
         let one_buffer = (SM2_CONTROL & !0x03) | 0x02;
 
         // 1C32h:01 = 0 (free run, the default) with SM2 in 1-buffer mode
-        write_sm(&sd, 2, SM2_START, SM2_LEN, one_buffer).await;
-        request(&sd, SAFEOP).await;
-        assert_eq!(
-            al_status(&sd).await,
-            (PREOP | ERR, AlStatusCode::FREERUN_NEEDS_3BUFFER.0)
-        );
+        write_sm(sd, 2, SM2_START, SM2_LEN, one_buffer).await;
+        request_gives(
+            sd,
+            SAFEOP,
+            (PREOP | ERR, AlStatusCode::FREERUN_NEEDS_3BUFFER.0),
+            "free run, 1-buffer SM2",
+        )
+        .await;
         // SM-synchronous: the device still needs its 3-buffer SM2 (001Dh)
-        c.download(&sd, 0x1C32, 1, &1u16.to_le_bytes()).await.unwrap();
-        request(&sd, SAFEOP | ACK).await;
-        assert_eq!(
-            al_status(&sd).await,
-            (PREOP | ERR, AlStatusCode::INVALID_OUTPUT_CONFIG.0)
-        );
+        c.download(sd, 0x1C32, 1, &1u16.to_le_bytes()).await.unwrap();
+        request_gives(
+            sd,
+            SAFEOP | ACK,
+            (PREOP | ERR, AlStatusCode::INVALID_OUTPUT_CONFIG.0),
+            "SM-synchronous, 1-buffer SM2",
+        )
+        .await;
         // free run with 3 buffers: fine
-        c.download(&sd, 0x1C32, 1, &0u16.to_le_bytes()).await.unwrap();
-        write_sm(&sd, 2, SM2_START, SM2_LEN, SM2_CONTROL).await;
-        request(&sd, SAFEOP | ACK).await;
-        assert_eq!(al_status(&sd).await, (SAFEOP, 0));
+        c.download(sd, 0x1C32, 1, &0u16.to_le_bytes()).await.unwrap();
+        write_sm(sd, 2, SM2_START, SM2_LEN, SM2_CONTROL).await;
+        request_gives(sd, SAFEOP | ACK, (SAFEOP, 0), "free run, 3 buffers").await;
     });
 }
 
 #[test]
 fn e031_invalid_sm_watchdog_settings_refused_with_001f() {
     let sim = line(1);
-    with_master(&sim, async |md, clock| {
-        let group = init(md, clock).await;
-        let group = group.into_safe_op(md).await.expect("SAFE-OP");
-        let group = group.into_pre_op(md).await.expect("PRE-OP");
-        let sd = group.subdevice(md, 0).unwrap();
+    with_sdo_set_up(&sim, async |sd, _| {
         let code = AlStatusCode::INVALID_WATCHDOG_CONFIG.0;
 
         // divider 0 with the watchdog running
         let divider: u16 = sd.register_read(regs::WATCHDOG_DIVIDER).await.unwrap();
         sd.register_write(regs::WATCHDOG_DIVIDER, 0u16).await.unwrap();
-        request(&sd, SAFEOP).await;
-        assert_eq!(al_status(&sd).await, (PREOP | ERR, code), "divider 0");
+        request_gives(sd, SAFEOP, (PREOP | ERR, code), "divider 0").await;
         sd.register_write(regs::WATCHDOG_DIVIDER, divider).await.unwrap();
 
         // A258 = 65534 relies on the master's SM watchdog
         set(&sim, A258, 0, 65534);
         sd.register_write(regs::WATCHDOG_TIME_PD, 0u16).await.unwrap();
-        request(&sd, SAFEOP | ACK).await;
-        assert_eq!(al_status(&sd).await, (PREOP | ERR, code), "SM watchdog off");
+        request_gives(sd, SAFEOP | ACK, (PREOP | ERR, code), "SM watchdog off").await;
         // 5 × 100 µs is shorter than the 1 ms cycle
         sd.register_write(regs::WATCHDOG_TIME_PD, 5u16).await.unwrap();
-        request(&sd, SAFEOP | ACK).await;
-        assert_eq!(al_status(&sd).await, (PREOP | ERR, code), "shorter than a cycle");
+        request_gives(sd, SAFEOP | ACK, (PREOP | ERR, code), "shorter than a cycle").await;
         // 100 ms: valid
         sd.register_write(regs::WATCHDOG_TIME_PD, 1000u16).await.unwrap();
-        request(&sd, SAFEOP | ACK).await;
-        assert_eq!(al_status(&sd).await, (SAFEOP, 0));
+        request_gives(sd, SAFEOP | ACK, (SAFEOP, 0), "100 ms").await;
     });
 }
 
@@ -177,32 +185,25 @@ fn e033_e047_safeop_to_op_waits_for_steady_rxpdo_and_refuses_after_200ms() {
         let sd = group.subdevice(md, 0).unwrap();
 
         // no process data: the request waits (Safe-Op, no error)…
-        request(&sd, OP).await;
-        assert_eq!(al_status(&sd).await, (SAFEOP, 0), "pending");
-        advance(&sim, 100_000_000);
-        assert_eq!(al_status(&sd).await, (SAFEOP, 0), "still pending at 100 ms");
+        request_gives(&sd, OP, (SAFEOP, 0), "pending").await;
+        quiet_for(&sim, &sd, 100_000_000, (SAFEOP, 0), "still pending at 100 ms").await;
         // …and is refused after 200 ms
-        advance(&sim, 150_000_000);
-        assert_eq!(
-            al_status(&sd).await,
-            (SAFEOP | ERR, AlStatusCode::NO_VALID_IO.0),
-            "no RxPDO within 200 ms"
-        );
+        quiet_for(&sim, &sd, 150_000_000, SAFEOP_002B, "no RxPDO within 200 ms").await;
 
         // one frame, then none: RxPDO, but not steady: 001Bh
-        request(&sd, OP | ACK).await;
-        assert_eq!(al_status(&sd).await, (SAFEOP, 0), "pending");
+        request_gives(&sd, OP | ACK, (SAFEOP, 0), "pending").await;
         cycles(md, &group, &sim, 1).await;
-        advance(&sim, 250_000_000);
-        assert_eq!(
-            al_status(&sd).await,
-            (SAFEOP | ERR, AlStatusCode::SM_WATCHDOG.0),
-            "RxPDO not steady within 200 ms"
-        );
+        quiet_for(
+            &sim,
+            &sd,
+            250_000_000,
+            SAFEOP_001B,
+            "RxPDO not steady within 200 ms",
+        )
+        .await;
 
         // a waiting request is granted once the RxPDO runs
-        request(&sd, OP | ACK).await;
-        assert_eq!(al_status(&sd).await, (SAFEOP, 0), "pending again");
+        request_gives(&sd, OP | ACK, (SAFEOP, 0), "pending again").await;
         cycles(md, &group, &sim, 5).await;
         assert_eq!(al_status(&sd).await, (OP, 0), "steady RxPDO: Op");
     });
@@ -218,16 +219,10 @@ fn e044_e126_e128_op_without_rxpdo_longer_than_a258_falls_to_safeop() {
         assert_eq!(al_status(&sd).await, (OP, 0), "RxPDO every 1 ms");
 
         // 40 ms without RxPDO: still within A258
-        advance(&sim, 40_000_000);
-        assert_eq!(al_status(&sd).await, (OP, 0));
+        quiet_for(&sim, &sd, 40_000_000, (OP, 0), "40 ms: within A258").await;
         cycles(md, &group, &sim, 1).await;
         // 60 ms without: PDO timeout
-        advance(&sim, 60_000_000);
-        assert_eq!(
-            al_status(&sd).await,
-            (SAFEOP | ERR, AlStatusCode::SM_WATCHDOG.0),
-            "PDO timeout"
-        );
+        quiet_for(&sim, &sd, 60_000_000, SAFEOP_001B, "PDO timeout").await;
         // EMCY 7500h, error register 10h, event 52 cause 6
         let mut c = CoeClient::new();
         c.upload(&sd, 0x1000, 0).await.unwrap();
@@ -252,8 +247,7 @@ fn e128_master_leaving_op_does_not_trigger_the_pdo_timeout() {
         cycles(md, &group, &sim, 5).await;
         let group = group.into_safe_op(md).await.expect("back to SAFE-OP");
         let sd = group.subdevice(md, 0).unwrap();
-        advance(&sim, 200_000_000);
-        assert_eq!(al_status(&sd).await, (SAFEOP, 0), "no timeout outside Op");
+        quiet_for(&sim, &sd, 200_000_000, (SAFEOP, 0), "no timeout outside Op").await;
     });
 }
 
@@ -265,14 +259,8 @@ fn e127_sm_watchdog_mode_uses_the_escs_watchdog() {
         let sd = group.subdevice(md, 0).unwrap();
         cycles(md, &group, &sim, 5).await;
         // the ESC's default SM watchdog: 1000 × 100 µs
-        advance(&sim, 90_000_000);
-        assert_eq!(al_status(&sd).await, (OP, 0));
-        advance(&sim, 20_000_000);
-        assert_eq!(
-            al_status(&sd).await,
-            (SAFEOP | ERR, AlStatusCode::SM_WATCHDOG.0),
-            "SM watchdog expired"
-        );
+        quiet_for(&sim, &sd, 90_000_000, (OP, 0), "90 ms: within the SM watchdog").await;
+        quiet_for(&sim, &sd, 20_000_000, SAFEOP_001B, "SM watchdog expired").await;
     });
 }
 

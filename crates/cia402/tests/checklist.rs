@@ -55,6 +55,14 @@ impl Rig {
         self.dc.step(&self.inp, self.t)
     }
 
+    /// A [`Rig::step`] that must make transition `number` from `from` to `to`.
+    #[track_caller]
+    fn step_through(&mut self, number: u8, from: State, to: State) -> Outputs {
+        let out = self.step();
+        assert_eq!(tr(&out), Some((number, from, to)));
+        out
+    }
+
     fn cw(&mut self, cw: u16) -> Outputs {
         self.inp.controlword = cw;
         self.step()
@@ -129,11 +137,7 @@ fn c001_init_then_switch_on_disabled() {
         assert!(!out.power_stage && !out.brake_release);
     }
     r.inp.initialised = true;
-    let out = r.step();
-    assert_eq!(
-        tr(&out),
-        Some((1, State::NotReadyToSwitchOn, State::SwitchOnDisabled))
-    );
+    r.step_through(1, State::NotReadyToSwitchOn, State::SwitchOnDisabled);
     // T2 comes only in the next cycle.
     assert_eq!(r.step().state, State::ReadyToSwitchOn);
 }
@@ -160,20 +164,19 @@ fn c002_shutdown_gives_ready_to_switch_on() {
 
 #[test]
 fn c002_controlword_decoding_masks() {
+    // the command patterns of CiA 402 (mask, value), the first that matches
+    let patterns = [
+        (0x0082, 0x0000, Command::DisableVoltage),
+        (0x0086, 0x0002, Command::QuickStop),
+        (0x0087, 0x0006, Command::Shutdown),
+        (0x008F, 0x0007, Command::SwitchOn),
+        (0x008F, 0x000F, Command::EnableOperation),
+    ];
     for cw in 0u16..=0x01FF {
-        let expect = if cw & 0x0082 == 0 {
-            Some(Command::DisableVoltage)
-        } else if cw & 0x0086 == 0x0002 {
-            Some(Command::QuickStop)
-        } else if cw & 0x0087 == 0x0006 {
-            Some(Command::Shutdown)
-        } else if cw & 0x008F == 0x0007 {
-            Some(Command::SwitchOn)
-        } else if cw & 0x008F == 0x000F {
-            Some(Command::EnableOperation)
-        } else {
-            None
-        };
+        let expect = patterns
+            .iter()
+            .find(|&&(mask, value, _)| cw & mask == value)
+            .map(|&(_, _, command)| command);
         assert_eq!(Command::decode(cw), expect, "cw {cw:#06x}");
         // Every controlword with bit 7 clear is exactly one command; bit 7 set is none.
         assert_eq!(Command::decode(cw).is_some(), cw & 0x80 == 0, "cw {cw:#06x}");
@@ -281,8 +284,7 @@ fn c006_disable_operation_option_codes() {
     assert!(out.motion_enabled);
     r.cw(SWITCH_ON);
     r.inp.standstill = true;
-    let out = r.step();
-    assert_eq!(tr(&out), Some((5, State::OperationEnabled, State::SwitchedOn)));
+    r.step_through(5, State::OperationEnabled, State::SwitchedOn);
 }
 
 #[test]
@@ -316,11 +318,7 @@ fn c008_shutdown_option_codes() {
     assert_eq!(out.ramp, Ramp::Disable(Decel::SlowDown));
     assert!(out.power_stage);
     r.inp.standstill = true;
-    let out = r.step();
-    assert_eq!(
-        tr(&out),
-        Some((8, State::OperationEnabled, State::ReadyToSwitchOn))
-    );
+    r.step_through(8, State::OperationEnabled, State::ReadyToSwitchOn);
 }
 
 #[test]
@@ -407,11 +405,7 @@ fn c010_quick_stop_option_codes() {
         assert_eq!(out.ramp, Ramp::QuickStop(*d));
         assert_eq!(r.step().state, State::QuickStopActive);
         r.inp.standstill = true;
-        let out = r.step();
-        assert_eq!(
-            tr(&out),
-            Some((12, State::QuickStopActive, State::SwitchOnDisabled))
-        );
+        let out = r.step_through(12, State::QuickStopActive, State::SwitchOnDisabled);
         assert!(!out.power_stage);
     }
 
@@ -449,11 +443,7 @@ fn c011_quick_stop_ends_in_switch_on_disabled_never_back() {
         assert!(!out.motion_enabled);
     }
     r.inp.standstill = true;
-    let out = r.step();
-    assert_eq!(
-        tr(&out),
-        Some((12, State::QuickStopActive, State::SwitchOnDisabled))
-    );
+    let out = r.step_through(12, State::QuickStopActive, State::SwitchOnDisabled);
     assert!(!out.power_stage && !out.brake_release);
     // Enable operation held: stays in Switch on disabled.
     assert_eq!(r.step().state, State::SwitchOnDisabled);
@@ -488,18 +478,13 @@ fn c013_losing_additional_enable() {
         let mut r = Rig::new();
         r.goto(from);
         r.inp.additional_enable = false;
-        let out = r.step();
-        assert_eq!(tr(&out), Some((number, from, State::SwitchOnDisabled)));
+        r.step_through(number, from, State::SwitchOnDisabled);
     }
 
     // A44 ≠ 1: Operation enabled → Switch on disabled at once (T9).
     let mut r = Rig::moving(Options::default());
     r.inp.additional_enable = false;
-    let out = r.step();
-    assert_eq!(
-        tr(&out),
-        Some((9, State::OperationEnabled, State::SwitchOnDisabled))
-    );
+    let out = r.step_through(9, State::OperationEnabled, State::SwitchOnDisabled);
     assert!(!out.power_stage);
 
     // A44 = 1: quick stop (T11) that runs to standstill although A60 stays off.
@@ -508,11 +493,7 @@ fn c013_losing_additional_enable() {
         ..Options::default()
     });
     r.inp.additional_enable = false;
-    let out = r.step();
-    assert_eq!(
-        tr(&out),
-        Some((11, State::OperationEnabled, State::QuickStopActive))
-    );
+    r.step_through(11, State::OperationEnabled, State::QuickStopActive);
     for _ in 0..3 {
         let out = r.step();
         assert_eq!(out.state, State::QuickStopActive);
@@ -528,11 +509,7 @@ fn c014_losing_additional_enable_in_quick_stop() {
     r.goto(State::QuickStopActive);
     assert_eq!(r.step().state, State::QuickStopActive);
     r.inp.additional_enable = false;
-    let out = r.step();
-    assert_eq!(
-        tr(&out),
-        Some((12, State::QuickStopActive, State::SwitchOnDisabled))
-    );
+    let out = r.step_through(12, State::QuickStopActive, State::SwitchOnDisabled);
     assert!(!out.power_stage);
 
     // A44 = 1 quick stop: A60 back and lost again also ends it at once.
@@ -576,8 +553,7 @@ fn c015_supply_and_sto_force_switch_on_disabled() {
             r.goto(from);
             r.inp.standstill = false;
             cut(&mut r.inp);
-            let out = r.step();
-            assert_eq!(tr(&out), Some((number, from, State::SwitchOnDisabled)));
+            let out = r.step_through(number, from, State::SwitchOnDisabled);
             assert!(!out.power_stage);
             assert!(out.sod_causes.contains(cause));
         }
@@ -619,8 +595,7 @@ fn c016_fault_reaction_then_fault() {
         assert_eq!(r.cw(cw).state, State::FaultReactionActive);
     }
     r.inp.standstill = true;
-    let out = r.step();
-    assert_eq!(tr(&out), Some((14, State::FaultReactionActive, State::Fault)));
+    let out = r.step_through(14, State::FaultReactionActive, State::Fault);
     assert!(!out.power_stage && !out.brake_release);
     assert_eq!(out.fault, Some(ev));
 
@@ -629,8 +604,7 @@ fn c016_fault_reaction_then_fault() {
         let mut r = Rig::new();
         r.goto(from);
         r.dc.raise_fault(ev);
-        let out = r.step();
-        assert_eq!(tr(&out), Some((13, from, State::FaultReactionActive)));
+        let out = r.step_through(13, from, State::FaultReactionActive);
         assert!(!out.power_stage);
         assert_eq!(out.ramp, Ramp::None);
         assert_eq!(r.step().transition.map(|t| t.number), Some(14));

@@ -46,35 +46,31 @@ fn block(kind: u16, seq: u16, data_len: usize) -> Vec<u8> {
     v
 }
 
-fn write_request(seq: u32, data: &[u8]) -> Vec<u8> {
-    let mut v = rpc(0, 3, seq);
+/// A PNIO call: the RPC header (`ptype`, `opnum`, `seq`), the NDR
+/// arguments (`first`: the maximum or the status, then the length, its
+/// maximum, offset and actual count), the record block `kind` for
+/// `block_len` bytes, then `data`.
+fn call(ptype: u8, opnum: u16, first: u32, seq: u32, kind: u16, block_len: usize, data: &[u8]) -> Vec<u8> {
+    let mut v = rpc(ptype, opnum, seq);
     let args = 64 + data.len() as u32;
-    for x in [4000u32, args, 4000, 0, args] {
+    for x in [first, args, 4000, 0, args] {
         v.extend_from_slice(&x.to_be_bytes());
     }
-    v.extend(block(0x0008, seq as u16, data.len()));
+    v.extend(block(kind, seq as u16, block_len));
     v.extend_from_slice(data);
     finish(v)
+}
+
+fn write_request(seq: u32, data: &[u8]) -> Vec<u8> {
+    call(0, 3, 4000, seq, 0x0008, data.len(), data)
 }
 
 fn read_request(seq: u32) -> Vec<u8> {
-    let mut v = rpc(0, 2, seq);
-    for x in [4000u32, 64, 4000, 0, 64] {
-        v.extend_from_slice(&x.to_be_bytes());
-    }
-    v.extend(block(0x0009, seq as u16, 4000));
-    finish(v)
+    call(0, 2, 4000, seq, 0x0009, 4000, &[])
 }
 
 fn read_response(seq: u32, data: &[u8]) -> Vec<u8> {
-    let mut v = rpc(2, 2, seq);
-    let args = 64 + data.len() as u32;
-    for x in [0u32, args, 4000, 0, args] {
-        v.extend_from_slice(&x.to_be_bytes());
-    }
-    v.extend(block(0x8009, seq as u16, data.len()));
-    v.extend_from_slice(data);
-    finish(v)
+    call(2, 2, 0, seq, 0x8009, data.len(), data)
 }
 
 fn pcap(frames: &[Vec<u8>]) -> Vec<u8> {

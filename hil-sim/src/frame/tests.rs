@@ -450,6 +450,17 @@ fn scan_frame(f: &mut [u8]) -> Result<Vec<(u16, Vec<u8>)>, FrameError> {
     Ok(first)
 }
 
+/// [`scan_frame`] of `f` answered as the scan must be: the BRD by both
+/// ESCs (type 1), the APWR by position 1 (`what`: the case).
+fn assert_scanned(f: &mut [u8], what: &str) {
+    let got = scan_frame(f).unwrap_or_else(|e| panic!("{what}: {e:?}"));
+    assert_eq!(
+        got,
+        std::vec![(2, std::vec![1]), (1, std::vec![0x01, 0x10])],
+        "{what}"
+    );
+}
+
 fn scan_dgs() -> [(Command, u32, &'static [u8]); 2] {
     [
         (Command::Brd, phys(0, 0), &[0; 1]),
@@ -462,12 +473,7 @@ fn e002_header_length_larger_than_the_datagrams_is_processed_as_silicon_does() {
     // libethercat: header length 16 bytes more than its datagrams, unpadded
     for delta in [16, 1, 200] {
         let mut f = as_sent(&scan_dgs(), delta, 0);
-        let got = scan_frame(&mut f).unwrap_or_else(|e| panic!("+{delta}: {e:?}"));
-        assert_eq!(
-            got,
-            std::vec![(2, std::vec![1]), (1, std::vec![0x01, 0x10])],
-            "+{delta}"
-        );
+        assert_scanned(&mut f, &std::format!("+{delta}"));
     }
 }
 
@@ -475,12 +481,7 @@ fn e002_header_length_larger_than_the_datagrams_is_processed_as_silicon_does() {
 fn e002_header_length_smaller_than_the_datagrams_is_processed_as_silicon_does() {
     for delta in [-1, -16, -30] {
         let mut f = as_sent(&scan_dgs(), delta, 60);
-        let got = scan_frame(&mut f).unwrap_or_else(|e| panic!("{delta}: {e:?}"));
-        assert_eq!(
-            got,
-            std::vec![(2, std::vec![1]), (1, std::vec![0x01, 0x10])],
-            "{delta}"
-        );
+        assert_scanned(&mut f, &std::format!("{delta}"));
     }
 }
 
@@ -489,8 +490,7 @@ fn e002_frame_shorter_than_60_bytes_is_processed() {
     let mut f = as_sent(&scan_dgs(), 0, 0);
     assert_eq!(f.len(), 16 + 13 + 14, "no padding");
     assert!(f.len() < 60);
-    let got = scan_frame(&mut f).unwrap();
-    assert_eq!(got, std::vec![(2, std::vec![1]), (1, std::vec![0x01, 0x10])]);
+    assert_scanned(&mut f, "no padding");
 }
 
 #[test]
@@ -498,8 +498,7 @@ fn e002_trailing_bytes_after_the_last_datagram_are_ignored_and_kept() {
     let mut f = as_sent(&scan_dgs(), 0, 0);
     let n = f.len();
     f.extend_from_slice(&[0xAA; 24]); // a trailer (e.g. a time stamp) or odd padding
-    let got = scan_frame(&mut f).unwrap();
-    assert_eq!(got, std::vec![(2, std::vec![1]), (1, std::vec![0x01, 0x10])]);
+    assert_scanned(&mut f, "with a trailer");
     assert_eq!(&f[n..], &[0xAA; 24], "the trailer comes back as it was");
 }
 

@@ -59,6 +59,25 @@ pub fn ip(args: &[&str]) {
     assert!(st.success(), "ip {args:?} failed");
 }
 
+/// Deletes the network namespaces `names` where they exist (left by an
+/// earlier run, or at the end), quietly.
+pub fn netns_del<S: AsRef<str>>(names: &[S]) {
+    for ns in names {
+        let _ = Command::new("ip")
+            .args(["netns", "del", ns.as_ref()])
+            .stderr(Stdio::null())
+            .status();
+    }
+}
+
+/// Adds the network namespaces `names`, each with its loopback up.
+pub fn netns_add<S: AsRef<str>>(names: &[S]) {
+    for ns in names {
+        ip(&["netns", "add", ns.as_ref()]);
+        ip(&["-n", ns.as_ref(), "link", "set", "lo", "up"]);
+    }
+}
+
 /// Stops a `serve` child: SIGTERM first (it flushes its recording and
 /// prints its summary; `ip netns exec` execs serve, so the child's pid is
 /// serve's), then SIGKILL if it is still there after `grace`.

@@ -4,7 +4,7 @@
 //! profinet-py tests drive. Everything is removed on drop (also when the
 //! test fails). Needs root.
 
-use super::{ip, stop_server, watch_script};
+use super::{ip, netns_add, netns_del, stop_server, watch_script};
 use std::ffi::OsStr;
 use std::path::{Path, PathBuf};
 use std::process::{Child, Command, ExitStatus, Stdio};
@@ -60,12 +60,7 @@ impl PnLine {
         let ctl_ns = format!("{prefix}ctl{id}");
         let dev_ns = format!("{prefix}dev{id}");
         let dev_if = format!("{prefix}{id}d");
-        for ns in [&ctl_ns, &dev_ns] {
-            let _ = Command::new("ip")
-                .args(["netns", "del", ns])
-                .stderr(Stdio::null())
-                .status();
-        }
+        netns_del(&[&ctl_ns, &dev_ns]);
         // from here on Drop cleans up whatever was made
         let mut line = PnLine {
             ctl_ns,
@@ -77,10 +72,7 @@ impl PnLine {
             control: dir.join(format!("control-{prefix}")),
         };
         let (c, d) = (line.ctl_ns.clone(), line.dev_ns.clone());
-        for ns in [&c, &d] {
-            ip(&["netns", "add", ns]);
-            ip(&["-n", ns, "link", "set", "lo", "up"]);
-        }
+        netns_add(&[&c, &d]);
         ip(&[
             "link",
             "add",
@@ -180,11 +172,6 @@ impl Drop for PnLine {
     fn drop(&mut self) {
         self.stop_server();
         // deleting the namespaces deletes the veth pair and the address
-        for ns in [&self.ctl_ns, &self.dev_ns] {
-            let _ = Command::new("ip")
-                .args(["netns", "del", ns])
-                .stderr(Stdio::null())
-                .status();
-        }
+        netns_del(&[&self.ctl_ns, &self.dev_ns]);
     }
 }

@@ -4,10 +4,38 @@
 //! is removed on drop. Needs root and a python with pysoem
 //! ([`pysoem_python`]).
 
-use super::{ip, stop_server, watch_script};
+use super::{ip, netns_add, netns_del, stop_server, watch_script};
+use hil_sim::matrix::Row;
 use std::path::{Path, PathBuf};
 use std::process::{Child, Command, ExitStatus, Stdio};
+use std::sync::{Mutex, MutexGuard};
 use std::time::Duration;
+
+/// One SOEM run at a time in a test binary: each needs the cores for its
+/// 1 ms cycle.
+static ONE_AT_A_TIME: Mutex<()> = Mutex::new(());
+
+/// The peer of the SOEM rows of the fault matrix (`scripts/fault-matrix`
+/// lets them be missing when no SOEM test ran, and checks them when one did).
+pub const SOEM_PEER: &str = "SOEM (pysoem) over veth";
+
+/// A row of the fault matrix run by SOEM.
+pub fn soem_row<'a>(order: &'a str, case: &'a str, spec: &'a str, expected: &'a str) -> Row<'a> {
+    Row {
+        order,
+        case,
+        spec,
+        peer: SOEM_PEER,
+        expected,
+    }
+}
+
+/// The python with pysoem ([`pysoem_python`]) and the test's turn (one SOEM
+/// run at a time), or `None` after saying why the test `what` does not run.
+pub fn pysoem_turn(what: &str) -> Option<(PathBuf, MutexGuard<'static, ()>)> {
+    let python = super::or_skip(pysoem_python(), what)?;
+    Some((python, ONE_AT_A_TIME.lock().unwrap_or_else(|e| e.into_inner())))
+}
 
 /// A script that has not finished after this long has hung ([`Line::run`]).
 pub const SCRIPT_LIMIT: Duration = Duration::from_secs(240);
@@ -56,14 +84,8 @@ impl Line {
         let sim_ns = format!("soem{tag}{id}s");
         let master_if = format!("so{tag}{id}m");
         let sim_if = format!("so{tag}{id}s");
-        for ns in [&master_ns, &sim_ns] {
-            let _ = Command::new("ip")
-                .args(["netns", "del", ns])
-                .stderr(Stdio::null())
-                .status();
-            ip(&["netns", "add", ns]);
-            ip(&["-n", ns, "link", "set", "lo", "up"]);
-        }
+        netns_del(&[&master_ns, &sim_ns]);
+        netns_add(&[&master_ns, &sim_ns]);
         ip(&[
             "link", "add", &master_if, "netns", &master_ns, "type", "veth", "peer", "name", &sim_if, "netns",
             &sim_ns,

@@ -14,6 +14,7 @@ connects. One line:
 """
 
 import argparse
+import contextlib
 import logging
 import sys
 import time
@@ -112,14 +113,17 @@ def identify(iface, src, name, timeout):
     return None
 
 
+def check_g472_c31(sc, acc, when, wanted, want):
+    """G472 and C31 read through `acc` must be `want` ([G472, C31]), checked
+    as "`when`: … (`wanted` …)"."""
+    got = acc.read(G472, C31)
+    sc.check(got == want, f"{when}: G472 {got and got[0]} C31 {got and got[1]} ({wanted} {want[0]}, {want[1]})")
+
+
 def p199(sc, a, src):
     info = pnctl.name_and_address(a.iface, src, a.device_mac.lower(), a.name, a.ip)
-    acc = Access(info, a.iface, src)
-    try:
-        before = acc.read(G472, C31)
-        sc.check(before == [G472_DEFAULT, C31_DEFAULT],
-                 f"before: G472 {before and before[0]} C31 {before and before[1]} "
-                 f"(the defaults {G472_DEFAULT}, {C31_DEFAULT})")
+    with contextlib.closing(Access(info, a.iface, src)) as acc:
+        check_g472_c31(sc, acc, "before", "the defaults", [G472_DEFAULT, C31_DEFAULT])
         ok, r = acc.change((G472, FMT_U16, G472_NEW), (C31, FMT_U32, C31_NEW))
         now = acc.read(G472, C31)
         sc.check(ok and now == [G472_NEW, C31_NEW],
@@ -130,21 +134,13 @@ def p199(sc, a, src):
         sc.check(ok and busy == [0], f"PNU 971 = 1: answer {r.hex() if r else r}, PNU 971 then reads {busy} (done)")
         ok, _ = acc.change((C31, FMT_U32, C31_UNSAVED))
         sc.check(ok, f"C31 = {C31_UNSAVED} after the save (not saved)")
-    finally:
-        acc.close()
     pnctl.control(a.control, "restart")
     time.sleep(0.5)
     info = identify(a.iface, src, a.name, 10.0)
     if not sc.check(info is not None, f"after the restart: identified by name {a.name!r}"):
         return
-    acc = Access(info, a.iface, src)
-    try:
-        after = acc.read(G472, C31)
-        sc.check(after == [G472_NEW, C31_NEW],
-                 f"after the restart: G472 {after and after[0]} C31 {after and after[1]} "
-                 f"(want the saved {G472_NEW}, {C31_NEW})")
-    finally:
-        acc.close()
+    with contextlib.closing(Access(info, a.iface, src)) as acc:
+        check_g472_c31(sc, acc, "after the restart", "want the saved", [G472_NEW, C31_NEW])
 
 
 def main():

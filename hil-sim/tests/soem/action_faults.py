@@ -66,8 +66,7 @@ def a69_text(a69, sel):
 
 def run_winding(axis):
     """B43 in Ready to switch on, no enable; A69 until it leaves running."""
-    axis.cw = 6
-    check(axis.until(lambda: L.sw_is(axis.sw, L.READY), 300), f"ready to switch on: statusword {axis.sw:#06x}")
+    M.ready(axis)
     axis.a75 = M.B43_SEL << 1 | 1
     seen = []
     for _ in range(10_000):
@@ -151,13 +150,9 @@ def afterwards(axis, words, before, history):
         f"603Fh {fault:04X}h; history: {'no new message' if newest == history else 'new message'}; "
         f"B05, B52, B53, B62 {'unchanged' if same else 'changed'}"
     )
-    axis.a75 = 0
-    axis.cw = 6
-    axis.cycle(20)
+    M.execute_low(axis)
     words.append(f"Execute low: A69 {STATES.get(axis.a69 >> 12, axis.a69)}")
-    for cw in (7, 0xF):
-        axis.cw = cw
-        axis.cycle(10)
+    M.switch_on_and_enable(axis)
     enabled = axis.until(lambda: L.sw_is(axis.sw, L.ENABLED), 300)
     axis.cycle(100)
     held = enabled and L.sw_is(axis.sw, L.ENABLED)
@@ -200,16 +195,10 @@ def run(m, args):
         check(a69 >> 12 == FAILED, f"{args.fault}: {name} A69 {a69:04X}h, expected failed")
         check(got == code, f"{args.fault}: {name}[0] {got}, expected {code}")
         afterwards(axis, words, before, history)
-    axis.cw = 0
-    axis.cycle(20)
+    L.stop(axis)
     print(f"ROW {ORDER[args.fault]} " + "; ".join(words), flush=True)
 
 
-def main():
-    return L.script_main(__doc__, run, "motor actions against the plant's fault: all checks passed",
-                         ("--fault", dict(required=True, choices=sorted(CASES), help="serve's --plant-fault")),
-                         ("--r", dict(type=float, default=3.6, help="the plant's phase resistance, ohm")))
-
-
-if __name__ == "__main__":
-    sys.exit(main())
+L.script(__name__, __doc__, run, "motor actions against the plant's fault: all checks passed",
+         ("--fault", dict(required=True, choices=sorted(CASES), help="serve's --plant-fault")),
+         ("--r", dict(type=float, default=3.6, help="the plant's phase resistance, ohm")))

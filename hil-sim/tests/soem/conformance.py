@@ -36,7 +36,6 @@ as root inside the master's network namespace (or by hand against `serve`).
 
 Exit status 0 when every check passed; each failed check is printed.
 """
-import argparse
 import os
 import socket
 import struct
@@ -319,30 +318,14 @@ def case_frames(m, iface):
         sock.close()
 
 
-def main():
-    p = argparse.ArgumentParser()
-    p.add_argument("--iface", required=True)
-    p.add_argument("--case", required=True, choices=["op-repeat", "sm-off", "mbx-type", "id-request", "frames"])
-    args = p.parse_args()
-    m = pysoem.Master()
-    m.open(args.iface)
-    try:
-        L.scan(m, 1)
-        check(m.read_state() == PREOP, f"Pre-Op after the scan: {L.state_report(m)}")
-        if args.case == "frames":
-            case_frames(m, args.iface)
-        else:
-            {"op-repeat": case_op_repeat, "sm-off": case_sm_off, "mbx-type": case_mbx_type, "id-request": case_id_request}[args.case](m)
-    except L.Fatal as e:
-        check(False, str(e))
-    finally:
-        m.close()
-    if L.failures:
-        say(f"\n{len(L.failures)} check(s) failed")
-        return 1
-    say("\nall checks passed")
-    return 0
+def run(m, args):
+    L.scan(m, 1)
+    check(m.read_state() == PREOP, f"Pre-Op after the scan: {L.state_report(m)}")
+    if args.case == "frames":
+        case_frames(m, args.iface)
+    else:
+        {"op-repeat": case_op_repeat, "sm-off": case_sm_off, "mbx-type": case_mbx_type, "id-request": case_id_request}[args.case](m)
 
 
-if __name__ == "__main__":
-    sys.exit(main())
+L.script(__name__, __doc__, run, "all checks passed",
+         ("--case", dict(required=True, choices=["op-repeat", "sm-off", "mbx-type", "id-request", "frames"])))

@@ -62,14 +62,8 @@ def run(m, args):
         step(axis, -share, limit, f"6071h = -{share / 10:.0f} %")
         axis.torque = 0
         axis.cycle(20)
-    axis.cw = 0
-    axis.cycle(20)
+    L.stop(axis)
 
 
-def main():
-    return L.script_main(__doc__, run, "cst on the electrical plant: all checks passed",
-                         ("--i10", dict(type=float, required=True, help="I10 maximum speed, inc/s")))
-
-
-if __name__ == "__main__":
-    sys.exit(main())
+L.script(__name__, __doc__, run, "cst on the electrical plant: all checks passed",
+         L.required_float("--i10", "I10 maximum speed, inc/s"))

@@ -652,6 +652,25 @@ def script_main(doc, run, done, *options):
     return master_main(ap.parse_args(), run, done)
 
 
+def script(name, doc, run, done, *options):
+    """A script's end: when `name` (its __name__) is "__main__", exits with
+    script_main(doc, run, done, *options); nothing when another script
+    imports it."""
+    if name == "__main__":
+        sys.exit(script_main(doc, run, done, *options))
+
+
+def required_float(name, what):
+    """An option of script_main: `name`, a float the command line must give."""
+    return (name, dict(type=float, required=True, help=what))
+
+
+def stop(axis, cycles=20):
+    """Controlword 0 for `cycles` cycles: the axis disabled at a script's end."""
+    axis.cw = 0
+    axis.cycle(cycles)
+
+
 def priority():
     """Timer slack 1 ns; nice -20 where permitted, so that the compile jobs of
     a shared machine do not hold up SOEM's mailbox exchanges (it waits for a

@@ -67,9 +67,7 @@ def refused_beyond_the_limits(axis):
     moved = abs(position(axis.s) - at)
     check(moved < 100, f"B44 refused: the axis moved {moved} inc")
     say(f"B44 beyond the software limits: refused (A69 {seen[-1]:04X}h, B44[0] 12), moved {moved} inc")
-    axis.a75 = 0
-    axis.cw = 6
-    axis.cycle(20)
+    M.execute_low(axis)
     for sub in (1, 2):
         axis.s.sdo_write(0x607D, sub, (0).to_bytes(4, "little", signed=True))
 
@@ -77,9 +75,8 @@ def refused_beyond_the_limits(axis):
 def identify(axis, j, fc, b):
     at = position(axis.s)
     seen, took = M.start(axis, SEL)
-    done = 100 | SEL << 8 | M.DONE << 12
     result = L.sdo_u(axis.s, B44, 1)
-    check(seen[-1] == done, f"B44: A69 ends {seen[-1]:04X}h, expected {done:04X}h; seen {[f'{s:04X}' for s in seen]}; B44[0] {result}")
+    M.check_done("B44", SEL, seen, f"; B44[0] {result}")
     check(all((a & 0xFF) <= (b_ & 0xFF) for a, b_ in zip(seen, seen[1:])), f"B44: progress rises: {[f'{s:04X}' for s in seen]}")
     check(result == 0, f"B44[0] result {result}, expected 0")
     j_id, fc_id, b_id, c31 = tuning(axis.s)
@@ -95,10 +92,7 @@ def identify(axis, j, fc, b):
     check(abs(c31 * 1e-6 - kp) <= 1e-3 * kp + 2e-6, f"C31 {c31} vs J ω / r = {kp * 1e6:.0f} µN m s/rad")
     back = abs(position(axis.s) - at)
     check(back < (1 << 20) // 100, f"B44: {back} inc from the start at the end")
-    axis.a75 = 0
-    axis.cw = 6
-    axis.cycle(20)
-    check(axis.a69 == 0, f"B44: A69 {axis.a69:04X}h after Execute low, expected idle")
+    M.execute_low(axis, "B44")
 
 
 def run(m, args):
@@ -108,16 +102,10 @@ def run(m, args):
     refused_switch_on_disabled(axis)
     refused_beyond_the_limits(axis)
     identify(axis, args.j, args.fc, args.b)
-    axis.cw = 0
-    axis.cycle(20)
+    L.stop(axis)
 
 
-def main():
-    return L.script_main(__doc__, run, "B44 identify mechanics on the electrical plant: all checks passed",
-                         ("--j", dict(type=float, required=True, help="the plant's inertia, kg m2")),
-                         ("--fc", dict(type=float, required=True, help="the plant's Coulomb friction, N m")),
-                         ("--b", dict(type=float, required=True, help="the plant's viscous friction, N m s/rad")))
-
-
-if __name__ == "__main__":
-    sys.exit(main())
+L.script(__name__, __doc__, run, "B44 identify mechanics on the electrical plant: all checks passed",
+         L.required_float("--j", "the plant's inertia, kg m2"),
+         L.required_float("--fc", "the plant's Coulomb friction, N m"),
+         L.required_float("--b", "the plant's viscous friction, N m s/rad"))

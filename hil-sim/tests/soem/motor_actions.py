@@ -99,39 +99,69 @@ def refused(axis):
     axis.cycle(5)
 
 
-def start(axis, sel):
-    """Starts `sel` in Ready to switch on, enables; A69 until it leaves running."""
+def ready(axis):
+    """Controlword 6 until the statusword shows Ready to switch on (300
+    frames at most)."""
     axis.cw = 6
     check(axis.until(lambda: L.sw_is(axis.sw, L.READY), 300), f"ready to switch on: statusword {axis.sw:#06x}")
-    axis.a75 = sel << 1 | 1
-    axis.cycle(10)
+
+
+def switch_on_and_enable(axis):
+    """Controlwords 7 and 0xF, 10 frames each."""
     for cw in (7, 0xF):
         axis.cw = cw
         axis.cycle(10)
+
+
+def watch(axis, seconds, busy=(RUNNING,)):
+    """A69 frame by frame until its state is not in `busy` (`seconds` at
+    most): the values it showed, the time it took."""
     seen = []
     start_t = time.monotonic()
-    while time.monotonic() - start_t < 30.0:
+    while time.monotonic() - start_t < seconds:
         axis.cycle()
         if not seen or seen[-1] != axis.a69:
             seen.append(axis.a69)
-        if axis.a69 >> 12 != RUNNING:
+        if axis.a69 >> 12 not in busy:
             break
     return seen, time.monotonic() - start_t
 
 
+def check_done(what, sel, seen, more=""):
+    """A69 ended in `sel` done (100 %); `more` goes into the message."""
+    done = 100 | sel << 8 | DONE << 12
+    check(seen[-1] == done, f"{what}: A69 ends {seen[-1]:04X}h, expected {done:04X}h; seen {[f'{s:04X}' for s in seen]}{more}")
+
+
+def execute_low(axis, what=None):
+    """Execute (A75 bit 0) low in Ready to switch on, 20 frames; with `what`,
+    A69 must then be idle."""
+    axis.a75 = 0
+    axis.cw = 6
+    axis.cycle(20)
+    if what is not None:
+        check(axis.a69 == 0, f"{what}: A69 {axis.a69:04X}h after Execute low, expected idle")
+
+
+def start(axis, sel):
+    """Starts `sel` in Ready to switch on, enables; A69 until it leaves running."""
+    ready(axis)
+    axis.a75 = sel << 1 | 1
+    axis.cycle(10)
+    switch_on_and_enable(axis)
+    return watch(axis, 30.0)
+
+
 def phase_test(axis):
     seen, took = start(axis, B40_SEL)
-    done = 100 | B40_SEL << 8 | DONE << 12
     result = L.sdo_u(axis.s, B40, 1)
-    check(seen[-1] == done, f"B40: A69 ends {seen[-1]:04X}h, expected {done:04X}h; seen {[f'{s:04X}' for s in seen]}; B40[0] {result}")
+    check_done("B40", B40_SEL, seen, f"; B40[0] {result}")
     check(result == 0, f"B40[0] result {result}, expected 0")
     per_turn = int.from_bytes(axis.s.sdo_read(B40, 2), "little", signed=True)
     pp = L.sdo_u(axis.s, B40, 3)
     say(f"B40: {per_turn} inc per electrical turn, {pp} pole pairs seen, in {took:.2f} s")
     check(pp == L.sdo_u(axis.s, B10, 0), f"B40: pole pairs seen {pp} vs B10")
-    axis.a75 = 0
-    axis.cw = 6
-    axis.cycle(20)
+    execute_low(axis)
 
 
 def calibrate(axis, offset_rad):
@@ -140,95 +170,65 @@ def calibrate(axis, offset_rad):
     truth = round(offset_rad / (2 * 3.141592653589793) * (1 << 20))
     check(L.sdo_u(axis.s, B05, 0) == 0, "B05 = 0 before")
     seen, took = start(axis, B41_SEL)
-    done = 100 | B41_SEL << 8 | DONE << 12
-    check(seen[-1] == done, f"B41: A69 ends {seen[-1]:04X}h, expected {done:04X}h; seen {[f'{s:04X}' for s in seen]}")
+    check_done("B41", B41_SEL, seen)
     check(L.sdo_u(axis.s, B41, 1) == 0, f"B41[0] result {L.sdo_u(axis.s, B41, 1)}, expected 0")
     b05 = L.sdo_u(axis.s, B05, 0)
     err = (b05 - truth) % per_el
     err = min(err, per_el - err) / per_el * 360.0
     say(f"B41: plant offset {truth} inc, B05 {b05} inc: {err:.3} deg electrical off, alignments {L.sdo_u(axis.s, B41, 2)} inc apart, in {took:.2f} s")
     check(err < 0.5, f"B41: B05 {b05} vs the plant's {truth} (mod {per_el}): {err} deg el")
-    axis.a75 = 0
-    axis.cw = 6
-    axis.cycle(20)
+    execute_low(axis)
 
 
 def test_brake(axis):
     seen, took = start(axis, B300_SEL)
-    done = 100 | B300_SEL << 8 | DONE << 12
     result, moved, torque = (L.sdo_u(axis.s, B300, k) for k in (1, 2, 3))
-    check(seen[-1] == done, f"B300: A69 ends {seen[-1]:04X}h, expected {done:04X}h; seen {[f'{s:04X}' for s in seen]}; B300[0] {result}")
+    check_done("B300", B300_SEL, seen, f"; B300[0] {result}")
     check(result == 0, f"B300[0] result {result}, expected 0 (held)")
     check(moved <= (1 << 20) // 360, f"B300: the shaft moved {moved} inc under the test torque")
     rated = L.sdo_u(axis.s, 0x6076, 0)
     check(torque == rated, f"B300: test torque {torque} mN m, 6076h {rated}")
     say(f"B300: the brake held {torque} mN m both ways, largest movement {moved} inc, in {took:.2f} s")
-    axis.a75 = 0
-    axis.cw = 6
-    axis.cycle(20)
+    execute_low(axis)
 
 
 def grind_brake(axis):
     seen, took = start(axis, B301_SEL)
-    done = 100 | B301_SEL << 8 | DONE << 12
     # A69 first: a fault's EMCY would come with the first SDO read
-    check(seen[-1] == done, f"B301: A69 ends {seen[-1]:04X}h, expected {done:04X}h; seen {[f'{s:04X}' for s in seen]}; statusword {axis.sw:#06x}")
+    check_done("B301", B301_SEL, seen, f"; statusword {axis.sw:#06x}")
     result, grind, released, torque = (L.sdo_u(axis.s, B301, k) for k in (1, 2, 3, 4))
     check(result == 0, f"B301[0] result {result}, expected 0 (ground in)")
     check(grind >= 0.8 * (1 << 19), f"B301: a grind phase turned the shaft {grind} inc only")
     check(released >= 0.8 * (1 << 18), f"B301: a released phase turned the shaft {released} inc only")
     check(2000 <= torque <= 2300, f"B301: grinding torque {torque} mN m, the plant's brake slides at 2000")
     say(f"B301: smallest grind travel {grind} inc, released {released} inc, grinding torque {torque} mN m, in {took:.2f} s")
-    axis.a75 = 0
-    axis.cw = 6
-    axis.cycle(20)
+    execute_low(axis)
 
 
 def winding(axis, r):
-    axis.cw = 6
-    check(axis.until(lambda: L.sw_is(axis.sw, L.READY), 300), f"ready to switch on: statusword {axis.sw:#06x}")
+    ready(axis)
     axis.a75 = B43_SEL << 1 | 1
-    seen = []
-    start_t = time.monotonic()
-    while time.monotonic() - start_t < 10.0:
-        axis.cycle()
-        if not seen or seen[-1] != axis.a69:
-            seen.append(axis.a69)
-        if axis.a69 >> 12 not in (0, RUNNING):
-            break
-    done = 100 | B43_SEL << 8 | DONE << 12
-    check(seen[-1] == done, f"B43: A69 ends {seen[-1]:04X}h, expected {done:04X}h; seen {[f'{s:04X}' for s in seen]}")
+    seen, took = watch(axis, 10.0, busy=(0, RUNNING))
+    check_done("B43", B43_SEL, seen)
     check(L.sdo_u(axis.s, E48, 0) == 2, "B43 runs without the enable: E48 = 2")
     check(L.sdo_u(axis.s, B43, 1) == 0, f"B43[0] result {L.sdo_u(axis.s, B43, 1)}, expected 0")
     rs = [L.sdo_u(axis.s, B43, k) * 1e-3 for k in (2, 3, 4)]
-    say(f"B43: resistances along U, V, W {rs} ohm (plant {r} ohm) in {time.monotonic() - start_t:.2f} s")
+    say(f"B43: resistances along U, V, W {rs} ohm (plant {r} ohm) in {took:.2f} s")
     check(all(abs(x - r) <= 0.03 * r for x in rs), f"B43: {rs} not within 3 % of {r} ohm")
     axis.a75 = 0
     axis.cycle(10)
 
 
 def optimise(axis, sel, r, l):
-    axis.cw = 6
-    check(axis.until(lambda: L.sw_is(axis.sw, L.READY), 300), f"ready to switch on: statusword {axis.sw:#06x}")
+    ready(axis)
     check(L.sdo_u(axis.s, E48, 0) == 2, "E48 = 2")
     axis.a75 = sel << 1 | 1
     axis.cycle(10)
     want = sel << 8 | RUNNING << 12
     check(axis.a69 == want, f"{sel:04b}: A69 {axis.a69:04X}h before the enable, expected {want:04X}h (running, 0 %)")
-    for cw in (7, 0xF):
-        axis.cw = cw
-        axis.cycle(10)
-    seen = []
-    start = time.monotonic()
-    while time.monotonic() - start < 10.0:
-        axis.cycle()
-        if not seen or seen[-1] != axis.a69:
-            seen.append(axis.a69)
-        if axis.a69 >> 12 != RUNNING:
-            break
-    took = time.monotonic() - start
-    done = 100 | sel << 8 | DONE << 12
-    check(seen[-1] == done, f"{sel:04b}: A69 ends {seen[-1]:04X}h, expected {done:04X}h; seen {[f'{s:04X}' for s in seen]}; B42[0] {L.sdo_u(axis.s, B42, 1)}, statusword {axis.sw:#06x}")
+    switch_on_and_enable(axis)
+    seen, took = watch(axis, 10.0)
+    check_done(f"{sel:04b}", sel, seen, f"; B42[0] {L.sdo_u(axis.s, B42, 1)}, statusword {axis.sw:#06x}")
     check(all((a & 0xFF) <= (b_ & 0xFF) for a, b_ in zip(seen, seen[1:])), f"{sel:04b}: progress rises: {[f'{s:04X}' for s in seen]}")
     check(L.sdo_u(axis.s, B42, 1) == 0, f"{sel:04b}: B42[0] result {L.sdo_u(axis.s, B42, 1)}, expected 0")
     r_mohm, l_uh, lq_uh = motor_data(axis.s)
@@ -238,10 +238,7 @@ def optimise(axis, sel, r, l):
     check(abs(l_id - l) <= 0.05 * l, f"{sel:04b}: B52 {l_id} H not within 5 % of the plant's {l} H")
     check(lq_uh == l_uh, f"{sel:04b}: B62 {lq_uh} = B52 {l_uh}")
     check((L.sdo_u(axis.s, B42, 2), L.sdo_u(axis.s, B42, 3)) == (r_mohm, l_uh), f"{sel:04b}: B42[1]/[2] = B53/B52")
-    axis.a75 = 0
-    axis.cw = 6
-    axis.cycle(20)
-    check(axis.a69 == 0, f"{sel:04b}: A69 {axis.a69:04X}h after Execute low, expected idle")
+    execute_low(axis, f"{sel:04b}")
 
 
 def run(m, args):
@@ -257,16 +254,10 @@ def run(m, args):
     winding(axis, args.r)
     test_brake(axis)
     grind_brake(axis)
-    axis.cw = 0
-    axis.cycle(20)
+    L.stop(axis)
 
 
-def main():
-    return L.script_main(__doc__, run, "motor actions on the electrical plant: all checks passed",
-                         ("--r", dict(type=float, required=True, help="the plant's phase resistance, ohm")),
-                         ("--l", dict(type=float, required=True, help="the plant's inductance, H")),
-                         ("--offset", dict(type=float, required=True, help="the plant's commutation offset, rad (mechanical)")))
-
-
-if __name__ == "__main__":
-    sys.exit(main())
+L.script(__name__, __doc__, run, "motor actions on the electrical plant: all checks passed",
+         L.required_float("--r", "the plant's phase resistance, ohm"),
+         L.required_float("--l", "the plant's inductance, H"),
+         L.required_float("--offset", "the plant's commutation offset, rad (mechanical)"))

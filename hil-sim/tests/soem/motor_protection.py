@@ -213,15 +213,9 @@ def run(m, args):
     axis.enable()
     current_limit(axis)
     i2t(m, axis, emcys, args.tau_ms / 1000.0, args.u11_ms / 1000.0)
-    axis.cw = 0
-    axis.cycle(20)
+    L.stop(axis)
 
 
-def main():
-    return L.script_main(__doc__, run, "motor protection on the electrical plant: all checks passed",
-                         ("--tau-ms", dict(type=int, default=4000, help="B73 thermal time constant, ms")),
-                         ("--u11-ms", dict(type=int, default=500, help="U11 i2t warning time, ms")))
-
-
-if __name__ == "__main__":
-    sys.exit(main())
+L.script(__name__, __doc__, run, "motor protection on the electrical plant: all checks passed",
+         ("--tau-ms", dict(type=int, default=4000, help="B73 thermal time constant, ms")),
+         ("--u11-ms", dict(type=int, default=500, help="U11 i2t warning time, ms")))

@@ -93,13 +93,7 @@ def run(m, args):
     axis.cw = 0
     axis.cycle(2)
     enable_into_the_short(m, axis, emcys, "enable after the reset, the short still there")
-    axis.cw = 0
-    axis.cycle(20)
+    L.stop(axis)
 
 
-def main():
-    return L.script_main(__doc__, run, "over-current on the electrical plant: all checks passed")
-
-
-if __name__ == "__main__":
-    sys.exit(main())
+L.script(__name__, __doc__, run, "over-current on the electrical plant: all checks passed")

@@ -91,13 +91,7 @@ def run(m, args):
     nowarn = [f for f in held if not f[3] & WARNING]
     check(not nowarn, f"stage i2t: bit 7 while limited: missing in {len(nowarn)}")
     check(not any(f[3] & MP.FAULT for f in held), "stage i2t: no fault (the limit is obeyed)")
-    axis.cw = 0
-    axis.cycle(20)
+    L.stop(axis)
 
 
-def main():
-    return L.script_main(__doc__, run, "current limit and power-stage i2t on the electrical plant: all checks passed")
-
-
-if __name__ == "__main__":
-    sys.exit(main())
+L.script(__name__, __doc__, run, "current limit and power-stage i2t on the electrical plant: all checks passed")

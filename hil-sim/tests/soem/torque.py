@@ -150,8 +150,7 @@ def run(m, args):
     say(f"pt shown in 6061h after {k + 1} frames (speed {axis.velocity / L.INC_PER_REV:.2f} rev/s)")
     check(axis.display == PT, f"6061h shows {axis.display} in pt")
     axis.run_torque(-100, limit, "pt, 6071h = -10 %")
-    axis.cw = 0
-    axis.cycle(20)
+    L.stop(axis)
 
 
 def to_op(m):
@@ -160,11 +159,6 @@ def to_op(m):
     return L.to_op(m, Axis)
 
 
-def main():
-    return L.script_main(__doc__, run, "torque modes: all checks passed",
-                         ("--limit", dict(type=int, default=400, help="G472 = G475, 0.1 %% of I10")),
-                         ("--i10", dict(type=float, required=True, help="I10 maximum speed, inc/s")))
-
-
-if __name__ == "__main__":
-    sys.exit(main())
+L.script(__name__, __doc__, run, "torque modes: all checks passed",
+         ("--limit", dict(type=int, default=400, help="G472 = G475, 0.1 %% of I10")),
+         L.required_float("--i10", "I10 maximum speed, inc/s"))

@@ -1,7 +1,7 @@
 //! Faults at the axis: encoder fault, STO and supply undervoltage during
 //! motion, a limit switch against the travel during homing.
 
-use super::{emcys, ethercrab, fault_end, fault_reset, get, E47};
+use super::{emcys, end_then_reset, ethercrab, reset_and_enable};
 use drive_tests::axis::{limit_switches_from_inputs, line_with_switches, with_drive, CW_BIT4, CW_ENABLED};
 use drive_tests::matrix::{al, cia402_state, emcys as show_emcys};
 use drive_tests::{al_status, fault_row, init, line, with_cyclic, with_master, Cyclic, REV};
@@ -27,17 +27,11 @@ fn during_motion(cause: fn(&mut AxisConditions), clear: fn(&mut AxisConditions))
                 "power stage on"
             }
         };
-        let state = cia402_state(tx.statusword);
-        let end = fault_end(sd, &sim).await;
         // a fault reset while the cause lasts
-        let tx = fault_reset(m).await;
-        let lasting = format!("{} (E47 {})", cia402_state(tx.statusword), get(&sim, E47, 0));
+        let (state, end, lasting, _) = end_then_reset(m, sd, &sim, tx).await;
         // the cause ends: reset, enable
         with_drive(&sim, |d| clear(&mut d.conditions[0]));
-        fault_reset(m).await;
-        m.set_controlword(0);
-        m.run(2).await;
-        let after = cia402_state(m.enable().await.statusword);
+        let after = reset_and_enable(m).await;
         format!(
             "{state}, {stage}; {end}; \
              while the cause lasts a reset gives {lasting}; after it: {after}"

@@ -6,7 +6,7 @@ use super::{advance, ethercrab};
 use drive_ecat::boot::{Slot, SlotState};
 use drive_tests::matrix::al;
 use drive_tests::{
-    al_status, fault_row, firmware_file, in_boot, init, line, to_boot, with_master, with_master_on,
+    al_status, fault_row, firmware_file, in_boot, init, line, to_boot, with_master, with_master_on, with_sdo,
     CoeClient, Cyclic, FoeClient, FoeReply, FwNode, RawMailbox, MAILBOX_LEN, REV,
 };
 use hil_sim::sim::Simulation;
@@ -105,9 +105,7 @@ fn e027_requests_into_a_full_mailbox_are_refused_and_nothing_is_lost() {
          the product code; nothing more; Pre-Op, AL 0000h",
     );
     let sim = line(1);
-    let seen = with_master(&sim, async |md, clock| {
-        let group = init(md, clock).await;
-        let sd = group.subdevice(md, 0).unwrap();
+    let seen = with_sdo(&sim, async |sd, _| {
         let mut names = Vec::new();
         for (sub, name) in [
             (1u8, "the vendor"),
@@ -122,7 +120,7 @@ fn e027_requests_into_a_full_mailbox_are_refused_and_nothing_is_lost() {
             ));
         }
         // a fresh counter sequence (ethercrab used its own)
-        CoeClient::new().hand_over(&sd).await;
+        CoeClient::new().hand_over(sd).await;
         let requests: Vec<_> = (1u8..=6)
             .map(|k| upload_request(k % 7 + 1, 0x1018, 1 + (k - 1) % 4))
             .collect();
@@ -138,7 +136,7 @@ fn e027_requests_into_a_full_mailbox_are_refused_and_nothing_is_lost() {
         }
         let mut mbx = RawMailbox::new();
         let mut got = Vec::new();
-        while let Some((kind, data)) = mbx.receive(&sd).await {
+        while let Some((kind, data)) = mbx.receive(sd).await {
             let mut d = describe(kind, &data);
             for (raw, name) in &names {
                 d = d.replace(raw.as_str(), name.as_str());
@@ -164,7 +162,7 @@ fn e027_requests_into_a_full_mailbox_are_refused_and_nothing_is_lost() {
         format!(
             "writes: {writes}; then, in order: {}; {}",
             got.join("; "),
-            al(al_status(&sd).await)
+            al(al_status(sd).await)
         )
     });
     fault_row!(row, seen);
@@ -181,39 +179,33 @@ fn e037_e065_a_master_restarted_during_a_segmented_download_leaves_the_object_as
          Pre-Op, AL 0000h",
     );
     let sim = line(1);
-    let old = with_master(&sim, async |md, clock| {
-        let group = init(md, clock).await;
-        let sd = group.subdevice(md, 0).unwrap();
-        let mut c = CoeClient::new();
-        let old = c.upload(&sd, E72, 0).await.unwrap();
+    let old = with_sdo(&sim, async |sd, c| {
+        let old = c.upload(sd, E72, 0).await.unwrap();
         let [i0, i1] = E72.to_le_bytes();
-        c.sdo(&sd, &[0x21, i0, i1, 0, 16, 0, 0, 0])
+        c.sdo(sd, &[0x21, i0, i1, 0, 16, 0, 0, 0])
             .await
             .expect("initiate");
-        c.sdo(&sd, b"\x00ABCDEFG").await.expect("segment 1");
+        c.sdo(sd, b"\x00ABCDEFG").await.expect("segment 1");
         old
     });
     // the master process ended; another one starts on the same line
-    let seen = with_master(&sim, async |md, clock| {
-        let group = init(md, clock).await;
-        let sd = group.subdevice(md, 0).unwrap();
-        let mut c = CoeClient::new();
-        c.hand_over(&sd).await;
-        let now = c.upload(&sd, E72, 0).await.unwrap();
+    let seen = with_sdo(&sim, async |sd, c| {
+        c.hand_over(sd).await;
+        let now = c.upload(sd, E72, 0).await.unwrap();
         let first = if now == old {
             "the new master reads the old E72".to_string()
         } else {
             format!("the new master reads E72 = {now:02x?}")
         };
         let ok = c
-            .download_segmented(&sd, E72, 0, b"after restart", false)
+            .download_segmented(sd, E72, 0, b"after restart", false)
             .await
             .is_ok()
-            && c.upload(&sd, E72, 0).await == Ok(b"after restart".to_vec());
+            && c.upload(sd, E72, 0).await == Ok(b"after restart".to_vec());
         format!(
             "{first}; its own segmented download is {}; {}",
             if ok { "taken and reads back" } else { "refused" },
-            al(al_status(&sd).await)
+            al(al_status(sd).await)
         )
     });
     fault_row!(row, seen);

@@ -108,6 +108,11 @@ impl Rig {
     fn get(&self, index: u16) -> i64 {
         self.od.get(index, 0).unwrap()
     }
+
+    /// What 6077h (torque actual) and 6078h (current actual) show, ‰.
+    fn shown(&self) -> (i64, i64) {
+        (self.get(0x6077), self.get(0x6078))
+    }
 }
 
 /// C-038, P-187: a 6071h step of 50 % in cst: 6077h follows the current
@@ -146,8 +151,7 @@ fn p186_current_actual_is_the_measured_iq_in_per_mille_of_rated_current() {
     r.seam.iq = 0.5;
     r.seam.tau_s = 1.0e9;
     r.cycle();
-    assert_eq!(r.get(0x6078), 250);
-    assert_eq!(r.get(0x6077), 250);
+    assert_eq!(r.shown(), (250, 250));
 }
 
 /// C-038 with 607Eh bit 7 (negative polarity): the command is turned into
@@ -163,8 +167,7 @@ fn c038_polarity_turns_the_measurement_back_into_user_coordinates() {
     }
     assert!((c.torque_nm + 0.65).abs() < 1e-4, "motor torque {}", c.torque_nm);
     assert!(r.seam.iq < -0.99, "iq {}", r.seam.iq);
-    assert_eq!(r.get(0x6077), 500);
-    assert_eq!(r.get(0x6078), 500);
+    assert_eq!(r.shown(), (500, 500));
 }
 
 /// Without a measurement (the rigid torque-in model) 6077h and 6078h show
@@ -174,8 +177,7 @@ fn c038_without_a_measurement_the_demand_is_shown() {
     let mut r = Rig::new(5.0e-3, false, 0);
     r.od.set(0x6071, 0, 500).unwrap();
     r.cycle();
-    assert_eq!(r.get(0x6077), 500);
-    assert_eq!(r.get(0x6078), 500);
+    assert_eq!(r.shown(), (500, 500));
 }
 
 /// Statusword bit 7 (warning) and bit 11 (internal limit active).
@@ -193,8 +195,7 @@ fn c038_max_current_6073h_limits_cst_torque_with_bit_11() {
     for _ in 0..30 {
         r.cycle();
     }
-    assert_eq!(r.get(0x6077), 500);
-    assert_eq!(r.get(0x6078), 500);
+    assert_eq!(r.shown(), (500, 500));
     assert_ne!(r.get(0x6041) & SW_LIMIT, 0, "bit 11");
     // raised again: the demand passes
     r.od.set(0x6073, 0, 3000).unwrap();

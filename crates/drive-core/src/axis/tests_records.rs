@@ -124,6 +124,14 @@ impl Rig {
         self.od.get(0x6041, 0).unwrap() as u16
     }
 
+    /// [`Rig::new`] with the fieldbus record ([`Rig::record`]) started.
+    fn started(target_rev: f32, v: f32, ve: f32, acc: f32, options: u8) -> Self {
+        let mut r = Rig::new();
+        r.record(FIELDBUS, target_rev, v, ve, acc, options);
+        r.start(FIELDBUS);
+        r
+    }
+
     /// Record `n` with target (rev), profile velocity (rev/s), end velocity
     /// (rev/s), acceleration = deceleration (rev/s²), options.
     fn record(&mut self, n: u16, target_rev: f32, v: f32, ve: f32, acc: f32, options: u8) {
@@ -197,9 +205,7 @@ fn p146_start_number_selects_the_stored_record() {
 /// target reached only after the last task.
 #[test]
 fn p135_p105_append_runs_after_the_running_task_reached_only_at_the_end() {
-    let mut r = Rig::new();
-    r.record(FIELDBUS, 2.0, 5.0, 0.0, 50.0, 0);
-    r.start(FIELDBUS);
+    let mut r = Rig::started(2.0, 5.0, 0.0, 50.0, 0);
     r.run(50);
     r.record(FIELDBUS, 4.0, 5.0, 0.0, 50.0, 0);
     let s = r.start(FIELDBUS);
@@ -228,9 +234,7 @@ fn p135_p105_append_runs_after_the_running_task_reached_only_at_the_end() {
 /// (record 266 with the command's bit).
 #[test]
 fn p136_p092_change_immediately_replaces_the_running_task() {
-    let mut r = Rig::new();
-    r.record(FIELDBUS, 10.0, 5.0, 0.0, 50.0, 0);
-    r.start(FIELDBUS);
+    let mut r = Rig::started(10.0, 5.0, 0.0, 50.0, 0);
     r.run(300);
     assert!(r.setpoint() > REV_I);
     r.record(FIELDBUS, 1.0, 5.0, 0.0, 50.0, 0);
@@ -251,9 +255,7 @@ fn p136_p092_change_immediately_replaces_the_running_task() {
 /// into the appended one (no stop in between).
 #[test]
 fn p137_end_velocity_chains_two_tasks_without_a_stop() {
-    let mut r = Rig::new();
-    r.record(FIELDBUS, 3.0, 5.0, 2.0, 50.0, 0);
-    r.start(FIELDBUS);
+    let mut r = Rig::started(3.0, 5.0, 2.0, 50.0, 0);
     r.run(20);
     r.record(FIELDBUS, 6.0, 2.0, 0.0, 50.0, 0);
     r.start(FIELDBUS);
@@ -284,9 +286,7 @@ fn p137_end_velocity_chains_two_tasks_without_a_stop() {
 /// (stopping distance v²/2d), the task is dropped, target reached not set.
 #[test]
 fn p078_p138_cancel_brakes_with_the_task_deceleration() {
-    let mut r = Rig::new();
-    r.record(FIELDBUS, 20.0, 5.0, 0.0, 25.0, 0);
-    r.start(FIELDBUS);
+    let mut r = Rig::started(20.0, 5.0, 0.0, 25.0, 0);
     r.run(600);
     assert!((r.sp_velocity / REV_F - 5.0).abs() < 0.01);
     let from = r.setpoint();
@@ -312,9 +312,7 @@ fn p078_p138_cancel_brakes_with_the_task_deceleration() {
 /// same task to its target.
 #[test]
 fn p080_intermediate_stop_holds_and_resumes_the_same_task() {
-    let mut r = Rig::new();
-    r.record(FIELDBUS, 6.0, 5.0, 0.0, 50.0, 0);
-    r.start(FIELDBUS);
+    let mut r = Rig::started(6.0, 5.0, 0.0, 50.0, 0);
     r.run(400);
     r.cmd.proceed = false;
     assert!(r.run_until(1000, |_, s| s.stopped).is_some());
@@ -331,9 +329,7 @@ fn p080_intermediate_stop_holds_and_resumes_the_same_task() {
 /// present position set-point.
 #[test]
 fn p091_relative_counts_from_the_position_setpoint() {
-    let mut r = Rig::new();
-    r.record(FIELDBUS, 2.0, 5.0, 0.0, 50.0, 0);
-    r.start(FIELDBUS);
+    let mut r = Rig::started(2.0, 5.0, 0.0, 50.0, 0);
     assert!(r.run_until(3000, |_, s| s.target_reached).is_some());
     r.record(FIELDBUS, -0.5, 5.0, 0.0, 50.0, 0);
     r.cmd.relative = true;
@@ -389,9 +385,7 @@ fn p152_software_limits_block_the_start() {
 /// ‰ halves it) without touching the accelerations; 0 pauses, 1000 goes on.
 #[test]
 fn p149_p150_override_scales_the_running_velocity() {
-    let mut r = Rig::new();
-    r.record(FIELDBUS, 30.0, 4.0, 0.0, 40.0, 0);
-    r.start(FIELDBUS);
+    let mut r = Rig::started(30.0, 4.0, 0.0, 40.0, 0);
     r.run(300);
     assert!((r.sp_velocity / REV_F - 4.0).abs() < 0.01);
     r.od.set(J403, 0, 500).unwrap();
@@ -420,9 +414,7 @@ fn p149_p150_override_scales_the_running_velocity() {
 /// ramp leaves its stopping distance alone.
 #[test]
 fn p150_override_has_no_effect_while_braking() {
-    let mut r = Rig::new();
-    r.record(FIELDBUS, 20.0, 5.0, 0.0, 25.0, 0);
-    r.start(FIELDBUS);
+    let mut r = Rig::started(20.0, 5.0, 0.0, 25.0, 0);
     r.run(600);
     let from = r.setpoint();
     r.cmd.proceed = false;

@@ -6,13 +6,18 @@ use super::{pkw_request, positioning, speed, Bench};
 use crate::PnDrive;
 
 impl Bench {
-    /// A PKW request in receive telegram 0 after the 0x00 toggle.
-    fn pkw0(&mut self, code: u8, index: u16, sub: u8, value: u32) -> (u8, i32) {
-        let mut t = positioning(0x0400, 0, 100, 10_000);
+    /// A PKW request in the receive telegram `t` after the 0x00 toggle: the
+    /// response's code and value.
+    fn pkw_in(&mut self, mut t: [u8; 36], code: u8, index: u16, sub: u8, value: u32) -> (u8, i32) {
         self.run(&t, 5);
         t[24..32].copy_from_slice(&pkw_request(code, index, sub, value));
         self.run(&t, 10);
         (self.response[24], self.i32_at(28))
+    }
+
+    /// A PKW request in receive telegram 0 after the 0x00 toggle.
+    pub(super) fn pkw0(&mut self, code: u8, index: u16, sub: u8, value: u32) -> (u8, i32) {
+        self.pkw_in(positioning(0x0400, 0, 100, 10_000), code, index, sub, value)
     }
 }
 
@@ -319,10 +324,7 @@ pub(super) fn pkw2(b: &mut Bench, code: u8, index: u16, sub: u8, value: u32) -> 
     let mut t = [0u8; 36];
     t[0] = 0xE2;
     t[2..4].copy_from_slice(&0x0400u16.to_be_bytes());
-    b.run(&t, 5);
-    t[24..32].copy_from_slice(&pkw_request(code, index, sub, value));
-    b.run(&t, 10);
-    (b.response[24], b.i32_at(28))
+    b.pkw_in(t, code, index, sub, value)
 }
 
 /// PNU 1041 (TIPP0, record 259) and 1042 (TIPP1, record 260): .0 the

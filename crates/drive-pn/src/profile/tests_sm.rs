@@ -81,13 +81,30 @@ fn p116_off_returns_switched_on_to_ready() {
 /// on → switching on inhibited at once, ZSW1 bit 4 = 0 while commanded.
 #[test]
 fn p117_p118_p119_coast_stop_from_each_state() {
-    for from in [RTSO, OP, SO] {
+    stops_from_each_state([RTSO, OP, SO], (0x040D, 20), (0x0010, "coast stop"), 0x0020);
+}
+
+/// From each state of `states` CW1 `stop` (for its ms) gives switching on
+/// inhibited with ZSW1's bit `active` 0 (the stop, named `what`, active)
+/// and bit `other` 1 (the other stop not); OFF then leaves it for ready.
+fn stops_from_each_state(states: [u16; 3], (stop, ms): (u16, u64), (active, what): (u16, &str), other: u16) {
+    for from in states {
         let mut b = Bench::new();
         b.reach(from);
-        assert_eq!(b.cw(0x040D, 20), SOI, "from {from:#06x}: {:#06x}", b.zsw1());
-        assert_eq!(b.zsw1() & 0x0010, 0, "bit 4: coast stop active");
-        assert_ne!(b.zsw1() & 0x0020, 0, "bit 5: no quick stop");
-        assert_eq!(b.cw(0x0406, 20), RTSO, "OFF leaves the coast stop");
+        assert_eq!(b.cw(stop, ms), SOI, "from {from:#06x}: {:#06x}", b.zsw1());
+        assert_eq!(
+            b.zsw1() & active,
+            0,
+            "bit {}: {what} active",
+            active.trailing_zeros()
+        );
+        assert_ne!(
+            b.zsw1() & other,
+            0,
+            "bit {}: only the {what}",
+            other.trailing_zeros()
+        );
+        assert_eq!(b.cw(0x0406, 20), RTSO, "OFF leaves the {what}");
     }
 }
 
@@ -95,14 +112,7 @@ fn p117_p118_p119_coast_stop_from_each_state() {
 /// switched on and ready → switching on inhibited; bit 5 = 0 meanwhile.
 #[test]
 fn p120_p121_p123_quick_stop_from_each_state() {
-    for from in [OP, SO, RTSO] {
-        let mut b = Bench::new();
-        b.reach(from);
-        assert_eq!(b.cw(0x040B, 50), SOI, "from {from:#06x}: {:#06x}", b.zsw1());
-        assert_eq!(b.zsw1() & 0x0020, 0, "bit 5: quick stop active");
-        assert_ne!(b.zsw1() & 0x0010, 0, "bit 4: no coast stop");
-        assert_eq!(b.cw(0x0406, 20), RTSO);
-    }
+    stops_from_each_state([OP, SO, RTSO], (0x040B, 50), (0x0020, "quick stop"), 0x0010);
 }
 
 /// T11: OFF (x110) in operation → ready.
@@ -145,7 +155,7 @@ fn p124_an_error_in_any_state_ends_in_soi_with_bit_3() {
 fn p127_p128_p055_pnu_1500_reports_and_switches_the_mode() {
     let mut b = Bench::new();
     b.run(&positioning(0x0400, 0, 100, 10_000), 10);
-    assert_eq!(b.pkw_positioning(0x41, 1500, 0, 0), (0x41, 0x10));
+    assert_eq!(b.pkw0(0x41, 1500, 0, 0), (0x41, 0x10));
     assert_eq!(b.pkw_read(1500, 0, 0x0400), (0x41, 0x08));
     // telegram 2 keeps the mode; PKW writes 0x04
     let mut t = [0u8; 36];
@@ -165,18 +175,6 @@ fn p127_p128_p055_pnu_1500_reports_and_switches_the_mode() {
     b.run(&t, 10);
     assert_eq!((b.response[24], b.i32_at(28)), (0xC2, 0x14), "0x20 is no mode");
     assert_eq!(b.d.objects().get(0x6060, 0), Ok(4), "unchanged");
-}
-
-impl Bench {
-    /// A PKW request in receive telegram 0 (after the 0x00 toggle): the
-    /// response's code and value.
-    fn pkw_positioning(&mut self, code: u8, pnu: u16, sub: u8, value: u32) -> (u8, i32) {
-        let mut t = positioning(0x0400, 0, 100, 10_000);
-        self.run(&t, 5);
-        t[24..32].copy_from_slice(&pkw_request(code, pnu, sub, value));
-        self.run(&t, 10);
-        (self.response[24], self.i32_at(28))
-    }
 }
 
 /// PNU 967 reads the CW1 the telegram carries (default 0 before any);
@@ -203,25 +201,17 @@ fn p179_p180_pnu_1011_ramps() {
     let mut b = Bench::new();
     // the one declaration's default (6048h/6049h: 3 000 rpm per 1 s), not
     // the Metronix drive's 14 100 rpm/s (docs/conformance.md, P-182)
-    assert_eq!(
-        b.pkw_positioning(0x41, 1011, 0, 0),
-        (0x41, 3_000),
-        "default acceleration"
-    );
-    assert_eq!(
-        b.pkw_positioning(0x41, 1011, 1, 0),
-        (0x41, 3_000),
-        "default deceleration"
-    );
-    assert_eq!(b.pkw_positioning(0x42, 1011, 0, 2_000).0, 0x42);
+    assert_eq!(b.pkw0(0x41, 1011, 0, 0), (0x41, 3_000), "default acceleration");
+    assert_eq!(b.pkw0(0x41, 1011, 1, 0), (0x41, 3_000), "default deceleration");
+    assert_eq!(b.pkw0(0x42, 1011, 0, 2_000).0, 0x42);
     assert_eq!(b.d.objects().get(0x6048, 1), Ok(2_000));
     assert_eq!(b.d.objects().get(0x6048, 2), Ok(1), "per 1 s");
     assert_eq!(b.d.objects().get(0x6049, 1), Ok(3_000), "deceleration kept");
-    assert_eq!(b.pkw_positioning(0x41, 1011, 0, 0), (0x41, 2_000));
-    assert_eq!(b.pkw_positioning(0x42, 1011, 1, 3_000).0, 0x42);
+    assert_eq!(b.pkw0(0x41, 1011, 0, 0), (0x41, 2_000));
+    assert_eq!(b.pkw0(0x42, 1011, 1, 3_000).0, 0x42);
     assert_eq!(b.d.objects().get(0x6049, 1), Ok(3_000));
     assert_eq!(b.d.objects().get(0x6048, 1), Ok(2_000), "acceleration kept");
-    assert_eq!(b.pkw_positioning(0x41, 1011, 1, 0), (0x41, 3_000));
+    assert_eq!(b.pkw0(0x41, 1011, 1, 0), (0x41, 3_000));
 }
 
 /// PNU 1101 is the actual velocity in the velocity unit (rpm): the encoder
