@@ -269,20 +269,23 @@ pub(crate) fn fits(t: DataType, value: i64) -> bool {
 mod tests_be {
     use super::*;
 
+    /// The types a telegram slot can hold (BOOLEAN and the integers).
+    pub(crate) const SLOT_TYPES: [DataType; 9] = [
+        DataType::Bool,
+        DataType::I8,
+        DataType::U8,
+        DataType::I16,
+        DataType::U16,
+        DataType::I32,
+        DataType::U32,
+        DataType::I64,
+        DataType::U64,
+    ];
+
     /// The two- and four-byte paths decode and encode as the byte loop.
     #[test]
     fn be_widths_answer_as_the_byte_loop() {
-        let types = [
-            DataType::Bool,
-            DataType::I8,
-            DataType::U8,
-            DataType::I16,
-            DataType::U16,
-            DataType::I32,
-            DataType::U32,
-            DataType::I64,
-            DataType::U64,
-        ];
+        let types = SLOT_TYPES;
         let values = [
             0i64,
             1,

@@ -178,6 +178,21 @@ mod tests {
         by_handle: Vec<Addr>,
     }
 
+    impl Handled {
+        /// Handle `h` must stand for `addr`; the access is counted.
+        fn used(&mut self, h: usize, addr: Addr) -> Result<(), PdError> {
+            let a = self
+                .f
+                .objs
+                .get(h)
+                .map(|o| o.addr)
+                .ok_or(PdError::IMPERMISSIBLE_PNU)?;
+            assert_eq!(a, addr, "the handle stands for its address");
+            self.by_handle.push(addr);
+            Ok(())
+        }
+    }
+
     impl ParamAccess for Handled {
         fn describe(&self, addr: Addr) -> Result<crate::Describe, PdError> {
             self.f.describe(addr)
@@ -196,25 +211,11 @@ mod tests {
             self.f.objs.iter().position(|o| o.addr == addr)
         }
         fn write_handle(&mut self, h: usize, addr: Addr, value: i64) -> Result<Completion, PdError> {
-            let a = self
-                .f
-                .objs
-                .get(h)
-                .map(|o| o.addr)
-                .ok_or(PdError::IMPERMISSIBLE_PNU)?;
-            assert_eq!(a, addr, "the handle stands for its address");
-            self.by_handle.push(addr);
+            self.used(h, addr)?;
             self.f.write(addr, value, true)
         }
         fn read_handle(&mut self, h: usize, addr: Addr) -> Result<i64, PdError> {
-            let a = self
-                .f
-                .objs
-                .get(h)
-                .map(|o| o.addr)
-                .ok_or(PdError::IMPERMISSIBLE_PNU)?;
-            assert_eq!(a, addr, "the handle stands for its address");
-            self.by_handle.push(addr);
+            self.used(h, addr)?;
             self.f.read(addr)
         }
     }

@@ -399,17 +399,7 @@ mod tests {
     /// BOOLEAN byte beyond 0/1 is refused).
     #[test]
     fn issue36_a_decoded_entry_fits_its_type() {
-        let types = [
-            DataType::Bool,
-            DataType::I8,
-            DataType::U8,
-            DataType::I16,
-            DataType::U16,
-            DataType::I32,
-            DataType::U32,
-            DataType::I64,
-            DataType::U64,
-        ];
+        let types = crate::tests_be::SLOT_TYPES;
         let patterns = [0x00u8, 0x01, 0x02, 0x7F, 0x80, 0xFF, 0x5A];
         for t in types {
             let size = crate::int_size(t).unwrap();
