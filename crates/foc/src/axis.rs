@@ -144,8 +144,17 @@ pub struct FocAxis {
     i2t_trip: Option<Trip>,
     /// The current error's and the reference's squares summed over the
     /// i²t window's periods with the current loop closed below half the
-    /// back-EMF's speed limit, and their count ([`CurrentDeviation`]).
-    deviation_sums: (f32, f32, u32),
+    /// back-EMF's speed limit, the squares of the reference's steps in the
+    /// window, and the periods counted ([`CurrentDeviation`]).
+    deviation_sums: (f32, f32, f32, u32),
+    /// The reference of the last closed-loop period (zero with the gates
+    /// off or open loop): its step to the next is [`Self::step_allowance`]'s.
+    deviation_last: Dq,
+    /// A healthy loop's error after a reference step Δ, ∑e² over the
+    /// periods of its transient, per |Δ|², twice over
+    /// ([`step_allowance`]): a step's transient is no deviation, however
+    /// small the window's reference (a step late in a window, a pulse).
+    step_allowance: f32,
     /// The last window's current deviated.
     deviation_trip: bool,
     /// The reference's mean square of the last window judged (A²): a
@@ -203,7 +212,9 @@ impl FocAxis {
             limit_a: 0.0,
             stage_limit_a: 0.0,
             i2t_trip: None,
-            deviation_sums: (0.0, 0.0, 0),
+            deviation_sums: (0.0, 0.0, 0.0, 0),
+            deviation_last: Dq::default(),
+            step_allowance: step_allowance(&gains),
             deviation_trip: false,
             deviation_last_ref: 0.0,
             deviation_hold: 0,
@@ -233,8 +244,10 @@ impl FocAxis {
         // counted (a window mostly at the voltage limit or open loop is not)
         // (not the windows of and after open-loop periods, and each against
         // the larger reference of its own and the last judged window's)
-        let (e, r, n) = self.deviation_sums;
+        let (e, r, steps, n) = self.deviation_sums;
         let k = 1.0 / fmath::max(n as f32, 1.0);
+        // the reference's steps' healthy transients are no deviation
+        let e = fmath::max(e - self.step_allowance * steps, 0.0);
         if self.deviation_hold > 0 {
             self.deviation_hold -= 1;
             self.deviation_last_ref = 0.0;
@@ -245,7 +258,7 @@ impl FocAxis {
         } else {
             self.deviation_last_ref = r * k;
         }
-        self.deviation_sums = (0.0, 0.0, 0);
+        self.deviation_sums = (0.0, 0.0, 0.0, 0);
         self.refresh_limits();
     }
 
@@ -312,6 +325,7 @@ impl FocAxis {
         self.i2t.set_level(x);
         self.i2t_alpha = self.i2t.alpha(gains.ts_s * I2T_DECIMATION as f32);
         self.stage_i2t_alpha = self.stage_i2t.alpha(gains.ts_s * I2T_DECIMATION as f32);
+        self.step_allowance = step_allowance(&gains);
         self.pi.reset();
         self.refresh_limits();
         Ok(())
@@ -372,7 +386,7 @@ impl FocAxis {
     pub fn reset_trip(&mut self) {
         self.trip = None;
         self.deviation_trip = false;
-        self.deviation_sums = (0.0, 0.0, 0);
+        self.deviation_sums = (0.0, 0.0, 0.0, 0);
     }
 
     /// What the last step measured.
@@ -513,6 +527,7 @@ impl FocAxis {
         let half = sc.pwm_period_counts / 2;
         if self.trip.is_some() || !self.enabled {
             self.pi.reset();
+            self.deviation_last = Dq::default();
             return PwmOut {
                 compare: [half; 3],
                 gate_enable: false,
@@ -524,13 +539,16 @@ impl FocAxis {
             Command::Current(reference) => {
                 let (d, q) = fmath::clamp_sym2(reference.d, reference.q, limit);
                 let out = self.pi.step(g, Dq { d, q }, current, omega_e, v_max);
+                let (sd, sq) = (d - self.deviation_last.d, q - self.deviation_last.q);
+                self.deviation_last = Dq { d, q };
+                self.deviation_sums.2 += sd * sd + sq * sq;
                 // judged below half the speed at which the back-EMF takes
                 // the whole voltage: there a healthy winding always takes the
                 // current (R·I ≪ the voltage), even with the voltage at its
                 // limit, which is where an open phase drives the integrators
                 if omega_e.abs() * self.motor.psi_vs < 0.5 * v_max {
                     let (ed, eq) = (d - current.d, q - current.q);
-                    let (e, r, n) = &mut self.deviation_sums;
+                    let (e, r, _, n) = &mut self.deviation_sums;
                     *e += ed * ed + eq * eq;
                     *r += d * d + q * q;
                     *n += 1;
@@ -540,6 +558,7 @@ impl FocAxis {
             Command::Voltage(v, _) => {
                 self.pi.reset();
                 self.deviation_hold = 2;
+                self.deviation_last = Dq::default();
                 let clamp = |x: f32| fmath::clamp(x, -v_max, v_max);
                 let cut = v.d.abs() > v_max || v.q.abs() > v_max;
                 (
@@ -595,4 +614,18 @@ impl FocAxis {
             gate_enable: true,
         }
     }
+}
+
+/// A healthy loop's error after a step Δ of its reference, ∑e² over the
+/// transient per |Δ|², twice over: the loop is first order with ω_c behind
+/// one period's delay (pole-zero cancellation, [`Gains::from_motor`]), so the
+/// error is Δ in the period of the step and the next, then Δ·aᵏ with
+/// a = e^(−ω_c·Ts): ∑e² = Δ²·(1 + 1/(1 − a²)) (2.26·Δ² at 1 kHz and
+/// 16 kHz). The factor 2 covers the decoupling's transient on the other
+/// axis and the voltage's limit below half the back-EMF's speed, where the
+/// check counts.
+fn step_allowance(g: &Gains) -> f32 {
+    let omega_c = g.kp_q / g.lq_h;
+    let a2 = libm::expf(-2.0 * omega_c * g.ts_s);
+    2.0 * (1.0 + 1.0 / fmath::max(1.0 - a2, 1e-6))
 }

@@ -43,7 +43,10 @@ pub enum Trip {
 /// ω_c ≫ the reference's changes leaves a small share (a step's error decays
 /// with 1/ω_c: 0.16 ms of a 16 ms window at 1 kHz); an open phase leaves the
 /// reference's component along the missing phase, half of its mean square
-/// on a turning rotor.
+/// on a turning rotor. The axis takes the healthy transients of the
+/// reference's steps in the window off the error before it asks (twice
+/// the first-order loop's ∑e² per step): a step late in a window, or a
+/// short pulse, is judged against the little reference the window holds.
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct CurrentDeviation {
     /// Largest share of the reference's mean square the error's may reach.

@@ -174,3 +174,81 @@ fn c038_p187_the_seam_reports_the_measured_torque_at_10_50_100_percent() {
         );
     }
 }
+
+/// The current loop's periods of `el` at the reference `torque_nm`, gates
+/// on, the rotor free; the first period whose step left a latched trip.
+fn periods(el: &mut ElectricalAxis, motor: &mut Motor, torque_nm: f64, n: u32) -> Option<u32> {
+    let period = Nanos::from_ns(62_500);
+    (0..n).find(|_| {
+        el.step(motor, torque_nm, true, false, period);
+        el.foc().trip().is_some()
+    })
+}
+
+/// E-089 against a false event 69 (seen through SOEM: `stage_i2t.py` on a
+/// loaded machine, its square wave's flips from the speed limit): the
+/// current deviation is judged per window of 256 PWM periods, so a torque
+/// step of 8 A from (nearly) nothing late in a window left its healthy
+/// transient (the error ≈ Δ for a period or two, then e^(−ω_c·t)) against
+/// a window of almost no reference. A step of 5.2 N·m (8 A) at each 4th
+/// period of a window, with the rotor at standstill, at 100 rad/s and at
+/// 312 rad/s (the torque modes' speed limit of `serve`), and a pulse of
+/// 8 A lasting one control cycle of 250 µs, trip nothing over two windows;
+/// the same step with motor phase c open still trips `MotorConnection`
+/// within two windows (the open phase's witness is kept).
+#[test]
+fn e089_a_torque_step_late_in_a_window_is_no_motor_connection_fault() {
+    let w = foc::axis::I2T_DECIMATION;
+    for open in [false, true] {
+        for speed in [0.0, 100.0, 312.0] {
+            for offset in (0..w).step_by(4) {
+                let mut el = ElectricalAxis::default_servo(7).unwrap();
+                let mut motor = Motor::default_servo();
+                let mut k = 0;
+                while motor.velocity_rad_s() < speed {
+                    assert_eq!(periods(&mut el, &mut motor, 5.2, 1), None, "speeding up");
+                    k += 1;
+                }
+                // two windows of (nearly) no torque, then the step `offset`
+                // periods into a window
+                let hold = 2 * w + (w - k % w) + offset;
+                assert_eq!(
+                    periods(&mut el, &mut motor, 0.03, hold),
+                    None,
+                    "{speed} rad/s, holding"
+                );
+                if open {
+                    el.plant_mut().set_faults(plant::FaultOptions {
+                        open_phase: Some(plant::Phase::C),
+                        ..plant::FaultOptions::NONE
+                    });
+                }
+                let tripped = periods(&mut el, &mut motor, -5.2, 2 * w);
+                if open {
+                    assert!(
+                        tripped.is_some(),
+                        "open phase c, {speed} rad/s, step at {offset}: not seen"
+                    );
+                    assert_eq!(el.foc().trip(), Some(foc::Trip::MotorConnection));
+                } else {
+                    assert_eq!(
+                        tripped, None,
+                        "{speed} rad/s, step at period {offset} of a window"
+                    );
+                }
+            }
+        }
+    }
+    // a pulse: 8 A for one control cycle of 250 µs (4 periods), at standstill
+    for offset in (0..w).step_by(4) {
+        let mut el = ElectricalAxis::default_servo(7).unwrap();
+        let mut motor = Motor::default_servo();
+        assert_eq!(periods(&mut el, &mut motor, 0.0, w + offset), None);
+        assert_eq!(periods(&mut el, &mut motor, 5.2, 4), None);
+        assert_eq!(
+            periods(&mut el, &mut motor, 0.0, 2 * w),
+            None,
+            "pulse at period {offset}"
+        );
+    }
+}

@@ -68,7 +68,13 @@ def run(m, args):
     axis.sdo(0x6072, 0, 5000, 2)
     axis.sdo(0x6073, 0, 5000, 2)
     frames = axis.square(5000, 3.0, stop=lambda f: f[3] & MP.FAULT)
-    check(not frames[-1][3] & MP.FAULT, f"no fault while the stage limits: statusword {frames[-1][3]:#06x}")
+    if frames[-1][3] & MP.FAULT:
+        # which fault: 603Fh, or the EMCY pysoem raises from the mailbox first
+        try:
+            why = f"603Fh {L.sdo_u(axis.s, 0x603F, 0):04X}h"
+        except Exception as e:  # noqa: BLE001 (pysoem.Emergency and its kin)
+            why = f"{type(e).__name__}: {e}"
+        check(False, f"no fault while the stage limits: statusword {frames[-1][3]:#06x} after {frames[-1][0]:.3f} s ({why})")
     warn = next((f for f in frames if f[3] & WARNING), None)
     settled = MP.settled(frames)
     # the limit in force from the first settled frame after which none is above the rated current

@@ -93,9 +93,12 @@ fn during_loaded_motion(
         if cia402_state(tx.statusword) != "Fault" {
             m.set_controlword(0);
             m.run(2).await;
-            for cw in [0x0006, 0x0007, 0x000F] {
+            // 60 cycles after the enable: an open phase is judged per
+            // window of 16 ms, the enable's step of the reference (its
+            // healthy transient) taken off the first (`foc`'s step allowance)
+            for (cw, cycles) in [(0x0006, 20), (0x0007, 20), (0x000F, 60)] {
                 m.set_controlword(cw);
-                m.run(20).await;
+                m.run(cycles).await;
             }
             lasting += &format!(", the enable into it: {}", cia402_state(m.tx.statusword));
         }
