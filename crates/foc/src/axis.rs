@@ -539,6 +539,8 @@ impl FocAxis {
             Command::Current(reference) => {
                 let (d, q) = fmath::clamp_sym2(reference.d, reference.q, limit);
                 let out = self.pi.step(g, Dq { d, q }, current, omega_e, v_max);
+                // the reference's step (none mostly: it changes once per
+                // control cycle at most; computed anyway, a constant cost)
                 let (sd, sq) = (d - self.deviation_last.d, q - self.deviation_last.q);
                 self.deviation_last = Dq { d, q };
                 self.deviation_sums.2 += sd * sd + sq * sq;
