@@ -20,6 +20,7 @@ LTO inlined into the task count where they are written).
 import bisect
 import collections
 import json
+import os
 import re
 import shutil
 import subprocess
@@ -51,10 +52,19 @@ tb_ins = {}   # pc -> the block's instruction addresses (for the per-line listin
 counts = collections.Counter()
 task = 'idle'
 entries = {}
+# PROFILE_ENTRY=NAME:SYMBOL (an image without tasks, e.g. firmware-qemu-pn):
+# the function whose demangled name contains SYMBOL counts as the task NAME
+# (its runs are entries), and PROFILE_IDLE=SYMBOL the code that ends a run
+# (the caller's own blocks; default the RTIC idle loop)
+extra = os.environ.get('PROFILE_ENTRY', '')
+extra_name, _, extra_sym = extra.partition(':')
 for a, sz, nm in syms:
     if nm in ('EXTI0', 'EXTI1', 'EXTI2'):
         entries[a] = nm
-idle_rng = [(a, a + sz) for a, sz, nm in syms if nm.startswith('firmware_qemu::app::idle')]
+    elif extra_sym and extra_sym in nm:
+        entries[a] = extra_name
+idle_sym = os.environ.get('PROFILE_IDLE', 'firmware_qemu::app::idle')
+idle_rng = [(a, a + sz) for a, sz, nm in syms if nm.startswith(idle_sym)]
 handlers = collections.Counter()
 cur = None; n = 0; ins = []
 for line in sys.stdin:
@@ -73,13 +83,15 @@ for line in sys.stdin:
         m = re.search(r'\[[0-9a-f]+/([0-9a-f]+)/', line)
         if m:
             pc = int(m.group(1), 16)
-            if pc in entries:
+            if pc in entries and not (extra_name and entries[pc] == extra_name and task != 'idle'):
+                # (the extra entry counts a run only from the caller: its
+                # first block runs again within a run)
                 task = entries[pc]
                 handlers[task] += 1
                 if window and task == window[0] and not window[1] <= handlers[task] <= window[2]:
                     task = task + '-other'
                     handlers[task] += 1
-            elif idle_rng and idle_rng[0][0] <= pc < idle_rng[0][1]:
+            elif any(lo <= pc < hi for lo, hi in idle_rng):
                 task = 'idle'
             counts[(task, pc)] += 1
 per = collections.Counter()
@@ -89,7 +101,7 @@ for (t, pc), c in counts.items():
     per[(t, name(pc))] += n
     tot[t] += n
 print('handler entries', dict(handlers))
-for t in ('EXTI1', 'EXTI2', 'EXTI0'):
+for t in ('EXTI1', 'EXTI2', 'EXTI0') + ((extra_name,) if extra_name else ()):
     k = max(handlers[t], 1)
     if window and t == window[0]:
         k = min(window[2], handlers[t]) - window[1] + 1
