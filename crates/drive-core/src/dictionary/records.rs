@@ -147,6 +147,32 @@ impl DriveObjects {
         true
     }
 
+    /// Word `w` of record `n` of `axis` (0 target, 1 profile velocity,
+    /// 2 end velocity, 3 acceleration, 4 deceleration: [`Record::to_bytes`])
+    /// set to `value` where it holds another, the window J401 following
+    /// when it shows `n` (as [`set_record`](Self::set_record) of the whole
+    /// record with that word changed). `Some(true)` stored, `Some(false)`
+    /// it held `value`, `None` no such record or word (issue 36: a field of
+    /// the jog records written by telegram 0 without the record read and
+    /// compared whole).
+    pub fn set_record_word(&mut self, axis: u8, n: u16, w: usize, value: u32) -> Option<bool> {
+        if w >= RECORD_BYTES / 4 {
+            return None;
+        }
+        let (range, _) = Self::record_range(axis, n)?;
+        let at = range.start + 4 * w;
+        let dst = self.image.get_mut(at..at + 4)?;
+        let bytes = value.to_le_bytes();
+        if *dst == bytes {
+            return Some(false);
+        }
+        copy(dst, &bytes);
+        if self.record_selector(axis) == n {
+            self.show_record(axis, n);
+        }
+        Some(true)
+    }
+
     fn store_record(&mut self, axis: u8, n: u16, r: &Record) -> bool {
         let Some((range, options)) = Self::record_range(axis, n) else {
             return false;

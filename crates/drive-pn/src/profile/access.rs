@@ -428,6 +428,13 @@ impl DriveAccess<'_> {
             _ => &[0],
         };
         let axis = self.axis.index();
+        if let Some(j) = jog {
+            let one = [self.record_number(Some(j))];
+            let jogs = if j == Jog::Both { numbers } else { &one[..] };
+            if !matches!(self.pending, Some((a, m, ..)) if a == axis && jogs.contains(&m)) {
+                return self.write_jog_words(axis, jogs, field, value);
+            }
+        }
         for &k in numbers {
             let selected = k == 0 && jog.is_none();
             let n = match self.pending {
@@ -464,6 +471,41 @@ impl DriveAccess<'_> {
             // stored at the next other access (a record that was read is
             // there to store: set_record cannot refuse it)
             *flag = selected;
+        }
+        Ok(())
+    }
+
+    /// A field of the jog records `numbers` (none of them pending) written
+    /// word by word where it changed (`DriveObjects::set_record_word`), as
+    /// the pending edit and its store would leave them, without reading
+    /// and comparing the records whole (issue 36: PNU 1040 in telegram 0
+    /// took two records through the pending edit every telegram). The
+    /// selected record stays pending.
+    fn write_jog_words(
+        &mut self,
+        axis: u8,
+        numbers: &[u16],
+        field: RecordField,
+        value: i64,
+    ) -> Result<(), PdError> {
+        let word = match field {
+            RecordField::Target => i32::try_from(value).map_err(|_| PdError::LIMIT_EXCEEDED)? as u32,
+            _ => u32::try_from(value).map_err(|_| PdError::LIMIT_EXCEEDED)?,
+        };
+        let words: &[usize] = match field {
+            RecordField::Target => &[0],
+            RecordField::ProfileVelocity => &[1],
+            RecordField::EndVelocity => &[2],
+            RecordField::Acceleration => &[3],
+            RecordField::Deceleration => &[4],
+            RecordField::BothAccelerations => &[3, 4],
+        };
+        for &n in numbers {
+            for &w in words {
+                self.objects
+                    .set_record_word(axis, n, w, word)
+                    .ok_or(PdError::NOT_IN_STATE)?;
+            }
         }
         Ok(())
     }

@@ -401,6 +401,77 @@ fn p173_symmetrical_jog_velocity_writes_both_jog_records() {
     assert_eq!((b.response[24], b.i32_at(28)), (0x41, 300));
 }
 
+/// P-173, issue 36: PNU 1040 in telegram 0 writes the jog records word by
+/// word where no record is pending, leaving what the whole-record edit
+/// left: both records' profile velocity and nothing else changed, the
+/// window J401 (element 1, the profile velocity) showing the selected
+/// record after the telegram. With J400 = 259 or 260 the selected record
+/// is a jog record: the telegram's record fields and PNU 1040 edit it in
+/// order (PNU 1040 last: its velocity), and the other jog record takes
+/// PNU 1040 alone; telegram 1's PNU 1040 (no record fields, nothing
+/// pending) moves the window along when it shows a jog record.
+#[test]
+fn issue36_p173_jog_velocity_word_by_word_as_the_whole_record() {
+    use drive_core::objects::records::{Record, J400, J401, JOG_NEGATIVE, JOG_POSITIVE};
+    let inc =
+        |rpm: i32| (f64::from(rpm) * f64::from(motion::INCREMENTS_PER_REVOLUTION) / 60.0).round() as u32;
+    for selected in [0, JOG_POSITIVE, JOG_NEGATIVE] {
+        let mut b = Bench::new();
+        b.d.objects_mut().set(J400, 0, i64::from(selected)).unwrap();
+        let before = [JOG_POSITIVE, JOG_NEGATIVE].map(|n| b.d.objects().record(0, n).unwrap());
+        let mut t = positioning(0x0400, 5000, 200, 10_000);
+        t[20..24].copy_from_slice(&300i32.to_be_bytes());
+        b.run(&t, 10);
+        let objects = b.d.objects();
+        for (n, was) in [JOG_POSITIVE, JOG_NEGATIVE].into_iter().zip(before) {
+            let r = objects.record(0, n).unwrap();
+            if n == selected {
+                assert_eq!(r.profile_velocity, inc(300), "J400 = {selected}: PNU 1040 last");
+                assert_ne!(
+                    r,
+                    Record {
+                        profile_velocity: inc(300),
+                        ..was
+                    },
+                    "the record fields too"
+                );
+            } else {
+                assert_eq!(
+                    r,
+                    Record {
+                        profile_velocity: inc(300),
+                        ..was
+                    },
+                    "J400 = {selected}, record {n}"
+                );
+            }
+        }
+        let shown = objects.record(0, selected).unwrap();
+        let velocity = if selected == 0 { inc(200) } else { inc(300) };
+        assert_eq!(shown.profile_velocity, velocity, "J400 = {selected}");
+        assert_eq!(
+            objects.get(J401, 2),
+            Ok(i64::from(velocity)),
+            "J400 = {selected}: the window"
+        );
+        // telegram 1 writes PNU 1040 with no record pending: word by word,
+        // the window following a jog record it shows
+        let mut t = speed(0x0400, 0, 0, [0; 8]);
+        t[20..24].copy_from_slice(&400i32.to_be_bytes());
+        b.run(&t, 10);
+        let objects = b.d.objects();
+        for n in [JOG_POSITIVE, JOG_NEGATIVE] {
+            assert_eq!(objects.record(0, n).map(|r| r.profile_velocity), Some(inc(400)));
+        }
+        let velocity = if selected == 0 { inc(200) } else { inc(400) };
+        assert_eq!(
+            objects.get(J401, 2),
+            Ok(i64::from(velocity)),
+            "J400 = {selected}: the window, telegram 1"
+        );
+    }
+}
+
 #[path = "tests_sm.rs"]
 mod sm;
 
