@@ -10,9 +10,12 @@ the end-to-end run; `scripts/cross profile` runs it.
 
 usage: qemu-system-arm ... -d in_asm,exec,nochain 2>&1 >/dev/null | qemu-profile.py ELF [TASK:FIRST:LAST [LINES]]
 
-TASK:FIRST:LAST (e.g. EXTI1:69:319, the control cycles of the csp move)
-counts only runs FIRST..=LAST (1-based) of that handler; its other runs are
-reported as TASK-other. LINES (e.g. 60) also lists that task's costliest
+TASK:FIRST:LAST[:EVERY] (e.g. EXTI1:69:319, the control cycles of the csp
+move) counts only runs FIRST..=LAST (1-based) of that handler, with EVERY
+only every EVERY-th of them from FIRST on; its other runs are reported as
+TASK-other. PROFILE_ENTRY=NAME:SYMBOL makes the calls of the function whose
+name contains SYMBOL the runs of a task NAME (an image without tasks:
+firmware-qemu-pn), PROFILE_IDLE=SYMBOL the caller whose blocks end a run. LINES (e.g. 60) also lists that task's costliest
 source lines per run: each instruction charged to the innermost frame in the
 project's crates (llvm-addr2line with inlining, so the lines of functions
 LTO inlined into the task count where they are written).
@@ -29,8 +32,8 @@ import sys
 elf = sys.argv[1]
 window = None
 if len(sys.argv) > 2:
-    t, a, b = sys.argv[2].split(':')
-    window = (t, int(a), int(b))
+    t, a, b, *every = sys.argv[2].split(':')
+    window = (t, int(a), int(b), int(every[0]) if every else 1)
 lines_wanted = int(sys.argv[3]) if len(sys.argv) > 3 else 0
 # symbols
 syms = []
@@ -88,7 +91,9 @@ for line in sys.stdin:
                 # first block runs again within a run)
                 task = entries[pc]
                 handlers[task] += 1
-                if window and task == window[0] and not window[1] <= handlers[task] <= window[2]:
+                if window and task == window[0] and not (
+                    window[1] <= handlers[task] <= window[2] and (handlers[task] - window[1]) % window[3] == 0
+                ):
                     task = task + '-other'
                     handlers[task] += 1
             elif any(lo <= pc < hi for lo, hi in idle_rng):
@@ -104,7 +109,7 @@ print('handler entries', dict(handlers))
 for t in ('EXTI1', 'EXTI2', 'EXTI0') + ((extra_name,) if extra_name else ()):
     k = max(handlers[t], 1)
     if window and t == window[0]:
-        k = min(window[2], handlers[t]) - window[1] + 1
+        k = (min(window[2], handlers[t]) - window[1]) // window[3] + 1
     print(f'== {t}: {tot[t]} instructions, {tot[t]//max(k, 1)} per run ({k} runs)')
     rows = [(c, f) for (tt, f), c in per.items() if tt == t]
     for c, f in sorted(rows, reverse=True)[:45]:
@@ -114,7 +119,7 @@ if lines_wanted and window:
     # the window task's instructions, each charged to its innermost frame
     # in the project's crates
     t = window[0]
-    k = max(min(window[2], handlers[t]) - window[1] + 1, 1)
+    k = max((min(window[2], handlers[t]) - window[1]) // window[3] + 1, 1)
     per_ins = collections.Counter()
     for (tt, pc), c in counts.items():
         if tt == t:
