@@ -118,17 +118,25 @@ pub fn with_cyclic<T>(
 /// A SubDevice of a group in PRE-OP, as [`init`] leaves it.
 pub type PreOpSubDevice<'a> = SubDeviceRef<'a, &'a ethercrab::SubDevice>;
 
+/// Runs `body` on `sim`'s line (of any node type) in PRE-OP ([`init`])
+/// with its first drive's SubDevice.
+pub fn with_preop<N: hil_sim::sim::Node, T>(
+    sim: &RefCell<Simulation<N>>,
+    body: impl for<'a> AsyncFnOnce(PreOpSubDevice<'a>) -> T,
+) -> T {
+    with_master_on(sim, async |md, clock| {
+        let group = init(md, clock).await;
+        body(group.subdevice(md, 0).unwrap()).await
+    })
+}
+
 /// Runs `body` on `sim`'s line in PRE-OP ([`init`]) with its first drive's
 /// SubDevice and a [`CoeClient`] for it.
 pub fn with_sdo<T>(
     sim: &RefCell<Simulation>,
     body: impl for<'a> AsyncFnOnce(&PreOpSubDevice<'a>, &mut CoeClient) -> T,
 ) -> T {
-    with_master(sim, async |md, clock| {
-        let group = init(md, clock).await;
-        let sd = group.subdevice(md, 0).unwrap();
-        body(&sd, &mut CoeClient::new()).await
-    })
+    with_preop(sim, async |sd| body(&sd, &mut CoeClient::new()).await)
 }
 
 /// [`with_sdo`] after the master's SyncManager set-up

@@ -8,7 +8,9 @@
 use drive_ecat::{parameter_index, Template};
 use drive_tests::al::{ERR, OP, SAFEOP};
 use drive_tests::step::{advance, op_via_safe_op};
-use drive_tests::{al_status, init, line, map_layout, sdo_is, variant, with_master, with_sdo, Cyclic, REV};
+use drive_tests::{
+    al_status, init, line, map_layout, sdo_is, variant, with_master, with_preop, with_sdo, Cyclic, REV,
+};
 use ecat::SdoAbort;
 use esc::AlStatusCode;
 use hil_sim::sim::Simulation;
@@ -463,13 +465,8 @@ fn power_cycle(sim: &RefCell<Simulation>) {
 #[test]
 fn c146_changes_are_volatile_until_a00_saves_them() {
     let sim = line(1);
-    let read = |sim: &RefCell<Simulation>| {
-        with_master(sim, async |md, clock| {
-            let group = init(md, clock).await;
-            let sd = group.subdevice(md, 0).unwrap();
-            sd.sdo_read::<u8>(I46, 0).await.unwrap()
-        })
-    };
+    let read =
+        |sim: &RefCell<Simulation>| with_preop(sim, async |sd| sd.sdo_read::<u8>(I46, 0).await.unwrap());
     with_sdo(&sim, async |sd, _| {
         sd.sdo_write(I46, 0, 5u8).await.unwrap();
     });
@@ -506,9 +503,7 @@ fn c146_changes_are_volatile_until_a00_saves_them() {
 fn c147_changed_mapping_kept_over_a_restart_only_when_saved() {
     let sim = line(1);
     let map_ip = |sim: &RefCell<Simulation>, save: bool| {
-        with_master(sim, async |md, clock| {
-            let group = init(md, clock).await;
-            let sd = group.subdevice(md, 0).unwrap();
+        with_preop(sim, async |sd| {
             map_layout(&sd, drive_ecat::PdoLayout::Ip).await;
             if save {
                 sd.sdo_write(A00, 1, 1u8).await.unwrap();
@@ -522,9 +517,7 @@ fn c147_changed_mapping_kept_over_a_restart_only_when_saved() {
         })
     };
     let rx_len = |sim: &RefCell<Simulation>| {
-        with_master(sim, async |md, clock| {
-            let group = init(md, clock).await;
-            let sd = group.subdevice(md, 0).unwrap();
+        with_preop(sim, async |sd| {
             let n: u8 = sd.sdo_read(0x1600, 0).await.unwrap();
             let mut bits = 0u32;
             for s in 1..=n {
