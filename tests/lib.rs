@@ -993,6 +993,18 @@ impl<'a> Cyclic<'a> {
         self.command(0x000F, sw::OE, 20).await
     }
 
+    /// Controlword 0 for two cycles, the fault reset (bit 7) until Switch on
+    /// disabled ([`Self::command`], 20 cycles at most), 0 for two cycles,
+    /// then [`Self::enable`].
+    pub async fn reset_and_enable(&mut self) -> TxPdo {
+        self.set_controlword(0);
+        self.run(2).await;
+        self.command(axis::CW_FAULT_RESET, sw::SOD, 20).await;
+        self.set_controlword(0);
+        self.run(2).await;
+        self.enable().await
+    }
+
     /// Enabled in csv ([`Self::enable_in`] 9), then `n` cycles at the target
     /// velocity `v` (inc/s).
     pub async fn csv_at(&mut self, v: i32, n: usize) -> TxPdo {

@@ -397,13 +397,7 @@ fn c104_c107_limit_switches_from_i210_and_e80() {
             "event 53"
         );
         m.set_target_velocity(0);
-        m.set_controlword(0);
-        m.run(2).await;
-        m.set_controlword(CW_FAULT_RESET);
-        m.run_until(20, |t| t.state() == sw::SOD).await.expect("reset");
-        m.set_controlword(0);
-        m.run(2).await;
-        m.enable().await;
+        m.reset_and_enable().await;
         // still on the switch: positive locked, E80 = 20 (C-107)
         m.set_target_velocity(REV);
         m.run(200).await;
