@@ -120,12 +120,7 @@ fn c130_c131_c132_standard_pdo_layout_byte_packed_through_the_master() {
 fn c133_up_to_24_entries_per_pdo() {
     let sim = line(1);
     with_sdo(&sim, async |sd, c| {
-        for pdo in [0x1600u16, 0x1A00] {
-            let entry = if pdo == 0x1600 {
-                m(0x6060, 0, 8)
-            } else {
-                m(0x6061, 0, 8)
-            };
+        for (pdo, entry) in [(0x1600u16, m(0x6060, 0, 8)), (0x1A00, m(0x6061, 0, 8))] {
             c.download(sd, pdo, 0, &[0]).await.unwrap();
             for s in 1..=24u8 {
                 c.download(sd, pdo, s, &entry.to_le_bytes()).await.unwrap();

@@ -71,12 +71,7 @@ fn e051_channel_1_is_axis_a_and_channel_2_axis_b() {
 fn e052_channel_4_mapping_is_refused_to_the_master() {
     let sim = line(1);
     with_sdo(&sim, async |sd, c| {
-        for pdo in [0x1603u16, 0x1A03] {
-            let entry = if pdo == 0x1603 {
-                m(0x6040, 0, 16)
-            } else {
-                m(0x6041, 0, 16)
-            };
+        for (pdo, entry) in [(0x1603u16, m(0x6040, 0, 16)), (0x1A03, m(0x6041, 0, 16))] {
             assert_eq!(
                 c.download(sd, pdo, 0, &[0]).await,
                 Err(SdoAbort::READ_ONLY.0),
