@@ -1050,14 +1050,25 @@ where
 {
     let (rx, tx) = layout.entries();
     for (pdo, entries) in [(0x1600u16, rx), (0x1A00, tx)] {
-        sd.sdo_write(pdo, 0, 0u8).await.expect("sub 0 = 0");
-        for (sub, e) in (1u8..).zip(entries) {
-            sd.sdo_write(pdo, sub, e.mapping_value()).await.expect("entry");
-        }
-        sd.sdo_write(pdo, 0, entries.len() as u8)
-            .await
-            .expect("sub 0 = n");
+        let entries: Vec<u32> = entries.iter().map(|e| e.mapping_value()).collect();
+        map_pdo(sd, pdo, &entries).await;
     }
+}
+
+/// Writes the mapping `entries` (index << 16 | sub << 8 | bits) into `pdo`
+/// by SDO (Pre-Op) as a master's start-up list does: sub 0 = 0, the
+/// entries from sub 1, sub 0 = their number.
+pub async fn map_pdo<S>(sd: &SubDeviceRef<'_, S>, pdo: u16, entries: &[u32])
+where
+    S: std::ops::Deref<Target = ethercrab::SubDevice>,
+{
+    sd.sdo_write(pdo, 0, 0u8).await.expect("sub 0 = 0");
+    for (sub, &e) in (1u8..).zip(entries) {
+        sd.sdo_write(pdo, sub, e).await.expect("entry");
+    }
+    sd.sdo_write(pdo, 0, entries.len() as u8)
+        .await
+        .expect("sub 0 = n");
 }
 
 /// A master running any process image of one drive in Op as raw bytes (the
