@@ -115,6 +115,11 @@ pub fn with_cyclic<T>(
     })
 }
 
+/// The velocity of `sim`'s first drive's motor `axis` (the plant's), rev/s.
+pub fn motor_rev_s(sim: &RefCell<Simulation>, axis: usize) -> f64 {
+    sim.borrow().drives()[0].motors[axis].velocity_rad_s() / std::f64::consts::TAU
+}
+
 /// A SubDevice of a group in PRE-OP, as [`init`] leaves it.
 pub type PreOpSubDevice<'a> = SubDeviceRef<'a, &'a ethercrab::SubDevice>;
 

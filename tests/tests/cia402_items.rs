@@ -8,7 +8,7 @@
 
 use drive_ecat::parameter_index;
 use drive_tests::axis::*;
-use drive_tests::{init, line, sw, with_cyclic, with_master, Cyclic};
+use drive_tests::{init, line, motor_rev_s, sw, with_cyclic, with_master, Cyclic};
 use drive_tests::{REV, REV_F};
 
 const A66: u16 = parameter_index(0, 66);
@@ -707,7 +707,7 @@ fn c109_gear_and_feed_scale_positions_and_velocities_through_the_master() {
         m.enable().await;
         m.set_target_velocity(36_000);
         m.run(500).await;
-        let motor = sim.borrow().drives()[0].motors[0].velocity_rad_s() / std::f64::consts::TAU;
+        let motor = motor_rev_s(&sim, 0);
         println!(
             "csv 36 000 units/s: 606Ch {}, motor {motor:.4} rev/s",
             m.tx.velocity

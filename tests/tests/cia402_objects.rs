@@ -9,7 +9,8 @@ use drive_ecat::{parameter_index, Template};
 use drive_tests::al::{ERR, OP, SAFEOP};
 use drive_tests::step::{advance, op_via_safe_op};
 use drive_tests::{
-    al_status, init, line, map_layout, sdo_is, variant, with_master, with_preop, with_sdo, Cyclic, REV,
+    al_status, init, line, map_layout, motor_rev_s, sdo_is, variant, with_master, with_preop, with_sdo,
+    Cyclic, REV,
 };
 use ecat::SdoAbort;
 use esc::AlStatusCode;
@@ -385,7 +386,7 @@ fn csv_at(setup: &[(u16, u8, u8)], v: i32) -> (i32, i32, f64) {
         c.set_target_velocity(v);
         let t = c.run(600).await;
         let shown = sd.sdo_read::<i32>(0x60FF, 0).await.unwrap();
-        let motor = sim.borrow().drives()[0].motors[0].velocity_rad_s() / std::f64::consts::TAU;
+        let motor = motor_rev_s(&sim, 0);
         println!(
             "{setup:?}: 60FFh {v} (SDO {shown}), 606Ch {}, plant {motor:.4} rev/s",
             t.velocity
