@@ -826,6 +826,18 @@ SETTLED_INC = 100
 MAX_STALLS = 3
 
 
+def align(cyc):
+    """Runs `cyc` (5000 cycles at most) until 190 of the last 200 frames
+    came within 100 us of the reference clock; those last frames' verdicts."""
+    recent = []
+    for _ in range(5000):
+        cyc.run()
+        recent = (recent + [abs(cyc.delta) < 100_000])[-200:]
+        if sum(recent) >= 190:
+            break
+    return recent
+
+
 def wait_states(m, cyc, want, max_cycles, every=10):
     """Cycles until every slave shows `want` (read every `every` cycles)."""
     for k in range(max_cycles):
@@ -1248,12 +1260,7 @@ def cyclic(m, args, layouts, emcys):
     line = Line(m, cyc, layouts)
     # the PI settles in a few hundred cycles; a frame answered late now and
     # then does not keep the run from going on
-    recent = []
-    for k in range(5000):
-        cyc.run()
-        recent = (recent + [abs(cyc.delta) < 100_000])[-200:]
-        if sum(recent) >= 190:
-            break
+    recent = align(cyc)
     say(
         f"aligned to the reference clock after {cyc.n} cycles: {sum(recent)} of the last {len(recent)} frames within 100 us, "
         f"phase error {cyc.delta / 1000:.1f} us, offset {cyc.toff} ns/cycle"

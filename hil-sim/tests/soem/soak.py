@@ -532,12 +532,7 @@ def setup(m, args):
     soak = Soak(m, args, layouts)
     soak.emcys = emcys
     cyc = soak.cyc
-    recent = []
-    for _ in range(5000):
-        cyc.run()
-        recent = (recent + [abs(cyc.delta) < 100_000])[-200:]
-        if sum(recent) >= 190:
-            break
+    L.align(cyc)
     say(f"aligned to the reference clock after {cyc.n} cycles, phase error {cyc.delta / 1000:.1f} us")
     m.state = SAFEOP
     m.write_state()
