@@ -163,13 +163,19 @@ def acknowledge(m, i):
 # --- 1. scan, identity, SII ---------------------------------------------------
 
 
-def scan(m, n_expected):
+def config_init(m):
+    """`m.config_init()` up to three times, 0.5 s apart; the slaves found."""
     for k in range(3):
         n = m.config_init()
         if n > 0:
             break
         say(f"config_init found no slave (attempt {k + 1}), again in 0.5 s")
         time.sleep(0.5)
+    return n
+
+
+def scan(m, n_expected):
+    n = config_init(m)
     say(f"config_init: {n} slave(s)")
     if n != n_expected:
         raise Fatal(f"config_init found {n} slaves, expected {n_expected}")
