@@ -832,6 +832,18 @@ SETTLED_INC = 100
 MAX_STALLS = 3
 
 
+def config_map(m, layouts):
+    """`m.config_map()` until every slave is mapped with the sizes its PDO
+    objects give (`layouts`), three times at most; the IO map's size."""
+    for _ in range(3):
+        size = m.config_map()
+        wrong = [i + 1 for i, s in enumerate(m.slaves) if (len(s.output), len(s.input)) != (layouts[i][0].bytes, layouts[i][1].bytes)]
+        if not wrong:
+            return size
+        say(f"RETRY config_map: slave(s) {wrong} mapped with other sizes than their PDO objects give")
+    raise Fatal(f"config_map: slave(s) {wrong} mapped with other sizes than their PDO objects give, 3 times")
+
+
 def align(cyc):
     """Runs `cyc` (5000 cycles at most) until 190 of the last 200 frames
     came within 100 us of the reference clock; those last frames' verdicts."""
