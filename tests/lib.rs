@@ -115,8 +115,25 @@ pub fn with_cyclic<T>(
     })
 }
 
+/// The velocity of `sim`'s first drive's motor `axis` (the plant's), rev/s.
+pub fn motor_rev_s(sim: &RefCell<Simulation>, axis: usize) -> f64 {
+    sim.borrow().drives()[0].motors[axis].velocity_rad_s() / std::f64::consts::TAU
+}
+
 /// A SubDevice of a group in PRE-OP, as [`init`] leaves it.
 pub type PreOpSubDevice<'a> = SubDeviceRef<'a, &'a ethercrab::SubDevice>;
+
+/// Runs `body` on `sim`'s line (of any node type) in PRE-OP ([`init`])
+/// with its first drive's SubDevice.
+pub fn with_preop<N: hil_sim::sim::Node, T>(
+    sim: &RefCell<Simulation<N>>,
+    body: impl for<'a> AsyncFnOnce(PreOpSubDevice<'a>) -> T,
+) -> T {
+    with_master_on(sim, async |md, clock| {
+        let group = init(md, clock).await;
+        body(group.subdevice(md, 0).unwrap()).await
+    })
+}
 
 /// Runs `body` on `sim`'s line in PRE-OP ([`init`]) with its first drive's
 /// SubDevice and a [`CoeClient`] for it.
@@ -124,11 +141,7 @@ pub fn with_sdo<T>(
     sim: &RefCell<Simulation>,
     body: impl for<'a> AsyncFnOnce(&PreOpSubDevice<'a>, &mut CoeClient) -> T,
 ) -> T {
-    with_master(sim, async |md, clock| {
-        let group = init(md, clock).await;
-        let sd = group.subdevice(md, 0).unwrap();
-        body(&sd, &mut CoeClient::new()).await
-    })
+    with_preop(sim, async |sd| body(&sd, &mut CoeClient::new()).await)
 }
 
 /// [`with_sdo`] after the master's SyncManager set-up
@@ -985,6 +998,18 @@ impl<'a> Cyclic<'a> {
         self.command(0x000F, sw::OE, 20).await
     }
 
+    /// Controlword 0 for two cycles, the fault reset (bit 7) until Switch on
+    /// disabled ([`Self::command`], 20 cycles at most), 0 for two cycles,
+    /// then [`Self::enable`].
+    pub async fn reset_and_enable(&mut self) -> TxPdo {
+        self.set_controlword(0);
+        self.run(2).await;
+        self.command(axis::CW_FAULT_RESET, sw::SOD, 20).await;
+        self.set_controlword(0);
+        self.run(2).await;
+        self.enable().await
+    }
+
     /// Enabled in csv ([`Self::enable_in`] 9), then `n` cycles at the target
     /// velocity `v` (inc/s).
     pub async fn csv_at(&mut self, v: i32, n: usize) -> TxPdo {
@@ -1030,14 +1055,25 @@ where
 {
     let (rx, tx) = layout.entries();
     for (pdo, entries) in [(0x1600u16, rx), (0x1A00, tx)] {
-        sd.sdo_write(pdo, 0, 0u8).await.expect("sub 0 = 0");
-        for (sub, e) in (1u8..).zip(entries) {
-            sd.sdo_write(pdo, sub, e.mapping_value()).await.expect("entry");
-        }
-        sd.sdo_write(pdo, 0, entries.len() as u8)
-            .await
-            .expect("sub 0 = n");
+        let entries: Vec<u32> = entries.iter().map(|e| e.mapping_value()).collect();
+        map_pdo(sd, pdo, &entries).await;
     }
+}
+
+/// Writes the mapping `entries` (index << 16 | sub << 8 | bits) into `pdo`
+/// by SDO (Pre-Op) as a master's start-up list does: sub 0 = 0, the
+/// entries from sub 1, sub 0 = their number.
+pub async fn map_pdo<S>(sd: &SubDeviceRef<'_, S>, pdo: u16, entries: &[u32])
+where
+    S: std::ops::Deref<Target = ethercrab::SubDevice>,
+{
+    sd.sdo_write(pdo, 0, 0u8).await.expect("sub 0 = 0");
+    for (sub, &e) in (1u8..).zip(entries) {
+        sd.sdo_write(pdo, sub, e).await.expect("entry");
+    }
+    sd.sdo_write(pdo, 0, entries.len() as u8)
+        .await
+        .expect("sub 0 = n");
 }
 
 /// A master running any process image of one drive in Op as raw bytes (the

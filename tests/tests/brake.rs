@@ -3,7 +3,7 @@
 //! SDO from ethercrab, the brake seen at the simulated motor (its brake
 //! input, one cycle after the drive's output) and the rotor's motion.
 
-use drive_tests::{line, sw, with_cyclic, REV};
+use drive_tests::{line, motor_rev_s, sw, with_cyclic, REV};
 use hil_sim::sim::Simulation;
 use std::cell::RefCell;
 
@@ -16,11 +16,6 @@ fn applied(sim: &RefCell<Simulation>) -> bool {
         .motor_outputs(0)
         .expect("the motor has run")
         .brake_applied
-}
-
-/// Motor velocity, rev/s.
-fn velocity_rev_s(sim: &RefCell<Simulation>) -> f64 {
-    sim.borrow().drives()[0].motors[0].velocity_rad_s() / std::f64::consts::TAU
 }
 
 /// C-020 (and E-129's "brake unless F06"): in the de-energised states the
@@ -72,20 +67,20 @@ fn c021_f00_brake_control_inactive_keeps_the_brake_applied_while_enabled() {
     with_cyclic(&sim, async |m, sd| {
         m.csv_at(2 * REV, 300).await;
         assert!(!applied(&sim), "F00 = 1, moving: released");
-        let v = velocity_rev_s(&sim);
+        let v = motor_rev_s(&sim, 0);
         assert!((v - 2.0).abs() < 0.1, "2 rev/s: {v}");
 
         sd.sdo_write(F00, 0, 0u8).await.expect("F00 = 0");
         let tx = m.run(300).await;
         assert_eq!(tx.state(), sw::OE, "still enabled");
         assert!(applied(&sim), "F00 = 0: applied");
-        let v = velocity_rev_s(&sim);
+        let v = motor_rev_s(&sim, 0);
         assert!(v.abs() < 0.05, "held by the brake: {v} rev/s");
 
         sd.sdo_write(F00, 0, 1u8).await.expect("F00 = 1");
         m.run(300).await;
         assert!(!applied(&sim), "F00 = 1 again: released");
-        let v = velocity_rev_s(&sim);
+        let v = motor_rev_s(&sim, 0);
         assert!((v - 2.0).abs() < 0.1, "2 rev/s again: {v}");
     });
 }

@@ -8,7 +8,7 @@
 
 use drive_ecat::parameter_index;
 use drive_tests::axis::*;
-use drive_tests::{init, line, sw, with_cyclic, with_master, Cyclic};
+use drive_tests::{init, line, motor_rev_s, sw, with_cyclic, with_master, Cyclic};
 use drive_tests::{REV, REV_F};
 
 const A66: u16 = parameter_index(0, 66);
@@ -397,13 +397,7 @@ fn c104_c107_limit_switches_from_i210_and_e80() {
             "event 53"
         );
         m.set_target_velocity(0);
-        m.set_controlword(0);
-        m.run(2).await;
-        m.set_controlword(CW_FAULT_RESET);
-        m.run_until(20, |t| t.state() == sw::SOD).await.expect("reset");
-        m.set_controlword(0);
-        m.run(2).await;
-        m.enable().await;
+        m.reset_and_enable().await;
         // still on the switch: positive locked, E80 = 20 (C-107)
         m.set_target_velocity(REV);
         m.run(200).await;
@@ -713,7 +707,7 @@ fn c109_gear_and_feed_scale_positions_and_velocities_through_the_master() {
         m.enable().await;
         m.set_target_velocity(36_000);
         m.run(500).await;
-        let motor = sim.borrow().drives()[0].motors[0].velocity_rad_s() / std::f64::consts::TAU;
+        let motor = motor_rev_s(&sim, 0);
         println!(
             "csv 36 000 units/s: 606Ch {}, motor {motor:.4} rev/s",
             m.tx.velocity

@@ -8,7 +8,10 @@
 use drive_ecat::{parameter_index, Template};
 use drive_tests::al::{ERR, OP, SAFEOP};
 use drive_tests::step::{advance, op_via_safe_op};
-use drive_tests::{al_status, init, line, map_layout, sdo_is, variant, with_master, with_sdo, Cyclic, REV};
+use drive_tests::{
+    al_status, init, line, map_layout, motor_rev_s, sdo_is, variant, with_master, with_preop, with_sdo,
+    Cyclic, REV,
+};
 use ecat::SdoAbort;
 use esc::AlStatusCode;
 use hil_sim::sim::Simulation;
@@ -118,12 +121,7 @@ fn c130_c131_c132_standard_pdo_layout_byte_packed_through_the_master() {
 fn c133_up_to_24_entries_per_pdo() {
     let sim = line(1);
     with_sdo(&sim, async |sd, c| {
-        for pdo in [0x1600u16, 0x1A00] {
-            let entry = if pdo == 0x1600 {
-                m(0x6060, 0, 8)
-            } else {
-                m(0x6061, 0, 8)
-            };
+        for (pdo, entry) in [(0x1600u16, m(0x6060, 0, 8)), (0x1A00, m(0x6061, 0, 8))] {
             c.download(sd, pdo, 0, &[0]).await.unwrap();
             for s in 1..=24u8 {
                 c.download(sd, pdo, s, &entry.to_le_bytes()).await.unwrap();
@@ -388,7 +386,7 @@ fn csv_at(setup: &[(u16, u8, u8)], v: i32) -> (i32, i32, f64) {
         c.set_target_velocity(v);
         let t = c.run(600).await;
         let shown = sd.sdo_read::<i32>(0x60FF, 0).await.unwrap();
-        let motor = sim.borrow().drives()[0].motors[0].velocity_rad_s() / std::f64::consts::TAU;
+        let motor = motor_rev_s(&sim, 0);
         println!(
             "{setup:?}: 60FFh {v} (SDO {shown}), 606Ch {}, plant {motor:.4} rev/s",
             t.velocity
@@ -463,13 +461,8 @@ fn power_cycle(sim: &RefCell<Simulation>) {
 #[test]
 fn c146_changes_are_volatile_until_a00_saves_them() {
     let sim = line(1);
-    let read = |sim: &RefCell<Simulation>| {
-        with_master(sim, async |md, clock| {
-            let group = init(md, clock).await;
-            let sd = group.subdevice(md, 0).unwrap();
-            sd.sdo_read::<u8>(I46, 0).await.unwrap()
-        })
-    };
+    let read =
+        |sim: &RefCell<Simulation>| with_preop(sim, async |sd| sd.sdo_read::<u8>(I46, 0).await.unwrap());
     with_sdo(&sim, async |sd, _| {
         sd.sdo_write(I46, 0, 5u8).await.unwrap();
     });
@@ -506,9 +499,7 @@ fn c146_changes_are_volatile_until_a00_saves_them() {
 fn c147_changed_mapping_kept_over_a_restart_only_when_saved() {
     let sim = line(1);
     let map_ip = |sim: &RefCell<Simulation>, save: bool| {
-        with_master(sim, async |md, clock| {
-            let group = init(md, clock).await;
-            let sd = group.subdevice(md, 0).unwrap();
+        with_preop(sim, async |sd| {
             map_layout(&sd, drive_ecat::PdoLayout::Ip).await;
             if save {
                 sd.sdo_write(A00, 1, 1u8).await.unwrap();
@@ -522,9 +513,7 @@ fn c147_changed_mapping_kept_over_a_restart_only_when_saved() {
         })
     };
     let rx_len = |sim: &RefCell<Simulation>| {
-        with_master(sim, async |md, clock| {
-            let group = init(md, clock).await;
-            let sd = group.subdevice(md, 0).unwrap();
+        with_preop(sim, async |sd| {
             let n: u8 = sd.sdo_read(0x1600, 0).await.unwrap();
             let mut bits = 0u32;
             for s in 1..=n {

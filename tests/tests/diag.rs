@@ -4,7 +4,7 @@
 
 use drive_tests::al::{ACK, BOOT, ERR, INIT, OP, PREOP, SAFEOP};
 use drive_tests::step::{advance, cycles};
-use drive_tests::{al_status, init, line, request, with_master, with_sdo, write_sm, CoeClient};
+use drive_tests::{al_status, init, line, request, with_master, with_preop, with_sdo, write_sm, CoeClient};
 use ecat::led::Pattern;
 use esc::AlStatusCode;
 use hil_sim::sim::Simulation;
@@ -186,9 +186,7 @@ fn e025_e033_e136_a257_0_error_codes_of_refused_transitions() {
     let rx = drive_ecat::DEVICE.output_bytes() as u16;
     let tx = drive_ecat::DEVICE.input_bytes() as u16;
     let sim = line(1);
-    with_master(&sim, async |md, clock| {
-        let group = init(md, clock).await;
-        let sd = group.subdevice(md, 0).unwrap();
+    with_preop(&sim, async |sd| {
         // invalid state change (0011h): Er11, see A257[3]
         request(&sd, OP).await;
         assert_eq!(al_status(&sd).await, (PREOP | ERR, 0x0011));

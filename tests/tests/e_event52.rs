@@ -5,7 +5,7 @@
 
 use drive_tests::al::{ACK, ERR, OP, SAFEOP};
 use drive_tests::step::op_via_safe_op;
-use drive_tests::{al_status, init, line, request, sw, with_master, CoeClient, Cyclic, REV};
+use drive_tests::{al_status, init, line, request, sw, with_master, with_preop, CoeClient, Cyclic, REV};
 use esc::AlStatusCode;
 use hil_sim::sim::Simulation;
 use std::cell::RefCell;
@@ -194,9 +194,7 @@ fn e130_projected_fieldbus_mismatch_raises_event52_cause_15() {
     sim.borrow_mut().drives_mut()[0]
         .drive
         .set_projected_fieldbus(drive_ecat::runtime::FIELDBUS_ID + 7);
-    with_master(&sim, async |md, clock| {
-        let group = init(md, clock).await;
-        let sd = group.subdevice(md, 0).unwrap();
+    with_preop(&sim, async |sd| {
         let emcys = event52_emcys(&sd).await;
         // the axes' fault reaction (quick stop at standstill, settle time)
         {

@@ -59,14 +59,7 @@ fn c017_c021_c041_pp_after_fault_reset_and_enable_follows_as_before() {
             .raise_event(motion::Event { number: 44, cause: 1 });
         let hit = m.run_until(500, |t| t.state() == sw::FAULT).await;
         assert!(hit.is_some(), "fault: {:#06x}", m.tx.statusword);
-        m.set_controlword(0);
-        m.run(2).await;
-        m.set_controlword(CW_FAULT_RESET);
-        let reset = m.run_until(20, |t| t.state() == sw::SOD).await;
-        assert!(reset.is_some(), "reset: {:#06x}", m.tx.statusword);
-        m.set_controlword(0);
-        m.run(2).await;
-        m.enable().await;
+        m.reset_and_enable().await;
         let (after, braked_after) = pp_move(m, &sim, 6 * REV).await;
         println!(
             "figure: pp 3 rev at 5 rev/s: max |60F4h| {before} inc before the fault, {after} inc after \

@@ -4,7 +4,7 @@
 //! refusals. The dictionary side: `crates/drive-core/src/tests_scaling.rs`.
 
 use drive_ecat::parameter_index;
-use drive_tests::{init, line, with_master, with_sdo, CoeClient, Cyclic, REV};
+use drive_tests::{init, line, motor_rev_s, with_master, with_sdo, CoeClient, Cyclic, REV};
 use ecat::SdoAbort;
 use hil_sim::sim::Simulation;
 use std::cell::RefCell;
@@ -20,10 +20,6 @@ const VELOCITY_AT: usize = 7;
 /// representation).
 fn kept(sim: &RefCell<Simulation>, index: u16, sub: u8) -> i64 {
     sim.borrow().drives()[0].drive.objects().get(index, sub).unwrap()
-}
-
-fn plant_rev_s(sim: &RefCell<Simulation>) -> f64 {
-    sim.borrow().drives()[0].motors[0].velocity_rad_s() / std::f64::consts::TAU
 }
 
 /// A213[0] = 0 with A310 = 2, A311 = 3 set in Pre-Op (bad values refused
@@ -85,7 +81,7 @@ fn e059_e143_integer_process_data_in_op_and_the_parameter_channel() {
             "60FFh little-endian in the RxPDO"
         );
         let t = cy.run(600).await;
-        let motor = plant_rev_s(&sim);
+        let motor = motor_rev_s(&sim, 0);
         println!(
             "A310 = 2: 60FFh {v}, 606Ch {}, plant {motor:.4} rev/s",
             t.velocity
@@ -121,7 +117,7 @@ fn e059_e143_integer_process_data_in_op_and_the_parameter_channel() {
         // and the process data ran on unchanged
         let t = cy.run(100).await;
         assert!((t.velocity - v).abs() < v / 100, "606Ch: {}", t.velocity);
-        assert!((plant_rev_s(&sim) - 0.5).abs() < 0.01);
+        assert!((motor_rev_s(&sim, 0) - 0.5).abs() < 0.01);
     });
 }
 

@@ -10,8 +10,8 @@ use drive_ecat::boot::{ImageHeader, IMAGE_HEADER_LEN};
 use drive_ecat::boot::{Slot, SlotState};
 use drive_tests::al::{ACK, BOOT, ERR, INIT, PREOP};
 use drive_tests::{
-    al_status, dev_seed, firmware_file, in_boot, init, request, signed_file, to_boot, with_master_on,
-    FoeClient, FoeReply, FwNode, RawMailbox,
+    al_status, dev_seed, firmware_file, in_boot, request, signed_file, to_boot, with_preop, FoeClient,
+    FoeReply, FwNode, RawMailbox,
 };
 use ecat::foe::{FoeError, FOE_TIMEOUT};
 use ecat::mailbox::MailboxError;
@@ -38,9 +38,7 @@ fn power_cycle(sim: &RefCell<Simulation<FwNode>>) {
 #[test]
 fn e022_e023_bootstrap_only_through_init_when_foe_is_declared() {
     let sim = line();
-    with_master_on(&sim, async |md, clock| {
-        let group = init(md, clock).await;
-        let sd = group.subdevice(md, 0).unwrap();
+    with_preop(&sim, async |sd| {
         // Pre-Op -> Bootstrap: an invalid change (0011h), not "not supported"
         request(&sd, BOOT).await;
         assert_eq!(al_status(&sd).await, (PREOP | ERR, 0x0011));
@@ -100,9 +98,7 @@ fn foe_256k_image_switches_on_next_power_cycle_and_confirms() {
     let d = node(&sim).boot.expect("a slot starts");
     assert_eq!((d.slot, d.trial, d.rolled_back), (Slot::B, false, None));
     // the updated drive still works on the bus
-    with_master_on(&sim, async |md, clock| {
-        let group = init(md, clock).await;
-        let sd = group.subdevice(md, 0).unwrap();
+    with_preop(&sim, async |sd| {
         assert_eq!(al_status(&sd).await, (PREOP, 0));
     });
 }
@@ -180,9 +176,7 @@ fn foe_cut_connection_times_out_and_the_slot_is_not_pending() {
 #[test]
 fn foe_write_outside_bootstrap_is_refused_with_8008() {
     let sim = line();
-    with_master_on(&sim, async |md, clock| {
-        let group = init(md, clock).await;
-        let sd = group.subdevice(md, 0).unwrap();
+    with_preop(&sim, async |sd| {
         assert_eq!(al_status(&sd).await, (PREOP, 0));
         let mut foe = FoeClient::new();
         assert_eq!(
@@ -254,9 +248,7 @@ fn foe_into_a_simulated_drive_with_firmware_slots() {
     ]));
     // both slots empty: the download goes to A
     let file = signed_file(Slot::A, 3, 1, 30_000, &dev_seed());
-    with_master_on(&sim, async |md, clock| {
-        let group = init(md, clock).await;
-        let sd = group.subdevice(md, 0).unwrap();
+    with_preop(&sim, async |sd| {
         to_boot(&sd).await;
         FoeClient::new()
             .write_file(&sd, "firmware.efw", &file)
@@ -378,9 +370,7 @@ fn e019_e140_a09_restart_starts_a_pending_firmware_image() {
         node(&sim).slots().state(Slot::B).unwrap(),
         SlotState::Pending { .. }
     ));
-    with_master_on(&sim, async |md, clock| {
-        let group = init(md, clock).await;
-        let sd = group.subdevice(md, 0).unwrap();
+    with_preop(&sim, async |sd| {
         assert_eq!(node(&sim).boot.map(|d| d.slot), Some(Slot::A), "A runs");
         sd.sdo_write(A09, 1, 1u8).await.expect("A09[0] = 1");
     });

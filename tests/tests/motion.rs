@@ -5,19 +5,13 @@
 //! drive's internals.
 
 use drive_tests::axis::*;
-use drive_tests::{init, line, sw, with_cyclic, with_master, CoeClient, Cyclic, RawMailbox};
+use drive_tests::{init, line, motor_rev_s, sw, with_cyclic, with_master, CoeClient, Cyclic, RawMailbox};
 use drive_tests::{REV, REV_F};
 use hil_sim::motor::PositionInput;
-use hil_sim::sim::{AxisConditions, Simulation};
-use std::cell::RefCell;
+use hil_sim::sim::AxisConditions;
 
 /// Axis B's CiA 402 objects (C-134).
 const B: u16 = 0x800;
-
-/// Motor velocity, rev/s (the plant).
-fn motor_velocity_rev_s(sim: &RefCell<Simulation>, axis: usize) -> f64 {
-    sim.borrow().drives()[0].motors[axis].velocity_rad_s() / std::f64::consts::TAU
-}
 
 /// Minimum-jerk profile 0 → `d` over `t_s`: d·(10s³ − 15s⁴ + 6s⁵).
 fn min_jerk(d: f64, t_s: f64, t: f64) -> f64 {
@@ -213,7 +207,7 @@ fn c037_csv_reaches_target_velocity() {
         );
         assert!((tx.velocity - v).abs() < v / 200, "606Ch {} vs {v}", tx.velocity);
         assert!(
-            (motor_velocity_rev_s(&sim, 0) - 5.0).abs() < 0.05,
+            (motor_rev_s(&sim, 0) - 5.0).abs() < 0.05,
             "the motor turns at 5 rev/s"
         );
         assert!(tx.bit(12));
@@ -664,7 +658,7 @@ fn c010_c011_quick_stop_through_pdo() {
             let tx = m.run(20).await;
             assert_eq!(tx.state(), sw::SOD, "{cw:#06x} in SOD: {:#06x}", tx.statusword);
         }
-        assert!(motor_velocity_rev_s(&sim, 0).abs() < 0.01, "the motor stands");
+        assert!(motor_rev_s(&sim, 0).abs() < 0.01, "the motor stands");
     });
 }
 
@@ -828,10 +822,7 @@ fn c134_axis_b_moves_independently_by_sdo() {
         assert!((v_b - 2 * REV).abs() < REV / 20, "686Ch {v_b}");
         assert!(s_b & (1 << 10) != 0, "axis B velocity reached: {s_b:#06x}");
         assert!(p_b > REV / 4, "6864h follows the motor: {p_b}");
-        assert!(
-            (motor_velocity_rev_s(&sim, 1) - 2.0).abs() < 0.05,
-            "motor B turns"
-        );
+        assert!((motor_rev_s(&sim, 1) - 2.0).abs() < 0.05, "motor B turns");
         assert_eq!(m.tx.state(), sw::SOD);
         assert_eq!((m.tx.position, m.tx.velocity), (0, 0), "axis A stands");
         assert_eq!(motor_position(&sim, 0), 0, "motor A stands");
@@ -854,10 +845,7 @@ fn c134_axis_b_moves_independently_by_sdo() {
             .expect("A: QS → SOD");
         let s_b: u16 = sd.sdo_read(0x6041 + B, 0).await.unwrap();
         assert_eq!(s_b & 0x6F, sw::OE, "axis B still enabled: {s_b:#06x}");
-        assert!(
-            (motor_velocity_rev_s(&sim, 1) - 2.0).abs() < 0.05,
-            "motor B still turns"
-        );
+        assert!((motor_rev_s(&sim, 1) - 2.0).abs() < 0.05, "motor B still turns");
     });
 }
 

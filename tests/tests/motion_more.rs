@@ -457,14 +457,7 @@ async fn fault_and_reset(m: &mut Cyclic<'_>, what: &str) -> u16 {
     );
     let sd = m.link.group.subdevice(m.link.md, m.link.slave).unwrap();
     let code: u16 = sd.sdo_read(0x603F, 0).await.unwrap();
-    m.set_controlword(0);
-    m.run(2).await;
-    m.set_controlword(CW_FAULT_RESET);
-    let reset = m.run_until(20, |t| t.state() == sw::SOD).await;
-    assert!(reset.is_some(), "{what}: reset, {:#06x}", m.tx.statusword);
-    m.set_controlword(0);
-    m.run(2).await;
-    m.enable().await;
+    m.reset_and_enable().await;
     code
 }
 

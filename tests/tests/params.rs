@@ -5,7 +5,7 @@
 
 use drive_ecat::params::{C31, C32, G472, G475, I04, I20, I25, I28, I29, I30, I423, I425, I43, I53, I87};
 use drive_tests::axis::{with_drive, CW_ENABLED};
-use drive_tests::{line, with_cyclic, with_sdo};
+use drive_tests::{line, sdo_is, with_cyclic, with_sdo, PreOpSubDevice};
 use ethercrab::error::CoeAbortCode::{ValueOutOfRange, ValueTooLarge};
 use hil_sim::sim::Simulation;
 use std::cell::RefCell;
@@ -19,6 +19,28 @@ fn abort_code(e: ethercrab::error::Error) -> ethercrab::error::CoeAbortCode {
     match e {
         ethercrab::error::Error::Mailbox(ethercrab::error::MailboxError::Aborted { code, .. }) => code,
         other => panic!("not an SDO abort: {other:?}"),
+    }
+}
+
+/// Writes each `(index, value)` (sub-index 0) by SDO.
+async fn write_all<T>(sd: &PreOpSubDevice<'_>, settings: &[(u16, T)])
+where
+    T: ethercrab::EtherCrabWireWrite + Copy,
+{
+    for &(index, v) in settings {
+        sd.sdo_write(index, 0, v)
+            .await
+            .unwrap_or_else(|e| panic!("write {index:04X}h: {e}"));
+    }
+}
+
+/// Each `(index, value)` (sub-index 0) reads back by SDO.
+async fn read_back<T>(sd: &PreOpSubDevice<'_>, settings: &[(u16, T)])
+where
+    T: ethercrab::EtherCrabWireReadSized + PartialEq + std::fmt::Debug + Copy,
+{
+    for &(index, v) in settings {
+        sdo_is(sd, index, 0, v, &format!("{index:04X}h read back")).await;
     }
 }
 
@@ -117,6 +139,9 @@ fn power_cycle(sim: &RefCell<Simulation>) {
 /// unsaved ones are gone.
 #[test]
 fn e018_issue40_settings_saved_with_the_parameter_set_and_restored() {
+    let words = [(G472, 250u16), (G475, 120), (I20, 800)];
+    let dwords = [(C31, 45_000u32), (C32, 12_000)];
+    let axis_b_g472 = [(G472 + drive_ecat::AXIS_B_MANUFACTURER, 330u16)];
     let sim = line(1);
     let axis_b = drive_tests::has_axis_b("e018_issue40_settings_saved");
     with_sdo(&sim, async |sd, _| {
@@ -126,15 +151,10 @@ fn e018_issue40_settings_saved_with_the_parameter_set_and_restored() {
         assert_eq!(abort_code(e), ValueTooLarge, "C31 above its range (0609 0031h)");
         assert_eq!(sd.sdo_read::<u16>(G472, 0).await.unwrap(), 0, "unchanged");
         assert_eq!(sd.sdo_read::<u32>(C31, 0).await.unwrap(), 60_000, "unchanged");
-        sd.sdo_write(G472, 0, 250u16).await.unwrap();
-        sd.sdo_write(G475, 0, 120u16).await.unwrap();
-        sd.sdo_write(C31, 0, 45_000u32).await.unwrap();
-        sd.sdo_write(C32, 0, 12_000u32).await.unwrap();
-        sd.sdo_write(I20, 0, 800u16).await.unwrap();
+        write_all(sd, &words).await;
+        write_all(sd, &dwords).await;
         if axis_b {
-            sd.sdo_write(G472 + drive_ecat::AXIS_B_MANUFACTURER, 0, 330u16)
-                .await
-                .unwrap();
+            write_all(sd, &axis_b_g472).await;
         }
         sd.sdo_write(0x1010, 1, SAVE).await.unwrap();
         // written after the save: RAM only
@@ -142,21 +162,11 @@ fn e018_issue40_settings_saved_with_the_parameter_set_and_restored() {
     });
     power_cycle(&sim);
     with_sdo(&sim, async |sd, _| {
-        assert_eq!(sd.sdo_read::<u16>(G472, 0).await.unwrap(), 250);
-        assert_eq!(
-            sd.sdo_read::<u16>(G475, 0).await.unwrap(),
-            120,
-            "the saved value, not 999"
-        );
-        assert_eq!(sd.sdo_read::<u32>(C31, 0).await.unwrap(), 45_000);
-        assert_eq!(sd.sdo_read::<u32>(C32, 0).await.unwrap(), 12_000);
-        assert_eq!(sd.sdo_read::<u16>(I20, 0).await.unwrap(), 800);
+        // G475: the saved value, not 999
+        read_back(sd, &words).await;
+        read_back(sd, &dwords).await;
         if axis_b {
-            let b: u16 = sd
-                .sdo_read(G472 + drive_ecat::AXIS_B_MANUFACTURER, 0)
-                .await
-                .unwrap();
-            assert_eq!(b, 330);
+            read_back(sd, &axis_b_g472).await;
         }
     });
 }
@@ -167,6 +177,9 @@ fn e018_issue40_settings_saved_with_the_parameter_set_and_restored() {
 /// 1010h:01 and read back after a power cycle.
 #[test]
 fn e018_issue40_homing_and_interpolation_settings_saved_and_restored() {
+    let bytes = [(I30, 2u8), (I43, 1), (I04, 2), (I25, 80), (I425, 4)];
+    let words = [(I28, 400u16), (I29, 50), (I423, 20), (I87, 5)];
+    let dwords = [(I53, 12_345u32)];
     let sim = line(1);
     with_sdo(&sim, async |sd, _| {
         let e = sd.sdo_write(I28, 0, 3001u16).await.unwrap_err();
@@ -178,35 +191,18 @@ fn e018_issue40_homing_and_interpolation_settings_saved_and_restored() {
         assert_eq!(sd.sdo_read::<u16>(I28, 0).await.unwrap(), 1000, "unchanged");
         assert_eq!(sd.sdo_read::<u8>(I25, 0).await.unwrap(), 100, "unchanged");
         assert_eq!(sd.sdo_read::<u8>(I425, 0).await.unwrap(), 0, "unchanged");
-        sd.sdo_write(I28, 0, 400u16).await.unwrap();
-        sd.sdo_write(I29, 0, 50u16).await.unwrap();
-        sd.sdo_write(I30, 0, 2u8).await.unwrap();
-        sd.sdo_write(I43, 0, 1u8).await.unwrap();
-        sd.sdo_write(I53, 0, 12_345u32).await.unwrap();
-        sd.sdo_write(I04, 0, 2u8).await.unwrap();
-        sd.sdo_write(I25, 0, 80u8).await.unwrap();
-        sd.sdo_write(I425, 0, 4u8).await.unwrap();
-        sd.sdo_write(I423, 0, 20u16).await.unwrap();
-        sd.sdo_write(I87, 0, 5u16).await.unwrap();
+        write_all(sd, &bytes).await;
+        write_all(sd, &words).await;
+        write_all(sd, &dwords).await;
         sd.sdo_write(0x1010, 1, SAVE).await.unwrap();
         // written after the save: RAM only
         sd.sdo_write(I29, 0, 999u16).await.unwrap();
     });
     power_cycle(&sim);
     with_sdo(&sim, async |sd, _| {
-        assert_eq!(sd.sdo_read::<u16>(I28, 0).await.unwrap(), 400);
-        assert_eq!(
-            sd.sdo_read::<u16>(I29, 0).await.unwrap(),
-            50,
-            "the saved value, not 999"
-        );
-        assert_eq!(sd.sdo_read::<u8>(I30, 0).await.unwrap(), 2);
-        assert_eq!(sd.sdo_read::<u8>(I43, 0).await.unwrap(), 1);
-        assert_eq!(sd.sdo_read::<u32>(I53, 0).await.unwrap(), 12_345);
-        assert_eq!(sd.sdo_read::<u8>(I04, 0).await.unwrap(), 2);
-        assert_eq!(sd.sdo_read::<u8>(I25, 0).await.unwrap(), 80);
-        assert_eq!(sd.sdo_read::<u8>(I425, 0).await.unwrap(), 4);
-        assert_eq!(sd.sdo_read::<u16>(I423, 0).await.unwrap(), 20);
-        assert_eq!(sd.sdo_read::<u16>(I87, 0).await.unwrap(), 5);
+        // I29: the saved value, not 999
+        read_back(sd, &bytes).await;
+        read_back(sd, &words).await;
+        read_back(sd, &dwords).await;
     });
 }

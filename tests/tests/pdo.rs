@@ -5,7 +5,8 @@
 
 use drive_tests::al::{ACK, ERR, OP, PREOP, SAFEOP};
 use drive_tests::{
-    al_status, init, line, request_gives, with_master, with_sdo, with_sdo_set_up, write_sm, CoeClient,
+    al_status, init, line, map_pdo, request_gives, with_master, with_sdo, with_sdo_set_up, write_sm,
+    CoeClient,
 };
 use ecat::SdoAbort;
 use esc::AlStatusCode;
@@ -304,9 +305,7 @@ fn e048_e049_slave_process_image_follows_a_remapped_layout() {
     with_master(&sim, async |md, clock| {
         let group = init(md, clock).await;
         let sd = group.subdevice(md, 0).unwrap();
-        sd.sdo_write(0x1600, 0, 0u8).await.unwrap();
-        sd.sdo_write(0x1600, 1, CONTROLWORD).await.unwrap();
-        sd.sdo_write(0x1600, 0, 1u8).await.unwrap();
+        map_pdo(&sd, 0x1600, &[CONTROLWORD]).await;
         sd.sdo_write(0x1A00, 0, 1u8).await.unwrap();
         let group = group.into_op(md).await.unwrap();
         group.tx_rx(md).await.unwrap();

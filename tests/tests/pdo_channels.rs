@@ -3,7 +3,7 @@
 //! direction in Op at once.
 
 use drive_tests::al::OP;
-use drive_tests::{al_status, init, line, with_master, with_sdo, CoeClient};
+use drive_tests::{al_status, init, line, map_pdo, with_master, with_sdo, CoeClient};
 use ecat::SdoAbort;
 
 /// Mapping entry: index << 16 | sub << 8 | bit length.
@@ -71,12 +71,7 @@ fn e051_channel_1_is_axis_a_and_channel_2_axis_b() {
 fn e052_channel_4_mapping_is_refused_to_the_master() {
     let sim = line(1);
     with_sdo(&sim, async |sd, c| {
-        for pdo in [0x1603u16, 0x1A03] {
-            let entry = if pdo == 0x1603 {
-                m(0x6040, 0, 16)
-            } else {
-                m(0x6041, 0, 16)
-            };
+        for (pdo, entry) in [(0x1603u16, m(0x6040, 0, 16)), (0x1A03, m(0x6041, 0, 16))] {
             assert_eq!(
                 c.download(sd, pdo, 0, &[0]).await,
                 Err(SdoAbort::READ_ONLY.0),
@@ -116,13 +111,8 @@ fn e053_four_channels_per_direction_in_op_at_once() {
         }
         let [rx1, tx1] = bytes;
         // channel 3: profile velocity (6081h) out, statusword and position actual in
-        sd.sdo_write(0x1602, 0, 0u8).await.unwrap();
-        sd.sdo_write(0x1602, 1, m(0x6081, 0, 32)).await.unwrap();
-        sd.sdo_write(0x1602, 0, 1u8).await.unwrap();
-        sd.sdo_write(0x1A02, 0, 0u8).await.unwrap();
-        sd.sdo_write(0x1A02, 1, m(0x6041, 0, 16)).await.unwrap();
-        sd.sdo_write(0x1A02, 2, m(0x6064, 0, 32)).await.unwrap();
-        sd.sdo_write(0x1A02, 0, 2u8).await.unwrap();
+        map_pdo(&sd, 0x1602, &[m(0x6081, 0, 32)]).await;
+        map_pdo(&sd, 0x1A02, &[m(0x6041, 0, 16), m(0x6064, 0, 32)]).await;
         // all four channels assigned
         for (assign, first) in [(0x1C12u16, 0x1600u16), (0x1C13, 0x1A00)] {
             sd.sdo_write(assign, 0, 0u8).await.unwrap();

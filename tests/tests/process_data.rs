@@ -6,7 +6,7 @@
 use drive_ecat::DriveObjects;
 use drive_tests::al::{OP, SAFEOP};
 use drive_tests::step::set;
-use drive_tests::{al_status, init, line, with_master};
+use drive_tests::{al_status, init, line, map_pdo, with_master};
 use ethercrab::subdevice_group::HasPdi;
 use ethercrab::{DefaultLock, MainDevice, SubDeviceGroup};
 use hil_sim::sim::Simulation;
@@ -204,14 +204,8 @@ fn e048_e034_a_remapped_layout_is_decoded_and_encoded_as_mapped() {
         let sd = group.subdevice(md, 0).unwrap();
         // RxPDO: target velocity first, then controlword; TxPDO: velocity
         // actual, statusword
-        sd.sdo_write(0x1600, 0, 0u8).await.unwrap();
-        sd.sdo_write(0x1600, 1, m(0x60FF, 0, 32)).await.unwrap();
-        sd.sdo_write(0x1600, 2, m(0x6040, 0, 16)).await.unwrap();
-        sd.sdo_write(0x1600, 0, 2u8).await.unwrap();
-        sd.sdo_write(0x1A00, 0, 0u8).await.unwrap();
-        sd.sdo_write(0x1A00, 1, m(0x606C, 0, 32)).await.unwrap();
-        sd.sdo_write(0x1A00, 2, m(0x6041, 0, 16)).await.unwrap();
-        sd.sdo_write(0x1A00, 0, 2u8).await.unwrap();
+        map_pdo(&sd, 0x1600, &[m(0x60FF, 0, 32), m(0x6040, 0, 16)]).await;
+        map_pdo(&sd, 0x1A00, &[m(0x606C, 0, 32), m(0x6041, 0, 16)]).await;
         let group = group.into_op(md).await.expect("OP with the new layout");
         let sd = group.subdevice(md, 0).unwrap();
         {

@@ -2,7 +2,7 @@
 //! values live in RAM until "save values"; a save cut short by a power loss
 //! leaves the previous set intact.
 
-use drive_tests::{init, line, with_master, with_sdo};
+use drive_tests::{line, with_preop, with_sdo};
 use hil_sim::sim::Simulation;
 use std::cell::RefCell;
 
@@ -13,17 +13,13 @@ const A00: u16 = drive_ecat::parameter_index(0, 0);
 const SAVE: u32 = u32::from_le_bytes(*b"save");
 
 fn read_a258(sim: &RefCell<Simulation>) -> u16 {
-    with_master(sim, async |md, clock| {
-        let group = init(md, clock).await;
-        let sd = group.subdevice(md, 0).unwrap();
+    with_preop(sim, async |sd| {
         sd.sdo_read::<u16>(A258, 0).await.expect("read A258")
     })
 }
 
 fn write_a258(sim: &RefCell<Simulation>, v: u16, save: Option<(u16, u8, u32)>) {
-    with_master(sim, async |md, clock| {
-        let group = init(md, clock).await;
-        let sd = group.subdevice(md, 0).unwrap();
+    with_preop(sim, async |sd| {
         sd.sdo_write(A258, 0, v).await.expect("write A258");
         if let Some((index, sub, value)) = save {
             if index == A00 {

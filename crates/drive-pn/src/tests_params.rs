@@ -329,31 +329,28 @@ fn p007_p009_reset_to_factory_clears_name_and_ip_and_mode_all_every_default() {
         assert!(d.save());
         restart(d)
     };
-    // mode 2, communication: name and IP only
-    let mut d = setup();
-    send(&mut d, &reset(2));
-    assert!(d.device().dcp().name_of_station().is_empty());
-    let d = restart(d);
-    assert!(d.device().dcp().name_of_station().is_empty());
-    assert_eq!(d.device().dcp().ip_suite(), IpSuite::UNSET);
-    assert_eq!(d.objects().get(A278, 0), Ok(9000));
-    assert_eq!(d.objects().get(parameter(150), 0), Ok(2000));
-    // mode 8, all: every parameter back to its default
-    let mut d = setup();
-    send(&mut d, &reset(8));
-    let d = restart(d);
-    assert!(d.device().dcp().name_of_station().is_empty());
-    assert_eq!(d.device().dcp().ip_suite(), IpSuite::UNSET);
-    assert_eq!(d.objects().get(A278, 0), Ok(8802));
-    assert_eq!(d.objects().get(parameter(150), 0), Ok(1000));
-    // mode 1, application data: the drive's defaults, the PROFINET ones kept
-    let mut d = setup();
-    send(&mut d, &reset(1));
-    let d = restart(d);
-    assert_eq!(d.device().dcp().name_of_station().as_str(), "drive-1");
-    assert_eq!(d.device().dcp().ip_suite(), ip);
-    assert_eq!(d.objects().get(A278, 0), Ok(9000));
-    assert_eq!(d.objects().get(parameter(150), 0), Ok(1000));
+    // (reset mode; after the restart: name of station, IP suite, A278, parameter 150)
+    let cases = [
+        // mode 2, communication: name and IP only
+        (2, "", IpSuite::UNSET, 9000, 2000),
+        // mode 8, all: every parameter back to its default
+        (8, "", IpSuite::UNSET, 8802, 1000),
+        // mode 1, application data: the drive's defaults, the PROFINET ones kept
+        (1, "drive-1", ip, 9000, 1000),
+    ];
+    for (mode, name, ip, a278, p150) in cases {
+        let mut d = setup();
+        send(&mut d, &reset(mode));
+        if mode == 2 {
+            // the name goes at once
+            assert!(d.device().dcp().name_of_station().is_empty());
+        }
+        let d = restart(d);
+        assert_eq!(d.device().dcp().name_of_station().as_str(), name, "mode {mode}");
+        assert_eq!(d.device().dcp().ip_suite(), ip, "mode {mode}");
+        assert_eq!(d.objects().get(A278, 0), Ok(a278), "mode {mode}");
+        assert_eq!(d.objects().get(parameter(150), 0), Ok(p150), "mode {mode}");
+    }
 }
 
 fn parameter(line: u16) -> u16 {

@@ -266,33 +266,19 @@ fn esi_matches_sii_image() {
                 assert_eq!(num(sm.attribute("DefaultSize").unwrap()), len, "SM{i}");
             }
         }
-        assert_eq!(
-            num(sms[0].attribute("StartAddress").unwrap()),
-            w(word::STD_RX_MAILBOX_OFFSET)
-        );
-        assert_eq!(
-            num(sms[0].attribute("DefaultSize").unwrap()),
-            w(word::STD_RX_MAILBOX_SIZE)
-        );
-        assert_eq!(
-            num(sms[1].attribute("StartAddress").unwrap()),
-            w(word::STD_TX_MAILBOX_OFFSET)
-        );
-        assert_eq!(
-            num(sms[1].attribute("DefaultSize").unwrap()),
-            w(word::STD_TX_MAILBOX_SIZE)
-        );
+        for (i, name, want) in [
+            (0, "StartAddress", w(word::STD_RX_MAILBOX_OFFSET)),
+            (0, "DefaultSize", w(word::STD_RX_MAILBOX_SIZE)),
+            (1, "StartAddress", w(word::STD_TX_MAILBOX_OFFSET)),
+            (1, "DefaultSize", w(word::STD_TX_MAILBOX_SIZE)),
+            (2, "DefaultSize", declared.output_bytes() as u64),
+            (3, "DefaultSize", declared.input_bytes() as u64),
+        ] {
+            assert_eq!(num(sms[i].attribute(name).unwrap()), want, "SM{i} {name}");
+        }
         assert_eq!(
             sms.iter().map(|s| s.text().unwrap()).collect::<Vec<_>>(),
             ["MBoxOut", "MBoxIn", "Outputs", "Inputs"]
-        );
-        assert_eq!(
-            num(sms[2].attribute("DefaultSize").unwrap()),
-            declared.output_bytes() as u64
-        );
-        assert_eq!(
-            num(sms[3].attribute("DefaultSize").unwrap()),
-            declared.input_bytes() as u64
         );
 
         // FMMUs

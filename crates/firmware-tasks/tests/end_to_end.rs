@@ -2,6 +2,7 @@
 //! (`hil_sim::world`) on the host: the QEMU image's loop without QEMU, so
 //! the end-to-end sequence can be debugged with `cargo test`.
 
+use drive_ecat::axis::AxisIo;
 use firmware_tasks::clock::Clock;
 use firmware_tasks::cycle::{CycleTimer, CYCLE};
 use firmware_tasks::net::{NetBuffers, NodeNet, BOARD_NET, EMPTY_SLOTS};
@@ -42,6 +43,30 @@ impl Board {
         b
     }
 
+    /// Serves the world's next event: a SYNC0 (the ESC's SYNC0 events
+    /// taken, the SYNC0 task) and a control cycle (the control task, then
+    /// `in_cycle` on the drive and the inputs, then the plant actuated) here;
+    /// a frame's time is given back, for the caller's ESC and mailbox tasks.
+    fn serve(&mut self, in_cycle: impl FnOnce(&Drive, &[AxisIo; 2])) -> Option<Nanos> {
+        let event = self.world.next(self.esc.next_sync0_at(), self.timer.next_at());
+        let now = self.world.now();
+        match event {
+            Event::Sync0 => {
+                let _ = self.esc.take_sync0_events(now);
+                tasks::sync0(&mut self.drive, &mut self.timer, &mut self.esc.pdi(), now).unwrap();
+                None
+            }
+            Event::Control => {
+                let io = self.world.io();
+                let cmd = tasks::control(&mut self.drive, &mut self.timer, now, &io);
+                in_cycle(&self.drive, &io);
+                self.world.actuate(&cmd, CYCLE);
+                None
+            }
+            Event::Frame => Some(now),
+        }
+    }
+
     /// Runs events until the script ends; returns its progress log and the
     /// number of control cycles that ran under the PLL.
     fn run(&mut self) -> (Vec<Progress>, u32) {
@@ -51,34 +76,21 @@ impl Board {
             if self.world.finished().is_some() {
                 break;
             }
-            let event = self.world.next(self.esc.next_sync0_at(), self.timer.next_at());
-            let now = self.world.now();
-            match event {
-                Event::Sync0 => {
-                    let _ = self.esc.take_sync0_events(now);
-                    tasks::sync0(&mut self.drive, &mut self.timer, &mut self.esc.pdi(), now).unwrap();
-                }
-                Event::Control => {
-                    let io = self.world.io();
-                    let cmd = tasks::control(&mut self.drive, &mut self.timer, now, &io);
-                    pll_cycles += u32::from(self.drive.pll().is_some_and(|p| p.is_locked()));
-                    self.world.actuate(&cmd, CYCLE);
-                }
-                Event::Frame => {
-                    let p = self.world.frame(&mut self.esc);
-                    tasks::esc_event(&mut self.drive, &mut self.timer, &mut self.esc.pdi(), now).unwrap();
-                    // the mailbox task runs after the ESC task returns (priority 1)
-                    match self.net.as_mut() {
-                        Some(net) => {
-                            tasks::mailbox_net(&mut self.drive, net, &mut self.esc.pdi(), now).unwrap()
-                        }
-                        None => tasks::mailbox(&mut self.drive, &mut self.esc.pdi(), now).unwrap(),
-                    }
-                    tasks::background(&mut Exclusive(&mut self.drive));
-                    if p != Progress::Busy {
-                        log.push(p);
-                    }
-                }
+            let Some(now) = self.serve(|drive, _| {
+                pll_cycles += u32::from(drive.pll().is_some_and(|p| p.is_locked()));
+            }) else {
+                continue;
+            };
+            let p = self.world.frame(&mut self.esc);
+            tasks::esc_event(&mut self.drive, &mut self.timer, &mut self.esc.pdi(), now).unwrap();
+            // the mailbox task runs after the ESC task returns (priority 1)
+            match self.net.as_mut() {
+                Some(net) => tasks::mailbox_net(&mut self.drive, net, &mut self.esc.pdi(), now).unwrap(),
+                None => tasks::mailbox(&mut self.drive, &mut self.esc.pdi(), now).unwrap(),
+            }
+            tasks::background(&mut Exclusive(&mut self.drive));
+            if p != Progress::Busy {
+                log.push(p);
             }
         }
         (log, pll_cycles)
@@ -313,25 +325,12 @@ fn issue35_scope_records_the_move_through_the_task_bodies() {
         if b.world.finished().is_some() || scope.state() == State::Complete {
             break;
         }
-        let event = b.world.next(b.esc.next_sync0_at(), b.timer.next_at());
-        let now = b.world.now();
-        match event {
-            Event::Sync0 => {
-                let _ = b.esc.take_sync0_events(now);
-                tasks::sync0(&mut b.drive, &mut b.timer, &mut b.esc.pdi(), now).unwrap();
-            }
-            Event::Control => {
-                let io = b.world.io();
-                let cmd = tasks::control(&mut b.drive, &mut b.timer, now, &io);
-                tasks::scope(&b.drive, &mut scope, &io);
-                b.world.actuate(&cmd, CYCLE);
-            }
-            Event::Frame => {
-                let _ = b.world.frame(&mut b.esc);
-                tasks::esc_event(&mut b.drive, &mut b.timer, &mut b.esc.pdi(), now).unwrap();
-                tasks::mailbox_scoped(&mut b.drive, &mut scope, &mut b.esc.pdi(), now).unwrap();
-            }
-        }
+        let Some(now) = b.serve(|drive, io| tasks::scope(drive, &mut scope, io)) else {
+            continue;
+        };
+        let _ = b.world.frame(&mut b.esc);
+        tasks::esc_event(&mut b.drive, &mut b.timer, &mut b.esc.pdi(), now).unwrap();
+        tasks::mailbox_scoped(&mut b.drive, &mut scope, &mut b.esc.pdi(), now).unwrap();
     }
     assert_eq!(
         scope.state(),

@@ -99,6 +99,16 @@ fn arp(op: u16, sha: [u8; 6], spa: [u8; 4], tha: [u8; 6], tpa: [u8; 4]) -> Vec<u
     a
 }
 
+/// Runs `body` on a rig with an IP address whose neighbour cache knows the
+/// host (an ARP request from it answered).
+fn with_host<T>(body: impl FnOnce(&mut Rig<'_>) -> T) -> T {
+    let mut bufs = NetBuffers::new();
+    let mut slots = [SocketStorage::EMPTY; SOCKETS];
+    let mut r = Rig::new(&mut bufs, &mut slots);
+    r.arp_from(HOST_MAC, HOST_IP);
+    body(&mut r)
+}
+
 struct Rig<'a> {
     q: EoeQueue,
     net: NetStack<'a>,
@@ -287,57 +297,51 @@ fn e095_e096_hostile_frames_are_dropped_and_ping_still_answers() {
 
 #[test]
 fn e095_udp_to_a_closed_port_gets_port_unreachable_with_the_header() {
-    let mut bufs = NetBuffers::new();
-    let mut slots = [SocketStorage::EMPTY; SOCKETS];
-    let mut r = Rig::new(&mut bufs, &mut slots);
-    r.arp_from(HOST_MAC, HOST_IP);
-    let dgram = ipv4(HOST_IP, DRIVE_IP, 17, &udp(5000, 9, 12, b"test"), |_| {});
-    let out = r.send(&eth(DRIVE_MAC, HOST_MAC, 0x0800, &dgram));
-    assert_eq!(out.len(), 1, "one ICMP error");
-    let ip = &out[0][14..];
-    assert_eq!(ip[9], 1, "ICMP");
-    assert_eq!(&ip[16..20], &HOST_IP);
-    let m = &ip[20..];
-    assert_eq!((m[0], m[1]), (3, 3), "destination unreachable, port unreachable");
-    assert_eq!(checksum(m), 0, "ICMP checksum");
-    assert_eq!(checksum(&ip[..20]), 0, "IPv4 header checksum");
-    // RFC 792: the original IP header and the first 8 bytes of its data
-    assert_eq!(&m[8..8 + 28], &dgram[..28]);
+    with_host(|r| {
+        let dgram = ipv4(HOST_IP, DRIVE_IP, 17, &udp(5000, 9, 12, b"test"), |_| {});
+        let out = r.send(&eth(DRIVE_MAC, HOST_MAC, 0x0800, &dgram));
+        assert_eq!(out.len(), 1, "one ICMP error");
+        let ip = &out[0][14..];
+        assert_eq!(ip[9], 1, "ICMP");
+        assert_eq!(&ip[16..20], &HOST_IP);
+        let m = &ip[20..];
+        assert_eq!((m[0], m[1]), (3, 3), "destination unreachable, port unreachable");
+        assert_eq!(checksum(m), 0, "ICMP checksum");
+        assert_eq!(checksum(&ip[..20]), 0, "IPv4 header checksum");
+        // RFC 792: the original IP header and the first 8 bytes of its data
+        assert_eq!(&m[8..8 + 28], &dgram[..28]);
+    });
 }
 
 #[test]
 fn e095_large_echo_request_is_answered_whole() {
-    let mut bufs = NetBuffers::new();
-    let mut slots = [SocketStorage::EMPTY; SOCKETS];
-    let mut r = Rig::new(&mut bufs, &mut slots);
-    r.arp_from(HOST_MAC, HOST_IP);
-    let data: Vec<u8> = (0..1472u32).map(|i| (i * 7) as u8).collect();
-    assert_eq!(r.ping(1, &data), Some(data));
+    with_host(|r| {
+        let data: Vec<u8> = (0..1472u32).map(|i| (i * 7) as u8).collect();
+        assert_eq!(r.ping(1, &data), Some(data));
+    });
 }
 
 #[test]
 fn e095_arp_flood_replaces_the_oldest_neighbour() {
-    let mut bufs = NetBuffers::new();
-    let mut slots = [SocketStorage::EMPTY; SOCKETS];
-    let mut r = Rig::new(&mut bufs, &mut slots);
-    r.arp_from(HOST_MAC, HOST_IP);
-    assert!(r.ping(1, b"x").is_some());
-    // more neighbours than the cache holds (smoltcp's default: 8)
-    for n in 0..24u8 {
-        let out = r.arp_from([0x02, 0, 0, 0, 1, n], [192, 168, 10, 100 + n]);
-        assert_eq!(out.len(), 1, "ARP reply to neighbour {n}");
-        assert_eq!(&out[0][0..6], &[0x02, 0, 0, 0, 1, n]);
-    }
-    // the host's entry was the oldest: the drive asks for it before answering
-    let m = icmp(8, 0, [0x12, 0x34, 0, 2], b"y");
-    let out = r.send(&to_drive(1, &m));
-    assert_eq!(out.len(), 1);
-    assert_eq!(&out[0][12..14], &[8, 6], "an ARP request");
-    assert_eq!(&out[0][14 + 24..14 + 28], &HOST_IP, "for the host");
-    // once the host has answered, ping works again
-    let reply = arp(2, HOST_MAC, HOST_IP, DRIVE_MAC, DRIVE_IP);
-    assert!(r.send(&eth(DRIVE_MAC, HOST_MAC, 0x0806, &reply)).is_empty());
-    assert_eq!(r.ping(3, b"z").as_deref(), Some(&b"z"[..]));
+    with_host(|r| {
+        assert!(r.ping(1, b"x").is_some());
+        // more neighbours than the cache holds (smoltcp's default: 8)
+        for n in 0..24u8 {
+            let out = r.arp_from([0x02, 0, 0, 0, 1, n], [192, 168, 10, 100 + n]);
+            assert_eq!(out.len(), 1, "ARP reply to neighbour {n}");
+            assert_eq!(&out[0][0..6], &[0x02, 0, 0, 0, 1, n]);
+        }
+        // the host's entry was the oldest: the drive asks for it before answering
+        let m = icmp(8, 0, [0x12, 0x34, 0, 2], b"y");
+        let out = r.send(&to_drive(1, &m));
+        assert_eq!(out.len(), 1);
+        assert_eq!(&out[0][12..14], &[8, 6], "an ARP request");
+        assert_eq!(&out[0][14 + 24..14 + 28], &HOST_IP, "for the host");
+        // once the host has answered, ping works again
+        let reply = arp(2, HOST_MAC, HOST_IP, DRIVE_MAC, DRIVE_IP);
+        assert!(r.send(&eth(DRIVE_MAC, HOST_MAC, 0x0806, &reply)).is_empty());
+        assert_eq!(r.ping(3, b"z").as_deref(), Some(&b"z"[..]));
+    });
 }
 
 /// E-098 with a server whose renewal time T1 (7200 s) is beyond its lease

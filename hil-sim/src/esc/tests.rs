@@ -575,6 +575,27 @@ fn pdi_handle_and_direct_impl_agree() {
     assert_eq!(rd(&mut e, 0x1200, 600, 0), (msg, 1));
 }
 
+/// Every access kind, for the randomized data-phase comparisons.
+const OPS: [Op; 5] = [Op::Read, Op::ReadOr, Op::Write, Op::ReadWrite, Op::ReadOrWrite];
+
+/// Every memory byte `i` of `e` set to `i * mul ^ xor` (wrapping).
+fn fill(e: &mut Esc, mul: u8, xor: u8) {
+    for (i, m) in e.mem.iter_mut().enumerate() {
+        *m = (i as u8).wrapping_mul(mul) ^ xor;
+    }
+}
+
+/// A xorshift64 generator from `seed`.
+fn xorshift(seed: u64) -> impl FnMut() -> u64 {
+    let mut x = seed;
+    move || {
+        x ^= x << 13;
+        x ^= x >> 7;
+        x ^= x << 17;
+        x
+    }
+}
+
 /// The data phase of an access no SyncManager area overlaps
 /// (`Esc::plain_data`, slices where it can) does byte for byte what the
 /// general per-byte phase does with every byte plain (`Esc::sm_data` with no
@@ -587,17 +608,8 @@ fn plain_data_phase_is_the_per_byte_phase() {
     // a system time that is not zero and moves
     base.set_clock(30_000, 123_456_789);
     base.tick(Nanos::from_us(777));
-    for (i, m) in base.mem.iter_mut().enumerate() {
-        *m = (i as u8).wrapping_mul(37) ^ 0x5A;
-    }
-    let mut x = 0x9E37_79B9_7F4A_7C15u64;
-    let mut next = move || {
-        x ^= x << 13;
-        x ^= x >> 7;
-        x ^= x << 17;
-        x
-    };
-    let ops = [Op::Read, Op::ReadOr, Op::Write, Op::ReadWrite, Op::ReadOrWrite];
+    fill(&mut base, 37, 0x5A);
+    let mut next = xorshift(0x9E37_79B9_7F4A_7C15u64);
     for round in 0..20_000 {
         let r = next();
         let addr = match r % 4 {
@@ -607,7 +619,7 @@ fn plain_data_phase_is_the_per_byte_phase() {
             _ => 0x1000 + (r >> 8) as u32 % 0x2100,
         };
         let len = 1 + (next() % 40) as usize;
-        let op = ops[(next() % 5) as usize];
+        let op = OPS[(next() % 5) as usize];
         let side = if next() % 2 == 0 { Side::Ecat } else { Side::Pdi };
         let mut e = base.clone();
         e.sii_pending = (round % 3 == 0).then_some(SiiPending {
@@ -635,17 +647,8 @@ fn buffer_data_phase_is_the_per_byte_phase() {
     let mut base = esc();
     base.set_clock(-20_000, 987_654_321);
     base.tick(Nanos::from_us(1234));
-    for (i, m) in base.mem.iter_mut().enumerate() {
-        *m = (i as u8).wrapping_mul(91) ^ 0xA5;
-    }
-    let mut x = 0x1234_5678_9ABC_DEF1u64;
-    let mut next = move || {
-        x ^= x << 13;
-        x ^= x >> 7;
-        x ^= x << 17;
-        x
-    };
-    let ops = [Op::Read, Op::ReadOr, Op::Write, Op::ReadWrite, Op::ReadOrWrite];
+    fill(&mut base, 91, 0xA5);
+    let mut next = xorshift(0x1234_5678_9ABC_DEF1u64);
     for _ in 0..20_000 {
         let start = match next() % 3 {
             0 => 0x0900 + (next() % 0x20) as u32,
@@ -670,7 +673,7 @@ fn buffer_data_phase_is_the_per_byte_phase() {
         };
         let addr = start + (next() % u64::from(len + 4)) as u32 - (next() % 3) as u32;
         let n = 1 + (next() % 70) as usize;
-        let op = ops[(next() % 5) as usize];
+        let op = OPS[(next() % 5) as usize];
         let (mut e, mut f) = (base.clone(), base.clone());
         let data: Vec<u8> = (0..n).map(|_| next() as u8).collect();
         let (mut a, mut b) = (data.clone(), data);

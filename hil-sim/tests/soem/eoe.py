@@ -320,11 +320,7 @@ def main():
     m.open(args.iface)
     tap = None
     try:
-        for k in range(3):
-            n = m.config_init()
-            if n > 0:
-                break
-            time.sleep(0.5)
+        n = L.config_init(m)
         say(f"config_init: {n} slave(s)")
         if not check(n == args.slaves, f"config_init found {n} slaves, expected {args.slaves}"):
             return 1

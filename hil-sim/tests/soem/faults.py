@@ -345,14 +345,7 @@ def bring_up(m, n, writes=(), scan=True, dc=True, must_op=True):
             L.write(m, i, index, sub, data)
     layouts = [S.remap(m, i) for i in range(n)]
     m.manual_state_change = 1
-    for _ in range(3):
-        m.config_map()
-        wrong = [i + 1 for i, s in enumerate(m.slaves) if (len(s.output), len(s.input)) != (layouts[i][0].bytes, layouts[i][1].bytes)]
-        if not wrong:
-            break
-        say(f"RETRY config_map: drive(s) {wrong} mapped with other sizes than their PDO objects give")
-    else:
-        raise L.Fatal(f"config_map: drive(s) {wrong} mapped with other sizes, 3 times")
+    L.config_map(m, layouts)
     if not m.config_dc():
         raise L.Fatal("config_dc: no DC")
     emcys = L.Emcys(m)
@@ -362,12 +355,7 @@ def bring_up(m, n, writes=(), scan=True, dc=True, must_op=True):
     L.real_time(True)
     gc.disable()
     bus = Bus(m, layouts, emcys)
-    recent = []
-    for _ in range(5000):
-        bus.cyc.run()
-        recent = (recent + [abs(bus.cyc.delta) < 100_000])[-200:]
-        if sum(recent) >= 190:
-            break
+    L.align(bus.cyc)
     say(f"aligned to the reference clock after {bus.cyc.n} cycles, phase error {bus.cyc.delta / 1000:.1f} us")
     # frames outside the drives' window count from here (not while aligning)
     bus.cyc.watch()

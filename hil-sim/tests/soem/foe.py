@@ -58,11 +58,7 @@ def main():
     m = pysoem.Master()
     m.open(args.iface)
     try:
-        for _ in range(3):
-            n = m.config_init()
-            if n > 0:
-                break
-            time.sleep(0.5)
+        n = L.config_init(m)
         if not check(n > 0, "config_init found no slave"):
             return 1
         s = m.slaves[0]

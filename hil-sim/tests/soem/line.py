@@ -163,13 +163,19 @@ def acknowledge(m, i):
 # --- 1. scan, identity, SII ---------------------------------------------------
 
 
-def scan(m, n_expected):
+def config_init(m):
+    """`m.config_init()` up to three times, 0.5 s apart; the slaves found."""
     for k in range(3):
         n = m.config_init()
         if n > 0:
             break
         say(f"config_init found no slave (attempt {k + 1}), again in 0.5 s")
         time.sleep(0.5)
+    return n
+
+
+def scan(m, n_expected):
+    n = config_init(m)
     say(f"config_init: {n} slave(s)")
     if n != n_expected:
         raise Fatal(f"config_init found {n} slaves, expected {n_expected}")
@@ -826,6 +832,30 @@ SETTLED_INC = 100
 MAX_STALLS = 3
 
 
+def config_map(m, layouts):
+    """`m.config_map()` until every slave is mapped with the sizes its PDO
+    objects give (`layouts`), three times at most; the IO map's size."""
+    for _ in range(3):
+        size = m.config_map()
+        wrong = [i + 1 for i, s in enumerate(m.slaves) if (len(s.output), len(s.input)) != (layouts[i][0].bytes, layouts[i][1].bytes)]
+        if not wrong:
+            return size
+        say(f"RETRY config_map: slave(s) {wrong} mapped with other sizes than their PDO objects give")
+    raise Fatal(f"config_map: slave(s) {wrong} mapped with other sizes than their PDO objects give, 3 times")
+
+
+def align(cyc):
+    """Runs `cyc` (5000 cycles at most) until 190 of the last 200 frames
+    came within 100 us of the reference clock; those last frames' verdicts."""
+    recent = []
+    for _ in range(5000):
+        cyc.run()
+        recent = (recent + [abs(cyc.delta) < 100_000])[-200:]
+        if sum(recent) >= 190:
+            break
+    return recent
+
+
 def wait_states(m, cyc, want, max_cycles, every=10):
     """Cycles until every slave shows `want` (read every `every` cycles)."""
     for k in range(max_cycles):
@@ -1248,12 +1278,7 @@ def cyclic(m, args, layouts, emcys):
     line = Line(m, cyc, layouts)
     # the PI settles in a few hundred cycles; a frame answered late now and
     # then does not keep the run from going on
-    recent = []
-    for k in range(5000):
-        cyc.run()
-        recent = (recent + [abs(cyc.delta) < 100_000])[-200:]
-        if sum(recent) >= 190:
-            break
+    recent = align(cyc)
     say(
         f"aligned to the reference clock after {cyc.n} cycles: {sum(recent)} of the last {len(recent)} frames within 100 us, "
         f"phase error {cyc.delta / 1000:.1f} us, offset {cyc.toff} ns/cycle"

@@ -511,14 +511,7 @@ def setup(m, args):
     # SOEM sizes each slave's process data from the PDO objects it reads by
     # SDO in config_map; a mailbox exchange it gave up on (a loaded machine)
     # leaves a slave sized from the SII instead: mapped again
-    for k in range(3):
-        size = m.config_map()
-        wrong = [i + 1 for i, s in enumerate(m.slaves) if (len(s.output), len(s.input)) != (layouts[i][0].bytes, layouts[i][1].bytes)]
-        if not wrong:
-            break
-        say(f"RETRY config_map: slave(s) {wrong} mapped with other sizes than their PDO objects give")
-    else:
-        raise L.Fatal(f"config_map: slave(s) {wrong} mapped with other sizes than their PDO objects give, 3 times")
+    size = L.config_map(m, layouts)
     out_l, in_l = layouts[0]
     say(f"config_map: IO map {size} bytes; per slave {out_l.bytes} output, {in_l.bytes} input bytes; expected WKC {m.expected_wkc}")
     if not m.config_dc():
@@ -532,12 +525,7 @@ def setup(m, args):
     soak = Soak(m, args, layouts)
     soak.emcys = emcys
     cyc = soak.cyc
-    recent = []
-    for _ in range(5000):
-        cyc.run()
-        recent = (recent + [abs(cyc.delta) < 100_000])[-200:]
-        if sum(recent) >= 190:
-            break
+    L.align(cyc)
     say(f"aligned to the reference clock after {cyc.n} cycles, phase error {cyc.delta / 1000:.1f} us")
     m.state = SAFEOP
     m.write_state()

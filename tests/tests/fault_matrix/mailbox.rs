@@ -6,7 +6,7 @@ use super::{advance, ethercrab};
 use drive_ecat::boot::{Slot, SlotState};
 use drive_tests::matrix::al;
 use drive_tests::{
-    al_status, fault_row, firmware_file, in_boot, init, line, to_boot, with_master, with_master_on, with_sdo,
+    al_status, fault_row, firmware_file, in_boot, init, line, to_boot, with_master, with_preop, with_sdo,
     CoeClient, Cyclic, FoeClient, FoeReply, FwNode, RawMailbox, MAILBOX_LEN, REV,
 };
 use hil_sim::sim::Simulation;
@@ -226,9 +226,7 @@ fn e037_a_master_restarted_during_an_foe_download_keeps_the_running_image() {
     );
     let sim = RefCell::new(Simulation::with_nodes(vec![FwNode::factory(20_000)]));
     let file = firmware_file(2, 30_000);
-    with_master_on(&sim, async |md, clock| {
-        let group = init(md, clock).await;
-        let sd = group.subdevice(md, 0).unwrap();
+    with_preop(&sim, async |sd| {
         to_boot(&sd).await;
         let mut foe = FoeClient::new();
         assert_eq!(foe.write_request(&sd, "firmware.efw").await, FoeReply::Ack(0));

@@ -206,6 +206,17 @@ fn c038_max_current_6073h_limits_cst_torque_with_bit_11() {
     assert_eq!(r.get(0x6041) & SW_LIMIT, 0);
 }
 
+/// The rig of the motor i²t tests: the current loop's 0.2 ms lag, B73 =
+/// 1000 ms (the winding's thermal time constant τ = 1 s), and the torque modes' speed limiter at I10 (at 40 % it allows
+/// 1.9 N·m at standstill: below the 2.6 N·m asked for).
+fn i2t_rig() -> Rig {
+    let mut r = Rig::new(0.2e-3, true, 0);
+    r.od.set(crate::params::B73, 0, 1000).unwrap();
+    r.od.set(crate::params::G472, 0, 1000).unwrap();
+    r.od.set(crate::params::G475, 0, 1000).unwrap();
+    r
+}
+
 /// E-089 (event 45 → 4380h), the motor i²t of issue 34 against the closed
 /// form of the first-order thermal model: 200 % of the rated current from
 /// cold reaches 100 % at t = −τ·ln(1 − (I_r/I)²) = −τ·ln(3/4) = 287.7 ms
@@ -213,12 +224,7 @@ fn c038_max_current_6073h_limits_cst_torque_with_bit_11() {
 /// current (6078h 1000 ‰, bit 11), and after U11 = 200 ms the fault 4380h.
 #[test]
 fn e089_motor_i2t_warning_limit_then_fault_4380h_at_the_closed_form_time() {
-    let mut r = Rig::new(0.2e-3, true, 0);
-    r.od.set(crate::params::B73, 0, 1000).unwrap();
-    // the torque modes' speed limiter at I10 (at 40 % it allows 1.9 N·m at
-    // standstill: below the 2.6 N·m asked for)
-    r.od.set(crate::params::G472, 0, 1000).unwrap();
-    r.od.set(crate::params::G475, 0, 1000).unwrap();
+    let mut r = i2t_rig();
     r.od.set(crate::params::U11, 0, 200).unwrap();
     // the parameters take effect; the model is cold (no current so far)
     r.cycle();
@@ -268,12 +274,7 @@ fn e089_motor_i2t_warning_limit_then_fault_4380h_at_the_closed_form_time() {
 /// warns, limits nor faults.
 #[test]
 fn e089_motor_i2t_inactive_with_u10_0() {
-    let mut r = Rig::new(0.2e-3, true, 0);
-    r.od.set(crate::params::B73, 0, 1000).unwrap();
-    // the torque modes' speed limiter at I10 (at 40 % it allows 1.9 N·m at
-    // standstill: below the 2.6 N·m asked for)
-    r.od.set(crate::params::G472, 0, 1000).unwrap();
-    r.od.set(crate::params::G475, 0, 1000).unwrap();
+    let mut r = i2t_rig();
     r.od.set(crate::params::U10, 0, 0).unwrap();
     r.od.set(0x6071, 0, 2000).unwrap();
     for _ in 0..1500 {

@@ -10,26 +10,24 @@ const fn m(index: u16, sub: u8, bits: u8) -> u32 {
 
 /// Writes `entries` into `pdo` as a startup list would (Pre-Op).
 fn map(objects: &mut DriveObjects, pdo: u16, entries: &[u32]) {
-    objects.write(pdo, 0, &[0], CommState::PreOp).unwrap();
-    for (sub, e) in (1u8..).zip(entries) {
-        objects
-            .write(pdo, sub, &e.to_le_bytes(), CommState::PreOp)
-            .unwrap();
-    }
-    objects
-        .write(pdo, 0, &[entries.len() as u8], CommState::PreOp)
-        .unwrap();
+    let items: Vec<_> = entries.iter().map(|e| e.to_le_bytes()).collect();
+    write_list(objects, pdo, &items);
 }
 
 fn assign(objects: &mut DriveObjects, index: u16, pdos: &[u16]) {
+    let items: Vec<_> = pdos.iter().map(|p| p.to_le_bytes()).collect();
+    write_list(objects, index, &items);
+}
+
+/// A list object as a startup list writes it (Pre-Op): count 0, the
+/// entries from sub-index 1, then the count.
+fn write_list<const N: usize>(objects: &mut DriveObjects, index: u16, items: &[[u8; N]]) {
     objects.write(index, 0, &[0], CommState::PreOp).unwrap();
-    for (sub, p) in (1u8..).zip(pdos) {
-        objects
-            .write(index, sub, &p.to_le_bytes(), CommState::PreOp)
-            .unwrap();
+    for (sub, item) in (1u8..).zip(items) {
+        objects.write(index, sub, item, CommState::PreOp).unwrap();
     }
     objects
-        .write(index, 0, &[pdos.len() as u8], CommState::PreOp)
+        .write(index, 0, &[items.len() as u8], CommState::PreOp)
         .unwrap();
 }
 

@@ -127,7 +127,7 @@ impl Bench {
 }
 
 /// Receive telegram 1 (speed): CW1, target velocity, all ramps, PKW.
-fn speed(cw1: u16, rpm: i32, ramps: u32, pkw: [u8; 8]) -> [u8; 36] {
+pub(super) fn speed(cw1: u16, rpm: i32, ramps: u32, pkw: [u8; 8]) -> [u8; 36] {
     let mut t = [0u8; 36];
     t[0] = 0xE1;
     t[2..4].copy_from_slice(&cw1.to_be_bytes());

@@ -105,15 +105,10 @@ fn t0(cw1: u16, target: i32, v: i32, end: i32, acc: u32, jog: i32, p: [u8; 8]) -
     t
 }
 
-/// Telegram 1: CW1, target velocity, both ramps, jog velocity, PKW.
+/// Telegram 1 ([`super::tests::speed`]) with jog velocity 300.
 fn t1(cw1: u16, rpm: i32, ramps: u32, p: [u8; 8]) -> [u8; 36] {
-    let mut t = [0u8; 36];
-    t[0] = 0xE1;
-    t[2..4].copy_from_slice(&cw1.to_be_bytes());
-    t[4..8].copy_from_slice(&rpm.to_be_bytes());
-    t[16..20].copy_from_slice(&ramps.to_be_bytes());
+    let mut t = super::tests::speed(cw1, rpm, ramps, p);
     t[20..24].copy_from_slice(&300i32.to_be_bytes());
-    t[24..32].copy_from_slice(&p);
     t
 }
 

@@ -3,6 +3,7 @@
 //! survives a restart.
 
 use super::{pkw_request, positioning, speed, Bench};
+use crate::tests::TestFlash;
 use crate::PnDrive;
 
 impl Bench {
@@ -18,6 +19,29 @@ impl Bench {
     /// A PKW request in receive telegram 0 after the 0x00 toggle.
     pub(super) fn pkw0(&mut self, code: u8, index: u16, sub: u8, value: u32) -> (u8, i32) {
         self.pkw_in(positioning(0x0400, 0, 100, 10_000), code, index, sub, value)
+    }
+
+    /// Writes each `(PNU, value)` (sub-index 0) by PKW in receive telegram
+    /// 0, each acknowledged.
+    fn pkw0_write_all(&mut self, settings: &[(u16, u32)]) {
+        for &(pnu, value) in settings {
+            assert_eq!(self.pkw0(0x42, pnu, 0, value).0, 0x42, "PNU {pnu} = {value}");
+        }
+    }
+
+    /// Saves the parameters (PNU 971 = 1 by PKW) and gives back a new drive
+    /// started over the same flash.
+    fn saved_and_restarted(&mut self) -> PnDrive<TestFlash> {
+        assert_eq!(self.pkw0(0x42, 971, 0, 1).0, 0x42, "saved");
+        let flash = core::mem::replace(&mut self.d, crate::tests::commissioned()).into_flash();
+        PnDrive::new(flash, crate::tests::hardware())
+    }
+}
+
+/// `d`'s objects hold each `(index, value)` (sub-index 0).
+fn holds(d: &PnDrive<TestFlash>, settings: &[(u16, u32)]) {
+    for &(index, value) in settings {
+        assert_eq!(d.objects().get(index, 0), Ok(i64::from(value)), "{index:04X}h");
     }
 }
 
@@ -92,9 +116,7 @@ fn p132_the_speed_setpoint_is_zero_after_a_restart() {
     b.run(&speed(0x0400, 250, 10_000, [0; 8]), 10);
     assert_eq!(b.d.objects().get(0x6042, 0), Ok(250));
     b.run(&positioning(0x0400, 0, 100, 10_000), 5);
-    assert_eq!(b.pkw0(0x42, 971, 0, 1).0, 0x42, "saved");
-    let flash = core::mem::replace(&mut b.d, crate::tests::commissioned()).into_flash();
-    let again = PnDrive::new(flash, crate::tests::hardware());
+    let again = b.saved_and_restarted();
     assert_eq!(again.objects().get(0x6042, 0), Ok(0));
 }
 
@@ -455,15 +477,11 @@ fn p045_issue40_g472_and_c31_through_pkw_saved_and_read_after_a_restart() {
         "beyond 100 %: limit exceeded"
     );
     assert_eq!(b.d.objects().get(G472, 0), Ok(0), "unchanged");
-    assert_eq!(b.pkw0(0x42, G472, 0, 300).0, 0x42);
-    assert_eq!(b.pkw0(0x42, C31, 0, 45_000).0, 0x42);
+    let settings = [(G472, 300), (C31, 45_000)];
+    b.pkw0_write_all(&settings);
     assert_eq!(b.pkw0(0x41, G472, 0, 0), (0x41, 300));
     assert_eq!(b.pkw0(0x41, C31, 0, 0), (0x41, 45_000));
-    assert_eq!(b.pkw0(0x42, 971, 0, 1).0, 0x42, "saved");
-    let flash = core::mem::replace(&mut b.d, crate::tests::commissioned()).into_flash();
-    let again = PnDrive::new(flash, crate::tests::hardware());
-    assert_eq!(again.objects().get(G472, 0), Ok(300));
-    assert_eq!(again.objects().get(C31, 0), Ok(45_000));
+    holds(&b.saved_and_restarted(), &settings);
 }
 
 /// The homing, interpolation and speed settings of issue 40 through PKW
@@ -479,18 +497,10 @@ fn p045_issue40_homing_and_speed_settings_through_pkw_saved_and_read_after_a_res
     assert_eq!(b.pkw0(0x42, I425, 0, 2).0, 0xC2, "I425 = 2 refused");
     assert_eq!(b.d.objects().get(I28, 0), Ok(1000), "unchanged");
     assert_eq!(b.d.objects().get(I425, 0), Ok(0), "unchanged");
-    assert_eq!(b.pkw0(0x42, I28, 0, 400).0, 0x42);
-    assert_eq!(b.pkw0(0x42, I425, 0, 4).0, 0x42);
-    assert_eq!(b.pkw0(0x42, I53, 0, 4096).0, 0x42);
-    assert_eq!(b.pkw0(0x42, I10, 0, 20 << 20).0, 0x42);
+    let settings = [(I28, 400), (I425, 4), (I53, 4096), (I10, 20 << 20)];
+    b.pkw0_write_all(&settings);
     assert_eq!(b.pkw0(0x41, I28, 0, 0), (0x41, 400));
-    assert_eq!(b.pkw0(0x42, 971, 0, 1).0, 0x42, "saved");
-    let flash = core::mem::replace(&mut b.d, crate::tests::commissioned()).into_flash();
-    let again = PnDrive::new(flash, crate::tests::hardware());
-    assert_eq!(again.objects().get(I28, 0), Ok(400));
-    assert_eq!(again.objects().get(I425, 0), Ok(4));
-    assert_eq!(again.objects().get(I53, 0), Ok(4096));
-    assert_eq!(again.objects().get(I10, 0), Ok(20 << 20));
+    holds(&b.saved_and_restarted(), &settings);
 }
 
 /// The motor data of issue 34 through PKW (PNU = index): B10 pole pairs,
@@ -508,18 +518,10 @@ fn p045_issue34_motor_data_through_pkw_saved_and_read_after_a_restart() {
     assert_eq!(b.pkw0(0x42, 0x6075, 0, 0), (0xC2, 2), "0 mA refused");
     assert_eq!(b.d.objects().get(B10, 0), Ok(4), "unchanged");
     assert_eq!(b.d.objects().get(0x6075, 0), Ok(2000), "unchanged");
-    assert_eq!(b.pkw0(0x42, B10, 0, 5).0, 0x42);
-    assert_eq!(b.pkw0(0x42, B73, 0, 900_000).0, 0x42);
-    assert_eq!(b.pkw0(0x42, U11, 0, 2_000).0, 0x42);
-    assert_eq!(b.pkw0(0x42, 0x6075, 0, 2_500).0, 0x42);
+    let settings = [(B10, 5), (B73, 900_000), (U11, 2_000), (0x6075, 2_500)];
+    b.pkw0_write_all(&settings);
     assert_eq!(b.pkw0(0x41, B10, 0, 0), (0x41, 5));
-    assert_eq!(b.pkw0(0x42, 971, 0, 1).0, 0x42, "saved");
-    let flash = core::mem::replace(&mut b.d, crate::tests::commissioned()).into_flash();
-    let again = PnDrive::new(flash, crate::tests::hardware());
-    assert_eq!(again.objects().get(B10, 0), Ok(5));
-    assert_eq!(again.objects().get(B73, 0), Ok(900_000));
-    assert_eq!(again.objects().get(U11, 0), Ok(2_000));
-    assert_eq!(again.objects().get(0x6075, 0), Ok(2_500));
+    holds(&b.saved_and_restarted(), &settings);
 }
 
 /// The power stage's data and the DC-link window of issue 34 through PKW

@@ -366,32 +366,37 @@ fn c118_external_feedforward_uses_60b1_weighted_by_i25() {
     let out = out.unwrap();
     assert!((out.velocity_feedforward - 4000.0).abs() < 1e-3);
     assert_eq!(out.position, 50);
-    assert_eq!(
-        from_i425(1),
-        Ok((InterpolationOrder::Linear, FeedforwardSource::External))
-    );
-    assert_eq!(
-        from_i425(3),
-        Ok((InterpolationOrder::Quadratic, FeedforwardSource::External))
-    );
+    i425_maps(&[
+        (1, Ok((InterpolationOrder::Linear, FeedforwardSource::External))),
+        (
+            3,
+            Ok((InterpolationOrder::Quadratic, FeedforwardSource::External)),
+        ),
+    ]);
 }
 
 #[test]
 fn c119_i425_maps_internal_orders() {
-    assert_eq!(
-        from_i425(0),
-        Ok((InterpolationOrder::Linear, FeedforwardSource::Internal))
-    );
-    assert_eq!(
-        from_i425(4),
-        Ok((InterpolationOrder::Quadratic, FeedforwardSource::Internal))
-    );
-    assert_eq!(
-        from_i425(5),
-        Ok((InterpolationOrder::Cubic, FeedforwardSource::Internal))
-    );
-    assert_eq!(from_i425(2), Err(ConfigError::UnknownI425(2)));
-    assert_eq!(from_i425(6), Err(ConfigError::UnknownI425(6)));
+    i425_maps(&[
+        (0, Ok((InterpolationOrder::Linear, FeedforwardSource::Internal))),
+        (
+            4,
+            Ok((InterpolationOrder::Quadratic, FeedforwardSource::Internal)),
+        ),
+        (5, Ok((InterpolationOrder::Cubic, FeedforwardSource::Internal))),
+        (2, Err(ConfigError::UnknownI425(2))),
+        (6, Err(ConfigError::UnknownI425(6))),
+    ]);
+}
+
+/// What I425 selects: the interpolation order and the feed-forward source.
+type I425 = Result<(InterpolationOrder, FeedforwardSource), ConfigError>;
+
+/// I425 → interpolation order and feed-forward source (or the refusal), each case.
+fn i425_maps(cases: &[(u8, I425)]) {
+    for &(i425, want) in cases {
+        assert_eq!(from_i425(i425), want, "I425 = {i425}");
+    }
 }
 
 #[test]
