@@ -18,7 +18,9 @@ name contains SYMBOL the runs of a task NAME (an image without tasks:
 firmware-qemu-pn), PROFILE_IDLE=SYMBOL the caller whose blocks end a run. LINES (e.g. 60) also lists that task's costliest
 source lines per run: each instruction charged to the innermost frame in the
 project's crates (llvm-addr2line with inlining, so the lines of functions
-LTO inlined into the task count where they are written).
+LTO inlined into the task count where they are written), and the call sites
+of the memory routines (memcpy, memclr, memset, memcmp) with the
+instructions those calls cost.
 """
 import bisect
 import collections
@@ -52,6 +54,12 @@ def name(pc):
     return '?'
 tb_len = {}   # pc -> instruction count (from in_asm)
 tb_ins = {}   # pc -> the block's instruction addresses (for the per-line listing)
+tb_last = {}  # pc -> the block's last instruction (a call site)
+# the memory routines: their instructions charged to the block that called them
+mem_rng = [(a, a + max(sz, 1)) for a, sz, nm in syms
+           if re.match(r'(__aeabi_mem|compiler_builtins::mem::|memc(py|mp)$|memset$|memmove$)', nm)]
+mem_calls = collections.Counter()
+caller = {}
 counts = collections.Counter()
 task = 'idle'
 entries = {}
@@ -72,17 +80,18 @@ handlers = collections.Counter()
 cur = None; n = 0; ins = []
 for line in sys.stdin:
     if line.startswith('IN:'):
-        if cur is not None: tb_len[cur] = n; tb_ins[cur] = ins
+        if cur is not None: tb_len[cur] = n; tb_ins[cur] = ins; tb_last[cur] = last
         cur = None; n = 0; ins = []
         continue
     m = re.match(r'^0x([0-9a-f]{8}):', line)
     if m:
         if cur is None: cur = int(m.group(1), 16)
+        last = int(m.group(1), 16)
         n += 1
         if lines_wanted: ins.append(int(m.group(1), 16))
         continue
     if line.startswith('Trace'):
-        if cur is not None: tb_len[cur] = n; tb_ins[cur] = ins; cur = None; n = 0; ins = []
+        if cur is not None: tb_len[cur] = n; tb_ins[cur] = ins; tb_last[cur] = last; cur = None; n = 0; ins = []
         m = re.search(r'\[[0-9a-f]+/([0-9a-f]+)/', line)
         if m:
             pc = int(m.group(1), 16)
@@ -99,6 +108,11 @@ for line in sys.stdin:
             elif any(lo <= pc < hi for lo, hi in idle_rng):
                 task = 'idle'
             counts[(task, pc)] += 1
+            if lines_wanted and window and task == window[0]:
+                if any(lo <= pc < hi for lo, hi in mem_rng):
+                    mem_calls[caller.get(task)] += tb_len.get(pc, 1)
+                else:
+                    caller[task] = pc
 per = collections.Counter()
 tot = collections.Counter()
 for (t, pc), c in counts.items():
@@ -146,3 +160,14 @@ if lines_wanted and window:
     print(f'== {t}: the {lines_wanted} costliest source lines per run (innermost frame in crates/)')
     for where, c in per_line.most_common(lines_wanted):
         print(f'{c/k:>9.1f} per run {100*c/total:5.1f}% {where}')
+    # the memory routines by call site (the calling block's last instruction)
+    sites = [(pc, c) for pc, c in mem_calls.most_common(20) if pc is not None]
+    out = subprocess.run([tool, '-e', elf, '-i', '-f', '--output-style=JSON'],
+                         input='\n'.join(hex(tb_last.get(pc, pc)) for pc, _ in sites),
+                         capture_output=True, text=True).stdout
+    print(f'== {t}: the memory routines by call site per run ({sum(mem_calls.values())/k:.1f} per run)')
+    for (pc, c), row in zip(sites, out.splitlines()):
+        frames = json.loads(row).get('Symbol') or []
+        chain = ' < '.join(f"{f['FileName'][len(top_dir):] if f['FileName'].startswith(top_dir) else f['FunctionName'][:40]}:{f['Line']}"
+                           for f in frames[:3])
+        print(f'{c/k:>9.1f} per run {tb_last.get(pc, pc):#x} {name(pc)[:60]} @ {chain}')
