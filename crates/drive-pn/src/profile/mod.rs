@@ -292,137 +292,141 @@ impl Profile {
         };
         self.core.resolve(objects, axis);
         let core = &self.core;
-        let mut access = drive_access!(self, objects, axis, live);
-        let rx = telegrams.apply_receive_compiled(frame, &mut access, &self.handles);
-        // the telegram's record fields stored before anything reads them
-        access.flush_record();
-        if !rx.warnings.is_empty() {
-            self.warnings = self.warnings.saturating_add(1);
-        }
-        if rx.telegram.is_none() {
-            // an unknown identifier changes nothing
-            return;
-        }
-        self.response = rx.response;
-        let binding = match rx.mode {
-            ModeBinding::Positioning => Some(1),
-            ModeBinding::Speed => Some(2),
-            ModeBinding::None => None,
-        };
-        if let Some(code) = binding {
-            let now = core.get(access.objects, axis, Core::Mode);
-            // homing runs inside positioning (6060h = 6 while it runs)
-            if !(code == 1 && now == 6 && self.homing) && now != code {
-                core.set(access.objects, axis, Core::Mode, code);
+        // the access ends in place at the block's end (issue 36: `drop(access)`
+        // moved its 92 bytes first)
+        let (speed_limit, torque_limit, record_command) = {
+            let mut access = drive_access!(self, objects, axis, live);
+            let rx = telegrams.apply_receive_compiled(frame, &mut access, &self.handles);
+            // the telegram's record fields stored before anything reads them
+            access.flush_record();
+            if !rx.warnings.is_empty() {
+                self.warnings = self.warnings.saturating_add(1);
             }
-        }
-        if let Some(req) = rx.pkw {
-            self.pkw_response = self.pkw.step(req, &mut access);
-        }
-        // a telegram select or apply the PKW step asked for
-        if access.own.edit.request.is_some() {
-            let mut edit = access.own.edit;
-            telegram_config::serve(&mut edit, telegrams, &mut access);
-            access.own.edit = edit;
-        }
-        if let Some(cw1) = rx.cw1 {
-            access.own.cw1 = cw1;
-        }
-        // the mode this frame's CW1 counts in: the one its telegram binds
-        // (6060h, set above, which the core takes at its next cycle, where
-        // CW1 acts) or else 6061h; the display alone lagged a cycle behind
-        // a telegram switch, so the first positioning cycle ran without a
-        // record command and a jog bit of the next frame was no edge (P-086)
-        let shown = core.get(access.objects, axis, Core::ModeDisplay);
-        let display = match binding {
-            Some(1) if matches!(shown, 1 | 6 | -1) => shown,
-            Some(code) => code,
-            None => shown,
-        };
-        let mode = match Ok::<i64, ()>(display) {
-            Ok(1 | 6 | -1) => Mode::Positioning,
-            Ok(2 | 3) => Mode::Speed,
-            _ => Mode::Other,
-        };
-        let t = self.cw1.decode(
-            rx.cw1,
-            Context {
-                mode,
-                homing_active: self.homing,
-            },
-        );
-        if !t.evaluated {
-            return;
-        }
-        let mut controlword = t.controlword;
-        let record_command = match t.mode {
-            ModeCommands::Positioning(p) => {
-                if p.homing_start && !self.homing {
-                    if let Some(m) = access::core_homing_method(access.own.homing_method) {
-                        let _ = access.objects.set(axis.cia402_index(0x6098), 0, i64::from(m));
-                        let _ = access.objects.set(axis.cia402_index(0x6060), 0, 6);
-                        self.homing = true;
+            if rx.telegram.is_none() {
+                // an unknown identifier changes nothing
+                return;
+            }
+            self.response = rx.response;
+            let binding = match rx.mode {
+                ModeBinding::Positioning => Some(1),
+                ModeBinding::Speed => Some(2),
+                ModeBinding::None => None,
+            };
+            if let Some(code) = binding {
+                let now = core.get(access.objects, axis, Core::Mode);
+                // homing runs inside positioning (6060h = 6 while it runs)
+                if !(code == 1 && now == 6 && self.homing) && now != code {
+                    core.set(access.objects, axis, Core::Mode, code);
+                }
+            }
+            if let Some(req) = rx.pkw {
+                self.pkw_response = self.pkw.step(req, &mut access);
+            }
+            // a telegram select or apply the PKW step asked for
+            if access.own.edit.request.is_some() {
+                let mut edit = access.own.edit;
+                telegram_config::serve(&mut edit, telegrams, &mut access);
+                access.own.edit = edit;
+            }
+            if let Some(cw1) = rx.cw1 {
+                access.own.cw1 = cw1;
+            }
+            // the mode this frame's CW1 counts in: the one its telegram binds
+            // (6060h, set above, which the core takes at its next cycle, where
+            // CW1 acts) or else 6061h; the display alone lagged a cycle behind
+            // a telegram switch, so the first positioning cycle ran without a
+            // record command and a jog bit of the next frame was no edge (P-086)
+            let shown = core.get(access.objects, axis, Core::ModeDisplay);
+            let display = match binding {
+                Some(1) if matches!(shown, 1 | 6 | -1) => shown,
+                Some(code) => code,
+                None => shown,
+            };
+            let mode = match Ok::<i64, ()>(display) {
+                Ok(1 | 6 | -1) => Mode::Positioning,
+                Ok(2 | 3) => Mode::Speed,
+                _ => Mode::Other,
+            };
+            let t = self.cw1.decode(
+                rx.cw1,
+                Context {
+                    mode,
+                    homing_active: self.homing,
+                },
+            );
+            if !t.evaluated {
+                return;
+            }
+            let mut controlword = t.controlword;
+            let record_command = match t.mode {
+                ModeCommands::Positioning(p) => {
+                    if p.homing_start && !self.homing {
+                        if let Some(m) = access::core_homing_method(access.own.homing_method) {
+                            let _ = access.objects.set(axis.cia402_index(0x6098), 0, i64::from(m));
+                            let _ = access.objects.set(axis.cia402_index(0x6060), 0, 6);
+                            self.homing = true;
+                        }
+                    }
+                    if p.homing_cancel {
+                        self.homing = false;
+                    }
+                    if self.homing {
+                        // 6040h bit 4 starts and holds the homing run (its rising
+                        // edge once the axis is in homing mode); clearing it ends
+                        // the run without an error
+                        if display == 6 {
+                            controlword |= BIT_4;
+                        }
+                        None
+                    } else {
+                        Some(RecordCommand {
+                            enable: !p.cancel,
+                            proceed: !p.intermediate_stop,
+                            start: p.start,
+                            relative: p.relative,
+                            immediate: p.immediate,
+                            jog_positive: p.jog_positive,
+                            jog_negative: p.jog_negative,
+                            setup_mode: false,
+                        })
                     }
                 }
-                if p.homing_cancel {
-                    self.homing = false;
-                }
-                if self.homing {
-                    // 6040h bit 4 starts and holds the homing run (its rising
-                    // edge once the axis is in homing mode); clearing it ends
-                    // the run without an error
-                    if display == 6 {
-                        controlword |= BIT_4;
+                ModeCommands::Speed(s) => {
+                    // vl: bit 4 enable ramp, bit 5 unlock ramp, bit 6 use the
+                    // set-point (Q-04: PROFIdrive polarity, 1 = the ramp runs)
+                    controlword &= !BITS_4_6;
+                    if s.rfg_enable {
+                        controlword |= 0x0010;
+                    }
+                    if !s.rfg_freeze {
+                        controlword |= 0x0020;
+                    }
+                    if s.setpoint_enable {
+                        controlword |= 0x0040;
                     }
                     None
-                } else {
-                    Some(RecordCommand {
-                        enable: !p.cancel,
-                        proceed: !p.intermediate_stop,
-                        start: p.start,
-                        relative: p.relative,
-                        immediate: p.immediate,
-                        jog_positive: p.jog_positive,
-                        jog_negative: p.jog_negative,
-                        setup_mode: false,
-                    })
                 }
-            }
-            ModeCommands::Speed(s) => {
-                // vl: bit 4 enable ramp, bit 5 unlock ramp, bit 6 use the
-                // set-point (Q-04: PROFIdrive polarity, 1 = the ramp runs)
-                controlword &= !BITS_4_6;
-                if s.rfg_enable {
-                    controlword |= 0x0010;
-                }
-                if !s.rfg_freeze {
-                    controlword |= 0x0020;
-                }
-                if s.setpoint_enable {
-                    controlword |= 0x0040;
-                }
-                None
-            }
-            ModeCommands::Other => None,
+                ModeCommands::Other => None,
+            };
+            core.set(access.objects, axis, Core::Controlword, i64::from(controlword));
+            // torque control: 2416h.02 (the PROFINET velocity unit, rpm by
+            // default) is the speed limit in both directions (P-130)
+            let speed_limit = (display == 4).then(|| {
+                let bus = i64::from(access.own.speed_limit);
+                self.units
+                    .velocity
+                    .from_bus(bus)
+                    .map_or(f32::MAX, |v| v.unsigned_abs() as f32)
+            });
+            // speed control: 2415h.02 (mA) limits the torque through the motor's
+            // rated current (P-133); 0 sets no limit
+            let current = access.own.current_limit_ma;
+            let torque_limit = (matches!(display, 2 | 3) && current > 0).then(|| {
+                let rated = u64::from(axis.motor().rated_current_ma().max(1));
+                (u64::from(current.unsigned_abs()) * 1000 / rated).min(u64::from(u16::MAX - 1)) as u16
+            });
+            (speed_limit, torque_limit, record_command)
         };
-        core.set(access.objects, axis, Core::Controlword, i64::from(controlword));
-        // torque control: 2416h.02 (the PROFINET velocity unit, rpm by
-        // default) is the speed limit in both directions (P-130)
-        let speed_limit = (display == 4).then(|| {
-            let bus = i64::from(access.own.speed_limit);
-            self.units
-                .velocity
-                .from_bus(bus)
-                .map_or(f32::MAX, |v| v.unsigned_abs() as f32)
-        });
-        // speed control: 2415h.02 (mA) limits the torque through the motor's
-        // rated current (P-133); 0 sets no limit
-        let current = access.own.current_limit_ma;
-        let torque_limit = (matches!(display, 2 | 3) && current > 0).then(|| {
-            let rated = u64::from(axis.motor().rated_current_ma().max(1));
-            (u64::from(current.unsigned_abs()) * 1000 / rated).min(u64::from(u16::MAX - 1)) as u16
-        });
-        drop(access);
         axis.set_torque_mode_speed_limit(speed_limit);
         axis.set_torque_limit_per_mille(torque_limit);
         axis.set_record_command(record_command);
