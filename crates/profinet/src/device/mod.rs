@@ -519,6 +519,33 @@ impl<H: RecordHook> Device<H> {
             .map(|m| m.data.as_slice())
     }
 
+    /// The output data of the module at `slot` (controller → drive) beside
+    /// the record hook: a profile that reads the one while the hook serves
+    /// it takes both without copying the frame out first (issue 36).
+    pub fn output_data_with_hook(&mut self, slot: u16) -> (Option<&[u8]>, &mut H) {
+        let data = self
+            .cyclic
+            .as_ref()
+            .filter(|c| c.outputs_valid)
+            .and_then(|c| c.outputs.iter().find(|m| m.slot == slot))
+            .map(|m| m.data.as_slice());
+        (data, self.cm.hook_mut())
+    }
+
+    /// The input data of the module at `slot` (drive → controller) to
+    /// write in place for the next provider frames, its configured length;
+    /// `None` if the AR has no such module (or no AR runs). What
+    /// [`set_input_data`](Self::set_input_data) does, without a buffer to
+    /// copy from (issue 36: the response telegram is built here).
+    pub fn input_data_mut(&mut self, slot: u16) -> Option<&mut [u8]> {
+        self.cyclic
+            .as_mut()?
+            .inputs
+            .iter_mut()
+            .find(|m| m.slot == slot)
+            .map(|m| m.data.as_mut_slice())
+    }
+
     /// Sets the input data of the OUT module at `slot` (drive → controller,
     /// the response telegram) for the next provider frames; `false` if the
     /// AR has no such module (or no AR runs). Extra bytes are ignored; missing

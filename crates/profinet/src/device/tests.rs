@@ -159,6 +159,34 @@ fn p027_p042_cyclic_outputs_reach_the_drive_and_inputs_go_out_every_cycle() {
     );
 }
 
+/// Issue 36: the response written in place and the outputs read beside the
+/// hook reach the same bytes as `set_input_data` and `output_data`.
+#[test]
+fn p027_p042_inputs_written_in_place_and_outputs_read_beside_the_hook() {
+    let mut d = connected();
+    let input_id = d.cm().ar().unwrap().input_cr.as_ref().unwrap().frame_id;
+    assert_eq!(d.output_data_with_hook(2).0, None, "nothing before the first frame");
+    let cycle = Nanos::from_ms(8);
+    for k in 0..4u16 {
+        let now = cycle * u64::from(k);
+        let f = output_frame(&d, k * 256, 0x10 + k as u8);
+        sent(&mut d, now, &f);
+        assert_eq!(d.output_data_with_hook(2).0, Some(&[0x10 + k as u8; 36][..]));
+        let data = d.input_data_mut(1).expect("slot 1 carries the inputs");
+        assert_eq!(data.len(), 36, "the module's configured length");
+        data.fill(0x5A + k as u8);
+        let sent_inputs: Vec<_> = poll(&mut d, now)
+            .into_iter()
+            .filter(|f| frame_id(f) == Some(input_id))
+            .collect();
+        assert!(!sent_inputs.is_empty(), "an input frame in cycle {k}");
+        for f in sent_inputs {
+            assert!(f.windows(36).any(|w| w == [0x5A + k as u8; 36]), "cycle {k}");
+        }
+    }
+    assert!(d.input_data_mut(2).is_none(), "slot 2 is an IN module");
+}
+
 #[test]
 fn p036_no_output_frames_for_the_watchdog_time_loses_the_ar() {
     let mut d = connected();
