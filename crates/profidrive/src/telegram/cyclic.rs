@@ -97,12 +97,19 @@ pub struct TxOutcome {
     pub warnings: Warnings,
 }
 
+/// A frame's bytes on a word boundary: the copies into the live view run
+/// word by word (issue 36: the response's copy to an odd address ran byte
+/// by byte, ~220 instructions per telegram on QEMU).
+#[derive(Debug, Clone, Copy)]
+#[repr(C, align(4))]
+struct Bytes([u8; MAX_TELEGRAM_BYTES]);
+
 /// The last frames both ways (P-070).
 #[derive(Debug, Clone, Copy)]
 pub(crate) struct Live {
-    rx: [u8; MAX_TELEGRAM_BYTES],
+    rx: Bytes,
     rx_len: u8,
-    tx: [u8; MAX_TELEGRAM_BYTES],
+    tx: Bytes,
     tx_len: u8,
     last_rx: Option<u8>,
     last_tx: Option<u8>,
@@ -111,9 +118,9 @@ pub(crate) struct Live {
 
 impl Live {
     pub(crate) const NEW: Self = Self {
-        rx: [0; MAX_TELEGRAM_BYTES],
+        rx: Bytes([0; MAX_TELEGRAM_BYTES]),
         rx_len: 0,
-        tx: [0; MAX_TELEGRAM_BYTES],
+        tx: Bytes([0; MAX_TELEGRAM_BYTES]),
         tx_len: 0,
         last_rx: None,
         last_tx: None,
@@ -179,7 +186,7 @@ impl Telegrams {
             out.warnings.0 |= Warnings::LENGTH_MISMATCH;
         }
         let keep = frame.len().min(MAX_TELEGRAM_BYTES);
-        if let (Some(dst), Some(src)) = (self.live.rx.get_mut(..keep), frame.get(..keep)) {
+        if let (Some(dst), Some(src)) = (self.live.rx.0.get_mut(..keep), frame.get(..keep)) {
             dst.copy_from_slice(src);
             self.live.rx_len = keep as u8;
         }
@@ -332,7 +339,7 @@ impl Telegrams {
             }
         }
         let keep = buf.len().min(MAX_TELEGRAM_BYTES);
-        if let (Some(dst), Some(src)) = (self.live.tx.get_mut(..keep), buf.get(..keep)) {
+        if let (Some(dst), Some(src)) = (self.live.tx.0.get_mut(..keep), buf.get(..keep)) {
             dst.copy_from_slice(src);
             self.live.tx_len = keep as u8;
         }
@@ -345,12 +352,12 @@ impl Telegrams {
 
     /// The last received frame as it came (up to [`MAX_TELEGRAM_BYTES`]).
     pub fn live_receive(&self) -> &[u8] {
-        self.live.rx.get(..usize::from(self.live.rx_len)).unwrap_or(&[])
+        self.live.rx.0.get(..usize::from(self.live.rx_len)).unwrap_or(&[])
     }
 
     /// The last response telegram sent.
     pub fn live_response(&self) -> &[u8] {
-        self.live.tx.get(..usize::from(self.live.tx_len)).unwrap_or(&[])
+        self.live.tx.0.get(..usize::from(self.live.tx_len)).unwrap_or(&[])
     }
 
     /// The receive telegram of the last frame with a known identifier.
