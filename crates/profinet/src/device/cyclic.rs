@@ -1,6 +1,7 @@
 //! The running AR's real-time side: the output CR's consumer, the input CR's
 //! provider and the alarm CR, configured from the connection management's
-//! [`Ar`], and the process data the application exchanges with them.
+//! [`Ar`], and the process data the application exchanges with them
+//! (`Device::output_data`, `input_data_mut` and the rest, here).
 
 use heapless::Vec;
 use nanos::Nanos;
@@ -163,5 +164,75 @@ impl Cyclic {
     /// Whether the alarm channel can take the next diagnosis alarm.
     pub fn alarm_free(&self) -> bool {
         self.alarm.as_ref().is_some_and(|a| a.can_send(Priority::Low))
+    }
+}
+
+/// The process data the application reads and writes: the data modules of
+/// the running AR.
+impl<H: crate::cm::RecordHook> super::Device<H> {
+    /// The controller's output data for the IN module at `slot` (controller →
+    /// drive, the receive telegram), while it is current: an AR exchanges
+    /// valid cyclic data and the data hold time has not expired.
+    pub fn output_data(&self, slot: u16) -> Option<&[u8]> {
+        let c = self.cyclic.as_ref().filter(|c| c.outputs_valid)?;
+        c.outputs
+            .iter()
+            .find(|m| m.slot == slot)
+            .map(|m| m.data.as_slice())
+    }
+
+    /// The output data of the module at `slot` (controller → drive) beside
+    /// the record hook: a profile that reads the one while the hook serves
+    /// it takes both without copying the frame out first (issue 36).
+    pub fn output_data_with_hook(&mut self, slot: u16) -> (Option<&[u8]>, &mut H) {
+        let data = self
+            .cyclic
+            .as_ref()
+            .filter(|c| c.outputs_valid)
+            .and_then(|c| c.outputs.iter().find(|m| m.slot == slot))
+            .map(|m| m.data.as_slice());
+        (data, self.cm.hook_mut())
+    }
+
+    /// The input data of the module at `slot` (drive → controller) to
+    /// write in place for the next provider frames, its configured length;
+    /// `None` if the AR has no such module (or no AR runs). What
+    /// [`set_input_data`](Self::set_input_data) does, without a buffer to
+    /// copy from (issue 36: the response telegram is built here).
+    pub fn input_data_mut(&mut self, slot: u16) -> Option<&mut [u8]> {
+        self.cyclic
+            .as_mut()?
+            .inputs
+            .iter_mut()
+            .find(|m| m.slot == slot)
+            .map(|m| m.data.as_mut_slice())
+    }
+
+    /// Sets the input data of the OUT module at `slot` (drive → controller,
+    /// the response telegram) for the next provider frames; `false` if the
+    /// AR has no such module (or no AR runs). Extra bytes are ignored; missing
+    /// ones stay as they were.
+    pub fn set_input_data(&mut self, slot: u16, data: &[u8]) -> bool {
+        let Some(m) = self
+            .cyclic
+            .as_mut()
+            .and_then(|c| c.inputs.iter_mut().find(|m| m.slot == slot))
+        else {
+            return false;
+        };
+        for (d, s) in m.data.iter_mut().zip(data) {
+            *d = *s;
+        }
+        true
+    }
+
+    /// The configured lengths of the AR's data modules (P-028): (slot, bytes,
+    /// direction seen from the drive: `true` = to the drive).
+    pub fn data_modules(&self) -> impl Iterator<Item = (u16, usize, bool)> + '_ {
+        self.cyclic.iter().flat_map(|c| {
+            let outs = c.outputs.iter().map(|m| (m.slot, m.data.len(), true));
+            let ins = c.inputs.iter().map(|m| (m.slot, m.data.len(), false));
+            outs.chain(ins)
+        })
     }
 }

@@ -165,7 +165,11 @@ fn p027_p042_cyclic_outputs_reach_the_drive_and_inputs_go_out_every_cycle() {
 fn p027_p042_inputs_written_in_place_and_outputs_read_beside_the_hook() {
     let mut d = connected();
     let input_id = d.cm().ar().unwrap().input_cr.as_ref().unwrap().frame_id;
-    assert_eq!(d.output_data_with_hook(2).0, None, "nothing before the first frame");
+    assert_eq!(
+        d.output_data_with_hook(2).0,
+        None,
+        "nothing before the first frame"
+    );
     let cycle = Nanos::from_ms(8);
     for k in 0..4u16 {
         let now = cycle * u64::from(k);
