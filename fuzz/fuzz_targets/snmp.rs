@@ -14,7 +14,7 @@
 
 use libfuzzer_sys::fuzz_target;
 use snmp::ber::{Reader, Writer};
-use snmp::{message, Agent, Delays, Device, LldpAgent, LocalPort, MacPhy, ManAddr, Neighbor, Pno};
+use snmp::{message, Agent, Device};
 
 const PREFIXES: &[&[u32]] = &[
     &[1, 3, 6, 1, 2, 1, 1],
@@ -41,31 +41,12 @@ const PREFIXES: &[&[u32]] = &[
 ];
 const PDUS: [u8; 6] = [0xa0, 0xa1, 0xa5, 0xa3, 0xa3, 0xa2];
 
+/// `snmp::testing`'s device with its neighbour on port 2 and port 1 empty (the
+/// remote-table prefixes above name port 2).
 fn device() -> Device<'static> {
-    Device {
-        descr: b"drive",
-        uptime_cs: 123,
-        macs: [[2, 0, 0, 0, 0, 1], [2, 0, 0, 0, 0, 2], [2, 0, 0, 0, 0, 3]],
-        links: [true, false],
-        neighbors: [
-            None,
-            Some(Neighbor {
-                chassis_subtype: 7,
-                chassis_id: b"plc",
-                port_subtype: 7,
-                port_id: b"port-001",
-                sys_name: b"plc",
-                pno: Some(Pno { delay: Delays { line: 9, tx: 1, rx: 2 }, rt2: 2, rt3: 4 }),
-                mac_phy: Some(MacPhy { autoneg: 3, advertised: [0x6c, 0], mau_type: 16 }),
-                man_addr: Some(ManAddr { ipv4: [192, 168, 0, 10], if_subtype: 2, if_id: 1 }),
-            }),
-        ],
-        name_of_station: b"drive-1",
-        man_addr: Some(ManAddr { ipv4: [192, 168, 0, 50], if_subtype: 2, if_id: 1 }),
-        man_addr_ports: [0xc0],
-        ports: [LocalPort::default(); 2],
-        lldp: LldpAgent { tx_interval: 5, hold: 4, ..LldpAgent::default() },
-    }
+    let mut d = snmp::testing::device();
+    d.neighbors.swap(0, 1);
+    d
 }
 
 /// The request's community, PDU tag and id as sent (after the byte change).

@@ -53,7 +53,7 @@
 )]
 #![deny(missing_docs)]
 
-pub use store::{crc32, Crc32, Flash, FlashError, RamFlash, MAX_WRITE};
+pub use store::{crc32, Crc32, Flash, FlashError, PowerCut, RamFlash, MAX_WRITE};
 
 mod sign;
 mod verified;

@@ -3,6 +3,7 @@ use std::vec;
 use std::vec::Vec;
 
 use crate::*;
+use boot::PowerCut;
 
 /// The QEMU geometry (4 KiB sectors, 256-byte units, 64 KiB per slot).
 type Mem<'a> = mps2::SlotFlash<'a, NoMirror>;
@@ -96,6 +97,11 @@ fn boot(mem: &mut [u8]) -> Outcome {
     select(&mut slots(Mem::new(mem, NoMirror)), &L, &PUBLIC_KEY)
 }
 
+/// [`check_image`] of slot B in `mem`, as the boot loader would judge it.
+fn check_slot_b(mem: &mut [u8]) -> Result<Entry, ImageFault> {
+    check_image(&mut slots(Mem::new(mem, NoMirror)), Slot::B, &L, &PUBLIC_KEY)
+}
+
 fn region() -> Vec<u8> {
     vec![0xFF; mps2::REGION_LEN]
 }
@@ -184,34 +190,7 @@ fn a_body_byte_flipped_after_the_download_is_never_started() {
         let st = start_of(boot(&mut mem));
         assert_eq!((st.slot, st.decision.trial, st.version), (Slot::A, false, 1));
     }
-    let mut s = slots(Mem::new(&mut mem, NoMirror));
-    assert_eq!(
-        check_image(&mut s, Slot::B, &L, &PUBLIC_KEY),
-        Err(ImageFault::NotBootable)
-    );
-}
-
-/// Fails every erase/write from the `left`-th on (a power cut).
-struct Cut<F> {
-    inner: F,
-    left: u32,
-}
-
-impl<F: Flash> Flash for Cut<F> {
-    const SECTOR: usize = F::SECTOR;
-    const SECTORS: usize = F::SECTORS;
-    const WRITE: usize = F::WRITE;
-    fn read(&mut self, addr: u32, buf: &mut [u8]) -> Result<(), FlashError> {
-        self.inner.read(addr, buf)
-    }
-    fn erase(&mut self, sector: u32) -> Result<(), FlashError> {
-        self.left = self.left.checked_sub(1).ok_or(FlashError::Device)?;
-        self.inner.erase(sector)
-    }
-    fn write(&mut self, addr: u32, data: &[u8]) -> Result<(), FlashError> {
-        self.left = self.left.checked_sub(1).ok_or(FlashError::Device)?;
-        self.inner.write(addr, data)
-    }
+    assert_eq!(check_slot_b(&mut mem), Err(ImageFault::NotBootable));
 }
 
 #[test]
@@ -221,10 +200,7 @@ fn a_power_cut_at_any_point_of_a_download_leaves_the_old_image_running() {
     for left in 0.. {
         let mut mem = region();
         factory(&mut mem);
-        let flash = Cut {
-            inner: Mem::new(&mut mem, NoMirror),
-            left,
-        };
+        let flash = PowerCut::after(Mem::new(&mut mem, NoMirror), left);
         let mut app = resume(flash, Slot::A);
         if install(&mut app, &f).is_ok() {
             break;
@@ -286,11 +262,7 @@ fn a_wrongly_signed_image_is_never_started() {
             (Slot::A, Some(Slot::B), None)
         );
     }
-    let mut s = slots(Mem::new(&mut mem, NoMirror));
-    assert_eq!(
-        check_image(&mut s, Slot::B, &L, &PUBLIC_KEY),
-        Err(ImageFault::Signature)
-    );
+    assert_eq!(check_slot_b(&mut mem), Err(ImageFault::Signature));
 }
 
 #[test]

@@ -58,3 +58,22 @@ impl Command {
         }
     }
 }
+
+/// The controlword a master writes to request each device-control command (spec §5.2,
+/// Tab. 5): the command's pattern with every other bit 0, as [`Command::decode`] reads it.
+pub mod controlword {
+    use super::{CW_ENABLE_OPERATION, CW_ENABLE_VOLTAGE, CW_FAULT_RESET, CW_QUICK_STOP, CW_SWITCH_ON};
+
+    /// Shutdown (transitions 2, 6, 8): `0x0006`.
+    pub const SHUTDOWN: u16 = CW_QUICK_STOP | CW_ENABLE_VOLTAGE;
+    /// Switch on (3), and Disable operation (5) in Operation enabled: `0x0007`.
+    pub const SWITCH_ON: u16 = SHUTDOWN | CW_SWITCH_ON;
+    /// Enable operation (4, 16; from Ready to switch on through Switched on): `0x000F`.
+    pub const ENABLE_OPERATION: u16 = SWITCH_ON | CW_ENABLE_OPERATION;
+    /// Disable voltage (7, 9, 10, 12): bit 1 clear, `0x0000`.
+    pub const DISABLE_VOLTAGE: u16 = 0;
+    /// Quick stop (7, 10, 11): bit 2 clear with bit 1 set, `0x0002`.
+    pub const QUICK_STOP: u16 = CW_ENABLE_VOLTAGE;
+    /// Fault reset (15, on the 0→1 edge of bit 7): `0x0080`; no command decodes while it is set.
+    pub const FAULT_RESET: u16 = CW_FAULT_RESET;
+}

@@ -33,8 +33,8 @@ mod options;
 mod state;
 
 pub use command::{
-    Command, CW_ENABLE_OPERATION, CW_ENABLE_VOLTAGE, CW_FAULT_RESET, CW_HALT, CW_MODE_BIT4, CW_MODE_BIT5,
-    CW_MODE_BIT6, CW_QUICK_STOP, CW_SWITCH_ON,
+    controlword, Command, CW_ENABLE_OPERATION, CW_ENABLE_VOLTAGE, CW_FAULT_RESET, CW_HALT, CW_MODE_BIT4,
+    CW_MODE_BIT5, CW_MODE_BIT6, CW_QUICK_STOP, CW_SWITCH_ON,
 };
 pub use machine::{DeviceControl, FaultEvent, Inputs, Options, Outputs, Ramp, SodCauses, Transition};
 pub use mode::{Mode, ModeClass, ModeError, SUPPORTED_DRIVE_MODES, SUPPORTED_JOG_BIT};

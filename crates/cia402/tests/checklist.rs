@@ -3,15 +3,9 @@
 //! general"). Tests without an item prefix check `[std]` behaviour the checklist does not
 //! list (halt, controlword decoding, instances).
 
+use cia402::controlword::{DISABLE_VOLTAGE, ENABLE_OPERATION, FAULT_RESET, QUICK_STOP, SHUTDOWN, SWITCH_ON};
 use cia402::*;
 use nanos::Nanos;
-
-const SHUTDOWN: u16 = 0x0006;
-const SWITCH_ON: u16 = 0x0007;
-const ENABLE: u16 = 0x000F;
-const DISABLE_VOLTAGE: u16 = 0x0000;
-const QUICK_STOP: u16 = 0x0002;
-const FAULT_RESET: u16 = 0x0080;
 
 /// One axis with inputs that allow everything: initialised, supply, A60, no STO, at
 /// standstill.
@@ -84,7 +78,7 @@ impl Rig {
             _ => &[
                 (SHUTDOWN, State::ReadyToSwitchOn),
                 (SWITCH_ON, State::SwitchedOn),
-                (ENABLE, State::OperationEnabled),
+                (ENABLE_OPERATION, State::OperationEnabled),
             ],
         };
         for &(cw, s) in path {
@@ -156,7 +150,7 @@ fn c002_shutdown_gives_ready_to_switch_on() {
     r.goto(State::SwitchOnDisabled);
     // Switch on / Enable operation are not Shutdown: no T2.
     assert_eq!(r.cw(SWITCH_ON).state, State::SwitchOnDisabled);
-    assert_eq!(r.cw(ENABLE).state, State::SwitchOnDisabled);
+    assert_eq!(r.cw(ENABLE_OPERATION).state, State::SwitchOnDisabled);
     // Bit 7 set: no command.
     assert_eq!(r.cw(SHUTDOWN | FAULT_RESET).state, State::SwitchOnDisabled);
     assert_eq!(r.cw(SHUTDOWN).state, State::ReadyToSwitchOn);
@@ -184,6 +178,26 @@ fn c002_controlword_decoding_masks() {
 }
 
 #[test]
+fn c002_the_controlword_constants_request_their_commands() {
+    for (cw, command) in [
+        (SHUTDOWN, Some(Command::Shutdown)),
+        (SWITCH_ON, Some(Command::SwitchOn)),
+        (ENABLE_OPERATION, Some(Command::EnableOperation)),
+        (DISABLE_VOLTAGE, Some(Command::DisableVoltage)),
+        (QUICK_STOP, Some(Command::QuickStop)),
+        (FAULT_RESET, None),
+    ] {
+        assert_eq!(Command::decode(cw), command, "cw {cw:#06x}");
+    }
+    // the patterns of Tab. 5 with every other bit 0
+    assert_eq!([SHUTDOWN, SWITCH_ON, ENABLE_OPERATION], [0x0006, 0x0007, 0x000F]);
+    assert_eq!(
+        [DISABLE_VOLTAGE, QUICK_STOP, FAULT_RESET],
+        [0x0000, 0x0002, 0x0080]
+    );
+}
+
+#[test]
 fn c003_no_transition_without_additional_enable() {
     // T2 blocked.
     let mut r = Rig::new();
@@ -198,11 +212,11 @@ fn c003_no_transition_without_additional_enable() {
 
     // T3, T4, T5, T6, T8 are not taken: losing A60 wins (T7, T10, T9).
     let cases: &[(State, u16, u8)] = &[
-        (State::ReadyToSwitchOn, SWITCH_ON, 7),  // T3
-        (State::SwitchedOn, ENABLE, 10),         // T4
-        (State::SwitchedOn, SHUTDOWN, 10),       // T6
-        (State::OperationEnabled, SWITCH_ON, 9), // T5
-        (State::OperationEnabled, SHUTDOWN, 9),  // T8
+        (State::ReadyToSwitchOn, SWITCH_ON, 7),    // T3
+        (State::SwitchedOn, ENABLE_OPERATION, 10), // T4
+        (State::SwitchedOn, SHUTDOWN, 10),         // T6
+        (State::OperationEnabled, SWITCH_ON, 9),   // T5
+        (State::OperationEnabled, SHUTDOWN, 9),    // T8
     ];
     for &(from, cw, number) in cases {
         let mut r = Rig::new();
@@ -228,7 +242,7 @@ fn c004_switch_on_gives_switched_on_and_power_stage() {
 fn c004_enable_operation_from_ready_takes_t3_then_t4() {
     let mut r = Rig::new();
     r.goto(State::ReadyToSwitchOn);
-    let out = r.cw(ENABLE);
+    let out = r.cw(ENABLE_OPERATION);
     assert_eq!(out.transition.map(|t| t.number), Some(3));
     let out = r.step();
     assert_eq!(out.transition.map(|t| t.number), Some(4));
@@ -238,14 +252,14 @@ fn c004_enable_operation_from_ready_takes_t3_then_t4() {
         ..Options::default()
     });
     r.goto(State::ReadyToSwitchOn);
-    assert_eq!(r.cw(ENABLE).state, State::ReadyToSwitchOn);
+    assert_eq!(r.cw(ENABLE_OPERATION).state, State::ReadyToSwitchOn);
 }
 
 #[test]
 fn c005_enable_operation_gives_operation_enabled() {
     let mut r = Rig::new();
     r.goto(State::SwitchedOn);
-    let out = r.cw(ENABLE);
+    let out = r.cw(ENABLE_OPERATION);
     assert_eq!(tr(&out), Some((4, State::SwitchedOn, State::OperationEnabled)));
     assert!(out.power_stage && out.drive_function && out.motion_enabled);
     assert_eq!(out.ramp, Ramp::None);
@@ -279,7 +293,7 @@ fn c006_disable_operation_option_codes() {
         assert!(out.drive_function && !out.motion_enabled);
     }
     // Enable operation again cancels the ramp.
-    let out = r.cw(ENABLE);
+    let out = r.cw(ENABLE_OPERATION);
     assert_eq!(out.ramp, Ramp::None);
     assert!(out.motion_enabled);
     r.cw(SWITCH_ON);
@@ -418,7 +432,7 @@ fn c010_quick_stop_option_codes() {
         });
         r.cw(QUICK_STOP);
         r.inp.standstill = true;
-        for cw in [QUICK_STOP, ENABLE, SHUTDOWN, SWITCH_ON] {
+        for cw in [QUICK_STOP, ENABLE_OPERATION, SHUTDOWN, SWITCH_ON] {
             let out = r.cw(cw);
             assert_eq!(out.state, State::QuickStopActive);
             assert_eq!(out.ramp, Ramp::QuickStop(*d));
@@ -438,7 +452,7 @@ fn c011_quick_stop_ends_in_switch_on_disabled_never_back() {
     r.goto(State::QuickStopActive);
     // Enable operation during the stop: no T16.
     for _ in 0..5 {
-        let out = r.cw(ENABLE);
+        let out = r.cw(ENABLE_OPERATION);
         assert_eq!(out.state, State::QuickStopActive);
         assert!(!out.motion_enabled);
     }
@@ -582,7 +596,7 @@ fn c016_fault_reaction_then_fault() {
         reaction: None,
     };
     r.dc.raise_fault(ev);
-    let out = r.cw(ENABLE);
+    let out = r.cw(ENABLE_OPERATION);
     assert_eq!(
         tr(&out),
         Some((13, State::OperationEnabled, State::FaultReactionActive))
@@ -591,7 +605,7 @@ fn c016_fault_reaction_then_fault() {
     assert!(out.power_stage && !out.motion_enabled);
     assert_eq!(out.fault, Some(ev));
     // Commands and reset edges do nothing during the reaction.
-    for cw in [ENABLE, DISABLE_VOLTAGE, FAULT_RESET, 0] {
+    for cw in [ENABLE_OPERATION, DISABLE_VOLTAGE, FAULT_RESET, 0] {
         assert_eq!(r.cw(cw).state, State::FaultReactionActive);
     }
     r.inp.standstill = true;
@@ -655,7 +669,7 @@ fn c016_fault_reaction_option_codes() {
             code: 0x5000,
             reaction: None,
         });
-        let out = r.cw(ENABLE);
+        let out = r.cw(ENABLE_OPERATION);
         assert_eq!(out.state, State::FaultReactionActive);
         match reaction {
             FaultReaction::Coast => {
@@ -753,7 +767,7 @@ fn c017_fault_reset_on_rising_edge_only() {
     let mut r = Rig::new();
     // Bit 7 already high when the fault comes: no edge.
     r.goto(State::OperationEnabled);
-    r.cw(ENABLE | FAULT_RESET);
+    r.cw(ENABLE_OPERATION | FAULT_RESET);
     r.dc.raise_fault(FaultEvent {
         code: 0x3210,
         reaction: Some(FaultReaction::Coast),
@@ -786,7 +800,10 @@ fn c017_fault_reset_bit_outside_fault_holds_state() {
     let mut r = Rig::new();
     r.goto(State::OperationEnabled);
     for _ in 0..3 {
-        assert_eq!(r.cw(ENABLE | FAULT_RESET).state, State::OperationEnabled);
+        assert_eq!(
+            r.cw(ENABLE_OPERATION | FAULT_RESET).state,
+            State::OperationEnabled
+        );
     }
 }
 
@@ -911,7 +928,7 @@ fn c021_brake_release_per_mode() {
         r.inp.mode_request = mode;
         r.goto(State::OperationEnabled);
         assert_eq!(r.step().mode_display, mode);
-        assert!(!r.cw(ENABLE | 0x10).brake_release, "mode {mode}: bit 4");
+        assert!(!r.cw(ENABLE_OPERATION | 0x10).brake_release, "mode {mode}: bit 4");
         r.inp.motion_command = true;
         assert!(r.step().brake_release, "mode {mode}");
         r.inp.motion_command = false;
@@ -924,8 +941,8 @@ fn c021_brake_release_per_mode() {
         r.goto(State::OperationEnabled);
         r.inp.motion_command = true;
         assert!(!r.step().brake_release, "mode {mode}: motion command");
-        assert!(r.cw(ENABLE | CW_MODE_BIT4).brake_release, "mode {mode}");
-        assert!(r.cw(ENABLE).brake_release, "mode {mode} stays released");
+        assert!(r.cw(ENABLE_OPERATION | CW_MODE_BIT4).brake_release, "mode {mode}");
+        assert!(r.cw(ENABLE_OPERATION).brake_release, "mode {mode} stays released");
     }
     // Jog: bit 4 or bit 5.
     for bit in [CW_MODE_BIT4, CW_MODE_BIT5] {
@@ -933,14 +950,14 @@ fn c021_brake_release_per_mode() {
         r.inp.mode_request = -1;
         r.goto(State::OperationEnabled);
         assert!(!r.step().brake_release);
-        assert!(r.cw(ENABLE | bit).brake_release);
+        assert!(r.cw(ENABLE_OPERATION | bit).brake_release);
     }
     // No mode: never.
     let mut r = Rig::new();
     r.inp.mode_request = 0;
     r.inp.motion_command = true;
     r.goto(State::OperationEnabled);
-    assert!(!r.cw(ENABLE | 0x70).brake_release);
+    assert!(!r.cw(ENABLE_OPERATION | 0x70).brake_release);
     // Leaving Operation enabled engages it.
     let mut r = Rig::new();
     r.inp.motion_command = true;
@@ -1027,7 +1044,7 @@ fn c024_no_motion_in_fault_or_quick_stop() {
         r.inp.motion_command = true;
         let out = r.goto(state);
         assert!(!out.motion_enabled, "{state:?}");
-        assert!(!r.cw(ENABLE | CW_MODE_BIT4).motion_enabled, "{state:?}");
+        assert!(!r.cw(ENABLE_OPERATION | CW_MODE_BIT4).motion_enabled, "{state:?}");
     }
     let mut r = Rig::new();
     assert!(r.goto(State::OperationEnabled).motion_enabled);
@@ -1175,16 +1192,16 @@ fn std_halt_option_codes() {
             });
             r.inp.mode_request = mode;
             r.goto(State::OperationEnabled);
-            let out = r.cw(ENABLE | CW_HALT);
+            let out = r.cw(ENABLE_OPERATION | CW_HALT);
             assert_eq!(out.ramp, Ramp::Halt(*d), "mode {mode}");
             assert_eq!(out.state, State::OperationEnabled);
-            assert_eq!(r.cw(ENABLE).ramp, Ramp::None);
+            assert_eq!(r.cw(ENABLE_OPERATION).ramp, Ramp::None);
         }
     }
     // Not in the cyclic modes.
     let mut r = Rig::new();
     r.goto(State::OperationEnabled);
-    assert_eq!(r.cw(ENABLE | CW_HALT).ramp, Ramp::None);
+    assert_eq!(r.cw(ENABLE_OPERATION | CW_HALT).ramp, Ramp::None);
 }
 
 #[test]
@@ -1199,7 +1216,7 @@ fn std_every_transition_reachable() {
     note(r.step()); // 1
     note(r.cw(SHUTDOWN)); // 2
     note(r.cw(SWITCH_ON)); // 3
-    note(r.cw(ENABLE)); // 4
+    note(r.cw(ENABLE_OPERATION)); // 4
     note(r.cw(SWITCH_ON)); // 5
     note(r.cw(SHUTDOWN)); // 6
     note(r.cw(DISABLE_VOLTAGE)); // 7
@@ -1208,14 +1225,14 @@ fn std_every_transition_reachable() {
     note(r.cw(DISABLE_VOLTAGE)); // 10
     r.cw(SHUTDOWN);
     r.cw(SWITCH_ON);
-    r.cw(ENABLE);
+    r.cw(ENABLE_OPERATION);
     note(r.cw(SHUTDOWN)); // 8
     r.cw(SWITCH_ON);
-    r.cw(ENABLE);
+    r.cw(ENABLE_OPERATION);
     note(r.cw(DISABLE_VOLTAGE)); // 9
     r.cw(SHUTDOWN);
     r.cw(SWITCH_ON);
-    r.cw(ENABLE);
+    r.cw(ENABLE_OPERATION);
     note(r.cw(QUICK_STOP)); // 11
     note(r.step()); // 12 (standstill)
     r.dc.raise_fault(FaultEvent::GENERIC);

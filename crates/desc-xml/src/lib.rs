@@ -1,6 +1,8 @@
 //! What the generators of the description files share (`crates/esi` for the
 //! EtherCAT ESI, `crates/gsdml` for the PROFINET GSDML): XML text escaping,
-//! and the drift check their tests run on the committed files.
+//! and the drift check their tests run on the committed files (also the one
+//! the generated Markdown references of `drive-core` and `drive-pn` run,
+//! [`check_file_current`]).
 #![deny(missing_docs)]
 
 use std::collections::BTreeSet;
@@ -28,30 +30,42 @@ pub fn escape(s: &str) -> String {
     out
 }
 
-/// The drift check: with the environment variable `update` set, writes
-/// `files` (name, text) into `dir` first; then every file must equal its
-/// generated text and `dir` must hold no other `.xml` (a stale file from an
-/// earlier declaration). `Err` says which file and how to regenerate
-/// (`command`).
+/// The drift check of one generated file, `dir`/`name`: with the environment
+/// variable `update` set, writes `text` there first; then the file must equal
+/// `text`. `Err` says which file and how to regenerate (`command`).
+pub fn check_file_current(
+    dir: &Path,
+    name: &str,
+    text: &str,
+    update: &str,
+    command: &str,
+) -> Result<(), String> {
+    if std::env::var_os(update).is_some() {
+        std::fs::create_dir_all(dir).map_err(|e| e.to_string())?;
+        std::fs::write(dir.join(name), text).map_err(|e| e.to_string())?;
+    }
+    let file = std::fs::read_to_string(dir.join(name)).unwrap_or_default();
+    if file != text {
+        let shown = dir.file_name().and_then(|n| n.to_str()).unwrap_or("?");
+        return Err(format!("{shown}/{name} is out of date: run {update}=1 {command}"));
+    }
+    Ok(())
+}
+
+/// The drift check of a folder of generated files: [`check_file_current`] for
+/// each of `files` (name, text) in `dir`, and `dir` must hold no other `.xml`
+/// (a stale file from an earlier declaration). `Err` says which file and how
+/// to regenerate (`command`).
 pub fn check_current(
     dir: &Path,
     files: &[(String, String)],
     update: &str,
     command: &str,
 ) -> Result<(), String> {
-    let shown = dir.file_name().and_then(|n| n.to_str()).unwrap_or("?");
-    if std::env::var_os(update).is_some() {
-        std::fs::create_dir_all(dir).map_err(|e| e.to_string())?;
-        for (name, text) in files {
-            std::fs::write(dir.join(name), text).map_err(|e| e.to_string())?;
-        }
-    }
     for (name, text) in files {
-        let file = std::fs::read_to_string(dir.join(name)).unwrap_or_default();
-        if &file != text {
-            return Err(format!("{shown}/{name} is out of date: run {update}=1 {command}"));
-        }
+        check_file_current(dir, name, text, update, command)?;
     }
+    let shown = dir.file_name().and_then(|n| n.to_str()).unwrap_or("?");
     let wanted: BTreeSet<&str> = files.iter().map(|(n, _)| n.as_str()).collect();
     for entry in std::fs::read_dir(dir).map_err(|e| e.to_string())? {
         let name = entry
@@ -108,6 +122,24 @@ mod tests {
         assert!(check_current(&dir, &files, "NO_SUCH_VAR_X", "cmd")
             .unwrap_err()
             .contains("not generated"));
+        std::fs::remove_dir_all(&dir).unwrap();
+    }
+
+    #[test]
+    fn drift_check_of_one_file_names_it_and_its_command() {
+        let dir = std::env::temp_dir().join(format!("generated-one-{}", std::process::id()));
+        let check = |text: &str| check_file_current(&dir, "a.md", text, "NO_SUCH_VAR_Y", "cargo test x");
+        assert!(check("text").is_err(), "no file yet");
+        std::fs::create_dir_all(&dir).unwrap();
+        std::fs::write(dir.join("a.md"), "text").unwrap();
+        assert_eq!(check("text"), Ok(()));
+        let shown = dir.file_name().unwrap().to_str().unwrap().to_string();
+        assert_eq!(
+            check("new text"),
+            Err(format!(
+                "{shown}/a.md is out of date: run NO_SUCH_VAR_Y=1 cargo test x"
+            ))
+        );
         std::fs::remove_dir_all(&dir).unwrap();
     }
 }

@@ -23,15 +23,10 @@ fn all_visible() -> DriveObjects {
 fn od_doc_is_current() {
     let mut text = String::new();
     doc::write_reference(&mut text).unwrap();
-    let path = concat!(env!("CARGO_MANIFEST_DIR"), "/../../docs/object-dictionary.md");
-    if std::env::var_os("UPDATE_OD_DOC").is_some() {
-        std::fs::write(path, &text).unwrap();
-    }
-    let file = std::fs::read_to_string(path).unwrap_or_default();
-    assert!(
-        file == text,
-        "docs/object-dictionary.md is out of date: run UPDATE_OD_DOC=1 cargo test -p drive-core od_doc_is_current"
-    );
+    let docs = std::path::Path::new(concat!(env!("CARGO_MANIFEST_DIR"), "/../../docs"));
+    let cmd = "cargo test -p drive-core od_doc_is_current";
+    let check = desc_xml::check_file_current(docs, "object-dictionary.md", &text, "UPDATE_OD_DOC", cmd);
+    assert_eq!(check, Ok(()));
 }
 
 #[test]

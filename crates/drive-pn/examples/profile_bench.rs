@@ -25,6 +25,7 @@ use drive_core::DriveObjects;
 use drive_pn::profile::Profile;
 use drive_pn::{settings, Hardware, PnDrive};
 use nanos::Nanos;
+use profidrive::telegram::{FbPositioning, FbSpeed, FbTorque, FB_RECEIVE_BYTES};
 use profinet::testing;
 use std::hint::black_box;
 use std::time::Instant;
@@ -38,42 +39,37 @@ const PROFILE_CYCLES: u32 = 20_000;
 /// Cycles per round of the whole drive.
 const DRIVE_CYCLES: u32 = 5_000;
 
+/// `write`'s telegram (one of `profidrive::telegram`'s builders).
+fn telegram(write: impl FnOnce(&mut [u8]) -> Option<usize>) -> [u8; FB_RECEIVE_BYTES] {
+    let mut t = [0u8; FB_RECEIVE_BYTES];
+    assert_eq!(write(&mut t), Some(FB_RECEIVE_BYTES));
+    t
+}
+
 /// Receive telegram 0 (positioning): homing method 34, CW1 0x0406, target
 /// 10000, profile velocity 5000, end velocity 0, all accelerations 10000,
 /// jog velocity 1000, PKW idle, current limit 2000 mA.
 fn telegram0() -> [u8; 36] {
-    let mut t = [0u8; 36];
-    t[0] = 0xE0;
-    t[1] = 34;
-    t[2..4].copy_from_slice(&0x0406u16.to_be_bytes());
-    t[4..8].copy_from_slice(&10_000i32.to_be_bytes());
-    t[8..12].copy_from_slice(&5_000i32.to_be_bytes());
-    t[16..20].copy_from_slice(&10_000u32.to_be_bytes());
-    t[20..24].copy_from_slice(&1_000i32.to_be_bytes());
-    t[32..36].copy_from_slice(&2_000i32.to_be_bytes());
-    t
+    let mut t = FbPositioning::default();
+    (t.homing_method, t.cw1, t.target, t.profile_velocity) = (34, 0x0406, 10_000, 5_000);
+    (t.accelerations, t.jog_velocity, t.current_limit) = (10_000, 1_000, 2_000);
+    telegram(|f| t.write(f))
 }
 
 /// Receive telegram 1 (speed) as `firmware-qemu-pn` sends it: CW1 0x0406,
 /// 100 rpm, all ramps 10000, the rest 0.
 fn telegram1() -> [u8; 36] {
-    let mut t = [0u8; 36];
-    t[0] = 0xE1;
-    t[2..4].copy_from_slice(&0x0406u16.to_be_bytes());
-    t[4..8].copy_from_slice(&100i32.to_be_bytes());
-    t[16..20].copy_from_slice(&10_000u32.to_be_bytes());
-    t
+    let mut t = FbSpeed::default();
+    (t.cw1, t.velocity, t.accelerations) = (0x0406, 100, 10_000);
+    telegram(|f| t.write(f))
 }
 
 /// Receive telegram 2 (torque): CW1 0x0406, 100 ‰ target torque, speed
 /// limit 3000.
 fn telegram2() -> [u8; 36] {
-    let mut t = [0u8; 36];
-    t[0] = 0xE2;
-    t[2..4].copy_from_slice(&0x0406u16.to_be_bytes());
-    t[4..6].copy_from_slice(&100i16.to_be_bytes());
-    t[32..36].copy_from_slice(&3_000i32.to_be_bytes());
-    t
+    let mut t = FbTorque::default();
+    (t.cw1, t.torque, t.speed_limit) = (0x0406, 100, 3_000);
+    telegram(|f| t.write(f))
 }
 
 /// The best of [`ROUNDS`] means of `f`'s ns per call over `n` calls.

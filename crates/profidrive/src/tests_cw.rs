@@ -169,18 +169,7 @@ fn p094_bits_14_and_15_are_ignored() {
 }
 
 fn status(state: State) -> Status {
-    Status {
-        state,
-        warning: false,
-        coast_stop: false,
-        quick_stop: false,
-        within_tolerance: false,
-        control_requested: false,
-        reached: false,
-        homed: false,
-        task_ack: false,
-        stopped: false,
-    }
+    Status::of(state)
 }
 
 #[test]

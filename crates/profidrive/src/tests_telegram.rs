@@ -489,3 +489,135 @@ fn p056_a_telegram_longer_than_the_longest_module_is_refused() {
     assert_eq!((err.entry, err.reason), (Some(9), Reason::TooLong));
     assert_eq!(*t.set(), FB_DEFAULTS);
 }
+
+/// `"e0220406 …"` as bytes.
+fn unhex(s: &str) -> std::vec::Vec<u8> {
+    let s: std::string::String = s.split_whitespace().collect();
+    (0..s.len())
+        .step_by(2)
+        .map(|i| u8::from_str_radix(&s[i..i + 2], 16).expect("hex"))
+        .collect()
+}
+
+#[test]
+fn p071_p072_p073_the_fb_receive_builders_fill_the_default_layouts_entry_by_entry() {
+    let mut f = Fake::drive();
+    let mut t = defaults(&f);
+    let mut frame = [0xAAu8; 40];
+    let pkw = [0x41, 0x04, 0x4C, 0, 0, 0, 0, 0];
+    let n = FbPositioning {
+        homing_method: -3,
+        cw1: 0x047F,
+        target: -5000,
+        profile_velocity: 1200,
+        end_velocity: 30,
+        accelerations: 40_000,
+        jog_velocity: -600,
+        pkw,
+        current_limit: 1500,
+    }
+    .write(&mut frame);
+    assert_eq!(n, Some(FB_RECEIVE_BYTES));
+    assert_eq!(frame[36..], [0xAA; 4], "nothing written past the telegram");
+    let r = t.apply_receive(&frame[..36], &mut f);
+    assert_eq!((r.telegram, r.cw1, r.pkw), (Some(0), Some(0x047F), Some(pkw)));
+    for (addr, v) in [
+        (a(1050, 0), -3),
+        (a(1001, 0), -5000),
+        (a(1001, 1), 1200),
+        (a(1001, 2), 30),
+        (a(1001, 5), 40_000),
+        (a(1040, 0), -600),
+        (a(0x2415, 2), 1500),
+    ] {
+        assert_eq!(f.value(addr), v, "{addr:?}");
+    }
+    let speed = FbSpeed {
+        cw1: 0x040F,
+        velocity: -250,
+        accelerations: 7000,
+        jog_velocity: 90,
+        pkw,
+        current_limit: 800,
+    };
+    assert_eq!(speed.write(&mut frame), Some(FB_RECEIVE_BYTES));
+    let r = t.apply_receive(&frame[..36], &mut f);
+    assert_eq!((r.telegram, r.cw1, r.pkw), (Some(1), Some(0x040F), Some(pkw)));
+    for (addr, v) in [
+        (a(1010, 0), -250),
+        (a(1011, 2), 7000),
+        (a(1040, 0), 90),
+        (a(0x2415, 2), 800),
+    ] {
+        assert_eq!(f.value(addr), v, "{addr:?}");
+    }
+    let torque = FbTorque {
+        cw1: 0x0407,
+        torque: -120,
+        pkw,
+        speed_limit: 2500,
+    };
+    assert_eq!(torque.write(&mut frame), Some(FB_RECEIVE_BYTES));
+    let r = t.apply_receive(&frame[..36], &mut f);
+    assert_eq!((r.telegram, r.cw1, r.pkw), (Some(2), Some(0x0407), Some(pkw)));
+    assert_eq!((f.value(a(0x6071, 0)), f.value(a(0x2416, 2))), (-120, 2500));
+    assert!(r.warnings.is_empty());
+    // placeholders carry 0 (P-064) whatever the buffer held
+    let mut frame = [0xAAu8; 36];
+    assert_eq!(speed.write(&mut frame), Some(FB_RECEIVE_BYTES));
+    assert_eq!((frame[1], &frame[8..16]), (0, &[0u8; 8][..]));
+    assert_eq!(torque.write(&mut frame), Some(FB_RECEIVE_BYTES));
+    assert_eq!((frame[1], &frame[6..24]), (0, &[0u8; 18][..]));
+    // a short buffer is refused and left as it was
+    let mut short = [0xAAu8; 35];
+    assert_eq!(FbPositioning::default().write(&mut short), None);
+    assert_eq!(speed.write(&mut short), None);
+    assert_eq!(torque.write(&mut short), None);
+    assert_eq!(short, [0xAA; 35]);
+}
+
+/// The frames the builders replaced, as their users wrote them byte by byte
+/// (`crates/drive-pn/examples/profile_bench.rs`, `firmware/src/bin/qemu_pn.rs`,
+/// the drive-pn profile tests' `speed` and `positioning`): the same bytes.
+#[test]
+fn p071_p072_p073_the_fb_receive_builders_give_the_frames_their_users_wrote_by_hand() {
+    let frame = |w: &dyn Fn(&mut [u8]) -> Option<usize>| {
+        let mut t = [0xAAu8; 36];
+        assert_eq!(w(&mut t), Some(36));
+        t.to_vec()
+    };
+    let (mut p, mut s, mut q) = (FbPositioning::default(), FbSpeed::default(), FbTorque::default());
+    // profile_bench's telegram0, telegram1, telegram2
+    (p.homing_method, p.cw1, p.target, p.profile_velocity) = (34, 0x0406, 10_000, 5_000);
+    (p.accelerations, p.jog_velocity, p.current_limit) = (10_000, 1_000, 2_000);
+    (s.cw1, s.velocity, s.accelerations) = (0x0406, 100, 10_000);
+    (q.cw1, q.torque, q.speed_limit) = (0x0406, 100, 3_000);
+    let bench = [
+        frame(&|t| p.write(t)),
+        frame(&|t| s.write(t)),
+        frame(&|t| q.write(t)),
+    ];
+    assert_eq!(
+        bench,
+        [
+            unhex("e0220406 00002710 00001388 00000000 00002710 000003e8 00000000 00000000 000007d0"),
+            unhex("e1000406 00000064 00000000 00000000 00002710 00000000 00000000 00000000 00000000"),
+            unhex("e2000406 00640000 00000000 00000000 00000000 00000000 00000000 00000000 00000bb8"),
+        ]
+    );
+    // qemu_pn's t0_pos and t2_torque (its t1_speed is the bench's telegram1)
+    (p.target, p.profile_velocity, p.jog_velocity, p.current_limit) = (5000, 1000, 0, 0);
+    (q.torque, q.speed_limit) = (0, 0);
+    let qemu = unhex("e0220406 00001388 000003e8 00000000 00002710 00000000 00000000 00000000 00000000");
+    assert_eq!(frame(&|t| p.write(t)), qemu);
+    let qemu = unhex("e2000406 00000000 00000000 00000000 00000000 00000000 00000000 00000000 00000000");
+    assert_eq!(frame(&|t| q.write(t)), qemu);
+    // the profile tests' speed(0x047F, -1500, 20000, pkw) and
+    // positioning(0x043F, -7, 3000, 250)
+    (s.cw1, s.velocity, s.accelerations, s.pkw) = (0x047F, -1500, 20_000, [1, 2, 3, 4, 5, 6, 7, 8]);
+    (p.cw1, p.target, p.profile_velocity, p.accelerations) = (0x043F, -7, 3000, 250);
+    let tests = unhex("e100047f fffffa24 00000000 00000000 00004e20 00000000 01020304 05060708 00000000");
+    assert_eq!(frame(&|t| s.write(t)), tests);
+    let tests = unhex("e022043f fffffff9 00000bb8 00000000 000000fa 00000000 00000000 00000000 00000000");
+    assert_eq!(frame(&|t| p.write(t)), tests);
+}

@@ -57,6 +57,25 @@ pub struct Status {
     pub stopped: bool,
 }
 
+impl Status {
+    /// A drive in `state` with no other flag set (no warning, stop, message or
+    /// acknowledgement): a start for a caller that sets the few it needs.
+    pub const fn of(state: State) -> Self {
+        Self {
+            state,
+            warning: false,
+            coast_stop: false,
+            quick_stop: false,
+            within_tolerance: false,
+            control_requested: false,
+            reached: false,
+            homed: false,
+            task_ack: false,
+            stopped: false,
+        }
+    }
+}
+
 /// The state mask (P-096).
 pub const STATE_MASK: u16 = 0x0047;
 /// Switching on inhibited.

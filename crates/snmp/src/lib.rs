@@ -679,5 +679,7 @@ pub fn message(
     w.close(top);
 }
 
+#[cfg(any(test, feature = "testing"))]
+pub mod testing;
 #[cfg(test)]
 mod tests;

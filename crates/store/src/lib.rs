@@ -19,7 +19,8 @@
 //! number arithmetic, so the u32 may wrap) whose layout matches.
 //!
 //! [`RamFlash`] is a RAM model of NOR flash with a power-cut injector for tests and the
-//! simulator.
+//! simulator; [`PowerCut`] puts a power-cut switch in front of any [`Flash`] (the boot
+//! loader's tests and `tools/flash-compose` cut their downloads with it).
 #![no_std]
 #![cfg_attr(
     not(test),
@@ -33,9 +34,11 @@
 #![deny(missing_docs)]
 
 mod crc;
+mod cut;
 mod ram;
 
 pub use crc::{crc32, Crc32};
+pub use cut::PowerCut;
 pub use ram::RamFlash;
 
 /// Largest program unit ([`Flash::WRITE`]) the store supports.

@@ -159,3 +159,23 @@ fn flash_errors_propagate() {
     assert_eq!(ram.write(3, &[0; 8]), Err(FlashError::Misaligned));
     assert_eq!(ram.erase(4), Err(FlashError::OutOfRange));
 }
+
+#[test]
+fn power_cut_fails_every_operation_after_its_budget_and_keeps_reads() {
+    let mut f = PowerCut::after(Ram::new(), 2);
+    assert_eq!(f.erase(0), Ok(()));
+    assert_eq!(f.write(0, &[0x5A; 8]), Ok(()));
+    assert_eq!(f.write(8, &[0x5A; 8]), Err(FlashError::Device));
+    assert_eq!(f.erase(1), Err(FlashError::Device));
+    let mut b = [0u8; 16];
+    assert_eq!(f.read(0, &mut b), Ok(()));
+    assert_eq!(b[..8], [0x5A; 8]);
+    assert_eq!(b[8..], [0xFF; 8]);
+    f.power_on();
+    assert_eq!(f.write(8, &[0x5A; 8]), Ok(()));
+    f.cut_after(0);
+    assert_eq!(f.erase(0), Err(FlashError::Device));
+    let mut plain = PowerCut::new(f.into_inner());
+    assert_eq!(plain.erase(0), Ok(()));
+    assert_eq!(plain.inner_mut().ops(), 4);
+}

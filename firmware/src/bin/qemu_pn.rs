@@ -29,6 +29,7 @@ use drive_pn::PnParamFlash as ParamFlash;
 use drive_pn::{Hardware, PnDrive};
 use firmware::systick::{now as now_ticks, ticks};
 use nanos::Nanos;
+use profidrive::telegram::{FbPositioning, FbSpeed, FbTorque, FB_RECEIVE_BYTES};
 use profinet::cm::CmEvent;
 use profinet::device::{DeviceEvent, RtEvent};
 use profinet::testing;
@@ -118,6 +119,43 @@ fn build(slot: &mut core::mem::MaybeUninit<Drive>, flash: ParamFlash) -> &mut Dr
     Drive::init(slot, flash, hardware())
 }
 
+/// The receive telegrams the measurement sends (CW1 0x0406 each): 0
+/// positioning (target 5000, profile velocity 1000, accelerations 10000),
+/// 2 torque (no bound mode), 1 speed (100 rpm, ramps 10000). Built out of
+/// line: `main`'s stack holds only the three frames.
+#[inline(never)]
+fn telegrams() -> (
+    [u8; FB_RECEIVE_BYTES],
+    [u8; FB_RECEIVE_BYTES],
+    [u8; FB_RECEIVE_BYTES],
+) {
+    let mut t0_pos = [0u8; FB_RECEIVE_BYTES];
+    let _ = FbPositioning {
+        homing_method: 34,
+        cw1: 0x0406,
+        target: 5000,
+        profile_velocity: 1000,
+        accelerations: 10_000,
+        ..FbPositioning::default()
+    }
+    .write(&mut t0_pos);
+    let mut t2_torque = [0u8; FB_RECEIVE_BYTES];
+    let _ = FbTorque {
+        cw1: 0x0406,
+        ..FbTorque::default()
+    }
+    .write(&mut t2_torque);
+    let mut t1_speed = [0u8; FB_RECEIVE_BYTES];
+    let _ = FbSpeed {
+        cw1: 0x0406,
+        velocity: 100,
+        accelerations: 10_000,
+        ..FbSpeed::default()
+    }
+    .write(&mut t1_speed);
+    (t0_pos, t2_torque, t1_speed)
+}
+
 #[entry]
 fn main() -> ! {
     let Some(mut cp) = cortex_m::Peripherals::take() else {
@@ -197,21 +235,7 @@ fn run(insn: impl Fn(u32) -> u32) -> bool {
     // Example Function block (CW1 0x0406 each): 0 positioning (target,
     // velocities, accelerations), 1 speed (100 rpm, ramps), 2 torque (no
     // bound mode); telegram 1 last, so its answer is the one checked
-    let mut t0_pos = [0u8; 36];
-    t0_pos[0] = 0xE0;
-    t0_pos[1] = 34;
-    t0_pos[2..4].copy_from_slice(&0x0406u16.to_be_bytes());
-    t0_pos[4..8].copy_from_slice(&5000i32.to_be_bytes());
-    t0_pos[8..12].copy_from_slice(&1000i32.to_be_bytes());
-    t0_pos[16..20].copy_from_slice(&10_000u32.to_be_bytes());
-    let mut t2_torque = [0u8; 36];
-    t2_torque[0] = 0xE2;
-    t2_torque[2..4].copy_from_slice(&0x0406u16.to_be_bytes());
-    let mut t1_speed = [0u8; 36];
-    t1_speed[0] = 0xE1;
-    t1_speed[2..4].copy_from_slice(&0x0406u16.to_be_bytes());
-    t1_speed[4..8].copy_from_slice(&100i32.to_be_bytes());
-    t1_speed[16..20].copy_from_slice(&10_000u32.to_be_bytes());
+    let (t0_pos, t2_torque, t1_speed) = telegrams();
     // the telegram runs at the fastest settings: A150 = 250 us, four
     // control cycles per 1 ms send cycle, one of them with a new telegram
     let _ = d

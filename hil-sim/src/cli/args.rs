@@ -397,6 +397,19 @@ pub fn create_output(path: &Path, what: &str) -> Result<File, String> {
     File::create(path).map_err(|e| format!("cannot write the {what} {}: {e}", path.display()))
 }
 
+/// The plot's path: `given` (`--plot`), else `default` in cargo's target
+/// directory, which is made if missing.
+pub fn plot_path_or(given: &Option<PathBuf>, default: &str) -> Result<PathBuf, String> {
+    if let Some(p) = given {
+        return Ok(p.clone());
+    }
+    let p = PathBuf::from(default);
+    if let Some(dir) = p.parent() {
+        std::fs::create_dir_all(dir).map_err(|e| format!("cannot create {}: {e}", dir.display()))?;
+    }
+    Ok(p)
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;

@@ -2,13 +2,12 @@
 //! time) brings one simulated drive to OP, enables axis A in csp, homes it on
 //! its reference switch, runs a csp profile and writes a plot of the run.
 
-use super::args::{create_output, DemoArgs, Plant, DEFAULT_PLOT};
+use super::args::{create_output, plot_path_or, DemoArgs, Plant, DEFAULT_PLOT};
 use super::print_new_changes;
 use hil_sim::motor::PositionInput;
 use hil_sim::sim::Simulation;
 use nanos::Nanos;
 use std::cell::RefCell;
-use std::path::PathBuf;
 use std::sync::atomic::Ordering;
 
 /// Position of axis A's reference switch, increments (a quarter revolution).
@@ -224,17 +223,7 @@ pub fn demo(args: &DemoArgs) -> Result<(), String> {
             .map_err(|e| format!("cannot write the pcap file {}: {e}", p.display()))?;
         println!("recording frames to {}", p.display());
     }
-    let plot_path = match &args.plot {
-        Some(p) => p.clone(),
-        None => {
-            // the default lives in cargo's target directory; make it if missing
-            let p = PathBuf::from(DEFAULT_PLOT);
-            if let Some(dir) = p.parent() {
-                std::fs::create_dir_all(dir).map_err(|e| format!("cannot create {}: {e}", dir.display()))?;
-            }
-            p
-        }
-    };
+    let plot_path = plot_path_or(&args.plot, DEFAULT_PLOT)?;
     let mut plot_file = Some(create_output(&plot_path, "plot")?);
     {
         // the reference switch of axis A, a quarter revolution out

@@ -7,14 +7,13 @@
 //! the plot shows position, velocity, torque, following error and the ZSW1
 //! state with the phases marked.
 
-use super::args::{create_output, DemoArgs, Plant, DEFAULT_PLOT_PN};
+use super::args::{create_output, plot_path_or, DemoArgs, Plant, DEFAULT_PLOT_PN};
 use hil_sim::fb::sequence::{self, Observer, Options, Phase, Report, Sample, INC_PER_REV};
 use hil_sim::fb::{state_name, zsw1_state};
 use hil_sim::pcap::Recording;
 use hil_sim::plot::Trace;
 use nanos::Nanos;
 use profidrive::zsw1::{OP, RTSO, SO};
-use std::path::PathBuf;
 
 /// Prints lines above a progress bar (one step per phase) and keeps the
 /// trace for the plot.
@@ -152,16 +151,7 @@ pub fn demo(args: &DemoArgs) -> Result<(), String> {
         }
         None => None,
     };
-    let plot_path = match &args.plot {
-        Some(p) => p.clone(),
-        None => {
-            let p = PathBuf::from(DEFAULT_PLOT_PN);
-            if let Some(dir) = p.parent() {
-                std::fs::create_dir_all(dir).map_err(|e| format!("cannot create {}: {e}", dir.display()))?;
-            }
-            p
-        }
-    };
+    let plot_path = plot_path_or(&args.plot, DEFAULT_PLOT_PN)?;
     let options = Options {
         plant: args.plant().into(),
         self_tune: args.self_tune,

@@ -207,16 +207,8 @@ fn p220_p219_the_response_telegram_becomes_the_outputs() {
 
 fn status(state: State) -> Status {
     Status {
-        state,
-        warning: false,
-        coast_stop: false,
-        quick_stop: false,
-        within_tolerance: false,
         control_requested: true,
-        reached: false,
-        homed: false,
-        task_ack: false,
-        stopped: false,
+        ..Status::of(state)
     }
 }
 

@@ -23,7 +23,7 @@
 //! it already, `BootSlots::finish_verified`).
 #![forbid(unsafe_code)]
 
-use boot::{BootSlots, Flash, FlashError, Slot};
+use boot::{BootSlots, Flash, PowerCut, Slot};
 use bootloader::{
     mps2, select, slot_name, state_name, xmc4800, Layout, MemFlash, NoMirror, Outcome, PUBLIC_KEY,
 };
@@ -80,42 +80,6 @@ impl Target {
             Target::Mps2 => mps2::SLOTS_BASE as usize,
             // S0..S1: the rest of the first physical sector is not the boot loader's
             Target::Xmc4800 => 32 * 1024,
-        }
-    }
-}
-
-/// The slot region's flash with a power-cut switch.
-struct Cuttable<F> {
-    flash: F,
-    left: Option<u32>,
-}
-
-impl<F: Flash> Flash for Cuttable<F> {
-    const SECTOR: usize = F::SECTOR;
-    const SECTORS: usize = F::SECTORS;
-    const WRITE: usize = F::WRITE;
-    fn read(&mut self, addr: u32, buf: &mut [u8]) -> Result<(), FlashError> {
-        self.flash.read(addr, buf)
-    }
-    fn erase(&mut self, sector: u32) -> Result<(), FlashError> {
-        self.spend()?;
-        self.flash.erase(sector)
-    }
-    fn write(&mut self, addr: u32, data: &[u8]) -> Result<(), FlashError> {
-        self.spend()?;
-        self.flash.write(addr, data)
-    }
-}
-
-impl<F> Cuttable<F> {
-    fn spend(&mut self) -> Result<(), FlashError> {
-        match self.left {
-            Some(0) => Err(FlashError::Device),
-            Some(n) => {
-                self.left = Some(n - 1);
-                Ok(())
-            }
-            None => Ok(()),
         }
     }
 }
@@ -217,7 +181,7 @@ fn run_steps<F: Flash + Bytes>(
     steps: &[Step],
     log: &mut dyn FnMut(String),
 ) -> Result<(), String> {
-    let mut slots = BootSlots::with_base(Cuttable { flash, left: None }, layout.region_xip);
+    let mut slots = BootSlots::with_base(PowerCut::new(flash), layout.region_xip);
     let mut last = None;
     for step in steps {
         match step {
@@ -232,7 +196,7 @@ fn run_steps<F: Flash + Bytes>(
             }
             Step::Reset => {
                 let mut s = BootSlots::with_base(slots.into_inner(), layout.region_xip);
-                s.flash_mut().left = None;
+                s.flash_mut().power_on();
                 match select(&mut s, layout, &PUBLIC_KEY) {
                     Outcome::Start(st) => {
                         log(format!("reset: slot {} starts", slot_name(st.slot)));
@@ -256,7 +220,7 @@ fn run_steps<F: Flash + Bytes>(
                 let i = slot.index() * BootSlots::<F>::slot_len() + BootSlots::<F>::body_offset() + at;
                 let b = slots
                     .flash_mut()
-                    .flash
+                    .inner_mut()
                     .bytes_mut()
                     .get_mut(i)
                     .ok_or("flip: offset outside the slot")?;
@@ -264,7 +228,7 @@ fn run_steps<F: Flash + Bytes>(
                 log(format!("flip: slot {} body byte {at}", slot_name(slot)));
             }
             Step::Cut(file, n) => {
-                slots.flash_mut().left = Some(*n);
+                slots.flash_mut().cut_after(*n);
                 let slot = slots.inactive();
                 let (sent, r) = download_counted(&mut slots, file);
                 match r {

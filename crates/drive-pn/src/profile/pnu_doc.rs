@@ -82,13 +82,8 @@ pub fn render() -> Result<String, core::fmt::Error> {
 #[test]
 fn pnu_doc_is_current() {
     let text = render().unwrap();
-    let path = concat!(env!("CARGO_MANIFEST_DIR"), "/../../docs/pnu.md");
-    if std::env::var_os("UPDATE_PNU_DOC").is_some() {
-        std::fs::write(path, &text).unwrap();
-    }
-    let file = std::fs::read_to_string(path).unwrap_or_default();
-    assert!(
-        file == text,
-        "docs/pnu.md is out of date: run UPDATE_PNU_DOC=1 cargo test -p drive-pn pnu_doc_is_current"
-    );
+    let docs = std::path::Path::new(concat!(env!("CARGO_MANIFEST_DIR"), "/../../docs"));
+    let cmd = "cargo test -p drive-pn pnu_doc_is_current";
+    let check = desc_xml::check_file_current(docs, "pnu.md", &text, "UPDATE_PNU_DOC", cmd);
+    assert_eq!(check, Ok(()));
 }

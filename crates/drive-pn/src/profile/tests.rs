@@ -6,6 +6,7 @@ use crate::tests::{drive, TestFlash};
 use crate::PnDrive;
 use drive_core::axis::{AxisCommand, AxisIo};
 use nanos::Nanos;
+use profidrive::telegram::{FbPositioning, FbSpeed, FB_RECEIVE_BYTES};
 use profinet::wire::EthFrame;
 use std::vec::Vec;
 
@@ -126,28 +127,38 @@ impl Bench {
     }
 }
 
-/// Receive telegram 1 (speed): CW1, target velocity, all ramps, PKW.
-pub(super) fn speed(cw1: u16, rpm: i32, ramps: u32, pkw: [u8; 8]) -> [u8; 36] {
+/// A receive telegram of the Example Function block, written by one of
+/// `profidrive::telegram`'s builders (`FbPositioning`, `FbSpeed`, `FbTorque`).
+pub(super) fn frame(write: impl FnOnce(&mut [u8]) -> Option<usize>) -> [u8; 36] {
     let mut t = [0u8; 36];
-    t[0] = 0xE1;
-    t[2..4].copy_from_slice(&cw1.to_be_bytes());
-    t[4..8].copy_from_slice(&rpm.to_be_bytes());
-    t[16..20].copy_from_slice(&ramps.to_be_bytes());
-    t[24..32].copy_from_slice(&pkw);
+    assert_eq!(write(&mut t), Some(FB_RECEIVE_BYTES));
     t
 }
 
-/// Receive telegram 0 (positioning): homing method, CW1, target, profile
-/// velocity, end velocity, all accelerations.
+/// Receive telegram 1 (speed): CW1, target velocity, all ramps, PKW.
+pub(super) fn speed(cw1: u16, rpm: i32, ramps: u32, pkw: [u8; 8]) -> [u8; 36] {
+    let t = FbSpeed {
+        cw1,
+        velocity: rpm,
+        accelerations: ramps,
+        pkw,
+        ..FbSpeed::default()
+    };
+    frame(|f| t.write(f))
+}
+
+/// Receive telegram 0 (positioning): homing method 34 (PNU 1050: the
+/// current position), CW1, target, profile velocity, all accelerations.
 fn positioning(cw1: u16, target: i32, velocity: i32, accelerations: u32) -> [u8; 36] {
-    let mut t = [0u8; 36];
-    t[0] = 0xE0;
-    t[1] = 34u8; // PNU 1050: method 34 (current position)
-    t[2..4].copy_from_slice(&cw1.to_be_bytes());
-    t[4..8].copy_from_slice(&target.to_be_bytes());
-    t[8..12].copy_from_slice(&velocity.to_be_bytes());
-    t[16..20].copy_from_slice(&accelerations.to_be_bytes());
-    t
+    let t = FbPositioning {
+        homing_method: 34,
+        cw1,
+        target,
+        profile_velocity: velocity,
+        accelerations,
+        ..FbPositioning::default()
+    };
+    frame(|f| t.write(f))
 }
 
 #[test]
@@ -519,13 +530,17 @@ fn p071_telegram_0_stores_its_record_fields_and_the_window_shows_them() {
     let mut profile = super::Profile::new(&mut od, &axis);
     let mut seen = Vec::new();
     for (target, velocity, end, acc) in [(10_000i32, 5_000i32, 0i32, 10_000u32), (-2_000, 700, 100, 300)] {
-        let mut t = [0u8; 36];
-        t[0] = 0xE0;
-        t[2..4].copy_from_slice(&0x0406u16.to_be_bytes());
-        t[4..8].copy_from_slice(&target.to_be_bytes());
-        t[8..12].copy_from_slice(&velocity.to_be_bytes());
-        t[12..16].copy_from_slice(&end.to_be_bytes());
-        t[16..20].copy_from_slice(&acc.to_be_bytes());
+        let t = frame(|f| {
+            FbPositioning {
+                cw1: 0x0406,
+                target,
+                profile_velocity: velocity,
+                end_velocity: end,
+                accelerations: acc,
+                ..FbPositioning::default()
+            }
+            .write(f)
+        });
         profile.receive(&t, &mut od, &mut axis);
         let n = od.record_selector(0);
         let r = od.record(0, n).unwrap();

@@ -7,11 +7,12 @@
 //! telegrams 0, 1 and 2, frames the telegram refuses or does not know, a
 //! unit change (A279) and a telegram configured over PKW between frames.
 
+use super::tests::frame;
 use super::Profile;
 use drive_core::axis::Axis;
 use drive_core::params::A279;
 use drive_core::DriveObjects;
-use profidrive::telegram::Dir;
+use profidrive::telegram::{Dir, FbPositioning, FbSpeed, FbTorque};
 use profidrive::Addr;
 use std::format;
 use std::string::String;
@@ -91,36 +92,42 @@ fn pkw(code: u8, pnu: u16, sub: u8, value: u32) -> [u8; 8] {
 /// Telegram 0: homing method, CW1, target, profile and end velocity, both
 /// accelerations, jog velocity, PKW, current limit.
 fn t0(cw1: u16, target: i32, v: i32, end: i32, acc: u32, jog: i32, p: [u8; 8]) -> [u8; 36] {
-    let mut t = [0u8; 36];
-    t[0] = 0xE0;
-    t[1] = 34;
-    t[2..4].copy_from_slice(&cw1.to_be_bytes());
-    t[4..8].copy_from_slice(&target.to_be_bytes());
-    t[8..12].copy_from_slice(&v.to_be_bytes());
-    t[12..16].copy_from_slice(&end.to_be_bytes());
-    t[16..20].copy_from_slice(&acc.to_be_bytes());
-    t[20..24].copy_from_slice(&jog.to_be_bytes());
-    t[24..32].copy_from_slice(&p);
-    t[32..36].copy_from_slice(&1500i32.to_be_bytes());
-    t
+    let t = FbPositioning {
+        homing_method: 34,
+        cw1,
+        target,
+        profile_velocity: v,
+        end_velocity: end,
+        accelerations: acc,
+        jog_velocity: jog,
+        pkw: p,
+        current_limit: 1500,
+    };
+    frame(|f| t.write(f))
 }
 
-/// Telegram 1 ([`super::tests::speed`]) with jog velocity 300.
+/// Telegram 1 (as [`super::tests::speed`]) with jog velocity 300.
 fn t1(cw1: u16, rpm: i32, ramps: u32, p: [u8; 8]) -> [u8; 36] {
-    let mut t = super::tests::speed(cw1, rpm, ramps, p);
-    t[20..24].copy_from_slice(&300i32.to_be_bytes());
-    t
+    let t = FbSpeed {
+        cw1,
+        velocity: rpm,
+        accelerations: ramps,
+        jog_velocity: 300,
+        pkw: p,
+        current_limit: 0,
+    };
+    frame(|f| t.write(f))
 }
 
 /// Telegram 2: CW1, target torque, PKW, speed limit.
 fn t2(cw1: u16, torque: i16, p: [u8; 8]) -> [u8; 36] {
-    let mut t = [0u8; 36];
-    t[0] = 0xE2;
-    t[2..4].copy_from_slice(&cw1.to_be_bytes());
-    t[4..6].copy_from_slice(&torque.to_be_bytes());
-    t[24..32].copy_from_slice(&p);
-    t[32..36].copy_from_slice(&2000i32.to_be_bytes());
-    t
+    let t = FbTorque {
+        cw1,
+        torque,
+        pkw: p,
+        speed_limit: 2000,
+    };
+    frame(|f| t.write(f))
 }
 
 /// Telegram 3 as configured below: CW1, target velocity.

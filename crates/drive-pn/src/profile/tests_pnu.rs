@@ -2,9 +2,10 @@
 //! (PNUs and CANopen objects in one index space), in which units, and what
 //! survives a restart.
 
-use super::{pkw_request, positioning, speed, Bench};
+use super::{frame, pkw_request, positioning, speed, Bench};
 use crate::tests::TestFlash;
 use crate::PnDrive;
+use profidrive::telegram::FbTorque;
 
 impl Bench {
     /// A PKW request in the receive telegram `t` after the 0x00 toggle: the
@@ -343,9 +344,13 @@ fn p214_canopen_objects_use_their_factor_group_pnus_the_profinet_units() {
 /// A PKW request in receive telegram 2, which maps no jog entry (telegrams
 /// 0 and 1 write 1040.0 every cycle).
 pub(super) fn pkw2(b: &mut Bench, code: u8, index: u16, sub: u8, value: u32) -> (u8, i32) {
-    let mut t = [0u8; 36];
-    t[0] = 0xE2;
-    t[2..4].copy_from_slice(&0x0400u16.to_be_bytes());
+    let t = frame(|f| {
+        FbTorque {
+            cw1: 0x0400,
+            ..FbTorque::default()
+        }
+        .write(f)
+    });
     b.pkw_in(t, code, index, sub, value)
 }
 

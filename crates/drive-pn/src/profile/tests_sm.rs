@@ -2,7 +2,8 @@
 //! from its source state), the mode PNU 1500 and the status PNUs 967/968,
 //! through the drive's telegrams.
 
-use super::{pkw_request, positioning, speed, Bench};
+use super::{frame, pkw_request, positioning, speed, Bench};
+use profidrive::telegram::FbTorque;
 
 /// ZSW1's state bits.
 const STATE: u16 = 0x0047;
@@ -158,9 +159,13 @@ fn p127_p128_p055_pnu_1500_reports_and_switches_the_mode() {
     assert_eq!(b.pkw0(0x41, 1500, 0, 0), (0x41, 0x10));
     assert_eq!(b.pkw_read(1500, 0, 0x0400), (0x41, 0x08));
     // telegram 2 keeps the mode; PKW writes 0x04
-    let mut t = [0u8; 36];
-    t[0] = 0xE2;
-    t[2..4].copy_from_slice(&0x0400u16.to_be_bytes());
+    let mut t = frame(|f| {
+        FbTorque {
+            cw1: 0x0400,
+            ..FbTorque::default()
+        }
+        .write(f)
+    });
     b.run(&t, 10);
     assert_eq!(b.response[0], 0xF2);
     assert_eq!(b.response[1], 0x08, "telegram 2 has no bound mode");
@@ -387,13 +392,13 @@ fn p218_c017_acknowledge_fails_while_the_cause_persists() {
 /// Receive telegram 2 (torque): CW1, target torque 6071h (‰), PKW, the
 /// speed limit 2416h.02 (the PROFINET velocity unit: rpm).
 fn torque(cw1: u16, per_mille: i16, limit: i32, pkw: [u8; 8]) -> [u8; 36] {
-    let mut t = [0u8; 36];
-    t[0] = 0xE2;
-    t[2..4].copy_from_slice(&cw1.to_be_bytes());
-    t[4..6].copy_from_slice(&per_mille.to_be_bytes());
-    t[24..32].copy_from_slice(&pkw);
-    t[32..36].copy_from_slice(&limit.to_be_bytes());
-    t
+    let t = FbTorque {
+        cw1,
+        torque: per_mille,
+        pkw,
+        speed_limit: limit,
+    };
+    frame(|f| t.write(f))
 }
 
 impl Bench {

@@ -15,6 +15,9 @@
 //!   CW1 and the PKW request; the caller runs the PKW step and applies CW1
 //!   last (spec §4.3, P-066). [`Telegrams::build_response`] packs the
 //!   associated response telegram.
+//! - [`fb_receive`]: the Example Function block's receive telegrams 0…2 as a
+//!   controller writes them ([`FbPositioning`], [`FbSpeed`], [`FbTorque`]),
+//!   for the host side (benchmarks, tests, the QEMU runs).
 //!
 //! Rules (spec §4.2): in receive telegrams 0…2 CW1 (967.0) sits at offset 2
 //! and in response telegrams 0…2 ZSW1 (968.0), so byte 1 is one 1-byte entry
@@ -31,10 +34,12 @@ use crate::{int_size, Addr, DataType, ParamAccess, PdError};
 pub mod compiled;
 pub mod cyclic;
 mod defaults;
+pub mod fb_receive;
 mod serial;
 
 pub use cyclic::{ModeBinding, RxOutcome, TxOutcome, Warnings};
 pub use defaults::FB_DEFAULTS;
+pub use fb_receive::{FbPositioning, FbSpeed, FbTorque, FB_RECEIVE_BYTES};
 pub use serial::{FormatError, MAX_SERIAL_BYTES};
 
 /// Entries per telegram (the identifier not counted, P-056).
