@@ -3,22 +3,11 @@
 
 use hil_sim::sim::Simulation;
 
-/// One datagram frame: Ethernet + EtherCAT header + datagram + WKC.
+/// One datagram frame: Ethernet + EtherCAT header + datagram + WKC, the
+/// data cut to 1,400 bytes.
 pub fn frame(cmd: u8, adp: u16, ado: u16, data: &[u8]) -> Vec<u8> {
-    let mut f = vec![0xFF; 6];
-    f.extend_from_slice(&[0x10; 6]);
-    f.extend_from_slice(&0x88A4u16.to_be_bytes());
-    let len = data.len().min(1400);
-    f.extend_from_slice(&((10 + len + 2) as u16 | 0x1000).to_le_bytes());
-    f.push(cmd);
-    f.push(0);
-    f.extend_from_slice(&adp.to_le_bytes());
-    f.extend_from_slice(&ado.to_le_bytes());
-    f.extend_from_slice(&(len as u16).to_le_bytes());
-    f.extend_from_slice(&0u16.to_le_bytes());
-    f.extend_from_slice(&data[..len]);
-    f.extend_from_slice(&0u16.to_le_bytes());
-    f
+    let data = &data[..data.len().min(1400)];
+    hil_sim::sim::datagram_frame([0x10; 6], cmd, 0, adp, ado, data, 0)
 }
 
 /// APWR (auto-increment write) to the first slave.

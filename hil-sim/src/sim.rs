@@ -6,6 +6,7 @@ use crate::esc::{Esc, EscConfig, LineTiming};
 use crate::frame::process_frame;
 use crate::motor::{Motor, MotorOutputs};
 mod axis_io;
+mod datagram;
 mod flash;
 mod plant;
 pub mod profile;
@@ -15,6 +16,7 @@ mod variant;
 
 use crate::pcap::Recording;
 pub(crate) use axis_io::axis_io;
+pub use datagram::{datagram_frame, MIN_FRAME_LEN};
 pub use flash::{firmware_body, FirmwareFlash, FirmwareSlots, SimFlash};
 use nanos::Nanos;
 pub use stamps::{CycleStamp, LockLoss, PllLock, Sync0Stamp};

@@ -8,18 +8,7 @@ use nanos::Nanos;
 
 /// One datagram frame to the first slave (`cmd` 2 APWR, 4 FPRD, 5 FPWR).
 fn frame(cmd: u8, adp: u16, ado: u16, data: &[u8]) -> Vec<u8> {
-    let mut f = vec![0xFF; 6];
-    f.extend_from_slice(&[0x10; 6]);
-    f.extend_from_slice(&0x88A4u16.to_be_bytes());
-    f.extend_from_slice(&((10 + data.len() + 2) as u16 | 0x1000).to_le_bytes());
-    f.extend_from_slice(&[cmd, 0]);
-    f.extend_from_slice(&adp.to_le_bytes());
-    f.extend_from_slice(&ado.to_le_bytes());
-    f.extend_from_slice(&(data.len() as u16).to_le_bytes());
-    f.extend_from_slice(&[0, 0]);
-    f.extend_from_slice(data);
-    f.extend_from_slice(&[0, 0]);
-    f
+    hil_sim::sim::datagram_frame([0x10; 6], cmd, 0, adp, ado, data, 0)
 }
 
 fn send(sim: &mut Simulation, cmd: u8, adp: u16, ado: u16, data: &[u8]) -> Vec<u8> {

@@ -248,20 +248,9 @@ fn second_master_write(
     ado: u16,
     data: &[u8],
 ) -> u16 {
-    let mut f = vec![0xFF; 6];
-    f.extend_from_slice(&[0x02, 0, 0, 0, 0, 0x99]); // the second master's MAC
-    f.extend_from_slice(&0x88A4u16.to_be_bytes());
-    f.extend_from_slice(&((10 + data.len() as u16 + 2) | 0x1000).to_le_bytes());
-    f.extend_from_slice(&[5, 0x42]); // FPWR, index
-    f.extend_from_slice(&station.to_le_bytes());
-    f.extend_from_slice(&ado.to_le_bytes());
-    f.extend_from_slice(&(data.len() as u16).to_le_bytes());
-    f.extend_from_slice(&[0, 0]);
-    f.extend_from_slice(data);
-    f.extend_from_slice(&[0, 0]);
-    while f.len() < 60 {
-        f.push(0);
-    }
+    // the second master's MAC; FPWR, index 0x42
+    let mac = [0x02, 0, 0, 0, 0, 0x99];
+    let mut f = hil_sim::sim::datagram_frame(mac, 5, 0x42, station, ado, data, hil_sim::sim::MIN_FRAME_LEN);
     sim.borrow_mut().exchange(&mut f);
     let w = 16 + 10 + data.len();
     u16::from_le_bytes([f[w], f[w + 1]])
