@@ -178,8 +178,7 @@ impl<'a> Writer<'a> {
             Endian::Big => v.to_be_bytes(),
             Endian::Little => v.to_le_bytes(),
         };
-        self.buf.get_mut(at..at.checked_add(2)?)?.copy_from_slice(&b);
-        Some(())
+        self.patch(at, b)
     }
 
     /// Overwrites a u32 at `at` (already written), in the cursor's order.
@@ -188,7 +187,12 @@ impl<'a> Writer<'a> {
             Endian::Big => v.to_be_bytes(),
             Endian::Little => v.to_le_bytes(),
         };
-        self.buf.get_mut(at..at.checked_add(4)?)?.copy_from_slice(&b);
+        self.patch(at, b)
+    }
+
+    /// Overwrites the `N` bytes at `at` (already written).
+    fn patch<const N: usize>(&mut self, at: usize, b: [u8; N]) -> Option<()> {
+        self.buf.get_mut(at..at.checked_add(N)?)?.copy_from_slice(&b);
         Some(())
     }
 }
