@@ -73,7 +73,9 @@ impl Protection {
 }
 
 /// What the last step measured and commanded (the actual torque 6077h and current
-/// 6078h/PNU 1102 come from `current.q`).
+/// 6078h/PNU 1102 come from `current.q`), with the limits in force and the i²t
+/// models' verdicts, which the axis shows from its making on and updates where
+/// they change.
 #[derive(Debug, Clone, Copy, PartialEq, Default)]
 pub struct Measured {
     /// Phase currents, A.
@@ -294,6 +296,17 @@ impl FocAxis {
         } else {
             None
         };
+        self.show_limits();
+    }
+
+    /// The limits in force and the i²t models' verdicts into the record of
+    /// the last step ([`Measured`]).
+    fn show_limits(&mut self) {
+        let m = &mut self.measured;
+        m.current_limit_a = self.limit_a;
+        m.i2t = Some(self.i2t_state);
+        m.stage_i2t = Some(self.stage_i2t_state);
+        m.stage_limit_a = self.stage_limit_a;
     }
 
     /// The simulated servo's loop (`MotorData::default_servo`,
@@ -389,7 +402,7 @@ impl FocAxis {
         self.deviation_sums = (0.0, 0.0, 0.0, 0);
     }
 
-    /// What the last step measured.
+    /// What the last step measured, and the limits in force.
     pub fn measured(&self) -> &Measured {
         &self.measured
     }
@@ -483,7 +496,6 @@ impl FocAxis {
             self.i2t_model_step();
         }
         let (sc, g) = (&self.scaling, &self.gains);
-        let i2t = self.i2t_state;
         if self.trip.is_none() {
             let p = &self.protection;
             // the DC link inside its window (the ordinary case) asks no more
@@ -510,22 +522,16 @@ impl FocAxis {
                 self.i2t_trip
             };
         }
-        let (limit, stage_limit) = (self.limit_a, self.stage_limit_a);
-        self.measured = Measured {
-            phases,
-            current,
-            vdc,
-            angle,
-            omega_e,
-            voltage: Dq::default(),
-            voltage_limited: false,
-            current_limit_a: limit,
-            i2t: Some(i2t),
-            stage_i2t: Some(self.stage_i2t_state),
-            stage_limit_a: stage_limit,
-        };
+        let limit = self.limit_a;
+        // the step's own values; the limits and the models' verdicts are
+        // written where they change (`show_limits`, from the axis' making
+        // on: issue 34's budget)
+        let m = &mut self.measured;
+        (m.phases, m.current, m.vdc, m.angle, m.omega_e) = (phases, current, vdc, angle, omega_e);
         let half = sc.pwm_period_counts / 2;
         if self.trip.is_some() || !self.enabled {
+            self.measured.voltage = Dq::default();
+            self.measured.voltage_limited = false;
             self.pi.reset();
             self.deviation_last = Dq::default();
             return PwmOut {
