@@ -142,8 +142,10 @@ pub struct FocAxis {
     limit_a: f32,
     /// The power stage's own limit in force, A.
     stage_limit_a: f32,
-    /// The trip the i²t models ask for (motor first, then the stage).
-    i2t_trip: Option<Trip>,
+    /// The trip the i²t model step judges: the current deviation (an open
+    /// motor connection) first, then the motor's i²t model, then the
+    /// stage's (one test in the step instead of three).
+    slow_trip: Option<Trip>,
     /// The current error's and the reference's squares summed over the
     /// i²t window's periods with the current loop closed below half the
     /// back-EMF's speed limit, the squares of the reference's steps in the
@@ -213,7 +215,7 @@ impl FocAxis {
             external_limit_a: f32::INFINITY,
             limit_a: 0.0,
             stage_limit_a: 0.0,
-            i2t_trip: None,
+            slow_trip: None,
             deviation_sums: (0.0, 0.0, 0.0, 0),
             deviation_last: Dq::default(),
             step_allowance: step_allowance(&gains),
@@ -289,7 +291,9 @@ impl FocAxis {
             fmath::min(self.external_limit_a, i2t_limit),
         );
         self.stage_limit_a = stage_limit;
-        self.i2t_trip = if i2t == I2tState::Fault {
+        self.slow_trip = if self.deviation_trip {
+            Some(Trip::MotorConnection)
+        } else if i2t == I2tState::Fault {
             Some(Trip::MotorI2t)
         } else if self.stage_i2t_state == I2tState::Fault {
             Some(Trip::StageI2t)
@@ -400,6 +404,7 @@ impl FocAxis {
         self.trip = None;
         self.deviation_trip = false;
         self.deviation_sums = (0.0, 0.0, 0.0, 0);
+        self.refresh_limits();
     }
 
     /// What the last step measured, and the limits in force.
@@ -508,18 +513,18 @@ impl FocAxis {
                     .check(vdc)
                     .filter(|&t| self.enabled || t != Trip::DcUnderVoltage)
             };
+            // (the phase sum needs no test of the shunts: with two,
+            // c = −a − b makes it exactly 0, never implausible)
             self.trip = if p.over_current.tripped(phases) {
                 Some(Trip::OverCurrent)
-            } else if sc.shunts == Shunts::Three && p.phase_sum.implausible(phases) {
+            } else if p.phase_sum.implausible(phases) {
                 Some(Trip::PhaseSum)
             } else if dc.is_some() {
                 dc
             } else if !s.encoder_ok {
                 Some(Trip::EncoderLost)
-            } else if self.deviation_trip {
-                Some(Trip::MotorConnection)
             } else {
-                self.i2t_trip
+                self.slow_trip
             };
         }
         let limit = self.limit_a;

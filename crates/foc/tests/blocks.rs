@@ -452,6 +452,54 @@ fn axis_trips_switch_the_gates_off_in_the_same_step() {
     assert!(out.compare.iter().all(|&c| c <= sc.pwm_period_counts));
 }
 
+/// E-089's phase-sum check with two shunts: c is −a − b, so the sum is
+/// exactly 0 and trips at no tolerance, whatever phase c's ADC reads (the
+/// step runs the check without testing the shunts, issue 34).
+#[test]
+fn e089_two_shunts_never_trip_the_phase_sum() {
+    let sc = Scaling {
+        shunts: foc::seam::Shunts::Two,
+        ..Scaling::default_board()
+    };
+    let protection = Protection {
+        phase_sum: PhaseSum { tolerance_a: 1e-30 },
+        deviation: CurrentDeviation {
+            share: f32::INFINITY,
+            floor_a: f32::INFINITY,
+        },
+        ..Protection::default_stage()
+    };
+    let mut a = FocAxis::new(
+        MotorData::default_servo(),
+        LoopParams::default_16k(),
+        sc,
+        protection,
+    )
+    .unwrap();
+    a.enable(true);
+    let q = foc::Dq { d: 0.0, q: 1.0 };
+    let mut x = 0x2545_F491_4F6C_DD1Du64;
+    for _ in 0..5000 {
+        x ^= x << 13;
+        x ^= x >> 7;
+        x ^= x << 17;
+        let c = |k: u32| 1500 + ((x >> k) % 1100) as u16;
+        assert!(a.step(&sample([c(0), c(16), c(32)], 2260), q).gate_enable);
+        assert_eq!(a.trip(), None);
+    }
+    // three shunts with the same tolerance: the first sample's sum trips
+    let mut three = FocAxis::new(
+        MotorData::default_servo(),
+        LoopParams::default_16k(),
+        Scaling::default_board(),
+        protection,
+    )
+    .unwrap();
+    three.enable(true);
+    three.step(&sample([2100, 2000, 2048], 2260), q);
+    assert_eq!(three.trip(), Some(Trip::PhaseSum));
+}
+
 #[test]
 fn torque_reference_is_iq_through_the_torque_constant_with_id_zero() {
     let a = FocAxis::default_servo(Scaling::default_board()).unwrap();
