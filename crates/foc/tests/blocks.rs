@@ -452,6 +452,31 @@ fn axis_trips_switch_the_gates_off_in_the_same_step() {
     assert!(out.compare.iter().all(|&c| c <= sc.pwm_period_counts));
 }
 
+/// The simulated servo's loop on `sc` with `protection`, enabled.
+fn enabled(sc: Scaling, protection: Protection) -> FocAxis {
+    let mut a = FocAxis::new(
+        MotorData::default_servo(),
+        LoopParams::default_16k(),
+        sc,
+        protection,
+    )
+    .unwrap();
+    a.enable(true);
+    a
+}
+
+/// The stage's protection without the current-deviation check (a test's
+/// fixed samples do not follow the loop's reference).
+fn deviation_off() -> Protection {
+    Protection {
+        deviation: CurrentDeviation {
+            share: f32::INFINITY,
+            floor_a: f32::INFINITY,
+        },
+        ..Protection::default_stage()
+    }
+}
+
 /// E-089's phase-sum check with two shunts: c is −a − b, so the sum is
 /// exactly 0 and trips at no tolerance, whatever phase c's ADC reads (the
 /// step runs the check without testing the shunts, issue 34).
@@ -463,20 +488,9 @@ fn e089_two_shunts_never_trip_the_phase_sum() {
     };
     let protection = Protection {
         phase_sum: PhaseSum { tolerance_a: 1e-30 },
-        deviation: CurrentDeviation {
-            share: f32::INFINITY,
-            floor_a: f32::INFINITY,
-        },
-        ..Protection::default_stage()
+        ..deviation_off()
     };
-    let mut a = FocAxis::new(
-        MotorData::default_servo(),
-        LoopParams::default_16k(),
-        sc,
-        protection,
-    )
-    .unwrap();
-    a.enable(true);
+    let mut a = enabled(sc, protection);
     let q = foc::Dq { d: 0.0, q: 1.0 };
     let mut x = 0x2545_F491_4F6C_DD1Du64;
     for _ in 0..5000 {
@@ -488,14 +502,7 @@ fn e089_two_shunts_never_trip_the_phase_sum() {
         assert_eq!(a.trip(), None);
     }
     // three shunts with the same tolerance: the first sample's sum trips
-    let mut three = FocAxis::new(
-        MotorData::default_servo(),
-        LoopParams::default_16k(),
-        Scaling::default_board(),
-        protection,
-    )
-    .unwrap();
-    three.enable(true);
+    let mut three = enabled(Scaling::default_board(), protection);
     three.step(&sample([2100, 2000, 2048], 2260), q);
     assert_eq!(three.trip(), Some(Trip::PhaseSum));
 }
@@ -523,20 +530,9 @@ fn stage_i2t_warns_then_limits_to_its_rated_current_then_trips() {
     let protection = Protection {
         stage_rated_a: 4.0,
         stage_tau_s: 0.1,
-        deviation: CurrentDeviation {
-            share: f32::INFINITY,
-            floor_a: f32::INFINITY,
-        },
-        ..Protection::default_stage()
+        ..deviation_off()
     };
-    let mut a = FocAxis::new(
-        MotorData::default_servo(),
-        LoopParams::default_16k(),
-        sc,
-        protection,
-    )
-    .unwrap();
-    a.enable(true);
+    let mut a = enabled(sc, protection);
     // 6 A along phase a at electrical angle 0: id ≈ 6 A, iq 0
     let s = sample([2048 + 1228, 2048 - 614, 2048 - 614], 2260);
     let q = foc::Dq { d: 0.0, q: 0.0 };
