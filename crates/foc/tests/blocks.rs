@@ -452,17 +452,18 @@ fn axis_trips_switch_the_gates_off_in_the_same_step() {
     assert!(out.compare.iter().all(|&c| c <= sc.pwm_period_counts));
 }
 
-/// The simulated servo's loop on `sc` with `protection`, enabled.
-fn enabled(sc: Scaling, protection: Protection) -> FocAxis {
+/// The simulated servo's loop on `sc` with `protection`, enabled (`None`:
+/// the parameters refused).
+fn enabled(sc: Scaling, protection: Protection) -> Option<FocAxis> {
     let mut a = FocAxis::new(
         MotorData::default_servo(),
         LoopParams::default_16k(),
         sc,
         protection,
     )
-    .unwrap();
+    .ok()?;
     a.enable(true);
-    a
+    Some(a)
 }
 
 /// The stage's protection without the current-deviation check (a test's
@@ -490,7 +491,7 @@ fn e089_two_shunts_never_trip_the_phase_sum() {
         phase_sum: PhaseSum { tolerance_a: 1e-30 },
         ..deviation_off()
     };
-    let mut a = enabled(sc, protection);
+    let mut a = enabled(sc, protection).unwrap();
     let q = foc::Dq { d: 0.0, q: 1.0 };
     let mut x = 0x2545_F491_4F6C_DD1Du64;
     for _ in 0..5000 {
@@ -502,7 +503,7 @@ fn e089_two_shunts_never_trip_the_phase_sum() {
         assert_eq!(a.trip(), None);
     }
     // three shunts with the same tolerance: the first sample's sum trips
-    let mut three = enabled(Scaling::default_board(), protection);
+    let mut three = enabled(Scaling::default_board(), protection).unwrap();
     three.step(&sample([2100, 2000, 2048], 2260), q);
     assert_eq!(three.trip(), Some(Trip::PhaseSum));
 }
@@ -532,7 +533,7 @@ fn stage_i2t_warns_then_limits_to_its_rated_current_then_trips() {
         stage_tau_s: 0.1,
         ..deviation_off()
     };
-    let mut a = enabled(sc, protection);
+    let mut a = enabled(sc, protection).unwrap();
     // 6 A along phase a at electrical angle 0: id ≈ 6 A, iq 0
     let s = sample([2048 + 1228, 2048 - 614, 2048 - 614], 2260);
     let q = foc::Dq { d: 0.0, q: 0.0 };
