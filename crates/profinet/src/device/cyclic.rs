@@ -174,24 +174,14 @@ impl<H: crate::cm::RecordHook> super::Device<H> {
     /// drive, the receive telegram), while it is current: an AR exchanges
     /// valid cyclic data and the data hold time has not expired.
     pub fn output_data(&self, slot: u16) -> Option<&[u8]> {
-        let c = self.cyclic.as_ref().filter(|c| c.outputs_valid)?;
-        c.outputs
-            .iter()
-            .find(|m| m.slot == slot)
-            .map(|m| m.data.as_slice())
+        valid_outputs(&self.cyclic, slot)
     }
 
     /// The output data of the module at `slot` (controller → drive) beside
     /// the record hook: a profile that reads the one while the hook serves
     /// it takes both without copying the frame out first (issue 36).
     pub fn output_data_with_hook(&mut self, slot: u16) -> (Option<&[u8]>, &mut H) {
-        let data = self
-            .cyclic
-            .as_ref()
-            .filter(|c| c.outputs_valid)
-            .and_then(|c| c.outputs.iter().find(|m| m.slot == slot))
-            .map(|m| m.data.as_slice());
-        (data, self.cm.hook_mut())
+        (valid_outputs(&self.cyclic, slot), self.cm.hook_mut())
     }
 
     /// The input data of the module at `slot` (drive → controller) to
@@ -235,4 +225,13 @@ impl<H: crate::cm::RecordHook> super::Device<H> {
             outs.chain(ins)
         })
     }
+}
+
+/// The output data of `slot` while it is current ([`output_data`](super::Device::output_data)).
+fn valid_outputs(cyclic: &Option<Cyclic>, slot: u16) -> Option<&[u8]> {
+    let c = cyclic.as_ref().filter(|c| c.outputs_valid)?;
+    c.outputs
+        .iter()
+        .find(|m| m.slot == slot)
+        .map(|m| m.data.as_slice())
 }
