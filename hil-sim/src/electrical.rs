@@ -175,9 +175,8 @@ impl CurrentControl for ElectricalAxis {
     fn actual(&self) -> Option<CurrentActual> {
         let iq = self.iq_cycle_mean;
         let m = self.foc.measured();
-        // the loop's record shows its limits from the loop's making on (no
-        // verdict would be no limit)
-        let stage = m.stage_i2t.map_or(f32::INFINITY, |_| m.stage_limit_a);
+        // the loop's record shows its limits from the loop's making on
+        let stage = m.stage_limit_a;
         let warning = matches!(m.stage_i2t, Some(s) if s != foc::I2tState::Normal) || self.chopper.warning();
         Some(CurrentActual {
             torque_nm: self.foc.gains().kt_nm_per_a * iq,
