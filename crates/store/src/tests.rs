@@ -160,8 +160,10 @@ fn flash_errors_propagate() {
     assert_eq!(ram.erase(4), Err(FlashError::OutOfRange));
 }
 
+/// The power-cut switch E-020's tests cut saves and downloads with: the
+/// operations after its budget fail, the flash keeps what the last one left.
 #[test]
-fn power_cut_fails_every_operation_after_its_budget_and_keeps_reads() {
+fn e020_power_cut_switch_fails_every_operation_after_its_budget_and_keeps_reads() {
     let mut f = PowerCut::after(Ram::new(), 2);
     assert_eq!(f.erase(0), Ok(()));
     assert_eq!(f.write(0, &[0x5A; 8]), Ok(()));
