@@ -534,14 +534,51 @@ const fn defaults_in_range(objs: &[Object]) -> bool {
 /// Every object of the drive, sorted by index, its entries in [`ENTRY_TABLE`].
 pub static OBJECTS: [Object; COUNT] = pack::objects(&TABLE, &ENTRY_TABLE);
 
+/// The objects of the standard PDO layout (spec §5.4: 1600h/1601h, then
+/// 1A00h/1A01h), in mapping order: the RAM image holds their values first
+/// and in this order, so the values the standard layout maps are adjacent
+/// in the RAM image as in the process image and its copy programs
+/// ([`crate::pdo_image`]) move them as a few runs of 8 bytes rather than
+/// entry by entry. Any other mapping copies as before, entry by entry.
+const PROCESS_ORDER: [&[od::PdoEntry]; 4] = [
+    &crate::pdo_maps::RX_A,
+    &crate::pdo_maps::RX_B,
+    &crate::pdo_maps::TX_A,
+    &crate::pdo_maps::TX_B,
+];
+
 const fn offsets() -> ([u16; COUNT], usize) {
     let mut out = [0u16; COUNT];
+    let mut placed = [false; COUNT];
     let mut at = 0usize;
+    // first the objects of the standard layout, in its order
+    let mut l = 0;
+    while l < PROCESS_ORDER.len() {
+        // l < PROCESS_ORDER.len() (compile-time evaluation)
+        #[allow(clippy::indexing_slicing)]
+        let mut list = PROCESS_ORDER[l];
+        while let [entry, rest @ ..] = list {
+            let mut i = 0;
+            while i < COUNT {
+                // i < COUNT (compile-time evaluation)
+                #[allow(clippy::indexing_slicing)]
+                if TABLE[i].info.index == entry.index && !placed[i] {
+                    placed[i] = true;
+                    out[i] = at as u16;
+                    at += TABLE[i].declared_ram_bytes();
+                }
+                i += 1;
+            }
+            list = rest;
+        }
+        l += 1;
+    }
+    // then every other object in table order
     let mut i = 0;
     while i < COUNT {
         // i < COUNT (compile-time evaluation)
         #[allow(clippy::indexing_slicing)]
-        {
+        if !placed[i] {
             out[i] = at as u16;
             at += TABLE[i].declared_ram_bytes();
         }
@@ -551,13 +588,16 @@ const fn offsets() -> ([u16; COUNT], usize) {
     (out, at)
 }
 
+/// [`offsets`] evaluated once.
+const LAYOUT: ([u16; COUNT], usize) = offsets();
+
 /// Size of the RAM image in bytes.
-pub const IMAGE_BYTES: usize = offsets().1;
+pub const IMAGE_BYTES: usize = LAYOUT.1;
 
 /// Byte offset in the RAM image of the values of the object at `index`
 /// (0 when it has none), computed at compile time.
 pub const fn image_offset(index: u16) -> usize {
-    let (offs, _) = offsets();
+    let (offs, _) = LAYOUT;
     let mut i = 0;
     while i < COUNT {
         // i < COUNT (compile-time evaluation)
@@ -573,7 +613,7 @@ pub const fn image_offset(index: u16) -> usize {
 /// Byte offset of each object's values in the RAM image (objects with
 /// [`Value::Ram`] / [`Value::Live`]; entries follow each other in subindex
 /// order, each [`DataType::bytes`] long).
-pub static OFFSETS: [u16; COUNT] = offsets().0;
+pub static OFFSETS: [u16; COUNT] = LAYOUT.0;
 
 const fn put(image: &mut [u8; IMAGE_BYTES], at: usize, v: i64, n: usize) {
     let b = v.to_le_bytes();
@@ -592,7 +632,7 @@ const fn put(image: &mut [u8; IMAGE_BYTES], at: usize, v: i64, n: usize) {
 /// for the image the dictionary writes at start (not in the firmware image).
 pub const INITIAL_IMAGE: [u8; IMAGE_BYTES] = {
     let mut image = [0u8; IMAGE_BYTES];
-    let (offs, _) = offsets();
+    let (offs, _) = LAYOUT;
     let mut i = 0;
     while i < COUNT {
         // i < COUNT (compile-time evaluation)

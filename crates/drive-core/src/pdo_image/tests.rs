@@ -247,13 +247,25 @@ fn e034_copy_program_equals_the_entry_copy() {
         let frames = [frame(rx, 201), frame(rx, 201), frame(rx, 7), frame(rx - 3, 90)];
         program_equals_entry_copy(&img, &objects, &frames, &std::format!("{layout:?}"));
     }
-    // standard: 60F4h and 60FDh adjacent in RAM and image, one copy of 8
+    // standard: the RAM image holds the layout's values in its order
+    // (objects::PROCESS_ORDER), so axis A's TxPDO is two runs, 6041h..60FDh
+    // (21 bytes: 8 + 8 + 4 + 1) and 60E4h:01..A67 (8 bytes; 60E4h's count
+    // lies between them in RAM): 5 copies for its 10 entries; both axes'
+    // (axis B's values follow A's) 10 copies for 20 entries, and the
+    // RxPDO's 16 entries 10 copies (6040h; 607Ah..6071h in two of 8; 6060h;
+    // the configuration entry 60FEh:01 on its own)
     let mut objects = DriveObjects::new();
     objects.apply_map(PdoLayout::Standard).unwrap();
+    let ops =
+        |p: &Program| -> std::vec::Vec<usize> { (0..GROUPS).map(|g| p.group(g).unwrap().len()).collect() };
     let img = PdoImage::compile(&objects).unwrap();
-    assert_eq!(img.tx.program.group(3).unwrap().len(), 1);
-    let ops: usize = (0..GROUPS).map(|g| img.tx.program.group(g).unwrap().len()).sum();
-    assert_eq!(ops, img.tx.entries().len() - 1);
+    assert_eq!(ops(&img.tx.program), [1, 0, 1, 3, 0]);
+    assign(&mut objects, 0x1C12, &[0x1600, 0x1601]);
+    assign(&mut objects, 0x1C13, &[0x1A00, 0x1A01]);
+    let img = PdoImage::compile(&objects).unwrap();
+    assert_eq!(ops(&img.tx.program), [2, 0, 2, 6, 0]);
+    assert_eq!(ops(&img.rx.program), [2, 2, 0, 4, 2]);
+    assert_eq!((img.tx.entries().len(), img.rx.entries().len()), (20, 16));
 
     // gaps, configuration entries of 1, 2 and 4 bytes (6065h, 60C2h:02,
     // 605Ah; 6060h and 60FEh:01 of 1601h), an entry off byte boundaries,
