@@ -8,7 +8,7 @@
 //! diagnosis history, and that nothing is lost. Each test ends with
 //! [`drive_tests::fault_row!`], which leaves its row for the printed table
 //! (`scripts/fault-matrix`). Cases elsewhere join the table the same way:
-//! SYNC0 loss (dc_sync.rs), power cut during a save (save.rs).
+//! SYNC0 loss (dc_sync/esm.rs), power cut during a save (save.rs).
 
 #[path = "fault_matrix/axis.rs"]
 mod axis;
