@@ -1,4 +1,4 @@
-//! Axis-level helpers of the motion tests (`motion.rs`, `motion_more.rs`,
+//! Axis-level helpers of the motion tests (`motion/`, `motion_more.rs`,
 //! `cia402_items.rs`, `homing.rs`): controlword bits, the simulated plant,
 //! homing in place.
 

@@ -1,4 +1,4 @@
-//! Cyclic process data of one drive in Op: the standard PDO layout ([`Cyclic`], `motion.rs`) and
+//! Cyclic process data of one drive in Op: the standard PDO layout ([`Cyclic`], `motion/`) and
 //! remapped layouts as raw bytes ([`RawCyclic`], `motion_more.rs`).
 
 use crate::{axis, REV};

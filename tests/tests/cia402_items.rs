@@ -1,5 +1,5 @@
 //! CiA 402 items through a real master that the mode scenarios of
-//! motion.rs / motion_more.rs do not name (features-cia402.md): mode 0,
+//! motion/*.rs / motion_more.rs do not name (features-cia402.md): mode 0,
 //! replacing commands, the velocity override A340, the cyclic modes without
 //! mode bits, the pp set-point handshake and absolute moves, switch sources
 //! from I210, E80, reference retaining I46, the position encoder I02, the

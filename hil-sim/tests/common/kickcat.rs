@@ -26,7 +26,7 @@ pub const TOLERANCE_INC: u32 = INC_PER_REV / 16;
 
 /// How far 6064h may end from the target once the move is over: the
 /// drive's default position window I22 (1/360 rev, the window of "target
-/// reached"), as `tests/tests/motion.rs` checks. At rest the axis hunts: the
+/// reached"), as `tests/tests/motion/drive_modes.rs` checks. At rest the axis hunts: the
 /// velocity PI's integral part winds the torque up at a following error
 /// until it passes the motor's breakaway friction (0.03 N·m), the rotor
 /// slides against the lower Coulomb friction (0.02 N·m) past the target and
