@@ -1,5 +1,5 @@
 //! The raw mailbox client (SM0/SM1 through register reads and writes) and the SDO client over it
-//! (`coe.rs`, `pdo.rs` and others): uploads and downloads of every shape, SDO Information.
+//! (`coe/`, `pdo.rs` and others): uploads and downloads of every shape, SDO Information.
 
 use ethercrab::SubDeviceRef;
 
@@ -87,7 +87,7 @@ impl RawMailbox {
 }
 
 // ---------------------------------------------------------------------------
-// SDO client over `RawMailbox` (tests/tests/coe.rs, tests/tests/pdo.rs)
+// SDO client over `RawMailbox` (tests/tests/coe/, tests/tests/pdo.rs)
 // ---------------------------------------------------------------------------
 
 /// An SDO abort code (the 32-bit CiA 301 value).
