@@ -1,5 +1,5 @@
 //! Axis-level helpers of the motion tests (`motion/`, `motion_more.rs`,
-//! `cia402_items.rs`, `homing.rs`): controlword bits, the simulated plant,
+//! `cia402_items/`, `homing.rs`): controlword bits, the simulated plant,
 //! homing in place.
 
 use crate::{Cyclic, TxPdo};
