@@ -558,16 +558,13 @@ const fn offsets() -> ([u16; COUNT], usize) {
         #[allow(clippy::indexing_slicing)]
         let mut list = PROCESS_ORDER[l];
         while let [entry, rest @ ..] = list {
-            let mut i = 0;
-            while i < COUNT {
-                // i < COUNT (compile-time evaluation)
-                #[allow(clippy::indexing_slicing)]
-                if TABLE[i].info.index == entry.index && !placed[i] {
-                    placed[i] = true;
-                    out[i] = at as u16;
-                    at += TABLE[i].declared_ram_bytes();
-                }
-                i += 1;
+            let i = table_position(entry.index);
+            // i < COUNT (compile-time evaluation)
+            #[allow(clippy::indexing_slicing)]
+            if i < COUNT && !placed[i] {
+                placed[i] = true;
+                out[i] = at as u16;
+                at += TABLE[i].declared_ram_bytes();
             }
             list = rest;
         }
@@ -597,17 +594,28 @@ pub const IMAGE_BYTES: usize = LAYOUT.1;
 /// Byte offset in the RAM image of the values of the object at `index`
 /// (0 when it has none), computed at compile time.
 pub const fn image_offset(index: u16) -> usize {
-    let (offs, _) = LAYOUT;
+    let i = table_position(index);
+    if i < COUNT {
+        // i < COUNT (compile-time evaluation)
+        #[allow(clippy::indexing_slicing)]
+        return LAYOUT.0[i] as usize;
+    }
+    0
+}
+
+/// Position of the object `index` in [`TABLE`] (`COUNT` when there is none),
+/// for the compile-time layout.
+const fn table_position(index: u16) -> usize {
     let mut i = 0;
     while i < COUNT {
         // i < COUNT (compile-time evaluation)
         #[allow(clippy::indexing_slicing)]
         if TABLE[i].info.index == index {
-            return offs[i] as usize;
+            return i;
         }
         i += 1;
     }
-    0
+    COUNT
 }
 
 /// Byte offset of each object's values in the RAM image (objects with
