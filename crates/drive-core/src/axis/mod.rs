@@ -508,7 +508,7 @@ impl Axis {
         let slots = cache::slots_of(&mut cache.slots, od, self.window);
         let cached: &CachedSnapshot = match &mut cache.snapshot {
             Some(cached) if cached.generation == generation => {
-                cached.snapshot.refresh_setpoints(od, slots);
+                cached.snapshot.refresh_setpoints(od, self.window.axis);
                 cached
             }
             stale => stale.insert(self.read_snapshot(od, generation)),
@@ -620,10 +620,10 @@ impl Axis {
             current_a: sign * m.current_a,
             ..m
         });
-        self.write_back(od, slots, &out, (bits, actual, torque, fe), measured);
-        self.user_statusword(od, slots, o);
-        self.switch_on_disabled_causes(od, slots, &out, io, o.controlword);
-        self.digital_inputs(od, slots, io);
+        self.write_back(od, &out, (bits, actual, torque, fe), measured);
+        self.user_statusword(od, o);
+        self.switch_on_disabled_causes(od, &out, io, o.controlword);
+        self.digital_inputs(od, io);
 
         AxisReport {
             command: AxisCommand {

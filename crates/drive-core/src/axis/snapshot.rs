@@ -9,14 +9,14 @@
 
 use core::cell::Cell;
 
-use crate::dictionary::{DriveObjects, Slot, SlotValue, Typed};
+use crate::dictionary::{DriveObjects, Slot, Typed};
 use crate::{AXIS_B_CIA402, AXIS_B_MANUFACTURER};
 use motion::scaling::AxisScaling;
 
 pub(crate) use crate::params::{
-    A150, A213, A291, A310, A311, A340, A44, A66, A67, B45, B46, B47, C31, C32, C40, E47, E48, E49, E80, F00,
-    F06, G472, G475, I00, I02, I04, I10, I101, I12, I13, I18, I20, I21, I210, I22, I23, I25, I26, I28, I29,
-    I30, I423, I425, I43, I44, I45, I46, I470, I471, I53, I87,
+    A150, A213, A291, A310, A311, A340, A44, A66, B45, B46, B47, C31, C32, C40, F00, F06, G472, G475, I00,
+    I02, I04, I10, I101, I12, I13, I18, I20, I21, I210, I22, I23, I25, I26, I28, I29, I30, I423, I425, I43,
+    I44, I45, I46, I470, I471, I53, I87,
 };
 
 /// Entry `index`:`sub`, or 0 with `misses` counted: the dictionary declares
@@ -78,44 +78,15 @@ impl Window {
     }
 }
 
-/// The entries one axis reads (set-points) and writes (actual values) in
-/// every control cycle, resolved once with their types: a load or store
-/// each instead of a dictionary lookup (docs/architecture.md, cycle cost).
-/// `None`: the entry is not in RAM with the type the cycle uses (reads give
-/// the default, writes are dropped; `cyclic_slots_resolve_every_entry_on_both_axes`
+/// The entries the axis' configuration writes (6076h, A291), resolved once
+/// with their types. The entries the control cycle reads and writes every
+/// cycle lie at fixed places in the axis' block of the RAM image instead
+/// ([`crate::objects::cycle`]). `None`: the entry is not in RAM with the
+/// type used (writes are dropped; `cyclic_slots_resolve_every_entry_on_both_axes`
 /// keeps this from happening).
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
 pub(crate) struct CyclicSlots {
-    pub controlword: Option<Typed<u16>>,
-    pub mode: Option<Typed<i8>>,
-    pub target_position: Option<Typed<i32>>,
-    pub ip_setpoint: Option<Typed<i32>>,
-    pub target_velocity: Option<Typed<i32>>,
-    pub target_torque: Option<Typed<i16>>,
-    pub velocity_offset: Option<Typed<i32>>,
-    pub torque_offset: Option<Typed<i16>>,
-    pub probe_function: Option<Typed<u16>>,
-    pub vl_target: Option<Typed<i16>>,
-    pub i210: Option<Typed<u16>>,
-    pub statusword: Option<Typed<u16>>,
-    pub mode_display: Option<Typed<i8>>,
-    pub position: Option<Typed<i32>>,
-    pub velocity: Option<Typed<i32>>,
-    pub torque: Option<Typed<i16>>,
-    pub current: Option<Typed<i16>>,
     pub rated_torque: Option<Typed<u32>>,
-    pub following_error: Option<Typed<i32>>,
-    pub probe_status: Option<Typed<u16>>,
-    pub probe_values: [Option<Typed<i32>>; 4],
-    pub additional_position: Option<Typed<i32>>,
-    pub vl_demand: Option<Typed<i16>>,
-    pub vl_actual: Option<Typed<i16>>,
-    pub digital_inputs: Option<Typed<u32>>,
-    pub e80: Option<Typed<u8>>,
-    pub e48: Option<Typed<u8>>,
-    pub e47: Option<Typed<u8>>,
-    pub e49: Option<Typed<u8>>,
-    pub a67: Option<Typed<u16>>,
     /// A291 (global): the copy of 60C2h.
     pub a291: Option<Typed<u32>>,
 }
@@ -123,89 +94,16 @@ pub(crate) struct CyclicSlots {
 impl CyclicSlots {
     /// The slots of axis `w`.
     pub fn resolve(od: &DriveObjects, w: Window) -> Self {
-        fn t<T: SlotValue>(slot: Option<Slot>) -> Option<Typed<T>> {
-            slot.and_then(Slot::typed)
-        }
-        let c = |index: u16, sub: u8| od.slot(w.cia402(index), sub);
-        let m = |index: u16| od.slot(w.manufacturer(index), 0);
         Self {
-            controlword: t(c(0x6040, 0)),
-            mode: t(c(0x6060, 0)),
-            target_position: t(c(0x607A, 0)),
-            ip_setpoint: t(c(0x60C1, 1)),
-            target_velocity: t(c(0x60FF, 0)),
-            target_torque: t(c(0x6071, 0)),
-            velocity_offset: t(c(0x60B1, 0)),
-            torque_offset: t(c(0x60B2, 0)),
-            probe_function: t(c(0x60B8, 0)),
-            vl_target: t(c(0x6042, 0)),
-            i210: t(m(I210)),
-            statusword: t(c(0x6041, 0)),
-            mode_display: t(c(0x6061, 0)),
-            position: t(c(0x6064, 0)),
-            velocity: t(c(0x606C, 0)),
-            torque: t(c(0x6077, 0)),
-            current: t(c(0x6078, 0)),
-            rated_torque: t(c(0x6076, 0)),
-            following_error: t(c(0x60F4, 0)),
-            probe_status: t(c(0x60B9, 0)),
-            probe_values: [t(c(0x60BA, 0)), t(c(0x60BB, 0)), t(c(0x60BC, 0)), t(c(0x60BD, 0))],
-            additional_position: t(c(0x60E4, 1)),
-            vl_demand: t(c(0x6043, 0)),
-            vl_actual: t(c(0x6044, 0)),
-            digital_inputs: t(c(0x60FD, 0)),
-            e80: t(m(E80)),
-            e48: t(m(E48)),
-            e47: t(m(E47)),
-            e49: t(m(E49)),
-            a67: t(m(A67)),
-            a291: t(od.slot(A291, 0)),
+            rated_torque: od.slot(w.cia402(0x6076), 0).and_then(Slot::typed),
+            a291: od.slot(A291, 0).and_then(Slot::typed),
         }
     }
 
     /// Every slot, for the completeness test.
     #[cfg(test)]
-    pub fn all(&self) -> [Option<u16>; 34] {
-        let [p0, p1, p2, p3] = self.probe_values.map(|s| s.map(Typed::at));
-        fn at<T>(s: Option<Typed<T>>) -> Option<u16> {
-            s.map(Typed::at)
-        }
-        [
-            at(self.controlword),
-            at(self.mode),
-            at(self.target_position),
-            at(self.ip_setpoint),
-            at(self.target_velocity),
-            at(self.target_torque),
-            at(self.velocity_offset),
-            at(self.torque_offset),
-            at(self.probe_function),
-            at(self.vl_target),
-            at(self.i210),
-            at(self.statusword),
-            at(self.mode_display),
-            at(self.position),
-            at(self.velocity),
-            at(self.torque),
-            at(self.current),
-            at(self.rated_torque),
-            at(self.following_error),
-            at(self.probe_status),
-            p0,
-            p1,
-            p2,
-            p3,
-            at(self.additional_position),
-            at(self.vl_demand),
-            at(self.vl_actual),
-            at(self.digital_inputs),
-            at(self.e80),
-            at(self.e48),
-            at(self.e47),
-            at(self.e49),
-            at(self.a67),
-            at(self.a291),
-        ]
+    pub fn all(&self) -> [Option<u16>; 2] {
+        [self.rated_torque.map(Typed::at), self.a291.map(Typed::at)]
     }
 }
 
@@ -396,21 +294,23 @@ impl super::Axis {
 impl Snapshot {
     /// Reads the cyclic set-points of axis `w` again (the objects of
     /// `CYCLIC_SETPOINTS` in the dictionary, whose writes do not move its
-    /// configuration generation); the rest of the snapshot is kept.
-    pub fn refresh_setpoints(&mut self, od: &DriveObjects, c: &CyclicSlots) {
-        self.controlword = od.read_typed(c.controlword).unwrap_or(0);
-        self.mode = od.read_typed(c.mode).unwrap_or(0);
-        self.target_position = od.read_typed(c.target_position).unwrap_or(0);
+    /// configuration generation) from axis `axis`' block; the rest of the
+    /// snapshot is kept.
+    pub fn refresh_setpoints(&mut self, od: &DriveObjects, axis: u8) {
+        use crate::objects::cycle as f;
+        self.controlword = od.cycle_read(axis, f::CONTROLWORD);
+        self.mode = od.cycle_read(axis, f::MODE);
+        self.target_position = od.cycle_read(axis, f::TARGET_POSITION);
         self.target_position_user = self.target_position;
-        self.ip_setpoint = od.read_typed(c.ip_setpoint).unwrap_or(0);
+        self.ip_setpoint = od.cycle_read(axis, f::IP_SETPOINT);
         self.ip_setpoint_user = self.ip_setpoint;
-        self.target_velocity = od.read_typed(c.target_velocity).unwrap_or(0);
-        self.target_torque = od.read_typed(c.target_torque).unwrap_or(0);
-        self.velocity_offset = od.read_typed(c.velocity_offset).unwrap_or(0);
-        self.torque_offset = od.read_typed(c.torque_offset).unwrap_or(0);
-        self.probe_function = od.read_typed(c.probe_function).unwrap_or(0);
-        self.vl_target = od.read_typed(c.vl_target).unwrap_or(0);
-        self.i210 = od.read_typed(c.i210).unwrap_or(0);
+        self.target_velocity = od.cycle_read(axis, f::TARGET_VELOCITY);
+        self.target_torque = od.cycle_read(axis, f::TARGET_TORQUE);
+        self.velocity_offset = od.cycle_read(axis, f::VELOCITY_OFFSET);
+        self.torque_offset = od.cycle_read(axis, f::TORQUE_OFFSET);
+        self.probe_function = od.cycle_read(axis, f::PROBE_FUNCTION);
+        self.vl_target = od.cycle_read(axis, f::VL_TARGET);
+        self.i210 = od.cycle_read(axis, f::I210);
     }
 
     /// Reads the snapshot of axis `w`.

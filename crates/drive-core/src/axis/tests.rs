@@ -45,7 +45,7 @@ fn snapshot_reads_only_declared_entries() {
 /// generation are counted, so the per-axis rule is exercised.
 #[test]
 fn cached_snapshot_equals_a_fresh_read_after_any_write() {
-    use crate::axis::snapshot::{CyclicSlots, Snapshot, Window};
+    use crate::axis::snapshot::{Snapshot, Window};
     use crate::objects::OBJECTS;
     let (mut checked, mut one_axis) = (0, 0);
     for o in OBJECTS.iter() {
@@ -73,7 +73,7 @@ fn cached_snapshot_equals_a_fresh_read_after_any_write() {
                 if moved[usize::from(w.axis)] {
                     continue;
                 }
-                cached.refresh_setpoints(&od, &CyclicSlots::resolve(&od, w));
+                cached.refresh_setpoints(&od, w.axis);
                 assert_eq!(
                     cached,
                     Snapshot::read(&od, w),
@@ -110,6 +110,90 @@ fn cyclic_slots_resolve_every_entry_on_both_axes() {
         assert!(!seen.contains(&s), "slot {k} shared");
         seen.push(s);
     }
+}
+
+/// Issue 36 (the cycle's values at fixed places): every cycle field is,
+/// on both axes, the entry the dictionary resolves for its index and
+/// subindex (aliases followed), at the field's offset in that axis' block
+/// and of the field's type; the fields the cycle writes are no
+/// configuration entries (their stores note no configuration change); and
+/// a value written through the dictionary reads back through the field and
+/// the other way round. A layout that moved an entry out of its block, a
+/// wrong subindex or type, or a written entry that is configuration, fails.
+#[test]
+fn cycle_fields_are_the_slots_of_both_axes() {
+    use crate::axis::snapshot::Window;
+    use crate::dictionary::SlotValue;
+    use crate::objects::{cycle as f, CycleField, AXIS_BLOCK};
+    use crate::params::{A67, E47, E48, E49, E80, I210};
+    fn check<T: SlotValue + Default + TryFrom<i64> + Into<i64> + PartialEq + core::fmt::Debug>(
+        index: u16,
+        sub: u8,
+        field: CycleField<T>,
+        written: bool,
+        seen: &mut std::vec::Vec<usize>,
+    ) {
+        for axis in 0..2u8 {
+            let mut od = DriveObjects::new();
+            let w = Window { axis };
+            let i = if index >= 0x6000 {
+                w.cia402(index)
+            } else {
+                w.manufacturer(index)
+            };
+            let slot = od
+                .slot(i, sub)
+                .unwrap_or_else(|| panic!("{i:04X}:{sub} has no slot"));
+            let at = usize::from(axis) * AXIS_BLOCK + field.at();
+            assert_eq!(usize::from(slot.ram_offset()), at, "{i:04X}:{sub}");
+            assert!(slot.typed::<T>().is_some(), "{i:04X}:{sub} type");
+            if written {
+                assert!(!slot.is_config(), "{i:04X}:{sub} is configuration");
+            }
+            assert!(!seen.contains(&at), "{i:04X}:{sub} shares its place");
+            seen.push(at);
+            let v = T::try_from(if written { 0x55 } else { 0x2A }).unwrap_or_default();
+            od.set(i, sub, v.into()).unwrap();
+            assert_eq!(od.cycle_read(axis, field), v, "{i:04X}:{sub} read");
+            let z = T::default();
+            od.cycle_write(axis, field, z);
+            assert_eq!(od.get(i, sub), Ok(z.into()), "{i:04X}:{sub} write");
+        }
+    }
+    let mut seen = std::vec::Vec::new();
+    let s = &mut seen;
+    check(0x6040, 0, f::CONTROLWORD, false, s);
+    check(0x6060, 0, f::MODE, false, s);
+    check(0x607A, 0, f::TARGET_POSITION, false, s);
+    check(0x60C1, 1, f::IP_SETPOINT, false, s);
+    check(0x60FF, 0, f::TARGET_VELOCITY, false, s);
+    check(0x6071, 0, f::TARGET_TORQUE, false, s);
+    check(0x60B1, 0, f::VELOCITY_OFFSET, false, s);
+    check(0x60B2, 0, f::TORQUE_OFFSET, false, s);
+    check(0x60B8, 0, f::PROBE_FUNCTION, false, s);
+    check(0x6042, 0, f::VL_TARGET, false, s);
+    check(I210, 0, f::I210, false, s);
+    check(0x6041, 0, f::STATUSWORD, true, s);
+    check(0x6061, 0, f::MODE_DISPLAY, true, s);
+    check(0x6064, 0, f::POSITION, true, s);
+    check(0x606C, 0, f::VELOCITY, true, s);
+    check(0x6077, 0, f::TORQUE, true, s);
+    check(0x6078, 0, f::CURRENT, true, s);
+    check(0x60F4, 0, f::FOLLOWING_ERROR, true, s);
+    check(0x60B9, 0, f::PROBE_STATUS, true, s);
+    for (k, field) in f::PROBE_VALUES.into_iter().enumerate() {
+        check(0x60BA + k as u16, 0, field, true, s);
+    }
+    check(0x60E4, 1, f::ADDITIONAL_POSITION, true, s);
+    check(0x6043, 0, f::VL_DEMAND, true, s);
+    check(0x6044, 0, f::VL_ACTUAL, true, s);
+    check(0x60FD, 0, f::DIGITAL_INPUTS, true, s);
+    check(E80, 0, f::E80_FIELD, true, s);
+    check(E48, 0, f::E48_FIELD, true, s);
+    check(E47, 0, f::E47_FIELD, true, s);
+    check(E49, 0, f::E49_FIELD, true, s);
+    check(A67, 0, f::A67_FIELD, true, s);
+    assert_eq!(seen.len(), 2 * 32);
 }
 
 /// Issue 36 (no long first or reconfiguration cycle): an axis prepared

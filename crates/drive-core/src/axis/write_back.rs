@@ -4,12 +4,12 @@
 //! the causes of Switch on disabled (E47/E49), A67 and 60FDh.
 
 use super::*;
+use crate::objects::cycle as f;
 
 impl Axis {
     pub(super) fn write_back(
         &mut self,
         od: &mut DriveObjects,
-        c: &CyclicSlots,
         out: &Outputs,
         (bits, actual, torque, fe): (u16, i32, f32, i32),
         measured: Option<CurrentActual>,
@@ -26,7 +26,7 @@ impl Axis {
         if out.drive_function {
             sw |= bits & SW_INTERNAL_LIMIT;
         }
-        od.write_typed(c.statusword, sw);
+        od.cycle_write(self.window.axis, f::STATUSWORD, sw);
         let e80 = match self.denial {
             Some(DenialCause::IllegalDirection) => 15,
             Some(
@@ -37,12 +37,12 @@ impl Axis {
             ) => 20,
             _ => 0u8,
         };
-        od.write_typed(c.e80, e80);
-        od.write_typed(c.mode_display, out.mode_display);
+        od.cycle_write(self.window.axis, f::E80_FIELD, e80);
+        od.cycle_write(self.window.axis, f::MODE_DISPLAY, out.mode_display);
         let position = self.user_position(actual);
-        od.write_typed(c.position, sat_i32(position));
+        od.cycle_write(self.window.axis, f::POSITION, sat_i32(position));
         let v = self.scaling.velocity_to_user(self.velocity) * self.velocity_decimals;
-        od.write_typed(c.velocity, round_i32(v));
+        od.cycle_write(self.window.axis, f::VELOCITY, round_i32(v));
         // 6077h in 0.1 % of the rated torque, 6078h in 0.1 % of the rated
         // current (CiA 402: 6076h, 6075h); without a measurement both show the
         // demand (an ideal current loop: the same fraction of either)
@@ -58,10 +58,10 @@ impl Axis {
                 (t, t)
             }
         };
-        od.write_typed(c.torque, t);
-        od.write_typed(c.current, i);
-        od.write_typed(c.following_error, sat_i32(self.user(fe)));
-        od.write_typed(c.probe_status, self.probe.status());
+        od.cycle_write(self.window.axis, f::TORQUE, t);
+        od.cycle_write(self.window.axis, f::CURRENT, i);
+        od.cycle_write(self.window.axis, f::FOLLOWING_ERROR, sat_i32(self.user(fe)));
+        od.cycle_write(self.window.axis, f::PROBE_STATUS, self.probe.status());
         if !self.probe_shown {
             let probe = [
                 self.probe.value_60ba(),
@@ -69,16 +69,16 @@ impl Axis {
                 self.probe.value_60bc(),
                 self.probe.value_60bd(),
             ];
-            for (slot, value) in c.probe_values.into_iter().zip(probe) {
-                od.write_typed(slot, sat_i32(self.user_position(value)));
+            for (field, value) in f::PROBE_VALUES.into_iter().zip(probe) {
+                od.cycle_write(self.window.axis, field, sat_i32(self.user_position(value)));
             }
             self.probe_shown = true;
         }
-        od.write_typed(c.additional_position, sat_i32(position));
+        od.cycle_write(self.window.axis, f::ADDITIONAL_POSITION, sat_i32(position));
         let rpm = |v: f32| round_i32(v / RPM_TO_INC_PER_S).clamp(-32768, 32767) as i16;
-        od.write_typed(c.vl_demand, rpm(self.vl_demand));
-        od.write_typed(c.vl_actual, rpm(self.velocity));
-        od.write_typed(c.e48, e48(out.state));
+        od.cycle_write(self.window.axis, f::VL_DEMAND, rpm(self.vl_demand));
+        od.cycle_write(self.window.axis, f::VL_ACTUAL, rpm(self.velocity));
+        od.cycle_write(self.window.axis, f::E48_FIELD, e48(out.state));
     }
 
     /// A position (or distance) in increments as the objects show it: user
@@ -117,7 +117,6 @@ impl Axis {
     pub(super) fn switch_on_disabled_causes(
         &self,
         od: &mut DriveObjects,
-        c: &CyclicSlots,
         out: &Outputs,
         io: &AxisIo,
         cw: u16,
@@ -142,14 +141,14 @@ impl Axis {
         } else {
             causes.trailing_zeros() as u8 + 1
         };
-        od.write_typed(c.e47, first);
-        od.write_typed(c.e49, causes);
+        od.cycle_write(self.window.axis, f::E47_FIELD, first);
+        od.cycle_write(self.window.axis, f::E49_FIELD, causes);
     }
 
     /// A67 from the sources in A66 (C-143): bit k is bit `b` of the entry
     /// `index`:`sub` that element k names (index << 16 | sub << 8 | b;
     /// 0 or an unreadable entry: the bit is 0).
-    pub(super) fn user_statusword(&self, od: &mut DriveObjects, c: &CyclicSlots, o: &Snapshot) {
+    pub(super) fn user_statusword(&self, od: &mut DriveObjects, o: &Snapshot) {
         let mut a67 = 0u16;
         let sources: &[u32] = if o.a66_used { o.a66.as_slice() } else { &[] };
         for (k, &src) in sources.iter().enumerate() {
@@ -160,14 +159,14 @@ impl Axis {
                 a67 |= 1 << k;
             }
         }
-        od.write_typed(c.a67, a67);
+        od.cycle_write(self.window.axis, f::A67_FIELD, a67);
     }
 
     /// The switch levels in 60FDh (bit 0 negative limit, bit 1 positive
     /// limit, bit 2 home switch, CiA 402).
-    pub(super) fn digital_inputs(&self, od: &mut DriveObjects, c: &CyclicSlots, io: &AxisIo) {
+    pub(super) fn digital_inputs(&self, od: &mut DriveObjects, io: &AxisIo) {
         let bits =
             u32::from(io.limit_negative) | u32::from(io.limit_positive) << 1 | u32::from(io.reference) << 2;
-        od.write_typed(c.digital_inputs, bits);
+        od.cycle_write(self.window.axis, f::DIGITAL_INPUTS, bits);
     }
 }

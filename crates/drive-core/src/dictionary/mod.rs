@@ -30,9 +30,11 @@ pub use persist::{ImageError, PERSISTENT_IMAGE_BYTES};
 pub use prepared::Prepared;
 use resolve::*;
 pub use slot::Slot;
+#[cfg(test)]
+pub(crate) use slot::SlotValue;
+pub(crate) use slot::Typed;
 use slot::*;
 pub use slot::{read_slot, write_slot};
-pub(crate) use slot::{SlotValue, Typed};
 
 /// Signature written to 1010h:01 to save ("save", CiA 301).
 pub const SAVE_SIGNATURE: u32 = 0x6576_6173;

@@ -1,8 +1,10 @@
 //! Resolved slots: an entry's place in the RAM image with its type, for
-//! the loads and stores of the control cycle and the PDO copy without a
-//! dictionary lookup ([`Slot`], [`Typed`]).
+//! the PDO copy and the runtime's entries without a dictionary lookup
+//! ([`Slot`], [`Typed`]); and the control cycle's loads and stores at the
+//! fixed places of its axis' block (`cycle_read`, `cycle_write`).
 
 use super::*;
+use crate::objects::{CycleField, AXIS_BLOCK};
 
 /// Reads `N` bytes at `at`.
 pub(super) fn bytes_at<const N: usize>(image: &[u8], at: usize) -> Option<[u8; N]> {
@@ -297,10 +299,44 @@ impl DriveObjects {
         }
     }
 
-    /// The value in a typed slot; `None` without one.
+    /// Axis `axis`' block at the start of the RAM image (axis B's for any
+    /// `axis` but 0); both ranges are constant, so the checks fold away.
     #[inline(always)]
-    pub(crate) fn read_typed<T: SlotValue>(&self, slot: Option<Typed<T>>) -> Option<T> {
-        slot.and_then(|s| T::load(&self.image, usize::from(s.at)))
+    fn axis_block(&self, axis: u8) -> Option<&[u8; AXIS_BLOCK]> {
+        let (a, rest) = self.image.split_first_chunk::<AXIS_BLOCK>()?;
+        if axis == 0 {
+            Some(a)
+        } else {
+            rest.first_chunk::<AXIS_BLOCK>()
+        }
+    }
+
+    /// The value of the cycle field `f` of axis `axis` (0 = A): a load at a
+    /// constant offset in the axis' block, no lookup, no `Option` to test.
+    #[inline(always)]
+    pub(crate) fn cycle_read<T: SlotValue + Default>(&self, axis: u8, f: CycleField<T>) -> T {
+        self.axis_block(axis)
+            .and_then(|b| T::load(b, f.at))
+            .unwrap_or_default()
+    }
+
+    /// Stores `value` in the cycle field `f` of axis `axis` (0 = A). The
+    /// fields the cycle writes are actual values, never configuration
+    /// entries (`cycle_fields_are_the_slots_of_both_axes`), so no
+    /// configuration change is noted.
+    #[inline(always)]
+    pub(crate) fn cycle_write<T: SlotValue>(&mut self, axis: u8, f: CycleField<T>, value: T) {
+        let Some((a, rest)) = self.image.split_first_chunk_mut::<AXIS_BLOCK>() else {
+            return;
+        };
+        let block = if axis == 0 {
+            Some(a)
+        } else {
+            rest.first_chunk_mut::<AXIS_BLOCK>()
+        };
+        if let Some(b) = block {
+            value.store(b, f.at);
+        }
     }
 
     /// Stores `value` in a typed slot (dropped without one); a

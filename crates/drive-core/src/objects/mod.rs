@@ -66,6 +66,7 @@ macro_rules! numbered {
 pub mod cia402;
 pub mod comm;
 pub mod control;
+mod layout;
 pub mod manufacturer;
 pub mod motor;
 mod pack;
@@ -76,6 +77,8 @@ mod shorthand;
 pub mod single;
 pub mod stage;
 
+pub(crate) use layout::{cycle, LAYOUT};
+pub use layout::{image_offset, CycleField, AXIS_BLOCK, IMAGE_BYTES, OFFSETS};
 pub use pack::{EntryRecord, ENTRY_TABLE};
 
 /// Where the values of an object live.
@@ -534,95 +537,6 @@ const fn defaults_in_range(objs: &[Object]) -> bool {
 /// Every object of the drive, sorted by index, its entries in [`ENTRY_TABLE`].
 pub static OBJECTS: [Object; COUNT] = pack::objects(&TABLE, &ENTRY_TABLE);
 
-/// The objects of the standard PDO layout (spec §5.4: 1600h/1601h, then
-/// 1A00h/1A01h), in mapping order: the RAM image holds their values first
-/// and in this order, so the values the standard layout maps are adjacent
-/// in the RAM image as in the process image and its copy programs
-/// ([`crate::pdo_image`]) move them as a few runs of 8 bytes rather than
-/// entry by entry. Any other mapping copies as before, entry by entry.
-const PROCESS_ORDER: [&[od::PdoEntry]; 4] = [
-    &crate::pdo_maps::RX_A,
-    &crate::pdo_maps::RX_B,
-    &crate::pdo_maps::TX_A,
-    &crate::pdo_maps::TX_B,
-];
-
-const fn offsets() -> ([u16; COUNT], usize) {
-    let mut out = [0u16; COUNT];
-    let mut placed = [false; COUNT];
-    let mut at = 0usize;
-    // first the objects of the standard layout, in its order
-    let mut l = 0;
-    while l < PROCESS_ORDER.len() {
-        // l < PROCESS_ORDER.len() (compile-time evaluation)
-        #[allow(clippy::indexing_slicing)]
-        let mut list = PROCESS_ORDER[l];
-        while let [entry, rest @ ..] = list {
-            let i = table_position(entry.index);
-            // i < COUNT (compile-time evaluation)
-            #[allow(clippy::indexing_slicing)]
-            if i < COUNT && !placed[i] {
-                placed[i] = true;
-                out[i] = at as u16;
-                at += TABLE[i].declared_ram_bytes();
-            }
-            list = rest;
-        }
-        l += 1;
-    }
-    // then every other object in table order
-    let mut i = 0;
-    while i < COUNT {
-        // i < COUNT (compile-time evaluation)
-        #[allow(clippy::indexing_slicing)]
-        if !placed[i] {
-            out[i] = at as u16;
-            at += TABLE[i].declared_ram_bytes();
-        }
-        i += 1;
-    }
-    assert!(at <= u16::MAX as usize, "RAM image too large for u16 offsets");
-    (out, at)
-}
-
-/// [`offsets`] evaluated once.
-const LAYOUT: ([u16; COUNT], usize) = offsets();
-
-/// Size of the RAM image in bytes.
-pub const IMAGE_BYTES: usize = LAYOUT.1;
-
-/// Byte offset in the RAM image of the values of the object at `index`
-/// (0 when it has none), computed at compile time.
-pub const fn image_offset(index: u16) -> usize {
-    let i = table_position(index);
-    if i < COUNT {
-        // i < COUNT (compile-time evaluation)
-        #[allow(clippy::indexing_slicing)]
-        return LAYOUT.0[i] as usize;
-    }
-    0
-}
-
-/// Position of the object `index` in [`TABLE`] (`COUNT` when there is none),
-/// for the compile-time layout.
-const fn table_position(index: u16) -> usize {
-    let mut i = 0;
-    while i < COUNT {
-        // i < COUNT (compile-time evaluation)
-        #[allow(clippy::indexing_slicing)]
-        if TABLE[i].info.index == index {
-            return i;
-        }
-        i += 1;
-    }
-    COUNT
-}
-
-/// Byte offset of each object's values in the RAM image (objects with
-/// [`Value::Ram`] / [`Value::Live`]; entries follow each other in subindex
-/// order, each [`DataType::bytes`] long).
-pub static OFFSETS: [u16; COUNT] = LAYOUT.0;
-
 const fn put(image: &mut [u8; IMAGE_BYTES], at: usize, v: i64, n: usize) {
     let b = v.to_le_bytes();
     let mut k = 0;
@@ -640,7 +554,7 @@ const fn put(image: &mut [u8; IMAGE_BYTES], at: usize, v: i64, n: usize) {
 /// for the image the dictionary writes at start (not in the firmware image).
 pub const INITIAL_IMAGE: [u8; IMAGE_BYTES] = {
     let mut image = [0u8; IMAGE_BYTES];
-    let (offs, _) = LAYOUT;
+    let offs = LAYOUT.0;
     let mut i = 0;
     while i < COUNT {
         // i < COUNT (compile-time evaluation)

@@ -247,13 +247,13 @@ fn e034_copy_program_equals_the_entry_copy() {
         let frames = [frame(rx, 201), frame(rx, 201), frame(rx, 7), frame(rx - 3, 90)];
         program_equals_entry_copy(&img, &objects, &frames, &std::format!("{layout:?}"));
     }
-    // standard: the RAM image holds the layout's values in its order
-    // (objects::PROCESS_ORDER), so axis A's TxPDO is two runs, 6041h..60FDh
-    // (21 bytes: 8 + 8 + 4 + 1) and 60E4h:01..A67 (8 bytes; 60E4h's count
-    // lies between them in RAM): 5 copies for its 10 entries; both axes'
-    // (axis B's values follow A's) 10 copies for 20 entries, and the
-    // RxPDO's 16 entries 10 copies (6040h; 607Ah..6071h in two of 8; 6060h;
-    // the configuration entry 60FEh:01 on its own)
+    // standard: each axis' block of the RAM image holds the layout's values
+    // in its order (objects::layout), so axis A's TxPDO is two runs,
+    // 6041h..60FDh (21 bytes: 8 + 8 + 4 + 1) and 60E4h:01..A67 (8 bytes;
+    // 60E4h's count lies between them in RAM): 5 copies for its 10 entries;
+    // both axes' (axis B's in its own block, the same runs) 10 copies for 20
+    // entries, and the RxPDO's 16 entries 10 copies (6040h; 607Ah..6071h in
+    // two of 8; 6060h; the configuration entry 60FEh:01 on its own)
     let mut objects = DriveObjects::new();
     objects.apply_map(PdoLayout::Standard).unwrap();
     let ops =
