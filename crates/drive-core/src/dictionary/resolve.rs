@@ -136,9 +136,10 @@ pub(super) const CONST_FLAG: u32 = 0x80;
 /// Type-code flag of a configuration entry.
 pub(super) const CONFIG_FLAG: u32 = 0x40;
 
-/// Set-points the control cycle reads every cycle (axis-A indices; axis B
-/// at +800h / +8000h): writes to them are not configuration changes.
-pub(super) const CYCLIC_SETPOINTS: [u16; 14] = [
+/// Set-points the control cycle reads every cycle and the process outputs
+/// a master writes every cycle (axis-A indices; axis B at +800h / +8000h):
+/// writes to them are not configuration changes.
+pub(super) const CYCLIC_SETPOINTS: [u16; 15] = [
     0x6040,
     0x6060,
     0x607A,
@@ -150,6 +151,10 @@ pub(super) const CYCLIC_SETPOINTS: [u16; 14] = [
     0x6042,
     0x60B8,
     parameter_index(8, 210),
+    // digital outputs (standard RxPDO, C-130): a process output, which no
+    // snapshot reads; as configuration, a master changing them every frame
+    // would reconfigure both axes every cycle (issue 36)
+    0x60FE,
     // the record window, start number and override (written cyclically by
     // a telegram; the axis reads them at a start, not every cycle)
     crate::objects::records::J401,

@@ -253,7 +253,8 @@ fn e034_copy_program_equals_the_entry_copy() {
     // 60E4h's count lies between them in RAM): 5 copies for its 10 entries;
     // both axes' (axis B's in its own block, the same runs) 10 copies for 20
     // entries, and the RxPDO's 16 entries 10 copies (6040h; 607Ah..6071h in
-    // two of 8; 6060h; the configuration entry 60FEh:01 on its own)
+    // two of 8; 6060h; 60FEh:01 on its own, 60FEh's count lying before it in
+    // RAM; no configuration entry, C-130)
     let mut objects = DriveObjects::new();
     objects.apply_map(PdoLayout::Standard).unwrap();
     let ops =
@@ -264,11 +265,11 @@ fn e034_copy_program_equals_the_entry_copy() {
     assign(&mut objects, 0x1C13, &[0x1A00, 0x1A01]);
     let img = PdoImage::compile(&objects).unwrap();
     assert_eq!(ops(&img.tx.program), [2, 0, 2, 6, 0]);
-    assert_eq!(ops(&img.rx.program), [2, 2, 0, 4, 2]);
+    assert_eq!(ops(&img.rx.program), [2, 2, 2, 4, 0]);
     assert_eq!((img.tx.entries().len(), img.rx.entries().len()), (20, 16));
 
     // gaps, configuration entries of 1, 2 and 4 bytes (6065h, 60C2h:02,
-    // 605Ah; 6060h and 60FEh:01 of 1601h), an entry off byte boundaries,
+    // 605Ah; set-points 6060h and 60FEh:01 of 1601h), an entry off byte boundaries,
     // a string, and adjacent entries (60B1h, 60B2h)
     let mut objects = DriveObjects::new();
     map(
@@ -324,7 +325,11 @@ fn e034_copy_program_equals_the_entry_copy() {
         .iter()
         .map(|op| op.width())
         .collect::<Vec<_>>();
-    assert_eq!(config_ops, [4, 1, 2, 4], "6065h, 60C2h:02, 605Ah, 60FEh:01");
+    assert_eq!(
+        config_ops,
+        [4, 1, 2],
+        "6065h, 60C2h:02, 605Ah (60FEh:01 is none, C-130)"
+    );
     let rx = img.rx.bytes();
     assert_eq!(rx, 2 + 1 + 4 + 1 + 2 + 3 + 4 + 4 + 2 + 2 + 1 + 4 + 16);
     let (first, other) = (frame(rx, 201), frame(rx, 202));
@@ -338,14 +343,15 @@ fn e034_copy_program_equals_the_entry_copy() {
     ];
     program_equals_entry_copy(&img, &objects, &frames, "mixed");
     // the configuration generation: the same values again are no change,
-    // other values of the five configuration entries are five
+    // other values of the four configuration entries (the three above and
+    // the string E72) are four
     let mut a = objects.clone();
     img.apply_outputs(&first, &mut a);
     let generation = a.config_generation();
     assert_eq!(img.apply_outputs(&first, &mut a), 12);
     assert_eq!(a.config_generation(), generation, "same values");
     img.apply_outputs(&other, &mut a);
-    assert_eq!(a.config_generation(), generation.wrapping_add(5), "other values");
+    assert_eq!(a.config_generation(), generation.wrapping_add(4), "other values");
     assert_eq!(
         a.get(0x6065, 0),
         Ok(i64::from(u32::from_le_bytes(other[3..7].try_into().unwrap())))
@@ -365,6 +371,52 @@ fn e034_copy_program_equals_the_entry_copy() {
         a.get(0x6040, 0),
         Ok(i64::from(u16::from_le_bytes([6 * 37 + 1, (7 * 37 + 1) as u8])))
     );
+}
+
+/// C-130 with issue 36: the standard RxPDO's digital outputs (60FEh:01,
+/// 68FEh:01) are a process output the master may change every frame, not
+/// a configuration entry: a frame that changes them (and only them) moves
+/// neither the dictionary's nor either axis' configuration generation
+/// (which would make both axes read their whole snapshot and configure
+/// again in the next control cycle), and the value is stored; a frame that
+/// changes the modes of operation or the target position moves neither as
+/// well, while a mapped parameter (6065h) still does.
+#[test]
+fn c130_digital_outputs_in_the_rxpdo_are_no_configuration_change() {
+    let mut objects = DriveObjects::new();
+    objects.apply_map(PdoLayout::Standard).unwrap();
+    assign(&mut objects, 0x1C12, &[0x1600, 0x1601]);
+    let img = PdoImage::compile(&objects).unwrap();
+    let generations = |o: &DriveObjects| {
+        (
+            o.config_generation(),
+            o.axis_config_generation(0),
+            o.axis_config_generation(1),
+        )
+    };
+    let mut rx = std::vec![0u8; img.rx.bytes()];
+    img.apply_outputs(&rx, &mut objects);
+    let before = generations(&objects);
+    for (k, value) in [0x0000_0001u32, 0x8000_0000, 0x0001_0000].into_iter().enumerate() {
+        // 60FEh:01 at bytes 19..23 of axis A's 23, 68FEh:01 at 42..46
+        rx[19..23].copy_from_slice(&value.to_le_bytes());
+        rx[42..46].copy_from_slice(&(!value).to_le_bytes());
+        rx[3..7].copy_from_slice(&(k as i32 * 1000).to_le_bytes());
+        img.apply_outputs(&rx, &mut objects);
+        assert_eq!(objects.get(0x60FE, 1), Ok(i64::from(value)));
+        assert_eq!(objects.get(0x68FE, 1), Ok(i64::from(!value)));
+        assert_eq!(generations(&objects), before, "frame {k}");
+    }
+    // a mapped parameter is still configuration
+    let mut objects = DriveObjects::new();
+    map(&mut objects, 0x1600, &[m(0x60FE, 1, 32), m(0x6065, 0, 32)]);
+    assign(&mut objects, 0x1C12, &[0x1600]);
+    let img = PdoImage::compile(&objects).unwrap();
+    let before = generations(&objects);
+    img.apply_outputs(&[1, 0, 0, 0, 0x10, 0x27, 0, 0], &mut objects);
+    assert_eq!(objects.get(0x6065, 0), Ok(10_000));
+    let after = generations(&objects);
+    assert!(after.0 != before.0 && after.1 != before.1, "{before:?} {after:?}");
 }
 
 #[test]
