@@ -336,9 +336,10 @@ impl Cascade {
 
     /// Runs one control cycle of `dt_ns` ns.
     pub fn cycle(&mut self, input: &CascadeInput, dt_ns: u32) -> CascadeOutput {
-        let cfg = self.config;
         let dt_s = dt_ns as f32 * 1e-9;
         let actual_velocity = self.actual_velocity(input, dt_ns, dt_s);
+        // borrowed, not copied (the whole configuration, every cycle)
+        let cfg = &self.config;
 
         let mut velocity_limited = false;
         let mut speed_limited = false;
@@ -412,7 +413,7 @@ impl Cascade {
                 let proportional = kp * error_rad_per_s;
                 let feedforward = finite_or_zero(input.torque_nm)
                     + cfg.inertia_kg_m2 * acceleration * RAD_PER_INCREMENT
-                    + friction_feedforward(&cfg, v_ref);
+                    + friction_feedforward(cfg, v_ref);
                 let unsaturated = proportional + self.integral_nm + feedforward;
 
                 // Anti-windup: conditional integration (no integration further
