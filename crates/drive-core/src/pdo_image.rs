@@ -45,6 +45,14 @@
 //! results are those of the per-entry copy, byte for byte and configuration
 //! change for configuration change.
 //!
+//! The standard layout (the defaults of 1600h/1601h, 1A00h/1A01h, of axis A
+//! or of both axes, in that order) needs no program: its values lie in two
+//! runs per axis at compile-time places of the axis' block of the RAM image
+//! (`objects::layout`), so `compile` recognises it (`standard.rs`) and the
+//! copy is straight-line loads and stores at constant offsets
+//! ([`DriveObjects`]' `copy_in_standard`/`copy_out_standard`), the same
+//! bytes the program would move.
+//!
 //! Subindices: a mapping entry names its object in the subindex numbering of
 //! the active template (as the mapping check does); the table holds the
 //! runtime ("EtherCAT Rx SDO Info") numbering of [`DriveObjects::get`] and
@@ -323,6 +331,10 @@ struct Program {
     whole_len: usize,
     /// Entries (not gaps) outside the program: copied one by one after it.
     others: bool,
+    /// The channel is exactly the standard layout of this many axes (1 or
+    /// 2; 0: another mapping): the straight-line copy stands for the
+    /// program (`standard.rs`).
+    standard: u8,
 }
 
 impl Program {
@@ -333,14 +345,15 @@ impl Program {
         min_len: usize::MAX,
         whole_len: usize::MAX,
         others: false,
+        standard: 0,
     };
 
     /// Makes `p` the program of `entries`, an image of `bytes` bytes; RxPDO
     /// configuration entries (`rx`) go to a group of their own. In place:
     /// the caller's frame holds two channels already.
     fn build(p: &mut Self, entries: &[ImageEntry], bytes: usize, rx: bool, objects: &DriveObjects) {
-        (p.groups, p.entries, p.min_len, p.whole_len, p.others) =
-            ([(0, 0); GROUPS], 0, usize::MAX, usize::MAX, false);
+        (p.groups, p.entries, p.min_len, p.whole_len, p.others, p.standard) =
+            ([(0, 0); GROUPS], 0, usize::MAX, usize::MAX, false, 0);
         if rx && stores_overlap(entries, objects) {
             return;
         }
@@ -390,6 +403,7 @@ impl Program {
         if !p.others && covered == bytes {
             p.whole_len = bytes;
         }
+        p.standard = standard::standard_axes(entries, bytes, rx);
     }
 
     /// Whether the program serves byte slices of the image's length.
@@ -602,7 +616,11 @@ impl PdoImage {
         if rx_bytes.len() < p.min_len {
             return self.rx.apply_each(rx_bytes, objects);
         }
-        p.copy_in(rx_bytes, objects);
+        if p.standard > 0 {
+            objects.copy_in_standard(rx_bytes, p.standard);
+        } else {
+            p.copy_in(rx_bytes, objects);
+        }
         let mut written = p.entries;
         if p.others {
             for e in self.rx.entries().iter().filter(|e| e.slot.is_none()) {
@@ -624,7 +642,11 @@ impl PdoImage {
         if tx_bytes.len() != p.whole_len {
             tx_bytes.fill(0);
         }
-        p.copy_out(objects, tx_bytes);
+        if p.standard > 0 {
+            objects.copy_out_standard(tx_bytes, p.standard);
+        } else {
+            p.copy_out(objects, tx_bytes);
+        }
         if p.others {
             for e in self.tx.entries().iter().filter(|e| e.slot.is_none()) {
                 fill_entry(e, objects, tx_bytes);
@@ -693,5 +715,6 @@ fn insert(dst: &mut [u8], offset: usize, bits: usize, value: &[u8; 8]) {
     }
 }
 
+mod standard;
 #[cfg(test)]
 mod tests;

@@ -24,6 +24,7 @@ mod records;
 mod resolve;
 mod scaling;
 mod slot;
+mod standard;
 
 pub use mapping::scope_mappable;
 pub use persist::{ImageError, PERSISTENT_IMAGE_BYTES};

@@ -300,3 +300,69 @@ pub(crate) mod cycle {
     pub const E49_FIELD: CycleField<u8> = field(E49, 0, U8);
     pub const A67_FIELD: CycleField<u16> = field(A67, 0, U16);
 }
+
+/// A run of the standard PDO layout of one axis: `len` bytes that lie at
+/// `ram` in the axis' block and at `img` in the axis' part of the process
+/// image, entries adjacent in both.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub(crate) struct Run {
+    pub ram: usize,
+    pub img: usize,
+    pub len: usize,
+}
+
+/// The two runs of `entries` (axis A's standard RxPDO or TxPDO) in the axis
+/// block, and the bytes of the axis' image; a compile error unless there are
+/// exactly two runs.
+const fn two_runs(entries: &[od::PdoEntry]) -> (Run, Run, usize) {
+    let empty = Run {
+        ram: 0,
+        img: 0,
+        len: 0,
+    };
+    let (mut first, mut second, mut count) = (empty, empty, 0);
+    let mut img = 0;
+    let mut rest = entries;
+    while let [e, tail @ ..] = rest {
+        let n = e.data_type.bytes();
+        let ram = match entry_offset(e.index, e.sub, e.data_type) {
+            Some(at) => at,
+            None => usize::MAX,
+        };
+        assert!(
+            ram != usize::MAX && ram + n <= AXIS_BLOCK,
+            "a standard entry lies in axis A's block"
+        );
+        let open = if count == 1 { first } else { second };
+        if count > 0 && open.ram + open.len == ram && open.img + open.len == img {
+            if count == 1 {
+                first.len += n;
+            } else {
+                second.len += n;
+            }
+        } else {
+            count += 1;
+            let run = Run { ram, img, len: n };
+            if count == 1 {
+                first = run;
+            } else {
+                second = run;
+            }
+        }
+        img += n;
+        rest = tail;
+    }
+    assert!(
+        count == 2,
+        "the standard layout of an axis is two runs in its block"
+    );
+    (first, second, img)
+}
+
+/// Axis A's standard RxPDO (1600h's default) in its block: 6040h … 6071h
+/// and 60FEh:01 (60FEh's count lies between them in RAM), and its bytes.
+pub(crate) const RX_RUNS: (Run, Run, usize) = two_runs(&crate::pdo_maps::RX_A);
+
+/// Axis A's standard TxPDO (1A00h's default) in its block: 6041h … 60FDh
+/// and 60E4h:01 … A67 (60E4h's count between them), and its bytes.
+pub(crate) const TX_RUNS: (Run, Run, usize) = two_runs(&crate::pdo_maps::TX_A);

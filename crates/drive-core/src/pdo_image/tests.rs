@@ -373,6 +373,70 @@ fn e034_copy_program_equals_the_entry_copy() {
     );
 }
 
+/// E-034 with issue 36: the standard layout of axis A alone and of both
+/// axes is recognised in both directions, and its straight-line copy moves
+/// what the per-entry copy does (the objects after RxPDO frames of several
+/// lengths, the TxPDO bytes); the same PDOs in another order, the standard
+/// PDO with an entry more, or one entry of another object are not
+/// recognised and copy through the program, as before.
+#[test]
+fn e034_standard_layout_copies_straight_as_the_entry_copy() {
+    let cases: [(&[u16], &[u16], u8); 4] = [
+        (&[0x1600], &[0x1A00], 1),
+        (&[0x1600, 0x1601], &[0x1A00, 0x1A01], 2),
+        (&[0x1601, 0x1600], &[0x1A01, 0x1A00], 0),
+        (&[0x1601], &[0x1A01], 0),
+    ];
+    for (rx_pdos, tx_pdos, axes) in cases {
+        let mut objects = DriveObjects::new();
+        objects.apply_map(PdoLayout::Standard).unwrap();
+        assign(&mut objects, 0x1C12, rx_pdos);
+        assign(&mut objects, 0x1C13, tx_pdos);
+        let img = PdoImage::compile(&objects).unwrap();
+        let label = std::format!("{rx_pdos:04X?}");
+        assert_eq!(
+            (img.rx.program.standard, img.tx.program.standard),
+            (axes, axes),
+            "{label}"
+        );
+        let rx = img.rx.bytes();
+        let frames = [frame(rx, 3), frame(rx, 90), frame(rx + 5, 11), frame(rx - 1, 4)];
+        program_equals_entry_copy(&img, &objects, &frames, &label);
+    }
+    // the standard PDO with an entry more, or one entry of another object
+    for entries in [
+        &[
+            m(0x6040, 0, 16),
+            m(0x6060, 0, 8),
+            m(0x607A, 0, 32),
+            m(0x60FF, 0, 32),
+            m(0x60B1, 0, 32),
+            m(0x60B2, 0, 16),
+            m(0x6071, 0, 16),
+            m(0x60FE, 1, 32),
+            m(0x6072, 0, 16),
+        ][..],
+        &[
+            m(0x6040, 0, 16),
+            m(0x6060, 0, 8),
+            m(0x607A, 0, 32),
+            m(0x60FF, 0, 32),
+            m(0x60B1, 0, 32),
+            m(0x60B2, 0, 16),
+            m(0x6071, 0, 16),
+            m(0x60FE, 2, 32),
+        ][..],
+    ] {
+        let mut objects = DriveObjects::new();
+        map(&mut objects, 0x1600, entries);
+        assign(&mut objects, 0x1C12, &[0x1600]);
+        let img = PdoImage::compile(&objects).unwrap();
+        assert_eq!(img.rx.program.standard, 0, "{entries:08X?}");
+        let rx = img.rx.bytes();
+        program_equals_entry_copy(&img, &objects, &[frame(rx, 5), frame(rx, 6)], "other");
+    }
+}
+
 /// C-130 with issue 36: the standard RxPDO's digital outputs (60FEh:01,
 /// 68FEh:01) are a process output the master may change every frame, not
 /// a configuration entry: a frame that changes them (and only them) moves
