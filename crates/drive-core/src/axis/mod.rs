@@ -505,7 +505,6 @@ impl Axis {
         new_setpoint: bool,
     ) -> AxisReport {
         let generation = od.axis_config_generation(usize::from(self.window.axis));
-        let slots = cache::slots_of(&mut cache.slots, od, self.window);
         let cached: &CachedSnapshot = match &mut cache.snapshot {
             Some(cached) if cached.generation == generation => {
                 cached.snapshot.refresh_setpoints(od, self.window.axis);
@@ -524,6 +523,8 @@ impl Axis {
         };
         let key = self.config_key(generation, dt_ns);
         if self.configured != Some(key) {
+            // the slots only configure uses, resolved on its first run
+            let slots = cache::slots_of(&mut cache.slots, od, self.window);
             self.configure(od, slots, o, dt_ns);
             self.configured = Some(key);
         }
