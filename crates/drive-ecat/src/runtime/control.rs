@@ -51,21 +51,27 @@ impl<F: Flash, B: Flash> Drive<F, B> {
         } else {
             AxisCommand::OFF
         };
-        // a running motor action (B42/B49) replaces the axis' command
-        let e48 = drive_core::axis::e48;
-        let a = match self.actions.control(0, e48(axis_a.state()), io_a) {
-            Some(cmd) => {
-                axis_a.overridden();
-                cmd
-            }
-            None => a,
-        };
-        let b = match self.actions.control(1, e48(axis_b.state()), io_b) {
-            Some(cmd) => {
-                axis_b.overridden();
-                cmd
-            }
-            None => b,
+        // a running motor action (B42/B49) replaces the axis' command (both
+        // looks skipped while none runs, as on PROFINET)
+        let (a, b) = if self.actions.measuring() {
+            let e48 = drive_core::axis::e48;
+            let a = match self.actions.control(0, e48(axis_a.state()), io_a) {
+                Some(cmd) => {
+                    axis_a.overridden();
+                    cmd
+                }
+                None => a,
+            };
+            let b = match self.actions.control(1, e48(axis_b.state()), io_b) {
+                Some(cmd) => {
+                    axis_b.overridden();
+                    cmd
+                }
+                None => b,
+            };
+            (a, b)
+        } else {
+            (a, b)
         };
         let register = axis_a.error_register() | axis_b.error_register();
         write_slot(&mut self.objects, self.slots.error_register, i64::from(register));
