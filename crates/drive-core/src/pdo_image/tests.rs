@@ -404,29 +404,14 @@ fn e034_standard_layout_copies_straight_as_the_entry_copy() {
         program_equals_entry_copy(&img, &objects, &frames, &label);
     }
     // the standard PDO with an entry more, or one entry of another object
-    for entries in [
-        &[
-            m(0x6040, 0, 16),
-            m(0x6060, 0, 8),
-            m(0x607A, 0, 32),
-            m(0x60FF, 0, 32),
-            m(0x60B1, 0, 32),
-            m(0x60B2, 0, 16),
-            m(0x6071, 0, 16),
-            m(0x60FE, 1, 32),
-            m(0x6072, 0, 16),
-        ][..],
-        &[
-            m(0x6040, 0, 16),
-            m(0x6060, 0, 8),
-            m(0x607A, 0, 32),
-            m(0x60FF, 0, 32),
-            m(0x60B1, 0, 32),
-            m(0x60B2, 0, 16),
-            m(0x6071, 0, 16),
-            m(0x60FE, 2, 32),
-        ][..],
-    ] {
+    let standard: Vec<u32> = crate::pdo_maps::RX_A
+        .iter()
+        .map(|e| m(e.index, e.sub, e.data_type.bits() as u8))
+        .collect();
+    let (mut more, mut other) = (standard.clone(), standard.clone());
+    more.push(m(0x6072, 0, 16));
+    *other.last_mut().unwrap() = m(0x60FE, 2, 32);
+    for entries in [&more, &other] {
         let mut objects = DriveObjects::new();
         map(&mut objects, 0x1600, entries);
         assign(&mut objects, 0x1C12, &[0x1600]);
