@@ -87,7 +87,7 @@ from profinet.exceptions import DCPDeviceNotFoundError
 from profinet.util import ethernet_socket, get_mac, mac2s, s2mac
 
 from pnargs import device_arguments
-from pnctl import Records, tx_checksum_offload_off
+from pnctl import Records, cyclic_setup, quiet_collector, real_time, tx_checksum_offload_off
 from steps import failures, report, run, verdict
 
 
@@ -423,11 +423,13 @@ def main():
     # (h) cyclic data at 1 ms through the profile's telegrams; (i) a drive
     # fault as a diagnosis alarm; (j) the controller goes silent
     def cyclic():
-        # 1 ms = send clock 32 x 31.25 us, reduction ratio 1: profinet-py's
-        # CyclicController refuses anything shorter. The watchdog (and data
-        # hold) at 50 cycles keeps a Python sender's scheduling gaps on a
-        # shared machine from ending the AR.
-        setup = IOCRSetup(slots=slots, reduction_ratio=1, watchdog_factor=50, data_hold_factor=50)
+        # 1 ms, profinet-py's shortest cycle (pnctl.cyclic_setup). Python's
+        # full collections held the sender for up to 110 ms and ended the AR
+        # (pnctl.quiet_collector); as in fb.py, the watchdog and data hold are
+        # 100 cycles and the threads run at a real-time priority below serve's.
+        quiet_collector()
+        print(f"  controller threads: {real_time()}", flush=True)
+        setup = cyclic_setup(slots, watchdog=100)
         out_slot = next(s for s in slots if s.output_length > 0)
         in_slot = next(s for s in slots if s.input_length > 0)
         n = min(out_slot.output_length, in_slot.input_length)
