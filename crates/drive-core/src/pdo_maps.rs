@@ -3,7 +3,7 @@
 //! (spec §5.4, cia402.md §6.5). The mapping objects' defaults and the
 //! EtherCAT device description both derive from them.
 
-use crate::{parameter_index, AXIS_B_CIA402, AXIS_B_MANUFACTURER};
+use crate::parameter_index;
 use od::{DataType, PdoEntry};
 
 /// Axis-A RxPDO entries (spec §5.4, 23 bytes): the default of 1600h.
@@ -143,11 +143,7 @@ const fn axis_b<const N: usize>(a: [PdoEntry; N]) -> [PdoEntry; N] {
         // N is the array's length: compile-time evaluation, no run-time index.
         #[allow(clippy::indexing_slicing)]
         let e = &mut b[i];
-        e.index += if e.index >= 0x6000 {
-            AXIS_B_CIA402
-        } else {
-            AXIS_B_MANUFACTURER
-        };
+        e.index = crate::objects::axis_b_index(e.index);
         i += 1;
     }
     b

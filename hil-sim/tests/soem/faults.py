@@ -6,8 +6,8 @@ Run by `hil-sim/tests/soem.rs` as root inside the master's network namespace
 (or by hand against any `serve --slaves N`). It builds on line.py's master
 and soak.py's mapping (imported from beside this file): scan, A258 and 6065h
 written in Pre-Op, both axes' PDOs assigned, DC SYNC0 1 ms with the master's
-cycle aligned to the reference clock (line.py's Cycle: SOEM's ec_sync PI),
-Safe-Op, Op, axis A of every drive enabled in profile velocity (pv, target
+cycle aligned to the reference clock (soem_cycle.py's Cycle through line:
+SOEM's ec_sync PI), Safe-Op, Op, axis A of every drive enabled in profile velocity (pv, target
 velocity 0: no cyclic set-point, so I423's extrapolation limit, C-117, does
 not apply), axis B left in Switch on disabled.
 
@@ -121,7 +121,7 @@ def per_drive(texts):
     return "; ".join(f"drive {i + 1}: {t}" for i, t in enumerate(texts))
 
 
-# --- SDO with SOEM's repetition (line.py's attempt) --------------------------
+# --- SDO with SOEM's repetition (soem_mailbox.py's attempt) -----------------
 
 
 def sdo_bytes(m, i, index, sub):
@@ -187,7 +187,7 @@ def drive_words(m, i, emcys, between=lambda: None, since=None):
 
 
 class Cycle(L.Cycle):
-    """line.py's cycle that also keeps, by the drives' clock (the DC time a
+    """soem_cycle.py's cycle that also keeps, by the drives' clock (the DC time a
     frame carries back), the longest time between two frames that came back
     since `watch()`."""
 

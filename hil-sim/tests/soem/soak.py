@@ -8,7 +8,8 @@ against any `serve` (`--seconds` for runs of hours). It builds on line.py's
 master (imported from beside this file): scan, both axes' PDOs assigned (a
 short map per axis: 6040h/6060h/607Ah out, 6041h/6061h/6064h/60F4h/606Ch/
 603Fh in, +800h for axis B), DC SYNC0 1 ms with the master's cycle aligned to
-the reference clock (line.py's Cycle: SOEM's ec_sync PI), Safe-Op, Op, the
+the reference clock (soem_cycle.py's Cycle through line: SOEM's ec_sync
+PI), Safe-Op, Op, the
 CiA 402 enable of every axis in csp, then for --seconds every axis moves
 back and forth on a slow sine of its own from where it was enabled, A (1 −
 cos(2 pi t / T)) (A = --amplitude rev, axis k of 2N with T = --period x (1 + k /

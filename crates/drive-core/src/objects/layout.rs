@@ -64,7 +64,8 @@ const fn pdo_indices<const N: usize>(entries: &[od::PdoEntry; N]) -> [u16; N] {
 }
 
 /// Axis B's index of the per-axis object `index` (axis-A numbering): CiA 402
-/// objects +800h, manufacturer parameters +8000h (as `pdo_maps` numbers them).
+/// objects +800h, manufacturer parameters +8000h (`pdo_maps` numbers axis B's
+/// PDO entries with it).
 pub(crate) const fn axis_b_index(index: u16) -> u16 {
     if index >= 0x6000 {
         index.wrapping_add(crate::AXIS_B_CIA402)

@@ -77,7 +77,7 @@ mod shorthand;
 pub mod single;
 pub mod stage;
 
-pub(crate) use layout::{cycle, Run, LAYOUT, RX_RUNS, TX_RUNS};
+pub(crate) use layout::{axis_b_index, cycle, Run, LAYOUT, RX_RUNS, TX_RUNS};
 pub use layout::{image_offset, CycleField, AXIS_BLOCK, IMAGE_BYTES, OFFSETS};
 pub use pack::{EntryRecord, ENTRY_TABLE};
 
