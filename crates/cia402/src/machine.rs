@@ -256,6 +256,9 @@ pub struct DeviceControl {
     stop: Option<Stopping>,
     pending_fault: Option<FaultEvent>,
     fault: Option<FaultEvent>,
+    /// The inputs and outputs of the last step when that step was a fixed
+    /// point (see [`DeviceControl::step`]); `None` otherwise.
+    settled: Option<(Inputs, Outputs)>,
 }
 
 impl DeviceControl {
@@ -272,6 +275,7 @@ impl DeviceControl {
             stop: None,
             pending_fault: None,
             fault: None,
+            settled: None,
         }
     }
 
@@ -292,6 +296,7 @@ impl DeviceControl {
 
     /// The configuration, for OD writes to the option codes, A44 and 6502h.
     pub fn options_mut(&mut self) -> &mut Options {
+        self.settled = None;
         &mut self.options
     }
 
@@ -326,7 +331,27 @@ impl DeviceControl {
 
     /// One control cycle: decodes the controlword, takes at most one transition, updates
     /// the mode and returns the outputs. `now` is a monotonic time in ns.
+    ///
+    /// A step that took no transition (a fault taken is T13) and left no stop running ends
+    /// in a state the same inputs keep: the edges of the fault-reset bit and of A60 are
+    /// gone, a mode switch or a brake release it made is done, and `now` enters only a
+    /// running stop or a transition. Its outputs were computed from that state, so the
+    /// next step with equal inputs, no fault raised and no option changed in between
+    /// returns them without running the machine (issue 36: the cycle while the master's
+    /// commands stand).
     pub fn step(&mut self, inp: &Inputs, now: Nanos) -> Outputs {
+        if let Some((last, out)) = &self.settled {
+            if self.pending_fault.is_none() && last == inp {
+                return *out;
+            }
+        }
+        let out = self.step_machine(inp, now);
+        let settled = out.transition.is_none() && self.stop.is_none();
+        self.settled = if settled { Some((*inp, out)) } else { None };
+        out
+    }
+
+    fn step_machine(&mut self, inp: &Inputs, now: Nanos) -> Outputs {
         let cw = inp.controlword;
         let reset_bit = cw & CW_FAULT_RESET != 0;
         let reset_edge = reset_bit && !self.prev_fault_reset;
@@ -693,3 +718,7 @@ impl DeviceControl {
         }
     }
 }
+
+#[cfg(test)]
+#[path = "machine_settled_tests.rs"]
+mod settled_tests;
