@@ -150,11 +150,20 @@ if lines_wanted and window:
     top_dir = elf.split('/firmware/target/')[0] + '/'
     for a, row in zip(addrs, out.splitlines()):
         frames = json.loads(row).get('Symbol') or []
-        where = '?'
+        where = None
         for f in frames:
             if f['FileName'].startswith(top_dir + 'crates/'):
                 where = f"{f['FileName'][len(top_dir):]}:{f['Line']}"
                 break
+        if where is None:
+            # outside crates/: the firmware's own code by line, anything
+            # else (core, compiler-builtins, the runtime) by function
+            f = frames[-1] if frames else {}
+            fname = f.get('FileName', '')
+            if fname.startswith(top_dir):
+                where = f"{fname[len(top_dir):]}:{f.get('Line', 0)}"
+            else:
+                where = f"? {f.get('FunctionName', '')[:80]}"
         per_line[where] += per_ins[a]
     total = max(sum(per_line.values()), 1)
     print(f'== {t}: the {lines_wanted} costliest source lines per run (innermost frame in crates/)')
