@@ -122,7 +122,11 @@ fn c002_c017_c018_settled_steps_equal_the_machine_run_every_step() {
         if rng.chance(2) {
             let event = FaultEvent {
                 code: 0x7300,
-                reaction: if rng.chance(300) { Some(FaultReaction::Coast) } else { None },
+                reaction: if rng.chance(300) {
+                    Some(FaultReaction::Coast)
+                } else {
+                    None
+                },
             };
             kept.raise_fault(event);
             full.raise_fault(event);
@@ -144,5 +148,8 @@ fn c002_c017_c018_settled_steps_equal_the_machine_run_every_step() {
     }
     assert!(reused > 100_000, "only {reused} kept steps");
     // every state but Not ready to switch on, left in the first step (T1)
-    assert!(states.iter().filter(|&&s| s).count() >= 7, "states reached: {states:?}");
+    assert!(
+        states.iter().filter(|&&s| s).count() >= 7,
+        "states reached: {states:?}"
+    );
 }
