@@ -112,7 +112,7 @@ fn cyclic_slots_resolve_every_entry_on_both_axes() {
     }
 }
 
-/// Issue 36 (the cycle's values at fixed places): every cycle field is,
+/// C-134 and issue 36 (the cycle's values at fixed places): every cycle field is,
 /// on both axes, the entry the dictionary resolves for its index and
 /// subindex (aliases followed), at the field's offset in that axis' block
 /// and of the field's type; the fields the cycle writes are no
@@ -121,7 +121,7 @@ fn cyclic_slots_resolve_every_entry_on_both_axes() {
 /// the other way round. A layout that moved an entry out of its block, a
 /// wrong subindex or type, or a written entry that is configuration, fails.
 #[test]
-fn cycle_fields_are_the_slots_of_both_axes() {
+fn c134_cycle_fields_are_the_slots_of_both_axes() {
     use crate::axis::snapshot::Window;
     use crate::dictionary::SlotValue;
     use crate::objects::{cycle as f, CycleField, AXIS_BLOCK};

@@ -322,7 +322,7 @@ impl DriveObjects {
 
     /// Stores `value` in the cycle field `f` of axis `axis` (0 = A). The
     /// fields the cycle writes are actual values, never configuration
-    /// entries (`cycle_fields_are_the_slots_of_both_axes`), so no
+    /// entries (`c134_cycle_fields_are_the_slots_of_both_axes`), so no
     /// configuration change is noted.
     #[inline(always)]
     pub(crate) fn cycle_write<T: SlotValue>(&mut self, axis: u8, f: CycleField<T>, value: T) {
